@@ -1,0 +1,10 @@
+//! dynrt: turns a 3D scene into a real-time ray tracing processor after the SaarCOR DynRT
+//! prototype (Schmittler et al., Graphics Hardware 2004): synthesizable Verilog, testbenches,
+//! memory images and constraints, plus a bit-exact software golden model.
+//!
+//! Data flows one way (see DESIGN.md section 2):
+//! `scene -> accel -> layout -> model / hw -> emit -> sim -> compare`.
+//! `fp` (the number format) is shared by every stage; nothing here imports the CLI, and `hw`
+//! never imports `model` (they meet in tests).
+
+pub mod fp;
