@@ -110,6 +110,31 @@ impl Format {
         }
     }
 
+    /// Exactly rounded square root; sqrt(-0) = -0, negative operands give NaN.
+    pub fn sqrt(self, a: u32) -> u32 {
+        match self.unpack(a) {
+            Unpacked::NaN | Unpacked::Normal { sign: true, .. } | Unpacked::Inf { sign: true } => {
+                self.nan()
+            }
+            Unpacked::Zero { sign } => self.zero(sign),
+            Unpacked::Inf { sign: false } => self.infinity(false),
+            Unpacked::Normal { exp, sig, .. } => {
+                // value = sig * 2^q; make q even, then scale by 2^(2k) so the integer root has
+                // at least man_bits + 3 bits (round_pack's sticky contract).
+                let mut q = exp - self.man_bits as i32;
+                let mut radicand = u128::from(sig);
+                if q % 2 != 0 {
+                    radicand <<= 1;
+                    q -= 1;
+                }
+                let k = self.man_bits + 3;
+                radicand <<= 2 * k;
+                let root = isqrt(radicand);
+                self.round_pack(false, root, q / 2 - k as i32, root * root != radicand)
+            }
+        }
+    }
+
     /// IEEE `<`: false when either operand is NaN; -0 and +0 are equal.
     pub fn lt(self, a: u32, b: u32) -> bool {
         match (self.order_key(a), self.order_key(b)) {
@@ -211,6 +236,26 @@ impl Format {
             b
         }
     }
+}
+
+/// Floor of the square root, bit by bit.
+fn isqrt(n: u128) -> u128 {
+    let mut rem = n;
+    let mut root = 0u128;
+    let mut bit = 1u128 << 126;
+    while bit > n {
+        bit >>= 2;
+    }
+    while bit != 0 {
+        if rem >= root + bit {
+            rem -= root + bit;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
+    }
+    root
 }
 
 /// A binary operator of the `dynrt fp` command and of the hardware operator set.

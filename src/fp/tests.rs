@@ -124,6 +124,45 @@ fn e8m23_equals_binary32_with_ftz_on_a_million_random_vectors_per_op() {
 
 #[cfg(target_arch = "x86_64")]
 #[test]
+fn e8m23_sqrt_equals_the_machine_sqrt_with_ftz() {
+    println!("seed {SEED:#x}");
+    let f = Format::E8M23;
+    let mut words: Vec<u32> = random_pairs(f, SEED, 1_000_000)
+        .into_iter()
+        .map(|(a, _)| a)
+        .collect();
+    words.extend(edge_cases(f));
+    with_ftz_daz(|| {
+        for w in words {
+            let want = std::hint::black_box(f32::from_bits(w)).sqrt().to_bits();
+            let got = f.sqrt(w);
+            if f.is_nan(want) {
+                assert_eq!(got, f.nan(), "sqrt {w:08x}");
+            } else {
+                assert_eq!(got, want, "sqrt {w:08x}");
+            }
+        }
+    });
+}
+
+#[test]
+fn e5m10_sqrt_of_every_word_is_the_nearest_value() {
+    // Exhaustive. f64's sqrt is correctly rounded to 53 bits, and rounding that again to 11
+    // bits is innocuous for sqrt (53 >= 2*11 + 2), so it is an independent exact reference.
+    let f = Format::E5M10;
+    for w in 0..=0xffffu32 {
+        let x = f.to_f64(w);
+        let r = f.sqrt(w);
+        if x.is_nan() || x < 0.0 {
+            assert_eq!(r, f.nan(), "sqrt {w:04x}");
+            continue;
+        }
+        assert_eq!(r, f.from_f64(x.sqrt()), "sqrt {w:04x}");
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[test]
 fn e8m23_conversion_from_f64_equals_the_machine_cast_with_ftz() {
     use rand::{Rng, SeedableRng};
     println!("seed {SEED:#x}");
