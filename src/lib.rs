@@ -7,4 +7,6 @@
 //! `fp` (the number format) is shared by every stage; nothing here imports the CLI, and `hw`
 //! never imports `model` (they meet in tests).
 
+pub mod emit;
 pub mod fp;
+pub mod hw;
