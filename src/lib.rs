@@ -8,3 +8,5 @@
 //! never imports `model` (they meet in tests).
 
 pub mod fp;
+pub mod sim;
+pub mod synth;
