@@ -110,6 +110,35 @@ fn adder_in_verilator() {
 }
 
 #[test]
+fn one_verilator_build_runs_twice() {
+    let dir = tempfile::tempdir().unwrap();
+    let vectors = adder_vectors(11, 16);
+    let src = write_adder_bench(dir.path(), &vectors);
+    let job = SimJob::new(dir.path(), vec![src], "tb_adder")
+        .define("NVEC", Some("16".into()))
+        .verilator_build(VerilatorBuild::Fast);
+    let build = compile(Simulator::Verilator, &job).unwrap();
+    println!("verilator Fast build: {:.2} s", build.compile_seconds);
+    let want: String = vectors
+        .iter()
+        .map(|&(a, b)| format!("{:03x}\n", a as u32 + b as u32))
+        .collect();
+    for name in ["first.hex", "second.hex"] {
+        let run = build
+            .run(&[format!("out={name}")], Duration::from_secs(60))
+            .unwrap();
+        assert!(run.stdout.contains("DONE 16"), "{}", run.stdout);
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join(name)).unwrap(),
+            want
+        );
+    }
+    // Without +out= the testbench stops with $fatal: a run error, not a silent success.
+    let err = build.run(&[], Duration::from_secs(60)).unwrap_err();
+    assert!(err.to_string().contains("missing +out="), "{err}");
+}
+
+#[test]
 fn two_jobs_in_one_work_dir_get_separate_build_dirs() {
     let dir = tempfile::tempdir().unwrap();
     let vectors = adder_vectors(7, 8);
