@@ -9,4 +9,8 @@
 
 pub mod emit;
 pub mod fp;
+pub mod emit;
+pub mod fp;
 pub mod hw;
+pub mod sim;
+pub mod synth;
