@@ -9,8 +9,6 @@
 
 pub mod emit;
 pub mod fp;
-pub mod emit;
-pub mod fp;
 pub mod hw;
 pub mod sim;
 pub mod synth;

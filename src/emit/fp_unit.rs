@@ -102,19 +102,12 @@ pub fn fp_unit_rtl(op: BinOp, fmt: Format) -> Result<FpUnitRtl> {
          // Waiver for the rust-hdl generated core below: rust-hdl writes 32-bit literals,\n\
          // mask-style casts and full-width intermediates, whose widths Verilog resolves as\n\
          // intended (the tests compare this file bit for bit against the software model in\n\
-         // Icarus and Verilator); one module per instance, not per file; unused slices of\n\
-         // registered words are optimized away by synthesis.\n\
-         /* verilator lint_off WIDTHEXPAND */\n\
-         /* verilator lint_off WIDTHTRUNC */\n\
+         // Icarus and Verilator), and one module per instance, all in one file.\n\
+         /* verilator lint_off WIDTH */\n\
          /* verilator lint_off DECLFILENAME */\n\
-         /* verilator lint_off UNUSEDSIGNAL */\n\
-         /* verilator lint_off UNUSEDPARAM */\n\
          {core}\n\
-         /* verilator lint_on UNUSEDPARAM */\n\
-         /* verilator lint_on UNUSEDSIGNAL */\n\
          /* verilator lint_on DECLFILENAME */\n\
-         /* verilator lint_on WIDTHTRUNC */\n\
-         /* verilator lint_on WIDTHEXPAND */\n\
+         /* verilator lint_on WIDTH */\n\
          \n\
          module {top}(\n    \
              input wire clock,\n    \
@@ -323,4 +316,23 @@ endmodule
         vin = vectors_path,
         vout = results_path,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Not a check: writes every e7m16 and e8m23 unit to /tmp/dynrt_fp_rtl for inspection.
+    #[test]
+    #[ignore]
+    fn dump_units_for_inspection() {
+        let dir = std::path::Path::new("/tmp/dynrt_fp_rtl");
+        std::fs::create_dir_all(dir).unwrap();
+        for fmt in [Format::E7M16, Format::E8M23] {
+            for op in [BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Lt] {
+                let u = fp_unit_rtl(op, fmt).unwrap();
+                std::fs::write(dir.join(format!("{}.v", u.top)), &u.verilog).unwrap();
+            }
+        }
+    }
 }

@@ -114,7 +114,7 @@ pub struct FpAddSub<
     sign_word: Signal<Local, Bits<W>>,
     zero_word: Signal<Local, Bits<W>>,
     inf_sign_word: Signal<Local, Bits<W>>,
-    packed: Signal<Local, Bits<W>>,
+    packed_word: Signal<Local, Bits<W>>,
     // Stage 4: output registers.
     out_result: DFF<Bits<W>>,
     out_valid_r: DFF<Bit>,
@@ -236,7 +236,7 @@ impl<
             sign_word: Default::default(),
             zero_word: Default::default(),
             inf_sign_word: Default::default(),
-            packed: Default::default(),
+            packed_word: Default::default(),
             out_result: Default::default(),
             out_valid_r: Default::default(),
             c_man_bits: const_index(M),
@@ -449,7 +449,7 @@ impl<
         if self.inf_sign3.q.val() {
             self.inf_sign_word.next = self.c_inf.val() | self.c_sign_bit.val();
         }
-        self.packed.next = (bit_cast::<W, E>(self.exp_final.val().get_bits::<E>(0))
+        self.packed_word.next = (bit_cast::<W, E>(self.exp_final.val().get_bits::<E>(0))
             << self.c_man_bits.val())
             | bit_cast::<W, M>(self.sig_rounded.val().get_bits::<M>(0));
 
@@ -465,7 +465,7 @@ impl<
         } else if self.exp_negative.val() | (self.exp_final.val() == 0) {
             self.out_result.d.next = self.sign_word.val();
         } else {
-            self.out_result.d.next = self.packed.val() | self.sign_word.val();
+            self.out_result.d.next = self.packed_word.val() | self.sign_word.val();
         }
         self.out_valid_r.d.next = self.valid3.q.val();
         self.result.next = self.out_result.q.val();

@@ -87,7 +87,7 @@ pub struct FpDiv<
     exp_final: Signal<Local, Bits<X2>>,
     exp_negative: Signal<Local, Bit>,
     sign_word: Signal<Local, Bits<W>>,
-    packed: Signal<Local, Bits<W>>,
+    packed_word: Signal<Local, Bits<W>>,
     // Output registers.
     out_result: DFF<Bits<W>>,
     out_valid_r: DFF<Bit>,
@@ -162,7 +162,7 @@ impl<
             exp_final: Default::default(),
             exp_negative: Default::default(),
             sign_word: Default::default(),
-            packed: Default::default(),
+            packed_word: Default::default(),
             out_result: Default::default(),
             out_valid_r: Default::default(),
             c_man_bits: const_index(M),
@@ -282,20 +282,23 @@ impl<
             self.zero[i].d.next = self.zero[i - 1].q.val();
             self.valid[i].d.next = self.valid[i - 1].q.val();
         }
-        // Stage S + 2: the round bit; the remainder is kept for the sticky bit.
-        if self.rem[S - 1].q.val() >= self.divisor[S - 1].q.val() {
-            self.last_rem.d.next = self.rem[S - 1].q.val() - self.divisor[S - 1].q.val();
-            self.last_quo.d.next = (self.quo[S - 1].q.val() << 1) | self.c_one.val();
-        } else {
-            self.last_rem.d.next = self.rem[S - 1].q.val();
-            self.last_quo.d.next = self.quo[S - 1].q.val() << 1;
+        // Stage S + 2: the round bit; the remainder is kept for the sticky bit. (A one-pass
+        // loop because rust-hdl evaluates array indices only from loop variables.)
+        for i in (S - 1)..S {
+            if self.rem[i].q.val() >= self.divisor[i].q.val() {
+                self.last_rem.d.next = self.rem[i].q.val() - self.divisor[i].q.val();
+                self.last_quo.d.next = (self.quo[i].q.val() << 1) | self.c_one.val();
+            } else {
+                self.last_rem.d.next = self.rem[i].q.val();
+                self.last_quo.d.next = self.quo[i].q.val() << 1;
+            }
+            self.last_exp.d.next = self.exp[i].q.val();
+            self.last_sign.d.next = self.sign[i].q.val();
+            self.last_nan.d.next = self.nan[i].q.val();
+            self.last_inf.d.next = self.inf[i].q.val();
+            self.last_zero.d.next = self.zero[i].q.val();
+            self.last_valid.d.next = self.valid[i].q.val();
         }
-        self.last_exp.d.next = self.exp[S - 1].q.val();
-        self.last_sign.d.next = self.sign[S - 1].q.val();
-        self.last_nan.d.next = self.nan[S - 1].q.val();
-        self.last_inf.d.next = self.inf[S - 1].q.val();
-        self.last_zero.d.next = self.zero[S - 1].q.val();
-        self.last_valid.d.next = self.valid[S - 1].q.val();
 
         // Round: quotient bits S..1 are the significand, bit 0 the round bit.
         self.sig.next = self.last_quo.q.val().get_bits::<S>(1);
@@ -312,7 +315,7 @@ impl<
         if self.last_sign.q.val() {
             self.sign_word.next = self.c_sign_bit.val();
         }
-        self.packed.next = (bit_cast::<W, E>(self.exp_final.val().get_bits::<E>(0))
+        self.packed_word.next = (bit_cast::<W, E>(self.exp_final.val().get_bits::<E>(0))
             << self.c_man_bits.val())
             | bit_cast::<W, M>(self.sig_rounded.val().get_bits::<M>(0));
 
@@ -327,7 +330,7 @@ impl<
         {
             self.out_result.d.next = self.sign_word.val();
         } else {
-            self.out_result.d.next = self.packed.val() | self.sign_word.val();
+            self.out_result.d.next = self.packed_word.val() | self.sign_word.val();
         }
         self.out_valid_r.d.next = self.last_valid.q.val();
         self.result.next = self.out_result.q.val();

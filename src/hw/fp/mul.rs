@@ -69,7 +69,7 @@ pub struct FpMul<
     exp_final: Signal<Local, Bits<X2>>,
     exp_negative: Signal<Local, Bit>,
     sign_word: Signal<Local, Bits<W>>,
-    packed: Signal<Local, Bits<W>>,
+    packed_word: Signal<Local, Bits<W>>,
     // Stage 3: output registers.
     out_result: DFF<Bits<W>>,
     out_valid_r: DFF<Bit>,
@@ -138,7 +138,7 @@ impl<
             exp_final: Default::default(),
             exp_negative: Default::default(),
             sign_word: Default::default(),
-            packed: Default::default(),
+            packed_word: Default::default(),
             out_result: Default::default(),
             out_valid_r: Default::default(),
             c_man_bits: const_index(M),
@@ -242,7 +242,7 @@ impl<
         if self.sign.q.val() {
             self.sign_word.next = self.c_sign_bit.val();
         }
-        self.packed.next = (bit_cast::<W, E>(self.exp_final.val().get_bits::<E>(0))
+        self.packed_word.next = (bit_cast::<W, E>(self.exp_final.val().get_bits::<E>(0))
             << self.c_man_bits.val())
             | bit_cast::<W, M>(self.sig_rounded.val().get_bits::<M>(0));
 
@@ -256,7 +256,7 @@ impl<
         } else if self.zero.q.val() | (self.exp_negative.val() | (self.exp_final.val() == 0)) {
             self.out_result.d.next = self.sign_word.val();
         } else {
-            self.out_result.d.next = self.packed.val() | self.sign_word.val();
+            self.out_result.d.next = self.packed_word.val() | self.sign_word.val();
         }
         self.out_valid_r.d.next = self.valid2.q.val();
         self.result.next = self.out_result.q.val();
