@@ -223,9 +223,9 @@ fn rename_rust_hdl_names(verilog: &str, core_name: &str) -> String {
 
 /// A testbench (module `tb`) that feeds `n_vectors` lines `a b` (hex) from `vectors_path`
 /// through `unit`, one per clock, and writes one hex result per line to `results_path` in input
-/// order, then calls `$finish`. It stops with an error message if the results do not arrive
-/// within `n_vectors + latency + 100` clocks. Runs in Icarus (`-g2012`) and Verilator 5
-/// (`--binary --timing`).
+/// order, then calls `$finish`. It stops with a message if the file has fewer vectors or the
+/// results do not arrive within `n_vectors + latency + 100` clocks. Runs in Icarus (`-g2012`)
+/// and Verilator 5 (`--binary --timing`).
 pub fn fp_unit_testbench(
     unit: &FpUnitRtl,
     fmt: Format,
@@ -233,36 +233,84 @@ pub fn fp_unit_testbench(
     vectors_path: &str,
     results_path: &str,
 ) -> String {
+    fp_units_testbench(&[unit], fmt, n_vectors, vectors_path, &[results_path])
+}
+
+/// Like [`fp_unit_testbench`] for several units of the same format fed the same vectors in
+/// parallel (one simulator build for all of them), unit `i` writing to `results_paths[i]`.
+pub fn fp_units_testbench(
+    units: &[&FpUnitRtl],
+    fmt: Format,
+    n_vectors: usize,
+    vectors_path: &str,
+    results_paths: &[&str],
+) -> String {
+    assert_eq!(
+        units.len(),
+        results_paths.len(),
+        "one results file per unit"
+    );
     let w = fmt.width();
-    let rw = unit.result_width;
-    let result_decl = if rw == 1 {
-        "wire result;".to_string()
+    let wm = w - 1;
+    let n = n_vectors;
+    let max_latency = units.iter().map(|u| u.latency).max().unwrap_or(0);
+    let timeout = n_vectors as u64 + max_latency as u64 + 100;
+    let vin = vectors_path;
+    let mut decls = String::new();
+    let mut opens = String::new();
+    let mut collect = String::new();
+    let mut all_done = Vec::new();
+    for (i, (unit, path)) in units.iter().zip(results_paths).enumerate() {
+        let top = &unit.top;
+        let range = if unit.result_width == 1 {
+            String::new()
+        } else {
+            format!("[{}:0] ", unit.result_width - 1)
+        };
+        decls += &format!(
+            "    wire out_valid_{i};\n    wire {range}result_{i};\n    integer results_{i};\n    \
+             integer received_{i} = 0;\n    \
+             {top} dut_{i}(.clock(clock), .in_valid(in_valid), .a(a), .b(b),\n        \
+             .out_valid(out_valid_{i}), .result(result_{i}));\n"
+        );
+        opens += &format!(
+            "        results_{i} = $fopen(\"{path}\", \"w\");\n        \
+             if (results_{i} == 0) begin\n            \
+             $display(\"tb: cannot open {path}\");\n            $finish;\n        end\n"
+        );
+        collect += &format!(
+            "        if (out_valid_{i}) begin\n            \
+             $fwrite(results_{i}, \"%h\\n\", result_{i});\n            \
+             received_{i} = received_{i} + 1;\n            \
+             if (received_{i} == {n}) $fclose(results_{i});\n        end\n"
+        );
+        all_done.push(format!("received_{i} == {n}"));
+    }
+    let all_done = if all_done.is_empty() {
+        "1'b1".to_string()
     } else {
-        format!("wire [{}:0] result;", rw - 1)
+        all_done.join(" && ")
     };
-    let timeout = n_vectors as u64 + unit.latency as u64 + 100;
+    let names = units
+        .iter()
+        .map(|u| u.top.as_str())
+        .collect::<Vec<_>>()
+        .join(", ");
     format!(
-        r#"// Testbench for {top}: streams {n} vectors from a file, one per clock.
+        r#"// Testbench for {names}: streams {n} vectors from a file, one per clock.
 `timescale 1ns/1ps
 module tb;
     reg clock = 1'b0;
     reg in_valid = 1'b0;
     reg [{wm}:0] a = {w}'d0;
     reg [{wm}:0] b = {w}'d0;
-    wire out_valid;
-    {result_decl}
     integer vectors;
-    integer results;
     integer sent = 0;
-    integer received = 0;
     integer scanned;
     integer cycles = 0;
     reg [31:0] word_a;
     reg [31:0] word_b;
-
-    {top} dut(.clock(clock), .in_valid(in_valid), .a(a), .b(b),
-        .out_valid(out_valid), .result(result));
-
+{decls}
     always #5 clock = ~clock;
 
     initial begin
@@ -271,24 +319,14 @@ module tb;
             $display("tb: cannot open {vin}");
             $finish;
         end
-        results = $fopen("{vout}", "w");
-        if (results == 0) begin
-            $display("tb: cannot open {vout}");
-            $finish;
-        end
-    end
+{opens}    end
 
     // Inputs change and outputs are sampled on the falling edge, away from the rising edge
-    // where the unit's registers load.
+    // where the units' registers load.
     always @(negedge clock) begin
         cycles = cycles + 1;
-        if (out_valid) begin
-            $fwrite(results, "%h\n", result);
-            received = received + 1;
-            if (received == {n}) begin
-                $fclose(results);
-                $finish;
-            end
+{collect}        if ({all_done}) begin
+            $finish;
         end
         if (sent < {n}) begin
             scanned = $fscanf(vectors, "%h %h\n", word_a, word_b);
@@ -304,17 +342,12 @@ module tb;
             in_valid <= 1'b0;
         end
         if (cycles > {timeout}) begin
-            $display("tb: timeout, %0d of {n} results", received);
+            $display("tb: timeout after %0d clocks", cycles);
             $finish;
         end
     end
 endmodule
-"#,
-        top = unit.top,
-        n = n_vectors,
-        wm = w - 1,
-        vin = vectors_path,
-        vout = results_path,
+"#
     )
 }
 

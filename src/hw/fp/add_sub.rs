@@ -162,7 +162,10 @@ impl<
 {
     fn default() -> Self {
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
-        assert!(T <= 32, "FpAddSub: the normalizer handles at most 31 leading zeros");
+        assert!(
+            T <= 32,
+            "FpAddSub: the normalizer handles at most 31 leading zeros"
+        );
         assert!(S + 3 < (1 << E), "FpAddSub: shift clamp must fit in E bits");
         Self {
             clock: Default::default(),
@@ -313,8 +316,16 @@ impl<
         self.sign_a.next = self.in_a.q.val().get_bit(self.c_sign_pos.val().index());
         self.sign_b.next =
             self.in_b.q.val().get_bit(self.c_sign_pos.val().index()) ^ self.in_sub.q.val();
-        self.exp_a.next = self.in_a.q.val().get_bits::<E>(self.c_man_bits.val().index());
-        self.exp_b.next = self.in_b.q.val().get_bits::<E>(self.c_man_bits.val().index());
+        self.exp_a.next = self
+            .in_a
+            .q
+            .val()
+            .get_bits::<E>(self.c_man_bits.val().index());
+        self.exp_b.next = self
+            .in_b
+            .q
+            .val()
+            .get_bits::<E>(self.c_man_bits.val().index());
         self.zero_a.next = self.exp_a.val() == 0;
         self.zero_b.next = self.exp_b.val() == 0;
         self.inf_a.next = (self.exp_a.val().all()) & (self.in_a.q.val().get_bits::<M>(0) == 0);
@@ -427,12 +438,14 @@ impl<
         self.sig.next = self.norm1.val().get_bits::<S>(4);
         self.round_bit.next = self.norm1.val().get_bit(3);
         self.sticky.next = (self.norm1.val() & self.c_sticky_mask.val()).any();
-        self.round_up.next =
-            self.round_bit.val() & (self.sticky.val() | self.sig.val().get_bit(0));
+        self.round_up.next = self.round_bit.val() & (self.sticky.val() | self.sig.val().get_bit(0));
         self.sig_rounded.next = bit_cast::<S1, S>(self.sig.val()) + self.round_up.val();
         // The top bit of the sum weighs 2^(big_exp + 1).
         self.exp_final.next = ((bit_cast::<X2, E>(self.sum_exp.q.val()) + 1) - self.lz1.val())
-            + self.sig_rounded.val().get_bit(self.c_carry_pos.val().index());
+            + self
+                .sig_rounded
+                .val()
+                .get_bit(self.c_carry_pos.val().index());
         self.exp_negative.next = self
             .exp_final
             .val()

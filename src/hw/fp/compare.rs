@@ -88,18 +88,40 @@ impl<const W: usize, const E: usize, const M: usize> Default for FpCompare<W, E,
 impl<const W: usize, const E: usize, const M: usize> Logic for FpCompare<W, E, M> {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, in_a, in_b, in_valid_r, out_lt, out_le, out_eq, out_valid_r);
+        dff_setup!(
+            self,
+            clock,
+            in_a,
+            in_b,
+            in_valid_r,
+            out_lt,
+            out_le,
+            out_eq,
+            out_valid_r
+        );
         self.in_a.d.next = self.a.val();
         self.in_b.d.next = self.b.val();
         self.in_valid_r.d.next = self.in_valid.val();
 
         // DAZ: a zero exponent field means zero, and zero compares without its sign.
         self.a_clean.next = self.in_a.q.val();
-        if self.in_a.q.val().get_bits::<E>(self.c_man_bits.val().index()) == 0 {
+        if self
+            .in_a
+            .q
+            .val()
+            .get_bits::<E>(self.c_man_bits.val().index())
+            == 0
+        {
             self.a_clean.next = 0.into();
         }
         self.b_clean.next = self.in_b.q.val();
-        if self.in_b.q.val().get_bits::<E>(self.c_man_bits.val().index()) == 0 {
+        if self
+            .in_b
+            .q
+            .val()
+            .get_bits::<E>(self.c_man_bits.val().index())
+            == 0
+        {
             self.b_clean.next = 0.into();
         }
         self.a_mag.next = self.a_clean.val() & self.c_mag_mask.val();
@@ -107,10 +129,19 @@ impl<const W: usize, const E: usize, const M: usize> Logic for FpCompare<W, E, M
         self.a_neg.next = self.a_clean.val().get_bit(self.c_sign_pos.val().index());
         self.b_neg.next = self.b_clean.val().get_bit(self.c_sign_pos.val().index());
         // A NaN has the exponent field all ones and a nonzero mantissa.
-        self.any_nan.next = ((self.in_a.q.val().get_bits::<E>(self.c_man_bits.val().index()))
-            .all()
+        self.any_nan.next = ((self
+            .in_a
+            .q
+            .val()
+            .get_bits::<E>(self.c_man_bits.val().index()))
+        .all()
             & (self.in_a.q.val().get_bits::<M>(0).any()))
-            | ((self.in_b.q.val().get_bits::<E>(self.c_man_bits.val().index())).all()
+            | ((self
+                .in_b
+                .q
+                .val()
+                .get_bits::<E>(self.c_man_bits.val().index()))
+            .all()
                 & (self.in_b.q.val().get_bits::<M>(0).any()));
         self.is_eq.next = self.a_clean.val() == self.b_clean.val();
         if self.a_neg.val() ^ self.b_neg.val() {
@@ -153,9 +184,8 @@ mod tests {
                 u.b.next = (b as u64).into();
             },
             |u| {
-                let bits = u32::from(u.lt.val()) << 2
-                    | u32::from(u.le.val()) << 1
-                    | u32::from(u.eq.val());
+                let bits =
+                    u32::from(u.lt.val()) << 2 | u32::from(u.le.val()) << 1 | u32::from(u.eq.val());
                 (u.out_valid.val(), bits)
             },
         );

@@ -226,8 +226,16 @@ impl<
         self.in_valid_r.d.next = self.in_valid.val();
 
         // Unpack; a zero exponent field is zero (DAZ).
-        self.exp_a.next = self.in_a.q.val().get_bits::<E>(self.c_man_bits.val().index());
-        self.exp_b.next = self.in_b.q.val().get_bits::<E>(self.c_man_bits.val().index());
+        self.exp_a.next = self
+            .in_a
+            .q
+            .val()
+            .get_bits::<E>(self.c_man_bits.val().index());
+        self.exp_b.next = self
+            .in_b
+            .q
+            .val()
+            .get_bits::<E>(self.c_man_bits.val().index());
         self.zero_a.next = self.exp_a.val() == 0;
         self.zero_b.next = self.exp_b.val() == 0;
         self.inf_a.next = (self.exp_a.val().all()) & (self.in_a.q.val().get_bits::<M>(0) == 0);
@@ -306,7 +314,10 @@ impl<
             & ((self.last_rem.q.val().any()) | self.sig.val().get_bit(0));
         self.sig_rounded.next = bit_cast::<S1, S>(self.sig.val()) + self.round_up.val();
         self.exp_final.next = self.last_exp.q.val()
-            + self.sig_rounded.val().get_bit(self.c_carry_pos.val().index());
+            + self
+                .sig_rounded
+                .val()
+                .get_bit(self.c_carry_pos.val().index());
         self.exp_negative.next = self
             .exp_final
             .val()
@@ -326,8 +337,7 @@ impl<
             | ((!self.exp_negative.val()) & (self.exp_final.val() >= self.c_exp_max.val()))
         {
             self.out_result.d.next = self.c_inf.val() | self.sign_word.val();
-        } else if self.last_zero.q.val() | (self.exp_negative.val() | (self.exp_final.val() == 0))
-        {
+        } else if self.last_zero.q.val() | (self.exp_negative.val() | (self.exp_final.val() == 0)) {
             self.out_result.d.next = self.sign_word.val();
         } else {
             self.out_result.d.next = self.packed_word.val() | self.sign_word.val();

@@ -60,7 +60,7 @@ macro_rules! format_list {
     };
 }
 
-const SUPPORTED: &[(u32, u32)] = fp_format_table!(format_list ! {});
+const SUPPORTED: &[(u32, u32)] = fp_format_table!(format_list! {});
 
 /// A format with no hardware instance.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -144,6 +144,9 @@ mod tests {
         let f = Format::parse("e6m10").unwrap();
         let err = dispatch_fp_format!(f, widths()).unwrap_err();
         let msg = err.to_string();
-        assert!(msg.contains("e6m10") && msg.contains("e7m16") && msg.contains("e8m23"), "{msg}");
+        assert!(
+            msg.contains("e6m10") && msg.contains("e7m16") && msg.contains("e8m23"),
+            "{msg}"
+        );
     }
 }

@@ -38,7 +38,10 @@ pub(crate) fn const_index(n: usize) -> Constant<Bits<8>> {
 
 /// A `N`-bit constant.
 pub(crate) fn const_bits<const N: usize>(v: u64) -> Constant<Bits<N>> {
-    assert!(N >= 64 || v >> N == 0, "constant {v:#x} does not fit in {N} bits");
+    assert!(
+        N >= 64 || v >> N == 0,
+        "constant {v:#x} does not fit in {N} bits"
+    );
     Constant::new(v.into())
 }
 

@@ -193,8 +193,16 @@ impl<
         self.in_valid_r.d.next = self.in_valid.val();
 
         // Unpack; a zero exponent field is zero (DAZ).
-        self.exp_a.next = self.in_a.q.val().get_bits::<E>(self.c_man_bits.val().index());
-        self.exp_b.next = self.in_b.q.val().get_bits::<E>(self.c_man_bits.val().index());
+        self.exp_a.next = self
+            .in_a
+            .q
+            .val()
+            .get_bits::<E>(self.c_man_bits.val().index());
+        self.exp_b.next = self
+            .in_b
+            .q
+            .val()
+            .get_bits::<E>(self.c_man_bits.val().index());
         self.zero_a.next = self.exp_a.val() == 0;
         self.zero_b.next = self.exp_b.val() == 0;
         self.inf_a.next = (self.exp_a.val().all()) & (self.in_a.q.val().get_bits::<M>(0) == 0);
@@ -225,15 +233,20 @@ impl<
         if !self.prod_top.val() {
             self.prod_norm.next = self.prod.q.val() << 1;
         }
-        self.sig.next = self.prod_norm.val().get_bits::<S>(self.c_sig_pos.val().index());
+        self.sig.next = self
+            .prod_norm
+            .val()
+            .get_bits::<S>(self.c_sig_pos.val().index());
         self.round_bit.next = self.prod_norm.val().get_bit(self.c_round_pos.val().index());
         self.sticky.next = (self.prod_norm.val() & self.c_sticky_mask.val()).any();
-        self.round_up.next =
-            self.round_bit.val() & (self.sticky.val() | self.sig.val().get_bit(0));
+        self.round_up.next = self.round_bit.val() & (self.sticky.val() | self.sig.val().get_bit(0));
         self.sig_rounded.next = bit_cast::<S1, S>(self.sig.val()) + self.round_up.val();
         // A carry out of rounding leaves the mantissa field zero and bumps the exponent.
         self.exp_final.next = (self.exp_sum.q.val() + self.prod_top.val())
-            + self.sig_rounded.val().get_bit(self.c_carry_pos.val().index());
+            + self
+                .sig_rounded
+                .val()
+                .get_bit(self.c_carry_pos.val().index());
         self.exp_negative.next = self
             .exp_final
             .val()

@@ -67,5 +67,10 @@ pub(crate) fn assert_matches_model(
             bad += 1;
         }
     }
-    assert_eq!(bad, 0, "{what}: {bad} of {} results differ from the model", got.len());
+    assert_eq!(
+        bad,
+        0,
+        "{what}: {bad} of {} results differ from the model",
+        got.len()
+    );
 }
