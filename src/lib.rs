@@ -7,4 +7,5 @@
 //! `fp` (the number format) is shared by every stage; nothing here imports the CLI, and `hw`
 //! never imports `model` (they meet in tests).
 
+pub mod accel;
 pub mod fp;

@@ -1,0 +1,365 @@
+//! The O(N log N) SAH kd-tree builder of Wald & Havran, "On building fast kd-trees for ray
+//! tracing, and on doing that in O(N log N)" (IEEE RT 2006), generic over [`KdPrimitives`].
+//!
+//! - Each node holds, per axis, an event list sorted by (position, kind) with kinds
+//!   End < Planar < Start: a primitive spanning `[a, b]` on the axis gives Start at `a` and
+//!   End at `b`; a flat one (`a == b`) gives one Planar event. The lists are sorted once at the
+//!   root.
+//! - One sweep per axis evaluates every event position strictly inside the node's box with the
+//!   SAH `λ (C_t + C_i (P_L N_L + P_R N_R))`, `λ = empty_bonus` if a side is empty; primitives
+//!   lying in the plane go to whichever side is cheaper.
+//! - The best plane splits the node if it is cheaper than a leaf (`C_i N`), or if the leaf would
+//!   exceed `max_leaf_prims` and some plane separates primitives; never below the depth limit.
+//! - Primitives are classified left / right / both from the split axis' events; the lists are
+//!   split in linear time keeping their order. With `clip_splits` the "both" primitives are
+//!   clipped to each child box and only their new events are sorted and merged in, so the total
+//!   stays O(N log N).
+//!
+//! Deterministic: no parallelism, ties broken by axis, position and primitive id.
+//! Primitives with non-finite bounds are left out of the tree.
+
+use super::aabb::Aabb;
+use super::kd_tree::{KdNode, KdParams, KdTree};
+use super::primitive::KdPrimitives;
+
+const END: u8 = 0;
+const PLANAR: u8 = 1;
+const START: u8 = 2;
+
+const SIDE_BOTH: u8 = 0;
+const SIDE_LEFT: u8 = 1;
+const SIDE_RIGHT: u8 = 2;
+
+#[derive(Clone, Copy, Debug)]
+struct Event {
+    pos: f64,
+    kind: u8,
+    prim: u32,
+}
+
+type Events = [Vec<Event>; 3];
+
+fn event_order(a: &Event, b: &Event) -> std::cmp::Ordering {
+    a.pos
+        .total_cmp(&b.pos)
+        .then(a.kind.cmp(&b.kind))
+        .then(a.prim.cmp(&b.prim))
+}
+
+/// Appends the events of one primitive with bounds `b`.
+fn push_events(events: &mut Events, prim: u32, b: &Aabb) {
+    for (axis, list) in events.iter_mut().enumerate() {
+        // `+ 0.0` turns -0.0 into +0.0 so that equal positions also sort as equal.
+        let (lo, hi) = (b.min[axis] + 0.0, b.max[axis] + 0.0);
+        if lo == hi {
+            list.push(Event {
+                pos: lo,
+                kind: PLANAR,
+                prim,
+            });
+        } else {
+            list.push(Event {
+                pos: lo,
+                kind: START,
+                prim,
+            });
+            list.push(Event {
+                pos: hi,
+                kind: END,
+                prim,
+            });
+        }
+    }
+}
+
+/// Merges two sorted lists.
+fn merge(a: Vec<Event>, b: Vec<Event>) -> Vec<Event> {
+    if b.is_empty() {
+        return a;
+    }
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        if event_order(&a[i], &b[j]).is_le() {
+            out.push(a[i]);
+            i += 1;
+        } else {
+            out.push(b[j]);
+            j += 1;
+        }
+    }
+    out.extend_from_slice(&a[i..]);
+    out.extend_from_slice(&b[j..]);
+    out
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Plane {
+    cost: f64,
+    axis: usize,
+    pos: f64,
+    planar_left: bool,
+}
+
+struct Builder<'a, P: KdPrimitives> {
+    prims: &'a P,
+    params: &'a KdParams,
+    depth_limit: u32,
+    side: Vec<u8>,
+    nodes: Vec<KdNode>,
+    prim_indices: Vec<u32>,
+    depth: u32,
+}
+
+/// Builds a kd-tree over `prims` (see the module doc).
+pub fn build<P: KdPrimitives>(prims: &P, params: &KdParams) -> KdTree {
+    let n = prims.len();
+    let mut events: Events = [
+        Vec::with_capacity(2 * n),
+        Vec::with_capacity(2 * n),
+        Vec::with_capacity(2 * n),
+    ];
+    let mut bounds = Aabb::EMPTY;
+    let mut count = 0;
+    for i in 0..n {
+        let b = prims.bounds(i);
+        if !b.is_finite() || b.is_empty() {
+            continue;
+        }
+        bounds = bounds.union(&b);
+        push_events(&mut events, i as u32, &b);
+        count += 1;
+    }
+    for list in events.iter_mut() {
+        list.sort_unstable_by(event_order);
+    }
+    let mut builder = Builder {
+        prims,
+        params,
+        depth_limit: params.depth_limit(count),
+        side: vec![SIDE_BOTH; n],
+        nodes: vec![KdNode::Leaf { first: 0, count: 0 }],
+        prim_indices: Vec::new(),
+        depth: 0,
+    };
+    builder.build_node(0, bounds, events, count, 0);
+    KdTree {
+        nodes: builder.nodes,
+        prim_indices: builder.prim_indices,
+        bounds,
+        depth: builder.depth,
+        num_prims: n as u32,
+    }
+}
+
+impl<P: KdPrimitives> Builder<'_, P> {
+    fn build_node(&mut self, node: usize, voxel: Aabb, events: Events, n: usize, depth: u32) {
+        let plane = if n == 0 || depth >= self.depth_limit {
+            None
+        } else {
+            self.choose_plane(&voxel, &events, n)
+        };
+        let Some(plane) = plane else {
+            self.make_leaf(node, &events, depth);
+            return;
+        };
+        let (vl, vr) = voxel.split(plane.axis, plane.pos);
+        let (left, nl, right, nr) = self.split_events(events, &plane, &vl, &vr);
+        let children = self.nodes.len();
+        self.nodes[node] = KdNode::Inner {
+            axis: plane.axis as u8,
+            split: plane.pos,
+            children: children as u32,
+        };
+        self.nodes.push(KdNode::Leaf { first: 0, count: 0 });
+        self.nodes.push(KdNode::Leaf { first: 0, count: 0 });
+        // Build the left subtree while the right lists wait; depth-first keeps memory
+        // proportional to one root-to-leaf path of lists.
+        self.build_node(children, vl, left, nl, depth + 1);
+        self.build_node(children + 1, vr, right, nr, depth + 1);
+    }
+
+    fn make_leaf(&mut self, node: usize, events: &Events, depth: u32) {
+        let first = self.prim_indices.len();
+        // Every primitive has exactly one Start or Planar event per axis.
+        self.prim_indices
+            .extend(events[0].iter().filter(|e| e.kind != END).map(|e| e.prim));
+        self.prim_indices[first..].sort_unstable();
+        self.nodes[node] = KdNode::Leaf {
+            first: first as u32,
+            count: (self.prim_indices.len() - first) as u32,
+        };
+        self.depth = self.depth.max(depth);
+    }
+
+    /// The plane to split at, or `None` for a leaf.
+    fn choose_plane(&self, voxel: &Aabb, events: &Events, n: usize) -> Option<Plane> {
+        let area = voxel.surface_area();
+        if !(area > 0.0) {
+            return None;
+        }
+        let inv_area = 1.0 / area;
+        let ct = self.params.traversal_cost;
+        let ci = self.params.intersection_cost;
+        let bonus = self.params.empty_bonus;
+        let cost = |pl: f64, pr: f64, nl: usize, nr: usize| {
+            let c = ct + ci * (pl * nl as f64 + pr * nr as f64);
+            if nl == 0 || nr == 0 {
+                c * bonus
+            } else {
+                c
+            }
+        };
+        let mut best: Option<Plane> = None;
+        // Best plane that leaves fewer than `n` primitives on each side (for the leaf-size cap).
+        let mut best_separating: Option<Plane> = None;
+        for (axis, list) in events.iter().enumerate() {
+            let (lo, hi) = (voxel.min[axis], voxel.max[axis]);
+            if !(lo < hi) {
+                continue;
+            }
+            let e = voxel.extent();
+            let (e1, e2) = (e[(axis + 1) % 3], e[(axis + 2) % 3]);
+            let (cap, ring) = (e1 * e2, e1 + e2);
+            let (mut nl, mut nr) = (0usize, n);
+            let mut i = 0;
+            while i < list.len() {
+                let p = list[i].pos;
+                let (mut ends, mut planars, mut starts) = (0, 0, 0);
+                while i < list.len() && list[i].pos == p && list[i].kind == END {
+                    ends += 1;
+                    i += 1;
+                }
+                while i < list.len() && list[i].pos == p && list[i].kind == PLANAR {
+                    planars += 1;
+                    i += 1;
+                }
+                while i < list.len() && list[i].pos == p && list[i].kind == START {
+                    starts += 1;
+                    i += 1;
+                }
+                nr -= planars + ends;
+                if lo < p && p < hi {
+                    let pl = 2.0 * (cap + (p - lo) * ring) * inv_area;
+                    let pr = 2.0 * (cap + (hi - p) * ring) * inv_area;
+                    let cl = cost(pl, pr, nl + planars, nr);
+                    let cr = cost(pl, pr, nl, nr + planars);
+                    let planar_left = cl < cr;
+                    let c = if planar_left { cl } else { cr };
+                    let plane = Plane {
+                        cost: c,
+                        axis,
+                        pos: p,
+                        planar_left,
+                    };
+                    if best.map_or(true, |b| c < b.cost) {
+                        best = Some(plane);
+                    }
+                    let (left_n, right_n) = if planar_left {
+                        (nl + planars, nr)
+                    } else {
+                        (nl, nr + planars)
+                    };
+                    if left_n < n && right_n < n && best_separating.map_or(true, |b| c < b.cost) {
+                        best_separating = Some(plane);
+                    }
+                }
+                nl += starts + planars;
+            }
+        }
+        let leaf_cost = ci * n as f64;
+        match best {
+            Some(b) if b.cost < leaf_cost => Some(b),
+            _ if n > self.params.max_leaf_prims as usize => best_separating,
+            _ => None,
+        }
+    }
+
+    /// Classifies the node's primitives against `plane` and returns the children's sorted
+    /// event lists and primitive counts.
+    fn split_events(
+        &mut self,
+        events: Events,
+        plane: &Plane,
+        vl: &Aabb,
+        vr: &Aabb,
+    ) -> (Events, usize, Events, usize) {
+        let s = plane.pos;
+        for e in &events[0] {
+            if e.kind != END {
+                self.side[e.prim as usize] = SIDE_BOTH;
+            }
+        }
+        for e in &events[plane.axis] {
+            let side = &mut self.side[e.prim as usize];
+            match e.kind {
+                END if e.pos <= s => *side = SIDE_LEFT,
+                START if e.pos >= s => *side = SIDE_RIGHT,
+                PLANAR => {
+                    *side = if e.pos < s || (e.pos == s && plane.planar_left) {
+                        SIDE_LEFT
+                    } else {
+                        SIDE_RIGHT
+                    }
+                }
+                _ => {}
+            }
+        }
+        let mut nl = 0;
+        let mut nr = 0;
+        let mut both = Vec::new();
+        for e in &events[0] {
+            if e.kind == END {
+                continue;
+            }
+            match self.side[e.prim as usize] {
+                SIDE_LEFT => nl += 1,
+                SIDE_RIGHT => nr += 1,
+                _ => both.push(e.prim),
+            }
+        }
+        let clip = self.params.clip_splits;
+        // Straddling primitives clipped to each child; their events are sorted separately and
+        // merged in (there are few of them, so sorting them keeps the build O(N log N)).
+        let mut new_left: Events = Default::default();
+        let mut new_right: Events = Default::default();
+        if clip {
+            for &p in &both {
+                if let Some(b) = self.prims.clipped_bounds(p as usize, vl) {
+                    push_events(&mut new_left, p, &b);
+                    nl += 1;
+                }
+                if let Some(b) = self.prims.clipped_bounds(p as usize, vr) {
+                    push_events(&mut new_right, p, &b);
+                    nr += 1;
+                }
+            }
+            for list in new_left.iter_mut().chain(new_right.iter_mut()) {
+                list.sort_unstable_by(event_order);
+            }
+        } else {
+            nl += both.len();
+            nr += both.len();
+        }
+        let mut left: Events = Default::default();
+        let mut right: Events = Default::default();
+        for (axis, list) in events.into_iter().enumerate() {
+            let mut l = Vec::with_capacity(list.len());
+            let mut r = Vec::with_capacity(list.len());
+            for e in list {
+                match self.side[e.prim as usize] {
+                    SIDE_LEFT => l.push(e),
+                    SIDE_RIGHT => r.push(e),
+                    _ if !clip => {
+                        l.push(e);
+                        r.push(e);
+                    }
+                    _ => {}
+                }
+            }
+            left[axis] = merge(l, std::mem::take(&mut new_left[axis]));
+            right[axis] = merge(r, std::mem::take(&mut new_right[axis]));
+        }
+        (left, nl, right, nr)
+    }
+}
