@@ -8,3 +8,4 @@
 //! never imports `model` (they meet in tests).
 
 pub mod fp;
+pub mod scene;
