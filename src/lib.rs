@@ -8,4 +8,11 @@
 //! never imports `model` (they meet in tests).
 
 pub mod accel;
+pub mod compare;
 pub mod fp;
+pub mod layout;
+pub mod model;
+pub mod output;
+pub mod scene;
+pub mod sim;
+pub mod synth;

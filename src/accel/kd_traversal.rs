@@ -15,10 +15,19 @@
 //!   farther on is kept); stack entries that start at or beyond the best hit are skipped,
 //!   which ends the traversal once the best hit lies within the leaves already visited.
 //!
+//! - rounding never loses a cell: the root box is grown by a relative `REL_SLACK` (1e-9) and
+//!   every plane crossing `t_split` is treated as uncertain by `1e-9 (|t_split| +
+//!   (|o| + |split|) / |d|)`, far above the rounding error of `t_split` and of a hit's `t`
+//!   near the plane; within that slack both children are visited, so a ray through a vertex
+//!   or an edge that rounding could place on either side of a plane sees both cells.
+//!
 //! The stack holds at most `depth` entries.
 
 use super::kd_tree::{KdNode, KdTree};
 use super::ray::Ray;
+
+/// Relative slack of every interval decision (see the module doc).
+const REL_SLACK: f64 = 1e-9;
 
 /// A closest hit with a caller-defined payload (e.g. barycentrics, or the instance's triangle).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,7 +84,16 @@ impl KdTree {
         t_max: f64,
         mut visit: impl FnMut(&[u32], f64, f64) -> f64,
     ) {
-        let Some((mut tn, mut tf)) = ray.intersect_aabb(&self.bounds, t_min, t_max) else {
+        // Rounding must never lose a cell the ray touches, so all interval decisions are
+        // widened by a relative slack (see the module doc).
+        let scale = self
+            .bounds
+            .min
+            .abs()
+            .max(self.bounds.max.abs())
+            .max_element();
+        let root = self.bounds.expanded(scale * REL_SLACK);
+        let Some((mut tn, mut tf)) = ray.intersect_aabb(&root, t_min, t_max) else {
             return;
         };
         let mut t_end = t_max;
@@ -92,6 +110,7 @@ impl KdTree {
                     let (o, d) = (ray.origin[a], ray.dir[a]);
                     let (left, right) = (children, children + 1);
                     if d == 0.0 {
+                        // The ray's coordinate is exactly `o` for every t: no rounding here.
                         if o < split {
                             node = left;
                         } else if o > split {
@@ -109,14 +128,17 @@ impl KdTree {
                         (right, left)
                     };
                     let t_split = (split - o) / d;
-                    if t_split > tf {
+                    // Bound on the rounding error of t_split (and of a hit's t near the plane).
+                    let slack = REL_SLACK * (t_split.abs() + (o.abs() + split.abs()) / d.abs());
+                    if t_split - slack > tf {
                         node = first;
-                    } else if t_split < tn {
+                    } else if t_split + slack < tn {
                         node = second;
                     } else {
-                        stack.push((second, t_split, tf));
+                        // NaN-free even for huge t_split: f64::max/min ignore a NaN operand.
+                        stack.push((second, tn.max(t_split - slack), tf));
                         node = first;
-                        tf = t_split;
+                        tf = tf.min(t_split + slack);
                     }
                 }
                 KdNode::Leaf { first, count } => {
@@ -124,17 +146,25 @@ impl KdTree {
                     if new_end < t_end {
                         t_end = new_end;
                     }
+                    if t_end == f64::NEG_INFINITY {
+                        return;
+                    }
                     // Pending entries start at or after this leaf's end, except the second
                     // child of a plane the ray lies in; so rather than stopping once
-                    // `t_end <= tf`, skip every entry that starts at or after `t_end`.
+                    // `t_end <= tf`, skip every entry that starts after `t_end`.
+                    let limit = if t_end.is_finite() {
+                        t_end + REL_SLACK * t_end.abs()
+                    } else {
+                        t_end
+                    };
                     loop {
                         let Some((n, a, b)) = stack.pop() else {
                             return;
                         };
-                        if a < t_end {
+                        if a <= limit {
                             node = n;
                             tn = a;
-                            tf = b.min(t_end);
+                            tf = b.min(limit);
                             break;
                         }
                     }
@@ -207,5 +237,196 @@ impl KdTree {
             t_max
         });
         found
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::kd_tree::{build_sah, KdParams};
+    use crate::accel::primitive::Triangles;
+    use crate::accel::test_meshes::*;
+    use crate::accel::triangle;
+    use glam::DVec3;
+    use std::collections::BTreeMap;
+
+    /// kd closest hit and any hit against brute force, with and without split clipping.
+    fn check_against_brute_force(name: &str, tris: &[[DVec3; 3]], per_kind: usize, seed: u64) {
+        println!("mesh {name}: {} triangles, ray seed {seed}", tris.len());
+        for clip in [true, false] {
+            let params = KdParams {
+                clip_splits: clip,
+                ..KdParams::default()
+            };
+            let tree = build_sah(tris, &params);
+            tree.validate_against(&Triangles(tris))
+                .unwrap_or_else(|e| panic!("{name} clip={clip}: {e}"));
+            let rays = ray_set(tris, &tree, per_kind, seed);
+            let mut per_kind_counts: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
+            let mut failures = Vec::new();
+            for (i, &(kind, ray)) in rays.iter().enumerate() {
+                let test = |p: u32, tb: f64| {
+                    triangle::intersect(&ray, &tris[p as usize], 0.0, tb).map(|h| h.0)
+                };
+                let kd = tree.closest_hit(&ray, 0.0, f64::INFINITY, test);
+                let bf = brute_closest(tris, &ray, 0.0, f64::INFINITY);
+                let entry = per_kind_counts.entry(kind).or_default();
+                entry.0 += 1;
+                entry.1 += bf.is_some() as usize;
+                let agree = match (kd, bf) {
+                    (None, None) => true,
+                    (Some((kp, kt)), Some((bp, bt))) => {
+                        kp == bp || (kt - bt).abs() <= 1e-9 * bt.abs()
+                    }
+                    _ => false,
+                };
+                if !agree {
+                    failures.push(format!("ray {i} ({kind}) {ray:?}: kd {kd:?} brute {bf:?}"));
+                }
+                // Any hit up to just before / just after the closest hit, or unbounded.
+                let limit = match bf {
+                    Some((_, t)) if i % 2 == 0 => t * (1.0 - 1e-6),
+                    Some((_, t)) => t * (1.0 + 1e-6) + 1e-12,
+                    None => f64::INFINITY,
+                };
+                let any = tree.any_hit(&ray, 0.0, limit, |p, tb| {
+                    triangle::intersect(&ray, &tris[p as usize], 0.0, tb).map(|h| h.0)
+                });
+                let bf_any = brute_closest(tris, &ray, 0.0, limit);
+                if let Some(p) = any {
+                    assert!(
+                        triangle::intersect(&ray, &tris[p as usize], 0.0, limit).is_some(),
+                        "any_hit returned a triangle that does not hit"
+                    );
+                }
+                if any.is_some() != bf_any.is_some() {
+                    failures.push(format!(
+                        "ray {i} ({kind}) {ray:?} any_hit to {limit}: kd {any:?} brute {bf_any:?}"
+                    ));
+                }
+            }
+            println!(
+                "  clip={clip}: {} rays (kind: rays, brute-force hits) {per_kind_counts:?}",
+                rays.len()
+            );
+            let hits: usize = per_kind_counts.values().map(|c| c.1).sum();
+            assert!(
+                hits * 5 > rays.len(),
+                "{name}: only {hits} of {} rays hit; the test would prove little",
+                rays.len()
+            );
+            assert!(
+                failures.is_empty(),
+                "{name} clip={clip}: {} disagreements, first: {:#?}",
+                failures.len(),
+                &failures[..failures.len().min(5)]
+            );
+        }
+    }
+
+    #[test]
+    fn sphere_matches_brute_force() {
+        check_against_brute_force("sphere(3)", &sphere(3), 300, 1);
+    }
+
+    #[test]
+    fn soup_matches_brute_force() {
+        check_against_brute_force("soup", &soup(3000, 2), 300, 2);
+    }
+
+    #[test]
+    fn quad_lattice_matches_brute_force() {
+        check_against_brute_force("quad lattice", &quad_lattice(6), 400, 3);
+    }
+
+    #[test]
+    fn woody_matches_brute_force() {
+        check_against_brute_force("woody", &public_mesh("woody.obj"), 200, 4);
+    }
+
+    #[test]
+    fn cow_matches_brute_force() {
+        check_against_brute_force("cow", &public_mesh("cow.obj"), 150, 5);
+    }
+
+    #[test]
+    fn teapot_matches_brute_force() {
+        check_against_brute_force("teapot", &public_mesh("teapot.obj"), 150, 6);
+    }
+
+    #[test]
+    fn fandisk_matches_brute_force() {
+        check_against_brute_force("fandisk", &public_mesh("fandisk.obj"), 100, 7);
+    }
+
+    #[test]
+    fn degenerate_inputs_match_brute_force() {
+        let tri = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let cases: Vec<(&str, Vec<[DVec3; 3]>)> = vec![
+            ("one triangle", vec![tri]),
+            ("200 identical triangles", vec![tri; 200]),
+            (
+                "coplanar soup",
+                soup(500, 9)
+                    .into_iter()
+                    .map(|t| t.map(|v| DVec3::new(v.x, v.y, 0.5)))
+                    .collect(),
+            ),
+        ];
+        for (name, tris) in cases {
+            check_against_brute_force(name, &tris, 100, 8);
+        }
+    }
+
+    /// The builder's real correctness property, checked directly: a triangle that reaches
+    /// into the interior of a leaf box is listed in that leaf.
+    #[test]
+    fn leaves_list_every_triangle_entering_them() {
+        use crate::accel::primitive::clip_triangle_bounds;
+        for (name, tris) in [
+            ("sphere(2)", sphere(2)),
+            ("soup", soup(400, 11)),
+            ("quad lattice", quad_lattice(4)),
+        ] {
+            for clip in [true, false] {
+                let params = KdParams {
+                    clip_splits: clip,
+                    ..KdParams::default()
+                };
+                let tree = build_sah(&tris, &params);
+                for leaf in tree.leaves() {
+                    let inner = {
+                        let shrink = leaf.bounds.extent() * 1e-9;
+                        crate::accel::Aabb::new(leaf.bounds.min + shrink, leaf.bounds.max - shrink)
+                    };
+                    let listed = tree.leaf_prims(leaf.first, leaf.count);
+                    for (i, tri) in tris.iter().enumerate() {
+                        if clip_triangle_bounds(tri, &inner).is_some() {
+                            assert!(
+                                listed.contains(&(i as u32)),
+                                "{name} clip={clip}: triangle {i} enters leaf {} {:?} but is not listed",
+                                leaf.node,
+                                leaf.bounds
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn empty_tree_is_never_hit() {
+        let tree = build_sah(&[], &KdParams::default());
+        tree.validate().unwrap();
+        let ray = Ray::new(DVec3::ZERO, DVec3::X);
+        assert_eq!(
+            tree.closest_hit(&ray, 0.0, f64::INFINITY, |_, _| Some(1.0)),
+            None
+        );
+        assert_eq!(
+            tree.any_hit(&ray, 0.0, f64::INFINITY, |_, _| Some(1.0)),
+            None
+        );
     }
 }

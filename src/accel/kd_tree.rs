@@ -17,11 +17,13 @@
 //! 2. `axis < 3`; `split` is finite and lies strictly inside the node's box along `axis` (the
 //!    box follows from `bounds` and the splits above), so both children have positive extent
 //!    along `axis` wherever the parent does.
-//! 3. Leaves' ranges are disjoint and together cover `prim_indices` exactly; ranges are listed
-//!    in increasing node order; within a leaf, ids are strictly increasing and `< num_prims`.
+//! 3. Leaves' ranges are disjoint and together cover `prim_indices` exactly (the builder lays
+//!    them out in depth-first order); within a leaf, ids are strictly increasing and
+//!    `< num_prims`.
 //! 4. `depth` is the largest leaf depth (root = 0).
-//! 5. (With the primitives, [`KdTree::validate_against`]) every referenced primitive touches
-//!    its leaf's closed box, and every primitive with finite bounds is referenced at least once.
+//! 5. (With the primitives, [`KdTree::validate_against`]) every referenced primitive's bounds
+//!    touch its leaf's closed box, and every primitive with finite bounds is referenced at least
+//!    once.
 //!    The builder guarantees the converse as well (a primitive is listed in every leaf whose box
 //!    its surface touches), which is what makes traversal exact; the traversal tests check it.
 
@@ -144,7 +146,7 @@ pub enum KdTreeError {
     BadPrim { node: usize, prim: u32 },
     #[error("depth field {stored} differs from the largest leaf depth {actual} (invariant 4)")]
     BadDepth { stored: u32, actual: u32 },
-    #[error("leaf {node}: primitive {prim} does not touch the leaf box (invariant 5)")]
+    #[error("leaf {node}: bounds of primitive {prim} do not touch the leaf box (invariant 5)")]
     PrimOutsideLeaf { node: usize, prim: u32 },
     #[error("primitive {prim} has finite bounds but is in no leaf (invariant 5)")]
     PrimMissing { prim: u32 },
@@ -268,7 +270,7 @@ impl KdTree {
         if let Some((i, &times)) = reached.iter().enumerate().find(|(_, &t)| t != 1) {
             return Err(KdTreeError::Reached { node: i, times });
         }
-        leaves.sort_by_key(|l| l.0);
+        leaves.sort_by_key(|l| (l.1, l.2));
         let mut next = 0u64;
         for &(i, first, count) in &leaves {
             if first as u64 != next || first as u64 + count as u64 > self.prim_indices.len() as u64
@@ -317,7 +319,7 @@ impl KdTree {
         for leaf in self.leaves() {
             for &p in self.leaf_prims(leaf.first, leaf.count) {
                 seen[p as usize] = true;
-                if prims.clipped_bounds(p as usize, &leaf.bounds).is_none() {
+                if !prims.bounds(p as usize).overlaps(&leaf.bounds) {
                     return Err(KdTreeError::PrimOutsideLeaf {
                         node: leaf.node,
                         prim: p,

@@ -23,6 +23,9 @@ pub mod sah_builder;
 pub mod top_level;
 pub mod triangle;
 
+#[cfg(test)]
+pub(crate) mod test_meshes;
+
 pub use aabb::Aabb;
 pub use kd_traversal::KdHit;
 pub use kd_tree::{build_sah, build_sah_boxes, KdNode, KdParams, KdStats, KdTree, KdTreeError};

@@ -37,8 +37,14 @@ impl KdPrimitives for Triangles<'_> {
     fn len(&self) -> usize {
         self.0.len()
     }
+    /// NaN bounds for a triangle with a non-finite vertex (`f64::min` would skip a NaN).
     fn bounds(&self, i: usize) -> Aabb {
-        Aabb::from_triangle(&self.0[i])
+        let tri = &self.0[i];
+        if tri.iter().all(|v| v.is_finite()) {
+            Aabb::from_triangle(tri)
+        } else {
+            Aabb::new(DVec3::NAN, DVec3::NAN)
+        }
     }
     fn clipped_bounds(&self, i: usize, voxel: &Aabb) -> Option<Aabb> {
         clip_triangle_bounds(&self.0[i], voxel)

@@ -363,3 +363,293 @@ impl<P: KdPrimitives> Builder<'_, P> {
         (left, nl, right, nr)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::kd_tree::{build_sah, build_sah_boxes, KdTreeError};
+    use crate::accel::primitive::{Boxes, Triangles};
+    use crate::accel::test_meshes::*;
+    use glam::DVec3;
+
+    fn meshes() -> Vec<(&'static str, Vec<[DVec3; 3]>)> {
+        vec![
+            ("sphere(3)", sphere(3)),
+            ("soup", soup(3000, 2)),
+            ("quad lattice", quad_lattice(6)),
+            ("woody", public_mesh("woody.obj")),
+            ("cow", public_mesh("cow.obj")),
+            ("teapot", public_mesh("teapot.obj")),
+            ("fandisk", public_mesh("fandisk.obj")),
+        ]
+    }
+
+    #[test]
+    fn sah_cost_beats_a_single_leaf_and_trees_are_valid() {
+        for (name, tris) in meshes() {
+            assert!(tris.len() > 64);
+            for clip in [true, false] {
+                let params = KdParams {
+                    clip_splits: clip,
+                    ..KdParams::default()
+                };
+                let tree = build_sah(&tris, &params);
+                tree.validate_against(&Triangles(&tris)).unwrap();
+                let s = tree.stats(&params);
+                let leaf_cost = params.intersection_cost * tris.len() as f64;
+                println!("{name} ({} tris) clip={clip}: {s:?}", tris.len());
+                assert!(
+                    s.sah_cost < leaf_cost,
+                    "{name}: SAH cost {} not below a single leaf's {leaf_cost}",
+                    s.sah_cost
+                );
+                assert!(s.depth <= params.depth_limit(tris.len()));
+                assert_eq!(s.references, tree.prim_indices.len());
+                assert!(s.references >= tris.len());
+            }
+        }
+    }
+
+    #[test]
+    fn builder_is_deterministic() {
+        for (name, tris) in meshes() {
+            let p = KdParams::default();
+            assert_eq!(build_sah(&tris, &p), build_sah(&tris, &p), "{name}");
+        }
+    }
+
+    #[test]
+    fn degenerate_inputs_give_valid_trees() {
+        let tri = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let p = DVec3::new(0.3, -2.0, 5.0);
+        let nan = DVec3::new(f64::NAN, 0.0, 0.0);
+        let mut with_nan = sphere(1);
+        with_nan.insert(7, [nan, DVec3::X, DVec3::Y]);
+        let cases: Vec<(&str, Vec<[DVec3; 3]>)> = vec![
+            ("no triangles", vec![]),
+            ("one triangle", vec![tri]),
+            ("identical triangles", vec![tri; 300]),
+            (
+                "coplanar triangles",
+                soup(400, 3)
+                    .into_iter()
+                    .map(|t| t.map(|v| DVec3::new(v.x, 2.0, v.z)))
+                    .collect(),
+            ),
+            ("point triangles", vec![[p; 3]; 50]),
+            (
+                "collinear triangles",
+                (0..60)
+                    .map(|i| {
+                        let x = i as f64 * 0.1;
+                        [
+                            DVec3::new(x, 1.0, 1.0),
+                            DVec3::new(x + 0.5, 1.0, 1.0),
+                            DVec3::new(x + 0.2, 1.0, 1.0),
+                        ]
+                    })
+                    .collect(),
+            ),
+            ("a NaN triangle among good ones", with_nan),
+        ];
+        for (name, tris) in cases {
+            for clip in [true, false] {
+                let params = KdParams {
+                    clip_splits: clip,
+                    ..KdParams::default()
+                };
+                let tree = build_sah(&tris, &params);
+                tree.validate_against(&Triangles(&tris))
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+                println!("{name} clip={clip}: {:?}", tree.stats(&params));
+            }
+        }
+        // The NaN triangle is left out, everything else is referenced (checked above).
+        let mut with_nan = sphere(1);
+        with_nan.insert(7, [nan, DVec3::X, DVec3::Y]);
+        assert!(!build_sah(&with_nan, &KdParams::default())
+            .prim_indices
+            .contains(&7));
+        // Boxes: none, identical, flat.
+        let b = Aabb::new(DVec3::ZERO, DVec3::ONE);
+        let flat = Aabb::new(DVec3::ZERO, DVec3::new(1.0, 0.0, 1.0));
+        for boxes in [vec![], vec![b; 100], vec![flat; 10], vec![b, flat]] {
+            let tree = build_sah_boxes(&boxes, &KdParams::default());
+            tree.validate_against(&Boxes(&boxes)).unwrap();
+        }
+    }
+
+    /// Two far-apart clusters: the root must cut the empty gap between them.
+    #[test]
+    fn root_split_lies_in_the_gap_between_clusters() {
+        let a = soup(100, 4);
+        let b: Vec<_> = soup(100, 5)
+            .into_iter()
+            .map(|t| t.map(|v| v + DVec3::new(10.0, 0.0, 0.0)))
+            .collect();
+        let max_a = a.iter().flatten().map(|v| v.x).fold(f64::MIN, f64::max);
+        let min_b = b.iter().flatten().map(|v| v.x).fold(f64::MAX, f64::min);
+        let tris: Vec<_> = a.into_iter().chain(b).collect();
+        let tree = build_sah(&tris, &KdParams::default());
+        match tree.nodes[0] {
+            KdNode::Inner { axis, split, .. } => {
+                assert_eq!(axis, 0);
+                assert!(
+                    split >= max_a && split <= min_b,
+                    "split {split} not in [{max_a}, {min_b}]"
+                );
+            }
+            n => panic!("root is {n:?}"),
+        }
+    }
+
+    #[test]
+    fn depth_limit() {
+        let p = KdParams::default();
+        assert_eq!(p.depth_limit(0), 8);
+        assert_eq!(p.depth_limit(1), 8);
+        assert_eq!(p.depth_limit(1024), 21);
+        assert_eq!(p.depth_limit(1 << 30), KdParams::AUTO_DEPTH_CAP);
+        let tris = sphere(3);
+        for d in [0, 1, 4] {
+            let params = KdParams {
+                max_depth: Some(d),
+                ..KdParams::default()
+            };
+            let tree = build_sah(&tris, &params);
+            tree.validate_against(&Triangles(&tris)).unwrap();
+            assert_eq!(
+                tree.depth, d,
+                "the sphere is worth splitting down to the limit"
+            );
+        }
+    }
+
+    /// With intersections almost free the SAH wants one leaf; the leaf-size cap must still
+    /// split separable triangles into leaves of at most `max_leaf_prims`.
+    #[test]
+    fn leaf_size_cap_forces_splits() {
+        let tris: Vec<_> = (0..200)
+            .map(|i| {
+                let x = i as f64;
+                [
+                    DVec3::new(x, 0.0, 0.0),
+                    DVec3::new(x + 0.5, 0.0, 0.0),
+                    DVec3::new(x, 1.0, 0.5),
+                ]
+            })
+            .collect();
+        let cheap = KdParams {
+            intersection_cost: 0.001,
+            max_leaf_prims: 1000,
+            ..KdParams::default()
+        };
+        let tree = build_sah(&tris, &cheap);
+        assert_eq!(tree.nodes.len(), 1, "SAH alone keeps one leaf");
+        let capped = KdParams {
+            max_leaf_prims: 8,
+            ..cheap
+        };
+        let tree = build_sah(&tris, &capped);
+        tree.validate_against(&Triangles(&tris)).unwrap();
+        let s = tree.stats(&capped);
+        assert!(s.max_tris_per_leaf <= 8, "{s:?}");
+        // Identical triangles cannot be separated: one leaf, no endless splitting.
+        let same = vec![tris[0]; 50];
+        let tree = build_sah(&same, &capped);
+        assert_eq!(tree.nodes.len(), 1);
+    }
+
+    #[test]
+    fn validate_detects_broken_trees() {
+        let tris = sphere(2);
+        let good = build_sah(&tris, &KdParams::default());
+        good.validate_against(&Triangles(&tris)).unwrap();
+        let inner = good
+            .nodes
+            .iter()
+            .position(|n| matches!(n, KdNode::Inner { .. }))
+            .unwrap();
+        let leaf = good
+            .nodes
+            .iter()
+            .position(|n| matches!(n, KdNode::Leaf { count, .. } if *count > 1))
+            .unwrap();
+
+        let mut t = good.clone();
+        if let KdNode::Inner { split, .. } = &mut t.nodes[inner] {
+            *split = 1e6;
+        }
+        assert!(matches!(t.validate(), Err(KdTreeError::BadSplit { .. })));
+
+        let mut t = good.clone();
+        if let KdNode::Inner { children, .. } = &mut t.nodes[inner] {
+            *children = inner as u32;
+        }
+        assert!(matches!(t.validate(), Err(KdTreeError::BadChildren { .. })));
+
+        let mut t = good.clone();
+        let last_inner = t
+            .nodes
+            .iter()
+            .rposition(|n| matches!(n, KdNode::Inner { .. }))
+            .unwrap();
+        let KdNode::Inner { children: c, .. } = t.nodes[last_inner] else {
+            unreachable!()
+        };
+        if let KdNode::Inner { children, .. } = &mut t.nodes[inner] {
+            *children = c; // two parents share a pair of children
+        }
+        assert!(matches!(
+            t.validate(),
+            Err(KdTreeError::Reached { .. }) | Err(KdTreeError::BadChildren { .. })
+        ));
+
+        let mut t = good.clone();
+        if let KdNode::Leaf { first, .. } = &mut t.nodes[leaf] {
+            *first += 1;
+        }
+        assert!(matches!(
+            t.validate(),
+            Err(KdTreeError::BadLeafRange { .. })
+        ));
+
+        let mut t = good.clone();
+        if let KdNode::Leaf { first, .. } = t.nodes[leaf] {
+            t.prim_indices[first as usize] = t.num_prims;
+        }
+        assert!(matches!(t.validate(), Err(KdTreeError::BadPrim { .. })));
+
+        let mut t = good.clone();
+        t.depth += 1;
+        assert!(matches!(t.validate(), Err(KdTreeError::BadDepth { .. })));
+
+        // Triangle 0 renamed to a far-away triangle in every leaf: it is outside the leaves
+        // that list it, and triangle 0 itself ends up missing.
+        let mut t = good.clone();
+        let mut moved = tris.clone();
+        moved[0] = [
+            DVec3::splat(50.0),
+            DVec3::splat(51.0),
+            DVec3::new(50.0, 51.0, 50.0),
+        ];
+        assert!(matches!(
+            t.validate_against(&Triangles(&moved)),
+            Err(KdTreeError::PrimOutsideLeaf { prim: 0, .. })
+        ));
+        for p in t.prim_indices.iter_mut() {
+            if *p == 0 {
+                *p = 1;
+            }
+        }
+        // (Leaves may now hold 1 twice, which `validate` reports first.)
+        assert!(t.validate_against(&Triangles(&tris)).is_err());
+        assert_eq!(
+            good.validate_against(&Triangles(&tris[1..])),
+            Err(KdTreeError::PrimCount {
+                tree: tris.len() as u32,
+                given: tris.len() - 1
+            })
+        );
+    }
+}

@@ -8,7 +8,11 @@ mod render_cmd;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "dynrt", version, about = "Generates a SaarCOR DynRT-style ray tracing processor from a 3D scene")]
+#[command(
+    name = "dynrt",
+    version,
+    about = "Generates a SaarCOR DynRT-style ray tracing processor from a 3D scene"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

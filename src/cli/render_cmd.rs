@@ -41,19 +41,32 @@ pub struct RenderArgs {
 }
 
 /// Loads a scene and applies a resolution override (checked like the scene's own).
-pub fn load_scene(path: &std::path::Path, width: Option<u32>, height: Option<u32>) -> anyhow::Result<Scene> {
+pub fn load_scene(
+    path: &std::path::Path,
+    width: Option<u32>,
+    height: Option<u32>,
+) -> anyhow::Result<Scene> {
     let mut scene = Scene::load(path)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
-    scene.set_resolution(width.unwrap_or(scene.camera.width), height.unwrap_or(scene.camera.height))?;
+    scene.set_resolution(
+        width.unwrap_or(scene.camera.width),
+        height.unwrap_or(scene.camera.height),
+    )?;
     Ok(scene)
 }
 
 pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
     let scene = load_scene(&a.scene, a.width, a.height)?;
     if a.frame >= scene.frames {
-        anyhow::bail!("{}: frame {} does not exist; the scene has {} frame(s) (0..{})", a.scene.display(), a.frame, scene.frames, scene.frames);
+        anyhow::bail!(
+            "{}: frame {} does not exist; the scene has {} frame(s) (0..{})",
+            a.scene.display(),
+            a.frame,
+            scene.frames,
+            scene.frames
+        );
     }
     let start = Instant::now();
     let frame = match a.model {
@@ -65,9 +78,13 @@ pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
         ModelKind::Reference => Reference::new(&scene).render(a.frame),
     };
     let secs = start.elapsed().as_secs_f64();
-    frame.save_png(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
+    frame
+        .save_png(&a.out)
+        .with_context(|| format!("writing {}", a.out.display()))?;
     if let Some(h) = &a.hits {
-        frame.save_hits(h).with_context(|| format!("writing {}", h.display()))?;
+        frame
+            .save_hits(h)
+            .with_context(|| format!("writing {}", h.display()))?;
     }
     let pixels = u64::from(frame.width) * u64::from(frame.height);
     let hits = frame.hits.iter().filter(|h| h.is_some()).count();
@@ -80,7 +97,11 @@ pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
         frame.width,
         frame.height,
         a.frame,
-        if a.model == ModelKind::Golden { a.format.to_string() } else { "f64".into() },
+        if a.model == ModelKind::Golden {
+            a.format.to_string()
+        } else {
+            "f64".into()
+        },
         hits,
         pixels,
         secs,

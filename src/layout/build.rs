@@ -15,13 +15,34 @@ pub enum LayoutError {
         needed_mb = *needed as f64 * 4.0 / 1048576.0,
         capacity_mb = *capacity as f64 * 4.0 / 1048576.0
     )]
-    TooBig { scene: String, bank: usize, name: &'static str, needed: usize, capacity: usize },
+    TooBig {
+        scene: String,
+        bank: usize,
+        name: &'static str,
+        needed: usize,
+        capacity: usize,
+    },
     #[error("scene `{scene}`: {what} does not fit the 30-bit address field of a kd node")]
     AddressOverflow { scene: String, what: String },
+    #[error(
+        "kd split plane {split} is not representable in {format}: the tree was built on \
+         geometry that was not rounded to the format (a bug in dynrt, please report it)"
+    )]
+    SplitNotRepresentable { split: f64, format: Format },
     #[error("scene `{scene}` has frame {frame} but only {frames} frames (0..{frames})")]
-    NoSuchFrame { scene: String, frame: u32, frames: u32 },
-    #[error("scene `{scene}`: object `{object}` has no triangle that survives rounding to {format}")]
-    EmptyAfterRounding { scene: String, object: String, format: Format },
+    NoSuchFrame {
+        scene: String,
+        frame: u32,
+        frames: u32,
+    },
+    #[error(
+        "scene `{scene}`: object `{object}` has no triangle that survives rounding to {format}"
+    )]
+    EmptyAfterRounding {
+        scene: String,
+        object: String,
+        format: Format,
+    },
 }
 
 /// The per-object kd-trees of a scene for one number format, built once and reused by every
@@ -42,11 +63,19 @@ pub struct SceneTrees {
 
 impl SceneTrees {
     pub fn build(scene: &Scene, format: Format) -> Result<SceneTrees, LayoutError> {
-        let params = KdParams::default();
+        // Perfect splits clip triangles at arbitrary planes; the hardware needs splits on
+        // representable values, which unclipped vertex-coordinate events guarantee.
+        let params = KdParams {
+            clip_splits: false,
+            ..KdParams::default()
+        };
         let mut all = Vec::new();
         for object in &scene.objects {
-            let rounded: Vec<[DVec3; 3]> =
-                object.triangles.iter().map(|t| t.map(|v| round_vec(format, v))).collect();
+            let rounded: Vec<[DVec3; 3]> = object
+                .triangles
+                .iter()
+                .map(|t| t.map(|v| round_vec(format, v)))
+                .collect();
             let (kept, dropped): (Vec<u32>, Vec<u32>) =
                 (0..rounded.len() as u32).partition(|&i| !is_flat(&rounded[i as usize]));
             if kept.is_empty() {
@@ -63,7 +92,12 @@ impl SceneTrees {
             }
             all.push((rounded, tree, dropped));
         }
-        let mut out = SceneTrees { format, triangles: vec![], trees: vec![], dropped: vec![] };
+        let mut out = SceneTrees {
+            format,
+            triangles: vec![],
+            trees: vec![],
+            dropped: vec![],
+        };
         for (t, tree, d) in all {
             out.triangles.push(t);
             out.trees.push(tree);
@@ -74,7 +108,11 @@ impl SceneTrees {
 }
 
 fn round_vec(f: Format, v: DVec3) -> DVec3 {
-    DVec3::new(f.to_f64(f.from_f64(v.x)), f.to_f64(f.from_f64(v.y)), f.to_f64(f.from_f64(v.z)))
+    DVec3::new(
+        f.to_f64(f.from_f64(v.x)),
+        f.to_f64(f.from_f64(v.y)),
+        f.to_f64(f.from_f64(v.z)),
+    )
 }
 
 fn is_flat(t: &[DVec3; 3]) -> bool {
@@ -118,11 +156,16 @@ fn step(f: Format, w: u32, up: bool) -> f64 {
 /// so that rays transformed with rounding still find the instance where they hit it.
 fn instance_box(f: Format, local: &Aabb, to_world: &DAffine3) -> Aabb {
     let b = local.transformed(to_world);
-    let margin = (b.max - b.min).max_element().max(b.max.abs().max_element()) * 2f64.powi(-(f.man_bits as i32) + 3);
+    let margin = (b.max - b.min).max_element().max(b.max.abs().max_element())
+        * 2f64.powi(-(f.man_bits as i32) + 3);
     let lo = b.min - DVec3::splat(margin);
     let hi = b.max + DVec3::splat(margin);
     Aabb::new(
-        DVec3::new(round_down(f, lo.x), round_down(f, lo.y), round_down(f, lo.z)),
+        DVec3::new(
+            round_down(f, lo.x),
+            round_down(f, lo.y),
+            round_down(f, lo.z),
+        ),
         DVec3::new(round_up(f, hi.x), round_up(f, hi.y), round_up(f, hi.z)),
     )
 }
@@ -158,12 +201,18 @@ fn pack_tree(
     map_prim: impl Fn(u32) -> u32,
     nodes: &mut Vec<u32>,
     lists: &mut Vec<u32>,
-) {
+) -> Result<(), LayoutError> {
     for node in &tree.nodes {
         match *node {
-            KdNode::Inner { axis, split, children } => {
+            KdNode::Inner {
+                axis,
+                split,
+                children,
+            } => {
                 let w = f.from_f64(split);
-                debug_assert_eq!(f.to_f64(w), split, "split planes sit on representable values");
+                if f.to_f64(w) != split {
+                    return Err(LayoutError::SplitNotRepresentable { split, format: f });
+                }
                 nodes.push(encode_inner(axis as usize, node_base + children));
                 nodes.push(w);
             }
@@ -175,14 +224,24 @@ fn pack_tree(
     }
     debug_assert_eq!(lists.len() as u32, list_base);
     lists.extend(tree.prim_indices.iter().map(|&p| map_prim(p)));
+    Ok(())
 }
 
 /// Builds the memory map of `frame`.
-pub fn build(scene: &Scene, trees: &SceneTrees, frame: u32, memory: &MemoryConfig) -> Result<Layout, LayoutError> {
+pub fn build(
+    scene: &Scene,
+    trees: &SceneTrees,
+    frame: u32,
+    memory: &MemoryConfig,
+) -> Result<Layout, LayoutError> {
     let f = trees.format;
     let scene_name = scene.source.display().to_string();
     if frame >= scene.frames {
-        return Err(LayoutError::NoSuchFrame { scene: scene_name, frame, frames: scene.frames });
+        return Err(LayoutError::NoSuchFrame {
+            scene: scene_name,
+            frame,
+            frames: scene.frames,
+        });
     }
     let mut banks: Vec<Vec<u32>> = vec![Vec::new(); 6];
 
@@ -198,10 +257,17 @@ pub fn build(scene: &Scene, trees: &SceneTrees, frame: u32, memory: &MemoryConfi
                 // Never referenced by a leaf; zero words keep the addressing regular.
                 (DAffine3::ZERO, DVec3::ZERO)
             } else {
-                (unit_triangle_transform(t), (t[0] - t[2]).cross(t[1] - t[2]).normalize())
+                (
+                    unit_triangle_transform(t),
+                    (t[0] - t[2]).cross(t[1] - t[2]).normalize(),
+                )
             };
             banks[TRIANGLES].extend(affine_words(f, &transform));
-            banks[SHADING].extend([f.from_f64(normal.x), f.from_f64(normal.y), f.from_f64(normal.z)]);
+            banks[SHADING].extend([
+                f.from_f64(normal.x),
+                f.from_f64(normal.y),
+                f.from_f64(normal.z),
+            ]);
             banks[SHADING].push(mat_count + object.triangle_material[i]);
         }
         tri_count += object.triangles.len() as u32;
@@ -209,13 +275,21 @@ pub fn build(scene: &Scene, trees: &SceneTrees, frame: u32, memory: &MemoryConfi
     }
     for object in &scene.objects {
         for m in &object.materials {
-            banks[SHADING].extend([f.from_f64(m.diffuse[0]), f.from_f64(m.diffuse[1]), f.from_f64(m.diffuse[2])]);
+            banks[SHADING].extend([
+                f.from_f64(m.diffuse[0]),
+                f.from_f64(m.diffuse[1]),
+                f.from_f64(m.diffuse[2]),
+            ]);
             banks[SHADING].push(f.from_f64(m.mirror));
         }
     }
 
     // Top-level tree over the instances' world bounds (absent for one untransformed object).
-    let to_world: Vec<DAffine3> = scene.instances.iter().map(|i| i.object_to_world(frame)).collect();
+    let to_world: Vec<DAffine3> = scene
+        .instances
+        .iter()
+        .map(|i| i.object_to_world(frame))
+        .collect();
     let top = if scene.is_single_untransformed_object() {
         None
     } else {
@@ -228,25 +302,35 @@ pub fn build(scene: &Scene, trees: &SceneTrees, frame: u32, memory: &MemoryConfi
         Some(kd_tree::build_sah_boxes(&boxes, &KdParams::default()))
     };
 
-    let mut node_base = 0u32;
+    let (mut nodes, mut lists) = (Vec::new(), Vec::new());
     let mut top_root = None;
     if let Some(top) = &top {
         top_root = Some(0);
-        pack_tree(f, top, 0, 0, |p| p, &mut banks[NODES], &mut banks[LISTS]);
-        node_base = top.nodes.len() as u32;
+        pack_tree(f, top, 0, 0, |p| p, &mut nodes, &mut lists)?;
     }
     let mut object_roots = Vec::new();
     for (o, tree) in trees.trees.iter().enumerate() {
+        let node_base = (nodes.len() / NODE_WORDS) as u32;
         object_roots.push(node_base);
-        let list_base = banks[LISTS].len() as u32;
         let base = first_triangle[o];
-        let mut nodes = std::mem::take(&mut banks[NODES]);
-        pack_tree(f, tree, node_base, list_base, |p| base + p, &mut nodes, &mut banks[LISTS]);
-        banks[NODES] = nodes;
-        node_base += tree.nodes.len() as u32;
+        pack_tree(
+            f,
+            tree,
+            node_base,
+            lists.len() as u32,
+            |p| base + p,
+            &mut nodes,
+            &mut lists,
+        )?;
     }
-    if node_base as usize >= 1 << 30 || banks[LISTS].len() >= 1 << 30 {
-        return Err(LayoutError::AddressOverflow { scene: scene_name, what: "the kd-tree".into() });
+    let node_base = nodes.len() / NODE_WORDS;
+    banks[NODES] = nodes;
+    banks[LISTS] = lists;
+    if node_base >= 1 << 30 || banks[LISTS].len() >= 1 << 30 {
+        return Err(LayoutError::AddressOverflow {
+            scene: scene_name,
+            what: "the kd-tree".into(),
+        });
     }
 
     // Instances.
@@ -257,7 +341,11 @@ pub fn build(scene: &Scene, trees: &SceneTrees, frame: u32, memory: &MemoryConfi
             let row = normal.row(r);
             banks[INSTANCES].extend([f.from_f64(row.x), f.from_f64(row.y), f.from_f64(row.z)]);
         }
-        banks[INSTANCES].extend([object_roots[inst.object], first_triangle[inst.object], inst.object as u32]);
+        banks[INSTANCES].extend([
+            object_roots[inst.object],
+            first_triangle[inst.object],
+            inst.object as u32,
+        ]);
     }
 
     // Frame constants, lights, frame buffer.
@@ -268,11 +356,17 @@ pub fn build(scene: &Scene, trees: &SceneTrees, frame: u32, memory: &MemoryConfi
     let aspect = w / h;
     let c0 = basis.right * (2.0 * half_h * aspect / w);
     let c1 = basis.up * (-2.0 * half_h / h);
-    let c2 = basis.forward + basis.right * ((1.0 / w - 1.0) * half_h * aspect) + basis.up * ((1.0 - 1.0 / h) * half_h);
+    let c2 = basis.forward
+        + basis.right * ((1.0 / w - 1.0) * half_h * aspect)
+        + basis.up * ((1.0 - 1.0 / h) * half_h);
     let camera = DAffine3::from_mat3_translation(DMat3::from_cols(c0, c1, DVec3::ZERO), c2);
     let fr = &mut banks[FRAME];
     fr.extend(affine_words(f, &camera));
-    fr.extend([f.from_f64(cam.eye.x), f.from_f64(cam.eye.y), f.from_f64(cam.eye.z)]);
+    fr.extend([
+        f.from_f64(cam.eye.x),
+        f.from_f64(cam.eye.y),
+        f.from_f64(cam.eye.z),
+    ]);
     fr.push(f.from_f64(scene.render.ambient));
     fr.extend(scene.render.background.map(|c| f.from_f64(c)));
     let (shadow_eps, mirror_eps) = secondary_t_min(f, scene);
@@ -313,7 +407,12 @@ pub fn build(scene: &Scene, trees: &SceneTrees, frame: u32, memory: &MemoryConfi
         top_depth: top.as_ref().map_or(0, |t| t.depth),
         object_first_triangle: first_triangle,
     };
-    Ok(Layout { format: f, memory: *memory, banks, info })
+    Ok(Layout {
+        format: f,
+        memory: *memory,
+        banks,
+        info,
+    })
 }
 
 /// The smallest t of secondary rays. A shadow ray runs from the hit point (t = 0) to the light

@@ -42,7 +42,14 @@ pub const TRIANGLES: usize = 2;
 pub const SHADING: usize = 3;
 pub const INSTANCES: usize = 4;
 pub const FRAME: usize = 5;
-pub const BANK_NAMES: [&str; 6] = ["nodes", "lists", "triangles", "shading", "instances", "frame"];
+pub const BANK_NAMES: [&str; 6] = [
+    "nodes",
+    "lists",
+    "triangles",
+    "shading",
+    "instances",
+    "frame",
+];
 
 pub const NODE_WORDS: usize = 2;
 pub const TRIANGLE_WORDS: usize = 12;
@@ -70,7 +77,10 @@ pub struct MemoryConfig {
 
 impl MemoryConfig {
     /// The paper's board: 6 banks of 4 MB.
-    pub const ADM_XRC_II: MemoryConfig = MemoryConfig { banks: 6, bank_bytes: 4 << 20 };
+    pub const ADM_XRC_II: MemoryConfig = MemoryConfig {
+        banks: 6,
+        bank_bytes: 4 << 20,
+    };
     pub fn bank_words(&self) -> usize {
         self.bank_bytes / 4
     }
@@ -148,7 +158,9 @@ impl Layout {
         self.banks[bank][addr as usize]
     }
     pub fn words<const N: usize>(&self, bank: usize, addr: usize) -> [u32; N] {
-        self.banks[bank][addr..addr + N].try_into().expect("slice of N words")
+        self.banks[bank][addr..addr + N]
+            .try_into()
+            .expect("slice of N words")
     }
     pub fn node(&self, index: u32) -> Node {
         let a = index as usize * NODE_WORDS;
@@ -156,9 +168,16 @@ impl Layout {
         let tag = w0 >> 30;
         let payload = w0 & 0x3fff_ffff;
         if tag == LEAF_TAG {
-            Node::Leaf { list: payload, count: w1 }
+            Node::Leaf {
+                list: payload,
+                count: w1,
+            }
         } else {
-            Node::Inner { axis: tag as usize, split: w1, left: payload }
+            Node::Inner {
+                axis: tag as usize,
+                split: w1,
+                left: payload,
+            }
         }
     }
     /// Words used per bank (frame buffer included).

@@ -16,7 +16,9 @@
 
 use super::units::{self, Vec3W, Visit};
 use crate::fp::Format;
-use crate::layout::{instance_word as iw, FrameMap, Layout, Node, FRAME, INSTANCES, LISTS, SHADING, TRIANGLES};
+use crate::layout::{
+    instance_word as iw, FrameMap, Layout, Node, FRAME, INSTANCES, LISTS, SHADING, TRIANGLES,
+};
 
 /// Entries of the per-ray mailboxes (most recently tested ids, first in first out).
 pub const MAILBOX_ENTRIES: usize = 8;
@@ -77,7 +79,11 @@ struct Mailbox {
 
 impl Mailbox {
     fn new() -> Self {
-        Mailbox { ids: [0; MAILBOX_ENTRIES], len: 0, next: 0 }
+        Mailbox {
+            ids: [0; MAILBOX_ENTRIES],
+            len: 0,
+            next: 0,
+        }
     }
     /// True when `id` was recently tested; otherwise records it.
     fn seen(&mut self, id: u32) -> bool {
@@ -112,7 +118,10 @@ pub struct Golden<'a> {
 
 impl<'a> Golden<'a> {
     pub fn new(layout: &'a Layout) -> Self {
-        Golden { layout, f: layout.format }
+        Golden {
+            layout,
+            f: layout.format,
+        }
     }
 
     fn frame_words<const N: usize>(&self, addr: usize) -> [u32; N] {
@@ -127,9 +136,21 @@ impl<'a> Golden<'a> {
         let mut stats = RayStats::default();
         let dir = units::primary_direction(f, &camera, x, y);
         stats.transforms += 1;
-        let query = Query { o: eye, d: dir, t_min: 0, t_max: f.infinity(false), skip: None, any: false };
+        let query = Query {
+            o: eye,
+            d: dir,
+            t_min: 0,
+            t_max: f.infinity(false),
+            skip: None,
+            any: false,
+        };
         let (color, hit) = self.shade(query, 0, &mut stats);
-        Pixel { rgb: units::pack_rgb(f, color), dir, hit, stats }
+        Pixel {
+            rgb: units::pack_rgb(f, color),
+            dir,
+            hit,
+            stats,
+        }
     }
 
     /// Traces a ray and shades what it hits; returns the colour and the hit.
@@ -151,7 +172,8 @@ impl<'a> Golden<'a> {
         };
         let n = units::facing_unit_normal(f, n_world, q.d);
         let material = l.word(SHADING, sh as u32 + 3) as usize;
-        let m_addr = l.info.triangle_count as usize * crate::layout::SHADING_WORDS + material * crate::layout::MATERIAL_WORDS;
+        let m_addr = l.info.triangle_count as usize * crate::layout::SHADING_WORDS
+            + material * crate::layout::MATERIAL_WORDS;
         let kd = l.words::<3>(SHADING, m_addr);
         let mirror = l.word(SHADING, m_addr as u32 + 3);
 
@@ -162,7 +184,9 @@ impl<'a> Golden<'a> {
             let position = self.frame_words::<3>(base);
             let color = self.frame_words::<3>(base + 3);
             let to_light = units::sub3(f, position, p);
-            let Some(cos) = units::lambert_cosine(f, n, to_light) else { continue };
+            let Some(cos) = units::lambert_cosine(f, n, to_light) else {
+                continue;
+            };
             if l.info.shadows {
                 stats.shadow_rays += 1;
                 let shadow = Query {
@@ -204,25 +228,37 @@ impl<'a> Golden<'a> {
         match l.info.top_root {
             None => {
                 let mut mailbox = Mailbox::new();
-                self.traverse(l.info.object_root, q, &mut best, stats, &mut |golden, list, count, best, stats| {
-                    golden.test_triangles(0, q, list, count, &mut mailbox, best, stats)
-                });
+                self.traverse(
+                    l.info.object_root,
+                    q,
+                    &mut best,
+                    stats,
+                    &mut |golden, list, count, best, stats| {
+                        golden.test_triangles(0, q, list, count, &mut mailbox, best, stats)
+                    },
+                );
             }
             Some(root) => {
                 let mut instances = Mailbox::new();
-                self.traverse(root, q, &mut best, stats, &mut |golden, list, count, best, stats| {
-                    for k in 0..count {
-                        let instance = l.word(LISTS, list + k);
-                        if instances.seen(instance) {
-                            stats.mailbox_skips += 1;
-                            continue;
+                self.traverse(
+                    root,
+                    q,
+                    &mut best,
+                    stats,
+                    &mut |golden, list, count, best, stats| {
+                        for k in 0..count {
+                            let instance = l.word(LISTS, list + k);
+                            if instances.seen(instance) {
+                                stats.mailbox_skips += 1;
+                                continue;
+                            }
+                            if golden.enter_instance(instance, q, best, stats) {
+                                return true;
+                            }
                         }
-                        if golden.enter_instance(instance, q, best, stats) {
-                            return true;
-                        }
-                    }
-                    false
-                });
+                        false
+                    },
+                );
             }
         }
         best
@@ -230,7 +266,13 @@ impl<'a> Golden<'a> {
 
     /// Transforms the ray into the instance's object space and traverses its tree. Affine maps
     /// keep the ray parameter t, so object-space hits compare directly with world ones.
-    fn enter_instance(&self, instance: u32, q: Query, best: &mut Option<Hit>, stats: &mut RayStats) -> bool {
+    fn enter_instance(
+        &self,
+        instance: u32,
+        q: Query,
+        best: &mut Option<Hit>,
+        stats: &mut RayStats,
+    ) -> bool {
         let f = self.f;
         let l = self.layout;
         stats.instance_entries += 1;
@@ -244,9 +286,15 @@ impl<'a> Golden<'a> {
             ..q
         };
         let mut mailbox = Mailbox::new();
-        self.traverse(root, local, best, stats, &mut |golden, list, count, best, stats| {
-            golden.test_triangles(instance, local, list, count, &mut mailbox, best, stats)
-        })
+        self.traverse(
+            root,
+            local,
+            best,
+            stats,
+            &mut |golden, list, count, best, stats| {
+                golden.test_triangles(instance, local, list, count, &mut mailbox, best, stats)
+            },
+        )
     }
 
     /// Tests the triangles of one leaf; true when an any-hit query is answered.
@@ -280,7 +328,11 @@ impl<'a> Golden<'a> {
             let t_max = best.map_or(q.t_max, |b| b.t);
             let r = units::intersect(f, o, d, q.t_min, t_max);
             if r.hit {
-                *best = Some(Hit { t: r.t, instance, triangle });
+                *best = Some(Hit {
+                    t: r.t,
+                    instance,
+                    triangle,
+                });
                 if q.any {
                     return true;
                 }
@@ -306,8 +358,13 @@ impl<'a> Golden<'a> {
             match self.layout.node(node) {
                 Node::Inner { axis, split, left } => {
                     stats.traversal_steps += 1;
-                    let (near_is_left, visit) = units::traversal_step(f, q.o[axis], q.d[axis], split, lo, hi);
-                    let (near, far) = if near_is_left { (left, left + 1) } else { (left + 1, left) };
+                    let (near_is_left, visit) =
+                        units::traversal_step(f, q.o[axis], q.d[axis], split, lo, hi);
+                    let (near, far) = if near_is_left {
+                        (left, left + 1)
+                    } else {
+                        (left + 1, left)
+                    };
                     match visit {
                         Visit::Near => node = near,
                         Visit::Far => node = far,

@@ -36,9 +36,19 @@ pub struct Frame {
 }
 
 impl Frame {
-    pub(crate) fn from_pixels(width: u32, height: u32, pixels: Vec<(u32, Option<HitRecord>)>) -> Frame {
+    pub(crate) fn from_pixels(
+        width: u32,
+        height: u32,
+        pixels: Vec<(u32, Option<HitRecord>)>,
+    ) -> Frame {
         let (rgb, hits) = pixels.into_iter().unzip();
-        Frame { width, height, rgb, hits, stats: RayStats::default() }
+        Frame {
+            width,
+            height,
+            rgb,
+            hits,
+            stats: RayStats::default(),
+        }
     }
 
     pub fn to_image(&self) -> image::RgbImage {
@@ -52,9 +62,13 @@ impl Frame {
     pub fn save_png(&self, path: &Path) -> anyhow::Result<()> {
         let mut bytes = Vec::new();
         self.to_image()
-            .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+            .write_to(
+                &mut std::io::Cursor::new(&mut bytes),
+                image::ImageFormat::Png,
+            )
             .context("encoding PNG")?;
         crate::output::write_atomically(path, &bytes)
+            .with_context(|| format!("writing {}", path.display()))
     }
 
     /// Writes the hits file of DESIGN.md section 3: `x,y,instance,triangle,dist`.
@@ -69,6 +83,7 @@ impl Frame {
             }
         }
         crate::output::write_atomically(path, &text)
+            .with_context(|| format!("writing {}", path.display()))
     }
 }
 
@@ -77,8 +92,15 @@ pub fn render_golden(layout: &Layout, progress: bool) -> Frame {
     let golden = Golden::new(layout);
     let (w, h) = (layout.info.width, layout.info.height);
     let f = layout.format;
-    let bar = if progress { ProgressBar::new(u64::from(h)) } else { ProgressBar::hidden() };
-    bar.set_style(ProgressStyle::with_template("golden {bar:40} {pos}/{len} rows {elapsed}").expect("valid template"));
+    let bar = if progress {
+        ProgressBar::new(u64::from(h))
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("golden {bar:40} {pos}/{len} rows {elapsed}")
+            .expect("valid template"),
+    );
     let rows: Vec<Vec<golden::Pixel>> = (0..h)
         .into_par_iter()
         .map(|y| {
@@ -95,9 +117,22 @@ pub fn render_golden(layout: &Layout, progress: bool) -> Frame {
         .map(|p| {
             stats += p.stats;
             let rec = p.hit.map(|hit| {
-                let object = layout.word(crate::layout::INSTANCES, hit.instance * crate::layout::INSTANCE_WORDS as u32 + crate::layout::instance_word::OBJECT as u32);
-                let object = if layout.info.top_root.is_some() { object as usize } else { 0 };
-                let len = p.dir.iter().map(|&c| f.to_f64(c).powi(2)).sum::<f64>().sqrt();
+                let object = layout.word(
+                    crate::layout::INSTANCES,
+                    hit.instance * crate::layout::INSTANCE_WORDS as u32
+                        + crate::layout::instance_word::OBJECT as u32,
+                );
+                let object = if layout.info.top_root.is_some() {
+                    object as usize
+                } else {
+                    0
+                };
+                let len = p
+                    .dir
+                    .iter()
+                    .map(|&c| f.to_f64(c).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
                 HitRecord {
                     instance: hit.instance,
                     triangle: hit.triangle - layout.info.object_first_triangle[object],

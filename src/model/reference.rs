@@ -36,23 +36,38 @@ struct RefHit {
 impl<'a> Reference<'a> {
     pub fn new(scene: &'a Scene) -> Self {
         let params = KdParams::default();
-        let trees = scene.objects.iter().map(|o| kd_tree::build_sah(&o.triangles, &params)).collect();
+        let trees = scene
+            .objects
+            .iter()
+            .map(|o| kd_tree::build_sah(&o.triangles, &params))
+            .collect();
         Reference { scene, trees }
     }
 
     /// Renders one frame at the scene camera's resolution.
     pub fn render(&self, frame: u32) -> Frame {
         let s = self.scene;
-        let to_world: Vec<DAffine3> = s.instances.iter().map(|i| i.object_to_world(frame)).collect();
-        let boxes: Vec<Aabb> =
-            s.instances.iter().zip(&to_world).map(|(i, m)| self.trees[i.object].bounds.transformed(m)).collect();
+        let to_world: Vec<DAffine3> = s
+            .instances
+            .iter()
+            .map(|i| i.object_to_world(frame))
+            .collect();
+        let boxes: Vec<Aabb> = s
+            .instances
+            .iter()
+            .zip(&to_world)
+            .map(|(i, m)| self.trees[i.object].bounds.transformed(m))
+            .collect();
         let mut extent = Aabb::from_points(std::iter::once(&s.camera.eye));
         for b in &boxes {
             extent = extent.union(b);
         }
         let geo = FrameGeometry {
             to_object: to_world.iter().map(|m| m.inverse()).collect(),
-            normal: to_world.iter().map(|m| m.matrix3.inverse().transpose()).collect(),
+            normal: to_world
+                .iter()
+                .map(|m| m.matrix3.inverse().transpose())
+                .collect(),
             top: kd_tree::build_sah_boxes(&boxes, &KdParams::default()),
             t_eps: 1e-9 * (extent.max - extent.min).max_element().max(1.0),
         };
@@ -63,14 +78,26 @@ impl<'a> Reference<'a> {
                 let (x, y) = (i % w, i / w);
                 let (o, d) = s.camera.primary_ray(x, y);
                 let (c, hit) = self.shade(&geo, o, d, 0.0, None, 0);
-                let rec = hit.map(|hh| HitRecord { instance: hh.instance, triangle: hh.triangle, dist: hh.t * d.length() });
+                let rec = hit.map(|hh| HitRecord {
+                    instance: hh.instance,
+                    triangle: hh.triangle,
+                    dist: hh.t * d.length(),
+                });
                 (pack(c), rec)
             })
             .collect();
         Frame::from_pixels(w, h, pixels)
     }
 
-    fn shade(&self, g: &FrameGeometry, o: DVec3, d: DVec3, t_min: f64, skip: Option<(u32, u32)>, depth: u32) -> (DVec3, Option<RefHit>) {
+    fn shade(
+        &self,
+        g: &FrameGeometry,
+        o: DVec3,
+        d: DVec3,
+        t_min: f64,
+        skip: Option<(u32, u32)>,
+        depth: u32,
+    ) -> (DVec3, Option<RefHit>) {
         let s = self.scene;
         let Some(hit) = self.trace(g, o, d, t_min, f64::INFINITY, skip, false) else {
             return (DVec3::from_array(s.render.background), None);
@@ -107,28 +134,44 @@ impl<'a> Reference<'a> {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn trace(&self, g: &FrameGeometry, o: DVec3, d: DVec3, t_min: f64, t_max: f64, skip: Option<(u32, u32)>, any: bool) -> Option<RefHit> {
+    fn trace(
+        &self,
+        g: &FrameGeometry,
+        o: DVec3,
+        d: DVec3,
+        t_min: f64,
+        t_max: f64,
+        skip: Option<(u32, u32)>,
+        any: bool,
+    ) -> Option<RefHit> {
         let s = self.scene;
         let world = Ray::new(o, d);
-        g.top.closest_hit_with(&world, t_min, t_max, |instance, t_best| {
-            let inst = &s.instances[instance as usize];
-            let m = &g.to_object[instance as usize];
-            let local = Ray::new(m.transform_point3(o), m.transform_vector3(d));
-            let tris = &s.objects[inst.object].triangles;
-            let test = |tri: u32, tb: f64| {
-                if skip == Some((instance, tri)) {
-                    return None;
+        g.top
+            .closest_hit_with(&world, t_min, t_max, |instance, t_best| {
+                let inst = &s.instances[instance as usize];
+                let m = &g.to_object[instance as usize];
+                let local = Ray::new(m.transform_point3(o), m.transform_vector3(d));
+                let tris = &s.objects[inst.object].triangles;
+                let test = |tri: u32, tb: f64| {
+                    if skip == Some((instance, tri)) {
+                        return None;
+                    }
+                    triangle::intersect(&local, &tris[tri as usize], t_min, tb).map(|(t, _, _)| t)
+                };
+                let tree = &self.trees[inst.object];
+                if any {
+                    tree.any_hit(&local, t_min, t_best, test)
+                        .map(|tri| (t_min, tri))
+                } else {
+                    tree.closest_hit(&local, t_min, t_best, test)
+                        .map(|(tri, t)| (t, tri))
                 }
-                triangle::intersect(&local, &tris[tri as usize], t_min, tb).map(|(t, _, _)| t)
-            };
-            let tree = &self.trees[inst.object];
-            if any {
-                tree.any_hit(&local, t_min, t_best, test).map(|tri| (t_min, tri))
-            } else {
-                tree.closest_hit(&local, t_min, t_best, test).map(|(tri, t)| (t, tri))
-            }
-        })
-        .map(|h| RefHit { t: h.t, instance: h.prim, triangle: h.payload })
+            })
+            .map(|h| RefHit {
+                t: h.t,
+                instance: h.prim,
+                triangle: h.payload,
+            })
     }
 }
 

@@ -16,7 +16,10 @@ pub type Mat34W = [u32; 12];
 pub fn transform(f: Format, m: &Mat34W, v: Vec3W, point: bool) -> Vec3W {
     let row = |r: usize| {
         let m = &m[r * 4..r * 4 + 4];
-        let s = f.add(f.add(f.mul(m[0], v[0]), f.mul(m[1], v[1])), f.mul(m[2], v[2]));
+        let s = f.add(
+            f.add(f.mul(m[0], v[0]), f.mul(m[1], v[1])),
+            f.mul(m[2], v[2]),
+        );
         if point {
             f.add(s, m[3])
         } else {
@@ -28,14 +31,24 @@ pub fn transform(f: Format, m: &Mat34W, v: Vec3W, point: bool) -> Vec3W {
 
 /// The normal transform is a 3x3 (the 3x4 layout without offsets), run as a vector transform.
 pub fn transform3(f: Format, m: &[u32; 9], v: Vec3W) -> Vec3W {
-    let row = |r: usize| f.add(f.add(f.mul(m[r * 3], v[0]), f.mul(m[r * 3 + 1], v[1])), f.mul(m[r * 3 + 2], v[2]));
+    let row = |r: usize| {
+        f.add(
+            f.add(f.mul(m[r * 3], v[0]), f.mul(m[r * 3 + 1], v[1])),
+            f.mul(m[r * 3 + 2], v[2]),
+        )
+    };
     [row(0), row(1), row(2)]
 }
 
 /// RayGen: the primary ray direction of pixel (x, y) is the camera matrix applied to the point
 /// (x, y, 0) (the layout bakes the pixel-centre offsets into the matrix's offset column).
 pub fn primary_direction(f: Format, camera: &Mat34W, x: u32, y: u32) -> Vec3W {
-    transform(f, camera, [f.from_int(x as i64), f.from_int(y as i64), 0], true)
+    transform(
+        f,
+        camera,
+        [f.from_int(x as i64), f.from_int(y as i64), 0],
+        true,
+    )
 }
 
 /// The result of one unit-triangle test.
@@ -75,7 +88,14 @@ pub enum Visit {
 /// the near child is the one holding the origin (on the plane, the one the ray heads into).
 /// Returns whether the near child is the left (below) one, and which children to visit.
 /// 1 add (sub), 1 div, comparisons.
-pub fn traversal_step(f: Format, o: u32, d: u32, split: u32, t_min: u32, t_max: u32) -> (bool, Visit) {
+pub fn traversal_step(
+    f: Format,
+    o: u32,
+    d: u32,
+    split: u32,
+    t_min: u32,
+    t_max: u32,
+) -> (bool, Visit) {
     let near_is_left = f.lt(o, split) || (f.eq(o, split) && f.le(d, 0));
     if f.eq(d, 0) {
         return (near_is_left, Visit::Near);
@@ -93,7 +113,10 @@ pub fn traversal_step(f: Format, o: u32, d: u32, split: u32, t_min: u32, t_max: 
 
 /// `a . b` as `(ax*bx + ay*by) + az*bz`.
 pub fn dot(f: Format, a: Vec3W, b: Vec3W) -> u32 {
-    f.add(f.add(f.mul(a[0], b[0]), f.mul(a[1], b[1])), f.mul(a[2], b[2]))
+    f.add(
+        f.add(f.mul(a[0], b[0]), f.mul(a[1], b[1])),
+        f.mul(a[2], b[2]),
+    )
 }
 
 /// The point `o + t*d`, per component `o + t*d`.

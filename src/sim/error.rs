@@ -1,0 +1,162 @@
+//! Errors of the external HDL tools (Icarus Verilog, Verilator, Yosys), shared by `sim` and
+//! `synth`.
+//!
+//! Contract: every error says which tool, which step, and quotes the tool's own first error
+//! lines (with file and line as the tool printed them), so the user can act without rerunning
+//! the tool by hand. Compile errors also carry the first error's location in structured form.
+
+use std::fmt;
+
+/// Where a tool located a problem: a source file and a 1-based line.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SourceLocation {
+    pub file: String,
+    pub line: u32,
+}
+
+impl fmt::Display for SourceLocation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}", self.file, self.line)
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ToolError {
+    #[error(
+        "{tool} not found on PATH: install it with `make deps` \
+         (apt-get install -y iverilog verilator yosys)"
+    )]
+    NotFound { tool: String },
+
+    #[error("{tool} rejected the design (top `{top}`){}:\n{excerpt}", at(.location))]
+    Compile {
+        tool: String,
+        top: String,
+        location: Option<SourceLocation>,
+        excerpt: String,
+    },
+
+    #[error("{tool}: simulation of `{top}` failed ({status}); last output:\n{excerpt}")]
+    Run {
+        tool: String,
+        top: String,
+        status: String,
+        excerpt: String,
+    },
+
+    #[error(
+        "{tool} timed out after {seconds:.1} s while {stage}; the process was killed \
+         (raise the timeout if the design is just slow, or check that the testbench calls \
+         $finish). Last output:\n{excerpt}"
+    )]
+    Timeout {
+        tool: String,
+        stage: String,
+        seconds: f64,
+        excerpt: String,
+    },
+
+    #[error("{context}: {source}")]
+    Io {
+        context: String,
+        #[source]
+        source: std::io::Error,
+    },
+
+    #[error("{tool}: could not understand its output ({message})")]
+    Parse { tool: String, message: String },
+
+    #[error("{0}")]
+    BadJob(String),
+}
+
+fn at(location: &Option<SourceLocation>) -> String {
+    match location {
+        Some(loc) => format!(" at {loc}"),
+        None => String::new(),
+    }
+}
+
+/// Parses `path:LINE:...` (Icarus) or `%Error: path:LINE:COL: ...` (Verilator) from one line.
+pub(crate) fn parse_location(line: &str) -> Option<SourceLocation> {
+    let mut rest = line.trim_start();
+    if let Some(stripped) = rest.strip_prefix('%') {
+        // "%Error: ", "%Error-PINMISSING: ", "%Warning-WIDTH: "
+        let colon = stripped.find(": ")?;
+        rest = &stripped[colon + 2..];
+    }
+    let mut parts = rest.splitn(3, ':');
+    let file = parts.next()?.trim();
+    let line_no: u32 = parts.next()?.trim().parse().ok()?;
+    parts.next()?;
+    if file.is_empty() || file.contains(' ') {
+        return None;
+    }
+    Some(SourceLocation {
+        file: file.to_string(),
+        line: line_no,
+    })
+}
+
+/// The tool's first error lines (up to `max`), falling back to its last lines when no line
+/// says "error" (some failures only print a summary).
+pub(crate) fn error_excerpt(output: &str, max: usize) -> (String, Option<SourceLocation>) {
+    let error_lines: Vec<&str> = output
+        .lines()
+        .filter(|l| {
+            let lower = l.to_ascii_lowercase();
+            lower.contains("error") && !lower.contains("exiting due to")
+        })
+        .take(max)
+        .collect();
+    let location = error_lines.iter().find_map(|l| parse_location(l));
+    if error_lines.is_empty() {
+        (super::process::last_lines(output, max), None)
+    } else {
+        (error_lines.join("\n"), location)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn locations_from_icarus_and_verilator_lines() {
+        assert_eq!(
+            parse_location("/tmp/x/tb.v:12: syntax error"),
+            Some(SourceLocation {
+                file: "/tmp/x/tb.v".into(),
+                line: 12
+            })
+        );
+        assert_eq!(
+            parse_location("%Error: tb.v:7:3: syntax error, unexpected IDENTIFIER"),
+            Some(SourceLocation {
+                file: "tb.v".into(),
+                line: 7
+            })
+        );
+        assert_eq!(
+            parse_location("%Warning-WIDTH: a/b.v:3:15: Operator ASSIGNW expects 8 bits"),
+            Some(SourceLocation {
+                file: "a/b.v".into(),
+                line: 3
+            })
+        );
+        assert_eq!(parse_location("I give up."), None);
+        assert_eq!(parse_location("%Error: Exiting due to 1 error(s)"), None);
+    }
+
+    #[test]
+    fn excerpt_prefers_error_lines() {
+        let out = "note: a\n/x.v:4: error: Unknown module type: foo\nnote: b\n\
+                   %Error: Exiting due to 1 error(s)\n";
+        let (text, loc) = error_excerpt(out, 5);
+        assert_eq!(text, "/x.v:4: error: Unknown module type: foo");
+        assert_eq!(loc.unwrap().line, 4);
+        let (text, loc) = error_excerpt("one\ntwo\n", 1);
+        assert_eq!(text, "two");
+        assert!(loc.is_none());
+    }
+}

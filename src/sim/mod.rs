@@ -1,0 +1,392 @@
+//! Drives the real HDL simulators: Icarus Verilog 11 (`iverilog` + `vvp`) and Verilator 5.006.
+//!
+//! Contract: [`run`] compiles a self-checking / self-dumping testbench (`SimJob::top` is the
+//! testbench module) and runs it with `work_dir` as the current directory, so relative
+//! `$fopen` / `$readmemh` paths in the testbench resolve against `work_dir`. Compile and run are
+//! timed separately. Every failure is a [`ToolError`]: the binary is missing (with the install
+//! hint), the design does not compile (quoting the tool's first error lines, with the first
+//! error's file and line), the simulation exits non-zero (quoting its last lines), or it
+//! exceeds `SimJob::timeout` (the process group is killed). Each job builds into its own fresh
+//! directory inside `work_dir`, so jobs sharing a `work_dir` never clobber each other.
+//!
+//! [`lint`] runs `verilator --lint-only -Wall` and returns structured warnings; [`vectors`]
+//! reads and writes the hex vector files of the `dynrt fp` CLI contract.
+
+mod error;
+mod lint;
+pub(crate) mod process;
+pub mod vectors;
+
+pub(crate) use error::error_excerpt;
+pub use error::{SourceLocation, ToolError};
+pub use lint::{lint, lint_with_timeout, LintReport, LintWarning};
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::str::FromStr;
+use std::time::Duration;
+
+use process::{describe_status, run_tool};
+
+/// How long [`tool_version`] and other trivial tool queries may take.
+const QUERY_TIMEOUT: Duration = Duration::from_secs(30);
+
+/// Which simulator runs a job.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Simulator {
+    /// Icarus Verilog: `iverilog -g2012` then `vvp`. Fast to compile, slow to run.
+    Icarus,
+    /// Verilator 5 with `--binary --timing`: slow to compile, fast to run.
+    Verilator,
+}
+
+impl Simulator {
+    pub const ALL: [Simulator; 2] = [Simulator::Icarus, Simulator::Verilator];
+
+    /// The CLI name, also the name of the compiler binary.
+    pub fn name(self) -> &'static str {
+        match self {
+            Simulator::Icarus => "iverilog",
+            Simulator::Verilator => "verilator",
+        }
+    }
+}
+
+impl fmt::Display for Simulator {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Simulator {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "iverilog" | "icarus" => Ok(Simulator::Icarus),
+            "verilator" => Ok(Simulator::Verilator),
+            other => Err(format!(
+                "unknown simulator `{other}`: expected `iverilog` or `verilator`"
+            )),
+        }
+    }
+}
+
+/// The simulator's version number, e.g. "11.0" for Icarus, "5.006" for Verilator.
+pub fn tool_version(sim: Simulator) -> Result<String, ToolError> {
+    let (binary, flag, marker) = match sim {
+        Simulator::Icarus => ("iverilog", "-V", "version"),
+        Simulator::Verilator => ("verilator", "--version", "Verilator"),
+    };
+    let out = run_tool(
+        binary,
+        "asking its version",
+        Command::new(binary).arg(flag),
+        QUERY_TIMEOUT,
+    )?;
+    // `iverilog -V` prints "Icarus Verilog version 11.0 (stable) ()" and then complains that
+    // no source was given; only the first line matters.
+    version_after(&out.combined(), marker).ok_or_else(|| ToolError::Parse {
+        tool: binary.to_string(),
+        message: format!(
+            "no version number after `{marker}` in: {}",
+            out.combined().lines().next().unwrap_or("")
+        ),
+    })
+}
+
+/// The first whitespace-separated word after `marker` that starts with a digit.
+pub(crate) fn version_after(text: &str, marker: &str) -> Option<String> {
+    text.lines().find_map(|line| {
+        let pos = line.find(marker)?;
+        line[pos + marker.len()..]
+            .split_whitespace()
+            .next()
+            .filter(|w| w.starts_with(|c: char| c.is_ascii_digit()))
+            .map(str::to_string)
+    })
+}
+
+/// One simulation: sources, testbench top, where to run, how long it may take.
+#[derive(Debug, Clone)]
+pub struct SimJob {
+    /// Current directory of the simulation; build products go in a fresh subdirectory.
+    pub work_dir: PathBuf,
+    /// Verilog / SystemVerilog sources (relative paths are taken from the caller's cwd).
+    pub sources: Vec<PathBuf>,
+    /// The testbench module.
+    pub top: String,
+    /// `` `define`` macros: (name, optional value).
+    pub defines: Vec<(String, Option<String>)>,
+    /// Run-time `+plusargs` (without the leading '+').
+    pub plusargs: Vec<String>,
+    /// `` `include`` search directories.
+    pub include_dirs: Vec<PathBuf>,
+    /// Limit for running the compiled simulation.
+    pub timeout: Duration,
+    /// Limit for compiling (Verilator's C++ build of a large design takes minutes).
+    pub compile_timeout: Duration,
+    /// Parallel C++ compile jobs for Verilator (`-j`).
+    pub verilator_jobs: u32,
+    /// C++ optimisation flag for the Verilator model, e.g. "-O1".
+    pub verilator_opt: String,
+}
+
+impl SimJob {
+    /// A job with defaults: 10 min run limit, 30 min compile limit, Verilator `-j 2 -O1`.
+    pub fn new(
+        work_dir: impl Into<PathBuf>,
+        sources: Vec<PathBuf>,
+        top: impl Into<String>,
+    ) -> SimJob {
+        SimJob {
+            work_dir: work_dir.into(),
+            sources,
+            top: top.into(),
+            defines: Vec::new(),
+            plusargs: Vec::new(),
+            include_dirs: Vec::new(),
+            timeout: Duration::from_secs(600),
+            compile_timeout: Duration::from_secs(1800),
+            verilator_jobs: 2,
+            verilator_opt: "-O1".to_string(),
+        }
+    }
+
+    pub fn timeout(mut self, timeout: Duration) -> SimJob {
+        self.timeout = timeout;
+        self
+    }
+
+    pub fn define(mut self, name: impl Into<String>, value: Option<String>) -> SimJob {
+        self.defines.push((name.into(), value));
+        self
+    }
+
+    pub fn plusarg(mut self, arg: impl Into<String>) -> SimJob {
+        self.plusargs.push(arg.into());
+        self
+    }
+}
+
+/// What a finished simulation produced.
+#[derive(Debug, Clone)]
+pub struct SimRun {
+    pub simulator: Simulator,
+    /// Wall time of compilation (iverilog, or verilator + make + g++), seconds.
+    pub compile_seconds: f64,
+    /// Wall time of the simulation run, seconds.
+    pub run_seconds: f64,
+    pub stdout: String,
+    pub stderr: String,
+    /// The directory holding this job's build products (vvp file or Verilator obj_dir).
+    pub build_dir: PathBuf,
+}
+
+/// Compiles and runs `job` in `sim`. See the module doc for the contract.
+pub fn run(sim: Simulator, job: &SimJob) -> Result<SimRun, ToolError> {
+    let prepared = prepare(job)?;
+    match sim {
+        Simulator::Icarus => run_icarus(job, &prepared),
+        Simulator::Verilator => run_verilator(job, &prepared),
+    }
+}
+
+struct Prepared {
+    work_dir: PathBuf,
+    sources: Vec<PathBuf>,
+    include_dirs: Vec<PathBuf>,
+    build_dir: PathBuf,
+}
+
+fn prepare(job: &SimJob) -> Result<Prepared, ToolError> {
+    if job.sources.is_empty() {
+        return Err(ToolError::BadJob(format!(
+            "simulation of `{}` has no source files",
+            job.top
+        )));
+    }
+    if !is_identifier(&job.top) {
+        return Err(ToolError::BadJob(format!(
+            "`{}` is not a Verilog module name (letters, digits, '_', '$'; not starting with a digit)",
+            job.top
+        )));
+    }
+    std::fs::create_dir_all(&job.work_dir).map_err(|e| ToolError::Io {
+        context: format!("cannot create work directory {}", job.work_dir.display()),
+        source: e,
+    })?;
+    let work_dir = absolute(&job.work_dir)?;
+    let mut sources = Vec::with_capacity(job.sources.len());
+    for s in &job.sources {
+        if !s.is_file() {
+            return Err(ToolError::BadJob(format!(
+                "source file {} does not exist (simulation of `{}`)",
+                s.display(),
+                job.top
+            )));
+        }
+        sources.push(absolute(s)?);
+    }
+    let include_dirs = job
+        .include_dirs
+        .iter()
+        .map(|d| absolute(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let build_dir = tempfile::Builder::new()
+        .prefix(&format!("build_{}_", job.top.replace('$', "_")))
+        .tempdir_in(&work_dir)
+        .map_err(|e| ToolError::Io {
+            context: format!("cannot create a build directory in {}", work_dir.display()),
+            source: e,
+        })?
+        .keep();
+    Ok(Prepared {
+        work_dir,
+        sources,
+        include_dirs,
+        build_dir,
+    })
+}
+
+fn absolute(p: &Path) -> Result<PathBuf, ToolError> {
+    std::path::absolute(p).map_err(|e| ToolError::Io {
+        context: format!("cannot resolve path {}", p.display()),
+        source: e,
+    })
+}
+
+fn is_identifier(s: &str) -> bool {
+    let mut chars = s.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '$')
+}
+
+fn define_arg(name: &str, value: &Option<String>) -> String {
+    match value {
+        Some(v) => format!("{name}={v}"),
+        None => name.to_string(),
+    }
+}
+
+fn compile_error(tool: &str, top: &str, output: &str) -> ToolError {
+    let (excerpt, location) = error::error_excerpt(output, 10);
+    ToolError::Compile {
+        tool: tool.to_string(),
+        top: top.to_string(),
+        location,
+        excerpt,
+    }
+}
+
+fn run_failed(tool: &str, top: &str, status: &std::process::ExitStatus, output: &str) -> ToolError {
+    ToolError::Run {
+        tool: tool.to_string(),
+        top: top.to_string(),
+        status: describe_status(status),
+        excerpt: process::last_lines(output, 15),
+    }
+}
+
+fn run_icarus(job: &SimJob, p: &Prepared) -> Result<SimRun, ToolError> {
+    let vvp_file = p.build_dir.join(format!("{}.vvp", job.top));
+    let mut compile = Command::new("iverilog");
+    compile
+        .current_dir(&p.work_dir)
+        .args(["-g2012", "-s", &job.top, "-o"])
+        .arg(&vvp_file);
+    for (name, value) in &job.defines {
+        compile.arg(format!("-D{}", define_arg(name, value)));
+    }
+    for dir in &p.include_dirs {
+        compile.arg("-I").arg(dir);
+    }
+    compile.args(&p.sources);
+    let stage = format!("compiling `{}`", job.top);
+    let built = run_tool("iverilog", &stage, &mut compile, job.compile_timeout)?;
+    // iverilog reports some errors ("Unknown module type") with exit status 0 on old versions
+    // but then writes no output file; treat either as a compile failure.
+    if !built.status.success() || !vvp_file.is_file() {
+        return Err(compile_error("iverilog", &job.top, &built.combined()));
+    }
+
+    let mut sim = Command::new("vvp");
+    // -n: $stop ends the run instead of dropping into the interactive prompt.
+    sim.current_dir(&p.work_dir).arg("-n").arg(&vvp_file);
+    for arg in &job.plusargs {
+        sim.arg(format!("+{arg}"));
+    }
+    let stage = format!("simulating `{}`", job.top);
+    let ran = run_tool("vvp", &stage, &mut sim, job.timeout)?;
+    if !ran.status.success() {
+        return Err(run_failed("vvp", &job.top, &ran.status, &ran.combined()));
+    }
+    Ok(SimRun {
+        simulator: Simulator::Icarus,
+        compile_seconds: built.seconds,
+        run_seconds: ran.seconds,
+        stdout: ran.stdout,
+        stderr: ran.stderr,
+        build_dir: p.build_dir.clone(),
+    })
+}
+
+fn run_verilator(job: &SimJob, p: &Prepared) -> Result<SimRun, ToolError> {
+    let exe_name = format!("V{}", job.top);
+    let mut compile = Command::new("verilator");
+    compile
+        .current_dir(&p.work_dir)
+        .args(["--binary", "--timing"])
+        .arg("-j")
+        .arg(job.verilator_jobs.max(1).to_string())
+        .args(["--top-module", &job.top])
+        // Warnings are the linter's business (see `lint`); they must not stop a simulation.
+        .arg("-Wno-fatal")
+        // X assignments (case defaults, out-of-range) become constants: faster, deterministic.
+        .args(["--x-assign", "fast"])
+        .arg("--Mdir")
+        .arg(&p.build_dir)
+        .args(["-o", &exe_name])
+        .arg("-CFLAGS")
+        .arg(&job.verilator_opt);
+    for (name, value) in &job.defines {
+        compile.arg(format!("-D{}", define_arg(name, value)));
+    }
+    for dir in &p.include_dirs {
+        compile.arg(format!("+incdir+{}", dir.display()));
+    }
+    compile.args(&p.sources);
+    let stage = format!("compiling `{}`", job.top);
+    let built = run_tool("verilator", &stage, &mut compile, job.compile_timeout)?;
+    let exe = p.build_dir.join(&exe_name);
+    if !built.status.success() || !exe.is_file() {
+        return Err(compile_error("verilator", &job.top, &built.combined()));
+    }
+
+    let mut sim = Command::new(&exe);
+    sim.current_dir(&p.work_dir);
+    for arg in &job.plusargs {
+        sim.arg(format!("+{arg}"));
+    }
+    let stage = format!("simulating `{}`", job.top);
+    let ran = run_tool(&exe_name, &stage, &mut sim, job.timeout)?;
+    if !ran.status.success() {
+        return Err(run_failed(
+            &exe_name,
+            &job.top,
+            &ran.status,
+            &ran.combined(),
+        ));
+    }
+    Ok(SimRun {
+        simulator: Simulator::Verilator,
+        compile_seconds: built.seconds,
+        run_seconds: ran.seconds,
+        stdout: ran.stdout,
+        stderr: ran.stderr,
+        build_dir: p.build_dir.clone(),
+    })
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,356 @@
+//! Synthesis with Yosys 0.23 for Virtex-II (`synth_xilinx -family xc2v`), reporting cell counts,
+//! logic depth and device utilization.
+//!
+//! Contract: [`synth_xc2v`] runs `read_verilog -sv SOURCES; synth_xilinx -family xc2v -flatten
+//! -top TOP; stat; write_json` in `work_dir` (script, log, `stat` text and netlist stay there
+//! for inspection) under a time limit, and reads the cell counts from the flattened netlist.
+//! `-flatten` makes the counts whole-design totals and lets the depth analysis see every path.
+//! Yosys marks xc2v support EXPERIMENTAL; it maps products to `MULT18X18` (17x17 -> 1,
+//! 24x24 -> 4 plus adders), registers to `FD*`, logic to `LUT1`..`LUT4` + `MUXF5`..`MUXF8`,
+//! adders to `MUXCY`/`XORCY`, memories to `RAMB16_*`. Logic depth is defined in [`depth`].
+
+mod depth;
+pub mod device;
+
+pub use device::{FpgaDevice, Utilization, XC2V6000};
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Duration;
+
+use crate::sim::ToolError;
+
+/// Options of one synthesis run.
+#[derive(Debug, Clone)]
+pub struct SynthOptions {
+    /// Kill yosys after this long.
+    pub timeout: Duration,
+    /// Insert I/O buffers (IBUF/OBUF/BUFG) as for a top-level chip design; `false` passes
+    /// `-noiopad -noclkbuf` for out-of-context measurement of a block.
+    pub io_pads: bool,
+}
+
+impl Default for SynthOptions {
+    fn default() -> Self {
+        SynthOptions {
+            timeout: Duration::from_secs(1800),
+            io_pads: true,
+        }
+    }
+}
+
+/// Cell counts and depth of a design after `synth_xilinx -family xc2v`.
+#[derive(Debug, Clone)]
+pub struct SynthReport {
+    pub top: String,
+    pub yosys_version: String,
+    /// Logic LUTs: `LUT1`..`LUT6` plus `INV` (an inverter occupies a LUT).
+    pub luts: u64,
+    /// Count per LUT type (`LUT1`..`LUT6`, `INV`).
+    pub lut_types: BTreeMap<String, u64>,
+    /// LUTs used as distributed RAM or shift registers (`RAM16X1S` = 1, `RAM32X1S` = 2,
+    /// `RAM16X1D` = 2, `SRL16*` = 1, ...).
+    pub lut_ram_luts: u64,
+    /// `FD*` cells.
+    pub flip_flops: u64,
+    /// `MULT18X18*` cells.
+    pub mult18x18: u64,
+    /// `RAMB16*` cells (18-Kbit block RAMs).
+    pub block_rams: u64,
+    /// `MUXF5`..`MUXF8` cells.
+    pub muxf: u64,
+    /// Carry-chain cells: `MUXCY`, `XORCY`, `MULT_AND`.
+    pub carry: u64,
+    /// Longest register-to-register (or port) path in LUT levels; see [`depth`].
+    pub logic_depth: u32,
+    /// Longest path in logic cells of any kind (LUT, MUXF, carry, multiplier).
+    pub path_cells: u32,
+    /// Every cell type and its count.
+    pub all_cells: BTreeMap<String, u64>,
+    /// Yosys's `stat` output.
+    pub stat_text: String,
+    /// Wall time of the yosys run, seconds.
+    pub seconds: f64,
+    /// The flattened netlist (`write_json`).
+    pub netlist_json: PathBuf,
+}
+
+impl SynthReport {
+    /// All LUTs the design occupies: logic plus distributed RAM / shift registers.
+    pub fn total_luts(&self) -> u64 {
+        self.luts + self.lut_ram_luts
+    }
+
+    pub fn utilization(&self, device: &FpgaDevice) -> Utilization {
+        Utilization {
+            device: *device,
+            luts_percent: device::percent(self.total_luts(), device.luts),
+            flip_flops_percent: device::percent(self.flip_flops, device.flip_flops),
+            mult18x18_percent: device::percent(self.mult18x18, device.mult18x18),
+            block_rams_percent: device::percent(self.block_rams, device.block_rams),
+        }
+    }
+
+    /// Count of one cell type (0 if absent).
+    pub fn cells(&self, cell_type: &str) -> u64 {
+        self.all_cells.get(cell_type).copied().unwrap_or(0)
+    }
+}
+
+impl fmt::Display for SynthReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{} (yosys {}, synth_xilinx -family xc2v, {:.1} s)",
+            self.top, self.yosys_version, self.seconds
+        )?;
+        writeln!(
+            f,
+            "  LUTs {} (+{} as RAM/SRL)  FFs {}  MULT18X18 {}  RAMB16 {}  MUXF {}  carry {}",
+            self.luts,
+            self.lut_ram_luts,
+            self.flip_flops,
+            self.mult18x18,
+            self.block_rams,
+            self.muxf,
+            self.carry
+        )?;
+        writeln!(
+            f,
+            "  logic depth {} LUT levels ({} cells on the longest path)",
+            self.logic_depth, self.path_cells
+        )?;
+        write!(f, "  {}", self.utilization(&XC2V6000))
+    }
+}
+
+/// Yosys's version number, e.g. "0.23".
+pub fn yosys_version() -> Result<String, ToolError> {
+    let out = crate::sim::process::run_tool(
+        "yosys",
+        "asking its version",
+        Command::new("yosys").arg("-V"),
+        Duration::from_secs(30),
+    )?;
+    crate::sim::version_after(&out.combined(), "Yosys").ok_or_else(|| ToolError::Parse {
+        tool: "yosys".into(),
+        message: format!("no version in `{}`", out.combined().trim()),
+    })
+}
+
+/// Synthesizes `top` from `sources` for Virtex-II with default options.
+pub fn synth_xc2v(
+    sources: &[PathBuf],
+    top: &str,
+    work_dir: &Path,
+) -> Result<SynthReport, ToolError> {
+    synth_xc2v_with(sources, top, work_dir, &SynthOptions::default())
+}
+
+pub fn synth_xc2v_with(
+    sources: &[PathBuf],
+    top: &str,
+    work_dir: &Path,
+    options: &SynthOptions,
+) -> Result<SynthReport, ToolError> {
+    if sources.is_empty() {
+        return Err(ToolError::BadJob(format!(
+            "synthesis of `{top}`: no source files"
+        )));
+    }
+    if top.is_empty()
+        || !top
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '$')
+    {
+        return Err(ToolError::BadJob(format!(
+            "synthesis: `{top}` is not a plain Verilog module name"
+        )));
+    }
+    let yosys_version = yosys_version()?;
+    std::fs::create_dir_all(work_dir).map_err(|e| ToolError::Io {
+        context: format!("cannot create {}", work_dir.display()),
+        source: e,
+    })?;
+    let abs = |p: &Path| {
+        std::path::absolute(p).map_err(|e| ToolError::Io {
+            context: format!("cannot resolve {}", p.display()),
+            source: e,
+        })
+    };
+    let work_dir = abs(work_dir)?;
+    let mut read = String::from("read_verilog -sv");
+    for s in sources {
+        if !s.is_file() {
+            return Err(ToolError::BadJob(format!(
+                "synthesis of `{top}`: source file {} does not exist",
+                s.display()
+            )));
+        }
+        let path = abs(s)?;
+        let text = path.to_string_lossy().into_owned();
+        if text.contains(|c: char| c.is_whitespace() || c == '"' || c == ';') {
+            return Err(ToolError::BadJob(format!(
+                "synthesis of `{top}`: yosys scripts cannot name {text} (whitespace, quote or ';' in the path); move the file"
+            )));
+        }
+        read.push(' ');
+        read.push_str(&text);
+    }
+    let stem = format!("synth_{}", top.replace('$', "_"));
+    let stat_file = work_dir.join(format!("{stem}.stat.txt"));
+    let json_file = work_dir.join(format!("{stem}.json"));
+    let log_file = work_dir.join(format!("{stem}.log"));
+    let script_file = work_dir.join(format!("{stem}.ys"));
+    for stale in [&stat_file, &json_file] {
+        let _ = std::fs::remove_file(stale);
+    }
+    let pads = if options.io_pads {
+        ""
+    } else {
+        " -noiopad -noclkbuf"
+    };
+    let script = format!(
+        "{read}\n\
+         synth_xilinx -family xc2v -flatten -top {top}{pads}\n\
+         tee -q -o {stat} stat\n\
+         write_json {json}\n",
+        stat = stat_file.display(),
+        json = json_file.display(),
+    );
+    std::fs::write(&script_file, &script).map_err(|e| ToolError::Io {
+        context: format!("cannot write {}", script_file.display()),
+        source: e,
+    })?;
+
+    let mut cmd = Command::new("yosys");
+    cmd.current_dir(&work_dir)
+        .arg("-q")
+        .arg("-l")
+        .arg(&log_file)
+        .arg("-s")
+        .arg(&script_file);
+    let out = crate::sim::process::run_tool(
+        "yosys",
+        &format!("synthesizing `{top}`"),
+        &mut cmd,
+        options.timeout,
+    )?;
+    if !out.status.success() || !json_file.is_file() {
+        let log = std::fs::read_to_string(&log_file).unwrap_or_default();
+        let text = crate::sim::process::combine(&out.combined(), &log);
+        let (excerpt, location) = crate::sim::error_excerpt(&text, 10);
+        return Err(ToolError::Compile {
+            tool: "yosys".into(),
+            top: top.to_string(),
+            location,
+            excerpt,
+        });
+    }
+    let stat_text = std::fs::read_to_string(&stat_file).unwrap_or_default();
+    let json = std::fs::read(&json_file).map_err(|e| ToolError::Io {
+        context: format!("cannot read {}", json_file.display()),
+        source: e,
+    })?;
+    let netlist: depth::Netlist = serde_json::from_slice(&json).map_err(|e| ToolError::Parse {
+        tool: "yosys".into(),
+        message: format!("{}: {e}", json_file.display()),
+    })?;
+    let module = netlist.modules.get(top).ok_or_else(|| ToolError::Parse {
+        tool: "yosys".into(),
+        message: format!("{} has no module `{top}`", json_file.display()),
+    })?;
+    let (logic_depth, path_cells) = depth::longest_paths(module).map_err(|m| ToolError::Parse {
+        tool: "yosys".into(),
+        message: format!("netlist of `{top}`: {m}"),
+    })?;
+    let mut all_cells = BTreeMap::new();
+    for c in module.cells.values() {
+        *all_cells.entry(c.cell_type.clone()).or_insert(0u64) += 1;
+    }
+    Ok(summarize(
+        top,
+        yosys_version,
+        all_cells,
+        logic_depth,
+        path_cells,
+        stat_text,
+        out.seconds,
+        json_file,
+    ))
+}
+
+/// LUTs a distributed RAM or shift-register primitive occupies on Virtex-II.
+fn lut_ram_size(t: &str) -> u64 {
+    if t.starts_with("SRL") {
+        return 1;
+    }
+    // RAM<depth>X<width><S|D>: 16 entries per LUT; dual-port doubles it.
+    let Some(rest) = t.strip_prefix("RAM") else {
+        return 0;
+    };
+    let Some((d, tail)) = rest.split_once('X') else {
+        return 0;
+    };
+    let (Ok(depth), Some(w_end)) = (d.parse::<u64>(), tail.find(|c: char| !c.is_ascii_digit()))
+    else {
+        return 0;
+    };
+    let width: u64 = tail[..w_end].parse().unwrap_or(1);
+    let dual = if tail[w_end..].starts_with('D') { 2 } else { 1 };
+    depth.div_ceil(16) * width * dual
+}
+
+#[allow(clippy::too_many_arguments)]
+fn summarize(
+    top: &str,
+    yosys_version: String,
+    all_cells: BTreeMap<String, u64>,
+    logic_depth: u32,
+    path_cells: u32,
+    stat_text: String,
+    seconds: f64,
+    netlist_json: PathBuf,
+) -> SynthReport {
+    let sum = |pred: &dyn Fn(&str) -> bool| -> u64 {
+        all_cells
+            .iter()
+            .filter(|(t, _)| pred(t))
+            .map(|(_, n)| n)
+            .sum()
+    };
+    let is_lut = |t: &str| t == "INV" || (t.starts_with("LUT") && t[3..].parse::<u32>().is_ok());
+    let lut_types = all_cells
+        .iter()
+        .filter(|(t, _)| is_lut(t))
+        .map(|(t, n)| (t.clone(), *n))
+        .collect();
+    let lut_ram_luts = all_cells
+        .iter()
+        .filter(|(t, _)| t.starts_with("SRL") || depth::is_distributed_ram(t))
+        .map(|(t, n)| lut_ram_size(t) * n)
+        .sum();
+    SynthReport {
+        top: top.to_string(),
+        yosys_version,
+        luts: sum(&is_lut),
+        lut_types,
+        lut_ram_luts,
+        flip_flops: sum(&|t| depth::is_flip_flop(t)),
+        mult18x18: sum(&|t| t.starts_with("MULT18X18")),
+        block_rams: sum(&|t| t.starts_with("RAMB16")),
+        muxf: sum(&|t| t.starts_with("MUXF")),
+        carry: sum(&|t| matches!(t, "MUXCY" | "XORCY" | "MULT_AND")),
+        logic_depth,
+        path_cells,
+        all_cells,
+        stat_text,
+        seconds,
+        netlist_json,
+    }
+}
+
+#[cfg(test)]
+mod tests;

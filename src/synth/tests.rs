@@ -1,0 +1,168 @@
+//! Tests of `synth` against the real Yosys 0.23 (no mocks).
+
+use super::*;
+
+fn synth_source(name: &str, verilog: &str, top: &str) -> SynthReport {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join(format!("{name}.v"));
+    std::fs::write(&src, verilog).unwrap();
+    let report = synth_xc2v(&[src], top, dir.path()).unwrap_or_else(|e| panic!("{top}: {e}"));
+    println!("{report}\n{:?}", report.all_cells);
+    report
+}
+
+fn registered_multiplier(w: u32) -> String {
+    format!(
+        "module mul{w} (input wire clk, input wire [{m}:0] a, input wire [{m}:0] b,\n\
+         \x20   output reg [{p}:0] p);\n\
+         \x20 reg [{m}:0] ra, rb;\n\
+         \x20 always @(posedge clk) begin ra <= a; rb <= b; p <= ra * rb; end\n\
+         endmodule\n",
+        m = w - 1,
+        p = 2 * w - 1
+    )
+}
+
+#[test]
+fn mult_17x17_uses_one_mult18x18() {
+    let r = synth_source("mul17", &registered_multiplier(17), "mul17");
+    assert_eq!(r.mult18x18, 1);
+    // Operand and product registers: 17 + 17 + 34.
+    assert_eq!(r.flip_flops, 68);
+    assert_eq!(r.yosys_version, "0.23");
+}
+
+#[test]
+fn mult_24x24_uses_four_mult18x18() {
+    // 24 = 17 + 7 unsigned slices per operand: a 2x2 grid of 18x18 signed multipliers,
+    // whose partial products are summed in carry-chain adders.
+    let r = synth_source("mul24", &registered_multiplier(24), "mul24");
+    assert_eq!(r.mult18x18, 4);
+    assert!(
+        r.carry > 0,
+        "partial products need adders: {:?}",
+        r.all_cells
+    );
+    assert_eq!(r.flip_flops, 24 + 24 + 48);
+}
+
+#[test]
+fn counter_has_n_flip_flops() {
+    for n in [5u32, 13] {
+        let v = format!(
+            "module counter (input wire clk, input wire rst, output reg [{m}:0] q);\n\
+             \x20 always @(posedge clk) if (rst) q <= 0; else q <= q + 1'b1;\n\
+             endmodule\n",
+            m = n - 1
+        );
+        let r = synth_source("counter", &v, "counter");
+        assert_eq!(r.flip_flops, n as u64, "{:?}", r.all_cells);
+        assert_eq!(r.mult18x18, 0);
+        assert_eq!(r.block_rams, 0);
+    }
+}
+
+#[test]
+fn parity_tree_depth_in_lut_levels() {
+    // XOR of 64 registered bits into a register. ABC maps to 8-input "wide LUTs" (16 LUT4s
+    // joined by MUXF5..MUXF8 inside the CLBs), which the depth definition counts as one level:
+    // 64 -> 8 -> 1 = 2 levels, and 5 cells (LUT4, MUXF5, MUXF6, MUXF7, MUXF8) per level.
+    // A wrong count of MUXFs as levels would give 10; cutting paths at the wrong place, 1.
+    let v = "module parity (input wire clk, input wire [63:0] d, output reg p);\n\
+             \x20 reg [63:0] r;\n\
+             \x20 always @(posedge clk) begin r <= d; p <= ^r; end\n\
+             endmodule\n";
+    let r = synth_source("parity", v, "parity");
+    assert_eq!(r.cells("MUXF8"), 9, "{:?}", r.all_cells);
+    assert_eq!(r.logic_depth, 2, "{:?}", r.all_cells);
+    assert_eq!(r.path_cells, 10, "{:?}", r.all_cells);
+    assert_eq!(r.flip_flops, 65);
+}
+
+#[test]
+fn adder_is_one_lut_level_plus_carry_chain() {
+    // Registered 16-bit add: one LUT2 per bit feeding MUXCY/XORCY; the path from the LSB's
+    // LUT through 15 MUXCYs to the MSB's XORCY is 17 cells but only 1 LUT level.
+    let v = "module add16 (input wire clk, input wire [15:0] a, input wire [15:0] b,\n\
+             \x20   output reg [15:0] s);\n\
+             \x20 reg [15:0] ra, rb;\n\
+             \x20 always @(posedge clk) begin ra <= a; rb <= b; s <= ra + rb; end\n\
+             endmodule\n";
+    let r = synth_source("add16", v, "add16");
+    assert_eq!(r.logic_depth, 1, "{:?}", r.all_cells);
+    assert_eq!(r.path_cells, 17, "{:?}", r.all_cells);
+    assert_eq!(r.cells("XORCY"), 16, "{:?}", r.all_cells);
+}
+
+#[test]
+fn syntax_error_is_located() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("bad.v");
+    std::fs::write(
+        &src,
+        "module bad (input wire a, output wire y);\n  assign y = ;\nendmodule\n",
+    )
+    .unwrap();
+    match synth_xc2v(&[src], "bad", dir.path()) {
+        Err(ToolError::Compile {
+            location, excerpt, ..
+        }) => {
+            let loc = location.expect(&excerpt);
+            assert!(loc.file.ends_with("bad.v"), "{loc}");
+            assert_eq!(loc.line, 2, "{excerpt}");
+        }
+        other => panic!("expected a compile error, got {other:?}"),
+    }
+}
+
+#[test]
+fn missing_top_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("m.v");
+    std::fs::write(
+        &src,
+        "module m (input wire a, output wire y);\n  assign y = a;\nendmodule\n",
+    )
+    .unwrap();
+    let err = synth_xc2v(&[src], "not_there", dir.path()).unwrap_err();
+    assert!(matches!(err, ToolError::Compile { .. }), "{err:?}");
+    assert!(err.to_string().contains("not_there"), "{err}");
+}
+
+#[test]
+fn utilization_of_xc2v6000() {
+    let mut cells = BTreeMap::new();
+    cells.insert("MULT18X18".to_string(), 36);
+    cells.insert("LUT4".to_string(), 6758);
+    cells.insert("RAM16X1D".to_string(), 1);
+    cells.insert("FDRE".to_string(), 33792);
+    cells.insert("RAMB16_S36_S36".to_string(), 144);
+    let r = summarize(
+        "t",
+        "0.23".into(),
+        cells,
+        0,
+        0,
+        String::new(),
+        0.0,
+        PathBuf::new(),
+    );
+    assert_eq!(r.luts, 6758);
+    assert_eq!(r.lut_ram_luts, 2);
+    let u = r.utilization(&XC2V6000);
+    assert!((u.luts_percent - 100.0 * 6760.0 / 67584.0).abs() < 1e-9);
+    assert_eq!(u.flip_flops_percent, 50.0);
+    assert_eq!(u.mult18x18_percent, 25.0);
+    assert_eq!(u.block_rams_percent, 100.0);
+    assert!(u.fits());
+    assert_eq!(XC2V6000.luts, 2 * XC2V6000.slices);
+}
+
+#[test]
+fn lut_ram_sizes() {
+    assert_eq!(lut_ram_size("RAM16X1S"), 1);
+    assert_eq!(lut_ram_size("RAM32X1S"), 2);
+    assert_eq!(lut_ram_size("RAM64X1D"), 8);
+    assert_eq!(lut_ram_size("RAM16X8S"), 8);
+    assert_eq!(lut_ram_size("SRL16E"), 1);
+}
