@@ -252,15 +252,28 @@ mod tests {
 
     /// kd closest hit and any hit against brute force, with and without split clipping.
     fn check_against_brute_force(name: &str, tris: &[[DVec3; 3]], per_kind: usize, seed: u64) {
-        println!("mesh {name}: {} triangles, ray seed {seed}", tris.len());
-        for clip in [true, false] {
-            let params = KdParams {
+        let variants: Vec<KdParams> = [true, false]
+            .map(|clip| KdParams {
                 clip_splits: clip,
                 ..KdParams::default()
-            };
-            let tree = build_sah(tris, &params);
+            })
+            .into();
+        check_variants(name, tris, per_kind, seed, &variants);
+    }
+
+    fn check_variants(
+        name: &str,
+        tris: &[[DVec3; 3]],
+        per_kind: usize,
+        seed: u64,
+        variants: &[KdParams],
+    ) {
+        println!("mesh {name}: {} triangles, ray seed {seed}", tris.len());
+        for params in variants {
+            let clip = params.clip_splits;
+            let tree = build_sah(tris, params);
             tree.validate_against(&Triangles(tris))
-                .unwrap_or_else(|e| panic!("{name} clip={clip}: {e}"));
+                .unwrap_or_else(|e| panic!("{name} {params:?}: {e}"));
             let rays = ray_set(tris, &tree, per_kind, seed);
             let mut per_kind_counts: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
             let mut failures = Vec::new();
@@ -357,6 +370,27 @@ mod tests {
     #[test]
     fn fandisk_matches_brute_force() {
         check_against_brute_force("fandisk", &public_mesh("fandisk.obj"), 100, 7);
+    }
+
+    /// Splits rounded to a short mantissa (as a reduced-precision layout stores them) are
+    /// exactly representable and traversal stays exact.
+    #[test]
+    fn rounded_splits_match_brute_force() {
+        for bits in [16, 6] {
+            let params = KdParams {
+                split_mantissa_bits: Some(bits),
+                ..KdParams::default()
+            };
+            for (name, tris) in [("sphere(3)", sphere(3)), ("cow", public_mesh("cow.obj"))] {
+                let tree = build_sah(&tris, &params);
+                let planes = split_planes(&tree);
+                assert!(planes.len() > 100);
+                for (_, s) in planes {
+                    assert_eq!(crate::accel::kd_tree::round_mantissa(s, bits), s);
+                }
+                check_variants(name, &tris, 100, 12, &[params.clone()]);
+            }
+        }
     }
 
     #[test]

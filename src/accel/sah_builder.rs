@@ -15,11 +15,14 @@
 //!   clipped to each child box and only their new events are sorted and merged in, so the total
 //!   stays O(N log N).
 //!
+//! - With `split_mantissa_bits` the candidate planes are rounded to the hardware format first
+//!   (duplicates after rounding are evaluated again, harmlessly).
+//!
 //! Deterministic: no parallelism, ties broken by axis, position and primitive id.
 //! Primitives with non-finite bounds are left out of the tree.
 
 use super::aabb::Aabb;
-use super::kd_tree::{KdNode, KdParams, KdTree};
+use super::kd_tree::{round_mantissa, KdNode, KdParams, KdTree};
 use super::primitive::KdPrimitives;
 
 const END: u8 = 0;
@@ -239,6 +242,12 @@ impl<P: KdPrimitives> Builder<'_, P> {
                     i += 1;
                 }
                 nr -= planars + ends;
+                // The counts are exact for `p`; for a rounded plane they are the estimate the
+                // SAH uses, while classification below is exact for the rounded plane.
+                let p = match self.params.split_mantissa_bits {
+                    Some(bits) => round_mantissa(p, bits),
+                    None => p,
+                };
                 if lo < p && p < hi {
                     let pl = 2.0 * (cap + (p - lo) * ring) * inv_area;
                     let pr = 2.0 * (cap + (hi - p) * ring) * inv_area;
