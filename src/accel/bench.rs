@@ -185,6 +185,13 @@ pub fn bench_build(cfg: &BenchConfig) -> anyhow::Result<Vec<BenchRow>> {
     measure(format!("object {mesh_name}"), mesh.len(), &|| {
         build_sah(&mesh, p).stats(p)
     });
+    let unclipped = KdParams {
+        clip_splits: false,
+        ..p.clone()
+    };
+    measure(format!("object {mesh_name} no-clip"), mesh.len(), &|| {
+        build_sah(&mesh, &unclipped).stats(p)
+    });
     measure(
         format!("object terrain {0}x{0}", cfg.terrain_side),
         terrain.len(),

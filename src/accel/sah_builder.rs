@@ -75,27 +75,6 @@ fn push_events(events: &mut Events, prim: u32, b: &Aabb) {
     }
 }
 
-/// Merges two sorted lists.
-fn merge(a: Vec<Event>, b: Vec<Event>) -> Vec<Event> {
-    if b.is_empty() {
-        return a;
-    }
-    let mut out = Vec::with_capacity(a.len() + b.len());
-    let (mut i, mut j) = (0, 0);
-    while i < a.len() && j < b.len() {
-        if event_order(&a[i], &b[j]).is_le() {
-            out.push(a[i]);
-            i += 1;
-        } else {
-            out.push(b[j]);
-            j += 1;
-        }
-    }
-    out.extend_from_slice(&a[i..]);
-    out.extend_from_slice(&b[j..]);
-    out
-}
-
 #[derive(Clone, Copy, Debug)]
 struct Plane {
     cost: f64,
@@ -228,19 +207,17 @@ impl<P: KdPrimitives> Builder<'_, P> {
             let mut i = 0;
             while i < list.len() {
                 let p = list[i].pos;
-                let (mut ends, mut planars, mut starts) = (0, 0, 0);
-                while i < list.len() && list[i].pos == p && list[i].kind == END {
-                    ends += 1;
+                // Counts of End, Planar and Start events at `p` (indexed by kind).
+                let mut at_p = [0usize; 3];
+                while i < list.len() && list[i].pos == p {
+                    at_p[list[i].kind as usize] += 1;
                     i += 1;
                 }
-                while i < list.len() && list[i].pos == p && list[i].kind == PLANAR {
-                    planars += 1;
-                    i += 1;
-                }
-                while i < list.len() && list[i].pos == p && list[i].kind == START {
-                    starts += 1;
-                    i += 1;
-                }
+                let (ends, planars, starts) = (
+                    at_p[END as usize],
+                    at_p[PLANAR as usize],
+                    at_p[START as usize],
+                );
                 nr -= planars + ends;
                 // The counts are exact for `p`; for a rounded plane they are the estimate the
                 // SAH uses, while classification below is exact for the rounded plane.
@@ -352,23 +329,37 @@ impl<P: KdPrimitives> Builder<'_, P> {
         }
         let mut left: Events = Default::default();
         let mut right: Events = Default::default();
-        for (axis, list) in events.into_iter().enumerate() {
-            let mut l = Vec::with_capacity(list.len());
-            let mut r = Vec::with_capacity(list.len());
+        for axis in 0..3 {
+            let list = &events[axis];
+            let (new_l, new_r) = (&new_left[axis], &new_right[axis]);
+            // Each event belongs to one primitive; a primitive's events per axis are 1 or 2.
+            let mut l = Vec::with_capacity(2 * nl);
+            let mut r = Vec::with_capacity(2 * nr);
+            // Filter the parent's list and merge the clipped primitives' events in, in one pass.
+            let (mut il, mut ir) = (0, 0);
             for e in list {
-                match self.side[e.prim as usize] {
-                    SIDE_LEFT => l.push(e),
-                    SIDE_RIGHT => r.push(e),
-                    _ if !clip => {
-                        l.push(e);
-                        r.push(e);
+                let side = self.side[e.prim as usize];
+                if side == SIDE_LEFT || (side == SIDE_BOTH && !clip) {
+                    while il < new_l.len() && event_order(&new_l[il], e).is_lt() {
+                        l.push(new_l[il]);
+                        il += 1;
                     }
-                    _ => {}
+                    l.push(*e);
+                }
+                if side == SIDE_RIGHT || (side == SIDE_BOTH && !clip) {
+                    while ir < new_r.len() && event_order(&new_r[ir], e).is_lt() {
+                        r.push(new_r[ir]);
+                        ir += 1;
+                    }
+                    r.push(*e);
                 }
             }
-            left[axis] = merge(l, std::mem::take(&mut new_left[axis]));
-            right[axis] = merge(r, std::mem::take(&mut new_right[axis]));
+            l.extend_from_slice(&new_l[il..]);
+            r.extend_from_slice(&new_r[ir..]);
+            left[axis] = l;
+            right[axis] = r;
         }
+        drop(events);
         (left, nl, right, nr)
     }
 }
