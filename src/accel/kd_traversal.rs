@@ -25,6 +25,8 @@
 
 use super::kd_tree::{KdNode, KdTree};
 use super::ray::Ray;
+use super::triangle;
+use glam::DVec3;
 
 /// Relative slack of every interval decision (see the module doc).
 const REL_SLACK: f64 = 1e-9;
@@ -35,6 +37,16 @@ pub struct KdHit<P> {
     pub prim: u32,
     pub t: f64,
     pub payload: P,
+}
+
+/// A closest triangle hit: triangle id, ray parameter and barycentrics (hit point
+/// `(1-u-v) A + u B + v C`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleHit {
+    pub prim: u32,
+    pub t: f64,
+    pub u: f64,
+    pub v: f64,
 }
 
 /// Traversal stack: inline for the depths the builder produces by default, growing beyond.
@@ -215,6 +227,39 @@ impl KdTree {
             .map(|h| (h.prim, h.t))
     }
 
+    /// Closest hit over triangles (the tree must have been built from `tris`), with the
+    /// barycentrics of [`triangle::intersect`]: the reference renderer's object-space query.
+    pub fn closest_triangle_hit(
+        &self,
+        tris: &[[DVec3; 3]],
+        ray: &Ray,
+        t_min: f64,
+        t_max: f64,
+    ) -> Option<TriangleHit> {
+        self.closest_hit_with(ray, t_min, t_max, |p, tb| {
+            triangle::intersect(ray, &tris[p as usize], t_min, tb).map(|(t, u, v)| (t, (u, v)))
+        })
+        .map(|h| TriangleHit {
+            prim: h.prim,
+            t: h.t,
+            u: h.payload.0,
+            v: h.payload.1,
+        })
+    }
+
+    /// Any triangle hit in `[t_min, t_max)` (shadow rays against an object tree).
+    pub fn any_triangle_hit(
+        &self,
+        tris: &[[DVec3; 3]],
+        ray: &Ray,
+        t_min: f64,
+        t_max: f64,
+    ) -> Option<u32> {
+        self.any_hit(ray, t_min, t_max, |p, tb| {
+            triangle::intersect(ray, &tris[p as usize], t_min, tb).map(|h| h.0)
+        })
+    }
+
     /// Any hit in `[t_min, t_max)` (shadow rays): stops at the first primitive whose test
     /// reports one, and returns it.
     pub fn any_hit(
@@ -246,8 +291,6 @@ mod tests {
     use crate::accel::kd_tree::{build_sah, KdParams};
     use crate::accel::primitive::Triangles;
     use crate::accel::test_meshes::*;
-    use crate::accel::triangle;
-    use glam::DVec3;
     use std::collections::BTreeMap;
 
     /// kd closest hit and any hit against brute force, with and without split clipping.
@@ -283,6 +326,18 @@ mod tests {
                 };
                 let kd = tree.closest_hit(&ray, 0.0, f64::INFINITY, test);
                 let bf = brute_closest(tris, &ray, 0.0, f64::INFINITY);
+                let th = tree.closest_triangle_hit(tris, &ray, 0.0, f64::INFINITY);
+                assert_eq!(
+                    th.map(|h| (h.prim, h.t)),
+                    kd,
+                    "closest_triangle_hit differs"
+                );
+                if let Some(h) = th {
+                    let (t, u, v) =
+                        triangle::intersect(&ray, &tris[h.prim as usize], 0.0, f64::INFINITY)
+                            .unwrap();
+                    assert_eq!((h.t, h.u, h.v), (t, u, v));
+                }
                 let entry = per_kind_counts.entry(kind).or_default();
                 entry.0 += 1;
                 entry.1 += bf.is_some() as usize;
@@ -306,6 +361,10 @@ mod tests {
                     triangle::intersect(&ray, &tris[p as usize], 0.0, tb).map(|h| h.0)
                 });
                 let bf_any = brute_closest(tris, &ray, 0.0, limit);
+                assert_eq!(
+                    tree.any_triangle_hit(tris, &ray, 0.0, limit).is_some(),
+                    any.is_some()
+                );
                 if let Some(p) = any {
                     assert!(
                         triangle::intersect(&ray, &tris[p as usize], 0.0, limit).is_some(),
@@ -388,7 +447,7 @@ mod tests {
                 for (_, s) in planes {
                     assert_eq!(crate::accel::kd_tree::round_mantissa(s, bits), s);
                 }
-                check_variants(name, &tris, 100, 12, &[params.clone()]);
+                check_variants(name, &tris, 100, 12, std::slice::from_ref(&params));
             }
         }
     }

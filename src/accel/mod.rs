@@ -27,7 +27,7 @@ pub mod triangle;
 pub(crate) mod test_meshes;
 
 pub use aabb::Aabb;
-pub use kd_traversal::KdHit;
+pub use kd_traversal::{KdHit, TriangleHit};
 pub use kd_tree::{build_sah, build_sah_boxes, KdNode, KdParams, KdStats, KdTree, KdTreeError};
 pub use ray::Ray;
 pub use top_level::TopLevel;

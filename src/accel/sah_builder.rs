@@ -175,6 +175,8 @@ impl<P: KdPrimitives> Builder<'_, P> {
     }
 
     /// The plane to split at, or `None` for a leaf.
+    // `!(a < b)` deliberately treats NaN as "no".
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     fn choose_plane(&self, voxel: &Aabb, events: &Events, n: usize) -> Option<Plane> {
         let area = voxel.surface_area();
         if !(area > 0.0) {
@@ -238,7 +240,7 @@ impl<P: KdPrimitives> Builder<'_, P> {
                         pos: p,
                         planar_left,
                     };
-                    if best.map_or(true, |b| c < b.cost) {
+                    if best.is_none_or(|b| c < b.cost) {
                         best = Some(plane);
                     }
                     let (left_n, right_n) = if planar_left {
@@ -246,7 +248,7 @@ impl<P: KdPrimitives> Builder<'_, P> {
                     } else {
                         (nl, nr + planars)
                     };
-                    if left_n < n && right_n < n && best_separating.map_or(true, |b| c < b.cost) {
+                    if left_n < n && right_n < n && best_separating.is_none_or(|b| c < b.cost) {
                         best_separating = Some(plane);
                     }
                 }
