@@ -431,13 +431,14 @@ mod tests {
         check_against_brute_force("fandisk", &public_mesh("fandisk.obj"), 100, 7);
     }
 
-    /// Splits rounded to a short mantissa (as a reduced-precision layout stores them) are
-    /// exactly representable and traversal stays exact.
+    /// Splits rounded into a reduced number format (as the layout stores them) are exactly
+    /// representable there, and traversal stays exact.
     #[test]
     fn rounded_splits_match_brute_force() {
-        for bits in [16, 6] {
+        use crate::fp::Format;
+        for format in [Format::E7M16, Format::new(5, 6).unwrap()] {
             let params = KdParams {
-                split_mantissa_bits: Some(bits),
+                split_format: Some(format),
                 ..KdParams::default()
             };
             for (name, tris) in [("sphere(3)", sphere(3)), ("cow", public_mesh("cow.obj"))] {
@@ -445,7 +446,7 @@ mod tests {
                 let planes = split_planes(&tree);
                 assert!(planes.len() > 100);
                 for (_, s) in planes {
-                    assert_eq!(crate::accel::kd_tree::round_mantissa(s, bits), s);
+                    assert_eq!(format.to_f64(format.from_f64(s)), s, "{format:?}");
                 }
                 check_variants(name, &tris, 100, 12, std::slice::from_ref(&params));
             }

@@ -29,6 +29,7 @@
 
 use super::aabb::Aabb;
 use super::primitive::{Boxes, KdPrimitives, Triangles};
+use crate::fp::Format;
 use glam::DVec3;
 use thiserror::Error;
 
@@ -76,13 +77,13 @@ pub struct KdParams {
     pub max_leaf_prims: u32,
     /// Clip straddling primitives to each child ("perfect splits").
     pub clip_splits: bool,
-    /// If set, every split position is rounded (to nearest, ties to even) to a float with this
-    /// many stored mantissa bits before it is evaluated and used, so that a reduced-precision
-    /// layout (16 for e7m16, 23 for e8m23) stores the planes exactly and traversal in that
-    /// format sees the very planes the primitives were classified against. The exponent range
-    /// is not limited (scene coordinates are far from a 7-bit exponent's limits; the layout must
-    /// still reject overflow and flush-to-zero cases).
-    pub split_mantissa_bits: Option<u32>,
+    /// If set, every candidate split position is first rounded into this number format
+    /// (`format.to_f64(format.from_f64(p))`: round to nearest even, subnormals flushed to zero,
+    /// exactly what the layout stores), and the rounded plane is the one evaluated and used.
+    /// The layout then stores the planes exactly, and traversal in that format sees the very
+    /// planes the primitives were classified against. Without it, perfect splits produce
+    /// planes at clipped coordinates that no reduced format can represent.
+    pub split_format: Option<Format>,
 }
 
 impl Default for KdParams {
@@ -94,7 +95,7 @@ impl Default for KdParams {
             max_depth: None,
             max_leaf_prims: 32,
             clip_splits: true,
-            split_mantissa_bits: None,
+            split_format: None,
         }
     }
 }
@@ -110,24 +111,6 @@ impl KdParams {
             auto.min(Self::AUTO_DEPTH_CAP)
         })
     }
-}
-
-/// `x` rounded to nearest (ties to even) to a float with `bits` stored mantissa bits (f64's
-/// exponent range); identity for `bits >= 52`, zeros, infinities and NaN.
-pub fn round_mantissa(x: f64, bits: u32) -> f64 {
-    if bits >= 52 || !x.is_finite() {
-        return x;
-    }
-    let drop = 52 - bits;
-    let m = x.to_bits();
-    let mask = (1u64 << drop) - 1;
-    let half = 1u64 << (drop - 1);
-    let (low, mut high) = (m & mask, m & !mask);
-    if low > half || (low == half && (high >> drop) & 1 == 1) {
-        // A carry out of the mantissa correctly bumps the exponent.
-        high += 1 << drop;
-    }
-    f64::from_bits(high)
 }
 
 /// Tree statistics.
@@ -399,40 +382,5 @@ impl KdTree {
             s.mean_tris_per_leaf = s.references as f64 / full as f64;
         }
         s
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use rand::{Rng, SeedableRng};
-    use rand_chacha::ChaCha8Rng;
-
-    #[test]
-    fn round_mantissa_cases() {
-        let ulp = 2f64.powi(-16);
-        assert_eq!(round_mantissa(1.0 + ulp / 2.0, 16), 1.0); // tie to even
-        assert_eq!(round_mantissa(1.0 + 1.5 * ulp, 16), 1.0 + 2.0 * ulp); // tie to even
-        assert_eq!(round_mantissa(1.0 + ulp / 2.0 + 1e-12, 16), 1.0 + ulp);
-        assert_eq!(round_mantissa(-(1.0 + ulp + 1e-12), 16), -(1.0 + ulp));
-        assert_eq!(round_mantissa(2.0 - 2f64.powi(-20), 16), 2.0); // carry into the exponent
-        assert_eq!(round_mantissa(0.0, 16), 0.0);
-        assert_eq!(round_mantissa(f64::INFINITY, 16), f64::INFINITY);
-        assert_eq!(round_mantissa(1.2345, 52), 1.2345);
-    }
-
-    /// With 23 bits the rounding must equal Rust's f64 -> f32 conversion (round to nearest
-    /// even) for values in f32's normal range.
-    #[test]
-    fn round_mantissa_23_equals_f32_conversion() {
-        let seed = 31;
-        println!("seed {seed}");
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        for _ in 0..100_000 {
-            let x: f64 = rng.gen_range(-1.0..1.0) * 2f64.powi(rng.gen_range(-100..100));
-            let r = round_mantissa(x, 23);
-            assert_eq!(r, x as f32 as f64, "{x:e}");
-            assert_eq!(round_mantissa(r, 23), r);
-        }
     }
 }

@@ -15,14 +15,15 @@
 //!   clipped to each child box and only their new events are sorted and merged in, so the total
 //!   stays O(N log N).
 //!
-//! - With `split_mantissa_bits` the candidate planes are rounded to the hardware format first
-//!   (duplicates after rounding are evaluated again, harmlessly).
+//! - With `split_format` the candidate planes are rounded into the hardware number format
+//!   first (a plane that rounds onto or outside the node's box is skipped; duplicates after
+//!   rounding are evaluated again, harmlessly).
 //!
 //! Deterministic: no parallelism, ties broken by axis, position and primitive id.
 //! Primitives with non-finite bounds are left out of the tree.
 
 use super::aabb::Aabb;
-use super::kd_tree::{round_mantissa, KdNode, KdParams, KdTree};
+use super::kd_tree::{KdNode, KdParams, KdTree};
 use super::primitive::KdPrimitives;
 
 const END: u8 = 0;
@@ -223,8 +224,8 @@ impl<P: KdPrimitives> Builder<'_, P> {
                 nr -= planars + ends;
                 // The counts are exact for `p`; for a rounded plane they are the estimate the
                 // SAH uses, while classification below is exact for the rounded plane.
-                let p = match self.params.split_mantissa_bits {
-                    Some(bits) => round_mantissa(p, bits),
+                let p = match self.params.split_format {
+                    Some(f) => f.to_f64(f.from_f64(p)),
                     None => p,
                 };
                 if lo < p && p < hi {
