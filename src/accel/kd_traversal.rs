@@ -12,9 +12,8 @@
 //!   (direction component 0, origin on the plane) visits both children; zero direction
 //!   components never divide;
 //! - hits are not restricted to the current leaf's interval (a hit found early but lying
-//!   farther on is kept); stack entries that start at or beyond the best hit are skipped,
-//!   which ends the traversal once the best hit lies within the leaves already visited.
-//!
+//!   farther on is kept); stack entries that start beyond the best hit are skipped, which
+//!   ends the traversal once the best hit lies within the leaves already visited;
 //! - rounding never loses a cell: the root box is grown by a relative `REL_SLACK` (1e-9) and
 //!   every plane crossing `t_split` is treated as uncertain by `1e-9 (|t_split| +
 //!   (|o| + |split|) / |d|)`, far above the rounding error of `t_split` and of a hit's `t`
