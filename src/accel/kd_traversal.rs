@@ -48,6 +48,34 @@ pub struct TriangleHit {
     pub v: f64,
 }
 
+/// The last few primitives tested along one ray. Re-testing a primitive can never change the
+/// result (the segment of interest only shrinks), so skipping recent ones is pure savings; it
+/// matters for the top level, where one test is a whole object traversal and an instance box
+/// spans many leaves.
+struct Mailbox {
+    ids: [u32; 8],
+    next: usize,
+}
+
+impl Mailbox {
+    fn new() -> Self {
+        Self {
+            ids: [u32::MAX; 8],
+            next: 0,
+        }
+    }
+
+    /// True if `id` was tested recently; otherwise remembers it.
+    fn seen(&mut self, id: u32) -> bool {
+        if self.ids.contains(&id) {
+            return true;
+        }
+        self.ids[self.next] = id;
+        self.next = (self.next + 1) % self.ids.len();
+        false
+    }
+}
+
 /// Traversal stack: inline for the depths the builder produces by default, growing beyond.
 struct Stack {
     inline: [(u32, f64, f64); 48],
@@ -195,8 +223,12 @@ impl KdTree {
     ) -> Option<KdHit<H>> {
         let mut best: Option<KdHit<H>> = None;
         let mut t_best = t_max;
+        let mut mailbox = Mailbox::new();
         self.traverse_leaves(ray, t_min, t_max, |prims, _, _| {
             for &p in prims {
+                if mailbox.seen(p) {
+                    continue;
+                }
                 if let Some((t, payload)) = test(p, t_best) {
                     if t >= t_min && t < t_best {
                         t_best = t;
@@ -269,8 +301,12 @@ impl KdTree {
         mut test: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<u32> {
         let mut found = None;
+        let mut mailbox = Mailbox::new();
         self.traverse_leaves(ray, t_min, t_max, |prims, _, _| {
             for &p in prims {
+                if mailbox.seen(p) {
+                    continue;
+                }
                 if let Some(t) = test(p, t_max) {
                     if t >= t_min && t < t_max {
                         found = Some(p);
@@ -506,6 +542,35 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A primitive listed in many leaves is tested once per ray (mailbox).
+    #[test]
+    fn mailbox_tests_each_primitive_once() {
+        use crate::accel::kd_tree::build_sah_boxes;
+        use crate::accel::Aabb;
+        let mut boxes = vec![Aabb::new(DVec3::ZERO, DVec3::new(100.0, 1.0, 1.0))];
+        for i in 0..5 {
+            let x = 10.0 + 20.0 * i as f64;
+            boxes.push(Aabb::new(
+                DVec3::new(x, 0.0, 0.0),
+                DVec3::new(x + 1.0, 1.0, 1.0),
+            ));
+        }
+        let tree = build_sah_boxes(&boxes, &KdParams::default());
+        let listed = tree.prim_indices.iter().filter(|&&p| p == 0).count();
+        assert!(
+            listed > 2,
+            "the big box should span several leaves: {tree:?}"
+        );
+        let ray = Ray::new(DVec3::new(-1.0, 0.5, 0.5), DVec3::X);
+        let mut calls = vec![0; boxes.len()];
+        let hit = tree.closest_hit(&ray, 0.0, f64::INFINITY, |p, _| {
+            calls[p as usize] += 1;
+            None
+        });
+        assert_eq!(hit, None);
+        assert_eq!(calls, vec![1; boxes.len()]);
     }
 
     #[test]
