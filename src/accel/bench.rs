@@ -1,7 +1,8 @@
 //! Build-rate benchmark of the acceleration structures (a measurement, never a test):
 //! object-tree build rate (triangles per second) on a mesh file (default: the Stanford bunny of
 //! the shared mesh folder) and on a generated terrain heightfield, and top-level rebuild time
-//! for random instance boxes. Prints a table and writes a CSV.
+//! for random instance boxes; plus single-thread closest-hit traversal speed on the mesh (the
+//! f64 reference's kernel). Prints a table and writes a CSV.
 //!
 //! Also holds two small geometry sources used by the benchmark and the tests:
 //! [`load_obj_triangles`] (positions only, polygons triangulated) and
@@ -9,6 +10,7 @@
 
 use super::aabb::Aabb;
 use super::kd_tree::{build_sah, build_sah_boxes, KdParams, KdStats};
+use super::ray::Ray;
 use anyhow::{bail, Context};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -114,6 +116,30 @@ pub fn random_instance_boxes(count: usize, seed: u64) -> Vec<Aabb> {
         .collect()
 }
 
+/// `count` rays from random points on a sphere around `b` towards random points inside it.
+pub fn random_rays_at(b: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let radius = b.extent().length();
+    (0..count)
+        .map(|_| {
+            let dir = loop {
+                let d = DVec3::new(
+                    rng.gen_range(-1.0..1.0),
+                    rng.gen_range(-1.0..1.0),
+                    rng.gen_range(-1.0..1.0),
+                );
+                let l = d.length();
+                if l > 1e-3 && l <= 1.0 {
+                    break d / l;
+                }
+            };
+            let origin = b.center() + dir * radius;
+            let target = b.min + b.extent() * DVec3::new(rng.gen(), rng.gen(), rng.gen());
+            Ray::new(origin, target - origin)
+        })
+        .collect()
+}
+
 /// What to measure.
 #[derive(Clone, Debug)]
 pub struct BenchConfig {
@@ -123,6 +149,8 @@ pub struct BenchConfig {
     pub terrain_side: usize,
     /// Instance counts for the top-level rebuild.
     pub instance_counts: Vec<usize>,
+    /// Rays traced against the mesh's tree for the traversal-speed row.
+    pub trace_rays: usize,
     /// Each case is built this many times; the fastest run is reported.
     pub repeats: usize,
     pub params: KdParams,
@@ -135,6 +163,7 @@ impl Default for BenchConfig {
             mesh: Path::new(SHARED_MESH_DIR).join("stanford-bunny.obj"),
             terrain_side: 256,
             instance_counts: vec![1000, 5000],
+            trace_rays: 200_000,
             repeats: 3,
             params: KdParams::default(),
             out_csv: PathBuf::from("out/bench/accel.csv"),
@@ -142,14 +171,18 @@ impl Default for BenchConfig {
     }
 }
 
-/// One measured case.
+/// One measured case: a build (items = primitives) or a trace (items = rays, closest hit,
+/// one thread).
 #[derive(Clone, Debug)]
 pub struct BenchRow {
     pub case: String,
-    pub primitives: usize,
-    /// Fastest build, seconds.
+    /// "build" or "trace".
+    pub kind: &'static str,
+    pub items: usize,
+    /// Fastest run, seconds.
     pub seconds: f64,
-    pub prims_per_second: f64,
+    pub items_per_second: f64,
+    /// Stats of the tree built or traced.
     pub stats: KdStats,
 }
 
@@ -159,7 +192,7 @@ pub fn bench_build(cfg: &BenchConfig) -> anyhow::Result<Vec<BenchRow>> {
     let mesh = load_obj_triangles(&cfg.mesh)?;
     let terrain = heightfield_triangles(cfg.terrain_side, 1);
     let mut rows = Vec::new();
-    let mut measure = |case: String, n: usize, build: &dyn Fn() -> KdStats| {
+    let mut measure = |case: String, kind: &'static str, n: usize, build: &dyn Fn() -> KdStats| {
         let mut best = f64::INFINITY;
         let mut stats = None;
         for _ in 0..cfg.repeats.max(1) {
@@ -170,9 +203,10 @@ pub fn bench_build(cfg: &BenchConfig) -> anyhow::Result<Vec<BenchRow>> {
         }
         rows.push(BenchRow {
             case,
-            primitives: n,
+            kind,
+            items: n,
             seconds: best,
-            prims_per_second: n as f64 / best,
+            items_per_second: n as f64 / best,
             stats: stats.expect("at least one run"),
         });
     };
@@ -182,32 +216,65 @@ pub fn bench_build(cfg: &BenchConfig) -> anyhow::Result<Vec<BenchRow>> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "mesh".into());
-    measure(format!("object {mesh_name}"), mesh.len(), &|| {
+    measure(format!("object {mesh_name}"), "build", mesh.len(), &|| {
         build_sah(&mesh, p).stats(p)
     });
+    let unclipped = KdParams {
+        clip_splits: false,
+        ..p.clone()
+    };
+    measure(
+        format!("object {mesh_name} no-clip"),
+        "build",
+        mesh.len(),
+        &|| build_sah(&mesh, &unclipped).stats(p),
+    );
     measure(
         format!("object terrain {0}x{0}", cfg.terrain_side),
+        "build",
         terrain.len(),
         &|| build_sah(&terrain, p).stats(p),
     );
     for &count in &cfg.instance_counts {
         let boxes = random_instance_boxes(count, 2);
-        measure(format!("top-level {count} instances"), count, &|| {
-            build_sah_boxes(&boxes, p).stats(p)
-        });
+        measure(
+            format!("top-level {count} instances"),
+            "build",
+            count,
+            &|| build_sah_boxes(&boxes, p).stats(p),
+        );
     }
+    // Reference traversal speed: random rays from around the mesh towards points inside it.
+    let tree = build_sah(&mesh, p);
+    let rays = random_rays_at(&tree.bounds, cfg.trace_rays, 3);
+    measure(
+        format!("trace {mesh_name} closest hit"),
+        "trace",
+        rays.len(),
+        &|| {
+            let hits = rays
+                .iter()
+                .filter(|r| {
+                    tree.closest_triangle_hit(&mesh, r, 0.0, f64::INFINITY)
+                        .is_some()
+                })
+                .count();
+            std::hint::black_box(hits);
+            tree.stats(p)
+        },
+    );
 
     println!(
-        "{:<28} {:>9} {:>10} {:>14} {:>8} {:>8} {:>6} {:>9} {:>8}",
-        "case", "prims", "ms", "prims/s", "nodes", "refs", "depth", "sah", "tris/lf"
+        "{:<33} {:>9} {:>10} {:>14} {:>8} {:>8} {:>6} {:>9} {:>8}",
+        "case", "items", "ms", "items/s", "nodes", "refs", "depth", "sah", "tris/lf"
     );
     for r in &rows {
         println!(
-            "{:<28} {:>9} {:>10.2} {:>14.0} {:>8} {:>8} {:>6} {:>9.2} {:>8.2}",
+            "{:<33} {:>9} {:>10.2} {:>14.0} {:>8} {:>8} {:>6} {:>9.2} {:>8.2}",
             r.case,
-            r.primitives,
+            r.items,
             r.seconds * 1e3,
-            r.prims_per_second,
+            r.items_per_second,
             r.stats.nodes,
             r.stats.references,
             r.stats.depth,
@@ -231,17 +298,18 @@ fn write_csv(path: &Path, rows: &[BenchRow]) -> anyhow::Result<()> {
         .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
     writeln!(
         tmp,
-        "case,primitives,seconds,prims_per_second,nodes,leaves,empty_leaves,references,depth,sah_cost,max_prims_per_leaf,mean_prims_per_leaf"
+        "case,kind,items,seconds,items_per_second,nodes,leaves,empty_leaves,references,depth,sah_cost,max_prims_per_leaf,mean_prims_per_leaf"
     )?;
     for r in rows {
         let s = &r.stats;
         writeln!(
             tmp,
-            "{},{},{:.6},{:.0},{},{},{},{},{},{:.4},{},{:.3}",
+            "{},{},{},{:.6},{:.0},{},{},{},{},{},{:.4},{},{:.3}",
             r.case,
-            r.primitives,
+            r.kind,
+            r.items,
             r.seconds,
-            r.prims_per_second,
+            r.items_per_second,
             s.nodes,
             s.leaves,
             s.empty_leaves,

@@ -12,9 +12,8 @@
 //!   (direction component 0, origin on the plane) visits both children; zero direction
 //!   components never divide;
 //! - hits are not restricted to the current leaf's interval (a hit found early but lying
-//!   farther on is kept); stack entries that start at or beyond the best hit are skipped,
-//!   which ends the traversal once the best hit lies within the leaves already visited.
-//!
+//!   farther on is kept); stack entries that start beyond the best hit are skipped, which
+//!   ends the traversal once the best hit lies within the leaves already visited;
 //! - rounding never loses a cell: the root box is grown by a relative `REL_SLACK` (1e-9) and
 //!   every plane crossing `t_split` is treated as uncertain by `1e-9 (|t_split| +
 //!   (|o| + |split|) / |d|)`, far above the rounding error of `t_split` and of a hit's `t`
@@ -25,6 +24,8 @@
 
 use super::kd_tree::{KdNode, KdTree};
 use super::ray::Ray;
+use super::triangle;
+use glam::DVec3;
 
 /// Relative slack of every interval decision (see the module doc).
 const REL_SLACK: f64 = 1e-9;
@@ -35,6 +36,44 @@ pub struct KdHit<P> {
     pub prim: u32,
     pub t: f64,
     pub payload: P,
+}
+
+/// A closest triangle hit: triangle id, ray parameter and barycentrics (hit point
+/// `(1-u-v) A + u B + v C`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleHit {
+    pub prim: u32,
+    pub t: f64,
+    pub u: f64,
+    pub v: f64,
+}
+
+/// The last few primitives tested along one ray. Re-testing a primitive can never change the
+/// result (the segment of interest only shrinks), so skipping recent ones is pure savings; it
+/// matters for the top level, where one test is a whole object traversal and an instance box
+/// spans many leaves.
+struct Mailbox {
+    ids: [u32; 8],
+    next: usize,
+}
+
+impl Mailbox {
+    fn new() -> Self {
+        Self {
+            ids: [u32::MAX; 8],
+            next: 0,
+        }
+    }
+
+    /// True if `id` was tested recently; otherwise remembers it.
+    fn seen(&mut self, id: u32) -> bool {
+        if self.ids.contains(&id) {
+            return true;
+        }
+        self.ids[self.next] = id;
+        self.next = (self.next + 1) % self.ids.len();
+        false
+    }
 }
 
 /// Traversal stack: inline for the depths the builder produces by default, growing beyond.
@@ -184,8 +223,12 @@ impl KdTree {
     ) -> Option<KdHit<H>> {
         let mut best: Option<KdHit<H>> = None;
         let mut t_best = t_max;
+        let mut mailbox = Mailbox::new();
         self.traverse_leaves(ray, t_min, t_max, |prims, _, _| {
             for &p in prims {
+                if mailbox.seen(p) {
+                    continue;
+                }
                 if let Some((t, payload)) = test(p, t_best) {
                     if t >= t_min && t < t_best {
                         t_best = t;
@@ -215,6 +258,39 @@ impl KdTree {
             .map(|h| (h.prim, h.t))
     }
 
+    /// Closest hit over triangles (the tree must have been built from `tris`), with the
+    /// barycentrics of [`triangle::intersect`]: the reference renderer's object-space query.
+    pub fn closest_triangle_hit(
+        &self,
+        tris: &[[DVec3; 3]],
+        ray: &Ray,
+        t_min: f64,
+        t_max: f64,
+    ) -> Option<TriangleHit> {
+        self.closest_hit_with(ray, t_min, t_max, |p, tb| {
+            triangle::intersect(ray, &tris[p as usize], t_min, tb).map(|(t, u, v)| (t, (u, v)))
+        })
+        .map(|h| TriangleHit {
+            prim: h.prim,
+            t: h.t,
+            u: h.payload.0,
+            v: h.payload.1,
+        })
+    }
+
+    /// Any triangle hit in `[t_min, t_max)` (shadow rays against an object tree).
+    pub fn any_triangle_hit(
+        &self,
+        tris: &[[DVec3; 3]],
+        ray: &Ray,
+        t_min: f64,
+        t_max: f64,
+    ) -> Option<u32> {
+        self.any_hit(ray, t_min, t_max, |p, tb| {
+            triangle::intersect(ray, &tris[p as usize], t_min, tb).map(|h| h.0)
+        })
+    }
+
     /// Any hit in `[t_min, t_max)` (shadow rays): stops at the first primitive whose test
     /// reports one, and returns it.
     pub fn any_hit(
@@ -225,8 +301,12 @@ impl KdTree {
         mut test: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<u32> {
         let mut found = None;
+        let mut mailbox = Mailbox::new();
         self.traverse_leaves(ray, t_min, t_max, |prims, _, _| {
             for &p in prims {
+                if mailbox.seen(p) {
+                    continue;
+                }
                 if let Some(t) = test(p, t_max) {
                     if t >= t_min && t < t_max {
                         found = Some(p);
@@ -246,21 +326,32 @@ mod tests {
     use crate::accel::kd_tree::{build_sah, KdParams};
     use crate::accel::primitive::Triangles;
     use crate::accel::test_meshes::*;
-    use crate::accel::triangle;
-    use glam::DVec3;
     use std::collections::BTreeMap;
 
     /// kd closest hit and any hit against brute force, with and without split clipping.
     fn check_against_brute_force(name: &str, tris: &[[DVec3; 3]], per_kind: usize, seed: u64) {
-        println!("mesh {name}: {} triangles, ray seed {seed}", tris.len());
-        for clip in [true, false] {
-            let params = KdParams {
+        let variants: Vec<KdParams> = [true, false]
+            .map(|clip| KdParams {
                 clip_splits: clip,
                 ..KdParams::default()
-            };
-            let tree = build_sah(tris, &params);
+            })
+            .into();
+        check_variants(name, tris, per_kind, seed, &variants);
+    }
+
+    fn check_variants(
+        name: &str,
+        tris: &[[DVec3; 3]],
+        per_kind: usize,
+        seed: u64,
+        variants: &[KdParams],
+    ) {
+        println!("mesh {name}: {} triangles, ray seed {seed}", tris.len());
+        for params in variants {
+            let clip = params.clip_splits;
+            let tree = build_sah(tris, params);
             tree.validate_against(&Triangles(tris))
-                .unwrap_or_else(|e| panic!("{name} clip={clip}: {e}"));
+                .unwrap_or_else(|e| panic!("{name} {params:?}: {e}"));
             let rays = ray_set(tris, &tree, per_kind, seed);
             let mut per_kind_counts: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
             let mut failures = Vec::new();
@@ -270,6 +361,18 @@ mod tests {
                 };
                 let kd = tree.closest_hit(&ray, 0.0, f64::INFINITY, test);
                 let bf = brute_closest(tris, &ray, 0.0, f64::INFINITY);
+                let th = tree.closest_triangle_hit(tris, &ray, 0.0, f64::INFINITY);
+                assert_eq!(
+                    th.map(|h| (h.prim, h.t)),
+                    kd,
+                    "closest_triangle_hit differs"
+                );
+                if let Some(h) = th {
+                    let (t, u, v) =
+                        triangle::intersect(&ray, &tris[h.prim as usize], 0.0, f64::INFINITY)
+                            .unwrap();
+                    assert_eq!((h.t, h.u, h.v), (t, u, v));
+                }
                 let entry = per_kind_counts.entry(kind).or_default();
                 entry.0 += 1;
                 entry.1 += bf.is_some() as usize;
@@ -293,6 +396,10 @@ mod tests {
                     triangle::intersect(&ray, &tris[p as usize], 0.0, tb).map(|h| h.0)
                 });
                 let bf_any = brute_closest(tris, &ray, 0.0, limit);
+                assert_eq!(
+                    tree.any_triangle_hit(tris, &ray, 0.0, limit).is_some(),
+                    any.is_some()
+                );
                 if let Some(p) = any {
                     assert!(
                         triangle::intersect(&ray, &tris[p as usize], 0.0, limit).is_some(),
@@ -359,6 +466,28 @@ mod tests {
         check_against_brute_force("fandisk", &public_mesh("fandisk.obj"), 100, 7);
     }
 
+    /// Splits rounded into a reduced number format (as the layout stores them) are exactly
+    /// representable there, and traversal stays exact.
+    #[test]
+    fn rounded_splits_match_brute_force() {
+        use crate::fp::Format;
+        for format in [Format::E7M16, Format::new(5, 6).unwrap()] {
+            let params = KdParams {
+                split_format: Some(format),
+                ..KdParams::default()
+            };
+            for (name, tris) in [("sphere(3)", sphere(3)), ("cow", public_mesh("cow.obj"))] {
+                let tree = build_sah(&tris, &params);
+                let planes = split_planes(&tree);
+                assert!(planes.len() > 100);
+                for (_, s) in planes {
+                    assert_eq!(format.to_f64(format.from_f64(s)), s, "{format:?}");
+                }
+                check_variants(name, &tris, 100, 12, std::slice::from_ref(&params));
+            }
+        }
+    }
+
     #[test]
     fn degenerate_inputs_match_brute_force() {
         let tri = [DVec3::ZERO, DVec3::X, DVec3::Y];
@@ -413,6 +542,35 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A primitive listed in many leaves is tested once per ray (mailbox).
+    #[test]
+    fn mailbox_tests_each_primitive_once() {
+        use crate::accel::kd_tree::build_sah_boxes;
+        use crate::accel::Aabb;
+        let mut boxes = vec![Aabb::new(DVec3::ZERO, DVec3::new(100.0, 1.0, 1.0))];
+        for i in 0..5 {
+            let x = 10.0 + 20.0 * i as f64;
+            boxes.push(Aabb::new(
+                DVec3::new(x, 0.0, 0.0),
+                DVec3::new(x + 1.0, 1.0, 1.0),
+            ));
+        }
+        let tree = build_sah_boxes(&boxes, &KdParams::default());
+        let listed = tree.prim_indices.iter().filter(|&&p| p == 0).count();
+        assert!(
+            listed > 2,
+            "the big box should span several leaves: {tree:?}"
+        );
+        let ray = Ray::new(DVec3::new(-1.0, 0.5, 0.5), DVec3::X);
+        let mut calls = vec![0; boxes.len()];
+        let hit = tree.closest_hit(&ray, 0.0, f64::INFINITY, |p, _| {
+            calls[p as usize] += 1;
+            None
+        });
+        assert_eq!(hit, None);
+        assert_eq!(calls, vec![1; boxes.len()]);
     }
 
     #[test]

@@ -29,6 +29,7 @@
 
 use super::aabb::Aabb;
 use super::primitive::{Boxes, KdPrimitives, Triangles};
+use crate::fp::Format;
 use glam::DVec3;
 use thiserror::Error;
 
@@ -76,6 +77,13 @@ pub struct KdParams {
     pub max_leaf_prims: u32,
     /// Clip straddling primitives to each child ("perfect splits").
     pub clip_splits: bool,
+    /// If set, every candidate split position is first rounded into this number format
+    /// (`format.to_f64(format.from_f64(p))`: round to nearest even, subnormals flushed to zero,
+    /// exactly what the layout stores), and the rounded plane is the one evaluated and used.
+    /// The layout then stores the planes exactly, and traversal in that format sees the very
+    /// planes the primitives were classified against. Without it, perfect splits produce
+    /// planes at clipped coordinates that no reduced format can represent.
+    pub split_format: Option<Format>,
 }
 
 impl Default for KdParams {
@@ -87,6 +95,7 @@ impl Default for KdParams {
             max_depth: None,
             max_leaf_prims: 32,
             clip_splits: true,
+            split_format: None,
         }
     }
 }

@@ -9,9 +9,12 @@
 //!   [`primitive::KdPrimitives`];
 //! - [`kd_traversal`]: front-to-back closest-hit and any-hit traversal (the reference renderer's);
 //! - [`top_level::TopLevel`]: the per-frame tree over instances;
-//! - [`bench`]: build-rate benchmark (called by `benches/accel.rs`).
+//! - [`mod@bench`]: build-rate benchmark (called by `benches/accel.rs`).
 //!
 //! Input is plain geometry (`&[[DVec3; 3]]`, `&[Aabb]`), independent of the scene module.
+//! A layout in a reduced number format should build with
+//! `KdParams { split_format: Some(format), ..Default::default() }` so that every split plane
+//! is a value of that format (perfect splits otherwise create planes at clipped coordinates).
 
 pub mod aabb;
 pub mod bench;
@@ -27,7 +30,7 @@ pub mod triangle;
 pub(crate) mod test_meshes;
 
 pub use aabb::Aabb;
-pub use kd_traversal::KdHit;
+pub use kd_traversal::{KdHit, TriangleHit};
 pub use kd_tree::{build_sah, build_sah_boxes, KdNode, KdParams, KdStats, KdTree, KdTreeError};
 pub use ray::Ray;
 pub use top_level::TopLevel;

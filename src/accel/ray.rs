@@ -24,6 +24,8 @@ impl Ray {
 
     /// Parameter interval `[t0, t1]` of the ray inside the closed box, clipped to
     /// `[t_min, t_max]`, or `None` if the ray misses it there.
+    // `!(a <= b)` deliberately treats NaN as a miss.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     ///
     /// A zero direction component is handled explicitly (no `0 * inf` NaN): the ray is inside
     /// that slab for all `t` iff its origin coordinate lies in it.

@@ -15,6 +15,10 @@
 //!   clipped to each child box and only their new events are sorted and merged in, so the total
 //!   stays O(N log N).
 //!
+//! - With `split_format` the candidate planes are rounded into the hardware number format
+//!   first (a plane that rounds onto or outside the node's box is skipped; duplicates after
+//!   rounding are evaluated again, harmlessly).
+//!
 //! Deterministic: no parallelism, ties broken by axis, position and primitive id.
 //! Primitives with non-finite bounds are left out of the tree.
 
@@ -70,27 +74,6 @@ fn push_events(events: &mut Events, prim: u32, b: &Aabb) {
             });
         }
     }
-}
-
-/// Merges two sorted lists.
-fn merge(a: Vec<Event>, b: Vec<Event>) -> Vec<Event> {
-    if b.is_empty() {
-        return a;
-    }
-    let mut out = Vec::with_capacity(a.len() + b.len());
-    let (mut i, mut j) = (0, 0);
-    while i < a.len() && j < b.len() {
-        if event_order(&a[i], &b[j]).is_le() {
-            out.push(a[i]);
-            i += 1;
-        } else {
-            out.push(b[j]);
-            j += 1;
-        }
-    }
-    out.extend_from_slice(&a[i..]);
-    out.extend_from_slice(&b[j..]);
-    out
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -193,6 +176,8 @@ impl<P: KdPrimitives> Builder<'_, P> {
     }
 
     /// The plane to split at, or `None` for a leaf.
+    // `!(a < b)` deliberately treats NaN as "no".
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     fn choose_plane(&self, voxel: &Aabb, events: &Events, n: usize) -> Option<Plane> {
         let area = voxel.surface_area();
         if !(area > 0.0) {
@@ -225,20 +210,24 @@ impl<P: KdPrimitives> Builder<'_, P> {
             let mut i = 0;
             while i < list.len() {
                 let p = list[i].pos;
-                let (mut ends, mut planars, mut starts) = (0, 0, 0);
-                while i < list.len() && list[i].pos == p && list[i].kind == END {
-                    ends += 1;
+                // Counts of End, Planar and Start events at `p` (indexed by kind).
+                let mut at_p = [0usize; 3];
+                while i < list.len() && list[i].pos == p {
+                    at_p[list[i].kind as usize] += 1;
                     i += 1;
                 }
-                while i < list.len() && list[i].pos == p && list[i].kind == PLANAR {
-                    planars += 1;
-                    i += 1;
-                }
-                while i < list.len() && list[i].pos == p && list[i].kind == START {
-                    starts += 1;
-                    i += 1;
-                }
+                let (ends, planars, starts) = (
+                    at_p[END as usize],
+                    at_p[PLANAR as usize],
+                    at_p[START as usize],
+                );
                 nr -= planars + ends;
+                // The counts are exact for `p`; for a rounded plane they are the estimate the
+                // SAH uses, while classification below is exact for the rounded plane.
+                let p = match self.params.split_format {
+                    Some(f) => f.to_f64(f.from_f64(p)),
+                    None => p,
+                };
                 if lo < p && p < hi {
                     let pl = 2.0 * (cap + (p - lo) * ring) * inv_area;
                     let pr = 2.0 * (cap + (hi - p) * ring) * inv_area;
@@ -252,7 +241,7 @@ impl<P: KdPrimitives> Builder<'_, P> {
                         pos: p,
                         planar_left,
                     };
-                    if best.map_or(true, |b| c < b.cost) {
+                    if best.is_none_or(|b| c < b.cost) {
                         best = Some(plane);
                     }
                     let (left_n, right_n) = if planar_left {
@@ -260,7 +249,7 @@ impl<P: KdPrimitives> Builder<'_, P> {
                     } else {
                         (nl, nr + planars)
                     };
-                    if left_n < n && right_n < n && best_separating.map_or(true, |b| c < b.cost) {
+                    if left_n < n && right_n < n && best_separating.is_none_or(|b| c < b.cost) {
                         best_separating = Some(plane);
                     }
                 }
@@ -343,23 +332,37 @@ impl<P: KdPrimitives> Builder<'_, P> {
         }
         let mut left: Events = Default::default();
         let mut right: Events = Default::default();
-        for (axis, list) in events.into_iter().enumerate() {
-            let mut l = Vec::with_capacity(list.len());
-            let mut r = Vec::with_capacity(list.len());
+        for axis in 0..3 {
+            let list = &events[axis];
+            let (new_l, new_r) = (&new_left[axis], &new_right[axis]);
+            // Each event belongs to one primitive; a primitive's events per axis are 1 or 2.
+            let mut l = Vec::with_capacity(2 * nl);
+            let mut r = Vec::with_capacity(2 * nr);
+            // Filter the parent's list and merge the clipped primitives' events in, in one pass.
+            let (mut il, mut ir) = (0, 0);
             for e in list {
-                match self.side[e.prim as usize] {
-                    SIDE_LEFT => l.push(e),
-                    SIDE_RIGHT => r.push(e),
-                    _ if !clip => {
-                        l.push(e);
-                        r.push(e);
+                let side = self.side[e.prim as usize];
+                if side == SIDE_LEFT || (side == SIDE_BOTH && !clip) {
+                    while il < new_l.len() && event_order(&new_l[il], e).is_lt() {
+                        l.push(new_l[il]);
+                        il += 1;
                     }
-                    _ => {}
+                    l.push(*e);
+                }
+                if side == SIDE_RIGHT || (side == SIDE_BOTH && !clip) {
+                    while ir < new_r.len() && event_order(&new_r[ir], e).is_lt() {
+                        r.push(new_r[ir]);
+                        ir += 1;
+                    }
+                    r.push(*e);
                 }
             }
-            left[axis] = merge(l, std::mem::take(&mut new_left[axis]));
-            right[axis] = merge(r, std::mem::take(&mut new_right[axis]));
+            l.extend_from_slice(&new_l[il..]);
+            r.extend_from_slice(&new_r[ir..]);
+            left[axis] = l;
+            right[axis] = r;
         }
+        drop(events);
         (left, nl, right, nr)
     }
 }

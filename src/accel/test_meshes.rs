@@ -135,7 +135,7 @@ pub fn brute_closest(tris: &[[DVec3; 3]], ray: &Ray, t_min: f64, t_max: f64) -> 
     let mut best: Option<(u32, f64)> = None;
     for (i, tri) in tris.iter().enumerate() {
         if let Some((t, _, _)) = triangle::intersect(ray, tri, t_min, t_max) {
-            if best.map_or(true, |(_, bt)| t < bt) {
+            if best.is_none_or(|(_, bt)| t < bt) {
                 best = Some((i as u32, t));
             }
         }

@@ -248,7 +248,7 @@ mod tests {
             let mut want: Option<(u32, u32, f64)> = None;
             for (inst, tri, w) in &world {
                 if let Some((t, _, _)) = triangle::intersect(&ray, w, 0.0, f64::INFINITY) {
-                    if want.map_or(true, |(_, _, bt)| t < bt) {
+                    if want.is_none_or(|(_, _, bt)| t < bt) {
                         want = Some((*inst, *tri, t));
                     }
                 }
