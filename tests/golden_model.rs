@@ -24,21 +24,8 @@ fn golden(scene: &Scene, f: Format, frame: u32) -> Frame {
     model::render_golden(&l, false)
 }
 
-fn same_hit(a: &Option<model::HitRecord>, b: &Option<model::HitRecord>) -> bool {
-    match (a, b) {
-        (None, None) => true,
-        (Some(a), Some(b)) => a.instance == b.instance && a.triangle == b.triangle,
-        _ => false,
-    }
-}
-
-fn identical_hit_ratio(a: &Frame, b: &Frame) -> f64 {
-    a.hits
-        .iter()
-        .zip(&b.hits)
-        .filter(|(x, y)| same_hit(x, y))
-        .count() as f64
-        / a.hits.len() as f64
+fn hit_metrics(a: &Frame, b: &Frame) -> dynrt::compare::HitMetrics {
+    dynrt::compare::compare_hits(&a.hit_tuples(), &b.hit_tuples()).unwrap()
 }
 
 /// The bundled scenes at test resolutions.

@@ -140,14 +140,23 @@ pub struct HitMetrics {
     pub pixels: usize,
     /// Pixels where both miss, or both hit the same instance and triangle.
     pub identical_hits: usize,
+    /// Identical hits plus ties: different triangles hit at the same distance (within
+    /// [`TIE_TOLERANCE`] relative), where the ray passes through a shared edge or vertex.
+    pub equivalent_hits: usize,
     /// Mean and maximum relative distance error over pixels that hit the same triangle.
     pub mean_rel_dist_error: f64,
     pub max_rel_dist_error: f64,
 }
 
+/// Relative distance within which hits on different triangles count as the same surface point.
+pub const TIE_TOLERANCE: f64 = 1e-5;
+
 impl HitMetrics {
     pub fn identical_ratio(&self) -> f64 {
         self.identical_hits as f64 / self.pixels.max(1) as f64
+    }
+    pub fn equivalent_ratio(&self) -> f64 {
+        self.equivalent_hits as f64 / self.pixels.max(1) as f64
     }
 }
 
@@ -163,10 +172,13 @@ pub fn compare_hits(
             b.len()
         );
     }
-    let (mut same, mut n_dist, mut sum, mut max) = (0, 0, 0.0, 0.0f64);
+    let (mut same, mut ties, mut n_dist, mut sum, mut max) = (0, 0, 0, 0.0, 0.0f64);
     for (x, y) in a.iter().zip(b) {
         match (x, y) {
             (None, None) => same += 1,
+            (Some((ia, ta, da)), Some((ib, tb, db))) if (ia, ta) != (ib, tb) => {
+                ties += usize::from((da - db).abs() <= TIE_TOLERANCE * db.abs());
+            }
             (Some((ia, ta, da)), Some((ib, tb, db))) if ia == ib && ta == tb => {
                 same += 1;
                 let rel = (da - db).abs() / db.abs().max(f64::MIN_POSITIVE);
@@ -180,6 +192,7 @@ pub fn compare_hits(
     Ok(HitMetrics {
         pixels: a.len(),
         identical_hits: same,
+        equivalent_hits: same + ties,
         mean_rel_dist_error: if n_dist > 0 { sum / n_dist as f64 } else { 0.0 },
         max_rel_dist_error: max,
     })

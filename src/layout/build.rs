@@ -10,10 +10,10 @@ use glam::{DAffine3, DMat3, DVec3};
 pub enum LayoutError {
     #[error(
         "scene `{scene}` does not fit the memory: bank {bank} ({name}) needs {needed} words \
-         ({needed_mb:.1} MB) but holds {capacity} ({capacity_mb:.1} MB); use a smaller scene \
+         ({needed_kib:.1} KiB) but holds {capacity} ({capacity_kib:.1} KiB); use a smaller scene \
          or a lower resolution, or configure larger banks",
-        needed_mb = *needed as f64 * 4.0 / 1048576.0,
-        capacity_mb = *capacity as f64 * 4.0 / 1048576.0
+        needed_kib = *needed as f64 * 4.0 / 1024.0,
+        capacity_kib = *capacity as f64 * 4.0 / 1024.0
     )]
     TooBig {
         scene: String,
@@ -45,39 +45,49 @@ pub enum LayoutError {
     },
 }
 
-/// The per-object kd-trees of a scene for one number format, built once and reused by every
-/// frame (only the top-level tree follows the instances).
+/// The per-object kd-trees and unit-triangle transforms of a scene for one number format,
+/// built once and reused by every frame (only the top-level tree follows the instances).
 ///
-/// Object vertices are first rounded to the format: every kd split then sits on a vertex
-/// coordinate, which the format represents exactly, so the hardware's split planes are the
-/// builder's planes and no triangle falls between them.
+/// The builder rounds every candidate split plane to the format before scoring it and sorts
+/// triangles against the rounded plane, so the planes the hardware stores are exactly the
+/// builder's and no triangle falls between them. A triangle whose transform does not fit the
+/// format (an entry overflows, as for slivers in narrow formats) is left out of the tree and
+/// reported in `dropped`.
 #[derive(Clone, Debug)]
 pub struct SceneTrees {
     pub format: Format,
-    /// Vertices rounded to the format, per object, same order as the scene's triangles.
-    pub triangles: Vec<Vec<[DVec3; 3]>>,
+    /// Woop transforms per object, in the scene's triangle order (zero words for dropped ones).
+    pub transforms: Vec<Vec<[u32; 12]>>,
     pub trees: Vec<KdTree>,
-    /// Triangles that became degenerate when rounded (never referenced by a leaf).
+    /// Local indices of the triangles left out, per object.
     pub dropped: Vec<Vec<u32>>,
 }
 
 impl SceneTrees {
     pub fn build(scene: &Scene, format: Format) -> Result<SceneTrees, LayoutError> {
-        // Perfect splits clip triangles at arbitrary planes; the hardware needs splits on
-        // representable values, which unclipped vertex-coordinate events guarantee.
         let params = KdParams {
-            clip_splits: false,
+            split_format: Some(format),
             ..KdParams::default()
         };
-        let mut all = Vec::new();
+        let mut out = SceneTrees {
+            format,
+            transforms: vec![],
+            trees: vec![],
+            dropped: vec![],
+        };
         for object in &scene.objects {
-            let rounded: Vec<[DVec3; 3]> = object
-                .triangles
-                .iter()
-                .map(|t| t.map(|v| round_vec(format, v)))
-                .collect();
-            let (kept, dropped): (Vec<u32>, Vec<u32>) =
-                (0..rounded.len() as u32).partition(|&i| !is_flat(&rounded[i as usize]));
+            let mut transforms = Vec::with_capacity(object.triangles.len());
+            let (mut kept, mut dropped) = (Vec::new(), Vec::new());
+            for (i, t) in object.triangles.iter().enumerate() {
+                let words = affine_words(format, &unit_triangle_transform(t));
+                if is_flat(t) || words.iter().any(|&w| format.is_nan(w) || format.is_inf(w)) {
+                    dropped.push(i as u32);
+                    transforms.push([0; 12]);
+                } else {
+                    kept.push(i as u32);
+                    transforms.push(words);
+                }
+            }
             if kept.is_empty() {
                 return Err(LayoutError::EmptyAfterRounding {
                     scene: scene.source.display().to_string(),
@@ -85,34 +95,22 @@ impl SceneTrees {
                     format,
                 });
             }
-            let kept_tris: Vec<[DVec3; 3]> = kept.iter().map(|&i| rounded[i as usize]).collect();
+            let kept_tris: Vec<[DVec3; 3]> =
+                kept.iter().map(|&i| object.triangles[i as usize]).collect();
             let mut tree = kd_tree::build_sah(&kept_tris, &params);
             for p in tree.prim_indices.iter_mut() {
                 *p = kept[*p as usize];
             }
-            all.push((rounded, tree, dropped));
-        }
-        let mut out = SceneTrees {
-            format,
-            triangles: vec![],
-            trees: vec![],
-            dropped: vec![],
-        };
-        for (t, tree, d) in all {
-            out.triangles.push(t);
+            out.transforms.push(transforms);
             out.trees.push(tree);
-            out.dropped.push(d);
+            out.dropped.push(dropped);
         }
         Ok(out)
     }
-}
 
-fn round_vec(f: Format, v: DVec3) -> DVec3 {
-    DVec3::new(
-        f.to_f64(f.from_f64(v.x)),
-        f.to_f64(f.from_f64(v.y)),
-        f.to_f64(f.from_f64(v.z)),
-    )
+    pub fn dropped_count(&self) -> usize {
+        self.dropped.iter().map(Vec::len).sum()
+    }
 }
 
 fn is_flat(t: &[DVec3; 3]) -> bool {
@@ -247,22 +245,18 @@ pub fn build(
 
     // Triangles and shading data, global triangle index = object base + local index.
     let mut first_triangle = Vec::new();
-    let mut first_material = Vec::new();
     let (mut tri_count, mut mat_count) = (0u32, 0u32);
     for (o, object) in scene.objects.iter().enumerate() {
         first_triangle.push(tri_count);
-        first_material.push(mat_count);
-        for (i, t) in trees.triangles[o].iter().enumerate() {
-            let (transform, normal) = if is_flat(t) {
-                // Never referenced by a leaf; zero words keep the addressing regular.
-                (DAffine3::ZERO, DVec3::ZERO)
+        for (i, t) in object.triangles.iter().enumerate() {
+            // Dropped triangles keep zero words so the addressing stays regular; no leaf
+            // refers to them.
+            let normal = if is_flat(t) {
+                DVec3::ZERO
             } else {
-                (
-                    unit_triangle_transform(t),
-                    (t[0] - t[2]).cross(t[1] - t[2]).normalize(),
-                )
+                (t[0] - t[2]).cross(t[1] - t[2]).normalize()
             };
-            banks[TRIANGLES].extend(affine_words(f, &transform));
+            banks[TRIANGLES].extend(trees.transforms[o][i]);
             banks[SHADING].extend([
                 f.from_f64(normal.x),
                 f.from_f64(normal.y),
@@ -299,7 +293,13 @@ pub fn build(
             .zip(&to_world)
             .map(|(inst, m)| instance_box(f, &trees.trees[inst.object].bounds, m))
             .collect();
-        Some(kd_tree::build_sah_boxes(&boxes, &KdParams::default()))
+        Some(kd_tree::build_sah_boxes(
+            &boxes,
+            &KdParams {
+                split_format: Some(f),
+                ..KdParams::default()
+            },
+        ))
     };
 
     let (mut nodes, mut lists) = (Vec::new(), Vec::new());
@@ -434,4 +434,161 @@ fn scene_extent(scene: &Scene) -> f64 {
         b = b.union(&Aabb::new(lo, hi).transformed(&inst.object_to_world(0)));
     }
     (b.max - b.min).max_element()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &str = r#"
+[camera]
+eye = [0.0, 1.0, 4.0]
+look_at = [0.0, 1.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov_y = 40.0
+width = 8
+height = 6
+
+[[lights]]
+position = [0.0, 1.9, 0.0]
+color = [1.0, 1.0, 1.0]
+
+[[objects]]
+name = "ball"
+generate = { kind = "sphere", subdivisions = 1 }
+
+[[instances]]
+object = "ball"
+translate = [0.5, 1.0, 0.0]
+
+[[instances]]
+object = "ball"
+translate = [-0.5, 1.0, 0.0]
+scale = [0.5, 0.5, 0.5]
+"#;
+
+    fn scene() -> Scene {
+        Scene::from_toml_str(SCENE, Path::new("."), "test.toml").unwrap()
+    }
+    use std::path::Path;
+
+    #[test]
+    fn unit_triangle_transform_maps_vertices_to_the_unit_triangle() {
+        let t = [
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::new(-2.0, 0.5, 1.0),
+            DVec3::new(0.3, -1.0, 2.0),
+        ];
+        let m = unit_triangle_transform(&t);
+        for (v, want) in t.iter().zip([DVec3::X, DVec3::Y, DVec3::ZERO]) {
+            assert!((m.transform_point3(*v) - want).length() < 1e-12);
+        }
+        let n = (t[0] - t[2]).cross(t[1] - t[2]).normalize();
+        assert!((m.transform_vector3(n) - DVec3::Z).length() < 1e-12);
+    }
+
+    #[test]
+    fn layout_decodes_to_the_trees_it_was_built_from() {
+        let s = scene();
+        let trees = SceneTrees::build(&s, Format::E7M16).unwrap();
+        let l = build(&s, &trees, 0, &MemoryConfig::default()).unwrap();
+        assert_eq!(l.info.instance_count, 2);
+        assert_eq!(l.info.triangle_count, 80);
+        assert_eq!(l.banks[TRIANGLES].len(), 80 * TRIANGLE_WORDS);
+        assert_eq!(l.banks[INSTANCES].len(), 2 * INSTANCE_WORDS);
+        let top = l.info.top_root.expect("two instances need a top level");
+        // Object tree nodes decode to the builder's nodes, offset past the top-level tree.
+        let root = l.word(INSTANCES, instance_word::ROOT as u32);
+        assert!(root > top);
+        for (i, node) in trees.trees[0].nodes.iter().enumerate() {
+            match (node, l.node(root + i as u32)) {
+                (
+                    KdNode::Inner {
+                        axis,
+                        split,
+                        children,
+                    },
+                    Node::Inner {
+                        axis: a,
+                        split: s,
+                        left,
+                    },
+                ) => {
+                    assert_eq!(
+                        (*axis as usize, Format::E7M16.to_f64(s), *children + root),
+                        (a, *split, left)
+                    );
+                }
+                (KdNode::Leaf { first, count }, Node::Leaf { list, count: c }) => {
+                    assert_eq!(c, *count);
+                    let ids: Vec<u32> = (0..c).map(|k| l.word(LISTS, list + k)).collect();
+                    assert_eq!(
+                        ids,
+                        trees.trees[0].prim_indices[*first as usize..(*first + count) as usize]
+                    );
+                }
+                (a, b) => panic!("node {i}: {a:?} decoded as {b:?}"),
+            }
+        }
+        // Frame buffer after the lights, one word per pixel.
+        assert_eq!(l.info.frame_buffer as usize, FrameMap::LIGHTS + LIGHT_WORDS);
+        assert_eq!(l.banks[FRAME].len(), l.info.frame_buffer as usize + 48);
+    }
+
+    #[test]
+    fn a_scene_too_big_for_the_memory_is_refused_with_the_bank_named() {
+        let s = scene();
+        let trees = SceneTrees::build(&s, Format::E7M16).unwrap();
+        let fits = build(&s, &trees, 0, &MemoryConfig::default()).unwrap();
+        let (bank, words) = fits
+            .used_words()
+            .into_iter()
+            .enumerate()
+            .max_by_key(|&(_, w)| w)
+            .unwrap();
+        let exact = MemoryConfig {
+            banks: 6,
+            bank_bytes: words * 4,
+        };
+        assert!(
+            build(&s, &trees, 0, &exact).is_ok(),
+            "a bank filled exactly still fits"
+        );
+        let small = MemoryConfig {
+            banks: 6,
+            bank_bytes: words * 4 - 4,
+        };
+        let err = build(&s, &trees, 0, &small).unwrap_err().to_string();
+        let want = format!("bank {bank} ({}) needs {words} words", BANK_NAMES[bank]);
+        assert!(
+            err.contains("does not fit") && err.contains(&want) && err.contains("test.toml"),
+            "{err}"
+        );
+        let err = build(&s, &trees, 3, &MemoryConfig::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("frame 3"), "{err}");
+    }
+
+    #[test]
+    fn instance_boxes_are_rounded_outward_to_the_format() {
+        let f = Format::parse("e5m10").unwrap();
+        let b = Aabb::new(DVec3::splat(0.1), DVec3::splat(0.3));
+        let r = instance_box(f, &b, &DAffine3::IDENTITY);
+        for v in [r.min, r.max] {
+            for c in v.to_array() {
+                assert_eq!(f.to_f64(f.from_f64(c)), c, "{c} must be representable");
+            }
+        }
+        assert!(r.min.max_element() < 0.1 && r.max.min_element() > 0.3);
+        assert_eq!(
+            round_down(f, 0.1),
+            f.to_f64(f.from_f64(0.1)).min(round_down(f, 0.1))
+        );
+        assert!(
+            round_down(f, 0.1) <= 0.1
+                && round_up(f, 0.1) >= 0.1
+                && round_up(f, 0.1) > round_down(f, 0.1)
+        );
+    }
 }

@@ -51,6 +51,14 @@ impl Frame {
         }
     }
 
+    /// Hits as `(instance, triangle, dist)` per pixel, the form `compare` works on.
+    pub fn hit_tuples(&self) -> Vec<Option<(i64, i64, f64)>> {
+        self.hits
+            .iter()
+            .map(|h| h.map(|h| (i64::from(h.instance), i64::from(h.triangle), h.dist)))
+            .collect()
+    }
+
     pub fn to_image(&self) -> image::RgbImage {
         image::RgbImage::from_fn(self.width, self.height, |x, y| {
             let c = self.rgb[(y * self.width + x) as usize];
