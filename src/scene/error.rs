@@ -47,7 +47,9 @@ pub enum Problem {
     UnknownObject { name: String, known: String },
     #[error("duplicate object name '{name}' (first defined on line {first_line}); give every object a unique name")]
     DuplicateObject { name: String, first_line: usize },
-    #[error("an object needs exactly one of `mesh = \"file.obj\"` or `generate = {{ kind = ... }}`")]
+    #[error(
+        "an object needs exactly one of `mesh = \"file.obj\"` or `generate = {{ kind = ... }}`"
+    )]
     ObjectSource,
     #[error("mesh file '{path}' cannot be read: {reason}; check the path (it is relative to the scene file)")]
     MeshUnreadable { path: PathBuf, reason: String },

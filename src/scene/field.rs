@@ -130,7 +130,10 @@ mod tests {
             assert!((0.0..360.0).contains(&i.transform.rotate_deg.y));
             let a = i.animation.unwrap();
             assert_eq!(a.frames, 6);
-            assert_eq!(a.end.translate, i.transform.translate + DVec3::new(0.0, 2.0, 0.0));
+            assert_eq!(
+                a.end.translate,
+                i.transform.translate + DVec3::new(0.0, 2.0, 0.0)
+            );
             assert_eq!(a.end.rotate_deg.y, i.transform.rotate_deg.y + 90.0);
         }
         // Grid is centred on origin: first and last points are symmetric about it.

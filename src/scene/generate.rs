@@ -160,9 +160,17 @@ fn build(def: &GenerateDef, material: Material) -> Result<RawMesh, ParamError> {
                 "terrain size",
                 &format!("1..={MAX_GRID_CELLS_PER_SIDE} cells per side"),
             )?;
-            check(amplitude.is_finite(), "terrain amplitude", "a finite number")?;
+            check(
+                amplitude.is_finite(),
+                "terrain amplitude",
+                "a finite number",
+            )?;
             check(positive(*extent), "terrain extent", "a finite number > 0")?;
-            check(positive(*frequency), "terrain frequency", "a finite number > 0")?;
+            check(
+                positive(*frequency),
+                "terrain frequency",
+                "a finite number > 0",
+            )?;
             check(
                 (1..=MAX_TERRAIN_OCTAVES).contains(octaves),
                 "terrain octaves",
@@ -189,7 +197,11 @@ fn quad(out: &mut Vec<[DVec3; 3]>, centre: DVec3, u: DVec3, v: DVec3) {
 /// A box with half extents `half`, turned `yaw_deg` about Y around `centre`, outward normals.
 fn box_triangles(centre: DVec3, half: DVec3, yaw_deg: f64, bottom: bool) -> Vec<[DVec3; 3]> {
     let r = DMat3::from_rotation_y(yaw_deg.to_radians());
-    let (x, y, z) = (r * DVec3::X * half.x, DVec3::Y * half.y, r * DVec3::Z * half.z);
+    let (x, y, z) = (
+        r * DVec3::X * half.x,
+        DVec3::Y * half.y,
+        r * DVec3::Z * half.z,
+    );
     let mut out = Vec::with_capacity(12);
     // (face centre offset, u, v) with u x v pointing outwards.
     quad(&mut out, centre + x, y, z); // +X: Y x Z = X
@@ -324,7 +336,7 @@ fn cornell_box(closed_front: bool, mirror_tall_block: f64) -> RawMesh {
     };
     let mut add = |tris: Vec<[DVec3; 3]>, material: u32| {
         mesh.triangle_material
-            .extend(std::iter::repeat(material).take(tris.len()));
+            .extend(std::iter::repeat_n(material, tris.len()));
         mesh.triangles.extend(tris);
     };
     let wall = |centre: DVec3, u: DVec3, v: DVec3| {
@@ -534,7 +546,13 @@ mod tests {
     #[test]
     fn bad_parameters_are_refused() {
         let m = Material::DEFAULT;
-        assert!(generate(&GenerateDef::Box { size: [1.0, 0.0, 1.0] }, m).is_err());
+        assert!(generate(
+            &GenerateDef::Box {
+                size: [1.0, 0.0, 1.0]
+            },
+            m
+        )
+        .is_err());
         assert!(generate(
             &GenerateDef::Sphere {
                 radius: 1.0,

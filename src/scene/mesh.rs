@@ -101,16 +101,14 @@ pub fn is_degenerate(t: &[DVec3; 3]) -> bool {
         .max(e1.length_squared())
         .max(e2.length_squared());
     let twice_area = e0.cross(e1).length();
-    // Written so that NaN and zero-length edges also count as degenerate.
-    !(twice_area > DEGENERATE_RELATIVE_EPSILON * longest2)
+    // NaN and zero-length edges also count as degenerate.
+    let keep = twice_area > DEGENERATE_RELATIVE_EPSILON * longest2;
+    !keep
 }
 
 /// Drops degenerate triangles; returns the object and how many were dropped.
 /// Errors with `EmptyMesh` when nothing remains.
-pub(crate) fn finish_object(
-    name: &str,
-    raw: RawMesh,
-) -> Result<(Object, usize), (usize, usize)> {
+pub(crate) fn finish_object(name: &str, raw: RawMesh) -> Result<(Object, usize), (usize, usize)> {
     let total = raw.triangles.len();
     let mut triangles = Vec::with_capacity(total);
     let mut triangle_material = Vec::with_capacity(total);
@@ -173,7 +171,9 @@ fn scan_obj(path: &Path, text: &str, item: &str) -> Result<ObjScan, SceneError> 
                             path,
                             lineno,
                             item,
-                            Problem::BrokenObj(format!("vertex {axis} coordinate '{word}' is not a number")),
+                            Problem::BrokenObj(format!(
+                                "vertex {axis} coordinate '{word}' is not a number"
+                            )),
                         )
                     })?;
                     if !value.is_finite() {
@@ -182,7 +182,10 @@ fn scan_obj(path: &Path, text: &str, item: &str) -> Result<ObjScan, SceneError> 
                             lineno,
                             item,
                             Problem::NonFinite {
-                                what: format!("vertex {} coordinate {axis} = '{word}' (as f32)", vertices + 1),
+                                what: format!(
+                                    "vertex {} coordinate {axis} = '{word}' (as f32)",
+                                    vertices + 1
+                                ),
                             },
                         ));
                     }
@@ -212,7 +215,11 @@ fn scan_obj(path: &Path, text: &str, item: &str) -> Result<ObjScan, SceneError> 
                             Problem::BrokenObj(format!("face vertex '{c}' is not an index")),
                         )
                     })?;
-                    let resolved = if index < 0 { vertices + index + 1 } else { index };
+                    let resolved = if index < 0 {
+                        vertices + index + 1
+                    } else {
+                        index
+                    };
                     if index == 0 || resolved < 1 || resolved > vertices {
                         return Err(obj_error(
                             path,
@@ -276,7 +283,9 @@ pub(crate) fn load_obj(path: &Path, item: &str) -> Result<(RawMesh, Vec<String>)
     let mut warnings = Vec::new();
     let mut out = RawMesh::default();
     for m in &tobj_materials {
-        let diffuse = m.diffuse.map_or(Material::DEFAULT.diffuse, |d| d.map(f64::from));
+        let diffuse = m
+            .diffuse
+            .map_or(Material::DEFAULT.diffuse, |d| d.map(f64::from));
         let what = format!("material '{}'", m.name);
         if diffuse.iter().any(|c| !c.is_finite()) {
             return Err(obj_error(

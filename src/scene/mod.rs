@@ -315,8 +315,10 @@ impl Builder<'_> {
         }
         for (o, u) in objects.iter().zip(used) {
             if !u {
-                self.warnings
-                    .push(format!("object '{}' is defined but never instanced", o.name));
+                self.warnings.push(format!(
+                    "object '{}' is defined but never instanced",
+                    o.name
+                ));
             }
         }
         if lights.is_empty() {
@@ -374,7 +376,8 @@ impl Builder<'_> {
         // Parallel when the sine of the angle between them is below 1e-9 (also catches up = 0).
         let f = view.normalize();
         let cross = f.cross(up);
-        if !(cross.length() > 1e-9 * up.length()) || up == DVec3::ZERO {
+        let across = cross.length() > 1e-9 * up.length();
+        if !across || up == DVec3::ZERO {
             return Err(self.err(
                 c.up.span(),
                 item,
@@ -479,7 +482,12 @@ impl Builder<'_> {
                 Some(m) => {
                     let v = self.finite(m, &item, "mirror")?;
                     if !(0.0..=1.0).contains(&v) {
-                        return Err(self.invalid(m.span(), &item, "mirror", "a reflectivity in [0, 1]"));
+                        return Err(self.invalid(
+                            m.span(),
+                            &item,
+                            "mirror",
+                            "a reflectivity in [0, 1]",
+                        ));
                     }
                     Some(v)
                 }
@@ -519,7 +527,9 @@ impl Builder<'_> {
                         ));
                     }
                     let raw = generate::generate(g, override_material.unwrap_or(Material::DEFAULT))
-                        .map_err(|(what, expected)| self.invalid(gen.span(), &item, &what, &expected))?;
+                        .map_err(|(what, expected)| {
+                            self.invalid(gen.span(), &item, &what, &expected)
+                        })?;
                     (raw, self.ctx.file.clone())
                 }
                 _ => return Err(self.err(o.span(), &item, Problem::ObjectSource)),
@@ -677,7 +687,12 @@ impl Builder<'_> {
             Some(j) => {
                 let v = self.finite(j, item, "jitter")?;
                 if !(0.0..1.0).contains(&v) {
-                    return Err(self.invalid(j.span(), item, "jitter", "a fraction of the spacing in [0, 1)"));
+                    return Err(self.invalid(
+                        j.span(),
+                        item,
+                        "jitter",
+                        "a fraction of the spacing in [0, 1)",
+                    ));
                 }
                 v
             }

@@ -19,7 +19,11 @@ pub fn lattice_value(ix: i64, iz: i64, seed: u64, octave: u32) -> f64 {
     let h = mix64(
         mix64(seed ^ 0x243F_6A88_85A3_08D3)
             ^ mix64((ix as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
-            ^ mix64((iz as u64).wrapping_add(0x1357_9BDF_0246_8ACE).rotate_left(17))
+            ^ mix64(
+                (iz as u64)
+                    .wrapping_add(0x1357_9BDF_0246_8ACE)
+                    .rotate_left(17),
+            )
             ^ u64::from(octave).wrapping_mul(0xD6E8_FEB8_6659_FD93),
     );
     // Top 53 bits -> [0, 1) exactly, then to [-1, 1).
