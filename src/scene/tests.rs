@@ -13,7 +13,18 @@ fn repo() -> PathBuf {
 
 fn bundled(name: &str) -> Scene {
     let path = repo().join("scenes").join(name);
-    Scene::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"))
+    let s = Scene::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+    println!(
+        "{name}: {} objects, {} triangles, {} instances, {} instanced triangles, {} frames, {}x{}",
+        s.objects.len(),
+        s.triangle_count(),
+        s.instances.len(),
+        s.instanced_triangle_count(),
+        s.frames,
+        s.camera.width,
+        s.camera.height
+    );
+    s
 }
 
 const CAMERA: &str = "[camera]\neye = [0.0, 1.0, 3.5]\nlook_at = [0.0, 1.0, 0.0]\nfov_y = 40.0\nwidth = 8\nheight = 6\n";
@@ -314,6 +325,29 @@ fn animation_matches_matrix_built_from_interpolated_values() {
         assert_eq!(s.instances[1].object_to_world(k), DAffine3::IDENTITY);
     }
     assert!(!s.is_single_untransformed_object());
+}
+
+#[test]
+fn frozen_frames_and_world_bounds() {
+    let s = bundled("tiny_animated.toml");
+    for k in 0..s.frames {
+        let f = s.at_frame(k);
+        assert_eq!(f.frames, 1);
+        for (a, b) in s.instances.iter().zip(&f.instances) {
+            assert!(b.animation.is_none());
+            assert_eq!(a.object_to_world(k), b.object_to_world(0));
+            assert_eq!(b.object_to_world(0), b.object_to_world(5));
+        }
+    }
+    // Box instance: unit cube translated to (-0.9, 0.55, 0) at frame 0.
+    let (lo, hi) = s.instance_world_bounds(1, 0);
+    assert!((lo - DVec3::new(-1.4, 0.05, -0.5)).length() < 1e-12, "{lo}");
+    assert!((hi - DVec3::new(-0.4, 1.05, 0.5)).length() < 1e-12, "{hi}");
+    // At the last frame it is turned 60 degrees about Y: the x extent is cos 60 + sin 60.
+    let (lo, hi) = s.instance_world_bounds(1, 2);
+    let half = 0.5 * (60f64.to_radians().cos() + 60f64.to_radians().sin());
+    assert!((lo.x - (-0.3 - half)).abs() < 1e-12 && (hi.x - (-0.3 + half)).abs() < 1e-12);
+    assert!((hi.y - 1.05).abs() < 1e-12);
 }
 
 #[test]
