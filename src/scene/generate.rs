@@ -336,7 +336,7 @@ fn cornell_box(closed_front: bool, mirror_tall_block: f64) -> RawMesh {
     };
     let mut add = |tris: Vec<[DVec3; 3]>, material: u32| {
         mesh.triangle_material
-            .extend(std::iter::repeat(material).take(tris.len()));
+            .extend(std::iter::repeat_n(material, tris.len()));
         mesh.triangles.extend(tris);
     };
     let wall = |centre: DVec3, u: DVec3, v: DVec3| {

@@ -101,8 +101,9 @@ pub fn is_degenerate(t: &[DVec3; 3]) -> bool {
         .max(e1.length_squared())
         .max(e2.length_squared());
     let twice_area = e0.cross(e1).length();
-    // Written so that NaN and zero-length edges also count as degenerate.
-    !(twice_area > DEGENERATE_RELATIVE_EPSILON * longest2)
+    // NaN and zero-length edges also count as degenerate.
+    let keep = twice_area > DEGENERATE_RELATIVE_EPSILON * longest2;
+    !keep
 }
 
 /// Drops degenerate triangles; returns the object and how many were dropped.

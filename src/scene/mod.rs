@@ -180,6 +180,39 @@ impl Scene {
     pub fn object_index(&self, name: &str) -> Option<usize> {
         self.objects.iter().position(|o| o.name == name)
     }
+
+    /// World-space bounds (min, max) of instance `i` at `frame`: the object's bounding box
+    /// corners transformed (a conservative box, what a top-level kd-tree needs).
+    pub fn instance_world_bounds(&self, i: usize, frame: u32) -> (DVec3, DVec3) {
+        let inst = &self.instances[i];
+        let (lo, hi) = self.objects[inst.object].bounds();
+        let m = inst.object_to_world(frame);
+        let mut wlo = DVec3::splat(f64::INFINITY);
+        let mut whi = DVec3::splat(f64::NEG_INFINITY);
+        for k in 0..8 {
+            let corner = DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            let p = m.transform_point3(corner);
+            wlo = wlo.min(p);
+            whi = whi.max(p);
+        }
+        (wlo, whi)
+    }
+
+    /// The static scene of one frame: every instance frozen at its transform of `frame`,
+    /// `frames` = 1. Rendering frame k of `self` must equal rendering `self.at_frame(k)`.
+    pub fn at_frame(&self, frame: u32) -> Scene {
+        let mut s = self.clone();
+        for inst in &mut s.instances {
+            inst.transform = inst.transform_at(frame);
+            inst.animation = None;
+        }
+        s.frames = 1;
+        s
+    }
 }
 
 fn resolution_ok(width: u32, height: u32) -> bool {
@@ -376,7 +409,8 @@ impl Builder<'_> {
         // Parallel when the sine of the angle between them is below 1e-9 (also catches up = 0).
         let f = view.normalize();
         let cross = f.cross(up);
-        if !(cross.length() > 1e-9 * up.length()) || up == DVec3::ZERO {
+        let across = cross.length() > 1e-9 * up.length();
+        if !across || up == DVec3::ZERO {
             return Err(self.err(
                 c.up.span(),
                 item,

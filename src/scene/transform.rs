@@ -99,7 +99,7 @@ impl Instance {
 
     /// True if this instance leaves its object where it is, at every frame.
     pub fn is_static_identity(&self) -> bool {
-        self.transform.is_identity() && self.animation.map_or(true, |a| a.end.is_identity())
+        self.transform.is_identity() && self.animation.is_none_or(|a| a.end.is_identity())
     }
 }
 
