@@ -3,10 +3,15 @@
 use super::*;
 
 fn synth_source(name: &str, verilog: &str, top: &str) -> SynthReport {
+    synth_source_with(name, verilog, top, &SynthOptions::default())
+}
+
+fn synth_source_with(name: &str, verilog: &str, top: &str, options: &SynthOptions) -> SynthReport {
     let dir = tempfile::tempdir().unwrap();
     let src = dir.path().join(format!("{name}.v"));
     std::fs::write(&src, verilog).unwrap();
-    let report = synth_xc2v(&[src], top, dir.path()).unwrap_or_else(|e| panic!("{top}: {e}"));
+    let report =
+        synth_xc2v_with(&[src], top, dir.path(), options).unwrap_or_else(|e| panic!("{top}: {e}"));
     println!("{report}\n{:?}", report.all_cells);
     report
 }
@@ -62,17 +67,35 @@ fn counter_has_n_flip_flops() {
     }
 }
 
+const PARITY_V: &str = "module parity (input wire clk, input wire [63:0] d, output reg p);\n\
+    \x20 reg [63:0] r;\n\
+    \x20 always @(posedge clk) begin r <= d; p <= ^r; end\n\
+    endmodule\n";
+
 #[test]
 fn parity_tree_depth_in_lut_levels() {
-    // XOR of 64 registered bits into a register. ABC maps to 8-input "wide LUTs" (16 LUT4s
-    // joined by MUXF5..MUXF8 inside the CLBs), which the depth definition counts as one level:
-    // 64 -> 8 -> 1 = 2 levels, and 5 cells (LUT4, MUXF5, MUXF6, MUXF7, MUXF8) per level.
-    // A wrong count of MUXFs as levels would give 10; cutting paths at the wrong place, 1.
-    let v = "module parity (input wire clk, input wire [63:0] d, output reg p);\n\
-             \x20 reg [63:0] r;\n\
-             \x20 always @(posedge clk) begin r <= d; p <= ^r; end\n\
-             endmodule\n";
-    let r = synth_source("parity", v, "parity");
+    // XOR of 64 registered bits into a register: a LUT4 tree 64 -> 16 -> 4 -> 1, 21 LUT4s in
+    // 3 levels (no LUT4 tree does better: 4^2 = 16 < 64). XOR does not map to carry chains.
+    let r = synth_source("parity", PARITY_V, "parity");
+    assert_eq!(r.cells("LUT4"), 21, "{:?}", r.all_cells);
+    assert_eq!(r.luts, 21);
+    assert_eq!(r.logic_depth, 3, "{:?}", r.all_cells);
+    assert_eq!(r.path_cells, 3);
+    assert_eq!(r.flip_flops, 65);
+}
+
+#[test]
+fn parity_tree_with_wide_luts() {
+    // With wide LUTs ABC builds 8-input functions (16 LUT4s joined by MUXF5..MUXF8 inside
+    // the CLBs), which the depth definition counts as one level: 64 -> 8 -> 1 = 2 levels,
+    // and 5 cells (LUT4, MUXF5, MUXF6, MUXF7, MUXF8) per level. Counting MUXFs as levels
+    // would give 10; cutting paths at the wrong place, 1.
+    let options = SynthOptions {
+        wide_luts: true,
+        ..SynthOptions::default()
+    };
+    let r = synth_source_with("parity", PARITY_V, "parity", &options);
+    assert!(!r.command.contains("-nowidelut"));
     assert_eq!(r.cells("MUXF8"), 9, "{:?}", r.all_cells);
     assert_eq!(r.logic_depth, 2, "{:?}", r.all_cells);
     assert_eq!(r.path_cells, 10, "{:?}", r.all_cells);
@@ -139,6 +162,7 @@ fn utilization_of_xc2v6000() {
     cells.insert("RAMB16_S36_S36".to_string(), 144);
     let r = summarize(
         "t",
+        String::new(),
         "0.23".into(),
         cells,
         0,
