@@ -234,6 +234,8 @@ pub struct CompiledSim {
     /// The vvp file (Icarus) or the model executable (Verilator).
     pub artifact: PathBuf,
     pub compile_seconds: f64,
+    /// Everything the compiler printed (Verilator's warnings land here).
+    pub compile_log: String,
 }
 
 /// Compiles `job` in `sim` into a fresh build directory inside `job.work_dir`.
@@ -400,6 +402,7 @@ fn compile_icarus(job: &SimJob, p: Prepared) -> Result<CompiledSim, ToolError> {
         build_dir: p.build_dir,
         artifact: vvp_file,
         compile_seconds: built.seconds,
+        compile_log: built.combined(),
     })
 }
 
@@ -444,6 +447,7 @@ fn compile_verilator(job: &SimJob, p: Prepared) -> Result<CompiledSim, ToolError
         build_dir: p.build_dir,
         artifact: exe,
         compile_seconds: built.seconds,
+        compile_log: built.combined(),
     })
 }
 

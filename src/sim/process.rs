@@ -140,6 +140,9 @@ fn kill_group(child: &mut Child) {
 /// The last `n` non-empty lines of `text`.
 pub(crate) fn last_lines(text: &str, n: usize) -> String {
     let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+    if lines.is_empty() {
+        return "(no output)".to_string();
+    }
     lines[lines.len().saturating_sub(n)..].join("\n")
 }
 
