@@ -190,3 +190,43 @@ fn lut_ram_sizes() {
     assert_eq!(lut_ram_size("RAM16X8S"), 8);
     assert_eq!(lut_ram_size("SRL16E"), 1);
 }
+
+#[test]
+fn memories_map_to_block_ram_and_distributed_ram() {
+    let dir = tempfile::tempdir().unwrap();
+    let init: String = (0..512).map(|i| format!("{i:08x}\n")).collect();
+    // $readmemh paths resolve against yosys's current directory, the work directory.
+    std::fs::write(dir.path().join("init.hex"), init).unwrap();
+    let src = dir.path().join("rams.v");
+    std::fs::write(
+        &src,
+        "module ram512 (input wire clk, input wire we, input wire [8:0] wa, input wire [31:0] wd,\n\
+         \x20   input wire [8:0] ra, output reg [31:0] rd);\n\
+         \x20 reg [31:0] mem [0:511];\n\
+         \x20 initial $readmemh(\"init.hex\", mem);\n\
+         \x20 always @(posedge clk) begin if (we) mem[wa] <= wd; rd <= mem[ra]; end\n\
+         endmodule\n\
+         module ram16 (input wire clk, input wire we, input wire [3:0] wa, input wire [7:0] wd,\n\
+         \x20   input wire [3:0] ra, output wire [7:0] rd);\n\
+         \x20 reg [7:0] mem [0:15];\n\
+         \x20 always @(posedge clk) if (we) mem[wa] <= wd;\n\
+         \x20 assign rd = mem[ra];\n\
+         endmodule\n",
+    )
+    .unwrap();
+    // 512 x 32 with a registered read: exactly one 18-Kbit block RAM in its 512x36 shape.
+    let big = synth_xc2v(std::slice::from_ref(&src), "ram512", dir.path()).unwrap();
+    println!("{big}\n{:?}", big.all_cells);
+    assert_eq!(big.block_rams, 1, "{:?}", big.all_cells);
+    assert_eq!(big.cells("RAMB16_S36_S36"), 1);
+    assert_eq!(big.luts, 0);
+    // 16 x 8 with an asynchronous read: 8 dual-port RAM16X1D, 2 LUTs each; the read is one
+    // LUT level from the address port to the output.
+    let small = synth_xc2v(&[src], "ram16", dir.path()).unwrap();
+    println!("{small}\n{:?}", small.all_cells);
+    assert_eq!(small.cells("RAM16X1D"), 8, "{:?}", small.all_cells);
+    assert_eq!(small.lut_ram_luts, 16);
+    assert_eq!(small.total_luts(), 16 + small.luts);
+    assert_eq!(small.logic_depth, 1);
+    assert_eq!(small.block_rams, 0);
+}
