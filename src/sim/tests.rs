@@ -110,6 +110,35 @@ fn adder_in_verilator() {
 }
 
 #[test]
+fn one_verilator_build_runs_twice() {
+    let dir = tempfile::tempdir().unwrap();
+    let vectors = adder_vectors(11, 16);
+    let src = write_adder_bench(dir.path(), &vectors);
+    let job = SimJob::new(dir.path(), vec![src], "tb_adder")
+        .define("NVEC", Some("16".into()))
+        .verilator_build(VerilatorBuild::Fast);
+    let build = compile(Simulator::Verilator, &job).unwrap();
+    println!("verilator Fast build: {:.2} s", build.compile_seconds);
+    let want: String = vectors
+        .iter()
+        .map(|&(a, b)| format!("{:03x}\n", a as u32 + b as u32))
+        .collect();
+    for name in ["first.hex", "second.hex"] {
+        let run = build
+            .run(&[format!("out={name}")], Duration::from_secs(60))
+            .unwrap();
+        assert!(run.stdout.contains("DONE 16"), "{}", run.stdout);
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join(name)).unwrap(),
+            want
+        );
+    }
+    // Without +out= the testbench stops with $fatal: a run error, not a silent success.
+    let err = build.run(&[], Duration::from_secs(60)).unwrap_err();
+    assert!(err.to_string().contains("missing +out="), "{err}");
+}
+
+#[test]
 fn two_jobs_in_one_work_dir_get_separate_build_dirs() {
     let dir = tempfile::tempdir().unwrap();
     let vectors = adder_vectors(7, 8);
@@ -331,4 +360,41 @@ fn lint_of_broken_source_is_an_error() {
         Err(ToolError::Compile { location, .. }) => assert_eq!(location.unwrap().line, 4),
         other => panic!("expected a compile error, got {other:?}"),
     }
+}
+
+#[test]
+fn verilator_compile_timeout_kills_the_build() {
+    let dir = tempfile::tempdir().unwrap();
+    let vectors = adder_vectors(3, 4);
+    let src = write_adder_bench(dir.path(), &vectors);
+    let mut job = SimJob::new(dir.path(), vec![src], "tb_adder").define("NVEC", Some("4".into()));
+    // Long enough for make and g++ to be running, far too short for them to finish.
+    job.compile_timeout = Duration::from_secs(2);
+    match compile(Simulator::Verilator, &job) {
+        Err(ToolError::Timeout { stage, .. }) => assert!(stage.contains("compiling"), "{stage}"),
+        other => panic!("expected a compile timeout, got {other:?}"),
+    }
+    // Had make and g++ survived the timeout, they would finish the model; killed, they don't.
+    std::thread::sleep(Duration::from_secs(15));
+    let built: Vec<_> = walk(dir.path())
+        .into_iter()
+        .filter(|p| p.file_name().is_some_and(|n| n == "Vtb_adder"))
+        .collect();
+    assert!(
+        built.is_empty(),
+        "the build went on after the timeout: {built:?}"
+    );
+}
+
+fn walk(dir: &std::path::Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            found.extend(walk(&path));
+        } else {
+            found.push(path);
+        }
+    }
+    found
 }

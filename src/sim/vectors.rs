@@ -60,6 +60,43 @@ pub fn read_vector_file(path: &Path, width_bits: u32) -> Result<Vec<(u32, u32)>,
     })
 }
 
+/// Reads a result file (one hex word a line, e.g. what a testbench wrote), checking that
+/// every word fits `width_bits`; blank lines are skipped.
+pub fn read_word_file(path: &Path, width_bits: u32) -> Result<Vec<u32>, VectorFileError> {
+    if width_bits == 0 || width_bits > 32 {
+        return Err(VectorFileError::BadWidth(width_bits));
+    }
+    let text = std::fs::read_to_string(path).map_err(|source| VectorFileError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut words = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let fields: Vec<&str> = line.split_whitespace().collect();
+        let problem = match fields.as_slice() {
+            [] => continue,
+            [w] => match parse_word(w, width_bits) {
+                Ok(v) => {
+                    words.push(v);
+                    continue;
+                }
+                Err(p) => p,
+            },
+            _ => format!(
+                "expected one hex word, found {} fields: `{}`",
+                fields.len(),
+                line.trim()
+            ),
+        };
+        return Err(VectorFileError::Line {
+            path: path.to_path_buf(),
+            line: i + 1,
+            problem,
+        });
+    }
+    Ok(words)
+}
+
 /// Parses vector text; errors are (1-based line, problem).
 fn parse_vectors(text: &str, width_bits: u32) -> Result<Vec<(u32, u32)>, (usize, String)> {
     let mut vectors = Vec::new();
@@ -265,6 +302,25 @@ mod tests {
             .map(|e| e.unwrap().file_name())
             .collect();
         assert_eq!(names, vec![std::ffi::OsString::from("out.hex")]);
+    }
+
+    #[test]
+    fn result_files_round_trip_and_bad_words_are_located() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("r.hex");
+        write_results_atomically(&out, &[0xabcdef, 0, 0x800000], 6).unwrap();
+        assert_eq!(
+            read_word_file(&out, 24).unwrap(),
+            vec![0xabcdef, 0, 0x800000]
+        );
+        // Icarus writes x for unknown bits: that must be an error, not a zero.
+        let p = write(dir.path(), "x.hex", "000001\n00000x\n");
+        let e = read_word_file(&p, 24).unwrap_err().to_string();
+        assert!(e.contains("x.hex:2:") && e.contains("not hex"), "{e}");
+        let p = write(dir.path(), "two.hex", "1 2\n");
+        let e = read_word_file(&p, 24).unwrap_err().to_string();
+        assert!(e.contains("two.hex:1:") && e.contains("2 fields"), "{e}");
+        assert!(read_word_file(&out, 23).is_err(), "0xabcdef needs 24 bits");
     }
 
     #[test]
