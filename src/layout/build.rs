@@ -256,26 +256,14 @@ pub fn build(
             } else {
                 (t[0] - t[2]).cross(t[1] - t[2]).normalize()
             };
-            banks[TRIANGLES].extend(trees.transforms[o][i]);
-            banks[SHADING].extend([
-                f.from_f64(normal.x),
-                f.from_f64(normal.y),
-                f.from_f64(normal.z),
-            ]);
-            banks[SHADING].push(mat_count + object.triangle_material[i]);
+            let t = &trees.transforms[o][i];
+            banks[TRIANGLES_UV].extend(&t[..8]);
+            banks[TRIANGLES_T].extend(&t[8..]);
+            banks[TRIANGLES_T].extend([normal.x, normal.y, normal.z].map(|c| f.from_f64(c)));
+            banks[TRIANGLES_T].push(mat_count + object.triangle_material[i]);
         }
         tri_count += object.triangles.len() as u32;
         mat_count += object.materials.len() as u32;
-    }
-    for object in &scene.objects {
-        for m in &object.materials {
-            banks[SHADING].extend([
-                f.from_f64(m.diffuse[0]),
-                f.from_f64(m.diffuse[1]),
-                f.from_f64(m.diffuse[2]),
-            ]);
-            banks[SHADING].push(f.from_f64(m.mirror));
-        }
     }
 
     // Top-level tree over the instances' world bounds (absent for one untransformed object).
@@ -377,6 +365,13 @@ pub fn build(
         fr.extend([light.position.x, light.position.y, light.position.z].map(|c| f.from_f64(c)));
         fr.extend(light.color.map(|c| f.from_f64(c)));
     }
+    let materials = fr.len() as u32;
+    for object in &scene.objects {
+        for m in &object.materials {
+            fr.extend(m.diffuse.map(|c| f.from_f64(c)));
+            fr.push(f.from_f64(m.mirror));
+        }
+    }
     let frame_buffer = fr.len() as u32;
     fr.resize(fr.len() + (cam.width * cam.height) as usize, 0);
 
@@ -399,6 +394,7 @@ pub fn build(
         reflection_depth: scene.render.reflection_depth,
         light_count: scene.lights.len() as u32,
         top_root,
+        materials,
         object_root: object_roots[0],
         instance_count: scene.instances.len() as u32,
         triangle_count: tri_count,
@@ -494,7 +490,10 @@ scale = [0.5, 0.5, 0.5]
         let l = build(&s, &trees, 0, &MemoryConfig::default()).unwrap();
         assert_eq!(l.info.instance_count, 2);
         assert_eq!(l.info.triangle_count, 80);
-        assert_eq!(l.banks[TRIANGLES].len(), 80 * TRIANGLE_WORDS);
+        assert_eq!(l.banks[TRIANGLES_UV].len(), 80 * TRIANGLE_BANK_WORDS);
+        assert_eq!(l.banks[TRIANGLES_T].len(), 80 * TRIANGLE_BANK_WORDS);
+        // The transform reassembled from both banks is the one the trees were built with.
+        assert_eq!(l.triangle_transform(17), trees.transforms[0][17]);
         assert_eq!(l.banks[INSTANCES].len(), 2 * INSTANCE_WORDS);
         let top = l.info.top_root.expect("two instances need a top level");
         // Object tree nodes decode to the builder's nodes, offset past the top-level tree.
@@ -531,7 +530,11 @@ scale = [0.5, 0.5, 0.5]
             }
         }
         // Frame buffer after the lights, one word per pixel.
-        assert_eq!(l.info.frame_buffer as usize, FrameMap::LIGHTS + LIGHT_WORDS);
+        assert_eq!(l.info.materials as usize, FrameMap::LIGHTS + LIGHT_WORDS);
+        assert_eq!(
+            l.info.frame_buffer as usize,
+            FrameMap::LIGHTS + LIGHT_WORDS + MATERIAL_WORDS
+        );
         assert_eq!(l.banks[FRAME].len(), l.info.frame_buffer as usize + 48);
     }
 

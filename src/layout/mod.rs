@@ -12,10 +12,13 @@
 //! |---|---|---|
 //! | 0 `NODES` | kd nodes: the top-level tree (rewritten each frame) then every object tree | 2 per node |
 //! | 1 `LISTS` | leaf lists: instance ids of top-level leaves, global triangle ids of object leaves | 1 per reference |
-//! | 2 `TRIANGLES` | Woop unit-triangle transforms `T` (3x4, row-major) | 12 per triangle |
-//! | 3 `SHADING` | per triangle: object-space unit normal (3 floats) and material index; then materials: diffuse r, g, b and mirror reflectivity | 4 per triangle, 4 per material |
+//! | 2 `TRIANGLES_UV` | rows 0 and 1 of the Woop unit-triangle transforms `T` (the u and v rows) | 8 per triangle |
+//! | 3 `TRIANGLES_T` | row 2 of `T` (the t row), then the object-space unit normal (3 floats) and the material index | 8 per triangle |
 //! | 4 `INSTANCES` | per instance: world-to-object 3x4 (12), normal matrix 3x3 object-to-world (9), object root node, first global triangle, object index (rewritten each frame) | 24 per instance |
-//! | 5 `FRAME` | camera 3x4 and eye, render constants, lights, then the frame buffer | see [`FrameMap`] |
+//! | 5 `FRAME` | camera 3x4 and eye, render constants, lights, materials (diffuse r, g, b, mirror), then the frame buffer | see [`FrameMap`] |
+//!
+//! Splitting a triangle's 16 words over two banks lets the intersection read them in parallel
+//! and fits 131,072 triangles (a 256x256 terrain) in the paper's 4 MB banks.
 //!
 //! # Word formats
 //! - A float word holds an `eXmY` value right-aligned (the format is at most 32 bits wide).
@@ -38,8 +41,8 @@ use crate::fp::Format;
 
 pub const NODES: usize = 0;
 pub const LISTS: usize = 1;
-pub const TRIANGLES: usize = 2;
-pub const SHADING: usize = 3;
+pub const TRIANGLES_UV: usize = 2;
+pub const TRIANGLES_T: usize = 3;
 pub const INSTANCES: usize = 4;
 pub const FRAME: usize = 5;
 pub const BANK_NAMES: [&str; 6] = [
@@ -52,8 +55,8 @@ pub const BANK_NAMES: [&str; 6] = [
 ];
 
 pub const NODE_WORDS: usize = 2;
-pub const TRIANGLE_WORDS: usize = 12;
-pub const SHADING_WORDS: usize = 4;
+/// Words per triangle in each of the two triangle banks.
+pub const TRIANGLE_BANK_WORDS: usize = 8;
 pub const MATERIAL_WORDS: usize = 4;
 pub const INSTANCE_WORDS: usize = 24;
 pub const LIGHT_WORDS: usize = 6;
@@ -132,6 +135,8 @@ pub struct LayoutInfo {
     pub light_count: u32,
     /// `None` for a scene of one untransformed object: rays enter the object tree directly.
     pub top_root: Option<u32>,
+    /// Bank-5 address of the material table.
+    pub materials: u32,
     /// Root node of the only object when there is no top level.
     pub object_root: u32,
     pub instance_count: u32,
@@ -179,6 +184,27 @@ impl Layout {
                 left: payload,
             }
         }
+    }
+    /// The 12 words of a triangle's unit-triangle transform, assembled from both banks.
+    pub fn triangle_transform(&self, triangle: u32) -> [u32; 12] {
+        let a = triangle as usize * TRIANGLE_BANK_WORDS;
+        let mut m = [0; 12];
+        m[..8].copy_from_slice(&self.banks[TRIANGLES_UV][a..a + 8]);
+        m[8..].copy_from_slice(&self.banks[TRIANGLES_T][a..a + 4]);
+        m
+    }
+    /// A triangle's object-space unit normal and material index.
+    pub fn triangle_shading(&self, triangle: u32) -> ([u32; 3], u32) {
+        let a = triangle as usize * TRIANGLE_BANK_WORDS + 4;
+        (
+            self.words::<3>(TRIANGLES_T, a),
+            self.banks[TRIANGLES_T][a + 3],
+        )
+    }
+    /// A material's diffuse colour and mirror reflectivity.
+    pub fn material(&self, material: u32) -> ([u32; 3], u32) {
+        let a = (self.info.materials + material * MATERIAL_WORDS as u32) as usize;
+        (self.words::<3>(FRAME, a), self.banks[FRAME][a + 3])
     }
     /// Words used per bank (frame buffer included).
     pub fn used_words(&self) -> Vec<usize> {

@@ -16,9 +16,7 @@
 
 use super::units::{self, Vec3W, Visit};
 use crate::fp::Format;
-use crate::layout::{
-    instance_word as iw, FrameMap, Layout, Node, FRAME, INSTANCES, LISTS, SHADING, TRIANGLES,
-};
+use crate::layout::{instance_word as iw, FrameMap, Layout, Node, FRAME, INSTANCES, LISTS};
 
 /// Entries of the per-ray mailboxes (most recently tested ids, first in first out).
 pub const MAILBOX_ENTRIES: usize = 8;
@@ -161,8 +159,7 @@ impl<'a> Golden<'a> {
         };
         let l = self.layout;
         let p = units::ray_point(f, q.o, q.d, hit.t);
-        let sh = hit.triangle as usize * crate::layout::SHADING_WORDS;
-        let n_obj = l.words::<3>(SHADING, sh);
+        let (n_obj, material) = l.triangle_shading(hit.triangle);
         let n_world = if l.info.top_root.is_some() {
             stats.transforms += 1;
             let base = hit.instance as usize * crate::layout::INSTANCE_WORDS + iw::NORMAL_MATRIX;
@@ -171,11 +168,7 @@ impl<'a> Golden<'a> {
             n_obj
         };
         let n = units::facing_unit_normal(f, n_world, q.d);
-        let material = l.word(SHADING, sh as u32 + 3) as usize;
-        let m_addr = l.info.triangle_count as usize * crate::layout::SHADING_WORDS
-            + material * crate::layout::MATERIAL_WORDS;
-        let kd = l.words::<3>(SHADING, m_addr);
-        let mirror = l.word(SHADING, m_addr as u32 + 3);
+        let (kd, mirror) = l.material(material);
 
         let mut acc = units::ambient(f, kd, self.frame_words::<1>(FrameMap::AMBIENT)[0]);
         let shadow_t_min = self.frame_words::<1>(FrameMap::SHADOW_T_MIN)[0];
@@ -322,7 +315,7 @@ impl<'a> Golden<'a> {
             }
             stats.triangle_tests += 1;
             stats.transforms += 2;
-            let m = l.words::<12>(TRIANGLES, triangle as usize * crate::layout::TRIANGLE_WORDS);
+            let m = l.triangle_transform(triangle);
             let o = units::transform(f, &m, q.o, true);
             let d = units::transform(f, &m, q.d, false);
             let t_max = best.map_or(q.t_max, |b| b.t);

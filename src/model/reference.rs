@@ -3,7 +3,8 @@
 //! Deliberately plain: the scene's original f64 geometry (no rounding of vertices), exact
 //! instance bounds, f64 kd-trees from `accel`, Möller-Trumbore intersection, and the shading
 //! formulas of the golden model written in f64. Secondary rays skip their own triangle and
-//! start at t = 1e-9 (relative), which f64 resolves easily.
+//! start at t = 1e-6 (relative to the light distance or the scene size): far above
+//! f64's rounding of the hit point, far below any feature of a scene.
 
 use super::{Frame, HitRecord};
 use crate::accel::kd_tree::{self, KdParams, KdTree};
@@ -69,7 +70,7 @@ impl<'a> Reference<'a> {
                 .map(|m| m.matrix3.inverse().transpose())
                 .collect(),
             top: kd_tree::build_sah_boxes(&boxes, &KdParams::default()),
-            t_eps: 1e-9 * (extent.max - extent.min).max_element().max(1.0),
+            t_eps: 1e-6 * (extent.max - extent.min).max_element().max(1.0),
         };
         let (w, h) = (s.camera.width, s.camera.height);
         let pixels: Vec<(u32, Option<HitRecord>)> = (0..w * h)
@@ -120,7 +121,7 @@ impl<'a> Reference<'a> {
             if n_dot_l <= 0.0 {
                 continue;
             }
-            if s.render.shadows && self.trace(g, p, to_light, 1e-9, 1.0, me, true).is_some() {
+            if s.render.shadows && self.trace(g, p, to_light, 1e-6, 1.0, me, true).is_some() {
                 continue;
             }
             acc += kd * DVec3::from_array(light.color) * (n_dot_l / to_light.length());
