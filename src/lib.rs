@@ -9,7 +9,9 @@
 
 pub mod accel;
 pub mod compare;
+pub mod emit;
 pub mod fp;
+pub mod hw;
 pub mod layout;
 pub mod model;
 pub mod output;

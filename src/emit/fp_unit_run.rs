@@ -1,0 +1,249 @@
+//! Runs one generated floating-point operator in a real simulator on a list of operand pairs:
+//! writes the unit's Verilog, its testbench and the vector file into a work directory, runs
+//! Icarus or Verilator through `crate::sim`, and reads the results back in input order.
+//! Used by `dynrt fp --sim iverilog|verilator` and by the bit-exactness tests.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+
+use super::fp_unit::{fp_unit_rtl, fp_units_testbench};
+use crate::fp::{BinOp, Format};
+use crate::sim::{self, SimJob, Simulator};
+
+/// Results of one simulated run of an operator.
+#[derive(Debug, Clone)]
+pub struct FpUnitRun {
+    /// One result per input vector, in input order (0/1 for comparisons).
+    pub results: Vec<u32>,
+    /// Wall time of compilation, seconds.
+    pub compile_seconds: f64,
+    /// Wall time of the simulation, seconds.
+    pub run_seconds: f64,
+}
+
+/// Simulates the operator computing `op` in `fmt` on `vectors` with `simulator`, using
+/// `work_dir` (created if needed) for the Verilog, the testbench, `vectors.hex` and the
+/// results. Fails if the format has no hardware, a tool fails, or a result is missing.
+pub fn run_fp_unit(
+    op: BinOp,
+    fmt: Format,
+    vectors: &[(u32, u32)],
+    simulator: Simulator,
+    work_dir: &Path,
+) -> Result<FpUnitRun> {
+    let mut runs = run_fp_units(&[op], fmt, vectors, simulator, work_dir)?;
+    Ok(runs.remove(0))
+}
+
+/// [`run_fp_unit`] for several operators of one format in one simulator build, all fed the
+/// same vectors; one [`FpUnitRun`] per operator, in the order of `ops` (the times are those of
+/// the shared build and run).
+pub fn run_fp_units(
+    ops: &[BinOp],
+    fmt: Format,
+    vectors: &[(u32, u32)],
+    simulator: Simulator,
+    work_dir: &Path,
+) -> Result<Vec<FpUnitRun>> {
+    let units = ops
+        .iter()
+        .map(|&op| fp_unit_rtl(op, fmt))
+        .collect::<Result<Vec<_>>>()?;
+    if vectors.is_empty() {
+        let empty = FpUnitRun {
+            results: Vec::new(),
+            compile_seconds: 0.0,
+            run_seconds: 0.0,
+        };
+        return Ok(vec![empty; ops.len()]);
+    }
+    std::fs::create_dir_all(work_dir)
+        .with_context(|| format!("cannot create {}", work_dir.display()))?;
+    let digits = fmt.hex_digits();
+    let mask = fmt.word_mask();
+    let mut text = String::with_capacity(vectors.len() * (2 * digits + 2));
+    for (i, &(a, b)) in vectors.iter().enumerate() {
+        if a & !mask != 0 || b & !mask != 0 {
+            bail!("vector {}: {a:#x} {b:#x} is wider than {fmt}", i + 1);
+        }
+        text += &format!("{a:0digits$x} {b:0digits$x}\n");
+    }
+    let vectors_file = work_dir.join("vectors.hex");
+    std::fs::write(&vectors_file, text)
+        .with_context(|| format!("cannot write {}", vectors_file.display()))?;
+    let mut sources = Vec::new();
+    let mut result_names = Vec::new();
+    for unit in &units {
+        let rtl_file = work_dir.join(format!("{}.v", unit.top));
+        std::fs::write(&rtl_file, &unit.verilog)
+            .with_context(|| format!("cannot write {}", rtl_file.display()))?;
+        sources.push(rtl_file);
+        let results_name = format!("results_{}.hex", unit.top);
+        let _ = std::fs::remove_file(work_dir.join(&results_name));
+        result_names.push(results_name);
+    }
+    let unit_refs = units.iter().collect::<Vec<_>>();
+    let name_refs = result_names.iter().map(String::as_str).collect::<Vec<_>>();
+    let tb = fp_units_testbench(&unit_refs, fmt, vectors.len(), "vectors.hex", &name_refs);
+    let tb_file = work_dir.join(format!("tb_fp_{fmt}.v"));
+    std::fs::write(&tb_file, tb).with_context(|| format!("cannot write {}", tb_file.display()))?;
+    sources.push(tb_file);
+    let job = SimJob::new(work_dir, sources, "tb");
+    let ran = sim::run(simulator, &job)?;
+    let mut runs = Vec::new();
+    for (unit, name) in units.iter().zip(&result_names) {
+        let results_file = work_dir.join(name);
+        let out = std::fs::read_to_string(&results_file).with_context(|| {
+            format!(
+                "{simulator} wrote no results for {}; its output:\n{}{}",
+                unit.top, ran.stdout, ran.stderr
+            )
+        })?;
+        let results = out
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                u32::from_str_radix(l.trim(), 16).with_context(|| {
+                    format!(
+                        "{}:{}: `{l}` is not a hex word",
+                        results_file.display(),
+                        i + 1
+                    )
+                })
+            })
+            .collect::<Result<Vec<u32>>>()?;
+        if results.len() != vectors.len() {
+            bail!(
+                "{simulator} produced {} results for {} vectors of {}; its output:\n{}{}",
+                results.len(),
+                vectors.len(),
+                unit.top,
+                ran.stdout,
+                ran.stderr
+            );
+        }
+        runs.push(FpUnitRun {
+            results,
+            compile_seconds: ran.compile_seconds,
+            run_seconds: ran.run_seconds,
+        });
+    }
+    Ok(runs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fp::vectors;
+    use crate::hw::fp::supported_formats;
+
+    const ALL_OPS: [BinOp; 7] = [
+        BinOp::Add,
+        BinOp::Sub,
+        BinOp::Mul,
+        BinOp::Div,
+        BinOp::Lt,
+        BinOp::Le,
+        BinOp::Eq,
+    ];
+
+    /// `n` seeded random pairs plus every pair of edge operands.
+    fn test_vectors(fmt: Format, n: usize, seed: u64) -> Vec<(u32, u32)> {
+        println!("{fmt}: seed {seed}");
+        let mut v = vectors::random_pairs(fmt, seed, n);
+        let edges = vectors::edge_cases(fmt);
+        for &a in &edges {
+            for &b in &edges {
+                v.push((a, b));
+            }
+        }
+        v
+    }
+
+    /// All seven operators of `fmt` in one build of `simulator`, against the model bit for bit.
+    fn check_all_ops(fmt: Format, n: usize, seed: u64, simulator: Simulator) {
+        let v = test_vectors(fmt, n, seed);
+        let dir = tempfile::tempdir().unwrap();
+        let runs = run_fp_units(&ALL_OPS, fmt, &v, simulator, dir.path()).unwrap();
+        println!(
+            "{simulator} {fmt}: 7 operators x {} vectors: compile {:.1} s, run {:.1} s",
+            v.len(),
+            runs[0].compile_seconds,
+            runs[0].run_seconds
+        );
+        let mut failures = Vec::new();
+        for (op, run) in ALL_OPS.iter().zip(&runs) {
+            let mut bad = 0;
+            for (i, (&(a, b), &r)) in v.iter().zip(&run.results).enumerate() {
+                let want = op.eval(fmt, a, b);
+                if r != want {
+                    if bad < 5 {
+                        eprintln!(
+                            "{simulator} {} {fmt} vector {i}: a={a:#x} b={b:#x} got {r:#x} want {want:#x}",
+                            op.name()
+                        );
+                    }
+                    bad += 1;
+                }
+            }
+            if bad > 0 {
+                failures.push(format!("{}: {bad} of {}", op.name(), v.len()));
+            }
+        }
+        assert!(
+            failures.is_empty(),
+            "{simulator} {fmt}: differ from the model: {failures:?}"
+        );
+    }
+
+    #[test]
+    fn single_unit_run_matches_model_in_icarus() {
+        let fmt = Format::E7M16;
+        let v = test_vectors(fmt, 1000, 5);
+        let dir = tempfile::tempdir().unwrap();
+        let run = run_fp_unit(BinOp::Div, fmt, &v, Simulator::Icarus, dir.path()).unwrap();
+        for (&(a, b), &r) in v.iter().zip(&run.results) {
+            assert_eq!(r, fmt.div(a, b), "div {a:#x} {b:#x}");
+        }
+    }
+
+    #[test]
+    fn bit_exact_e7m16_icarus() {
+        check_all_ops(Format::E7M16, 100_000, 16, Simulator::Icarus);
+    }
+
+    #[test]
+    fn bit_exact_e7m16_verilator() {
+        check_all_ops(Format::E7M16, 100_000, 16, Simulator::Verilator);
+    }
+
+    #[test]
+    fn bit_exact_e8m23_icarus() {
+        check_all_ops(Format::E8M23, 100_000, 23, Simulator::Icarus);
+    }
+
+    #[test]
+    fn bit_exact_e8m23_verilator() {
+        check_all_ops(Format::E8M23, 100_000, 23, Simulator::Verilator);
+    }
+
+    /// Every other supported format, 5k random vectors plus the edge cases, in both.
+    #[test]
+    fn bit_exact_other_formats_icarus() {
+        for fmt in supported_formats() {
+            if fmt != Format::E7M16 && fmt != Format::E8M23 {
+                check_all_ops(fmt, 5000, 1000 + fmt.width() as u64, Simulator::Icarus);
+            }
+        }
+    }
+
+    #[test]
+    fn bit_exact_other_formats_verilator() {
+        for fmt in supported_formats() {
+            if fmt != Format::E7M16 && fmt != Format::E8M23 {
+                check_all_ops(fmt, 5000, 1000 + fmt.width() as u64, Simulator::Verilator);
+            }
+        }
+    }
+}
