@@ -3,8 +3,10 @@
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
+use dynrt::emit::run_fp_unit;
 use dynrt::fp::{BinOp, Format};
 use dynrt::sim::vectors::{read_vector_file, write_results_atomically};
+use dynrt::sim::{self, Simulator};
 use std::path::PathBuf;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -43,7 +45,21 @@ pub fn run(a: FpArgs) -> anyhow::Result<i32> {
     let results: Vec<u32> = match a.sim {
         FpEngine::Model => vectors.iter().map(|&(x, y)| a.op.eval(f, x, y)).collect(),
         FpEngine::Iverilog | FpEngine::Verilator => {
-            anyhow::bail!("the RTL operators are not generated yet; use --sim model")
+            let simulator = if a.sim == FpEngine::Iverilog {
+                Simulator::Icarus
+            } else {
+                Simulator::Verilator
+            };
+            let work = tempfile::tempdir().context("creating a work directory")?;
+            let run = run_fp_unit(a.op, f, &vectors, simulator, work.path())?;
+            eprintln!(
+                "{} {}: compiled in {:.1} s, simulated in {:.2} s",
+                simulator,
+                sim::tool_version(simulator).unwrap_or_default(),
+                run.compile_seconds,
+                run.run_seconds
+            );
+            run.results
         }
     };
     let digits = if a.op.is_comparison() {
