@@ -7,8 +7,14 @@
 //! `fp` (the number format) is shared by every stage; nothing here imports the CLI, and `hw`
 //! never imports `model` (they meet in tests).
 
+pub mod accel;
+pub mod compare;
 pub mod emit;
 pub mod fp;
 pub mod hw;
+pub mod layout;
+pub mod model;
+pub mod output;
+pub mod scene;
 pub mod sim;
 pub mod synth;

@@ -138,10 +138,17 @@ pub struct SimJob {
 /// Verilator's own makefile compiles the model with `OPT_FAST=-Os` and its runtime library
 /// (verilated.cpp, verilated_timing.cpp: most of a small design's build time) with
 /// `OPT_GLOBAL=-Os`, and those flags come after `-CFLAGS`, so `-CFLAGS -O1` has no effect;
-/// the profiles set the make variables instead. Measured on a 300-stage multiply pipeline
-/// (2 shared cores, so only the ratios mean much): Verilator's default -Os/-Os built in 16.5 s
-/// and ran 200k cycles in 0.14 s; `Quick` built in 10.9 s and ran in 0.31 s; all -O0 built in
-/// 10.2 s but ran in 0.83 s.
+/// the profiles set the make variables instead. Measured in CPU seconds (user+sys of verilator,
+/// make and g++; wall times on the shared 2-core machine vary 2x with load):
+///
+/// | design                                   | default -Os | `Quick` | `Fast` |
+/// |------------------------------------------|-------------|---------|--------|
+/// | 8-bit adder testbench: build             | 5.4-5.7     | 3.5-4.3 | 5.4-5.7|
+/// | 300-stage 24-bit multiply pipeline: build| 6.0         | 4.1     | 7.5    |
+/// | same, run 200k cycles                    | 0.06        | 0.11    | 0.04   |
+///
+/// Most of a small design's build is Verilator's runtime library, which `Quick` compiles at
+/// -O0; `Fast` pays ~2 s more per build for a model that runs ~2.5x faster than `Quick`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum VerilatorBuild {
     /// `OPT_FAST=-O1 OPT_SLOW=-O0 OPT_GLOBAL=-O0`: for unit tests and short runs.
@@ -234,6 +241,8 @@ pub struct CompiledSim {
     /// The vvp file (Icarus) or the model executable (Verilator).
     pub artifact: PathBuf,
     pub compile_seconds: f64,
+    /// Everything the compiler printed (Verilator's warnings land here).
+    pub compile_log: String,
 }
 
 /// Compiles `job` in `sim` into a fresh build directory inside `job.work_dir`.
@@ -400,6 +409,7 @@ fn compile_icarus(job: &SimJob, p: Prepared) -> Result<CompiledSim, ToolError> {
         build_dir: p.build_dir,
         artifact: vvp_file,
         compile_seconds: built.seconds,
+        compile_log: built.combined(),
     })
 }
 
@@ -444,6 +454,7 @@ fn compile_verilator(job: &SimJob, p: Prepared) -> Result<CompiledSim, ToolError
         build_dir: p.build_dir,
         artifact: exe,
         compile_seconds: built.seconds,
+        compile_log: built.combined(),
     })
 }
 

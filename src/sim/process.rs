@@ -8,10 +8,14 @@
 use std::io::Read;
 use std::os::unix::process::CommandExt;
 use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use super::error::ToolError;
+
+/// How long to wait for output pipes to close after the child has exited or been killed.
+const PIPE_GRACE: Duration = Duration::from_secs(5);
 
 /// What a finished (not timed-out) tool run produced.
 #[derive(Debug)]
@@ -92,8 +96,10 @@ pub(crate) fn run_tool(
         std::thread::sleep(pause);
     };
     let seconds = start.elapsed().as_secs_f64();
-    let stdout = join(out_reader);
-    let stderr = join(err_reader);
+    // The whole group is dead or done by now, so the pipes close at once; a grandchild that
+    // left the group (setsid) could hold them open forever, hence the bounded wait.
+    let stdout = join(out_reader, PIPE_GRACE);
+    let stderr = join(err_reader, PIPE_GRACE);
     match status {
         Some(status) => Ok(ToolOutput {
             status,
@@ -110,18 +116,44 @@ pub(crate) fn run_tool(
     }
 }
 
-fn drain<R: Read + Send + 'static>(pipe: Option<R>) -> Option<JoinHandle<String>> {
+/// Output collected by a reader thread; shared so that it can be taken even if the thread is
+/// still blocked on a pipe that an escaped grandchild holds open.
+struct Reader {
+    buffer: Arc<Mutex<Vec<u8>>>,
+    handle: JoinHandle<()>,
+}
+
+fn drain<R: Read + Send + 'static>(pipe: Option<R>) -> Option<Reader> {
     pipe.map(|mut p| {
-        std::thread::spawn(move || {
-            let mut bytes = Vec::new();
-            let _ = p.read_to_end(&mut bytes);
-            String::from_utf8_lossy(&bytes).into_owned()
-        })
+        let buffer = Arc::new(Mutex::new(Vec::new()));
+        let sink = Arc::clone(&buffer);
+        let handle = std::thread::spawn(move || {
+            let mut chunk = [0u8; 8192];
+            loop {
+                match p.read(&mut chunk) {
+                    Ok(0) | Err(_) => break,
+                    Ok(n) => sink
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .extend_from_slice(&chunk[..n]),
+                }
+            }
+        });
+        Reader { buffer, handle }
     })
 }
 
-fn join(reader: Option<JoinHandle<String>>) -> String {
-    reader.and_then(|h| h.join().ok()).unwrap_or_default()
+/// Waits up to `grace` for the pipe to reach end of file, then takes what was read.
+fn join(reader: Option<Reader>, grace: Duration) -> String {
+    let Some(reader) = reader else {
+        return String::new();
+    };
+    let start = Instant::now();
+    while !reader.handle.is_finished() && start.elapsed() < grace {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let bytes = reader.buffer.lock().unwrap_or_else(|e| e.into_inner());
+    String::from_utf8_lossy(&bytes).into_owned()
 }
 
 /// Kills the child's whole process group (the child is its leader), then reaps the child.
@@ -140,6 +172,9 @@ fn kill_group(child: &mut Child) {
 /// The last `n` non-empty lines of `text`.
 pub(crate) fn last_lines(text: &str, n: usize) -> String {
     let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+    if lines.is_empty() {
+        return "(no output)".to_string();
+    }
     lines[lines.len().saturating_sub(n)..].join("\n")
 }
 

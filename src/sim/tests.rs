@@ -361,3 +361,40 @@ fn lint_of_broken_source_is_an_error() {
         other => panic!("expected a compile error, got {other:?}"),
     }
 }
+
+#[test]
+fn verilator_compile_timeout_kills_the_build() {
+    let dir = tempfile::tempdir().unwrap();
+    let vectors = adder_vectors(3, 4);
+    let src = write_adder_bench(dir.path(), &vectors);
+    let mut job = SimJob::new(dir.path(), vec![src], "tb_adder").define("NVEC", Some("4".into()));
+    // Long enough for make and g++ to be running, far too short for them to finish.
+    job.compile_timeout = Duration::from_secs(2);
+    match compile(Simulator::Verilator, &job) {
+        Err(ToolError::Timeout { stage, .. }) => assert!(stage.contains("compiling"), "{stage}"),
+        other => panic!("expected a compile timeout, got {other:?}"),
+    }
+    // Had make and g++ survived the timeout, they would finish the model; killed, they don't.
+    std::thread::sleep(Duration::from_secs(15));
+    let built: Vec<_> = walk(dir.path())
+        .into_iter()
+        .filter(|p| p.file_name().is_some_and(|n| n == "Vtb_adder"))
+        .collect();
+    assert!(
+        built.is_empty(),
+        "the build went on after the timeout: {built:?}"
+    );
+}
+
+fn walk(dir: &std::path::Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            found.extend(walk(&path));
+        } else {
+            found.push(path);
+        }
+    }
+    found
+}

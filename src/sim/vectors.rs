@@ -9,7 +9,6 @@
 //! written to a temporary file in the destination's directory and renamed over the
 //! destination, so a reader never sees a half-written file and a failure leaves none behind.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
@@ -59,6 +58,43 @@ pub fn read_vector_file(path: &Path, width_bits: u32) -> Result<Vec<(u32, u32)>,
         line,
         problem,
     })
+}
+
+/// Reads a result file (one hex word a line, e.g. what a testbench wrote), checking that
+/// every word fits `width_bits`; blank lines are skipped.
+pub fn read_word_file(path: &Path, width_bits: u32) -> Result<Vec<u32>, VectorFileError> {
+    if width_bits == 0 || width_bits > 32 {
+        return Err(VectorFileError::BadWidth(width_bits));
+    }
+    let text = std::fs::read_to_string(path).map_err(|source| VectorFileError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut words = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let fields: Vec<&str> = line.split_whitespace().collect();
+        let problem = match fields.as_slice() {
+            [] => continue,
+            [w] => match parse_word(w, width_bits) {
+                Ok(v) => {
+                    words.push(v);
+                    continue;
+                }
+                Err(p) => p,
+            },
+            _ => format!(
+                "expected one hex word, found {} fields: `{}`",
+                fields.len(),
+                line.trim()
+            ),
+        };
+        return Err(VectorFileError::Line {
+            path: path.to_path_buf(),
+            line: i + 1,
+            problem,
+        });
+    }
+    Ok(words)
 }
 
 /// Parses vector text; errors are (1-based line, problem).
@@ -129,26 +165,16 @@ pub fn write_results_atomically(
             hex_digits,
         });
     }
-    let io_err = |source| VectorFileError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
     let mut text = String::with_capacity(results.len() * (hex_digits + 1));
     for v in results {
         text.push_str(&format!("{v:0width$x}\n", width = hex_digits));
     }
-    // The temporary file is removed on drop if anything below fails.
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".dynrt-results-")
-        .tempfile_in(&dir)
-        .map_err(io_err)?;
-    tmp.write_all(text.as_bytes()).map_err(io_err)?;
-    tmp.as_file().sync_all().map_err(io_err)?;
-    tmp.persist(path).map_err(|e| io_err(e.error))?;
+    crate::output::write_atomically(path, text.as_bytes()).map_err(|source| {
+        VectorFileError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    })?;
     Ok(())
 }
 
@@ -276,6 +302,25 @@ mod tests {
             .map(|e| e.unwrap().file_name())
             .collect();
         assert_eq!(names, vec![std::ffi::OsString::from("out.hex")]);
+    }
+
+    #[test]
+    fn result_files_round_trip_and_bad_words_are_located() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("r.hex");
+        write_results_atomically(&out, &[0xabcdef, 0, 0x800000], 6).unwrap();
+        assert_eq!(
+            read_word_file(&out, 24).unwrap(),
+            vec![0xabcdef, 0, 0x800000]
+        );
+        // Icarus writes x for unknown bits: that must be an error, not a zero.
+        let p = write(dir.path(), "x.hex", "000001\n00000x\n");
+        let e = read_word_file(&p, 24).unwrap_err().to_string();
+        assert!(e.contains("x.hex:2:") && e.contains("not hex"), "{e}");
+        let p = write(dir.path(), "two.hex", "1 2\n");
+        let e = read_word_file(&p, 24).unwrap_err().to_string();
+        assert!(e.contains("two.hex:1:") && e.contains("2 fields"), "{e}");
+        assert!(read_word_file(&out, 23).is_err(), "0xabcdef needs 24 bits");
     }
 
     #[test]

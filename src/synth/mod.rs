@@ -2,7 +2,7 @@
 //! logic depth and device utilization.
 //!
 //! Contract: [`synth_xc2v`] runs `read_verilog -sv SOURCES; synth_xilinx -family xc2v -flatten
-//! -top TOP; stat; write_json` in `work_dir` (script, log, `stat` text and netlist stay there
+//! -top TOP -nowidelut; stat; write_json` in `work_dir` (see [`SynthOptions`]) (script, log, `stat` text and netlist stay there
 //! for inspection) under a time limit, and reads the cell counts from the flattened netlist.
 //! `-flatten` makes the counts whole-design totals and lets the depth analysis see every path.
 //! Yosys marks xc2v support EXPERIMENTAL; it maps products to `MULT18X18` (17x17 -> 1,
@@ -30,6 +30,12 @@ pub struct SynthOptions {
     /// Insert I/O buffers (IBUF/OBUF/BUFG) as for a top-level chip design; `false` passes
     /// `-noiopad -noclkbuf` for out-of-context measurement of a block.
     pub io_pads: bool,
+    /// Let ABC build 5..8-input functions from LUT4s + MUXF5..MUXF8 (yosys's default). Off by
+    /// default (`-nowidelut`): yosys 0.23's xc2v wide-LUT mapping bloats logic badly. Measured:
+    /// a 64-bit XOR tree takes 144 LUT4 + 135 MUXF with it, 21 LUT4 (the optimum) without;
+    /// a shifter + leading-zero count + compare block takes 528 LUTs + 476 MUXF with it,
+    /// 331 LUTs without. The LUT counts without it are the ones comparable with ISE's.
+    pub wide_luts: bool,
 }
 
 impl Default for SynthOptions {
@@ -37,6 +43,7 @@ impl Default for SynthOptions {
         SynthOptions {
             timeout: Duration::from_secs(1800),
             io_pads: true,
+            wide_luts: false,
         }
     }
 }
@@ -45,6 +52,8 @@ impl Default for SynthOptions {
 #[derive(Debug, Clone)]
 pub struct SynthReport {
     pub top: String,
+    /// The `synth_xilinx` command as run.
+    pub command: String,
     pub yosys_version: String,
     /// Logic LUTs: `LUT1`..`LUT6` plus `INV` (an inverter occupies a LUT).
     pub luts: u64,
@@ -103,8 +112,8 @@ impl fmt::Display for SynthReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "{} (yosys {}, synth_xilinx -family xc2v, {:.1} s)",
-            self.top, self.yosys_version, self.seconds
+            "{} (yosys {}: {}, {:.1} s)",
+            self.top, self.yosys_version, self.command, self.seconds
         )?;
         writeln!(
             f,
@@ -207,14 +216,16 @@ pub fn synth_xc2v_with(
     for stale in [&stat_file, &json_file] {
         let _ = std::fs::remove_file(stale);
     }
-    let pads = if options.io_pads {
-        ""
-    } else {
-        " -noiopad -noclkbuf"
-    };
+    let mut command = format!("synth_xilinx -family xc2v -flatten -top {top}");
+    if !options.io_pads {
+        command.push_str(" -noiopad -noclkbuf");
+    }
+    if !options.wide_luts {
+        command.push_str(" -nowidelut");
+    }
     let script = format!(
         "{read}\n\
-         synth_xilinx -family xc2v -flatten -top {top}{pads}\n\
+         {command}\n\
          tee -q -o {stat} stat\n\
          write_json {json}\n",
         stat = stat_file.display(),
@@ -272,6 +283,7 @@ pub fn synth_xc2v_with(
     }
     Ok(summarize(
         top,
+        command,
         yosys_version,
         all_cells,
         logic_depth,
@@ -306,6 +318,7 @@ fn lut_ram_size(t: &str) -> u64 {
 #[allow(clippy::too_many_arguments)]
 fn summarize(
     top: &str,
+    command: String,
     yosys_version: String,
     all_cells: BTreeMap<String, u64>,
     logic_depth: u32,
@@ -334,6 +347,7 @@ fn summarize(
         .sum();
     SynthReport {
         top: top.to_string(),
+        command,
         yosys_version,
         luts: sum(&is_lut),
         lut_types,

@@ -3,10 +3,15 @@
 use super::*;
 
 fn synth_source(name: &str, verilog: &str, top: &str) -> SynthReport {
+    synth_source_with(name, verilog, top, &SynthOptions::default())
+}
+
+fn synth_source_with(name: &str, verilog: &str, top: &str, options: &SynthOptions) -> SynthReport {
     let dir = tempfile::tempdir().unwrap();
     let src = dir.path().join(format!("{name}.v"));
     std::fs::write(&src, verilog).unwrap();
-    let report = synth_xc2v(&[src], top, dir.path()).unwrap_or_else(|e| panic!("{top}: {e}"));
+    let report =
+        synth_xc2v_with(&[src], top, dir.path(), options).unwrap_or_else(|e| panic!("{top}: {e}"));
     println!("{report}\n{:?}", report.all_cells);
     report
 }
@@ -62,17 +67,35 @@ fn counter_has_n_flip_flops() {
     }
 }
 
+const PARITY_V: &str = "module parity (input wire clk, input wire [63:0] d, output reg p);\n\
+    \x20 reg [63:0] r;\n\
+    \x20 always @(posedge clk) begin r <= d; p <= ^r; end\n\
+    endmodule\n";
+
 #[test]
 fn parity_tree_depth_in_lut_levels() {
-    // XOR of 64 registered bits into a register. ABC maps to 8-input "wide LUTs" (16 LUT4s
-    // joined by MUXF5..MUXF8 inside the CLBs), which the depth definition counts as one level:
-    // 64 -> 8 -> 1 = 2 levels, and 5 cells (LUT4, MUXF5, MUXF6, MUXF7, MUXF8) per level.
-    // A wrong count of MUXFs as levels would give 10; cutting paths at the wrong place, 1.
-    let v = "module parity (input wire clk, input wire [63:0] d, output reg p);\n\
-             \x20 reg [63:0] r;\n\
-             \x20 always @(posedge clk) begin r <= d; p <= ^r; end\n\
-             endmodule\n";
-    let r = synth_source("parity", v, "parity");
+    // XOR of 64 registered bits into a register: a LUT4 tree 64 -> 16 -> 4 -> 1, 21 LUT4s in
+    // 3 levels (no LUT4 tree does better: 4^2 = 16 < 64). XOR does not map to carry chains.
+    let r = synth_source("parity", PARITY_V, "parity");
+    assert_eq!(r.cells("LUT4"), 21, "{:?}", r.all_cells);
+    assert_eq!(r.luts, 21);
+    assert_eq!(r.logic_depth, 3, "{:?}", r.all_cells);
+    assert_eq!(r.path_cells, 3);
+    assert_eq!(r.flip_flops, 65);
+}
+
+#[test]
+fn parity_tree_with_wide_luts() {
+    // With wide LUTs ABC builds 8-input functions (16 LUT4s joined by MUXF5..MUXF8 inside
+    // the CLBs), which the depth definition counts as one level: 64 -> 8 -> 1 = 2 levels,
+    // and 5 cells (LUT4, MUXF5, MUXF6, MUXF7, MUXF8) per level. Counting MUXFs as levels
+    // would give 10; cutting paths at the wrong place, 1.
+    let options = SynthOptions {
+        wide_luts: true,
+        ..SynthOptions::default()
+    };
+    let r = synth_source_with("parity", PARITY_V, "parity", &options);
+    assert!(!r.command.contains("-nowidelut"));
     assert_eq!(r.cells("MUXF8"), 9, "{:?}", r.all_cells);
     assert_eq!(r.logic_depth, 2, "{:?}", r.all_cells);
     assert_eq!(r.path_cells, 10, "{:?}", r.all_cells);
@@ -139,6 +162,7 @@ fn utilization_of_xc2v6000() {
     cells.insert("RAMB16_S36_S36".to_string(), 144);
     let r = summarize(
         "t",
+        String::new(),
         "0.23".into(),
         cells,
         0,
@@ -165,4 +189,44 @@ fn lut_ram_sizes() {
     assert_eq!(lut_ram_size("RAM64X1D"), 8);
     assert_eq!(lut_ram_size("RAM16X8S"), 8);
     assert_eq!(lut_ram_size("SRL16E"), 1);
+}
+
+#[test]
+fn memories_map_to_block_ram_and_distributed_ram() {
+    let dir = tempfile::tempdir().unwrap();
+    let init: String = (0..512).map(|i| format!("{i:08x}\n")).collect();
+    // $readmemh paths resolve against yosys's current directory, the work directory.
+    std::fs::write(dir.path().join("init.hex"), init).unwrap();
+    let src = dir.path().join("rams.v");
+    std::fs::write(
+        &src,
+        "module ram512 (input wire clk, input wire we, input wire [8:0] wa, input wire [31:0] wd,\n\
+         \x20   input wire [8:0] ra, output reg [31:0] rd);\n\
+         \x20 reg [31:0] mem [0:511];\n\
+         \x20 initial $readmemh(\"init.hex\", mem);\n\
+         \x20 always @(posedge clk) begin if (we) mem[wa] <= wd; rd <= mem[ra]; end\n\
+         endmodule\n\
+         module ram16 (input wire clk, input wire we, input wire [3:0] wa, input wire [7:0] wd,\n\
+         \x20   input wire [3:0] ra, output wire [7:0] rd);\n\
+         \x20 reg [7:0] mem [0:15];\n\
+         \x20 always @(posedge clk) if (we) mem[wa] <= wd;\n\
+         \x20 assign rd = mem[ra];\n\
+         endmodule\n",
+    )
+    .unwrap();
+    // 512 x 32 with a registered read: exactly one 18-Kbit block RAM in its 512x36 shape.
+    let big = synth_xc2v(std::slice::from_ref(&src), "ram512", dir.path()).unwrap();
+    println!("{big}\n{:?}", big.all_cells);
+    assert_eq!(big.block_rams, 1, "{:?}", big.all_cells);
+    assert_eq!(big.cells("RAMB16_S36_S36"), 1);
+    assert_eq!(big.luts, 0);
+    // 16 x 8 with an asynchronous read: 8 dual-port RAM16X1D, 2 LUTs each; the read is one
+    // LUT level from the address port to the output.
+    let small = synth_xc2v(&[src], "ram16", dir.path()).unwrap();
+    println!("{small}\n{:?}", small.all_cells);
+    assert_eq!(small.cells("RAM16X1D"), 8, "{:?}", small.all_cells);
+    assert_eq!(small.lut_ram_luts, 16);
+    assert_eq!(small.total_luts(), 16 + small.luts);
+    assert_eq!(small.logic_depth, 1);
+    assert_eq!(small.block_rams, 0);
 }

@@ -1,0 +1,658 @@
+//! The O(N log N) SAH kd-tree builder of Wald & Havran, "On building fast kd-trees for ray
+//! tracing, and on doing that in O(N log N)" (IEEE RT 2006), generic over [`KdPrimitives`].
+//!
+//! - Each node holds, per axis, an event list sorted by (position, kind) with kinds
+//!   End < Planar < Start: a primitive spanning `[a, b]` on the axis gives Start at `a` and
+//!   End at `b`; a flat one (`a == b`) gives one Planar event. The lists are sorted once at the
+//!   root.
+//! - One sweep per axis evaluates every event position strictly inside the node's box with the
+//!   SAH `λ (C_t + C_i (P_L N_L + P_R N_R))`, `λ = empty_bonus` if a side is empty; primitives
+//!   lying in the plane go to whichever side is cheaper.
+//! - The best plane splits the node if it is cheaper than a leaf (`C_i N`), or if the leaf would
+//!   exceed `max_leaf_prims` and some plane separates primitives; never below the depth limit.
+//! - Primitives are classified left / right / both from the split axis' events; the lists are
+//!   split in linear time keeping their order. With `clip_splits` the "both" primitives are
+//!   clipped to each child box and only their new events are sorted and merged in, so the total
+//!   stays O(N log N).
+//!
+//! - With `split_format` the candidate planes are rounded into the hardware number format
+//!   first (a plane that rounds onto or outside the node's box is skipped; duplicates after
+//!   rounding are evaluated again, harmlessly).
+//!
+//! Deterministic: no parallelism, ties broken by axis, position and primitive id.
+//! Primitives with non-finite bounds are left out of the tree.
+
+use super::aabb::Aabb;
+use super::kd_tree::{KdNode, KdParams, KdTree};
+use super::primitive::KdPrimitives;
+
+const END: u8 = 0;
+const PLANAR: u8 = 1;
+const START: u8 = 2;
+
+const SIDE_BOTH: u8 = 0;
+const SIDE_LEFT: u8 = 1;
+const SIDE_RIGHT: u8 = 2;
+
+#[derive(Clone, Copy, Debug)]
+struct Event {
+    pos: f64,
+    kind: u8,
+    prim: u32,
+}
+
+type Events = [Vec<Event>; 3];
+
+fn event_order(a: &Event, b: &Event) -> std::cmp::Ordering {
+    a.pos
+        .total_cmp(&b.pos)
+        .then(a.kind.cmp(&b.kind))
+        .then(a.prim.cmp(&b.prim))
+}
+
+/// Appends the events of one primitive with bounds `b`.
+fn push_events(events: &mut Events, prim: u32, b: &Aabb) {
+    for (axis, list) in events.iter_mut().enumerate() {
+        // `+ 0.0` turns -0.0 into +0.0 so that equal positions also sort as equal.
+        let (lo, hi) = (b.min[axis] + 0.0, b.max[axis] + 0.0);
+        if lo == hi {
+            list.push(Event {
+                pos: lo,
+                kind: PLANAR,
+                prim,
+            });
+        } else {
+            list.push(Event {
+                pos: lo,
+                kind: START,
+                prim,
+            });
+            list.push(Event {
+                pos: hi,
+                kind: END,
+                prim,
+            });
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Plane {
+    cost: f64,
+    axis: usize,
+    pos: f64,
+    planar_left: bool,
+}
+
+struct Builder<'a, P: KdPrimitives> {
+    prims: &'a P,
+    params: &'a KdParams,
+    depth_limit: u32,
+    side: Vec<u8>,
+    nodes: Vec<KdNode>,
+    prim_indices: Vec<u32>,
+    depth: u32,
+}
+
+/// Builds a kd-tree over `prims` (see the module doc).
+pub fn build<P: KdPrimitives>(prims: &P, params: &KdParams) -> KdTree {
+    let n = prims.len();
+    let mut events: Events = [
+        Vec::with_capacity(2 * n),
+        Vec::with_capacity(2 * n),
+        Vec::with_capacity(2 * n),
+    ];
+    let mut bounds = Aabb::EMPTY;
+    let mut count = 0;
+    for i in 0..n {
+        let b = prims.bounds(i);
+        if !b.is_finite() || b.is_empty() {
+            continue;
+        }
+        bounds = bounds.union(&b);
+        push_events(&mut events, i as u32, &b);
+        count += 1;
+    }
+    for list in events.iter_mut() {
+        list.sort_unstable_by(event_order);
+    }
+    let mut builder = Builder {
+        prims,
+        params,
+        depth_limit: params.depth_limit(count),
+        side: vec![SIDE_BOTH; n],
+        nodes: vec![KdNode::Leaf { first: 0, count: 0 }],
+        prim_indices: Vec::new(),
+        depth: 0,
+    };
+    builder.build_node(0, bounds, events, count, 0);
+    KdTree {
+        nodes: builder.nodes,
+        prim_indices: builder.prim_indices,
+        bounds,
+        depth: builder.depth,
+        num_prims: n as u32,
+    }
+}
+
+impl<P: KdPrimitives> Builder<'_, P> {
+    fn build_node(&mut self, node: usize, voxel: Aabb, events: Events, n: usize, depth: u32) {
+        let plane = if n == 0 || depth >= self.depth_limit {
+            None
+        } else {
+            self.choose_plane(&voxel, &events, n)
+        };
+        let Some(plane) = plane else {
+            self.make_leaf(node, &events, depth);
+            return;
+        };
+        let (vl, vr) = voxel.split(plane.axis, plane.pos);
+        let (left, nl, right, nr) = self.split_events(events, &plane, &vl, &vr);
+        let children = self.nodes.len();
+        self.nodes[node] = KdNode::Inner {
+            axis: plane.axis as u8,
+            split: plane.pos,
+            children: children as u32,
+        };
+        self.nodes.push(KdNode::Leaf { first: 0, count: 0 });
+        self.nodes.push(KdNode::Leaf { first: 0, count: 0 });
+        // Build the left subtree while the right lists wait; depth-first keeps memory
+        // proportional to one root-to-leaf path of lists.
+        self.build_node(children, vl, left, nl, depth + 1);
+        self.build_node(children + 1, vr, right, nr, depth + 1);
+    }
+
+    fn make_leaf(&mut self, node: usize, events: &Events, depth: u32) {
+        let first = self.prim_indices.len();
+        // Every primitive has exactly one Start or Planar event per axis.
+        self.prim_indices
+            .extend(events[0].iter().filter(|e| e.kind != END).map(|e| e.prim));
+        self.prim_indices[first..].sort_unstable();
+        self.nodes[node] = KdNode::Leaf {
+            first: first as u32,
+            count: (self.prim_indices.len() - first) as u32,
+        };
+        self.depth = self.depth.max(depth);
+    }
+
+    /// The plane to split at, or `None` for a leaf.
+    // `!(a < b)` deliberately treats NaN as "no".
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    fn choose_plane(&self, voxel: &Aabb, events: &Events, n: usize) -> Option<Plane> {
+        let area = voxel.surface_area();
+        if !(area > 0.0) {
+            return None;
+        }
+        let inv_area = 1.0 / area;
+        let ct = self.params.traversal_cost;
+        let ci = self.params.intersection_cost;
+        let bonus = self.params.empty_bonus;
+        let cost = |pl: f64, pr: f64, nl: usize, nr: usize| {
+            let c = ct + ci * (pl * nl as f64 + pr * nr as f64);
+            if nl == 0 || nr == 0 {
+                c * bonus
+            } else {
+                c
+            }
+        };
+        let mut best: Option<Plane> = None;
+        // Best plane that leaves fewer than `n` primitives on each side (for the leaf-size cap).
+        let mut best_separating: Option<Plane> = None;
+        for (axis, list) in events.iter().enumerate() {
+            let (lo, hi) = (voxel.min[axis], voxel.max[axis]);
+            if !(lo < hi) {
+                continue;
+            }
+            let e = voxel.extent();
+            let (e1, e2) = (e[(axis + 1) % 3], e[(axis + 2) % 3]);
+            let (cap, ring) = (e1 * e2, e1 + e2);
+            let (mut nl, mut nr) = (0usize, n);
+            let mut i = 0;
+            while i < list.len() {
+                let p = list[i].pos;
+                // Counts of End, Planar and Start events at `p` (indexed by kind).
+                let mut at_p = [0usize; 3];
+                while i < list.len() && list[i].pos == p {
+                    at_p[list[i].kind as usize] += 1;
+                    i += 1;
+                }
+                let (ends, planars, starts) = (
+                    at_p[END as usize],
+                    at_p[PLANAR as usize],
+                    at_p[START as usize],
+                );
+                nr -= planars + ends;
+                // The counts are exact for `p`; for a rounded plane they are the estimate the
+                // SAH uses, while classification below is exact for the rounded plane.
+                let p = match self.params.split_format {
+                    Some(f) => f.to_f64(f.from_f64(p)),
+                    None => p,
+                };
+                if lo < p && p < hi {
+                    let pl = 2.0 * (cap + (p - lo) * ring) * inv_area;
+                    let pr = 2.0 * (cap + (hi - p) * ring) * inv_area;
+                    let cl = cost(pl, pr, nl + planars, nr);
+                    let cr = cost(pl, pr, nl, nr + planars);
+                    let planar_left = cl < cr;
+                    let c = if planar_left { cl } else { cr };
+                    let plane = Plane {
+                        cost: c,
+                        axis,
+                        pos: p,
+                        planar_left,
+                    };
+                    if best.is_none_or(|b| c < b.cost) {
+                        best = Some(plane);
+                    }
+                    let (left_n, right_n) = if planar_left {
+                        (nl + planars, nr)
+                    } else {
+                        (nl, nr + planars)
+                    };
+                    if left_n < n && right_n < n && best_separating.is_none_or(|b| c < b.cost) {
+                        best_separating = Some(plane);
+                    }
+                }
+                nl += starts + planars;
+            }
+        }
+        let leaf_cost = ci * n as f64;
+        match best {
+            Some(b) if b.cost < leaf_cost => Some(b),
+            _ if n > self.params.max_leaf_prims as usize => best_separating,
+            _ => None,
+        }
+    }
+
+    /// Classifies the node's primitives against `plane` and returns the children's sorted
+    /// event lists and primitive counts.
+    fn split_events(
+        &mut self,
+        events: Events,
+        plane: &Plane,
+        vl: &Aabb,
+        vr: &Aabb,
+    ) -> (Events, usize, Events, usize) {
+        let s = plane.pos;
+        for e in &events[0] {
+            if e.kind != END {
+                self.side[e.prim as usize] = SIDE_BOTH;
+            }
+        }
+        for e in &events[plane.axis] {
+            let side = &mut self.side[e.prim as usize];
+            match e.kind {
+                END if e.pos <= s => *side = SIDE_LEFT,
+                START if e.pos >= s => *side = SIDE_RIGHT,
+                PLANAR => {
+                    *side = if e.pos < s || (e.pos == s && plane.planar_left) {
+                        SIDE_LEFT
+                    } else {
+                        SIDE_RIGHT
+                    }
+                }
+                _ => {}
+            }
+        }
+        let mut nl = 0;
+        let mut nr = 0;
+        let mut both = Vec::new();
+        for e in &events[0] {
+            if e.kind == END {
+                continue;
+            }
+            match self.side[e.prim as usize] {
+                SIDE_LEFT => nl += 1,
+                SIDE_RIGHT => nr += 1,
+                _ => both.push(e.prim),
+            }
+        }
+        let clip = self.params.clip_splits;
+        // Straddling primitives clipped to each child; their events are sorted separately and
+        // merged in (there are few of them, so sorting them keeps the build O(N log N)).
+        let mut new_left: Events = Default::default();
+        let mut new_right: Events = Default::default();
+        if clip {
+            for &p in &both {
+                if let Some(b) = self.prims.clipped_bounds(p as usize, vl) {
+                    push_events(&mut new_left, p, &b);
+                    nl += 1;
+                }
+                if let Some(b) = self.prims.clipped_bounds(p as usize, vr) {
+                    push_events(&mut new_right, p, &b);
+                    nr += 1;
+                }
+            }
+            for list in new_left.iter_mut().chain(new_right.iter_mut()) {
+                list.sort_unstable_by(event_order);
+            }
+        } else {
+            nl += both.len();
+            nr += both.len();
+        }
+        let mut left: Events = Default::default();
+        let mut right: Events = Default::default();
+        for axis in 0..3 {
+            let list = &events[axis];
+            let (new_l, new_r) = (&new_left[axis], &new_right[axis]);
+            // Each event belongs to one primitive; a primitive's events per axis are 1 or 2.
+            let mut l = Vec::with_capacity(2 * nl);
+            let mut r = Vec::with_capacity(2 * nr);
+            // Filter the parent's list and merge the clipped primitives' events in, in one pass.
+            let (mut il, mut ir) = (0, 0);
+            for e in list {
+                let side = self.side[e.prim as usize];
+                if side == SIDE_LEFT || (side == SIDE_BOTH && !clip) {
+                    while il < new_l.len() && event_order(&new_l[il], e).is_lt() {
+                        l.push(new_l[il]);
+                        il += 1;
+                    }
+                    l.push(*e);
+                }
+                if side == SIDE_RIGHT || (side == SIDE_BOTH && !clip) {
+                    while ir < new_r.len() && event_order(&new_r[ir], e).is_lt() {
+                        r.push(new_r[ir]);
+                        ir += 1;
+                    }
+                    r.push(*e);
+                }
+            }
+            l.extend_from_slice(&new_l[il..]);
+            r.extend_from_slice(&new_r[ir..]);
+            left[axis] = l;
+            right[axis] = r;
+        }
+        drop(events);
+        (left, nl, right, nr)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::kd_tree::{build_sah, build_sah_boxes, KdTreeError};
+    use crate::accel::primitive::{Boxes, Triangles};
+    use crate::accel::test_meshes::*;
+    use glam::DVec3;
+
+    fn meshes() -> Vec<(&'static str, Vec<[DVec3; 3]>)> {
+        vec![
+            ("sphere(3)", sphere(3)),
+            ("soup", soup(3000, 2)),
+            ("quad lattice", quad_lattice(6)),
+            ("woody", public_mesh("woody.obj")),
+            ("cow", public_mesh("cow.obj")),
+            ("teapot", public_mesh("teapot.obj")),
+            ("fandisk", public_mesh("fandisk.obj")),
+        ]
+    }
+
+    #[test]
+    fn sah_cost_beats_a_single_leaf_and_trees_are_valid() {
+        for (name, tris) in meshes() {
+            assert!(tris.len() > 64);
+            for clip in [true, false] {
+                let params = KdParams {
+                    clip_splits: clip,
+                    ..KdParams::default()
+                };
+                let tree = build_sah(&tris, &params);
+                tree.validate_against(&Triangles(&tris)).unwrap();
+                let s = tree.stats(&params);
+                let leaf_cost = params.intersection_cost * tris.len() as f64;
+                println!("{name} ({} tris) clip={clip}: {s:?}", tris.len());
+                assert!(
+                    s.sah_cost < leaf_cost,
+                    "{name}: SAH cost {} not below a single leaf's {leaf_cost}",
+                    s.sah_cost
+                );
+                assert!(s.depth <= params.depth_limit(tris.len()));
+                assert_eq!(s.references, tree.prim_indices.len());
+                assert!(s.references >= tris.len());
+            }
+        }
+    }
+
+    #[test]
+    fn builder_is_deterministic() {
+        for (name, tris) in meshes() {
+            let p = KdParams::default();
+            assert_eq!(build_sah(&tris, &p), build_sah(&tris, &p), "{name}");
+        }
+    }
+
+    #[test]
+    fn degenerate_inputs_give_valid_trees() {
+        let tri = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let p = DVec3::new(0.3, -2.0, 5.0);
+        let nan = DVec3::new(f64::NAN, 0.0, 0.0);
+        let mut with_nan = sphere(1);
+        with_nan.insert(7, [nan, DVec3::X, DVec3::Y]);
+        let cases: Vec<(&str, Vec<[DVec3; 3]>)> = vec![
+            ("no triangles", vec![]),
+            ("one triangle", vec![tri]),
+            ("identical triangles", vec![tri; 300]),
+            (
+                "coplanar triangles",
+                soup(400, 3)
+                    .into_iter()
+                    .map(|t| t.map(|v| DVec3::new(v.x, 2.0, v.z)))
+                    .collect(),
+            ),
+            ("point triangles", vec![[p; 3]; 50]),
+            (
+                "collinear triangles",
+                (0..60)
+                    .map(|i| {
+                        let x = i as f64 * 0.1;
+                        [
+                            DVec3::new(x, 1.0, 1.0),
+                            DVec3::new(x + 0.5, 1.0, 1.0),
+                            DVec3::new(x + 0.2, 1.0, 1.0),
+                        ]
+                    })
+                    .collect(),
+            ),
+            ("a NaN triangle among good ones", with_nan),
+        ];
+        for (name, tris) in cases {
+            for clip in [true, false] {
+                let params = KdParams {
+                    clip_splits: clip,
+                    ..KdParams::default()
+                };
+                let tree = build_sah(&tris, &params);
+                tree.validate_against(&Triangles(&tris))
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+                println!("{name} clip={clip}: {:?}", tree.stats(&params));
+            }
+        }
+        // The NaN triangle is left out, everything else is referenced (checked above).
+        let mut with_nan = sphere(1);
+        with_nan.insert(7, [nan, DVec3::X, DVec3::Y]);
+        assert!(!build_sah(&with_nan, &KdParams::default())
+            .prim_indices
+            .contains(&7));
+        // Boxes: none, identical, flat.
+        let b = Aabb::new(DVec3::ZERO, DVec3::ONE);
+        let flat = Aabb::new(DVec3::ZERO, DVec3::new(1.0, 0.0, 1.0));
+        for boxes in [vec![], vec![b; 100], vec![flat; 10], vec![b, flat]] {
+            let tree = build_sah_boxes(&boxes, &KdParams::default());
+            tree.validate_against(&Boxes(&boxes)).unwrap();
+        }
+    }
+
+    /// Two far-apart clusters: the root must cut the empty gap between them.
+    #[test]
+    fn root_split_lies_in_the_gap_between_clusters() {
+        let a = soup(100, 4);
+        let b: Vec<_> = soup(100, 5)
+            .into_iter()
+            .map(|t| t.map(|v| v + DVec3::new(10.0, 0.0, 0.0)))
+            .collect();
+        let max_a = a.iter().flatten().map(|v| v.x).fold(f64::MIN, f64::max);
+        let min_b = b.iter().flatten().map(|v| v.x).fold(f64::MAX, f64::min);
+        let tris: Vec<_> = a.into_iter().chain(b).collect();
+        let tree = build_sah(&tris, &KdParams::default());
+        match tree.nodes[0] {
+            KdNode::Inner { axis, split, .. } => {
+                assert_eq!(axis, 0);
+                assert!(
+                    split >= max_a && split <= min_b,
+                    "split {split} not in [{max_a}, {min_b}]"
+                );
+            }
+            n => panic!("root is {n:?}"),
+        }
+    }
+
+    #[test]
+    fn depth_limit() {
+        let p = KdParams::default();
+        assert_eq!(p.depth_limit(0), 8);
+        assert_eq!(p.depth_limit(1), 8);
+        assert_eq!(p.depth_limit(1024), 21);
+        assert_eq!(p.depth_limit(1 << 30), KdParams::AUTO_DEPTH_CAP);
+        let tris = sphere(3);
+        for d in [0, 1, 4] {
+            let params = KdParams {
+                max_depth: Some(d),
+                ..KdParams::default()
+            };
+            let tree = build_sah(&tris, &params);
+            tree.validate_against(&Triangles(&tris)).unwrap();
+            assert_eq!(
+                tree.depth, d,
+                "the sphere is worth splitting down to the limit"
+            );
+        }
+    }
+
+    /// With intersections almost free the SAH wants one leaf; the leaf-size cap must still
+    /// split separable triangles into leaves of at most `max_leaf_prims`.
+    #[test]
+    fn leaf_size_cap_forces_splits() {
+        let tris: Vec<_> = (0..200)
+            .map(|i| {
+                let x = i as f64;
+                [
+                    DVec3::new(x, 0.0, 0.0),
+                    DVec3::new(x + 0.5, 0.0, 0.0),
+                    DVec3::new(x, 1.0, 0.5),
+                ]
+            })
+            .collect();
+        let cheap = KdParams {
+            intersection_cost: 0.001,
+            max_leaf_prims: 1000,
+            ..KdParams::default()
+        };
+        let tree = build_sah(&tris, &cheap);
+        assert_eq!(tree.nodes.len(), 1, "SAH alone keeps one leaf");
+        let capped = KdParams {
+            max_leaf_prims: 8,
+            ..cheap
+        };
+        let tree = build_sah(&tris, &capped);
+        tree.validate_against(&Triangles(&tris)).unwrap();
+        let s = tree.stats(&capped);
+        assert!(s.max_tris_per_leaf <= 8, "{s:?}");
+        // Identical triangles cannot be separated: one leaf, no endless splitting.
+        let same = vec![tris[0]; 50];
+        let tree = build_sah(&same, &capped);
+        assert_eq!(tree.nodes.len(), 1);
+    }
+
+    #[test]
+    fn validate_detects_broken_trees() {
+        let tris = sphere(2);
+        let good = build_sah(&tris, &KdParams::default());
+        good.validate_against(&Triangles(&tris)).unwrap();
+        let inner = good
+            .nodes
+            .iter()
+            .position(|n| matches!(n, KdNode::Inner { .. }))
+            .unwrap();
+        let leaf = good
+            .nodes
+            .iter()
+            .position(|n| matches!(n, KdNode::Leaf { count, .. } if *count > 1))
+            .unwrap();
+
+        let mut t = good.clone();
+        if let KdNode::Inner { split, .. } = &mut t.nodes[inner] {
+            *split = 1e6;
+        }
+        assert!(matches!(t.validate(), Err(KdTreeError::BadSplit { .. })));
+
+        let mut t = good.clone();
+        if let KdNode::Inner { children, .. } = &mut t.nodes[inner] {
+            *children = inner as u32;
+        }
+        assert!(matches!(t.validate(), Err(KdTreeError::BadChildren { .. })));
+
+        let mut t = good.clone();
+        let last_inner = t
+            .nodes
+            .iter()
+            .rposition(|n| matches!(n, KdNode::Inner { .. }))
+            .unwrap();
+        let KdNode::Inner { children: c, .. } = t.nodes[last_inner] else {
+            unreachable!()
+        };
+        if let KdNode::Inner { children, .. } = &mut t.nodes[inner] {
+            *children = c; // two parents share a pair of children
+        }
+        assert!(matches!(
+            t.validate(),
+            Err(KdTreeError::Reached { .. }) | Err(KdTreeError::BadChildren { .. })
+        ));
+
+        let mut t = good.clone();
+        if let KdNode::Leaf { first, .. } = &mut t.nodes[leaf] {
+            *first += 1;
+        }
+        assert!(matches!(
+            t.validate(),
+            Err(KdTreeError::BadLeafRange { .. })
+        ));
+
+        let mut t = good.clone();
+        if let KdNode::Leaf { first, .. } = t.nodes[leaf] {
+            t.prim_indices[first as usize] = t.num_prims;
+        }
+        assert!(matches!(t.validate(), Err(KdTreeError::BadPrim { .. })));
+
+        let mut t = good.clone();
+        t.depth += 1;
+        assert!(matches!(t.validate(), Err(KdTreeError::BadDepth { .. })));
+
+        // Triangle 0 renamed to a far-away triangle in every leaf: it is outside the leaves
+        // that list it, and triangle 0 itself ends up missing.
+        let mut t = good.clone();
+        let mut moved = tris.clone();
+        moved[0] = [
+            DVec3::splat(50.0),
+            DVec3::splat(51.0),
+            DVec3::new(50.0, 51.0, 50.0),
+        ];
+        assert!(matches!(
+            t.validate_against(&Triangles(&moved)),
+            Err(KdTreeError::PrimOutsideLeaf { prim: 0, .. })
+        ));
+        for p in t.prim_indices.iter_mut() {
+            if *p == 0 {
+                *p = 1;
+            }
+        }
+        // (Leaves may now hold 1 twice, which `validate` reports first.)
+        assert!(t.validate_against(&Triangles(&tris)).is_err());
+        assert_eq!(
+            good.validate_against(&Triangles(&tris[1..])),
+            Err(KdTreeError::PrimCount {
+                tree: tris.len() as u32,
+                given: tris.len() - 1
+            })
+        );
+    }
+}

@@ -1,0 +1,68 @@
+//! `dynrt compare`: error metrics between two images (and their hits files).
+
+use anyhow::Context;
+use clap::Args;
+use dynrt::compare;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct CompareArgs {
+    pub a: PathBuf,
+    pub b: PathBuf,
+    /// Write a diff image (amplified absolute difference).
+    #[arg(long)]
+    pub diff: Option<PathBuf>,
+    /// Hits files of A and B: adds the identical-hit ratio and distance errors.
+    #[arg(long, num_args = 2, value_names = ["HITS_A", "HITS_B"])]
+    pub hits: Option<Vec<PathBuf>>,
+}
+
+fn open(p: &std::path::Path) -> anyhow::Result<image::RgbImage> {
+    Ok(image::open(p)
+        .with_context(|| format!("reading image {}", p.display()))?
+        .to_rgb8())
+}
+
+pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
+    let (ia, ib) = (open(&a.a)?, open(&a.b)?);
+    let m = compare::compare_images(&ia, &ib)
+        .with_context(|| format!("comparing {} with {}", a.a.display(), a.b.display()))?;
+    println!("pixels           {}", m.pixels);
+    println!(
+        "differing pixels {} ({:.4}%)",
+        m.differing_pixels,
+        100.0 * m.differing_share()
+    );
+    println!("max channel err  {}", m.max_channel_error);
+    println!("PSNR             {:.2} dB", m.psnr_db);
+    if let Some(h) = &a.hits {
+        let ra = compare::read_hits(&h[0])?;
+        let rb = compare::read_hits(&h[1])?;
+        let hm = compare::compare_hits(
+            &ra.iter().map(|r| r.hit).collect::<Vec<_>>(),
+            &rb.iter().map(|r| r.hit).collect::<Vec<_>>(),
+        )?;
+        println!(
+            "identical hits   {} of {} ({:.4}%)",
+            hm.identical_hits,
+            hm.pixels,
+            100.0 * hm.identical_ratio()
+        );
+        println!(
+            "rel dist error   mean {:.3e} max {:.3e}",
+            hm.mean_rel_dist_error, hm.max_rel_dist_error
+        );
+    }
+    if let Some(d) = &a.diff {
+        let img = compare::diff_image(&ia, &ib);
+        let mut bytes = Vec::new();
+        img.write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )?;
+        dynrt::output::write_atomically(d, &bytes)
+            .with_context(|| format!("writing {}", d.display()))?;
+        println!("diff image       {}", d.display());
+    }
+    Ok(0)
+}

@@ -1,0 +1,46 @@
+//! Argument parsing (clap) and dispatch of the `dynrt` verbs. Errors are printed as one clear
+//! message (with its causes) and give a non-zero exit status.
+
+mod compare_cmd;
+mod fp_cmd;
+mod render_cmd;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "dynrt",
+    version,
+    about = "Generates a SaarCOR DynRT-style ray tracing processor from a 3D scene"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render one frame with the golden model (eXmY) or the f64 reference.
+    Render(render_cmd::RenderArgs),
+    /// Error metrics between two images (and hits files); writes a diff image.
+    Compare(compare_cmd::CompareArgs),
+    /// Run operand vectors through one floating-point operator (RTL or software model).
+    Fp(fp_cmd::FpArgs),
+}
+
+/// Runs the command line and returns the process exit status.
+pub fn run() -> i32 {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(a) => render_cmd::run(a),
+        Command::Compare(a) => compare_cmd::run(a),
+        Command::Fp(a) => fp_cmd::run(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            1
+        }
+    }
+}

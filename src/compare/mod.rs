@@ -1,0 +1,267 @@
+//! Comparing frames: the RTL frame against the golden one (must be identical) and the golden
+//! frame against the f64 reference (error metrics, diff images).
+
+use anyhow::{bail, Context};
+use std::path::Path;
+
+/// Error metrics between two images of the same size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImageMetrics {
+    pub pixels: usize,
+    pub differing_pixels: usize,
+    /// Largest absolute difference of one 8-bit channel.
+    pub max_channel_error: u8,
+    /// Peak signal-to-noise ratio in dB over all channels (infinite for identical images).
+    pub psnr_db: f64,
+}
+
+impl ImageMetrics {
+    pub fn differing_share(&self) -> f64 {
+        self.differing_pixels as f64 / self.pixels.max(1) as f64
+    }
+    pub fn identical(&self) -> bool {
+        self.differing_pixels == 0
+    }
+}
+
+/// Compares two RGB images pixel by pixel.
+pub fn compare_images(a: &image::RgbImage, b: &image::RgbImage) -> anyhow::Result<ImageMetrics> {
+    if a.dimensions() != b.dimensions() {
+        bail!(
+            "the images differ in size: {}x{} and {}x{}",
+            a.width(),
+            a.height(),
+            b.width(),
+            b.height()
+        );
+    }
+    let mut differing = 0;
+    let mut max_err = 0u8;
+    let mut sq = 0f64;
+    for (pa, pb) in a.pixels().zip(b.pixels()) {
+        let mut differs = false;
+        for c in 0..3 {
+            let e = pa[c].abs_diff(pb[c]);
+            differs |= e != 0;
+            max_err = max_err.max(e);
+            sq += f64::from(e).powi(2);
+        }
+        differing += usize::from(differs);
+    }
+    let pixels = (a.width() * a.height()) as usize;
+    let mse = sq / (3 * pixels.max(1)) as f64;
+    let psnr_db = if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (255.0f64 * 255.0 / mse).log10()
+    };
+    Ok(ImageMetrics {
+        pixels,
+        differing_pixels: differing,
+        max_channel_error: max_err,
+        psnr_db,
+    })
+}
+
+/// A diff image: black where equal, the absolute difference amplified 8x (at least 64 so any
+/// difference shows) where not.
+pub fn diff_image(a: &image::RgbImage, b: &image::RgbImage) -> image::RgbImage {
+    image::RgbImage::from_fn(a.width(), a.height(), |x, y| {
+        let (pa, pb) = (a.get_pixel(x, y), b.get_pixel(x, y));
+        image::Rgb([0, 1, 2].map(|c| {
+            let e = pa[c].abs_diff(pb[c]);
+            if e == 0 {
+                0
+            } else {
+                (u16::from(e) * 8).clamp(64, 255) as u8
+            }
+        }))
+    })
+}
+
+/// One row of a hits file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HitRow {
+    pub x: u32,
+    pub y: u32,
+    /// `None` for a miss.
+    pub hit: Option<(i64, i64, f64)>,
+}
+
+/// Reads a hits file (`x,y,instance,triangle,dist`), naming the file and line of any error.
+pub fn read_hits(path: &Path) -> anyhow::Result<Vec<HitRow>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading hits file {}", path.display()))?;
+    let mut lines = text.lines().enumerate();
+    match lines.next() {
+        Some((_, h)) if h.trim() == "x,y,instance,triangle,dist" => {}
+        _ => bail!(
+            "{}: line 1: expected the header `x,y,instance,triangle,dist`",
+            path.display()
+        ),
+    }
+    let mut rows = Vec::new();
+    for (i, line) in lines {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let bad =
+            |what: &str| anyhow::anyhow!("{}: line {}: {what}: `{line}`", path.display(), i + 1);
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if fields.len() != 5 {
+            return Err(bad("expected 5 comma-separated fields"));
+        }
+        let x = fields[0]
+            .parse()
+            .map_err(|_| bad("x is not a pixel coordinate"))?;
+        let y = fields[1]
+            .parse()
+            .map_err(|_| bad("y is not a pixel coordinate"))?;
+        let instance: i64 = fields[2]
+            .parse()
+            .map_err(|_| bad("instance is not an integer"))?;
+        let triangle: i64 = fields[3]
+            .parse()
+            .map_err(|_| bad("triangle is not an integer"))?;
+        let dist: f64 = fields[4].parse().map_err(|_| bad("dist is not a number"))?;
+        let hit = if instance < 0 {
+            None
+        } else {
+            Some((instance, triangle, dist))
+        };
+        rows.push(HitRow { x, y, hit });
+    }
+    Ok(rows)
+}
+
+/// Agreement of two hits files of the same frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HitMetrics {
+    pub pixels: usize,
+    /// Pixels where both miss, or both hit the same instance and triangle.
+    pub identical_hits: usize,
+    /// Identical hits plus ties: different triangles hit at the same distance (within
+    /// [`TIE_TOLERANCE`] relative), where the ray passes through a shared edge or vertex.
+    pub equivalent_hits: usize,
+    /// Mean and maximum relative distance error over pixels that hit the same triangle.
+    pub mean_rel_dist_error: f64,
+    pub max_rel_dist_error: f64,
+}
+
+/// Relative distance within which hits on different triangles count as the same surface point.
+pub const TIE_TOLERANCE: f64 = 1e-5;
+
+impl HitMetrics {
+    pub fn identical_ratio(&self) -> f64 {
+        self.identical_hits as f64 / self.pixels.max(1) as f64
+    }
+    pub fn equivalent_ratio(&self) -> f64 {
+        self.equivalent_hits as f64 / self.pixels.max(1) as f64
+    }
+}
+
+/// Compares hit lists given per pixel in the same order.
+pub fn compare_hits(
+    a: &[Option<(i64, i64, f64)>],
+    b: &[Option<(i64, i64, f64)>],
+) -> anyhow::Result<HitMetrics> {
+    if a.len() != b.len() {
+        bail!(
+            "the hits files cover different pixel counts: {} and {}",
+            a.len(),
+            b.len()
+        );
+    }
+    let (mut same, mut ties, mut n_dist, mut sum, mut max) = (0, 0, 0, 0.0, 0.0f64);
+    for (x, y) in a.iter().zip(b) {
+        match (x, y) {
+            (None, None) => same += 1,
+            (Some((ia, ta, da)), Some((ib, tb, db))) if (ia, ta) != (ib, tb) => {
+                ties += usize::from((da - db).abs() <= TIE_TOLERANCE * db.abs());
+            }
+            (Some((ia, ta, da)), Some((ib, tb, db))) if ia == ib && ta == tb => {
+                same += 1;
+                let rel = (da - db).abs() / db.abs().max(f64::MIN_POSITIVE);
+                n_dist += 1;
+                sum += rel;
+                max = max.max(rel);
+            }
+            _ => {}
+        }
+    }
+    Ok(HitMetrics {
+        pixels: a.len(),
+        identical_hits: same,
+        equivalent_hits: same + ties,
+        mean_rel_dist_error: if n_dist > 0 { sum / n_dist as f64 } else { 0.0 },
+        max_rel_dist_error: max,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn metrics_of_known_differences() {
+        let a = image::RgbImage::from_pixel(4, 2, image::Rgb([10, 20, 30]));
+        let mut b = a.clone();
+        b.put_pixel(1, 1, image::Rgb([10, 24, 30]));
+        b.put_pixel(3, 0, image::Rgb([7, 20, 30]));
+        let m = compare_images(&a, &b).unwrap();
+        assert_eq!(
+            (m.pixels, m.differing_pixels, m.max_channel_error),
+            (8, 2, 4)
+        );
+        // MSE = (16 + 9) / 24.
+        let want = 10.0 * (255.0f64.powi(2) / (25.0 / 24.0)).log10();
+        assert!((m.psnr_db - want).abs() < 1e-12);
+        assert!(compare_images(&a, &a).unwrap().psnr_db.is_infinite());
+        let d = diff_image(&a, &b);
+        assert_eq!(d.get_pixel(1, 1).0, [0, 64, 0]);
+        assert_eq!(d.get_pixel(0, 0).0, [0, 0, 0]);
+        let small = image::RgbImage::new(2, 2);
+        assert!(compare_images(&a, &small)
+            .unwrap_err()
+            .to_string()
+            .contains("differ in size"));
+    }
+
+    #[test]
+    fn hit_agreement_counts_same_triangle_or_both_miss() {
+        let a = [
+            None,
+            Some((0, 5, 2.0)),
+            Some((1, 5, 2.0)),
+            Some((0, 3, 4.0)),
+        ];
+        let b = [None, Some((0, 5, 2.5)), Some((0, 5, 2.0)), None];
+        let m = compare_hits(&a, &b).unwrap();
+        assert_eq!(m.identical_hits, 2);
+        assert!((m.max_rel_dist_error - 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn hits_file_errors_name_file_and_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("h.csv");
+        std::fs::write(
+            &p,
+            "x,y,instance,triangle,dist\n0,0,1,2,3.5\n1,0,-1,-1,inf\n2,0,zz,1,1\n",
+        )
+        .unwrap();
+        let err = read_hits(&p).unwrap_err().to_string();
+        assert!(
+            err.contains("h.csv") && err.contains("line 4") && err.contains("instance"),
+            "{err}"
+        );
+        std::fs::write(
+            &p,
+            "x,y,instance,triangle,dist\n0,0,1,2,3.5\n1,0,-1,-1,inf\n",
+        )
+        .unwrap();
+        let rows = read_hits(&p).unwrap();
+        assert_eq!(rows[0].hit, Some((1, 2, 3.5)));
+        assert_eq!(rows[1].hit, None);
+    }
+}

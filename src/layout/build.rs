@@ -1,0 +1,597 @@
+//! Building the memory map of one frame.
+
+use super::*;
+use crate::accel::kd_tree::{self, KdNode, KdParams, KdTree};
+use crate::accel::Aabb;
+use crate::scene::Scene;
+use glam::{DAffine3, DMat3, DVec3};
+
+#[derive(Debug, thiserror::Error)]
+pub enum LayoutError {
+    #[error(
+        "scene `{scene}` does not fit the memory: bank {bank} ({name}) needs {needed} words \
+         ({needed_kib:.1} KiB) but holds {capacity} ({capacity_kib:.1} KiB); use a smaller scene \
+         or a lower resolution, or configure larger banks",
+        needed_kib = *needed as f64 * 4.0 / 1024.0,
+        capacity_kib = *capacity as f64 * 4.0 / 1024.0
+    )]
+    TooBig {
+        scene: String,
+        bank: usize,
+        name: &'static str,
+        needed: usize,
+        capacity: usize,
+    },
+    #[error("scene `{scene}`: {what} does not fit the 30-bit address field of a kd node")]
+    AddressOverflow { scene: String, what: String },
+    #[error(
+        "kd split plane {split} is not representable in {format}: the tree was built on \
+         geometry that was not rounded to the format (a bug in dynrt, please report it)"
+    )]
+    SplitNotRepresentable { split: f64, format: Format },
+    #[error("scene `{scene}` has frame {frame} but only {frames} frames (0..{frames})")]
+    NoSuchFrame {
+        scene: String,
+        frame: u32,
+        frames: u32,
+    },
+    #[error(
+        "scene `{scene}`: object `{object}` has no triangle that survives rounding to {format}"
+    )]
+    EmptyAfterRounding {
+        scene: String,
+        object: String,
+        format: Format,
+    },
+}
+
+/// The per-object kd-trees and unit-triangle transforms of a scene for one number format,
+/// built once and reused by every frame (only the top-level tree follows the instances).
+///
+/// The builder rounds every candidate split plane to the format before scoring it and sorts
+/// triangles against the rounded plane, so the planes the hardware stores are exactly the
+/// builder's and no triangle falls between them. A triangle whose transform does not fit the
+/// format (an entry overflows, as for slivers in narrow formats) is left out of the tree and
+/// reported in `dropped`.
+#[derive(Clone, Debug)]
+pub struct SceneTrees {
+    pub format: Format,
+    /// Woop transforms per object, in the scene's triangle order (zero words for dropped ones).
+    pub transforms: Vec<Vec<[u32; 12]>>,
+    pub trees: Vec<KdTree>,
+    /// Local indices of the triangles left out, per object.
+    pub dropped: Vec<Vec<u32>>,
+}
+
+impl SceneTrees {
+    pub fn build(scene: &Scene, format: Format) -> Result<SceneTrees, LayoutError> {
+        let params = KdParams {
+            split_format: Some(format),
+            ..KdParams::default()
+        };
+        let mut out = SceneTrees {
+            format,
+            transforms: vec![],
+            trees: vec![],
+            dropped: vec![],
+        };
+        for object in &scene.objects {
+            let mut transforms = Vec::with_capacity(object.triangles.len());
+            let (mut kept, mut dropped) = (Vec::new(), Vec::new());
+            for (i, t) in object.triangles.iter().enumerate() {
+                let words = affine_words(format, &unit_triangle_transform(t));
+                if is_flat(t) || words.iter().any(|&w| format.is_nan(w) || format.is_inf(w)) {
+                    dropped.push(i as u32);
+                    transforms.push([0; 12]);
+                } else {
+                    kept.push(i as u32);
+                    transforms.push(words);
+                }
+            }
+            if kept.is_empty() {
+                return Err(LayoutError::EmptyAfterRounding {
+                    scene: scene.source.display().to_string(),
+                    object: object.name.clone(),
+                    format,
+                });
+            }
+            let kept_tris: Vec<[DVec3; 3]> =
+                kept.iter().map(|&i| object.triangles[i as usize]).collect();
+            let mut tree = kd_tree::build_sah(&kept_tris, &params);
+            for p in tree.prim_indices.iter_mut() {
+                *p = kept[*p as usize];
+            }
+            out.transforms.push(transforms);
+            out.trees.push(tree);
+            out.dropped.push(dropped);
+        }
+        Ok(out)
+    }
+
+    pub fn dropped_count(&self) -> usize {
+        self.dropped.iter().map(Vec::len).sum()
+    }
+}
+
+fn is_flat(t: &[DVec3; 3]) -> bool {
+    (t[0] - t[2]).cross(t[1] - t[2]).length_squared() == 0.0
+}
+
+/// The largest format value <= x (x finite).
+fn round_down(f: Format, x: f64) -> f64 {
+    let w = f.from_f64(x);
+    let v = f.to_f64(w);
+    if v <= x {
+        v
+    } else {
+        step(f, w, false)
+    }
+}
+
+/// The smallest format value >= x (x finite).
+fn round_up(f: Format, x: f64) -> f64 {
+    let w = f.from_f64(x);
+    let v = f.to_f64(w);
+    if v >= x {
+        v
+    } else {
+        step(f, w, true)
+    }
+}
+
+/// The neighbour of word `w` towards +inf (`up`) or -inf.
+fn step(f: Format, w: u32, up: bool) -> f64 {
+    if f.is_zero(w) {
+        let m = f.to_f64(f.min_normal(false));
+        return if up { m } else { -m };
+    }
+    let away = up != f.sign_of(w); // moving away from zero grows the magnitude
+    let n = if away { w + 1 } else { w - 1 };
+    f.to_f64(if f.is_zero(n) { f.zero(false) } else { n })
+}
+
+/// An instance's world bounds rounded outward to format values, plus a margin of a few ulps
+/// so that rays transformed with rounding still find the instance where they hit it.
+fn instance_box(f: Format, local: &Aabb, to_world: &DAffine3) -> Aabb {
+    let b = local.transformed(to_world);
+    let margin = (b.max - b.min).max_element().max(b.max.abs().max_element())
+        * 2f64.powi(-(f.man_bits as i32) + 3);
+    let lo = b.min - DVec3::splat(margin);
+    let hi = b.max + DVec3::splat(margin);
+    Aabb::new(
+        DVec3::new(
+            round_down(f, lo.x),
+            round_down(f, lo.y),
+            round_down(f, lo.z),
+        ),
+        DVec3::new(round_up(f, hi.x), round_up(f, hi.y), round_up(f, hi.z)),
+    )
+}
+
+/// The matrix words of an affine map, row-major 3x4.
+fn affine_words(f: Format, m: &DAffine3) -> [u32; 12] {
+    let mut w = [0; 12];
+    for r in 0..3 {
+        let row = m.matrix3.row(r);
+        w[r * 4] = f.from_f64(row.x);
+        w[r * 4 + 1] = f.from_f64(row.y);
+        w[r * 4 + 2] = f.from_f64(row.z);
+        w[r * 4 + 3] = f.from_f64(m.translation[r]);
+    }
+    w
+}
+
+/// Woop's unit-triangle transform: the affine map taking triangle (A, B, C) to the unit
+/// triangle (1,0,0), (0,1,0), (0,0,0) and its unit normal to (0,0,1).
+pub fn unit_triangle_transform(t: &[DVec3; 3]) -> DAffine3 {
+    let [a, b, c] = *t;
+    let n = (a - c).cross(b - c).normalize();
+    DAffine3::from_mat3_translation(DMat3::from_cols(a - c, b - c, n), c).inverse()
+}
+
+/// Packs a kd-tree into node words at `node_base` (node index) with leaf lists at `list_base`
+/// (bank-1 address). `map_prim` turns a builder primitive index into the stored id.
+fn pack_tree(
+    f: Format,
+    tree: &KdTree,
+    node_base: u32,
+    list_base: u32,
+    map_prim: impl Fn(u32) -> u32,
+    nodes: &mut Vec<u32>,
+    lists: &mut Vec<u32>,
+) -> Result<(), LayoutError> {
+    for node in &tree.nodes {
+        match *node {
+            KdNode::Inner {
+                axis,
+                split,
+                children,
+            } => {
+                let w = f.from_f64(split);
+                if f.to_f64(w) != split {
+                    return Err(LayoutError::SplitNotRepresentable { split, format: f });
+                }
+                nodes.push(encode_inner(axis as usize, node_base + children));
+                nodes.push(w);
+            }
+            KdNode::Leaf { first, count } => {
+                nodes.push(encode_leaf(list_base + first));
+                nodes.push(count);
+            }
+        }
+    }
+    debug_assert_eq!(lists.len() as u32, list_base);
+    lists.extend(tree.prim_indices.iter().map(|&p| map_prim(p)));
+    Ok(())
+}
+
+/// Builds the memory map of `frame`.
+pub fn build(
+    scene: &Scene,
+    trees: &SceneTrees,
+    frame: u32,
+    memory: &MemoryConfig,
+) -> Result<Layout, LayoutError> {
+    let f = trees.format;
+    let scene_name = scene.source.display().to_string();
+    if frame >= scene.frames {
+        return Err(LayoutError::NoSuchFrame {
+            scene: scene_name,
+            frame,
+            frames: scene.frames,
+        });
+    }
+    let mut banks: Vec<Vec<u32>> = vec![Vec::new(); 6];
+
+    // Triangles and shading data, global triangle index = object base + local index.
+    let mut first_triangle = Vec::new();
+    let (mut tri_count, mut mat_count) = (0u32, 0u32);
+    for (o, object) in scene.objects.iter().enumerate() {
+        first_triangle.push(tri_count);
+        for (i, t) in object.triangles.iter().enumerate() {
+            // Dropped triangles keep zero words so the addressing stays regular; no leaf
+            // refers to them.
+            let normal = if is_flat(t) {
+                DVec3::ZERO
+            } else {
+                (t[0] - t[2]).cross(t[1] - t[2]).normalize()
+            };
+            let t = &trees.transforms[o][i];
+            banks[TRIANGLES_UV].extend(&t[..8]);
+            banks[TRIANGLES_T].extend(&t[8..]);
+            banks[TRIANGLES_T].extend([normal.x, normal.y, normal.z].map(|c| f.from_f64(c)));
+            banks[TRIANGLES_T].push(mat_count + object.triangle_material[i]);
+        }
+        tri_count += object.triangles.len() as u32;
+        mat_count += object.materials.len() as u32;
+    }
+
+    // Top-level tree over the instances' world bounds (absent for one untransformed object).
+    let to_world: Vec<DAffine3> = scene
+        .instances
+        .iter()
+        .map(|i| i.object_to_world(frame))
+        .collect();
+    let top = if scene.is_single_untransformed_object() {
+        None
+    } else {
+        let boxes: Vec<Aabb> = scene
+            .instances
+            .iter()
+            .zip(&to_world)
+            .map(|(inst, m)| instance_box(f, &trees.trees[inst.object].bounds, m))
+            .collect();
+        Some(kd_tree::build_sah_boxes(
+            &boxes,
+            &KdParams {
+                split_format: Some(f),
+                ..KdParams::default()
+            },
+        ))
+    };
+
+    let (mut nodes, mut lists) = (Vec::new(), Vec::new());
+    let mut top_root = None;
+    if let Some(top) = &top {
+        top_root = Some(0);
+        pack_tree(f, top, 0, 0, |p| p, &mut nodes, &mut lists)?;
+    }
+    let mut object_roots = Vec::new();
+    for (o, tree) in trees.trees.iter().enumerate() {
+        let node_base = (nodes.len() / NODE_WORDS) as u32;
+        object_roots.push(node_base);
+        let base = first_triangle[o];
+        pack_tree(
+            f,
+            tree,
+            node_base,
+            lists.len() as u32,
+            |p| base + p,
+            &mut nodes,
+            &mut lists,
+        )?;
+    }
+    let node_base = nodes.len() / NODE_WORDS;
+    banks[NODES] = nodes;
+    banks[LISTS] = lists;
+    if node_base >= 1 << 30 || banks[LISTS].len() >= 1 << 30 {
+        return Err(LayoutError::AddressOverflow {
+            scene: scene_name,
+            what: "the kd-tree".into(),
+        });
+    }
+
+    // Instances.
+    for (inst, m) in scene.instances.iter().zip(&to_world) {
+        banks[INSTANCES].extend(affine_words(f, &m.inverse()));
+        let normal = m.matrix3.inverse().transpose();
+        for r in 0..3 {
+            let row = normal.row(r);
+            banks[INSTANCES].extend([f.from_f64(row.x), f.from_f64(row.y), f.from_f64(row.z)]);
+        }
+        banks[INSTANCES].extend([
+            object_roots[inst.object],
+            first_triangle[inst.object],
+            inst.object as u32,
+        ]);
+    }
+
+    // Frame constants, lights, frame buffer.
+    let cam = &scene.camera;
+    let (w, h) = (cam.width as f64, cam.height as f64);
+    let basis = cam.basis();
+    let half_h = (cam.fov_y_deg.to_radians() / 2.0).tan();
+    let aspect = w / h;
+    let c0 = basis.right * (2.0 * half_h * aspect / w);
+    let c1 = basis.up * (-2.0 * half_h / h);
+    let c2 = basis.forward
+        + basis.right * ((1.0 / w - 1.0) * half_h * aspect)
+        + basis.up * ((1.0 - 1.0 / h) * half_h);
+    let camera = DAffine3::from_mat3_translation(DMat3::from_cols(c0, c1, DVec3::ZERO), c2);
+    let fr = &mut banks[FRAME];
+    fr.extend(affine_words(f, &camera));
+    fr.extend([
+        f.from_f64(cam.eye.x),
+        f.from_f64(cam.eye.y),
+        f.from_f64(cam.eye.z),
+    ]);
+    fr.push(f.from_f64(scene.render.ambient));
+    fr.extend(scene.render.background.map(|c| f.from_f64(c)));
+    let (shadow_eps, mirror_eps) = secondary_t_min(f, scene);
+    fr.extend([f.from_f64(shadow_eps), f.from_f64(mirror_eps)]);
+    fr.extend([0, f.one(), f.from_int(2)]);
+    debug_assert_eq!(fr.len(), FrameMap::LIGHTS);
+    for light in &scene.lights {
+        fr.extend([light.position.x, light.position.y, light.position.z].map(|c| f.from_f64(c)));
+        fr.extend(light.color.map(|c| f.from_f64(c)));
+    }
+    let materials = fr.len() as u32;
+    for object in &scene.objects {
+        for m in &object.materials {
+            fr.extend(m.diffuse.map(|c| f.from_f64(c)));
+            fr.push(f.from_f64(m.mirror));
+        }
+    }
+    let frame_buffer = fr.len() as u32;
+    fr.resize(fr.len() + (cam.width * cam.height) as usize, 0);
+
+    for (bank, words) in banks.iter().enumerate() {
+        if words.len() > memory.bank_words() {
+            return Err(LayoutError::TooBig {
+                scene: scene_name,
+                bank,
+                name: BANK_NAMES[bank],
+                needed: words.len(),
+                capacity: memory.bank_words(),
+            });
+        }
+    }
+
+    let info = LayoutInfo {
+        width: cam.width,
+        height: cam.height,
+        shadows: scene.render.shadows && !scene.lights.is_empty(),
+        reflection_depth: scene.render.reflection_depth,
+        light_count: scene.lights.len() as u32,
+        top_root,
+        materials,
+        object_root: object_roots[0],
+        instance_count: scene.instances.len() as u32,
+        triangle_count: tri_count,
+        frame_buffer,
+        object_depth: trees.trees.iter().map(|t| t.depth).max().unwrap_or(0),
+        top_depth: top.as_ref().map_or(0, |t| t.depth),
+        object_first_triangle: first_triangle,
+    };
+    Ok(Layout {
+        format: f,
+        memory: *memory,
+        banks,
+        info,
+    })
+}
+
+/// The smallest t of secondary rays. A shadow ray runs from the hit point (t = 0) to the light
+/// (t = 1); a mirror ray's direction has the length of the incoming one. Both start a few
+/// hundred ulps of the scene's size away from the surface, so the rounding of the hit point
+/// (about one ulp of its coordinates) cannot put the origin behind its own surface; the
+/// originating triangle is also skipped by id (see `model::golden`).
+fn secondary_t_min(f: Format, scene: &Scene) -> (f64, f64) {
+    let ulp = 2f64.powi(-(f.man_bits as i32));
+    let shadow = (ulp * 256.0).min(1e-2);
+    let extent = scene_extent(scene);
+    (shadow, (extent * ulp * 256.0).max(f64::MIN_POSITIVE))
+}
+
+fn scene_extent(scene: &Scene) -> f64 {
+    let mut b = Aabb::from_points(std::iter::once(&scene.camera.eye));
+    for inst in &scene.instances {
+        let (lo, hi) = scene.objects[inst.object].bounds();
+        b = b.union(&Aabb::new(lo, hi).transformed(&inst.object_to_world(0)));
+    }
+    (b.max - b.min).max_element()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &str = r#"
+[camera]
+eye = [0.0, 1.0, 4.0]
+look_at = [0.0, 1.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov_y = 40.0
+width = 8
+height = 6
+
+[[lights]]
+position = [0.0, 1.9, 0.0]
+color = [1.0, 1.0, 1.0]
+
+[[objects]]
+name = "ball"
+generate = { kind = "sphere", subdivisions = 1 }
+
+[[instances]]
+object = "ball"
+translate = [0.5, 1.0, 0.0]
+
+[[instances]]
+object = "ball"
+translate = [-0.5, 1.0, 0.0]
+scale = [0.5, 0.5, 0.5]
+"#;
+
+    fn scene() -> Scene {
+        Scene::from_toml_str(SCENE, Path::new("."), "test.toml").unwrap()
+    }
+    use std::path::Path;
+
+    #[test]
+    fn unit_triangle_transform_maps_vertices_to_the_unit_triangle() {
+        let t = [
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::new(-2.0, 0.5, 1.0),
+            DVec3::new(0.3, -1.0, 2.0),
+        ];
+        let m = unit_triangle_transform(&t);
+        for (v, want) in t.iter().zip([DVec3::X, DVec3::Y, DVec3::ZERO]) {
+            assert!((m.transform_point3(*v) - want).length() < 1e-12);
+        }
+        let n = (t[0] - t[2]).cross(t[1] - t[2]).normalize();
+        assert!((m.transform_vector3(n) - DVec3::Z).length() < 1e-12);
+    }
+
+    #[test]
+    fn layout_decodes_to_the_trees_it_was_built_from() {
+        let s = scene();
+        let trees = SceneTrees::build(&s, Format::E7M16).unwrap();
+        let l = build(&s, &trees, 0, &MemoryConfig::default()).unwrap();
+        assert_eq!(l.info.instance_count, 2);
+        assert_eq!(l.info.triangle_count, 80);
+        assert_eq!(l.banks[TRIANGLES_UV].len(), 80 * TRIANGLE_BANK_WORDS);
+        assert_eq!(l.banks[TRIANGLES_T].len(), 80 * TRIANGLE_BANK_WORDS);
+        // The transform reassembled from both banks is the one the trees were built with.
+        assert_eq!(l.triangle_transform(17), trees.transforms[0][17]);
+        assert_eq!(l.banks[INSTANCES].len(), 2 * INSTANCE_WORDS);
+        let top = l.info.top_root.expect("two instances need a top level");
+        // Object tree nodes decode to the builder's nodes, offset past the top-level tree.
+        let root = l.word(INSTANCES, instance_word::ROOT as u32);
+        assert!(root > top);
+        for (i, node) in trees.trees[0].nodes.iter().enumerate() {
+            match (node, l.node(root + i as u32)) {
+                (
+                    KdNode::Inner {
+                        axis,
+                        split,
+                        children,
+                    },
+                    Node::Inner {
+                        axis: a,
+                        split: s,
+                        left,
+                    },
+                ) => {
+                    assert_eq!(
+                        (*axis as usize, Format::E7M16.to_f64(s), *children + root),
+                        (a, *split, left)
+                    );
+                }
+                (KdNode::Leaf { first, count }, Node::Leaf { list, count: c }) => {
+                    assert_eq!(c, *count);
+                    let ids: Vec<u32> = (0..c).map(|k| l.word(LISTS, list + k)).collect();
+                    assert_eq!(
+                        ids,
+                        trees.trees[0].prim_indices[*first as usize..(*first + count) as usize]
+                    );
+                }
+                (a, b) => panic!("node {i}: {a:?} decoded as {b:?}"),
+            }
+        }
+        // Frame buffer after the lights, one word per pixel.
+        assert_eq!(l.info.materials as usize, FrameMap::LIGHTS + LIGHT_WORDS);
+        assert_eq!(
+            l.info.frame_buffer as usize,
+            FrameMap::LIGHTS + LIGHT_WORDS + MATERIAL_WORDS
+        );
+        assert_eq!(l.banks[FRAME].len(), l.info.frame_buffer as usize + 48);
+    }
+
+    #[test]
+    fn a_scene_too_big_for_the_memory_is_refused_with_the_bank_named() {
+        let s = scene();
+        let trees = SceneTrees::build(&s, Format::E7M16).unwrap();
+        let fits = build(&s, &trees, 0, &MemoryConfig::default()).unwrap();
+        let (bank, words) = fits
+            .used_words()
+            .into_iter()
+            .enumerate()
+            .max_by_key(|&(_, w)| w)
+            .unwrap();
+        let exact = MemoryConfig {
+            banks: 6,
+            bank_bytes: words * 4,
+        };
+        assert!(
+            build(&s, &trees, 0, &exact).is_ok(),
+            "a bank filled exactly still fits"
+        );
+        let small = MemoryConfig {
+            banks: 6,
+            bank_bytes: words * 4 - 4,
+        };
+        let err = build(&s, &trees, 0, &small).unwrap_err().to_string();
+        let want = format!("bank {bank} ({}) needs {words} words", BANK_NAMES[bank]);
+        assert!(
+            err.contains("does not fit") && err.contains(&want) && err.contains("test.toml"),
+            "{err}"
+        );
+        let err = build(&s, &trees, 3, &MemoryConfig::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("frame 3"), "{err}");
+    }
+
+    #[test]
+    fn instance_boxes_are_rounded_outward_to_the_format() {
+        let f = Format::parse("e5m10").unwrap();
+        let b = Aabb::new(DVec3::splat(0.1), DVec3::splat(0.3));
+        let r = instance_box(f, &b, &DAffine3::IDENTITY);
+        for v in [r.min, r.max] {
+            for c in v.to_array() {
+                assert_eq!(f.to_f64(f.from_f64(c)), c, "{c} must be representable");
+            }
+        }
+        assert!(r.min.max_element() < 0.1 && r.max.min_element() > 0.3);
+        assert_eq!(
+            round_down(f, 0.1),
+            f.to_f64(f.from_f64(0.1)).min(round_down(f, 0.1))
+        );
+        assert!(
+            round_down(f, 0.1) <= 0.1
+                && round_up(f, 0.1) >= 0.1
+                && round_up(f, 0.1) > round_down(f, 0.1)
+        );
+    }
+}

@@ -1,0 +1,223 @@
+//! The hardware memory map: the scene as the processor's SRAM banks hold it, in words of the
+//! chosen number format. Produced once per frame and read by both the golden model and the
+//! RTL (as `$readmemh` images), so the two can only differ in how they compute, never in what
+//! they read.
+//!
+//! # Banks
+//! Modelled on the paper's board (Alpha Data ADM-XRC-II): six independent banks of 32-bit
+//! words, 4 MB each by default. Each structure sits in its own bank so that the units that
+//! read it never wait for one another:
+//!
+//! | bank | contents | words per item |
+//! |---|---|---|
+//! | 0 `NODES` | kd nodes: the top-level tree (rewritten each frame) then every object tree | 2 per node |
+//! | 1 `LISTS` | leaf lists: instance ids of top-level leaves, global triangle ids of object leaves | 1 per reference |
+//! | 2 `TRIANGLES_UV` | rows 0 and 1 of the Woop unit-triangle transforms `T` (the u and v rows) | 8 per triangle |
+//! | 3 `TRIANGLES_T` | row 2 of `T` (the t row), then the object-space unit normal (3 floats) and the material index | 8 per triangle |
+//! | 4 `INSTANCES` | per instance: world-to-object 3x4 (12), normal matrix 3x3 object-to-world (9), object root node, first global triangle, object index (rewritten each frame) | 24 per instance |
+//! | 5 `FRAME` | camera 3x4 and eye, render constants, lights, materials (diffuse r, g, b, mirror), then the frame buffer | see [`FrameMap`] |
+//!
+//! Splitting a triangle's 16 words over two banks lets the intersection read them in parallel
+//! and fits 131,072 triangles (a 256x256 terrain) in the paper's 4 MB banks.
+//!
+//! # Word formats
+//! - A float word holds an `eXmY` value right-aligned (the format is at most 32 bits wide).
+//! - A kd node is two words. Word 0: bits 31..30 = 0, 1, 2 for an inner node splitting x, y,
+//!   z, or 3 for a leaf; bits 29..0 = for an inner node the node index of its left child (the
+//!   right child is the next node), for a leaf the bank-1 address of its list. Word 1: the
+//!   split position (float) or the leaf's reference count.
+//! - A 3x4 matrix is `m00 m01 m02 n0 m10 m11 m12 n1 m20 m21 m22 n2`; points transform as
+//!   `x' = ((m00*x + m01*y) + m02*z) + n0` (see `model::units::transform`).
+//! - A frame-buffer word is `0x00RRGGBB`.
+//!
+//! Every value the host computes (triangle transforms, instance matrices, camera) is computed
+//! in f64 and rounded once into the format by [`Format::from_f64`].
+
+mod build;
+
+pub use build::{build, LayoutError, SceneTrees};
+
+use crate::fp::Format;
+
+pub const NODES: usize = 0;
+pub const LISTS: usize = 1;
+pub const TRIANGLES_UV: usize = 2;
+pub const TRIANGLES_T: usize = 3;
+pub const INSTANCES: usize = 4;
+pub const FRAME: usize = 5;
+pub const BANK_NAMES: [&str; 6] = [
+    "nodes",
+    "lists",
+    "triangles",
+    "shading",
+    "instances",
+    "frame",
+];
+
+pub const NODE_WORDS: usize = 2;
+/// Words per triangle in each of the two triangle banks.
+pub const TRIANGLE_BANK_WORDS: usize = 8;
+pub const MATERIAL_WORDS: usize = 4;
+pub const INSTANCE_WORDS: usize = 24;
+pub const LIGHT_WORDS: usize = 6;
+pub const LEAF_TAG: u32 = 3;
+
+/// Offsets inside an instance record.
+pub mod instance_word {
+    pub const WORLD_TO_OBJECT: usize = 0;
+    pub const NORMAL_MATRIX: usize = 12;
+    pub const ROOT: usize = 21;
+    pub const FIRST_TRIANGLE: usize = 22;
+    pub const OBJECT: usize = 23;
+}
+
+/// The memory the layout must fit in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemoryConfig {
+    pub banks: usize,
+    pub bank_bytes: usize,
+}
+
+impl MemoryConfig {
+    /// The paper's board: 6 banks of 4 MB.
+    pub const ADM_XRC_II: MemoryConfig = MemoryConfig {
+        banks: 6,
+        bank_bytes: 4 << 20,
+    };
+    pub fn bank_words(&self) -> usize {
+        self.bank_bytes / 4
+    }
+}
+
+impl Default for MemoryConfig {
+    fn default() -> Self {
+        Self::ADM_XRC_II
+    }
+}
+
+/// Addresses inside bank 5.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameMap;
+
+impl FrameMap {
+    /// Camera: 3x4 matrix taking pixel (x, y, 0) to the primary ray direction.
+    pub const CAMERA: usize = 0;
+    /// Eye position (3 floats).
+    pub const EYE: usize = 12;
+    pub const AMBIENT: usize = 15;
+    /// Background colour (3 floats).
+    pub const BACKGROUND: usize = 16;
+    /// Smallest t of a shadow ray (a fraction of the way to the light).
+    pub const SHADOW_T_MIN: usize = 19;
+    /// Smallest t of a mirror ray (in units of the ray's direction length).
+    pub const MIRROR_T_MIN: usize = 20;
+    /// The float constants 0, 1, 2 (read by units that need them).
+    pub const ZERO: usize = 21;
+    pub const ONE: usize = 22;
+    pub const TWO: usize = 23;
+    pub const LIGHTS: usize = 24;
+}
+
+/// A decoded kd node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Node {
+    Inner { axis: usize, split: u32, left: u32 },
+    Leaf { list: u32, count: u32 },
+}
+
+/// What the generator tells the hardware besides the memory contents (as parameters).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayoutInfo {
+    pub width: u32,
+    pub height: u32,
+    pub shadows: bool,
+    pub reflection_depth: u32,
+    pub light_count: u32,
+    /// `None` for a scene of one untransformed object: rays enter the object tree directly.
+    pub top_root: Option<u32>,
+    /// Bank-5 address of the material table.
+    pub materials: u32,
+    /// Root node of the only object when there is no top level.
+    pub object_root: u32,
+    pub instance_count: u32,
+    pub triangle_count: u32,
+    pub frame_buffer: u32,
+    /// Deepest object tree and the top-level tree: the traversal stacks' sizes.
+    pub object_depth: u32,
+    pub top_depth: u32,
+    /// First global triangle index of every object (to report object-local indices).
+    pub object_first_triangle: Vec<u32>,
+}
+
+/// The banks' contents plus what the hardware is parameterized with.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    pub format: Format,
+    pub memory: MemoryConfig,
+    pub banks: Vec<Vec<u32>>,
+    pub info: LayoutInfo,
+}
+
+impl Layout {
+    pub fn word(&self, bank: usize, addr: u32) -> u32 {
+        self.banks[bank][addr as usize]
+    }
+    pub fn words<const N: usize>(&self, bank: usize, addr: usize) -> [u32; N] {
+        self.banks[bank][addr..addr + N]
+            .try_into()
+            .expect("slice of N words")
+    }
+    pub fn node(&self, index: u32) -> Node {
+        let a = index as usize * NODE_WORDS;
+        let (w0, w1) = (self.banks[NODES][a], self.banks[NODES][a + 1]);
+        let tag = w0 >> 30;
+        let payload = w0 & 0x3fff_ffff;
+        if tag == LEAF_TAG {
+            Node::Leaf {
+                list: payload,
+                count: w1,
+            }
+        } else {
+            Node::Inner {
+                axis: tag as usize,
+                split: w1,
+                left: payload,
+            }
+        }
+    }
+    /// The 12 words of a triangle's unit-triangle transform, assembled from both banks.
+    pub fn triangle_transform(&self, triangle: u32) -> [u32; 12] {
+        let a = triangle as usize * TRIANGLE_BANK_WORDS;
+        let mut m = [0; 12];
+        m[..8].copy_from_slice(&self.banks[TRIANGLES_UV][a..a + 8]);
+        m[8..].copy_from_slice(&self.banks[TRIANGLES_T][a..a + 4]);
+        m
+    }
+    /// A triangle's object-space unit normal and material index.
+    pub fn triangle_shading(&self, triangle: u32) -> ([u32; 3], u32) {
+        let a = triangle as usize * TRIANGLE_BANK_WORDS + 4;
+        (
+            self.words::<3>(TRIANGLES_T, a),
+            self.banks[TRIANGLES_T][a + 3],
+        )
+    }
+    /// A material's diffuse colour and mirror reflectivity.
+    pub fn material(&self, material: u32) -> ([u32; 3], u32) {
+        let a = (self.info.materials + material * MATERIAL_WORDS as u32) as usize;
+        (self.words::<3>(FRAME, a), self.banks[FRAME][a + 3])
+    }
+    /// Words used per bank (frame buffer included).
+    pub fn used_words(&self) -> Vec<usize> {
+        self.banks.iter().map(Vec::len).collect()
+    }
+    pub fn total_bytes(&self) -> usize {
+        self.used_words().iter().sum::<usize>() * 4
+    }
+}
+
+pub(crate) fn encode_inner(axis: usize, left: u32) -> u32 {
+    ((axis as u32) << 30) | left
+}
+pub(crate) fn encode_leaf(list: u32) -> u32 {
+    (LEAF_TAG << 30) | list
+}
