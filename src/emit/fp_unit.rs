@@ -3,7 +3,8 @@
 //!
 //! [`fp_unit_rtl`] produces one self-contained Verilog file: rust-hdl's flat output for the
 //! operator, renamed to `<top>_core` with readable names (`$` in rust-hdl's hierarchical names
-//! becomes `__`), and a clean top module `<top>` (e.g. `fp_add_e7m16`) with the ports
+//! becomes `__`) and identical per-instance modules merged (see `verilog_tidy`), and a clean
+//! top module `<top>` (e.g. `fp_add_e7m16`) with the ports
 //! `clock, in_valid, a[W-1:0], b[W-1:0], out_valid, result` (`result` is 1 bit for `lt`, `le`,
 //! `eq`, else a word). `out_valid` follows `in_valid` after [`FpUnitRtl::latency`] clocks.
 //!
@@ -17,6 +18,7 @@
 use anyhow::Result;
 use rust_hdl::prelude::*;
 
+use super::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
 use crate::dispatch_fp_format;
 use crate::fp::{BinOp, Format};
 use crate::hw::fp::{latency, FpAddSub, FpCompare, FpDiv, FpMul};
@@ -46,7 +48,7 @@ pub fn fp_unit_rtl(op: BinOp, fmt: Format) -> Result<FpUnitRtl> {
         BinOp::Div => dispatch_fp_format!(fmt, div_verilog())?,
         BinOp::Lt | BinOp::Le | BinOp::Eq => dispatch_fp_format!(fmt, compare_verilog())?,
     };
-    let core = rename_rust_hdl_names(&core, &core_name);
+    let core = merge_identical_modules(&rename_rust_hdl_names(&core, &core_name));
     let w = fmt.width();
     let is_compare = matches!(op, BinOp::Lt | BinOp::Le | BinOp::Eq);
     let result_width = if is_compare { 1 } else { w };
@@ -185,40 +187,6 @@ fn compare_verilog<
     const P: usize,
 >() -> String {
     core_verilog(FpCompare::<W, E, M>::default())
-}
-
-/// Renames rust-hdl's module `top` to `core_name`, its sub-modules `top$x$y` to
-/// `core_name__x__y`, and every `$` inside an identifier to `__` (system tasks such as
-/// `$signed` keep theirs). Field names never contain `__`, so no two names collide.
-fn rename_rust_hdl_names(verilog: &str, core_name: &str) -> String {
-    let mut out = String::with_capacity(verilog.len() + verilog.len() / 8);
-    let chars: Vec<char> = verilog.chars().collect();
-    let is_ident = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '$';
-    let mut i = 0;
-    while i < chars.len() {
-        let c = chars[i];
-        let starts_ident = (c.is_ascii_alphabetic() || c == '_')
-            && (i == 0 || !(is_ident(chars[i - 1]) || chars[i - 1] == '\''));
-        if !starts_ident {
-            out.push(c);
-            i += 1;
-            continue;
-        }
-        let start = i;
-        while i < chars.len() && is_ident(chars[i]) {
-            i += 1;
-        }
-        let word: String = chars[start..i].iter().collect();
-        let word = if word == "top" {
-            core_name.to_string()
-        } else if let Some(rest) = word.strip_prefix("top$") {
-            format!("{core_name}__{rest}")
-        } else {
-            word
-        };
-        out.push_str(&word.replace('$', "__"));
-    }
-    out
 }
 
 /// A testbench (module `tb`) that feeds `n_vectors` lines `a b` (hex) from `vectors_path`
@@ -408,16 +376,6 @@ mod tests {
         assert!(
             msg.contains("e4m3") && msg.contains("supported formats"),
             "{msg}"
-        );
-    }
-
-    #[test]
-    fn renaming_keeps_system_functions_and_maps_hierarchy() {
-        let v = "module top(a);\ntop$in_a in_a(.d(in_a$d));\nx = $signed(y$q) + 8'hff;\n";
-        let r = rename_rust_hdl_names(v, "fp_x_core");
-        assert_eq!(
-            r,
-            "module fp_x_core(a);\nfp_x_core__in_a in_a(.d(in_a__d));\nx = $signed(y__q) + 8'hff;\n"
         );
     }
 
