@@ -351,7 +351,7 @@ mod tests {
     fn top_module_has_the_contract_ports() {
         let unit = fp_unit_rtl(BinOp::Add, Format::E7M16).unwrap();
         assert_eq!(unit.top, "fp_add_e7m16");
-        assert_eq!(unit.latency, 5);
+        assert_eq!(unit.latency, 6);
         assert!(unit.verilog.contains("module fp_add_e7m16(\n"));
         for port in [
             "input wire clock,",
@@ -371,7 +371,7 @@ mod tests {
         assert_eq!(lt.result_width, 1);
         assert!(lt.verilog.contains("output wire result\n"));
         let div = fp_unit_rtl(BinOp::Div, Format::E8M23).unwrap();
-        assert_eq!(div.latency, 27);
+        assert_eq!(div.latency, 28);
     }
 
     #[test]

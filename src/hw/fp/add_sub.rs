@@ -1,15 +1,16 @@
 //! `FpAddSub`: pipelined `eXmY` adder/subtracter (`sub` input: 0 adds, 1 subtracts b), exactly
 //! rounded (nearest even), equal to `dynrt::fp::Format::add` / `sub` bit for bit.
 //!
-//! Latency 5 clocks, throughput one operation per clock:
+//! Latency 6 clocks, throughput one operation per clock:
 //! 1. input registers;
 //! 2. unpack (DAZ), special cases, magnitude compare and swap so that |big| >= |small|,
 //!    exponent difference; registered;
 //! 3. align the small significand (guard, round and sticky bits below it) and add or subtract;
 //!    registered;
 //! 4. normalize with a 5-level leading-zero shifter; registered;
-//! 5. round to nearest even on `S` bits with an unbounded exponent, overflow to infinity /
-//!    flush below the smallest normal to a signed zero, pack; registered.
+//! 5. round to nearest even on `S` bits with an unbounded exponent; registered;
+//! 6. overflow to infinity / flush below the smallest normal to a signed zero, pack;
+//!    registered.
 //!
 //! An exactly zero sum is +0 unless both operands are negative zeros (x - x = +0,
 //! (-0) + (-0) = -0), as IEEE prescribes for round to nearest.
@@ -24,7 +25,7 @@ use rust_hdl::prelude::*;
 use super::{const_bits, const_index, inf_word, qnan_word};
 
 /// Latency of [`FpAddSub`] in clocks.
-pub const ADD_SUB_LATENCY: u32 = 5;
+pub const ADD_SUB_LATENCY: u32 = 6;
 
 #[derive(LogicBlock)]
 pub struct FpAddSub<
@@ -127,7 +128,17 @@ pub struct FpAddSub<
     zero_sign4: DFF<Bit>,
     is_zero4: DFF<Bit>,
     valid4: DFF<Bit>,
-    // Stage 5: output registers.
+    // Stage 5: rounded result registers.
+    rnd_sig: DFF<Bits<S1>>,
+    rnd_exp: DFF<Bits<X2>>,
+    rnd_sign: DFF<Bit>,
+    rnd_zero_sign: DFF<Bit>,
+    rnd_inf_sign: DFF<Bit>,
+    rnd_nan: DFF<Bit>,
+    rnd_inf: DFF<Bit>,
+    rnd_is_zero: DFF<Bit>,
+    rnd_valid: DFF<Bit>,
+    // Stage 6: output registers.
     out_result: DFF<Bits<W>>,
     out_valid_r: DFF<Bit>,
     // Format constants.
@@ -262,6 +273,15 @@ impl<
             zero_sign4: Default::default(),
             is_zero4: Default::default(),
             valid4: Default::default(),
+            rnd_sig: Default::default(),
+            rnd_exp: Default::default(),
+            rnd_sign: Default::default(),
+            rnd_zero_sign: Default::default(),
+            rnd_inf_sign: Default::default(),
+            rnd_nan: Default::default(),
+            rnd_inf: Default::default(),
+            rnd_is_zero: Default::default(),
+            rnd_valid: Default::default(),
             out_result: Default::default(),
             out_valid_r: Default::default(),
             c_man_bits: const_index(M),
@@ -335,6 +355,15 @@ impl<
             zero_sign4,
             is_zero4,
             valid4,
+            rnd_sig,
+            rnd_exp,
+            rnd_sign,
+            rnd_zero_sign,
+            rnd_inf_sign,
+            rnd_nan,
+            rnd_inf,
+            rnd_is_zero,
+            rnd_valid,
             out_result,
             out_valid_r
         );
@@ -490,41 +519,53 @@ impl<
                 .sig_rounded
                 .val()
                 .get_bit(self.c_carry_pos.val().index());
+        // Registered: the rounded significand and exponent (splits the logic depth).
+        self.rnd_sig.d.next = self.sig_rounded.val();
+        self.rnd_exp.d.next = self.exp_final.val();
+        self.rnd_sign.d.next = self.sign4.q.val();
+        self.rnd_zero_sign.d.next = self.zero_sign4.q.val();
+        self.rnd_inf_sign.d.next = self.inf_sign4.q.val();
+        self.rnd_nan.d.next = self.nan4.q.val();
+        self.rnd_inf.d.next = self.inf4.q.val();
+        self.rnd_is_zero.d.next = self.is_zero4.q.val();
+        self.rnd_valid.d.next = self.valid4.q.val();
+
         self.exp_negative.next = self
-            .exp_final
+            .rnd_exp
+            .q
             .val()
             .get_bit(self.c_exp_sign_pos.val().index());
         self.sign_word.next = 0.into();
-        if self.sign4.q.val() {
+        if self.rnd_sign.q.val() {
             self.sign_word.next = self.c_sign_bit.val();
         }
         self.zero_word.next = 0.into();
-        if self.zero_sign4.q.val() {
+        if self.rnd_zero_sign.q.val() {
             self.zero_word.next = self.c_sign_bit.val();
         }
         self.inf_sign_word.next = self.c_inf.val();
-        if self.inf_sign4.q.val() {
+        if self.rnd_inf_sign.q.val() {
             self.inf_sign_word.next = self.c_inf.val() | self.c_sign_bit.val();
         }
-        self.packed_word.next = (bit_cast::<W, E>(self.exp_final.val().get_bits::<E>(0))
+        self.packed_word.next = (bit_cast::<W, E>(self.rnd_exp.q.val().get_bits::<E>(0))
             << self.c_man_bits.val())
-            | bit_cast::<W, M>(self.sig_rounded.val().get_bits::<M>(0));
+            | bit_cast::<W, M>(self.rnd_sig.q.val().get_bits::<M>(0));
 
-        // Stage 5.
-        if self.nan4.q.val() {
+        // Stage 6.
+        if self.rnd_nan.q.val() {
             self.out_result.d.next = self.c_qnan.val();
-        } else if self.inf4.q.val() {
+        } else if self.rnd_inf.q.val() {
             self.out_result.d.next = self.inf_sign_word.val();
-        } else if self.is_zero4.q.val() {
+        } else if self.rnd_is_zero.q.val() {
             self.out_result.d.next = self.zero_word.val();
-        } else if (!self.exp_negative.val()) & (self.exp_final.val() >= self.c_exp_max.val()) {
+        } else if (!self.exp_negative.val()) & (self.rnd_exp.q.val() >= self.c_exp_max.val()) {
             self.out_result.d.next = self.c_inf.val() | self.sign_word.val();
-        } else if self.exp_negative.val() | (self.exp_final.val() == 0) {
+        } else if self.exp_negative.val() | (self.rnd_exp.q.val() == 0) {
             self.out_result.d.next = self.sign_word.val();
         } else {
             self.out_result.d.next = self.packed_word.val() | self.sign_word.val();
         }
-        self.out_valid_r.d.next = self.valid4.q.val();
+        self.out_valid_r.d.next = self.rnd_valid.q.val();
         self.result.next = self.out_result.q.val();
         self.out_valid.next = self.out_valid_r.q.val();
     }
