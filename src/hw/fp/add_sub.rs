@@ -1,15 +1,16 @@
 //! `FpAddSub`: pipelined `eXmY` adder/subtracter (`sub` input: 0 adds, 1 subtracts b), exactly
 //! rounded (nearest even), equal to `dynrt::fp::Format::add` / `sub` bit for bit.
 //!
-//! Latency 6 clocks, throughput one operation per clock:
+//! Latency 7 clocks, throughput one operation per clock:
 //! 1. input registers;
 //! 2. unpack (DAZ), special cases, magnitude compare and swap so that |big| >= |small|,
 //!    exponent difference; registered;
 //! 3. align the small significand (guard, round and sticky bits below it) and add or subtract;
 //!    registered;
-//! 4. normalize with a 5-level leading-zero shifter; registered;
-//! 5. round to nearest even on `S` bits with an unbounded exponent; registered;
-//! 6. overflow to infinity / flush below the smallest normal to a signed zero, pack;
+//! 4. normalize with a 5-level leading-zero shifter: shifts by 16 and 8; registered;
+//! 5. shifts by 4, 2 and 1; registered;
+//! 6. round to nearest even on `S` bits with an unbounded exponent; registered;
+//! 7. overflow to infinity / flush below the smallest normal to a signed zero, pack;
 //!    registered.
 //!
 //! An exactly zero sum is +0 unless both operands are negative zeros (x - x = +0,
@@ -25,7 +26,7 @@ use rust_hdl::prelude::*;
 use super::{const_bits, const_index, inf_word, qnan_word};
 
 /// Latency of [`FpAddSub`] in clocks.
-pub const ADD_SUB_LATENCY: u32 = 6;
+pub const ADD_SUB_LATENCY: u32 = 7;
 
 #[derive(LogicBlock)]
 pub struct FpAddSub<
@@ -118,6 +119,17 @@ pub struct FpAddSub<
     inf_sign_word: Signal<Local, Bits<W>>,
     packed_word: Signal<Local, Bits<W>>,
     // Stage 4 registers.
+    mid_norm: DFF<Bits<T>>,
+    mid_lz: DFF<Bits<X2>>,
+    mid_exp: DFF<Bits<E>>,
+    mid_sign: DFF<Bit>,
+    mid_nan: DFF<Bit>,
+    mid_inf: DFF<Bit>,
+    mid_inf_sign: DFF<Bit>,
+    mid_zero_sign: DFF<Bit>,
+    mid_is_zero: DFF<Bit>,
+    mid_valid: DFF<Bit>,
+    // Stage 5 registers.
     norm: DFF<Bits<T>>,
     lz: DFF<Bits<X2>>,
     exp4: DFF<Bits<E>>,
@@ -128,7 +140,7 @@ pub struct FpAddSub<
     zero_sign4: DFF<Bit>,
     is_zero4: DFF<Bit>,
     valid4: DFF<Bit>,
-    // Stage 5: rounded result registers.
+    // Stage 6: rounded result registers.
     rnd_sig: DFF<Bits<S1>>,
     rnd_exp: DFF<Bits<X2>>,
     rnd_sign: DFF<Bit>,
@@ -138,7 +150,7 @@ pub struct FpAddSub<
     rnd_inf: DFF<Bit>,
     rnd_is_zero: DFF<Bit>,
     rnd_valid: DFF<Bit>,
-    // Stage 6: output registers.
+    // Stage 7: output registers.
     out_result: DFF<Bits<W>>,
     out_valid_r: DFF<Bit>,
     // Format constants.
@@ -263,6 +275,16 @@ impl<
             zero_word: Default::default(),
             inf_sign_word: Default::default(),
             packed_word: Default::default(),
+            mid_norm: Default::default(),
+            mid_lz: Default::default(),
+            mid_exp: Default::default(),
+            mid_sign: Default::default(),
+            mid_nan: Default::default(),
+            mid_inf: Default::default(),
+            mid_inf_sign: Default::default(),
+            mid_zero_sign: Default::default(),
+            mid_is_zero: Default::default(),
+            mid_valid: Default::default(),
             norm: Default::default(),
             lz: Default::default(),
             exp4: Default::default(),
@@ -345,6 +367,16 @@ impl<
             inf_sign3,
             zero_sign3,
             valid3,
+            mid_norm,
+            mid_lz,
+            mid_exp,
+            mid_sign,
+            mid_nan,
+            mid_inf,
+            mid_inf_sign,
+            mid_zero_sign,
+            mid_is_zero,
+            mid_valid,
             norm,
             lz,
             exp4,
@@ -477,11 +509,23 @@ impl<
             self.norm8.next = self.norm16.val() << 8;
             self.lz8.next = self.lz16.val() + 8;
         }
-        self.norm4.next = self.norm8.val();
-        self.lz4.next = self.lz8.val();
-        if (self.norm8.val() & self.c_top4.val()) == 0 {
-            self.norm4.next = self.norm8.val() << 4;
-            self.lz4.next = self.lz8.val() + 4;
+        // Stage 4: half-way through normalization (shifts by 16 and 8 done).
+        self.mid_norm.d.next = self.norm8.val();
+        self.mid_lz.d.next = self.lz8.val();
+        self.mid_exp.d.next = self.sum_exp.q.val();
+        self.mid_sign.d.next = self.sum_sign.q.val();
+        self.mid_nan.d.next = self.nan3.q.val();
+        self.mid_inf.d.next = self.inf3.q.val();
+        self.mid_inf_sign.d.next = self.inf_sign3.q.val();
+        self.mid_zero_sign.d.next = self.zero_sign3.q.val();
+        self.mid_is_zero.d.next = self.sum.q.val() == 0;
+        self.mid_valid.d.next = self.valid3.q.val();
+
+        self.norm4.next = self.mid_norm.q.val();
+        self.lz4.next = self.mid_lz.q.val();
+        if (self.mid_norm.q.val() & self.c_top4.val()) == 0 {
+            self.norm4.next = self.mid_norm.q.val() << 4;
+            self.lz4.next = self.mid_lz.q.val() + 4;
         }
         self.norm2.next = self.norm4.val();
         self.lz2.next = self.lz4.val();
@@ -495,17 +539,17 @@ impl<
             self.norm1.next = self.norm2.val() << 1;
             self.lz1.next = self.lz2.val() + 1;
         }
-        // Stage 4.
+        // Stage 5.
         self.norm.d.next = self.norm1.val();
         self.lz.d.next = self.lz1.val();
-        self.exp4.d.next = self.sum_exp.q.val();
-        self.sign4.d.next = self.sum_sign.q.val();
-        self.nan4.d.next = self.nan3.q.val();
-        self.inf4.d.next = self.inf3.q.val();
-        self.inf_sign4.d.next = self.inf_sign3.q.val();
-        self.zero_sign4.d.next = self.zero_sign3.q.val();
-        self.is_zero4.d.next = self.sum.q.val() == 0;
-        self.valid4.d.next = self.valid3.q.val();
+        self.exp4.d.next = self.mid_exp.q.val();
+        self.sign4.d.next = self.mid_sign.q.val();
+        self.nan4.d.next = self.mid_nan.q.val();
+        self.inf4.d.next = self.mid_inf.q.val();
+        self.inf_sign4.d.next = self.mid_inf_sign.q.val();
+        self.zero_sign4.d.next = self.mid_zero_sign.q.val();
+        self.is_zero4.d.next = self.mid_is_zero.q.val();
+        self.valid4.d.next = self.mid_valid.q.val();
 
         // Round: the top S bits are the significand, then round bit, then sticky bits.
         self.sig.next = self.norm.q.val().get_bits::<S>(4);
@@ -551,7 +595,7 @@ impl<
             << self.c_man_bits.val())
             | bit_cast::<W, M>(self.rnd_sig.q.val().get_bits::<M>(0));
 
-        // Stage 6.
+        // Stage 7.
         if self.rnd_nan.q.val() {
             self.out_result.d.next = self.c_qnan.val();
         } else if self.rnd_inf.q.val() {

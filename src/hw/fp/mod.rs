@@ -12,7 +12,7 @@
 //! [`formats`] lists the supported formats with their derived widths; `dispatch_fp_format!`
 //! dispatches from a runtime [`Format`] to the monomorphized instance.
 //!
-//! Latencies (clocks from `in_valid` to `out_valid`): add/sub 6, mul 4, div `M + 5`
+//! Latencies (clocks from `in_valid` to `out_valid`): add/sub 7, mul 4, div `M + 5`
 //! (e7m16: 21, e8m23: 28), compare 2. Every stage is at most about 7 LUT4 levels deep after
 //! `synth_xilinx -family xc2v` (the final rounding and the range check/packing are separate
 //! stages for that reason).
