@@ -8,6 +8,7 @@
 //! never imports `model` (they meet in tests).
 
 pub mod accel;
+pub mod bench;
 pub mod compare;
 pub mod emit;
 pub mod fp;

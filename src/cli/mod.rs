@@ -1,6 +1,7 @@
 //! Argument parsing (clap) and dispatch of the `dynrt` verbs. Errors are printed as one clear
 //! message (with its causes) and give a non-zero exit status.
 
+mod bench_cmd;
 mod compare_cmd;
 mod fp_cmd;
 mod render_cmd;
@@ -24,6 +25,8 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// Error metrics between two images (and hits files); writes a diff image.
     Compare(compare_cmd::CompareArgs),
+    /// Measure speed, area and error; CSV and Markdown reports under --out.
+    Bench(bench_cmd::BenchArgs),
     /// Run operand vectors through one floating-point operator (RTL or software model).
     Fp(fp_cmd::FpArgs),
 }
@@ -35,6 +38,7 @@ pub fn run() -> i32 {
         Command::Render(a) => render_cmd::run(a),
         Command::Compare(a) => compare_cmd::run(a),
         Command::Fp(a) => fp_cmd::run(a),
+        Command::Bench(a) => bench_cmd::run(a),
     };
     match result {
         Ok(code) => code,
