@@ -10,6 +10,7 @@
 pub mod accel;
 pub mod bench;
 pub mod compare;
+pub mod demo;
 pub mod emit;
 pub mod fp;
 pub mod hw;
