@@ -39,9 +39,9 @@ demo: deps build
 rtl: build
 	$(DYNRT) emit-fp --format e7m16 --rtl rtl_out/fp --testbench testbench/fp
 
-sim: deps build  # random e7m16 vectors (FORMAT must be 24 bits wide here)
+sim: deps build
 	@mkdir -p $(OUT)/sim; \
-	python3 -c "import random; random.seed(7); print('\n'.join(f'{random.getrandbits(24):06x} {random.getrandbits(24):06x}' for _ in range(20000)))" > $(OUT)/sim/vectors.txt; \
+	python3 -c "import random, re; e, m = map(int, re.findall(r'\d+', '$(FORMAT)')); w = 1 + e + m; d = (w + 3) // 4; random.seed(7); print('\n'.join(f'{random.getrandbits(w):0{d}x} {random.getrandbits(w):0{d}x}' for _ in range(20000)))" > $(OUT)/sim/vectors.txt; \
 	for op in add sub mul div lt le eq; do \
 	  $(DYNRT) fp --op $$op --format $(FORMAT) --vectors $(OUT)/sim/vectors.txt --out $(OUT)/sim/$$op.model --sim model || exit 1; \
 	  for s in iverilog verilator; do \
