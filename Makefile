@@ -6,6 +6,7 @@
 #   make sim     simulate every FP operator in Icarus and Verilator against the model
 #   make bench   speed, area and error reports under out/bench/
 #   make synth   yosys synth_xilinx -family xc2v of the FP operators (resources only)
+#   make images  regenerate the README's pictures in docs/
 
 SHELL := /bin/bash
 CARGO ?= cargo
@@ -13,7 +14,7 @@ FORMAT ?= e7m16
 DYNRT := target/release/dynrt
 OUT ?= out
 
-.PHONY: deps build test demo rtl sim bench synth fmt
+.PHONY: deps build test demo rtl sim bench synth images fmt
 
 deps:
 	@missing=""; \
@@ -57,6 +58,9 @@ bench: deps build
 
 synth: deps build
 	$(DYNRT) bench fp --vectors 0 --formats e6m11,e7m12,e7m14,e7m16,e8m16,e7m18,e8m20,e8m23 --out $(OUT)/synth
+
+images: build
+	for s in cornell mirror dynamic terrain; do $(DYNRT) render scenes/$$s.toml --width 256 --height 192 --out docs/$$s.png; done
 
 fmt:
 	$(CARGO) fmt
