@@ -479,17 +479,4 @@ mod tests {
             }
         }
     }
-
-    /// Not a check: writes every e7m16 and e8m23 unit to /tmp/dynrt_fp_rtl for inspection.
-    #[test]
-    #[ignore]
-    fn dump_units_for_inspection() {
-        let dir = std::path::Path::new("/tmp/dynrt_fp_rtl");
-        std::fs::create_dir_all(dir).unwrap();
-        for fmt in [Format::E7M16, Format::E8M23] {
-            for op in ALL_OPS {
-                write_unit(dir, &fp_unit_rtl(op, fmt).unwrap());
-            }
-        }
-    }
 }
