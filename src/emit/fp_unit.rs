@@ -354,6 +354,128 @@ endmodule
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::hw::fp::supported_formats;
+    use crate::sim;
+    use crate::synth;
+
+    const ALL_OPS: [BinOp; 7] = [
+        BinOp::Add,
+        BinOp::Sub,
+        BinOp::Mul,
+        BinOp::Div,
+        BinOp::Lt,
+        BinOp::Le,
+        BinOp::Eq,
+    ];
+
+    fn write_unit(dir: &std::path::Path, unit: &FpUnitRtl) -> std::path::PathBuf {
+        let path = dir.join(format!("{}.v", unit.top));
+        std::fs::write(&path, &unit.verilog).unwrap();
+        path
+    }
+
+    #[test]
+    fn top_module_has_the_contract_ports() {
+        let unit = fp_unit_rtl(BinOp::Add, Format::E7M16).unwrap();
+        assert_eq!(unit.top, "fp_add_e7m16");
+        assert_eq!(unit.latency, 4);
+        assert!(unit.verilog.contains("module fp_add_e7m16(\n"));
+        for port in [
+            "input wire clock,",
+            "input wire in_valid,",
+            "input wire [23:0] a,",
+            "input wire [23:0] b,",
+            "output wire out_valid,",
+            "output wire [23:0] result",
+        ] {
+            assert!(unit.verilog.contains(port), "missing `{port}`");
+        }
+        assert!(
+            !unit.verilog.contains("module top"),
+            "rust-hdl's name leaked"
+        );
+        let lt = fp_unit_rtl(BinOp::Lt, Format::E8M23).unwrap();
+        assert_eq!(lt.result_width, 1);
+        assert!(lt.verilog.contains("output wire result\n"));
+        let div = fp_unit_rtl(BinOp::Div, Format::E8M23).unwrap();
+        assert_eq!(div.latency, 27);
+    }
+
+    #[test]
+    fn unsupported_format_is_a_clear_error() {
+        let err = fp_unit_rtl(BinOp::Mul, Format::new(4, 3).unwrap()).unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            msg.contains("e4m3") && msg.contains("supported formats"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn renaming_keeps_system_functions_and_maps_hierarchy() {
+        let v = "module top(a);\ntop$in_a in_a(.d(in_a$d));\nx = $signed(y$q) + 8'hff;\n";
+        let r = rename_rust_hdl_names(v, "fp_x_core");
+        assert_eq!(
+            r,
+            "module fp_x_core(a);\nfp_x_core__in_a in_a(.d(in_a__d));\nx = $signed(y__q) + 8'hff;\n"
+        );
+    }
+
+    /// `verilator --lint-only -Wall` passes on every operator of e7m16 and e8m23, and on each
+    /// distinct core (add/sub, mul, div, compare) of every other format.
+    #[test]
+    fn verilator_lint_wall_is_clean() {
+        let dir = tempfile::tempdir().unwrap();
+        for fmt in supported_formats() {
+            let ops: &[BinOp] = if fmt == Format::E7M16 || fmt == Format::E8M23 {
+                &ALL_OPS
+            } else {
+                &[BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Lt]
+            };
+            for &op in ops {
+                let unit = fp_unit_rtl(op, fmt).unwrap();
+                let path = write_unit(dir.path(), &unit);
+                let report = sim::lint(&[path], &unit.top).unwrap();
+                assert!(report.is_clean(), "{}: {report}", unit.top);
+            }
+        }
+    }
+
+    /// Every operator of e7m16 and e8m23 synthesizes for Virtex-II; the significand products
+    /// map to one MULT18X18 (17x17) and four (24x24). Prints the resource counts.
+    #[test]
+    fn yosys_xc2v_synthesis() {
+        let dir = tempfile::tempdir().unwrap();
+        for fmt in [Format::E7M16, Format::E8M23] {
+            for op in [BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Lt] {
+                let unit = fp_unit_rtl(op, fmt).unwrap();
+                let path = write_unit(dir.path(), &unit);
+                let work = dir.path().join(format!("synth_{}", unit.top));
+                let options = synth::SynthOptions {
+                    io_pads: false,
+                    ..Default::default()
+                };
+                let report = synth::synth_xc2v_with(&[path], &unit.top, &work, &options).unwrap();
+                println!(
+                    "{}: latency {} LUTs {} FFs {} MULT18X18 {} depth {} ({:.1} s)",
+                    unit.top,
+                    unit.latency,
+                    report.total_luts(),
+                    report.flip_flops,
+                    report.mult18x18,
+                    report.logic_depth,
+                    report.seconds
+                );
+                let expected_mults = match (op, fmt.man_bits) {
+                    (BinOp::Mul, 16) => 1,
+                    (BinOp::Mul, 23) => 4,
+                    _ => 0,
+                };
+                assert_eq!(report.mult18x18, expected_mults, "{}", unit.top);
+                assert!(report.flip_flops >= u64::from(unit.latency), "{}", unit.top);
+            }
+        }
+    }
 
     /// Not a check: writes every e7m16 and e8m23 unit to /tmp/dynrt_fp_rtl for inspection.
     #[test]
@@ -362,9 +484,8 @@ mod tests {
         let dir = std::path::Path::new("/tmp/dynrt_fp_rtl");
         std::fs::create_dir_all(dir).unwrap();
         for fmt in [Format::E7M16, Format::E8M23] {
-            for op in [BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Lt] {
-                let u = fp_unit_rtl(op, fmt).unwrap();
-                std::fs::write(dir.join(format!("{}.v", u.top)), &u.verilog).unwrap();
+            for op in ALL_OPS {
+                write_unit(dir, &fp_unit_rtl(op, fmt).unwrap());
             }
         }
     }
