@@ -190,7 +190,7 @@ fn compare_verilog<
 /// Renames rust-hdl's module `top` to `core_name`, its sub-modules `top$x$y` to
 /// `core_name__x__y`, and every `$` inside an identifier to `__` (system tasks such as
 /// `$signed` keep theirs). Field names never contain `__`, so no two names collide.
-fn rename_rust_hdl_names(verilog: &str, core_name: &str) -> String {
+pub(crate) fn rename_rust_hdl_names(verilog: &str, core_name: &str) -> String {
     let mut out = String::with_capacity(verilog.len() + verilog.len() / 8);
     let chars: Vec<char> = verilog.chars().collect();
     let is_ident = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '$';

@@ -2,6 +2,13 @@
 
 pub mod fp_unit;
 pub mod fp_unit_run;
+pub mod geometry_unit;
+pub mod stream_bench;
 
 pub use fp_unit::{fp_unit_rtl, fp_unit_testbench, fp_units_testbench, FpUnitRtl};
 pub use fp_unit_run::{run_fp_unit, run_fp_units, FpUnitRun};
+pub use geometry_unit::{geometry_unit_rtl, synth_unit, GeometryUnit, GeometryUnitRtl};
+pub use stream_bench::{
+    run_stream_bench, stream_bench_verilog, BenchPort, InputStream, OutputSink, StreamBench,
+    StreamBenchRun,
+};
