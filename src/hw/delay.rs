@@ -35,7 +35,10 @@ impl<D: Synth, const N: usize> Logic for Delay<D, N> {
         for i in 1..N {
             self.stage[i].d.next = self.stage[i - 1].q.val();
         }
-        self.data_out.next = self.stage[N - 1].q.val();
+        // The last write wins: the last stage (rust-hdl's Verilog cannot index with `N - 1`).
+        for i in 0..N {
+            self.data_out.next = self.stage[i].q.val();
+        }
     }
 }
 

@@ -129,9 +129,13 @@ impl<
         // Round robin: the first valid client after `last`, else the first valid client.
         self.any_after_before[0].next = false;
         self.any_valid_before[0].next = false;
-        for c in 0..4 {
+        // Client 0 never comes after another in this round.
+        self.after_last[0].next = false;
+        for c in 1..4 {
             self.after_last[c].next =
                 self.req_valid[c].val() & (self.c_client[c].val() > self.last.q.val());
+        }
+        for c in 0..4 {
             self.any_after_before[c + 1].next =
                 self.any_after_before[c].val() | self.after_last[c].val();
             self.any_valid_before[c + 1].next =
