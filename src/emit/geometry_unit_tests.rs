@@ -373,7 +373,11 @@ fn shared_case(f: Format, per_client: usize, seed: u64, sim: Simulator) {
     // Full load: the first 4 * (per_client / 2) results rotate over the clients, starting
     // after client 0 (the arbiter's reset state is "client 0 taken last").
     for (i, r) in got.iter().take(4 * (per_client / 2)).enumerate() {
-        assert_eq!(r.client as usize, (i + 1) % 4, "{sim}: round robin at result {i}");
+        assert_eq!(
+            r.client as usize,
+            (i + 1) % 4,
+            "{sim}: round robin at result {i}"
+        );
     }
     for c in 0..4 {
         let mine: Vec<&TransformResult> = got.iter().filter(|r| r.client as usize == c).collect();

@@ -239,3 +239,83 @@ impl<
         self.out_tag.next = self.tag_delay_rest.data_out.val();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hw::sim_harness::{clock_cycle, random_word};
+    use crate::model::units;
+    use rand::{Rng, SeedableRng};
+
+    /// rust-hdl simulation: 250 tests (random words, and rays aimed near the unit triangle so
+    /// that many hit), one per clock, at the documented latency, equal to the model.
+    #[test]
+    fn rust_hdl_simulation_matches_model_e7m16() {
+        let f = Format::E7M16;
+        let seed = 12;
+        println!("seed {seed}");
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let w = |x: f64| f.from_f64(x);
+        let reqs: Vec<([u32; 3], [u32; 3], u32, u32)> = (0..250)
+            .map(|i| {
+                if i % 4 == 0 {
+                    let mut r = || random_word(f, &mut rng);
+                    ([r(), r(), r()], [r(), r(), r()], r(), r())
+                } else {
+                    let oz = rng.gen_range(0.5..2.0);
+                    let (tx, ty) = (rng.gen_range(-0.3..1.2), rng.gen_range(-0.3..1.2));
+                    let (ox, oy) = (rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0));
+                    (
+                        [w(ox), w(oy), w(oz)],
+                        [w(tx - ox), w(ty - oy), w(-oz)],
+                        0,
+                        f.infinity(false),
+                    )
+                }
+            })
+            .collect();
+        let mut u = IntersectUnit::<24, 7, 16, 17, 18, 9, 21, 34, 20>::default();
+        u.connect_all();
+        let lat = intersect_latency(f) as usize;
+        let mut got = Vec::new();
+        for cycle in 0..reqs.len() + lat + 2 {
+            let req = reqs.get(cycle);
+            u.in_valid.next = req.is_some();
+            if let Some((o, d, t_min, t_max)) = req {
+                for k in 0..3 {
+                    u.o[k].next = (o[k] as u64).into();
+                    u.d[k].next = (d[k] as u64).into();
+                }
+                u.t_min.next = (*t_min as u64).into();
+                u.t_max.next = (*t_max as u64).into();
+                u.tag.next = (cycle as u64).into();
+            }
+            clock_cycle(&mut u, |u, c| u.clock.next = Clock { clk: c });
+            let expect_valid = cycle + 1 >= lat && cycle + 1 - lat < reqs.len();
+            assert_eq!(
+                u.out_valid.val(),
+                expect_valid,
+                "out_valid at clock {cycle}"
+            );
+            if u.out_valid.val() {
+                got.push((
+                    units::UnitHit {
+                        t: u.t.val().to_u64() as u32,
+                        u: u.u.val().to_u64() as u32,
+                        v: u.v.val().to_u64() as u32,
+                        hit: u.hit.val(),
+                    },
+                    u.out_tag.val().to_u64(),
+                ));
+            }
+        }
+        let mut hits = 0;
+        for (i, ((o, d, t_min, t_max), (r, tag))) in reqs.iter().zip(&got).enumerate() {
+            let want = units::intersect(f, *o, *d, *t_min, *t_max);
+            hits += usize::from(want.hit);
+            assert_eq!(*r, want, "test {i}");
+            assert_eq!(*tag, i as u64, "tag of test {i}");
+        }
+        assert!(hits > 25, "only {hits} hits: the vectors should hit often");
+    }
+}

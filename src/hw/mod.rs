@@ -12,6 +12,8 @@ pub mod geometry_formats;
 pub mod int_to_float;
 pub mod intersect;
 pub mod raygen;
+#[cfg(test)]
+mod sim_harness;
 pub mod transform;
 pub mod transform_arbiter;
 

@@ -255,3 +255,82 @@ impl<
         self.out_thread.next = self.unit.out_tag.val().get_bits::<THREAD_BITS>(0);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fp::Format;
+    use crate::hw::sim_harness::{clock_cycle, random_word};
+    use crate::model::units;
+    use rand::SeedableRng;
+
+    /// rust-hdl simulation: a 5x3 frame with a random camera, threads offered every clock but
+    /// the fourth: pixels issued in raster order to the offering thread, rays equal to the
+    /// model's primary directions with the eye as origin, `active` falling after the last pixel.
+    #[test]
+    fn rust_hdl_simulation_matches_model_e7m16() {
+        let f = Format::E7M16;
+        let seed = 14;
+        println!("seed {seed}");
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let camera: [u32; 12] = std::array::from_fn(|_| random_word(f, &mut rng));
+        let eye: [u32; 3] = std::array::from_fn(|_| random_word(f, &mut rng));
+        let (w, h) = (5u16, 3u16);
+        let mut u = RayGenUnit::<24, 7, 16, 17, 18, 9, 21, 34>::default();
+        u.connect_all();
+        u.width.next = (w as u64).into();
+        u.height.next = (h as u64).into();
+        for k in 0..12 {
+            u.camera[k].next = (camera[k] as u64).into();
+        }
+        for k in 0..3 {
+            u.eye[k].next = (eye[k] as u64).into();
+        }
+        let mut issued = Vec::new();
+        let mut rays = Vec::new();
+        let mut thread = 0u64;
+        for cycle in 0..80 {
+            u.start.next = cycle == 1;
+            u.thread_valid.next = cycle % 4 != 3;
+            u.thread_id.next = thread.into();
+            u.clock.next = Clock { clk: false };
+            crate::hw::sim_harness::settle(&mut u);
+            if u.issued_valid.val() {
+                assert!(u.thread_ready.val());
+                issued.push((
+                    u.issued_x.val().to_u64() as u32,
+                    u.issued_y.val().to_u64() as u32,
+                    u.issued_thread.val().to_u64(),
+                ));
+                thread = (thread + 1) % 32;
+            }
+            clock_cycle(&mut u, |u, c| u.clock.next = Clock { clk: c });
+            if u.out_valid.val() {
+                rays.push((
+                    u.out_thread.val().to_u64(),
+                    [0, 1, 2].map(|k| u.dir[k].val().to_u64() as u32),
+                    [0, 1, 2].map(|k| u.origin[k].val().to_u64() as u32),
+                ));
+            }
+        }
+        assert!(!u.active.val(), "the frame is done");
+        let pixels: Vec<(u32, u32)> = (0..h as u32)
+            .flat_map(|y| (0..w as u32).map(move |x| (x, y)))
+            .collect();
+        assert_eq!(issued.len(), pixels.len());
+        assert_eq!(rays.len(), pixels.len());
+        for (i, (&(x, y), (&(ix, iy, t), (rt, d, o)))) in
+            pixels.iter().zip(issued.iter().zip(&rays)).enumerate()
+        {
+            assert_eq!((ix, iy), (x, y), "pixel {i}");
+            assert_eq!(t, i as u64 % 32, "thread of pixel {i}");
+            assert_eq!(*rt, t, "ray {i} thread");
+            assert_eq!(
+                *d,
+                units::primary_direction(f, &camera, x, y),
+                "pixel ({x}, {y})"
+            );
+            assert_eq!(*o, eye, "origin of pixel {i}");
+        }
+    }
+}

@@ -197,3 +197,101 @@ impl<
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fp::Format;
+    use crate::hw::sim_harness::{clock_cycle, random_word};
+    use crate::hw::TRANSFORM_LATENCY;
+    use crate::model::units;
+    use rand::{Rng, SeedableRng};
+
+    /// rust-hdl simulation: every client requests all the time, some with pauses; each request
+    /// is taken exactly once, round robin under full load, and every result comes back to its
+    /// client and thread in order, equal to the model.
+    #[test]
+    fn arbitration_under_full_load() {
+        let f = Format::E7M16;
+        let seed = 13;
+        println!("seed {seed}");
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let per_client = 20;
+        type Req = ([u32; 12], [u32; 3], bool, u8);
+        let reqs: Vec<Vec<Req>> = (0..4)
+            .map(|c| {
+                (0..per_client)
+                    .map(|i| {
+                        (
+                            std::array::from_fn(|_| random_word(f, &mut rng)),
+                            std::array::from_fn(|_| random_word(f, &mut rng)),
+                            rng.gen_bool(0.5),
+                            (c * 50 + i) as u8,
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut u = SharedTransformUnit::<24, 7, 16, 17, 18, 9, 21, 34>::default();
+        u.connect_all();
+        let mut next = [0usize; 4];
+        let mut grants = Vec::new();
+        let mut results: Vec<Vec<([u32; 3], u8)>> = vec![Vec::new(); 4];
+        for cycle in 0..4 * per_client + TRANSFORM_LATENCY as usize + 40 {
+            for c in 0..4 {
+                // Client 3 pauses every third clock after the first 40.
+                let pause = c == 3 && cycle > 40 && cycle % 3 == 0;
+                let valid = next[c] < per_client && !pause;
+                u.req_valid[c].next = valid;
+                if let Some((m, v, point, thread)) = reqs[c].get(next[c]) {
+                    for k in 0..12 {
+                        u.req_m[c * 12 + k].next = (m[k] as u64).into();
+                    }
+                    for k in 0..3 {
+                        u.req_v[c * 3 + k].next = (v[k] as u64).into();
+                    }
+                    u.req_point[c].next = *point;
+                    u.req_thread[c].next = (*thread as u64).into();
+                }
+            }
+            // Settle with the clock low, read the grants of this clock, then clock.
+            u.clock.next = Clock { clk: false };
+            crate::hw::sim_harness::settle(&mut u);
+            let granted: Vec<usize> = (0..4).filter(|&c| u.req_ready[c].val()).collect();
+            assert!(granted.len() <= 1, "clock {cycle}: two grants {granted:?}");
+            for &c in &granted {
+                assert!(u.req_valid[c].val(), "clock {cycle}: grant without request");
+                next[c] += 1;
+                grants.push(c);
+            }
+            let any_valid = (0..4).any(|c| u.req_valid[c].val());
+            assert_eq!(
+                granted.len(),
+                usize::from(any_valid),
+                "clock {cycle}: idle arbiter"
+            );
+            clock_cycle(&mut u, |u, c| u.clock.next = Clock { clk: c });
+            if u.out_valid.val() {
+                let c = u.out_client.val().to_u64() as usize;
+                let r = [0, 1, 2].map(|k| u.result[k].val().to_u64() as u32);
+                results[c].push((r, u.out_thread.val().to_u64() as u8));
+            }
+        }
+        // Full load for the first 40 clocks: 1, 2, 3, 0, 1, ...
+        for (i, &c) in grants.iter().take(40).enumerate() {
+            assert_eq!(c, (i + 1) % 4, "grant {i}");
+        }
+        for c in 0..4 {
+            assert_eq!(results[c].len(), per_client, "client {c}: result count");
+            for (i, ((m, v, point, thread), (r, t))) in reqs[c].iter().zip(&results[c]).enumerate()
+            {
+                assert_eq!(
+                    *r,
+                    units::transform(f, m, *v, *point),
+                    "client {c} request {i}"
+                );
+                assert_eq!(t, thread, "client {c} request {i}: thread");
+            }
+        }
+    }
+}
