@@ -804,3 +804,22 @@ fn yosys_xc2v_synthesis_e7m16() {
 fn yosys_xc2v_synthesis_e8m23() {
     synthesize(Format::E8M23);
 }
+
+/// The arbiter's cost: the shared unit against the bare transform unit (same 9 products).
+#[test]
+#[ignore = "yosys takes a few minutes; run with --ignored for the figures"]
+fn yosys_xc2v_synthesis_shared_transform_e7m16() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = Format::E7M16;
+    let r = synth_unit(GeometryUnit::SharedTransform, f, dir.path()).unwrap();
+    println!(
+        "SYNTH shared_transform {f}: LUTs {} FFs {} MULT18X18 {} RAMB16 {} depth {} ({:.0} s)",
+        r.total_luts(),
+        r.flip_flops,
+        r.mult18x18,
+        r.block_rams,
+        r.logic_depth,
+        r.seconds
+    );
+    assert_eq!(r.mult18x18, 9);
+}

@@ -20,6 +20,12 @@
 //! `active` falls. No clock of its own: requests are combinational from the counter registers
 //! (the transform unit registers its inputs).
 //!
+//! [`RayGenUnit`] measured (yosys xc2v, out of context): e7m16 4708 LUTs, 3522 FFs,
+//! 6 MULT18X18, depth 15; e8m23 6784 LUTs, 4574 FFs, 24 MULT18X18. Six, not nine, products:
+//! the point's z is the constant 0, so yosys turns the three `m[r][2] * z` significand products
+//! into shifts (the exponent and NaN/infinity logic stay: `inf * 0` is still NaN). In the full
+//! design RayGen uses the shared unit and adds no multiplier.
+//!
 //! [`RayGenUnit`]: latency [`TRANSFORM_LATENCY`] (15) from the issue clock to `out_valid` with
 //! `out_thread`, `dir` and `origin` (the eye), one primary ray per clock.
 

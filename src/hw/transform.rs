@@ -9,7 +9,9 @@
 //!
 //! Resources (paper Table 2, transformation: 9 mul, 9 add): 9 [`FpMul`], 9 [`FpAddSub`], no
 //! divider. With `e7m16` each multiplier is one MULT18X18 (9 in all); with `e8m23` a 24x24
-//! significand product takes four (36).
+//! significand product takes four (36). Measured (`yosys synth_xilinx -family xc2v`, out of
+//! context, `emit::synth_unit`): e7m16 4712 LUTs, 3693 FFs, 9 MULT18X18, 0 BRAM, depth 15
+//! LUT levels; e8m23 7074 LUTs, 4788 FFs, 36 MULT18X18, 0 BRAM, depth 16.
 //!
 //! Latency [`TRANSFORM_LATENCY`] = mul (3) + 3 adds (4 each) = 15 clocks for every format, one
 //! transform per clock. `tag` (client and thread id, [`TAG_BITS`]) travels with the data and
