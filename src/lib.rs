@@ -8,7 +8,9 @@
 //! never imports `model` (they meet in tests).
 
 pub mod accel;
+pub mod bench;
 pub mod compare;
+pub mod demo;
 pub mod emit;
 pub mod fp;
 pub mod hw;

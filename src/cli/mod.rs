@@ -1,7 +1,10 @@
 //! Argument parsing (clap) and dispatch of the `dynrt` verbs. Errors are printed as one clear
 //! message (with its causes) and give a non-zero exit status.
 
+mod bench_cmd;
 mod compare_cmd;
+mod demo_cmd;
+mod emit_fp_cmd;
 mod fp_cmd;
 mod render_cmd;
 
@@ -20,10 +23,16 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job on a scene: golden vs reference, FP operators simulated and checked; report.
+    Demo(demo_cmd::DemoArgs),
     /// Render one frame with the golden model (eXmY) or the f64 reference.
     Render(render_cmd::RenderArgs),
     /// Error metrics between two images (and hits files); writes a diff image.
     Compare(compare_cmd::CompareArgs),
+    /// Measure speed, area and error; CSV and Markdown reports under --out.
+    Bench(bench_cmd::BenchArgs),
+    /// Write the Verilog and testbenches of every FP operator of a format.
+    EmitFp(emit_fp_cmd::EmitFpArgs),
     /// Run operand vectors through one floating-point operator (RTL or software model).
     Fp(fp_cmd::FpArgs),
 }
@@ -35,6 +44,9 @@ pub fn run() -> i32 {
         Command::Render(a) => render_cmd::run(a),
         Command::Compare(a) => compare_cmd::run(a),
         Command::Fp(a) => fp_cmd::run(a),
+        Command::Bench(a) => bench_cmd::run(a),
+        Command::Demo(a) => demo_cmd::run(a),
+        Command::EmitFp(a) => emit_fp_cmd::run(a),
     };
     match result {
         Ok(code) => code,

@@ -68,14 +68,39 @@ pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
             scene.frames
         );
     }
-    let start = Instant::now();
+    let mut start = Instant::now();
     let frame = match a.model {
         ModelKind::Golden => {
             let trees = SceneTrees::build(&scene, a.format)?;
+            if trees.dropped_count() > 0 {
+                eprintln!(
+                    "warning: {} triangle(s) dropped: their unit-triangle transforms overflow {}",
+                    trees.dropped_count(),
+                    a.format
+                );
+            }
             let layout = layout::build(&scene, &trees, a.frame, &MemoryConfig::default())?;
+            let sizes: Vec<String> = layout
+                .used_words()
+                .iter()
+                .zip(layout::BANK_NAMES)
+                .map(|(w, n)| format!("{n} {:.1} KiB", *w as f64 * 4.0 / 1024.0))
+                .collect();
+            eprintln!(
+                "layout {:.1} KiB: {}",
+                layout.total_bytes() as f64 / 1024.0,
+                sizes.join(", ")
+            );
+            eprintln!("trees and layout {:.3} s", start.elapsed().as_secs_f64());
+            start = Instant::now();
             model::render_golden(&layout, true)
         }
-        ModelKind::Reference => Reference::new(&scene).render(a.frame),
+        ModelKind::Reference => {
+            let reference = Reference::new(&scene);
+            eprintln!("trees {:.3} s", start.elapsed().as_secs_f64());
+            start = Instant::now();
+            reference.render_with_progress(a.frame, true)
+        }
     };
     let secs = start.elapsed().as_secs_f64();
     frame
@@ -89,7 +114,7 @@ pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
     let pixels = u64::from(frame.width) * u64::from(frame.height);
     let hits = frame.hits.iter().filter(|h| h.is_some()).count();
     println!(
-        "{} {}x{} frame {} ({}): {} of {} primary rays hit, {:.3} s, {:.3} M primary rays/s -> {}",
+        "{} {}x{} frame {} ({}): {} of {} primary rays hit, frame {:.3} s, {:.3} M primary rays/s -> {}",
         match a.model {
             ModelKind::Golden => "golden",
             ModelKind::Reference => "reference",

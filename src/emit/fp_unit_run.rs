@@ -253,4 +253,26 @@ mod tests {
             }
         }
     }
+
+    /// Not a check (prints figures): Verilator and Icarus build and run time per operator.
+    #[test]
+    #[ignore]
+    fn measure_build_and_run_time_per_unit() {
+        for fmt in [Format::E7M16, Format::E8M23] {
+            let v = vectors::random_pairs(fmt, 9, 100_000);
+            for op in [BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Lt] {
+                for simulator in Simulator::ALL {
+                    let dir = tempfile::tempdir().unwrap();
+                    let run = run_fp_unit(op, fmt, &v, simulator, dir.path()).unwrap();
+                    println!(
+                        "{simulator} {} {fmt}: compile {:.1} s, run {} vectors {:.1} s",
+                        op.name(),
+                        run.compile_seconds,
+                        v.len(),
+                        run.run_seconds
+                    );
+                }
+            }
+        }
+    }
 }

@@ -25,8 +25,8 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use rust_hdl::prelude::*;
 
-use super::fp_unit::rename_rust_hdl_names;
 use super::stream_bench::BenchPort;
+use super::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
 use crate::dispatch_geometry_format;
 use crate::fp::Format;
 use crate::hw::transform_arbiter::THREAD_BITS;
@@ -318,7 +318,7 @@ pub fn geometry_unit_rtl(unit: GeometryUnit, fmt: Format) -> Result<GeometryUnit
         GeometryUnit::Intersect => dispatch_geometry_format!(fmt, intersect_core())?,
         GeometryUnit::RayGen => dispatch_geometry_format!(fmt, raygen_core())?,
     };
-    let core = rename_rust_hdl_names(&core, &core_name);
+    let core = merge_identical_modules(&rename_rust_hdl_names(&core, &core_name));
     let latency = match unit {
         GeometryUnit::Intersect => intersect_latency(fmt),
         _ => TRANSFORM_LATENCY,

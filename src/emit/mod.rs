@@ -7,6 +7,7 @@ pub mod geometry_unit_run;
 #[cfg(test)]
 mod geometry_unit_tests;
 pub mod stream_bench;
+pub mod verilog_tidy;
 
 pub use fp_unit::{fp_unit_rtl, fp_unit_testbench, fp_units_testbench, FpUnitRtl};
 pub use fp_unit_run::{run_fp_unit, run_fp_units, FpUnitRun};

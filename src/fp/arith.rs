@@ -38,18 +38,19 @@ impl Format {
                 if gap >= self.man_bits + 3 {
                     // The smaller operand lies wholly below the rounding position of the larger
                     // one shifted left by 2: it only decides the sticky bit.
-                    let big = u128::from(ma) << 2;
+                    let big = ma << 2;
                     let sig = if subtract { big - 1 } else { big };
-                    self.round_pack(sa, sig, ea - self.man_bits as i32 - 2, true)
+                    self.round_pack64(sa, sig, ea - self.man_bits as i32 - 2, true)
                 } else {
-                    let big = u128::from(ma) << gap;
-                    let small = u128::from(mb);
+                    // gap <= man_bits + 2, so the aligned sum fits 2 * 24 + 3 bits.
+                    let big = ma << gap;
+                    let small = mb;
                     if subtract && big == small {
                         self.zero(false) // x - x is +0 when rounding to nearest
                     } else if subtract {
-                        self.round_pack(sa, big - small, low_exp, false)
+                        self.round_pack64(sa, big - small, low_exp, false)
                     } else {
-                        self.round_pack(sa, big + small, low_exp, false)
+                        self.round_pack64(sa, big + small, low_exp, false)
                     }
                 }
             }
@@ -75,12 +76,7 @@ impl Format {
                 Normal {
                     exp: eb, sig: mb, ..
                 },
-            ) => self.round_pack(
-                sign,
-                u128::from(ma * mb),
-                ea + eb - 2 * self.man_bits as i32,
-                false,
-            ),
+            ) => self.round_pack64(sign, ma * mb, ea + eb - 2 * self.man_bits as i32, false),
         }
     }
 
@@ -103,9 +99,9 @@ impl Format {
                 // ma / mb lies in (1/2, 2); M+3 extra quotient bits leave at least M+2 bits
                 // above the remainder, as round_pack's sticky contract needs.
                 let extra = self.man_bits + 3;
-                let num = u128::from(ma) << extra;
-                let den = u128::from(mb);
-                self.round_pack(sign, num / den, ea - eb - extra as i32, num % den != 0)
+                let num = ma << extra; // at most 24 + 26 bits
+                let den = mb;
+                self.round_pack64(sign, num / den, ea - eb - extra as i32, num % den != 0)
             }
         }
     }

@@ -14,13 +14,14 @@
 //! Measured (`yosys synth_xilinx -family xc2v`, out of context): e7m16 2713 LUTs, 5967 FFs,
 //! 2 MULT18X18, 0 BRAM, depth 15; e8m23 4377 LUTs, 9720 FFs, 8 MULT18X18 (two 24x24 products),
 //! depth 15. Most flip-flops are delay lines (O'x, O'y, D'x, D'y, t_min, t_max and the tag wait
-//! out the divider's `M + 4` clocks); yosys 0.23 does not map them to SRL16s.
+//! out the divider's `M + 5` clocks); yosys 0.23 does not map them to SRL16s.
 //!
-//! Latency [`intersect_latency`] = div (`M + 4`) + mul (3) + add (4) + add (4) + compare (2):
-//! 33 clocks for e7m16, 40 for e8m23; one test per clock. `tag` travels with the data.
+//! Latency [`intersect_latency`] = div (`M + 5`) + mul (4) + add (7) + add (7) + compare (2):
+//! 41 clocks for e7m16, 48 for e8m23; one test per clock. `tag` travels with the data.
 //!
-//! Timeline (clock offsets from the input): t at `DL`; the two products at `DL + 3`; u and v at
-//! `DL + 7`; u + v at `DL + 11`; every comparison result at `DL + 13`, the output. The
+//! Timeline (clock offsets from the input, with the operators' latencies `Lm`, `La`, `Lc`): t
+//! at `DL`; the two products at `DL + Lm`; u and v at `DL + Lm + La`; u + v at
+//! `DL + Lm + 2 La`; every comparison result at `DL + Lm + 2 La + Lc`, the output. The
 //! comparisons on t and u, v start as soon as their operands exist and wait in 1-bit delay
 //! lines.
 //!

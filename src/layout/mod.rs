@@ -48,8 +48,8 @@ pub const FRAME: usize = 5;
 pub const BANK_NAMES: [&str; 6] = [
     "nodes",
     "lists",
-    "triangles",
-    "shading",
+    "triangles_uv",
+    "triangles_t",
     "instances",
     "frame",
 ];

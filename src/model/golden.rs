@@ -345,7 +345,14 @@ impl<'a> Golden<'a> {
         leaf: &mut dyn FnMut(&Self, u32, u32, &mut Option<Hit>, &mut RayStats) -> bool,
     ) -> bool {
         let f = self.f;
-        let mut stack: Vec<(u32, u32, u32)> = Vec::with_capacity(32);
+        // The hardware's stack holds one entry per tree level: a ray pushes at most once per
+        // inner node on its way down, so the deepest tree bounds it.
+        let capacity = self
+            .layout
+            .info
+            .object_depth
+            .max(self.layout.info.top_depth) as usize;
+        let mut stack: Vec<(u32, u32, u32)> = Vec::with_capacity(capacity);
         let (mut node, mut lo, mut hi) = (root, q.t_min, best.map_or(q.t_max, |b| b.t));
         loop {
             match self.layout.node(node) {
@@ -362,6 +369,10 @@ impl<'a> Golden<'a> {
                         Visit::Near => node = near,
                         Visit::Far => node = far,
                         Visit::Both { t_split } => {
+                            assert!(
+                                stack.len() < capacity,
+                                "traversal stack overflow: the layout's depth is wrong"
+                            );
                             stack.push((far, t_split, hi));
                             node = near;
                             hi = t_split;

@@ -95,6 +95,22 @@ impl Frame {
     }
 }
 
+/// A progress bar over `rows` rows, hidden unless `show`.
+pub(crate) fn progress_bar(show: bool, rows: u32, what: &str) -> ProgressBar {
+    let bar = if show {
+        ProgressBar::new(u64::from(rows))
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template(&format!(
+            "{what} {{bar:40}} {{pos}}/{{len}} rows {{elapsed}}"
+        ))
+        .expect("valid template"),
+    );
+    bar
+}
+
 /// Renders a frame with the golden model, in parallel, with a progress bar when `progress`.
 pub fn render_golden(layout: &Layout, progress: bool) -> Frame {
     let golden = Golden::new(layout);

@@ -47,6 +47,11 @@ impl<'a> Reference<'a> {
 
     /// Renders one frame at the scene camera's resolution.
     pub fn render(&self, frame: u32) -> Frame {
+        self.render_with_progress(frame, false)
+    }
+
+    /// [`Reference::render`] with a progress bar (rows) when `progress`.
+    pub fn render_with_progress(&self, frame: u32, progress: bool) -> Frame {
         let s = self.scene;
         let to_world: Vec<DAffine3> = s
             .instances
@@ -73,10 +78,14 @@ impl<'a> Reference<'a> {
             t_eps: 1e-6 * (extent.max - extent.min).max_element().max(1.0),
         };
         let (w, h) = (s.camera.width, s.camera.height);
+        let bar = super::progress_bar(progress, h, "reference");
         let pixels: Vec<(u32, Option<HitRecord>)> = (0..w * h)
             .into_par_iter()
             .map(|i| {
                 let (x, y) = (i % w, i / w);
+                if x + 1 == w {
+                    bar.inc(1);
+                }
                 let (o, d) = s.camera.primary_ray(x, y);
                 let (c, hit) = self.shade(&geo, o, d, 0.0, None, 0);
                 let rec = hit.map(|hh| HitRecord {
@@ -87,6 +96,7 @@ impl<'a> Reference<'a> {
                 (pack(c), rec)
             })
             .collect();
+        bar.finish_and_clear();
         Frame::from_pixels(w, h, pixels)
     }
 

@@ -338,11 +338,11 @@ mod tests {
 
     #[test]
     fn unwritable_directory_is_an_error_naming_the_path() {
-        let out = Path::new("/nonexistent-dir-dynrt/out.hex");
-        let e = write_results_atomically(out, &[1], 6).unwrap_err();
-        assert!(
-            e.to_string().contains("/nonexistent-dir-dynrt/out.hex"),
-            "{e}"
-        );
+        // A directory cannot be created below a regular file, even by root.
+        let dir = tempfile::tempdir().unwrap();
+        let file = write(dir.path(), "plain", "x");
+        let out = file.join("out.hex");
+        let e = write_results_atomically(&out, &[1], 6).unwrap_err();
+        assert!(e.to_string().contains(&out.display().to_string()), "{e}");
     }
 }

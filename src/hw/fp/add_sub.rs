@@ -1,15 +1,17 @@
 //! `FpAddSub`: pipelined `eXmY` adder/subtracter (`sub` input: 0 adds, 1 subtracts b), exactly
 //! rounded (nearest even), equal to `dynrt::fp::Format::add` / `sub` bit for bit.
 //!
-//! Latency 4 clocks, throughput one operation per clock:
+//! Latency 7 clocks, throughput one operation per clock:
 //! 1. input registers;
 //! 2. unpack (DAZ), special cases, magnitude compare and swap so that |big| >= |small|,
 //!    exponent difference; registered;
 //! 3. align the small significand (guard, round and sticky bits below it) and add or subtract;
 //!    registered;
-//! 4. normalize with a 5-level leading-zero shifter, round to nearest even on `S` bits with an
-//!    unbounded exponent, overflow to infinity / flush below the smallest normal to a signed
-//!    zero, pack; registered.
+//! 4. normalize with a 5-level leading-zero shifter: shifts by 16 and 8; registered;
+//! 5. shifts by 4, 2 and 1; registered;
+//! 6. round to nearest even on `S` bits with an unbounded exponent; registered;
+//! 7. overflow to infinity / flush below the smallest normal to a signed zero, pack;
+//!    registered.
 //!
 //! An exactly zero sum is +0 unless both operands are negative zeros (x - x = +0,
 //! (-0) + (-0) = -0), as IEEE prescribes for round to nearest.
@@ -24,7 +26,7 @@ use rust_hdl::prelude::*;
 use super::{const_bits, const_index, inf_word, qnan_word};
 
 /// Latency of [`FpAddSub`] in clocks.
-pub const ADD_SUB_LATENCY: u32 = 4;
+pub const ADD_SUB_LATENCY: u32 = 7;
 
 #[derive(LogicBlock)]
 pub struct FpAddSub<
@@ -93,7 +95,7 @@ pub struct FpAddSub<
     inf_sign3: DFF<Bit>,
     zero_sign3: DFF<Bit>,
     valid3: DFF<Bit>,
-    // Normalize, round, pack (combinational).
+    // Normalize (combinational).
     norm16: Signal<Local, Bits<T>>,
     norm8: Signal<Local, Bits<T>>,
     norm4: Signal<Local, Bits<T>>,
@@ -104,6 +106,7 @@ pub struct FpAddSub<
     lz4: Signal<Local, Bits<X2>>,
     lz2: Signal<Local, Bits<X2>>,
     lz1: Signal<Local, Bits<X2>>,
+    // Round, pack (combinational, after stage 4).
     sig: Signal<Local, Bits<S>>,
     round_bit: Signal<Local, Bit>,
     sticky: Signal<Local, Bit>,
@@ -115,7 +118,39 @@ pub struct FpAddSub<
     zero_word: Signal<Local, Bits<W>>,
     inf_sign_word: Signal<Local, Bits<W>>,
     packed_word: Signal<Local, Bits<W>>,
-    // Stage 4: output registers.
+    // Stage 4 registers.
+    mid_norm: DFF<Bits<T>>,
+    mid_lz: DFF<Bits<X2>>,
+    mid_exp: DFF<Bits<E>>,
+    mid_sign: DFF<Bit>,
+    mid_nan: DFF<Bit>,
+    mid_inf: DFF<Bit>,
+    mid_inf_sign: DFF<Bit>,
+    mid_zero_sign: DFF<Bit>,
+    mid_is_zero: DFF<Bit>,
+    mid_valid: DFF<Bit>,
+    // Stage 5 registers.
+    norm: DFF<Bits<T>>,
+    lz: DFF<Bits<X2>>,
+    exp4: DFF<Bits<E>>,
+    sign4: DFF<Bit>,
+    nan4: DFF<Bit>,
+    inf4: DFF<Bit>,
+    inf_sign4: DFF<Bit>,
+    zero_sign4: DFF<Bit>,
+    is_zero4: DFF<Bit>,
+    valid4: DFF<Bit>,
+    // Stage 6: rounded result registers.
+    rnd_sig: DFF<Bits<S1>>,
+    rnd_exp: DFF<Bits<X2>>,
+    rnd_sign: DFF<Bit>,
+    rnd_zero_sign: DFF<Bit>,
+    rnd_inf_sign: DFF<Bit>,
+    rnd_nan: DFF<Bit>,
+    rnd_inf: DFF<Bit>,
+    rnd_is_zero: DFF<Bit>,
+    rnd_valid: DFF<Bit>,
+    // Stage 7: output registers.
     out_result: DFF<Bits<W>>,
     out_valid_r: DFF<Bit>,
     // Format constants.
@@ -240,6 +275,35 @@ impl<
             zero_word: Default::default(),
             inf_sign_word: Default::default(),
             packed_word: Default::default(),
+            mid_norm: Default::default(),
+            mid_lz: Default::default(),
+            mid_exp: Default::default(),
+            mid_sign: Default::default(),
+            mid_nan: Default::default(),
+            mid_inf: Default::default(),
+            mid_inf_sign: Default::default(),
+            mid_zero_sign: Default::default(),
+            mid_is_zero: Default::default(),
+            mid_valid: Default::default(),
+            norm: Default::default(),
+            lz: Default::default(),
+            exp4: Default::default(),
+            sign4: Default::default(),
+            nan4: Default::default(),
+            inf4: Default::default(),
+            inf_sign4: Default::default(),
+            zero_sign4: Default::default(),
+            is_zero4: Default::default(),
+            valid4: Default::default(),
+            rnd_sig: Default::default(),
+            rnd_exp: Default::default(),
+            rnd_sign: Default::default(),
+            rnd_zero_sign: Default::default(),
+            rnd_inf_sign: Default::default(),
+            rnd_nan: Default::default(),
+            rnd_inf: Default::default(),
+            rnd_is_zero: Default::default(),
+            rnd_valid: Default::default(),
             out_result: Default::default(),
             out_valid_r: Default::default(),
             c_man_bits: const_index(M),
@@ -303,6 +367,35 @@ impl<
             inf_sign3,
             zero_sign3,
             valid3,
+            mid_norm,
+            mid_lz,
+            mid_exp,
+            mid_sign,
+            mid_nan,
+            mid_inf,
+            mid_inf_sign,
+            mid_zero_sign,
+            mid_is_zero,
+            mid_valid,
+            norm,
+            lz,
+            exp4,
+            sign4,
+            nan4,
+            inf4,
+            inf_sign4,
+            zero_sign4,
+            is_zero4,
+            valid4,
+            rnd_sig,
+            rnd_exp,
+            rnd_sign,
+            rnd_zero_sign,
+            rnd_inf_sign,
+            rnd_nan,
+            rnd_inf,
+            rnd_is_zero,
+            rnd_valid,
             out_result,
             out_valid_r
         );
@@ -416,11 +509,23 @@ impl<
             self.norm8.next = self.norm16.val() << 8;
             self.lz8.next = self.lz16.val() + 8;
         }
-        self.norm4.next = self.norm8.val();
-        self.lz4.next = self.lz8.val();
-        if (self.norm8.val() & self.c_top4.val()) == 0 {
-            self.norm4.next = self.norm8.val() << 4;
-            self.lz4.next = self.lz8.val() + 4;
+        // Stage 4: half-way through normalization (shifts by 16 and 8 done).
+        self.mid_norm.d.next = self.norm8.val();
+        self.mid_lz.d.next = self.lz8.val();
+        self.mid_exp.d.next = self.sum_exp.q.val();
+        self.mid_sign.d.next = self.sum_sign.q.val();
+        self.mid_nan.d.next = self.nan3.q.val();
+        self.mid_inf.d.next = self.inf3.q.val();
+        self.mid_inf_sign.d.next = self.inf_sign3.q.val();
+        self.mid_zero_sign.d.next = self.zero_sign3.q.val();
+        self.mid_is_zero.d.next = self.sum.q.val() == 0;
+        self.mid_valid.d.next = self.valid3.q.val();
+
+        self.norm4.next = self.mid_norm.q.val();
+        self.lz4.next = self.mid_lz.q.val();
+        if (self.mid_norm.q.val() & self.c_top4.val()) == 0 {
+            self.norm4.next = self.mid_norm.q.val() << 4;
+            self.lz4.next = self.mid_lz.q.val() + 4;
         }
         self.norm2.next = self.norm4.val();
         self.lz2.next = self.lz4.val();
@@ -434,53 +539,77 @@ impl<
             self.norm1.next = self.norm2.val() << 1;
             self.lz1.next = self.lz2.val() + 1;
         }
+        // Stage 5.
+        self.norm.d.next = self.norm1.val();
+        self.lz.d.next = self.lz1.val();
+        self.exp4.d.next = self.mid_exp.q.val();
+        self.sign4.d.next = self.mid_sign.q.val();
+        self.nan4.d.next = self.mid_nan.q.val();
+        self.inf4.d.next = self.mid_inf.q.val();
+        self.inf_sign4.d.next = self.mid_inf_sign.q.val();
+        self.zero_sign4.d.next = self.mid_zero_sign.q.val();
+        self.is_zero4.d.next = self.mid_is_zero.q.val();
+        self.valid4.d.next = self.mid_valid.q.val();
+
         // Round: the top S bits are the significand, then round bit, then sticky bits.
-        self.sig.next = self.norm1.val().get_bits::<S>(4);
-        self.round_bit.next = self.norm1.val().get_bit(3);
-        self.sticky.next = (self.norm1.val() & self.c_sticky_mask.val()).any();
+        self.sig.next = self.norm.q.val().get_bits::<S>(4);
+        self.round_bit.next = self.norm.q.val().get_bit(3);
+        self.sticky.next = (self.norm.q.val() & self.c_sticky_mask.val()).any();
         self.round_up.next = self.round_bit.val() & (self.sticky.val() | self.sig.val().get_bit(0));
         self.sig_rounded.next = bit_cast::<S1, S>(self.sig.val()) + self.round_up.val();
         // The top bit of the sum weighs 2^(big_exp + 1).
-        self.exp_final.next = ((bit_cast::<X2, E>(self.sum_exp.q.val()) + 1) - self.lz1.val())
+        self.exp_final.next = ((bit_cast::<X2, E>(self.exp4.q.val()) + 1) - self.lz.q.val())
             + self
                 .sig_rounded
                 .val()
                 .get_bit(self.c_carry_pos.val().index());
+        // Registered: the rounded significand and exponent (splits the logic depth).
+        self.rnd_sig.d.next = self.sig_rounded.val();
+        self.rnd_exp.d.next = self.exp_final.val();
+        self.rnd_sign.d.next = self.sign4.q.val();
+        self.rnd_zero_sign.d.next = self.zero_sign4.q.val();
+        self.rnd_inf_sign.d.next = self.inf_sign4.q.val();
+        self.rnd_nan.d.next = self.nan4.q.val();
+        self.rnd_inf.d.next = self.inf4.q.val();
+        self.rnd_is_zero.d.next = self.is_zero4.q.val();
+        self.rnd_valid.d.next = self.valid4.q.val();
+
         self.exp_negative.next = self
-            .exp_final
+            .rnd_exp
+            .q
             .val()
             .get_bit(self.c_exp_sign_pos.val().index());
         self.sign_word.next = 0.into();
-        if self.sum_sign.q.val() {
+        if self.rnd_sign.q.val() {
             self.sign_word.next = self.c_sign_bit.val();
         }
         self.zero_word.next = 0.into();
-        if self.zero_sign3.q.val() {
+        if self.rnd_zero_sign.q.val() {
             self.zero_word.next = self.c_sign_bit.val();
         }
         self.inf_sign_word.next = self.c_inf.val();
-        if self.inf_sign3.q.val() {
+        if self.rnd_inf_sign.q.val() {
             self.inf_sign_word.next = self.c_inf.val() | self.c_sign_bit.val();
         }
-        self.packed_word.next = (bit_cast::<W, E>(self.exp_final.val().get_bits::<E>(0))
+        self.packed_word.next = (bit_cast::<W, E>(self.rnd_exp.q.val().get_bits::<E>(0))
             << self.c_man_bits.val())
-            | bit_cast::<W, M>(self.sig_rounded.val().get_bits::<M>(0));
+            | bit_cast::<W, M>(self.rnd_sig.q.val().get_bits::<M>(0));
 
-        // Stage 4.
-        if self.nan3.q.val() {
+        // Stage 7.
+        if self.rnd_nan.q.val() {
             self.out_result.d.next = self.c_qnan.val();
-        } else if self.inf3.q.val() {
+        } else if self.rnd_inf.q.val() {
             self.out_result.d.next = self.inf_sign_word.val();
-        } else if self.sum.q.val() == 0 {
+        } else if self.rnd_is_zero.q.val() {
             self.out_result.d.next = self.zero_word.val();
-        } else if (!self.exp_negative.val()) & (self.exp_final.val() >= self.c_exp_max.val()) {
+        } else if (!self.exp_negative.val()) & (self.rnd_exp.q.val() >= self.c_exp_max.val()) {
             self.out_result.d.next = self.c_inf.val() | self.sign_word.val();
-        } else if self.exp_negative.val() | (self.exp_final.val() == 0) {
+        } else if self.exp_negative.val() | (self.rnd_exp.q.val() == 0) {
             self.out_result.d.next = self.sign_word.val();
         } else {
             self.out_result.d.next = self.packed_word.val() | self.sign_word.val();
         }
-        self.out_valid_r.d.next = self.valid3.q.val();
+        self.out_valid_r.d.next = self.rnd_valid.q.val();
         self.result.next = self.out_result.q.val();
         self.out_valid.next = self.out_valid_r.q.val();
     }

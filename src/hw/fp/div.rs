@@ -6,12 +6,13 @@
 //! and its first bit is always 1. `S + 1` quotient bits give the significand and the round bit;
 //! the final partial remainder being nonzero is the sticky bit, so the rounding is exact.
 //!
-//! Latency `S + 3` clocks (e7m16: 20, e8m23: 27), throughput one quotient per clock:
+//! Latency `S + 4` clocks (e7m16: 21, e8m23: 28), throughput one quotient per clock:
 //! 1. input registers;
 //! 2. unpack, special cases, exponent difference and the first quotient bit; registered;
 //! 3. .. `S + 2`: the remaining `S` quotient bits, one per stage;
-//! `S + 3`. round, overflow to infinity / flush below the smallest normal to a signed zero,
-//!    pack; registered.
+//! `S + 3`. round to nearest even; registered;
+//! `S + 4`. overflow to infinity / flush below the smallest normal to a signed zero, pack;
+//!    registered.
 //!
 //! Special cases (IEEE): 0/0 and inf/inf are NaN, finite nonzero / 0 is a signed infinity,
 //! x/inf is a signed zero; the sign is the xor of the operand signs.
@@ -26,7 +27,7 @@ use super::{bias, const_bits, const_index, inf_word, qnan_word};
 
 /// Latency of [`FpDiv`] in clocks for a format with `man_bits` stored mantissa bits.
 pub const fn div_latency(man_bits: u32) -> u32 {
-    man_bits + 4
+    man_bits + 5
 }
 
 #[derive(LogicBlock)]
@@ -88,6 +89,14 @@ pub struct FpDiv<
     exp_negative: Signal<Local, Bit>,
     sign_word: Signal<Local, Bits<W>>,
     packed_word: Signal<Local, Bits<W>>,
+    // Stage S + 3: rounded result registers.
+    rnd_sig: DFF<Bits<S1>>,
+    rnd_exp: DFF<Bits<X2>>,
+    rnd_sign: DFF<Bit>,
+    rnd_nan: DFF<Bit>,
+    rnd_inf: DFF<Bit>,
+    rnd_zero: DFF<Bit>,
+    rnd_valid: DFF<Bit>,
     // Output registers.
     out_result: DFF<Bits<W>>,
     out_valid_r: DFF<Bit>,
@@ -163,6 +172,13 @@ impl<
             exp_negative: Default::default(),
             sign_word: Default::default(),
             packed_word: Default::default(),
+            rnd_sig: Default::default(),
+            rnd_exp: Default::default(),
+            rnd_sign: Default::default(),
+            rnd_nan: Default::default(),
+            rnd_inf: Default::default(),
+            rnd_zero: Default::default(),
+            rnd_valid: Default::default(),
             out_result: Default::default(),
             out_valid_r: Default::default(),
             c_man_bits: const_index(M),
@@ -206,6 +222,13 @@ impl<
             last_inf,
             last_zero,
             last_valid,
+            rnd_sig,
+            rnd_exp,
+            rnd_sign,
+            rnd_nan,
+            rnd_inf,
+            rnd_zero,
+            rnd_valid,
             out_result,
             out_valid_r
         );
@@ -318,31 +341,41 @@ impl<
                 .sig_rounded
                 .val()
                 .get_bit(self.c_carry_pos.val().index());
+        // Registered: the rounded significand and exponent (splits the logic depth).
+        self.rnd_sig.d.next = self.sig_rounded.val();
+        self.rnd_exp.d.next = self.exp_final.val();
+        self.rnd_sign.d.next = self.last_sign.q.val();
+        self.rnd_nan.d.next = self.last_nan.q.val();
+        self.rnd_inf.d.next = self.last_inf.q.val();
+        self.rnd_zero.d.next = self.last_zero.q.val();
+        self.rnd_valid.d.next = self.last_valid.q.val();
+
         self.exp_negative.next = self
-            .exp_final
+            .rnd_exp
+            .q
             .val()
             .get_bit(self.c_exp_sign_pos.val().index());
         self.sign_word.next = 0.into();
-        if self.last_sign.q.val() {
+        if self.rnd_sign.q.val() {
             self.sign_word.next = self.c_sign_bit.val();
         }
-        self.packed_word.next = (bit_cast::<W, E>(self.exp_final.val().get_bits::<E>(0))
+        self.packed_word.next = (bit_cast::<W, E>(self.rnd_exp.q.val().get_bits::<E>(0))
             << self.c_man_bits.val())
-            | bit_cast::<W, M>(self.sig_rounded.val().get_bits::<M>(0));
+            | bit_cast::<W, M>(self.rnd_sig.q.val().get_bits::<M>(0));
 
         // Output stage.
-        if self.last_nan.q.val() {
+        if self.rnd_nan.q.val() {
             self.out_result.d.next = self.c_qnan.val();
-        } else if self.last_inf.q.val()
-            | ((!self.exp_negative.val()) & (self.exp_final.val() >= self.c_exp_max.val()))
+        } else if self.rnd_inf.q.val()
+            | ((!self.exp_negative.val()) & (self.rnd_exp.q.val() >= self.c_exp_max.val()))
         {
             self.out_result.d.next = self.c_inf.val() | self.sign_word.val();
-        } else if self.last_zero.q.val() | (self.exp_negative.val() | (self.exp_final.val() == 0)) {
+        } else if self.rnd_zero.q.val() | (self.exp_negative.val() | (self.rnd_exp.q.val() == 0)) {
             self.out_result.d.next = self.sign_word.val();
         } else {
             self.out_result.d.next = self.packed_word.val() | self.sign_word.val();
         }
-        self.out_valid_r.d.next = self.last_valid.q.val();
+        self.out_valid_r.d.next = self.rnd_valid.q.val();
         self.result.next = self.out_result.q.val();
         self.out_valid.next = self.out_valid_r.q.val();
     }

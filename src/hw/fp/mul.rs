@@ -1,13 +1,14 @@
 //! `FpMul`: pipelined `eXmY` multiplier, exactly rounded (nearest even), equal to
 //! `dynrt::fp::Format::mul` bit for bit.
 //!
-//! Latency 3 clocks, throughput one product per clock:
+//! Latency 4 clocks, throughput one product per clock:
 //! 1. input registers;
 //! 2. unpack, special cases (NaN, infinity, zero with DAZ), exponent sum, and the significand
 //!    product from the [`SigMul`] leaf, registered;
 //! 3. normalize (product in [1, 4)), round to nearest even on `S` bits with an unbounded
-//!    exponent, then overflow to infinity / flush results below the smallest normal to a signed
-//!    zero, pack; registered.
+//!    exponent; registered;
+//! 4. overflow to infinity / flush results below the smallest normal to a signed zero, pack;
+//!    registered.
 //!
 //! Const parameters (derived widths, checked in `default()`): `W = 1+E+M` word, `E` exponent
 //! bits, `M` mantissa bits, `S = M+1` significand, `S1 = S+1` rounded significand with carry,
@@ -18,7 +19,7 @@ use rust_hdl::prelude::*;
 use super::{bias, const_bits, const_index, inf_word, qnan_word, SigMul};
 
 /// Latency of [`FpMul`] in clocks.
-pub const MUL_LATENCY: u32 = 3;
+pub const MUL_LATENCY: u32 = 4;
 
 #[derive(LogicBlock)]
 pub struct FpMul<
@@ -70,7 +71,15 @@ pub struct FpMul<
     exp_negative: Signal<Local, Bit>,
     sign_word: Signal<Local, Bits<W>>,
     packed_word: Signal<Local, Bits<W>>,
-    // Stage 3: output registers.
+    // Stage 3: rounded result registers.
+    rnd_sig: DFF<Bits<S1>>,
+    rnd_exp: DFF<Bits<X2>>,
+    rnd_sign: DFF<Bit>,
+    rnd_nan: DFF<Bit>,
+    rnd_inf: DFF<Bit>,
+    rnd_zero: DFF<Bit>,
+    rnd_valid: DFF<Bit>,
+    // Stage 4: output registers.
     out_result: DFF<Bits<W>>,
     out_valid_r: DFF<Bit>,
     // Format constants.
@@ -139,6 +148,13 @@ impl<
             exp_negative: Default::default(),
             sign_word: Default::default(),
             packed_word: Default::default(),
+            rnd_sig: Default::default(),
+            rnd_exp: Default::default(),
+            rnd_sign: Default::default(),
+            rnd_nan: Default::default(),
+            rnd_inf: Default::default(),
+            rnd_zero: Default::default(),
+            rnd_valid: Default::default(),
             out_result: Default::default(),
             out_valid_r: Default::default(),
             c_man_bits: const_index(M),
@@ -184,6 +200,13 @@ impl<
             inf,
             zero,
             valid2,
+            rnd_sig,
+            rnd_exp,
+            rnd_sign,
+            rnd_nan,
+            rnd_inf,
+            rnd_zero,
+            rnd_valid,
             out_result,
             out_valid_r
         );
@@ -247,31 +270,41 @@ impl<
                 .sig_rounded
                 .val()
                 .get_bit(self.c_carry_pos.val().index());
+        // Registered: the rounded significand and exponent (splits the logic depth).
+        self.rnd_sig.d.next = self.sig_rounded.val();
+        self.rnd_exp.d.next = self.exp_final.val();
+        self.rnd_sign.d.next = self.sign.q.val();
+        self.rnd_nan.d.next = self.nan.q.val();
+        self.rnd_inf.d.next = self.inf.q.val();
+        self.rnd_zero.d.next = self.zero.q.val();
+        self.rnd_valid.d.next = self.valid2.q.val();
+
         self.exp_negative.next = self
-            .exp_final
+            .rnd_exp
+            .q
             .val()
             .get_bit(self.c_exp_sign_pos.val().index());
         self.sign_word.next = 0.into();
-        if self.sign.q.val() {
+        if self.rnd_sign.q.val() {
             self.sign_word.next = self.c_sign_bit.val();
         }
-        self.packed_word.next = (bit_cast::<W, E>(self.exp_final.val().get_bits::<E>(0))
+        self.packed_word.next = (bit_cast::<W, E>(self.rnd_exp.q.val().get_bits::<E>(0))
             << self.c_man_bits.val())
-            | bit_cast::<W, M>(self.sig_rounded.val().get_bits::<M>(0));
+            | bit_cast::<W, M>(self.rnd_sig.q.val().get_bits::<M>(0));
 
-        // Stage 3.
-        if self.nan.q.val() {
+        // Stage 4.
+        if self.rnd_nan.q.val() {
             self.out_result.d.next = self.c_qnan.val();
-        } else if self.inf.q.val()
-            | ((!self.exp_negative.val()) & (self.exp_final.val() >= self.c_exp_max.val()))
+        } else if self.rnd_inf.q.val()
+            | ((!self.exp_negative.val()) & (self.rnd_exp.q.val() >= self.c_exp_max.val()))
         {
             self.out_result.d.next = self.c_inf.val() | self.sign_word.val();
-        } else if self.zero.q.val() | (self.exp_negative.val() | (self.exp_final.val() == 0)) {
+        } else if self.rnd_zero.q.val() | (self.exp_negative.val() | (self.rnd_exp.q.val() == 0)) {
             self.out_result.d.next = self.sign_word.val();
         } else {
             self.out_result.d.next = self.packed_word.val() | self.sign_word.val();
         }
-        self.out_valid_r.d.next = self.valid2.q.val();
+        self.out_valid_r.d.next = self.rnd_valid.q.val();
         self.result.next = self.out_result.q.val();
         self.out_valid.next = self.out_valid_r.q.val();
     }

@@ -1,0 +1,81 @@
+//! `dynrt bench`: measurements written as CSV and Markdown under `--out`.
+
+use clap::{Args, Subcommand};
+use dynrt::bench;
+use dynrt::fp::Format;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    pub what: BenchWhat,
+    /// Report directory.
+    #[arg(long, default_value = "out/bench", global = true)]
+    pub out: PathBuf,
+}
+
+#[derive(Subcommand)]
+pub enum BenchWhat {
+    /// FP operators: latency, yosys xc2v resources and depth, Verilator operations per second.
+    Fp {
+        /// Formats to measure (comma-separated); default: the paper's e7m16 and IEEE e8m23.
+        #[arg(long, value_delimiter = ',', default_values = ["e7m16", "e8m23"])]
+        formats: Vec<Format>,
+        /// Random vectors per Verilator run (0: skip simulation).
+        #[arg(long, default_value_t = 200_000)]
+        vectors: usize,
+    },
+    /// Bundled scenes: tree build rate, layout size, golden and reference speed, golden error.
+    Scenes {
+        /// Scene files; default: every scene in scenes/.
+        scenes: Vec<PathBuf>,
+        #[arg(long, value_delimiter = ',', default_values = ["e7m16", "e8m23"])]
+        formats: Vec<Format>,
+        /// Override every scene's resolution, e.g. 128x96.
+        #[arg(long, value_parser = parse_resolution)]
+        resolution: Option<(u32, u32)>,
+    },
+}
+
+fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once('x')
+        .ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT such as 128x96"))?;
+    Ok((
+        w.parse().map_err(|_| format!("`{w}` is not a width"))?,
+        h.parse().map_err(|_| format!("`{h}` is not a height"))?,
+    ))
+}
+
+pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
+    match a.what {
+        BenchWhat::Fp { formats, vectors } => {
+            let work = tempfile::tempdir()?;
+            let rows =
+                bench::fp::bench_fp(&bench::fp::DISTINCT_OPS, &formats, vectors, work.path())?;
+            let t = bench::fp::fp_table(&rows);
+            t.save(&a.out, "fp")?;
+            print!("{}", t.to_markdown());
+            if let Some(r) = rows.first() {
+                println!("yosys: {} ({})", r.synth.yosys_version, r.synth.command);
+            }
+        }
+        BenchWhat::Scenes {
+            scenes,
+            formats,
+            resolution,
+        } => {
+            let scenes = if scenes.is_empty() {
+                bench::scenes::bundled_scenes(std::path::Path::new("scenes"))?
+            } else {
+                scenes
+            };
+            let rows = bench::scenes::bench_scenes(&scenes, &formats, resolution)?;
+            let t = bench::scenes::scenes_table(&rows);
+            t.save(&a.out, "scenes")?;
+            print!("{}", t.to_markdown());
+        }
+    }
+    println!("written to {}", a.out.display());
+    Ok(0)
+}

@@ -1,0 +1,32 @@
+//! `dynrt demo`: the main job on a scene (default: the bundled Cornell box).
+
+use clap::Args;
+use dynrt::demo::{default_scene, run_demo, DemoConfig};
+use dynrt::fp::Format;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct DemoArgs {
+    /// Scene file (default: scenes/cornell.toml).
+    pub scene: Option<PathBuf>,
+    #[arg(long, default_value = "e7m16")]
+    pub format: Format,
+    #[arg(long, default_value = "out/demo")]
+    pub out: PathBuf,
+    /// Random vectors per operator and simulator.
+    #[arg(long, default_value_t = 20_000)]
+    pub vectors: usize,
+}
+
+pub fn run(a: DemoArgs) -> anyhow::Result<i32> {
+    let config = DemoConfig {
+        scene: a.scene.unwrap_or_else(|| default_scene().to_path_buf()),
+        format: a.format,
+        out: a.out,
+        vectors: a.vectors,
+    };
+    let r = run_demo(&config)?;
+    println!("{}", r.summary);
+    println!("report: {}", r.report.display());
+    Ok(if r.ok { 0 } else { 1 })
+}
