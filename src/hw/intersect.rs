@@ -280,7 +280,8 @@ mod tests {
                 }
             })
             .collect();
-        let mut u = IntersectUnit::<24, 7, 16, 17, 18, 9, 21, 34, 20>::default();
+        let mut u =
+            IntersectUnit::<24, 7, 16, 17, 18, 9, 21, 34, { div_latency(16) as usize }>::default();
         u.connect_all();
         let lat = intersect_latency(f) as usize;
         let mut got = Vec::new();
