@@ -1,15 +1,18 @@
 //! Runs one generated floating-point operator in a real simulator on a list of operand pairs:
-//! writes the unit's Verilog, its testbench and the vector file into a work directory, runs
-//! Icarus or Verilator through `crate::sim`, and reads the results back in input order.
+//! writes the unit's Verilog, a wrapper and the streaming testbench of
+//! [`super::stream_bench`] (the one the geometry units use) with the vector file into a work
+//! directory, runs Icarus or Verilator through `crate::sim`, and reads the results back in
+//! input order.
 //! Used by `dynrt fp --sim iverilog|verilator` and by the bit-exactness tests.
 
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 
-use super::fp_unit::{fp_unit_rtl, fp_units_testbench};
+use super::fp_unit::fp_unit_rtl;
+use super::stream_bench::{run_stream_bench, BenchPort, InputStream, OutputSink, StreamBench};
 use crate::fp::{BinOp, Format};
-use crate::sim::{self, SimJob, Simulator};
+use crate::sim::Simulator;
 
 /// Results of one simulated run of an operator.
 #[derive(Debug, Clone)]
@@ -58,78 +61,82 @@ pub fn run_fp_units(
         };
         return Ok(vec![empty; ops.len()]);
     }
-    std::fs::create_dir_all(work_dir)
-        .with_context(|| format!("cannot create {}", work_dir.display()))?;
-    let digits = fmt.hex_digits();
+    let w = fmt.width();
     let mask = fmt.word_mask();
-    let mut text = String::with_capacity(vectors.len() * (2 * digits + 2));
     for (i, &(a, b)) in vectors.iter().enumerate() {
         if a & !mask != 0 || b & !mask != 0 {
             bail!("vector {}: {a:#x} {b:#x} is wider than {fmt}", i + 1);
         }
-        text += &format!("{a:0digits$x} {b:0digits$x}\n");
     }
-    let vectors_file = work_dir.join("vectors.hex");
-    std::fs::write(&vectors_file, text)
-        .with_context(|| format!("cannot write {}", vectors_file.display()))?;
-    let mut sources = Vec::new();
-    let mut result_names = Vec::new();
-    for unit in &units {
-        let rtl_file = work_dir.join(format!("{}.v", unit.top));
-        std::fs::write(&rtl_file, &unit.verilog)
-            .with_context(|| format!("cannot write {}", rtl_file.display()))?;
-        sources.push(rtl_file);
-        let results_name = format!("results_{}.hex", unit.top);
-        let _ = std::fs::remove_file(work_dir.join(&results_name));
-        result_names.push(results_name);
-    }
-    let unit_refs = units.iter().collect::<Vec<_>>();
-    let name_refs = result_names.iter().map(String::as_str).collect::<Vec<_>>();
-    let tb = fp_units_testbench(&unit_refs, fmt, vectors.len(), "vectors.hex", &name_refs);
-    let tb_file = work_dir.join(format!("tb_fp_{fmt}.v"));
-    std::fs::write(&tb_file, tb).with_context(|| format!("cannot write {}", tb_file.display()))?;
-    sources.push(tb_file);
-    let job = SimJob::new(work_dir, sources, "tb");
-    let ran = sim::run(simulator, &job)?;
-    let mut runs = Vec::new();
-    for (unit, name) in units.iter().zip(&result_names) {
-        let results_file = work_dir.join(name);
-        let out = std::fs::read_to_string(&results_file).with_context(|| {
-            format!(
-                "{simulator} wrote no results for {}; its output:\n{}{}",
-                unit.top, ran.stdout, ran.stderr
-            )
-        })?;
-        let results = out
-            .lines()
-            .enumerate()
-            .map(|(i, l)| {
-                u32::from_str_radix(l.trim(), 16).with_context(|| {
-                    format!(
-                        "{}:{}: `{l}` is not a hex word",
-                        results_file.display(),
-                        i + 1
-                    )
-                })
-            })
-            .collect::<Result<Vec<u32>>>()?;
-        if results.len() != vectors.len() {
-            bail!(
-                "{simulator} produced {} results for {} vectors of {}; its output:\n{}{}",
-                results.len(),
-                vectors.len(),
-                unit.top,
-                ran.stdout,
-                ran.stderr
-            );
-        }
-        runs.push(FpUnitRun {
-            results,
-            compile_seconds: ran.compile_seconds,
-            run_seconds: ran.run_seconds,
+    // One wrapper instantiates every operator on the shared operands; the generic streaming
+    // bench (the geometry units' too) feeds it and records each operator's results.
+    let wrapper = format!("fp_units_{fmt}");
+    let mut ports = vec![
+        BenchPort::input("clock", 1),
+        BenchPort::input("in_valid", 1),
+        BenchPort::input("a", w),
+        BenchPort::input("b", w),
+    ];
+    let mut body = String::new();
+    let mut sinks = Vec::new();
+    let mut verilog = String::new();
+    for (i, unit) in units.iter().enumerate() {
+        verilog += &unit.verilog;
+        verilog.push('\n');
+        ports.push(BenchPort::output(format!("out_valid_{i}"), 1));
+        ports.push(BenchPort::output(format!("result_{i}"), unit.result_width));
+        body += &format!(
+            "    {} dut_{i}(.clock(clock), .in_valid(in_valid), .a(a), .b(b),\n        \
+             .out_valid(out_valid_{i}), .result(result_{i}));\n",
+            unit.top
+        );
+        sinks.push(OutputSink {
+            name: format!("results_{}", unit.top),
+            valid: format!("out_valid_{i}"),
+            fields: vec![format!("result_{i}")],
+            expected: vectors.len(),
         });
     }
-    Ok(runs)
+    let decls = ports
+        .iter()
+        .map(|p| {
+            let dir = if p.output { "output" } else { "input" };
+            let range = if p.width > 1 {
+                format!("[{}:0] ", p.width - 1)
+            } else {
+                String::new()
+            };
+            format!("    {dir} wire {range}{}", p.name)
+        })
+        .collect::<Vec<_>>()
+        .join(",\n");
+    verilog += &format!("module {wrapper}(\n{decls}\n);\n{body}endmodule\n");
+    let bench = StreamBench {
+        dut: wrapper,
+        ports,
+        streams: vec![InputStream {
+            name: "vectors".into(),
+            fields: vec!["a".into(), "b".into()],
+            valid: Some("in_valid".into()),
+            ready: None,
+            lines: vectors
+                .iter()
+                .map(|&(a, b)| (0, vec![u64::from(a), u64::from(b)]))
+                .collect(),
+        }],
+        sinks,
+        max_cycles: vectors.len() as u64 + 1000,
+    };
+    let ran = run_stream_bench(&bench, &verilog, simulator, work_dir)?;
+    Ok(ran
+        .sinks
+        .into_iter()
+        .map(|records| FpUnitRun {
+            results: records.into_iter().map(|r| r[0] as u32).collect(),
+            compile_seconds: ran.compile_seconds,
+            run_seconds: ran.run_seconds,
+        })
+        .collect())
 }
 
 #[cfg(test)]

@@ -2,7 +2,21 @@
 
 pub mod fp_unit;
 pub mod fp_unit_run;
+pub mod geometry_unit;
+pub mod geometry_unit_run;
+#[cfg(test)]
+mod geometry_unit_tests;
+pub mod stream_bench;
 pub mod verilog_tidy;
 
 pub use fp_unit::{fp_unit_rtl, fp_unit_testbench, fp_units_testbench, FpUnitRtl};
 pub use fp_unit_run::{run_fp_unit, run_fp_units, FpUnitRun};
+pub use geometry_unit::{geometry_unit_rtl, synth_unit, GeometryUnit, GeometryUnitRtl};
+pub use geometry_unit_run::{
+    run_intersect, run_raygen, run_shared_transform, run_transform, GeometryRun, IntersectRequest,
+    IntersectResult, RayGenFrame, RayGenOutput, TransformRequest, TransformResult,
+};
+pub use stream_bench::{
+    run_stream_bench, stream_bench_verilog, BenchPort, InputStream, OutputSink, StreamBench,
+    StreamBenchRun,
+};

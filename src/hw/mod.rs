@@ -1,4 +1,29 @@
 //! Hardware: rust-hdl modules of the ray tracing processor, one file per unit.
 //! They are turned into Verilog by `crate::emit`.
+//!
+//! Geometry units (the paper's Table 2 counts in brackets): [`TransformUnit`] (9 mul, 9 add),
+//! shared by several clients through [`SharedTransformUnit`]'s round-robin arbiter;
+//! [`IntersectUnit`] (1 div, 2 mul, 3 add, plus 5 comparators); [`RayGen`], the ray-generation
+//! client of the transform unit.
 
+pub mod delay;
 pub mod fp;
+pub mod geometry_formats;
+pub mod int_to_float;
+pub mod intersect;
+pub mod raygen;
+#[cfg(test)]
+mod sim_harness;
+pub mod transform;
+pub mod transform_arbiter;
+
+pub use delay::Delay;
+pub use int_to_float::UIntToFloat;
+pub use intersect::{intersect_latency, IntersectUnit};
+pub use raygen::{RayGen, RayGenUnit};
+pub use transform::{TransformUnit, TRANSFORM_LATENCY};
+pub use transform_arbiter::{SharedTransformUnit, TRANSFORM_CLIENTS};
+
+/// Width of the tag that travels with every request through a geometry unit (client id and
+/// thread id; the unit only carries it).
+pub const TAG_BITS: usize = 16;

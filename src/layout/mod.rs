@@ -35,7 +35,7 @@
 
 mod build;
 
-pub use build::{build, LayoutError, SceneTrees};
+pub use build::{build, unit_triangle_transform, LayoutError, SceneTrees};
 
 use crate::fp::Format;
 

@@ -1,0 +1,825 @@
+//! Bit-exactness of the generated geometry units against the golden model's unit sequences
+//! (`model::units`), in Icarus and Verilator, plus lint and synthesis. One simulator build per
+//! unit, format and simulator; every vector streams through it.
+//!
+//! Vectors: seeded random words and geometric cases, plus the hard ones: unit-triangle
+//! transforms of real mesh triangles (`../shared/scenes/meshes/*.obj`, the slivers and
+//! near-degenerate ones first) rounded as the layout rounds them, with rays aimed at their
+//! vertices, edge midpoints and centroids, rays lying in the triangle plane (edge-on) and
+//! grazing it; rays in unit-triangle space landing exactly on edges and vertices; D'z = +-0;
+//! huge and tiny coordinates; NaN and infinity.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::geometry_unit::{geometry_unit_rtl, synth_unit, GeometryUnit};
+use super::geometry_unit_run::*;
+use crate::fp::{vectors, Format};
+use crate::layout::unit_triangle_transform;
+use crate::model::units;
+use crate::sim::{self, Simulator};
+
+/// A random word: a third uniform bit patterns, a third edge cases, a third "geometric" values
+/// (magnitudes 2^-8..2^8, either sign).
+fn random_word(f: Format, rng: &mut ChaCha8Rng, edges: &[u32]) -> u32 {
+    match rng.gen_range(0..3) {
+        0 => rng.gen::<u32>() & f.word_mask(),
+        1 => edges[rng.gen_range(0..edges.len())],
+        _ => geometric(f, rng, 8),
+    }
+}
+
+/// A value with magnitude in 2^-spread .. 2^spread and random sign, rounded to `f`.
+fn geometric(f: Format, rng: &mut ChaCha8Rng, spread: i32) -> u32 {
+    let x = rng.gen_range(1.0..2.0) * 2f64.powi(rng.gen_range(-spread..=spread));
+    f.from_f64(if rng.gen_bool(0.5) { -x } else { x })
+}
+
+fn word(f: Format, x: f64) -> u32 {
+    f.from_f64(x)
+}
+
+fn vec_words(f: Format, v: DVec3) -> [u32; 3] {
+    [f.from_f64(v.x), f.from_f64(v.y), f.from_f64(v.z)]
+}
+
+/// The layout's rounding of an affine map: row-major 3x4, each entry rounded once.
+fn matrix_words(f: Format, m: &glam::DAffine3) -> [u32; 12] {
+    let mut w = [0; 12];
+    for r in 0..3 {
+        let row = m.matrix3.row(r);
+        w[r * 4] = f.from_f64(row.x);
+        w[r * 4 + 1] = f.from_f64(row.y);
+        w[r * 4 + 2] = f.from_f64(row.z);
+        w[r * 4 + 3] = f.from_f64(m.translation[r]);
+    }
+    w
+}
+
+fn meshes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/scenes/meshes")
+}
+
+/// Triangles of every mesh in ../shared/scenes/meshes: per mesh the `slivers` worst-shaped
+/// (smallest area over longest edge squared, degenerate ones included) and `random` others.
+fn mesh_triangles(slivers: usize, random: usize, seed: u64) -> Vec<[DVec3; 3]> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(meshes_dir())
+        .expect("../shared/scenes/meshes")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
+    paths.sort();
+    assert!(!paths.is_empty(), "no meshes in {}", meshes_dir().display());
+    let mut out = Vec::new();
+    for path in paths {
+        let options = tobj::LoadOptions {
+            triangulate: true,
+            single_index: true,
+            ..Default::default()
+        };
+        let (models, _) = tobj::load_obj(&path, &options).unwrap();
+        let mut tris = Vec::new();
+        for model in models {
+            let p = &model.mesh.positions;
+            let v = |i: u32| {
+                let i = i as usize * 3;
+                DVec3::new(p[i] as f64, p[i + 1] as f64, p[i + 2] as f64)
+            };
+            for t in model.mesh.indices.chunks_exact(3) {
+                tris.push([v(t[0]), v(t[1]), v(t[2])]);
+            }
+        }
+        let quality = |t: &[DVec3; 3]| {
+            let area = (t[1] - t[0]).cross(t[2] - t[0]).length();
+            let longest = (t[1] - t[0])
+                .length_squared()
+                .max((t[2] - t[0]).length_squared())
+                .max((t[2] - t[1]).length_squared());
+            if longest == 0.0 {
+                0.0
+            } else {
+                area / longest
+            }
+        };
+        let mut order: Vec<usize> = (0..tris.len()).collect();
+        order.sort_by(|&a, &b| quality(&tris[a]).total_cmp(&quality(&tris[b])));
+        out.extend(order.iter().take(slivers).map(|&i| tris[i]));
+        for _ in 0..random {
+            out.push(tris[rng.gen_range(0..tris.len())]);
+        }
+    }
+    out
+}
+
+/// World-space rays at a triangle: at each vertex, each edge midpoint, the centroid, a random
+/// interior point; one lying in the triangle's plane along an edge (edge-on) and one grazing
+/// it. Returns (origin, direction) pairs.
+fn rays_at(t: &[DVec3; 3], rng: &mut ChaCha8Rng) -> Vec<(DVec3, DVec3)> {
+    let [a, b, c] = *t;
+    let n = (b - a).cross(c - a);
+    let n = if n.length() > 0.0 {
+        n.normalize()
+    } else {
+        DVec3::Z
+    };
+    let size = (b - a).length().max((c - a).length()).max(1e-3);
+    let eye = (a + b + c) / 3.0
+        + n * size * rng.gen_range(0.5..4.0)
+        + DVec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), 0.3) * size * 0.5;
+    let (r1, r2): (f64, f64) = (rng.gen(), rng.gen());
+    let (r1, r2) = if r1 + r2 > 1.0 {
+        (1.0 - r1, 1.0 - r2)
+    } else {
+        (r1, r2)
+    };
+    let targets = [
+        a,
+        b,
+        c,
+        (a + b) / 2.0,
+        (b + c) / 2.0,
+        (c + a) / 2.0,
+        (a + b + c) / 3.0,
+        a + (b - a) * r1 + (c - a) * r2,
+    ];
+    let mut rays: Vec<(DVec3, DVec3)> = targets.iter().map(|&p| (eye, p - eye)).collect();
+    // Edge-on: starts on the plane outside the triangle and runs along it.
+    rays.push((a - (b - a), b - a));
+    // Grazing: almost parallel to the plane.
+    rays.push((eye, (b - a) - n * size * 1e-4));
+    rays
+}
+
+/// The model's intersect inputs for a world-space ray and a triangle, through the same
+/// transform sequence the hardware uses.
+fn unit_space_request(
+    f: Format,
+    m: &[u32; 12],
+    o: DVec3,
+    d: DVec3,
+    t_min: u32,
+    t_max: u32,
+) -> ([u32; 3], [u32; 3], u32, u32) {
+    let o2 = units::transform(f, m, vec_words(f, o), true);
+    let d2 = units::transform(f, m, vec_words(f, d), false);
+    (o2, d2, t_min, t_max)
+}
+
+// ---------------------------------------------------------------------------------------
+// Transform
+
+fn transform_random(f: Format, n: usize, seed: u64) -> Vec<TransformRequest> {
+    println!("transform {f}: seed {seed}");
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let edges = vectors::edge_cases(f);
+    (0..n)
+        .map(|i| {
+            let geometric_only = rng.gen_bool(0.5);
+            let mut w = || {
+                if geometric_only {
+                    geometric(f, &mut rng, 6)
+                } else {
+                    random_word(f, &mut rng, &edges)
+                }
+            };
+            let m: [u32; 12] = std::array::from_fn(|_| w());
+            let v: [u32; 3] = std::array::from_fn(|_| w());
+            TransformRequest {
+                m,
+                v,
+                point: rng.gen_bool(0.5),
+                tag: i as u16,
+            }
+        })
+        .collect()
+}
+
+/// Unit-triangle transforms of mesh triangles applied to ray origins and directions;
+/// cancellations (m0 x = -m1 y exactly, signed zeros), overflow, huge and tiny values.
+fn transform_hard(f: Format, seed: u64) -> Vec<TransformRequest> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = Vec::new();
+    let mut push = |m: [u32; 12], v: [u32; 3], point: bool| {
+        out.push(TransformRequest {
+            m,
+            v,
+            point,
+            tag: 0,
+        })
+    };
+    for t in mesh_triangles(20, 10, seed) {
+        let m = matrix_words(f, &unit_triangle_transform(&t));
+        for (o, d) in rays_at(&t, &mut rng) {
+            push(m, vec_words(f, o), true);
+            push(m, vec_words(f, d), false);
+        }
+    }
+    let big = f.max_finite(false);
+    let tiny = f.min_normal(false);
+    let one = f.one();
+    let neg = |w: u32| w ^ f.sign_mask();
+    for &(a, b) in &[
+        (one, one),
+        (big, big),
+        (tiny, tiny),
+        (big, tiny),
+        (word(f, 3.0), word(f, 1.0 / 3.0)),
+    ] {
+        // Row sums that cancel exactly, with every sign of zero.
+        for signs in 0..16u32 {
+            let s = |k: u32, w: u32| if signs >> k & 1 == 1 { neg(w) } else { w };
+            let m = [
+                s(0, a),
+                neg(s(0, a)),
+                s(1, 0),
+                s(2, 0),
+                s(1, b),
+                s(3, b),
+                s(2, b),
+                neg(s(3, 0)),
+                s(3, big),
+                s(0, big),
+                s(1, tiny),
+                s(2, tiny),
+            ];
+            push(m, [b, b, a], true);
+            push(m, [s(1, b), b, s(2, a)], false);
+            push(m, [0, neg(0), s(3, 0)], true);
+        }
+    }
+    // Infinities times zeros, NaN payloads.
+    let inf = f.infinity(false);
+    push(
+        [inf, 0, 0, 0, 0, inf, 0, 0, 0, 0, inf, 0],
+        [0, one, neg(0)],
+        true,
+    );
+    push([one; 12], [inf, neg(inf), one], false);
+    push([one; 12], [f.nan() | 1, one, one], true);
+    for (i, r) in out.iter_mut().enumerate() {
+        r.tag = (i as u16).wrapping_mul(7919);
+    }
+    out
+}
+
+fn check_transform(f: Format, reqs: &[TransformRequest], got: &[TransformResult], what: &str) {
+    assert_eq!(got.len(), reqs.len(), "{what}: result count");
+    let mut bad = 0;
+    for (i, (q, r)) in reqs.iter().zip(got).enumerate() {
+        let want = units::transform(f, &q.m, q.v, q.point);
+        if r.r != want || r.tag != q.tag {
+            if bad < 5 {
+                eprintln!(
+                    "{what} #{i}: m={:x?} v={:x?} point={} tag {:#x}: got {:x?} tag {:#x}, want {:x?}",
+                    q.m, q.v, q.point, q.tag, r.r, r.tag, want
+                );
+            }
+            bad += 1;
+        }
+    }
+    assert_eq!(bad, 0, "{what}: {bad} of {} results differ", reqs.len());
+}
+
+fn transform_case(f: Format, n_random: usize, seed: u64, sim: Simulator) {
+    let mut reqs = transform_random(f, n_random, seed);
+    let hard = transform_hard(f, seed + 1);
+    let n_hard = hard.len();
+    reqs.extend(hard);
+    // Bubbles in the stream: every 50th request comes after 1..3 idle clocks.
+    let mut rng = ChaCha8Rng::seed_from_u64(seed + 2);
+    let gaps: Vec<u32> = (0..reqs.len())
+        .map(|i| if i % 50 == 49 { rng.gen_range(1..4) } else { 0 })
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let run = run_transform(f, &reqs, &gaps, sim, dir.path()).unwrap();
+    println!(
+        "{sim} transform {f}: {} random + {n_hard} hard: compile {:.1} s, run {:.1} s",
+        n_random, run.compile_seconds, run.run_seconds
+    );
+    check_transform(f, &reqs, &run.results, &format!("{sim} transform {f}"));
+}
+
+/// Icarus runs ~600 transforms a second here: 25k random plus every hard case in CI; the
+/// 100k run is `transform_e7m16_icarus_100k` (ignored, ~3 min).
+#[test]
+fn transform_e7m16_icarus() {
+    transform_case(Format::E7M16, 25_000, 4001, Simulator::Icarus);
+}
+
+#[test]
+#[ignore = "about 3 minutes in Icarus; CI runs 25k"]
+fn transform_e7m16_icarus_100k() {
+    transform_case(Format::E7M16, 100_000, 4001, Simulator::Icarus);
+}
+
+#[test]
+fn transform_e7m16_verilator() {
+    transform_case(Format::E7M16, 100_000, 4001, Simulator::Verilator);
+}
+
+#[test]
+fn transform_e8m23_icarus() {
+    transform_case(Format::E8M23, 10_000, 4002, Simulator::Icarus);
+}
+
+#[test]
+fn transform_e8m23_verilator() {
+    transform_case(Format::E8M23, 100_000, 4002, Simulator::Verilator);
+}
+
+// ---------------------------------------------------------------------------------------
+// Shared transform: arbitration
+
+/// Every client requests every clock (full load) and, in a second phase, with random gaps;
+/// no request is lost, each client's results come back in its order with its thread ids, the
+/// values equal the model, and under full load the grants rotate 0, 1, 2, 3.
+fn shared_case(f: Format, per_client: usize, seed: u64, sim: Simulator) {
+    println!("shared transform {f}: seed {seed}");
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let reqs = transform_random(f, 4 * per_client, seed + 1);
+    let clients: [Vec<(u32, TransformRequest)>; 4] = std::array::from_fn(|c| {
+        reqs[c * per_client..(c + 1) * per_client]
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                // First half: full load; second half: random gaps.
+                let gap = if i < per_client / 2 {
+                    0
+                } else {
+                    rng.gen_range(0..6)
+                };
+                let mut r = *r;
+                r.tag = rng.gen_range(0..256);
+                (gap, r)
+            })
+            .collect()
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let run = run_shared_transform(f, &clients, sim, dir.path()).unwrap();
+    println!(
+        "{sim} shared transform {f}: 4 x {per_client}: compile {:.1} s, run {:.1} s",
+        run.compile_seconds, run.run_seconds
+    );
+    let got = &run.results;
+    assert_eq!(
+        got.len(),
+        4 * per_client,
+        "no request lost, none duplicated"
+    );
+    // Full load: the first 4 * (per_client / 2) results rotate over the clients, starting
+    // after client 0 (the arbiter's reset state is "client 0 taken last").
+    for (i, r) in got.iter().take(4 * (per_client / 2)).enumerate() {
+        assert_eq!(
+            r.client as usize,
+            (i + 1) % 4,
+            "{sim}: round robin at result {i}"
+        );
+    }
+    for c in 0..4 {
+        let mine: Vec<&TransformResult> = got.iter().filter(|r| r.client as usize == c).collect();
+        assert_eq!(mine.len(), per_client, "{sim}: client {c} result count");
+        let sent: Vec<TransformRequest> = clients[c].iter().map(|&(_, r)| r).collect();
+        let mine: Vec<TransformResult> = mine.into_iter().copied().collect();
+        check_transform(
+            f,
+            &sent,
+            &mine,
+            &format!("{sim} shared transform {f} client {c}"),
+        );
+    }
+}
+
+#[test]
+fn shared_transform_arbitration_icarus() {
+    shared_case(Format::E7M16, 1000, 4101, Simulator::Icarus);
+}
+
+#[test]
+fn shared_transform_arbitration_verilator() {
+    shared_case(Format::E7M16, 5000, 4101, Simulator::Verilator);
+}
+
+// ---------------------------------------------------------------------------------------
+// Intersect
+
+fn intersect_random(f: Format, n: usize, seed: u64) -> Vec<IntersectRequest> {
+    println!("intersect {f}: seed {seed}");
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let edges = vectors::edge_cases(f);
+    (0..n)
+        .map(|i| {
+            let (o, d, t_min, t_max) = if rng.gen_bool(0.25) {
+                let mut w = || random_word(f, &mut rng, &edges);
+                ([w(), w(), w()], [w(), w(), w()], w(), w())
+            } else {
+                // A ray from above or below the unit triangle's plane towards it, hitting about
+                // half the time.
+                let oz: f64 = rng.gen_range(0.1..4.0) * if rng.gen_bool(0.5) { 1.0 } else { -1.0 };
+                let target = (rng.gen_range(-0.5..1.5), rng.gen_range(-0.5..1.5));
+                let o = (rng.gen_range(-2.0..2.0), rng.gen_range(-2.0..2.0), oz);
+                let d = (
+                    target.0 - o.0,
+                    target.1 - o.1,
+                    -oz * rng.gen_range(0.2..3.0),
+                );
+                let t_min = if rng.gen_bool(0.5) {
+                    0.0
+                } else {
+                    rng.gen_range(0.0..0.6)
+                };
+                let t_max = if rng.gen_bool(0.5) {
+                    f64::INFINITY
+                } else {
+                    rng.gen_range(0.3..3.0)
+                };
+                (
+                    [word(f, o.0), word(f, o.1), word(f, o.2)],
+                    [word(f, d.0), word(f, d.1), word(f, d.2)],
+                    word(f, t_min),
+                    word(f, t_max),
+                )
+            };
+            IntersectRequest {
+                o,
+                d,
+                t_min,
+                t_max,
+                tag: i as u16,
+            }
+        })
+        .collect()
+}
+
+/// Mesh triangles (slivers first) with rays at vertices, edges, centroid, edge-on and grazing;
+/// unit-space rays landing exactly on edges and vertices; D'z = +-0; huge and tiny values;
+/// t exactly at t_min or t_max.
+fn intersect_hard(f: Format, seed: u64) -> Vec<IntersectRequest> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = Vec::new();
+    let inf = f.infinity(false);
+    let mut push = |(o, d, t_min, t_max): ([u32; 3], [u32; 3], u32, u32)| {
+        out.push(IntersectRequest {
+            o,
+            d,
+            t_min,
+            t_max,
+            tag: 0,
+        })
+    };
+    for t in mesh_triangles(40, 20, seed) {
+        let m = matrix_words(f, &unit_triangle_transform(&t));
+        for (o, d) in rays_at(&t, &mut rng) {
+            push(unit_space_request(f, &m, o, d, 0, inf));
+            push(unit_space_request(
+                f,
+                &m,
+                o,
+                d,
+                word(f, 1e-3),
+                word(f, 0.999),
+            ));
+        }
+    }
+    let neg = |w: u32| w ^ f.sign_mask();
+    let z = |x: f64| word(f, x);
+    // Exactly on edges and vertices: O' above (u0, v0), D' straight down, or slanted so that
+    // u = O'x + t D'x lands exactly on the edge value.
+    let on_edges = [
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (0.0, 1.0),
+        (0.5, 0.5),
+        (0.25, 0.75),
+        (0.0, 0.5),
+        (0.5, 0.0),
+        (-0.0, 0.5),
+        (0.5, -0.0),
+        (1.0, 1.0),
+        (0.75, 0.25),
+        (0.125, 0.875),
+    ];
+    for &(u0, v0) in &on_edges {
+        for height in [1.0, 2.0, 0.5, -1.0] {
+            for dz in [-1.0, -2.0, 1.0, -0.25] {
+                push(([z(u0), z(v0), z(height)], [0, neg(0), z(dz)], 0, inf));
+                // Slanted: t = height / -dz, O'x = u0 - t * 0.5 with D'x = 0.5.
+                let t = height / -dz;
+                push((
+                    [z(u0 - t * 0.5), z(v0 + t * 0.25), z(height)],
+                    [z(0.5), z(-0.25), z(dz)],
+                    0,
+                    inf,
+                ));
+                // t exactly at the ends of the range.
+                push(([z(u0), z(v0), z(height)], [0, 0, z(dz)], z(t), inf));
+                push(([z(u0), z(v0), z(height)], [0, 0, z(dz)], 0, z(t)));
+            }
+        }
+    }
+    // Parallel rays: D'z = +0 and -0, with O'z zero (t = NaN) or not (t = inf).
+    for dz in [0, neg(0)] {
+        for oz in [0, neg(0), z(1.0), z(-1.0)] {
+            push(([z(0.25), z(0.25), oz], [z(0.1), z(0.1), dz], neg(inf), inf));
+        }
+    }
+    // Huge and tiny coordinates, infinities, NaNs.
+    let big = f.max_finite(false);
+    let tiny = f.min_normal(false);
+    for &(a, b) in &[
+        (big, tiny),
+        (tiny, big),
+        (big, big),
+        (tiny, tiny),
+        (inf, z(1.0)),
+        (z(1.0), inf),
+    ] {
+        for s in 0..8u32 {
+            let sg = |k: u32, w: u32| if s >> k & 1 == 1 { neg(w) } else { w };
+            push((
+                [sg(0, a), sg(1, b), sg(2, a)],
+                [sg(1, b), sg(2, a), sg(0, b)],
+                0,
+                inf,
+            ));
+            push((
+                [z(0.25), z(0.25), sg(0, a)],
+                [sg(1, a), sg(2, b), sg(0, b)],
+                neg(inf),
+                inf,
+            ));
+        }
+    }
+    push(([f.nan(), z(0.2), z(1.0)], [0, 0, z(-1.0)], 0, inf));
+    push(([z(0.2), z(0.2), z(1.0)], [0, 0, z(-1.0)], f.nan(), inf));
+    push(([z(0.2), z(0.2), z(1.0)], [0, 0, z(-1.0)], 0, f.nan()));
+    for (i, r) in out.iter_mut().enumerate() {
+        r.tag = (i as u16).wrapping_mul(31337);
+    }
+    out
+}
+
+fn check_intersect(f: Format, reqs: &[IntersectRequest], got: &[IntersectResult], what: &str) {
+    assert_eq!(got.len(), reqs.len(), "{what}: result count");
+    let mut bad = 0;
+    let mut hits = 0;
+    for (i, (q, r)) in reqs.iter().zip(got).enumerate() {
+        let want = units::intersect(f, q.o, q.d, q.t_min, q.t_max);
+        hits += usize::from(want.hit);
+        let same = r.t == want.t && r.u == want.u && r.v == want.v && r.hit == want.hit;
+        if !same || r.tag != q.tag {
+            if bad < 5 {
+                eprintln!("{what} #{i}: {q:x?}: got {r:x?}, want {want:x?}");
+            }
+            bad += 1;
+        }
+    }
+    println!("{what}: {hits} hits in {} tests", reqs.len());
+    assert!(
+        hits > reqs.len() / 20,
+        "{what}: the vectors should hit often"
+    );
+    assert_eq!(bad, 0, "{what}: {bad} of {} results differ", reqs.len());
+}
+
+fn intersect_case(f: Format, n_random: usize, seed: u64, sim: Simulator) {
+    let mut reqs = intersect_random(f, n_random, seed);
+    let hard = intersect_hard(f, seed + 1);
+    let n_hard = hard.len();
+    reqs.extend(hard);
+    let dir = tempfile::tempdir().unwrap();
+    let run = run_intersect(f, &reqs, sim, dir.path()).unwrap();
+    println!(
+        "{sim} intersect {f}: {n_random} random + {n_hard} hard: compile {:.1} s, run {:.1} s",
+        run.compile_seconds, run.run_seconds
+    );
+    check_intersect(f, &reqs, &run.results, &format!("{sim} intersect {f}"));
+}
+
+/// 25k random plus every hard case in CI; the 100k run is `intersect_e7m16_icarus_100k`.
+#[test]
+fn intersect_e7m16_icarus() {
+    intersect_case(Format::E7M16, 25_000, 4201, Simulator::Icarus);
+}
+
+#[test]
+#[ignore = "about 3 minutes in Icarus; CI runs 25k"]
+fn intersect_e7m16_icarus_100k() {
+    intersect_case(Format::E7M16, 100_000, 4201, Simulator::Icarus);
+}
+
+#[test]
+fn intersect_e7m16_verilator() {
+    intersect_case(Format::E7M16, 100_000, 4201, Simulator::Verilator);
+}
+
+#[test]
+fn intersect_e8m23_icarus() {
+    intersect_case(Format::E8M23, 10_000, 4202, Simulator::Icarus);
+}
+
+#[test]
+fn intersect_e8m23_verilator() {
+    intersect_case(Format::E8M23, 100_000, 4202, Simulator::Verilator);
+}
+
+// ---------------------------------------------------------------------------------------
+// Ray generation
+
+/// Cameras of real scenes (the layout's words) at several sizes, and odd ones.
+fn raygen_frames(f: Format, sizes: &[(u16, u16)]) -> Vec<RayGenFrame> {
+    use crate::layout::{self, FrameMap, MemoryConfig, SceneTrees, FRAME};
+    use crate::scene::Scene;
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut frames = Vec::new();
+    for (i, &(w, h)) in sizes.iter().enumerate() {
+        let name = ["tiny.toml", "cornell.toml"][i % 2];
+        let text = std::fs::read_to_string(scenes.join(name)).unwrap();
+        let text = text
+            .lines()
+            .map(|l| {
+                if l.starts_with("width") {
+                    format!("width = {w}")
+                } else if l.starts_with("height") {
+                    format!("height = {h}")
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        let scene = Scene::from_toml_str(&text, &scenes, scenes.join(name)).unwrap();
+        let trees = SceneTrees::build(&scene, f).unwrap();
+        let lay = layout::build(&scene, &trees, 0, &MemoryConfig::ADM_XRC_II).unwrap();
+        frames.push(RayGenFrame {
+            width: w,
+            height: h,
+            camera: lay.words::<12>(FRAME, FrameMap::CAMERA),
+            eye: lay.words::<3>(FRAME, FrameMap::EYE),
+        });
+    }
+    frames
+}
+
+fn raygen_case(f: Format, sizes: &[(u16, u16)], seed: u64, sim: Simulator) {
+    println!("raygen {f}: seed {seed}");
+    let frames = raygen_frames(f, sizes);
+    let pixels: usize = sizes.iter().map(|&(w, h)| w as usize * h as usize).sum();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    // Threads mostly come every clock, sometimes after a pause.
+    let gaps: Vec<u32> = (0..pixels)
+        .map(|_| {
+            if rng.gen_bool(0.05) {
+                rng.gen_range(1..5)
+            } else {
+                0
+            }
+        })
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let run = run_raygen(f, &frames, &gaps, sim, dir.path()).unwrap();
+    println!(
+        "{sim} raygen {f}: {pixels} pixels in {} frames: compile {:.1} s, run {:.1} s",
+        frames.len(),
+        run.compile_seconds,
+        run.run_seconds
+    );
+    let out = &run.results;
+    assert_eq!(out.issued.len(), pixels, "{sim}: issued count");
+    assert_eq!(out.rays.len(), pixels, "{sim}: ray count");
+    let mut i = 0;
+    let mut bad = 0;
+    for fr in &frames {
+        for y in 0..fr.height {
+            for x in 0..fr.width {
+                let (ix, iy, thread) = out.issued[i];
+                assert_eq!((ix, iy), (x, y), "{sim}: pixel order at ray {i}");
+                assert_eq!(thread as usize, i % 32, "{sim}: thread of ray {i}");
+                let (t, d, o) = out.rays[i];
+                let want = units::primary_direction(f, &fr.camera, x as u32, y as u32);
+                if t != thread || d != want || o != fr.eye {
+                    if bad < 5 {
+                        eprintln!(
+                            "{sim} raygen {f} pixel ({x}, {y}): got thread {t} dir {d:x?} origin {o:x?}, want {thread} {want:x?} {:x?}",
+                            fr.eye
+                        );
+                    }
+                    bad += 1;
+                }
+                i += 1;
+            }
+        }
+    }
+    assert_eq!(bad, 0, "{sim} raygen {f}: {bad} of {pixels} rays differ");
+}
+
+#[test]
+fn raygen_e7m16_icarus() {
+    raygen_case(
+        Format::E7M16,
+        &[(16, 12), (160, 120), (3, 1), (1, 5)],
+        4301,
+        Simulator::Icarus,
+    );
+}
+
+#[test]
+fn raygen_e7m16_verilator() {
+    raygen_case(
+        Format::E7M16,
+        &[(16, 12), (400, 256), (3, 1), (1, 5)],
+        4301,
+        Simulator::Verilator,
+    );
+}
+
+#[test]
+fn raygen_e8m23_both() {
+    for sim in Simulator::ALL {
+        raygen_case(Format::E8M23, &[(64, 48), (7, 3)], 4302, sim);
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Lint and synthesis
+
+/// `verilator --lint-only -Wall` is clean on every unit in e7m16 and e8m23 (with the waiver
+/// block documented in `CORE_WAIVER` around the generated core, none on the tops).
+#[test]
+fn verilator_lint_wall_is_clean() {
+    let dir = tempfile::tempdir().unwrap();
+    for f in [Format::E7M16, Format::E8M23] {
+        for unit in GeometryUnit::ALL {
+            let rtl = geometry_unit_rtl(unit, f).unwrap();
+            let path = dir.path().join(format!("{}.v", rtl.top));
+            std::fs::write(&path, &rtl.verilog).unwrap();
+            let report = sim::lint(&[path], &rtl.top).unwrap();
+            assert!(report.is_clean(), "{}: {report}", rtl.top);
+        }
+    }
+}
+
+/// Synthesis for Virtex-II: multiplier counts as the operator counts predict (e7m16: one
+/// MULT18X18 per product; e8m23: four; RayGen's z = 0 makes three of the nine products a
+/// constant shift, so its private unit keeps six), and prints the figures.
+fn synthesize(f: Format) {
+    let dir = tempfile::tempdir().unwrap();
+    for unit in [
+        GeometryUnit::Transform,
+        GeometryUnit::RayGen,
+        GeometryUnit::Intersect,
+    ] {
+        let r = synth_unit(unit, f, &dir.path().join(format!("{unit}_{f}"))).unwrap();
+        let (add, mul, div) = unit.paper_operators();
+        println!(
+            "SYNTH {unit} {f}: LUTs {} FFs {} MULT18X18 {} RAMB16 {} depth {} ({:.0} s); paper: {add} add {mul} mul {div} div",
+            r.total_luts(),
+            r.flip_flops,
+            r.mult18x18,
+            r.block_rams,
+            r.logic_depth,
+            r.seconds
+        );
+        let per_product = if f.man_bits <= 17 { 1 } else { 4 };
+        let products = if unit == GeometryUnit::RayGen {
+            6
+        } else {
+            u64::from(mul)
+        };
+        assert_eq!(r.mult18x18, products * per_product, "{unit} {f}");
+    }
+}
+
+#[test]
+#[ignore = "yosys takes ~15 minutes; run with --ignored for the figures"]
+fn yosys_xc2v_synthesis_e7m16() {
+    synthesize(Format::E7M16);
+}
+
+#[test]
+#[ignore = "yosys takes ~20 minutes; run with --ignored for the figures"]
+fn yosys_xc2v_synthesis_e8m23() {
+    synthesize(Format::E8M23);
+}
+
+/// The arbiter's cost: the shared unit against the bare transform unit (same 9 products).
+#[test]
+#[ignore = "yosys takes a few minutes; run with --ignored for the figures"]
+fn yosys_xc2v_synthesis_shared_transform_e7m16() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = Format::E7M16;
+    let r = synth_unit(GeometryUnit::SharedTransform, f, dir.path()).unwrap();
+    println!(
+        "SYNTH shared_transform {f}: LUTs {} FFs {} MULT18X18 {} RAMB16 {} depth {} ({:.0} s)",
+        r.total_luts(),
+        r.flip_flops,
+        r.mult18x18,
+        r.block_rams,
+        r.logic_depth,
+        r.seconds
+    );
+    assert_eq!(r.mult18x18, 9);
+}
