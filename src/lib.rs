@@ -8,6 +8,7 @@
 //! never imports `model` (they meet in tests).
 
 pub mod accel;
+pub mod bench;
 pub mod compare;
 pub mod emit;
 pub mod fp;
@@ -17,4 +18,5 @@ pub mod model;
 pub mod output;
 pub mod scene;
 pub mod sim;
+pub mod stress;
 pub mod synth;
