@@ -7,7 +7,7 @@ fn main() -> anyhow::Result<()> {
         c.rays = r.parse()?;
     }
     if let Some(m) = a.get(2) {
-        c.edge_margin = m.parse()?;
+        c.edge_margins = m.split(',').map(str::parse).collect::<Result<_, _>>()?;
     }
     if let Some(d) = a.get(3).filter(|d| !d.is_empty() && *d != "-") {
         c.mesh_dir = Some(d.into());

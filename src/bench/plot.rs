@@ -102,27 +102,28 @@ pub fn scatter_with_front(
                     } else {
                         BLUE.mix(0.6).filled()
                     };
-                    chart
-                        .draw_series(std::iter::once(Circle::new(
-                            (p.cost, y(p.error)),
-                            if on { 6 } else { 4 },
-                            style,
-                        )))
-                        .map_err(|e| anyhow!("{e}"))?;
-                    chart
-                        .draw_series(std::iter::once(Text::new(
+                    // Labels alternate above and below their point so neighbours overlap less.
+                    let offset = if i % 2 == 0 { (6, -16) } else { (6, 4) };
+                    let marker = EmptyElement::at((p.cost, y(p.error)))
+                        + Circle::new((0, 0), if on { 6 } else { 4 }, style)
+                        + Text::new(
                             p.label.clone(),
-                            (p.cost, y(p.error)),
+                            offset,
                             ("sans-serif", 13).into_font().color(&BLACK),
-                        )))
+                        );
+                    chart
+                        .draw_series(std::iter::once(marker))
                         .map_err(|e| anyhow!("{e}"))?;
                 }
                 chart
-                    .draw_series(std::iter::once(Text::new(
-                        "red: Pareto front".to_string(),
-                        (xmin, ymax),
-                        ("sans-serif", 14).into_font().color(&RED),
-                    )))
+                    .draw_series(std::iter::once(
+                        EmptyElement::at((xmin, ymax))
+                            + Text::new(
+                                "red: Pareto front".to_string(),
+                                (10, 6),
+                                ("sans-serif", 14).into_font().color(&RED),
+                            ),
+                    ))
                     .map_err(|e| anyhow!("{e}"))?;
             }};
         }

@@ -65,7 +65,7 @@ impl SweepConfig {
             formats: crate::hw::fp::supported_formats(),
             width: 96,
             height: 72,
-            edge_margin_ulps: crate::stress::DEFAULT_EDGE_MARGIN,
+            edge_margin_ulps: 0.0,
             cost_csv: PathBuf::from("out/bench/fp_cost.csv"),
             synth_dir: std::env::temp_dir().join("dynrt-fp-cost"),
             synthesize: true,

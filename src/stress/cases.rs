@@ -353,26 +353,13 @@ pub fn placed(tris: &[[DVec3; 3]], s: DVec3, t: DVec3) -> Tris {
     )
 }
 
-/// The configuration's format list with the exact caster first.
-pub fn formats_with_exact(config: &StressConfig) -> Vec<Option<Format>> {
-    std::iter::once(None)
-        .chain(config.formats.iter().copied().map(Some))
-        .collect()
-}
-
-/// Rows for one ray case across formats.
+/// Rows for one ray case across formats and edge margins (the exact caster once).
 pub fn ray_case_rows(case: &RayCase, config: &StressConfig) -> Vec<CaseResult> {
-    formats_with_exact(config)
+    runs(config)
         .into_iter()
-        .map(|f| {
-            let mut row = CaseResult::new(
-                &case.name,
-                &case.subject.name,
-                f,
-                config.edge_margin,
-                case.limit,
-            );
-            match run_ray_case(case, f, config.edge_margin) {
+        .map(|(f, margin)| {
+            let mut row = CaseResult::new(&case.name, &case.subject.name, f, margin, case.limit);
+            match run_ray_case(case, f, margin) {
                 Ok((rays, failures)) => {
                     row.rays = rays;
                     row.failures = failures;
@@ -384,6 +371,17 @@ pub fn ray_case_rows(case: &RayCase, config: &StressConfig) -> Vec<CaseResult> {
         .collect()
 }
 
+/// (format, margin) pairs of a run: the exact caster once, then every format at every margin.
+fn runs(config: &StressConfig) -> Vec<(Option<Format>, f64)> {
+    let mut v = vec![(None, 0.0)];
+    for &f in &config.formats {
+        for &m in &config.edge_margins {
+            v.push((Some(f), m));
+        }
+    }
+    v
+}
+
 /// Rows for a camera inside a closed mesh: every pixel must hit, no colour may be NaN/inf.
 pub fn camera_rows(
     subject: &Subject,
@@ -391,17 +389,17 @@ pub fn camera_rows(
     case: &str,
     limit: Limit,
 ) -> Vec<CaseResult> {
-    formats_with_exact(config)
+    runs(config)
         .into_iter()
-        .map(|f| {
-            let mut row = CaseResult::new(case, &subject.name, f, config.edge_margin, limit);
+        .map(|(f, margin)| {
+            let mut row = CaseResult::new(case, &subject.name, f, margin, limit);
             match f {
                 None => {
                     (row.rays, row.failures) = reference_misses(&subject.scene);
                 }
                 Some(f) => match layout_for(&subject.scene, f) {
                     Ok(l) => {
-                        let g = Golden::with_edge_margin(&l, margin_for(f, config.edge_margin));
+                        let g = Golden::with_edge_margin(&l, margin_for(f, margin));
                         let (px, miss, bad) = render_check(&g);
                         (row.rays, row.failures, row.nonfinite) = (px, miss, bad);
                     }

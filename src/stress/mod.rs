@@ -19,10 +19,16 @@
 //! Every scene case also renders its camera and counts shaded colours with a NaN or infinite
 //! channel (`nonfinite`), which must be zero everywhere.
 //!
-//! Invariants ([`Limit`]): the exact caster never fails; nothing non-finite reaches a pixel; on
-//! `Watertight` cases (closed meshes at ordinary scale and position) formats with at least 16
-//! mantissa bits leak at most [`WATERTIGHT_PPM`] rays per million. Other rates are documented
-//! limits: measured and printed, not asserted.
+//! Every format runs at each edge margin of the configuration (default 0, what the hardware
+//! computes, and [`RECOMMENDED_EDGE_MARGIN`]), so the table shows the mitigation's benefit and
+//! cost side by side.
+//!
+//! Invariants ([`Limit`]): the exact caster never fails; nothing non-finite reaches a pixel;
+//! inside cameras of closed meshes at ordinary scale leak at most [`WATERTIGHT_PPM`] rays per
+//! million in formats with at least 16 mantissa bits; so do edge-aimed rays once an edge margin
+//! is on. Other rates (edge-aimed rays without a margin, slivers, extreme scales and positions,
+//! grazing rays, acne, narrow formats) are documented limits: measured and printed, not
+//! asserted by the suite (the regression tests pin them with bounds).
 
 pub mod cases;
 pub mod geometry;
@@ -40,8 +46,11 @@ use geometry::TestScene;
 /// The target: at most 1 leaked ray in 10,000 at e7m16 on closed meshes.
 pub const WATERTIGHT_PPM: f64 = 100.0;
 
-/// The default unit-triangle edge margin of the study, in units of 2^-mantissa bits.
-pub const DEFAULT_EDGE_MARGIN: f64 = 0.0;
+/// The unit-triangle edge margin the study recommends, in units of 2^-mantissa bits
+/// (2^-12 at e7m16): it closes the cracks exact-edge rays find and leaves the images'
+/// accuracy unchanged within the sweep's noise (see README). The golden model and the
+/// hardware use margin 0 until the intersection unit adopts it.
+pub const RECOMMENDED_EDGE_MARGIN: f64 = 16.0;
 
 /// How a case's failure rate is judged.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,6 +58,9 @@ pub enum Limit {
     /// Closed meshes at ordinary scale: f64 must not fail, formats with >= 16 mantissa bits
     /// at most [`WATERTIGHT_PPM`].
     Watertight,
+    /// Rays aimed exactly at shared edges: as `Watertight` with an edge margin; without one,
+    /// the per-triangle rounding leaks about one such ray in ten in every format, documented.
+    EdgeAimed,
     /// f64 must not fail; the formats' rates are documented, not bounded.
     Documented,
     /// Nothing is bounded but non-finite colours (cases that are about overflow).
@@ -57,11 +69,13 @@ pub enum Limit {
 
 impl Limit {
     /// The bound in failures per million for a format (`None` = exact f64), if any.
-    pub fn bound_ppm(self, format: Option<Format>) -> Option<f64> {
+    /// `margin` is the edge margin in units of 2^-mantissa bits.
+    pub fn bound_ppm(self, format: Option<Format>, margin: f64) -> Option<f64> {
         match (self, format) {
             (Limit::NonFiniteOnly, _) => None,
             (_, None) => Some(0.0),
             (Limit::Watertight, Some(f)) if f.man_bits >= 16 => Some(WATERTIGHT_PPM),
+            (Limit::EdgeAimed, Some(f)) if f.man_bits >= 16 && margin > 0.0 => Some(WATERTIGHT_PPM),
             _ => None,
         }
     }
@@ -77,9 +91,10 @@ pub struct StressConfig {
     /// Resolution of the camera cases.
     pub width: u32,
     pub height: u32,
-    /// Edge margin of the unit-triangle test (see `model::units::intersect_with_margin`), in
-    /// units of the format's spacing at 1 (2^-mantissa bits): 64 means 2^-10 at e7m16.
-    pub edge_margin: f64,
+    /// Edge margins of the unit-triangle test to run every format with (see
+    /// `model::units::intersect_with_margin`), in units of the format's spacing at 1
+    /// (2^-mantissa bits): 16 means 2^-12 at e7m16; 0 is what the hardware computes.
+    pub edge_margins: Vec<f64>,
     /// Where public meshes live (`/work/shared/scenes/meshes`); closed ones join `edge_rays`
     /// and `inside_camera`.
     pub mesh_dir: Option<PathBuf>,
@@ -98,7 +113,7 @@ impl Default for StressConfig {
             rays: 20_000,
             width: 64,
             height: 48,
-            edge_margin: DEFAULT_EDGE_MARGIN,
+            edge_margins: vec![0.0, RECOMMENDED_EDGE_MARGIN],
             mesh_dir: None,
             quick: false,
         }
@@ -129,12 +144,12 @@ impl CaseResult {
             case: case.into(),
             subject: subject.into(),
             format: f.map_or("f64".into(), |f| f.to_string()),
-            edge_margin: margin,
+            edge_margin: if f.is_some() { margin } else { 0.0 },
             rays: 0,
             failures: 0,
             nonfinite: 0,
             limit,
-            bound_ppm: limit.bound_ppm(f),
+            bound_ppm: limit.bound_ppm(f, margin),
             held: true,
             note: String::new(),
         }
@@ -166,10 +181,10 @@ impl StressReport {
         self.rows.iter().filter(|r| !r.held).collect()
     }
     /// The row of one case, subject and format.
-    pub fn row(&self, case: &str, subject: &str, format: &str) -> Option<&CaseResult> {
-        self.rows
-            .iter()
-            .find(|r| r.case == case && r.subject == subject && r.format == format)
+    pub fn row(&self, case: &str, subject: &str, format: &str, margin: f64) -> Option<&CaseResult> {
+        self.rows.iter().find(|r| {
+            r.case == case && r.subject == subject && r.format == format && r.edge_margin == margin
+        })
     }
     /// A fixed-width text table.
     pub fn table(&self) -> String {
@@ -320,7 +335,7 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
             subject,
             rays,
             check: Check::MustHit,
-            limit: Limit::Watertight,
+            limit: Limit::EdgeAimed,
         };
         rows.extend(cases::ray_case_rows(&case, config));
         if let Some(&eye) = inside.first() {
@@ -390,7 +405,7 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
             subject,
             rays,
             check: Check::MustHit,
-            limit: Limit::Watertight,
+            limit: Limit::EdgeAimed,
         };
         rows.extend(cases::ray_case_rows(&case, config));
         rows.extend(cases::camera_rows(
@@ -472,7 +487,7 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
             subject,
             rays,
             check: Check::MustHit,
-            limit: Limit::Watertight,
+            limit: Limit::EdgeAimed,
         };
         rows.extend(cases::ray_case_rows(&case, config));
         let subject = Subject::new(dir, name, &tris, &outside)?;
@@ -509,7 +524,7 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
             subject,
             rays,
             check: Check::ShadowAcne { light },
-            limit: Limit::Watertight,
+            limit: Limit::Documented,
         };
         rows.extend(cases::ray_case_rows(&case, config));
         let case = RayCase {
@@ -530,4 +545,109 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
         seed: config.seed,
         rows,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The suite at CI size: every case, three formats, both margins, a few thousand rays.
+    fn quick_report() -> StressReport {
+        let config = StressConfig {
+            formats: ["e5m10", "e7m16", "e8m23"]
+                .iter()
+                .map(|s| Format::parse(s).unwrap())
+                .collect(),
+            seed: 6,
+            rays: 3000,
+            width: 24,
+            height: 18,
+            quick: true,
+            ..StressConfig::default()
+        };
+        println!("stress seed {}", config.seed);
+        let report = run_stress(&config, &mut |_| {}).unwrap();
+        println!("{}", report.table());
+        report
+    }
+
+    fn ppm(r: &StressReport, case: &str, subject: &str, format: &str, margin: f64) -> f64 {
+        r.row(case, subject, format, margin)
+            .unwrap_or_else(|| panic!("no row {case} {subject} {format} {margin}"))
+            .ppm()
+    }
+
+    #[test]
+    fn stress_suite_invariants_hold_and_measured_limits_stay_within_bounds() {
+        let r = quick_report();
+        let broken: Vec<String> = r.broken().iter().map(|b| format!("{b:?}")).collect();
+        assert!(
+            broken.is_empty(),
+            "broken invariants:\n{}",
+            broken.join("\n")
+        );
+        for row in &r.rows {
+            assert_eq!(row.nonfinite, 0, "{row:?}");
+            if row.format == "f64" && row.limit != Limit::NonFiniteOnly {
+                assert_eq!(row.failures, 0, "the exact caster never fails: {row:?}");
+            }
+        }
+        let m = RECOMMENDED_EDGE_MARGIN;
+        for subject in ["icosphere", "box", "icosphere_instanced"] {
+            // The target: inside a closed mesh at e7m16, at most 1 leak in 10,000.
+            assert!(ppm(&r, "inside_camera", &format!("{subject}_cam"), "e7m16", 0.0) <= 100.0);
+            // The margin closes the cracks that rays aimed exactly at shared edges find.
+            assert_eq!(ppm(&r, "edge_rays", subject, "e7m16", m), 0.0, "{subject}");
+            assert_eq!(ppm(&r, "edge_rays", subject, "e8m23", m), 0.0, "{subject}");
+        }
+        // Without it they leak: the rate every non-watertight unit-triangle test shows
+        // (measured 9-12% on the icosphere in every format); if this drops to zero the test
+        // has become watertight and the margin may no longer be needed.
+        let open = ppm(&r, "edge_rays", "icosphere", "e7m16", 0.0);
+        assert!((20_000.0..=300_000.0).contains(&open), "{open}");
+        assert_eq!(ppm(&r, "axis_rays", "box", "e7m16", 0.0), 0.0);
+        assert_eq!(ppm(&r, "axis_rays", "icosphere", "e7m16", m), 0.0);
+        // Acne on convex meshes (measured 330-1000 per million at e7m16, 0 at e8m23).
+        for margin in [0.0, m] {
+            assert!(ppm(&r, "acne_shadow", "icosphere", "e7m16", margin) <= 3000.0);
+            assert!(ppm(&r, "acne_mirror", "icosphere", "e7m16", margin) <= 3000.0);
+            assert!(ppm(&r, "acne_shadow", "box", "e7m16", margin) <= 1000.0);
+            assert_eq!(ppm(&r, "acne_shadow", "icosphere", "e8m23", margin), 0.0);
+        }
+        // Slivers and needles hold at e7m16; e5m10 cannot resolve a 1e-3 needle.
+        assert_eq!(ppm(&r, "needle", "needle", "e7m16", 0.0), 0.0);
+        assert_eq!(ppm(&r, "pancake", "pancake", "e7m16", 0.0), 0.0);
+        // A radius-1e-2 object 1e3 from the origin is below e7m16's resolution there (ulp
+        // 2^-6 at 1024): a documented limit, most rays are lost.
+        assert!(ppm(&r, "far_small", "far_small", "e7m16", m) > 100_000.0);
+        // e5m10 cannot hold a scene of 1e5 units: refused with a message, not a panic.
+        let refused = r.row("scale_1e5", "scale_1e5", "e5m10", 0.0).unwrap();
+        assert!(
+            refused.note.starts_with("refused:") && refused.rays == 0,
+            "{refused:?}"
+        );
+    }
+
+    #[test]
+    fn bounds_follow_the_limit_kind() {
+        let e7 = Some(Format::E7M16);
+        let e5 = Some(Format::E5M10);
+        assert_eq!(Limit::Watertight.bound_ppm(None, 0.0), Some(0.0));
+        assert_eq!(Limit::Watertight.bound_ppm(e7, 0.0), Some(WATERTIGHT_PPM));
+        assert_eq!(Limit::Watertight.bound_ppm(e5, 0.0), None);
+        assert_eq!(Limit::EdgeAimed.bound_ppm(e7, 0.0), None);
+        assert_eq!(Limit::EdgeAimed.bound_ppm(e7, 16.0), Some(WATERTIGHT_PPM));
+        assert_eq!(Limit::NonFiniteOnly.bound_ppm(None, 0.0), None);
+        let mut row = CaseResult::new("c", "s", e7, 0.0, Limit::Watertight);
+        (row.rays, row.failures) = (10_000, 1);
+        assert!(
+            row.clone().finish().held,
+            "100 per million is within the bound"
+        );
+        row.failures = 2;
+        assert!(!row.clone().finish().held);
+        row.failures = 0;
+        row.nonfinite = 1;
+        assert!(!row.finish().held, "a non-finite pixel always breaks");
+    }
 }
