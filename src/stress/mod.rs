@@ -302,25 +302,32 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
 
     // Closed meshes at ordinary scale.
     let sphere = geometry::icosphere(if config.quick { 2 } else { 3 })?;
-    let mut closed: Vec<(String, geometry::Tris, Option<_>)> = vec![
-        ("icosphere".into(), sphere.clone(), None),
+    // (name, triangles, instance, limit of the edge-aimed rays)
+    let mut closed: Vec<(String, geometry::Tris, Option<_>, Limit)> = vec![
+        ("icosphere".into(), sphere.clone(), None, Limit::EdgeAimed),
         (
             "box".into(),
             geometry::box_mesh(DVec3::new(1.0, 0.7, 1.3)),
             None,
+            Limit::EdgeAimed,
         ),
         (
             "icosphere_instanced".into(),
             sphere.clone(),
             Some(cases::INSTANCE),
+            Limit::EdgeAimed,
         ),
     ];
     if let (Some(d), false) = (&config.mesh_dir, config.quick) {
+        // Dense meshes seen from inside put the ray origin tens to hundreds of triangle sizes
+        // away, and the unit-triangle test's rounding in u, v grows with that ratio: a margin
+        // of a fixed number of ulps narrows their exact-edge leaks but does not close them.
+        // Documented; their inside cameras stay bounded.
         for (name, tris) in closed_public_meshes(d)? {
-            closed.push((name, tris, None));
+            closed.push((name, tris, None, Limit::Documented));
         }
     }
-    for (name, tris, instance) in &closed {
+    for (name, tris, instance, edge_limit) in &closed {
         log(&format!("edge_rays / inside_camera: {name}"));
         let s = TestScene {
             instance: *instance,
@@ -335,7 +342,7 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
             subject,
             rays,
             check: Check::MustHit,
-            limit: Limit::EdgeAimed,
+            limit: *edge_limit,
         };
         rows.extend(cases::ray_case_rows(&case, config));
         if let Some(&eye) = inside.first() {
