@@ -19,4 +19,5 @@ pub mod model;
 pub mod output;
 pub mod scene;
 pub mod sim;
+pub mod stress;
 pub mod synth;

@@ -1,7 +1,21 @@
-//! Benchmarks: speed, size and error measured on this machine and written as CSV and
-//! Markdown tables under a report directory. Nothing here asserts timings; tests check only
-//! that the figures are computed from real runs.
+//! Benchmarks: speed, size, hardware cost and error measured on this machine and written as
+//! CSV, Markdown and PNG reports. Nothing here asserts timings.
+//!
+//! - [`fp`]: FP operators' latency, yosys xc2v resources and Verilator speed (`dynrt bench fp`);
+//! - [`scenes`]: per bundled scene, tree build, layout size, renderer speed and golden error
+//!   (`dynrt bench scenes`);
+//! - [`cost`]: per-format operator cost from yosys (cached CSV) and the datapath estimate;
+//! - [`precision`]: the sweep over scenes and formats, CSV, summaries, recommendation
+//!   (`dynrt bench precision`);
+//! - [`plot`]: PNG scatter plots with the Pareto front ([`pareto`]);
+//! - [`table`]: CSV and Markdown tables.
 
+pub mod cost;
 pub mod fp;
+pub mod pareto;
+pub mod plot;
+pub mod precision;
 pub mod scenes;
 pub mod table;
+
+pub use precision::{precision_sweep, recommend, summarize, write_outputs, FormatSummary, Row, SweepConfig};

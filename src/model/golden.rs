@@ -63,6 +63,9 @@ impl std::ops::AddAssign for RayStats {
 pub struct Pixel {
     /// Frame-buffer word `0x00RRGGBB`.
     pub rgb: u32,
+    /// The shaded colour before packing (format words): the stress suite checks that no NaN
+    /// or infinity reaches a pixel, which packing (NaN to 0) would hide.
+    pub color: Vec3W,
     /// Primary ray direction (world space, format words).
     pub dir: Vec3W,
     pub hit: Option<Hit>,
@@ -112,6 +115,17 @@ struct Query {
 pub struct Golden<'a> {
     layout: &'a Layout,
     f: Format,
+    /// Edge margin of the unit-triangle test (a format word; 0 = the exact test of
+    /// [`units::intersect`]). An experiment of the precision study, see
+    /// [`units::intersect_with_margin`]; the hardware implements margin 0.
+    edge_margin: u32,
+}
+
+/// The outcome of one ray traced with [`Golden::trace_ray`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RayResult {
+    pub hit: Option<Hit>,
+    pub stats: RayStats,
 }
 
 impl<'a> Golden<'a> {
@@ -119,7 +133,47 @@ impl<'a> Golden<'a> {
         Golden {
             layout,
             f: layout.format,
+            edge_margin: 0,
         }
+    }
+
+    /// A golden model whose unit-triangle test accepts `u, v >= -margin` and
+    /// `u + v <= 1 + margin` (margin in unit-triangle coordinates, rounded to the format).
+    /// Not what the hardware computes unless the hardware adopts the same margin.
+    pub fn with_edge_margin(layout: &'a Layout, margin: f64) -> Self {
+        Golden {
+            edge_margin: layout.format.from_f64(margin.abs()),
+            ..Golden::new(layout)
+        }
+    }
+
+    pub fn layout(&self) -> &'a Layout {
+        self.layout
+    }
+
+    /// Traces one world-space ray `o + t d`, t in (t_min, t_max), exactly as the renderer
+    /// traces its rays (closest hit, or the first hit found when `any`), optionally skipping one
+    /// (instance, global triangle). For stress tests and studies of single rays.
+    pub fn trace_ray(
+        &self,
+        o: Vec3W,
+        d: Vec3W,
+        t_min: u32,
+        t_max: u32,
+        skip: Option<(u32, u32)>,
+        any: bool,
+    ) -> RayResult {
+        let mut stats = RayStats::default();
+        let q = Query {
+            o,
+            d,
+            t_min,
+            t_max,
+            skip,
+            any,
+        };
+        let hit = self.trace(q, &mut stats);
+        RayResult { hit, stats }
     }
 
     fn frame_words<const N: usize>(&self, addr: usize) -> [u32; N] {
@@ -145,6 +199,7 @@ impl<'a> Golden<'a> {
         let (color, hit) = self.shade(query, 0, &mut stats);
         Pixel {
             rgb: units::pack_rgb(f, color),
+            color,
             dir,
             hit,
             stats,
@@ -319,7 +374,11 @@ impl<'a> Golden<'a> {
             let o = units::transform(f, &m, q.o, true);
             let d = units::transform(f, &m, q.d, false);
             let t_max = best.map_or(q.t_max, |b| b.t);
-            let r = units::intersect(f, o, d, q.t_min, t_max);
+            let r = if self.edge_margin == 0 {
+                units::intersect(f, o, d, q.t_min, t_max)
+            } else {
+                units::intersect_with_margin(f, o, d, q.t_min, t_max, self.edge_margin)
+            };
             if r.hit {
                 *best = Some(Hit {
                     t: r.t,

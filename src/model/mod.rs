@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;
 
-pub use golden::{Golden, RayStats};
+pub use golden::{Golden, RayResult, RayStats};
 pub use reference::Reference;
 
 /// The primary hit of a pixel as the hits file reports it.
@@ -113,7 +113,12 @@ pub(crate) fn progress_bar(show: bool, rows: u32, what: &str) -> ProgressBar {
 
 /// Renders a frame with the golden model, in parallel, with a progress bar when `progress`.
 pub fn render_golden(layout: &Layout, progress: bool) -> Frame {
-    let golden = Golden::new(layout);
+    render_with(&Golden::new(layout), progress)
+}
+
+/// Renders a frame with a configured golden model (see [`Golden::with_edge_margin`]).
+pub fn render_with(golden: &Golden, progress: bool) -> Frame {
+    let layout = golden.layout();
     let (w, h) = (layout.info.width, layout.info.height);
     let f = layout.format;
     let bar = if progress {

@@ -73,6 +73,31 @@ pub fn intersect(f: Format, o: Vec3W, d: Vec3W, t_min: u32, t_max: u32) -> UnitH
     UnitHit { t, u, v, hit }
 }
 
+/// The unit-triangle test with a conservative edge margin: a hit when `-margin <= u`,
+/// `-margin <= v` and `u + v <= 1 + margin` (and t in range). The bounds are constants
+/// (`-margin` and `1 + margin`, each rounded once), so in hardware the margin costs no operator:
+/// the comparators compare against other constants. With `margin` = 0 this is exactly
+/// [`intersect`]. Grows every triangle by `margin` in unit-triangle coordinates (a fraction of
+/// its size) so that rounding cannot open a crack along a shared edge; the precision study
+/// (`bench`, `stress`) measures what it closes and what it adds at silhouettes.
+pub fn intersect_with_margin(
+    f: Format,
+    o: Vec3W,
+    d: Vec3W,
+    t_min: u32,
+    t_max: u32,
+    margin: u32,
+) -> UnitHit {
+    let lo = f.neg(margin);
+    let hi = f.add(f.one(), margin);
+    let t = f.div(f.neg(o[2]), d[2]);
+    let u = f.add(o[0], f.mul(t, d[0]));
+    let v = f.add(o[1], f.mul(t, d[1]));
+    let inside = f.le(lo, u) && f.le(lo, v) && f.le(f.add(u, v), hi);
+    let hit = inside && f.lt(t_min, t) && f.lt(t, t_max);
+    UnitHit { t, u, v, hit }
+}
+
 /// Which children of an inner kd node a ray segment [t_min, t_max] visits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Visit {
@@ -177,4 +202,47 @@ pub fn mix_mirror(f: Format, local: Vec3W, reflected: Vec3W, m: u32) -> Vec3W {
 pub fn pack_rgb(f: Format, c: Vec3W) -> u32 {
     let [r, g, b] = c.map(|x| u32::from(f.to_u8(x)));
     (r << 16) | (g << 8) | b
+}
+
+#[cfg(test)]
+mod margin_tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn margin_zero_is_the_exact_test_and_a_margin_only_adds_hits_near_edges() {
+        let seed = 61;
+        println!("seed {seed}");
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        for f in [Format::E7M16, Format::E8M23, Format::E5M10] {
+            // Wide enough that random rays land in it often.
+            let margin = f.from_f64(0.05);
+            let (mut added, mut near_edge) = (0, 0);
+            for _ in 0..20_000 {
+                let mut w = || f.from_f64(rng.gen_range(-2.0..2.0));
+                let (o, d) = ([w(), w(), w()], [w(), w(), w()]);
+                let inf = f.infinity(false);
+                let exact = intersect(f, o, d, 0, inf);
+                assert_eq!(intersect_with_margin(f, o, d, 0, inf, 0), exact, "{f}");
+                let wide = intersect_with_margin(f, o, d, 0, inf, margin);
+                assert_eq!((wide.t, wide.u, wide.v), (exact.t, exact.u, exact.v));
+                assert!(wide.hit || !exact.hit, "a margin never loses a hit");
+                if wide.hit && !exact.hit {
+                    added += 1;
+                    let (u, v) = (f.to_f64(wide.u), f.to_f64(wide.v));
+                    let m = f.to_f64(margin);
+                    // Only points within the margin of the triangle's edges are added.
+                    assert!(u < 0.0 || v < 0.0 || u + v > 1.0);
+                    assert!(u >= -m && v >= -m && u + v <= 1.0 + 2.0 * m, "{u} {v}");
+                    near_edge += 1;
+                }
+            }
+            println!("{f}: margin adds {added} hits, all within it of an edge ({near_edge})");
+            assert!(
+                added > 0,
+                "{f}: random rays must sometimes land in the margin"
+            );
+        }
+    }
 }

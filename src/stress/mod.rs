@@ -1,0 +1,660 @@
+//! `dynrt stress`: a seeded, reproducible suite that tries to break the arithmetic of the
+//! golden model (and so of the hardware, which computes the same words), run for each number
+//! format of interest plus the exact f64 caster.
+//!
+//! Cases (see [`cases`] for what counts as a failure):
+//! - `edge_rays`: rays from inside closed meshes aimed at shared vertices and edges (an
+//!   icosphere, a box, the icosphere through a rotated, non-uniformly scaled instance, and the
+//!   closed public meshes when a mesh directory is given);
+//! - `inside_camera`: a camera inside a closed mesh, every pixel must hit;
+//! - `needle`, `pancake`: convex meshes of 1000:1 aspect (sliver and needle triangles), rays from
+//!   outside aimed at interior points; `degenerate`: a box holding zero-area and 1e-9-sized
+//!   triangles (the layout drops what it cannot represent);
+//! - `scale_1e-3`, `scale_1e5`, `far_small`, `far_small_instanced`: the icosphere at radius
+//!   1e-3 and 1e5, and at radius 1e-2 placed 1e3 from the origin;
+//! - `axis_rays`: rays along the axes and in coordinate planes (zero direction components),
+//!   from origins exactly on kd split planes; `grazing`: rays at 0.5..5 degrees to the surface;
+//! - `acne_shadow`, `acne_mirror`: self-intersection of secondary rays on convex meshes.
+//!
+//! Every scene case also renders its camera and counts shaded colours with a NaN or infinite
+//! channel (`nonfinite`), which must be zero everywhere.
+//!
+//! Every format runs at each edge margin of the configuration (default 0, what the hardware
+//! computes, and [`RECOMMENDED_EDGE_MARGIN`]), so the table shows the mitigation's benefit and
+//! cost side by side.
+//!
+//! Invariants ([`Limit`]): the exact caster never fails; nothing non-finite reaches a pixel;
+//! inside cameras of closed meshes at ordinary scale leak at most [`WATERTIGHT_PPM`] rays per
+//! million in formats with at least 16 mantissa bits; so do edge-aimed rays once an edge margin
+//! is on. Other rates (edge-aimed rays without a margin, slivers, extreme scales and positions,
+//! grazing rays, acne, narrow formats) are documented limits: measured and printed, not
+//! asserted by the suite (the regression tests pin them with bounds).
+
+pub mod cases;
+pub mod geometry;
+
+use crate::fp::Format;
+use anyhow::{Context, Result};
+use glam::DVec3;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use std::path::{Path, PathBuf};
+
+use cases::{Check, RayCase, Subject};
+use geometry::TestScene;
+
+/// The issue's target: at most 1 leaked ray in 10,000 at e7m16 on closed meshes.
+pub const WATERTIGHT_PPM: f64 = 100.0;
+
+/// The unit-triangle edge margin the study recommends, in units of 2^-mantissa bits
+/// (2^-10 at e7m16): it closes the cracks inside cameras and exact-edge rays find, costs no
+/// operator, and moves silhouettes by 2^-10 of a triangle (see PRECISION.md). The golden model and the
+/// hardware use margin 0 until the intersection unit adopts it.
+pub const RECOMMENDED_EDGE_MARGIN: f64 = 64.0;
+
+/// How a case's failure rate is judged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Limit {
+    /// Closed meshes at ordinary scale: f64 must not fail, formats with >= 16 mantissa bits
+    /// at most [`WATERTIGHT_PPM`].
+    Watertight,
+    /// Rays aimed exactly at shared edges: as `Watertight` with an edge margin; without one,
+    /// the per-triangle rounding leaks about one such ray in ten in every format, documented.
+    EdgeAimed,
+    /// f64 must not fail; the formats' rates are documented, not bounded.
+    Documented,
+    /// Nothing is bounded but non-finite colours (cases that are about overflow).
+    NonFiniteOnly,
+}
+
+impl Limit {
+    /// The bound in failures per million for a format (`None` = exact f64), if any.
+    /// `margin` is the edge margin in units of 2^-mantissa bits.
+    pub fn bound_ppm(self, format: Option<Format>, margin: f64) -> Option<f64> {
+        match (self, format) {
+            (Limit::NonFiniteOnly, _) => None,
+            (_, None) => Some(0.0),
+            (Limit::Watertight, Some(f)) if f.man_bits >= 16 => Some(WATERTIGHT_PPM),
+            (Limit::EdgeAimed, Some(f)) if f.man_bits >= 16 && margin > 0.0 => Some(WATERTIGHT_PPM),
+            _ => None,
+        }
+    }
+}
+
+/// Settings of a stress run.
+#[derive(Clone, Debug)]
+pub struct StressConfig {
+    pub formats: Vec<Format>,
+    pub seed: u64,
+    /// Rays per ray case.
+    pub rays: usize,
+    /// Resolution of the camera cases.
+    pub width: u32,
+    pub height: u32,
+    /// Edge margins of the unit-triangle test to run every format with (see
+    /// `model::units::intersect_with_margin`), in units of the format's spacing at 1
+    /// (2^-mantissa bits): 64 means 2^-10 at e7m16; 0 is what the hardware computes.
+    pub edge_margins: Vec<f64>,
+    /// Where public meshes live (`/work/shared/scenes/meshes`); closed ones join `edge_rays`
+    /// and `inside_camera`.
+    pub mesh_dir: Option<PathBuf>,
+    /// Skip the slower cases (public meshes, icosphere subdivision 3): for regression tests.
+    pub quick: bool,
+}
+
+impl Default for StressConfig {
+    fn default() -> Self {
+        StressConfig {
+            formats: ["e5m10", "e6m14", "e7m16", "e8m16", "e8m23"]
+                .iter()
+                .map(|s| Format::parse(s).expect("valid format"))
+                .collect(),
+            seed: 6,
+            rays: 20_000,
+            width: 64,
+            height: 48,
+            edge_margins: vec![0.0, RECOMMENDED_EDGE_MARGIN],
+            mesh_dir: None,
+            quick: false,
+        }
+    }
+}
+
+/// One line of the table: one case, subject and format.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CaseResult {
+    pub case: String,
+    pub subject: String,
+    /// `f64` or the format name.
+    pub format: String,
+    pub edge_margin: f64,
+    pub rays: u64,
+    pub failures: u64,
+    /// Pixels whose shaded colour had a NaN or infinite channel.
+    pub nonfinite: u64,
+    pub limit: Limit,
+    pub bound_ppm: Option<f64>,
+    pub held: bool,
+    pub note: String,
+}
+
+impl CaseResult {
+    pub fn new(case: &str, subject: &str, f: Option<Format>, margin: f64, limit: Limit) -> Self {
+        CaseResult {
+            case: case.into(),
+            subject: subject.into(),
+            format: f.map_or("f64".into(), |f| f.to_string()),
+            edge_margin: if f.is_some() { margin } else { 0.0 },
+            rays: 0,
+            failures: 0,
+            nonfinite: 0,
+            limit,
+            bound_ppm: limit.bound_ppm(f, margin),
+            held: true,
+            note: String::new(),
+        }
+    }
+    /// Failures per million rays.
+    pub fn ppm(&self) -> f64 {
+        self.failures as f64 * 1e6 / self.rays.max(1) as f64
+    }
+    /// Judges the row against its bound.
+    pub fn finish(mut self) -> Self {
+        self.held = self.nonfinite == 0 && self.bound_ppm.is_none_or(|b| self.ppm() <= b);
+        self
+    }
+}
+
+/// Every row of a run.
+#[derive(Clone, Debug)]
+pub struct StressReport {
+    pub seed: u64,
+    pub rows: Vec<CaseResult>,
+}
+
+impl StressReport {
+    pub fn all_held(&self) -> bool {
+        self.rows.iter().all(|r| r.held)
+    }
+    /// The rows that broke an invariant.
+    pub fn broken(&self) -> Vec<&CaseResult> {
+        self.rows.iter().filter(|r| !r.held).collect()
+    }
+    /// The row of one case, subject and format.
+    pub fn row(&self, case: &str, subject: &str, format: &str, margin: f64) -> Option<&CaseResult> {
+        self.rows.iter().find(|r| {
+            r.case == case && r.subject == subject && r.format == format && r.edge_margin == margin
+        })
+    }
+    /// A fixed-width text table.
+    pub fn table(&self) -> String {
+        let mut s = format!(
+            "stress seed {}\n{:<20} {:<22} {:<6} {:>7} {:>8} {:>7} {:>11} {:>9} {:>5}  {}\n",
+            self.seed,
+            "case",
+            "subject",
+            "format",
+            "margin",
+            "rays",
+            "fails",
+            "per million",
+            "bound",
+            "ok",
+            "note"
+        );
+        for r in &self.rows {
+            s += &format!(
+                "{:<20} {:<22} {:<6} {:>7} {:>8} {:>7} {:>11.1} {:>9} {:>5}  {}{}\n",
+                r.case,
+                r.subject,
+                r.format,
+                r.edge_margin,
+                r.rays,
+                r.failures,
+                r.ppm(),
+                r.bound_ppm.map_or("-".into(), |b| format!("{b}")),
+                if r.held { "yes" } else { "NO" },
+                if r.nonfinite > 0 {
+                    format!("{} non-finite pixels; ", r.nonfinite)
+                } else {
+                    String::new()
+                },
+                r.note
+            );
+        }
+        s += &format!(
+            "{} rows, {} broke an invariant\n",
+            self.rows.len(),
+            self.broken().len()
+        );
+        s
+    }
+    /// The rows as CSV.
+    pub fn csv(&self) -> String {
+        let mut s = String::from(
+            "case,subject,format,edge_margin,rays,failures,per_million,nonfinite,bound_per_million,held,note\n",
+        );
+        for r in &self.rows {
+            s += &format!(
+                "{},{},{},{},{},{},{:.3},{},{},{},\"{}\"\n",
+                r.case,
+                r.subject,
+                r.format,
+                r.edge_margin,
+                r.rays,
+                r.failures,
+                r.ppm(),
+                r.nonfinite,
+                r.bound_ppm.map_or(String::new(), |b| b.to_string()),
+                r.held,
+                r.note.replace('"', "'")
+            );
+        }
+        s
+    }
+    pub fn save_csv(&self, path: &Path) -> Result<()> {
+        crate::output::write_atomically(path, self.csv().as_bytes())
+            .with_context(|| format!("writing {}", path.display()))
+    }
+}
+
+/// The closed meshes among the OBJ files of `dir` (sorted by name), as (name, triangles).
+pub fn closed_public_meshes(dir: &Path) -> Result<Vec<(String, geometry::Tris)>> {
+    let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("reading mesh directory {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
+    names.sort();
+    let mut out = Vec::new();
+    for p in names {
+        let Ok(tris) = geometry::load_mesh(&p) else {
+            continue;
+        };
+        if geometry::is_closed(&tris) {
+            let name = p
+                .file_stem()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned();
+            out.push((name, tris));
+        }
+    }
+    Ok(out)
+}
+
+/// Runs the whole suite; `log` gets a line per case as it starts.
+pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<StressReport> {
+    let dir = tempfile::tempdir().context("creating a temporary directory for stress scenes")?;
+    let dir = dir.path();
+    let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
+    let n = config.rays;
+    let mut rows = Vec::new();
+    let cam = |eye: DVec3, look_at: DVec3| TestScene {
+        eye,
+        look_at,
+        fov_y: 90.0,
+        width: config.width,
+        height: config.height,
+        ..TestScene::default()
+    };
+    let outside = cam(DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO);
+
+    // Closed meshes at ordinary scale.
+    let sphere = geometry::icosphere(if config.quick { 2 } else { 3 })?;
+    // (name, triangles, instance, limit of the edge-aimed rays)
+    let mut closed: Vec<(String, geometry::Tris, Option<_>, Limit)> = vec![
+        ("icosphere".into(), sphere.clone(), None, Limit::EdgeAimed),
+        (
+            "box".into(),
+            geometry::box_mesh(DVec3::new(1.0, 0.7, 1.3)),
+            None,
+            Limit::EdgeAimed,
+        ),
+        (
+            "icosphere_instanced".into(),
+            sphere.clone(),
+            Some(cases::INSTANCE),
+            Limit::EdgeAimed,
+        ),
+    ];
+    if let (Some(d), false) = (&config.mesh_dir, config.quick) {
+        // Dense meshes seen from inside put the ray origin tens to hundreds of triangle sizes
+        // away, and the unit-triangle test's rounding in u, v grows with that ratio: a margin
+        // of a fixed number of ulps narrows their exact-edge leaks but does not close them.
+        // Documented; their inside cameras stay bounded.
+        for (name, tris) in closed_public_meshes(d)? {
+            closed.push((name, tris, None, Limit::Documented));
+        }
+    }
+    for (name, tris, instance, edge_limit) in &closed {
+        log(&format!("edge_rays / inside_camera: {name}"));
+        let s = TestScene {
+            instance: *instance,
+            ..outside.clone()
+        };
+        let subject = Subject::new(dir, name, tris, &s)?;
+        let rays = cases::edge_rays(&subject.world, n, &mut rng);
+        // A camera at an inside point looking at a random direction.
+        let inside = geometry::inside_points(&subject.world, 1, &mut rng);
+        let case = RayCase {
+            name: "edge_rays".into(),
+            subject,
+            rays,
+            check: Check::MustHit,
+            limit: *edge_limit,
+        };
+        rows.extend(cases::ray_case_rows(&case, config));
+        if let Some(&eye) = inside.first() {
+            let look = eye + geometry::random_direction(&mut rng);
+            let s = TestScene {
+                instance: *instance,
+                ..cam(eye, look)
+            };
+            let subject = Subject::new(dir, &format!("{name}_cam"), tris, &s)?;
+            rows.extend(cases::camera_rows(
+                &subject,
+                config,
+                "inside_camera",
+                Limit::Watertight,
+            ));
+        }
+    }
+
+    // Slivers, needles and degenerate triangles.
+    let ico2 = geometry::icosphere(2)?;
+    let shapes: Vec<(&str, geometry::Tris)> = vec![
+        ("needle", geometry::box_mesh(DVec3::new(1.0, 1e-3, 1e-3))),
+        (
+            "pancake",
+            cases::placed(&ico2, DVec3::new(1.0, 1e-3, 1.0), DVec3::ZERO),
+        ),
+    ];
+    for (name, tris) in shapes {
+        log(&format!("interior rays: {name}"));
+        let subject = Subject::new(dir, name, &tris, &outside)?;
+        let rays = cases::interior_rays(&subject.world, n, &mut rng);
+        let case = RayCase {
+            name: name.into(),
+            subject,
+            rays,
+            check: Check::MustHit,
+            limit: Limit::Documented,
+        };
+        rows.extend(cases::ray_case_rows(&case, config));
+    }
+    {
+        log("degenerate");
+        let mut tris = geometry::box_mesh(DVec3::ONE);
+        let (a, b) = (DVec3::new(-0.2, 0.1, 0.0), DVec3::new(0.3, -0.1, 0.2));
+        tris.push([a, a, b]); // repeated vertex
+        tris.push([a, (a + b) * 0.5, b]); // collinear
+        for k in 0..20 {
+            let p = DVec3::new(0.02 * k as f64 - 0.2, 0.1, -0.1);
+            let e = 1e-9 * (1.0 + k as f64);
+            tris.push([p, p + DVec3::new(e, 0.0, 0.0), p + DVec3::new(0.0, e, 0.0)]);
+            tris.push([
+                p,
+                p + DVec3::new(0.5, 0.0, 0.0),
+                p + DVec3::new(0.5, e, 0.0),
+            ]); // needle
+        }
+        let subject = Subject::new(
+            dir,
+            "degenerate",
+            &tris,
+            &cam(DVec3::new(0.1, 0.05, 0.2), DVec3::new(-1.0, 0.0, -1.0)),
+        )?;
+        let box_only = geometry::box_mesh(DVec3::ONE);
+        let rays: Vec<_> = cases::edge_rays(&box_only, n, &mut rng);
+        let case = RayCase {
+            name: "degenerate".into(),
+            subject,
+            rays,
+            check: Check::MustHit,
+            limit: Limit::EdgeAimed,
+        };
+        rows.extend(cases::ray_case_rows(&case, config));
+        rows.extend(cases::camera_rows(
+            &case.subject,
+            config,
+            "degenerate_camera",
+            Limit::Watertight,
+        ));
+    }
+
+    // Scale and position.
+    let scaled: Vec<(&str, geometry::Tris, Option<_>, Limit)> = vec![
+        (
+            "scale_1e-3",
+            cases::placed(&ico2, DVec3::splat(1e-3), DVec3::ZERO),
+            None,
+            Limit::Documented,
+        ),
+        (
+            "scale_1e5",
+            cases::placed(&ico2, DVec3::splat(1e5), DVec3::ZERO),
+            None,
+            Limit::NonFiniteOnly,
+        ),
+        (
+            "far_small",
+            cases::placed(&ico2, DVec3::splat(1e-2), DVec3::new(1e3, -1e3, 1e3)),
+            None,
+            Limit::Documented,
+        ),
+        (
+            "far_small_instanced",
+            cases::placed(&ico2, DVec3::splat(1e-2), DVec3::ZERO),
+            Some(([1e3, -1e3, 1e3], [0.0, 0.0, 0.0], [1.0, 1.0, 1.0])),
+            Limit::Documented,
+        ),
+    ];
+    for (name, tris, instance, limit) in scaled {
+        log(&format!("scale: {name}"));
+        let probe = TestScene {
+            instance,
+            ..outside.clone()
+        };
+        let world = geometry::world_triangles(&Subject::new(dir, name, &tris, &probe)?.scene);
+        let inside = geometry::inside_points(&world, 1, &mut rng);
+        let eye = inside.first().copied().unwrap_or_default();
+        let s = TestScene {
+            instance,
+            ..cam(eye, eye + DVec3::new(0.3, 0.2, -1.0))
+        };
+        let subject = Subject::new(dir, name, &tris, &s)?;
+        let rays = cases::edge_rays(&subject.world, n, &mut rng);
+        let case = RayCase {
+            name: name.into(),
+            subject,
+            rays,
+            check: Check::MustHit,
+            limit,
+        };
+        rows.extend(cases::ray_case_rows(&case, config));
+        rows.extend(cases::camera_rows(
+            &case.subject,
+            config,
+            &format!("{name}_camera"),
+            limit,
+        ));
+    }
+
+    // Axis-parallel and grazing rays.
+    for (name, tris) in [
+        ("box", geometry::box_mesh(DVec3::new(1.0, 0.7, 1.3))),
+        ("icosphere", ico2.clone()),
+    ] {
+        log(&format!("axis_rays / grazing: {name}"));
+        let subject = Subject::new(dir, name, &tris, &outside)?;
+        let rays = cases::axis_rays(&subject, n, &mut rng);
+        let case = RayCase {
+            name: "axis_rays".into(),
+            subject,
+            rays,
+            check: Check::MustHit,
+            limit: Limit::EdgeAimed,
+        };
+        rows.extend(cases::ray_case_rows(&case, config));
+        let subject = Subject::new(dir, name, &tris, &outside)?;
+        let rays = cases::grazing_rays(&subject.world, n, &mut rng);
+        let case = RayCase {
+            name: "grazing".into(),
+            subject,
+            rays,
+            check: Check::MustHit,
+            limit: Limit::Documented,
+        };
+        rows.extend(cases::ray_case_rows(&case, config));
+    }
+
+    // Acne on convex meshes.
+    for (name, tris) in [
+        ("icosphere", sphere.clone()),
+        ("box", geometry::box_mesh(DVec3::new(1.0, 0.7, 1.3))),
+    ] {
+        log(&format!("acne: {name}"));
+        let light = DVec3::new(2.0, 3.0, 2.5);
+        let eye = DVec3::new(0.5, 1.0, 4.0);
+        let s = TestScene {
+            light: Some(light),
+            shadows: true,
+            reflection_depth: 1,
+            mirror: 0.5,
+            ..cam(eye, DVec3::ZERO)
+        };
+        let subject = Subject::new(dir, name, &tris, &s)?;
+        let rays = cases::surface_rays(&subject.world, eye, n, &mut rng);
+        let case = RayCase {
+            name: "acne_shadow".into(),
+            subject,
+            rays,
+            check: Check::ShadowAcne { light },
+            limit: Limit::Documented,
+        };
+        rows.extend(cases::ray_case_rows(&case, config));
+        let case = RayCase {
+            name: "acne_mirror".into(),
+            check: Check::MirrorAcne,
+            ..case
+        };
+        rows.extend(cases::ray_case_rows(&case, config));
+        rows.extend(cases::camera_rows(
+            &case.subject,
+            config,
+            "acne_camera",
+            Limit::NonFiniteOnly,
+        ));
+    }
+
+    Ok(StressReport {
+        seed: config.seed,
+        rows,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The suite at CI size: every case, three formats, both margins, a few thousand rays.
+    fn quick_report() -> StressReport {
+        let config = StressConfig {
+            formats: ["e5m10", "e7m16", "e8m23"]
+                .iter()
+                .map(|s| Format::parse(s).unwrap())
+                .collect(),
+            seed: 6,
+            rays: 3000,
+            width: 24,
+            height: 18,
+            quick: true,
+            ..StressConfig::default()
+        };
+        println!("stress seed {}", config.seed);
+        let report = run_stress(&config, &mut |_| {}).unwrap();
+        println!("{}", report.table());
+        report
+    }
+
+    fn ppm(r: &StressReport, case: &str, subject: &str, format: &str, margin: f64) -> f64 {
+        r.row(case, subject, format, margin)
+            .unwrap_or_else(|| panic!("no row {case} {subject} {format} {margin}"))
+            .ppm()
+    }
+
+    #[test]
+    fn stress_suite_invariants_hold_and_measured_limits_stay_within_bounds() {
+        let r = quick_report();
+        let broken: Vec<String> = r.broken().iter().map(|b| format!("{b:?}")).collect();
+        assert!(
+            broken.is_empty(),
+            "broken invariants:\n{}",
+            broken.join("\n")
+        );
+        for row in &r.rows {
+            assert_eq!(row.nonfinite, 0, "{row:?}");
+            if row.format == "f64" && row.limit != Limit::NonFiniteOnly {
+                assert_eq!(row.failures, 0, "the exact caster never fails: {row:?}");
+            }
+        }
+        let m = RECOMMENDED_EDGE_MARGIN;
+        for subject in ["icosphere", "box", "icosphere_instanced"] {
+            // The issue's target: inside a closed mesh at e7m16, at most 1 leak in 10,000.
+            assert!(ppm(&r, "inside_camera", &format!("{subject}_cam"), "e7m16", 0.0) <= 100.0);
+            // The margin closes the cracks that rays aimed exactly at shared edges find.
+            assert_eq!(ppm(&r, "edge_rays", subject, "e7m16", m), 0.0, "{subject}");
+            assert_eq!(ppm(&r, "edge_rays", subject, "e8m23", m), 0.0, "{subject}");
+        }
+        // Without it they leak: the rate every non-watertight unit-triangle test shows
+        // (measured 9-12% on the icosphere in every format); if this drops to zero the test
+        // has become watertight and the margin may no longer be needed.
+        let open = ppm(&r, "edge_rays", "icosphere", "e7m16", 0.0);
+        assert!((20_000.0..=300_000.0).contains(&open), "{open}");
+        assert_eq!(ppm(&r, "axis_rays", "box", "e7m16", 0.0), 0.0);
+        assert_eq!(ppm(&r, "axis_rays", "icosphere", "e7m16", m), 0.0);
+        // Acne on convex meshes (measured 330-1000 per million at e7m16, 0 at e8m23).
+        for margin in [0.0, m] {
+            assert!(ppm(&r, "acne_shadow", "icosphere", "e7m16", margin) <= 3000.0);
+            assert!(ppm(&r, "acne_mirror", "icosphere", "e7m16", margin) <= 3000.0);
+            assert!(ppm(&r, "acne_shadow", "box", "e7m16", margin) <= 1000.0);
+            assert_eq!(ppm(&r, "acne_shadow", "icosphere", "e8m23", margin), 0.0);
+        }
+        // Slivers and needles hold at e7m16; e5m10 cannot resolve a 1e-3 needle.
+        assert_eq!(ppm(&r, "needle", "needle", "e7m16", 0.0), 0.0);
+        assert_eq!(ppm(&r, "pancake", "pancake", "e7m16", 0.0), 0.0);
+        // A radius-1e-2 object 1e3 from the origin is below e7m16's resolution there (ulp
+        // 2^-6 at 1024): a documented limit, most rays are lost.
+        assert!(ppm(&r, "far_small", "far_small", "e7m16", m) > 100_000.0);
+        // e5m10 cannot hold a scene of 1e5 units: refused with a message, not a panic.
+        let refused = r.row("scale_1e5", "scale_1e5", "e5m10", 0.0).unwrap();
+        assert!(
+            refused.note.starts_with("refused:") && refused.rays == 0,
+            "{refused:?}"
+        );
+    }
+
+    #[test]
+    fn bounds_follow_the_limit_kind() {
+        let e7 = Some(Format::E7M16);
+        let e5 = Some(Format::E5M10);
+        assert_eq!(Limit::Watertight.bound_ppm(None, 0.0), Some(0.0));
+        assert_eq!(Limit::Watertight.bound_ppm(e7, 0.0), Some(WATERTIGHT_PPM));
+        assert_eq!(Limit::Watertight.bound_ppm(e5, 0.0), None);
+        assert_eq!(Limit::EdgeAimed.bound_ppm(e7, 0.0), None);
+        assert_eq!(Limit::EdgeAimed.bound_ppm(e7, 16.0), Some(WATERTIGHT_PPM));
+        assert_eq!(Limit::NonFiniteOnly.bound_ppm(None, 0.0), None);
+        let mut row = CaseResult::new("c", "s", e7, 0.0, Limit::Watertight);
+        (row.rays, row.failures) = (10_000, 1);
+        assert!(
+            row.clone().finish().held,
+            "100 per million is within the bound"
+        );
+        row.failures = 2;
+        assert!(!row.clone().finish().held);
+        row.failures = 0;
+        row.nonfinite = 1;
+        assert!(!row.finish().held, "a non-finite pixel always breaks");
+    }
+}
