@@ -18,4 +18,6 @@ pub mod precision;
 pub mod scenes;
 pub mod table;
 
-pub use precision::{precision_sweep, recommend, summarize, write_outputs, FormatSummary, Row, SweepConfig};
+pub use precision::{
+    precision_sweep, recommend, summarize, write_outputs, FormatSummary, Row, SweepConfig,
+};

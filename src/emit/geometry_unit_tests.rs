@@ -15,7 +15,7 @@ use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::geometry_unit::{geometry_unit_rtl, synth_unit, GeometryUnit};
+use super::geometry_unit::{geometry_unit_rtl, GeometryUnit};
 use super::geometry_unit_run::*;
 use crate::fp::{vectors, Format};
 use crate::layout::unit_triangle_transform;
@@ -303,17 +303,11 @@ fn transform_case(f: Format, n_random: usize, seed: u64, sim: Simulator) {
     check_transform(f, &reqs, &run.results, &format!("{sim} transform {f}"));
 }
 
-/// Icarus runs ~600 transforms a second here: 25k random plus every hard case in CI; the
-/// 100k run is `transform_e7m16_icarus_100k` (ignored, ~3 min).
+/// Icarus runs ~600 transforms a second here: 25k random plus every hard case keeps CI short;
+/// Verilator runs 100k.
 #[test]
 fn transform_e7m16_icarus() {
     transform_case(Format::E7M16, 25_000, 4001, Simulator::Icarus);
-}
-
-#[test]
-#[ignore = "about 3 minutes in Icarus; CI runs 25k"]
-fn transform_e7m16_icarus_100k() {
-    transform_case(Format::E7M16, 100_000, 4001, Simulator::Icarus);
 }
 
 #[test]
@@ -599,16 +593,10 @@ fn intersect_case(f: Format, n_random: usize, seed: u64, sim: Simulator) {
     check_intersect(f, &reqs, &run.results, &format!("{sim} intersect {f}"));
 }
 
-/// 25k random plus every hard case in CI; the 100k run is `intersect_e7m16_icarus_100k`.
+/// 25k random plus every hard case keeps CI short; Verilator runs 100k.
 #[test]
 fn intersect_e7m16_icarus() {
     intersect_case(Format::E7M16, 25_000, 4201, Simulator::Icarus);
-}
-
-#[test]
-#[ignore = "about 3 minutes in Icarus; CI runs 25k"]
-fn intersect_e7m16_icarus_100k() {
-    intersect_case(Format::E7M16, 100_000, 4201, Simulator::Icarus);
 }
 
 #[test]
@@ -760,66 +748,4 @@ fn verilator_lint_wall_is_clean() {
             assert!(report.is_clean(), "{}: {report}", rtl.top);
         }
     }
-}
-
-/// Synthesis for Virtex-II: multiplier counts as the operator counts predict (e7m16: one
-/// MULT18X18 per product; e8m23: four; RayGen's z = 0 makes three of the nine products a
-/// constant shift, so its private unit keeps six), and prints the figures.
-fn synthesize(f: Format) {
-    let dir = tempfile::tempdir().unwrap();
-    for unit in [
-        GeometryUnit::Transform,
-        GeometryUnit::RayGen,
-        GeometryUnit::Intersect,
-    ] {
-        let r = synth_unit(unit, f, &dir.path().join(format!("{unit}_{f}"))).unwrap();
-        let (add, mul, div) = unit.paper_operators();
-        println!(
-            "SYNTH {unit} {f}: LUTs {} FFs {} MULT18X18 {} RAMB16 {} depth {} ({:.0} s); paper: {add} add {mul} mul {div} div",
-            r.total_luts(),
-            r.flip_flops,
-            r.mult18x18,
-            r.block_rams,
-            r.logic_depth,
-            r.seconds
-        );
-        let per_product = if f.man_bits <= 17 { 1 } else { 4 };
-        let products = if unit == GeometryUnit::RayGen {
-            6
-        } else {
-            u64::from(mul)
-        };
-        assert_eq!(r.mult18x18, products * per_product, "{unit} {f}");
-    }
-}
-
-#[test]
-#[ignore = "yosys takes ~15 minutes; run with --ignored for the figures"]
-fn yosys_xc2v_synthesis_e7m16() {
-    synthesize(Format::E7M16);
-}
-
-#[test]
-#[ignore = "yosys takes ~20 minutes; run with --ignored for the figures"]
-fn yosys_xc2v_synthesis_e8m23() {
-    synthesize(Format::E8M23);
-}
-
-/// The arbiter's cost: the shared unit against the bare transform unit (same 9 products).
-#[test]
-#[ignore = "yosys takes a few minutes; run with --ignored for the figures"]
-fn yosys_xc2v_synthesis_shared_transform_e7m16() {
-    let dir = tempfile::tempdir().unwrap();
-    let f = Format::E7M16;
-    let r = synth_unit(GeometryUnit::SharedTransform, f, dir.path()).unwrap();
-    println!(
-        "SYNTH shared_transform {f}: LUTs {} FFs {} MULT18X18 {} RAMB16 {} depth {} ({:.0} s)",
-        r.total_luts(),
-        r.flip_flops,
-        r.mult18x18,
-        r.block_rams,
-        r.logic_depth,
-        r.seconds
-    );
-    assert_eq!(r.mult18x18, 9);
 }
