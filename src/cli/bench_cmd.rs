@@ -25,6 +25,18 @@ pub enum BenchWhat {
         #[arg(long, default_value_t = 200_000)]
         vectors: usize,
     },
+    /// Number formats: error against the f64 reference versus hardware cost and run time, with
+    /// the Pareto front (CSV + PNG plots).
+    Precision {
+        /// Edge margin of the unit-triangle test, in units of 2^-mantissa bits (0 = the hardware's).
+        #[arg(long, default_value_t = 0.0)]
+        margin: f64,
+        /// Directory of public OBJ meshes to add to the bundled scenes.
+        #[arg(long)]
+        meshes: Option<PathBuf>,
+        #[arg(long, value_parser = parse_resolution)]
+        resolution: Option<(u32, u32)>,
+    },
     /// Bundled scenes: tree build rate, layout size, golden and reference speed, golden error.
     Scenes {
         /// Scene files; default: every scene in scenes/.
@@ -58,6 +70,27 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             print!("{}", t.to_markdown());
             if let Some(r) = rows.first() {
                 println!("yosys: {} ({})", r.synth.yosys_version, r.synth.command);
+            }
+        }
+        BenchWhat::Precision {
+            margin,
+            meshes,
+            resolution,
+        } => {
+            let mut c = bench::SweepConfig::new(std::path::Path::new("scenes"))?;
+            c.edge_margin_ulps = margin;
+            c.mesh_dir = meshes;
+            if let Some((w, h)) = resolution {
+                (c.width, c.height) = (w, h);
+            }
+            let rows = bench::precision_sweep(&c, &mut |l| eprintln!("{l}"))?;
+            for p in bench::write_outputs(&rows, &a.out)? {
+                println!("wrote {}", p.display());
+            }
+            let s = bench::summarize(&rows);
+            print!("{}", bench::precision::summary_csv(&s));
+            if let Some(r) = bench::recommend(&s, 1e-3, 100.0) {
+                println!("recommended: {}", r.format);
             }
         }
         BenchWhat::Scenes {

@@ -7,6 +7,8 @@ mod demo_cmd;
 mod emit_fp_cmd;
 mod fp_cmd;
 mod render_cmd;
+mod stress_cmd;
+mod synth_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -33,6 +35,10 @@ enum Command {
     Bench(bench_cmd::BenchArgs),
     /// Write the Verilog and testbenches of every FP operator of a format.
     EmitFp(emit_fp_cmd::EmitFpArgs),
+    /// The seeded numerical stress suite; exits non-zero when an invariant breaks.
+    Stress(stress_cmd::StressArgs),
+    /// yosys synth_xilinx -family xc2v of one geometry unit: resources and logic depth.
+    Synth(synth_cmd::SynthArgs),
     /// Run operand vectors through one floating-point operator (RTL or software model).
     Fp(fp_cmd::FpArgs),
 }
@@ -46,6 +52,8 @@ pub fn run() -> i32 {
         Command::Fp(a) => fp_cmd::run(a),
         Command::Bench(a) => bench_cmd::run(a),
         Command::Demo(a) => demo_cmd::run(a),
+        Command::Stress(a) => stress_cmd::run(a),
+        Command::Synth(a) => synth_cmd::run(a),
         Command::EmitFp(a) => emit_fp_cmd::run(a),
     };
     match result {

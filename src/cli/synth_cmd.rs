@@ -1,0 +1,34 @@
+//! `dynrt synth --unit U`: yosys `synth_xilinx -family xc2v` of one geometry unit.
+
+use clap::Args;
+use dynrt::emit::geometry_unit::{synth_unit, GeometryUnit};
+use dynrt::fp::Format;
+use dynrt::synth::XC2V6000;
+
+#[derive(Args)]
+pub struct SynthArgs {
+    /// transform, shared_transform, intersect or raygen.
+    #[arg(long)]
+    pub unit: GeometryUnit,
+    #[arg(long, default_value = "e7m16")]
+    pub format: Format,
+}
+
+pub fn run(a: SynthArgs) -> anyhow::Result<i32> {
+    let work = tempfile::tempdir()?;
+    let r = synth_unit(a.unit, a.format, work.path())?;
+    let (add, mul, div) = a.unit.paper_operators();
+    let u = r.utilization(&XC2V6000);
+    println!(
+        "{} {} (yosys {}: {})",
+        a.unit, a.format, r.yosys_version, r.command
+    );
+    println!("LUTs        {}", r.total_luts());
+    println!("flip-flops  {}", r.flip_flops);
+    println!("MULT18X18   {}", r.mult18x18);
+    println!("block RAMs  {}", r.block_rams);
+    println!("logic depth {} LUT levels", r.logic_depth);
+    println!("XC2V6000    {u}");
+    println!("paper Table 2 operators: {add} add, {mul} mul, {div} div");
+    Ok(0)
+}
