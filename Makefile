@@ -11,7 +11,7 @@
 SHELL := /bin/bash
 CARGO ?= cargo
 FORMAT ?= e7m16
-DYNRT := target/release/dynrt
+DYNRT := $(or $(CARGO_TARGET_DIR),target)/release/dynrt
 OUT ?= out
 
 .PHONY: deps build test demo rtl sim bench synth images fmt

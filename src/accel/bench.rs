@@ -19,9 +19,6 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Where this project's machines keep the public test meshes.
-pub const SHARED_MESH_DIR: &str = "/work/shared/scenes/meshes";
-
 /// Triangles of an OBJ file, in file order (faces triangulated as fans by tobj), all groups.
 pub fn load_obj_triangles(path: &Path) -> anyhow::Result<Vec<[DVec3; 3]>> {
     let opts = tobj::LoadOptions {
@@ -143,7 +140,7 @@ pub fn random_rays_at(b: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
 /// What to measure.
 #[derive(Clone, Debug)]
 pub struct BenchConfig {
-    /// Mesh measured as-is (default: the Stanford bunny in [`SHARED_MESH_DIR`]).
+    /// Mesh measured as-is (default: the Stanford bunny of [`crate::scene::shared_mesh_dir`]).
     pub mesh: PathBuf,
     /// Terrain quads per side (2 side² triangles; default 256 -> 131,072 triangles).
     pub terrain_side: usize,
@@ -160,7 +157,7 @@ pub struct BenchConfig {
 impl Default for BenchConfig {
     fn default() -> Self {
         Self {
-            mesh: Path::new(SHARED_MESH_DIR).join("stanford-bunny.obj"),
+            mesh: crate::scene::shared_mesh_dir().join("stanford-bunny.obj"),
             terrain_side: 256,
             instance_counts: vec![1000, 5000],
             trace_rays: 200_000,

@@ -4,14 +4,13 @@
 //! closest / any hit over all triangles.
 
 use super::aabb::Aabb;
-use super::bench::{load_obj_triangles, SHARED_MESH_DIR};
+use super::bench::load_obj_triangles;
 use super::kd_tree::{KdNode, KdTree};
 use super::ray::Ray;
 use super::triangle;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::path::Path;
 
 /// Icosahedron subdivided `levels` times, projected on the unit sphere (20 * 4^levels tris).
 pub fn sphere(levels: u32) -> Vec<[DVec3; 3]> {
@@ -118,12 +117,14 @@ pub fn quad_lattice(n: usize) -> Vec<[DVec3; 3]> {
 
 /// One of the shared public meshes; a missing file is a broken machine, so fail loudly.
 pub fn public_mesh(name: &str) -> Vec<[DVec3; 3]> {
-    let path = Path::new(SHARED_MESH_DIR).join(name);
+    let dir = crate::scene::shared_mesh_dir();
+    let path = dir.join(name);
     assert!(
         path.exists(),
         "public test mesh {} is missing: every machine of this project has \
-         {SHARED_MESH_DIR}; restore it from its SOURCES.md",
-        path.display()
+         {}; restore it from its SOURCES.md",
+        path.display(),
+        dir.display()
     );
     let tris = load_obj_triangles(&path).unwrap_or_else(|e| panic!("{e:#}"));
     assert!(!tris.is_empty(), "{} has no triangles", path.display());

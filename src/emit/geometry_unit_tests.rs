@@ -60,7 +60,7 @@ fn matrix_words(f: Format, m: &glam::DAffine3) -> [u32; 12] {
 }
 
 fn meshes_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/scenes/meshes")
+    crate::scene::shared_mesh_dir()
 }
 
 /// Triangles of every mesh in ../shared/scenes/meshes: per mesh the `slivers` worst-shaped

@@ -769,5 +769,11 @@ impl Builder<'_> {
     }
 }
 
+/// The public test meshes kept beside the repository (`../shared/scenes/meshes`, see its
+/// SOURCES.md): data for tests and benchmarks, which the repository itself must not copy.
+pub fn shared_mesh_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/scenes/meshes")
+}
+
 #[cfg(test)]
 mod tests;

@@ -187,8 +187,6 @@ fn every_bundled_scene_is_tested() {
 
 // ---------------------------------------------------------------- public meshes
 
-const SHARED_MESHES: &str = "/work/shared/scenes/meshes";
-
 /// Parses an OBJ without tobj: fan-triangulated faces in file order with their `usemtl` name.
 fn parse_obj_by_hand(path: &Path) -> Vec<([DVec3; 3], Option<String>)> {
     let text = std::fs::read_to_string(path).unwrap();
@@ -231,8 +229,8 @@ fn parse_obj_by_hand(path: &Path) -> Vec<([DVec3; 3], Option<String>)> {
 #[test]
 fn public_meshes_load_in_file_order() {
     let dir = tempfile::tempdir().unwrap();
-    let mut names: Vec<PathBuf> = std::fs::read_dir(SHARED_MESHES)
-        .expect("public meshes in /work/shared/scenes/meshes")
+    let mut names: Vec<PathBuf> = std::fs::read_dir(super::shared_mesh_dir())
+        .expect("public meshes in ../shared/scenes/meshes")
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "obj"))
         .collect();

@@ -95,7 +95,7 @@ pub struct StressConfig {
     /// `model::units::intersect_with_margin`), in units of the format's spacing at 1
     /// (2^-mantissa bits): 64 means 2^-10 at e7m16; 0 is what the hardware computes.
     pub edge_margins: Vec<f64>,
-    /// Where public meshes live (`/work/shared/scenes/meshes`); closed ones join `edge_rays`
+    /// Where public meshes live ([`crate::scene::shared_mesh_dir`]); closed ones join `edge_rays`
     /// and `inside_camera`.
     pub mesh_dir: Option<PathBuf>,
     /// Skip the slower cases (public meshes, icosphere subdivision 3): for regression tests.
