@@ -368,8 +368,10 @@ fn verilator_compile_timeout_kills_the_build() {
     let vectors = adder_vectors(3, 4);
     let src = write_adder_bench(dir.path(), &vectors);
     let mut job = SimJob::new(dir.path(), vec![src], "tb_adder").define("NVEC", Some("4".into()));
-    // Long enough for make and g++ to be running, far too short for them to finish.
-    job.compile_timeout = Duration::from_secs(2);
+    // Far too short for the build to finish even on an idle machine (at 2 s a fast machine
+    // was already linking when the timeout fired); left alone, make and g++ would finish the
+    // model well within the 15 s below.
+    job.compile_timeout = Duration::from_millis(300);
     match compile(Simulator::Verilator, &job) {
         Err(ToolError::Timeout { stage, .. }) => assert!(stage.contains("compiling"), "{stage}"),
         other => panic!("expected a compile timeout, got {other:?}"),
