@@ -62,12 +62,7 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
     let (gi, ri) = (golden.to_image(), reference.to_image());
     let img = compare_images(&gi, &ri)?;
     let hits = compare_hits(&golden.hit_tuples(), &reference.hit_tuples())?;
-    let mut diff = Vec::new();
-    diff_image(&gi, &ri).write_to(
-        &mut std::io::Cursor::new(&mut diff),
-        image::ImageFormat::Png,
-    )?;
-    crate::output::write_atomically(&c.out.join("diff.png"), &diff)?;
+    crate::output::write_png(&c.out.join("diff.png"), &diff_image(&gi, &ri))?;
     writeln!(
         md,
         "## Golden model ({}) against the f64 reference\n",

@@ -19,3 +19,15 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
 }
+
+/// Encodes an RGB image as PNG and writes it atomically, naming the file in any error.
+pub fn write_png(path: &Path, img: &image::RgbImage) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let mut bytes = Vec::new();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .context("encoding PNG")?;
+    write_atomically(path, &bytes).with_context(|| format!("writing {}", path.display()))
+}

@@ -139,14 +139,7 @@ pub fn scatter_with_front(
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
     let img = image::RgbImage::from_raw(w, h, buf).context("plot buffer size")?;
-    let mut bytes = Vec::new();
-    img.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )
-    .context("encoding PNG")?;
-    crate::output::write_atomically(path, &bytes)
-        .with_context(|| format!("writing {}", path.display()))
+    crate::output::write_png(path, &img)
 }
 
 #[cfg(test)]

@@ -54,14 +54,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
         );
     }
     if let Some(d) = &a.diff {
-        let img = compare::diff_image(&ia, &ib);
-        let mut bytes = Vec::new();
-        img.write_to(
-            &mut std::io::Cursor::new(&mut bytes),
-            image::ImageFormat::Png,
-        )?;
-        dynrt::output::write_atomically(d, &bytes)
-            .with_context(|| format!("writing {}", d.display()))?;
+        dynrt::output::write_png(d, &compare::diff_image(&ia, &ib))?;
         println!("diff image       {}", d.display());
     }
     Ok(0)

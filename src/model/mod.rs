@@ -68,15 +68,7 @@ impl Frame {
 
     /// Writes the frame as PNG; the file appears complete or not at all.
     pub fn save_png(&self, path: &Path) -> anyhow::Result<()> {
-        let mut bytes = Vec::new();
-        self.to_image()
-            .write_to(
-                &mut std::io::Cursor::new(&mut bytes),
-                image::ImageFormat::Png,
-            )
-            .context("encoding PNG")?;
-        crate::output::write_atomically(path, &bytes)
-            .with_context(|| format!("writing {}", path.display()))
+        crate::output::write_png(path, &self.to_image())
     }
 
     /// Writes the hits file of DESIGN.md section 3: `x,y,instance,triangle,dist`.
