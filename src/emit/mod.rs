@@ -8,6 +8,7 @@ pub mod geometry_unit_run;
 mod geometry_unit_tests;
 pub mod stream_bench;
 pub mod verilog_tidy;
+pub mod vga_timing;
 
 pub use fp_unit::{fp_unit_rtl, fp_unit_testbench, fp_units_testbench, FpUnitRtl};
 pub use fp_unit_run::{run_fp_unit, run_fp_units, FpUnitRun};
@@ -20,3 +21,4 @@ pub use stream_bench::{
     run_stream_bench, stream_bench_verilog, BenchPort, InputStream, OutputSink, StreamBench,
     StreamBenchRun,
 };
+pub use vga_timing::{run_vga_timing, vga_timing_testbench, vga_timing_verilog, VgaSample};

@@ -16,6 +16,7 @@ pub mod raygen;
 mod sim_harness;
 pub mod transform;
 pub mod transform_arbiter;
+pub mod vga;
 
 pub use delay::Delay;
 pub use int_to_float::UIntToFloat;
@@ -23,6 +24,7 @@ pub use intersect::{intersect_latency, IntersectUnit};
 pub use raygen::{RayGen, RayGenUnit};
 pub use transform::{TransformUnit, TRANSFORM_LATENCY};
 pub use transform_arbiter::{SharedTransformUnit, TRANSFORM_CLIENTS};
+pub use vga::{VgaError, VgaMode, VgaPlacement, VgaTiming};
 
 /// Width of the tag that travels with every request through a geometry unit (client id and
 /// thread id; the unit only carries it).
