@@ -6,6 +6,7 @@ pub mod geometry_unit;
 pub mod geometry_unit_run;
 #[cfg(test)]
 mod geometry_unit_tests;
+pub mod memory_images;
 pub mod stream_bench;
 pub mod verilog_tidy;
 pub mod vga_timing;
@@ -16,6 +17,10 @@ pub use geometry_unit::{geometry_unit_rtl, synth_unit, GeometryUnit, GeometryUni
 pub use geometry_unit_run::{
     run_intersect, run_raygen, run_shared_transform, run_transform, GeometryRun, IntersectRequest,
     IntersectResult, RayGenFrame, RayGenOutput, TransformRequest, TransformResult,
+};
+pub use memory_images::{
+    bank_extents, bank_file_name, frame_update, read_memh, update_file_name, write_frame_update,
+    write_memory_images, BankExtent, WordUpdate,
 };
 pub use stream_bench::{
     run_stream_bench, stream_bench_verilog, BenchPort, InputStream, OutputSink, StreamBench,
