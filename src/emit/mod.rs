@@ -1,5 +1,6 @@
 //! Emission of Verilog, testbenches and their inputs from the `hw` modules.
 
+pub mod constraints;
 pub mod fp_unit;
 pub mod fp_unit_run;
 pub mod geometry_unit;
@@ -11,6 +12,10 @@ pub mod stream_bench;
 pub mod verilog_tidy;
 pub mod vga_timing;
 
+pub use constraints::{
+    load_board, parse_board, ucf_text, write_ucf, BoardPins, ClockOffsets, Port, PortDirection,
+    PortKind, UcfOptions,
+};
 pub use fp_unit::{fp_unit_rtl, fp_unit_testbench, fp_units_testbench, FpUnitRtl};
 pub use fp_unit_run::{run_fp_unit, run_fp_units, FpUnitRun};
 pub use geometry_unit::{geometry_unit_rtl, synth_unit, GeometryUnit, GeometryUnitRtl};
