@@ -1,8 +1,14 @@
 //! The arithmetic of every hardware unit, written once as sequences of `fp` operations.
 //!
-//! The golden model calls these; each hardware unit's tests compare the RTL with them, so the
-//! RTL computes the same operations in the same order with the same rounding (DESIGN.md
-//! section 2). Change an order here and the hardware must change with it.
+//! The golden model calls these with a [`Format`] (values are format words); the processor's
+//! microprogram generator calls the same functions with its assembler (values are registers),
+//! so the hardware executes the same operations in the same order with the same rounding
+//! (DESIGN.md section 2). Each hardware unit's tests compare the RTL with these functions.
+//! Change an order here and both sides change with it.
+//!
+//! The decisions (comparisons) around the arithmetic are small and live beside it: the golden
+//! model evaluates them with `Format::lt`/`le`/`eq`, the microprogram as branches; the
+//! processor's tests compare the two renderers pixel by pixel.
 
 use crate::fp::Format;
 
@@ -11,17 +17,67 @@ pub type Vec3W = [u32; 3];
 /// A 3x4 matrix, row-major: `m00 m01 m02 n0 m10 m11 m12 n1 m20 m21 m22 n2`.
 pub type Mat34W = [u32; 12];
 
+/// Something that carries out `fp` operations: [`Format`] computes them; an assembler records
+/// them as instructions. Copy, so the sequences below take it by value like a `Format`.
+pub trait Arith: Copy {
+    /// A value: a format word, or the register holding one.
+    type V: Copy;
+    fn add(self, a: Self::V, b: Self::V) -> Self::V;
+    fn sub(self, a: Self::V, b: Self::V) -> Self::V;
+    fn mul(self, a: Self::V, b: Self::V) -> Self::V;
+    fn div(self, a: Self::V, b: Self::V) -> Self::V;
+    fn sqrt(self, a: Self::V) -> Self::V;
+    /// Sign flip (no rounding).
+    fn neg(self, a: Self::V) -> Self::V;
+    /// A constant format word.
+    fn word(self, w: u32) -> Self::V;
+    /// An unsigned integer converted to the format (exact for the pixel coordinates).
+    fn from_uint(self, i: Self::V) -> Self::V;
+    fn format(self) -> Format;
+}
+
+impl Arith for Format {
+    type V = u32;
+    fn add(self, a: u32, b: u32) -> u32 {
+        Format::add(self, a, b)
+    }
+    fn sub(self, a: u32, b: u32) -> u32 {
+        Format::sub(self, a, b)
+    }
+    fn mul(self, a: u32, b: u32) -> u32 {
+        Format::mul(self, a, b)
+    }
+    fn div(self, a: u32, b: u32) -> u32 {
+        Format::div(self, a, b)
+    }
+    fn sqrt(self, a: u32) -> u32 {
+        Format::sqrt(self, a)
+    }
+    fn neg(self, a: u32) -> u32 {
+        Format::neg(self, a)
+    }
+    fn word(self, w: u32) -> u32 {
+        w
+    }
+    fn from_uint(self, i: u32) -> u32 {
+        self.from_int(i64::from(i))
+    }
+    fn format(self) -> Format {
+        self
+    }
+}
+
 /// TransformUnit: `x' = ((m00*x + m01*y) + m02*z) + n0` per row for a point; a vector omits
 /// the `+ n` step. 9 multiplications and 9 additions for a point (6 for a vector).
-pub fn transform(f: Format, m: &Mat34W, v: Vec3W, point: bool) -> Vec3W {
+pub fn transform<A: Arith>(a: A, m: &[A::V; 12], v: [A::V; 3], point: bool) -> [A::V; 3] {
     let row = |r: usize| {
         let m = &m[r * 4..r * 4 + 4];
-        let s = f.add(
-            f.add(f.mul(m[0], v[0]), f.mul(m[1], v[1])),
-            f.mul(m[2], v[2]),
+        let s = a.add(
+            a.add(a.mul(m[0], v[0]), a.mul(m[1], v[1])),
+            a.mul(m[2], v[2]),
         );
         if point {
-            f.add(s, m[3])
+            a.add(s, m[3])
         } else {
             s
         }
@@ -30,11 +86,11 @@ pub fn transform(f: Format, m: &Mat34W, v: Vec3W, point: bool) -> Vec3W {
 }
 
 /// The normal transform is a 3x3 (the 3x4 layout without offsets), run as a vector transform.
-pub fn transform3(f: Format, m: &[u32; 9], v: Vec3W) -> Vec3W {
+pub fn transform3<A: Arith>(a: A, m: &[A::V; 9], v: [A::V; 3]) -> [A::V; 3] {
     let row = |r: usize| {
-        f.add(
-            f.add(f.mul(m[r * 3], v[0]), f.mul(m[r * 3 + 1], v[1])),
-            f.mul(m[r * 3 + 2], v[2]),
+        a.add(
+            a.add(a.mul(m[r * 3], v[0]), a.mul(m[r * 3 + 1], v[1])),
+            a.mul(m[r * 3 + 2], v[2]),
         )
     };
     [row(0), row(1), row(2)]
@@ -42,13 +98,14 @@ pub fn transform3(f: Format, m: &[u32; 9], v: Vec3W) -> Vec3W {
 
 /// RayGen: the primary ray direction of pixel (x, y) is the camera matrix applied to the point
 /// (x, y, 0) (the layout bakes the pixel-centre offsets into the matrix's offset column).
+pub fn primary_direction_of<A: Arith>(a: A, camera: &[A::V; 12], x: A::V, y: A::V) -> [A::V; 3] {
+    let zero = a.word(0);
+    transform(a, camera, [a.from_uint(x), a.from_uint(y), zero], true)
+}
+
+/// [`primary_direction_of`] for pixel (x, y) in format words.
 pub fn primary_direction(f: Format, camera: &Mat34W, x: u32, y: u32) -> Vec3W {
-    transform(
-        f,
-        camera,
-        [f.from_int(x as i64), f.from_int(y as i64), 0],
-        true,
-    )
+    primary_direction_of(f, camera, x, y)
 }
 
 /// The result of one unit-triangle test.
@@ -60,26 +117,43 @@ pub struct UnitHit {
     pub hit: bool,
 }
 
-/// IntersectUnit, given the ray already in unit-triangle space (O', D'):
-/// `t = -O'z / D'z`, `u = O'x + t*D'x`, `v = O'y + t*D'y`; a hit when `0 <= u`, `0 <= v`,
-/// `u + v <= 1` and `t_min < t < t_max`. NaN fails every comparison, so a ray parallel to the
-/// triangle (D'z = 0) or any NaN or infinity never hits. 1 div, 2 mul, 3 add.
-pub fn intersect(f: Format, o: Vec3W, d: Vec3W, t_min: u32, t_max: u32) -> UnitHit {
-    let t = f.div(f.neg(o[2]), d[2]);
-    let u = f.add(o[0], f.mul(t, d[0]));
-    let v = f.add(o[1], f.mul(t, d[1]));
-    let inside = f.le(0, u) && f.le(0, v) && f.le(f.add(u, v), f.one());
-    let hit = inside && f.lt(t_min, t) && f.lt(t, t_max);
-    UnitHit { t, u, v, hit }
+/// The unit-triangle edge margin in units of the format's spacing at 1 (`2^-M`): 64 ulps,
+/// 2^-10 at e7m16. Rounding of O' and D' can open a crack along an edge shared by two
+/// triangles; growing each triangle by the margin closes it (PRECISION.md measures what it
+/// closes and what it adds at silhouettes).
+pub const EDGE_MARGIN_ULPS: u32 = 64;
+
+/// The margin of [`EDGE_MARGIN_ULPS`] as a format word.
+pub fn edge_margin(f: Format) -> u32 {
+    f.from_f64(f64::from(EDGE_MARGIN_ULPS) * 2f64.powi(-(f.man_bits as i32)))
 }
 
-/// The unit-triangle test with a conservative edge margin: a hit when `-margin <= u`,
-/// `-margin <= v` and `u + v <= 1 + margin` (and t in range). The bounds are constants
-/// (`-margin` and `1 + margin`, each rounded once), so in hardware the margin costs no operator:
-/// the comparators compare against other constants. With `margin` = 0 this is exactly
-/// [`intersect`]. Grows every triangle by `margin` in unit-triangle coordinates (a fraction of
-/// its size) so that rounding cannot open a crack along a shared edge; the precision study
-/// (`bench`, `stress`) measures what it closes and what it adds at silhouettes.
+/// The bounds of the unit-triangle test with edge margin `margin`: `u, v >= lo` and
+/// `u + v <= hi`, with `lo = -margin` and `hi = 1 + margin` (each rounded once). Constants, so
+/// in hardware the margin costs no operator.
+pub fn edge_bounds(f: Format, margin: u32) -> (u32, u32) {
+    (f.neg(margin), f.add(f.one(), margin))
+}
+
+/// IntersectUnit's arithmetic, given the ray already in unit-triangle space (O', D'):
+/// `t = -O'z / D'z`, `u = O'x + t*D'x`, `v = O'y + t*D'y` and `u + v`. 1 div, 2 mul, 3 add.
+pub fn unit_triangle_coords<A: Arith>(a: A, o: [A::V; 3], d: [A::V; 3]) -> [A::V; 4] {
+    let t = a.div(a.neg(o[2]), d[2]);
+    let u = a.add(o[0], a.mul(t, d[0]));
+    let v = a.add(o[1], a.mul(t, d[1]));
+    [t, u, v, a.add(u, v)]
+}
+
+/// IntersectUnit: a hit when `lo <= u`, `lo <= v`, `u + v <= hi` and `t_min < t < t_max`
+/// ([`unit_triangle_coords`], bounds from [`edge_bounds`] with the default [`edge_margin`]).
+/// NaN fails every comparison, so a ray parallel to the triangle (D'z = 0) or any NaN or
+/// infinity never hits.
+pub fn intersect(f: Format, o: Vec3W, d: Vec3W, t_min: u32, t_max: u32) -> UnitHit {
+    intersect_with_margin(f, o, d, t_min, t_max, edge_margin(f))
+}
+
+/// The unit-triangle test with edge margin `margin` (a format word; 0 is the exact test).
+/// Grows every triangle by `margin` in unit-triangle coordinates (a fraction of its size).
 pub fn intersect_with_margin(
     f: Format,
     o: Vec3W,
@@ -88,12 +162,9 @@ pub fn intersect_with_margin(
     t_max: u32,
     margin: u32,
 ) -> UnitHit {
-    let lo = f.neg(margin);
-    let hi = f.add(f.one(), margin);
-    let t = f.div(f.neg(o[2]), d[2]);
-    let u = f.add(o[0], f.mul(t, d[0]));
-    let v = f.add(o[1], f.mul(t, d[1]));
-    let inside = f.le(lo, u) && f.le(lo, v) && f.le(f.add(u, v), hi);
+    let (lo, hi) = edge_bounds(f, margin);
+    let [t, u, v, uv] = unit_triangle_coords(f, o, d);
+    let inside = f.le(lo, u) && f.le(lo, v) && f.le(uv, hi);
     let hit = inside && f.lt(t_min, t) && f.lt(t, t_max);
     UnitHit { t, u, v, hit }
 }
@@ -109,10 +180,15 @@ pub enum Visit {
     Both { t_split: u32 },
 }
 
-/// One traversal step (traversal unit): `t_split = (split - o) / d` along the node's axis, and
-/// the near child is the one holding the origin (on the plane, the one the ray heads into).
-/// Returns whether the near child is the left (below) one, and which children to visit.
-/// 1 add (sub), 1 div, comparisons.
+/// The traversal unit's arithmetic: the distance `(split - o) / d` to a split plane.
+pub fn split_distance<A: Arith>(a: A, o: A::V, d: A::V, split: A::V) -> A::V {
+    a.div(a.sub(split, o), d)
+}
+
+/// One traversal step (traversal unit): `t_split` ([`split_distance`]) along the node's axis,
+/// and the near child is the one holding the origin (on the plane, the one the ray heads
+/// into). Returns whether the near child is the left (below) one, and which children to
+/// visit. 1 add (sub), 1 div, comparisons.
 pub fn traversal_step(
     f: Format,
     o: u32,
@@ -125,7 +201,7 @@ pub fn traversal_step(
     if f.eq(d, 0) {
         return (near_is_left, Visit::Near);
     }
-    let t_split = f.div(f.sub(split, o), d);
+    let t_split = split_distance(f, o, d, split);
     let visit = if f.lt(t_max, t_split) || f.le(t_split, 0) {
         Visit::Near
     } else if f.lt(t_split, t_min) {
@@ -137,71 +213,119 @@ pub fn traversal_step(
 }
 
 /// `a . b` as `(ax*bx + ay*by) + az*bz`.
-pub fn dot(f: Format, a: Vec3W, b: Vec3W) -> u32 {
-    f.add(
-        f.add(f.mul(a[0], b[0]), f.mul(a[1], b[1])),
-        f.mul(a[2], b[2]),
+pub fn dot<A: Arith>(a: A, x: [A::V; 3], y: [A::V; 3]) -> A::V {
+    a.add(
+        a.add(a.mul(x[0], y[0]), a.mul(x[1], y[1])),
+        a.mul(x[2], y[2]),
     )
 }
 
 /// The point `o + t*d`, per component `o + t*d`.
-pub fn ray_point(f: Format, o: Vec3W, d: Vec3W, t: u32) -> Vec3W {
-    [0, 1, 2].map(|i| f.add(o[i], f.mul(t, d[i])))
+pub fn ray_point<A: Arith>(a: A, o: [A::V; 3], d: [A::V; 3], t: A::V) -> [A::V; 3] {
+    [0, 1, 2].map(|i| a.add(o[i], a.mul(t, d[i])))
 }
 
 /// `b - a` per component.
-pub fn sub3(f: Format, b: Vec3W, a: Vec3W) -> Vec3W {
-    [0, 1, 2].map(|i| f.sub(b[i], a[i]))
+pub fn sub3<A: Arith>(a: A, y: [A::V; 3], x: [A::V; 3]) -> [A::V; 3] {
+    [0, 1, 2].map(|i| a.sub(y[i], x[i]))
 }
 
-/// Shader: the unit normal facing the incoming ray. `n / sqrt(n.n)` as one reciprocal and
-/// three products, then flipped when it points along the ray.
+/// Shader: `n / sqrt(n.n)` as one reciprocal and three products, and the unit normal's dot
+/// product with the ray direction (positive: the normal points along the ray and is flipped).
+pub fn unit_normal<A: Arith>(a: A, n: [A::V; 3], ray_dir: [A::V; 3]) -> ([A::V; 3], A::V) {
+    let inv_len = a.div(a.word(a.format().one()), a.sqrt(dot(a, n, n)));
+    let unit = n.map(|c| a.mul(c, inv_len));
+    (unit, dot(a, unit, ray_dir))
+}
+
+/// Shader: the unit normal facing the incoming ray ([`unit_normal`], flipped when `0 < s`).
 pub fn facing_unit_normal(f: Format, n: Vec3W, ray_dir: Vec3W) -> Vec3W {
-    let inv_len = f.div(f.one(), f.sqrt(dot(f, n, n)));
-    let unit = n.map(|c| f.mul(c, inv_len));
-    if f.lt(0, dot(f, unit, ray_dir)) {
+    let (unit, s) = unit_normal(f, n, ray_dir);
+    if f.lt(0, s) {
         unit.map(|c| f.neg(c))
     } else {
         unit
     }
 }
 
+/// Shader: the Lambert cosine `(n . L) / sqrt(L . L)` from `n . L` ([`dot`]) once it is known
+/// to be positive.
+pub fn lambert_from_dot<A: Arith>(a: A, n_dot_l: A::V, to_light: [A::V; 3]) -> A::V {
+    a.div(n_dot_l, a.sqrt(dot(a, to_light, to_light)))
+}
+
 /// Shader: the Lambert cosine of a light seen along `to_light` (not normalized) from a surface
-/// with unit normal `n`: `(n . L) / sqrt(L . L)`, or `None` when the light is behind.
+/// with unit normal `n`, or `None` when the light is behind (`!(0 < n . L)`).
 pub fn lambert_cosine(f: Format, n: Vec3W, to_light: Vec3W) -> Option<u32> {
     let n_dot_l = dot(f, n, to_light);
     if !f.lt(0, n_dot_l) {
         return None;
     }
-    Some(f.div(n_dot_l, f.sqrt(dot(f, to_light, to_light))))
+    Some(lambert_from_dot(f, n_dot_l, to_light))
 }
 
 /// Shader: `acc + (kd * light) * cos` per channel.
-pub fn add_light(f: Format, acc: Vec3W, kd: Vec3W, light: Vec3W, cos: u32) -> Vec3W {
-    [0, 1, 2].map(|i| f.add(acc[i], f.mul(f.mul(kd[i], light[i]), cos)))
+pub fn add_light<A: Arith>(
+    a: A,
+    acc: [A::V; 3],
+    kd: [A::V; 3],
+    light: [A::V; 3],
+    cos: A::V,
+) -> [A::V; 3] {
+    [0, 1, 2].map(|i| a.add(acc[i], a.mul(a.mul(kd[i], light[i]), cos)))
 }
 
 /// Shader: the ambient term `kd * ambient` per channel.
-pub fn ambient(f: Format, kd: Vec3W, ambient: u32) -> Vec3W {
-    kd.map(|c| f.mul(c, ambient))
+pub fn ambient<A: Arith>(a: A, kd: [A::V; 3], ambient: A::V) -> [A::V; 3] {
+    kd.map(|c| a.mul(c, ambient))
 }
 
 /// Shader: the mirror direction `d - (2 (d . n)) n` for a unit normal `n`.
-pub fn reflect(f: Format, d: Vec3W, n: Vec3W) -> Vec3W {
-    let k = f.mul(f.from_int(2), dot(f, d, n));
-    [0, 1, 2].map(|i| f.sub(d[i], f.mul(k, n[i])))
+pub fn reflect<A: Arith>(a: A, d: [A::V; 3], n: [A::V; 3]) -> [A::V; 3] {
+    let k = a.mul(a.word(a.format().from_int(2)), dot(a, d, n));
+    [0, 1, 2].map(|i| a.sub(d[i], a.mul(k, n[i])))
 }
 
 /// Shader: `(1 - m) * local + m * reflected` per channel.
-pub fn mix_mirror(f: Format, local: Vec3W, reflected: Vec3W, m: u32) -> Vec3W {
-    let keep = f.sub(f.one(), m);
-    [0, 1, 2].map(|i| f.add(f.mul(keep, local[i]), f.mul(m, reflected[i])))
+pub fn mix_mirror<A: Arith>(a: A, local: [A::V; 3], reflected: [A::V; 3], m: A::V) -> [A::V; 3] {
+    let keep = a.sub(a.word(a.format().one()), m);
+    [0, 1, 2].map(|i| a.add(a.mul(keep, local[i]), a.mul(m, reflected[i])))
+}
+
+/// Shader: a colour channel already clamped to [0, 1], scaled by 255 (one rounding) and
+/// rounded to an integer by adding `2^M`: the sum's spacing is 1, so the adder's round to
+/// nearest even does the integer rounding, and the word's low 8 bits are the channel byte
+/// (`Format::to_u8` after its clamp; `M >= 8`).
+pub fn channel_byte_word<A: Arith>(a: A, clamped: A::V) -> A::V {
+    let f = a.format();
+    let scaled = a.mul(clamped, a.word(f.from_int(255)));
+    a.add(scaled, a.word(f.from_int(1i64 << f.man_bits)))
 }
 
 /// The frame-buffer word `0x00RRGGBB` of a colour.
 pub fn pack_rgb(f: Format, c: Vec3W) -> u32 {
     let [r, g, b] = c.map(|x| u32::from(f.to_u8(x)));
     (r << 16) | (g << 8) | b
+}
+
+#[cfg(test)]
+mod byte_tests {
+    use super::*;
+
+    #[test]
+    fn channel_byte_word_equals_to_u8_on_every_clamped_word() {
+        for f in [Format::E7M16, Format::E5M10, Format::E8M23] {
+            let one = f.one();
+            // Every non-negative word up to 1.0 (the clamp's range), in order.
+            for w in 0..=one {
+                if f.is_nan(w) {
+                    continue;
+                }
+                let byte = channel_byte_word(f, w) & 0xff;
+                assert_eq!(byte, u32::from(f.to_u8(w)), "{f} word {w:#x}");
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -223,8 +347,7 @@ mod margin_tests {
                 let mut w = || f.from_f64(rng.gen_range(-2.0..2.0));
                 let (o, d) = ([w(), w(), w()], [w(), w(), w()]);
                 let inf = f.infinity(false);
-                let exact = intersect(f, o, d, 0, inf);
-                assert_eq!(intersect_with_margin(f, o, d, 0, inf, 0), exact, "{f}");
+                let exact = intersect_with_margin(f, o, d, 0, inf, 0);
                 let wide = intersect_with_margin(f, o, d, 0, inf, margin);
                 assert_eq!((wide.t, wide.u, wide.v), (exact.t, exact.u, exact.v));
                 assert!(wide.hit || !exact.hit, "a margin never loses a hit");
