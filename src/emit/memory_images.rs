@@ -143,7 +143,7 @@ pub fn write_frame_update(
 ) -> Result<Vec<(usize, PathBuf)>> {
     let updates = frame_update(prev, next)?;
     let mut written = Vec::new();
-    for bank in 0..next.banks.len() {
+    for (bank, name) in BANK_NAMES.iter().enumerate().take(next.banks.len()) {
         let pairs: Vec<(u32, u32)> = updates
             .iter()
             .filter(|u| u.bank == bank)
@@ -154,8 +154,7 @@ pub fn write_frame_update(
         }
         let path = dir.join(update_file_name(frame, bank));
         let header = format!(
-            "dynrt frame update: frame {frame}, bank {bank} ({}), {} changed words",
-            BANK_NAMES[bank],
+            "dynrt frame update: frame {frame}, bank {bank} ({name}), {} changed words",
             pairs.len()
         );
         write_atomically(&path, memh_text(&header, &pairs).as_bytes())

@@ -165,12 +165,11 @@ fn checked_updates(name: &str, layouts: &[Layout]) -> Vec<Vec<WordUpdate>> {
         let (prev, next) = (&layouts[f - 1], &layouts[f]);
         let updates = frame_update(prev, next).unwrap();
         let banks: BTreeSet<usize> = updates.iter().map(|u| u.bank).collect();
-        for bank in 0..6 {
+        for (bank, bank_name) in BANK_NAMES.iter().enumerate() {
             let n = updates.iter().filter(|u| u.bank == bank).count();
             println!(
-                "{name} frame {} -> {f}: bank {bank} ({}): {n} of {} words change (was {})",
+                "{name} frame {} -> {f}: bank {bank} ({bank_name}): {n} of {} words change (was {})",
                 f - 1,
-                BANK_NAMES[bank],
                 next.banks[bank].len(),
                 prev.banks[bank].len()
             );
@@ -212,14 +211,9 @@ fn checked_updates(name: &str, layouts: &[Layout]) -> Vec<Vec<WordUpdate>> {
                 m[addr as usize] = word;
             }
         }
-        for bank in 0..6 {
-            let n = next.banks[bank].len();
-            assert!(memory[bank].len() >= n, "bank {bank}");
-            assert_eq!(
-                memory[bank][..n],
-                next.banks[bank][..],
-                "frame {f} bank {bank}"
-            );
+        for (bank, (m, want)) in memory.iter().zip(&next.banks).enumerate() {
+            assert!(m.len() >= want.len(), "bank {bank}");
+            assert_eq!(m[..want.len()], want[..], "frame {f} bank {bank}");
         }
         all.push(updates);
     }

@@ -136,13 +136,13 @@ fn check(
     m.frames = frame_starts.len();
 
     // Coordinates, frame_start, border and addresses of every complete line.
-    for l in 0..lines {
+    for (l, &visible_line) in line_visible.iter().enumerate() {
         let f = *frame_starts.iter().rev().find(|&&f| f <= l).unwrap();
         let y = (l - f) as u32;
         if y as usize >= vt {
             return Err(format!("line {l} is {y} lines into a frame of {vt}"));
         }
-        if line_visible[l] && y == 0 {
+        if visible_line && y == 0 {
             m.image_pixels_per_frame.push(0);
         }
         for o in 0..ht {
@@ -397,7 +397,7 @@ fn vga_64x48(sim: Simulator) {
     };
     let row = |r: u32| -> Vec<u32> {
         (0..64)
-            .flat_map(|c| std::iter::repeat(base + r * 64 + c).take(10))
+            .flat_map(|c| std::iter::repeat_n(base + r * 64 + c, 10))
             .collect()
     };
     assert_eq!(line(0), row(0));

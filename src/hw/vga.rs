@@ -36,8 +36,9 @@
 //! (e.g. with `crate::hw::Delay`) so that colour and syncs line up. Throughput: one pixel per
 //! clock.
 //!
-//! Size: 14 registers (about 150 flip-flops) and a dozen 12-bit comparators; counters are 12
-//! bits wide, so `h_total` and `v_total` must be below 4096, and addresses are
+//! Size (yosys 0.23 `synth_xilinx -family xc2v -flatten`, 640x480 showing 64x48): 132
+//! flip-flops, 160 LUTs, 119 MUXCY + 102 XORCY carry cells, no multiplier. Counters are 12
+//! bits wide, so `h_total` and `v_total` must be below 4096; addresses are
 //! [`VGA_ADDR_BITS`] wide.
 
 use rust_hdl::prelude::*;
