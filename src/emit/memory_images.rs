@@ -18,6 +18,9 @@
 //!   records (only the changed words), one file per bank that changed:
 //!   `frame<f>_bank<k>_<name>.hex`. `$readmemh` of such a file into the memory already
 //!   holding the previous frame updates exactly those words.
+//! - Memories larger than an image are fine: neither Icarus nor Verilator warns when a file
+//!   fills only part of a memory, but the words it does not write are X in Icarus and 0 in
+//!   Verilator, so the processor must not read past a bank's extent.
 //! - [`read_memh`] parses `$readmemh` text (`//` and `/* */` comments, `@hex` address records,
 //!   hex words with optional `_`), so tests and tools can read the files back.
 //! - [`bank_extents`] gives each bank's used size and highest address, to size the

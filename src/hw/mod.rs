@@ -5,6 +5,9 @@
 //! shared by several clients through [`SharedTransformUnit`]'s round-robin arbiter;
 //! [`IntersectUnit`] (1 div, 2 mul, 3 add, plus 5 comparators); [`RayGen`], the ray-generation
 //! client of the transform unit.
+//!
+//! Display: [`VgaTiming`], the VGA sync and frame-buffer address generator in the pixel clock
+//! domain (modes [`VgaMode::VGA_640X480_60`], [`VgaMode::XGA_1024X768_60`]).
 
 pub mod delay;
 pub mod fp;
