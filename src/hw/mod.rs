@@ -5,6 +5,9 @@
 //! shared by several clients through [`SharedTransformUnit`]'s round-robin arbiter;
 //! [`IntersectUnit`] (1 div, 2 mul, 3 add, plus 5 comparators); [`RayGen`], the ray-generation
 //! client of the transform unit.
+//!
+//! Display: [`VgaTiming`], the VGA sync and frame-buffer address generator in the pixel clock
+//! domain (modes [`VgaMode::VGA_640X480_60`], [`VgaMode::XGA_1024X768_60`]).
 
 pub mod delay;
 pub mod fp;
@@ -16,6 +19,7 @@ pub mod raygen;
 mod sim_harness;
 pub mod transform;
 pub mod transform_arbiter;
+pub mod vga;
 
 pub use delay::Delay;
 pub use int_to_float::UIntToFloat;
@@ -23,6 +27,7 @@ pub use intersect::{intersect_latency, IntersectUnit};
 pub use raygen::{RayGen, RayGenUnit};
 pub use transform::{TransformUnit, TRANSFORM_LATENCY};
 pub use transform_arbiter::{SharedTransformUnit, TRANSFORM_CLIENTS};
+pub use vga::{VgaError, VgaMode, VgaPlacement, VgaTiming};
 
 /// Width of the tag that travels with every request through a geometry unit (client id and
 /// thread id; the unit only carries it).
