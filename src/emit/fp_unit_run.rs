@@ -85,8 +85,9 @@ pub fn run_fp_units(
         verilog.push('\n');
         ports.push(BenchPort::output(format!("out_valid_{i}"), 1));
         ports.push(BenchPort::output(format!("result_{i}"), unit.result_width));
+        let b_pin = if unit.unary { "" } else { " .b(b)," };
         body += &format!(
-            "    {} dut_{i}(.clock(clock), .in_valid(in_valid), .a(a), .b(b),\n        \
+            "    {} dut_{i}(.clock(clock), .in_valid(in_valid), .a(a),{b_pin}\n        \
              .out_valid(out_valid_{i}), .result(result_{i}));\n",
             unit.top
         );
