@@ -202,7 +202,7 @@ fn sqrt_verilog<
     const T: usize,
     const P: usize,
 >() -> String {
-    core_verilog(FpSqrt::<W, E, M, S, S1, X2, T>::default())
+    core_verilog(FpSqrt::<W, E, M, S, S1, T>::default())
 }
 
 fn compare_verilog<
@@ -291,13 +291,21 @@ pub fn fp_units_testbench(
     };
     // With only unary units there is no `b` to drive; the second word is still read (and
     // dropped), so every operator takes the same vector files.
-    let (b_decl, b_drive) = if units.iter().any(|u| !u.unary) {
+    let (b_decl, word_b_decl, b_drive) = if units.iter().any(|u| !u.unary) {
         (
             format!("    reg [{wm}:0] b = {w}'d0;\n"),
+            format!("    reg [{wm}:0] word_b;\n"),
             "            b <= word_b;\n",
         )
     } else {
-        (String::new(), "")
+        (
+            String::new(),
+            format!(
+                "    /* verilator lint_off UNUSEDSIGNAL */ // read and dropped: unary units only\n    \
+                 reg [{wm}:0] word_b;\n    /* verilator lint_on UNUSEDSIGNAL */\n"
+            ),
+            "",
+        )
     };
     let names = units
         .iter()
@@ -320,8 +328,7 @@ module tb;
     integer scanned;
     integer cycles = 0;
     reg [{wm}:0] word_a;
-    reg [{wm}:0] word_b;
-{decls}
+{word_b_decl}{decls}
     always #5 clock = ~clock;
 
     initial begin
@@ -365,18 +372,10 @@ endmodule
 mod tests {
     use super::*;
     use crate::hw::fp::supported_formats;
-    use crate::sim;
+    use crate::sim::{self, Simulator};
     use crate::synth;
 
-    const ALL_OPS: [BinOp; 7] = [
-        BinOp::Add,
-        BinOp::Sub,
-        BinOp::Mul,
-        BinOp::Div,
-        BinOp::Lt,
-        BinOp::Le,
-        BinOp::Eq,
-    ];
+    const ALL_OPS: [BinOp; 8] = BinOp::ALL;
 
     fn write_unit(dir: &std::path::Path, unit: &FpUnitRtl) -> std::path::PathBuf {
         let path = dir.join(format!("{}.v", unit.top));
@@ -409,6 +408,14 @@ mod tests {
         assert!(lt.verilog.contains("output wire result\n"));
         let div = fp_unit_rtl(BinOp::Div, Format::E8M23).unwrap();
         assert_eq!(div.latency, 28);
+        let sqrt = fp_unit_rtl(BinOp::Sqrt, Format::E7M16).unwrap();
+        assert_eq!(sqrt.top, "fp_sqrt_e7m16");
+        assert_eq!((sqrt.latency, sqrt.result_width), (21, 24));
+        assert!(sqrt.unary && !div.unary);
+        assert!(sqrt.verilog.contains(
+            "input wire [23:0] a,\n    output wire out_valid,\n    output wire [23:0] result\n"
+        ));
+        assert!(!sqrt.verilog.contains(" b,"), "sqrt has no b port");
     }
 
     #[test]
@@ -422,7 +429,7 @@ mod tests {
     }
 
     /// `verilator --lint-only -Wall` passes on every operator of e7m16 and e8m23, and on each
-    /// distinct core (add/sub, mul, div, compare) of every other format.
+    /// distinct core (add/sub, mul, div, sqrt, compare) of every other format.
     #[test]
     fn verilator_lint_wall_is_clean() {
         let dir = tempfile::tempdir().unwrap();
@@ -430,7 +437,7 @@ mod tests {
             let ops: &[BinOp] = if fmt == Format::E7M16 || fmt == Format::E8M23 {
                 &ALL_OPS
             } else {
-                &[BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Lt]
+                &[BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Sqrt, BinOp::Lt]
             };
             for &op in ops {
                 let unit = fp_unit_rtl(op, fmt).unwrap();
@@ -477,8 +484,59 @@ mod tests {
         let multi = dir.path().join("tb_multi.v");
         let tb = fp_units_testbench(&[&add, &eq], fmt, 10, "v.hex", &["r0.hex", "r1.hex"]);
         std::fs::write(&multi, tb).unwrap();
-        let problems = lint_testbench(&[add_file, eq_file, multi]);
+        let problems = lint_testbench(&[add_file.clone(), eq_file, multi]);
         assert!(problems.is_empty(), "two-unit testbench:\n{problems}");
+        // A unary unit alone (no `b` to drive), and beside a binary one.
+        let sqrt = fp_unit_rtl(BinOp::Sqrt, fmt).unwrap();
+        let sqrt_file = write_unit(dir.path(), &sqrt);
+        let unary = dir.path().join("tb_unary.v");
+        std::fs::write(&unary, fp_unit_testbench(&sqrt, fmt, 10, "v.hex", "r.hex")).unwrap();
+        let problems = lint_testbench(&[sqrt_file.clone(), unary]);
+        assert!(problems.is_empty(), "unary testbench:\n{problems}");
+        let mixed = dir.path().join("tb_mixed.v");
+        let tb = fp_units_testbench(&[&add, &sqrt], fmt, 10, "v.hex", &["r0.hex", "r1.hex"]);
+        std::fs::write(&mixed, tb).unwrap();
+        let problems = lint_testbench(&[add_file, sqrt_file, mixed]);
+        assert!(problems.is_empty(), "add and sqrt testbench:\n{problems}");
+    }
+
+    /// The file-driven testbench runs in Icarus with a binary and a unary unit side by side:
+    /// both read the same `a b` lines (sqrt ignores `b`) and write the model's results.
+    #[test]
+    fn testbench_feeds_binary_and_unary_units_in_icarus() {
+        let dir = tempfile::tempdir().unwrap();
+        let fmt = Format::E7M16;
+        let add = fp_unit_rtl(BinOp::Add, fmt).unwrap();
+        let sqrt = fp_unit_rtl(BinOp::Sqrt, fmt).unwrap();
+        let v = crate::fp::vectors::random_pairs(fmt, 77, 300);
+        println!("seed 77");
+        let lines: String = v
+            .iter()
+            .map(|(a, b)| format!("{a:06x} {b:06x}\n"))
+            .collect();
+        std::fs::write(dir.path().join("v.hex"), lines).unwrap();
+        let tb = dir.path().join("tb.v");
+        let text = fp_units_testbench(&[&add, &sqrt], fmt, v.len(), "v.hex", &["r0.hex", "r1.hex"]);
+        std::fs::write(&tb, text).unwrap();
+        let files = vec![
+            write_unit(dir.path(), &add),
+            write_unit(dir.path(), &sqrt),
+            tb,
+        ];
+        sim::run(
+            Simulator::Icarus,
+            &sim::SimJob::new(dir.path(), files, "tb"),
+        )
+        .unwrap();
+        for (file, op) in [("r0.hex", BinOp::Add), ("r1.hex", BinOp::Sqrt)] {
+            let text = std::fs::read_to_string(dir.path().join(file)).unwrap();
+            let got: Vec<u32> = text
+                .lines()
+                .map(|l| u32::from_str_radix(l, 16).unwrap())
+                .collect();
+            let want: Vec<u32> = v.iter().map(|&(a, b)| op.eval(fmt, a, b)).collect();
+            assert_eq!(got, want, "{op}");
+        }
     }
 
     /// Every operator of e7m16 and e8m23 synthesizes for Virtex-II; the significand products
@@ -487,7 +545,7 @@ mod tests {
     fn yosys_xc2v_synthesis() {
         let dir = tempfile::tempdir().unwrap();
         for fmt in [Format::E7M16, Format::E8M23] {
-            for op in [BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Lt] {
+            for op in [BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Sqrt, BinOp::Lt] {
                 let unit = fp_unit_rtl(op, fmt).unwrap();
                 let path = write_unit(dir.path(), &unit);
                 let work = dir.path().join(format!("synth_{}", unit.top));

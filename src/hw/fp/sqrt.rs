@@ -29,9 +29,9 @@
 //! (including -inf) gives the canonical NaN.
 //!
 //! Const parameters, in the order of the other operators (derived widths, checked in
-//! `default()`): `W = 1+E+M` word, `E` exponent bits, `M` mantissa bits, `S = M+1` significand,
-//! `S1 = S+1` radicand and root (with the round bit), `X2 = E+2` exponent sum, `T = M+5` partial
-//! remainder (`S+3` bits needed, one spare).
+//! `default()`; no `X2`: the exponent arithmetic fits `E` bits): `W = 1+E+M` word, `E` exponent
+//! bits, `M` mantissa bits, `S = M+1` significand, `S1 = S+1` radicand, `T = M+5` partial
+//! remainder, partial root and radicand bits to come (the remainder needs `S+3` bits).
 
 use rust_hdl::prelude::*;
 
@@ -50,7 +50,6 @@ pub struct FpSqrt<
     const M: usize,
     const S: usize,
     const S1: usize,
-    const X2: usize,
     const T: usize,
 > {
     pub clock: Signal<In, Clock>,
@@ -69,11 +68,10 @@ pub struct FpSqrt<
     nan_a: Signal<Local, Bit>,
     sig_a: Signal<Local, Bits<S1>>,
     radicand: Signal<Local, Bits<S1>>,
-    exp_sum: Signal<Local, Bits<X2>>,
+    exp_half: Signal<Local, Bits<E>>,
     first_rem: Signal<Local, Bits<T>>,
-    // Root stages: stage i holds the root after bit i, and the remainder after bit i with the
-    // next radicand bit pair already brought down; `rest` holds the radicand bits still to come
-    // (zeros below the radicand), the pair after that at its top.
+    // Root stages: stage i holds the root and the remainder after bit i, and in `rest` the
+    // radicand bits still to come (zeros below the radicand), the next pair at the top.
     rem: [DFF<Bits<T>>; S],
     root: [DFF<Bits<T>>; S],
     rest: [DFF<Bits<T>>; S],
@@ -111,9 +109,8 @@ pub struct FpSqrt<
     c_man_bits: Constant<Bits<8>>,
     c_sign_pos: Constant<Bits<8>>,
     c_pair_pos: Constant<Bits<8>>,
-    c_second_pair_pos: Constant<Bits<8>>,
     c_hidden: Constant<Bits<S1>>,
-    c_bias: Constant<Bits<X2>>,
+    c_half_bias: Constant<Bits<E>>,
     c_rest_shift: Constant<Bits<8>>,
     c_pair_shift: Constant<Bits<8>>,
     c_one: Constant<Bits<T>>,
@@ -129,12 +126,11 @@ impl<
         const M: usize,
         const S: usize,
         const S1: usize,
-        const X2: usize,
         const T: usize,
-    > Default for FpSqrt<W, E, M, S, S1, X2, T>
+    > Default for FpSqrt<W, E, M, S, S1, T>
 {
     fn default() -> Self {
-        assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == M + 5);
+        assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && T == M + 5);
         Self {
             clock: Default::default(),
             in_valid: Default::default(),
@@ -150,7 +146,7 @@ impl<
             nan_a: Default::default(),
             sig_a: Default::default(),
             radicand: Default::default(),
-            exp_sum: Default::default(),
+            exp_half: Default::default(),
             first_rem: Default::default(),
             rem: std::array::from_fn(|_| Default::default()),
             root: std::array::from_fn(|_| Default::default()),
@@ -184,11 +180,10 @@ impl<
             c_man_bits: const_index(M),
             c_sign_pos: const_index(W - 1),
             c_pair_pos: const_index(S - 1),
-            c_second_pair_pos: const_index(S - 3),
             c_hidden: const_bits::<S1>(1 << M),
-            c_bias: const_bits::<X2>(bias(E)),
-            // Puts radicand bit S - 4 (the top of the third pair) at bit T - 1.
-            c_rest_shift: const_index(T - 1 - (S - 4)),
+            c_half_bias: const_bits::<E>(bias(E) >> 1),
+            // Puts radicand bit S - 2 (the top of the second pair) at bit T - 1.
+            c_rest_shift: const_index(T - 1 - (S - 2)),
             c_pair_shift: const_index(T - 2),
             c_one: const_bits::<T>(1),
             c_one_s: const_bits::<S>(1),
@@ -205,9 +200,8 @@ impl<
         const M: usize,
         const S: usize,
         const S1: usize,
-        const X2: usize,
         const T: usize,
-    > Logic for FpSqrt<W, E, M, S, S1, X2, T>
+    > Logic for FpSqrt<W, E, M, S, S1, T>
 {
     #[hdl_gen]
     fn update(&mut self) {
@@ -267,7 +261,9 @@ impl<
         if self.exp_a.val().get_bit(0) {
             self.radicand.next = self.sig_a.val();
         }
-        self.exp_sum.next = bit_cast::<X2, E>(self.exp_a.val()) + self.c_bias.val();
+        // (e + bias) >> 1 without a carry out, the bias being odd.
+        self.exp_half.next =
+            ((self.exp_a.val() >> 1) + self.c_half_bias.val()) + self.exp_a.val().get_bit(0);
         // The top bit pair is 01, 10 or 11, so the first root bit is 1 and its trial value 1.
         self.first_rem.next = bit_cast::<T, 2>(
             self.radicand
@@ -275,31 +271,30 @@ impl<
                 .get_bits::<2>(self.c_pair_pos.val().index()),
         ) - self.c_one.val();
 
-        // Stage 2: root bit 0 (always 1), the second bit pair brought down, and the flags.
-        self.rem[0].d.next = (self.first_rem.val() << 2)
-            | bit_cast::<T, 2>(
-                self.radicand
-                    .val()
-                    .get_bits::<2>(self.c_second_pair_pos.val().index()),
-            );
+        // Stage 2: root bit 0 (always 1) and the flags.
+        self.rem[0].d.next = self.first_rem.val();
         self.root[0].d.next = self.c_one.val();
         self.rest[0].d.next = bit_cast::<T, S1>(self.radicand.val()) << self.c_rest_shift.val();
-        self.exp[0].d.next = self.exp_sum.val().get_bits::<E>(1);
+        self.exp[0].d.next = self.exp_half.val();
         self.sign[0].d.next = self.sign_a.val();
         self.nan[0].d.next = self.nan_a.val() | (self.sign_a.val() & (!self.zero_a.val()));
         self.inf[0].d.next = self.inf_a.val();
         self.zero[0].d.next = self.zero_a.val();
         self.valid[0].d.next = self.in_valid_r.q.val();
 
-        // Stages 3 ..= S + 1: one root bit each; the trial value for root q is 4q + 1. (No
-        // casts in the loops: rust-hdl evaluates a cast's width outside the unrolled loop, so
-        // the root and the radicand bits are kept at the remainder's width.)
+        // Stages 3 ..= S + 1: one root bit each. The next bit pair is brought down (wiring
+        // only: the remainder's two low bits are zero after the shift) and the trial value for
+        // root q is 4q + 1. (No casts in the loops: rust-hdl evaluates a cast's width outside
+        // the unrolled loop, so the root and the radicand bits are kept at the remainder's
+        // width.)
         for i in 1..S {
-            if self.rem[i - 1].q.val() >= ((self.root[i - 1].q.val() << 2) | self.c_one.val()) {
-                self.rem[i].d.next = ((self.rem[i - 1].q.val()
-                    - ((self.root[i - 1].q.val() << 2) | self.c_one.val()))
-                    << 2)
-                    | (self.rest[i - 1].q.val() >> self.c_pair_shift.val());
+            if ((self.rem[i - 1].q.val() << 2)
+                | (self.rest[i - 1].q.val() >> self.c_pair_shift.val()))
+                >= ((self.root[i - 1].q.val() << 2) | self.c_one.val())
+            {
+                self.rem[i].d.next = ((self.rem[i - 1].q.val() << 2)
+                    | (self.rest[i - 1].q.val() >> self.c_pair_shift.val()))
+                    - ((self.root[i - 1].q.val() << 2) | self.c_one.val());
                 self.root[i].d.next = (self.root[i - 1].q.val() << 1) | self.c_one.val();
             } else {
                 self.rem[i].d.next = (self.rem[i - 1].q.val() << 2)
@@ -318,13 +313,17 @@ impl<
         // bit (the hidden 1) is shifted out. (A one-pass loop because rust-hdl evaluates array
         // indices only from loop variables.)
         for i in (S - 1)..S {
-            if self.rem[i].q.val() >= ((self.root[i].q.val() << 2) | self.c_one.val()) {
-                self.last_rem.d.next =
-                    self.rem[i].q.val() - ((self.root[i].q.val() << 2) | self.c_one.val());
+            if ((self.rem[i].q.val() << 2) | (self.rest[i].q.val() >> self.c_pair_shift.val()))
+                >= ((self.root[i].q.val() << 2) | self.c_one.val())
+            {
+                self.last_rem.d.next = ((self.rem[i].q.val() << 2)
+                    | (self.rest[i].q.val() >> self.c_pair_shift.val()))
+                    - ((self.root[i].q.val() << 2) | self.c_one.val());
                 self.last_root.d.next =
                     (self.root[i].q.val().get_bits::<S>(0) << 1) | self.c_one_s.val();
             } else {
-                self.last_rem.d.next = self.rem[i].q.val();
+                self.last_rem.d.next =
+                    (self.rem[i].q.val() << 2) | (self.rest[i].q.val() >> self.c_pair_shift.val());
                 self.last_root.d.next = self.root[i].q.val().get_bits::<S>(0) << 1;
             }
             self.last_exp.d.next = self.exp[i].q.val();
@@ -382,7 +381,6 @@ mod tests {
         const M: usize,
         const S: usize,
         const S1: usize,
-        const X2: usize,
         const T: usize,
     >(
         f: Format,
@@ -393,7 +391,7 @@ mod tests {
         let mut v = vectors::random_pairs(f, seed, n);
         v.extend(vectors::edge_cases(f).into_iter().map(|a| (a, 0)));
         let got = run_pipelined(
-            FpSqrt::<W, E, M, S, S1, X2, T>::default(),
+            FpSqrt::<W, E, M, S, S1, T>::default(),
             &v,
             sqrt_latency(M as u32) as usize,
             |u, c| u.clock.next = Clock { clk: c },
@@ -408,12 +406,12 @@ mod tests {
 
     #[test]
     fn rust_hdl_simulation_matches_model_e5m10() {
-        check::<16, 5, 10, 11, 12, 7, 15>(Format::E5M10, 311, 300);
+        check::<16, 5, 10, 11, 12, 15>(Format::E5M10, 311, 300);
     }
 
     #[test]
     fn rust_hdl_simulation_matches_model_e7m16() {
-        check::<24, 7, 16, 17, 18, 9, 21>(Format::E7M16, 312, 200);
+        check::<24, 7, 16, 17, 18, 21>(Format::E7M16, 312, 200);
     }
 
     /// The module comment's claim that rounding never carries out of the significand, checked
