@@ -1,8 +1,9 @@
 //! The `eXmY` floating-point operators as fully pipelined rust-hdl hardware.
 //!
 //! One file per operator: [`FpAddSub`] (add and subtract), [`FpMul`], [`FpDiv`], [`FpSqrt`]
-//! (the one unary operator: ports `a` only) and [`FpCompare`] (`lt`, `le`, `eq`). Each accepts a new operation every clock and delivers it
-//! a fixed number of clocks later (see [`latency`]), with a `valid` bit travelling alongside.
+//! (the one unary operator: no `b` port) and [`FpCompare`] (`lt`, `le`, `eq`). Each accepts a
+//! new operation every clock and delivers it a fixed number of clocks later (see [`latency`]),
+//! with a `valid` bit travelling alongside.
 //! Results equal `dynrt::fp` bit for bit (round to nearest even, subnormals flushed on input and
 //! output with tininess detected after rounding, overflow to infinity, one canonical quiet NaN).
 //!
