@@ -21,3 +21,4 @@ pub mod scene;
 pub mod sim;
 pub mod stress;
 pub mod synth;
+pub mod units;

@@ -27,3 +27,4 @@ pub use transform_arbiter::{SharedTransformUnit, TRANSFORM_CLIENTS};
 /// Width of the tag that travels with every request through a geometry unit (client id and
 /// thread id; the unit only carries it).
 pub const TAG_BITS: usize = 16;
+pub mod program;

@@ -18,8 +18,7 @@ use super::units::{self, Vec3W, Visit};
 use crate::fp::Format;
 use crate::layout::{instance_word as iw, FrameMap, Layout, Node, FRAME, INSTANCES, LISTS};
 
-/// Entries of the per-ray mailboxes (most recently tested ids, first in first out).
-pub const MAILBOX_ENTRIES: usize = 8;
+pub use super::units::MAILBOX_ENTRIES;
 
 /// The closest hit found so far.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -115,9 +114,8 @@ struct Query {
 pub struct Golden<'a> {
     layout: &'a Layout,
     f: Format,
-    /// Edge margin of the unit-triangle test (a format word; 0 = the exact test of
-    /// [`units::intersect`]). An experiment of the precision study, see
-    /// [`units::intersect_with_margin`]; the hardware implements margin 0.
+    /// Edge margin of the unit-triangle test (a format word): [`units::edge_margin`] unless
+    /// a study sets another with [`Golden::with_edge_margin`] (0 = the exact test).
     edge_margin: u32,
 }
 
@@ -133,13 +131,13 @@ impl<'a> Golden<'a> {
         Golden {
             layout,
             f: layout.format,
-            edge_margin: 0,
+            edge_margin: units::edge_margin(layout.format),
         }
     }
 
     /// A golden model whose unit-triangle test accepts `u, v >= -margin` and
     /// `u + v <= 1 + margin` (margin in unit-triangle coordinates, rounded to the format).
-    /// Not what the hardware computes unless the hardware adopts the same margin.
+    /// What the hardware computes only for the default margin (`units::edge_margin`).
     pub fn with_edge_margin(layout: &'a Layout, margin: f64) -> Self {
         Golden {
             edge_margin: layout.format.from_f64(margin.abs()),
@@ -374,11 +372,7 @@ impl<'a> Golden<'a> {
             let o = units::transform(f, &m, q.o, true);
             let d = units::transform(f, &m, q.d, false);
             let t_max = best.map_or(q.t_max, |b| b.t);
-            let r = if self.edge_margin == 0 {
-                units::intersect(f, o, d, q.t_min, t_max)
-            } else {
-                units::intersect_with_margin(f, o, d, q.t_min, t_max, self.edge_margin)
-            };
+            let r = units::intersect_with_margin(f, o, d, q.t_min, t_max, self.edge_margin);
             if r.hit {
                 *best = Some(Hit {
                     t: r.t,

@@ -1,0 +1,375 @@
+//! The arithmetic of every hardware unit, written once as sequences of `fp` operations.
+//!
+//! The golden model calls these with a [`Format`] (values are format words); the processor's
+//! microprogram generator calls the same functions with its assembler (values are registers),
+//! so the hardware executes the same operations in the same order with the same rounding
+//! (DESIGN.md section 2). Each hardware unit's tests compare the RTL with these functions.
+//! Change an order here and both sides change with it.
+//!
+//! The decisions (comparisons) around the arithmetic are small and live beside it: the golden
+//! model evaluates them with `Format::lt`/`le`/`eq`, the microprogram as branches; the
+//! processor's tests compare the two renderers pixel by pixel.
+
+use crate::fp::Format;
+
+/// Entries of the per-ray mailboxes (most recently tested ids, first in first out), in the
+/// golden model and in the hardware.
+pub const MAILBOX_ENTRIES: usize = 8;
+
+/// A 3-vector of format words.
+pub type Vec3W = [u32; 3];
+/// A 3x4 matrix, row-major: `m00 m01 m02 n0 m10 m11 m12 n1 m20 m21 m22 n2`.
+pub type Mat34W = [u32; 12];
+
+/// Something that carries out `fp` operations: [`Format`] computes them; an assembler records
+/// them as instructions. Copy, so the sequences below take it by value like a `Format`.
+pub trait Arith: Copy {
+    /// A value: a format word, or the register holding one.
+    type V: Copy;
+    fn add(self, a: Self::V, b: Self::V) -> Self::V;
+    fn sub(self, a: Self::V, b: Self::V) -> Self::V;
+    fn mul(self, a: Self::V, b: Self::V) -> Self::V;
+    fn div(self, a: Self::V, b: Self::V) -> Self::V;
+    fn sqrt(self, a: Self::V) -> Self::V;
+    /// Sign flip (no rounding).
+    fn neg(self, a: Self::V) -> Self::V;
+    /// A constant format word.
+    fn word(self, w: u32) -> Self::V;
+    /// An unsigned integer converted to the format (exact for the pixel coordinates).
+    fn from_uint(self, i: Self::V) -> Self::V;
+    fn format(self) -> Format;
+}
+
+impl Arith for Format {
+    type V = u32;
+    fn add(self, a: u32, b: u32) -> u32 {
+        Format::add(self, a, b)
+    }
+    fn sub(self, a: u32, b: u32) -> u32 {
+        Format::sub(self, a, b)
+    }
+    fn mul(self, a: u32, b: u32) -> u32 {
+        Format::mul(self, a, b)
+    }
+    fn div(self, a: u32, b: u32) -> u32 {
+        Format::div(self, a, b)
+    }
+    fn sqrt(self, a: u32) -> u32 {
+        Format::sqrt(self, a)
+    }
+    fn neg(self, a: u32) -> u32 {
+        Format::neg(self, a)
+    }
+    fn word(self, w: u32) -> u32 {
+        w
+    }
+    fn from_uint(self, i: u32) -> u32 {
+        self.from_int(i64::from(i))
+    }
+    fn format(self) -> Format {
+        self
+    }
+}
+
+/// TransformUnit: `x' = ((m00*x + m01*y) + m02*z) + n0` per row for a point; a vector omits
+/// the `+ n` step. 9 multiplications and 9 additions for a point (6 for a vector).
+pub fn transform<A: Arith>(a: A, m: &[A::V; 12], v: [A::V; 3], point: bool) -> [A::V; 3] {
+    let row = |r: usize| {
+        let m = &m[r * 4..r * 4 + 4];
+        let s = a.add(
+            a.add(a.mul(m[0], v[0]), a.mul(m[1], v[1])),
+            a.mul(m[2], v[2]),
+        );
+        if point {
+            a.add(s, m[3])
+        } else {
+            s
+        }
+    };
+    [row(0), row(1), row(2)]
+}
+
+/// The normal transform is a 3x3 (the 3x4 layout without offsets), run as a vector transform.
+pub fn transform3<A: Arith>(a: A, m: &[A::V; 9], v: [A::V; 3]) -> [A::V; 3] {
+    let row = |r: usize| {
+        a.add(
+            a.add(a.mul(m[r * 3], v[0]), a.mul(m[r * 3 + 1], v[1])),
+            a.mul(m[r * 3 + 2], v[2]),
+        )
+    };
+    [row(0), row(1), row(2)]
+}
+
+/// RayGen: the primary ray direction of pixel (x, y) is the camera matrix applied to the point
+/// (x, y, 0) (the layout bakes the pixel-centre offsets into the matrix's offset column).
+pub fn primary_direction_of<A: Arith>(a: A, camera: &[A::V; 12], x: A::V, y: A::V) -> [A::V; 3] {
+    let zero = a.word(0);
+    transform(a, camera, [a.from_uint(x), a.from_uint(y), zero], true)
+}
+
+/// [`primary_direction_of`] for pixel (x, y) in format words.
+pub fn primary_direction(f: Format, camera: &Mat34W, x: u32, y: u32) -> Vec3W {
+    primary_direction_of(f, camera, x, y)
+}
+
+/// The result of one unit-triangle test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UnitHit {
+    pub t: u32,
+    pub u: u32,
+    pub v: u32,
+    pub hit: bool,
+}
+
+/// The unit-triangle edge margin in units of the format's spacing at 1 (`2^-M`): 64 ulps,
+/// 2^-10 at e7m16. Rounding of O' and D' can open a crack along an edge shared by two
+/// triangles; growing each triangle by the margin closes it (PRECISION.md measures what it
+/// closes and what it adds at silhouettes).
+pub const EDGE_MARGIN_ULPS: u32 = 64;
+
+/// The margin of [`EDGE_MARGIN_ULPS`] as a format word.
+pub fn edge_margin(f: Format) -> u32 {
+    f.from_f64(f64::from(EDGE_MARGIN_ULPS) * 2f64.powi(-(f.man_bits as i32)))
+}
+
+/// The bounds of the unit-triangle test with edge margin `margin`: `u, v >= lo` and
+/// `u + v <= hi`, with `lo = -margin` and `hi = 1 + margin` (each rounded once). Constants, so
+/// in hardware the margin costs no operator.
+pub fn edge_bounds(f: Format, margin: u32) -> (u32, u32) {
+    (f.neg(margin), f.add(f.one(), margin))
+}
+
+/// IntersectUnit's arithmetic, given the ray already in unit-triangle space (O', D'):
+/// `t = -O'z / D'z`, `u = O'x + t*D'x`, `v = O'y + t*D'y` and `u + v`. 1 div, 2 mul, 3 add.
+pub fn unit_triangle_coords<A: Arith>(a: A, o: [A::V; 3], d: [A::V; 3]) -> [A::V; 4] {
+    let t = a.div(a.neg(o[2]), d[2]);
+    let u = a.add(o[0], a.mul(t, d[0]));
+    let v = a.add(o[1], a.mul(t, d[1]));
+    [t, u, v, a.add(u, v)]
+}
+
+/// IntersectUnit: a hit when `lo <= u`, `lo <= v`, `u + v <= hi` and `t_min < t < t_max`
+/// ([`unit_triangle_coords`], bounds from [`edge_bounds`] with the default [`edge_margin`]).
+/// NaN fails every comparison, so a ray parallel to the triangle (D'z = 0) or any NaN or
+/// infinity never hits.
+pub fn intersect(f: Format, o: Vec3W, d: Vec3W, t_min: u32, t_max: u32) -> UnitHit {
+    intersect_with_margin(f, o, d, t_min, t_max, edge_margin(f))
+}
+
+/// The unit-triangle test with edge margin `margin` (a format word; 0 is the exact test).
+/// Grows every triangle by `margin` in unit-triangle coordinates (a fraction of its size).
+pub fn intersect_with_margin(
+    f: Format,
+    o: Vec3W,
+    d: Vec3W,
+    t_min: u32,
+    t_max: u32,
+    margin: u32,
+) -> UnitHit {
+    let (lo, hi) = edge_bounds(f, margin);
+    let [t, u, v, uv] = unit_triangle_coords(f, o, d);
+    let inside = f.le(lo, u) && f.le(lo, v) && f.le(uv, hi);
+    let hit = inside && f.lt(t_min, t) && f.lt(t, t_max);
+    UnitHit { t, u, v, hit }
+}
+
+/// Which children of an inner kd node a ray segment [t_min, t_max] visits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Visit {
+    /// Only the near child, with the whole segment.
+    Near,
+    /// Only the far child, with the whole segment.
+    Far,
+    /// The near child with [t_min, t_split], then the far child with [t_split, t_max].
+    Both { t_split: u32 },
+}
+
+/// The traversal unit's arithmetic: the distance `(split - o) / d` to a split plane.
+pub fn split_distance<A: Arith>(a: A, o: A::V, d: A::V, split: A::V) -> A::V {
+    a.div(a.sub(split, o), d)
+}
+
+/// One traversal step (traversal unit): `t_split` ([`split_distance`]) along the node's axis,
+/// and the near child is the one holding the origin (on the plane, the one the ray heads
+/// into). Returns whether the near child is the left (below) one, and which children to
+/// visit. 1 add (sub), 1 div, comparisons.
+pub fn traversal_step(
+    f: Format,
+    o: u32,
+    d: u32,
+    split: u32,
+    t_min: u32,
+    t_max: u32,
+) -> (bool, Visit) {
+    let near_is_left = f.lt(o, split) || (f.eq(o, split) && f.le(d, 0));
+    if f.eq(d, 0) {
+        return (near_is_left, Visit::Near);
+    }
+    let t_split = split_distance(f, o, d, split);
+    let visit = if f.lt(t_max, t_split) || f.le(t_split, 0) {
+        Visit::Near
+    } else if f.lt(t_split, t_min) {
+        Visit::Far
+    } else {
+        Visit::Both { t_split }
+    };
+    (near_is_left, visit)
+}
+
+/// `a . b` as `(ax*bx + ay*by) + az*bz`.
+pub fn dot<A: Arith>(a: A, x: [A::V; 3], y: [A::V; 3]) -> A::V {
+    a.add(
+        a.add(a.mul(x[0], y[0]), a.mul(x[1], y[1])),
+        a.mul(x[2], y[2]),
+    )
+}
+
+/// The point `o + t*d`, per component `o + t*d`.
+pub fn ray_point<A: Arith>(a: A, o: [A::V; 3], d: [A::V; 3], t: A::V) -> [A::V; 3] {
+    [0, 1, 2].map(|i| a.add(o[i], a.mul(t, d[i])))
+}
+
+/// `b - a` per component.
+pub fn sub3<A: Arith>(a: A, y: [A::V; 3], x: [A::V; 3]) -> [A::V; 3] {
+    [0, 1, 2].map(|i| a.sub(y[i], x[i]))
+}
+
+/// Shader: `n / sqrt(n.n)` as one reciprocal and three products, and the unit normal's dot
+/// product with the ray direction (positive: the normal points along the ray and is flipped).
+pub fn unit_normal<A: Arith>(a: A, n: [A::V; 3], ray_dir: [A::V; 3]) -> ([A::V; 3], A::V) {
+    let inv_len = a.div(a.word(a.format().one()), a.sqrt(dot(a, n, n)));
+    let unit = n.map(|c| a.mul(c, inv_len));
+    (unit, dot(a, unit, ray_dir))
+}
+
+/// Shader: the unit normal facing the incoming ray ([`unit_normal`], flipped when `0 < s`).
+pub fn facing_unit_normal(f: Format, n: Vec3W, ray_dir: Vec3W) -> Vec3W {
+    let (unit, s) = unit_normal(f, n, ray_dir);
+    if f.lt(0, s) {
+        unit.map(|c| f.neg(c))
+    } else {
+        unit
+    }
+}
+
+/// Shader: the Lambert cosine `(n . L) / sqrt(L . L)` from `n . L` ([`dot`]) once it is known
+/// to be positive.
+pub fn lambert_from_dot<A: Arith>(a: A, n_dot_l: A::V, to_light: [A::V; 3]) -> A::V {
+    a.div(n_dot_l, a.sqrt(dot(a, to_light, to_light)))
+}
+
+/// Shader: the Lambert cosine of a light seen along `to_light` (not normalized) from a surface
+/// with unit normal `n`, or `None` when the light is behind (`!(0 < n . L)`).
+pub fn lambert_cosine(f: Format, n: Vec3W, to_light: Vec3W) -> Option<u32> {
+    let n_dot_l = dot(f, n, to_light);
+    if !f.lt(0, n_dot_l) {
+        return None;
+    }
+    Some(lambert_from_dot(f, n_dot_l, to_light))
+}
+
+/// Shader: `acc + (kd * light) * cos` per channel.
+pub fn add_light<A: Arith>(
+    a: A,
+    acc: [A::V; 3],
+    kd: [A::V; 3],
+    light: [A::V; 3],
+    cos: A::V,
+) -> [A::V; 3] {
+    [0, 1, 2].map(|i| a.add(acc[i], a.mul(a.mul(kd[i], light[i]), cos)))
+}
+
+/// Shader: the ambient term `kd * ambient` per channel.
+pub fn ambient<A: Arith>(a: A, kd: [A::V; 3], ambient: A::V) -> [A::V; 3] {
+    kd.map(|c| a.mul(c, ambient))
+}
+
+/// Shader: the mirror direction `d - (2 (d . n)) n` for a unit normal `n`.
+pub fn reflect<A: Arith>(a: A, d: [A::V; 3], n: [A::V; 3]) -> [A::V; 3] {
+    let k = a.mul(a.word(a.format().from_int(2)), dot(a, d, n));
+    [0, 1, 2].map(|i| a.sub(d[i], a.mul(k, n[i])))
+}
+
+/// Shader: `(1 - m) * local + m * reflected` per channel.
+pub fn mix_mirror<A: Arith>(a: A, local: [A::V; 3], reflected: [A::V; 3], m: A::V) -> [A::V; 3] {
+    let keep = a.sub(a.word(a.format().one()), m);
+    [0, 1, 2].map(|i| a.add(a.mul(keep, local[i]), a.mul(m, reflected[i])))
+}
+
+/// Shader: a colour channel already clamped to [0, 1], scaled by 255 (one rounding) and
+/// rounded to an integer by adding `2^M`: the sum's spacing is 1, so the adder's round to
+/// nearest even does the integer rounding, and the word's low 8 bits are the channel byte
+/// (`Format::to_u8` after its clamp; `M >= 8`).
+pub fn channel_byte_word<A: Arith>(a: A, clamped: A::V) -> A::V {
+    let f = a.format();
+    let scaled = a.mul(clamped, a.word(f.from_int(255)));
+    a.add(scaled, a.word(f.from_int(1i64 << f.man_bits)))
+}
+
+/// The frame-buffer word `0x00RRGGBB` of a colour.
+pub fn pack_rgb(f: Format, c: Vec3W) -> u32 {
+    let [r, g, b] = c.map(|x| u32::from(f.to_u8(x)));
+    (r << 16) | (g << 8) | b
+}
+
+#[cfg(test)]
+mod byte_tests {
+    use super::*;
+
+    #[test]
+    fn channel_byte_word_equals_to_u8_on_every_clamped_word() {
+        for f in [Format::E7M16, Format::E5M10, Format::E8M23] {
+            let one = f.one();
+            // Every non-negative word up to 1.0 (the clamp's range), in order.
+            for w in 0..=one {
+                if f.is_nan(w) {
+                    continue;
+                }
+                let byte = channel_byte_word(f, w) & 0xff;
+                assert_eq!(byte, u32::from(f.to_u8(w)), "{f} word {w:#x}");
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod margin_tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn margin_zero_is_the_exact_test_and_a_margin_only_adds_hits_near_edges() {
+        let seed = 61;
+        println!("seed {seed}");
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        for f in [Format::E7M16, Format::E8M23, Format::E5M10] {
+            // Wide enough that random rays land in it often.
+            let margin = f.from_f64(0.05);
+            let (mut added, mut near_edge) = (0, 0);
+            for _ in 0..20_000 {
+                let mut w = || f.from_f64(rng.gen_range(-2.0..2.0));
+                let (o, d) = ([w(), w(), w()], [w(), w(), w()]);
+                let inf = f.infinity(false);
+                let exact = intersect_with_margin(f, o, d, 0, inf, 0);
+                let wide = intersect_with_margin(f, o, d, 0, inf, margin);
+                assert_eq!((wide.t, wide.u, wide.v), (exact.t, exact.u, exact.v));
+                assert!(wide.hit || !exact.hit, "a margin never loses a hit");
+                if wide.hit && !exact.hit {
+                    added += 1;
+                    let (u, v) = (f.to_f64(wide.u), f.to_f64(wide.v));
+                    let m = f.to_f64(margin);
+                    // Only points within the margin of the triangle's edges are added.
+                    assert!(u < 0.0 || v < 0.0 || u + v > 1.0);
+                    assert!(u >= -m && v >= -m && u + v <= 1.0 + 2.0 * m, "{u} {v}");
+                    near_edge += 1;
+                }
+            }
+            println!("{f}: margin adds {added} hits, all within it of an edge ({near_edge})");
+            assert!(
+                added > 0,
+                "{f}: random rays must sometimes land in the margin"
+            );
+        }
+    }
+}
