@@ -8,6 +8,8 @@ pub mod geometry_unit_run;
 #[cfg(test)]
 mod geometry_unit_tests;
 pub mod memory_images;
+pub mod processor;
+pub mod processor_run;
 pub mod stream_bench;
 pub mod verilog_tidy;
 pub mod vga_timing;

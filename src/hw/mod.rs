@@ -10,6 +10,7 @@
 //! domain (modes [`VgaMode::VGA_640X480_60`], [`VgaMode::XGA_1024X768_60`]).
 
 pub mod delay;
+pub mod engine;
 pub mod fp;
 pub mod geometry_formats;
 pub mod int_to_float;
