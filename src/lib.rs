@@ -12,6 +12,7 @@ pub mod bench;
 pub mod compare;
 pub mod demo;
 pub mod emit;
+pub mod flow;
 pub mod fp;
 pub mod hw;
 pub mod layout;

@@ -84,6 +84,8 @@ enum Pixels {
 pub struct RunStats {
     /// Instructions executed per unit (the engine issues one per clock).
     pub per_unit: std::collections::BTreeMap<Unit, u64>,
+    /// Instructions executed per routine of the program (`Program::sections`).
+    pub per_section: std::collections::BTreeMap<&'static str, u64>,
     pub instructions: u64,
     /// Rotations of the thread slots until the last thread halted.
     pub rounds: u64,
@@ -293,6 +295,10 @@ impl<'a> Machine<'a> {
             }
         }
         *stats.per_unit.entry(i.op.unit()).or_default() += 1;
+        *stats
+            .per_section
+            .entry(self.program.sections[t.pc])
+            .or_default() += 1;
         stats.instructions += 1;
         t.pc = next;
         Ok(())
