@@ -2,7 +2,8 @@
 #   make deps    install iverilog, verilator and yosys from Debian packages when missing
 #   make test    the whole test suite (installs the tools first)
 #   make demo    the main job on the bundled default scene (report in out/demo/report.md)
-#   make rtl     regenerate the checked-in Verilog (rtl_out/) and testbenches (testbench/)
+#   make rtl     regenerate the checked-in Verilog (rtl_out/), testbenches and memory images
+#                (testbench/) and constraints (constraints/) of the default scene
 #   make sim     simulate every FP operator in Icarus and Verilator against the model
 #   make bench   speed, area and error reports under out/bench/
 #   make synth   yosys synth_xilinx -family xc2v of the FP operators (resources only)
@@ -39,6 +40,11 @@ demo: deps build
 
 rtl: build
 	$(DYNRT) emit-fp --format e7m16 --rtl rtl_out/fp --testbench testbench/fp
+	rm -rf $(OUT)/rtl/cornell && $(DYNRT) rtl scenes/cornell.toml --out $(OUT)/rtl/cornell
+	mkdir -p rtl_out/processor testbench/processor constraints
+	cp $(OUT)/rtl/cornell/rtl/dynrt_processor.v $(OUT)/rtl/cornell/program.lst rtl_out/processor/
+	rm -rf testbench/processor/mem && cp -r $(OUT)/rtl/cornell/testbench/tb.v $(OUT)/rtl/cornell/mem testbench/processor/
+	cp $(OUT)/rtl/cornell/constraints/dynrt.ucf constraints/
 
 sim: deps build
 	@mkdir -p $(OUT)/sim; \

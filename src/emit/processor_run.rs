@@ -105,14 +105,23 @@ pub fn simulate_processor(
     let job = SimJob::new(dir, vec![rtl, tb], "tb")
         .timeout(Duration::from_secs(3600))
         .verilator_build(VerilatorBuild::Fast);
-    let run = sim::run(sim, &job)?;
+    let timeout = |detail: &str| {
+        anyhow::anyhow!(
+            "{}: the processor did not finish a frame within {cycle_limit} clocks (the \
+             testbench's limit; a hung thread or a limit too small for the scene):\n{}",
+            sim.name(),
+            detail.trim()
+        )
+    };
+    // The testbench ends a timed-out run with $fatal, so the tool reports a failure.
+    let run = match sim::run(sim, &job) {
+        Ok(run) => run,
+        Err(e) if e.to_string().contains("TIMEOUT") => return Err(timeout(&e.to_string())),
+        Err(e) => return Err(e.into()),
+    };
     let out = format!("{}{}", run.stdout, run.stderr);
     if out.contains("TIMEOUT") {
-        bail!(
-            "{}: the processor did not finish a frame within {cycle_limit} clocks:\n{}",
-            sim.name(),
-            out.trim()
-        );
+        return Err(timeout(&out));
     }
     let pixels = (layouts[0].info.width * layouts[0].info.height) as usize;
     let mut frames = Vec::new();

@@ -290,12 +290,9 @@ pub fn build(
         ))
     };
 
+    // Object trees first, the top-level tree (rebuilt every frame) after them: its root has
+    // the same index in every frame and a frame update rewrites only its words.
     let (mut nodes, mut lists) = (Vec::new(), Vec::new());
-    let mut top_root = None;
-    if let Some(top) = &top {
-        top_root = Some(0);
-        pack_tree(f, top, 0, 0, |p| p, &mut nodes, &mut lists)?;
-    }
     let mut object_roots = Vec::new();
     for (o, tree) in trees.trees.iter().enumerate() {
         let node_base = (nodes.len() / NODE_WORDS) as u32;
@@ -307,6 +304,20 @@ pub fn build(
             node_base,
             lists.len() as u32,
             |p| base + p,
+            &mut nodes,
+            &mut lists,
+        )?;
+    }
+    let mut top_root = None;
+    if let Some(top) = &top {
+        let node_base = (nodes.len() / NODE_WORDS) as u32;
+        top_root = Some(node_base);
+        pack_tree(
+            f,
+            top,
+            node_base,
+            lists.len() as u32,
+            |p| p,
             &mut nodes,
             &mut lists,
         )?;

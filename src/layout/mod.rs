@@ -10,8 +10,8 @@
 //!
 //! | bank | contents | words per item |
 //! |---|---|---|
-//! | 0 `NODES` | kd nodes: the top-level tree (rewritten each frame) then every object tree | 2 per node |
-//! | 1 `LISTS` | leaf lists: instance ids of top-level leaves, global triangle ids of object leaves | 1 per reference |
+//! | 0 `NODES` | kd nodes: every object tree, then the top-level tree (rewritten each frame) | 2 per node |
+//! | 1 `LISTS` | leaf lists: global triangle ids of object leaves, then instance ids of top-level leaves | 1 per reference |
 //! | 2 `TRIANGLES_UV` | rows 0 and 1 of the Woop unit-triangle transforms `T` (the u and v rows) | 8 per triangle |
 //! | 3 `TRIANGLES_T` | row 2 of `T` (the t row), then the object-space unit normal (3 floats) and the material index | 8 per triangle |
 //! | 4 `INSTANCES` | per instance: world-to-object 3x4 (12), normal matrix 3x3 object-to-world (9), object root node, first global triangle, object index (rewritten each frame) | 24 per instance |
