@@ -242,7 +242,6 @@ impl<
                     .map(|i| Bits::<32>::from(u64::from(rom_words(i)[k]))),
             ))
         };
-        let zeros = |n: usize| (0..n).map(|_| Bits::<32>::from(0u64));
         Self {
             clock: Default::default(),
             start: Default::default(),
@@ -260,10 +259,14 @@ impl<
             rom_ctl: rom(0),
             rom_imm: rom(1),
             rom_aux: rom(2),
-            regs_a: RAM::new(word_map(zeros(1 << 13))),
-            regs_b: RAM::new(word_map(zeros(1 << 13))),
-            scratch: RAM::new(word_map(zeros(1 << 12))),
-            mailbox: std::array::from_fn(|_| RAM::new(word_map(zeros(64)))),
+            // Registers, scratch and mailbox entries start undefined: the program writes every
+            // register and scratch word before reading it, and an entry counts only below the
+            // mailbox's length (so the generated Verilog stays small and Icarus compiles it
+            // quickly).
+            regs_a: Default::default(),
+            regs_b: Default::default(),
+            scratch: Default::default(),
+            mailbox: Default::default(),
             mailbox_meta: RAM::new(word_map((0..64).map(|_| Bits::<8>::from(0u64)))),
             running: Default::default(),
             epoch: Default::default(),
