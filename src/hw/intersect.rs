@@ -17,10 +17,13 @@
 //! (the paper counts comparators only for traversal). The negation of O'z is a sign flip
 //! (the divider reads NaNs and subnormals the way `Format::neg` leaves them).
 //!
-//! Measured (`yosys synth_xilinx -family xc2v`, out of context): e7m16 2713 LUTs, 5967 FFs,
-//! 2 MULT18X18, 0 BRAM, depth 15; e8m23 4377 LUTs, 9720 FFs, 8 MULT18X18 (two 24x24 products),
-//! depth 15. Most flip-flops are delay lines (O'x, O'y, D'x, D'y, t_min, t_max and the tag wait
-//! out the divider's `M + 5` clocks); yosys 0.23 does not map them to SRL16s.
+//! Measured (`dynrt synth --unit intersect`, yosys 0.23 `synth_xilinx -family xc2v`, out of
+//! context): e7m16 2773 LUTs, 7032 FFs, 2 MULT18X18, 0 BRAM, logic depth 9; e8m23 4473 LUTs,
+//! 11049 FFs, 8 MULT18X18 (two 24x24 products), depth 8. The margin's bounds cost 59 LUTs at
+//! e7m16 (55 at e8m23) and one LUT level at e7m16 over the exact test's 0 and 1, which the
+//! comparators simplify further. Most flip-flops are delay lines (O'x, O'y, D'x, D'y, t_min,
+//! t_max and the tag wait out the divider's `M + 5` clocks); yosys 0.23 does not map them to
+//! SRL16s.
 //!
 //! Latency [`intersect_latency`] = div (`M + 5`) + mul (4) + add (7) + add (7) + compare (2):
 //! 41 clocks for e7m16, 48 for e8m23; one test per clock. `tag` travels with the data.
