@@ -43,7 +43,7 @@ rtl: build
 sim: deps build
 	@mkdir -p $(OUT)/sim; \
 	python3 -c "import random, re; e, m = map(int, re.findall(r'\d+', '$(FORMAT)')); w = 1 + e + m; d = (w + 3) // 4; random.seed(7); print('\n'.join(f'{random.getrandbits(w):0{d}x} {random.getrandbits(w):0{d}x}' for _ in range(20000)))" > $(OUT)/sim/vectors.txt; \
-	for op in add sub mul div lt le eq; do \
+	for op in add sub mul div sqrt lt le eq; do \
 	  $(DYNRT) fp --op $$op --format $(FORMAT) --vectors $(OUT)/sim/vectors.txt --out $(OUT)/sim/$$op.model --sim model || exit 1; \
 	  for s in iverilog verilator; do \
 	    $(DYNRT) fp --op $$op --format $(FORMAT) --vectors $(OUT)/sim/vectors.txt --out $(OUT)/sim/$$op.$$s --sim $$s || exit 1; \

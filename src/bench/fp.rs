@@ -26,7 +26,7 @@ pub struct FpUnitRow {
 
 /// The operators whose hardware differs: add and sub share one unit, lt, le and eq another,
 /// so one of each is enough for resources.
-pub const DISTINCT_OPS: [BinOp; 4] = [BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Lt];
+pub const DISTINCT_OPS: [BinOp; 5] = [BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Sqrt, BinOp::Lt];
 
 /// Synthesizes and simulates every operator of `ops` in every format of `formats`; `vectors`
 /// random operand pairs per Verilator run (0 skips the simulation). Results are checked

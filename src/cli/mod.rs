@@ -7,6 +7,7 @@ mod demo_cmd;
 mod emit_fp_cmd;
 mod fp_cmd;
 mod render_cmd;
+mod rtl_cmd;
 mod stress_cmd;
 mod synth_cmd;
 
@@ -39,6 +40,10 @@ enum Command {
     Stress(stress_cmd::StressArgs),
     /// yosys synth_xilinx -family xc2v of one geometry unit: resources and logic depth.
     Synth(synth_cmd::SynthArgs),
+    /// Write the ray tracing processor of a scene: Verilog, testbench, memory images, UCF.
+    Rtl(rtl_cmd::RtlArgs),
+    /// Generate, simulate (Icarus or Verilator) and compare every frame with the golden model.
+    Sim(rtl_cmd::SimArgs),
     /// Run operand vectors through one floating-point operator (RTL or software model).
     Fp(fp_cmd::FpArgs),
 }
@@ -55,6 +60,8 @@ pub fn run() -> i32 {
         Command::Stress(a) => stress_cmd::run(a),
         Command::Synth(a) => synth_cmd::run(a),
         Command::EmitFp(a) => emit_fp_cmd::run(a),
+        Command::Rtl(a) => rtl_cmd::run_rtl(a),
+        Command::Sim(a) => rtl_cmd::run_sim(a),
     };
     match result {
         Ok(code) => code,

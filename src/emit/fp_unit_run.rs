@@ -85,8 +85,9 @@ pub fn run_fp_units(
         verilog.push('\n');
         ports.push(BenchPort::output(format!("out_valid_{i}"), 1));
         ports.push(BenchPort::output(format!("result_{i}"), unit.result_width));
+        let b_pin = if unit.unary { "" } else { " .b(b)," };
         body += &format!(
-            "    {} dut_{i}(.clock(clock), .in_valid(in_valid), .a(a), .b(b),\n        \
+            "    {} dut_{i}(.clock(clock), .in_valid(in_valid), .a(a),{b_pin}\n        \
              .out_valid(out_valid_{i}), .result(result_{i}));\n",
             unit.top
         );
@@ -145,17 +146,12 @@ mod tests {
     use crate::fp::vectors;
     use crate::hw::fp::supported_formats;
 
-    const ALL_OPS: [BinOp; 7] = [
-        BinOp::Add,
-        BinOp::Sub,
-        BinOp::Mul,
-        BinOp::Div,
-        BinOp::Lt,
-        BinOp::Le,
-        BinOp::Eq,
-    ];
+    const ALL_OPS: [BinOp; 8] = BinOp::ALL;
 
-    /// `n` seeded random pairs plus every pair of edge operands.
+    /// `n` seeded random pairs, every pair of edge operands, and `n / 2` seeded square-root
+    /// operands (exact squares and their neighbours, roots next to rounding midpoints, ...) as
+    /// first operands of random second ones, so sqrt gets vectors of its own besides the pairs'
+    /// first operands.
     fn test_vectors(fmt: Format, n: usize, seed: u64) -> Vec<(u32, u32)> {
         println!("{fmt}: seed {seed}");
         let mut v = vectors::random_pairs(fmt, seed, n);
@@ -165,16 +161,19 @@ mod tests {
                 v.push((a, b));
             }
         }
+        let others = vectors::random_pairs(fmt, seed + 1, n / 2);
+        let roots = vectors::sqrt_operands(fmt, seed + 2, n / 2);
+        v.extend(roots.into_iter().zip(others).map(|(a, (b, _))| (a, b)));
         v
     }
 
-    /// All seven operators of `fmt` in one build of `simulator`, against the model bit for bit.
+    /// All eight operators of `fmt` in one build of `simulator`, against the model bit for bit.
     fn check_all_ops(fmt: Format, n: usize, seed: u64, simulator: Simulator) {
         let v = test_vectors(fmt, n, seed);
         let dir = tempfile::tempdir().unwrap();
         let runs = run_fp_units(&ALL_OPS, fmt, &v, simulator, dir.path()).unwrap();
         println!(
-            "{simulator} {fmt}: 7 operators x {} vectors: compile {:.1} s, run {:.1} s",
+            "{simulator} {fmt}: 8 operators x {} vectors: compile {:.1} s, run {:.1} s",
             v.len(),
             runs[0].compile_seconds,
             runs[0].run_seconds
@@ -212,6 +211,38 @@ mod tests {
         let run = run_fp_unit(BinOp::Div, fmt, &v, Simulator::Icarus, dir.path()).unwrap();
         for (&(a, b), &r) in v.iter().zip(&run.results) {
             assert_eq!(r, fmt.div(a, b), "div {a:#x} {b:#x}");
+        }
+    }
+
+    /// Sqrt on every word of each format of at most 20 bits, and on every positive word (the
+    /// negative ones all give NaN, as the others show) of the formats up to 24 bits, e7m16
+    /// included, in Verilator.
+    #[test]
+    fn sqrt_exhaustive_up_to_24_bits_verilator() {
+        for fmt in supported_formats() {
+            let words = match fmt.width() {
+                0..=20 => 0..=fmt.word_mask(),
+                21..=24 => 0..=(fmt.word_mask() >> 1),
+                _ => continue,
+            };
+            let v: Vec<(u32, u32)> = words.map(|a| (a, 0)).collect();
+            let dir = tempfile::tempdir().unwrap();
+            let run = run_fp_unit(BinOp::Sqrt, fmt, &v, Simulator::Verilator, dir.path()).unwrap();
+            println!(
+                "sqrt {fmt}: {} words: compile {:.1} s, run {:.1} s",
+                v.len(),
+                run.compile_seconds,
+                run.run_seconds
+            );
+            assert_eq!(run.results.len(), v.len());
+            let bad: Vec<_> = v
+                .iter()
+                .zip(&run.results)
+                .filter(|&(&(a, _), &r)| r != fmt.sqrt(a))
+                .take(5)
+                .map(|(&(a, _), &r)| (a, r, fmt.sqrt(a)))
+                .collect();
+            assert!(bad.is_empty(), "sqrt {fmt} (a, RTL, model): {bad:x?}");
         }
     }
 

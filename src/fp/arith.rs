@@ -254,24 +254,28 @@ fn isqrt(n: u128) -> u128 {
     root
 }
 
-/// A binary operator of the `dynrt fp` command and of the hardware operator set.
+/// An operator of the `dynrt fp` command and of the hardware operator set. All but `Sqrt` are
+/// binary; `Sqrt` is the one unary operator: it reads `a` and ignores `b`, so the vector files
+/// and testbenches keep their `a b` lines for every operator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum BinOp {
     Add,
     Sub,
     Mul,
     Div,
+    Sqrt,
     Lt,
     Le,
     Eq,
 }
 
 impl BinOp {
-    pub const ALL: [BinOp; 7] = [
+    pub const ALL: [BinOp; 8] = [
         BinOp::Add,
         BinOp::Sub,
         BinOp::Mul,
         BinOp::Div,
+        BinOp::Sqrt,
         BinOp::Lt,
         BinOp::Le,
         BinOp::Eq,
@@ -286,6 +290,7 @@ impl BinOp {
             BinOp::Sub => "sub",
             BinOp::Mul => "mul",
             BinOp::Div => "div",
+            BinOp::Sqrt => "sqrt",
             BinOp::Lt => "lt",
             BinOp::Le => "le",
             BinOp::Eq => "eq",
@@ -294,13 +299,18 @@ impl BinOp {
     pub fn is_comparison(self) -> bool {
         matches!(self, BinOp::Lt | BinOp::Le | BinOp::Eq)
     }
-    /// The result word (0 or 1 for comparisons).
+    /// True for `Sqrt`, which ignores its second operand.
+    pub fn is_unary(self) -> bool {
+        self == BinOp::Sqrt
+    }
+    /// The result word (0 or 1 for comparisons); a unary operator ignores `b`.
     pub fn eval(self, f: Format, a: u32, b: u32) -> u32 {
         match self {
             BinOp::Add => f.add(a, b),
             BinOp::Sub => f.sub(a, b),
             BinOp::Mul => f.mul(a, b),
             BinOp::Div => f.div(a, b),
+            BinOp::Sqrt => f.sqrt(a),
             BinOp::Lt => u32::from(f.lt(a, b)),
             BinOp::Le => u32::from(f.le(a, b)),
             BinOp::Eq => u32::from(f.eq(a, b)),

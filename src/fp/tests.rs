@@ -2,7 +2,7 @@
 //! arithmetic with FTZ and DAZ set (for e8m23), and exact rational arithmetic with rounding by
 //! nearest-candidate search (for e5m10, small enough to enumerate every value).
 
-use super::vectors::{edge_cases, random_pairs};
+use super::vectors::{edge_cases, random_pairs, sqrt_operands};
 use super::{BinOp, Format};
 
 const SEED: u64 = 0x5AA2_C0DE;
@@ -30,6 +30,7 @@ fn machine_f32(op: BinOp, a: u32, b: u32) -> u32 {
         BinOp::Sub => x - y,
         BinOp::Mul => x * y,
         BinOp::Div => x / y,
+        BinOp::Sqrt => x.sqrt(),
         BinOp::Lt => return u32::from(black_box(x) < black_box(y)),
         BinOp::Le => return u32::from(black_box(x) <= black_box(y)),
         BinOp::Eq => return u32::from(black_box(x) == black_box(y)),
@@ -132,6 +133,7 @@ fn e8m23_sqrt_equals_the_machine_sqrt_with_ftz() {
         .map(|(a, _)| a)
         .collect();
     words.extend(edge_cases(f));
+    words.extend(sqrt_operands(f, SEED, 300_000));
     with_ftz_daz(|| {
         for w in words {
             let want = std::hint::black_box(f32::from_bits(w)).sqrt().to_bits();
@@ -143,6 +145,38 @@ fn e8m23_sqrt_equals_the_machine_sqrt_with_ftz() {
             }
         }
     });
+}
+
+/// The square-root vectors do what they are for: many operands are exact squares, and many
+/// have a root within 2^-8 units in the last place of a rounding midpoint.
+#[test]
+fn sqrt_operands_hold_exact_squares_and_near_ties() {
+    println!("seed {SEED:#x}");
+    for f in [Format::E5M10, Format::E7M16, Format::E8M23] {
+        let n = 20_000;
+        let ops = sqrt_operands(f, SEED, n);
+        assert_eq!(ops.len(), n);
+        let (mut exact, mut near_tie) = (0, 0);
+        for &x in &ops {
+            let xf = f.to_f64(x);
+            if !(xf > 0.0 && xf.is_finite()) {
+                continue;
+            }
+            let r = f.sqrt(x);
+            let rf = f.to_f64(r);
+            if rf * rf == xf {
+                exact += 1;
+            }
+            let ulp = 2f64.powi(f.exp_field(r) as i32 - f.bias() - f.man_bits as i32);
+            let frac = (xf.sqrt() / ulp).fract();
+            if (frac - 0.5).abs() < 1.0 / 256.0 {
+                near_tie += 1;
+            }
+        }
+        println!("{f}: {exact} exact squares, {near_tie} near ties of {n}");
+        assert!(exact >= n / 8, "{f}: only {exact} exact squares");
+        assert!(near_tie >= n / 10, "{f}: only {near_tie} near ties");
+    }
 }
 
 #[test]
@@ -310,6 +344,7 @@ impl E5m10Reference {
                     (true, _, _, _) | (_, _, false, true) => f.infinity(prod_sign),
                     _ => f.zero(prod_sign),
                 },
+                BinOp::Sqrt => unreachable!("{UNARY}"),
             };
         }
         let (ua, ub) = (Self::units(a), Self::units(b));
@@ -336,9 +371,13 @@ impl E5m10Reference {
             BinOp::Lt => u32::from(ua < ub),
             BinOp::Le => u32::from(ua <= ub),
             BinOp::Eq => u32::from(ua == ub),
+            BinOp::Sqrt => unreachable!("{UNARY}"),
         }
     }
 }
+
+/// The rational reference covers the binary operators; sqrt has its own exhaustive e5m10 test.
+const UNARY: &str = "sqrt is checked by e5m10_sqrt_of_every_word_is_the_nearest_value";
 
 #[test]
 fn e5m10_binary_ops_equal_exact_rational_rounding() {
@@ -351,7 +390,7 @@ fn e5m10_binary_ops_equal_exact_rational_rounding() {
             pairs.push((a, b));
         }
     }
-    for op in BinOp::ALL {
+    for op in BinOp::ALL.into_iter().filter(|op| !op.is_unary()) {
         for &(a, b) in &pairs {
             let want = reference.eval(op, a, b);
             let got = op.eval(f, a, b);

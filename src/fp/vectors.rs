@@ -1,6 +1,7 @@
 //! Test vectors for the number format: the hand-picked edge operands every operator must get
-//! right, and seeded random operand pairs that mix uniform bit patterns with pairs chosen to
-//! provoke cancellation, exponent gaps, overflow and underflow.
+//! right, seeded random operand pairs that mix uniform bit patterns with pairs chosen to
+//! provoke cancellation, exponent gaps, overflow and underflow, and seeded square-root operands
+//! around exact squares and rounding midpoints.
 
 use super::Format;
 use rand::{Rng, SeedableRng};
@@ -96,4 +97,89 @@ pub fn random_pairs(f: Format, seed: u64, n: usize) -> Vec<(u32, u32)> {
         });
     }
     out
+}
+
+/// `n` seeded random square-root operands: every edge case first (as many as fit), then a mix
+/// of exact squares and their neighbours one unit in the last place away (the remainder is zero
+/// or just not), words whose root lies within a tiny fraction of a unit in the last place of a
+/// rounding midpoint (on either side, with the neighbouring word), uniform positive words
+/// (subnormals, infinity and NaNs included), and uniform words of either sign.
+pub fn sqrt_operands(f: Format, seed: u64, n: usize) -> Vec<u32> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mask = f.word_mask();
+    let s = f.man_bits + 1;
+    let mut out: Vec<u32> = edge_cases(f).into_iter().take(n).collect();
+    // The positive normal word whose significand is the top `s` bits of the integer `sig`
+    // (truncated), times `2^(2k)` with `k` chosen at random in the exponent range: scaling by an
+    // even power of two keeps the operand a square, or near one, of a scaled root.
+    let scaled_word = |rng: &mut ChaCha8Rng, sig: u64| -> u32 {
+        let bits = 64 - sig.leading_zeros();
+        let man = if bits >= s {
+            sig >> (bits - s)
+        } else {
+            sig << (s - bits)
+        } as u32
+            & f.man_mask();
+        let target = rng.gen_range(f.emin()..=f.emax());
+        let top = bits as i32 - 1;
+        let mut e = top + 2 * (target - top).div_euclid(2);
+        if e < f.emin() {
+            e += 2;
+        }
+        (((e + f.bias()) as u32) << f.man_bits) | man
+    };
+    while out.len() < n {
+        match rng.gen_range(0..7) {
+            0 | 1 => {
+                // An exact square of a root with at most s / 2 significant bits, and the words
+                // one unit in the last place below and above it.
+                let h = rng.gen_range(1..=s / 2);
+                let root = (1u64 << (h - 1)) | (rng.gen::<u64>() & ((1u64 << (h - 1)) - 1));
+                let w = scaled_word(&mut rng, root * root);
+                out.extend([w, w.wrapping_sub(1) & mask, (w + 1) & mask]);
+            }
+            2 | 3 => {
+                // A midpoint `mid` between adjacent s-bit roots (s + 1 bits, odd) whose square
+                // is within a few units of the word grid: `mid^2 mod 2^(s+2)` is a small `c`
+                // (the truncated word's root is just below `mid`) or `2^(s+2)` minus a small
+                // value (the next word's root is just above). Squares of odd numbers are 1 mod
+                // 8, and `mid` is a square root of `c` modulo `2^(s+2)`, found by lifting.
+                let k = s + 2;
+                let small = 1 + 8 * rng.gen_range(0..(1u64 << s.saturating_sub(9)).max(1));
+                let above = rng.gen_bool(0.5);
+                let c = if above {
+                    (1u64 << k) - 7 - (small - 1)
+                } else {
+                    small
+                };
+                let y = sqrt_mod_pow2(c, k) & ((1u64 << (s + 1)) - 1);
+                let mid = if y >> s == 1 {
+                    y
+                } else {
+                    (1u64 << (s + 1)) - y
+                };
+                let w = scaled_word(&mut rng, mid * mid);
+                let near = if above { w + 1 } else { w };
+                out.extend([near & mask, (w + 1 + w - near) & mask]);
+            }
+            4 | 5 => out.push(rng.gen::<u32>() & (mask >> 1)),
+            _ => out.push(rng.gen::<u32>() & mask),
+        }
+    }
+    out.truncate(n);
+    out
+}
+
+/// A square root of `c` modulo `2^k`, for `c = 1 (mod 8)` and `k >= 3`: if `y^2 = c` modulo
+/// `2^j`, then `y` or `y + 2^(j-1)` is a root modulo `2^(j+1)`.
+fn sqrt_mod_pow2(c: u64, k: u32) -> u64 {
+    debug_assert!(c % 8 == 1 && k >= 3);
+    let modulus = 1u64 << k;
+    let mut y = 1u64;
+    for j in 3..k {
+        if (y * y).wrapping_sub(c) >> j & 1 != 0 {
+            y += 1 << (j - 1);
+        }
+    }
+    y % modulus
 }

@@ -5,8 +5,12 @@
 //! shared by several clients through [`SharedTransformUnit`]'s round-robin arbiter;
 //! [`IntersectUnit`] (1 div, 2 mul, 3 add, plus 5 comparators); [`RayGen`], the ray-generation
 //! client of the transform unit.
+//!
+//! Display: [`VgaTiming`], the VGA sync and frame-buffer address generator in the pixel clock
+//! domain (modes [`VgaMode::VGA_640X480_60`], [`VgaMode::XGA_1024X768_60`]).
 
 pub mod delay;
+pub mod engine;
 pub mod fp;
 pub mod geometry_formats;
 pub mod int_to_float;
@@ -16,6 +20,7 @@ pub mod raygen;
 mod sim_harness;
 pub mod transform;
 pub mod transform_arbiter;
+pub mod vga;
 
 pub use delay::Delay;
 pub use int_to_float::UIntToFloat;
@@ -23,7 +28,9 @@ pub use intersect::{intersect_latency, IntersectUnit};
 pub use raygen::{RayGen, RayGenUnit};
 pub use transform::{TransformUnit, TRANSFORM_LATENCY};
 pub use transform_arbiter::{SharedTransformUnit, TRANSFORM_CLIENTS};
+pub use vga::{VgaError, VgaMode, VgaPlacement, VgaTiming};
 
 /// Width of the tag that travels with every request through a geometry unit (client id and
 /// thread id; the unit only carries it).
 pub const TAG_BITS: usize = 16;
+pub mod program;

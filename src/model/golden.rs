@@ -18,8 +18,7 @@ use super::units::{self, Vec3W, Visit};
 use crate::fp::Format;
 use crate::layout::{instance_word as iw, FrameMap, Layout, Node, FRAME, INSTANCES, LISTS};
 
-/// Entries of the per-ray mailboxes (most recently tested ids, first in first out).
-pub const MAILBOX_ENTRIES: usize = 8;
+pub use super::units::MAILBOX_ENTRIES;
 
 /// The closest hit found so far.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -3,7 +3,9 @@
 
 pub mod golden;
 pub mod reference;
-pub mod units;
+/// The shared arithmetic sequences (they live beside the golden model and the hardware, see
+/// [`crate::units`]).
+pub use crate::units;
 
 use crate::layout::Layout;
 use anyhow::Context;

@@ -12,6 +12,7 @@ use super::add_sub::ADD_SUB_LATENCY;
 use super::compare::COMPARE_LATENCY;
 use super::div::div_latency;
 use super::mul::MUL_LATENCY;
+use super::sqrt::sqrt_latency;
 
 /// The single list of supported formats, as `(exponent bits, mantissa bits)`.
 /// Calls `$callback! { $($extra)* ; (E, M) ... }`.
@@ -94,6 +95,7 @@ pub fn latency(op: BinOp, fmt: Format) -> u32 {
         BinOp::Add | BinOp::Sub => ADD_SUB_LATENCY,
         BinOp::Mul => MUL_LATENCY,
         BinOp::Div => div_latency(fmt.man_bits),
+        BinOp::Sqrt => sqrt_latency(fmt.man_bits),
         BinOp::Lt | BinOp::Le | BinOp::Eq => COMPARE_LATENCY,
     }
 }

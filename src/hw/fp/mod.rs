@@ -1,8 +1,9 @@
 //! The `eXmY` floating-point operators as fully pipelined rust-hdl hardware.
 //!
-//! One file per operator: [`FpAddSub`] (add and subtract), [`FpMul`], [`FpDiv`] and
-//! [`FpCompare`] (`lt`, `le`, `eq`). Each accepts a new operation every clock and delivers it
-//! a fixed number of clocks later (see [`latency`]), with a `valid` bit travelling alongside.
+//! One file per operator: [`FpAddSub`] (add and subtract), [`FpMul`], [`FpDiv`], [`FpSqrt`]
+//! (the one unary operator: no `b` port) and [`FpCompare`] (`lt`, `le`, `eq`). Each accepts a
+//! new operation every clock and delivers it a fixed number of clocks later (see [`latency`]),
+//! with a `valid` bit travelling alongside.
 //! Results equal `dynrt::fp` bit for bit (round to nearest even, subnormals flushed on input and
 //! output with tininess detected after rounding, overflow to infinity, one canonical quiet NaN).
 //!
@@ -12,7 +13,7 @@
 //! [`formats`] lists the supported formats with their derived widths; `dispatch_fp_format!`
 //! dispatches from a runtime [`Format`] to the monomorphized instance.
 //!
-//! Latencies (clocks from `in_valid` to `out_valid`): add/sub 7, mul 4, div `M + 5`
+//! Latencies (clocks from `in_valid` to `out_valid`): add/sub 7, mul 4, div and sqrt `M + 5`
 //! (e7m16: 21, e8m23: 28), compare 2. Every stage is at most about 7 LUT4 levels deep after
 //! `synth_xilinx -family xc2v` (the final rounding and the range check/packing are separate
 //! stages for that reason).
@@ -29,6 +30,7 @@ pub mod div;
 pub mod formats;
 pub mod mul;
 pub mod sig_mul;
+pub mod sqrt;
 #[cfg(test)]
 mod test_harness;
 
@@ -38,6 +40,7 @@ pub use div::FpDiv;
 pub use formats::{check_supported, latency, supported_formats, UnsupportedFormat};
 pub use mul::FpMul;
 pub use sig_mul::SigMul;
+pub use sqrt::FpSqrt;
 
 use rust_hdl::prelude::*;
 

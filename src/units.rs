@@ -12,6 +12,10 @@
 
 use crate::fp::Format;
 
+/// Entries of the per-ray mailboxes (most recently tested ids, first in first out), in the
+/// golden model and in the hardware.
+pub const MAILBOX_ENTRIES: usize = 8;
+
 /// A 3-vector of format words.
 pub type Vec3W = [u32; 3];
 /// A 3x4 matrix, row-major: `m00 m01 m02 n0 m10 m11 m12 n1 m20 m21 m22 n2`.

@@ -1,0 +1,161 @@
+//! `dynrt rtl` and `dynrt sim`: the processor of a scene, generated, and simulated frame by
+//! frame against the golden model.
+use anyhow::bail;
+use clap::{Args, ValueEnum};
+use dynrt::emit::processor::ProcessorParams;
+use dynrt::flow;
+use dynrt::fp::Format;
+use dynrt::sim::Simulator;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct RtlArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    #[arg(long)]
+    pub out: PathBuf,
+    #[arg(long, default_value = "e7m16")]
+    pub format: Format,
+    /// Ray threads in flight (1..=32).
+    #[arg(long, default_value_t = 32)]
+    pub threads: u32,
+    /// SRAM read latency in clocks (1..=6).
+    #[arg(long, default_value_t = 2)]
+    pub mem_latency: u32,
+    /// Frames of an animated scene (default: all).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    #[arg(long)]
+    pub width: Option<u32>,
+    #[arg(long)]
+    pub height: Option<u32>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SimKind {
+    Iverilog,
+    Verilator,
+}
+
+#[derive(Args)]
+pub struct SimArgs {
+    #[command(flatten)]
+    pub rtl: RtlArgs,
+    #[arg(long, value_enum, default_value = "verilator")]
+    pub sim: SimKind,
+}
+
+fn setup(a: &RtlArgs) -> anyhow::Result<(dynrt::scene::Scene, String, ProcessorParams)> {
+    let scene = super::render_cmd::load_scene(&a.scene, a.width, a.height)?;
+    if let Some(n) = a.frames {
+        if n == 0 || n > scene.frames {
+            bail!(
+                "{}: --frames {n}, but the scene has {} frame(s)",
+                a.scene.display(),
+                scene.frames
+            );
+        }
+    }
+    let name = a
+        .scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    Ok((
+        scene,
+        name,
+        ProcessorParams {
+            threads: a.threads,
+            mem_latency: a.mem_latency,
+        },
+    ))
+}
+
+pub fn run_rtl(a: RtlArgs) -> anyhow::Result<i32> {
+    let (scene, name, params) = setup(&a)?;
+    let r = flow::generate_rtl(&scene, &name, a.format, params, a.frames, &a.out)?;
+    println!(
+        "{name}: microprogram of {} instructions, {} registers, {} scratch words per thread; {} frame(s)",
+        r.program.code.len(),
+        r.program.registers_used,
+        r.program.scratch.words,
+        r.frames
+    );
+    for l in &r.program.left_out {
+        println!("left out: {l}");
+    }
+    println!(
+        "predicted frame 0: {} clocks ({} threads, rotation {} clocks)",
+        r.predicted.rounds * u64::from(r.period),
+        params.threads,
+        r.period
+    );
+    for f in &r.files {
+        println!("wrote {}", f.display());
+    }
+    Ok(0)
+}
+
+pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
+    let (scene, name, params) = setup(&a.rtl)?;
+    let sim = match a.sim {
+        SimKind::Iverilog => Simulator::Icarus,
+        SimKind::Verilator => Simulator::Verilator,
+    };
+    let r = flow::simulate_scene(
+        &scene,
+        &name,
+        a.rtl.format,
+        params,
+        a.rtl.frames,
+        sim,
+        &a.rtl.out,
+    )?;
+    println!("{name} in {} ({}):", sim.name(), r.tool_version);
+    for l in &r.left_out {
+        println!("  left out: {l}");
+    }
+    for (k, f) in r.frames.iter().enumerate() {
+        println!(
+            "  frame {k}: {} cycles, {} instructions, {:.1} cycles per primary ray, {:.1} fps at 90 MHz ({:.2} fps at 512x384): {}",
+            f.cycles,
+            f.instructions,
+            f.cycles_per_ray(),
+            f.fps(),
+            f.fps_512x384(),
+            if f.differing_pixels == 0 {
+                "identical to the golden model".to_string()
+            } else {
+                format!("{} pixels DIFFER from the golden model", f.differing_pixels)
+            }
+        );
+        for m in &f.mismatches {
+            println!(
+                "    pixel ({}, {}): rtl {:06x}, golden {:06x}, engine twin {:06x}; golden {}",
+                m.x, m.y, m.rtl, m.golden, m.twin, m.golden_trace
+            );
+        }
+    }
+    let shares: Vec<String> = r
+        .section_shares()
+        .iter()
+        .map(|(s, v)| format!("{s} {:.0}%", 100.0 * v))
+        .collect();
+    println!("  engine issue slots by routine: {}", shares.join(", "));
+    println!(
+        "  simulated {:.0} cycles/s (compile {:.1} s, run {:.1} s)",
+        r.simulated_cycles_per_second(),
+        r.compile_seconds,
+        r.run_seconds
+    );
+    if r.identical() {
+        println!("every pixel of every frame is identical");
+        Ok(0)
+    } else {
+        println!(
+            "MISMATCH: diff images and traces in {}",
+            a.rtl.out.display()
+        );
+        Ok(1)
+    }
+}

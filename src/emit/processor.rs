@@ -1,0 +1,275 @@
+//! Verilog of the whole ray tracing processor for one scene, and its frame testbench.
+//!
+//! [`processor_rtl`] turns a scene's [`Program`] into one self-contained Verilog file: the
+//! rust-hdl `ThreadEngine` (renamed `<top>_core`, see `verilog_tidy`) under a clean top module
+//! `dynrt_processor` with the ports
+//! `clock, start, done, cycles[31:0], instructions[31:0], mem_read, mem_bank[2:0],
+//! mem_addr[23:0], mem_rdata[31:0], fb_write, fb_addr[23:0], fb_data[31:0]`.
+//!
+//! [`processor_testbench`] writes module `tb` for Icarus (`iverilog -g2012`) and Verilator 5
+//! (`--binary --timing`): six SRAM banks loaded with `$readmemh` from `mem/` (the layout of
+//! frame 0), a read latency of `mem_latency` clocks, and per frame: the frame's update files
+//! (only the words that changed), a start pulse, a wait for `done` or the cycle limit (then
+//! `TIMEOUT` and a non-zero exit), and the frame buffer written to `frame<k>.hex` (one
+//! `RRGGBB` word a line) with `cycles instructions` in `frame<k>.stats`.
+
+use std::fmt::Write as _;
+
+use anyhow::Result;
+use rust_hdl::prelude::*;
+
+use super::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
+use crate::fp::Format;
+use crate::hw::engine::ThreadEngine;
+use crate::hw::program::Program;
+use crate::layout::BANK_NAMES;
+
+/// The name of the processor's top module.
+pub const PROCESSOR_TOP: &str = "dynrt_processor";
+
+/// Dispatches to `func::<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF>(args)` for the engine's
+/// delay lines (write back `L = M + 6` clocks after the operands: DA = L - 7, DM = L - 4,
+/// DD = L - (M + 5), DC = L - 2, DF = L - 8).
+#[macro_export]
+macro_rules! dispatch_engine_format {
+    (@arms $fmt:expr, $func:ident, $args:tt ; $(($e:literal, $m:literal))*) => {{
+        let format: $crate::fp::Format = $fmt;
+        match (format.exp_bits, format.man_bits) {
+            $(
+                ($e, $m) => Ok($func::<
+                    { 1 + $e + $m }, $e, $m, { $m + 1 }, { $m + 2 }, { $e + 2 }, { $m + 5 },
+                    { 2 * ($m + 1) }, { $m - 1 }, { $m + 2 }, 1, { $m + 4 }, { $m - 2 },
+                >$args),
+            )*
+            _ => Err($crate::hw::fp::UnsupportedFormat(format)),
+        }
+    }};
+    ($fmt:expr, $func:ident ( $($arg:expr),* $(,)? )) => {
+        $crate::fp_format_table!(dispatch_engine_format ! { @arms $fmt, $func, ($($arg),*) })
+    };
+}
+
+#[allow(clippy::too_many_arguments)]
+fn engine_verilog<
+    const W: usize,
+    const E: usize,
+    const M: usize,
+    const S: usize,
+    const S1: usize,
+    const X2: usize,
+    const T: usize,
+    const P: usize,
+    const DA: usize,
+    const DM: usize,
+    const DD: usize,
+    const DC: usize,
+    const DF: usize,
+>(
+    program: &Program,
+    threads: u32,
+    mem_latency: u32,
+) -> String {
+    let mut uut = ThreadEngine::<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF>::new(
+        program,
+        threads,
+        mem_latency,
+    );
+    uut.connect_all();
+    generate_verilog(&uut)
+}
+
+/// How the processor is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ProcessorParams {
+    /// Ray threads (1..=32).
+    pub threads: u32,
+    /// SRAM read latency in clocks (1..=6).
+    pub mem_latency: u32,
+}
+
+impl Default for ProcessorParams {
+    fn default() -> Self {
+        ProcessorParams {
+            threads: 32,
+            mem_latency: 2,
+        }
+    }
+}
+
+const PORTS: [(&str, bool, u32); 12] = [
+    ("clock", false, 1),
+    ("start", false, 1),
+    ("done", true, 1),
+    ("cycles", true, 32),
+    ("instructions", true, 32),
+    ("mem_read", true, 1),
+    ("mem_bank", true, 3),
+    ("mem_addr", true, 24),
+    ("mem_rdata", false, 32),
+    ("fb_write", true, 1),
+    ("fb_addr", true, 24),
+    ("fb_data", true, 32),
+];
+
+/// The processor's Verilog (one file, top module [`PROCESSOR_TOP`]).
+pub fn processor_rtl(
+    program: &Program,
+    params: ProcessorParams,
+    scene_name: &str,
+) -> Result<String> {
+    let f: Format = program.config.format;
+    anyhow::ensure!(
+        (1..=32).contains(&params.threads),
+        "--threads must be 1..=32, not {}",
+        params.threads
+    );
+    anyhow::ensure!(
+        (1..=crate::hw::engine::MAX_MEM_LATENCY).contains(&params.mem_latency),
+        "--mem-latency must be 1..={}, not {}",
+        crate::hw::engine::MAX_MEM_LATENCY,
+        params.mem_latency
+    );
+    anyhow::ensure!(
+        program.scratch.words <= crate::hw::engine::SCRATCH_WORDS,
+        "the scene needs {} scratch words per thread (kd stack and mirror chain), the engine has {}: \
+         use shallower trees or a smaller reflection_depth",
+        program.scratch.words,
+        crate::hw::engine::SCRATCH_WORDS
+    );
+    let core = dispatch_engine_format!(
+        f,
+        engine_verilog(program, params.threads, params.mem_latency)
+    )?;
+    let core_name = format!("{PROCESSOR_TOP}_core");
+    let core = merge_identical_modules(&rename_rust_hdl_names(&core, &core_name));
+    let decls = PORTS
+        .iter()
+        .map(|(name, out, w)| {
+            let dir = if *out { "output" } else { "input" };
+            let range = if *w > 1 {
+                format!("[{}:0] ", w - 1)
+            } else {
+                String::new()
+            };
+            format!("    {dir} wire {range}{name}")
+        })
+        .collect::<Vec<_>>()
+        .join(",\n");
+    let conns = PORTS
+        .iter()
+        .map(|(name, _, _)| format!(".{name}({name})"))
+        .collect::<Vec<_>>()
+        .join(",\n        ");
+    let c = &program.config;
+    let mut header = String::new();
+    writeln!(
+        header,
+        "// {PROCESSOR_TOP}: dynrt ray tracing processor for scene `{scene_name}` (generated by \
+         dynrt; do not edit).\n// Format {f}, {}x{} pixels, {} threads, SRAM read latency {} \
+         clocks, {} instructions of microprogram.",
+        c.width,
+        c.height,
+        params.threads,
+        params.mem_latency,
+        program.code.len()
+    )?;
+    for l in &program.left_out {
+        writeln!(header, "// Left out: {l}.")?;
+    }
+    Ok(format!(
+        "{header}\n/* verilator lint_off WIDTH */\n/* verilator lint_off DECLFILENAME */\n\
+         /* verilator lint_off UNUSEDSIGNAL */\n{core}\n/* verilator lint_on UNUSEDSIGNAL */\n\
+         /* verilator lint_on DECLFILENAME */\n/* verilator lint_on WIDTH */\n\
+         module {PROCESSOR_TOP}(\n{decls}\n);\n    {core_name} core(\n        {conns}\n    );\nendmodule\n"
+    ))
+}
+
+/// What the testbench needs to know about the frames it runs.
+#[derive(Clone, Debug)]
+pub struct TestbenchFrames {
+    /// Words per bank (the largest over all frames).
+    pub bank_words: [usize; 6],
+    /// For frames 1.., the `(bank, file name)` update files to load before the frame.
+    pub updates: Vec<Vec<(usize, String)>>,
+    pub frame_buffer: u32,
+    pub pixels: u32,
+    pub cycle_limit: u64,
+}
+
+/// The frame testbench (module `tb`).
+pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) -> String {
+    let mut v = String::new();
+    let ml = params.mem_latency;
+    let _ = writeln!(
+        v,
+        "// tb: runs {} frame(s) of {PROCESSOR_TOP} (generated by dynrt; do not edit).\n\
+         `timescale 1ns/1ps\nmodule tb;\n  reg clock = 1'b0;\n  reg start = 1'b0;\n  wire done;\n\
+         \x20 wire [31:0] cycles, instructions;\n  wire mem_read;\n  wire [2:0] mem_bank;\n\
+         \x20 wire [23:0] mem_addr;\n  wire [31:0] mem_rdata;\n  wire fb_write;\n\
+         \x20 wire [23:0] fb_addr;\n  wire [31:0] fb_data;",
+        frames.updates.len() + 1
+    );
+    for (b, name) in BANK_NAMES.iter().enumerate() {
+        let _ = writeln!(
+            v,
+            "  reg [31:0] bank{b} [0:{}]; // {name}",
+            frames.bank_words[b].max(1) - 1
+        );
+    }
+    let _ = writeln!(
+        v,
+        "  reg [31:0] rd [0:{}];\n  reg [31:0] word;\n  integer k, n, f, fd;\n  reg timeout = 1'b0;",
+        ml - 1
+    );
+    let _ = writeln!(
+        v,
+        "  {PROCESSOR_TOP} dut(.clock(clock), .start(start), .done(done), .cycles(cycles),\n\
+         \x20   .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank),\n\
+         \x20   .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write),\n\
+         \x20   .fb_addr(fb_addr), .fb_data(fb_data));\n  always #5 clock = ~clock;\n\
+         \x20 // SRAM banks: the word read arrives {ml} clock(s) after the request.\n\
+         \x20 always @(*) begin\n    case (mem_bank)"
+    );
+    for b in 0..6 {
+        let _ = writeln!(
+            v,
+            "      3'd{b}: word = (mem_addr < {}) ? bank{b}[mem_addr] : 32'hdeadbeef;",
+            frames.bank_words[b].max(1)
+        );
+    }
+    let _ = writeln!(
+        v,
+        "      default: word = 32'hdeadbeef;\n    endcase\n  end\n\
+         \x20 always @(posedge clock) begin\n    rd[0] <= word;\n    for (k = 1; k < {ml}; k = k + 1) rd[k] <= rd[k - 1];\n\
+         \x20   if (fb_write) bank5[fb_addr] <= fb_data;\n  end\n  assign mem_rdata = rd[{}];",
+        ml - 1
+    );
+    let _ = writeln!(v, "  initial begin");
+    for (b, name) in BANK_NAMES.iter().enumerate() {
+        let _ = writeln!(v, "    $readmemh(\"mem/bank{b}_{name}.hex\", bank{b});");
+    }
+    for fr in 0..=frames.updates.len() {
+        if fr > 0 {
+            for (b, file) in &frames.updates[fr - 1] {
+                let _ = writeln!(v, "    $readmemh(\"mem/{file}\", bank{b});");
+            }
+        }
+        let _ = writeln!(
+            v,
+            "    @(negedge clock) start = 1'b1;\n    @(negedge clock) start = 1'b0;\n\
+             \x20   n = 0;\n    while (!done && n < {limit}) begin @(posedge clock); n = n + 1; end\n\
+             \x20   if (!done) begin\n      $display(\"TIMEOUT: frame {fr} not done after {limit} clocks\");\n\
+             \x20     $fatal(1, \"timeout\");\n    end\n\
+             \x20   fd = $fopen(\"frame{fr}.hex\", \"w\");\n\
+             \x20   for (k = 0; k < {px}; k = k + 1) $fwrite(fd, \"%06h\\n\", bank5[{fb} + k][23:0]);\n\
+             \x20   $fclose(fd);\n    fd = $fopen(\"frame{fr}.stats\", \"w\");\n\
+             \x20   $fwrite(fd, \"%0d %0d\\n\", cycles, instructions);\n    $fclose(fd);\n\
+             \x20   $display(\"frame {fr}: %0d cycles, %0d instructions\", cycles, instructions);",
+            limit = frames.cycle_limit,
+            px = frames.pixels,
+            fb = frames.frame_buffer,
+        );
+    }
+    let _ = writeln!(v, "    $finish;\n  end\nendmodule");
+    v
+}

@@ -1,0 +1,171 @@
+//! Runs the generated processor on a scene's frames in Icarus or Verilator: writes the RTL,
+//! the testbench and the memory images into a directory, simulates, and reads back every
+//! frame buffer and the cycle counters.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use anyhow::{bail, Context, Result};
+
+use super::memory_images::{write_frame_update, write_memory_images};
+use super::processor::{processor_rtl, processor_testbench, ProcessorParams, TestbenchFrames};
+use crate::hw::program::Program;
+use crate::layout::Layout;
+use crate::output::write_atomically;
+use crate::sim::{self, SimJob, Simulator, VerilatorBuild};
+
+/// One simulated frame.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SimFrame {
+    /// `0x00RRGGBB` per pixel, row by row.
+    pub pixels: Vec<u32>,
+    pub cycles: u64,
+    pub instructions: u64,
+}
+
+/// What a processor simulation produced.
+#[derive(Clone, Debug)]
+pub struct ProcessorSim {
+    pub frames: Vec<SimFrame>,
+    pub compile_seconds: f64,
+    pub run_seconds: f64,
+    pub tool_version: String,
+}
+
+/// Writes everything a simulation of `layouts` (frame 0, 1, ...) needs into `dir`: the
+/// processor Verilog (`rtl/dynrt_processor.v`), the testbench (`testbench/tb.v`) and the
+/// memory images (`mem/`). Returns the two Verilog paths.
+pub fn write_processor_files(
+    program: &Program,
+    layouts: &[Layout],
+    params: ProcessorParams,
+    scene_name: &str,
+    cycle_limit: u64,
+    dir: &Path,
+) -> Result<(PathBuf, PathBuf)> {
+    let first = layouts.first().context("no frame to simulate")?;
+    let (rtl_dir, tb_dir, mem_dir) = (dir.join("rtl"), dir.join("testbench"), dir.join("mem"));
+    for d in [&rtl_dir, &tb_dir, &mem_dir] {
+        std::fs::create_dir_all(d).with_context(|| format!("cannot create {}", d.display()))?;
+    }
+    let rtl = processor_rtl(program, params, scene_name)?;
+    let rtl_path = rtl_dir.join(format!("{}.v", super::processor::PROCESSOR_TOP));
+    write_atomically(&rtl_path, rtl.as_bytes())?;
+    write_memory_images(first, &mem_dir)?;
+    let mut updates = Vec::new();
+    for (k, pair) in layouts.windows(2).enumerate() {
+        let files = write_frame_update(&pair[0], &pair[1], k as u32 + 1, &mem_dir)?;
+        updates.push(
+            files
+                .into_iter()
+                .map(|(bank, p)| {
+                    (
+                        bank,
+                        p.file_name()
+                            .unwrap_or_default()
+                            .to_string_lossy()
+                            .into_owned(),
+                    )
+                })
+                .collect(),
+        );
+    }
+    let mut bank_words = [0usize; 6];
+    for l in layouts {
+        for (b, w) in bank_words.iter_mut().enumerate() {
+            *w = (*w).max(l.banks[b].len());
+        }
+    }
+    let frames = TestbenchFrames {
+        bank_words,
+        updates,
+        frame_buffer: first.info.frame_buffer,
+        pixels: first.info.width * first.info.height,
+        cycle_limit,
+    };
+    let tb_path = tb_dir.join("tb.v");
+    write_atomically(&tb_path, processor_testbench(params, &frames).as_bytes())?;
+    Ok((rtl_path, tb_path))
+}
+
+/// Simulates the processor for `program` on `layouts` in `sim`, in `dir`.
+pub fn simulate_processor(
+    program: &Program,
+    layouts: &[Layout],
+    params: ProcessorParams,
+    scene_name: &str,
+    cycle_limit: u64,
+    sim: Simulator,
+    dir: &Path,
+) -> Result<ProcessorSim> {
+    let (rtl, tb) = write_processor_files(program, layouts, params, scene_name, cycle_limit, dir)?;
+    for k in 0..layouts.len() {
+        let _ = std::fs::remove_file(dir.join(format!("frame{k}.hex")));
+    }
+    let job = SimJob::new(dir, vec![rtl, tb], "tb")
+        .timeout(Duration::from_secs(3600))
+        .verilator_build(VerilatorBuild::Fast);
+    let run = sim::run(sim, &job)?;
+    let out = format!("{}{}", run.stdout, run.stderr);
+    if out.contains("TIMEOUT") {
+        bail!(
+            "{}: the processor did not finish a frame within {cycle_limit} clocks:\n{}",
+            sim.name(),
+            out.trim()
+        );
+    }
+    let pixels = (layouts[0].info.width * layouts[0].info.height) as usize;
+    let mut frames = Vec::new();
+    for k in 0..layouts.len() {
+        let hex = dir.join(format!("frame{k}.hex"));
+        let text = std::fs::read_to_string(&hex).with_context(|| {
+            format!(
+                "{}: no frame buffer dump {} (simulator output:\n{})",
+                sim.name(),
+                hex.display(),
+                out.trim()
+            )
+        })?;
+        let px: Vec<u32> = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                u32::from_str_radix(l.trim(), 16).with_context(|| {
+                    format!(
+                        "{} line {}: `{l}` is not a hex word (X in the frame buffer?)",
+                        hex.display(),
+                        i + 1
+                    )
+                })
+            })
+            .collect::<Result<_>>()?;
+        if px.len() != pixels {
+            bail!("{}: {} pixels, expected {pixels}", hex.display(), px.len());
+        }
+        let stats_path = dir.join(format!("frame{k}.stats"));
+        let stats = std::fs::read_to_string(&stats_path)
+            .with_context(|| format!("cannot read {}", stats_path.display()))?;
+        let nums: Vec<u64> = stats
+            .split_whitespace()
+            .filter_map(|w| w.parse().ok())
+            .collect();
+        if nums.len() != 2 {
+            bail!(
+                "{}: expected `cycles instructions`, got `{}`",
+                stats_path.display(),
+                stats.trim()
+            );
+        }
+        frames.push(SimFrame {
+            pixels: px,
+            cycles: nums[0],
+            instructions: nums[1],
+        });
+    }
+    Ok(ProcessorSim {
+        frames,
+        compile_seconds: run.compile_seconds,
+        run_seconds: run.run_seconds,
+        tool_version: sim::tool_version(sim).unwrap_or_default(),
+    })
+}

@@ -1,0 +1,296 @@
+//! The processor flow of one scene: `dynrt rtl` (Verilog, testbench, memory images,
+//! constraints) and `dynrt sim` (simulate every frame, compare each with the golden model,
+//! measure). Library side, so tests run exactly what the CLI runs.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+use crate::emit::constraints::{write_ucf, Port, PortDirection, UcfOptions};
+use crate::emit::processor::{ProcessorParams, PROCESSOR_TOP};
+use crate::emit::processor_run::{simulate_processor, write_processor_files, ProcessorSim};
+use crate::fp::Format;
+use crate::hw::engine::engine_period;
+use crate::hw::program::exec::{Machine, RunStats, Write};
+use crate::hw::program::{build_program, Program, ProgramConfig};
+use crate::layout::{self, Layout, MemoryConfig, SceneTrees};
+use crate::model::{self, golden::Golden};
+use crate::scene::Scene;
+use crate::sim::Simulator;
+
+/// The target clock of the paper's prototype (XC2V6000-4).
+pub const CLOCK_HZ: f64 = 90e6;
+
+/// The layouts of frames `0..frames` (all of an animated scene's frames when `None`).
+pub fn scene_layouts(scene: &Scene, f: Format, frames: Option<u32>) -> Result<Vec<Layout>> {
+    let trees = SceneTrees::build(scene, f)?;
+    let n = frames.unwrap_or(scene.frames).clamp(1, scene.frames.max(1));
+    (0..n)
+        .map(|k| Ok(layout::build(scene, &trees, k, &MemoryConfig::default())?))
+        .collect()
+}
+
+/// The processor's top-level ports for the constraints file.
+pub fn processor_ports() -> Vec<Port> {
+    use PortDirection::{Input, Output};
+    vec![
+        Port::clock("clock", CLOCK_HZ),
+        Port::io("start", 1, Input),
+        Port::io("done", 1, Output),
+        Port::io("cycles", 32, Output),
+        Port::io("instructions", 32, Output),
+        Port::io("mem_read", 1, Output),
+        Port::io("mem_bank", 3, Output),
+        Port::io("mem_addr", 24, Output),
+        Port::io("mem_rdata", 32, Input),
+        Port::io("fb_write", 1, Output),
+        Port::io("fb_addr", 24, Output),
+        Port::io("fb_data", 32, Output),
+    ]
+}
+
+/// What `dynrt rtl` wrote.
+#[derive(Debug)]
+pub struct RtlReport {
+    pub program: Program,
+    pub frames: usize,
+    pub files: Vec<PathBuf>,
+    /// The twin's prediction of frame 0 (cycles = rounds x period).
+    pub predicted: RunStats,
+    pub period: u32,
+}
+
+fn cycle_limit(predicted: &RunStats, period: u32) -> u64 {
+    2 * predicted.rounds * u64::from(period) + 100_000
+}
+
+/// Writes the processor for `scene` into `out`: `rtl/`, `testbench/`, `mem/`,
+/// `constraints/dynrt.ucf` and `program.lst` (the microprogram listing).
+pub fn generate_rtl(
+    scene: &Scene,
+    name: &str,
+    f: Format,
+    params: ProcessorParams,
+    frames: Option<u32>,
+    out: &Path,
+) -> Result<RtlReport> {
+    let layouts = scene_layouts(scene, f, frames)?;
+    let program = build_program(&ProgramConfig::from_layout(f, &layouts[0].info));
+    let predicted = Machine::new(&program, &layouts[0])
+        .run_frame(params.threads as usize)
+        .context("the engine's twin failed on frame 0 (a generator bug)")?
+        .stats;
+    let period = engine_period(params.threads, f.man_bits);
+    let (rtl, tb) = write_processor_files(
+        &program,
+        &layouts,
+        params,
+        name,
+        cycle_limit(&predicted, period),
+        out,
+    )?;
+    let ucf = out.join("constraints").join("dynrt.ucf");
+    std::fs::create_dir_all(ucf.parent().unwrap())?;
+    write_ucf(&ucf, &processor_ports(), &UcfOptions::default())?;
+    let listing = out.join("program.lst");
+    crate::output::write_atomically(&listing, program.listing().as_bytes())?;
+    Ok(RtlReport {
+        program,
+        frames: layouts.len(),
+        files: vec![rtl, tb, ucf, listing, out.join("mem")],
+        predicted,
+        period,
+    })
+}
+
+/// One differing pixel, with what the golden model and the engine's twin computed for it.
+#[derive(Debug, Clone)]
+pub struct Mismatch {
+    pub frame: usize,
+    pub x: u32,
+    pub y: u32,
+    pub rtl: u32,
+    pub golden: u32,
+    /// The twin's word for the pixel (equal to `golden` unless the program is wrong).
+    pub twin: u32,
+    /// The golden model's account: hit and shaded colour.
+    pub golden_trace: String,
+    /// Every register write of the twin for this pixel: `pc routine instruction -> value`.
+    pub twin_trace: Vec<String>,
+}
+
+/// Measured figures of one simulated frame.
+#[derive(Debug, Clone)]
+pub struct FrameReport {
+    pub cycles: u64,
+    pub instructions: u64,
+    pub pixels: u64,
+    pub mismatches: Vec<Mismatch>,
+    pub differing_pixels: usize,
+}
+
+impl FrameReport {
+    pub fn cycles_per_ray(&self) -> f64 {
+        self.cycles as f64 / self.pixels as f64
+    }
+    pub fn fps(&self) -> f64 {
+        CLOCK_HZ / self.cycles as f64
+    }
+    /// Frames per second at 90 MHz for 512x384 at this scene's cycles per primary ray.
+    pub fn fps_512x384(&self) -> f64 {
+        CLOCK_HZ / (self.cycles_per_ray() * 512.0 * 384.0)
+    }
+}
+
+/// What `dynrt sim` measured.
+#[derive(Debug)]
+pub struct SimReport {
+    pub simulator: Simulator,
+    pub tool_version: String,
+    pub frames: Vec<FrameReport>,
+    pub twin: RunStats,
+    pub period: u32,
+    pub compile_seconds: f64,
+    pub run_seconds: f64,
+    pub program_len: usize,
+    pub left_out: Vec<String>,
+}
+
+impl SimReport {
+    pub fn identical(&self) -> bool {
+        self.frames.iter().all(|f| f.differing_pixels == 0)
+    }
+    pub fn simulated_cycles_per_second(&self) -> f64 {
+        self.frames.iter().map(|f| f.cycles).sum::<u64>() as f64 / self.run_seconds.max(1e-9)
+    }
+    /// Share of the clocks in which the engine issued to each routine (frame 0's twin run).
+    pub fn section_shares(&self) -> Vec<(&'static str, f64)> {
+        let cycles = self.frames[0].cycles.max(1) as f64;
+        self.twin
+            .per_section
+            .iter()
+            .map(|(s, n)| (*s, *n as f64 / cycles))
+            .collect()
+    }
+}
+
+/// Generates, simulates and compares every frame of `scene` with the golden model. On a
+/// mismatch writes `diff<k>.png` and a trace of the first differing pixels into `out`.
+pub fn simulate_scene(
+    scene: &Scene,
+    name: &str,
+    f: Format,
+    params: ProcessorParams,
+    frames: Option<u32>,
+    sim: Simulator,
+    out: &Path,
+) -> Result<SimReport> {
+    let layouts = scene_layouts(scene, f, frames)?;
+    let program = build_program(&ProgramConfig::from_layout(f, &layouts[0].info));
+    let twin = Machine::new(&program, &layouts[0])
+        .run_frame(params.threads as usize)
+        .context("the engine's twin failed on frame 0 (a generator bug)")?
+        .stats;
+    let period = engine_period(params.threads, f.man_bits);
+    let run: ProcessorSim = simulate_processor(
+        &program,
+        &layouts,
+        params,
+        name,
+        cycle_limit(&twin, period),
+        sim,
+        out,
+    )?;
+    let mut reports = Vec::new();
+    for (k, (l, fr)) in layouts.iter().zip(&run.frames).enumerate() {
+        let golden = model::render_golden(l, false);
+        let (w, h) = (l.info.width, l.info.height);
+        let rtl_frame = model::Frame {
+            rgb: fr.pixels.clone(),
+            ..golden.clone()
+        };
+        rtl_frame.save_png(&out.join(format!("frame{k}.png")))?;
+        golden.save_png(&out.join(format!("golden{k}.png")))?;
+        let differing: Vec<usize> = (0..(w * h) as usize)
+            .filter(|&i| fr.pixels[i] != golden.rgb[i])
+            .collect();
+        let mut mismatches = Vec::new();
+        if !differing.is_empty() {
+            let diff = crate::compare::diff_image(&rtl_frame.to_image(), &golden.to_image());
+            crate::output::write_png(&out.join(format!("diff{k}.png")), &diff)?;
+            let m = Machine::new(&program, l);
+            let g = Golden::new(l);
+            for &i in differing.iter().take(3) {
+                let (x, y) = (i as u32 % w, i as u32 / w);
+                let (twin_rgb, _, writes) = m.run_pixel(x, y, true)?;
+                let p = g.pixel(x, y);
+                mismatches.push(Mismatch {
+                    frame: k,
+                    x,
+                    y,
+                    rtl: fr.pixels[i],
+                    golden: golden.rgb[i],
+                    twin: twin_rgb,
+                    golden_trace: format!(
+                        "hit {:?}, colour {:?}",
+                        p.hit,
+                        p.color.map(|c| f.to_f64(c))
+                    ),
+                    twin_trace: writes.iter().map(|w| describe(&program, f, w)).collect(),
+                });
+            }
+            let trace = out.join(format!("mismatch{k}.txt"));
+            let text: String = mismatches
+                .iter()
+                .map(|m| {
+                    format!(
+                        "pixel ({}, {}): rtl {:06x}, golden {:06x}, twin {:06x}\ngolden: {}\n{}\n\n",
+                        m.x,
+                        m.y,
+                        m.rtl,
+                        m.golden,
+                        m.twin,
+                        m.golden_trace,
+                        m.twin_trace.join("\n")
+                    )
+                })
+                .collect();
+            crate::output::write_atomically(&trace, text.as_bytes())?;
+        }
+        reports.push(FrameReport {
+            cycles: fr.cycles,
+            instructions: fr.instructions,
+            pixels: u64::from(w * h),
+            differing_pixels: differing.len(),
+            mismatches,
+        });
+    }
+    Ok(SimReport {
+        simulator: sim,
+        tool_version: run.tool_version,
+        frames: reports,
+        twin,
+        period,
+        compile_seconds: run.compile_seconds,
+        run_seconds: run.run_seconds,
+        program_len: program.code.len(),
+        left_out: program.left_out.clone(),
+    })
+}
+
+fn describe(p: &Program, f: Format, w: &Write) -> String {
+    format!(
+        "{:4} {:<10} {:<44} r{} = {:#010x} ({})",
+        w.pc,
+        p.sections[w.pc as usize],
+        p.code[w.pc as usize].to_string(),
+        w.reg,
+        w.value,
+        f.to_f64(w.value)
+    )
+}
+
+/// The name of the top module, for reports.
+pub fn top_module() -> &'static str {
+    PROCESSOR_TOP
+}

@@ -1,0 +1,785 @@
+//! `ThreadEngine`: the ray thread engine that runs the microprogram (`hw::program`) for up to
+//! 32 ray threads, one instruction per clock, on pipelined floating-point units.
+//!
+//! Threads take fixed turns (a barrel): slot `s` of a rotation of `period` clocks issues
+//! thread `s` (slots `threads..period` are bubbles). Every instruction writes back exactly
+//! `L = M + 6` clocks after its operands are read, whatever unit it uses, and a thread's next
+//! turn comes only after that, so there is no hazard, stall or forwarding logic: memory and
+//! unit latency are hidden by the other threads (the paper's 32 threads). `period >= L + 4`.
+//!
+//! Pipeline (clock offsets from the issue slot):
+//! - I0: read the thread's `{epoch, halted, pc}` (a stale epoch means "new frame": pc 0).
+//! - I1: read the instruction ROM (three words: control, immediate, branch fields).
+//! - I2: decode; read the two source registers and the thread's mailbox.
+//! - I3: operands. Feed every unit; compute the integer result, mailbox hit (and update),
+//!   pixel counter, memory and scratch addresses; drive the memory and frame-buffer ports.
+//! - I4..: the fast result line; scratch data joins at I4, memory data at I4 + `mem_latency`.
+//! - I3 + L: write back the register and the next pc (branch decision from the compare,
+//!   integer, mailbox or pixel condition).
+//!
+//! Throughput: one instruction per clock while `threads >= period`; a frame ends when every
+//! thread has executed `halt` (`done`). Counters: clocks of the frame and instructions issued.
+//!
+//! Memory: one read per clock on the `mem_*` port (bank, word address); the word must arrive on
+//! `mem_rdata` exactly `mem_latency` clocks after the request (1..=6). Frame-buffer writes come
+//! out on `fb_*`.
+
+use rust_hdl::prelude::*;
+
+use super::fp::{FpAddSub, FpCompare, FpDiv, FpMul, FpSqrt};
+use super::program::isa::Instr;
+use super::program::Program;
+use super::{Delay, UIntToFloat};
+
+/// Most threads (the thread id is 5 bits).
+pub const MAX_THREADS: usize = 32;
+/// Largest supported `mem_latency`.
+pub const MAX_MEM_LATENCY: u32 = 6;
+/// Scratch words per thread the engine provides.
+pub const SCRATCH_WORDS: u32 = 128;
+
+/// Clocks from operand read to write back for mantissa width `m`.
+pub const fn engine_latency(m: u32) -> u32 {
+    m + 6
+}
+
+/// The rotation period for `threads` threads in a format with `m` mantissa bits.
+pub fn engine_period(threads: u32, m: u32) -> u32 {
+    threads.max(engine_latency(m) + 4)
+}
+
+/// Registers of the fast result line (the `0..8` loops of `update` spell it out: rust-hdl's
+/// Verilog cannot name Rust constants).
+const FAST_STAGES: usize = 8;
+
+#[derive(LogicBlock)]
+pub struct ThreadEngine<
+    const W: usize,
+    const E: usize,
+    const M: usize,
+    const S: usize,
+    const S1: usize,
+    const X2: usize,
+    const T: usize,
+    const P: usize,
+    const DA: usize,
+    const DM: usize,
+    const DD: usize,
+    const DC: usize,
+    const DF: usize,
+> {
+    pub clock: Signal<In, Clock>,
+    /// A one-clock pulse starts a frame (while `done` or before the first frame).
+    pub start: Signal<In, Bit>,
+    pub done: Signal<Out, Bit>,
+    pub cycles: Signal<Out, Bits<32>>,
+    pub instructions: Signal<Out, Bits<32>>,
+    pub mem_read: Signal<Out, Bit>,
+    pub mem_bank: Signal<Out, Bits<3>>,
+    pub mem_addr: Signal<Out, Bits<24>>,
+    pub mem_rdata: Signal<In, Bits<32>>,
+    pub fb_write: Signal<Out, Bit>,
+    pub fb_addr: Signal<Out, Bits<24>>,
+    pub fb_data: Signal<Out, Bits<32>>,
+
+    // Thread state and program.
+    pc_ram: RAM<Bits<16>, 5>,
+    rom_ctl: RAM<Bits<32>, 12>,
+    rom_imm: RAM<Bits<32>, 12>,
+    rom_aux: RAM<Bits<32>, 12>,
+    regs_a: RAM<Bits<32>, 13>,
+    regs_b: RAM<Bits<32>, 13>,
+    scratch: RAM<Bits<32>, 12>,
+    mailbox: [RAM<Bits<32>, 6>; 8],
+    mailbox_meta: RAM<Bits<8>, 6>,
+
+    // Control.
+    running: DFF<Bit>,
+    epoch: DFF<Bit>,
+    slot: DFF<Bits<8>>,
+    halted_count: DFF<Bits<8>>,
+    cycle_count: DFF<Bits<32>>,
+    instr_count: DFF<Bits<32>>,
+    px: DFF<Bits<16>>,
+    py: DFF<Bits<16>>,
+    // I1
+    v1: DFF<Bit>,
+    t1: DFF<Bits<5>>,
+    // I2
+    v2: DFF<Bit>,
+    t2: DFF<Bits<5>>,
+    pc2: DFF<Bits<12>>,
+    pc1_eff: Signal<Local, Bits<12>>,
+    entry_fresh: Signal<Local, Bit>,
+    // I3
+    v3: DFF<Bit>,
+    t3: DFF<Bits<5>>,
+    pc3: DFF<Bits<12>>,
+    ctl3: DFF<Bits<32>>,
+    imm3: DFF<Bits<32>>,
+    aux3: DFF<Bits<32>>,
+    op3: Signal<Local, Bits<5>>,
+    opa: Signal<Local, Bits<32>>,
+    opb: Signal<Local, Bits<32>>,
+    shifted: Signal<Local, Bits<32>>,
+    mem_address: Signal<Local, Bits<32>>,
+    scratch_address: Signal<Local, Bits<32>>,
+    fast: Signal<Local, Bits<32>>,
+    int_eq: Signal<Local, Bit>,
+    int_lt: Signal<Local, Bit>,
+    mb_hit: Signal<Local, Bit>,
+    mb_len: Signal<Local, Bits<4>>,
+    mb_next: Signal<Local, Bits<3>>,
+    pix_done: Signal<Local, Bit>,
+    fast_kind: Signal<Local, Bits<2>>,
+    // Ports.
+    mem_read_r: DFF<Bit>,
+    mem_bank_r: DFF<Bits<3>>,
+    mem_addr_r: DFF<Bits<24>>,
+    fb_write_r: DFF<Bit>,
+    fb_addr_r: DFF<Bits<24>>,
+    fb_data_r: DFF<Bits<32>>,
+
+    // Units.
+    add: FpAddSub<W, E, M, S, S1, X2, T>,
+    mul: FpMul<W, E, M, S, S1, X2, P>,
+    div: FpDiv<W, E, M, S, S1, X2>,
+    sqrt: FpSqrt<W, E, M, S, S1, T>,
+    cmp: FpCompare<W, E, M>,
+    itof: UIntToFloat<W, E, M>,
+    add_delay: Delay<Bits<W>, DA>,
+    mul_delay: Delay<Bits<W>, DM>,
+    div_delay: Delay<Bits<W>, DD>,
+    sqrt_delay: Delay<Bits<W>, DD>,
+    cmp_delay: Delay<Bits<3>, DC>,
+    fast_line: [DFF<Bits<32>>; FAST_STAGES],
+    fast_kind_line: [DFF<Bits<2>>; FAST_STAGES],
+    fast_delay: Delay<Bits<32>, DF>,
+    /// {valid, op, dst, thread, invert} from I3 to write back.
+    ctl_delay: Delay<Bits<21>, DF>,
+    ctl_line: [DFF<Bits<21>>; FAST_STAGES],
+    /// {pc + 1, target}.
+    pc_delay: Delay<Bits<24>, DF>,
+    pc_line: [DFF<Bits<24>>; FAST_STAGES],
+    /// {jump register (12 bits), int_eq, int_lt, mailbox hit, pixels exhausted}.
+    cond_delay: Delay<Bits<16>, DF>,
+    cond_line: [DFF<Bits<16>>; FAST_STAGES],
+
+    // Write back.
+    wb_valid: Signal<Local, Bit>,
+    wb_op: Signal<Local, Bits<5>>,
+    wb_dst: Signal<Local, Bits<8>>,
+    wb_thread: Signal<Local, Bits<5>>,
+    wb_invert: Signal<Local, Bit>,
+    wb_cond: Signal<Local, Bit>,
+    wb_next_pc: Signal<Local, Bits<12>>,
+    wb_result: Signal<Local, Bits<32>>,
+    wb_writes: Signal<Local, Bit>,
+
+    c_threads: Constant<Bits<8>>,
+    c_period_last: Constant<Bits<8>>,
+    c_width: Constant<Bits<16>>,
+    c_height: Constant<Bits<16>>,
+    c_mem_latency: Constant<Bits<8>>,
+    c_index: [Constant<Bits<8>>; 8],
+}
+
+fn word_map<const N: usize, D: Synth>(
+    words: impl Iterator<Item = D>,
+) -> std::collections::BTreeMap<Bits<N>, D> {
+    words
+        .enumerate()
+        .map(|(i, w)| (Bits::<N>::from(i as u64), w))
+        .collect()
+}
+
+/// The three ROM words of an instruction: control `{op, dst, a, b, b_imm, invert}`, the
+/// immediate, and `{shift, bank, target}`.
+pub fn rom_words(i: &Instr) -> [u32; 3] {
+    let ctl = ((i.op as u32) << 26)
+        | (u32::from(i.dst) << 18)
+        | (u32::from(i.a) << 10)
+        | (u32::from(i.b) << 2)
+        | (u32::from(i.b_imm) << 1)
+        | u32::from(i.invert);
+    let aux = (u32::from(i.shift) << 15) | (u32::from(i.bank) << 12) | u32::from(i.target);
+    [ctl, i.imm, aux]
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+        const DA: usize,
+        const DM: usize,
+        const DD: usize,
+        const DC: usize,
+        const DF: usize,
+    > ThreadEngine<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF>
+{
+    /// The engine running `program` with `threads` threads and memory read latency
+    /// `mem_latency`.
+    pub fn new(program: &Program, threads: u32, mem_latency: u32) -> Self {
+        let l = engine_latency(M as u32) as usize;
+        assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
+        assert!(P == 2 * S);
+        assert!(DA == l - 7 && DM == l - 4 && DD == l - (M + 5) && DC == l - 2);
+        assert!(DF == l - FAST_STAGES);
+        assert!((1..=MAX_THREADS as u32).contains(&threads));
+        assert!((1..=MAX_MEM_LATENCY).contains(&mem_latency));
+        assert!(program.scratch.words <= SCRATCH_WORDS);
+        let period = engine_period(threads, M as u32);
+        let rom = |k: usize| -> RAM<Bits<32>, 12> {
+            RAM::new(word_map(
+                program
+                    .code
+                    .iter()
+                    .map(|i| Bits::<32>::from(u64::from(rom_words(i)[k]))),
+            ))
+        };
+        let zeros = |n: usize| (0..n).map(|_| Bits::<32>::from(0u64));
+        Self {
+            clock: Default::default(),
+            start: Default::default(),
+            done: Default::default(),
+            cycles: Default::default(),
+            instructions: Default::default(),
+            mem_read: Default::default(),
+            mem_bank: Default::default(),
+            mem_addr: Default::default(),
+            mem_rdata: Default::default(),
+            fb_write: Default::default(),
+            fb_addr: Default::default(),
+            fb_data: Default::default(),
+            pc_ram: RAM::new(word_map((0..32).map(|_| Bits::<16>::from(0u64)))),
+            rom_ctl: rom(0),
+            rom_imm: rom(1),
+            rom_aux: rom(2),
+            regs_a: RAM::new(word_map(zeros(1 << 13))),
+            regs_b: RAM::new(word_map(zeros(1 << 13))),
+            scratch: RAM::new(word_map(zeros(1 << 12))),
+            mailbox: std::array::from_fn(|_| RAM::new(word_map(zeros(64)))),
+            mailbox_meta: RAM::new(word_map((0..64).map(|_| Bits::<8>::from(0u64)))),
+            running: Default::default(),
+            epoch: Default::default(),
+            slot: Default::default(),
+            halted_count: Default::default(),
+            cycle_count: Default::default(),
+            instr_count: Default::default(),
+            px: Default::default(),
+            py: Default::default(),
+            v1: Default::default(),
+            t1: Default::default(),
+            v2: Default::default(),
+            t2: Default::default(),
+            pc2: Default::default(),
+            pc1_eff: Default::default(),
+            entry_fresh: Default::default(),
+            v3: Default::default(),
+            t3: Default::default(),
+            pc3: Default::default(),
+            ctl3: Default::default(),
+            imm3: Default::default(),
+            aux3: Default::default(),
+            op3: Default::default(),
+            opa: Default::default(),
+            opb: Default::default(),
+            shifted: Default::default(),
+            mem_address: Default::default(),
+            scratch_address: Default::default(),
+            fast: Default::default(),
+            int_eq: Default::default(),
+            int_lt: Default::default(),
+            mb_hit: Default::default(),
+            mb_len: Default::default(),
+            mb_next: Default::default(),
+            pix_done: Default::default(),
+            fast_kind: Default::default(),
+            mem_read_r: Default::default(),
+            mem_bank_r: Default::default(),
+            mem_addr_r: Default::default(),
+            fb_write_r: Default::default(),
+            fb_addr_r: Default::default(),
+            fb_data_r: Default::default(),
+            add: Default::default(),
+            mul: Default::default(),
+            div: Default::default(),
+            sqrt: Default::default(),
+            cmp: Default::default(),
+            itof: Default::default(),
+            add_delay: Default::default(),
+            mul_delay: Default::default(),
+            div_delay: Default::default(),
+            sqrt_delay: Default::default(),
+            cmp_delay: Default::default(),
+            fast_line: Default::default(),
+            fast_kind_line: Default::default(),
+            fast_delay: Default::default(),
+            ctl_delay: Default::default(),
+            ctl_line: Default::default(),
+            pc_delay: Default::default(),
+            pc_line: Default::default(),
+            cond_delay: Default::default(),
+            cond_line: Default::default(),
+            wb_valid: Default::default(),
+            wb_op: Default::default(),
+            wb_dst: Default::default(),
+            wb_thread: Default::default(),
+            wb_invert: Default::default(),
+            wb_cond: Default::default(),
+            wb_next_pc: Default::default(),
+            wb_result: Default::default(),
+            wb_writes: Default::default(),
+            c_threads: Constant::new(u64::from(threads).into()),
+            c_period_last: Constant::new(u64::from(period - 1).into()),
+            c_width: Constant::new(u64::from(program.config.width).into()),
+            c_height: Constant::new(u64::from(program.config.height).into()),
+            c_mem_latency: Constant::new(u64::from(mem_latency).into()),
+            c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
+        }
+    }
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+        const DA: usize,
+        const DM: usize,
+        const DD: usize,
+        const DC: usize,
+        const DF: usize,
+    > Logic for ThreadEngine<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF>
+{
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(
+            self,
+            clock,
+            running,
+            epoch,
+            slot,
+            halted_count,
+            cycle_count,
+            instr_count,
+            px,
+            py,
+            v1,
+            t1,
+            v2,
+            t2,
+            pc2,
+            v3,
+            t3,
+            pc3,
+            ctl3,
+            imm3,
+            aux3,
+            mem_read_r,
+            mem_bank_r,
+            mem_addr_r,
+            fb_write_r,
+            fb_addr_r,
+            fb_data_r
+        );
+        clock!(
+            self, clock, add, mul, div, sqrt, cmp, add_delay, mul_delay, div_delay, sqrt_delay,
+            cmp_delay, fast_delay, ctl_delay, pc_delay, cond_delay
+        );
+        self.pc_ram.read_clock.next = self.clock.val();
+        self.pc_ram.write_clock.next = self.clock.val();
+        self.rom_ctl.read_clock.next = self.clock.val();
+        self.rom_ctl.write_clock.next = self.clock.val();
+        self.rom_imm.read_clock.next = self.clock.val();
+        self.rom_imm.write_clock.next = self.clock.val();
+        self.rom_aux.read_clock.next = self.clock.val();
+        self.rom_aux.write_clock.next = self.clock.val();
+        self.regs_a.read_clock.next = self.clock.val();
+        self.regs_a.write_clock.next = self.clock.val();
+        self.regs_b.read_clock.next = self.clock.val();
+        self.regs_b.write_clock.next = self.clock.val();
+        self.scratch.read_clock.next = self.clock.val();
+        self.scratch.write_clock.next = self.clock.val();
+        self.mailbox_meta.read_clock.next = self.clock.val();
+        self.mailbox_meta.write_clock.next = self.clock.val();
+        for k in 0..8 {
+            self.mailbox[k].read_clock.next = self.clock.val();
+            self.mailbox[k].write_clock.next = self.clock.val();
+        }
+        for k in 0..8 {
+            self.fast_line[k].clock.next = self.clock.val();
+            self.fast_kind_line[k].clock.next = self.clock.val();
+            self.ctl_line[k].clock.next = self.clock.val();
+            self.pc_line[k].clock.next = self.clock.val();
+            self.cond_line[k].clock.next = self.clock.val();
+        }
+        // The ROMs are never written.
+        self.rom_ctl.write_enable.next = false;
+        self.rom_imm.write_enable.next = false;
+        self.rom_aux.write_enable.next = false;
+        self.rom_ctl.write_address.next = 0.into();
+        self.rom_imm.write_address.next = 0.into();
+        self.rom_aux.write_address.next = 0.into();
+        self.rom_ctl.write_data.next = 0.into();
+        self.rom_imm.write_data.next = 0.into();
+        self.rom_aux.write_data.next = 0.into();
+
+        // Frame control and counters.
+        self.done.next =
+            (!self.running.q.val()) & (self.halted_count.q.val() == self.c_threads.val());
+        self.cycles.next = self.cycle_count.q.val();
+        self.instructions.next = self.instr_count.q.val();
+        if self.running.q.val() {
+            self.cycle_count.d.next = self.cycle_count.q.val() + 1;
+        }
+        if self.slot.q.val() == self.c_period_last.val() {
+            self.slot.d.next = 0.into();
+        } else {
+            self.slot.d.next = self.slot.q.val() + 1;
+        }
+
+        // I0: the thread's state.
+        self.pc_ram.read_address.next = self.slot.q.val().get_bits::<5>(0);
+        self.v1.d.next = self.running.q.val() & (self.slot.q.val() < self.c_threads.val());
+        self.t1.d.next = self.slot.q.val().get_bits::<5>(0);
+
+        // I1: `{epoch, halted, pc}`; another epoch is a thread of an earlier frame: pc 0.
+        self.entry_fresh.next = self.pc_ram.read_data.val().get_bit(13) != self.epoch.q.val();
+        if self.entry_fresh.val() {
+            self.pc1_eff.next = 0.into();
+        } else {
+            self.pc1_eff.next = self.pc_ram.read_data.val().get_bits::<12>(0);
+        }
+        self.rom_ctl.read_address.next = self.pc1_eff.val();
+        self.rom_imm.read_address.next = self.pc1_eff.val();
+        self.rom_aux.read_address.next = self.pc1_eff.val();
+        self.v2.d.next =
+            self.v1.q.val() & (self.entry_fresh.val() | (!self.pc_ram.read_data.val().get_bit(12)));
+        self.t2.d.next = self.t1.q.val();
+        self.pc2.d.next = self.pc1_eff.val();
+
+        // I2: decode, read the registers and the mailbox.
+        self.regs_a.read_address.next = (bit_cast::<13, 5>(self.t2.q.val()) << 8)
+            | bit_cast::<13, 8>(self.rom_ctl.read_data.val().get_bits::<8>(10));
+        self.regs_b.read_address.next = (bit_cast::<13, 5>(self.t2.q.val()) << 8)
+            | bit_cast::<13, 8>(self.rom_ctl.read_data.val().get_bits::<8>(2));
+        self.mailbox_meta.read_address.next = (bit_cast::<6, 5>(self.t2.q.val()) << 1)
+            | bit_cast::<6, 1>(self.rom_imm.read_data.val().get_bits::<1>(0));
+        for k in 0..8 {
+            self.mailbox[k].read_address.next = (bit_cast::<6, 5>(self.t2.q.val()) << 1)
+                | bit_cast::<6, 1>(self.rom_imm.read_data.val().get_bits::<1>(0));
+        }
+        self.v3.d.next = self.v2.q.val();
+        self.t3.d.next = self.t2.q.val();
+        self.pc3.d.next = self.pc2.q.val();
+        self.ctl3.d.next = self.rom_ctl.read_data.val();
+        self.imm3.d.next = self.rom_imm.read_data.val();
+        self.aux3.d.next = self.rom_aux.read_data.val();
+
+        // I3: operands (r0 always reads 0).
+        self.op3.next = self.ctl3.q.val().get_bits::<5>(26);
+        if self.ctl3.q.val().get_bits::<8>(10) == 0 {
+            self.opa.next = 0.into();
+        } else {
+            self.opa.next = self.regs_a.read_data.val();
+        }
+        if self.ctl3.q.val().get_bit(1) {
+            self.opb.next = self.imm3.q.val();
+        } else if self.ctl3.q.val().get_bits::<8>(2) == 0 {
+            self.opb.next = 0.into();
+        } else {
+            self.opb.next = self.regs_b.read_data.val();
+        }
+        if self.v3.q.val() {
+            self.instr_count.d.next = self.instr_count.q.val() + 1;
+        }
+
+        // Floating-point units: every clock, whether used or not.
+        self.add.a.next = self.opa.val().get_bits::<W>(0);
+        self.add.b.next = self.opb.val().get_bits::<W>(0);
+        self.add.sub.next = self.op3.val() == 2;
+        self.add.in_valid.next = true;
+        self.mul.a.next = self.opa.val().get_bits::<W>(0);
+        self.mul.b.next = self.opb.val().get_bits::<W>(0);
+        self.mul.in_valid.next = true;
+        self.div.a.next = self.opa.val().get_bits::<W>(0);
+        self.div.b.next = self.opb.val().get_bits::<W>(0);
+        self.div.in_valid.next = true;
+        self.sqrt.a.next = self.opa.val().get_bits::<W>(0);
+        self.sqrt.in_valid.next = true;
+        self.cmp.a.next = self.opa.val().get_bits::<W>(0);
+        self.cmp.b.next = self.opb.val().get_bits::<W>(0);
+        self.cmp.in_valid.next = true;
+        self.itof.value.next = self.opa.val().get_bits::<16>(0);
+        self.add_delay.data_in.next = self.add.result.val();
+        self.mul_delay.data_in.next = self.mul.result.val();
+        self.div_delay.data_in.next = self.div.result.val();
+        self.sqrt_delay.data_in.next = self.sqrt.result.val();
+        self.cmp_delay.data_in.next = (bit_cast::<3, 1>(self.cmp.lt.val().into()) << 2)
+            | (bit_cast::<3, 1>(self.cmp.le.val().into()) << 1)
+            | bit_cast::<3, 1>(self.cmp.eq.val().into());
+
+        // Integer conditions, addresses.
+        self.int_eq.next = self.opa.val() == self.opb.val();
+        self.int_lt.next = self.opa.val() < self.opb.val();
+        self.shifted.next = self.opa.val() << self.aux3.q.val().get_bits::<3>(15);
+        self.mem_address.next = self.shifted.val() + self.imm3.q.val();
+        self.scratch_address.next = self.opa.val() + self.imm3.q.val();
+
+        // Mailbox: hit when A is one of the first `len` entries.
+        self.mb_len.next = self.mailbox_meta.read_data.val().get_bits::<4>(0);
+        self.mb_next.next = self.mailbox_meta.read_data.val().get_bits::<3>(4);
+        self.mb_hit.next = false;
+        for k in 0..8 {
+            if (self.mailbox[k].read_data.val() == self.opa.val())
+                & (bit_cast::<8, 4>(self.mb_len.val()) > self.c_index[k].val())
+            {
+                self.mb_hit.next = true;
+            }
+        }
+        self.mailbox_meta.write_address.next = (bit_cast::<6, 5>(self.t3.q.val()) << 1)
+            | bit_cast::<6, 1>(self.imm3.q.val().get_bits::<1>(0));
+        self.mailbox_meta.write_enable.next = false;
+        self.mailbox_meta.write_data.next = 0.into();
+        for k in 0..8 {
+            self.mailbox[k].write_address.next = (bit_cast::<6, 5>(self.t3.q.val()) << 1)
+                | bit_cast::<6, 1>(self.imm3.q.val().get_bits::<1>(0));
+            self.mailbox[k].write_data.next = self.opa.val();
+            self.mailbox[k].write_enable.next = false;
+        }
+        if self.v3.q.val() & (self.op3.val() == 26) {
+            self.mailbox_meta.write_enable.next = true;
+        }
+        if self.v3.q.val() & (self.op3.val() == 25) & (!self.mb_hit.val()) {
+            self.mailbox_meta.write_enable.next = true;
+            if self.mb_len.val() == 8 {
+                self.mailbox_meta.write_data.next =
+                    (bit_cast::<8, 3>(self.mb_next.val() + 1) << 4) | (self.c_index[7].val() + 1);
+            } else {
+                self.mailbox_meta.write_data.next = (bit_cast::<8, 3>(self.mb_next.val() + 1) << 4)
+                    | bit_cast::<8, 4>(self.mb_len.val() + 1);
+            }
+            for k in 0..8 {
+                if bit_cast::<8, 3>(self.mb_next.val()) == self.c_index[k].val() {
+                    self.mailbox[k].write_enable.next = true;
+                }
+            }
+        }
+
+        // Pixel counter.
+        self.pix_done.next = !(self.py.q.val() < self.c_height.val());
+        if self.running.q.val() & self.v3.q.val() & (self.op3.val() == 27) & (!self.pix_done.val())
+        {
+            if (self.px.q.val() + 1) == self.c_width.val() {
+                self.px.d.next = 0.into();
+                self.py.d.next = self.py.q.val() + 1;
+            } else {
+                self.px.d.next = self.px.q.val() + 1;
+            }
+        }
+
+        // Scratch memory.
+        self.scratch.read_address.next = (bit_cast::<12, 5>(self.t3.q.val()) << 7)
+            | bit_cast::<12, 7>(self.scratch_address.val().get_bits::<7>(0));
+        self.scratch.write_address.next = (bit_cast::<12, 5>(self.t3.q.val()) << 7)
+            | bit_cast::<12, 7>(self.scratch_address.val().get_bits::<7>(0));
+        self.scratch.write_data.next = self.regs_b.read_data.val();
+        self.scratch.write_enable.next = self.v3.q.val() & (self.op3.val() == 17);
+
+        // Memory and frame-buffer ports (registered).
+        self.mem_read_r.d.next = self.v3.q.val() & (self.op3.val() == 14);
+        self.mem_bank_r.d.next = self.aux3.q.val().get_bits::<3>(12);
+        self.mem_addr_r.d.next = self.mem_address.val().get_bits::<24>(0);
+        self.fb_write_r.d.next = self.v3.q.val() & (self.op3.val() == 15);
+        self.fb_addr_r.d.next = self.mem_address.val().get_bits::<24>(0);
+        self.fb_data_r.d.next = self.regs_b.read_data.val();
+        self.mem_read.next = self.mem_read_r.q.val();
+        self.mem_bank.next = self.mem_bank_r.q.val();
+        self.mem_addr.next = self.mem_addr_r.q.val();
+        self.fb_write.next = self.fb_write_r.q.val();
+        self.fb_addr.next = self.fb_addr_r.q.val();
+        self.fb_data.next = self.fb_data_r.q.val();
+
+        // The fast result (integer, conversion, link, pixel; loads fill in later).
+        self.fast_kind.next = 0.into();
+        self.fast.next = 0.into();
+        if self.op3.val() == 6 {
+            self.fast.next = bit_cast::<32, W>(self.itof.word.val());
+        }
+        if self.op3.val() == 7 {
+            self.fast.next = self.opa.val() + self.opb.val();
+        }
+        if self.op3.val() == 8 {
+            self.fast.next = self.opa.val() - self.opb.val();
+        }
+        if self.op3.val() == 9 {
+            self.fast.next = self.opa.val() & self.opb.val();
+        }
+        if self.op3.val() == 10 {
+            self.fast.next = self.opa.val() | self.opb.val();
+        }
+        if self.op3.val() == 11 {
+            self.fast.next = self.opa.val() ^ self.opb.val();
+        }
+        if self.op3.val() == 12 {
+            self.fast.next = self.opa.val() >> self.opb.val().get_bits::<5>(0);
+        }
+        if self.op3.val() == 13 {
+            self.fast.next = self.opa.val() << self.opb.val().get_bits::<5>(0);
+        }
+        if self.op3.val() == 14 {
+            self.fast_kind.next = 2.into();
+        }
+        if self.op3.val() == 16 {
+            self.fast_kind.next = 1.into();
+        }
+        if self.op3.val() == 23 {
+            self.fast.next = bit_cast::<32, 12>(self.pc3.q.val() + 1);
+        }
+        if self.op3.val() == 27 {
+            self.fast.next =
+                (bit_cast::<32, 16>(self.py.q.val()) << 16) | bit_cast::<32, 16>(self.px.q.val());
+        }
+
+        // The fast line: scratch data at I4, memory data at I4 + latency.
+        self.fast_line[0].d.next = self.fast.val();
+        self.fast_kind_line[0].d.next = self.fast_kind.val();
+        self.ctl_line[0].d.next = (bit_cast::<21, 1>(self.v3.q.val().into()) << 20)
+            | (bit_cast::<21, 5>(self.op3.val()) << 15)
+            | (bit_cast::<21, 8>(self.ctl3.q.val().get_bits::<8>(18)) << 7)
+            | (bit_cast::<21, 5>(self.t3.q.val()) << 2)
+            | bit_cast::<21, 1>(self.ctl3.q.val().get_bits::<1>(0));
+        self.pc_line[0].d.next = (bit_cast::<24, 12>(self.pc3.q.val() + 1) << 12)
+            | bit_cast::<24, 12>(self.aux3.q.val().get_bits::<12>(0));
+        self.cond_line[0].d.next = (bit_cast::<16, 12>(self.opa.val().get_bits::<12>(0)) << 4)
+            | (bit_cast::<16, 1>(self.int_eq.val().into()) << 3)
+            | (bit_cast::<16, 1>(self.int_lt.val().into()) << 2)
+            | (bit_cast::<16, 1>(self.mb_hit.val().into()) << 1)
+            | bit_cast::<16, 1>(self.pix_done.val().into());
+        for k in 1..8 {
+            self.fast_line[k].d.next = self.fast_line[k - 1].q.val();
+            self.fast_kind_line[k].d.next = self.fast_kind_line[k - 1].q.val();
+            self.ctl_line[k].d.next = self.ctl_line[k - 1].q.val();
+            self.pc_line[k].d.next = self.pc_line[k - 1].q.val();
+            self.cond_line[k].d.next = self.cond_line[k - 1].q.val();
+        }
+        if self.fast_kind_line[0].q.val() == 1 {
+            self.fast_line[1].d.next = self.scratch.read_data.val();
+        }
+        for k in 1..7 {
+            if (self.fast_kind_line[k].q.val() == 2)
+                & (self.c_mem_latency.val() == self.c_index[k].val())
+            {
+                self.fast_line[k + 1].d.next = self.mem_rdata.val();
+            }
+        }
+        self.fast_delay.data_in.next = self.fast_line[7].q.val();
+        self.ctl_delay.data_in.next = self.ctl_line[7].q.val();
+        self.pc_delay.data_in.next = self.pc_line[7].q.val();
+        self.cond_delay.data_in.next = self.cond_line[7].q.val();
+
+        // Write back.
+        self.wb_valid.next = self.ctl_delay.data_out.val().get_bit(20);
+        self.wb_op.next = self.ctl_delay.data_out.val().get_bits::<5>(15);
+        self.wb_dst.next = self.ctl_delay.data_out.val().get_bits::<8>(7);
+        self.wb_thread.next = self.ctl_delay.data_out.val().get_bits::<5>(2);
+        self.wb_invert.next = self.ctl_delay.data_out.val().get_bit(0);
+        self.wb_cond.next = false;
+        if self.wb_op.val() == 18 {
+            self.wb_cond.next = self.cmp_delay.data_out.val().get_bit(2);
+        }
+        if self.wb_op.val() == 19 {
+            self.wb_cond.next = self.cmp_delay.data_out.val().get_bit(1);
+        }
+        if self.wb_op.val() == 20 {
+            self.wb_cond.next = self.cmp_delay.data_out.val().get_bit(0);
+        }
+        if self.wb_op.val() == 21 {
+            self.wb_cond.next = self.cond_delay.data_out.val().get_bit(3);
+        }
+        if self.wb_op.val() == 22 {
+            self.wb_cond.next = self.cond_delay.data_out.val().get_bit(2);
+        }
+        if self.wb_op.val() == 25 {
+            self.wb_cond.next = self.cond_delay.data_out.val().get_bit(1);
+        }
+        if self.wb_op.val() == 27 {
+            self.wb_cond.next = self.cond_delay.data_out.val().get_bit(0);
+        }
+        if self.wb_op.val() == 23 {
+            self.wb_cond.next = true;
+        }
+        if self.wb_cond.val() != self.wb_invert.val() {
+            self.wb_next_pc.next = self.pc_delay.data_out.val().get_bits::<12>(0);
+        } else {
+            self.wb_next_pc.next = self.pc_delay.data_out.val().get_bits::<12>(12);
+        }
+        if self.wb_op.val() == 24 {
+            self.wb_next_pc.next = self.cond_delay.data_out.val().get_bits::<12>(4);
+        }
+        if self.wb_op.val() == 28 {
+            // A halted thread keeps its pc.
+            self.wb_next_pc.next = self.pc_delay.data_out.val().get_bits::<12>(12) - 1;
+        }
+        self.wb_result.next = self.fast_delay.data_out.val();
+        if (self.wb_op.val() == 1) | (self.wb_op.val() == 2) {
+            self.wb_result.next = bit_cast::<32, W>(self.add_delay.data_out.val());
+        }
+        if self.wb_op.val() == 3 {
+            self.wb_result.next = bit_cast::<32, W>(self.mul_delay.data_out.val());
+        }
+        if self.wb_op.val() == 4 {
+            self.wb_result.next = bit_cast::<32, W>(self.div_delay.data_out.val());
+        }
+        if self.wb_op.val() == 5 {
+            self.wb_result.next = bit_cast::<32, W>(self.sqrt_delay.data_out.val());
+        }
+        // Ops that write: fp 1-6, integer 7-13, ld 14, lds 16, jal 23, pixel 27 (not when the
+        // frame's pixels are exhausted).
+        self.wb_writes.next = self.wb_valid.val()
+            & (self.wb_dst.val() != 0)
+            & ((((self.wb_op.val() >= 1) & (self.wb_op.val() <= 14)) | (self.wb_op.val() == 16))
+                | ((self.wb_op.val() == 23)
+                    | ((self.wb_op.val() == 27) & (!self.cond_delay.data_out.val().get_bit(0)))));
+        self.regs_a.write_address.next =
+            (bit_cast::<13, 5>(self.wb_thread.val()) << 8) | bit_cast::<13, 8>(self.wb_dst.val());
+        self.regs_b.write_address.next =
+            (bit_cast::<13, 5>(self.wb_thread.val()) << 8) | bit_cast::<13, 8>(self.wb_dst.val());
+        self.regs_a.write_data.next = self.wb_result.val();
+        self.regs_b.write_data.next = self.wb_result.val();
+        self.regs_a.write_enable.next = self.wb_writes.val();
+        self.regs_b.write_enable.next = self.wb_writes.val();
+        self.pc_ram.write_address.next = self.wb_thread.val();
+        self.pc_ram.write_data.next = (bit_cast::<16, 1>(self.epoch.q.val().into()) << 13)
+            | (bit_cast::<16, 1>((self.wb_op.val() == 28).into()) << 12)
+            | bit_cast::<16, 12>(self.wb_next_pc.val());
+        self.pc_ram.write_enable.next = self.wb_valid.val();
+        if self.wb_valid.val() & (self.wb_op.val() == 28) {
+            self.halted_count.d.next = self.halted_count.q.val() + 1;
+            if (self.halted_count.q.val() + 1) == self.c_threads.val() {
+                self.running.d.next = false;
+            }
+        }
+
+        // Start of a frame: a new epoch restarts every thread at pc 0.
+        if self.start.val() & (!self.running.q.val()) {
+            self.running.d.next = true;
+            self.epoch.d.next = !self.epoch.q.val();
+            self.halted_count.d.next = 0.into();
+            self.cycle_count.d.next = 0.into();
+            self.instr_count.d.next = 0.into();
+            self.px.d.next = 0.into();
+            self.py.d.next = 0.into();
+        }
+    }
+}

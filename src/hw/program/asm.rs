@@ -1,0 +1,436 @@
+//! The assembler the microprogram is written with: labels, registers, and [`Arith`] over
+//! registers, so the shared arithmetic sequences of `crate::units` emit the instructions that
+//! compute them.
+//!
+//! Registers come from a pool. Every value an [`Arith`] operation produces is a temporary;
+//! [`Asm::keep`] makes one a named register the caller frees, [`Asm::end_temps`] returns all
+//! other temporaries to the pool. Constants are immediates where the instruction can take one.
+
+use std::cell::RefCell;
+
+use super::isa::{Instr, Op, MAX_PROGRAM, REGISTERS};
+use crate::fp::Format;
+use crate::units::Arith;
+
+/// A register number (`Reg::ZERO` always reads 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Reg(pub u8);
+
+impl Reg {
+    pub const ZERO: Reg = Reg(0);
+}
+
+/// An operand: a register or a constant word.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Val {
+    R(Reg),
+    K(u32),
+}
+
+impl From<Reg> for Val {
+    fn from(r: Reg) -> Val {
+        Val::R(r)
+    }
+}
+
+/// A position in the program, bound once.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Label(usize);
+
+struct State {
+    code: Vec<Instr>,
+    /// The routine each instruction belongs to (for traces and statistics).
+    sections: Vec<&'static str>,
+    section: &'static str,
+    labels: Vec<Option<u16>>,
+    fixups: Vec<(usize, Label)>,
+    free: Vec<Reg>,
+    temps: Vec<Reg>,
+}
+
+/// The assembler. Shared (`&Asm`) so that it can be the `Arith` of the unit sequences.
+pub struct Asm {
+    format: Format,
+    state: RefCell<State>,
+}
+
+/// An assembled program.
+#[derive(Clone, Debug)]
+pub struct Assembled {
+    pub code: Vec<Instr>,
+    pub sections: Vec<&'static str>,
+}
+
+impl Asm {
+    pub fn new(format: Format) -> Self {
+        Asm {
+            format,
+            state: RefCell::new(State {
+                code: Vec::new(),
+                sections: Vec::new(),
+                section: "init",
+                labels: Vec::new(),
+                fixups: Vec::new(),
+                // Lowest numbers first.
+                free: (1..REGISTERS).rev().map(|r| Reg(r as u8)).collect(),
+                temps: Vec::new(),
+            }),
+        }
+    }
+
+    pub fn format(&self) -> Format {
+        self.format
+    }
+
+    /// Names the routine the next instructions belong to.
+    pub fn section(&self, name: &'static str) {
+        self.state.borrow_mut().section = name;
+    }
+
+    /// A named register, freed by [`Asm::free`].
+    pub fn reg(&self) -> Reg {
+        self.state
+            .borrow_mut()
+            .free
+            .pop()
+            .expect("microprogram needs more registers than the engine has")
+    }
+
+    pub fn regs<const N: usize>(&self) -> [Reg; N] {
+        [(); N].map(|_| self.reg())
+    }
+
+    pub fn free(&self, r: Reg) {
+        let mut s = self.state.borrow_mut();
+        debug_assert!(r != Reg::ZERO && !s.free.contains(&r));
+        s.free.push(r);
+    }
+
+    fn temp(&self) -> Reg {
+        let r = self.reg();
+        self.state.borrow_mut().temps.push(r);
+        r
+    }
+
+    /// Makes a temporary a named register (so [`Asm::end_temps`] keeps it); constants are put
+    /// in a fresh register.
+    pub fn keep(&self, v: Val) -> Reg {
+        match v {
+            Val::R(r) => {
+                let mut s = self.state.borrow_mut();
+                if let Some(i) = s.temps.iter().position(|&t| t == r) {
+                    s.temps.swap_remove(i);
+                    r
+                } else {
+                    drop(s);
+                    let k = self.reg();
+                    self.mov(k, v);
+                    k
+                }
+            }
+            Val::K(_) => {
+                let k = self.reg();
+                self.mov(k, v);
+                k
+            }
+        }
+    }
+
+    /// The number of instructions so far.
+    pub fn len(&self) -> usize {
+        self.state.borrow().code.len()
+    }
+
+    /// Takes every register named by the instructions from `start` on out of the pool for
+    /// good: a routine's registers, kept away from its callers' live values.
+    pub fn reserve_registers_of(&self, start: usize) {
+        let mut s = self.state.borrow_mut();
+        let named: std::collections::BTreeSet<u8> = s.code[start..]
+            .iter()
+            .flat_map(|i| [i.dst, i.a, if i.b_imm { 0 } else { i.b }])
+            .collect();
+        s.free.retain(|r| !named.contains(&r.0));
+        s.temps.retain(|r| !named.contains(&r.0));
+    }
+
+    /// Returns every temporary to the pool.
+    pub fn end_temps(&self) {
+        let mut s = self.state.borrow_mut();
+        let t = std::mem::take(&mut s.temps);
+        s.free.extend(t);
+    }
+
+    pub fn label(&self) -> Label {
+        let mut s = self.state.borrow_mut();
+        s.labels.push(None);
+        Label(s.labels.len() - 1)
+    }
+
+    pub fn bind(&self, l: Label) {
+        let mut s = self.state.borrow_mut();
+        assert!(s.labels[l.0].is_none(), "label bound twice");
+        s.labels[l.0] = Some(s.code.len() as u16);
+    }
+
+    /// A label bound here.
+    pub fn here(&self) -> Label {
+        let l = self.label();
+        self.bind(l);
+        l
+    }
+
+    pub fn emit(&self, i: Instr) {
+        let mut s = self.state.borrow_mut();
+        let section = s.section;
+        s.code.push(i);
+        s.sections.push(section);
+    }
+
+    fn emit_to(&self, mut i: Instr, target: Label) {
+        let at = self.state.borrow().code.len();
+        i.target = 0;
+        self.emit(i);
+        self.state.borrow_mut().fixups.push((at, target));
+    }
+
+    /// An instruction reading `a` and `b` (a constant `b` becomes the immediate; a constant
+    /// `a` is loaded into a temporary first).
+    fn operands(&self, op: Op, a: Val, b: Val) -> Instr {
+        let a = match a {
+            Val::R(r) => r,
+            Val::K(0) => Reg::ZERO,
+            Val::K(k) => {
+                let t = self.temp();
+                self.emit(Instr {
+                    dst: t.0,
+                    b_imm: true,
+                    imm: k,
+                    ..Instr::new(Op::Or)
+                });
+                t
+            }
+        };
+        let mut i = Instr {
+            a: a.0,
+            ..Instr::new(op)
+        };
+        match b {
+            Val::R(r) => i.b = r.0,
+            Val::K(k) => {
+                i.b_imm = true;
+                i.imm = k;
+            }
+        }
+        i
+    }
+
+    /// `dst = a op b`.
+    pub fn op_to(&self, op: Op, dst: Reg, a: Val, b: Val) {
+        let mut i = self.operands(op, a, b);
+        i.dst = dst.0;
+        self.emit(i);
+    }
+
+    /// `a op b` into a new temporary.
+    pub fn op(&self, op: Op, a: Val, b: Val) -> Val {
+        let i = self.operands(op, a, b);
+        let t = self.temp();
+        self.emit(Instr { dst: t.0, ..i });
+        Val::R(t)
+    }
+
+    pub fn mov(&self, dst: Reg, v: Val) {
+        match v {
+            Val::R(r) if r == dst => {}
+            Val::R(_) => self.op_to(Op::Or, dst, v, Val::K(0)),
+            Val::K(k) => self.op_to(Op::Or, dst, Val::K(0), Val::K(k)),
+        }
+    }
+
+    pub fn mov3(&self, dst: [Reg; 3], v: [Val; 3]) {
+        for i in 0..3 {
+            self.mov(dst[i], v[i]);
+        }
+    }
+
+    /// `dst = bank[(a << shift) + offset]`.
+    pub fn load_to(&self, dst: Reg, bank: usize, a: Val, shift: u8, offset: u32) {
+        let mut i = self.operands(Op::Ld, a, Val::K(0));
+        i.b_imm = false;
+        i.imm = offset;
+        i.dst = dst.0;
+        i.shift = shift;
+        i.bank = bank as u8;
+        self.emit(i);
+    }
+
+    /// A temporary loaded from `bank[(a << shift) + offset]`.
+    pub fn load(&self, bank: usize, a: Val, shift: u8, offset: u32) -> Val {
+        let t = self.temp();
+        self.load_to(t, bank, a, shift, offset);
+        Val::R(t)
+    }
+
+    pub fn load_n<const N: usize>(&self, bank: usize, a: Val, shift: u8, offset: u32) -> [Val; N] {
+        std::array::from_fn(|k| self.load(bank, a, shift, offset + k as u32))
+    }
+
+    /// `frame[(a << shift) + offset] = data`.
+    pub fn store_frame(&self, a: Val, shift: u8, offset: u32, data: Reg) {
+        let mut i = self.operands(Op::St, a, Val::R(data));
+        i.imm = offset;
+        i.shift = shift;
+        self.emit(i);
+    }
+
+    pub fn scratch_load_to(&self, dst: Reg, a: Val, offset: u32) {
+        let mut i = self.operands(Op::Lds, a, Val::K(0));
+        i.b_imm = false;
+        i.imm = offset;
+        i.dst = dst.0;
+        self.emit(i);
+    }
+
+    pub fn scratch_store(&self, a: Val, offset: u32, data: Val) {
+        let data = match data {
+            Val::R(r) => r,
+            k => {
+                let t = self.temp();
+                self.mov(t, k);
+                t
+            }
+        };
+        let mut i = self.operands(Op::Sts, a, Val::R(data));
+        i.imm = offset;
+        self.emit(i);
+    }
+
+    /// Branch to `target` when `cond(a, b) != invert` (`cond` one of the branch ops).
+    pub fn branch(&self, cond: Op, a: Val, b: Val, invert: bool, target: Label) {
+        debug_assert!(matches!(
+            cond,
+            Op::BFlt | Op::BFle | Op::BFeq | Op::Beq | Op::Bltu
+        ));
+        let mut i = self.operands(cond, a, b);
+        i.invert = invert;
+        self.emit_to(i, target);
+    }
+
+    pub fn jump(&self, target: Label) {
+        self.emit_to(Instr::new(Op::Jal), target);
+    }
+
+    /// Calls `target`, the return address in `link`.
+    pub fn call(&self, link: Reg, target: Label) {
+        self.emit_to(
+            Instr {
+                dst: link.0,
+                ..Instr::new(Op::Jal)
+            },
+            target,
+        );
+    }
+
+    pub fn ret(&self, link: Reg) {
+        self.emit(Instr {
+            a: link.0,
+            ..Instr::new(Op::Jr)
+        });
+    }
+
+    /// Branch to `seen` when `id` is in mailbox `which`, else record it.
+    pub fn mailbox_check(&self, which: u32, id: Reg, seen: Label) {
+        self.emit_to(
+            Instr {
+                a: id.0,
+                imm: which,
+                ..Instr::new(Op::Mbx)
+            },
+            seen,
+        );
+    }
+
+    pub fn mailbox_clear(&self, which: u32) {
+        self.emit(Instr {
+            imm: which,
+            ..Instr::new(Op::Mbc)
+        });
+    }
+
+    /// `dst = (y << 16) | x` of the next pixel, or branch to `done`.
+    pub fn next_pixel(&self, dst: Reg, done: Label) {
+        self.emit_to(
+            Instr {
+                dst: dst.0,
+                ..Instr::new(Op::Pixel)
+            },
+            done,
+        );
+    }
+
+    pub fn halt(&self) {
+        self.emit(Instr::new(Op::Halt));
+    }
+
+    /// Resolves the labels.
+    pub fn finish(self) -> Assembled {
+        let s = self.state.into_inner();
+        let mut code = s.code;
+        assert!(
+            code.len() <= MAX_PROGRAM,
+            "microprogram of {} instructions exceeds the {MAX_PROGRAM}-word ROM",
+            code.len()
+        );
+        for (at, l) in s.fixups {
+            code[at].target = s.labels[l.0].expect("label never bound");
+        }
+        Assembled {
+            code,
+            sections: s.sections,
+        }
+    }
+}
+
+impl<'a> Arith for &'a Asm {
+    type V = Val;
+    fn add(self, a: Val, b: Val) -> Val {
+        commutative(self, Op::FAdd, a, b)
+    }
+    fn sub(self, a: Val, b: Val) -> Val {
+        self.op(Op::FSub, a, b)
+    }
+    fn mul(self, a: Val, b: Val) -> Val {
+        commutative(self, Op::FMul, a, b)
+    }
+    fn div(self, a: Val, b: Val) -> Val {
+        self.op(Op::FDiv, a, b)
+    }
+    fn sqrt(self, a: Val) -> Val {
+        self.op(Op::FSqrt, a, Val::K(0))
+    }
+    fn neg(self, a: Val) -> Val {
+        match a {
+            Val::K(k) => Val::K(self.format.neg(k)),
+            r => self.op(Op::Xor, r, Val::K(1 << (self.format.width() - 1))),
+        }
+    }
+    fn word(self, w: u32) -> Val {
+        Val::K(w)
+    }
+    fn from_uint(self, i: Val) -> Val {
+        self.op(Op::IToF, i, Val::K(0))
+    }
+    fn format(self) -> Format {
+        self.format
+    }
+}
+
+/// A commutative operation with a constant first operand swaps it into the immediate (IEEE
+/// addition and multiplication are commutative bit for bit, NaN payloads included, since
+/// every NaN is the canonical one).
+fn commutative(asm: &Asm, op: Op, a: Val, b: Val) -> Val {
+    match (a, b) {
+        (Val::K(_), Val::R(_)) => asm.op(op, b, a),
+        _ => asm.op(op, a, b),
+    }
+}

@@ -1,0 +1,315 @@
+//! The engine's Rust twin: runs a [`Program`] on a frame's memory exactly as the ray thread
+//! engine does, instruction by instruction.
+//!
+//! Threads take turns in a fixed rotation (thread 0, 1, ..., N-1, then again), one
+//! instruction per turn, like the engine's issue slots; so the pixels go to the threads in the
+//! same order and the frame buffer, the cycle count (turns times the rotation period) and the
+//! per-unit instruction counts are those of the RTL. [`Machine::run_pixel`] runs a single
+//! pixel on one thread (threads never share state, so its result is the same; rayon runs
+//! those in parallel), optionally recording every register write for traces.
+
+use super::isa::{Instr, Op, Unit, REGISTERS};
+use super::Program;
+use crate::fp::Format;
+use crate::layout::Layout;
+use crate::units::MAILBOX_ENTRIES;
+
+/// A failure of the program on this memory (a generator bug or a layout that does not belong
+/// to the program).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("thread {thread} at pc {pc} ({instr}): {what}")]
+pub struct ExecError {
+    pub thread: usize,
+    pub pc: usize,
+    pub instr: String,
+    pub what: String,
+}
+
+/// One register write, for traces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Write {
+    pub pc: u16,
+    pub reg: u8,
+    pub value: u32,
+}
+
+#[derive(Clone, Default)]
+struct Mailbox {
+    ids: [u32; MAILBOX_ENTRIES],
+    len: usize,
+    next: usize,
+}
+
+impl Mailbox {
+    fn seen(&mut self, id: u32) -> bool {
+        if self.ids[..self.len].contains(&id) {
+            return true;
+        }
+        self.ids[self.next] = id;
+        self.next = (self.next + 1) % MAILBOX_ENTRIES;
+        self.len = (self.len + 1).min(MAILBOX_ENTRIES);
+        false
+    }
+}
+
+#[derive(Clone)]
+struct Thread {
+    pc: usize,
+    regs: Vec<u32>,
+    scratch: Vec<u32>,
+    mailboxes: [Mailbox; 2],
+    halted: bool,
+}
+
+impl Thread {
+    fn new(scratch_words: usize) -> Self {
+        Thread {
+            pc: 0,
+            regs: vec![0; REGISTERS],
+            scratch: vec![0; scratch_words],
+            mailboxes: Default::default(),
+            halted: false,
+        }
+    }
+}
+
+/// Where pixels come from: the frame's raster order, or one given pixel.
+enum Pixels {
+    Raster { next: u32, count: u32 },
+    One(Option<(u32, u32)>),
+}
+
+/// What a run did, per unit and in total.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct RunStats {
+    /// Instructions executed per unit (the engine issues one per clock).
+    pub per_unit: std::collections::BTreeMap<Unit, u64>,
+    /// Instructions executed per routine of the program (`Program::sections`).
+    pub per_section: std::collections::BTreeMap<&'static str, u64>,
+    pub instructions: u64,
+    /// Rotations of the thread slots until the last thread halted.
+    pub rounds: u64,
+}
+
+/// A frame rendered by the engine's twin.
+#[derive(Clone, Debug)]
+pub struct EngineFrame {
+    /// `0x00RRGGBB` per pixel, row by row.
+    pub pixels: Vec<u32>,
+    pub stats: RunStats,
+}
+
+/// The engine's twin on one frame's memory.
+pub struct Machine<'a> {
+    program: &'a Program,
+    layout: &'a Layout,
+    f: Format,
+}
+
+impl<'a> Machine<'a> {
+    pub fn new(program: &'a Program, layout: &'a Layout) -> Self {
+        Machine {
+            program,
+            layout,
+            f: program.config.format,
+        }
+    }
+
+    /// Runs the whole frame with `threads` threads in the engine's order.
+    pub fn run_frame(&self, threads: usize) -> Result<EngineFrame, ExecError> {
+        let c = &self.program.config;
+        let mut fb = vec![0u32; (c.width * c.height) as usize];
+        let mut ts: Vec<Thread> = (0..threads)
+            .map(|_| Thread::new(self.program.scratch.words as usize))
+            .collect();
+        let mut pixels = Pixels::Raster {
+            next: 0,
+            count: c.width * c.height,
+        };
+        let mut stats = RunStats::default();
+        loop {
+            let mut any = false;
+            for (k, t) in ts.iter_mut().enumerate() {
+                if t.halted {
+                    continue;
+                }
+                any = true;
+                self.step(k, t, &mut pixels, &mut fb, &mut stats, None)?;
+            }
+            if !any {
+                break;
+            }
+            stats.rounds += 1;
+        }
+        Ok(EngineFrame { pixels: fb, stats })
+    }
+
+    /// Runs pixel (x, y) alone on one thread; returns its frame-buffer word, and every
+    /// register write when `trace`.
+    pub fn run_pixel(
+        &self,
+        x: u32,
+        y: u32,
+        trace: bool,
+    ) -> Result<(u32, RunStats, Vec<Write>), ExecError> {
+        let c = &self.program.config;
+        let mut fb = vec![0u32; (c.width * c.height) as usize];
+        let mut t = Thread::new(self.program.scratch.words as usize);
+        let mut pixels = Pixels::One(Some((x, y)));
+        let mut stats = RunStats::default();
+        let mut writes = trace.then(Vec::new);
+        while !t.halted {
+            self.step(0, &mut t, &mut pixels, &mut fb, &mut stats, writes.as_mut())?;
+            stats.rounds += 1;
+        }
+        Ok((
+            fb[(y * c.width + x) as usize],
+            stats,
+            writes.unwrap_or_default(),
+        ))
+    }
+
+    fn step(
+        &self,
+        k: usize,
+        t: &mut Thread,
+        pixels: &mut Pixels,
+        fb: &mut [u32],
+        stats: &mut RunStats,
+        trace: Option<&mut Vec<Write>>,
+    ) -> Result<(), ExecError> {
+        let f = self.f;
+        let Some(&i) = self.program.code.get(t.pc) else {
+            return Err(self.error(k, t.pc, None, "program counter beyond the program"));
+        };
+        let a = t.regs[i.a as usize];
+        let b = if i.b_imm { i.imm } else { t.regs[i.b as usize] };
+        let fail = |what: String| self.error(k, t.pc, Some(i), &what);
+        let mut next = t.pc + 1;
+        let mut result = None;
+        let branch_if = |cond: bool, next: &mut usize| {
+            if cond != i.invert {
+                *next = i.target as usize;
+            }
+        };
+        match i.op {
+            Op::Nop => {}
+            Op::FAdd => result = Some(f.add(a, b)),
+            Op::FSub => result = Some(f.sub(a, b)),
+            Op::FMul => result = Some(f.mul(a, b)),
+            Op::FDiv => result = Some(f.div(a, b)),
+            Op::FSqrt => result = Some(f.sqrt(a)),
+            Op::IToF => result = Some(f.from_int(i64::from(a))),
+            Op::Add => result = Some(a.wrapping_add(b)),
+            Op::Sub => result = Some(a.wrapping_sub(b)),
+            Op::And => result = Some(a & b),
+            Op::Or => result = Some(a | b),
+            Op::Xor => result = Some(a ^ b),
+            Op::Shr => result = Some(a >> (b & 31)),
+            Op::Shl => result = Some(a << (b & 31)),
+            Op::Ld => {
+                let addr = (a << i.shift).wrapping_add(i.imm);
+                let bank = self
+                    .layout
+                    .banks
+                    .get(i.bank as usize)
+                    .ok_or_else(|| fail(format!("no bank {}", i.bank)))?;
+                let w = bank.get(addr as usize).ok_or_else(|| {
+                    fail(format!(
+                        "bank {} address {addr} beyond its {} words",
+                        i.bank,
+                        bank.len()
+                    ))
+                })?;
+                result = Some(*w);
+            }
+            Op::St => {
+                let addr = (a << i.shift).wrapping_add(i.imm);
+                let base = self.program.config.frame_buffer;
+                let slot = addr
+                    .checked_sub(base)
+                    .filter(|&s| (s as usize) < fb.len())
+                    .ok_or_else(|| fail(format!("store to {addr}, outside the frame buffer")))?;
+                fb[slot as usize] = t.regs[i.b as usize];
+            }
+            Op::Lds | Op::Sts => {
+                let addr = a.wrapping_add(i.imm) as usize;
+                if addr >= t.scratch.len() {
+                    return Err(fail(format!(
+                        "scratch word {addr} beyond its {} words",
+                        t.scratch.len()
+                    )));
+                }
+                if i.op == Op::Lds {
+                    result = Some(t.scratch[addr]);
+                } else {
+                    t.scratch[addr] = t.regs[i.b as usize];
+                }
+            }
+            Op::BFlt => branch_if(f.lt(a, b), &mut next),
+            Op::BFle => branch_if(f.le(a, b), &mut next),
+            Op::BFeq => branch_if(f.eq(a, b), &mut next),
+            Op::Beq => branch_if(a == b, &mut next),
+            Op::Bltu => branch_if(a < b, &mut next),
+            Op::Jal => {
+                result = Some(next as u32);
+                next = i.target as usize;
+            }
+            Op::Jr => next = a as usize,
+            Op::Mbx => {
+                if t.mailboxes[(i.imm & 1) as usize].seen(a) {
+                    next = i.target as usize;
+                }
+            }
+            Op::Mbc => t.mailboxes[(i.imm & 1) as usize] = Mailbox::default(),
+            Op::Pixel => match pixels {
+                Pixels::Raster { next: n, count } => {
+                    if *n < *count {
+                        let w = self.program.config.width;
+                        result = Some(((*n / w) << 16) | (*n % w));
+                        *n += 1;
+                    } else {
+                        next = i.target as usize;
+                    }
+                }
+                Pixels::One(p) => match p.take() {
+                    Some((x, y)) => result = Some((y << 16) | x),
+                    None => next = i.target as usize,
+                },
+            },
+            Op::Halt => {
+                t.halted = true;
+                next = t.pc;
+            }
+        }
+        if let Some(v) = result {
+            if i.dst != 0 {
+                t.regs[i.dst as usize] = v;
+                if let Some(tr) = trace {
+                    tr.push(Write {
+                        pc: t.pc as u16,
+                        reg: i.dst,
+                        value: v,
+                    });
+                }
+            }
+        }
+        *stats.per_unit.entry(i.op.unit()).or_default() += 1;
+        *stats
+            .per_section
+            .entry(self.program.sections[t.pc])
+            .or_default() += 1;
+        stats.instructions += 1;
+        t.pc = next;
+        Ok(())
+    }
+
+    fn error(&self, thread: usize, pc: usize, i: Option<Instr>, what: &str) -> ExecError {
+        ExecError {
+            thread,
+            pc,
+            instr: i.map_or_else(|| "-".to_string(), |i| i.to_string()),
+            what: what.to_string(),
+        }
+    }
+}

@@ -1,0 +1,398 @@
+//! The instruction set of the ray thread engine: what one thread asks of one unit per step.
+//!
+//! Every instruction reads at most two registers (`a`, and `b` or the immediate), writes at
+//! most one (`dst`, never `r0`, which always reads 0) and chooses the thread's next program
+//! counter (`pc + 1`, or `target` for a taken branch). All instructions take the same number
+//! of clocks in the engine, so the engine needs no hazard logic (see `hw::engine`).
+//!
+//! Encoding (ROM word of [`INSTR_BITS`] bits, most significant first):
+//! `op[5] dst[8] a[8] b[8] b_imm[1] invert[1] shift[3] bank[3] imm[32] target[12]`.
+
+use std::fmt;
+
+/// Registers per thread.
+pub const REGISTERS: usize = 256;
+pub const REG_BITS: usize = 8;
+/// Bits of a program address.
+pub const PC_BITS: usize = 12;
+/// Largest program.
+pub const MAX_PROGRAM: usize = 1 << PC_BITS;
+/// Width of one encoded instruction.
+pub const INSTR_BITS: usize = 5 + 3 * REG_BITS + 1 + 1 + 3 + 3 + 32 + PC_BITS;
+
+/// The two mailboxes of a thread (the `imm` of `Mbx` / `Mbc`).
+pub const MAILBOX_TRIANGLES: u32 = 0;
+pub const MAILBOX_INSTANCES: u32 = 1;
+
+/// What an instruction does. `A` = `r[a]`; `B` = `imm` when `b_imm`, else `r[b]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Op {
+    Nop = 0,
+    /// `dst = A + B` in the format (and so on for the next four).
+    FAdd,
+    FSub,
+    FMul,
+    FDiv,
+    /// `dst = sqrt(A)`.
+    FSqrt,
+    /// `dst` = the unsigned integer `A` converted to the format.
+    IToF,
+    /// Integer (32-bit, wrapping) `dst = A + B`, `A - B`, `A & B`, `A | B`, `A ^ B`,
+    /// `A >> B`, `A << B` (shift counts modulo 32).
+    Add,
+    Sub,
+    And,
+    Or,
+    Xor,
+    Shr,
+    Shl,
+    /// `dst = bank[(A << shift) + imm]`.
+    Ld,
+    /// Frame-buffer store: `frame[(A << shift) + imm] = r[b]`.
+    St,
+    /// Thread scratch memory (kd stack, mirror chain): `dst = scratch[A + imm]`.
+    Lds,
+    /// `scratch[A + imm] = r[b]`.
+    Sts,
+    /// Branch to `target` when `(A < B) != invert` in the format (and `<=`, `==`).
+    BFlt,
+    BFle,
+    BFeq,
+    /// Branch when `(A == B) != invert` / `(A < B unsigned) != invert` on integers.
+    Beq,
+    Bltu,
+    /// `dst = pc + 1`, jump to `target`.
+    Jal,
+    /// Jump to `A`.
+    Jr,
+    /// Mailbox `imm`: branch to `target` when `A` is in it, else record `A` (first in, first
+    /// out over `MAILBOX_ENTRIES` entries).
+    Mbx,
+    /// Empty mailbox `imm`.
+    Mbc,
+    /// Take the next pixel of the frame: `dst = (y << 16) | x`; branch to `target` when every
+    /// pixel is taken.
+    Pixel,
+    /// The thread stops.
+    Halt,
+}
+
+pub const OPS: [Op; 29] = [
+    Op::Nop,
+    Op::FAdd,
+    Op::FSub,
+    Op::FMul,
+    Op::FDiv,
+    Op::FSqrt,
+    Op::IToF,
+    Op::Add,
+    Op::Sub,
+    Op::And,
+    Op::Or,
+    Op::Xor,
+    Op::Shr,
+    Op::Shl,
+    Op::Ld,
+    Op::St,
+    Op::Lds,
+    Op::Sts,
+    Op::BFlt,
+    Op::BFle,
+    Op::BFeq,
+    Op::Beq,
+    Op::Bltu,
+    Op::Jal,
+    Op::Jr,
+    Op::Mbx,
+    Op::Mbc,
+    Op::Pixel,
+    Op::Halt,
+];
+
+impl Op {
+    /// Whether the instruction writes `dst`.
+    pub fn writes(self) -> bool {
+        use Op::*;
+        matches!(
+            self,
+            FAdd | FSub
+                | FMul
+                | FDiv
+                | FSqrt
+                | IToF
+                | Add
+                | Sub
+                | And
+                | Or
+                | Xor
+                | Shr
+                | Shl
+                | Ld
+                | Lds
+                | Jal
+                | Pixel
+        )
+    }
+    /// Whether `target` is a branch target.
+    pub fn branches(self) -> bool {
+        use Op::*;
+        matches!(self, BFlt | BFle | BFeq | Beq | Bltu | Jal | Mbx | Pixel)
+    }
+    /// The hardware unit that executes it (for statistics and for leaving units out).
+    pub fn unit(self) -> Unit {
+        use Op::*;
+        match self {
+            FAdd | FSub => Unit::FpAdd,
+            FMul => Unit::FpMul,
+            FDiv => Unit::FpDiv,
+            FSqrt => Unit::FpSqrt,
+            IToF => Unit::IntToFloat,
+            BFlt | BFle | BFeq => Unit::FpCompare,
+            Ld | St => Unit::Memory,
+            Lds | Sts => Unit::Scratch,
+            Mbx | Mbc => Unit::Mailbox,
+            Pixel => Unit::PixelCounter,
+            Nop | Add | Sub | And | Or | Xor | Shr | Shl | Beq | Bltu | Jal | Jr | Halt => {
+                Unit::Integer
+            }
+        }
+    }
+    pub fn name(self) -> &'static str {
+        use Op::*;
+        match self {
+            Nop => "nop",
+            FAdd => "fadd",
+            FSub => "fsub",
+            FMul => "fmul",
+            FDiv => "fdiv",
+            FSqrt => "fsqrt",
+            IToF => "itof",
+            Add => "add",
+            Sub => "sub",
+            And => "and",
+            Or => "or",
+            Xor => "xor",
+            Shr => "shr",
+            Shl => "shl",
+            Ld => "ld",
+            St => "st",
+            Lds => "lds",
+            Sts => "sts",
+            BFlt => "bflt",
+            BFle => "bfle",
+            BFeq => "bfeq",
+            Beq => "beq",
+            Bltu => "bltu",
+            Jal => "jal",
+            Jr => "jr",
+            Mbx => "mbx",
+            Mbc => "mbc",
+            Pixel => "pixel",
+            Halt => "halt",
+        }
+    }
+}
+
+/// The engine's functional units.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Unit {
+    FpAdd,
+    FpMul,
+    FpDiv,
+    FpSqrt,
+    FpCompare,
+    IntToFloat,
+    Integer,
+    Memory,
+    Scratch,
+    Mailbox,
+    PixelCounter,
+}
+
+impl Unit {
+    pub const ALL: [Unit; 11] = [
+        Unit::FpAdd,
+        Unit::FpMul,
+        Unit::FpDiv,
+        Unit::FpSqrt,
+        Unit::FpCompare,
+        Unit::IntToFloat,
+        Unit::Integer,
+        Unit::Memory,
+        Unit::Scratch,
+        Unit::Mailbox,
+        Unit::PixelCounter,
+    ];
+    pub fn name(self) -> &'static str {
+        match self {
+            Unit::FpAdd => "fp add",
+            Unit::FpMul => "fp mul",
+            Unit::FpDiv => "fp div",
+            Unit::FpSqrt => "fp sqrt",
+            Unit::FpCompare => "fp compare",
+            Unit::IntToFloat => "int to float",
+            Unit::Integer => "integer",
+            Unit::Memory => "memory",
+            Unit::Scratch => "scratch",
+            Unit::Mailbox => "mailbox",
+            Unit::PixelCounter => "pixel counter",
+        }
+    }
+}
+
+/// One decoded instruction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Instr {
+    pub op: Op,
+    pub dst: u8,
+    pub a: u8,
+    pub b: u8,
+    pub b_imm: bool,
+    pub invert: bool,
+    pub shift: u8,
+    pub bank: u8,
+    pub imm: u32,
+    pub target: u16,
+}
+
+impl Instr {
+    pub fn new(op: Op) -> Self {
+        Instr {
+            op,
+            dst: 0,
+            a: 0,
+            b: 0,
+            b_imm: false,
+            invert: false,
+            shift: 0,
+            bank: 0,
+            imm: 0,
+            target: 0,
+        }
+    }
+
+    /// The ROM word (see the module doc for the field order).
+    pub fn encode(&self) -> u128 {
+        let mut w: u128 = self.op as u128;
+        let mut put = |bits: usize, v: u128| {
+            debug_assert!(v < (1u128 << bits));
+            w = (w << bits) | v;
+        };
+        put(REG_BITS, self.dst.into());
+        put(REG_BITS, self.a.into());
+        put(REG_BITS, self.b.into());
+        put(1, self.b_imm.into());
+        put(1, self.invert.into());
+        put(3, self.shift.into());
+        put(3, self.bank.into());
+        put(32, self.imm.into());
+        put(PC_BITS, self.target.into());
+        w
+    }
+
+    /// The inverse of [`Instr::encode`]; `None` for an unknown opcode.
+    pub fn decode(w: u128) -> Option<Instr> {
+        let mut w = w;
+        let mut take = |bits: usize| {
+            let v = w & ((1u128 << bits) - 1);
+            w >>= bits;
+            v
+        };
+        let target = take(PC_BITS) as u16;
+        let imm = take(32) as u32;
+        let bank = take(3) as u8;
+        let shift = take(3) as u8;
+        let invert = take(1) == 1;
+        let b_imm = take(1) == 1;
+        let b = take(REG_BITS) as u8;
+        let a = take(REG_BITS) as u8;
+        let dst = take(REG_BITS) as u8;
+        let op = *OPS.get(take(5) as usize)?;
+        Some(Instr {
+            op,
+            dst,
+            a,
+            b,
+            b_imm,
+            invert,
+            shift,
+            bank,
+            imm,
+            target,
+        })
+    }
+}
+
+impl fmt::Display for Instr {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let b = if self.b_imm {
+            format!("#{:#x}", self.imm)
+        } else {
+            format!("r{}", self.b)
+        };
+        let inv = if self.invert { "!" } else { "" };
+        match self.op {
+            Op::Nop | Op::Halt => write!(f, "{}", self.op.name()),
+            Op::Ld => write!(
+                f,
+                "ld r{}, bank{}[(r{} << {}) + {}]",
+                self.dst, self.bank, self.a, self.shift, self.imm
+            ),
+            Op::St => write!(
+                f,
+                "st frame[(r{} << {}) + {}], r{}",
+                self.a, self.shift, self.imm, self.b
+            ),
+            Op::Lds => write!(f, "lds r{}, [r{} + {}]", self.dst, self.a, self.imm),
+            Op::Sts => write!(f, "sts [r{} + {}], r{}", self.a, self.imm, self.b),
+            Op::BFlt | Op::BFle | Op::BFeq | Op::Beq | Op::Bltu => write!(
+                f,
+                "{}{} r{}, {}, @{}",
+                inv,
+                self.op.name(),
+                self.a,
+                b,
+                self.target
+            ),
+            Op::Jal => write!(f, "jal r{}, @{}", self.dst, self.target),
+            Op::Jr => write!(f, "jr r{}", self.a),
+            Op::Mbx => write!(f, "mbx{} r{}, @{}", self.imm, self.a, self.target),
+            Op::Mbc => write!(f, "mbc{}", self.imm),
+            Op::Pixel => write!(f, "pixel r{}, @{}", self.dst, self.target),
+            Op::FSqrt | Op::IToF => write!(f, "{} r{}, r{}", self.op.name(), self.dst, self.a),
+            _ => write!(f, "{} r{}, r{}, {}", self.op.name(), self.dst, self.a, b),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn encode_decode_round_trip() {
+        let seed = 5;
+        println!("seed {seed}");
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        for _ in 0..10_000 {
+            let i = Instr {
+                op: OPS[rng.gen_range(0..OPS.len())],
+                dst: rng.gen(),
+                a: rng.gen(),
+                b: rng.gen(),
+                b_imm: rng.gen(),
+                invert: rng.gen(),
+                shift: rng.gen_range(0..8),
+                bank: rng.gen_range(0..6),
+                imm: rng.gen(),
+                target: rng.gen_range(0..MAX_PROGRAM as u16),
+            };
+            let w = i.encode();
+            assert!(w < 1u128 << INSTR_BITS);
+            assert_eq!(Instr::decode(w), Some(i));
+        }
+    }
+}

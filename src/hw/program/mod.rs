@@ -1,0 +1,248 @@
+//! The microprogram of the ray thread engine: ray generation, kd traversal (top level,
+//! instance entry, object level, mailboxed triangle lists), the unit-triangle test, shading,
+//! shadow and mirror rays, and the frame-buffer write, as one program every thread runs.
+//!
+//! The program is generated per scene from the layout's parameters, so it holds only what the
+//! scene needs: no top level and no instance transform for a scene of one untransformed
+//! object, no shadow rays when shadows are off, no mirror path for `reflection_depth = 0`,
+//! exactly the scene's lights, and a kd stack as deep as the scene's trees. The arithmetic is
+//! emitted by the shared sequences of `crate::units` (through [`asm::Asm`]'s `Arith`), so the
+//! engine computes what the golden model computes, operation for operation; the control flow
+//! follows `model::golden` step for step (the tests compare the two renderers on every pixel).
+//!
+//! [`exec`] runs a program in Rust exactly as the engine does (same round-robin thread order,
+//! same pixel allocation), which predicts the engine's cycle count and gives a trace of every
+//! register write to compare an RTL trace with.
+
+pub mod asm;
+pub mod exec;
+pub mod isa;
+mod shader;
+mod traversal;
+
+use std::collections::BTreeSet;
+
+use asm::{Asm, Reg};
+use isa::{Instr, Unit};
+
+use crate::fp::Format;
+use crate::layout::LayoutInfo;
+
+/// What the generated processor is built for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProgramConfig {
+    pub format: Format,
+    pub width: u32,
+    pub height: u32,
+    pub shadows: bool,
+    pub reflection_depth: u32,
+    pub light_count: u32,
+    /// Root of the top-level tree; `None`: rays enter `object_root` directly.
+    pub top_root: Option<u32>,
+    pub object_root: u32,
+    pub materials: u32,
+    pub frame_buffer: u32,
+    /// Kd stack entries per thread: the deepest top-level plus the deepest object tree.
+    pub stack_entries: u32,
+}
+
+impl ProgramConfig {
+    pub fn from_layout(format: Format, info: &LayoutInfo) -> Self {
+        ProgramConfig {
+            format,
+            width: info.width,
+            height: info.height,
+            shadows: info.shadows,
+            reflection_depth: info.reflection_depth,
+            light_count: info.light_count,
+            top_root: info.top_root,
+            object_root: info.object_root,
+            materials: info.materials,
+            frame_buffer: info.frame_buffer,
+            stack_entries: info.object_depth
+                + if info.top_root.is_some() {
+                    info.top_depth
+                } else {
+                    0
+                },
+        }
+    }
+}
+
+/// Words of a thread's scratch memory: the current ray of each traversal level (read by axis
+/// index), the kd stack, then the mirror chain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ScratchMap {
+    /// World ray (o then d) as the top level (or the only object) traverses it.
+    pub ray_top: u32,
+    /// Object-space ray of the entered instance.
+    pub ray_object: u32,
+    pub stack: u32,
+    /// Per mirror bounce: the local colour (3 words) and the mirror reflectivity.
+    pub chain: u32,
+    /// Total words, a power of two.
+    pub words: u32,
+}
+
+pub const STACK_ENTRY_WORDS: u32 = 3;
+pub const CHAIN_ENTRY_WORDS: u32 = 4;
+
+impl ScratchMap {
+    pub fn for_config(c: &ProgramConfig) -> Self {
+        let ray_top = 0;
+        let ray_object = 6;
+        let stack = 12;
+        let chain = stack + STACK_ENTRY_WORDS * c.stack_entries;
+        let used = chain + CHAIN_ENTRY_WORDS * c.reflection_depth;
+        ScratchMap {
+            ray_top,
+            ray_object,
+            stack,
+            chain,
+            words: used.next_power_of_two().max(16),
+        }
+    }
+}
+
+/// A generated program.
+#[derive(Clone, Debug)]
+pub struct Program {
+    pub config: ProgramConfig,
+    pub code: Vec<Instr>,
+    /// The routine of each instruction (traces name where a value came from).
+    pub sections: Vec<&'static str>,
+    pub scratch: ScratchMap,
+    /// Registers the program uses (the engine's register file holds `isa::REGISTERS`).
+    pub registers_used: usize,
+    /// What this scene does not need, in words (printed by `dynrt rtl`).
+    pub left_out: Vec<String>,
+}
+
+impl Program {
+    /// The units some instruction uses; the engine is built with these only.
+    pub fn units(&self) -> BTreeSet<Unit> {
+        self.code.iter().map(|i| i.op.unit()).collect()
+    }
+    /// The assembly listing, one instruction a line with its address and routine.
+    pub fn listing(&self) -> String {
+        self.code
+            .iter()
+            .zip(&self.sections)
+            .enumerate()
+            .map(|(pc, (i, s))| format!("{pc:4}  {s:<12} {i}\n"))
+            .collect()
+    }
+}
+
+/// Registers every routine shares.
+pub(crate) struct Shared {
+    /// The trace query: origin, direction, t range, any-hit flag, the (instance, triangle)
+    /// to skip.
+    pub q_o: [Reg; 3],
+    pub q_d: [Reg; 3],
+    pub q_t_min: Reg,
+    pub q_t_max: Reg,
+    pub q_any: Reg,
+    pub skip_instance: Reg,
+    pub skip_triangle: Reg,
+    /// The closest hit so far (`hit` is 0 or 1; `best_t` starts at `q_t_max`).
+    pub hit: Reg,
+    pub best_t: Reg,
+    pub best_instance: Reg,
+    pub best_triangle: Reg,
+    /// Return address of the trace routine; the kd stack pointer (scratch word index).
+    pub link: Reg,
+    pub sp: Reg,
+}
+
+pub(crate) struct Gen<'a> {
+    pub asm: &'a Asm,
+    pub c: &'a ProgramConfig,
+    pub scratch: ScratchMap,
+    pub s: Shared,
+}
+
+/// Generates the program for `config`.
+pub fn build_program(config: &ProgramConfig) -> Program {
+    let asm = Asm::new(config.format);
+    let a = &asm;
+    let s = Shared {
+        q_o: a.regs(),
+        q_d: a.regs(),
+        q_t_min: a.reg(),
+        q_t_max: a.reg(),
+        q_any: a.reg(),
+        skip_instance: a.reg(),
+        skip_triangle: a.reg(),
+        hit: a.reg(),
+        best_t: a.reg(),
+        best_instance: a.reg(),
+        best_triangle: a.reg(),
+        link: a.reg(),
+        sp: a.reg(),
+    };
+    let gen = Gen {
+        asm: a,
+        c: config,
+        scratch: ScratchMap::for_config(config),
+        s,
+    };
+    // The trace routine's registers are its own: the shader's values live across its calls.
+    let (trace, pixels) = (a.label(), a.label());
+    let constants = gen.load_constants();
+    a.jump(pixels);
+    a.bind(trace);
+    let start = a.len();
+    gen.trace_routine();
+    a.reserve_registers_of(start);
+    a.bind(pixels);
+    gen.pixel_loop(&constants, trace);
+    let scratch = gen.scratch;
+    let mut left_out = Vec::new();
+    if config.top_root.is_none() {
+        left_out.push(
+            "top-level traversal, instance mailbox and instance transforms (one untransformed object)"
+                .to_string(),
+        );
+    }
+    if !config.shadows {
+        left_out.push("shadow rays (shadows off or no lights)".to_string());
+    }
+    if config.reflection_depth == 0 {
+        left_out.push("mirror rays and the mirror chain (reflection_depth = 0)".to_string());
+    }
+    let assembled = asm.finish();
+    // Registers are handed out lowest first, so the highest one named bounds the use.
+    let registers_used = assembled
+        .code
+        .iter()
+        .flat_map(|i| [i.dst, i.a, if i.b_imm { 0 } else { i.b }])
+        .max()
+        .map_or(1, |r| r as usize + 1);
+    let program = Program {
+        config: config.clone(),
+        code: assembled.code,
+        sections: assembled.sections,
+        scratch,
+        registers_used,
+        left_out,
+    };
+    let units = program.units();
+    let mut left_out = program.left_out.clone();
+    for u in Unit::ALL {
+        if !units.contains(&u) {
+            left_out.push(format!("{} unit (no instruction uses it)", u.name()));
+        }
+    }
+    Program {
+        left_out,
+        ..program
+    }
+}
+
+impl Gen<'_> {
+    /// A frame word (bank 5) at a fixed address.
+    pub fn frame_word(&self, addr: u32) -> asm::Val {
+        self.asm.load(crate::layout::FRAME, asm::Val::K(0), 0, addr)
+    }
+}

@@ -1,0 +1,282 @@
+//! Traversal: the trace routine of the microprogram (`model::golden`'s `trace`, `traverse`,
+//! `enter_instance` and `test_triangles`, step for step).
+//!
+//! State machine (per thread, one instruction per engine turn): fetch a node (2 loads), decode
+//! it; at an inner node read the ray's origin and direction along the split axis from scratch
+//! (indexed by the axis), pick near and far child, compute `t_split` with the shared
+//! `units::split_distance` and visit near, far or both (pushing far on the kd stack); at a
+//! leaf run its list: at the top level enter each instance not yet in the instance mailbox
+//! (world-to-object transform of the ray, then the object tree), at the object level test each
+//! triangle not skipped and not in the triangle mailbox (unit-triangle transform and test, the
+//! shared `units::transform` and `units::unit_triangle_coords`). A shadow query (`q_any`)
+//! returns at its first hit. Then pop the stack until a segment can still hold a closer hit.
+//!
+//! Cost per step (instructions = engine turns): inner node 15-19, leaf 6 plus per triangle
+//! about 45 (2 mailbox/skip, 12 loads, 18 transform, 6 test, 5 range compares, 4 updates).
+
+use super::asm::{Label, Reg, Val};
+use super::isa::{Op, MAILBOX_INSTANCES, MAILBOX_TRIANGLES};
+use super::{Gen, STACK_ENTRY_WORDS};
+use crate::layout::{
+    instance_word as iw, INSTANCES, LEAF_TAG, LISTS, NODES, TRIANGLES_T, TRIANGLES_UV,
+};
+use crate::units;
+
+/// The ray one traversal level walks: registers, and where scratch holds a copy for the
+/// axis-indexed reads.
+#[derive(Clone, Copy)]
+struct LevelRay {
+    o: [Reg; 3],
+    d: [Reg; 3],
+    scratch: u32,
+}
+
+/// Which kind of leaf a level has.
+#[derive(Clone, Copy)]
+enum Leaves {
+    Instances,
+    /// Triangles of the instance in this register (`Reg::ZERO` for the only object).
+    Triangles(Reg),
+}
+
+impl Gen<'_> {
+    /// The trace routine: closest hit (or any hit when `q_any` is 1) of the query registers;
+    /// returns through `link` with `hit`, `best_t`, `best_instance`, `best_triangle`.
+    pub(super) fn trace_routine(&self) {
+        let a = self.asm;
+        let s = &self.s;
+        a.section("trace");
+        let done = a.label();
+        a.mov(s.best_t, s.q_t_max.into());
+        a.mov(s.hit, Val::K(0));
+        a.mov(s.sp, Val::K(self.scratch.stack));
+        let world = LevelRay {
+            o: s.q_o,
+            d: s.q_d,
+            scratch: self.scratch.ray_top,
+        };
+        self.store_ray(world);
+        match self.c.top_root {
+            Some(root) => {
+                a.mailbox_clear(MAILBOX_INSTANCES);
+                self.traverse(Val::K(root), world, Leaves::Instances, done);
+            }
+            None => {
+                a.mailbox_clear(MAILBOX_TRIANGLES);
+                self.traverse(
+                    Val::K(self.c.object_root),
+                    world,
+                    Leaves::Triangles(Reg::ZERO),
+                    done,
+                );
+            }
+        }
+        a.bind(done);
+        a.section("trace");
+        a.ret(s.link);
+    }
+
+    fn store_ray(&self, ray: LevelRay) {
+        for k in 0..3 {
+            self.asm
+                .scratch_store(Val::K(0), ray.scratch + k as u32, ray.o[k].into());
+            self.asm
+                .scratch_store(Val::K(0), ray.scratch + 3 + k as u32, ray.d[k].into());
+        }
+    }
+
+    /// Front-to-back traversal from `root`; an answered any-hit query jumps to `answered`.
+    fn traverse(&self, root: Val, ray: LevelRay, leaves: Leaves, answered: Label) {
+        let a = self.asm;
+        let s = &self.s;
+        a.section("traversal");
+        let [node, lo, hi, base] = a.regs::<4>();
+        let [near, far] = a.regs::<2>();
+        a.mov(node, root);
+        a.mov(lo, s.q_t_min.into());
+        a.mov(hi, s.best_t.into());
+        a.mov(base, s.sp.into());
+        let (top, leaf, pop, finished) = (a.label(), a.label(), a.label(), a.label());
+        a.bind(top);
+        a.section("traversal");
+        let w0 = a.keep(a.load(NODES, node.into(), 1, 0));
+        let w1 = a.keep(a.load(NODES, node.into(), 1, 1));
+        let tag = a.keep(a.op(Op::Shr, w0.into(), Val::K(30)));
+        a.branch(Op::Beq, tag.into(), Val::K(LEAF_TAG), false, leaf);
+        // Inner node: `tag` is the axis, `w1` the split plane.
+        let left = a.op(Op::And, w0.into(), Val::K(0x3fff_ffff));
+        let [o, d] = a.regs::<2>();
+        a.scratch_load_to(o, tag.into(), ray.scratch);
+        a.scratch_load_to(d, tag.into(), ray.scratch + 3);
+        let (near_left, decided) = (a.label(), a.label());
+        a.branch(Op::BFlt, o.into(), w1.into(), false, near_left);
+        let near_right = a.label();
+        a.branch(Op::BFeq, o.into(), w1.into(), true, near_right);
+        a.branch(Op::BFle, d.into(), Val::K(0), false, near_left);
+        a.bind(near_right);
+        a.op_to(Op::Add, near, left, Val::K(1));
+        a.mov(far, left);
+        a.jump(decided);
+        a.bind(near_left);
+        a.mov(near, left);
+        a.op_to(Op::Add, far, left, Val::K(1));
+        a.bind(decided);
+        let (go_near, go_far) = (a.label(), a.label());
+        a.branch(Op::BFeq, d.into(), Val::K(0), false, go_near);
+        let t_split = units::split_distance(a, o.into(), d.into(), w1.into());
+        a.branch(Op::BFlt, hi.into(), t_split, false, go_near);
+        a.branch(Op::BFle, t_split, Val::K(0), false, go_near);
+        a.branch(Op::BFlt, t_split, lo.into(), false, go_far);
+        // Both: push (far, t_split, hi), go near with [lo, t_split].
+        a.scratch_store(s.sp.into(), 0, far.into());
+        a.scratch_store(s.sp.into(), 1, t_split);
+        a.scratch_store(s.sp.into(), 2, hi.into());
+        a.op_to(Op::Add, s.sp, s.sp.into(), Val::K(STACK_ENTRY_WORDS));
+        a.mov(node, near.into());
+        a.mov(hi, t_split);
+        a.jump(top);
+        a.bind(go_near);
+        a.mov(node, near.into());
+        a.jump(top);
+        a.bind(go_far);
+        a.mov(node, far.into());
+        a.jump(top);
+        a.end_temps();
+
+        // Leaf: `w0`'s payload is the list address, `w1` the count.
+        a.bind(leaf);
+        let list = a.keep(a.op(Op::And, w0.into(), Val::K(0x3fff_ffff)));
+        let end = a.keep(a.op(Op::Add, list.into(), w1.into()));
+        for r in [w0, w1, tag, o, d] {
+            a.free(r);
+        }
+        match leaves {
+            Leaves::Instances => self.instance_list(list, end, answered),
+            Leaves::Triangles(instance) => self.triangle_list(instance, ray, list, end, answered),
+        }
+        a.free(list);
+        a.free(end);
+        a.section("traversal");
+        // A hit inside the segment just searched is the closest.
+        a.branch(Op::Beq, s.hit.into(), Val::K(0), false, pop);
+        a.branch(Op::BFle, s.best_t.into(), hi.into(), false, finished);
+        a.bind(pop);
+        a.branch(Op::Beq, s.sp.into(), base.into(), false, finished);
+        a.op_to(Op::Sub, s.sp, s.sp.into(), Val::K(STACK_ENTRY_WORDS));
+        a.scratch_load_to(node, s.sp.into(), 0);
+        a.scratch_load_to(lo, s.sp.into(), 1);
+        a.scratch_load_to(hi, s.sp.into(), 2);
+        a.branch(Op::Beq, s.hit.into(), Val::K(0), false, top);
+        a.branch(Op::BFlt, s.best_t.into(), lo.into(), false, finished);
+        a.jump(top);
+        a.bind(finished);
+        a.mov(s.sp, base.into());
+        for r in [node, lo, hi, base, near, far] {
+            a.free(r);
+        }
+    }
+
+    /// The instances of a top-level leaf, `list..end` in bank 1.
+    fn instance_list(&self, list: Reg, end: Reg, answered: Label) {
+        let a = self.asm;
+        let s = &self.s;
+        a.section("instances");
+        let [p, instance] = a.regs::<2>();
+        a.mov(p, list.into());
+        let (next, done) = (a.label(), a.label());
+        a.bind(next);
+        a.section("instances");
+        a.branch(Op::Beq, p.into(), end.into(), false, done);
+        a.load_to(instance, LISTS, p.into(), 0, 0);
+        a.op_to(Op::Add, p, p.into(), Val::K(1));
+        a.mailbox_check(MAILBOX_INSTANCES, instance, next);
+        let record = a.keep(self.instance_record(instance));
+        let m: [Val; 12] = a.load_n(INSTANCES, record.into(), 0, iw::WORLD_TO_OBJECT as u32);
+        let root = a.keep(a.load(INSTANCES, record.into(), 0, iw::ROOT as u32));
+        let local_o = units::transform(a, &m, s.q_o.map(Val::R), true).map(|v| a.keep(v));
+        let local_d = units::transform(a, &m, s.q_d.map(Val::R), false).map(|v| a.keep(v));
+        a.end_temps();
+        a.free(record);
+        let local = LevelRay {
+            o: local_o,
+            d: local_d,
+            scratch: self.scratch.ray_object,
+        };
+        self.store_ray(local);
+        a.mailbox_clear(MAILBOX_TRIANGLES);
+        self.traverse(root.into(), local, Leaves::Triangles(instance), answered);
+        for r in local_o.into_iter().chain(local_d).chain([root]) {
+            a.free(r);
+        }
+        a.jump(next);
+        a.bind(done);
+        a.free(p);
+        a.free(instance);
+    }
+
+    /// `instance * INSTANCE_WORDS` (24 = 16 + 8).
+    pub(super) fn instance_record(&self, instance: Reg) -> Val {
+        let a = self.asm;
+        debug_assert_eq!(crate::layout::INSTANCE_WORDS, 24);
+        let x16 = a.op(Op::Shl, instance.into(), Val::K(4));
+        let x8 = a.op(Op::Shl, instance.into(), Val::K(3));
+        a.op(Op::Add, x16, x8)
+    }
+
+    /// The triangles of an object leaf, `list..end` in bank 1.
+    fn triangle_list(&self, instance: Reg, ray: LevelRay, list: Reg, end: Reg, answered: Label) {
+        let a = self.asm;
+        let s = &self.s;
+        a.section("triangles");
+        let [p, triangle] = a.regs::<2>();
+        a.mov(p, list.into());
+        let (next, done) = (a.label(), a.label());
+        a.bind(next);
+        a.section("triangles");
+        a.branch(Op::Beq, p.into(), end.into(), false, done);
+        a.load_to(triangle, LISTS, p.into(), 0, 0);
+        a.op_to(Op::Add, p, p.into(), Val::K(1));
+        // The triangle a secondary ray starts on is never tested.
+        let not_skipped = a.label();
+        a.branch(
+            Op::Beq,
+            triangle.into(),
+            s.skip_triangle.into(),
+            true,
+            not_skipped,
+        );
+        a.branch(
+            Op::Beq,
+            instance.into(),
+            s.skip_instance.into(),
+            false,
+            next,
+        );
+        a.bind(not_skipped);
+        a.mailbox_check(MAILBOX_TRIANGLES, triangle, next);
+        a.section("intersect");
+        let uv: [Val; 8] = a.load_n(TRIANGLES_UV, triangle.into(), 3, 0);
+        let t_row: [Val; 4] = a.load_n(TRIANGLES_T, triangle.into(), 3, 0);
+        let m: [Val; 12] = std::array::from_fn(|k| if k < 8 { uv[k] } else { t_row[k - 8] });
+        let o = units::transform(a, &m, ray.o.map(Val::R), true);
+        let d = units::transform(a, &m, ray.d.map(Val::R), false);
+        let [t, u, v, u_plus_v] = units::unit_triangle_coords(a, o, d);
+        let f = self.c.format;
+        let (lo, hi) = units::edge_bounds(f, units::edge_margin(f));
+        a.branch(Op::BFle, Val::K(lo), u, true, next);
+        a.branch(Op::BFle, Val::K(lo), v, true, next);
+        a.branch(Op::BFle, u_plus_v, Val::K(hi), true, next);
+        a.branch(Op::BFlt, s.q_t_min.into(), t, true, next);
+        a.branch(Op::BFlt, t, s.best_t.into(), true, next);
+        a.mov(s.best_t, t);
+        a.mov(s.best_instance, instance.into());
+        a.mov(s.best_triangle, triangle.into());
+        a.mov(s.hit, Val::K(1));
+        a.branch(Op::Beq, s.q_any.into(), Val::K(0), true, answered);
+        a.jump(next);
+        a.end_temps();
+        a.bind(done);
+        a.free(p);
+        a.free(triangle);
+    }
+}

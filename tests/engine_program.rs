@@ -1,0 +1,125 @@
+//! The ray thread engine's microprogram, run by its Rust twin, renders exactly what the golden
+//! model renders: every pixel of every bundled scene, and every frame of an animated one.
+
+use dynrt::fp::Format;
+use dynrt::hw::program::exec::Machine;
+use dynrt::hw::program::{build_program, ProgramConfig};
+use dynrt::layout::{self, Layout, MemoryConfig, SceneTrees};
+use dynrt::model;
+use dynrt::scene::Scene;
+use rayon::prelude::*;
+use std::path::Path;
+
+fn layout_of(name: &str, w: u32, h: u32, f: Format, frame: u32) -> Layout {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name);
+    let mut s = Scene::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+    s.set_resolution(w, h).unwrap();
+    let trees = SceneTrees::build(&s, f).unwrap();
+    layout::build(&s, &trees, frame, &MemoryConfig::default()).unwrap()
+}
+
+/// Pixels where the twin differs from the golden model, and how many pixels hit something.
+fn mismatches(l: &Layout, f: Format) -> (Vec<(u32, u32, u32, u32)>, usize) {
+    let program = build_program(&ProgramConfig::from_layout(f, &l.info));
+    let golden = model::render_golden(l, false);
+    let m = Machine::new(&program, l);
+    let (w, h) = (l.info.width, l.info.height);
+    let bad = (0..w * h)
+        .into_par_iter()
+        .filter_map(|i| {
+            let (x, y) = (i % w, i / w);
+            let (rgb, _, _) = m
+                .run_pixel(x, y, false)
+                .unwrap_or_else(|e| panic!("pixel ({x}, {y}): {e}"));
+            let want = golden.rgb[i as usize];
+            (rgb != want).then_some((x, y, rgb, want))
+        })
+        .collect();
+    (bad, golden.hits.iter().filter(|h| h.is_some()).count())
+}
+
+#[test]
+fn microprogram_renders_the_golden_frame_on_every_bundled_scene() {
+    for (name, w, h) in [
+        ("tiny.toml", 16, 12),
+        ("cornell.toml", 32, 24),
+        ("cornell_noshadow.toml", 32, 24),
+        ("mirror.toml", 32, 24),
+        ("dynamic.toml", 32, 24),
+        ("terrain.toml", 24, 18),
+    ] {
+        for f in [Format::E7M16, Format::E8M23] {
+            let l = layout_of(name, w, h, f, 0);
+            let (bad, hits) = mismatches(&l, f);
+            println!(
+                "{name} {f}: {} of {} pixels differ, {hits} hits",
+                bad.len(),
+                w * h
+            );
+            assert!(
+                hits > 0,
+                "{name}: nothing hit, the comparison proves little"
+            );
+            assert!(
+                bad.is_empty(),
+                "{name} {f}: first differences (x, y, twin, golden) {:x?}",
+                &bad[..bad.len().min(5)]
+            );
+        }
+    }
+}
+
+#[test]
+fn engine_order_frame_equals_per_pixel_runs_and_every_pixel_is_written() {
+    let f = Format::E7M16;
+    let l = layout_of("mirror.toml", 16, 12, f, 0);
+    let program = build_program(&ProgramConfig::from_layout(f, &l.info));
+    let m = Machine::new(&program, &l);
+    let frame = m.run_frame(32).unwrap();
+    let golden = model::render_golden(&l, false);
+    assert_eq!(frame.pixels, golden.rgb);
+    // Every instruction is counted once per unit.
+    assert_eq!(
+        frame.stats.per_unit.values().sum::<u64>(),
+        frame.stats.instructions
+    );
+    assert!(frame.stats.rounds * 32 >= frame.stats.instructions);
+}
+
+#[test]
+fn animated_frames_match_the_golden_model() {
+    let f = Format::E7M16;
+    for frame in 0..2 {
+        let l = layout_of("tiny_animated.toml", 16, 12, f, frame);
+        let (bad, _) = mismatches(&l, f);
+        assert!(
+            bad.is_empty(),
+            "frame {frame}: {:x?}",
+            &bad[..bad.len().min(5)]
+        );
+    }
+}
+
+#[test]
+fn the_program_leaves_out_what_the_scene_does_not_need() {
+    let f = Format::E7M16;
+    let plain = layout_of("cornell_noshadow.toml", 16, 12, f, 0);
+    let p = build_program(&ProgramConfig::from_layout(f, &plain.info));
+    let names: Vec<&str> = p.sections.clone();
+    assert!(
+        !names.contains(&"shadow") && !names.contains(&"mirror") && !names.contains(&"instances")
+    );
+    assert!(p.left_out.iter().any(|s| s.contains("shadow")));
+    let full = layout_of("mirror.toml", 16, 12, f, 0);
+    let q = build_program(&ProgramConfig::from_layout(f, &full.info));
+    assert!(q.sections.contains(&"mirror"));
+    assert!(q.code.len() > p.code.len());
+    println!(
+        "cornell_noshadow: {} instructions, {} registers; mirror: {} instructions",
+        p.code.len(),
+        p.registers_used,
+        q.code.len()
+    );
+}
