@@ -5,8 +5,9 @@
 //! mean / maximum relative hit-distance error (`compare`), shadow-acne pixels (shadowed in the
 //! golden frame but lit in the reference at a pixel whose primary hit agrees: each frame is
 //! rendered with and without shadow rays to tell), and for closed meshes the pixels an inside
-//! camera leaks and the leak rate of rays aimed at shared edges ([`crate::stress`]); the golden
-//! model's single-frame run time (rayon-parallel, wall clock: compare formats within one run
+//! camera leaks and the leak rate of rays aimed at shared edges ([`crate::stress`]); with an
+//! edge margin, what it changes against the exact test (margin 0) ([`MarginChanges`]: the
+//! silhouette cost and the cracks closed); the golden model's single-frame run time (rayon-parallel, wall clock: compare formats within one run
 //! only) and the datapath cost estimate ([`super::cost`]).
 //!
 //! [`summarize`] folds the rows into one [`FormatSummary`] per format, [`write_outputs`]
@@ -18,7 +19,7 @@ use super::plot::{scatter_with_front, Point};
 use crate::compare::{compare_hits, compare_images};
 use crate::fp::Format;
 use crate::layout::{self, MemoryConfig, SceneTrees};
-use crate::model::{render_with, Frame, Golden, Reference};
+use crate::model::{render_with, units, Frame, Golden, Reference};
 use crate::scene::Scene;
 use crate::stress::{cases, geometry};
 use anyhow::{Context, Result};
@@ -38,7 +39,9 @@ pub struct SweepConfig {
     pub formats: Vec<Format>,
     pub width: u32,
     pub height: u32,
-    /// Edge margin of the unit-triangle test in units of 2^-mantissa bits (0 = exact test).
+    /// Edge margin of the unit-triangle test in units of 2^-mantissa bits: by default
+    /// `units::EDGE_MARGIN_ULPS`, what the golden model and the hardware compute; 0 is the
+    /// exact test.
     pub edge_margin_ulps: f64,
     /// Cost cache (see [`cost::measure_or_load`]) and where yosys works.
     pub cost_csv: PathBuf,
@@ -52,7 +55,8 @@ pub struct SweepConfig {
 
 impl SweepConfig {
     /// The bundled scenes of `scenes_dir`, every format with hardware operators, 96x72, the
-    /// exact unit-triangle test (what the hardware computes), and the operator costs measured
+    /// hardware's unit-triangle test (edge margin `units::EDGE_MARGIN_ULPS`), and the operator
+    /// costs measured
     /// once and kept in the repository (`benches/data/fp_cost_xc2v.csv` beside `scenes_dir`;
     /// missing rows are synthesized and appended).
     pub fn new(scenes_dir: &Path) -> Result<SweepConfig> {
@@ -68,7 +72,7 @@ impl SweepConfig {
             formats: crate::hw::fp::supported_formats(),
             width: 96,
             height: 72,
-            edge_margin_ulps: 0.0,
+            edge_margin_ulps: f64::from(units::EDGE_MARGIN_ULPS),
             cost_csv: scenes_dir
                 .parent()
                 .unwrap_or(Path::new("."))
@@ -99,6 +103,8 @@ pub struct Row {
     pub inside_leaks: Option<(u64, u64)>,
     /// Edge-aimed rays from inside that leaked, and rays cast (closed meshes only).
     pub edge_leaks: Option<(u64, u64)>,
+    /// With a non-zero edge margin: the frame against the exact test's.
+    pub margin_changes: Option<MarginChanges>,
     pub golden_seconds: f64,
     pub reference_seconds: f64,
     /// Triangles the layout dropped (transform not representable).
@@ -106,6 +112,56 @@ pub struct Row {
     pub datapath: Option<DatapathCost>,
     /// Why a format could not render the scene (the row's error figures are then NaN).
     pub note: String,
+}
+
+/// What an edge margin changes in a frame against the exact test (margin 0): pixels whose
+/// colour changes, primary hits on another triangle (or hit against miss), and of those the
+/// ones that now agree with the f64 reference where they did not (cracks closed) and the
+/// reverse (silhouettes grown: a triangle grown by the margin catches a ray that passes just
+/// outside it). Agreement is [`compare_hits`]'s equivalence, per pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MarginChanges {
+    pub changed_pixels: usize,
+    pub changed_hits: usize,
+    pub fixed_hits: usize,
+    pub broken_hits: usize,
+}
+
+impl MarginChanges {
+    /// `with`: rendered with the margin; `exact`: margin 0; `reference`: f64.
+    pub fn measure(with: &Frame, exact: &Frame, reference: &Frame) -> MarginChanges {
+        let (w, e, r) = (
+            with.hit_tuples(),
+            exact.hit_tuples(),
+            reference.hit_tuples(),
+        );
+        let agrees = |a: &Option<(i64, i64, f64)>, b: &Option<(i64, i64, f64)>| {
+            compare_hits(&[*a], &[*b]).is_ok_and(|m| m.equivalent_hits == 1)
+        };
+        let key = |h: &Option<(i64, i64, f64)>| h.map(|(i, t, _)| (i, t));
+        let mut c = MarginChanges::default();
+        for i in 0..w.len() {
+            c.changed_pixels += usize::from(with.rgb[i] != exact.rgb[i]);
+            if key(&w[i]) != key(&e[i]) {
+                c.changed_hits += 1;
+                match (agrees(&w[i], &r[i]), agrees(&e[i], &r[i])) {
+                    (true, false) => c.fixed_hits += 1,
+                    (false, true) => c.broken_hits += 1,
+                    _ => {}
+                }
+            }
+        }
+        c
+    }
+
+    fn add(self, o: MarginChanges) -> MarginChanges {
+        MarginChanges {
+            changed_pixels: self.changed_pixels + o.changed_pixels,
+            changed_hits: self.changed_hits + o.changed_hits,
+            fixed_hits: self.fixed_hits + o.fixed_hits,
+            broken_hits: self.broken_hits + o.broken_hits,
+        }
+    }
 }
 
 /// One scene prepared for the sweep.
@@ -252,6 +308,7 @@ pub fn precision_sweep(config: &SweepConfig, log: &mut dyn FnMut(&str)) -> Resul
                 acne_pixels: 0,
                 inside_leaks: None,
                 edge_leaks: None,
+                margin_changes: None,
                 golden_seconds: f64::NAN,
                 reference_seconds,
                 dropped_triangles: 0,
@@ -284,6 +341,10 @@ pub fn precision_sweep(config: &SweepConfig, log: &mut dyn FnMut(&str)) -> Resul
             row.max_channel_error = im.max_channel_error;
             row.mean_rel_dist_error = hm.mean_rel_dist_error;
             row.max_rel_dist_error = hm.max_rel_dist_error;
+            if margin != 0.0 {
+                let exact = render_with(&Golden::with_edge_margin(&lay, 0.0), false);
+                row.margin_changes = Some(MarginChanges::measure(&g_on, &exact, &r_on));
+            }
             if let Some(r_off) = &r_off {
                 lay.info.shadows = false;
                 let g_off = render_with(&Golden::with_edge_margin(&lay, margin), false);
@@ -338,12 +399,21 @@ pub fn rows_csv(rows: &[Row]) -> String {
     let mut s = String::from(
         "scene,format,triangles,pixels,identical_hit_ratio,equivalent_hit_ratio,psnr_db,max_channel_error,\
          mean_rel_dist_error,max_rel_dist_error,acne_pixels,inside_leaked_pixels,inside_pixels,\
-         edge_leaked_rays,edge_rays,golden_seconds,reference_seconds,dropped_triangles,datapath_luts,\
+         edge_leaked_rays,edge_rays,margin_changed_pixels,margin_changed_hits,margin_fixed_hits,\
+         margin_broken_hits,golden_seconds,reference_seconds,dropped_triangles,datapath_luts,\
          datapath_flip_flops,datapath_mult18x18,note\n",
     );
     for r in rows {
         let (il, ip) = opt_pair(r.inside_leaks);
         let (el, er) = opt_pair(r.edge_leaks);
+        let (mp, mh, mf, mb) = r.margin_changes.map_or(Default::default(), |c| {
+            (
+                c.changed_pixels.to_string(),
+                c.changed_hits.to_string(),
+                c.fixed_hits.to_string(),
+                c.broken_hits.to_string(),
+            )
+        });
         let (l, ff, m) = r
             .datapath
             .map_or((String::new(), String::new(), String::new()), |d| {
@@ -354,7 +424,7 @@ pub fn rows_csv(rows: &[Row]) -> String {
                 )
             });
         s += &format!(
-            "{},{},{},{},{:.6},{:.6},{:.3},{},{:.3e},{:.3e},{},{il},{ip},{el},{er},{:.4},{:.4},{},{l},{ff},{m},\"{}\"\n",
+            "{},{},{},{},{:.6},{:.6},{:.3},{},{:.3e},{:.3e},{},{il},{ip},{el},{er},{mp},{mh},{mf},{mb},{:.4},{:.4},{},{l},{ff},{m},\"{}\"\n",
             r.scene, r.format, r.triangles, r.pixels, r.identical_hit_ratio, r.equivalent_hit_ratio,
             r.psnr_db, r.max_channel_error, r.mean_rel_dist_error, r.max_rel_dist_error, r.acne_pixels,
             r.golden_seconds, r.reference_seconds, r.dropped_triangles, r.note.replace('"', "'")
@@ -386,6 +456,8 @@ pub struct FormatSummary {
     /// Leaked / cast over every closed mesh (inside cameras; edge-aimed rays).
     pub inside_leaks: (u64, u64),
     pub edge_leaks: (u64, u64),
+    /// Summed over the scenes (zero without an edge margin).
+    pub margin_changes: MarginChanges,
     pub golden_seconds: f64,
     pub datapath: Option<DatapathCost>,
 }
@@ -442,6 +514,10 @@ pub fn summarize(rows: &[Row]) -> Vec<FormatSummary> {
                 pixels: ok.iter().map(|r| r.pixels).sum(),
                 inside_leaks: sum2(&|r| r.inside_leaks),
                 edge_leaks: sum2(&|r| r.edge_leaks),
+                margin_changes: ok
+                    .iter()
+                    .filter_map(|r| r.margin_changes)
+                    .fold(MarginChanges::default(), MarginChanges::add),
                 golden_seconds: ok.iter().map(|r| r.golden_seconds).sum(),
                 datapath: all.first().and_then(|r| r.datapath),
             }
@@ -453,7 +529,8 @@ pub fn summarize(rows: &[Row]) -> Vec<FormatSummary> {
 pub fn summary_csv(s: &[FormatSummary]) -> String {
     let mut out = String::from(
         "format,width_bits,scenes,refused,refused_other,mean_mismatch,worst_mismatch,mean_identical,mean_psnr_db,min_psnr_db,\
-         acne_pixels,pixels,inside_leak_ppm,edge_leak_ppm,golden_seconds,datapath_luts,datapath_flip_flops,datapath_mult18x18\n",
+         acne_pixels,pixels,inside_leak_ppm,edge_leak_ppm,margin_changed_pixels,margin_changed_hits,margin_fixed_hits,\
+         margin_broken_hits,golden_seconds,datapath_luts,datapath_flip_flops,datapath_mult18x18\n",
     );
     for x in s {
         let (l, ff, m) = x
@@ -466,7 +543,7 @@ pub fn summary_csv(s: &[FormatSummary]) -> String {
                 )
             });
         out += &format!(
-            "{},{},{},{},{},{:.6},{:.6},{:.6},{:.2},{:.2},{},{},{:.1},{:.1},{:.3},{l},{ff},{m}\n",
+            "{},{},{},{},{},{:.6},{:.6},{:.6},{:.2},{:.2},{},{},{:.1},{:.1},{},{},{},{},{:.3},{l},{ff},{m}\n",
             x.format,
             x.format.width(),
             x.scenes,
@@ -481,6 +558,10 @@ pub fn summary_csv(s: &[FormatSummary]) -> String {
             x.pixels,
             x.inside_leak_ppm(),
             x.edge_leak_ppm(),
+            x.margin_changes.changed_pixels,
+            x.margin_changes.changed_hits,
+            x.margin_changes.fixed_hits,
+            x.margin_changes.broken_hits,
             x.golden_seconds
         );
     }
@@ -595,6 +676,7 @@ mod tests {
             acne_pixels: 1,
             inside_leaks: Some((1, 1000)),
             edge_leaks: None,
+            margin_changes: None,
             golden_seconds: 0.5,
             reference_seconds: 0.1,
             dropped_triangles: 0,
@@ -663,6 +745,56 @@ mod tests {
     }
 
     #[test]
+    fn margin_changes_count_closed_cracks_and_grown_silhouettes() {
+        use crate::model::HitRecord;
+        let hit = |triangle: u32, dist: f64| {
+            Some(HitRecord {
+                instance: 0,
+                triangle,
+                dist,
+            })
+        };
+        let frame = |hits: Vec<Option<HitRecord>>, rgb: Vec<u32>| Frame {
+            width: hits.len() as u32,
+            height: 1,
+            rgb,
+            hits,
+            stats: Default::default(),
+        };
+        // Pixel 0: unchanged. 1: a crack closed (miss -> the reference's triangle). 2: a
+        // silhouette grown (the reference misses). 3: a tie at an edge (another triangle at the
+        // same distance: changed, neither fixed nor broken). 4: same hit, other colour.
+        let reference = frame(
+            vec![hit(1, 2.0), hit(2, 3.0), None, hit(4, 5.0), hit(5, 1.0)],
+            vec![0; 5],
+        );
+        let exact = frame(
+            vec![hit(1, 2.0), None, None, hit(4, 5.0), hit(5, 1.0)],
+            vec![0, 0, 0, 7, 0],
+        );
+        let with = frame(
+            vec![
+                hit(1, 2.0),
+                hit(2, 3.0),
+                hit(3, 4.0),
+                hit(6, 5.0),
+                hit(5, 1.0),
+            ],
+            vec![0, 9, 9, 7, 1],
+        );
+        let c = MarginChanges::measure(&with, &exact, &reference);
+        assert_eq!(
+            c,
+            MarginChanges {
+                changed_pixels: 3,
+                changed_hits: 3,
+                fixed_hits: 1,
+                broken_hits: 1
+            }
+        );
+    }
+
+    #[test]
     fn a_small_sweep_measures_a_bundled_scene_and_writes_csv_and_plots() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
         let dir = tempfile::tempdir().unwrap();
@@ -682,6 +814,11 @@ mod tests {
             "e8m23 must beat e5m10: {wide:?} {narrow:?}"
         );
         assert!(wide.golden_seconds > 0.0 && wide.datapath.is_none());
+        // The hardware's margin by default, measured against the exact test.
+        assert_eq!(c.edge_margin_ulps, f64::from(units::EDGE_MARGIN_ULPS));
+        let changes = wide.margin_changes.expect("margin changes are measured");
+        assert!(changes.changed_hits * 50 <= wide.pixels, "{changes:?}");
+        assert!(changes.fixed_hits + changes.broken_hits <= changes.changed_hits);
         // Without costs there is no LUT plot, but the CSVs and the run-time plot are written.
         let written = write_outputs(&rows, dir.path()).unwrap();
         let names: Vec<String> = written

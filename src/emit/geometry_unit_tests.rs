@@ -6,8 +6,9 @@
 //! transforms of real mesh triangles (`../shared/scenes/meshes/*.obj`, the slivers and
 //! near-degenerate ones first) rounded as the layout rounds them, with rays aimed at their
 //! vertices, edge midpoints and centroids, rays lying in the triangle plane (edge-on) and
-//! grazing it; rays in unit-triangle space landing exactly on edges and vertices; D'z = +-0;
-//! huge and tiny coordinates; NaN and infinity.
+//! grazing it; rays in unit-triangle space landing exactly on edges and vertices and on the
+//! edge margin's bounds (`lo = -margin`, `hi = 1 + margin`, and one word either side);
+//! D'z = +-0; huge and tiny coordinates; NaN and infinity.
 
 use std::path::{Path, PathBuf};
 
@@ -448,8 +449,9 @@ fn intersect_random(f: Format, n: usize, seed: u64) -> Vec<IntersectRequest> {
 }
 
 /// Mesh triangles (slivers first) with rays at vertices, edges, centroid, edge-on and grazing;
-/// unit-space rays landing exactly on edges and vertices; D'z = +-0; huge and tiny values;
-/// t exactly at t_min or t_max.
+/// unit-space rays landing exactly on edges and vertices, and exactly on and one word either
+/// side of the edge margin's bounds; D'z = +-0; huge and tiny values; t exactly at t_min or
+/// t_max.
 fn intersect_hard(f: Format, seed: u64) -> Vec<IntersectRequest> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut out = Vec::new();
@@ -545,6 +547,11 @@ fn intersect_hard(f: Format, seed: u64) -> Vec<IntersectRequest> {
                 inf,
             ));
         }
+    }
+    // Exactly on the edge margin's bounds (lo = -margin, hi = 1 + margin) and one word either
+    // side of them.
+    for (req, _) in crate::hw::intersect::edge_bound_cases(f) {
+        push(req);
     }
     push(([f.nan(), z(0.2), z(1.0)], [0, 0, z(-1.0)], 0, inf));
     push(([z(0.2), z(0.2), z(1.0)], [0, 0, z(-1.0)], f.nan(), inf));

@@ -1,20 +1,29 @@
-//! `IntersectUnit`: Woop's unit-triangle test, fully pipelined, bit-exact with
-//! `model::units::intersect`.
+//! `IntersectUnit`: Woop's unit-triangle test with the edge margin, fully pipelined, bit-exact
+//! with `model::units::intersect`.
 //!
 //! Given the ray already in unit-triangle space (O', D') and the segment (t_min, t_max):
-//! `t = (-O'z) / D'z`, `u = O'x + t*D'x`, `v = O'y + t*D'y`, and a hit when `0 <= u`,
-//! `0 <= v`, `u + v <= 1`, `t_min < t` and `t < t_max`. NaN fails every comparison, so a ray
+//! `t = (-O'z) / D'z`, `u = O'x + t*D'x`, `v = O'y + t*D'y`, and a hit when `lo <= u`,
+//! `lo <= v`, `u + v <= hi`, `t_min < t` and `t < t_max`. NaN fails every comparison, so a ray
 //! parallel to the triangle (`D'z = 0`: t is infinite or NaN), NaN or infinite inputs never hit.
+//!
+//! `lo = -margin` and `hi = 1 + margin` are constants of the format
+//! (`units::edge_bounds(f, units::edge_margin(f))`, [`units::EDGE_MARGIN_ULPS`] ulps of 1:
+//! 2^-10 at e7m16): every triangle grows by the margin so that the rounding of O' and D' in two
+//! neighbours' unit spaces cannot open a crack along their shared edge (PRECISION.md). The
+//! comparators read constants either way, so the margin costs no hardware.
 //!
 //! Resources (paper Table 2, intersection: 3 add, 2 mul, 1 div): one [`FpDiv`], two
 //! [`FpMul`], three [`FpAddSub`] (u, v, u + v), and five [`FpCompare`] for the range tests
 //! (the paper counts comparators only for traversal). The negation of O'z is a sign flip
 //! (the divider reads NaNs and subnormals the way `Format::neg` leaves them).
 //!
-//! Measured (`yosys synth_xilinx -family xc2v`, out of context): e7m16 2713 LUTs, 5967 FFs,
-//! 2 MULT18X18, 0 BRAM, depth 15; e8m23 4377 LUTs, 9720 FFs, 8 MULT18X18 (two 24x24 products),
-//! depth 15. Most flip-flops are delay lines (O'x, O'y, D'x, D'y, t_min, t_max and the tag wait
-//! out the divider's `M + 5` clocks); yosys 0.23 does not map them to SRL16s.
+//! Measured (`dynrt synth --unit intersect`, yosys 0.23 `synth_xilinx -family xc2v`, out of
+//! context): e7m16 2773 LUTs, 7032 FFs, 2 MULT18X18, 0 BRAM, logic depth 9; e8m23 4473 LUTs,
+//! 11049 FFs, 8 MULT18X18 (two 24x24 products), depth 8. The margin's bounds cost 59 LUTs at
+//! e7m16 (55 at e8m23) and one LUT level at e7m16 over the exact test's 0 and 1, which the
+//! comparators simplify further. Most flip-flops are delay lines (O'x, O'y, D'x, D'y, t_min,
+//! t_max and the tag wait out the divider's `M + 5` clocks); yosys 0.23 does not map them to
+//! SRL16s.
 //!
 //! Latency [`intersect_latency`] = div (`M + 5`) + mul (4) + add (7) + add (7) + compare (2):
 //! 41 clocks for e7m16, 48 for e8m23; one test per clock. `tag` travels with the data.
@@ -37,6 +46,7 @@ use super::fp::mul::MUL_LATENCY;
 use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv, FpMul};
 use super::{Delay, TAG_BITS};
 use crate::fp::Format;
+use crate::model::units;
 
 /// Clocks from t to the output.
 const AFTER_DIV: u32 = MUL_LATENCY + 2 * ADD_SUB_LATENCY + COMPARE_LATENCY;
@@ -85,7 +95,7 @@ pub struct IntersectUnit<
     mul: [FpMul<W, E, M, S, S1, X2, P>; 2],
     /// u = O'x + t D'x, v = O'y + t D'y, u + v.
     add: [FpAddSub<W, E, M, S, S1, X2, T>; 3],
-    /// t_min < t, t < t_max, 0 <= u, 0 <= v, u + v <= 1.
+    /// t_min < t, t < t_max, lo <= u, lo <= v, u + v <= hi.
     cmp: [FpCompare<W, E, M>; 5],
     /// O'x, O'y, D'x, D'y, t_min, t_max wait for t.
     operand_delay: [Delay<Bits<W>, DL>; 6],
@@ -98,8 +108,9 @@ pub struct IntersectUnit<
     tag_delay_div: Delay<Bits<TAG_BITS>, DL>,
     tag_delay_rest: Delay<Bits<TAG_BITS>, T_DELAY>,
     c_sign_bit: Constant<Bits<W>>,
-    c_one: Constant<Bits<W>>,
-    c_zero: Constant<Bits<W>>,
+    /// The edge bounds: `lo = -margin`, `hi = 1 + margin` in the format.
+    c_lo: Constant<Bits<W>>,
+    c_hi: Constant<Bits<W>>,
 }
 
 impl<
@@ -117,6 +128,8 @@ impl<
     fn default() -> Self {
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
         assert!(P == 2 * S && DL == div_latency(M as u32) as usize);
+        let f = Format::new(E as u32, M as u32).expect("a supported format");
+        let (lo, hi) = units::edge_bounds(f, units::edge_margin(f));
         Self {
             clock: Default::default(),
             in_valid: Default::default(),
@@ -144,8 +157,8 @@ impl<
             tag_delay_div: Default::default(),
             tag_delay_rest: Default::default(),
             c_sign_bit: const_bits::<W>(1 << (W - 1)),
-            c_one: const_bits::<W>(((1 << (E - 1)) - 1) << M),
-            c_zero: const_bits::<W>(0),
+            c_lo: const_bits::<W>(u64::from(lo)),
+            c_hi: const_bits::<W>(u64::from(hi)),
         }
     }
 }
@@ -220,20 +233,20 @@ impl<
             self.add[i].a.next = self.o_delay[i].data_out.val();
             self.add[i].b.next = self.mul[i].result.val();
             self.uv_delay[i].data_in.next = self.add[i].result.val();
-            // 0 <= u, 0 <= v.
+            // lo <= u, lo <= v.
             self.cmp[2 + i].in_valid.next = self.add[i].out_valid.val();
-            self.cmp[2 + i].a.next = self.c_zero.val();
+            self.cmp[2 + i].a.next = self.c_lo.val();
             self.cmp[2 + i].b.next = self.add[i].result.val();
             self.uv_cmp_delay[i].data_in.next = self.cmp[2 + i].le.val();
         }
 
-        // u + v <= 1.
+        // u + v <= hi.
         self.add[2].in_valid.next = self.add[0].out_valid.val();
         self.add[2].a.next = self.add[0].result.val();
         self.add[2].b.next = self.add[1].result.val();
         self.cmp[4].in_valid.next = self.add[2].out_valid.val();
         self.cmp[4].a.next = self.add[2].result.val();
-        self.cmp[4].b.next = self.c_one.val();
+        self.cmp[4].b.next = self.c_hi.val();
 
         self.out_valid.next = self.cmp[4].out_valid.val();
         self.t.next = self.t_delay.data_out.val();
@@ -246,15 +259,85 @@ impl<
     }
 }
 
+/// Unit-space rays landing exactly on the edge bounds and one word either side of them:
+/// `u` and `v` at `lo`, `u + v` at `hi`, the corners (lo, lo) and (lo, hi - lo), and the exact
+/// test's old bounds (-0, 0, 1) which now lie inside. Each is `(O', D', t_min, t_max)` with
+/// `D' = (0, 0, -1)` so that u = O'x, v = O'y exactly (t = O'z), and `expect_hit` says whether
+/// it lies inside the bounds; the generator checks that the arithmetic lands on the intended
+/// words, so the cases keep probing the bounds if the margin changes.
+#[cfg(test)]
+pub(crate) fn edge_bound_cases(f: Format) -> Vec<(([u32; 3], [u32; 3], u32, u32), bool)> {
+    let (lo, hi) = units::edge_bounds(f, units::edge_margin(f));
+    // The next word towards +inf / -inf of a finite non-zero word.
+    let up = |w: u32| if f.sign_of(w) { w - 1 } else { w + 1 };
+    let down = |w: u32| if f.sign_of(w) { w + 1 } else { w - 1 };
+    let quarter = f.from_f64(0.25);
+    let half = f.from_f64(0.5);
+    let mut pairs: Vec<(u32, u32, bool)> = vec![];
+    for (u, inside) in [(lo, true), (up(lo), true), (down(lo), false)] {
+        pairs.push((u, quarter, inside));
+        pairs.push((quarter, u, inside));
+    }
+    for (uv, inside) in [(hi, true), (down(hi), true), (up(hi), false)] {
+        let v = f.sub(uv, half);
+        assert_eq!(f.add(half, v), uv, "u + v must land on {uv:#x}");
+        pairs.push((half, v, inside));
+        pairs.push((v, half, inside));
+    }
+    let v = f.sub(hi, lo);
+    assert_eq!(f.add(lo, v), hi, "lo + (hi - lo) must be hi");
+    pairs.push((lo, v, true));
+    pairs.push((lo, up(v), false));
+    pairs.push((lo, lo, true));
+    pairs.push((down(lo), lo, false));
+    let one = f.one();
+    pairs.push((f.neg(0), f.neg(0), true));
+    pairs.push((0, one, true));
+    pairs.push((one, 0, true));
+    pairs.push((f.from_f64(0.5 * f.to_f64(lo)), quarter, true));
+    let mut out = vec![];
+    for (u, v, inside) in pairs {
+        for oz in [f.one(), f.from_f64(2.5)] {
+            let req = (
+                [u, v, oz],
+                [0, f.neg(0), f.neg(f.one())],
+                0,
+                f.infinity(false),
+            );
+            let [_, gu, gv, _] = units::unit_triangle_coords(f, req.0, req.1);
+            // (-0 + t*0 is +0: equal as values.)
+            assert!(f.eq(gu, u) && f.eq(gv, v), "u, v must be O'x, O'y exactly");
+            out.push((req, inside));
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::hw::sim_harness::{clock_cycle, random_word};
-    use crate::model::units;
     use rand::{Rng, SeedableRng};
 
+    /// The bound cases straddle the margin: on and just inside `lo`/`hi` hit, one word
+    /// outside misses, and the exact test's bounds are now inside.
+    #[test]
+    fn edge_bound_cases_hit_exactly_inside_the_margin() {
+        for f in [Format::E7M16, Format::E8M23, Format::E5M10] {
+            let cases = edge_bound_cases(f);
+            for ((o, d, t_min, t_max), inside) in &cases {
+                let r = units::intersect(f, *o, *d, *t_min, *t_max);
+                assert_eq!(r.hit, *inside, "{f}: O'={o:x?}");
+            }
+            // Without the margin the points on lo and hi (outside the unit triangle) miss.
+            let ((o, d, a, b), _) = cases[0];
+            assert!(!units::intersect_with_margin(f, o, d, a, b, 0).hit);
+        }
+    }
+
     /// rust-hdl simulation: 250 tests (random words, and rays aimed near the unit triangle so
-    /// that many hit), one per clock, at the documented latency, equal to the model.
+    /// that many hit) and the edge-bound cases, one per clock, at the documented latency,
+    /// equal to the model (with its edge margin).
     #[test]
     fn rust_hdl_simulation_matches_model_e7m16() {
         let f = Format::E7M16;
@@ -279,6 +362,7 @@ mod tests {
                     )
                 }
             })
+            .chain(edge_bound_cases(f).into_iter().map(|(r, _)| r))
             .collect();
         let mut u =
             IntersectUnit::<24, 7, 16, 17, 18, 9, 21, 34, { div_latency(16) as usize }>::default();

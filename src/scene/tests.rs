@@ -135,6 +135,14 @@ fn bundled_terrain_scene() {
 }
 
 #[test]
+fn bundled_terrain_small_scene() {
+    let s = bundled("terrain_small.toml");
+    assert_eq!(s.triangle_count(), 2 * 72 * 72);
+    assert!(s.triangle_count() >= 10_000, "the CI-sized large object");
+    assert!(s.is_single_untransformed_object());
+}
+
+#[test]
 fn bundled_tiny_scenes() {
     let s = bundled("tiny.toml");
     // plane 2 + box 12 + icosahedron 20 + pyramid (4 sides + 1 quad base = 6)
@@ -172,6 +180,7 @@ fn every_bundled_scene_is_tested() {
             "dynamic.toml",
             "mirror.toml",
             "terrain.toml",
+            "terrain_small.toml",
             "tiny.toml",
             "tiny_animated.toml"
         ]

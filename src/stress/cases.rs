@@ -382,6 +382,69 @@ fn runs(config: &StressConfig) -> Vec<(Option<Format>, f64)> {
     v
 }
 
+/// Rows for several cameras inside a closed mesh, summed into one row per format and margin:
+/// every pixel must hit, no colour may be NaN/inf. `cameras` are (eye, look_at) pairs placed
+/// into the subject's scene (its resolution and settings are kept); the kd-trees are built once
+/// per format, as they do not depend on the camera.
+pub fn inside_camera_rows(
+    subject: &Subject,
+    cameras: &[(DVec3, DVec3)],
+    config: &StressConfig,
+    case: &str,
+    limit: Limit,
+) -> Vec<CaseResult> {
+    let scenes: Vec<Scene> = cameras
+        .iter()
+        .map(|&(eye, look_at)| {
+            let mut s = subject.scene.clone();
+            s.camera.eye = eye;
+            s.camera.look_at = look_at;
+            s
+        })
+        .collect();
+    let mut trees: Option<(Format, std::result::Result<SceneTrees, String>)> = None;
+    runs(config)
+        .into_iter()
+        .map(|(f, margin)| {
+            let mut row = CaseResult::new(case, &subject.name, f, margin, limit);
+            let Some(f) = f else {
+                for s in &scenes {
+                    let (px, miss) = reference_misses(s);
+                    row.rays += px;
+                    row.failures += miss;
+                }
+                return row.finish();
+            };
+            if trees.as_ref().is_none_or(|(g, _)| *g != f) {
+                let built = SceneTrees::build(&subject.scene, f).map_err(|e| e.to_string());
+                trees = Some((f, built));
+            }
+            let Some((_, Ok(t))) = &trees else {
+                if let Some((_, Err(e))) = &trees {
+                    row.note = format!("refused: {e}");
+                }
+                return row.finish();
+            };
+            for s in &scenes {
+                match layout::build(s, t, 0, &MemoryConfig::default()) {
+                    Ok(l) => {
+                        let g = Golden::with_edge_margin(&l, margin_for(f, margin));
+                        let (px, miss, bad) = render_check(&g);
+                        row.rays += px;
+                        row.failures += miss;
+                        row.nonfinite += bad;
+                    }
+                    Err(e) => {
+                        row.note = format!("refused: {e}");
+                        break;
+                    }
+                }
+            }
+            row.finish()
+        })
+        .collect()
+}
+
 /// Rows for a camera inside a closed mesh: every pixel must hit, no colour may be NaN/inf.
 pub fn camera_rows(
     subject: &Subject,

@@ -6,7 +6,8 @@
 //! - `edge_rays`: rays from inside closed meshes aimed at shared vertices and edges (an
 //!   icosphere, a box, the icosphere through a rotated, non-uniformly scaled instance, and the
 //!   closed public meshes when a mesh directory is given);
-//! - `inside_camera`: a camera inside a closed mesh, every pixel must hit;
+//! - `inside_camera`: cameras inside a closed mesh ([`StressConfig::inside_cameras`] of them,
+//!   at random points and directions, one row), every pixel must hit;
 //! - `needle`, `pancake`: convex meshes of 1000:1 aspect (sliver and needle triangles), rays from
 //!   outside aimed at interior points; `degenerate`: a box holding zero-area and 1e-9-sized
 //!   triangles (the layout drops what it cannot represent);
@@ -19,14 +20,17 @@
 //! Every scene case also renders its camera and counts shaded colours with a NaN or infinite
 //! channel (`nonfinite`), which must be zero everywhere.
 //!
-//! Every format runs at each edge margin of the configuration (default 0, what the hardware
-//! computes, and [`RECOMMENDED_EDGE_MARGIN`]), so the table shows the mitigation's benefit and
-//! cost side by side.
+//! Every format runs at each edge margin of the configuration: by default
+//! [`RECOMMENDED_EDGE_MARGIN`], what the golden model and the intersection unit compute, and 0,
+//! the exact unit-triangle test without the mitigation, so the table shows the margin's
+//! benefit and cost side by side.
 //!
 //! Invariants ([`Limit`]): the exact caster never fails; nothing non-finite reaches a pixel;
-//! inside cameras of closed meshes at ordinary scale leak at most [`WATERTIGHT_PPM`] rays per
-//! million in formats with at least 16 mantissa bits; so do edge-aimed rays once an edge margin
-//! is on. Other rates (edge-aimed rays without a margin, slivers, extreme scales and positions,
+//! at the hardware's edge margin (or a wider one), inside cameras of closed meshes at ordinary
+//! scale leak at most [`WATERTIGHT_PPM`] rays per million in formats with at least 16 mantissa
+//! bits (the target: 1 in 10,000 at e7m16), and so do edge-aimed rays on the simple
+//! closed meshes. Narrower margins (0 included) are studies: measured and printed, not judged.
+//! Other rates (edge-aimed rays on dense public meshes, slivers, extreme scales and positions,
 //! grazing rays, acne, narrow formats) are documented limits: measured and printed, not
 //! asserted by the suite (the regression tests pin them with bounds).
 
@@ -34,6 +38,7 @@ pub mod cases;
 pub mod geometry;
 
 use crate::fp::Format;
+use crate::model::units;
 use anyhow::{Context, Result};
 use glam::DVec3;
 use rand::SeedableRng;
@@ -46,20 +51,21 @@ use geometry::TestScene;
 /// The target: at most 1 leaked ray in 10,000 at e7m16 on closed meshes.
 pub const WATERTIGHT_PPM: f64 = 100.0;
 
-/// The unit-triangle edge margin the study recommends, in units of 2^-mantissa bits
-/// (2^-10 at e7m16): it closes the cracks inside cameras and exact-edge rays find, costs no
-/// operator, and moves silhouettes by 2^-10 of a triangle (see PRECISION.md). The golden model and the
-/// hardware use margin 0 until the intersection unit adopts it.
-pub const RECOMMENDED_EDGE_MARGIN: f64 = 64.0;
+/// The unit-triangle edge margin the golden model and the intersection unit compute
+/// ([`units::EDGE_MARGIN_ULPS`]), in units of 2^-mantissa bits (2^-10 at e7m16): it closes the
+/// cracks inside cameras and exact-edge rays find, costs no operator, and moves silhouettes by
+/// 2^-10 of a triangle (see PRECISION.md).
+pub const RECOMMENDED_EDGE_MARGIN: f64 = units::EDGE_MARGIN_ULPS as f64;
 
 /// How a case's failure rate is judged.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Limit {
     /// Closed meshes at ordinary scale: f64 must not fail, formats with >= 16 mantissa bits
-    /// at most [`WATERTIGHT_PPM`].
+    /// at most [`WATERTIGHT_PPM`] at the hardware's edge margin or a wider one.
     Watertight,
-    /// Rays aimed exactly at shared edges: as `Watertight` with an edge margin; without one,
-    /// the per-triangle rounding leaks about one such ray in ten in every format, documented.
+    /// Rays aimed exactly at shared edges of simple closed meshes: as `Watertight`. Without
+    /// the margin the per-triangle rounding leaks about one such ray in ten in every format
+    /// (documented by the margin-0 rows).
     EdgeAimed,
     /// f64 must not fail; the formats' rates are documented, not bounded.
     Documented,
@@ -69,13 +75,17 @@ pub enum Limit {
 
 impl Limit {
     /// The bound in failures per million for a format (`None` = exact f64), if any.
-    /// `margin` is the edge margin in units of 2^-mantissa bits.
+    /// `margin` is the edge margin in units of 2^-mantissa bits: rows below the hardware's
+    /// ([`RECOMMENDED_EDGE_MARGIN`]) are studies of a weaker test and are not bounded.
     pub fn bound_ppm(self, format: Option<Format>, margin: f64) -> Option<f64> {
         match (self, format) {
             (Limit::NonFiniteOnly, _) => None,
             (_, None) => Some(0.0),
-            (Limit::Watertight, Some(f)) if f.man_bits >= 16 => Some(WATERTIGHT_PPM),
-            (Limit::EdgeAimed, Some(f)) if f.man_bits >= 16 && margin > 0.0 => Some(WATERTIGHT_PPM),
+            (Limit::Watertight | Limit::EdgeAimed, Some(f))
+                if f.man_bits >= 16 && margin >= RECOMMENDED_EDGE_MARGIN =>
+            {
+                Some(WATERTIGHT_PPM)
+            }
             _ => None,
         }
     }
@@ -91,9 +101,14 @@ pub struct StressConfig {
     /// Resolution of the camera cases.
     pub width: u32,
     pub height: u32,
+    /// Cameras at random inside points and directions per closed mesh (`inside_camera`),
+    /// summed into one row: 16 cameras of 64x48 are 49,152 pixels, so that the
+    /// [`WATERTIGHT_PPM`] bound (4 pixels) measures a rate rather than a single pixel.
+    pub inside_cameras: usize,
     /// Edge margins of the unit-triangle test to run every format with (see
     /// `model::units::intersect_with_margin`), in units of the format's spacing at 1
-    /// (2^-mantissa bits): 64 means 2^-10 at e7m16; 0 is what the hardware computes.
+    /// (2^-mantissa bits): 64 means 2^-10 at e7m16 and is what the hardware computes
+    /// ([`RECOMMENDED_EDGE_MARGIN`]); 0 is the exact test, without the mitigation.
     pub edge_margins: Vec<f64>,
     /// Where public meshes live ([`crate::scene::shared_mesh_dir`]); closed ones join `edge_rays`
     /// and `inside_camera`.
@@ -113,7 +128,8 @@ impl Default for StressConfig {
             rays: 20_000,
             width: 64,
             height: 48,
-            edge_margins: vec![0.0, RECOMMENDED_EDGE_MARGIN],
+            inside_cameras: 16,
+            edge_margins: vec![RECOMMENDED_EDGE_MARGIN, 0.0],
             mesh_dir: None,
             quick: false,
         }
@@ -335,8 +351,9 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
         };
         let subject = Subject::new(dir, name, tris, &s)?;
         let rays = cases::edge_rays(&subject.world, n, &mut rng);
-        // A camera at an inside point looking at a random direction.
-        let inside = geometry::inside_points(&subject.world, 1, &mut rng);
+        // Cameras at inside points looking in random directions.
+        let inside =
+            geometry::inside_points(&subject.world, config.inside_cameras.max(1), &mut rng);
         let case = RayCase {
             name: "edge_rays".into(),
             subject,
@@ -345,15 +362,19 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
             limit: *edge_limit,
         };
         rows.extend(cases::ray_case_rows(&case, config));
-        if let Some(&eye) = inside.first() {
-            let look = eye + geometry::random_direction(&mut rng);
+        let cameras: Vec<(DVec3, DVec3)> = inside
+            .iter()
+            .map(|&eye| (eye, eye + geometry::random_direction(&mut rng)))
+            .collect();
+        if let Some(&(eye, look)) = cameras.first() {
             let s = TestScene {
                 instance: *instance,
                 ..cam(eye, look)
             };
             let subject = Subject::new(dir, &format!("{name}_cam"), tris, &s)?;
-            rows.extend(cases::camera_rows(
+            rows.extend(cases::inside_camera_rows(
                 &subject,
+                &cameras,
                 config,
                 "inside_camera",
                 Limit::Watertight,
@@ -601,8 +622,17 @@ mod tests {
         }
         let m = RECOMMENDED_EDGE_MARGIN;
         for subject in ["icosphere", "box", "icosphere_instanced"] {
-            // The target: inside a closed mesh at e7m16, at most 1 leak in 10,000.
-            assert!(ppm(&r, "inside_camera", &format!("{subject}_cam"), "e7m16", 0.0) <= 100.0);
+            // The target: inside a closed mesh at e7m16, at most 1 leak in 10,000, with
+            // the margin the hardware computes; judged by the suite there, not at margin 0.
+            let cam = format!("{subject}_cam");
+            let row = r.row("inside_camera", &cam, "e7m16", m).unwrap();
+            assert_eq!(row.bound_ppm, Some(WATERTIGHT_PPM), "{row:?}");
+            assert!(row.ppm() <= WATERTIGHT_PPM, "{row:?}");
+            let row = r.row("inside_camera", &cam, "e7m16", 0.0).unwrap();
+            assert_eq!(
+                row.bound_ppm, None,
+                "margin 0 is the unmitigated comparison"
+            );
             // The margin closes the cracks that rays aimed exactly at shared edges find.
             assert_eq!(ppm(&r, "edge_rays", subject, "e7m16", m), 0.0, "{subject}");
             assert_eq!(ppm(&r, "edge_rays", subject, "e8m23", m), 0.0, "{subject}");
@@ -635,17 +665,105 @@ mod tests {
         );
     }
 
+    /// The target on the closed public meshes seen from inside, at e7m16: 8 cameras
+    /// per mesh at random inside points and directions (seed 6), 24,576 pixels each.
+    #[test]
+    fn public_closed_meshes_seen_from_inside_at_e7m16() {
+        let dir = crate::scene::shared_mesh_dir();
+        let meshes = closed_public_meshes(&dir).expect("../shared/scenes/meshes");
+        assert!(
+            meshes.len() >= 4,
+            "closed public meshes in {}",
+            dir.display()
+        );
+        let config = StressConfig {
+            formats: vec![Format::E7M16],
+            inside_cameras: 8,
+            ..StressConfig::default()
+        };
+        println!("seed {}", config.seed);
+        let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
+        let tmp = tempfile::tempdir().unwrap();
+        let m = RECOMMENDED_EDGE_MARGIN;
+        let (mut with, mut without) = (0, 0);
+        for (name, tris) in &meshes {
+            let eyes = geometry::inside_points(tris, config.inside_cameras, &mut rng);
+            let cameras: Vec<(DVec3, DVec3)> = eyes
+                .iter()
+                .map(|&e| (e, e + geometry::random_direction(&mut rng)))
+                .collect();
+            let s = TestScene {
+                eye: cameras[0].0,
+                look_at: cameras[0].1,
+                fov_y: 90.0,
+                width: config.width,
+                height: config.height,
+                ..TestScene::default()
+            };
+            let subject = Subject::new(tmp.path(), name, tris, &s).unwrap();
+            let rows =
+                cases::inside_camera_rows(&subject, &cameras, &config, "inside", Limit::Watertight);
+            for r in &rows {
+                println!(
+                    "{name} {} margin {}: {} of {} ({:.1} ppm)",
+                    r.format,
+                    r.edge_margin,
+                    r.failures,
+                    r.rays,
+                    r.ppm()
+                );
+                assert_eq!(r.nonfinite, 0, "{r:?}");
+            }
+            let row = |fmt: &str, margin: f64| {
+                rows.iter()
+                    .find(|r| r.format == fmt && r.edge_margin == margin)
+                    .unwrap()
+            };
+            assert_eq!(
+                row("f64", 0.0).failures,
+                0,
+                "{name}: the f64 reference never leaks"
+            );
+            let (a, b) = (row("e7m16", m), row("e7m16", 0.0));
+            (with, without) = (with + a.failures, without + b.failures);
+            // fandisk is the documented exception: its eye is tens of triangle sizes from the
+            // mesh origin, and the rounding of the unit-triangle transform's terms exceeds the
+            // 2^-10 margin (measured 244 ppm here, 6 of 24,576 pixels; 224 ppm with the suite's
+            // 16 cameras; PRECISION.md). The others measure 0.
+            let bound = if name == "fandisk" {
+                1000.0
+            } else {
+                WATERTIGHT_PPM
+            };
+            assert!(a.ppm() <= bound, "{name}: {a:?}");
+        }
+        // The margin closes most leaks (measured: 6 left of 31 at margin 0).
+        assert!(
+            with * 3 <= without,
+            "margin {m}: {with} leaks, margin 0: {without}"
+        );
+    }
+
     #[test]
     fn bounds_follow_the_limit_kind() {
         let e7 = Some(Format::E7M16);
         let e5 = Some(Format::E5M10);
         assert_eq!(Limit::Watertight.bound_ppm(None, 0.0), Some(0.0));
-        assert_eq!(Limit::Watertight.bound_ppm(e7, 0.0), Some(WATERTIGHT_PPM));
-        assert_eq!(Limit::Watertight.bound_ppm(e5, 0.0), None);
+        // Judged at the hardware's margin (or wider); narrower margins are studies.
+        let m = RECOMMENDED_EDGE_MARGIN;
+        assert_eq!(
+            m, 64.0,
+            "the golden model's margin, units::EDGE_MARGIN_ULPS"
+        );
+        assert_eq!(Limit::Watertight.bound_ppm(e7, 0.0), None);
+        assert_eq!(Limit::Watertight.bound_ppm(e7, m), Some(WATERTIGHT_PPM));
+        assert_eq!(Limit::Watertight.bound_ppm(e5, m), None);
         assert_eq!(Limit::EdgeAimed.bound_ppm(e7, 0.0), None);
-        assert_eq!(Limit::EdgeAimed.bound_ppm(e7, 16.0), Some(WATERTIGHT_PPM));
+        assert_eq!(Limit::EdgeAimed.bound_ppm(e7, 16.0), None);
+        assert_eq!(Limit::EdgeAimed.bound_ppm(e7, m), Some(WATERTIGHT_PPM));
+        assert_eq!(Limit::EdgeAimed.bound_ppm(e7, 256.0), Some(WATERTIGHT_PPM));
         assert_eq!(Limit::NonFiniteOnly.bound_ppm(None, 0.0), None);
-        let mut row = CaseResult::new("c", "s", e7, 0.0, Limit::Watertight);
+        let mut row = CaseResult::new("c", "s", e7, m, Limit::Watertight);
         (row.rays, row.failures) = (10_000, 1);
         assert!(
             row.clone().finish().held,
