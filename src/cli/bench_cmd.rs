@@ -28,8 +28,9 @@ pub enum BenchWhat {
     /// Number formats: error against the f64 reference versus hardware cost and run time, with
     /// the Pareto front (CSV + PNG plots).
     Precision {
-        /// Edge margin of the unit-triangle test, in units of 2^-mantissa bits (0 = the hardware's).
-        #[arg(long, default_value_t = 0.0)]
+        /// Edge margin of the unit-triangle test, in units of 2^-mantissa bits (default: the
+        /// hardware's, `units::EDGE_MARGIN_ULPS`; 0 = the exact test).
+        #[arg(long, default_value_t = dynrt::units::EDGE_MARGIN_ULPS as f64)]
         margin: f64,
         /// Directory of public OBJ meshes to add to the bundled scenes.
         #[arg(long)]
