@@ -16,6 +16,31 @@ use crate::fp::Format;
 /// golden model and in the hardware.
 pub const MAILBOX_ENTRIES: usize = 8;
 
+/// A ray's mailbox: the ids it tested most recently, first in first out, as the hardware keeps
+/// them (the golden model and the engine's twin share it).
+#[derive(Clone, Debug, Default)]
+pub struct Mailbox {
+    ids: [u32; MAILBOX_ENTRIES],
+    len: usize,
+    next: usize,
+}
+
+impl Mailbox {
+    pub fn new() -> Self {
+        Self::default()
+    }
+    /// True when `id` was recently tested; otherwise records it.
+    pub fn seen(&mut self, id: u32) -> bool {
+        if self.ids[..self.len].contains(&id) {
+            return true;
+        }
+        self.ids[self.next] = id;
+        self.next = (self.next + 1) % MAILBOX_ENTRIES;
+        self.len = (self.len + 1).min(MAILBOX_ENTRIES);
+        false
+    }
+}
+
 /// A 3-vector of format words.
 pub type Vec3W = [u32; 3];
 /// A 3x4 matrix, row-major: `m00 m01 m02 n0 m10 m11 m12 n1 m20 m21 m22 n2`.

@@ -18,7 +18,7 @@ use super::units::{self, Vec3W, Visit};
 use crate::fp::Format;
 use crate::layout::{instance_word as iw, FrameMap, Layout, Node, FRAME, INSTANCES, LISTS};
 
-pub use super::units::MAILBOX_ENTRIES;
+pub use super::units::{Mailbox, MAILBOX_ENTRIES};
 
 /// The closest hit found so far.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,32 +69,6 @@ pub struct Pixel {
     pub dir: Vec3W,
     pub hit: Option<Hit>,
     pub stats: RayStats,
-}
-
-struct Mailbox {
-    ids: [u32; MAILBOX_ENTRIES],
-    len: usize,
-    next: usize,
-}
-
-impl Mailbox {
-    fn new() -> Self {
-        Mailbox {
-            ids: [0; MAILBOX_ENTRIES],
-            len: 0,
-            next: 0,
-        }
-    }
-    /// True when `id` was recently tested; otherwise records it.
-    fn seen(&mut self, id: u32) -> bool {
-        if self.ids[..self.len].contains(&id) {
-            return true;
-        }
-        self.ids[self.next] = id;
-        self.next = (self.next + 1) % MAILBOX_ENTRIES;
-        self.len = (self.len + 1).min(MAILBOX_ENTRIES);
-        false
-    }
 }
 
 /// One ray query.

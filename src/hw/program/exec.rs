@@ -12,7 +12,7 @@ use super::isa::{Instr, Op, Unit, REGISTERS};
 use super::Program;
 use crate::fp::Format;
 use crate::layout::Layout;
-use crate::units::MAILBOX_ENTRIES;
+use crate::units::Mailbox;
 
 /// A failure of the program on this memory (a generator bug or a layout that does not belong
 /// to the program).
@@ -31,25 +31,6 @@ pub struct Write {
     pub pc: u16,
     pub reg: u8,
     pub value: u32,
-}
-
-#[derive(Clone, Default)]
-struct Mailbox {
-    ids: [u32; MAILBOX_ENTRIES],
-    len: usize,
-    next: usize,
-}
-
-impl Mailbox {
-    fn seen(&mut self, id: u32) -> bool {
-        if self.ids[..self.len].contains(&id) {
-            return true;
-        }
-        self.ids[self.next] = id;
-        self.next = (self.next + 1) % MAILBOX_ENTRIES;
-        self.len = (self.len + 1).min(MAILBOX_ENTRIES);
-        false
-    }
 }
 
 #[derive(Clone)]
