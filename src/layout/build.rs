@@ -507,9 +507,13 @@ scale = [0.5, 0.5, 0.5]
         assert_eq!(l.triangle_transform(17), trees.transforms[0][17]);
         assert_eq!(l.banks[INSTANCES].len(), 2 * INSTANCE_WORDS);
         let top = l.info.top_root.expect("two instances need a top level");
-        // Object tree nodes decode to the builder's nodes, offset past the top-level tree.
+        // Object tree nodes decode to the builder's nodes; the top-level tree comes after them.
         let root = l.word(INSTANCES, instance_word::ROOT as u32);
-        assert!(root > top);
+        assert!(root < top);
+        assert_eq!(
+            top as usize,
+            trees.trees.iter().map(|t| t.nodes.len()).sum::<usize>()
+        );
         for (i, node) in trees.trees[0].nodes.iter().enumerate() {
             match (node, l.node(root + i as u32)) {
                 (
