@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use crate::emit::constraints::{write_ucf, Port, PortDirection, UcfOptions};
-use crate::emit::processor::{ProcessorParams, PROCESSOR_TOP};
+use crate::emit::processor::ProcessorParams;
 use crate::emit::processor_run::{simulate_processor, write_processor_files, ProcessorSim};
 use crate::fp::Format;
 use crate::hw::engine::engine_period;
@@ -60,6 +60,35 @@ pub struct RtlReport {
     pub period: u32,
 }
 
+/// What both `dynrt rtl` and `dynrt sim` start from: the frames' layouts, the scene's
+/// microprogram, the engine twin's run of frame 0 and the engine's rotation period.
+struct Prepared {
+    layouts: Vec<Layout>,
+    program: Program,
+    twin: RunStats,
+    period: u32,
+}
+
+fn prepare(
+    scene: &Scene,
+    f: Format,
+    params: ProcessorParams,
+    frames: Option<u32>,
+) -> Result<Prepared> {
+    let layouts = scene_layouts(scene, f, frames)?;
+    let program = build_program(&ProgramConfig::from_layout(f, &layouts[0].info));
+    let twin = Machine::new(&program, &layouts[0])
+        .run_frame(params.threads as usize)
+        .context("the engine's twin failed on frame 0 (a generator bug)")?
+        .stats;
+    Ok(Prepared {
+        layouts,
+        program,
+        twin,
+        period: engine_period(params.threads, f.man_bits),
+    })
+}
+
 fn cycle_limit(predicted: &RunStats, period: u32) -> u64 {
     2 * predicted.rounds * u64::from(period) + 100_000
 }
@@ -74,13 +103,12 @@ pub fn generate_rtl(
     frames: Option<u32>,
     out: &Path,
 ) -> Result<RtlReport> {
-    let layouts = scene_layouts(scene, f, frames)?;
-    let program = build_program(&ProgramConfig::from_layout(f, &layouts[0].info));
-    let predicted = Machine::new(&program, &layouts[0])
-        .run_frame(params.threads as usize)
-        .context("the engine's twin failed on frame 0 (a generator bug)")?
-        .stats;
-    let period = engine_period(params.threads, f.man_bits);
+    let Prepared {
+        layouts,
+        program,
+        twin: predicted,
+        period,
+    } = prepare(scene, f, params, frames)?;
     let (rtl, tb) = write_processor_files(
         &program,
         &layouts,
@@ -185,13 +213,12 @@ pub fn simulate_scene(
     sim: Simulator,
     out: &Path,
 ) -> Result<SimReport> {
-    let layouts = scene_layouts(scene, f, frames)?;
-    let program = build_program(&ProgramConfig::from_layout(f, &layouts[0].info));
-    let twin = Machine::new(&program, &layouts[0])
-        .run_frame(params.threads as usize)
-        .context("the engine's twin failed on frame 0 (a generator bug)")?
-        .stats;
-    let period = engine_period(params.threads, f.man_bits);
+    let Prepared {
+        layouts,
+        program,
+        twin,
+        period,
+    } = prepare(scene, f, params, frames)?;
     let run: ProcessorSim = simulate_processor(
         &program,
         &layouts,
@@ -288,9 +315,4 @@ fn describe(p: &Program, f: Format, w: &Write) -> String {
         w.value,
         f.to_f64(w.value)
     )
-}
-
-/// The name of the top module, for reports.
-pub fn top_module() -> &'static str {
-    PROCESSOR_TOP
 }

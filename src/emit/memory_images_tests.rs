@@ -304,3 +304,120 @@ fn dynamic_scene_updates_rewrite_only_the_top_level_and_the_instances() {
         "the top-level tree must change between these frames"
     );
 }
+
+#[test]
+fn frame_update_refuses_layouts_of_different_formats() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/tiny_animated.toml");
+    let scene = Scene::load(&path).unwrap();
+    let other = Format::parse("e5m10").unwrap();
+    let a = layout::build(
+        &scene,
+        &SceneTrees::build(&scene, Format::E7M16).unwrap(),
+        0,
+        &MemoryConfig::default(),
+    )
+    .unwrap();
+    let b = layout::build(
+        &scene,
+        &SceneTrees::build(&scene, other).unwrap(),
+        0,
+        &MemoryConfig::default(),
+    )
+    .unwrap();
+    let e = frame_update(&a, &b).unwrap_err().to_string();
+    assert!(e.contains("e7m16") && e.contains("e5m10"), "{e}");
+    assert!(frame_update(&a, &a).unwrap().is_empty());
+}
+
+/// A testbench that loads the six frame-0 images, prints every word, loads frame 1's update
+/// files on top, and prints every word of the next layout again.
+fn readmemh_bench(prev: &Layout, next: &Layout, updates: &[(usize, PathBuf)]) -> String {
+    let mut tb = String::from("module tb;\n");
+    let size = |b: usize| prev.banks[b].len().max(next.banks[b].len()).max(1);
+    for b in 0..6 {
+        let _ = writeln!(tb, "    reg [31:0] m{b} [0:{}];", size(b) - 1);
+    }
+    tb.push_str("    integer a;\n    initial begin\n");
+    for b in 0..6 {
+        let _ = writeln!(tb, "        $readmemh(\"{}\", m{b});", bank_file_name(b));
+        let _ = writeln!(
+            tb,
+            "        for (a = 0; a < {}; a = a + 1) $display(\"R {b} %0d %h\", a, m{b}[a]);",
+            prev.banks[b].len()
+        );
+    }
+    for (b, path) in updates {
+        let _ = writeln!(
+            tb,
+            "        $readmemh(\"{}\", m{b});",
+            path.file_name().unwrap().to_string_lossy()
+        );
+    }
+    for b in 0..6 {
+        let _ = writeln!(
+            tb,
+            "        for (a = 0; a < {}; a = a + 1) $display(\"U {b} %0d %h\", a, m{b}[a]);",
+            next.banks[b].len()
+        );
+    }
+    tb.push_str("        $finish;\n    end\nendmodule\n");
+    tb
+}
+
+fn readmemh_in(simulator: Simulator) {
+    let layouts = animated_layouts();
+    let (prev, next) = (&layouts[0], &layouts[1]);
+    let dir = temp(simulator.name());
+    write_memory_images(prev, dir.path()).unwrap();
+    // A frame 0 -> 1 update in which the frame grows or shrinks still loads: the memories
+    // are sized for the larger of the two.
+    let updates = write_frame_update(prev, next, 1, dir.path()).unwrap();
+    assert!(!updates.is_empty());
+    let tb_path = dir.path().join("tb_readmemh.v");
+    std::fs::write(&tb_path, readmemh_bench(prev, next, &updates)).unwrap();
+    let compiled = sim::compile(simulator, &SimJob::new(dir.path(), vec![tb_path], "tb")).unwrap();
+    let ran = compiled
+        .run(&[], std::time::Duration::from_secs(300))
+        .unwrap();
+    let log = format!("{}{}{}", compiled.compile_log, ran.stdout, ran.stderr);
+    assert!(
+        !log.to_ascii_lowercase().contains("warning"),
+        "{simulator} warned:\n{}",
+        log.lines()
+            .filter(|l| l.to_ascii_lowercase().contains("warning"))
+            .take(10)
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+    let (mut reads, mut updated) = (0, 0);
+    for line in ran.stdout.lines() {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        if f.len() != 4 || !(f[0] == "R" || f[0] == "U") {
+            continue;
+        }
+        let bank: usize = f[1].parse().unwrap();
+        let addr: usize = f[2].parse().unwrap();
+        let word = u32::from_str_radix(f[3], 16)
+            .unwrap_or_else(|_| panic!("{simulator}: `{line}`: not a defined word"));
+        let want = if f[0] == "R" { prev } else { next };
+        assert_eq!(word, want.banks[bank][addr], "{simulator}: {line}");
+        if f[0] == "R" {
+            reads += 1
+        } else {
+            updated += 1
+        }
+    }
+    let total = |l: &Layout| l.banks.iter().map(Vec::len).sum::<usize>();
+    assert_eq!((reads, updated), (total(prev), total(next)));
+    println!("{simulator}: {reads} words loaded, {updated} checked after the update");
+}
+
+#[test]
+fn readmemh_loads_images_and_updates_in_icarus() {
+    readmemh_in(Simulator::Icarus);
+}
+
+#[test]
+fn readmemh_loads_images_and_updates_in_verilator() {
+    readmemh_in(Simulator::Verilator);
+}
