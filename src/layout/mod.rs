@@ -32,6 +32,16 @@
 //!
 //! Every value the host computes (triangle transforms, instance matrices, camera) is computed
 //! in f64 and rounded once into the format by [`Format::from_f64`].
+//!
+//! # Coordinates
+//! Each object is stored relative to its anchor, the centre of its bounding box (see
+//! [`SceneTrees`]), so its coordinates are as small as its size allows. The hardware's
+//! coordinates are the world's moved to [`LayoutInfo::origin`]: the eye when there is a top
+//! level (camera-relative, so the instance matrices of objects near the camera have small
+//! translations however far from the world origin the scene puts them), and the anchor of the
+//! only object when there is none (it has no instance matrix to move it). The instance
+//! matrices, the eye and the lights are stored in these coordinates; distances along rays do
+//! not change.
 
 mod build;
 
@@ -147,6 +157,9 @@ pub struct LayoutInfo {
     pub top_depth: u32,
     /// First global triangle index of every object (to report object-local indices).
     pub object_first_triangle: Vec<u32>,
+    /// World position of the hardware's coordinate origin: the only object's anchor when
+    /// there is no top level, else the eye.
+    pub origin: [f64; 3],
 }
 
 /// The banks' contents plus what the hardware is parameterized with.

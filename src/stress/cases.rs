@@ -150,18 +150,20 @@ fn run_golden(case: &RayCase, golden: &Golden) -> (u64, u64) {
     let l = golden.layout();
     let f = l.format;
     let inf = f.infinity(false);
+    // The cases' points are in the world; the layout's coordinates start at its origin.
+    let origin = DVec3::from_array(l.info.origin);
     let results: Vec<(u64, u64)> = case
         .rays
         .par_iter()
         .map(|&(o, d)| {
-            let (o, d) = (w3(f, o), w3(f, d));
+            let (o, d) = (w3(f, o - origin), w3(f, d));
             let primary = golden.trace_ray(o, d, 0, inf, None, false).hit;
             match &case.check {
                 Check::MustHit => (1, u64::from(primary.is_none())),
                 Check::ShadowAcne { light } => {
                     let Some(hit) = primary else { return (0, 0) };
                     let (p, n) = surface(golden, o, d, hit);
-                    let to_light = units::sub3(f, w3(f, *light), p);
+                    let to_light = units::sub3(f, w3(f, *light - origin), p);
                     if units::lambert_cosine(f, n, to_light).is_none() {
                         return (0, 0);
                     }
