@@ -181,6 +181,9 @@ fn mesh_subject(
     cfg: &SweepConfig,
     rng: &mut ChaCha8Rng,
 ) -> Result<Subject> {
+    // The scene text is parsed relative to `dir`, so it must name the mesh absolutely.
+    let path =
+        &std::path::absolute(path).with_context(|| format!("mesh path {}", path.display()))?;
     let tris = geometry::load_mesh(path)?;
     let (lo, hi) = geometry::bounds(&tris);
     let (c, s) = ((lo + hi) * 0.5, (hi - lo).max_element());
@@ -792,6 +795,23 @@ mod tests {
                 broken_hits: 1
             }
         );
+    }
+
+    #[test]
+    fn a_mesh_given_by_a_relative_path_is_framed() {
+        // Tests run in the crate root; the framed scene is parsed relative to a temp dir.
+        let dir = tempfile::tempdir().unwrap();
+        let c = SweepConfig::new(Path::new("scenes")).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let s = mesh_subject(
+            dir.path(),
+            Path::new("scenes/meshes/pyramid.obj"),
+            &c,
+            &mut rng,
+        )
+        .unwrap_or_else(|e| panic!("{e:#}"));
+        assert_eq!(s.name, "pyramid");
+        assert!(s.scene.triangle_count() > 0);
     }
 
     #[test]

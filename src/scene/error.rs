@@ -18,7 +18,7 @@ pub struct SceneError {
     pub file: PathBuf,
     pub line: Option<usize>,
     pub item: Option<String>,
-    #[source]
+    /// Not a `#[source]`: the display already says it, and an error chain would say it twice.
     pub problem: Problem,
 }
 
