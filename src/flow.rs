@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use crate::emit::constraints::{write_ucf, Port, PortDirection, UcfOptions};
-use crate::emit::processor::ProcessorParams;
+use crate::emit::processor::{ProcessorParams, PROCESSOR_TOP};
 use crate::emit::processor_run::{simulate_processor, write_processor_files, ProcessorSim};
 use crate::fp::Format;
 use crate::hw::engine::engine_period;
@@ -17,6 +17,7 @@ use crate::layout::{self, Layout, MemoryConfig, SceneTrees};
 use crate::model::{self, golden::Golden};
 use crate::scene::Scene;
 use crate::sim::Simulator;
+use crate::synth::{self, SynthOptions, SynthReport};
 
 /// The target clock of the paper's prototype (XC2V6000-4).
 pub const CLOCK_HZ: f64 = 90e6;
@@ -129,6 +130,23 @@ pub fn generate_rtl(
         predicted,
         period,
     })
+}
+
+/// Synthesizes the processor that `generate_rtl` or `simulate_scene` wrote into `out` with
+/// yosys for Virtex-II, out of context (no I/O pads: the ports go to the board's SRAMs and the
+/// host), into `out/synth/`. Takes minutes: the whole processor, flattened.
+pub fn synthesize_processor(out: &Path) -> Result<SynthReport> {
+    let rtl = out.join("rtl").join(format!("{PROCESSOR_TOP}.v"));
+    let options = SynthOptions {
+        io_pads: false,
+        ..SynthOptions::default()
+    };
+    Ok(synth::synth_xc2v_with(
+        &[rtl],
+        PROCESSOR_TOP,
+        &out.join("synth"),
+        &options,
+    )?)
 }
 
 /// One differing pixel, with what the golden model and the engine's twin computed for it.

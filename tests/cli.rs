@@ -181,3 +181,40 @@ fn bad_input_gets_one_clear_error_and_no_output_file() {
         assert!(!out.exists(), "{args:?} left an output file behind");
     }
 }
+
+/// `dynrt rtl --synth` writes the processor and yosys maps all of it to Virtex-II primitives:
+/// the register files and scratch to block RAMs, the mantissa product to a multiplier.
+#[test]
+fn rtl_with_synth_reports_the_processors_resources_against_the_device() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, out, err) = dynrt(&[
+        "rtl",
+        &scene("tiny.toml"),
+        "--threads",
+        "4",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--synth",
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
+    let count = |name: &str| -> u64 {
+        let at = out
+            .find(name)
+            .unwrap_or_else(|| panic!("no {name} in:\n{out}"));
+        out[at + name.len()..]
+            .split_whitespace()
+            .next()
+            .and_then(|w| w.parse().ok())
+            .unwrap_or_else(|| panic!("no count after {name} in:\n{out}"))
+    };
+    assert!(count("LUTs ") > 1000, "{out}");
+    assert!(count("FFs ") > 1000, "{out}");
+    assert_eq!(
+        count("MULT18X18 "),
+        1,
+        "a 17x17 mantissa product at e7m16: {out}"
+    );
+    assert!(count("RAMB16 ") >= 3, "{out}");
+    assert!(out.contains("XC2V6000: LUTs"), "{out}");
+    assert!(dir.path().join("synth").is_dir());
+}

@@ -57,32 +57,32 @@ fn check(name: &str, w: u32, h: u32, frames: Option<u32>, sim: Simulator) {
     assert_eq!(r.frames.len(), frames.unwrap_or(s.frames) as usize);
 }
 
-#[test]
-fn verilator_frames_equal_the_golden_model() {
-    for (name, w, h, frames) in [
-        ("cornell.toml", 16, 12, None),
-        ("mirror.toml", 16, 12, None),
-        ("tiny_animated.toml", 16, 12, Some(2)),
-        ("dynamic.toml", 12, 9, Some(2)),
-        ("terrain_small.toml", 16, 12, None),
-        ("cornell_noshadow.toml", 16, 12, None),
-    ] {
-        check(name, w, h, frames, Simulator::Verilator);
-    }
+/// One test per scene and simulator, so that the test harness spreads the simulations over the
+/// machine's cores.
+macro_rules! frames_equal_the_golden_model {
+    ($($test:ident: $sim:ident $name:literal $w:literal x $h:literal, frames $frames:expr;)*) => {
+        $(
+            #[test]
+            fn $test() {
+                check($name, $w, $h, $frames, Simulator::$sim);
+            }
+        )*
+    };
 }
 
-#[test]
-fn icarus_frames_equal_the_golden_model() {
-    for (name, w, h, frames) in [
-        // Icarus runs about 2k clocks per second here: two-pixel frames (a frame lasts as long as
-        // its slowest pixel times the 32-clock rotation, so more pixels cost little more).
-        ("cornell.toml", 2, 1, None),
-        ("mirror.toml", 2, 1, None),
-        ("tiny_animated.toml", 2, 1, Some(2)),
-        ("terrain_small.toml", 2, 1, None),
-    ] {
-        check(name, w, h, frames, Simulator::Icarus);
-    }
+frames_equal_the_golden_model! {
+    verilator_cornell: Verilator "cornell.toml" 16 x 12, frames None;
+    verilator_mirror: Verilator "mirror.toml" 16 x 12, frames None;
+    verilator_tiny_animated: Verilator "tiny_animated.toml" 16 x 12, frames Some(2);
+    verilator_dynamic: Verilator "dynamic.toml" 12 x 9, frames Some(2);
+    verilator_terrain_small: Verilator "terrain_small.toml" 16 x 12, frames None;
+    verilator_cornell_noshadow: Verilator "cornell_noshadow.toml" 16 x 12, frames None;
+    // Icarus runs about 2k clocks per second here: two-pixel frames (a frame lasts as long as
+    // its slowest pixel times the 32-clock rotation, so more pixels cost little more).
+    icarus_cornell: Icarus "cornell.toml" 2 x 1, frames None;
+    icarus_mirror: Icarus "mirror.toml" 2 x 1, frames None;
+    icarus_tiny_animated: Icarus "tiny_animated.toml" 2 x 1, frames Some(2);
+    icarus_terrain_small: Icarus "terrain_small.toml" 2 x 1, frames None;
 }
 
 #[test]

@@ -29,6 +29,10 @@ pub struct RtlArgs {
     pub width: Option<u32>,
     #[arg(long)]
     pub height: Option<u32>,
+    /// Also synthesize the processor with yosys (xc2v) and print its resources against an
+    /// XC2V6000 (takes minutes).
+    #[arg(long)]
+    pub synth: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -93,7 +97,15 @@ pub fn run_rtl(a: RtlArgs) -> anyhow::Result<i32> {
     for f in &r.files {
         println!("wrote {}", f.display());
     }
+    print_synthesis(&a)?;
     Ok(0)
+}
+
+fn print_synthesis(a: &RtlArgs) -> anyhow::Result<()> {
+    if a.synth {
+        println!("{}", flow::synthesize_processor(&a.out)?);
+    }
+    Ok(())
 }
 
 pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
@@ -148,6 +160,7 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         r.compile_seconds,
         r.run_seconds
     );
+    print_synthesis(&a.rtl)?;
     if r.identical() {
         println!("every pixel of every frame is identical");
         Ok(0)
