@@ -7,12 +7,13 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use crate::emit::constraints::{write_ucf, Port, PortDirection, UcfOptions};
-use crate::emit::processor::{ProcessorParams, PROCESSOR_TOP};
+use crate::emit::processor::{display_mode, ProcessorParams, PROCESSOR_TOP};
 use crate::emit::processor_run::{simulate_processor, write_processor_files, ProcessorSim};
 use crate::fp::Format;
 use crate::hw::engine::engine_period;
 use crate::hw::program::exec::{Machine, RunStats, Write};
 use crate::hw::program::{build_program, Program, ProgramConfig};
+use crate::hw::vga::VgaMode;
 use crate::layout::{self, Layout, MemoryConfig, SceneTrees};
 use crate::model::{self, golden::Golden};
 use crate::scene::Scene;
@@ -32,7 +33,7 @@ pub fn scene_layouts(scene: &Scene, f: Format, frames: Option<u32>) -> Result<Ve
 }
 
 /// The processor's top-level ports for the constraints file.
-pub fn processor_ports() -> Vec<Port> {
+pub fn processor_ports(display: &VgaMode) -> Vec<Port> {
     use PortDirection::{Input, Output};
     vec![
         Port::clock("clock", CLOCK_HZ),
@@ -47,6 +48,14 @@ pub fn processor_ports() -> Vec<Port> {
         Port::io("fb_write", 1, Output),
         Port::io("fb_addr", 24, Output),
         Port::io("fb_data", 32, Output),
+        Port::clock("vga_clock", display.pixel_clock_hz as f64),
+        Port::io("vga_reset", 1, Input),
+        Port::io("vga_fb_addr", 24, Output),
+        Port::io("vga_fb_data", 32, Input),
+        Port::io("vga_hsync", 1, Output),
+        Port::io("vga_vsync", 1, Output),
+        Port::io("vga_rgb", 24, Output),
+        Port::io("vga_frame_start", 1, Output),
     ]
 }
 
@@ -120,7 +129,9 @@ pub fn generate_rtl(
     )?;
     let ucf = out.join("constraints").join("dynrt.ucf");
     std::fs::create_dir_all(ucf.parent().unwrap())?;
-    write_ucf(&ucf, &processor_ports(), &UcfOptions::default())?;
+    let info = &layouts[0].info;
+    let display = display_mode(info.width, info.height)?;
+    write_ucf(&ucf, &processor_ports(&display), &UcfOptions::default())?;
     let listing = out.join("program.lst");
     crate::output::write_atomically(&listing, program.listing().as_bytes())?;
     Ok(RtlReport {

@@ -109,3 +109,59 @@ fn a_frame_that_cannot_finish_in_time_is_a_clear_timeout_error() {
         "{msg}"
     );
 }
+
+/// The display (VgaDisplay in the processor's top) sends the rendered frame to the monitor:
+/// 640x480 at 60 Hz, each of the 20x12 pixels magnified to 32x32 and centred, black around
+/// it, colour aligned with the raster to the pixel. Verilator only: a VGA frame is 420,000
+/// pixel clocks (the timing generator alone is checked in Icarus too, in `emit::vga_timing`).
+#[test]
+fn the_display_shows_the_rendered_frame_magnified_and_centred() {
+    use dynrt::emit::processor_run::simulate_processor_with;
+    use dynrt::hw::program::{build_program, ProgramConfig};
+    use dynrt::hw::VgaMode;
+    let (w, h) = (20, 12);
+    let s = scene("cornell_noshadow.toml", w, h);
+    let layouts = flow::scene_layouts(&s, Format::E7M16, None).unwrap();
+    let p = build_program(&ProgramConfig::from_layout(Format::E7M16, &layouts[0].info));
+    let dir = tempfile::tempdir().unwrap();
+    let r = simulate_processor_with(
+        &p,
+        &layouts,
+        ProcessorParams::default(),
+        "cornell_noshadow",
+        20_000_000,
+        Simulator::Verilator,
+        dir.path(),
+        true,
+    )
+    .unwrap_or_else(|e| panic!("{e:#}"));
+    let fb = &r.frames.last().unwrap().pixels;
+    let mode = VgaMode::VGA_640X480_60;
+    let place = mode.fit(w, h).unwrap();
+    assert_eq!((place.scale, place.x0, place.y0), (32, 0, 48));
+    let vga = r.vga.expect("a display capture");
+    let (sw, sh) = (mode.h_visible, mode.v_visible);
+    assert_eq!(vga.len(), (sw * sh) as usize);
+    let mut wrong = Vec::new();
+    for y in 0..sh {
+        for x in 0..sw {
+            let inside = (place.x0..place.x0 + place.width).contains(&x)
+                && (place.y0..place.y0 + place.height).contains(&y);
+            let want = if inside {
+                let (fx, fy) = ((x - place.x0) / place.scale, (y - place.y0) / place.scale);
+                fb[(fy * w + fx) as usize]
+            } else {
+                0
+            };
+            let got = vga[(y * sw + x) as usize];
+            if got != want && wrong.len() < 5 {
+                wrong.push((x, y, got, want));
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "(x, y, shown, frame buffer): {wrong:x?}");
+    assert!(
+        fb.iter().filter(|&&c| c != 0).count() > fb.len() / 2,
+        "the frame is not black"
+    );
+}

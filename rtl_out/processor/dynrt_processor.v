@@ -2,6 +2,7 @@
 // Format e7m16, 64x48 pixels, 32 threads, SRAM read latency 2 clocks, 333 instructions of microprogram.
 // Left out: top-level traversal, instance mailbox and instance transforms (one untransformed object).
 // Left out: mirror rays and the mirror chain (reflection_depth = 0).
+// Display: 640x480 at 25.18 MHz pixel clock (vga_clock), frame buffer shown from word 46.
 
 /* verilator lint_off WIDTH */
 /* verilator lint_off DECLFILENAME */
@@ -10922,6 +10923,512 @@ endmodule // dynrt_processor_core__t1
 
 
 
+
+
+module dynrt_processor_vga(clock,reset,fb_addr,fb_data,hsync,vsync,rgb,frame_start);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    output reg  [23:0] fb_addr;
+    input wire  [31:0] fb_data;
+    output reg  hsync;
+    output reg  vsync;
+    output reg  [23:0] rgb;
+    output reg  frame_start;
+    
+    // Stub signals
+    reg  timing__clock;
+    reg  timing__reset;
+    wire  timing__hsync;
+    wire  timing__vsync;
+    wire  timing__blank;
+    wire  timing__border;
+    wire  [11:0] timing__x;
+    wire  [11:0] timing__y;
+    wire  [23:0] timing__fb_addr;
+    wire  timing__frame_start;
+    reg  hsync_d__d;
+    wire  hsync_d__q;
+    reg  hsync_d__clock;
+    reg  vsync_d__d;
+    wire  vsync_d__q;
+    reg  vsync_d__clock;
+    reg  dark_d__d;
+    wire  dark_d__q;
+    reg  dark_d__clock;
+    reg  start_d__d;
+    wire  start_d__q;
+    reg  start_d__clock;
+    reg  hsync_q__d;
+    wire  hsync_q__q;
+    reg  hsync_q__clock;
+    reg  vsync_q__d;
+    wire  vsync_q__q;
+    reg  vsync_q__clock;
+    reg  start_q__d;
+    wire  start_q__q;
+    reg  start_q__clock;
+    reg  [23:0] rgb_q__d;
+    wire  [23:0] rgb_q__q;
+    reg  rgb_q__clock;
+    
+    // Sub module instances
+    dynrt_processor_vga__timing timing(
+        .clock(timing__clock),
+        .reset(timing__reset),
+        .hsync(timing__hsync),
+        .vsync(timing__vsync),
+        .blank(timing__blank),
+        .border(timing__border),
+        .x(timing__x),
+        .y(timing__y),
+        .fb_addr(timing__fb_addr),
+        .frame_start(timing__frame_start)
+    );
+    dynrt_processor_vga__dark_d hsync_d(
+        .d(hsync_d__d),
+        .q(hsync_d__q),
+        .clock(hsync_d__clock)
+    );
+    dynrt_processor_vga__dark_d vsync_d(
+        .d(vsync_d__d),
+        .q(vsync_d__q),
+        .clock(vsync_d__clock)
+    );
+    dynrt_processor_vga__dark_d dark_d(
+        .d(dark_d__d),
+        .q(dark_d__q),
+        .clock(dark_d__clock)
+    );
+    dynrt_processor_vga__dark_d start_d(
+        .d(start_d__d),
+        .q(start_d__q),
+        .clock(start_d__clock)
+    );
+    dynrt_processor_vga__dark_d hsync_q(
+        .d(hsync_q__d),
+        .q(hsync_q__q),
+        .clock(hsync_q__clock)
+    );
+    dynrt_processor_vga__dark_d vsync_q(
+        .d(vsync_q__d),
+        .q(vsync_q__q),
+        .clock(vsync_q__clock)
+    );
+    dynrt_processor_vga__dark_d start_q(
+        .d(start_q__d),
+        .q(start_q__q),
+        .clock(start_q__clock)
+    );
+    dynrt_processor_vga__rgb_q rgb_q(
+        .d(rgb_q__d),
+        .q(rgb_q__q),
+        .clock(rgb_q__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        hsync_d__clock = clock;
+        vsync_d__clock = clock;
+        dark_d__clock = clock;
+        start_d__clock = clock;
+        hsync_q__clock = clock;
+        vsync_q__clock = clock;
+        start_q__clock = clock;
+        rgb_q__clock = clock;
+        hsync_d__d = hsync_d__q;
+        vsync_d__d = vsync_d__q;
+        dark_d__d = dark_d__q;
+        start_d__d = start_d__q;
+        hsync_q__d = hsync_q__q;
+        vsync_q__d = vsync_q__q;
+        start_q__d = start_q__q;
+        rgb_q__d = rgb_q__q;
+        timing__clock = clock;
+        timing__reset = reset;
+        fb_addr = timing__fb_addr;
+        hsync_d__d = timing__hsync;
+        vsync_d__d = timing__vsync;
+        dark_d__d = timing__blank | timing__border;
+        start_d__d = timing__frame_start;
+        hsync_q__d = hsync_d__q;
+        vsync_q__d = vsync_d__q;
+        start_q__d = start_d__q;
+        if (dark_d__q) begin
+            rgb_q__d = 32'h0;
+        end
+        else begin
+            rgb_q__d = fb_data[(32'h0)+:(24)];
+        end
+        hsync = hsync_q__q;
+        vsync = vsync_q__q;
+        frame_start = start_q__q;
+        rgb = rgb_q__q;
+    end
+    
+endmodule // dynrt_processor_vga
+
+
+module dynrt_processor_vga__dark_d(d,q,clock);
+    
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor_vga__dark_d
+
+
+
+
+
+
+module dynrt_processor_vga__rgb_q(d,q,clock);
+    
+    // Module arguments
+    input wire  [23:0] d;
+    output reg  [23:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 24'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor_vga__rgb_q
+
+
+
+
+
+
+module dynrt_processor_vga__timing(clock,reset,hsync,vsync,blank,border,x,y,fb_addr,frame_start);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    output reg  hsync;
+    output reg  vsync;
+    output reg  blank;
+    output reg  border;
+    output reg  [11:0] x;
+    output reg  [11:0] y;
+    output reg  [23:0] fb_addr;
+    output reg  frame_start;
+    
+    // Constant declarations
+    localparam  c_h_last = 12'h31f;
+    localparam  c_v_last = 12'h20c;
+    localparam  c_h_visible = 12'h280;
+    localparam  c_v_visible = 12'h1e0;
+    localparam  c_hs_start = 12'h290;
+    localparam  c_hs_end = 12'h2f0;
+    localparam  c_vs_start = 12'h1ea;
+    localparam  c_vs_end = 12'h1ec;
+    localparam  c_x0 = 12'h0;
+    localparam  c_x1 = 12'h280;
+    localparam  c_y0 = 12'h0;
+    localparam  c_y1 = 12'h1e0;
+    localparam  c_rep_last = 12'h9;
+    localparam  c_fb_width = 24'h40;
+    localparam  c_fb_base = 24'h2e;
+    localparam  c_hs_negative = 1'b1;
+    localparam  c_vs_negative = 1'b1;
+    
+    // Stub signals
+    reg  [11:0] h__d;
+    wire  [11:0] h__q;
+    reg  h__clock;
+    reg  [11:0] v__d;
+    wire  [11:0] v__q;
+    reg  v__clock;
+    reg  [11:0] col__d;
+    wire  [11:0] col__q;
+    reg  col__clock;
+    reg  [11:0] hrep__d;
+    wire  [11:0] hrep__q;
+    reg  hrep__clock;
+    reg  [11:0] vrep__d;
+    wire  [11:0] vrep__q;
+    reg  vrep__clock;
+    reg  [23:0] row_base__d;
+    wire  [23:0] row_base__q;
+    reg  row_base__clock;
+    reg  hsync_q__d;
+    wire  hsync_q__q;
+    reg  hsync_q__clock;
+    reg  vsync_q__d;
+    wire  vsync_q__q;
+    reg  vsync_q__clock;
+    reg  blank_q__d;
+    wire  blank_q__q;
+    reg  blank_q__clock;
+    reg  border_q__d;
+    wire  border_q__q;
+    reg  border_q__clock;
+    reg  start_q__d;
+    wire  start_q__q;
+    reg  start_q__clock;
+    reg  [11:0] x_q__d;
+    wire  [11:0] x_q__q;
+    reg  x_q__clock;
+    reg  [11:0] y_q__d;
+    wire  [11:0] y_q__q;
+    reg  y_q__clock;
+    reg  [23:0] addr_q__d;
+    wire  [23:0] addr_q__q;
+    reg  addr_q__clock;
+    
+    // Local signals
+    reg  line_end;
+    reg  in_x;
+    reg  in_y;
+    reg  visible;
+    reg  hs_active;
+    reg  vs_active;
+    
+    // Sub module instances
+    dynrt_processor_vga__timing__col h(
+        .d(h__d),
+        .q(h__q),
+        .clock(h__clock)
+    );
+    dynrt_processor_vga__timing__col v(
+        .d(v__d),
+        .q(v__q),
+        .clock(v__clock)
+    );
+    dynrt_processor_vga__timing__col col(
+        .d(col__d),
+        .q(col__q),
+        .clock(col__clock)
+    );
+    dynrt_processor_vga__timing__col hrep(
+        .d(hrep__d),
+        .q(hrep__q),
+        .clock(hrep__clock)
+    );
+    dynrt_processor_vga__timing__col vrep(
+        .d(vrep__d),
+        .q(vrep__q),
+        .clock(vrep__clock)
+    );
+    dynrt_processor_vga__rgb_q row_base(
+        .d(row_base__d),
+        .q(row_base__q),
+        .clock(row_base__clock)
+    );
+    dynrt_processor_vga__dark_d hsync_q(
+        .d(hsync_q__d),
+        .q(hsync_q__q),
+        .clock(hsync_q__clock)
+    );
+    dynrt_processor_vga__dark_d vsync_q(
+        .d(vsync_q__d),
+        .q(vsync_q__q),
+        .clock(vsync_q__clock)
+    );
+    dynrt_processor_vga__dark_d blank_q(
+        .d(blank_q__d),
+        .q(blank_q__q),
+        .clock(blank_q__clock)
+    );
+    dynrt_processor_vga__dark_d border_q(
+        .d(border_q__d),
+        .q(border_q__q),
+        .clock(border_q__clock)
+    );
+    dynrt_processor_vga__dark_d start_q(
+        .d(start_q__d),
+        .q(start_q__q),
+        .clock(start_q__clock)
+    );
+    dynrt_processor_vga__timing__col x_q(
+        .d(x_q__d),
+        .q(x_q__q),
+        .clock(x_q__clock)
+    );
+    dynrt_processor_vga__timing__col y_q(
+        .d(y_q__d),
+        .q(y_q__q),
+        .clock(y_q__clock)
+    );
+    dynrt_processor_vga__rgb_q addr_q(
+        .d(addr_q__d),
+        .q(addr_q__q),
+        .clock(addr_q__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        h__clock = clock;
+        v__clock = clock;
+        col__clock = clock;
+        hrep__clock = clock;
+        vrep__clock = clock;
+        row_base__clock = clock;
+        hsync_q__clock = clock;
+        vsync_q__clock = clock;
+        blank_q__clock = clock;
+        border_q__clock = clock;
+        start_q__clock = clock;
+        x_q__clock = clock;
+        y_q__clock = clock;
+        addr_q__clock = clock;
+        h__d = h__q;
+        v__d = v__q;
+        col__d = col__q;
+        hrep__d = hrep__q;
+        vrep__d = vrep__q;
+        row_base__d = row_base__q;
+        hsync_q__d = hsync_q__q;
+        vsync_q__d = vsync_q__q;
+        blank_q__d = blank_q__q;
+        border_q__d = border_q__q;
+        start_q__d = start_q__q;
+        x_q__d = x_q__q;
+        y_q__d = y_q__q;
+        addr_q__d = addr_q__q;
+        line_end = h__q == c_h_last;
+        in_x = (h__q >= c_x0) & (h__q < c_x1);
+        in_y = (v__q >= c_y0) & (v__q < c_y1);
+        visible = (h__q < c_h_visible) & (v__q < c_v_visible);
+        hs_active = (h__q >= c_hs_start) & (h__q < c_hs_end);
+        vs_active = (v__q >= c_vs_start) & (v__q < c_vs_end);
+        hsync_q__d = hs_active ^ c_hs_negative;
+        vsync_q__d = vs_active ^ c_vs_negative;
+        blank_q__d = ~visible;
+        border_q__d = visible & ~(in_x & in_y);
+        start_q__d = (h__q == 32'h0) & (v__q == 32'h0);
+        x_q__d = h__q;
+        y_q__d = v__q;
+        if (in_x & in_y) begin
+            addr_q__d = row_base__q + ((col__q) & 24'hffffff);
+        end
+        else begin
+            addr_q__d = c_fb_base;
+        end
+        if (line_end) begin
+            h__d = 32'h0;
+            if (v__q == c_v_last) begin
+                v__d = 32'h0;
+            end
+            else begin
+                v__d = v__q + 32'h1;
+            end
+            if (in_y) begin
+                if (vrep__q == c_rep_last) begin
+                    vrep__d = 32'h0;
+                    row_base__d = row_base__q + c_fb_width;
+                end
+                else begin
+                    vrep__d = vrep__q + 32'h1;
+                end
+            end
+            else begin
+                vrep__d = 32'h0;
+                row_base__d = c_fb_base;
+            end
+        end
+        else begin
+            h__d = h__q + 32'h1;
+        end
+        if (in_x) begin
+            if (hrep__q == c_rep_last) begin
+                hrep__d = 32'h0;
+                col__d = col__q + 32'h1;
+            end
+            else begin
+                hrep__d = hrep__q + 32'h1;
+            end
+        end
+        else begin
+            hrep__d = 32'h0;
+            col__d = 32'h0;
+        end
+        if (reset) begin
+            h__d = 32'h0;
+            v__d = 32'h0;
+            col__d = 32'h0;
+            hrep__d = 32'h0;
+            vrep__d = 32'h0;
+            row_base__d = c_fb_base;
+        end
+        hsync = hsync_q__q;
+        vsync = vsync_q__q;
+        blank = blank_q__q;
+        border = border_q__q;
+        frame_start = start_q__q;
+        x = x_q__q;
+        y = y_q__q;
+        fb_addr = addr_q__q;
+    end
+    
+endmodule // dynrt_processor_vga__timing
+
+
+
+
+
+
+
+
+module dynrt_processor_vga__timing__col(d,q,clock);
+    
+    // Module arguments
+    input wire  [11:0] d;
+    output reg  [11:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 12'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor_vga__timing__col
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 /* verilator lint_on UNUSEDSIGNAL */
 /* verilator lint_on DECLFILENAME */
 /* verilator lint_on WIDTH */
@@ -10937,7 +11444,15 @@ module dynrt_processor(
     input wire [31:0] mem_rdata,
     output wire fb_write,
     output wire [23:0] fb_addr,
-    output wire [31:0] fb_data
+    output wire [31:0] fb_data,
+    input wire vga_clock,
+    input wire vga_reset,
+    output wire [23:0] vga_fb_addr,
+    input wire [31:0] vga_fb_data,
+    output wire vga_hsync,
+    output wire vga_vsync,
+    output wire [23:0] vga_rgb,
+    output wire vga_frame_start
 );
     dynrt_processor_core core(
         .clock(clock),
@@ -10952,5 +11467,15 @@ module dynrt_processor(
         .fb_write(fb_write),
         .fb_addr(fb_addr),
         .fb_data(fb_data)
+    );
+    dynrt_processor_vga display(
+        .clock(vga_clock),
+        .reset(vga_reset),
+        .fb_addr(vga_fb_addr),
+        .fb_data(vga_fb_data),
+        .hsync(vga_hsync),
+        .vsync(vga_vsync),
+        .rgb(vga_rgb),
+        .frame_start(vga_frame_start)
     );
 endmodule

@@ -22,6 +22,8 @@ use super::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
 use crate::fp::Format;
 use crate::hw::engine::ThreadEngine;
 use crate::hw::program::Program;
+use crate::hw::vga::VgaMode;
+use crate::hw::VgaDisplay;
 use crate::layout::BANK_NAMES;
 
 /// The name of the processor's top module.
@@ -96,7 +98,8 @@ impl Default for ProcessorParams {
     }
 }
 
-const PORTS: [(&str, bool, u32); 12] = [
+/// The top module's ports: (name, output, width).
+const PORTS: [(&str, bool, u32); 20] = [
     ("clock", false, 1),
     ("start", false, 1),
     ("done", true, 1),
@@ -109,7 +112,32 @@ const PORTS: [(&str, bool, u32); 12] = [
     ("fb_write", true, 1),
     ("fb_addr", true, 24),
     ("fb_data", true, 32),
+    ("vga_clock", false, 1),
+    ("vga_reset", false, 1),
+    ("vga_fb_addr", true, 24),
+    ("vga_fb_data", false, 32),
+    ("vga_hsync", true, 1),
+    ("vga_vsync", true, 1),
+    ("vga_rgb", true, 24),
+    ("vga_frame_start", true, 1),
 ];
+
+/// Ports of the engine core (the first 12) and of the display (the `vga_` ones, which the
+/// display module names without the prefix).
+const CORE_PORTS: usize = 12;
+
+/// The video mode the processor's display uses for a `width x height` frame: 640x480 at 60 Hz
+/// when the frame fits, else 1024x768.
+pub fn display_mode(width: u32, height: u32) -> Result<VgaMode> {
+    for mode in [VgaMode::VGA_640X480_60, VgaMode::XGA_1024X768_60] {
+        if mode.fit(width, height).is_ok() {
+            return Ok(mode);
+        }
+    }
+    anyhow::bail!(
+        "a {width}x{height} frame is larger than the largest VGA mode the display drives          (1024x768); render at most 1024x768"
+    )
+}
 
 /// The processor's Verilog (one file, top module [`PROCESSOR_TOP`]).
 pub fn processor_rtl(
@@ -142,6 +170,15 @@ pub fn processor_rtl(
     )?;
     let core_name = format!("{PROCESSOR_TOP}_core");
     let core = merge_identical_modules(&rename_rust_hdl_names(&core, &core_name));
+    let c = &program.config;
+    let mode = display_mode(c.width, c.height)?;
+    let mut display = VgaDisplay::new(&mode, c.width, c.height, c.frame_buffer)?;
+    display.connect_all();
+    let display_name = format!("{PROCESSOR_TOP}_vga");
+    let display = merge_identical_modules(&rename_rust_hdl_names(
+        &generate_verilog(&display),
+        &display_name,
+    ));
     let decls = PORTS
         .iter()
         .map(|(name, out, w)| {
@@ -155,12 +192,17 @@ pub fn processor_rtl(
         })
         .collect::<Vec<_>>()
         .join(",\n");
-    let conns = PORTS
-        .iter()
-        .map(|(name, _, _)| format!(".{name}({name})"))
-        .collect::<Vec<_>>()
-        .join(",\n        ");
-    let c = &program.config;
+    let conns = |ports: &[(&str, bool, u32)], strip: &str| {
+        ports
+            .iter()
+            .map(|(name, _, _)| format!(".{}({name})", name.trim_start_matches(strip)))
+            .collect::<Vec<_>>()
+            .join(",\n        ")
+    };
+    let (core_conns, display_conns) = (
+        conns(&PORTS[..CORE_PORTS], ""),
+        conns(&PORTS[CORE_PORTS..], "vga_"),
+    );
     let mut header = String::new();
     writeln!(
         header,
@@ -176,11 +218,20 @@ pub fn processor_rtl(
     for l in &program.left_out {
         writeln!(header, "// Left out: {l}.")?;
     }
+    writeln!(
+        header,
+        "// Display: {}x{} at {:.2} MHz pixel clock (vga_clock), frame buffer shown from word {}.",
+        mode.h_visible,
+        mode.v_visible,
+        mode.pixel_clock_hz as f64 / 1e6,
+        c.frame_buffer
+    )?;
     Ok(format!(
         "{header}\n/* verilator lint_off WIDTH */\n/* verilator lint_off DECLFILENAME */\n\
-         /* verilator lint_off UNUSEDSIGNAL */\n{core}\n/* verilator lint_on UNUSEDSIGNAL */\n\
+         /* verilator lint_off UNUSEDSIGNAL */\n{core}\n{display}\n/* verilator lint_on UNUSEDSIGNAL */\n\
          /* verilator lint_on DECLFILENAME */\n/* verilator lint_on WIDTH */\n\
-         module {PROCESSOR_TOP}(\n{decls}\n);\n    {core_name} core(\n        {conns}\n    );\nendmodule\n"
+         module {PROCESSOR_TOP}(\n{decls}\n);\n    {core_name} core(\n        {core_conns}\n    );\n\
+         \x20   {display_name} display(\n        {display_conns}\n    );\nendmodule\n"
     ))
 }
 
@@ -194,6 +245,8 @@ pub struct TestbenchFrames {
     pub frame_buffer: u32,
     pub pixels: u32,
     pub cycle_limit: u64,
+    /// The display's video mode.
+    pub vga: VgaMode,
 }
 
 /// The frame testbench (module `tb`).
@@ -206,7 +259,10 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
          `timescale 1ns/1ps\nmodule tb;\n  reg clock = 1'b0;\n  reg start = 1'b0;\n  wire done;\n\
          \x20 wire [31:0] cycles, instructions;\n  wire mem_read;\n  wire [2:0] mem_bank;\n\
          \x20 wire [23:0] mem_addr;\n  wire [31:0] mem_rdata;\n  wire fb_write;\n\
-         \x20 wire [23:0] fb_addr;\n  wire [31:0] fb_data;",
+         \x20 wire [23:0] fb_addr;\n  wire [31:0] fb_data;\n\
+         \x20 reg vga_clock = 1'b0;\n  reg vga_reset = 1'b1;\n  wire [23:0] vga_fb_addr, vga_rgb;\n\
+         \x20 reg [31:0] vga_fb_data = 32'd0;\n  wire vga_hsync, vga_vsync, vga_frame_start;\n\
+         \x20 integer px;",
         frames.updates.len() + 1
     );
     for (b, name) in BANK_NAMES.iter().enumerate() {
@@ -226,7 +282,15 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
         "  {PROCESSOR_TOP} dut(.clock(clock), .start(start), .done(done), .cycles(cycles),\n\
          \x20   .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank),\n\
          \x20   .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write),\n\
-         \x20   .fb_addr(fb_addr), .fb_data(fb_data));\n  always #5 clock = ~clock;\n\
+         \x20   .fb_addr(fb_addr), .fb_data(fb_data), .vga_clock(vga_clock), .vga_reset(vga_reset),\n\
+         \x20   .vga_fb_addr(vga_fb_addr), .vga_fb_data(vga_fb_data), .vga_hsync(vga_hsync),\n\
+         \x20   .vga_vsync(vga_vsync), .vga_rgb(vga_rgb), .vga_frame_start(vga_frame_start));\n\
+         \x20 always #5 clock = ~clock;\n\
+         \x20 // The display's pixel clock (25 MHz against the core's 100 MHz here) and its read port\n\
+         \x20 // on the frame bank, one clock of latency.\n\
+         \x20 always #20 vga_clock = ~vga_clock;\n\
+         \x20 initial begin repeat (3) @(posedge vga_clock); vga_reset = 1'b0; end\n\
+         \x20 always @(posedge vga_clock) vga_fb_data <= bank5[vga_fb_addr];\n\
          \x20 // SRAM banks: the word read arrives {ml} clock(s) after the request.\n\
          \x20 always @(*) begin\n    case (mem_bank)"
     );
@@ -270,6 +334,20 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
             fb = frames.frame_buffer,
         );
     }
+    // With +vga: the next whole frame the display sends after the last rendered frame, the
+    // visible pixels' colours sampled between pixel clocks (raster order).
+    let _ = writeln!(
+        v,
+        "    if ($test$plusargs(\"vga\")) begin\n      @(posedge vga_frame_start);\n\
+         \x20     fd = $fopen(\"vga.hex\", \"w\");\n\
+         \x20     for (px = 0; px < {h} * {vv}; px = px + 1) begin\n\
+         \x20       @(negedge vga_clock);\n\
+         \x20       if (px % {h} < {hv}) $fwrite(fd, \"%06h\\n\", vga_rgb);\n      end\n\
+         \x20     $fclose(fd);\n    end",
+        h = frames.vga.h_total(),
+        hv = frames.vga.h_visible,
+        vv = frames.vga.v_visible,
+    );
     let _ = writeln!(v, "    $finish;\n  end\nendmodule");
     v
 }

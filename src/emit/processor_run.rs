@@ -8,7 +8,9 @@ use std::time::Duration;
 use anyhow::{bail, Context, Result};
 
 use super::memory_images::{write_frame_update, write_memory_images};
-use super::processor::{processor_rtl, processor_testbench, ProcessorParams, TestbenchFrames};
+use super::processor::{
+    display_mode, processor_rtl, processor_testbench, ProcessorParams, TestbenchFrames,
+};
 use crate::hw::program::Program;
 use crate::layout::Layout;
 use crate::output::write_atomically;
@@ -30,6 +32,9 @@ pub struct ProcessorSim {
     pub compile_seconds: f64,
     pub run_seconds: f64,
     pub tool_version: String,
+    /// With `capture_vga`: the visible pixels of the display's next frame after the last
+    /// rendered one, `0xRRGGBB` in raster order.
+    pub vga: Option<Vec<u32>>,
 }
 
 /// Writes everything a simulation of `layouts` (frame 0, 1, ...) needs into `dir`: the
@@ -82,6 +87,7 @@ pub fn write_processor_files(
         frame_buffer: first.info.frame_buffer,
         pixels: first.info.width * first.info.height,
         cycle_limit,
+        vga: display_mode(first.info.width, first.info.height)?,
     };
     let tb_path = tb_dir.join("tb.v");
     write_atomically(&tb_path, processor_testbench(params, &frames).as_bytes())?;
@@ -98,13 +104,43 @@ pub fn simulate_processor(
     sim: Simulator,
     dir: &Path,
 ) -> Result<ProcessorSim> {
+    simulate_processor_with(
+        program,
+        layouts,
+        params,
+        scene_name,
+        cycle_limit,
+        sim,
+        dir,
+        false,
+    )
+}
+
+/// [`simulate_processor`], and with `capture_vga` also one frame of the display's output
+/// after the last rendered frame (about 420,000 pixel clocks: minutes in Icarus).
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_processor_with(
+    program: &Program,
+    layouts: &[Layout],
+    params: ProcessorParams,
+    scene_name: &str,
+    cycle_limit: u64,
+    sim: Simulator,
+    dir: &Path,
+    capture_vga: bool,
+) -> Result<ProcessorSim> {
     let (rtl, tb) = write_processor_files(program, layouts, params, scene_name, cycle_limit, dir)?;
     for k in 0..layouts.len() {
         let _ = std::fs::remove_file(dir.join(format!("frame{k}.hex")));
     }
-    let job = SimJob::new(dir, vec![rtl, tb], "tb")
+    let vga_path = dir.join("vga.hex");
+    let _ = std::fs::remove_file(&vga_path);
+    let mut job = SimJob::new(dir, vec![rtl, tb], "tb")
         .timeout(Duration::from_secs(3600))
         .verilator_build(VerilatorBuild::Fast);
+    if capture_vga {
+        job = job.plusarg("vga");
+    }
     let timeout = |detail: &str| {
         anyhow::anyhow!(
             "{}: the processor did not finish a frame within {cycle_limit} clocks (the \
@@ -135,19 +171,7 @@ pub fn simulate_processor(
                 out.trim()
             )
         })?;
-        let px: Vec<u32> = text
-            .lines()
-            .enumerate()
-            .map(|(i, l)| {
-                u32::from_str_radix(l.trim(), 16).with_context(|| {
-                    format!(
-                        "{} line {}: `{l}` is not a hex word (X in the frame buffer?)",
-                        hex.display(),
-                        i + 1
-                    )
-                })
-            })
-            .collect::<Result<_>>()?;
+        let px = parse_hex_words(&text, &hex)?;
         if px.len() != pixels {
             bail!("{}: {} pixels, expected {pixels}", hex.display(), px.len());
         }
@@ -171,10 +195,50 @@ pub fn simulate_processor(
             instructions: nums[1],
         });
     }
+    let vga = if capture_vga {
+        let mode = display_mode(layouts[0].info.width, layouts[0].info.height)?;
+        let text = std::fs::read_to_string(&vga_path).with_context(|| {
+            format!(
+                "{}: no display capture {} (simulator output:\n{})",
+                sim.name(),
+                vga_path.display(),
+                out.trim()
+            )
+        })?;
+        let px = parse_hex_words(&text, &vga_path)?;
+        let want = (mode.h_visible * mode.v_visible) as usize;
+        if px.len() != want {
+            bail!(
+                "{}: {} pixels, expected {want}",
+                vga_path.display(),
+                px.len()
+            );
+        }
+        Some(px)
+    } else {
+        None
+    };
     Ok(ProcessorSim {
         frames,
+        vga,
         compile_seconds: run.compile_seconds,
         run_seconds: run.run_seconds,
         tool_version: sim::tool_version(sim).unwrap_or_default(),
     })
+}
+
+/// One hex word a line, as the testbench writes its dumps.
+fn parse_hex_words(text: &str, path: &Path) -> Result<Vec<u32>> {
+    text.lines()
+        .enumerate()
+        .map(|(i, l)| {
+            u32::from_str_radix(l.trim(), 16).with_context(|| {
+                format!(
+                    "{} line {}: `{l}` is not a hex word (X in the frame buffer?)",
+                    path.display(),
+                    i + 1
+                )
+            })
+        })
+        .collect()
 }

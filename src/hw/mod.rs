@@ -7,9 +7,11 @@
 //! client of the transform unit.
 //!
 //! Display: [`VgaTiming`], the VGA sync and frame-buffer address generator in the pixel clock
-//! domain (modes [`VgaMode::VGA_640X480_60`], [`VgaMode::XGA_1024X768_60`]).
+//! domain (modes [`VgaMode::VGA_640X480_60`], [`VgaMode::XGA_1024X768_60`]), and
+//! [`VgaDisplay`], which reads the frame buffer with it and drives the monitor.
 
 pub mod delay;
+pub mod display;
 pub mod engine;
 pub mod fp;
 pub mod geometry_formats;
@@ -23,6 +25,7 @@ pub mod transform_arbiter;
 pub mod vga;
 
 pub use delay::Delay;
+pub use display::VgaDisplay;
 pub use int_to_float::UIntToFloat;
 pub use intersect::{intersect_latency, IntersectUnit};
 pub use raygen::{RayGen, RayGenUnit};

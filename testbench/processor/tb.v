@@ -12,6 +12,12 @@ module tb;
   wire fb_write;
   wire [23:0] fb_addr;
   wire [31:0] fb_data;
+  reg vga_clock = 1'b0;
+  reg vga_reset = 1'b1;
+  wire [23:0] vga_fb_addr, vga_rgb;
+  reg [31:0] vga_fb_data = 32'd0;
+  wire vga_hsync, vga_vsync, vga_frame_start;
+  integer px;
   reg [31:0] bank0 [0:233]; // nodes
   reg [31:0] bank1 [0:177]; // lists
   reg [31:0] bank2 [0:239]; // triangles_uv
@@ -25,8 +31,15 @@ module tb;
   dynrt_processor dut(.clock(clock), .start(start), .done(done), .cycles(cycles),
     .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank),
     .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write),
-    .fb_addr(fb_addr), .fb_data(fb_data));
+    .fb_addr(fb_addr), .fb_data(fb_data), .vga_clock(vga_clock), .vga_reset(vga_reset),
+    .vga_fb_addr(vga_fb_addr), .vga_fb_data(vga_fb_data), .vga_hsync(vga_hsync),
+    .vga_vsync(vga_vsync), .vga_rgb(vga_rgb), .vga_frame_start(vga_frame_start));
   always #5 clock = ~clock;
+  // The display's pixel clock (25 MHz against the core's 100 MHz here) and its read port
+  // on the frame bank, one clock of latency.
+  always #20 vga_clock = ~vga_clock;
+  initial begin repeat (3) @(posedge vga_clock); vga_reset = 1'b0; end
+  always @(posedge vga_clock) vga_fb_data <= bank5[vga_fb_addr];
   // SRAM banks: the word read arrives 2 clock(s) after the request.
   always @(*) begin
     case (mem_bank)
@@ -67,6 +80,15 @@ module tb;
     $fwrite(fd, "%0d %0d\n", cycles, instructions);
     $fclose(fd);
     $display("frame 0: %0d cycles, %0d instructions", cycles, instructions);
+    if ($test$plusargs("vga")) begin
+      @(posedge vga_frame_start);
+      fd = $fopen("vga.hex", "w");
+      for (px = 0; px < 800 * 480; px = px + 1) begin
+        @(negedge vga_clock);
+        if (px % 800 < 640) $fwrite(fd, "%06h\n", vga_rgb);
+      end
+      $fclose(fd);
+    end
     $finish;
   end
 endmodule
