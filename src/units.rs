@@ -99,19 +99,21 @@ impl Arith for Format {
 /// TransformUnit: `x' = ((m00*x + m01*y) + m02*z) + n0` per row for a point; a vector omits
 /// the `+ n` step. 9 multiplications and 9 additions for a point (6 for a vector).
 pub fn transform<A: Arith>(a: A, m: &[A::V; 12], v: [A::V; 3], point: bool) -> [A::V; 3] {
-    let row = |r: usize| {
-        let m = &m[r * 4..r * 4 + 4];
-        let s = a.add(
-            a.add(a.mul(m[0], v[0]), a.mul(m[1], v[1])),
-            a.mul(m[2], v[2]),
-        );
-        if point {
-            a.add(s, m[3])
-        } else {
-            s
-        }
-    };
+    let row = |r: usize| transform_row(a, &m[r * 4..r * 4 + 4], v, point);
     [row(0), row(1), row(2)]
+}
+
+/// One row of [`transform`]: `row` is `m0 m1 m2 n`.
+pub fn transform_row<A: Arith>(a: A, row: &[A::V], v: [A::V; 3], point: bool) -> A::V {
+    let s = a.add(
+        a.add(a.mul(row[0], v[0]), a.mul(row[1], v[1])),
+        a.mul(row[2], v[2]),
+    );
+    if point {
+        a.add(s, row[3])
+    } else {
+        s
+    }
 }
 
 /// The normal transform is a 3x3 (the 3x4 layout without offsets), run as a vector transform.
@@ -167,10 +169,20 @@ pub fn edge_bounds(f: Format, margin: u32) -> (u32, u32) {
 /// IntersectUnit's arithmetic, given the ray already in unit-triangle space (O', D'):
 /// `t = -O'z / D'z`, `u = O'x + t*D'x`, `v = O'y + t*D'y` and `u + v`. 1 div, 2 mul, 3 add.
 pub fn unit_triangle_coords<A: Arith>(a: A, o: [A::V; 3], d: [A::V; 3]) -> [A::V; 4] {
-    let t = a.div(a.neg(o[2]), d[2]);
-    let u = a.add(o[0], a.mul(t, d[0]));
-    let v = a.add(o[1], a.mul(t, d[1]));
+    let t = unit_triangle_t(a, o[2], d[2]);
+    let u = unit_triangle_coord(a, o[0], d[0], t);
+    let v = unit_triangle_coord(a, o[1], d[1], t);
     [t, u, v, a.add(u, v)]
+}
+
+/// The first step of [`unit_triangle_coords`]: `t = -O'z / D'z`.
+pub fn unit_triangle_t<A: Arith>(a: A, o_z: A::V, d_z: A::V) -> A::V {
+    a.div(a.neg(o_z), d_z)
+}
+
+/// `u = O'x + t*D'x` (or `v` from the y components), as [`unit_triangle_coords`] computes it.
+pub fn unit_triangle_coord<A: Arith>(a: A, o: A::V, d: A::V, t: A::V) -> A::V {
+    a.add(o, a.mul(t, d))
 }
 
 /// IntersectUnit: a hit when `lo <= u`, `lo <= v`, `u + v <= hi` and `t_min < t < t_max`

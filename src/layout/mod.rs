@@ -34,8 +34,9 @@
 //! in f64 and rounded once into the format by [`Format::from_f64`].
 //!
 //! # Coordinates
-//! Each object is stored relative to its anchor, the centre of its bounding box (see
-//! [`SceneTrees`]), so its coordinates are as small as its size allows. The hardware's
+//! Each object is stored relative to its anchor (see [`SceneTrees`]): the centre of its
+//! bounding box when the object lies farther from its file's origin than its own size, so its
+//! coordinates are as small as its size allows. The hardware's
 //! coordinates are the world's moved to [`LayoutInfo::origin`]: the eye when there is a top
 //! level (camera-relative, so the instance matrices of objects near the camera have small
 //! translations however far from the world origin the scene puts them), and the anchor of the

@@ -18,8 +18,8 @@ module tb;
   reg [31:0] vga_fb_data = 32'd0;
   wire vga_hsync, vga_vsync, vga_frame_start;
   integer px;
-  reg [31:0] bank0 [0:233]; // nodes
-  reg [31:0] bank1 [0:177]; // lists
+  reg [31:0] bank0 [0:525]; // nodes
+  reg [31:0] bank1 [0:342]; // lists
   reg [31:0] bank2 [0:239]; // triangles_uv
   reg [31:0] bank3 [0:239]; // triangles_t
   reg [31:0] bank4 [0:23]; // instances
@@ -43,8 +43,8 @@ module tb;
   // SRAM banks: the word read arrives 2 clock(s) after the request.
   always @(*) begin
     case (mem_bank)
-      3'd0: word = (mem_addr < 234) ? bank0[mem_addr] : 32'hdeadbeef;
-      3'd1: word = (mem_addr < 178) ? bank1[mem_addr] : 32'hdeadbeef;
+      3'd0: word = (mem_addr < 526) ? bank0[mem_addr] : 32'hdeadbeef;
+      3'd1: word = (mem_addr < 343) ? bank1[mem_addr] : 32'hdeadbeef;
       3'd2: word = (mem_addr < 240) ? bank2[mem_addr] : 32'hdeadbeef;
       3'd3: word = (mem_addr < 240) ? bank3[mem_addr] : 32'hdeadbeef;
       3'd4: word = (mem_addr < 24) ? bank4[mem_addr] : 32'hdeadbeef;
@@ -68,9 +68,9 @@ module tb;
     @(negedge clock) start = 1'b1;
     @(negedge clock) start = 1'b0;
     n = 0;
-    while (!done && n < 10464608) begin @(posedge clock); n = n + 1; end
+    while (!done && n < 7529888) begin @(posedge clock); n = n + 1; end
     if (!done) begin
-      $display("TIMEOUT: frame 0 not done after 10464608 clocks");
+      $display("TIMEOUT: frame 0 not done after 7529888 clocks");
       $fatal(1, "timeout");
     end
     fd = $fopen("frame0.hex", "w");

@@ -255,19 +255,35 @@ impl Gen<'_> {
         a.bind(not_skipped);
         a.mailbox_check(MAILBOX_TRIANGLES, triangle, next);
         a.section("intersect");
-        let uv: [Val; 8] = a.load_n(TRIANGLES_UV, triangle.into(), 3, 0);
-        let t_row: [Val; 4] = a.load_n(TRIANGLES_T, triangle.into(), 3, 0);
-        let m: [Val; 12] = std::array::from_fn(|k| if k < 8 { uv[k] } else { t_row[k - 8] });
-        let o = units::transform(a, &m, ray.o.map(Val::R), true);
-        let d = units::transform(a, &m, ray.d.map(Val::R), false);
-        let [t, u, v, u_plus_v] = units::unit_triangle_coords(a, o, d);
-        let f = self.c.format;
-        let (lo, hi) = units::edge_bounds(f, units::edge_margin(f));
-        a.branch(Op::BFle, Val::K(lo), u, true, next);
-        a.branch(Op::BFle, Val::K(lo), v, true, next);
-        a.branch(Op::BFle, u_plus_v, Val::K(hi), true, next);
+        // `units::unit_triangle_coords` row by row, leaving at the first failed condition
+        // (the hit is their conjunction, so the order cannot change it): the t row first,
+        // since most rejected triangles lie outside the segment or behind the best hit.
+        let (o, d) = (ray.o.map(Val::R), ray.d.map(Val::R));
+        let row =
+            |bank: usize, first: u32| -> [Val; 4] { a.load_n(bank, triangle.into(), 3, first) };
+        let t_row = row(TRIANGLES_T, 0);
+        let t = units::unit_triangle_t(
+            a,
+            units::transform_row(a, &t_row, o, true),
+            units::transform_row(a, &t_row, d, false),
+        );
         a.branch(Op::BFlt, s.q_t_min.into(), t, true, next);
         a.branch(Op::BFlt, t, s.best_t.into(), true, next);
+        let f = self.c.format;
+        let (lo, hi) = units::edge_bounds(f, units::edge_margin(f));
+        let [u, v] = [0, 4].map(|first| {
+            let m = row(TRIANGLES_UV, first);
+            let c = units::unit_triangle_coord(
+                a,
+                units::transform_row(a, &m, o, true),
+                units::transform_row(a, &m, d, false),
+                t,
+            );
+            a.branch(Op::BFle, Val::K(lo), c, true, next);
+            c
+        });
+        let u_plus_v = units::Arith::add(a, u, v);
+        a.branch(Op::BFle, u_plus_v, Val::K(hi), true, next);
         a.mov(s.best_t, t);
         a.mov(s.best_instance, instance.into());
         a.mov(s.best_triangle, triangle.into());
