@@ -91,7 +91,7 @@ impl Gen<'_> {
         let s = &self.s;
         a.section("traversal");
         let [node, lo, hi, base] = a.regs::<4>();
-        let [near, far] = a.regs::<2>();
+        let far = a.reg();
         a.mov(node, root);
         a.mov(lo, s.q_t_min.into());
         a.mov(hi, s.best_t.into());
@@ -108,39 +108,45 @@ impl Gen<'_> {
         let [o, d] = a.regs::<2>();
         a.scratch_load_to(o, tag.into(), ray.scratch);
         a.scratch_load_to(d, tag.into(), ray.scratch + 3);
-        let (near_left, decided) = (a.label(), a.label());
+        // Near child: the one holding the origin (on the plane, the one the ray heads into).
+        // The decision code is emitted once per near side, so that the children are `left`
+        // and `left + 1` without registers to hold near and far.
+        let near_left = a.label();
         a.branch(Op::BFlt, o.into(), w1.into(), false, near_left);
         let near_right = a.label();
         a.branch(Op::BFeq, o.into(), w1.into(), true, near_right);
         a.branch(Op::BFle, d.into(), Val::K(0), false, near_left);
-        a.bind(near_right);
-        a.op_to(Op::Add, near, left, Val::K(1));
-        a.mov(far, left);
-        a.jump(decided);
-        a.bind(near_left);
-        a.mov(near, left);
-        a.op_to(Op::Add, far, left, Val::K(1));
-        a.bind(decided);
-        let (go_near, go_far) = (a.label(), a.label());
-        a.branch(Op::BFeq, d.into(), Val::K(0), false, go_near);
-        let t_split = units::split_distance(a, o.into(), d.into(), w1.into());
-        a.branch(Op::BFlt, hi.into(), t_split, false, go_near);
-        a.branch(Op::BFle, t_split, Val::K(0), false, go_near);
-        a.branch(Op::BFlt, t_split, lo.into(), false, go_far);
-        // Both: push (far, t_split, hi), go near with [lo, t_split].
-        a.scratch_store(s.sp.into(), 0, far.into());
-        a.scratch_store(s.sp.into(), 1, t_split);
-        a.scratch_store(s.sp.into(), 2, hi.into());
-        a.op_to(Op::Add, s.sp, s.sp.into(), Val::K(STACK_ENTRY_WORDS));
-        a.mov(node, near.into());
-        a.mov(hi, t_split);
-        a.jump(top);
-        a.bind(go_near);
-        a.mov(node, near.into());
-        a.jump(top);
-        a.bind(go_far);
-        a.mov(node, far.into());
-        a.jump(top);
+        for (side, near_is_left) in [(near_right, false), (near_left, true)] {
+            a.bind(side);
+            let child = |to: Reg, near: bool| {
+                if near == near_is_left {
+                    a.mov(to, left);
+                } else {
+                    a.op_to(Op::Add, to, left, Val::K(1));
+                }
+            };
+            let (go_near, go_far) = (a.label(), a.label());
+            a.branch(Op::BFeq, d.into(), Val::K(0), false, go_near);
+            let t_split = units::split_distance(a, o.into(), d.into(), w1.into());
+            a.branch(Op::BFlt, hi.into(), t_split, false, go_near);
+            a.branch(Op::BFle, t_split, Val::K(0), false, go_near);
+            a.branch(Op::BFlt, t_split, lo.into(), false, go_far);
+            // Both: push (far, t_split, hi), go near with [lo, t_split].
+            child(far, false);
+            a.scratch_store(s.sp.into(), 0, far.into());
+            a.scratch_store(s.sp.into(), 1, t_split);
+            a.scratch_store(s.sp.into(), 2, hi.into());
+            a.op_to(Op::Add, s.sp, s.sp.into(), Val::K(STACK_ENTRY_WORDS));
+            child(node, true);
+            a.mov(hi, t_split);
+            a.jump(top);
+            a.bind(go_near);
+            child(node, true);
+            a.jump(top);
+            a.bind(go_far);
+            child(node, false);
+            a.jump(top);
+        }
         a.end_temps();
 
         // Leaf: `w0`'s payload is the list address, `w1` the count.
@@ -171,7 +177,7 @@ impl Gen<'_> {
         a.jump(top);
         a.bind(finished);
         a.mov(s.sp, base.into());
-        for r in [node, lo, hi, base, near, far] {
+        for r in [node, lo, hi, base, far] {
             a.free(r);
         }
     }
@@ -236,23 +242,26 @@ impl Gen<'_> {
         a.branch(Op::Beq, p.into(), end.into(), false, done);
         a.load_to(triangle, LISTS, p.into(), 0, 0);
         a.op_to(Op::Add, p, p.into(), Val::K(1));
-        // The triangle a secondary ray starts on is never tested.
-        let not_skipped = a.label();
-        a.branch(
-            Op::Beq,
-            triangle.into(),
-            s.skip_triangle.into(),
-            true,
-            not_skipped,
-        );
-        a.branch(
-            Op::Beq,
-            instance.into(),
-            s.skip_instance.into(),
-            false,
-            next,
-        );
-        a.bind(not_skipped);
+        // The triangle a secondary ray starts on is never tested (primary rays skip none, so
+        // a scene without secondary rays needs no check).
+        if self.c.shadows || self.c.reflection_depth > 0 {
+            let not_skipped = a.label();
+            a.branch(
+                Op::Beq,
+                triangle.into(),
+                s.skip_triangle.into(),
+                true,
+                not_skipped,
+            );
+            a.branch(
+                Op::Beq,
+                instance.into(),
+                s.skip_instance.into(),
+                false,
+                next,
+            );
+            a.bind(not_skipped);
+        }
         a.mailbox_check(MAILBOX_TRIANGLES, triangle, next);
         a.section("intersect");
         // `units::unit_triangle_coords` row by row, leaving at the first failed condition
