@@ -7536,7 +7536,7 @@ module dynrt_processor_core__rom_aux(read_address,read_clock,read_data,write_add
     mem[12'h10] = 32'h5000;
     mem[12'h11] = 32'h5000;
     mem[12'h12] = 32'h5000;
-    mem[12'h13] = 32'h5000;
+    mem[12'h13] = 32'h50a7;
     mem[12'h14] = 32'ha7;
     mem[12'h15] = 32'h0;
     mem[12'h16] = 32'h0;
@@ -7574,11 +7574,11 @@ module dynrt_processor_core__rom_aux(read_address,read_clock,read_data,write_add
     mem[12'h36] = 32'h0;
     mem[12'h37] = 32'h0;
     mem[12'h38] = 32'h0;
-    mem[12'h39] = 32'h0;
+    mem[12'h39] = 32'h23;
     mem[12'h3a] = 32'h23;
-    mem[12'h3b] = 32'h0;
+    mem[12'h3b] = 32'h23;
     mem[12'h3c] = 32'h23;
-    mem[12'h3d] = 32'h0;
+    mem[12'h3d] = 32'h23;
     mem[12'h3e] = 32'h23;
     mem[12'h3f] = 32'h4d;
     mem[12'h40] = 32'h0;
@@ -7592,11 +7592,11 @@ module dynrt_processor_core__rom_aux(read_address,read_clock,read_data,write_add
     mem[12'h48] = 32'h0;
     mem[12'h49] = 32'h0;
     mem[12'h4a] = 32'h0;
-    mem[12'h4b] = 32'h0;
+    mem[12'h4b] = 32'h23;
     mem[12'h4c] = 32'h23;
-    mem[12'h4d] = 32'h0;
+    mem[12'h4d] = 32'h23;
     mem[12'h4e] = 32'h23;
-    mem[12'h4f] = 32'h0;
+    mem[12'h4f] = 32'h23;
     mem[12'h50] = 32'h23;
     mem[12'h51] = 32'h0;
     mem[12'h52] = 32'h0;
@@ -7819,7 +7819,7 @@ module dynrt_processor_core__rom_aux(read_address,read_clock,read_data,write_add
     mem[12'h12b] = 32'h0;
     mem[12'h12c] = 32'h0;
     mem[12'h12d] = 32'h0;
-    mem[12'h12e] = 32'h0;
+    mem[12'h12e] = 32'h133;
     mem[12'h12f] = 32'h133;
     mem[12'h130] = 32'h0;
     mem[12'h131] = 32'h0;
@@ -7828,7 +7828,7 @@ module dynrt_processor_core__rom_aux(read_address,read_clock,read_data,write_add
     mem[12'h134] = 32'h139;
     mem[12'h135] = 32'h0;
     mem[12'h136] = 32'h13a;
-    mem[12'h137] = 32'h0;
+    mem[12'h137] = 32'h13a;
     mem[12'h138] = 32'h13a;
     mem[12'h139] = 32'h0;
     mem[12'h13a] = 32'h0;
@@ -7839,7 +7839,7 @@ module dynrt_processor_core__rom_aux(read_address,read_clock,read_data,write_add
     mem[12'h13f] = 32'h144;
     mem[12'h140] = 32'h0;
     mem[12'h141] = 32'h145;
-    mem[12'h142] = 32'h0;
+    mem[12'h142] = 32'h145;
     mem[12'h143] = 32'h145;
     mem[12'h144] = 32'h0;
     mem[12'h145] = 32'h0;
@@ -7850,7 +7850,7 @@ module dynrt_processor_core__rom_aux(read_address,read_clock,read_data,write_add
     mem[12'h14a] = 32'h14f;
     mem[12'h14b] = 32'h0;
     mem[12'h14c] = 32'h150;
-    mem[12'h14d] = 32'h0;
+    mem[12'h14d] = 32'h150;
     mem[12'h14e] = 32'h150;
     mem[12'h14f] = 32'h0;
     mem[12'h150] = 32'h0;
@@ -7861,7 +7861,7 @@ module dynrt_processor_core__rom_aux(read_address,read_clock,read_data,write_add
     mem[12'h155] = 32'h0;
     mem[12'h156] = 32'h0;
     mem[12'h157] = 32'h0;
-    mem[12'h158] = 32'h0;
+    mem[12'h158] = 32'ha7;
     mem[12'h159] = 32'ha7;
     mem[12'h15a] = 32'h0;
     end
@@ -7914,7 +7914,7 @@ module dynrt_processor_core__rom_ctl(read_address,read_clock,read_data,write_add
     mem[12'h10] = 32'h38880000;
     mem[12'h11] = 32'h388c0000;
     mem[12'h12] = 32'h38900000;
-    mem[12'h13] = 32'h38940000;
+    mem[12'h13] = 32'h38940001;
     mem[12'h14] = 32'h5c000000;
     mem[12'h15] = 32'h28342002;
     mem[12'h16] = 32'h28300002;
@@ -7952,11 +7952,11 @@ module dynrt_processor_core__rom_ctl(read_address,read_clock,read_data,write_add
     mem[12'h36] = 32'h440044a0;
     mem[12'h37] = 32'h1c444402;
     mem[12'h38] = 32'h1c98b802;
-    mem[12'h39] = 32'h28a0c802;
+    mem[12'h39] = 32'h28a0c803;
     mem[12'h3a] = 32'h5c000000;
-    mem[12'h3b] = 32'h1c98b802;
+    mem[12'h3b] = 32'h1c98b803;
     mem[12'h3c] = 32'h5c000000;
-    mem[12'h3d] = 32'h2898b802;
+    mem[12'h3d] = 32'h2898b803;
     mem[12'h3e] = 32'h5c000000;
     mem[12'h3f] = 32'h5000c002;
     mem[12'h40] = 32'h8ccb0bc;
@@ -7970,11 +7970,11 @@ module dynrt_processor_core__rom_ctl(read_address,read_clock,read_data,write_add
     mem[12'h48] = 32'h440044a0;
     mem[12'h49] = 32'h1c444402;
     mem[12'h4a] = 32'h2898b802;
-    mem[12'h4b] = 32'h28a0d002;
+    mem[12'h4b] = 32'h28a0d003;
     mem[12'h4c] = 32'h5c000000;
-    mem[12'h4d] = 32'h2898b802;
+    mem[12'h4d] = 32'h2898b803;
     mem[12'h4e] = 32'h5c000000;
-    mem[12'h4f] = 32'h1c98b802;
+    mem[12'h4f] = 32'h1c98b803;
     mem[12'h50] = 32'h5c000000;
     mem[12'h51] = 32'h24d0ac02;
     mem[12'h52] = 32'h1cccd0b0;
@@ -8197,7 +8197,7 @@ module dynrt_processor_core__rom_ctl(read_address,read_clock,read_data,write_add
     mem[12'h12b] = 32'h2a264402;
     mem[12'h12c] = 32'h29c1f802;
     mem[12'h12d] = 32'h29c61c02;
-    mem[12'h12e] = 32'h29ca2402;
+    mem[12'h12e] = 32'h29ca2403;
     mem[12'h12f] = 32'h5c000000;
     mem[12'h130] = 32'h29c08802;
     mem[12'h131] = 32'h29c48c02;
@@ -8206,7 +8206,7 @@ module dynrt_processor_core__rom_ctl(read_address,read_clock,read_data,write_add
     mem[12'h134] = 32'h480001c1;
     mem[12'h135] = 32'h2a180002;
     mem[12'h136] = 32'h480219c1;
-    mem[12'h137] = 32'h29c00002;
+    mem[12'h137] = 32'h29c00003;
     mem[12'h138] = 32'h5c000000;
     mem[12'h139] = 32'h29c00002;
     mem[12'h13a] = 32'he21c002;
@@ -8217,7 +8217,7 @@ module dynrt_processor_core__rom_ctl(read_address,read_clock,read_data,write_add
     mem[12'h13f] = 32'h480001c5;
     mem[12'h140] = 32'h29f80002;
     mem[12'h141] = 32'h4801f9c5;
-    mem[12'h142] = 32'h29c40002;
+    mem[12'h142] = 32'h29c40003;
     mem[12'h143] = 32'h5c000000;
     mem[12'h144] = 32'h29c40002;
     mem[12'h145] = 32'he1dc402;
@@ -8228,7 +8228,7 @@ module dynrt_processor_core__rom_ctl(read_address,read_clock,read_data,write_add
     mem[12'h14a] = 32'h480001c9;
     mem[12'h14b] = 32'h2a180002;
     mem[12'h14c] = 32'h480219c9;
-    mem[12'h14d] = 32'h29c80002;
+    mem[12'h14d] = 32'h29c80003;
     mem[12'h14e] = 32'h5c000000;
     mem[12'h14f] = 32'h29c80002;
     mem[12'h150] = 32'he21c802;
@@ -8239,7 +8239,7 @@ module dynrt_processor_core__rom_ctl(read_address,read_clock,read_data,write_add
     mem[12'h155] = 32'h29f99802;
     mem[12'h156] = 32'h361d9c02;
     mem[12'h157] = 32'h1df9fa1c;
-    mem[12'h158] = 32'h3c01fa14;
+    mem[12'h158] = 32'h3c01fa15;
     mem[12'h159] = 32'h5c000000;
     mem[12'h15a] = 32'h70000000;
     end

@@ -14,8 +14,10 @@
 //! - I3: operands. Feed every unit; compute the integer result, mailbox hit (and update),
 //!   pixel counter, memory and scratch addresses; drive the memory and frame-buffer ports.
 //! - I4..: the fast result line; scratch data joins at I4, memory data at I4 + `mem_latency`.
-//! - I3 + L: write back the register and the next pc (branch decision from the compare,
-//!   integer, mailbox or pixel condition).
+//! - I3 + L: write back the register and the next pc: `target` when the condition differs
+//!   from `invert` (a non-branching instruction's condition is false, so its `invert` is a jump
+//!   after it), else `pc + 1`; the condition comes from the compare, integer, mailbox or
+//!   pixel unit.
 //!
 //! Throughput: one instruction per clock while `threads >= period`; a frame ends when every
 //! thread has executed `halt` (`done`). Counters: clocks of the frame and instructions issued.

@@ -384,6 +384,7 @@ impl Asm {
         for (at, l) in s.fixups {
             code[at].target = s.labels[l.0].expect("label never bound");
         }
+        fold_jumps(&mut code);
         Assembled {
             code,
             sections: s.sections,
@@ -425,6 +426,19 @@ impl<'a> Arith for &'a Asm {
     }
 }
 
+/// Folds each plain jump (`jal r0`) into the instruction before it when that one can carry
+/// it, so that the thread spends no turn on the jump. The `jal` stays where it was: branches
+/// elsewhere may still land on it.
+fn fold_jumps(code: &mut [Instr]) {
+    for at in 1..code.len() {
+        let (before, jump) = (code[at - 1], code[at]);
+        if jump.op == Op::Jal && jump.dst == 0 && before.op.can_jump_after() && !before.invert {
+            code[at - 1].invert = true;
+            code[at - 1].target = jump.target;
+        }
+    }
+}
+
 /// A commutative operation with a constant first operand swaps it into the immediate (IEEE
 /// addition and multiplication are commutative bit for bit, NaN payloads included, since
 /// every NaN is the canonical one).
@@ -432,5 +446,31 @@ fn commutative(asm: &Asm, op: Op, a: Val, b: Val) -> Val {
     match (a, b) {
         (Val::K(_), Val::R(_)) => asm.op(op, b, a),
         _ => asm.op(op, a, b),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_plain_jump_folds_into_the_instruction_before_it_but_not_into_a_branch() {
+        let a = Asm::new(Format::E7M16);
+        a.section("test");
+        let (top, out) = (a.label(), a.label());
+        let r = a.reg();
+        a.bind(top);
+        a.op_to(Op::Add, r, r.into(), Val::K(1)); // 0: add, then jump @0
+        a.jump(top); // 1: kept for branches that land on it
+        a.branch(Op::Beq, r.into(), Val::K(9), false, out); // 2
+        a.jump(top); // 3: a branch cannot carry it
+        a.bind(out);
+        a.halt(); // 4
+        let code = a.finish().code;
+        assert!(code[0].jumps_after() && code[0].target == 0, "{}", code[0]);
+        assert_eq!(code[0].to_string(), format!("add r{0}, r{0}, #0x1; jump @0", r.0));
+        assert_eq!((code[1].op, code[1].target), (Op::Jal, 0));
+        assert!(!code[2].jumps_after() && !code[2].invert && code[2].target == 4);
+        assert!(!code[4].jumps_after());
     }
 }

@@ -263,6 +263,9 @@ impl<'a> Machine<'a> {
                 next = t.pc;
             }
         }
+        if i.jumps_after() {
+            next = i.target as usize;
+        }
         if let Some(v) = result {
             if i.dst != 0 {
                 t.regs[i.dst as usize] = v;

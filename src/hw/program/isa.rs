@@ -2,8 +2,10 @@
 //!
 //! Every instruction reads at most two registers (`a`, and `b` or the immediate), writes at
 //! most one (`dst`, never `r0`, which always reads 0) and chooses the thread's next program
-//! counter (`pc + 1`, or `target` for a taken branch). All instructions take the same number
-//! of clocks in the engine, so the engine needs no hazard logic (see `hw::engine`).
+//! counter (`pc + 1`, or `target` for a taken branch). A non-branching instruction with
+//! `invert` set jumps to `target` after it (the assembler folds a following `jal r0` into it,
+//! saving the jump's turn). All instructions take the same number of clocks in the engine, so
+//! the engine needs no hazard logic (see `hw::engine`).
 //!
 //! Encoding (ROM word of [`INSTR_BITS`] bits, most significant first):
 //! `op[5] dst[8] a[8] b[8] b_imm[1] invert[1] shift[3] bank[3] imm[32] target[12]`.
@@ -133,6 +135,10 @@ impl Op {
                 | Jal
                 | Pixel
         )
+    }
+    /// Whether an instruction of this op can carry a jump to `target` after it (`invert`).
+    pub fn can_jump_after(self) -> bool {
+        !self.branches() && !matches!(self, Op::Jr | Op::Halt)
     }
     /// Whether `target` is a branch target.
     pub fn branches(self) -> bool {
@@ -272,6 +278,13 @@ impl Instr {
         }
     }
 
+    /// Whether the instruction continues at `target` rather than `pc + 1` when it does not
+    /// branch by itself (the engine's next-pc rule: `condition != invert`, the condition of a
+    /// non-branching instruction being false).
+    pub fn jumps_after(&self) -> bool {
+        self.invert && self.op.can_jump_after()
+    }
+
     /// The ROM word (see the module doc for the field order).
     pub fn encode(&self) -> u128 {
         let mut w: u128 = self.op as u128;
@@ -332,6 +345,13 @@ impl fmt::Display for Instr {
             format!("r{}", self.b)
         };
         let inv = if self.invert { "!" } else { "" };
+        if self.jumps_after() {
+            let plain = Instr {
+                invert: false,
+                ..*self
+            };
+            return write!(f, "{plain}; jump @{}", self.target);
+        }
         match self.op {
             Op::Nop | Op::Halt => write!(f, "{}", self.op.name()),
             Op::Ld => write!(

@@ -11,8 +11,10 @@
 //! shared `units::transform` and `units::unit_triangle_coords`). A shadow query (`q_any`)
 //! returns at its first hit. Then pop the stack until a segment can still hold a closer hit.
 //!
-//! Cost per step (instructions = engine turns): inner node 15-19, leaf 6 plus per triangle
-//! about 45 (2 mailbox/skip, 12 loads, 18 transform, 6 test, 5 range compares, 4 updates).
+//! Cost per step (instructions = engine turns): inner node 15-23, leaf 4 plus per listed
+//! triangle 5 (list word, mailbox and skip checks) and its test: 19 when the distance row
+//! rejects it (4 loads, 11 operations of the transform row, the division, 2 range compares),
+//! 40 when the first barycentric row does, about 60 for a hit.
 
 use super::asm::{Label, Reg, Val};
 use super::isa::{Op, MAILBOX_INSTANCES, MAILBOX_TRIANGLES};
