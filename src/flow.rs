@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 
 use crate::emit::constraints::{write_ucf, Port, PortDirection, UcfOptions};
 use crate::emit::processor::{display_mode, ProcessorParams, PROCESSOR_TOP};
-use crate::emit::processor_run::{simulate_processor, write_processor_files, ProcessorSim};
+use crate::emit::processor_run::{simulate_processor, write_processor_files, ProcessorSim, SimRun};
 use crate::fp::Format;
 use crate::hw::engine::engine_period;
 use crate::hw::program::exec::{Machine, RunStats, Write};
@@ -253,8 +253,11 @@ pub fn simulate_scene(
         &layouts,
         params,
         name,
-        cycle_limit(&twin, period),
-        sim,
+        SimRun {
+            sim,
+            cycle_limit: cycle_limit(&twin, period),
+            capture_vga: false,
+        },
         out,
     )?;
     let mut reports = Vec::new();

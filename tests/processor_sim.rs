@@ -87,7 +87,7 @@ frames_equal_the_golden_model! {
 
 #[test]
 fn a_frame_that_cannot_finish_in_time_is_a_clear_timeout_error() {
-    use dynrt::emit::processor_run::simulate_processor;
+    use dynrt::emit::processor_run::{simulate_processor, SimRun};
     use dynrt::hw::program::{build_program, ProgramConfig};
     let s = scene("cornell_noshadow.toml", 4, 3);
     let layouts = flow::scene_layouts(&s, Format::E7M16, None).unwrap();
@@ -98,8 +98,11 @@ fn a_frame_that_cannot_finish_in_time_is_a_clear_timeout_error() {
         &layouts,
         ProcessorParams::default(),
         "cornell_noshadow",
-        500,
-        Simulator::Verilator,
+        SimRun {
+            sim: Simulator::Verilator,
+            cycle_limit: 500,
+            capture_vga: false,
+        },
         dir.path(),
     )
     .unwrap_err();
@@ -116,7 +119,7 @@ fn a_frame_that_cannot_finish_in_time_is_a_clear_timeout_error() {
 /// pixel clocks (the timing generator alone is checked in Icarus too, in `emit::vga_timing`).
 #[test]
 fn the_display_shows_the_rendered_frame_magnified_and_centred() {
-    use dynrt::emit::processor_run::simulate_processor_with;
+    use dynrt::emit::processor_run::{simulate_processor, SimRun};
     use dynrt::hw::program::{build_program, ProgramConfig};
     use dynrt::hw::VgaMode;
     let (w, h) = (20, 12);
@@ -124,15 +127,17 @@ fn the_display_shows_the_rendered_frame_magnified_and_centred() {
     let layouts = flow::scene_layouts(&s, Format::E7M16, None).unwrap();
     let p = build_program(&ProgramConfig::from_layout(Format::E7M16, &layouts[0].info));
     let dir = tempfile::tempdir().unwrap();
-    let r = simulate_processor_with(
+    let r = simulate_processor(
         &p,
         &layouts,
         ProcessorParams::default(),
         "cornell_noshadow",
-        20_000_000,
-        Simulator::Verilator,
+        SimRun {
+            sim: Simulator::Verilator,
+            cycle_limit: 20_000_000,
+            capture_vga: true,
+        },
         dir.path(),
-        true,
     )
     .unwrap_or_else(|e| panic!("{e:#}"));
     let fb = &r.frames.last().unwrap().pixels;

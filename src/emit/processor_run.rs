@@ -94,41 +94,31 @@ pub fn write_processor_files(
     Ok((rtl_path, tb_path))
 }
 
-/// Simulates the processor for `program` on `layouts` in `sim`, in `dir`.
+/// How to run a processor simulation.
+#[derive(Clone, Copy, Debug)]
+pub struct SimRun {
+    pub sim: Simulator,
+    /// Clocks a frame may take before the testbench stops with a timeout error.
+    pub cycle_limit: u64,
+    /// Also capture one frame of the display's output after the last rendered frame (about
+    /// 420,000 pixel clocks: minutes in Icarus).
+    pub capture_vga: bool,
+}
+
+/// Simulates the processor for `program` on `layouts` as `run` says, in `dir`.
 pub fn simulate_processor(
     program: &Program,
     layouts: &[Layout],
     params: ProcessorParams,
     scene_name: &str,
-    cycle_limit: u64,
-    sim: Simulator,
+    run: SimRun,
     dir: &Path,
 ) -> Result<ProcessorSim> {
-    simulate_processor_with(
-        program,
-        layouts,
-        params,
-        scene_name,
-        cycle_limit,
+    let SimRun {
         sim,
-        dir,
-        false,
-    )
-}
-
-/// [`simulate_processor`], and with `capture_vga` also one frame of the display's output
-/// after the last rendered frame (about 420,000 pixel clocks: minutes in Icarus).
-#[allow(clippy::too_many_arguments)]
-pub fn simulate_processor_with(
-    program: &Program,
-    layouts: &[Layout],
-    params: ProcessorParams,
-    scene_name: &str,
-    cycle_limit: u64,
-    sim: Simulator,
-    dir: &Path,
-    capture_vga: bool,
-) -> Result<ProcessorSim> {
+        cycle_limit,
+        capture_vga,
+    } = run;
     let (rtl, tb) = write_processor_files(program, layouts, params, scene_name, cycle_limit, dir)?;
     for k in 0..layouts.len() {
         let _ = std::fs::remove_file(dir.join(format!("frame{k}.hex")));
