@@ -28,12 +28,6 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
     localparam  c_bias = 9'b111111;
     localparam  c_bias_less_one = 9'b111110;
     localparam  c_one = 18'b1;
-    localparam  c_carry_pos = 8'h11;
-    localparam  c_exp_sign_pos = 8'h8;
-    localparam  c_exp_max = 9'b1111111;
-    localparam  c_qnan = 24'h7f8000;
-    localparam  c_inf = 24'h7f0000;
-    localparam  c_sign_bit = 24'h800000;
     
     // Stub signals
     reg  [23:0] in_a__d;
@@ -528,33 +522,17 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
     reg  last_valid__d;
     wire  last_valid__q;
     reg  last_valid__clock;
-    reg  [17:0] rnd_sig__d;
-    wire  [17:0] rnd_sig__q;
-    reg  rnd_sig__clock;
-    reg  [8:0] rnd_exp__d;
-    wire  [8:0] rnd_exp__q;
-    reg  rnd_exp__clock;
-    reg  rnd_sign__d;
-    wire  rnd_sign__q;
-    reg  rnd_sign__clock;
-    reg  rnd_nan__d;
-    wire  rnd_nan__q;
-    reg  rnd_nan__clock;
-    reg  rnd_inf__d;
-    wire  rnd_inf__q;
-    reg  rnd_inf__clock;
-    reg  rnd_zero__d;
-    wire  rnd_zero__q;
-    reg  rnd_zero__clock;
-    reg  rnd_valid__d;
-    wire  rnd_valid__q;
-    reg  rnd_valid__clock;
-    reg  [23:0] out_result__d;
-    wire  [23:0] out_result__q;
-    reg  out_result__clock;
-    reg  out_valid_r__d;
-    wire  out_valid_r__q;
-    reg  out_valid_r__clock;
+    reg  pack__clock;
+    reg  pack__in_valid;
+    reg  [16:0] pack__sig;
+    reg  pack__round_up;
+    reg  [8:0] pack__exp;
+    reg  pack__sign;
+    reg  pack__nan;
+    reg  pack__inf;
+    reg  pack__zero;
+    wire  pack__out_valid;
+    wire  [23:0] pack__result;
     
     // Local signals
     reg  [6:0] exp_a;
@@ -571,11 +549,6 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
     reg  [17:0] dividend;
     reg  [16:0] sig;
     reg  round_up;
-    reg  [17:0] sig_rounded;
-    reg  [8:0] exp_final;
-    reg  exp_negative;
-    reg  [23:0] sign_word;
-    reg  [23:0] packed_word;
     
     // Sub module instances
     fp_div_e7m16_core__in_a in_a(
@@ -1398,50 +1371,18 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         .q(last_valid__q),
         .clock(last_valid__clock)
     );
-    fp_div_e7m16_core__divisor__0 rnd_sig(
-        .d(rnd_sig__d),
-        .q(rnd_sig__q),
-        .clock(rnd_sig__clock)
-    );
-    fp_div_e7m16_core__exp__0 rnd_exp(
-        .d(rnd_exp__d),
-        .q(rnd_exp__q),
-        .clock(rnd_exp__clock)
-    );
-    fp_div_e7m16_core__in_valid_r rnd_sign(
-        .d(rnd_sign__d),
-        .q(rnd_sign__q),
-        .clock(rnd_sign__clock)
-    );
-    fp_div_e7m16_core__in_valid_r rnd_nan(
-        .d(rnd_nan__d),
-        .q(rnd_nan__q),
-        .clock(rnd_nan__clock)
-    );
-    fp_div_e7m16_core__in_valid_r rnd_inf(
-        .d(rnd_inf__d),
-        .q(rnd_inf__q),
-        .clock(rnd_inf__clock)
-    );
-    fp_div_e7m16_core__in_valid_r rnd_zero(
-        .d(rnd_zero__d),
-        .q(rnd_zero__q),
-        .clock(rnd_zero__clock)
-    );
-    fp_div_e7m16_core__in_valid_r rnd_valid(
-        .d(rnd_valid__d),
-        .q(rnd_valid__q),
-        .clock(rnd_valid__clock)
-    );
-    fp_div_e7m16_core__in_a out_result(
-        .d(out_result__d),
-        .q(out_result__q),
-        .clock(out_result__clock)
-    );
-    fp_div_e7m16_core__in_valid_r out_valid_r(
-        .d(out_valid_r__d),
-        .q(out_valid_r__q),
-        .clock(out_valid_r__clock)
+    fp_div_e7m16_core__pack pack(
+        .clock(pack__clock),
+        .in_valid(pack__in_valid),
+        .sig(pack__sig),
+        .round_up(pack__round_up),
+        .exp(pack__exp),
+        .sign(pack__sign),
+        .nan(pack__nan),
+        .inf(pack__inf),
+        .zero(pack__zero),
+        .out_valid(pack__out_valid),
+        .result(pack__result)
     );
     
     // Update code
@@ -1457,15 +1398,6 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         last_inf__clock = clock;
         last_zero__clock = clock;
         last_valid__clock = clock;
-        rnd_sig__clock = clock;
-        rnd_exp__clock = clock;
-        rnd_sign__clock = clock;
-        rnd_nan__clock = clock;
-        rnd_inf__clock = clock;
-        rnd_zero__clock = clock;
-        rnd_valid__clock = clock;
-        out_result__clock = clock;
-        out_valid_r__clock = clock;
         in_a__d = in_a__q;
         in_b__d = in_b__q;
         in_valid_r__d = in_valid_r__q;
@@ -1477,15 +1409,6 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         last_inf__d = last_inf__q;
         last_zero__d = last_zero__q;
         last_valid__d = last_valid__q;
-        rnd_sig__d = rnd_sig__q;
-        rnd_exp__d = rnd_exp__q;
-        rnd_sign__d = rnd_sign__q;
-        rnd_nan__d = rnd_nan__q;
-        rnd_inf__d = rnd_inf__q;
-        rnd_zero__d = rnd_zero__q;
-        rnd_valid__d = rnd_valid__q;
-        out_result__d = out_result__q;
-        out_valid_r__d = out_valid_r__q;
         rem__0__clock = clock;
         quo__0__clock = clock;
         divisor__0__clock = clock;
@@ -1925,36 +1848,17 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         last_valid__d = valid__16__q;
         sig = last_quo__q[(32'h1)+:(17)];
         round_up = last_quo__q[32'h0] & ((|last_rem__q) | sig[32'h0]);
-        sig_rounded = ((sig) & 18'h3ffff) + round_up;
-        exp_final = last_exp__q + sig_rounded[c_carry_pos];
-        rnd_sig__d = sig_rounded;
-        rnd_exp__d = exp_final;
-        rnd_sign__d = last_sign__q;
-        rnd_nan__d = last_nan__q;
-        rnd_inf__d = last_inf__q;
-        rnd_zero__d = last_zero__q;
-        rnd_valid__d = last_valid__q;
-        exp_negative = rnd_exp__q[c_exp_sign_pos];
-        sign_word = 32'h0;
-        if (rnd_sign__q) begin
-            sign_word = c_sign_bit;
-        end
-        packed_word = (((rnd_exp__q[(32'h0)+:(7)]) & 24'hffffff) << c_man_bits) | ((rnd_sig__q[(32'h0)+:(16)]) & 24'hffffff);
-        if (rnd_nan__q) begin
-            out_result__d = c_qnan;
-        end
-        else if (rnd_inf__q | ((~exp_negative) & (rnd_exp__q >= c_exp_max))) begin
-            out_result__d = c_inf | sign_word;
-        end
-        else if (rnd_zero__q | (exp_negative | (rnd_exp__q == 32'h0))) begin
-            out_result__d = sign_word;
-        end
-        else begin
-            out_result__d = packed_word | sign_word;
-        end
-        out_valid_r__d = rnd_valid__q;
-        result = out_result__q;
-        out_valid = out_valid_r__q;
+        pack__clock = clock;
+        pack__in_valid = last_valid__q;
+        pack__sig = sig;
+        pack__round_up = round_up;
+        pack__exp = last_exp__q;
+        pack__sign = last_sign__q;
+        pack__nan = last_nan__q;
+        pack__inf = last_inf__q;
+        pack__zero = last_zero__q;
+        result = pack__result;
+        out_valid = pack__out_valid;
     end
     
 endmodule // fp_div_e7m16_core
@@ -2184,6 +2088,168 @@ endmodule // fp_div_e7m16_core__in_valid_r
 
 
 
+
+
+module fp_div_e7m16_core__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero,out_valid,result);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  in_valid;
+    input wire  [16:0] sig;
+    input wire  round_up;
+    input wire  [8:0] exp;
+    input wire  sign;
+    input wire  nan;
+    input wire  inf;
+    input wire  zero;
+    output reg  out_valid;
+    output reg  [23:0] result;
+    
+    // Constant declarations
+    localparam  c_man_bits = 8'h10;
+    localparam  c_carry_pos = 8'h11;
+    localparam  c_exp_sign_pos = 8'h8;
+    localparam  c_exp_max = 9'b1111111;
+    localparam  c_qnan = 24'h7f8000;
+    localparam  c_inf = 24'h7f0000;
+    localparam  c_sign_bit = 24'h800000;
+    
+    // Stub signals
+    reg  [17:0] rnd_sig__d;
+    wire  [17:0] rnd_sig__q;
+    reg  rnd_sig__clock;
+    reg  [8:0] rnd_exp__d;
+    wire  [8:0] rnd_exp__q;
+    reg  rnd_exp__clock;
+    reg  rnd_sign__d;
+    wire  rnd_sign__q;
+    reg  rnd_sign__clock;
+    reg  rnd_nan__d;
+    wire  rnd_nan__q;
+    reg  rnd_nan__clock;
+    reg  rnd_inf__d;
+    wire  rnd_inf__q;
+    reg  rnd_inf__clock;
+    reg  rnd_zero__d;
+    wire  rnd_zero__q;
+    reg  rnd_zero__clock;
+    reg  rnd_valid__d;
+    wire  rnd_valid__q;
+    reg  rnd_valid__clock;
+    reg  [23:0] out_result__d;
+    wire  [23:0] out_result__q;
+    reg  out_result__clock;
+    reg  out_valid_r__d;
+    wire  out_valid_r__q;
+    reg  out_valid_r__clock;
+    
+    // Local signals
+    reg  [17:0] sig_rounded;
+    reg  [8:0] exp_final;
+    reg  exp_negative;
+    reg  [23:0] sign_word;
+    reg  [23:0] packed_word;
+    
+    // Sub module instances
+    fp_div_e7m16_core__divisor__0 rnd_sig(
+        .d(rnd_sig__d),
+        .q(rnd_sig__q),
+        .clock(rnd_sig__clock)
+    );
+    fp_div_e7m16_core__exp__0 rnd_exp(
+        .d(rnd_exp__d),
+        .q(rnd_exp__q),
+        .clock(rnd_exp__clock)
+    );
+    fp_div_e7m16_core__in_valid_r rnd_sign(
+        .d(rnd_sign__d),
+        .q(rnd_sign__q),
+        .clock(rnd_sign__clock)
+    );
+    fp_div_e7m16_core__in_valid_r rnd_nan(
+        .d(rnd_nan__d),
+        .q(rnd_nan__q),
+        .clock(rnd_nan__clock)
+    );
+    fp_div_e7m16_core__in_valid_r rnd_inf(
+        .d(rnd_inf__d),
+        .q(rnd_inf__q),
+        .clock(rnd_inf__clock)
+    );
+    fp_div_e7m16_core__in_valid_r rnd_zero(
+        .d(rnd_zero__d),
+        .q(rnd_zero__q),
+        .clock(rnd_zero__clock)
+    );
+    fp_div_e7m16_core__in_valid_r rnd_valid(
+        .d(rnd_valid__d),
+        .q(rnd_valid__q),
+        .clock(rnd_valid__clock)
+    );
+    fp_div_e7m16_core__in_a out_result(
+        .d(out_result__d),
+        .q(out_result__q),
+        .clock(out_result__clock)
+    );
+    fp_div_e7m16_core__in_valid_r out_valid_r(
+        .d(out_valid_r__d),
+        .q(out_valid_r__q),
+        .clock(out_valid_r__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        rnd_sig__clock = clock;
+        rnd_exp__clock = clock;
+        rnd_sign__clock = clock;
+        rnd_nan__clock = clock;
+        rnd_inf__clock = clock;
+        rnd_zero__clock = clock;
+        rnd_valid__clock = clock;
+        out_result__clock = clock;
+        out_valid_r__clock = clock;
+        rnd_sig__d = rnd_sig__q;
+        rnd_exp__d = rnd_exp__q;
+        rnd_sign__d = rnd_sign__q;
+        rnd_nan__d = rnd_nan__q;
+        rnd_inf__d = rnd_inf__q;
+        rnd_zero__d = rnd_zero__q;
+        rnd_valid__d = rnd_valid__q;
+        out_result__d = out_result__q;
+        out_valid_r__d = out_valid_r__q;
+        sig_rounded = ((sig) & 18'h3ffff) + round_up;
+        exp_final = exp + sig_rounded[c_carry_pos];
+        rnd_sig__d = sig_rounded;
+        rnd_exp__d = exp_final;
+        rnd_sign__d = sign;
+        rnd_nan__d = nan;
+        rnd_inf__d = inf;
+        rnd_zero__d = zero;
+        rnd_valid__d = in_valid;
+        exp_negative = rnd_exp__q[c_exp_sign_pos];
+        sign_word = 32'h0;
+        if (rnd_sign__q) begin
+            sign_word = c_sign_bit;
+        end
+        packed_word = (((rnd_exp__q[(32'h0)+:(7)]) & 24'hffffff) << c_man_bits) | ((rnd_sig__q[(32'h0)+:(16)]) & 24'hffffff);
+        if (rnd_nan__q) begin
+            out_result__d = c_qnan;
+        end
+        else if (rnd_inf__q | ((~exp_negative) & (rnd_exp__q >= c_exp_max))) begin
+            out_result__d = c_inf | sign_word;
+        end
+        else if (rnd_zero__q | (exp_negative | (rnd_exp__q == 32'h0))) begin
+            out_result__d = sign_word;
+        end
+        else begin
+            out_result__d = packed_word | sign_word;
+        end
+        out_valid_r__d = rnd_valid__q;
+        result = out_result__q;
+        out_valid = out_valid_r__q;
+    end
+    
+endmodule // fp_div_e7m16_core__pack
 
 
 

@@ -12,7 +12,7 @@
 //! 3. .. `S + 2`: the remaining `S` quotient bits, one per stage;
 //! `S + 3`. round to nearest even; registered;
 //! `S + 4`. overflow to infinity / flush below the smallest normal to a signed zero, pack;
-//!    registered.
+//!    registered (these two stages are the shared [`FpRoundPack`]).
 //!
 //! Special cases (IEEE): 0/0 and inf/inf are NaN, finite nonzero / 0 is a signed infinity,
 //! x/inf is a signed zero; the sign is the xor of the operand signs.
@@ -23,7 +23,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::{bias, const_bits, const_index, inf_word, qnan_word};
+use super::{bias, const_bits, const_index, FpRoundPack};
 
 /// Latency of [`FpDiv`] in clocks for a format with `man_bits` stored mantissa bits.
 pub const fn div_latency(man_bits: u32) -> u32 {
@@ -81,25 +81,11 @@ pub struct FpDiv<
     last_inf: DFF<Bit>,
     last_zero: DFF<Bit>,
     last_valid: DFF<Bit>,
-    // Round and pack (combinational).
+    // The round decision (combinational).
     sig: Signal<Local, Bits<S>>,
     round_up: Signal<Local, Bit>,
-    sig_rounded: Signal<Local, Bits<S1>>,
-    exp_final: Signal<Local, Bits<X2>>,
-    exp_negative: Signal<Local, Bit>,
-    sign_word: Signal<Local, Bits<W>>,
-    packed_word: Signal<Local, Bits<W>>,
-    // Stage S + 3: rounded result registers.
-    rnd_sig: DFF<Bits<S1>>,
-    rnd_exp: DFF<Bits<X2>>,
-    rnd_sign: DFF<Bit>,
-    rnd_nan: DFF<Bit>,
-    rnd_inf: DFF<Bit>,
-    rnd_zero: DFF<Bit>,
-    rnd_valid: DFF<Bit>,
-    // Output registers.
-    out_result: DFF<Bits<W>>,
-    out_valid_r: DFF<Bit>,
+    // Stages S + 3 and S + 4.
+    pack: FpRoundPack<W, E, M, S, S1, X2>,
     // Format constants.
     c_man_bits: Constant<Bits<8>>,
     c_sign_pos: Constant<Bits<8>>,
@@ -107,12 +93,6 @@ pub struct FpDiv<
     c_bias: Constant<Bits<X2>>,
     c_bias_less_one: Constant<Bits<X2>>,
     c_one: Constant<Bits<S1>>,
-    c_carry_pos: Constant<Bits<8>>,
-    c_exp_sign_pos: Constant<Bits<8>>,
-    c_exp_max: Constant<Bits<X2>>,
-    c_qnan: Constant<Bits<W>>,
-    c_inf: Constant<Bits<W>>,
-    c_sign_bit: Constant<Bits<W>>,
 }
 
 impl<
@@ -167,32 +147,13 @@ impl<
             last_valid: Default::default(),
             sig: Default::default(),
             round_up: Default::default(),
-            sig_rounded: Default::default(),
-            exp_final: Default::default(),
-            exp_negative: Default::default(),
-            sign_word: Default::default(),
-            packed_word: Default::default(),
-            rnd_sig: Default::default(),
-            rnd_exp: Default::default(),
-            rnd_sign: Default::default(),
-            rnd_nan: Default::default(),
-            rnd_inf: Default::default(),
-            rnd_zero: Default::default(),
-            rnd_valid: Default::default(),
-            out_result: Default::default(),
-            out_valid_r: Default::default(),
+            pack: Default::default(),
             c_man_bits: const_index(M),
             c_sign_pos: const_index(W - 1),
             c_hidden: const_bits::<S1>(1 << M),
             c_bias: const_bits::<X2>(bias(E)),
             c_bias_less_one: const_bits::<X2>(bias(E) - 1),
             c_one: const_bits::<S1>(1),
-            c_carry_pos: const_index(S),
-            c_exp_sign_pos: const_index(X2 - 1),
-            c_exp_max: const_bits::<X2>((1 << E) - 1),
-            c_qnan: const_bits::<W>(qnan_word(E, M)),
-            c_inf: const_bits::<W>(inf_word(E, M)),
-            c_sign_bit: const_bits::<W>(1 << (W - 1)),
         }
     }
 }
@@ -221,16 +182,7 @@ impl<
             last_nan,
             last_inf,
             last_zero,
-            last_valid,
-            rnd_sig,
-            rnd_exp,
-            rnd_sign,
-            rnd_nan,
-            rnd_inf,
-            rnd_zero,
-            rnd_valid,
-            out_result,
-            out_valid_r
+            last_valid
         );
         for i in 0..S {
             self.rem[i].clock.next = self.clock.val();
@@ -335,49 +287,18 @@ impl<
         self.sig.next = self.last_quo.q.val().get_bits::<S>(1);
         self.round_up.next = self.last_quo.q.val().get_bit(0)
             & ((self.last_rem.q.val().any()) | self.sig.val().get_bit(0));
-        self.sig_rounded.next = bit_cast::<S1, S>(self.sig.val()) + self.round_up.val();
-        self.exp_final.next = self.last_exp.q.val()
-            + self
-                .sig_rounded
-                .val()
-                .get_bit(self.c_carry_pos.val().index());
-        // Registered: the rounded significand and exponent (splits the logic depth).
-        self.rnd_sig.d.next = self.sig_rounded.val();
-        self.rnd_exp.d.next = self.exp_final.val();
-        self.rnd_sign.d.next = self.last_sign.q.val();
-        self.rnd_nan.d.next = self.last_nan.q.val();
-        self.rnd_inf.d.next = self.last_inf.q.val();
-        self.rnd_zero.d.next = self.last_zero.q.val();
-        self.rnd_valid.d.next = self.last_valid.q.val();
-
-        self.exp_negative.next = self
-            .rnd_exp
-            .q
-            .val()
-            .get_bit(self.c_exp_sign_pos.val().index());
-        self.sign_word.next = 0.into();
-        if self.rnd_sign.q.val() {
-            self.sign_word.next = self.c_sign_bit.val();
-        }
-        self.packed_word.next = (bit_cast::<W, E>(self.rnd_exp.q.val().get_bits::<E>(0))
-            << self.c_man_bits.val())
-            | bit_cast::<W, M>(self.rnd_sig.q.val().get_bits::<M>(0));
-
-        // Output stage.
-        if self.rnd_nan.q.val() {
-            self.out_result.d.next = self.c_qnan.val();
-        } else if self.rnd_inf.q.val()
-            | ((!self.exp_negative.val()) & (self.rnd_exp.q.val() >= self.c_exp_max.val()))
-        {
-            self.out_result.d.next = self.c_inf.val() | self.sign_word.val();
-        } else if self.rnd_zero.q.val() | (self.exp_negative.val() | (self.rnd_exp.q.val() == 0)) {
-            self.out_result.d.next = self.sign_word.val();
-        } else {
-            self.out_result.d.next = self.packed_word.val() | self.sign_word.val();
-        }
-        self.out_valid_r.d.next = self.rnd_valid.q.val();
-        self.result.next = self.out_result.q.val();
-        self.out_valid.next = self.out_valid_r.q.val();
+        // Stages S + 3 and S + 4.
+        self.pack.clock.next = self.clock.val();
+        self.pack.in_valid.next = self.last_valid.q.val();
+        self.pack.sig.next = self.sig.val();
+        self.pack.round_up.next = self.round_up.val();
+        self.pack.exp.next = self.last_exp.q.val();
+        self.pack.sign.next = self.last_sign.q.val();
+        self.pack.nan.next = self.last_nan.q.val();
+        self.pack.inf.next = self.last_inf.q.val();
+        self.pack.zero.next = self.last_zero.q.val();
+        self.result.next = self.pack.result.val();
+        self.out_valid.next = self.pack.out_valid.val();
     }
 }
 

@@ -29,6 +29,7 @@ pub mod compare;
 pub mod div;
 pub mod formats;
 pub mod mul;
+pub mod round_pack;
 pub mod sig_mul;
 pub mod sqrt;
 #[cfg(test)]
@@ -39,6 +40,7 @@ pub use compare::FpCompare;
 pub use div::FpDiv;
 pub use formats::{check_supported, latency, supported_formats, UnsupportedFormat};
 pub use mul::FpMul;
+pub use round_pack::FpRoundPack;
 pub use sig_mul::SigMul;
 pub use sqrt::FpSqrt;
 

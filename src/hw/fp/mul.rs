@@ -8,7 +8,7 @@
 //! 3. normalize (product in [1, 4)), round to nearest even on `S` bits with an unbounded
 //!    exponent; registered;
 //! 4. overflow to infinity / flush results below the smallest normal to a signed zero, pack;
-//!    registered.
+//!    registered (the rounding of 3 and all of 4 are the shared [`FpRoundPack`]).
 //!
 //! Const parameters (derived widths, checked in `default()`): `W = 1+E+M` word, `E` exponent
 //! bits, `M` mantissa bits, `S = M+1` significand, `S1 = S+1` rounded significand with carry,
@@ -16,7 +16,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::{bias, const_bits, const_index, inf_word, qnan_word, SigMul};
+use super::{bias, const_bits, const_index, FpRoundPack, SigMul};
 
 /// Latency of [`FpMul`] in clocks.
 pub const MUL_LATENCY: u32 = 4;
@@ -66,22 +66,8 @@ pub struct FpMul<
     round_bit: Signal<Local, Bit>,
     sticky: Signal<Local, Bit>,
     round_up: Signal<Local, Bit>,
-    sig_rounded: Signal<Local, Bits<S1>>,
-    exp_final: Signal<Local, Bits<X2>>,
-    exp_negative: Signal<Local, Bit>,
-    sign_word: Signal<Local, Bits<W>>,
-    packed_word: Signal<Local, Bits<W>>,
-    // Stage 3: rounded result registers.
-    rnd_sig: DFF<Bits<S1>>,
-    rnd_exp: DFF<Bits<X2>>,
-    rnd_sign: DFF<Bit>,
-    rnd_nan: DFF<Bit>,
-    rnd_inf: DFF<Bit>,
-    rnd_zero: DFF<Bit>,
-    rnd_valid: DFF<Bit>,
-    // Stage 4: output registers.
-    out_result: DFF<Bits<W>>,
-    out_valid_r: DFF<Bit>,
+    // Stages 3 and 4.
+    pack: FpRoundPack<W, E, M, S, S1, X2>,
     // Format constants.
     c_man_bits: Constant<Bits<8>>,
     c_sign_pos: Constant<Bits<8>>,
@@ -91,12 +77,6 @@ pub struct FpMul<
     c_sig_pos: Constant<Bits<8>>,
     c_round_pos: Constant<Bits<8>>,
     c_sticky_mask: Constant<Bits<P>>,
-    c_carry_pos: Constant<Bits<8>>,
-    c_exp_sign_pos: Constant<Bits<8>>,
-    c_exp_max: Constant<Bits<X2>>,
-    c_qnan: Constant<Bits<W>>,
-    c_inf: Constant<Bits<W>>,
-    c_sign_bit: Constant<Bits<W>>,
 }
 
 impl<
@@ -143,20 +123,7 @@ impl<
             round_bit: Default::default(),
             sticky: Default::default(),
             round_up: Default::default(),
-            sig_rounded: Default::default(),
-            exp_final: Default::default(),
-            exp_negative: Default::default(),
-            sign_word: Default::default(),
-            packed_word: Default::default(),
-            rnd_sig: Default::default(),
-            rnd_exp: Default::default(),
-            rnd_sign: Default::default(),
-            rnd_nan: Default::default(),
-            rnd_inf: Default::default(),
-            rnd_zero: Default::default(),
-            rnd_valid: Default::default(),
-            out_result: Default::default(),
-            out_valid_r: Default::default(),
+            pack: Default::default(),
             c_man_bits: const_index(M),
             c_sign_pos: const_index(W - 1),
             c_hidden: const_bits::<S>(1 << M),
@@ -165,12 +132,6 @@ impl<
             c_sig_pos: const_index(S),
             c_round_pos: const_index(S - 1),
             c_sticky_mask: const_bits::<P>((1 << (S - 1)) - 1),
-            c_carry_pos: const_index(S),
-            c_exp_sign_pos: const_index(X2 - 1),
-            c_exp_max: const_bits::<X2>((1 << E) - 1),
-            c_qnan: const_bits::<W>(qnan_word(E, M)),
-            c_inf: const_bits::<W>(inf_word(E, M)),
-            c_sign_bit: const_bits::<W>(1 << (W - 1)),
         }
     }
 }
@@ -199,16 +160,7 @@ impl<
             nan,
             inf,
             zero,
-            valid2,
-            rnd_sig,
-            rnd_exp,
-            rnd_sign,
-            rnd_nan,
-            rnd_inf,
-            rnd_zero,
-            rnd_valid,
-            out_result,
-            out_valid_r
+            valid2
         );
         // Stage 1.
         self.in_a.d.next = self.a.val();
@@ -263,50 +215,18 @@ impl<
         self.round_bit.next = self.prod_norm.val().get_bit(self.c_round_pos.val().index());
         self.sticky.next = (self.prod_norm.val() & self.c_sticky_mask.val()).any();
         self.round_up.next = self.round_bit.val() & (self.sticky.val() | self.sig.val().get_bit(0));
-        self.sig_rounded.next = bit_cast::<S1, S>(self.sig.val()) + self.round_up.val();
-        // A carry out of rounding leaves the mantissa field zero and bumps the exponent.
-        self.exp_final.next = (self.exp_sum.q.val() + self.prod_top.val())
-            + self
-                .sig_rounded
-                .val()
-                .get_bit(self.c_carry_pos.val().index());
-        // Registered: the rounded significand and exponent (splits the logic depth).
-        self.rnd_sig.d.next = self.sig_rounded.val();
-        self.rnd_exp.d.next = self.exp_final.val();
-        self.rnd_sign.d.next = self.sign.q.val();
-        self.rnd_nan.d.next = self.nan.q.val();
-        self.rnd_inf.d.next = self.inf.q.val();
-        self.rnd_zero.d.next = self.zero.q.val();
-        self.rnd_valid.d.next = self.valid2.q.val();
-
-        self.exp_negative.next = self
-            .rnd_exp
-            .q
-            .val()
-            .get_bit(self.c_exp_sign_pos.val().index());
-        self.sign_word.next = 0.into();
-        if self.rnd_sign.q.val() {
-            self.sign_word.next = self.c_sign_bit.val();
-        }
-        self.packed_word.next = (bit_cast::<W, E>(self.rnd_exp.q.val().get_bits::<E>(0))
-            << self.c_man_bits.val())
-            | bit_cast::<W, M>(self.rnd_sig.q.val().get_bits::<M>(0));
-
-        // Stage 4.
-        if self.rnd_nan.q.val() {
-            self.out_result.d.next = self.c_qnan.val();
-        } else if self.rnd_inf.q.val()
-            | ((!self.exp_negative.val()) & (self.rnd_exp.q.val() >= self.c_exp_max.val()))
-        {
-            self.out_result.d.next = self.c_inf.val() | self.sign_word.val();
-        } else if self.rnd_zero.q.val() | (self.exp_negative.val() | (self.rnd_exp.q.val() == 0)) {
-            self.out_result.d.next = self.sign_word.val();
-        } else {
-            self.out_result.d.next = self.packed_word.val() | self.sign_word.val();
-        }
-        self.out_valid_r.d.next = self.rnd_valid.q.val();
-        self.result.next = self.out_result.q.val();
-        self.out_valid.next = self.out_valid_r.q.val();
+        // Stages 3 and 4: round and pack.
+        self.pack.clock.next = self.clock.val();
+        self.pack.in_valid.next = self.valid2.q.val();
+        self.pack.sig.next = self.sig.val();
+        self.pack.round_up.next = self.round_up.val();
+        self.pack.exp.next = self.exp_sum.q.val() + self.prod_top.val();
+        self.pack.sign.next = self.sign.q.val();
+        self.pack.nan.next = self.nan.q.val();
+        self.pack.inf.next = self.inf.q.val();
+        self.pack.zero.next = self.zero.q.val();
+        self.result.next = self.pack.result.val();
+        self.out_valid.next = self.pack.out_valid.val();
     }
 }
 
