@@ -170,19 +170,8 @@ impl<
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self,
-            clock,
-            in_a,
-            in_b,
-            in_valid_r,
-            last_rem,
-            last_quo,
-            last_exp,
-            last_sign,
-            last_nan,
-            last_inf,
-            last_zero,
-            last_valid
+            self, clock, in_a, in_b, in_valid_r, last_rem, last_quo, last_exp, last_sign, last_nan,
+            last_inf, last_zero, last_valid
         );
         for i in 0..S {
             self.rem[i].clock.next = self.clock.val();

@@ -149,18 +149,7 @@ impl<
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self,
-            clock,
-            in_a,
-            in_b,
-            in_valid_r,
-            prod,
-            exp_sum,
-            sign,
-            nan,
-            inf,
-            zero,
-            valid2
+            self, clock, in_a, in_b, in_valid_r, prod, exp_sum, sign, nan, inf, zero, valid2
         );
         // Stage 1.
         self.in_a.d.next = self.a.val();

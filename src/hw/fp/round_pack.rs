@@ -69,8 +69,14 @@ pub struct FpRoundPack<
     c_sign_bit: Constant<Bits<W>>,
 }
 
-impl<const W: usize, const E: usize, const M: usize, const S: usize, const S1: usize, const X2: usize>
-    Default for FpRoundPack<W, E, M, S, S1, X2>
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+    > Default for FpRoundPack<W, E, M, S, S1, X2>
 {
     fn default() -> Self {
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2);
@@ -111,8 +117,14 @@ impl<const W: usize, const E: usize, const M: usize, const S: usize, const S1: u
     }
 }
 
-impl<const W: usize, const E: usize, const M: usize, const S: usize, const S1: usize, const X2: usize>
-    Logic for FpRoundPack<W, E, M, S, S1, X2>
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+    > Logic for FpRoundPack<W, E, M, S, S1, X2>
 {
     #[hdl_gen]
     fn update(&mut self) {

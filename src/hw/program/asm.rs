@@ -468,7 +468,10 @@ mod tests {
         a.halt(); // 4
         let code = a.finish().code;
         assert!(code[0].jumps_after() && code[0].target == 0, "{}", code[0]);
-        assert_eq!(code[0].to_string(), format!("add r{0}, r{0}, #0x1; jump @0", r.0));
+        assert_eq!(
+            code[0].to_string(),
+            format!("add r{0}, r{0}, #0x1; jump @0", r.0)
+        );
         assert_eq!((code[1].op, code[1].target), (Op::Jal, 0));
         assert!(!code[2].jumps_after() && !code[2].invert && code[2].target == 4);
         assert!(!code[4].jumps_after());
