@@ -77,8 +77,9 @@ frames_equal_the_golden_model! {
     verilator_dynamic: Verilator "dynamic.toml" 12 x 9, frames Some(2);
     verilator_terrain_small: Verilator "terrain_small.toml" 16 x 12, frames None;
     verilator_cornell_noshadow: Verilator "cornell_noshadow.toml" 16 x 12, frames None;
-    // Icarus is about 20x slower than Verilator: one pixel per thread (a frame of up to 32
-    // pixels lasts about as long as its slowest pixel times the 32-clock rotation).
+    // Icarus simulates about 2k clocks per second here (Verilator about 1.7M): one pixel per
+    // thread (a frame of up to 32 pixels lasts about as long as its slowest pixel times the
+    // 32-clock rotation).
     icarus_cornell: Icarus "cornell.toml" 8 x 4, frames None;
     icarus_mirror: Icarus "mirror.toml" 8 x 4, frames None;
     icarus_tiny_animated: Icarus "tiny_animated.toml" 8 x 4, frames Some(2);

@@ -23,11 +23,13 @@
 
 use rust_hdl::prelude::*;
 
+use super::round_pack::ROUND_PACK_LATENCY;
 use super::{bias, const_bits, const_index, FpRoundPack};
 
-/// Latency of [`FpDiv`] in clocks for a format with `man_bits` stored mantissa bits.
+/// Latency of [`FpDiv`] in clocks for a format with `man_bits` stored mantissa bits: input
+/// registers, the first quotient bit, the other `man_bits + 1`, then rounding and packing.
 pub const fn div_latency(man_bits: u32) -> u32 {
-    man_bits + 5
+    man_bits + 3 + ROUND_PACK_LATENCY
 }
 
 #[derive(LogicBlock)]

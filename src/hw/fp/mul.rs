@@ -16,10 +16,11 @@
 
 use rust_hdl::prelude::*;
 
+use super::round_pack::ROUND_PACK_LATENCY;
 use super::{bias, const_bits, const_index, FpRoundPack, SigMul};
 
-/// Latency of [`FpMul`] in clocks.
-pub const MUL_LATENCY: u32 = 4;
+/// Latency of [`FpMul`] in clocks: input registers, the product, then rounding and packing.
+pub const MUL_LATENCY: u32 = 2 + ROUND_PACK_LATENCY;
 
 #[derive(LogicBlock)]
 pub struct FpMul<
