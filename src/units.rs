@@ -193,6 +193,23 @@ pub fn intersect(f: Format, o: Vec3W, d: Vec3W, t_min: u32, t_max: u32) -> UnitH
     intersect_with_margin(f, o, d, t_min, t_max, edge_margin(f))
 }
 
+/// The triangle tester's test (`hw::TriangleTester`): the ray into the triangle's unit space
+/// through the transformation unit (a point, then a vector), then [`intersect`] with no upper
+/// bound. The tester keeps the closest hit with [`closer_hit`] against the best so far, which
+/// is the golden model's test with `t_max` = the best t: `t < best_t` and `t < +inf` hold
+/// together exactly when `t < best_t`, since `best_t <= +inf`.
+pub fn triangle_test(f: Format, m: &Mat34W, o: Vec3W, d: Vec3W, t_min: u32) -> UnitHit {
+    let o = transform(f, m, o, true);
+    let d = transform(f, m, d, false);
+    intersect(f, o, d, t_min, f.infinity(false))
+}
+
+/// Whether a [`triangle_test`] result replaces the best hit so far (the first of equal ts
+/// stays, as in the golden model's list order).
+pub fn closer_hit(f: Format, r: &UnitHit, best_t: u32) -> bool {
+    r.hit && f.lt(r.t, best_t)
+}
+
 /// The unit-triangle test with edge margin `margin` (a format word; 0 is the exact test).
 /// Grows every triangle by `margin` in unit-triangle coordinates (a fraction of its size).
 pub fn intersect_with_margin(

@@ -23,6 +23,9 @@ pub struct SimFrame {
     pub pixels: Vec<u32>,
     pub cycles: u64,
     pub instructions: u64,
+    /// Clocks in which the TransformUnit, the IntersectUnit took an input.
+    pub transform_busy: u64,
+    pub intersect_busy: u64,
 }
 
 /// What a processor simulation produced.
@@ -172,9 +175,9 @@ pub fn simulate_processor(
             .split_whitespace()
             .filter_map(|w| w.parse().ok())
             .collect();
-        if nums.len() != 2 {
+        if nums.len() != 4 {
             bail!(
-                "{}: expected `cycles instructions`, got `{}`",
+                "{}: expected `cycles instructions transform_busy intersect_busy`, got `{}`",
                 stats_path.display(),
                 stats.trim()
             );
@@ -183,6 +186,8 @@ pub fn simulate_processor(
             pixels: px,
             cycles: nums[0],
             instructions: nums[1],
+            transform_busy: nums[2],
+            intersect_busy: nums[3],
         });
     }
     let vga = if capture_vga {

@@ -31,7 +31,7 @@ use rust_hdl::prelude::*;
 use super::fp::{FpAddSub, FpCompare, FpDiv, FpMul, FpSqrt};
 use super::program::isa::Instr;
 use super::program::Program;
-use super::{Delay, UIntToFloat};
+use super::{Delay, TriangleTester, UIntToFloat};
 
 /// Most threads (the thread id is 5 bits).
 pub const MAX_THREADS: usize = 32;
@@ -69,6 +69,7 @@ pub struct ThreadEngine<
     const DD: usize,
     const DC: usize,
     const DF: usize,
+    const DL: usize,
 > {
     pub clock: Signal<In, Clock>,
     /// A one-clock pulse starts a frame (while `done` or before the first frame).
@@ -83,6 +84,17 @@ pub struct ThreadEngine<
     pub fb_write: Signal<Out, Bit>,
     pub fb_addr: Signal<Out, Bits<24>>,
     pub fb_data: Signal<Out, Bits<32>>,
+    /// Banks 2 and 3 (the triangles) have their own ports: the triangle tester reads both at
+    /// once, and the engine's loads of these banks go out here too.
+    pub bank2_read: Signal<Out, Bit>,
+    pub bank2_addr: Signal<Out, Bits<24>>,
+    pub bank2_rdata: Signal<In, Bits<32>>,
+    pub bank3_read: Signal<Out, Bit>,
+    pub bank3_addr: Signal<Out, Bits<24>>,
+    pub bank3_rdata: Signal<In, Bits<32>>,
+    /// Clocks of the frame in which the TransformUnit and the IntersectUnit took an input.
+    pub transform_busy: Signal<Out, Bits<32>>,
+    pub intersect_busy: Signal<Out, Bits<32>>,
 
     // Thread state and program.
     pc_ram: RAM<Bits<16>, 5>,
@@ -102,6 +114,8 @@ pub struct ThreadEngine<
     halted_count: DFF<Bits<8>>,
     cycle_count: DFF<Bits<32>>,
     instr_count: DFF<Bits<32>>,
+    transform_count: DFF<Bits<32>>,
+    intersect_count: DFF<Bits<32>>,
     px: DFF<Bits<16>>,
     py: DFF<Bits<16>>,
     // I1
@@ -133,7 +147,8 @@ pub struct ThreadEngine<
     mb_len: Signal<Local, Bits<4>>,
     mb_next: Signal<Local, Bits<3>>,
     pix_done: Signal<Local, Bit>,
-    fast_kind: Signal<Local, Bits<2>>,
+    tri_cond: Signal<Local, Bit>,
+    fast_kind: Signal<Local, Bits<3>>,
     // Ports.
     mem_read_r: DFF<Bit>,
     mem_bank_r: DFF<Bits<3>>,
@@ -149,13 +164,14 @@ pub struct ThreadEngine<
     sqrt: FpSqrt<W, E, M, S, S1, T>,
     cmp: FpCompare<W, E, M>,
     itof: UIntToFloat<W, E, M>,
+    tester: TriangleTester<W, E, M, S, S1, X2, T, P, DL>,
     add_delay: Delay<Bits<W>, DA>,
     mul_delay: Delay<Bits<W>, DM>,
     div_delay: Delay<Bits<W>, DD>,
     sqrt_delay: Delay<Bits<W>, DD>,
     cmp_delay: Delay<Bits<3>, DC>,
     fast_line: [DFF<Bits<32>>; FAST_STAGES],
-    fast_kind_line: [DFF<Bits<2>>; FAST_STAGES],
+    fast_kind_line: [DFF<Bits<3>>; FAST_STAGES],
     fast_delay: Delay<Bits<32>, DF>,
     /// {valid, op, dst, thread, invert} from I3 to write back.
     ctl_delay: Delay<Bits<21>, DF>,
@@ -163,9 +179,10 @@ pub struct ThreadEngine<
     /// {pc + 1, target}.
     pc_delay: Delay<Bits<24>, DF>,
     pc_line: [DFF<Bits<24>>; FAST_STAGES],
-    /// {jump register (12 bits), int_eq, int_lt, mailbox hit, pixels exhausted}.
-    cond_delay: Delay<Bits<16>, DF>,
-    cond_line: [DFF<Bits<16>>; FAST_STAGES],
+    /// {tester refused or pending, jump register (12 bits), int_eq, int_lt, mailbox hit,
+    /// pixels exhausted}.
+    cond_delay: Delay<Bits<17>, DF>,
+    cond_line: [DFF<Bits<17>>; FAST_STAGES],
 
     // Write back.
     wb_valid: Signal<Local, Bit>,
@@ -222,7 +239,8 @@ impl<
         const DD: usize,
         const DC: usize,
         const DF: usize,
-    > ThreadEngine<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF>
+        const DL: usize,
+    > ThreadEngine<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF, DL>
 {
     /// The engine running `program` with `threads` threads and memory read latency
     /// `mem_latency`.
@@ -232,6 +250,7 @@ impl<
         assert!(P == 2 * S);
         assert!(DA == l - 7 && DM == l - 4 && DD == l - (M + 5) && DC == l - 2);
         assert!(DF == l - FAST_STAGES);
+        assert!(DL == super::fp::div::div_latency(M as u32) as usize);
         assert!((1..=MAX_THREADS as u32).contains(&threads));
         assert!((1..=MAX_MEM_LATENCY).contains(&mem_latency));
         assert!(program.scratch.words <= SCRATCH_WORDS);
@@ -257,6 +276,14 @@ impl<
             fb_write: Default::default(),
             fb_addr: Default::default(),
             fb_data: Default::default(),
+            bank2_read: Default::default(),
+            bank2_addr: Default::default(),
+            bank2_rdata: Default::default(),
+            bank3_read: Default::default(),
+            bank3_addr: Default::default(),
+            bank3_rdata: Default::default(),
+            transform_busy: Default::default(),
+            intersect_busy: Default::default(),
             pc_ram: RAM::new(word_map((0..32).map(|_| Bits::<16>::from(0u64)))),
             rom_ctl: rom(0),
             rom_imm: rom(1),
@@ -276,6 +303,8 @@ impl<
             halted_count: Default::default(),
             cycle_count: Default::default(),
             instr_count: Default::default(),
+            transform_count: Default::default(),
+            intersect_count: Default::default(),
             px: Default::default(),
             py: Default::default(),
             v1: Default::default(),
@@ -304,6 +333,7 @@ impl<
             mb_len: Default::default(),
             mb_next: Default::default(),
             pix_done: Default::default(),
+            tri_cond: Default::default(),
             fast_kind: Default::default(),
             mem_read_r: Default::default(),
             mem_bank_r: Default::default(),
@@ -317,6 +347,7 @@ impl<
             sqrt: Default::default(),
             cmp: Default::default(),
             itof: Default::default(),
+            tester: TriangleTester::new(mem_latency),
             add_delay: Default::default(),
             mul_delay: Default::default(),
             div_delay: Default::default(),
@@ -364,7 +395,8 @@ impl<
         const DD: usize,
         const DC: usize,
         const DF: usize,
-    > Logic for ThreadEngine<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF>
+        const DL: usize,
+    > Logic for ThreadEngine<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF, DL>
 {
     #[hdl_gen]
     fn update(&mut self) {
@@ -377,6 +409,8 @@ impl<
             halted_count,
             cycle_count,
             instr_count,
+            transform_count,
+            intersect_count,
             px,
             py,
             v1,
@@ -399,7 +433,7 @@ impl<
         );
         clock!(
             self, clock, add, mul, div, sqrt, cmp, add_delay, mul_delay, div_delay, sqrt_delay,
-            cmp_delay, fast_delay, ctl_delay, pc_delay, cond_delay
+            cmp_delay, fast_delay, ctl_delay, pc_delay, cond_delay, tester
         );
         self.pc_ram.read_clock.next = self.clock.val();
         self.pc_ram.write_clock.next = self.clock.val();
@@ -444,8 +478,16 @@ impl<
             (!self.running.q.val()) & (self.halted_count.q.val() == self.c_threads.val());
         self.cycles.next = self.cycle_count.q.val();
         self.instructions.next = self.instr_count.q.val();
+        self.transform_busy.next = self.transform_count.q.val();
+        self.intersect_busy.next = self.intersect_count.q.val();
         if self.running.q.val() {
             self.cycle_count.d.next = self.cycle_count.q.val() + 1;
+            if self.tester.transform_busy.val() {
+                self.transform_count.d.next = self.transform_count.q.val() + 1;
+            }
+            if self.tester.intersect_busy.val() {
+                self.intersect_count.d.next = self.intersect_count.q.val() + 1;
+            }
         }
         if self.slot.q.val() == self.c_period_last.val() {
             self.slot.d.next = 0.into();
@@ -484,6 +526,7 @@ impl<
             self.mailbox[k].read_address.next = (bit_cast::<6, 5>(self.t2.q.val()) << 1)
                 | bit_cast::<6, 1>(self.rom_imm.read_data.val().get_bits::<1>(0));
         }
+        self.tester.query_thread.next = self.t2.q.val();
         self.v3.d.next = self.v2.q.val();
         self.t3.d.next = self.t2.q.val();
         self.pc3.d.next = self.pc2.q.val();
@@ -608,9 +651,41 @@ impl<
         self.fb_write_r.d.next = self.v3.q.val() & (self.op3.val() == 15);
         self.fb_addr_r.d.next = self.mem_address.val().get_bits::<24>(0);
         self.fb_data_r.d.next = self.regs_b.read_data.val();
-        self.mem_read.next = self.mem_read_r.q.val();
+        // Banks 2 and 3 go through the triangle tester's ports.
+        self.mem_read.next = self.mem_read_r.q.val()
+            & (self.mem_bank_r.q.val() != 2)
+            & (self.mem_bank_r.q.val() != 3);
         self.mem_bank.next = self.mem_bank_r.q.val();
         self.mem_addr.next = self.mem_addr_r.q.val();
+        self.tester.engine_read.next = self.mem_read_r.q.val();
+        self.tester.engine_bank.next = self.mem_bank_r.q.val();
+        self.tester.engine_addr.next = self.mem_addr_r.q.val();
+        self.bank2_read.next = self.tester.uv_read.val();
+        self.bank2_addr.next = self.tester.uv_addr.val();
+        self.tester.uv_rdata.next = self.bank2_rdata.val();
+        self.bank3_read.next = self.tester.t_read.val();
+        self.bank3_addr.next = self.tester.t_addr.val();
+        self.tester.t_rdata.next = self.bank3_rdata.val();
+
+        // Triangle tester (op 29, function in imm): ray words 0-2, init 3, test 4, wait 5,
+        // hit 6, instance 7, triangle 8.
+        self.tester.thread.next = self.t3.q.val();
+        self.tester.word_a.next = self.opa.val();
+        self.tester.word_b.next = self.opb.val();
+        self.tester.ray_pair.next = self.imm3.q.val().get_bits::<2>(0);
+        self.tester.ray_write.next =
+            self.v3.q.val() & (self.op3.val() == 29) & (self.imm3.q.val() < 3);
+        self.tester.enqueue.next = self.v3.q.val()
+            & (self.op3.val() == 29)
+            & ((self.imm3.q.val() == 3) | (self.imm3.q.val() == 4));
+        self.tester.queue_init.next = self.imm3.q.val() == 3;
+        self.tri_cond.next = false;
+        if (self.imm3.q.val() == 3) | (self.imm3.q.val() == 4) {
+            self.tri_cond.next = self.tester.full.val();
+        }
+        if self.imm3.q.val() == 5 {
+            self.tri_cond.next = self.tester.pending.val();
+        }
         self.fb_write.next = self.fb_write_r.q.val();
         self.fb_addr.next = self.fb_addr_r.q.val();
         self.fb_data.next = self.fb_data_r.q.val();
@@ -644,6 +719,12 @@ impl<
         }
         if self.op3.val() == 14 {
             self.fast_kind.next = 2.into();
+            if self.aux3.q.val().get_bits::<3>(12) == 2 {
+                self.fast_kind.next = 3.into();
+            }
+            if self.aux3.q.val().get_bits::<3>(12) == 3 {
+                self.fast_kind.next = 4.into();
+            }
         }
         if self.op3.val() == 16 {
             self.fast_kind.next = 1.into();
@@ -654,6 +735,20 @@ impl<
         if self.op3.val() == 27 {
             self.fast.next =
                 (bit_cast::<32, 16>(self.py.q.val()) << 16) | bit_cast::<32, 16>(self.px.q.val());
+        }
+        if self.op3.val() == 29 {
+            if self.imm3.q.val() == 5 {
+                self.fast.next = bit_cast::<32, W>(self.tester.best_t.val());
+            }
+            if self.imm3.q.val() == 6 {
+                self.fast.next = bit_cast::<32, 1>(self.tester.hit.val().into());
+            }
+            if self.imm3.q.val() == 7 {
+                self.fast.next = self.tester.best_instance.val();
+            }
+            if self.imm3.q.val() == 8 {
+                self.fast.next = self.tester.best_triangle.val();
+            }
         }
 
         // The fast line: scratch data at I4, memory data at I4 + latency.
@@ -666,11 +761,12 @@ impl<
             | bit_cast::<21, 1>(self.ctl3.q.val().get_bits::<1>(0));
         self.pc_line[0].d.next = (bit_cast::<24, 12>(self.pc3.q.val() + 1) << 12)
             | bit_cast::<24, 12>(self.aux3.q.val().get_bits::<12>(0));
-        self.cond_line[0].d.next = (bit_cast::<16, 12>(self.opa.val().get_bits::<12>(0)) << 4)
-            | (bit_cast::<16, 1>(self.int_eq.val().into()) << 3)
-            | (bit_cast::<16, 1>(self.int_lt.val().into()) << 2)
-            | (bit_cast::<16, 1>(self.mb_hit.val().into()) << 1)
-            | bit_cast::<16, 1>(self.pix_done.val().into());
+        self.cond_line[0].d.next = (bit_cast::<17, 1>(self.tri_cond.val().into()) << 16)
+            | (bit_cast::<17, 12>(self.opa.val().get_bits::<12>(0)) << 4)
+            | (bit_cast::<17, 1>(self.int_eq.val().into()) << 3)
+            | (bit_cast::<17, 1>(self.int_lt.val().into()) << 2)
+            | (bit_cast::<17, 1>(self.mb_hit.val().into()) << 1)
+            | bit_cast::<17, 1>(self.pix_done.val().into());
         for k in 1..8 {
             self.fast_line[k].d.next = self.fast_line[k - 1].q.val();
             self.fast_kind_line[k].d.next = self.fast_kind_line[k - 1].q.val();
@@ -682,10 +778,16 @@ impl<
             self.fast_line[1].d.next = self.scratch.read_data.val();
         }
         for k in 1..7 {
-            if (self.fast_kind_line[k].q.val() == 2)
-                & (self.c_mem_latency.val() == self.c_index[k].val())
-            {
-                self.fast_line[k + 1].d.next = self.mem_rdata.val();
+            if self.c_mem_latency.val() == self.c_index[k].val() {
+                if self.fast_kind_line[k].q.val() == 2 {
+                    self.fast_line[k + 1].d.next = self.mem_rdata.val();
+                }
+                if self.fast_kind_line[k].q.val() == 3 {
+                    self.fast_line[k + 1].d.next = self.bank2_rdata.val();
+                }
+                if self.fast_kind_line[k].q.val() == 4 {
+                    self.fast_line[k + 1].d.next = self.bank3_rdata.val();
+                }
             }
         }
         self.fast_delay.data_in.next = self.fast_line[7].q.val();
@@ -724,6 +826,9 @@ impl<
         if self.wb_op.val() == 23 {
             self.wb_cond.next = true;
         }
+        if self.wb_op.val() == 29 {
+            self.wb_cond.next = self.cond_delay.data_out.val().get_bit(16);
+        }
         if self.wb_cond.val() != self.wb_invert.val() {
             self.wb_next_pc.next = self.pc_delay.data_out.val().get_bits::<12>(0);
         } else {
@@ -750,12 +855,13 @@ impl<
             self.wb_result.next = bit_cast::<32, W>(self.sqrt_delay.data_out.val());
         }
         // Ops that write: fp 1-6, integer 7-13, ld 14, lds 16, jal 23, pixel 27 (not when the
-        // frame's pixels are exhausted).
+        // frame's pixels are exhausted), tri 29 (its reading functions name a `dst`).
         self.wb_writes.next = self.wb_valid.val()
             & (self.wb_dst.val() != 0)
             & ((((self.wb_op.val() >= 1) & (self.wb_op.val() <= 14)) | (self.wb_op.val() == 16))
                 | ((self.wb_op.val() == 23)
-                    | ((self.wb_op.val() == 27) & (!self.cond_delay.data_out.val().get_bit(0)))));
+                    | ((self.wb_op.val() == 27) & (!self.cond_delay.data_out.val().get_bit(0)))
+                    | (self.wb_op.val() == 29)));
         self.regs_a.write_address.next =
             (bit_cast::<13, 5>(self.wb_thread.val()) << 8) | bit_cast::<13, 8>(self.wb_dst.val());
         self.regs_b.write_address.next =
@@ -783,6 +889,8 @@ impl<
             self.halted_count.d.next = 0.into();
             self.cycle_count.d.next = 0.into();
             self.instr_count.d.next = 0.into();
+            self.transform_count.d.next = 0.into();
+            self.intersect_count.d.next = 0.into();
             self.px.d.next = 0.into();
             self.py.d.next = 0.into();
         }

@@ -22,6 +22,7 @@ pub mod raygen;
 mod sim_harness;
 pub mod transform;
 pub mod transform_arbiter;
+pub mod triangle_tester;
 pub mod vga;
 
 pub use delay::Delay;
@@ -31,6 +32,7 @@ pub use intersect::{intersect_latency, IntersectUnit};
 pub use raygen::{RayGen, RayGenUnit};
 pub use transform::{TransformUnit, TRANSFORM_LATENCY};
 pub use transform_arbiter::{SharedTransformUnit, TRANSFORM_CLIENTS};
+pub use triangle_tester::TriangleTester;
 pub use vga::{VgaError, VgaMode, VgaPlacement, VgaTiming};
 
 /// Width of the tag that travels with every request through a geometry unit (client id and

@@ -8,7 +8,7 @@
 
 use std::cell::RefCell;
 
-use super::isa::{Instr, Op, MAX_PROGRAM, REGISTERS};
+use super::isa::{Instr, Op, TriFn, MAX_PROGRAM, REGISTERS};
 use crate::fp::Format;
 use crate::units::Arith;
 
@@ -348,6 +348,61 @@ impl Asm {
             },
             seen,
         );
+    }
+
+    /// `tri.<f> a, b` for a function that neither queues nor writes (the ray words).
+    pub fn tri_ray(&self, f: TriFn, a: Reg, b: Reg) {
+        debug_assert!(matches!(f, TriFn::RayOxy | TriFn::RayOzDx | TriFn::RayDyz));
+        self.emit(Instr {
+            a: a.0,
+            b: b.0,
+            imm: f as u32,
+            ..Instr::new(Op::Tri)
+        });
+    }
+
+    /// Queues `f` (`Init` or `Test`) with operands `a`, `b`, offering it again on the thread's
+    /// next turn while the queue is full. With `then`, the thread continues there once the
+    /// entry is taken (a refusal falls through to a jump back).
+    pub fn tri_queue(&self, f: TriFn, a: Reg, b: Reg, then: Option<Label>) {
+        debug_assert!(f.queues());
+        let i = Instr {
+            a: a.0,
+            b: b.0,
+            imm: f as u32,
+            ..Instr::new(Op::Tri)
+        };
+        let offer = self.here();
+        match then {
+            None => self.emit_to(i, offer),
+            Some(next) => {
+                self.emit_to(Instr { invert: true, ..i }, next);
+                self.jump(offer);
+            }
+        }
+    }
+
+    /// Waits until the thread's queued entries are done; `dst` = the best t.
+    pub fn tri_wait(&self, dst: Reg) {
+        let again = self.here();
+        self.emit_to(
+            Instr {
+                dst: dst.0,
+                imm: TriFn::Wait as u32,
+                ..Instr::new(Op::Tri)
+            },
+            again,
+        );
+    }
+
+    /// `dst` = the tester's `Hit`, `Instance` or `Triangle` (after a wait).
+    pub fn tri_read(&self, f: TriFn, dst: Reg) {
+        debug_assert!(matches!(f, TriFn::Hit | TriFn::Instance | TriFn::Triangle));
+        self.emit(Instr {
+            dst: dst.0,
+            imm: f as u32,
+            ..Instr::new(Op::Tri)
+        });
     }
 
     pub fn mailbox_clear(&self, which: u32) {

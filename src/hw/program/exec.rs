@@ -8,11 +8,11 @@
 //! pixel on one thread (threads never share state, so its result is the same; rayon runs
 //! those in parallel), optionally recording every register write for traces.
 
-use super::isa::{Instr, Op, Unit, REGISTERS};
+use super::isa::{Instr, Op, TriFn, Unit, REGISTERS};
 use super::Program;
 use crate::fp::Format;
-use crate::layout::Layout;
-use crate::units::Mailbox;
+use crate::layout::{Layout, TRIANGLES_T, TRIANGLE_BANK_WORDS};
+use crate::units::{self, Mailbox};
 
 /// A failure of the program on this memory (a generator bug or a layout that does not belong
 /// to the program).
@@ -33,12 +33,27 @@ pub struct Write {
     pub value: u32,
 }
 
+/// A thread's state in the triangle tester: its ray and its closest hit. The twin tests a
+/// queued triangle at once; the tester tests a thread's entries in the order they were queued,
+/// so a `wait` sees the same result.
+#[derive(Clone, Default)]
+struct TesterState {
+    o: [u32; 3],
+    d: [u32; 3],
+    t_min: u32,
+    hit: bool,
+    best_t: u32,
+    best_instance: u32,
+    best_triangle: u32,
+}
+
 #[derive(Clone)]
 struct Thread {
     pc: usize,
     regs: Vec<u32>,
     scratch: Vec<u32>,
     mailboxes: [Mailbox; 2],
+    tester: TesterState,
     halted: bool,
 }
 
@@ -49,6 +64,7 @@ impl Thread {
             regs: vec![0; REGISTERS],
             scratch: vec![0; scratch_words],
             mailboxes: Default::default(),
+            tester: TesterState::default(),
             halted: false,
         }
     }
@@ -261,6 +277,44 @@ impl<'a> Machine<'a> {
             Op::Halt => {
                 t.halted = true;
                 next = t.pc;
+            }
+            Op::Tri => {
+                let function = TriFn::from_imm(i.imm)
+                    .ok_or_else(|| fail(format!("no triangle tester function {}", i.imm)))?;
+                let tt = &mut t.tester;
+                match function {
+                    TriFn::RayOxy => (tt.o[0], tt.o[1]) = (a, b),
+                    TriFn::RayOzDx => (tt.o[2], tt.d[0]) = (a, b),
+                    TriFn::RayDyz => (tt.d[1], tt.d[2]) = (a, b),
+                    TriFn::Init => {
+                        tt.t_min = a;
+                        tt.hit = false;
+                        tt.best_t = b;
+                    }
+                    TriFn::Test => {
+                        let words = self.layout.banks[TRIANGLES_T].len() / TRIANGLE_BANK_WORDS;
+                        if a as usize >= words {
+                            return Err(fail(format!(
+                                "triangle {a} beyond the {words} triangles in memory"
+                            )));
+                        }
+                        let m = self.layout.triangle_transform(a);
+                        let r = units::triangle_test(f, &m, tt.o, tt.d, tt.t_min);
+                        if units::closer_hit(f, &r, tt.best_t) {
+                            tt.hit = true;
+                            tt.best_t = r.t;
+                            tt.best_instance = b;
+                            tt.best_triangle = a;
+                        }
+                    }
+                    TriFn::Wait => result = Some(tt.best_t),
+                    TriFn::Hit => result = Some(u32::from(tt.hit)),
+                    TriFn::Instance => result = Some(tt.best_instance),
+                    TriFn::Triangle => result = Some(tt.best_triangle),
+                }
+                // The twin's queue never refuses and its tests are done at once: the branch
+                // condition (refused, or still pending) is false.
+                branch_if(false, &mut next);
             }
         }
         if i.jumps_after() {

@@ -78,9 +78,69 @@ pub enum Op {
     Pixel,
     /// The thread stops.
     Halt,
+    /// The triangle tester (`hw::TriangleTester`), function `imm` ([`TriFn`]): give it the
+    /// ray, queue a triangle test, wait for the thread's tests, read the closest hit. A
+    /// function that queues branches to `target` when the queue refused it (full); `wait`
+    /// branches while tests are in flight.
+    Tri,
 }
 
-pub const OPS: [Op; 29] = [
+/// The functions of [`Op::Tri`] (its `imm`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum TriFn {
+    /// Ray words: `o.x = A, o.y = B`; `o.z = A, d.x = B`; `d.y = A, d.z = B` (object space).
+    RayOxy = 0,
+    RayOzDx,
+    RayDyz,
+    /// A new query: `t_min = A`, and queue "no hit yet, best t = B" behind the thread's tests.
+    Init,
+    /// Queue the test of triangle `A` of instance `B`.
+    Test,
+    /// Branch to `target` while tests are in flight; `dst` = best t.
+    Wait,
+    /// `dst` = 1 when some test hit, else 0.
+    Hit,
+    /// `dst` = the instance, the triangle of the closest hit.
+    Instance,
+    Triangle,
+}
+
+impl TriFn {
+    pub const ALL: [TriFn; 9] = [
+        TriFn::RayOxy,
+        TriFn::RayOzDx,
+        TriFn::RayDyz,
+        TriFn::Init,
+        TriFn::Test,
+        TriFn::Wait,
+        TriFn::Hit,
+        TriFn::Instance,
+        TriFn::Triangle,
+    ];
+    pub fn from_imm(imm: u32) -> Option<TriFn> {
+        Self::ALL.get(imm as usize).copied()
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            TriFn::RayOxy => "ray.oxy",
+            TriFn::RayOzDx => "ray.ozdx",
+            TriFn::RayDyz => "ray.dyz",
+            TriFn::Init => "init",
+            TriFn::Test => "test",
+            TriFn::Wait => "wait",
+            TriFn::Hit => "hit",
+            TriFn::Instance => "instance",
+            TriFn::Triangle => "triangle",
+        }
+    }
+    /// Whether the function puts an entry in the tester's queue.
+    pub fn queues(self) -> bool {
+        matches!(self, TriFn::Init | TriFn::Test)
+    }
+}
+
+pub const OPS: [Op; 30] = [
     Op::Nop,
     Op::FAdd,
     Op::FSub,
@@ -110,6 +170,7 @@ pub const OPS: [Op; 29] = [
     Op::Mbc,
     Op::Pixel,
     Op::Halt,
+    Op::Tri,
 ];
 
 impl Op {
@@ -134,6 +195,7 @@ impl Op {
                 | Lds
                 | Jal
                 | Pixel
+                | Tri
         )
     }
     /// Whether an instruction of this op can carry a jump to `target` after it (`invert`).
@@ -143,7 +205,10 @@ impl Op {
     /// Whether `target` is a branch target.
     pub fn branches(self) -> bool {
         use Op::*;
-        matches!(self, BFlt | BFle | BFeq | Beq | Bltu | Jal | Mbx | Pixel)
+        matches!(
+            self,
+            BFlt | BFle | BFeq | Beq | Bltu | Jal | Mbx | Pixel | Tri
+        )
     }
     /// The hardware unit that executes it (for statistics and for leaving units out).
     pub fn unit(self) -> Unit {
@@ -159,6 +224,7 @@ impl Op {
             Lds | Sts => Unit::Scratch,
             Mbx | Mbc => Unit::Mailbox,
             Pixel => Unit::PixelCounter,
+            Tri => Unit::TriangleTester,
             Nop | Add | Sub | And | Or | Xor | Shr | Shl | Beq | Bltu | Jal | Jr | Halt => {
                 Unit::Integer
             }
@@ -196,6 +262,7 @@ impl Op {
             Mbc => "mbc",
             Pixel => "pixel",
             Halt => "halt",
+            Tri => "tri",
         }
     }
 }
@@ -214,10 +281,11 @@ pub enum Unit {
     Scratch,
     Mailbox,
     PixelCounter,
+    TriangleTester,
 }
 
 impl Unit {
-    pub const ALL: [Unit; 11] = [
+    pub const ALL: [Unit; 12] = [
         Unit::FpAdd,
         Unit::FpMul,
         Unit::FpDiv,
@@ -229,6 +297,7 @@ impl Unit {
         Unit::Scratch,
         Unit::Mailbox,
         Unit::PixelCounter,
+        Unit::TriangleTester,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -243,6 +312,7 @@ impl Unit {
             Unit::Scratch => "scratch",
             Unit::Mailbox => "mailbox",
             Unit::PixelCounter => "pixel counter",
+            Unit::TriangleTester => "triangle tester",
         }
     }
 }
@@ -380,6 +450,14 @@ impl fmt::Display for Instr {
             Op::Mbx => write!(f, "mbx{} r{}, @{}", self.imm, self.a, self.target),
             Op::Mbc => write!(f, "mbc{}", self.imm),
             Op::Pixel => write!(f, "pixel r{}, @{}", self.dst, self.target),
+            Op::Tri => {
+                let name = TriFn::from_imm(self.imm).map_or("?", TriFn::name);
+                write!(
+                    f,
+                    "{inv}tri.{name} r{}, r{}, r{}, @{}",
+                    self.dst, self.a, self.b, self.target
+                )
+            }
             Op::FSqrt | Op::IToF => write!(f, "{} r{}, r{}", self.op.name(), self.dst, self.a),
             _ => write!(f, "{} r{}, r{}, {}", self.op.name(), self.dst, self.a, b),
         }

@@ -16,13 +16,19 @@
 //! rejects it (4 loads, 11 operations of the transform row, the division, 2 range compares),
 //! 40 when the first barycentric row does, about 60 for a hit.
 
+use super::asm::Asm;
 use super::asm::{Label, Reg, Val};
-use super::isa::{Op, MAILBOX_INSTANCES, MAILBOX_TRIANGLES};
+use super::isa::{Op, TriFn, MAILBOX_INSTANCES, MAILBOX_TRIANGLES};
 use super::{Gen, STACK_ENTRY_WORDS};
-use crate::layout::{
-    instance_word as iw, INSTANCES, LEAF_TAG, LISTS, NODES, TRIANGLES_T, TRIANGLES_UV,
-};
+use crate::layout::{instance_word as iw, INSTANCES, LEAF_TAG, LISTS, NODES};
 use crate::units;
+
+/// Gives the triangle tester the ray the triangles of this level are tested with.
+fn tester_ray(a: &Asm, ray: LevelRay) {
+    a.tri_ray(TriFn::RayOxy, ray.o[0], ray.o[1]);
+    a.tri_ray(TriFn::RayOzDx, ray.o[2], ray.d[0]);
+    a.tri_ray(TriFn::RayDyz, ray.d[1], ray.d[2]);
+}
 
 /// The ray one traversal level walks: registers, and where scratch holds a copy for the
 /// axis-indexed reads.
@@ -58,6 +64,10 @@ impl Gen<'_> {
             scratch: self.scratch.ray_top,
         };
         self.store_ray(world);
+        if self.c.top_root.is_none() {
+            tester_ray(a, world);
+        }
+        a.tri_queue(TriFn::Init, s.q_t_min, s.q_t_max, None);
         match self.c.top_root {
             Some(root) => {
                 a.mailbox_clear(MAILBOX_INSTANCES);
@@ -75,6 +85,8 @@ impl Gen<'_> {
         }
         a.bind(done);
         a.section("trace");
+        a.tri_read(TriFn::Instance, s.best_instance);
+        a.tri_read(TriFn::Triangle, s.best_triangle);
         a.ret(s.link);
     }
 
@@ -160,7 +172,7 @@ impl Gen<'_> {
         }
         match leaves {
             Leaves::Instances => self.instance_list(list, end, answered),
-            Leaves::Triangles(instance) => self.triangle_list(instance, ray, list, end, answered),
+            Leaves::Triangles(instance) => self.triangle_list(instance, list, end, answered),
         }
         a.free(list);
         a.free(end);
@@ -211,6 +223,7 @@ impl Gen<'_> {
             scratch: self.scratch.ray_object,
         };
         self.store_ray(local);
+        tester_ray(a, local);
         a.mailbox_clear(MAILBOX_TRIANGLES);
         self.traverse(root.into(), local, Leaves::Triangles(instance), answered);
         for r in local_o.into_iter().chain(local_d).chain([root]) {
@@ -232,7 +245,7 @@ impl Gen<'_> {
     }
 
     /// The triangles of an object leaf, `list..end` in bank 1.
-    fn triangle_list(&self, instance: Reg, ray: LevelRay, list: Reg, end: Reg, answered: Label) {
+    fn triangle_list(&self, instance: Reg, list: Reg, end: Reg, answered: Label) {
         let a = self.asm;
         let s = &self.s;
         a.section("triangles");
@@ -265,44 +278,20 @@ impl Gen<'_> {
             a.bind(not_skipped);
         }
         a.mailbox_check(MAILBOX_TRIANGLES, triangle, next);
-        a.section("intersect");
-        // `units::unit_triangle_coords` row by row, leaving at the first failed condition
-        // (the hit is their conjunction, so the order cannot change it): the t row first,
-        // since most rejected triangles lie outside the segment or behind the best hit.
-        let (o, d) = (ray.o.map(Val::R), ray.d.map(Val::R));
-        let row =
-            |bank: usize, first: u32| -> [Val; 4] { a.load_n(bank, triangle.into(), 3, first) };
-        let t_row = row(TRIANGLES_T, 0);
-        let t = units::unit_triangle_t(
-            a,
-            units::transform_row(a, &t_row, o, true),
-            units::transform_row(a, &t_row, d, false),
-        );
-        a.branch(Op::BFlt, s.q_t_min.into(), t, true, next);
-        a.branch(Op::BFlt, t, s.best_t.into(), true, next);
-        let f = self.c.format;
-        let (lo, hi) = units::edge_bounds(f, units::edge_margin(f));
-        let [u, v] = [0, 4].map(|first| {
-            let m = row(TRIANGLES_UV, first);
-            let c = units::unit_triangle_coord(
-                a,
-                units::transform_row(a, &m, o, true),
-                units::transform_row(a, &m, d, false),
-                t,
-            );
-            a.branch(Op::BFle, Val::K(lo), c, true, next);
-            c
-        });
-        let u_plus_v = units::Arith::add(a, u, v);
-        a.branch(Op::BFle, u_plus_v, Val::K(hi), true, next);
-        a.mov(s.best_t, t);
-        a.mov(s.best_instance, instance.into());
-        a.mov(s.best_triangle, triangle.into());
-        a.mov(s.hit, Val::K(1));
-        a.branch(Op::Beq, s.q_any.into(), Val::K(0), true, answered);
-        a.jump(next);
-        a.end_temps();
+        // The test runs in the triangle tester while the thread queues the leaf's next
+        // triangles; the tester keeps the closest hit in list order.
+        a.tri_queue(TriFn::Test, triangle, instance, Some(next));
         a.bind(done);
+        a.section("intersect");
+        a.tri_wait(s.best_t);
+        a.tri_read(TriFn::Hit, s.hit);
+        if self.c.shadows {
+            // A shadow query is answered by any hit.
+            let closest = a.label();
+            a.branch(Op::Beq, s.hit.into(), Val::K(0), false, closest);
+            a.branch(Op::Beq, s.q_any.into(), Val::K(0), true, answered);
+            a.bind(closest);
+        }
         a.free(p);
         a.free(triangle);
     }

@@ -1,0 +1,593 @@
+//! `TriangleTester`: the ray thread engine's coprocessor for triangle tests. A thread queues
+//! the triangles of a kd leaf (`tri.test`, one engine turn each), the tester fetches each
+//! triangle from banks 2 and 3, takes the ray into the triangle's unit space with the
+//! [`TransformUnit`] (the origin as a point, then the direction as a vector), tests it in the
+//! [`IntersectUnit`] and keeps the thread's closest hit; the thread waits for its tests once
+//! per leaf (`tri.wait`). Bit-exact with `units::triangle_test` and `units::closer_hit`.
+//!
+//! Engine side (the engine's I2/I3 stages):
+//! - Ray words: `ray_write` with `ray_pair` 0, 1, 2 writes `(o.x, o.y)`, `(o.z, d.x)`,
+//!   `(d.y, d.z)` of `thread` from `word_a`, `word_b`.
+//! - Queue: `queue` offers an entry of `thread`: a test of triangle `word_a` of instance
+//!   `word_b`, or with `queue_init` a new query (`t_min = word_a`, written at once; "no hit,
+//!   best t = `word_b`" queued behind the thread's earlier entries). It is taken when `full`
+//!   is low in that clock; the engine then counts it as issued.
+//! - Answers: `query_thread` at I2; at I3 `pending` (entries of the thread not yet done),
+//!   `hit`, `best_t`, `best_instance`, `best_triangle` of its closest hit.
+//!
+//! Entries are done in queue order, so a thread's closest hit is chosen in its list order
+//! (the first of equal ts stays), as in the golden model.
+//!
+//! State machine per entry: take it from the 16-entry queue (1 clock), fetch the triangle's 8
+//! words of bank 2 and 4 of bank 3 (8 clocks when the engine leaves the banks alone, plus the
+//! SRAM latency; an init fetches nothing), launch the origin and then the direction into the
+//! TransformUnit (2 clocks). Throughput: one test per `11 + mem_latency` clocks, one init per
+//! 4; entries leave the launch at least 4 clocks apart, which the hit merge needs (it reads,
+//! compares and writes a thread's best hit in 4 clocks). The engine's own loads of banks 2
+//! and 3 (shading data) take the bank in their clock; the fetch waits for it.
+//!
+//! Latency from launch to the merged hit: `TRANSFORM_LATENCY` (25) + 1 + `intersect_latency`
+//! (41 at e7m16) + 3. Const parameters: the operators' `W, E, M, S, S1, X2, T, P` and
+//! `DL = div_latency(M)` (the IntersectUnit's).
+
+use rust_hdl::prelude::*;
+
+use super::fp::{const_bits, FpCompare};
+use super::{IntersectUnit, TransformUnit};
+use crate::fp::Format;
+
+/// Entries the queue holds.
+pub const TESTER_QUEUE: usize = 16;
+// `update` spells out its numbers (rust-hdl's Verilog cannot name Rust constants): a
+// triangle is 8 words of bank 2 (the u and v rows) and 4 of bank 3 (the t row); the phases of
+// the fetch and launch state machine are 0 idle, 1 fetch, 2 launch the origin, 3 launch the
+// direction.
+
+/// Queue entry: `{init[69], thread[68:64], a[63:32], b[31:0]}`.
+type Entry = Bits<70>;
+
+/// Per-thread counters that start at 0 (nothing pending at power-up).
+fn zero_counters() -> RAM<Bits<8>, 5> {
+    RAM::new(
+        (0..32u64)
+            .map(|k| (Bits::<5>::from(k), Bits::<8>::from(0u64)))
+            .collect(),
+    )
+}
+
+#[derive(LogicBlock)]
+pub struct TriangleTester<
+    const W: usize,
+    const E: usize,
+    const M: usize,
+    const S: usize,
+    const S1: usize,
+    const X2: usize,
+    const T: usize,
+    const P: usize,
+    const DL: usize,
+> {
+    pub clock: Signal<In, Clock>,
+    pub thread: Signal<In, Bits<5>>,
+    pub word_a: Signal<In, Bits<32>>,
+    pub word_b: Signal<In, Bits<32>>,
+    pub ray_write: Signal<In, Bit>,
+    pub ray_pair: Signal<In, Bits<2>>,
+    pub enqueue: Signal<In, Bit>,
+    pub queue_init: Signal<In, Bit>,
+    pub full: Signal<Out, Bit>,
+    pub query_thread: Signal<In, Bits<5>>,
+    pub pending: Signal<Out, Bit>,
+    pub hit: Signal<Out, Bit>,
+    pub best_t: Signal<Out, Bits<W>>,
+    pub best_instance: Signal<Out, Bits<32>>,
+    pub best_triangle: Signal<Out, Bits<32>>,
+    /// The engine's memory port (registered): its loads of bank 2 or 3 go out here.
+    pub engine_read: Signal<In, Bit>,
+    pub engine_bank: Signal<In, Bits<3>>,
+    pub engine_addr: Signal<In, Bits<24>>,
+    /// Bank 2 (u and v rows) and bank 3 (t row, shading): one read per clock each, the word
+    /// `mem_latency` clocks after the request.
+    pub uv_read: Signal<Out, Bit>,
+    pub uv_addr: Signal<Out, Bits<24>>,
+    pub uv_rdata: Signal<In, Bits<32>>,
+    pub t_read: Signal<Out, Bit>,
+    pub t_addr: Signal<Out, Bits<24>>,
+    pub t_rdata: Signal<In, Bits<32>>,
+    /// High in the clocks the TransformUnit and the IntersectUnit take an input.
+    pub transform_busy: Signal<Out, Bit>,
+    pub intersect_busy: Signal<Out, Bit>,
+
+    queue_fifo: SynchronousFIFO<Entry, 4, 5, 1>,
+    /// Per thread: the ray (o, d), t_min; entries taken; (engine copies) entries done, best
+    /// hit `{hit, t}`, instance, triangle; (merge copies) entries done, best hit.
+    ray: [RAM<Bits<W>, 5>; 7],
+    issued: RAM<Bits<8>, 5>,
+    done_e: RAM<Bits<8>, 5>,
+    best_e: RAM<Bits<33>, 5>,
+    instance_e: RAM<Bits<32>, 5>,
+    triangle_e: RAM<Bits<32>, 5>,
+    done_m: RAM<Bits<8>, 5>,
+    best_m: RAM<Bits<33>, 5>,
+    /// Per launched entry (by sequence number): t_min for the IntersectUnit; a and b for the
+    /// merge.
+    flight_t_min: RAM<Bits<W>, 4>,
+    flight_a: RAM<Bits<32>, 4>,
+    flight_b: RAM<Bits<32>, 4>,
+
+    // Fetch and launch.
+    phase: DFF<Bits<2>>,
+    cur_init: DFF<Bit>,
+    cur_thread: DFF<Bits<5>>,
+    cur_a: DFF<Bits<32>>,
+    cur_b: DFF<Bits<32>>,
+    uv_issued: DFF<Bits<4>>,
+    t_issued: DFF<Bits<4>>,
+    received: DFF<Bits<4>>,
+    seq: DFF<Bits<4>>,
+    words: [DFF<Bits<W>>; 12],
+    uv_take: Signal<Local, Bit>,
+    t_take: Signal<Local, Bit>,
+    /// Requests in flight to the banks: `{valid, word index}` per clock of latency.
+    uv_line: [DFF<Bits<4>>; 6],
+    t_line: [DFF<Bits<4>>; 6],
+    uv_arrive: Signal<Local, Bits<4>>,
+    t_arrive: Signal<Local, Bits<4>>,
+    transform_unit: TransformUnit<W, E, M, S, S1, X2, T, P>,
+    o_hold: [DFF<Bits<W>>; 3],
+    intersect_unit: IntersectUnit<W, E, M, S, S1, X2, T, P, DL>,
+
+    // Merge: `m1` the IntersectUnit's result, `m2` with the thread's state, `m3` waiting for
+    // the comparison.
+    cmp: FpCompare<W, E, M>,
+    m1_valid: DFF<Bit>,
+    m1_hit: DFF<Bit>,
+    m1_init: DFF<Bit>,
+    m1_thread: DFF<Bits<5>>,
+    m1_t: DFF<Bits<W>>,
+    m2_valid: DFF<Bit>,
+    m2_hit: DFF<Bit>,
+    m2_init: DFF<Bit>,
+    m2_thread: DFF<Bits<5>>,
+    m2_t: DFF<Bits<W>>,
+    m2_a: DFF<Bits<32>>,
+    m2_b: DFF<Bits<32>>,
+    m2_done: DFF<Bits<8>>,
+    m3_valid: DFF<Bit>,
+    m3_hit: DFF<Bit>,
+    m3_init: DFF<Bit>,
+    m3_thread: DFF<Bits<5>>,
+    m3_t: DFF<Bits<W>>,
+    m3_a: DFF<Bits<32>>,
+    m3_b: DFF<Bits<32>>,
+    m3_done: DFF<Bits<8>>,
+    merge_hit: Signal<Local, Bit>,
+    merge_best: Signal<Local, Bits<33>>,
+    merge_write: Signal<Local, Bit>,
+    launch_tag: Signal<Local, Bits<16>>,
+
+    c_ml_last: Constant<Bits<4>>,
+    c_index: [Constant<Bits<4>>; 12],
+    c_infinity: Constant<Bits<W>>,
+    c_d_pass: Constant<Bits<16>>,
+    c_hit_flag: Constant<Bits<33>>,
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+        const DL: usize,
+    > TriangleTester<W, E, M, S, S1, X2, T, P, DL>
+{
+    /// The tester for SRAM read latency `mem_latency` (1..=6).
+    pub fn new(mem_latency: u32) -> Self {
+        assert!((1..=6).contains(&mem_latency));
+        let f = Format::new(E as u32, M as u32).expect("a supported format");
+        Self {
+            clock: Default::default(),
+            thread: Default::default(),
+            word_a: Default::default(),
+            word_b: Default::default(),
+            ray_write: Default::default(),
+            ray_pair: Default::default(),
+            enqueue: Default::default(),
+            queue_init: Default::default(),
+            full: Default::default(),
+            query_thread: Default::default(),
+            pending: Default::default(),
+            hit: Default::default(),
+            best_t: Default::default(),
+            best_instance: Default::default(),
+            best_triangle: Default::default(),
+            engine_read: Default::default(),
+            engine_bank: Default::default(),
+            engine_addr: Default::default(),
+            uv_read: Default::default(),
+            uv_addr: Default::default(),
+            uv_rdata: Default::default(),
+            t_read: Default::default(),
+            t_addr: Default::default(),
+            t_rdata: Default::default(),
+            transform_busy: Default::default(),
+            intersect_busy: Default::default(),
+            queue_fifo: Default::default(),
+            ray: Default::default(),
+            // The counters start equal (nothing pending) at power-up.
+            issued: zero_counters(),
+            done_e: zero_counters(),
+            best_e: Default::default(),
+            instance_e: Default::default(),
+            triangle_e: Default::default(),
+            done_m: zero_counters(),
+            best_m: Default::default(),
+            flight_t_min: Default::default(),
+            flight_a: Default::default(),
+            flight_b: Default::default(),
+            phase: Default::default(),
+            cur_init: Default::default(),
+            cur_thread: Default::default(),
+            cur_a: Default::default(),
+            cur_b: Default::default(),
+            uv_issued: Default::default(),
+            t_issued: Default::default(),
+            received: Default::default(),
+            seq: Default::default(),
+            words: Default::default(),
+            uv_take: Default::default(),
+            t_take: Default::default(),
+            uv_line: Default::default(),
+            t_line: Default::default(),
+            uv_arrive: Default::default(),
+            t_arrive: Default::default(),
+            transform_unit: Default::default(),
+            o_hold: Default::default(),
+            intersect_unit: Default::default(),
+            cmp: Default::default(),
+            m1_valid: Default::default(),
+            m1_hit: Default::default(),
+            m1_init: Default::default(),
+            m1_thread: Default::default(),
+            m1_t: Default::default(),
+            m2_valid: Default::default(),
+            m2_hit: Default::default(),
+            m2_init: Default::default(),
+            m2_thread: Default::default(),
+            m2_t: Default::default(),
+            m2_a: Default::default(),
+            m2_b: Default::default(),
+            m2_done: Default::default(),
+            m3_valid: Default::default(),
+            m3_hit: Default::default(),
+            m3_init: Default::default(),
+            m3_thread: Default::default(),
+            m3_t: Default::default(),
+            m3_a: Default::default(),
+            m3_b: Default::default(),
+            m3_done: Default::default(),
+            merge_hit: Default::default(),
+            merge_best: Default::default(),
+            merge_write: Default::default(),
+            launch_tag: Default::default(),
+            c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
+            c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
+            c_infinity: const_bits::<W>(u64::from(f.infinity(false))),
+            c_d_pass: Constant::new((1u64 << 10).into()),
+            c_hit_flag: Constant::new((1u64 << 32).into()),
+        }
+    }
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+        const DL: usize,
+    > Logic for TriangleTester<W, E, M, S, S1, X2, T, P, DL>
+{
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(
+            self, clock, phase, cur_init, cur_thread, cur_a, cur_b, uv_issued, t_issued, received,
+            seq, m1_valid, m1_hit, m1_init, m1_thread, m1_t, m2_valid, m2_hit, m2_init, m2_thread,
+            m2_t, m2_a, m2_b, m2_done, m3_valid, m3_hit, m3_init, m3_thread, m3_t, m3_a, m3_b,
+            m3_done
+        );
+        clock!(self, clock, queue_fifo, transform_unit, intersect_unit, cmp);
+        for k in 0..7 {
+            self.ray[k].read_clock.next = self.clock.val();
+            self.ray[k].write_clock.next = self.clock.val();
+        }
+        self.issued.read_clock.next = self.clock.val();
+        self.issued.write_clock.next = self.clock.val();
+        self.done_e.read_clock.next = self.clock.val();
+        self.done_e.write_clock.next = self.clock.val();
+        self.best_e.read_clock.next = self.clock.val();
+        self.best_e.write_clock.next = self.clock.val();
+        self.instance_e.read_clock.next = self.clock.val();
+        self.instance_e.write_clock.next = self.clock.val();
+        self.triangle_e.read_clock.next = self.clock.val();
+        self.triangle_e.write_clock.next = self.clock.val();
+        self.done_m.read_clock.next = self.clock.val();
+        self.done_m.write_clock.next = self.clock.val();
+        self.best_m.read_clock.next = self.clock.val();
+        self.best_m.write_clock.next = self.clock.val();
+        self.flight_t_min.read_clock.next = self.clock.val();
+        self.flight_t_min.write_clock.next = self.clock.val();
+        self.flight_a.read_clock.next = self.clock.val();
+        self.flight_a.write_clock.next = self.clock.val();
+        self.flight_b.read_clock.next = self.clock.val();
+        self.flight_b.write_clock.next = self.clock.val();
+        for k in 0..12 {
+            self.words[k].clock.next = self.clock.val();
+            self.words[k].d.next = self.words[k].q.val();
+        }
+        for k in 0..6 {
+            self.uv_line[k].clock.next = self.clock.val();
+            self.t_line[k].clock.next = self.clock.val();
+        }
+        for k in 0..3 {
+            self.o_hold[k].clock.next = self.clock.val();
+        }
+
+        // Engine side: ray words, t_min of a new query, the queue.
+        for k in 0..7 {
+            self.ray[k].write_address.next = self.thread.val();
+            self.ray[k].write_enable.next = false;
+            self.ray[k].write_data.next = self.word_a.val().get_bits::<W>(0);
+        }
+        if self.ray_write.val() {
+            if self.ray_pair.val() == 0 {
+                self.ray[0].write_enable.next = true;
+                self.ray[1].write_enable.next = true;
+                self.ray[1].write_data.next = self.word_b.val().get_bits::<W>(0);
+            }
+            if self.ray_pair.val() == 1 {
+                self.ray[2].write_enable.next = true;
+                self.ray[3].write_enable.next = true;
+                self.ray[3].write_data.next = self.word_b.val().get_bits::<W>(0);
+            }
+            if self.ray_pair.val() == 2 {
+                self.ray[4].write_enable.next = true;
+                self.ray[5].write_enable.next = true;
+                self.ray[5].write_data.next = self.word_b.val().get_bits::<W>(0);
+            }
+        }
+        self.ray[6].write_enable.next = self.enqueue.val() & self.queue_init.val();
+        self.full.next = self.queue_fifo.full.val();
+        self.queue_fifo.write.next = self.enqueue.val() & (!self.queue_fifo.full.val());
+        self.queue_fifo.data_in.next = (bit_cast::<70, 1>(self.queue_init.val().into()) << 69)
+            | (bit_cast::<70, 5>(self.thread.val()) << 64)
+            | (bit_cast::<70, 32>(self.word_a.val()) << 32)
+            | bit_cast::<70, 32>(self.word_b.val());
+
+        // Engine answers (address at I2, data at I3).
+        self.issued.read_address.next = self.query_thread.val();
+        self.done_e.read_address.next = self.query_thread.val();
+        self.best_e.read_address.next = self.query_thread.val();
+        self.instance_e.read_address.next = self.query_thread.val();
+        self.triangle_e.read_address.next = self.query_thread.val();
+        self.pending.next = self.issued.read_data.val() != self.done_e.read_data.val();
+        self.hit.next = self.best_e.read_data.val().get_bit(32);
+        self.best_t.next = self.best_e.read_data.val().get_bits::<W>(0);
+        self.best_instance.next = self.instance_e.read_data.val();
+        self.best_triangle.next = self.triangle_e.read_data.val();
+        self.issued.write_address.next = self.thread.val();
+        self.issued.write_data.next = self.issued.read_data.val() + 1;
+        self.issued.write_enable.next = self.enqueue.val() & (!self.queue_fifo.full.val());
+
+        // Fetch: the banks serve the engine first.
+        self.queue_fifo.read.next = false;
+        for k in 0..7 {
+            self.ray[k].read_address.next = self.cur_thread.q.val();
+        }
+        self.uv_take.next = (self.phase.q.val() == 1)
+            & (self.uv_issued.q.val() < 8)
+            & (!(self.engine_read.val() & (self.engine_bank.val() == 2)));
+        self.t_take.next = (self.phase.q.val() == 1)
+            & (self.t_issued.q.val() < 4)
+            & (!(self.engine_read.val() & (self.engine_bank.val() == 3)));
+        self.uv_read.next =
+            self.uv_take.val() | (self.engine_read.val() & (self.engine_bank.val() == 2));
+        self.t_read.next =
+            self.t_take.val() | (self.engine_read.val() & (self.engine_bank.val() == 3));
+        self.uv_addr.next = self.engine_addr.val();
+        self.t_addr.next = self.engine_addr.val();
+        if self.uv_take.val() {
+            self.uv_addr.next = (self.cur_a.q.val().get_bits::<24>(0) << 3)
+                + bit_cast::<24, 4>(self.uv_issued.q.val());
+            self.uv_issued.d.next = self.uv_issued.q.val() + 1;
+        }
+        if self.t_take.val() {
+            self.t_addr.next = (self.cur_a.q.val().get_bits::<24>(0) << 3)
+                + bit_cast::<24, 4>(self.t_issued.q.val());
+            self.t_issued.d.next = self.t_issued.q.val() + 1;
+        }
+        self.uv_line[0].d.next = (bit_cast::<4, 1>(self.uv_take.val().into()) << 3)
+            | bit_cast::<4, 3>(self.uv_issued.q.val().get_bits::<3>(0));
+        self.t_line[0].d.next = (bit_cast::<4, 1>(self.t_take.val().into()) << 3)
+            | bit_cast::<4, 3>(self.t_issued.q.val().get_bits::<3>(0));
+        for k in 1..6 {
+            self.uv_line[k].d.next = self.uv_line[k - 1].q.val();
+            self.t_line[k].d.next = self.t_line[k - 1].q.val();
+        }
+        // The word of the request `mem_latency` clocks ago: `{valid, index}`.
+        self.uv_arrive.next = 0.into();
+        self.t_arrive.next = 0.into();
+        for k in 0..6 {
+            if self.c_ml_last.val() == self.c_index[k].val() {
+                self.uv_arrive.next = self.uv_line[k].q.val();
+                self.t_arrive.next = self.t_line[k].q.val();
+            }
+        }
+        for k in 0..8 {
+            if self.uv_arrive.val().get_bit(3)
+                & (bit_cast::<4, 3>(self.uv_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
+            {
+                self.words[k].d.next = self.uv_rdata.val().get_bits::<W>(0);
+            }
+        }
+        for k in 0..4 {
+            if self.t_arrive.val().get_bit(3)
+                & (bit_cast::<4, 3>(self.t_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
+            {
+                self.words[8 + k].d.next = self.t_rdata.val().get_bits::<W>(0);
+            }
+        }
+        self.received.d.next = self.received.q.val()
+            + bit_cast::<4, 1>(self.uv_arrive.val().get_bit(3).into())
+            + bit_cast::<4, 1>(self.t_arrive.val().get_bit(3).into());
+
+        // Launch: the origin, then the direction, of the entry's thread.
+        self.transform_unit.in_valid.next = false;
+        self.transform_unit.point.next = true;
+        for k in 0..12 {
+            self.transform_unit.m[k].next = self.words[k].q.val();
+        }
+        for k in 0..3 {
+            self.transform_unit.v[k].next = self.ray[k].read_data.val();
+        }
+        // Tag: `{d pass[10], init[9], thread[8:4], seq[3:0]}`.
+        self.launch_tag.next = (bit_cast::<16, 1>(self.cur_init.q.val().into()) << 9)
+            | (bit_cast::<16, 5>(self.cur_thread.q.val()) << 4)
+            | bit_cast::<16, 4>(self.seq.q.val());
+        self.transform_unit.tag.next = self.launch_tag.val();
+        self.flight_t_min.write_address.next = self.seq.q.val();
+        self.flight_a.write_address.next = self.seq.q.val();
+        self.flight_b.write_address.next = self.seq.q.val();
+        self.flight_t_min.write_data.next = self.ray[6].read_data.val();
+        self.flight_a.write_data.next = self.cur_a.q.val();
+        self.flight_b.write_data.next = self.cur_b.q.val();
+        self.flight_t_min.write_enable.next = false;
+        self.flight_a.write_enable.next = false;
+        self.flight_b.write_enable.next = false;
+        if self.phase.q.val() == 0 {
+            if !self.queue_fifo.empty.val() {
+                self.queue_fifo.read.next = true;
+                self.cur_init.d.next = self.queue_fifo.data_out.val().get_bit(69);
+                self.cur_thread.d.next = self.queue_fifo.data_out.val().get_bits::<5>(64);
+                self.cur_a.d.next = self.queue_fifo.data_out.val().get_bits::<32>(32);
+                self.cur_b.d.next = self.queue_fifo.data_out.val().get_bits::<32>(0);
+                self.uv_issued.d.next = 0.into();
+                self.t_issued.d.next = 0.into();
+                self.received.d.next = 0.into();
+                if self.queue_fifo.data_out.val().get_bit(69) {
+                    // An init fetches nothing.
+                    self.uv_issued.d.next = 8.into();
+                    self.t_issued.d.next = 4.into();
+                    self.received.d.next = 12.into();
+                }
+                self.phase.d.next = 1.into();
+            }
+        }
+        if (self.phase.q.val() == 1) & (self.received.q.val() == 12) {
+            self.phase.d.next = 2.into();
+        }
+        if self.phase.q.val() == 2 {
+            self.transform_unit.in_valid.next = true;
+            self.flight_t_min.write_enable.next = true;
+            self.flight_a.write_enable.next = true;
+            self.flight_b.write_enable.next = true;
+            self.phase.d.next = 3.into();
+        }
+        if self.phase.q.val() == 3 {
+            self.transform_unit.in_valid.next = true;
+            self.transform_unit.point.next = false;
+            for k in 0..3 {
+                self.transform_unit.v[k].next = self.ray[3 + k].read_data.val();
+            }
+            self.transform_unit.tag.next = self.launch_tag.val() | self.c_d_pass.val();
+            self.seq.d.next = self.seq.q.val() + 1;
+            self.phase.d.next = 0.into();
+        }
+        self.transform_busy.next = self.transform_unit.in_valid.val();
+
+        // O' waits a clock for D'; then the unit-triangle test.
+        for k in 0..3 {
+            self.o_hold[k].d.next = self.o_hold[k].q.val();
+            if self.transform_unit.out_valid.val()
+                & (!self.transform_unit.out_tag.val().get_bit(10))
+            {
+                self.o_hold[k].d.next = self.transform_unit.result[k].val();
+            }
+        }
+        self.flight_t_min.read_address.next = self.transform_unit.out_tag.val().get_bits::<4>(0);
+        self.intersect_unit.in_valid.next =
+            self.transform_unit.out_valid.val() & self.transform_unit.out_tag.val().get_bit(10);
+        for k in 0..3 {
+            self.intersect_unit.o[k].next = self.o_hold[k].q.val();
+            self.intersect_unit.d[k].next = self.transform_unit.result[k].val();
+        }
+        self.intersect_unit.t_min.next = self.flight_t_min.read_data.val();
+        self.intersect_unit.t_max.next = self.c_infinity.val();
+        self.intersect_unit.tag.next = self.transform_unit.out_tag.val();
+        self.intersect_busy.next = self.intersect_unit.in_valid.val();
+
+        // Merge: read the thread's state, compare t with its best, write.
+        self.done_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(4);
+        self.best_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(4);
+        self.flight_a.read_address.next = self.intersect_unit.out_tag.val().get_bits::<4>(0);
+        self.flight_b.read_address.next = self.intersect_unit.out_tag.val().get_bits::<4>(0);
+        self.m1_valid.d.next = self.intersect_unit.out_valid.val();
+        self.m1_hit.d.next = self.intersect_unit.hit.val();
+        self.m1_init.d.next = self.intersect_unit.out_tag.val().get_bit(9);
+        self.m1_thread.d.next = self.intersect_unit.out_tag.val().get_bits::<5>(4);
+        self.m1_t.d.next = self.intersect_unit.t.val();
+        self.cmp.in_valid.next = true;
+        self.cmp.a.next = self.m1_t.q.val();
+        self.cmp.b.next = self.best_m.read_data.val().get_bits::<W>(0);
+        self.m2_valid.d.next = self.m1_valid.q.val();
+        self.m2_hit.d.next = self.m1_hit.q.val();
+        self.m2_init.d.next = self.m1_init.q.val();
+        self.m2_thread.d.next = self.m1_thread.q.val();
+        self.m2_t.d.next = self.m1_t.q.val();
+        self.m2_a.d.next = self.flight_a.read_data.val();
+        self.m2_b.d.next = self.flight_b.read_data.val();
+        self.m2_done.d.next = self.done_m.read_data.val();
+        self.m3_valid.d.next = self.m2_valid.q.val();
+        self.m3_hit.d.next = self.m2_hit.q.val();
+        self.m3_init.d.next = self.m2_init.q.val();
+        self.m3_thread.d.next = self.m2_thread.q.val();
+        self.m3_t.d.next = self.m2_t.q.val();
+        self.m3_a.d.next = self.m2_a.q.val();
+        self.m3_b.d.next = self.m2_b.q.val();
+        self.m3_done.d.next = self.m2_done.q.val();
+        self.merge_hit.next = self.m3_hit.q.val() & self.cmp.lt.val() & (!self.m3_init.q.val());
+
+        self.done_m.write_address.next = self.m3_thread.q.val();
+        self.done_e.write_address.next = self.m3_thread.q.val();
+        self.best_m.write_address.next = self.m3_thread.q.val();
+        self.best_e.write_address.next = self.m3_thread.q.val();
+        self.instance_e.write_address.next = self.m3_thread.q.val();
+        self.triangle_e.write_address.next = self.m3_thread.q.val();
+        self.done_m.write_data.next = self.m3_done.q.val() + 1;
+        self.done_e.write_data.next = self.m3_done.q.val() + 1;
+        self.done_m.write_enable.next = self.m3_valid.q.val();
+        self.done_e.write_enable.next = self.m3_valid.q.val();
+        // An init: no hit, best t = its b. A closer hit: hit, its t.
+        self.merge_best.next = bit_cast::<33, W>(self.m3_b.q.val().get_bits::<W>(0));
+        if self.merge_hit.val() {
+            self.merge_best.next = self.c_hit_flag.val() | bit_cast::<33, W>(self.m3_t.q.val());
+        }
+        self.merge_write.next =
+            self.m3_valid.q.val() & (self.m3_init.q.val() | self.merge_hit.val());
+        self.best_m.write_data.next = self.merge_best.val();
+        self.best_e.write_data.next = self.merge_best.val();
+        self.best_m.write_enable.next = self.merge_write.val();
+        self.best_e.write_enable.next = self.merge_write.val();
+        self.instance_e.write_data.next = self.m3_b.q.val();
+        self.triangle_e.write_data.next = self.m3_a.q.val();
+        self.instance_e.write_enable.next = self.m3_valid.q.val() & self.merge_hit.val();
+        self.triangle_e.write_enable.next = self.m3_valid.q.val() & self.merge_hit.val();
+    }
+}
