@@ -48,6 +48,9 @@ pub fn processor_ports(display: &VgaMode) -> Vec<Port> {
         Port::io("fb_write", 1, Output),
         Port::io("fb_addr", 24, Output),
         Port::io("fb_data", 32, Output),
+        Port::io("bank0_read", 1, Output),
+        Port::io("bank0_addr", 24, Output),
+        Port::io("bank0_rdata", 32, Input),
         Port::io("bank2_read", 1, Output),
         Port::io("bank2_addr", 24, Output),
         Port::io("bank2_rdata", 32, Input),
@@ -56,6 +59,7 @@ pub fn processor_ports(display: &VgaMode) -> Vec<Port> {
         Port::io("bank3_rdata", 32, Input),
         Port::io("transform_busy", 32, Output),
         Port::io("intersect_busy", 32, Output),
+        Port::io("traversal_busy", 32, Output),
         Port::clock("vga_clock", display.pixel_clock_hz as f64),
         Port::io("vga_reset", 1, Input),
         Port::io("vga_fb_addr", 24, Output),
@@ -189,6 +193,11 @@ pub struct Mismatch {
 pub struct FrameReport {
     pub cycles: u64,
     pub instructions: u64,
+    /// Clocks in which the triangle tester's TransformUnit, IntersectUnit took an input.
+    pub transform_busy: u64,
+    pub intersect_busy: u64,
+    /// Clocks in which the traversal unit started a node decision.
+    pub traversal_busy: u64,
     pub pixels: u64,
     pub mismatches: Vec<Mismatch>,
     pub differing_pixels: usize,
@@ -200,6 +209,17 @@ impl FrameReport {
     }
     pub fn fps(&self) -> f64 {
         CLOCK_HZ / self.cycles as f64
+    }
+    /// Shares of the frame's clocks in which the TransformUnit, the IntersectUnit and the
+    /// traversal unit's decision took an input.
+    pub fn unit_busy_shares(&self) -> [f64; 3] {
+        let c = self.cycles.max(1) as f64;
+        [
+            self.transform_busy,
+            self.intersect_busy,
+            self.traversal_busy,
+        ]
+        .map(|n| n as f64 / c)
     }
     /// Frames per second at 90 MHz for 512x384 at this scene's cycles per primary ray.
     pub fn fps_512x384(&self) -> f64 {
@@ -327,6 +347,9 @@ pub fn simulate_scene(
         reports.push(FrameReport {
             cycles: fr.cycles,
             instructions: fr.instructions,
+            transform_busy: fr.transform_busy,
+            intersect_busy: fr.intersect_busy,
+            traversal_busy: fr.traversal_busy,
             pixels: u64::from(w * h),
             differing_pixels: differing.len(),
             mismatches,

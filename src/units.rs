@@ -11,6 +11,7 @@
 //! processor's tests compare the two renderers pixel by pixel.
 
 use crate::fp::Format;
+use crate::layout::Node;
 
 /// Entries of the per-ray mailboxes (most recently tested ids, first in first out), in the
 /// golden model and in the hardware.
@@ -268,6 +269,110 @@ pub fn traversal_step(
         Visit::Both { t_split }
     };
     (near_is_left, visit)
+}
+
+/// Where a [`KdWalk`] stopped: at a leaf (its list in bank 1), or at the end of the walk.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KdStop {
+    Leaf { list: u32, count: u32 },
+    Finished,
+}
+
+/// The traversal unit's walk of one kd tree, resumable at each leaf: `model::golden`'s
+/// `traverse` with [`traversal_step`], which the golden model runs in one loop and the
+/// hardware runs between the thread's leaves. The engine's twin and the unit's tests share it.
+#[derive(Clone, Debug, Default)]
+pub struct KdWalk {
+    node: u32,
+    lo: u32,
+    hi: u32,
+    stack: Vec<(u32, u32, u32)>,
+    /// The segment end of the leaf handed out last.
+    leaf_hi: u32,
+}
+
+impl KdWalk {
+    /// Walks from `root` with the segment `[t_min, t_max]` to the first leaf. `fetch` reads a
+    /// node; `max_depth` bounds the stack.
+    pub fn start(
+        f: Format,
+        ray: (Vec3W, Vec3W),
+        root: u32,
+        (t_min, t_max): (u32, u32),
+        max_depth: usize,
+        fetch: impl FnMut(u32) -> Result<Node, String>,
+    ) -> Result<(KdWalk, KdStop), String> {
+        let mut walk = KdWalk {
+            node: root,
+            lo: t_min,
+            hi: t_max,
+            ..KdWalk::default()
+        };
+        let stop = walk.to_leaf(f, ray, max_depth, fetch)?;
+        Ok((walk, stop))
+    }
+
+    /// Goes on after the last leaf, whose closest hit so far is `best_t` (when `hit`): ends
+    /// when the hit lies in that leaf's segment, the stack is empty, or the popped segment
+    /// starts behind the hit.
+    pub fn next(
+        &mut self,
+        f: Format,
+        ray: (Vec3W, Vec3W),
+        (best_t, hit): (u32, bool),
+        max_depth: usize,
+        fetch: impl FnMut(u32) -> Result<Node, String>,
+    ) -> Result<KdStop, String> {
+        if hit && f.le(best_t, self.leaf_hi) {
+            return Ok(KdStop::Finished);
+        }
+        match self.stack.pop() {
+            Some((_, lo, _)) if hit && f.lt(best_t, lo) => Ok(KdStop::Finished),
+            Some((node, lo, hi)) => {
+                (self.node, self.lo, self.hi) = (node, lo, hi);
+                self.to_leaf(f, ray, max_depth, fetch)
+            }
+            None => Ok(KdStop::Finished),
+        }
+    }
+
+    fn to_leaf(
+        &mut self,
+        f: Format,
+        (o, d): (Vec3W, Vec3W),
+        max_depth: usize,
+        mut fetch: impl FnMut(u32) -> Result<Node, String>,
+    ) -> Result<KdStop, String> {
+        loop {
+            match fetch(self.node)? {
+                Node::Inner { axis, split, left } => {
+                    let (near_is_left, visit) =
+                        traversal_step(f, o[axis], d[axis], split, self.lo, self.hi);
+                    let (near, far) = if near_is_left {
+                        (left, left + 1)
+                    } else {
+                        (left + 1, left)
+                    };
+                    self.node = match visit {
+                        Visit::Near => near,
+                        Visit::Far => far,
+                        Visit::Both { t_split } => {
+                            if self.stack.len() >= max_depth {
+                                return Err(format!("kd stack deeper than {max_depth} levels"));
+                            }
+                            self.stack.push((far, t_split, self.hi));
+                            self.hi = t_split;
+                            near
+                        }
+                    };
+                }
+                Node::Leaf { list, count } => {
+                    self.leaf_hi = self.hi;
+                    return Ok(KdStop::Leaf { list, count });
+                }
+            }
+        }
+    }
 }
 
 /// `a . b` as `(ax*bx + ay*by) + az*bz`.

@@ -153,6 +153,13 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         .iter()
         .map(|(s, v)| format!("{s} {:.0}%", 100.0 * v))
         .collect();
+    let [transform, intersect, traversal] = r.frames[0].unit_busy_shares();
+    println!(
+        "  busy (frame 0): TransformUnit {:.1}%, IntersectUnit {:.1}%, traversal unit {:.1}% of the clocks",
+        100.0 * transform,
+        100.0 * intersect,
+        100.0 * traversal
+    );
     println!("  engine issue slots by routine: {}", shares.join(", "));
     println!(
         "  simulated {:.0} cycles/s (compile {:.1} s, run {:.1} s)",

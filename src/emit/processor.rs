@@ -4,19 +4,20 @@
 //! rust-hdl `ThreadEngine` (renamed `<top>_core`, see `verilog_tidy`) under a clean top module
 //! `dynrt_processor` with the ports
 //! `clock, start, done, cycles[31:0], instructions[31:0], mem_read, mem_bank[2:0],
-//! mem_addr[23:0], mem_rdata[31:0], fb_write, fb_addr[23:0], fb_data[31:0]` (banks 0, 1, 4,
-//! 5), `bank2_read, bank2_addr[23:0], bank2_rdata[31:0]` and the same for bank 3 (the
-//! triangles, which the triangle tester reads in parallel), `transform_busy[31:0],
-//! intersect_busy[31:0]` (activity counters of the frame), and the `vga_` display ports.
+//! mem_addr[23:0], mem_rdata[31:0], fb_write, fb_addr[23:0], fb_data[31:0]` (banks 1, 4, 5),
+//! `bank0_read, bank0_addr[23:0], bank0_rdata[31:0]` (the kd nodes, read by the traversal
+//! unit) and the same for banks 2 and 3 (the triangles, which the triangle tester reads in
+//! parallel), `transform_busy[31:0], intersect_busy[31:0], traversal_busy[31:0]` (activity
+//! counters of the frame), and the `vga_` display ports.
 //!
 //! [`processor_testbench`] writes module `tb` for Icarus (`iverilog -g2012`) and Verilator 5
 //! (`--binary --timing`): six SRAM banks loaded with `$readmemh` from `mem/` (the layout of
-//! frame 0), one read per clock on each port (banks 2 and 3 have their own), a read latency
+//! frame 0), one read per clock on each port (banks 0, 2 and 3 have their own), a read latency
 //! of `mem_latency` clocks, and per frame: the frame's update files
 //! (only the words that changed), a start pulse, a wait for `done` or the cycle limit (then
 //! `TIMEOUT` and a non-zero exit), and the frame buffer written to `frame<k>.hex` (one
-//! `RRGGBB` word a line) with `cycles instructions transform_busy intersect_busy` in
-//! `frame<k>.stats`.
+//! `RRGGBB` word a line) with `cycles instructions transform_busy intersect_busy
+//! traversal_busy` in `frame<k>.stats`.
 
 use std::fmt::Write as _;
 
@@ -106,7 +107,7 @@ impl Default for ProcessorParams {
 }
 
 /// The top module's ports: (name, output, width).
-const PORTS: [(&str, bool, u32); 28] = [
+const PORTS: [(&str, bool, u32); 32] = [
     ("clock", false, 1),
     ("start", false, 1),
     ("done", true, 1),
@@ -119,6 +120,9 @@ const PORTS: [(&str, bool, u32); 28] = [
     ("fb_write", true, 1),
     ("fb_addr", true, 24),
     ("fb_data", true, 32),
+    ("bank0_read", true, 1),
+    ("bank0_addr", true, 24),
+    ("bank0_rdata", false, 32),
     ("bank2_read", true, 1),
     ("bank2_addr", true, 24),
     ("bank2_rdata", false, 32),
@@ -127,6 +131,7 @@ const PORTS: [(&str, bool, u32); 28] = [
     ("bank3_rdata", false, 32),
     ("transform_busy", true, 32),
     ("intersect_busy", true, 32),
+    ("traversal_busy", true, 32),
     ("vga_clock", false, 1),
     ("vga_reset", false, 1),
     ("vga_fb_addr", true, 24),
@@ -137,9 +142,9 @@ const PORTS: [(&str, bool, u32); 28] = [
     ("vga_frame_start", true, 1),
 ];
 
-/// Ports of the engine core (the first 20) and of the display (the `vga_` ones, which the
+/// Ports of the engine core (the first 24) and of the display (the `vga_` ones, which the
 /// display module names without the prefix).
-const CORE_PORTS: usize = 20;
+const CORE_PORTS: usize = 24;
 
 /// The video mode the processor's display uses for a `width x height` frame: 640x480 at 60 Hz
 /// when the frame fits, else 1024x768.
@@ -275,8 +280,8 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
          \x20 wire [31:0] cycles, instructions;\n  wire mem_read;\n  wire [2:0] mem_bank;\n\
          \x20 wire [23:0] mem_addr;\n  wire [31:0] mem_rdata;\n  wire fb_write;\n\
          \x20 wire [23:0] fb_addr;\n  wire [31:0] fb_data;\n\
-         \x20 wire bank2_read, bank3_read;\n  wire [23:0] bank2_addr, bank3_addr;\n\
-         \x20 wire [31:0] bank2_rdata, bank3_rdata, transform_busy, intersect_busy;\n\
+         \x20 wire bank0_read, bank2_read, bank3_read;\n  wire [23:0] bank0_addr, bank2_addr, bank3_addr;\n\
+         \x20 wire [31:0] bank0_rdata, bank2_rdata, bank3_rdata;\n  wire [31:0] transform_busy, intersect_busy, traversal_busy;\n\
          \x20 reg vga_clock = 1'b0;\n  reg vga_reset = 1'b1;\n  wire [23:0] vga_fb_addr, vga_rgb;\n\
          \x20 reg [31:0] vga_fb_data = 32'd0;\n  wire vga_hsync, vga_vsync, vga_frame_start;\n\
          \x20 integer px;",
@@ -291,7 +296,7 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
     }
     let _ = writeln!(
         v,
-        "  reg [31:0] rd [0:{0}];\n  reg [31:0] rd2 [0:{0}];\n  reg [31:0] rd3 [0:{0}];\n\
+        "  reg [31:0] rd [0:{0}];\n  reg [31:0] rd0 [0:{0}];\n  reg [31:0] rd2 [0:{0}];\n  reg [31:0] rd3 [0:{0}];\n\
          \x20 integer k, n, f, fd;\n  reg timeout = 1'b0;",
         ml - 1
     );
@@ -300,10 +305,12 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
         "  {PROCESSOR_TOP} dut(.clock(clock), .start(start), .done(done), .cycles(cycles),\n\
          \x20   .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank),\n\
          \x20   .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write),\n\
-         \x20   .fb_addr(fb_addr), .fb_data(fb_data), .bank2_read(bank2_read),\n\
+         \x20   .fb_addr(fb_addr), .fb_data(fb_data), .bank0_read(bank0_read),\n\
+         \x20   .bank0_addr(bank0_addr), .bank0_rdata(bank0_rdata), .bank2_read(bank2_read),\n\
          \x20   .bank2_addr(bank2_addr), .bank2_rdata(bank2_rdata), .bank3_read(bank3_read),\n\
          \x20   .bank3_addr(bank3_addr), .bank3_rdata(bank3_rdata),\n\
          \x20   .transform_busy(transform_busy), .intersect_busy(intersect_busy),\n\
+         \x20   .traversal_busy(traversal_busy),\n\
          \x20   .vga_clock(vga_clock), .vga_reset(vga_reset),\n\
          \x20   .vga_fb_addr(vga_fb_addr), .vga_fb_data(vga_fb_data), .vga_hsync(vga_hsync),\n\
          \x20   .vga_vsync(vga_vsync), .vga_rgb(vga_rgb), .vga_frame_start(vga_frame_start));\n\
@@ -319,7 +326,7 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
          \x20 // re-evaluate on every write to a bank (twice as slow on large scenes).\n\
          \x20 always @(posedge clock) begin\n    case (mem_bank)"
     );
-    for b in [0, 1, 4, 5] {
+    for b in [1, 4, 5] {
         let _ = writeln!(
             v,
             "      3'd{b}: rd[0] <= (mem_addr < {}) ? bank{b}[mem_addr] : 32'hdeadbeef;",
@@ -328,9 +335,9 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
     }
     let _ = writeln!(
         v,
-        "      default: rd[0] <= 32'hdeadbeef; // banks 2 and 3 have their own ports\n    endcase"
+        "      default: rd[0] <= 32'hdeadbeef; // banks 0, 2 and 3 have their own ports\n    endcase"
     );
-    for b in [2, 3] {
+    for b in [0, 2, 3] {
         let _ = writeln!(
             v,
             "    rd{b}[0] <= (bank{b}_addr < {}) ? bank{b}[bank{b}_addr] : 32'hdeadbeef;",
@@ -340,9 +347,9 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
     let _ = writeln!(
         v,
         "    for (k = 1; k < {ml}; k = k + 1) begin\n\
-         \x20     rd[k] <= rd[k - 1];\n      rd2[k] <= rd2[k - 1];\n      rd3[k] <= rd3[k - 1];\n\
+         \x20     rd[k] <= rd[k - 1];\n      rd0[k] <= rd0[k - 1];\n      rd2[k] <= rd2[k - 1];\n      rd3[k] <= rd3[k - 1];\n\
          \x20   end\n\
-         \x20   if (fb_write) bank5[fb_addr] <= fb_data;\n  end\n  assign mem_rdata = rd[{0}];\n\
+         \x20   if (fb_write) bank5[fb_addr] <= fb_data;\n  end\n  assign mem_rdata = rd[{0}];\n  assign bank0_rdata = rd0[{0}];\n\
          \x20 assign bank2_rdata = rd2[{0}];\n  assign bank3_rdata = rd3[{0}];",
         ml - 1
     );
@@ -365,8 +372,8 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
              \x20   fd = $fopen(\"frame{fr}.hex\", \"w\");\n\
              \x20   for (k = 0; k < {px}; k = k + 1) $fwrite(fd, \"%06h\\n\", bank5[{fb} + k][23:0]);\n\
              \x20   $fclose(fd);\n    fd = $fopen(\"frame{fr}.stats\", \"w\");\n\
-             \x20   $fwrite(fd, \"%0d %0d %0d %0d\\n\", cycles, instructions, transform_busy,\n\
-             \x20     intersect_busy);\n    $fclose(fd);\n\
+             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d\\n\", cycles, instructions, transform_busy,\n\
+             \x20     intersect_busy, traversal_busy);\n    $fclose(fd);\n\
              \x20   $display(\"frame {fr}: %0d cycles, %0d instructions\", cycles, instructions);",
             limit = frames.cycle_limit,
             px = frames.pixels,

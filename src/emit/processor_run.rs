@@ -26,6 +26,8 @@ pub struct SimFrame {
     /// Clocks in which the TransformUnit, the IntersectUnit took an input.
     pub transform_busy: u64,
     pub intersect_busy: u64,
+    /// Clocks in which the traversal unit started a node decision.
+    pub traversal_busy: u64,
 }
 
 /// What a processor simulation produced.
@@ -175,9 +177,10 @@ pub fn simulate_processor(
             .split_whitespace()
             .filter_map(|w| w.parse().ok())
             .collect();
-        if nums.len() != 4 {
+        if nums.len() != 5 {
             bail!(
-                "{}: expected `cycles instructions transform_busy intersect_busy`, got `{}`",
+                "{}: expected `cycles instructions transform_busy intersect_busy traversal_busy`, \
+                 got `{}`",
                 stats_path.display(),
                 stats.trim()
             );
@@ -188,6 +191,7 @@ pub fn simulate_processor(
             instructions: nums[1],
             transform_busy: nums[2],
             intersect_busy: nums[3],
+            traversal_busy: nums[4],
         });
     }
     let vga = if capture_vga {

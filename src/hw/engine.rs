@@ -10,28 +10,37 @@
 //! Pipeline (clock offsets from the issue slot):
 //! - I0: read the thread's `{epoch, halted, pc}` (a stale epoch means "new frame": pc 0).
 //! - I1: read the instruction ROM (three words: control, immediate, branch fields).
-//! - I2: decode; read the two source registers and the thread's mailbox.
+//! - I2: decode; read the two source registers, the thread's mailbox and its state in the
+//!   triangle tester.
 //! - I3: operands. Feed every unit; compute the integer result, mailbox hit (and update),
-//!   pixel counter, memory and scratch addresses; drive the memory and frame-buffer ports.
+//!   pixel counter, memory and scratch addresses; drive the memory and frame-buffer ports;
+//!   offer `tri` entries to the triangle tester (its answer, refused or pending, is the
+//!   condition that sends the thread back to offer or wait again on its next turn).
 //! - I4..: the fast result line; scratch data joins at I4, memory data at I4 + `mem_latency`.
 //! - I3 + L: write back the register and the next pc: `target` when the condition differs
 //!   from `invert` (a non-branching instruction's condition is false, so its `invert` is a jump
-//!   after it), else `pc + 1`; the condition comes from the compare, integer, mailbox or
-//!   pixel unit.
+//!   after it), else `pc + 1`; the condition comes from the compare, integer, mailbox, pixel
+//!   unit or triangle tester.
 //!
 //! Throughput: one instruction per clock while `threads >= period`; a frame ends when every
-//! thread has executed `halt` (`done`). Counters: clocks of the frame and instructions issued.
+//! thread has executed `halt` (`done`). Counters: clocks of the frame, instructions issued,
+//! and clocks in which the triangle tester's TransformUnit and IntersectUnit took an input.
 //!
-//! Memory: one read per clock on the `mem_*` port (bank, word address); the word must arrive on
-//! `mem_rdata` exactly `mem_latency` clocks after the request (1..=6). Frame-buffer writes come
-//! out on `fb_*`.
+//! The [`TriangleTester`] runs beside the barrel: threads queue triangle tests into it and
+//! wait for their results once per kd leaf, so a test costs a thread one turn instead of the
+//! 19-60 turns of the test in microcode.
+//!
+//! Memory: one read per clock on the `mem_*` port (banks 0, 1, 4, 5) and on each of the
+//! `bank2_*` and `bank3_*` ports (the triangles; the tester fetches from both at once, the
+//! engine's loads of these banks go there too, first); a word must arrive exactly
+//! `mem_latency` clocks after its request (1..=6). Frame-buffer writes come out on `fb_*`.
 
 use rust_hdl::prelude::*;
 
 use super::fp::{FpAddSub, FpCompare, FpDiv, FpMul, FpSqrt};
 use super::program::isa::Instr;
 use super::program::Program;
-use super::{Delay, TriangleTester, UIntToFloat};
+use super::{Delay, TraversalUnit, TriangleTester, UIntToFloat};
 
 /// Most threads (the thread id is 5 bits).
 pub const MAX_THREADS: usize = 32;
@@ -84,8 +93,12 @@ pub struct ThreadEngine<
     pub fb_write: Signal<Out, Bit>,
     pub fb_addr: Signal<Out, Bits<24>>,
     pub fb_data: Signal<Out, Bits<32>>,
-    /// Banks 2 and 3 (the triangles) have their own ports: the triangle tester reads both at
-    /// once, and the engine's loads of these banks go out here too.
+    /// Banks 0 (kd nodes), 2 and 3 (the triangles) have their own ports: the traversal unit
+    /// reads bank 0, the triangle tester banks 2 and 3 at once, and the engine's loads of
+    /// these banks go out here too.
+    pub bank0_read: Signal<Out, Bit>,
+    pub bank0_addr: Signal<Out, Bits<24>>,
+    pub bank0_rdata: Signal<In, Bits<32>>,
     pub bank2_read: Signal<Out, Bit>,
     pub bank2_addr: Signal<Out, Bits<24>>,
     pub bank2_rdata: Signal<In, Bits<32>>,
@@ -95,6 +108,8 @@ pub struct ThreadEngine<
     /// Clocks of the frame in which the TransformUnit and the IntersectUnit took an input.
     pub transform_busy: Signal<Out, Bits<32>>,
     pub intersect_busy: Signal<Out, Bits<32>>,
+    /// Clocks of the frame in which the traversal unit started a node decision.
+    pub traversal_busy: Signal<Out, Bits<32>>,
 
     // Thread state and program.
     pc_ram: RAM<Bits<16>, 5>,
@@ -116,6 +131,7 @@ pub struct ThreadEngine<
     instr_count: DFF<Bits<32>>,
     transform_count: DFF<Bits<32>>,
     intersect_count: DFF<Bits<32>>,
+    traversal_count: DFF<Bits<32>>,
     px: DFF<Bits<16>>,
     py: DFF<Bits<16>>,
     // I1
@@ -148,6 +164,7 @@ pub struct ThreadEngine<
     mb_next: Signal<Local, Bits<3>>,
     pix_done: Signal<Local, Bit>,
     tri_cond: Signal<Local, Bit>,
+    kd_cond: Signal<Local, Bit>,
     fast_kind: Signal<Local, Bits<3>>,
     // Ports.
     mem_read_r: DFF<Bit>,
@@ -165,6 +182,7 @@ pub struct ThreadEngine<
     cmp: FpCompare<W, E, M>,
     itof: UIntToFloat<W, E, M>,
     tester: TriangleTester<W, E, M, S, S1, X2, T, P, DL>,
+    traversal_unit: TraversalUnit<W, E, M, S, S1, X2, T, DL>,
     add_delay: Delay<Bits<W>, DA>,
     mul_delay: Delay<Bits<W>, DM>,
     div_delay: Delay<Bits<W>, DD>,
@@ -179,10 +197,10 @@ pub struct ThreadEngine<
     /// {pc + 1, target}.
     pc_delay: Delay<Bits<24>, DF>,
     pc_line: [DFF<Bits<24>>; FAST_STAGES],
-    /// {tester refused or pending, jump register (12 bits), int_eq, int_lt, mailbox hit,
-    /// pixels exhausted}.
-    cond_delay: Delay<Bits<17>, DF>,
-    cond_line: [DFF<Bits<17>>; FAST_STAGES],
+    /// {traversal unit refused or pending, tester refused or pending, jump register (12
+    /// bits), int_eq, int_lt, mailbox hit, pixels exhausted}.
+    cond_delay: Delay<Bits<18>, DF>,
+    cond_line: [DFF<Bits<18>>; FAST_STAGES],
 
     // Write back.
     wb_valid: Signal<Local, Bit>,
@@ -276,6 +294,9 @@ impl<
             fb_write: Default::default(),
             fb_addr: Default::default(),
             fb_data: Default::default(),
+            bank0_read: Default::default(),
+            bank0_addr: Default::default(),
+            bank0_rdata: Default::default(),
             bank2_read: Default::default(),
             bank2_addr: Default::default(),
             bank2_rdata: Default::default(),
@@ -284,6 +305,7 @@ impl<
             bank3_rdata: Default::default(),
             transform_busy: Default::default(),
             intersect_busy: Default::default(),
+            traversal_busy: Default::default(),
             pc_ram: RAM::new(word_map((0..32).map(|_| Bits::<16>::from(0u64)))),
             rom_ctl: rom(0),
             rom_imm: rom(1),
@@ -305,6 +327,7 @@ impl<
             instr_count: Default::default(),
             transform_count: Default::default(),
             intersect_count: Default::default(),
+            traversal_count: Default::default(),
             px: Default::default(),
             py: Default::default(),
             v1: Default::default(),
@@ -334,6 +357,7 @@ impl<
             mb_next: Default::default(),
             pix_done: Default::default(),
             tri_cond: Default::default(),
+            kd_cond: Default::default(),
             fast_kind: Default::default(),
             mem_read_r: Default::default(),
             mem_bank_r: Default::default(),
@@ -348,6 +372,7 @@ impl<
             cmp: Default::default(),
             itof: Default::default(),
             tester: TriangleTester::new(mem_latency),
+            traversal_unit: TraversalUnit::new(mem_latency),
             add_delay: Default::default(),
             mul_delay: Default::default(),
             div_delay: Default::default(),
@@ -411,6 +436,7 @@ impl<
             instr_count,
             transform_count,
             intersect_count,
+            traversal_count,
             px,
             py,
             v1,
@@ -432,8 +458,24 @@ impl<
             fb_data_r
         );
         clock!(
-            self, clock, add, mul, div, sqrt, cmp, add_delay, mul_delay, div_delay, sqrt_delay,
-            cmp_delay, fast_delay, ctl_delay, pc_delay, cond_delay, tester
+            self,
+            clock,
+            add,
+            mul,
+            div,
+            sqrt,
+            cmp,
+            add_delay,
+            mul_delay,
+            div_delay,
+            sqrt_delay,
+            cmp_delay,
+            fast_delay,
+            ctl_delay,
+            pc_delay,
+            cond_delay,
+            tester,
+            traversal_unit
         );
         self.pc_ram.read_clock.next = self.clock.val();
         self.pc_ram.write_clock.next = self.clock.val();
@@ -480,6 +522,7 @@ impl<
         self.instructions.next = self.instr_count.q.val();
         self.transform_busy.next = self.transform_count.q.val();
         self.intersect_busy.next = self.intersect_count.q.val();
+        self.traversal_busy.next = self.traversal_count.q.val();
         if self.running.q.val() {
             self.cycle_count.d.next = self.cycle_count.q.val() + 1;
             if self.tester.transform_busy.val() {
@@ -487,6 +530,9 @@ impl<
             }
             if self.tester.intersect_busy.val() {
                 self.intersect_count.d.next = self.intersect_count.q.val() + 1;
+            }
+            if self.traversal_unit.step_busy.val() {
+                self.traversal_count.d.next = self.traversal_count.q.val() + 1;
             }
         }
         if self.slot.q.val() == self.c_period_last.val() {
@@ -527,6 +573,7 @@ impl<
                 | bit_cast::<6, 1>(self.rom_imm.read_data.val().get_bits::<1>(0));
         }
         self.tester.query_thread.next = self.t2.q.val();
+        self.traversal_unit.query_thread.next = self.t2.q.val();
         self.v3.d.next = self.v2.q.val();
         self.t3.d.next = self.t2.q.val();
         self.pc3.d.next = self.pc2.q.val();
@@ -651,10 +698,18 @@ impl<
         self.fb_write_r.d.next = self.v3.q.val() & (self.op3.val() == 15);
         self.fb_addr_r.d.next = self.mem_address.val().get_bits::<24>(0);
         self.fb_data_r.d.next = self.regs_b.read_data.val();
-        // Banks 2 and 3 go through the triangle tester's ports.
+        // Bank 0 goes through the traversal unit's port, banks 2 and 3 through the triangle
+        // tester's.
         self.mem_read.next = self.mem_read_r.q.val()
+            & (self.mem_bank_r.q.val() != 0)
             & (self.mem_bank_r.q.val() != 2)
             & (self.mem_bank_r.q.val() != 3);
+        self.traversal_unit.engine_read.next = self.mem_read_r.q.val();
+        self.traversal_unit.engine_bank.next = self.mem_bank_r.q.val();
+        self.traversal_unit.engine_addr.next = self.mem_addr_r.q.val();
+        self.bank0_read.next = self.traversal_unit.node_read.val();
+        self.bank0_addr.next = self.traversal_unit.node_addr.val();
+        self.traversal_unit.node_rdata.next = self.bank0_rdata.val();
         self.mem_bank.next = self.mem_bank_r.q.val();
         self.mem_addr.next = self.mem_addr_r.q.val();
         self.tester.engine_read.next = self.mem_read_r.q.val();
@@ -685,6 +740,24 @@ impl<
         }
         if self.imm3.q.val() == 5 {
             self.tri_cond.next = self.tester.pending.val();
+        }
+        // Traversal unit (op 30, function in imm): start 0, wait 1, end 2, next 3. It sees the
+        // object-space ray and t_min the thread gives the tester.
+        self.traversal_unit.thread.next = self.t3.q.val();
+        self.traversal_unit.word_a.next = self.opa.val();
+        self.traversal_unit.word_b.next = self.opb.val();
+        self.traversal_unit.ray_pair.next = self.imm3.q.val().get_bits::<2>(0);
+        self.traversal_unit.ray_write.next =
+            self.v3.q.val() & (self.op3.val() == 29) & (self.imm3.q.val() < 3);
+        self.traversal_unit.t_min_write.next =
+            self.v3.q.val() & (self.op3.val() == 29) & (self.imm3.q.val() == 3);
+        self.traversal_unit.enqueue.next = self.v3.q.val()
+            & (self.op3.val() == 30)
+            & ((self.imm3.q.val() == 0) | (self.imm3.q.val() == 3));
+        self.traversal_unit.enqueue_next.next = self.imm3.q.val() == 3;
+        self.kd_cond.next = self.traversal_unit.full.val();
+        if self.imm3.q.val() == 1 {
+            self.kd_cond.next = self.traversal_unit.pending.val();
         }
         self.fb_write.next = self.fb_write_r.q.val();
         self.fb_addr.next = self.fb_addr_r.q.val();
@@ -725,6 +798,9 @@ impl<
             if self.aux3.q.val().get_bits::<3>(12) == 3 {
                 self.fast_kind.next = 4.into();
             }
+            if self.aux3.q.val().get_bits::<3>(12) == 0 {
+                self.fast_kind.next = 5.into();
+            }
         }
         if self.op3.val() == 16 {
             self.fast_kind.next = 1.into();
@@ -750,6 +826,14 @@ impl<
                 self.fast.next = self.tester.best_triangle.val();
             }
         }
+        if self.op3.val() == 30 {
+            if self.imm3.q.val() == 1 {
+                self.fast.next = self.traversal_unit.result.val();
+            }
+            if self.imm3.q.val() == 2 {
+                self.fast.next = self.traversal_unit.list_end.val();
+            }
+        }
 
         // The fast line: scratch data at I4, memory data at I4 + latency.
         self.fast_line[0].d.next = self.fast.val();
@@ -761,12 +845,13 @@ impl<
             | bit_cast::<21, 1>(self.ctl3.q.val().get_bits::<1>(0));
         self.pc_line[0].d.next = (bit_cast::<24, 12>(self.pc3.q.val() + 1) << 12)
             | bit_cast::<24, 12>(self.aux3.q.val().get_bits::<12>(0));
-        self.cond_line[0].d.next = (bit_cast::<17, 1>(self.tri_cond.val().into()) << 16)
-            | (bit_cast::<17, 12>(self.opa.val().get_bits::<12>(0)) << 4)
-            | (bit_cast::<17, 1>(self.int_eq.val().into()) << 3)
-            | (bit_cast::<17, 1>(self.int_lt.val().into()) << 2)
-            | (bit_cast::<17, 1>(self.mb_hit.val().into()) << 1)
-            | bit_cast::<17, 1>(self.pix_done.val().into());
+        self.cond_line[0].d.next = (bit_cast::<18, 1>(self.kd_cond.val().into()) << 17)
+            | (bit_cast::<18, 1>(self.tri_cond.val().into()) << 16)
+            | (bit_cast::<18, 12>(self.opa.val().get_bits::<12>(0)) << 4)
+            | (bit_cast::<18, 1>(self.int_eq.val().into()) << 3)
+            | (bit_cast::<18, 1>(self.int_lt.val().into()) << 2)
+            | (bit_cast::<18, 1>(self.mb_hit.val().into()) << 1)
+            | bit_cast::<18, 1>(self.pix_done.val().into());
         for k in 1..8 {
             self.fast_line[k].d.next = self.fast_line[k - 1].q.val();
             self.fast_kind_line[k].d.next = self.fast_kind_line[k - 1].q.val();
@@ -787,6 +872,9 @@ impl<
                 }
                 if self.fast_kind_line[k].q.val() == 4 {
                     self.fast_line[k + 1].d.next = self.bank3_rdata.val();
+                }
+                if self.fast_kind_line[k].q.val() == 5 {
+                    self.fast_line[k + 1].d.next = self.bank0_rdata.val();
                 }
             }
         }
@@ -829,6 +917,9 @@ impl<
         if self.wb_op.val() == 29 {
             self.wb_cond.next = self.cond_delay.data_out.val().get_bit(16);
         }
+        if self.wb_op.val() == 30 {
+            self.wb_cond.next = self.cond_delay.data_out.val().get_bit(17);
+        }
         if self.wb_cond.val() != self.wb_invert.val() {
             self.wb_next_pc.next = self.pc_delay.data_out.val().get_bits::<12>(0);
         } else {
@@ -861,7 +952,8 @@ impl<
             & ((((self.wb_op.val() >= 1) & (self.wb_op.val() <= 14)) | (self.wb_op.val() == 16))
                 | ((self.wb_op.val() == 23)
                     | ((self.wb_op.val() == 27) & (!self.cond_delay.data_out.val().get_bit(0)))
-                    | (self.wb_op.val() == 29)));
+                    | (self.wb_op.val() == 29)
+                    | (self.wb_op.val() == 30)));
         self.regs_a.write_address.next =
             (bit_cast::<13, 5>(self.wb_thread.val()) << 8) | bit_cast::<13, 8>(self.wb_dst.val());
         self.regs_b.write_address.next =
@@ -891,6 +983,7 @@ impl<
             self.instr_count.d.next = 0.into();
             self.transform_count.d.next = 0.into();
             self.intersect_count.d.next = 0.into();
+            self.traversal_count.d.next = 0.into();
             self.px.d.next = 0.into();
             self.py.d.next = 0.into();
         }

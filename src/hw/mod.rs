@@ -22,6 +22,7 @@ pub mod raygen;
 mod sim_harness;
 pub mod transform;
 pub mod transform_arbiter;
+pub mod traversal_unit;
 pub mod triangle_tester;
 pub mod vga;
 
@@ -32,6 +33,7 @@ pub use intersect::{intersect_latency, IntersectUnit};
 pub use raygen::{RayGen, RayGenUnit};
 pub use transform::{TransformUnit, TRANSFORM_LATENCY};
 pub use transform_arbiter::{SharedTransformUnit, TRANSFORM_CLIENTS};
+pub use traversal_unit::TraversalUnit;
 pub use triangle_tester::TriangleTester;
 pub use vga::{VgaError, VgaMode, VgaPlacement, VgaTiming};
 

@@ -591,3 +591,232 @@ impl<
         self.triangle_e.write_enable.next = self.m3_valid.q.val() & self.merge_hit.val();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hw::fp::div::div_latency;
+    use crate::hw::sim_harness::{clock_cycle, settle};
+    use crate::units;
+    use rand::{Rng, SeedableRng};
+    use std::collections::VecDeque;
+
+    type Tester = TriangleTester<24, 7, 16, 17, 18, 9, 21, 34, { div_latency(16) as usize }>;
+
+    /// An entry a thread offers, in its order.
+    #[derive(Clone, Copy, Debug)]
+    enum Offer {
+        Init { t_min: u32, t_max: u32 },
+        Test { triangle: u32, instance: u32 },
+    }
+
+    /// rust-hdl simulation with an SRAM model behind banks 2 and 3: four threads each queue a
+    /// new query and 40 triangle tests (a second query half-way for thread 0), offered every
+    /// clock so that the queue fills and refuses; the engine takes banks 2 and 3 in random
+    /// clocks. Every thread's closest hit, instance and triangle equal the model's sequential
+    /// `units::triangle_test` / `units::closer_hit` in its queue order.
+    #[test]
+    fn rust_hdl_simulation_matches_sequential_tests() {
+        let f = Format::E7M16;
+        let seed = 31;
+        println!("seed {seed}");
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let w = |x: f64| f.from_f64(x);
+        let mem_latency = 3;
+        // Triangles: near-identity unit-triangle transforms, so that rays aimed at the unit
+        // triangle hit often and at different distances.
+        let triangles: Vec<units::Mat34W> = (0..24)
+            .map(|_| {
+                let mut m = [0; 12];
+                for r in 0..3 {
+                    for c in 0..3 {
+                        let diag = if r == c { 1.0 } else { 0.0 };
+                        m[4 * r + c] = w(diag + rng.gen_range(-0.2..0.2));
+                    }
+                    m[4 * r + 3] = w(rng.gen_range(-0.3..0.3));
+                }
+                m
+            })
+            .collect();
+        let mut bank2 = vec![0u32; 8 * triangles.len()];
+        let mut bank3 = vec![0u32; 8 * triangles.len()];
+        for (k, m) in triangles.iter().enumerate() {
+            bank2[8 * k..8 * k + 8].copy_from_slice(&m[..8]);
+            bank3[8 * k..8 * k + 4].copy_from_slice(&m[8..]);
+            for j in 4..8 {
+                bank3[8 * k + j] = rng.gen::<u32>() & 0xff_ffff; // shading words
+            }
+        }
+        let threads = 4usize;
+        let rays: Vec<([u32; 3], [u32; 3])> = (0..threads)
+            .map(|_| {
+                let oz = rng.gen_range(0.5..2.0);
+                let (tx, ty) = (rng.gen_range(0.0..0.6), rng.gen_range(0.0..0.6));
+                let (ox, oy) = (rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0));
+                ([w(ox), w(oy), w(oz)], [w(tx - ox), w(ty - oy), w(-oz)])
+            })
+            .collect();
+        let mut offers: Vec<VecDeque<Offer>> = (0..threads)
+            .map(|th| {
+                let mut q = VecDeque::new();
+                q.push_back(Offer::Init {
+                    t_min: 0,
+                    t_max: f.infinity(false),
+                });
+                for k in 0..40 {
+                    if th == 0 && k == 20 {
+                        q.push_back(Offer::Init {
+                            t_min: w(0.1),
+                            t_max: w(1.5),
+                        });
+                    }
+                    q.push_back(Offer::Test {
+                        triangle: rng.gen_range(0..triangles.len() as u32),
+                        instance: rng.gen_range(0..1000),
+                    });
+                }
+                q
+            })
+            .collect();
+        // The model: each thread's entries in order.
+        let want: Vec<(bool, u32, u32, u32)> = (0..threads)
+            .map(|th| {
+                let (o, d) = rays[th];
+                let (mut t_min, mut best) = (0, (false, 0, 0, 0));
+                for offer in &offers[th] {
+                    match *offer {
+                        Offer::Init { t_min: lo, t_max } => {
+                            t_min = lo;
+                            best = (false, t_max, best.2, best.3);
+                        }
+                        Offer::Test { triangle, instance } => {
+                            let m = triangles[triangle as usize];
+                            let r = units::triangle_test(f, &m, o, d, t_min);
+                            if units::closer_hit(f, &r, best.1) {
+                                best = (true, r.t, instance, triangle);
+                            }
+                        }
+                    }
+                }
+                best
+            })
+            .collect();
+        assert!(
+            want.iter().filter(|b| b.0).count() >= 3,
+            "too few hits: {want:?}"
+        );
+
+        let mut u = Tester::new(mem_latency);
+        u.connect_all();
+        let cycle = |u: &mut Tester| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
+        // Ray words, one thread a clock.
+        for (th, (o, d)) in rays.iter().enumerate() {
+            for (pair, (a, b)) in [(o[0], o[1]), (o[2], d[0]), (d[1], d[2])]
+                .into_iter()
+                .enumerate()
+            {
+                u.thread.next = (th as u64).into();
+                u.ray_write.next = true;
+                u.ray_pair.next = (pair as u64).into();
+                u.word_a.next = (a as u64).into();
+                u.word_b.next = (b as u64).into();
+                cycle(&mut u);
+            }
+        }
+        u.ray_write.next = false;
+        let mut requests: VecDeque<(Option<u32>, Option<u32>)> = std::iter::repeat((None, None))
+            .take(mem_latency as usize)
+            .collect();
+        let (mut refused, mut stolen, mut drain) = (0, 0, 0);
+        // The thread whose counters were read last clock (the engine's I2): only it may offer.
+        let mut queried: Option<usize> = None;
+        while offers.iter().any(|q| !q.is_empty()) || drain < 3000 {
+            if offers.iter().all(|q| q.is_empty()) {
+                drain += 1;
+            }
+            // The SRAMs answer the request of `mem_latency` clocks ago.
+            let (uv, t) = requests.pop_front().unwrap();
+            u.uv_rdata.next = u64::from(uv.map_or(0xdead, |a| bank2[a as usize])).into();
+            u.t_rdata.next = u64::from(t.map_or(0xdead, |a| bank3[a as usize])).into();
+            // Round robin over the threads with something to offer (like the engine's turns);
+            // a thread never offers in two clocks in a row (as in the engine's barrel).
+            let th = queried.filter(|&t| !offers[t].is_empty());
+            let start = th.map_or(0, |t| t + 1);
+            queried = (0..threads)
+                .map(|k| (start + k) % threads)
+                .find(|&k| !offers[k].is_empty() && Some(k) != th);
+            u.query_thread.next = (queried.unwrap_or(0) as u64).into();
+            u.enqueue.next = th.is_some();
+            if let Some(th) = th {
+                let (init, a, b) = match offers[th][0] {
+                    Offer::Init { t_min, t_max } => (true, t_min, t_max),
+                    Offer::Test { triangle, instance } => (false, triangle, instance),
+                };
+                u.thread.next = (th as u64).into();
+                u.queue_init.next = init;
+                u.word_a.next = u64::from(a).into();
+                u.word_b.next = u64::from(b).into();
+            }
+            // The engine takes bank 2 or 3 in one clock of five.
+            let steal = rng
+                .gen_ratio(1, 5)
+                .then(|| (rng.gen_range(2..=3u64), rng.gen_range(0..64u64)));
+            u.engine_read.next = steal.is_some();
+            u.engine_bank.next = steal.map_or(0, |s| s.0).into();
+            u.engine_addr.next = steal.map_or(0, |s| s.1).into();
+            settle(&mut u);
+            if let Some((bank, addr)) = steal {
+                stolen += 1;
+                let (read, port) = if bank == 2 {
+                    (u.uv_read.val(), u.uv_addr.val())
+                } else {
+                    (u.t_read.val(), u.t_addr.val())
+                };
+                assert!(
+                    read && port.to_u64() == addr,
+                    "the engine's read of bank {bank}"
+                );
+            }
+            let port = |read: bool, addr: Bits<24>| read.then(|| addr.to_u64() as u32);
+            requests.push_back((
+                port(u.uv_read.val(), u.uv_addr.val()),
+                port(u.t_read.val(), u.t_addr.val()),
+            ));
+            if let Some(th) = th {
+                if u.full.val() {
+                    refused += 1;
+                } else {
+                    offers[th].pop_front();
+                }
+            }
+            cycle(&mut u);
+        }
+        u.enqueue.next = false;
+        u.engine_read.next = false;
+        assert!(
+            refused > 0,
+            "the queue never filled: back-pressure untested"
+        );
+        assert!(stolen > 0);
+        for (th, want) in want.iter().enumerate() {
+            u.query_thread.next = (th as u64).into();
+            cycle(&mut u);
+            assert!(!u.pending.val(), "thread {th} still pending");
+            let got = (
+                u.hit.val(),
+                u.best_t.val().to_u64() as u32,
+                u.best_instance.val().to_u64() as u32,
+                u.best_triangle.val().to_u64() as u32,
+            );
+            if want.0 {
+                assert_eq!(got, *want, "thread {th}: (hit, t, instance, triangle)");
+            } else {
+                assert_eq!(
+                    (got.0, got.1),
+                    (want.0, want.1),
+                    "thread {th}: (hit, best t)"
+                );
+            }
+        }
+    }
+}

@@ -8,7 +8,7 @@
 
 use std::cell::RefCell;
 
-use super::isa::{Instr, Op, TriFn, MAX_PROGRAM, REGISTERS};
+use super::isa::{Instr, KdFn, Op, TriFn, MAX_PROGRAM, REGISTERS};
 use crate::fp::Format;
 use crate::units::Arith;
 
@@ -402,6 +402,43 @@ impl Asm {
             dst: dst.0,
             imm: f as u32,
             ..Instr::new(Op::Tri)
+        });
+    }
+
+    /// Offers `kd.start a, b` or `kd.next a, b` to the traversal unit until it takes it.
+    pub fn kd_queue(&self, f: KdFn, a: Reg, b: Reg) {
+        debug_assert!(matches!(f, KdFn::Start | KdFn::Next));
+        let offer = self.here();
+        self.emit_to(
+            Instr {
+                a: a.0,
+                b: b.0,
+                imm: f as u32,
+                ..Instr::new(Op::Kd)
+            },
+            offer,
+        );
+    }
+
+    /// Waits for the traversal unit's walk; `dst` = the leaf's list (or `KD_FINISHED`).
+    pub fn kd_wait(&self, dst: Reg) {
+        let again = self.here();
+        self.emit_to(
+            Instr {
+                dst: dst.0,
+                imm: KdFn::Wait as u32,
+                ..Instr::new(Op::Kd)
+            },
+            again,
+        );
+    }
+
+    /// `dst` = the leaf's list end.
+    pub fn kd_end(&self, dst: Reg) {
+        self.emit(Instr {
+            dst: dst.0,
+            imm: KdFn::End as u32,
+            ..Instr::new(Op::Kd)
         });
     }
 

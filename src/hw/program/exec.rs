@@ -8,10 +8,11 @@
 //! pixel on one thread (threads never share state, so its result is the same; rayon runs
 //! those in parallel), optionally recording every register write for traces.
 
-use super::isa::{Instr, Op, TriFn, Unit, REGISTERS};
+use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_FINISHED, REGISTERS};
 use super::Program;
 use crate::fp::Format;
-use crate::layout::{Layout, TRIANGLES_T, TRIANGLE_BANK_WORDS};
+use crate::hw::traversal_unit::STACK_LEVELS;
+use crate::layout::{Layout, Node, NODES, NODE_WORDS, TRIANGLES_T, TRIANGLE_BANK_WORDS};
 use crate::units::{self, Mailbox};
 
 /// A failure of the program on this memory (a generator bug or a layout that does not belong
@@ -47,6 +48,14 @@ struct TesterState {
     best_triangle: u32,
 }
 
+/// A thread's walk in the traversal unit and the leaf it handed out (list, list end).
+#[derive(Clone, Default)]
+struct WalkState {
+    walk: units::KdWalk,
+    result: u32,
+    end: u32,
+}
+
 #[derive(Clone)]
 struct Thread {
     pc: usize,
@@ -54,6 +63,7 @@ struct Thread {
     scratch: Vec<u32>,
     mailboxes: [Mailbox; 2],
     tester: TesterState,
+    walk: WalkState,
     halted: bool,
 }
 
@@ -65,6 +75,7 @@ impl Thread {
             scratch: vec![0; scratch_words],
             mailboxes: Default::default(),
             tester: TesterState::default(),
+            walk: WalkState::default(),
             halted: false,
         }
     }
@@ -316,6 +327,42 @@ impl<'a> Machine<'a> {
                 // condition (refused, or still pending) is false.
                 branch_if(false, &mut next);
             }
+            Op::Kd => {
+                let function = KdFn::from_imm(i.imm)
+                    .ok_or_else(|| fail(format!("no traversal unit function {}", i.imm)))?;
+                let (tt, walk) = (&t.tester, &mut t.walk);
+                let ray = (tt.o, tt.d);
+                let fetch = |n| self.kd_node(n);
+                let stop = match function {
+                    KdFn::Start => {
+                        let (w, stop) =
+                            units::KdWalk::start(f, ray, a, (tt.t_min, b), STACK_LEVELS, fetch)
+                                .map_err(fail)?;
+                        walk.walk = w;
+                        Some(stop)
+                    }
+                    KdFn::Next => Some(
+                        walk.walk
+                            .next(f, ray, (a, b & 1 == 1), STACK_LEVELS, fetch)
+                            .map_err(fail)?,
+                    ),
+                    _ => None,
+                };
+                match stop {
+                    Some(units::KdStop::Leaf { list, count }) => {
+                        walk.result = list;
+                        walk.end = list.wrapping_add(count);
+                    }
+                    Some(units::KdStop::Finished) => walk.result = KD_FINISHED,
+                    None => {}
+                }
+                match function {
+                    KdFn::Wait => result = Some(walk.result),
+                    KdFn::End => result = Some(walk.end),
+                    KdFn::Start | KdFn::Next => {}
+                }
+                branch_if(false, &mut next);
+            }
         }
         if i.jumps_after() {
             next = i.target as usize;
@@ -340,6 +387,15 @@ impl<'a> Machine<'a> {
         stats.instructions += 1;
         t.pc = next;
         Ok(())
+    }
+
+    /// A kd node of the layout, as the traversal unit decodes it.
+    fn kd_node(&self, n: u32) -> Result<Node, String> {
+        let nodes = self.layout.banks[NODES].len() / NODE_WORDS;
+        if n as usize >= nodes {
+            return Err(format!("kd node {n} beyond the {nodes} nodes"));
+        }
+        Ok(self.layout.node(n))
     }
 
     fn error(&self, thread: usize, pc: usize, i: Option<Instr>, what: &str) -> ExecError {

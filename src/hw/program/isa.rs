@@ -83,6 +83,43 @@ pub enum Op {
     /// function that queues branches to `target` when the queue refused it (full); `wait`
     /// branches while tests are in flight.
     Tri,
+    /// The traversal unit (`hw::TraversalUnit`), function `imm` ([`KdFn`]): walk an object's
+    /// kd tree to its next leaf. `start` and `next` branch to `target` when refused; `wait`
+    /// branches while the walk is in flight.
+    Kd,
+}
+
+/// The functions of [`Op::Kd`] (its `imm`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum KdFn {
+    /// Walk from root `A` with the segment `[t_min, B]` (t_min from the tester's init).
+    Start = 0,
+    /// Branch to `target` while the walk is in flight; `dst` = the leaf's list address, or
+    /// [`KD_FINISHED`] when the walk ended.
+    Wait,
+    /// `dst` = the leaf's list end (list + count).
+    End,
+    /// Go on after a leaf whose closest hit so far is `A` (best t), `B` (hit, 0 or 1).
+    Next,
+}
+
+/// The `kd.wait` result of a finished walk (bit 31).
+pub const KD_FINISHED: u32 = 1 << 31;
+
+impl KdFn {
+    pub const ALL: [KdFn; 4] = [KdFn::Start, KdFn::Wait, KdFn::End, KdFn::Next];
+    pub fn from_imm(imm: u32) -> Option<KdFn> {
+        Self::ALL.get(imm as usize).copied()
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            KdFn::Start => "start",
+            KdFn::Wait => "wait",
+            KdFn::End => "end",
+            KdFn::Next => "next",
+        }
+    }
 }
 
 /// The functions of [`Op::Tri`] (its `imm`).
@@ -140,7 +177,7 @@ impl TriFn {
     }
 }
 
-pub const OPS: [Op; 30] = [
+pub const OPS: [Op; 31] = [
     Op::Nop,
     Op::FAdd,
     Op::FSub,
@@ -171,6 +208,7 @@ pub const OPS: [Op; 30] = [
     Op::Pixel,
     Op::Halt,
     Op::Tri,
+    Op::Kd,
 ];
 
 impl Op {
@@ -196,6 +234,7 @@ impl Op {
                 | Jal
                 | Pixel
                 | Tri
+                | Kd
         )
     }
     /// Whether an instruction of this op can carry a jump to `target` after it (`invert`).
@@ -207,7 +246,7 @@ impl Op {
         use Op::*;
         matches!(
             self,
-            BFlt | BFle | BFeq | Beq | Bltu | Jal | Mbx | Pixel | Tri
+            BFlt | BFle | BFeq | Beq | Bltu | Jal | Mbx | Pixel | Tri | Kd
         )
     }
     /// The hardware unit that executes it (for statistics and for leaving units out).
@@ -225,6 +264,7 @@ impl Op {
             Mbx | Mbc => Unit::Mailbox,
             Pixel => Unit::PixelCounter,
             Tri => Unit::TriangleTester,
+            Kd => Unit::TraversalUnit,
             Nop | Add | Sub | And | Or | Xor | Shr | Shl | Beq | Bltu | Jal | Jr | Halt => {
                 Unit::Integer
             }
@@ -263,6 +303,7 @@ impl Op {
             Pixel => "pixel",
             Halt => "halt",
             Tri => "tri",
+            Kd => "kd",
         }
     }
 }
@@ -282,10 +323,11 @@ pub enum Unit {
     Mailbox,
     PixelCounter,
     TriangleTester,
+    TraversalUnit,
 }
 
 impl Unit {
-    pub const ALL: [Unit; 12] = [
+    pub const ALL: [Unit; 13] = [
         Unit::FpAdd,
         Unit::FpMul,
         Unit::FpDiv,
@@ -298,6 +340,7 @@ impl Unit {
         Unit::Mailbox,
         Unit::PixelCounter,
         Unit::TriangleTester,
+        Unit::TraversalUnit,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -313,6 +356,7 @@ impl Unit {
             Unit::Mailbox => "mailbox",
             Unit::PixelCounter => "pixel counter",
             Unit::TriangleTester => "triangle tester",
+            Unit::TraversalUnit => "traversal unit",
         }
     }
 }
@@ -455,6 +499,14 @@ impl fmt::Display for Instr {
                 write!(
                     f,
                     "{inv}tri.{name} r{}, r{}, r{}, @{}",
+                    self.dst, self.a, self.b, self.target
+                )
+            }
+            Op::Kd => {
+                let name = KdFn::from_imm(self.imm).map_or("?", KdFn::name);
+                write!(
+                    f,
+                    "{inv}kd.{name} r{}, r{}, r{}, @{}",
                     self.dst, self.a, self.b, self.target
                 )
             }

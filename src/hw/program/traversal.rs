@@ -6,28 +6,29 @@
 //! (indexed by the axis), pick near and far child, compute `t_split` with the shared
 //! `units::split_distance` and visit near, far or both (pushing far on the kd stack); at a
 //! leaf run its list: at the top level enter each instance not yet in the instance mailbox
-//! (world-to-object transform of the ray, then the object tree), at the object level test each
-//! triangle not skipped and not in the triangle mailbox (unit-triangle transform and test, the
-//! shared `units::transform` and `units::unit_triangle_coords`). A shadow query (`q_any`)
-//! returns at its first hit. Then pop the stack until a segment can still hold a closer hit.
+//! (world-to-object transform of the ray, handed to the triangle tester), at the object level
+//! queue each triangle not skipped and not in the triangle mailbox in the triangle tester
+//! (`hw::TriangleTester`), then wait for the tester and read the closest hit. A shadow query
+//! (`q_any`) returns after the first leaf with a hit. Then pop the stack until a segment can
+//! still hold a closer hit.
 //!
-//! Cost per step (instructions = engine turns): inner node 15-23, leaf 4 plus per listed
-//! triangle 5 (list word, mailbox and skip checks) and its test: 19 when the distance row
-//! rejects it (4 loads, 11 operations of the transform row, the division, 2 range compares),
-//! 40 when the first barycentric row does, about 60 for a hit.
+//! Cost per step (instructions = engine turns): inner node 15-23, leaf 4 plus 5 per listed
+//! triangle (list word, mailbox and skip checks, queueing; a refusal by a full queue costs 2
+//! turns more), and at its end a wait of about 3 turns (the tester's latency of about 90
+//! clocks) and 2 reads.
 
 use super::asm::Asm;
 use super::asm::{Label, Reg, Val};
-use super::isa::{Op, TriFn, MAILBOX_INSTANCES, MAILBOX_TRIANGLES};
+use super::isa::{KdFn, Op, TriFn, KD_FINISHED, MAILBOX_INSTANCES, MAILBOX_TRIANGLES};
 use super::{Gen, STACK_ENTRY_WORDS};
 use crate::layout::{instance_word as iw, INSTANCES, LEAF_TAG, LISTS, NODES};
 use crate::units;
 
-/// Gives the triangle tester the ray the triangles of this level are tested with.
-fn tester_ray(a: &Asm, ray: LevelRay) {
-    a.tri_ray(TriFn::RayOxy, ray.o[0], ray.o[1]);
-    a.tri_ray(TriFn::RayOzDx, ray.o[2], ray.d[0]);
-    a.tri_ray(TriFn::RayDyz, ray.d[1], ray.d[2]);
+/// Gives the triangle tester and the traversal unit the object-space ray.
+fn tester_ray(a: &Asm, o: [Reg; 3], d: [Reg; 3]) {
+    a.tri_ray(TriFn::RayOxy, o[0], o[1]);
+    a.tri_ray(TriFn::RayOzDx, o[2], d[0]);
+    a.tri_ray(TriFn::RayDyz, d[1], d[2]);
 }
 
 /// The ray one traversal level walks: registers, and where scratch holds a copy for the
@@ -37,14 +38,6 @@ struct LevelRay {
     o: [Reg; 3],
     d: [Reg; 3],
     scratch: u32,
-}
-
-/// Which kind of leaf a level has.
-#[derive(Clone, Copy)]
-enum Leaves {
-    Instances,
-    /// Triangles of the instance in this register (`Reg::ZERO` for the only object).
-    Triangles(Reg),
 }
 
 impl Gen<'_> {
@@ -63,24 +56,17 @@ impl Gen<'_> {
             d: s.q_d,
             scratch: self.scratch.ray_top,
         };
-        self.store_ray(world);
-        if self.c.top_root.is_none() {
-            tester_ray(a, world);
-        }
         a.tri_queue(TriFn::Init, s.q_t_min, s.q_t_max, None);
         match self.c.top_root {
             Some(root) => {
+                self.store_ray(world);
                 a.mailbox_clear(MAILBOX_INSTANCES);
-                self.traverse(Val::K(root), world, Leaves::Instances, done);
+                self.traverse(Val::K(root), world, done);
             }
             None => {
+                tester_ray(a, world.o, world.d);
                 a.mailbox_clear(MAILBOX_TRIANGLES);
-                self.traverse(
-                    Val::K(self.c.object_root),
-                    world,
-                    Leaves::Triangles(Reg::ZERO),
-                    done,
-                );
+                self.walk_object(Val::K(self.c.object_root), Reg::ZERO, done);
             }
         }
         a.bind(done);
@@ -99,8 +85,34 @@ impl Gen<'_> {
         }
     }
 
-    /// Front-to-back traversal from `root`; an answered any-hit query jumps to `answered`.
-    fn traverse(&self, root: Val, ray: LevelRay, leaves: Leaves, answered: Label) {
+    /// An object's kd tree, walked by the traversal unit from `root`: each leaf's triangles
+    /// go to the triangle tester; an answered any-hit query jumps to `answered`.
+    fn walk_object(&self, root: Val, instance: Reg, answered: Label) {
+        let a = self.asm;
+        let s = &self.s;
+        a.section("traversal");
+        let [from, list, end] = a.regs::<3>();
+        a.mov(from, root);
+        a.kd_queue(KdFn::Start, from, s.best_t);
+        let (leaf, finished) = (a.label(), a.label());
+        a.bind(leaf);
+        a.section("traversal");
+        a.kd_wait(list);
+        a.branch(Op::Bltu, list.into(), Val::K(KD_FINISHED), true, finished);
+        a.kd_end(end);
+        self.triangle_list(instance, list, end, answered);
+        a.section("traversal");
+        a.kd_queue(KdFn::Next, s.best_t, s.hit);
+        a.jump(leaf);
+        a.bind(finished);
+        for r in [from, list, end] {
+            a.free(r);
+        }
+    }
+
+    /// Front-to-back traversal of the top-level tree from `root` in microcode; an answered
+    /// any-hit query jumps to `answered`.
+    fn traverse(&self, root: Val, ray: LevelRay, answered: Label) {
         let a = self.asm;
         let s = &self.s;
         a.section("traversal");
@@ -170,10 +182,7 @@ impl Gen<'_> {
         for r in [w0, w1, tag, o, d] {
             a.free(r);
         }
-        match leaves {
-            Leaves::Instances => self.instance_list(list, end, answered),
-            Leaves::Triangles(instance) => self.triangle_list(instance, list, end, answered),
-        }
+        self.instance_list(list, end, answered);
         a.free(list);
         a.free(end);
         a.section("traversal");
@@ -217,15 +226,9 @@ impl Gen<'_> {
         let local_d = units::transform(a, &m, s.q_d.map(Val::R), false).map(|v| a.keep(v));
         a.end_temps();
         a.free(record);
-        let local = LevelRay {
-            o: local_o,
-            d: local_d,
-            scratch: self.scratch.ray_object,
-        };
-        self.store_ray(local);
-        tester_ray(a, local);
+        tester_ray(a, local_o, local_d);
         a.mailbox_clear(MAILBOX_TRIANGLES);
-        self.traverse(root.into(), local, Leaves::Triangles(instance), answered);
+        self.walk_object(root.into(), instance, answered);
         for r in local_o.into_iter().chain(local_d).chain([root]) {
             a.free(r);
         }

@@ -1,0 +1,916 @@
+//! `TraversalUnit`: the ray thread engine's coprocessor for object-level kd traversal. A thread
+//! starts a walk (`kd.start root, t_max`) and waits; the unit steps through inner nodes on its
+//! own (fetch the node from bank 0, decide with `units::traversal_step`, push the far child on
+//! the thread's stack) until it reaches a leaf, and hands the leaf's list (`kd.wait`,
+//! `kd.end`) to the thread, which queues the list's triangles in the triangle tester. With the
+//! leaf's closest hit (`kd.next best_t, hit`) the unit ends the walk when that hit lies in the
+//! leaf's segment, or pops the stack (ending when the stack is empty or the popped segment
+//! starts behind the hit), exactly as `model::golden`'s `traverse`.
+//!
+//! Engine side (I2/I3, like the triangle tester): `enqueue` offers an entry of `thread`
+//! (`start`: root `word_a`, t_max `word_b`, t_min the thread's `t_min` written with the
+//! tester's init; else next: best t `word_a`, hit `word_b`), taken when `full` is low.
+//! `query_thread` at I2; at I3 `pending` (the thread's entry not done), `result` (the leaf's
+//! list address, or bit 31 set when the walk ended) and `list_end` (list + count).
+//!
+//! Structure: entries from the engine go through the front (a start becomes a step job; a
+//! next reads the thread's leaf segment and stack and compares in 4 clocks) into the front
+//! queue; steps that continue go into the loop queue, which the fetch serves first. Fetch:
+//! one job at a time, two words of bank 0 (the engine's own loads of bank 0 go first), then
+//! the decision pipeline: `split - o` (FpAddSub), `/ d` (FpDiv), then five FpCompares; at its
+//! end a push and the next step. Latency per inner node: `mem_latency + 4` clocks of fetch
+//! plus `7 + DL + 2` of decision; fetch throughput one node per `mem_latency + 4` clocks,
+//! while other threads' jobs fill the decision pipeline. Each thread has at most one job in
+//! the unit, so the 32-entry queues never overflow.
+//!
+//! Per thread: a stack of [`STACK_LEVELS`] entries `(node, lo, hi)`, the leaf's segment end
+//! and stack depth, the result. Const parameters: the operators' `W, E, M, S, S1, X2, T` and
+//! `DL = div_latency(M)`.
+
+use rust_hdl::prelude::*;
+
+use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
+use super::Delay;
+use crate::fp::Format;
+
+/// Entries of each thread's kd stack (the deepest object tree the unit walks).
+pub const STACK_LEVELS: usize = 64;
+
+/// Engine queue entry: `{next[69], thread[68:64], a[63:32], b[31:0]}`.
+type Entry = Bits<70>;
+/// Step job: `{finish[101], thread[100:96], sp[95:90], node[89:64], lo[63:32], hi[31:0]}`
+/// (nodes below 2^26).
+type Job = Bits<102>;
+/// Decision control: `{valid[37], thread[36:32], sp[31:26], left[25:0]}`.
+type Control = Bits<38>;
+
+#[derive(LogicBlock)]
+pub struct TraversalUnit<
+    const W: usize,
+    const E: usize,
+    const M: usize,
+    const S: usize,
+    const S1: usize,
+    const X2: usize,
+    const T: usize,
+    const DL: usize,
+> {
+    pub clock: Signal<In, Clock>,
+    pub thread: Signal<In, Bits<5>>,
+    pub word_a: Signal<In, Bits<32>>,
+    pub word_b: Signal<In, Bits<32>>,
+    /// The thread's ray (object space): `ray_write` with `ray_pair` 0, 1, 2 as in the
+    /// triangle tester; `t_min_write` with `word_a`.
+    pub ray_write: Signal<In, Bit>,
+    pub ray_pair: Signal<In, Bits<2>>,
+    pub t_min_write: Signal<In, Bit>,
+    pub enqueue: Signal<In, Bit>,
+    pub enqueue_next: Signal<In, Bit>,
+    pub full: Signal<Out, Bit>,
+    pub query_thread: Signal<In, Bits<5>>,
+    pub pending: Signal<Out, Bit>,
+    pub result: Signal<Out, Bits<32>>,
+    pub list_end: Signal<Out, Bits<32>>,
+    /// The engine's memory port (registered): its loads of bank 0 go out here.
+    pub engine_read: Signal<In, Bit>,
+    pub engine_bank: Signal<In, Bits<3>>,
+    pub engine_addr: Signal<In, Bits<24>>,
+    /// Bank 0 (the kd nodes): one read per clock, the word `mem_latency` clocks later.
+    pub node_read: Signal<Out, Bit>,
+    pub node_addr: Signal<Out, Bits<24>>,
+    pub node_rdata: Signal<In, Bits<32>>,
+    /// High in the clocks a node decision starts.
+    pub step_busy: Signal<Out, Bit>,
+
+    entry_fifo: SynchronousFIFO<Entry, 5, 6, 1>,
+    front_fifo: SynchronousFIFO<Job, 5, 6, 1>,
+    loop_fifo: SynchronousFIFO<Job, 5, 6, 1>,
+    /// Per thread: ray o, d and t_min (engine-written); entries taken (engine); entries done,
+    /// result and list end (unit, read by the engine); leaf segment end and stack depth (unit).
+    ray: [RAM<Bits<W>, 5>; 7],
+    issued: RAM<Bits<8>, 5>,
+    done_e: RAM<Bits<8>, 5>,
+    done_u: RAM<Bits<8>, 5>,
+    result_e: RAM<Bits<32>, 5>,
+    end_e: RAM<Bits<32>, 5>,
+    leaf_hi: RAM<Bits<W>, 5>,
+    leaf_sp: RAM<Bits<6>, 5>,
+    stack_node: RAM<Bits<26>, 11>,
+    stack_lo: RAM<Bits<W>, 11>,
+    stack_hi: RAM<Bits<W>, 11>,
+
+    // Front: f1 reads the thread's leaf segment end, stack depth and t_min; f2 reads the
+    // stack entry to pop and compares the hit with the leaf's end; f3 compares it with the
+    // popped lo; f5 writes the job.
+    f1_valid: DFF<Bit>,
+    f1_next: DFF<Bit>,
+    f1_thread: DFF<Bits<5>>,
+    f1_a: DFF<Bits<32>>,
+    f1_b: DFF<Bits<32>>,
+    f2_valid: DFF<Bit>,
+    f2_next: DFF<Bit>,
+    f2_thread: DFF<Bits<5>>,
+    f2_a: DFF<Bits<32>>,
+    f2_b: DFF<Bits<32>>,
+    f3_valid: DFF<Bit>,
+    f3_next: DFF<Bit>,
+    f3_thread: DFF<Bits<5>>,
+    f3_a: DFF<Bits<32>>,
+    f3_b: DFF<Bits<32>>,
+    f3_sp: DFF<Bits<6>>,
+    f3_t_min: DFF<Bits<W>>,
+    f4_valid: DFF<Bit>,
+    f4_next: DFF<Bit>,
+    f4_thread: DFF<Bits<5>>,
+    f4_a: DFF<Bits<32>>,
+    f4_b: DFF<Bits<32>>,
+    f4_sp: DFF<Bits<6>>,
+    f4_t_min: DFF<Bits<W>>,
+    f4_node: DFF<Bits<26>>,
+    f4_lo: DFF<Bits<W>>,
+    f4_hi: DFF<Bits<W>>,
+    f5_valid: DFF<Bit>,
+    f5_next: DFF<Bit>,
+    f5_thread: DFF<Bits<5>>,
+    f5_a: DFF<Bits<32>>,
+    f5_b: DFF<Bits<32>>,
+    f5_sp: DFF<Bits<6>>,
+    f5_t_min: DFF<Bits<W>>,
+    f5_node: DFF<Bits<26>>,
+    f5_lo: DFF<Bits<W>>,
+    f5_hi: DFF<Bits<W>>,
+    f5_in_leaf: DFF<Bit>,
+    /// hit t <= leaf end (the hit lies in the segment just searched); hit t < popped lo.
+    cmp_leaf: FpCompare<W, E, M>,
+    cmp_pop: FpCompare<W, E, M>,
+    f2_sp: Signal<Local, Bits<6>>,
+    /// Depths after a pop, wrapped in 6 bits (the Verilog of an expression would widen it).
+    f2_pop: Signal<Local, Bits<6>>,
+    f5_pop: Signal<Local, Bits<6>>,
+    front_end: Signal<Local, Bit>,
+    front_job: Signal<Local, Job>,
+
+    // Fetch: `phase` 0 idle, 1 request word 0, 2 request word 1, 3 wait for the words.
+    phase: DFF<Bits<2>>,
+    job: DFF<Job>,
+    words_in: DFF<Bits<2>>,
+    w0: DFF<Bits<32>>,
+    w1: DFF<Bits<32>>,
+    take: Signal<Local, Bit>,
+    /// Requests in flight: `{valid, word}` per clock of latency.
+    node_line: [DFF<Bits<2>>; 6],
+    arrive: Signal<Local, Bits<2>>,
+    // A: the node's words are here.
+    at_a: Signal<Local, Bit>,
+    a_leaf: Signal<Local, Bit>,
+    a_axis: Signal<Local, Bits<2>>,
+    a_o: Signal<Local, Bits<W>>,
+    a_d: Signal<Local, Bits<W>>,
+    a_inner: Signal<Local, Bit>,
+
+    // Decision.
+    sub: FpAddSub<W, E, M, S, S1, X2, T>,
+    div: FpDiv<W, E, M, S, S1, X2>,
+    /// o, d, lo, hi and the split plane wait for t_split.
+    o_delay: [Delay<Bits<W>, 7>; 5],
+    o_delay_div: [Delay<Bits<W>, DL>; 5],
+    control_delay: Delay<Control, 7>,
+    control_delay_div: Delay<Control, DL>,
+    control_delay_cmp: Delay<Control, 2>,
+    /// (o, split), (d, 0), (hi, t_split), (t_split, 0), (t_split, lo).
+    cmp: [FpCompare<W, E, M>; 5],
+    ts_delay: Delay<Bits<W>, 2>,
+    lo_delay: Delay<Bits<W>, 2>,
+    hi_delay: Delay<Bits<W>, 2>,
+    d_valid: Signal<Local, Bit>,
+    d_thread: Signal<Local, Bits<5>>,
+    d_sp: Signal<Local, Bits<6>>,
+    d_left: Signal<Local, Bits<26>>,
+    d_near_left: Signal<Local, Bit>,
+    d_near: Signal<Local, Bits<26>>,
+    d_far: Signal<Local, Bits<26>>,
+
+    c_ml_last: Constant<Bits<4>>,
+    c_index: [Constant<Bits<4>>; 6],
+    c_zero: Constant<Bits<W>>,
+    c_finished: Constant<Bits<32>>,
+}
+
+/// Per-thread counters that start at 0 (nothing pending at power-up).
+fn zero_counters() -> RAM<Bits<8>, 5> {
+    RAM::new(
+        (0..32u64)
+            .map(|k| (Bits::<5>::from(k), Bits::<8>::from(0u64)))
+            .collect(),
+    )
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const DL: usize,
+    > TraversalUnit<W, E, M, S, S1, X2, T, DL>
+{
+    /// The unit for SRAM read latency `mem_latency` (1..=6).
+    pub fn new(mem_latency: u32) -> Self {
+        assert!((1..=6).contains(&mem_latency));
+        let f = Format::new(E as u32, M as u32).expect("a supported format");
+        Self {
+            clock: Default::default(),
+            thread: Default::default(),
+            word_a: Default::default(),
+            word_b: Default::default(),
+            ray_write: Default::default(),
+            ray_pair: Default::default(),
+            t_min_write: Default::default(),
+            enqueue: Default::default(),
+            enqueue_next: Default::default(),
+            full: Default::default(),
+            query_thread: Default::default(),
+            pending: Default::default(),
+            result: Default::default(),
+            list_end: Default::default(),
+            engine_read: Default::default(),
+            engine_bank: Default::default(),
+            engine_addr: Default::default(),
+            node_read: Default::default(),
+            node_addr: Default::default(),
+            node_rdata: Default::default(),
+            step_busy: Default::default(),
+            entry_fifo: Default::default(),
+            front_fifo: Default::default(),
+            loop_fifo: Default::default(),
+            ray: Default::default(),
+            issued: zero_counters(),
+            done_e: zero_counters(),
+            done_u: zero_counters(),
+            result_e: Default::default(),
+            end_e: Default::default(),
+            leaf_hi: Default::default(),
+            leaf_sp: Default::default(),
+            stack_node: Default::default(),
+            stack_lo: Default::default(),
+            stack_hi: Default::default(),
+            f1_valid: Default::default(),
+            f1_next: Default::default(),
+            f1_thread: Default::default(),
+            f1_a: Default::default(),
+            f1_b: Default::default(),
+            f2_valid: Default::default(),
+            f2_next: Default::default(),
+            f2_thread: Default::default(),
+            f2_a: Default::default(),
+            f2_b: Default::default(),
+            f3_valid: Default::default(),
+            f3_next: Default::default(),
+            f3_thread: Default::default(),
+            f3_a: Default::default(),
+            f3_b: Default::default(),
+            f3_sp: Default::default(),
+            f3_t_min: Default::default(),
+            f4_valid: Default::default(),
+            f4_next: Default::default(),
+            f4_thread: Default::default(),
+            f4_a: Default::default(),
+            f4_b: Default::default(),
+            f4_sp: Default::default(),
+            f4_t_min: Default::default(),
+            f4_node: Default::default(),
+            f4_lo: Default::default(),
+            f4_hi: Default::default(),
+            f5_valid: Default::default(),
+            f5_next: Default::default(),
+            f5_thread: Default::default(),
+            f5_a: Default::default(),
+            f5_b: Default::default(),
+            f5_sp: Default::default(),
+            f5_t_min: Default::default(),
+            f5_node: Default::default(),
+            f5_lo: Default::default(),
+            f5_hi: Default::default(),
+            f5_in_leaf: Default::default(),
+            cmp_leaf: Default::default(),
+            cmp_pop: Default::default(),
+            f2_sp: Default::default(),
+            f2_pop: Default::default(),
+            f5_pop: Default::default(),
+            front_end: Default::default(),
+            front_job: Default::default(),
+            phase: Default::default(),
+            job: Default::default(),
+            words_in: Default::default(),
+            w0: Default::default(),
+            w1: Default::default(),
+            take: Default::default(),
+            node_line: Default::default(),
+            arrive: Default::default(),
+            at_a: Default::default(),
+            a_leaf: Default::default(),
+            a_axis: Default::default(),
+            a_o: Default::default(),
+            a_d: Default::default(),
+            a_inner: Default::default(),
+            sub: Default::default(),
+            div: Default::default(),
+            o_delay: Default::default(),
+            o_delay_div: Default::default(),
+            control_delay: Default::default(),
+            control_delay_div: Default::default(),
+            control_delay_cmp: Default::default(),
+            cmp: Default::default(),
+            ts_delay: Default::default(),
+            lo_delay: Default::default(),
+            hi_delay: Default::default(),
+            d_valid: Default::default(),
+            d_thread: Default::default(),
+            d_sp: Default::default(),
+            d_left: Default::default(),
+            d_near_left: Default::default(),
+            d_near: Default::default(),
+            d_far: Default::default(),
+            c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
+            c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
+            c_zero: const_bits::<W>(u64::from(f.zero(false))),
+            c_finished: Constant::new((1u64 << 31).into()),
+        }
+    }
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const DL: usize,
+    > Logic for TraversalUnit<W, E, M, S, S1, X2, T, DL>
+{
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(
+            self, clock, f1_valid, f1_next, f1_thread, f1_a, f1_b, f2_valid, f2_next, f2_thread,
+            f2_a, f2_b, f3_valid, f3_next, f3_thread, f3_a, f3_b, f3_sp, f3_t_min, f4_valid,
+            f4_next, f4_thread, f4_a, f4_b, f4_sp, f4_t_min, f4_node, f4_lo, f4_hi, f5_valid,
+            f5_next, f5_thread, f5_a, f5_b, f5_sp, f5_t_min, f5_node, f5_lo, f5_hi, f5_in_leaf,
+            phase, job, words_in, w0, w1
+        );
+        clock!(
+            self,
+            clock,
+            entry_fifo,
+            front_fifo,
+            loop_fifo,
+            cmp_leaf,
+            cmp_pop,
+            sub,
+            div,
+            control_delay,
+            control_delay_div,
+            control_delay_cmp,
+            ts_delay,
+            lo_delay,
+            hi_delay
+        );
+        for k in 0..7 {
+            self.ray[k].read_clock.next = self.clock.val();
+            self.ray[k].write_clock.next = self.clock.val();
+        }
+        self.issued.read_clock.next = self.clock.val();
+        self.issued.write_clock.next = self.clock.val();
+        self.done_e.read_clock.next = self.clock.val();
+        self.done_e.write_clock.next = self.clock.val();
+        self.done_u.read_clock.next = self.clock.val();
+        self.done_u.write_clock.next = self.clock.val();
+        self.result_e.read_clock.next = self.clock.val();
+        self.result_e.write_clock.next = self.clock.val();
+        self.end_e.read_clock.next = self.clock.val();
+        self.end_e.write_clock.next = self.clock.val();
+        self.leaf_hi.read_clock.next = self.clock.val();
+        self.leaf_hi.write_clock.next = self.clock.val();
+        self.leaf_sp.read_clock.next = self.clock.val();
+        self.leaf_sp.write_clock.next = self.clock.val();
+        self.stack_node.read_clock.next = self.clock.val();
+        self.stack_node.write_clock.next = self.clock.val();
+        self.stack_lo.read_clock.next = self.clock.val();
+        self.stack_lo.write_clock.next = self.clock.val();
+        self.stack_hi.read_clock.next = self.clock.val();
+        self.stack_hi.write_clock.next = self.clock.val();
+        for k in 0..6 {
+            self.node_line[k].clock.next = self.clock.val();
+        }
+        for k in 0..5 {
+            self.o_delay[k].clock.next = self.clock.val();
+            self.o_delay_div[k].clock.next = self.clock.val();
+        }
+        for k in 0..5 {
+            self.cmp[k].clock.next = self.clock.val();
+        }
+
+        // Engine side: the ray, t_min, the queue, the answers.
+        for k in 0..7 {
+            self.ray[k].write_address.next = self.thread.val();
+            self.ray[k].write_enable.next = false;
+            self.ray[k].write_data.next = self.word_a.val().get_bits::<W>(0);
+        }
+        if self.ray_write.val() {
+            if self.ray_pair.val() == 0 {
+                self.ray[0].write_enable.next = true;
+                self.ray[1].write_enable.next = true;
+                self.ray[1].write_data.next = self.word_b.val().get_bits::<W>(0);
+            }
+            if self.ray_pair.val() == 1 {
+                self.ray[2].write_enable.next = true;
+                self.ray[3].write_enable.next = true;
+                self.ray[3].write_data.next = self.word_b.val().get_bits::<W>(0);
+            }
+            if self.ray_pair.val() == 2 {
+                self.ray[4].write_enable.next = true;
+                self.ray[5].write_enable.next = true;
+                self.ray[5].write_data.next = self.word_b.val().get_bits::<W>(0);
+            }
+        }
+        self.ray[6].write_enable.next = self.t_min_write.val();
+        self.full.next = self.entry_fifo.full.val();
+        self.entry_fifo.write.next = self.enqueue.val() & (!self.entry_fifo.full.val());
+        self.entry_fifo.data_in.next = (bit_cast::<70, 1>(self.enqueue_next.val().into()) << 69)
+            | (bit_cast::<70, 5>(self.thread.val()) << 64)
+            | (bit_cast::<70, 32>(self.word_a.val()) << 32)
+            | bit_cast::<70, 32>(self.word_b.val());
+        self.issued.read_address.next = self.query_thread.val();
+        self.done_e.read_address.next = self.query_thread.val();
+        self.result_e.read_address.next = self.query_thread.val();
+        self.end_e.read_address.next = self.query_thread.val();
+        self.pending.next = self.issued.read_data.val() != self.done_e.read_data.val();
+        self.result.next = self.result_e.read_data.val();
+        self.list_end.next = self.end_e.read_data.val();
+        self.issued.write_address.next = self.thread.val();
+        self.issued.write_data.next = self.issued.read_data.val() + 1;
+        self.issued.write_enable.next = self.enqueue.val() & (!self.entry_fifo.full.val());
+
+        // Front: one engine entry a clock, a job five clocks later.
+        self.entry_fifo.read.next = !self.entry_fifo.empty.val();
+        self.f1_valid.d.next = !self.entry_fifo.empty.val();
+        self.f1_next.d.next = self.entry_fifo.data_out.val().get_bit(69);
+        self.f1_thread.d.next = self.entry_fifo.data_out.val().get_bits::<5>(64);
+        self.f1_a.d.next = self.entry_fifo.data_out.val().get_bits::<32>(32);
+        self.f1_b.d.next = self.entry_fifo.data_out.val().get_bits::<32>(0);
+        self.leaf_hi.read_address.next = self.f1_thread.q.val();
+        self.leaf_sp.read_address.next = self.f1_thread.q.val();
+        self.ray[6].read_address.next = self.f1_thread.q.val();
+        self.f2_valid.d.next = self.f1_valid.q.val();
+        self.f2_next.d.next = self.f1_next.q.val();
+        self.f2_thread.d.next = self.f1_thread.q.val();
+        self.f2_a.d.next = self.f1_a.q.val();
+        self.f2_b.d.next = self.f1_b.q.val();
+        // f2: the thread's leaf end, depth and t_min are here.
+        self.f2_sp.next = self.leaf_sp.read_data.val();
+        self.f2_pop.next = self.f2_sp.val() - 1;
+        self.cmp_leaf.in_valid.next = true;
+        self.cmp_leaf.a.next = self.f2_a.q.val().get_bits::<W>(0);
+        self.cmp_leaf.b.next = self.leaf_hi.read_data.val();
+        self.stack_node.read_address.next =
+            (bit_cast::<11, 5>(self.f2_thread.q.val()) << 6) | bit_cast::<11, 6>(self.f2_pop.val());
+        self.stack_lo.read_address.next =
+            (bit_cast::<11, 5>(self.f2_thread.q.val()) << 6) | bit_cast::<11, 6>(self.f2_pop.val());
+        self.stack_hi.read_address.next =
+            (bit_cast::<11, 5>(self.f2_thread.q.val()) << 6) | bit_cast::<11, 6>(self.f2_pop.val());
+        self.f3_valid.d.next = self.f2_valid.q.val();
+        self.f3_next.d.next = self.f2_next.q.val();
+        self.f3_thread.d.next = self.f2_thread.q.val();
+        self.f3_a.d.next = self.f2_a.q.val();
+        self.f3_b.d.next = self.f2_b.q.val();
+        self.f3_sp.d.next = self.f2_sp.val();
+        self.f3_t_min.d.next = self.ray[6].read_data.val();
+        // f3: the popped entry is here.
+        self.cmp_pop.in_valid.next = true;
+        self.cmp_pop.a.next = self.f3_a.q.val().get_bits::<W>(0);
+        self.cmp_pop.b.next = self.stack_lo.read_data.val();
+        self.f4_valid.d.next = self.f3_valid.q.val();
+        self.f4_next.d.next = self.f3_next.q.val();
+        self.f4_thread.d.next = self.f3_thread.q.val();
+        self.f4_a.d.next = self.f3_a.q.val();
+        self.f4_b.d.next = self.f3_b.q.val();
+        self.f4_sp.d.next = self.f3_sp.q.val();
+        self.f4_t_min.d.next = self.f3_t_min.q.val();
+        self.f4_node.d.next = self.stack_node.read_data.val();
+        self.f4_lo.d.next = self.stack_lo.read_data.val();
+        self.f4_hi.d.next = self.stack_hi.read_data.val();
+        self.f5_valid.d.next = self.f4_valid.q.val();
+        self.f5_next.d.next = self.f4_next.q.val();
+        self.f5_thread.d.next = self.f4_thread.q.val();
+        self.f5_a.d.next = self.f4_a.q.val();
+        self.f5_b.d.next = self.f4_b.q.val();
+        self.f5_sp.d.next = self.f4_sp.q.val();
+        self.f5_t_min.d.next = self.f4_t_min.q.val();
+        self.f5_node.d.next = self.f4_node.q.val();
+        self.f5_lo.d.next = self.f4_lo.q.val();
+        self.f5_hi.d.next = self.f4_hi.q.val();
+        self.f5_in_leaf.d.next = self.cmp_leaf.le.val();
+        // f5: a start steps from the root (`a`) with [t_min, t_max = `b`]; a next ends the
+        // walk when the hit lies in the leaf's segment, the stack is empty or the popped
+        // segment starts behind the hit, else steps from the popped entry.
+        self.f5_pop.next = self.f5_sp.q.val() - 1;
+        self.front_end.next = self.f5_next.q.val()
+            & ((self.f5_b.q.val().get_bit(0) & self.f5_in_leaf.q.val())
+                | (self.f5_sp.q.val() == 0)
+                | (self.f5_b.q.val().get_bit(0) & self.cmp_pop.lt.val()));
+        self.front_job.next = (bit_cast::<102, 1>(self.front_end.val().into()) << 101)
+            | (bit_cast::<102, 5>(self.f5_thread.q.val()) << 96)
+            | (bit_cast::<102, 6>(self.f5_pop.val()) << 90)
+            | (bit_cast::<102, 26>(self.f5_node.q.val()) << 64)
+            | (bit_cast::<102, W>(self.f5_lo.q.val()) << 32)
+            | bit_cast::<102, W>(self.f5_hi.q.val());
+        if !self.f5_next.q.val() {
+            self.front_job.next = (bit_cast::<102, 5>(self.f5_thread.q.val()) << 96)
+                | (bit_cast::<102, 26>(self.f5_a.q.val().get_bits::<26>(0)) << 64)
+                | (bit_cast::<102, W>(self.f5_t_min.q.val()) << 32)
+                | bit_cast::<102, W>(self.f5_b.q.val().get_bits::<W>(0));
+        }
+        self.front_fifo.write.next = self.f5_valid.q.val();
+        self.front_fifo.data_in.next = self.front_job.val();
+
+        // Fetch: loop jobs first; two words of bank 0 (the engine's loads first).
+        self.loop_fifo.read.next = false;
+        self.front_fifo.read.next = false;
+        if self.phase.q.val() == 0 {
+            if !self.loop_fifo.empty.val() {
+                self.loop_fifo.read.next = true;
+                self.job.d.next = self.loop_fifo.data_out.val();
+                self.phase.d.next = 1.into();
+            } else if !self.front_fifo.empty.val() {
+                self.front_fifo.read.next = true;
+                self.job.d.next = self.front_fifo.data_out.val();
+                self.phase.d.next = 1.into();
+            }
+        }
+        self.words_in.d.next = 0.into();
+        self.take.next = ((self.phase.q.val() == 1) | (self.phase.q.val() == 2))
+            & (!self.job.q.val().get_bit(101))
+            & (!(self.engine_read.val() & (self.engine_bank.val() == 0)));
+        self.node_read.next =
+            self.take.val() | (self.engine_read.val() & (self.engine_bank.val() == 0));
+        self.node_addr.next = self.engine_addr.val();
+        if self.take.val() {
+            self.node_addr.next = (bit_cast::<24, 26>(self.job.q.val().get_bits::<26>(64)) << 1)
+                | bit_cast::<24, 2>(self.phase.q.val() - 1);
+            self.phase.d.next = self.phase.q.val() + 1;
+        }
+        self.node_line[0].d.next = (bit_cast::<2, 1>(self.take.val().into()) << 1)
+            | bit_cast::<2, 1>((self.phase.q.val() == 2).into());
+        for k in 1..6 {
+            self.node_line[k].d.next = self.node_line[k - 1].q.val();
+        }
+        self.arrive.next = 0.into();
+        for k in 0..6 {
+            if self.c_ml_last.val() == self.c_index[k].val() {
+                self.arrive.next = self.node_line[k].q.val();
+            }
+        }
+        if self.arrive.val() == 2 {
+            self.w0.d.next = self.node_rdata.val();
+        }
+        if self.arrive.val() == 3 {
+            self.w1.d.next = self.node_rdata.val();
+        }
+        if (self.phase.q.val() == 3) & (self.arrive.val() == 3) {
+            self.words_in.d.next = 1.into();
+        }
+        // A finishing job skips the fetch.
+        if (self.phase.q.val() == 1) & self.job.q.val().get_bit(101) {
+            self.phase.d.next = 3.into();
+            self.words_in.d.next = 1.into();
+        }
+        self.ray[0].read_address.next = self.job.q.val().get_bits::<5>(96);
+        self.ray[1].read_address.next = self.job.q.val().get_bits::<5>(96);
+        self.ray[2].read_address.next = self.job.q.val().get_bits::<5>(96);
+        self.ray[3].read_address.next = self.job.q.val().get_bits::<5>(96);
+        self.ray[4].read_address.next = self.job.q.val().get_bits::<5>(96);
+        self.ray[5].read_address.next = self.job.q.val().get_bits::<5>(96);
+
+        // A: both words are here (or the walk ended).
+        self.at_a.next = (self.phase.q.val() == 3) & (self.words_in.q.val() == 1);
+        if self.at_a.val() {
+            self.phase.d.next = 0.into();
+        }
+        self.a_leaf.next = self.job.q.val().get_bit(101) | (self.w0.q.val().get_bits::<2>(30) == 3);
+        self.a_axis.next = self.w0.q.val().get_bits::<2>(30);
+        self.a_o.next = self.ray[0].read_data.val();
+        self.a_d.next = self.ray[3].read_data.val();
+        if self.a_axis.val() == 1 {
+            self.a_o.next = self.ray[1].read_data.val();
+            self.a_d.next = self.ray[4].read_data.val();
+        }
+        if self.a_axis.val() == 2 {
+            self.a_o.next = self.ray[2].read_data.val();
+            self.a_d.next = self.ray[5].read_data.val();
+        }
+        self.a_inner.next = self.at_a.val() & (!self.a_leaf.val());
+        // A leaf (or the end): the result for the engine, the segment end and depth for next.
+        self.result_e.write_address.next = self.job.q.val().get_bits::<5>(96);
+        self.end_e.write_address.next = self.job.q.val().get_bits::<5>(96);
+        self.done_e.write_address.next = self.job.q.val().get_bits::<5>(96);
+        self.leaf_hi.write_address.next = self.job.q.val().get_bits::<5>(96);
+        self.leaf_sp.write_address.next = self.job.q.val().get_bits::<5>(96);
+        self.result_e.write_data.next = bit_cast::<32, 30>(self.w0.q.val().get_bits::<30>(0));
+        if self.job.q.val().get_bit(101) {
+            self.result_e.write_data.next = self.c_finished.val();
+        }
+        self.end_e.write_data.next =
+            bit_cast::<32, 30>(self.w0.q.val().get_bits::<30>(0)) + self.w1.q.val();
+        self.leaf_hi.write_data.next = self.job.q.val().get_bits::<W>(0);
+        self.leaf_sp.write_data.next = self.job.q.val().get_bits::<6>(90);
+        // Entries done: the unit's copy is read at the job's thread, the engine's at its own.
+        self.done_u.read_address.next = self.job.q.val().get_bits::<5>(96);
+        self.done_u.write_address.next = self.job.q.val().get_bits::<5>(96);
+        self.done_e.write_data.next = self.done_u.read_data.val() + 1;
+        self.done_u.write_data.next = self.done_u.read_data.val() + 1;
+        self.done_u.write_enable.next = self.at_a.val() & self.a_leaf.val();
+        self.result_e.write_enable.next = self.at_a.val() & self.a_leaf.val();
+        self.end_e.write_enable.next = self.at_a.val() & self.a_leaf.val();
+        self.done_e.write_enable.next = self.at_a.val() & self.a_leaf.val();
+        self.leaf_hi.write_enable.next = self.at_a.val() & self.a_leaf.val();
+        self.leaf_sp.write_enable.next = self.at_a.val() & self.a_leaf.val();
+
+        // Decision: t_split = (split - o) / d, then the comparisons of `units::traversal_step`.
+        self.step_busy.next = self.a_inner.val();
+        self.sub.in_valid.next = true;
+        self.sub.sub.next = true;
+        self.sub.a.next = self.w1.q.val().get_bits::<W>(0);
+        self.sub.b.next = self.a_o.val();
+        self.div.in_valid.next = true;
+        self.div.a.next = self.sub.result.val();
+        self.div.b.next = self.o_delay[1].data_out.val();
+        // o, d, lo, hi wait for t_split; so does the control.
+        self.o_delay[0].data_in.next = self.a_o.val();
+        self.o_delay[1].data_in.next = self.a_d.val();
+        self.o_delay[2].data_in.next = self.job.q.val().get_bits::<W>(32);
+        self.o_delay[3].data_in.next = self.job.q.val().get_bits::<W>(0);
+        self.o_delay[4].data_in.next = self.w1.q.val().get_bits::<W>(0);
+        for k in 0..5 {
+            self.o_delay_div[k].data_in.next = self.o_delay[k].data_out.val();
+        }
+        self.control_delay.data_in.next = (bit_cast::<38, 1>(self.a_inner.val().into()) << 37)
+            | (bit_cast::<38, 5>(self.job.q.val().get_bits::<5>(96)) << 32)
+            | (bit_cast::<38, 6>(self.job.q.val().get_bits::<6>(90)) << 26)
+            | bit_cast::<38, 26>(self.w0.q.val().get_bits::<26>(0));
+        self.control_delay_div.data_in.next = self.control_delay.data_out.val();
+        self.control_delay_cmp.data_in.next = self.control_delay_div.data_out.val();
+        // The split plane waits with o: compare o with it when t_split is done.
+        self.cmp[0].a.next = self.o_delay_div[0].data_out.val();
+        self.cmp[0].b.next = self.o_delay_div[4].data_out.val();
+        self.cmp[1].a.next = self.o_delay_div[1].data_out.val();
+        self.cmp[1].b.next = self.c_zero.val();
+        self.cmp[2].a.next = self.o_delay_div[3].data_out.val();
+        self.cmp[2].b.next = self.div.result.val();
+        self.cmp[3].a.next = self.div.result.val();
+        self.cmp[3].b.next = self.c_zero.val();
+        self.cmp[4].a.next = self.div.result.val();
+        self.cmp[4].b.next = self.o_delay_div[2].data_out.val();
+        for k in 0..5 {
+            self.cmp[k].in_valid.next = true;
+        }
+        self.ts_delay.data_in.next = self.div.result.val();
+        self.lo_delay.data_in.next = self.o_delay_div[2].data_out.val();
+        self.hi_delay.data_in.next = self.o_delay_div[3].data_out.val();
+
+        // D: the decision, a push for both children, the next step.
+        self.d_valid.next = self.control_delay_cmp.data_out.val().get_bit(37);
+        self.d_thread.next = self.control_delay_cmp.data_out.val().get_bits::<5>(32);
+        self.d_sp.next = self.control_delay_cmp.data_out.val().get_bits::<6>(26);
+        self.d_left.next = self.control_delay_cmp.data_out.val().get_bits::<26>(0);
+        self.d_near_left.next =
+            self.cmp[0].lt.val() | (self.cmp[0].eq.val() & self.cmp[1].le.val());
+        self.d_near.next = self.d_left.val() + 1;
+        self.d_far.next = self.d_left.val();
+        if self.d_near_left.val() {
+            self.d_near.next = self.d_left.val();
+            self.d_far.next = self.d_left.val() + 1;
+        }
+        self.stack_node.write_address.next =
+            (bit_cast::<11, 5>(self.d_thread.val()) << 6) | bit_cast::<11, 6>(self.d_sp.val());
+        self.stack_lo.write_address.next = self.stack_node.write_address.val();
+        self.stack_hi.write_address.next = self.stack_node.write_address.val();
+        self.stack_node.write_data.next = self.d_far.val();
+        self.stack_lo.write_data.next = self.ts_delay.data_out.val();
+        self.stack_hi.write_data.next = self.hi_delay.data_out.val();
+        self.stack_node.write_enable.next = false;
+        self.stack_lo.write_enable.next = false;
+        self.stack_hi.write_enable.next = false;
+        // Near with the whole segment.
+        self.loop_fifo.data_in.next = (bit_cast::<102, 5>(self.d_thread.val()) << 96)
+            | (bit_cast::<102, 6>(self.d_sp.val()) << 90)
+            | (bit_cast::<102, 26>(self.d_near.val()) << 64)
+            | (bit_cast::<102, W>(self.lo_delay.data_out.val()) << 32)
+            | bit_cast::<102, W>(self.hi_delay.data_out.val());
+        if (!self.cmp[1].eq.val()) & (!self.cmp[2].lt.val()) & (!self.cmp[3].le.val()) {
+            if self.cmp[4].lt.val() {
+                // Far with the whole segment.
+                self.loop_fifo.data_in.next = (bit_cast::<102, 5>(self.d_thread.val()) << 96)
+                    | (bit_cast::<102, 6>(self.d_sp.val()) << 90)
+                    | (bit_cast::<102, 26>(self.d_far.val()) << 64)
+                    | (bit_cast::<102, W>(self.lo_delay.data_out.val()) << 32)
+                    | bit_cast::<102, W>(self.hi_delay.data_out.val());
+            } else {
+                // Both: push (far, t_split, hi), near with [lo, t_split].
+                self.stack_node.write_enable.next = self.d_valid.val();
+                self.stack_lo.write_enable.next = self.d_valid.val();
+                self.stack_hi.write_enable.next = self.d_valid.val();
+                self.loop_fifo.data_in.next = (bit_cast::<102, 5>(self.d_thread.val()) << 96)
+                    | (bit_cast::<102, 6>(self.d_sp.val() + 1) << 90)
+                    | (bit_cast::<102, 26>(self.d_near.val()) << 64)
+                    | (bit_cast::<102, W>(self.lo_delay.data_out.val()) << 32)
+                    | bit_cast::<102, W>(self.ts_delay.data_out.val());
+            }
+        }
+        self.loop_fifo.write.next = self.d_valid.val();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fp::Format;
+    use crate::hw::fp::div::div_latency;
+    use crate::hw::sim_harness::{clock_cycle, settle};
+    use crate::layout::{self, FrameMap, MemoryConfig, SceneTrees, FRAME, NODES};
+    use crate::scene::Scene;
+    use crate::units::{KdStop, KdWalk};
+    use rand::{Rng, SeedableRng};
+    use std::collections::VecDeque;
+
+    type Unit = TraversalUnit<24, 7, 16, 17, 18, 9, 21, { div_latency(16) as usize }>;
+
+    /// rust-hdl simulation on the Cornell box's kd tree with an SRAM model behind bank 0:
+    /// eight threads walk from the root with rays from around the eye; after each leaf the
+    /// thread answers `next` with no hit, or (from its third leaf on, one thread in two) a hit
+    /// at a random distance. Every thread's sequence of leaves and its end equal
+    /// `units::KdWalk`'s; the engine takes bank 0 in random clocks.
+    #[test]
+    fn rust_hdl_simulation_walks_like_the_model() {
+        let f = Format::E7M16;
+        let seed = 41;
+        println!("seed {seed}");
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_noshadow.toml");
+        let scene = Scene::load(&path).unwrap();
+        let trees = SceneTrees::build(&scene, f).unwrap();
+        let lay = layout::build(&scene, &trees, 0, &MemoryConfig::default()).unwrap();
+        let nodes = lay.banks[NODES].clone();
+        let root = lay.info.object_root;
+        let eye = lay.words::<3>(FRAME, FrameMap::EYE);
+        let mem_latency = 2;
+        let threads = 8usize;
+        let w = |x: f64| f.from_f64(x);
+        let rays: Vec<([u32; 3], [u32; 3])> = (0..threads)
+            .map(|_| {
+                let o = eye.map(|e| f.add(e, w(rng.gen_range(-0.2..0.2))));
+                let d = [
+                    w(rng.gen_range(-1.0..1.0)),
+                    w(rng.gen_range(-1.0..1.0)),
+                    w(rng.gen_range(-1.0..1.0)),
+                ];
+                (o, d)
+            })
+            .collect();
+        // The answer a thread gives after its k-th leaf.
+        let answers: Vec<Vec<(u32, bool)>> = (0..threads)
+            .map(|th| {
+                (0..64)
+                    .map(|k| {
+                        if th % 2 == 1 && k >= 2 {
+                            (w(rng.gen_range(0.5..8.0)), true)
+                        } else {
+                            (f.infinity(false), false)
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        let fetch = |n: u32| Ok(lay.node(n));
+        let t_max = f.infinity(false);
+        let want: Vec<Vec<KdStop>> = (0..threads)
+            .map(|th| {
+                let (mut walk, mut stop) =
+                    KdWalk::start(f, rays[th], root, (0, t_max), STACK_LEVELS, fetch).unwrap();
+                let mut stops = vec![stop];
+                let mut k = 0;
+                while stop != KdStop::Finished {
+                    stop = walk
+                        .next(f, rays[th], answers[th][k], STACK_LEVELS, fetch)
+                        .unwrap();
+                    stops.push(stop);
+                    k += 1;
+                }
+                stops
+            })
+            .collect();
+        assert!(
+            want.iter().map(Vec::len).sum::<usize>() > 4 * threads,
+            "too few leaves"
+        );
+
+        let mut u = Unit::new(mem_latency);
+        u.connect_all();
+        let cycle = |u: &mut Unit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
+        for (th, (o, d)) in rays.iter().enumerate() {
+            u.thread.next = (th as u64).into();
+            for (pair, (a, b)) in [(o[0], o[1]), (o[2], d[0]), (d[1], d[2])]
+                .into_iter()
+                .enumerate()
+            {
+                u.ray_write.next = true;
+                u.ray_pair.next = (pair as u64).into();
+                u.word_a.next = u64::from(a).into();
+                u.word_b.next = u64::from(b).into();
+                cycle(&mut u);
+            }
+            u.ray_write.next = false;
+            u.t_min_write.next = true;
+            u.word_a.next = 0.into();
+            cycle(&mut u);
+            u.t_min_write.next = false;
+        }
+        // Per thread: the entry to offer next (start first), whether one is in flight.
+        let mut offer: Vec<Option<(bool, u32, u32)>> = (0..threads as u32)
+            .map(|_| Some((false, root, t_max)))
+            .collect();
+        let mut in_flight = vec![false; threads];
+        let mut got: Vec<Vec<KdStop>> = vec![Vec::new(); threads];
+        let mut requests: VecDeque<Option<u32>> =
+            std::iter::repeat(None).take(mem_latency as usize).collect();
+        let (mut clocks, mut stolen) = (0, 0);
+        // Two clocks per turn of a thread, as the engine's I2 and I3: present the thread to
+        // the counters, then read its answer and offer its entry.
+        let mut tick = |u: &mut Unit, rng: &mut rand_chacha::ChaCha8Rng| {
+            let addr = requests.pop_front().unwrap();
+            u.node_rdata.next = u64::from(addr.map_or(0xdead_beef, |a| nodes[a as usize])).into();
+            let steal = rng
+                .gen_ratio(1, 6)
+                .then(|| rng.gen_range(0..nodes.len() as u64));
+            u.engine_read.next = steal.is_some();
+            u.engine_bank.next = 0.into();
+            u.engine_addr.next = steal.unwrap_or(0).into();
+            settle(u);
+            if let Some(a) = steal {
+                stolen += 1;
+                assert!(
+                    u.node_read.val() && u.node_addr.val().to_u64() == a,
+                    "the engine's read"
+                );
+            }
+            requests.push_back(u.node_read.val().then(|| u.node_addr.val().to_u64() as u32));
+            let full = u.full.val();
+            cycle(u);
+            !full
+        };
+        let mut th = 0;
+        while got.iter().zip(&want).any(|(g, w)| g.len() < w.len()) {
+            clocks += 2;
+            assert!(clocks < 400_000, "the walks do not end: got {got:?}");
+            th = (th + 1) % threads;
+            u.query_thread.next = (th as u64).into();
+            u.enqueue.next = false;
+            tick(&mut u, &mut rng);
+            if in_flight[th] && !u.pending.val() {
+                in_flight[th] = false;
+                let result = u.result.val().to_u64() as u32;
+                let stop = if result == 1 << 31 {
+                    KdStop::Finished
+                } else {
+                    let end = u.list_end.val().to_u64() as u32;
+                    KdStop::Leaf {
+                        list: result,
+                        count: end - result,
+                    }
+                };
+                let k = got[th].len();
+                got[th].push(stop);
+                if stop != KdStop::Finished {
+                    let (best_t, hit) = answers[th][k];
+                    offer[th] = Some((true, best_t, u32::from(hit)));
+                }
+            }
+            u.enqueue.next = offer[th].is_some();
+            if let Some((next, a, b)) = offer[th] {
+                u.thread.next = (th as u64).into();
+                u.enqueue_next.next = next;
+                u.word_a.next = u64::from(a).into();
+                u.word_b.next = u64::from(b).into();
+            }
+            if tick(&mut u, &mut rng) && offer[th].is_some() {
+                offer[th] = None;
+                in_flight[th] = true;
+            }
+        }
+        assert!(stolen > 0);
+        assert_eq!(got, want, "leaves per thread");
+    }
+}
