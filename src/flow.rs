@@ -13,6 +13,7 @@ use crate::fp::Format;
 use crate::hw::engine::engine_period;
 use crate::hw::program::exec::{Machine, RunStats, Write};
 use crate::hw::program::{build_program, Program, ProgramConfig};
+use crate::hw::traversal_unit::STACK_LEVELS;
 use crate::hw::vga::VgaMode;
 use crate::layout::{self, Layout, MemoryConfig, SceneTrees};
 use crate::model::{self, golden::Golden};
@@ -98,6 +99,16 @@ fn prepare(
     frames: Option<u32>,
 ) -> Result<Prepared> {
     let layouts = scene_layouts(scene, f, frames)?;
+    let deepest = layouts
+        .iter()
+        .map(|l| l.info.object_depth)
+        .max()
+        .unwrap_or(0);
+    anyhow::ensure!(
+        deepest as usize <= STACK_LEVELS,
+        "the scene's deepest object kd tree has {deepest} levels; the traversal unit's stack \
+         holds {STACK_LEVELS}: use fewer triangles per object or split the mesh into instances"
+    );
     let program = build_program(&ProgramConfig::from_layout(f, &layouts[0].info));
     let twin = Machine::new(&program, &layouts[0])
         .run_frame(params.threads as usize)

@@ -88,6 +88,20 @@ fn engine_verilog<
     generate_verilog(&uut)
 }
 
+/// Runs `f` on a thread with a 256 MB stack: rust-hdl builds and prints the design by
+/// recursion over its blocks, which overflows the 2 MB stack of a test thread for the whole
+/// processor. A panic in `f` propagates.
+fn on_large_stack<T: Send>(f: impl FnOnce() -> T + Send) -> T {
+    std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .stack_size(256 << 20)
+            .spawn_scoped(scope, f)
+            .expect("cannot start the Verilog generation thread")
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    })
+}
+
 /// How the processor is built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ProcessorParams {
@@ -184,10 +198,12 @@ pub fn processor_rtl(
         program.scratch.words,
         crate::hw::engine::SCRATCH_WORDS
     );
-    let core = dispatch_engine_format!(
-        f,
-        engine_verilog(program, params.threads, params.mem_latency)
-    )?;
+    let core = on_large_stack(|| {
+        dispatch_engine_format!(
+            f,
+            engine_verilog(program, params.threads, params.mem_latency)
+        )
+    })?;
     let core_name = format!("{PROCESSOR_TOP}_core");
     let core = merge_identical_modules(&rename_rust_hdl_names(&core, &core_name));
     let c = &program.config;

@@ -23,8 +23,11 @@
 //!   unit or triangle tester.
 //!
 //! Throughput: one instruction per clock while `threads >= period`; a frame ends when every
-//! thread has executed `halt` (`done`). Counters: clocks of the frame, instructions issued,
+//! thread has executed `halt` (`done`). Counters: clocks of the frame, instructions retired,
 //! and clocks in which the triangle tester's TransformUnit and IntersectUnit took an input.
+//! `instructions` counts retired instructions: not the turns a thread spends offering an entry
+//! again to a full coprocessor queue or waiting for a coprocessor, so it equals the count of
+//! the engine's twin, which never waits.
 //!
 //! The [`TriangleTester`] runs beside the barrel: threads queue triangle tests into it and
 //! wait for their results once per kd leaf, so a test costs a thread one turn instead of the
@@ -595,9 +598,6 @@ impl<
         } else {
             self.opb.next = self.regs_b.read_data.val();
         }
-        if self.v3.q.val() {
-            self.instr_count.d.next = self.instr_count.q.val() + 1;
-        }
 
         // Floating-point units: every clock, whether used or not.
         self.add.a.next = self.opa.val().get_bits::<W>(0);
@@ -967,6 +967,13 @@ impl<
             | (bit_cast::<16, 1>((self.wb_op.val() == 28).into()) << 12)
             | bit_cast::<16, 12>(self.wb_next_pc.val());
         self.pc_ram.write_enable.next = self.wb_valid.val();
+        // Instructions retired: every write back but a turn spent offering again to a full
+        // coprocessor queue or waiting for a coprocessor (the twin never repeats those).
+        if self.wb_valid.val()
+            & (!(((self.wb_op.val() == 29) | (self.wb_op.val() == 30)) & self.wb_cond.val()))
+        {
+            self.instr_count.d.next = self.instr_count.q.val() + 1;
+        }
         if self.wb_valid.val() & (self.wb_op.val() == 28) {
             self.halted_count.d.next = self.halted_count.q.val() + 1;
             if (self.halted_count.q.val() + 1) == self.c_threads.val() {

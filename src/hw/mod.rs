@@ -17,6 +17,7 @@ pub mod fp;
 pub mod geometry_formats;
 pub mod int_to_float;
 pub mod intersect;
+pub mod ray_store;
 pub mod raygen;
 #[cfg(test)]
 mod sim_harness;

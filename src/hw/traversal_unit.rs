@@ -30,6 +30,7 @@
 use rust_hdl::prelude::*;
 
 use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
+use super::ray_store::{zero_counters, RayStore};
 use super::Delay;
 use crate::fp::Format;
 
@@ -87,7 +88,7 @@ pub struct TraversalUnit<
     loop_fifo: SynchronousFIFO<Job, 5, 6, 1>,
     /// Per thread: ray o, d and t_min (engine-written); entries taken (engine); entries done,
     /// result and list end (unit, read by the engine); leaf segment end and stack depth (unit).
-    ray: [RAM<Bits<W>, 5>; 7],
+    ray: RayStore<W>,
     issued: RAM<Bits<8>, 5>,
     done_e: RAM<Bits<8>, 5>,
     done_u: RAM<Bits<8>, 5>,
@@ -194,15 +195,6 @@ pub struct TraversalUnit<
     c_index: [Constant<Bits<4>>; 6],
     c_zero: Constant<Bits<W>>,
     c_finished: Constant<Bits<32>>,
-}
-
-/// Per-thread counters that start at 0 (nothing pending at power-up).
-fn zero_counters() -> RAM<Bits<8>, 5> {
-    RAM::new(
-        (0..32u64)
-            .map(|k| (Bits::<5>::from(k), Bits::<8>::from(0u64)))
-            .collect(),
-    )
 }
 
 impl<
@@ -367,6 +359,7 @@ impl<
             entry_fifo,
             front_fifo,
             loop_fifo,
+            ray,
             cmp_leaf,
             cmp_pop,
             sub,
@@ -378,10 +371,6 @@ impl<
             lo_delay,
             hi_delay
         );
-        for k in 0..7 {
-            self.ray[k].read_clock.next = self.clock.val();
-            self.ray[k].write_clock.next = self.clock.val();
-        }
         self.issued.read_clock.next = self.clock.val();
         self.issued.write_clock.next = self.clock.val();
         self.done_e.read_clock.next = self.clock.val();
@@ -414,29 +403,12 @@ impl<
         }
 
         // Engine side: the ray, t_min, the queue, the answers.
-        for k in 0..7 {
-            self.ray[k].write_address.next = self.thread.val();
-            self.ray[k].write_enable.next = false;
-            self.ray[k].write_data.next = self.word_a.val().get_bits::<W>(0);
-        }
-        if self.ray_write.val() {
-            if self.ray_pair.val() == 0 {
-                self.ray[0].write_enable.next = true;
-                self.ray[1].write_enable.next = true;
-                self.ray[1].write_data.next = self.word_b.val().get_bits::<W>(0);
-            }
-            if self.ray_pair.val() == 1 {
-                self.ray[2].write_enable.next = true;
-                self.ray[3].write_enable.next = true;
-                self.ray[3].write_data.next = self.word_b.val().get_bits::<W>(0);
-            }
-            if self.ray_pair.val() == 2 {
-                self.ray[4].write_enable.next = true;
-                self.ray[5].write_enable.next = true;
-                self.ray[5].write_data.next = self.word_b.val().get_bits::<W>(0);
-            }
-        }
-        self.ray[6].write_enable.next = self.t_min_write.val();
+        self.ray.thread.next = self.thread.val();
+        self.ray.word_a.next = self.word_a.val();
+        self.ray.word_b.next = self.word_b.val();
+        self.ray.ray_write.next = self.ray_write.val();
+        self.ray.ray_pair.next = self.ray_pair.val();
+        self.ray.t_min_write.next = self.t_min_write.val();
         self.full.next = self.entry_fifo.full.val();
         self.entry_fifo.write.next = self.enqueue.val() & (!self.entry_fifo.full.val());
         self.entry_fifo.data_in.next = (bit_cast::<70, 1>(self.enqueue_next.val().into()) << 69)
@@ -463,7 +435,7 @@ impl<
         self.f1_b.d.next = self.entry_fifo.data_out.val().get_bits::<32>(0);
         self.leaf_hi.read_address.next = self.f1_thread.q.val();
         self.leaf_sp.read_address.next = self.f1_thread.q.val();
-        self.ray[6].read_address.next = self.f1_thread.q.val();
+        self.ray.t_min_thread.next = self.f1_thread.q.val();
         self.f2_valid.d.next = self.f1_valid.q.val();
         self.f2_next.d.next = self.f1_next.q.val();
         self.f2_thread.d.next = self.f1_thread.q.val();
@@ -487,7 +459,7 @@ impl<
         self.f3_a.d.next = self.f2_a.q.val();
         self.f3_b.d.next = self.f2_b.q.val();
         self.f3_sp.d.next = self.f2_sp.val();
-        self.f3_t_min.d.next = self.ray[6].read_data.val();
+        self.f3_t_min.d.next = self.ray.t_min.val();
         // f3: the popped entry is here.
         self.cmp_pop.in_valid.next = true;
         self.cmp_pop.a.next = self.f3_a.q.val().get_bits::<W>(0);
@@ -587,12 +559,7 @@ impl<
             self.phase.d.next = 3.into();
             self.words_in.d.next = 1.into();
         }
-        self.ray[0].read_address.next = self.job.q.val().get_bits::<5>(96);
-        self.ray[1].read_address.next = self.job.q.val().get_bits::<5>(96);
-        self.ray[2].read_address.next = self.job.q.val().get_bits::<5>(96);
-        self.ray[3].read_address.next = self.job.q.val().get_bits::<5>(96);
-        self.ray[4].read_address.next = self.job.q.val().get_bits::<5>(96);
-        self.ray[5].read_address.next = self.job.q.val().get_bits::<5>(96);
+        self.ray.ray_thread.next = self.job.q.val().get_bits::<5>(96);
 
         // A: both words are here (or the walk ended).
         self.at_a.next = (self.phase.q.val() == 3) & (self.words_in.q.val() == 1);
@@ -601,15 +568,15 @@ impl<
         }
         self.a_leaf.next = self.job.q.val().get_bit(101) | (self.w0.q.val().get_bits::<2>(30) == 3);
         self.a_axis.next = self.w0.q.val().get_bits::<2>(30);
-        self.a_o.next = self.ray[0].read_data.val();
-        self.a_d.next = self.ray[3].read_data.val();
+        self.a_o.next = self.ray.o[0].val();
+        self.a_d.next = self.ray.d[0].val();
         if self.a_axis.val() == 1 {
-            self.a_o.next = self.ray[1].read_data.val();
-            self.a_d.next = self.ray[4].read_data.val();
+            self.a_o.next = self.ray.o[1].val();
+            self.a_d.next = self.ray.d[1].val();
         }
         if self.a_axis.val() == 2 {
-            self.a_o.next = self.ray[2].read_data.val();
-            self.a_d.next = self.ray[5].read_data.val();
+            self.a_o.next = self.ray.o[2].val();
+            self.a_d.next = self.ray.d[2].val();
         }
         self.a_inner.next = self.at_a.val() & (!self.a_leaf.val());
         // A leaf (or the end): the result for the engine, the segment end and depth for next.

@@ -33,6 +33,7 @@
 use rust_hdl::prelude::*;
 
 use super::fp::{const_bits, FpCompare};
+use super::ray_store::{zero_counters, RayStore};
 use super::{IntersectUnit, TransformUnit};
 use crate::fp::Format;
 
@@ -45,15 +46,6 @@ pub const TESTER_QUEUE: usize = 16;
 
 /// Queue entry: `{init[69], thread[68:64], a[63:32], b[31:0]}`.
 type Entry = Bits<70>;
-
-/// Per-thread counters that start at 0 (nothing pending at power-up).
-fn zero_counters() -> RAM<Bits<8>, 5> {
-    RAM::new(
-        (0..32u64)
-            .map(|k| (Bits::<5>::from(k), Bits::<8>::from(0u64)))
-            .collect(),
-    )
-}
 
 #[derive(LogicBlock)]
 pub struct TriangleTester<
@@ -101,7 +93,7 @@ pub struct TriangleTester<
     queue_fifo: SynchronousFIFO<Entry, 4, 5, 1>,
     /// Per thread: the ray (o, d), t_min; entries taken; (engine copies) entries done, best
     /// hit `{hit, t}`, instance, triangle; (merge copies) entries done, best hit.
-    ray: [RAM<Bits<W>, 5>; 7],
+    ray: RayStore<W>,
     issued: RAM<Bits<8>, 5>,
     done_e: RAM<Bits<8>, 5>,
     best_e: RAM<Bits<33>, 5>,
@@ -303,11 +295,15 @@ impl<
             m2_t, m2_a, m2_b, m2_done, m3_valid, m3_hit, m3_init, m3_thread, m3_t, m3_a, m3_b,
             m3_done
         );
-        clock!(self, clock, queue_fifo, transform_unit, intersect_unit, cmp);
-        for k in 0..7 {
-            self.ray[k].read_clock.next = self.clock.val();
-            self.ray[k].write_clock.next = self.clock.val();
-        }
+        clock!(
+            self,
+            clock,
+            queue_fifo,
+            ray,
+            transform_unit,
+            intersect_unit,
+            cmp
+        );
         self.issued.read_clock.next = self.clock.val();
         self.issued.write_clock.next = self.clock.val();
         self.done_e.read_clock.next = self.clock.val();
@@ -341,29 +337,12 @@ impl<
         }
 
         // Engine side: ray words, t_min of a new query, the queue.
-        for k in 0..7 {
-            self.ray[k].write_address.next = self.thread.val();
-            self.ray[k].write_enable.next = false;
-            self.ray[k].write_data.next = self.word_a.val().get_bits::<W>(0);
-        }
-        if self.ray_write.val() {
-            if self.ray_pair.val() == 0 {
-                self.ray[0].write_enable.next = true;
-                self.ray[1].write_enable.next = true;
-                self.ray[1].write_data.next = self.word_b.val().get_bits::<W>(0);
-            }
-            if self.ray_pair.val() == 1 {
-                self.ray[2].write_enable.next = true;
-                self.ray[3].write_enable.next = true;
-                self.ray[3].write_data.next = self.word_b.val().get_bits::<W>(0);
-            }
-            if self.ray_pair.val() == 2 {
-                self.ray[4].write_enable.next = true;
-                self.ray[5].write_enable.next = true;
-                self.ray[5].write_data.next = self.word_b.val().get_bits::<W>(0);
-            }
-        }
-        self.ray[6].write_enable.next = self.enqueue.val() & self.queue_init.val();
+        self.ray.thread.next = self.thread.val();
+        self.ray.word_a.next = self.word_a.val();
+        self.ray.word_b.next = self.word_b.val();
+        self.ray.ray_write.next = self.ray_write.val();
+        self.ray.ray_pair.next = self.ray_pair.val();
+        self.ray.t_min_write.next = self.enqueue.val() & self.queue_init.val();
         self.full.next = self.queue_fifo.full.val();
         self.queue_fifo.write.next = self.enqueue.val() & (!self.queue_fifo.full.val());
         self.queue_fifo.data_in.next = (bit_cast::<70, 1>(self.queue_init.val().into()) << 69)
@@ -388,9 +367,8 @@ impl<
 
         // Fetch: the banks serve the engine first.
         self.queue_fifo.read.next = false;
-        for k in 0..7 {
-            self.ray[k].read_address.next = self.cur_thread.q.val();
-        }
+        self.ray.ray_thread.next = self.cur_thread.q.val();
+        self.ray.t_min_thread.next = self.cur_thread.q.val();
         self.uv_take.next = (self.phase.q.val() == 1)
             & (self.uv_issued.q.val() < 8)
             & (!(self.engine_read.val() & (self.engine_bank.val() == 2)));
@@ -455,7 +433,7 @@ impl<
             self.transform_unit.m[k].next = self.words[k].q.val();
         }
         for k in 0..3 {
-            self.transform_unit.v[k].next = self.ray[k].read_data.val();
+            self.transform_unit.v[k].next = self.ray.o[k].val();
         }
         // Tag: `{d pass[10], init[9], thread[8:4], seq[3:0]}`.
         self.launch_tag.next = (bit_cast::<16, 1>(self.cur_init.q.val().into()) << 9)
@@ -465,7 +443,7 @@ impl<
         self.flight_t_min.write_address.next = self.seq.q.val();
         self.flight_a.write_address.next = self.seq.q.val();
         self.flight_b.write_address.next = self.seq.q.val();
-        self.flight_t_min.write_data.next = self.ray[6].read_data.val();
+        self.flight_t_min.write_data.next = self.ray.t_min.val();
         self.flight_a.write_data.next = self.cur_a.q.val();
         self.flight_b.write_data.next = self.cur_b.q.val();
         self.flight_t_min.write_enable.next = false;
@@ -504,7 +482,7 @@ impl<
             self.transform_unit.in_valid.next = true;
             self.transform_unit.point.next = false;
             for k in 0..3 {
-                self.transform_unit.v[k].next = self.ray[3 + k].read_data.val();
+                self.transform_unit.v[k].next = self.ray.d[k].val();
             }
             self.transform_unit.tag.next = self.launch_tag.val() | self.c_d_pass.val();
             self.seq.d.next = self.seq.q.val() + 1;

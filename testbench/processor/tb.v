@@ -12,6 +12,10 @@ module tb;
   wire fb_write;
   wire [23:0] fb_addr;
   wire [31:0] fb_data;
+  wire bank0_read, bank2_read, bank3_read;
+  wire [23:0] bank0_addr, bank2_addr, bank3_addr;
+  wire [31:0] bank0_rdata, bank2_rdata, bank3_rdata;
+  wire [31:0] transform_busy, intersect_busy, traversal_busy;
   reg vga_clock = 1'b0;
   reg vga_reset = 1'b1;
   wire [23:0] vga_fb_addr, vga_rgb;
@@ -25,12 +29,21 @@ module tb;
   reg [31:0] bank4 [0:23]; // instances
   reg [31:0] bank5 [0:3117]; // frame
   reg [31:0] rd [0:1];
+  reg [31:0] rd0 [0:1];
+  reg [31:0] rd2 [0:1];
+  reg [31:0] rd3 [0:1];
   integer k, n, f, fd;
   reg timeout = 1'b0;
   dynrt_processor dut(.clock(clock), .start(start), .done(done), .cycles(cycles),
     .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank),
     .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write),
-    .fb_addr(fb_addr), .fb_data(fb_data), .vga_clock(vga_clock), .vga_reset(vga_reset),
+    .fb_addr(fb_addr), .fb_data(fb_data), .bank0_read(bank0_read),
+    .bank0_addr(bank0_addr), .bank0_rdata(bank0_rdata), .bank2_read(bank2_read),
+    .bank2_addr(bank2_addr), .bank2_rdata(bank2_rdata), .bank3_read(bank3_read),
+    .bank3_addr(bank3_addr), .bank3_rdata(bank3_rdata),
+    .transform_busy(transform_busy), .intersect_busy(intersect_busy),
+    .traversal_busy(traversal_busy),
+    .vga_clock(vga_clock), .vga_reset(vga_reset),
     .vga_fb_addr(vga_fb_addr), .vga_fb_data(vga_fb_data), .vga_hsync(vga_hsync),
     .vga_vsync(vga_vsync), .vga_rgb(vga_rgb), .vga_frame_start(vga_frame_start));
   always #5 clock = ~clock;
@@ -45,18 +58,26 @@ module tb;
   // re-evaluate on every write to a bank (twice as slow on large scenes).
   always @(posedge clock) begin
     case (mem_bank)
-      3'd0: rd[0] <= (mem_addr < 526) ? bank0[mem_addr] : 32'hdeadbeef;
       3'd1: rd[0] <= (mem_addr < 343) ? bank1[mem_addr] : 32'hdeadbeef;
-      3'd2: rd[0] <= (mem_addr < 240) ? bank2[mem_addr] : 32'hdeadbeef;
-      3'd3: rd[0] <= (mem_addr < 240) ? bank3[mem_addr] : 32'hdeadbeef;
       3'd4: rd[0] <= (mem_addr < 24) ? bank4[mem_addr] : 32'hdeadbeef;
       3'd5: rd[0] <= (mem_addr < 3118) ? bank5[mem_addr] : 32'hdeadbeef;
-      default: rd[0] <= 32'hdeadbeef;
+      default: rd[0] <= 32'hdeadbeef; // banks 0, 2 and 3 have their own ports
     endcase
-    for (k = 1; k < 2; k = k + 1) rd[k] <= rd[k - 1];
+    rd0[0] <= (bank0_addr < 526) ? bank0[bank0_addr] : 32'hdeadbeef;
+    rd2[0] <= (bank2_addr < 240) ? bank2[bank2_addr] : 32'hdeadbeef;
+    rd3[0] <= (bank3_addr < 240) ? bank3[bank3_addr] : 32'hdeadbeef;
+    for (k = 1; k < 2; k = k + 1) begin
+      rd[k] <= rd[k - 1];
+      rd0[k] <= rd0[k - 1];
+      rd2[k] <= rd2[k - 1];
+      rd3[k] <= rd3[k - 1];
+    end
     if (fb_write) bank5[fb_addr] <= fb_data;
   end
   assign mem_rdata = rd[1];
+  assign bank0_rdata = rd0[1];
+  assign bank2_rdata = rd2[1];
+  assign bank3_rdata = rd3[1];
   initial begin
     $readmemh("mem/bank0_nodes.hex", bank0);
     $readmemh("mem/bank1_lists.hex", bank1);
@@ -67,16 +88,17 @@ module tb;
     @(negedge clock) start = 1'b1;
     @(negedge clock) start = 1'b0;
     n = 0;
-    while (!done && n < 7149920) begin @(posedge clock); n = n + 1; end
+    while (!done && n < 2285216) begin @(posedge clock); n = n + 1; end
     if (!done) begin
-      $display("TIMEOUT: frame 0 not done after 7149920 clocks");
+      $display("TIMEOUT: frame 0 not done after 2285216 clocks");
       $fatal(1, "timeout");
     end
     fd = $fopen("frame0.hex", "w");
     for (k = 0; k < 3072; k = k + 1) $fwrite(fd, "%06h\n", bank5[46 + k][23:0]);
     $fclose(fd);
     fd = $fopen("frame0.stats", "w");
-    $fwrite(fd, "%0d %0d\n", cycles, instructions);
+    $fwrite(fd, "%0d %0d %0d %0d %0d\n", cycles, instructions, transform_busy,
+      intersect_busy, traversal_busy);
     $fclose(fd);
     $display("frame 0: %0d cycles, %0d instructions", cycles, instructions);
     if ($test$plusargs("vga")) begin

@@ -42,8 +42,10 @@ pub struct ProgramConfig {
     pub object_root: u32,
     pub materials: u32,
     pub frame_buffer: u32,
-    /// Kd stack entries per thread: the deepest top-level plus the deepest object tree.
+    /// Kd stack entries per thread in scratch: the deepest top-level tree.
     pub stack_entries: u32,
+    /// The deepest object tree (the traversal unit's stack holds that many entries).
+    pub object_depth: u32,
 }
 
 impl ProgramConfig {
@@ -59,24 +61,23 @@ impl ProgramConfig {
             object_root: info.object_root,
             materials: info.materials,
             frame_buffer: info.frame_buffer,
-            stack_entries: info.object_depth
-                + if info.top_root.is_some() {
-                    info.top_depth
-                } else {
-                    0
-                },
+            stack_entries: if info.top_root.is_some() {
+                info.top_depth
+            } else {
+                0
+            },
+            object_depth: info.object_depth,
         }
     }
 }
 
-/// Words of a thread's scratch memory: the current ray of each traversal level (read by axis
-/// index), the kd stack, then the mirror chain.
+/// Words of a thread's scratch memory: the world ray the top-level traversal reads by axis
+/// index, its kd stack, then the mirror chain (object trees are walked by the traversal unit,
+/// which keeps its own ray and stack).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ScratchMap {
-    /// World ray (o then d) as the top level (or the only object) traverses it.
+    /// World ray (o then d) as the top level traverses it.
     pub ray_top: u32,
-    /// Object-space ray of the entered instance.
-    pub ray_object: u32,
     pub stack: u32,
     /// Per mirror bounce: the local colour (3 words) and the mirror reflectivity.
     pub chain: u32,
@@ -90,13 +91,11 @@ pub const CHAIN_ENTRY_WORDS: u32 = 4;
 impl ScratchMap {
     pub fn for_config(c: &ProgramConfig) -> Self {
         let ray_top = 0;
-        let ray_object = 6;
-        let stack = 12;
+        let stack = 6;
         let chain = stack + STACK_ENTRY_WORDS * c.stack_entries;
         let used = chain + CHAIN_ENTRY_WORDS * c.reflection_depth;
         ScratchMap {
             ray_top,
-            ray_object,
             stack,
             chain,
             words: used.next_power_of_two().max(16),

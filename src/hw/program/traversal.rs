@@ -1,21 +1,27 @@
 //! Traversal: the trace routine of the microprogram (`model::golden`'s `trace`, `traverse`,
 //! `enter_instance` and `test_triangles`, step for step).
 //!
-//! State machine (per thread, one instruction per engine turn): fetch a node (2 loads), decode
-//! it; at an inner node read the ray's origin and direction along the split axis from scratch
-//! (indexed by the axis), pick near and far child, compute `t_split` with the shared
-//! `units::split_distance` and visit near, far or both (pushing far on the kd stack); at a
-//! leaf run its list: at the top level enter each instance not yet in the instance mailbox
-//! (world-to-object transform of the ray, handed to the triangle tester), at the object level
-//! queue each triangle not skipped and not in the triangle mailbox in the triangle tester
-//! (`hw::TriangleTester`), then wait for the tester and read the closest hit. A shadow query
-//! (`q_any`) returns after the first leaf with a hit. Then pop the stack until a segment can
-//! still hold a closer hit.
+//! Object trees are walked by the traversal unit (`hw::TraversalUnit`, per `units::KdWalk`):
+//! the thread starts the walk, waits, and gets each leaf's list; it queues the list's
+//! triangles that are not skipped and not in the triangle mailbox in the triangle tester
+//! (`hw::TriangleTester`), waits for the tester, reads the closest hit, and answers the
+//! traversal unit with it (which ends the walk or pops its stack). A shadow query (`q_any`)
+//! returns after the first leaf with a hit.
 //!
-//! Cost per step (instructions = engine turns): inner node 15-23, leaf 4 plus 5 per listed
-//! triangle (list word, mailbox and skip checks, queueing; a refusal by a full queue costs 2
-//! turns more), and at its end a wait of about 3 turns (the tester's latency of about 90
-//! clocks) and 2 reads.
+//! The top-level tree of a scene with instances is walked here in microcode (state machine
+//! per thread, one instruction per engine turn): fetch a node (2 loads), decode it; at an
+//! inner node read the world ray's origin and direction along the split axis from scratch
+//! (indexed by the axis), pick near and far child, compute `t_split` with the shared
+//! `units::split_distance` and visit near, far or both (pushing far on the scratch kd stack);
+//! at a leaf enter each instance not yet in the instance mailbox (world-to-object transform of
+//! the ray, given to both coprocessors, then the object walk); then pop the stack until a
+//! segment can still hold a closer hit.
+//!
+//! Cost (instructions = engine turns): per object leaf 5 per listed triangle (list word,
+//! mailbox and skip checks, queueing; a refusal by a full queue costs 2 turns more), a wait of
+//! about 3 turns for the tester (about 90 clocks) and 2 reads, and per walk segment a wait for
+//! the traversal unit (its inner nodes cost the thread no instruction); per top-level inner
+//! node 15-23, per instance about 40 (the transforms).
 
 use super::asm::Asm;
 use super::asm::{Label, Reg, Val};
