@@ -1794,7 +1794,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         if (wb_op == 32'h18) begin
             wb_next_pc = cond_delay__data_out[(32'h4)+:(12)];
         end
-        if (wb_op == 32'h1c) begin
+        if ((wb_op == 32'h1c) | (((wb_op == 32'h1d) | (wb_op == 32'h1e)) & wb_cond)) begin
             wb_next_pc = pc_delay__data_out[(32'hc)+:(12)] - 32'h1;
         end
         wb_result = fast_delay__data_out;
@@ -7804,14 +7804,14 @@ module dynrt_processor_core__rom_aux(read_address,read_clock,read_data,write_add
     mem[12'h15] = 32'h0;
     mem[12'h16] = 32'h0;
     mem[12'h17] = 32'h0;
-    mem[12'h18] = 32'h18;
+    mem[12'h18] = 32'h0;
     mem[12'h19] = 32'h0;
     mem[12'h1a] = 32'h0;
     mem[12'h1b] = 32'h0;
     mem[12'h1c] = 32'h0;
     mem[12'h1d] = 32'h0;
-    mem[12'h1e] = 32'h1e;
-    mem[12'h1f] = 32'h1f;
+    mem[12'h1e] = 32'h0;
+    mem[12'h1f] = 32'h0;
     mem[12'h20] = 32'h31;
     mem[12'h21] = 32'h0;
     mem[12'h22] = 32'h0;
@@ -7822,12 +7822,12 @@ module dynrt_processor_core__rom_aux(read_address,read_clock,read_data,write_add
     mem[12'h27] = 32'h23;
     mem[12'h28] = 32'h23;
     mem[12'h29] = 32'h23;
-    mem[12'h2a] = 32'h29;
-    mem[12'h2b] = 32'h2b;
+    mem[12'h2a] = 32'h23;
+    mem[12'h2b] = 32'h0;
     mem[12'h2c] = 32'h0;
     mem[12'h2d] = 32'h2f;
     mem[12'h2e] = 32'h31;
-    mem[12'h2f] = 32'h2f;
+    mem[12'h2f] = 32'h1f;
     mem[12'h30] = 32'h1f;
     mem[12'h31] = 32'h0;
     mem[12'h32] = 32'h0;
@@ -8090,7 +8090,7 @@ module dynrt_processor_core__rom_ctl(read_address,read_clock,read_data,write_add
     mem[12'h2c] = 32'h74300000;
     mem[12'h2d] = 32'h54003002;
     mem[12'h2e] = 32'h54002403;
-    mem[12'h2f] = 32'h78003430;
+    mem[12'h2f] = 32'h78003431;
     mem[12'h30] = 32'h5c000000;
     mem[12'h31] = 32'h74380000;
     mem[12'h32] = 32'h743c0000;

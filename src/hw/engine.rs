@@ -14,8 +14,8 @@
 //!   triangle tester.
 //! - I3: operands. Feed every unit; compute the integer result, mailbox hit (and update),
 //!   pixel counter, memory and scratch addresses; drive the memory and frame-buffer ports;
-//!   offer `tri` entries to the triangle tester (its answer, refused or pending, is the
-//!   condition that sends the thread back to offer or wait again on its next turn).
+//!   offer `tri` and `kd` entries to the coprocessors (their answer, refused or pending,
+//!   makes the thread repeat the instruction on its next turn).
 //! - I4..: the fast result line; scratch data joins at I4, memory data at I4 + `mem_latency`.
 //! - I3 + L: write back the register and the next pc: `target` when the condition differs
 //!   from `invert` (a non-branching instruction's condition is false, so its `invert` is a jump
@@ -29,9 +29,11 @@
 //! again to a full coprocessor queue or waiting for a coprocessor, so it equals the count of
 //! the engine's twin, which never waits.
 //!
-//! The [`TriangleTester`] runs beside the barrel: threads queue triangle tests into it and
-//! wait for their results once per kd leaf, so a test costs a thread one turn instead of the
-//! 19-60 turns of the test in microcode.
+//! Two coprocessors run beside the barrel. The [`TraversalUnit`] walks a thread's object kd
+//! tree from leaf to leaf (a thread starts the walk and waits, instead of 15-23 turns per inner
+//! node in microcode); the [`TriangleTester`] takes the leaf's triangles in a queue and keeps
+//! the closest hit (a test costs the thread one turn instead of 19-60). The thread waits once
+//! per leaf for each.
 //!
 //! Memory: one read per clock on the `mem_*` port (banks 0, 1, 4, 5) and on each of the
 //! `bank2_*` and `bank3_*` ports (the triangles; the tester fetches from both at once, the
@@ -928,8 +930,11 @@ impl<
         if self.wb_op.val() == 24 {
             self.wb_next_pc.next = self.cond_delay.data_out.val().get_bits::<12>(4);
         }
-        if self.wb_op.val() == 28 {
-            // A halted thread keeps its pc.
+        if (self.wb_op.val() == 28)
+            | (((self.wb_op.val() == 29) | (self.wb_op.val() == 30)) & self.wb_cond.val())
+        {
+            // A halted thread keeps its pc; so does one whose coprocessor refused its entry
+            // (queue full) or has not finished (a wait): it repeats on its next turn.
             self.wb_next_pc.next = self.pc_delay.data_out.val().get_bits::<12>(12) - 1;
         }
         self.wb_result.next = self.fast_delay.data_out.val();

@@ -353,92 +353,51 @@ impl Asm {
     /// `tri.<f> a, b` for a function that neither queues nor writes (the ray words).
     pub fn tri_ray(&self, f: TriFn, a: Reg, b: Reg) {
         debug_assert!(matches!(f, TriFn::RayOxy | TriFn::RayOzDx | TriFn::RayDyz));
-        self.emit(Instr {
-            a: a.0,
-            b: b.0,
-            imm: f as u32,
-            ..Instr::new(Op::Tri)
-        });
+        self.coprocessor(Op::Tri, f as u32, Reg::ZERO, a, b);
     }
 
-    /// Queues `f` (`Init` or `Test`) with operands `a`, `b`, offering it again on the thread's
-    /// next turn while the queue is full. With `then`, the thread continues there once the
-    /// entry is taken (a refusal falls through to a jump back).
-    pub fn tri_queue(&self, f: TriFn, a: Reg, b: Reg, then: Option<Label>) {
+    /// Queues `f` (`Init` or `Test`) with operands `a`, `b` (the engine offers it again on the
+    /// thread's next turns while the queue is full).
+    pub fn tri_queue(&self, f: TriFn, a: Reg, b: Reg) {
         debug_assert!(f.queues());
-        let i = Instr {
-            a: a.0,
-            b: b.0,
-            imm: f as u32,
-            ..Instr::new(Op::Tri)
-        };
-        let offer = self.here();
-        match then {
-            None => self.emit_to(i, offer),
-            Some(next) => {
-                self.emit_to(Instr { invert: true, ..i }, next);
-                self.jump(offer);
-            }
-        }
+        self.coprocessor(Op::Tri, f as u32, Reg::ZERO, a, b);
     }
 
     /// Waits until the thread's queued entries are done; `dst` = the best t.
     pub fn tri_wait(&self, dst: Reg) {
-        let again = self.here();
-        self.emit_to(
-            Instr {
-                dst: dst.0,
-                imm: TriFn::Wait as u32,
-                ..Instr::new(Op::Tri)
-            },
-            again,
-        );
+        self.coprocessor(Op::Tri, TriFn::Wait as u32, dst, Reg::ZERO, Reg::ZERO);
     }
 
     /// `dst` = the tester's `Hit`, `Instance` or `Triangle` (after a wait).
     pub fn tri_read(&self, f: TriFn, dst: Reg) {
         debug_assert!(matches!(f, TriFn::Hit | TriFn::Instance | TriFn::Triangle));
-        self.emit(Instr {
-            dst: dst.0,
-            imm: f as u32,
-            ..Instr::new(Op::Tri)
-        });
+        self.coprocessor(Op::Tri, f as u32, dst, Reg::ZERO, Reg::ZERO);
     }
 
-    /// Offers `kd.start a, b` or `kd.next a, b` to the traversal unit until it takes it.
+    /// Offers `kd.start a, b` or `kd.next a, b` to the traversal unit (again while refused).
     pub fn kd_queue(&self, f: KdFn, a: Reg, b: Reg) {
         debug_assert!(matches!(f, KdFn::Start | KdFn::Next));
-        let offer = self.here();
-        self.emit_to(
-            Instr {
-                a: a.0,
-                b: b.0,
-                imm: f as u32,
-                ..Instr::new(Op::Kd)
-            },
-            offer,
-        );
+        self.coprocessor(Op::Kd, f as u32, Reg::ZERO, a, b);
     }
 
     /// Waits for the traversal unit's walk; `dst` = the leaf's list (or `KD_FINISHED`).
     pub fn kd_wait(&self, dst: Reg) {
-        let again = self.here();
-        self.emit_to(
-            Instr {
-                dst: dst.0,
-                imm: KdFn::Wait as u32,
-                ..Instr::new(Op::Kd)
-            },
-            again,
-        );
+        self.coprocessor(Op::Kd, KdFn::Wait as u32, dst, Reg::ZERO, Reg::ZERO);
     }
 
     /// `dst` = the leaf's list end.
     pub fn kd_end(&self, dst: Reg) {
+        self.coprocessor(Op::Kd, KdFn::End as u32, dst, Reg::ZERO, Reg::ZERO);
+    }
+
+    /// A coprocessor instruction: function `function`, operands `a`, `b`, result `dst`.
+    fn coprocessor(&self, op: Op, function: u32, dst: Reg, a: Reg, b: Reg) {
         self.emit(Instr {
             dst: dst.0,
-            imm: KdFn::End as u32,
-            ..Instr::new(Op::Kd)
+            a: a.0,
+            b: b.0,
+            imm: function,
+            ..Instr::new(op)
         });
     }
 

@@ -2,9 +2,11 @@
 //! engine does, instruction by instruction.
 //!
 //! Threads take turns in a fixed rotation (thread 0, 1, ..., N-1, then again), one
-//! instruction per turn, like the engine's issue slots; so the pixels go to the threads in the
-//! same order and the frame buffer, the cycle count (turns times the rotation period) and the
-//! per-unit instruction counts are those of the RTL. [`Machine::run_pixel`] runs a single
+//! instruction per turn, like the engine's issue slots. The coprocessors' work (`tri`, `kd`)
+//! is done at once, so the twin never spends a turn waiting: its frame buffer and retired
+//! instruction counts are the RTL's, its turns a lower bound of the RTL's clocks over the
+//! rotation period (pixels are independent, so which thread takes which pixel does not change
+//! the frame). [`Machine::run_pixel`] runs a single
 //! pixel on one thread (threads never share state, so its result is the same; rayon runs
 //! those in parallel), optionally recording every register write for traces.
 
@@ -323,9 +325,8 @@ impl<'a> Machine<'a> {
                     TriFn::Instance => result = Some(tt.best_instance),
                     TriFn::Triangle => result = Some(tt.best_triangle),
                 }
-                // The twin's queue never refuses and its tests are done at once: the branch
-                // condition (refused, or still pending) is false.
-                branch_if(false, &mut next);
+                // The twin's queue never refuses and its tests are done at once, so the
+                // instruction never repeats.
             }
             Op::Kd => {
                 let function = KdFn::from_imm(i.imm)
@@ -361,7 +362,6 @@ impl<'a> Machine<'a> {
                     KdFn::End => result = Some(walk.end),
                     KdFn::Start | KdFn::Next => {}
                 }
-                branch_if(false, &mut next);
             }
         }
         if i.jumps_after() {

@@ -80,12 +80,12 @@ pub enum Op {
     Halt,
     /// The triangle tester (`hw::TriangleTester`), function `imm` ([`TriFn`]): give it the
     /// ray, queue a triangle test, wait for the thread's tests, read the closest hit. A
-    /// function that queues branches to `target` when the queue refused it (full); `wait`
-    /// branches while tests are in flight.
+    /// function that queues repeats itself on the thread's next turn while the queue is full;
+    /// `wait` repeats while tests are in flight (neither repeat counts as retired).
     Tri,
     /// The traversal unit (`hw::TraversalUnit`), function `imm` ([`KdFn`]): walk an object's
-    /// kd tree to its next leaf. `start` and `next` branch to `target` when refused; `wait`
-    /// branches while the walk is in flight.
+    /// kd tree to its next leaf. `start` and `next` repeat while refused, `wait` while the walk
+    /// is in flight.
     Kd,
 }
 
@@ -95,7 +95,7 @@ pub enum Op {
 pub enum KdFn {
     /// Walk from root `A` with the segment `[t_min, B]` (t_min from the tester's init).
     Start = 0,
-    /// Branch to `target` while the walk is in flight; `dst` = the leaf's list address, or
+    /// Repeat while the walk is in flight; `dst` = the leaf's list address, or
     /// [`KD_FINISHED`] when the walk ended.
     Wait,
     /// `dst` = the leaf's list end (list + count).
@@ -134,7 +134,7 @@ pub enum TriFn {
     Init,
     /// Queue the test of triangle `A` of instance `B`.
     Test,
-    /// Branch to `target` while tests are in flight; `dst` = best t.
+    /// Repeat while tests are in flight; `dst` = best t.
     Wait,
     /// `dst` = 1 when some test hit, else 0.
     Hit,
@@ -244,10 +244,7 @@ impl Op {
     /// Whether `target` is a branch target.
     pub fn branches(self) -> bool {
         use Op::*;
-        matches!(
-            self,
-            BFlt | BFle | BFeq | Beq | Bltu | Jal | Mbx | Pixel | Tri | Kd
-        )
+        matches!(self, BFlt | BFle | BFeq | Beq | Bltu | Jal | Mbx | Pixel)
     }
     /// The hardware unit that executes it (for statistics and for leaving units out).
     pub fn unit(self) -> Unit {
@@ -496,19 +493,11 @@ impl fmt::Display for Instr {
             Op::Pixel => write!(f, "pixel r{}, @{}", self.dst, self.target),
             Op::Tri => {
                 let name = TriFn::from_imm(self.imm).map_or("?", TriFn::name);
-                write!(
-                    f,
-                    "{inv}tri.{name} r{}, r{}, r{}, @{}",
-                    self.dst, self.a, self.b, self.target
-                )
+                write!(f, "tri.{name} r{}, r{}, r{}", self.dst, self.a, self.b)
             }
             Op::Kd => {
                 let name = KdFn::from_imm(self.imm).map_or("?", KdFn::name);
-                write!(
-                    f,
-                    "{inv}kd.{name} r{}, r{}, r{}, @{}",
-                    self.dst, self.a, self.b, self.target
-                )
+                write!(f, "kd.{name} r{}, r{}, r{}", self.dst, self.a, self.b)
             }
             Op::FSqrt | Op::IToF => write!(f, "{} r{}, r{}", self.op.name(), self.dst, self.a),
             _ => write!(f, "{} r{}, r{}, {}", self.op.name(), self.dst, self.a, b),

@@ -1,6 +1,8 @@
-//! The microprogram of the ray thread engine: ray generation, kd traversal (top level,
-//! instance entry, object level, mailboxed triangle lists), the unit-triangle test, shading,
-//! shadow and mirror rays, and the frame-buffer write, as one program every thread runs.
+//! The microprogram of the ray thread engine: ray generation, the top-level kd traversal and
+//! instance entry, the object walk and the mailboxed triangle lists it hands to the
+//! coprocessors (`tri` and `kd` instructions: `hw::TriangleTester`, `hw::TraversalUnit`),
+//! shading, shadow and mirror rays, and the frame-buffer write, as one program every thread
+//! runs.
 //!
 //! The program is generated per scene from the layout's parameters, so it holds only what the
 //! scene needs: no top level and no instance transform for a scene of one untransformed
@@ -11,8 +13,9 @@
 //! follows `model::golden` step for step (the tests compare the two renderers on every pixel).
 //!
 //! [`exec`] runs a program in Rust exactly as the engine does (same round-robin thread order,
-//! same pixel allocation), which predicts the engine's cycle count and gives a trace of every
-//! register write to compare an RTL trace with.
+//! same pixel allocation; a coprocessor's work is done at once, so the twin never waits),
+//! which predicts the engine's retired instructions and gives a trace of every register write
+//! to compare an RTL trace with.
 
 pub mod asm;
 pub mod exec;

@@ -18,7 +18,7 @@
 //! segment can still hold a closer hit.
 //!
 //! Cost (instructions = engine turns): per object leaf 5 per listed triangle (list word,
-//! mailbox and skip checks, queueing; a refusal by a full queue costs 2 turns more), a wait of
+//! mailbox and skip checks, queueing; a full queue repeats the offer on the next turn), a wait of
 //! about 3 turns for the tester (about 90 clocks) and 2 reads, and per walk segment a wait for
 //! the traversal unit (its inner nodes cost the thread no instruction); per top-level inner
 //! node 15-23, per instance about 40 (the transforms).
@@ -62,7 +62,7 @@ impl Gen<'_> {
             d: s.q_d,
             scratch: self.scratch.ray_top,
         };
-        a.tri_queue(TriFn::Init, s.q_t_min, s.q_t_max, None);
+        a.tri_queue(TriFn::Init, s.q_t_min, s.q_t_max);
         match self.c.top_root {
             Some(root) => {
                 self.store_ray(world);
@@ -289,7 +289,8 @@ impl Gen<'_> {
         a.mailbox_check(MAILBOX_TRIANGLES, triangle, next);
         // The test runs in the triangle tester while the thread queues the leaf's next
         // triangles; the tester keeps the closest hit in list order.
-        a.tri_queue(TriFn::Test, triangle, instance, Some(next));
+        a.tri_queue(TriFn::Test, triangle, instance);
+        a.jump(next);
         a.bind(done);
         a.section("intersect");
         a.tri_wait(s.best_t);
