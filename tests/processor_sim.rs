@@ -77,7 +77,7 @@ frames_equal_the_golden_model! {
     verilator_dynamic: Verilator "dynamic.toml" 12 x 9, frames Some(2);
     verilator_terrain_small: Verilator "terrain_small.toml" 16 x 12, frames None;
     verilator_cornell_noshadow: Verilator "cornell_noshadow.toml" 16 x 12, frames None;
-    // Icarus simulates about 2k clocks per second here (Verilator about 1.7M): one pixel per
+    // Icarus simulates about 400 clocks per second here (Verilator about 0.6M): one pixel per
     // thread (a frame of up to 32 pixels lasts about as long as its slowest pixel times the
     // 32-clock rotation).
     icarus_cornell: Icarus "cornell.toml" 8 x 4, frames None;
