@@ -11,10 +11,14 @@
 //! (`start`: root `word_a`, t_max `word_b`, t_min the thread's `t_min` written with the
 //! tester's init; else next: best t `word_a`, hit `word_b`), taken when `full` is low.
 //! `query_thread` at I2; at I3 `pending` (the thread's entry not done), `result` (the leaf's
-//! list address, or bit 31 set when the walk ended) and `list_end` (list + count).
+//! list address, or bit 31 set when the walk ended) and `list_end` (list + count). The entry
+//! offered at I3 must be of the thread presented at I2 the clock before (its count of entries
+//! taken is read there), and a thread never offers in two clocks in a row (the barrel's
+//! rotation guarantees both).
 //!
 //! Structure: entries from the engine go through the front (a start becomes a step job; a
-//! next reads the thread's leaf segment and stack and compares in 4 clocks) into the front
+//! next reads the thread's leaf segment and stack and compares the hit with both in 5 clocks,
+//! its own pipeline, one entry a clock) into the front
 //! queue; steps that continue go into the loop queue, which the fetch serves first. Fetch:
 //! one job at a time, two words of bank 0 (the engine's own loads of bank 0 go first), then
 //! the decision pipeline: `split - o` (FpAddSub), `/ d` (FpDiv), then five FpCompares; at its
@@ -29,6 +33,9 @@
 
 use rust_hdl::prelude::*;
 
+use super::fp::add_sub::ADD_SUB_LATENCY;
+use super::fp::compare::COMPARE_LATENCY;
+use super::fp::div::div_latency;
 use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
 use super::ray_store::{zero_counters, RayStore};
 use super::Delay;
@@ -211,6 +218,9 @@ impl<
     /// The unit for SRAM read latency `mem_latency` (1..=6).
     pub fn new(mem_latency: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
+        // The decision's delay lines are spelled with these latencies.
+        assert!(ADD_SUB_LATENCY == 7 && COMPARE_LATENCY == 2);
+        assert!(DL == div_latency(M as u32) as usize);
         let f = Format::new(E as u32, M as u32).expect("a supported format");
         Self {
             clock: Default::default(),
@@ -704,7 +714,6 @@ impl<
 mod tests {
     use super::*;
     use crate::fp::Format;
-    use crate::hw::fp::div::div_latency;
     use crate::hw::sim_harness::{clock_cycle, settle};
     use crate::layout::{self, FrameMap, MemoryConfig, SceneTrees, FRAME, NODES};
     use crate::scene::Scene;

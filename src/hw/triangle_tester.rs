@@ -8,12 +8,15 @@
 //! Engine side (the engine's I2/I3 stages):
 //! - Ray words: `ray_write` with `ray_pair` 0, 1, 2 writes `(o.x, o.y)`, `(o.z, d.x)`,
 //!   `(d.y, d.z)` of `thread` from `word_a`, `word_b`.
-//! - Queue: `queue` offers an entry of `thread`: a test of triangle `word_a` of instance
+//! - Queue: `enqueue` offers an entry of `thread`: a test of triangle `word_a` of instance
 //!   `word_b`, or with `queue_init` a new query (`t_min = word_a`, written at once; "no hit,
 //!   best t = `word_b`" queued behind the thread's earlier entries). It is taken when `full`
 //!   is low in that clock; the engine then counts it as issued.
 //! - Answers: `query_thread` at I2; at I3 `pending` (entries of the thread not yet done),
-//!   `hit`, `best_t`, `best_instance`, `best_triangle` of its closest hit.
+//!   `hit`, `best_t`, `best_instance`, `best_triangle` of its closest hit. An entry offered at
+//!   I3 must be of the thread presented at I2 the clock before (its count of entries taken is
+//!   read there), and a thread never offers in two clocks in a row (the barrel guarantees
+//!   both).
 //!
 //! Entries are done in queue order, so a thread's closest hit is chosen in its list order
 //! (the first of equal ts stays), as in the golden model.
