@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use crate::emit::constraints::{write_ucf, Port, PortDirection, UcfOptions};
-use crate::emit::processor::{display_mode, ProcessorParams, PROCESSOR_TOP};
+use crate::emit::processor::{display_mode, ProcessorParams, PORTS, PROCESSOR_TOP};
 use crate::emit::processor_run::{simulate_processor, write_processor_files, ProcessorSim, SimRun};
 use crate::fp::Format;
 use crate::hw::engine::engine_period;
@@ -33,43 +33,24 @@ pub fn scene_layouts(scene: &Scene, f: Format, frames: Option<u32>) -> Result<Ve
         .collect()
 }
 
-/// The processor's top-level ports for the constraints file.
+/// The processor's top-level ports for the constraints file: the top module's ports, its two
+/// clocks at the core's and the display's frequencies.
 pub fn processor_ports(display: &VgaMode) -> Vec<Port> {
-    use PortDirection::{Input, Output};
-    vec![
-        Port::clock("clock", CLOCK_HZ),
-        Port::io("start", 1, Input),
-        Port::io("done", 1, Output),
-        Port::io("cycles", 32, Output),
-        Port::io("instructions", 32, Output),
-        Port::io("mem_read", 1, Output),
-        Port::io("mem_bank", 3, Output),
-        Port::io("mem_addr", 24, Output),
-        Port::io("mem_rdata", 32, Input),
-        Port::io("fb_write", 1, Output),
-        Port::io("fb_addr", 24, Output),
-        Port::io("fb_data", 32, Output),
-        Port::io("bank0_read", 1, Output),
-        Port::io("bank0_addr", 24, Output),
-        Port::io("bank0_rdata", 32, Input),
-        Port::io("bank2_read", 1, Output),
-        Port::io("bank2_addr", 24, Output),
-        Port::io("bank2_rdata", 32, Input),
-        Port::io("bank3_read", 1, Output),
-        Port::io("bank3_addr", 24, Output),
-        Port::io("bank3_rdata", 32, Input),
-        Port::io("transform_busy", 32, Output),
-        Port::io("intersect_busy", 32, Output),
-        Port::io("traversal_busy", 32, Output),
-        Port::clock("vga_clock", display.pixel_clock_hz as f64),
-        Port::io("vga_reset", 1, Input),
-        Port::io("vga_fb_addr", 24, Output),
-        Port::io("vga_fb_data", 32, Input),
-        Port::io("vga_hsync", 1, Output),
-        Port::io("vga_vsync", 1, Output),
-        Port::io("vga_rgb", 24, Output),
-        Port::io("vga_frame_start", 1, Output),
-    ]
+    PORTS
+        .iter()
+        .map(|&(name, output, width)| match name {
+            "clock" => Port::clock(name, CLOCK_HZ),
+            "vga_clock" => Port::clock(name, display.pixel_clock_hz as f64),
+            _ => {
+                let direction = if output {
+                    PortDirection::Output
+                } else {
+                    PortDirection::Input
+                };
+                Port::io(name, width, direction)
+            }
+        })
+        .collect()
 }
 
 /// What `dynrt rtl` wrote.

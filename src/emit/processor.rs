@@ -120,8 +120,9 @@ impl Default for ProcessorParams {
     }
 }
 
-/// The top module's ports: (name, output, width).
-const PORTS: [(&str, bool, u32); 32] = [
+/// The top module's ports: (name, output, width). The constraints file lists the same ports
+/// (`flow::processor_ports`).
+pub const PORTS: [(&str, bool, u32); 32] = [
     ("clock", false, 1),
     ("start", false, 1),
     ("done", true, 1),
