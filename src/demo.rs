@@ -171,7 +171,7 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
     )?;
     writeln!(
         md,
-        "Generated in processor/: {} microprogram instructions, {} threads, rotation {} clocks. \
+        "Generated in processor/: {} microprogram instructions, {} threads, a round of {} clocks. \
          Left out for this scene: {}.\n",
         generated.program.code.len(),
         params.threads,

@@ -89,7 +89,7 @@ pub fn run_rtl(a: RtlArgs) -> anyhow::Result<i32> {
         println!("left out: {l}");
     }
     println!(
-        "predicted frame 0: {} clocks ({} threads, rotation {} clocks)",
+        "predicted frame 0: {} clocks before coprocessor waits ({} threads, a round of {} clocks)",
         r.predicted.rounds * u64::from(r.period),
         params.threads,
         r.period

@@ -1,13 +1,16 @@
 //! `ThreadEngine`: the ray thread engine that runs the microprogram (`hw::program`) for up to
 //! 32 ray threads, one instruction per clock, on pipelined floating-point units.
 //!
-//! Threads take fixed turns (a barrel): slot `s` of a rotation of `period` clocks issues
-//! thread `s` (slots `threads..period` are bubbles). Every instruction writes back exactly
-//! `L = M + 6` clocks after its operands are read, whatever unit it uses, and a thread's next
-//! turn comes only after that, so there is no hazard, stall or forwarding logic: memory and
-//! unit latency are hidden by the other threads (the paper's 32 threads). `period >= L + 4`.
+//! A scheduler issues one ready thread per clock, round robin. Every instruction writes back
+//! exactly `L = M + 6` clocks after its operands are read, whatever unit it uses, and a thread
+//! is ready again only at its write back, so there is no hazard, stall or forwarding logic:
+//! memory and unit latency are hidden by the other threads (the paper's 32 threads). A thread
+//! issues at most once per `period = L + 4` clocks (`engine_period`). A thread whose
+//! coprocessor wait (`tri.wait`, `kd.wait`) is still pending sleeps: it is not ready until the
+//! coprocessor finishes work for it, so the clocks it waits go to the other threads (an offer
+//! to a full queue repeats at once).
 //!
-//! Pipeline (clock offsets from the issue slot):
+//! Pipeline (clock offsets from the issue):
 //! - I0: read the thread's `{epoch, halted, pc}` (a stale epoch means "new frame": pc 0).
 //! - I1: read the instruction ROM (three words: control, immediate, branch fields).
 //! - I2: decode; read the two source registers, the thread's mailbox and its state in the
@@ -15,27 +18,28 @@
 //! - I3: operands. Feed every unit; compute the integer result, mailbox hit (and update),
 //!   pixel counter, memory and scratch addresses; drive the memory and frame-buffer ports;
 //!   offer `tri` and `kd` entries to the coprocessors (their answer, refused or pending,
-//!   makes the thread repeat the instruction on its next turn).
+//!   makes the thread repeat the instruction on its next turn, after a sleep for a wait).
 //! - I4..: the fast result line; scratch data joins at I4, memory data at I4 + `mem_latency`.
 //! - I3 + L: write back the register and the next pc: `target` when the condition differs
 //!   from `invert` (a non-branching instruction's condition is false, so its `invert` is a jump
 //!   after it), else `pc + 1`; the condition comes from the compare, integer, mailbox, pixel
 //!   unit or triangle tester.
 //!
-//! Throughput: one instruction per clock while `threads >= period`; a frame ends when every
-//! thread has executed `halt` (`done`). Counters: clocks of the frame, instructions retired,
+//! Throughput: one instruction per clock while at least `L + 4` threads are awake; a frame
+//! ends when every thread has executed `halt` (`done`). Counters: clocks of the frame, instructions retired,
 //! and clocks in which the triangle tester's TransformUnit and IntersectUnit took an input.
 //! `instructions` counts retired instructions: not the turns a thread spends offering an entry
 //! again to a full coprocessor queue or waiting for a coprocessor, so it equals the count of
 //! the engine's twin, which never waits.
 //!
-//! Two coprocessors run beside the barrel. The [`TraversalUnit`] walks a thread's object kd
+//! Two coprocessors run beside the engine. The [`TraversalUnit`] walks a thread's object kd
 //! tree from leaf to leaf (a thread starts the walk and waits, instead of 15-23 turns per inner
 //! node in microcode); the [`TriangleTester`] takes the leaf's triangles in a queue and keeps
-//! the closest hit (a test costs the thread one turn instead of 19-60). The thread waits once
-//! per leaf for each.
+//! the closest hit (its list unit reads the leaf's list: a leaf costs the thread one turn).
+//! The thread waits once per leaf for each.
 //!
-//! Memory: one read per clock on the `mem_*` port (banks 0, 1, 4, 5) and on each of the
+//! Memory: one read per clock on the `mem_*` port (banks 0, 1, 4, 5; the tester's list reads
+//! of bank 1 use it in the clocks the engine leaves free) and on each of the
 //! `bank2_*` and `bank3_*` ports (the triangles; the tester fetches from both at once, the
 //! engine's loads of these banks go there too, first); a word must arrive exactly
 //! `mem_latency` clocks after its request (1..=6). Frame-buffer writes come out on `fb_*`.
@@ -59,7 +63,8 @@ pub const fn engine_latency(m: u32) -> u32 {
     m + 6
 }
 
-/// The rotation period for `threads` threads in a format with `m` mantissa bits.
+/// The clocks of one round of `threads` threads, each issuing once, in a format with `m`
+/// mantissa bits: a thread issues at most once per `engine_latency(m) + 4` clocks.
 pub fn engine_period(threads: u32, m: u32) -> u32 {
     threads.max(engine_latency(m) + 4)
 }
@@ -130,7 +135,24 @@ pub struct ThreadEngine<
     // Control.
     running: DFF<Bit>,
     epoch: DFF<Bit>,
-    slot: DFF<Bits<8>>,
+    /// The scheduler: threads that may issue (written back, not asleep); threads asleep on a
+    /// coprocessor wait; threads a coprocessor finished work for since their issue; the
+    /// thread issued last (the search for the next starts below it).
+    ready: DFF<Bits<32>>,
+    asleep: DFF<Bits<32>>,
+    woken: DFF<Bits<32>>,
+    last_pick: DFF<Bits<5>>,
+    below: Signal<Local, Bits<32>>,
+    pick: Signal<Local, Bits<5>>,
+    issue: Signal<Local, Bit>,
+    issue_mask: Signal<Local, Bits<32>>,
+    wb_mask: Signal<Local, Bits<32>>,
+    tester_event: Signal<Local, Bits<32>>,
+    walk_event: Signal<Local, Bits<32>>,
+    event_mask: Signal<Local, Bits<32>>,
+    wb_sleep: Signal<Local, Bit>,
+    wake_mask: Signal<Local, Bits<32>>,
+    sleep_mask: Signal<Local, Bits<32>>,
     halted_count: DFF<Bits<8>>,
     cycle_count: DFF<Bits<32>>,
     instr_count: DFF<Bits<32>>,
@@ -169,6 +191,7 @@ pub struct ThreadEngine<
     mb_next: Signal<Local, Bits<3>>,
     pix_done: Signal<Local, Bit>,
     tri_cond: Signal<Local, Bit>,
+    wait_fn: Signal<Local, Bit>,
     kd_cond: Signal<Local, Bit>,
     fast_kind: Signal<Local, Bits<3>>,
     // Ports.
@@ -202,10 +225,10 @@ pub struct ThreadEngine<
     /// {pc + 1, target}.
     pc_delay: Delay<Bits<24>, DF>,
     pc_line: [DFF<Bits<24>>; FAST_STAGES],
-    /// {traversal unit refused or pending, tester refused or pending, jump register (12
-    /// bits), int_eq, int_lt, mailbox hit, pixels exhausted}.
-    cond_delay: Delay<Bits<18>, DF>,
-    cond_line: [DFF<Bits<18>>; FAST_STAGES],
+    /// {a coprocessor wait, traversal unit refused or pending, tester refused or pending,
+    /// jump register (12 bits), int_eq, int_lt, mailbox hit, pixels exhausted}.
+    cond_delay: Delay<Bits<19>, DF>,
+    cond_line: [DFF<Bits<19>>; FAST_STAGES],
 
     // Write back.
     wb_valid: Signal<Local, Bit>,
@@ -219,7 +242,11 @@ pub struct ThreadEngine<
     wb_writes: Signal<Local, Bit>,
 
     c_threads: Constant<Bits<8>>,
-    c_period_last: Constant<Bits<8>>,
+    /// Bit `t` set for every thread `t`; one; all ones; each thread's number.
+    c_thread_mask: Constant<Bits<32>>,
+    c_one: Constant<Bits<32>>,
+    c_ones: Constant<Bits<32>>,
+    c_thread_ids: [Constant<Bits<5>>; 32],
     c_width: Constant<Bits<16>>,
     c_height: Constant<Bits<16>>,
     c_mem_latency: Constant<Bits<8>>,
@@ -277,7 +304,6 @@ impl<
         assert!((1..=MAX_THREADS as u32).contains(&threads));
         assert!((1..=MAX_MEM_LATENCY).contains(&mem_latency));
         assert!(program.scratch.words <= SCRATCH_WORDS);
-        let period = engine_period(threads, M as u32);
         let rom = |k: usize| -> RAM<Bits<32>, 12> {
             RAM::new(word_map(
                 program
@@ -326,7 +352,21 @@ impl<
             mailbox_meta: RAM::new(word_map((0..64).map(|_| Bits::<8>::from(0u64)))),
             running: Default::default(),
             epoch: Default::default(),
-            slot: Default::default(),
+            ready: Default::default(),
+            asleep: Default::default(),
+            woken: Default::default(),
+            last_pick: Default::default(),
+            below: Default::default(),
+            pick: Default::default(),
+            issue: Default::default(),
+            issue_mask: Default::default(),
+            wb_mask: Default::default(),
+            tester_event: Default::default(),
+            walk_event: Default::default(),
+            event_mask: Default::default(),
+            wb_sleep: Default::default(),
+            wake_mask: Default::default(),
+            sleep_mask: Default::default(),
             halted_count: Default::default(),
             cycle_count: Default::default(),
             instr_count: Default::default(),
@@ -362,6 +402,7 @@ impl<
             mb_next: Default::default(),
             pix_done: Default::default(),
             tri_cond: Default::default(),
+            wait_fn: Default::default(),
             kd_cond: Default::default(),
             fast_kind: Default::default(),
             mem_read_r: Default::default(),
@@ -402,7 +443,10 @@ impl<
             wb_result: Default::default(),
             wb_writes: Default::default(),
             c_threads: Constant::new(u64::from(threads).into()),
-            c_period_last: Constant::new(u64::from(period - 1).into()),
+            c_thread_mask: Constant::new(((1u64 << threads) - 1).into()),
+            c_one: Constant::new(1u64.into()),
+            c_ones: Constant::new(0xffff_ffffu64.into()),
+            c_thread_ids: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_width: Constant::new(u64::from(program.config.width).into()),
             c_height: Constant::new(u64::from(program.config.height).into()),
             c_mem_latency: Constant::new(u64::from(mem_latency).into()),
@@ -435,7 +479,10 @@ impl<
             clock,
             running,
             epoch,
-            slot,
+            ready,
+            asleep,
+            woken,
+            last_pick,
             halted_count,
             cycle_count,
             instr_count,
@@ -540,16 +587,30 @@ impl<
                 self.traversal_count.d.next = self.traversal_count.q.val() + 1;
             }
         }
-        if self.slot.q.val() == self.c_period_last.val() {
-            self.slot.d.next = 0.into();
-        } else {
-            self.slot.d.next = self.slot.q.val() + 1;
-        }
 
-        // I0: the thread's state.
-        self.pc_ram.read_address.next = self.slot.q.val().get_bits::<5>(0);
-        self.v1.d.next = self.running.q.val() & (self.slot.q.val() < self.c_threads.val());
-        self.t1.d.next = self.slot.q.val().get_bits::<5>(0);
+        // I0: pick a ready thread, round robin (the highest below the last pick, else the
+        // highest), and read its state.
+        self.below.next = self.ready.q.val() & (!(self.c_ones.val() << self.last_pick.q.val()));
+        self.pick.next = 0.into();
+        for k in 0..32 {
+            if self.ready.q.val().get_bit(k) {
+                self.pick.next = self.c_thread_ids[k].val();
+            }
+        }
+        for k in 0..32 {
+            if self.below.val().get_bit(k) {
+                self.pick.next = self.c_thread_ids[k].val();
+            }
+        }
+        self.issue.next = self.running.q.val() & (self.ready.q.val() != 0);
+        self.issue_mask.next = 0.into();
+        if self.issue.val() {
+            self.issue_mask.next = self.c_one.val() << self.pick.val();
+            self.last_pick.d.next = self.pick.val();
+        }
+        self.pc_ram.read_address.next = self.pick.val();
+        self.v1.d.next = self.issue.val();
+        self.t1.d.next = self.pick.val();
 
         // I1: `{epoch, halted, pc}`; another epoch is a thread of an earlier frame: pc 0.
         self.entry_fresh.next = self.pc_ram.read_data.val().get_bit(13) != self.epoch.q.val();
@@ -701,11 +762,12 @@ impl<
         self.fb_addr_r.d.next = self.mem_address.val().get_bits::<24>(0);
         self.fb_data_r.d.next = self.regs_b.read_data.val();
         // Bank 0 goes through the traversal unit's port, banks 2 and 3 through the triangle
-        // tester's.
-        self.mem_read.next = self.mem_read_r.q.val()
+        // tester's; the tester's list reads (bank 1) use this bus when the engine does not.
+        self.mem_read.next = (self.mem_read_r.q.val()
             & (self.mem_bank_r.q.val() != 0)
             & (self.mem_bank_r.q.val() != 2)
-            & (self.mem_bank_r.q.val() != 3);
+            & (self.mem_bank_r.q.val() != 3))
+            | self.tester.list_read.val();
         self.traversal_unit.engine_read.next = self.mem_read_r.q.val();
         self.traversal_unit.engine_bank.next = self.mem_bank_r.q.val();
         self.traversal_unit.engine_addr.next = self.mem_addr_r.q.val();
@@ -714,6 +776,11 @@ impl<
         self.traversal_unit.node_rdata.next = self.bank0_rdata.val();
         self.mem_bank.next = self.mem_bank_r.q.val();
         self.mem_addr.next = self.mem_addr_r.q.val();
+        if self.tester.list_read.val() {
+            self.mem_bank.next = 1.into();
+            self.mem_addr.next = self.tester.list_addr.val();
+        }
+        self.tester.list_rdata.next = self.mem_rdata.val();
         self.tester.engine_read.next = self.mem_read_r.q.val();
         self.tester.engine_bank.next = self.mem_bank_r.q.val();
         self.tester.engine_addr.next = self.mem_addr_r.q.val();
@@ -724,8 +791,9 @@ impl<
         self.bank3_addr.next = self.tester.t_addr.val();
         self.tester.t_rdata.next = self.bank3_rdata.val();
 
-        // Triangle tester (op 29, function in imm): ray words 0-2, init 3, test 4, wait 5,
-        // hit 6, instance 7, triangle 8.
+        // Triangle tester (op 29, function in imm): ray words 0-2, init 3, list 4, wait 5,
+        // hit 6, instance 7, triangle 8, object 9, skip 10; the queued ones (3, 4, 9, 10) as
+        // the list unit's command kinds 1, 0, 2, 3.
         self.tester.thread.next = self.t3.q.val();
         self.tester.word_a.next = self.opa.val();
         self.tester.word_b.next = self.opb.val();
@@ -734,10 +802,21 @@ impl<
             self.v3.q.val() & (self.op3.val() == 29) & (self.imm3.q.val() < 3);
         self.tester.enqueue.next = self.v3.q.val()
             & (self.op3.val() == 29)
-            & ((self.imm3.q.val() == 3) | (self.imm3.q.val() == 4));
-        self.tester.queue_init.next = self.imm3.q.val() == 3;
+            & ((self.imm3.q.val() == 3)
+                | (self.imm3.q.val() == 4)
+                | (self.imm3.q.val() == 9)
+                | (self.imm3.q.val() == 10));
+        // One assignment: a default overridden in this block would glitch an input of the
+        // tester's block, whose outputs feed back here, and Icarus would loop forever.
+        self.tester.queue_kind.next =
+            (bit_cast::<2, 1>(((self.imm3.q.val() == 9) | (self.imm3.q.val() == 10)).into()) << 1)
+                | bit_cast::<2, 1>(((self.imm3.q.val() == 3) | (self.imm3.q.val() == 10)).into());
         self.tri_cond.next = false;
-        if (self.imm3.q.val() == 3) | (self.imm3.q.val() == 4) {
+        if (self.imm3.q.val() == 3)
+            | (self.imm3.q.val() == 4)
+            | (self.imm3.q.val() == 9)
+            | (self.imm3.q.val() == 10)
+        {
             self.tri_cond.next = self.tester.full.val();
         }
         if self.imm3.q.val() == 5 {
@@ -761,6 +840,9 @@ impl<
         if self.imm3.q.val() == 1 {
             self.kd_cond.next = self.traversal_unit.pending.val();
         }
+        // The waits (`tri.wait`, `kd.wait`): a pending one sleeps instead of repeating.
+        self.wait_fn.next = ((self.op3.val() == 29) & (self.imm3.q.val() == 5))
+            | ((self.op3.val() == 30) & (self.imm3.q.val() == 1));
         self.fb_write.next = self.fb_write_r.q.val();
         self.fb_addr.next = self.fb_addr_r.q.val();
         self.fb_data.next = self.fb_data_r.q.val();
@@ -847,13 +929,14 @@ impl<
             | bit_cast::<21, 1>(self.ctl3.q.val().get_bits::<1>(0));
         self.pc_line[0].d.next = (bit_cast::<24, 12>(self.pc3.q.val() + 1) << 12)
             | bit_cast::<24, 12>(self.aux3.q.val().get_bits::<12>(0));
-        self.cond_line[0].d.next = (bit_cast::<18, 1>(self.kd_cond.val().into()) << 17)
-            | (bit_cast::<18, 1>(self.tri_cond.val().into()) << 16)
-            | (bit_cast::<18, 12>(self.opa.val().get_bits::<12>(0)) << 4)
-            | (bit_cast::<18, 1>(self.int_eq.val().into()) << 3)
-            | (bit_cast::<18, 1>(self.int_lt.val().into()) << 2)
-            | (bit_cast::<18, 1>(self.mb_hit.val().into()) << 1)
-            | bit_cast::<18, 1>(self.pix_done.val().into());
+        self.cond_line[0].d.next = (bit_cast::<19, 1>(self.wait_fn.val().into()) << 18)
+            | (bit_cast::<19, 1>(self.kd_cond.val().into()) << 17)
+            | (bit_cast::<19, 1>(self.tri_cond.val().into()) << 16)
+            | (bit_cast::<19, 12>(self.opa.val().get_bits::<12>(0)) << 4)
+            | (bit_cast::<19, 1>(self.int_eq.val().into()) << 3)
+            | (bit_cast::<19, 1>(self.int_lt.val().into()) << 2)
+            | (bit_cast::<19, 1>(self.mb_hit.val().into()) << 1)
+            | bit_cast::<19, 1>(self.pix_done.val().into());
         for k in 1..8 {
             self.fast_line[k].d.next = self.fast_line[k - 1].q.val();
             self.fast_kind_line[k].d.next = self.fast_kind_line[k - 1].q.val();
@@ -979,6 +1062,41 @@ impl<
         {
             self.instr_count.d.next = self.instr_count.q.val() + 1;
         }
+
+        // Scheduler: a written-back thread is ready again, unless it halted or waits for a
+        // coprocessor that has not finished its work since the thread issued (it sleeps until
+        // the coprocessor does: the `woken` bit catches a finish between the check at I3 and
+        // this write back).
+        self.wb_mask.next = self.c_one.val() << self.wb_thread.val();
+        self.tester_event.next = 0.into();
+        if self.tester.done_event.val() {
+            self.tester_event.next = self.c_one.val() << self.tester.done_thread.val();
+        }
+        self.walk_event.next = 0.into();
+        if self.traversal_unit.done_event.val() {
+            self.walk_event.next = self.c_one.val() << self.traversal_unit.done_thread.val();
+        }
+        self.event_mask.next = self.tester_event.val() | self.walk_event.val();
+        self.wb_sleep.next = self.wb_valid.val()
+            & self.wb_cond.val()
+            & self.cond_delay.data_out.val().get_bit(18)
+            & (((self.woken.q.val() | self.event_mask.val()) & self.wb_mask.val()) == 0);
+        self.wake_mask.next = 0.into();
+        self.sleep_mask.next = 0.into();
+        if self.wb_valid.val() & (self.wb_op.val() != 28) {
+            if self.wb_sleep.val() {
+                self.sleep_mask.next = self.wb_mask.val();
+            } else {
+                self.wake_mask.next = self.wb_mask.val();
+            }
+        }
+        self.ready.d.next = (self.ready.q.val() & (!self.issue_mask.val()))
+            | self.wake_mask.val()
+            | (self.asleep.q.val() & self.event_mask.val());
+        self.asleep.d.next =
+            (self.asleep.q.val() & (!self.event_mask.val())) | self.sleep_mask.val();
+        self.woken.d.next = (self.woken.q.val() & (!self.issue_mask.val())) | self.event_mask.val();
+
         if self.wb_valid.val() & (self.wb_op.val() == 28) {
             self.halted_count.d.next = self.halted_count.q.val() + 1;
             if (self.halted_count.q.val() + 1) == self.c_threads.val() {
@@ -990,6 +1108,9 @@ impl<
         if self.start.val() & (!self.running.q.val()) {
             self.running.d.next = true;
             self.epoch.d.next = !self.epoch.q.val();
+            self.ready.d.next = self.c_thread_mask.val();
+            self.asleep.d.next = 0.into();
+            self.woken.d.next = 0.into();
             self.halted_count.d.next = 0.into();
             self.cycle_count.d.next = 0.into();
             self.instr_count.d.next = 0.into();

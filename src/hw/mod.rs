@@ -17,6 +17,7 @@ pub mod fp;
 pub mod geometry_formats;
 pub mod int_to_float;
 pub mod intersect;
+pub mod list_unit;
 pub mod ray_store;
 pub mod raygen;
 #[cfg(test)]
@@ -31,6 +32,7 @@ pub use delay::Delay;
 pub use display::VgaDisplay;
 pub use int_to_float::UIntToFloat;
 pub use intersect::{intersect_latency, IntersectUnit};
+pub use list_unit::ListUnit;
 pub use raygen::{RayGen, RayGenUnit};
 pub use transform::{TransformUnit, TRANSFORM_LATENCY};
 pub use transform_arbiter::{SharedTransformUnit, TRANSFORM_CLIENTS};

@@ -13,8 +13,8 @@
 //! `query_thread` at I2; at I3 `pending` (the thread's entry not done), `result` (the leaf's
 //! list address, or bit 31 set when the walk ended) and `list_end` (list + count). The entry
 //! offered at I3 must be of the thread presented at I2 the clock before (its count of entries
-//! taken is read there), and a thread never offers in two clocks in a row (the barrel's
-//! rotation guarantees both).
+//! taken is read there), and a thread never offers in two clocks in a row (the engine's
+//! scheduler guarantees both).
 //!
 //! Structure: entries from the engine go through the front (a start becomes a step job; a
 //! next reads the thread's leaf segment and stack and compares the hit with both in 5 clocks,
@@ -89,6 +89,9 @@ pub struct TraversalUnit<
     pub node_rdata: Signal<In, Bits<32>>,
     /// High in the clocks a node decision starts.
     pub step_busy: Signal<Out, Bit>,
+    /// High when `done_thread`'s walk reaches a leaf or ends (its pending count changes).
+    pub done_event: Signal<Out, Bit>,
+    pub done_thread: Signal<Out, Bits<5>>,
 
     entry_fifo: SynchronousFIFO<Entry, 5, 6, 1>,
     front_fifo: SynchronousFIFO<Job, 5, 6, 1>,
@@ -244,6 +247,8 @@ impl<
             node_addr: Default::default(),
             node_rdata: Default::default(),
             step_busy: Default::default(),
+            done_event: Default::default(),
+            done_thread: Default::default(),
             entry_fifo: Default::default(),
             front_fifo: Default::default(),
             loop_fifo: Default::default(),
@@ -612,6 +617,8 @@ impl<
         self.result_e.write_enable.next = self.at_a.val() & self.a_leaf.val();
         self.end_e.write_enable.next = self.at_a.val() & self.a_leaf.val();
         self.done_e.write_enable.next = self.at_a.val() & self.a_leaf.val();
+        self.done_event.next = self.at_a.val() & self.a_leaf.val();
+        self.done_thread.next = self.job.q.val().get_bits::<5>(96);
         self.leaf_hi.write_enable.next = self.at_a.val() & self.a_leaf.val();
         self.leaf_sp.write_enable.next = self.at_a.val() & self.a_leaf.val();
 

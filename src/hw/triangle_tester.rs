@@ -1,30 +1,33 @@
-//! `TriangleTester`: the ray thread engine's coprocessor for triangle tests. A thread queues
-//! the triangles of a kd leaf (`tri.test`, one engine turn each), the tester fetches each
-//! triangle from banks 2 and 3, takes the ray into the triangle's unit space with the
-//! [`TransformUnit`] (the origin as a point, then the direction as a vector), tests it in the
-//! [`IntersectUnit`] and keeps the thread's closest hit; the thread waits for its tests once
-//! per leaf (`tri.wait`). Bit-exact with `units::triangle_test` and `units::closer_hit`.
+//! `TriangleTester`: the ray thread engine's coprocessor for triangle tests. A thread hands
+//! it each kd leaf's list (`tri.list`, one engine turn); the [`ListUnit`] reads the list from
+//! bank 1 and drops the query's own triangle and those the thread's mailbox has seen; the
+//! tester fetches each triangle from banks 2 and 3, takes the ray into the triangle's unit
+//! space with the [`TransformUnit`] (the origin as a point, then the direction as a vector),
+//! tests it in the [`IntersectUnit`] and keeps the thread's closest hit; the thread waits for
+//! its tests once per leaf (`tri.wait`). Bit-exact with `units::triangle_test` and
+//! `units::closer_hit`.
 //!
 //! Engine side (the engine's I2/I3 stages):
 //! - Ray words: `ray_write` with `ray_pair` 0, 1, 2 writes `(o.x, o.y)`, `(o.z, d.x)`,
 //!   `(d.y, d.z)` of `thread` from `word_a`, `word_b`.
-//! - Queue: `enqueue` offers an entry of `thread`: a test of triangle `word_a` of instance
-//!   `word_b`, or with `queue_init` a new query (`t_min = word_a`, written at once; "no hit,
-//!   best t = `word_b`" queued behind the thread's earlier entries). It is taken when `full`
-//!   is low in that clock; the engine then counts it as issued.
-//! - Answers: `query_thread` at I2; at I3 `pending` (entries of the thread not yet done),
-//!   `hit`, `best_t`, `best_instance`, `best_triangle` of its closest hit. An entry offered at
-//!   I3 must be of the thread presented at I2 the clock before (its count of entries taken is
-//!   read there), and a thread never offers in two clocks in a row (the barrel guarantees
-//!   both).
+//! - Queue: `enqueue` offers a command of `thread` (`queue_kind`, the [`ListUnit`]'s): a list,
+//!   a new query (`t_min = word_a`, written at once; "no hit, best t = `word_b`" queued behind
+//!   the thread's earlier entries), the object of the next lists, the pair to skip. It is
+//!   taken when `full` is low in that clock; the engine then counts a list or a query as
+//!   issued.
+//! - Answers: `query_thread` at I2; at I3 `pending` (lists and queries of the thread not yet
+//!   done), `hit`, `best_t`, `best_instance`, `best_triangle` of its closest hit. An entry
+//!   offered at I3 must be of the thread presented at I2 the clock before (its count of
+//!   entries taken is read there), and a thread never offers in two clocks in a row (the
+//!   engine's scheduler guarantees both).
 //!
 //! Entries are done in queue order, so a thread's closest hit is chosen in its list order
 //! (the first of equal ts stays), as in the golden model.
 //!
-//! State machine per entry: take it from the 16-entry queue (1 clock), fetch the triangle's 8
+//! State machine per entry: take it from the list unit's test queue (1 clock), fetch the triangle's 8
 //! words of bank 2 and 4 of bank 3 (8 clocks when the engine leaves the banks alone, plus the
-//! SRAM latency; an init fetches nothing), launch the origin and then the direction into the
-//! TransformUnit (2 clocks). Throughput: one test per `11 + mem_latency` clocks, one init per
+//! SRAM latency; an init or a list end fetches nothing), launch the origin and then the direction into the
+//! TransformUnit (2 clocks). Throughput: one test per `11 + mem_latency` clocks, one init or list end per
 //! 4; entries leave the launch at least 4 clocks apart, which the hit merge needs (it reads,
 //! compares and writes a thread's best hit in 4 clocks). The engine's own loads of banks 2
 //! and 3 (shading data) take the bank in their clock; the fetch waits for it.
@@ -37,18 +40,15 @@ use rust_hdl::prelude::*;
 
 use super::fp::{const_bits, FpCompare};
 use super::ray_store::{zero_counters, RayStore};
-use super::{IntersectUnit, TransformUnit};
+use super::{IntersectUnit, ListUnit, TransformUnit};
 use crate::fp::Format;
 
-/// Entries the queue holds.
+/// Commands the engine-side queue holds (the [`ListUnit`]'s).
 pub const TESTER_QUEUE: usize = 16;
 // `update` spells out its numbers (rust-hdl's Verilog cannot name Rust constants): a
 // triangle is 8 words of bank 2 (the u and v rows) and 4 of bank 3 (the t row); the phases of
 // the fetch and launch state machine are 0 idle, 1 fetch, 2 launch the origin, 3 launch the
 // direction.
-
-/// Queue entry: `{init[69], thread[68:64], a[63:32], b[31:0]}`.
-type Entry = Bits<70>;
 
 #[derive(LogicBlock)]
 pub struct TriangleTester<
@@ -69,7 +69,8 @@ pub struct TriangleTester<
     pub ray_write: Signal<In, Bit>,
     pub ray_pair: Signal<In, Bits<2>>,
     pub enqueue: Signal<In, Bit>,
-    pub queue_init: Signal<In, Bit>,
+    /// `list_unit::CMD_*`.
+    pub queue_kind: Signal<In, Bits<2>>,
     pub full: Signal<Out, Bit>,
     pub query_thread: Signal<In, Bits<5>>,
     pub pending: Signal<Out, Bit>,
@@ -89,11 +90,18 @@ pub struct TriangleTester<
     pub t_read: Signal<Out, Bit>,
     pub t_addr: Signal<Out, Bits<24>>,
     pub t_rdata: Signal<In, Bits<32>>,
+    /// Bank 1 (triangle lists), on the engine's bus when the engine leaves it free.
+    pub list_read: Signal<Out, Bit>,
+    pub list_addr: Signal<Out, Bits<24>>,
+    pub list_rdata: Signal<In, Bits<32>>,
+    /// High when a list or a query of `done_thread` is done (its pending count changes).
+    pub done_event: Signal<Out, Bit>,
+    pub done_thread: Signal<Out, Bits<5>>,
     /// High in the clocks the TransformUnit and the IntersectUnit take an input.
     pub transform_busy: Signal<Out, Bit>,
     pub intersect_busy: Signal<Out, Bit>,
 
-    queue_fifo: SynchronousFIFO<Entry, 4, 5, 1>,
+    list_unit: ListUnit,
     /// Per thread: the ray (o, d), t_min; entries taken; (engine copies) entries done, best
     /// hit `{hit, t}`, instance, triangle; (merge copies) entries done, best hit.
     ray: RayStore<W>,
@@ -112,7 +120,8 @@ pub struct TriangleTester<
 
     // Fetch and launch.
     phase: DFF<Bits<2>>,
-    cur_init: DFF<Bit>,
+    /// `list_unit::TEST_*`.
+    cur_kind: DFF<Bits<2>>,
     cur_thread: DFF<Bits<5>>,
     cur_a: DFF<Bits<32>>,
     cur_b: DFF<Bits<32>>,
@@ -137,12 +146,12 @@ pub struct TriangleTester<
     cmp: FpCompare<W, E, M>,
     m1_valid: DFF<Bit>,
     m1_hit: DFF<Bit>,
-    m1_init: DFF<Bit>,
+    m1_kind: DFF<Bits<2>>,
     m1_thread: DFF<Bits<5>>,
     m1_t: DFF<Bits<W>>,
     m2_valid: DFF<Bit>,
     m2_hit: DFF<Bit>,
-    m2_init: DFF<Bit>,
+    m2_kind: DFF<Bits<2>>,
     m2_thread: DFF<Bits<5>>,
     m2_t: DFF<Bits<W>>,
     m2_a: DFF<Bits<32>>,
@@ -150,7 +159,7 @@ pub struct TriangleTester<
     m2_done: DFF<Bits<8>>,
     m3_valid: DFF<Bit>,
     m3_hit: DFF<Bit>,
-    m3_init: DFF<Bit>,
+    m3_kind: DFF<Bits<2>>,
     m3_thread: DFF<Bits<5>>,
     m3_t: DFF<Bits<W>>,
     m3_a: DFF<Bits<32>>,
@@ -192,7 +201,7 @@ impl<
             ray_write: Default::default(),
             ray_pair: Default::default(),
             enqueue: Default::default(),
-            queue_init: Default::default(),
+            queue_kind: Default::default(),
             full: Default::default(),
             query_thread: Default::default(),
             pending: Default::default(),
@@ -209,9 +218,14 @@ impl<
             t_read: Default::default(),
             t_addr: Default::default(),
             t_rdata: Default::default(),
+            list_read: Default::default(),
+            list_addr: Default::default(),
+            list_rdata: Default::default(),
+            done_event: Default::default(),
+            done_thread: Default::default(),
             transform_busy: Default::default(),
             intersect_busy: Default::default(),
-            queue_fifo: Default::default(),
+            list_unit: ListUnit::new(mem_latency),
             ray: Default::default(),
             // The counters start equal (nothing pending) at power-up.
             issued: zero_counters(),
@@ -225,7 +239,7 @@ impl<
             flight_a: Default::default(),
             flight_b: Default::default(),
             phase: Default::default(),
-            cur_init: Default::default(),
+            cur_kind: Default::default(),
             cur_thread: Default::default(),
             cur_a: Default::default(),
             cur_b: Default::default(),
@@ -246,12 +260,12 @@ impl<
             cmp: Default::default(),
             m1_valid: Default::default(),
             m1_hit: Default::default(),
-            m1_init: Default::default(),
+            m1_kind: Default::default(),
             m1_thread: Default::default(),
             m1_t: Default::default(),
             m2_valid: Default::default(),
             m2_hit: Default::default(),
-            m2_init: Default::default(),
+            m2_kind: Default::default(),
             m2_thread: Default::default(),
             m2_t: Default::default(),
             m2_a: Default::default(),
@@ -259,7 +273,7 @@ impl<
             m2_done: Default::default(),
             m3_valid: Default::default(),
             m3_hit: Default::default(),
-            m3_init: Default::default(),
+            m3_kind: Default::default(),
             m3_thread: Default::default(),
             m3_t: Default::default(),
             m3_a: Default::default(),
@@ -272,7 +286,7 @@ impl<
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_infinity: const_bits::<W>(u64::from(f.infinity(false))),
-            c_d_pass: Constant::new((1u64 << 10).into()),
+            c_d_pass: Constant::new((1u64 << 12).into()),
             c_hit_flag: Constant::new((1u64 << 32).into()),
         }
     }
@@ -293,15 +307,15 @@ impl<
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self, clock, phase, cur_init, cur_thread, cur_a, cur_b, uv_issued, t_issued, received,
-            seq, m1_valid, m1_hit, m1_init, m1_thread, m1_t, m2_valid, m2_hit, m2_init, m2_thread,
-            m2_t, m2_a, m2_b, m2_done, m3_valid, m3_hit, m3_init, m3_thread, m3_t, m3_a, m3_b,
+            self, clock, phase, cur_kind, cur_thread, cur_a, cur_b, uv_issued, t_issued, received,
+            seq, m1_valid, m1_hit, m1_kind, m1_thread, m1_t, m2_valid, m2_hit, m2_kind, m2_thread,
+            m2_t, m2_a, m2_b, m2_done, m3_valid, m3_hit, m3_kind, m3_thread, m3_t, m3_a, m3_b,
             m3_done
         );
         clock!(
             self,
             clock,
-            queue_fifo,
+            list_unit,
             ray,
             transform_unit,
             intersect_unit,
@@ -345,13 +359,18 @@ impl<
         self.ray.word_b.next = self.word_b.val();
         self.ray.ray_write.next = self.ray_write.val();
         self.ray.ray_pair.next = self.ray_pair.val();
-        self.ray.t_min_write.next = self.enqueue.val() & self.queue_init.val();
-        self.full.next = self.queue_fifo.full.val();
-        self.queue_fifo.write.next = self.enqueue.val() & (!self.queue_fifo.full.val());
-        self.queue_fifo.data_in.next = (bit_cast::<70, 1>(self.queue_init.val().into()) << 69)
-            | (bit_cast::<70, 5>(self.thread.val()) << 64)
-            | (bit_cast::<70, 32>(self.word_a.val()) << 32)
-            | bit_cast::<70, 32>(self.word_b.val());
+        self.ray.t_min_write.next = self.enqueue.val() & (self.queue_kind.val() == 1);
+        self.list_unit.enqueue.next = self.enqueue.val();
+        self.list_unit.kind.next = self.queue_kind.val();
+        self.list_unit.thread.next = self.thread.val();
+        self.list_unit.word_a.next = self.word_a.val();
+        self.list_unit.word_b.next = self.word_b.val();
+        self.full.next = self.list_unit.full.val();
+        self.list_unit.engine_read.next = self.engine_read.val();
+        self.list_unit.engine_bank.next = self.engine_bank.val();
+        self.list_read.next = self.list_unit.list_read.val();
+        self.list_addr.next = self.list_unit.list_addr.val();
+        self.list_unit.list_rdata.next = self.list_rdata.val();
 
         // Engine answers (address at I2, data at I3).
         self.issued.read_address.next = self.query_thread.val();
@@ -366,10 +385,13 @@ impl<
         self.best_triangle.next = self.triangle_e.read_data.val();
         self.issued.write_address.next = self.thread.val();
         self.issued.write_data.next = self.issued.read_data.val() + 1;
-        self.issued.write_enable.next = self.enqueue.val() & (!self.queue_fifo.full.val());
+        // A list counts as one entry (done with its end entry), an init as one.
+        self.issued.write_enable.next = self.enqueue.val()
+            & (!self.list_unit.full.val())
+            & (self.queue_kind.val().get_bits::<1>(1) == 0);
 
         // Fetch: the banks serve the engine first.
-        self.queue_fifo.read.next = false;
+        self.list_unit.test_take.next = false;
         self.ray.ray_thread.next = self.cur_thread.q.val();
         self.ray.t_min_thread.next = self.cur_thread.q.val();
         self.uv_take.next = (self.phase.q.val() == 1)
@@ -438,8 +460,8 @@ impl<
         for k in 0..3 {
             self.transform_unit.v[k].next = self.ray.o[k].val();
         }
-        // Tag: `{d pass[10], init[9], thread[8:4], seq[3:0]}`.
-        self.launch_tag.next = (bit_cast::<16, 1>(self.cur_init.q.val().into()) << 9)
+        // Tag: `{d pass[12], kind[10:9], thread[8:4], seq[3:0]}`.
+        self.launch_tag.next = (bit_cast::<16, 2>(self.cur_kind.q.val()) << 9)
             | (bit_cast::<16, 5>(self.cur_thread.q.val()) << 4)
             | bit_cast::<16, 4>(self.seq.q.val());
         self.transform_unit.tag.next = self.launch_tag.val();
@@ -453,17 +475,17 @@ impl<
         self.flight_a.write_enable.next = false;
         self.flight_b.write_enable.next = false;
         if self.phase.q.val() == 0 {
-            if !self.queue_fifo.empty.val() {
-                self.queue_fifo.read.next = true;
-                self.cur_init.d.next = self.queue_fifo.data_out.val().get_bit(69);
-                self.cur_thread.d.next = self.queue_fifo.data_out.val().get_bits::<5>(64);
-                self.cur_a.d.next = self.queue_fifo.data_out.val().get_bits::<32>(32);
-                self.cur_b.d.next = self.queue_fifo.data_out.val().get_bits::<32>(0);
+            if self.list_unit.test_valid.val() {
+                self.list_unit.test_take.next = true;
+                self.cur_kind.d.next = self.list_unit.test_entry.val().get_bits::<2>(69);
+                self.cur_thread.d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
+                self.cur_a.d.next = self.list_unit.test_entry.val().get_bits::<32>(32);
+                self.cur_b.d.next = self.list_unit.test_entry.val().get_bits::<32>(0);
                 self.uv_issued.d.next = 0.into();
                 self.t_issued.d.next = 0.into();
                 self.received.d.next = 0.into();
-                if self.queue_fifo.data_out.val().get_bit(69) {
-                    // An init fetches nothing.
+                if self.list_unit.test_entry.val().get_bits::<2>(69) != 0 {
+                    // An init or a list end fetches nothing.
                     self.uv_issued.d.next = 8.into();
                     self.t_issued.d.next = 4.into();
                     self.received.d.next = 12.into();
@@ -491,20 +513,22 @@ impl<
             self.seq.d.next = self.seq.q.val() + 1;
             self.phase.d.next = 0.into();
         }
-        self.transform_busy.next = self.transform_unit.in_valid.val();
+        // Busy counts tests only (inits and list ends pass the units to keep their order).
+        self.transform_busy.next =
+            self.transform_unit.in_valid.val() & (self.cur_kind.q.val() == 0);
 
         // O' waits a clock for D'; then the unit-triangle test.
         for k in 0..3 {
             self.o_hold[k].d.next = self.o_hold[k].q.val();
             if self.transform_unit.out_valid.val()
-                & (!self.transform_unit.out_tag.val().get_bit(10))
+                & (!self.transform_unit.out_tag.val().get_bit(12))
             {
                 self.o_hold[k].d.next = self.transform_unit.result[k].val();
             }
         }
         self.flight_t_min.read_address.next = self.transform_unit.out_tag.val().get_bits::<4>(0);
         self.intersect_unit.in_valid.next =
-            self.transform_unit.out_valid.val() & self.transform_unit.out_tag.val().get_bit(10);
+            self.transform_unit.out_valid.val() & self.transform_unit.out_tag.val().get_bit(12);
         for k in 0..3 {
             self.intersect_unit.o[k].next = self.o_hold[k].q.val();
             self.intersect_unit.d[k].next = self.transform_unit.result[k].val();
@@ -512,7 +536,8 @@ impl<
         self.intersect_unit.t_min.next = self.flight_t_min.read_data.val();
         self.intersect_unit.t_max.next = self.c_infinity.val();
         self.intersect_unit.tag.next = self.transform_unit.out_tag.val();
-        self.intersect_busy.next = self.intersect_unit.in_valid.val();
+        self.intersect_busy.next = self.intersect_unit.in_valid.val()
+            & (self.transform_unit.out_tag.val().get_bits::<2>(9) == 0);
 
         // Merge: read the thread's state, compare t with its best, write.
         self.done_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(4);
@@ -521,7 +546,7 @@ impl<
         self.flight_b.read_address.next = self.intersect_unit.out_tag.val().get_bits::<4>(0);
         self.m1_valid.d.next = self.intersect_unit.out_valid.val();
         self.m1_hit.d.next = self.intersect_unit.hit.val();
-        self.m1_init.d.next = self.intersect_unit.out_tag.val().get_bit(9);
+        self.m1_kind.d.next = self.intersect_unit.out_tag.val().get_bits::<2>(9);
         self.m1_thread.d.next = self.intersect_unit.out_tag.val().get_bits::<5>(4);
         self.m1_t.d.next = self.intersect_unit.t.val();
         self.cmp.in_valid.next = true;
@@ -529,7 +554,7 @@ impl<
         self.cmp.b.next = self.best_m.read_data.val().get_bits::<W>(0);
         self.m2_valid.d.next = self.m1_valid.q.val();
         self.m2_hit.d.next = self.m1_hit.q.val();
-        self.m2_init.d.next = self.m1_init.q.val();
+        self.m2_kind.d.next = self.m1_kind.q.val();
         self.m2_thread.d.next = self.m1_thread.q.val();
         self.m2_t.d.next = self.m1_t.q.val();
         self.m2_a.d.next = self.flight_a.read_data.val();
@@ -537,13 +562,13 @@ impl<
         self.m2_done.d.next = self.done_m.read_data.val();
         self.m3_valid.d.next = self.m2_valid.q.val();
         self.m3_hit.d.next = self.m2_hit.q.val();
-        self.m3_init.d.next = self.m2_init.q.val();
+        self.m3_kind.d.next = self.m2_kind.q.val();
         self.m3_thread.d.next = self.m2_thread.q.val();
         self.m3_t.d.next = self.m2_t.q.val();
         self.m3_a.d.next = self.m2_a.q.val();
         self.m3_b.d.next = self.m2_b.q.val();
         self.m3_done.d.next = self.m2_done.q.val();
-        self.merge_hit.next = self.m3_hit.q.val() & self.cmp.lt.val() & (!self.m3_init.q.val());
+        self.merge_hit.next = self.m3_hit.q.val() & self.cmp.lt.val() & (self.m3_kind.q.val() == 0);
 
         self.done_m.write_address.next = self.m3_thread.q.val();
         self.done_e.write_address.next = self.m3_thread.q.val();
@@ -553,15 +578,18 @@ impl<
         self.triangle_e.write_address.next = self.m3_thread.q.val();
         self.done_m.write_data.next = self.m3_done.q.val() + 1;
         self.done_e.write_data.next = self.m3_done.q.val() + 1;
-        self.done_m.write_enable.next = self.m3_valid.q.val();
-        self.done_e.write_enable.next = self.m3_valid.q.val();
+        // Inits and list ends count (the engine counted them as issued), not single tests.
+        self.done_m.write_enable.next = self.m3_valid.q.val() & (self.m3_kind.q.val() != 0);
+        self.done_e.write_enable.next = self.m3_valid.q.val() & (self.m3_kind.q.val() != 0);
+        self.done_event.next = self.m3_valid.q.val() & (self.m3_kind.q.val() != 0);
+        self.done_thread.next = self.m3_thread.q.val();
         // An init: no hit, best t = its b. A closer hit: hit, its t.
         self.merge_best.next = bit_cast::<33, W>(self.m3_b.q.val().get_bits::<W>(0));
         if self.merge_hit.val() {
             self.merge_best.next = self.c_hit_flag.val() | bit_cast::<33, W>(self.m3_t.q.val());
         }
         self.merge_write.next =
-            self.m3_valid.q.val() & (self.m3_init.q.val() | self.merge_hit.val());
+            self.m3_valid.q.val() & ((self.m3_kind.q.val() == 1) | self.merge_hit.val());
         self.best_m.write_data.next = self.merge_best.val();
         self.best_e.write_data.next = self.merge_best.val();
         self.best_m.write_enable.next = self.merge_write.val();
@@ -587,15 +615,24 @@ mod tests {
     /// An entry a thread offers, in its order.
     #[derive(Clone, Copy, Debug)]
     enum Offer {
-        Init { t_min: u32, t_max: u32 },
-        Test { triangle: u32, instance: u32 },
+        Init {
+            t_min: u32,
+            t_max: u32,
+        },
+        Object(u32),
+        /// Bank-1 words `from..to`.
+        List {
+            from: u32,
+            to: u32,
+        },
     }
 
-    /// rust-hdl simulation with an SRAM model behind banks 2 and 3: four threads each queue a
-    /// new query and 40 triangle tests (a second query half-way for thread 0), offered every
-    /// clock so that the queue fills and refuses; the engine takes banks 2 and 3 in random
+    /// rust-hdl simulation with an SRAM model behind banks 1, 2 and 3: four threads each
+    /// give an object and a new query and 12 lists of 0-7 triangles from a shared list bank
+    /// (so the mailbox drops repeats; a second query half-way for thread 0), offered every
+    /// clock so that the queues fill and refuse; the engine takes banks 1, 2 and 3 in random
     /// clocks. Every thread's closest hit, instance and triangle equal the model's sequential
-    /// `units::triangle_test` / `units::closer_hit` in its queue order.
+    /// `units::triangle_test` / `units::closer_hit` over its lists after `units::Mailbox`.
     #[test]
     fn rust_hdl_simulation_matches_sequential_tests() {
         let f = Format::E7M16;
@@ -628,6 +665,9 @@ mod tests {
                 bank3[8 * k + j] = rng.gen::<u32>() & 0xff_ffff; // shading words
             }
         }
+        let bank1: Vec<u32> = (0..200)
+            .map(|_| rng.gen_range(0..triangles.len() as u32))
+            .collect();
         let threads = 4usize;
         let rays: Vec<([u32; 3], [u32; 3])> = (0..threads)
             .map(|_| {
@@ -640,20 +680,22 @@ mod tests {
         let mut offers: Vec<VecDeque<Offer>> = (0..threads)
             .map(|th| {
                 let mut q = VecDeque::new();
+                q.push_back(Offer::Object(rng.gen_range(0..1000)));
                 q.push_back(Offer::Init {
                     t_min: 0,
                     t_max: f.infinity(false),
                 });
-                for k in 0..40 {
-                    if th == 0 && k == 20 {
+                for k in 0..12 {
+                    if th == 0 && k == 6 {
                         q.push_back(Offer::Init {
                             t_min: w(0.1),
                             t_max: w(1.5),
                         });
                     }
-                    q.push_back(Offer::Test {
-                        triangle: rng.gen_range(0..triangles.len() as u32),
-                        instance: rng.gen_range(0..1000),
+                    let from = rng.gen_range(0..190);
+                    q.push_back(Offer::List {
+                        from,
+                        to: from + rng.gen_range(0..8),
                     });
                 }
                 q
@@ -664,17 +706,24 @@ mod tests {
             .map(|th| {
                 let (o, d) = rays[th];
                 let (mut t_min, mut best) = (0, (false, 0, 0, 0));
+                let (mut instance, mut mailbox) = (0, units::Mailbox::new());
                 for offer in &offers[th] {
                     match *offer {
                         Offer::Init { t_min: lo, t_max } => {
                             t_min = lo;
                             best = (false, t_max, best.2, best.3);
                         }
-                        Offer::Test { triangle, instance } => {
-                            let m = triangles[triangle as usize];
-                            let r = units::triangle_test(f, &m, o, d, t_min);
-                            if units::closer_hit(f, &r, best.1) {
-                                best = (true, r.t, instance, triangle);
+                        Offer::Object(o) => (instance, mailbox) = (o, units::Mailbox::new()),
+                        Offer::List { from, to } => {
+                            for &triangle in &bank1[from as usize..to as usize] {
+                                if mailbox.seen(triangle) {
+                                    continue;
+                                }
+                                let m = triangles[triangle as usize];
+                                let r = units::triangle_test(f, &m, o, d, t_min);
+                                if units::closer_hit(f, &r, best.1) {
+                                    best = (true, r.t, instance, triangle);
+                                }
                             }
                         }
                     }
@@ -705,22 +754,23 @@ mod tests {
             }
         }
         u.ray_write.next = false;
-        let mut requests: VecDeque<(Option<u32>, Option<u32>)> = std::iter::repeat((None, None))
+        let mut requests: VecDeque<[Option<u32>; 3]> = std::iter::repeat([None; 3])
             .take(mem_latency as usize)
             .collect();
         let (mut refused, mut stolen, mut drain) = (0, 0, 0);
         // The thread whose counters were read last clock (the engine's I2): only it may offer.
         let mut queried: Option<usize> = None;
-        while offers.iter().any(|q| !q.is_empty()) || drain < 3000 {
+        while offers.iter().any(|q| !q.is_empty()) || drain < 4000 {
             if offers.iter().all(|q| q.is_empty()) {
                 drain += 1;
             }
             // The SRAMs answer the request of `mem_latency` clocks ago.
-            let (uv, t) = requests.pop_front().unwrap();
+            let [uv, t, list] = requests.pop_front().unwrap();
             u.uv_rdata.next = u64::from(uv.map_or(0xdead, |a| bank2[a as usize])).into();
             u.t_rdata.next = u64::from(t.map_or(0xdead, |a| bank3[a as usize])).into();
+            u.list_rdata.next = u64::from(list.map_or(0xdead, |a| bank1[a as usize])).into();
             // Round robin over the threads with something to offer (like the engine's turns);
-            // a thread never offers in two clocks in a row (as in the engine's barrel).
+            // a thread never offers in two clocks in a row (as in the engine: a thread issues once per write back).
             let th = queried.filter(|&t| !offers[t].is_empty());
             let start = th.map_or(0, |t| t + 1);
             queried = (0..threads)
@@ -729,24 +779,29 @@ mod tests {
             u.query_thread.next = (queried.unwrap_or(0) as u64).into();
             u.enqueue.next = th.is_some();
             if let Some(th) = th {
-                let (init, a, b) = match offers[th][0] {
-                    Offer::Init { t_min, t_max } => (true, t_min, t_max),
-                    Offer::Test { triangle, instance } => (false, triangle, instance),
+                use crate::hw::list_unit::{CMD_INIT, CMD_LIST, CMD_OBJECT};
+                let (kind, a, b) = match offers[th][0] {
+                    Offer::Init { t_min, t_max } => (CMD_INIT, t_min, t_max),
+                    Offer::Object(o) => (CMD_OBJECT, o, 0),
+                    Offer::List { from, to } => (CMD_LIST, from, to),
                 };
                 u.thread.next = (th as u64).into();
-                u.queue_init.next = init;
+                u.queue_kind.next = kind.into();
                 u.word_a.next = u64::from(a).into();
                 u.word_b.next = u64::from(b).into();
             }
-            // The engine takes bank 2 or 3 in one clock of five.
+            // The engine takes bank 1, 2 or 3 in one clock of five.
             let steal = rng
                 .gen_ratio(1, 5)
-                .then(|| (rng.gen_range(2..=3u64), rng.gen_range(0..64u64)));
+                .then(|| (rng.gen_range(1..=3u64), rng.gen_range(0..64u64)));
             u.engine_read.next = steal.is_some();
             u.engine_bank.next = steal.map_or(0, |s| s.0).into();
             u.engine_addr.next = steal.map_or(0, |s| s.1).into();
             settle(&mut u);
-            if let Some((bank, addr)) = steal {
+            if let Some((1, _)) = steal {
+                assert!(!u.list_read.val(), "the list read took the engine's bus");
+            }
+            if let Some((bank @ 2..=3, addr)) = steal {
                 stolen += 1;
                 let (read, port) = if bank == 2 {
                     (u.uv_read.val(), u.uv_addr.val())
@@ -759,10 +814,11 @@ mod tests {
                 );
             }
             let port = |read: bool, addr: Bits<24>| read.then(|| addr.to_u64() as u32);
-            requests.push_back((
+            requests.push_back([
                 port(u.uv_read.val(), u.uv_addr.val()),
                 port(u.t_read.val(), u.t_addr.val()),
-            ));
+                port(u.list_read.val(), u.list_addr.val()),
+            ]);
             if let Some(th) = th {
                 if u.full.val() {
                     refused += 1;

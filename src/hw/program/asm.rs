@@ -253,6 +253,68 @@ impl Asm {
         }
     }
 
+    /// `dst = v` for a temporary `v` that dies here: the instruction that computed it writes
+    /// `dst` instead, without a move, when that is the same program. It is when the
+    /// instruction is plain arithmetic or a load and the last write of `v`, and the code since
+    /// runs straight (no branch, jump or label) and neither reads `v` nor touches `dst`.
+    /// Otherwise a move.
+    pub fn assign(&self, dst: Reg, v: Val) {
+        if let Val::R(t) = v {
+            let mut s = self.state.borrow_mut();
+            let len = s.code.len();
+            let producer = s.code.iter().rposition(|i| i.op.writes() && i.dst == t.0);
+            if let Some(k) = producer.filter(|_| t != dst && s.temps.contains(&t)) {
+                let plain = |i: &Instr| !i.op.branches() && !i.invert && i.op != Op::Jr;
+                let reads = |i: &Instr, r: Reg| i.a == r.0 || (!i.b_imm && i.b == r.0);
+                let later = &s.code[k + 1..];
+                let labelled = s
+                    .labels
+                    .iter()
+                    .flatten()
+                    .any(|&p| (k + 1..=len).contains(&(p as usize)));
+                use Op::*;
+                let retargetable = matches!(
+                    s.code[k].op,
+                    FAdd | FSub
+                        | FMul
+                        | FDiv
+                        | FSqrt
+                        | IToF
+                        | Add
+                        | Sub
+                        | And
+                        | Or
+                        | Xor
+                        | Shr
+                        | Shl
+                        | Ld
+                        | Lds
+                );
+                if retargetable
+                    && plain(&s.code[k])
+                    && !labelled
+                    && later.iter().all(|i| {
+                        plain(i)
+                            && !reads(i, t)
+                            && !reads(i, dst)
+                            && !(i.op.writes() && i.dst == dst.0)
+                    })
+                {
+                    s.code[k].dst = dst.0;
+                    return;
+                }
+            }
+        }
+        self.mov(dst, v)
+    }
+
+    /// [`Asm::assign`] of three values.
+    pub fn assign3(&self, dst: [Reg; 3], v: [Val; 3]) {
+        for i in 0..3 {
+            self.assign(dst[i], v[i]);
+        }
+    }
+
     /// `dst = bank[(a << shift) + offset]`.
     pub fn load_to(&self, dst: Reg, bank: usize, a: Val, shift: u8, offset: u32) {
         let mut i = self.operands(Op::Ld, a, Val::K(0));
@@ -356,7 +418,7 @@ impl Asm {
         self.coprocessor(Op::Tri, f as u32, Reg::ZERO, a, b);
     }
 
-    /// Queues `f` (`Init` or `Test`) with operands `a`, `b` (the engine offers it again on the
+    /// Queues `f` (`Init`, `List`, `Object` or `Skip`) with operands `a`, `b` (the engine offers it again on the
     /// thread's next turns while the queue is full).
     pub fn tri_queue(&self, f: TriFn, a: Reg, b: Reg) {
         debug_assert!(f.queues());

@@ -14,7 +14,7 @@ use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_FINISHED, REGISTERS};
 use super::Program;
 use crate::fp::Format;
 use crate::hw::traversal_unit::STACK_LEVELS;
-use crate::layout::{Layout, Node, NODES, NODE_WORDS, TRIANGLES_T, TRIANGLE_BANK_WORDS};
+use crate::layout::{Layout, Node, LISTS, NODES, NODE_WORDS, TRIANGLES_T, TRIANGLE_BANK_WORDS};
 use crate::units::{self, Mailbox};
 
 /// A failure of the program on this memory (a generator bug or a layout that does not belong
@@ -39,7 +39,7 @@ pub struct Write {
 /// A thread's state in the triangle tester: its ray and its closest hit. The twin tests a
 /// queued triangle at once; the tester tests a thread's entries in the order they were queued,
 /// so a `wait` sees the same result.
-#[derive(Clone, Default)]
+#[derive(Clone)]
 struct TesterState {
     o: [u32; 3],
     d: [u32; 3],
@@ -48,6 +48,29 @@ struct TesterState {
     best_t: u32,
     best_instance: u32,
     best_triangle: u32,
+    /// The list unit's: the object of the lists, the skipped pair, the triangle mailbox.
+    object: u32,
+    skip: (u32, u32),
+    mailbox: Mailbox,
+}
+
+impl Default for TesterState {
+    fn default() -> Self {
+        TesterState {
+            o: [0; 3],
+            d: [0; 3],
+            t_min: 0,
+            hit: false,
+            best_t: 0,
+            best_instance: 0,
+            best_triangle: 0,
+            object: 0,
+            // The hardware's skip words start all ones: no triangle is skipped until a
+            // query says so.
+            skip: (u32::MAX, u32::MAX),
+            mailbox: Mailbox::default(),
+        }
+    }
 }
 
 /// A thread's walk in the traversal unit and the leaf it handed out (list, list end).
@@ -304,20 +327,31 @@ impl<'a> Machine<'a> {
                         tt.hit = false;
                         tt.best_t = b;
                     }
-                    TriFn::Test => {
+                    TriFn::Object => (tt.object, tt.mailbox) = (a, Mailbox::default()),
+                    TriFn::Skip => tt.skip = (a, b),
+                    TriFn::List => {
+                        let list = self.layout.banks[LISTS].get(a as usize..b as usize);
+                        let list = list.ok_or_else(|| {
+                            fail(format!("triangle list {a}..{b} beyond the list bank"))
+                        })?;
                         let words = self.layout.banks[TRIANGLES_T].len() / TRIANGLE_BANK_WORDS;
-                        if a as usize >= words {
-                            return Err(fail(format!(
-                                "triangle {a} beyond the {words} triangles in memory"
-                            )));
-                        }
-                        let m = self.layout.triangle_transform(a);
-                        let r = units::triangle_test(f, &m, tt.o, tt.d, tt.t_min);
-                        if units::closer_hit(f, &r, tt.best_t) {
-                            tt.hit = true;
-                            tt.best_t = r.t;
-                            tt.best_instance = b;
-                            tt.best_triangle = a;
+                        for &triangle in list {
+                            if (tt.object, triangle) == tt.skip || tt.mailbox.seen(triangle) {
+                                continue;
+                            }
+                            if triangle as usize >= words {
+                                return Err(fail(format!(
+                                    "triangle {triangle} beyond the {words} triangles in memory"
+                                )));
+                            }
+                            let m = self.layout.triangle_transform(triangle);
+                            let r = units::triangle_test(f, &m, tt.o, tt.d, tt.t_min);
+                            if units::closer_hit(f, &r, tt.best_t) {
+                                tt.hit = true;
+                                tt.best_t = r.t;
+                                tt.best_instance = tt.object;
+                                tt.best_triangle = triangle;
+                            }
                         }
                     }
                     TriFn::Wait => result = Some(tt.best_t),

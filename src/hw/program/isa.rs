@@ -22,7 +22,8 @@ pub const MAX_PROGRAM: usize = 1 << PC_BITS;
 /// Width of one encoded instruction.
 pub const INSTR_BITS: usize = 5 + 3 * REG_BITS + 1 + 1 + 3 + 3 + 32 + PC_BITS;
 
-/// The two mailboxes of a thread (the `imm` of `Mbx` / `Mbc`).
+/// The two mailboxes of a thread (the `imm` of `Mbx` / `Mbc`). The program uses the instance
+/// mailbox; triangles are mailboxed by the triangle tester's list unit (`TriFn::List`).
 pub const MAILBOX_TRIANGLES: u32 = 0;
 pub const MAILBOX_INSTANCES: u32 = 1;
 
@@ -132,8 +133,10 @@ pub enum TriFn {
     RayDyz,
     /// A new query: `t_min = A`, and queue "no hit yet, best t = B" behind the thread's tests.
     Init,
-    /// Queue the test of triangle `A` of instance `B`.
-    Test,
+    /// Queue the tests of the triangle list `A..B` (bank-1 word addresses): every triangle
+    /// that is not the query's skipped one and not in the thread's triangle mailbox (which
+    /// records it), in list order (the tester's list unit reads the list).
+    List,
     /// Repeat while tests are in flight; `dst` = best t.
     Wait,
     /// `dst` = 1 when some test hit, else 0.
@@ -141,19 +144,25 @@ pub enum TriFn {
     /// `dst` = the instance, the triangle of the closest hit.
     Instance,
     Triangle,
+    /// Queue: the next lists are of instance `A`; empty the triangle mailbox.
+    Object,
+    /// Queue: the query does not test triangle `B` of instance `A` (the one it starts on).
+    Skip,
 }
 
 impl TriFn {
-    pub const ALL: [TriFn; 9] = [
+    pub const ALL: [TriFn; 11] = [
         TriFn::RayOxy,
         TriFn::RayOzDx,
         TriFn::RayDyz,
         TriFn::Init,
-        TriFn::Test,
+        TriFn::List,
         TriFn::Wait,
         TriFn::Hit,
         TriFn::Instance,
         TriFn::Triangle,
+        TriFn::Object,
+        TriFn::Skip,
     ];
     pub fn from_imm(imm: u32) -> Option<TriFn> {
         Self::ALL.get(imm as usize).copied()
@@ -164,16 +173,21 @@ impl TriFn {
             TriFn::RayOzDx => "ray.ozdx",
             TriFn::RayDyz => "ray.dyz",
             TriFn::Init => "init",
-            TriFn::Test => "test",
+            TriFn::List => "list",
             TriFn::Wait => "wait",
             TriFn::Hit => "hit",
             TriFn::Instance => "instance",
             TriFn::Triangle => "triangle",
+            TriFn::Object => "object",
+            TriFn::Skip => "skip",
         }
     }
     /// Whether the function puts an entry in the tester's queue.
     pub fn queues(self) -> bool {
-        matches!(self, TriFn::Init | TriFn::Test)
+        matches!(
+            self,
+            TriFn::Init | TriFn::List | TriFn::Object | TriFn::Skip
+        )
     }
 }
 

@@ -2,11 +2,12 @@
 //! `enter_instance` and `test_triangles`, step for step).
 //!
 //! Object trees are walked by the traversal unit (`hw::TraversalUnit`, per `units::KdWalk`):
-//! the thread starts the walk, waits, and gets each leaf's list; it queues the list's
-//! triangles that are not skipped and not in the triangle mailbox in the triangle tester
-//! (`hw::TriangleTester`), waits for the tester, reads the closest hit, and answers the
-//! traversal unit with it (which ends the walk or pops its stack). A shadow query (`q_any`)
-//! returns after the first leaf with a hit.
+//! the thread starts the walk, waits, and gets each leaf's list; it hands the list to the
+//! triangle tester (`hw::TriangleTester`), whose list unit drops the triangle the query
+//! starts on and those in the thread's triangle mailbox and queues the rest; the thread waits
+//! for the tester, reads the closest hit, and answers the traversal unit with it (which ends
+//! the walk or pops its stack). A shadow query (`q_any`) returns after the first leaf with a
+//! hit.
 //!
 //! The top-level tree of a scene with instances is walked here in microcode (state machine
 //! per thread, one instruction per engine turn): fetch a node (2 loads), decode it; at an
@@ -17,24 +18,26 @@
 //! the ray, given to both coprocessors, then the object walk); then pop the stack until a
 //! segment can still hold a closer hit.
 //!
-//! Cost (instructions = engine turns): per object leaf 5 per listed triangle (list word,
-//! mailbox and skip checks, queueing; a full queue repeats the offer on the next turn), a wait of
-//! about 3 turns for the tester (about 90 clocks) and 2 reads, and per walk segment a wait for
-//! the traversal unit (its inner nodes cost the thread no instruction); per top-level inner
-//! node 15-23, per instance about 40 (the transforms).
+//! Cost (instructions = engine turns): per object leaf 7 (the leaf, its end, the list, the
+//! wait, the hit, the answer, the jump folded into it); a waiting thread sleeps until the
+//! tester or the traversal unit is done (the tree's inner nodes and the leaf's triangles
+//! cost it no instruction); per top-level inner node 15-23, per
+//! instance about 40 (the transforms).
 
 use super::asm::Asm;
 use super::asm::{Label, Reg, Val};
-use super::isa::{KdFn, Op, TriFn, KD_FINISHED, MAILBOX_INSTANCES, MAILBOX_TRIANGLES};
+use super::isa::{KdFn, Op, TriFn, KD_FINISHED, MAILBOX_INSTANCES};
 use super::{Gen, STACK_ENTRY_WORDS};
 use crate::layout::{instance_word as iw, INSTANCES, LEAF_TAG, LISTS, NODES};
 use crate::units;
 
-/// Gives the triangle tester and the traversal unit the object-space ray.
-fn tester_ray(a: &Asm, o: [Reg; 3], d: [Reg; 3]) {
+/// Gives the triangle tester and the traversal unit the object-space ray of `instance`
+/// (which empties the tester's triangle mailbox).
+fn tester_ray(a: &Asm, o: [Reg; 3], d: [Reg; 3], instance: Reg) {
     a.tri_ray(TriFn::RayOxy, o[0], o[1]);
     a.tri_ray(TriFn::RayOzDx, o[2], d[0]);
     a.tri_ray(TriFn::RayDyz, d[1], d[2]);
+    a.tri_queue(TriFn::Object, instance, Reg::ZERO);
 }
 
 /// The ray one traversal level walks: registers, and where scratch holds a copy for the
@@ -63,6 +66,11 @@ impl Gen<'_> {
             scratch: self.scratch.ray_top,
         };
         a.tri_queue(TriFn::Init, s.q_t_min, s.q_t_max);
+        // The triangle a secondary ray starts on is never tested (primary rays skip none, so
+        // a scene without secondary rays never names one).
+        if self.c.shadows || self.c.reflection_depth > 0 {
+            a.tri_queue(TriFn::Skip, s.skip_instance, s.skip_triangle);
+        }
         match self.c.top_root {
             Some(root) => {
                 self.store_ray(world);
@@ -70,9 +78,8 @@ impl Gen<'_> {
                 self.traverse(Val::K(root), world, done);
             }
             None => {
-                tester_ray(a, world.o, world.d);
-                a.mailbox_clear(MAILBOX_TRIANGLES);
-                self.walk_object(Val::K(self.c.object_root), Reg::ZERO, done);
+                tester_ray(a, world.o, world.d, Reg::ZERO);
+                self.walk_object(Val::K(self.c.object_root), done);
             }
         }
         a.bind(done);
@@ -93,7 +100,7 @@ impl Gen<'_> {
 
     /// An object's kd tree, walked by the traversal unit from `root`: each leaf's triangles
     /// go to the triangle tester; an answered any-hit query jumps to `answered`.
-    fn walk_object(&self, root: Val, instance: Reg, answered: Label) {
+    fn walk_object(&self, root: Val, answered: Label) {
         let a = self.asm;
         let s = &self.s;
         a.section("traversal");
@@ -106,7 +113,7 @@ impl Gen<'_> {
         a.kd_wait(list);
         a.branch(Op::Bltu, list.into(), Val::K(KD_FINISHED), true, finished);
         a.kd_end(end);
-        self.triangle_list(instance, list, end, answered);
+        self.triangle_list(list, end, answered);
         a.section("traversal");
         a.kd_queue(KdFn::Next, s.best_t, s.hit);
         a.jump(leaf);
@@ -232,9 +239,8 @@ impl Gen<'_> {
         let local_d = units::transform(a, &m, s.q_d.map(Val::R), false).map(|v| a.keep(v));
         a.end_temps();
         a.free(record);
-        tester_ray(a, local_o, local_d);
-        a.mailbox_clear(MAILBOX_TRIANGLES);
-        self.walk_object(root.into(), instance, answered);
+        tester_ray(a, local_o, local_d, instance);
+        self.walk_object(root.into(), answered);
         for r in local_o.into_iter().chain(local_d).chain([root]) {
             a.free(r);
         }
@@ -253,45 +259,13 @@ impl Gen<'_> {
         a.op(Op::Add, x16, x8)
     }
 
-    /// The triangles of an object leaf, `list..end` in bank 1.
-    fn triangle_list(&self, instance: Reg, list: Reg, end: Reg, answered: Label) {
+    /// The triangles of an object leaf, `list..end` in bank 1: the tester's list unit reads
+    /// the list and drops the skipped triangle and those in the mailbox.
+    fn triangle_list(&self, list: Reg, end: Reg, answered: Label) {
         let a = self.asm;
         let s = &self.s;
         a.section("triangles");
-        let [p, triangle] = a.regs::<2>();
-        a.mov(p, list.into());
-        let (next, done) = (a.label(), a.label());
-        a.bind(next);
-        a.section("triangles");
-        a.branch(Op::Beq, p.into(), end.into(), false, done);
-        a.load_to(triangle, LISTS, p.into(), 0, 0);
-        a.op_to(Op::Add, p, p.into(), Val::K(1));
-        // The triangle a secondary ray starts on is never tested (primary rays skip none, so
-        // a scene without secondary rays needs no check).
-        if self.c.shadows || self.c.reflection_depth > 0 {
-            let not_skipped = a.label();
-            a.branch(
-                Op::Beq,
-                triangle.into(),
-                s.skip_triangle.into(),
-                true,
-                not_skipped,
-            );
-            a.branch(
-                Op::Beq,
-                instance.into(),
-                s.skip_instance.into(),
-                false,
-                next,
-            );
-            a.bind(not_skipped);
-        }
-        a.mailbox_check(MAILBOX_TRIANGLES, triangle, next);
-        // The test runs in the triangle tester while the thread queues the leaf's next
-        // triangles; the tester keeps the closest hit in list order.
-        a.tri_queue(TriFn::Test, triangle, instance);
-        a.jump(next);
-        a.bind(done);
+        a.tri_queue(TriFn::List, list, end);
         a.section("intersect");
         a.tri_wait(s.best_t);
         a.tri_read(TriFn::Hit, s.hit);
@@ -302,7 +276,5 @@ impl Gen<'_> {
             a.branch(Op::Beq, s.q_any.into(), Val::K(0), true, answered);
             a.bind(closest);
         }
-        a.free(p);
-        a.free(triangle);
     }
 }

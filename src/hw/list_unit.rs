@@ -1,0 +1,541 @@
+//! `ListUnit`: the triangle tester's front end, the paper's list unit. It takes a thread's
+//! commands from the engine in one queue, walks each kd leaf's triangle list in bank 1 by
+//! itself, drops the triangle the query starts on and the triangles the thread's mailbox has
+//! seen, and hands the tests on to the tester's launch in a second queue. A leaf costs the
+//! thread one engine turn (`tri.list`) instead of five per triangle.
+//!
+//! Engine side (the engine's I3): `enqueue` offers a command of `thread`, taken when `full`
+//! is low in that clock. Commands by `kind`: [`CMD_LIST`] the list `word_a..word_b` (bank-1
+//! word addresses); [`CMD_INIT`] a new query (passed on as it is); [`CMD_OBJECT`] the object
+//! (instance) `word_a` the next lists belong to, which empties the thread's mailbox;
+//! [`CMD_SKIP`] the (instance `word_a`, triangle `word_b`) the query must not test. All are
+//! done in queue order, so a thread's object and skip apply to exactly its later lists.
+//!
+//! Launch side: `test_valid` / `test_entry` is the head of the test queue, `test_take` pops
+//! it. Entries `{kind[70:69], thread[68:64], a[63:32], b[31:0]}`: [`TEST_TRIANGLE`] (a the
+//! triangle, b the instance), [`TEST_INIT`] (the init command) and [`TEST_LIST_END`], queued
+//! behind a list's last test so that the tester can count the list as done.
+//!
+//! Memory: one bank-1 read per clock on `list_*`, the word `mem_latency` clocks later; the
+//! engine's port shares the bus (`engine_read` of banks 1, 4, 5 goes first).
+//!
+//! State machine: idle (apply object and skip commands, pass inits on, take a list: 1 clock
+//! each), load the thread's mailbox, object and skip (2 clocks), walk: one list word a clock
+//! while the test queue has room for the words in flight. The mailbox check and update is one
+//! clock on the word's arrival (`units::Mailbox`: the first `len` of 8 ids, first in first
+//! out), so a list of n words takes about `n + 3 + mem_latency` clocks; a thread has at most
+//! one list queued (it waits for its tests before the next).
+
+use rust_hdl::prelude::*;
+
+/// Command kinds (the engine's `kind`).
+pub const CMD_LIST: u64 = 0;
+pub const CMD_INIT: u64 = 1;
+pub const CMD_OBJECT: u64 = 2;
+pub const CMD_SKIP: u64 = 3;
+/// Test queue entry kinds.
+pub const TEST_TRIANGLE: u64 = 0;
+pub const TEST_INIT: u64 = 1;
+pub const TEST_LIST_END: u64 = 2;
+
+/// A queue entry: `{kind[70:69], thread[68:64], a[63:32], b[31:0]}`.
+pub type ListEntry = Bits<71>;
+
+// `update` spells out its numbers (rust-hdl's Verilog cannot name Rust constants): the
+// phases are 0 idle, 1 read the thread's state, 2 latch it, 3 walk; the test queue holds 8.
+
+#[derive(LogicBlock)]
+pub struct ListUnit {
+    pub clock: Signal<In, Clock>,
+    pub enqueue: Signal<In, Bit>,
+    pub kind: Signal<In, Bits<2>>,
+    pub thread: Signal<In, Bits<5>>,
+    pub word_a: Signal<In, Bits<32>>,
+    pub word_b: Signal<In, Bits<32>>,
+    pub full: Signal<Out, Bit>,
+    pub engine_read: Signal<In, Bit>,
+    pub engine_bank: Signal<In, Bits<3>>,
+    pub list_read: Signal<Out, Bit>,
+    pub list_addr: Signal<Out, Bits<24>>,
+    pub list_rdata: Signal<In, Bits<32>>,
+    pub test_valid: Signal<Out, Bit>,
+    pub test_entry: Signal<Out, ListEntry>,
+    pub test_take: Signal<In, Bit>,
+
+    commands: SynchronousFIFO<ListEntry, 4, 5, 1>,
+    tests: SynchronousFIFO<ListEntry, 3, 4, 1>,
+    /// Per thread: the object of its lists, the skipped pair, its mailbox.
+    object_ram: RAM<Bits<32>, 5>,
+    skip_object_ram: RAM<Bits<32>, 5>,
+    skip_triangle_ram: RAM<Bits<32>, 5>,
+    mailbox_ids: [RAM<Bits<32>, 5>; 8],
+    /// `{next[6:4], len[3:0]}`.
+    mailbox_meta: RAM<Bits<8>, 5>,
+
+    phase: DFF<Bits<2>>,
+    walk_thread: DFF<Bits<5>>,
+    cursor: DFF<Bits<24>>,
+    list_end: DFF<Bits<24>>,
+    object_id: DFF<Bits<32>>,
+    skip_object: DFF<Bits<32>>,
+    skip_triangle: DFF<Bits<32>>,
+    ids: [DFF<Bits<32>>; 8],
+    mb_len: DFF<Bits<4>>,
+    mb_next: DFF<Bits<3>>,
+    /// Reads in flight; entries in the test queue.
+    flight: DFF<Bits<4>>,
+    queued: DFF<Bits<4>>,
+    /// Request valid per clock of SRAM latency.
+    flight_line: [DFF<Bit>; 6],
+    take: Signal<Local, Bit>,
+    arrive: Signal<Local, Bit>,
+    seen: Signal<Local, Bit>,
+    fresh: Signal<Local, Bit>,
+    push: Signal<Local, Bit>,
+    next_after: Signal<Local, Bits<3>>,
+    len_after: Signal<Local, Bits<4>>,
+    head_kind: Signal<Local, Bits<2>>,
+    c_ml_last: Constant<Bits<4>>,
+    c_index: [Constant<Bits<4>>; 8],
+    /// The kind field of a list-end entry.
+    c_list_end: Constant<ListEntry>,
+}
+
+/// A per-thread RAM of all-ones words: no thread skips a triangle until it says so (a scene
+/// without secondary rays never does).
+fn ones_words() -> RAM<Bits<32>, 5> {
+    RAM::new(
+        (0..32u64)
+            .map(|k| (Bits::<5>::from(k), Bits::<32>::from(0xffff_ffffu64)))
+            .collect(),
+    )
+}
+
+impl ListUnit {
+    /// The unit for SRAM read latency `mem_latency` (1..=6).
+    pub fn new(mem_latency: u32) -> Self {
+        assert!((1..=6).contains(&mem_latency));
+        Self {
+            clock: Default::default(),
+            enqueue: Default::default(),
+            kind: Default::default(),
+            thread: Default::default(),
+            word_a: Default::default(),
+            word_b: Default::default(),
+            full: Default::default(),
+            engine_read: Default::default(),
+            engine_bank: Default::default(),
+            list_read: Default::default(),
+            list_addr: Default::default(),
+            list_rdata: Default::default(),
+            test_valid: Default::default(),
+            test_entry: Default::default(),
+            test_take: Default::default(),
+            commands: Default::default(),
+            tests: Default::default(),
+            object_ram: Default::default(),
+            skip_object_ram: ones_words(),
+            skip_triangle_ram: ones_words(),
+            mailbox_ids: Default::default(),
+            mailbox_meta: Default::default(),
+            phase: Default::default(),
+            walk_thread: Default::default(),
+            cursor: Default::default(),
+            list_end: Default::default(),
+            object_id: Default::default(),
+            skip_object: Default::default(),
+            skip_triangle: Default::default(),
+            ids: Default::default(),
+            mb_len: Default::default(),
+            mb_next: Default::default(),
+            flight: Default::default(),
+            queued: Default::default(),
+            flight_line: Default::default(),
+            take: Default::default(),
+            arrive: Default::default(),
+            seen: Default::default(),
+            fresh: Default::default(),
+            push: Default::default(),
+            next_after: Default::default(),
+            len_after: Default::default(),
+            head_kind: Default::default(),
+            c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
+            c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
+            c_list_end: Constant::new(ListEntry::from(TEST_LIST_END) << 69),
+        }
+    }
+}
+
+impl Logic for ListUnit {
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(
+            self,
+            clock,
+            phase,
+            walk_thread,
+            cursor,
+            list_end,
+            object_id,
+            skip_object,
+            skip_triangle,
+            mb_len,
+            mb_next,
+            flight,
+            queued
+        );
+        clock!(self, clock, commands, tests);
+        self.object_ram.read_clock.next = self.clock.val();
+        self.object_ram.write_clock.next = self.clock.val();
+        self.skip_object_ram.read_clock.next = self.clock.val();
+        self.skip_object_ram.write_clock.next = self.clock.val();
+        self.skip_triangle_ram.read_clock.next = self.clock.val();
+        self.skip_triangle_ram.write_clock.next = self.clock.val();
+        self.mailbox_meta.read_clock.next = self.clock.val();
+        self.mailbox_meta.write_clock.next = self.clock.val();
+        for k in 0..8 {
+            self.mailbox_ids[k].read_clock.next = self.clock.val();
+            self.mailbox_ids[k].write_clock.next = self.clock.val();
+            self.ids[k].clock.next = self.clock.val();
+            self.ids[k].d.next = self.ids[k].q.val();
+        }
+        for k in 0..6 {
+            self.flight_line[k].clock.next = self.clock.val();
+        }
+
+        // Engine side.
+        self.full.next = self.commands.full.val();
+        self.commands.write.next = self.enqueue.val() & (!self.commands.full.val());
+        self.commands.data_in.next = (bit_cast::<71, 2>(self.kind.val()) << 69)
+            | (bit_cast::<71, 5>(self.thread.val()) << 64)
+            | (bit_cast::<71, 32>(self.word_a.val()) << 32)
+            | bit_cast::<71, 32>(self.word_b.val());
+        self.commands.read.next = false;
+        self.head_kind.next = self.commands.data_out.val().get_bits::<2>(69);
+
+        // Launch side.
+        self.test_valid.next = !self.tests.empty.val();
+        self.test_entry.next = self.tests.data_out.val();
+        self.tests.read.next = self.test_take.val();
+        self.push.next = false;
+        self.tests.data_in.next = self.commands.data_out.val();
+
+        // The thread's state: written by its object and skip commands (idle) and by the
+        // mailbox updates of its walk; read for the walk of the list just taken.
+        self.object_ram.read_address.next = self.walk_thread.q.val();
+        self.skip_object_ram.read_address.next = self.walk_thread.q.val();
+        self.skip_triangle_ram.read_address.next = self.walk_thread.q.val();
+        self.mailbox_meta.read_address.next = self.walk_thread.q.val();
+        self.object_ram.write_address.next = self.commands.data_out.val().get_bits::<5>(64);
+        self.skip_object_ram.write_address.next = self.commands.data_out.val().get_bits::<5>(64);
+        self.skip_triangle_ram.write_address.next = self.commands.data_out.val().get_bits::<5>(64);
+        self.mailbox_meta.write_address.next = self.walk_thread.q.val();
+        self.object_ram.write_data.next = self.commands.data_out.val().get_bits::<32>(32);
+        self.skip_object_ram.write_data.next = self.commands.data_out.val().get_bits::<32>(32);
+        self.skip_triangle_ram.write_data.next = self.commands.data_out.val().get_bits::<32>(0);
+        self.object_ram.write_enable.next = false;
+        self.skip_object_ram.write_enable.next = false;
+        self.skip_triangle_ram.write_enable.next = false;
+        self.mailbox_meta.write_enable.next = false;
+        self.mailbox_meta.write_data.next = 0.into();
+        for k in 0..8 {
+            self.mailbox_ids[k].read_address.next = self.walk_thread.q.val();
+            self.mailbox_ids[k].write_address.next = self.walk_thread.q.val();
+            self.mailbox_ids[k].write_data.next = self.list_rdata.val();
+            self.mailbox_ids[k].write_enable.next = false;
+        }
+
+        if (self.phase.q.val() == 0) & (!self.commands.empty.val()) {
+            if self.head_kind.val() == 1 {
+                // An init goes on to the launch as it is.
+                if !self.tests.full.val() {
+                    self.push.next = true;
+                    self.commands.read.next = true;
+                }
+            }
+            if self.head_kind.val() == 2 {
+                self.object_ram.write_enable.next = true;
+                self.mailbox_meta.write_address.next =
+                    self.commands.data_out.val().get_bits::<5>(64);
+                self.mailbox_meta.write_enable.next = true;
+                self.commands.read.next = true;
+            }
+            if self.head_kind.val() == 3 {
+                self.skip_object_ram.write_enable.next = true;
+                self.skip_triangle_ram.write_enable.next = true;
+                self.commands.read.next = true;
+            }
+            if self.head_kind.val() == 0 {
+                self.walk_thread.d.next = self.commands.data_out.val().get_bits::<5>(64);
+                self.cursor.d.next = self.commands.data_out.val().get_bits::<24>(32);
+                self.list_end.d.next = self.commands.data_out.val().get_bits::<24>(0);
+                self.commands.read.next = true;
+                self.phase.d.next = 1.into();
+            }
+        }
+        if self.phase.q.val() == 1 {
+            self.phase.d.next = 2.into();
+        }
+        if self.phase.q.val() == 2 {
+            self.object_id.d.next = self.object_ram.read_data.val();
+            self.skip_object.d.next = self.skip_object_ram.read_data.val();
+            self.skip_triangle.d.next = self.skip_triangle_ram.read_data.val();
+            self.mb_len.d.next = self.mailbox_meta.read_data.val().get_bits::<4>(0);
+            self.mb_next.d.next = self.mailbox_meta.read_data.val().get_bits::<3>(4);
+            for k in 0..8 {
+                self.ids[k].d.next = self.mailbox_ids[k].read_data.val();
+            }
+            self.phase.d.next = 3.into();
+        }
+
+        // Walk: a read while the test queue has room for every word in flight and for the
+        // list's end entry; the engine's loads of banks 1, 4 and 5 take the bus first.
+        self.take.next = (self.phase.q.val() == 3)
+            & (self.cursor.q.val() != self.list_end.q.val())
+            & ((bit_cast::<5, 4>(self.queued.q.val()) + bit_cast::<5, 4>(self.flight.q.val())) < 7)
+            & (!(self.engine_read.val()
+                & (self.engine_bank.val() != 0)
+                & (self.engine_bank.val() != 2)
+                & (self.engine_bank.val() != 3)));
+        self.list_read.next = self.take.val();
+        self.list_addr.next = self.cursor.q.val();
+        if self.take.val() {
+            self.cursor.d.next = self.cursor.q.val() + 1;
+        }
+        self.flight_line[0].d.next = self.take.val();
+        for k in 1..6 {
+            self.flight_line[k].d.next = self.flight_line[k - 1].q.val();
+        }
+        self.arrive.next = false;
+        for k in 0..6 {
+            if self.c_ml_last.val() == self.c_index[k].val() {
+                self.arrive.next = self.flight_line[k].q.val();
+            }
+        }
+        self.flight.d.next = self.flight.q.val();
+        if self.take.val() & (!self.arrive.val()) {
+            self.flight.d.next = self.flight.q.val() + 1;
+        }
+        if self.arrive.val() & (!self.take.val()) {
+            self.flight.d.next = self.flight.q.val() - 1;
+        }
+
+        // A word arrives: skip the query's own triangle, then the mailbox (hit: the first
+        // `len` ids; miss: record it first in, first out).
+        self.seen.next = false;
+        for k in 0..8 {
+            if (self.c_index[k].val() < self.mb_len.q.val())
+                & (self.ids[k].q.val() == self.list_rdata.val())
+            {
+                self.seen.next = true;
+            }
+        }
+        self.fresh.next = self.arrive.val()
+            & (!self.seen.val())
+            & (!((self.list_rdata.val() == self.skip_triangle.q.val())
+                & (self.object_id.q.val() == self.skip_object.q.val())));
+        self.next_after.next = self.mb_next.q.val() + 1;
+        self.len_after.next = self.mb_len.q.val();
+        if self.mb_len.q.val() != 8 {
+            self.len_after.next = self.mb_len.q.val() + 1;
+        }
+        if self.fresh.val() {
+            self.push.next = true;
+            self.tests.data_in.next = (bit_cast::<71, 5>(self.walk_thread.q.val()) << 64)
+                | (bit_cast::<71, 32>(self.list_rdata.val()) << 32)
+                | bit_cast::<71, 32>(self.object_id.q.val());
+            for k in 0..8 {
+                if bit_cast::<4, 3>(self.mb_next.q.val()) == self.c_index[k].val() {
+                    self.ids[k].d.next = self.list_rdata.val();
+                    self.mailbox_ids[k].write_enable.next = true;
+                }
+            }
+            self.mb_next.d.next = self.next_after.val();
+            self.mb_len.d.next = self.len_after.val();
+            self.mailbox_meta.write_enable.next = true;
+            self.mailbox_meta.write_data.next = (bit_cast::<8, 3>(self.next_after.val()) << 4)
+                | bit_cast::<8, 4>(self.len_after.val());
+        }
+        // The list is done when every word has arrived: its end entry follows its tests.
+        if (self.phase.q.val() == 3)
+            & (self.cursor.q.val() == self.list_end.q.val())
+            & (self.flight.q.val() == 0)
+            & (!self.tests.full.val())
+        {
+            self.push.next = true;
+            self.tests.data_in.next =
+                self.c_list_end.val() | (bit_cast::<71, 5>(self.walk_thread.q.val()) << 64);
+            self.phase.d.next = 0.into();
+        }
+        self.tests.write.next = self.push.val();
+        self.queued.d.next = self.queued.q.val();
+        if self.push.val() & (!self.test_take.val()) {
+            self.queued.d.next = self.queued.q.val() + 1;
+        }
+        if self.test_take.val() & (!self.push.val()) {
+            self.queued.d.next = self.queued.q.val() - 1;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hw::sim_harness::{clock_cycle, settle};
+    use crate::units::Mailbox;
+    use rand::{Rng, SeedableRng};
+    use std::collections::VecDeque;
+
+    #[derive(Clone, Copy, Debug)]
+    enum Command {
+        List(u32, u32),
+        Init(u32, u32),
+        Object(u32),
+        Skip(u32, u32),
+    }
+
+    /// What the launch must receive from one thread: `(kind, a, b)` in order, from
+    /// `units::Mailbox` and the skip rule of `model::golden`'s `test_triangles`.
+    fn model(commands: &[Command], bank1: &[u32]) -> Vec<(u64, u32, u32)> {
+        let (mut out, mut mailbox) = (Vec::new(), Mailbox::new());
+        let (mut object, mut skip) = (0, (u32::MAX, u32::MAX));
+        for c in commands {
+            match *c {
+                Command::Object(o) => (object, mailbox) = (o, Mailbox::new()),
+                Command::Skip(i, t) => skip = (i, t),
+                Command::Init(a, b) => out.push((TEST_INIT, a, b)),
+                Command::List(from, to) => {
+                    for &triangle in &bank1[from as usize..to as usize] {
+                        if (object, triangle) != skip && !mailbox.seen(triangle) {
+                            out.push((TEST_TRIANGLE, triangle, object));
+                        }
+                    }
+                    out.push((TEST_LIST_END, 0, 0));
+                }
+            }
+        }
+        out
+    }
+
+    /// rust-hdl simulation: four threads offer objects, skips, inits and lists (lists that
+    /// repeat triangles, so the mailbox hits and evicts, and some that hold the skipped
+    /// triangle), a command most clocks; the engine takes the bus in one clock of four; the
+    /// launch takes tests in random clocks, so both queues fill. Each thread's entries equal
+    /// the model's, in order.
+    #[test]
+    fn rust_hdl_simulation_matches_the_mailbox_model() {
+        let seed = 53;
+        println!("seed {seed}");
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mem_latency = 2;
+        let bank1: Vec<u32> = (0..400).map(|_| rng.gen_range(0..24)).collect();
+        let threads = 4usize;
+        let scripts: Vec<Vec<Command>> = (0..threads)
+            .map(|th| {
+                let mut s = vec![Command::Object(th as u32 + 7)];
+                if th % 2 == 1 {
+                    s.push(Command::Skip(th as u32 + 7, 5));
+                }
+                for q in 0..12 {
+                    if q == 6 {
+                        s.push(Command::Object(th as u32 + 100));
+                    }
+                    s.push(Command::Init(q, 1000 + q));
+                    for _ in 0..rng.gen_range(1..4) {
+                        let from = rng.gen_range(0..380u32);
+                        s.push(Command::List(from, from + rng.gen_range(0..16)));
+                    }
+                }
+                s
+            })
+            .collect();
+        let want: Vec<_> = scripts.iter().map(|s| model(s, &bank1)).collect();
+        assert!(
+            want.iter()
+                .flatten()
+                .filter(|e| e.0 == TEST_TRIANGLE)
+                .count()
+                > 300
+        );
+
+        let mut u = ListUnit::new(mem_latency);
+        u.connect_all();
+        let cycle = |u: &mut ListUnit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
+        let mut offers: Vec<VecDeque<Command>> = scripts
+            .iter()
+            .map(|s| s.iter().copied().collect())
+            .collect();
+        let mut got: Vec<Vec<(u64, u32, u32)>> = vec![Vec::new(); threads];
+        let mut requests: VecDeque<Option<u32>> =
+            std::iter::repeat(None).take(mem_latency as usize).collect();
+        let (mut refused, mut stolen, mut clocks) = (0, 0, 0);
+        while got.iter().zip(&want).any(|(g, w)| g.len() < w.len()) {
+            clocks += 1;
+            assert!(clocks < 20_000, "the unit stalled: {got:?}");
+            u.list_rdata.next = u64::from(
+                requests
+                    .pop_front()
+                    .unwrap()
+                    .map_or(0xdead, |a| bank1[a as usize]),
+            )
+            .into();
+            let th = rng.gen_range(0..threads);
+            let offer = rng
+                .gen_ratio(3, 4)
+                .then(|| offers[th].front().copied())
+                .flatten();
+            u.enqueue.next = offer.is_some();
+            if let Some(c) = offer {
+                let (kind, a, b) = match c {
+                    Command::List(a, b) => (CMD_LIST, a, b),
+                    Command::Init(a, b) => (CMD_INIT, a, b),
+                    Command::Object(a) => (CMD_OBJECT, a, 0),
+                    Command::Skip(a, b) => (CMD_SKIP, a, b),
+                };
+                u.kind.next = kind.into();
+                u.thread.next = (th as u64).into();
+                u.word_a.next = u64::from(a).into();
+                u.word_b.next = u64::from(b).into();
+            }
+            let steal = rng
+                .gen_ratio(1, 4)
+                .then(|| [0, 1, 2, 4, 5][rng.gen_range(0..5)]);
+            u.engine_read.next = steal.is_some();
+            u.engine_bank.next = steal.unwrap_or(0u64).into();
+            u.test_take.next = false;
+            settle(&mut u);
+            let take = u.test_valid.val() && rng.gen_ratio(1, 2);
+            u.test_take.next = take;
+            settle(&mut u);
+            if take {
+                let e = u.test_entry.val();
+                let th = e.get_bits::<5>(64).to_u64() as usize;
+                got[th].push((
+                    e.get_bits::<2>(69).to_u64(),
+                    e.get_bits::<32>(32).to_u64() as u32,
+                    e.get_bits::<32>(0).to_u64() as u32,
+                ));
+            }
+            if let Some(bank) = steal {
+                if [1, 4, 5].contains(&bank) {
+                    stolen += 1;
+                    assert!(!u.list_read.val(), "the list read took the engine's bus");
+                }
+            }
+            requests.push_back(u.list_read.val().then(|| u.list_addr.val().to_u64() as u32));
+            if offer.is_some() {
+                if u.full.val() {
+                    refused += 1;
+                } else {
+                    offers[th].pop_front();
+                }
+            }
+            cycle(&mut u);
+        }
+        assert!(refused > 0, "the command queue never filled");
+        assert!(stolen > 0);
+        for th in 0..threads {
+            assert_eq!(got[th], want[th], "thread {th}");
+        }
+    }
+}
