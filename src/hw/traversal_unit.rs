@@ -44,6 +44,11 @@ use crate::fp::Format;
 /// Entries of each thread's kd stack (the deepest object tree the unit walks).
 pub const STACK_LEVELS: usize = 64;
 
+/// Clocks the fetch spends on one inner node (the unit's throughput bound).
+pub const fn fetch_clocks_per_node(mem_latency: u32) -> u32 {
+    mem_latency + 4
+}
+
 /// Engine queue entry: `{next[69], thread[68:64], a[63:32], b[31:0]}`.
 type Entry = Bits<70>;
 /// Step job: `{finish[101], thread[100:96], sp[95:90], node[89:64], lo[63:32], hi[31:0]}`

@@ -45,6 +45,12 @@ use crate::fp::Format;
 
 /// Commands the engine-side queue holds (the [`ListUnit`]'s).
 pub const TESTER_QUEUE: usize = 16;
+
+/// Clocks between two tests when the engine leaves banks 2 and 3 alone (the tester's
+/// throughput bound).
+pub const fn clocks_per_test(mem_latency: u32) -> u32 {
+    11 + mem_latency
+}
 // `update` spells out its numbers (rust-hdl's Verilog cannot name Rust constants): a
 // triangle is 8 words of bank 2 (the u and v rows) and 4 of bank 3 (the t row); the phases of
 // the fetch and launch state machine are 0 idle, 1 fetch, 2 launch the origin, 3 launch the

@@ -272,24 +272,7 @@ impl Asm {
                     .iter()
                     .flatten()
                     .any(|&p| (k + 1..=len).contains(&(p as usize)));
-                use Op::*;
-                let retargetable = matches!(
-                    s.code[k].op,
-                    FAdd | FSub
-                        | FMul
-                        | FDiv
-                        | FSqrt
-                        | IToF
-                        | Add
-                        | Sub
-                        | And
-                        | Or
-                        | Xor
-                        | Shr
-                        | Shl
-                        | Ld
-                        | Lds
-                );
+                let retargetable = s.code[k].op.computes();
                 if retargetable
                     && plain(&s.code[k])
                     && !labelled
@@ -588,5 +571,52 @@ mod tests {
         assert_eq!((code[1].op, code[1].target), (Op::Jal, 0));
         assert!(!code[2].jumps_after() && !code[2].invert && code[2].target == 4);
         assert!(!code[4].jumps_after());
+    }
+
+    #[test]
+    fn assign_writes_the_destination_directly_only_when_that_is_the_same_program() {
+        let f = Format::E7M16;
+        // Straight code: the add writes `d` itself, no move.
+        let a = Asm::new(f);
+        let [x, d] = a.regs::<2>();
+        let t = a.add(x.into(), Val::K(f.one()));
+        a.assign(d, t);
+        let code = a.finish().code;
+        assert_eq!(code.len(), 1);
+        assert_eq!((code[0].op, code[0].dst), (Op::FAdd, d.0));
+
+        // `d` read between the add and the assignment: the add must not overwrite it early.
+        let a = Asm::new(f);
+        let [x, d, e] = a.regs::<3>();
+        let t = a.add(x.into(), Val::K(f.one()));
+        a.mov(e, d.into());
+        a.assign(d, t);
+        let code = a.finish().code;
+        assert_eq!(code.len(), 3);
+        assert_ne!(code[0].dst, d.0);
+        assert_eq!((code[2].op, code[2].dst), (Op::Or, d.0));
+
+        // A label between them (another path reaches the assignment): a move.
+        let a = Asm::new(f);
+        let [x, d] = a.regs::<2>();
+        let t = a.add(x.into(), Val::K(f.one()));
+        let join = a.here();
+        a.assign(d, t);
+        a.jump(join);
+        let code = a.finish().code;
+        assert_eq!(code[1].op, Op::Or, "{}", code[1]);
+        assert_ne!(code[0].dst, d.0);
+
+        // A branch between them: a move.
+        let a = Asm::new(f);
+        let [x, d] = a.regs::<2>();
+        let out = a.label();
+        let t = a.add(x.into(), Val::K(f.one()));
+        a.branch(Op::Beq, x.into(), Val::K(0), false, out);
+        a.assign(d, t);
+        a.bind(out);
+        a.halt();
+        let code = a.finish().code;
+        assert_eq!((code[2].op, code[2].dst), (Op::Or, d.0));
     }
 }

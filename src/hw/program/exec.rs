@@ -120,8 +120,11 @@ pub struct RunStats {
     /// Instructions executed per routine of the program (`Program::sections`).
     pub per_section: std::collections::BTreeMap<&'static str, u64>,
     pub instructions: u64,
-    /// Rotations of the thread slots until the last thread halted.
+    /// Rounds of the threads (each issuing once) until the last thread halted.
     pub rounds: u64,
+    /// The coprocessors' work: triangles tested, kd nodes fetched by the traversal unit.
+    pub triangle_tests: u64,
+    pub kd_nodes: u64,
 }
 
 /// A frame rendered by the engine's twin.
@@ -344,6 +347,7 @@ impl<'a> Machine<'a> {
                                     "triangle {triangle} beyond the {words} triangles in memory"
                                 )));
                             }
+                            stats.triangle_tests += 1;
                             let m = self.layout.triangle_transform(triangle);
                             let r = units::triangle_test(f, &m, tt.o, tt.d, tt.t_min);
                             if units::closer_hit(f, &r, tt.best_t) {
@@ -367,7 +371,11 @@ impl<'a> Machine<'a> {
                     .ok_or_else(|| fail(format!("no traversal unit function {}", i.imm)))?;
                 let (tt, walk) = (&t.tester, &mut t.walk);
                 let ray = (tt.o, tt.d);
-                let fetch = |n| self.kd_node(n);
+                let nodes = std::cell::Cell::new(0u64);
+                let fetch = |n| {
+                    nodes.set(nodes.get() + 1);
+                    self.kd_node(n)
+                };
                 let stop = match function {
                     KdFn::Start => {
                         let (w, stop) =
@@ -383,6 +391,7 @@ impl<'a> Machine<'a> {
                     ),
                     _ => None,
                 };
+                stats.kd_nodes += nodes.get();
                 match stop {
                     Some(units::KdStop::Leaf { list, count }) => {
                         walk.result = list;

@@ -251,6 +251,11 @@ impl Op {
                 | Kd
         )
     }
+    /// Whether the instruction writes `dst` with a value computed from its operands alone
+    /// (arithmetic and loads; not a link, a pixel or a coprocessor's answer).
+    pub fn computes(self) -> bool {
+        self.writes() && !matches!(self, Op::Jal | Op::Pixel | Op::Tri | Op::Kd)
+    }
     /// Whether an instruction of this op can carry a jump to `target` after it (`invert`).
     pub fn can_jump_after(self) -> bool {
         !self.branches() && !matches!(self, Op::Jr | Op::Halt)

@@ -243,6 +243,11 @@ pub fn build_program(config: &ProgramConfig) -> Program {
 }
 
 impl Gen<'_> {
+    /// Whether the scene traces rays other than the primary ones (shadow or mirror rays).
+    pub fn secondary_rays(&self) -> bool {
+        self.c.shadows || self.c.reflection_depth > 0
+    }
+
     /// A frame word (bank 5) at a fixed address.
     pub fn frame_word(&self, addr: u32) -> asm::Val {
         self.asm.load(crate::layout::FRAME, asm::Val::K(0), 0, addr)

@@ -37,9 +37,31 @@ impl Gen<'_> {
         let c = self.c;
         a.section("init");
         let load = |addr: usize| a.keep(self.frame_word(addr as u32));
+        let s = &self.s;
+        let camera = std::array::from_fn(|k| load(FrameMap::CAMERA + k));
+        // Without secondary rays every query starts at the eye with t_min 0 and t_max
+        // infinity: the query registers hold them for the whole frame.
+        let eye = if self.secondary_rays() {
+            std::array::from_fn(|k| load(FrameMap::EYE + k))
+        } else {
+            for k in 0..3 {
+                a.load_to(
+                    s.q_o[k],
+                    crate::layout::FRAME,
+                    Val::K(0),
+                    0,
+                    (FrameMap::EYE + k) as u32,
+                );
+            }
+            a.mov(s.q_t_min, Val::K(0));
+            s.q_o
+        };
+        if !c.shadows {
+            a.mov(s.q_t_max, Val::K(c.format.infinity(false)));
+        }
         Constants {
-            camera: std::array::from_fn(|k| load(FrameMap::CAMERA + k)),
-            eye: std::array::from_fn(|k| load(FrameMap::EYE + k)),
+            camera,
+            eye,
             ambient: load(FrameMap::AMBIENT),
             background: std::array::from_fn(|k| load(FrameMap::BACKGROUND + k)),
             shadow_t_min: c.shadows.then(|| load(FrameMap::SHADOW_T_MIN)),
@@ -62,9 +84,11 @@ impl Gen<'_> {
             mirror_t_min,
         } = *k;
         let [pixel, x, y, depth] = a.regs::<4>();
-        let ray_o: [Reg; 3] = a.regs();
-        let ray_d: [Reg; 3] = a.regs();
-        let ray_t_min = a.reg();
+        // The ray being shaded lives in the trace query's registers (the trace routine only
+        // reads them). A shadow query overwrites them: a scene with shadows and mirrors keeps
+        // the direction apart for the reflection.
+        let (ray_o, ray_d, ray_t_min) = (s.q_o, s.q_d, s.q_t_min);
+        let secondary = self.secondary_rays();
         let color: [Reg; 3] = a.regs();
 
         let (next_pixel, frame_done, shade, fold, pack) =
@@ -75,28 +99,41 @@ impl Gen<'_> {
         a.op_to(Op::And, x, pixel.into(), Val::K(0xffff));
         a.op_to(Op::Shr, y, pixel.into(), Val::K(16));
         let dir = units::primary_direction_of(a, &camera.map(Val::R), x.into(), y.into());
-        a.mov3(ray_d, dir);
+        a.assign3(ray_d, dir);
         a.end_temps();
-        a.mov3(ray_o, eye.map(Val::R));
-        a.mov(ray_t_min, Val::K(0));
-        a.mov(s.skip_instance, Val::K(u32::MAX));
-        a.mov(s.skip_triangle, Val::K(u32::MAX));
-        a.mov(depth, Val::K(0));
+        if secondary {
+            a.mov3(ray_o, eye.map(Val::R));
+            a.mov(ray_t_min, Val::K(0));
+            a.mov(s.skip_instance, Val::K(u32::MAX));
+            a.mov(s.skip_triangle, Val::K(u32::MAX));
+        }
+        if c.reflection_depth > 0 {
+            a.mov(depth, Val::K(0));
+        }
 
         // Shade the ray (ray_o, ray_d, ray_t_min, skip) at mirror depth `depth`.
         a.bind(shade);
         a.section("shader");
-        a.mov3(s.q_o, ray_o.map(Val::R));
-        a.mov3(s.q_d, ray_d.map(Val::R));
-        a.mov(s.q_t_min, ray_t_min.into());
-        a.mov(s.q_t_max, Val::K(f.infinity(false)));
-        a.mov(s.q_any, Val::K(0));
+        if c.shadows {
+            a.mov(s.q_t_max, Val::K(f.infinity(false)));
+            a.mov(s.q_any, Val::K(0));
+        }
         a.call(s.link, trace);
         a.section("shader");
         let miss = a.label();
         a.branch(Op::Beq, s.hit.into(), Val::K(0), false, miss);
-        let hit_instance = a.keep(s.best_instance.into());
-        let hit_triangle = a.keep(s.best_triangle.into());
+        // The hit outlives the next trace only in a scene with secondary rays; a scene of one
+        // object hits instance 0.
+        let hit_instance = match (c.top_root.is_some(), secondary) {
+            (false, _) => Reg::ZERO,
+            (true, true) => a.keep(s.best_instance.into()),
+            (true, false) => s.best_instance,
+        };
+        let hit_triangle = if secondary {
+            a.keep(s.best_triangle.into())
+        } else {
+            s.best_triangle
+        };
         let p = units::ray_point(a, ray_o.map(Val::R), ray_d.map(Val::R), s.best_t.into())
             .map(|v| a.keep(v));
         a.end_temps();
@@ -116,7 +153,7 @@ impl Gen<'_> {
         a.branch(Op::BFlt, Val::K(0), along, true, facing);
         for k in 0..3 {
             let flipped = a.neg(n[k].into());
-            a.mov(n[k], flipped);
+            a.assign(n[k], flipped);
         }
         a.bind(facing);
         a.end_temps();
@@ -126,6 +163,13 @@ impl Gen<'_> {
         a.free(material);
         let acc = units::ambient(a, kd.map(Val::R), ambient.into()).map(|v| a.keep(v));
         a.end_temps();
+        let incoming: [Reg; 3] = if c.shadows && c.reflection_depth > 0 {
+            let kept = a.regs();
+            a.mov3(kept, ray_d.map(Val::R));
+            kept
+        } else {
+            ray_d
+        };
         for light in 0..c.light_count {
             a.section("light");
             let base = (FrameMap::LIGHTS + light as usize * crate::layout::LIGHT_WORDS) as u32;
@@ -153,7 +197,7 @@ impl Gen<'_> {
             let color_words: [Val; 3] =
                 std::array::from_fn(|k| self.frame_word(base + 3 + k as u32));
             let lit = units::add_light(a, acc.map(Val::R), kd.map(Val::R), color_words, cos.into());
-            a.mov3(acc, lit);
+            a.assign3(acc, lit);
             a.end_temps();
             a.free(cos);
             a.bind(skip_light);
@@ -183,8 +227,8 @@ impl Gen<'_> {
             }
             a.scratch_store(entry, self.scratch.chain + 3, mirror.into());
             a.op_to(Op::Add, depth, depth.into(), Val::K(1));
-            let r = units::reflect(a, ray_d.map(Val::R), n.map(Val::R));
-            a.mov3(ray_d, r);
+            let r = units::reflect(a, incoming.map(Val::R), n.map(Val::R));
+            a.assign3(ray_d, r);
             a.mov3(ray_o, p.map(Val::R));
             a.mov(ray_t_min, mirror_t_min.into());
             a.mov(s.skip_instance, hit_instance.into());
@@ -195,12 +239,19 @@ impl Gen<'_> {
         a.bind(local_done);
         a.mov3(color, acc.map(Val::R));
         a.jump(fold);
-        for r in
-            p.into_iter()
-                .chain(n)
-                .chain(kd)
-                .chain(acc)
-                .chain([mirror, hit_instance, hit_triangle])
+        let owned = |r: &Reg| *r != Reg::ZERO && !s.best_instance.eq(r) && !s.best_triangle.eq(r);
+        for r in p
+            .into_iter()
+            .chain(n)
+            .chain(kd)
+            .chain(acc)
+            .chain([mirror, hit_instance, hit_triangle])
+            .chain(if incoming == ray_d {
+                [Reg::ZERO; 3]
+            } else {
+                incoming
+            })
+            .filter(owned)
         {
             a.free(r);
         }
@@ -228,7 +279,7 @@ impl Gen<'_> {
                 color.map(Val::R),
                 saved[3].into(),
             );
-            a.mov3(color, mixed);
+            a.assign3(color, mixed);
             a.end_temps();
             for r in saved.into_iter().chain([entry]) {
                 a.free(r);
@@ -240,12 +291,12 @@ impl Gen<'_> {
         a.bind(pack);
         a.section("pack");
         let rgb = a.reg();
-        a.mov(rgb, Val::K(0));
         for k in 0..3 {
             let (zero, clamped) = (a.label(), a.label());
             let ch = color[k];
             a.branch(Op::BFlt, Val::K(0), ch.into(), true, zero);
-            a.branch(Op::BFlt, Val::K(f.one()), ch.into(), true, clamped);
+            // Not NaN from here: `!(1 < ch)` is `ch <= 1`.
+            a.branch(Op::BFle, ch.into(), Val::K(f.one()), false, clamped);
             a.mov(ch, Val::K(f.one()));
             a.jump(clamped);
             a.bind(zero);
@@ -253,22 +304,33 @@ impl Gen<'_> {
             a.bind(clamped);
             let word = units::channel_byte_word(a, ch.into());
             let byte = a.op(Op::And, word, Val::K(0xff));
-            let shifted = a.op(Op::Shl, byte, Val::K(16 - 8 * k as u32));
-            a.op_to(Op::Or, rgb, rgb.into(), shifted);
+            let shift = 16 - 8 * k as u32;
+            if k == 0 {
+                a.op_to(Op::Shl, rgb, byte, Val::K(shift));
+            } else {
+                let shifted = if shift == 0 {
+                    byte
+                } else {
+                    a.op(Op::Shl, byte, Val::K(shift))
+                };
+                a.op_to(Op::Or, rgb, rgb.into(), shifted);
+            }
             a.end_temps();
         }
         // y * W + x with shifts and adds (W is a constant of the scene).
-        let address = a.reg();
-        a.mov(address, x.into());
+        let mut address = Val::R(x);
         for bit in 0..32 {
             if c.width >> bit & 1 == 1 {
-                let part = a.op(Op::Shl, y.into(), Val::K(bit));
-                a.op_to(Op::Add, address, address.into(), part);
+                let part = if bit == 0 {
+                    y.into()
+                } else {
+                    a.op(Op::Shl, y.into(), Val::K(bit))
+                };
+                address = a.op(Op::Add, address, part);
             }
         }
+        a.store_frame(address, 0, c.frame_buffer, rgb);
         a.end_temps();
-        a.store_frame(address.into(), 0, c.frame_buffer, rgb);
-        a.free(address);
         a.free(rgb);
         a.jump(next_pixel);
 

@@ -51,15 +51,14 @@ struct LevelRay {
 
 impl Gen<'_> {
     /// The trace routine: closest hit (or any hit when `q_any` is 1) of the query registers;
-    /// returns through `link` with `hit`, `best_t`, `best_instance`, `best_triangle`.
+    /// returns through `link` with `hit`, `best_t`, `best_triangle` and (in a scene with a
+    /// top level) `best_instance`.
     pub(super) fn trace_routine(&self) {
         let a = self.asm;
         let s = &self.s;
         a.section("trace");
         let done = a.label();
-        a.mov(s.best_t, s.q_t_max.into());
         a.mov(s.hit, Val::K(0));
-        a.mov(s.sp, Val::K(self.scratch.stack));
         let world = LevelRay {
             o: s.q_o,
             d: s.q_d,
@@ -68,23 +67,28 @@ impl Gen<'_> {
         a.tri_queue(TriFn::Init, s.q_t_min, s.q_t_max);
         // The triangle a secondary ray starts on is never tested (primary rays skip none, so
         // a scene without secondary rays never names one).
-        if self.c.shadows || self.c.reflection_depth > 0 {
+        if self.secondary_rays() {
             a.tri_queue(TriFn::Skip, s.skip_instance, s.skip_triangle);
         }
         match self.c.top_root {
             Some(root) => {
+                // The closest hit so far bounds every instance's walk.
+                a.mov(s.best_t, s.q_t_max.into());
+                a.mov(s.sp, Val::K(self.scratch.stack));
                 self.store_ray(world);
                 a.mailbox_clear(MAILBOX_INSTANCES);
                 self.traverse(Val::K(root), world, done);
             }
             None => {
                 tester_ray(a, world.o, world.d, Reg::ZERO);
-                self.walk_object(Val::K(self.c.object_root), done);
+                self.walk_object(Val::K(self.c.object_root), s.q_t_max, done);
             }
         }
         a.bind(done);
         a.section("trace");
-        a.tri_read(TriFn::Instance, s.best_instance);
+        if self.c.top_root.is_some() {
+            a.tri_read(TriFn::Instance, s.best_instance);
+        }
         a.tri_read(TriFn::Triangle, s.best_triangle);
         a.ret(s.link);
     }
@@ -100,13 +104,18 @@ impl Gen<'_> {
 
     /// An object's kd tree, walked by the traversal unit from `root`: each leaf's triangles
     /// go to the triangle tester; an answered any-hit query jumps to `answered`.
-    fn walk_object(&self, root: Val, answered: Label) {
+    /// `t_max` bounds the walk's segment.
+    fn walk_object(&self, root: Val, t_max: Reg, answered: Label) {
         let a = self.asm;
         let s = &self.s;
         a.section("traversal");
-        let [from, list, end] = a.regs::<3>();
-        a.mov(from, root);
-        a.kd_queue(KdFn::Start, from, s.best_t);
+        let [list, end] = a.regs::<2>();
+        let from = match root {
+            Val::K(0) => Reg::ZERO,
+            Val::R(r) => r,
+            k => a.keep(k),
+        };
+        a.kd_queue(KdFn::Start, from, t_max);
         let (leaf, finished) = (a.label(), a.label());
         a.bind(leaf);
         a.section("traversal");
@@ -118,8 +127,11 @@ impl Gen<'_> {
         a.kd_queue(KdFn::Next, s.best_t, s.hit);
         a.jump(leaf);
         a.bind(finished);
-        for r in [from, list, end] {
+        for r in [list, end] {
             a.free(r);
+        }
+        if from != Reg::ZERO && Val::R(from) != root {
+            a.free(from);
         }
     }
 
@@ -240,7 +252,7 @@ impl Gen<'_> {
         a.end_temps();
         a.free(record);
         tester_ray(a, local_o, local_d, instance);
-        self.walk_object(root.into(), answered);
+        self.walk_object(root.into(), s.best_t, answered);
         for r in local_o.into_iter().chain(local_d).chain([root]) {
             a.free(r);
         }
