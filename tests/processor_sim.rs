@@ -77,13 +77,12 @@ frames_equal_the_golden_model! {
     verilator_dynamic: Verilator "dynamic.toml" 12 x 9, frames Some(2);
     verilator_terrain_small: Verilator "terrain_small.toml" 16 x 12, frames None;
     verilator_cornell_noshadow: Verilator "cornell_noshadow.toml" 16 x 12, frames None;
-    // Icarus simulates about 400 clocks per second here (Verilator about 0.6M): one pixel per
-    // thread (a frame of up to 32 pixels lasts about as long as its slowest pixel times the
-    // 32-clock rotation).
-    icarus_cornell: Icarus "cornell.toml" 8 x 4, frames None;
-    icarus_mirror: Icarus "mirror.toml" 8 x 4, frames None;
-    icarus_tiny_animated: Icarus "tiny_animated.toml" 8 x 4, frames Some(2);
-    icarus_terrain_small: Icarus "terrain_small.toml" 8 x 4, frames None;
+    // Icarus simulates 150-400 clocks per second here (Verilator about 0.4M): 16 pixels, one
+    // per thread (such a frame lasts about as long as its slowest ray: 11k-35k clocks).
+    icarus_cornell: Icarus "cornell.toml" 4 x 4, frames None;
+    icarus_mirror: Icarus "mirror.toml" 4 x 4, frames None;
+    icarus_tiny_animated: Icarus "tiny_animated.toml" 4 x 4, frames Some(2);
+    icarus_terrain_small: Icarus "terrain_small.toml" 4 x 4, frames None;
 }
 
 #[test]
