@@ -26,8 +26,9 @@
 //!   unit or triangle tester.
 //!
 //! Throughput: one instruction per clock while at least `L + 4` threads are awake; a frame
-//! ends when every thread has executed `halt` (`done`). Counters: clocks of the frame, instructions retired,
-//! and clocks in which the triangle tester's TransformUnit and IntersectUnit took an input.
+//! ends when every thread has executed `halt` (`done`). Counters: clocks of the frame,
+//! instructions retired, and clocks in which the triangle tester's TransformUnit and
+//! IntersectUnit took an input.
 //! `instructions` counts retired instructions: not the turns a thread spends offering an entry
 //! again to a full coprocessor queue or waiting for a coprocessor, so it equals the count of
 //! the engine's twin, which never waits.

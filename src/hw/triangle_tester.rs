@@ -24,11 +24,12 @@
 //! Entries are done in queue order, so a thread's closest hit is chosen in its list order
 //! (the first of equal ts stays), as in the golden model.
 //!
-//! State machine per entry: take it from the list unit's test queue (1 clock), fetch the triangle's 8
-//! words of bank 2 and 4 of bank 3 (8 clocks when the engine leaves the banks alone, plus the
-//! SRAM latency; an init or a list end fetches nothing), launch the origin and then the direction into the
-//! TransformUnit (2 clocks). Throughput: one test per `11 + mem_latency` clocks, one init or list end per
-//! 4; entries leave the launch at least 4 clocks apart, which the hit merge needs (it reads,
+//! State machine per entry: take it from the list unit's test queue (1 clock), fetch the
+//! triangle's 8 words of bank 2 and 4 of bank 3 (8 clocks when the engine leaves the banks
+//! alone, plus the SRAM latency; an init or a list end fetches nothing), launch the origin and
+//! then the direction into the TransformUnit (2 clocks). Throughput: one test per
+//! `clocks_per_test(mem_latency) = 11 + mem_latency` clocks, one init or list end per 4;
+//! entries leave the launch at least 4 clocks apart, which the hit merge needs (it reads,
 //! compares and writes a thread's best hit in 4 clocks). The engine's own loads of banks 2
 //! and 3 (shading data) take the bank in their clock; the fetch waits for it.
 //!
@@ -776,7 +777,8 @@ mod tests {
             u.t_rdata.next = u64::from(t.map_or(0xdead, |a| bank3[a as usize])).into();
             u.list_rdata.next = u64::from(list.map_or(0xdead, |a| bank1[a as usize])).into();
             // Round robin over the threads with something to offer (like the engine's turns);
-            // a thread never offers in two clocks in a row (as in the engine: a thread issues once per write back).
+            // a thread never offers in two clocks in a row (as in the engine: a thread issues
+            // once per write back).
             let th = queried.filter(|&t| !offers[t].is_empty());
             let start = th.map_or(0, |t| t + 1);
             queried = (0..threads)

@@ -401,8 +401,8 @@ impl Asm {
         self.coprocessor(Op::Tri, f as u32, Reg::ZERO, a, b);
     }
 
-    /// Queues `f` (`Init`, `List`, `Object` or `Skip`) with operands `a`, `b` (the engine offers it again on the
-    /// thread's next turns while the queue is full).
+    /// Queues `f` (`Init`, `List`, `Object` or `Skip`) with operands `a`, `b` (the engine
+    /// offers it again on the thread's next turns while the queue is full).
     pub fn tri_queue(&self, f: TriFn, a: Reg, b: Reg) {
         debug_assert!(f.queues());
         self.coprocessor(Op::Tri, f as u32, Reg::ZERO, a, b);

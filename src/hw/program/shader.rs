@@ -11,7 +11,8 @@
 //! `units::mix_mirror`. Each channel is clamped, scaled and rounded to a byte
 //! (`units::channel_byte_word`), packed, and written to the frame buffer at `y * W + x`.
 //!
-//! Cost: about 45 instructions per pixel plus 30 per hit, 20 per light and the traces.
+//! Cost: about 45 instructions per pixel plus 40 per hit, 30 per light and the traces
+//! (`cornell_noshadow`: 141 per primary ray, the walk included).
 
 use super::asm::{Reg, Val};
 use super::isa::Op;
