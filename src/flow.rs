@@ -101,7 +101,7 @@ fn prepare(
         layouts,
         program,
         twin,
-        period: engine_period(params.threads, f.man_bits),
+        period: engine_period(params.threads),
     })
 }
 

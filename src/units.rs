@@ -465,6 +465,26 @@ pub fn channel_byte_word<A: Arith>(a: A, clamped: A::V) -> A::V {
     a.add(scaled, a.word(f.from_int(1i64 << f.man_bits)))
 }
 
+/// Shader: a colour channel clamped to [0, 1] (NaN, negatives, zeros and subnormals give
+/// +0, everything above 1 gives 1), on the bits alone: for positive non-NaN words the unsigned
+/// order of the encodings is the order of the values, so the hardware needs no comparator
+/// (`Format::to_u8`'s clamp, exhaustively tested).
+pub fn clamp_unit_word(f: Format, w: u32) -> u32 {
+    if f.sign_of(w) || f.is_zero(w) || f.is_nan(w) {
+        0
+    } else if w > f.one() {
+        f.one()
+    } else {
+        w
+    }
+}
+
+/// Shader: the byte of a colour channel, `Format::to_u8` as the hardware computes it (the
+/// engine's `byte` instruction): [`clamp_unit_word`], then [`channel_byte_word`]'s low 8 bits.
+pub fn channel_byte(f: Format, w: u32) -> u32 {
+    channel_byte_word(f, clamp_unit_word(f, w)) & 0xff
+}
+
 /// The frame-buffer word `0x00RRGGBB` of a colour.
 pub fn pack_rgb(f: Format, c: Vec3W) -> u32 {
     let [r, g, b] = c.map(|x| u32::from(f.to_u8(x)));
@@ -476,17 +496,36 @@ mod byte_tests {
     use super::*;
 
     #[test]
-    fn channel_byte_word_equals_to_u8_on_every_clamped_word() {
-        for f in [Format::E7M16, Format::E5M10, Format::E8M23] {
-            let one = f.one();
-            // Every non-negative word up to 1.0 (the clamp's range), in order.
-            for w in 0..=one {
-                if f.is_nan(w) {
-                    continue;
-                }
-                let byte = channel_byte_word(f, w) & 0xff;
-                assert_eq!(byte, u32::from(f.to_u8(w)), "{f} word {w:#x}");
+    fn channel_byte_equals_to_u8_on_every_word() {
+        // Every word of the 16- and 24-bit formats; binary32 on a seeded sample and its edges.
+        for f in [Format::E5M10, Format::E7M16] {
+            for w in 0..1u32 << f.width() {
+                assert_eq!(channel_byte(f, w), u32::from(f.to_u8(w)), "{f} word {w:#x}");
             }
+        }
+        let f = Format::E8M23;
+        let seed = 41;
+        println!("seed {seed}");
+        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(seed);
+        let edges = [
+            0,
+            f.one(),
+            f.one() + 1,
+            f.one() - 1,
+            f.infinity(false),
+            f.nan(),
+        ];
+        // Half the sample in [0, 1], where every byte is made.
+        let sample = (0..1_000_000).map(|k| match k % 2 {
+            0 => rand::Rng::gen_range(&mut rng, 0..=f.one()),
+            _ => rand::Rng::gen::<u32>(&mut rng),
+        });
+        for w in edges
+            .into_iter()
+            .flat_map(|w| [w, w | f.sign_mask()])
+            .chain(sample)
+        {
+            assert_eq!(channel_byte(f, w), u32::from(f.to_u8(w)), "{f} word {w:#x}");
         }
     }
 }

@@ -148,17 +148,14 @@ fn golden_closest_hits_equal_brute_force_over_every_triangle() {
                     } else {
                         (eye, d)
                     };
-                    for tri in 0..l.info.triangle_count as usize {
-                        let obj = l.word(
-                            layout::INSTANCES,
-                            (base + layout::instance_word::OBJECT) as u32,
-                        ) as usize;
-                        let first = l.info.object_first_triangle[obj] as usize;
-                        let count = scene.objects[obj].triangles.len();
-                        if tri < first
-                            || tri >= first + count
-                            || trees.dropped[obj].contains(&((tri - first) as u32))
-                        {
+                    let obj = l.word(
+                        layout::INSTANCES,
+                        (base + layout::instance_word::OBJECT) as u32,
+                    ) as usize;
+                    let first = l.info.object_first_triangle[obj] as usize;
+                    let count = scene.objects[obj].triangles.len();
+                    for tri in first..first + count {
+                        if trees.dropped[obj].contains(&((tri - first) as u32)) {
                             continue;
                         }
                         let m = l.triangle_transform(tri as u32);

@@ -539,13 +539,18 @@ mod tests {
         }
     }
 
-    /// Every operator of e7m16 and e8m23 synthesizes for Virtex-II; the significand products
-    /// map to one MULT18X18 (17x17) and four (24x24). Prints the resource counts.
+    /// Every operator of e7m16 synthesizes for Virtex-II; the significand products map to
+    /// one MULT18X18 (17x17) and, for e8m23's multiplier, four (24x24). Prints the resource
+    /// counts (`make synth` and `dynrt bench fp` cover every operator of every format).
     #[test]
     fn yosys_xc2v_synthesis() {
         let dir = tempfile::tempdir().unwrap();
-        for fmt in [Format::E7M16, Format::E8M23] {
-            for op in [BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Sqrt, BinOp::Lt] {
+        let all = [BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Sqrt, BinOp::Lt];
+        for (fmt, ops) in [
+            (Format::E7M16, &all[..]),
+            (Format::E8M23, &[BinOp::Mul][..]),
+        ] {
+            for &op in ops {
                 let unit = fp_unit_rtl(op, fmt).unwrap();
                 let path = write_unit(dir.path(), &unit);
                 let work = dir.path().join(format!("synth_{}", unit.top));

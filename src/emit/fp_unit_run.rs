@@ -271,12 +271,13 @@ mod tests {
         check_all_ops(Format::E8M23, 100_000, 23, Simulator::Verilator);
     }
 
-    /// Every other supported format, 5k random vectors plus the edge cases, in both.
+    /// Every other supported format, 5k random vectors plus the edge cases in Verilator, the
+    /// first 1k of them plus the edge cases in Icarus.
     #[test]
     fn bit_exact_other_formats_icarus() {
         for fmt in supported_formats() {
             if fmt != Format::E7M16 && fmt != Format::E8M23 {
-                check_all_ops(fmt, 5000, 1000 + fmt.width() as u64, Simulator::Icarus);
+                check_all_ops(fmt, 1000, 1000 + fmt.width() as u64, Simulator::Icarus);
             }
         }
     }

@@ -305,9 +305,11 @@ fn transform_case(f: Format, n_random: usize, seed: u64, sim: Simulator) {
 }
 
 /// Icarus and Verilator simulate the same Verilog: Verilator carries the 100k random cases,
-/// Icarus a quarter of them plus every hard case, to show that the result does not depend on
-/// the simulator at a quarter of its CI time.
-const ICARUS_CASES: usize = 25_000;
+/// Icarus the first 4,000 of them plus every hard case, to show that the result does not
+/// depend on the simulator at a small share of its CI time (Icarus runs about 300 cases/s).
+const ICARUS_CASES: usize = 4_000;
+/// The same for binary32 (Verilator: 100k).
+const ICARUS_CASES_E8M23: usize = 2_000;
 
 #[test]
 fn transform_e7m16_icarus() {
@@ -321,7 +323,7 @@ fn transform_e7m16_verilator() {
 
 #[test]
 fn transform_e8m23_icarus() {
-    transform_case(Format::E8M23, 10_000, 4002, Simulator::Icarus);
+    transform_case(Format::E8M23, ICARUS_CASES_E8M23, 4002, Simulator::Icarus);
 }
 
 #[test]
@@ -616,7 +618,7 @@ fn intersect_e7m16_verilator() {
 
 #[test]
 fn intersect_e8m23_icarus() {
-    intersect_case(Format::E8M23, 10_000, 4202, Simulator::Icarus);
+    intersect_case(Format::E8M23, ICARUS_CASES_E8M23, 4202, Simulator::Icarus);
 }
 
 #[test]
@@ -718,7 +720,7 @@ fn raygen_case(f: Format, sizes: &[(u16, u16)], seed: u64, sim: Simulator) {
 fn raygen_e7m16_icarus() {
     raygen_case(
         Format::E7M16,
-        &[(16, 12), (160, 120), (3, 1), (1, 5)],
+        &[(16, 12), (40, 30), (3, 1), (1, 5)],
         4301,
         Simulator::Icarus,
     );

@@ -35,9 +35,9 @@ use crate::layout::BANK_NAMES;
 /// The name of the processor's top module.
 pub const PROCESSOR_TOP: &str = "dynrt_processor";
 
-/// Dispatches to `func::<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF, DL>(args)` for the engine's
-/// delay lines (write back `L = M + 6` clocks after the operands: DA = L - 7, DM = L - 4,
-/// DD = L - (M + 5), DC = L - 2, DF = L - 8).
+/// Dispatches to `func::<W, E, M, S, S1, X2, T, P, DX, DL>(args)` for the engine: `DX =
+/// long_latency - ENGINE_LATENCY = M - 5` (the long line of `fdiv` and `fsqrt`) and `DL =
+/// div_latency = M + 5` (the IntersectUnit's divider).
 #[macro_export]
 macro_rules! dispatch_engine_format {
     (@arms $fmt:expr, $func:ident, $args:tt ; $(($e:literal, $m:literal))*) => {{
@@ -46,8 +46,7 @@ macro_rules! dispatch_engine_format {
             $(
                 ($e, $m) => Ok($func::<
                     { 1 + $e + $m }, $e, $m, { $m + 1 }, { $m + 2 }, { $e + 2 }, { $m + 5 },
-                    { 2 * ($m + 1) }, { $m - 1 }, { $m + 2 }, 1, { $m + 4 }, { $m - 2 },
-                    { $m + 5 },
+                    { 2 * ($m + 1) }, { $m - 5 }, { $m + 5 },
                 >$args),
             )*
             _ => Err($crate::hw::fp::UnsupportedFormat(format)),
@@ -68,22 +67,15 @@ fn engine_verilog<
     const X2: usize,
     const T: usize,
     const P: usize,
-    const DA: usize,
-    const DM: usize,
-    const DD: usize,
-    const DC: usize,
-    const DF: usize,
+    const DX: usize,
     const DL: usize,
 >(
     program: &Program,
     threads: u32,
     mem_latency: u32,
 ) -> String {
-    let mut uut = ThreadEngine::<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF, DL>::new(
-        program,
-        threads,
-        mem_latency,
-    );
+    let mut uut =
+        ThreadEngine::<W, E, M, S, S1, X2, T, P, DX, DL>::new(program, threads, mem_latency);
     uut.connect_all();
     generate_verilog(&uut)
 }

@@ -1,14 +1,17 @@
 //! `ThreadEngine`: the ray thread engine that runs the microprogram (`hw::program`) for up to
 //! 32 ray threads, one instruction per clock, on pipelined floating-point units.
 //!
-//! A scheduler issues one ready thread per clock, round robin. Every instruction writes back
-//! exactly `L = M + 6` clocks after its operands are read, whatever unit it uses, and a thread
-//! is ready again only at its write back, so there is no hazard, stall or forwarding logic:
-//! memory and unit latency are hidden by the other threads (the paper's 32 threads). A thread
-//! issues at most once per `period = L + 4` clocks (`engine_period`). A thread whose
-//! coprocessor wait (`tri.wait`, `kd.wait`) is still pending sleeps: it is not ready until the
-//! coprocessor finishes work for it, so the clocks it waits go to the other threads (an offer
-//! to a full queue repeats at once).
+//! A scheduler issues one ready thread per clock, round robin. An instruction writes back
+//! exactly [`ENGINE_LATENCY`] (11) clocks after its operands are read, `fdiv` and `fsqrt`
+//! [`long_latency`] (`M + 6`) clocks after, and a thread is ready again only at its write
+//! back, so there is no hazard, stall or forwarding logic: memory and unit latency are hidden
+//! by the other threads (the paper's 32 threads). A long instruction reserves its write-back
+//! clock: the scheduler issues nothing in the one clock whose instruction would write back
+//! with it (one bubble per `fdiv` or `fsqrt`). A thread issues at most once per `period =
+//! ENGINE_LATENCY + 4` clocks (`engine_period`). A thread whose coprocessor wait (`tri.wait`,
+//! `kd.wait`) is still pending sleeps: it is not ready until the coprocessor finishes work for
+//! it, so the clocks it waits go to the other threads (an offer to a full queue repeats at
+//! once).
 //!
 //! Pipeline (clock offsets from the issue):
 //! - I0: read the thread's `{epoch, halted, pc}` (a stale epoch means "new frame": pc 0).
@@ -20,12 +23,13 @@
 //!   offer `tri` and `kd` entries to the coprocessors (their answer, refused or pending,
 //!   makes the thread repeat the instruction on its next turn, after a sleep for a wait).
 //! - I4..: the fast result line; scratch data joins at I4, memory data at I4 + `mem_latency`.
-//! - I3 + L: write back the register and the next pc: `target` when the condition differs
+//! - I3 + 11 (`I3 + M + 6` for `fdiv`, `fsqrt`, which go on in the long line): write back
+//!   the register and the next pc: `target` when the condition differs
 //!   from `invert` (a non-branching instruction's condition is false, so its `invert` is a jump
 //!   after it), else `pc + 1`; the condition comes from the compare, integer, mailbox, pixel
 //!   unit or triangle tester.
 //!
-//! Throughput: one instruction per clock while at least `L + 4` threads are awake; a frame
+//! Throughput: one instruction per clock while at least 15 threads are awake; a frame
 //! ends when every thread has executed `halt` (`done`). Counters: clocks of the frame,
 //! instructions retired, and clocks in which the triangle tester's TransformUnit and
 //! IntersectUnit took an input.
@@ -50,7 +54,7 @@ use rust_hdl::prelude::*;
 use super::fp::{FpAddSub, FpCompare, FpDiv, FpMul, FpSqrt};
 use super::program::isa::Instr;
 use super::program::Program;
-use super::{Delay, TraversalUnit, TriangleTester, UIntToFloat};
+use super::{ChannelByte, Delay, TraversalUnit, TriangleTester, UIntToFloat, CHANNEL_BYTE_LATENCY};
 
 /// Most threads (the thread id is 5 bits).
 pub const MAX_THREADS: usize = 32;
@@ -59,15 +63,20 @@ pub const MAX_MEM_LATENCY: u32 = 6;
 /// Scratch words per thread the engine provides.
 pub const SCRATCH_WORDS: u32 = 128;
 
-/// Clocks from operand read to write back for mantissa width `m`.
-pub const fn engine_latency(m: u32) -> u32 {
+/// Clocks from operand read to write back of every instruction but `fdiv` and `fsqrt`: the
+/// longest of them is `byte` ([`CHANNEL_BYTE_LATENCY`]; `fadd` takes 7, loads at most 8).
+pub const ENGINE_LATENCY: u32 = CHANNEL_BYTE_LATENCY;
+
+/// Clocks from operand read to write back of `fdiv` and `fsqrt` for mantissa width `m` (the
+/// divider's and the square root's `m + 5`, plus one register).
+pub const fn long_latency(m: u32) -> u32 {
     m + 6
 }
 
-/// The clocks of one round of `threads` threads, each issuing once, in a format with `m`
-/// mantissa bits: a thread issues at most once per `engine_latency(m) + 4` clocks.
-pub fn engine_period(threads: u32, m: u32) -> u32 {
-    threads.max(engine_latency(m) + 4)
+/// The clocks of one round of `threads` threads, each issuing once: a thread issues at most
+/// once per `ENGINE_LATENCY + 4` clocks.
+pub fn engine_period(threads: u32) -> u32 {
+    threads.max(ENGINE_LATENCY + 4)
 }
 
 /// Registers of the fast result line (the `0..8` loops of `update` spell it out: rust-hdl's
@@ -84,11 +93,7 @@ pub struct ThreadEngine<
     const X2: usize,
     const T: usize,
     const P: usize,
-    const DA: usize,
-    const DM: usize,
-    const DD: usize,
-    const DC: usize,
-    const DF: usize,
+    const DX: usize,
     const DL: usize,
 > {
     pub clock: Signal<In, Clock>,
@@ -210,26 +215,43 @@ pub struct ThreadEngine<
     sqrt: FpSqrt<W, E, M, S, S1, T>,
     cmp: FpCompare<W, E, M>,
     itof: UIntToFloat<W, E, M>,
+    byte_unit: ChannelByte<W, E, M, S, S1, X2, T, P>,
     tester: TriangleTester<W, E, M, S, S1, X2, T, P, DL>,
     traversal_unit: TraversalUnit<W, E, M, S, S1, X2, T, DL>,
-    add_delay: Delay<Bits<W>, DA>,
-    mul_delay: Delay<Bits<W>, DM>,
-    div_delay: Delay<Bits<W>, DD>,
-    sqrt_delay: Delay<Bits<W>, DD>,
-    cmp_delay: Delay<Bits<3>, DC>,
+    // The delays bring each unit's result to write back at `ENGINE_LATENCY` (11) after I3:
+    // 11 - 7 for the adder, 11 - 4 for the multiplier, 11 - 2 for the comparator, 11 - 8
+    // after the fast line; the divider and square root (`m + 5`) write back one clock later
+    // at `long_latency`.
+    add_delay: Delay<Bits<W>, 4>,
+    mul_delay: Delay<Bits<W>, 7>,
+    div_delay: Delay<Bits<W>, 1>,
+    sqrt_delay: Delay<Bits<W>, 1>,
+    cmp_delay: Delay<Bits<3>, 9>,
     fast_line: [DFF<Bits<32>>; FAST_STAGES],
     fast_kind_line: [DFF<Bits<3>>; FAST_STAGES],
-    fast_delay: Delay<Bits<32>, DF>,
+    fast_delay: Delay<Bits<32>, 3>,
     /// {valid, op, dst, thread, invert} from I3 to write back.
-    ctl_delay: Delay<Bits<21>, DF>,
+    ctl_delay: Delay<Bits<21>, 3>,
     ctl_line: [DFF<Bits<21>>; FAST_STAGES],
     /// {pc + 1, target}.
-    pc_delay: Delay<Bits<24>, DF>,
+    pc_delay: Delay<Bits<24>, 3>,
     pc_line: [DFF<Bits<24>>; FAST_STAGES],
     /// {a coprocessor wait, traversal unit refused or pending, tester refused or pending,
     /// jump register (12 bits), int_eq, int_lt, mailbox hit, pixels exhausted}.
-    cond_delay: Delay<Bits<19>, DF>,
+    cond_delay: Delay<Bits<19>, 3>,
     cond_line: [DFF<Bits<19>>; FAST_STAGES],
+    /// `fdiv` and `fsqrt` go on from the others' write back for `DX = long_latency -
+    /// ENGINE_LATENCY` clocks: their control and pcs.
+    long_ctl: Delay<Bits<21>, DX>,
+    long_pc: Delay<Bits<24>, DX>,
+    short_ctl: Signal<Local, Bits<21>>,
+    long_in: Signal<Local, Bits<21>>,
+    wb_ctl: Signal<Local, Bits<21>>,
+    wb_pcs: Signal<Local, Bits<24>>,
+    /// Clocks in which the scheduler must not issue: a long instruction writes back in the
+    /// clock where that issue's instruction would (bit 0 is this clock).
+    reserved: DFF<Bits<32>>,
+    long3: Signal<Local, Bit>,
 
     // Write back.
     wb_valid: Signal<Local, Bit>,
@@ -252,6 +274,8 @@ pub struct ThreadEngine<
     c_height: Constant<Bits<16>>,
     c_mem_latency: Constant<Bits<8>>,
     c_index: [Constant<Bits<8>>; 8],
+    /// The bit of `reserved` a long instruction at I3 sets: `DX - 4`.
+    c_reserve_bit: Constant<Bits<32>>,
 }
 
 fn word_map<const N: usize, D: Synth>(
@@ -285,22 +309,20 @@ impl<
         const X2: usize,
         const T: usize,
         const P: usize,
-        const DA: usize,
-        const DM: usize,
-        const DD: usize,
-        const DC: usize,
-        const DF: usize,
+        const DX: usize,
         const DL: usize,
-    > ThreadEngine<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF, DL>
+    > ThreadEngine<W, E, M, S, S1, X2, T, P, DX, DL>
 {
     /// The engine running `program` with `threads` threads and memory read latency
     /// `mem_latency`.
     pub fn new(program: &Program, threads: u32, mem_latency: u32) -> Self {
-        let l = engine_latency(M as u32) as usize;
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
         assert!(P == 2 * S);
-        assert!(DA == l - 7 && DM == l - 4 && DD == l - (M + 5) && DC == l - 2);
-        assert!(DF == l - FAST_STAGES);
+        assert!(ENGINE_LATENCY as usize == FAST_STAGES + 3);
+        assert!(super::fp::div::div_latency(M as u32) + 1 == long_latency(M as u32));
+        assert!(super::fp::sqrt::sqrt_latency(M as u32) + 1 == long_latency(M as u32));
+        // The reservation is made at I3 for an issue `DX - 3` clocks later.
+        assert!(DX == (long_latency(M as u32) - ENGINE_LATENCY) as usize && DX >= 4);
         assert!(DL == super::fp::div::div_latency(M as u32) as usize);
         assert!((1..=MAX_THREADS as u32).contains(&threads));
         assert!((1..=MAX_MEM_LATENCY).contains(&mem_latency));
@@ -418,6 +440,7 @@ impl<
             sqrt: Default::default(),
             cmp: Default::default(),
             itof: Default::default(),
+            byte_unit: Default::default(),
             tester: TriangleTester::new(mem_latency),
             traversal_unit: TraversalUnit::new(mem_latency),
             add_delay: Default::default(),
@@ -434,6 +457,14 @@ impl<
             pc_line: Default::default(),
             cond_delay: Default::default(),
             cond_line: Default::default(),
+            long_ctl: Default::default(),
+            long_pc: Default::default(),
+            short_ctl: Default::default(),
+            long_in: Default::default(),
+            wb_ctl: Default::default(),
+            wb_pcs: Default::default(),
+            reserved: Default::default(),
+            long3: Default::default(),
             wb_valid: Default::default(),
             wb_op: Default::default(),
             wb_dst: Default::default(),
@@ -452,6 +483,7 @@ impl<
             c_height: Constant::new(u64::from(program.config.height).into()),
             c_mem_latency: Constant::new(u64::from(mem_latency).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
+            c_reserve_bit: Constant::new(((DX - 4) as u64).into()),
         }
     }
 }
@@ -465,13 +497,9 @@ impl<
         const X2: usize,
         const T: usize,
         const P: usize,
-        const DA: usize,
-        const DM: usize,
-        const DD: usize,
-        const DC: usize,
-        const DF: usize,
+        const DX: usize,
         const DL: usize,
-    > Logic for ThreadEngine<W, E, M, S, S1, X2, T, P, DA, DM, DD, DC, DF, DL>
+    > Logic for ThreadEngine<W, E, M, S, S1, X2, T, P, DX, DL>
 {
     #[hdl_gen]
     fn update(&mut self) {
@@ -508,7 +536,8 @@ impl<
             mem_addr_r,
             fb_write_r,
             fb_addr_r,
-            fb_data_r
+            fb_data_r,
+            reserved
         );
         clock!(
             self,
@@ -518,6 +547,7 @@ impl<
             div,
             sqrt,
             cmp,
+            byte_unit,
             add_delay,
             mul_delay,
             div_delay,
@@ -527,6 +557,8 @@ impl<
             ctl_delay,
             pc_delay,
             cond_delay,
+            long_ctl,
+            long_pc,
             tester,
             traversal_unit
         );
@@ -603,7 +635,8 @@ impl<
                 self.pick.next = self.c_thread_ids[k].val();
             }
         }
-        self.issue.next = self.running.q.val() & (self.ready.q.val() != 0);
+        self.issue.next =
+            self.running.q.val() & (self.ready.q.val() != 0) & (!self.reserved.q.val().get_bit(0));
         self.issue_mask.next = 0.into();
         if self.issue.val() {
             self.issue_mask.next = self.c_one.val() << self.pick.val();
@@ -680,6 +713,13 @@ impl<
         self.cmp.b.next = self.opb.val().get_bits::<W>(0);
         self.cmp.in_valid.next = true;
         self.itof.value.next = self.opa.val().get_bits::<16>(0);
+        self.byte_unit.word.next = self.opa.val().get_bits::<W>(0);
+        self.byte_unit.in_valid.next = true;
+        // A long instruction at I3 reserves its write-back clock: no issue `DX - 3` clocks
+        // from now, whose instruction would write back with it.
+        self.long3.next = self.v3.q.val() & ((self.op3.val() == 4) | (self.op3.val() == 5));
+        self.reserved.d.next = (self.reserved.q.val() >> 1)
+            | (bit_cast::<32, 1>(self.long3.val().into()) << self.c_reserve_bit.val());
         self.add_delay.data_in.next = self.add.result.val();
         self.mul_delay.data_in.next = self.mul.result.val();
         self.div_delay.data_in.next = self.div.result.val();
@@ -893,6 +933,9 @@ impl<
         if self.op3.val() == 23 {
             self.fast.next = bit_cast::<32, 12>(self.pc3.q.val() + 1);
         }
+        if self.op3.val() == 31 {
+            self.fast.next = self.opb.val() << 8;
+        }
         if self.op3.val() == 27 {
             self.fast.next =
                 (bit_cast::<32, 16>(self.py.q.val()) << 16) | bit_cast::<32, 16>(self.px.q.val());
@@ -969,12 +1012,29 @@ impl<
         self.pc_delay.data_in.next = self.pc_line[7].q.val();
         self.cond_delay.data_in.next = self.cond_line[7].q.val();
 
-        // Write back.
-        self.wb_valid.next = self.ctl_delay.data_out.val().get_bit(20);
-        self.wb_op.next = self.ctl_delay.data_out.val().get_bits::<5>(15);
-        self.wb_dst.next = self.ctl_delay.data_out.val().get_bits::<8>(7);
-        self.wb_thread.next = self.ctl_delay.data_out.val().get_bits::<5>(2);
-        self.wb_invert.next = self.ctl_delay.data_out.val().get_bit(0);
+        // Write back: `fdiv` and `fsqrt` go on into the long line and write back from there
+        // (the reservation keeps this clock's other write back empty).
+        self.short_ctl.next = self.ctl_delay.data_out.val();
+        self.long_in.next = 0.into();
+        if (self.ctl_delay.data_out.val().get_bits::<5>(15) == 4)
+            | (self.ctl_delay.data_out.val().get_bits::<5>(15) == 5)
+        {
+            self.short_ctl.next = 0.into();
+            self.long_in.next = self.ctl_delay.data_out.val();
+        }
+        self.long_ctl.data_in.next = self.long_in.val();
+        self.long_pc.data_in.next = self.pc_delay.data_out.val();
+        self.wb_ctl.next = self.short_ctl.val();
+        self.wb_pcs.next = self.pc_delay.data_out.val();
+        if self.long_ctl.data_out.val().get_bit(20) {
+            self.wb_ctl.next = self.long_ctl.data_out.val();
+            self.wb_pcs.next = self.long_pc.data_out.val();
+        }
+        self.wb_valid.next = self.wb_ctl.val().get_bit(20);
+        self.wb_op.next = self.wb_ctl.val().get_bits::<5>(15);
+        self.wb_dst.next = self.wb_ctl.val().get_bits::<8>(7);
+        self.wb_thread.next = self.wb_ctl.val().get_bits::<5>(2);
+        self.wb_invert.next = self.wb_ctl.val().get_bit(0);
         self.wb_cond.next = false;
         if self.wb_op.val() == 18 {
             self.wb_cond.next = self.cmp_delay.data_out.val().get_bit(2);
@@ -1007,9 +1067,9 @@ impl<
             self.wb_cond.next = self.cond_delay.data_out.val().get_bit(17);
         }
         if self.wb_cond.val() != self.wb_invert.val() {
-            self.wb_next_pc.next = self.pc_delay.data_out.val().get_bits::<12>(0);
+            self.wb_next_pc.next = self.wb_pcs.val().get_bits::<12>(0);
         } else {
-            self.wb_next_pc.next = self.pc_delay.data_out.val().get_bits::<12>(12);
+            self.wb_next_pc.next = self.wb_pcs.val().get_bits::<12>(12);
         }
         if self.wb_op.val() == 24 {
             self.wb_next_pc.next = self.cond_delay.data_out.val().get_bits::<12>(4);
@@ -1019,7 +1079,7 @@ impl<
         {
             // A halted thread keeps its pc; so does one whose coprocessor refused its entry
             // (queue full) or has not finished (a wait): it repeats on its next turn.
-            self.wb_next_pc.next = self.pc_delay.data_out.val().get_bits::<12>(12) - 1;
+            self.wb_next_pc.next = self.wb_pcs.val().get_bits::<12>(12) - 1;
         }
         self.wb_result.next = self.fast_delay.data_out.val();
         if (self.wb_op.val() == 1) | (self.wb_op.val() == 2) {
@@ -1034,15 +1094,21 @@ impl<
         if self.wb_op.val() == 5 {
             self.wb_result.next = bit_cast::<32, W>(self.sqrt_delay.data_out.val());
         }
+        if self.wb_op.val() == 31 {
+            self.wb_result.next =
+                self.fast_delay.data_out.val() | bit_cast::<32, 8>(self.byte_unit.result.val());
+        }
         // Ops that write: fp 1-6, integer 7-13, ld 14, lds 16, jal 23, pixel 27 (not when the
-        // frame's pixels are exhausted), tri 29 (its reading functions name a `dst`).
+        // frame's pixels are exhausted), tri 29 and kd 30 (their reading functions name a
+        // `dst`), byte 31.
         self.wb_writes.next = self.wb_valid.val()
             & (self.wb_dst.val() != 0)
             & ((((self.wb_op.val() >= 1) & (self.wb_op.val() <= 14)) | (self.wb_op.val() == 16))
                 | ((self.wb_op.val() == 23)
                     | ((self.wb_op.val() == 27) & (!self.cond_delay.data_out.val().get_bit(0)))
                     | (self.wb_op.val() == 29)
-                    | (self.wb_op.val() == 30)));
+                    | (self.wb_op.val() == 30)
+                    | (self.wb_op.val() == 31)));
         self.regs_a.write_address.next =
             (bit_cast::<13, 5>(self.wb_thread.val()) << 8) | bit_cast::<13, 8>(self.wb_dst.val());
         self.regs_b.write_address.next =
@@ -1112,6 +1178,7 @@ impl<
             self.ready.d.next = self.c_thread_mask.val();
             self.asleep.d.next = 0.into();
             self.woken.d.next = 0.into();
+            self.reserved.d.next = 0.into();
             self.halted_count.d.next = 0.into();
             self.cycle_count.d.next = 0.into();
             self.instr_count.d.next = 0.into();

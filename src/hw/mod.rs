@@ -10,6 +10,7 @@
 //! domain (modes [`VgaMode::VGA_640X480_60`], [`VgaMode::XGA_1024X768_60`]), and
 //! [`VgaDisplay`], which reads the frame buffer with it and drives the monitor.
 
+pub mod channel_byte;
 pub mod delay;
 pub mod display;
 pub mod engine;
@@ -28,6 +29,7 @@ pub mod traversal_unit;
 pub mod triangle_tester;
 pub mod vga;
 
+pub use channel_byte::{ChannelByte, CHANNEL_BYTE_LATENCY};
 pub use delay::Delay;
 pub use display::VgaDisplay;
 pub use int_to_float::UIntToFloat;

@@ -33,7 +33,7 @@ pub mod round_pack;
 pub mod sig_mul;
 pub mod sqrt;
 #[cfg(test)]
-mod test_harness;
+pub(crate) mod test_harness;
 
 pub use add_sub::FpAddSub;
 pub use compare::FpCompare;

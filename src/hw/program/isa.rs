@@ -4,8 +4,8 @@
 //! most one (`dst`, never `r0`, which always reads 0) and chooses the thread's next program
 //! counter (`pc + 1`, or `target` for a taken branch). A non-branching instruction with
 //! `invert` set jumps to `target` after it (the assembler folds a following `jal r0` into it,
-//! saving the jump's turn). All instructions take the same number of clocks in the engine, so
-//! the engine needs no hazard logic (see `hw::engine`).
+//! saving the jump's turn). A thread has one instruction in flight, so the engine needs no
+//! hazard logic (see `hw::engine`).
 //!
 //! Encoding (ROM word of [`INSTR_BITS`] bits, most significant first):
 //! `op[5] dst[8] a[8] b[8] b_imm[1] invert[1] shift[3] bank[3] imm[32] target[12]`.
@@ -88,6 +88,10 @@ pub enum Op {
     /// kd tree to its next leaf. `start` and `next` repeat while refused, `wait` while the walk
     /// is in flight.
     Kd,
+    /// A colour channel's byte shifted in: `dst = (B << 8) | byte(A)`, where `byte` clamps `A`
+    /// to [0, 1] and rounds 255 times it to an integer (`units::channel_byte`); three in a row
+    /// pack `0x00RRGGBB`.
+    Byte,
 }
 
 /// The functions of [`Op::Kd`] (its `imm`).
@@ -191,7 +195,7 @@ impl TriFn {
     }
 }
 
-pub const OPS: [Op; 31] = [
+pub const OPS: [Op; 32] = [
     Op::Nop,
     Op::FAdd,
     Op::FSub,
@@ -223,6 +227,7 @@ pub const OPS: [Op; 31] = [
     Op::Halt,
     Op::Tri,
     Op::Kd,
+    Op::Byte,
 ];
 
 impl Op {
@@ -249,6 +254,7 @@ impl Op {
                 | Pixel
                 | Tri
                 | Kd
+                | Byte
         )
     }
     /// Whether the instruction writes `dst` with a value computed from its operands alone
@@ -281,6 +287,7 @@ impl Op {
             Pixel => Unit::PixelCounter,
             Tri => Unit::TriangleTester,
             Kd => Unit::TraversalUnit,
+            Byte => Unit::ChannelByte,
             Nop | Add | Sub | And | Or | Xor | Shr | Shl | Beq | Bltu | Jal | Jr | Halt => {
                 Unit::Integer
             }
@@ -320,6 +327,7 @@ impl Op {
             Halt => "halt",
             Tri => "tri",
             Kd => "kd",
+            Byte => "byte",
         }
     }
 }
@@ -340,10 +348,11 @@ pub enum Unit {
     PixelCounter,
     TriangleTester,
     TraversalUnit,
+    ChannelByte,
 }
 
 impl Unit {
-    pub const ALL: [Unit; 13] = [
+    pub const ALL: [Unit; 14] = [
         Unit::FpAdd,
         Unit::FpMul,
         Unit::FpDiv,
@@ -357,6 +366,7 @@ impl Unit {
         Unit::PixelCounter,
         Unit::TriangleTester,
         Unit::TraversalUnit,
+        Unit::ChannelByte,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -373,6 +383,7 @@ impl Unit {
             Unit::PixelCounter => "pixel counter",
             Unit::TriangleTester => "triangle tester",
             Unit::TraversalUnit => "traversal unit",
+            Unit::ChannelByte => "channel byte",
         }
     }
 }

@@ -8,11 +8,12 @@
 //! term, after a shadow query when shadows are on. A mirror material within the reflection
 //! depth saves the local colour and reflectivity in the thread's mirror chain and traces the
 //! reflected ray from the hit point; at the end of the chain the colours fold back with
-//! `units::mix_mirror`. Each channel is clamped, scaled and rounded to a byte
-//! (`units::channel_byte_word`), packed, and written to the frame buffer at `y * W + x`.
+//! `units::mix_mirror`. The colour accumulates in the registers the pack reads; each channel's
+//! byte (the `byte` instruction: `units::channel_byte`) is shifted into the word written to
+//! the frame buffer at `y * W + x`. Lights' words stay in registers (up to [`KEPT_LIGHTS`]).
 //!
-//! Cost: about 45 instructions per pixel plus 40 per hit, 30 per light and the traces
-//! (`cornell_noshadow`: 141 per primary ray, the walk included).
+//! Cost: about 35 instructions per pixel plus 40 per hit, 20 per light and the traces
+//! (`cornell_noshadow`: 118 per primary ray, the walk included).
 
 use super::asm::{Reg, Val};
 use super::isa::Op;
@@ -21,8 +22,16 @@ use crate::layout::{instance_word as iw, FrameMap, FRAME, INSTANCES, TRIANGLES_T
 use crate::units;
 use crate::units::Arith;
 
+/// The frame word of light `light`'s first word (position x).
+fn light_base(light: u32) -> u32 {
+    (FrameMap::LIGHTS + light as usize * crate::layout::LIGHT_WORDS) as u32
+}
+
+/// Lights whose position and colour every thread keeps in registers (loaded once per frame);
+/// a scene with more loads them at each use.
+const KEPT_LIGHTS: u32 = 8;
+
 /// Frame constants every thread loads once, at its start.
-#[derive(Clone, Copy)]
 pub(super) struct Constants {
     camera: [Reg; 12],
     eye: [Reg; 3],
@@ -30,6 +39,8 @@ pub(super) struct Constants {
     background: [Reg; 3],
     shadow_t_min: Option<Reg>,
     mirror_t_min: Option<Reg>,
+    /// Each light's position and colour words, when the scene has at most [`KEPT_LIGHTS`].
+    lights: Option<Vec<[Reg; 6]>>,
 }
 
 impl Gen<'_> {
@@ -67,6 +78,11 @@ impl Gen<'_> {
             background: std::array::from_fn(|k| load(FrameMap::BACKGROUND + k)),
             shadow_t_min: c.shadows.then(|| load(FrameMap::SHADOW_T_MIN)),
             mirror_t_min: (c.reflection_depth > 0).then(|| load(FrameMap::MIRROR_T_MIN)),
+            lights: (c.light_count <= KEPT_LIGHTS).then(|| {
+                (0..c.light_count)
+                    .map(|light| std::array::from_fn(|k| load(light_base(light) as usize + k)))
+                    .collect()
+            }),
         }
     }
 
@@ -83,7 +99,13 @@ impl Gen<'_> {
             background,
             shadow_t_min,
             mirror_t_min,
+            ref lights,
         } = *k;
+        // The light's word `k` (position 0-2, colour 3-5): a register or a load.
+        let light_word = |light: u32, k: u32| match lights {
+            Some(l) => Val::R(l[light as usize][k as usize]),
+            None => self.frame_word(light_base(light) + k),
+        };
         let [pixel, x, y, depth] = a.regs::<4>();
         // The ray being shaded lives in the trace query's registers (the trace routine only
         // reads them). A shadow query overwrites them: a scene with shadows and mirrors keeps
@@ -162,7 +184,9 @@ impl Gen<'_> {
         let kd = [mat[0], mat[1], mat[2]].map(|v| a.keep(v));
         let mirror = a.keep(mat[3]);
         a.free(material);
-        let acc = units::ambient(a, kd.map(Val::R), ambient.into()).map(|v| a.keep(v));
+        // The colour accumulates in `color`, where the pack and the mirror fold read it.
+        let acc = color;
+        a.assign3(acc, units::ambient(a, kd.map(Val::R), ambient.into()));
         a.end_temps();
         let incoming: [Reg; 3] = if c.shadows && c.reflection_depth > 0 {
             let kept = a.regs();
@@ -173,8 +197,7 @@ impl Gen<'_> {
         };
         for light in 0..c.light_count {
             a.section("light");
-            let base = (FrameMap::LIGHTS + light as usize * crate::layout::LIGHT_WORDS) as u32;
-            let position: [Val; 3] = std::array::from_fn(|k| self.frame_word(base + k as u32));
+            let position: [Val; 3] = std::array::from_fn(|k| light_word(light, k as u32));
             let to_light = units::sub3(a, position, p.map(Val::R)).map(|v| a.keep(v));
             a.end_temps();
             let skip_light = a.label();
@@ -195,8 +218,7 @@ impl Gen<'_> {
                 a.section("light");
                 a.branch(Op::Beq, s.hit.into(), Val::K(0), true, skip_light);
             }
-            let color_words: [Val; 3] =
-                std::array::from_fn(|k| self.frame_word(base + 3 + k as u32));
+            let color_words: [Val; 3] = std::array::from_fn(|k| light_word(light, 3 + k as u32));
             let lit = units::add_light(a, acc.map(Val::R), kd.map(Val::R), color_words, cos.into());
             a.assign3(acc, lit);
             a.end_temps();
@@ -238,14 +260,11 @@ impl Gen<'_> {
             a.jump(shade);
         }
         a.bind(local_done);
-        a.mov3(color, acc.map(Val::R));
-        a.jump(fold);
         let owned = |r: &Reg| *r != Reg::ZERO && !s.best_instance.eq(r) && !s.best_triangle.eq(r);
         for r in p
             .into_iter()
             .chain(n)
             .chain(kd)
-            .chain(acc)
             .chain([mirror, hit_instance, hit_triangle])
             .chain(if incoming == ray_d {
                 [Reg::ZERO; 3]
@@ -256,9 +275,6 @@ impl Gen<'_> {
         {
             a.free(r);
         }
-        a.bind(miss);
-        a.mov3(color, background.map(Val::R));
-
         // Fold the mirror chain back: colour = mix(local, colour, m), deepest first.
         a.bind(fold);
         if c.reflection_depth > 0 {
@@ -288,35 +304,13 @@ impl Gen<'_> {
             a.jump(fold);
         }
 
-        // Pack: clamp each channel to [0, 1] (NaN to 0), byte, 0x00RRGGBB.
+        // Pack: each channel's byte (clamped to [0, 1], NaN to 0) shifted in, 0x00RRGGBB.
         a.bind(pack);
         a.section("pack");
         let rgb = a.reg();
         for k in 0..3 {
-            let (zero, clamped) = (a.label(), a.label());
-            let ch = color[k];
-            a.branch(Op::BFlt, Val::K(0), ch.into(), true, zero);
-            // Not NaN from here: `!(1 < ch)` is `ch <= 1`.
-            a.branch(Op::BFle, ch.into(), Val::K(f.one()), false, clamped);
-            a.mov(ch, Val::K(f.one()));
-            a.jump(clamped);
-            a.bind(zero);
-            a.mov(ch, Val::K(0));
-            a.bind(clamped);
-            let word = units::channel_byte_word(a, ch.into());
-            let byte = a.op(Op::And, word, Val::K(0xff));
-            let shift = 16 - 8 * k as u32;
-            if k == 0 {
-                a.op_to(Op::Shl, rgb, byte, Val::K(shift));
-            } else {
-                let shifted = if shift == 0 {
-                    byte
-                } else {
-                    a.op(Op::Shl, byte, Val::K(shift))
-                };
-                a.op_to(Op::Or, rgb, rgb.into(), shifted);
-            }
-            a.end_temps();
+            let high = if k == 0 { Val::K(0) } else { Val::R(rgb) };
+            a.op_to(Op::Byte, rgb, color[k].into(), high);
         }
         // y * W + x with shifts and adds (W is a constant of the scene).
         let mut address = Val::R(x);
@@ -334,6 +328,12 @@ impl Gen<'_> {
         a.end_temps();
         a.free(rgb);
         a.jump(next_pixel);
+
+        // A miss takes the background (out of the hit's straight path).
+        a.bind(miss);
+        a.section("shader");
+        a.mov3(color, background.map(Val::R));
+        a.jump(fold);
 
         a.bind(frame_done);
         a.section("raygen");
