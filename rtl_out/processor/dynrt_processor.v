@@ -544,6 +544,9 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     reg  [31:0] reserved__d;
     wire  [31:0] reserved__q;
     reg  reserved__clock;
+    reg  wake_late__clock;
+    reg  [31:0] wake_late__data_in;
+    wire  [31:0] wake_late__data_out;
     
     // Local signals
     reg  [31:0] below;
@@ -1262,6 +1265,11 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         .q(reserved__q),
         .clock(reserved__clock)
     );
+    dynrt_processor_core__wake_late wake_late(
+        .clock(wake_late__clock),
+        .data_in(wake_late__data_in),
+        .data_out(wake_late__data_out)
+    );
     
     // Update code
     always @(*) begin
@@ -1346,6 +1354,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         cond_delay__clock = clock;
         long_ctl__clock = clock;
         long_pc__clock = clock;
+        wake_late__clock = clock;
         tester__clock = clock;
         traversal_unit__clock = clock;
         pc_ram__read_clock = clock;
@@ -2206,7 +2215,8 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
                 wake_mask = wb_mask;
             end
         end
-        ready__d = (ready__q & (~issue_mask)) | wake_mask | (asleep__q & event_mask);
+        wake_late__data_in = wake_mask;
+        ready__d = (ready__q & (~issue_mask)) | wake_late__data_out | (asleep__q & event_mask);
         asleep__d = (asleep__q & (~event_mask)) | sleep_mask;
         woken__d = (woken__q & (~issue_mask)) | event_mask;
         if (wb_valid & (wb_op == 32'h1c)) begin
@@ -23648,6 +23658,167 @@ endmodule // dynrt_processor_core__traversal_unit__stack_node
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor_core__wake_late(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] data_in;
+    output reg  [31:0] data_out;
+    
+    // Stub signals
+    reg  [31:0] stage__0__d;
+    wire  [31:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [31:0] stage__1__d;
+    wire  [31:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [31:0] stage__2__d;
+    wire  [31:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [31:0] stage__3__d;
+    wire  [31:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [31:0] stage__4__d;
+    wire  [31:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [31:0] stage__5__d;
+    wire  [31:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [31:0] stage__6__d;
+    wire  [31:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [31:0] stage__7__d;
+    wire  [31:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [31:0] stage__8__d;
+    wire  [31:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [31:0] stage__9__d;
+    wire  [31:0] stage__9__q;
+    reg  stage__9__clock;
+    reg  [31:0] stage__10__d;
+    wire  [31:0] stage__10__q;
+    reg  stage__10__clock;
+    
+    // Sub module instances
+    dynrt_processor_core__asleep stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor_core__asleep stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor_core__asleep stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor_core__asleep stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor_core__asleep stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor_core__asleep stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor_core__asleep stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor_core__asleep stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor_core__asleep stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor_core__asleep stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor_core__asleep stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+    end
+    
+endmodule // dynrt_processor_core__wake_late
 
 
 
