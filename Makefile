@@ -34,12 +34,13 @@ build:
 
 # The whole-processor synthesis (one yosys run of several minutes, in tests/cli.rs) runs beside
 # the other tests, so that it does not leave the second core idle at the end.
+SYNTH_TEST := rtl_with_synth_reports_the_processors_resources_against_the_device
 test: deps
 	$(CARGO) test --release --no-run
 	@cli=$$($(CARGO) test --release --no-run --test cli 2>&1 | sed -n 's/.*Executable tests\/cli.rs (\(.*\))/\1/p'); \
 	test -x "$$cli" || { echo "make test: cannot find the tests/cli.rs binary"; exit 1; }; \
-	"$$cli" --exact rtl_with_synth_reports_the_processors_resources_against_the_device & synth=$$!; \
-	$(CARGO) test --release -- --skip rtl_with_synth_reports_the_processors_resources; rest=$$?; \
+	"$$cli" --exact $(SYNTH_TEST) & synth=$$!; \
+	$(CARGO) test --release -- --skip $(SYNTH_TEST); rest=$$?; \
 	wait $$synth; synth_rc=$$?; \
 	if [ $$synth_rc != 0 ]; then echo "make test: the processor synthesis test failed"; fi; \
 	test $$rest = 0 && test $$synth_rc = 0

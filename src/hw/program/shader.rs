@@ -185,8 +185,7 @@ impl Gen<'_> {
         let mirror = a.keep(mat[3]);
         a.free(material);
         // The colour accumulates in `color`, where the pack and the mirror fold read it.
-        let acc = color;
-        a.assign3(acc, units::ambient(a, kd.map(Val::R), ambient.into()));
+        a.assign3(color, units::ambient(a, kd.map(Val::R), ambient.into()));
         a.end_temps();
         let incoming: [Reg; 3] = if c.shadows && c.reflection_depth > 0 {
             let kept = a.regs();
@@ -219,8 +218,14 @@ impl Gen<'_> {
                 a.branch(Op::Beq, s.hit.into(), Val::K(0), true, skip_light);
             }
             let color_words: [Val; 3] = std::array::from_fn(|k| light_word(light, 3 + k as u32));
-            let lit = units::add_light(a, acc.map(Val::R), kd.map(Val::R), color_words, cos.into());
-            a.assign3(acc, lit);
+            let lit = units::add_light(
+                a,
+                color.map(Val::R),
+                kd.map(Val::R),
+                color_words,
+                cos.into(),
+            );
+            a.assign3(color, lit);
             a.end_temps();
             a.free(cos);
             a.bind(skip_light);
@@ -246,7 +251,7 @@ impl Gen<'_> {
                 Val::K(CHAIN_ENTRY_WORDS.trailing_zeros()),
             );
             for k in 0..3 {
-                a.scratch_store(entry, self.scratch.chain + k as u32, acc[k].into());
+                a.scratch_store(entry, self.scratch.chain + k as u32, color[k].into());
             }
             a.scratch_store(entry, self.scratch.chain + 3, mirror.into());
             a.op_to(Op::Add, depth, depth.into(), Val::K(1));
