@@ -544,9 +544,6 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     reg  [31:0] reserved__d;
     wire  [31:0] reserved__q;
     reg  reserved__clock;
-    reg  wake_late__clock;
-    reg  [31:0] wake_late__data_in;
-    wire  [31:0] wake_late__data_out;
     
     // Local signals
     reg  [31:0] below;
@@ -1265,11 +1262,6 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         .q(reserved__q),
         .clock(reserved__clock)
     );
-    dynrt_processor_core__wake_late wake_late(
-        .clock(wake_late__clock),
-        .data_in(wake_late__data_in),
-        .data_out(wake_late__data_out)
-    );
     
     // Update code
     always @(*) begin
@@ -1354,7 +1346,6 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         cond_delay__clock = clock;
         long_ctl__clock = clock;
         long_pc__clock = clock;
-        wake_late__clock = clock;
         tester__clock = clock;
         traversal_unit__clock = clock;
         pc_ram__read_clock = clock;
@@ -2215,8 +2206,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
                 wake_mask = wb_mask;
             end
         end
-        wake_late__data_in = wake_mask;
-        ready__d = (ready__q & (~issue_mask)) | wake_late__data_out | (asleep__q & event_mask);
+        ready__d = (ready__q & (~issue_mask)) | wake_mask | (asleep__q & event_mask);
         asleep__d = (asleep__q & (~event_mask)) | sleep_mask;
         woken__d = (woken__q & (~issue_mask)) | event_mask;
         if (wb_valid & (wb_op == 32'h1c)) begin
@@ -10715,7 +10705,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
     localparam  c_index__10 = 4'ha;
     localparam  c_index__11 = 4'hb;
     localparam  c_infinity = 24'h7f0000;
-    localparam  c_d_pass = 16'h1000;
+    localparam  c_d_pass = 16'h2000;
     localparam  c_hit_flag = 33'h100000000;
     
     // Stub signals
@@ -10799,24 +10789,24 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
     reg  best_m__write_clock;
     reg  [32:0] best_m__write_data;
     reg  best_m__write_enable;
-    reg  [3:0] flight_t_min__read_address;
+    reg  [4:0] flight_t_min__read_address;
     reg  flight_t_min__read_clock;
     wire  [23:0] flight_t_min__read_data;
-    reg  [3:0] flight_t_min__write_address;
+    reg  [4:0] flight_t_min__write_address;
     reg  flight_t_min__write_clock;
     reg  [23:0] flight_t_min__write_data;
     reg  flight_t_min__write_enable;
-    reg  [3:0] flight_a__read_address;
+    reg  [4:0] flight_a__read_address;
     reg  flight_a__read_clock;
     wire  [31:0] flight_a__read_data;
-    reg  [3:0] flight_a__write_address;
+    reg  [4:0] flight_a__write_address;
     reg  flight_a__write_clock;
     reg  [31:0] flight_a__write_data;
     reg  flight_a__write_enable;
-    reg  [3:0] flight_b__read_address;
+    reg  [4:0] flight_b__read_address;
     reg  flight_b__read_clock;
     wire  [31:0] flight_b__read_data;
-    reg  [3:0] flight_b__write_address;
+    reg  [4:0] flight_b__write_address;
     reg  flight_b__write_clock;
     reg  [31:0] flight_b__write_data;
     reg  flight_b__write_enable;
@@ -10844,8 +10834,8 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
     reg  [3:0] received__d;
     wire  [3:0] received__q;
     reg  received__clock;
-    reg  [3:0] seq__d;
-    wire  [3:0] seq__q;
+    reg  [4:0] seq__d;
+    wire  [4:0] seq__q;
     reg  seq__clock;
     reg  [23:0] words__0__d;
     wire  [23:0] words__0__q;
@@ -11114,7 +11104,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(best_e__write_data),
         .write_enable(best_e__write_enable)
     );
-    dynrt_processor_core__tester__instance_e instance_e(
+    dynrt_processor_core__tester__flight_a instance_e(
         .read_address(instance_e__read_address),
         .read_clock(instance_e__read_clock),
         .read_data(instance_e__read_data),
@@ -11123,7 +11113,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(instance_e__write_data),
         .write_enable(instance_e__write_enable)
     );
-    dynrt_processor_core__tester__instance_e triangle_e(
+    dynrt_processor_core__tester__flight_a triangle_e(
         .read_address(triangle_e__read_address),
         .read_clock(triangle_e__read_clock),
         .read_data(triangle_e__read_data),
@@ -11217,7 +11207,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .q(received__q),
         .clock(received__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight seq(
+    dynrt_processor_core__last_pick seq(
         .d(seq__d),
         .q(seq__q),
         .clock(seq__clock)
@@ -11783,7 +11773,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         transform_unit__v__0 = ray__o__0;
         transform_unit__v__1 = ray__o__1;
         transform_unit__v__2 = ray__o__2;
-        launch_tag = (((cur_kind__q) & 16'hffff) << 32'h9) | (((cur_thread__q) & 16'hffff) << 32'h4) | ((seq__q) & 16'hffff);
+        launch_tag = (((cur_kind__q) & 16'hffff) << 32'ha) | (((cur_thread__q) & 16'hffff) << 32'h5) | ((seq__q) & 16'hffff);
         transform_unit__tag = launch_tag;
         flight_t_min__write_address = seq__q;
         flight_a__write_address = seq__q;
@@ -11834,19 +11824,19 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         end
         transform_busy = transform_unit__in_valid & (cur_kind__q == 32'h0);
         o_hold__0__d = o_hold__0__q;
-        if (transform_unit__out_valid & (~transform_unit__out_tag[32'hc])) begin
+        if (transform_unit__out_valid & (~transform_unit__out_tag[32'hd])) begin
             o_hold__0__d = transform_unit__result__0;
         end
         o_hold__1__d = o_hold__1__q;
-        if (transform_unit__out_valid & (~transform_unit__out_tag[32'hc])) begin
+        if (transform_unit__out_valid & (~transform_unit__out_tag[32'hd])) begin
             o_hold__1__d = transform_unit__result__1;
         end
         o_hold__2__d = o_hold__2__q;
-        if (transform_unit__out_valid & (~transform_unit__out_tag[32'hc])) begin
+        if (transform_unit__out_valid & (~transform_unit__out_tag[32'hd])) begin
             o_hold__2__d = transform_unit__result__2;
         end
-        flight_t_min__read_address = transform_unit__out_tag[(32'h0)+:(4)];
-        intersect_unit__in_valid = transform_unit__out_valid & transform_unit__out_tag[32'hc];
+        flight_t_min__read_address = transform_unit__out_tag[(32'h0)+:(5)];
+        intersect_unit__in_valid = transform_unit__out_valid & transform_unit__out_tag[32'hd];
         intersect_unit__o__0 = o_hold__0__q;
         intersect_unit__d__0 = transform_unit__result__0;
         intersect_unit__o__1 = o_hold__1__q;
@@ -11856,15 +11846,15 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         intersect_unit__t_min = flight_t_min__read_data;
         intersect_unit__t_max = c_infinity;
         intersect_unit__tag = transform_unit__out_tag;
-        intersect_busy = intersect_unit__in_valid & (transform_unit__out_tag[(32'h9)+:(2)] == 32'h0);
-        done_m__read_address = intersect_unit__out_tag[(32'h4)+:(5)];
-        best_m__read_address = intersect_unit__out_tag[(32'h4)+:(5)];
-        flight_a__read_address = intersect_unit__out_tag[(32'h0)+:(4)];
-        flight_b__read_address = intersect_unit__out_tag[(32'h0)+:(4)];
+        intersect_busy = intersect_unit__in_valid & (transform_unit__out_tag[(32'ha)+:(2)] == 32'h0);
+        done_m__read_address = intersect_unit__out_tag[(32'h5)+:(5)];
+        best_m__read_address = intersect_unit__out_tag[(32'h5)+:(5)];
+        flight_a__read_address = intersect_unit__out_tag[(32'h0)+:(5)];
+        flight_b__read_address = intersect_unit__out_tag[(32'h0)+:(5)];
         m1_valid__d = intersect_unit__out_valid;
         m1_hit__d = intersect_unit__hit;
-        m1_kind__d = intersect_unit__out_tag[(32'h9)+:(2)];
-        m1_thread__d = intersect_unit__out_tag[(32'h4)+:(5)];
+        m1_kind__d = intersect_unit__out_tag[(32'ha)+:(2)];
+        m1_thread__d = intersect_unit__out_tag[(32'h5)+:(5)];
         m1_t__d = intersect_unit__t;
         cmp__in_valid = 1'b1;
         cmp__a = m1_t__q;
@@ -12056,66 +12046,6 @@ endmodule // dynrt_processor_core__tester__done_e
 module dynrt_processor_core__tester__flight_a(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
-    input wire  [3:0] read_address;
-    input wire  read_clock;
-    output reg  [31:0] read_data;
-    input wire  [3:0] write_address;
-    input wire  write_clock;
-    input wire  [31:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[31:0] mem[15:0];
-    
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor_core__tester__flight_a
-
-
-
-
-module dynrt_processor_core__tester__flight_t_min(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [3:0] read_address;
-    input wire  read_clock;
-    output reg  [23:0] read_data;
-    input wire  [3:0] write_address;
-    input wire  write_clock;
-    input wire  [23:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[23:0] mem[15:0];
-    
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor_core__tester__flight_t_min
-
-
-module dynrt_processor_core__tester__instance_e(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
     input wire  [4:0] read_address;
     input wire  read_clock;
     output reg  [31:0] read_data;
@@ -12139,7 +12069,40 @@ module dynrt_processor_core__tester__instance_e(read_address,read_clock,read_dat
        end
     end
                 
-endmodule // dynrt_processor_core__tester__instance_e
+endmodule // dynrt_processor_core__tester__flight_a
+
+
+
+
+module dynrt_processor_core__tester__flight_t_min(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [4:0] read_address;
+    input wire  read_clock;
+    output reg  [23:0] read_data;
+    input wire  [4:0] write_address;
+    input wire  write_clock;
+    input wire  [23:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[23:0] mem[31:0];
+    
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor_core__tester__flight_t_min
+
+
 
 
 module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__2,d__0,d__1,d__2,t_min,t_max,tag,out_valid,t,u,v,hit,out_tag);
@@ -15631,7 +15594,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .almost_full(tests__almost_full),
         .overflow(tests__overflow)
     );
-    dynrt_processor_core__tester__instance_e object_ram(
+    dynrt_processor_core__tester__flight_a object_ram(
         .read_address(object_ram__read_address),
         .read_clock(object_ram__read_clock),
         .read_data(object_ram__read_data),
@@ -15658,7 +15621,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(skip_triangle_ram__write_data),
         .write_enable(skip_triangle_ram__write_enable)
     );
-    dynrt_processor_core__tester__instance_e mailbox_ids__0(
+    dynrt_processor_core__tester__flight_a mailbox_ids__0(
         .read_address(mailbox_ids__0__read_address),
         .read_clock(mailbox_ids__0__read_clock),
         .read_data(mailbox_ids__0__read_data),
@@ -15667,7 +15630,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__0__write_data),
         .write_enable(mailbox_ids__0__write_enable)
     );
-    dynrt_processor_core__tester__instance_e mailbox_ids__1(
+    dynrt_processor_core__tester__flight_a mailbox_ids__1(
         .read_address(mailbox_ids__1__read_address),
         .read_clock(mailbox_ids__1__read_clock),
         .read_data(mailbox_ids__1__read_data),
@@ -15676,7 +15639,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__1__write_data),
         .write_enable(mailbox_ids__1__write_enable)
     );
-    dynrt_processor_core__tester__instance_e mailbox_ids__2(
+    dynrt_processor_core__tester__flight_a mailbox_ids__2(
         .read_address(mailbox_ids__2__read_address),
         .read_clock(mailbox_ids__2__read_clock),
         .read_data(mailbox_ids__2__read_data),
@@ -15685,7 +15648,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__2__write_data),
         .write_enable(mailbox_ids__2__write_enable)
     );
-    dynrt_processor_core__tester__instance_e mailbox_ids__3(
+    dynrt_processor_core__tester__flight_a mailbox_ids__3(
         .read_address(mailbox_ids__3__read_address),
         .read_clock(mailbox_ids__3__read_clock),
         .read_data(mailbox_ids__3__read_data),
@@ -15694,7 +15657,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__3__write_data),
         .write_enable(mailbox_ids__3__write_enable)
     );
-    dynrt_processor_core__tester__instance_e mailbox_ids__4(
+    dynrt_processor_core__tester__flight_a mailbox_ids__4(
         .read_address(mailbox_ids__4__read_address),
         .read_clock(mailbox_ids__4__read_clock),
         .read_data(mailbox_ids__4__read_data),
@@ -15703,7 +15666,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__4__write_data),
         .write_enable(mailbox_ids__4__write_enable)
     );
-    dynrt_processor_core__tester__instance_e mailbox_ids__5(
+    dynrt_processor_core__tester__flight_a mailbox_ids__5(
         .read_address(mailbox_ids__5__read_address),
         .read_clock(mailbox_ids__5__read_clock),
         .read_data(mailbox_ids__5__read_data),
@@ -15712,7 +15675,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__5__write_data),
         .write_enable(mailbox_ids__5__write_enable)
     );
-    dynrt_processor_core__tester__instance_e mailbox_ids__6(
+    dynrt_processor_core__tester__flight_a mailbox_ids__6(
         .read_address(mailbox_ids__6__read_address),
         .read_clock(mailbox_ids__6__read_clock),
         .read_data(mailbox_ids__6__read_data),
@@ -15721,7 +15684,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__6__write_data),
         .write_enable(mailbox_ids__6__write_enable)
     );
-    dynrt_processor_core__tester__instance_e mailbox_ids__7(
+    dynrt_processor_core__tester__flight_a mailbox_ids__7(
         .read_address(mailbox_ids__7__read_address),
         .read_clock(mailbox_ids__7__read_clock),
         .read_data(mailbox_ids__7__read_data),
@@ -17116,7 +17079,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
     reg  words__6__write_enable;
     
     // Sub module instances
-    dynrt_processor_core__tester__ray__words__0 words__0(
+    dynrt_processor_core__tester__flight_t_min words__0(
         .read_address(words__0__read_address),
         .read_clock(words__0__read_clock),
         .read_data(words__0__read_data),
@@ -17125,7 +17088,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__0__write_data),
         .write_enable(words__0__write_enable)
     );
-    dynrt_processor_core__tester__ray__words__0 words__1(
+    dynrt_processor_core__tester__flight_t_min words__1(
         .read_address(words__1__read_address),
         .read_clock(words__1__read_clock),
         .read_data(words__1__read_data),
@@ -17134,7 +17097,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__1__write_data),
         .write_enable(words__1__write_enable)
     );
-    dynrt_processor_core__tester__ray__words__0 words__2(
+    dynrt_processor_core__tester__flight_t_min words__2(
         .read_address(words__2__read_address),
         .read_clock(words__2__read_clock),
         .read_data(words__2__read_data),
@@ -17143,7 +17106,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__2__write_data),
         .write_enable(words__2__write_enable)
     );
-    dynrt_processor_core__tester__ray__words__0 words__3(
+    dynrt_processor_core__tester__flight_t_min words__3(
         .read_address(words__3__read_address),
         .read_clock(words__3__read_clock),
         .read_data(words__3__read_data),
@@ -17152,7 +17115,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__3__write_data),
         .write_enable(words__3__write_enable)
     );
-    dynrt_processor_core__tester__ray__words__0 words__4(
+    dynrt_processor_core__tester__flight_t_min words__4(
         .read_address(words__4__read_address),
         .read_clock(words__4__read_clock),
         .read_data(words__4__read_data),
@@ -17161,7 +17124,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__4__write_data),
         .write_enable(words__4__write_enable)
     );
-    dynrt_processor_core__tester__ray__words__0 words__5(
+    dynrt_processor_core__tester__flight_t_min words__5(
         .read_address(words__5__read_address),
         .read_clock(words__5__read_clock),
         .read_data(words__5__read_data),
@@ -17170,7 +17133,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__5__write_data),
         .write_enable(words__5__write_enable)
     );
-    dynrt_processor_core__tester__ray__words__0 words__6(
+    dynrt_processor_core__tester__flight_t_min words__6(
         .read_address(words__6__read_address),
         .read_clock(words__6__read_clock),
         .read_data(words__6__read_data),
@@ -17254,33 +17217,6 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
 endmodule // dynrt_processor_core__tester__ray
 
 
-module dynrt_processor_core__tester__ray__words__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [4:0] read_address;
-    input wire  read_clock;
-    output reg  [23:0] read_data;
-    input wire  [4:0] write_address;
-    input wire  write_clock;
-    input wire  [23:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[23:0] mem[31:0];
-    
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor_core__tester__ray__words__0
 
 
 
@@ -20477,7 +20413,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(done_u__write_data),
         .write_enable(done_u__write_enable)
     );
-    dynrt_processor_core__tester__instance_e result_e(
+    dynrt_processor_core__tester__flight_a result_e(
         .read_address(result_e__read_address),
         .read_clock(result_e__read_clock),
         .read_data(result_e__read_data),
@@ -20486,7 +20422,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(result_e__write_data),
         .write_enable(result_e__write_enable)
     );
-    dynrt_processor_core__tester__instance_e end_e(
+    dynrt_processor_core__tester__flight_a end_e(
         .read_address(end_e__read_address),
         .read_clock(end_e__read_clock),
         .read_data(end_e__read_data),
@@ -20495,7 +20431,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(end_e__write_data),
         .write_enable(end_e__write_enable)
     );
-    dynrt_processor_core__tester__ray__words__0 leaf_hi(
+    dynrt_processor_core__tester__flight_t_min leaf_hi(
         .read_address(leaf_hi__read_address),
         .read_clock(leaf_hi__read_clock),
         .read_data(leaf_hi__read_data),
@@ -23658,167 +23594,6 @@ endmodule // dynrt_processor_core__traversal_unit__stack_node
 
 
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor_core__wake_late(clock,data_in,data_out);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  [31:0] data_in;
-    output reg  [31:0] data_out;
-    
-    // Stub signals
-    reg  [31:0] stage__0__d;
-    wire  [31:0] stage__0__q;
-    reg  stage__0__clock;
-    reg  [31:0] stage__1__d;
-    wire  [31:0] stage__1__q;
-    reg  stage__1__clock;
-    reg  [31:0] stage__2__d;
-    wire  [31:0] stage__2__q;
-    reg  stage__2__clock;
-    reg  [31:0] stage__3__d;
-    wire  [31:0] stage__3__q;
-    reg  stage__3__clock;
-    reg  [31:0] stage__4__d;
-    wire  [31:0] stage__4__q;
-    reg  stage__4__clock;
-    reg  [31:0] stage__5__d;
-    wire  [31:0] stage__5__q;
-    reg  stage__5__clock;
-    reg  [31:0] stage__6__d;
-    wire  [31:0] stage__6__q;
-    reg  stage__6__clock;
-    reg  [31:0] stage__7__d;
-    wire  [31:0] stage__7__q;
-    reg  stage__7__clock;
-    reg  [31:0] stage__8__d;
-    wire  [31:0] stage__8__q;
-    reg  stage__8__clock;
-    reg  [31:0] stage__9__d;
-    wire  [31:0] stage__9__q;
-    reg  stage__9__clock;
-    reg  [31:0] stage__10__d;
-    wire  [31:0] stage__10__q;
-    reg  stage__10__clock;
-    
-    // Sub module instances
-    dynrt_processor_core__asleep stage__0(
-        .d(stage__0__d),
-        .q(stage__0__q),
-        .clock(stage__0__clock)
-    );
-    dynrt_processor_core__asleep stage__1(
-        .d(stage__1__d),
-        .q(stage__1__q),
-        .clock(stage__1__clock)
-    );
-    dynrt_processor_core__asleep stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
-    dynrt_processor_core__asleep stage__3(
-        .d(stage__3__d),
-        .q(stage__3__q),
-        .clock(stage__3__clock)
-    );
-    dynrt_processor_core__asleep stage__4(
-        .d(stage__4__d),
-        .q(stage__4__q),
-        .clock(stage__4__clock)
-    );
-    dynrt_processor_core__asleep stage__5(
-        .d(stage__5__d),
-        .q(stage__5__q),
-        .clock(stage__5__clock)
-    );
-    dynrt_processor_core__asleep stage__6(
-        .d(stage__6__d),
-        .q(stage__6__q),
-        .clock(stage__6__clock)
-    );
-    dynrt_processor_core__asleep stage__7(
-        .d(stage__7__d),
-        .q(stage__7__q),
-        .clock(stage__7__clock)
-    );
-    dynrt_processor_core__asleep stage__8(
-        .d(stage__8__d),
-        .q(stage__8__q),
-        .clock(stage__8__clock)
-    );
-    dynrt_processor_core__asleep stage__9(
-        .d(stage__9__d),
-        .q(stage__9__q),
-        .clock(stage__9__clock)
-    );
-    dynrt_processor_core__asleep stage__10(
-        .d(stage__10__d),
-        .q(stage__10__q),
-        .clock(stage__10__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        stage__0__clock = clock;
-        stage__1__clock = clock;
-        stage__2__clock = clock;
-        stage__3__clock = clock;
-        stage__4__clock = clock;
-        stage__5__clock = clock;
-        stage__6__clock = clock;
-        stage__7__clock = clock;
-        stage__8__clock = clock;
-        stage__9__clock = clock;
-        stage__10__clock = clock;
-        stage__0__d = data_in;
-        stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        stage__3__d = stage__2__q;
-        stage__4__d = stage__3__q;
-        stage__5__d = stage__4__q;
-        stage__6__d = stage__5__q;
-        stage__7__d = stage__6__q;
-        stage__8__d = stage__7__q;
-        stage__9__d = stage__8__q;
-        stage__10__d = stage__9__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-    end
-    
-endmodule // dynrt_processor_core__wake_late
 
 
 

@@ -7,9 +7,8 @@
 //! back, so there is no hazard, stall or forwarding logic: memory and unit latency are hidden
 //! by the other threads (the paper's 32 threads). A long instruction reserves its write-back
 //! clock: the scheduler issues nothing in the one clock whose instruction would write back
-//! with it (one bubble per `fdiv` or `fsqrt`). A thread is ready again [`REISSUE_DELAY`]
-//! clocks after its write back, so it issues at most once per `period = ENGINE_LATENCY + 4 +
-//! REISSUE_DELAY` (26) clocks (`engine_period`). A thread whose coprocessor wait (`tri.wait`,
+//! with it (one bubble per `fdiv` or `fsqrt`). A thread issues at most once per `period =
+//! ENGINE_LATENCY + 4` (15) clocks (`engine_period`). A thread whose coprocessor wait (`tri.wait`,
 //! `kd.wait`) is still pending sleeps: it is not ready until the coprocessor finishes work for
 //! it, so the clocks it waits go to the other threads (an offer to a full queue repeats at
 //! once).
@@ -30,7 +29,7 @@
 //!   after it), else `pc + 1`; the condition comes from the compare, integer, mailbox, pixel
 //!   unit or triangle tester.
 //!
-//! Throughput: one instruction per clock while at least 26 threads are awake; a frame
+//! Throughput: one instruction per clock while at least 15 threads are awake; a frame
 //! ends when every thread has executed `halt` (`done`). Counters: clocks of the frame,
 //! instructions retired, and clocks in which the triangle tester's TransformUnit and
 //! IntersectUnit took an input.
@@ -74,18 +73,10 @@ pub const fn long_latency(m: u32) -> u32 {
     m + 6
 }
 
-/// Clocks between a thread's write back and its next issue. With 0 (a thread issuing every 15
-/// clocks) Verilator frames of `cornell_noshadow` at 64x48 differ from the golden model in one
-/// pixel with 31 threads or an SRAM latency of 1 or 3 (a hit on a different triangle), and in
-/// two with the six-instruction-shorter ray generation of the `planar-camera` branch; with 11
-/// (every 26 clocks, the spacing of the design before the 11-clock write back) every frame is
-/// identical. The race this hides is not found yet.
-pub const REISSUE_DELAY: u32 = 11;
-
 /// The clocks of one round of `threads` threads, each issuing once: a thread issues at most
-/// once per `ENGINE_LATENCY + 4 + REISSUE_DELAY` clocks.
+/// once per `ENGINE_LATENCY + 4` clocks.
 pub fn engine_period(threads: u32) -> u32 {
-    threads.max(ENGINE_LATENCY + 4 + REISSUE_DELAY)
+    threads.max(ENGINE_LATENCY + 4)
 }
 
 /// Registers of the fast result line (the `0..8` loops of `update` spell it out: rust-hdl's
@@ -261,8 +252,6 @@ pub struct ThreadEngine<
     /// clock where that issue's instruction would (bit 0 is this clock).
     reserved: DFF<Bits<32>>,
     long3: Signal<Local, Bit>,
-    /// A written-back thread is ready again `REISSUE_DELAY` clocks later (see the constant).
-    wake_late: Delay<Bits<32>, 11>,
 
     // Write back.
     wb_valid: Signal<Local, Bit>,
@@ -329,7 +318,7 @@ impl<
     pub fn new(program: &Program, threads: u32, mem_latency: u32) -> Self {
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
         assert!(P == 2 * S);
-        assert!(ENGINE_LATENCY as usize == FAST_STAGES + 3 && REISSUE_DELAY == 11);
+        assert!(ENGINE_LATENCY as usize == FAST_STAGES + 3);
         assert!(super::fp::div::div_latency(M as u32) + 1 == long_latency(M as u32));
         assert!(super::fp::sqrt::sqrt_latency(M as u32) + 1 == long_latency(M as u32));
         // The reservation is made at I3 for an issue `DX - 3` clocks later.
@@ -476,7 +465,6 @@ impl<
             wb_pcs: Default::default(),
             reserved: Default::default(),
             long3: Default::default(),
-            wake_late: Default::default(),
             wb_valid: Default::default(),
             wb_op: Default::default(),
             wb_dst: Default::default(),
@@ -571,7 +559,6 @@ impl<
             cond_delay,
             long_ctl,
             long_pc,
-            wake_late,
             tester,
             traversal_unit
         );
@@ -1143,9 +1130,8 @@ impl<
             self.instr_count.d.next = self.instr_count.q.val() + 1;
         }
 
-        // Scheduler: a written-back thread is ready again (`REISSUE_DELAY` later), unless it
-        // halted or waits for a coprocessor that has not finished its work since the thread
-        // issued (it sleeps until the coprocessor does: the `woken` bit catches a finish
+        // Scheduler: a written-back thread is ready again, unless it halted or waits for a
+        // coprocessor that has not finished its work since the thread issued (it sleeps until the coprocessor does: the `woken` bit catches a finish
         // between the check at I3 and this write back).
         self.wb_mask.next = self.c_one.val() << self.wb_thread.val();
         self.tester_event.next = 0.into();
@@ -1170,9 +1156,8 @@ impl<
                 self.wake_mask.next = self.wb_mask.val();
             }
         }
-        self.wake_late.data_in.next = self.wake_mask.val();
         self.ready.d.next = (self.ready.q.val() & (!self.issue_mask.val()))
-            | self.wake_late.data_out.val()
+            | self.wake_mask.val()
             | (self.asleep.q.val() & self.event_mask.val());
         self.asleep.d.next =
             (self.asleep.q.val() & (!self.event_mask.val())) | self.sleep_mask.val();

@@ -34,18 +34,40 @@
 //! and 3 (shading data) take the bank in their clock; the fetch waits for it.
 //!
 //! Latency from launch to the merged hit: `TRANSFORM_LATENCY` (25) + 1 + `intersect_latency`
-//! (41 at e7m16) + 3. Const parameters: the operators' `W, E, M, S, S1, X2, T, P` and
+//! (41 at e7m16) + 3. Up to [`FLIGHT_SLOTS`] entries are in flight in that time, each with its
+//! own slot for the words the merge needs. Const parameters: the operators' `W, E, M, S, S1, X2, T, P` and
 //! `DL = div_latency(M)` (the IntersectUnit's).
 
 use rust_hdl::prelude::*;
 
 use super::fp::{const_bits, FpCompare};
 use super::ray_store::{zero_counters, RayStore};
-use super::{IntersectUnit, ListUnit, TransformUnit};
+use super::{intersect_latency, IntersectUnit, ListUnit, TransformUnit, TRANSFORM_LATENCY};
 use crate::fp::Format;
 
 /// Commands the engine-side queue holds (the [`ListUnit`]'s).
 pub const TESTER_QUEUE: usize = 16;
+
+/// Entries in flight from launch to merge that the tester tells apart (each keeps its
+/// triangle, instance and t_min in its own slot until its merge reads them). Entries launch
+/// at least [`LAUNCH_SPACING`] clocks apart (an init or a list end, which fetch nothing), so
+/// the slots must outlast the launch-to-merge latency: see [`flight_slots_suffice`].
+pub const FLIGHT_SLOTS: u32 = 32;
+
+/// The fewest clocks between two launches (take, fetch, origin, direction).
+pub const LAUNCH_SPACING: u32 = 4;
+
+/// Clocks from an entry's launch to its merge reading the entry's slot.
+pub fn launch_to_merge(fmt: Format) -> u32 {
+    TRANSFORM_LATENCY + 1 + intersect_latency(fmt)
+}
+
+/// Whether a slot is still free when its sequence number comes round again: with 16 slots a
+/// burst of inits and list ends overwrote a hit's triangle before its merge (e7m16 needs 67
+/// clocks; 16 launches take 64).
+pub fn flight_slots_suffice(fmt: Format) -> bool {
+    FLIGHT_SLOTS * LAUNCH_SPACING > launch_to_merge(fmt)
+}
 
 /// Clocks between two tests when the engine leaves banks 2 and 3 alone (the tester's
 /// throughput bound).
@@ -119,11 +141,11 @@ pub struct TriangleTester<
     triangle_e: RAM<Bits<32>, 5>,
     done_m: RAM<Bits<8>, 5>,
     best_m: RAM<Bits<33>, 5>,
-    /// Per launched entry (by sequence number): t_min for the IntersectUnit; a and b for the
-    /// merge.
-    flight_t_min: RAM<Bits<W>, 4>,
-    flight_a: RAM<Bits<32>, 4>,
-    flight_b: RAM<Bits<32>, 4>,
+    /// Per launched entry (by sequence number, [`FLIGHT_SLOTS`] of them): t_min for the
+    /// IntersectUnit; a and b for the merge.
+    flight_t_min: RAM<Bits<W>, 5>,
+    flight_a: RAM<Bits<32>, 5>,
+    flight_b: RAM<Bits<32>, 5>,
 
     // Fetch and launch.
     phase: DFF<Bits<2>>,
@@ -135,7 +157,7 @@ pub struct TriangleTester<
     uv_issued: DFF<Bits<4>>,
     t_issued: DFF<Bits<4>>,
     received: DFF<Bits<4>>,
-    seq: DFF<Bits<4>>,
+    seq: DFF<Bits<5>>,
     words: [DFF<Bits<W>>; 12],
     uv_take: Signal<Local, Bit>,
     t_take: Signal<Local, Bit>,
@@ -200,6 +222,7 @@ impl<
     pub fn new(mem_latency: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
         let f = Format::new(E as u32, M as u32).expect("a supported format");
+        assert!(flight_slots_suffice(f), "{f}: too few in-flight slots");
         Self {
             clock: Default::default(),
             thread: Default::default(),
@@ -293,7 +316,7 @@ impl<
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_infinity: const_bits::<W>(u64::from(f.infinity(false))),
-            c_d_pass: Constant::new((1u64 << 12).into()),
+            c_d_pass: Constant::new((1u64 << 13).into()),
             c_hit_flag: Constant::new((1u64 << 32).into()),
         }
     }
@@ -467,10 +490,10 @@ impl<
         for k in 0..3 {
             self.transform_unit.v[k].next = self.ray.o[k].val();
         }
-        // Tag: `{d pass[12], kind[10:9], thread[8:4], seq[3:0]}`.
-        self.launch_tag.next = (bit_cast::<16, 2>(self.cur_kind.q.val()) << 9)
-            | (bit_cast::<16, 5>(self.cur_thread.q.val()) << 4)
-            | bit_cast::<16, 4>(self.seq.q.val());
+        // Tag: `{d pass[13], kind[11:10], thread[9:5], seq[4:0]}`.
+        self.launch_tag.next = (bit_cast::<16, 2>(self.cur_kind.q.val()) << 10)
+            | (bit_cast::<16, 5>(self.cur_thread.q.val()) << 5)
+            | bit_cast::<16, 5>(self.seq.q.val());
         self.transform_unit.tag.next = self.launch_tag.val();
         self.flight_t_min.write_address.next = self.seq.q.val();
         self.flight_a.write_address.next = self.seq.q.val();
@@ -528,14 +551,14 @@ impl<
         for k in 0..3 {
             self.o_hold[k].d.next = self.o_hold[k].q.val();
             if self.transform_unit.out_valid.val()
-                & (!self.transform_unit.out_tag.val().get_bit(12))
+                & (!self.transform_unit.out_tag.val().get_bit(13))
             {
                 self.o_hold[k].d.next = self.transform_unit.result[k].val();
             }
         }
-        self.flight_t_min.read_address.next = self.transform_unit.out_tag.val().get_bits::<4>(0);
+        self.flight_t_min.read_address.next = self.transform_unit.out_tag.val().get_bits::<5>(0);
         self.intersect_unit.in_valid.next =
-            self.transform_unit.out_valid.val() & self.transform_unit.out_tag.val().get_bit(12);
+            self.transform_unit.out_valid.val() & self.transform_unit.out_tag.val().get_bit(13);
         for k in 0..3 {
             self.intersect_unit.o[k].next = self.o_hold[k].q.val();
             self.intersect_unit.d[k].next = self.transform_unit.result[k].val();
@@ -544,17 +567,17 @@ impl<
         self.intersect_unit.t_max.next = self.c_infinity.val();
         self.intersect_unit.tag.next = self.transform_unit.out_tag.val();
         self.intersect_busy.next = self.intersect_unit.in_valid.val()
-            & (self.transform_unit.out_tag.val().get_bits::<2>(9) == 0);
+            & (self.transform_unit.out_tag.val().get_bits::<2>(10) == 0);
 
         // Merge: read the thread's state, compare t with its best, write.
-        self.done_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(4);
-        self.best_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(4);
-        self.flight_a.read_address.next = self.intersect_unit.out_tag.val().get_bits::<4>(0);
-        self.flight_b.read_address.next = self.intersect_unit.out_tag.val().get_bits::<4>(0);
+        self.done_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(5);
+        self.best_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(5);
+        self.flight_a.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(0);
+        self.flight_b.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(0);
         self.m1_valid.d.next = self.intersect_unit.out_valid.val();
         self.m1_hit.d.next = self.intersect_unit.hit.val();
-        self.m1_kind.d.next = self.intersect_unit.out_tag.val().get_bits::<2>(9);
-        self.m1_thread.d.next = self.intersect_unit.out_tag.val().get_bits::<5>(4);
+        self.m1_kind.d.next = self.intersect_unit.out_tag.val().get_bits::<2>(10);
+        self.m1_thread.d.next = self.intersect_unit.out_tag.val().get_bits::<5>(5);
         self.m1_t.d.next = self.intersect_unit.t.val();
         self.cmp.in_valid.next = true;
         self.cmp.a.next = self.m1_t.q.val();
@@ -634,12 +657,201 @@ mod tests {
         },
     }
 
-    /// rust-hdl simulation with an SRAM model behind banks 1, 2 and 3: four threads each
-    /// give an object and a new query and 12 lists of 0-7 triangles from a shared list bank
-    /// (so the mailbox drops repeats; a second query half-way for thread 0), offered every
-    /// clock so that the queues fill and refuse; the engine takes banks 1, 2 and 3 in random
-    /// clocks. Every thread's closest hit, instance and triangle equal the model's sequential
-    /// `units::triangle_test` / `units::closer_hit` over its lists after `units::Mailbox`.
+    /// Each thread's closest hit `(hit, t, instance, triangle)` from the model's sequential
+    /// `units::triangle_test` / `units::closer_hit` over its entries, after `units::Mailbox`.
+    fn model_hits(
+        f: Format,
+        triangles: &[units::Mat34W],
+        bank1: &[u32],
+        rays: &[([u32; 3], [u32; 3])],
+        offers: &[VecDeque<Offer>],
+    ) -> Vec<(bool, u32, u32, u32)> {
+        rays.iter()
+            .zip(offers)
+            .map(|(&(o, d), offers)| {
+                let (mut t_min, mut best) = (0, (false, 0, 0, 0));
+                let (mut instance, mut mailbox) = (0, units::Mailbox::new());
+                for offer in offers {
+                    match *offer {
+                        Offer::Init { t_min: lo, t_max } => {
+                            t_min = lo;
+                            best = (false, t_max, best.2, best.3);
+                        }
+                        Offer::Object(o) => (instance, mailbox) = (o, units::Mailbox::new()),
+                        Offer::List { from, to } => {
+                            for &triangle in &bank1[from as usize..to as usize] {
+                                if mailbox.seen(triangle) {
+                                    continue;
+                                }
+                                let m = triangles[triangle as usize];
+                                let r = units::triangle_test(f, &m, o, d, t_min);
+                                if units::closer_hit(f, &r, best.1) {
+                                    best = (true, r.t, instance, triangle);
+                                }
+                            }
+                        }
+                    }
+                }
+                best
+            })
+            .collect()
+    }
+
+    /// What the driver saw: offers refused by a full queue, engine reads of banks 2 and 3.
+    struct Drive {
+        refused: usize,
+        stolen: usize,
+    }
+
+    /// Runs the tester in rust-hdl simulation with an SRAM model behind banks 1, 2 and 3 (the
+    /// words `mem_latency` clocks after the request): the threads' rays, then their offers
+    /// round robin, every clock a thread has one (a thread never offers in two clocks in a
+    /// row, as in the engine), while the engine takes bank 1, 2 or 3 in one clock of
+    /// `steal_one_in` (none when 0). Asserts the engine's reads get their banks and that every
+    /// thread's closest hit equals `want` once the offers are drained.
+    fn drive_tester(
+        mem_latency: u32,
+        triangles: &[units::Mat34W],
+        bank1: &[u32],
+        rays: &[([u32; 3], [u32; 3])],
+        mut offers: Vec<VecDeque<Offer>>,
+        steal_one_in: u32,
+        rng: &mut impl Rng,
+        want: &[(bool, u32, u32, u32)],
+    ) -> Drive {
+        let mut bank2 = vec![0u32; 8 * triangles.len()];
+        let mut bank3 = vec![0u32; 8 * triangles.len()];
+        for (k, m) in triangles.iter().enumerate() {
+            bank2[8 * k..8 * k + 8].copy_from_slice(&m[..8]);
+            bank3[8 * k..8 * k + 4].copy_from_slice(&m[8..]);
+            for j in 4..8 {
+                bank3[8 * k + j] = rng.gen::<u32>() & 0xff_ffff; // shading words
+            }
+        }
+        let threads = rays.len();
+        let mut u = Tester::new(mem_latency);
+        u.connect_all();
+        let cycle = |u: &mut Tester| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
+        // Ray words, one thread a clock.
+        for (th, (o, d)) in rays.iter().enumerate() {
+            for (pair, (a, b)) in [(o[0], o[1]), (o[2], d[0]), (d[1], d[2])]
+                .into_iter()
+                .enumerate()
+            {
+                u.thread.next = (th as u64).into();
+                u.ray_write.next = true;
+                u.ray_pair.next = (pair as u64).into();
+                u.word_a.next = (a as u64).into();
+                u.word_b.next = (b as u64).into();
+                cycle(&mut u);
+            }
+        }
+        u.ray_write.next = false;
+        let mut requests: VecDeque<[Option<u32>; 3]> = std::iter::repeat([None; 3])
+            .take(mem_latency as usize)
+            .collect();
+        let mut drive = Drive {
+            refused: 0,
+            stolen: 0,
+        };
+        let mut drain = 0;
+        // The thread whose counters were read last clock (the engine's I2): only it may offer.
+        let mut queried: Option<usize> = None;
+        while offers.iter().any(|q| !q.is_empty()) || drain < 4000 {
+            if offers.iter().all(|q| q.is_empty()) {
+                drain += 1;
+            }
+            // The SRAMs answer the request of `mem_latency` clocks ago.
+            let [uv, t, list] = requests.pop_front().unwrap();
+            u.uv_rdata.next = u64::from(uv.map_or(0xdead, |a| bank2[a as usize])).into();
+            u.t_rdata.next = u64::from(t.map_or(0xdead, |a| bank3[a as usize])).into();
+            u.list_rdata.next = u64::from(list.map_or(0xdead, |a| bank1[a as usize])).into();
+            // Round robin over the threads with something to offer (like the engine's turns).
+            let th = queried.filter(|&t| !offers[t].is_empty());
+            let start = th.map_or(0, |t| t + 1);
+            queried = (0..threads)
+                .map(|k| (start + k) % threads)
+                .find(|&k| !offers[k].is_empty() && Some(k) != th);
+            u.query_thread.next = (queried.unwrap_or(0) as u64).into();
+            u.enqueue.next = th.is_some();
+            if let Some(th) = th {
+                use crate::hw::list_unit::{CMD_INIT, CMD_LIST, CMD_OBJECT};
+                let (kind, a, b) = match offers[th][0] {
+                    Offer::Init { t_min, t_max } => (CMD_INIT, t_min, t_max),
+                    Offer::Object(o) => (CMD_OBJECT, o, 0),
+                    Offer::List { from, to } => (CMD_LIST, from, to),
+                };
+                u.thread.next = (th as u64).into();
+                u.queue_kind.next = kind.into();
+                u.word_a.next = u64::from(a).into();
+                u.word_b.next = u64::from(b).into();
+            }
+            let steal = (steal_one_in > 0 && rng.gen_ratio(1, steal_one_in.max(1)))
+                .then(|| (rng.gen_range(1..=3u64), rng.gen_range(0..64u64)));
+            u.engine_read.next = steal.is_some();
+            u.engine_bank.next = steal.map_or(0, |s| s.0).into();
+            u.engine_addr.next = steal.map_or(0, |s| s.1).into();
+            settle(&mut u);
+            if let Some((1, _)) = steal {
+                assert!(!u.list_read.val(), "the list read took the engine's bus");
+            }
+            if let Some((bank @ 2..=3, addr)) = steal {
+                drive.stolen += 1;
+                let (read, port) = if bank == 2 {
+                    (u.uv_read.val(), u.uv_addr.val())
+                } else {
+                    (u.t_read.val(), u.t_addr.val())
+                };
+                assert!(
+                    read && port.to_u64() == addr,
+                    "the engine's read of bank {bank}"
+                );
+            }
+            let port = |read: bool, addr: Bits<24>| read.then(|| addr.to_u64() as u32);
+            requests.push_back([
+                port(u.uv_read.val(), u.uv_addr.val()),
+                port(u.t_read.val(), u.t_addr.val()),
+                port(u.list_read.val(), u.list_addr.val()),
+            ]);
+            if let Some(th) = th {
+                if u.full.val() {
+                    drive.refused += 1;
+                } else {
+                    offers[th].pop_front();
+                }
+            }
+            cycle(&mut u);
+        }
+        u.enqueue.next = false;
+        u.engine_read.next = false;
+        for (th, want) in want.iter().enumerate() {
+            u.query_thread.next = (th as u64).into();
+            cycle(&mut u);
+            assert!(!u.pending.val(), "thread {th} still pending");
+            let got = (
+                u.hit.val(),
+                u.best_t.val().to_u64() as u32,
+                u.best_instance.val().to_u64() as u32,
+                u.best_triangle.val().to_u64() as u32,
+            );
+            if want.0 {
+                assert_eq!(got, *want, "thread {th}: (hit, t, instance, triangle)");
+            } else {
+                assert_eq!(
+                    (got.0, got.1),
+                    (want.0, want.1),
+                    "thread {th}: (hit, best t)"
+                );
+            }
+        }
+        drive
+    }
+
+    /// Four threads each give an object and a new query and 12 lists of 0-7 triangles from a
+    /// shared list bank (so the mailbox drops repeats; a second query half-way for thread 0),
+    /// offered every clock so that the queues fill and refuse; the engine takes banks 1, 2
+    /// and 3 in random clocks. Every thread's closest hit, instance and triangle equal the
+    /// model's.
     #[test]
     fn rust_hdl_simulation_matches_sequential_tests() {
         let f = Format::E7M16;
@@ -647,7 +859,6 @@ mod tests {
         println!("seed {seed}");
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let w = |x: f64| f.from_f64(x);
-        let mem_latency = 3;
         // Triangles: near-identity unit-triangle transforms, so that rays aimed at the unit
         // triangle hit often and at different distances.
         let triangles: Vec<units::Mat34W> = (0..24)
@@ -663,15 +874,6 @@ mod tests {
                 m
             })
             .collect();
-        let mut bank2 = vec![0u32; 8 * triangles.len()];
-        let mut bank3 = vec![0u32; 8 * triangles.len()];
-        for (k, m) in triangles.iter().enumerate() {
-            bank2[8 * k..8 * k + 8].copy_from_slice(&m[..8]);
-            bank3[8 * k..8 * k + 4].copy_from_slice(&m[8..]);
-            for j in 4..8 {
-                bank3[8 * k + j] = rng.gen::<u32>() & 0xff_ffff; // shading words
-            }
-        }
         let bank1: Vec<u32> = (0..200)
             .map(|_| rng.gen_range(0..triangles.len() as u32))
             .collect();
@@ -684,7 +886,7 @@ mod tests {
                 ([w(ox), w(oy), w(oz)], [w(tx - ox), w(ty - oy), w(-oz)])
             })
             .collect();
-        let mut offers: Vec<VecDeque<Offer>> = (0..threads)
+        let offers: Vec<VecDeque<Offer>> = (0..threads)
             .map(|th| {
                 let mut q = VecDeque::new();
                 q.push_back(Offer::Object(rng.gen_range(0..1000)));
@@ -708,160 +910,71 @@ mod tests {
                 q
             })
             .collect();
-        // The model: each thread's entries in order.
-        let want: Vec<(bool, u32, u32, u32)> = (0..threads)
-            .map(|th| {
-                let (o, d) = rays[th];
-                let (mut t_min, mut best) = (0, (false, 0, 0, 0));
-                let (mut instance, mut mailbox) = (0, units::Mailbox::new());
-                for offer in &offers[th] {
-                    match *offer {
-                        Offer::Init { t_min: lo, t_max } => {
-                            t_min = lo;
-                            best = (false, t_max, best.2, best.3);
-                        }
-                        Offer::Object(o) => (instance, mailbox) = (o, units::Mailbox::new()),
-                        Offer::List { from, to } => {
-                            for &triangle in &bank1[from as usize..to as usize] {
-                                if mailbox.seen(triangle) {
-                                    continue;
-                                }
-                                let m = triangles[triangle as usize];
-                                let r = units::triangle_test(f, &m, o, d, t_min);
-                                if units::closer_hit(f, &r, best.1) {
-                                    best = (true, r.t, instance, triangle);
-                                }
-                            }
-                        }
-                    }
-                }
-                best
-            })
-            .collect();
+        let want = model_hits(f, &triangles, &bank1, &rays, &offers);
         assert!(
             want.iter().filter(|b| b.0).count() >= 3,
             "too few hits: {want:?}"
         );
-
-        let mut u = Tester::new(mem_latency);
-        u.connect_all();
-        let cycle = |u: &mut Tester| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
-        // Ray words, one thread a clock.
-        for (th, (o, d)) in rays.iter().enumerate() {
-            for (pair, (a, b)) in [(o[0], o[1]), (o[2], d[0]), (d[1], d[2])]
-                .into_iter()
-                .enumerate()
-            {
-                u.thread.next = (th as u64).into();
-                u.ray_write.next = true;
-                u.ray_pair.next = (pair as u64).into();
-                u.word_a.next = (a as u64).into();
-                u.word_b.next = (b as u64).into();
-                cycle(&mut u);
-            }
-        }
-        u.ray_write.next = false;
-        let mut requests: VecDeque<[Option<u32>; 3]> = std::iter::repeat([None; 3])
-            .take(mem_latency as usize)
-            .collect();
-        let (mut refused, mut stolen, mut drain) = (0, 0, 0);
-        // The thread whose counters were read last clock (the engine's I2): only it may offer.
-        let mut queried: Option<usize> = None;
-        while offers.iter().any(|q| !q.is_empty()) || drain < 4000 {
-            if offers.iter().all(|q| q.is_empty()) {
-                drain += 1;
-            }
-            // The SRAMs answer the request of `mem_latency` clocks ago.
-            let [uv, t, list] = requests.pop_front().unwrap();
-            u.uv_rdata.next = u64::from(uv.map_or(0xdead, |a| bank2[a as usize])).into();
-            u.t_rdata.next = u64::from(t.map_or(0xdead, |a| bank3[a as usize])).into();
-            u.list_rdata.next = u64::from(list.map_or(0xdead, |a| bank1[a as usize])).into();
-            // Round robin over the threads with something to offer (like the engine's turns);
-            // a thread never offers in two clocks in a row (as in the engine: a thread issues
-            // once per write back).
-            let th = queried.filter(|&t| !offers[t].is_empty());
-            let start = th.map_or(0, |t| t + 1);
-            queried = (0..threads)
-                .map(|k| (start + k) % threads)
-                .find(|&k| !offers[k].is_empty() && Some(k) != th);
-            u.query_thread.next = (queried.unwrap_or(0) as u64).into();
-            u.enqueue.next = th.is_some();
-            if let Some(th) = th {
-                use crate::hw::list_unit::{CMD_INIT, CMD_LIST, CMD_OBJECT};
-                let (kind, a, b) = match offers[th][0] {
-                    Offer::Init { t_min, t_max } => (CMD_INIT, t_min, t_max),
-                    Offer::Object(o) => (CMD_OBJECT, o, 0),
-                    Offer::List { from, to } => (CMD_LIST, from, to),
-                };
-                u.thread.next = (th as u64).into();
-                u.queue_kind.next = kind.into();
-                u.word_a.next = u64::from(a).into();
-                u.word_b.next = u64::from(b).into();
-            }
-            // The engine takes bank 1, 2 or 3 in one clock of five.
-            let steal = rng
-                .gen_ratio(1, 5)
-                .then(|| (rng.gen_range(1..=3u64), rng.gen_range(0..64u64)));
-            u.engine_read.next = steal.is_some();
-            u.engine_bank.next = steal.map_or(0, |s| s.0).into();
-            u.engine_addr.next = steal.map_or(0, |s| s.1).into();
-            settle(&mut u);
-            if let Some((1, _)) = steal {
-                assert!(!u.list_read.val(), "the list read took the engine's bus");
-            }
-            if let Some((bank @ 2..=3, addr)) = steal {
-                stolen += 1;
-                let (read, port) = if bank == 2 {
-                    (u.uv_read.val(), u.uv_addr.val())
-                } else {
-                    (u.t_read.val(), u.t_addr.val())
-                };
-                assert!(
-                    read && port.to_u64() == addr,
-                    "the engine's read of bank {bank}"
-                );
-            }
-            let port = |read: bool, addr: Bits<24>| read.then(|| addr.to_u64() as u32);
-            requests.push_back([
-                port(u.uv_read.val(), u.uv_addr.val()),
-                port(u.t_read.val(), u.t_addr.val()),
-                port(u.list_read.val(), u.list_addr.val()),
-            ]);
-            if let Some(th) = th {
-                if u.full.val() {
-                    refused += 1;
-                } else {
-                    offers[th].pop_front();
-                }
-            }
-            cycle(&mut u);
-        }
-        u.enqueue.next = false;
-        u.engine_read.next = false;
+        let drive = drive_tester(3, &triangles, &bank1, &rays, offers, 5, &mut rng, &want);
         assert!(
-            refused > 0,
+            drive.refused > 0,
             "the queue never filled: back-pressure untested"
         );
-        assert!(stolen > 0);
-        for (th, want) in want.iter().enumerate() {
-            u.query_thread.next = (th as u64).into();
-            cycle(&mut u);
-            assert!(!u.pending.val(), "thread {th} still pending");
-            let got = (
-                u.hit.val(),
-                u.best_t.val().to_u64() as u32,
-                u.best_instance.val().to_u64() as u32,
-                u.best_triangle.val().to_u64() as u32,
-            );
-            if want.0 {
-                assert_eq!(got, *want, "thread {th}: (hit, t, instance, triangle)");
-            } else {
-                assert_eq!(
-                    (got.0, got.1),
-                    (want.0, want.1),
-                    "thread {th}: (hit, best t)"
-                );
+        assert!(drive.stolen > 0);
+    }
+
+    /// Every format the generator accepts has enough in-flight slots (the `new` assertion).
+    #[test]
+    fn flight_slots_outlast_the_latency_in_every_format() {
+        for e in Format::MIN_EXP_BITS..=Format::MAX_EXP_BITS {
+            for m in Format::MIN_MAN_BITS..=Format::MAX_MAN_BITS {
+                let f = Format::new(e, m).unwrap();
+                assert!(flight_slots_suffice(f), "{f}: {}", launch_to_merge(f));
             }
         }
+        // 16 slots, the design before, do not suffice at the default format.
+        assert!(!(16 * LAUNCH_SPACING > launch_to_merge(Format::E7M16)));
+    }
+
+    /// A burst of new queries launches right behind a thread's hit, one every 4 clocks (the
+    /// fastest launches): more entries launch within the hit's latency than 16. The hit keeps
+    /// its triangle and instance (each in-flight entry keeps its own slot until it merges),
+    /// and the bursting threads end with no hit.
+    #[test]
+    fn launch_burst_behind_a_hit_keeps_its_triangle() {
+        let f = Format::E7M16;
+        let w = |x: f64| f.from_f64(x);
+        // The unit triangle itself; the rays from z = 1 straight down into it.
+        let mut unit = [0; 12];
+        for r in 0..3 {
+            unit[5 * r] = w(1.0);
+        }
+        let triangles = vec![unit; 8];
+        let bank1: Vec<u32> = (0..8).collect();
+        let threads = 24usize;
+        let rays: Vec<([u32; 3], [u32; 3])> = (0..threads)
+            .map(|_| ([w(0.25), w(0.25), w(1.0)], [0, 0, w(-1.0)]))
+            .collect();
+        let init = Offer::Init {
+            t_min: 0,
+            t_max: f.infinity(false),
+        };
+        let offers: Vec<VecDeque<Offer>> = (0..threads)
+            .map(|th| {
+                let mut q = VecDeque::from([Offer::Object(100 + th as u32), init]);
+                if th == 0 {
+                    // The list's last triangle is the one that counts: every earlier one
+                    // is at the same t, and the first of equal ts stays.
+                    q.push_back(Offer::List { from: 7, to: 8 });
+                } else {
+                    q.extend(std::iter::repeat(init).take(3));
+                }
+                q
+            })
+            .collect();
+        let want = model_hits(f, &triangles, &bank1, &rays, &offers);
+        assert_eq!(want[0], (true, w(1.0), 100, 7), "the model's hit");
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
+        drive_tester(1, &triangles, &bank1, &rays, offers, 0, &mut rng, &want);
     }
 }
