@@ -92,7 +92,7 @@ fn prepare(
         "the scene's deepest object kd tree has {deepest} levels; the traversal unit's stack \
          holds {STACK_LEVELS}: use fewer triangles per object or split the mesh into instances"
     );
-    let program = build_program(&ProgramConfig::from_layout(f, &layouts[0].info));
+    let program = build_program(&ProgramConfig::from_layout(&layouts[0]));
     let twin = Machine::new(&program, &layouts[0])
         .run_frame(params.threads as usize)
         .context("the engine's twin failed on frame 0 (a generator bug)")?

@@ -22,7 +22,7 @@ fn layout_of(name: &str, w: u32, h: u32, f: Format, frame: u32) -> Layout {
 
 /// Pixels where the twin differs from the golden model, and how many pixels hit something.
 fn mismatches(l: &Layout, f: Format) -> (Vec<(u32, u32, u32, u32)>, usize) {
-    let program = build_program(&ProgramConfig::from_layout(f, &l.info));
+    let program = build_program(&ProgramConfig::from_layout(l));
     let golden = model::render_golden(l, false);
     let m = Machine::new(&program, l);
     let (w, h) = (l.info.width, l.info.height);
@@ -75,7 +75,7 @@ fn microprogram_renders_the_golden_frame_on_every_bundled_scene() {
 fn engine_order_frame_equals_per_pixel_runs_and_every_pixel_is_written() {
     let f = Format::E7M16;
     let l = layout_of("mirror.toml", 16, 12, f, 0);
-    let program = build_program(&ProgramConfig::from_layout(f, &l.info));
+    let program = build_program(&ProgramConfig::from_layout(&l));
     let m = Machine::new(&program, &l);
     let frame = m.run_frame(32).unwrap();
     let golden = model::render_golden(&l, false);
@@ -106,14 +106,14 @@ fn animated_frames_match_the_golden_model() {
 fn the_program_leaves_out_what_the_scene_does_not_need() {
     let f = Format::E7M16;
     let plain = layout_of("cornell_noshadow.toml", 16, 12, f, 0);
-    let p = build_program(&ProgramConfig::from_layout(f, &plain.info));
+    let p = build_program(&ProgramConfig::from_layout(&plain));
     let names: Vec<&str> = p.sections.clone();
     assert!(
         !names.contains(&"shadow") && !names.contains(&"mirror") && !names.contains(&"instances")
     );
     assert!(p.left_out.iter().any(|s| s.contains("shadow")));
     let full = layout_of("mirror.toml", 16, 12, f, 0);
-    let q = build_program(&ProgramConfig::from_layout(f, &full.info));
+    let q = build_program(&ProgramConfig::from_layout(&full));
     assert!(q.sections.contains(&"mirror"));
     assert!(q.code.len() > p.code.len());
     println!(

@@ -93,7 +93,7 @@ fn a_frame_that_cannot_finish_in_time_is_a_clear_timeout_error() {
     use dynrt::hw::program::{build_program, ProgramConfig};
     let s = scene("cornell_noshadow.toml", 4, 3);
     let layouts = flow::scene_layouts(&s, Format::E7M16, None).unwrap();
-    let p = build_program(&ProgramConfig::from_layout(Format::E7M16, &layouts[0].info));
+    let p = build_program(&ProgramConfig::from_layout(&layouts[0]));
     let dir = tempfile::tempdir().unwrap();
     let e = simulate_processor(
         &p,
@@ -127,7 +127,7 @@ fn the_display_shows_the_rendered_frame_magnified_and_centred() {
     let (w, h) = (20, 12);
     let s = scene("cornell_noshadow.toml", w, h);
     let layouts = flow::scene_layouts(&s, Format::E7M16, None).unwrap();
-    let p = build_program(&ProgramConfig::from_layout(Format::E7M16, &layouts[0].info));
+    let p = build_program(&ProgramConfig::from_layout(&layouts[0]));
     let dir = tempfile::tempdir().unwrap();
     let r = simulate_processor(
         &p,

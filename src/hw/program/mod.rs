@@ -29,7 +29,7 @@ use asm::{Asm, Reg};
 use isa::{Instr, Unit};
 
 use crate::fp::Format;
-use crate::layout::LayoutInfo;
+use crate::layout::Layout;
 
 /// What the generated processor is built for.
 #[derive(Clone, Debug, PartialEq)]
@@ -49,10 +49,15 @@ pub struct ProgramConfig {
     pub stack_entries: u32,
     /// The deepest object tree (the traversal unit's stack holds that many entries).
     pub object_depth: u32,
+    /// Primary rays leave out the camera's z column (`units::camera_z_column_vanishes`; the
+    /// processor keeps frame 0's camera for every frame).
+    pub planar_camera: bool,
 }
 
 impl ProgramConfig {
-    pub fn from_layout(format: Format, info: &LayoutInfo) -> Self {
+    pub fn from_layout(layout: &Layout) -> Self {
+        let (format, info) = (layout.format, &layout.info);
+        let camera = layout.words(crate::layout::FRAME, crate::layout::FrameMap::CAMERA);
         ProgramConfig {
             format,
             width: info.width,
@@ -70,6 +75,7 @@ impl ProgramConfig {
                 0
             },
             object_depth: info.object_depth,
+            planar_camera: crate::units::camera_z_column_vanishes(format, &camera),
         }
     }
 }

@@ -2,7 +2,8 @@
 //! and `shade`, step for step).
 //!
 //! State machine per thread: take a pixel (or halt when the frame is done); the primary ray is
-//! the camera transform of (x, y, 0) (`units::primary_direction_of`); trace it. On a hit: the
+//! the camera transform of (x, y, 0) (`units::primary_direction_of`, or without the z column
+//! when that is the same: `units::primary_direction_planar`); trace it. On a hit: the
 //! hit point, the triangle's normal (through the instance's normal matrix when there is a top
 //! level) made unit and facing the ray, the ambient term, and per light (unrolled) the Lambert
 //! term, after a shadow query when shadows are on. A mirror material within the reflection
@@ -50,7 +51,14 @@ impl Gen<'_> {
         a.section("init");
         let load = |addr: usize| a.keep(self.frame_word(addr as u32));
         let s = &self.s;
-        let camera = std::array::from_fn(|k| load(FrameMap::CAMERA + k));
+        // A planar camera's z column is never read.
+        let camera = std::array::from_fn(|k| {
+            if c.planar_camera && k % 4 == 2 {
+                Reg::ZERO
+            } else {
+                load(FrameMap::CAMERA + k)
+            }
+        });
         // Without secondary rays every query starts at the eye with t_min 0 and t_max
         // infinity: the query registers hold them for the whole frame.
         let eye = if self.secondary_rays() {
@@ -121,7 +129,11 @@ impl Gen<'_> {
         a.next_pixel(pixel, frame_done);
         a.op_to(Op::And, x, pixel.into(), Val::K(0xffff));
         a.op_to(Op::Shr, y, pixel.into(), Val::K(16));
-        let dir = units::primary_direction_of(a, &camera.map(Val::R), x.into(), y.into());
+        let dir = if c.planar_camera {
+            units::primary_direction_planar(a, &camera.map(Val::R), x.into(), y.into())
+        } else {
+            units::primary_direction_of(a, &camera.map(Val::R), x.into(), y.into())
+        };
         a.assign3(ray_d, dir);
         a.end_temps();
         if secondary {
