@@ -565,7 +565,10 @@ mod planar_camera_tests {
             }
             // Both sides of the rule occur: cameras it accepts, and rejected ones that do
             // differ somewhere.
-            assert!(agreed > 20 && differed > 20, "{f}: {agreed} agreed, {differed} differed");
+            assert!(
+                agreed > 20 && differed > 20,
+                "{f}: {agreed} agreed, {differed} differed"
+            );
         }
     }
 }

@@ -865,6 +865,16 @@ impl<
         }
         // Traversal unit (op 30, function in imm): start 0, wait 1, end 2, next 3. It sees the
         // object-space ray and t_min the thread gives the tester.
+        // The traversal unit hands its leaves to the tester, the tester its answers back.
+        self.tester.walk_list_valid.next = self.traversal_unit.leaf_valid.val();
+        self.tester.walk_list_thread.next = self.traversal_unit.leaf_thread.val();
+        self.tester.walk_list_from.next = self.traversal_unit.leaf_from.val();
+        self.tester.walk_list_to.next = self.traversal_unit.leaf_to.val();
+        self.traversal_unit.leaf_take.next = self.tester.walk_list_take.val();
+        self.traversal_unit.answer_valid.next = self.tester.walk_end_event.val();
+        self.traversal_unit.answer_thread.next = self.tester.walk_end_thread.val();
+        self.traversal_unit.answer_t.next = self.tester.walk_end_t.val();
+        self.traversal_unit.answer_hit.next = self.tester.walk_end_hit.val();
         self.traversal_unit.thread.next = self.t3.q.val();
         self.traversal_unit.word_a.next = self.opa.val();
         self.traversal_unit.word_b.next = self.opb.val();

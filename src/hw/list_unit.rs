@@ -14,7 +14,9 @@
 //! Launch side: `test_valid` / `test_entry` is the head of the test queue, `test_take` pops
 //! it. Entries `{kind[70:69], thread[68:64], a[63:32], b[31:0]}`: [`TEST_TRIANGLE`] (a the
 //! triangle, b the instance), [`TEST_INIT`] (the init command) and [`TEST_LIST_END`], queued
-//! behind a list's last test so that the tester can count the list as done.
+//! behind a list's last test so that the tester can count the list as done ([`TEST_WALK_END`]
+//! for a list of a traversal-unit walk, marked [`LIST_OF_WALK`]: the tester answers the
+//! traversal unit with the closest hit instead).
 //!
 //! Memory: one bank-1 read per clock on `list_*`, the word `mem_latency` clocks later; the
 //! engine's port shares the bus (`engine_read` of banks 1, 4, 5 goes first).
@@ -30,6 +32,9 @@ use rust_hdl::prelude::*;
 
 /// Command kinds (the engine's `kind`).
 pub const CMD_LIST: u64 = 0;
+/// Bit 31 of a [`CMD_LIST`]'s `word_b` (the list end, an address below 2^24): the list is a
+/// leaf of a traversal-unit walk, whose end entry is a [`TEST_WALK_END`].
+pub const LIST_OF_WALK: u64 = 1 << 31;
 pub const CMD_INIT: u64 = 1;
 pub const CMD_OBJECT: u64 = 2;
 pub const CMD_SKIP: u64 = 3;
@@ -37,6 +42,8 @@ pub const CMD_SKIP: u64 = 3;
 pub const TEST_TRIANGLE: u64 = 0;
 pub const TEST_INIT: u64 = 1;
 pub const TEST_LIST_END: u64 = 2;
+/// The end of a walk's list ([`LIST_OF_WALK`]): the tester answers the traversal unit.
+pub const TEST_WALK_END: u64 = 3;
 
 /// A queue entry: `{kind[70:69], thread[68:64], a[63:32], b[31:0]}`.
 pub type ListEntry = Bits<71>;
@@ -76,6 +83,8 @@ pub struct ListUnit {
     walk_thread: DFF<Bits<5>>,
     cursor: DFF<Bits<24>>,
     list_end: DFF<Bits<24>>,
+    /// The list being walked is a leaf of a traversal-unit walk.
+    of_walk: DFF<Bit>,
     object_id: DFF<Bits<32>>,
     skip_object: DFF<Bits<32>>,
     skip_triangle: DFF<Bits<32>>,
@@ -142,6 +151,7 @@ impl ListUnit {
             walk_thread: Default::default(),
             cursor: Default::default(),
             list_end: Default::default(),
+            of_walk: Default::default(),
             object_id: Default::default(),
             skip_object: Default::default(),
             skip_triangle: Default::default(),
@@ -176,6 +186,7 @@ impl Logic for ListUnit {
             walk_thread,
             cursor,
             list_end,
+            of_walk,
             object_id,
             skip_object,
             skip_triangle,
@@ -269,6 +280,7 @@ impl Logic for ListUnit {
                 self.walk_thread.d.next = self.commands.data_out.val().get_bits::<5>(64);
                 self.cursor.d.next = self.commands.data_out.val().get_bits::<24>(32);
                 self.list_end.d.next = self.commands.data_out.val().get_bits::<24>(0);
+                self.of_walk.d.next = self.commands.data_out.val().get_bit(31);
                 self.commands.read.next = true;
                 self.phase.d.next = 1.into();
             }
@@ -363,8 +375,9 @@ impl Logic for ListUnit {
             & (!self.tests.full.val())
         {
             self.push.next = true;
-            self.tests.data_in.next =
-                self.c_list_end.val() | (bit_cast::<71, 5>(self.walk_thread.q.val()) << 64);
+            self.tests.data_in.next = self.c_list_end.val()
+                | (bit_cast::<71, 1>(self.of_walk.q.val().into()) << 69)
+                | (bit_cast::<71, 5>(self.walk_thread.q.val()) << 64);
             self.phase.d.next = 0.into();
         }
         self.tests.write.next = self.push.val();
@@ -405,12 +418,22 @@ mod tests {
                 Command::Skip(i, t) => skip = (i, t),
                 Command::Init(a, b) => out.push((TEST_INIT, a, b)),
                 Command::List(from, to) => {
-                    for &triangle in &bank1[from as usize..to as usize] {
+                    let end = to & 0xff_ffff;
+                    for &triangle in &bank1[from as usize..end as usize] {
                         if (object, triangle) != skip && !mailbox.seen(triangle) {
                             out.push((TEST_TRIANGLE, triangle, object));
                         }
                     }
-                    out.push((TEST_LIST_END, 0, 0));
+                    let of_walk = u64::from(to) & LIST_OF_WALK != 0;
+                    out.push((
+                        if of_walk {
+                            TEST_WALK_END
+                        } else {
+                            TEST_LIST_END
+                        },
+                        0,
+                        0,
+                    ));
                 }
             }
         }
@@ -418,8 +441,8 @@ mod tests {
     }
 
     /// rust-hdl simulation: four threads offer objects, skips, inits and lists (lists that
-    /// repeat triangles, so the mailbox hits and evicts, and some that hold the skipped
-    /// triangle), a command most clocks; the engine takes the bus in one clock of four; the
+    /// repeat triangles, so the mailbox hits and evicts, some that hold the skipped triangle,
+    /// half of them a walk's, which end in a walk end), a command most clocks; the engine takes the bus in one clock of four; the
     /// launch takes tests in random clocks, so both queues fill. Each thread's entries equal
     /// the model's, in order.
     #[test]
@@ -443,7 +466,13 @@ mod tests {
                     s.push(Command::Init(q, 1000 + q));
                     for _ in 0..rng.gen_range(1..4) {
                         let from = rng.gen_range(0..380u32);
-                        s.push(Command::List(from, from + rng.gen_range(0..16)));
+                        // Half the lists are leaves of a traversal-unit walk.
+                        let walk = if rng.gen_bool(0.5) {
+                            LIST_OF_WALK as u32
+                        } else {
+                            0
+                        };
+                        s.push(Command::List(from, (from + rng.gen_range(0..16)) | walk));
                     }
                 }
                 s

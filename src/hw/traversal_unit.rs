@@ -94,11 +94,32 @@ pub struct TraversalUnit<
     pub node_rdata: Signal<In, Bits<32>>,
     /// High in the clocks a node decision starts.
     pub step_busy: Signal<Out, Bit>,
-    /// High when `done_thread`'s walk reaches a leaf or ends (its pending count changes).
+    /// High when `done_thread`'s walk ends (its pending count changes).
     pub done_event: Signal<Out, Bit>,
     pub done_thread: Signal<Out, Bits<5>>,
+    /// Leaves for the triangle tester: `leaf_thread`'s list, bank-1 words
+    /// `leaf_from..leaf_to`; `leaf_take` pops it.
+    pub leaf_valid: Signal<Out, Bit>,
+    pub leaf_thread: Signal<Out, Bits<5>>,
+    pub leaf_from: Signal<Out, Bits<32>>,
+    pub leaf_to: Signal<Out, Bits<32>>,
+    pub leaf_take: Signal<In, Bit>,
+    /// The tester's answer for a leaf: `answer_thread`'s closest hit so far (`answer_t`,
+    /// `answer_hit`). It goes into the queue ahead of the engine's entry of that clock.
+    pub answer_valid: Signal<In, Bit>,
+    pub answer_thread: Signal<In, Bits<5>>,
+    pub answer_t: Signal<In, Bits<32>>,
+    pub answer_hit: Signal<In, Bit>,
 
     entry_fifo: SynchronousFIFO<Entry, 5, 6, 1>,
+    /// `{thread[68:64], from[63:32], to[31:0]}`: a thread has at most one leaf out.
+    leaf_fifo: SynchronousFIFO<Bits<69>, 5, 6, 1>,
+    /// Per thread: the walk answers any hit (a shadow query: `kd.start`'s root bit 31).
+    any_hit: RAM<Bits<1>, 5>,
+    engine_full: Signal<Local, Bit>,
+    a_end: Signal<Local, Bit>,
+    /// The leaf's list end: list address plus count.
+    a_list_end: Signal<Local, Bits<32>>,
     front_fifo: SynchronousFIFO<Job, 5, 6, 1>,
     loop_fifo: SynchronousFIFO<Job, 5, 6, 1>,
     /// Per thread: ray o, d and t_min (engine-written); entries taken (engine); entries done,
@@ -254,7 +275,21 @@ impl<
             step_busy: Default::default(),
             done_event: Default::default(),
             done_thread: Default::default(),
+            leaf_valid: Default::default(),
+            leaf_thread: Default::default(),
+            leaf_from: Default::default(),
+            leaf_to: Default::default(),
+            leaf_take: Default::default(),
+            answer_valid: Default::default(),
+            answer_thread: Default::default(),
+            answer_t: Default::default(),
+            answer_hit: Default::default(),
             entry_fifo: Default::default(),
+            leaf_fifo: Default::default(),
+            any_hit: Default::default(),
+            engine_full: Default::default(),
+            a_end: Default::default(),
+            a_list_end: Default::default(),
             front_fifo: Default::default(),
             loop_fifo: Default::default(),
             ray: Default::default(),
@@ -377,6 +412,7 @@ impl<
             self,
             clock,
             entry_fifo,
+            leaf_fifo,
             front_fifo,
             loop_fifo,
             ray,
@@ -393,6 +429,8 @@ impl<
         );
         self.issued.read_clock.next = self.clock.val();
         self.issued.write_clock.next = self.clock.val();
+        self.any_hit.read_clock.next = self.clock.val();
+        self.any_hit.write_clock.next = self.clock.val();
         self.done_e.read_clock.next = self.clock.val();
         self.done_e.write_clock.next = self.clock.val();
         self.done_u.read_clock.next = self.clock.val();
@@ -429,12 +467,26 @@ impl<
         self.ray.ray_write.next = self.ray_write.val();
         self.ray.ray_pair.next = self.ray_pair.val();
         self.ray.t_min_write.next = self.t_min_write.val();
-        self.full.next = self.entry_fifo.full.val();
-        self.entry_fifo.write.next = self.enqueue.val() & (!self.entry_fifo.full.val());
+        // The tester's answer takes the queue first (a thread has one entry in the unit at a
+        // time, so the queue never overflows with it).
+        self.engine_full.next = self.entry_fifo.full.val() | self.answer_valid.val();
+        self.full.next = self.engine_full.val();
+        self.entry_fifo.write.next =
+            (self.enqueue.val() & (!self.engine_full.val())) | self.answer_valid.val();
         self.entry_fifo.data_in.next = (bit_cast::<70, 1>(self.enqueue_next.val().into()) << 69)
             | (bit_cast::<70, 5>(self.thread.val()) << 64)
             | (bit_cast::<70, 32>(self.word_a.val()) << 32)
             | bit_cast::<70, 32>(self.word_b.val());
+        if self.answer_valid.val() {
+            self.entry_fifo.data_in.next = (bit_cast::<70, 1>(true.into()) << 69)
+                | (bit_cast::<70, 5>(self.answer_thread.val()) << 64)
+                | (bit_cast::<70, 32>(self.answer_t.val()) << 32)
+                | bit_cast::<70, 1>(self.answer_hit.val().into());
+        }
+        self.any_hit.write_address.next = self.thread.val();
+        self.any_hit.write_data.next = bit_cast::<1, 1>(self.word_a.val().get_bit(31).into());
+        self.any_hit.write_enable.next =
+            self.enqueue.val() & (!self.engine_full.val()) & (!self.enqueue_next.val());
         self.issued.read_address.next = self.query_thread.val();
         self.done_e.read_address.next = self.query_thread.val();
         self.result_e.read_address.next = self.query_thread.val();
@@ -444,7 +496,7 @@ impl<
         self.list_end.next = self.end_e.read_data.val();
         self.issued.write_address.next = self.thread.val();
         self.issued.write_data.next = self.issued.read_data.val() + 1;
-        self.issued.write_enable.next = self.enqueue.val() & (!self.entry_fifo.full.val());
+        self.issued.write_enable.next = self.enqueue.val() & (!self.engine_full.val());
 
         // Front: one engine entry a clock, a job five clocks later.
         self.entry_fifo.read.next = !self.entry_fifo.empty.val();
@@ -505,12 +557,14 @@ impl<
         self.f5_lo.d.next = self.f4_lo.q.val();
         self.f5_hi.d.next = self.f4_hi.q.val();
         self.f5_in_leaf.d.next = self.cmp_leaf.le.val();
+        self.any_hit.read_address.next = self.f4_thread.q.val();
         // f5: a start steps from the root (`a`) with [t_min, t_max = `b`]; a next ends the
-        // walk when the hit lies in the leaf's segment, the stack is empty or the popped
-        // segment starts behind the hit, else steps from the popped entry.
+        // walk when the hit lies in the leaf's segment, the walk answers any hit, the stack is
+        // empty or the popped segment starts behind the hit, else steps from the popped entry.
         self.f5_pop.next = self.f5_sp.q.val() - 1;
         self.front_end.next = self.f5_next.q.val()
             & ((self.f5_b.q.val().get_bit(0) & self.f5_in_leaf.q.val())
+                | (self.f5_b.q.val().get_bit(0) & (self.any_hit.read_data.val() != 0))
                 | (self.f5_sp.q.val() == 0)
                 | (self.f5_b.q.val().get_bit(0) & self.cmp_pop.lt.val()));
         self.front_job.next = (bit_cast::<102, 1>(self.front_end.val().into()) << 101)
@@ -599,7 +653,20 @@ impl<
             self.a_d.next = self.ray.d[2].val();
         }
         self.a_inner.next = self.at_a.val() & (!self.a_leaf.val());
-        // A leaf (or the end): the result for the engine, the segment end and depth for next.
+        // A leaf goes to the tester; the end to the engine. Either keeps the segment end and
+        // depth for the answer.
+        self.a_end.next = self.at_a.val() & self.job.q.val().get_bit(101);
+        self.a_list_end.next =
+            bit_cast::<32, 30>(self.w0.q.val().get_bits::<30>(0)) + self.w1.q.val();
+        self.leaf_fifo.write.next = self.at_a.val() & self.a_leaf.val() & (!self.a_end.val());
+        self.leaf_fifo.data_in.next = (bit_cast::<69, 5>(self.job.q.val().get_bits::<5>(96)) << 64)
+            | (bit_cast::<69, 30>(self.w0.q.val().get_bits::<30>(0)) << 32)
+            | bit_cast::<69, 32>(self.a_list_end.val());
+        self.leaf_valid.next = !self.leaf_fifo.empty.val();
+        self.leaf_thread.next = self.leaf_fifo.data_out.val().get_bits::<5>(64);
+        self.leaf_from.next = self.leaf_fifo.data_out.val().get_bits::<32>(32);
+        self.leaf_to.next = self.leaf_fifo.data_out.val().get_bits::<32>(0);
+        self.leaf_fifo.read.next = self.leaf_take.val();
         self.result_e.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.end_e.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.done_e.write_address.next = self.job.q.val().get_bits::<5>(96);
@@ -609,8 +676,7 @@ impl<
         if self.job.q.val().get_bit(101) {
             self.result_e.write_data.next = self.c_finished.val();
         }
-        self.end_e.write_data.next =
-            bit_cast::<32, 30>(self.w0.q.val().get_bits::<30>(0)) + self.w1.q.val();
+        self.end_e.write_data.next = self.a_list_end.val();
         self.leaf_hi.write_data.next = self.job.q.val().get_bits::<W>(0);
         self.leaf_sp.write_data.next = self.job.q.val().get_bits::<6>(90);
         // Entries done: the unit's copy is read at the job's thread, the engine's at its own.
@@ -618,11 +684,11 @@ impl<
         self.done_u.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.done_e.write_data.next = self.done_u.read_data.val() + 1;
         self.done_u.write_data.next = self.done_u.read_data.val() + 1;
-        self.done_u.write_enable.next = self.at_a.val() & self.a_leaf.val();
-        self.result_e.write_enable.next = self.at_a.val() & self.a_leaf.val();
-        self.end_e.write_enable.next = self.at_a.val() & self.a_leaf.val();
-        self.done_e.write_enable.next = self.at_a.val() & self.a_leaf.val();
-        self.done_event.next = self.at_a.val() & self.a_leaf.val();
+        self.done_u.write_enable.next = self.a_end.val();
+        self.result_e.write_enable.next = self.a_end.val();
+        self.end_e.write_enable.next = self.a_end.val();
+        self.done_e.write_enable.next = self.a_end.val();
+        self.done_event.next = self.a_end.val();
         self.done_thread.next = self.job.q.val().get_bits::<5>(96);
         self.leaf_hi.write_enable.next = self.at_a.val() & self.a_leaf.val();
         self.leaf_sp.write_enable.next = self.at_a.val() & self.a_leaf.val();
@@ -736,10 +802,12 @@ mod tests {
     type Unit = TraversalUnit<24, 7, 16, 17, 18, 9, 21, { div_latency(16) as usize }>;
 
     /// rust-hdl simulation on the Cornell box's kd tree with an SRAM model behind bank 0:
-    /// eight threads walk from the root with rays from around the eye; after each leaf the
-    /// thread answers `next` with no hit, or (from its third leaf on, one thread in two) a hit
-    /// at a random distance. Every thread's sequence of leaves and its end equal
-    /// `units::KdWalk`'s; the engine takes bank 0 in random clocks.
+    /// eight threads start walks from the root with rays from around the eye (two of them
+    /// any-hit walks); the test plays the triangle tester: it takes each leaf in random
+    /// clocks and answers it some clocks later with no hit, or (from a thread's third leaf
+    /// on, one thread in two) a hit at a random distance. Every thread's sequence of leaves
+    /// and its end equal `units::KdWalk`'s (an any-hit walk ends at its first hit); the engine
+    /// takes bank 0 in random clocks, and its starts are refused while an answer goes in.
     #[test]
     fn rust_hdl_simulation_walks_like_the_model() {
         let f = Format::E7M16;
@@ -756,6 +824,7 @@ mod tests {
         let eye = lay.words::<3>(FRAME, FrameMap::EYE);
         let mem_latency = 2;
         let threads = 8usize;
+        let any_hit = |th: usize| th == 5 || th == 7;
         let w = |x: f64| f.from_f64(x);
         let rays: Vec<([u32; 3], [u32; 3])> = (0..threads)
             .map(|_| {
@@ -768,7 +837,7 @@ mod tests {
                 (o, d)
             })
             .collect();
-        // The answer a thread gives after its k-th leaf.
+        // The answer the tester gives after a thread's k-th leaf.
         let answers: Vec<Vec<(u32, bool)>> = (0..threads)
             .map(|th| {
                 (0..64)
@@ -791,9 +860,12 @@ mod tests {
                 let mut stops = vec![stop];
                 let mut k = 0;
                 while stop != KdStop::Finished {
-                    stop = walk
-                        .next(f, rays[th], answers[th][k], STACK_LEVELS, fetch)
-                        .unwrap();
+                    stop = if any_hit(th) && answers[th][k].1 {
+                        KdStop::Finished
+                    } else {
+                        walk.next(f, rays[th], answers[th][k], STACK_LEVELS, fetch)
+                            .unwrap()
+                    };
                     stops.push(stop);
                     k += 1;
                 }
@@ -804,6 +876,7 @@ mod tests {
             want.iter().map(Vec::len).sum::<usize>() > 4 * threads,
             "too few leaves"
         );
+        assert!(want[7].len() == 4, "the any-hit walk ends at its first hit");
 
         let mut u = Unit::new(mem_latency);
         u.connect_all();
@@ -826,19 +899,29 @@ mod tests {
             cycle(&mut u);
             u.t_min_write.next = false;
         }
-        // Per thread: the entry to offer next (start first), whether one is in flight.
-        let mut offer: Vec<Option<(bool, u32, u32)>> = (0..threads as u32)
-            .map(|_| Some((false, root, t_max)))
-            .collect();
-        let mut in_flight = vec![false; threads];
-        let mut got: Vec<Vec<KdStop>> = vec![Vec::new(); threads];
-        let mut requests: VecDeque<Option<u32>> =
-            std::iter::repeat(None).take(mem_latency as usize).collect();
-        let (mut clocks, mut stolen) = (0, 0);
-        // Two clocks per turn of a thread, as the engine's I2 and I3: present the thread to
-        // the counters, then read its answer and offer its entry.
-        let mut tick = |u: &mut Unit, rng: &mut rand_chacha::ChaCha8Rng| {
-            let addr = requests.pop_front().unwrap();
+        /// The test's side of the unit: the SRAM, the engine's stolen reads, the tester.
+        struct Bench {
+            requests: VecDeque<Option<u32>>,
+            stolen: usize,
+            refused: usize,
+            /// Answers due: (clock, thread, best t, hit).
+            due: Vec<(u64, usize, u32, bool)>,
+            clock: u64,
+            got: Vec<Vec<KdStop>>,
+        }
+        let mut b = Bench {
+            requests: std::iter::repeat(None).take(mem_latency as usize).collect(),
+            stolen: 0,
+            refused: 0,
+            due: Vec::new(),
+            clock: 0,
+            got: vec![Vec::new(); threads],
+        };
+        // One clock; returns whether the engine's offer (if any) was taken. An answer goes in
+        // early when the engine offers, so that the two meet.
+        let tick = |u: &mut Unit, b: &mut Bench, rng: &mut rand_chacha::ChaCha8Rng, offer: bool| {
+            b.clock += 1;
+            let addr = b.requests.pop_front().unwrap();
             u.node_rdata.next = u64::from(addr.map_or(0xdead_beef, |a| nodes[a as usize])).into();
             let steal = rng
                 .gen_ratio(1, 6)
@@ -846,59 +929,81 @@ mod tests {
             u.engine_read.next = steal.is_some();
             u.engine_bank.next = 0.into();
             u.engine_addr.next = steal.unwrap_or(0).into();
+            // The tester answers one due leaf a clock.
+            let answer = b.due.iter().position(|d| d.0 <= b.clock || offer);
+            u.answer_valid.next = answer.is_some();
+            if let Some(k) = answer {
+                let (_, th, t, hit) = b.due.remove(k);
+                u.answer_thread.next = (th as u64).into();
+                u.answer_t.next = u64::from(t).into();
+                u.answer_hit.next = hit;
+            }
+            u.leaf_take.next = false;
             settle(u);
+            if u.leaf_valid.val() && rng.gen_bool(0.5) {
+                u.leaf_take.next = true;
+                settle(u);
+                let th = u.leaf_thread.val().to_u64() as usize;
+                let from = u.leaf_from.val().to_u64() as u32;
+                let to = u.leaf_to.val().to_u64() as u32;
+                let k = b.got[th].len();
+                b.got[th].push(KdStop::Leaf {
+                    list: from,
+                    count: to - from,
+                });
+                let (t, hit) = answers[th][k];
+                b.due.push((b.clock + rng.gen_range(4..60), th, t, hit));
+            }
             if let Some(a) = steal {
-                stolen += 1;
+                b.stolen += 1;
                 assert!(
                     u.node_read.val() && u.node_addr.val().to_u64() == a,
                     "the engine's read"
                 );
             }
-            requests.push_back(u.node_read.val().then(|| u.node_addr.val().to_u64() as u32));
+            b.requests
+                .push_back(u.node_read.val().then(|| u.node_addr.val().to_u64() as u32));
             let full = u.full.val();
+            if full && u.enqueue.val() {
+                b.refused += 1;
+            }
             cycle(u);
             !full
         };
+        // Per thread: whether its start is still to offer, whether its walk is in flight.
+        let mut to_start = vec![true; threads];
+        let mut in_flight = vec![false; threads];
         let mut th = 0;
-        while got.iter().zip(&want).any(|(g, w)| g.len() < w.len()) {
-            clocks += 2;
-            assert!(clocks < 400_000, "the walks do not end: got {got:?}");
+        while b.got.iter().zip(&want).any(|(g, w)| g.len() < w.len()) {
+            assert!(b.clock < 400_000, "the walks do not end: got {:?}", b.got);
+            // Two clocks per turn of a thread, as the engine's I2 and I3: present the thread
+            // to the counters, then read its state and offer its start.
             th = (th + 1) % threads;
             u.query_thread.next = (th as u64).into();
             u.enqueue.next = false;
-            tick(&mut u, &mut rng);
+            tick(&mut u, &mut b, &mut rng, false);
             if in_flight[th] && !u.pending.val() {
                 in_flight[th] = false;
-                let result = u.result.val().to_u64() as u32;
-                let stop = if result == 1 << 31 {
-                    KdStop::Finished
-                } else {
-                    let end = u.list_end.val().to_u64() as u32;
-                    KdStop::Leaf {
-                        list: result,
-                        count: end - result,
-                    }
-                };
-                let k = got[th].len();
-                got[th].push(stop);
-                if stop != KdStop::Finished {
-                    let (best_t, hit) = answers[th][k];
-                    offer[th] = Some((true, best_t, u32::from(hit)));
-                }
+                assert_eq!(u.result.val().to_u64(), 1 << 31, "thread {th}: the end");
+                b.got[th].push(KdStop::Finished);
             }
-            u.enqueue.next = offer[th].is_some();
-            if let Some((next, a, b)) = offer[th] {
+            // Later threads start while answers for the earlier ones go in.
+            let start = to_start[th] && b.clock >= 120 * th as u64;
+            u.enqueue.next = start;
+            if start {
+                let any = if any_hit(th) { 1u64 << 31 } else { 0 };
                 u.thread.next = (th as u64).into();
-                u.enqueue_next.next = next;
-                u.word_a.next = u64::from(a).into();
-                u.word_b.next = u64::from(b).into();
+                u.enqueue_next.next = false;
+                u.word_a.next = (u64::from(root) | any).into();
+                u.word_b.next = u64::from(t_max).into();
             }
-            if tick(&mut u, &mut rng) && offer[th].is_some() {
-                offer[th] = None;
+            if tick(&mut u, &mut b, &mut rng, start) && start {
+                to_start[th] = false;
                 in_flight[th] = true;
             }
         }
-        assert!(stolen > 0);
-        assert_eq!(got, want, "leaves per thread");
+        assert!(b.stolen > 0);
+        assert!(b.refused > 0, "no start was refused for an answer");
+        assert_eq!(b.got, want, "leaves per thread");
     }
 }

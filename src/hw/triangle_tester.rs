@@ -41,6 +41,7 @@
 use rust_hdl::prelude::*;
 
 use super::fp::{const_bits, FpCompare};
+use super::list_unit::LIST_OF_WALK;
 use super::ray_store::{zero_counters, RayStore};
 use super::{intersect_latency, IntersectUnit, ListUnit, TransformUnit, TRANSFORM_LATENCY};
 use crate::fp::Format;
@@ -126,6 +127,19 @@ pub struct TriangleTester<
     /// High when a list or a query of `done_thread` is done (its pending count changes).
     pub done_event: Signal<Out, Bit>,
     pub done_thread: Signal<Out, Bits<5>>,
+    /// The traversal unit's leaves: a list of `walk_list_thread`, bank-1 words
+    /// `walk_list_from..walk_list_to`, taken (`walk_list_take`) in a clock the engine does not
+    /// enqueue and the queue has room.
+    pub walk_list_valid: Signal<In, Bit>,
+    pub walk_list_thread: Signal<In, Bits<5>>,
+    pub walk_list_from: Signal<In, Bits<32>>,
+    pub walk_list_to: Signal<In, Bits<32>>,
+    pub walk_list_take: Signal<Out, Bit>,
+    /// A walk's list is done: the thread's closest hit so far, for the traversal unit.
+    pub walk_end_event: Signal<Out, Bit>,
+    pub walk_end_thread: Signal<Out, Bits<5>>,
+    pub walk_end_t: Signal<Out, Bits<32>>,
+    pub walk_end_hit: Signal<Out, Bit>,
     /// High in the clocks the TransformUnit and the IntersectUnit take an input.
     pub transform_busy: Signal<Out, Bit>,
     pub intersect_busy: Signal<Out, Bit>,
@@ -186,6 +200,7 @@ pub struct TriangleTester<
     m2_a: DFF<Bits<32>>,
     m2_b: DFF<Bits<32>>,
     m2_done: DFF<Bits<8>>,
+    m2_best: DFF<Bits<33>>,
     m3_valid: DFF<Bit>,
     m3_hit: DFF<Bit>,
     m3_kind: DFF<Bits<2>>,
@@ -194,6 +209,10 @@ pub struct TriangleTester<
     m3_a: DFF<Bits<32>>,
     m3_b: DFF<Bits<32>>,
     m3_done: DFF<Bits<8>>,
+    m3_best: DFF<Bits<33>>,
+    walk_take: Signal<Local, Bit>,
+    /// The entry ends an engine's list or query (`TEST_LIST_END`, `TEST_INIT`).
+    m3_counts: Signal<Local, Bit>,
     merge_hit: Signal<Local, Bit>,
     merge_best: Signal<Local, Bits<33>>,
     merge_write: Signal<Local, Bit>,
@@ -203,6 +222,7 @@ pub struct TriangleTester<
     c_index: [Constant<Bits<4>>; 12],
     c_infinity: Constant<Bits<W>>,
     c_d_pass: Constant<Bits<16>>,
+    c_list_of_walk: Constant<Bits<32>>,
     c_hit_flag: Constant<Bits<33>>,
 }
 
@@ -253,6 +273,15 @@ impl<
             list_rdata: Default::default(),
             done_event: Default::default(),
             done_thread: Default::default(),
+            walk_list_valid: Default::default(),
+            walk_list_thread: Default::default(),
+            walk_list_from: Default::default(),
+            walk_list_to: Default::default(),
+            walk_list_take: Default::default(),
+            walk_end_event: Default::default(),
+            walk_end_thread: Default::default(),
+            walk_end_t: Default::default(),
+            walk_end_hit: Default::default(),
             transform_busy: Default::default(),
             intersect_busy: Default::default(),
             list_unit: ListUnit::new(mem_latency),
@@ -301,6 +330,7 @@ impl<
             m2_a: Default::default(),
             m2_b: Default::default(),
             m2_done: Default::default(),
+            m2_best: Default::default(),
             m3_valid: Default::default(),
             m3_hit: Default::default(),
             m3_kind: Default::default(),
@@ -309,6 +339,9 @@ impl<
             m3_a: Default::default(),
             m3_b: Default::default(),
             m3_done: Default::default(),
+            m3_best: Default::default(),
+            walk_take: Default::default(),
+            m3_counts: Default::default(),
             merge_hit: Default::default(),
             merge_best: Default::default(),
             merge_write: Default::default(),
@@ -317,6 +350,7 @@ impl<
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_infinity: const_bits::<W>(u64::from(f.infinity(false))),
             c_d_pass: Constant::new((1u64 << 13).into()),
+            c_list_of_walk: Constant::new(LIST_OF_WALK.into()),
             c_hit_flag: Constant::new((1u64 << 32).into()),
         }
     }
@@ -339,8 +373,8 @@ impl<
         dff_setup!(
             self, clock, phase, cur_kind, cur_thread, cur_a, cur_b, uv_issued, t_issued, received,
             seq, m1_valid, m1_hit, m1_kind, m1_thread, m1_t, m2_valid, m2_hit, m2_kind, m2_thread,
-            m2_t, m2_a, m2_b, m2_done, m3_valid, m3_hit, m3_kind, m3_thread, m3_t, m3_a, m3_b,
-            m3_done
+            m2_t, m2_a, m2_b, m2_done, m2_best, m3_valid, m3_hit, m3_kind, m3_thread, m3_t, m3_a,
+            m3_b, m3_done, m3_best
         );
         clock!(
             self,
@@ -390,11 +424,22 @@ impl<
         self.ray.ray_write.next = self.ray_write.val();
         self.ray.ray_pair.next = self.ray_pair.val();
         self.ray.t_min_write.next = self.enqueue.val() & (self.queue_kind.val() == 1);
-        self.list_unit.enqueue.next = self.enqueue.val();
-        self.list_unit.kind.next = self.queue_kind.val();
-        self.list_unit.thread.next = self.thread.val();
-        self.list_unit.word_a.next = self.word_a.val();
-        self.list_unit.word_b.next = self.word_b.val();
+        // The engine's entries first; a walk's list in the other clocks.
+        self.walk_take.next =
+            self.walk_list_valid.val() & (!self.enqueue.val()) & (!self.list_unit.full.val());
+        self.walk_list_take.next = self.walk_take.val();
+        self.list_unit.enqueue.next = self.enqueue.val() | self.walk_take.val();
+        if self.enqueue.val() {
+            self.list_unit.kind.next = self.queue_kind.val();
+            self.list_unit.thread.next = self.thread.val();
+            self.list_unit.word_a.next = self.word_a.val();
+            self.list_unit.word_b.next = self.word_b.val();
+        } else {
+            self.list_unit.kind.next = 0.into();
+            self.list_unit.thread.next = self.walk_list_thread.val();
+            self.list_unit.word_a.next = self.walk_list_from.val();
+            self.list_unit.word_b.next = self.walk_list_to.val() | self.c_list_of_walk.val();
+        }
         self.full.next = self.list_unit.full.val();
         self.list_unit.engine_read.next = self.engine_read.val();
         self.list_unit.engine_bank.next = self.engine_bank.val();
@@ -590,6 +635,7 @@ impl<
         self.m2_a.d.next = self.flight_a.read_data.val();
         self.m2_b.d.next = self.flight_b.read_data.val();
         self.m2_done.d.next = self.done_m.read_data.val();
+        self.m2_best.d.next = self.best_m.read_data.val();
         self.m3_valid.d.next = self.m2_valid.q.val();
         self.m3_hit.d.next = self.m2_hit.q.val();
         self.m3_kind.d.next = self.m2_kind.q.val();
@@ -598,6 +644,7 @@ impl<
         self.m3_a.d.next = self.m2_a.q.val();
         self.m3_b.d.next = self.m2_b.q.val();
         self.m3_done.d.next = self.m2_done.q.val();
+        self.m3_best.d.next = self.m2_best.q.val();
         self.merge_hit.next = self.m3_hit.q.val() & self.cmp.lt.val() & (self.m3_kind.q.val() == 0);
 
         self.done_m.write_address.next = self.m3_thread.q.val();
@@ -608,11 +655,18 @@ impl<
         self.triangle_e.write_address.next = self.m3_thread.q.val();
         self.done_m.write_data.next = self.m3_done.q.val() + 1;
         self.done_e.write_data.next = self.m3_done.q.val() + 1;
-        // Inits and list ends count (the engine counted them as issued), not single tests.
-        self.done_m.write_enable.next = self.m3_valid.q.val() & (self.m3_kind.q.val() != 0);
-        self.done_e.write_enable.next = self.m3_valid.q.val() & (self.m3_kind.q.val() != 0);
-        self.done_event.next = self.m3_valid.q.val() & (self.m3_kind.q.val() != 0);
+        // Inits and list ends count (the engine counted them as issued), not single tests nor
+        // a walk's list ends, which answer the traversal unit with the closest hit so far.
+        self.m3_counts.next =
+            self.m3_valid.q.val() & ((self.m3_kind.q.val() == 1) | (self.m3_kind.q.val() == 2));
+        self.done_m.write_enable.next = self.m3_counts.val();
+        self.done_e.write_enable.next = self.m3_counts.val();
+        self.done_event.next = self.m3_counts.val();
         self.done_thread.next = self.m3_thread.q.val();
+        self.walk_end_event.next = self.m3_valid.q.val() & (self.m3_kind.q.val() == 3);
+        self.walk_end_thread.next = self.m3_thread.q.val();
+        self.walk_end_t.next = bit_cast::<32, W>(self.m3_best.q.val().get_bits::<W>(0));
+        self.walk_end_hit.next = self.m3_best.q.val().get_bit(32);
         // An init: no hit, best t = its b. A closer hit: hit, its t.
         self.merge_best.next = bit_cast::<33, W>(self.m3_b.q.val().get_bits::<W>(0));
         if self.merge_hit.val() {

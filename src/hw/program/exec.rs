@@ -10,7 +10,7 @@
 //! pixel on one thread (threads never share state, so its result is the same; rayon runs
 //! those in parallel), optionally recording every register write for traces.
 
-use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_FINISHED, REGISTERS};
+use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_ANY_HIT, KD_FINISHED, REGISTERS};
 use super::Program;
 use crate::fp::Format;
 use crate::hw::traversal_unit::STACK_LEVELS;
@@ -333,32 +333,7 @@ impl<'a> Machine<'a> {
                     }
                     TriFn::Object => (tt.object, tt.mailbox) = (a, Mailbox::default()),
                     TriFn::Skip => tt.skip = (a, b),
-                    TriFn::List => {
-                        let list = self.layout.banks[LISTS].get(a as usize..b as usize);
-                        let list = list.ok_or_else(|| {
-                            fail(format!("triangle list {a}..{b} beyond the list bank"))
-                        })?;
-                        let words = self.layout.banks[TRIANGLES_T].len() / TRIANGLE_BANK_WORDS;
-                        for &triangle in list {
-                            if (tt.object, triangle) == tt.skip || tt.mailbox.seen(triangle) {
-                                continue;
-                            }
-                            if triangle as usize >= words {
-                                return Err(fail(format!(
-                                    "triangle {triangle} beyond the {words} triangles in memory"
-                                )));
-                            }
-                            stats.triangle_tests += 1;
-                            let m = self.layout.triangle_transform(triangle);
-                            let r = units::triangle_test(f, &m, tt.o, tt.d, tt.t_min);
-                            if units::closer_hit(f, &r, tt.best_t) {
-                                tt.hit = true;
-                                tt.best_t = r.t;
-                                tt.best_instance = tt.object;
-                                tt.best_triangle = triangle;
-                            }
-                        }
-                    }
+                    TriFn::List => self.test_list(tt, a, b, stats).map_err(fail)?,
                     TriFn::Wait => result = Some(tt.best_t),
                     TriFn::Hit => result = Some(u32::from(tt.hit)),
                     TriFn::Instance => result = Some(tt.best_instance),
@@ -370,7 +345,7 @@ impl<'a> Machine<'a> {
             Op::Kd => {
                 let function = KdFn::from_imm(i.imm)
                     .ok_or_else(|| fail(format!("no traversal unit function {}", i.imm)))?;
-                let (tt, walk) = (&t.tester, &mut t.walk);
+                let (tt, walk) = (&mut t.tester, &mut t.walk);
                 let ray = (tt.o, tt.d);
                 let nodes = std::cell::Cell::new(0u64);
                 let fetch = |n| {
@@ -379,10 +354,25 @@ impl<'a> Machine<'a> {
                 };
                 let stop = match function {
                     KdFn::Start => {
-                        let (w, stop) =
-                            units::KdWalk::start(f, ray, a, (tt.t_min, b), STACK_LEVELS, fetch)
+                        // The whole walk: each leaf's list goes to the tester, whose closest
+                        // hit answers the unit (an any-hit walk ends at the first hit).
+                        let any_hit = a & KD_ANY_HIT != 0;
+                        let root = a & !KD_ANY_HIT;
+                        let (w, mut stop) =
+                            units::KdWalk::start(f, ray, root, (tt.t_min, b), STACK_LEVELS, fetch)
                                 .map_err(fail)?;
                         walk.walk = w;
+                        while let units::KdStop::Leaf { list, count } = stop {
+                            self.test_list(tt, list, list.wrapping_add(count), stats)
+                                .map_err(fail)?;
+                            stop = if any_hit && tt.hit {
+                                units::KdStop::Finished
+                            } else {
+                                walk.walk
+                                    .next(f, ray, (tt.best_t, tt.hit), STACK_LEVELS, fetch)
+                                    .map_err(fail)?
+                            };
+                        }
                         Some(stop)
                     }
                     KdFn::Next => Some(
@@ -430,6 +420,42 @@ impl<'a> Machine<'a> {
             .or_default() += 1;
         stats.instructions += 1;
         t.pc = next;
+        Ok(())
+    }
+
+    /// The tester's work on the triangle list `from..to` of bank 1: the list unit's skip and
+    /// mailbox, then each test and the closest hit.
+    fn test_list(
+        &self,
+        tt: &mut TesterState,
+        from: u32,
+        to: u32,
+        stats: &mut RunStats,
+    ) -> Result<(), String> {
+        let f = self.f;
+        let list = self.layout.banks[LISTS].get(from as usize..to as usize);
+        let list =
+            list.ok_or_else(|| format!("triangle list {from}..{to} beyond the list bank"))?;
+        let words = self.layout.banks[TRIANGLES_T].len() / TRIANGLE_BANK_WORDS;
+        for &triangle in list {
+            if (tt.object, triangle) == tt.skip || tt.mailbox.seen(triangle) {
+                continue;
+            }
+            if triangle as usize >= words {
+                return Err(format!(
+                    "triangle {triangle} beyond the {words} triangles in memory"
+                ));
+            }
+            stats.triangle_tests += 1;
+            let m = self.layout.triangle_transform(triangle);
+            let r = units::triangle_test(f, &m, tt.o, tt.d, tt.t_min);
+            if units::closer_hit(f, &r, tt.best_t) {
+                tt.hit = true;
+                tt.best_t = r.t;
+                tt.best_instance = tt.object;
+                tt.best_triangle = triangle;
+            }
+        }
         Ok(())
     }
 

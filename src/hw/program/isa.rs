@@ -98,12 +98,14 @@ pub enum Op {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(u32)]
 pub enum KdFn {
-    /// Walk from root `A` with the segment `[t_min, B]` (t_min from the tester's init).
+    /// Walk from root `A` (bits 25..0; [`KD_ANY_HIT`] for a walk that ends at the first hit)
+    /// with the segment `[t_min, B]` (t_min from the tester's init). The unit hands each leaf's
+    /// list to the triangle tester and goes on with its closest hit, to the walk's end.
     Start = 0,
-    /// Repeat while the walk is in flight; `dst` = the leaf's list address, or
-    /// [`KD_FINISHED`] when the walk ended.
+    /// Repeat while the walk is in flight (asleep); `dst` = [`KD_FINISHED`] when it ended, or
+    /// the leaf's list address of a walk the engine answers itself (`next`).
     Wait,
-    /// `dst` = the leaf's list end (list + count).
+    /// `dst` = the leaf's list end (list + count) of a walk the engine answers.
     End,
     /// Go on after a leaf whose closest hit so far is `A` (best t), `B` (hit, 0 or 1).
     Next,
@@ -111,6 +113,9 @@ pub enum KdFn {
 
 /// The `kd.wait` result of a finished walk (bit 31).
 pub const KD_FINISHED: u32 = 1 << 31;
+
+/// Bit 31 of `kd.start`'s root: the walk answers a shadow query, and ends at the first hit.
+pub const KD_ANY_HIT: u32 = 1 << 31;
 
 impl KdFn {
     pub const ALL: [KdFn; 4] = [KdFn::Start, KdFn::Wait, KdFn::End, KdFn::Next];

@@ -17,7 +17,7 @@
 //! (`cornell_noshadow`: 118 per primary ray, the walk included).
 
 use super::asm::{Reg, Val};
-use super::isa::Op;
+use super::isa::{Op, KD_ANY_HIT};
 use super::{Gen, CHAIN_ENTRY_WORDS};
 use crate::layout::{instance_word as iw, FrameMap, FRAME, INSTANCES, TRIANGLES_T};
 use crate::units;
@@ -222,7 +222,7 @@ impl Gen<'_> {
                 a.mov3(s.q_d, to_light.map(Val::R));
                 a.mov(s.q_t_min, shadow_t_min.into());
                 a.mov(s.q_t_max, Val::K(f.one()));
-                a.mov(s.q_any, Val::K(1));
+                a.mov(s.q_any, Val::K(KD_ANY_HIT));
                 a.mov(s.skip_instance, hit_instance.into());
                 a.mov(s.skip_triangle, hit_triangle.into());
                 a.call(s.link, trace);

@@ -2,12 +2,11 @@
 //! `enter_instance` and `test_triangles`, step for step).
 //!
 //! Object trees are walked by the traversal unit (`hw::TraversalUnit`, per `units::KdWalk`):
-//! the thread starts the walk, waits, and gets each leaf's list; it hands the list to the
-//! triangle tester (`hw::TriangleTester`), whose list unit drops the triangle the query
-//! starts on and those in the thread's triangle mailbox and queues the rest; the thread waits
-//! for the tester, reads the closest hit, and answers the traversal unit with it (which ends
-//! the walk or pops its stack). A shadow query (`q_any`) returns after the first leaf with a
-//! hit.
+//! the thread starts the walk and sleeps until it ends. The unit hands each leaf's list to
+//! the triangle tester (`hw::TriangleTester`), whose list unit drops the triangle the query
+//! starts on and those in the thread's triangle mailbox and queues the rest; the tester
+//! answers the unit with the closest hit, which ends the walk or pops its stack. A shadow
+//! query's walk (`q_any`) ends after the first leaf with a hit.
 //!
 //! The top-level tree of a scene with instances is walked here in microcode (state machine
 //! per thread, one instruction per engine turn): fetch a node (2 loads), decode it; at an
@@ -18,15 +17,14 @@
 //! the ray, given to both coprocessors, then the object walk); then pop the stack until a
 //! segment can still hold a closer hit.
 //!
-//! Cost (instructions = engine turns): per object leaf 7 (the leaf, its end, the list, the
-//! wait, the hit, the answer, the jump folded into it); a waiting thread sleeps until the
-//! tester or the traversal unit is done (the tree's inner nodes and the leaf's triangles
-//! cost it no instruction); per top-level inner node 15-23, per
-//! instance about 40 (the transforms).
+//! Cost (instructions = engine turns): per object walk 4 (start, wait, the closest hit's t
+//! and flag), whatever its leaves; a waiting thread sleeps until the walk ends (the tree's
+//! nodes and the leaves' triangles cost it no instruction); per top-level inner node 15-23,
+//! per instance about 40 (the transforms).
 
 use super::asm::Asm;
 use super::asm::{Label, Reg, Val};
-use super::isa::{KdFn, Op, TriFn, KD_FINISHED, MAILBOX_INSTANCES};
+use super::isa::{KdFn, Op, TriFn, MAILBOX_INSTANCES};
 use super::{Gen, STACK_ENTRY_WORDS};
 use crate::layout::{instance_word as iw, INSTANCES, LEAF_TAG, LISTS, NODES};
 use crate::units;
@@ -102,35 +100,35 @@ impl Gen<'_> {
         }
     }
 
-    /// An object's kd tree, walked by the traversal unit from `root`: each leaf's triangles
-    /// go to the triangle tester; an answered any-hit query jumps to `answered`.
-    /// `t_max` bounds the walk's segment.
+    /// An object's kd tree, walked by the traversal unit from `root`, which hands each leaf's
+    /// triangles to the triangle tester and goes on with its closest hit by itself; the
+    /// thread sleeps until the walk ends and reads the hit. An answered any-hit query jumps to
+    /// `answered`. `t_max` bounds the walk's segment.
     fn walk_object(&self, root: Val, t_max: Reg, answered: Label) {
         let a = self.asm;
         let s = &self.s;
         a.section("traversal");
-        let [list, end] = a.regs::<2>();
-        let from = match root {
-            Val::K(0) => Reg::ZERO,
-            Val::R(r) => r,
-            k => a.keep(k),
+        // A shadow query's walk ends at its first hit (`q_any` is `KD_ANY_HIT` or 0).
+        let from = match (root, self.c.shadows) {
+            (Val::K(0), false) => Reg::ZERO,
+            (Val::K(0), true) => s.q_any,
+            (Val::R(r), false) => r,
+            (root, true) => a.keep(a.op(Op::Or, s.q_any.into(), root)),
+            (k, false) => a.keep(k),
         };
         a.kd_queue(KdFn::Start, from, t_max);
-        let (leaf, finished) = (a.label(), a.label());
-        a.bind(leaf);
-        a.section("traversal");
-        a.kd_wait(list);
-        a.branch(Op::Bltu, list.into(), Val::K(KD_FINISHED), true, finished);
-        a.kd_end(end);
-        self.triangle_list(list, end, answered);
-        a.section("traversal");
-        a.kd_queue(KdFn::Next, s.best_t, s.hit);
-        a.jump(leaf);
-        a.bind(finished);
-        for r in [list, end] {
-            a.free(r);
+        a.kd_wait(Reg::ZERO);
+        a.section("intersect");
+        a.tri_wait(s.best_t);
+        a.tri_read(TriFn::Hit, s.hit);
+        if self.c.shadows {
+            // A shadow query is answered by any hit.
+            let closest = a.label();
+            a.branch(Op::Beq, s.hit.into(), Val::K(0), false, closest);
+            a.branch(Op::Beq, s.q_any.into(), Val::K(0), true, answered);
+            a.bind(closest);
         }
-        if from != Reg::ZERO && Val::R(from) != root {
+        if from != Reg::ZERO && from != s.q_any && Val::R(from) != root {
             a.free(from);
         }
     }
@@ -269,24 +267,5 @@ impl Gen<'_> {
         let x16 = a.op(Op::Shl, instance.into(), Val::K(4));
         let x8 = a.op(Op::Shl, instance.into(), Val::K(3));
         a.op(Op::Add, x16, x8)
-    }
-
-    /// The triangles of an object leaf, `list..end` in bank 1: the tester's list unit reads
-    /// the list and drops the skipped triangle and those in the mailbox.
-    fn triangle_list(&self, list: Reg, end: Reg, answered: Label) {
-        let a = self.asm;
-        let s = &self.s;
-        a.section("triangles");
-        a.tri_queue(TriFn::List, list, end);
-        a.section("intersect");
-        a.tri_wait(s.best_t);
-        a.tri_read(TriFn::Hit, s.hit);
-        if self.c.shadows {
-            // A shadow query is answered by any hit.
-            let closest = a.label();
-            a.branch(Op::Beq, s.hit.into(), Val::K(0), false, closest);
-            a.branch(Op::Beq, s.q_any.into(), Val::K(0), true, answered);
-            a.bind(closest);
-        }
     }
 }
