@@ -13,9 +13,9 @@ use crate::fp::Format;
 use crate::hw::engine::engine_period;
 use crate::hw::program::exec::{Machine, RunStats, Write};
 use crate::hw::program::{build_program, Program, ProgramConfig};
-use crate::hw::traversal_unit::fetch_clocks_per_node;
+use crate::hw::traversal_unit::FETCH_CLOCKS_PER_NODE;
 use crate::hw::traversal_unit::STACK_LEVELS;
-use crate::hw::triangle_tester::clocks_per_test;
+use crate::hw::triangle_tester::CLOCKS_PER_TEST;
 use crate::hw::vga::VgaMode;
 use crate::layout::{self, Layout, MemoryConfig, SceneTrees};
 use crate::model::{self, golden::Golden};
@@ -107,10 +107,10 @@ fn prepare(
 
 /// Twice the clocks the frame would take if the engine and the coprocessors took turns (they
 /// overlap, so a frame within it is never cut short; a hung one stops).
-fn cycle_limit(predicted: &RunStats, period: u32, mem_latency: u32) -> u64 {
+fn cycle_limit(predicted: &RunStats, period: u32) -> u64 {
     let engine = predicted.rounds * u64::from(period);
-    let tester = predicted.triangle_tests * u64::from(clocks_per_test(mem_latency));
-    let traversal = predicted.kd_nodes * u64::from(fetch_clocks_per_node(mem_latency));
+    let tester = predicted.triangle_tests * u64::from(CLOCKS_PER_TEST);
+    let traversal = predicted.kd_nodes * u64::from(FETCH_CLOCKS_PER_NODE);
     2 * (engine + tester + traversal) + 100_000
 }
 
@@ -135,7 +135,7 @@ pub fn generate_rtl(
         &layouts,
         params,
         name,
-        cycle_limit(&predicted, period, params.mem_latency),
+        cycle_limit(&predicted, period),
         out,
     )?;
     let ucf = out.join("constraints").join("dynrt.ucf");
@@ -282,7 +282,7 @@ pub fn simulate_scene(
         name,
         SimRun {
             sim,
-            cycle_limit: cycle_limit(&twin, period, params.mem_latency),
+            cycle_limit: cycle_limit(&twin, period),
             capture_vga: false,
         },
         out,

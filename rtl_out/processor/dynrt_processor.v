@@ -10719,6 +10719,8 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
     localparam  c_infinity = 24'h7f0000;
     localparam  c_d_pass = 16'h2000;
     localparam  c_list_of_walk = 32'h80000000;
+    localparam  c_buffer__0 = 1'b0;
+    localparam  c_buffer__1 = 1'b1;
     localparam  c_hit_flag = 33'h100000000;
     
     // Stub signals
@@ -10823,30 +10825,60 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
     reg  flight_b__write_clock;
     reg  [31:0] flight_b__write_data;
     reg  flight_b__write_enable;
-    reg  [1:0] phase__d;
-    wire  [1:0] phase__q;
-    reg  phase__clock;
-    reg  [1:0] cur_kind__d;
-    wire  [1:0] cur_kind__q;
-    reg  cur_kind__clock;
-    reg  [4:0] cur_thread__d;
-    wire  [4:0] cur_thread__q;
-    reg  cur_thread__clock;
-    reg  [31:0] cur_a__d;
-    wire  [31:0] cur_a__q;
-    reg  cur_a__clock;
-    reg  [31:0] cur_b__d;
-    wire  [31:0] cur_b__q;
-    reg  cur_b__clock;
+    reg  fetching__d;
+    wire  fetching__q;
+    reg  fetching__clock;
+    reg  fb__d;
+    wire  fb__q;
+    reg  fb__clock;
+    reg  lb__d;
+    wire  lb__q;
+    reg  lb__clock;
+    reg  [1:0] lphase__d;
+    wire  [1:0] lphase__q;
+    reg  lphase__clock;
+    reg  loaded__0__d;
+    wire  loaded__0__q;
+    reg  loaded__0__clock;
+    reg  loaded__1__d;
+    wire  loaded__1__q;
+    reg  loaded__1__clock;
+    reg  [1:0] cur_kind__0__d;
+    wire  [1:0] cur_kind__0__q;
+    reg  cur_kind__0__clock;
+    reg  [1:0] cur_kind__1__d;
+    wire  [1:0] cur_kind__1__q;
+    reg  cur_kind__1__clock;
+    reg  [4:0] cur_thread__0__d;
+    wire  [4:0] cur_thread__0__q;
+    reg  cur_thread__0__clock;
+    reg  [4:0] cur_thread__1__d;
+    wire  [4:0] cur_thread__1__q;
+    reg  cur_thread__1__clock;
+    reg  [31:0] cur_a__0__d;
+    wire  [31:0] cur_a__0__q;
+    reg  cur_a__0__clock;
+    reg  [31:0] cur_a__1__d;
+    wire  [31:0] cur_a__1__q;
+    reg  cur_a__1__clock;
+    reg  [31:0] cur_b__0__d;
+    wire  [31:0] cur_b__0__q;
+    reg  cur_b__0__clock;
+    reg  [31:0] cur_b__1__d;
+    wire  [31:0] cur_b__1__q;
+    reg  cur_b__1__clock;
+    reg  [3:0] received__0__d;
+    wire  [3:0] received__0__q;
+    reg  received__0__clock;
+    reg  [3:0] received__1__d;
+    wire  [3:0] received__1__q;
+    reg  received__1__clock;
     reg  [3:0] uv_issued__d;
     wire  [3:0] uv_issued__q;
     reg  uv_issued__clock;
     reg  [3:0] t_issued__d;
     wire  [3:0] t_issued__q;
     reg  t_issued__clock;
-    reg  [3:0] received__d;
-    wire  [3:0] received__q;
-    reg  received__clock;
     reg  [4:0] seq__d;
     wire  [4:0] seq__q;
     reg  seq__clock;
@@ -10886,41 +10918,77 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
     reg  [23:0] words__11__d;
     wire  [23:0] words__11__q;
     reg  words__11__clock;
-    reg  [3:0] uv_line__0__d;
-    wire  [3:0] uv_line__0__q;
+    reg  [23:0] words__12__d;
+    wire  [23:0] words__12__q;
+    reg  words__12__clock;
+    reg  [23:0] words__13__d;
+    wire  [23:0] words__13__q;
+    reg  words__13__clock;
+    reg  [23:0] words__14__d;
+    wire  [23:0] words__14__q;
+    reg  words__14__clock;
+    reg  [23:0] words__15__d;
+    wire  [23:0] words__15__q;
+    reg  words__15__clock;
+    reg  [23:0] words__16__d;
+    wire  [23:0] words__16__q;
+    reg  words__16__clock;
+    reg  [23:0] words__17__d;
+    wire  [23:0] words__17__q;
+    reg  words__17__clock;
+    reg  [23:0] words__18__d;
+    wire  [23:0] words__18__q;
+    reg  words__18__clock;
+    reg  [23:0] words__19__d;
+    wire  [23:0] words__19__q;
+    reg  words__19__clock;
+    reg  [23:0] words__20__d;
+    wire  [23:0] words__20__q;
+    reg  words__20__clock;
+    reg  [23:0] words__21__d;
+    wire  [23:0] words__21__q;
+    reg  words__21__clock;
+    reg  [23:0] words__22__d;
+    wire  [23:0] words__22__q;
+    reg  words__22__clock;
+    reg  [23:0] words__23__d;
+    wire  [23:0] words__23__q;
+    reg  words__23__clock;
+    reg  [4:0] uv_line__0__d;
+    wire  [4:0] uv_line__0__q;
     reg  uv_line__0__clock;
-    reg  [3:0] uv_line__1__d;
-    wire  [3:0] uv_line__1__q;
+    reg  [4:0] uv_line__1__d;
+    wire  [4:0] uv_line__1__q;
     reg  uv_line__1__clock;
-    reg  [3:0] uv_line__2__d;
-    wire  [3:0] uv_line__2__q;
+    reg  [4:0] uv_line__2__d;
+    wire  [4:0] uv_line__2__q;
     reg  uv_line__2__clock;
-    reg  [3:0] uv_line__3__d;
-    wire  [3:0] uv_line__3__q;
+    reg  [4:0] uv_line__3__d;
+    wire  [4:0] uv_line__3__q;
     reg  uv_line__3__clock;
-    reg  [3:0] uv_line__4__d;
-    wire  [3:0] uv_line__4__q;
+    reg  [4:0] uv_line__4__d;
+    wire  [4:0] uv_line__4__q;
     reg  uv_line__4__clock;
-    reg  [3:0] uv_line__5__d;
-    wire  [3:0] uv_line__5__q;
+    reg  [4:0] uv_line__5__d;
+    wire  [4:0] uv_line__5__q;
     reg  uv_line__5__clock;
-    reg  [3:0] t_line__0__d;
-    wire  [3:0] t_line__0__q;
+    reg  [4:0] t_line__0__d;
+    wire  [4:0] t_line__0__q;
     reg  t_line__0__clock;
-    reg  [3:0] t_line__1__d;
-    wire  [3:0] t_line__1__q;
+    reg  [4:0] t_line__1__d;
+    wire  [4:0] t_line__1__q;
     reg  t_line__1__clock;
-    reg  [3:0] t_line__2__d;
-    wire  [3:0] t_line__2__q;
+    reg  [4:0] t_line__2__d;
+    wire  [4:0] t_line__2__q;
     reg  t_line__2__clock;
-    reg  [3:0] t_line__3__d;
-    wire  [3:0] t_line__3__q;
+    reg  [4:0] t_line__3__d;
+    wire  [4:0] t_line__3__q;
     reg  t_line__3__clock;
-    reg  [3:0] t_line__4__d;
-    wire  [3:0] t_line__4__q;
+    reg  [4:0] t_line__4__d;
+    wire  [4:0] t_line__4__q;
     reg  t_line__4__clock;
-    reg  [3:0] t_line__5__d;
-    wire  [3:0] t_line__5__q;
+    reg  [4:0] t_line__5__d;
+    wire  [4:0] t_line__5__q;
     reg  t_line__5__clock;
     reg  transform_unit__clock;
     reg  transform_unit__in_valid;
@@ -11051,10 +11119,21 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
     reg  m3_best__clock;
     
     // Local signals
+    reg  uv_here__0;
+    reg  uv_here__1;
+    reg  t_here__0;
+    reg  t_here__1;
+    reg  [31:0] fetch_a;
+    reg  fb_free;
+    reg  [1:0] l_kind;
+    reg  [4:0] l_thread;
+    reg  [31:0] l_a;
+    reg  [31:0] l_b;
+    reg  l_ready;
     reg  uv_take;
     reg  t_take;
-    reg  [3:0] uv_arrive;
-    reg  [3:0] t_arrive;
+    reg  [4:0] uv_arrive;
+    reg  [4:0] t_arrive;
     reg  walk_take;
     reg  m3_counts;
     reg  merge_hit;
@@ -11188,30 +11267,85 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(flight_b__write_data),
         .write_enable(flight_b__write_enable)
     );
-    dynrt_processor_core__tester__cur_kind phase(
-        .d(phase__d),
-        .q(phase__q),
-        .clock(phase__clock)
+    dynrt_processor_core__add__big_sign fetching(
+        .d(fetching__d),
+        .q(fetching__q),
+        .clock(fetching__clock)
     );
-    dynrt_processor_core__tester__cur_kind cur_kind(
-        .d(cur_kind__d),
-        .q(cur_kind__q),
-        .clock(cur_kind__clock)
+    dynrt_processor_core__add__big_sign fb(
+        .d(fb__d),
+        .q(fb__q),
+        .clock(fb__clock)
     );
-    dynrt_processor_core__last_pick cur_thread(
-        .d(cur_thread__d),
-        .q(cur_thread__q),
-        .clock(cur_thread__clock)
+    dynrt_processor_core__add__big_sign lb(
+        .d(lb__d),
+        .q(lb__q),
+        .clock(lb__clock)
     );
-    dynrt_processor_core__asleep cur_a(
-        .d(cur_a__d),
-        .q(cur_a__q),
-        .clock(cur_a__clock)
+    dynrt_processor_core__tester__cur_kind__0 lphase(
+        .d(lphase__d),
+        .q(lphase__q),
+        .clock(lphase__clock)
     );
-    dynrt_processor_core__asleep cur_b(
-        .d(cur_b__d),
-        .q(cur_b__q),
-        .clock(cur_b__clock)
+    dynrt_processor_core__add__big_sign loaded__0(
+        .d(loaded__0__d),
+        .q(loaded__0__q),
+        .clock(loaded__0__clock)
+    );
+    dynrt_processor_core__add__big_sign loaded__1(
+        .d(loaded__1__d),
+        .q(loaded__1__q),
+        .clock(loaded__1__clock)
+    );
+    dynrt_processor_core__tester__cur_kind__0 cur_kind__0(
+        .d(cur_kind__0__d),
+        .q(cur_kind__0__q),
+        .clock(cur_kind__0__clock)
+    );
+    dynrt_processor_core__tester__cur_kind__0 cur_kind__1(
+        .d(cur_kind__1__d),
+        .q(cur_kind__1__q),
+        .clock(cur_kind__1__clock)
+    );
+    dynrt_processor_core__last_pick cur_thread__0(
+        .d(cur_thread__0__d),
+        .q(cur_thread__0__q),
+        .clock(cur_thread__0__clock)
+    );
+    dynrt_processor_core__last_pick cur_thread__1(
+        .d(cur_thread__1__d),
+        .q(cur_thread__1__q),
+        .clock(cur_thread__1__clock)
+    );
+    dynrt_processor_core__asleep cur_a__0(
+        .d(cur_a__0__d),
+        .q(cur_a__0__q),
+        .clock(cur_a__0__clock)
+    );
+    dynrt_processor_core__asleep cur_a__1(
+        .d(cur_a__1__d),
+        .q(cur_a__1__q),
+        .clock(cur_a__1__clock)
+    );
+    dynrt_processor_core__asleep cur_b__0(
+        .d(cur_b__0__d),
+        .q(cur_b__0__q),
+        .clock(cur_b__0__clock)
+    );
+    dynrt_processor_core__asleep cur_b__1(
+        .d(cur_b__1__d),
+        .q(cur_b__1__q),
+        .clock(cur_b__1__clock)
+    );
+    dynrt_processor_core__tester__list_unit__flight received__0(
+        .d(received__0__d),
+        .q(received__0__q),
+        .clock(received__0__clock)
+    );
+    dynrt_processor_core__tester__list_unit__flight received__1(
+        .d(received__1__d),
+        .q(received__1__q),
+        .clock(received__1__clock)
     );
     dynrt_processor_core__tester__list_unit__flight uv_issued(
         .d(uv_issued__d),
@@ -11222,11 +11356,6 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .d(t_issued__d),
         .q(t_issued__q),
         .clock(t_issued__clock)
-    );
-    dynrt_processor_core__tester__list_unit__flight received(
-        .d(received__d),
-        .q(received__q),
-        .clock(received__clock)
     );
     dynrt_processor_core__last_pick seq(
         .d(seq__d),
@@ -11293,62 +11422,122 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .q(words__11__q),
         .clock(words__11__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight uv_line__0(
+    dynrt_processor_core__add__in_a words__12(
+        .d(words__12__d),
+        .q(words__12__q),
+        .clock(words__12__clock)
+    );
+    dynrt_processor_core__add__in_a words__13(
+        .d(words__13__d),
+        .q(words__13__q),
+        .clock(words__13__clock)
+    );
+    dynrt_processor_core__add__in_a words__14(
+        .d(words__14__d),
+        .q(words__14__q),
+        .clock(words__14__clock)
+    );
+    dynrt_processor_core__add__in_a words__15(
+        .d(words__15__d),
+        .q(words__15__q),
+        .clock(words__15__clock)
+    );
+    dynrt_processor_core__add__in_a words__16(
+        .d(words__16__d),
+        .q(words__16__q),
+        .clock(words__16__clock)
+    );
+    dynrt_processor_core__add__in_a words__17(
+        .d(words__17__d),
+        .q(words__17__q),
+        .clock(words__17__clock)
+    );
+    dynrt_processor_core__add__in_a words__18(
+        .d(words__18__d),
+        .q(words__18__q),
+        .clock(words__18__clock)
+    );
+    dynrt_processor_core__add__in_a words__19(
+        .d(words__19__d),
+        .q(words__19__q),
+        .clock(words__19__clock)
+    );
+    dynrt_processor_core__add__in_a words__20(
+        .d(words__20__d),
+        .q(words__20__q),
+        .clock(words__20__clock)
+    );
+    dynrt_processor_core__add__in_a words__21(
+        .d(words__21__d),
+        .q(words__21__q),
+        .clock(words__21__clock)
+    );
+    dynrt_processor_core__add__in_a words__22(
+        .d(words__22__d),
+        .q(words__22__q),
+        .clock(words__22__clock)
+    );
+    dynrt_processor_core__add__in_a words__23(
+        .d(words__23__d),
+        .q(words__23__q),
+        .clock(words__23__clock)
+    );
+    dynrt_processor_core__last_pick uv_line__0(
         .d(uv_line__0__d),
         .q(uv_line__0__q),
         .clock(uv_line__0__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight uv_line__1(
+    dynrt_processor_core__last_pick uv_line__1(
         .d(uv_line__1__d),
         .q(uv_line__1__q),
         .clock(uv_line__1__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight uv_line__2(
+    dynrt_processor_core__last_pick uv_line__2(
         .d(uv_line__2__d),
         .q(uv_line__2__q),
         .clock(uv_line__2__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight uv_line__3(
+    dynrt_processor_core__last_pick uv_line__3(
         .d(uv_line__3__d),
         .q(uv_line__3__q),
         .clock(uv_line__3__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight uv_line__4(
+    dynrt_processor_core__last_pick uv_line__4(
         .d(uv_line__4__d),
         .q(uv_line__4__q),
         .clock(uv_line__4__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight uv_line__5(
+    dynrt_processor_core__last_pick uv_line__5(
         .d(uv_line__5__d),
         .q(uv_line__5__q),
         .clock(uv_line__5__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight t_line__0(
+    dynrt_processor_core__last_pick t_line__0(
         .d(t_line__0__d),
         .q(t_line__0__q),
         .clock(t_line__0__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight t_line__1(
+    dynrt_processor_core__last_pick t_line__1(
         .d(t_line__1__d),
         .q(t_line__1__q),
         .clock(t_line__1__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight t_line__2(
+    dynrt_processor_core__last_pick t_line__2(
         .d(t_line__2__d),
         .q(t_line__2__q),
         .clock(t_line__2__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight t_line__3(
+    dynrt_processor_core__last_pick t_line__3(
         .d(t_line__3__d),
         .q(t_line__3__q),
         .clock(t_line__3__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight t_line__4(
+    dynrt_processor_core__last_pick t_line__4(
         .d(t_line__4__d),
         .q(t_line__4__q),
         .clock(t_line__4__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight t_line__5(
+    dynrt_processor_core__last_pick t_line__5(
         .d(t_line__5__d),
         .q(t_line__5__q),
         .clock(t_line__5__clock)
@@ -11433,7 +11622,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .q(m1_hit__q),
         .clock(m1_hit__clock)
     );
-    dynrt_processor_core__tester__cur_kind m1_kind(
+    dynrt_processor_core__tester__cur_kind__0 m1_kind(
         .d(m1_kind__d),
         .q(m1_kind__q),
         .clock(m1_kind__clock)
@@ -11458,7 +11647,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .q(m2_hit__q),
         .clock(m2_hit__clock)
     );
-    dynrt_processor_core__tester__cur_kind m2_kind(
+    dynrt_processor_core__tester__cur_kind__0 m2_kind(
         .d(m2_kind__d),
         .q(m2_kind__q),
         .clock(m2_kind__clock)
@@ -11503,7 +11692,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .q(m3_hit__q),
         .clock(m3_hit__clock)
     );
-    dynrt_processor_core__tester__cur_kind m3_kind(
+    dynrt_processor_core__tester__cur_kind__0 m3_kind(
         .d(m3_kind__d),
         .q(m3_kind__q),
         .clock(m3_kind__clock)
@@ -11541,14 +11730,12 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
     
     // Update code
     always @(*) begin
-        phase__clock = clock;
-        cur_kind__clock = clock;
-        cur_thread__clock = clock;
-        cur_a__clock = clock;
-        cur_b__clock = clock;
+        fetching__clock = clock;
+        fb__clock = clock;
+        lb__clock = clock;
+        lphase__clock = clock;
         uv_issued__clock = clock;
         t_issued__clock = clock;
-        received__clock = clock;
         seq__clock = clock;
         m1_valid__clock = clock;
         m1_hit__clock = clock;
@@ -11573,14 +11760,12 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         m3_b__clock = clock;
         m3_done__clock = clock;
         m3_best__clock = clock;
-        phase__d = phase__q;
-        cur_kind__d = cur_kind__q;
-        cur_thread__d = cur_thread__q;
-        cur_a__d = cur_a__q;
-        cur_b__d = cur_b__q;
+        fetching__d = fetching__q;
+        fb__d = fb__q;
+        lb__d = lb__q;
+        lphase__d = lphase__q;
         uv_issued__d = uv_issued__q;
         t_issued__d = t_issued__q;
-        received__d = received__q;
         seq__d = seq__q;
         m1_valid__d = m1_valid__q;
         m1_hit__d = m1_hit__q;
@@ -11654,6 +11839,54 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         words__10__d = words__10__q;
         words__11__clock = clock;
         words__11__d = words__11__q;
+        words__12__clock = clock;
+        words__12__d = words__12__q;
+        words__13__clock = clock;
+        words__13__d = words__13__q;
+        words__14__clock = clock;
+        words__14__d = words__14__q;
+        words__15__clock = clock;
+        words__15__d = words__15__q;
+        words__16__clock = clock;
+        words__16__d = words__16__q;
+        words__17__clock = clock;
+        words__17__d = words__17__q;
+        words__18__clock = clock;
+        words__18__d = words__18__q;
+        words__19__clock = clock;
+        words__19__d = words__19__q;
+        words__20__clock = clock;
+        words__20__d = words__20__q;
+        words__21__clock = clock;
+        words__21__d = words__21__q;
+        words__22__clock = clock;
+        words__22__d = words__22__q;
+        words__23__clock = clock;
+        words__23__d = words__23__q;
+        loaded__0__clock = clock;
+        loaded__0__d = loaded__0__q;
+        cur_kind__0__clock = clock;
+        cur_kind__0__d = cur_kind__0__q;
+        cur_thread__0__clock = clock;
+        cur_thread__0__d = cur_thread__0__q;
+        cur_a__0__clock = clock;
+        cur_a__0__d = cur_a__0__q;
+        cur_b__0__clock = clock;
+        cur_b__0__d = cur_b__0__q;
+        received__0__clock = clock;
+        received__0__d = received__0__q;
+        loaded__1__clock = clock;
+        loaded__1__d = loaded__1__q;
+        cur_kind__1__clock = clock;
+        cur_kind__1__d = cur_kind__1__q;
+        cur_thread__1__clock = clock;
+        cur_thread__1__d = cur_thread__1__q;
+        cur_a__1__clock = clock;
+        cur_a__1__d = cur_a__1__q;
+        cur_b__1__clock = clock;
+        cur_b__1__d = cur_b__1__q;
+        received__1__clock = clock;
+        received__1__d = received__1__q;
         uv_line__0__clock = clock;
         t_line__0__clock = clock;
         uv_line__1__clock = clock;
@@ -11710,24 +11943,26 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         issued__write_data = issued__read_data + 32'h1;
         issued__write_enable = enqueue & (~list_unit__full) & (queue_kind[(32'h1)+:(1)] == 32'h0);
         list_unit__test_take = 1'b0;
-        ray__ray_thread = cur_thread__q;
-        ray__t_min_thread = cur_thread__q;
-        uv_take = (phase__q == 32'h1) & (uv_issued__q < 32'h8) & (~(engine_read & (engine_bank == 32'h2)));
-        t_take = (phase__q == 32'h1) & (t_issued__q < 32'h4) & (~(engine_read & (engine_bank == 32'h3)));
+        uv_take = fetching__q & (uv_issued__q < 32'h8) & (~(engine_read & (engine_bank == 32'h2)));
+        t_take = fetching__q & (t_issued__q < 32'h4) & (~(engine_read & (engine_bank == 32'h3)));
         uv_read = uv_take | (engine_read & (engine_bank == 32'h2));
         t_read = t_take | (engine_read & (engine_bank == 32'h3));
         uv_addr = engine_addr;
         t_addr = engine_addr;
+        fetch_a = cur_a__0__q;
+        if (fb__q) begin
+            fetch_a = cur_a__1__q;
+        end
         if (uv_take) begin
-            uv_addr = (cur_a__q[(32'h0)+:(24)] << 32'h3) + ((uv_issued__q) & 24'hffffff);
+            uv_addr = (fetch_a[(32'h0)+:(24)] << 32'h3) + ((uv_issued__q) & 24'hffffff);
             uv_issued__d = uv_issued__q + 32'h1;
         end
         if (t_take) begin
-            t_addr = (cur_a__q[(32'h0)+:(24)] << 32'h3) + ((t_issued__q) & 24'hffffff);
+            t_addr = (fetch_a[(32'h0)+:(24)] << 32'h3) + ((t_issued__q) & 24'hffffff);
             t_issued__d = t_issued__q + 32'h1;
         end
-        uv_line__0__d = (((uv_take) & 4'hf) << 32'h3) | ((uv_issued__q[(32'h0)+:(3)]) & 4'hf);
-        t_line__0__d = (((t_take) & 4'hf) << 32'h3) | ((t_issued__q[(32'h0)+:(3)]) & 4'hf);
+        uv_line__0__d = (((uv_take) & 5'h1f) << 32'h4) | (((fb__q) & 5'h1f) << 32'h3) | ((uv_issued__q[(32'h0)+:(3)]) & 5'h1f);
+        t_line__0__d = (((t_take) & 5'h1f) << 32'h4) | (((fb__q) & 5'h1f) << 32'h3) | ((t_issued__q[(32'h0)+:(3)]) & 5'h1f);
         uv_line__1__d = uv_line__0__q;
         t_line__1__d = t_line__0__q;
         uv_line__2__d = uv_line__1__q;
@@ -11738,6 +11973,48 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         t_line__4__d = t_line__3__q;
         uv_line__5__d = uv_line__4__q;
         t_line__5__d = t_line__4__q;
+        if (fetching__q & ((uv_issued__q == 32'h8) | (uv_take & (uv_issued__q == 32'h7))) & ((t_issued__q == 32'h4) | (t_take & (t_issued__q == 32'h3)))) begin
+            fetching__d = 1'b0;
+            fb__d = ~fb__q;
+        end
+        fb_free = ~loaded__0__q;
+        if (fb__q) begin
+            fb_free = ~loaded__1__q;
+        end
+        if ((~fetching__q) & fb_free & list_unit__test_valid) begin
+            list_unit__test_take = 1'b1;
+            uv_issued__d = 32'h0;
+            t_issued__d = 32'h0;
+            fetching__d = 1'b1;
+            if (list_unit__test_entry[(32'h45)+:(2)] != 32'h0) begin
+                uv_issued__d = 32'h8;
+                t_issued__d = 32'h4;
+                fetching__d = 1'b0;
+                fb__d = ~fb__q;
+            end
+            if (fb__q == c_buffer__0) begin
+                loaded__0__d = 1'b1;
+                cur_kind__0__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__0__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__0__d = list_unit__test_entry[(32'h0)+:(32)];
+                received__0__d = 32'h0;
+                if (list_unit__test_entry[(32'h45)+:(2)] != 32'h0) begin
+                    received__0__d = 32'hc;
+                end
+            end
+            if (fb__q == c_buffer__1) begin
+                loaded__1__d = 1'b1;
+                cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__1__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__1__d = list_unit__test_entry[(32'h0)+:(32)];
+                received__1__d = 32'h0;
+                if (list_unit__test_entry[(32'h45)+:(2)] != 32'h0) begin
+                    received__1__d = 32'hc;
+                end
+            end
+        end
         uv_arrive = 32'h0;
         t_arrive = 32'h0;
         if (c_ml_last == c_index__0) begin
@@ -11764,45 +12041,123 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
             uv_arrive = uv_line__5__q;
             t_arrive = t_line__5__q;
         end
-        if (uv_arrive[32'h3] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__0)) begin
-            words__0__d = uv_rdata[(32'h0)+:(24)];
+        if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__0)) begin
+            if (uv_arrive[32'h3]) begin
+                words__12__d = uv_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__0__d = uv_rdata[(32'h0)+:(24)];
+            end
         end
-        if (uv_arrive[32'h3] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__1)) begin
-            words__1__d = uv_rdata[(32'h0)+:(24)];
+        if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__1)) begin
+            if (uv_arrive[32'h3]) begin
+                words__13__d = uv_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__1__d = uv_rdata[(32'h0)+:(24)];
+            end
         end
-        if (uv_arrive[32'h3] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__2)) begin
-            words__2__d = uv_rdata[(32'h0)+:(24)];
+        if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__2)) begin
+            if (uv_arrive[32'h3]) begin
+                words__14__d = uv_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__2__d = uv_rdata[(32'h0)+:(24)];
+            end
         end
-        if (uv_arrive[32'h3] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__3)) begin
-            words__3__d = uv_rdata[(32'h0)+:(24)];
+        if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__3)) begin
+            if (uv_arrive[32'h3]) begin
+                words__15__d = uv_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__3__d = uv_rdata[(32'h0)+:(24)];
+            end
         end
-        if (uv_arrive[32'h3] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__4)) begin
-            words__4__d = uv_rdata[(32'h0)+:(24)];
+        if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__4)) begin
+            if (uv_arrive[32'h3]) begin
+                words__16__d = uv_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__4__d = uv_rdata[(32'h0)+:(24)];
+            end
         end
-        if (uv_arrive[32'h3] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__5)) begin
-            words__5__d = uv_rdata[(32'h0)+:(24)];
+        if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__5)) begin
+            if (uv_arrive[32'h3]) begin
+                words__17__d = uv_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__5__d = uv_rdata[(32'h0)+:(24)];
+            end
         end
-        if (uv_arrive[32'h3] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__6)) begin
-            words__6__d = uv_rdata[(32'h0)+:(24)];
+        if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__6)) begin
+            if (uv_arrive[32'h3]) begin
+                words__18__d = uv_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__6__d = uv_rdata[(32'h0)+:(24)];
+            end
         end
-        if (uv_arrive[32'h3] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__7)) begin
-            words__7__d = uv_rdata[(32'h0)+:(24)];
+        if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__7)) begin
+            if (uv_arrive[32'h3]) begin
+                words__19__d = uv_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__7__d = uv_rdata[(32'h0)+:(24)];
+            end
         end
-        if (t_arrive[32'h3] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__0)) begin
-            words__8__d = t_rdata[(32'h0)+:(24)];
+        if (t_arrive[32'h4] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__0)) begin
+            if (t_arrive[32'h3]) begin
+                words__20__d = t_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__8__d = t_rdata[(32'h0)+:(24)];
+            end
         end
-        if (t_arrive[32'h3] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__1)) begin
-            words__9__d = t_rdata[(32'h0)+:(24)];
+        if (t_arrive[32'h4] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__1)) begin
+            if (t_arrive[32'h3]) begin
+                words__21__d = t_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__9__d = t_rdata[(32'h0)+:(24)];
+            end
         end
-        if (t_arrive[32'h3] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__2)) begin
-            words__10__d = t_rdata[(32'h0)+:(24)];
+        if (t_arrive[32'h4] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__2)) begin
+            if (t_arrive[32'h3]) begin
+                words__22__d = t_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__10__d = t_rdata[(32'h0)+:(24)];
+            end
         end
-        if (t_arrive[32'h3] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__3)) begin
-            words__11__d = t_rdata[(32'h0)+:(24)];
+        if (t_arrive[32'h4] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__3)) begin
+            if (t_arrive[32'h3]) begin
+                words__23__d = t_rdata[(32'h0)+:(24)];
+            end
+            else begin
+                words__11__d = t_rdata[(32'h0)+:(24)];
+            end
         end
-        received__d = received__q + ((uv_arrive[32'h3]) & 4'hf) + ((t_arrive[32'h3]) & 4'hf);
-        transform_unit__in_valid = 1'b0;
-        transform_unit__point = 1'b1;
+        uv_here__0 = uv_arrive[32'h4] & (uv_arrive[32'h3] == c_buffer__0);
+        t_here__0 = t_arrive[32'h4] & (t_arrive[32'h3] == c_buffer__0);
+        if (uv_here__0 | t_here__0) begin
+            received__0__d = received__0__q + 32'h1;
+        end
+        if (uv_here__0 & t_here__0) begin
+            received__0__d = received__0__q + 32'h2;
+        end
+        uv_here__1 = uv_arrive[32'h4] & (uv_arrive[32'h3] == c_buffer__1);
+        t_here__1 = t_arrive[32'h4] & (t_arrive[32'h3] == c_buffer__1);
+        if (uv_here__1 | t_here__1) begin
+            received__1__d = received__1__q + 32'h1;
+        end
+        if (uv_here__1 & t_here__1) begin
+            received__1__d = received__1__q + 32'h2;
+        end
+        l_kind = cur_kind__0__q;
+        l_thread = cur_thread__0__q;
+        l_a = cur_a__0__q;
+        l_b = cur_b__0__q;
+        l_ready = loaded__0__q & (received__0__q == 32'hc);
         transform_unit__m__0 = words__0__q;
         transform_unit__m__1 = words__1__q;
         transform_unit__m__2 = words__2__q;
@@ -11815,49 +12170,54 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         transform_unit__m__9 = words__9__q;
         transform_unit__m__10 = words__10__q;
         transform_unit__m__11 = words__11__q;
+        if (lb__q) begin
+            l_kind = cur_kind__1__q;
+            l_thread = cur_thread__1__q;
+            l_a = cur_a__1__q;
+            l_b = cur_b__1__q;
+            l_ready = loaded__1__q & (received__1__q == 32'hc);
+            transform_unit__m__0 = words__12__q;
+            transform_unit__m__1 = words__13__q;
+            transform_unit__m__2 = words__14__q;
+            transform_unit__m__3 = words__15__q;
+            transform_unit__m__4 = words__16__q;
+            transform_unit__m__5 = words__17__q;
+            transform_unit__m__6 = words__18__q;
+            transform_unit__m__7 = words__19__q;
+            transform_unit__m__8 = words__20__q;
+            transform_unit__m__9 = words__21__q;
+            transform_unit__m__10 = words__22__q;
+            transform_unit__m__11 = words__23__q;
+        end
+        ray__ray_thread = l_thread;
+        ray__t_min_thread = l_thread;
+        transform_unit__in_valid = 1'b0;
+        transform_unit__point = 1'b1;
         transform_unit__v__0 = ray__o__0;
         transform_unit__v__1 = ray__o__1;
         transform_unit__v__2 = ray__o__2;
-        launch_tag = (((cur_kind__q) & 16'hffff) << 32'ha) | (((cur_thread__q) & 16'hffff) << 32'h5) | ((seq__q) & 16'hffff);
+        launch_tag = (((l_kind) & 16'hffff) << 32'ha) | (((l_thread) & 16'hffff) << 32'h5) | ((seq__q) & 16'hffff);
         transform_unit__tag = launch_tag;
         flight_t_min__write_address = seq__q;
         flight_a__write_address = seq__q;
         flight_b__write_address = seq__q;
         flight_t_min__write_data = ray__t_min;
-        flight_a__write_data = cur_a__q;
-        flight_b__write_data = cur_b__q;
+        flight_a__write_data = l_a;
+        flight_b__write_data = l_b;
         flight_t_min__write_enable = 1'b0;
         flight_a__write_enable = 1'b0;
         flight_b__write_enable = 1'b0;
-        if (phase__q == 32'h0) begin
-            if (list_unit__test_valid) begin
-                list_unit__test_take = 1'b1;
-                cur_kind__d = list_unit__test_entry[(32'h45)+:(2)];
-                cur_thread__d = list_unit__test_entry[(32'h40)+:(5)];
-                cur_a__d = list_unit__test_entry[(32'h20)+:(32)];
-                cur_b__d = list_unit__test_entry[(32'h0)+:(32)];
-                uv_issued__d = 32'h0;
-                t_issued__d = 32'h0;
-                received__d = 32'h0;
-                if (list_unit__test_entry[(32'h45)+:(2)] != 32'h0) begin
-                    uv_issued__d = 32'h8;
-                    t_issued__d = 32'h4;
-                    received__d = 32'hc;
-                end
-                phase__d = 32'h1;
-            end
+        if ((lphase__q == 32'h0) & l_ready) begin
+            lphase__d = 32'h1;
         end
-        if ((phase__q == 32'h1) & (received__q == 32'hc)) begin
-            phase__d = 32'h2;
-        end
-        if (phase__q == 32'h2) begin
+        if (lphase__q == 32'h1) begin
             transform_unit__in_valid = 1'b1;
             flight_t_min__write_enable = 1'b1;
             flight_a__write_enable = 1'b1;
             flight_b__write_enable = 1'b1;
-            phase__d = 32'h3;
+            lphase__d = 32'h2;
         end
-        if (phase__q == 32'h3) begin
+        if (lphase__q == 32'h2) begin
             transform_unit__in_valid = 1'b1;
             transform_unit__point = 1'b0;
             transform_unit__v__0 = ray__d__0;
@@ -11865,9 +12225,19 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
             transform_unit__v__2 = ray__d__2;
             transform_unit__tag = launch_tag | c_d_pass;
             seq__d = seq__q + 32'h1;
-            phase__d = 32'h0;
+            lphase__d = 32'h3;
         end
-        transform_busy = transform_unit__in_valid & (cur_kind__q == 32'h0);
+        if (lphase__q == 32'h3) begin
+            if (lb__q == c_buffer__0) begin
+                loaded__0__d = 1'b0;
+            end
+            if (lb__q == c_buffer__1) begin
+                loaded__1__d = 1'b0;
+            end
+            lb__d = ~lb__q;
+            lphase__d = 32'h0;
+        end
+        transform_busy = transform_unit__in_valid & (l_kind == 32'h0);
         o_hold__0__d = o_hold__0__q;
         if (transform_unit__out_valid & (~transform_unit__out_tag[32'hd])) begin
             o_hold__0__d = transform_unit__result__0;
@@ -12009,7 +12379,11 @@ endmodule // dynrt_processor_core__tester__best_e
 
 
 
-module dynrt_processor_core__tester__cur_kind(d,q,clock);
+
+
+
+
+module dynrt_processor_core__tester__cur_kind__0(d,q,clock);
     
     // Module arguments
     input wire  [1:0] d;
@@ -12025,7 +12399,11 @@ module dynrt_processor_core__tester__cur_kind(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__tester__cur_kind
+endmodule // dynrt_processor_core__tester__cur_kind__0
+
+
+
+
 
 
 
@@ -12091,6 +12469,10 @@ module dynrt_processor_core__tester__done_e(read_address,read_clock,read_data,wr
     end
                 
 endmodule // dynrt_processor_core__tester__done_e
+
+
+
+
 
 
 
@@ -15395,6 +15777,8 @@ endmodule // dynrt_processor_core__tester__intersect_unit__uv_delay__0
 
 
 
+
+
 module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,word_b,full,engine_read,engine_bank,list_read,list_addr,list_rdata,test_valid,test_entry,test_take);
     
     // Module arguments
@@ -15757,7 +16141,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_meta__write_data),
         .write_enable(mailbox_meta__write_enable)
     );
-    dynrt_processor_core__tester__cur_kind phase(
+    dynrt_processor_core__tester__cur_kind__0 phase(
         .d(phase__d),
         .q(phase__q),
         .clock(phase__clock)
@@ -17036,6 +17420,12 @@ endmodule // dynrt_processor_core__tester__list_unit__tests__write_logic
 
 
 
+
+
+
+
+
+
 module dynrt_processor_core__tester__m2_best(d,q,clock);
     
     // Module arguments
@@ -17053,8 +17443,6 @@ module dynrt_processor_core__tester__m2_best(d,q,clock);
     end
           
 endmodule // dynrt_processor_core__tester__m2_best
-
-
 
 
 
@@ -17301,6 +17689,8 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
     end
     
 endmodule // dynrt_processor_core__tester__ray
+
+
 
 
 
@@ -19969,6 +20359,30 @@ endmodule // dynrt_processor_core__tester__transform_unit__tag_delay
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write,ray_pair,t_min_write,enqueue,enqueue_next,full,query_thread,pending,result,list_end,engine_read,engine_bank,engine_addr,node_read,node_addr,node_rdata,step_busy,done_event,done_thread,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit);
     
     // Module arguments
@@ -20287,6 +20701,20 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
     reg  [1:0] phase__d;
     wire  [1:0] phase__q;
     reg  phase__clock;
+    reg  [101:0] fetch_job__d;
+    wire  [101:0] fetch_job__q;
+    reg  fetch_job__clock;
+    reg  in_flight__clock;
+    reg  in_flight__read;
+    wire  [101:0] in_flight__data_out;
+    wire  in_flight__empty;
+    wire  in_flight__almost_empty;
+    wire  in_flight__underflow;
+    reg  in_flight__write;
+    reg  [101:0] in_flight__data_in;
+    wire  in_flight__full;
+    wire  in_flight__almost_full;
+    wire  in_flight__overflow;
     reg  [101:0] job__d;
     wire  [101:0] job__q;
     reg  job__clock;
@@ -20428,6 +20856,8 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
     reg  [5:0] f5_pop;
     reg  front_end;
     reg  [101:0] front_job;
+    reg  fetch_free;
+    reg  [4:0] next_a_thread;
     reg  take;
     reg  [1:0] arrive;
     reg  at_a;
@@ -20824,17 +21254,35 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .le(cmp_pop__le),
         .eq(cmp_pop__eq)
     );
-    dynrt_processor_core__tester__cur_kind phase(
+    dynrt_processor_core__tester__cur_kind__0 phase(
         .d(phase__d),
         .q(phase__q),
         .clock(phase__clock)
     );
-    dynrt_processor_core__traversal_unit__job job(
+    dynrt_processor_core__traversal_unit__fetch_job fetch_job(
+        .d(fetch_job__d),
+        .q(fetch_job__q),
+        .clock(fetch_job__clock)
+    );
+    dynrt_processor_core__traversal_unit__in_flight in_flight(
+        .clock(in_flight__clock),
+        .read(in_flight__read),
+        .data_out(in_flight__data_out),
+        .empty(in_flight__empty),
+        .almost_empty(in_flight__almost_empty),
+        .underflow(in_flight__underflow),
+        .write(in_flight__write),
+        .data_in(in_flight__data_in),
+        .full(in_flight__full),
+        .almost_full(in_flight__almost_full),
+        .overflow(in_flight__overflow)
+    );
+    dynrt_processor_core__traversal_unit__fetch_job job(
         .d(job__d),
         .q(job__q),
         .clock(job__clock)
     );
-    dynrt_processor_core__tester__cur_kind words_in(
+    dynrt_processor_core__tester__cur_kind__0 words_in(
         .d(words_in__d),
         .q(words_in__q),
         .clock(words_in__clock)
@@ -20849,32 +21297,32 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .q(w1__q),
         .clock(w1__clock)
     );
-    dynrt_processor_core__tester__cur_kind node_line__0(
+    dynrt_processor_core__tester__cur_kind__0 node_line__0(
         .d(node_line__0__d),
         .q(node_line__0__q),
         .clock(node_line__0__clock)
     );
-    dynrt_processor_core__tester__cur_kind node_line__1(
+    dynrt_processor_core__tester__cur_kind__0 node_line__1(
         .d(node_line__1__d),
         .q(node_line__1__q),
         .clock(node_line__1__clock)
     );
-    dynrt_processor_core__tester__cur_kind node_line__2(
+    dynrt_processor_core__tester__cur_kind__0 node_line__2(
         .d(node_line__2__d),
         .q(node_line__2__q),
         .clock(node_line__2__clock)
     );
-    dynrt_processor_core__tester__cur_kind node_line__3(
+    dynrt_processor_core__tester__cur_kind__0 node_line__3(
         .d(node_line__3__d),
         .q(node_line__3__q),
         .clock(node_line__3__clock)
     );
-    dynrt_processor_core__tester__cur_kind node_line__4(
+    dynrt_processor_core__tester__cur_kind__0 node_line__4(
         .d(node_line__4__d),
         .q(node_line__4__q),
         .clock(node_line__4__clock)
     );
-    dynrt_processor_core__tester__cur_kind node_line__5(
+    dynrt_processor_core__tester__cur_kind__0 node_line__5(
         .d(node_line__5__d),
         .q(node_line__5__q),
         .clock(node_line__5__clock)
@@ -21068,6 +21516,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         f5_hi__clock = clock;
         f5_in_leaf__clock = clock;
         phase__clock = clock;
+        fetch_job__clock = clock;
         job__clock = clock;
         words_in__clock = clock;
         w0__clock = clock;
@@ -21111,12 +21560,14 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         f5_hi__d = f5_hi__q;
         f5_in_leaf__d = f5_in_leaf__q;
         phase__d = phase__q;
+        fetch_job__d = fetch_job__q;
         job__d = job__q;
         words_in__d = words_in__q;
         w0__d = w0__q;
         w1__d = w1__q;
         entry_fifo__clock = clock;
         leaf_fifo__clock = clock;
+        in_flight__clock = clock;
         front_fifo__clock = clock;
         loop_fifo__clock = clock;
         ray__clock = clock;
@@ -21263,26 +21714,20 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         front_fifo__data_in = front_job;
         loop_fifo__read = 1'b0;
         front_fifo__read = 1'b0;
-        if (phase__q == 32'h0) begin
-            if (~loop_fifo__empty) begin
-                loop_fifo__read = 1'b1;
-                job__d = loop_fifo__data_out;
-                phase__d = 32'h1;
-            end
-            else if (~front_fifo__empty) begin
-                front_fifo__read = 1'b1;
-                job__d = front_fifo__data_out;
-                phase__d = 32'h1;
-            end
-        end
-        words_in__d = 32'h0;
-        take = ((phase__q == 32'h1) | (phase__q == 32'h2)) & (~job__q[32'h65]) & (~(engine_read & (engine_bank == 32'h0)));
+        in_flight__read = 1'b0;
+        take = (phase__q != 32'h0) & (~(engine_read & (engine_bank == 32'h0)));
         node_read = take | (engine_read & (engine_bank == 32'h0));
         node_addr = engine_addr;
         if (take) begin
-            node_addr = (((job__q[(32'h40)+:(26)]) & 24'hffffff) << 32'h1) | ((phase__q - 32'h1) & 24'hffffff);
-            phase__d = phase__q + 32'h1;
+            node_addr = (((fetch_job__q[(32'h40)+:(26)]) & 24'hffffff) << 32'h1) | ((phase__q - 32'h1) & 24'hffffff);
+            phase__d = 32'h2;
+            if (phase__q == 32'h2) begin
+                phase__d = 32'h0;
+            end
         end
+        in_flight__write = take & (phase__q == 32'h1);
+        in_flight__data_in = fetch_job__q;
+        words_in__d = 32'h0;
         node_line__0__d = (((take) & 2'h3) << 32'h1) | (((phase__q == 32'h2)) & 2'h3);
         node_line__1__d = node_line__0__q;
         node_line__2__d = node_line__1__q;
@@ -21311,21 +21756,37 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         if (arrive == 32'h2) begin
             w0__d = node_rdata;
         end
+        next_a_thread = job__q[(32'h60)+:(5)];
         if (arrive == 32'h3) begin
             w1__d = node_rdata;
-        end
-        if ((phase__q == 32'h3) & (arrive == 32'h3)) begin
+            job__d = in_flight__data_out;
+            next_a_thread = in_flight__data_out[(32'h60)+:(5)];
+            in_flight__read = 1'b1;
             words_in__d = 32'h1;
         end
-        if ((phase__q == 32'h1) & job__q[32'h65]) begin
-            phase__d = 32'h3;
-            words_in__d = 32'h1;
+        fetch_free = (phase__q == 32'h0) | ((phase__q == 32'h2) & take);
+        if (fetch_free) begin
+            if (~loop_fifo__empty) begin
+                loop_fifo__read = 1'b1;
+                fetch_job__d = loop_fifo__data_out;
+                phase__d = 32'h1;
+            end
+            else if (~front_fifo__empty) begin
+                if (~front_fifo__data_out[32'h65]) begin
+                    front_fifo__read = 1'b1;
+                    fetch_job__d = front_fifo__data_out;
+                    phase__d = 32'h1;
+                end
+                else if ((phase__q == 32'h0) & in_flight__empty) begin
+                    front_fifo__read = 1'b1;
+                    job__d = front_fifo__data_out;
+                    next_a_thread = front_fifo__data_out[(32'h60)+:(5)];
+                    words_in__d = 32'h1;
+                end
+            end
         end
-        ray__ray_thread = job__q[(32'h60)+:(5)];
-        at_a = (phase__q == 32'h3) & (words_in__q == 32'h1);
-        if (at_a) begin
-            phase__d = 32'h0;
-        end
+        ray__ray_thread = in_flight__data_out[(32'h60)+:(5)];
+        at_a = words_in__q == 32'h1;
         a_leaf = job__q[32'h65] | (w0__q[(32'h1e)+:(2)] == 32'h3);
         a_axis = w0__q[(32'h1e)+:(2)];
         a_o = ray__o__0;
@@ -21360,7 +21821,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         end_e__write_data = a_list_end;
         leaf_hi__write_data = job__q[(32'h0)+:(24)];
         leaf_sp__write_data = job__q[(32'h5a)+:(6)];
-        done_u__read_address = job__q[(32'h60)+:(5)];
+        done_u__read_address = next_a_thread;
         done_u__write_address = job__q[(32'h60)+:(5)];
         done_e__write_data = done_u__read_data + 32'h1;
         done_u__write_data = done_u__read_data + 32'h1;
@@ -22841,6 +23302,25 @@ endmodule // dynrt_processor_core__traversal_unit__f4_node
 
 
 
+module dynrt_processor_core__traversal_unit__fetch_job(d,q,clock);
+    
+    // Module arguments
+    input wire  [101:0] d;
+    output reg  [101:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 102'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor_core__traversal_unit__fetch_job
+
+
 module dynrt_processor_core__traversal_unit__front_fifo(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
     
     // Module arguments
@@ -23209,25 +23689,332 @@ endmodule // dynrt_processor_core__traversal_unit__hi_delay
 
 
 
-
-
-module dynrt_processor_core__traversal_unit__job(d,q,clock);
+module dynrt_processor_core__traversal_unit__in_flight(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
     
     // Module arguments
-    input wire  [101:0] d;
-    output reg  [101:0] q;
     input wire  clock;
+    input wire  read;
+    output reg  [101:0] data_out;
+    output reg  empty;
+    output reg  almost_empty;
+    output reg  underflow;
+    input wire  write;
+    input wire  [101:0] data_in;
+    output reg  full;
+    output reg  almost_full;
+    output reg  overflow;
+    
+    // Stub signals
+    reg  [2:0] ram__read_address;
+    reg  ram__read_clock;
+    wire  [101:0] ram__read_data;
+    reg  [2:0] ram__write_address;
+    reg  ram__write_clock;
+    reg  [101:0] ram__write_data;
+    reg  ram__write_enable;
+    reg  read_logic__clock;
+    reg  read_logic__read;
+    wire  [101:0] read_logic__data_out;
+    wire  read_logic__empty;
+    wire  read_logic__almost_empty;
+    wire  read_logic__underflow;
+    reg  [3:0] read_logic__write_address_delayed;
+    wire  [2:0] read_logic__ram_read_address;
+    reg  [101:0] read_logic__ram_read_data;
+    wire  read_logic__ram_read_clock;
+    wire  [3:0] read_logic__read_address_out;
+    wire  [3:0] read_logic__fill_level;
+    reg  write_logic__write;
+    reg  [101:0] write_logic__data_in;
+    wire  write_logic__full;
+    wire  write_logic__almost_full;
+    wire  write_logic__overflow;
+    reg  write_logic__clock;
+    wire  [2:0] write_logic__ram_write_address;
+    wire  write_logic__ram_write_clock;
+    wire  [101:0] write_logic__ram_write_data;
+    wire  write_logic__ram_write_enable;
+    reg  [3:0] write_logic__read_address;
+    wire  [3:0] write_logic__write_address_delayed;
+    wire  [3:0] write_logic__fill_level;
+    
+    // Sub module instances
+    dynrt_processor_core__traversal_unit__in_flight__ram ram(
+        .read_address(ram__read_address),
+        .read_clock(ram__read_clock),
+        .read_data(ram__read_data),
+        .write_address(ram__write_address),
+        .write_clock(ram__write_clock),
+        .write_data(ram__write_data),
+        .write_enable(ram__write_enable)
+    );
+    dynrt_processor_core__traversal_unit__in_flight__read_logic read_logic(
+        .clock(read_logic__clock),
+        .read(read_logic__read),
+        .data_out(read_logic__data_out),
+        .empty(read_logic__empty),
+        .almost_empty(read_logic__almost_empty),
+        .underflow(read_logic__underflow),
+        .write_address_delayed(read_logic__write_address_delayed),
+        .ram_read_address(read_logic__ram_read_address),
+        .ram_read_data(read_logic__ram_read_data),
+        .ram_read_clock(read_logic__ram_read_clock),
+        .read_address_out(read_logic__read_address_out),
+        .fill_level(read_logic__fill_level)
+    );
+    dynrt_processor_core__traversal_unit__in_flight__write_logic write_logic(
+        .write(write_logic__write),
+        .data_in(write_logic__data_in),
+        .full(write_logic__full),
+        .almost_full(write_logic__almost_full),
+        .overflow(write_logic__overflow),
+        .clock(write_logic__clock),
+        .ram_write_address(write_logic__ram_write_address),
+        .ram_write_clock(write_logic__ram_write_clock),
+        .ram_write_data(write_logic__ram_write_data),
+        .ram_write_enable(write_logic__ram_write_enable),
+        .read_address(write_logic__read_address),
+        .write_address_delayed(write_logic__write_address_delayed),
+        .fill_level(write_logic__fill_level)
+    );
+    
+    // Update code
+    always @(*) begin
+        read_logic__clock = clock;
+        write_logic__clock = clock;
+        read_logic__read = read;
+        empty = read_logic__empty;
+        almost_empty = read_logic__almost_empty;
+        data_out = read_logic__data_out;
+        underflow = read_logic__underflow;
+        overflow = write_logic__overflow;
+        almost_full = write_logic__almost_full;
+        full = write_logic__full;
+        write_logic__write = write;
+        write_logic__data_in = data_in;
+        ram__write_clock = clock;
+        ram__write_enable = write_logic__ram_write_enable;
+        ram__write_address = write_logic__ram_write_address;
+        ram__write_data = write_logic__ram_write_data;
+        ram__read_clock = clock;
+        ram__read_address = read_logic__ram_read_address;
+        read_logic__ram_read_data = ram__read_data;
+        read_logic__write_address_delayed = write_logic__write_address_delayed;
+        write_logic__read_address = read_logic__read_address_out;
+    end
+    
+endmodule // dynrt_processor_core__traversal_unit__in_flight
+
+
+module dynrt_processor_core__traversal_unit__in_flight__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [2:0] read_address;
+    input wire  read_clock;
+    output reg  [101:0] read_data;
+    input wire  [2:0] write_address;
+    input wire  write_clock;
+    input wire  [101:0] write_data;
+    input wire  write_enable;
     
     // Update code (custom)
-    initial begin
-       q = 102'h0;
+    reg[101:0] mem[7:0];
+    
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
     end
     
-    always @(posedge clock) begin
-       q <= d;
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
     end
-          
-endmodule // dynrt_processor_core__traversal_unit__job
+                
+endmodule // dynrt_processor_core__traversal_unit__in_flight__ram
+
+
+module dynrt_processor_core__traversal_unit__in_flight__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  read;
+    output reg  [101:0] data_out;
+    output reg  empty;
+    output reg  almost_empty;
+    output reg  underflow;
+    input wire  [3:0] write_address_delayed;
+    output reg  [2:0] ram_read_address;
+    input wire  [101:0] ram_read_data;
+    output reg  ram_read_clock;
+    output reg  [3:0] read_address_out;
+    output reg  [3:0] fill_level;
+    
+    // Constant declarations
+    localparam  fifo_address_mask = 4'h7;
+    localparam  fifo_size = 4'h8;
+    localparam  block_size = 4'h1;
+    
+    // Stub signals
+    reg  [3:0] read_address__d;
+    wire  [3:0] read_address__q;
+    reg  read_address__clock;
+    reg  dff_underflow__d;
+    wire  dff_underflow__q;
+    reg  dff_underflow__clock;
+    
+    // Local signals
+    reg  is_empty;
+    reg  is_full;
+    
+    // Sub module instances
+    dynrt_processor_core__tester__list_unit__flight read_address(
+        .d(read_address__d),
+        .q(read_address__q),
+        .clock(read_address__clock)
+    );
+    dynrt_processor_core__add__big_sign dff_underflow(
+        .d(dff_underflow__d),
+        .q(dff_underflow__q),
+        .clock(dff_underflow__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        read_address__clock = clock;
+        dff_underflow__clock = clock;
+        read_address__d = read_address__q;
+        dff_underflow__d = dff_underflow__q;
+        ram_read_clock = clock;
+        is_empty = (read_address__q == write_address_delayed);
+        is_full = ~is_empty & ((read_address__q & fifo_address_mask) == (write_address_delayed & fifo_address_mask));
+        fill_level = ((write_address_delayed & fifo_address_mask) + fifo_size - (read_address__q & fifo_address_mask)) & fifo_address_mask;
+        if (is_full) begin
+            fill_level = fifo_size;
+        end
+        almost_empty = (fill_level < block_size);
+        empty = is_empty;
+        ram_read_address = ((read_address__q & fifo_address_mask) & 3'h7);
+        data_out = ram_read_data;
+        if (read & ~is_empty) begin
+            read_address__d = read_address__q + 32'h1;
+            ram_read_address = (((read_address__q + 32'h1) & fifo_address_mask) & 3'h7);
+        end
+        else begin
+            read_address__d = read_address__q;
+        end
+        dff_underflow__d = dff_underflow__q | (is_empty & read);
+        underflow = dff_underflow__q;
+        read_address_out = read_address__q;
+    end
+    
+endmodule // dynrt_processor_core__traversal_unit__in_flight__read_logic
+
+
+
+
+
+
+module dynrt_processor_core__traversal_unit__in_flight__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
+    
+    // Module arguments
+    input wire  write;
+    input wire  [101:0] data_in;
+    output reg  full;
+    output reg  almost_full;
+    output reg  overflow;
+    input wire  clock;
+    output reg  [2:0] ram_write_address;
+    output reg  ram_write_clock;
+    output reg  [101:0] ram_write_data;
+    output reg  ram_write_enable;
+    input wire  [3:0] read_address;
+    output reg  [3:0] write_address_delayed;
+    output reg  [3:0] fill_level;
+    
+    // Constant declarations
+    localparam  fifo_address_mask = 4'h7;
+    localparam  fifo_size = 4'h8;
+    localparam  almost_full_level = 4'h7;
+    
+    // Stub signals
+    reg  [3:0] write_address__d;
+    wire  [3:0] write_address__q;
+    reg  write_address__clock;
+    reg  [3:0] dff_write_address_delay__d;
+    wire  [3:0] dff_write_address_delay__q;
+    reg  dff_write_address_delay__clock;
+    reg  dff_overflow__d;
+    wire  dff_overflow__q;
+    reg  dff_overflow__clock;
+    
+    // Local signals
+    reg  is_empty;
+    reg  is_full;
+    
+    // Sub module instances
+    dynrt_processor_core__tester__list_unit__flight write_address(
+        .d(write_address__d),
+        .q(write_address__q),
+        .clock(write_address__clock)
+    );
+    dynrt_processor_core__tester__list_unit__flight dff_write_address_delay(
+        .d(dff_write_address_delay__d),
+        .q(dff_write_address_delay__q),
+        .clock(dff_write_address_delay__clock)
+    );
+    dynrt_processor_core__add__big_sign dff_overflow(
+        .d(dff_overflow__d),
+        .q(dff_overflow__q),
+        .clock(dff_overflow__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        dff_overflow__clock = clock;
+        write_address__clock = clock;
+        dff_write_address_delay__clock = clock;
+        dff_overflow__d = dff_overflow__q;
+        write_address__d = write_address__q;
+        dff_write_address_delay__d = dff_write_address_delay__q;
+        ram_write_clock = clock;
+        dff_write_address_delay__d = write_address__q;
+        write_address_delayed = dff_write_address_delay__q;
+        ram_write_enable = 1'b0;
+        is_empty = (read_address == dff_write_address_delay__q);
+        is_full = ~is_empty & ((read_address & fifo_address_mask) == (write_address__q & fifo_address_mask));
+        fill_level = ((dff_write_address_delay__q & fifo_address_mask) + fifo_size - (read_address & fifo_address_mask)) & fifo_address_mask;
+        if (is_full) begin
+            fill_level = fifo_size;
+        end
+        almost_full = (fill_level >= almost_full_level);
+        full = is_full;
+        ram_write_address = ((write_address__q & fifo_address_mask) & 3'h7);
+        ram_write_data = data_in;
+        if (write & ~is_full) begin
+            write_address__d = write_address__q + 32'h1;
+            ram_write_enable = 1'b1;
+        end
+        else begin
+            write_address__d = write_address__q;
+            ram_write_enable = 1'b0;
+        end
+        dff_overflow__d = dff_overflow__q | (is_full & write);
+        overflow = dff_overflow__q;
+    end
+    
+endmodule // dynrt_processor_core__traversal_unit__in_flight__write_logic
+
+
+
+
+
+
+
+
+
+
 
 
 module dynrt_processor_core__traversal_unit__leaf_fifo(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);

@@ -1,10 +1,11 @@
 //! `TraversalUnit`: the ray thread engine's coprocessor for object-level kd traversal. A thread
-//! starts a walk (`kd.start root, t_max`) and waits; the unit steps through inner nodes on its
-//! own (fetch the node from bank 0, decide with `units::traversal_step`, push the far child on
-//! the thread's stack) until it reaches a leaf, and hands the leaf's list (`kd.wait`,
-//! `kd.end`) to the thread, which queues the list's triangles in the triangle tester. With the
-//! leaf's closest hit (`kd.next best_t, hit`) the unit ends the walk when that hit lies in the
-//! leaf's segment, or pops the stack (ending when the stack is empty or the popped segment
+//! starts a walk (`kd.start root, t_max`) and sleeps until it ends (`kd.wait`); the unit steps
+//! through inner nodes on its own (fetch the node from bank 0, decide with
+//! `units::traversal_step`, push the far child on the thread's stack) until it reaches a
+//! leaf, and hands the leaf's list to the triangle tester (`leaf_*`). With the leaf's closest
+//! hit (the tester's `answer_*`; the engine's `kd.next best_t, hit` enters the same way) the
+//! unit ends the walk when that hit lies in the leaf's segment or the walk answers any hit
+//! (`KD_ANY_HIT`), or pops the stack (ending when the stack is empty or the popped segment
 //! starts behind the hit), exactly as `model::golden`'s `traverse`.
 //!
 //! Engine side (I2/I3, like the triangle tester): `enqueue` offers an entry of `thread`
@@ -20,11 +21,12 @@
 //! next reads the thread's leaf segment and stack and compares the hit with both in 5 clocks,
 //! its own pipeline, one entry a clock) into the front
 //! queue; steps that continue go into the loop queue, which the fetch serves first. Fetch:
-//! one job at a time, two words of bank 0 (the engine's own loads of bank 0 go first), then
-//! the decision pipeline: `split - o` (FpAddSub), `/ d` (FpDiv), then five FpCompares; at its
-//! end a push and the next step. Latency per inner node: `mem_latency + 4` clocks of fetch
-//! plus `7 + DL + 2` of decision; fetch throughput one node per `mem_latency + 4` clocks,
-//! while other threads' jobs fill the decision pipeline. Each thread has at most one job in
+//! two words of bank 0 a job, the next job's requests right behind (the engine's own loads of
+//! bank 0 go first; the words come back in order), then the decision pipeline: `split - o`
+//! (FpAddSub), `/ d` (FpDiv), then five FpCompares; at its end a push and the next step.
+//! Latency per inner node: `mem_latency + 3` clocks of fetch plus `7 + DL + 2` of decision;
+//! throughput one node per [`FETCH_CLOCKS_PER_NODE`] (2) clocks, while other threads' jobs
+//! fill the decision pipeline. Each thread has at most one job in
 //! the unit, so the 32-entry queues never overflow.
 //!
 //! Per thread: a stack of [`STACK_LEVELS`] entries `(node, lo, hi)`, the leaf's segment end
@@ -44,10 +46,8 @@ use crate::fp::Format;
 /// Entries of each thread's kd stack (the deepest object tree the unit walks).
 pub const STACK_LEVELS: usize = 64;
 
-/// Clocks the fetch spends on one inner node (the unit's throughput bound).
-pub const fn fetch_clocks_per_node(mem_latency: u32) -> u32 {
-    mem_latency + 4
-}
+/// Clocks the fetch spends on one node, its two words (the unit's throughput bound).
+pub const FETCH_CLOCKS_PER_NODE: u32 = 2;
 
 /// Engine queue entry: `{next[69], thread[68:64], a[63:32], b[31:0]}`.
 type Entry = Bits<70>;
@@ -187,8 +187,13 @@ pub struct TraversalUnit<
     front_end: Signal<Local, Bit>,
     front_job: Signal<Local, Job>,
 
-    // Fetch: `phase` 0 idle, 1 request word 0, 2 request word 1, 3 wait for the words.
+    // Fetch: `phase` 0 idle, 1 request word 0, 2 request word 1 of `fetch_job`; `job` is at A.
     phase: DFF<Bits<2>>,
+    fetch_job: DFF<Job>,
+    fetch_free: Signal<Local, Bit>,
+    next_a_thread: Signal<Local, Bits<5>>,
+    /// Jobs whose words are requested, oldest first (at most `mem_latency / 2 + 2`).
+    in_flight: SynchronousFIFO<Job, 3, 4, 1>,
     job: DFF<Job>,
     words_in: DFF<Bits<2>>,
     w0: DFF<Bits<32>>,
@@ -349,6 +354,10 @@ impl<
             front_end: Default::default(),
             front_job: Default::default(),
             phase: Default::default(),
+            fetch_job: Default::default(),
+            fetch_free: Default::default(),
+            next_a_thread: Default::default(),
+            in_flight: Default::default(),
             job: Default::default(),
             words_in: Default::default(),
             w0: Default::default(),
@@ -406,13 +415,14 @@ impl<
             f2_a, f2_b, f3_valid, f3_next, f3_thread, f3_a, f3_b, f3_sp, f3_t_min, f4_valid,
             f4_next, f4_thread, f4_a, f4_b, f4_sp, f4_t_min, f4_node, f4_lo, f4_hi, f5_valid,
             f5_next, f5_thread, f5_a, f5_b, f5_sp, f5_t_min, f5_node, f5_lo, f5_hi, f5_in_leaf,
-            phase, job, words_in, w0, w1
+            phase, fetch_job, job, words_in, w0, w1
         );
         clock!(
             self,
             clock,
             entry_fifo,
             leaf_fifo,
+            in_flight,
             front_fifo,
             loop_fifo,
             ray,
@@ -582,32 +592,29 @@ impl<
         self.front_fifo.write.next = self.f5_valid.q.val();
         self.front_fifo.data_in.next = self.front_job.val();
 
-        // Fetch: loop jobs first; two words of bank 0 (the engine's loads first).
+        // Fetch: loop jobs first; two words of bank 0 a job (the engine's loads first), the
+        // next job's right behind. The words arrive in order: a job waits in `in_flight` from
+        // its first request to its second word.
         self.loop_fifo.read.next = false;
         self.front_fifo.read.next = false;
-        if self.phase.q.val() == 0 {
-            if !self.loop_fifo.empty.val() {
-                self.loop_fifo.read.next = true;
-                self.job.d.next = self.loop_fifo.data_out.val();
-                self.phase.d.next = 1.into();
-            } else if !self.front_fifo.empty.val() {
-                self.front_fifo.read.next = true;
-                self.job.d.next = self.front_fifo.data_out.val();
-                self.phase.d.next = 1.into();
-            }
-        }
-        self.words_in.d.next = 0.into();
-        self.take.next = ((self.phase.q.val() == 1) | (self.phase.q.val() == 2))
-            & (!self.job.q.val().get_bit(101))
-            & (!(self.engine_read.val() & (self.engine_bank.val() == 0)));
+        self.in_flight.read.next = false;
+        self.take.next =
+            (self.phase.q.val() != 0) & (!(self.engine_read.val() & (self.engine_bank.val() == 0)));
         self.node_read.next =
             self.take.val() | (self.engine_read.val() & (self.engine_bank.val() == 0));
         self.node_addr.next = self.engine_addr.val();
         if self.take.val() {
-            self.node_addr.next = (bit_cast::<24, 26>(self.job.q.val().get_bits::<26>(64)) << 1)
+            self.node_addr.next = (bit_cast::<24, 26>(self.fetch_job.q.val().get_bits::<26>(64))
+                << 1)
                 | bit_cast::<24, 2>(self.phase.q.val() - 1);
-            self.phase.d.next = self.phase.q.val() + 1;
+            self.phase.d.next = 2.into();
+            if self.phase.q.val() == 2 {
+                self.phase.d.next = 0.into();
+            }
         }
+        self.in_flight.write.next = self.take.val() & (self.phase.q.val() == 1);
+        self.in_flight.data_in.next = self.fetch_job.q.val();
+        self.words_in.d.next = 0.into();
         self.node_line[0].d.next = (bit_cast::<2, 1>(self.take.val().into()) << 1)
             | bit_cast::<2, 1>((self.phase.q.val() == 2).into());
         for k in 1..6 {
@@ -622,24 +629,42 @@ impl<
         if self.arrive.val() == 2 {
             self.w0.d.next = self.node_rdata.val();
         }
+        // The thread of the job at A next clock, whose count of entries done is read now.
+        self.next_a_thread.next = self.job.q.val().get_bits::<5>(96);
         if self.arrive.val() == 3 {
             self.w1.d.next = self.node_rdata.val();
-        }
-        if (self.phase.q.val() == 3) & (self.arrive.val() == 3) {
+            self.job.d.next = self.in_flight.data_out.val();
+            self.next_a_thread.next = self.in_flight.data_out.val().get_bits::<5>(96);
+            self.in_flight.read.next = true;
             self.words_in.d.next = 1.into();
         }
-        // A finishing job skips the fetch.
-        if (self.phase.q.val() == 1) & self.job.q.val().get_bit(101) {
-            self.phase.d.next = 3.into();
-            self.words_in.d.next = 1.into();
+        // The next job: a fetch, or a finishing job straight to A when nothing is in flight.
+        self.fetch_free.next =
+            (self.phase.q.val() == 0) | ((self.phase.q.val() == 2) & self.take.val());
+        if self.fetch_free.val() {
+            if !self.loop_fifo.empty.val() {
+                self.loop_fifo.read.next = true;
+                self.fetch_job.d.next = self.loop_fifo.data_out.val();
+                self.phase.d.next = 1.into();
+            } else if !self.front_fifo.empty.val() {
+                if !self.front_fifo.data_out.val().get_bit(101) {
+                    self.front_fifo.read.next = true;
+                    self.fetch_job.d.next = self.front_fifo.data_out.val();
+                    self.phase.d.next = 1.into();
+                } else if (self.phase.q.val() == 0) & self.in_flight.empty.val() {
+                    self.front_fifo.read.next = true;
+                    self.job.d.next = self.front_fifo.data_out.val();
+                    self.next_a_thread.next = self.front_fifo.data_out.val().get_bits::<5>(96);
+                    self.words_in.d.next = 1.into();
+                }
+            }
         }
-        self.ray.ray_thread.next = self.job.q.val().get_bits::<5>(96);
+        // The ray's words for A: read for the oldest job in flight, a clock before it gets
+        // there.
+        self.ray.ray_thread.next = self.in_flight.data_out.val().get_bits::<5>(96);
 
         // A: both words are here (or the walk ended).
-        self.at_a.next = (self.phase.q.val() == 3) & (self.words_in.q.val() == 1);
-        if self.at_a.val() {
-            self.phase.d.next = 0.into();
-        }
+        self.at_a.next = self.words_in.q.val() == 1;
         self.a_leaf.next = self.job.q.val().get_bit(101) | (self.w0.q.val().get_bits::<2>(30) == 3);
         self.a_axis.next = self.w0.q.val().get_bits::<2>(30);
         self.a_o.next = self.ray.o[0].val();
@@ -679,8 +704,9 @@ impl<
         self.end_e.write_data.next = self.a_list_end.val();
         self.leaf_hi.write_data.next = self.job.q.val().get_bits::<W>(0);
         self.leaf_sp.write_data.next = self.job.q.val().get_bits::<6>(90);
-        // Entries done: the unit's copy is read at the job's thread, the engine's at its own.
-        self.done_u.read_address.next = self.job.q.val().get_bits::<5>(96);
+        // Entries done: the unit's copy is read a clock ahead at the thread of the job coming
+        // to A, the engine's at its own.
+        self.done_u.read_address.next = self.next_a_thread.val();
         self.done_u.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.done_e.write_data.next = self.done_u.read_data.val() + 1;
         self.done_u.write_data.next = self.done_u.read_data.val() + 1;
@@ -805,7 +831,7 @@ mod tests {
     /// eight threads start walks from the root with rays from around the eye (two of them
     /// any-hit walks); the test plays the triangle tester: it takes each leaf in random
     /// clocks and answers it some clocks later with no hit, or (from a thread's third leaf
-    /// on, one thread in two) a hit at a random distance. Every thread's sequence of leaves
+    /// on, one thread in two) a hit at a random distance; each thread walks twice. Every thread's sequence of leaves
     /// and its end equal `units::KdWalk`'s (an any-hit walk ends at its first hit); the engine
     /// takes bank 0 in random clocks, and its starts are refused while an answer goes in.
     #[test]
@@ -869,14 +895,15 @@ mod tests {
                     stops.push(stop);
                     k += 1;
                 }
-                stops
+                // Each thread walks twice (its counts go on from the first walk).
+                stops.repeat(2)
             })
             .collect();
         assert!(
             want.iter().map(Vec::len).sum::<usize>() > 4 * threads,
             "too few leaves"
         );
-        assert!(want[7].len() == 4, "the any-hit walk ends at its first hit");
+        assert!(want[7].len() == 8, "the any-hit walk ends at its first hit");
 
         let mut u = Unit::new(mem_latency);
         u.connect_all();
@@ -908,6 +935,8 @@ mod tests {
             due: Vec<(u64, usize, u32, bool)>,
             clock: u64,
             got: Vec<Vec<KdStop>>,
+            /// Where each thread's current walk starts in `got`.
+            walk_from: Vec<usize>,
         }
         let mut b = Bench {
             requests: std::iter::repeat(None).take(mem_latency as usize).collect(),
@@ -916,6 +945,7 @@ mod tests {
             due: Vec::new(),
             clock: 0,
             got: vec![Vec::new(); threads],
+            walk_from: vec![0; threads],
         };
         // One clock; returns whether the engine's offer (if any) was taken. An answer goes in
         // early when the engine offers, so that the two meet.
@@ -946,7 +976,7 @@ mod tests {
                 let th = u.leaf_thread.val().to_u64() as usize;
                 let from = u.leaf_from.val().to_u64() as u32;
                 let to = u.leaf_to.val().to_u64() as u32;
-                let k = b.got[th].len();
+                let k = b.got[th].len() - b.walk_from[th];
                 b.got[th].push(KdStop::Leaf {
                     list: from,
                     count: to - from,
@@ -986,6 +1016,10 @@ mod tests {
                 in_flight[th] = false;
                 assert_eq!(u.result.val().to_u64(), 1 << 31, "thread {th}: the end");
                 b.got[th].push(KdStop::Finished);
+                if b.got[th].len() < want[th].len() {
+                    to_start[th] = true;
+                    b.walk_from[th] = b.got[th].len();
+                }
             }
             // Later threads start while answers for the earlier ones go in.
             let start = to_start[th] && b.clock >= 120 * th as u64;

@@ -24,19 +24,22 @@
 //! Entries are done in queue order, so a thread's closest hit is chosen in its list order
 //! (the first of equal ts stays), as in the golden model.
 //!
-//! State machine per entry: take it from the list unit's test queue (1 clock), fetch the
-//! triangle's 8 words of bank 2 and 4 of bank 3 (8 clocks when the engine leaves the banks
-//! alone, plus the SRAM latency; an init or a list end fetches nothing), launch the origin and
-//! then the direction into the TransformUnit (2 clocks). Throughput: one test per
-//! `clocks_per_test(mem_latency) = 11 + mem_latency` clocks, one init or list end per 4;
-//! entries leave the launch at least 4 clocks apart, which the hit merge needs (it reads,
-//! compares and writes a thread's best hit in 4 clocks). The engine's own loads of banks 2
-//! and 3 (shading data) take the bank in their clock; the fetch waits for it.
+//! Fetch and launch, two state machines around two entry buffers: the fetch takes an entry
+//! from the list unit's test queue into a free buffer (1 clock) and requests the triangle's 8
+//! words of bank 2 and 4 of bank 3 (8 clocks when the engine leaves the banks alone; an init
+//! or a list end fetches nothing), then goes on with the next entry in the other buffer. The
+//! launch waits for its buffer's words (the SRAM latency after their requests), launches the
+//! origin and then the direction into the TransformUnit (2 clocks), frees the buffer and
+//! waits a clock for the next entry's ray words. Throughput: one test per [`CLOCKS_PER_TEST`]
+//! (9) clocks, one init or list end per [`LAUNCH_SPACING`] (4); entries leave the launch at
+//! least 4 clocks apart, which the hit merge needs (it reads, compares and writes a thread's
+//! best hit in 4 clocks). The engine's own loads of banks 2 and 3 (shading data) take the
+//! bank in their clock; the fetch waits for it.
 //!
 //! Latency from launch to the merged hit: `TRANSFORM_LATENCY` (25) + 1 + `intersect_latency`
 //! (41 at e7m16) + 3. Up to [`FLIGHT_SLOTS`] entries are in flight in that time, each with its
-//! own slot for the words the merge needs. Const parameters: the operators' `W, E, M, S, S1, X2, T, P` and
-//! `DL = div_latency(M)` (the IntersectUnit's).
+//! own slot for the words the merge needs. Const parameters: the operators' `W, E, M, S, S1,
+//! X2, T, P` and `DL = div_latency(M)` (the IntersectUnit's).
 
 use rust_hdl::prelude::*;
 
@@ -71,14 +74,11 @@ pub fn flight_slots_suffice(fmt: Format) -> bool {
 }
 
 /// Clocks between two tests when the engine leaves banks 2 and 3 alone (the tester's
-/// throughput bound).
-pub const fn clocks_per_test(mem_latency: u32) -> u32 {
-    11 + mem_latency
-}
+/// throughput bound): the take and the 8 words of bank 2.
+pub const CLOCKS_PER_TEST: u32 = 9;
 // `update` spells out its numbers (rust-hdl's Verilog cannot name Rust constants): a
-// triangle is 8 words of bank 2 (the u and v rows) and 4 of bank 3 (the t row); the phases of
-// the fetch and launch state machine are 0 idle, 1 fetch, 2 launch the origin, 3 launch the
-// direction.
+// triangle is 8 words of bank 2 (the u and v rows) and 4 of bank 3 (the t row), buffer 1's
+// words follow buffer 0's 12.
 
 #[derive(LogicBlock)]
 pub struct TriangleTester<
@@ -161,25 +161,41 @@ pub struct TriangleTester<
     flight_a: RAM<Bits<32>, 5>,
     flight_b: RAM<Bits<32>, 5>,
 
-    // Fetch and launch.
-    phase: DFF<Bits<2>>,
+    // Fetch and launch: two buffers of an entry and its triangle's 12 words; the fetch fills
+    // `fb` while the launch empties `lb`.
+    fetching: DFF<Bit>,
+    fb: DFF<Bit>,
+    lb: DFF<Bit>,
+    /// 0 wait for the buffer, 1 launch the origin, 2 the direction, 3 free the buffer.
+    lphase: DFF<Bits<2>>,
+    loaded: [DFF<Bit>; 2],
     /// `list_unit::TEST_*`.
-    cur_kind: DFF<Bits<2>>,
-    cur_thread: DFF<Bits<5>>,
-    cur_a: DFF<Bits<32>>,
-    cur_b: DFF<Bits<32>>,
+    cur_kind: [DFF<Bits<2>>; 2],
+    cur_thread: [DFF<Bits<5>>; 2],
+    cur_a: [DFF<Bits<32>>; 2],
+    cur_b: [DFF<Bits<32>>; 2],
+    received: [DFF<Bits<4>>; 2],
+    /// A word of bank 2, of bank 3 arrives for each buffer this clock.
+    uv_here: [Signal<Local, Bit>; 2],
+    t_here: [Signal<Local, Bit>; 2],
     uv_issued: DFF<Bits<4>>,
     t_issued: DFF<Bits<4>>,
-    received: DFF<Bits<4>>,
     seq: DFF<Bits<5>>,
-    words: [DFF<Bits<W>>; 12],
+    words: [DFF<Bits<W>>; 24],
+    fetch_a: Signal<Local, Bits<32>>,
+    fb_free: Signal<Local, Bit>,
+    l_kind: Signal<Local, Bits<2>>,
+    l_thread: Signal<Local, Bits<5>>,
+    l_a: Signal<Local, Bits<32>>,
+    l_b: Signal<Local, Bits<32>>,
+    l_ready: Signal<Local, Bit>,
     uv_take: Signal<Local, Bit>,
     t_take: Signal<Local, Bit>,
-    /// Requests in flight to the banks: `{valid, word index}` per clock of latency.
-    uv_line: [DFF<Bits<4>>; 6],
-    t_line: [DFF<Bits<4>>; 6],
-    uv_arrive: Signal<Local, Bits<4>>,
-    t_arrive: Signal<Local, Bits<4>>,
+    /// Requests in flight to the banks: `{valid, buffer, word index}` per clock of latency.
+    uv_line: [DFF<Bits<5>>; 6],
+    t_line: [DFF<Bits<5>>; 6],
+    uv_arrive: Signal<Local, Bits<5>>,
+    t_arrive: Signal<Local, Bits<5>>,
     transform_unit: TransformUnit<W, E, M, S, S1, X2, T, P>,
     o_hold: [DFF<Bits<W>>; 3],
     intersect_unit: IntersectUnit<W, E, M, S, S1, X2, T, P, DL>,
@@ -223,6 +239,8 @@ pub struct TriangleTester<
     c_infinity: Constant<Bits<W>>,
     c_d_pass: Constant<Bits<16>>,
     c_list_of_walk: Constant<Bits<32>>,
+    /// Each buffer's number.
+    c_buffer: [Constant<Bit>; 2],
     c_hit_flag: Constant<Bits<33>>,
 }
 
@@ -297,11 +315,24 @@ impl<
             flight_t_min: Default::default(),
             flight_a: Default::default(),
             flight_b: Default::default(),
-            phase: Default::default(),
+            fetching: Default::default(),
+            fb: Default::default(),
+            lb: Default::default(),
+            lphase: Default::default(),
+            loaded: Default::default(),
             cur_kind: Default::default(),
             cur_thread: Default::default(),
             cur_a: Default::default(),
             cur_b: Default::default(),
+            uv_here: Default::default(),
+            t_here: Default::default(),
+            fetch_a: Default::default(),
+            fb_free: Default::default(),
+            l_kind: Default::default(),
+            l_thread: Default::default(),
+            l_a: Default::default(),
+            l_b: Default::default(),
+            l_ready: Default::default(),
             uv_issued: Default::default(),
             t_issued: Default::default(),
             received: Default::default(),
@@ -351,6 +382,7 @@ impl<
             c_infinity: const_bits::<W>(u64::from(f.infinity(false))),
             c_d_pass: Constant::new((1u64 << 13).into()),
             c_list_of_walk: Constant::new(LIST_OF_WALK.into()),
+            c_buffer: [Constant::new(false), Constant::new(true)],
             c_hit_flag: Constant::new((1u64 << 32).into()),
         }
     }
@@ -371,10 +403,10 @@ impl<
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self, clock, phase, cur_kind, cur_thread, cur_a, cur_b, uv_issued, t_issued, received,
-            seq, m1_valid, m1_hit, m1_kind, m1_thread, m1_t, m2_valid, m2_hit, m2_kind, m2_thread,
-            m2_t, m2_a, m2_b, m2_done, m2_best, m3_valid, m3_hit, m3_kind, m3_thread, m3_t, m3_a,
-            m3_b, m3_done, m3_best
+            self, clock, fetching, fb, lb, lphase, uv_issued, t_issued, seq, m1_valid, m1_hit,
+            m1_kind, m1_thread, m1_t, m2_valid, m2_hit, m2_kind, m2_thread, m2_t, m2_a, m2_b,
+            m2_done, m2_best, m3_valid, m3_hit, m3_kind, m3_thread, m3_t, m3_a, m3_b, m3_done,
+            m3_best
         );
         clock!(
             self,
@@ -405,9 +437,23 @@ impl<
         self.flight_a.write_clock.next = self.clock.val();
         self.flight_b.read_clock.next = self.clock.val();
         self.flight_b.write_clock.next = self.clock.val();
-        for k in 0..12 {
+        for k in 0..24 {
             self.words[k].clock.next = self.clock.val();
             self.words[k].d.next = self.words[k].q.val();
+        }
+        for k in 0..2 {
+            self.loaded[k].clock.next = self.clock.val();
+            self.loaded[k].d.next = self.loaded[k].q.val();
+            self.cur_kind[k].clock.next = self.clock.val();
+            self.cur_kind[k].d.next = self.cur_kind[k].q.val();
+            self.cur_thread[k].clock.next = self.clock.val();
+            self.cur_thread[k].d.next = self.cur_thread[k].q.val();
+            self.cur_a[k].clock.next = self.clock.val();
+            self.cur_a[k].d.next = self.cur_a[k].q.val();
+            self.cur_b[k].clock.next = self.clock.val();
+            self.cur_b[k].d.next = self.cur_b[k].q.val();
+            self.received[k].clock.next = self.clock.val();
+            self.received[k].d.next = self.received[k].q.val();
         }
         for k in 0..6 {
             self.uv_line[k].clock.next = self.clock.val();
@@ -465,14 +511,14 @@ impl<
             & (!self.list_unit.full.val())
             & (self.queue_kind.val().get_bits::<1>(1) == 0);
 
-        // Fetch: the banks serve the engine first.
+        // Fetch into buffer `fb`: take the list unit's next entry when the buffer is free,
+        // then request its 8 + 4 words (the banks serve the engine first). An init or a list
+        // end fetches nothing. The next entry's fetch goes on while this one is launched.
         self.list_unit.test_take.next = false;
-        self.ray.ray_thread.next = self.cur_thread.q.val();
-        self.ray.t_min_thread.next = self.cur_thread.q.val();
-        self.uv_take.next = (self.phase.q.val() == 1)
+        self.uv_take.next = self.fetching.q.val()
             & (self.uv_issued.q.val() < 8)
             & (!(self.engine_read.val() & (self.engine_bank.val() == 2)));
-        self.t_take.next = (self.phase.q.val() == 1)
+        self.t_take.next = self.fetching.q.val()
             & (self.t_issued.q.val() < 4)
             & (!(self.engine_read.val() & (self.engine_bank.val() == 3)));
         self.uv_read.next =
@@ -481,25 +527,70 @@ impl<
             self.t_take.val() | (self.engine_read.val() & (self.engine_bank.val() == 3));
         self.uv_addr.next = self.engine_addr.val();
         self.t_addr.next = self.engine_addr.val();
+        self.fetch_a.next = self.cur_a[0].q.val();
+        if self.fb.q.val() {
+            self.fetch_a.next = self.cur_a[1].q.val();
+        }
         if self.uv_take.val() {
-            self.uv_addr.next = (self.cur_a.q.val().get_bits::<24>(0) << 3)
+            self.uv_addr.next = (self.fetch_a.val().get_bits::<24>(0) << 3)
                 + bit_cast::<24, 4>(self.uv_issued.q.val());
             self.uv_issued.d.next = self.uv_issued.q.val() + 1;
         }
         if self.t_take.val() {
-            self.t_addr.next = (self.cur_a.q.val().get_bits::<24>(0) << 3)
+            self.t_addr.next = (self.fetch_a.val().get_bits::<24>(0) << 3)
                 + bit_cast::<24, 4>(self.t_issued.q.val());
             self.t_issued.d.next = self.t_issued.q.val() + 1;
         }
-        self.uv_line[0].d.next = (bit_cast::<4, 1>(self.uv_take.val().into()) << 3)
-            | bit_cast::<4, 3>(self.uv_issued.q.val().get_bits::<3>(0));
-        self.t_line[0].d.next = (bit_cast::<4, 1>(self.t_take.val().into()) << 3)
-            | bit_cast::<4, 3>(self.t_issued.q.val().get_bits::<3>(0));
+        // Requests in flight: `{valid, buffer, word index}`.
+        self.uv_line[0].d.next = (bit_cast::<5, 1>(self.uv_take.val().into()) << 4)
+            | (bit_cast::<5, 1>(self.fb.q.val().into()) << 3)
+            | bit_cast::<5, 3>(self.uv_issued.q.val().get_bits::<3>(0));
+        self.t_line[0].d.next = (bit_cast::<5, 1>(self.t_take.val().into()) << 4)
+            | (bit_cast::<5, 1>(self.fb.q.val().into()) << 3)
+            | bit_cast::<5, 3>(self.t_issued.q.val().get_bits::<3>(0));
         for k in 1..6 {
             self.uv_line[k].d.next = self.uv_line[k - 1].q.val();
             self.t_line[k].d.next = self.t_line[k - 1].q.val();
         }
-        // The word of the request `mem_latency` clocks ago: `{valid, index}`.
+        // The fetch is done with the buffer once its last words are requested.
+        if self.fetching.q.val()
+            & ((self.uv_issued.q.val() == 8) | (self.uv_take.val() & (self.uv_issued.q.val() == 7)))
+            & ((self.t_issued.q.val() == 4) | (self.t_take.val() & (self.t_issued.q.val() == 3)))
+        {
+            self.fetching.d.next = false;
+            self.fb.d.next = !self.fb.q.val();
+        }
+        self.fb_free.next = !self.loaded[0].q.val();
+        if self.fb.q.val() {
+            self.fb_free.next = !self.loaded[1].q.val();
+        }
+        if (!self.fetching.q.val()) & self.fb_free.val() & self.list_unit.test_valid.val() {
+            self.list_unit.test_take.next = true;
+            self.uv_issued.d.next = 0.into();
+            self.t_issued.d.next = 0.into();
+            self.fetching.d.next = true;
+            if self.list_unit.test_entry.val().get_bits::<2>(69) != 0 {
+                // An init or a list end fetches nothing.
+                self.uv_issued.d.next = 8.into();
+                self.t_issued.d.next = 4.into();
+                self.fetching.d.next = false;
+                self.fb.d.next = !self.fb.q.val();
+            }
+            for k in 0..2 {
+                if self.fb.q.val() == self.c_buffer[k].val() {
+                    self.loaded[k].d.next = true;
+                    self.cur_kind[k].d.next = self.list_unit.test_entry.val().get_bits::<2>(69);
+                    self.cur_thread[k].d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
+                    self.cur_a[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(32);
+                    self.cur_b[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(0);
+                    self.received[k].d.next = 0.into();
+                    if self.list_unit.test_entry.val().get_bits::<2>(69) != 0 {
+                        self.received[k].d.next = 12.into();
+                    }
+                }
+            }
+        }
+        // The word of the request `mem_latency` clocks ago.
         self.uv_arrive.next = 0.into();
         self.t_arrive.next = 0.into();
         for k in 0..6 {
@@ -509,76 +600,93 @@ impl<
             }
         }
         for k in 0..8 {
-            if self.uv_arrive.val().get_bit(3)
+            if self.uv_arrive.val().get_bit(4)
                 & (bit_cast::<4, 3>(self.uv_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
             {
-                self.words[k].d.next = self.uv_rdata.val().get_bits::<W>(0);
+                if self.uv_arrive.val().get_bit(3) {
+                    self.words[12 + k].d.next = self.uv_rdata.val().get_bits::<W>(0);
+                } else {
+                    self.words[k].d.next = self.uv_rdata.val().get_bits::<W>(0);
+                }
             }
         }
         for k in 0..4 {
-            if self.t_arrive.val().get_bit(3)
+            if self.t_arrive.val().get_bit(4)
                 & (bit_cast::<4, 3>(self.t_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
             {
-                self.words[8 + k].d.next = self.t_rdata.val().get_bits::<W>(0);
+                if self.t_arrive.val().get_bit(3) {
+                    self.words[20 + k].d.next = self.t_rdata.val().get_bits::<W>(0);
+                } else {
+                    self.words[8 + k].d.next = self.t_rdata.val().get_bits::<W>(0);
+                }
             }
         }
-        self.received.d.next = self.received.q.val()
-            + bit_cast::<4, 1>(self.uv_arrive.val().get_bit(3).into())
-            + bit_cast::<4, 1>(self.t_arrive.val().get_bit(3).into());
+        for k in 0..2 {
+            self.uv_here[k].next = self.uv_arrive.val().get_bit(4)
+                & (self.uv_arrive.val().get_bit(3) == self.c_buffer[k].val());
+            self.t_here[k].next = self.t_arrive.val().get_bit(4)
+                & (self.t_arrive.val().get_bit(3) == self.c_buffer[k].val());
+            if self.uv_here[k].val() | self.t_here[k].val() {
+                self.received[k].d.next = self.received[k].q.val() + 1;
+            }
+            if self.uv_here[k].val() & self.t_here[k].val() {
+                self.received[k].d.next = self.received[k].q.val() + 2;
+            }
+        }
 
-        // Launch: the origin, then the direction, of the entry's thread.
-        self.transform_unit.in_valid.next = false;
-        self.transform_unit.point.next = true;
+        // Launch from buffer `lb`: the origin, then the direction, of the entry's thread, then
+        // a clock to free the buffer and one for the next entry's ray words (entries launch
+        // `LAUNCH_SPACING` clocks apart at the fastest).
+        self.l_kind.next = self.cur_kind[0].q.val();
+        self.l_thread.next = self.cur_thread[0].q.val();
+        self.l_a.next = self.cur_a[0].q.val();
+        self.l_b.next = self.cur_b[0].q.val();
+        self.l_ready.next = self.loaded[0].q.val() & (self.received[0].q.val() == 12);
         for k in 0..12 {
             self.transform_unit.m[k].next = self.words[k].q.val();
         }
+        if self.lb.q.val() {
+            self.l_kind.next = self.cur_kind[1].q.val();
+            self.l_thread.next = self.cur_thread[1].q.val();
+            self.l_a.next = self.cur_a[1].q.val();
+            self.l_b.next = self.cur_b[1].q.val();
+            self.l_ready.next = self.loaded[1].q.val() & (self.received[1].q.val() == 12);
+            for k in 0..12 {
+                self.transform_unit.m[k].next = self.words[12 + k].q.val();
+            }
+        }
+        self.ray.ray_thread.next = self.l_thread.val();
+        self.ray.t_min_thread.next = self.l_thread.val();
+        self.transform_unit.in_valid.next = false;
+        self.transform_unit.point.next = true;
         for k in 0..3 {
             self.transform_unit.v[k].next = self.ray.o[k].val();
         }
         // Tag: `{d pass[13], kind[11:10], thread[9:5], seq[4:0]}`.
-        self.launch_tag.next = (bit_cast::<16, 2>(self.cur_kind.q.val()) << 10)
-            | (bit_cast::<16, 5>(self.cur_thread.q.val()) << 5)
+        self.launch_tag.next = (bit_cast::<16, 2>(self.l_kind.val()) << 10)
+            | (bit_cast::<16, 5>(self.l_thread.val()) << 5)
             | bit_cast::<16, 5>(self.seq.q.val());
         self.transform_unit.tag.next = self.launch_tag.val();
         self.flight_t_min.write_address.next = self.seq.q.val();
         self.flight_a.write_address.next = self.seq.q.val();
         self.flight_b.write_address.next = self.seq.q.val();
         self.flight_t_min.write_data.next = self.ray.t_min.val();
-        self.flight_a.write_data.next = self.cur_a.q.val();
-        self.flight_b.write_data.next = self.cur_b.q.val();
+        self.flight_a.write_data.next = self.l_a.val();
+        self.flight_b.write_data.next = self.l_b.val();
         self.flight_t_min.write_enable.next = false;
         self.flight_a.write_enable.next = false;
         self.flight_b.write_enable.next = false;
-        if self.phase.q.val() == 0 {
-            if self.list_unit.test_valid.val() {
-                self.list_unit.test_take.next = true;
-                self.cur_kind.d.next = self.list_unit.test_entry.val().get_bits::<2>(69);
-                self.cur_thread.d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
-                self.cur_a.d.next = self.list_unit.test_entry.val().get_bits::<32>(32);
-                self.cur_b.d.next = self.list_unit.test_entry.val().get_bits::<32>(0);
-                self.uv_issued.d.next = 0.into();
-                self.t_issued.d.next = 0.into();
-                self.received.d.next = 0.into();
-                if self.list_unit.test_entry.val().get_bits::<2>(69) != 0 {
-                    // An init or a list end fetches nothing.
-                    self.uv_issued.d.next = 8.into();
-                    self.t_issued.d.next = 4.into();
-                    self.received.d.next = 12.into();
-                }
-                self.phase.d.next = 1.into();
-            }
+        if (self.lphase.q.val() == 0) & self.l_ready.val() {
+            self.lphase.d.next = 1.into();
         }
-        if (self.phase.q.val() == 1) & (self.received.q.val() == 12) {
-            self.phase.d.next = 2.into();
-        }
-        if self.phase.q.val() == 2 {
+        if self.lphase.q.val() == 1 {
             self.transform_unit.in_valid.next = true;
             self.flight_t_min.write_enable.next = true;
             self.flight_a.write_enable.next = true;
             self.flight_b.write_enable.next = true;
-            self.phase.d.next = 3.into();
+            self.lphase.d.next = 2.into();
         }
-        if self.phase.q.val() == 3 {
+        if self.lphase.q.val() == 2 {
             self.transform_unit.in_valid.next = true;
             self.transform_unit.point.next = false;
             for k in 0..3 {
@@ -586,11 +694,19 @@ impl<
             }
             self.transform_unit.tag.next = self.launch_tag.val() | self.c_d_pass.val();
             self.seq.d.next = self.seq.q.val() + 1;
-            self.phase.d.next = 0.into();
+            self.lphase.d.next = 3.into();
+        }
+        if self.lphase.q.val() == 3 {
+            for k in 0..2 {
+                if self.lb.q.val() == self.c_buffer[k].val() {
+                    self.loaded[k].d.next = false;
+                }
+            }
+            self.lb.d.next = !self.lb.q.val();
+            self.lphase.d.next = 0.into();
         }
         // Busy counts tests only (inits and list ends pass the units to keep their order).
-        self.transform_busy.next =
-            self.transform_unit.in_valid.val() & (self.cur_kind.q.val() == 0);
+        self.transform_busy.next = self.transform_unit.in_valid.val() & (self.l_kind.val() == 0);
 
         // O' waits a clock for D'; then the unit-triangle test.
         for k in 0..3 {
