@@ -272,6 +272,8 @@ pub struct ThreadEngine<
     c_thread_ids: [Constant<Bits<5>>; 32],
     c_width: Constant<Bits<16>>,
     c_height: Constant<Bits<16>>,
+    /// `ProgramConfig::pixel_shift`: where the pixel word puts y.
+    c_pixel_shift: Constant<Bits<5>>,
     c_mem_latency: Constant<Bits<8>>,
     c_index: [Constant<Bits<8>>; 8],
     /// The bit of `reserved` a long instruction at I3 sets: `DX - 4`.
@@ -481,6 +483,7 @@ impl<
             c_thread_ids: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_width: Constant::new(u64::from(program.config.width).into()),
             c_height: Constant::new(u64::from(program.config.height).into()),
+            c_pixel_shift: Constant::new(u64::from(program.config.pixel_shift()).into()),
             c_mem_latency: Constant::new(u64::from(mem_latency).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_reserve_bit: Constant::new(((DX - 4) as u64).into()),
@@ -947,8 +950,8 @@ impl<
             self.fast.next = self.opb.val() << 8;
         }
         if self.op3.val() == 27 {
-            self.fast.next =
-                (bit_cast::<32, 16>(self.py.q.val()) << 16) | bit_cast::<32, 16>(self.px.q.val());
+            self.fast.next = (bit_cast::<32, 16>(self.py.q.val()) << self.c_pixel_shift.val())
+                | bit_cast::<32, 16>(self.px.q.val());
         }
         if self.op3.val() == 29 {
             if self.imm3.q.val() == 5 {

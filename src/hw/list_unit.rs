@@ -6,7 +6,7 @@
 //!
 //! Engine side (the engine's I3): `enqueue` offers a command of `thread`, taken when `full`
 //! is low in that clock. Commands by `kind`: [`CMD_LIST`] the list `word_a..word_b` (bank-1
-//! word addresses); [`CMD_INIT`] a new query (passed on as it is); [`CMD_OBJECT`] the object
+//! word addresses); [`CMD_INIT`] a new query (passed on as it is; it empties the thread's mailbox); [`CMD_OBJECT`] the object
 //! (instance) `word_a` the next lists belong to, which empties the thread's mailbox;
 //! [`CMD_SKIP`] the (instance `word_a`, triangle `word_b`) the query must not test. All are
 //! done in queue order, so a thread's object and skip apply to exactly its later lists.
@@ -110,12 +110,12 @@ pub struct ListUnit {
     c_list_end: Constant<ListEntry>,
 }
 
-/// A per-thread RAM of all-ones words: no thread skips a triangle until it says so (a scene
-/// without secondary rays never does).
-fn ones_words() -> RAM<Bits<32>, 5> {
+/// A per-thread RAM of `value` words: the skip words start all ones (no triangle is skipped
+/// until a query says so; a scene without secondary rays never does), the object 0.
+fn words_of(value: u64) -> RAM<Bits<32>, 5> {
     RAM::new(
         (0..32u64)
-            .map(|k| (Bits::<5>::from(k), Bits::<32>::from(0xffff_ffffu64)))
+            .map(|k| (Bits::<5>::from(k), Bits::<32>::from(value)))
             .collect(),
     )
 }
@@ -142,9 +142,10 @@ impl ListUnit {
             test_take: Default::default(),
             commands: Default::default(),
             tests: Default::default(),
-            object_ram: Default::default(),
-            skip_object_ram: ones_words(),
-            skip_triangle_ram: ones_words(),
+            // Object 0 until the thread names one (a scene of one object never does).
+            object_ram: words_of(0),
+            skip_object_ram: words_of(0xffff_ffff),
+            skip_triangle_ram: words_of(0xffff_ffff),
             mailbox_ids: Default::default(),
             mailbox_meta: Default::default(),
             phase: Default::default(),
@@ -258,10 +259,13 @@ impl Logic for ListUnit {
 
         if (self.phase.q.val() == 0) & (!self.commands.empty.val()) {
             if self.head_kind.val() == 1 {
-                // An init goes on to the launch as it is.
+                // An init goes on to the launch as it is; a new query empties the mailbox.
                 if !self.tests.full.val() {
                     self.push.next = true;
                     self.commands.read.next = true;
+                    self.mailbox_meta.write_address.next =
+                        self.commands.data_out.val().get_bits::<5>(64);
+                    self.mailbox_meta.write_enable.next = true;
                 }
             }
             if self.head_kind.val() == 2 {
@@ -416,7 +420,10 @@ mod tests {
             match *c {
                 Command::Object(o) => (object, mailbox) = (o, Mailbox::new()),
                 Command::Skip(i, t) => skip = (i, t),
-                Command::Init(a, b) => out.push((TEST_INIT, a, b)),
+                Command::Init(a, b) => {
+                    out.push((TEST_INIT, a, b));
+                    mailbox = Mailbox::new();
+                }
                 Command::List(from, to) => {
                     let end = to & 0xff_ffff;
                     for &triangle in &bank1[from as usize..end as usize] {

@@ -845,6 +845,7 @@ mod tests {
                     match *offer {
                         Offer::Init { t_min: lo, t_max } => {
                             t_min = lo;
+                            mailbox = units::Mailbox::new();
                             best = (false, t_max, best.2, best.3);
                         }
                         Offer::Object(o) => (instance, mailbox) = (o, units::Mailbox::new()),

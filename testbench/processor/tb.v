@@ -88,9 +88,9 @@ module tb;
     @(negedge clock) start = 1'b1;
     @(negedge clock) start = 1'b0;
     n = 0;
-    while (!done && n < 1908190) begin @(posedge clock); n = n + 1; end
+    while (!done && n < 1868830) begin @(posedge clock); n = n + 1; end
     if (!done) begin
-      $display("TIMEOUT: frame 0 not done after 1908190 clocks");
+      $display("TIMEOUT: frame 0 not done after 1868830 clocks");
       $fatal(1, "timeout");
     end
     fd = $fopen("frame0.hex", "w");

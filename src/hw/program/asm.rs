@@ -46,6 +46,8 @@ struct State {
     fixups: Vec<(usize, Label)>,
     free: Vec<Reg>,
     temps: Vec<Reg>,
+    /// Registers that hold a constant for the whole program ([`Asm::keep_constant`]).
+    constants: Vec<(u32, Reg)>,
 }
 
 /// The assembler. Shared (`&Asm`) so that it can be the `Arith` of the unit sequences.
@@ -74,6 +76,7 @@ impl Asm {
                 // Lowest numbers first.
                 free: (1..REGISTERS).rev().map(|r| Reg(r as u8)).collect(),
                 temps: Vec::new(),
+                constants: Vec::new(),
             }),
         }
     }
@@ -195,10 +198,23 @@ impl Asm {
 
     /// An instruction reading `a` and `b` (a constant `b` becomes the immediate; a constant
     /// `a` is loaded into a temporary first).
+    /// Puts `k` in a register for the rest of the program: an operation whose first operand
+    /// is `k` reads it there (the first operand cannot be an immediate). For the program's
+    /// start, before any branch.
+    pub fn keep_constant(&self, k: u32) {
+        let r = self.keep(Val::K(k));
+        self.state.borrow_mut().constants.push((k, r));
+    }
+
     fn operands(&self, op: Op, a: Val, b: Val) -> Instr {
+        let kept = |k: u32| {
+            let s = self.state.borrow();
+            s.constants.iter().find(|c| c.0 == k).map(|c| c.1)
+        };
         let a = match a {
             Val::R(r) => r,
             Val::K(0) => Reg::ZERO,
+            Val::K(k) if kept(k).is_some() => kept(k).unwrap(),
             Val::K(k) => {
                 let t = self.temp();
                 self.emit(Instr {
@@ -453,7 +469,8 @@ impl Asm {
         });
     }
 
-    /// `dst = (y << 16) | x` of the next pixel, or branch to `done`.
+    /// `dst = (y << s) | x` of the next pixel (`ProgramConfig::pixel_shift`), or branch to
+    /// `done`.
     pub fn next_pixel(&self, dst: Reg, done: Label) {
         self.emit_to(
             Instr {

@@ -299,21 +299,24 @@ impl<'a> Machine<'a> {
                 }
             }
             Op::Mbc => t.mailboxes[(i.imm & 1) as usize] = Mailbox::default(),
-            Op::Pixel => match pixels {
-                Pixels::Raster { next: n, count } => {
-                    if *n < *count {
-                        let w = self.program.config.width;
-                        result = Some(((*n / w) << 16) | (*n % w));
-                        *n += 1;
-                    } else {
-                        next = i.target as usize;
+            Op::Pixel => {
+                let shift = self.program.config.pixel_shift();
+                match pixels {
+                    Pixels::Raster { next: n, count } => {
+                        if *n < *count {
+                            let w = self.program.config.width;
+                            result = Some(((*n / w) << shift) | (*n % w));
+                            *n += 1;
+                        } else {
+                            next = i.target as usize;
+                        }
                     }
+                    Pixels::One(p) => match p.take() {
+                        Some((x, y)) => result = Some((y << shift) | x),
+                        None => next = i.target as usize,
+                    },
                 }
-                Pixels::One(p) => match p.take() {
-                    Some((x, y)) => result = Some((y << 16) | x),
-                    None => next = i.target as usize,
-                },
-            },
+            }
             Op::Halt => {
                 t.halted = true;
                 next = t.pc;
@@ -327,6 +330,8 @@ impl<'a> Machine<'a> {
                     TriFn::RayOzDx => (tt.o[2], tt.d[0]) = (a, b),
                     TriFn::RayDyz => (tt.d[1], tt.d[2]) = (a, b),
                     TriFn::Init => {
+                        // A new query empties the mailbox (the list unit's).
+                        tt.mailbox = Mailbox::default();
                         tt.t_min = a;
                         tt.hit = false;
                         tt.best_t = b;

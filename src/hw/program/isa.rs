@@ -74,8 +74,9 @@ pub enum Op {
     Mbx,
     /// Empty mailbox `imm`.
     Mbc,
-    /// Take the next pixel of the frame: `dst = (y << 16) | x`; branch to `target` when every
-    /// pixel is taken.
+    /// Take the next pixel of the frame: `dst = (y << s) | x` with `s` the program's
+    /// `ProgramConfig::pixel_shift` (log2 of a power-of-two width: the pixel's index in the
+    /// frame; else 16); branch to `target` when every pixel is taken.
     Pixel,
     /// The thread stops.
     Halt,

@@ -55,6 +55,16 @@ pub struct ProgramConfig {
 }
 
 impl ProgramConfig {
+    /// Where `pixel` puts y: above x's bits, so that with a power-of-two width the word is the
+    /// pixel's index in the frame buffer (no address arithmetic); else at bit 16.
+    pub fn pixel_shift(&self) -> u32 {
+        if self.width.is_power_of_two() {
+            self.width.trailing_zeros()
+        } else {
+            16
+        }
+    }
+
     pub fn from_layout(layout: &Layout) -> Self {
         let (format, info) = (layout.format, &layout.info);
         let camera = layout.words(crate::layout::FRAME, crate::layout::FrameMap::CAMERA);
@@ -195,15 +205,19 @@ pub fn build_program(config: &ProgramConfig) -> Program {
         scratch: ScratchMap::for_config(config),
         s,
     };
-    // The trace routine's registers are its own: the shader's values live across its calls.
-    let (trace, pixels) = (a.label(), a.label());
     let constants = gen.load_constants();
-    a.jump(pixels);
-    a.bind(trace);
-    let start = a.len();
-    gen.trace_routine();
-    a.reserve_registers_of(start);
-    a.bind(pixels);
+    // With secondary rays the trace is a routine, whose registers are its own (the shader's
+    // values live across its calls); else the one primary trace is written in line.
+    let trace = gen.secondary_rays().then(|| {
+        let (trace, pixels) = (a.label(), a.label());
+        a.jump(pixels);
+        a.bind(trace);
+        let start = a.len();
+        gen.trace_routine(true);
+        a.reserve_registers_of(start);
+        a.bind(pixels);
+        trace
+    });
     gen.pixel_loop(&constants, trace);
     let scratch = gen.scratch;
     let mut left_out = Vec::new();
@@ -252,6 +266,13 @@ impl Gen<'_> {
     /// Whether the scene traces rays other than the primary ones (shadow or mirror rays).
     pub fn secondary_rays(&self) -> bool {
         self.c.shadows || self.c.reflection_depth > 0
+    }
+
+    /// Whether the shader tells a hit by `best_t < q_t_max` instead of the tester's hit flag
+    /// (the same: a hit only ever lowers the best t from t_max), which saves reading the flag:
+    /// for the one primary trace of a scene of one object.
+    pub fn hit_by_t(&self) -> bool {
+        !self.secondary_rays() && self.c.top_root.is_none()
     }
 
     /// A frame word (bank 5) at a fixed address.

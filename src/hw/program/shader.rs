@@ -59,6 +59,8 @@ impl Gen<'_> {
                 load(FrameMap::CAMERA + k)
             }
         });
+        // 1 / |n| of every hit's normal.
+        a.keep_constant(c.format.one());
         // Without secondary rays every query starts at the eye with t_min 0 and t_max
         // infinity: the query registers hold them for the whole frame.
         let eye = if self.secondary_rays() {
@@ -94,8 +96,9 @@ impl Gen<'_> {
         }
     }
 
-    /// One pixel after another until the frame is done; `trace` is the trace routine.
-    pub(super) fn pixel_loop(&self, k: &Constants, trace: super::asm::Label) {
+    /// One pixel after another until the frame is done; `trace` is the trace routine (none:
+    /// the trace is written in line, for a scene without secondary rays).
+    pub(super) fn pixel_loop(&self, k: &Constants, trace: Option<super::asm::Label>) {
         let a = self.asm;
         let s = &self.s;
         let c = self.c;
@@ -127,8 +130,9 @@ impl Gen<'_> {
         a.bind(next_pixel);
         a.section("raygen");
         a.next_pixel(pixel, frame_done);
-        a.op_to(Op::And, x, pixel.into(), Val::K(0xffff));
-        a.op_to(Op::Shr, y, pixel.into(), Val::K(16));
+        let shift = c.pixel_shift();
+        a.op_to(Op::And, x, pixel.into(), Val::K((1 << shift) - 1));
+        a.op_to(Op::Shr, y, pixel.into(), Val::K(shift));
         let dir = if c.planar_camera {
             units::primary_direction_planar(a, &camera.map(Val::R), x.into(), y.into())
         } else {
@@ -153,10 +157,17 @@ impl Gen<'_> {
             a.mov(s.q_t_max, Val::K(f.infinity(false)));
             a.mov(s.q_any, Val::K(0));
         }
-        a.call(s.link, trace);
+        match trace {
+            Some(trace) => a.call(s.link, trace),
+            None => self.trace_routine(false),
+        }
         a.section("shader");
         let miss = a.label();
-        a.branch(Op::Beq, s.hit.into(), Val::K(0), false, miss);
+        if self.hit_by_t() {
+            a.branch(Op::BFlt, s.best_t.into(), s.q_t_max.into(), true, miss);
+        } else {
+            a.branch(Op::Beq, s.hit.into(), Val::K(0), false, miss);
+        }
         // The hit outlives the next trace only in a scene with secondary rays; a scene of one
         // object hits instance 0.
         let hit_instance = match (c.top_root.is_some(), secondary) {
@@ -225,7 +236,7 @@ impl Gen<'_> {
                 a.mov(s.q_any, Val::K(KD_ANY_HIT));
                 a.mov(s.skip_instance, hit_instance.into());
                 a.mov(s.skip_triangle, hit_triangle.into());
-                a.call(s.link, trace);
+                a.call(s.link, trace.expect("a trace routine for secondary rays"));
                 a.section("light");
                 a.branch(Op::Beq, s.hit.into(), Val::K(0), true, skip_light);
             }
@@ -329,10 +340,14 @@ impl Gen<'_> {
             let high = if k == 0 { Val::K(0) } else { Val::R(rgb) };
             a.op_to(Op::Byte, rgb, color[k].into(), high);
         }
-        // y * W + x with shifts and adds (W is a constant of the scene).
+        // y * W + x with shifts and adds (W is a constant of the scene); the pixel word itself
+        // for a power-of-two W.
         let mut address = Val::R(x);
+        if c.width.is_power_of_two() {
+            address = Val::R(pixel);
+        }
         for bit in 0..32 {
-            if c.width >> bit & 1 == 1 {
+            if !c.width.is_power_of_two() && c.width >> bit & 1 == 1 {
                 let part = if bit == 0 {
                     y.into()
                 } else {

@@ -30,12 +30,15 @@ use crate::layout::{instance_word as iw, INSTANCES, LEAF_TAG, LISTS, NODES};
 use crate::units;
 
 /// Gives the triangle tester and the traversal unit the object-space ray of `instance`
-/// (which empties the tester's triangle mailbox).
-fn tester_ray(a: &Asm, o: [Reg; 3], d: [Reg; 3], instance: Reg) {
+/// (which empties the tester's triangle mailbox); of the one object when `None` (object 0,
+/// whose mailbox the query's init emptied).
+fn tester_ray(a: &Asm, o: [Reg; 3], d: [Reg; 3], instance: Option<Reg>) {
     a.tri_ray(TriFn::RayOxy, o[0], o[1]);
     a.tri_ray(TriFn::RayOzDx, o[2], d[0]);
     a.tri_ray(TriFn::RayDyz, d[1], d[2]);
-    a.tri_queue(TriFn::Object, instance, Reg::ZERO);
+    if let Some(instance) = instance {
+        a.tri_queue(TriFn::Object, instance, Reg::ZERO);
+    }
 }
 
 /// The ray one traversal level walks: registers, and where scratch holds a copy for the
@@ -48,15 +51,18 @@ struct LevelRay {
 }
 
 impl Gen<'_> {
-    /// The trace routine: closest hit (or any hit when `q_any` is 1) of the query registers;
-    /// returns through `link` with `hit`, `best_t`, `best_triangle` and (in a scene with a
-    /// top level) `best_instance`.
-    pub(super) fn trace_routine(&self) {
+    /// The trace routine: closest hit (or any hit when `q_any` is set) of the query registers;
+    /// gives `hit`, `best_t`, `best_triangle` and (in a scene with a top level)
+    /// `best_instance`, and returns through `link` when `routine` (else it is in line).
+    pub(super) fn trace_routine(&self, routine: bool) {
         let a = self.asm;
         let s = &self.s;
         a.section("trace");
         let done = a.label();
-        a.mov(s.hit, Val::K(0));
+        // A walk of the one object writes the hit flag; a top level may enter no instance.
+        if self.c.top_root.is_some() {
+            a.mov(s.hit, Val::K(0));
+        }
         let world = LevelRay {
             o: s.q_o,
             d: s.q_d,
@@ -78,7 +84,7 @@ impl Gen<'_> {
                 self.traverse(Val::K(root), world, done);
             }
             None => {
-                tester_ray(a, world.o, world.d, Reg::ZERO);
+                tester_ray(a, world.o, world.d, None);
                 self.walk_object(Val::K(self.c.object_root), s.q_t_max, done);
             }
         }
@@ -88,7 +94,9 @@ impl Gen<'_> {
             a.tri_read(TriFn::Instance, s.best_instance);
         }
         a.tri_read(TriFn::Triangle, s.best_triangle);
-        a.ret(s.link);
+        if routine {
+            a.ret(s.link);
+        }
     }
 
     fn store_ray(&self, ray: LevelRay) {
@@ -120,7 +128,9 @@ impl Gen<'_> {
         a.kd_wait(Reg::ZERO);
         a.section("intersect");
         a.tri_wait(s.best_t);
-        a.tri_read(TriFn::Hit, s.hit);
+        if !self.hit_by_t() {
+            a.tri_read(TriFn::Hit, s.hit);
+        }
         if self.c.shadows {
             // A shadow query is answered by any hit.
             let closest = a.label();
@@ -249,7 +259,7 @@ impl Gen<'_> {
         let local_d = units::transform(a, &m, s.q_d.map(Val::R), false).map(|v| a.keep(v));
         a.end_temps();
         a.free(record);
-        tester_ray(a, local_o, local_d, instance);
+        tester_ray(a, local_o, local_d, Some(instance));
         self.walk_object(root.into(), s.best_t, answered);
         for r in local_o.into_iter().chain(local_d).chain([root]) {
             a.free(r);
