@@ -21,7 +21,7 @@ fn layout_of(name: &str, w: u32, h: u32, f: Format, frame: u32) -> Layout {
 }
 
 /// Pixels where the twin differs from the golden model, and how many pixels hit something.
-fn mismatches(l: &Layout, f: Format) -> (Vec<(u32, u32, u32, u32)>, usize) {
+fn mismatches(l: &Layout) -> (Vec<(u32, u32, u32, u32)>, usize) {
     let program = build_program(&ProgramConfig::from_layout(l));
     let golden = model::render_golden(l, false);
     let m = Machine::new(&program, l);
@@ -52,7 +52,7 @@ fn microprogram_renders_the_golden_frame_on_every_bundled_scene() {
     ] {
         for f in [Format::E7M16, Format::E8M23] {
             let l = layout_of(name, w, h, f, 0);
-            let (bad, hits) = mismatches(&l, f);
+            let (bad, hits) = mismatches(&l);
             println!(
                 "{name} {f}: {} of {} pixels differ, {hits} hits",
                 bad.len(),
@@ -93,7 +93,7 @@ fn animated_frames_match_the_golden_model() {
     let f = Format::E7M16;
     for frame in 0..2 {
         let l = layout_of("tiny_animated.toml", 16, 12, f, frame);
-        let (bad, _) = mismatches(&l, f);
+        let (bad, _) = mismatches(&l);
         assert!(
             bad.is_empty(),
             "frame {frame}: {:x?}",

@@ -38,10 +38,10 @@
 //! the engine's twin, which never waits.
 //!
 //! Two coprocessors run beside the engine. The [`TraversalUnit`] walks a thread's object kd
-//! tree from leaf to leaf (a thread starts the walk and waits, instead of 15-23 turns per inner
-//! node in microcode); the [`TriangleTester`] takes the leaf's triangles in a queue and keeps
-//! the closest hit (its list unit reads the leaf's list: a leaf costs the thread one turn).
-//! The thread waits once per leaf for each.
+//! tree (a thread starts the walk and sleeps until it ends, instead of 15-23 turns per inner
+//! node in microcode); it hands each leaf's list to the [`TriangleTester`], whose list unit
+//! reads it and queues its triangles, and which answers the traversal unit with the closest
+//! hit. A walk costs the thread four turns, whatever its leaves.
 //!
 //! Memory: one read per clock on the `mem_*` port (banks 0, 1, 4, 5; the tester's list reads
 //! of bank 1 use it in the clocks the engine leaves free) and on each of the

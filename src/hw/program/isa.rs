@@ -86,8 +86,8 @@ pub enum Op {
     /// `wait` repeats while tests are in flight (neither repeat counts as retired).
     Tri,
     /// The traversal unit (`hw::TraversalUnit`), function `imm` ([`KdFn`]): walk an object's
-    /// kd tree to its next leaf. `start` and `next` repeat while refused, `wait` while the walk
-    /// is in flight.
+    /// kd tree, its leaves' triangles tested by the triangle tester. `start` and `next` repeat
+    /// while refused, `wait` while the walk is in flight.
     Kd,
     /// A colour channel's byte shifted in: `dst = (B << 8) | byte(A)`, where `byte` clamps `A`
     /// to [0, 1] and rounds 255 times it to an integer (`units::channel_byte`); three in a row
