@@ -4,7 +4,8 @@
 //! tester fetches each triangle from banks 2 and 3, takes the ray into the triangle's unit
 //! space with the [`TransformUnit`] (the origin as a point, then the direction as a vector),
 //! tests it in the [`IntersectUnit`] and keeps the thread's closest hit; the thread waits for
-//! its tests once per leaf (`tri.wait`). Bit-exact with `units::triangle_test` and
+//! its tests once per leaf (`tri.wait`), or the traversal unit hands the leaves of a walk
+//! itself and gets the closest hit back (`walk_*`). Bit-exact with `units::triangle_test` and
 //! `units::closer_hit`.
 //!
 //! Engine side (the engine's I2/I3 stages):
