@@ -34,9 +34,12 @@ pub struct DemoReport {
 }
 
 pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
-    std::fs::create_dir_all(&c.out).with_context(|| format!("creating {}", c.out.display()))?;
-    let mut md = String::new();
+    crate::output::check_output_dir(&c.out, "--out")?;
     let scene = Scene::load(&c.scene)?;
+    let params = crate::emit::processor::ProcessorParams::default();
+    crate::flow::preflight(&scene, c.format, params, None)?;
+    let out_dir = crate::output::OutputDir::create(&c.out, "--out")?;
+    let mut md = String::new();
     writeln!(md, "# dynrt demo: {}\n", c.scene.display())?;
     writeln!(
         md,
@@ -64,6 +67,9 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
     let (gi, ri) = (golden.to_image(), reference.to_image());
     let img = compare_images(&gi, &ri)?;
     let hits = compare_hits(&golden.hit_tuples(), &reference.hit_tuples())?;
+    if let Some(w) = crate::compare::golden_warning(c.format, &hits) {
+        eprintln!("warning: {}: {w}", c.scene.display());
+    }
     crate::output::write_png(&c.out.join("diff.png"), &diff_image(&gi, &ri))?;
     writeln!(
         md,
@@ -160,7 +166,6 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let params = crate::emit::processor::ProcessorParams::default();
     let generated = crate::flow::generate_rtl(
         &scene,
         &name,
@@ -225,7 +230,9 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
     )?;
     ok &= processor_ok;
     let report = c.out.join("report.md");
-    crate::output::write_atomically(&report, md.as_bytes())?;
+    crate::output::write_atomically(&report, md.as_bytes())
+        .with_context(|| format!("writing {}", report.display()))?;
+    out_dir.keep();
     let summary = format!(
         "{}: golden {} vs reference: {:.3}% equivalent hits, PSNR {:.1} dB; FP operators and the processor's frames in Icarus and Verilator against the model: {}",
         c.scene.display(),

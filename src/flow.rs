@@ -12,6 +12,7 @@ use crate::emit::processor_run::{simulate_processor, write_processor_files, Proc
 use crate::fp::Format;
 use crate::hw::engine::engine_period;
 use crate::hw::program::exec::{Machine, RunStats, Write};
+use crate::hw::program::isa::MAX_PROGRAM;
 use crate::hw::program::{build_program, Program, ProgramConfig};
 use crate::hw::traversal_unit::FETCH_CLOCKS_PER_NODE;
 use crate::hw::traversal_unit::STACK_LEVELS;
@@ -33,6 +34,89 @@ pub fn scene_layouts(scene: &Scene, f: Format, frames: Option<u32>) -> Result<Ve
     (0..n)
         .map(|k| Ok(layout::build(scene, &trees, k, &MemoryConfig::default())?))
         .collect()
+}
+
+/// Most frames one `dynrt rtl` or `dynrt sim` run writes and simulates: each frame is an update
+/// of the memory images (several files) and a frame of simulation (seconds in Verilator), so an
+/// animation of thousands of frames is a mistake more often than a wish; `--frames N` takes the
+/// first N.
+pub const MAX_PROCESSOR_FRAMES: u32 = 256;
+
+/// Every limit of the generated processor checked on the scene alone, before any tree, file or
+/// folder is made: threads, SRAM latency, frames per run, the display's largest mode, the
+/// memory map's size from counts, and the microprogram's length against the ROM (the program is
+/// generated for the scene's features with a worst-case tree, which does not change its length).
+/// The kd stack depth needs the trees and is checked by [`generate_rtl`] and
+/// [`simulate_scene`] right after they are built.
+pub fn preflight(scene: &Scene, f: Format, params: ProcessorParams, frames: Option<u32>) -> Result<()> {
+    use crate::hw::engine::{MAX_MEM_LATENCY, MAX_THREADS};
+    let src = scene.source.display();
+    anyhow::ensure!(
+        (1..=MAX_THREADS as u32).contains(&params.threads),
+        "--threads {}: the engine runs 1..={MAX_THREADS} ray threads; use e.g. --threads 32",
+        params.threads
+    );
+    anyhow::ensure!(
+        (1..=MAX_MEM_LATENCY).contains(&params.mem_latency),
+        "--mem-latency {}: the processor's SRAM read ports take a latency of 1..={MAX_MEM_LATENCY} clocks; use e.g. --mem-latency 2",
+        params.mem_latency
+    );
+    if let Some(n) = frames {
+        anyhow::ensure!(
+            n >= 1 && n <= scene.frames,
+            "{src}: --frames {n}, but the scene has {} frame(s); use 1..={}",
+            scene.frames,
+            scene.frames
+        );
+    }
+    let n = frames.unwrap_or(scene.frames);
+    anyhow::ensure!(
+        n <= MAX_PROCESSOR_FRAMES,
+        "{src}: {n} frames, but one processor run writes and simulates at most {MAX_PROCESSOR_FRAMES}; \
+         give --frames N (N <= {MAX_PROCESSOR_FRAMES}) to take the first N"
+    );
+    display_mode(scene.camera.width, scene.camera.height)
+        .with_context(|| format!("{src}: camera resolution"))?;
+    layout::check_capacity(scene, &MemoryConfig::default())?;
+    let worst = ProgramConfig {
+        format: f,
+        width: scene.camera.width,
+        height: scene.camera.height,
+        shadows: scene.render.shadows && !scene.lights.is_empty(),
+        reflection_depth: scene.render.reflection_depth,
+        light_count: scene.lights.len() as u32,
+        top_root: (!scene.is_single_untransformed_object()).then_some(0),
+        object_root: 0,
+        materials: 0,
+        frame_buffer: 0,
+        stack_entries: STACK_LEVELS as u32,
+        object_depth: STACK_LEVELS as u32,
+        planar_camera: false,
+    };
+    let length = |lights: u32| {
+        build_program(&ProgramConfig {
+            light_count: lights,
+            ..worst.clone()
+        })
+        .code
+        .len()
+    };
+    let needed = length(worst.light_count);
+    if needed > MAX_PROGRAM {
+        // Each light adds the same code (its shading and shadow ray): the largest count that
+        // fits follows from two lengths.
+        let (one, two) = (length(1), length(2));
+        let per_light = two.saturating_sub(one).max(1);
+        let fit = if one > MAX_PROGRAM { 0 } else { 1 + (MAX_PROGRAM - one) / per_light };
+        anyhow::bail!(
+            "{src}: the scene's microprogram needs {needed} instructions, the engine's ROM holds \
+             {MAX_PROGRAM}: each of its {} lights adds about {per_light} (shading and shadow ray); \
+             with these render settings at most {fit} lights fit, so use at most {fit} lights \
+             (or a smaller reflection_depth)",
+            scene.lights.len()
+        );
+    }
+    Ok(())
 }
 
 /// The processor's top-level ports for the constraints file: the top module's ports, its two
@@ -81,6 +165,7 @@ fn prepare(
     params: ProcessorParams,
     frames: Option<u32>,
 ) -> Result<Prepared> {
+    preflight(scene, f, params, frames)?;
     let layouts = scene_layouts(scene, f, frames)?;
     let deepest = layouts
         .iter()

@@ -2,7 +2,7 @@
 //! prototype (Schmittler et al., Graphics Hardware 2004): synthesizable Verilog, testbenches,
 //! memory images and constraints, plus a bit-exact software golden model.
 //!
-//! Data flows one way (see DESIGN.md section 2):
+//! Data flows one way (see docs/ARCHITECTURE.md, "Data flow"):
 //! `scene -> accel -> layout -> model / hw -> emit -> sim -> compare`.
 //! `fp` (the number format) is shared by every stage; nothing here imports the CLI, and `hw`
 //! never imports `model` (they meet in tests).
@@ -15,6 +15,7 @@ pub mod emit;
 pub mod flow;
 pub mod fp;
 pub mod hw;
+pub mod input;
 pub mod layout;
 pub mod model;
 pub mod output;

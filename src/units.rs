@@ -3,7 +3,7 @@
 //! The golden model calls these with a [`Format`] (values are format words); the processor's
 //! microprogram generator calls the same functions with its assembler (values are registers),
 //! so the hardware executes the same operations in the same order with the same rounding
-//! (DESIGN.md section 2). Each hardware unit's tests compare the RTL with these functions.
+//! (docs/ARCHITECTURE.md, "Data flow"). Each hardware unit's tests compare the RTL with these functions.
 //! Change an order here and both sides change with it.
 //!
 //! The decisions (comparisons) around the arithmetic are small and live beside it: the golden

@@ -61,6 +61,7 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 }
 
 pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
+    dynrt::output::check_output_dir(&a.out, "--out")?;
     match a.what {
         BenchWhat::Fp { formats, vectors } => {
             let work = tempfile::tempdir()?;

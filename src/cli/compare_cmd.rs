@@ -18,12 +18,37 @@ pub struct CompareArgs {
 }
 
 fn open(p: &std::path::Path) -> anyhow::Result<image::RgbImage> {
-    Ok(image::open(p)
-        .with_context(|| format!("reading image {}", p.display()))?
+    let bytes = dynrt::input::read_bytes(p, "image", dynrt::input::MAX_IMAGE_BYTES)?;
+    Ok(image::load_from_memory(&bytes)
+        .with_context(|| format!("image '{}' cannot be decoded (PNG expected)", p.display()))?
         .to_rgb8())
 }
 
 pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
+    if let Some(d) = &a.diff {
+        dynrt::output::check_output_file(d, "--diff")?;
+        let mut roles: Vec<(&str, &std::path::Path)> = vec![("image A", &a.a), ("image B", &a.b), ("--diff", d)];
+        if let Some(h) = &a.hits {
+            roles.extend([("HITS_A", h[0].as_path()), ("HITS_B", h[1].as_path())]);
+        }
+        dynrt::output::check_distinct(&roles)?;
+    }
+    // Every input is read and checked before anything is computed or written.
+    let hits = match &a.hits {
+        Some(h) => {
+            let ra = compare::read_hits(&h[0])?;
+            let rb = compare::read_hits(&h[1])?;
+            let size = |r: &[compare::HitRow]| r.last().map_or((0, 0), |l| (l.x + 1, l.y + 1));
+            if size(&ra) != size(&rb) {
+                anyhow::bail!(
+                    "hits files {} ({}x{}) and {} ({}x{}) are of frames of different sizes; compare hits of the same frame",
+                    h[0].display(), size(&ra).0, size(&ra).1, h[1].display(), size(&rb).0, size(&rb).1
+                );
+            }
+            Some((ra, rb))
+        }
+        None => None,
+    };
     let (ia, ib) = (open(&a.a)?, open(&a.b)?);
     let m = compare::compare_images(&ia, &ib)
         .with_context(|| format!("comparing {} with {}", a.a.display(), a.b.display()))?;
@@ -35,9 +60,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
     );
     println!("max channel err  {}", m.max_channel_error);
     println!("PSNR             {:.2} dB", m.psnr_db);
-    if let Some(h) = &a.hits {
-        let ra = compare::read_hits(&h[0])?;
-        let rb = compare::read_hits(&h[1])?;
+    if let Some((ra, rb)) = &hits {
         let hm = compare::compare_hits(
             &ra.iter().map(|r| r.hit).collect::<Vec<_>>(),
             &rb.iter().map(|r| r.hit).collect::<Vec<_>>(),

@@ -28,5 +28,5 @@ pub fn run(a: DemoArgs) -> anyhow::Result<i32> {
     let r = run_demo(&config)?;
     println!("{}", r.summary);
     println!("report: {}", r.report.display());
-    Ok(if r.ok { 0 } else { 1 })
+    Ok(if r.ok { 0 } else { super::EXIT_DIFFERS })
 }

@@ -24,6 +24,8 @@ pub struct EmitFpArgs {
 }
 
 pub fn run(a: EmitFpArgs) -> anyhow::Result<i32> {
+    dynrt::output::check_output_dir(&a.rtl, "--rtl")?;
+    dynrt::output::check_output_dir(&a.testbench, "--testbench")?;
     for op in BinOp::ALL {
         let unit = fp_unit_rtl(op, a.format)?;
         let rtl = a.rtl.join(format!("{}.v", unit.top));

@@ -18,7 +18,7 @@ pub enum FpEngine {
 
 #[derive(Args)]
 pub struct FpArgs {
-    /// add, sub, mul, div, lt, le or eq.
+    /// add, sub, mul, div, sqrt (of the first word), lt, le or eq.
     #[arg(long, value_parser = parse_op)]
     pub op: BinOp,
     #[arg(long, default_value = "e7m16")]
@@ -35,12 +35,14 @@ pub struct FpArgs {
 
 fn parse_op(s: &str) -> Result<BinOp, String> {
     BinOp::parse(s).ok_or_else(|| {
-        format!("unknown operator `{s}`: expected one of add, sub, mul, div, lt, le, eq")
+        format!("unknown operator `{s}`: expected one of add, sub, mul, div, sqrt, lt, le, eq")
     })
 }
 
 pub fn run(a: FpArgs) -> anyhow::Result<i32> {
     let f = a.format;
+    dynrt::output::check_output_file(&a.out, "--out")?;
+    dynrt::output::check_distinct(&[("--vectors", &a.vectors), ("--out", &a.out)])?;
     let vectors = read_vector_file(&a.vectors, f.width())?;
     let results: Vec<u32> = match a.sim {
         FpEngine::Model => vectors.iter().map(|&(x, y)| a.op.eval(f, x, y)).collect(),
@@ -67,8 +69,7 @@ pub fn run(a: FpArgs) -> anyhow::Result<i32> {
     } else {
         f.hex_digits()
     };
-    write_results_atomically(&a.out, &results, digits)
-        .with_context(|| format!("writing {}", a.out.display()))?;
+    write_results_atomically(&a.out, &results, digits)?;
     eprintln!(
         "{} {} vectors through {} {} -> {}",
         vectors.len(),

@@ -51,6 +51,9 @@ enum Command {
 /// Runs the command line and returns the process exit status.
 pub fn run() -> i32 {
     let cli = Cli::parse();
+    if let Err(e) = dynrt::sim::process::forward_signals() {
+        eprintln!("warning: cannot take Ctrl-C and SIGTERM to end the simulators dynrt starts: {e}");
+    }
     let result = match cli.command {
         Command::Render(a) => render_cmd::run(a),
         Command::Compare(a) => compare_cmd::run(a),
@@ -67,7 +70,29 @@ pub fn run() -> i32 {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
-            1
+            exit_code_of(&e)
         }
+    }
+}
+
+/// Exit status when a command ran into results that differ (frames, vectors, invariants).
+pub const EXIT_DIFFERS: i32 = 1;
+/// Exit status of a usage error or bad input (scene, mesh, arguments, paths); clap uses it too.
+pub const EXIT_USAGE: i32 = 2;
+/// Exit status when a tool or the machine failed (a simulator missing, a timeout, a full disk).
+pub const EXIT_TOOL: i32 = 3;
+
+/// [`EXIT_TOOL`] when a tool error is in the chain, else [`EXIT_USAGE`].
+fn exit_code_of(e: &anyhow::Error) -> i32 {
+    let tool = e.chain().any(|c| {
+        c.downcast_ref::<dynrt::sim::ToolError>().is_some()
+            || c
+                .downcast_ref::<std::io::Error>()
+                .is_some_and(|io| matches!(io.raw_os_error(), Some(libc::ENOSPC | libc::EDQUOT | libc::EIO)))
+    });
+    if tool {
+        EXIT_TOOL
+    } else {
+        EXIT_USAGE
     }
 }

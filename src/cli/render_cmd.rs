@@ -1,6 +1,5 @@
 //! `dynrt render`: one frame of a scene with the golden model or the f64 reference.
 
-use anyhow::Context;
 use clap::{Args, ValueEnum};
 use dynrt::fp::Format;
 use dynrt::layout::{self, MemoryConfig, SceneTrees};
@@ -58,6 +57,13 @@ pub fn load_scene(
 }
 
 pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
+    dynrt::output::check_output_file(&a.out, "--out")?;
+    let mut roles: Vec<(&str, &std::path::Path)> = vec![("the scene", &a.scene), ("--out", &a.out)];
+    if let Some(h) = &a.hits {
+        dynrt::output::check_output_file(h, "--hits")?;
+        roles.push(("--hits", h));
+    }
+    dynrt::output::check_distinct(&roles)?;
     let scene = load_scene(&a.scene, a.width, a.height)?;
     if a.frame >= scene.frames {
         anyhow::bail!(
@@ -93,7 +99,15 @@ pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
             );
             eprintln!("trees and layout {:.3} s", start.elapsed().as_secs_f64());
             start = Instant::now();
-            model::render_golden(&layout, true)
+            let golden = model::render_golden(&layout, true);
+            // The RTL matches the golden model whatever the format does to the scene; only the
+            // f64 reference shows a format that cannot hold it.
+            let reference = Reference::new(&scene).render(a.frame);
+            let hits = dynrt::compare::compare_hits(&golden.hit_tuples(), &reference.hit_tuples())?;
+            if let Some(w) = dynrt::compare::golden_warning(a.format, &hits) {
+                eprintln!("warning: {}: {w}", a.scene.display());
+            }
+            golden
         }
         ModelKind::Reference => {
             let reference = Reference::new(&scene);
@@ -103,14 +117,13 @@ pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
         }
     };
     let secs = start.elapsed().as_secs_f64();
-    frame
-        .save_png(&a.out)
-        .with_context(|| format!("writing {}", a.out.display()))?;
+    let png = dynrt::output::png_bytes(&frame.to_image())?;
+    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&a.out, &png)];
+    let hits_text = frame.hits_text();
     if let Some(h) = &a.hits {
-        frame
-            .save_hits(h)
-            .with_context(|| format!("writing {}", h.display()))?;
+        files.push((h, &hits_text));
     }
+    dynrt::output::write_all_atomically(&files)?;
     let pixels = u64::from(frame.width) * u64::from(frame.height);
     let hits = frame.hits.iter().filter(|h| h.is_some()).count();
     println!(

@@ -1,10 +1,10 @@
 //! `dynrt rtl` and `dynrt sim`: the processor of a scene, generated, and simulated frame by
 //! frame against the golden model.
-use anyhow::bail;
 use clap::{Args, ValueEnum};
 use dynrt::emit::processor::ProcessorParams;
 use dynrt::flow;
 use dynrt::fp::Format;
+use dynrt::output::OutputDir;
 use dynrt::sim::Simulator;
 use std::path::PathBuf;
 
@@ -49,34 +49,27 @@ pub struct SimArgs {
     pub sim: SimKind,
 }
 
+/// Loads the scene and checks every limit of the processor and the output folder, before
+/// anything is written.
 fn setup(a: &RtlArgs) -> anyhow::Result<(dynrt::scene::Scene, String, ProcessorParams)> {
+    dynrt::output::check_output_dir(&a.out, "--out")?;
     let scene = super::render_cmd::load_scene(&a.scene, a.width, a.height)?;
-    if let Some(n) = a.frames {
-        if n == 0 || n > scene.frames {
-            bail!(
-                "{}: --frames {n}, but the scene has {} frame(s)",
-                a.scene.display(),
-                scene.frames
-            );
-        }
-    }
+    let params = ProcessorParams {
+        threads: a.threads,
+        mem_latency: a.mem_latency,
+    };
+    flow::preflight(&scene, a.format, params, a.frames)?;
     let name = a
         .scene
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    Ok((
-        scene,
-        name,
-        ProcessorParams {
-            threads: a.threads,
-            mem_latency: a.mem_latency,
-        },
-    ))
+    Ok((scene, name, params))
 }
 
 pub fn run_rtl(a: RtlArgs) -> anyhow::Result<i32> {
     let (scene, name, params) = setup(&a)?;
+    let out = OutputDir::create(&a.out, "--out")?;
     let r = flow::generate_rtl(&scene, &name, a.format, params, a.frames, &a.out)?;
     println!(
         "{name}: microprogram of {} instructions, {} registers, {} scratch words per thread; {} frame(s)",
@@ -98,6 +91,7 @@ pub fn run_rtl(a: RtlArgs) -> anyhow::Result<i32> {
         println!("wrote {}", f.display());
     }
     print_synthesis(&a)?;
+    out.keep();
     Ok(0)
 }
 
@@ -110,6 +104,7 @@ fn print_synthesis(a: &RtlArgs) -> anyhow::Result<()> {
 
 pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
     let (scene, name, params) = setup(&a.rtl)?;
+    let out = OutputDir::create(&a.rtl.out, "--out")?;
     let sim = match a.sim {
         SimKind::Iverilog => Simulator::Icarus,
         SimKind::Verilator => Simulator::Verilator,
@@ -168,6 +163,8 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         r.run_seconds
     );
     print_synthesis(&a.rtl)?;
+    // A mismatch is a result, with its diff images and traces: keep them.
+    out.keep();
     if r.identical() {
         println!("every pixel of every frame is identical");
         Ok(0)
@@ -176,6 +173,6 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
             "MISMATCH: diff images and traces in {}",
             a.rtl.out.display()
         );
-        Ok(1)
+        Ok(super::EXIT_DIFFERS)
     }
 }

@@ -34,8 +34,24 @@ pub fn run(a: StressArgs) -> anyhow::Result<i32> {
         c.rays = r;
     }
     if !a.margins.is_empty() {
+        // A margin counts ulps the unit-triangle test widens its edges by: NaN or an infinity
+        // makes every comparison false, a negative one shrinks the triangle, and beyond 2^16
+        // ulps the edge moves by more than the triangle is wide in every format.
+        for m in &a.margins {
+            anyhow::ensure!(
+                m.is_finite() && (0.0..=65536.0).contains(m),
+                "--margins {m}: an edge margin is a number of ulps in 0..=65536 (e.g. --margins 0,64)"
+            );
+        }
         c.edge_margins = a.margins;
     }
+    if let Some(r) = a.rays {
+        anyhow::ensure!(
+            (1..=100_000_000).contains(&r),
+            "--rays {r}: give 1..=100000000 rays per case"
+        );
+    }
+    dynrt::output::check_output_file(&a.out, "--out")?;
     c.mesh_dir = a.meshes;
     c.seed = a.seed;
     println!("seed {:#x}", c.seed);
@@ -43,5 +59,5 @@ pub fn run(a: StressArgs) -> anyhow::Result<i32> {
     print!("{}", report.table());
     report.save_csv(&a.out)?;
     println!("written to {}", a.out.display());
-    Ok(if report.all_held() { 0 } else { 1 })
+    Ok(if report.all_held() { 0 } else { super::EXIT_DIFFERS })
 }

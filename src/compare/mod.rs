@@ -1,7 +1,7 @@
 //! Comparing frames: the RTL frame against the golden one (must be identical) and the golden
 //! frame against the f64 reference (error metrics, diff images).
 
-use anyhow::{bail, Context};
+use anyhow::bail;
 use std::path::Path;
 
 /// Error metrics between two images of the same size.
@@ -89,9 +89,12 @@ pub struct HitRow {
 }
 
 /// Reads a hits file (`x,y,instance,triangle,dist`), naming the file and line of any error.
+/// Every pixel of a `width x height` frame must appear exactly once (in any order; the rows
+/// come back in frame order, y then x); a miss is `-1,-1,inf` (or any negative instance), a hit
+/// has a triangle index >= 0 and a finite distance >= 0.
 pub fn read_hits(path: &Path) -> anyhow::Result<Vec<HitRow>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("reading hits file {}", path.display()))?;
+    let text = crate::input::read_text(path, "hits file", crate::input::MAX_TABLE_BYTES)?;
+    let text = crate::input::normalize_line_endings(&text);
     let mut lines = text.lines().enumerate();
     match lines.next() {
         Some((_, h)) if h.trim() == "x,y,instance,triangle,dist" => {}
@@ -101,6 +104,7 @@ pub fn read_hits(path: &Path) -> anyhow::Result<Vec<HitRow>> {
         ),
     }
     let mut rows = Vec::new();
+    let mut line_of = std::collections::HashMap::new();
     for (i, line) in lines {
         if line.trim().is_empty() {
             continue;
@@ -111,12 +115,15 @@ pub fn read_hits(path: &Path) -> anyhow::Result<Vec<HitRow>> {
         if fields.len() != 5 {
             return Err(bad("expected 5 comma-separated fields"));
         }
-        let x = fields[0]
+        let x: u32 = fields[0]
             .parse()
             .map_err(|_| bad("x is not a pixel coordinate"))?;
-        let y = fields[1]
+        let y: u32 = fields[1]
             .parse()
             .map_err(|_| bad("y is not a pixel coordinate"))?;
+        if x >= crate::scene::MAX_RESOLUTION || y >= crate::scene::MAX_RESOLUTION {
+            return Err(bad(&format!("pixel beyond the largest frame ({0}x{0})", crate::scene::MAX_RESOLUTION)));
+        }
         let instance: i64 = fields[2]
             .parse()
             .map_err(|_| bad("instance is not an integer"))?;
@@ -127,11 +134,67 @@ pub fn read_hits(path: &Path) -> anyhow::Result<Vec<HitRow>> {
         let hit = if instance < 0 {
             None
         } else {
+            if triangle < 0 {
+                return Err(bad("a hit (instance >= 0) needs a triangle index >= 0"));
+            }
+            if !(dist.is_finite() && dist >= 0.0) {
+                return Err(bad("a hit's dist must be a finite distance >= 0 (a miss is `-1,-1,inf`)"));
+            }
             Some((instance, triangle, dist))
         };
+        if let Some(first) = line_of.insert((x, y), i + 1) {
+            return Err(bad(&format!("pixel ({x}, {y}) appears twice (first on line {first}); each pixel has one row")));
+        }
         rows.push(HitRow { x, y, hit });
     }
+    if rows.is_empty() {
+        bail!("{}: no rows after the header; a hits file has one row per pixel", path.display());
+    }
+    let width = rows.iter().map(|r| r.x).max().unwrap_or(0) as usize + 1;
+    let height = rows.iter().map(|r| r.y).max().unwrap_or(0) as usize + 1;
+    if width * height != rows.len() {
+        bail!(
+            "{}: {} rows, but its pixels span {width}x{height} = {}; a hits file has one row for every pixel of the frame",
+            path.display(),
+            rows.len(),
+            width * height
+        );
+    }
+    rows.sort_by_key(|r| (r.y, r.x));
     Ok(rows)
+}
+
+/// The share of pixels whose primary hit may differ from the f64 reference's in each format
+/// before a frame is suspect: four times the mean mismatch measured for the nearest measured
+/// format with no more mantissa bits (PRECISION.md, margin 64: e5m10 8.25%, e6m14 0.458%,
+/// e7m16 0.089%, e7m18 0.019%, e8m23 0.014%), and at least 1% (a frame of a few thousand pixels
+/// has silhouettes where any format may differ); below e5m10 nothing is measured, and 50% is
+/// taken, enough to tell a format that cannot hold the scene.
+pub fn expected_mismatch_bound(f: crate::fp::Format) -> f64 {
+    let measured: [(u32, f64); 5] = [(23, 0.00014), (18, 0.00019), (16, 0.00089), (14, 0.00458), (10, 0.0825)];
+    match measured.iter().find(|(m, _)| f.man_bits >= *m) {
+        Some((_, share)) => (4.0 * share).max(0.01),
+        None => 0.5,
+    }
+}
+
+/// A warning when the golden frame's primary hits differ from the f64 reference's by more than
+/// the format's norm ([`expected_mismatch_bound`]): the values of the scene do not suit the
+/// format (the RTL still matches the golden model, so only the reference shows it).
+pub fn golden_warning(f: crate::fp::Format, hits: &HitMetrics) -> Option<String> {
+    let differing = 1.0 - hits.equivalent_ratio();
+    let bound = expected_mismatch_bound(f);
+    (differing > bound).then(|| {
+        format!(
+            "the golden model's primary hits in {f} differ from the f64 reference's in {:.2}% of the pixels \
+             ({} of {}), more than the {:.2}% expected of {f}: the scene's values do not suit the format \
+             (try a format with more mantissa or exponent bits, e.g. --format e8m23, or smaller coordinates)",
+            100.0 * differing,
+            hits.pixels - hits.equivalent_hits,
+            hits.pixels,
+            100.0 * bound
+        )
+    })
 }
 
 /// Agreement of two hits files of the same frame.

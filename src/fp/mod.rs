@@ -1,6 +1,6 @@
 //! The `eXmY` floating-point number format and its exact software arithmetic.
 //!
-//! Contract (DESIGN.md section 3): sign, X exponent bits (bias 2^(X-1)-1), Y stored mantissa
+//! Contract (docs/ARCHITECTURE.md, "Number format"): sign, X exponent bits (bias 2^(X-1)-1), Y stored mantissa
 //! bits with a hidden 1. Round to nearest, ties to even. Subnormal inputs and results are
 //! flushed to zero keeping the sign, with tininess detected *after* rounding (the result is
 //! rounded to Y+1 significant bits with an unbounded exponent, and flushed when that rounded

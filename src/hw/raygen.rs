@@ -2,7 +2,7 @@
 //! each primary ray direction; [`RayGenUnit`] is RayGen with a private [`TransformUnit`], the
 //! standalone unit that is emitted, tested and synthesized.
 //!
-//! Contract (bit-exact with `model::units::primary_direction`, DESIGN.md section 3): pixel
+//! Contract (bit-exact with `model::units::primary_direction`, docs/ARCHITECTURE.md, "Primary rays"): pixel
 //! (x, y) in raster order (x fastest, row 0 first) becomes the request "camera matrix times the
 //! point (from_int(x), from_int(y), 0)"; the layout bakes the pixel-centre offsets and the
 //! field of view into the matrix (`FrameMap::CAMERA`), and the origin is the eye

@@ -9,11 +9,12 @@ use glam::{DAffine3, DMat3, DVec3};
 #[derive(Debug, thiserror::Error)]
 pub enum LayoutError {
     #[error(
-        "scene `{scene}` does not fit the memory: bank {bank} ({name}) needs {needed} words \
-         ({needed_kib:.1} KiB) but holds {capacity} ({capacity_kib:.1} KiB); use a smaller scene \
-         or a lower resolution, or configure larger banks",
+        "scene `{scene}` does not fit the memory: bank {bank} ({name}) needs {at_least}{needed} words \
+         ({needed_kib:.1} KiB) but holds {capacity} ({capacity_kib:.1} KiB); {advice}",
+        at_least = if *estimated { "at least " } else { "" },
         needed_kib = *needed as f64 * 4.0 / 1024.0,
-        capacity_kib = *capacity as f64 * 4.0 / 1024.0
+        capacity_kib = *capacity as f64 * 4.0 / 1024.0,
+        advice = bank_advice(*bank)
     )]
     TooBig {
         scene: String,
@@ -21,6 +22,22 @@ pub enum LayoutError {
         name: &'static str,
         needed: usize,
         capacity: usize,
+        /// Counted from the scene before any tree was built (a lower bound).
+        estimated: bool,
+    },
+    #[error(
+        "scene `{scene}`: {what} = {value:.4e} {problem} {format} (its normal numbers have \
+         magnitudes {min:.4e} to {max:.4e}); {advice}",
+        min = format.to_f64(format.min_normal(false)),
+        max = format.to_f64(format.max_finite(false))
+    )]
+    NotRepresentable {
+        scene: String,
+        what: String,
+        value: f64,
+        problem: &'static str,
+        format: Format,
+        advice: &'static str,
     },
     #[error("scene `{scene}`: {what} does not fit the 30-bit address field of a kd node")]
     AddressOverflow { scene: String, what: String },
@@ -43,6 +60,97 @@ pub enum LayoutError {
         object: String,
         format: Format,
     },
+}
+
+/// What to change when a bank is full.
+fn bank_advice(bank: usize) -> &'static str {
+    match bank {
+        NODES | LISTS => "use fewer triangles per object (simplify the mesh) or instance repeated parts",
+        TRIANGLES_UV | TRIANGLES_T => "use fewer triangles (simplify the mesh, a coarser generator) or instance repeated objects",
+        INSTANCES => "use fewer instances",
+        _ => "use a lower resolution (--width/--height), fewer lights or fewer materials",
+    }
+}
+
+/// Checks from the scene's counts alone, before any tree is built, that the memory map can fit:
+/// every bank's words are counted where the count is exact (triangles, instances, the frame
+/// bank) and bounded from below where a tree decides them (each triangle is listed at least
+/// once, each object and the top level have at least one node).
+pub fn check_capacity(scene: &Scene, memory: &MemoryConfig) -> Result<(), LayoutError> {
+    let triangles = scene.triangle_count();
+    let materials: usize = scene.objects.iter().map(|o| o.materials.len()).sum();
+    let mut needed = [0usize; 6];
+    needed[NODES] = NODE_WORDS * (scene.objects.len() + 1);
+    needed[LISTS] = triangles;
+    needed[TRIANGLES_UV] = TRIANGLE_BANK_WORDS * triangles;
+    needed[TRIANGLES_T] = TRIANGLE_BANK_WORDS * triangles;
+    needed[INSTANCES] = INSTANCE_WORDS * scene.instances.len();
+    needed[FRAME] = FrameMap::LIGHTS
+        + LIGHT_WORDS * scene.lights.len()
+        + MATERIAL_WORDS * materials
+        + (scene.camera.width * scene.camera.height) as usize;
+    for (bank, &words) in needed.iter().enumerate() {
+        if words > memory.bank_words() {
+            return Err(LayoutError::TooBig {
+                scene: scene.source.display().to_string(),
+                bank,
+                name: BANK_NAMES[bank],
+                needed: words,
+                capacity: memory.bank_words(),
+                estimated: true,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Rounds a group of values that the hardware reads together (a matrix, a vector) into `f`,
+/// refusing what the format cannot hold: an infinite or NaN word, or a value that flushes to
+/// zero although it is within the group's precision of its largest member (a rotation's
+/// 1e-17 next to 1 is noise and may vanish; a scale of 1e-39 next to nothing is the matrix).
+fn checked_words(
+    f: Format,
+    scene: &Scene,
+    what: &dyn Fn(usize) -> String,
+    values: &[f64],
+) -> Result<Vec<u32>, LayoutError> {
+    let largest = values.iter().fold(0f64, |m, v| m.max(v.abs()));
+    let matters = largest * 2f64.powi(-(f.man_bits as i32) - 2);
+    let refuse = |i: usize, problem, advice| LayoutError::NotRepresentable {
+        scene: scene.source.display().to_string(),
+        what: what(i),
+        value: values[i],
+        problem,
+        format: f,
+        advice,
+    };
+    let mut words = Vec::with_capacity(values.len());
+    for (i, &x) in values.iter().enumerate() {
+        let w = f.from_f64(x);
+        if !x.is_finite() || f.is_nan(w) || f.is_inf(w) {
+            return Err(refuse(i, "overflows", "bring the scene's coordinates, scales and colours into the format's range, or choose a format with more exponent bits (--format e8m16)"));
+        }
+        if x != 0.0 && f.is_zero(w) && x.abs() >= matters {
+            return Err(refuse(i, "underflows to zero in", "avoid extreme scales (an instance's scale and its inverse both go into the hardware), or choose a format with more exponent bits (--format e8m16)"));
+        }
+        words.push(w);
+    }
+    Ok(words)
+}
+
+/// [`affine_words`] through [`checked_words`].
+fn checked_affine_words(
+    f: Format,
+    scene: &Scene,
+    what: &str,
+    m: &DAffine3,
+) -> Result<Vec<u32>, LayoutError> {
+    let mut values = Vec::with_capacity(12);
+    for r in 0..3 {
+        let row = m.matrix3.row(r);
+        values.extend([row.x, row.y, row.z, m.translation[r]]);
+    }
+    checked_words(f, scene, &|i| format!("{what}, row {} column {}", i / 4, i % 4), &values)
 }
 
 /// The per-object kd-trees and unit-triangle transforms of a scene for one number format,
@@ -76,6 +184,7 @@ pub struct SceneTrees {
 
 impl SceneTrees {
     pub fn build(scene: &Scene, format: Format) -> Result<SceneTrees, LayoutError> {
+        check_capacity(scene, &MemoryConfig::default())?;
         let params = KdParams {
             split_format: Some(format),
             ..KdParams::default()
@@ -327,8 +436,13 @@ pub fn build(
             .instances
             .iter()
             .zip(&to_world)
-            .map(|(inst, m)| instance_box(f, &trees.trees[inst.object].bounds, m))
-            .collect();
+            .map(|(inst, m)| {
+                let b = instance_box(f, &trees.trees[inst.object].bounds, m);
+                let values = [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z];
+                checked_words(f, scene, &|i| format!("instance '{}': its bounding box {} {}", inst.name, ["min", "max"][i / 3], ["x", "y", "z"][i % 3]), &values)?;
+                Ok(b)
+            })
+            .collect::<Result<_, LayoutError>>()?;
         Some(kd_tree::build_sah_boxes(
             &boxes,
             &KdParams {
@@ -382,12 +496,11 @@ pub fn build(
 
     // Instances.
     for (inst, m) in scene.instances.iter().zip(&to_world) {
-        banks[INSTANCES].extend(affine_words(f, &m.inverse()));
+        let item = format!("instance '{}'", inst.name);
+        banks[INSTANCES].extend(checked_affine_words(f, scene, &format!("{item}: its world-to-object matrix"), &m.inverse())?);
         let normal = m.matrix3.inverse().transpose();
-        for r in 0..3 {
-            let row = normal.row(r);
-            banks[INSTANCES].extend([f.from_f64(row.x), f.from_f64(row.y), f.from_f64(row.z)]);
-        }
+        let values: Vec<f64> = (0..3).flat_map(|r| normal.row(r).to_array()).collect();
+        banks[INSTANCES].extend(checked_words(f, scene, &|i| format!("{item}: its normal matrix, row {} column {}", i / 3, i % 3), &values)?);
         banks[INSTANCES].extend([
             object_roots[inst.object],
             first_triangle[inst.object],
@@ -408,23 +521,25 @@ pub fn build(
         + basis.up * ((1.0 - 1.0 / h) * half_h);
     let camera = DAffine3::from_mat3_translation(DMat3::from_cols(c0, c1, DVec3::ZERO), c2);
     let fr = &mut banks[FRAME];
-    fr.extend(affine_words(f, &camera));
-    fr.extend((cam.eye - origin).to_array().map(|c| f.from_f64(c)));
-    fr.push(f.from_f64(scene.render.ambient));
-    fr.extend(scene.render.background.map(|c| f.from_f64(c)));
+    fr.extend(checked_affine_words(f, scene, "the camera's pixel-to-direction matrix", &camera)?);
+    let xyz = |i: usize| ["x", "y", "z"][i % 3];
+    let rgb = |i: usize| ["r", "g", "b"][i % 3];
+    fr.extend(checked_words(f, scene, &|i| format!("the camera's eye {} (relative to the hardware's origin)", xyz(i)), &(cam.eye - origin).to_array())?);
+    fr.extend(checked_words(f, scene, &|_| "ambient".into(), &[scene.render.ambient])?);
+    fr.extend(checked_words(f, scene, &|i| format!("background {}", rgb(i)), &scene.render.background)?);
     let (shadow_eps, mirror_eps) = secondary_t_min(f, scene);
-    fr.extend([f.from_f64(shadow_eps), f.from_f64(mirror_eps)]);
+    fr.extend(checked_words(f, scene, &|i| format!("the {} rays' start offset (from the scene's size)", ["shadow", "mirror"][i]), &[shadow_eps, mirror_eps])?);
     fr.extend([0, f.one(), f.from_int(2)]);
     debug_assert_eq!(fr.len(), FrameMap::LIGHTS);
-    for light in &scene.lights {
-        fr.extend((light.position - origin).to_array().map(|c| f.from_f64(c)));
-        fr.extend(light.color.map(|c| f.from_f64(c)));
+    for (k, light) in scene.lights.iter().enumerate() {
+        fr.extend(checked_words(f, scene, &|i| format!("light {k}: position {} (relative to the hardware's origin)", xyz(i)), &(light.position - origin).to_array())?);
+        fr.extend(checked_words(f, scene, &|i| format!("light {k}: colour {}", rgb(i)), &light.color)?);
     }
     let materials = fr.len() as u32;
     for object in &scene.objects {
-        for m in &object.materials {
-            fr.extend(m.diffuse.map(|c| f.from_f64(c)));
-            fr.push(f.from_f64(m.mirror));
+        for (k, m) in object.materials.iter().enumerate() {
+            let values = [m.diffuse[0], m.diffuse[1], m.diffuse[2], m.mirror];
+            fr.extend(checked_words(f, scene, &|i| format!("object '{}': material {k}: {}", object.name, ["diffuse r", "diffuse g", "diffuse b", "mirror"][i]), &values)?);
         }
     }
     let frame_buffer = fr.len() as u32;
@@ -438,6 +553,7 @@ pub fn build(
                 name: BANK_NAMES[bank],
                 needed: words.len(),
                 capacity: memory.bank_words(),
+                estimated: false,
             });
         }
     }
@@ -631,6 +747,44 @@ scale = [0.5, 0.5, 0.5]
             .unwrap_err()
             .to_string();
         assert!(err.contains("frame 3"), "{err}");
+    }
+
+    #[test]
+    fn the_estimate_from_counts_is_a_lower_bound_of_the_built_map() {
+        let s = scene();
+        let trees = SceneTrees::build(&s, Format::E7M16).unwrap();
+        let built = build(&s, &trees, 0, &MemoryConfig::default()).unwrap();
+        let words = built.used_words();
+        let (bank, most) = words.iter().copied().enumerate().max_by_key(|&(_, w)| w).unwrap();
+        // A bank just big enough for the built map passes the estimate (it counts no more than
+        // the map holds); one word less than the exactly counted banks fails it.
+        let exact = MemoryConfig { banks: 6, bank_bytes: most * 4 };
+        check_capacity(&s, &exact).unwrap();
+        let frame_words = words[FRAME];
+        let small = MemoryConfig { banks: 6, bank_bytes: (frame_words - 1) * 4 };
+        let err = check_capacity(&s, &small).unwrap_err().to_string();
+        assert!(err.contains("needs at least") && err.contains("test.toml"), "{err}");
+        let _ = bank;
+    }
+
+    #[test]
+    fn values_the_format_cannot_hold_are_refused_with_what_they_are() {
+        let huge = SCENE.replace("scale = [0.5, 0.5, 0.5]", "scale = [1e30, 1e30, 1e30]");
+        assert_ne!(huge, SCENE, "the test scene has a scale to change");
+        let s = Scene::from_toml_str(&huge, Path::new("."), "test.toml").unwrap();
+        let trees = SceneTrees::build(&s, Format::E7M16).unwrap();
+        let err = build(&s, &trees, 0, &MemoryConfig::default()).unwrap_err().to_string();
+        assert!(err.contains("instance '") && err.contains("e7m16") && (err.contains("overflows") || err.contains("underflows")), "{err}");
+        // e8m23 holds 1e30 and its inverse: the same scene builds.
+        let trees = SceneTrees::build(&s, Format::E8M23).unwrap();
+        build(&s, &trees, 0, &MemoryConfig::default()).unwrap();
+        // A rotation's 1e-17 beside 1 may flush to zero: that is rounding, not an error.
+        let f = Format::E7M16;
+        assert!(checked_words(f, &s, &|_| "m".into(), &[1.0, 1e-25, 0.5]).is_ok());
+        let e = checked_words(f, &s, &|i| format!("value {i}"), &[1e-25, 0.0]).unwrap_err().to_string();
+        assert!(e.contains("value 0") && e.contains("underflows"), "{e}");
+        let e = checked_words(f, &s, &|i| format!("value {i}"), &[1.0, f64::NAN]).unwrap_err().to_string();
+        assert!(e.contains("value 1") && e.contains("overflows"), "{e}");
     }
 
     /// Applies a stored 3x4 matrix in f64.

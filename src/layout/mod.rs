@@ -46,7 +46,7 @@
 
 mod build;
 
-pub use build::{build, unit_triangle_transform, LayoutError, SceneTrees};
+pub use build::{build, check_capacity, unit_triangle_transform, LayoutError, SceneTrees};
 
 use crate::fp::Format;
 

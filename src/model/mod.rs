@@ -73,18 +73,24 @@ impl Frame {
         crate::output::write_png(path, &self.to_image())
     }
 
-    /// Writes the hits file of DESIGN.md section 3: `x,y,instance,triangle,dist`.
-    pub fn save_hits(&self, path: &Path) -> anyhow::Result<()> {
+    /// The hits file (docs/ARCHITECTURE.md, "Hits files"): `x,y,instance,triangle,dist`.
+    pub fn hits_text(&self) -> Vec<u8> {
         let mut text = Vec::new();
-        writeln!(text, "x,y,instance,triangle,dist")?;
+        // Writing into a Vec cannot fail.
+        let _ = writeln!(text, "x,y,instance,triangle,dist");
         for (i, h) in self.hits.iter().enumerate() {
             let (x, y) = (i as u32 % self.width, i as u32 / self.width);
-            match h {
-                Some(h) => writeln!(text, "{x},{y},{},{},{}", h.instance, h.triangle, h.dist)?,
-                None => writeln!(text, "{x},{y},-1,-1,inf")?,
-            }
+            let _ = match h {
+                Some(h) => writeln!(text, "{x},{y},{},{},{}", h.instance, h.triangle, h.dist),
+                None => writeln!(text, "{x},{y},-1,-1,inf"),
+            };
         }
-        crate::output::write_atomically(path, &text)
+        text
+    }
+
+    /// Writes the hits file ([`Frame::hits_text`]) atomically.
+    pub fn save_hits(&self, path: &Path) -> anyhow::Result<()> {
+        crate::output::write_atomically(path, &self.hits_text())
             .with_context(|| format!("writing {}", path.display()))
     }
 }

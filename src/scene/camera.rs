@@ -1,4 +1,4 @@
-//! The pinhole camera and its primary rays (DESIGN.md section 3), in f64.
+//! The pinhole camera and its primary rays (docs/ARCHITECTURE.md, "Primary rays"), in f64.
 //!
 //! Pixel (x, y), row 0 at the top, goes through the pixel centre: with
 //! f = normalize(look_at − eye), r = normalize(f × up), u = r × f, h = tan(fov_y / 2),
@@ -45,7 +45,7 @@ impl Camera {
         f64::from(self.width) / f64::from(self.height)
     }
 
-    /// Primary ray of pixel (x, y) as (origin, unnormalized direction), per DESIGN.md.
+    /// Primary ray of pixel (x, y) as (origin, unnormalized direction), per docs/ARCHITECTURE.md, "Primary rays".
     pub fn primary_ray(&self, x: u32, y: u32) -> (DVec3, DVec3) {
         self.ray_through(f64::from(x) + 0.5, f64::from(y) + 0.5)
     }

@@ -41,7 +41,10 @@ impl fmt::Display for SceneError {
 pub enum Problem {
     #[error("cannot read the file: {0}; check the path and permissions")]
     Unreadable(#[from] std::io::Error),
-    #[error("{0}; see DESIGN.md section 3 and src/scene/mod.rs for the scene schema")]
+    /// A file that is not a regular file, too large, or not text (the message names it).
+    #[error("{0}")]
+    Input(crate::input::InputError),
+    #[error("{0}; the scene schema is in docs/ARCHITECTURE.md (section \"Scene files\")")]
     Toml(String),
     #[error("unknown object '{name}' (defined objects: {known}); define it under [[objects]] or fix the name")]
     UnknownObject { name: String, known: String },
@@ -53,6 +56,8 @@ pub enum Problem {
     ObjectSource,
     #[error("mesh file '{path}' cannot be read: {reason}; check the path (it is relative to the scene file)")]
     MeshUnreadable { path: PathBuf, reason: String },
+    #[error("the scene has no [[objects]]; add at least one object, e.g. `[[objects]]` with `name = \"box\"` and `generate = {{ kind = \"box\" }}`")]
+    NoObjects,
     #[error("broken OBJ: {0}; fix or re-export the mesh")]
     BrokenObj(String),
     #[error("material library problem: {0}; fix the .mtl file or remove the `mtllib` line")]

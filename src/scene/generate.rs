@@ -18,7 +18,7 @@
 //! blocks without bottom faces (10 triangles each): a short 0.6 cube centred (0.33, 0.3, 0.3)
 //! turned −17° about Y, and a tall 0.6 x 1.2 x 0.6 block centred (−0.33, 0.6, −0.3) turned +17°,
 //! whose material has mirror reflectivity `mirror_tall_block`. Materials: 0 white, 1 red,
-//! 2 green, 3 tall block. The DESIGN.md example camera (eye (0, 1, 3.5), fov 40) frames it.
+//! 2 green, 3 tall block. The bundled scenes' camera (eye (0, 1, 3.5), fov 40) frames it.
 //!
 //! Terrain: a `size` x `size` grid over x, z in [−extent/2, extent/2], height
 //! `amplitude · fbm(frequency · u, frequency · v)` (see `noise.rs`; u, v in [0, 1] across the
@@ -66,8 +66,11 @@ pub fn has_own_materials(def: &GenerateDef) -> bool {
 pub fn expected_triangles(def: &GenerateDef) -> u64 {
     match def {
         GenerateDef::Box { .. } => 12,
+        // Saturating: the count is taken before the parameters' ranges are checked.
         GenerateDef::Plane { subdivisions, .. } => 2 * u64::from(*subdivisions).pow(2),
-        GenerateDef::Sphere { subdivisions, .. } => 20 * 4u64.pow(*subdivisions),
+        GenerateDef::Sphere { subdivisions, .. } => {
+            20u64.saturating_mul(4u64.saturating_pow(*subdivisions))
+        }
         GenerateDef::CornellBox { closed_front, .. } => {
             if *closed_front {
                 32
@@ -81,6 +84,26 @@ pub fn expected_triangles(def: &GenerateDef) -> u64 {
 
 /// Builds the mesh; `material` is used by single-material generators.
 pub fn generate(def: &GenerateDef, material: Material) -> Result<RawMesh, ParamError> {
+    // Counted before anything is built: a 2048x2048 terrain is 8.4 M triangles, gigabytes of
+    // trees, and can never fit the processor's memory.
+    let n = expected_triangles(def);
+    let in_range = match def {
+        GenerateDef::Sphere { subdivisions, .. } => *subdivisions <= MAX_SPHERE_SUBDIVISIONS,
+        GenerateDef::Plane { subdivisions: s, .. } | GenerateDef::Terrain { size: s, .. } => {
+            *s <= MAX_GRID_CELLS_PER_SIDE
+        }
+        _ => true,
+    };
+    // Out-of-range parameters get their own message from `build`.
+    if in_range && n > super::mesh::MAX_OBJ_TRIANGLES {
+        return Err((
+            "the generator's parameters".into(),
+            format!(
+                "they give {n} triangles, more than the {} one object may have (the processor's memory holds 131,072); use a smaller size or fewer subdivisions",
+                super::mesh::MAX_OBJ_TRIANGLES
+            ),
+        ));
+    }
     let mesh = build(def, material)?;
     debug_assert_eq!(mesh.triangles.len() as u64, expected_triangles(def));
     Ok(mesh)

@@ -142,98 +142,164 @@ fn obj_error(path: &Path, line: Option<usize>, item: &str, problem: Problem) -> 
     }
 }
 
-/// What the line scan learnt: the material libraries referenced and the triangle count.
+/// What the line scan learnt: the material libraries referenced.
 struct ObjScan {
     mtllibs: Vec<PathBuf>,
 }
 
-/// Checks `v` and `f` lines the way tobj will read them (f32 coordinates), with line numbers.
+/// Most triangles one OBJ may give: far more than the board's banks hold (131,072 triangles
+/// at 16 words each), so that only the memory-map check decides for a real mesh, while a file
+/// of millions of faces is refused before tobj builds them (its parse costs about 80 bytes of
+/// memory per triangle).
+pub const MAX_OBJ_TRIANGLES: u64 = 4_000_000;
+
+/// Parses `words` as numbers (the way tobj will, as f32), naming the line's `what` in errors.
+fn numbers(
+    words: &[&str],
+    path: &Path,
+    lineno: Option<usize>,
+    item: &str,
+    what: &str,
+) -> Result<Vec<f32>, SceneError> {
+    words
+        .iter()
+        .map(|w| {
+            let v: f32 = w.parse().map_err(|_| {
+                obj_error(
+                    path,
+                    lineno,
+                    item,
+                    Problem::BrokenObj(format!("{what}: '{w}' is not a number")),
+                )
+            })?;
+            if !v.is_finite() {
+                return Err(obj_error(
+                    path,
+                    lineno,
+                    item,
+                    Problem::NonFinite {
+                        what: format!("{what} '{w}' (as f32)"),
+                    },
+                ));
+            }
+            Ok(v)
+        })
+        .collect()
+}
+
+/// Checks every line the way tobj will read it (f32 numbers; `v x y z [w | r g b]`, `vt u v [w]`,
+/// `vn x y z`, faces `v[/vt][/vn]` with 1-based or negative indices), so that a broken line is
+/// reported with its number; tobj itself says only "position parse error" (and panics on some
+/// MTL lines, see [`scan_mtl`]).
 fn scan_obj(path: &Path, text: &str, item: &str) -> Result<ObjScan, SceneError> {
     let dir = path.parent().unwrap_or(Path::new(""));
-    let mut vertices: i64 = 0;
+    let (mut vertices, mut texcoords, mut normals): (i64, i64, i64) = (0, 0, 0);
     let mut mtllibs = Vec::new();
+    let mut triangles: u64 = 0;
     for (i, line) in text.lines().enumerate() {
         let lineno = Some(i + 1);
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => {
-                for axis in ["x", "y", "z"] {
-                    let word = words.next().ok_or_else(|| {
-                        obj_error(
-                            path,
-                            lineno,
-                            item,
-                            Problem::BrokenObj("vertex line needs three coordinates".into()),
-                        )
-                    })?;
-                    let value: f32 = word.parse().map_err(|_| {
-                        obj_error(
-                            path,
-                            lineno,
-                            item,
-                            Problem::BrokenObj(format!(
-                                "vertex {axis} coordinate '{word}' is not a number"
-                            )),
-                        )
-                    })?;
-                    if !value.is_finite() {
-                        return Err(obj_error(
-                            path,
-                            lineno,
-                            item,
-                            Problem::NonFinite {
-                                what: format!(
-                                    "vertex {} coordinate {axis} = '{word}' (as f32)",
-                                    vertices + 1
-                                ),
-                            },
-                        ));
+        let broken = |message: String| obj_error(path, lineno, item, Problem::BrokenObj(message));
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let Some((&key, args)) = words.split_first() else {
+            continue;
+        };
+        match key {
+            "v" => {
+                let what = format!("vertex {}", vertices + 1);
+                let v = numbers(args, path, lineno, item, &what)?;
+                match v.len() {
+                    3 | 6 => {}
+                    4 => {
+                        // tobj divides x, y, z by w.
+                        if v[3] == 0.0 {
+                            return Err(broken(format!("{what} has weight w = 0; drop the fourth number or make it non-zero")));
+                        }
+                        if v[..3].iter().any(|c| !(c / v[3]).is_finite()) {
+                            return Err(obj_error(path, lineno, item, Problem::NonFinite { what: format!("{what} divided by its weight w = {}", v[3]) }));
+                        }
+                    }
+                    n => {
+                        return Err(broken(format!(
+                            "{what} has {n} numbers; a vertex line is `v x y z`, `v x y z w` or `v x y z r g b`"
+                        )))
                     }
                 }
                 vertices += 1;
             }
-            Some("f") => {
-                let corners: Vec<&str> = words.collect();
-                if corners.len() < 3 {
-                    return Err(obj_error(
-                        path,
-                        lineno,
-                        item,
-                        Problem::BrokenObj(format!(
-                            "face has {} vertices, a face needs at least 3",
-                            corners.len()
-                        )),
-                    ));
+            "vt" => {
+                let what = format!("texture coordinate {}", texcoords + 1);
+                let v = numbers(args, path, lineno, item, &what)?;
+                if !(2..=3).contains(&v.len()) {
+                    return Err(broken(format!(
+                        "{what} has {} numbers; a texture coordinate line is `vt u v` or `vt u v w`",
+                        v.len()
+                    )));
                 }
-                for c in corners {
-                    let first = c.split('/').next().unwrap_or("");
-                    let index: i64 = first.parse().map_err(|_| {
-                        obj_error(
-                            path,
-                            lineno,
-                            item,
-                            Problem::BrokenObj(format!("face vertex '{c}' is not an index")),
-                        )
-                    })?;
-                    let resolved = if index < 0 {
-                        vertices + index + 1
-                    } else {
-                        index
-                    };
-                    if index == 0 || resolved < 1 || resolved > vertices {
-                        return Err(obj_error(
-                            path,
-                            lineno,
-                            item,
-                            Problem::BrokenObj(format!(
-                                "face vertex index {index} is out of range (only {vertices} vertices defined so far)"
-                            )),
-                        ));
+                texcoords += 1;
+            }
+            "vn" => {
+                let what = format!("normal {}", normals + 1);
+                let v = numbers(args, path, lineno, item, &what)?;
+                if v.len() != 3 {
+                    return Err(broken(format!(
+                        "{what} has {} numbers; a normal line is `vn x y z`",
+                        v.len()
+                    )));
+                }
+                normals += 1;
+            }
+            "f" | "l" => {
+                let least = if key == "f" { 3 } else { 2 };
+                if args.len() < least {
+                    return Err(broken(format!(
+                        "{} has {} vertices, it needs at least {least}",
+                        if key == "f" { "face" } else { "line" },
+                        args.len()
+                    )));
+                }
+                for c in args {
+                    let parts: Vec<&str> = c.split('/').collect();
+                    if parts.len() > 3 {
+                        return Err(broken(format!(
+                            "face vertex '{c}' has {} parts; it is `v`, `v/vt`, `v//vn` or `v/vt/vn`",
+                            parts.len()
+                        )));
+                    }
+                    let kinds = [
+                        ("vertex", "vertices", vertices),
+                        ("texture coordinate", "texture coordinates", texcoords),
+                        ("normal", "normals", normals),
+                    ];
+                    for (k, part) in parts.iter().enumerate() {
+                        let (kind, kinds_name, defined) = kinds[k];
+                        if part.is_empty() && k > 0 {
+                            continue;
+                        }
+                        let index: i64 = part.parse().map_err(|_| {
+                            broken(format!("face vertex '{c}': {kind} index '{part}' is not an integer"))
+                        })?;
+                        let resolved = if index < 0 { defined + index + 1 } else { index };
+                        if index == 0 || resolved < 1 || resolved > defined {
+                            return Err(broken(format!(
+                                "face vertex '{c}': {kind} index {index} is out of range (only {defined} {kinds_name} defined so far)"
+                            )));
+                        }
+                    }
+                }
+                if key == "f" {
+                    triangles += args.len() as u64 - 2;
+                    if triangles > MAX_OBJ_TRIANGLES {
+                        return Err(broken(format!(
+                            "more than {MAX_OBJ_TRIANGLES} triangles; the processor's memory holds at most 131,072 (six 4 MB banks): simplify the mesh or split it into instanced objects"
+                        )));
                     }
                 }
             }
-            Some("mtllib") => {
+            "mtllib" => {
                 let name = line.trim_start()[6..].trim();
+                if name.is_empty() {
+                    return Err(broken("`mtllib` names no file".into()));
+                }
                 mtllibs.push(dir.join(name));
             }
             _ => {}
@@ -242,19 +308,57 @@ fn scan_obj(path: &Path, text: &str, item: &str) -> Result<ObjScan, SceneError> 
     Ok(ObjScan { mtllibs })
 }
 
+/// Checks every MTL line tobj reads (`Ka Kd Ks Ke` three numbers, `Ns Ni d Tr` one, `illum` an
+/// integer, `newmtl` a name, `map_*` a file name): tobj reports only "material parse error",
+/// and panics on a colour with fewer than three numbers.
+fn scan_mtl(path: &Path, text: &str, item: &str) -> Result<(), SceneError> {
+    for (i, line) in text.lines().enumerate() {
+        let lineno = Some(i + 1);
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let Some((&key, args)) = words.split_first() else {
+            continue;
+        };
+        let broken = |message: String| obj_error(path, lineno, item, Problem::BrokenMtl(message));
+        match key {
+            "Ka" | "Kd" | "Ks" | "Ke" => {
+                let v = numbers(&args[..args.len().min(3)], path, lineno, item, key).map_err(|_| {
+                    broken(format!("`{key}` needs three numbers (r g b), found `{}`", args.join(" ")))
+                })?;
+                if v.len() < 3 {
+                    return Err(broken(format!("`{key}` needs three numbers (r g b), found `{}`", args.join(" "))));
+                }
+            }
+            "Ns" | "Ni" | "d" | "Tr" => {
+                if args.first().and_then(|w| w.parse::<f32>().ok()).is_none() {
+                    return Err(broken(format!("`{key}` needs a number, found `{}`", args.join(" "))));
+                }
+            }
+            "illum" => {
+                if args.first().and_then(|w| w.parse::<i32>().ok()).is_none() {
+                    return Err(broken(format!("`illum` needs an integer model number (0..10), found `{}`", args.join(" "))));
+                }
+            }
+            "newmtl" if args.is_empty() => return Err(broken("`newmtl` names no material".into())),
+            k if k.starts_with("map_") || k == "bump" => {
+                if args.is_empty() {
+                    return Err(broken(format!("`{k}` names no file")));
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+fn read_obj_text(path: &Path, item: &str) -> Result<String, SceneError> {
+    let text = crate::input::read_text(path, "mesh", crate::input::MAX_MESH_BYTES)
+        .map_err(|e| obj_error(path, None, item, Problem::Input(e)))?;
+    Ok(crate::input::normalize_line_endings(&text).into_owned())
+}
+
 /// Loads an OBJ file (and its MTL) as a raw mesh in file order, plus warnings.
 pub(crate) fn load_obj(path: &Path, item: &str) -> Result<(RawMesh, Vec<String>), SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        obj_error(
-            path,
-            None,
-            item,
-            Problem::MeshUnreadable {
-                path: path.to_path_buf(),
-                reason: e.to_string(),
-            },
-        )
-    })?;
+    let text = read_obj_text(path, item)?;
     let scan = scan_obj(path, &text, item)?;
     let options = tobj::LoadOptions {
         triangulate: true,
@@ -262,7 +366,27 @@ pub(crate) fn load_obj(path: &Path, item: &str) -> Result<(RawMesh, Vec<String>)
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, materials) = tobj::load_obj(path, &options)
+    // tobj asks for each `mtllib` by the name in the file; the library is read here, through
+    // the same checks as every input, and an error in it is kept to be reported as it is.
+    let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
+    let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
+        let file = dir.join(name);
+        let result = crate::input::read_text(&file, "material library", crate::input::MAX_MTL_BYTES)
+            .map_err(|e| obj_error(&file, None, item, Problem::Input(e)))
+            .and_then(|t| {
+                let t = crate::input::normalize_line_endings(&t).into_owned();
+                scan_mtl(&file, &t, item)?;
+                tobj::load_mtl_buf(&mut t.as_bytes()).map_err(|e| {
+                    obj_error(&file, None, item, Problem::BrokenMtl(e.to_string()))
+                })
+            });
+        result.map_err(|e| {
+            *mtl_error.borrow_mut() = Some(e);
+            tobj::LoadError::OpenFileFailed
+        })
+    };
+    let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &options, load_mtl)
         .map_err(|e| obj_error(path, None, item, Problem::BrokenObj(e.to_string())))?;
     let mtl_file = || {
         scan.mtllibs
@@ -270,15 +394,19 @@ pub(crate) fn load_obj(path: &Path, item: &str) -> Result<(RawMesh, Vec<String>)
             .cloned()
             .unwrap_or_else(|| path.to_path_buf())
     };
-    let tobj_materials = materials.map_err(|e| {
-        let file = mtl_file();
-        obj_error(
-            &file,
-            None,
-            item,
-            Problem::BrokenMtl(format!("'{}': {e}", file.display())),
-        )
-    })?;
+    let tobj_materials = match (materials, mtl_error.into_inner()) {
+        (_, Some(e)) => return Err(e),
+        (Ok(m), None) => m,
+        (Err(e), None) => {
+            let file = mtl_file();
+            return Err(obj_error(
+                &file,
+                None,
+                item,
+                Problem::BrokenMtl(format!("'{}': {e}", file.display())),
+            ));
+        }
+    };
 
     let mut warnings = Vec::new();
     let mut out = RawMesh::default();

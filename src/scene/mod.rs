@@ -1,10 +1,10 @@
-//! Dynamic scenes: load a scene TOML (DESIGN.md section 3), build its objects from OBJ/MTL files
+//! Dynamic scenes: load a scene TOML (docs/ARCHITECTURE.md, "Scene files"), build its objects from OBJ/MTL files
 //! or procedural generators, place instances (static or animated), validate everything, and hand
 //! the result on as plain f64 data (`Scene`) for the acceleration structures, the layout and the
 //! renderers.
 //!
 //! # Scene file
-//! The schema of DESIGN.md section 3; every table rejects unknown keys. Defaults: `up = [0,1,0]`;
+//! The schema of docs/ARCHITECTURE.md, "Scene files"; every table rejects unknown keys. Defaults: `up = [0,1,0]`;
 //! `[render]` may be omitted (`shadows = true`, `reflection_depth = 0`, `ambient = 0.1`,
 //! `background = [0,0,0]`); a light's `color` defaults to white. Extensions:
 //! - `[[objects]]` take exactly one of `mesh = "file.obj"` (relative to the scene file) or
@@ -107,12 +107,14 @@ pub struct Scene {
 impl Scene {
     /// Loads a scene file; meshes are found relative to its directory.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
-            file: path.to_path_buf(),
-            line: None,
-            item: None,
-            problem: Problem::Unreadable(e),
-        })?;
+        let text = crate::input::read_text(path, "scene file", crate::input::MAX_SCENE_BYTES)
+            .map_err(|e| SceneError {
+                file: path.to_path_buf(),
+                line: None,
+                item: None,
+                problem: Problem::Input(e),
+            })?;
+        let text = crate::input::normalize_line_endings(&text);
         let base = path.parent().unwrap_or(Path::new(""));
         Scene::from_toml_str(&text, base, path)
     }
@@ -285,6 +287,9 @@ impl Builder<'_> {
         let render = self.render(&file)?;
         let lights = self.lights(&file)?;
         let objects = self.objects(&file)?;
+        if objects.is_empty() {
+            return Err(self.ctx.error(None, None, Problem::NoObjects));
+        }
         let names: HashMap<&str, usize> = objects
             .iter()
             .enumerate()
@@ -341,6 +346,16 @@ impl Builder<'_> {
                     animation: None,
                 })
                 .collect();
+        }
+        if instances.is_empty() {
+            return Err(self.ctx.error(
+                None,
+                None,
+                Problem::Invalid {
+                    what: "the scene's instances".into(),
+                    expected: "at least one instance; the [[fields]] place none (check their counts) and there are no [[instances]]".into(),
+                },
+            ));
         }
         let mut used = vec![false; objects.len()];
         for i in &instances {
@@ -405,6 +420,18 @@ impl Builder<'_> {
         let view = look_at - eye;
         if view == DVec3::ZERO {
             return Err(self.err(c.look_at.span(), item, Problem::EyeAtLookAt(eye.to_array())));
+        }
+        // Coordinates near f64's limit make |view| overflow, and a NaN direction would pass
+        // for "up parallel to the view" below.
+        if !view.length().is_finite() || !up.length().is_finite() {
+            return Err(self.err(
+                c.look_at.span(),
+                item,
+                Problem::Invalid {
+                    what: format!("the distance from eye {:?} to look_at {:?} (or up's length)", eye.to_array(), look_at.to_array()),
+                    expected: "it overflows f64; use coordinates below about 1e150 (no number format of the hardware holds more than about 3e38)".into(),
+                },
+            ));
         }
         // Parallel when the sine of the angle between them is below 1e-9 (also catches up = 0).
         let f = view.normalize();
@@ -536,7 +563,7 @@ impl Builder<'_> {
                     let path = self.base_dir.join(mesh.get_ref());
                     let (mut raw, warnings) = mesh::load_obj(&path, &item).map_err(|mut e| {
                         // A missing mesh is the scene's fault: point at the `mesh =` line.
-                        if matches!(e.problem, Problem::MeshUnreadable { .. }) {
+                        if matches!(e.problem, Problem::MeshUnreadable { .. } | Problem::Input(_)) {
                             e.file = self.ctx.file.clone();
                             e.line = Some(self.ctx.line_of(mesh.span().start));
                         }

@@ -1,4 +1,4 @@
-//! The scene TOML as serde sees it (DESIGN.md section 3 plus the extensions documented in
+//! The scene TOML as serde sees it (docs/ARCHITECTURE.md, "Scene files" plus the extensions documented in
 //! `scene/mod.rs`). Every table denies unknown fields so a misspelt key is an error, not a
 //! silently ignored setting. Values that later checks may reject are `Spanned` so the error can
 //! name their line. Nothing here is validated; `scene/mod.rs` turns this into a `Scene`.

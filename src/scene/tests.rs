@@ -800,3 +800,128 @@ fn error_other_ranges() {
         assert_eq!(e.line, Some(line_of(&body, needle)), "{s}");
     }
 }
+
+/// Seeded mutation fuzzing of the scene and OBJ/MTL parsers: random edits of valid files (bytes
+/// flipped, lines cut, duplicated or swapped, hostile numbers spliced into number positions)
+/// must give a scene or a `SceneError` naming a file, never a panic. Bounded: a fixed number
+/// of cases from a fixed seed, a few seconds in release.
+mod fuzz {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    const HOSTILE: [&str; 14] = [
+        "nan", "inf", "-inf", "1e39", "-1e39", "1e-39", "1e300", "0", "-0", "4294967296",
+        "-1", "1e400", "0x10", "\u{feff}",
+    ];
+
+    fn mutate(rng: &mut ChaCha8Rng, text: &str) -> String {
+        let mut lines: Vec<String> = text.lines().map(String::from).collect();
+        for _ in 0..rng.gen_range(1..4) {
+            if lines.is_empty() {
+                break;
+            }
+            let i = rng.gen_range(0..lines.len());
+            match rng.gen_range(0..6) {
+                0 => {
+                    lines.remove(i);
+                }
+                1 => {
+                    let l = lines[i].clone();
+                    lines.insert(rng.gen_range(0..=lines.len()), l);
+                }
+                2 => {
+                    let j = rng.gen_range(0..lines.len());
+                    lines.swap(i, j);
+                }
+                3 => {
+                    // A hostile number in place of a number-looking word.
+                    let words: Vec<String> = lines[i]
+                        .split(' ')
+                        .map(|w| {
+                            let numeric = w.trim_matches(|c| c == ',' || c == '[' || c == ']');
+                            if numeric.parse::<f64>().is_ok() && rng.gen_bool(0.5) {
+                                w.replace(numeric, HOSTILE[rng.gen_range(0..HOSTILE.len())])
+                            } else {
+                                w.to_string()
+                            }
+                        })
+                        .collect();
+                    lines[i] = words.join(" ");
+                }
+                4 => {
+                    let cut = rng.gen_range(0..=lines[i].len());
+                    let cut = (0..=cut).rev().find(|&c| lines[i].is_char_boundary(c)).unwrap_or(0);
+                    lines[i].truncate(cut);
+                }
+                _ => {
+                    let mut bytes = lines[i].clone().into_bytes();
+                    if !bytes.is_empty() {
+                        let k = rng.gen_range(0..bytes.len());
+                        bytes[k] = rng.gen_range(b' '..=b'~');
+                    }
+                    lines[i] = String::from_utf8(bytes).unwrap();
+                }
+            }
+        }
+        let sep = ["\n", "\r\n", "\r"][rng.gen_range(0..3)];
+        lines.join(sep)
+    }
+
+    fn load_survives(path: &Path) -> Result<(), String> {
+        match std::panic::catch_unwind(|| Scene::load(path)) {
+            Err(_) => Err("panicked".into()),
+            Ok(Ok(_)) => Ok(()),
+            Ok(Err(e)) => {
+                let text = e.to_string();
+                if text.is_empty() || !text.contains(".toml") && !text.contains(".obj") && !text.contains(".mtl") {
+                    Err(format!("error names no file: {text}"))
+                } else {
+                    Ok(())
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn mutated_scenes_and_meshes_give_a_scene_or_an_error_never_a_panic() {
+        let scene = format!(
+            "{CAMERA}[render]\nshadows = true\nreflection_depth = 1\nambient = 0.1\n\
+             [[lights]]\nposition = [0.0, 1.9, 0.8]\ncolor = [1.0, 1.0, 1.0]\n\
+             [[objects]]\nname = \"m\"\nmesh = \"m.obj\"\n\
+             [[objects]]\nname = \"g\"\ngenerate = {{ kind = \"sphere\", subdivisions = 1 }}\n\
+             [[instances]]\nobject = \"m\"\ntranslate = [0.0, 0.5, 0.0]\nscale = [1.0, 1.0, 1.0]\n\
+             [instances.animate]\nframes = 3\nrotate = [0.0, 90.0, 0.0]\n\
+             [[instances]]\nobject = \"g\"\nscale = [0.3, 0.3, 0.3]\n"
+        );
+        let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0 1\nvt 0 0\nvt 1 0\nvn 0 0 1\n\
+                   usemtl a\nf 1/1/1 2/2/1 3/1/1\nf -1 -2 -3\nf 2//1 4//1 3//1\n";
+        let mtl = "newmtl a\nKd 0.8 0.2 0.2\nKs 0.5 0.5 0.5\nillum 3\nNs 10\nd 1\n";
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("s.toml"), &scene).unwrap();
+        std::fs::write(d.join("m.obj"), obj).unwrap();
+        std::fs::write(d.join("m.mtl"), mtl).unwrap();
+        load_survives(&d.join("s.toml")).expect("the unmutated files load");
+        let mut rng = ChaCha8Rng::seed_from_u64(0xF022);
+        let mut failures = Vec::new();
+        // Silence the default hook's backtrace printing for the caught panics; restored after.
+        let hook = std::panic::take_hook();
+        std::panic::set_hook(Box::new(|_| {}));
+        for case in 0..1500 {
+            let (s, o, m) = match case % 3 {
+                0 => (mutate(&mut rng, &scene), obj.to_string(), mtl.to_string()),
+                1 => (scene.clone(), mutate(&mut rng, obj), mtl.to_string()),
+                _ => (scene.clone(), obj.to_string(), mutate(&mut rng, mtl)),
+            };
+            std::fs::write(d.join("s.toml"), &s).unwrap();
+            std::fs::write(d.join("m.obj"), &o).unwrap();
+            std::fs::write(d.join("m.mtl"), &m).unwrap();
+            if let Err(e) = load_survives(&d.join("s.toml")) {
+                failures.push(format!("case {case}: {e}\n--- scene\n{s}\n--- obj\n{o}\n--- mtl\n{m}"));
+            }
+        }
+        std::panic::set_hook(hook);
+        assert!(failures.is_empty(), "{} of 1500 cases failed; first:\n{}", failures.len(), failures[0]);
+    }
+}

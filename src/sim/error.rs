@@ -56,11 +56,20 @@ pub enum ToolError {
         excerpt: String,
     },
 
+    /// Not a `#[source]`: the message says it, and an error chain would say it twice.
     #[error("{context}: {source}")]
     Io {
         context: String,
-        #[source]
         source: std::io::Error,
+    },
+
+    /// The design is fine; the machine is not (a compiler or make missing, the disk full).
+    #[error("{tool} could not finish {stage}: {problem}. Its last output:\n{excerpt}")]
+    Environment {
+        tool: String,
+        stage: String,
+        problem: String,
+        excerpt: String,
     },
 
     #[error("{tool}: could not understand its output ({message})")]
@@ -96,6 +105,29 @@ pub(crate) fn parse_location(line: &str) -> Option<SourceLocation> {
         file: file.to_string(),
         line: line_no,
     })
+}
+
+/// What in a tool's output says that the machine, not the design, failed: a missing C++
+/// compiler or make (Verilator builds its model with them), or a full disk. The answer says what
+/// to do.
+pub(crate) fn environment_problem(output: &str) -> Option<String> {
+    let lower = output.to_ascii_lowercase();
+    if lower.contains("no space left on device") || lower.contains("disk quota exceeded") {
+        return Some("the disk is full (\"No space left on device\"); free space in the output folder's file system or point --out elsewhere".into());
+    }
+    for tool in ["g++", "c++", "clang++", "make", "gmake", "ccache", "python3", "perl"] {
+        let missing = lower.lines().any(|l| {
+            let names_it = l.contains(&format!("{tool}: not found"))
+                || l.contains(&format!("{tool}: command not found"))
+                || (l.contains(&format!("'{tool}'")) || l.contains(&format!("\"{tool}\"")) || l.contains(&format!("`{tool}'")))
+                    && (l.contains("no such file") || l.contains("not found"));
+            names_it
+        });
+        if missing {
+            return Some(format!("`{tool}` is not installed or not on PATH (Verilator needs a C++ compiler and make to build its model); install it, e.g. `apt-get install -y build-essential`, or run `make deps`"));
+        }
+    }
+    None
 }
 
 /// The tool's first error lines (up to `max`), falling back to its last lines when no line
@@ -146,6 +178,20 @@ mod tests {
         );
         assert_eq!(parse_location("I give up."), None);
         assert_eq!(parse_location("%Error: Exiting due to 1 error(s)"), None);
+    }
+
+    #[test]
+    fn the_machine_failing_is_not_the_design_failing() {
+        let no_gpp = "make: g++: No such file or directory\nmake: *** [Vtb__ALL.a] Error 127";
+        assert!(environment_problem(no_gpp).unwrap().contains("`g++` is not installed"));
+        let no_make = "sh: 1: make: not found\n%Error: make failed";
+        assert!(environment_problem(no_make).unwrap().contains("`make` is not installed"));
+        let full = "Vtb.cpp: fatal error: error writing to /tmp/cc.s: No space left on device";
+        assert!(environment_problem(full).unwrap().contains("disk is full"));
+        let design = "%Error: tb.v:7:3: syntax error, unexpected IDENTIFIER";
+        assert_eq!(environment_problem(design), None);
+        let err = super::super::compile_error("verilator", "tb", no_gpp).to_string();
+        assert!(!err.contains("rejected the design") && err.contains("g++"), "{err}");
     }
 
     #[test]

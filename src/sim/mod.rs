@@ -15,7 +15,7 @@
 
 mod error;
 mod lint;
-pub(crate) mod process;
+pub mod process;
 pub mod vectors;
 
 pub(crate) use error::error_excerpt;
@@ -365,6 +365,14 @@ fn define_arg(name: &str, value: &Option<String>) -> String {
 }
 
 fn compile_error(tool: &str, top: &str, output: &str) -> ToolError {
+    if let Some(problem) = error::environment_problem(output) {
+        return ToolError::Environment {
+            tool: tool.to_string(),
+            stage: format!("building `{top}`"),
+            problem,
+            excerpt: process::last_lines(output, 6),
+        };
+    }
     let (excerpt, location) = error::error_excerpt(output, 10);
     ToolError::Compile {
         tool: tool.to_string(),

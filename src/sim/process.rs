@@ -4,6 +4,12 @@
 //! (Verilator starts make, which starts g++); stdout and stderr are drained on their own threads
 //! so a chatty simulation can never block on a full pipe; a missing binary becomes
 //! [`ToolError::NotFound`] with the install hint, never a bare "No such file or directory".
+//!
+//! Since the child's group is not the terminal's, Ctrl-C reaches only dynrt: with
+//! [`forward_signals`] installed (the CLI does it first thing), SIGINT, SIGTERM and SIGHUP are
+//! forwarded to every running tool's group, dynrt waits for the groups to end (SIGKILL after
+//! [`SIGNAL_GRACE`]), removes the outputs of the interrupted run
+//! ([`crate::output::abandon_all`]) and exits with 128 + the signal's number, as a shell does.
 
 use std::io::Read;
 use std::os::unix::process::CommandExt;
@@ -16,6 +22,68 @@ use super::error::ToolError;
 
 /// How long to wait for output pipes to close after the child has exited or been killed.
 const PIPE_GRACE: Duration = Duration::from_secs(5);
+/// How long a forwarded signal has to end a tool's group before SIGKILL does.
+pub const SIGNAL_GRACE: Duration = Duration::from_secs(3);
+
+/// The process groups of the tools running now (each child leads its own group).
+static RUNNING_GROUPS: Mutex<Vec<i32>> = Mutex::new(Vec::new());
+
+fn running_groups() -> std::sync::MutexGuard<'static, Vec<i32>> {
+    RUNNING_GROUPS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Whether any process of group `pgid` is alive; reaps the leader if it is our exited child.
+fn group_alive(pgid: i32) -> bool {
+    // SAFETY: waitpid and kill take plain integers; a null status pointer is allowed.
+    unsafe {
+        libc::waitpid(pgid, std::ptr::null_mut(), libc::WNOHANG);
+        libc::kill(-pgid, 0) == 0
+    }
+}
+
+/// Sends `signal` to every group, waits up to `grace` for them to end, then kills the rest.
+fn end_groups(groups: &[i32], signal: i32, grace: Duration) {
+    for &g in groups {
+        // SAFETY: kill with a negative pid signals a process group; no memory is involved.
+        unsafe { libc::kill(-g, signal) };
+    }
+    let start = Instant::now();
+    while groups.iter().any(|&g| group_alive(g)) && start.elapsed() < grace {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    for &g in groups {
+        if group_alive(g) {
+            // SAFETY: as above.
+            unsafe { libc::kill(-g, libc::SIGKILL) };
+        }
+    }
+}
+
+/// Installs the signal forwarding of the module doc (once; later calls do nothing).
+pub fn forward_signals() -> std::io::Result<()> {
+    static INSTALLED: std::sync::OnceLock<()> = std::sync::OnceLock::new();
+    if INSTALLED.get().is_some() {
+        return Ok(());
+    }
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])?;
+    let _ = INSTALLED.set(());
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            let groups = running_groups().clone();
+            if !groups.is_empty() {
+                eprintln!(
+                    "dynrt: signal {signal}: ending {} running tool(s) and removing this run's output",
+                    groups.len()
+                );
+            }
+            end_groups(&groups, signal, SIGNAL_GRACE);
+            crate::output::abandon_all();
+            std::process::exit(128 + signal);
+        }
+    });
+    Ok(())
+}
 
 /// What a finished (not timed-out) tool run produced.
 #[derive(Debug)]
@@ -68,6 +136,8 @@ pub(crate) fn run_tool(
             }
         }
     })?;
+    let pgid = child.id() as i32;
+    running_groups().push(pgid);
     let out_reader = drain(child.stdout.take());
     let err_reader = drain(child.stderr.take());
 
@@ -77,6 +147,7 @@ pub(crate) fn run_tool(
             Ok(None) => {}
             Err(e) => {
                 kill_group(&mut child);
+                running_groups().retain(|&g| g != pgid);
                 return Err(ToolError::Io {
                     context: format!("waiting for {tool} ({stage})"),
                     source: e,
@@ -95,6 +166,7 @@ pub(crate) fn run_tool(
         };
         std::thread::sleep(pause);
     };
+    running_groups().retain(|&g| g != pgid);
     let seconds = start.elapsed().as_secs_f64();
     // The whole group is dead or done by now, so the pipes close at once; a grandchild that
     // left the group (setsid) could hold them open forever, hence the bounded wait.
@@ -158,13 +230,8 @@ fn join(reader: Option<Reader>, grace: Duration) -> String {
 
 /// Kills the child's whole process group (the child is its leader), then reaps the child.
 fn kill_group(child: &mut Child) {
-    let pgid = child.id();
-    // std has no killpg; /bin/kill with a negative id signals the group.
-    let _ = Command::new("kill")
-        .args(["-KILL", "--", &format!("-{pgid}")])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status();
+    // SAFETY: kill with a negative pid signals the child's group; no memory is involved.
+    unsafe { libc::kill(-(child.id() as i32), libc::SIGKILL) };
     let _ = child.kill();
     let _ = child.wait();
 }

@@ -1,4 +1,4 @@
-//! Hex vector files of the `dynrt fp` CLI contract (DESIGN.md section 3).
+//! Hex vector files of the `dynrt fp` CLI contract (docs/ARCHITECTURE.md, "Vector files").
 //!
 //! Input: one vector a line, two hex words `a b` separated by whitespace, each fitting the
 //! format's width in bits (leading zeros allowed, no `0x`, either case). Blank lines are
@@ -13,12 +13,14 @@ use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
 pub enum VectorFileError {
+    /// Not a `#[source]`: the message says it, and an error chain would say it twice.
     #[error("{}: {source}", .path.display())]
     Io {
         path: PathBuf,
-        #[source]
         source: std::io::Error,
     },
+    #[error(transparent)]
+    Input(#[from] crate::input::InputError),
     #[error("{}:{line}: {problem}", .path.display())]
     Line {
         path: PathBuf,
@@ -49,10 +51,8 @@ pub fn read_vector_file(path: &Path, width_bits: u32) -> Result<Vec<(u32, u32)>,
     if width_bits == 0 || width_bits > 32 {
         return Err(VectorFileError::BadWidth(width_bits));
     }
-    let text = std::fs::read_to_string(path).map_err(|source| VectorFileError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = crate::input::read_text(path, "vector file", crate::input::MAX_TABLE_BYTES)?;
+    let text = crate::input::normalize_line_endings(&text);
     parse_vectors(&text, width_bits).map_err(|(line, problem)| VectorFileError::Line {
         path: path.to_path_buf(),
         line,
@@ -66,10 +66,8 @@ pub fn read_word_file(path: &Path, width_bits: u32) -> Result<Vec<u32>, VectorFi
     if width_bits == 0 || width_bits > 32 {
         return Err(VectorFileError::BadWidth(width_bits));
     }
-    let text = std::fs::read_to_string(path).map_err(|source| VectorFileError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = crate::input::read_text(path, "vector file", crate::input::MAX_TABLE_BYTES)?;
+    let text = crate::input::normalize_line_endings(&text);
     let mut words = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let fields: Vec<&str> = line.split_whitespace().collect();

@@ -301,6 +301,14 @@ pub fn closed_public_meshes(dir: &Path) -> Result<Vec<(String, geometry::Tris)>>
 
 /// Runs the whole suite; `log` gets a line per case as it starts.
 pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<StressReport> {
+    // NaN or infinite margins make every comparison of the unit-triangle test false, so every
+    // ray misses and a case that counts leaks would report none.
+    for m in &config.edge_margins {
+        anyhow::ensure!(
+            m.is_finite() && (0.0..=65536.0).contains(m),
+            "edge margin {m}: a margin is a number of ulps in 0..=65536 (e.g. 0 or 64)"
+        );
+    }
     let dir = tempfile::tempdir().context("creating a temporary directory for stress scenes")?;
     let dir = dir.path();
     let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
