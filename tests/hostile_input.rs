@@ -101,7 +101,7 @@ fn corpus() -> Vec<Case> {
         case("instance scale overflows the format", &[("s.toml", &scaled)], "render $D/s.toml --out $D/o.png", USAGE, &["instance 'box#0'", "overflows", "e7m16"]),
         case("stress margin nan", &[], "stress --margins nan --out $D/s.csv", USAGE, &["--margins NaN", "0..=65536"]),
         case("stress margin inf", &[], "stress --margins inf --out $D/s.csv", USAGE, &["--margins inf"]),
-        case("stress margin negative", &[], "stress --margins -1e9 --out $D/s.csv", USAGE, &["--margins -1000000000"]),
+        case("stress margin negative", &[], "stress --margins=-1e9 --out $D/s.csv", USAGE, &["--margins -1000000000"]),
         case("hits with a duplicate pixel", &[("a.png", ""), ("h.csv", "x,y,instance,triangle,dist\n0,0,-1,-1,inf\n0,0,-1,-1,inf\n")], "compare $D/a.png $D/a.png --hits $D/h.csv $D/h.csv", USAGE, &["h.csv: line 3", "appears twice"]),
         case("hits with a nan distance", &[("a.png", ""), ("h.csv", "x,y,instance,triangle,dist\n0,0,0,1,nan\n")], "compare $D/a.png $D/a.png --hits $D/h.csv $D/h.csv", USAGE, &["h.csv: line 2", "finite distance"]),
         // Runaway output.

@@ -27,8 +27,13 @@ pub fn load_obj_triangles(path: &Path) -> anyhow::Result<Vec<[DVec3; 3]>> {
         ignore_lines: true,
         ..Default::default()
     };
-    let (models, _materials) = tobj::load_obj(path, &opts)
-        .with_context(|| format!("cannot read OBJ mesh {}", path.display()))?;
+    // Through the bounded reader: a FIFO or a device named `x.obj` in a mesh folder is refused,
+    // not read forever; materials are not needed here.
+    let text = crate::input::read_text(path, "mesh", crate::input::MAX_MESH_BYTES)?;
+    let text = crate::input::normalize_line_endings(&text);
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| Ok(Default::default()))
+            .with_context(|| format!("cannot read OBJ mesh {}", path.display()))?;
     let mut tris = Vec::new();
     for m in &models {
         let pos = &m.mesh.positions;

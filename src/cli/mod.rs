@@ -69,6 +69,7 @@ pub fn run() -> i32 {
     match result {
         Ok(code) => code,
         Err(e) => {
+            dynrt::sim::process::wait_if_interrupted();
             eprintln!("error: {e:#}");
             exit_code_of(&e)
         }

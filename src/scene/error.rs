@@ -39,8 +39,6 @@ impl fmt::Display for SceneError {
 /// What is wrong, with the fix in the message.
 #[derive(Debug, Error)]
 pub enum Problem {
-    #[error("cannot read the file: {0}; check the path and permissions")]
-    Unreadable(#[from] std::io::Error),
     /// A file that is not a regular file, too large, or not text (the message names it).
     #[error("{0}")]
     Input(crate::input::InputError),
@@ -54,8 +52,6 @@ pub enum Problem {
         "an object needs exactly one of `mesh = \"file.obj\"` or `generate = {{ kind = ... }}`"
     )]
     ObjectSource,
-    #[error("mesh file '{path}' cannot be read: {reason}; check the path (it is relative to the scene file)")]
-    MeshUnreadable { path: PathBuf, reason: String },
     #[error("the scene has no [[objects]]; add at least one object, e.g. `[[objects]]` with `name = \"box\"` and `generate = {{ kind = \"box\" }}`")]
     NoObjects,
     #[error("broken OBJ: {0}; fix or re-export the mesh")]

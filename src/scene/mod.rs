@@ -563,7 +563,7 @@ impl Builder<'_> {
                     let path = self.base_dir.join(mesh.get_ref());
                     let (mut raw, warnings) = mesh::load_obj(&path, &item).map_err(|mut e| {
                         // A missing mesh is the scene's fault: point at the `mesh =` line.
-                        if matches!(e.problem, Problem::MeshUnreadable { .. } | Problem::Input(_)) {
+                        if matches!(e.problem, Problem::Input(_)) && e.file == path {
                             e.file = self.ctx.file.clone();
                             e.line = Some(self.ctx.line_of(mesh.span().start));
                         }

@@ -544,7 +544,7 @@ fn error_missing_mesh() {
     let dir = tempfile::tempdir().unwrap();
     let body = "[[objects]]\nname = \"bunny\"\nmesh = \"no_such.obj\"\n";
     let (e, s) = fail_in(dir.path(), body);
-    assert!(matches!(e.problem, Problem::MeshUnreadable { .. }));
+    assert!(matches!(e.problem, Problem::Input(_)), "{e}");
     assert_eq!(e.line, Some(line_of(body, "mesh =")));
     assert!(
         s.contains("object 'bunny'") && s.contains("no_such.obj"),
@@ -552,8 +552,8 @@ fn error_missing_mesh() {
     );
     // A missing scene file.
     let e = Scene::load(&dir.path().join("missing.toml")).unwrap_err();
-    assert!(matches!(e.problem, Problem::Unreadable(_)));
-    assert!(e.to_string().contains("missing.toml"));
+    assert!(matches!(e.problem, Problem::Input(_)), "{e}");
+    assert!(e.to_string().contains("missing.toml") && e.to_string().contains("does not exist"));
 }
 
 #[test]
@@ -565,8 +565,8 @@ fn error_missing_mtl() {
     )
     .unwrap();
     let (e, s) = fail_in(dir.path(), "[[objects]]\nname = \"m\"\nmesh = \"m.obj\"\n");
-    assert!(matches!(e.problem, Problem::BrokenMtl(_)));
-    assert!(s.contains("gone.mtl") && s.contains("object 'm'"), "{s}");
+    assert!(matches!(e.problem, Problem::Input(_)), "{s}");
+    assert!(s.contains("gone.mtl") && s.contains("does not exist") && s.contains("object 'm'"), "{s}");
 }
 
 #[test]
@@ -576,7 +576,13 @@ fn error_broken_obj_names_the_line() {
         ("v 0 0 0\nv 1 0 zero\nv 0 1 0\nf 1 2 3\n", 2, "not a number"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", 4, "out of range"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", 4, "at least 3"),
-        ("v 0 0\n", 1, "three coordinates"),
+        ("v 0 0\n", 1, "has 2 numbers"),
+        ("v 0 0 0 1 junk\n", 1, "'junk' is not a number"),
+        ("\u{feff}v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 4\r", 4, "out of range"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//2 2//1 3//1\n", 5, "normal index 2 is out of range"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/1\n", 4, "texture coordinate index 1 is out of range"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n", 4, "has 4 parts"),
+        ("v 0 0 0 0\n", 1, "w = 0"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -4 -2 -1\n", 4, "out of range"),
     ];
     for (obj, line, what) in cases {

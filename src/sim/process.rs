@@ -59,6 +59,18 @@ fn end_groups(groups: &[i32], signal: i32, grace: Duration) {
     }
 }
 
+/// Set when a signal is being handled: from then on the signal thread alone ends the process.
+static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Blocks for good when a signal is being handled, so that the thread that saw its tool die
+/// does not report the death as the tool's failure, clean up while the tool's group is still
+/// ending, or exit first; the signal thread exits the process.
+pub fn wait_if_interrupted() {
+    while INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst) {
+        std::thread::sleep(Duration::from_secs(1));
+    }
+}
+
 /// Installs the signal forwarding of the module doc (once; later calls do nothing).
 pub fn forward_signals() -> std::io::Result<()> {
     static INSTALLED: std::sync::OnceLock<()> = std::sync::OnceLock::new();
@@ -70,6 +82,7 @@ pub fn forward_signals() -> std::io::Result<()> {
     let _ = INSTALLED.set(());
     std::thread::spawn(move || {
         if let Some(signal) = signals.forever().next() {
+            INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst);
             let groups = running_groups().clone();
             if !groups.is_empty() {
                 eprintln!(
@@ -146,6 +159,8 @@ pub(crate) fn run_tool(
             Ok(Some(status)) => break Some(status),
             Ok(None) => {}
             Err(e) => {
+                // The signal thread may have reaped the child already.
+                wait_if_interrupted();
                 kill_group(&mut child);
                 running_groups().retain(|&g| g != pgid);
                 return Err(ToolError::Io {
@@ -167,6 +182,7 @@ pub(crate) fn run_tool(
         std::thread::sleep(pause);
     };
     running_groups().retain(|&g| g != pgid);
+    wait_if_interrupted();
     let seconds = start.elapsed().as_secs_f64();
     // The whole group is dead or done by now, so the pipes close at once; a grandchild that
     // left the group (setsid) could hold them open forever, hence the bounded wait.
