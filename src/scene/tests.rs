@@ -880,7 +880,7 @@ mod fuzz {
             Ok(Ok(_)) => Ok(()),
             Ok(Err(e)) => {
                 let text = e.to_string();
-                if text.is_empty() || !text.contains(".toml") && !text.contains(".obj") && !text.contains(".mtl") {
+                if e.file.as_os_str().is_empty() || !text.starts_with(&e.file.display().to_string()) {
                     Err(format!("error names no file: {text}"))
                 } else {
                     Ok(())

@@ -118,6 +118,7 @@ pub(crate) fn environment_problem(output: &str) -> Option<String> {
     for tool in ["g++", "c++", "clang++", "make", "gmake", "ccache", "python3", "perl"] {
         let missing = lower.lines().any(|l| {
             let names_it = l.contains(&format!("{tool}: not found"))
+                || l.contains(&format!("{tool}: no such file or directory"))
                 || l.contains(&format!("{tool}: command not found"))
                 || (l.contains(&format!("'{tool}'")) || l.contains(&format!("\"{tool}\"")) || l.contains(&format!("`{tool}'")))
                     && (l.contains("no such file") || l.contains("not found"));
