@@ -42,6 +42,7 @@ use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
 use super::ray_store::{zero_counters, RayStore};
 use super::Delay;
 use crate::fp::Format;
+use crate::layout;
 
 /// Entries of each thread's kd stack (the deepest object tree the unit walks).
 pub const STACK_LEVELS: usize = 64;
@@ -56,6 +57,14 @@ type Entry = Bits<70>;
 type Job = Bits<102>;
 /// Decision control: `{valid[37], thread[36:32], sp[31:26], left[25:0]}`.
 type Control = Bits<38>;
+
+/// The node fetch: idle, or requesting word 0 or word 1 of a node (two words a node).
+#[derive(Copy, Clone, Debug, PartialEq, LogicState)]
+pub enum Fetch {
+    Idle,
+    Word0,
+    Word1,
+}
 
 #[derive(LogicBlock)]
 pub struct TraversalUnit<
@@ -187,8 +196,8 @@ pub struct TraversalUnit<
     front_end: Signal<Local, Bit>,
     front_job: Signal<Local, Job>,
 
-    // Fetch: `phase` 0 idle, 1 request word 0, 2 request word 1 of `fetch_job`; `job` is at A.
-    phase: DFF<Bits<2>>,
+    // Fetch: `phase` requests the words of `fetch_job`; `job` is at A.
+    phase: DFF<Fetch>,
     fetch_job: DFF<Job>,
     fetch_free: Signal<Local, Bit>,
     next_a_thread: Signal<Local, Bits<5>>,
@@ -236,6 +245,8 @@ pub struct TraversalUnit<
     c_index: [Constant<Bits<4>>; 6],
     c_zero: Constant<Bits<W>>,
     c_finished: Constant<Bits<32>>,
+    c_bank_nodes: Constant<Bits<3>>,
+    c_leaf_tag: Constant<Bits<2>>,
 }
 
 impl<
@@ -393,6 +404,8 @@ impl<
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_zero: const_bits::<W>(u64::from(f.zero(false))),
             c_finished: Constant::new((1u64 << 31).into()),
+            c_bank_nodes: Constant::new((layout::NODES as u64).into()),
+            c_leaf_tag: Constant::new(u64::from(layout::LEAF_TAG).into()),
         }
     }
 }
@@ -599,24 +612,25 @@ impl<
         self.front_fifo.read.next = false;
         self.in_flight.read.next = false;
         self.take.next =
-            (self.phase.q.val() != 0) & (!(self.engine_read.val() & (self.engine_bank.val() == 0)));
+            (self.phase.q.val() != Fetch::Idle)
+            & (!(self.engine_read.val() & (self.engine_bank.val() == self.c_bank_nodes.val())));
         self.node_read.next =
-            self.take.val() | (self.engine_read.val() & (self.engine_bank.val() == 0));
+            self.take.val() | (self.engine_read.val() & (self.engine_bank.val() == self.c_bank_nodes.val()));
         self.node_addr.next = self.engine_addr.val();
         if self.take.val() {
             self.node_addr.next = (bit_cast::<24, 26>(self.fetch_job.q.val().get_bits::<26>(64))
                 << 1)
-                | bit_cast::<24, 2>(self.phase.q.val() - 1);
-            self.phase.d.next = 2.into();
-            if self.phase.q.val() == 2 {
-                self.phase.d.next = 0.into();
+                | bit_cast::<24, 1>((self.phase.q.val() == Fetch::Word1).into());
+            self.phase.d.next = Fetch::Word1;
+            if self.phase.q.val() == Fetch::Word1 {
+                self.phase.d.next = Fetch::Idle;
             }
         }
-        self.in_flight.write.next = self.take.val() & (self.phase.q.val() == 1);
+        self.in_flight.write.next = self.take.val() & (self.phase.q.val() == Fetch::Word0);
         self.in_flight.data_in.next = self.fetch_job.q.val();
         self.words_in.d.next = 0.into();
         self.node_line[0].d.next = (bit_cast::<2, 1>(self.take.val().into()) << 1)
-            | bit_cast::<2, 1>((self.phase.q.val() == 2).into());
+            | bit_cast::<2, 1>((self.phase.q.val() == Fetch::Word1).into());
         for k in 1..6 {
             self.node_line[k].d.next = self.node_line[k - 1].q.val();
         }
@@ -640,18 +654,18 @@ impl<
         }
         // The next job: a fetch, or a finishing job straight to A when nothing is in flight.
         self.fetch_free.next =
-            (self.phase.q.val() == 0) | ((self.phase.q.val() == 2) & self.take.val());
+            (self.phase.q.val() == Fetch::Idle) | ((self.phase.q.val() == Fetch::Word1) & self.take.val());
         if self.fetch_free.val() {
             if !self.loop_fifo.empty.val() {
                 self.loop_fifo.read.next = true;
                 self.fetch_job.d.next = self.loop_fifo.data_out.val();
-                self.phase.d.next = 1.into();
+                self.phase.d.next = Fetch::Word0;
             } else if !self.front_fifo.empty.val() {
                 if !self.front_fifo.data_out.val().get_bit(101) {
                     self.front_fifo.read.next = true;
                     self.fetch_job.d.next = self.front_fifo.data_out.val();
-                    self.phase.d.next = 1.into();
-                } else if (self.phase.q.val() == 0) & self.in_flight.empty.val() {
+                    self.phase.d.next = Fetch::Word0;
+                } else if (self.phase.q.val() == Fetch::Idle) & self.in_flight.empty.val() {
                     self.front_fifo.read.next = true;
                     self.job.d.next = self.front_fifo.data_out.val();
                     self.next_a_thread.next = self.front_fifo.data_out.val().get_bits::<5>(96);
@@ -665,7 +679,7 @@ impl<
 
         // A: both words are here (or the walk ended).
         self.at_a.next = self.words_in.q.val() == 1;
-        self.a_leaf.next = self.job.q.val().get_bit(101) | (self.w0.q.val().get_bits::<2>(30) == 3);
+        self.a_leaf.next = self.job.q.val().get_bit(101) | (self.w0.q.val().get_bits::<2>(30) == self.c_leaf_tag.val());
         self.a_axis.next = self.w0.q.val().get_bits::<2>(30);
         self.a_o.next = self.ray.o[0].val();
         self.a_d.next = self.ray.d[0].val();
