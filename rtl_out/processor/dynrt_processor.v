@@ -142,6 +142,15 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     localparam  bank_lists = 3'b1;
     localparam  bank_uv = 3'b10;
     localparam  bank_t = 3'b11;
+    localparam  f_op = 5'b11010;
+    localparam  f_dst = 5'b10010;
+    localparam  f_a = 5'b1010;
+    localparam  f_b = 5'b10;
+    localparam  f_b_imm = 5'b1;
+    localparam  f_invert = 5'b0;
+    localparam  f_shift = 5'b1111;
+    localparam  f_bank = 5'b1100;
+    localparam  f_target = 5'b0;
     
     // Enums
     localparam FastKind__Computed = 0;
@@ -1763,8 +1772,8 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         v2__d = v1__q & (entry_fresh | (~pc_ram__read_data[32'hc]));
         t2__d = t1__q;
         pc2__d = pc1_eff;
-        regs_a__read_address = (((t2__q) & 13'h1fff) << 32'h8) | ((rom_ctl__read_data[(32'ha)+:(8)]) & 13'h1fff);
-        regs_b__read_address = (((t2__q) & 13'h1fff) << 32'h8) | ((rom_ctl__read_data[(32'h2)+:(8)]) & 13'h1fff);
+        regs_a__read_address = (((t2__q) & 13'h1fff) << 32'h8) | ((rom_ctl__read_data[(f_a)+:(8)]) & 13'h1fff);
+        regs_b__read_address = (((t2__q) & 13'h1fff) << 32'h8) | ((rom_ctl__read_data[(f_b)+:(8)]) & 13'h1fff);
         mailbox_meta__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
         mailbox__0__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
         mailbox__1__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
@@ -1782,17 +1791,17 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         ctl3__d = rom_ctl__read_data;
         imm3__d = rom_imm__read_data;
         aux3__d = rom_aux__read_data;
-        op3 = ctl3__q[(32'h1a)+:(5)];
-        if (ctl3__q[(32'ha)+:(8)] == 32'h0) begin
+        op3 = ctl3__q[(f_op)+:(5)];
+        if (ctl3__q[(f_a)+:(8)] == 32'h0) begin
             opa = 32'h0;
         end
         else begin
             opa = regs_a__read_data;
         end
-        if (ctl3__q[32'h1]) begin
+        if (ctl3__q[f_b_imm]) begin
             opb = imm3__q;
         end
-        else if (ctl3__q[(32'h2)+:(8)] == 32'h0) begin
+        else if (ctl3__q[(f_b)+:(8)] == 32'h0) begin
             opb = 32'h0;
         end
         else begin
@@ -1825,7 +1834,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         cmp_delay__data_in = (((cmp__lt) & 3'h7) << 32'h2) | (((cmp__le) & 3'h7) << 32'h1) | ((cmp__eq) & 3'h7);
         int_eq = opa == opb;
         int_lt = opa < opb;
-        shifted = opa << aux3__q[(32'hf)+:(3)];
+        shifted = opa << aux3__q[(f_shift)+:(3)];
         mem_address = shifted + imm3__q;
         scratch_address = opa + imm3__q;
         mb_len = mailbox_meta__read_data[(32'h0)+:(4)];
@@ -1933,7 +1942,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         scratch__write_data = regs_b__read_data;
         scratch__write_enable = v3__q & (op3 == op_sts);
         mem_read_r__d = v3__q & (op3 == op_ld);
-        mem_bank_r__d = aux3__q[(32'hc)+:(3)];
+        mem_bank_r__d = aux3__q[(f_bank)+:(3)];
         mem_addr_r__d = mem_address[(32'h0)+:(24)];
         fb_write_r__d = v3__q & (op3 == op_st);
         fb_addr_r__d = mem_address[(32'h0)+:(24)];
@@ -2039,13 +2048,13 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         end
         if (op3 == op_ld) begin
             fast_kind = FastKind__Memory;
-            if (aux3__q[(32'hc)+:(3)] == bank_uv) begin
+            if (aux3__q[(f_bank)+:(3)] == bank_uv) begin
                 fast_kind = FastKind__TrianglesUv;
             end
-            if (aux3__q[(32'hc)+:(3)] == bank_t) begin
+            if (aux3__q[(f_bank)+:(3)] == bank_t) begin
                 fast_kind = FastKind__TrianglesT;
             end
-            if (aux3__q[(32'hc)+:(3)] == bank_nodes) begin
+            if (aux3__q[(f_bank)+:(3)] == bank_nodes) begin
                 fast_kind = FastKind__Nodes;
             end
         end
@@ -2085,8 +2094,8 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         end
         fast_line__0__d = fast;
         fast_kind_line__0__d = fast_kind;
-        ctl_line__0__d = (((v3__q) & 21'h1fffff) << 32'h14) | (((op3) & 21'h1fffff) << 32'hf) | (((ctl3__q[(32'h12)+:(8)]) & 21'h1fffff) << 32'h7) | (((t3__q) & 21'h1fffff) << 32'h2) | ((ctl3__q[(32'h0)+:(1)]) & 21'h1fffff);
-        pc_line__0__d = (((pc3__q + 32'h1) & 24'hffffff) << 32'hc) | ((aux3__q[(32'h0)+:(12)]) & 24'hffffff);
+        ctl_line__0__d = (((v3__q) & 21'h1fffff) << 32'h14) | (((op3) & 21'h1fffff) << 32'hf) | (((ctl3__q[(f_dst)+:(8)]) & 21'h1fffff) << 32'h7) | (((t3__q) & 21'h1fffff) << 32'h2) | ((ctl3__q[(f_invert)+:(1)]) & 21'h1fffff);
+        pc_line__0__d = (((pc3__q + 32'h1) & 24'hffffff) << 32'hc) | ((aux3__q[(f_target)+:(12)]) & 24'hffffff);
         cond_line__0__d = (((wait_fn) & 19'h7ffff) << 32'h12) | (((kd_cond) & 19'h7ffff) << 32'h11) | (((tri_cond) & 19'h7ffff) << 32'h10) | (((opa[(32'h0)+:(12)]) & 19'h7ffff) << 32'h4) | (((int_eq) & 19'h7ffff) << 32'h3) | (((int_lt) & 19'h7ffff) << 32'h2) | (((mb_hit) & 19'h7ffff) << 32'h1) | ((pix_done) & 19'h7ffff);
         fast_line__1__d = fast_line__0__q;
         fast_kind_line__1__d = fast_kind_line__0__q;

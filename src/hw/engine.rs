@@ -53,7 +53,7 @@ use rust_hdl::prelude::*;
 
 use super::fp::{FpAddSub, FpCompare, FpDiv, FpMul, FpSqrt};
 use super::list_unit;
-use super::program::isa::{Instr, KdFn, Op, TriFn, OPS};
+use super::program::isa::{self, KdFn, Op, TriFn, OPS};
 use crate::layout;
 use super::program::Program;
 use super::{ChannelByte, Delay, TraversalUnit, TriangleTester, UIntToFloat, CHANNEL_BYTE_LATENCY};
@@ -341,6 +341,16 @@ pub struct ThreadEngine<
     bank_lists: Constant<Bits<3>>,
     bank_uv: Constant<Bits<3>>,
     bank_t: Constant<Bits<3>>,
+    /// The lowest bit of each field of the ROM words (`isa::CTL_*`, `isa::AUX_*`).
+    f_op: Constant<Bits<5>>,
+    f_dst: Constant<Bits<5>>,
+    f_a: Constant<Bits<5>>,
+    f_b: Constant<Bits<5>>,
+    f_b_imm: Constant<Bits<5>>,
+    f_invert: Constant<Bits<5>>,
+    f_shift: Constant<Bits<5>>,
+    f_bank: Constant<Bits<5>>,
+    f_target: Constant<Bits<5>>,
 }
 
 /// Where an instruction's result comes from on the fast line: computed at I3, or the data of
@@ -375,6 +385,10 @@ fn cmd(c: u64) -> Constant<Bits<2>> {
     Constant::new(c.into())
 }
 
+fn field(at: usize) -> Constant<Bits<5>> {
+    Constant::new((at as u64).into())
+}
+
 fn word_map<const N: usize, D: Synth>(
     words: impl Iterator<Item = D>,
 ) -> std::collections::BTreeMap<Bits<N>, D> {
@@ -382,19 +396,6 @@ fn word_map<const N: usize, D: Synth>(
         .enumerate()
         .map(|(i, w)| (Bits::<N>::from(i as u64), w))
         .collect()
-}
-
-/// The three ROM words of an instruction: control `{op, dst, a, b, b_imm, invert}`, the
-/// immediate, and `{shift, bank, target}`.
-pub fn rom_words(i: &Instr) -> [u32; 3] {
-    let ctl = ((i.op as u32) << 26)
-        | (u32::from(i.dst) << 18)
-        | (u32::from(i.a) << 10)
-        | (u32::from(i.b) << 2)
-        | (u32::from(i.b_imm) << 1)
-        | u32::from(i.invert);
-    let aux = (u32::from(i.shift) << 15) | (u32::from(i.bank) << 12) | u32::from(i.target);
-    [ctl, i.imm, aux]
 }
 
 impl<
@@ -430,12 +431,10 @@ impl<
             TriFn::RayOxy as u32 == 0 && TriFn::RayOzDx as u32 == 1 && TriFn::RayDyz as u32 == 2
         );
         assert!(TriFn::Init as u32 == 3);
+        let words = program.rom();
         let rom = |k: usize| -> RAM<Bits<32>, 12> {
             RAM::new(word_map(
-                program
-                    .code
-                    .iter()
-                    .map(|i| Bits::<32>::from(u64::from(rom_words(i)[k]))),
+                words.iter().map(|w| Bits::<32>::from(u64::from(w[k]))),
             ))
         };
         Self {
@@ -648,6 +647,15 @@ impl<
             bank_lists: bank(layout::LISTS),
             bank_uv: bank(layout::TRIANGLES_UV),
             bank_t: bank(layout::TRIANGLES_T),
+            f_op: field(isa::CTL_OP),
+            f_dst: field(isa::CTL_DST),
+            f_a: field(isa::CTL_A),
+            f_b: field(isa::CTL_B),
+            f_b_imm: field(isa::CTL_B_IMM),
+            f_invert: field(isa::CTL_INVERT),
+            f_shift: field(isa::AUX_SHIFT),
+            f_bank: field(isa::AUX_BANK),
+            f_target: field(isa::AUX_TARGET),
         }
     }
 }
@@ -827,9 +835,9 @@ impl<
 
         // I2: decode, read the registers and the mailbox.
         self.regs_a.read_address.next = (bit_cast::<13, 5>(self.t2.q.val()) << 8)
-            | bit_cast::<13, 8>(self.rom_ctl.read_data.val().get_bits::<8>(10));
+            | bit_cast::<13, 8>(self.rom_ctl.read_data.val().get_bits::<{ isa::REG_BITS }>(self.f_a.val().index()));
         self.regs_b.read_address.next = (bit_cast::<13, 5>(self.t2.q.val()) << 8)
-            | bit_cast::<13, 8>(self.rom_ctl.read_data.val().get_bits::<8>(2));
+            | bit_cast::<13, 8>(self.rom_ctl.read_data.val().get_bits::<{ isa::REG_BITS }>(self.f_b.val().index()));
         self.mailbox_meta.read_address.next = (bit_cast::<6, 5>(self.t2.q.val()) << 1)
             | bit_cast::<6, 1>(self.rom_imm.read_data.val().get_bits::<1>(0));
         for k in 0..8 {
@@ -846,15 +854,15 @@ impl<
         self.aux3.d.next = self.rom_aux.read_data.val();
 
         // I3: operands (r0 always reads 0).
-        self.op3.next = self.ctl3.q.val().get_bits::<5>(26);
-        if self.ctl3.q.val().get_bits::<8>(10) == 0 {
+        self.op3.next = self.ctl3.q.val().get_bits::<{ isa::OP_BITS }>(self.f_op.val().index());
+        if self.ctl3.q.val().get_bits::<{ isa::REG_BITS }>(self.f_a.val().index()) == 0 {
             self.opa.next = 0.into();
         } else {
             self.opa.next = self.regs_a.read_data.val();
         }
-        if self.ctl3.q.val().get_bit(1) {
+        if self.ctl3.q.val().get_bit(self.f_b_imm.val().index()) {
             self.opb.next = self.imm3.q.val();
-        } else if self.ctl3.q.val().get_bits::<8>(2) == 0 {
+        } else if self.ctl3.q.val().get_bits::<{ isa::REG_BITS }>(self.f_b.val().index()) == 0 {
             self.opb.next = 0.into();
         } else {
             self.opb.next = self.regs_b.read_data.val();
@@ -895,7 +903,7 @@ impl<
         // Integer conditions, addresses.
         self.int_eq.next = self.opa.val() == self.opb.val();
         self.int_lt.next = self.opa.val() < self.opb.val();
-        self.shifted.next = self.opa.val() << self.aux3.q.val().get_bits::<3>(15);
+        self.shifted.next = self.opa.val() << self.aux3.q.val().get_bits::<{ isa::SHIFT_BITS }>(self.f_shift.val().index());
         self.mem_address.next = self.shifted.val() + self.imm3.q.val();
         self.scratch_address.next = self.opa.val() + self.imm3.q.val();
 
@@ -961,7 +969,7 @@ impl<
 
         // Memory and frame-buffer ports (registered).
         self.mem_read_r.d.next = self.v3.q.val() & (self.op3.val() == self.op_ld.val());
-        self.mem_bank_r.d.next = self.aux3.q.val().get_bits::<3>(12);
+        self.mem_bank_r.d.next = self.aux3.q.val().get_bits::<{ isa::BANK_BITS }>(self.f_bank.val().index());
         self.mem_addr_r.d.next = self.mem_address.val().get_bits::<24>(0);
         self.fb_write_r.d.next = self.v3.q.val() & (self.op3.val() == self.op_st.val());
         self.fb_addr_r.d.next = self.mem_address.val().get_bits::<24>(0);
@@ -1096,13 +1104,13 @@ impl<
         }
         if self.op3.val() == self.op_ld.val() {
             self.fast_kind.next = FastKind::Memory;
-            if self.aux3.q.val().get_bits::<3>(12) == self.bank_uv.val() {
+            if self.aux3.q.val().get_bits::<{ isa::BANK_BITS }>(self.f_bank.val().index()) == self.bank_uv.val() {
                 self.fast_kind.next = FastKind::TrianglesUv;
             }
-            if self.aux3.q.val().get_bits::<3>(12) == self.bank_t.val() {
+            if self.aux3.q.val().get_bits::<{ isa::BANK_BITS }>(self.f_bank.val().index()) == self.bank_t.val() {
                 self.fast_kind.next = FastKind::TrianglesT;
             }
-            if self.aux3.q.val().get_bits::<3>(12) == self.bank_nodes.val() {
+            if self.aux3.q.val().get_bits::<{ isa::BANK_BITS }>(self.f_bank.val().index()) == self.bank_nodes.val() {
                 self.fast_kind.next = FastKind::Nodes;
             }
         }
@@ -1147,11 +1155,11 @@ impl<
         self.fast_kind_line[0].d.next = self.fast_kind.val();
         self.ctl_line[0].d.next = (bit_cast::<21, 1>(self.v3.q.val().into()) << 20)
             | (bit_cast::<21, 5>(self.op3.val()) << 15)
-            | (bit_cast::<21, 8>(self.ctl3.q.val().get_bits::<8>(18)) << 7)
+            | (bit_cast::<21, 8>(self.ctl3.q.val().get_bits::<{ isa::REG_BITS }>(self.f_dst.val().index())) << 7)
             | (bit_cast::<21, 5>(self.t3.q.val()) << 2)
-            | bit_cast::<21, 1>(self.ctl3.q.val().get_bits::<1>(0));
+            | bit_cast::<21, 1>(self.ctl3.q.val().get_bits::<1>(self.f_invert.val().index()));
         self.pc_line[0].d.next = (bit_cast::<24, 12>(self.pc3.q.val() + 1) << 12)
-            | bit_cast::<24, 12>(self.aux3.q.val().get_bits::<12>(0));
+            | bit_cast::<24, 12>(self.aux3.q.val().get_bits::<{ isa::PC_BITS }>(self.f_target.val().index()));
         self.cond_line[0].d.next = (bit_cast::<19, 1>(self.wait_fn.val().into()) << 18)
             | (bit_cast::<19, 1>(self.kd_cond.val().into()) << 17)
             | (bit_cast::<19, 1>(self.tri_cond.val().into()) << 16)

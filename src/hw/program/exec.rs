@@ -138,14 +138,22 @@ pub struct EngineFrame {
 /// The engine's twin on one frame's memory.
 pub struct Machine<'a> {
     program: &'a Program,
+    /// What the engine runs: the program's ROM words, decoded.
+    rom: Vec<Instr>,
     layout: &'a Layout,
     f: Format,
 }
 
 impl<'a> Machine<'a> {
     pub fn new(program: &'a Program, layout: &'a Layout) -> Self {
+        let rom = program
+            .rom()
+            .into_iter()
+            .map(|w| Instr::decode(w).expect("an encoded instruction decodes"))
+            .collect();
         Machine {
             program,
+            rom,
             layout,
             f: program.config.format,
         }
@@ -215,7 +223,7 @@ impl<'a> Machine<'a> {
         trace: Option<&mut Vec<Write>>,
     ) -> Result<(), ExecError> {
         let f = self.f;
-        let Some(&i) = self.program.code.get(t.pc) else {
+        let Some(&i) = self.rom.get(t.pc) else {
             return Err(self.error(k, t.pc, None, "program counter beyond the program"));
         };
         let a = t.regs[i.a as usize];
