@@ -119,7 +119,10 @@ fn engine_localparams() -> std::collections::HashMap<String, u64> {
 fn the_generated_decoder_reads_every_instruction_as_the_isa_encodes_it() {
     use dynrt::hw::program::isa::{Instr, KdFn, Op, TriFn, OPS};
     let p = engine_localparams();
-    let at = |name: &str| *p.get(name).unwrap_or_else(|| panic!("no localparam {name}")) as u32;
+    let at = |name: &str| {
+        *p.get(name)
+            .unwrap_or_else(|| panic!("no localparam {name}")) as u32
+    };
     let slice = |w: u32, field: &str, bits: u32| (w >> at(field)) & ((1 << bits) - 1);
     for op in OPS {
         let mut i = Instr::new(op);

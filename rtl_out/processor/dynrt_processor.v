@@ -120,7 +120,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     localparam  op_tri = 5'b11101;
     localparam  op_kd = 5'b11110;
     localparam  op_byte = 5'b11111;
-    localparam  op_writes = 32'he8817ffe;
+    localparam  op_writes = 32'ha8817ffe;
     localparam  tri_ray_words = 32'h3;
     localparam  tri_init = 32'h3;
     localparam  tri_list = 32'h4;
@@ -132,8 +132,6 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     localparam  tri_skip = 32'ha;
     localparam  kd_start = 32'h0;
     localparam  kd_wait = 32'h1;
-    localparam  kd_end = 32'h2;
-    localparam  kd_next = 32'h3;
     localparam  cmd_list = 2'b0;
     localparam  cmd_init = 2'b1;
     localparam  cmd_object = 2'b10;
@@ -453,12 +451,9 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     reg  [1:0] traversal_unit__ray_pair;
     reg  traversal_unit__t_min_write;
     reg  traversal_unit__enqueue;
-    reg  traversal_unit__enqueue_next;
     wire  traversal_unit__full;
     reg  [4:0] traversal_unit__query_thread;
     wire  traversal_unit__pending;
-    wire  [31:0] traversal_unit__result;
-    wire  [31:0] traversal_unit__list_end;
     reg  traversal_unit__engine_read;
     reg  [2:0] traversal_unit__engine_bank;
     reg  [23:0] traversal_unit__engine_addr;
@@ -1086,12 +1081,9 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         .ray_pair(traversal_unit__ray_pair),
         .t_min_write(traversal_unit__t_min_write),
         .enqueue(traversal_unit__enqueue),
-        .enqueue_next(traversal_unit__enqueue_next),
         .full(traversal_unit__full),
         .query_thread(traversal_unit__query_thread),
         .pending(traversal_unit__pending),
-        .result(traversal_unit__result),
-        .list_end(traversal_unit__list_end),
         .engine_read(traversal_unit__engine_read),
         .engine_bank(traversal_unit__engine_bank),
         .engine_addr(traversal_unit__engine_addr),
@@ -2010,8 +2002,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         traversal_unit__ray_pair = imm3__q[(32'h0)+:(2)];
         traversal_unit__ray_write = v3__q & (op3 == op_tri) & (imm3__q < tri_ray_words);
         traversal_unit__t_min_write = v3__q & (op3 == op_tri) & (imm3__q == tri_init);
-        traversal_unit__enqueue = v3__q & (op3 == op_kd) & ((imm3__q == kd_start) | (imm3__q == kd_next));
-        traversal_unit__enqueue_next = imm3__q == kd_next;
+        traversal_unit__enqueue = v3__q & (op3 == op_kd) & (imm3__q == kd_start);
         kd_cond = traversal_unit__full;
         if (imm3__q == kd_wait) begin
             kd_cond = traversal_unit__pending;
@@ -2082,14 +2073,6 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
             end
             if (imm3__q == tri_triangle) begin
                 fast = tester__best_triangle;
-            end
-        end
-        if (op3 == op_kd) begin
-            if (imm3__q == kd_wait) begin
-                fast = traversal_unit__result;
-            end
-            if (imm3__q == kd_end) begin
-                fast = traversal_unit__list_end;
             end
         end
         fast_line__0__d = fast;
@@ -20616,7 +20599,7 @@ endmodule // dynrt_processor_core__tester__transform_unit__tag_delay
 
 
 
-module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write,ray_pair,t_min_write,enqueue,enqueue_next,full,query_thread,pending,result,list_end,engine_read,engine_bank,engine_addr,node_read,node_addr,node_rdata,step_busy,done_event,done_thread,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit);
+module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write,ray_pair,t_min_write,enqueue,full,query_thread,pending,engine_read,engine_bank,engine_addr,node_read,node_addr,node_rdata,step_busy,done_event,done_thread,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit);
     
     // Module arguments
     input wire  clock;
@@ -20627,12 +20610,9 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
     input wire  [1:0] ray_pair;
     input wire  t_min_write;
     input wire  enqueue;
-    input wire  enqueue_next;
     output reg  full;
     input wire  [4:0] query_thread;
     output reg  pending;
-    output reg  [31:0] result;
-    output reg  [31:0] list_end;
     input wire  engine_read;
     input wire  [2:0] engine_bank;
     input wire  [23:0] engine_addr;
@@ -20661,7 +20641,6 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
     localparam  c_index__4 = 4'h4;
     localparam  c_index__5 = 4'h5;
     localparam  c_zero = 24'h0;
-    localparam  c_finished = 32'h80000000;
     localparam  c_bank_nodes = 3'b0;
     localparam  c_leaf_tag = 2'b11;
     
@@ -20759,20 +20738,6 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
     reg  done_u__write_clock;
     reg  [7:0] done_u__write_data;
     reg  done_u__write_enable;
-    reg  [4:0] result_e__read_address;
-    reg  result_e__read_clock;
-    wire  [31:0] result_e__read_data;
-    reg  [4:0] result_e__write_address;
-    reg  result_e__write_clock;
-    reg  [31:0] result_e__write_data;
-    reg  result_e__write_enable;
-    reg  [4:0] end_e__read_address;
-    reg  end_e__read_clock;
-    wire  [31:0] end_e__read_data;
-    reg  [4:0] end_e__write_address;
-    reg  end_e__write_clock;
-    reg  [31:0] end_e__write_data;
-    reg  end_e__write_enable;
     reg  [4:0] leaf_hi__read_address;
     reg  leaf_hi__read_clock;
     wire  [23:0] leaf_hi__read_data;
@@ -21220,24 +21185,6 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_clock(done_u__write_clock),
         .write_data(done_u__write_data),
         .write_enable(done_u__write_enable)
-    );
-    dynrt_processor_core__tester__flight_a result_e(
-        .read_address(result_e__read_address),
-        .read_clock(result_e__read_clock),
-        .read_data(result_e__read_data),
-        .write_address(result_e__write_address),
-        .write_clock(result_e__write_clock),
-        .write_data(result_e__write_data),
-        .write_enable(result_e__write_enable)
-    );
-    dynrt_processor_core__tester__flight_a end_e(
-        .read_address(end_e__read_address),
-        .read_clock(end_e__read_clock),
-        .read_data(end_e__read_data),
-        .write_address(end_e__write_address),
-        .write_clock(end_e__write_clock),
-        .write_data(end_e__write_data),
-        .write_enable(end_e__write_enable)
     );
     dynrt_processor_core__tester__flight_t_min leaf_hi(
         .read_address(leaf_hi__read_address),
@@ -21829,10 +21776,6 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         done_e__write_clock = clock;
         done_u__read_clock = clock;
         done_u__write_clock = clock;
-        result_e__read_clock = clock;
-        result_e__write_clock = clock;
-        end_e__read_clock = clock;
-        end_e__write_clock = clock;
         leaf_hi__read_clock = clock;
         leaf_hi__write_clock = clock;
         leaf_sp__read_clock = clock;
@@ -21873,20 +21816,16 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         engine_full = entry_fifo__full | answer_valid;
         full = engine_full;
         entry_fifo__write = (enqueue & (~engine_full)) | answer_valid;
-        entry_fifo__data_in = (((enqueue_next) & 70'h3fffffffffffffffff) << 32'h45) | (((thread) & 70'h3fffffffffffffffff) << 32'h40) | (((word_a) & 70'h3fffffffffffffffff) << 32'h20) | ((word_b) & 70'h3fffffffffffffffff);
+        entry_fifo__data_in = (((thread) & 70'h3fffffffffffffffff) << 32'h40) | (((word_a) & 70'h3fffffffffffffffff) << 32'h20) | ((word_b) & 70'h3fffffffffffffffff);
         if (answer_valid) begin
             entry_fifo__data_in = (((1'b1) & 70'h3fffffffffffffffff) << 32'h45) | (((answer_thread) & 70'h3fffffffffffffffff) << 32'h40) | (((answer_t) & 70'h3fffffffffffffffff) << 32'h20) | ((answer_hit) & 70'h3fffffffffffffffff);
         end
         any_hit__write_address = thread;
         any_hit__write_data = ((word_a[32'h1f]) & 1'h1);
-        any_hit__write_enable = enqueue & (~engine_full) & (~enqueue_next);
+        any_hit__write_enable = enqueue & (~engine_full);
         issued__read_address = query_thread;
         done_e__read_address = query_thread;
-        result_e__read_address = query_thread;
-        end_e__read_address = query_thread;
         pending = issued__read_data != done_e__read_data;
-        result = result_e__read_data;
-        list_end = end_e__read_data;
         issued__write_address = thread;
         issued__write_data = issued__read_data + 32'h1;
         issued__write_enable = enqueue & (~engine_full);
@@ -22049,16 +21988,9 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         leaf_from = leaf_fifo__data_out[(32'h20)+:(32)];
         leaf_to = leaf_fifo__data_out[(32'h0)+:(32)];
         leaf_fifo__read = leaf_take;
-        result_e__write_address = job__q[(32'h60)+:(5)];
-        end_e__write_address = job__q[(32'h60)+:(5)];
         done_e__write_address = job__q[(32'h60)+:(5)];
         leaf_hi__write_address = job__q[(32'h60)+:(5)];
         leaf_sp__write_address = job__q[(32'h60)+:(5)];
-        result_e__write_data = ((w0__q[(32'h0)+:(30)]) & 32'hffffffff);
-        if (job__q[32'h65]) begin
-            result_e__write_data = c_finished;
-        end
-        end_e__write_data = a_list_end;
         leaf_hi__write_data = job__q[(32'h0)+:(24)];
         leaf_sp__write_data = job__q[(32'h5a)+:(6)];
         done_u__read_address = next_a_thread;
@@ -22066,8 +21998,6 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         done_e__write_data = done_u__read_data + 32'h1;
         done_u__write_data = done_u__read_data + 32'h1;
         done_u__write_enable = a_end;
-        result_e__write_enable = a_end;
-        end_e__write_enable = a_end;
         done_e__write_enable = a_end;
         done_event = a_end;
         done_thread = job__q[(32'h60)+:(5)];
@@ -22708,8 +22638,6 @@ module dynrt_processor_core__traversal_unit__control_delay_div(clock,data_in,dat
     end
     
 endmodule // dynrt_processor_core__traversal_unit__control_delay_div
-
-
 
 
 
@@ -24970,8 +24898,6 @@ module dynrt_processor_core__traversal_unit__phase(d,q,clock);
     end
           
 endmodule // dynrt_processor_core__traversal_unit__phase
-
-
 
 
 

@@ -53,10 +53,12 @@ use rust_hdl::prelude::*;
 
 use super::fp::{FpAddSub, FpCompare, FpDiv, FpMul, FpSqrt};
 use super::list_unit;
-use super::program::isa::{self, KdFn, Op, TriFn, OPS};
-use crate::layout;
+use super::program::isa::{
+    self, KdFn, Op, TriFn, BANK_BITS, OPS, OP_BITS, PC_BITS, REG_BITS, SHIFT_BITS,
+};
 use super::program::Program;
 use super::{ChannelByte, Delay, TraversalUnit, TriangleTester, UIntToFloat, CHANNEL_BYTE_LATENCY};
+use crate::layout;
 
 /// Most threads (the thread id is 5 bits).
 pub const MAX_THREADS: usize = 32;
@@ -331,8 +333,6 @@ pub struct ThreadEngine<
     tri_skip: Constant<Bits<32>>,
     kd_start: Constant<Bits<32>>,
     kd_wait: Constant<Bits<32>>,
-    kd_end: Constant<Bits<32>>,
-    kd_next: Constant<Bits<32>>,
     cmd_list: Constant<Bits<2>>,
     cmd_init: Constant<Bits<2>>,
     cmd_object: Constant<Bits<2>>,
@@ -637,8 +637,6 @@ impl<
             tri_skip: tri_fn(TriFn::Skip),
             kd_start: kd_fn(KdFn::Start),
             kd_wait: kd_fn(KdFn::Wait),
-            kd_end: kd_fn(KdFn::End),
-            kd_next: kd_fn(KdFn::Next),
             cmd_list: cmd(list_unit::CMD_LIST),
             cmd_init: cmd(list_unit::CMD_INIT),
             cmd_object: cmd(list_unit::CMD_OBJECT),
@@ -835,9 +833,19 @@ impl<
 
         // I2: decode, read the registers and the mailbox.
         self.regs_a.read_address.next = (bit_cast::<13, 5>(self.t2.q.val()) << 8)
-            | bit_cast::<13, 8>(self.rom_ctl.read_data.val().get_bits::<{ isa::REG_BITS }>(self.f_a.val().index()));
+            | bit_cast::<13, 8>(
+                self.rom_ctl
+                    .read_data
+                    .val()
+                    .get_bits::<REG_BITS>(self.f_a.val().index()),
+            );
         self.regs_b.read_address.next = (bit_cast::<13, 5>(self.t2.q.val()) << 8)
-            | bit_cast::<13, 8>(self.rom_ctl.read_data.val().get_bits::<{ isa::REG_BITS }>(self.f_b.val().index()));
+            | bit_cast::<13, 8>(
+                self.rom_ctl
+                    .read_data
+                    .val()
+                    .get_bits::<REG_BITS>(self.f_b.val().index()),
+            );
         self.mailbox_meta.read_address.next = (bit_cast::<6, 5>(self.t2.q.val()) << 1)
             | bit_cast::<6, 1>(self.rom_imm.read_data.val().get_bits::<1>(0));
         for k in 0..8 {
@@ -854,15 +862,31 @@ impl<
         self.aux3.d.next = self.rom_aux.read_data.val();
 
         // I3: operands (r0 always reads 0).
-        self.op3.next = self.ctl3.q.val().get_bits::<{ isa::OP_BITS }>(self.f_op.val().index());
-        if self.ctl3.q.val().get_bits::<{ isa::REG_BITS }>(self.f_a.val().index()) == 0 {
+        self.op3.next = self
+            .ctl3
+            .q
+            .val()
+            .get_bits::<OP_BITS>(self.f_op.val().index());
+        if self
+            .ctl3
+            .q
+            .val()
+            .get_bits::<REG_BITS>(self.f_a.val().index())
+            == 0
+        {
             self.opa.next = 0.into();
         } else {
             self.opa.next = self.regs_a.read_data.val();
         }
         if self.ctl3.q.val().get_bit(self.f_b_imm.val().index()) {
             self.opb.next = self.imm3.q.val();
-        } else if self.ctl3.q.val().get_bits::<{ isa::REG_BITS }>(self.f_b.val().index()) == 0 {
+        } else if self
+            .ctl3
+            .q
+            .val()
+            .get_bits::<REG_BITS>(self.f_b.val().index())
+            == 0
+        {
             self.opb.next = 0.into();
         } else {
             self.opb.next = self.regs_b.read_data.val();
@@ -889,7 +913,8 @@ impl<
         self.byte_unit.in_valid.next = true;
         // A long instruction at I3 reserves its write-back clock: no issue `DX - 3` clocks
         // from now, whose instruction would write back with it.
-        self.long3.next = self.v3.q.val() & ((self.op3.val() == self.op_fdiv.val()) | (self.op3.val() == self.op_fsqrt.val()));
+        self.long3.next = self.v3.q.val()
+            & ((self.op3.val() == self.op_fdiv.val()) | (self.op3.val() == self.op_fsqrt.val()));
         self.reserved.d.next = (self.reserved.q.val() >> 1)
             | (bit_cast::<32, 1>(self.long3.val().into()) << self.c_reserve_bit.val());
         self.add_delay.data_in.next = self.add.result.val();
@@ -903,7 +928,12 @@ impl<
         // Integer conditions, addresses.
         self.int_eq.next = self.opa.val() == self.opb.val();
         self.int_lt.next = self.opa.val() < self.opb.val();
-        self.shifted.next = self.opa.val() << self.aux3.q.val().get_bits::<{ isa::SHIFT_BITS }>(self.f_shift.val().index());
+        self.shifted.next = self.opa.val()
+            << self
+                .aux3
+                .q
+                .val()
+                .get_bits::<SHIFT_BITS>(self.f_shift.val().index());
         self.mem_address.next = self.shifted.val() + self.imm3.q.val();
         self.scratch_address.next = self.opa.val() + self.imm3.q.val();
 
@@ -949,7 +979,10 @@ impl<
 
         // Pixel counter.
         self.pix_done.next = !(self.py.q.val() < self.c_height.val());
-        if self.running.q.val() & self.v3.q.val() & (self.op3.val() == self.op_pixel.val()) & (!self.pix_done.val())
+        if self.running.q.val()
+            & self.v3.q.val()
+            & (self.op3.val() == self.op_pixel.val())
+            & (!self.pix_done.val())
         {
             if (self.px.q.val() + 1) == self.c_width.val() {
                 self.px.d.next = 0.into();
@@ -969,7 +1002,11 @@ impl<
 
         // Memory and frame-buffer ports (registered).
         self.mem_read_r.d.next = self.v3.q.val() & (self.op3.val() == self.op_ld.val());
-        self.mem_bank_r.d.next = self.aux3.q.val().get_bits::<{ isa::BANK_BITS }>(self.f_bank.val().index());
+        self.mem_bank_r.d.next = self
+            .aux3
+            .q
+            .val()
+            .get_bits::<BANK_BITS>(self.f_bank.val().index());
         self.mem_addr_r.d.next = self.mem_address.val().get_bits::<24>(0);
         self.fb_write_r.d.next = self.v3.q.val() & (self.op3.val() == self.op_st.val());
         self.fb_addr_r.d.next = self.mem_address.val().get_bits::<24>(0);
@@ -1010,15 +1047,15 @@ impl<
         self.tester.word_a.next = self.opa.val();
         self.tester.word_b.next = self.opb.val();
         self.tester.ray_pair.next = self.imm3.q.val().get_bits::<2>(0);
-        self.tester.ray_write.next =
-            self.v3.q.val() & (self.op3.val() == self.op_tri.val()) & (self.imm3.q.val() < self.tri_ray_words.val());
+        self.tester.ray_write.next = self.v3.q.val()
+            & (self.op3.val() == self.op_tri.val())
+            & (self.imm3.q.val() < self.tri_ray_words.val());
         self.tri_queues.next = (self.imm3.q.val() == self.tri_init.val())
             | (self.imm3.q.val() == self.tri_list.val())
             | (self.imm3.q.val() == self.tri_object.val())
             | (self.imm3.q.val() == self.tri_skip.val());
-        self.tester.enqueue.next = self.v3.q.val()
-            & (self.op3.val() == self.op_tri.val())
-            & self.tri_queues.val();
+        self.tester.enqueue.next =
+            self.v3.q.val() & (self.op3.val() == self.op_tri.val()) & self.tri_queues.val();
         // The kind is settled in a local signal and given to the tester in one assignment: a
         // default overridden on the tester's input itself would glitch it, the tester's
         // outputs feed back here, and Icarus would loop forever.
@@ -1056,20 +1093,22 @@ impl<
         self.traversal_unit.word_a.next = self.opa.val();
         self.traversal_unit.word_b.next = self.opb.val();
         self.traversal_unit.ray_pair.next = self.imm3.q.val().get_bits::<2>(0);
-        self.traversal_unit.ray_write.next =
-            self.v3.q.val() & (self.op3.val() == self.op_tri.val()) & (self.imm3.q.val() < self.tri_ray_words.val());
-        self.traversal_unit.t_min_write.next =
-            self.v3.q.val() & (self.op3.val() == self.op_tri.val()) & (self.imm3.q.val() == self.tri_init.val());
+        self.traversal_unit.ray_write.next = self.v3.q.val()
+            & (self.op3.val() == self.op_tri.val())
+            & (self.imm3.q.val() < self.tri_ray_words.val());
+        self.traversal_unit.t_min_write.next = self.v3.q.val()
+            & (self.op3.val() == self.op_tri.val())
+            & (self.imm3.q.val() == self.tri_init.val());
         self.traversal_unit.enqueue.next = self.v3.q.val()
             & (self.op3.val() == self.op_kd.val())
-            & ((self.imm3.q.val() == self.kd_start.val()) | (self.imm3.q.val() == self.kd_next.val()));
-        self.traversal_unit.enqueue_next.next = self.imm3.q.val() == self.kd_next.val();
+            & (self.imm3.q.val() == self.kd_start.val());
         self.kd_cond.next = self.traversal_unit.full.val();
         if self.imm3.q.val() == self.kd_wait.val() {
             self.kd_cond.next = self.traversal_unit.pending.val();
         }
         // The waits (`tri.wait`, `kd.wait`): a pending one sleeps instead of repeating.
-        self.wait_fn.next = ((self.op3.val() == self.op_tri.val()) & (self.imm3.q.val() == self.tri_wait.val()))
+        self.wait_fn.next = ((self.op3.val() == self.op_tri.val())
+            & (self.imm3.q.val() == self.tri_wait.val()))
             | ((self.op3.val() == self.op_kd.val()) & (self.imm3.q.val() == self.kd_wait.val()));
         self.fb_write.next = self.fb_write_r.q.val();
         self.fb_addr.next = self.fb_addr_r.q.val();
@@ -1104,13 +1143,31 @@ impl<
         }
         if self.op3.val() == self.op_ld.val() {
             self.fast_kind.next = FastKind::Memory;
-            if self.aux3.q.val().get_bits::<{ isa::BANK_BITS }>(self.f_bank.val().index()) == self.bank_uv.val() {
+            if self
+                .aux3
+                .q
+                .val()
+                .get_bits::<BANK_BITS>(self.f_bank.val().index())
+                == self.bank_uv.val()
+            {
                 self.fast_kind.next = FastKind::TrianglesUv;
             }
-            if self.aux3.q.val().get_bits::<{ isa::BANK_BITS }>(self.f_bank.val().index()) == self.bank_t.val() {
+            if self
+                .aux3
+                .q
+                .val()
+                .get_bits::<BANK_BITS>(self.f_bank.val().index())
+                == self.bank_t.val()
+            {
                 self.fast_kind.next = FastKind::TrianglesT;
             }
-            if self.aux3.q.val().get_bits::<{ isa::BANK_BITS }>(self.f_bank.val().index()) == self.bank_nodes.val() {
+            if self
+                .aux3
+                .q
+                .val()
+                .get_bits::<BANK_BITS>(self.f_bank.val().index())
+                == self.bank_nodes.val()
+            {
                 self.fast_kind.next = FastKind::Nodes;
             }
         }
@@ -1141,25 +1198,27 @@ impl<
                 self.fast.next = self.tester.best_triangle.val();
             }
         }
-        if self.op3.val() == self.op_kd.val() {
-            if self.imm3.q.val() == self.kd_wait.val() {
-                self.fast.next = self.traversal_unit.result.val();
-            }
-            if self.imm3.q.val() == self.kd_end.val() {
-                self.fast.next = self.traversal_unit.list_end.val();
-            }
-        }
 
         // The fast line: scratch data at I4, memory data at I4 + latency.
         self.fast_line[0].d.next = self.fast.val();
         self.fast_kind_line[0].d.next = self.fast_kind.val();
         self.ctl_line[0].d.next = (bit_cast::<21, 1>(self.v3.q.val().into()) << 20)
             | (bit_cast::<21, 5>(self.op3.val()) << 15)
-            | (bit_cast::<21, 8>(self.ctl3.q.val().get_bits::<{ isa::REG_BITS }>(self.f_dst.val().index())) << 7)
+            | (bit_cast::<21, 8>(
+                self.ctl3
+                    .q
+                    .val()
+                    .get_bits::<REG_BITS>(self.f_dst.val().index()),
+            ) << 7)
             | (bit_cast::<21, 5>(self.t3.q.val()) << 2)
             | bit_cast::<21, 1>(self.ctl3.q.val().get_bits::<1>(self.f_invert.val().index()));
         self.pc_line[0].d.next = (bit_cast::<24, 12>(self.pc3.q.val() + 1) << 12)
-            | bit_cast::<24, 12>(self.aux3.q.val().get_bits::<{ isa::PC_BITS }>(self.f_target.val().index()));
+            | bit_cast::<24, 12>(
+                self.aux3
+                    .q
+                    .val()
+                    .get_bits::<PC_BITS>(self.f_target.val().index()),
+            );
         self.cond_line[0].d.next = (bit_cast::<19, 1>(self.wait_fn.val().into()) << 18)
             | (bit_cast::<19, 1>(self.kd_cond.val().into()) << 17)
             | (bit_cast::<19, 1>(self.tri_cond.val().into()) << 16)
@@ -1262,7 +1321,8 @@ impl<
             self.wb_next_pc.next = self.cond_delay.data_out.val().get_bits::<12>(4);
         }
         if (self.wb_op.val() == self.op_halt.val())
-            | (((self.wb_op.val() == self.op_tri.val()) | (self.wb_op.val() == self.op_kd.val())) & self.wb_cond.val())
+            | (((self.wb_op.val() == self.op_tri.val()) | (self.wb_op.val() == self.op_kd.val()))
+                & self.wb_cond.val())
         {
             // A halted thread keeps its pc; so does one whose coprocessor refused its entry
             // (queue full) or has not finished (a wait): it repeats on its next turn.
@@ -1308,7 +1368,9 @@ impl<
         // Instructions retired: every write back but a turn spent offering again to a full
         // coprocessor queue or waiting for a coprocessor (the twin never repeats those).
         if self.wb_valid.val()
-            & (!(((self.wb_op.val() == self.op_tri.val()) | (self.wb_op.val() == self.op_kd.val())) & self.wb_cond.val()))
+            & (!(((self.wb_op.val() == self.op_tri.val())
+                | (self.wb_op.val() == self.op_kd.val()))
+                & self.wb_cond.val()))
         {
             self.instr_count.d.next = self.instr_count.q.val() + 1;
         }

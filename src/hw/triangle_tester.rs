@@ -498,7 +498,8 @@ impl<
         self.ray.word_b.next = self.word_b.val();
         self.ray.ray_write.next = self.ray_write.val();
         self.ray.ray_pair.next = self.ray_pair.val();
-        self.ray.t_min_write.next = self.enqueue.val() & (self.queue_kind.val() == self.c_cmd_init.val());
+        self.ray.t_min_write.next =
+            self.enqueue.val() & (self.queue_kind.val() == self.c_cmd_init.val());
         // The engine's entries first; a walk's list in the other clocks.
         self.walk_take.next =
             self.walk_list_valid.val() & (!self.enqueue.val()) & (!self.list_unit.full.val());
@@ -551,10 +552,10 @@ impl<
         self.t_take.next = self.fetching.q.val()
             & (self.t_issued.q.val() < 4)
             & (!(self.engine_read.val() & (self.engine_bank.val() == self.c_bank_t.val())));
-        self.uv_read.next =
-            self.uv_take.val() | (self.engine_read.val() & (self.engine_bank.val() == self.c_bank_uv.val()));
-        self.t_read.next =
-            self.t_take.val() | (self.engine_read.val() & (self.engine_bank.val() == self.c_bank_t.val()));
+        self.uv_read.next = self.uv_take.val()
+            | (self.engine_read.val() & (self.engine_bank.val() == self.c_bank_uv.val()));
+        self.t_read.next = self.t_take.val()
+            | (self.engine_read.val() & (self.engine_bank.val() == self.c_bank_t.val()));
         self.uv_addr.next = self.engine_addr.val();
         self.t_addr.next = self.engine_addr.val();
         self.fetch_a.next = self.cur_a[0].q.val();
@@ -614,7 +615,9 @@ impl<
                     self.cur_a[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(32);
                     self.cur_b[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(0);
                     self.received[k].d.next = 0.into();
-                    if self.list_unit.test_entry.val().get_bits::<2>(69) != self.c_test_triangle.val() {
+                    if self.list_unit.test_entry.val().get_bits::<2>(69)
+                        != self.c_test_triangle.val()
+                    {
                         self.received[k].d.next = 12.into();
                     }
                 }
@@ -736,7 +739,8 @@ impl<
             self.lphase.d.next = Launch::Wait;
         }
         // Busy counts tests only (inits and list ends pass the units to keep their order).
-        self.transform_busy.next = self.transform_unit.in_valid.val() & (self.l_kind.val() == self.c_test_triangle.val());
+        self.transform_busy.next =
+            self.transform_unit.in_valid.val() & (self.l_kind.val() == self.c_test_triangle.val());
 
         // O' waits a clock for D'; then the unit-triangle test.
         for k in 0..3 {
@@ -791,7 +795,9 @@ impl<
         self.m3_b.d.next = self.m2_b.q.val();
         self.m3_done.d.next = self.m2_done.q.val();
         self.m3_best.d.next = self.m2_best.q.val();
-        self.merge_hit.next = self.m3_hit.q.val() & self.cmp.lt.val() & (self.m3_kind.q.val() == self.c_test_triangle.val());
+        self.merge_hit.next = self.m3_hit.q.val()
+            & self.cmp.lt.val()
+            & (self.m3_kind.q.val() == self.c_test_triangle.val());
 
         self.done_m.write_address.next = self.m3_thread.q.val();
         self.done_e.write_address.next = self.m3_thread.q.val();
@@ -803,14 +809,15 @@ impl<
         self.done_e.write_data.next = self.m3_done.q.val() + 1;
         // Inits and list ends count (the engine counted them as issued), not single tests nor
         // a walk's list ends, which answer the traversal unit with the closest hit so far.
-        self.m3_counts.next =
-            self.m3_valid.q.val() & ((self.m3_kind.q.val() == self.c_test_init.val())
+        self.m3_counts.next = self.m3_valid.q.val()
+            & ((self.m3_kind.q.val() == self.c_test_init.val())
                 | (self.m3_kind.q.val() == self.c_test_list_end.val()));
         self.done_m.write_enable.next = self.m3_counts.val();
         self.done_e.write_enable.next = self.m3_counts.val();
         self.done_event.next = self.m3_counts.val();
         self.done_thread.next = self.m3_thread.q.val();
-        self.walk_end_event.next = self.m3_valid.q.val() & (self.m3_kind.q.val() == self.c_test_walk_end.val());
+        self.walk_end_event.next =
+            self.m3_valid.q.val() & (self.m3_kind.q.val() == self.c_test_walk_end.val());
         self.walk_end_thread.next = self.m3_thread.q.val();
         self.walk_end_t.next = bit_cast::<32, W>(self.m3_best.q.val().get_bits::<W>(0));
         self.walk_end_hit.next = self.m3_best.q.val().get_bit(32);
@@ -819,8 +826,8 @@ impl<
         if self.merge_hit.val() {
             self.merge_best.next = self.c_hit_flag.val() | bit_cast::<33, W>(self.m3_t.q.val());
         }
-        self.merge_write.next =
-            self.m3_valid.q.val() & ((self.m3_kind.q.val() == self.c_test_init.val()) | self.merge_hit.val());
+        self.merge_write.next = self.m3_valid.q.val()
+            & ((self.m3_kind.q.val() == self.c_test_init.val()) | self.merge_hit.val());
         self.best_m.write_data.next = self.merge_best.val();
         self.best_e.write_data.next = self.merge_best.val();
         self.best_m.write_enable.next = self.merge_write.val();

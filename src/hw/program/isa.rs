@@ -108,8 +108,8 @@ pub enum Op {
     /// `wait` repeats while tests are in flight (neither repeat counts as retired).
     Tri,
     /// The traversal unit (`hw::TraversalUnit`), function `imm` ([`KdFn`]): walk an object's
-    /// kd tree, its leaves' triangles tested by the triangle tester. `start` and `next` repeat
-    /// while refused, `wait` while the walk is in flight.
+    /// kd tree, its leaves' triangles tested by the triangle tester. `start` repeats while
+    /// refused, `wait` while the walk is in flight. It writes no register.
     Kd,
     /// A colour channel's byte shifted in: `dst = (B << 8) | byte(A)`, where `byte` clamps `A`
     /// to [0, 1] and rounds 255 times it to an integer (`units::channel_byte`); three in a row
@@ -125,23 +125,15 @@ pub enum KdFn {
     /// with the segment `[t_min, B]` (t_min from the tester's init). The unit hands each leaf's
     /// list to the triangle tester and goes on with its closest hit, to the walk's end.
     Start = 0,
-    /// Repeat while the walk is in flight (asleep); `dst` = [`KD_FINISHED`] when it ended, or
-    /// the leaf's list address of a walk the engine answers itself (`next`).
+    /// Repeat while the walk is in flight (asleep); the closest hit is the tester's.
     Wait,
-    /// `dst` = the leaf's list end (list + count) of a walk the engine answers.
-    End,
-    /// Go on after a leaf whose closest hit so far is `A` (best t), `B` (hit, 0 or 1).
-    Next,
 }
-
-/// The `kd.wait` result of a finished walk (bit 31).
-pub const KD_FINISHED: u32 = 1 << 31;
 
 /// Bit 31 of `kd.start`'s root: the walk answers a shadow query, and ends at the first hit.
 pub const KD_ANY_HIT: u32 = 1 << 31;
 
 impl KdFn {
-    pub const ALL: [KdFn; 4] = [KdFn::Start, KdFn::Wait, KdFn::End, KdFn::Next];
+    pub const ALL: [KdFn; 2] = [KdFn::Start, KdFn::Wait];
     pub fn from_imm(imm: u32) -> Option<KdFn> {
         Self::ALL.get(imm as usize).copied()
     }
@@ -149,8 +141,6 @@ impl KdFn {
         match self {
             KdFn::Start => "start",
             KdFn::Wait => "wait",
-            KdFn::End => "end",
-            KdFn::Next => "next",
         }
     }
 }
@@ -281,7 +271,6 @@ impl Op {
                 | Jal
                 | Pixel
                 | Tri
-                | Kd
                 | Byte
         )
     }
@@ -541,7 +530,7 @@ impl fmt::Display for Instr {
             }
             Op::Kd => {
                 let name = KdFn::from_imm(self.imm).map_or("?", KdFn::name);
-                write!(f, "kd.{name} r{}, r{}, r{}", self.dst, self.a, self.b)
+                write!(f, "kd.{name} r{}, r{}", self.a, self.b)
             }
             Op::FSqrt | Op::IToF => write!(f, "{} r{}, r{}", self.op.name(), self.dst, self.a),
             _ => write!(f, "{} r{}, r{}, {}", self.op.name(), self.dst, self.a, b),
@@ -586,7 +575,11 @@ mod tests {
                     invert: rng.gen(),
                     shift: rng.gen_range(0..1 << SHIFT_BITS),
                     bank: rng.gen_range(0..1 << BANK_BITS),
-                    imm: if function == u32::MAX { rng.gen() } else { function },
+                    imm: if function == u32::MAX {
+                        rng.gen()
+                    } else {
+                        function
+                    },
                     target: rng.gen_range(0..MAX_PROGRAM as u16),
                 };
                 let w = i.encode();

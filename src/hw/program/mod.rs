@@ -154,7 +154,10 @@ impl Program {
             .zip(&self.sections)
             .enumerate()
             .map(|(pc, ((w, i), s))| {
-                format!("{pc:4}  {:08x} {:08x} {:05x}  {s:<12} {i}\n", w[0], w[1], w[2])
+                format!(
+                    "{pc:4}  {:08x} {:08x} {:05x}  {s:<12} {i}\n",
+                    w[0], w[1], w[2]
+                )
             })
             .collect()
     }
