@@ -82,3 +82,92 @@ fn checked_in_processor_of_the_default_scene_matches_the_generator() {
         );
     }
 }
+
+/// The localparams of the checked-in processor's engine module (`dynrt_processor_core`),
+/// which the test above keeps equal to the generator's.
+fn engine_localparams() -> std::collections::HashMap<String, u64> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let v = std::fs::read_to_string(root.join("rtl_out/processor/dynrt_processor.v")).unwrap();
+    let start = v.find("module dynrt_processor_core(").unwrap();
+    let end = start + v[start..].find("endmodule").unwrap();
+    v[start..end]
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("localparam"))
+        .map(|l| {
+            let (name, value) = l.split_once('=').unwrap();
+            let value = value.trim().trim_end_matches(';');
+            let (radix, digits) = match value.split_once('\'') {
+                Some((_, v)) => match &v[..1] {
+                    "b" => (2, &v[1..]),
+                    "h" => (16, &v[1..]),
+                    _ => (10, &v[1..]),
+                },
+                None => (10, value),
+            };
+            let n = u64::from_str_radix(digits, radix).unwrap_or_else(|e| panic!("{l}: {e}"));
+            (name.trim().to_string(), n)
+        })
+        .collect()
+}
+
+/// Every instruction, encoded as the ROM holds it, decodes in the generated Verilog to its
+/// own op and function: the decoder slices the fields at the localparams `f_*` and compares
+/// the opcode with `op_*`, `imm` with `tri_*` and `kd_*`, all built from `isa`. Were a
+/// decoder constant spelled out (or `Op` reordered against it), the RTL would run another
+/// instruction than the twin and this would name it.
+#[test]
+fn the_generated_decoder_reads_every_instruction_as_the_isa_encodes_it() {
+    use dynrt::hw::program::isa::{Instr, KdFn, Op, TriFn, OPS};
+    let p = engine_localparams();
+    let at = |name: &str| {
+        *p.get(name)
+            .unwrap_or_else(|| panic!("no localparam {name}")) as u32
+    };
+    let slice = |w: u32, field: &str, bits: u32| (w >> at(field)) & ((1 << bits) - 1);
+    for op in OPS {
+        let mut i = Instr::new(op);
+        (i.dst, i.a, i.b, i.b_imm, i.invert) = (0x5a, 0xc3, 0x81, true, true);
+        (i.shift, i.bank, i.target) = (5, 3, 0xabc);
+        let [ctl, _, aux] = i.encode();
+        let code = u64::from(slice(ctl, "f_op", 5));
+        let named: Vec<&str> = p
+            .iter()
+            .filter(|(n, v)| n.starts_with("op_") && *n != "op_writes" && **v == code)
+            .map(|(n, _)| n.as_str())
+            .collect();
+        let want: Vec<String> = match op {
+            Op::Nop => vec![],
+            _ => vec![format!("op_{}", op.name())],
+        };
+        assert_eq!(named, want, "{op:?} (opcode {code})");
+        assert_eq!(
+            (at("op_writes") >> code) & 1 == 1,
+            op.writes(),
+            "{op:?}: the write back's op_writes"
+        );
+        assert_eq!(slice(ctl, "f_dst", 8), 0x5a, "{op:?} dst");
+        assert_eq!(slice(ctl, "f_a", 8), 0xc3, "{op:?} a");
+        assert_eq!(slice(ctl, "f_b", 8), 0x81, "{op:?} b");
+        assert_eq!(slice(ctl, "f_b_imm", 1), 1, "{op:?} b_imm");
+        assert_eq!(slice(ctl, "f_invert", 1), 1, "{op:?} invert");
+        assert_eq!(slice(aux, "f_shift", 3), 5, "{op:?} shift");
+        assert_eq!(slice(aux, "f_bank", 3), 3, "{op:?} bank");
+        assert_eq!(slice(aux, "f_target", 12), 0xabc, "{op:?} target");
+    }
+    for f in TriFn::ALL {
+        let mut i = Instr::new(Op::Tri);
+        i.imm = f as u32;
+        let imm = i.encode()[1];
+        let ray = matches!(f, TriFn::RayOxy | TriFn::RayOzDx | TriFn::RayDyz);
+        assert_eq!(imm < at("tri_ray_words"), ray, "{f:?}: a ray word");
+        if !ray {
+            let name = format!("tri_{}", f.name());
+            assert_eq!(at(&name), imm, "{f:?}");
+        }
+    }
+    for f in KdFn::ALL {
+        let mut i = Instr::new(Op::Kd);
+        i.imm = f as u32;
+        assert_eq!(at(&format!("kd_{}", f.name())), i.encode()[1], "{f:?}");
+    }
+}

@@ -89,6 +89,74 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     localparam  c_index__6 = 8'h6;
     localparam  c_index__7 = 8'h7;
     localparam  c_reserve_bit = 32'h7;
+    localparam  op_fadd = 5'b1;
+    localparam  op_fsub = 5'b10;
+    localparam  op_fmul = 5'b11;
+    localparam  op_fdiv = 5'b100;
+    localparam  op_fsqrt = 5'b101;
+    localparam  op_itof = 5'b110;
+    localparam  op_add = 5'b111;
+    localparam  op_sub = 5'b1000;
+    localparam  op_and = 5'b1001;
+    localparam  op_or = 5'b1010;
+    localparam  op_xor = 5'b1011;
+    localparam  op_shr = 5'b1100;
+    localparam  op_shl = 5'b1101;
+    localparam  op_ld = 5'b1110;
+    localparam  op_st = 5'b1111;
+    localparam  op_lds = 5'b10000;
+    localparam  op_sts = 5'b10001;
+    localparam  op_bflt = 5'b10010;
+    localparam  op_bfle = 5'b10011;
+    localparam  op_bfeq = 5'b10100;
+    localparam  op_beq = 5'b10101;
+    localparam  op_bltu = 5'b10110;
+    localparam  op_jal = 5'b10111;
+    localparam  op_jr = 5'b11000;
+    localparam  op_mbx = 5'b11001;
+    localparam  op_mbc = 5'b11010;
+    localparam  op_pixel = 5'b11011;
+    localparam  op_halt = 5'b11100;
+    localparam  op_tri = 5'b11101;
+    localparam  op_kd = 5'b11110;
+    localparam  op_byte = 5'b11111;
+    localparam  op_writes = 32'ha8817ffe;
+    localparam  tri_ray_words = 32'h3;
+    localparam  tri_init = 32'h3;
+    localparam  tri_list = 32'h4;
+    localparam  tri_wait = 32'h5;
+    localparam  tri_hit = 32'h6;
+    localparam  tri_instance = 32'h7;
+    localparam  tri_triangle = 32'h8;
+    localparam  tri_object = 32'h9;
+    localparam  tri_skip = 32'ha;
+    localparam  kd_start = 32'h0;
+    localparam  kd_wait = 32'h1;
+    localparam  cmd_list = 2'b0;
+    localparam  cmd_init = 2'b1;
+    localparam  cmd_object = 2'b10;
+    localparam  cmd_skip = 2'b11;
+    localparam  bank_nodes = 3'b0;
+    localparam  bank_lists = 3'b1;
+    localparam  bank_uv = 3'b10;
+    localparam  bank_t = 3'b11;
+    localparam  f_op = 5'b11010;
+    localparam  f_dst = 5'b10010;
+    localparam  f_a = 5'b1010;
+    localparam  f_b = 5'b10;
+    localparam  f_b_imm = 5'b1;
+    localparam  f_invert = 5'b0;
+    localparam  f_shift = 5'b1111;
+    localparam  f_bank = 5'b1100;
+    localparam  f_target = 5'b0;
+    
+    // Enums
+    localparam FastKind__Computed = 0;
+    localparam FastKind__Scratch = 1;
+    localparam FastKind__Memory = 2;
+    localparam FastKind__TrianglesUv = 3;
+    localparam FastKind__TrianglesT = 4;
+    localparam FastKind__Nodes = 5;
     
     // Stub signals
     reg  [4:0] pc_ram__read_address;
@@ -383,12 +451,9 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     reg  [1:0] traversal_unit__ray_pair;
     reg  traversal_unit__t_min_write;
     reg  traversal_unit__enqueue;
-    reg  traversal_unit__enqueue_next;
     wire  traversal_unit__full;
     reg  [4:0] traversal_unit__query_thread;
     wire  traversal_unit__pending;
-    wire  [31:0] traversal_unit__result;
-    wire  [31:0] traversal_unit__list_end;
     reg  traversal_unit__engine_read;
     reg  [2:0] traversal_unit__engine_bank;
     reg  [23:0] traversal_unit__engine_addr;
@@ -595,6 +660,8 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     reg  wait_fn;
     reg  kd_cond;
     reg  [2:0] fast_kind;
+    reg  tri_queues;
+    reg  [1:0] tri_kind;
     reg  [20:0] short_ctl;
     reg  [20:0] long_in;
     reg  [20:0] wb_ctl;
@@ -1014,12 +1081,9 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         .ray_pair(traversal_unit__ray_pair),
         .t_min_write(traversal_unit__t_min_write),
         .enqueue(traversal_unit__enqueue),
-        .enqueue_next(traversal_unit__enqueue_next),
         .full(traversal_unit__full),
         .query_thread(traversal_unit__query_thread),
         .pending(traversal_unit__pending),
-        .result(traversal_unit__result),
-        .list_end(traversal_unit__list_end),
         .engine_read(traversal_unit__engine_read),
         .engine_bank(traversal_unit__engine_bank),
         .engine_addr(traversal_unit__engine_addr),
@@ -1104,42 +1168,42 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         .q(fast_line__7__q),
         .clock(fast_line__7__clock)
     );
-    dynrt_processor_core__cmp_delay__stage__0 fast_kind_line__0(
+    dynrt_processor_core__fast_kind_line__0 fast_kind_line__0(
         .d(fast_kind_line__0__d),
         .q(fast_kind_line__0__q),
         .clock(fast_kind_line__0__clock)
     );
-    dynrt_processor_core__cmp_delay__stage__0 fast_kind_line__1(
+    dynrt_processor_core__fast_kind_line__0 fast_kind_line__1(
         .d(fast_kind_line__1__d),
         .q(fast_kind_line__1__q),
         .clock(fast_kind_line__1__clock)
     );
-    dynrt_processor_core__cmp_delay__stage__0 fast_kind_line__2(
+    dynrt_processor_core__fast_kind_line__0 fast_kind_line__2(
         .d(fast_kind_line__2__d),
         .q(fast_kind_line__2__q),
         .clock(fast_kind_line__2__clock)
     );
-    dynrt_processor_core__cmp_delay__stage__0 fast_kind_line__3(
+    dynrt_processor_core__fast_kind_line__0 fast_kind_line__3(
         .d(fast_kind_line__3__d),
         .q(fast_kind_line__3__q),
         .clock(fast_kind_line__3__clock)
     );
-    dynrt_processor_core__cmp_delay__stage__0 fast_kind_line__4(
+    dynrt_processor_core__fast_kind_line__0 fast_kind_line__4(
         .d(fast_kind_line__4__d),
         .q(fast_kind_line__4__q),
         .clock(fast_kind_line__4__clock)
     );
-    dynrt_processor_core__cmp_delay__stage__0 fast_kind_line__5(
+    dynrt_processor_core__fast_kind_line__0 fast_kind_line__5(
         .d(fast_kind_line__5__d),
         .q(fast_kind_line__5__q),
         .clock(fast_kind_line__5__clock)
     );
-    dynrt_processor_core__cmp_delay__stage__0 fast_kind_line__6(
+    dynrt_processor_core__fast_kind_line__0 fast_kind_line__6(
         .d(fast_kind_line__6__d),
         .q(fast_kind_line__6__q),
         .clock(fast_kind_line__6__clock)
     );
-    dynrt_processor_core__cmp_delay__stage__0 fast_kind_line__7(
+    dynrt_processor_core__fast_kind_line__0 fast_kind_line__7(
         .d(fast_kind_line__7__d),
         .q(fast_kind_line__7__q),
         .clock(fast_kind_line__7__clock)
@@ -1700,8 +1764,8 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         v2__d = v1__q & (entry_fresh | (~pc_ram__read_data[32'hc]));
         t2__d = t1__q;
         pc2__d = pc1_eff;
-        regs_a__read_address = (((t2__q) & 13'h1fff) << 32'h8) | ((rom_ctl__read_data[(32'ha)+:(8)]) & 13'h1fff);
-        regs_b__read_address = (((t2__q) & 13'h1fff) << 32'h8) | ((rom_ctl__read_data[(32'h2)+:(8)]) & 13'h1fff);
+        regs_a__read_address = (((t2__q) & 13'h1fff) << 32'h8) | ((rom_ctl__read_data[(f_a)+:(8)]) & 13'h1fff);
+        regs_b__read_address = (((t2__q) & 13'h1fff) << 32'h8) | ((rom_ctl__read_data[(f_b)+:(8)]) & 13'h1fff);
         mailbox_meta__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
         mailbox__0__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
         mailbox__1__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
@@ -1719,17 +1783,17 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         ctl3__d = rom_ctl__read_data;
         imm3__d = rom_imm__read_data;
         aux3__d = rom_aux__read_data;
-        op3 = ctl3__q[(32'h1a)+:(5)];
-        if (ctl3__q[(32'ha)+:(8)] == 32'h0) begin
+        op3 = ctl3__q[(f_op)+:(5)];
+        if (ctl3__q[(f_a)+:(8)] == 32'h0) begin
             opa = 32'h0;
         end
         else begin
             opa = regs_a__read_data;
         end
-        if (ctl3__q[32'h1]) begin
+        if (ctl3__q[f_b_imm]) begin
             opb = imm3__q;
         end
-        else if (ctl3__q[(32'h2)+:(8)] == 32'h0) begin
+        else if (ctl3__q[(f_b)+:(8)] == 32'h0) begin
             opb = 32'h0;
         end
         else begin
@@ -1737,7 +1801,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         end
         add__a = opa[(32'h0)+:(24)];
         add__b = opb[(32'h0)+:(24)];
-        add__sub = op3 == 32'h2;
+        add__sub = op3 == op_fsub;
         add__in_valid = 1'b1;
         mul__a = opa[(32'h0)+:(24)];
         mul__b = opb[(32'h0)+:(24)];
@@ -1753,7 +1817,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         itof__value = opa[(32'h0)+:(16)];
         byte_unit__word = opa[(32'h0)+:(24)];
         byte_unit__in_valid = 1'b1;
-        long3 = v3__q & ((op3 == 32'h4) | (op3 == 32'h5));
+        long3 = v3__q & ((op3 == op_fdiv) | (op3 == op_fsqrt));
         reserved__d = (reserved__q >> 32'h1) | (((long3) & 32'hffffffff) << c_reserve_bit);
         add_delay__data_in = add__result;
         mul_delay__data_in = mul__result;
@@ -1762,7 +1826,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         cmp_delay__data_in = (((cmp__lt) & 3'h7) << 32'h2) | (((cmp__le) & 3'h7) << 32'h1) | ((cmp__eq) & 3'h7);
         int_eq = opa == opb;
         int_lt = opa < opb;
-        shifted = opa << aux3__q[(32'hf)+:(3)];
+        shifted = opa << aux3__q[(f_shift)+:(3)];
         mem_address = shifted + imm3__q;
         scratch_address = opa + imm3__q;
         mb_len = mailbox_meta__read_data[(32'h0)+:(4)];
@@ -1819,10 +1883,10 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         mailbox__7__write_address = (((t3__q) & 6'h3f) << 32'h1) | ((imm3__q[(32'h0)+:(1)]) & 6'h3f);
         mailbox__7__write_data = opa;
         mailbox__7__write_enable = 1'b0;
-        if (v3__q & (op3 == 32'h1a)) begin
+        if (v3__q & (op3 == op_mbc)) begin
             mailbox_meta__write_enable = 1'b1;
         end
-        if (v3__q & (op3 == 32'h19) & (~mb_hit)) begin
+        if (v3__q & (op3 == op_mbx) & (~mb_hit)) begin
             mailbox_meta__write_enable = 1'b1;
             if (mb_len == 32'h8) begin
                 mailbox_meta__write_data = (((mb_next + 32'h1) & 8'hff) << 32'h4) | (c_index__7 + 32'h1);
@@ -1856,7 +1920,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
             end
         end
         pix_done = ~(py__q < c_height);
-        if (running__q & v3__q & (op3 == 32'h1b) & (~pix_done)) begin
+        if (running__q & v3__q & (op3 == op_pixel) & (~pix_done)) begin
             if ((px__q + 32'h1) == c_width) begin
                 px__d = 32'h0;
                 py__d = py__q + 32'h1;
@@ -1868,14 +1932,14 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         scratch__read_address = (((t3__q) & 12'hfff) << 32'h7) | ((scratch_address[(32'h0)+:(7)]) & 12'hfff);
         scratch__write_address = (((t3__q) & 12'hfff) << 32'h7) | ((scratch_address[(32'h0)+:(7)]) & 12'hfff);
         scratch__write_data = regs_b__read_data;
-        scratch__write_enable = v3__q & (op3 == 32'h11);
-        mem_read_r__d = v3__q & (op3 == 32'he);
-        mem_bank_r__d = aux3__q[(32'hc)+:(3)];
+        scratch__write_enable = v3__q & (op3 == op_sts);
+        mem_read_r__d = v3__q & (op3 == op_ld);
+        mem_bank_r__d = aux3__q[(f_bank)+:(3)];
         mem_addr_r__d = mem_address[(32'h0)+:(24)];
-        fb_write_r__d = v3__q & (op3 == 32'hf);
+        fb_write_r__d = v3__q & (op3 == op_st);
         fb_addr_r__d = mem_address[(32'h0)+:(24)];
         fb_data_r__d = regs_b__read_data;
-        mem_read = (mem_read_r__q & (mem_bank_r__q != 32'h0) & (mem_bank_r__q != 32'h2) & (mem_bank_r__q != 32'h3)) | tester__list_read;
+        mem_read = (mem_read_r__q & (mem_bank_r__q != bank_nodes) & (mem_bank_r__q != bank_uv) & (mem_bank_r__q != bank_t)) | tester__list_read;
         traversal_unit__engine_read = mem_read_r__q;
         traversal_unit__engine_bank = mem_bank_r__q;
         traversal_unit__engine_addr = mem_addr_r__q;
@@ -1885,7 +1949,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         mem_bank = mem_bank_r__q;
         mem_addr = mem_addr_r__q;
         if (tester__list_read) begin
-            mem_bank = 32'h1;
+            mem_bank = bank_lists;
             mem_addr = tester__list_addr;
         end
         tester__list_rdata = mem_rdata;
@@ -1902,14 +1966,25 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         tester__word_a = opa;
         tester__word_b = opb;
         tester__ray_pair = imm3__q[(32'h0)+:(2)];
-        tester__ray_write = v3__q & (op3 == 32'h1d) & (imm3__q < 32'h3);
-        tester__enqueue = v3__q & (op3 == 32'h1d) & ((imm3__q == 32'h3) | (imm3__q == 32'h4) | (imm3__q == 32'h9) | (imm3__q == 32'ha));
-        tester__queue_kind = (((((imm3__q == 32'h9) | (imm3__q == 32'ha))) & 2'h3) << 32'h1) | ((((imm3__q == 32'h3) | (imm3__q == 32'ha))) & 2'h3);
+        tester__ray_write = v3__q & (op3 == op_tri) & (imm3__q < tri_ray_words);
+        tri_queues = (imm3__q == tri_init) | (imm3__q == tri_list) | (imm3__q == tri_object) | (imm3__q == tri_skip);
+        tester__enqueue = v3__q & (op3 == op_tri) & tri_queues;
+        tri_kind = cmd_list;
+        if (imm3__q == tri_init) begin
+            tri_kind = cmd_init;
+        end
+        if (imm3__q == tri_object) begin
+            tri_kind = cmd_object;
+        end
+        if (imm3__q == tri_skip) begin
+            tri_kind = cmd_skip;
+        end
+        tester__queue_kind = tri_kind;
         tri_cond = 1'b0;
-        if ((imm3__q == 32'h3) | (imm3__q == 32'h4) | (imm3__q == 32'h9) | (imm3__q == 32'ha)) begin
+        if (tri_queues) begin
             tri_cond = tester__full;
         end
-        if (imm3__q == 32'h5) begin
+        if (imm3__q == tri_wait) begin
             tri_cond = tester__pending;
         end
         tester__walk_list_valid = traversal_unit__leaf_valid;
@@ -1925,94 +2000,85 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         traversal_unit__word_a = opa;
         traversal_unit__word_b = opb;
         traversal_unit__ray_pair = imm3__q[(32'h0)+:(2)];
-        traversal_unit__ray_write = v3__q & (op3 == 32'h1d) & (imm3__q < 32'h3);
-        traversal_unit__t_min_write = v3__q & (op3 == 32'h1d) & (imm3__q == 32'h3);
-        traversal_unit__enqueue = v3__q & (op3 == 32'h1e) & ((imm3__q == 32'h0) | (imm3__q == 32'h3));
-        traversal_unit__enqueue_next = imm3__q == 32'h3;
+        traversal_unit__ray_write = v3__q & (op3 == op_tri) & (imm3__q < tri_ray_words);
+        traversal_unit__t_min_write = v3__q & (op3 == op_tri) & (imm3__q == tri_init);
+        traversal_unit__enqueue = v3__q & (op3 == op_kd) & (imm3__q == kd_start);
         kd_cond = traversal_unit__full;
-        if (imm3__q == 32'h1) begin
+        if (imm3__q == kd_wait) begin
             kd_cond = traversal_unit__pending;
         end
-        wait_fn = ((op3 == 32'h1d) & (imm3__q == 32'h5)) | ((op3 == 32'h1e) & (imm3__q == 32'h1));
+        wait_fn = ((op3 == op_tri) & (imm3__q == tri_wait)) | ((op3 == op_kd) & (imm3__q == kd_wait));
         fb_write = fb_write_r__q;
         fb_addr = fb_addr_r__q;
         fb_data = fb_data_r__q;
-        fast_kind = 32'h0;
+        fast_kind = FastKind__Computed;
         fast = 32'h0;
-        if (op3 == 32'h6) begin
+        if (op3 == op_itof) begin
             fast = ((itof__word) & 32'hffffffff);
         end
-        if (op3 == 32'h7) begin
+        if (op3 == op_add) begin
             fast = opa + opb;
         end
-        if (op3 == 32'h8) begin
+        if (op3 == op_sub) begin
             fast = opa - opb;
         end
-        if (op3 == 32'h9) begin
+        if (op3 == op_and) begin
             fast = opa & opb;
         end
-        if (op3 == 32'ha) begin
+        if (op3 == op_or) begin
             fast = opa | opb;
         end
-        if (op3 == 32'hb) begin
+        if (op3 == op_xor) begin
             fast = opa ^ opb;
         end
-        if (op3 == 32'hc) begin
+        if (op3 == op_shr) begin
             fast = opa >> opb[(32'h0)+:(5)];
         end
-        if (op3 == 32'hd) begin
+        if (op3 == op_shl) begin
             fast = opa << opb[(32'h0)+:(5)];
         end
-        if (op3 == 32'he) begin
-            fast_kind = 32'h2;
-            if (aux3__q[(32'hc)+:(3)] == 32'h2) begin
-                fast_kind = 32'h3;
+        if (op3 == op_ld) begin
+            fast_kind = FastKind__Memory;
+            if (aux3__q[(f_bank)+:(3)] == bank_uv) begin
+                fast_kind = FastKind__TrianglesUv;
             end
-            if (aux3__q[(32'hc)+:(3)] == 32'h3) begin
-                fast_kind = 32'h4;
+            if (aux3__q[(f_bank)+:(3)] == bank_t) begin
+                fast_kind = FastKind__TrianglesT;
             end
-            if (aux3__q[(32'hc)+:(3)] == 32'h0) begin
-                fast_kind = 32'h5;
+            if (aux3__q[(f_bank)+:(3)] == bank_nodes) begin
+                fast_kind = FastKind__Nodes;
             end
         end
-        if (op3 == 32'h10) begin
-            fast_kind = 32'h1;
+        if (op3 == op_lds) begin
+            fast_kind = FastKind__Scratch;
         end
-        if (op3 == 32'h17) begin
+        if (op3 == op_jal) begin
             fast = ((pc3__q + 32'h1) & 32'hffffffff);
         end
-        if (op3 == 32'h1f) begin
+        if (op3 == op_byte) begin
             fast = opb << 32'h8;
         end
-        if (op3 == 32'h1b) begin
+        if (op3 == op_pixel) begin
             fast = (((py__q) & 32'hffffffff) << c_pixel_shift) | ((px__q) & 32'hffffffff);
         end
-        if (op3 == 32'h1d) begin
-            if (imm3__q == 32'h5) begin
+        if (op3 == op_tri) begin
+            if (imm3__q == tri_wait) begin
                 fast = ((tester__best_t) & 32'hffffffff);
             end
-            if (imm3__q == 32'h6) begin
+            if (imm3__q == tri_hit) begin
                 fast = ((tester__hit) & 32'hffffffff);
             end
-            if (imm3__q == 32'h7) begin
+            if (imm3__q == tri_instance) begin
                 fast = tester__best_instance;
             end
-            if (imm3__q == 32'h8) begin
+            if (imm3__q == tri_triangle) begin
                 fast = tester__best_triangle;
-            end
-        end
-        if (op3 == 32'h1e) begin
-            if (imm3__q == 32'h1) begin
-                fast = traversal_unit__result;
-            end
-            if (imm3__q == 32'h2) begin
-                fast = traversal_unit__list_end;
             end
         end
         fast_line__0__d = fast;
         fast_kind_line__0__d = fast_kind;
-        ctl_line__0__d = (((v3__q) & 21'h1fffff) << 32'h14) | (((op3) & 21'h1fffff) << 32'hf) | (((ctl3__q[(32'h12)+:(8)]) & 21'h1fffff) << 32'h7) | (((t3__q) & 21'h1fffff) << 32'h2) | ((ctl3__q[(32'h0)+:(1)]) & 21'h1fffff);
-        pc_line__0__d = (((pc3__q + 32'h1) & 24'hffffff) << 32'hc) | ((aux3__q[(32'h0)+:(12)]) & 24'hffffff);
+        ctl_line__0__d = (((v3__q) & 21'h1fffff) << 32'h14) | (((op3) & 21'h1fffff) << 32'hf) | (((ctl3__q[(f_dst)+:(8)]) & 21'h1fffff) << 32'h7) | (((t3__q) & 21'h1fffff) << 32'h2) | ((ctl3__q[(f_invert)+:(1)]) & 21'h1fffff);
+        pc_line__0__d = (((pc3__q + 32'h1) & 24'hffffff) << 32'hc) | ((aux3__q[(f_target)+:(12)]) & 24'hffffff);
         cond_line__0__d = (((wait_fn) & 19'h7ffff) << 32'h12) | (((kd_cond) & 19'h7ffff) << 32'h11) | (((tri_cond) & 19'h7ffff) << 32'h10) | (((opa[(32'h0)+:(12)]) & 19'h7ffff) << 32'h4) | (((int_eq) & 19'h7ffff) << 32'h3) | (((int_lt) & 19'h7ffff) << 32'h2) | (((mb_hit) & 19'h7ffff) << 32'h1) | ((pix_done) & 19'h7ffff);
         fast_line__1__d = fast_line__0__q;
         fast_kind_line__1__d = fast_kind_line__0__q;
@@ -2049,90 +2115,90 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         ctl_line__7__d = ctl_line__6__q;
         pc_line__7__d = pc_line__6__q;
         cond_line__7__d = cond_line__6__q;
-        if (fast_kind_line__0__q == 32'h1) begin
+        if (fast_kind_line__0__q == FastKind__Scratch) begin
             fast_line__1__d = scratch__read_data;
         end
         if (c_mem_latency == c_index__1) begin
-            if (fast_kind_line__1__q == 32'h2) begin
+            if (fast_kind_line__1__q == FastKind__Memory) begin
                 fast_line__2__d = mem_rdata;
             end
-            if (fast_kind_line__1__q == 32'h3) begin
+            if (fast_kind_line__1__q == FastKind__TrianglesUv) begin
                 fast_line__2__d = bank2_rdata;
             end
-            if (fast_kind_line__1__q == 32'h4) begin
+            if (fast_kind_line__1__q == FastKind__TrianglesT) begin
                 fast_line__2__d = bank3_rdata;
             end
-            if (fast_kind_line__1__q == 32'h5) begin
+            if (fast_kind_line__1__q == FastKind__Nodes) begin
                 fast_line__2__d = bank0_rdata;
             end
         end
         if (c_mem_latency == c_index__2) begin
-            if (fast_kind_line__2__q == 32'h2) begin
+            if (fast_kind_line__2__q == FastKind__Memory) begin
                 fast_line__3__d = mem_rdata;
             end
-            if (fast_kind_line__2__q == 32'h3) begin
+            if (fast_kind_line__2__q == FastKind__TrianglesUv) begin
                 fast_line__3__d = bank2_rdata;
             end
-            if (fast_kind_line__2__q == 32'h4) begin
+            if (fast_kind_line__2__q == FastKind__TrianglesT) begin
                 fast_line__3__d = bank3_rdata;
             end
-            if (fast_kind_line__2__q == 32'h5) begin
+            if (fast_kind_line__2__q == FastKind__Nodes) begin
                 fast_line__3__d = bank0_rdata;
             end
         end
         if (c_mem_latency == c_index__3) begin
-            if (fast_kind_line__3__q == 32'h2) begin
+            if (fast_kind_line__3__q == FastKind__Memory) begin
                 fast_line__4__d = mem_rdata;
             end
-            if (fast_kind_line__3__q == 32'h3) begin
+            if (fast_kind_line__3__q == FastKind__TrianglesUv) begin
                 fast_line__4__d = bank2_rdata;
             end
-            if (fast_kind_line__3__q == 32'h4) begin
+            if (fast_kind_line__3__q == FastKind__TrianglesT) begin
                 fast_line__4__d = bank3_rdata;
             end
-            if (fast_kind_line__3__q == 32'h5) begin
+            if (fast_kind_line__3__q == FastKind__Nodes) begin
                 fast_line__4__d = bank0_rdata;
             end
         end
         if (c_mem_latency == c_index__4) begin
-            if (fast_kind_line__4__q == 32'h2) begin
+            if (fast_kind_line__4__q == FastKind__Memory) begin
                 fast_line__5__d = mem_rdata;
             end
-            if (fast_kind_line__4__q == 32'h3) begin
+            if (fast_kind_line__4__q == FastKind__TrianglesUv) begin
                 fast_line__5__d = bank2_rdata;
             end
-            if (fast_kind_line__4__q == 32'h4) begin
+            if (fast_kind_line__4__q == FastKind__TrianglesT) begin
                 fast_line__5__d = bank3_rdata;
             end
-            if (fast_kind_line__4__q == 32'h5) begin
+            if (fast_kind_line__4__q == FastKind__Nodes) begin
                 fast_line__5__d = bank0_rdata;
             end
         end
         if (c_mem_latency == c_index__5) begin
-            if (fast_kind_line__5__q == 32'h2) begin
+            if (fast_kind_line__5__q == FastKind__Memory) begin
                 fast_line__6__d = mem_rdata;
             end
-            if (fast_kind_line__5__q == 32'h3) begin
+            if (fast_kind_line__5__q == FastKind__TrianglesUv) begin
                 fast_line__6__d = bank2_rdata;
             end
-            if (fast_kind_line__5__q == 32'h4) begin
+            if (fast_kind_line__5__q == FastKind__TrianglesT) begin
                 fast_line__6__d = bank3_rdata;
             end
-            if (fast_kind_line__5__q == 32'h5) begin
+            if (fast_kind_line__5__q == FastKind__Nodes) begin
                 fast_line__6__d = bank0_rdata;
             end
         end
         if (c_mem_latency == c_index__6) begin
-            if (fast_kind_line__6__q == 32'h2) begin
+            if (fast_kind_line__6__q == FastKind__Memory) begin
                 fast_line__7__d = mem_rdata;
             end
-            if (fast_kind_line__6__q == 32'h3) begin
+            if (fast_kind_line__6__q == FastKind__TrianglesUv) begin
                 fast_line__7__d = bank2_rdata;
             end
-            if (fast_kind_line__6__q == 32'h4) begin
+            if (fast_kind_line__6__q == FastKind__TrianglesT) begin
                 fast_line__7__d = bank3_rdata;
             end
-            if (fast_kind_line__6__q == 32'h5) begin
+            if (fast_kind_line__6__q == FastKind__Nodes) begin
                 fast_line__7__d = bank0_rdata;
             end
         end
@@ -2142,7 +2208,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         cond_delay__data_in = cond_line__7__q;
         short_ctl = ctl_delay__data_out;
         long_in = 32'h0;
-        if ((ctl_delay__data_out[(32'hf)+:(5)] == 32'h4) | (ctl_delay__data_out[(32'hf)+:(5)] == 32'h5)) begin
+        if ((ctl_delay__data_out[(32'hf)+:(5)] == op_fdiv) | (ctl_delay__data_out[(32'hf)+:(5)] == op_fsqrt)) begin
             short_ctl = 32'h0;
             long_in = ctl_delay__data_out;
         end
@@ -2160,34 +2226,34 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         wb_thread = wb_ctl[(32'h2)+:(5)];
         wb_invert = wb_ctl[32'h0];
         wb_cond = 1'b0;
-        if (wb_op == 32'h12) begin
+        if (wb_op == op_bflt) begin
             wb_cond = cmp_delay__data_out[32'h2];
         end
-        if (wb_op == 32'h13) begin
+        if (wb_op == op_bfle) begin
             wb_cond = cmp_delay__data_out[32'h1];
         end
-        if (wb_op == 32'h14) begin
+        if (wb_op == op_bfeq) begin
             wb_cond = cmp_delay__data_out[32'h0];
         end
-        if (wb_op == 32'h15) begin
+        if (wb_op == op_beq) begin
             wb_cond = cond_delay__data_out[32'h3];
         end
-        if (wb_op == 32'h16) begin
+        if (wb_op == op_bltu) begin
             wb_cond = cond_delay__data_out[32'h2];
         end
-        if (wb_op == 32'h19) begin
+        if (wb_op == op_mbx) begin
             wb_cond = cond_delay__data_out[32'h1];
         end
-        if (wb_op == 32'h1b) begin
+        if (wb_op == op_pixel) begin
             wb_cond = cond_delay__data_out[32'h0];
         end
-        if (wb_op == 32'h17) begin
+        if (wb_op == op_jal) begin
             wb_cond = 1'b1;
         end
-        if (wb_op == 32'h1d) begin
+        if (wb_op == op_tri) begin
             wb_cond = cond_delay__data_out[32'h10];
         end
-        if (wb_op == 32'h1e) begin
+        if (wb_op == op_kd) begin
             wb_cond = cond_delay__data_out[32'h11];
         end
         if (wb_cond != wb_invert) begin
@@ -2196,29 +2262,29 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         else begin
             wb_next_pc = wb_pcs[(32'hc)+:(12)];
         end
-        if (wb_op == 32'h18) begin
+        if (wb_op == op_jr) begin
             wb_next_pc = cond_delay__data_out[(32'h4)+:(12)];
         end
-        if ((wb_op == 32'h1c) | (((wb_op == 32'h1d) | (wb_op == 32'h1e)) & wb_cond)) begin
+        if ((wb_op == op_halt) | (((wb_op == op_tri) | (wb_op == op_kd)) & wb_cond)) begin
             wb_next_pc = wb_pcs[(32'hc)+:(12)] - 32'h1;
         end
         wb_result = fast_delay__data_out;
-        if ((wb_op == 32'h1) | (wb_op == 32'h2)) begin
+        if ((wb_op == op_fadd) | (wb_op == op_fsub)) begin
             wb_result = ((add_delay__data_out) & 32'hffffffff);
         end
-        if (wb_op == 32'h3) begin
+        if (wb_op == op_fmul) begin
             wb_result = ((mul_delay__data_out) & 32'hffffffff);
         end
-        if (wb_op == 32'h4) begin
+        if (wb_op == op_fdiv) begin
             wb_result = ((div_delay__data_out) & 32'hffffffff);
         end
-        if (wb_op == 32'h5) begin
+        if (wb_op == op_fsqrt) begin
             wb_result = ((sqrt_delay__data_out) & 32'hffffffff);
         end
-        if (wb_op == 32'h1f) begin
+        if (wb_op == op_byte) begin
             wb_result = fast_delay__data_out | ((byte_unit__result) & 32'hffffffff);
         end
-        wb_writes = wb_valid & (wb_dst != 32'h0) & ((((wb_op >= 32'h1) & (wb_op <= 32'he)) | (wb_op == 32'h10)) | ((wb_op == 32'h17) | ((wb_op == 32'h1b) & (~cond_delay__data_out[32'h0])) | (wb_op == 32'h1d) | (wb_op == 32'h1e) | (wb_op == 32'h1f)));
+        wb_writes = wb_valid & (wb_dst != 32'h0) & op_writes[wb_op] & (~((wb_op == op_pixel) & cond_delay__data_out[32'h0]));
         regs_a__write_address = (((wb_thread) & 13'h1fff) << 32'h8) | ((wb_dst) & 13'h1fff);
         regs_b__write_address = (((wb_thread) & 13'h1fff) << 32'h8) | ((wb_dst) & 13'h1fff);
         regs_a__write_data = wb_result;
@@ -2226,9 +2292,9 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         regs_a__write_enable = wb_writes;
         regs_b__write_enable = wb_writes;
         pc_ram__write_address = wb_thread;
-        pc_ram__write_data = (((epoch__q) & 16'hffff) << 32'hd) | ((((wb_op == 32'h1c)) & 16'hffff) << 32'hc) | ((wb_next_pc) & 16'hffff);
+        pc_ram__write_data = (((epoch__q) & 16'hffff) << 32'hd) | ((((wb_op == op_halt)) & 16'hffff) << 32'hc) | ((wb_next_pc) & 16'hffff);
         pc_ram__write_enable = wb_valid;
-        if (wb_valid & (~(((wb_op == 32'h1d) | (wb_op == 32'h1e)) & wb_cond))) begin
+        if (wb_valid & (~(((wb_op == op_tri) | (wb_op == op_kd)) & wb_cond))) begin
             instr_count__d = instr_count__q + 32'h1;
         end
         wb_mask = c_one << wb_thread;
@@ -2244,7 +2310,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         wb_sleep = wb_valid & wb_cond & cond_delay__data_out[32'h12] & (((woken__q | event_mask) & wb_mask) == 32'h0);
         wake_mask = 32'h0;
         sleep_mask = 32'h0;
-        if (wb_valid & (wb_op != 32'h1c)) begin
+        if (wb_valid & (wb_op != op_halt)) begin
             if (wb_sleep) begin
                 sleep_mask = wb_mask;
             end
@@ -2255,7 +2321,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         ready__d = (ready__q & (~issue_mask)) | wake_mask | (asleep__q & event_mask);
         asleep__d = (asleep__q & (~event_mask)) | sleep_mask;
         woken__d = (woken__q & (~issue_mask)) | event_mask;
-        if (wb_valid & (wb_op == 32'h1c)) begin
+        if (wb_valid & (wb_op == op_halt)) begin
             halted_count__d = halted_count__q + 32'h1;
             if ((halted_count__q + 32'h1) == c_threads) begin
                 running__d = 1'b0;
@@ -6810,6 +6876,31 @@ endmodule // dynrt_processor_core__fast_delay
 
 
 
+module dynrt_processor_core__fast_kind_line__0(d,q,clock);
+    
+    // Module arguments
+    input wire  [2:0] d;
+    output reg  [2:0] q;
+    input wire  clock;
+    
+    // Enums
+    localparam FastKind__Computed = 0;
+    localparam FastKind__Scratch = 1;
+    localparam FastKind__Memory = 2;
+    localparam FastKind__TrianglesUv = 3;
+    localparam FastKind__TrianglesT = 4;
+    localparam FastKind__Nodes = 5;
+    
+    // Update code (custom)
+    initial begin
+       q = 64'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor_core__fast_kind_line__0
 
 
 
@@ -10711,6 +10802,20 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
     localparam  c_buffer__0 = 1'b0;
     localparam  c_buffer__1 = 1'b1;
     localparam  c_hit_flag = 33'h100000000;
+    localparam  c_cmd_list = 2'b0;
+    localparam  c_cmd_init = 2'b1;
+    localparam  c_test_triangle = 2'b0;
+    localparam  c_test_init = 2'b1;
+    localparam  c_test_list_end = 2'b10;
+    localparam  c_test_walk_end = 2'b11;
+    localparam  c_bank_uv = 3'b10;
+    localparam  c_bank_t = 3'b11;
+    
+    // Enums
+    localparam Launch__Wait = 0;
+    localparam Launch__Origin = 1;
+    localparam Launch__Direction = 2;
+    localparam Launch__Free = 3;
     
     // Stub signals
     reg  list_unit__clock;
@@ -11271,7 +11376,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .q(lb__q),
         .clock(lb__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 lphase(
+    dynrt_processor_core__tester__lphase lphase(
         .d(lphase__d),
         .q(lphase__q),
         .clock(lphase__clock)
@@ -11896,7 +12001,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         ray__word_b = word_b;
         ray__ray_write = ray_write;
         ray__ray_pair = ray_pair;
-        ray__t_min_write = enqueue & (queue_kind == 32'h1);
+        ray__t_min_write = enqueue & (queue_kind == c_cmd_init);
         walk_take = walk_list_valid & (~enqueue) & (~list_unit__full);
         walk_list_take = walk_take;
         list_unit__enqueue = enqueue | walk_take;
@@ -11907,7 +12012,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
             list_unit__word_b = word_b;
         end
         else begin
-            list_unit__kind = 32'h0;
+            list_unit__kind = c_cmd_list;
             list_unit__thread = walk_list_thread;
             list_unit__word_a = walk_list_from;
             list_unit__word_b = walk_list_to | c_list_of_walk;
@@ -11930,12 +12035,12 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         best_triangle = triangle_e__read_data;
         issued__write_address = thread;
         issued__write_data = issued__read_data + 32'h1;
-        issued__write_enable = enqueue & (~list_unit__full) & (queue_kind[(32'h1)+:(1)] == 32'h0);
+        issued__write_enable = enqueue & (~list_unit__full) & ((queue_kind == c_cmd_list) | (queue_kind == c_cmd_init));
         list_unit__test_take = 1'b0;
-        uv_take = fetching__q & (uv_issued__q < 32'h8) & (~(engine_read & (engine_bank == 32'h2)));
-        t_take = fetching__q & (t_issued__q < 32'h4) & (~(engine_read & (engine_bank == 32'h3)));
-        uv_read = uv_take | (engine_read & (engine_bank == 32'h2));
-        t_read = t_take | (engine_read & (engine_bank == 32'h3));
+        uv_take = fetching__q & (uv_issued__q < 32'h8) & (~(engine_read & (engine_bank == c_bank_uv)));
+        t_take = fetching__q & (t_issued__q < 32'h4) & (~(engine_read & (engine_bank == c_bank_t)));
+        uv_read = uv_take | (engine_read & (engine_bank == c_bank_uv));
+        t_read = t_take | (engine_read & (engine_bank == c_bank_t));
         uv_addr = engine_addr;
         t_addr = engine_addr;
         fetch_a = cur_a__0__q;
@@ -11975,7 +12080,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
             uv_issued__d = 32'h0;
             t_issued__d = 32'h0;
             fetching__d = 1'b1;
-            if (list_unit__test_entry[(32'h45)+:(2)] != 32'h0) begin
+            if (list_unit__test_entry[(32'h45)+:(2)] != c_test_triangle) begin
                 uv_issued__d = 32'h8;
                 t_issued__d = 32'h4;
                 fetching__d = 1'b0;
@@ -11988,7 +12093,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
                 cur_a__0__d = list_unit__test_entry[(32'h20)+:(32)];
                 cur_b__0__d = list_unit__test_entry[(32'h0)+:(32)];
                 received__0__d = 32'h0;
-                if (list_unit__test_entry[(32'h45)+:(2)] != 32'h0) begin
+                if (list_unit__test_entry[(32'h45)+:(2)] != c_test_triangle) begin
                     received__0__d = 32'hc;
                 end
             end
@@ -11999,7 +12104,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
                 cur_a__1__d = list_unit__test_entry[(32'h20)+:(32)];
                 cur_b__1__d = list_unit__test_entry[(32'h0)+:(32)];
                 received__1__d = 32'h0;
-                if (list_unit__test_entry[(32'h45)+:(2)] != 32'h0) begin
+                if (list_unit__test_entry[(32'h45)+:(2)] != c_test_triangle) begin
                     received__1__d = 32'hc;
                 end
             end
@@ -12196,17 +12301,17 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         flight_t_min__write_enable = 1'b0;
         flight_a__write_enable = 1'b0;
         flight_b__write_enable = 1'b0;
-        if ((lphase__q == 32'h0) & l_ready) begin
-            lphase__d = 32'h1;
+        if ((lphase__q == Launch__Wait) & l_ready) begin
+            lphase__d = Launch__Origin;
         end
-        if (lphase__q == 32'h1) begin
+        if (lphase__q == Launch__Origin) begin
             transform_unit__in_valid = 1'b1;
             flight_t_min__write_enable = 1'b1;
             flight_a__write_enable = 1'b1;
             flight_b__write_enable = 1'b1;
-            lphase__d = 32'h2;
+            lphase__d = Launch__Direction;
         end
-        if (lphase__q == 32'h2) begin
+        if (lphase__q == Launch__Direction) begin
             transform_unit__in_valid = 1'b1;
             transform_unit__point = 1'b0;
             transform_unit__v__0 = ray__d__0;
@@ -12214,9 +12319,9 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
             transform_unit__v__2 = ray__d__2;
             transform_unit__tag = launch_tag | c_d_pass;
             seq__d = seq__q + 32'h1;
-            lphase__d = 32'h3;
+            lphase__d = Launch__Free;
         end
-        if (lphase__q == 32'h3) begin
+        if (lphase__q == Launch__Free) begin
             if (lb__q == c_buffer__0) begin
                 loaded__0__d = 1'b0;
             end
@@ -12224,9 +12329,9 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
                 loaded__1__d = 1'b0;
             end
             lb__d = ~lb__q;
-            lphase__d = 32'h0;
+            lphase__d = Launch__Wait;
         end
-        transform_busy = transform_unit__in_valid & (l_kind == 32'h0);
+        transform_busy = transform_unit__in_valid & (l_kind == c_test_triangle);
         o_hold__0__d = o_hold__0__q;
         if (transform_unit__out_valid & (~transform_unit__out_tag[32'hd])) begin
             o_hold__0__d = transform_unit__result__0;
@@ -12250,7 +12355,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         intersect_unit__t_min = flight_t_min__read_data;
         intersect_unit__t_max = c_infinity;
         intersect_unit__tag = transform_unit__out_tag;
-        intersect_busy = intersect_unit__in_valid & (transform_unit__out_tag[(32'ha)+:(2)] == 32'h0);
+        intersect_busy = intersect_unit__in_valid & (transform_unit__out_tag[(32'ha)+:(2)] == c_test_triangle);
         done_m__read_address = intersect_unit__out_tag[(32'h5)+:(5)];
         best_m__read_address = intersect_unit__out_tag[(32'h5)+:(5)];
         flight_a__read_address = intersect_unit__out_tag[(32'h0)+:(5)];
@@ -12281,7 +12386,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         m3_b__d = m2_b__q;
         m3_done__d = m2_done__q;
         m3_best__d = m2_best__q;
-        merge_hit = m3_hit__q & cmp__lt & (m3_kind__q == 32'h0);
+        merge_hit = m3_hit__q & cmp__lt & (m3_kind__q == c_test_triangle);
         done_m__write_address = m3_thread__q;
         done_e__write_address = m3_thread__q;
         best_m__write_address = m3_thread__q;
@@ -12290,12 +12395,12 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         triangle_e__write_address = m3_thread__q;
         done_m__write_data = m3_done__q + 32'h1;
         done_e__write_data = m3_done__q + 32'h1;
-        m3_counts = m3_valid__q & ((m3_kind__q == 32'h1) | (m3_kind__q == 32'h2));
+        m3_counts = m3_valid__q & ((m3_kind__q == c_test_init) | (m3_kind__q == c_test_list_end));
         done_m__write_enable = m3_counts;
         done_e__write_enable = m3_counts;
         done_event = m3_counts;
         done_thread = m3_thread__q;
-        walk_end_event = m3_valid__q & (m3_kind__q == 32'h3);
+        walk_end_event = m3_valid__q & (m3_kind__q == c_test_walk_end);
         walk_end_thread = m3_thread__q;
         walk_end_t = ((m3_best__q[(32'h0)+:(24)]) & 32'hffffffff);
         walk_end_hit = m3_best__q[32'h20];
@@ -12303,7 +12408,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         if (merge_hit) begin
             merge_best = c_hit_flag | ((m3_t__q) & 33'h1ffffffff);
         end
-        merge_write = m3_valid__q & ((m3_kind__q == 32'h1) | merge_hit);
+        merge_write = m3_valid__q & ((m3_kind__q == c_test_init) | merge_hit);
         best_m__write_data = merge_best;
         best_e__write_data = merge_best;
         best_m__write_enable = merge_write;
@@ -15798,6 +15903,19 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
     localparam  c_index__6 = 4'h6;
     localparam  c_index__7 = 4'h7;
     localparam  c_list_end = 71'h400000000000000000;
+    localparam  c_cmd_list = 2'b0;
+    localparam  c_cmd_init = 2'b1;
+    localparam  c_cmd_object = 2'b10;
+    localparam  c_cmd_skip = 2'b11;
+    localparam  c_bank_nodes = 3'b0;
+    localparam  c_bank_uv = 3'b10;
+    localparam  c_bank_t = 3'b11;
+    
+    // Enums
+    localparam ListPhase__Idle = 0;
+    localparam ListPhase__Read = 1;
+    localparam ListPhase__Latch = 2;
+    localparam ListPhase__Walk = 3;
     
     // Stub signals
     reg  commands__clock;
@@ -16130,7 +16248,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_meta__write_data),
         .write_enable(mailbox_meta__write_enable)
     );
-    dynrt_processor_core__tester__cur_kind__0 phase(
+    dynrt_processor_core__tester__list_unit__phase phase(
         .d(phase__d),
         .q(phase__q),
         .clock(phase__clock)
@@ -16393,8 +16511,8 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         mailbox_ids__7__write_address = walk_thread__q;
         mailbox_ids__7__write_data = list_rdata;
         mailbox_ids__7__write_enable = 1'b0;
-        if ((phase__q == 32'h0) & (~commands__empty)) begin
-            if (head_kind == 32'h1) begin
+        if ((phase__q == ListPhase__Idle) & (~commands__empty)) begin
+            if (head_kind == c_cmd_init) begin
                 if (~tests__full) begin
                     push = 1'b1;
                     commands__read = 1'b1;
@@ -16402,30 +16520,30 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
                     mailbox_meta__write_enable = 1'b1;
                 end
             end
-            if (head_kind == 32'h2) begin
+            if (head_kind == c_cmd_object) begin
                 object_ram__write_enable = 1'b1;
                 mailbox_meta__write_address = commands__data_out[(32'h40)+:(5)];
                 mailbox_meta__write_enable = 1'b1;
                 commands__read = 1'b1;
             end
-            if (head_kind == 32'h3) begin
+            if (head_kind == c_cmd_skip) begin
                 skip_object_ram__write_enable = 1'b1;
                 skip_triangle_ram__write_enable = 1'b1;
                 commands__read = 1'b1;
             end
-            if (head_kind == 32'h0) begin
+            if (head_kind == c_cmd_list) begin
                 walk_thread__d = commands__data_out[(32'h40)+:(5)];
                 cursor__d = commands__data_out[(32'h20)+:(24)];
                 list_end__d = commands__data_out[(32'h0)+:(24)];
                 of_walk__d = commands__data_out[32'h1f];
                 commands__read = 1'b1;
-                phase__d = 32'h1;
+                phase__d = ListPhase__Read;
             end
         end
-        if (phase__q == 32'h1) begin
-            phase__d = 32'h2;
+        if (phase__q == ListPhase__Read) begin
+            phase__d = ListPhase__Latch;
         end
-        if (phase__q == 32'h2) begin
+        if (phase__q == ListPhase__Latch) begin
             object_id__d = object_ram__read_data;
             skip_object__d = skip_object_ram__read_data;
             skip_triangle__d = skip_triangle_ram__read_data;
@@ -16439,9 +16557,9 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
             ids__5__d = mailbox_ids__5__read_data;
             ids__6__d = mailbox_ids__6__read_data;
             ids__7__d = mailbox_ids__7__read_data;
-            phase__d = 32'h3;
+            phase__d = ListPhase__Walk;
         end
-        take = (phase__q == 32'h3) & (cursor__q != list_end__q) & ((((queued__q) & 5'h1f) + ((flight__q) & 5'h1f)) < 32'h7) & (~(engine_read & (engine_bank != 32'h0) & (engine_bank != 32'h2) & (engine_bank != 32'h3)));
+        take = (phase__q == ListPhase__Walk) & (cursor__q != list_end__q) & ((((queued__q) & 5'h1f) + ((flight__q) & 5'h1f)) < 32'h7) & (~(engine_read & (engine_bank != c_bank_nodes) & (engine_bank != c_bank_uv) & (engine_bank != c_bank_t)));
         list_read = take;
         list_addr = cursor__q;
         if (take) begin
@@ -16550,10 +16668,10 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
             mailbox_meta__write_enable = 1'b1;
             mailbox_meta__write_data = (((next_after) & 8'hff) << 32'h4) | ((len_after) & 8'hff);
         end
-        if ((phase__q == 32'h3) & (cursor__q == list_end__q) & (flight__q == 32'h0) & (~tests__full)) begin
+        if ((phase__q == ListPhase__Walk) & (cursor__q == list_end__q) & (flight__q == 32'h0) & (~tests__full)) begin
             push = 1'b1;
             tests__data_in = c_list_end | (((of_walk__q) & 71'h7fffffffffffffffff) << 32'h45) | (((walk_thread__q) & 71'h7fffffffffffffffff) << 32'h40);
-            phase__d = 32'h0;
+            phase__d = ListPhase__Idle;
         end
         tests__write = push;
         queued__d = queued__q;
@@ -17059,6 +17177,29 @@ endmodule // dynrt_processor_core__tester__list_unit__object_ram
 
 
 
+module dynrt_processor_core__tester__list_unit__phase(d,q,clock);
+    
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+    
+    // Enums
+    localparam ListPhase__Idle = 0;
+    localparam ListPhase__Read = 1;
+    localparam ListPhase__Latch = 2;
+    localparam ListPhase__Walk = 3;
+    
+    // Update code (custom)
+    initial begin
+       q = 64'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor_core__tester__list_unit__phase
 
 
 
@@ -17462,6 +17603,29 @@ endmodule // dynrt_processor_core__tester__list_unit__tests__write_logic
 
 
 
+module dynrt_processor_core__tester__lphase(d,q,clock);
+    
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+    
+    // Enums
+    localparam Launch__Wait = 0;
+    localparam Launch__Origin = 1;
+    localparam Launch__Direction = 2;
+    localparam Launch__Free = 3;
+    
+    // Update code (custom)
+    initial begin
+       q = 64'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor_core__tester__lphase
 
 
 
@@ -20435,7 +20599,7 @@ endmodule // dynrt_processor_core__tester__transform_unit__tag_delay
 
 
 
-module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write,ray_pair,t_min_write,enqueue,enqueue_next,full,query_thread,pending,result,list_end,engine_read,engine_bank,engine_addr,node_read,node_addr,node_rdata,step_busy,done_event,done_thread,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit);
+module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write,ray_pair,t_min_write,enqueue,full,query_thread,pending,engine_read,engine_bank,engine_addr,node_read,node_addr,node_rdata,step_busy,done_event,done_thread,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit);
     
     // Module arguments
     input wire  clock;
@@ -20446,12 +20610,9 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
     input wire  [1:0] ray_pair;
     input wire  t_min_write;
     input wire  enqueue;
-    input wire  enqueue_next;
     output reg  full;
     input wire  [4:0] query_thread;
     output reg  pending;
-    output reg  [31:0] result;
-    output reg  [31:0] list_end;
     input wire  engine_read;
     input wire  [2:0] engine_bank;
     input wire  [23:0] engine_addr;
@@ -20480,7 +20641,13 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
     localparam  c_index__4 = 4'h4;
     localparam  c_index__5 = 4'h5;
     localparam  c_zero = 24'h0;
-    localparam  c_finished = 32'h80000000;
+    localparam  c_bank_nodes = 3'b0;
+    localparam  c_leaf_tag = 2'b11;
+    
+    // Enums
+    localparam Fetch__Idle = 0;
+    localparam Fetch__Word0 = 1;
+    localparam Fetch__Word1 = 2;
     
     // Stub signals
     reg  entry_fifo__clock;
@@ -20571,20 +20738,6 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
     reg  done_u__write_clock;
     reg  [7:0] done_u__write_data;
     reg  done_u__write_enable;
-    reg  [4:0] result_e__read_address;
-    reg  result_e__read_clock;
-    wire  [31:0] result_e__read_data;
-    reg  [4:0] result_e__write_address;
-    reg  result_e__write_clock;
-    reg  [31:0] result_e__write_data;
-    reg  result_e__write_enable;
-    reg  [4:0] end_e__read_address;
-    reg  end_e__read_clock;
-    wire  [31:0] end_e__read_data;
-    reg  [4:0] end_e__write_address;
-    reg  end_e__write_clock;
-    reg  [31:0] end_e__write_data;
-    reg  end_e__write_enable;
     reg  [4:0] leaf_hi__read_address;
     reg  leaf_hi__read_clock;
     wire  [23:0] leaf_hi__read_data;
@@ -21033,24 +21186,6 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(done_u__write_data),
         .write_enable(done_u__write_enable)
     );
-    dynrt_processor_core__tester__flight_a result_e(
-        .read_address(result_e__read_address),
-        .read_clock(result_e__read_clock),
-        .read_data(result_e__read_data),
-        .write_address(result_e__write_address),
-        .write_clock(result_e__write_clock),
-        .write_data(result_e__write_data),
-        .write_enable(result_e__write_enable)
-    );
-    dynrt_processor_core__tester__flight_a end_e(
-        .read_address(end_e__read_address),
-        .read_clock(end_e__read_clock),
-        .read_data(end_e__read_data),
-        .write_address(end_e__write_address),
-        .write_clock(end_e__write_clock),
-        .write_data(end_e__write_data),
-        .write_enable(end_e__write_enable)
-    );
     dynrt_processor_core__tester__flight_t_min leaf_hi(
         .read_address(leaf_hi__read_address),
         .read_clock(leaf_hi__read_clock),
@@ -21306,7 +21441,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .le(cmp_pop__le),
         .eq(cmp_pop__eq)
     );
-    dynrt_processor_core__tester__cur_kind__0 phase(
+    dynrt_processor_core__traversal_unit__phase phase(
         .d(phase__d),
         .q(phase__q),
         .clock(phase__clock)
@@ -21641,10 +21776,6 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         done_e__write_clock = clock;
         done_u__read_clock = clock;
         done_u__write_clock = clock;
-        result_e__read_clock = clock;
-        result_e__write_clock = clock;
-        end_e__read_clock = clock;
-        end_e__write_clock = clock;
         leaf_hi__read_clock = clock;
         leaf_hi__write_clock = clock;
         leaf_sp__read_clock = clock;
@@ -21685,20 +21816,16 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         engine_full = entry_fifo__full | answer_valid;
         full = engine_full;
         entry_fifo__write = (enqueue & (~engine_full)) | answer_valid;
-        entry_fifo__data_in = (((enqueue_next) & 70'h3fffffffffffffffff) << 32'h45) | (((thread) & 70'h3fffffffffffffffff) << 32'h40) | (((word_a) & 70'h3fffffffffffffffff) << 32'h20) | ((word_b) & 70'h3fffffffffffffffff);
+        entry_fifo__data_in = (((thread) & 70'h3fffffffffffffffff) << 32'h40) | (((word_a) & 70'h3fffffffffffffffff) << 32'h20) | ((word_b) & 70'h3fffffffffffffffff);
         if (answer_valid) begin
             entry_fifo__data_in = (((1'b1) & 70'h3fffffffffffffffff) << 32'h45) | (((answer_thread) & 70'h3fffffffffffffffff) << 32'h40) | (((answer_t) & 70'h3fffffffffffffffff) << 32'h20) | ((answer_hit) & 70'h3fffffffffffffffff);
         end
         any_hit__write_address = thread;
         any_hit__write_data = ((word_a[32'h1f]) & 1'h1);
-        any_hit__write_enable = enqueue & (~engine_full) & (~enqueue_next);
+        any_hit__write_enable = enqueue & (~engine_full);
         issued__read_address = query_thread;
         done_e__read_address = query_thread;
-        result_e__read_address = query_thread;
-        end_e__read_address = query_thread;
         pending = issued__read_data != done_e__read_data;
-        result = result_e__read_data;
-        list_end = end_e__read_data;
         issued__write_address = thread;
         issued__write_data = issued__read_data + 32'h1;
         issued__write_enable = enqueue & (~engine_full);
@@ -21767,20 +21894,20 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         loop_fifo__read = 1'b0;
         front_fifo__read = 1'b0;
         in_flight__read = 1'b0;
-        take = (phase__q != 32'h0) & (~(engine_read & (engine_bank == 32'h0)));
-        node_read = take | (engine_read & (engine_bank == 32'h0));
+        take = (phase__q != Fetch__Idle) & (~(engine_read & (engine_bank == c_bank_nodes)));
+        node_read = take | (engine_read & (engine_bank == c_bank_nodes));
         node_addr = engine_addr;
         if (take) begin
-            node_addr = (((fetch_job__q[(32'h40)+:(26)]) & 24'hffffff) << 32'h1) | ((phase__q - 32'h1) & 24'hffffff);
-            phase__d = 32'h2;
-            if (phase__q == 32'h2) begin
-                phase__d = 32'h0;
+            node_addr = (((fetch_job__q[(32'h40)+:(26)]) & 24'hffffff) << 32'h1) | (((phase__q == Fetch__Word1)) & 24'hffffff);
+            phase__d = Fetch__Word1;
+            if (phase__q == Fetch__Word1) begin
+                phase__d = Fetch__Idle;
             end
         end
-        in_flight__write = take & (phase__q == 32'h1);
+        in_flight__write = take & (phase__q == Fetch__Word0);
         in_flight__data_in = fetch_job__q;
         words_in__d = 32'h0;
-        node_line__0__d = (((take) & 2'h3) << 32'h1) | (((phase__q == 32'h2)) & 2'h3);
+        node_line__0__d = (((take) & 2'h3) << 32'h1) | (((phase__q == Fetch__Word1)) & 2'h3);
         node_line__1__d = node_line__0__q;
         node_line__2__d = node_line__1__q;
         node_line__3__d = node_line__2__q;
@@ -21816,20 +21943,20 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
             in_flight__read = 1'b1;
             words_in__d = 32'h1;
         end
-        fetch_free = (phase__q == 32'h0) | ((phase__q == 32'h2) & take);
+        fetch_free = (phase__q == Fetch__Idle) | ((phase__q == Fetch__Word1) & take);
         if (fetch_free) begin
             if (~loop_fifo__empty) begin
                 loop_fifo__read = 1'b1;
                 fetch_job__d = loop_fifo__data_out;
-                phase__d = 32'h1;
+                phase__d = Fetch__Word0;
             end
             else if (~front_fifo__empty) begin
                 if (~front_fifo__data_out[32'h65]) begin
                     front_fifo__read = 1'b1;
                     fetch_job__d = front_fifo__data_out;
-                    phase__d = 32'h1;
+                    phase__d = Fetch__Word0;
                 end
-                else if ((phase__q == 32'h0) & in_flight__empty) begin
+                else if ((phase__q == Fetch__Idle) & in_flight__empty) begin
                     front_fifo__read = 1'b1;
                     job__d = front_fifo__data_out;
                     next_a_thread = front_fifo__data_out[(32'h60)+:(5)];
@@ -21839,7 +21966,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         end
         ray__ray_thread = in_flight__data_out[(32'h60)+:(5)];
         at_a = words_in__q == 32'h1;
-        a_leaf = job__q[32'h65] | (w0__q[(32'h1e)+:(2)] == 32'h3);
+        a_leaf = job__q[32'h65] | (w0__q[(32'h1e)+:(2)] == c_leaf_tag);
         a_axis = w0__q[(32'h1e)+:(2)];
         a_o = ray__o__0;
         a_d = ray__d__0;
@@ -21861,16 +21988,9 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         leaf_from = leaf_fifo__data_out[(32'h20)+:(32)];
         leaf_to = leaf_fifo__data_out[(32'h0)+:(32)];
         leaf_fifo__read = leaf_take;
-        result_e__write_address = job__q[(32'h60)+:(5)];
-        end_e__write_address = job__q[(32'h60)+:(5)];
         done_e__write_address = job__q[(32'h60)+:(5)];
         leaf_hi__write_address = job__q[(32'h60)+:(5)];
         leaf_sp__write_address = job__q[(32'h60)+:(5)];
-        result_e__write_data = ((w0__q[(32'h0)+:(30)]) & 32'hffffffff);
-        if (job__q[32'h65]) begin
-            result_e__write_data = c_finished;
-        end
-        end_e__write_data = a_list_end;
         leaf_hi__write_data = job__q[(32'h0)+:(24)];
         leaf_sp__write_data = job__q[(32'h5a)+:(6)];
         done_u__read_address = next_a_thread;
@@ -21878,8 +21998,6 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         done_e__write_data = done_u__read_data + 32'h1;
         done_u__write_data = done_u__read_data + 32'h1;
         done_u__write_enable = a_end;
-        result_e__write_enable = a_end;
-        end_e__write_enable = a_end;
         done_e__write_enable = a_end;
         done_event = a_end;
         done_thread = job__q[(32'h60)+:(5)];
@@ -22520,8 +22638,6 @@ module dynrt_processor_core__traversal_unit__control_delay_div(clock,data_in,dat
     end
     
 endmodule // dynrt_processor_core__traversal_unit__control_delay_div
-
-
 
 
 
@@ -24760,8 +24876,28 @@ endmodule // dynrt_processor_core__traversal_unit__leaf_sp
 
 
 
-
-
+module dynrt_processor_core__traversal_unit__phase(d,q,clock);
+    
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+    
+    // Enums
+    localparam Fetch__Idle = 0;
+    localparam Fetch__Word0 = 1;
+    localparam Fetch__Word1 = 2;
+    
+    // Update code (custom)
+    initial begin
+       q = 64'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor_core__traversal_unit__phase
 
 
 

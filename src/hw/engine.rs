@@ -52,9 +52,13 @@
 use rust_hdl::prelude::*;
 
 use super::fp::{FpAddSub, FpCompare, FpDiv, FpMul, FpSqrt};
-use super::program::isa::Instr;
+use super::list_unit;
+use super::program::isa::{
+    self, KdFn, Op, TriFn, BANK_BITS, OPS, OP_BITS, PC_BITS, REG_BITS, SHIFT_BITS,
+};
 use super::program::Program;
 use super::{ChannelByte, Delay, TraversalUnit, TriangleTester, UIntToFloat, CHANNEL_BYTE_LATENCY};
+use crate::layout;
 
 /// Most threads (the thread id is 5 bits).
 pub const MAX_THREADS: usize = 32;
@@ -199,7 +203,9 @@ pub struct ThreadEngine<
     tri_cond: Signal<Local, Bit>,
     wait_fn: Signal<Local, Bit>,
     kd_cond: Signal<Local, Bit>,
-    fast_kind: Signal<Local, Bits<3>>,
+    fast_kind: Signal<Local, FastKind>,
+    tri_queues: Signal<Local, Bit>,
+    tri_kind: Signal<Local, Bits<2>>,
     // Ports.
     mem_read_r: DFF<Bit>,
     mem_bank_r: DFF<Bits<3>>,
@@ -228,7 +234,7 @@ pub struct ThreadEngine<
     sqrt_delay: Delay<Bits<W>, 1>,
     cmp_delay: Delay<Bits<3>, 9>,
     fast_line: [DFF<Bits<32>>; FAST_STAGES],
-    fast_kind_line: [DFF<Bits<3>>; FAST_STAGES],
+    fast_kind_line: [DFF<FastKind>; FAST_STAGES],
     fast_delay: Delay<Bits<32>, 3>,
     /// {valid, op, dst, thread, invert} from I3 to write back.
     ctl_delay: Delay<Bits<21>, 3>,
@@ -278,6 +284,109 @@ pub struct ThreadEngine<
     c_index: [Constant<Bits<8>>; 8],
     /// The bit of `reserved` a long instruction at I3 sets: `DX - 4`.
     c_reserve_bit: Constant<Bits<32>>,
+
+    // The decoder's names, every one from its definition in `isa` (`Op`, `TriFn`, `KdFn`),
+    // `layout` (banks) and `list_unit` (command kinds): the Verilog's localparams follow the
+    // twin's numbering by construction.
+    op_fadd: Constant<Bits<5>>,
+    op_fsub: Constant<Bits<5>>,
+    op_fmul: Constant<Bits<5>>,
+    op_fdiv: Constant<Bits<5>>,
+    op_fsqrt: Constant<Bits<5>>,
+    op_itof: Constant<Bits<5>>,
+    op_add: Constant<Bits<5>>,
+    op_sub: Constant<Bits<5>>,
+    op_and: Constant<Bits<5>>,
+    op_or: Constant<Bits<5>>,
+    op_xor: Constant<Bits<5>>,
+    op_shr: Constant<Bits<5>>,
+    op_shl: Constant<Bits<5>>,
+    op_ld: Constant<Bits<5>>,
+    op_st: Constant<Bits<5>>,
+    op_lds: Constant<Bits<5>>,
+    op_sts: Constant<Bits<5>>,
+    op_bflt: Constant<Bits<5>>,
+    op_bfle: Constant<Bits<5>>,
+    op_bfeq: Constant<Bits<5>>,
+    op_beq: Constant<Bits<5>>,
+    op_bltu: Constant<Bits<5>>,
+    op_jal: Constant<Bits<5>>,
+    op_jr: Constant<Bits<5>>,
+    op_mbx: Constant<Bits<5>>,
+    op_mbc: Constant<Bits<5>>,
+    op_pixel: Constant<Bits<5>>,
+    op_halt: Constant<Bits<5>>,
+    op_tri: Constant<Bits<5>>,
+    op_kd: Constant<Bits<5>>,
+    op_byte: Constant<Bits<5>>,
+    /// Bit `op` set for every op that writes `dst` (`Op::writes`).
+    op_writes: Constant<Bits<32>>,
+    /// The ray words are `TriFn`s 0..3, their number the ray store's `ray_pair`.
+    tri_ray_words: Constant<Bits<32>>,
+    tri_init: Constant<Bits<32>>,
+    tri_list: Constant<Bits<32>>,
+    tri_wait: Constant<Bits<32>>,
+    tri_hit: Constant<Bits<32>>,
+    tri_instance: Constant<Bits<32>>,
+    tri_triangle: Constant<Bits<32>>,
+    tri_object: Constant<Bits<32>>,
+    tri_skip: Constant<Bits<32>>,
+    kd_start: Constant<Bits<32>>,
+    kd_wait: Constant<Bits<32>>,
+    cmd_list: Constant<Bits<2>>,
+    cmd_init: Constant<Bits<2>>,
+    cmd_object: Constant<Bits<2>>,
+    cmd_skip: Constant<Bits<2>>,
+    bank_nodes: Constant<Bits<3>>,
+    bank_lists: Constant<Bits<3>>,
+    bank_uv: Constant<Bits<3>>,
+    bank_t: Constant<Bits<3>>,
+    /// The lowest bit of each field of the ROM words (`isa::CTL_*`, `isa::AUX_*`).
+    f_op: Constant<Bits<5>>,
+    f_dst: Constant<Bits<5>>,
+    f_a: Constant<Bits<5>>,
+    f_b: Constant<Bits<5>>,
+    f_b_imm: Constant<Bits<5>>,
+    f_invert: Constant<Bits<5>>,
+    f_shift: Constant<Bits<5>>,
+    f_bank: Constant<Bits<5>>,
+    f_target: Constant<Bits<5>>,
+}
+
+/// Where an instruction's result comes from on the fast line: computed at I3, or the data of
+/// a scratch read or of a load from the shared memory port or a bank's own port.
+#[derive(Copy, Clone, Debug, PartialEq, LogicState)]
+pub enum FastKind {
+    Computed,
+    Scratch,
+    Memory,
+    TrianglesUv,
+    TrianglesT,
+    Nodes,
+}
+
+fn op_code(op: Op) -> Constant<Bits<5>> {
+    Constant::new((op as u64).into())
+}
+
+fn tri_fn(f: TriFn) -> Constant<Bits<32>> {
+    Constant::new((f as u64).into())
+}
+
+fn kd_fn(f: KdFn) -> Constant<Bits<32>> {
+    Constant::new((f as u64).into())
+}
+
+fn bank(b: usize) -> Constant<Bits<3>> {
+    Constant::new((b as u64).into())
+}
+
+fn cmd(c: u64) -> Constant<Bits<2>> {
+    Constant::new(c.into())
+}
+
+fn field(at: usize) -> Constant<Bits<5>> {
+    Constant::new((at as u64).into())
 }
 
 fn word_map<const N: usize, D: Synth>(
@@ -287,19 +396,6 @@ fn word_map<const N: usize, D: Synth>(
         .enumerate()
         .map(|(i, w)| (Bits::<N>::from(i as u64), w))
         .collect()
-}
-
-/// The three ROM words of an instruction: control `{op, dst, a, b, b_imm, invert}`, the
-/// immediate, and `{shift, bank, target}`.
-pub fn rom_words(i: &Instr) -> [u32; 3] {
-    let ctl = ((i.op as u32) << 26)
-        | (u32::from(i.dst) << 18)
-        | (u32::from(i.a) << 10)
-        | (u32::from(i.b) << 2)
-        | (u32::from(i.b_imm) << 1)
-        | u32::from(i.invert);
-    let aux = (u32::from(i.shift) << 15) | (u32::from(i.bank) << 12) | u32::from(i.target);
-    [ctl, i.imm, aux]
 }
 
 impl<
@@ -329,12 +425,16 @@ impl<
         assert!((1..=MAX_THREADS as u32).contains(&threads));
         assert!((1..=MAX_MEM_LATENCY).contains(&mem_latency));
         assert!(program.scratch.words <= SCRATCH_WORDS);
+        // The ray words' function number is the ray store's `ray_pair` (`imm` bits 1..0), and
+        // every function below `TriFn::Init` is one.
+        assert!(
+            TriFn::RayOxy as u32 == 0 && TriFn::RayOzDx as u32 == 1 && TriFn::RayDyz as u32 == 2
+        );
+        assert!(TriFn::Init as u32 == 3);
+        let words = program.rom();
         let rom = |k: usize| -> RAM<Bits<32>, 12> {
             RAM::new(word_map(
-                program
-                    .code
-                    .iter()
-                    .map(|i| Bits::<32>::from(u64::from(rom_words(i)[k]))),
+                words.iter().map(|w| Bits::<32>::from(u64::from(w[k]))),
             ))
         };
         Self {
@@ -430,6 +530,8 @@ impl<
             wait_fn: Default::default(),
             kd_cond: Default::default(),
             fast_kind: Default::default(),
+            tri_queues: Default::default(),
+            tri_kind: Default::default(),
             mem_read_r: Default::default(),
             mem_bank_r: Default::default(),
             mem_addr_r: Default::default(),
@@ -487,6 +589,71 @@ impl<
             c_mem_latency: Constant::new(u64::from(mem_latency).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_reserve_bit: Constant::new(((DX - 4) as u64).into()),
+            op_fadd: op_code(Op::FAdd),
+            op_fsub: op_code(Op::FSub),
+            op_fmul: op_code(Op::FMul),
+            op_fdiv: op_code(Op::FDiv),
+            op_fsqrt: op_code(Op::FSqrt),
+            op_itof: op_code(Op::IToF),
+            op_add: op_code(Op::Add),
+            op_sub: op_code(Op::Sub),
+            op_and: op_code(Op::And),
+            op_or: op_code(Op::Or),
+            op_xor: op_code(Op::Xor),
+            op_shr: op_code(Op::Shr),
+            op_shl: op_code(Op::Shl),
+            op_ld: op_code(Op::Ld),
+            op_st: op_code(Op::St),
+            op_lds: op_code(Op::Lds),
+            op_sts: op_code(Op::Sts),
+            op_bflt: op_code(Op::BFlt),
+            op_bfle: op_code(Op::BFle),
+            op_bfeq: op_code(Op::BFeq),
+            op_beq: op_code(Op::Beq),
+            op_bltu: op_code(Op::Bltu),
+            op_jal: op_code(Op::Jal),
+            op_jr: op_code(Op::Jr),
+            op_mbx: op_code(Op::Mbx),
+            op_mbc: op_code(Op::Mbc),
+            op_pixel: op_code(Op::Pixel),
+            op_halt: op_code(Op::Halt),
+            op_tri: op_code(Op::Tri),
+            op_kd: op_code(Op::Kd),
+            op_byte: op_code(Op::Byte),
+            op_writes: Constant::new(
+                OPS.iter()
+                    .filter(|o| o.writes())
+                    .fold(0u64, |m, &o| m | 1 << (o as u64))
+                    .into(),
+            ),
+            tri_ray_words: tri_fn(TriFn::Init),
+            tri_init: tri_fn(TriFn::Init),
+            tri_list: tri_fn(TriFn::List),
+            tri_wait: tri_fn(TriFn::Wait),
+            tri_hit: tri_fn(TriFn::Hit),
+            tri_instance: tri_fn(TriFn::Instance),
+            tri_triangle: tri_fn(TriFn::Triangle),
+            tri_object: tri_fn(TriFn::Object),
+            tri_skip: tri_fn(TriFn::Skip),
+            kd_start: kd_fn(KdFn::Start),
+            kd_wait: kd_fn(KdFn::Wait),
+            cmd_list: cmd(list_unit::CMD_LIST),
+            cmd_init: cmd(list_unit::CMD_INIT),
+            cmd_object: cmd(list_unit::CMD_OBJECT),
+            cmd_skip: cmd(list_unit::CMD_SKIP),
+            bank_nodes: bank(layout::NODES),
+            bank_lists: bank(layout::LISTS),
+            bank_uv: bank(layout::TRIANGLES_UV),
+            bank_t: bank(layout::TRIANGLES_T),
+            f_op: field(isa::CTL_OP),
+            f_dst: field(isa::CTL_DST),
+            f_a: field(isa::CTL_A),
+            f_b: field(isa::CTL_B),
+            f_b_imm: field(isa::CTL_B_IMM),
+            f_invert: field(isa::CTL_INVERT),
+            f_shift: field(isa::AUX_SHIFT),
+            f_bank: field(isa::AUX_BANK),
+            f_target: field(isa::AUX_TARGET),
         }
     }
 }
@@ -666,9 +833,19 @@ impl<
 
         // I2: decode, read the registers and the mailbox.
         self.regs_a.read_address.next = (bit_cast::<13, 5>(self.t2.q.val()) << 8)
-            | bit_cast::<13, 8>(self.rom_ctl.read_data.val().get_bits::<8>(10));
+            | bit_cast::<13, 8>(
+                self.rom_ctl
+                    .read_data
+                    .val()
+                    .get_bits::<REG_BITS>(self.f_a.val().index()),
+            );
         self.regs_b.read_address.next = (bit_cast::<13, 5>(self.t2.q.val()) << 8)
-            | bit_cast::<13, 8>(self.rom_ctl.read_data.val().get_bits::<8>(2));
+            | bit_cast::<13, 8>(
+                self.rom_ctl
+                    .read_data
+                    .val()
+                    .get_bits::<REG_BITS>(self.f_b.val().index()),
+            );
         self.mailbox_meta.read_address.next = (bit_cast::<6, 5>(self.t2.q.val()) << 1)
             | bit_cast::<6, 1>(self.rom_imm.read_data.val().get_bits::<1>(0));
         for k in 0..8 {
@@ -685,15 +862,31 @@ impl<
         self.aux3.d.next = self.rom_aux.read_data.val();
 
         // I3: operands (r0 always reads 0).
-        self.op3.next = self.ctl3.q.val().get_bits::<5>(26);
-        if self.ctl3.q.val().get_bits::<8>(10) == 0 {
+        self.op3.next = self
+            .ctl3
+            .q
+            .val()
+            .get_bits::<OP_BITS>(self.f_op.val().index());
+        if self
+            .ctl3
+            .q
+            .val()
+            .get_bits::<REG_BITS>(self.f_a.val().index())
+            == 0
+        {
             self.opa.next = 0.into();
         } else {
             self.opa.next = self.regs_a.read_data.val();
         }
-        if self.ctl3.q.val().get_bit(1) {
+        if self.ctl3.q.val().get_bit(self.f_b_imm.val().index()) {
             self.opb.next = self.imm3.q.val();
-        } else if self.ctl3.q.val().get_bits::<8>(2) == 0 {
+        } else if self
+            .ctl3
+            .q
+            .val()
+            .get_bits::<REG_BITS>(self.f_b.val().index())
+            == 0
+        {
             self.opb.next = 0.into();
         } else {
             self.opb.next = self.regs_b.read_data.val();
@@ -702,7 +895,7 @@ impl<
         // Floating-point units: every clock, whether used or not.
         self.add.a.next = self.opa.val().get_bits::<W>(0);
         self.add.b.next = self.opb.val().get_bits::<W>(0);
-        self.add.sub.next = self.op3.val() == 2;
+        self.add.sub.next = self.op3.val() == self.op_fsub.val();
         self.add.in_valid.next = true;
         self.mul.a.next = self.opa.val().get_bits::<W>(0);
         self.mul.b.next = self.opb.val().get_bits::<W>(0);
@@ -720,7 +913,8 @@ impl<
         self.byte_unit.in_valid.next = true;
         // A long instruction at I3 reserves its write-back clock: no issue `DX - 3` clocks
         // from now, whose instruction would write back with it.
-        self.long3.next = self.v3.q.val() & ((self.op3.val() == 4) | (self.op3.val() == 5));
+        self.long3.next = self.v3.q.val()
+            & ((self.op3.val() == self.op_fdiv.val()) | (self.op3.val() == self.op_fsqrt.val()));
         self.reserved.d.next = (self.reserved.q.val() >> 1)
             | (bit_cast::<32, 1>(self.long3.val().into()) << self.c_reserve_bit.val());
         self.add_delay.data_in.next = self.add.result.val();
@@ -734,7 +928,12 @@ impl<
         // Integer conditions, addresses.
         self.int_eq.next = self.opa.val() == self.opb.val();
         self.int_lt.next = self.opa.val() < self.opb.val();
-        self.shifted.next = self.opa.val() << self.aux3.q.val().get_bits::<3>(15);
+        self.shifted.next = self.opa.val()
+            << self
+                .aux3
+                .q
+                .val()
+                .get_bits::<SHIFT_BITS>(self.f_shift.val().index());
         self.mem_address.next = self.shifted.val() + self.imm3.q.val();
         self.scratch_address.next = self.opa.val() + self.imm3.q.val();
 
@@ -759,10 +958,10 @@ impl<
             self.mailbox[k].write_data.next = self.opa.val();
             self.mailbox[k].write_enable.next = false;
         }
-        if self.v3.q.val() & (self.op3.val() == 26) {
+        if self.v3.q.val() & (self.op3.val() == self.op_mbc.val()) {
             self.mailbox_meta.write_enable.next = true;
         }
-        if self.v3.q.val() & (self.op3.val() == 25) & (!self.mb_hit.val()) {
+        if self.v3.q.val() & (self.op3.val() == self.op_mbx.val()) & (!self.mb_hit.val()) {
             self.mailbox_meta.write_enable.next = true;
             if self.mb_len.val() == 8 {
                 self.mailbox_meta.write_data.next =
@@ -780,7 +979,10 @@ impl<
 
         // Pixel counter.
         self.pix_done.next = !(self.py.q.val() < self.c_height.val());
-        if self.running.q.val() & self.v3.q.val() & (self.op3.val() == 27) & (!self.pix_done.val())
+        if self.running.q.val()
+            & self.v3.q.val()
+            & (self.op3.val() == self.op_pixel.val())
+            & (!self.pix_done.val())
         {
             if (self.px.q.val() + 1) == self.c_width.val() {
                 self.px.d.next = 0.into();
@@ -796,21 +998,25 @@ impl<
         self.scratch.write_address.next = (bit_cast::<12, 5>(self.t3.q.val()) << 7)
             | bit_cast::<12, 7>(self.scratch_address.val().get_bits::<7>(0));
         self.scratch.write_data.next = self.regs_b.read_data.val();
-        self.scratch.write_enable.next = self.v3.q.val() & (self.op3.val() == 17);
+        self.scratch.write_enable.next = self.v3.q.val() & (self.op3.val() == self.op_sts.val());
 
         // Memory and frame-buffer ports (registered).
-        self.mem_read_r.d.next = self.v3.q.val() & (self.op3.val() == 14);
-        self.mem_bank_r.d.next = self.aux3.q.val().get_bits::<3>(12);
+        self.mem_read_r.d.next = self.v3.q.val() & (self.op3.val() == self.op_ld.val());
+        self.mem_bank_r.d.next = self
+            .aux3
+            .q
+            .val()
+            .get_bits::<BANK_BITS>(self.f_bank.val().index());
         self.mem_addr_r.d.next = self.mem_address.val().get_bits::<24>(0);
-        self.fb_write_r.d.next = self.v3.q.val() & (self.op3.val() == 15);
+        self.fb_write_r.d.next = self.v3.q.val() & (self.op3.val() == self.op_st.val());
         self.fb_addr_r.d.next = self.mem_address.val().get_bits::<24>(0);
         self.fb_data_r.d.next = self.regs_b.read_data.val();
         // Bank 0 goes through the traversal unit's port, banks 2 and 3 through the triangle
         // tester's; the tester's list reads (bank 1) use this bus when the engine does not.
         self.mem_read.next = (self.mem_read_r.q.val()
-            & (self.mem_bank_r.q.val() != 0)
-            & (self.mem_bank_r.q.val() != 2)
-            & (self.mem_bank_r.q.val() != 3))
+            & (self.mem_bank_r.q.val() != self.bank_nodes.val())
+            & (self.mem_bank_r.q.val() != self.bank_uv.val())
+            & (self.mem_bank_r.q.val() != self.bank_t.val()))
             | self.tester.list_read.val();
         self.traversal_unit.engine_read.next = self.mem_read_r.q.val();
         self.traversal_unit.engine_bank.next = self.mem_bank_r.q.val();
@@ -821,7 +1027,7 @@ impl<
         self.mem_bank.next = self.mem_bank_r.q.val();
         self.mem_addr.next = self.mem_addr_r.q.val();
         if self.tester.list_read.val() {
-            self.mem_bank.next = 1.into();
+            self.mem_bank.next = self.bank_lists.val();
             self.mem_addr.next = self.tester.list_addr.val();
         }
         self.tester.list_rdata.next = self.mem_rdata.val();
@@ -835,39 +1041,44 @@ impl<
         self.bank3_addr.next = self.tester.t_addr.val();
         self.tester.t_rdata.next = self.bank3_rdata.val();
 
-        // Triangle tester (op 29, function in imm): ray words 0-2, init 3, list 4, wait 5,
-        // hit 6, instance 7, triangle 8, object 9, skip 10; the queued ones (3, 4, 9, 10) as
-        // the list unit's command kinds 1, 0, 2, 3.
+        // Triangle tester (`tri`, its `TriFn` in imm); the queued functions go to the list
+        // unit as its command kinds.
         self.tester.thread.next = self.t3.q.val();
         self.tester.word_a.next = self.opa.val();
         self.tester.word_b.next = self.opb.val();
         self.tester.ray_pair.next = self.imm3.q.val().get_bits::<2>(0);
-        self.tester.ray_write.next =
-            self.v3.q.val() & (self.op3.val() == 29) & (self.imm3.q.val() < 3);
-        self.tester.enqueue.next = self.v3.q.val()
-            & (self.op3.val() == 29)
-            & ((self.imm3.q.val() == 3)
-                | (self.imm3.q.val() == 4)
-                | (self.imm3.q.val() == 9)
-                | (self.imm3.q.val() == 10));
-        // One assignment: a default overridden in this block would glitch an input of the
-        // tester's block, whose outputs feed back here, and Icarus would loop forever.
-        self.tester.queue_kind.next =
-            (bit_cast::<2, 1>(((self.imm3.q.val() == 9) | (self.imm3.q.val() == 10)).into()) << 1)
-                | bit_cast::<2, 1>(((self.imm3.q.val() == 3) | (self.imm3.q.val() == 10)).into());
+        self.tester.ray_write.next = self.v3.q.val()
+            & (self.op3.val() == self.op_tri.val())
+            & (self.imm3.q.val() < self.tri_ray_words.val());
+        self.tri_queues.next = (self.imm3.q.val() == self.tri_init.val())
+            | (self.imm3.q.val() == self.tri_list.val())
+            | (self.imm3.q.val() == self.tri_object.val())
+            | (self.imm3.q.val() == self.tri_skip.val());
+        self.tester.enqueue.next =
+            self.v3.q.val() & (self.op3.val() == self.op_tri.val()) & self.tri_queues.val();
+        // The kind is settled in a local signal and given to the tester in one assignment: a
+        // default overridden on the tester's input itself would glitch it, the tester's
+        // outputs feed back here, and Icarus would loop forever.
+        self.tri_kind.next = self.cmd_list.val();
+        if self.imm3.q.val() == self.tri_init.val() {
+            self.tri_kind.next = self.cmd_init.val();
+        }
+        if self.imm3.q.val() == self.tri_object.val() {
+            self.tri_kind.next = self.cmd_object.val();
+        }
+        if self.imm3.q.val() == self.tri_skip.val() {
+            self.tri_kind.next = self.cmd_skip.val();
+        }
+        self.tester.queue_kind.next = self.tri_kind.val();
         self.tri_cond.next = false;
-        if (self.imm3.q.val() == 3)
-            | (self.imm3.q.val() == 4)
-            | (self.imm3.q.val() == 9)
-            | (self.imm3.q.val() == 10)
-        {
+        if self.tri_queues.val() {
             self.tri_cond.next = self.tester.full.val();
         }
-        if self.imm3.q.val() == 5 {
+        if self.imm3.q.val() == self.tri_wait.val() {
             self.tri_cond.next = self.tester.pending.val();
         }
-        // Traversal unit (op 30, function in imm): start 0, wait 1, end 2, next 3. It sees the
-        // object-space ray and t_min the thread gives the tester.
+        // Traversal unit (`kd`, its `KdFn` in imm). It sees the object-space ray and t_min the
+        // thread gives the tester.
         // The traversal unit hands its leaves to the tester, the tester its answers back.
         self.tester.walk_list_valid.next = self.traversal_unit.leaf_valid.val();
         self.tester.walk_list_thread.next = self.traversal_unit.leaf_thread.val();
@@ -882,97 +1093,109 @@ impl<
         self.traversal_unit.word_a.next = self.opa.val();
         self.traversal_unit.word_b.next = self.opb.val();
         self.traversal_unit.ray_pair.next = self.imm3.q.val().get_bits::<2>(0);
-        self.traversal_unit.ray_write.next =
-            self.v3.q.val() & (self.op3.val() == 29) & (self.imm3.q.val() < 3);
-        self.traversal_unit.t_min_write.next =
-            self.v3.q.val() & (self.op3.val() == 29) & (self.imm3.q.val() == 3);
+        self.traversal_unit.ray_write.next = self.v3.q.val()
+            & (self.op3.val() == self.op_tri.val())
+            & (self.imm3.q.val() < self.tri_ray_words.val());
+        self.traversal_unit.t_min_write.next = self.v3.q.val()
+            & (self.op3.val() == self.op_tri.val())
+            & (self.imm3.q.val() == self.tri_init.val());
         self.traversal_unit.enqueue.next = self.v3.q.val()
-            & (self.op3.val() == 30)
-            & ((self.imm3.q.val() == 0) | (self.imm3.q.val() == 3));
-        self.traversal_unit.enqueue_next.next = self.imm3.q.val() == 3;
+            & (self.op3.val() == self.op_kd.val())
+            & (self.imm3.q.val() == self.kd_start.val());
         self.kd_cond.next = self.traversal_unit.full.val();
-        if self.imm3.q.val() == 1 {
+        if self.imm3.q.val() == self.kd_wait.val() {
             self.kd_cond.next = self.traversal_unit.pending.val();
         }
         // The waits (`tri.wait`, `kd.wait`): a pending one sleeps instead of repeating.
-        self.wait_fn.next = ((self.op3.val() == 29) & (self.imm3.q.val() == 5))
-            | ((self.op3.val() == 30) & (self.imm3.q.val() == 1));
+        self.wait_fn.next = ((self.op3.val() == self.op_tri.val())
+            & (self.imm3.q.val() == self.tri_wait.val()))
+            | ((self.op3.val() == self.op_kd.val()) & (self.imm3.q.val() == self.kd_wait.val()));
         self.fb_write.next = self.fb_write_r.q.val();
         self.fb_addr.next = self.fb_addr_r.q.val();
         self.fb_data.next = self.fb_data_r.q.val();
 
         // The fast result (integer, conversion, link, pixel; loads fill in later).
-        self.fast_kind.next = 0.into();
+        self.fast_kind.next = FastKind::Computed;
         self.fast.next = 0.into();
-        if self.op3.val() == 6 {
+        if self.op3.val() == self.op_itof.val() {
             self.fast.next = bit_cast::<32, W>(self.itof.word.val());
         }
-        if self.op3.val() == 7 {
+        if self.op3.val() == self.op_add.val() {
             self.fast.next = self.opa.val() + self.opb.val();
         }
-        if self.op3.val() == 8 {
+        if self.op3.val() == self.op_sub.val() {
             self.fast.next = self.opa.val() - self.opb.val();
         }
-        if self.op3.val() == 9 {
+        if self.op3.val() == self.op_and.val() {
             self.fast.next = self.opa.val() & self.opb.val();
         }
-        if self.op3.val() == 10 {
+        if self.op3.val() == self.op_or.val() {
             self.fast.next = self.opa.val() | self.opb.val();
         }
-        if self.op3.val() == 11 {
+        if self.op3.val() == self.op_xor.val() {
             self.fast.next = self.opa.val() ^ self.opb.val();
         }
-        if self.op3.val() == 12 {
+        if self.op3.val() == self.op_shr.val() {
             self.fast.next = self.opa.val() >> self.opb.val().get_bits::<5>(0);
         }
-        if self.op3.val() == 13 {
+        if self.op3.val() == self.op_shl.val() {
             self.fast.next = self.opa.val() << self.opb.val().get_bits::<5>(0);
         }
-        if self.op3.val() == 14 {
-            self.fast_kind.next = 2.into();
-            if self.aux3.q.val().get_bits::<3>(12) == 2 {
-                self.fast_kind.next = 3.into();
+        if self.op3.val() == self.op_ld.val() {
+            self.fast_kind.next = FastKind::Memory;
+            if self
+                .aux3
+                .q
+                .val()
+                .get_bits::<BANK_BITS>(self.f_bank.val().index())
+                == self.bank_uv.val()
+            {
+                self.fast_kind.next = FastKind::TrianglesUv;
             }
-            if self.aux3.q.val().get_bits::<3>(12) == 3 {
-                self.fast_kind.next = 4.into();
+            if self
+                .aux3
+                .q
+                .val()
+                .get_bits::<BANK_BITS>(self.f_bank.val().index())
+                == self.bank_t.val()
+            {
+                self.fast_kind.next = FastKind::TrianglesT;
             }
-            if self.aux3.q.val().get_bits::<3>(12) == 0 {
-                self.fast_kind.next = 5.into();
+            if self
+                .aux3
+                .q
+                .val()
+                .get_bits::<BANK_BITS>(self.f_bank.val().index())
+                == self.bank_nodes.val()
+            {
+                self.fast_kind.next = FastKind::Nodes;
             }
         }
-        if self.op3.val() == 16 {
-            self.fast_kind.next = 1.into();
+        if self.op3.val() == self.op_lds.val() {
+            self.fast_kind.next = FastKind::Scratch;
         }
-        if self.op3.val() == 23 {
+        if self.op3.val() == self.op_jal.val() {
             self.fast.next = bit_cast::<32, 12>(self.pc3.q.val() + 1);
         }
-        if self.op3.val() == 31 {
+        if self.op3.val() == self.op_byte.val() {
             self.fast.next = self.opb.val() << 8;
         }
-        if self.op3.val() == 27 {
+        if self.op3.val() == self.op_pixel.val() {
             self.fast.next = (bit_cast::<32, 16>(self.py.q.val()) << self.c_pixel_shift.val())
                 | bit_cast::<32, 16>(self.px.q.val());
         }
-        if self.op3.val() == 29 {
-            if self.imm3.q.val() == 5 {
+        if self.op3.val() == self.op_tri.val() {
+            if self.imm3.q.val() == self.tri_wait.val() {
                 self.fast.next = bit_cast::<32, W>(self.tester.best_t.val());
             }
-            if self.imm3.q.val() == 6 {
+            if self.imm3.q.val() == self.tri_hit.val() {
                 self.fast.next = bit_cast::<32, 1>(self.tester.hit.val().into());
             }
-            if self.imm3.q.val() == 7 {
+            if self.imm3.q.val() == self.tri_instance.val() {
                 self.fast.next = self.tester.best_instance.val();
             }
-            if self.imm3.q.val() == 8 {
+            if self.imm3.q.val() == self.tri_triangle.val() {
                 self.fast.next = self.tester.best_triangle.val();
-            }
-        }
-        if self.op3.val() == 30 {
-            if self.imm3.q.val() == 1 {
-                self.fast.next = self.traversal_unit.result.val();
-            }
-            if self.imm3.q.val() == 2 {
-                self.fast.next = self.traversal_unit.list_end.val();
             }
         }
 
@@ -981,11 +1204,21 @@ impl<
         self.fast_kind_line[0].d.next = self.fast_kind.val();
         self.ctl_line[0].d.next = (bit_cast::<21, 1>(self.v3.q.val().into()) << 20)
             | (bit_cast::<21, 5>(self.op3.val()) << 15)
-            | (bit_cast::<21, 8>(self.ctl3.q.val().get_bits::<8>(18)) << 7)
+            | (bit_cast::<21, 8>(
+                self.ctl3
+                    .q
+                    .val()
+                    .get_bits::<REG_BITS>(self.f_dst.val().index()),
+            ) << 7)
             | (bit_cast::<21, 5>(self.t3.q.val()) << 2)
-            | bit_cast::<21, 1>(self.ctl3.q.val().get_bits::<1>(0));
+            | bit_cast::<21, 1>(self.ctl3.q.val().get_bits::<1>(self.f_invert.val().index()));
         self.pc_line[0].d.next = (bit_cast::<24, 12>(self.pc3.q.val() + 1) << 12)
-            | bit_cast::<24, 12>(self.aux3.q.val().get_bits::<12>(0));
+            | bit_cast::<24, 12>(
+                self.aux3
+                    .q
+                    .val()
+                    .get_bits::<PC_BITS>(self.f_target.val().index()),
+            );
         self.cond_line[0].d.next = (bit_cast::<19, 1>(self.wait_fn.val().into()) << 18)
             | (bit_cast::<19, 1>(self.kd_cond.val().into()) << 17)
             | (bit_cast::<19, 1>(self.tri_cond.val().into()) << 16)
@@ -1001,21 +1234,21 @@ impl<
             self.pc_line[k].d.next = self.pc_line[k - 1].q.val();
             self.cond_line[k].d.next = self.cond_line[k - 1].q.val();
         }
-        if self.fast_kind_line[0].q.val() == 1 {
+        if self.fast_kind_line[0].q.val() == FastKind::Scratch {
             self.fast_line[1].d.next = self.scratch.read_data.val();
         }
         for k in 1..7 {
             if self.c_mem_latency.val() == self.c_index[k].val() {
-                if self.fast_kind_line[k].q.val() == 2 {
+                if self.fast_kind_line[k].q.val() == FastKind::Memory {
                     self.fast_line[k + 1].d.next = self.mem_rdata.val();
                 }
-                if self.fast_kind_line[k].q.val() == 3 {
+                if self.fast_kind_line[k].q.val() == FastKind::TrianglesUv {
                     self.fast_line[k + 1].d.next = self.bank2_rdata.val();
                 }
-                if self.fast_kind_line[k].q.val() == 4 {
+                if self.fast_kind_line[k].q.val() == FastKind::TrianglesT {
                     self.fast_line[k + 1].d.next = self.bank3_rdata.val();
                 }
-                if self.fast_kind_line[k].q.val() == 5 {
+                if self.fast_kind_line[k].q.val() == FastKind::Nodes {
                     self.fast_line[k + 1].d.next = self.bank0_rdata.val();
                 }
             }
@@ -1029,8 +1262,8 @@ impl<
         // (the reservation keeps this clock's other write back empty).
         self.short_ctl.next = self.ctl_delay.data_out.val();
         self.long_in.next = 0.into();
-        if (self.ctl_delay.data_out.val().get_bits::<5>(15) == 4)
-            | (self.ctl_delay.data_out.val().get_bits::<5>(15) == 5)
+        if (self.ctl_delay.data_out.val().get_bits::<5>(15) == self.op_fdiv.val())
+            | (self.ctl_delay.data_out.val().get_bits::<5>(15) == self.op_fsqrt.val())
         {
             self.short_ctl.next = 0.into();
             self.long_in.next = self.ctl_delay.data_out.val();
@@ -1049,34 +1282,34 @@ impl<
         self.wb_thread.next = self.wb_ctl.val().get_bits::<5>(2);
         self.wb_invert.next = self.wb_ctl.val().get_bit(0);
         self.wb_cond.next = false;
-        if self.wb_op.val() == 18 {
+        if self.wb_op.val() == self.op_bflt.val() {
             self.wb_cond.next = self.cmp_delay.data_out.val().get_bit(2);
         }
-        if self.wb_op.val() == 19 {
+        if self.wb_op.val() == self.op_bfle.val() {
             self.wb_cond.next = self.cmp_delay.data_out.val().get_bit(1);
         }
-        if self.wb_op.val() == 20 {
+        if self.wb_op.val() == self.op_bfeq.val() {
             self.wb_cond.next = self.cmp_delay.data_out.val().get_bit(0);
         }
-        if self.wb_op.val() == 21 {
+        if self.wb_op.val() == self.op_beq.val() {
             self.wb_cond.next = self.cond_delay.data_out.val().get_bit(3);
         }
-        if self.wb_op.val() == 22 {
+        if self.wb_op.val() == self.op_bltu.val() {
             self.wb_cond.next = self.cond_delay.data_out.val().get_bit(2);
         }
-        if self.wb_op.val() == 25 {
+        if self.wb_op.val() == self.op_mbx.val() {
             self.wb_cond.next = self.cond_delay.data_out.val().get_bit(1);
         }
-        if self.wb_op.val() == 27 {
+        if self.wb_op.val() == self.op_pixel.val() {
             self.wb_cond.next = self.cond_delay.data_out.val().get_bit(0);
         }
-        if self.wb_op.val() == 23 {
+        if self.wb_op.val() == self.op_jal.val() {
             self.wb_cond.next = true;
         }
-        if self.wb_op.val() == 29 {
+        if self.wb_op.val() == self.op_tri.val() {
             self.wb_cond.next = self.cond_delay.data_out.val().get_bit(16);
         }
-        if self.wb_op.val() == 30 {
+        if self.wb_op.val() == self.op_kd.val() {
             self.wb_cond.next = self.cond_delay.data_out.val().get_bit(17);
         }
         if self.wb_cond.val() != self.wb_invert.val() {
@@ -1084,44 +1317,41 @@ impl<
         } else {
             self.wb_next_pc.next = self.wb_pcs.val().get_bits::<12>(12);
         }
-        if self.wb_op.val() == 24 {
+        if self.wb_op.val() == self.op_jr.val() {
             self.wb_next_pc.next = self.cond_delay.data_out.val().get_bits::<12>(4);
         }
-        if (self.wb_op.val() == 28)
-            | (((self.wb_op.val() == 29) | (self.wb_op.val() == 30)) & self.wb_cond.val())
+        if (self.wb_op.val() == self.op_halt.val())
+            | (((self.wb_op.val() == self.op_tri.val()) | (self.wb_op.val() == self.op_kd.val()))
+                & self.wb_cond.val())
         {
             // A halted thread keeps its pc; so does one whose coprocessor refused its entry
             // (queue full) or has not finished (a wait): it repeats on its next turn.
             self.wb_next_pc.next = self.wb_pcs.val().get_bits::<12>(12) - 1;
         }
         self.wb_result.next = self.fast_delay.data_out.val();
-        if (self.wb_op.val() == 1) | (self.wb_op.val() == 2) {
+        if (self.wb_op.val() == self.op_fadd.val()) | (self.wb_op.val() == self.op_fsub.val()) {
             self.wb_result.next = bit_cast::<32, W>(self.add_delay.data_out.val());
         }
-        if self.wb_op.val() == 3 {
+        if self.wb_op.val() == self.op_fmul.val() {
             self.wb_result.next = bit_cast::<32, W>(self.mul_delay.data_out.val());
         }
-        if self.wb_op.val() == 4 {
+        if self.wb_op.val() == self.op_fdiv.val() {
             self.wb_result.next = bit_cast::<32, W>(self.div_delay.data_out.val());
         }
-        if self.wb_op.val() == 5 {
+        if self.wb_op.val() == self.op_fsqrt.val() {
             self.wb_result.next = bit_cast::<32, W>(self.sqrt_delay.data_out.val());
         }
-        if self.wb_op.val() == 31 {
+        if self.wb_op.val() == self.op_byte.val() {
             self.wb_result.next =
                 self.fast_delay.data_out.val() | bit_cast::<32, 8>(self.byte_unit.result.val());
         }
-        // Ops that write: fp 1-6, integer 7-13, ld 14, lds 16, jal 23, pixel 27 (not when the
-        // frame's pixels are exhausted), tri 29 and kd 30 (their reading functions name a
-        // `dst`), byte 31.
+        // The ops that write (`Op::writes`; a coprocessor's reading functions name a `dst`, the
+        // others r0); `pixel` not when the frame's pixels are exhausted.
         self.wb_writes.next = self.wb_valid.val()
             & (self.wb_dst.val() != 0)
-            & ((((self.wb_op.val() >= 1) & (self.wb_op.val() <= 14)) | (self.wb_op.val() == 16))
-                | ((self.wb_op.val() == 23)
-                    | ((self.wb_op.val() == 27) & (!self.cond_delay.data_out.val().get_bit(0)))
-                    | (self.wb_op.val() == 29)
-                    | (self.wb_op.val() == 30)
-                    | (self.wb_op.val() == 31)));
+            & self.op_writes.val().get_bit(self.wb_op.val().index())
+            & (!((self.wb_op.val() == self.op_pixel.val())
+                & self.cond_delay.data_out.val().get_bit(0)));
         self.regs_a.write_address.next =
             (bit_cast::<13, 5>(self.wb_thread.val()) << 8) | bit_cast::<13, 8>(self.wb_dst.val());
         self.regs_b.write_address.next =
@@ -1132,13 +1362,15 @@ impl<
         self.regs_b.write_enable.next = self.wb_writes.val();
         self.pc_ram.write_address.next = self.wb_thread.val();
         self.pc_ram.write_data.next = (bit_cast::<16, 1>(self.epoch.q.val().into()) << 13)
-            | (bit_cast::<16, 1>((self.wb_op.val() == 28).into()) << 12)
+            | (bit_cast::<16, 1>((self.wb_op.val() == self.op_halt.val()).into()) << 12)
             | bit_cast::<16, 12>(self.wb_next_pc.val());
         self.pc_ram.write_enable.next = self.wb_valid.val();
         // Instructions retired: every write back but a turn spent offering again to a full
         // coprocessor queue or waiting for a coprocessor (the twin never repeats those).
         if self.wb_valid.val()
-            & (!(((self.wb_op.val() == 29) | (self.wb_op.val() == 30)) & self.wb_cond.val()))
+            & (!(((self.wb_op.val() == self.op_tri.val())
+                | (self.wb_op.val() == self.op_kd.val()))
+                & self.wb_cond.val()))
         {
             self.instr_count.d.next = self.instr_count.q.val() + 1;
         }
@@ -1162,7 +1394,7 @@ impl<
             & (((self.woken.q.val() | self.event_mask.val()) & self.wb_mask.val()) == 0);
         self.wake_mask.next = 0.into();
         self.sleep_mask.next = 0.into();
-        if self.wb_valid.val() & (self.wb_op.val() != 28) {
+        if self.wb_valid.val() & (self.wb_op.val() != self.op_halt.val()) {
             if self.wb_sleep.val() {
                 self.sleep_mask.next = self.wb_mask.val();
             } else {
@@ -1176,7 +1408,7 @@ impl<
             (self.asleep.q.val() & (!self.event_mask.val())) | self.sleep_mask.val();
         self.woken.d.next = (self.woken.q.val() & (!self.issue_mask.val())) | self.event_mask.val();
 
-        if self.wb_valid.val() & (self.wb_op.val() == 28) {
+        if self.wb_valid.val() & (self.wb_op.val() == self.op_halt.val()) {
             self.halted_count.d.next = self.halted_count.q.val() + 1;
             if (self.halted_count.q.val() + 1) == self.c_threads.val() {
                 self.running.d.next = false;

@@ -30,6 +30,8 @@
 
 use rust_hdl::prelude::*;
 
+use crate::layout;
+
 /// Command kinds (the engine's `kind`).
 pub const CMD_LIST: u64 = 0;
 /// Bit 31 of a [`CMD_LIST`]'s `word_b` (the list end, an address below 2^24): the list is a
@@ -48,8 +50,14 @@ pub const TEST_WALK_END: u64 = 3;
 /// A queue entry: `{kind[70:69], thread[68:64], a[63:32], b[31:0]}`.
 pub type ListEntry = Bits<71>;
 
-// `update` spells out its numbers (rust-hdl's Verilog cannot name Rust constants): the
-// phases are 0 idle, 1 read the thread's state, 2 latch it, 3 walk; the test queue holds 8.
+/// The state machine: idle (take a command), read the thread's state, latch it, walk a list.
+#[derive(Copy, Clone, Debug, PartialEq, LogicState)]
+pub enum ListPhase {
+    Idle,
+    Read,
+    Latch,
+    Walk,
+}
 
 #[derive(LogicBlock)]
 pub struct ListUnit {
@@ -79,7 +87,7 @@ pub struct ListUnit {
     /// `{next[6:4], len[3:0]}`.
     mailbox_meta: RAM<Bits<8>, 5>,
 
-    phase: DFF<Bits<2>>,
+    phase: DFF<ListPhase>,
     walk_thread: DFF<Bits<5>>,
     cursor: DFF<Bits<24>>,
     list_end: DFF<Bits<24>>,
@@ -108,6 +116,15 @@ pub struct ListUnit {
     c_index: [Constant<Bits<4>>; 8],
     /// The kind field of a list-end entry.
     c_list_end: Constant<ListEntry>,
+    c_cmd_list: Constant<Bits<2>>,
+    c_cmd_init: Constant<Bits<2>>,
+    c_cmd_object: Constant<Bits<2>>,
+    c_cmd_skip: Constant<Bits<2>>,
+    /// The banks with their own ports (`layout`): the engine's loads of them leave the bus
+    /// free.
+    c_bank_nodes: Constant<Bits<3>>,
+    c_bank_uv: Constant<Bits<3>>,
+    c_bank_t: Constant<Bits<3>>,
 }
 
 /// A per-thread RAM of `value` words: the skip words start all ones (no triangle is skipped
@@ -124,6 +141,8 @@ impl ListUnit {
     /// The unit for SRAM read latency `mem_latency` (1..=6).
     pub fn new(mem_latency: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
+        // A walk's list end is a list end with the walk's bit (69) set.
+        assert!(TEST_WALK_END == TEST_LIST_END | 1 && TEST_LIST_END & 1 == 0);
         Self {
             clock: Default::default(),
             enqueue: Default::default(),
@@ -173,6 +192,13 @@ impl ListUnit {
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_list_end: Constant::new(ListEntry::from(TEST_LIST_END) << 69),
+            c_cmd_list: Constant::new(CMD_LIST.into()),
+            c_cmd_init: Constant::new(CMD_INIT.into()),
+            c_cmd_object: Constant::new(CMD_OBJECT.into()),
+            c_cmd_skip: Constant::new(CMD_SKIP.into()),
+            c_bank_nodes: Constant::new((layout::NODES as u64).into()),
+            c_bank_uv: Constant::new((layout::TRIANGLES_UV as u64).into()),
+            c_bank_t: Constant::new((layout::TRIANGLES_T as u64).into()),
         }
     }
 }
@@ -257,8 +283,8 @@ impl Logic for ListUnit {
             self.mailbox_ids[k].write_enable.next = false;
         }
 
-        if (self.phase.q.val() == 0) & (!self.commands.empty.val()) {
-            if self.head_kind.val() == 1 {
+        if (self.phase.q.val() == ListPhase::Idle) & (!self.commands.empty.val()) {
+            if self.head_kind.val() == self.c_cmd_init.val() {
                 // An init goes on to the launch as it is; a new query empties the mailbox.
                 if !self.tests.full.val() {
                     self.push.next = true;
@@ -268,31 +294,31 @@ impl Logic for ListUnit {
                     self.mailbox_meta.write_enable.next = true;
                 }
             }
-            if self.head_kind.val() == 2 {
+            if self.head_kind.val() == self.c_cmd_object.val() {
                 self.object_ram.write_enable.next = true;
                 self.mailbox_meta.write_address.next =
                     self.commands.data_out.val().get_bits::<5>(64);
                 self.mailbox_meta.write_enable.next = true;
                 self.commands.read.next = true;
             }
-            if self.head_kind.val() == 3 {
+            if self.head_kind.val() == self.c_cmd_skip.val() {
                 self.skip_object_ram.write_enable.next = true;
                 self.skip_triangle_ram.write_enable.next = true;
                 self.commands.read.next = true;
             }
-            if self.head_kind.val() == 0 {
+            if self.head_kind.val() == self.c_cmd_list.val() {
                 self.walk_thread.d.next = self.commands.data_out.val().get_bits::<5>(64);
                 self.cursor.d.next = self.commands.data_out.val().get_bits::<24>(32);
                 self.list_end.d.next = self.commands.data_out.val().get_bits::<24>(0);
                 self.of_walk.d.next = self.commands.data_out.val().get_bit(31);
                 self.commands.read.next = true;
-                self.phase.d.next = 1.into();
+                self.phase.d.next = ListPhase::Read;
             }
         }
-        if self.phase.q.val() == 1 {
-            self.phase.d.next = 2.into();
+        if self.phase.q.val() == ListPhase::Read {
+            self.phase.d.next = ListPhase::Latch;
         }
-        if self.phase.q.val() == 2 {
+        if self.phase.q.val() == ListPhase::Latch {
             self.object_id.d.next = self.object_ram.read_data.val();
             self.skip_object.d.next = self.skip_object_ram.read_data.val();
             self.skip_triangle.d.next = self.skip_triangle_ram.read_data.val();
@@ -301,18 +327,19 @@ impl Logic for ListUnit {
             for k in 0..8 {
                 self.ids[k].d.next = self.mailbox_ids[k].read_data.val();
             }
-            self.phase.d.next = 3.into();
+            self.phase.d.next = ListPhase::Walk;
         }
 
         // Walk: a read while the test queue has room for every word in flight and for the
         // list's end entry; the engine's loads of banks 1, 4 and 5 take the bus first.
-        self.take.next = (self.phase.q.val() == 3)
+        self.take.next = (self.phase.q.val() == ListPhase::Walk)
             & (self.cursor.q.val() != self.list_end.q.val())
+            // (of the queue's 8: the words in flight and the end entry)
             & ((bit_cast::<5, 4>(self.queued.q.val()) + bit_cast::<5, 4>(self.flight.q.val())) < 7)
             & (!(self.engine_read.val()
-                & (self.engine_bank.val() != 0)
-                & (self.engine_bank.val() != 2)
-                & (self.engine_bank.val() != 3)));
+                & (self.engine_bank.val() != self.c_bank_nodes.val())
+                & (self.engine_bank.val() != self.c_bank_uv.val())
+                & (self.engine_bank.val() != self.c_bank_t.val())));
         self.list_read.next = self.take.val();
         self.list_addr.next = self.cursor.q.val();
         if self.take.val() {
@@ -373,7 +400,7 @@ impl Logic for ListUnit {
                 | bit_cast::<8, 4>(self.len_after.val());
         }
         // The list is done when every word has arrived: its end entry follows its tests.
-        if (self.phase.q.val() == 3)
+        if (self.phase.q.val() == ListPhase::Walk)
             & (self.cursor.q.val() == self.list_end.q.val())
             & (self.flight.q.val() == 0)
             & (!self.tests.full.val())
@@ -382,7 +409,7 @@ impl Logic for ListUnit {
             self.tests.data_in.next = self.c_list_end.val()
                 | (bit_cast::<71, 1>(self.of_walk.q.val().into()) << 69)
                 | (bit_cast::<71, 5>(self.walk_thread.q.val()) << 64);
-            self.phase.d.next = 0.into();
+            self.phase.d.next = ListPhase::Idle;
         }
         self.tests.write.next = self.push.val();
         self.queued.d.next = self.queued.q.val();

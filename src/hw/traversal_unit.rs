@@ -3,24 +3,21 @@
 //! through inner nodes on its own (fetch the node from bank 0, decide with
 //! `units::traversal_step`, push the far child on the thread's stack) until it reaches a
 //! leaf, and hands the leaf's list to the triangle tester (`leaf_*`). With the leaf's closest
-//! hit (the tester's `answer_*`; the engine's `kd.next best_t, hit` enters the same way) the
-//! unit ends the walk when that hit lies in the leaf's segment or the walk answers any hit
-//! (`KD_ANY_HIT`), or pops the stack (ending when the stack is empty or the popped segment
-//! starts behind the hit), exactly as `model::golden`'s `traverse`.
+//! hit (the tester's `answer_*`) the unit ends the walk when that hit lies in the leaf's
+//! segment or the walk answers any hit (`KD_ANY_HIT`), or pops the stack (ending when the
+//! stack is empty or the popped segment starts behind the hit), exactly as
+//! `model::golden`'s `traverse`.
 //!
-//! Engine side (I2/I3, like the triangle tester): `enqueue` offers an entry of `thread`
-//! (`start`: root `word_a`, t_max `word_b`, t_min the thread's `t_min` written with the
-//! tester's init; else next: best t `word_a`, hit `word_b`), taken when `full` is low.
-//! `query_thread` at I2; at I3 `pending` (the thread's entry not done), `result` (the leaf's
-//! list address, or bit 31 set when the walk ended) and `list_end` (list + count). The entry
-//! offered at I3 must be of the thread presented at I2 the clock before (its count of entries
-//! taken is read there), and a thread never offers in two clocks in a row (the engine's
-//! scheduler guarantees both).
+//! Engine side (I2/I3, like the triangle tester): `enqueue` offers the start of a walk of
+//! `thread` (root `word_a`, t_max `word_b`, t_min the thread's `t_min` written with the
+//! tester's init), taken when `full` is low. `query_thread` at I2; at I3 `pending` (the
+//! thread's walk has not ended). The entry offered at I3 must be of the thread presented at
+//! I2 the clock before (its count of entries taken is read there), and a thread never offers
+//! in two clocks in a row (the engine's scheduler guarantees both).
 //!
-//! Structure: entries from the engine go through the front (a start becomes a step job; a
-//! next reads the thread's leaf segment and stack and compares the hit with both in 5 clocks,
-//! its own pipeline, one entry a clock) into the front
-//! queue; steps that continue go into the loop queue, which the fetch serves first. Fetch:
+//! Structure: entries go through the front (an engine's start becomes a step job; a tester's
+//! answer reads the thread's leaf segment and stack and compares the hit with both in 5
+//! clocks, its own pipeline, one entry a clock) into the front queue; steps that continue go into the loop queue, which the fetch serves first. Fetch:
 //! two words of bank 0 a job, the next job's requests right behind (the engine's own loads of
 //! bank 0 go first; the words come back in order), then the decision pipeline: `split - o`
 //! (FpAddSub), `/ d` (FpDiv), then five FpCompares; at its end a push and the next step.
@@ -30,7 +27,7 @@
 //! the unit, so the 32-entry queues never overflow.
 //!
 //! Per thread: a stack of [`STACK_LEVELS`] entries `(node, lo, hi)`, the leaf's segment end
-//! and stack depth, the result. Const parameters: the operators' `W, E, M, S, S1, X2, T` and
+//! and stack depth. Const parameters: the operators' `W, E, M, S, S1, X2, T` and
 //! `DL = div_latency(M)`.
 
 use rust_hdl::prelude::*;
@@ -42,6 +39,7 @@ use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
 use super::ray_store::{zero_counters, RayStore};
 use super::Delay;
 use crate::fp::Format;
+use crate::layout;
 
 /// Entries of each thread's kd stack (the deepest object tree the unit walks).
 pub const STACK_LEVELS: usize = 64;
@@ -56,6 +54,14 @@ type Entry = Bits<70>;
 type Job = Bits<102>;
 /// Decision control: `{valid[37], thread[36:32], sp[31:26], left[25:0]}`.
 type Control = Bits<38>;
+
+/// The node fetch: idle, or requesting word 0 or word 1 of a node (two words a node).
+#[derive(Copy, Clone, Debug, PartialEq, LogicState)]
+pub enum Fetch {
+    Idle,
+    Word0,
+    Word1,
+}
 
 #[derive(LogicBlock)]
 pub struct TraversalUnit<
@@ -78,12 +84,9 @@ pub struct TraversalUnit<
     pub ray_pair: Signal<In, Bits<2>>,
     pub t_min_write: Signal<In, Bit>,
     pub enqueue: Signal<In, Bit>,
-    pub enqueue_next: Signal<In, Bit>,
     pub full: Signal<Out, Bit>,
     pub query_thread: Signal<In, Bits<5>>,
     pub pending: Signal<Out, Bit>,
-    pub result: Signal<Out, Bits<32>>,
-    pub list_end: Signal<Out, Bits<32>>,
     /// The engine's memory port (registered): its loads of bank 0 go out here.
     pub engine_read: Signal<In, Bit>,
     pub engine_bank: Signal<In, Bits<3>>,
@@ -122,14 +125,12 @@ pub struct TraversalUnit<
     a_list_end: Signal<Local, Bits<32>>,
     front_fifo: SynchronousFIFO<Job, 5, 6, 1>,
     loop_fifo: SynchronousFIFO<Job, 5, 6, 1>,
-    /// Per thread: ray o, d and t_min (engine-written); entries taken (engine); entries done,
-    /// result and list end (unit, read by the engine); leaf segment end and stack depth (unit).
+    /// Per thread: ray o, d and t_min (engine-written); entries taken (engine); entries done
+    /// (unit, read by the engine); leaf segment end and stack depth (unit).
     ray: RayStore<W>,
     issued: RAM<Bits<8>, 5>,
     done_e: RAM<Bits<8>, 5>,
     done_u: RAM<Bits<8>, 5>,
-    result_e: RAM<Bits<32>, 5>,
-    end_e: RAM<Bits<32>, 5>,
     leaf_hi: RAM<Bits<W>, 5>,
     leaf_sp: RAM<Bits<6>, 5>,
     stack_node: RAM<Bits<26>, 11>,
@@ -187,8 +188,8 @@ pub struct TraversalUnit<
     front_end: Signal<Local, Bit>,
     front_job: Signal<Local, Job>,
 
-    // Fetch: `phase` 0 idle, 1 request word 0, 2 request word 1 of `fetch_job`; `job` is at A.
-    phase: DFF<Bits<2>>,
+    // Fetch: `phase` requests the words of `fetch_job`; `job` is at A.
+    phase: DFF<Fetch>,
     fetch_job: DFF<Job>,
     fetch_free: Signal<Local, Bit>,
     next_a_thread: Signal<Local, Bits<5>>,
@@ -235,7 +236,8 @@ pub struct TraversalUnit<
     c_ml_last: Constant<Bits<4>>,
     c_index: [Constant<Bits<4>>; 6],
     c_zero: Constant<Bits<W>>,
-    c_finished: Constant<Bits<32>>,
+    c_bank_nodes: Constant<Bits<3>>,
+    c_leaf_tag: Constant<Bits<2>>,
 }
 
 impl<
@@ -265,12 +267,9 @@ impl<
             ray_pair: Default::default(),
             t_min_write: Default::default(),
             enqueue: Default::default(),
-            enqueue_next: Default::default(),
             full: Default::default(),
             query_thread: Default::default(),
             pending: Default::default(),
-            result: Default::default(),
-            list_end: Default::default(),
             engine_read: Default::default(),
             engine_bank: Default::default(),
             engine_addr: Default::default(),
@@ -301,8 +300,6 @@ impl<
             issued: zero_counters(),
             done_e: zero_counters(),
             done_u: zero_counters(),
-            result_e: Default::default(),
-            end_e: Default::default(),
             leaf_hi: Default::default(),
             leaf_sp: Default::default(),
             stack_node: Default::default(),
@@ -392,7 +389,8 @@ impl<
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_zero: const_bits::<W>(u64::from(f.zero(false))),
-            c_finished: Constant::new((1u64 << 31).into()),
+            c_bank_nodes: Constant::new((layout::NODES as u64).into()),
+            c_leaf_tag: Constant::new(u64::from(layout::LEAF_TAG).into()),
         }
     }
 }
@@ -445,10 +443,6 @@ impl<
         self.done_e.write_clock.next = self.clock.val();
         self.done_u.read_clock.next = self.clock.val();
         self.done_u.write_clock.next = self.clock.val();
-        self.result_e.read_clock.next = self.clock.val();
-        self.result_e.write_clock.next = self.clock.val();
-        self.end_e.read_clock.next = self.clock.val();
-        self.end_e.write_clock.next = self.clock.val();
         self.leaf_hi.read_clock.next = self.clock.val();
         self.leaf_hi.write_clock.next = self.clock.val();
         self.leaf_sp.read_clock.next = self.clock.val();
@@ -483,8 +477,8 @@ impl<
         self.full.next = self.engine_full.val();
         self.entry_fifo.write.next =
             (self.enqueue.val() & (!self.engine_full.val())) | self.answer_valid.val();
-        self.entry_fifo.data_in.next = (bit_cast::<70, 1>(self.enqueue_next.val().into()) << 69)
-            | (bit_cast::<70, 5>(self.thread.val()) << 64)
+        // Bit 69: an answer (0: the engine's start).
+        self.entry_fifo.data_in.next = (bit_cast::<70, 5>(self.thread.val()) << 64)
             | (bit_cast::<70, 32>(self.word_a.val()) << 32)
             | bit_cast::<70, 32>(self.word_b.val());
         if self.answer_valid.val() {
@@ -495,15 +489,10 @@ impl<
         }
         self.any_hit.write_address.next = self.thread.val();
         self.any_hit.write_data.next = bit_cast::<1, 1>(self.word_a.val().get_bit(31).into());
-        self.any_hit.write_enable.next =
-            self.enqueue.val() & (!self.engine_full.val()) & (!self.enqueue_next.val());
+        self.any_hit.write_enable.next = self.enqueue.val() & (!self.engine_full.val());
         self.issued.read_address.next = self.query_thread.val();
         self.done_e.read_address.next = self.query_thread.val();
-        self.result_e.read_address.next = self.query_thread.val();
-        self.end_e.read_address.next = self.query_thread.val();
         self.pending.next = self.issued.read_data.val() != self.done_e.read_data.val();
-        self.result.next = self.result_e.read_data.val();
-        self.list_end.next = self.end_e.read_data.val();
         self.issued.write_address.next = self.thread.val();
         self.issued.write_data.next = self.issued.read_data.val() + 1;
         self.issued.write_enable.next = self.enqueue.val() & (!self.engine_full.val());
@@ -598,25 +587,25 @@ impl<
         self.loop_fifo.read.next = false;
         self.front_fifo.read.next = false;
         self.in_flight.read.next = false;
-        self.take.next =
-            (self.phase.q.val() != 0) & (!(self.engine_read.val() & (self.engine_bank.val() == 0)));
-        self.node_read.next =
-            self.take.val() | (self.engine_read.val() & (self.engine_bank.val() == 0));
+        self.take.next = (self.phase.q.val() != Fetch::Idle)
+            & (!(self.engine_read.val() & (self.engine_bank.val() == self.c_bank_nodes.val())));
+        self.node_read.next = self.take.val()
+            | (self.engine_read.val() & (self.engine_bank.val() == self.c_bank_nodes.val()));
         self.node_addr.next = self.engine_addr.val();
         if self.take.val() {
             self.node_addr.next = (bit_cast::<24, 26>(self.fetch_job.q.val().get_bits::<26>(64))
                 << 1)
-                | bit_cast::<24, 2>(self.phase.q.val() - 1);
-            self.phase.d.next = 2.into();
-            if self.phase.q.val() == 2 {
-                self.phase.d.next = 0.into();
+                | bit_cast::<24, 1>((self.phase.q.val() == Fetch::Word1).into());
+            self.phase.d.next = Fetch::Word1;
+            if self.phase.q.val() == Fetch::Word1 {
+                self.phase.d.next = Fetch::Idle;
             }
         }
-        self.in_flight.write.next = self.take.val() & (self.phase.q.val() == 1);
+        self.in_flight.write.next = self.take.val() & (self.phase.q.val() == Fetch::Word0);
         self.in_flight.data_in.next = self.fetch_job.q.val();
         self.words_in.d.next = 0.into();
         self.node_line[0].d.next = (bit_cast::<2, 1>(self.take.val().into()) << 1)
-            | bit_cast::<2, 1>((self.phase.q.val() == 2).into());
+            | bit_cast::<2, 1>((self.phase.q.val() == Fetch::Word1).into());
         for k in 1..6 {
             self.node_line[k].d.next = self.node_line[k - 1].q.val();
         }
@@ -639,19 +628,19 @@ impl<
             self.words_in.d.next = 1.into();
         }
         // The next job: a fetch, or a finishing job straight to A when nothing is in flight.
-        self.fetch_free.next =
-            (self.phase.q.val() == 0) | ((self.phase.q.val() == 2) & self.take.val());
+        self.fetch_free.next = (self.phase.q.val() == Fetch::Idle)
+            | ((self.phase.q.val() == Fetch::Word1) & self.take.val());
         if self.fetch_free.val() {
             if !self.loop_fifo.empty.val() {
                 self.loop_fifo.read.next = true;
                 self.fetch_job.d.next = self.loop_fifo.data_out.val();
-                self.phase.d.next = 1.into();
+                self.phase.d.next = Fetch::Word0;
             } else if !self.front_fifo.empty.val() {
                 if !self.front_fifo.data_out.val().get_bit(101) {
                     self.front_fifo.read.next = true;
                     self.fetch_job.d.next = self.front_fifo.data_out.val();
-                    self.phase.d.next = 1.into();
-                } else if (self.phase.q.val() == 0) & self.in_flight.empty.val() {
+                    self.phase.d.next = Fetch::Word0;
+                } else if (self.phase.q.val() == Fetch::Idle) & self.in_flight.empty.val() {
                     self.front_fifo.read.next = true;
                     self.job.d.next = self.front_fifo.data_out.val();
                     self.next_a_thread.next = self.front_fifo.data_out.val().get_bits::<5>(96);
@@ -665,7 +654,8 @@ impl<
 
         // A: both words are here (or the walk ended).
         self.at_a.next = self.words_in.q.val() == 1;
-        self.a_leaf.next = self.job.q.val().get_bit(101) | (self.w0.q.val().get_bits::<2>(30) == 3);
+        self.a_leaf.next = self.job.q.val().get_bit(101)
+            | (self.w0.q.val().get_bits::<2>(30) == self.c_leaf_tag.val());
         self.a_axis.next = self.w0.q.val().get_bits::<2>(30);
         self.a_o.next = self.ray.o[0].val();
         self.a_d.next = self.ray.d[0].val();
@@ -692,16 +682,9 @@ impl<
         self.leaf_from.next = self.leaf_fifo.data_out.val().get_bits::<32>(32);
         self.leaf_to.next = self.leaf_fifo.data_out.val().get_bits::<32>(0);
         self.leaf_fifo.read.next = self.leaf_take.val();
-        self.result_e.write_address.next = self.job.q.val().get_bits::<5>(96);
-        self.end_e.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.done_e.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.leaf_hi.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.leaf_sp.write_address.next = self.job.q.val().get_bits::<5>(96);
-        self.result_e.write_data.next = bit_cast::<32, 30>(self.w0.q.val().get_bits::<30>(0));
-        if self.job.q.val().get_bit(101) {
-            self.result_e.write_data.next = self.c_finished.val();
-        }
-        self.end_e.write_data.next = self.a_list_end.val();
         self.leaf_hi.write_data.next = self.job.q.val().get_bits::<W>(0);
         self.leaf_sp.write_data.next = self.job.q.val().get_bits::<6>(90);
         // Entries done: the unit's copy is read a clock ahead at the thread of the job coming
@@ -711,8 +694,6 @@ impl<
         self.done_e.write_data.next = self.done_u.read_data.val() + 1;
         self.done_u.write_data.next = self.done_u.read_data.val() + 1;
         self.done_u.write_enable.next = self.a_end.val();
-        self.result_e.write_enable.next = self.a_end.val();
-        self.end_e.write_enable.next = self.a_end.val();
         self.done_e.write_enable.next = self.a_end.val();
         self.done_event.next = self.a_end.val();
         self.done_thread.next = self.job.q.val().get_bits::<5>(96);
@@ -1014,7 +995,6 @@ mod tests {
             tick(&mut u, &mut b, &mut rng, false);
             if in_flight[th] && !u.pending.val() {
                 in_flight[th] = false;
-                assert_eq!(u.result.val().to_u64(), 1 << 31, "thread {th}: the end");
                 b.got[th].push(KdStop::Finished);
                 if b.got[th].len() < want[th].len() {
                     to_start[th] = true;
@@ -1027,7 +1007,6 @@ mod tests {
             if start {
                 let any = if any_hit(th) { 1u64 << 31 } else { 0 };
                 u.thread.next = (th as u64).into();
-                u.enqueue_next.next = false;
                 u.word_a.next = (u64::from(root) | any).into();
                 u.word_b.next = u64::from(t_max).into();
             }

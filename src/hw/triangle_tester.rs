@@ -45,10 +45,13 @@
 use rust_hdl::prelude::*;
 
 use super::fp::{const_bits, FpCompare};
-use super::list_unit::LIST_OF_WALK;
+use super::list_unit::{
+    CMD_INIT, CMD_LIST, LIST_OF_WALK, TEST_INIT, TEST_LIST_END, TEST_TRIANGLE, TEST_WALK_END,
+};
 use super::ray_store::{zero_counters, RayStore};
 use super::{intersect_latency, IntersectUnit, ListUnit, TransformUnit, TRANSFORM_LATENCY};
 use crate::fp::Format;
+use crate::layout;
 
 /// Commands the engine-side queue holds (the [`ListUnit`]'s).
 pub const TESTER_QUEUE: usize = 16;
@@ -167,8 +170,7 @@ pub struct TriangleTester<
     fetching: DFF<Bit>,
     fb: DFF<Bit>,
     lb: DFF<Bit>,
-    /// 0 wait for the buffer, 1 launch the origin, 2 the direction, 3 free the buffer.
-    lphase: DFF<Bits<2>>,
+    lphase: DFF<Launch>,
     loaded: [DFF<Bit>; 2],
     /// `list_unit::TEST_*`.
     cur_kind: [DFF<Bits<2>>; 2],
@@ -243,6 +245,24 @@ pub struct TriangleTester<
     /// Each buffer's number.
     c_buffer: [Constant<Bit>; 2],
     c_hit_flag: Constant<Bits<33>>,
+    c_cmd_list: Constant<Bits<2>>,
+    c_cmd_init: Constant<Bits<2>>,
+    c_test_triangle: Constant<Bits<2>>,
+    c_test_init: Constant<Bits<2>>,
+    c_test_list_end: Constant<Bits<2>>,
+    c_test_walk_end: Constant<Bits<2>>,
+    c_bank_uv: Constant<Bits<3>>,
+    c_bank_t: Constant<Bits<3>>,
+}
+
+/// The launch of a buffered entry: wait for a loaded buffer, launch the origin, then the
+/// direction, free the buffer.
+#[derive(Copy, Clone, Debug, PartialEq, LogicState)]
+pub enum Launch {
+    Wait,
+    Origin,
+    Direction,
+    Free,
 }
 
 impl<
@@ -385,6 +405,14 @@ impl<
             c_list_of_walk: Constant::new(LIST_OF_WALK.into()),
             c_buffer: [Constant::new(false), Constant::new(true)],
             c_hit_flag: Constant::new((1u64 << 32).into()),
+            c_cmd_list: Constant::new(CMD_LIST.into()),
+            c_cmd_init: Constant::new(CMD_INIT.into()),
+            c_test_triangle: Constant::new(TEST_TRIANGLE.into()),
+            c_test_init: Constant::new(TEST_INIT.into()),
+            c_test_list_end: Constant::new(TEST_LIST_END.into()),
+            c_test_walk_end: Constant::new(TEST_WALK_END.into()),
+            c_bank_uv: Constant::new((layout::TRIANGLES_UV as u64).into()),
+            c_bank_t: Constant::new((layout::TRIANGLES_T as u64).into()),
         }
     }
 }
@@ -470,7 +498,8 @@ impl<
         self.ray.word_b.next = self.word_b.val();
         self.ray.ray_write.next = self.ray_write.val();
         self.ray.ray_pair.next = self.ray_pair.val();
-        self.ray.t_min_write.next = self.enqueue.val() & (self.queue_kind.val() == 1);
+        self.ray.t_min_write.next =
+            self.enqueue.val() & (self.queue_kind.val() == self.c_cmd_init.val());
         // The engine's entries first; a walk's list in the other clocks.
         self.walk_take.next =
             self.walk_list_valid.val() & (!self.enqueue.val()) & (!self.list_unit.full.val());
@@ -482,7 +511,7 @@ impl<
             self.list_unit.word_a.next = self.word_a.val();
             self.list_unit.word_b.next = self.word_b.val();
         } else {
-            self.list_unit.kind.next = 0.into();
+            self.list_unit.kind.next = self.c_cmd_list.val();
             self.list_unit.thread.next = self.walk_list_thread.val();
             self.list_unit.word_a.next = self.walk_list_from.val();
             self.list_unit.word_b.next = self.walk_list_to.val() | self.c_list_of_walk.val();
@@ -510,7 +539,8 @@ impl<
         // A list counts as one entry (done with its end entry), an init as one.
         self.issued.write_enable.next = self.enqueue.val()
             & (!self.list_unit.full.val())
-            & (self.queue_kind.val().get_bits::<1>(1) == 0);
+            & ((self.queue_kind.val() == self.c_cmd_list.val())
+                | (self.queue_kind.val() == self.c_cmd_init.val()));
 
         // Fetch into buffer `fb`: take the list unit's next entry when the buffer is free,
         // then request its 8 + 4 words (the banks serve the engine first). An init or a list
@@ -518,14 +548,14 @@ impl<
         self.list_unit.test_take.next = false;
         self.uv_take.next = self.fetching.q.val()
             & (self.uv_issued.q.val() < 8)
-            & (!(self.engine_read.val() & (self.engine_bank.val() == 2)));
+            & (!(self.engine_read.val() & (self.engine_bank.val() == self.c_bank_uv.val())));
         self.t_take.next = self.fetching.q.val()
             & (self.t_issued.q.val() < 4)
-            & (!(self.engine_read.val() & (self.engine_bank.val() == 3)));
-        self.uv_read.next =
-            self.uv_take.val() | (self.engine_read.val() & (self.engine_bank.val() == 2));
-        self.t_read.next =
-            self.t_take.val() | (self.engine_read.val() & (self.engine_bank.val() == 3));
+            & (!(self.engine_read.val() & (self.engine_bank.val() == self.c_bank_t.val())));
+        self.uv_read.next = self.uv_take.val()
+            | (self.engine_read.val() & (self.engine_bank.val() == self.c_bank_uv.val()));
+        self.t_read.next = self.t_take.val()
+            | (self.engine_read.val() & (self.engine_bank.val() == self.c_bank_t.val()));
         self.uv_addr.next = self.engine_addr.val();
         self.t_addr.next = self.engine_addr.val();
         self.fetch_a.next = self.cur_a[0].q.val();
@@ -570,7 +600,7 @@ impl<
             self.uv_issued.d.next = 0.into();
             self.t_issued.d.next = 0.into();
             self.fetching.d.next = true;
-            if self.list_unit.test_entry.val().get_bits::<2>(69) != 0 {
+            if self.list_unit.test_entry.val().get_bits::<2>(69) != self.c_test_triangle.val() {
                 // An init or a list end fetches nothing.
                 self.uv_issued.d.next = 8.into();
                 self.t_issued.d.next = 4.into();
@@ -585,7 +615,9 @@ impl<
                     self.cur_a[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(32);
                     self.cur_b[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(0);
                     self.received[k].d.next = 0.into();
-                    if self.list_unit.test_entry.val().get_bits::<2>(69) != 0 {
+                    if self.list_unit.test_entry.val().get_bits::<2>(69)
+                        != self.c_test_triangle.val()
+                    {
                         self.received[k].d.next = 12.into();
                     }
                 }
@@ -677,17 +709,17 @@ impl<
         self.flight_t_min.write_enable.next = false;
         self.flight_a.write_enable.next = false;
         self.flight_b.write_enable.next = false;
-        if (self.lphase.q.val() == 0) & self.l_ready.val() {
-            self.lphase.d.next = 1.into();
+        if (self.lphase.q.val() == Launch::Wait) & self.l_ready.val() {
+            self.lphase.d.next = Launch::Origin;
         }
-        if self.lphase.q.val() == 1 {
+        if self.lphase.q.val() == Launch::Origin {
             self.transform_unit.in_valid.next = true;
             self.flight_t_min.write_enable.next = true;
             self.flight_a.write_enable.next = true;
             self.flight_b.write_enable.next = true;
-            self.lphase.d.next = 2.into();
+            self.lphase.d.next = Launch::Direction;
         }
-        if self.lphase.q.val() == 2 {
+        if self.lphase.q.val() == Launch::Direction {
             self.transform_unit.in_valid.next = true;
             self.transform_unit.point.next = false;
             for k in 0..3 {
@@ -695,19 +727,20 @@ impl<
             }
             self.transform_unit.tag.next = self.launch_tag.val() | self.c_d_pass.val();
             self.seq.d.next = self.seq.q.val() + 1;
-            self.lphase.d.next = 3.into();
+            self.lphase.d.next = Launch::Free;
         }
-        if self.lphase.q.val() == 3 {
+        if self.lphase.q.val() == Launch::Free {
             for k in 0..2 {
                 if self.lb.q.val() == self.c_buffer[k].val() {
                     self.loaded[k].d.next = false;
                 }
             }
             self.lb.d.next = !self.lb.q.val();
-            self.lphase.d.next = 0.into();
+            self.lphase.d.next = Launch::Wait;
         }
         // Busy counts tests only (inits and list ends pass the units to keep their order).
-        self.transform_busy.next = self.transform_unit.in_valid.val() & (self.l_kind.val() == 0);
+        self.transform_busy.next =
+            self.transform_unit.in_valid.val() & (self.l_kind.val() == self.c_test_triangle.val());
 
         // O' waits a clock for D'; then the unit-triangle test.
         for k in 0..3 {
@@ -729,7 +762,7 @@ impl<
         self.intersect_unit.t_max.next = self.c_infinity.val();
         self.intersect_unit.tag.next = self.transform_unit.out_tag.val();
         self.intersect_busy.next = self.intersect_unit.in_valid.val()
-            & (self.transform_unit.out_tag.val().get_bits::<2>(10) == 0);
+            & (self.transform_unit.out_tag.val().get_bits::<2>(10) == self.c_test_triangle.val());
 
         // Merge: read the thread's state, compare t with its best, write.
         self.done_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(5);
@@ -762,7 +795,9 @@ impl<
         self.m3_b.d.next = self.m2_b.q.val();
         self.m3_done.d.next = self.m2_done.q.val();
         self.m3_best.d.next = self.m2_best.q.val();
-        self.merge_hit.next = self.m3_hit.q.val() & self.cmp.lt.val() & (self.m3_kind.q.val() == 0);
+        self.merge_hit.next = self.m3_hit.q.val()
+            & self.cmp.lt.val()
+            & (self.m3_kind.q.val() == self.c_test_triangle.val());
 
         self.done_m.write_address.next = self.m3_thread.q.val();
         self.done_e.write_address.next = self.m3_thread.q.val();
@@ -774,13 +809,15 @@ impl<
         self.done_e.write_data.next = self.m3_done.q.val() + 1;
         // Inits and list ends count (the engine counted them as issued), not single tests nor
         // a walk's list ends, which answer the traversal unit with the closest hit so far.
-        self.m3_counts.next =
-            self.m3_valid.q.val() & ((self.m3_kind.q.val() == 1) | (self.m3_kind.q.val() == 2));
+        self.m3_counts.next = self.m3_valid.q.val()
+            & ((self.m3_kind.q.val() == self.c_test_init.val())
+                | (self.m3_kind.q.val() == self.c_test_list_end.val()));
         self.done_m.write_enable.next = self.m3_counts.val();
         self.done_e.write_enable.next = self.m3_counts.val();
         self.done_event.next = self.m3_counts.val();
         self.done_thread.next = self.m3_thread.q.val();
-        self.walk_end_event.next = self.m3_valid.q.val() & (self.m3_kind.q.val() == 3);
+        self.walk_end_event.next =
+            self.m3_valid.q.val() & (self.m3_kind.q.val() == self.c_test_walk_end.val());
         self.walk_end_thread.next = self.m3_thread.q.val();
         self.walk_end_t.next = bit_cast::<32, W>(self.m3_best.q.val().get_bits::<W>(0));
         self.walk_end_hit.next = self.m3_best.q.val().get_bit(32);
@@ -789,8 +826,8 @@ impl<
         if self.merge_hit.val() {
             self.merge_best.next = self.c_hit_flag.val() | bit_cast::<33, W>(self.m3_t.q.val());
         }
-        self.merge_write.next =
-            self.m3_valid.q.val() & ((self.m3_kind.q.val() == 1) | self.merge_hit.val());
+        self.merge_write.next = self.m3_valid.q.val()
+            & ((self.m3_kind.q.val() == self.c_test_init.val()) | self.merge_hit.val());
         self.best_m.write_data.next = self.merge_best.val();
         self.best_e.write_data.next = self.merge_best.val();
         self.best_m.write_enable.next = self.merge_write.val();

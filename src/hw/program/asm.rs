@@ -435,20 +435,14 @@ impl Asm {
         self.coprocessor(Op::Tri, f as u32, dst, Reg::ZERO, Reg::ZERO);
     }
 
-    /// Offers `kd.start a, b` or `kd.next a, b` to the traversal unit (again while refused).
-    pub fn kd_queue(&self, f: KdFn, a: Reg, b: Reg) {
-        debug_assert!(matches!(f, KdFn::Start | KdFn::Next));
-        self.coprocessor(Op::Kd, f as u32, Reg::ZERO, a, b);
+    /// Offers `kd.start a, b` (root, t_max) to the traversal unit (again while refused).
+    pub fn kd_start(&self, a: Reg, b: Reg) {
+        self.coprocessor(Op::Kd, KdFn::Start as u32, Reg::ZERO, a, b);
     }
 
-    /// Waits for the traversal unit's walk; `dst` = the leaf's list (or `KD_FINISHED`).
-    pub fn kd_wait(&self, dst: Reg) {
-        self.coprocessor(Op::Kd, KdFn::Wait as u32, dst, Reg::ZERO, Reg::ZERO);
-    }
-
-    /// `dst` = the leaf's list end.
-    pub fn kd_end(&self, dst: Reg) {
-        self.coprocessor(Op::Kd, KdFn::End as u32, dst, Reg::ZERO, Reg::ZERO);
+    /// Waits for the traversal unit's walk to end.
+    pub fn kd_wait(&self) {
+        self.coprocessor(Op::Kd, KdFn::Wait as u32, Reg::ZERO, Reg::ZERO, Reg::ZERO);
     }
 
     /// A coprocessor instruction: function `function`, operands `a`, `b`, result `dst`.

@@ -10,7 +10,7 @@
 //! pixel on one thread (threads never share state, so its result is the same; rayon runs
 //! those in parallel), optionally recording every register write for traces.
 
-use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_ANY_HIT, KD_FINISHED, REGISTERS};
+use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_ANY_HIT, REGISTERS};
 use super::Program;
 use crate::fp::Format;
 use crate::hw::traversal_unit::STACK_LEVELS;
@@ -73,14 +73,6 @@ impl Default for TesterState {
     }
 }
 
-/// A thread's walk in the traversal unit and the leaf it handed out (list, list end).
-#[derive(Clone, Default)]
-struct WalkState {
-    walk: units::KdWalk,
-    result: u32,
-    end: u32,
-}
-
 #[derive(Clone)]
 struct Thread {
     pc: usize,
@@ -88,7 +80,6 @@ struct Thread {
     scratch: Vec<u32>,
     mailboxes: [Mailbox; 2],
     tester: TesterState,
-    walk: WalkState,
     halted: bool,
 }
 
@@ -100,7 +91,6 @@ impl Thread {
             scratch: vec![0; scratch_words],
             mailboxes: Default::default(),
             tester: TesterState::default(),
-            walk: WalkState::default(),
             halted: false,
         }
     }
@@ -138,14 +128,22 @@ pub struct EngineFrame {
 /// The engine's twin on one frame's memory.
 pub struct Machine<'a> {
     program: &'a Program,
+    /// What the engine runs: the program's ROM words, decoded.
+    rom: Vec<Instr>,
     layout: &'a Layout,
     f: Format,
 }
 
 impl<'a> Machine<'a> {
     pub fn new(program: &'a Program, layout: &'a Layout) -> Self {
+        let rom = program
+            .rom()
+            .into_iter()
+            .map(|w| Instr::decode(w).expect("an encoded instruction decodes"))
+            .collect();
         Machine {
             program,
+            rom,
             layout,
             f: program.config.format,
         }
@@ -215,7 +213,7 @@ impl<'a> Machine<'a> {
         trace: Option<&mut Vec<Write>>,
     ) -> Result<(), ExecError> {
         let f = self.f;
-        let Some(&i) = self.program.code.get(t.pc) else {
+        let Some(&i) = self.rom.get(t.pc) else {
             return Err(self.error(k, t.pc, None, "program counter beyond the program"));
         };
         let a = t.regs[i.a as usize];
@@ -350,56 +348,33 @@ impl<'a> Machine<'a> {
             Op::Kd => {
                 let function = KdFn::from_imm(i.imm)
                     .ok_or_else(|| fail(format!("no traversal unit function {}", i.imm)))?;
-                let (tt, walk) = (&mut t.tester, &mut t.walk);
-                let ray = (tt.o, tt.d);
-                let nodes = std::cell::Cell::new(0u64);
-                let fetch = |n| {
-                    nodes.set(nodes.get() + 1);
-                    self.kd_node(n)
-                };
-                let stop = match function {
-                    KdFn::Start => {
-                        // The whole walk: each leaf's list goes to the tester, whose closest
-                        // hit answers the unit (an any-hit walk ends at the first hit).
-                        let any_hit = a & KD_ANY_HIT != 0;
-                        let root = a & !KD_ANY_HIT;
-                        let (w, mut stop) =
-                            units::KdWalk::start(f, ray, root, (tt.t_min, b), STACK_LEVELS, fetch)
-                                .map_err(fail)?;
-                        walk.walk = w;
-                        while let units::KdStop::Leaf { list, count } = stop {
-                            self.test_list(tt, list, list.wrapping_add(count), stats)
-                                .map_err(fail)?;
-                            stop = if any_hit && tt.hit {
-                                units::KdStop::Finished
-                            } else {
-                                walk.walk
-                                    .next(f, ray, (tt.best_t, tt.hit), STACK_LEVELS, fetch)
-                                    .map_err(fail)?
-                            };
-                        }
-                        Some(stop)
+                // `wait` has nothing to do: the twin's walk is over when it starts.
+                if function == KdFn::Start {
+                    // The whole walk: each leaf's list goes to the tester, whose closest hit
+                    // answers the unit (an any-hit walk ends at the first hit).
+                    let tt = &mut t.tester;
+                    let ray = (tt.o, tt.d);
+                    let nodes = std::cell::Cell::new(0u64);
+                    let fetch = |n| {
+                        nodes.set(nodes.get() + 1);
+                        self.kd_node(n)
+                    };
+                    let any_hit = a & KD_ANY_HIT != 0;
+                    let root = a & !KD_ANY_HIT;
+                    let (mut walk, mut stop) =
+                        units::KdWalk::start(f, ray, root, (tt.t_min, b), STACK_LEVELS, fetch)
+                            .map_err(fail)?;
+                    while let units::KdStop::Leaf { list, count } = stop {
+                        self.test_list(tt, list, list.wrapping_add(count), stats)
+                            .map_err(fail)?;
+                        stop = if any_hit && tt.hit {
+                            units::KdStop::Finished
+                        } else {
+                            walk.next(f, ray, (tt.best_t, tt.hit), STACK_LEVELS, fetch)
+                                .map_err(fail)?
+                        };
                     }
-                    KdFn::Next => Some(
-                        walk.walk
-                            .next(f, ray, (a, b & 1 == 1), STACK_LEVELS, fetch)
-                            .map_err(fail)?,
-                    ),
-                    _ => None,
-                };
-                stats.kd_nodes += nodes.get();
-                match stop {
-                    Some(units::KdStop::Leaf { list, count }) => {
-                        walk.result = list;
-                        walk.end = list.wrapping_add(count);
-                    }
-                    Some(units::KdStop::Finished) => walk.result = KD_FINISHED,
-                    None => {}
-                }
-                match function {
-                    KdFn::Wait => result = Some(walk.result),
-                    KdFn::End => result = Some(walk.end),
-                    KdFn::Start | KdFn::Next => {}
+                    stats.kd_nodes += nodes.get();
                 }
             }
         }

@@ -7,8 +7,13 @@
 //! saving the jump's turn). A thread has one instruction in flight, so the engine needs no
 //! hazard logic (see `hw::engine`).
 //!
-//! Encoding (ROM word of [`INSTR_BITS`] bits, most significant first):
-//! `op[5] dst[8] a[8] b[8] b_imm[1] invert[1] shift[3] bank[3] imm[32] target[12]`.
+//! Encoding ([`Instr::encode`], the only one: the engine's three ROMs hold its words, the
+//! listing prints them, the twin runs what they decode to): [`ROM_WORDS`] words of 32 bits,
+//! - control: `op[30:26] dst[25:18] a[17:10] b[9:2] b_imm[1] invert[0]`,
+//! - immediate: `imm[31:0]`,
+//! - auxiliary: `shift[17:15] bank[14:12] target[11:0]`,
+//!
+//! each field at its `CTL_*` / `AUX_*` bit, which the engine's decoder takes from here.
 
 use std::fmt;
 
@@ -19,8 +24,25 @@ pub const REG_BITS: usize = 8;
 pub const PC_BITS: usize = 12;
 /// Largest program.
 pub const MAX_PROGRAM: usize = 1 << PC_BITS;
-/// Width of one encoded instruction.
-pub const INSTR_BITS: usize = 5 + 3 * REG_BITS + 1 + 1 + 3 + 3 + 32 + PC_BITS;
+/// Bits of an opcode.
+pub const OP_BITS: usize = 5;
+
+/// 32-bit ROM words per instruction: control, immediate, auxiliary.
+pub const ROM_WORDS: usize = 3;
+/// The lowest bit of each field of the control word.
+pub const CTL_OP: usize = 26;
+pub const CTL_DST: usize = 18;
+pub const CTL_A: usize = 10;
+pub const CTL_B: usize = 2;
+pub const CTL_B_IMM: usize = 1;
+pub const CTL_INVERT: usize = 0;
+/// The lowest bit of each field of the auxiliary word.
+pub const AUX_SHIFT: usize = 15;
+pub const AUX_BANK: usize = 12;
+pub const AUX_TARGET: usize = 0;
+/// Bits of `shift` and of `bank`.
+pub const SHIFT_BITS: usize = 3;
+pub const BANK_BITS: usize = 3;
 
 /// The two mailboxes of a thread (the `imm` of `Mbx` / `Mbc`). The program uses the instance
 /// mailbox; triangles are mailboxed by the triangle tester's list unit (`TriFn::List`).
@@ -86,8 +108,8 @@ pub enum Op {
     /// `wait` repeats while tests are in flight (neither repeat counts as retired).
     Tri,
     /// The traversal unit (`hw::TraversalUnit`), function `imm` ([`KdFn`]): walk an object's
-    /// kd tree, its leaves' triangles tested by the triangle tester. `start` and `next` repeat
-    /// while refused, `wait` while the walk is in flight.
+    /// kd tree, its leaves' triangles tested by the triangle tester. `start` repeats while
+    /// refused, `wait` while the walk is in flight. It writes no register.
     Kd,
     /// A colour channel's byte shifted in: `dst = (B << 8) | byte(A)`, where `byte` clamps `A`
     /// to [0, 1] and rounds 255 times it to an integer (`units::channel_byte`); three in a row
@@ -103,23 +125,15 @@ pub enum KdFn {
     /// with the segment `[t_min, B]` (t_min from the tester's init). The unit hands each leaf's
     /// list to the triangle tester and goes on with its closest hit, to the walk's end.
     Start = 0,
-    /// Repeat while the walk is in flight (asleep); `dst` = [`KD_FINISHED`] when it ended, or
-    /// the leaf's list address of a walk the engine answers itself (`next`).
+    /// Repeat while the walk is in flight (asleep); the closest hit is the tester's.
     Wait,
-    /// `dst` = the leaf's list end (list + count) of a walk the engine answers.
-    End,
-    /// Go on after a leaf whose closest hit so far is `A` (best t), `B` (hit, 0 or 1).
-    Next,
 }
-
-/// The `kd.wait` result of a finished walk (bit 31).
-pub const KD_FINISHED: u32 = 1 << 31;
 
 /// Bit 31 of `kd.start`'s root: the walk answers a shadow query, and ends at the first hit.
 pub const KD_ANY_HIT: u32 = 1 << 31;
 
 impl KdFn {
-    pub const ALL: [KdFn; 4] = [KdFn::Start, KdFn::Wait, KdFn::End, KdFn::Next];
+    pub const ALL: [KdFn; 2] = [KdFn::Start, KdFn::Wait];
     pub fn from_imm(imm: u32) -> Option<KdFn> {
         Self::ALL.get(imm as usize).copied()
     }
@@ -127,8 +141,6 @@ impl KdFn {
         match self {
             KdFn::Start => "start",
             KdFn::Wait => "wait",
-            KdFn::End => "end",
-            KdFn::Next => "next",
         }
     }
 }
@@ -259,7 +271,6 @@ impl Op {
                 | Jal
                 | Pixel
                 | Tri
-                | Kd
                 | Byte
         )
     }
@@ -432,55 +443,41 @@ impl Instr {
         self.invert && self.op.can_jump_after()
     }
 
-    /// The ROM word (see the module doc for the field order).
-    pub fn encode(&self) -> u128 {
-        let mut w: u128 = self.op as u128;
-        let mut put = |bits: usize, v: u128| {
-            debug_assert!(v < (1u128 << bits));
-            w = (w << bits) | v;
+    /// The ROM words (see the module doc for the fields).
+    pub fn encode(&self) -> [u32; ROM_WORDS] {
+        let field = |v: u32, bits: usize, at: usize| {
+            debug_assert!(v < 1 << bits, "{self:?}: {v} does not fit {bits} bits");
+            v << at
         };
-        put(REG_BITS, self.dst.into());
-        put(REG_BITS, self.a.into());
-        put(REG_BITS, self.b.into());
-        put(1, self.b_imm.into());
-        put(1, self.invert.into());
-        put(3, self.shift.into());
-        put(3, self.bank.into());
-        put(32, self.imm.into());
-        put(PC_BITS, self.target.into());
-        w
+        let ctl = field(self.op as u32, OP_BITS, CTL_OP)
+            | field(self.dst.into(), REG_BITS, CTL_DST)
+            | field(self.a.into(), REG_BITS, CTL_A)
+            | field(self.b.into(), REG_BITS, CTL_B)
+            | field(self.b_imm.into(), 1, CTL_B_IMM)
+            | field(self.invert.into(), 1, CTL_INVERT);
+        let aux = field(self.shift.into(), SHIFT_BITS, AUX_SHIFT)
+            | field(self.bank.into(), BANK_BITS, AUX_BANK)
+            | field(self.target.into(), PC_BITS, AUX_TARGET);
+        [ctl, self.imm, aux]
     }
 
-    /// The inverse of [`Instr::encode`]; `None` for an unknown opcode.
-    pub fn decode(w: u128) -> Option<Instr> {
-        let mut w = w;
-        let mut take = |bits: usize| {
-            let v = w & ((1u128 << bits) - 1);
-            w >>= bits;
-            v
-        };
-        let target = take(PC_BITS) as u16;
-        let imm = take(32) as u32;
-        let bank = take(3) as u8;
-        let shift = take(3) as u8;
-        let invert = take(1) == 1;
-        let b_imm = take(1) == 1;
-        let b = take(REG_BITS) as u8;
-        let a = take(REG_BITS) as u8;
-        let dst = take(REG_BITS) as u8;
-        let op = *OPS.get(take(5) as usize)?;
-        Some(Instr {
-            op,
-            dst,
-            a,
-            b,
-            b_imm,
-            invert,
-            shift,
-            bank,
+    /// The inverse of [`Instr::encode`]; `None` for a word with a bit outside every field.
+    pub fn decode(w: [u32; ROM_WORDS]) -> Option<Instr> {
+        let [ctl, imm, aux] = w;
+        let field = |word: u32, bits: usize, at: usize| (word >> at) & ((1 << bits) - 1);
+        let i = Instr {
+            op: OPS[field(ctl, OP_BITS, CTL_OP) as usize],
+            dst: field(ctl, REG_BITS, CTL_DST) as u8,
+            a: field(ctl, REG_BITS, CTL_A) as u8,
+            b: field(ctl, REG_BITS, CTL_B) as u8,
+            b_imm: field(ctl, 1, CTL_B_IMM) == 1,
+            invert: field(ctl, 1, CTL_INVERT) == 1,
+            shift: field(aux, SHIFT_BITS, AUX_SHIFT) as u8,
+            bank: field(aux, BANK_BITS, AUX_BANK) as u8,
             imm,
-            target,
-        })
+            target: field(aux, PC_BITS, AUX_TARGET) as u16,
+        };
+        (i.encode() == w).then_some(i)
     }
 }
 
@@ -533,7 +530,7 @@ impl fmt::Display for Instr {
             }
             Op::Kd => {
                 let name = KdFn::from_imm(self.imm).map_or("?", KdFn::name);
-                write!(f, "kd.{name} r{}, r{}, r{}", self.dst, self.a, self.b)
+                write!(f, "kd.{name} r{}, r{}", self.a, self.b)
             }
             Op::FSqrt | Op::IToF => write!(f, "{} r{}, r{}", self.op.name(), self.dst, self.a),
             _ => write!(f, "{} r{}, r{}, {}", self.op.name(), self.dst, self.a, b),
@@ -547,27 +544,56 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
+    /// Every op with every function it has, and random fields: the words decode to the
+    /// instruction, and a bit outside every field is refused.
     #[test]
-    fn encode_decode_round_trip() {
+    fn encode_decode_round_trip_of_every_instruction_kind() {
+        assert_eq!(OPS.len(), 1 << OP_BITS);
+        for (k, op) in OPS.iter().enumerate() {
+            assert_eq!(*op as usize, k, "OPS is in encoding order");
+        }
         let seed = 5;
         println!("seed {seed}");
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        for _ in 0..10_000 {
-            let i = Instr {
-                op: OPS[rng.gen_range(0..OPS.len())],
-                dst: rng.gen(),
-                a: rng.gen(),
-                b: rng.gen(),
-                b_imm: rng.gen(),
-                invert: rng.gen(),
-                shift: rng.gen_range(0..8),
-                bank: rng.gen_range(0..6),
-                imm: rng.gen(),
-                target: rng.gen_range(0..MAX_PROGRAM as u16),
+        let kinds = OPS.iter().flat_map(|&op| {
+            let functions: Vec<u32> = match op {
+                Op::Tri => TriFn::ALL.iter().map(|&f| f as u32).collect(),
+                Op::Kd => KdFn::ALL.iter().map(|&f| f as u32).collect(),
+                _ => vec![u32::MAX],
             };
-            let w = i.encode();
-            assert!(w < 1u128 << INSTR_BITS);
-            assert_eq!(Instr::decode(w), Some(i));
+            functions.into_iter().map(move |f| (op, f))
+        });
+        let mut count = 0;
+        for (op, function) in kinds {
+            for _ in 0..1_000 {
+                let i = Instr {
+                    op,
+                    dst: rng.gen(),
+                    a: rng.gen(),
+                    b: rng.gen(),
+                    b_imm: rng.gen(),
+                    invert: rng.gen(),
+                    shift: rng.gen_range(0..1 << SHIFT_BITS),
+                    bank: rng.gen_range(0..1 << BANK_BITS),
+                    imm: if function == u32::MAX {
+                        rng.gen()
+                    } else {
+                        function
+                    },
+                    target: rng.gen_range(0..MAX_PROGRAM as u16),
+                };
+                let w = i.encode();
+                assert_eq!(Instr::decode(w), Some(i), "{i:?}");
+                // The words' free bits: ctl 31, aux 31..18.
+                let stray = [1u32 << 31, 0, 1 << rng.gen_range(18..32)];
+                for (k, bit) in stray.into_iter().enumerate().filter(|(_, b)| *b != 0) {
+                    let mut bad = w;
+                    bad[k] |= bit;
+                    assert_eq!(Instr::decode(bad), None, "{i:?} with word {k} bit {bit:#x}");
+                }
+            }
+            count += 1;
         }
+        assert_eq!(count, 30 + TriFn::ALL.len() + KdFn::ALL.len());
     }
 }

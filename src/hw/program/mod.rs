@@ -141,13 +141,24 @@ impl Program {
     pub fn units(&self) -> BTreeSet<Unit> {
         self.code.iter().map(|i| i.op.unit()).collect()
     }
-    /// The assembly listing, one instruction a line with its address and routine.
+    /// The instruction ROM: each instruction's words ([`isa::Instr::encode`]).
+    pub fn rom(&self) -> Vec<[u32; isa::ROM_WORDS]> {
+        self.code.iter().map(isa::Instr::encode).collect()
+    }
+    /// The assembly listing, one instruction a line with its address, ROM words (control,
+    /// immediate, auxiliary) and routine.
     pub fn listing(&self) -> String {
-        self.code
+        self.rom()
             .iter()
+            .zip(&self.code)
             .zip(&self.sections)
             .enumerate()
-            .map(|(pc, (i, s))| format!("{pc:4}  {s:<12} {i}\n"))
+            .map(|(pc, ((w, i), s))| {
+                format!(
+                    "{pc:4}  {:08x} {:08x} {:05x}  {s:<12} {i}\n",
+                    w[0], w[1], w[2]
+                )
+            })
             .collect()
     }
 }

@@ -24,7 +24,7 @@
 
 use super::asm::Asm;
 use super::asm::{Label, Reg, Val};
-use super::isa::{KdFn, Op, TriFn, MAILBOX_INSTANCES};
+use super::isa::{Op, TriFn, MAILBOX_INSTANCES};
 use super::{Gen, STACK_ENTRY_WORDS};
 use crate::layout::{instance_word as iw, INSTANCES, LEAF_TAG, LISTS, NODES};
 use crate::units;
@@ -124,8 +124,8 @@ impl Gen<'_> {
             (root, true) => a.keep(a.op(Op::Or, s.q_any.into(), root)),
             (k, false) => a.keep(k),
         };
-        a.kd_queue(KdFn::Start, from, t_max);
-        a.kd_wait(Reg::ZERO);
+        a.kd_start(from, t_max);
+        a.kd_wait();
         a.section("intersect");
         a.tri_wait(s.best_t);
         if !self.hit_by_t() {
