@@ -178,8 +178,10 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
     );
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create {}", a.out.display()))?;
-    let command = std::env::args()
-        .map(|s| s.rsplit('/').next().unwrap_or(&s).to_string())
+    // The binary's own path depends on the target directory; the verb and its arguments are
+    // what reproduces the table.
+    let command = std::iter::once("dynrt".to_string())
+        .chain(std::env::args().skip(1))
         .collect::<Vec<_>>()
         .join(" ");
     let mut done: Vec<DesignTiming> = Vec::new();
