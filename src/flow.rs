@@ -291,8 +291,13 @@ impl FrameReport {
     pub fn cycles_per_ray(&self) -> f64 {
         self.cycles as f64 / self.pixels as f64
     }
+    /// Frames per second at the paper's 90 MHz (an assumed clock; see [`Self::fps_at`]).
     pub fn fps(&self) -> f64 {
-        CLOCK_HZ / self.cycles as f64
+        self.fps_at(CLOCK_HZ)
+    }
+    /// Frames per second at a clock of `hz`.
+    pub fn fps_at(&self, hz: f64) -> f64 {
+        hz / self.cycles as f64
     }
     /// Shares of the frame's clocks in which the TransformUnit, the IntersectUnit and the
     /// traversal unit's decision took an input.
@@ -307,7 +312,11 @@ impl FrameReport {
     }
     /// Frames per second at 90 MHz for 512x384 at this scene's cycles per primary ray.
     pub fn fps_512x384(&self) -> f64 {
-        CLOCK_HZ / (self.cycles_per_ray() * 512.0 * 384.0)
+        self.fps_512x384_at(CLOCK_HZ)
+    }
+    /// Frames per second at a clock of `hz` for 512x384 at this scene's cycles per primary ray.
+    pub fn fps_512x384_at(&self, hz: f64) -> f64 {
+        hz / (self.cycles_per_ray() * 512.0 * 384.0)
     }
 }
 

@@ -10,6 +10,7 @@ mod render_cmd;
 mod rtl_cmd;
 mod stress_cmd;
 mod synth_cmd;
+mod timing_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -40,6 +41,9 @@ enum Command {
     Stress(stress_cmd::StressArgs),
     /// yosys synth_xilinx -family xc2v of one geometry unit: resources and logic depth.
     Synth(synth_cmd::SynthArgs),
+    /// Placed-and-routed timing (ECP5, nextpnr, out of context) of units alone or of the whole
+    /// processor of scenes: fmax per clock, critical paths, utilization; timing.md/.csv.
+    Timing(timing_cmd::TimingArgs),
     /// Write the ray tracing processor of a scene: Verilog, testbench, memory images, UCF.
     Rtl(rtl_cmd::RtlArgs),
     /// Generate, simulate (Icarus or Verilator) and compare every frame with the golden model.
@@ -62,6 +66,7 @@ pub fn run() -> i32 {
         Command::Demo(a) => demo_cmd::run(a),
         Command::Stress(a) => stress_cmd::run(a),
         Command::Synth(a) => synth_cmd::run(a),
+        Command::Timing(a) => timing_cmd::run(a),
         Command::EmitFp(a) => emit_fp_cmd::run(a),
         Command::Rtl(a) => rtl_cmd::run_rtl(a),
         Command::Sim(a) => rtl_cmd::run_sim(a),

@@ -47,6 +47,36 @@ pub struct SimArgs {
     pub rtl: RtlArgs,
     #[arg(long, value_enum, default_value = "verilator")]
     pub sim: SimKind,
+    /// State fps at this clock, MHz (default: the paper's 90 MHz, assumed, not measured).
+    #[arg(long, conflicts_with = "timing_report")]
+    pub clock: Option<f64>,
+    /// State fps at the main clock measured in this report of the same design: `dynrt timing
+    /// SCENE`'s timing.csv or a seed's report.json (the slowest seed's clock is taken).
+    #[arg(long)]
+    pub timing_report: Option<PathBuf>,
+}
+
+/// The clock fps are stated at, in MHz, and where it comes from.
+fn fps_clock(a: &SimArgs) -> anyhow::Result<(f64, String)> {
+    if let Some(mhz) = a.clock {
+        if !(mhz.is_finite() && mhz > 0.0 && mhz <= 1000.0) {
+            bail!("--clock {mhz}: give the clock in MHz, in (0, 1000], e.g. --clock 90");
+        }
+        return Ok((mhz, "given with --clock".into()));
+    }
+    if let Some(path) = &a.timing_report {
+        let mhz = dynrt::synth::ecp5::measured_clock_mhz(path).map_err(|m| {
+            anyhow::anyhow!("--timing-report: {m} (make one with `dynrt timing SCENE --out DIR`)")
+        })?;
+        return Ok((
+            mhz,
+            format!("measured after place and route, {}", path.display()),
+        ));
+    }
+    Ok((
+        flow::CLOCK_HZ / 1e6,
+        "assumed: the paper's clock, not measured; give --clock or --timing-report".into(),
+    ))
 }
 
 /// Loads the scene and checks every limit of the processor and the output folder, before
@@ -104,6 +134,7 @@ fn print_synthesis(a: &RtlArgs) -> anyhow::Result<()> {
 
 pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
     let (scene, name, params) = setup(&a.rtl)?;
+    let (mhz, clock_source) = fps_clock(&a)?;
     let out = OutputDir::create(&a.rtl.out, "--out")?;
     let sim = match a.sim {
         SimKind::Iverilog => Simulator::Icarus,
@@ -119,17 +150,18 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         &a.rtl.out,
     )?;
     println!("{name} in {} ({}):", sim.name(), r.tool_version);
+    println!("  fps at {mhz:.1} MHz ({clock_source})");
     for l in &r.left_out {
         println!("  left out: {l}");
     }
     for (k, f) in r.frames.iter().enumerate() {
         println!(
-            "  frame {k}: {} cycles, {} instructions, {:.1} cycles per primary ray, {:.1} fps at 90 MHz ({:.2} fps at 512x384): {}",
+            "  frame {k}: {} cycles, {} instructions, {:.1} cycles per primary ray, {:.1} fps at {mhz:.1} MHz ({:.2} fps at 512x384): {}",
             f.cycles,
             f.instructions,
             f.cycles_per_ray(),
-            f.fps(),
-            f.fps_512x384(),
+            f.fps_at(mhz * 1e6),
+            f.fps_512x384_at(mhz * 1e6),
             if f.differing_pixels == 0 {
                 "identical to the golden model".to_string()
             } else {

@@ -28,6 +28,7 @@ pub fn run(a: SynthArgs) -> anyhow::Result<i32> {
     println!("MULT18X18   {}", r.mult18x18);
     println!("block RAMs  {}", r.block_rams);
     println!("logic depth {} LUT levels", r.logic_depth);
+    println!("deepest     {} -> {}", r.deepest_start, r.deepest_end);
     println!("XC2V6000    {u}");
     println!("paper Table 2 operators: {add} add, {mul} mul, {div} div");
     Ok(0)

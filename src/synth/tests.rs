@@ -82,6 +82,9 @@ fn parity_tree_depth_in_lut_levels() {
     assert_eq!(r.logic_depth, 3, "{:?}", r.all_cells);
     assert_eq!(r.path_cells, 3);
     assert_eq!(r.flip_flops, 65);
+    // The tree runs from a bit of register r to register p, named as in the Verilog.
+    assert!(r.deepest_start.starts_with('r'), "{}", r.deepest_start);
+    assert_eq!(r.deepest_end, "p");
 }
 
 #[test]
@@ -165,8 +168,12 @@ fn utilization_of_xc2v6000() {
         String::new(),
         "0.23".into(),
         cells,
-        0,
-        0,
+        depth::Depth {
+            logic_depth: 0,
+            path_cells: 0,
+            start: String::new(),
+            end: String::new(),
+        },
         String::new(),
         0.0,
         PathBuf::new(),
