@@ -60,7 +60,7 @@ pub struct SimArgs {
 fn fps_clock(a: &SimArgs) -> anyhow::Result<(f64, String)> {
     if let Some(mhz) = a.clock {
         if !(mhz.is_finite() && mhz > 0.0 && mhz <= 1000.0) {
-            bail!("--clock {mhz}: give the clock in MHz, in (0, 1000], e.g. --clock 90");
+            anyhow::bail!("--clock {mhz}: give the clock in MHz, in (0, 1000], e.g. --clock 90");
         }
         return Ok((mhz, "given with --clock".into()));
     }
