@@ -48,7 +48,12 @@ pub const MAX_PROCESSOR_FRAMES: u32 = 256;
 /// generated for the scene's features with a worst-case tree, which does not change its length).
 /// The kd stack depth needs the trees and is checked by [`generate_rtl`] and
 /// [`simulate_scene`] right after they are built.
-pub fn preflight(scene: &Scene, f: Format, params: ProcessorParams, frames: Option<u32>) -> Result<()> {
+pub fn preflight(
+    scene: &Scene,
+    f: Format,
+    params: ProcessorParams,
+    frames: Option<u32>,
+) -> Result<()> {
     use crate::hw::engine::{MAX_MEM_LATENCY, MAX_THREADS};
     let src = scene.source.display();
     anyhow::ensure!(
@@ -107,7 +112,11 @@ pub fn preflight(scene: &Scene, f: Format, params: ProcessorParams, frames: Opti
         // fits follows from two lengths.
         let (one, two) = (length(1), length(2));
         let per_light = two.saturating_sub(one).max(1);
-        let fit = if one > MAX_PROGRAM { 0 } else { 1 + (MAX_PROGRAM - one) / per_light };
+        let fit = if one > MAX_PROGRAM {
+            0
+        } else {
+            1 + (MAX_PROGRAM - one) / per_light
+        };
         anyhow::bail!(
             "{src}: the scene's microprogram needs {needed} instructions, the engine's ROM holds \
              {MAX_PROGRAM}: each of its {} lights adds about {per_light} (shading and shadow ray); \

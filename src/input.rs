@@ -44,7 +44,9 @@ pub enum InputError {
         size: u64,
         cap: u64,
     },
-    #[error("{what} '{path}' is not UTF-8 text (first bad byte at offset {offset}); save it as UTF-8")]
+    #[error(
+        "{what} '{path}' is not UTF-8 text (first bad byte at offset {offset}); save it as UTF-8"
+    )]
     NotText {
         what: String,
         path: PathBuf,

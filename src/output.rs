@@ -50,8 +50,17 @@ pub fn check_output_file(path: &Path, what: &str) -> Result<()> {
     if text.is_empty() {
         bail!("{what}: the path is empty; give a file name");
     }
-    if text.ends_with('/') || matches!(path.components().next_back(), Some(Component::CurDir | Component::ParentDir | Component::RootDir)) {
-        bail!("{what} '{}' names a folder; give a file name, e.g. '{}'", path.display(), Path::new(&*text).join("out.png").display());
+    if text.ends_with('/')
+        || matches!(
+            path.components().next_back(),
+            Some(Component::CurDir | Component::ParentDir | Component::RootDir)
+        )
+    {
+        bail!(
+            "{what} '{}' names a folder; give a file name, e.g. '{}'",
+            path.display(),
+            Path::new(&*text).join("out.png").display()
+        );
     }
     refuse_non_regular(path, what)?;
     let mut ancestor = parent_of(path);
@@ -162,7 +171,10 @@ pub fn write_all_atomically(files: &[(&Path, &[u8])]) -> Result<()> {
     let mut ready = Vec::with_capacity(files.len());
     for (path, bytes) in files {
         refuse_non_regular(path, "output")?;
-        ready.push((*path, staged(path, bytes).with_context(|| format!("writing {}", path.display()))?));
+        ready.push((
+            *path,
+            staged(path, bytes).with_context(|| format!("writing {}", path.display()))?,
+        ));
     }
     for (path, tmp) in ready {
         tmp.persist(path)
@@ -175,8 +187,11 @@ pub fn write_all_atomically(files: &[(&Path, &[u8])]) -> Result<()> {
 /// PNG bytes of an RGB image.
 pub fn png_bytes(img: &image::RgbImage) -> Result<Vec<u8>> {
     let mut bytes = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .context("encoding PNG")?;
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .context("encoding PNG")?;
     Ok(bytes)
 }
 
@@ -304,16 +319,28 @@ mod tests {
         assert!(e.contains("symbolic link"), "{e}");
         let e = write_atomically(&link, b"new").unwrap_err().to_string();
         assert!(e.contains("symbolic link"), "{e}");
-        assert_eq!(std::fs::read(&file).unwrap(), b"old", "the link's target is untouched");
-        let e = check_output_file(Path::new("/dev/null"), "--out").unwrap_err().to_string();
+        assert_eq!(
+            std::fs::read(&file).unwrap(),
+            b"old",
+            "the link's target is untouched"
+        );
+        let e = check_output_file(Path::new("/dev/null"), "--out")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("character device"), "{e}");
         let e = check_output_file(d, "--out").unwrap_err().to_string();
         assert!(e.contains("a directory"), "{e}");
-        let e = check_output_file(Path::new("."), "--out").unwrap_err().to_string();
+        let e = check_output_file(Path::new("."), "--out")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("names a folder"), "{e}");
-        let e = check_output_file(Path::new("newdir/"), "--out").unwrap_err().to_string();
+        let e = check_output_file(Path::new("newdir/"), "--out")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("names a folder"), "{e}");
-        let e = check_output_file(&file.join("x"), "--out").unwrap_err().to_string();
+        let e = check_output_file(&file.join("x"), "--out")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("is a file, not a folder"), "{e}");
         let e = check_output_dir(&file, "--out").unwrap_err().to_string();
         assert!(e.contains("not a folder"), "{e}");
@@ -325,7 +352,9 @@ mod tests {
         let a = dir.path().join("x.csv");
         let b = dir.path().join("sub/../x.csv");
         std::fs::create_dir(dir.path().join("sub")).unwrap();
-        let e = check_distinct(&[("--out", &a), ("--hits", &b)]).unwrap_err().to_string();
+        let e = check_distinct(&[("--out", &a), ("--hits", &b)])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("--out and --hits are the same file"), "{e}");
         check_distinct(&[("--out", &a), ("--hits", &dir.path().join("y.csv"))]).unwrap();
     }
@@ -362,7 +391,10 @@ mod tests {
         // A file where the second output's folder should be: its staging fails.
         let b = blocked.join("b.csv");
         assert!(write_all_atomically(&[(&a, b"1"), (&b, b"2")]).is_err());
-        assert!(!a.exists(), "the first file is not written when the second fails");
+        assert!(
+            !a.exists(),
+            "the first file is not written when the second fails"
+        );
         let leftovers = std::fs::read_dir(dir.path()).unwrap().count();
         assert_eq!(leftovers, 1, "no temporary file is left behind");
     }

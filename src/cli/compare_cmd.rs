@@ -27,7 +27,8 @@ fn open(p: &std::path::Path) -> anyhow::Result<image::RgbImage> {
 pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
     if let Some(d) = &a.diff {
         dynrt::output::check_output_file(d, "--diff")?;
-        let mut roles: Vec<(&str, &std::path::Path)> = vec![("image A", &a.a), ("image B", &a.b), ("--diff", d)];
+        let mut roles: Vec<(&str, &std::path::Path)> =
+            vec![("image A", &a.a), ("image B", &a.b), ("--diff", d)];
         if let Some(h) = &a.hits {
             roles.extend([("HITS_A", h[0].as_path()), ("HITS_B", h[1].as_path())]);
         }

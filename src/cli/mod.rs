@@ -56,7 +56,9 @@ enum Command {
 pub fn run() -> i32 {
     let cli = Cli::parse();
     if let Err(e) = dynrt::sim::process::forward_signals() {
-        eprintln!("warning: cannot take Ctrl-C and SIGTERM to end the simulators dynrt starts: {e}");
+        eprintln!(
+            "warning: cannot take Ctrl-C and SIGTERM to end the simulators dynrt starts: {e}"
+        );
     }
     let result = match cli.command {
         Command::Render(a) => render_cmd::run(a),
@@ -92,9 +94,12 @@ pub const EXIT_TOOL: i32 = 3;
 fn exit_code_of(e: &anyhow::Error) -> i32 {
     let tool = e.chain().any(|c| {
         c.downcast_ref::<dynrt::sim::ToolError>().is_some()
-            || c
-                .downcast_ref::<std::io::Error>()
-                .is_some_and(|io| matches!(io.raw_os_error(), Some(libc::ENOSPC | libc::EDQUOT | libc::EIO)))
+            || c.downcast_ref::<std::io::Error>().is_some_and(|io| {
+                matches!(
+                    io.raw_os_error(),
+                    Some(libc::ENOSPC | libc::EDQUOT | libc::EIO)
+                )
+            })
     });
     if tool {
         EXIT_TOOL

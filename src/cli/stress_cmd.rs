@@ -59,5 +59,9 @@ pub fn run(a: StressArgs) -> anyhow::Result<i32> {
     print!("{}", report.table());
     report.save_csv(&a.out)?;
     println!("written to {}", a.out.display());
-    Ok(if report.all_held() { 0 } else { super::EXIT_DIFFERS })
+    Ok(if report.all_held() {
+        0
+    } else {
+        super::EXIT_DIFFERS
+    })
 }

@@ -122,7 +122,10 @@ pub fn read_hits(path: &Path) -> anyhow::Result<Vec<HitRow>> {
             .parse()
             .map_err(|_| bad("y is not a pixel coordinate"))?;
         if x >= crate::scene::MAX_RESOLUTION || y >= crate::scene::MAX_RESOLUTION {
-            return Err(bad(&format!("pixel beyond the largest frame ({0}x{0})", crate::scene::MAX_RESOLUTION)));
+            return Err(bad(&format!(
+                "pixel beyond the largest frame ({0}x{0})",
+                crate::scene::MAX_RESOLUTION
+            )));
         }
         let instance: i64 = fields[2]
             .parse()
@@ -138,17 +141,24 @@ pub fn read_hits(path: &Path) -> anyhow::Result<Vec<HitRow>> {
                 return Err(bad("a hit (instance >= 0) needs a triangle index >= 0"));
             }
             if !(dist.is_finite() && dist >= 0.0) {
-                return Err(bad("a hit's dist must be a finite distance >= 0 (a miss is `-1,-1,inf`)"));
+                return Err(bad(
+                    "a hit's dist must be a finite distance >= 0 (a miss is `-1,-1,inf`)",
+                ));
             }
             Some((instance, triangle, dist))
         };
         if let Some(first) = line_of.insert((x, y), i + 1) {
-            return Err(bad(&format!("pixel ({x}, {y}) appears twice (first on line {first}); each pixel has one row")));
+            return Err(bad(&format!(
+                "pixel ({x}, {y}) appears twice (first on line {first}); each pixel has one row"
+            )));
         }
         rows.push(HitRow { x, y, hit });
     }
     if rows.is_empty() {
-        bail!("{}: no rows after the header; a hits file has one row per pixel", path.display());
+        bail!(
+            "{}: no rows after the header; a hits file has one row per pixel",
+            path.display()
+        );
     }
     let width = rows.iter().map(|r| r.x).max().unwrap_or(0) as usize + 1;
     let height = rows.iter().map(|r| r.y).max().unwrap_or(0) as usize + 1;
@@ -171,7 +181,13 @@ pub fn read_hits(path: &Path) -> anyhow::Result<Vec<HitRow>> {
 /// has silhouettes where any format may differ); below e5m10 nothing is measured, and 50% is
 /// taken, enough to tell a format that cannot hold the scene.
 pub fn expected_mismatch_bound(f: crate::fp::Format) -> f64 {
-    let measured: [(u32, f64); 5] = [(23, 0.00014), (18, 0.00019), (16, 0.00089), (14, 0.00458), (10, 0.0825)];
+    let measured: [(u32, f64); 5] = [
+        (23, 0.00014),
+        (18, 0.00019),
+        (16, 0.00089),
+        (14, 0.00458),
+        (10, 0.0825),
+    ];
     match measured.iter().find(|(m, _)| f.man_bits >= *m) {
         Some((_, share)) => (4.0 * share).max(0.01),
         None => 0.5,

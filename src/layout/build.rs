@@ -150,7 +150,12 @@ fn checked_affine_words(
         let row = m.matrix3.row(r);
         values.extend([row.x, row.y, row.z, m.translation[r]]);
     }
-    checked_words(f, scene, &|i| format!("{what}, row {} column {}", i / 4, i % 4), &values)
+    checked_words(
+        f,
+        scene,
+        &|i| format!("{what}, row {} column {}", i / 4, i % 4),
+        &values,
+    )
 }
 
 /// The per-object kd-trees and unit-triangle transforms of a scene for one number format,
@@ -439,7 +444,19 @@ pub fn build(
             .map(|(inst, m)| {
                 let b = instance_box(f, &trees.trees[inst.object].bounds, m);
                 let values = [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z];
-                checked_words(f, scene, &|i| format!("instance '{}': its bounding box {} {}", inst.name, ["min", "max"][i / 3], ["x", "y", "z"][i % 3]), &values)?;
+                checked_words(
+                    f,
+                    scene,
+                    &|i| {
+                        format!(
+                            "instance '{}': its bounding box {} {}",
+                            inst.name,
+                            ["min", "max"][i / 3],
+                            ["x", "y", "z"][i % 3]
+                        )
+                    },
+                    &values,
+                )?;
                 Ok(b)
             })
             .collect::<Result<_, LayoutError>>()?;
@@ -497,10 +514,20 @@ pub fn build(
     // Instances.
     for (inst, m) in scene.instances.iter().zip(&to_world) {
         let item = format!("instance '{}'", inst.name);
-        banks[INSTANCES].extend(checked_affine_words(f, scene, &format!("{item}: its world-to-object matrix"), &m.inverse())?);
+        banks[INSTANCES].extend(checked_affine_words(
+            f,
+            scene,
+            &format!("{item}: its world-to-object matrix"),
+            &m.inverse(),
+        )?);
         let normal = m.matrix3.inverse().transpose();
         let values: Vec<f64> = (0..3).flat_map(|r| normal.row(r).to_array()).collect();
-        banks[INSTANCES].extend(checked_words(f, scene, &|i| format!("{item}: its normal matrix, row {} column {}", i / 3, i % 3), &values)?);
+        banks[INSTANCES].extend(checked_words(
+            f,
+            scene,
+            &|i| format!("{item}: its normal matrix, row {} column {}", i / 3, i % 3),
+            &values,
+        )?);
         banks[INSTANCES].extend([
             object_roots[inst.object],
             first_triangle[inst.object],
@@ -521,25 +548,86 @@ pub fn build(
         + basis.up * ((1.0 - 1.0 / h) * half_h);
     let camera = DAffine3::from_mat3_translation(DMat3::from_cols(c0, c1, DVec3::ZERO), c2);
     let fr = &mut banks[FRAME];
-    fr.extend(checked_affine_words(f, scene, "the camera's pixel-to-direction matrix", &camera)?);
+    fr.extend(checked_affine_words(
+        f,
+        scene,
+        "the camera's pixel-to-direction matrix",
+        &camera,
+    )?);
     let xyz = |i: usize| ["x", "y", "z"][i % 3];
     let rgb = |i: usize| ["r", "g", "b"][i % 3];
-    fr.extend(checked_words(f, scene, &|i| format!("the camera's eye {} (relative to the hardware's origin)", xyz(i)), &(cam.eye - origin).to_array())?);
-    fr.extend(checked_words(f, scene, &|_| "ambient".into(), &[scene.render.ambient])?);
-    fr.extend(checked_words(f, scene, &|i| format!("background {}", rgb(i)), &scene.render.background)?);
+    fr.extend(checked_words(
+        f,
+        scene,
+        &|i| {
+            format!(
+                "the camera's eye {} (relative to the hardware's origin)",
+                xyz(i)
+            )
+        },
+        &(cam.eye - origin).to_array(),
+    )?);
+    fr.extend(checked_words(
+        f,
+        scene,
+        &|_| "ambient".into(),
+        &[scene.render.ambient],
+    )?);
+    fr.extend(checked_words(
+        f,
+        scene,
+        &|i| format!("background {}", rgb(i)),
+        &scene.render.background,
+    )?);
     let (shadow_eps, mirror_eps) = secondary_t_min(f, scene);
-    fr.extend(checked_words(f, scene, &|i| format!("the {} rays' start offset (from the scene's size)", ["shadow", "mirror"][i]), &[shadow_eps, mirror_eps])?);
+    fr.extend(checked_words(
+        f,
+        scene,
+        &|i| {
+            format!(
+                "the {} rays' start offset (from the scene's size)",
+                ["shadow", "mirror"][i]
+            )
+        },
+        &[shadow_eps, mirror_eps],
+    )?);
     fr.extend([0, f.one(), f.from_int(2)]);
     debug_assert_eq!(fr.len(), FrameMap::LIGHTS);
     for (k, light) in scene.lights.iter().enumerate() {
-        fr.extend(checked_words(f, scene, &|i| format!("light {k}: position {} (relative to the hardware's origin)", xyz(i)), &(light.position - origin).to_array())?);
-        fr.extend(checked_words(f, scene, &|i| format!("light {k}: colour {}", rgb(i)), &light.color)?);
+        fr.extend(checked_words(
+            f,
+            scene,
+            &|i| {
+                format!(
+                    "light {k}: position {} (relative to the hardware's origin)",
+                    xyz(i)
+                )
+            },
+            &(light.position - origin).to_array(),
+        )?);
+        fr.extend(checked_words(
+            f,
+            scene,
+            &|i| format!("light {k}: colour {}", rgb(i)),
+            &light.color,
+        )?);
     }
     let materials = fr.len() as u32;
     for object in &scene.objects {
         for (k, m) in object.materials.iter().enumerate() {
             let values = [m.diffuse[0], m.diffuse[1], m.diffuse[2], m.mirror];
-            fr.extend(checked_words(f, scene, &|i| format!("object '{}': material {k}: {}", object.name, ["diffuse r", "diffuse g", "diffuse b", "mirror"][i]), &values)?);
+            fr.extend(checked_words(
+                f,
+                scene,
+                &|i| {
+                    format!(
+                        "object '{}': material {k}: {}",
+                        object.name,
+                        ["diffuse r", "diffuse g", "diffuse b", "mirror"][i]
+                    )
+                },
+                &values,
+            )?);
         }
     }
     let frame_buffer = fr.len() as u32;
@@ -755,15 +843,29 @@ scale = [0.5, 0.5, 0.5]
         let trees = SceneTrees::build(&s, Format::E7M16).unwrap();
         let built = build(&s, &trees, 0, &MemoryConfig::default()).unwrap();
         let words = built.used_words();
-        let (bank, most) = words.iter().copied().enumerate().max_by_key(|&(_, w)| w).unwrap();
+        let (bank, most) = words
+            .iter()
+            .copied()
+            .enumerate()
+            .max_by_key(|&(_, w)| w)
+            .unwrap();
         // A bank just big enough for the built map passes the estimate (it counts no more than
         // the map holds); one word less than the exactly counted banks fails it.
-        let exact = MemoryConfig { banks: 6, bank_bytes: most * 4 };
+        let exact = MemoryConfig {
+            banks: 6,
+            bank_bytes: most * 4,
+        };
         check_capacity(&s, &exact).unwrap();
         let frame_words = words[FRAME];
-        let small = MemoryConfig { banks: 6, bank_bytes: (frame_words - 1) * 4 };
+        let small = MemoryConfig {
+            banks: 6,
+            bank_bytes: (frame_words - 1) * 4,
+        };
         let err = check_capacity(&s, &small).unwrap_err().to_string();
-        assert!(err.contains("needs at least") && err.contains("test.toml"), "{err}");
+        assert!(
+            err.contains("needs at least") && err.contains("test.toml"),
+            "{err}"
+        );
         let _ = bank;
     }
 
@@ -773,17 +875,28 @@ scale = [0.5, 0.5, 0.5]
         assert_ne!(huge, SCENE, "the test scene has a scale to change");
         let s = Scene::from_toml_str(&huge, Path::new("."), "test.toml").unwrap();
         let trees = SceneTrees::build(&s, Format::E7M16).unwrap();
-        let err = build(&s, &trees, 0, &MemoryConfig::default()).unwrap_err().to_string();
-        assert!(err.contains("instance '") && err.contains("e7m16") && (err.contains("overflows") || err.contains("underflows")), "{err}");
+        let err = build(&s, &trees, 0, &MemoryConfig::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("instance '")
+                && err.contains("e7m16")
+                && (err.contains("overflows") || err.contains("underflows")),
+            "{err}"
+        );
         // e8m23 holds 1e30 and its inverse: the same scene builds.
         let trees = SceneTrees::build(&s, Format::E8M23).unwrap();
         build(&s, &trees, 0, &MemoryConfig::default()).unwrap();
         // A rotation's 1e-17 beside 1 may flush to zero: that is rounding, not an error.
         let f = Format::E7M16;
         assert!(checked_words(f, &s, &|_| "m".into(), &[1.0, 1e-25, 0.5]).is_ok());
-        let e = checked_words(f, &s, &|i| format!("value {i}"), &[1e-25, 0.0]).unwrap_err().to_string();
+        let e = checked_words(f, &s, &|i| format!("value {i}"), &[1e-25, 0.0])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("value 0") && e.contains("underflows"), "{e}");
-        let e = checked_words(f, &s, &|i| format!("value {i}"), &[1.0, f64::NAN]).unwrap_err().to_string();
+        let e = checked_words(f, &s, &|i| format!("value {i}"), &[1.0, f64::NAN])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("value 1") && e.contains("overflows"), "{e}");
     }
 

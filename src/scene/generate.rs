@@ -89,9 +89,10 @@ pub fn generate(def: &GenerateDef, material: Material) -> Result<RawMesh, ParamE
     let n = expected_triangles(def);
     let in_range = match def {
         GenerateDef::Sphere { subdivisions, .. } => *subdivisions <= MAX_SPHERE_SUBDIVISIONS,
-        GenerateDef::Plane { subdivisions: s, .. } | GenerateDef::Terrain { size: s, .. } => {
-            *s <= MAX_GRID_CELLS_PER_SIDE
+        GenerateDef::Plane {
+            subdivisions: s, ..
         }
+        | GenerateDef::Terrain { size: s, .. } => *s <= MAX_GRID_CELLS_PER_SIDE,
         _ => true,
     };
     // Out-of-range parameters get their own message from `build`.

@@ -276,9 +276,15 @@ fn scan_obj(path: &Path, text: &str, item: &str) -> Result<ObjScan, SceneError> 
                             continue;
                         }
                         let index: i64 = part.parse().map_err(|_| {
-                            broken(format!("face vertex '{c}': {kind} index '{part}' is not an integer"))
+                            broken(format!(
+                                "face vertex '{c}': {kind} index '{part}' is not an integer"
+                            ))
                         })?;
-                        let resolved = if index < 0 { defined + index + 1 } else { index };
+                        let resolved = if index < 0 {
+                            defined + index + 1
+                        } else {
+                            index
+                        };
                         if index == 0 || resolved < 1 || resolved > defined {
                             return Err(broken(format!(
                                 "face vertex '{c}': {kind} index {index} is out of range (only {defined} {kinds_name} defined so far)"
@@ -321,21 +327,34 @@ fn scan_mtl(path: &Path, text: &str, item: &str) -> Result<(), SceneError> {
         let broken = |message: String| obj_error(path, lineno, item, Problem::BrokenMtl(message));
         match key {
             "Ka" | "Kd" | "Ks" | "Ke" => {
-                let v = numbers(&args[..args.len().min(3)], path, lineno, item, key).map_err(|_| {
-                    broken(format!("`{key}` needs three numbers (r g b), found `{}`", args.join(" ")))
-                })?;
+                let v =
+                    numbers(&args[..args.len().min(3)], path, lineno, item, key).map_err(|_| {
+                        broken(format!(
+                            "`{key}` needs three numbers (r g b), found `{}`",
+                            args.join(" ")
+                        ))
+                    })?;
                 if v.len() < 3 {
-                    return Err(broken(format!("`{key}` needs three numbers (r g b), found `{}`", args.join(" "))));
+                    return Err(broken(format!(
+                        "`{key}` needs three numbers (r g b), found `{}`",
+                        args.join(" ")
+                    )));
                 }
             }
             "Ns" | "Ni" | "d" | "Tr" => {
                 if args.first().and_then(|w| w.parse::<f32>().ok()).is_none() {
-                    return Err(broken(format!("`{key}` needs a number, found `{}`", args.join(" "))));
+                    return Err(broken(format!(
+                        "`{key}` needs a number, found `{}`",
+                        args.join(" ")
+                    )));
                 }
             }
             "illum" => {
                 if args.first().and_then(|w| w.parse::<i32>().ok()).is_none() {
-                    return Err(broken(format!("`illum` needs an integer model number (0..10), found `{}`", args.join(" "))));
+                    return Err(broken(format!(
+                        "`illum` needs an integer model number (0..10), found `{}`",
+                        args.join(" ")
+                    )));
                 }
             }
             "newmtl" if args.is_empty() => return Err(broken("`newmtl` names no material".into())),
@@ -372,15 +391,16 @@ pub(crate) fn load_obj(path: &Path, item: &str) -> Result<(RawMesh, Vec<String>)
     let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
         let file = dir.join(name);
-        let result = crate::input::read_text(&file, "material library", crate::input::MAX_MTL_BYTES)
-            .map_err(|e| obj_error(&file, None, item, Problem::Input(e)))
-            .and_then(|t| {
-                let t = crate::input::normalize_line_endings(&t).into_owned();
-                scan_mtl(&file, &t, item)?;
-                tobj::load_mtl_buf(&mut t.as_bytes()).map_err(|e| {
-                    obj_error(&file, None, item, Problem::BrokenMtl(e.to_string()))
-                })
-            });
+        let result =
+            crate::input::read_text(&file, "material library", crate::input::MAX_MTL_BYTES)
+                .map_err(|e| obj_error(&file, None, item, Problem::Input(e)))
+                .and_then(|t| {
+                    let t = crate::input::normalize_line_endings(&t).into_owned();
+                    scan_mtl(&file, &t, item)?;
+                    tobj::load_mtl_buf(&mut t.as_bytes()).map_err(|e| {
+                        obj_error(&file, None, item, Problem::BrokenMtl(e.to_string()))
+                    })
+                });
         result.map_err(|e| {
             *mtl_error.borrow_mut() = Some(e);
             tobj::LoadError::OpenFileFailed

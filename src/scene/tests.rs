@@ -566,7 +566,10 @@ fn error_missing_mtl() {
     .unwrap();
     let (e, s) = fail_in(dir.path(), "[[objects]]\nname = \"m\"\nmesh = \"m.obj\"\n");
     assert!(matches!(e.problem, Problem::Input(_)), "{s}");
-    assert!(s.contains("gone.mtl") && s.contains("does not exist") && s.contains("object 'm'"), "{s}");
+    assert!(
+        s.contains("gone.mtl") && s.contains("does not exist") && s.contains("object 'm'"),
+        "{s}"
+    );
 }
 
 #[test]
@@ -578,10 +581,26 @@ fn error_broken_obj_names_the_line() {
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", 4, "at least 3"),
         ("v 0 0\n", 1, "has 2 numbers"),
         ("v 0 0 0 1 junk\n", 1, "'junk' is not a number"),
-        ("\u{feff}v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 4\r", 4, "out of range"),
-        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//2 2//1 3//1\n", 5, "normal index 2 is out of range"),
-        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/1\n", 4, "texture coordinate index 1 is out of range"),
-        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n", 4, "has 4 parts"),
+        (
+            "\u{feff}v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 4\r",
+            4,
+            "out of range",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//2 2//1 3//1\n",
+            5,
+            "normal index 2 is out of range",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/1\n",
+            4,
+            "texture coordinate index 1 is out of range",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n",
+            4,
+            "has 4 parts",
+        ),
         ("v 0 0 0 0\n", 1, "w = 0"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -4 -2 -1\n", 4, "out of range"),
     ];
@@ -817,8 +836,20 @@ mod fuzz {
     use rand_chacha::ChaCha8Rng;
 
     const HOSTILE: [&str; 14] = [
-        "nan", "inf", "-inf", "1e39", "-1e39", "1e-39", "1e300", "0", "-0", "4294967296",
-        "-1", "1e400", "0x10", "\u{feff}",
+        "nan",
+        "inf",
+        "-inf",
+        "1e39",
+        "-1e39",
+        "1e-39",
+        "1e300",
+        "0",
+        "-0",
+        "4294967296",
+        "-1",
+        "1e400",
+        "0x10",
+        "\u{feff}",
     ];
 
     fn mutate(rng: &mut ChaCha8Rng, text: &str) -> String {
@@ -857,7 +888,10 @@ mod fuzz {
                 }
                 4 => {
                     let cut = rng.gen_range(0..=lines[i].len());
-                    let cut = (0..=cut).rev().find(|&c| lines[i].is_char_boundary(c)).unwrap_or(0);
+                    let cut = (0..=cut)
+                        .rev()
+                        .find(|&c| lines[i].is_char_boundary(c))
+                        .unwrap_or(0);
                     lines[i].truncate(cut);
                 }
                 _ => {
@@ -880,7 +914,8 @@ mod fuzz {
             Ok(Ok(_)) => Ok(()),
             Ok(Err(e)) => {
                 let text = e.to_string();
-                if e.file.as_os_str().is_empty() || !text.starts_with(&e.file.display().to_string()) {
+                if e.file.as_os_str().is_empty() || !text.starts_with(&e.file.display().to_string())
+                {
                     Err(format!("error names no file: {text}"))
                 } else {
                     Ok(())
@@ -924,10 +959,17 @@ mod fuzz {
             std::fs::write(d.join("m.obj"), &o).unwrap();
             std::fs::write(d.join("m.mtl"), &m).unwrap();
             if let Err(e) = load_survives(&d.join("s.toml")) {
-                failures.push(format!("case {case}: {e}\n--- scene\n{s}\n--- obj\n{o}\n--- mtl\n{m}"));
+                failures.push(format!(
+                    "case {case}: {e}\n--- scene\n{s}\n--- obj\n{o}\n--- mtl\n{m}"
+                ));
             }
         }
         std::panic::set_hook(hook);
-        assert!(failures.is_empty(), "{} of 1500 cases failed; first:\n{}", failures.len(), failures[0]);
+        assert!(
+            failures.is_empty(),
+            "{} of 1500 cases failed; first:\n{}",
+            failures.len(),
+            failures[0]
+        );
     }
 }

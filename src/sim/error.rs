@@ -124,12 +124,16 @@ pub(crate) fn environment_problem(output: &str) -> Option<String> {
     if lower.contains("no space left on device") || lower.contains("disk quota exceeded") {
         return Some("the disk is full (\"No space left on device\"); free space in the output folder's file system or point --out elsewhere".into());
     }
-    for tool in ["g++", "c++", "clang++", "make", "gmake", "ccache", "python3", "perl"] {
+    for tool in [
+        "g++", "c++", "clang++", "make", "gmake", "ccache", "python3", "perl",
+    ] {
         let missing = lower.lines().any(|l| {
             let names_it = l.contains(&format!("{tool}: not found"))
                 || l.contains(&format!("{tool}: no such file or directory"))
                 || l.contains(&format!("{tool}: command not found"))
-                || (l.contains(&format!("'{tool}'")) || l.contains(&format!("\"{tool}\"")) || l.contains(&format!("`{tool}'")))
+                || (l.contains(&format!("'{tool}'"))
+                    || l.contains(&format!("\"{tool}\""))
+                    || l.contains(&format!("`{tool}'")))
                     && (l.contains("no such file") || l.contains("not found"));
             names_it
         });
@@ -193,15 +197,22 @@ mod tests {
     #[test]
     fn the_machine_failing_is_not_the_design_failing() {
         let no_gpp = "make: g++: No such file or directory\nmake: *** [Vtb__ALL.a] Error 127";
-        assert!(environment_problem(no_gpp).unwrap().contains("`g++` is not installed"));
+        assert!(environment_problem(no_gpp)
+            .unwrap()
+            .contains("`g++` is not installed"));
         let no_make = "sh: 1: make: not found\n%Error: make failed";
-        assert!(environment_problem(no_make).unwrap().contains("`make` is not installed"));
+        assert!(environment_problem(no_make)
+            .unwrap()
+            .contains("`make` is not installed"));
         let full = "Vtb.cpp: fatal error: error writing to /tmp/cc.s: No space left on device";
         assert!(environment_problem(full).unwrap().contains("disk is full"));
         let design = "%Error: tb.v:7:3: syntax error, unexpected IDENTIFIER";
         assert_eq!(environment_problem(design), None);
         let err = super::super::compile_error("verilator", "tb", no_gpp).to_string();
-        assert!(!err.contains("rejected the design") && err.contains("g++"), "{err}");
+        assert!(
+            !err.contains("rejected the design") && err.contains("g++"),
+            "{err}"
+        );
     }
 
     #[test]
