@@ -27,17 +27,20 @@ fn parent_of(path: &Path) -> &Path {
     }
 }
 
+/// What the node at `path` is when it exists and is not a regular file (a symlink is not
+/// followed: renaming over it would replace the link itself).
+fn non_regular_kind(path: &Path) -> Option<&'static str> {
+    let t = std::fs::symlink_metadata(path).ok()?.file_type();
+    (!t.is_file()).then(|| crate::input::kind_name(t))
+}
+
 /// Refuses a path whose existing node is not a regular file.
 fn refuse_non_regular(path: &Path, what: &str) -> Result<()> {
-    if let Ok(meta) = std::fs::symlink_metadata(path) {
-        let t = meta.file_type();
-        if !t.is_file() {
-            bail!(
-                "{what} '{}' is {}; dynrt writes only to regular files or new paths: name another path",
-                path.display(),
-                crate::input::kind_name(t)
-            );
-        }
+    if let Some(kind) = non_regular_kind(path) {
+        bail!(
+            "{what} '{}' is {kind}; dynrt writes only to regular files or new paths: name another path",
+            path.display()
+        );
     }
     Ok(())
 }
@@ -151,16 +154,11 @@ fn staged(path: &Path, bytes: &[u8]) -> std::io::Result<tempfile::NamedTempFile>
 /// Writes `bytes` to `path` atomically (see the module doc). The error says what failed; the
 /// caller's context names the file.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    if let Ok(meta) = std::fs::symlink_metadata(path) {
-        if !meta.file_type().is_file() {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::AlreadyExists,
-                format!(
-                    "{} is there; dynrt replaces only regular files",
-                    crate::input::kind_name(meta.file_type())
-                ),
-            ));
-        }
+    if let Some(kind) = non_regular_kind(path) {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::AlreadyExists,
+            format!("{kind} is there; dynrt replaces only regular files"),
+        ));
     }
     staged(path, bytes)?.persist(path).map_err(|e| e.error)?;
     Ok(())

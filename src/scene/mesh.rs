@@ -327,14 +327,9 @@ fn scan_mtl(path: &Path, text: &str, item: &str) -> Result<(), SceneError> {
         let broken = |message: String| obj_error(path, lineno, item, Problem::BrokenMtl(message));
         match key {
             "Ka" | "Kd" | "Ks" | "Ke" => {
-                let v =
-                    numbers(&args[..args.len().min(3)], path, lineno, item, key).map_err(|_| {
-                        broken(format!(
-                            "`{key}` needs three numbers (r g b), found `{}`",
-                            args.join(" ")
-                        ))
-                    })?;
-                if v.len() < 3 {
+                let colour =
+                    args.len() >= 3 && numbers(&args[..3], path, lineno, item, key).is_ok();
+                if !colour {
                     return Err(broken(format!(
                         "`{key}` needs three numbers (r g b), found `{}`",
                         args.join(" ")
