@@ -274,7 +274,13 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let missing = dir.path().join("nope.hex");
         let e = read_vector_file(&missing, 24).unwrap_err();
-        assert!(matches!(e, VectorFileError::Io { .. }));
+        assert!(
+            matches!(
+                e,
+                VectorFileError::Input(crate::input::InputError::Missing { .. })
+            ),
+            "{e}"
+        );
         assert!(e.to_string().contains("nope.hex"), "{e}");
         assert!(matches!(
             read_vector_file(&missing, 33),
