@@ -7,10 +7,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use crate::emit::constraints::{write_ucf, Port, PortDirection, UcfOptions};
-use crate::emit::processor::{display_mode, ProcessorParams, PORTS, PROCESSOR_TOP};
+use crate::emit::processor::{display_mode, ProcessorParams, PROCESSOR_TOP};
 use crate::emit::processor_run::{simulate_processor, write_processor_files, ProcessorSim, SimRun};
 use crate::fp::Format;
 use crate::hw::engine::engine_period;
+use crate::hw::processor::TopPort;
 use crate::hw::program::exec::{Machine, RunStats, Write};
 use crate::hw::program::isa::MAX_PROGRAM;
 use crate::hw::program::{build_program, Program, ProgramConfig};
@@ -128,21 +129,22 @@ pub fn preflight(
     Ok(())
 }
 
-/// The processor's top-level ports for the constraints file: the top module's ports, its two
-/// clocks at the core's and the display's frequencies.
-pub fn processor_ports(display: &VgaMode) -> Vec<Port> {
-    PORTS
+/// The processor's top-level ports for the constraints file: the top module's ports
+/// ([`crate::hw::processor::Processor::ports`]), its two clocks at the core's and the
+/// display's frequencies.
+pub fn processor_ports(ports: &[TopPort], display: &VgaMode) -> Vec<Port> {
+    ports
         .iter()
-        .map(|&(name, output, width)| match name {
-            "clock" => Port::clock(name, CLOCK_HZ),
-            "vga_clock" => Port::clock(name, display.pixel_clock_hz as f64),
-            _ => {
-                let direction = if output {
+        .map(|p| match (p.clock, p.name.as_str()) {
+            (true, "vga_clock") => Port::clock(&p.name, display.pixel_clock_hz as f64),
+            (true, _) => Port::clock(&p.name, CLOCK_HZ),
+            (false, _) => {
+                let direction = if p.output {
                     PortDirection::Output
                 } else {
                     PortDirection::Input
                 };
-                Port::io(name, width, direction)
+                Port::io(&p.name, p.bits as u32, direction)
             }
         })
         .collect()
@@ -236,7 +238,12 @@ pub fn generate_rtl(
     std::fs::create_dir_all(ucf.parent().unwrap())?;
     let info = &layouts[0].info;
     let display = display_mode(info.width, info.height)?;
-    write_ucf(&ucf, &processor_ports(&display), &UcfOptions::default())?;
+    let ports = crate::emit::processor::processor_ports(&program, params)?;
+    write_ucf(
+        &ucf,
+        &processor_ports(&ports, &display),
+        &UcfOptions::default(),
+    )?;
     let listing = out.join("program.lst");
     crate::output::write_atomically(&listing, program.listing().as_bytes())?;
     Ok(RtlReport {

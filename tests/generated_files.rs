@@ -83,14 +83,42 @@ fn checked_in_processor_of_the_default_scene_matches_the_generator() {
     }
 }
 
-/// The localparams of the checked-in processor's engine module (`dynrt_processor_core`),
-/// which the test above keeps equal to the generator's.
+/// The localparams of the checked-in processor's engine and its stage blocks (the modules
+/// `dynrt_processor__engine` and `dynrt_processor__engine__<stage>`), which the test above
+/// keeps equal to the generator's. A name in several of them must have one value.
 fn engine_localparams() -> std::collections::HashMap<String, u64> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let v = std::fs::read_to_string(root.join("rtl_out/processor/dynrt_processor.v")).unwrap();
-    let start = v.find("module dynrt_processor_core(").unwrap();
-    let end = start + v[start..].find("endmodule").unwrap();
-    v[start..end]
+    let mut params = std::collections::HashMap::new();
+    let mut modules = 0;
+    for (start, _) in v.match_indices("\nmodule dynrt_processor__engine") {
+        let name: String = v[start + 8..]
+            .chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect();
+        let stage = name.trim_start_matches("dynrt_processor__engine");
+        if !(stage.is_empty() || (stage.starts_with("__") && !stage[2..].contains("__"))) {
+            continue;
+        }
+        modules += 1;
+        let end = start + v[start..].find("endmodule").unwrap();
+        for (n, value) in localparams(&v[start..end]) {
+            let old = params.insert(n.clone(), value);
+            assert!(
+                old.is_none() || old == Some(value),
+                "{name}: localparam {n} = {value}, another stage has {old:?}"
+            );
+        }
+    }
+    assert!(
+        modules >= 5,
+        "the engine's stage modules are missing ({modules} found)"
+    );
+    params
+}
+
+fn localparams(module: &str) -> Vec<(String, u64)> {
+    module
         .lines()
         .filter_map(|l| l.trim().strip_prefix("localparam"))
         .map(|l| {

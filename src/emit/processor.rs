@@ -1,8 +1,8 @@
 //! Verilog of the whole ray tracing processor for one scene, and its frame testbench.
 //!
 //! [`processor_rtl`] turns a scene's [`Program`] into one self-contained Verilog file: the
-//! rust-hdl `ThreadEngine` (renamed `<top>_core`, see `verilog_tidy`) under a clean top module
-//! `dynrt_processor` with the ports
+//! rust-hdl block [`Processor`] (the engine and the display), its top module renamed
+//! `dynrt_processor` (see `verilog_tidy`), with the ports `Processor::ports` lists:
 //! `clock, start, done, cycles[31:0], instructions[31:0], mem_read, mem_bank[2:0],
 //! mem_addr[23:0], mem_rdata[31:0], fb_write, fb_addr[23:0], fb_data[31:0]` (banks 1, 4, 5),
 //! `bank0_read, bank0_addr[23:0], bank0_rdata[31:0]` (the kd nodes, read by the traversal
@@ -26,10 +26,9 @@ use rust_hdl::prelude::*;
 
 use super::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
 use crate::fp::Format;
-use crate::hw::engine::ThreadEngine;
+use crate::hw::processor::{Processor, TopPort};
 use crate::hw::program::Program;
 use crate::hw::vga::VgaMode;
-use crate::hw::VgaDisplay;
 use crate::layout::BANK_NAMES;
 
 /// The name of the processor's top module.
@@ -57,8 +56,9 @@ macro_rules! dispatch_engine_format {
     };
 }
 
+/// The processor's rust-hdl Verilog (top module `top`) and its top ports.
 #[allow(clippy::too_many_arguments)]
-fn engine_verilog<
+fn processor_verilog<
     const W: usize,
     const E: usize,
     const M: usize,
@@ -71,13 +71,24 @@ fn engine_verilog<
     const DL: usize,
 >(
     program: &Program,
-    threads: u32,
-    mem_latency: u32,
-) -> String {
-    let mut uut =
-        ThreadEngine::<W, E, M, S, S1, X2, T, P, DX, DL>::new(program, threads, mem_latency);
+    params: ProcessorParams,
+    mode: &VgaMode,
+    verilog: bool,
+) -> Result<(String, Vec<TopPort>)> {
+    let mut uut = Processor::<W, E, M, S, S1, X2, T, P, DX, DL>::new(
+        program,
+        params.threads,
+        params.mem_latency,
+        mode,
+    )?;
     uut.connect_all();
-    generate_verilog(&uut)
+    let ports = uut.ports();
+    let text = if verilog {
+        generate_verilog(&uut)
+    } else {
+        String::new()
+    };
+    Ok((text, ports))
 }
 
 /// Runs `f` on a thread with a 256 MB stack: rust-hdl builds and prints the design by
@@ -112,47 +123,6 @@ impl Default for ProcessorParams {
     }
 }
 
-/// The top module's ports: (name, output, width). The constraints file lists the same ports
-/// (`flow::processor_ports`).
-pub const PORTS: [(&str, bool, u32); 32] = [
-    ("clock", false, 1),
-    ("start", false, 1),
-    ("done", true, 1),
-    ("cycles", true, 32),
-    ("instructions", true, 32),
-    ("mem_read", true, 1),
-    ("mem_bank", true, 3),
-    ("mem_addr", true, 24),
-    ("mem_rdata", false, 32),
-    ("fb_write", true, 1),
-    ("fb_addr", true, 24),
-    ("fb_data", true, 32),
-    ("bank0_read", true, 1),
-    ("bank0_addr", true, 24),
-    ("bank0_rdata", false, 32),
-    ("bank2_read", true, 1),
-    ("bank2_addr", true, 24),
-    ("bank2_rdata", false, 32),
-    ("bank3_read", true, 1),
-    ("bank3_addr", true, 24),
-    ("bank3_rdata", false, 32),
-    ("transform_busy", true, 32),
-    ("intersect_busy", true, 32),
-    ("traversal_busy", true, 32),
-    ("vga_clock", false, 1),
-    ("vga_reset", false, 1),
-    ("vga_fb_addr", true, 24),
-    ("vga_fb_data", false, 32),
-    ("vga_hsync", true, 1),
-    ("vga_vsync", true, 1),
-    ("vga_rgb", true, 24),
-    ("vga_frame_start", true, 1),
-];
-
-/// Ports of the engine core (the first 24) and of the display (the `vga_` ones, which the
-/// display module names without the prefix).
-const CORE_PORTS: usize = 24;
-
 /// The video mode the processor's display uses for a `width x height` frame: 640x480 at 60 Hz
 /// when the frame fits, else 1024x768.
 pub fn display_mode(width: u32, height: u32) -> Result<VgaMode> {
@@ -166,12 +136,77 @@ pub fn display_mode(width: u32, height: u32) -> Result<VgaMode> {
     )
 }
 
+/// The processor's Verilog and the ports of its top module.
+#[derive(Clone, Debug)]
+pub struct ProcessorRtl {
+    /// One file, top module [`PROCESSOR_TOP`].
+    pub verilog: String,
+    pub ports: Vec<TopPort>,
+}
+
+/// rust-hdl names a top port of a bundle `<bundle>$<port>`; the board's name for it is
+/// `<bundle>_<port>` (`mem$read` is `mem_read`). Renames those identifiers everywhere (a
+/// child's port of the same bundle and port names becomes the same name, consistently), after
+/// checking that no module already has an identifier of the new name beside the old one.
+fn name_top_ports(verilog: &str, ports: &[TopPort]) -> Result<String> {
+    let renames: std::collections::HashMap<String, String> = ports
+        .iter()
+        .filter(|p| p.hdl_name != p.name)
+        .map(|p| (p.hdl_name.clone(), p.name.clone()))
+        .collect();
+    for module in verilog.split("\nmodule ") {
+        let names = identifiers(module);
+        for (hdl, clean) in &renames {
+            anyhow::ensure!(
+                !(names.contains(hdl.as_str()) && names.contains(clean.as_str())),
+                "module {} of the processor has both `{hdl}` and `{clean}`, and the top port \
+                 `{hdl}` is to be named `{clean}`: rename that signal",
+                module.split(['(', ' ', ';']).next().unwrap_or_default()
+            );
+        }
+    }
+    Ok(super::verilog_tidy::rename_identifiers(verilog, |w| {
+        renames.get(w).cloned()
+    }))
+}
+
+/// The identifiers a module declares or uses, without the child ports named in its
+/// instantiations (`.port(...)`: those are the child's names, not this module's).
+fn identifiers(verilog: &str) -> std::collections::HashSet<&str> {
+    let is_ident = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '$';
+    let mut names = std::collections::HashSet::new();
+    let mut rest = verilog;
+    while let Some(start) = rest.find(is_ident) {
+        let len = rest[start..]
+            .find(|c| !is_ident(c))
+            .unwrap_or(rest.len() - start);
+        if !rest[..start].ends_with('.') {
+            names.insert(&rest[start..start + len]);
+        }
+        rest = &rest[start + len..];
+    }
+    names
+}
+
+/// The processor's top ports, as [`processor_rtl`] names them (without generating the
+/// Verilog).
+pub fn processor_ports(program: &Program, params: ProcessorParams) -> Result<Vec<TopPort>> {
+    let mode = display_mode(program.config.width, program.config.height)?;
+    let (_, ports) = on_large_stack(|| {
+        dispatch_engine_format!(
+            program.config.format,
+            processor_verilog(program, params, &mode, false)
+        )
+    })??;
+    Ok(ports)
+}
+
 /// The processor's Verilog (one file, top module [`PROCESSOR_TOP`]).
 pub fn processor_rtl(
     program: &Program,
     params: ProcessorParams,
     scene_name: &str,
-) -> Result<String> {
+) -> Result<ProcessorRtl> {
     let f: Format = program.config.format;
     anyhow::ensure!(
         (1..=32).contains(&params.threads),
@@ -191,47 +226,15 @@ pub fn processor_rtl(
         program.scratch.words,
         crate::hw::engine::SCRATCH_WORDS
     );
-    let core = on_large_stack(|| {
-        dispatch_engine_format!(
-            f,
-            engine_verilog(program, params.threads, params.mem_latency)
-        )
-    })?;
-    let core_name = format!("{PROCESSOR_TOP}_core");
-    let core = merge_identical_modules(&rename_rust_hdl_names(&core, &core_name));
-    let c = &program.config;
-    let mode = display_mode(c.width, c.height)?;
-    let mut display = VgaDisplay::new(&mode, c.width, c.height, c.frame_buffer)?;
-    display.connect_all();
-    let display_name = format!("{PROCESSOR_TOP}_vga");
-    let display = merge_identical_modules(&rename_rust_hdl_names(
-        &generate_verilog(&display),
-        &display_name,
+    let mode = display_mode(program.config.width, program.config.height)?;
+    let (verilog, ports) = on_large_stack(|| {
+        dispatch_engine_format!(f, processor_verilog(program, params, &mode, true))
+    })??;
+    let verilog = merge_identical_modules(&rename_rust_hdl_names(
+        &name_top_ports(&verilog, &ports)?,
+        PROCESSOR_TOP,
     ));
-    let decls = PORTS
-        .iter()
-        .map(|(name, out, w)| {
-            let dir = if *out { "output" } else { "input" };
-            let range = if *w > 1 {
-                format!("[{}:0] ", w - 1)
-            } else {
-                String::new()
-            };
-            format!("    {dir} wire {range}{name}")
-        })
-        .collect::<Vec<_>>()
-        .join(",\n");
-    let conns = |ports: &[(&str, bool, u32)], strip: &str| {
-        ports
-            .iter()
-            .map(|(name, _, _)| format!(".{}({name})", name.trim_start_matches(strip)))
-            .collect::<Vec<_>>()
-            .join(",\n        ")
-    };
-    let (core_conns, display_conns) = (
-        conns(&PORTS[..CORE_PORTS], ""),
-        conns(&PORTS[CORE_PORTS..], "vga_"),
-    );
+    let c = &program.config;
     let mut header = String::new();
     writeln!(
         header,
@@ -255,13 +258,14 @@ pub fn processor_rtl(
         mode.pixel_clock_hz as f64 / 1e6,
         c.frame_buffer
     )?;
-    Ok(format!(
-        "{header}\n/* verilator lint_off WIDTH */\n/* verilator lint_off DECLFILENAME */\n\
-         /* verilator lint_off UNUSEDSIGNAL */\n{core}\n{display}\n/* verilator lint_on UNUSEDSIGNAL */\n\
-         /* verilator lint_on DECLFILENAME */\n/* verilator lint_on WIDTH */\n\
-         module {PROCESSOR_TOP}(\n{decls}\n);\n    {core_name} core(\n        {core_conns}\n    );\n\
-         \x20   {display_name} display(\n        {display_conns}\n    );\nendmodule\n"
-    ))
+    Ok(ProcessorRtl {
+        verilog: format!(
+            "{header}\n/* verilator lint_off WIDTH */\n/* verilator lint_off DECLFILENAME */\n\
+             /* verilator lint_off UNUSEDSIGNAL */\n{verilog}\n/* verilator lint_on UNUSEDSIGNAL */\n\
+             /* verilator lint_on DECLFILENAME */\n/* verilator lint_on WIDTH */\n"
+        ),
+        ports,
+    })
 }
 
 /// What the testbench needs to know about the frames it runs.
@@ -278,24 +282,85 @@ pub struct TestbenchFrames {
     pub vga: VgaMode,
 }
 
-/// The frame testbench (module `tb`).
-pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) -> String {
+/// The top ports the testbench drives itself, with their initial values; it reads every other
+/// port through a wire of the port's name.
+const TESTBENCH_DRIVES: [(&str, &str); 5] = [
+    ("clock", "1'b0"),
+    ("start", "1'b0"),
+    ("vga_clock", "1'b0"),
+    ("vga_reset", "1'b1"),
+    ("vga_fb_data", "32'd0"),
+];
+
+/// The ports the testbench's memory model and frame loop use by name.
+const TESTBENCH_USES: [&str; 20] = [
+    "done",
+    "cycles",
+    "instructions",
+    "mem_read",
+    "mem_bank",
+    "mem_addr",
+    "mem_rdata",
+    "fb_write",
+    "fb_addr",
+    "fb_data",
+    "bank0_addr",
+    "bank0_rdata",
+    "bank2_addr",
+    "bank2_rdata",
+    "bank3_addr",
+    "bank3_rdata",
+    "transform_busy",
+    "intersect_busy",
+    "traversal_busy",
+    "vga_fb_addr",
+];
+
+/// The frame testbench (module `tb`) of a processor with the top ports `ports`
+/// ([`ProcessorRtl::ports`]): the device under test is instantiated from that list, so a port
+/// the testbench needs and the processor lacks is an error here, not in a simulator.
+pub fn processor_testbench(
+    params: ProcessorParams,
+    frames: &TestbenchFrames,
+    ports: &[TopPort],
+) -> Result<String> {
+    let port = |name: &str| ports.iter().find(|p| p.name == name);
+    for name in TESTBENCH_DRIVES
+        .iter()
+        .map(|(n, _)| *n)
+        .chain(TESTBENCH_USES.iter().copied())
+    {
+        anyhow::ensure!(
+            port(name).is_some(),
+            "the processor has no top port `{name}`, which the frame testbench uses"
+        );
+    }
+    let range = |bits: usize| {
+        if bits > 1 {
+            format!("[{}:0] ", bits - 1)
+        } else {
+            String::new()
+        }
+    };
     let mut v = String::new();
     let ml = params.mem_latency;
     let _ = writeln!(
         v,
         "// tb: runs {} frame(s) of {PROCESSOR_TOP} (generated by dynrt; do not edit).\n\
-         `timescale 1ns/1ps\nmodule tb;\n  reg clock = 1'b0;\n  reg start = 1'b0;\n  wire done;\n\
-         \x20 wire [31:0] cycles, instructions;\n  wire mem_read;\n  wire [2:0] mem_bank;\n\
-         \x20 wire [23:0] mem_addr;\n  wire [31:0] mem_rdata;\n  wire fb_write;\n\
-         \x20 wire [23:0] fb_addr;\n  wire [31:0] fb_data;\n\
-         \x20 wire bank0_read, bank2_read, bank3_read;\n  wire [23:0] bank0_addr, bank2_addr, bank3_addr;\n\
-         \x20 wire [31:0] bank0_rdata, bank2_rdata, bank3_rdata;\n  wire [31:0] transform_busy, intersect_busy, traversal_busy;\n\
-         \x20 reg vga_clock = 1'b0;\n  reg vga_reset = 1'b1;\n  wire [23:0] vga_fb_addr, vga_rgb;\n\
-         \x20 reg [31:0] vga_fb_data = 32'd0;\n  wire vga_hsync, vga_vsync, vga_frame_start;\n\
-         \x20 integer px;",
+         `timescale 1ns/1ps\nmodule tb;",
         frames.updates.len() + 1
     );
+    for p in ports {
+        match TESTBENCH_DRIVES.iter().find(|(n, _)| *n == p.name) {
+            Some((_, init)) => {
+                let _ = writeln!(v, "  reg {}{} = {init};", range(p.bits), p.name);
+            }
+            None => {
+                let _ = writeln!(v, "  wire {}{};", range(p.bits), p.name);
+            }
+        }
+    }
+    let _ = writeln!(v, "  integer px;");
     for (b, name) in BANK_NAMES.iter().enumerate() {
         let _ = writeln!(
             v,
@@ -311,18 +376,7 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
     );
     let _ = writeln!(
         v,
-        "  {PROCESSOR_TOP} dut(.clock(clock), .start(start), .done(done), .cycles(cycles),\n\
-         \x20   .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank),\n\
-         \x20   .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write),\n\
-         \x20   .fb_addr(fb_addr), .fb_data(fb_data), .bank0_read(bank0_read),\n\
-         \x20   .bank0_addr(bank0_addr), .bank0_rdata(bank0_rdata), .bank2_read(bank2_read),\n\
-         \x20   .bank2_addr(bank2_addr), .bank2_rdata(bank2_rdata), .bank3_read(bank3_read),\n\
-         \x20   .bank3_addr(bank3_addr), .bank3_rdata(bank3_rdata),\n\
-         \x20   .transform_busy(transform_busy), .intersect_busy(intersect_busy),\n\
-         \x20   .traversal_busy(traversal_busy),\n\
-         \x20   .vga_clock(vga_clock), .vga_reset(vga_reset),\n\
-         \x20   .vga_fb_addr(vga_fb_addr), .vga_fb_data(vga_fb_data), .vga_hsync(vga_hsync),\n\
-         \x20   .vga_vsync(vga_vsync), .vga_rgb(vga_rgb), .vga_frame_start(vga_frame_start));\n\
+        "  {PROCESSOR_TOP} dut({});\n\
          \x20 always #5 clock = ~clock;\n\
          \x20 // The display's pixel clock (25 MHz against the core's 100 MHz here; running only with\n\
          \x20 // +vga, so that frame runs do not simulate it) and its read port on the frame bank,\n\
@@ -333,7 +387,12 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
          \x20 // SRAM banks: the word read arrives {ml} clock(s) after the request. The bank is read\n\
          \x20 // at the clock edge rather than through a combinational mux, which Icarus would\n\
          \x20 // re-evaluate on every write to a bank (twice as slow on large scenes).\n\
-         \x20 always @(posedge clock) begin\n    case (mem_bank)"
+         \x20 always @(posedge clock) begin\n    case (mem_bank)",
+        ports
+            .iter()
+            .map(|p| format!(".{0}({0})", p.name))
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     for b in [1, 4, 5] {
         let _ = writeln!(
@@ -404,5 +463,5 @@ pub fn processor_testbench(params: ProcessorParams, frames: &TestbenchFrames) ->
         vv = frames.vga.v_visible,
     );
     let _ = writeln!(v, "    $finish;\n  end\nendmodule");
-    v
+    Ok(v)
 }

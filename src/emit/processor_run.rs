@@ -60,7 +60,7 @@ pub fn write_processor_files(
     }
     let rtl = processor_rtl(program, params, scene_name)?;
     let rtl_path = rtl_dir.join(format!("{}.v", super::processor::PROCESSOR_TOP));
-    write_atomically(&rtl_path, rtl.as_bytes())?;
+    write_atomically(&rtl_path, rtl.verilog.as_bytes())?;
     write_memory_images(first, &mem_dir)?;
     let mut updates = Vec::new();
     for (k, pair) in layouts.windows(2).enumerate() {
@@ -95,7 +95,10 @@ pub fn write_processor_files(
         vga: display_mode(first.info.width, first.info.height)?,
     };
     let tb_path = tb_dir.join("tb.v");
-    write_atomically(&tb_path, processor_testbench(params, &frames).as_bytes())?;
+    write_atomically(
+        &tb_path,
+        processor_testbench(params, &frames, &rtl.ports)?.as_bytes(),
+    )?;
     Ok((rtl_path, tb_path))
 }
 

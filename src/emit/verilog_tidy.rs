@@ -38,6 +38,11 @@ fn map_identifiers(verilog: &str, f: impl Fn(&str) -> Option<String>) -> String 
     out
 }
 
+/// Rewrites every identifier for which `f` returns a new name (see `map_identifiers`).
+pub fn rename_identifiers(verilog: &str, f: impl Fn(&str) -> Option<String>) -> String {
+    map_identifiers(verilog, f)
+}
+
 /// Renames rust-hdl's module `top` to `core_name`, its sub-modules `top$x$y` to
 /// `core_name__x__y`, and every `$` inside an identifier to `__` (system functions such as
 /// `$signed` keep theirs). rust-hdl field names used here never contain `__`, so no two names

@@ -19,6 +19,8 @@ pub mod geometry_formats;
 pub mod int_to_float;
 pub mod intersect;
 pub mod list_unit;
+pub mod ports;
+pub mod processor;
 pub mod ray_store;
 pub mod raygen;
 #[cfg(test)]

@@ -36,6 +36,7 @@ use super::fp::add_sub::ADD_SUB_LATENCY;
 use super::fp::compare::COMPARE_LATENCY;
 use super::fp::div::div_latency;
 use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
+use super::ports::{CoprocessorPort, SramRead};
 use super::ray_store::{zero_counters, RayStore};
 use super::Delay;
 use crate::fp::Format;
@@ -75,31 +76,17 @@ pub struct TraversalUnit<
     const DL: usize,
 > {
     pub clock: Signal<In, Clock>,
-    pub thread: Signal<In, Bits<5>>,
-    pub word_a: Signal<In, Bits<32>>,
-    pub word_b: Signal<In, Bits<32>>,
-    /// The thread's ray (object space): `ray_write` with `ray_pair` 0, 1, 2 as in the
-    /// triangle tester; `t_min_write` with `word_a`.
-    pub ray_write: Signal<In, Bit>,
-    pub ray_pair: Signal<In, Bits<2>>,
+    /// The engine's offers (`kd.start`: `word_a` the root with `KD_ANY_HIT`, `word_b`
+    /// t_max), the thread's ray (object space: `ray_write` with `ray_pair` 0, 1, 2 as in the
+    /// triangle tester), its walks pending, their ends (`done`), and the engine's loads of
+    /// bank 0.
+    pub engine: CoprocessorPort,
+    /// `t_min_write`: the thread's t_min, in `engine.word_a` (the tester's `tri.init`).
     pub t_min_write: Signal<In, Bit>,
-    pub enqueue: Signal<In, Bit>,
-    pub full: Signal<Out, Bit>,
-    pub query_thread: Signal<In, Bits<5>>,
-    pub pending: Signal<Out, Bit>,
-    /// The engine's memory port (registered): its loads of bank 0 go out here.
-    pub engine_read: Signal<In, Bit>,
-    pub engine_bank: Signal<In, Bits<3>>,
-    pub engine_addr: Signal<In, Bits<24>>,
     /// Bank 0 (the kd nodes): one read per clock, the word `mem_latency` clocks later.
-    pub node_read: Signal<Out, Bit>,
-    pub node_addr: Signal<Out, Bits<24>>,
-    pub node_rdata: Signal<In, Bits<32>>,
+    pub nodes: SramRead,
     /// High in the clocks a node decision starts.
     pub step_busy: Signal<Out, Bit>,
-    /// High when `done_thread`'s walk ends (its pending count changes).
-    pub done_event: Signal<Out, Bit>,
-    pub done_thread: Signal<Out, Bits<5>>,
     /// Leaves for the triangle tester: `leaf_thread`'s list, bank-1 words
     /// `leaf_from..leaf_to`; `leaf_take` pops it.
     pub leaf_valid: Signal<Out, Bit>,
@@ -260,25 +247,10 @@ impl<
         let f = Format::new(E as u32, M as u32).expect("a supported format");
         Self {
             clock: Default::default(),
-            thread: Default::default(),
-            word_a: Default::default(),
-            word_b: Default::default(),
-            ray_write: Default::default(),
-            ray_pair: Default::default(),
+            engine: Default::default(),
+            nodes: Default::default(),
             t_min_write: Default::default(),
-            enqueue: Default::default(),
-            full: Default::default(),
-            query_thread: Default::default(),
-            pending: Default::default(),
-            engine_read: Default::default(),
-            engine_bank: Default::default(),
-            engine_addr: Default::default(),
-            node_read: Default::default(),
-            node_addr: Default::default(),
-            node_rdata: Default::default(),
             step_busy: Default::default(),
-            done_event: Default::default(),
-            done_thread: Default::default(),
             leaf_valid: Default::default(),
             leaf_thread: Default::default(),
             leaf_from: Default::default(),
@@ -465,37 +437,38 @@ impl<
         }
 
         // Engine side: the ray, t_min, the queue, the answers.
-        self.ray.thread.next = self.thread.val();
-        self.ray.word_a.next = self.word_a.val();
-        self.ray.word_b.next = self.word_b.val();
-        self.ray.ray_write.next = self.ray_write.val();
-        self.ray.ray_pair.next = self.ray_pair.val();
+        self.ray.thread.next = self.engine.thread.val();
+        self.ray.word_a.next = self.engine.word_a.val();
+        self.ray.word_b.next = self.engine.word_b.val();
+        self.ray.ray_write.next = self.engine.ray_write.val();
+        self.ray.ray_pair.next = self.engine.ray_pair.val();
         self.ray.t_min_write.next = self.t_min_write.val();
         // The tester's answer takes the queue first (a thread has one entry in the unit at a
         // time, so the queue never overflows with it).
         self.engine_full.next = self.entry_fifo.full.val() | self.answer_valid.val();
-        self.full.next = self.engine_full.val();
+        self.engine.full.next = self.engine_full.val();
         self.entry_fifo.write.next =
-            (self.enqueue.val() & (!self.engine_full.val())) | self.answer_valid.val();
+            (self.engine.enqueue.val() & (!self.engine_full.val())) | self.answer_valid.val();
         // Bit 69: an answer (0: the engine's start).
-        self.entry_fifo.data_in.next = (bit_cast::<70, 5>(self.thread.val()) << 64)
-            | (bit_cast::<70, 32>(self.word_a.val()) << 32)
-            | bit_cast::<70, 32>(self.word_b.val());
+        self.entry_fifo.data_in.next = (bit_cast::<70, 5>(self.engine.thread.val()) << 64)
+            | (bit_cast::<70, 32>(self.engine.word_a.val()) << 32)
+            | bit_cast::<70, 32>(self.engine.word_b.val());
         if self.answer_valid.val() {
             self.entry_fifo.data_in.next = (bit_cast::<70, 1>(true.into()) << 69)
                 | (bit_cast::<70, 5>(self.answer_thread.val()) << 64)
                 | (bit_cast::<70, 32>(self.answer_t.val()) << 32)
                 | bit_cast::<70, 1>(self.answer_hit.val().into());
         }
-        self.any_hit.write_address.next = self.thread.val();
-        self.any_hit.write_data.next = bit_cast::<1, 1>(self.word_a.val().get_bit(31).into());
-        self.any_hit.write_enable.next = self.enqueue.val() & (!self.engine_full.val());
-        self.issued.read_address.next = self.query_thread.val();
-        self.done_e.read_address.next = self.query_thread.val();
-        self.pending.next = self.issued.read_data.val() != self.done_e.read_data.val();
-        self.issued.write_address.next = self.thread.val();
+        self.any_hit.write_address.next = self.engine.thread.val();
+        self.any_hit.write_data.next =
+            bit_cast::<1, 1>(self.engine.word_a.val().get_bit(31).into());
+        self.any_hit.write_enable.next = self.engine.enqueue.val() & (!self.engine_full.val());
+        self.issued.read_address.next = self.engine.query_thread.val();
+        self.done_e.read_address.next = self.engine.query_thread.val();
+        self.engine.pending.next = self.issued.read_data.val() != self.done_e.read_data.val();
+        self.issued.write_address.next = self.engine.thread.val();
         self.issued.write_data.next = self.issued.read_data.val() + 1;
-        self.issued.write_enable.next = self.enqueue.val() & (!self.engine_full.val());
+        self.issued.write_enable.next = self.engine.enqueue.val() & (!self.engine_full.val());
 
         // Front: one engine entry a clock, a job five clocks later.
         self.entry_fifo.read.next = !self.entry_fifo.empty.val();
@@ -588,12 +561,14 @@ impl<
         self.front_fifo.read.next = false;
         self.in_flight.read.next = false;
         self.take.next = (self.phase.q.val() != Fetch::Idle)
-            & (!(self.engine_read.val() & (self.engine_bank.val() == self.c_bank_nodes.val())));
-        self.node_read.next = self.take.val()
-            | (self.engine_read.val() & (self.engine_bank.val() == self.c_bank_nodes.val()));
-        self.node_addr.next = self.engine_addr.val();
+            & (!(self.engine.load_read.val()
+                & (self.engine.load_bank.val() == self.c_bank_nodes.val())));
+        self.nodes.read.next = self.take.val()
+            | (self.engine.load_read.val()
+                & (self.engine.load_bank.val() == self.c_bank_nodes.val()));
+        self.nodes.addr.next = self.engine.load_addr.val();
         if self.take.val() {
-            self.node_addr.next = (bit_cast::<24, 26>(self.fetch_job.q.val().get_bits::<26>(64))
+            self.nodes.addr.next = (bit_cast::<24, 26>(self.fetch_job.q.val().get_bits::<26>(64))
                 << 1)
                 | bit_cast::<24, 1>((self.phase.q.val() == Fetch::Word1).into());
             self.phase.d.next = Fetch::Word1;
@@ -616,12 +591,12 @@ impl<
             }
         }
         if self.arrive.val() == 2 {
-            self.w0.d.next = self.node_rdata.val();
+            self.w0.d.next = self.nodes.rdata.val();
         }
         // The thread of the job at A next clock, whose count of entries done is read now.
         self.next_a_thread.next = self.job.q.val().get_bits::<5>(96);
         if self.arrive.val() == 3 {
-            self.w1.d.next = self.node_rdata.val();
+            self.w1.d.next = self.nodes.rdata.val();
             self.job.d.next = self.in_flight.data_out.val();
             self.next_a_thread.next = self.in_flight.data_out.val().get_bits::<5>(96);
             self.in_flight.read.next = true;
@@ -695,8 +670,8 @@ impl<
         self.done_u.write_data.next = self.done_u.read_data.val() + 1;
         self.done_u.write_enable.next = self.a_end.val();
         self.done_e.write_enable.next = self.a_end.val();
-        self.done_event.next = self.a_end.val();
-        self.done_thread.next = self.job.q.val().get_bits::<5>(96);
+        self.engine.done.next = self.a_end.val();
+        self.engine.done_thread.next = self.job.q.val().get_bits::<5>(96);
         self.leaf_hi.write_enable.next = self.at_a.val() & self.a_leaf.val();
         self.leaf_sp.write_enable.next = self.at_a.val() & self.a_leaf.val();
 
@@ -890,20 +865,20 @@ mod tests {
         u.connect_all();
         let cycle = |u: &mut Unit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
         for (th, (o, d)) in rays.iter().enumerate() {
-            u.thread.next = (th as u64).into();
+            u.engine.thread.next = (th as u64).into();
             for (pair, (a, b)) in [(o[0], o[1]), (o[2], d[0]), (d[1], d[2])]
                 .into_iter()
                 .enumerate()
             {
-                u.ray_write.next = true;
-                u.ray_pair.next = (pair as u64).into();
-                u.word_a.next = u64::from(a).into();
-                u.word_b.next = u64::from(b).into();
+                u.engine.ray_write.next = true;
+                u.engine.ray_pair.next = (pair as u64).into();
+                u.engine.word_a.next = u64::from(a).into();
+                u.engine.word_b.next = u64::from(b).into();
                 cycle(&mut u);
             }
-            u.ray_write.next = false;
+            u.engine.ray_write.next = false;
             u.t_min_write.next = true;
-            u.word_a.next = 0.into();
+            u.engine.word_a.next = 0.into();
             cycle(&mut u);
             u.t_min_write.next = false;
         }
@@ -933,13 +908,13 @@ mod tests {
         let tick = |u: &mut Unit, b: &mut Bench, rng: &mut rand_chacha::ChaCha8Rng, offer: bool| {
             b.clock += 1;
             let addr = b.requests.pop_front().unwrap();
-            u.node_rdata.next = u64::from(addr.map_or(0xdead_beef, |a| nodes[a as usize])).into();
+            u.nodes.rdata.next = u64::from(addr.map_or(0xdead_beef, |a| nodes[a as usize])).into();
             let steal = rng
                 .gen_ratio(1, 6)
                 .then(|| rng.gen_range(0..nodes.len() as u64));
-            u.engine_read.next = steal.is_some();
-            u.engine_bank.next = 0.into();
-            u.engine_addr.next = steal.unwrap_or(0).into();
+            u.engine.load_read.next = steal.is_some();
+            u.engine.load_bank.next = 0.into();
+            u.engine.load_addr.next = steal.unwrap_or(0).into();
             // The tester answers one due leaf a clock.
             let answer = b.due.iter().position(|d| d.0 <= b.clock || offer);
             u.answer_valid.next = answer.is_some();
@@ -968,14 +943,18 @@ mod tests {
             if let Some(a) = steal {
                 b.stolen += 1;
                 assert!(
-                    u.node_read.val() && u.node_addr.val().to_u64() == a,
+                    u.nodes.read.val() && u.nodes.addr.val().to_u64() == a,
                     "the engine's read"
                 );
             }
-            b.requests
-                .push_back(u.node_read.val().then(|| u.node_addr.val().to_u64() as u32));
-            let full = u.full.val();
-            if full && u.enqueue.val() {
+            b.requests.push_back(
+                u.nodes
+                    .read
+                    .val()
+                    .then(|| u.nodes.addr.val().to_u64() as u32),
+            );
+            let full = u.engine.full.val();
+            if full && u.engine.enqueue.val() {
                 b.refused += 1;
             }
             cycle(u);
@@ -990,10 +969,10 @@ mod tests {
             // Two clocks per turn of a thread, as the engine's I2 and I3: present the thread
             // to the counters, then read its state and offer its start.
             th = (th + 1) % threads;
-            u.query_thread.next = (th as u64).into();
-            u.enqueue.next = false;
+            u.engine.query_thread.next = (th as u64).into();
+            u.engine.enqueue.next = false;
             tick(&mut u, &mut b, &mut rng, false);
-            if in_flight[th] && !u.pending.val() {
+            if in_flight[th] && !u.engine.pending.val() {
                 in_flight[th] = false;
                 b.got[th].push(KdStop::Finished);
                 if b.got[th].len() < want[th].len() {
@@ -1003,12 +982,12 @@ mod tests {
             }
             // Later threads start while answers for the earlier ones go in.
             let start = to_start[th] && b.clock >= 120 * th as u64;
-            u.enqueue.next = start;
+            u.engine.enqueue.next = start;
             if start {
                 let any = if any_hit(th) { 1u64 << 31 } else { 0 };
-                u.thread.next = (th as u64).into();
-                u.word_a.next = (u64::from(root) | any).into();
-                u.word_b.next = u64::from(t_max).into();
+                u.engine.thread.next = (th as u64).into();
+                u.engine.word_a.next = (u64::from(root) | any).into();
+                u.engine.word_b.next = u64::from(t_max).into();
             }
             if tick(&mut u, &mut b, &mut rng, start) && start {
                 to_start[th] = false;

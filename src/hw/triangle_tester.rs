@@ -48,6 +48,7 @@ use super::fp::{const_bits, FpCompare};
 use super::list_unit::{
     CMD_INIT, CMD_LIST, LIST_OF_WALK, TEST_INIT, TEST_LIST_END, TEST_TRIANGLE, TEST_WALK_END,
 };
+use super::ports::{CoprocessorPort, SramRead};
 use super::ray_store::{zero_counters, RayStore};
 use super::{intersect_latency, IntersectUnit, ListUnit, TransformUnit, TRANSFORM_LATENCY};
 use crate::fp::Format;
@@ -97,40 +98,23 @@ pub struct TriangleTester<
     const DL: usize,
 > {
     pub clock: Signal<In, Clock>,
-    pub thread: Signal<In, Bits<5>>,
-    pub word_a: Signal<In, Bits<32>>,
-    pub word_b: Signal<In, Bits<32>>,
-    pub ray_write: Signal<In, Bit>,
-    pub ray_pair: Signal<In, Bits<2>>,
-    pub enqueue: Signal<In, Bit>,
+    /// The engine's offers (`tri` entries, `queue_kind` = `list_unit::CMD_*`), the thread's
+    /// ray (`ray_write` with `ray_pair`), its lists pending, their ends (`done`), and the
+    /// engine's loads of banks 2 and 3.
+    pub engine: CoprocessorPort,
     /// `list_unit::CMD_*`.
     pub queue_kind: Signal<In, Bits<2>>,
-    pub full: Signal<Out, Bit>,
-    pub query_thread: Signal<In, Bits<5>>,
-    pub pending: Signal<Out, Bit>,
+    /// The thread's closest hit so far (`engine.query_thread`, read at I2 for I3).
     pub hit: Signal<Out, Bit>,
     pub best_t: Signal<Out, Bits<W>>,
     pub best_instance: Signal<Out, Bits<32>>,
     pub best_triangle: Signal<Out, Bits<32>>,
-    /// The engine's memory port (registered): its loads of bank 2 or 3 go out here.
-    pub engine_read: Signal<In, Bit>,
-    pub engine_bank: Signal<In, Bits<3>>,
-    pub engine_addr: Signal<In, Bits<24>>,
     /// Bank 2 (u and v rows) and bank 3 (t row, shading): one read per clock each, the word
     /// `mem_latency` clocks after the request.
-    pub uv_read: Signal<Out, Bit>,
-    pub uv_addr: Signal<Out, Bits<24>>,
-    pub uv_rdata: Signal<In, Bits<32>>,
-    pub t_read: Signal<Out, Bit>,
-    pub t_addr: Signal<Out, Bits<24>>,
-    pub t_rdata: Signal<In, Bits<32>>,
+    pub uv_words: SramRead,
+    pub t_words: SramRead,
     /// Bank 1 (triangle lists), on the engine's bus when the engine leaves it free.
-    pub list_read: Signal<Out, Bit>,
-    pub list_addr: Signal<Out, Bits<24>>,
-    pub list_rdata: Signal<In, Bits<32>>,
-    /// High when a list or a query of `done_thread` is done (its pending count changes).
-    pub done_event: Signal<Out, Bit>,
-    pub done_thread: Signal<Out, Bits<5>>,
+    pub lists: SramRead,
     /// The traversal unit's leaves: a list of `walk_list_thread`, bank-1 words
     /// `walk_list_from..walk_list_to`, taken (`walk_list_take`) in a clock the engine does not
     /// enqueue and the queue has room.
@@ -284,34 +268,15 @@ impl<
         assert!(flight_slots_suffice(f), "{f}: too few in-flight slots");
         Self {
             clock: Default::default(),
-            thread: Default::default(),
-            word_a: Default::default(),
-            word_b: Default::default(),
-            ray_write: Default::default(),
-            ray_pair: Default::default(),
-            enqueue: Default::default(),
+            engine: Default::default(),
+            uv_words: Default::default(),
+            t_words: Default::default(),
+            lists: Default::default(),
             queue_kind: Default::default(),
-            full: Default::default(),
-            query_thread: Default::default(),
-            pending: Default::default(),
             hit: Default::default(),
             best_t: Default::default(),
             best_instance: Default::default(),
             best_triangle: Default::default(),
-            engine_read: Default::default(),
-            engine_bank: Default::default(),
-            engine_addr: Default::default(),
-            uv_read: Default::default(),
-            uv_addr: Default::default(),
-            uv_rdata: Default::default(),
-            t_read: Default::default(),
-            t_addr: Default::default(),
-            t_rdata: Default::default(),
-            list_read: Default::default(),
-            list_addr: Default::default(),
-            list_rdata: Default::default(),
-            done_event: Default::default(),
-            done_thread: Default::default(),
             walk_list_valid: Default::default(),
             walk_list_thread: Default::default(),
             walk_list_from: Default::default(),
@@ -493,51 +458,52 @@ impl<
         }
 
         // Engine side: ray words, t_min of a new query, the queue.
-        self.ray.thread.next = self.thread.val();
-        self.ray.word_a.next = self.word_a.val();
-        self.ray.word_b.next = self.word_b.val();
-        self.ray.ray_write.next = self.ray_write.val();
-        self.ray.ray_pair.next = self.ray_pair.val();
+        self.ray.thread.next = self.engine.thread.val();
+        self.ray.word_a.next = self.engine.word_a.val();
+        self.ray.word_b.next = self.engine.word_b.val();
+        self.ray.ray_write.next = self.engine.ray_write.val();
+        self.ray.ray_pair.next = self.engine.ray_pair.val();
         self.ray.t_min_write.next =
-            self.enqueue.val() & (self.queue_kind.val() == self.c_cmd_init.val());
+            self.engine.enqueue.val() & (self.queue_kind.val() == self.c_cmd_init.val());
         // The engine's entries first; a walk's list in the other clocks.
-        self.walk_take.next =
-            self.walk_list_valid.val() & (!self.enqueue.val()) & (!self.list_unit.full.val());
+        self.walk_take.next = self.walk_list_valid.val()
+            & (!self.engine.enqueue.val())
+            & (!self.list_unit.full.val());
         self.walk_list_take.next = self.walk_take.val();
-        self.list_unit.enqueue.next = self.enqueue.val() | self.walk_take.val();
-        if self.enqueue.val() {
+        self.list_unit.enqueue.next = self.engine.enqueue.val() | self.walk_take.val();
+        if self.engine.enqueue.val() {
             self.list_unit.kind.next = self.queue_kind.val();
-            self.list_unit.thread.next = self.thread.val();
-            self.list_unit.word_a.next = self.word_a.val();
-            self.list_unit.word_b.next = self.word_b.val();
+            self.list_unit.thread.next = self.engine.thread.val();
+            self.list_unit.word_a.next = self.engine.word_a.val();
+            self.list_unit.word_b.next = self.engine.word_b.val();
         } else {
             self.list_unit.kind.next = self.c_cmd_list.val();
             self.list_unit.thread.next = self.walk_list_thread.val();
             self.list_unit.word_a.next = self.walk_list_from.val();
             self.list_unit.word_b.next = self.walk_list_to.val() | self.c_list_of_walk.val();
         }
-        self.full.next = self.list_unit.full.val();
-        self.list_unit.engine_read.next = self.engine_read.val();
-        self.list_unit.engine_bank.next = self.engine_bank.val();
-        self.list_read.next = self.list_unit.list_read.val();
-        self.list_addr.next = self.list_unit.list_addr.val();
-        self.list_unit.list_rdata.next = self.list_rdata.val();
+        self.engine.full.next = self.list_unit.full.val();
+        self.list_unit.engine_read.next = self.engine.load_read.val();
+        self.list_unit.engine_bank.next = self.engine.load_bank.val();
+        self.lists.read.next = self.list_unit.list_read.val();
+        self.lists.addr.next = self.list_unit.list_addr.val();
+        self.list_unit.list_rdata.next = self.lists.rdata.val();
 
         // Engine answers (address at I2, data at I3).
-        self.issued.read_address.next = self.query_thread.val();
-        self.done_e.read_address.next = self.query_thread.val();
-        self.best_e.read_address.next = self.query_thread.val();
-        self.instance_e.read_address.next = self.query_thread.val();
-        self.triangle_e.read_address.next = self.query_thread.val();
-        self.pending.next = self.issued.read_data.val() != self.done_e.read_data.val();
+        self.issued.read_address.next = self.engine.query_thread.val();
+        self.done_e.read_address.next = self.engine.query_thread.val();
+        self.best_e.read_address.next = self.engine.query_thread.val();
+        self.instance_e.read_address.next = self.engine.query_thread.val();
+        self.triangle_e.read_address.next = self.engine.query_thread.val();
+        self.engine.pending.next = self.issued.read_data.val() != self.done_e.read_data.val();
         self.hit.next = self.best_e.read_data.val().get_bit(32);
         self.best_t.next = self.best_e.read_data.val().get_bits::<W>(0);
         self.best_instance.next = self.instance_e.read_data.val();
         self.best_triangle.next = self.triangle_e.read_data.val();
-        self.issued.write_address.next = self.thread.val();
+        self.issued.write_address.next = self.engine.thread.val();
         self.issued.write_data.next = self.issued.read_data.val() + 1;
         // A list counts as one entry (done with its end entry), an init as one.
-        self.issued.write_enable.next = self.enqueue.val()
+        self.issued.write_enable.next = self.engine.enqueue.val()
             & (!self.list_unit.full.val())
             & ((self.queue_kind.val() == self.c_cmd_list.val())
                 | (self.queue_kind.val() == self.c_cmd_init.val()));
@@ -548,27 +514,29 @@ impl<
         self.list_unit.test_take.next = false;
         self.uv_take.next = self.fetching.q.val()
             & (self.uv_issued.q.val() < 8)
-            & (!(self.engine_read.val() & (self.engine_bank.val() == self.c_bank_uv.val())));
+            & (!(self.engine.load_read.val()
+                & (self.engine.load_bank.val() == self.c_bank_uv.val())));
         self.t_take.next = self.fetching.q.val()
             & (self.t_issued.q.val() < 4)
-            & (!(self.engine_read.val() & (self.engine_bank.val() == self.c_bank_t.val())));
-        self.uv_read.next = self.uv_take.val()
-            | (self.engine_read.val() & (self.engine_bank.val() == self.c_bank_uv.val()));
-        self.t_read.next = self.t_take.val()
-            | (self.engine_read.val() & (self.engine_bank.val() == self.c_bank_t.val()));
-        self.uv_addr.next = self.engine_addr.val();
-        self.t_addr.next = self.engine_addr.val();
+            & (!(self.engine.load_read.val()
+                & (self.engine.load_bank.val() == self.c_bank_t.val())));
+        self.uv_words.read.next = self.uv_take.val()
+            | (self.engine.load_read.val() & (self.engine.load_bank.val() == self.c_bank_uv.val()));
+        self.t_words.read.next = self.t_take.val()
+            | (self.engine.load_read.val() & (self.engine.load_bank.val() == self.c_bank_t.val()));
+        self.uv_words.addr.next = self.engine.load_addr.val();
+        self.t_words.addr.next = self.engine.load_addr.val();
         self.fetch_a.next = self.cur_a[0].q.val();
         if self.fb.q.val() {
             self.fetch_a.next = self.cur_a[1].q.val();
         }
         if self.uv_take.val() {
-            self.uv_addr.next = (self.fetch_a.val().get_bits::<24>(0) << 3)
+            self.uv_words.addr.next = (self.fetch_a.val().get_bits::<24>(0) << 3)
                 + bit_cast::<24, 4>(self.uv_issued.q.val());
             self.uv_issued.d.next = self.uv_issued.q.val() + 1;
         }
         if self.t_take.val() {
-            self.t_addr.next = (self.fetch_a.val().get_bits::<24>(0) << 3)
+            self.t_words.addr.next = (self.fetch_a.val().get_bits::<24>(0) << 3)
                 + bit_cast::<24, 4>(self.t_issued.q.val());
             self.t_issued.d.next = self.t_issued.q.val() + 1;
         }
@@ -637,9 +605,9 @@ impl<
                 & (bit_cast::<4, 3>(self.uv_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
             {
                 if self.uv_arrive.val().get_bit(3) {
-                    self.words[12 + k].d.next = self.uv_rdata.val().get_bits::<W>(0);
+                    self.words[12 + k].d.next = self.uv_words.rdata.val().get_bits::<W>(0);
                 } else {
-                    self.words[k].d.next = self.uv_rdata.val().get_bits::<W>(0);
+                    self.words[k].d.next = self.uv_words.rdata.val().get_bits::<W>(0);
                 }
             }
         }
@@ -648,9 +616,9 @@ impl<
                 & (bit_cast::<4, 3>(self.t_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
             {
                 if self.t_arrive.val().get_bit(3) {
-                    self.words[20 + k].d.next = self.t_rdata.val().get_bits::<W>(0);
+                    self.words[20 + k].d.next = self.t_words.rdata.val().get_bits::<W>(0);
                 } else {
-                    self.words[8 + k].d.next = self.t_rdata.val().get_bits::<W>(0);
+                    self.words[8 + k].d.next = self.t_words.rdata.val().get_bits::<W>(0);
                 }
             }
         }
@@ -814,8 +782,8 @@ impl<
                 | (self.m3_kind.q.val() == self.c_test_list_end.val()));
         self.done_m.write_enable.next = self.m3_counts.val();
         self.done_e.write_enable.next = self.m3_counts.val();
-        self.done_event.next = self.m3_counts.val();
-        self.done_thread.next = self.m3_thread.q.val();
+        self.engine.done.next = self.m3_counts.val();
+        self.engine.done_thread.next = self.m3_thread.q.val();
         self.walk_end_event.next =
             self.m3_valid.q.val() & (self.m3_kind.q.val() == self.c_test_walk_end.val());
         self.walk_end_thread.next = self.m3_thread.q.val();
@@ -947,15 +915,15 @@ mod tests {
                 .into_iter()
                 .enumerate()
             {
-                u.thread.next = (th as u64).into();
-                u.ray_write.next = true;
-                u.ray_pair.next = (pair as u64).into();
-                u.word_a.next = (a as u64).into();
-                u.word_b.next = (b as u64).into();
+                u.engine.thread.next = (th as u64).into();
+                u.engine.ray_write.next = true;
+                u.engine.ray_pair.next = (pair as u64).into();
+                u.engine.word_a.next = (a as u64).into();
+                u.engine.word_b.next = (b as u64).into();
                 cycle(&mut u);
             }
         }
-        u.ray_write.next = false;
+        u.engine.ray_write.next = false;
         let mut requests: VecDeque<[Option<u32>; 3]> = std::iter::repeat([None; 3])
             .take(mem_latency as usize)
             .collect();
@@ -972,17 +940,17 @@ mod tests {
             }
             // The SRAMs answer the request of `mem_latency` clocks ago.
             let [uv, t, list] = requests.pop_front().unwrap();
-            u.uv_rdata.next = u64::from(uv.map_or(0xdead, |a| bank2[a as usize])).into();
-            u.t_rdata.next = u64::from(t.map_or(0xdead, |a| bank3[a as usize])).into();
-            u.list_rdata.next = u64::from(list.map_or(0xdead, |a| bank1[a as usize])).into();
+            u.uv_words.rdata.next = u64::from(uv.map_or(0xdead, |a| bank2[a as usize])).into();
+            u.t_words.rdata.next = u64::from(t.map_or(0xdead, |a| bank3[a as usize])).into();
+            u.lists.rdata.next = u64::from(list.map_or(0xdead, |a| bank1[a as usize])).into();
             // Round robin over the threads with something to offer (like the engine's turns).
             let th = queried.filter(|&t| !offers[t].is_empty());
             let start = th.map_or(0, |t| t + 1);
             queried = (0..threads)
                 .map(|k| (start + k) % threads)
                 .find(|&k| !offers[k].is_empty() && Some(k) != th);
-            u.query_thread.next = (queried.unwrap_or(0) as u64).into();
-            u.enqueue.next = th.is_some();
+            u.engine.query_thread.next = (queried.unwrap_or(0) as u64).into();
+            u.engine.enqueue.next = th.is_some();
             if let Some(th) = th {
                 use crate::hw::list_unit::{CMD_INIT, CMD_LIST, CMD_OBJECT};
                 let (kind, a, b) = match offers[th][0] {
@@ -990,26 +958,26 @@ mod tests {
                     Offer::Object(o) => (CMD_OBJECT, o, 0),
                     Offer::List { from, to } => (CMD_LIST, from, to),
                 };
-                u.thread.next = (th as u64).into();
+                u.engine.thread.next = (th as u64).into();
                 u.queue_kind.next = kind.into();
-                u.word_a.next = u64::from(a).into();
-                u.word_b.next = u64::from(b).into();
+                u.engine.word_a.next = u64::from(a).into();
+                u.engine.word_b.next = u64::from(b).into();
             }
             let steal = (steal_one_in > 0 && rng.gen_ratio(1, steal_one_in.max(1)))
                 .then(|| (rng.gen_range(1..=3u64), rng.gen_range(0..64u64)));
-            u.engine_read.next = steal.is_some();
-            u.engine_bank.next = steal.map_or(0, |s| s.0).into();
-            u.engine_addr.next = steal.map_or(0, |s| s.1).into();
+            u.engine.load_read.next = steal.is_some();
+            u.engine.load_bank.next = steal.map_or(0, |s| s.0).into();
+            u.engine.load_addr.next = steal.map_or(0, |s| s.1).into();
             settle(&mut u);
             if let Some((1, _)) = steal {
-                assert!(!u.list_read.val(), "the list read took the engine's bus");
+                assert!(!u.lists.read.val(), "the list read took the engine's bus");
             }
             if let Some((bank @ 2..=3, addr)) = steal {
                 drive.stolen += 1;
                 let (read, port) = if bank == 2 {
-                    (u.uv_read.val(), u.uv_addr.val())
+                    (u.uv_words.read.val(), u.uv_words.addr.val())
                 } else {
-                    (u.t_read.val(), u.t_addr.val())
+                    (u.t_words.read.val(), u.t_words.addr.val())
                 };
                 assert!(
                     read && port.to_u64() == addr,
@@ -1018,12 +986,12 @@ mod tests {
             }
             let port = |read: bool, addr: Bits<24>| read.then(|| addr.to_u64() as u32);
             requests.push_back([
-                port(u.uv_read.val(), u.uv_addr.val()),
-                port(u.t_read.val(), u.t_addr.val()),
-                port(u.list_read.val(), u.list_addr.val()),
+                port(u.uv_words.read.val(), u.uv_words.addr.val()),
+                port(u.t_words.read.val(), u.t_words.addr.val()),
+                port(u.lists.read.val(), u.lists.addr.val()),
             ]);
             if let Some(th) = th {
-                if u.full.val() {
+                if u.engine.full.val() {
                     drive.refused += 1;
                 } else {
                     offers[th].pop_front();
@@ -1031,12 +999,12 @@ mod tests {
             }
             cycle(&mut u);
         }
-        u.enqueue.next = false;
-        u.engine_read.next = false;
+        u.engine.enqueue.next = false;
+        u.engine.load_read.next = false;
         for (th, want) in want.iter().enumerate() {
-            u.query_thread.next = (th as u64).into();
+            u.engine.query_thread.next = (th as u64).into();
             cycle(&mut u);
-            assert!(!u.pending.val(), "thread {th} still pending");
+            assert!(!u.engine.pending.val(), "thread {th} still pending");
             let got = (
                 u.hit.val(),
                 u.best_t.val().to_u64() as u32,

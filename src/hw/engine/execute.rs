@@ -1,0 +1,204 @@
+//! `Execute`: the engine's single-clock work at I3. It computes the integer, conversion,
+//! link, pixel and coprocessor-reading results (the *fast* result), the integer conditions,
+//! and the addresses of loads, stores and scratch accesses, and names where a load's data
+//! will come from.
+//!
+//! Contract: from an instruction's `op`, operands `a`, `b`, `imm`, `shift`, `bank` and `pc`
+//! at I3: `fast` is `add`/`sub`/`and`/`or`/`xor`/`shr`/`shl` of `a` and `b`, `itof a`, `jal`'s
+//! link `pc + 1`, `byte`'s `b << 8` (the unit's byte joins it at the write back), the
+//! pixel word, or what `tri.wait`/`tri.hit`/`tri.instance`/`tri.triangle` read from the
+//! triangle tester; `kind` says whether the result line fills in a scratch or memory word
+//! later (`ld` by its bank, `lds`). `mem_address = (a << shift) + imm` (loads and frame-buffer
+//! stores), `scratch_address = a + imm`; `int_eq`, `int_lt`: `a == b`, `a < b` unsigned.
+//!
+//! Latency: combinational (I3). Throughput: one instruction per clock.
+//!
+//! Golden twin: `hw::program::exec` (the engine's twin), the same operations per opcode.
+
+use rust_hdl::prelude::*;
+
+use super::{op_code, FastKind};
+use crate::hw::program::isa::{Op, TriFn, BANK_BITS, OP_BITS, PC_BITS, SHIFT_BITS};
+use crate::hw::UIntToFloat;
+use crate::layout;
+
+#[derive(LogicBlock)]
+pub struct Execute<const W: usize, const E: usize, const M: usize> {
+    /// I3: the instruction.
+    pub op: Signal<In, Bits<OP_BITS>>,
+    pub a: Signal<In, Bits<32>>,
+    pub b: Signal<In, Bits<32>>,
+    pub imm: Signal<In, Bits<32>>,
+    pub shift: Signal<In, Bits<SHIFT_BITS>>,
+    pub bank: Signal<In, Bits<BANK_BITS>>,
+    pub pc: Signal<In, Bits<PC_BITS>>,
+    /// The pixel counter's word.
+    pub pixel: Signal<In, Bits<32>>,
+    /// The triangle tester's answers for the thread at I3.
+    pub tester_best_t: Signal<In, Bits<W>>,
+    pub tester_hit: Signal<In, Bit>,
+    pub tester_instance: Signal<In, Bits<32>>,
+    pub tester_triangle: Signal<In, Bits<32>>,
+    pub fast: Signal<Out, Bits<32>>,
+    pub kind: Signal<Out, FastKind>,
+    pub int_eq: Signal<Out, Bit>,
+    pub int_lt: Signal<Out, Bit>,
+    pub mem_address: Signal<Out, Bits<32>>,
+    pub scratch_address: Signal<Out, Bits<32>>,
+
+    itof: UIntToFloat<W, E, M>,
+    result: Signal<Local, Bits<32>>,
+    source: Signal<Local, FastKind>,
+
+    op_itof: Constant<Bits<5>>,
+    op_add: Constant<Bits<5>>,
+    op_sub: Constant<Bits<5>>,
+    op_and: Constant<Bits<5>>,
+    op_or: Constant<Bits<5>>,
+    op_xor: Constant<Bits<5>>,
+    op_shr: Constant<Bits<5>>,
+    op_shl: Constant<Bits<5>>,
+    op_ld: Constant<Bits<5>>,
+    op_lds: Constant<Bits<5>>,
+    op_jal: Constant<Bits<5>>,
+    op_byte: Constant<Bits<5>>,
+    op_pixel: Constant<Bits<5>>,
+    op_tri: Constant<Bits<5>>,
+    tri_wait: Constant<Bits<32>>,
+    tri_hit: Constant<Bits<32>>,
+    tri_instance: Constant<Bits<32>>,
+    tri_triangle: Constant<Bits<32>>,
+    bank_nodes: Constant<Bits<3>>,
+    bank_uv: Constant<Bits<3>>,
+    bank_t: Constant<Bits<3>>,
+}
+
+impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M> {
+    fn default() -> Self {
+        let tri_fn = |f: TriFn| Constant::new((f as u64).into());
+        let bank = |b: usize| Constant::new((b as u64).into());
+        Self {
+            op: Default::default(),
+            a: Default::default(),
+            b: Default::default(),
+            imm: Default::default(),
+            shift: Default::default(),
+            bank: Default::default(),
+            pc: Default::default(),
+            pixel: Default::default(),
+            tester_best_t: Default::default(),
+            tester_hit: Default::default(),
+            tester_instance: Default::default(),
+            tester_triangle: Default::default(),
+            fast: Default::default(),
+            kind: Default::default(),
+            int_eq: Default::default(),
+            int_lt: Default::default(),
+            mem_address: Default::default(),
+            scratch_address: Default::default(),
+            itof: Default::default(),
+            result: Default::default(),
+            source: Default::default(),
+            op_itof: op_code(Op::IToF),
+            op_add: op_code(Op::Add),
+            op_sub: op_code(Op::Sub),
+            op_and: op_code(Op::And),
+            op_or: op_code(Op::Or),
+            op_xor: op_code(Op::Xor),
+            op_shr: op_code(Op::Shr),
+            op_shl: op_code(Op::Shl),
+            op_ld: op_code(Op::Ld),
+            op_lds: op_code(Op::Lds),
+            op_jal: op_code(Op::Jal),
+            op_byte: op_code(Op::Byte),
+            op_pixel: op_code(Op::Pixel),
+            op_tri: op_code(Op::Tri),
+            tri_wait: tri_fn(TriFn::Wait),
+            tri_hit: tri_fn(TriFn::Hit),
+            tri_instance: tri_fn(TriFn::Instance),
+            tri_triangle: tri_fn(TriFn::Triangle),
+            bank_nodes: bank(layout::NODES),
+            bank_uv: bank(layout::TRIANGLES_UV),
+            bank_t: bank(layout::TRIANGLES_T),
+        }
+    }
+}
+
+impl<const W: usize, const E: usize, const M: usize> Logic for Execute<W, E, M> {
+    #[hdl_gen]
+    fn update(&mut self) {
+        self.itof.value.next = self.a.val().get_bits::<16>(0);
+        self.int_eq.next = self.a.val() == self.b.val();
+        self.int_lt.next = self.a.val() < self.b.val();
+        self.mem_address.next = (self.a.val() << self.shift.val()) + self.imm.val();
+        self.scratch_address.next = self.a.val() + self.imm.val();
+
+        // Settled in locals and given to the outputs once (they leave the block).
+        self.source.next = FastKind::Computed;
+        self.result.next = 0.into();
+        if self.op.val() == self.op_itof.val() {
+            self.result.next = bit_cast::<32, W>(self.itof.word.val());
+        }
+        if self.op.val() == self.op_add.val() {
+            self.result.next = self.a.val() + self.b.val();
+        }
+        if self.op.val() == self.op_sub.val() {
+            self.result.next = self.a.val() - self.b.val();
+        }
+        if self.op.val() == self.op_and.val() {
+            self.result.next = self.a.val() & self.b.val();
+        }
+        if self.op.val() == self.op_or.val() {
+            self.result.next = self.a.val() | self.b.val();
+        }
+        if self.op.val() == self.op_xor.val() {
+            self.result.next = self.a.val() ^ self.b.val();
+        }
+        if self.op.val() == self.op_shr.val() {
+            self.result.next = self.a.val() >> self.b.val().get_bits::<5>(0);
+        }
+        if self.op.val() == self.op_shl.val() {
+            self.result.next = self.a.val() << self.b.val().get_bits::<5>(0);
+        }
+        if self.op.val() == self.op_ld.val() {
+            self.source.next = FastKind::Memory;
+            if self.bank.val() == self.bank_uv.val() {
+                self.source.next = FastKind::TrianglesUv;
+            }
+            if self.bank.val() == self.bank_t.val() {
+                self.source.next = FastKind::TrianglesT;
+            }
+            if self.bank.val() == self.bank_nodes.val() {
+                self.source.next = FastKind::Nodes;
+            }
+        }
+        if self.op.val() == self.op_lds.val() {
+            self.source.next = FastKind::Scratch;
+        }
+        if self.op.val() == self.op_jal.val() {
+            self.result.next = bit_cast::<32, PC_BITS>(self.pc.val() + 1);
+        }
+        if self.op.val() == self.op_byte.val() {
+            self.result.next = self.b.val() << 8;
+        }
+        if self.op.val() == self.op_pixel.val() {
+            self.result.next = self.pixel.val();
+        }
+        if self.op.val() == self.op_tri.val() {
+            if self.imm.val() == self.tri_wait.val() {
+                self.result.next = bit_cast::<32, W>(self.tester_best_t.val());
+            }
+            if self.imm.val() == self.tri_hit.val() {
+                self.result.next = bit_cast::<32, 1>(self.tester_hit.val().into());
+            }
+            if self.imm.val() == self.tri_instance.val() {
+                self.result.next = self.tester_instance.val();
+            }
+            if self.imm.val() == self.tri_triangle.val() {
+                self.result.next = self.tester_triangle.val();
+            }
+        }
+        self.fast.next = self.result.val();
+        self.kind.next = self.source.val();
+    }
+}

@@ -1,0 +1,120 @@
+//! `FpUnits`: the engine's floating-point units (add/sub, multiply, divide, square root,
+//! compare, the colour-channel byte), fed every clock from I3, and the delays that bring each
+//! result to the write back.
+//!
+//! Contract: operands `a`, `b` (and `sub` for `fsub`) given at I3 come out at the write back,
+//! [`super::ENGINE_LATENCY`] clocks later: `sum`, `product`, the compare flags `lt`, `le`,
+//! `eq`, `byte` (`ChannelByte`); `quotient` and `root` come
+//! [`super::long_latency`]`(M)` clocks later, the clock the long line writes them back. Every
+//! unit takes an input every clock whether the instruction uses it or not; the write back
+//! picks the one its opcode names.
+//!
+//! Latency: 11 clocks (`quotient`, `root`: `M + 6`). Throughput: one operation per clock.
+//!
+//! Golden twin: each operator's own (`Format::add`, `sub`, `mul`, `div`, `sqrt`, `lt`, `le`,
+//! `eq` in `crate::fp::arith`, and `units::channel_byte`), as the engine's twin
+//! (`hw::program::exec`) runs them for `fadd`, `fsub`, `fmul`, `fdiv`, `fsqrt`, the float
+//! branches and `byte`.
+
+use rust_hdl::prelude::*;
+
+use crate::hw::fp::{FpAddSub, FpCompare, FpDiv, FpMul, FpSqrt};
+use crate::hw::ChannelByte;
+
+#[derive(LogicBlock, Default)]
+pub struct FpUnits<
+    const W: usize,
+    const E: usize,
+    const M: usize,
+    const S: usize,
+    const S1: usize,
+    const X2: usize,
+    const T: usize,
+    const P: usize,
+> {
+    pub clock: Signal<In, Clock>,
+    /// I3: the operands; `sub`: the adder subtracts.
+    pub a: Signal<In, Bits<W>>,
+    pub b: Signal<In, Bits<W>>,
+    pub sub: Signal<In, Bit>,
+    /// Write back.
+    pub sum: Signal<Out, Bits<W>>,
+    pub product: Signal<Out, Bits<W>>,
+    pub quotient: Signal<Out, Bits<W>>,
+    pub root: Signal<Out, Bits<W>>,
+    pub lt: Signal<Out, Bit>,
+    pub le: Signal<Out, Bit>,
+    pub eq: Signal<Out, Bit>,
+    pub colour_byte: Signal<Out, Bits<8>>,
+
+    add: FpAddSub<W, E, M, S, S1, X2, T>,
+    mul: FpMul<W, E, M, S, S1, X2, P>,
+    div: FpDiv<W, E, M, S, S1, X2>,
+    sqrt: FpSqrt<W, E, M, S, S1, T>,
+    cmp: FpCompare<W, E, M>,
+    byte_unit: ChannelByte<W, E, M, S, S1, X2, T, P>,
+    // Each delay brings its unit's result to the write back at `ENGINE_LATENCY` (11): 11 - 7
+    // for the adder, 11 - 4 for the multiplier, 11 - 2 for the comparator; the divider and
+    // square root (`M + 5`) write back one clock later, at `long_latency`. `ChannelByte` takes
+    // the 11 clocks itself.
+    add_delay: crate::hw::Delay<Bits<W>, 4>,
+    mul_delay: crate::hw::Delay<Bits<W>, 7>,
+    div_delay: crate::hw::Delay<Bits<W>, 1>,
+    sqrt_delay: crate::hw::Delay<Bits<W>, 1>,
+    lt_delay: crate::hw::Delay<Bit, 9>,
+    le_delay: crate::hw::Delay<Bit, 9>,
+    eq_delay: crate::hw::Delay<Bit, 9>,
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+    > Logic for FpUnits<W, E, M, S, S1, X2, T, P>
+{
+    #[hdl_gen]
+    fn update(&mut self) {
+        clock!(
+            self, clock, add, mul, div, sqrt, cmp, byte_unit, add_delay, mul_delay, div_delay,
+            sqrt_delay, lt_delay, le_delay, eq_delay
+        );
+        self.add.a.next = self.a.val();
+        self.add.b.next = self.b.val();
+        self.add.sub.next = self.sub.val();
+        self.add.in_valid.next = true;
+        self.mul.a.next = self.a.val();
+        self.mul.b.next = self.b.val();
+        self.mul.in_valid.next = true;
+        self.div.a.next = self.a.val();
+        self.div.b.next = self.b.val();
+        self.div.in_valid.next = true;
+        self.sqrt.a.next = self.a.val();
+        self.sqrt.in_valid.next = true;
+        self.cmp.a.next = self.a.val();
+        self.cmp.b.next = self.b.val();
+        self.cmp.in_valid.next = true;
+        self.byte_unit.word.next = self.a.val();
+        self.byte_unit.in_valid.next = true;
+
+        self.add_delay.data_in.next = self.add.result.val();
+        self.mul_delay.data_in.next = self.mul.result.val();
+        self.div_delay.data_in.next = self.div.result.val();
+        self.sqrt_delay.data_in.next = self.sqrt.result.val();
+        self.lt_delay.data_in.next = self.cmp.lt.val();
+        self.le_delay.data_in.next = self.cmp.le.val();
+        self.eq_delay.data_in.next = self.cmp.eq.val();
+        self.sum.next = self.add_delay.data_out.val();
+        self.product.next = self.mul_delay.data_out.val();
+        self.quotient.next = self.div_delay.data_out.val();
+        self.root.next = self.sqrt_delay.data_out.val();
+        self.lt.next = self.lt_delay.data_out.val();
+        self.le.next = self.le_delay.data_out.val();
+        self.eq.next = self.eq_delay.data_out.val();
+        self.colour_byte.next = self.byte_unit.result.val();
+    }
+}

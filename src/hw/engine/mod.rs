@@ -1,0 +1,702 @@
+//! `ThreadEngine`: the ray thread engine that runs the microprogram (`hw::program`) for up to
+//! 32 ray threads, one instruction per clock, on pipelined floating-point units.
+//!
+//! A scheduler issues one ready thread per clock, round robin. An instruction writes back
+//! exactly [`ENGINE_LATENCY`] (11) clocks after its operands are read, `fdiv` and `fsqrt`
+//! [`long_latency`] (`M + 6`) clocks after, and a thread is ready again only at its write
+//! back, so there is no hazard, stall or forwarding logic: memory and unit latency are hidden
+//! by the other threads (the paper's 32 threads). A long instruction reserves its write-back
+//! clock: the scheduler issues nothing in the one clock whose instruction would write back
+//! with it (one bubble per `fdiv` or `fsqrt`). A thread issues at most once per `period =
+//! ENGINE_LATENCY + 4` (15) clocks (`engine_period`). A thread whose coprocessor wait (`tri.wait`,
+//! `kd.wait`) is still pending sleeps: it is not ready until the coprocessor finishes work for
+//! it, so the clocks it waits go to the other threads (an offer to a full queue repeats at
+//! once).
+//!
+//! Pipeline (clock offsets from the issue), one block per stage, each with its own contract:
+//! - I0: [`Scheduler`] picks a ready thread.
+//! - I0..I2: [`Fetch`] reads the thread's `{epoch, halted, pc}` (a stale epoch means "new
+//!   frame": pc 0), then the instruction ROM's three words.
+//! - I2..I3: [`Decode`] reads the two source registers and splits the fields; the
+//!   [`MailboxUnit`] reads the thread's mailbox and the triangle tester its state.
+//! - I3: [`Execute`] computes the integer result and the addresses, the [`PixelCounter`]
+//!   hands out a pixel, the mailbox tests and updates, [`FpUnits`] take their operands; this
+//!   block drives the memory and frame-buffer ports and offers `tri` and `kd` entries to the
+//!   coprocessors (their answer, refused or pending, makes the thread repeat the instruction
+//!   on its next turn, after a sleep for a wait).
+//! - I4..: the [`ResultLine`]; scratch data joins at I4, memory data at I4 + `mem_latency`.
+//! - I3 + 11 (`I3 + M + 6` for `fdiv`, `fsqrt`, which go on in the long line): the
+//!   [`WriteBack`] writes the register and the next pc: `target` when the condition differs
+//!   from `invert` (a non-branching instruction's condition is false, so its `invert` is a jump
+//!   after it), else `pc + 1`; the condition comes from the compare, integer, mailbox, pixel
+//!   unit or triangle tester.
+//!
+//! Golden twin: [`crate::hw::program::exec`] runs the same microprogram instruction by
+//! instruction (the engine's twin); its retired-instruction count and every frame equal the
+//! engine's (`tests/processor_sim.rs`). The arithmetic of the ray, in both, is the sequences of
+//! [`crate::units`].
+//!
+//! Throughput: one instruction per clock while at least 15 threads are awake; a frame
+//! ends when every thread has executed `halt` (`done`). Counters: clocks of the frame,
+//! instructions retired, and clocks in which the triangle tester's TransformUnit and
+//! IntersectUnit took an input.
+//! `instructions` counts retired instructions: not the turns a thread spends offering an entry
+//! again to a full coprocessor queue or waiting for a coprocessor, so it equals the count of
+//! the engine's twin, which never waits.
+//!
+//! Two coprocessors run beside the engine. The [`TraversalUnit`] walks a thread's object kd
+//! tree (a thread starts the walk and sleeps until it ends, instead of 15-23 turns per inner
+//! node in microcode); it hands each leaf's list to the [`TriangleTester`], whose list unit
+//! reads it and queues its triangles, and which answers the traversal unit with the closest
+//! hit. A walk costs the thread four turns, whatever its leaves.
+//!
+//! Memory: one read per clock on the `mem_*` port (banks 0, 1, 4, 5; the tester's list reads
+//! of bank 1 use it in the clocks the engine leaves free) and on each of the
+//! `bank2_*` and `bank3_*` ports (the triangles; the tester fetches from both at once, the
+//! engine's loads of these banks go there too, first); a word must arrive exactly
+//! `mem_latency` clocks after its request (1..=6). Frame-buffer writes come out on `fb_*`.
+
+use rust_hdl::prelude::*;
+
+use super::list_unit;
+use super::ports::{BankedSramRead, FrameBufferWrite, SramRead};
+use super::program::isa::{KdFn, Op, TriFn, PC_BITS};
+use super::program::Program;
+use super::{TraversalUnit, TriangleTester, CHANNEL_BYTE_LATENCY};
+use crate::layout;
+
+mod decode;
+mod execute;
+mod fetch;
+mod fp_units;
+mod mailbox;
+mod pixel_counter;
+mod result_line;
+mod scheduler;
+mod write_back;
+
+pub use decode::Decode;
+pub use execute::Execute;
+pub use fetch::Fetch;
+pub use fp_units::FpUnits;
+pub use mailbox::MailboxUnit;
+pub use pixel_counter::PixelCounter;
+pub use result_line::ResultLine;
+pub use scheduler::Scheduler;
+pub use write_back::WriteBack;
+
+/// Most threads (the thread id is 5 bits).
+pub const MAX_THREADS: usize = 32;
+/// Largest supported `mem_latency`.
+pub const MAX_MEM_LATENCY: u32 = 6;
+/// Scratch words per thread the engine provides.
+pub const SCRATCH_WORDS: u32 = 128;
+
+/// Clocks from operand read to write back of every instruction but `fdiv` and `fsqrt`: the
+/// longest of them is `byte` ([`CHANNEL_BYTE_LATENCY`]; `fadd` takes 7, loads at most 8).
+pub const ENGINE_LATENCY: u32 = CHANNEL_BYTE_LATENCY;
+
+/// Clocks from operand read to write back of `fdiv` and `fsqrt` for mantissa width `m` (the
+/// divider's and the square root's `m + 5`, plus one register).
+pub const fn long_latency(m: u32) -> u32 {
+    m + 6
+}
+
+/// The clocks of one round of `threads` threads, each issuing once: a thread issues at most
+/// once per `ENGINE_LATENCY + 4` clocks.
+pub fn engine_period(threads: u32) -> u32 {
+    threads.max(ENGINE_LATENCY + 4)
+}
+
+/// Where an instruction's result comes from on the fast line: computed at I3, or the data of
+/// a scratch read or of a load from the shared memory port or a bank's own port.
+#[derive(Copy, Clone, Debug, PartialEq, LogicState)]
+pub enum FastKind {
+    Computed,
+    Scratch,
+    Memory,
+    TrianglesUv,
+    TrianglesT,
+    Nodes,
+}
+
+/// An opcode as the decoders compare it, from its one definition in `isa::Op`.
+fn op_code(op: Op) -> Constant<Bits<5>> {
+    Constant::new((op as u64).into())
+}
+
+fn tri_fn(f: TriFn) -> Constant<Bits<32>> {
+    Constant::new((f as u64).into())
+}
+
+fn kd_fn(f: KdFn) -> Constant<Bits<32>> {
+    Constant::new((f as u64).into())
+}
+
+fn bank(b: usize) -> Constant<Bits<3>> {
+    Constant::new((b as u64).into())
+}
+
+fn cmd(c: u64) -> Constant<Bits<2>> {
+    Constant::new(c.into())
+}
+
+/// A RAM's initial contents: word `i` at address `i`.
+fn word_map<const N: usize, D: Synth>(
+    words: impl Iterator<Item = D>,
+) -> std::collections::BTreeMap<Bits<N>, D> {
+    words
+        .enumerate()
+        .map(|(i, w)| (Bits::<N>::from(i as u64), w))
+        .collect()
+}
+
+#[derive(LogicBlock)]
+pub struct ThreadEngine<
+    const W: usize,
+    const E: usize,
+    const M: usize,
+    const S: usize,
+    const S1: usize,
+    const X2: usize,
+    const T: usize,
+    const P: usize,
+    const DX: usize,
+    const DL: usize,
+> {
+    pub clock: Signal<In, Clock>,
+    /// A one-clock pulse starts a frame (while `done` or before the first frame).
+    pub start: Signal<In, Bit>,
+    pub done: Signal<Out, Bit>,
+    pub cycles: Signal<Out, Bits<32>>,
+    pub instructions: Signal<Out, Bits<32>>,
+    /// Banks 1, 4 and 5 (lists, instances and objects, shading), with the triangle tester's
+    /// list reads in the clocks the engine leaves free.
+    pub mem: BankedSramRead,
+    pub fb: FrameBufferWrite,
+    /// Banks 0 (kd nodes), 2 and 3 (the triangles) have their own ports: the traversal unit
+    /// reads bank 0, the triangle tester banks 2 and 3 at once, and the engine's loads of
+    /// these banks go out here too.
+    pub bank0: SramRead,
+    pub bank2: SramRead,
+    pub bank3: SramRead,
+    /// Clocks of the frame in which the TransformUnit and the IntersectUnit took an input.
+    pub transform_busy: Signal<Out, Bits<32>>,
+    pub intersect_busy: Signal<Out, Bits<32>>,
+    /// Clocks of the frame in which the traversal unit started a node decision.
+    pub traversal_busy: Signal<Out, Bits<32>>,
+
+    // The pipeline's stages.
+    scheduler: Scheduler,
+    fetch: Fetch,
+    decode: Decode,
+    mailboxes: MailboxUnit,
+    pixels: PixelCounter,
+    execute: Execute<W, E, M>,
+    fp_units: FpUnits<W, E, M, S, S1, X2, T, P>,
+    result_line: ResultLine<DX>,
+    write_back: WriteBack<W>,
+    /// Per thread `SCRATCH_WORDS` words (`lds`, `sts`: the kd stack and the mirror chain).
+    scratch: RAM<Bits<32>, 12>,
+
+    // The coprocessors.
+    tester: TriangleTester<W, E, M, S, S1, X2, T, P, DL>,
+    traversal_unit: TraversalUnit<W, E, M, S, S1, X2, T, DL>,
+
+    // Frame control and counters.
+    running: DFF<Bit>,
+    epoch: DFF<Bit>,
+    halted_count: DFF<Bits<8>>,
+    cycle_count: DFF<Bits<32>>,
+    instr_count: DFF<Bits<32>>,
+    transform_count: DFF<Bits<32>>,
+    intersect_count: DFF<Bits<32>>,
+    traversal_count: DFF<Bits<32>>,
+    frame_start: Signal<Local, Bit>,
+    // The memory and frame-buffer ports' request registers.
+    mem_read_r: DFF<Bit>,
+    mem_bank_r: DFF<Bits<3>>,
+    mem_addr_r: DFF<Bits<24>>,
+    fb_write_r: DFF<Bit>,
+    fb_addr_r: DFF<Bits<24>>,
+    fb_data_r: DFF<Bits<32>>,
+    // The coprocessor glue at I3.
+    is_tri: Signal<Local, Bit>,
+    ray_write: Signal<Local, Bit>,
+    tri_queues: Signal<Local, Bit>,
+    tri_kind: Signal<Local, Bits<2>>,
+    tri_busy: Signal<Local, Bit>,
+    kd_busy: Signal<Local, Bit>,
+    wait_fn: Signal<Local, Bit>,
+
+    c_threads: Constant<Bits<8>>,
+    // The glue's names, every one from its definition in `isa` (`Op`, `TriFn`, `KdFn`),
+    // `layout` (banks) and `list_unit` (command kinds): the Verilog's localparams follow the
+    // twin's numbering by construction.
+    op_fsub: Constant<Bits<5>>,
+    op_fdiv: Constant<Bits<5>>,
+    op_fsqrt: Constant<Bits<5>>,
+    op_ld: Constant<Bits<5>>,
+    op_st: Constant<Bits<5>>,
+    op_sts: Constant<Bits<5>>,
+    op_mbx: Constant<Bits<5>>,
+    op_mbc: Constant<Bits<5>>,
+    op_pixel: Constant<Bits<5>>,
+    op_tri: Constant<Bits<5>>,
+    op_kd: Constant<Bits<5>>,
+    /// The ray words are `TriFn`s 0..3, their number the ray store's `ray_pair`.
+    tri_ray_words: Constant<Bits<32>>,
+    tri_init: Constant<Bits<32>>,
+    tri_list: Constant<Bits<32>>,
+    tri_wait: Constant<Bits<32>>,
+    tri_object: Constant<Bits<32>>,
+    tri_skip: Constant<Bits<32>>,
+    kd_start: Constant<Bits<32>>,
+    kd_wait: Constant<Bits<32>>,
+    cmd_list: Constant<Bits<2>>,
+    cmd_init: Constant<Bits<2>>,
+    cmd_object: Constant<Bits<2>>,
+    cmd_skip: Constant<Bits<2>>,
+    bank_nodes: Constant<Bits<3>>,
+    bank_lists: Constant<Bits<3>>,
+    bank_uv: Constant<Bits<3>>,
+    bank_t: Constant<Bits<3>>,
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+        const DX: usize,
+        const DL: usize,
+    > ThreadEngine<W, E, M, S, S1, X2, T, P, DX, DL>
+{
+    /// The engine running `program` with `threads` threads and memory read latency
+    /// `mem_latency`.
+    pub fn new(program: &Program, threads: u32, mem_latency: u32) -> Self {
+        assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
+        assert!(P == 2 * S);
+        assert!(super::fp::div::div_latency(M as u32) + 1 == long_latency(M as u32));
+        assert!(super::fp::sqrt::sqrt_latency(M as u32) + 1 == long_latency(M as u32));
+        // The reservation is made at I3 for an issue `DX - 4` clocks later (I3 + DX - 4 + 3 +
+        // ENGINE_LATENCY = I3 + long_latency).
+        assert!(DX == (long_latency(M as u32) - ENGINE_LATENCY) as usize && DX >= 4);
+        assert!(DL == super::fp::div::div_latency(M as u32) as usize);
+        assert!((1..=MAX_THREADS as u32).contains(&threads));
+        assert!((1..=MAX_MEM_LATENCY).contains(&mem_latency));
+        assert!(program.scratch.words <= SCRATCH_WORDS);
+        // The ray words' function number is the ray store's `ray_pair` (`imm` bits 1..0), and
+        // every function below `TriFn::Init` is one.
+        assert!(
+            TriFn::RayOxy as u32 == 0 && TriFn::RayOzDx as u32 == 1 && TriFn::RayDyz as u32 == 2
+        );
+        assert!(TriFn::Init as u32 == 3);
+        Self {
+            clock: Default::default(),
+            start: Default::default(),
+            done: Default::default(),
+            cycles: Default::default(),
+            instructions: Default::default(),
+            mem: Default::default(),
+            fb: Default::default(),
+            bank0: Default::default(),
+            bank2: Default::default(),
+            bank3: Default::default(),
+            transform_busy: Default::default(),
+            intersect_busy: Default::default(),
+            traversal_busy: Default::default(),
+            scheduler: Scheduler::new(threads, DX as u32 - 4),
+            fetch: Fetch::new(program),
+            decode: Decode::new(),
+            mailboxes: Default::default(),
+            pixels: PixelCounter::new(&program.config),
+            execute: Default::default(),
+            fp_units: Default::default(),
+            result_line: ResultLine::new(mem_latency),
+            write_back: Default::default(),
+            // Scratch words start undefined: the program writes every one before reading it.
+            scratch: Default::default(),
+            tester: TriangleTester::new(mem_latency),
+            traversal_unit: TraversalUnit::new(mem_latency),
+            running: Default::default(),
+            epoch: Default::default(),
+            halted_count: Default::default(),
+            cycle_count: Default::default(),
+            instr_count: Default::default(),
+            transform_count: Default::default(),
+            intersect_count: Default::default(),
+            traversal_count: Default::default(),
+            frame_start: Default::default(),
+            mem_read_r: Default::default(),
+            mem_bank_r: Default::default(),
+            mem_addr_r: Default::default(),
+            fb_write_r: Default::default(),
+            fb_addr_r: Default::default(),
+            fb_data_r: Default::default(),
+            is_tri: Default::default(),
+            ray_write: Default::default(),
+            tri_queues: Default::default(),
+            tri_kind: Default::default(),
+            tri_busy: Default::default(),
+            kd_busy: Default::default(),
+            wait_fn: Default::default(),
+            c_threads: Constant::new(u64::from(threads).into()),
+            op_fsub: op_code(Op::FSub),
+            op_fdiv: op_code(Op::FDiv),
+            op_fsqrt: op_code(Op::FSqrt),
+            op_ld: op_code(Op::Ld),
+            op_st: op_code(Op::St),
+            op_sts: op_code(Op::Sts),
+            op_mbx: op_code(Op::Mbx),
+            op_mbc: op_code(Op::Mbc),
+            op_pixel: op_code(Op::Pixel),
+            op_tri: op_code(Op::Tri),
+            op_kd: op_code(Op::Kd),
+            tri_ray_words: tri_fn(TriFn::Init),
+            tri_init: tri_fn(TriFn::Init),
+            tri_list: tri_fn(TriFn::List),
+            tri_wait: tri_fn(TriFn::Wait),
+            tri_object: tri_fn(TriFn::Object),
+            tri_skip: tri_fn(TriFn::Skip),
+            kd_start: kd_fn(KdFn::Start),
+            kd_wait: kd_fn(KdFn::Wait),
+            cmd_list: cmd(list_unit::CMD_LIST),
+            cmd_init: cmd(list_unit::CMD_INIT),
+            cmd_object: cmd(list_unit::CMD_OBJECT),
+            cmd_skip: cmd(list_unit::CMD_SKIP),
+            bank_nodes: bank(layout::NODES),
+            bank_lists: bank(layout::LISTS),
+            bank_uv: bank(layout::TRIANGLES_UV),
+            bank_t: bank(layout::TRIANGLES_T),
+        }
+    }
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+        const DX: usize,
+        const DL: usize,
+    > Logic for ThreadEngine<W, E, M, S, S1, X2, T, P, DX, DL>
+{
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(
+            self,
+            clock,
+            running,
+            epoch,
+            halted_count,
+            cycle_count,
+            instr_count,
+            transform_count,
+            intersect_count,
+            traversal_count,
+            mem_read_r,
+            mem_bank_r,
+            mem_addr_r,
+            fb_write_r,
+            fb_addr_r,
+            fb_data_r
+        );
+        clock!(
+            self,
+            clock,
+            scheduler,
+            fetch,
+            decode,
+            mailboxes,
+            pixels,
+            fp_units,
+            result_line,
+            tester,
+            traversal_unit
+        );
+        self.scratch.read_clock.next = self.clock.val();
+        self.scratch.write_clock.next = self.clock.val();
+
+        // Frame control and counters.
+        self.frame_start.next = self.start.val() & (!self.running.q.val());
+        self.done.next =
+            (!self.running.q.val()) & (self.halted_count.q.val() == self.c_threads.val());
+        self.cycles.next = self.cycle_count.q.val();
+        self.instructions.next = self.instr_count.q.val();
+        self.transform_busy.next = self.transform_count.q.val();
+        self.intersect_busy.next = self.intersect_count.q.val();
+        self.traversal_busy.next = self.traversal_count.q.val();
+        if self.running.q.val() {
+            self.cycle_count.d.next = self.cycle_count.q.val() + 1;
+            if self.tester.transform_busy.val() {
+                self.transform_count.d.next = self.transform_count.q.val() + 1;
+            }
+            if self.tester.intersect_busy.val() {
+                self.intersect_count.d.next = self.intersect_count.q.val() + 1;
+            }
+            if self.traversal_unit.step_busy.val() {
+                self.traversal_count.d.next = self.traversal_count.q.val() + 1;
+            }
+        }
+
+        // I0..I2.
+        self.scheduler.running.next = self.running.q.val();
+        self.scheduler.frame_start.next = self.frame_start.val();
+        self.fetch.epoch.next = self.epoch.q.val();
+        self.fetch.issue.next = self.scheduler.issue.val();
+        self.fetch.pick.next = self.scheduler.pick.val();
+        self.decode.valid_i2.next = self.fetch.valid.val();
+        self.decode.thread_i2.next = self.fetch.thread.val();
+        self.decode.pc_i2.next = self.fetch.pc.val();
+        self.decode.ctl_i2.next = self.fetch.ctl.val();
+        self.decode.imm_i2.next = self.fetch.imm.val();
+        self.decode.aux_i2.next = self.fetch.aux.val();
+        self.mailboxes.read_thread.next = self.fetch.thread.val();
+        self.mailboxes.read_which.next = self.fetch.imm.val().get_bit(0);
+        self.tester.engine.query_thread.next = self.fetch.thread.val();
+        self.traversal_unit.engine.query_thread.next = self.fetch.thread.val();
+
+        // I3.
+        self.scheduler.long_at_i3.next = self.decode.valid.val()
+            & ((self.decode.op.val() == self.op_fdiv.val())
+                | (self.decode.op.val() == self.op_fsqrt.val()));
+        self.fp_units.a.next = self.decode.a.val().get_bits::<W>(0);
+        self.fp_units.b.next = self.decode.b.val().get_bits::<W>(0);
+        self.fp_units.sub.next = self.decode.op.val() == self.op_fsub.val();
+        self.execute.op.next = self.decode.op.val();
+        self.execute.a.next = self.decode.a.val();
+        self.execute.b.next = self.decode.b.val();
+        self.execute.imm.next = self.decode.imm.val();
+        self.execute.shift.next = self.decode.shift.val();
+        self.execute.bank.next = self.decode.bank.val();
+        self.execute.pc.next = self.decode.pc.val();
+        self.execute.pixel.next = self.pixels.word.val();
+        self.execute.tester_best_t.next = self.tester.best_t.val();
+        self.execute.tester_hit.next = self.tester.hit.val();
+        self.execute.tester_instance.next = self.tester.best_instance.val();
+        self.execute.tester_triangle.next = self.tester.best_triangle.val();
+        self.mailboxes.thread.next = self.decode.thread.val();
+        self.mailboxes.which.next = self.decode.imm.val().get_bit(0);
+        self.mailboxes.value.next = self.decode.a.val();
+        self.mailboxes.insert.next =
+            self.decode.valid.val() & (self.decode.op.val() == self.op_mbx.val());
+        self.mailboxes.clear.next =
+            self.decode.valid.val() & (self.decode.op.val() == self.op_mbc.val());
+        self.pixels.frame_start.next = self.frame_start.val();
+        self.pixels.take.next = self.running.q.val()
+            & self.decode.valid.val()
+            & (self.decode.op.val() == self.op_pixel.val());
+
+        // Scratch memory.
+        self.scratch.read_address.next = (bit_cast::<12, 5>(self.decode.thread.val()) << 7)
+            | bit_cast::<12, 7>(self.execute.scratch_address.val().get_bits::<7>(0));
+        self.scratch.write_address.next = (bit_cast::<12, 5>(self.decode.thread.val()) << 7)
+            | bit_cast::<12, 7>(self.execute.scratch_address.val().get_bits::<7>(0));
+        self.scratch.write_data.next = self.decode.store.val();
+        self.scratch.write_enable.next =
+            self.decode.valid.val() & (self.decode.op.val() == self.op_sts.val());
+
+        // Memory and frame-buffer ports (registered).
+        self.mem_read_r.d.next =
+            self.decode.valid.val() & (self.decode.op.val() == self.op_ld.val());
+        self.mem_bank_r.d.next = self.decode.bank.val();
+        self.mem_addr_r.d.next = self.execute.mem_address.val().get_bits::<24>(0);
+        self.fb_write_r.d.next =
+            self.decode.valid.val() & (self.decode.op.val() == self.op_st.val());
+        self.fb_addr_r.d.next = self.execute.mem_address.val().get_bits::<24>(0);
+        self.fb_data_r.d.next = self.decode.store.val();
+        self.fb.write.next = self.fb_write_r.q.val();
+        self.fb.addr.next = self.fb_addr_r.q.val();
+        self.fb.data.next = self.fb_data_r.q.val();
+        // Bank 0 goes through the traversal unit's port, banks 2 and 3 through the triangle
+        // tester's; the tester's list reads (bank 1) use this bus when the engine does not.
+        self.mem.read.next = (self.mem_read_r.q.val()
+            & (self.mem_bank_r.q.val() != self.bank_nodes.val())
+            & (self.mem_bank_r.q.val() != self.bank_uv.val())
+            & (self.mem_bank_r.q.val() != self.bank_t.val()))
+            | self.tester.lists.read.val();
+        if self.tester.lists.read.val() {
+            self.mem.bank.next = self.bank_lists.val();
+            self.mem.addr.next = self.tester.lists.addr.val();
+        } else {
+            self.mem.bank.next = self.mem_bank_r.q.val();
+            self.mem.addr.next = self.mem_addr_r.q.val();
+        }
+        self.tester.lists.rdata.next = self.mem.rdata.val();
+        SramRead::link(&mut self.bank0, &mut self.traversal_unit.nodes);
+        SramRead::link(&mut self.bank2, &mut self.tester.uv_words);
+        SramRead::link(&mut self.bank3, &mut self.tester.t_words);
+        // Both coprocessors see the engine's loads, the thread at I3 and its ray words.
+        self.is_tri.next = self.decode.valid.val() & (self.decode.op.val() == self.op_tri.val());
+        self.ray_write.next =
+            self.is_tri.val() & (self.decode.imm.val() < self.tri_ray_words.val());
+        self.traversal_unit.engine.load_read.next = self.mem_read_r.q.val();
+        self.traversal_unit.engine.load_bank.next = self.mem_bank_r.q.val();
+        self.traversal_unit.engine.load_addr.next = self.mem_addr_r.q.val();
+        self.traversal_unit.engine.thread.next = self.decode.thread.val();
+        self.traversal_unit.engine.word_a.next = self.decode.a.val();
+        self.traversal_unit.engine.word_b.next = self.decode.b.val();
+        self.traversal_unit.engine.ray_pair.next = self.decode.imm.val().get_bits::<2>(0);
+        self.traversal_unit.engine.ray_write.next = self.ray_write.val();
+        self.tester.engine.load_read.next = self.mem_read_r.q.val();
+        self.tester.engine.load_bank.next = self.mem_bank_r.q.val();
+        self.tester.engine.load_addr.next = self.mem_addr_r.q.val();
+        self.tester.engine.thread.next = self.decode.thread.val();
+        self.tester.engine.word_a.next = self.decode.a.val();
+        self.tester.engine.word_b.next = self.decode.b.val();
+        self.tester.engine.ray_pair.next = self.decode.imm.val().get_bits::<2>(0);
+        self.tester.engine.ray_write.next = self.ray_write.val();
+
+        // Triangle tester (`tri`, its `TriFn` in imm); the queued functions go to the list
+        // unit as its command kinds.
+        self.tri_queues.next = (self.decode.imm.val() == self.tri_init.val())
+            | (self.decode.imm.val() == self.tri_list.val())
+            | (self.decode.imm.val() == self.tri_object.val())
+            | (self.decode.imm.val() == self.tri_skip.val());
+        self.tester.engine.enqueue.next = self.is_tri.val() & self.tri_queues.val();
+        // The kind is settled in a local signal and given to the tester in one assignment: a
+        // default overridden on the tester's input itself would glitch it, the tester's
+        // outputs feed back here, and Icarus would loop forever.
+        self.tri_kind.next = self.cmd_list.val();
+        if self.decode.imm.val() == self.tri_init.val() {
+            self.tri_kind.next = self.cmd_init.val();
+        }
+        if self.decode.imm.val() == self.tri_object.val() {
+            self.tri_kind.next = self.cmd_object.val();
+        }
+        if self.decode.imm.val() == self.tri_skip.val() {
+            self.tri_kind.next = self.cmd_skip.val();
+        }
+        self.tester.queue_kind.next = self.tri_kind.val();
+        self.tri_busy.next = false;
+        if self.tri_queues.val() {
+            self.tri_busy.next = self.tester.engine.full.val();
+        }
+        if self.decode.imm.val() == self.tri_wait.val() {
+            self.tri_busy.next = self.tester.engine.pending.val();
+        }
+        // Traversal unit (`kd`, its `KdFn` in imm). It sees the object-space ray and t_min the
+        // thread gives the tester, hands its leaves to the tester and takes the answers back.
+        self.tester.walk_list_valid.next = self.traversal_unit.leaf_valid.val();
+        self.tester.walk_list_thread.next = self.traversal_unit.leaf_thread.val();
+        self.tester.walk_list_from.next = self.traversal_unit.leaf_from.val();
+        self.tester.walk_list_to.next = self.traversal_unit.leaf_to.val();
+        self.traversal_unit.leaf_take.next = self.tester.walk_list_take.val();
+        self.traversal_unit.answer_valid.next = self.tester.walk_end_event.val();
+        self.traversal_unit.answer_thread.next = self.tester.walk_end_thread.val();
+        self.traversal_unit.answer_t.next = self.tester.walk_end_t.val();
+        self.traversal_unit.answer_hit.next = self.tester.walk_end_hit.val();
+        self.traversal_unit.t_min_write.next =
+            self.is_tri.val() & (self.decode.imm.val() == self.tri_init.val());
+        self.traversal_unit.engine.enqueue.next = self.decode.valid.val()
+            & (self.decode.op.val() == self.op_kd.val())
+            & (self.decode.imm.val() == self.kd_start.val());
+        if self.decode.imm.val() == self.kd_wait.val() {
+            self.kd_busy.next = self.traversal_unit.engine.pending.val();
+        } else {
+            self.kd_busy.next = self.traversal_unit.engine.full.val();
+        }
+        // The waits (`tri.wait`, `kd.wait`): a pending one sleeps instead of repeating.
+        self.wait_fn.next = ((self.decode.op.val() == self.op_tri.val())
+            & (self.decode.imm.val() == self.tri_wait.val()))
+            | ((self.decode.op.val() == self.op_kd.val())
+                & (self.decode.imm.val() == self.kd_wait.val()));
+
+        // I3 into the result line.
+        self.result_line.valid.next = self.decode.valid.val();
+        self.result_line.op.next = self.decode.op.val();
+        self.result_line.dst.next = self.decode.dst.val();
+        self.result_line.thread.next = self.decode.thread.val();
+        self.result_line.invert.next = self.decode.invert.val();
+        self.result_line.pc.next = self.decode.pc.val();
+        self.result_line.target.next = self.decode.target.val();
+        self.result_line.is_wait.next = self.wait_fn.val();
+        self.result_line.kd_busy.next = self.kd_busy.val();
+        self.result_line.tri_busy.next = self.tri_busy.val();
+        self.result_line.jr_target.next = self.decode.a.val().get_bits::<PC_BITS>(0);
+        self.result_line.int_eq.next = self.execute.int_eq.val();
+        self.result_line.int_lt.next = self.execute.int_lt.val();
+        self.result_line.mb_hit.next = self.mailboxes.hit.val();
+        self.result_line.pix_done.next = self.pixels.exhausted.val();
+        self.result_line.fast.next = self.execute.fast.val();
+        self.result_line.kind.next = self.execute.kind.val();
+        self.result_line.scratch_data.next = self.scratch.read_data.val();
+        self.result_line.mem_data.next = self.mem.rdata.val();
+        self.result_line.nodes_data.next = self.bank0.rdata.val();
+        self.result_line.uv_data.next = self.bank2.rdata.val();
+        self.result_line.t_data.next = self.bank3.rdata.val();
+
+        // Write back.
+        self.write_back.valid.next = self.result_line.wb_valid.val();
+        self.write_back.op.next = self.result_line.wb_op.val();
+        self.write_back.dst.next = self.result_line.wb_dst.val();
+        self.write_back.invert.next = self.result_line.wb_invert.val();
+        self.write_back.pc_plus_one.next = self.result_line.wb_next.val();
+        self.write_back.target.next = self.result_line.wb_target.val();
+        self.write_back.is_wait.next = self.result_line.wb_wait.val();
+        self.write_back.kd_busy.next = self.result_line.wb_kd_busy.val();
+        self.write_back.tri_busy.next = self.result_line.wb_tri_busy.val();
+        self.write_back.jr_target.next = self.result_line.wb_jr_target.val();
+        self.write_back.int_eq.next = self.result_line.wb_int_eq.val();
+        self.write_back.int_lt.next = self.result_line.wb_int_lt.val();
+        self.write_back.mb_hit.next = self.result_line.wb_mb_hit.val();
+        self.write_back.pix_done.next = self.result_line.wb_pix_done.val();
+        self.write_back.fast.next = self.result_line.wb_fast.val();
+        self.write_back.sum.next = self.fp_units.sum.val();
+        self.write_back.product.next = self.fp_units.product.val();
+        self.write_back.quotient.next = self.fp_units.quotient.val();
+        self.write_back.root.next = self.fp_units.root.val();
+        self.write_back.lt.next = self.fp_units.lt.val();
+        self.write_back.le.next = self.fp_units.le.val();
+        self.write_back.eq.next = self.fp_units.eq.val();
+        self.write_back.colour_byte.next = self.fp_units.colour_byte.val();
+        self.decode.wb_write.next = self.write_back.write.val();
+        self.decode.wb_thread.next = self.result_line.wb_thread.val();
+        self.decode.wb_dst.next = self.result_line.wb_dst.val();
+        self.decode.wb_data.next = self.write_back.data.val();
+        self.fetch.wb_valid.next = self.result_line.wb_valid.val();
+        self.fetch.wb_thread.next = self.result_line.wb_thread.val();
+        self.fetch.wb_halt.next = self.write_back.halt.val();
+        self.fetch.wb_next_pc.next = self.write_back.next_pc.val();
+        self.scheduler.wb_valid.next = self.result_line.wb_valid.val();
+        self.scheduler.wb_thread.next = self.result_line.wb_thread.val();
+        self.scheduler.wb_halt.next = self.write_back.halt.val();
+        self.scheduler.wb_wait_pending.next = self.write_back.wait_pending.val();
+        self.scheduler.tester_done.next = self.tester.engine.done.val();
+        self.scheduler.tester_done_thread.next = self.tester.engine.done_thread.val();
+        self.scheduler.walk_done.next = self.traversal_unit.engine.done.val();
+        self.scheduler.walk_done_thread.next = self.traversal_unit.engine.done_thread.val();
+        // Instructions retired: every write back but a turn spent offering again to a full
+        // coprocessor queue or waiting for a coprocessor (the twin never repeats those).
+        if self.write_back.retired.val() {
+            self.instr_count.d.next = self.instr_count.q.val() + 1;
+        }
+        if self.result_line.wb_valid.val() & self.write_back.halt.val() {
+            self.halted_count.d.next = self.halted_count.q.val() + 1;
+            if (self.halted_count.q.val() + 1) == self.c_threads.val() {
+                self.running.d.next = false;
+            }
+        }
+
+        // Start of a frame: a new epoch restarts every thread at pc 0.
+        if self.frame_start.val() {
+            self.running.d.next = true;
+            self.epoch.d.next = !self.epoch.q.val();
+            self.halted_count.d.next = 0.into();
+            self.cycle_count.d.next = 0.into();
+            self.instr_count.d.next = 0.into();
+            self.transform_count.d.next = 0.into();
+            self.intersect_count.d.next = 0.into();
+            self.traversal_count.d.next = 0.into();
+        }
+    }
+}

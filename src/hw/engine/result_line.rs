@@ -1,0 +1,312 @@
+//! `ResultLine`: carries each instruction from I3 to its write back: its control fields, its
+//! pcs, its conditions and its fast result, into which scratch and memory data join on the
+//! way. `fdiv` and `fsqrt` go on from there through a long line of `DX` more clocks.
+//!
+//! Contract: what enters at I3 leaves at the write back [`super::ENGINE_LATENCY`] (11) clocks
+//! later; a long instruction's control and pcs leave `DX = long_latency - ENGINE_LATENCY`
+//! clocks later still (the scheduler reserved that clock, so no other instruction leaves with
+//! it; its conditions and fast result are not used). The fast result of `lds` is replaced by
+//! the scratch word one clock after I3, that of `ld` by the word of its bank's port
+//! `mem_latency` clocks after the request (which leaves the engine one clock after I3).
+//!
+//! Latency: 11 clocks (`fdiv`, `fsqrt`: `11 + DX`). Throughput: one instruction per clock.
+//!
+//! Golden twin: none (it computes nothing); the engine's twin `hw::program::exec` sees every
+//! result at once, and the frames' equality checks that the line keeps each result with its
+//! instruction.
+
+use rust_hdl::prelude::*;
+
+use super::{op_code, FastKind, MAX_MEM_LATENCY};
+use crate::hw::program::isa::{Op, OP_BITS, PC_BITS, REG_BITS};
+use crate::hw::Delay;
+
+/// Registers of the fast line up to the last clock a load's data can join (the `0..8`
+/// loops of `update` spell it out: rust-hdl's Verilog cannot name Rust constants); three
+/// more follow.
+const FAST_STAGES: usize = 8;
+/// Clocks from I3 to the write back.
+const LINE: usize = 11;
+
+#[derive(LogicBlock)]
+pub struct ResultLine<const DX: usize> {
+    pub clock: Signal<In, Clock>,
+    /// I3: the instruction.
+    pub valid: Signal<In, Bit>,
+    pub op: Signal<In, Bits<OP_BITS>>,
+    pub dst: Signal<In, Bits<REG_BITS>>,
+    pub thread: Signal<In, Bits<5>>,
+    pub invert: Signal<In, Bit>,
+    pub pc: Signal<In, Bits<PC_BITS>>,
+    pub target: Signal<In, Bits<PC_BITS>>,
+    /// I3: its conditions: a coprocessor wait; the traversal unit or the triangle tester
+    /// refused the entry or has not finished; operand A's low bits (`jr`'s target); the
+    /// integer compares; the mailbox hit; the pixels exhausted.
+    pub is_wait: Signal<In, Bit>,
+    pub kd_busy: Signal<In, Bit>,
+    pub tri_busy: Signal<In, Bit>,
+    pub jr_target: Signal<In, Bits<PC_BITS>>,
+    pub int_eq: Signal<In, Bit>,
+    pub int_lt: Signal<In, Bit>,
+    pub mb_hit: Signal<In, Bit>,
+    pub pix_done: Signal<In, Bit>,
+    /// I3: the fast result and where a load's data comes from.
+    pub fast: Signal<In, Bits<32>>,
+    pub kind: Signal<In, FastKind>,
+    /// The data that joins: the scratch word (I4) and the ports' words.
+    pub scratch_data: Signal<In, Bits<32>>,
+    pub mem_data: Signal<In, Bits<32>>,
+    pub nodes_data: Signal<In, Bits<32>>,
+    pub uv_data: Signal<In, Bits<32>>,
+    pub t_data: Signal<In, Bits<32>>,
+
+    /// Write back: the instruction leaving the line (from the long line when one leaves it).
+    pub wb_valid: Signal<Out, Bit>,
+    pub wb_op: Signal<Out, Bits<OP_BITS>>,
+    pub wb_dst: Signal<Out, Bits<REG_BITS>>,
+    pub wb_thread: Signal<Out, Bits<5>>,
+    pub wb_invert: Signal<Out, Bit>,
+    pub wb_next: Signal<Out, Bits<PC_BITS>>,
+    pub wb_target: Signal<Out, Bits<PC_BITS>>,
+    pub wb_wait: Signal<Out, Bit>,
+    pub wb_kd_busy: Signal<Out, Bit>,
+    pub wb_tri_busy: Signal<Out, Bit>,
+    pub wb_jr_target: Signal<Out, Bits<PC_BITS>>,
+    pub wb_int_eq: Signal<Out, Bit>,
+    pub wb_int_lt: Signal<Out, Bit>,
+    pub wb_mb_hit: Signal<Out, Bit>,
+    pub wb_pix_done: Signal<Out, Bit>,
+    pub wb_fast: Signal<Out, Bits<32>>,
+
+    valid_line: Delay<Bit, LINE>,
+    op_line: Delay<Bits<OP_BITS>, LINE>,
+    dst_line: Delay<Bits<REG_BITS>, LINE>,
+    thread_line: Delay<Bits<5>, LINE>,
+    invert_line: Delay<Bit, LINE>,
+    next_line: Delay<Bits<PC_BITS>, LINE>,
+    target_line: Delay<Bits<PC_BITS>, LINE>,
+    wait_line: Delay<Bit, LINE>,
+    kd_busy_line: Delay<Bit, LINE>,
+    tri_busy_line: Delay<Bit, LINE>,
+    jr_target_line: Delay<Bits<PC_BITS>, LINE>,
+    int_eq_line: Delay<Bit, LINE>,
+    int_lt_line: Delay<Bit, LINE>,
+    mb_hit_line: Delay<Bit, LINE>,
+    pix_done_line: Delay<Bit, LINE>,
+    /// The fast result and its source, a register per clock up to the last join.
+    fast_line: [DFF<Bits<32>>; FAST_STAGES],
+    kind_line: [DFF<FastKind>; FAST_STAGES],
+    fast_tail: Delay<Bits<32>, 3>,
+    /// The long line of `fdiv` and `fsqrt`.
+    long_valid: Delay<Bit, DX>,
+    long_op: Delay<Bits<OP_BITS>, DX>,
+    long_dst: Delay<Bits<REG_BITS>, DX>,
+    long_thread: Delay<Bits<5>, DX>,
+    long_invert: Delay<Bit, DX>,
+    long_next: Delay<Bits<PC_BITS>, DX>,
+    long_target: Delay<Bits<PC_BITS>, DX>,
+    is_long: Signal<Local, Bit>,
+
+    c_mem_latency: Constant<Bits<8>>,
+    c_index: [Constant<Bits<8>>; FAST_STAGES],
+    op_fdiv: Constant<Bits<5>>,
+    op_fsqrt: Constant<Bits<5>>,
+}
+
+impl<const DX: usize> ResultLine<DX> {
+    /// The line of an engine whose memory answers `mem_latency` clocks after a request.
+    pub fn new(mem_latency: u32) -> Self {
+        assert!((1..=MAX_MEM_LATENCY).contains(&mem_latency));
+        // A load's data joins at stage `mem_latency + 1 <= FAST_STAGES - 1`.
+        assert!(MAX_MEM_LATENCY as usize + 1 < FAST_STAGES && LINE == FAST_STAGES + 3);
+        assert_eq!(LINE as u32, super::ENGINE_LATENCY);
+        Self {
+            clock: Default::default(),
+            valid: Default::default(),
+            op: Default::default(),
+            dst: Default::default(),
+            thread: Default::default(),
+            invert: Default::default(),
+            pc: Default::default(),
+            target: Default::default(),
+            is_wait: Default::default(),
+            kd_busy: Default::default(),
+            tri_busy: Default::default(),
+            jr_target: Default::default(),
+            int_eq: Default::default(),
+            int_lt: Default::default(),
+            mb_hit: Default::default(),
+            pix_done: Default::default(),
+            fast: Default::default(),
+            kind: Default::default(),
+            scratch_data: Default::default(),
+            mem_data: Default::default(),
+            nodes_data: Default::default(),
+            uv_data: Default::default(),
+            t_data: Default::default(),
+            wb_valid: Default::default(),
+            wb_op: Default::default(),
+            wb_dst: Default::default(),
+            wb_thread: Default::default(),
+            wb_invert: Default::default(),
+            wb_next: Default::default(),
+            wb_target: Default::default(),
+            wb_wait: Default::default(),
+            wb_kd_busy: Default::default(),
+            wb_tri_busy: Default::default(),
+            wb_jr_target: Default::default(),
+            wb_int_eq: Default::default(),
+            wb_int_lt: Default::default(),
+            wb_mb_hit: Default::default(),
+            wb_pix_done: Default::default(),
+            wb_fast: Default::default(),
+            valid_line: Default::default(),
+            op_line: Default::default(),
+            dst_line: Default::default(),
+            thread_line: Default::default(),
+            invert_line: Default::default(),
+            next_line: Default::default(),
+            target_line: Default::default(),
+            wait_line: Default::default(),
+            kd_busy_line: Default::default(),
+            tri_busy_line: Default::default(),
+            jr_target_line: Default::default(),
+            int_eq_line: Default::default(),
+            int_lt_line: Default::default(),
+            mb_hit_line: Default::default(),
+            pix_done_line: Default::default(),
+            fast_line: Default::default(),
+            kind_line: Default::default(),
+            fast_tail: Default::default(),
+            long_valid: Default::default(),
+            long_op: Default::default(),
+            long_dst: Default::default(),
+            long_thread: Default::default(),
+            long_invert: Default::default(),
+            long_next: Default::default(),
+            long_target: Default::default(),
+            is_long: Default::default(),
+            c_mem_latency: Constant::new(u64::from(mem_latency).into()),
+            c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
+            op_fdiv: op_code(Op::FDiv),
+            op_fsqrt: op_code(Op::FSqrt),
+        }
+    }
+}
+
+impl<const DX: usize> Logic for ResultLine<DX> {
+    #[hdl_gen]
+    fn update(&mut self) {
+        clock!(
+            self,
+            clock,
+            valid_line,
+            op_line,
+            dst_line,
+            thread_line,
+            invert_line,
+            next_line,
+            target_line,
+            wait_line,
+            kd_busy_line,
+            tri_busy_line,
+            jr_target_line,
+            int_eq_line,
+            int_lt_line,
+            mb_hit_line,
+            pix_done_line,
+            fast_tail,
+            long_valid,
+            long_op,
+            long_dst,
+            long_thread,
+            long_invert,
+            long_next,
+            long_target
+        );
+        for k in 0..8 {
+            self.fast_line[k].clock.next = self.clock.val();
+            self.kind_line[k].clock.next = self.clock.val();
+        }
+        self.valid_line.data_in.next = self.valid.val();
+        self.op_line.data_in.next = self.op.val();
+        self.dst_line.data_in.next = self.dst.val();
+        self.thread_line.data_in.next = self.thread.val();
+        self.invert_line.data_in.next = self.invert.val();
+        self.next_line.data_in.next = self.pc.val() + 1;
+        self.target_line.data_in.next = self.target.val();
+        self.wait_line.data_in.next = self.is_wait.val();
+        self.kd_busy_line.data_in.next = self.kd_busy.val();
+        self.tri_busy_line.data_in.next = self.tri_busy.val();
+        self.jr_target_line.data_in.next = self.jr_target.val();
+        self.int_eq_line.data_in.next = self.int_eq.val();
+        self.int_lt_line.data_in.next = self.int_lt.val();
+        self.mb_hit_line.data_in.next = self.mb_hit.val();
+        self.pix_done_line.data_in.next = self.pix_done.val();
+
+        // The fast line: scratch data at I4, memory data at I4 + latency.
+        self.fast_line[0].d.next = self.fast.val();
+        self.kind_line[0].d.next = self.kind.val();
+        for k in 1..8 {
+            self.fast_line[k].d.next = self.fast_line[k - 1].q.val();
+            self.kind_line[k].d.next = self.kind_line[k - 1].q.val();
+        }
+        if self.kind_line[0].q.val() == FastKind::Scratch {
+            self.fast_line[1].d.next = self.scratch_data.val();
+        }
+        for k in 1..7 {
+            if self.c_mem_latency.val() == self.c_index[k].val() {
+                if self.kind_line[k].q.val() == FastKind::Memory {
+                    self.fast_line[k + 1].d.next = self.mem_data.val();
+                }
+                if self.kind_line[k].q.val() == FastKind::TrianglesUv {
+                    self.fast_line[k + 1].d.next = self.uv_data.val();
+                }
+                if self.kind_line[k].q.val() == FastKind::TrianglesT {
+                    self.fast_line[k + 1].d.next = self.t_data.val();
+                }
+                if self.kind_line[k].q.val() == FastKind::Nodes {
+                    self.fast_line[k + 1].d.next = self.nodes_data.val();
+                }
+            }
+        }
+        self.fast_tail.data_in.next = self.fast_line[7].q.val();
+
+        // `fdiv` and `fsqrt` go on into the long line and leave from there.
+        self.is_long.next = (self.op_line.data_out.val() == self.op_fdiv.val())
+            | (self.op_line.data_out.val() == self.op_fsqrt.val());
+        self.long_valid.data_in.next = self.valid_line.data_out.val() & self.is_long.val();
+        self.long_op.data_in.next = self.op_line.data_out.val();
+        self.long_dst.data_in.next = self.dst_line.data_out.val();
+        self.long_thread.data_in.next = self.thread_line.data_out.val();
+        self.long_invert.data_in.next = self.invert_line.data_out.val();
+        self.long_next.data_in.next = self.next_line.data_out.val();
+        self.long_target.data_in.next = self.target_line.data_out.val();
+        if self.long_valid.data_out.val() {
+            self.wb_valid.next = true;
+            self.wb_op.next = self.long_op.data_out.val();
+            self.wb_dst.next = self.long_dst.data_out.val();
+            self.wb_thread.next = self.long_thread.data_out.val();
+            self.wb_invert.next = self.long_invert.data_out.val();
+            self.wb_next.next = self.long_next.data_out.val();
+            self.wb_target.next = self.long_target.data_out.val();
+        } else {
+            self.wb_valid.next = self.valid_line.data_out.val() & (!self.is_long.val());
+            self.wb_op.next = self.op_line.data_out.val();
+            self.wb_dst.next = self.dst_line.data_out.val();
+            self.wb_thread.next = self.thread_line.data_out.val();
+            self.wb_invert.next = self.invert_line.data_out.val();
+            self.wb_next.next = self.next_line.data_out.val();
+            self.wb_target.next = self.target_line.data_out.val();
+        }
+        self.wb_wait.next = self.wait_line.data_out.val();
+        self.wb_kd_busy.next = self.kd_busy_line.data_out.val();
+        self.wb_tri_busy.next = self.tri_busy_line.data_out.val();
+        self.wb_jr_target.next = self.jr_target_line.data_out.val();
+        self.wb_int_eq.next = self.int_eq_line.data_out.val();
+        self.wb_int_lt.next = self.int_lt_line.data_out.val();
+        self.wb_mb_hit.next = self.mb_hit_line.data_out.val();
+        self.wb_pix_done.next = self.pix_done_line.data_out.val();
+        self.wb_fast.next = self.fast_tail.data_out.val();
+    }
+}

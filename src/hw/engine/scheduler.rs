@@ -1,0 +1,196 @@
+//! `Scheduler`: the engine's issue stage (I0). It picks one ready thread per clock, round
+//! robin, and keeps which threads may issue.
+//!
+//! Contract: a thread is *ready* from the start of a frame and again at the write back of
+//! its instruction, unless that instruction was `halt` or a coprocessor wait (`tri.wait`,
+//! `kd.wait`) that is still pending. A pending waiter *sleeps* until its coprocessor reports
+//! a finish for it (`tester_done`, `walk_done`); a finish between the waiter's issue and its
+//! write back is remembered (`woken`), so the waiter does not sleep through it. A long
+//! instruction (`fdiv`, `fsqrt`) at I3 reserves the clock its write back will take: the
+//! scheduler issues nothing in the one clock whose instruction would write back with it.
+//!
+//! Latency: `issue`/`pick` are combinational from the registered state (I0). Throughput: one
+//! issue per clock while a thread is ready and the clock is not reserved.
+//!
+//! Golden twin: none of its own. The engine's twin (`hw::program::exec`, see
+//! `ThreadEngine`) runs threads in an order of its own and never waits; the scheduler may
+//! change only *when* a thread issues, never what it computes, so the frames and the count of
+//! retired instructions equal the twin's whatever the order.
+
+use rust_hdl::prelude::*;
+
+use super::MAX_THREADS;
+
+#[derive(LogicBlock)]
+pub struct Scheduler {
+    pub clock: Signal<In, Clock>,
+    /// The frame runs; threads issue only while it does.
+    pub running: Signal<In, Bit>,
+    /// A new frame starts: every thread is ready, none asleep, no clock reserved.
+    pub frame_start: Signal<In, Bit>,
+    /// A long instruction is at I3 (its write back is `long_latency - ENGINE_LATENCY` clocks
+    /// after the others').
+    pub long_at_i3: Signal<In, Bit>,
+    /// The write back of `wb_thread`'s instruction; `wb_halt`: it was `halt`;
+    /// `wb_wait_pending`: it was a coprocessor wait whose work is not finished.
+    pub wb_valid: Signal<In, Bit>,
+    pub wb_thread: Signal<In, Bits<5>>,
+    pub wb_halt: Signal<In, Bit>,
+    pub wb_wait_pending: Signal<In, Bit>,
+    /// The triangle tester and the traversal unit finished work for a thread.
+    pub tester_done: Signal<In, Bit>,
+    pub tester_done_thread: Signal<In, Bits<5>>,
+    pub walk_done: Signal<In, Bit>,
+    pub walk_done_thread: Signal<In, Bits<5>>,
+    /// A thread issues this clock: `pick`.
+    pub issue: Signal<Out, Bit>,
+    pub pick: Signal<Out, Bits<5>>,
+
+    /// Threads that may issue (written back, not asleep); threads asleep on a coprocessor
+    /// wait; threads a coprocessor finished work for since their issue; the thread issued
+    /// last (the search for the next starts below it).
+    ready: DFF<Bits<32>>,
+    asleep: DFF<Bits<32>>,
+    woken: DFF<Bits<32>>,
+    last_pick: DFF<Bits<5>>,
+    /// Clocks in which no thread may issue: a long instruction writes back in the clock where
+    /// that issue's instruction would (bit 0 is this clock).
+    reserved: DFF<Bits<32>>,
+
+    below: Signal<Local, Bits<32>>,
+    choice: Signal<Local, Bits<5>>,
+    issues: Signal<Local, Bit>,
+    issue_mask: Signal<Local, Bits<32>>,
+    wb_mask: Signal<Local, Bits<32>>,
+    tester_event: Signal<Local, Bits<32>>,
+    walk_event: Signal<Local, Bits<32>>,
+    event_mask: Signal<Local, Bits<32>>,
+    wb_sleep: Signal<Local, Bit>,
+    wake_mask: Signal<Local, Bits<32>>,
+    sleep_mask: Signal<Local, Bits<32>>,
+
+    /// Bit `t` set for every thread `t` of the design; one; all ones; each thread's number.
+    c_thread_mask: Constant<Bits<32>>,
+    c_one: Constant<Bits<32>>,
+    c_ones: Constant<Bits<32>>,
+    c_thread_ids: [Constant<Bits<5>>; MAX_THREADS],
+    /// The bit of `reserved` a long instruction at I3 sets: the issue `reserve_ahead` clocks
+    /// after this one would write back with it.
+    c_reserve_bit: Constant<Bits<32>>,
+}
+
+impl Scheduler {
+    /// A scheduler of `threads` threads; a long instruction at I3 reserves the issue
+    /// `reserve_ahead` clocks later.
+    pub fn new(threads: u32, reserve_ahead: u32) -> Self {
+        assert!((1..=MAX_THREADS as u32).contains(&threads) && reserve_ahead < 32);
+        Self {
+            clock: Default::default(),
+            running: Default::default(),
+            frame_start: Default::default(),
+            long_at_i3: Default::default(),
+            wb_valid: Default::default(),
+            wb_thread: Default::default(),
+            wb_halt: Default::default(),
+            wb_wait_pending: Default::default(),
+            tester_done: Default::default(),
+            tester_done_thread: Default::default(),
+            walk_done: Default::default(),
+            walk_done_thread: Default::default(),
+            issue: Default::default(),
+            pick: Default::default(),
+            ready: Default::default(),
+            asleep: Default::default(),
+            woken: Default::default(),
+            last_pick: Default::default(),
+            reserved: Default::default(),
+            below: Default::default(),
+            choice: Default::default(),
+            issues: Default::default(),
+            issue_mask: Default::default(),
+            wb_mask: Default::default(),
+            tester_event: Default::default(),
+            walk_event: Default::default(),
+            event_mask: Default::default(),
+            wb_sleep: Default::default(),
+            wake_mask: Default::default(),
+            sleep_mask: Default::default(),
+            c_thread_mask: Constant::new(((1u64 << threads) - 1).into()),
+            c_one: Constant::new(1u64.into()),
+            c_ones: Constant::new(0xffff_ffffu64.into()),
+            c_thread_ids: std::array::from_fn(|k| Constant::new((k as u64).into())),
+            c_reserve_bit: Constant::new(u64::from(reserve_ahead).into()),
+        }
+    }
+}
+
+impl Logic for Scheduler {
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(self, clock, ready, asleep, woken, last_pick, reserved);
+
+        // The pick: the highest ready thread below the last pick, else the highest. It is
+        // settled in a local and given to the output once (the output leaves the block).
+        self.below.next = self.ready.q.val() & (!(self.c_ones.val() << self.last_pick.q.val()));
+        self.choice.next = 0.into();
+        for k in 0..32 {
+            if self.ready.q.val().get_bit(k) {
+                self.choice.next = self.c_thread_ids[k].val();
+            }
+        }
+        for k in 0..32 {
+            if self.below.val().get_bit(k) {
+                self.choice.next = self.c_thread_ids[k].val();
+            }
+        }
+        self.issues.next =
+            self.running.val() & (self.ready.q.val() != 0) & (!self.reserved.q.val().get_bit(0));
+        self.pick.next = self.choice.val();
+        self.issue.next = self.issues.val();
+        self.issue_mask.next = 0.into();
+        if self.issues.val() {
+            self.issue_mask.next = self.c_one.val() << self.choice.val();
+            self.last_pick.d.next = self.choice.val();
+        }
+        self.reserved.d.next = (self.reserved.q.val() >> 1)
+            | (bit_cast::<32, 1>(self.long_at_i3.val().into()) << self.c_reserve_bit.val());
+
+        // Write back: the thread is ready again unless it halted or sleeps on a wait that no
+        // finish has answered since its issue.
+        self.wb_mask.next = self.c_one.val() << self.wb_thread.val();
+        self.tester_event.next = 0.into();
+        if self.tester_done.val() {
+            self.tester_event.next = self.c_one.val() << self.tester_done_thread.val();
+        }
+        self.walk_event.next = 0.into();
+        if self.walk_done.val() {
+            self.walk_event.next = self.c_one.val() << self.walk_done_thread.val();
+        }
+        self.event_mask.next = self.tester_event.val() | self.walk_event.val();
+        self.wb_sleep.next = self.wb_valid.val()
+            & self.wb_wait_pending.val()
+            & (((self.woken.q.val() | self.event_mask.val()) & self.wb_mask.val()) == 0);
+        self.wake_mask.next = 0.into();
+        self.sleep_mask.next = 0.into();
+        if self.wb_valid.val() & (!self.wb_halt.val()) {
+            if self.wb_sleep.val() {
+                self.sleep_mask.next = self.wb_mask.val();
+            } else {
+                self.wake_mask.next = self.wb_mask.val();
+            }
+        }
+        self.ready.d.next = (self.ready.q.val() & (!self.issue_mask.val()))
+            | self.wake_mask.val()
+            | (self.asleep.q.val() & self.event_mask.val());
+        self.asleep.d.next =
+            (self.asleep.q.val() & (!self.event_mask.val())) | self.sleep_mask.val();
+        self.woken.d.next = (self.woken.q.val() & (!self.issue_mask.val())) | self.event_mask.val();
+
+        if self.frame_start.val() {
+            self.ready.d.next = self.c_thread_mask.val();
+            self.asleep.d.next = 0.into();
+            self.woken.d.next = 0.into();
+            self.reserved.d.next = 0.into();
+        }
+    }
+}

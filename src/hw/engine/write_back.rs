@@ -1,0 +1,233 @@
+//! `WriteBack`: the engine's last stage. It chooses an instruction's result and its thread's
+//! next pc, and says what the scheduler and the counters need to know.
+//!
+//! Contract: for the instruction leaving the [`super::ResultLine`] (`valid`, `op`, ...) and
+//! the floating-point units' results of the same clock: `data` is the result its opcode names
+//! (`sum` for `fadd`/`fsub`, `product`, `quotient`, `root`, the fast result, or for `byte`
+//! the fast result with the unit's byte in its low bits); `write` is set for the ops that
+//! write (`Op::writes`) a destination other than r0, and not for a `pixel` once the pixels are
+//! exhausted. The condition is the compare flag, integer compare, mailbox hit, pixels
+//! exhausted, "always" (`jal`) or the coprocessor's refusal (`tri`, `kd`) the opcode names;
+//! the next pc is the target when the condition differs from `invert`, else `pc + 1`; `jr`
+//! jumps to its operand; `halt` and a refused or pending coprocessor instruction keep the pc
+//! (the thread repeats it on its next turn). `retired` counts every instruction but those
+//! repeats (the twin never repeats); `wait_pending` tells the scheduler that a wait is not
+//! answered yet.
+//!
+//! Latency: combinational (the write back clock). Throughput: one instruction per clock.
+//!
+//! Golden twin: `hw::program::exec` (the engine's twin): the same result, condition and next
+//! pc per opcode.
+
+use rust_hdl::prelude::*;
+
+use super::op_code;
+use crate::hw::program::isa::{Op, OPS, OP_BITS, PC_BITS, REG_BITS};
+
+#[derive(LogicBlock)]
+pub struct WriteBack<const W: usize> {
+    /// The instruction leaving the result line.
+    pub valid: Signal<In, Bit>,
+    pub op: Signal<In, Bits<OP_BITS>>,
+    pub dst: Signal<In, Bits<REG_BITS>>,
+    pub invert: Signal<In, Bit>,
+    pub pc_plus_one: Signal<In, Bits<PC_BITS>>,
+    pub target: Signal<In, Bits<PC_BITS>>,
+    pub is_wait: Signal<In, Bit>,
+    pub kd_busy: Signal<In, Bit>,
+    pub tri_busy: Signal<In, Bit>,
+    pub jr_target: Signal<In, Bits<PC_BITS>>,
+    pub int_eq: Signal<In, Bit>,
+    pub int_lt: Signal<In, Bit>,
+    pub mb_hit: Signal<In, Bit>,
+    pub pix_done: Signal<In, Bit>,
+    pub fast: Signal<In, Bits<32>>,
+    /// The floating-point units' results of this clock.
+    pub sum: Signal<In, Bits<W>>,
+    pub product: Signal<In, Bits<W>>,
+    pub quotient: Signal<In, Bits<W>>,
+    pub root: Signal<In, Bits<W>>,
+    pub lt: Signal<In, Bit>,
+    pub le: Signal<In, Bit>,
+    pub eq: Signal<In, Bit>,
+    pub colour_byte: Signal<In, Bits<8>>,
+
+    pub write: Signal<Out, Bit>,
+    pub data: Signal<Out, Bits<32>>,
+    pub next_pc: Signal<Out, Bits<PC_BITS>>,
+    pub halt: Signal<Out, Bit>,
+    pub retired: Signal<Out, Bit>,
+    pub wait_pending: Signal<Out, Bit>,
+
+    cond: Signal<Local, Bit>,
+    repeats: Signal<Local, Bit>,
+    pc: Signal<Local, Bits<PC_BITS>>,
+    result: Signal<Local, Bits<32>>,
+
+    op_fadd: Constant<Bits<5>>,
+    op_fsub: Constant<Bits<5>>,
+    op_fmul: Constant<Bits<5>>,
+    op_fdiv: Constant<Bits<5>>,
+    op_fsqrt: Constant<Bits<5>>,
+    op_bflt: Constant<Bits<5>>,
+    op_bfle: Constant<Bits<5>>,
+    op_bfeq: Constant<Bits<5>>,
+    op_beq: Constant<Bits<5>>,
+    op_bltu: Constant<Bits<5>>,
+    op_jal: Constant<Bits<5>>,
+    op_jr: Constant<Bits<5>>,
+    op_mbx: Constant<Bits<5>>,
+    op_pixel: Constant<Bits<5>>,
+    op_halt: Constant<Bits<5>>,
+    op_tri: Constant<Bits<5>>,
+    op_kd: Constant<Bits<5>>,
+    op_byte: Constant<Bits<5>>,
+    /// Bit `op` set for every op that writes `dst` (`Op::writes`).
+    op_writes: Constant<Bits<32>>,
+}
+
+impl<const W: usize> Default for WriteBack<W> {
+    fn default() -> Self {
+        Self {
+            valid: Default::default(),
+            op: Default::default(),
+            dst: Default::default(),
+            invert: Default::default(),
+            pc_plus_one: Default::default(),
+            target: Default::default(),
+            is_wait: Default::default(),
+            kd_busy: Default::default(),
+            tri_busy: Default::default(),
+            jr_target: Default::default(),
+            int_eq: Default::default(),
+            int_lt: Default::default(),
+            mb_hit: Default::default(),
+            pix_done: Default::default(),
+            fast: Default::default(),
+            sum: Default::default(),
+            product: Default::default(),
+            quotient: Default::default(),
+            root: Default::default(),
+            lt: Default::default(),
+            le: Default::default(),
+            eq: Default::default(),
+            colour_byte: Default::default(),
+            write: Default::default(),
+            data: Default::default(),
+            next_pc: Default::default(),
+            halt: Default::default(),
+            retired: Default::default(),
+            wait_pending: Default::default(),
+            cond: Default::default(),
+            repeats: Default::default(),
+            pc: Default::default(),
+            result: Default::default(),
+            op_fadd: op_code(Op::FAdd),
+            op_fsub: op_code(Op::FSub),
+            op_fmul: op_code(Op::FMul),
+            op_fdiv: op_code(Op::FDiv),
+            op_fsqrt: op_code(Op::FSqrt),
+            op_bflt: op_code(Op::BFlt),
+            op_bfle: op_code(Op::BFle),
+            op_bfeq: op_code(Op::BFeq),
+            op_beq: op_code(Op::Beq),
+            op_bltu: op_code(Op::Bltu),
+            op_jal: op_code(Op::Jal),
+            op_jr: op_code(Op::Jr),
+            op_mbx: op_code(Op::Mbx),
+            op_pixel: op_code(Op::Pixel),
+            op_halt: op_code(Op::Halt),
+            op_tri: op_code(Op::Tri),
+            op_kd: op_code(Op::Kd),
+            op_byte: op_code(Op::Byte),
+            op_writes: Constant::new(
+                OPS.iter()
+                    .filter(|o| o.writes())
+                    .fold(0u64, |m, &o| m | 1 << (o as u64))
+                    .into(),
+            ),
+        }
+    }
+}
+
+impl<const W: usize> Logic for WriteBack<W> {
+    #[hdl_gen]
+    fn update(&mut self) {
+        self.cond.next = false;
+        if self.op.val() == self.op_bflt.val() {
+            self.cond.next = self.lt.val();
+        }
+        if self.op.val() == self.op_bfle.val() {
+            self.cond.next = self.le.val();
+        }
+        if self.op.val() == self.op_bfeq.val() {
+            self.cond.next = self.eq.val();
+        }
+        if self.op.val() == self.op_beq.val() {
+            self.cond.next = self.int_eq.val();
+        }
+        if self.op.val() == self.op_bltu.val() {
+            self.cond.next = self.int_lt.val();
+        }
+        if self.op.val() == self.op_mbx.val() {
+            self.cond.next = self.mb_hit.val();
+        }
+        if self.op.val() == self.op_pixel.val() {
+            self.cond.next = self.pix_done.val();
+        }
+        if self.op.val() == self.op_jal.val() {
+            self.cond.next = true;
+        }
+        if self.op.val() == self.op_tri.val() {
+            self.cond.next = self.tri_busy.val();
+        }
+        if self.op.val() == self.op_kd.val() {
+            self.cond.next = self.kd_busy.val();
+        }
+        // A coprocessor refused the entry (queue full) or has not finished (a wait).
+        self.repeats.next = ((self.op.val() == self.op_tri.val())
+            | (self.op.val() == self.op_kd.val()))
+            & self.cond.val();
+
+        if self.cond.val() != self.invert.val() {
+            self.pc.next = self.target.val();
+        } else {
+            self.pc.next = self.pc_plus_one.val();
+        }
+        if self.op.val() == self.op_jr.val() {
+            self.pc.next = self.jr_target.val();
+        }
+        if (self.op.val() == self.op_halt.val()) | self.repeats.val() {
+            // A halted thread keeps its pc; a repeat comes back to it on the next turn.
+            self.pc.next = self.pc_plus_one.val() - 1;
+        }
+
+        self.result.next = self.fast.val();
+        if (self.op.val() == self.op_fadd.val()) | (self.op.val() == self.op_fsub.val()) {
+            self.result.next = bit_cast::<32, W>(self.sum.val());
+        }
+        if self.op.val() == self.op_fmul.val() {
+            self.result.next = bit_cast::<32, W>(self.product.val());
+        }
+        if self.op.val() == self.op_fdiv.val() {
+            self.result.next = bit_cast::<32, W>(self.quotient.val());
+        }
+        if self.op.val() == self.op_fsqrt.val() {
+            self.result.next = bit_cast::<32, W>(self.root.val());
+        }
+        if self.op.val() == self.op_byte.val() {
+            self.result.next = self.fast.val() | bit_cast::<32, 8>(self.colour_byte.val());
+        }
+
+        self.next_pc.next = self.pc.val();
+        self.data.next = self.result.val();
+        self.halt.next = self.op.val() == self.op_halt.val();
+        // `pixel` writes nothing once the frame's pixels are exhausted.
+        self.write.next = self.valid.val()
+            & (self.dst.val() != 0)
+            & self.op_writes.val().get_bit(self.op.val().index())
+            & (!((self.op.val() == self.op_pixel.val()) & self.pix_done.val()));
+        self.retired.next = self.valid.val() & (!self.repeats.val());
+        self.wait_pending.next = self.cond.val() & self.is_wait.val();
+    }
+}
