@@ -46,7 +46,7 @@ use super::fp::mul::MUL_LATENCY;
 use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv, FpMul};
 use super::{Delay, TAG_BITS};
 use crate::fp::Format;
-use crate::model::units;
+use crate::units;
 
 /// Clocks from t to the output.
 const AFTER_DIV: u32 = MUL_LATENCY + 2 * ADD_SUB_LATENCY + COMPARE_LATENCY;

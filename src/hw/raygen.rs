@@ -267,7 +267,7 @@ mod tests {
     use super::*;
     use crate::fp::Format;
     use crate::hw::sim_harness::{clock_cycle, random_word};
-    use crate::model::units;
+    use crate::units;
     use rand::SeedableRng;
 
     /// rust-hdl simulation: a 5x3 frame with a random camera, threads offered every clock but

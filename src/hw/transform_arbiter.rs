@@ -204,7 +204,7 @@ mod tests {
     use crate::fp::Format;
     use crate::hw::sim_harness::{clock_cycle, random_word};
     use crate::hw::TRANSFORM_LATENCY;
-    use crate::model::units;
+    use crate::units;
     use rand::{Rng, SeedableRng};
 
     /// rust-hdl simulation: every client requests all the time, some with pauses; each request

@@ -16,12 +16,11 @@ use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::geometry_unit::{geometry_unit_rtl, GeometryUnit};
-use super::geometry_unit_run::*;
-use crate::fp::{vectors, Format};
+use super::*;
+use crate::fp::vectors;
 use crate::layout::unit_triangle_transform;
-use crate::model::units;
-use crate::sim::{self, Simulator};
+use crate::sim;
+use crate::units;
 
 /// A random word: a third uniform bit patterns, a third edge cases, a third "geometric" values
 /// (magnitudes 2^-8..2^8, either sign).
