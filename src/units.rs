@@ -521,9 +521,12 @@ pub fn pack_rgb(f: Format, c: Vec3W) -> u32 {
 }
 
 #[cfg(test)]
-mod planar_camera_tests {
+mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    // Planar camera directions.
 
     /// Random cameras with the layout's shape (m2 = +0) and others (m2 of either sign, zero,
     /// infinite), rows whose `n` is +-0 or a negative subnormal, on every pixel of a 17x9 frame
@@ -532,7 +535,7 @@ mod planar_camera_tests {
     fn planar_directions_equal_the_full_transform_exactly_when_the_z_column_vanishes() {
         let seed = 71;
         println!("seed {seed}");
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
         for f in [Format::E7M16, Format::E8M23] {
             let neg_sub = f.zero(true) | 1;
             let (mut agreed, mut differed) = (0, 0);
@@ -571,11 +574,8 @@ mod planar_camera_tests {
             );
         }
     }
-}
 
-#[cfg(test)]
-mod byte_tests {
-    use super::*;
+    // Channel bytes.
 
     #[test]
     fn channel_byte_equals_to_u8_on_every_word() {
@@ -588,7 +588,7 @@ mod byte_tests {
         let f = Format::E8M23;
         let seed = 41;
         println!("seed {seed}");
-        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(seed);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let edges = [
             0,
             f.one(),
@@ -599,8 +599,8 @@ mod byte_tests {
         ];
         // Half the sample in [0, 1], where every byte is made.
         let sample = (0..1_000_000).map(|k| match k % 2 {
-            0 => rand::Rng::gen_range(&mut rng, 0..=f.one()),
-            _ => rand::Rng::gen::<u32>(&mut rng),
+            0 => rng.gen_range(0..=f.one()),
+            _ => rng.gen::<u32>(),
         });
         for w in edges
             .into_iter()
@@ -610,13 +610,8 @@ mod byte_tests {
             assert_eq!(channel_byte(f, w), u32::from(f.to_u8(w)), "{f} word {w:#x}");
         }
     }
-}
 
-#[cfg(test)]
-mod margin_tests {
-    use super::*;
-    use rand::{Rng, SeedableRng};
-    use rand_chacha::ChaCha8Rng;
+    // Edge margins.
 
     #[test]
     fn margin_zero_is_the_exact_test_and_a_margin_only_adds_hits_near_edges() {
