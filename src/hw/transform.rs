@@ -1,5 +1,5 @@
 //! `TransformUnit`: the 3x4 matrix times a point or a vector, fully pipelined, bit-exact with
-//! `model::units::transform`.
+//! its golden twin [`units::transform`](crate::units::transform) (src/units.rs).
 //!
 //! Per row `r`: `((m[r][0]*x + m[r][1]*y) + m[r][2]*z) + n[r]`, the golden model's exact order
 //! and rounding. A vector (`point` = 0) omits the offset: the last adder then adds `-0`
@@ -18,7 +18,7 @@
 //! leaves with the result; `out_valid` is `in_valid` 25 clocks later.
 //!
 //! Matrix words are row-major `m00 m01 m02 n0 m10 m11 m12 n1 m20 m21 m22 n2`
-//! (`model::units::Mat34W`, the layout's matrix order).
+//! ([`units::Mat34W`](crate::units::Mat34W), the layout's matrix order).
 
 use rust_hdl::prelude::*;
 
