@@ -1,5 +1,5 @@
 //! Bit-exactness of the generated geometry units against the golden model's unit sequences
-//! (`model::units`), in Icarus and Verilator, plus lint and synthesis. One simulator build per
+//! (`crate::units`), in Icarus and Verilator, plus lint. One simulator build per
 //! unit, format and simulator; every vector streams through it.
 //!
 //! Vectors: seeded random words and geometric cases, plus the hard ones: unit-triangle
@@ -743,7 +743,7 @@ fn raygen_e8m23_both() {
 }
 
 // ---------------------------------------------------------------------------------------
-// Lint and synthesis
+// Lint
 
 /// `verilator --lint-only -Wall` is clean on every unit in e7m16 and e8m23 (with the waiver
 /// block documented in `CORE_WAIVER` around the generated core, none on the tops).
