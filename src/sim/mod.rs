@@ -36,7 +36,6 @@ pub use geometry_unit::{
     IntersectResult, RayGenFrame, RayGenOutput, TransformRequest, TransformResult,
 };
 pub use lint::{lint, lint_with_timeout, LintReport, LintWarning};
-
 pub use stream_bench::{run_stream_bench, StreamBenchRun};
 pub use vga_timing::{run_vga_timing, VgaSample};
 
