@@ -7,12 +7,12 @@
 //! Markdown report.
 
 use crate::compare::{compare_hits, compare_images, diff_image};
-use crate::emit::{fp_unit_rtl, run_fp_unit};
+use crate::emit::fp_unit_rtl;
 use crate::fp::{vectors, BinOp, Format};
 use crate::layout::{self, MemoryConfig, SceneTrees};
 use crate::model::{render_golden, Reference};
 use crate::scene::Scene;
-use crate::sim::{self, Simulator};
+use crate::sim::{self, run_fp_unit, Simulator};
 use anyhow::Context;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

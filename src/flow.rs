@@ -8,7 +8,6 @@ use anyhow::{Context, Result};
 
 use crate::emit::constraints::{write_ucf, Port, PortDirection, UcfOptions};
 use crate::emit::processor::{display_mode, ProcessorParams, PROCESSOR_TOP};
-use crate::emit::processor_run::{simulate_processor, write_processor_files, ProcessorSim, SimRun};
 use crate::fp::Format;
 use crate::hw::engine::engine_period;
 use crate::hw::processor::TopPort;
@@ -22,6 +21,7 @@ use crate::hw::vga::VgaMode;
 use crate::layout::{self, Layout, MemoryConfig, SceneTrees};
 use crate::model::{self, golden::Golden};
 use crate::scene::Scene;
+use crate::sim::processor::{simulate_processor, write_processor_files, ProcessorSim, SimRun};
 use crate::sim::Simulator;
 use crate::synth::{self, SynthOptions, SynthReport};
 

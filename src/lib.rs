@@ -3,9 +3,15 @@
 //! memory images and constraints, plus a bit-exact software golden model.
 //!
 //! Data flows one way (see docs/ARCHITECTURE.md, "Data flow"):
-//! `scene -> accel -> layout -> model / hw -> emit -> sim -> compare`.
-//! `fp` (the number format) is shared by every stage; nothing here imports the CLI, and `hw`
-//! never imports `model` (they meet in tests).
+//! `scene -> accel -> layout -> model / hw -> emit -> sim -> compare`, with `synth` beside
+//! `sim`. Outside its tests a stage imports only the stages before it: `emit` writes text and
+//! runs nothing, `sim` runs the simulators on that text and `synth` runs yosys and nextpnr on
+//! it (both through `sim::process`). `fp` (the number format), `units` (the arithmetic
+//! sequences the hardware and the golden model share), `input` and `output` serve every stage.
+//! `hw` and `model` never import each other: both take their arithmetic from `units`, and
+//! they meet in the tests. `flow`, `demo`, `bench` and `stress` drive whole runs and may use
+//! any stage; nothing here imports the CLI. Tests may reach later stages to check a stage's
+//! output (an `emit` test loads its memory images in a simulator).
 
 pub mod accel;
 pub mod bench;

@@ -9,6 +9,10 @@
 //! The decisions (comparisons) around the arithmetic are small and live beside it: the golden
 //! model evaluates them with `Format::lt`/`le`/`eq`, the microprogram as branches; the
 //! processor's tests compare the two renderers pixel by pixel.
+//!
+//! Several functions here are also the golden twin of a block in `src/hw/` that computes them
+//! in dedicated hardware; each names its block, and the block's file names the function back
+//! (the whole list: docs/ARCHITECTURE.md, "Golden twins").
 
 use crate::fp::Format;
 use crate::layout::Node;
@@ -18,7 +22,8 @@ use crate::layout::Node;
 pub const MAILBOX_ENTRIES: usize = 8;
 
 /// A ray's mailbox: the ids it tested most recently, first in first out, as the hardware keeps
-/// them (the golden model and the engine's twin share it).
+/// them (the golden model and the engine's twin share it). Golden twin of the mailbox check in
+/// [`hw::ListUnit`](crate::hw::ListUnit) (src/hw/list_unit.rs).
 #[derive(Clone, Debug, Default)]
 pub struct Mailbox {
     ids: [u32; MAILBOX_ENTRIES],
@@ -98,7 +103,10 @@ impl Arith for Format {
 }
 
 /// TransformUnit: `x' = ((m00*x + m01*y) + m02*z) + n0` per row for a point; a vector omits
-/// the `+ n` step. 9 multiplications and 9 additions for a point (6 for a vector).
+/// the `+ n` step. 9 multiplications and 9 additions for a point (6 for a vector). Golden twin
+/// of [`hw::TransformUnit`](crate::hw::TransformUnit) (src/hw/transform.rs) and, per client,
+/// of [`hw::SharedTransformUnit`](crate::hw::SharedTransformUnit)
+/// (src/hw/transform_arbiter.rs).
 pub fn transform<A: Arith>(a: A, m: &[A::V; 12], v: [A::V; 3], point: bool) -> [A::V; 3] {
     let row = |r: usize| transform_row(a, &m[r * 4..r * 4 + 4], v, point);
     [row(0), row(1), row(2)]
@@ -129,7 +137,9 @@ pub fn transform3<A: Arith>(a: A, m: &[A::V; 9], v: [A::V; 3]) -> [A::V; 3] {
 }
 
 /// RayGen: the primary ray direction of pixel (x, y) is the camera matrix applied to the point
-/// (x, y, 0) (the layout bakes the pixel-centre offsets into the matrix's offset column).
+/// (x, y, 0) (the layout bakes the pixel-centre offsets into the matrix's offset column). The
+/// hardware is [`hw::RayGen`](crate::hw::RayGen) (src/hw/raygen.rs); its twin in words is
+/// [`primary_direction`].
 pub fn primary_direction_of<A: Arith>(a: A, camera: &[A::V; 12], x: A::V, y: A::V) -> [A::V; 3] {
     let zero = a.word(0);
     transform(a, camera, [a.from_uint(x), a.from_uint(y), zero], true)
@@ -164,7 +174,10 @@ pub fn primary_direction_planar<A: Arith>(
     })
 }
 
-/// [`primary_direction_of`] for pixel (x, y) in format words.
+/// [`primary_direction_of`] for pixel (x, y) in format words: the golden twin of
+/// [`hw::RayGen`](crate::hw::RayGen) and [`hw::RayGenUnit`](crate::hw::RayGenUnit)
+/// (src/hw/raygen.rs), whose coordinates go through
+/// [`hw::UIntToFloat`](crate::hw::UIntToFloat) as `from_uint` here.
 pub fn primary_direction(f: Format, camera: &Mat34W, x: u32, y: u32) -> Vec3W {
     primary_direction_of(f, camera, x, y)
 }
@@ -184,20 +197,25 @@ pub struct UnitHit {
 /// closes and what it adds at silhouettes).
 pub const EDGE_MARGIN_ULPS: u32 = 64;
 
-/// The margin of [`EDGE_MARGIN_ULPS`] as a format word.
+/// The margin of [`EDGE_MARGIN_ULPS`] as a format word ([`hw::IntersectUnit`]'s margin).
+///
+/// [`hw::IntersectUnit`]: crate::hw::IntersectUnit
 pub fn edge_margin(f: Format) -> u32 {
     f.from_f64(f64::from(EDGE_MARGIN_ULPS) * 2f64.powi(-(f.man_bits as i32)))
 }
 
 /// The bounds of the unit-triangle test with edge margin `margin`: `u, v >= lo` and
 /// `u + v <= hi`, with `lo = -margin` and `hi = 1 + margin` (each rounded once). Constants, so
-/// in hardware the margin costs no operator.
+/// in hardware the margin costs no operator: [`hw::IntersectUnit`](crate::hw::IntersectUnit)
+/// (src/hw/intersect.rs) compares with these two words.
 pub fn edge_bounds(f: Format, margin: u32) -> (u32, u32) {
     (f.neg(margin), f.add(f.one(), margin))
 }
 
 /// IntersectUnit's arithmetic, given the ray already in unit-triangle space (O', D'):
-/// `t = -O'z / D'z`, `u = O'x + t*D'x`, `v = O'y + t*D'y` and `u + v`. 1 div, 2 mul, 3 add.
+/// `t = -O'z / D'z`, `u = O'x + t*D'x`, `v = O'y + t*D'y` and `u + v`. 1 div, 2 mul, 3 add,
+/// in the order of the pipeline of [`hw::IntersectUnit`](crate::hw::IntersectUnit)
+/// (src/hw/intersect.rs).
 pub fn unit_triangle_coords<A: Arith>(a: A, o: [A::V; 3], d: [A::V; 3]) -> [A::V; 4] {
     let t = unit_triangle_t(a, o[2], d[2]);
     let u = unit_triangle_coord(a, o[0], d[0], t);
@@ -205,12 +223,15 @@ pub fn unit_triangle_coords<A: Arith>(a: A, o: [A::V; 3], d: [A::V; 3]) -> [A::V
     [t, u, v, a.add(u, v)]
 }
 
-/// The first step of [`unit_triangle_coords`]: `t = -O'z / D'z`.
+/// The first step of [`unit_triangle_coords`]: `t = -O'z / D'z`. In hardware: the sign flip
+/// and the [`FpDiv`](crate::hw::fp::FpDiv) at the head of
+/// [`hw::IntersectUnit`](crate::hw::IntersectUnit) (src/hw/intersect.rs).
 pub fn unit_triangle_t<A: Arith>(a: A, o_z: A::V, d_z: A::V) -> A::V {
     a.div(a.neg(o_z), d_z)
 }
 
-/// `u = O'x + t*D'x` (or `v` from the y components), as [`unit_triangle_coords`] computes it.
+/// `u = O'x + t*D'x` (or `v` from the y components), as [`unit_triangle_coords`] computes it
+/// and [`hw::IntersectUnit`](crate::hw::IntersectUnit)'s products and adders after the divider.
 pub fn unit_triangle_coord<A: Arith>(a: A, o: A::V, d: A::V, t: A::V) -> A::V {
     a.add(o, a.mul(t, d))
 }
@@ -218,12 +239,14 @@ pub fn unit_triangle_coord<A: Arith>(a: A, o: A::V, d: A::V, t: A::V) -> A::V {
 /// IntersectUnit: a hit when `lo <= u`, `lo <= v`, `u + v <= hi` and `t_min < t < t_max`
 /// ([`unit_triangle_coords`], bounds from [`edge_bounds`] with the default [`edge_margin`]).
 /// NaN fails every comparison, so a ray parallel to the triangle (D'z = 0) or any NaN or
-/// infinity never hits.
+/// infinity never hits. Golden twin of [`hw::IntersectUnit`](crate::hw::IntersectUnit)
+/// (src/hw/intersect.rs).
 pub fn intersect(f: Format, o: Vec3W, d: Vec3W, t_min: u32, t_max: u32) -> UnitHit {
     intersect_with_margin(f, o, d, t_min, t_max, edge_margin(f))
 }
 
-/// The triangle tester's test (`hw::TriangleTester`): the ray into the triangle's unit space
+/// The triangle tester's test ([`hw::TriangleTester`](crate::hw::TriangleTester),
+/// src/hw/triangle_tester.rs, whose golden twin this is): the ray into the triangle's unit space
 /// through the transformation unit (a point, then a vector), then [`intersect`] with no upper
 /// bound. The tester keeps the closest hit with [`closer_hit`] against the best so far, which
 /// is the golden model's test with `t_max` = the best t: `t < best_t` and `t < +inf` hold
@@ -235,7 +258,8 @@ pub fn triangle_test(f: Format, m: &Mat34W, o: Vec3W, d: Vec3W, t_min: u32) -> U
 }
 
 /// Whether a [`triangle_test`] result replaces the best hit so far (the first of equal ts
-/// stays, as in the golden model's list order).
+/// stays, as in the golden model's list order): the golden twin of the hit merge in
+/// [`hw::TriangleTester`](crate::hw::TriangleTester) (src/hw/triangle_tester.rs).
 pub fn closer_hit(f: Format, r: &UnitHit, best_t: u32) -> bool {
     r.hit && f.lt(r.t, best_t)
 }
@@ -268,7 +292,9 @@ pub enum Visit {
     Both { t_split: u32 },
 }
 
-/// The traversal unit's arithmetic: the distance `(split - o) / d` to a split plane.
+/// The traversal unit's arithmetic: the distance `(split - o) / d` to a split plane (the
+/// `FpAddSub` and `FpDiv` of [`hw::TraversalUnit`](crate::hw::TraversalUnit)'s decision
+/// pipeline, src/hw/traversal_unit.rs).
 pub fn split_distance<A: Arith>(a: A, o: A::V, d: A::V, split: A::V) -> A::V {
     a.div(a.sub(split, o), d)
 }
@@ -276,7 +302,8 @@ pub fn split_distance<A: Arith>(a: A, o: A::V, d: A::V, split: A::V) -> A::V {
 /// One traversal step (traversal unit): `t_split` ([`split_distance`]) along the node's axis,
 /// and the near child is the one holding the origin (on the plane, the one the ray heads
 /// into). Returns whether the near child is the left (below) one, and which children to
-/// visit. 1 add (sub), 1 div, comparisons.
+/// visit. 1 add (sub), 1 div, comparisons: one inner node of
+/// [`hw::TraversalUnit`](crate::hw::TraversalUnit) (src/hw/traversal_unit.rs).
 pub fn traversal_step(
     f: Format,
     o: u32,
@@ -309,7 +336,9 @@ pub enum KdStop {
 
 /// The traversal unit's walk of one kd tree, resumable at each leaf: `model::golden`'s
 /// `traverse` with [`traversal_step`], which the golden model runs in one loop and the
-/// hardware runs between the thread's leaves. The engine's twin and the unit's tests share it.
+/// hardware runs between the thread's leaves. The engine's twin and the unit's tests share it:
+/// the golden twin of [`hw::TraversalUnit`](crate::hw::TraversalUnit)
+/// (src/hw/traversal_unit.rs).
 #[derive(Clone, Debug, Default)]
 pub struct KdWalk {
     node: u32,
@@ -487,7 +516,8 @@ pub fn mix_mirror<A: Arith>(a: A, local: [A::V; 3], reflected: [A::V; 3], m: A::
 /// Shader: a colour channel already clamped to [0, 1], scaled by 255 (one rounding) and
 /// rounded to an integer by adding `2^M`: the sum's spacing is 1, so the adder's round to
 /// nearest even does the integer rounding, and the word's low 8 bits are the channel byte
-/// (`Format::to_u8` after its clamp; `M >= 8`).
+/// (`Format::to_u8` after its clamp; `M >= 8`). In hardware: the `FpMul` and `FpAddSub` of
+/// [`hw::ChannelByte`](crate::hw::ChannelByte).
 pub fn channel_byte_word<A: Arith>(a: A, clamped: A::V) -> A::V {
     let f = a.format();
     let scaled = a.mul(clamped, a.word(f.from_int(255)));
@@ -497,7 +527,8 @@ pub fn channel_byte_word<A: Arith>(a: A, clamped: A::V) -> A::V {
 /// Shader: a colour channel clamped to [0, 1] (NaN, negatives, zeros and subnormals give
 /// +0, everything above 1 gives 1), on the bits alone: for positive non-NaN words the unsigned
 /// order of the encodings is the order of the values, so the hardware needs no comparator
-/// (`Format::to_u8`'s clamp, exhaustively tested).
+/// (`Format::to_u8`'s clamp, exhaustively tested). In hardware: the combinational clamp in
+/// front of [`hw::ChannelByte`](crate::hw::ChannelByte)'s multiplier.
 pub fn clamp_unit_word(f: Format, w: u32) -> u32 {
     if f.sign_of(w) || f.is_zero(w) || f.is_nan(w) {
         0
@@ -510,6 +541,7 @@ pub fn clamp_unit_word(f: Format, w: u32) -> u32 {
 
 /// Shader: the byte of a colour channel, `Format::to_u8` as the hardware computes it (the
 /// engine's `byte` instruction): [`clamp_unit_word`], then [`channel_byte_word`]'s low 8 bits.
+/// Golden twin of [`hw::ChannelByte`](crate::hw::ChannelByte) (src/hw/channel_byte.rs).
 pub fn channel_byte(f: Format, w: u32) -> u32 {
     channel_byte_word(f, clamp_unit_word(f, w)) & 0xff
 }
@@ -521,9 +553,12 @@ pub fn pack_rgb(f: Format, c: Vec3W) -> u32 {
 }
 
 #[cfg(test)]
-mod planar_camera_tests {
+mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    // Planar camera directions.
 
     /// Random cameras with the layout's shape (m2 = +0) and others (m2 of either sign, zero,
     /// infinite), rows whose `n` is +-0 or a negative subnormal, on every pixel of a 17x9 frame
@@ -532,7 +567,7 @@ mod planar_camera_tests {
     fn planar_directions_equal_the_full_transform_exactly_when_the_z_column_vanishes() {
         let seed = 71;
         println!("seed {seed}");
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
         for f in [Format::E7M16, Format::E8M23] {
             let neg_sub = f.zero(true) | 1;
             let (mut agreed, mut differed) = (0, 0);
@@ -571,11 +606,8 @@ mod planar_camera_tests {
             );
         }
     }
-}
 
-#[cfg(test)]
-mod byte_tests {
-    use super::*;
+    // Channel bytes.
 
     #[test]
     fn channel_byte_equals_to_u8_on_every_word() {
@@ -588,7 +620,7 @@ mod byte_tests {
         let f = Format::E8M23;
         let seed = 41;
         println!("seed {seed}");
-        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(seed);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let edges = [
             0,
             f.one(),
@@ -599,8 +631,8 @@ mod byte_tests {
         ];
         // Half the sample in [0, 1], where every byte is made.
         let sample = (0..1_000_000).map(|k| match k % 2 {
-            0 => rand::Rng::gen_range(&mut rng, 0..=f.one()),
-            _ => rand::Rng::gen::<u32>(&mut rng),
+            0 => rng.gen_range(0..=f.one()),
+            _ => rng.gen::<u32>(),
         });
         for w in edges
             .into_iter()
@@ -610,13 +642,8 @@ mod byte_tests {
             assert_eq!(channel_byte(f, w), u32::from(f.to_u8(w)), "{f} word {w:#x}");
         }
     }
-}
 
-#[cfg(test)]
-mod margin_tests {
-    use super::*;
-    use rand::{Rng, SeedableRng};
-    use rand_chacha::ChaCha8Rng;
+    // Edge margins.
 
     #[test]
     fn margin_zero_is_the_exact_test_and_a_margin_only_adds_hits_near_edges() {

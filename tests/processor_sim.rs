@@ -89,8 +89,8 @@ frames_equal_the_golden_model! {
 
 #[test]
 fn a_frame_that_cannot_finish_in_time_is_a_clear_timeout_error() {
-    use dynrt::emit::processor_run::{simulate_processor, SimRun};
     use dynrt::hw::program::{build_program, ProgramConfig};
+    use dynrt::sim::processor::{simulate_processor, SimRun};
     let s = scene("cornell_noshadow.toml", 4, 3);
     let layouts = flow::scene_layouts(&s, Format::E7M16, None).unwrap();
     let p = build_program(&ProgramConfig::from_layout(&layouts[0]));
@@ -118,12 +118,12 @@ fn a_frame_that_cannot_finish_in_time_is_a_clear_timeout_error() {
 /// The display (VgaDisplay in the processor's top) sends the rendered frame to the monitor:
 /// 640x480 at 60 Hz, each of the 20x12 pixels magnified to 32x32 and centred, black around
 /// it, colour aligned with the raster to the pixel. Verilator only: a VGA frame is 420,000
-/// pixel clocks (the timing generator alone is checked in Icarus too, in `emit::vga_timing`).
+/// pixel clocks (the timing generator alone is checked in Icarus too, in `sim::vga_timing`).
 #[test]
 fn the_display_shows_the_rendered_frame_magnified_and_centred() {
-    use dynrt::emit::processor_run::{simulate_processor, SimRun};
     use dynrt::hw::program::{build_program, ProgramConfig};
     use dynrt::hw::VgaMode;
+    use dynrt::sim::processor::{simulate_processor, SimRun};
     let (w, h) = (20, 12);
     let s = scene("cornell_noshadow.toml", w, h);
     let layouts = flow::scene_layouts(&s, Format::E7M16, None).unwrap();

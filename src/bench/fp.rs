@@ -4,9 +4,9 @@
 //! this measures the simulator's speed on the unit, file I/O included).
 
 use super::table::Table;
-use crate::emit::{fp_unit_rtl, run_fp_unit};
+use crate::emit::fp_unit_rtl;
 use crate::fp::{vectors, BinOp, Format};
-use crate::sim::Simulator;
+use crate::sim::{run_fp_unit, Simulator};
 use crate::synth::{synth_xc2v, SynthReport};
 use anyhow::{bail, Context};
 use indicatif::{ProgressBar, ProgressStyle};

@@ -3,10 +3,9 @@
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use dynrt::emit::run_fp_unit;
 use dynrt::fp::{BinOp, Format};
 use dynrt::sim::vectors::{read_vector_file, write_results_atomically};
-use dynrt::sim::{self, Simulator};
+use dynrt::sim::{self, run_fp_unit, Simulator};
 use std::path::PathBuf;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

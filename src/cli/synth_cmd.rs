@@ -1,9 +1,9 @@
 //! `dynrt synth --unit U`: yosys `synth_xilinx -family xc2v` of one geometry unit.
 
 use clap::Args;
-use dynrt::emit::geometry_unit::{synth_unit, GeometryUnit};
+use dynrt::emit::GeometryUnit;
 use dynrt::fp::Format;
-use dynrt::synth::XC2V6000;
+use dynrt::synth::{synth_unit, XC2V6000};
 
 #[derive(Args)]
 pub struct SynthArgs {

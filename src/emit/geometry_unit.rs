@@ -16,13 +16,13 @@
 //!   issued_thread, out_valid, out_thread, dir_x, _y, _z, origin_x, _y, _z`.
 //!
 //! The file passes `verilator --lint-only -Wall` with the documented waiver block around the
-//! generated core (see [`CORE_WAIVER`]). [`synth_unit`] runs `yosys synth_xilinx -family xc2v`
-//! on it (out of context: no I/O pads), the library side of `dynrt synth --unit`.
+//! generated core (see [`CORE_WAIVER`]). `crate::synth::geometry_unit::synth_unit` runs
+//! `yosys synth_xilinx -family xc2v` on it (out of context: no I/O pads), the library side of
+//! `dynrt synth --unit`.
 
 use std::fmt::Write as _;
-use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use rust_hdl::prelude::*;
 
 use super::stream_bench::BenchPort;
@@ -34,7 +34,6 @@ use crate::hw::{
     intersect_latency, IntersectUnit, RayGenUnit, SharedTransformUnit, TransformUnit, TAG_BITS,
     TRANSFORM_LATENCY,
 };
-use crate::synth::{self, SynthOptions, SynthReport};
 
 /// The geometry units that can be emitted and synthesized on their own.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -376,25 +375,4 @@ pub fn geometry_unit_rtl(unit: GeometryUnit, fmt: Format) -> Result<GeometryUnit
         latency,
         ports: ports.into_iter().map(|p| p.port).collect(),
     })
-}
-
-/// Synthesizes `unit` in `fmt` for Virtex-II (`yosys synth_xilinx -family xc2v`, out of
-/// context: no I/O pads), in `work_dir` (created; the Verilog, script, log and netlist stay
-/// there). The library side of `dynrt synth --unit transform|intersect|raygen [--format]`.
-pub fn synth_unit(unit: GeometryUnit, fmt: Format, work_dir: &Path) -> Result<SynthReport> {
-    let rtl = geometry_unit_rtl(unit, fmt)?;
-    std::fs::create_dir_all(work_dir)
-        .with_context(|| format!("cannot create {}", work_dir.display()))?;
-    let path = work_dir.join(format!("{}.v", rtl.top));
-    std::fs::write(&path, &rtl.verilog)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    let options = SynthOptions {
-        io_pads: false,
-        ..Default::default()
-    };
-    let report = synth::synth_xc2v_with(&[path], &rtl.top, &work_dir.join("yosys"), &options)?;
-    if report.top != rtl.top {
-        bail!("yosys reported top {} for {}", report.top, rtl.top);
-    }
-    Ok(report)
 }

@@ -1,9 +1,14 @@
 //! Exactly rounded arithmetic on `eXmY` words: each operation computes the exact result with
 //! wide integers and rounds once through [`Format::round_pack`].
+//!
+//! Each operation is the golden twin of a pipelined operator in src/hw/fp/ (named in its doc),
+//! which must equal it bit for bit.
 
 use super::format::{Format, Unpacked};
 
 impl Format {
+    /// Exactly rounded `a + b`. Golden twin of [`hw::fp::FpAddSub`](crate::hw::fp::FpAddSub)
+    /// (src/hw/fp/add_sub.rs).
     pub fn add(self, a: u32, b: u32) -> u32 {
         use Unpacked::*;
         match (self.unpack(a), self.unpack(b)) {
@@ -57,10 +62,14 @@ impl Format {
         }
     }
 
+    /// Exactly rounded `a - b`. Golden twin of [`hw::fp::FpAddSub`](crate::hw::fp::FpAddSub)
+    /// with `sub` set (src/hw/fp/add_sub.rs).
     pub fn sub(self, a: u32, b: u32) -> u32 {
         self.add(a, self.flip_sign(b))
     }
 
+    /// Exactly rounded `a * b`. Golden twin of [`hw::fp::FpMul`](crate::hw::fp::FpMul)
+    /// (src/hw/fp/mul.rs).
     pub fn mul(self, a: u32, b: u32) -> u32 {
         use Unpacked::*;
         let sign = self.sign_of(a) != self.sign_of(b);
@@ -80,6 +89,8 @@ impl Format {
         }
     }
 
+    /// Exactly rounded `a / b`. Golden twin of [`hw::fp::FpDiv`](crate::hw::fp::FpDiv)
+    /// (src/hw/fp/div.rs).
     pub fn div(self, a: u32, b: u32) -> u32 {
         use Unpacked::*;
         let sign = self.sign_of(a) != self.sign_of(b);
@@ -106,7 +117,8 @@ impl Format {
         }
     }
 
-    /// Exactly rounded square root; sqrt(-0) = -0, negative operands give NaN.
+    /// Exactly rounded square root; sqrt(-0) = -0, negative operands give NaN. Golden twin of
+    /// [`hw::fp::FpSqrt`](crate::hw::fp::FpSqrt) (src/hw/fp/sqrt.rs).
     pub fn sqrt(self, a: u32) -> u32 {
         match self.unpack(a) {
             Unpacked::NaN | Unpacked::Normal { sign: true, .. } | Unpacked::Inf { sign: true } => {
@@ -131,7 +143,9 @@ impl Format {
         }
     }
 
-    /// IEEE `<`: false when either operand is NaN; -0 and +0 are equal.
+    /// IEEE `<`: false when either operand is NaN; -0 and +0 are equal. Golden twin of
+    /// [`hw::fp::FpCompare`](crate::hw::fp::FpCompare)'s `lt` (src/hw/fp/compare.rs), as
+    /// are [`Format::le`] and [`Format::eq`] of its `le` and `eq`.
     pub fn lt(self, a: u32, b: u32) -> bool {
         match (self.order_key(a), self.order_key(b)) {
             (Some(x), Some(y)) => x < y,

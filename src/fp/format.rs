@@ -216,6 +216,9 @@ impl Format {
     /// `man_bits + 1` significant bits with an unbounded exponent; then a result below the
     /// smallest normal flushes to zero (tininess after rounding) and one above the largest
     /// finite value becomes infinity.
+    ///
+    /// Golden twin of [`hw::fp::FpRoundPack`](crate::hw::fp::FpRoundPack)
+    /// (src/hw/fp/round_pack.rs), the last two stages of the multiplier and the divider.
     pub(crate) fn round_pack(self, sign: bool, sig: u128, exp2: i32, sticky: bool) -> u32 {
         // Keep 64 bits and fold the rest into the sticky bit: 64 bits are far more than the
         // man_bits + 2 that rounding needs, and the u64 path is several times faster.
@@ -307,7 +310,9 @@ impl Format {
     }
 
     /// Exact conversion of a small integer (pixel coordinates, loop counts); rounds like any
-    /// other conversion when the integer needs more than `man_bits + 1` bits.
+    /// other conversion when the integer needs more than `man_bits + 1` bits. Golden twin of
+    /// [`hw::UIntToFloat`](crate::hw::UIntToFloat) (src/hw/int_to_float.rs) for values below
+    /// `2^(man_bits + 1)`.
     pub fn from_int(self, i: i64) -> u32 {
         self.round_pack64(i < 0, i.unsigned_abs(), 0, false)
     }
@@ -343,7 +348,9 @@ impl Format {
 
     /// An 8-bit colour channel from a word, as the hardware shader computes it:
     /// clamp to [0, 1] (NaN and -0 give 0), multiply by 255 in the format (one rounding),
-    /// then round to the nearest integer, ties to even.
+    /// then round to the nearest integer, ties to even. The hardware's sequence is
+    /// [`units::channel_byte`](crate::units::channel_byte), the golden twin of
+    /// [`hw::ChannelByte`](crate::hw::ChannelByte).
     pub fn to_u8(self, w: u32) -> u8 {
         let clamped = if self.is_nan(w) || !self.lt(0, w) {
             0

@@ -1,9 +1,13 @@
 //! `ChannelByte`: a colour channel's byte for the frame buffer, the engine's `byte`
-//! instruction. Bit-exact with `units::channel_byte` (= `Format::to_u8`): the word is clamped
-//! to [0, 1] on its bits (`units::clamp_unit_word`: sign, zero, subnormal or NaN give +0; above
-//! the encoding of 1 gives 1), multiplied by 255 in an [`FpMul`] and rounded to an integer by
-//! adding `2^M` in an [`FpAddSub`] (`units::channel_byte_word`); the sum's low 8 bits are the
-//! byte.
+//! instruction. Golden twin: [`units::channel_byte`] (src/units.rs; equal to
+//! `Format::to_u8`), bit for bit: the word is clamped to [0, 1] on its bits
+//! ([`units::clamp_unit_word`]: sign, zero, subnormal or NaN give +0; above the encoding of 1
+//! gives 1), multiplied by 255 in an [`FpMul`] and rounded to an integer by adding `2^M` in an
+//! [`FpAddSub`] ([`units::channel_byte_word`]); the sum's low 8 bits are the byte.
+//!
+//! [`units::channel_byte`]: crate::units::channel_byte
+//! [`units::clamp_unit_word`]: crate::units::clamp_unit_word
+//! [`units::channel_byte_word`]: crate::units::channel_byte_word
 //!
 //! Latency [`CHANNEL_BYTE_LATENCY`] (11) from `in_valid` to `out_valid`, one word per clock;
 //! the clamp is combinational in front of the multiplier's input registers.

@@ -11,6 +11,10 @@
 //!
 //! Throughput: one pixel per clock. Latency: [`DISPLAY_LATENCY`] clocks behind the timing
 //! generator. Size: the timing generator plus 5 flip-flops and a 24-bit output register.
+//!
+//! Golden twin: none that computes words. The pixel shown is the frame-buffer word as written,
+//! and the timing is [`VgaTiming`]'s (checked in src/sim/vga_timing/tests.rs);
+//! tests/processor_sim.rs checks that the processor's display shows the rendered frame.
 
 use rust_hdl::prelude::*;
 

@@ -5,6 +5,10 @@
 //!
 //! A four-level leading-zero shifter (8, 4, 2, 1) normalizes the value; the shift amounts give
 //! the exponent, the bits below the leading one the mantissa. Zero gives +0.
+//!
+//! Latency 0 (combinational: the unit around it registers), throughput one value per clock.
+//! Golden twin: [`Format::from_int`](crate::fp::Format::from_int) (src/fp/format.rs), which
+//! the golden model's `units::primary_direction` calls for the pixel coordinates.
 
 use rust_hdl::prelude::*;
 

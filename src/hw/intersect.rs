@@ -1,14 +1,15 @@
 //! `IntersectUnit`: Woop's unit-triangle test with the edge margin, fully pipelined, bit-exact
-//! with `model::units::intersect`.
+//! with its golden twin [`units::intersect`] (src/units.rs: `t = -O'z / D'z` is
+//! [`units::unit_triangle_t`], u and v [`units::unit_triangle_coord`]).
 //!
 //! Given the ray already in unit-triangle space (O', D') and the segment (t_min, t_max):
 //! `t = (-O'z) / D'z`, `u = O'x + t*D'x`, `v = O'y + t*D'y`, and a hit when `lo <= u`,
 //! `lo <= v`, `u + v <= hi`, `t_min < t` and `t < t_max`. NaN fails every comparison, so a ray
 //! parallel to the triangle (`D'z = 0`: t is infinite or NaN), NaN or infinite inputs never hit.
 //!
-//! `lo = -margin` and `hi = 1 + margin` are constants of the format
-//! (`units::edge_bounds(f, units::edge_margin(f))`, [`units::EDGE_MARGIN_ULPS`] ulps of 1:
-//! 2^-10 at e7m16): every triangle grows by the margin so that the rounding of O' and D' in two
+//! `lo = -margin` and `hi = 1 + margin` are constants of the format ([`units::edge_bounds`]
+//! with the margin of [`units::edge_margin`], [`units::EDGE_MARGIN_ULPS`] ulps of 1: 2^-10 at
+//! e7m16): every triangle grows by the margin so that the rounding of O' and D' in two
 //! neighbours' unit spaces cannot open a crack along their shared edge (PRECISION.md). The
 //! comparators read constants either way, so the margin costs no hardware.
 //!
@@ -36,6 +37,12 @@
 //!
 //! Const parameters: the operators' `W, E, M, S, S1, X2, T, P` and `DL = div_latency(M)`,
 //! checked in `default()`.
+//!
+//! [`units::intersect`]: crate::units::intersect
+//! [`units::unit_triangle_t`]: crate::units::unit_triangle_t
+//! [`units::unit_triangle_coord`]: crate::units::unit_triangle_coord
+//! [`units::edge_bounds`]: crate::units::edge_bounds
+//! [`units::edge_margin`]: crate::units::edge_margin
 
 use rust_hdl::prelude::*;
 
@@ -46,7 +53,7 @@ use super::fp::mul::MUL_LATENCY;
 use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv, FpMul};
 use super::{Delay, TAG_BITS};
 use crate::fp::Format;
-use crate::model::units;
+use crate::units;
 
 /// Clocks from t to the output.
 const AFTER_DIV: u32 = MUL_LATENCY + 2 * ADD_SUB_LATENCY + COMPARE_LATENCY;

@@ -24,9 +24,16 @@
 //! State machine: idle (apply object and skip commands, pass inits on, take a list: 1 clock
 //! each), load the thread's mailbox, object and skip (2 clocks), walk: one list word a clock
 //! while the test queue has room for the words in flight. The mailbox check and update is one
-//! clock on the word's arrival (`units::Mailbox`: the first `len` of 8 ids, first in first
-//! out), so a list of n words takes about `n + 3 + mem_latency` clocks; a thread has at most
-//! one list queued (it waits for its tests before the next).
+//! clock on the word's arrival ([`units::Mailbox`]: the first `len` of 8 ids, first in first
+//! out), so a list of n words takes about `n + 3 + mem_latency` clocks (latency) at one list
+//! word per clock (throughput); a thread has at most one list queued (it waits for its tests
+//! before the next).
+//!
+//! Golden twin: [`units::Mailbox`] (src/units.rs) and the skip rule of the golden model's
+//! `test_triangles` (src/model/golden.rs): the tests leave in the order, and with the drops,
+//! that the golden model tests the list in.
+//!
+//! [`units::Mailbox`]: crate::units::Mailbox
 
 use rust_hdl::prelude::*;
 

@@ -6,6 +6,11 @@
 //! `(o.z, d.x)`, `(d.y, d.z)` of `thread` from `word_a`, `word_b`; `t_min_write` writes t_min
 //! from `word_a`. Read side: `ray_thread` gives `o`, `d` one clock later; `t_min_thread` gives
 //! `t_min` one clock later (block RAMs, one read port each).
+//!
+//! Latency 1 clock per read; throughput one write and one read of each memory per clock.
+//! No golden twin: storage only. The words it keeps are the ray that
+//! [`units::triangle_test`](crate::units::triangle_test) and
+//! [`units::KdWalk`](crate::units::KdWalk) read.
 
 use rust_hdl::prelude::*;
 

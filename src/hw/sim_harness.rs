@@ -1,7 +1,7 @@
 //! Test helper for rust-hdl's own simulation of the geometry units: one clock cycle with the
 //! combinational logic settled after each edge (as rust-hdl's `Simulation` does), and random
 //! words for quick checks. A quick check only: the generated Verilog in Icarus and Verilator
-//! is the proof (`crate::emit::geometry_unit_tests`).
+//! is the proof (`crate::sim::geometry_unit`, its tests).
 
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;

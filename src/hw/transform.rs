@@ -1,5 +1,5 @@
 //! `TransformUnit`: the 3x4 matrix times a point or a vector, fully pipelined, bit-exact with
-//! `model::units::transform`.
+//! its golden twin [`units::transform`](crate::units::transform) (src/units.rs).
 //!
 //! Per row `r`: `((m[r][0]*x + m[r][1]*y) + m[r][2]*z) + n[r]`, the golden model's exact order
 //! and rounding. A vector (`point` = 0) omits the offset: the last adder then adds `-0`
@@ -10,7 +10,7 @@
 //! Resources (paper Table 2, transformation: 9 mul, 9 add): 9 [`FpMul`], 9 [`FpAddSub`], no
 //! divider. With `e7m16` each multiplier is one MULT18X18 (9 in all); with `e8m23` a 24x24
 //! significand product takes four (36). Measured (`yosys synth_xilinx -family xc2v`, out of
-//! context, `emit::synth_unit`): e7m16 4712 LUTs, 3693 FFs, 9 MULT18X18, 0 BRAM, depth 15
+//! context, `synth::synth_unit`): e7m16 4712 LUTs, 3693 FFs, 9 MULT18X18, 0 BRAM, depth 15
 //! LUT levels; e8m23 7074 LUTs, 4788 FFs, 36 MULT18X18, 0 BRAM, depth 16.
 //!
 //! Latency [`TRANSFORM_LATENCY`] = mul (4) + 3 adds (7 each) = 25 clocks for every format, one
@@ -18,7 +18,7 @@
 //! leaves with the result; `out_valid` is `in_valid` 25 clocks later.
 //!
 //! Matrix words are row-major `m00 m01 m02 n0 m10 m11 m12 n1 m20 m21 m22 n2`
-//! (`model::units::Mat34W`, the layout's matrix order).
+//! ([`units::Mat34W`](crate::units::Mat34W), the layout's matrix order).
 
 use rust_hdl::prelude::*;
 
@@ -168,7 +168,7 @@ mod tests {
     use super::*;
     use crate::fp::Format;
     use crate::hw::sim_harness::{clock_cycle, random_word};
-    use crate::model::units;
+    use crate::units;
     use rand::{Rng, SeedableRng};
 
     /// rust-hdl simulation: 300 random transforms (points and vectors) one per clock, each

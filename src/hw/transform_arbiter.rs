@@ -16,7 +16,11 @@
 //! Results of one client leave in the order its requests were taken.
 //!
 //! Latency [`TRANSFORM_LATENCY`] (25) from the taken request to the result; the arbiter is
-//! combinational in front of the unit's input registers, so it adds no clock.
+//! combinational in front of the unit's input registers, so it adds no clock. Throughput one
+//! request per clock, shared by the clients.
+//!
+//! Golden twin: [`units::transform`](crate::units::transform) (src/units.rs) on each client's
+//! requests, the results in that client's request order.
 
 use rust_hdl::prelude::*;
 
@@ -204,7 +208,7 @@ mod tests {
     use crate::fp::Format;
     use crate::hw::sim_harness::{clock_cycle, random_word};
     use crate::hw::TRANSFORM_LATENCY;
-    use crate::model::units;
+    use crate::units;
     use rand::{Rng, SeedableRng};
 
     /// rust-hdl simulation: every client requests all the time, some with pauses; each request

@@ -8,6 +8,11 @@
 //! stack is empty or the popped segment starts behind the hit), exactly as
 //! `model::golden`'s `traverse`.
 //!
+//! Golden twin: [`units::KdWalk`](crate::units::KdWalk) (src/units.rs), one walk resumable at
+//! each leaf, with [`units::traversal_step`](crate::units::traversal_step) and
+//! [`units::split_distance`](crate::units::split_distance) for each inner node; they name this
+//! unit back. Latency and throughput: see "Structure" below.
+//!
 //! Engine side (I2/I3, like the triangle tester): `enqueue` offers the start of a walk of
 //! `thread` (root `word_a`, t_max `word_b`, t_min the thread's `t_min` written with the
 //! tester's init), taken when `full` is low. `query_thread` at I2; at I3 `pending` (the

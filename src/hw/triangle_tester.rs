@@ -5,8 +5,12 @@
 //! space with the [`TransformUnit`] (the origin as a point, then the direction as a vector),
 //! tests it in the [`IntersectUnit`] and keeps the thread's closest hit; the thread waits for
 //! its tests once per leaf (`tri.wait`), or the traversal unit hands the leaves of a walk
-//! itself and gets the closest hit back (`walk_*`). Bit-exact with `units::triangle_test` and
-//! `units::closer_hit`.
+//! itself and gets the closest hit back (`walk_*`).
+//!
+//! Golden twin: [`units::triangle_test`](crate::units::triangle_test) for each test and
+//! [`units::closer_hit`](crate::units::closer_hit) for the merge, in queue order
+//! (src/units.rs), bit for bit; both name this unit back. Latency and throughput: see "Fetch
+//! and launch" and "Latency from launch" below.
 //!
 //! Engine side (the engine's I2/I3 stages):
 //! - Ray words: `ray_write` with `ray_pair` 0, 1, 2 writes `(o.x, o.y)`, `(o.z, d.x)`,

@@ -36,6 +36,10 @@
 //! (e.g. with `crate::hw::Delay`) so that colour and syncs line up. Throughput: one pixel per
 //! clock.
 //!
+//! Golden twin: none that computes words; the placement is [`VgaMode::fit`], and the timing
+//! spec above is checked against the generated Verilog by the recording testbench's checker
+//! in src/sim/vga_timing/tests.rs.
+//!
 //! Size (yosys 0.23 `synth_xilinx -family xc2v -flatten`, 640x480 showing 64x48): 132
 //! flip-flops, 160 LUTs, 119 MUXCY + 102 XORCY carry cells, no multiplier. Counters are 12
 //! bits wide, so `h_total` and `v_total` must be below 4096; addresses are

@@ -27,7 +27,7 @@
 //!   right child is the next node), for a leaf the bank-1 address of its list. Word 1: the
 //!   split position (float) or the leaf's reference count.
 //! - A 3x4 matrix is `m00 m01 m02 n0 m10 m11 m12 n1 m20 m21 m22 n2`; points transform as
-//!   `x' = ((m00*x + m01*y) + m02*z) + n0` (see `model::units::transform`).
+//!   `x' = ((m00*x + m01*y) + m02*z) + n0` (see `crate::units::transform`).
 //! - A frame-buffer word is `0x00RRGGBB`.
 //!
 //! Every value the host computes (triangle transforms, instance matrices, camera) is computed

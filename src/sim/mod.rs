@@ -12,15 +12,32 @@
 //!
 //! [`lint`] runs `verilator --lint-only -Wall` and returns structured warnings; [`vectors`]
 //! reads and writes the hex vector files of the `dynrt fp` CLI contract.
+//!
+//! On top of [`run`], the runners of what `crate::emit` writes: [`stream_bench`] (the
+//! streaming testbench every pipelined unit is checked with), [`fp_unit`] and
+//! [`geometry_unit`] (one operator or geometry unit on a list of inputs), [`vga_timing`] and
+//! [`processor`] (the whole processor on a scene's frames).
 
 mod error;
+pub mod fp_unit;
+pub mod geometry_unit;
 mod lint;
 pub mod process;
+pub mod processor;
+pub mod stream_bench;
 pub mod vectors;
+pub mod vga_timing;
 
 pub(crate) use error::error_excerpt;
 pub use error::{SourceLocation, ToolError};
+pub use fp_unit::{run_fp_unit, run_fp_units, FpUnitRun};
+pub use geometry_unit::{
+    run_intersect, run_raygen, run_shared_transform, run_transform, GeometryRun, IntersectRequest,
+    IntersectResult, RayGenFrame, RayGenOutput, TransformRequest, TransformResult,
+};
 pub use lint::{lint, lint_with_timeout, LintReport, LintWarning};
+pub use stream_bench::{run_stream_bench, StreamBenchRun};
+pub use vga_timing::{run_vga_timing, VgaSample};
 
 use std::fmt;
 use std::path::{Path, PathBuf};

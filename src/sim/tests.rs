@@ -304,7 +304,7 @@ fn versions_of_installed_tools() {
     let iv = tool_version(Simulator::Icarus).unwrap();
     let vl = tool_version(Simulator::Verilator).unwrap();
     println!("iverilog {iv}, verilator {vl}");
-    // DESIGN: Icarus 11 and Verilator 5.006 are the supported versions.
+    // The supported versions (docs/ARCHITECTURE.md, "Data flow", Tools): Icarus 11, Verilator 5.
     assert!(iv.starts_with("11."), "{iv}");
     assert!(vl.starts_with("5."), "{vl}");
     assert_eq!(

@@ -15,10 +15,12 @@
 mod depth;
 pub mod device;
 pub mod ecp5;
+pub mod geometry_unit;
 pub mod nextpnr_report;
 pub mod timing_table;
 
 pub use device::{FpgaDevice, Utilization, XC2V6000};
+pub use geometry_unit::synth_unit;
 
 use std::collections::BTreeMap;
 use std::fmt;

@@ -1,5 +1,9 @@
 //! `FpAddSub`: pipelined `eXmY` adder/subtracter (`sub` input: 0 adds, 1 subtracts b), exactly
-//! rounded (nearest even), equal to `dynrt::fp::Format::add` / `sub` bit for bit.
+//! rounded (nearest even), equal bit for bit to its golden twin [`Format::add`] /
+//! [`Format::sub`] (src/fp/arith.rs).
+//!
+//! [`Format::add`]: crate::fp::Format::add
+//! [`Format::sub`]: crate::fp::Format::sub
 //!
 //! Latency 7 clocks, throughput one operation per clock:
 //! 1. input registers;

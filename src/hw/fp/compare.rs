@@ -1,7 +1,12 @@
 //! `FpCompare`: pipelined IEEE comparison (`lt`, `le`, `eq`) of two `eXmY` words.
 //!
 //! Contract (same as `dynrt::fp`): subnormal inputs are read as zeros of their sign
-//! (DAZ), `-0 == +0`, and every comparison involving a NaN is false.
+//! (DAZ), `-0 == +0`, and every comparison involving a NaN is false. Golden twin:
+//! [`Format::lt`], [`Format::le`], [`Format::eq`] (src/fp/arith.rs), bit for bit.
+//!
+//! [`Format::lt`]: crate::fp::Format::lt
+//! [`Format::le`]: crate::fp::Format::le
+//! [`Format::eq`]: crate::fp::Format::eq
 //!
 //! Latency 2 clocks, throughput one comparison per clock: stage 1 registers the inputs,
 //! stage 2 registers the three results. `out_valid` is `in_valid` delayed by 2.

@@ -1,5 +1,5 @@
-//! `FpDiv`: pipelined `eXmY` divider, exactly rounded (nearest even), equal to
-//! `dynrt::fp::Format::div` bit for bit.
+//! `FpDiv`: pipelined `eXmY` divider, exactly rounded (nearest even), equal bit for bit to its
+//! golden twin [`Format::div`](crate::fp::Format::div) (src/fp/arith.rs).
 //!
 //! Algorithm: radix-2 restoring division, one quotient bit per pipeline stage. The dividend
 //! significand is doubled when it is smaller than the divisor's, so the quotient lies in [1, 2)

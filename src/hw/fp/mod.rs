@@ -11,7 +11,7 @@
 //! generic over its word width and the derived internal widths (checked in its constructor), and
 //! format-dependent offsets and masks are `Constant` fields (Verilog localparams). The table in
 //! [`formats`] lists the supported formats with their derived widths; `dispatch_fp_format!`
-//! dispatches from a runtime [`Format`] to the monomorphized instance.
+//! dispatches from a runtime [`Format`](crate::fp::Format) to the monomorphized instance.
 //!
 //! Latencies (clocks from `in_valid` to `out_valid`): add/sub 7, mul 4, div and sqrt `M + 5`
 //! (e7m16: 21, e8m23: 28), compare 2. Every stage is at most about 7 LUT4 levels deep after
@@ -23,6 +23,11 @@
 //! `FpMul::<W, E, M, S, S1, X2, P>::default()` as a field, drive `clock`, `in_valid`, `a`, `b`
 //! (and `sub`) from the kernel, and delay side data by the operator's latency. The unit's own
 //! entry point then goes through `dispatch_fp_format!` once, like `crate::emit::fp_unit_rtl`.
+//!
+//! Golden twins (src/fp/arith.rs, src/fp/format.rs): [`FpAddSub`] is `Format::add` / `sub`,
+//! [`FpMul`] `Format::mul`, [`FpDiv`] `Format::div`, [`FpSqrt`] `Format::sqrt`, [`FpCompare`]
+//! `Format::lt` / `le` / `eq`, [`FpRoundPack`] `Format::round_pack`; each of those names its
+//! operator back.
 
 pub mod add_sub;
 pub mod compare;

@@ -1,5 +1,5 @@
-//! `FpMul`: pipelined `eXmY` multiplier, exactly rounded (nearest even), equal to
-//! `dynrt::fp::Format::mul` bit for bit.
+//! `FpMul`: pipelined `eXmY` multiplier, exactly rounded (nearest even), equal bit for bit to
+//! its golden twin [`Format::mul`](crate::fp::Format::mul) (src/fp/arith.rs).
 //!
 //! Latency 4 clocks, throughput one product per clock:
 //! 1. input registers;

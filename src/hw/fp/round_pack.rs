@@ -9,6 +9,9 @@
 //! `inf` or an exponent past the largest after rounding; a signed zero for `zero` or an exponent
 //! below 1 after rounding (FTZ, tininess after rounding); else the rounded number.
 //!
+//! Golden twin: `Format::round_pack` (src/fp/format.rs), the single rounding step of every
+//! software operation.
+//!
 //! Latency 2 clocks (round and its carry into the exponent, registered; range check and pack,
 //! registered), throughput one word per clock.
 //!

@@ -4,7 +4,9 @@
 //! (`always @(*) p = a * b;`, a full-width product because `p` is `P = 2S` bits wide) and an
 //! `update()` computing the same product in Rust. Yosys maps it onto MULT18X18 blocks
 //! (one for S <= 17 (e7m16), four for S = 24 (e8m23)). No latency of its own: the operator
-//! around it registers its inputs and its output.
+//! around it registers its inputs and its output. No golden twin of its own: it is the exact
+//! product `ma * mb` inside [`Format::mul`](crate::fp::Format::mul), checked through
+//! [`FpMul`](super::FpMul).
 
 use rust_hdl::prelude::*;
 

@@ -1,5 +1,5 @@
-//! `FpSqrt`: pipelined `eXmY` square root, exactly rounded (nearest even), equal to
-//! `dynrt::fp::Format::sqrt` bit for bit.
+//! `FpSqrt`: pipelined `eXmY` square root, exactly rounded (nearest even), equal bit for bit
+//! to its golden twin [`Format::sqrt`](crate::fp::Format::sqrt) (src/fp/arith.rs).
 //!
 //! Algorithm: radix-2 restoring square root, one root bit per pipeline stage. With the biased
 //! exponent `e` and the significand `1.f`, the radicand is `1.f` when the unbiased exponent is

@@ -1,7 +1,7 @@
 //! Test helper: clocks a pipelined operator in rust-hdl's own simulation (settling the
 //! combinational logic after every edge, as rust-hdl's `Simulation` does) and collects its
 //! valid outputs in order. rust-hdl's simulation is only a quick check: the generated Verilog
-//! in Icarus and Verilator is the proof (see `crate::emit::fp_unit`).
+//! in Icarus and Verilator is the proof (see `crate::sim::fp_unit`).
 
 use rust_hdl::prelude::*;
 

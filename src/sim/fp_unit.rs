@@ -1,18 +1,19 @@
 //! Runs one generated floating-point operator in a real simulator on a list of operand pairs:
-//! writes the unit's Verilog, a wrapper and the streaming testbench of
-//! [`super::stream_bench`] (the one the geometry units use) with the vector file into a work
-//! directory, runs Icarus or Verilator through `crate::sim`, and reads the results back in
-//! input order.
+//! writes the unit's Verilog (`crate::emit::fp_unit`), a wrapper and the streaming testbench
+//! of `crate::emit::stream_bench` (the one the geometry units use) with the vector file into a
+//! work directory, runs Icarus or Verilator through [`super::stream_bench`], and reads the
+//! results back in input order.
 //! Used by `dynrt fp --sim iverilog|verilator` and by the bit-exactness tests.
 
 use std::path::Path;
 
 use anyhow::{bail, Result};
 
-use super::fp_unit::fp_unit_rtl;
-use super::stream_bench::{run_stream_bench, BenchPort, InputStream, OutputSink, StreamBench};
+use super::stream_bench::run_stream_bench;
+use super::Simulator;
+use crate::emit::fp_unit::fp_unit_rtl;
+use crate::emit::stream_bench::{BenchPort, InputStream, OutputSink, StreamBench};
 use crate::fp::{BinOp, Format};
-use crate::sim::Simulator;
 
 /// Results of one simulated run of an operator.
 #[derive(Debug, Clone)]

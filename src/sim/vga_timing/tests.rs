@@ -3,7 +3,7 @@
 //! pulses, not from the generator's `x`/`y`.
 
 use super::*;
-use crate::hw::vga::{VgaError, VgaPlacement};
+use crate::hw::vga::{VgaError, VgaPlacement, VgaTiming};
 
 /// What the checker measured.
 #[derive(Debug, Default)]

@@ -486,5 +486,4 @@ pub fn write_ucf(path: &Path, ports: &[Port], opts: &UcfOptions) -> Result<()> {
 }
 
 #[cfg(test)]
-#[path = "constraints_tests.rs"]
 mod tests;

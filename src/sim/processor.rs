@@ -7,8 +7,8 @@ use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
 
-use super::memory_images::{write_frame_update, write_memory_images};
-use super::processor::{
+use crate::emit::memory_images::{write_frame_update, write_memory_images};
+use crate::emit::processor::{
     display_mode, processor_rtl, processor_testbench, ProcessorParams, TestbenchFrames,
 };
 use crate::hw::program::Program;
@@ -59,7 +59,7 @@ pub fn write_processor_files(
         std::fs::create_dir_all(d).with_context(|| format!("cannot create {}", d.display()))?;
     }
     let rtl = processor_rtl(program, params, scene_name)?;
-    let rtl_path = rtl_dir.join(format!("{}.v", super::processor::PROCESSOR_TOP));
+    let rtl_path = rtl_dir.join(format!("{}.v", crate::emit::processor::PROCESSOR_TOP));
     write_atomically(&rtl_path, rtl.verilog.as_bytes())?;
     write_memory_images(first, &mem_dir)?;
     let mut updates = Vec::new();

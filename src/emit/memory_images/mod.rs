@@ -290,5 +290,4 @@ impl BankExtent {
 }
 
 #[cfg(test)]
-#[path = "memory_images_tests.rs"]
 mod tests;

@@ -1,5 +1,5 @@
 //! Bit-exactness of the generated geometry units against the golden model's unit sequences
-//! (`model::units`), in Icarus and Verilator, plus lint and synthesis. One simulator build per
+//! (`crate::units`), in Icarus and Verilator, plus lint. One simulator build per
 //! unit, format and simulator; every vector streams through it.
 //!
 //! Vectors: seeded random words and geometric cases, plus the hard ones: unit-triangle
@@ -16,12 +16,11 @@ use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::geometry_unit::{geometry_unit_rtl, GeometryUnit};
-use super::geometry_unit_run::*;
-use crate::fp::{vectors, Format};
+use super::*;
+use crate::fp::vectors;
 use crate::layout::unit_triangle_transform;
-use crate::model::units;
-use crate::sim::{self, Simulator};
+use crate::sim;
+use crate::units;
 
 /// A random word: a third uniform bit patterns, a third edge cases, a third "geometric" values
 /// (magnitudes 2^-8..2^8, either sign).
@@ -744,7 +743,7 @@ fn raygen_e8m23_both() {
 }
 
 // ---------------------------------------------------------------------------------------
-// Lint and synthesis
+// Lint
 
 /// `verilator --lint-only -Wall` is clean on every unit in e7m16 and e8m23 (with the waiver
 /// block documented in `CORE_WAIVER` around the generated core, none on the tops).

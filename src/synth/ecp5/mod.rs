@@ -489,5 +489,4 @@ pub fn measured_clock_mhz(path: &Path) -> Result<f64, String> {
 }
 
 #[cfg(test)]
-#[path = "ecp5_tests.rs"]
 mod tests;

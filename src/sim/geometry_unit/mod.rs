@@ -1,19 +1,21 @@
-//! Runs the generated geometry units in Icarus or Verilator on lists of requests, through the
-//! streaming testbench of [`super::stream_bench`]: one simulator build per call, every request
-//! streamed through it, the results read back in the order the unit produced them.
+//! Runs the generated geometry units (`crate::emit::geometry_unit`) in Icarus or Verilator on
+//! lists of requests, through the streaming testbench of `crate::emit::stream_bench`: one
+//! simulator build per call, every request streamed through it, the results read back in the
+//! order the unit produced them.
 //!
-//! The bit-exactness tests (in `geometry_unit_tests`) compare these results with the golden
-//! model's unit sequences (`model::units`).
+//! The bit-exactness tests (in `tests.rs` beside this file) compare these results with the
+//! golden twins in [`crate::units`].
 
 use std::path::Path;
 
 use anyhow::{bail, Result};
 
-use super::geometry_unit::{geometry_unit_rtl, GeometryUnit};
-use super::stream_bench::{run_stream_bench, InputStream, OutputSink, StreamBench};
+use super::stream_bench::run_stream_bench;
+use super::Simulator;
+use crate::emit::geometry_unit::{geometry_unit_rtl, GeometryUnit};
+use crate::emit::stream_bench::{InputStream, OutputSink, StreamBench};
 use crate::fp::Format;
 use crate::hw::TRANSFORM_CLIENTS;
-use crate::sim::Simulator;
 
 /// Results of one simulated run, in output order, with the tool times.
 #[derive(Debug, Clone)]
@@ -382,3 +384,6 @@ pub fn run_raygen(
         run_seconds: run.run_seconds,
     })
 }
+
+#[cfg(test)]
+mod tests;
