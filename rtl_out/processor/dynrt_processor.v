@@ -11,7 +11,627 @@
 /* verilator lint_off UNUSEDSIGNAL */
 
 
-module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy);
+module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,vga_clock,vga_reset,vga_fb_addr,vga_fb_data,vga_hsync,vga_vsync,vga_rgb,vga_frame_start);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  start;
+    output reg  done;
+    output reg  [31:0] cycles;
+    output reg  [31:0] instructions;
+    output wire  mem_read;
+    output wire  [2:0] mem_bank;
+    output wire  [23:0] mem_addr;
+    input wire  [31:0] mem_rdata;
+    output wire  fb_write;
+    output wire  [23:0] fb_addr;
+    output wire  [31:0] fb_data;
+    output wire  bank0_read;
+    output wire  [23:0] bank0_addr;
+    input wire  [31:0] bank0_rdata;
+    output wire  bank2_read;
+    output wire  [23:0] bank2_addr;
+    input wire  [31:0] bank2_rdata;
+    output wire  bank3_read;
+    output wire  [23:0] bank3_addr;
+    input wire  [31:0] bank3_rdata;
+    output reg  [31:0] transform_busy;
+    output reg  [31:0] intersect_busy;
+    output reg  [31:0] traversal_busy;
+    input wire  vga_clock;
+    input wire  vga_reset;
+    output reg  [23:0] vga_fb_addr;
+    input wire  [31:0] vga_fb_data;
+    output reg  vga_hsync;
+    output reg  vga_vsync;
+    output reg  [23:0] vga_rgb;
+    output reg  vga_frame_start;
+    
+    // Stub signals
+    reg  engine__clock;
+    reg  engine__start;
+    wire  engine__done;
+    wire  [31:0] engine__cycles;
+    wire  [31:0] engine__instructions;
+    wire  [31:0] engine__transform_busy;
+    wire  [31:0] engine__intersect_busy;
+    wire  [31:0] engine__traversal_busy;
+    reg  display__clock;
+    reg  display__reset;
+    wire  [23:0] display__fb_addr;
+    reg  [31:0] display__fb_data;
+    wire  display__hsync;
+    wire  display__vsync;
+    wire  [23:0] display__rgb;
+    wire  display__frame_start;
+    
+    // Sub module instances
+    dynrt_processor__engine engine(
+        .clock(engine__clock),
+        .start(engine__start),
+        .done(engine__done),
+        .cycles(engine__cycles),
+        .instructions(engine__instructions),
+        .mem_read(mem_read),
+        .mem_bank(mem_bank),
+        .mem_addr(mem_addr),
+        .mem_rdata(mem_rdata),
+        .fb_write(fb_write),
+        .fb_addr(fb_addr),
+        .fb_data(fb_data),
+        .bank0_read(bank0_read),
+        .bank0_addr(bank0_addr),
+        .bank0_rdata(bank0_rdata),
+        .bank2_read(bank2_read),
+        .bank2_addr(bank2_addr),
+        .bank2_rdata(bank2_rdata),
+        .bank3_read(bank3_read),
+        .bank3_addr(bank3_addr),
+        .bank3_rdata(bank3_rdata),
+        .transform_busy(engine__transform_busy),
+        .intersect_busy(engine__intersect_busy),
+        .traversal_busy(engine__traversal_busy)
+    );
+    dynrt_processor__display display(
+        .clock(display__clock),
+        .reset(display__reset),
+        .fb_addr(display__fb_addr),
+        .fb_data(display__fb_data),
+        .hsync(display__hsync),
+        .vsync(display__vsync),
+        .rgb(display__rgb),
+        .frame_start(display__frame_start)
+    );
+    
+    // Update code
+    always @(*) begin
+        engine__clock = clock;
+        engine__start = start;
+        done = engine__done;
+        cycles = engine__cycles;
+        instructions = engine__instructions;
+        transform_busy = engine__transform_busy;
+        intersect_busy = engine__intersect_busy;
+        traversal_busy = engine__traversal_busy;
+        display__clock = vga_clock;
+        display__reset = vga_reset;
+        vga_fb_addr = ((display__fb_addr) & 24'hffffff);
+        display__fb_data = vga_fb_data;
+        vga_hsync = display__hsync;
+        vga_vsync = display__vsync;
+        vga_rgb = display__rgb;
+        vga_frame_start = display__frame_start;
+    end
+    
+endmodule // dynrt_processor
+
+
+module dynrt_processor__display(clock,reset,fb_addr,fb_data,hsync,vsync,rgb,frame_start);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    output reg  [23:0] fb_addr;
+    input wire  [31:0] fb_data;
+    output reg  hsync;
+    output reg  vsync;
+    output reg  [23:0] rgb;
+    output reg  frame_start;
+    
+    // Stub signals
+    reg  timing__clock;
+    reg  timing__reset;
+    wire  timing__hsync;
+    wire  timing__vsync;
+    wire  timing__blank;
+    wire  timing__border;
+    wire  [11:0] timing__x;
+    wire  [11:0] timing__y;
+    wire  [23:0] timing__fb_addr;
+    wire  timing__frame_start;
+    reg  hsync_d__d;
+    wire  hsync_d__q;
+    reg  hsync_d__clock;
+    reg  vsync_d__d;
+    wire  vsync_d__q;
+    reg  vsync_d__clock;
+    reg  dark_d__d;
+    wire  dark_d__q;
+    reg  dark_d__clock;
+    reg  start_d__d;
+    wire  start_d__q;
+    reg  start_d__clock;
+    reg  hsync_q__d;
+    wire  hsync_q__q;
+    reg  hsync_q__clock;
+    reg  vsync_q__d;
+    wire  vsync_q__q;
+    reg  vsync_q__clock;
+    reg  start_q__d;
+    wire  start_q__q;
+    reg  start_q__clock;
+    reg  [23:0] rgb_q__d;
+    wire  [23:0] rgb_q__q;
+    reg  rgb_q__clock;
+    
+    // Sub module instances
+    dynrt_processor__display__timing timing(
+        .clock(timing__clock),
+        .reset(timing__reset),
+        .hsync(timing__hsync),
+        .vsync(timing__vsync),
+        .blank(timing__blank),
+        .border(timing__border),
+        .x(timing__x),
+        .y(timing__y),
+        .fb_addr(timing__fb_addr),
+        .frame_start(timing__frame_start)
+    );
+    dynrt_processor__display__dark_d hsync_d(
+        .d(hsync_d__d),
+        .q(hsync_d__q),
+        .clock(hsync_d__clock)
+    );
+    dynrt_processor__display__dark_d vsync_d(
+        .d(vsync_d__d),
+        .q(vsync_d__q),
+        .clock(vsync_d__clock)
+    );
+    dynrt_processor__display__dark_d dark_d(
+        .d(dark_d__d),
+        .q(dark_d__q),
+        .clock(dark_d__clock)
+    );
+    dynrt_processor__display__dark_d start_d(
+        .d(start_d__d),
+        .q(start_d__q),
+        .clock(start_d__clock)
+    );
+    dynrt_processor__display__dark_d hsync_q(
+        .d(hsync_q__d),
+        .q(hsync_q__q),
+        .clock(hsync_q__clock)
+    );
+    dynrt_processor__display__dark_d vsync_q(
+        .d(vsync_q__d),
+        .q(vsync_q__q),
+        .clock(vsync_q__clock)
+    );
+    dynrt_processor__display__dark_d start_q(
+        .d(start_q__d),
+        .q(start_q__q),
+        .clock(start_q__clock)
+    );
+    dynrt_processor__display__rgb_q rgb_q(
+        .d(rgb_q__d),
+        .q(rgb_q__q),
+        .clock(rgb_q__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        hsync_d__clock = clock;
+        vsync_d__clock = clock;
+        dark_d__clock = clock;
+        start_d__clock = clock;
+        hsync_q__clock = clock;
+        vsync_q__clock = clock;
+        start_q__clock = clock;
+        rgb_q__clock = clock;
+        hsync_d__d = hsync_d__q;
+        vsync_d__d = vsync_d__q;
+        dark_d__d = dark_d__q;
+        start_d__d = start_d__q;
+        hsync_q__d = hsync_q__q;
+        vsync_q__d = vsync_q__q;
+        start_q__d = start_q__q;
+        rgb_q__d = rgb_q__q;
+        timing__clock = clock;
+        timing__reset = reset;
+        fb_addr = timing__fb_addr;
+        hsync_d__d = timing__hsync;
+        vsync_d__d = timing__vsync;
+        dark_d__d = timing__blank | timing__border;
+        start_d__d = timing__frame_start;
+        hsync_q__d = hsync_d__q;
+        vsync_q__d = vsync_d__q;
+        start_q__d = start_d__q;
+        if (dark_d__q) begin
+            rgb_q__d = 32'h0;
+        end
+        else begin
+            rgb_q__d = fb_data[(32'h0)+:(24)];
+        end
+        hsync = hsync_q__q;
+        vsync = vsync_q__q;
+        frame_start = start_q__q;
+        rgb = rgb_q__q;
+    end
+    
+endmodule // dynrt_processor__display
+
+
+module dynrt_processor__display__dark_d(d,q,clock);
+    
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__display__dark_d
+
+
+
+
+
+
+module dynrt_processor__display__rgb_q(d,q,clock);
+    
+    // Module arguments
+    input wire  [23:0] d;
+    output reg  [23:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 24'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__display__rgb_q
+
+
+
+
+
+
+module dynrt_processor__display__timing(clock,reset,hsync,vsync,blank,border,x,y,fb_addr,frame_start);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    output reg  hsync;
+    output reg  vsync;
+    output reg  blank;
+    output reg  border;
+    output reg  [11:0] x;
+    output reg  [11:0] y;
+    output reg  [23:0] fb_addr;
+    output reg  frame_start;
+    
+    // Constant declarations
+    localparam  c_h_last = 12'h31f;
+    localparam  c_v_last = 12'h20c;
+    localparam  c_h_visible = 12'h280;
+    localparam  c_v_visible = 12'h1e0;
+    localparam  c_hs_start = 12'h290;
+    localparam  c_hs_end = 12'h2f0;
+    localparam  c_vs_start = 12'h1ea;
+    localparam  c_vs_end = 12'h1ec;
+    localparam  c_x0 = 12'h0;
+    localparam  c_x1 = 12'h280;
+    localparam  c_y0 = 12'h0;
+    localparam  c_y1 = 12'h1e0;
+    localparam  c_rep_last = 12'h9;
+    localparam  c_fb_width = 24'h40;
+    localparam  c_fb_base = 24'h2e;
+    localparam  c_hs_negative = 1'b1;
+    localparam  c_vs_negative = 1'b1;
+    
+    // Stub signals
+    reg  [11:0] h__d;
+    wire  [11:0] h__q;
+    reg  h__clock;
+    reg  [11:0] v__d;
+    wire  [11:0] v__q;
+    reg  v__clock;
+    reg  [11:0] col__d;
+    wire  [11:0] col__q;
+    reg  col__clock;
+    reg  [11:0] hrep__d;
+    wire  [11:0] hrep__q;
+    reg  hrep__clock;
+    reg  [11:0] vrep__d;
+    wire  [11:0] vrep__q;
+    reg  vrep__clock;
+    reg  [23:0] row_base__d;
+    wire  [23:0] row_base__q;
+    reg  row_base__clock;
+    reg  hsync_q__d;
+    wire  hsync_q__q;
+    reg  hsync_q__clock;
+    reg  vsync_q__d;
+    wire  vsync_q__q;
+    reg  vsync_q__clock;
+    reg  blank_q__d;
+    wire  blank_q__q;
+    reg  blank_q__clock;
+    reg  border_q__d;
+    wire  border_q__q;
+    reg  border_q__clock;
+    reg  start_q__d;
+    wire  start_q__q;
+    reg  start_q__clock;
+    reg  [11:0] x_q__d;
+    wire  [11:0] x_q__q;
+    reg  x_q__clock;
+    reg  [11:0] y_q__d;
+    wire  [11:0] y_q__q;
+    reg  y_q__clock;
+    reg  [23:0] addr_q__d;
+    wire  [23:0] addr_q__q;
+    reg  addr_q__clock;
+    
+    // Local signals
+    reg  line_end;
+    reg  in_x;
+    reg  in_y;
+    reg  visible;
+    reg  hs_active;
+    reg  vs_active;
+    
+    // Sub module instances
+    dynrt_processor__display__timing__col h(
+        .d(h__d),
+        .q(h__q),
+        .clock(h__clock)
+    );
+    dynrt_processor__display__timing__col v(
+        .d(v__d),
+        .q(v__q),
+        .clock(v__clock)
+    );
+    dynrt_processor__display__timing__col col(
+        .d(col__d),
+        .q(col__q),
+        .clock(col__clock)
+    );
+    dynrt_processor__display__timing__col hrep(
+        .d(hrep__d),
+        .q(hrep__q),
+        .clock(hrep__clock)
+    );
+    dynrt_processor__display__timing__col vrep(
+        .d(vrep__d),
+        .q(vrep__q),
+        .clock(vrep__clock)
+    );
+    dynrt_processor__display__rgb_q row_base(
+        .d(row_base__d),
+        .q(row_base__q),
+        .clock(row_base__clock)
+    );
+    dynrt_processor__display__dark_d hsync_q(
+        .d(hsync_q__d),
+        .q(hsync_q__q),
+        .clock(hsync_q__clock)
+    );
+    dynrt_processor__display__dark_d vsync_q(
+        .d(vsync_q__d),
+        .q(vsync_q__q),
+        .clock(vsync_q__clock)
+    );
+    dynrt_processor__display__dark_d blank_q(
+        .d(blank_q__d),
+        .q(blank_q__q),
+        .clock(blank_q__clock)
+    );
+    dynrt_processor__display__dark_d border_q(
+        .d(border_q__d),
+        .q(border_q__q),
+        .clock(border_q__clock)
+    );
+    dynrt_processor__display__dark_d start_q(
+        .d(start_q__d),
+        .q(start_q__q),
+        .clock(start_q__clock)
+    );
+    dynrt_processor__display__timing__col x_q(
+        .d(x_q__d),
+        .q(x_q__q),
+        .clock(x_q__clock)
+    );
+    dynrt_processor__display__timing__col y_q(
+        .d(y_q__d),
+        .q(y_q__q),
+        .clock(y_q__clock)
+    );
+    dynrt_processor__display__rgb_q addr_q(
+        .d(addr_q__d),
+        .q(addr_q__q),
+        .clock(addr_q__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        h__clock = clock;
+        v__clock = clock;
+        col__clock = clock;
+        hrep__clock = clock;
+        vrep__clock = clock;
+        row_base__clock = clock;
+        hsync_q__clock = clock;
+        vsync_q__clock = clock;
+        blank_q__clock = clock;
+        border_q__clock = clock;
+        start_q__clock = clock;
+        x_q__clock = clock;
+        y_q__clock = clock;
+        addr_q__clock = clock;
+        h__d = h__q;
+        v__d = v__q;
+        col__d = col__q;
+        hrep__d = hrep__q;
+        vrep__d = vrep__q;
+        row_base__d = row_base__q;
+        hsync_q__d = hsync_q__q;
+        vsync_q__d = vsync_q__q;
+        blank_q__d = blank_q__q;
+        border_q__d = border_q__q;
+        start_q__d = start_q__q;
+        x_q__d = x_q__q;
+        y_q__d = y_q__q;
+        addr_q__d = addr_q__q;
+        line_end = h__q == c_h_last;
+        in_x = (h__q >= c_x0) & (h__q < c_x1);
+        in_y = (v__q >= c_y0) & (v__q < c_y1);
+        visible = (h__q < c_h_visible) & (v__q < c_v_visible);
+        hs_active = (h__q >= c_hs_start) & (h__q < c_hs_end);
+        vs_active = (v__q >= c_vs_start) & (v__q < c_vs_end);
+        hsync_q__d = hs_active ^ c_hs_negative;
+        vsync_q__d = vs_active ^ c_vs_negative;
+        blank_q__d = ~visible;
+        border_q__d = visible & ~(in_x & in_y);
+        start_q__d = (h__q == 32'h0) & (v__q == 32'h0);
+        x_q__d = h__q;
+        y_q__d = v__q;
+        if (in_x & in_y) begin
+            addr_q__d = row_base__q + ((col__q) & 24'hffffff);
+        end
+        else begin
+            addr_q__d = c_fb_base;
+        end
+        if (line_end) begin
+            h__d = 32'h0;
+            if (v__q == c_v_last) begin
+                v__d = 32'h0;
+            end
+            else begin
+                v__d = v__q + 32'h1;
+            end
+            if (in_y) begin
+                if (vrep__q == c_rep_last) begin
+                    vrep__d = 32'h0;
+                    row_base__d = row_base__q + c_fb_width;
+                end
+                else begin
+                    vrep__d = vrep__q + 32'h1;
+                end
+            end
+            else begin
+                vrep__d = 32'h0;
+                row_base__d = c_fb_base;
+            end
+        end
+        else begin
+            h__d = h__q + 32'h1;
+        end
+        if (in_x) begin
+            if (hrep__q == c_rep_last) begin
+                hrep__d = 32'h0;
+                col__d = col__q + 32'h1;
+            end
+            else begin
+                hrep__d = hrep__q + 32'h1;
+            end
+        end
+        else begin
+            hrep__d = 32'h0;
+            col__d = 32'h0;
+        end
+        if (reset) begin
+            h__d = 32'h0;
+            v__d = 32'h0;
+            col__d = 32'h0;
+            hrep__d = 32'h0;
+            vrep__d = 32'h0;
+            row_base__d = c_fb_base;
+        end
+        hsync = hsync_q__q;
+        vsync = vsync_q__q;
+        blank = blank_q__q;
+        border = border_q__q;
+        frame_start = start_q__q;
+        x = x_q__q;
+        y = y_q__q;
+        fb_addr = addr_q__q;
+    end
+    
+endmodule // dynrt_processor__display__timing
+
+
+
+
+
+
+
+
+module dynrt_processor__display__timing__col(d,q,clock);
+    
+    // Module arguments
+    input wire  [11:0] d;
+    output reg  [11:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 12'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__display__timing__col
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy);
     
     // Module arguments
     input wire  clock;
@@ -26,14 +646,14 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     output reg  fb_write;
     output reg  [23:0] fb_addr;
     output reg  [31:0] fb_data;
-    output reg  bank0_read;
-    output reg  [23:0] bank0_addr;
+    output wire  bank0_read;
+    output wire  [23:0] bank0_addr;
     input wire  [31:0] bank0_rdata;
-    output reg  bank2_read;
-    output reg  [23:0] bank2_addr;
+    output wire  bank2_read;
+    output wire  [23:0] bank2_addr;
     input wire  [31:0] bank2_rdata;
-    output reg  bank3_read;
-    output reg  [23:0] bank3_addr;
+    output wire  bank3_read;
+    output wire  [23:0] bank3_addr;
     input wire  [31:0] bank3_rdata;
     output reg  [31:0] transform_busy;
     output reg  [31:0] intersect_busy;
@@ -41,93 +661,21 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     
     // Constant declarations
     localparam  c_threads = 8'h20;
-    localparam  c_thread_mask = 32'hffffffff;
-    localparam  c_one = 32'h1;
-    localparam  c_ones = 32'hffffffff;
-    localparam  c_thread_ids__0 = 5'b0;
-    localparam  c_thread_ids__1 = 5'b1;
-    localparam  c_thread_ids__2 = 5'b10;
-    localparam  c_thread_ids__3 = 5'b11;
-    localparam  c_thread_ids__4 = 5'b100;
-    localparam  c_thread_ids__5 = 5'b101;
-    localparam  c_thread_ids__6 = 5'b110;
-    localparam  c_thread_ids__7 = 5'b111;
-    localparam  c_thread_ids__8 = 5'b1000;
-    localparam  c_thread_ids__9 = 5'b1001;
-    localparam  c_thread_ids__10 = 5'b1010;
-    localparam  c_thread_ids__11 = 5'b1011;
-    localparam  c_thread_ids__12 = 5'b1100;
-    localparam  c_thread_ids__13 = 5'b1101;
-    localparam  c_thread_ids__14 = 5'b1110;
-    localparam  c_thread_ids__15 = 5'b1111;
-    localparam  c_thread_ids__16 = 5'b10000;
-    localparam  c_thread_ids__17 = 5'b10001;
-    localparam  c_thread_ids__18 = 5'b10010;
-    localparam  c_thread_ids__19 = 5'b10011;
-    localparam  c_thread_ids__20 = 5'b10100;
-    localparam  c_thread_ids__21 = 5'b10101;
-    localparam  c_thread_ids__22 = 5'b10110;
-    localparam  c_thread_ids__23 = 5'b10111;
-    localparam  c_thread_ids__24 = 5'b11000;
-    localparam  c_thread_ids__25 = 5'b11001;
-    localparam  c_thread_ids__26 = 5'b11010;
-    localparam  c_thread_ids__27 = 5'b11011;
-    localparam  c_thread_ids__28 = 5'b11100;
-    localparam  c_thread_ids__29 = 5'b11101;
-    localparam  c_thread_ids__30 = 5'b11110;
-    localparam  c_thread_ids__31 = 5'b11111;
-    localparam  c_width = 16'h40;
-    localparam  c_height = 16'h30;
-    localparam  c_pixel_shift = 5'b110;
-    localparam  c_mem_latency = 8'h2;
-    localparam  c_index__0 = 8'h0;
-    localparam  c_index__1 = 8'h1;
-    localparam  c_index__2 = 8'h2;
-    localparam  c_index__3 = 8'h3;
-    localparam  c_index__4 = 8'h4;
-    localparam  c_index__5 = 8'h5;
-    localparam  c_index__6 = 8'h6;
-    localparam  c_index__7 = 8'h7;
-    localparam  c_reserve_bit = 32'h7;
-    localparam  op_fadd = 5'b1;
     localparam  op_fsub = 5'b10;
-    localparam  op_fmul = 5'b11;
     localparam  op_fdiv = 5'b100;
     localparam  op_fsqrt = 5'b101;
-    localparam  op_itof = 5'b110;
-    localparam  op_add = 5'b111;
-    localparam  op_sub = 5'b1000;
-    localparam  op_and = 5'b1001;
-    localparam  op_or = 5'b1010;
-    localparam  op_xor = 5'b1011;
-    localparam  op_shr = 5'b1100;
-    localparam  op_shl = 5'b1101;
     localparam  op_ld = 5'b1110;
     localparam  op_st = 5'b1111;
-    localparam  op_lds = 5'b10000;
     localparam  op_sts = 5'b10001;
-    localparam  op_bflt = 5'b10010;
-    localparam  op_bfle = 5'b10011;
-    localparam  op_bfeq = 5'b10100;
-    localparam  op_beq = 5'b10101;
-    localparam  op_bltu = 5'b10110;
-    localparam  op_jal = 5'b10111;
-    localparam  op_jr = 5'b11000;
     localparam  op_mbx = 5'b11001;
     localparam  op_mbc = 5'b11010;
     localparam  op_pixel = 5'b11011;
-    localparam  op_halt = 5'b11100;
     localparam  op_tri = 5'b11101;
     localparam  op_kd = 5'b11110;
-    localparam  op_byte = 5'b11111;
-    localparam  op_writes = 32'ha8817ffe;
     localparam  tri_ray_words = 32'h3;
     localparam  tri_init = 32'h3;
     localparam  tri_list = 32'h4;
     localparam  tri_wait = 32'h5;
-    localparam  tri_hit = 32'h6;
-    localparam  tri_instance = 32'h7;
-    localparam  tri_triangle = 32'h8;
     localparam  tri_object = 32'h9;
     localparam  tri_skip = 32'ha;
     localparam  kd_start = 32'h0;
@@ -140,6 +688,946 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     localparam  bank_lists = 3'b1;
     localparam  bank_uv = 3'b10;
     localparam  bank_t = 3'b11;
+    
+    // Enums
+    localparam FastKind__Computed = 0;
+    localparam FastKind__Scratch = 1;
+    localparam FastKind__Memory = 2;
+    localparam FastKind__TrianglesUv = 3;
+    localparam FastKind__TrianglesT = 4;
+    localparam FastKind__Nodes = 5;
+    
+    // Stub signals
+    reg  scheduler__clock;
+    reg  scheduler__running;
+    reg  scheduler__frame_start;
+    reg  scheduler__long_at_i3;
+    reg  scheduler__wb_valid;
+    reg  [4:0] scheduler__wb_thread;
+    reg  scheduler__wb_halt;
+    reg  scheduler__wb_wait_pending;
+    reg  scheduler__tester_done;
+    reg  [4:0] scheduler__tester_done_thread;
+    reg  scheduler__walk_done;
+    reg  [4:0] scheduler__walk_done_thread;
+    wire  scheduler__issue;
+    wire  [4:0] scheduler__pick;
+    reg  fetch__clock;
+    reg  fetch__epoch;
+    reg  fetch__issue;
+    reg  [4:0] fetch__pick;
+    wire  fetch__valid;
+    wire  [4:0] fetch__thread;
+    wire  [11:0] fetch__pc;
+    wire  [31:0] fetch__ctl;
+    wire  [31:0] fetch__imm;
+    wire  [31:0] fetch__aux;
+    reg  fetch__wb_valid;
+    reg  [4:0] fetch__wb_thread;
+    reg  fetch__wb_halt;
+    reg  [11:0] fetch__wb_next_pc;
+    reg  decode__clock;
+    reg  decode__valid_i2;
+    reg  [4:0] decode__thread_i2;
+    reg  [11:0] decode__pc_i2;
+    reg  [31:0] decode__ctl_i2;
+    reg  [31:0] decode__imm_i2;
+    reg  [31:0] decode__aux_i2;
+    wire  decode__valid;
+    wire  [4:0] decode__thread;
+    wire  [11:0] decode__pc;
+    wire  [4:0] decode__op;
+    wire  [7:0] decode__dst;
+    wire  decode__invert;
+    wire  [31:0] decode__imm;
+    wire  [2:0] decode__shift;
+    wire  [2:0] decode__bank;
+    wire  [11:0] decode__target;
+    wire  [31:0] decode__a;
+    wire  [31:0] decode__b;
+    wire  [31:0] decode__store;
+    reg  decode__wb_write;
+    reg  [4:0] decode__wb_thread;
+    reg  [7:0] decode__wb_dst;
+    reg  [31:0] decode__wb_data;
+    reg  mailboxes__clock;
+    reg  [4:0] mailboxes__read_thread;
+    reg  mailboxes__read_which;
+    reg  [4:0] mailboxes__thread;
+    reg  mailboxes__which;
+    reg  [31:0] mailboxes__value;
+    reg  mailboxes__insert;
+    reg  mailboxes__clear;
+    wire  mailboxes__hit;
+    reg  pixels__clock;
+    reg  pixels__frame_start;
+    reg  pixels__take;
+    wire  [31:0] pixels__word;
+    wire  pixels__exhausted;
+    reg  [4:0] execute__op;
+    reg  [31:0] execute__a;
+    reg  [31:0] execute__b;
+    reg  [31:0] execute__imm;
+    reg  [2:0] execute__shift;
+    reg  [2:0] execute__bank;
+    reg  [11:0] execute__pc;
+    reg  [31:0] execute__pixel;
+    reg  [23:0] execute__tester_best_t;
+    reg  execute__tester_hit;
+    reg  [31:0] execute__tester_instance;
+    reg  [31:0] execute__tester_triangle;
+    wire  [31:0] execute__fast;
+    wire  [2:0] execute__kind;
+    wire  execute__int_eq;
+    wire  execute__int_lt;
+    wire  [31:0] execute__mem_address;
+    wire  [31:0] execute__scratch_address;
+    reg  fp_units__clock;
+    reg  [23:0] fp_units__a;
+    reg  [23:0] fp_units__b;
+    reg  fp_units__sub;
+    wire  [23:0] fp_units__sum;
+    wire  [23:0] fp_units__product;
+    wire  [23:0] fp_units__quotient;
+    wire  [23:0] fp_units__root;
+    wire  fp_units__lt;
+    wire  fp_units__le;
+    wire  fp_units__eq;
+    wire  [7:0] fp_units__colour_byte;
+    reg  result_line__clock;
+    reg  result_line__valid;
+    reg  [4:0] result_line__op;
+    reg  [7:0] result_line__dst;
+    reg  [4:0] result_line__thread;
+    reg  result_line__invert;
+    reg  [11:0] result_line__pc;
+    reg  [11:0] result_line__target;
+    reg  result_line__is_wait;
+    reg  result_line__kd_busy;
+    reg  result_line__tri_busy;
+    reg  [11:0] result_line__jr_target;
+    reg  result_line__int_eq;
+    reg  result_line__int_lt;
+    reg  result_line__mb_hit;
+    reg  result_line__pix_done;
+    reg  [31:0] result_line__fast;
+    reg  [2:0] result_line__kind;
+    reg  [31:0] result_line__scratch_data;
+    reg  [31:0] result_line__mem_data;
+    reg  [31:0] result_line__nodes_data;
+    reg  [31:0] result_line__uv_data;
+    reg  [31:0] result_line__t_data;
+    wire  result_line__wb_valid;
+    wire  [4:0] result_line__wb_op;
+    wire  [7:0] result_line__wb_dst;
+    wire  [4:0] result_line__wb_thread;
+    wire  result_line__wb_invert;
+    wire  [11:0] result_line__wb_next;
+    wire  [11:0] result_line__wb_target;
+    wire  result_line__wb_wait;
+    wire  result_line__wb_kd_busy;
+    wire  result_line__wb_tri_busy;
+    wire  [11:0] result_line__wb_jr_target;
+    wire  result_line__wb_int_eq;
+    wire  result_line__wb_int_lt;
+    wire  result_line__wb_mb_hit;
+    wire  result_line__wb_pix_done;
+    wire  [31:0] result_line__wb_fast;
+    reg  write_back__valid;
+    reg  [4:0] write_back__op;
+    reg  [7:0] write_back__dst;
+    reg  write_back__invert;
+    reg  [11:0] write_back__pc_plus_one;
+    reg  [11:0] write_back__target;
+    reg  write_back__is_wait;
+    reg  write_back__kd_busy;
+    reg  write_back__tri_busy;
+    reg  [11:0] write_back__jr_target;
+    reg  write_back__int_eq;
+    reg  write_back__int_lt;
+    reg  write_back__mb_hit;
+    reg  write_back__pix_done;
+    reg  [31:0] write_back__fast;
+    reg  [23:0] write_back__sum;
+    reg  [23:0] write_back__product;
+    reg  [23:0] write_back__quotient;
+    reg  [23:0] write_back__root;
+    reg  write_back__lt;
+    reg  write_back__le;
+    reg  write_back__eq;
+    reg  [7:0] write_back__colour_byte;
+    wire  write_back__write;
+    wire  [31:0] write_back__data;
+    wire  [11:0] write_back__next_pc;
+    wire  write_back__halt;
+    wire  write_back__retired;
+    wire  write_back__wait_pending;
+    reg  [11:0] scratch__read_address;
+    reg  scratch__read_clock;
+    wire  [31:0] scratch__read_data;
+    reg  [11:0] scratch__write_address;
+    reg  scratch__write_clock;
+    reg  [31:0] scratch__write_data;
+    reg  scratch__write_enable;
+    reg  tester__clock;
+    reg  [4:0] tester__engine__thread;
+    reg  [31:0] tester__engine__word_a;
+    reg  [31:0] tester__engine__word_b;
+    reg  tester__engine__ray_write;
+    reg  [1:0] tester__engine__ray_pair;
+    reg  tester__engine__enqueue;
+    wire  tester__engine__full;
+    reg  [4:0] tester__engine__query_thread;
+    wire  tester__engine__pending;
+    wire  tester__engine__done;
+    wire  [4:0] tester__engine__done_thread;
+    reg  tester__engine__load_read;
+    reg  [2:0] tester__engine__load_bank;
+    reg  [23:0] tester__engine__load_addr;
+    reg  [1:0] tester__queue_kind;
+    wire  tester__hit;
+    wire  [23:0] tester__best_t;
+    wire  [31:0] tester__best_instance;
+    wire  [31:0] tester__best_triangle;
+    wire  tester__lists__read;
+    wire  [23:0] tester__lists__addr;
+    reg  [31:0] tester__lists__rdata;
+    reg  tester__walk_list_valid;
+    reg  [4:0] tester__walk_list_thread;
+    reg  [31:0] tester__walk_list_from;
+    reg  [31:0] tester__walk_list_to;
+    wire  tester__walk_list_take;
+    wire  tester__walk_end_event;
+    wire  [4:0] tester__walk_end_thread;
+    wire  [31:0] tester__walk_end_t;
+    wire  tester__walk_end_hit;
+    wire  tester__transform_busy;
+    wire  tester__intersect_busy;
+    reg  traversal_unit__clock;
+    reg  [4:0] traversal_unit__engine__thread;
+    reg  [31:0] traversal_unit__engine__word_a;
+    reg  [31:0] traversal_unit__engine__word_b;
+    reg  traversal_unit__engine__ray_write;
+    reg  [1:0] traversal_unit__engine__ray_pair;
+    reg  traversal_unit__engine__enqueue;
+    wire  traversal_unit__engine__full;
+    reg  [4:0] traversal_unit__engine__query_thread;
+    wire  traversal_unit__engine__pending;
+    wire  traversal_unit__engine__done;
+    wire  [4:0] traversal_unit__engine__done_thread;
+    reg  traversal_unit__engine__load_read;
+    reg  [2:0] traversal_unit__engine__load_bank;
+    reg  [23:0] traversal_unit__engine__load_addr;
+    reg  traversal_unit__t_min_write;
+    wire  traversal_unit__step_busy;
+    wire  traversal_unit__leaf_valid;
+    wire  [4:0] traversal_unit__leaf_thread;
+    wire  [31:0] traversal_unit__leaf_from;
+    wire  [31:0] traversal_unit__leaf_to;
+    reg  traversal_unit__leaf_take;
+    reg  traversal_unit__answer_valid;
+    reg  [4:0] traversal_unit__answer_thread;
+    reg  [31:0] traversal_unit__answer_t;
+    reg  traversal_unit__answer_hit;
+    reg  running__d;
+    wire  running__q;
+    reg  running__clock;
+    reg  epoch__d;
+    wire  epoch__q;
+    reg  epoch__clock;
+    reg  [7:0] halted_count__d;
+    wire  [7:0] halted_count__q;
+    reg  halted_count__clock;
+    reg  [31:0] cycle_count__d;
+    wire  [31:0] cycle_count__q;
+    reg  cycle_count__clock;
+    reg  [31:0] instr_count__d;
+    wire  [31:0] instr_count__q;
+    reg  instr_count__clock;
+    reg  [31:0] transform_count__d;
+    wire  [31:0] transform_count__q;
+    reg  transform_count__clock;
+    reg  [31:0] intersect_count__d;
+    wire  [31:0] intersect_count__q;
+    reg  intersect_count__clock;
+    reg  [31:0] traversal_count__d;
+    wire  [31:0] traversal_count__q;
+    reg  traversal_count__clock;
+    reg  mem_read_r__d;
+    wire  mem_read_r__q;
+    reg  mem_read_r__clock;
+    reg  [2:0] mem_bank_r__d;
+    wire  [2:0] mem_bank_r__q;
+    reg  mem_bank_r__clock;
+    reg  [23:0] mem_addr_r__d;
+    wire  [23:0] mem_addr_r__q;
+    reg  mem_addr_r__clock;
+    reg  fb_write_r__d;
+    wire  fb_write_r__q;
+    reg  fb_write_r__clock;
+    reg  [23:0] fb_addr_r__d;
+    wire  [23:0] fb_addr_r__q;
+    reg  fb_addr_r__clock;
+    reg  [31:0] fb_data_r__d;
+    wire  [31:0] fb_data_r__q;
+    reg  fb_data_r__clock;
+    
+    // Local signals
+    reg  frame_start;
+    reg  is_tri;
+    reg  ray_write;
+    reg  tri_queues;
+    reg  [1:0] tri_kind;
+    reg  tri_busy;
+    reg  kd_busy;
+    reg  wait_fn;
+    
+    // Sub module instances
+    dynrt_processor__engine__scheduler scheduler(
+        .clock(scheduler__clock),
+        .running(scheduler__running),
+        .frame_start(scheduler__frame_start),
+        .long_at_i3(scheduler__long_at_i3),
+        .wb_valid(scheduler__wb_valid),
+        .wb_thread(scheduler__wb_thread),
+        .wb_halt(scheduler__wb_halt),
+        .wb_wait_pending(scheduler__wb_wait_pending),
+        .tester_done(scheduler__tester_done),
+        .tester_done_thread(scheduler__tester_done_thread),
+        .walk_done(scheduler__walk_done),
+        .walk_done_thread(scheduler__walk_done_thread),
+        .issue(scheduler__issue),
+        .pick(scheduler__pick)
+    );
+    dynrt_processor__engine__fetch fetch(
+        .clock(fetch__clock),
+        .epoch(fetch__epoch),
+        .issue(fetch__issue),
+        .pick(fetch__pick),
+        .valid(fetch__valid),
+        .thread(fetch__thread),
+        .pc(fetch__pc),
+        .ctl(fetch__ctl),
+        .imm(fetch__imm),
+        .aux(fetch__aux),
+        .wb_valid(fetch__wb_valid),
+        .wb_thread(fetch__wb_thread),
+        .wb_halt(fetch__wb_halt),
+        .wb_next_pc(fetch__wb_next_pc)
+    );
+    dynrt_processor__engine__decode decode(
+        .clock(decode__clock),
+        .valid_i2(decode__valid_i2),
+        .thread_i2(decode__thread_i2),
+        .pc_i2(decode__pc_i2),
+        .ctl_i2(decode__ctl_i2),
+        .imm_i2(decode__imm_i2),
+        .aux_i2(decode__aux_i2),
+        .valid(decode__valid),
+        .thread(decode__thread),
+        .pc(decode__pc),
+        .op(decode__op),
+        .dst(decode__dst),
+        .invert(decode__invert),
+        .imm(decode__imm),
+        .shift(decode__shift),
+        .bank(decode__bank),
+        .target(decode__target),
+        .a(decode__a),
+        .b(decode__b),
+        .store(decode__store),
+        .wb_write(decode__wb_write),
+        .wb_thread(decode__wb_thread),
+        .wb_dst(decode__wb_dst),
+        .wb_data(decode__wb_data)
+    );
+    dynrt_processor__engine__mailboxes mailboxes(
+        .clock(mailboxes__clock),
+        .read_thread(mailboxes__read_thread),
+        .read_which(mailboxes__read_which),
+        .thread(mailboxes__thread),
+        .which(mailboxes__which),
+        .value(mailboxes__value),
+        .insert(mailboxes__insert),
+        .clear(mailboxes__clear),
+        .hit(mailboxes__hit)
+    );
+    dynrt_processor__engine__pixels pixels(
+        .clock(pixels__clock),
+        .frame_start(pixels__frame_start),
+        .take(pixels__take),
+        .word(pixels__word),
+        .exhausted(pixels__exhausted)
+    );
+    dynrt_processor__engine__execute execute(
+        .op(execute__op),
+        .a(execute__a),
+        .b(execute__b),
+        .imm(execute__imm),
+        .shift(execute__shift),
+        .bank(execute__bank),
+        .pc(execute__pc),
+        .pixel(execute__pixel),
+        .tester_best_t(execute__tester_best_t),
+        .tester_hit(execute__tester_hit),
+        .tester_instance(execute__tester_instance),
+        .tester_triangle(execute__tester_triangle),
+        .fast(execute__fast),
+        .kind(execute__kind),
+        .int_eq(execute__int_eq),
+        .int_lt(execute__int_lt),
+        .mem_address(execute__mem_address),
+        .scratch_address(execute__scratch_address)
+    );
+    dynrt_processor__engine__fp_units fp_units(
+        .clock(fp_units__clock),
+        .a(fp_units__a),
+        .b(fp_units__b),
+        .sub(fp_units__sub),
+        .sum(fp_units__sum),
+        .product(fp_units__product),
+        .quotient(fp_units__quotient),
+        .root(fp_units__root),
+        .lt(fp_units__lt),
+        .le(fp_units__le),
+        .eq(fp_units__eq),
+        .colour_byte(fp_units__colour_byte)
+    );
+    dynrt_processor__engine__result_line result_line(
+        .clock(result_line__clock),
+        .valid(result_line__valid),
+        .op(result_line__op),
+        .dst(result_line__dst),
+        .thread(result_line__thread),
+        .invert(result_line__invert),
+        .pc(result_line__pc),
+        .target(result_line__target),
+        .is_wait(result_line__is_wait),
+        .kd_busy(result_line__kd_busy),
+        .tri_busy(result_line__tri_busy),
+        .jr_target(result_line__jr_target),
+        .int_eq(result_line__int_eq),
+        .int_lt(result_line__int_lt),
+        .mb_hit(result_line__mb_hit),
+        .pix_done(result_line__pix_done),
+        .fast(result_line__fast),
+        .kind(result_line__kind),
+        .scratch_data(result_line__scratch_data),
+        .mem_data(result_line__mem_data),
+        .nodes_data(result_line__nodes_data),
+        .uv_data(result_line__uv_data),
+        .t_data(result_line__t_data),
+        .wb_valid(result_line__wb_valid),
+        .wb_op(result_line__wb_op),
+        .wb_dst(result_line__wb_dst),
+        .wb_thread(result_line__wb_thread),
+        .wb_invert(result_line__wb_invert),
+        .wb_next(result_line__wb_next),
+        .wb_target(result_line__wb_target),
+        .wb_wait(result_line__wb_wait),
+        .wb_kd_busy(result_line__wb_kd_busy),
+        .wb_tri_busy(result_line__wb_tri_busy),
+        .wb_jr_target(result_line__wb_jr_target),
+        .wb_int_eq(result_line__wb_int_eq),
+        .wb_int_lt(result_line__wb_int_lt),
+        .wb_mb_hit(result_line__wb_mb_hit),
+        .wb_pix_done(result_line__wb_pix_done),
+        .wb_fast(result_line__wb_fast)
+    );
+    dynrt_processor__engine__write_back write_back(
+        .valid(write_back__valid),
+        .op(write_back__op),
+        .dst(write_back__dst),
+        .invert(write_back__invert),
+        .pc_plus_one(write_back__pc_plus_one),
+        .target(write_back__target),
+        .is_wait(write_back__is_wait),
+        .kd_busy(write_back__kd_busy),
+        .tri_busy(write_back__tri_busy),
+        .jr_target(write_back__jr_target),
+        .int_eq(write_back__int_eq),
+        .int_lt(write_back__int_lt),
+        .mb_hit(write_back__mb_hit),
+        .pix_done(write_back__pix_done),
+        .fast(write_back__fast),
+        .sum(write_back__sum),
+        .product(write_back__product),
+        .quotient(write_back__quotient),
+        .root(write_back__root),
+        .lt(write_back__lt),
+        .le(write_back__le),
+        .eq(write_back__eq),
+        .colour_byte(write_back__colour_byte),
+        .write(write_back__write),
+        .data(write_back__data),
+        .next_pc(write_back__next_pc),
+        .halt(write_back__halt),
+        .retired(write_back__retired),
+        .wait_pending(write_back__wait_pending)
+    );
+    dynrt_processor__engine__scratch scratch(
+        .read_address(scratch__read_address),
+        .read_clock(scratch__read_clock),
+        .read_data(scratch__read_data),
+        .write_address(scratch__write_address),
+        .write_clock(scratch__write_clock),
+        .write_data(scratch__write_data),
+        .write_enable(scratch__write_enable)
+    );
+    dynrt_processor__engine__tester tester(
+        .clock(tester__clock),
+        .engine__thread(tester__engine__thread),
+        .engine__word_a(tester__engine__word_a),
+        .engine__word_b(tester__engine__word_b),
+        .engine__ray_write(tester__engine__ray_write),
+        .engine__ray_pair(tester__engine__ray_pair),
+        .engine__enqueue(tester__engine__enqueue),
+        .engine__full(tester__engine__full),
+        .engine__query_thread(tester__engine__query_thread),
+        .engine__pending(tester__engine__pending),
+        .engine__done(tester__engine__done),
+        .engine__done_thread(tester__engine__done_thread),
+        .engine__load_read(tester__engine__load_read),
+        .engine__load_bank(tester__engine__load_bank),
+        .engine__load_addr(tester__engine__load_addr),
+        .queue_kind(tester__queue_kind),
+        .hit(tester__hit),
+        .best_t(tester__best_t),
+        .best_instance(tester__best_instance),
+        .best_triangle(tester__best_triangle),
+        .uv_words__read(bank2_read),
+        .uv_words__addr(bank2_addr),
+        .uv_words__rdata(bank2_rdata),
+        .t_words__read(bank3_read),
+        .t_words__addr(bank3_addr),
+        .t_words__rdata(bank3_rdata),
+        .lists__read(tester__lists__read),
+        .lists__addr(tester__lists__addr),
+        .lists__rdata(tester__lists__rdata),
+        .walk_list_valid(tester__walk_list_valid),
+        .walk_list_thread(tester__walk_list_thread),
+        .walk_list_from(tester__walk_list_from),
+        .walk_list_to(tester__walk_list_to),
+        .walk_list_take(tester__walk_list_take),
+        .walk_end_event(tester__walk_end_event),
+        .walk_end_thread(tester__walk_end_thread),
+        .walk_end_t(tester__walk_end_t),
+        .walk_end_hit(tester__walk_end_hit),
+        .transform_busy(tester__transform_busy),
+        .intersect_busy(tester__intersect_busy)
+    );
+    dynrt_processor__engine__traversal_unit traversal_unit(
+        .clock(traversal_unit__clock),
+        .engine__thread(traversal_unit__engine__thread),
+        .engine__word_a(traversal_unit__engine__word_a),
+        .engine__word_b(traversal_unit__engine__word_b),
+        .engine__ray_write(traversal_unit__engine__ray_write),
+        .engine__ray_pair(traversal_unit__engine__ray_pair),
+        .engine__enqueue(traversal_unit__engine__enqueue),
+        .engine__full(traversal_unit__engine__full),
+        .engine__query_thread(traversal_unit__engine__query_thread),
+        .engine__pending(traversal_unit__engine__pending),
+        .engine__done(traversal_unit__engine__done),
+        .engine__done_thread(traversal_unit__engine__done_thread),
+        .engine__load_read(traversal_unit__engine__load_read),
+        .engine__load_bank(traversal_unit__engine__load_bank),
+        .engine__load_addr(traversal_unit__engine__load_addr),
+        .t_min_write(traversal_unit__t_min_write),
+        .nodes__read(bank0_read),
+        .nodes__addr(bank0_addr),
+        .nodes__rdata(bank0_rdata),
+        .step_busy(traversal_unit__step_busy),
+        .leaf_valid(traversal_unit__leaf_valid),
+        .leaf_thread(traversal_unit__leaf_thread),
+        .leaf_from(traversal_unit__leaf_from),
+        .leaf_to(traversal_unit__leaf_to),
+        .leaf_take(traversal_unit__leaf_take),
+        .answer_valid(traversal_unit__answer_valid),
+        .answer_thread(traversal_unit__answer_thread),
+        .answer_t(traversal_unit__answer_t),
+        .answer_hit(traversal_unit__answer_hit)
+    );
+    dynrt_processor__display__dark_d running(
+        .d(running__d),
+        .q(running__q),
+        .clock(running__clock)
+    );
+    dynrt_processor__display__dark_d epoch(
+        .d(epoch__d),
+        .q(epoch__q),
+        .clock(epoch__clock)
+    );
+    dynrt_processor__engine__halted_count halted_count(
+        .d(halted_count__d),
+        .q(halted_count__q),
+        .clock(halted_count__clock)
+    );
+    dynrt_processor__engine__cycle_count cycle_count(
+        .d(cycle_count__d),
+        .q(cycle_count__q),
+        .clock(cycle_count__clock)
+    );
+    dynrt_processor__engine__cycle_count instr_count(
+        .d(instr_count__d),
+        .q(instr_count__q),
+        .clock(instr_count__clock)
+    );
+    dynrt_processor__engine__cycle_count transform_count(
+        .d(transform_count__d),
+        .q(transform_count__q),
+        .clock(transform_count__clock)
+    );
+    dynrt_processor__engine__cycle_count intersect_count(
+        .d(intersect_count__d),
+        .q(intersect_count__q),
+        .clock(intersect_count__clock)
+    );
+    dynrt_processor__engine__cycle_count traversal_count(
+        .d(traversal_count__d),
+        .q(traversal_count__q),
+        .clock(traversal_count__clock)
+    );
+    dynrt_processor__display__dark_d mem_read_r(
+        .d(mem_read_r__d),
+        .q(mem_read_r__q),
+        .clock(mem_read_r__clock)
+    );
+    dynrt_processor__engine__mem_bank_r mem_bank_r(
+        .d(mem_bank_r__d),
+        .q(mem_bank_r__q),
+        .clock(mem_bank_r__clock)
+    );
+    dynrt_processor__display__rgb_q mem_addr_r(
+        .d(mem_addr_r__d),
+        .q(mem_addr_r__q),
+        .clock(mem_addr_r__clock)
+    );
+    dynrt_processor__display__dark_d fb_write_r(
+        .d(fb_write_r__d),
+        .q(fb_write_r__q),
+        .clock(fb_write_r__clock)
+    );
+    dynrt_processor__display__rgb_q fb_addr_r(
+        .d(fb_addr_r__d),
+        .q(fb_addr_r__q),
+        .clock(fb_addr_r__clock)
+    );
+    dynrt_processor__engine__cycle_count fb_data_r(
+        .d(fb_data_r__d),
+        .q(fb_data_r__q),
+        .clock(fb_data_r__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        running__clock = clock;
+        epoch__clock = clock;
+        halted_count__clock = clock;
+        cycle_count__clock = clock;
+        instr_count__clock = clock;
+        transform_count__clock = clock;
+        intersect_count__clock = clock;
+        traversal_count__clock = clock;
+        mem_read_r__clock = clock;
+        mem_bank_r__clock = clock;
+        mem_addr_r__clock = clock;
+        fb_write_r__clock = clock;
+        fb_addr_r__clock = clock;
+        fb_data_r__clock = clock;
+        running__d = running__q;
+        epoch__d = epoch__q;
+        halted_count__d = halted_count__q;
+        cycle_count__d = cycle_count__q;
+        instr_count__d = instr_count__q;
+        transform_count__d = transform_count__q;
+        intersect_count__d = intersect_count__q;
+        traversal_count__d = traversal_count__q;
+        mem_read_r__d = mem_read_r__q;
+        mem_bank_r__d = mem_bank_r__q;
+        mem_addr_r__d = mem_addr_r__q;
+        fb_write_r__d = fb_write_r__q;
+        fb_addr_r__d = fb_addr_r__q;
+        fb_data_r__d = fb_data_r__q;
+        scheduler__clock = clock;
+        fetch__clock = clock;
+        decode__clock = clock;
+        mailboxes__clock = clock;
+        pixels__clock = clock;
+        fp_units__clock = clock;
+        result_line__clock = clock;
+        tester__clock = clock;
+        traversal_unit__clock = clock;
+        scratch__read_clock = clock;
+        scratch__write_clock = clock;
+        frame_start = start & (~running__q);
+        done = (~running__q) & (halted_count__q == c_threads);
+        cycles = cycle_count__q;
+        instructions = instr_count__q;
+        transform_busy = transform_count__q;
+        intersect_busy = intersect_count__q;
+        traversal_busy = traversal_count__q;
+        if (running__q) begin
+            cycle_count__d = cycle_count__q + 32'h1;
+            if (tester__transform_busy) begin
+                transform_count__d = transform_count__q + 32'h1;
+            end
+            if (tester__intersect_busy) begin
+                intersect_count__d = intersect_count__q + 32'h1;
+            end
+            if (traversal_unit__step_busy) begin
+                traversal_count__d = traversal_count__q + 32'h1;
+            end
+        end
+        scheduler__running = running__q;
+        scheduler__frame_start = frame_start;
+        fetch__epoch = epoch__q;
+        fetch__issue = scheduler__issue;
+        fetch__pick = scheduler__pick;
+        decode__valid_i2 = fetch__valid;
+        decode__thread_i2 = fetch__thread;
+        decode__pc_i2 = fetch__pc;
+        decode__ctl_i2 = fetch__ctl;
+        decode__imm_i2 = fetch__imm;
+        decode__aux_i2 = fetch__aux;
+        mailboxes__read_thread = fetch__thread;
+        mailboxes__read_which = fetch__imm[32'h0];
+        tester__engine__query_thread = fetch__thread;
+        traversal_unit__engine__query_thread = fetch__thread;
+        scheduler__long_at_i3 = decode__valid & ((decode__op == op_fdiv) | (decode__op == op_fsqrt));
+        fp_units__a = decode__a[(32'h0)+:(24)];
+        fp_units__b = decode__b[(32'h0)+:(24)];
+        fp_units__sub = decode__op == op_fsub;
+        execute__op = decode__op;
+        execute__a = decode__a;
+        execute__b = decode__b;
+        execute__imm = decode__imm;
+        execute__shift = decode__shift;
+        execute__bank = decode__bank;
+        execute__pc = decode__pc;
+        execute__pixel = pixels__word;
+        execute__tester_best_t = tester__best_t;
+        execute__tester_hit = tester__hit;
+        execute__tester_instance = tester__best_instance;
+        execute__tester_triangle = tester__best_triangle;
+        mailboxes__thread = decode__thread;
+        mailboxes__which = decode__imm[32'h0];
+        mailboxes__value = decode__a;
+        mailboxes__insert = decode__valid & (decode__op == op_mbx);
+        mailboxes__clear = decode__valid & (decode__op == op_mbc);
+        pixels__frame_start = frame_start;
+        pixels__take = running__q & decode__valid & (decode__op == op_pixel);
+        scratch__read_address = (((decode__thread) & 12'hfff) << 32'h7) | ((execute__scratch_address[(32'h0)+:(7)]) & 12'hfff);
+        scratch__write_address = (((decode__thread) & 12'hfff) << 32'h7) | ((execute__scratch_address[(32'h0)+:(7)]) & 12'hfff);
+        scratch__write_data = decode__store;
+        scratch__write_enable = decode__valid & (decode__op == op_sts);
+        mem_read_r__d = decode__valid & (decode__op == op_ld);
+        mem_bank_r__d = decode__bank;
+        mem_addr_r__d = execute__mem_address[(32'h0)+:(24)];
+        fb_write_r__d = decode__valid & (decode__op == op_st);
+        fb_addr_r__d = execute__mem_address[(32'h0)+:(24)];
+        fb_data_r__d = decode__store;
+        fb_write = fb_write_r__q;
+        fb_addr = fb_addr_r__q;
+        fb_data = fb_data_r__q;
+        mem_read = (mem_read_r__q & (mem_bank_r__q != bank_nodes) & (mem_bank_r__q != bank_uv) & (mem_bank_r__q != bank_t)) | tester__lists__read;
+        if (tester__lists__read) begin
+            mem_bank = bank_lists;
+            mem_addr = tester__lists__addr;
+        end
+        else begin
+            mem_bank = mem_bank_r__q;
+            mem_addr = mem_addr_r__q;
+        end
+        tester__lists__rdata = mem_rdata;
+        is_tri = decode__valid & (decode__op == op_tri);
+        ray_write = is_tri & (decode__imm < tri_ray_words);
+        traversal_unit__engine__load_read = mem_read_r__q;
+        traversal_unit__engine__load_bank = mem_bank_r__q;
+        traversal_unit__engine__load_addr = mem_addr_r__q;
+        traversal_unit__engine__thread = decode__thread;
+        traversal_unit__engine__word_a = decode__a;
+        traversal_unit__engine__word_b = decode__b;
+        traversal_unit__engine__ray_pair = decode__imm[(32'h0)+:(2)];
+        traversal_unit__engine__ray_write = ray_write;
+        tester__engine__load_read = mem_read_r__q;
+        tester__engine__load_bank = mem_bank_r__q;
+        tester__engine__load_addr = mem_addr_r__q;
+        tester__engine__thread = decode__thread;
+        tester__engine__word_a = decode__a;
+        tester__engine__word_b = decode__b;
+        tester__engine__ray_pair = decode__imm[(32'h0)+:(2)];
+        tester__engine__ray_write = ray_write;
+        tri_queues = (decode__imm == tri_init) | (decode__imm == tri_list) | (decode__imm == tri_object) | (decode__imm == tri_skip);
+        tester__engine__enqueue = is_tri & tri_queues;
+        tri_kind = cmd_list;
+        if (decode__imm == tri_init) begin
+            tri_kind = cmd_init;
+        end
+        if (decode__imm == tri_object) begin
+            tri_kind = cmd_object;
+        end
+        if (decode__imm == tri_skip) begin
+            tri_kind = cmd_skip;
+        end
+        tester__queue_kind = tri_kind;
+        tri_busy = 1'b0;
+        if (tri_queues) begin
+            tri_busy = tester__engine__full;
+        end
+        if (decode__imm == tri_wait) begin
+            tri_busy = tester__engine__pending;
+        end
+        tester__walk_list_valid = traversal_unit__leaf_valid;
+        tester__walk_list_thread = traversal_unit__leaf_thread;
+        tester__walk_list_from = traversal_unit__leaf_from;
+        tester__walk_list_to = traversal_unit__leaf_to;
+        traversal_unit__leaf_take = tester__walk_list_take;
+        traversal_unit__answer_valid = tester__walk_end_event;
+        traversal_unit__answer_thread = tester__walk_end_thread;
+        traversal_unit__answer_t = tester__walk_end_t;
+        traversal_unit__answer_hit = tester__walk_end_hit;
+        traversal_unit__t_min_write = is_tri & (decode__imm == tri_init);
+        traversal_unit__engine__enqueue = decode__valid & (decode__op == op_kd) & (decode__imm == kd_start);
+        if (decode__imm == kd_wait) begin
+            kd_busy = traversal_unit__engine__pending;
+        end
+        else begin
+            kd_busy = traversal_unit__engine__full;
+        end
+        wait_fn = ((decode__op == op_tri) & (decode__imm == tri_wait)) | ((decode__op == op_kd) & (decode__imm == kd_wait));
+        result_line__valid = decode__valid;
+        result_line__op = decode__op;
+        result_line__dst = decode__dst;
+        result_line__thread = decode__thread;
+        result_line__invert = decode__invert;
+        result_line__pc = decode__pc;
+        result_line__target = decode__target;
+        result_line__is_wait = wait_fn;
+        result_line__kd_busy = kd_busy;
+        result_line__tri_busy = tri_busy;
+        result_line__jr_target = decode__a[(32'h0)+:(12)];
+        result_line__int_eq = execute__int_eq;
+        result_line__int_lt = execute__int_lt;
+        result_line__mb_hit = mailboxes__hit;
+        result_line__pix_done = pixels__exhausted;
+        result_line__fast = execute__fast;
+        result_line__kind = execute__kind;
+        result_line__scratch_data = scratch__read_data;
+        result_line__mem_data = mem_rdata;
+        result_line__nodes_data = bank0_rdata;
+        result_line__uv_data = bank2_rdata;
+        result_line__t_data = bank3_rdata;
+        write_back__valid = result_line__wb_valid;
+        write_back__op = result_line__wb_op;
+        write_back__dst = result_line__wb_dst;
+        write_back__invert = result_line__wb_invert;
+        write_back__pc_plus_one = result_line__wb_next;
+        write_back__target = result_line__wb_target;
+        write_back__is_wait = result_line__wb_wait;
+        write_back__kd_busy = result_line__wb_kd_busy;
+        write_back__tri_busy = result_line__wb_tri_busy;
+        write_back__jr_target = result_line__wb_jr_target;
+        write_back__int_eq = result_line__wb_int_eq;
+        write_back__int_lt = result_line__wb_int_lt;
+        write_back__mb_hit = result_line__wb_mb_hit;
+        write_back__pix_done = result_line__wb_pix_done;
+        write_back__fast = result_line__wb_fast;
+        write_back__sum = fp_units__sum;
+        write_back__product = fp_units__product;
+        write_back__quotient = fp_units__quotient;
+        write_back__root = fp_units__root;
+        write_back__lt = fp_units__lt;
+        write_back__le = fp_units__le;
+        write_back__eq = fp_units__eq;
+        write_back__colour_byte = fp_units__colour_byte;
+        decode__wb_write = write_back__write;
+        decode__wb_thread = result_line__wb_thread;
+        decode__wb_dst = result_line__wb_dst;
+        decode__wb_data = write_back__data;
+        fetch__wb_valid = result_line__wb_valid;
+        fetch__wb_thread = result_line__wb_thread;
+        fetch__wb_halt = write_back__halt;
+        fetch__wb_next_pc = write_back__next_pc;
+        scheduler__wb_valid = result_line__wb_valid;
+        scheduler__wb_thread = result_line__wb_thread;
+        scheduler__wb_halt = write_back__halt;
+        scheduler__wb_wait_pending = write_back__wait_pending;
+        scheduler__tester_done = tester__engine__done;
+        scheduler__tester_done_thread = tester__engine__done_thread;
+        scheduler__walk_done = traversal_unit__engine__done;
+        scheduler__walk_done_thread = traversal_unit__engine__done_thread;
+        if (write_back__retired) begin
+            instr_count__d = instr_count__q + 32'h1;
+        end
+        if (result_line__wb_valid & write_back__halt) begin
+            halted_count__d = halted_count__q + 32'h1;
+            if ((halted_count__q + 32'h1) == c_threads) begin
+                running__d = 1'b0;
+            end
+        end
+        if (frame_start) begin
+            running__d = 1'b1;
+            epoch__d = ~epoch__q;
+            halted_count__d = 32'h0;
+            cycle_count__d = 32'h0;
+            instr_count__d = 32'h0;
+            transform_count__d = 32'h0;
+            intersect_count__d = 32'h0;
+            traversal_count__d = 32'h0;
+        end
+    end
+    
+endmodule // dynrt_processor__engine
+
+
+module dynrt_processor__engine__cycle_count(d,q,clock);
+    
+    // Module arguments
+    input wire  [31:0] d;
+    output reg  [31:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 32'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__cycle_count
+
+
+module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm_i2,aux_i2,valid,thread,pc,op,dst,invert,imm,shift,bank,target,a,b,store,wb_write,wb_thread,wb_dst,wb_data);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  valid_i2;
+    input wire  [4:0] thread_i2;
+    input wire  [11:0] pc_i2;
+    input wire  [31:0] ctl_i2;
+    input wire  [31:0] imm_i2;
+    input wire  [31:0] aux_i2;
+    output reg  valid;
+    output reg  [4:0] thread;
+    output reg  [11:0] pc;
+    output reg  [4:0] op;
+    output reg  [7:0] dst;
+    output reg  invert;
+    output reg  [31:0] imm;
+    output reg  [2:0] shift;
+    output reg  [2:0] bank;
+    output reg  [11:0] target;
+    output reg  [31:0] a;
+    output reg  [31:0] b;
+    output reg  [31:0] store;
+    input wire  wb_write;
+    input wire  [4:0] wb_thread;
+    input wire  [7:0] wb_dst;
+    input wire  [31:0] wb_data;
+    
+    // Constant declarations
     localparam  f_op = 5'b11010;
     localparam  f_dst = 5'b10010;
     localparam  f_a = 5'b1010;
@@ -150,6 +1638,268 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     localparam  f_bank = 5'b1100;
     localparam  f_target = 5'b0;
     
+    // Stub signals
+    reg  [12:0] regs_a__read_address;
+    reg  regs_a__read_clock;
+    wire  [31:0] regs_a__read_data;
+    reg  [12:0] regs_a__write_address;
+    reg  regs_a__write_clock;
+    reg  [31:0] regs_a__write_data;
+    reg  regs_a__write_enable;
+    reg  [12:0] regs_b__read_address;
+    reg  regs_b__read_clock;
+    wire  [31:0] regs_b__read_data;
+    reg  [12:0] regs_b__write_address;
+    reg  regs_b__write_clock;
+    reg  [31:0] regs_b__write_data;
+    reg  regs_b__write_enable;
+    reg  v3__d;
+    wire  v3__q;
+    reg  v3__clock;
+    reg  [4:0] t3__d;
+    wire  [4:0] t3__q;
+    reg  t3__clock;
+    reg  [11:0] pc3__d;
+    wire  [11:0] pc3__q;
+    reg  pc3__clock;
+    reg  [31:0] ctl3__d;
+    wire  [31:0] ctl3__q;
+    reg  ctl3__clock;
+    reg  [31:0] imm3__d;
+    wire  [31:0] imm3__q;
+    reg  imm3__clock;
+    reg  [31:0] aux3__d;
+    wire  [31:0] aux3__q;
+    reg  aux3__clock;
+    
+    // Local signals
+    reg  [7:0] reg_a;
+    reg  [7:0] reg_b;
+    reg  [12:0] wb_address;
+    
+    // Sub module instances
+    dynrt_processor__engine__decode__regs_a regs_a(
+        .read_address(regs_a__read_address),
+        .read_clock(regs_a__read_clock),
+        .read_data(regs_a__read_data),
+        .write_address(regs_a__write_address),
+        .write_clock(regs_a__write_clock),
+        .write_data(regs_a__write_data),
+        .write_enable(regs_a__write_enable)
+    );
+    dynrt_processor__engine__decode__regs_a regs_b(
+        .read_address(regs_b__read_address),
+        .read_clock(regs_b__read_clock),
+        .read_data(regs_b__read_data),
+        .write_address(regs_b__write_address),
+        .write_clock(regs_b__write_clock),
+        .write_data(regs_b__write_data),
+        .write_enable(regs_b__write_enable)
+    );
+    dynrt_processor__display__dark_d v3(
+        .d(v3__d),
+        .q(v3__q),
+        .clock(v3__clock)
+    );
+    dynrt_processor__engine__decode__t3 t3(
+        .d(t3__d),
+        .q(t3__q),
+        .clock(t3__clock)
+    );
+    dynrt_processor__display__timing__col pc3(
+        .d(pc3__d),
+        .q(pc3__q),
+        .clock(pc3__clock)
+    );
+    dynrt_processor__engine__cycle_count ctl3(
+        .d(ctl3__d),
+        .q(ctl3__q),
+        .clock(ctl3__clock)
+    );
+    dynrt_processor__engine__cycle_count imm3(
+        .d(imm3__d),
+        .q(imm3__q),
+        .clock(imm3__clock)
+    );
+    dynrt_processor__engine__cycle_count aux3(
+        .d(aux3__d),
+        .q(aux3__q),
+        .clock(aux3__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        v3__clock = clock;
+        t3__clock = clock;
+        pc3__clock = clock;
+        ctl3__clock = clock;
+        imm3__clock = clock;
+        aux3__clock = clock;
+        v3__d = v3__q;
+        t3__d = t3__q;
+        pc3__d = pc3__q;
+        ctl3__d = ctl3__q;
+        imm3__d = imm3__q;
+        aux3__d = aux3__q;
+        regs_a__read_clock = clock;
+        regs_a__write_clock = clock;
+        regs_b__read_clock = clock;
+        regs_b__write_clock = clock;
+        reg_a = ctl_i2[(f_a)+:(8)];
+        reg_b = ctl_i2[(f_b)+:(8)];
+        regs_a__read_address = (((thread_i2) & 13'h1fff) << 32'h8) | ((reg_a) & 13'h1fff);
+        regs_b__read_address = (((thread_i2) & 13'h1fff) << 32'h8) | ((reg_b) & 13'h1fff);
+        v3__d = valid_i2;
+        t3__d = thread_i2;
+        pc3__d = pc_i2;
+        ctl3__d = ctl_i2;
+        imm3__d = imm_i2;
+        aux3__d = aux_i2;
+        valid = v3__q;
+        thread = t3__q;
+        pc = pc3__q;
+        op = ctl3__q[(f_op)+:(5)];
+        dst = ctl3__q[(f_dst)+:(8)];
+        invert = ctl3__q[f_invert];
+        imm = imm3__q;
+        shift = aux3__q[(f_shift)+:(3)];
+        bank = aux3__q[(f_bank)+:(3)];
+        target = aux3__q[(f_target)+:(12)];
+        if (ctl3__q[(f_a)+:(8)] == 32'h0) begin
+            a = 32'h0;
+        end
+        else begin
+            a = regs_a__read_data;
+        end
+        if (ctl3__q[f_b_imm]) begin
+            b = imm3__q;
+        end
+        else if (ctl3__q[(f_b)+:(8)] == 32'h0) begin
+            b = 32'h0;
+        end
+        else begin
+            b = regs_b__read_data;
+        end
+        store = regs_b__read_data;
+        wb_address = (((wb_thread) & 13'h1fff) << 32'h8) | ((wb_dst) & 13'h1fff);
+        regs_a__write_address = wb_address;
+        regs_b__write_address = wb_address;
+        regs_a__write_data = wb_data;
+        regs_b__write_data = wb_data;
+        regs_a__write_enable = wb_write;
+        regs_b__write_enable = wb_write;
+    end
+    
+endmodule // dynrt_processor__engine__decode
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__decode__regs_a(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [12:0] read_address;
+    input wire  read_clock;
+    output reg  [31:0] read_data;
+    input wire  [12:0] write_address;
+    input wire  write_clock;
+    input wire  [31:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[31:0] mem[8191:0];
+    
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__decode__regs_a
+
+
+
+
+module dynrt_processor__engine__decode__t3(d,q,clock);
+    
+    // Module arguments
+    input wire  [4:0] d;
+    output reg  [4:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 5'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__decode__t3
+
+
+
+
+
+
+module dynrt_processor__engine__execute(op,a,b,imm,shift,bank,pc,pixel,tester_best_t,tester_hit,tester_instance,tester_triangle,fast,kind,int_eq,int_lt,mem_address,scratch_address);
+    
+    // Module arguments
+    input wire  [4:0] op;
+    input wire  [31:0] a;
+    input wire  [31:0] b;
+    input wire  [31:0] imm;
+    input wire  [2:0] shift;
+    input wire  [2:0] bank;
+    input wire  [11:0] pc;
+    input wire  [31:0] pixel;
+    input wire  [23:0] tester_best_t;
+    input wire  tester_hit;
+    input wire  [31:0] tester_instance;
+    input wire  [31:0] tester_triangle;
+    output reg  [31:0] fast;
+    output reg  [2:0] kind;
+    output reg  int_eq;
+    output reg  int_lt;
+    output reg  [31:0] mem_address;
+    output reg  [31:0] scratch_address;
+    
+    // Constant declarations
+    localparam  op_itof = 5'b110;
+    localparam  op_add = 5'b111;
+    localparam  op_sub = 5'b1000;
+    localparam  op_and = 5'b1001;
+    localparam  op_or = 5'b1010;
+    localparam  op_xor = 5'b1011;
+    localparam  op_shr = 5'b1100;
+    localparam  op_shl = 5'b1101;
+    localparam  op_ld = 5'b1110;
+    localparam  op_lds = 5'b10000;
+    localparam  op_jal = 5'b10111;
+    localparam  op_byte = 5'b11111;
+    localparam  op_pixel = 5'b11011;
+    localparam  op_tri = 5'b11101;
+    localparam  tri_wait = 32'h5;
+    localparam  tri_hit = 32'h6;
+    localparam  tri_instance = 32'h7;
+    localparam  tri_triangle = 32'h8;
+    localparam  bank_nodes = 3'b0;
+    localparam  bank_uv = 3'b10;
+    localparam  bank_t = 3'b11;
+    
     // Enums
     localparam FastKind__Computed = 0;
     localparam FastKind__Scratch = 1;
@@ -157,6 +1907,197 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     localparam FastKind__TrianglesUv = 3;
     localparam FastKind__TrianglesT = 4;
     localparam FastKind__Nodes = 5;
+    
+    // Stub signals
+    reg  [15:0] itof__value;
+    wire  [23:0] itof__word;
+    
+    // Local signals
+    reg  [31:0] result;
+    reg  [2:0] source;
+    
+    // Sub module instances
+    dynrt_processor__engine__execute__itof itof(
+        .value(itof__value),
+        .word(itof__word)
+    );
+    
+    // Update code
+    always @(*) begin
+        itof__value = a[(32'h0)+:(16)];
+        int_eq = a == b;
+        int_lt = a < b;
+        mem_address = (a << shift) + imm;
+        scratch_address = a + imm;
+        source = FastKind__Computed;
+        result = 32'h0;
+        if (op == op_itof) begin
+            result = ((itof__word) & 32'hffffffff);
+        end
+        if (op == op_add) begin
+            result = a + b;
+        end
+        if (op == op_sub) begin
+            result = a - b;
+        end
+        if (op == op_and) begin
+            result = a & b;
+        end
+        if (op == op_or) begin
+            result = a | b;
+        end
+        if (op == op_xor) begin
+            result = a ^ b;
+        end
+        if (op == op_shr) begin
+            result = a >> b[(32'h0)+:(5)];
+        end
+        if (op == op_shl) begin
+            result = a << b[(32'h0)+:(5)];
+        end
+        if (op == op_ld) begin
+            source = FastKind__Memory;
+            if (bank == bank_uv) begin
+                source = FastKind__TrianglesUv;
+            end
+            if (bank == bank_t) begin
+                source = FastKind__TrianglesT;
+            end
+            if (bank == bank_nodes) begin
+                source = FastKind__Nodes;
+            end
+        end
+        if (op == op_lds) begin
+            source = FastKind__Scratch;
+        end
+        if (op == op_jal) begin
+            result = ((pc + 32'h1) & 32'hffffffff);
+        end
+        if (op == op_byte) begin
+            result = b << 32'h8;
+        end
+        if (op == op_pixel) begin
+            result = pixel;
+        end
+        if (op == op_tri) begin
+            if (imm == tri_wait) begin
+                result = ((tester_best_t) & 32'hffffffff);
+            end
+            if (imm == tri_hit) begin
+                result = ((tester_hit) & 32'hffffffff);
+            end
+            if (imm == tri_instance) begin
+                result = tester_instance;
+            end
+            if (imm == tri_triangle) begin
+                result = tester_triangle;
+            end
+        end
+        fast = result;
+        kind = source;
+    end
+    
+endmodule // dynrt_processor__engine__execute
+
+
+module dynrt_processor__engine__execute__itof(value,word);
+    
+    // Module arguments
+    input wire  [15:0] value;
+    output reg  [23:0] word;
+    
+    // Constant declarations
+    localparam  c_shift__0 = 8'h8;
+    localparam  c_shift__1 = 8'h4;
+    localparam  c_shift__2 = 8'h2;
+    localparam  c_shift__3 = 8'h1;
+    localparam  c_shift_e__0 = 7'b1000;
+    localparam  c_shift_e__1 = 7'b100;
+    localparam  c_shift_e__2 = 7'b10;
+    localparam  c_shift_e__3 = 7'b1;
+    localparam  c_top_mask__0 = 16'hff00;
+    localparam  c_top_mask__1 = 16'hf000;
+    localparam  c_top_mask__2 = 16'hc000;
+    localparam  c_top_mask__3 = 16'h8000;
+    localparam  c_exp_top = 7'b1001110;
+    localparam  c_man_bits = 8'h10;
+    localparam  c_fraction_pos = 8'h10;
+    localparam  c_fraction_shift = 8'h11;
+    
+    // Local signals
+    reg  [15:0] norm__0;
+    reg  [15:0] norm__1;
+    reg  [15:0] norm__2;
+    reg  [15:0] norm__3;
+    reg  [15:0] norm__4;
+    reg  [6:0] exp__0;
+    reg  [6:0] exp__1;
+    reg  [6:0] exp__2;
+    reg  [6:0] exp__3;
+    reg  [6:0] exp__4;
+    reg  [31:0] fraction;
+    
+    // Update code
+    always @(*) begin
+        norm__0 = value;
+        exp__0 = c_exp_top;
+        norm__1 = norm__0;
+        exp__1 = exp__0;
+        if ((norm__0 & c_top_mask__0) == 32'h0) begin
+            norm__1 = norm__0 << c_shift__0;
+            exp__1 = exp__0 - c_shift_e__0;
+        end
+        norm__2 = norm__1;
+        exp__2 = exp__1;
+        if ((norm__1 & c_top_mask__1) == 32'h0) begin
+            norm__2 = norm__1 << c_shift__1;
+            exp__2 = exp__1 - c_shift_e__1;
+        end
+        norm__3 = norm__2;
+        exp__3 = exp__2;
+        if ((norm__2 & c_top_mask__2) == 32'h0) begin
+            norm__3 = norm__2 << c_shift__2;
+            exp__3 = exp__2 - c_shift_e__2;
+        end
+        norm__4 = norm__3;
+        exp__4 = exp__3;
+        if ((norm__3 & c_top_mask__3) == 32'h0) begin
+            norm__4 = norm__3 << c_shift__3;
+            exp__4 = exp__3 - c_shift_e__3;
+        end
+        fraction = ((norm__4) & 32'hffffffff) << c_fraction_shift;
+        word = (((exp__4) & 24'hffffff) << c_man_bits) | ((fraction[(c_fraction_pos)+:(16)]) & 24'hffffff);
+        if (value == 32'h0) begin
+            word = 32'h0;
+        end
+    end
+    
+endmodule // dynrt_processor__engine__execute__itof
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl,imm,aux,wb_valid,wb_thread,wb_halt,wb_next_pc);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  epoch;
+    input wire  issue;
+    input wire  [4:0] pick;
+    output reg  valid;
+    output reg  [4:0] thread;
+    output reg  [11:0] pc;
+    output reg  [31:0] ctl;
+    output reg  [31:0] imm;
+    output reg  [31:0] aux;
+    input wire  wb_valid;
+    input wire  [4:0] wb_thread;
+    input wire  wb_halt;
+    input wire  [11:0] wb_next_pc;
     
     // Stub signals
     reg  [4:0] pc_ram__read_address;
@@ -187,132 +2128,6 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     reg  rom_aux__write_clock;
     reg  [31:0] rom_aux__write_data;
     reg  rom_aux__write_enable;
-    reg  [12:0] regs_a__read_address;
-    reg  regs_a__read_clock;
-    wire  [31:0] regs_a__read_data;
-    reg  [12:0] regs_a__write_address;
-    reg  regs_a__write_clock;
-    reg  [31:0] regs_a__write_data;
-    reg  regs_a__write_enable;
-    reg  [12:0] regs_b__read_address;
-    reg  regs_b__read_clock;
-    wire  [31:0] regs_b__read_data;
-    reg  [12:0] regs_b__write_address;
-    reg  regs_b__write_clock;
-    reg  [31:0] regs_b__write_data;
-    reg  regs_b__write_enable;
-    reg  [11:0] scratch__read_address;
-    reg  scratch__read_clock;
-    wire  [31:0] scratch__read_data;
-    reg  [11:0] scratch__write_address;
-    reg  scratch__write_clock;
-    reg  [31:0] scratch__write_data;
-    reg  scratch__write_enable;
-    reg  [5:0] mailbox__0__read_address;
-    reg  mailbox__0__read_clock;
-    wire  [31:0] mailbox__0__read_data;
-    reg  [5:0] mailbox__0__write_address;
-    reg  mailbox__0__write_clock;
-    reg  [31:0] mailbox__0__write_data;
-    reg  mailbox__0__write_enable;
-    reg  [5:0] mailbox__1__read_address;
-    reg  mailbox__1__read_clock;
-    wire  [31:0] mailbox__1__read_data;
-    reg  [5:0] mailbox__1__write_address;
-    reg  mailbox__1__write_clock;
-    reg  [31:0] mailbox__1__write_data;
-    reg  mailbox__1__write_enable;
-    reg  [5:0] mailbox__2__read_address;
-    reg  mailbox__2__read_clock;
-    wire  [31:0] mailbox__2__read_data;
-    reg  [5:0] mailbox__2__write_address;
-    reg  mailbox__2__write_clock;
-    reg  [31:0] mailbox__2__write_data;
-    reg  mailbox__2__write_enable;
-    reg  [5:0] mailbox__3__read_address;
-    reg  mailbox__3__read_clock;
-    wire  [31:0] mailbox__3__read_data;
-    reg  [5:0] mailbox__3__write_address;
-    reg  mailbox__3__write_clock;
-    reg  [31:0] mailbox__3__write_data;
-    reg  mailbox__3__write_enable;
-    reg  [5:0] mailbox__4__read_address;
-    reg  mailbox__4__read_clock;
-    wire  [31:0] mailbox__4__read_data;
-    reg  [5:0] mailbox__4__write_address;
-    reg  mailbox__4__write_clock;
-    reg  [31:0] mailbox__4__write_data;
-    reg  mailbox__4__write_enable;
-    reg  [5:0] mailbox__5__read_address;
-    reg  mailbox__5__read_clock;
-    wire  [31:0] mailbox__5__read_data;
-    reg  [5:0] mailbox__5__write_address;
-    reg  mailbox__5__write_clock;
-    reg  [31:0] mailbox__5__write_data;
-    reg  mailbox__5__write_enable;
-    reg  [5:0] mailbox__6__read_address;
-    reg  mailbox__6__read_clock;
-    wire  [31:0] mailbox__6__read_data;
-    reg  [5:0] mailbox__6__write_address;
-    reg  mailbox__6__write_clock;
-    reg  [31:0] mailbox__6__write_data;
-    reg  mailbox__6__write_enable;
-    reg  [5:0] mailbox__7__read_address;
-    reg  mailbox__7__read_clock;
-    wire  [31:0] mailbox__7__read_data;
-    reg  [5:0] mailbox__7__write_address;
-    reg  mailbox__7__write_clock;
-    reg  [31:0] mailbox__7__write_data;
-    reg  mailbox__7__write_enable;
-    reg  [5:0] mailbox_meta__read_address;
-    reg  mailbox_meta__read_clock;
-    wire  [7:0] mailbox_meta__read_data;
-    reg  [5:0] mailbox_meta__write_address;
-    reg  mailbox_meta__write_clock;
-    reg  [7:0] mailbox_meta__write_data;
-    reg  mailbox_meta__write_enable;
-    reg  running__d;
-    wire  running__q;
-    reg  running__clock;
-    reg  epoch__d;
-    wire  epoch__q;
-    reg  epoch__clock;
-    reg  [31:0] ready__d;
-    wire  [31:0] ready__q;
-    reg  ready__clock;
-    reg  [31:0] asleep__d;
-    wire  [31:0] asleep__q;
-    reg  asleep__clock;
-    reg  [31:0] woken__d;
-    wire  [31:0] woken__q;
-    reg  woken__clock;
-    reg  [4:0] last_pick__d;
-    wire  [4:0] last_pick__q;
-    reg  last_pick__clock;
-    reg  [7:0] halted_count__d;
-    wire  [7:0] halted_count__q;
-    reg  halted_count__clock;
-    reg  [31:0] cycle_count__d;
-    wire  [31:0] cycle_count__q;
-    reg  cycle_count__clock;
-    reg  [31:0] instr_count__d;
-    wire  [31:0] instr_count__q;
-    reg  instr_count__clock;
-    reg  [31:0] transform_count__d;
-    wire  [31:0] transform_count__q;
-    reg  transform_count__clock;
-    reg  [31:0] intersect_count__d;
-    wire  [31:0] intersect_count__q;
-    reg  intersect_count__clock;
-    reg  [31:0] traversal_count__d;
-    wire  [31:0] traversal_count__q;
-    reg  traversal_count__clock;
-    reg  [15:0] px__d;
-    wire  [15:0] px__q;
-    reg  px__clock;
-    reg  [15:0] py__d;
-    wire  [15:0] py__q;
-    reg  py__clock;
     reg  v1__d;
     wire  v1__q;
     reg  v1__clock;
@@ -328,42 +2143,766 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     reg  [11:0] pc2__d;
     wire  [11:0] pc2__q;
     reg  pc2__clock;
-    reg  v3__d;
-    wire  v3__q;
-    reg  v3__clock;
-    reg  [4:0] t3__d;
-    wire  [4:0] t3__q;
-    reg  t3__clock;
-    reg  [11:0] pc3__d;
-    wire  [11:0] pc3__q;
-    reg  pc3__clock;
-    reg  [31:0] ctl3__d;
-    wire  [31:0] ctl3__q;
-    reg  ctl3__clock;
-    reg  [31:0] imm3__d;
-    wire  [31:0] imm3__q;
-    reg  imm3__clock;
-    reg  [31:0] aux3__d;
-    wire  [31:0] aux3__q;
-    reg  aux3__clock;
-    reg  mem_read_r__d;
-    wire  mem_read_r__q;
-    reg  mem_read_r__clock;
-    reg  [2:0] mem_bank_r__d;
-    wire  [2:0] mem_bank_r__q;
-    reg  mem_bank_r__clock;
-    reg  [23:0] mem_addr_r__d;
-    wire  [23:0] mem_addr_r__q;
-    reg  mem_addr_r__clock;
-    reg  fb_write_r__d;
-    wire  fb_write_r__q;
-    reg  fb_write_r__clock;
-    reg  [23:0] fb_addr_r__d;
-    wire  [23:0] fb_addr_r__q;
-    reg  fb_addr_r__clock;
-    reg  [31:0] fb_data_r__d;
-    wire  [31:0] fb_data_r__q;
-    reg  fb_data_r__clock;
+    
+    // Local signals
+    reg  fresh;
+    reg  [11:0] pc1;
+    
+    // Sub module instances
+    dynrt_processor__engine__fetch__pc_ram pc_ram(
+        .read_address(pc_ram__read_address),
+        .read_clock(pc_ram__read_clock),
+        .read_data(pc_ram__read_data),
+        .write_address(pc_ram__write_address),
+        .write_clock(pc_ram__write_clock),
+        .write_data(pc_ram__write_data),
+        .write_enable(pc_ram__write_enable)
+    );
+    dynrt_processor__engine__fetch__rom_ctl rom_ctl(
+        .read_address(rom_ctl__read_address),
+        .read_clock(rom_ctl__read_clock),
+        .read_data(rom_ctl__read_data),
+        .write_address(rom_ctl__write_address),
+        .write_clock(rom_ctl__write_clock),
+        .write_data(rom_ctl__write_data),
+        .write_enable(rom_ctl__write_enable)
+    );
+    dynrt_processor__engine__fetch__rom_imm rom_imm(
+        .read_address(rom_imm__read_address),
+        .read_clock(rom_imm__read_clock),
+        .read_data(rom_imm__read_data),
+        .write_address(rom_imm__write_address),
+        .write_clock(rom_imm__write_clock),
+        .write_data(rom_imm__write_data),
+        .write_enable(rom_imm__write_enable)
+    );
+    dynrt_processor__engine__fetch__rom_aux rom_aux(
+        .read_address(rom_aux__read_address),
+        .read_clock(rom_aux__read_clock),
+        .read_data(rom_aux__read_data),
+        .write_address(rom_aux__write_address),
+        .write_clock(rom_aux__write_clock),
+        .write_data(rom_aux__write_data),
+        .write_enable(rom_aux__write_enable)
+    );
+    dynrt_processor__display__dark_d v1(
+        .d(v1__d),
+        .q(v1__q),
+        .clock(v1__clock)
+    );
+    dynrt_processor__engine__decode__t3 t1(
+        .d(t1__d),
+        .q(t1__q),
+        .clock(t1__clock)
+    );
+    dynrt_processor__display__dark_d v2(
+        .d(v2__d),
+        .q(v2__q),
+        .clock(v2__clock)
+    );
+    dynrt_processor__engine__decode__t3 t2(
+        .d(t2__d),
+        .q(t2__q),
+        .clock(t2__clock)
+    );
+    dynrt_processor__display__timing__col pc2(
+        .d(pc2__d),
+        .q(pc2__q),
+        .clock(pc2__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        v1__clock = clock;
+        t1__clock = clock;
+        v2__clock = clock;
+        t2__clock = clock;
+        pc2__clock = clock;
+        v1__d = v1__q;
+        t1__d = t1__q;
+        v2__d = v2__q;
+        t2__d = t2__q;
+        pc2__d = pc2__q;
+        pc_ram__read_clock = clock;
+        pc_ram__write_clock = clock;
+        rom_ctl__read_clock = clock;
+        rom_ctl__write_clock = clock;
+        rom_imm__read_clock = clock;
+        rom_imm__write_clock = clock;
+        rom_aux__read_clock = clock;
+        rom_aux__write_clock = clock;
+        rom_ctl__write_enable = 1'b0;
+        rom_imm__write_enable = 1'b0;
+        rom_aux__write_enable = 1'b0;
+        rom_ctl__write_address = 32'h0;
+        rom_imm__write_address = 32'h0;
+        rom_aux__write_address = 32'h0;
+        rom_ctl__write_data = 32'h0;
+        rom_imm__write_data = 32'h0;
+        rom_aux__write_data = 32'h0;
+        pc_ram__read_address = pick;
+        v1__d = issue;
+        t1__d = pick;
+        fresh = pc_ram__read_data[32'hd] != epoch;
+        if (fresh) begin
+            pc1 = 32'h0;
+        end
+        else begin
+            pc1 = pc_ram__read_data[(32'h0)+:(12)];
+        end
+        rom_ctl__read_address = pc1;
+        rom_imm__read_address = pc1;
+        rom_aux__read_address = pc1;
+        v2__d = v1__q & (fresh | (~pc_ram__read_data[32'hc]));
+        t2__d = t1__q;
+        pc2__d = pc1;
+        valid = v2__q;
+        thread = t2__q;
+        pc = pc2__q;
+        ctl = rom_ctl__read_data;
+        imm = rom_imm__read_data;
+        aux = rom_aux__read_data;
+        pc_ram__write_address = wb_thread;
+        pc_ram__write_data = (((epoch) & 16'hffff) << 32'hd) | (((wb_halt) & 16'hffff) << 32'hc) | ((wb_next_pc) & 16'hffff);
+        pc_ram__write_enable = wb_valid;
+    end
+    
+endmodule // dynrt_processor__engine__fetch
+
+
+
+
+module dynrt_processor__engine__fetch__pc_ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [4:0] read_address;
+    input wire  read_clock;
+    output reg  [15:0] read_data;
+    input wire  [4:0] write_address;
+    input wire  write_clock;
+    input wire  [15:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[15:0] mem[31:0];
+    
+    initial begin
+    mem[5'b0] = 16'h0;
+    mem[5'b1] = 16'h0;
+    mem[5'b10] = 16'h0;
+    mem[5'b11] = 16'h0;
+    mem[5'b100] = 16'h0;
+    mem[5'b101] = 16'h0;
+    mem[5'b110] = 16'h0;
+    mem[5'b111] = 16'h0;
+    mem[5'b1000] = 16'h0;
+    mem[5'b1001] = 16'h0;
+    mem[5'b1010] = 16'h0;
+    mem[5'b1011] = 16'h0;
+    mem[5'b1100] = 16'h0;
+    mem[5'b1101] = 16'h0;
+    mem[5'b1110] = 16'h0;
+    mem[5'b1111] = 16'h0;
+    mem[5'b10000] = 16'h0;
+    mem[5'b10001] = 16'h0;
+    mem[5'b10010] = 16'h0;
+    mem[5'b10011] = 16'h0;
+    mem[5'b10100] = 16'h0;
+    mem[5'b10101] = 16'h0;
+    mem[5'b10110] = 16'h0;
+    mem[5'b10111] = 16'h0;
+    mem[5'b11000] = 16'h0;
+    mem[5'b11001] = 16'h0;
+    mem[5'b11010] = 16'h0;
+    mem[5'b11011] = 16'h0;
+    mem[5'b11100] = 16'h0;
+    mem[5'b11101] = 16'h0;
+    mem[5'b11110] = 16'h0;
+    mem[5'b11111] = 16'h0;
+    end
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__fetch__pc_ram
+
+
+module dynrt_processor__engine__fetch__rom_aux(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [11:0] read_address;
+    input wire  read_clock;
+    output reg  [31:0] read_data;
+    input wire  [11:0] write_address;
+    input wire  write_clock;
+    input wire  [31:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[31:0] mem[4095:0];
+    
+    initial begin
+    mem[12'h0] = 32'h5000;
+    mem[12'h1] = 32'h5000;
+    mem[12'h2] = 32'h5000;
+    mem[12'h3] = 32'h5000;
+    mem[12'h4] = 32'h5000;
+    mem[12'h5] = 32'h5000;
+    mem[12'h6] = 32'h5000;
+    mem[12'h7] = 32'h5000;
+    mem[12'h8] = 32'h5000;
+    mem[12'h9] = 32'h0;
+    mem[12'ha] = 32'h5000;
+    mem[12'hb] = 32'h5000;
+    mem[12'hc] = 32'h5000;
+    mem[12'hd] = 32'h5000;
+    mem[12'he] = 32'h5000;
+    mem[12'hf] = 32'h5000;
+    mem[12'h10] = 32'h5000;
+    mem[12'h11] = 32'h5000;
+    mem[12'h12] = 32'h5000;
+    mem[12'h13] = 32'h5000;
+    mem[12'h14] = 32'h5000;
+    mem[12'h15] = 32'h5000;
+    mem[12'h16] = 32'h5000;
+    mem[12'h17] = 32'h5026;
+    mem[12'h18] = 32'h26;
+    mem[12'h19] = 32'h0;
+    mem[12'h1a] = 32'h0;
+    mem[12'h1b] = 32'h0;
+    mem[12'h1c] = 32'h0;
+    mem[12'h1d] = 32'h0;
+    mem[12'h1e] = 32'h0;
+    mem[12'h1f] = 32'h0;
+    mem[12'h20] = 32'h0;
+    mem[12'h21] = 32'h0;
+    mem[12'h22] = 32'h24;
+    mem[12'h23] = 32'h24;
+    mem[12'h24] = 32'h0;
+    mem[12'h25] = 32'h0;
+    mem[12'h26] = 32'h95;
+    mem[12'h27] = 32'h0;
+    mem[12'h28] = 32'h0;
+    mem[12'h29] = 32'h0;
+    mem[12'h2a] = 32'h0;
+    mem[12'h2b] = 32'h0;
+    mem[12'h2c] = 32'h0;
+    mem[12'h2d] = 32'h0;
+    mem[12'h2e] = 32'h0;
+    mem[12'h2f] = 32'h0;
+    mem[12'h30] = 32'h0;
+    mem[12'h31] = 32'h0;
+    mem[12'h32] = 32'h0;
+    mem[12'h33] = 32'h0;
+    mem[12'h34] = 32'h0;
+    mem[12'h35] = 32'h0;
+    mem[12'h36] = 32'h0;
+    mem[12'h37] = 32'h0;
+    mem[12'h38] = 32'h0;
+    mem[12'h39] = 32'h0;
+    mem[12'h3a] = 32'h0;
+    mem[12'h3b] = 32'h0;
+    mem[12'h3c] = 32'h0;
+    mem[12'h3d] = 32'h0;
+    mem[12'h3e] = 32'h0;
+    mem[12'h3f] = 32'h19;
+    mem[12'h40] = 32'h91;
+    mem[12'h41] = 32'h0;
+    mem[12'h42] = 32'h0;
+    mem[12'h43] = 32'h0;
+    mem[12'h44] = 32'h0;
+    mem[12'h45] = 32'h0;
+    mem[12'h46] = 32'h0;
+    mem[12'h47] = 32'h0;
+    mem[12'h48] = 32'h1b000;
+    mem[12'h49] = 32'h1b000;
+    mem[12'h4a] = 32'h1b000;
+    mem[12'h4b] = 32'h1b000;
+    mem[12'h4c] = 32'h0;
+    mem[12'h4d] = 32'h0;
+    mem[12'h4e] = 32'h0;
+    mem[12'h4f] = 32'h0;
+    mem[12'h50] = 32'h0;
+    mem[12'h51] = 32'h0;
+    mem[12'h52] = 32'h0;
+    mem[12'h53] = 32'h0;
+    mem[12'h54] = 32'h0;
+    mem[12'h55] = 32'h0;
+    mem[12'h56] = 32'h0;
+    mem[12'h57] = 32'h0;
+    mem[12'h58] = 32'h0;
+    mem[12'h59] = 32'h0;
+    mem[12'h5a] = 32'h0;
+    mem[12'h5b] = 32'h5f;
+    mem[12'h5c] = 32'h0;
+    mem[12'h5d] = 32'h0;
+    mem[12'h5e] = 32'h0;
+    mem[12'h5f] = 32'h15000;
+    mem[12'h60] = 32'h15000;
+    mem[12'h61] = 32'h15000;
+    mem[12'h62] = 32'h15000;
+    mem[12'h63] = 32'h0;
+    mem[12'h64] = 32'h0;
+    mem[12'h65] = 32'h0;
+    mem[12'h66] = 32'h0;
+    mem[12'h67] = 32'h0;
+    mem[12'h68] = 32'h0;
+    mem[12'h69] = 32'h0;
+    mem[12'h6a] = 32'h0;
+    mem[12'h6b] = 32'h0;
+    mem[12'h6c] = 32'h0;
+    mem[12'h6d] = 32'h0;
+    mem[12'h6e] = 32'h8c;
+    mem[12'h6f] = 32'h0;
+    mem[12'h70] = 32'h0;
+    mem[12'h71] = 32'h0;
+    mem[12'h72] = 32'h0;
+    mem[12'h73] = 32'h0;
+    mem[12'h74] = 32'h0;
+    mem[12'h75] = 32'h0;
+    mem[12'h76] = 32'h0;
+    mem[12'h77] = 32'h0;
+    mem[12'h78] = 32'h0;
+    mem[12'h79] = 32'h0;
+    mem[12'h7a] = 32'h0;
+    mem[12'h7b] = 32'h0;
+    mem[12'h7c] = 32'h0;
+    mem[12'h7d] = 32'h0;
+    mem[12'h7e] = 32'h0;
+    mem[12'h7f] = 32'h0;
+    mem[12'h80] = 32'h0;
+    mem[12'h81] = 32'h19;
+    mem[12'h82] = 32'h8c;
+    mem[12'h83] = 32'h0;
+    mem[12'h84] = 32'h0;
+    mem[12'h85] = 32'h0;
+    mem[12'h86] = 32'h0;
+    mem[12'h87] = 32'h0;
+    mem[12'h88] = 32'h0;
+    mem[12'h89] = 32'h0;
+    mem[12'h8a] = 32'h0;
+    mem[12'h8b] = 32'h0;
+    mem[12'h8c] = 32'h0;
+    mem[12'h8d] = 32'h0;
+    mem[12'h8e] = 32'h0;
+    mem[12'h8f] = 32'h26;
+    mem[12'h90] = 32'h26;
+    mem[12'h91] = 32'h0;
+    mem[12'h92] = 32'h0;
+    mem[12'h93] = 32'h8c;
+    mem[12'h94] = 32'h8c;
+    mem[12'h95] = 32'h0;
+    end
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__fetch__rom_aux
+
+
+module dynrt_processor__engine__fetch__rom_ctl(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [11:0] read_address;
+    input wire  read_clock;
+    output reg  [31:0] read_data;
+    input wire  [11:0] write_address;
+    input wire  write_clock;
+    input wire  [31:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[31:0] mem[4095:0];
+    
+    initial begin
+    mem[12'h0] = 32'h38480000;
+    mem[12'h1] = 32'h384c0000;
+    mem[12'h2] = 32'h38500000;
+    mem[12'h3] = 32'h38540000;
+    mem[12'h4] = 32'h38580000;
+    mem[12'h5] = 32'h385c0000;
+    mem[12'h6] = 32'h38600000;
+    mem[12'h7] = 32'h38640000;
+    mem[12'h8] = 32'h38680000;
+    mem[12'h9] = 32'h286c0002;
+    mem[12'ha] = 32'h38700000;
+    mem[12'hb] = 32'h38740000;
+    mem[12'hc] = 32'h38780000;
+    mem[12'hd] = 32'h387c0000;
+    mem[12'he] = 32'h38800000;
+    mem[12'hf] = 32'h38840000;
+    mem[12'h10] = 32'h38880000;
+    mem[12'h11] = 32'h388c0000;
+    mem[12'h12] = 32'h38900000;
+    mem[12'h13] = 32'h38940000;
+    mem[12'h14] = 32'h38980000;
+    mem[12'h15] = 32'h389c0000;
+    mem[12'h16] = 32'h38a00000;
+    mem[12'h17] = 32'h38a40001;
+    mem[12'h18] = 32'h5c000000;
+    mem[12'h19] = 32'h74001c20;
+    mem[12'h1a] = 32'h7400282c;
+    mem[12'h1b] = 32'h74000408;
+    mem[12'h1c] = 32'h74000c10;
+    mem[12'h1d] = 32'h74001418;
+    mem[12'h1e] = 32'h78002420;
+    mem[12'h1f] = 32'h78000000;
+    mem[12'h20] = 32'h74340000;
+    mem[12'h21] = 32'h74300000;
+    mem[12'h22] = 32'h54003002;
+    mem[12'h23] = 32'h54002403;
+    mem[12'h24] = 32'h743c0000;
+    mem[12'h25] = 32'h60004000;
+    mem[12'h26] = 32'h6ca80000;
+    mem[12'h27] = 32'h24aca802;
+    mem[12'h28] = 32'h30b0a802;
+    mem[12'h29] = 32'h18c4ac02;
+    mem[12'h2a] = 32'h18c8b002;
+    mem[12'h2b] = 32'hccc48c4;
+    mem[12'h2c] = 32'hcd04cc8;
+    mem[12'h2d] = 32'h4d4ccd0;
+    mem[12'h2e] = 32'h410d450;
+    mem[12'h2f] = 32'hcdc54c4;
+    mem[12'h30] = 32'hce058c8;
+    mem[12'h31] = 32'h4e4dce0;
+    mem[12'h32] = 32'h414e45c;
+    mem[12'h33] = 32'hcec60c4;
+    mem[12'h34] = 32'hcf064c8;
+    mem[12'h35] = 32'h4f4ecf0;
+    mem[12'h36] = 32'h418f468;
+    mem[12'h37] = 32'h28047002;
+    mem[12'h38] = 32'h28087402;
+    mem[12'h39] = 32'h280c7802;
+    mem[12'h3a] = 32'h281c0002;
+    mem[12'h3b] = 32'h28280002;
+    mem[12'h3c] = 32'h282c0002;
+    mem[12'h3d] = 32'h28200002;
+    mem[12'h3e] = 32'h28240002;
+    mem[12'h3f] = 32'h5c400000;
+    mem[12'h40] = 32'h54003002;
+    mem[12'h41] = 32'h28f83c02;
+    mem[12'h42] = 32'hcf43410;
+    mem[12'h43] = 32'h4f004f4;
+    mem[12'h44] = 32'hcec3414;
+    mem[12'h45] = 32'h4e808ec;
+    mem[12'h46] = 32'hce43418;
+    mem[12'h47] = 32'h4e00ce4;
+    mem[12'h48] = 32'h38ecf800;
+    mem[12'h49] = 32'h38e4f800;
+    mem[12'h4a] = 32'h38f4f800;
+    mem[12'h4b] = 32'h38dcf800;
+    mem[12'h4c] = 32'hcd8ecec;
+    mem[12'h4d] = 32'hcd4e4e4;
+    mem[12'h4e] = 32'h4d0d8d4;
+    mem[12'h4f] = 32'hcccf4f4;
+    mem[12'h50] = 32'h4c8d0cc;
+    mem[12'h51] = 32'h14c4c802;
+    mem[12'h52] = 32'h10fc6cc4;
+    mem[12'h53] = 32'hd00ecfc;
+    mem[12'h54] = 32'hd04e4fc;
+    mem[12'h55] = 32'hd08f4fc;
+    mem[12'h56] = 32'hd0d0010;
+    mem[12'h57] = 32'hd110414;
+    mem[12'h58] = 32'h5150d10;
+    mem[12'h59] = 32'hd190818;
+    mem[12'h5a] = 32'h51d1518;
+    mem[12'h5b] = 32'h4800011d;
+    mem[12'h5c] = 32'h2d010002;
+    mem[12'h5d] = 32'h2d050402;
+    mem[12'h5e] = 32'h2d090802;
+    mem[12'h5f] = 32'h3928dc00;
+    mem[12'h60] = 32'h3924dc00;
+    mem[12'h61] = 32'h3920dc00;
+    mem[12'h62] = 32'h3910dc00;
+    mem[12'h63] = 32'hcb9287c;
+    mem[12'h64] = 32'hcbd247c;
+    mem[12'h65] = 32'hcc1207c;
+    mem[12'h66] = 32'h91490f0;
+    mem[12'h67] = 32'h90c94e8;
+    mem[12'h68] = 32'h8dc98e0;
+    mem[12'h69] = 32'hd190114;
+    mem[12'h6a] = 32'hd1d050c;
+    mem[12'h6b] = 32'h4fd191c;
+    mem[12'h6c] = 32'hcc508dc;
+    mem[12'h6d] = 32'h4c8fcc4;
+    mem[12'h6e] = 32'h480000c9;
+    mem[12'h6f] = 32'hccd1514;
+    mem[12'h70] = 32'hcd10d0c;
+    mem[12'h71] = 32'h4d4ccd0;
+    mem[12'h72] = 32'hcd8dcdc;
+    mem[12'h73] = 32'h4f4d4d8;
+    mem[12'h74] = 32'h14e4f402;
+    mem[12'h75] = 32'h10ecc8e4;
+    mem[12'h76] = 32'h2804f002;
+    mem[12'h77] = 32'h2808e802;
+    mem[12'h78] = 32'h280ce002;
+    mem[12'h79] = 32'h28111402;
+    mem[12'h7a] = 32'h28150c02;
+    mem[12'h7b] = 32'h2818dc02;
+    mem[12'h7c] = 32'h281c8c02;
+    mem[12'h7d] = 32'h28200002;
+    mem[12'h7e] = 32'h28240002;
+    mem[12'h7f] = 32'h28280002;
+    mem[12'h80] = 32'h282cf802;
+    mem[12'h81] = 32'h5c400000;
+    mem[12'h82] = 32'h54003003;
+    mem[12'h83] = 32'hce5289c;
+    mem[12'h84] = 32'hcf4e4ec;
+    mem[12'h85] = 32'h4b8b8f4;
+    mem[12'h86] = 32'hcd524a0;
+    mem[12'h87] = 32'hcd0d4ec;
+    mem[12'h88] = 32'h4bcbcd0;
+    mem[12'h89] = 32'hcc920a4;
+    mem[12'h8a] = 32'hcc4c8ec;
+    mem[12'h8b] = 32'h4c0c0c4;
+    mem[12'h8c] = 32'h7cf8b802;
+    mem[12'h8d] = 32'h7cf8bcf8;
+    mem[12'h8e] = 32'h7cf8c0f8;
+    mem[12'h8f] = 32'h3c00a8f9;
+    mem[12'h90] = 32'h5c000000;
+    mem[12'h91] = 32'h28b88002;
+    mem[12'h92] = 32'h28bc8402;
+    mem[12'h93] = 32'h28c08803;
+    mem[12'h94] = 32'h5c000000;
+    mem[12'h95] = 32'h70000000;
+    end
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__fetch__rom_ctl
+
+
+module dynrt_processor__engine__fetch__rom_imm(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [11:0] read_address;
+    input wire  read_clock;
+    output reg  [31:0] read_data;
+    input wire  [11:0] write_address;
+    input wire  write_clock;
+    input wire  [31:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[31:0] mem[4095:0];
+    
+    initial begin
+    mem[12'h0] = 32'h0;
+    mem[12'h1] = 32'h1;
+    mem[12'h2] = 32'h3;
+    mem[12'h3] = 32'h4;
+    mem[12'h4] = 32'h5;
+    mem[12'h5] = 32'h7;
+    mem[12'h6] = 32'h8;
+    mem[12'h7] = 32'h9;
+    mem[12'h8] = 32'hb;
+    mem[12'h9] = 32'h3f0000;
+    mem[12'ha] = 32'hc;
+    mem[12'hb] = 32'hd;
+    mem[12'hc] = 32'he;
+    mem[12'hd] = 32'hf;
+    mem[12'he] = 32'h10;
+    mem[12'hf] = 32'h11;
+    mem[12'h10] = 32'h12;
+    mem[12'h11] = 32'h13;
+    mem[12'h12] = 32'h18;
+    mem[12'h13] = 32'h19;
+    mem[12'h14] = 32'h1a;
+    mem[12'h15] = 32'h1b;
+    mem[12'h16] = 32'h1c;
+    mem[12'h17] = 32'h1d;
+    mem[12'h18] = 32'h0;
+    mem[12'h19] = 32'h3;
+    mem[12'h1a] = 32'ha;
+    mem[12'h1b] = 32'h0;
+    mem[12'h1c] = 32'h1;
+    mem[12'h1d] = 32'h2;
+    mem[12'h1e] = 32'h0;
+    mem[12'h1f] = 32'h1;
+    mem[12'h20] = 32'h5;
+    mem[12'h21] = 32'h6;
+    mem[12'h22] = 32'h0;
+    mem[12'h23] = 32'h0;
+    mem[12'h24] = 32'h8;
+    mem[12'h25] = 32'h0;
+    mem[12'h26] = 32'h0;
+    mem[12'h27] = 32'h3f;
+    mem[12'h28] = 32'h6;
+    mem[12'h29] = 32'h0;
+    mem[12'h2a] = 32'h0;
+    mem[12'h2b] = 32'h0;
+    mem[12'h2c] = 32'h0;
+    mem[12'h2d] = 32'h0;
+    mem[12'h2e] = 32'h0;
+    mem[12'h2f] = 32'h0;
+    mem[12'h30] = 32'h0;
+    mem[12'h31] = 32'h0;
+    mem[12'h32] = 32'h0;
+    mem[12'h33] = 32'h0;
+    mem[12'h34] = 32'h0;
+    mem[12'h35] = 32'h0;
+    mem[12'h36] = 32'h0;
+    mem[12'h37] = 32'h0;
+    mem[12'h38] = 32'h0;
+    mem[12'h39] = 32'h0;
+    mem[12'h3a] = 32'h0;
+    mem[12'h3b] = 32'hffffffff;
+    mem[12'h3c] = 32'hffffffff;
+    mem[12'h3d] = 32'h7f0000;
+    mem[12'h3e] = 32'h0;
+    mem[12'h3f] = 32'h0;
+    mem[12'h40] = 32'h0;
+    mem[12'h41] = 32'h0;
+    mem[12'h42] = 32'h0;
+    mem[12'h43] = 32'h0;
+    mem[12'h44] = 32'h0;
+    mem[12'h45] = 32'h0;
+    mem[12'h46] = 32'h0;
+    mem[12'h47] = 32'h0;
+    mem[12'h48] = 32'h4;
+    mem[12'h49] = 32'h5;
+    mem[12'h4a] = 32'h6;
+    mem[12'h4b] = 32'h7;
+    mem[12'h4c] = 32'h0;
+    mem[12'h4d] = 32'h0;
+    mem[12'h4e] = 32'h0;
+    mem[12'h4f] = 32'h0;
+    mem[12'h50] = 32'h0;
+    mem[12'h51] = 32'h0;
+    mem[12'h52] = 32'h0;
+    mem[12'h53] = 32'h0;
+    mem[12'h54] = 32'h0;
+    mem[12'h55] = 32'h0;
+    mem[12'h56] = 32'h0;
+    mem[12'h57] = 32'h0;
+    mem[12'h58] = 32'h0;
+    mem[12'h59] = 32'h0;
+    mem[12'h5a] = 32'h0;
+    mem[12'h5b] = 32'h0;
+    mem[12'h5c] = 32'h800000;
+    mem[12'h5d] = 32'h800000;
+    mem[12'h5e] = 32'h800000;
+    mem[12'h5f] = 32'h1e;
+    mem[12'h60] = 32'h1f;
+    mem[12'h61] = 32'h20;
+    mem[12'h62] = 32'h21;
+    mem[12'h63] = 32'h0;
+    mem[12'h64] = 32'h0;
+    mem[12'h65] = 32'h0;
+    mem[12'h66] = 32'h0;
+    mem[12'h67] = 32'h0;
+    mem[12'h68] = 32'h0;
+    mem[12'h69] = 32'h0;
+    mem[12'h6a] = 32'h0;
+    mem[12'h6b] = 32'h0;
+    mem[12'h6c] = 32'h0;
+    mem[12'h6d] = 32'h0;
+    mem[12'h6e] = 32'h0;
+    mem[12'h6f] = 32'h0;
+    mem[12'h70] = 32'h0;
+    mem[12'h71] = 32'h0;
+    mem[12'h72] = 32'h0;
+    mem[12'h73] = 32'h0;
+    mem[12'h74] = 32'h0;
+    mem[12'h75] = 32'h0;
+    mem[12'h76] = 32'h0;
+    mem[12'h77] = 32'h0;
+    mem[12'h78] = 32'h0;
+    mem[12'h79] = 32'h0;
+    mem[12'h7a] = 32'h0;
+    mem[12'h7b] = 32'h0;
+    mem[12'h7c] = 32'h0;
+    mem[12'h7d] = 32'h3f0000;
+    mem[12'h7e] = 32'h80000000;
+    mem[12'h7f] = 32'h0;
+    mem[12'h80] = 32'h0;
+    mem[12'h81] = 32'h0;
+    mem[12'h82] = 32'h0;
+    mem[12'h83] = 32'h0;
+    mem[12'h84] = 32'h0;
+    mem[12'h85] = 32'h0;
+    mem[12'h86] = 32'h0;
+    mem[12'h87] = 32'h0;
+    mem[12'h88] = 32'h0;
+    mem[12'h89] = 32'h0;
+    mem[12'h8a] = 32'h0;
+    mem[12'h8b] = 32'h0;
+    mem[12'h8c] = 32'h0;
+    mem[12'h8d] = 32'h0;
+    mem[12'h8e] = 32'h0;
+    mem[12'h8f] = 32'h2e;
+    mem[12'h90] = 32'h0;
+    mem[12'h91] = 32'h0;
+    mem[12'h92] = 32'h0;
+    mem[12'h93] = 32'h0;
+    mem[12'h94] = 32'h0;
+    mem[12'h95] = 32'h0;
+    end
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__fetch__rom_imm
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__fp_units(clock,a,b,sub,sum,product,quotient,root,lt,le,eq,colour_byte);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [23:0] a;
+    input wire  [23:0] b;
+    input wire  sub;
+    output reg  [23:0] sum;
+    output reg  [23:0] product;
+    output reg  [23:0] quotient;
+    output reg  [23:0] root;
+    output reg  lt;
+    output reg  le;
+    output reg  eq;
+    output reg  [7:0] colour_byte;
+    
+    // Stub signals
     reg  add__clock;
     reg  add__in_valid;
     reg  [23:0] add__a;
@@ -396,82 +2935,11 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     wire  cmp__lt;
     wire  cmp__le;
     wire  cmp__eq;
-    reg  [15:0] itof__value;
-    wire  [23:0] itof__word;
     reg  byte_unit__clock;
     reg  byte_unit__in_valid;
     reg  [23:0] byte_unit__word;
     wire  byte_unit__out_valid;
     wire  [7:0] byte_unit__result;
-    reg  tester__clock;
-    reg  [4:0] tester__thread;
-    reg  [31:0] tester__word_a;
-    reg  [31:0] tester__word_b;
-    reg  tester__ray_write;
-    reg  [1:0] tester__ray_pair;
-    reg  tester__enqueue;
-    reg  [1:0] tester__queue_kind;
-    wire  tester__full;
-    reg  [4:0] tester__query_thread;
-    wire  tester__pending;
-    wire  tester__hit;
-    wire  [23:0] tester__best_t;
-    wire  [31:0] tester__best_instance;
-    wire  [31:0] tester__best_triangle;
-    reg  tester__engine_read;
-    reg  [2:0] tester__engine_bank;
-    reg  [23:0] tester__engine_addr;
-    wire  tester__uv_read;
-    wire  [23:0] tester__uv_addr;
-    reg  [31:0] tester__uv_rdata;
-    wire  tester__t_read;
-    wire  [23:0] tester__t_addr;
-    reg  [31:0] tester__t_rdata;
-    wire  tester__list_read;
-    wire  [23:0] tester__list_addr;
-    reg  [31:0] tester__list_rdata;
-    wire  tester__done_event;
-    wire  [4:0] tester__done_thread;
-    reg  tester__walk_list_valid;
-    reg  [4:0] tester__walk_list_thread;
-    reg  [31:0] tester__walk_list_from;
-    reg  [31:0] tester__walk_list_to;
-    wire  tester__walk_list_take;
-    wire  tester__walk_end_event;
-    wire  [4:0] tester__walk_end_thread;
-    wire  [31:0] tester__walk_end_t;
-    wire  tester__walk_end_hit;
-    wire  tester__transform_busy;
-    wire  tester__intersect_busy;
-    reg  traversal_unit__clock;
-    reg  [4:0] traversal_unit__thread;
-    reg  [31:0] traversal_unit__word_a;
-    reg  [31:0] traversal_unit__word_b;
-    reg  traversal_unit__ray_write;
-    reg  [1:0] traversal_unit__ray_pair;
-    reg  traversal_unit__t_min_write;
-    reg  traversal_unit__enqueue;
-    wire  traversal_unit__full;
-    reg  [4:0] traversal_unit__query_thread;
-    wire  traversal_unit__pending;
-    reg  traversal_unit__engine_read;
-    reg  [2:0] traversal_unit__engine_bank;
-    reg  [23:0] traversal_unit__engine_addr;
-    wire  traversal_unit__node_read;
-    wire  [23:0] traversal_unit__node_addr;
-    reg  [31:0] traversal_unit__node_rdata;
-    wire  traversal_unit__step_busy;
-    wire  traversal_unit__done_event;
-    wire  [4:0] traversal_unit__done_thread;
-    wire  traversal_unit__leaf_valid;
-    wire  [4:0] traversal_unit__leaf_thread;
-    wire  [31:0] traversal_unit__leaf_from;
-    wire  [31:0] traversal_unit__leaf_to;
-    reg  traversal_unit__leaf_take;
-    reg  traversal_unit__answer_valid;
-    reg  [4:0] traversal_unit__answer_thread;
-    reg  [31:0] traversal_unit__answer_t;
-    reg  traversal_unit__answer_hit;
     reg  add_delay__clock;
     reg  [23:0] add_delay__data_in;
     wire  [23:0] add_delay__data_out;
@@ -484,500 +2952,18 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
     reg  sqrt_delay__clock;
     reg  [23:0] sqrt_delay__data_in;
     wire  [23:0] sqrt_delay__data_out;
-    reg  cmp_delay__clock;
-    reg  [2:0] cmp_delay__data_in;
-    wire  [2:0] cmp_delay__data_out;
-    reg  [31:0] fast_line__0__d;
-    wire  [31:0] fast_line__0__q;
-    reg  fast_line__0__clock;
-    reg  [31:0] fast_line__1__d;
-    wire  [31:0] fast_line__1__q;
-    reg  fast_line__1__clock;
-    reg  [31:0] fast_line__2__d;
-    wire  [31:0] fast_line__2__q;
-    reg  fast_line__2__clock;
-    reg  [31:0] fast_line__3__d;
-    wire  [31:0] fast_line__3__q;
-    reg  fast_line__3__clock;
-    reg  [31:0] fast_line__4__d;
-    wire  [31:0] fast_line__4__q;
-    reg  fast_line__4__clock;
-    reg  [31:0] fast_line__5__d;
-    wire  [31:0] fast_line__5__q;
-    reg  fast_line__5__clock;
-    reg  [31:0] fast_line__6__d;
-    wire  [31:0] fast_line__6__q;
-    reg  fast_line__6__clock;
-    reg  [31:0] fast_line__7__d;
-    wire  [31:0] fast_line__7__q;
-    reg  fast_line__7__clock;
-    reg  [2:0] fast_kind_line__0__d;
-    wire  [2:0] fast_kind_line__0__q;
-    reg  fast_kind_line__0__clock;
-    reg  [2:0] fast_kind_line__1__d;
-    wire  [2:0] fast_kind_line__1__q;
-    reg  fast_kind_line__1__clock;
-    reg  [2:0] fast_kind_line__2__d;
-    wire  [2:0] fast_kind_line__2__q;
-    reg  fast_kind_line__2__clock;
-    reg  [2:0] fast_kind_line__3__d;
-    wire  [2:0] fast_kind_line__3__q;
-    reg  fast_kind_line__3__clock;
-    reg  [2:0] fast_kind_line__4__d;
-    wire  [2:0] fast_kind_line__4__q;
-    reg  fast_kind_line__4__clock;
-    reg  [2:0] fast_kind_line__5__d;
-    wire  [2:0] fast_kind_line__5__q;
-    reg  fast_kind_line__5__clock;
-    reg  [2:0] fast_kind_line__6__d;
-    wire  [2:0] fast_kind_line__6__q;
-    reg  fast_kind_line__6__clock;
-    reg  [2:0] fast_kind_line__7__d;
-    wire  [2:0] fast_kind_line__7__q;
-    reg  fast_kind_line__7__clock;
-    reg  fast_delay__clock;
-    reg  [31:0] fast_delay__data_in;
-    wire  [31:0] fast_delay__data_out;
-    reg  ctl_delay__clock;
-    reg  [20:0] ctl_delay__data_in;
-    wire  [20:0] ctl_delay__data_out;
-    reg  [20:0] ctl_line__0__d;
-    wire  [20:0] ctl_line__0__q;
-    reg  ctl_line__0__clock;
-    reg  [20:0] ctl_line__1__d;
-    wire  [20:0] ctl_line__1__q;
-    reg  ctl_line__1__clock;
-    reg  [20:0] ctl_line__2__d;
-    wire  [20:0] ctl_line__2__q;
-    reg  ctl_line__2__clock;
-    reg  [20:0] ctl_line__3__d;
-    wire  [20:0] ctl_line__3__q;
-    reg  ctl_line__3__clock;
-    reg  [20:0] ctl_line__4__d;
-    wire  [20:0] ctl_line__4__q;
-    reg  ctl_line__4__clock;
-    reg  [20:0] ctl_line__5__d;
-    wire  [20:0] ctl_line__5__q;
-    reg  ctl_line__5__clock;
-    reg  [20:0] ctl_line__6__d;
-    wire  [20:0] ctl_line__6__q;
-    reg  ctl_line__6__clock;
-    reg  [20:0] ctl_line__7__d;
-    wire  [20:0] ctl_line__7__q;
-    reg  ctl_line__7__clock;
-    reg  pc_delay__clock;
-    reg  [23:0] pc_delay__data_in;
-    wire  [23:0] pc_delay__data_out;
-    reg  [23:0] pc_line__0__d;
-    wire  [23:0] pc_line__0__q;
-    reg  pc_line__0__clock;
-    reg  [23:0] pc_line__1__d;
-    wire  [23:0] pc_line__1__q;
-    reg  pc_line__1__clock;
-    reg  [23:0] pc_line__2__d;
-    wire  [23:0] pc_line__2__q;
-    reg  pc_line__2__clock;
-    reg  [23:0] pc_line__3__d;
-    wire  [23:0] pc_line__3__q;
-    reg  pc_line__3__clock;
-    reg  [23:0] pc_line__4__d;
-    wire  [23:0] pc_line__4__q;
-    reg  pc_line__4__clock;
-    reg  [23:0] pc_line__5__d;
-    wire  [23:0] pc_line__5__q;
-    reg  pc_line__5__clock;
-    reg  [23:0] pc_line__6__d;
-    wire  [23:0] pc_line__6__q;
-    reg  pc_line__6__clock;
-    reg  [23:0] pc_line__7__d;
-    wire  [23:0] pc_line__7__q;
-    reg  pc_line__7__clock;
-    reg  cond_delay__clock;
-    reg  [18:0] cond_delay__data_in;
-    wire  [18:0] cond_delay__data_out;
-    reg  [18:0] cond_line__0__d;
-    wire  [18:0] cond_line__0__q;
-    reg  cond_line__0__clock;
-    reg  [18:0] cond_line__1__d;
-    wire  [18:0] cond_line__1__q;
-    reg  cond_line__1__clock;
-    reg  [18:0] cond_line__2__d;
-    wire  [18:0] cond_line__2__q;
-    reg  cond_line__2__clock;
-    reg  [18:0] cond_line__3__d;
-    wire  [18:0] cond_line__3__q;
-    reg  cond_line__3__clock;
-    reg  [18:0] cond_line__4__d;
-    wire  [18:0] cond_line__4__q;
-    reg  cond_line__4__clock;
-    reg  [18:0] cond_line__5__d;
-    wire  [18:0] cond_line__5__q;
-    reg  cond_line__5__clock;
-    reg  [18:0] cond_line__6__d;
-    wire  [18:0] cond_line__6__q;
-    reg  cond_line__6__clock;
-    reg  [18:0] cond_line__7__d;
-    wire  [18:0] cond_line__7__q;
-    reg  cond_line__7__clock;
-    reg  long_ctl__clock;
-    reg  [20:0] long_ctl__data_in;
-    wire  [20:0] long_ctl__data_out;
-    reg  long_pc__clock;
-    reg  [23:0] long_pc__data_in;
-    wire  [23:0] long_pc__data_out;
-    reg  [31:0] reserved__d;
-    wire  [31:0] reserved__q;
-    reg  reserved__clock;
-    
-    // Local signals
-    reg  [31:0] below;
-    reg  [4:0] pick;
-    reg  issue;
-    reg  [31:0] issue_mask;
-    reg  [31:0] wb_mask;
-    reg  [31:0] tester_event;
-    reg  [31:0] walk_event;
-    reg  [31:0] event_mask;
-    reg  wb_sleep;
-    reg  [31:0] wake_mask;
-    reg  [31:0] sleep_mask;
-    reg  [11:0] pc1_eff;
-    reg  entry_fresh;
-    reg  [4:0] op3;
-    reg  [31:0] opa;
-    reg  [31:0] opb;
-    reg  [31:0] shifted;
-    reg  [31:0] mem_address;
-    reg  [31:0] scratch_address;
-    reg  [31:0] fast;
-    reg  int_eq;
-    reg  int_lt;
-    reg  mb_hit;
-    reg  [3:0] mb_len;
-    reg  [2:0] mb_next;
-    reg  pix_done;
-    reg  tri_cond;
-    reg  wait_fn;
-    reg  kd_cond;
-    reg  [2:0] fast_kind;
-    reg  tri_queues;
-    reg  [1:0] tri_kind;
-    reg  [20:0] short_ctl;
-    reg  [20:0] long_in;
-    reg  [20:0] wb_ctl;
-    reg  [23:0] wb_pcs;
-    reg  long3;
-    reg  wb_valid;
-    reg  [4:0] wb_op;
-    reg  [7:0] wb_dst;
-    reg  [4:0] wb_thread;
-    reg  wb_invert;
-    reg  wb_cond;
-    reg  [11:0] wb_next_pc;
-    reg  [31:0] wb_result;
-    reg  wb_writes;
+    reg  lt_delay__clock;
+    reg  lt_delay__data_in;
+    wire  lt_delay__data_out;
+    reg  le_delay__clock;
+    reg  le_delay__data_in;
+    wire  le_delay__data_out;
+    reg  eq_delay__clock;
+    reg  eq_delay__data_in;
+    wire  eq_delay__data_out;
     
     // Sub module instances
-    dynrt_processor_core__pc_ram pc_ram(
-        .read_address(pc_ram__read_address),
-        .read_clock(pc_ram__read_clock),
-        .read_data(pc_ram__read_data),
-        .write_address(pc_ram__write_address),
-        .write_clock(pc_ram__write_clock),
-        .write_data(pc_ram__write_data),
-        .write_enable(pc_ram__write_enable)
-    );
-    dynrt_processor_core__rom_ctl rom_ctl(
-        .read_address(rom_ctl__read_address),
-        .read_clock(rom_ctl__read_clock),
-        .read_data(rom_ctl__read_data),
-        .write_address(rom_ctl__write_address),
-        .write_clock(rom_ctl__write_clock),
-        .write_data(rom_ctl__write_data),
-        .write_enable(rom_ctl__write_enable)
-    );
-    dynrt_processor_core__rom_imm rom_imm(
-        .read_address(rom_imm__read_address),
-        .read_clock(rom_imm__read_clock),
-        .read_data(rom_imm__read_data),
-        .write_address(rom_imm__write_address),
-        .write_clock(rom_imm__write_clock),
-        .write_data(rom_imm__write_data),
-        .write_enable(rom_imm__write_enable)
-    );
-    dynrt_processor_core__rom_aux rom_aux(
-        .read_address(rom_aux__read_address),
-        .read_clock(rom_aux__read_clock),
-        .read_data(rom_aux__read_data),
-        .write_address(rom_aux__write_address),
-        .write_clock(rom_aux__write_clock),
-        .write_data(rom_aux__write_data),
-        .write_enable(rom_aux__write_enable)
-    );
-    dynrt_processor_core__regs_a regs_a(
-        .read_address(regs_a__read_address),
-        .read_clock(regs_a__read_clock),
-        .read_data(regs_a__read_data),
-        .write_address(regs_a__write_address),
-        .write_clock(regs_a__write_clock),
-        .write_data(regs_a__write_data),
-        .write_enable(regs_a__write_enable)
-    );
-    dynrt_processor_core__regs_a regs_b(
-        .read_address(regs_b__read_address),
-        .read_clock(regs_b__read_clock),
-        .read_data(regs_b__read_data),
-        .write_address(regs_b__write_address),
-        .write_clock(regs_b__write_clock),
-        .write_data(regs_b__write_data),
-        .write_enable(regs_b__write_enable)
-    );
-    dynrt_processor_core__scratch scratch(
-        .read_address(scratch__read_address),
-        .read_clock(scratch__read_clock),
-        .read_data(scratch__read_data),
-        .write_address(scratch__write_address),
-        .write_clock(scratch__write_clock),
-        .write_data(scratch__write_data),
-        .write_enable(scratch__write_enable)
-    );
-    dynrt_processor_core__mailbox__0 mailbox__0(
-        .read_address(mailbox__0__read_address),
-        .read_clock(mailbox__0__read_clock),
-        .read_data(mailbox__0__read_data),
-        .write_address(mailbox__0__write_address),
-        .write_clock(mailbox__0__write_clock),
-        .write_data(mailbox__0__write_data),
-        .write_enable(mailbox__0__write_enable)
-    );
-    dynrt_processor_core__mailbox__0 mailbox__1(
-        .read_address(mailbox__1__read_address),
-        .read_clock(mailbox__1__read_clock),
-        .read_data(mailbox__1__read_data),
-        .write_address(mailbox__1__write_address),
-        .write_clock(mailbox__1__write_clock),
-        .write_data(mailbox__1__write_data),
-        .write_enable(mailbox__1__write_enable)
-    );
-    dynrt_processor_core__mailbox__0 mailbox__2(
-        .read_address(mailbox__2__read_address),
-        .read_clock(mailbox__2__read_clock),
-        .read_data(mailbox__2__read_data),
-        .write_address(mailbox__2__write_address),
-        .write_clock(mailbox__2__write_clock),
-        .write_data(mailbox__2__write_data),
-        .write_enable(mailbox__2__write_enable)
-    );
-    dynrt_processor_core__mailbox__0 mailbox__3(
-        .read_address(mailbox__3__read_address),
-        .read_clock(mailbox__3__read_clock),
-        .read_data(mailbox__3__read_data),
-        .write_address(mailbox__3__write_address),
-        .write_clock(mailbox__3__write_clock),
-        .write_data(mailbox__3__write_data),
-        .write_enable(mailbox__3__write_enable)
-    );
-    dynrt_processor_core__mailbox__0 mailbox__4(
-        .read_address(mailbox__4__read_address),
-        .read_clock(mailbox__4__read_clock),
-        .read_data(mailbox__4__read_data),
-        .write_address(mailbox__4__write_address),
-        .write_clock(mailbox__4__write_clock),
-        .write_data(mailbox__4__write_data),
-        .write_enable(mailbox__4__write_enable)
-    );
-    dynrt_processor_core__mailbox__0 mailbox__5(
-        .read_address(mailbox__5__read_address),
-        .read_clock(mailbox__5__read_clock),
-        .read_data(mailbox__5__read_data),
-        .write_address(mailbox__5__write_address),
-        .write_clock(mailbox__5__write_clock),
-        .write_data(mailbox__5__write_data),
-        .write_enable(mailbox__5__write_enable)
-    );
-    dynrt_processor_core__mailbox__0 mailbox__6(
-        .read_address(mailbox__6__read_address),
-        .read_clock(mailbox__6__read_clock),
-        .read_data(mailbox__6__read_data),
-        .write_address(mailbox__6__write_address),
-        .write_clock(mailbox__6__write_clock),
-        .write_data(mailbox__6__write_data),
-        .write_enable(mailbox__6__write_enable)
-    );
-    dynrt_processor_core__mailbox__0 mailbox__7(
-        .read_address(mailbox__7__read_address),
-        .read_clock(mailbox__7__read_clock),
-        .read_data(mailbox__7__read_data),
-        .write_address(mailbox__7__write_address),
-        .write_clock(mailbox__7__write_clock),
-        .write_data(mailbox__7__write_data),
-        .write_enable(mailbox__7__write_enable)
-    );
-    dynrt_processor_core__mailbox_meta mailbox_meta(
-        .read_address(mailbox_meta__read_address),
-        .read_clock(mailbox_meta__read_clock),
-        .read_data(mailbox_meta__read_data),
-        .write_address(mailbox_meta__write_address),
-        .write_clock(mailbox_meta__write_clock),
-        .write_data(mailbox_meta__write_data),
-        .write_enable(mailbox_meta__write_enable)
-    );
-    dynrt_processor_core__add__big_sign running(
-        .d(running__d),
-        .q(running__q),
-        .clock(running__clock)
-    );
-    dynrt_processor_core__add__big_sign epoch(
-        .d(epoch__d),
-        .q(epoch__q),
-        .clock(epoch__clock)
-    );
-    dynrt_processor_core__asleep ready(
-        .d(ready__d),
-        .q(ready__q),
-        .clock(ready__clock)
-    );
-    dynrt_processor_core__asleep asleep(
-        .d(asleep__d),
-        .q(asleep__q),
-        .clock(asleep__clock)
-    );
-    dynrt_processor_core__asleep woken(
-        .d(woken__d),
-        .q(woken__q),
-        .clock(woken__clock)
-    );
-    dynrt_processor_core__last_pick last_pick(
-        .d(last_pick__d),
-        .q(last_pick__q),
-        .clock(last_pick__clock)
-    );
-    dynrt_processor_core__halted_count halted_count(
-        .d(halted_count__d),
-        .q(halted_count__q),
-        .clock(halted_count__clock)
-    );
-    dynrt_processor_core__asleep cycle_count(
-        .d(cycle_count__d),
-        .q(cycle_count__q),
-        .clock(cycle_count__clock)
-    );
-    dynrt_processor_core__asleep instr_count(
-        .d(instr_count__d),
-        .q(instr_count__q),
-        .clock(instr_count__clock)
-    );
-    dynrt_processor_core__asleep transform_count(
-        .d(transform_count__d),
-        .q(transform_count__q),
-        .clock(transform_count__clock)
-    );
-    dynrt_processor_core__asleep intersect_count(
-        .d(intersect_count__d),
-        .q(intersect_count__q),
-        .clock(intersect_count__clock)
-    );
-    dynrt_processor_core__asleep traversal_count(
-        .d(traversal_count__d),
-        .q(traversal_count__q),
-        .clock(traversal_count__clock)
-    );
-    dynrt_processor_core__px px(
-        .d(px__d),
-        .q(px__q),
-        .clock(px__clock)
-    );
-    dynrt_processor_core__px py(
-        .d(py__d),
-        .q(py__q),
-        .clock(py__clock)
-    );
-    dynrt_processor_core__add__big_sign v1(
-        .d(v1__d),
-        .q(v1__q),
-        .clock(v1__clock)
-    );
-    dynrt_processor_core__last_pick t1(
-        .d(t1__d),
-        .q(t1__q),
-        .clock(t1__clock)
-    );
-    dynrt_processor_core__add__big_sign v2(
-        .d(v2__d),
-        .q(v2__q),
-        .clock(v2__clock)
-    );
-    dynrt_processor_core__last_pick t2(
-        .d(t2__d),
-        .q(t2__q),
-        .clock(t2__clock)
-    );
-    dynrt_processor_core__pc2 pc2(
-        .d(pc2__d),
-        .q(pc2__q),
-        .clock(pc2__clock)
-    );
-    dynrt_processor_core__add__big_sign v3(
-        .d(v3__d),
-        .q(v3__q),
-        .clock(v3__clock)
-    );
-    dynrt_processor_core__last_pick t3(
-        .d(t3__d),
-        .q(t3__q),
-        .clock(t3__clock)
-    );
-    dynrt_processor_core__pc2 pc3(
-        .d(pc3__d),
-        .q(pc3__q),
-        .clock(pc3__clock)
-    );
-    dynrt_processor_core__asleep ctl3(
-        .d(ctl3__d),
-        .q(ctl3__q),
-        .clock(ctl3__clock)
-    );
-    dynrt_processor_core__asleep imm3(
-        .d(imm3__d),
-        .q(imm3__q),
-        .clock(imm3__clock)
-    );
-    dynrt_processor_core__asleep aux3(
-        .d(aux3__d),
-        .q(aux3__q),
-        .clock(aux3__clock)
-    );
-    dynrt_processor_core__add__big_sign mem_read_r(
-        .d(mem_read_r__d),
-        .q(mem_read_r__q),
-        .clock(mem_read_r__clock)
-    );
-    dynrt_processor_core__cmp_delay__stage__0 mem_bank_r(
-        .d(mem_bank_r__d),
-        .q(mem_bank_r__q),
-        .clock(mem_bank_r__clock)
-    );
-    dynrt_processor_core__add__in_a mem_addr_r(
-        .d(mem_addr_r__d),
-        .q(mem_addr_r__q),
-        .clock(mem_addr_r__clock)
-    );
-    dynrt_processor_core__add__big_sign fb_write_r(
-        .d(fb_write_r__d),
-        .q(fb_write_r__q),
-        .clock(fb_write_r__clock)
-    );
-    dynrt_processor_core__add__in_a fb_addr_r(
-        .d(fb_addr_r__d),
-        .q(fb_addr_r__q),
-        .clock(fb_addr_r__clock)
-    );
-    dynrt_processor_core__asleep fb_data_r(
-        .d(fb_data_r__d),
-        .q(fb_data_r__q),
-        .clock(fb_data_r__clock)
-    );
-    dynrt_processor_core__add add(
+    dynrt_processor__engine__fp_units__add add(
         .clock(add__clock),
         .in_valid(add__in_valid),
         .a(add__a),
@@ -986,7 +2972,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         .out_valid(add__out_valid),
         .result(add__result)
     );
-    dynrt_processor_core__byte_unit__scale mul(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul(
         .clock(mul__clock),
         .in_valid(mul__in_valid),
         .a(mul__a),
@@ -994,7 +2980,7 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         .out_valid(mul__out_valid),
         .result(mul__result)
     );
-    dynrt_processor_core__div div(
+    dynrt_processor__engine__fp_units__div div(
         .clock(div__clock),
         .in_valid(div__in_valid),
         .a(div__a),
@@ -1002,14 +2988,14 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         .out_valid(div__out_valid),
         .result(div__result)
     );
-    dynrt_processor_core__sqrt sqrt(
+    dynrt_processor__engine__fp_units__sqrt sqrt(
         .clock(sqrt__clock),
         .in_valid(sqrt__in_valid),
         .a(sqrt__a),
         .out_valid(sqrt__out_valid),
         .result(sqrt__result)
     );
-    dynrt_processor_core__cmp cmp(
+    dynrt_processor__engine__fp_units__cmp cmp(
         .clock(cmp__clock),
         .in_valid(cmp__in_valid),
         .a(cmp__a),
@@ -1019,417 +3005,51 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         .le(cmp__le),
         .eq(cmp__eq)
     );
-    dynrt_processor_core__itof itof(
-        .value(itof__value),
-        .word(itof__word)
-    );
-    dynrt_processor_core__byte_unit byte_unit(
+    dynrt_processor__engine__fp_units__byte_unit byte_unit(
         .clock(byte_unit__clock),
         .in_valid(byte_unit__in_valid),
         .word(byte_unit__word),
         .out_valid(byte_unit__out_valid),
         .result(byte_unit__result)
     );
-    dynrt_processor_core__tester tester(
-        .clock(tester__clock),
-        .thread(tester__thread),
-        .word_a(tester__word_a),
-        .word_b(tester__word_b),
-        .ray_write(tester__ray_write),
-        .ray_pair(tester__ray_pair),
-        .enqueue(tester__enqueue),
-        .queue_kind(tester__queue_kind),
-        .full(tester__full),
-        .query_thread(tester__query_thread),
-        .pending(tester__pending),
-        .hit(tester__hit),
-        .best_t(tester__best_t),
-        .best_instance(tester__best_instance),
-        .best_triangle(tester__best_triangle),
-        .engine_read(tester__engine_read),
-        .engine_bank(tester__engine_bank),
-        .engine_addr(tester__engine_addr),
-        .uv_read(tester__uv_read),
-        .uv_addr(tester__uv_addr),
-        .uv_rdata(tester__uv_rdata),
-        .t_read(tester__t_read),
-        .t_addr(tester__t_addr),
-        .t_rdata(tester__t_rdata),
-        .list_read(tester__list_read),
-        .list_addr(tester__list_addr),
-        .list_rdata(tester__list_rdata),
-        .done_event(tester__done_event),
-        .done_thread(tester__done_thread),
-        .walk_list_valid(tester__walk_list_valid),
-        .walk_list_thread(tester__walk_list_thread),
-        .walk_list_from(tester__walk_list_from),
-        .walk_list_to(tester__walk_list_to),
-        .walk_list_take(tester__walk_list_take),
-        .walk_end_event(tester__walk_end_event),
-        .walk_end_thread(tester__walk_end_thread),
-        .walk_end_t(tester__walk_end_t),
-        .walk_end_hit(tester__walk_end_hit),
-        .transform_busy(tester__transform_busy),
-        .intersect_busy(tester__intersect_busy)
-    );
-    dynrt_processor_core__traversal_unit traversal_unit(
-        .clock(traversal_unit__clock),
-        .thread(traversal_unit__thread),
-        .word_a(traversal_unit__word_a),
-        .word_b(traversal_unit__word_b),
-        .ray_write(traversal_unit__ray_write),
-        .ray_pair(traversal_unit__ray_pair),
-        .t_min_write(traversal_unit__t_min_write),
-        .enqueue(traversal_unit__enqueue),
-        .full(traversal_unit__full),
-        .query_thread(traversal_unit__query_thread),
-        .pending(traversal_unit__pending),
-        .engine_read(traversal_unit__engine_read),
-        .engine_bank(traversal_unit__engine_bank),
-        .engine_addr(traversal_unit__engine_addr),
-        .node_read(traversal_unit__node_read),
-        .node_addr(traversal_unit__node_addr),
-        .node_rdata(traversal_unit__node_rdata),
-        .step_busy(traversal_unit__step_busy),
-        .done_event(traversal_unit__done_event),
-        .done_thread(traversal_unit__done_thread),
-        .leaf_valid(traversal_unit__leaf_valid),
-        .leaf_thread(traversal_unit__leaf_thread),
-        .leaf_from(traversal_unit__leaf_from),
-        .leaf_to(traversal_unit__leaf_to),
-        .leaf_take(traversal_unit__leaf_take),
-        .answer_valid(traversal_unit__answer_valid),
-        .answer_thread(traversal_unit__answer_thread),
-        .answer_t(traversal_unit__answer_t),
-        .answer_hit(traversal_unit__answer_hit)
-    );
-    dynrt_processor_core__add_delay add_delay(
+    dynrt_processor__engine__fp_units__add_delay add_delay(
         .clock(add_delay__clock),
         .data_in(add_delay__data_in),
         .data_out(add_delay__data_out)
     );
-    dynrt_processor_core__mul_delay mul_delay(
+    dynrt_processor__engine__fp_units__mul_delay mul_delay(
         .clock(mul_delay__clock),
         .data_in(mul_delay__data_in),
         .data_out(mul_delay__data_out)
     );
-    dynrt_processor_core__div_delay div_delay(
+    dynrt_processor__engine__fp_units__div_delay div_delay(
         .clock(div_delay__clock),
         .data_in(div_delay__data_in),
         .data_out(div_delay__data_out)
     );
-    dynrt_processor_core__div_delay sqrt_delay(
+    dynrt_processor__engine__fp_units__div_delay sqrt_delay(
         .clock(sqrt_delay__clock),
         .data_in(sqrt_delay__data_in),
         .data_out(sqrt_delay__data_out)
     );
-    dynrt_processor_core__cmp_delay cmp_delay(
-        .clock(cmp_delay__clock),
-        .data_in(cmp_delay__data_in),
-        .data_out(cmp_delay__data_out)
+    dynrt_processor__engine__fp_units__eq_delay lt_delay(
+        .clock(lt_delay__clock),
+        .data_in(lt_delay__data_in),
+        .data_out(lt_delay__data_out)
     );
-    dynrt_processor_core__asleep fast_line__0(
-        .d(fast_line__0__d),
-        .q(fast_line__0__q),
-        .clock(fast_line__0__clock)
+    dynrt_processor__engine__fp_units__eq_delay le_delay(
+        .clock(le_delay__clock),
+        .data_in(le_delay__data_in),
+        .data_out(le_delay__data_out)
     );
-    dynrt_processor_core__asleep fast_line__1(
-        .d(fast_line__1__d),
-        .q(fast_line__1__q),
-        .clock(fast_line__1__clock)
-    );
-    dynrt_processor_core__asleep fast_line__2(
-        .d(fast_line__2__d),
-        .q(fast_line__2__q),
-        .clock(fast_line__2__clock)
-    );
-    dynrt_processor_core__asleep fast_line__3(
-        .d(fast_line__3__d),
-        .q(fast_line__3__q),
-        .clock(fast_line__3__clock)
-    );
-    dynrt_processor_core__asleep fast_line__4(
-        .d(fast_line__4__d),
-        .q(fast_line__4__q),
-        .clock(fast_line__4__clock)
-    );
-    dynrt_processor_core__asleep fast_line__5(
-        .d(fast_line__5__d),
-        .q(fast_line__5__q),
-        .clock(fast_line__5__clock)
-    );
-    dynrt_processor_core__asleep fast_line__6(
-        .d(fast_line__6__d),
-        .q(fast_line__6__q),
-        .clock(fast_line__6__clock)
-    );
-    dynrt_processor_core__asleep fast_line__7(
-        .d(fast_line__7__d),
-        .q(fast_line__7__q),
-        .clock(fast_line__7__clock)
-    );
-    dynrt_processor_core__fast_kind_line__0 fast_kind_line__0(
-        .d(fast_kind_line__0__d),
-        .q(fast_kind_line__0__q),
-        .clock(fast_kind_line__0__clock)
-    );
-    dynrt_processor_core__fast_kind_line__0 fast_kind_line__1(
-        .d(fast_kind_line__1__d),
-        .q(fast_kind_line__1__q),
-        .clock(fast_kind_line__1__clock)
-    );
-    dynrt_processor_core__fast_kind_line__0 fast_kind_line__2(
-        .d(fast_kind_line__2__d),
-        .q(fast_kind_line__2__q),
-        .clock(fast_kind_line__2__clock)
-    );
-    dynrt_processor_core__fast_kind_line__0 fast_kind_line__3(
-        .d(fast_kind_line__3__d),
-        .q(fast_kind_line__3__q),
-        .clock(fast_kind_line__3__clock)
-    );
-    dynrt_processor_core__fast_kind_line__0 fast_kind_line__4(
-        .d(fast_kind_line__4__d),
-        .q(fast_kind_line__4__q),
-        .clock(fast_kind_line__4__clock)
-    );
-    dynrt_processor_core__fast_kind_line__0 fast_kind_line__5(
-        .d(fast_kind_line__5__d),
-        .q(fast_kind_line__5__q),
-        .clock(fast_kind_line__5__clock)
-    );
-    dynrt_processor_core__fast_kind_line__0 fast_kind_line__6(
-        .d(fast_kind_line__6__d),
-        .q(fast_kind_line__6__q),
-        .clock(fast_kind_line__6__clock)
-    );
-    dynrt_processor_core__fast_kind_line__0 fast_kind_line__7(
-        .d(fast_kind_line__7__d),
-        .q(fast_kind_line__7__q),
-        .clock(fast_kind_line__7__clock)
-    );
-    dynrt_processor_core__fast_delay fast_delay(
-        .clock(fast_delay__clock),
-        .data_in(fast_delay__data_in),
-        .data_out(fast_delay__data_out)
-    );
-    dynrt_processor_core__ctl_delay ctl_delay(
-        .clock(ctl_delay__clock),
-        .data_in(ctl_delay__data_in),
-        .data_out(ctl_delay__data_out)
-    );
-    dynrt_processor_core__add__mid_norm ctl_line__0(
-        .d(ctl_line__0__d),
-        .q(ctl_line__0__q),
-        .clock(ctl_line__0__clock)
-    );
-    dynrt_processor_core__add__mid_norm ctl_line__1(
-        .d(ctl_line__1__d),
-        .q(ctl_line__1__q),
-        .clock(ctl_line__1__clock)
-    );
-    dynrt_processor_core__add__mid_norm ctl_line__2(
-        .d(ctl_line__2__d),
-        .q(ctl_line__2__q),
-        .clock(ctl_line__2__clock)
-    );
-    dynrt_processor_core__add__mid_norm ctl_line__3(
-        .d(ctl_line__3__d),
-        .q(ctl_line__3__q),
-        .clock(ctl_line__3__clock)
-    );
-    dynrt_processor_core__add__mid_norm ctl_line__4(
-        .d(ctl_line__4__d),
-        .q(ctl_line__4__q),
-        .clock(ctl_line__4__clock)
-    );
-    dynrt_processor_core__add__mid_norm ctl_line__5(
-        .d(ctl_line__5__d),
-        .q(ctl_line__5__q),
-        .clock(ctl_line__5__clock)
-    );
-    dynrt_processor_core__add__mid_norm ctl_line__6(
-        .d(ctl_line__6__d),
-        .q(ctl_line__6__q),
-        .clock(ctl_line__6__clock)
-    );
-    dynrt_processor_core__add__mid_norm ctl_line__7(
-        .d(ctl_line__7__d),
-        .q(ctl_line__7__q),
-        .clock(ctl_line__7__clock)
-    );
-    dynrt_processor_core__pc_delay pc_delay(
-        .clock(pc_delay__clock),
-        .data_in(pc_delay__data_in),
-        .data_out(pc_delay__data_out)
-    );
-    dynrt_processor_core__add__in_a pc_line__0(
-        .d(pc_line__0__d),
-        .q(pc_line__0__q),
-        .clock(pc_line__0__clock)
-    );
-    dynrt_processor_core__add__in_a pc_line__1(
-        .d(pc_line__1__d),
-        .q(pc_line__1__q),
-        .clock(pc_line__1__clock)
-    );
-    dynrt_processor_core__add__in_a pc_line__2(
-        .d(pc_line__2__d),
-        .q(pc_line__2__q),
-        .clock(pc_line__2__clock)
-    );
-    dynrt_processor_core__add__in_a pc_line__3(
-        .d(pc_line__3__d),
-        .q(pc_line__3__q),
-        .clock(pc_line__3__clock)
-    );
-    dynrt_processor_core__add__in_a pc_line__4(
-        .d(pc_line__4__d),
-        .q(pc_line__4__q),
-        .clock(pc_line__4__clock)
-    );
-    dynrt_processor_core__add__in_a pc_line__5(
-        .d(pc_line__5__d),
-        .q(pc_line__5__q),
-        .clock(pc_line__5__clock)
-    );
-    dynrt_processor_core__add__in_a pc_line__6(
-        .d(pc_line__6__d),
-        .q(pc_line__6__q),
-        .clock(pc_line__6__clock)
-    );
-    dynrt_processor_core__add__in_a pc_line__7(
-        .d(pc_line__7__d),
-        .q(pc_line__7__q),
-        .clock(pc_line__7__clock)
-    );
-    dynrt_processor_core__cond_delay cond_delay(
-        .clock(cond_delay__clock),
-        .data_in(cond_delay__data_in),
-        .data_out(cond_delay__data_out)
-    );
-    dynrt_processor_core__cond_delay__stage__0 cond_line__0(
-        .d(cond_line__0__d),
-        .q(cond_line__0__q),
-        .clock(cond_line__0__clock)
-    );
-    dynrt_processor_core__cond_delay__stage__0 cond_line__1(
-        .d(cond_line__1__d),
-        .q(cond_line__1__q),
-        .clock(cond_line__1__clock)
-    );
-    dynrt_processor_core__cond_delay__stage__0 cond_line__2(
-        .d(cond_line__2__d),
-        .q(cond_line__2__q),
-        .clock(cond_line__2__clock)
-    );
-    dynrt_processor_core__cond_delay__stage__0 cond_line__3(
-        .d(cond_line__3__d),
-        .q(cond_line__3__q),
-        .clock(cond_line__3__clock)
-    );
-    dynrt_processor_core__cond_delay__stage__0 cond_line__4(
-        .d(cond_line__4__d),
-        .q(cond_line__4__q),
-        .clock(cond_line__4__clock)
-    );
-    dynrt_processor_core__cond_delay__stage__0 cond_line__5(
-        .d(cond_line__5__d),
-        .q(cond_line__5__q),
-        .clock(cond_line__5__clock)
-    );
-    dynrt_processor_core__cond_delay__stage__0 cond_line__6(
-        .d(cond_line__6__d),
-        .q(cond_line__6__q),
-        .clock(cond_line__6__clock)
-    );
-    dynrt_processor_core__cond_delay__stage__0 cond_line__7(
-        .d(cond_line__7__d),
-        .q(cond_line__7__q),
-        .clock(cond_line__7__clock)
-    );
-    dynrt_processor_core__long_ctl long_ctl(
-        .clock(long_ctl__clock),
-        .data_in(long_ctl__data_in),
-        .data_out(long_ctl__data_out)
-    );
-    dynrt_processor_core__long_pc long_pc(
-        .clock(long_pc__clock),
-        .data_in(long_pc__data_in),
-        .data_out(long_pc__data_out)
-    );
-    dynrt_processor_core__asleep reserved(
-        .d(reserved__d),
-        .q(reserved__q),
-        .clock(reserved__clock)
+    dynrt_processor__engine__fp_units__eq_delay eq_delay(
+        .clock(eq_delay__clock),
+        .data_in(eq_delay__data_in),
+        .data_out(eq_delay__data_out)
     );
     
     // Update code
     always @(*) begin
-        running__clock = clock;
-        epoch__clock = clock;
-        ready__clock = clock;
-        asleep__clock = clock;
-        woken__clock = clock;
-        last_pick__clock = clock;
-        halted_count__clock = clock;
-        cycle_count__clock = clock;
-        instr_count__clock = clock;
-        transform_count__clock = clock;
-        intersect_count__clock = clock;
-        traversal_count__clock = clock;
-        px__clock = clock;
-        py__clock = clock;
-        v1__clock = clock;
-        t1__clock = clock;
-        v2__clock = clock;
-        t2__clock = clock;
-        pc2__clock = clock;
-        v3__clock = clock;
-        t3__clock = clock;
-        pc3__clock = clock;
-        ctl3__clock = clock;
-        imm3__clock = clock;
-        aux3__clock = clock;
-        mem_read_r__clock = clock;
-        mem_bank_r__clock = clock;
-        mem_addr_r__clock = clock;
-        fb_write_r__clock = clock;
-        fb_addr_r__clock = clock;
-        fb_data_r__clock = clock;
-        reserved__clock = clock;
-        running__d = running__q;
-        epoch__d = epoch__q;
-        ready__d = ready__q;
-        asleep__d = asleep__q;
-        woken__d = woken__q;
-        last_pick__d = last_pick__q;
-        halted_count__d = halted_count__q;
-        cycle_count__d = cycle_count__q;
-        instr_count__d = instr_count__q;
-        transform_count__d = transform_count__q;
-        intersect_count__d = intersect_count__q;
-        traversal_count__d = traversal_count__q;
-        px__d = px__q;
-        py__d = py__q;
-        v1__d = v1__q;
-        t1__d = t1__q;
-        v2__d = v2__q;
-        t2__d = t2__q;
-        pc2__d = pc2__q;
-        v3__d = v3__q;
-        t3__d = t3__q;
-        pc3__d = pc3__q;
-        ctl3__d = ctl3__q;
-        imm3__d = imm3__q;
-        aux3__d = aux3__q;
-        mem_read_r__d = mem_read_r__q;
-        mem_bank_r__d = mem_bank_r__q;
-        mem_addr_r__d = mem_addr_r__q;
-        fb_write_r__d = fb_write_r__q;
-        fb_addr_r__d = fb_addr_r__q;
-        fb_data_r__d = fb_data_r__q;
-        reserved__d = reserved__q;
         add__clock = clock;
         mul__clock = clock;
         div__clock = clock;
@@ -1440,915 +3060,47 @@ module dynrt_processor_core(clock,start,done,cycles,instructions,mem_read,mem_ba
         mul_delay__clock = clock;
         div_delay__clock = clock;
         sqrt_delay__clock = clock;
-        cmp_delay__clock = clock;
-        fast_delay__clock = clock;
-        ctl_delay__clock = clock;
-        pc_delay__clock = clock;
-        cond_delay__clock = clock;
-        long_ctl__clock = clock;
-        long_pc__clock = clock;
-        tester__clock = clock;
-        traversal_unit__clock = clock;
-        pc_ram__read_clock = clock;
-        pc_ram__write_clock = clock;
-        rom_ctl__read_clock = clock;
-        rom_ctl__write_clock = clock;
-        rom_imm__read_clock = clock;
-        rom_imm__write_clock = clock;
-        rom_aux__read_clock = clock;
-        rom_aux__write_clock = clock;
-        regs_a__read_clock = clock;
-        regs_a__write_clock = clock;
-        regs_b__read_clock = clock;
-        regs_b__write_clock = clock;
-        scratch__read_clock = clock;
-        scratch__write_clock = clock;
-        mailbox_meta__read_clock = clock;
-        mailbox_meta__write_clock = clock;
-        mailbox__0__read_clock = clock;
-        mailbox__0__write_clock = clock;
-        mailbox__1__read_clock = clock;
-        mailbox__1__write_clock = clock;
-        mailbox__2__read_clock = clock;
-        mailbox__2__write_clock = clock;
-        mailbox__3__read_clock = clock;
-        mailbox__3__write_clock = clock;
-        mailbox__4__read_clock = clock;
-        mailbox__4__write_clock = clock;
-        mailbox__5__read_clock = clock;
-        mailbox__5__write_clock = clock;
-        mailbox__6__read_clock = clock;
-        mailbox__6__write_clock = clock;
-        mailbox__7__read_clock = clock;
-        mailbox__7__write_clock = clock;
-        fast_line__0__clock = clock;
-        fast_kind_line__0__clock = clock;
-        ctl_line__0__clock = clock;
-        pc_line__0__clock = clock;
-        cond_line__0__clock = clock;
-        fast_line__1__clock = clock;
-        fast_kind_line__1__clock = clock;
-        ctl_line__1__clock = clock;
-        pc_line__1__clock = clock;
-        cond_line__1__clock = clock;
-        fast_line__2__clock = clock;
-        fast_kind_line__2__clock = clock;
-        ctl_line__2__clock = clock;
-        pc_line__2__clock = clock;
-        cond_line__2__clock = clock;
-        fast_line__3__clock = clock;
-        fast_kind_line__3__clock = clock;
-        ctl_line__3__clock = clock;
-        pc_line__3__clock = clock;
-        cond_line__3__clock = clock;
-        fast_line__4__clock = clock;
-        fast_kind_line__4__clock = clock;
-        ctl_line__4__clock = clock;
-        pc_line__4__clock = clock;
-        cond_line__4__clock = clock;
-        fast_line__5__clock = clock;
-        fast_kind_line__5__clock = clock;
-        ctl_line__5__clock = clock;
-        pc_line__5__clock = clock;
-        cond_line__5__clock = clock;
-        fast_line__6__clock = clock;
-        fast_kind_line__6__clock = clock;
-        ctl_line__6__clock = clock;
-        pc_line__6__clock = clock;
-        cond_line__6__clock = clock;
-        fast_line__7__clock = clock;
-        fast_kind_line__7__clock = clock;
-        ctl_line__7__clock = clock;
-        pc_line__7__clock = clock;
-        cond_line__7__clock = clock;
-        rom_ctl__write_enable = 1'b0;
-        rom_imm__write_enable = 1'b0;
-        rom_aux__write_enable = 1'b0;
-        rom_ctl__write_address = 32'h0;
-        rom_imm__write_address = 32'h0;
-        rom_aux__write_address = 32'h0;
-        rom_ctl__write_data = 32'h0;
-        rom_imm__write_data = 32'h0;
-        rom_aux__write_data = 32'h0;
-        done = (~running__q) & (halted_count__q == c_threads);
-        cycles = cycle_count__q;
-        instructions = instr_count__q;
-        transform_busy = transform_count__q;
-        intersect_busy = intersect_count__q;
-        traversal_busy = traversal_count__q;
-        if (running__q) begin
-            cycle_count__d = cycle_count__q + 32'h1;
-            if (tester__transform_busy) begin
-                transform_count__d = transform_count__q + 32'h1;
-            end
-            if (tester__intersect_busy) begin
-                intersect_count__d = intersect_count__q + 32'h1;
-            end
-            if (traversal_unit__step_busy) begin
-                traversal_count__d = traversal_count__q + 32'h1;
-            end
-        end
-        below = ready__q & (~(c_ones << last_pick__q));
-        pick = 32'h0;
-        if (ready__q[0]) begin
-            pick = c_thread_ids__0;
-        end
-        if (ready__q[1]) begin
-            pick = c_thread_ids__1;
-        end
-        if (ready__q[2]) begin
-            pick = c_thread_ids__2;
-        end
-        if (ready__q[3]) begin
-            pick = c_thread_ids__3;
-        end
-        if (ready__q[4]) begin
-            pick = c_thread_ids__4;
-        end
-        if (ready__q[5]) begin
-            pick = c_thread_ids__5;
-        end
-        if (ready__q[6]) begin
-            pick = c_thread_ids__6;
-        end
-        if (ready__q[7]) begin
-            pick = c_thread_ids__7;
-        end
-        if (ready__q[8]) begin
-            pick = c_thread_ids__8;
-        end
-        if (ready__q[9]) begin
-            pick = c_thread_ids__9;
-        end
-        if (ready__q[10]) begin
-            pick = c_thread_ids__10;
-        end
-        if (ready__q[11]) begin
-            pick = c_thread_ids__11;
-        end
-        if (ready__q[12]) begin
-            pick = c_thread_ids__12;
-        end
-        if (ready__q[13]) begin
-            pick = c_thread_ids__13;
-        end
-        if (ready__q[14]) begin
-            pick = c_thread_ids__14;
-        end
-        if (ready__q[15]) begin
-            pick = c_thread_ids__15;
-        end
-        if (ready__q[16]) begin
-            pick = c_thread_ids__16;
-        end
-        if (ready__q[17]) begin
-            pick = c_thread_ids__17;
-        end
-        if (ready__q[18]) begin
-            pick = c_thread_ids__18;
-        end
-        if (ready__q[19]) begin
-            pick = c_thread_ids__19;
-        end
-        if (ready__q[20]) begin
-            pick = c_thread_ids__20;
-        end
-        if (ready__q[21]) begin
-            pick = c_thread_ids__21;
-        end
-        if (ready__q[22]) begin
-            pick = c_thread_ids__22;
-        end
-        if (ready__q[23]) begin
-            pick = c_thread_ids__23;
-        end
-        if (ready__q[24]) begin
-            pick = c_thread_ids__24;
-        end
-        if (ready__q[25]) begin
-            pick = c_thread_ids__25;
-        end
-        if (ready__q[26]) begin
-            pick = c_thread_ids__26;
-        end
-        if (ready__q[27]) begin
-            pick = c_thread_ids__27;
-        end
-        if (ready__q[28]) begin
-            pick = c_thread_ids__28;
-        end
-        if (ready__q[29]) begin
-            pick = c_thread_ids__29;
-        end
-        if (ready__q[30]) begin
-            pick = c_thread_ids__30;
-        end
-        if (ready__q[31]) begin
-            pick = c_thread_ids__31;
-        end
-        if (below[0]) begin
-            pick = c_thread_ids__0;
-        end
-        if (below[1]) begin
-            pick = c_thread_ids__1;
-        end
-        if (below[2]) begin
-            pick = c_thread_ids__2;
-        end
-        if (below[3]) begin
-            pick = c_thread_ids__3;
-        end
-        if (below[4]) begin
-            pick = c_thread_ids__4;
-        end
-        if (below[5]) begin
-            pick = c_thread_ids__5;
-        end
-        if (below[6]) begin
-            pick = c_thread_ids__6;
-        end
-        if (below[7]) begin
-            pick = c_thread_ids__7;
-        end
-        if (below[8]) begin
-            pick = c_thread_ids__8;
-        end
-        if (below[9]) begin
-            pick = c_thread_ids__9;
-        end
-        if (below[10]) begin
-            pick = c_thread_ids__10;
-        end
-        if (below[11]) begin
-            pick = c_thread_ids__11;
-        end
-        if (below[12]) begin
-            pick = c_thread_ids__12;
-        end
-        if (below[13]) begin
-            pick = c_thread_ids__13;
-        end
-        if (below[14]) begin
-            pick = c_thread_ids__14;
-        end
-        if (below[15]) begin
-            pick = c_thread_ids__15;
-        end
-        if (below[16]) begin
-            pick = c_thread_ids__16;
-        end
-        if (below[17]) begin
-            pick = c_thread_ids__17;
-        end
-        if (below[18]) begin
-            pick = c_thread_ids__18;
-        end
-        if (below[19]) begin
-            pick = c_thread_ids__19;
-        end
-        if (below[20]) begin
-            pick = c_thread_ids__20;
-        end
-        if (below[21]) begin
-            pick = c_thread_ids__21;
-        end
-        if (below[22]) begin
-            pick = c_thread_ids__22;
-        end
-        if (below[23]) begin
-            pick = c_thread_ids__23;
-        end
-        if (below[24]) begin
-            pick = c_thread_ids__24;
-        end
-        if (below[25]) begin
-            pick = c_thread_ids__25;
-        end
-        if (below[26]) begin
-            pick = c_thread_ids__26;
-        end
-        if (below[27]) begin
-            pick = c_thread_ids__27;
-        end
-        if (below[28]) begin
-            pick = c_thread_ids__28;
-        end
-        if (below[29]) begin
-            pick = c_thread_ids__29;
-        end
-        if (below[30]) begin
-            pick = c_thread_ids__30;
-        end
-        if (below[31]) begin
-            pick = c_thread_ids__31;
-        end
-        issue = running__q & (ready__q != 32'h0) & (~reserved__q[32'h0]);
-        issue_mask = 32'h0;
-        if (issue) begin
-            issue_mask = c_one << pick;
-            last_pick__d = pick;
-        end
-        pc_ram__read_address = pick;
-        v1__d = issue;
-        t1__d = pick;
-        entry_fresh = pc_ram__read_data[32'hd] != epoch__q;
-        if (entry_fresh) begin
-            pc1_eff = 32'h0;
-        end
-        else begin
-            pc1_eff = pc_ram__read_data[(32'h0)+:(12)];
-        end
-        rom_ctl__read_address = pc1_eff;
-        rom_imm__read_address = pc1_eff;
-        rom_aux__read_address = pc1_eff;
-        v2__d = v1__q & (entry_fresh | (~pc_ram__read_data[32'hc]));
-        t2__d = t1__q;
-        pc2__d = pc1_eff;
-        regs_a__read_address = (((t2__q) & 13'h1fff) << 32'h8) | ((rom_ctl__read_data[(f_a)+:(8)]) & 13'h1fff);
-        regs_b__read_address = (((t2__q) & 13'h1fff) << 32'h8) | ((rom_ctl__read_data[(f_b)+:(8)]) & 13'h1fff);
-        mailbox_meta__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__0__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__1__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__2__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__3__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__4__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__5__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__6__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__7__read_address = (((t2__q) & 6'h3f) << 32'h1) | ((rom_imm__read_data[(32'h0)+:(1)]) & 6'h3f);
-        tester__query_thread = t2__q;
-        traversal_unit__query_thread = t2__q;
-        v3__d = v2__q;
-        t3__d = t2__q;
-        pc3__d = pc2__q;
-        ctl3__d = rom_ctl__read_data;
-        imm3__d = rom_imm__read_data;
-        aux3__d = rom_aux__read_data;
-        op3 = ctl3__q[(f_op)+:(5)];
-        if (ctl3__q[(f_a)+:(8)] == 32'h0) begin
-            opa = 32'h0;
-        end
-        else begin
-            opa = regs_a__read_data;
-        end
-        if (ctl3__q[f_b_imm]) begin
-            opb = imm3__q;
-        end
-        else if (ctl3__q[(f_b)+:(8)] == 32'h0) begin
-            opb = 32'h0;
-        end
-        else begin
-            opb = regs_b__read_data;
-        end
-        add__a = opa[(32'h0)+:(24)];
-        add__b = opb[(32'h0)+:(24)];
-        add__sub = op3 == op_fsub;
+        lt_delay__clock = clock;
+        le_delay__clock = clock;
+        eq_delay__clock = clock;
+        add__a = a;
+        add__b = b;
+        add__sub = sub;
         add__in_valid = 1'b1;
-        mul__a = opa[(32'h0)+:(24)];
-        mul__b = opb[(32'h0)+:(24)];
+        mul__a = a;
+        mul__b = b;
         mul__in_valid = 1'b1;
-        div__a = opa[(32'h0)+:(24)];
-        div__b = opb[(32'h0)+:(24)];
+        div__a = a;
+        div__b = b;
         div__in_valid = 1'b1;
-        sqrt__a = opa[(32'h0)+:(24)];
+        sqrt__a = a;
         sqrt__in_valid = 1'b1;
-        cmp__a = opa[(32'h0)+:(24)];
-        cmp__b = opb[(32'h0)+:(24)];
+        cmp__a = a;
+        cmp__b = b;
         cmp__in_valid = 1'b1;
-        itof__value = opa[(32'h0)+:(16)];
-        byte_unit__word = opa[(32'h0)+:(24)];
+        byte_unit__word = a;
         byte_unit__in_valid = 1'b1;
-        long3 = v3__q & ((op3 == op_fdiv) | (op3 == op_fsqrt));
-        reserved__d = (reserved__q >> 32'h1) | (((long3) & 32'hffffffff) << c_reserve_bit);
         add_delay__data_in = add__result;
         mul_delay__data_in = mul__result;
         div_delay__data_in = div__result;
         sqrt_delay__data_in = sqrt__result;
-        cmp_delay__data_in = (((cmp__lt) & 3'h7) << 32'h2) | (((cmp__le) & 3'h7) << 32'h1) | ((cmp__eq) & 3'h7);
-        int_eq = opa == opb;
-        int_lt = opa < opb;
-        shifted = opa << aux3__q[(f_shift)+:(3)];
-        mem_address = shifted + imm3__q;
-        scratch_address = opa + imm3__q;
-        mb_len = mailbox_meta__read_data[(32'h0)+:(4)];
-        mb_next = mailbox_meta__read_data[(32'h4)+:(3)];
-        mb_hit = 1'b0;
-        if ((mailbox__0__read_data == opa) & (((mb_len) & 8'hff) > c_index__0)) begin
-            mb_hit = 1'b1;
-        end
-        if ((mailbox__1__read_data == opa) & (((mb_len) & 8'hff) > c_index__1)) begin
-            mb_hit = 1'b1;
-        end
-        if ((mailbox__2__read_data == opa) & (((mb_len) & 8'hff) > c_index__2)) begin
-            mb_hit = 1'b1;
-        end
-        if ((mailbox__3__read_data == opa) & (((mb_len) & 8'hff) > c_index__3)) begin
-            mb_hit = 1'b1;
-        end
-        if ((mailbox__4__read_data == opa) & (((mb_len) & 8'hff) > c_index__4)) begin
-            mb_hit = 1'b1;
-        end
-        if ((mailbox__5__read_data == opa) & (((mb_len) & 8'hff) > c_index__5)) begin
-            mb_hit = 1'b1;
-        end
-        if ((mailbox__6__read_data == opa) & (((mb_len) & 8'hff) > c_index__6)) begin
-            mb_hit = 1'b1;
-        end
-        if ((mailbox__7__read_data == opa) & (((mb_len) & 8'hff) > c_index__7)) begin
-            mb_hit = 1'b1;
-        end
-        mailbox_meta__write_address = (((t3__q) & 6'h3f) << 32'h1) | ((imm3__q[(32'h0)+:(1)]) & 6'h3f);
-        mailbox_meta__write_enable = 1'b0;
-        mailbox_meta__write_data = 32'h0;
-        mailbox__0__write_address = (((t3__q) & 6'h3f) << 32'h1) | ((imm3__q[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__0__write_data = opa;
-        mailbox__0__write_enable = 1'b0;
-        mailbox__1__write_address = (((t3__q) & 6'h3f) << 32'h1) | ((imm3__q[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__1__write_data = opa;
-        mailbox__1__write_enable = 1'b0;
-        mailbox__2__write_address = (((t3__q) & 6'h3f) << 32'h1) | ((imm3__q[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__2__write_data = opa;
-        mailbox__2__write_enable = 1'b0;
-        mailbox__3__write_address = (((t3__q) & 6'h3f) << 32'h1) | ((imm3__q[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__3__write_data = opa;
-        mailbox__3__write_enable = 1'b0;
-        mailbox__4__write_address = (((t3__q) & 6'h3f) << 32'h1) | ((imm3__q[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__4__write_data = opa;
-        mailbox__4__write_enable = 1'b0;
-        mailbox__5__write_address = (((t3__q) & 6'h3f) << 32'h1) | ((imm3__q[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__5__write_data = opa;
-        mailbox__5__write_enable = 1'b0;
-        mailbox__6__write_address = (((t3__q) & 6'h3f) << 32'h1) | ((imm3__q[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__6__write_data = opa;
-        mailbox__6__write_enable = 1'b0;
-        mailbox__7__write_address = (((t3__q) & 6'h3f) << 32'h1) | ((imm3__q[(32'h0)+:(1)]) & 6'h3f);
-        mailbox__7__write_data = opa;
-        mailbox__7__write_enable = 1'b0;
-        if (v3__q & (op3 == op_mbc)) begin
-            mailbox_meta__write_enable = 1'b1;
-        end
-        if (v3__q & (op3 == op_mbx) & (~mb_hit)) begin
-            mailbox_meta__write_enable = 1'b1;
-            if (mb_len == 32'h8) begin
-                mailbox_meta__write_data = (((mb_next + 32'h1) & 8'hff) << 32'h4) | (c_index__7 + 32'h1);
-            end
-            else begin
-                mailbox_meta__write_data = (((mb_next + 32'h1) & 8'hff) << 32'h4) | ((mb_len + 32'h1) & 8'hff);
-            end
-            if (((mb_next) & 8'hff) == c_index__0) begin
-                mailbox__0__write_enable = 1'b1;
-            end
-            if (((mb_next) & 8'hff) == c_index__1) begin
-                mailbox__1__write_enable = 1'b1;
-            end
-            if (((mb_next) & 8'hff) == c_index__2) begin
-                mailbox__2__write_enable = 1'b1;
-            end
-            if (((mb_next) & 8'hff) == c_index__3) begin
-                mailbox__3__write_enable = 1'b1;
-            end
-            if (((mb_next) & 8'hff) == c_index__4) begin
-                mailbox__4__write_enable = 1'b1;
-            end
-            if (((mb_next) & 8'hff) == c_index__5) begin
-                mailbox__5__write_enable = 1'b1;
-            end
-            if (((mb_next) & 8'hff) == c_index__6) begin
-                mailbox__6__write_enable = 1'b1;
-            end
-            if (((mb_next) & 8'hff) == c_index__7) begin
-                mailbox__7__write_enable = 1'b1;
-            end
-        end
-        pix_done = ~(py__q < c_height);
-        if (running__q & v3__q & (op3 == op_pixel) & (~pix_done)) begin
-            if ((px__q + 32'h1) == c_width) begin
-                px__d = 32'h0;
-                py__d = py__q + 32'h1;
-            end
-            else begin
-                px__d = px__q + 32'h1;
-            end
-        end
-        scratch__read_address = (((t3__q) & 12'hfff) << 32'h7) | ((scratch_address[(32'h0)+:(7)]) & 12'hfff);
-        scratch__write_address = (((t3__q) & 12'hfff) << 32'h7) | ((scratch_address[(32'h0)+:(7)]) & 12'hfff);
-        scratch__write_data = regs_b__read_data;
-        scratch__write_enable = v3__q & (op3 == op_sts);
-        mem_read_r__d = v3__q & (op3 == op_ld);
-        mem_bank_r__d = aux3__q[(f_bank)+:(3)];
-        mem_addr_r__d = mem_address[(32'h0)+:(24)];
-        fb_write_r__d = v3__q & (op3 == op_st);
-        fb_addr_r__d = mem_address[(32'h0)+:(24)];
-        fb_data_r__d = regs_b__read_data;
-        mem_read = (mem_read_r__q & (mem_bank_r__q != bank_nodes) & (mem_bank_r__q != bank_uv) & (mem_bank_r__q != bank_t)) | tester__list_read;
-        traversal_unit__engine_read = mem_read_r__q;
-        traversal_unit__engine_bank = mem_bank_r__q;
-        traversal_unit__engine_addr = mem_addr_r__q;
-        bank0_read = traversal_unit__node_read;
-        bank0_addr = traversal_unit__node_addr;
-        traversal_unit__node_rdata = bank0_rdata;
-        mem_bank = mem_bank_r__q;
-        mem_addr = mem_addr_r__q;
-        if (tester__list_read) begin
-            mem_bank = bank_lists;
-            mem_addr = tester__list_addr;
-        end
-        tester__list_rdata = mem_rdata;
-        tester__engine_read = mem_read_r__q;
-        tester__engine_bank = mem_bank_r__q;
-        tester__engine_addr = mem_addr_r__q;
-        bank2_read = tester__uv_read;
-        bank2_addr = tester__uv_addr;
-        tester__uv_rdata = bank2_rdata;
-        bank3_read = tester__t_read;
-        bank3_addr = tester__t_addr;
-        tester__t_rdata = bank3_rdata;
-        tester__thread = t3__q;
-        tester__word_a = opa;
-        tester__word_b = opb;
-        tester__ray_pair = imm3__q[(32'h0)+:(2)];
-        tester__ray_write = v3__q & (op3 == op_tri) & (imm3__q < tri_ray_words);
-        tri_queues = (imm3__q == tri_init) | (imm3__q == tri_list) | (imm3__q == tri_object) | (imm3__q == tri_skip);
-        tester__enqueue = v3__q & (op3 == op_tri) & tri_queues;
-        tri_kind = cmd_list;
-        if (imm3__q == tri_init) begin
-            tri_kind = cmd_init;
-        end
-        if (imm3__q == tri_object) begin
-            tri_kind = cmd_object;
-        end
-        if (imm3__q == tri_skip) begin
-            tri_kind = cmd_skip;
-        end
-        tester__queue_kind = tri_kind;
-        tri_cond = 1'b0;
-        if (tri_queues) begin
-            tri_cond = tester__full;
-        end
-        if (imm3__q == tri_wait) begin
-            tri_cond = tester__pending;
-        end
-        tester__walk_list_valid = traversal_unit__leaf_valid;
-        tester__walk_list_thread = traversal_unit__leaf_thread;
-        tester__walk_list_from = traversal_unit__leaf_from;
-        tester__walk_list_to = traversal_unit__leaf_to;
-        traversal_unit__leaf_take = tester__walk_list_take;
-        traversal_unit__answer_valid = tester__walk_end_event;
-        traversal_unit__answer_thread = tester__walk_end_thread;
-        traversal_unit__answer_t = tester__walk_end_t;
-        traversal_unit__answer_hit = tester__walk_end_hit;
-        traversal_unit__thread = t3__q;
-        traversal_unit__word_a = opa;
-        traversal_unit__word_b = opb;
-        traversal_unit__ray_pair = imm3__q[(32'h0)+:(2)];
-        traversal_unit__ray_write = v3__q & (op3 == op_tri) & (imm3__q < tri_ray_words);
-        traversal_unit__t_min_write = v3__q & (op3 == op_tri) & (imm3__q == tri_init);
-        traversal_unit__enqueue = v3__q & (op3 == op_kd) & (imm3__q == kd_start);
-        kd_cond = traversal_unit__full;
-        if (imm3__q == kd_wait) begin
-            kd_cond = traversal_unit__pending;
-        end
-        wait_fn = ((op3 == op_tri) & (imm3__q == tri_wait)) | ((op3 == op_kd) & (imm3__q == kd_wait));
-        fb_write = fb_write_r__q;
-        fb_addr = fb_addr_r__q;
-        fb_data = fb_data_r__q;
-        fast_kind = FastKind__Computed;
-        fast = 32'h0;
-        if (op3 == op_itof) begin
-            fast = ((itof__word) & 32'hffffffff);
-        end
-        if (op3 == op_add) begin
-            fast = opa + opb;
-        end
-        if (op3 == op_sub) begin
-            fast = opa - opb;
-        end
-        if (op3 == op_and) begin
-            fast = opa & opb;
-        end
-        if (op3 == op_or) begin
-            fast = opa | opb;
-        end
-        if (op3 == op_xor) begin
-            fast = opa ^ opb;
-        end
-        if (op3 == op_shr) begin
-            fast = opa >> opb[(32'h0)+:(5)];
-        end
-        if (op3 == op_shl) begin
-            fast = opa << opb[(32'h0)+:(5)];
-        end
-        if (op3 == op_ld) begin
-            fast_kind = FastKind__Memory;
-            if (aux3__q[(f_bank)+:(3)] == bank_uv) begin
-                fast_kind = FastKind__TrianglesUv;
-            end
-            if (aux3__q[(f_bank)+:(3)] == bank_t) begin
-                fast_kind = FastKind__TrianglesT;
-            end
-            if (aux3__q[(f_bank)+:(3)] == bank_nodes) begin
-                fast_kind = FastKind__Nodes;
-            end
-        end
-        if (op3 == op_lds) begin
-            fast_kind = FastKind__Scratch;
-        end
-        if (op3 == op_jal) begin
-            fast = ((pc3__q + 32'h1) & 32'hffffffff);
-        end
-        if (op3 == op_byte) begin
-            fast = opb << 32'h8;
-        end
-        if (op3 == op_pixel) begin
-            fast = (((py__q) & 32'hffffffff) << c_pixel_shift) | ((px__q) & 32'hffffffff);
-        end
-        if (op3 == op_tri) begin
-            if (imm3__q == tri_wait) begin
-                fast = ((tester__best_t) & 32'hffffffff);
-            end
-            if (imm3__q == tri_hit) begin
-                fast = ((tester__hit) & 32'hffffffff);
-            end
-            if (imm3__q == tri_instance) begin
-                fast = tester__best_instance;
-            end
-            if (imm3__q == tri_triangle) begin
-                fast = tester__best_triangle;
-            end
-        end
-        fast_line__0__d = fast;
-        fast_kind_line__0__d = fast_kind;
-        ctl_line__0__d = (((v3__q) & 21'h1fffff) << 32'h14) | (((op3) & 21'h1fffff) << 32'hf) | (((ctl3__q[(f_dst)+:(8)]) & 21'h1fffff) << 32'h7) | (((t3__q) & 21'h1fffff) << 32'h2) | ((ctl3__q[(f_invert)+:(1)]) & 21'h1fffff);
-        pc_line__0__d = (((pc3__q + 32'h1) & 24'hffffff) << 32'hc) | ((aux3__q[(f_target)+:(12)]) & 24'hffffff);
-        cond_line__0__d = (((wait_fn) & 19'h7ffff) << 32'h12) | (((kd_cond) & 19'h7ffff) << 32'h11) | (((tri_cond) & 19'h7ffff) << 32'h10) | (((opa[(32'h0)+:(12)]) & 19'h7ffff) << 32'h4) | (((int_eq) & 19'h7ffff) << 32'h3) | (((int_lt) & 19'h7ffff) << 32'h2) | (((mb_hit) & 19'h7ffff) << 32'h1) | ((pix_done) & 19'h7ffff);
-        fast_line__1__d = fast_line__0__q;
-        fast_kind_line__1__d = fast_kind_line__0__q;
-        ctl_line__1__d = ctl_line__0__q;
-        pc_line__1__d = pc_line__0__q;
-        cond_line__1__d = cond_line__0__q;
-        fast_line__2__d = fast_line__1__q;
-        fast_kind_line__2__d = fast_kind_line__1__q;
-        ctl_line__2__d = ctl_line__1__q;
-        pc_line__2__d = pc_line__1__q;
-        cond_line__2__d = cond_line__1__q;
-        fast_line__3__d = fast_line__2__q;
-        fast_kind_line__3__d = fast_kind_line__2__q;
-        ctl_line__3__d = ctl_line__2__q;
-        pc_line__3__d = pc_line__2__q;
-        cond_line__3__d = cond_line__2__q;
-        fast_line__4__d = fast_line__3__q;
-        fast_kind_line__4__d = fast_kind_line__3__q;
-        ctl_line__4__d = ctl_line__3__q;
-        pc_line__4__d = pc_line__3__q;
-        cond_line__4__d = cond_line__3__q;
-        fast_line__5__d = fast_line__4__q;
-        fast_kind_line__5__d = fast_kind_line__4__q;
-        ctl_line__5__d = ctl_line__4__q;
-        pc_line__5__d = pc_line__4__q;
-        cond_line__5__d = cond_line__4__q;
-        fast_line__6__d = fast_line__5__q;
-        fast_kind_line__6__d = fast_kind_line__5__q;
-        ctl_line__6__d = ctl_line__5__q;
-        pc_line__6__d = pc_line__5__q;
-        cond_line__6__d = cond_line__5__q;
-        fast_line__7__d = fast_line__6__q;
-        fast_kind_line__7__d = fast_kind_line__6__q;
-        ctl_line__7__d = ctl_line__6__q;
-        pc_line__7__d = pc_line__6__q;
-        cond_line__7__d = cond_line__6__q;
-        if (fast_kind_line__0__q == FastKind__Scratch) begin
-            fast_line__1__d = scratch__read_data;
-        end
-        if (c_mem_latency == c_index__1) begin
-            if (fast_kind_line__1__q == FastKind__Memory) begin
-                fast_line__2__d = mem_rdata;
-            end
-            if (fast_kind_line__1__q == FastKind__TrianglesUv) begin
-                fast_line__2__d = bank2_rdata;
-            end
-            if (fast_kind_line__1__q == FastKind__TrianglesT) begin
-                fast_line__2__d = bank3_rdata;
-            end
-            if (fast_kind_line__1__q == FastKind__Nodes) begin
-                fast_line__2__d = bank0_rdata;
-            end
-        end
-        if (c_mem_latency == c_index__2) begin
-            if (fast_kind_line__2__q == FastKind__Memory) begin
-                fast_line__3__d = mem_rdata;
-            end
-            if (fast_kind_line__2__q == FastKind__TrianglesUv) begin
-                fast_line__3__d = bank2_rdata;
-            end
-            if (fast_kind_line__2__q == FastKind__TrianglesT) begin
-                fast_line__3__d = bank3_rdata;
-            end
-            if (fast_kind_line__2__q == FastKind__Nodes) begin
-                fast_line__3__d = bank0_rdata;
-            end
-        end
-        if (c_mem_latency == c_index__3) begin
-            if (fast_kind_line__3__q == FastKind__Memory) begin
-                fast_line__4__d = mem_rdata;
-            end
-            if (fast_kind_line__3__q == FastKind__TrianglesUv) begin
-                fast_line__4__d = bank2_rdata;
-            end
-            if (fast_kind_line__3__q == FastKind__TrianglesT) begin
-                fast_line__4__d = bank3_rdata;
-            end
-            if (fast_kind_line__3__q == FastKind__Nodes) begin
-                fast_line__4__d = bank0_rdata;
-            end
-        end
-        if (c_mem_latency == c_index__4) begin
-            if (fast_kind_line__4__q == FastKind__Memory) begin
-                fast_line__5__d = mem_rdata;
-            end
-            if (fast_kind_line__4__q == FastKind__TrianglesUv) begin
-                fast_line__5__d = bank2_rdata;
-            end
-            if (fast_kind_line__4__q == FastKind__TrianglesT) begin
-                fast_line__5__d = bank3_rdata;
-            end
-            if (fast_kind_line__4__q == FastKind__Nodes) begin
-                fast_line__5__d = bank0_rdata;
-            end
-        end
-        if (c_mem_latency == c_index__5) begin
-            if (fast_kind_line__5__q == FastKind__Memory) begin
-                fast_line__6__d = mem_rdata;
-            end
-            if (fast_kind_line__5__q == FastKind__TrianglesUv) begin
-                fast_line__6__d = bank2_rdata;
-            end
-            if (fast_kind_line__5__q == FastKind__TrianglesT) begin
-                fast_line__6__d = bank3_rdata;
-            end
-            if (fast_kind_line__5__q == FastKind__Nodes) begin
-                fast_line__6__d = bank0_rdata;
-            end
-        end
-        if (c_mem_latency == c_index__6) begin
-            if (fast_kind_line__6__q == FastKind__Memory) begin
-                fast_line__7__d = mem_rdata;
-            end
-            if (fast_kind_line__6__q == FastKind__TrianglesUv) begin
-                fast_line__7__d = bank2_rdata;
-            end
-            if (fast_kind_line__6__q == FastKind__TrianglesT) begin
-                fast_line__7__d = bank3_rdata;
-            end
-            if (fast_kind_line__6__q == FastKind__Nodes) begin
-                fast_line__7__d = bank0_rdata;
-            end
-        end
-        fast_delay__data_in = fast_line__7__q;
-        ctl_delay__data_in = ctl_line__7__q;
-        pc_delay__data_in = pc_line__7__q;
-        cond_delay__data_in = cond_line__7__q;
-        short_ctl = ctl_delay__data_out;
-        long_in = 32'h0;
-        if ((ctl_delay__data_out[(32'hf)+:(5)] == op_fdiv) | (ctl_delay__data_out[(32'hf)+:(5)] == op_fsqrt)) begin
-            short_ctl = 32'h0;
-            long_in = ctl_delay__data_out;
-        end
-        long_ctl__data_in = long_in;
-        long_pc__data_in = pc_delay__data_out;
-        wb_ctl = short_ctl;
-        wb_pcs = pc_delay__data_out;
-        if (long_ctl__data_out[32'h14]) begin
-            wb_ctl = long_ctl__data_out;
-            wb_pcs = long_pc__data_out;
-        end
-        wb_valid = wb_ctl[32'h14];
-        wb_op = wb_ctl[(32'hf)+:(5)];
-        wb_dst = wb_ctl[(32'h7)+:(8)];
-        wb_thread = wb_ctl[(32'h2)+:(5)];
-        wb_invert = wb_ctl[32'h0];
-        wb_cond = 1'b0;
-        if (wb_op == op_bflt) begin
-            wb_cond = cmp_delay__data_out[32'h2];
-        end
-        if (wb_op == op_bfle) begin
-            wb_cond = cmp_delay__data_out[32'h1];
-        end
-        if (wb_op == op_bfeq) begin
-            wb_cond = cmp_delay__data_out[32'h0];
-        end
-        if (wb_op == op_beq) begin
-            wb_cond = cond_delay__data_out[32'h3];
-        end
-        if (wb_op == op_bltu) begin
-            wb_cond = cond_delay__data_out[32'h2];
-        end
-        if (wb_op == op_mbx) begin
-            wb_cond = cond_delay__data_out[32'h1];
-        end
-        if (wb_op == op_pixel) begin
-            wb_cond = cond_delay__data_out[32'h0];
-        end
-        if (wb_op == op_jal) begin
-            wb_cond = 1'b1;
-        end
-        if (wb_op == op_tri) begin
-            wb_cond = cond_delay__data_out[32'h10];
-        end
-        if (wb_op == op_kd) begin
-            wb_cond = cond_delay__data_out[32'h11];
-        end
-        if (wb_cond != wb_invert) begin
-            wb_next_pc = wb_pcs[(32'h0)+:(12)];
-        end
-        else begin
-            wb_next_pc = wb_pcs[(32'hc)+:(12)];
-        end
-        if (wb_op == op_jr) begin
-            wb_next_pc = cond_delay__data_out[(32'h4)+:(12)];
-        end
-        if ((wb_op == op_halt) | (((wb_op == op_tri) | (wb_op == op_kd)) & wb_cond)) begin
-            wb_next_pc = wb_pcs[(32'hc)+:(12)] - 32'h1;
-        end
-        wb_result = fast_delay__data_out;
-        if ((wb_op == op_fadd) | (wb_op == op_fsub)) begin
-            wb_result = ((add_delay__data_out) & 32'hffffffff);
-        end
-        if (wb_op == op_fmul) begin
-            wb_result = ((mul_delay__data_out) & 32'hffffffff);
-        end
-        if (wb_op == op_fdiv) begin
-            wb_result = ((div_delay__data_out) & 32'hffffffff);
-        end
-        if (wb_op == op_fsqrt) begin
-            wb_result = ((sqrt_delay__data_out) & 32'hffffffff);
-        end
-        if (wb_op == op_byte) begin
-            wb_result = fast_delay__data_out | ((byte_unit__result) & 32'hffffffff);
-        end
-        wb_writes = wb_valid & (wb_dst != 32'h0) & op_writes[wb_op] & (~((wb_op == op_pixel) & cond_delay__data_out[32'h0]));
-        regs_a__write_address = (((wb_thread) & 13'h1fff) << 32'h8) | ((wb_dst) & 13'h1fff);
-        regs_b__write_address = (((wb_thread) & 13'h1fff) << 32'h8) | ((wb_dst) & 13'h1fff);
-        regs_a__write_data = wb_result;
-        regs_b__write_data = wb_result;
-        regs_a__write_enable = wb_writes;
-        regs_b__write_enable = wb_writes;
-        pc_ram__write_address = wb_thread;
-        pc_ram__write_data = (((epoch__q) & 16'hffff) << 32'hd) | ((((wb_op == op_halt)) & 16'hffff) << 32'hc) | ((wb_next_pc) & 16'hffff);
-        pc_ram__write_enable = wb_valid;
-        if (wb_valid & (~(((wb_op == op_tri) | (wb_op == op_kd)) & wb_cond))) begin
-            instr_count__d = instr_count__q + 32'h1;
-        end
-        wb_mask = c_one << wb_thread;
-        tester_event = 32'h0;
-        if (tester__done_event) begin
-            tester_event = c_one << tester__done_thread;
-        end
-        walk_event = 32'h0;
-        if (traversal_unit__done_event) begin
-            walk_event = c_one << traversal_unit__done_thread;
-        end
-        event_mask = tester_event | walk_event;
-        wb_sleep = wb_valid & wb_cond & cond_delay__data_out[32'h12] & (((woken__q | event_mask) & wb_mask) == 32'h0);
-        wake_mask = 32'h0;
-        sleep_mask = 32'h0;
-        if (wb_valid & (wb_op != op_halt)) begin
-            if (wb_sleep) begin
-                sleep_mask = wb_mask;
-            end
-            else begin
-                wake_mask = wb_mask;
-            end
-        end
-        ready__d = (ready__q & (~issue_mask)) | wake_mask | (asleep__q & event_mask);
-        asleep__d = (asleep__q & (~event_mask)) | sleep_mask;
-        woken__d = (woken__q & (~issue_mask)) | event_mask;
-        if (wb_valid & (wb_op == op_halt)) begin
-            halted_count__d = halted_count__q + 32'h1;
-            if ((halted_count__q + 32'h1) == c_threads) begin
-                running__d = 1'b0;
-            end
-        end
-        if (start & (~running__q)) begin
-            running__d = 1'b1;
-            epoch__d = ~epoch__q;
-            ready__d = c_thread_mask;
-            asleep__d = 32'h0;
-            woken__d = 32'h0;
-            reserved__d = 32'h0;
-            halted_count__d = 32'h0;
-            cycle_count__d = 32'h0;
-            instr_count__d = 32'h0;
-            transform_count__d = 32'h0;
-            intersect_count__d = 32'h0;
-            traversal_count__d = 32'h0;
-            px__d = 32'h0;
-            py__d = 32'h0;
-        end
+        lt_delay__data_in = cmp__lt;
+        le_delay__data_in = cmp__le;
+        eq_delay__data_in = cmp__eq;
+        sum = add_delay__data_out;
+        product = mul_delay__data_out;
+        quotient = div_delay__data_out;
+        root = sqrt_delay__data_out;
+        lt = lt_delay__data_out;
+        le = le_delay__data_out;
+        eq = eq_delay__data_out;
+        colour_byte = byte_unit__result;
     end
     
-endmodule // dynrt_processor_core
+endmodule // dynrt_processor__engine__fp_units
 
 
-module dynrt_processor_core__add(clock,in_valid,a,b,sub,out_valid,result);
+module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,result);
     
     // Module arguments
     input wire  clock;
@@ -2589,272 +3341,272 @@ module dynrt_processor_core__add(clock,in_valid,a,b,sub,out_valid,result);
     reg  [23:0] packed_word;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a in_a(
+    dynrt_processor__display__rgb_q in_a(
         .d(in_a__d),
         .q(in_a__q),
         .clock(in_a__clock)
     );
-    dynrt_processor_core__add__in_a in_b(
+    dynrt_processor__display__rgb_q in_b(
         .d(in_b__d),
         .q(in_b__q),
         .clock(in_b__clock)
     );
-    dynrt_processor_core__add__big_sign in_sub(
+    dynrt_processor__display__dark_d in_sub(
         .d(in_sub__d),
         .q(in_sub__q),
         .clock(in_sub__clock)
     );
-    dynrt_processor_core__add__big_sign in_valid_r(
+    dynrt_processor__display__dark_d in_valid_r(
         .d(in_valid_r__d),
         .q(in_valid_r__q),
         .clock(in_valid_r__clock)
     );
-    dynrt_processor_core__add__big_sig big_sig(
+    dynrt_processor__engine__fp_units__add__big_sig big_sig(
         .d(big_sig__d),
         .q(big_sig__q),
         .clock(big_sig__clock)
     );
-    dynrt_processor_core__add__big_sig small_sig(
+    dynrt_processor__engine__fp_units__add__big_sig small_sig(
         .d(small_sig__d),
         .q(small_sig__q),
         .clock(small_sig__clock)
     );
-    dynrt_processor_core__add__big_exp big_exp(
+    dynrt_processor__engine__fp_units__add__big_exp big_exp(
         .d(big_exp__d),
         .q(big_exp__q),
         .clock(big_exp__clock)
     );
-    dynrt_processor_core__add__big_exp exp_diff(
+    dynrt_processor__engine__fp_units__add__big_exp exp_diff(
         .d(exp_diff__d),
         .q(exp_diff__q),
         .clock(exp_diff__clock)
     );
-    dynrt_processor_core__add__big_sign big_sign(
+    dynrt_processor__display__dark_d big_sign(
         .d(big_sign__d),
         .q(big_sign__q),
         .clock(big_sign__clock)
     );
-    dynrt_processor_core__add__big_sign eff_sub(
+    dynrt_processor__display__dark_d eff_sub(
         .d(eff_sub__d),
         .q(eff_sub__q),
         .clock(eff_sub__clock)
     );
-    dynrt_processor_core__add__big_sign nan(
+    dynrt_processor__display__dark_d nan(
         .d(nan__d),
         .q(nan__q),
         .clock(nan__clock)
     );
-    dynrt_processor_core__add__big_sign inf(
+    dynrt_processor__display__dark_d inf(
         .d(inf__d),
         .q(inf__q),
         .clock(inf__clock)
     );
-    dynrt_processor_core__add__big_sign inf_sign(
+    dynrt_processor__display__dark_d inf_sign(
         .d(inf_sign__d),
         .q(inf_sign__q),
         .clock(inf_sign__clock)
     );
-    dynrt_processor_core__add__big_sign zero_sign(
+    dynrt_processor__display__dark_d zero_sign(
         .d(zero_sign__d),
         .q(zero_sign__q),
         .clock(zero_sign__clock)
     );
-    dynrt_processor_core__add__big_sign valid2(
+    dynrt_processor__display__dark_d valid2(
         .d(valid2__d),
         .q(valid2__q),
         .clock(valid2__clock)
     );
-    dynrt_processor_core__add__mid_norm sum(
+    dynrt_processor__engine__fp_units__add__mid_norm sum(
         .d(sum__d),
         .q(sum__q),
         .clock(sum__clock)
     );
-    dynrt_processor_core__add__big_exp sum_exp(
+    dynrt_processor__engine__fp_units__add__big_exp sum_exp(
         .d(sum_exp__d),
         .q(sum_exp__q),
         .clock(sum_exp__clock)
     );
-    dynrt_processor_core__add__big_sign sum_sign(
+    dynrt_processor__display__dark_d sum_sign(
         .d(sum_sign__d),
         .q(sum_sign__q),
         .clock(sum_sign__clock)
     );
-    dynrt_processor_core__add__big_sign nan3(
+    dynrt_processor__display__dark_d nan3(
         .d(nan3__d),
         .q(nan3__q),
         .clock(nan3__clock)
     );
-    dynrt_processor_core__add__big_sign inf3(
+    dynrt_processor__display__dark_d inf3(
         .d(inf3__d),
         .q(inf3__q),
         .clock(inf3__clock)
     );
-    dynrt_processor_core__add__big_sign inf_sign3(
+    dynrt_processor__display__dark_d inf_sign3(
         .d(inf_sign3__d),
         .q(inf_sign3__q),
         .clock(inf_sign3__clock)
     );
-    dynrt_processor_core__add__big_sign zero_sign3(
+    dynrt_processor__display__dark_d zero_sign3(
         .d(zero_sign3__d),
         .q(zero_sign3__q),
         .clock(zero_sign3__clock)
     );
-    dynrt_processor_core__add__big_sign valid3(
+    dynrt_processor__display__dark_d valid3(
         .d(valid3__d),
         .q(valid3__q),
         .clock(valid3__clock)
     );
-    dynrt_processor_core__add__mid_norm mid_norm(
+    dynrt_processor__engine__fp_units__add__mid_norm mid_norm(
         .d(mid_norm__d),
         .q(mid_norm__q),
         .clock(mid_norm__clock)
     );
-    dynrt_processor_core__add__lz mid_lz(
+    dynrt_processor__engine__fp_units__add__lz mid_lz(
         .d(mid_lz__d),
         .q(mid_lz__q),
         .clock(mid_lz__clock)
     );
-    dynrt_processor_core__add__big_exp mid_exp(
+    dynrt_processor__engine__fp_units__add__big_exp mid_exp(
         .d(mid_exp__d),
         .q(mid_exp__q),
         .clock(mid_exp__clock)
     );
-    dynrt_processor_core__add__big_sign mid_sign(
+    dynrt_processor__display__dark_d mid_sign(
         .d(mid_sign__d),
         .q(mid_sign__q),
         .clock(mid_sign__clock)
     );
-    dynrt_processor_core__add__big_sign mid_nan(
+    dynrt_processor__display__dark_d mid_nan(
         .d(mid_nan__d),
         .q(mid_nan__q),
         .clock(mid_nan__clock)
     );
-    dynrt_processor_core__add__big_sign mid_inf(
+    dynrt_processor__display__dark_d mid_inf(
         .d(mid_inf__d),
         .q(mid_inf__q),
         .clock(mid_inf__clock)
     );
-    dynrt_processor_core__add__big_sign mid_inf_sign(
+    dynrt_processor__display__dark_d mid_inf_sign(
         .d(mid_inf_sign__d),
         .q(mid_inf_sign__q),
         .clock(mid_inf_sign__clock)
     );
-    dynrt_processor_core__add__big_sign mid_zero_sign(
+    dynrt_processor__display__dark_d mid_zero_sign(
         .d(mid_zero_sign__d),
         .q(mid_zero_sign__q),
         .clock(mid_zero_sign__clock)
     );
-    dynrt_processor_core__add__big_sign mid_is_zero(
+    dynrt_processor__display__dark_d mid_is_zero(
         .d(mid_is_zero__d),
         .q(mid_is_zero__q),
         .clock(mid_is_zero__clock)
     );
-    dynrt_processor_core__add__big_sign mid_valid(
+    dynrt_processor__display__dark_d mid_valid(
         .d(mid_valid__d),
         .q(mid_valid__q),
         .clock(mid_valid__clock)
     );
-    dynrt_processor_core__add__mid_norm norm(
+    dynrt_processor__engine__fp_units__add__mid_norm norm(
         .d(norm__d),
         .q(norm__q),
         .clock(norm__clock)
     );
-    dynrt_processor_core__add__lz lz(
+    dynrt_processor__engine__fp_units__add__lz lz(
         .d(lz__d),
         .q(lz__q),
         .clock(lz__clock)
     );
-    dynrt_processor_core__add__big_exp exp4(
+    dynrt_processor__engine__fp_units__add__big_exp exp4(
         .d(exp4__d),
         .q(exp4__q),
         .clock(exp4__clock)
     );
-    dynrt_processor_core__add__big_sign sign4(
+    dynrt_processor__display__dark_d sign4(
         .d(sign4__d),
         .q(sign4__q),
         .clock(sign4__clock)
     );
-    dynrt_processor_core__add__big_sign nan4(
+    dynrt_processor__display__dark_d nan4(
         .d(nan4__d),
         .q(nan4__q),
         .clock(nan4__clock)
     );
-    dynrt_processor_core__add__big_sign inf4(
+    dynrt_processor__display__dark_d inf4(
         .d(inf4__d),
         .q(inf4__q),
         .clock(inf4__clock)
     );
-    dynrt_processor_core__add__big_sign inf_sign4(
+    dynrt_processor__display__dark_d inf_sign4(
         .d(inf_sign4__d),
         .q(inf_sign4__q),
         .clock(inf_sign4__clock)
     );
-    dynrt_processor_core__add__big_sign zero_sign4(
+    dynrt_processor__display__dark_d zero_sign4(
         .d(zero_sign4__d),
         .q(zero_sign4__q),
         .clock(zero_sign4__clock)
     );
-    dynrt_processor_core__add__big_sign is_zero4(
+    dynrt_processor__display__dark_d is_zero4(
         .d(is_zero4__d),
         .q(is_zero4__q),
         .clock(is_zero4__clock)
     );
-    dynrt_processor_core__add__big_sign valid4(
+    dynrt_processor__display__dark_d valid4(
         .d(valid4__d),
         .q(valid4__q),
         .clock(valid4__clock)
     );
-    dynrt_processor_core__add__rnd_sig rnd_sig(
+    dynrt_processor__engine__fp_units__add__rnd_sig rnd_sig(
         .d(rnd_sig__d),
         .q(rnd_sig__q),
         .clock(rnd_sig__clock)
     );
-    dynrt_processor_core__add__lz rnd_exp(
+    dynrt_processor__engine__fp_units__add__lz rnd_exp(
         .d(rnd_exp__d),
         .q(rnd_exp__q),
         .clock(rnd_exp__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_sign(
+    dynrt_processor__display__dark_d rnd_sign(
         .d(rnd_sign__d),
         .q(rnd_sign__q),
         .clock(rnd_sign__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_zero_sign(
+    dynrt_processor__display__dark_d rnd_zero_sign(
         .d(rnd_zero_sign__d),
         .q(rnd_zero_sign__q),
         .clock(rnd_zero_sign__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_inf_sign(
+    dynrt_processor__display__dark_d rnd_inf_sign(
         .d(rnd_inf_sign__d),
         .q(rnd_inf_sign__q),
         .clock(rnd_inf_sign__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_nan(
+    dynrt_processor__display__dark_d rnd_nan(
         .d(rnd_nan__d),
         .q(rnd_nan__q),
         .clock(rnd_nan__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_inf(
+    dynrt_processor__display__dark_d rnd_inf(
         .d(rnd_inf__d),
         .q(rnd_inf__q),
         .clock(rnd_inf__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_is_zero(
+    dynrt_processor__display__dark_d rnd_is_zero(
         .d(rnd_is_zero__d),
         .q(rnd_is_zero__q),
         .clock(rnd_is_zero__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_valid(
+    dynrt_processor__display__dark_d rnd_valid(
         .d(rnd_valid__d),
         .q(rnd_valid__q),
         .clock(rnd_valid__clock)
     );
-    dynrt_processor_core__add__in_a out_result(
+    dynrt_processor__display__rgb_q out_result(
         .d(out_result__d),
         .q(out_result__q),
         .clock(out_result__clock)
     );
-    dynrt_processor_core__add__big_sign out_valid_r(
+    dynrt_processor__display__dark_d out_valid_r(
         .d(out_valid_r__d),
         .q(out_valid_r__q),
         .clock(out_valid_r__clock)
@@ -3149,10 +3901,10 @@ module dynrt_processor_core__add(clock,in_valid,a,b,sub,out_valid,result);
         out_valid = out_valid_r__q;
     end
     
-endmodule // dynrt_processor_core__add
+endmodule // dynrt_processor__engine__fp_units__add
 
 
-module dynrt_processor_core__add__big_exp(d,q,clock);
+module dynrt_processor__engine__fp_units__add__big_exp(d,q,clock);
     
     // Module arguments
     input wire  [6:0] d;
@@ -3168,10 +3920,10 @@ module dynrt_processor_core__add__big_exp(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__add__big_exp
+endmodule // dynrt_processor__engine__fp_units__add__big_exp
 
 
-module dynrt_processor_core__add__big_sig(d,q,clock);
+module dynrt_processor__engine__fp_units__add__big_sig(d,q,clock);
     
     // Module arguments
     input wire  [16:0] d;
@@ -3187,51 +3939,7 @@ module dynrt_processor_core__add__big_sig(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__add__big_sig
-
-
-module dynrt_processor_core__add__big_sign(d,q,clock);
-    
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_core__add__big_sign
-
-
-
-
-
-
-
-
-module dynrt_processor_core__add__in_a(d,q,clock);
-    
-    // Module arguments
-    input wire  [23:0] d;
-    output reg  [23:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 24'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_core__add__in_a
+endmodule // dynrt_processor__engine__fp_units__add__big_sig
 
 
 
@@ -3254,7 +3962,17 @@ endmodule // dynrt_processor_core__add__in_a
 
 
 
-module dynrt_processor_core__add__lz(d,q,clock);
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__fp_units__add__lz(d,q,clock);
     
     // Module arguments
     input wire  [8:0] d;
@@ -3270,7 +3988,7 @@ module dynrt_processor_core__add__lz(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__add__lz
+endmodule // dynrt_processor__engine__fp_units__add__lz
 
 
 
@@ -3285,7 +4003,7 @@ endmodule // dynrt_processor_core__add__lz
 
 
 
-module dynrt_processor_core__add__mid_norm(d,q,clock);
+module dynrt_processor__engine__fp_units__add__mid_norm(d,q,clock);
     
     // Module arguments
     input wire  [20:0] d;
@@ -3301,7 +4019,7 @@ module dynrt_processor_core__add__mid_norm(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__add__mid_norm
+endmodule // dynrt_processor__engine__fp_units__add__mid_norm
 
 
 
@@ -3332,7 +4050,7 @@ endmodule // dynrt_processor_core__add__mid_norm
 
 
 
-module dynrt_processor_core__add__rnd_sig(d,q,clock);
+module dynrt_processor__engine__fp_units__add__rnd_sig(d,q,clock);
     
     // Module arguments
     input wire  [17:0] d;
@@ -3348,7 +4066,7 @@ module dynrt_processor_core__add__rnd_sig(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__add__rnd_sig
+endmodule // dynrt_processor__engine__fp_units__add__rnd_sig
 
 
 
@@ -3379,7 +4097,7 @@ endmodule // dynrt_processor_core__add__rnd_sig
 
 
 
-module dynrt_processor_core__add_delay(clock,data_in,data_out);
+module dynrt_processor__engine__fp_units__add_delay(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -3401,22 +4119,22 @@ module dynrt_processor_core__add_delay(clock,data_in,data_out);
     reg  stage__3__clock;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a stage__0(
+    dynrt_processor__display__rgb_q stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__add__in_a stage__1(
+    dynrt_processor__display__rgb_q stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__add__in_a stage__2(
+    dynrt_processor__display__rgb_q stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__add__in_a stage__3(
+    dynrt_processor__display__rgb_q stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
@@ -3438,7 +4156,7 @@ module dynrt_processor_core__add_delay(clock,data_in,data_out);
         data_out = stage__3__q;
     end
     
-endmodule // dynrt_processor_core__add_delay
+endmodule // dynrt_processor__engine__fp_units__add_delay
 
 
 
@@ -3449,28 +4167,7 @@ endmodule // dynrt_processor_core__add_delay
 
 
 
-module dynrt_processor_core__asleep(d,q,clock);
-    
-    // Module arguments
-    input wire  [31:0] d;
-    output reg  [31:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 32'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_core__asleep
-
-
-
-
-module dynrt_processor_core__byte_unit(clock,in_valid,word,out_valid,result);
+module dynrt_processor__engine__fp_units__byte_unit(clock,in_valid,word,out_valid,result);
     
     // Module arguments
     input wire  clock;
@@ -3506,7 +4203,7 @@ module dynrt_processor_core__byte_unit(clock,in_valid,word,out_valid,result);
     reg  [23:0] clamped;
     
     // Sub module instances
-    dynrt_processor_core__byte_unit__scale scale(
+    dynrt_processor__engine__fp_units__byte_unit__scale scale(
         .clock(scale__clock),
         .in_valid(scale__in_valid),
         .a(scale__a),
@@ -3514,7 +4211,7 @@ module dynrt_processor_core__byte_unit(clock,in_valid,word,out_valid,result);
         .out_valid(scale__out_valid),
         .result(scale__result)
     );
-    dynrt_processor_core__add round(
+    dynrt_processor__engine__fp_units__add round(
         .clock(round__clock),
         .in_valid(round__in_valid),
         .a(round__a),
@@ -3548,7 +4245,7 @@ module dynrt_processor_core__byte_unit(clock,in_valid,word,out_valid,result);
         result = round__result[(32'h0)+:(8)];
     end
     
-endmodule // dynrt_processor_core__byte_unit
+endmodule // dynrt_processor__engine__fp_units__byte_unit
 
 
 
@@ -3661,7 +4358,7 @@ endmodule // dynrt_processor_core__byte_unit
 
 
 
-module dynrt_processor_core__byte_unit__scale(clock,in_valid,a,b,out_valid,result);
+module dynrt_processor__engine__fp_units__byte_unit__scale(clock,in_valid,a,b,out_valid,result);
     
     // Module arguments
     input wire  clock;
@@ -3744,62 +4441,62 @@ module dynrt_processor_core__byte_unit__scale(clock,in_valid,a,b,out_valid,resul
     reg  round_up;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a in_a(
+    dynrt_processor__display__rgb_q in_a(
         .d(in_a__d),
         .q(in_a__q),
         .clock(in_a__clock)
     );
-    dynrt_processor_core__add__in_a in_b(
+    dynrt_processor__display__rgb_q in_b(
         .d(in_b__d),
         .q(in_b__q),
         .clock(in_b__clock)
     );
-    dynrt_processor_core__add__big_sign in_valid_r(
+    dynrt_processor__display__dark_d in_valid_r(
         .d(in_valid_r__d),
         .q(in_valid_r__q),
         .clock(in_valid_r__clock)
     );
-    dynrt_processor_core__byte_unit__scale__multiplier multiplier(
+    dynrt_processor__engine__fp_units__byte_unit__scale__multiplier multiplier(
         .a(multiplier__a),
         .b(multiplier__b),
         .p(multiplier__p)
     );
-    dynrt_processor_core__byte_unit__scale__prod prod(
+    dynrt_processor__engine__fp_units__byte_unit__scale__prod prod(
         .d(prod__d),
         .q(prod__q),
         .clock(prod__clock)
     );
-    dynrt_processor_core__add__lz exp_sum(
+    dynrt_processor__engine__fp_units__add__lz exp_sum(
         .d(exp_sum__d),
         .q(exp_sum__q),
         .clock(exp_sum__clock)
     );
-    dynrt_processor_core__add__big_sign sign(
+    dynrt_processor__display__dark_d sign(
         .d(sign__d),
         .q(sign__q),
         .clock(sign__clock)
     );
-    dynrt_processor_core__add__big_sign nan(
+    dynrt_processor__display__dark_d nan(
         .d(nan__d),
         .q(nan__q),
         .clock(nan__clock)
     );
-    dynrt_processor_core__add__big_sign inf(
+    dynrt_processor__display__dark_d inf(
         .d(inf__d),
         .q(inf__q),
         .clock(inf__clock)
     );
-    dynrt_processor_core__add__big_sign zero(
+    dynrt_processor__display__dark_d zero(
         .d(zero__d),
         .q(zero__q),
         .clock(zero__clock)
     );
-    dynrt_processor_core__add__big_sign valid2(
+    dynrt_processor__display__dark_d valid2(
         .d(valid2__d),
         .q(valid2__q),
         .clock(valid2__clock)
     );
-    dynrt_processor_core__byte_unit__scale__pack pack(
+    dynrt_processor__engine__fp_units__byte_unit__scale__pack pack(
         .clock(pack__clock),
         .in_valid(pack__in_valid),
         .sig(pack__sig),
@@ -3877,7 +4574,7 @@ module dynrt_processor_core__byte_unit__scale(clock,in_valid,a,b,out_valid,resul
         out_valid = pack__out_valid;
     end
     
-endmodule // dynrt_processor_core__byte_unit__scale
+endmodule // dynrt_processor__engine__fp_units__byte_unit__scale
 
 
 
@@ -3890,7 +4587,7 @@ endmodule // dynrt_processor_core__byte_unit__scale
 
 
 
-module dynrt_processor_core__byte_unit__scale__multiplier(a,b,p);
+module dynrt_processor__engine__fp_units__byte_unit__scale__multiplier(a,b,p);
     
     // Module arguments
     input wire  [16:0] a;
@@ -3899,12 +4596,12 @@ module dynrt_processor_core__byte_unit__scale__multiplier(a,b,p);
     
     // Update code (custom)
     always @(*) p = a * b;
-endmodule // dynrt_processor_core__byte_unit__scale__multiplier
+endmodule // dynrt_processor__engine__fp_units__byte_unit__scale__multiplier
 
 
 
 
-module dynrt_processor_core__byte_unit__scale__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero,out_valid,result);
+module dynrt_processor__engine__fp_units__byte_unit__scale__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero,out_valid,result);
     
     // Module arguments
     input wire  clock;
@@ -3965,47 +4662,47 @@ module dynrt_processor_core__byte_unit__scale__pack(clock,in_valid,sig,round_up,
     reg  [23:0] packed_word;
     
     // Sub module instances
-    dynrt_processor_core__add__rnd_sig rnd_sig(
+    dynrt_processor__engine__fp_units__add__rnd_sig rnd_sig(
         .d(rnd_sig__d),
         .q(rnd_sig__q),
         .clock(rnd_sig__clock)
     );
-    dynrt_processor_core__add__lz rnd_exp(
+    dynrt_processor__engine__fp_units__add__lz rnd_exp(
         .d(rnd_exp__d),
         .q(rnd_exp__q),
         .clock(rnd_exp__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_sign(
+    dynrt_processor__display__dark_d rnd_sign(
         .d(rnd_sign__d),
         .q(rnd_sign__q),
         .clock(rnd_sign__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_nan(
+    dynrt_processor__display__dark_d rnd_nan(
         .d(rnd_nan__d),
         .q(rnd_nan__q),
         .clock(rnd_nan__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_inf(
+    dynrt_processor__display__dark_d rnd_inf(
         .d(rnd_inf__d),
         .q(rnd_inf__q),
         .clock(rnd_inf__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_zero(
+    dynrt_processor__display__dark_d rnd_zero(
         .d(rnd_zero__d),
         .q(rnd_zero__q),
         .clock(rnd_zero__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_valid(
+    dynrt_processor__display__dark_d rnd_valid(
         .d(rnd_valid__d),
         .q(rnd_valid__q),
         .clock(rnd_valid__clock)
     );
-    dynrt_processor_core__add__in_a out_result(
+    dynrt_processor__display__rgb_q out_result(
         .d(out_result__d),
         .q(out_result__q),
         .clock(out_result__clock)
     );
-    dynrt_processor_core__add__big_sign out_valid_r(
+    dynrt_processor__display__dark_d out_valid_r(
         .d(out_valid_r__d),
         .q(out_valid_r__q),
         .clock(out_valid_r__clock)
@@ -4063,7 +4760,7 @@ module dynrt_processor_core__byte_unit__scale__pack(clock,in_valid,sig,round_up,
         out_valid = out_valid_r__q;
     end
     
-endmodule // dynrt_processor_core__byte_unit__scale__pack
+endmodule // dynrt_processor__engine__fp_units__byte_unit__scale__pack
 
 
 
@@ -4084,7 +4781,7 @@ endmodule // dynrt_processor_core__byte_unit__scale__pack
 
 
 
-module dynrt_processor_core__byte_unit__scale__prod(d,q,clock);
+module dynrt_processor__engine__fp_units__byte_unit__scale__prod(d,q,clock);
     
     // Module arguments
     input wire  [33:0] d;
@@ -4100,7 +4797,7 @@ module dynrt_processor_core__byte_unit__scale__prod(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__byte_unit__scale__prod
+endmodule // dynrt_processor__engine__fp_units__byte_unit__scale__prod
 
 
 
@@ -4109,7 +4806,7 @@ endmodule // dynrt_processor_core__byte_unit__scale__prod
 
 
 
-module dynrt_processor_core__cmp(clock,in_valid,a,b,out_valid,lt,le,eq);
+module dynrt_processor__engine__fp_units__cmp(clock,in_valid,a,b,out_valid,lt,le,eq);
     
     // Module arguments
     input wire  clock;
@@ -4161,37 +4858,37 @@ module dynrt_processor_core__cmp(clock,in_valid,a,b,out_valid,lt,le,eq);
     reg  is_lt;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a in_a(
+    dynrt_processor__display__rgb_q in_a(
         .d(in_a__d),
         .q(in_a__q),
         .clock(in_a__clock)
     );
-    dynrt_processor_core__add__in_a in_b(
+    dynrt_processor__display__rgb_q in_b(
         .d(in_b__d),
         .q(in_b__q),
         .clock(in_b__clock)
     );
-    dynrt_processor_core__add__big_sign in_valid_r(
+    dynrt_processor__display__dark_d in_valid_r(
         .d(in_valid_r__d),
         .q(in_valid_r__q),
         .clock(in_valid_r__clock)
     );
-    dynrt_processor_core__add__big_sign out_lt(
+    dynrt_processor__display__dark_d out_lt(
         .d(out_lt__d),
         .q(out_lt__q),
         .clock(out_lt__clock)
     );
-    dynrt_processor_core__add__big_sign out_le(
+    dynrt_processor__display__dark_d out_le(
         .d(out_le__d),
         .q(out_le__q),
         .clock(out_le__clock)
     );
-    dynrt_processor_core__add__big_sign out_eq(
+    dynrt_processor__display__dark_d out_eq(
         .d(out_eq__d),
         .q(out_eq__q),
         .clock(out_eq__clock)
     );
-    dynrt_processor_core__add__big_sign out_valid_r(
+    dynrt_processor__display__dark_d out_valid_r(
         .d(out_valid_r__d),
         .q(out_valid_r__q),
         .clock(out_valid_r__clock)
@@ -4249,160 +4946,7 @@ module dynrt_processor_core__cmp(clock,in_valid,a,b,out_valid,lt,le,eq);
         out_valid = out_valid_r__q;
     end
     
-endmodule // dynrt_processor_core__cmp
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor_core__cmp_delay(clock,data_in,data_out);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  [2:0] data_in;
-    output reg  [2:0] data_out;
-    
-    // Stub signals
-    reg  [2:0] stage__0__d;
-    wire  [2:0] stage__0__q;
-    reg  stage__0__clock;
-    reg  [2:0] stage__1__d;
-    wire  [2:0] stage__1__q;
-    reg  stage__1__clock;
-    reg  [2:0] stage__2__d;
-    wire  [2:0] stage__2__q;
-    reg  stage__2__clock;
-    reg  [2:0] stage__3__d;
-    wire  [2:0] stage__3__q;
-    reg  stage__3__clock;
-    reg  [2:0] stage__4__d;
-    wire  [2:0] stage__4__q;
-    reg  stage__4__clock;
-    reg  [2:0] stage__5__d;
-    wire  [2:0] stage__5__q;
-    reg  stage__5__clock;
-    reg  [2:0] stage__6__d;
-    wire  [2:0] stage__6__q;
-    reg  stage__6__clock;
-    reg  [2:0] stage__7__d;
-    wire  [2:0] stage__7__q;
-    reg  stage__7__clock;
-    reg  [2:0] stage__8__d;
-    wire  [2:0] stage__8__q;
-    reg  stage__8__clock;
-    
-    // Sub module instances
-    dynrt_processor_core__cmp_delay__stage__0 stage__0(
-        .d(stage__0__d),
-        .q(stage__0__q),
-        .clock(stage__0__clock)
-    );
-    dynrt_processor_core__cmp_delay__stage__0 stage__1(
-        .d(stage__1__d),
-        .q(stage__1__q),
-        .clock(stage__1__clock)
-    );
-    dynrt_processor_core__cmp_delay__stage__0 stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
-    dynrt_processor_core__cmp_delay__stage__0 stage__3(
-        .d(stage__3__d),
-        .q(stage__3__q),
-        .clock(stage__3__clock)
-    );
-    dynrt_processor_core__cmp_delay__stage__0 stage__4(
-        .d(stage__4__d),
-        .q(stage__4__q),
-        .clock(stage__4__clock)
-    );
-    dynrt_processor_core__cmp_delay__stage__0 stage__5(
-        .d(stage__5__d),
-        .q(stage__5__q),
-        .clock(stage__5__clock)
-    );
-    dynrt_processor_core__cmp_delay__stage__0 stage__6(
-        .d(stage__6__d),
-        .q(stage__6__q),
-        .clock(stage__6__clock)
-    );
-    dynrt_processor_core__cmp_delay__stage__0 stage__7(
-        .d(stage__7__d),
-        .q(stage__7__q),
-        .clock(stage__7__clock)
-    );
-    dynrt_processor_core__cmp_delay__stage__0 stage__8(
-        .d(stage__8__d),
-        .q(stage__8__q),
-        .clock(stage__8__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        stage__0__clock = clock;
-        stage__1__clock = clock;
-        stage__2__clock = clock;
-        stage__3__clock = clock;
-        stage__4__clock = clock;
-        stage__5__clock = clock;
-        stage__6__clock = clock;
-        stage__7__clock = clock;
-        stage__8__clock = clock;
-        stage__0__d = data_in;
-        stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        stage__3__d = stage__2__q;
-        stage__4__d = stage__3__q;
-        stage__5__d = stage__4__q;
-        stage__6__d = stage__5__q;
-        stage__7__d = stage__6__q;
-        stage__8__d = stage__7__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-    end
-    
-endmodule // dynrt_processor_core__cmp_delay
-
-
-module dynrt_processor_core__cmp_delay__stage__0(d,q,clock);
-    
-    // Module arguments
-    input wire  [2:0] d;
-    output reg  [2:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 3'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_core__cmp_delay__stage__0
-
-
-
+endmodule // dynrt_processor__engine__fp_units__cmp
 
 
 
@@ -4418,174 +4962,8 @@ endmodule // dynrt_processor_core__cmp_delay__stage__0
 
 
 
-module dynrt_processor_core__cond_delay(clock,data_in,data_out);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  [18:0] data_in;
-    output reg  [18:0] data_out;
-    
-    // Stub signals
-    reg  [18:0] stage__0__d;
-    wire  [18:0] stage__0__q;
-    reg  stage__0__clock;
-    reg  [18:0] stage__1__d;
-    wire  [18:0] stage__1__q;
-    reg  stage__1__clock;
-    reg  [18:0] stage__2__d;
-    wire  [18:0] stage__2__q;
-    reg  stage__2__clock;
-    
-    // Sub module instances
-    dynrt_processor_core__cond_delay__stage__0 stage__0(
-        .d(stage__0__d),
-        .q(stage__0__q),
-        .clock(stage__0__clock)
-    );
-    dynrt_processor_core__cond_delay__stage__0 stage__1(
-        .d(stage__1__d),
-        .q(stage__1__q),
-        .clock(stage__1__clock)
-    );
-    dynrt_processor_core__cond_delay__stage__0 stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        stage__0__clock = clock;
-        stage__1__clock = clock;
-        stage__2__clock = clock;
-        stage__0__d = data_in;
-        stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-    end
-    
-endmodule // dynrt_processor_core__cond_delay
-
 
-module dynrt_processor_core__cond_delay__stage__0(d,q,clock);
-    
-    // Module arguments
-    input wire  [18:0] d;
-    output reg  [18:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 19'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_core__cond_delay__stage__0
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor_core__ctl_delay(clock,data_in,data_out);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  [20:0] data_in;
-    output reg  [20:0] data_out;
-    
-    // Stub signals
-    reg  [20:0] stage__0__d;
-    wire  [20:0] stage__0__q;
-    reg  stage__0__clock;
-    reg  [20:0] stage__1__d;
-    wire  [20:0] stage__1__q;
-    reg  stage__1__clock;
-    reg  [20:0] stage__2__d;
-    wire  [20:0] stage__2__q;
-    reg  stage__2__clock;
-    
-    // Sub module instances
-    dynrt_processor_core__add__mid_norm stage__0(
-        .d(stage__0__d),
-        .q(stage__0__q),
-        .clock(stage__0__clock)
-    );
-    dynrt_processor_core__add__mid_norm stage__1(
-        .d(stage__1__d),
-        .q(stage__1__q),
-        .clock(stage__1__clock)
-    );
-    dynrt_processor_core__add__mid_norm stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        stage__0__clock = clock;
-        stage__1__clock = clock;
-        stage__2__clock = clock;
-        stage__0__d = data_in;
-        stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-    end
-    
-endmodule // dynrt_processor_core__ctl_delay
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor_core__div(clock,in_valid,a,b,out_valid,result);
+module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,result);
     
     // Module arguments
     input wire  clock;
@@ -5125,827 +5503,827 @@ module dynrt_processor_core__div(clock,in_valid,a,b,out_valid,result);
     reg  round_up;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a in_a(
+    dynrt_processor__display__rgb_q in_a(
         .d(in_a__d),
         .q(in_a__q),
         .clock(in_a__clock)
     );
-    dynrt_processor_core__add__in_a in_b(
+    dynrt_processor__display__rgb_q in_b(
         .d(in_b__d),
         .q(in_b__q),
         .clock(in_b__clock)
     );
-    dynrt_processor_core__add__big_sign in_valid_r(
+    dynrt_processor__display__dark_d in_valid_r(
         .d(in_valid_r__d),
         .q(in_valid_r__q),
         .clock(in_valid_r__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__0(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__0(
         .d(rem__0__d),
         .q(rem__0__q),
         .clock(rem__0__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__1(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__1(
         .d(rem__1__d),
         .q(rem__1__q),
         .clock(rem__1__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__2(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__2(
         .d(rem__2__d),
         .q(rem__2__q),
         .clock(rem__2__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__3(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__3(
         .d(rem__3__d),
         .q(rem__3__q),
         .clock(rem__3__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__4(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__4(
         .d(rem__4__d),
         .q(rem__4__q),
         .clock(rem__4__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__5(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__5(
         .d(rem__5__d),
         .q(rem__5__q),
         .clock(rem__5__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__6(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__6(
         .d(rem__6__d),
         .q(rem__6__q),
         .clock(rem__6__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__7(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__7(
         .d(rem__7__d),
         .q(rem__7__q),
         .clock(rem__7__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__8(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__8(
         .d(rem__8__d),
         .q(rem__8__q),
         .clock(rem__8__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__9(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__9(
         .d(rem__9__d),
         .q(rem__9__q),
         .clock(rem__9__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__10(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__10(
         .d(rem__10__d),
         .q(rem__10__q),
         .clock(rem__10__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__11(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__11(
         .d(rem__11__d),
         .q(rem__11__q),
         .clock(rem__11__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__12(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__12(
         .d(rem__12__d),
         .q(rem__12__q),
         .clock(rem__12__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__13(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__13(
         .d(rem__13__d),
         .q(rem__13__q),
         .clock(rem__13__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__14(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__14(
         .d(rem__14__d),
         .q(rem__14__q),
         .clock(rem__14__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__15(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__15(
         .d(rem__15__d),
         .q(rem__15__q),
         .clock(rem__15__clock)
     );
-    dynrt_processor_core__add__rnd_sig rem__16(
+    dynrt_processor__engine__fp_units__add__rnd_sig rem__16(
         .d(rem__16__d),
         .q(rem__16__q),
         .clock(rem__16__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__0(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__0(
         .d(quo__0__d),
         .q(quo__0__q),
         .clock(quo__0__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__1(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__1(
         .d(quo__1__d),
         .q(quo__1__q),
         .clock(quo__1__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__2(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__2(
         .d(quo__2__d),
         .q(quo__2__q),
         .clock(quo__2__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__3(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__3(
         .d(quo__3__d),
         .q(quo__3__q),
         .clock(quo__3__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__4(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__4(
         .d(quo__4__d),
         .q(quo__4__q),
         .clock(quo__4__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__5(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__5(
         .d(quo__5__d),
         .q(quo__5__q),
         .clock(quo__5__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__6(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__6(
         .d(quo__6__d),
         .q(quo__6__q),
         .clock(quo__6__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__7(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__7(
         .d(quo__7__d),
         .q(quo__7__q),
         .clock(quo__7__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__8(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__8(
         .d(quo__8__d),
         .q(quo__8__q),
         .clock(quo__8__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__9(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__9(
         .d(quo__9__d),
         .q(quo__9__q),
         .clock(quo__9__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__10(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__10(
         .d(quo__10__d),
         .q(quo__10__q),
         .clock(quo__10__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__11(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__11(
         .d(quo__11__d),
         .q(quo__11__q),
         .clock(quo__11__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__12(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__12(
         .d(quo__12__d),
         .q(quo__12__q),
         .clock(quo__12__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__13(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__13(
         .d(quo__13__d),
         .q(quo__13__q),
         .clock(quo__13__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__14(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__14(
         .d(quo__14__d),
         .q(quo__14__q),
         .clock(quo__14__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__15(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__15(
         .d(quo__15__d),
         .q(quo__15__q),
         .clock(quo__15__clock)
     );
-    dynrt_processor_core__add__rnd_sig quo__16(
+    dynrt_processor__engine__fp_units__add__rnd_sig quo__16(
         .d(quo__16__d),
         .q(quo__16__q),
         .clock(quo__16__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__0(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__0(
         .d(divisor__0__d),
         .q(divisor__0__q),
         .clock(divisor__0__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__1(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__1(
         .d(divisor__1__d),
         .q(divisor__1__q),
         .clock(divisor__1__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__2(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__2(
         .d(divisor__2__d),
         .q(divisor__2__q),
         .clock(divisor__2__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__3(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__3(
         .d(divisor__3__d),
         .q(divisor__3__q),
         .clock(divisor__3__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__4(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__4(
         .d(divisor__4__d),
         .q(divisor__4__q),
         .clock(divisor__4__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__5(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__5(
         .d(divisor__5__d),
         .q(divisor__5__q),
         .clock(divisor__5__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__6(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__6(
         .d(divisor__6__d),
         .q(divisor__6__q),
         .clock(divisor__6__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__7(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__7(
         .d(divisor__7__d),
         .q(divisor__7__q),
         .clock(divisor__7__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__8(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__8(
         .d(divisor__8__d),
         .q(divisor__8__q),
         .clock(divisor__8__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__9(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__9(
         .d(divisor__9__d),
         .q(divisor__9__q),
         .clock(divisor__9__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__10(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__10(
         .d(divisor__10__d),
         .q(divisor__10__q),
         .clock(divisor__10__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__11(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__11(
         .d(divisor__11__d),
         .q(divisor__11__q),
         .clock(divisor__11__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__12(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__12(
         .d(divisor__12__d),
         .q(divisor__12__q),
         .clock(divisor__12__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__13(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__13(
         .d(divisor__13__d),
         .q(divisor__13__q),
         .clock(divisor__13__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__14(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__14(
         .d(divisor__14__d),
         .q(divisor__14__q),
         .clock(divisor__14__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__15(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__15(
         .d(divisor__15__d),
         .q(divisor__15__q),
         .clock(divisor__15__clock)
     );
-    dynrt_processor_core__add__rnd_sig divisor__16(
+    dynrt_processor__engine__fp_units__add__rnd_sig divisor__16(
         .d(divisor__16__d),
         .q(divisor__16__q),
         .clock(divisor__16__clock)
     );
-    dynrt_processor_core__add__lz exp__0(
+    dynrt_processor__engine__fp_units__add__lz exp__0(
         .d(exp__0__d),
         .q(exp__0__q),
         .clock(exp__0__clock)
     );
-    dynrt_processor_core__add__lz exp__1(
+    dynrt_processor__engine__fp_units__add__lz exp__1(
         .d(exp__1__d),
         .q(exp__1__q),
         .clock(exp__1__clock)
     );
-    dynrt_processor_core__add__lz exp__2(
+    dynrt_processor__engine__fp_units__add__lz exp__2(
         .d(exp__2__d),
         .q(exp__2__q),
         .clock(exp__2__clock)
     );
-    dynrt_processor_core__add__lz exp__3(
+    dynrt_processor__engine__fp_units__add__lz exp__3(
         .d(exp__3__d),
         .q(exp__3__q),
         .clock(exp__3__clock)
     );
-    dynrt_processor_core__add__lz exp__4(
+    dynrt_processor__engine__fp_units__add__lz exp__4(
         .d(exp__4__d),
         .q(exp__4__q),
         .clock(exp__4__clock)
     );
-    dynrt_processor_core__add__lz exp__5(
+    dynrt_processor__engine__fp_units__add__lz exp__5(
         .d(exp__5__d),
         .q(exp__5__q),
         .clock(exp__5__clock)
     );
-    dynrt_processor_core__add__lz exp__6(
+    dynrt_processor__engine__fp_units__add__lz exp__6(
         .d(exp__6__d),
         .q(exp__6__q),
         .clock(exp__6__clock)
     );
-    dynrt_processor_core__add__lz exp__7(
+    dynrt_processor__engine__fp_units__add__lz exp__7(
         .d(exp__7__d),
         .q(exp__7__q),
         .clock(exp__7__clock)
     );
-    dynrt_processor_core__add__lz exp__8(
+    dynrt_processor__engine__fp_units__add__lz exp__8(
         .d(exp__8__d),
         .q(exp__8__q),
         .clock(exp__8__clock)
     );
-    dynrt_processor_core__add__lz exp__9(
+    dynrt_processor__engine__fp_units__add__lz exp__9(
         .d(exp__9__d),
         .q(exp__9__q),
         .clock(exp__9__clock)
     );
-    dynrt_processor_core__add__lz exp__10(
+    dynrt_processor__engine__fp_units__add__lz exp__10(
         .d(exp__10__d),
         .q(exp__10__q),
         .clock(exp__10__clock)
     );
-    dynrt_processor_core__add__lz exp__11(
+    dynrt_processor__engine__fp_units__add__lz exp__11(
         .d(exp__11__d),
         .q(exp__11__q),
         .clock(exp__11__clock)
     );
-    dynrt_processor_core__add__lz exp__12(
+    dynrt_processor__engine__fp_units__add__lz exp__12(
         .d(exp__12__d),
         .q(exp__12__q),
         .clock(exp__12__clock)
     );
-    dynrt_processor_core__add__lz exp__13(
+    dynrt_processor__engine__fp_units__add__lz exp__13(
         .d(exp__13__d),
         .q(exp__13__q),
         .clock(exp__13__clock)
     );
-    dynrt_processor_core__add__lz exp__14(
+    dynrt_processor__engine__fp_units__add__lz exp__14(
         .d(exp__14__d),
         .q(exp__14__q),
         .clock(exp__14__clock)
     );
-    dynrt_processor_core__add__lz exp__15(
+    dynrt_processor__engine__fp_units__add__lz exp__15(
         .d(exp__15__d),
         .q(exp__15__q),
         .clock(exp__15__clock)
     );
-    dynrt_processor_core__add__lz exp__16(
+    dynrt_processor__engine__fp_units__add__lz exp__16(
         .d(exp__16__d),
         .q(exp__16__q),
         .clock(exp__16__clock)
     );
-    dynrt_processor_core__add__big_sign sign__0(
+    dynrt_processor__display__dark_d sign__0(
         .d(sign__0__d),
         .q(sign__0__q),
         .clock(sign__0__clock)
     );
-    dynrt_processor_core__add__big_sign sign__1(
+    dynrt_processor__display__dark_d sign__1(
         .d(sign__1__d),
         .q(sign__1__q),
         .clock(sign__1__clock)
     );
-    dynrt_processor_core__add__big_sign sign__2(
+    dynrt_processor__display__dark_d sign__2(
         .d(sign__2__d),
         .q(sign__2__q),
         .clock(sign__2__clock)
     );
-    dynrt_processor_core__add__big_sign sign__3(
+    dynrt_processor__display__dark_d sign__3(
         .d(sign__3__d),
         .q(sign__3__q),
         .clock(sign__3__clock)
     );
-    dynrt_processor_core__add__big_sign sign__4(
+    dynrt_processor__display__dark_d sign__4(
         .d(sign__4__d),
         .q(sign__4__q),
         .clock(sign__4__clock)
     );
-    dynrt_processor_core__add__big_sign sign__5(
+    dynrt_processor__display__dark_d sign__5(
         .d(sign__5__d),
         .q(sign__5__q),
         .clock(sign__5__clock)
     );
-    dynrt_processor_core__add__big_sign sign__6(
+    dynrt_processor__display__dark_d sign__6(
         .d(sign__6__d),
         .q(sign__6__q),
         .clock(sign__6__clock)
     );
-    dynrt_processor_core__add__big_sign sign__7(
+    dynrt_processor__display__dark_d sign__7(
         .d(sign__7__d),
         .q(sign__7__q),
         .clock(sign__7__clock)
     );
-    dynrt_processor_core__add__big_sign sign__8(
+    dynrt_processor__display__dark_d sign__8(
         .d(sign__8__d),
         .q(sign__8__q),
         .clock(sign__8__clock)
     );
-    dynrt_processor_core__add__big_sign sign__9(
+    dynrt_processor__display__dark_d sign__9(
         .d(sign__9__d),
         .q(sign__9__q),
         .clock(sign__9__clock)
     );
-    dynrt_processor_core__add__big_sign sign__10(
+    dynrt_processor__display__dark_d sign__10(
         .d(sign__10__d),
         .q(sign__10__q),
         .clock(sign__10__clock)
     );
-    dynrt_processor_core__add__big_sign sign__11(
+    dynrt_processor__display__dark_d sign__11(
         .d(sign__11__d),
         .q(sign__11__q),
         .clock(sign__11__clock)
     );
-    dynrt_processor_core__add__big_sign sign__12(
+    dynrt_processor__display__dark_d sign__12(
         .d(sign__12__d),
         .q(sign__12__q),
         .clock(sign__12__clock)
     );
-    dynrt_processor_core__add__big_sign sign__13(
+    dynrt_processor__display__dark_d sign__13(
         .d(sign__13__d),
         .q(sign__13__q),
         .clock(sign__13__clock)
     );
-    dynrt_processor_core__add__big_sign sign__14(
+    dynrt_processor__display__dark_d sign__14(
         .d(sign__14__d),
         .q(sign__14__q),
         .clock(sign__14__clock)
     );
-    dynrt_processor_core__add__big_sign sign__15(
+    dynrt_processor__display__dark_d sign__15(
         .d(sign__15__d),
         .q(sign__15__q),
         .clock(sign__15__clock)
     );
-    dynrt_processor_core__add__big_sign sign__16(
+    dynrt_processor__display__dark_d sign__16(
         .d(sign__16__d),
         .q(sign__16__q),
         .clock(sign__16__clock)
     );
-    dynrt_processor_core__add__big_sign nan__0(
+    dynrt_processor__display__dark_d nan__0(
         .d(nan__0__d),
         .q(nan__0__q),
         .clock(nan__0__clock)
     );
-    dynrt_processor_core__add__big_sign nan__1(
+    dynrt_processor__display__dark_d nan__1(
         .d(nan__1__d),
         .q(nan__1__q),
         .clock(nan__1__clock)
     );
-    dynrt_processor_core__add__big_sign nan__2(
+    dynrt_processor__display__dark_d nan__2(
         .d(nan__2__d),
         .q(nan__2__q),
         .clock(nan__2__clock)
     );
-    dynrt_processor_core__add__big_sign nan__3(
+    dynrt_processor__display__dark_d nan__3(
         .d(nan__3__d),
         .q(nan__3__q),
         .clock(nan__3__clock)
     );
-    dynrt_processor_core__add__big_sign nan__4(
+    dynrt_processor__display__dark_d nan__4(
         .d(nan__4__d),
         .q(nan__4__q),
         .clock(nan__4__clock)
     );
-    dynrt_processor_core__add__big_sign nan__5(
+    dynrt_processor__display__dark_d nan__5(
         .d(nan__5__d),
         .q(nan__5__q),
         .clock(nan__5__clock)
     );
-    dynrt_processor_core__add__big_sign nan__6(
+    dynrt_processor__display__dark_d nan__6(
         .d(nan__6__d),
         .q(nan__6__q),
         .clock(nan__6__clock)
     );
-    dynrt_processor_core__add__big_sign nan__7(
+    dynrt_processor__display__dark_d nan__7(
         .d(nan__7__d),
         .q(nan__7__q),
         .clock(nan__7__clock)
     );
-    dynrt_processor_core__add__big_sign nan__8(
+    dynrt_processor__display__dark_d nan__8(
         .d(nan__8__d),
         .q(nan__8__q),
         .clock(nan__8__clock)
     );
-    dynrt_processor_core__add__big_sign nan__9(
+    dynrt_processor__display__dark_d nan__9(
         .d(nan__9__d),
         .q(nan__9__q),
         .clock(nan__9__clock)
     );
-    dynrt_processor_core__add__big_sign nan__10(
+    dynrt_processor__display__dark_d nan__10(
         .d(nan__10__d),
         .q(nan__10__q),
         .clock(nan__10__clock)
     );
-    dynrt_processor_core__add__big_sign nan__11(
+    dynrt_processor__display__dark_d nan__11(
         .d(nan__11__d),
         .q(nan__11__q),
         .clock(nan__11__clock)
     );
-    dynrt_processor_core__add__big_sign nan__12(
+    dynrt_processor__display__dark_d nan__12(
         .d(nan__12__d),
         .q(nan__12__q),
         .clock(nan__12__clock)
     );
-    dynrt_processor_core__add__big_sign nan__13(
+    dynrt_processor__display__dark_d nan__13(
         .d(nan__13__d),
         .q(nan__13__q),
         .clock(nan__13__clock)
     );
-    dynrt_processor_core__add__big_sign nan__14(
+    dynrt_processor__display__dark_d nan__14(
         .d(nan__14__d),
         .q(nan__14__q),
         .clock(nan__14__clock)
     );
-    dynrt_processor_core__add__big_sign nan__15(
+    dynrt_processor__display__dark_d nan__15(
         .d(nan__15__d),
         .q(nan__15__q),
         .clock(nan__15__clock)
     );
-    dynrt_processor_core__add__big_sign nan__16(
+    dynrt_processor__display__dark_d nan__16(
         .d(nan__16__d),
         .q(nan__16__q),
         .clock(nan__16__clock)
     );
-    dynrt_processor_core__add__big_sign inf__0(
+    dynrt_processor__display__dark_d inf__0(
         .d(inf__0__d),
         .q(inf__0__q),
         .clock(inf__0__clock)
     );
-    dynrt_processor_core__add__big_sign inf__1(
+    dynrt_processor__display__dark_d inf__1(
         .d(inf__1__d),
         .q(inf__1__q),
         .clock(inf__1__clock)
     );
-    dynrt_processor_core__add__big_sign inf__2(
+    dynrt_processor__display__dark_d inf__2(
         .d(inf__2__d),
         .q(inf__2__q),
         .clock(inf__2__clock)
     );
-    dynrt_processor_core__add__big_sign inf__3(
+    dynrt_processor__display__dark_d inf__3(
         .d(inf__3__d),
         .q(inf__3__q),
         .clock(inf__3__clock)
     );
-    dynrt_processor_core__add__big_sign inf__4(
+    dynrt_processor__display__dark_d inf__4(
         .d(inf__4__d),
         .q(inf__4__q),
         .clock(inf__4__clock)
     );
-    dynrt_processor_core__add__big_sign inf__5(
+    dynrt_processor__display__dark_d inf__5(
         .d(inf__5__d),
         .q(inf__5__q),
         .clock(inf__5__clock)
     );
-    dynrt_processor_core__add__big_sign inf__6(
+    dynrt_processor__display__dark_d inf__6(
         .d(inf__6__d),
         .q(inf__6__q),
         .clock(inf__6__clock)
     );
-    dynrt_processor_core__add__big_sign inf__7(
+    dynrt_processor__display__dark_d inf__7(
         .d(inf__7__d),
         .q(inf__7__q),
         .clock(inf__7__clock)
     );
-    dynrt_processor_core__add__big_sign inf__8(
+    dynrt_processor__display__dark_d inf__8(
         .d(inf__8__d),
         .q(inf__8__q),
         .clock(inf__8__clock)
     );
-    dynrt_processor_core__add__big_sign inf__9(
+    dynrt_processor__display__dark_d inf__9(
         .d(inf__9__d),
         .q(inf__9__q),
         .clock(inf__9__clock)
     );
-    dynrt_processor_core__add__big_sign inf__10(
+    dynrt_processor__display__dark_d inf__10(
         .d(inf__10__d),
         .q(inf__10__q),
         .clock(inf__10__clock)
     );
-    dynrt_processor_core__add__big_sign inf__11(
+    dynrt_processor__display__dark_d inf__11(
         .d(inf__11__d),
         .q(inf__11__q),
         .clock(inf__11__clock)
     );
-    dynrt_processor_core__add__big_sign inf__12(
+    dynrt_processor__display__dark_d inf__12(
         .d(inf__12__d),
         .q(inf__12__q),
         .clock(inf__12__clock)
     );
-    dynrt_processor_core__add__big_sign inf__13(
+    dynrt_processor__display__dark_d inf__13(
         .d(inf__13__d),
         .q(inf__13__q),
         .clock(inf__13__clock)
     );
-    dynrt_processor_core__add__big_sign inf__14(
+    dynrt_processor__display__dark_d inf__14(
         .d(inf__14__d),
         .q(inf__14__q),
         .clock(inf__14__clock)
     );
-    dynrt_processor_core__add__big_sign inf__15(
+    dynrt_processor__display__dark_d inf__15(
         .d(inf__15__d),
         .q(inf__15__q),
         .clock(inf__15__clock)
     );
-    dynrt_processor_core__add__big_sign inf__16(
+    dynrt_processor__display__dark_d inf__16(
         .d(inf__16__d),
         .q(inf__16__q),
         .clock(inf__16__clock)
     );
-    dynrt_processor_core__add__big_sign zero__0(
+    dynrt_processor__display__dark_d zero__0(
         .d(zero__0__d),
         .q(zero__0__q),
         .clock(zero__0__clock)
     );
-    dynrt_processor_core__add__big_sign zero__1(
+    dynrt_processor__display__dark_d zero__1(
         .d(zero__1__d),
         .q(zero__1__q),
         .clock(zero__1__clock)
     );
-    dynrt_processor_core__add__big_sign zero__2(
+    dynrt_processor__display__dark_d zero__2(
         .d(zero__2__d),
         .q(zero__2__q),
         .clock(zero__2__clock)
     );
-    dynrt_processor_core__add__big_sign zero__3(
+    dynrt_processor__display__dark_d zero__3(
         .d(zero__3__d),
         .q(zero__3__q),
         .clock(zero__3__clock)
     );
-    dynrt_processor_core__add__big_sign zero__4(
+    dynrt_processor__display__dark_d zero__4(
         .d(zero__4__d),
         .q(zero__4__q),
         .clock(zero__4__clock)
     );
-    dynrt_processor_core__add__big_sign zero__5(
+    dynrt_processor__display__dark_d zero__5(
         .d(zero__5__d),
         .q(zero__5__q),
         .clock(zero__5__clock)
     );
-    dynrt_processor_core__add__big_sign zero__6(
+    dynrt_processor__display__dark_d zero__6(
         .d(zero__6__d),
         .q(zero__6__q),
         .clock(zero__6__clock)
     );
-    dynrt_processor_core__add__big_sign zero__7(
+    dynrt_processor__display__dark_d zero__7(
         .d(zero__7__d),
         .q(zero__7__q),
         .clock(zero__7__clock)
     );
-    dynrt_processor_core__add__big_sign zero__8(
+    dynrt_processor__display__dark_d zero__8(
         .d(zero__8__d),
         .q(zero__8__q),
         .clock(zero__8__clock)
     );
-    dynrt_processor_core__add__big_sign zero__9(
+    dynrt_processor__display__dark_d zero__9(
         .d(zero__9__d),
         .q(zero__9__q),
         .clock(zero__9__clock)
     );
-    dynrt_processor_core__add__big_sign zero__10(
+    dynrt_processor__display__dark_d zero__10(
         .d(zero__10__d),
         .q(zero__10__q),
         .clock(zero__10__clock)
     );
-    dynrt_processor_core__add__big_sign zero__11(
+    dynrt_processor__display__dark_d zero__11(
         .d(zero__11__d),
         .q(zero__11__q),
         .clock(zero__11__clock)
     );
-    dynrt_processor_core__add__big_sign zero__12(
+    dynrt_processor__display__dark_d zero__12(
         .d(zero__12__d),
         .q(zero__12__q),
         .clock(zero__12__clock)
     );
-    dynrt_processor_core__add__big_sign zero__13(
+    dynrt_processor__display__dark_d zero__13(
         .d(zero__13__d),
         .q(zero__13__q),
         .clock(zero__13__clock)
     );
-    dynrt_processor_core__add__big_sign zero__14(
+    dynrt_processor__display__dark_d zero__14(
         .d(zero__14__d),
         .q(zero__14__q),
         .clock(zero__14__clock)
     );
-    dynrt_processor_core__add__big_sign zero__15(
+    dynrt_processor__display__dark_d zero__15(
         .d(zero__15__d),
         .q(zero__15__q),
         .clock(zero__15__clock)
     );
-    dynrt_processor_core__add__big_sign zero__16(
+    dynrt_processor__display__dark_d zero__16(
         .d(zero__16__d),
         .q(zero__16__q),
         .clock(zero__16__clock)
     );
-    dynrt_processor_core__add__big_sign valid__0(
+    dynrt_processor__display__dark_d valid__0(
         .d(valid__0__d),
         .q(valid__0__q),
         .clock(valid__0__clock)
     );
-    dynrt_processor_core__add__big_sign valid__1(
+    dynrt_processor__display__dark_d valid__1(
         .d(valid__1__d),
         .q(valid__1__q),
         .clock(valid__1__clock)
     );
-    dynrt_processor_core__add__big_sign valid__2(
+    dynrt_processor__display__dark_d valid__2(
         .d(valid__2__d),
         .q(valid__2__q),
         .clock(valid__2__clock)
     );
-    dynrt_processor_core__add__big_sign valid__3(
+    dynrt_processor__display__dark_d valid__3(
         .d(valid__3__d),
         .q(valid__3__q),
         .clock(valid__3__clock)
     );
-    dynrt_processor_core__add__big_sign valid__4(
+    dynrt_processor__display__dark_d valid__4(
         .d(valid__4__d),
         .q(valid__4__q),
         .clock(valid__4__clock)
     );
-    dynrt_processor_core__add__big_sign valid__5(
+    dynrt_processor__display__dark_d valid__5(
         .d(valid__5__d),
         .q(valid__5__q),
         .clock(valid__5__clock)
     );
-    dynrt_processor_core__add__big_sign valid__6(
+    dynrt_processor__display__dark_d valid__6(
         .d(valid__6__d),
         .q(valid__6__q),
         .clock(valid__6__clock)
     );
-    dynrt_processor_core__add__big_sign valid__7(
+    dynrt_processor__display__dark_d valid__7(
         .d(valid__7__d),
         .q(valid__7__q),
         .clock(valid__7__clock)
     );
-    dynrt_processor_core__add__big_sign valid__8(
+    dynrt_processor__display__dark_d valid__8(
         .d(valid__8__d),
         .q(valid__8__q),
         .clock(valid__8__clock)
     );
-    dynrt_processor_core__add__big_sign valid__9(
+    dynrt_processor__display__dark_d valid__9(
         .d(valid__9__d),
         .q(valid__9__q),
         .clock(valid__9__clock)
     );
-    dynrt_processor_core__add__big_sign valid__10(
+    dynrt_processor__display__dark_d valid__10(
         .d(valid__10__d),
         .q(valid__10__q),
         .clock(valid__10__clock)
     );
-    dynrt_processor_core__add__big_sign valid__11(
+    dynrt_processor__display__dark_d valid__11(
         .d(valid__11__d),
         .q(valid__11__q),
         .clock(valid__11__clock)
     );
-    dynrt_processor_core__add__big_sign valid__12(
+    dynrt_processor__display__dark_d valid__12(
         .d(valid__12__d),
         .q(valid__12__q),
         .clock(valid__12__clock)
     );
-    dynrt_processor_core__add__big_sign valid__13(
+    dynrt_processor__display__dark_d valid__13(
         .d(valid__13__d),
         .q(valid__13__q),
         .clock(valid__13__clock)
     );
-    dynrt_processor_core__add__big_sign valid__14(
+    dynrt_processor__display__dark_d valid__14(
         .d(valid__14__d),
         .q(valid__14__q),
         .clock(valid__14__clock)
     );
-    dynrt_processor_core__add__big_sign valid__15(
+    dynrt_processor__display__dark_d valid__15(
         .d(valid__15__d),
         .q(valid__15__q),
         .clock(valid__15__clock)
     );
-    dynrt_processor_core__add__big_sign valid__16(
+    dynrt_processor__display__dark_d valid__16(
         .d(valid__16__d),
         .q(valid__16__q),
         .clock(valid__16__clock)
     );
-    dynrt_processor_core__add__rnd_sig last_rem(
+    dynrt_processor__engine__fp_units__add__rnd_sig last_rem(
         .d(last_rem__d),
         .q(last_rem__q),
         .clock(last_rem__clock)
     );
-    dynrt_processor_core__add__rnd_sig last_quo(
+    dynrt_processor__engine__fp_units__add__rnd_sig last_quo(
         .d(last_quo__d),
         .q(last_quo__q),
         .clock(last_quo__clock)
     );
-    dynrt_processor_core__add__lz last_exp(
+    dynrt_processor__engine__fp_units__add__lz last_exp(
         .d(last_exp__d),
         .q(last_exp__q),
         .clock(last_exp__clock)
     );
-    dynrt_processor_core__add__big_sign last_sign(
+    dynrt_processor__display__dark_d last_sign(
         .d(last_sign__d),
         .q(last_sign__q),
         .clock(last_sign__clock)
     );
-    dynrt_processor_core__add__big_sign last_nan(
+    dynrt_processor__display__dark_d last_nan(
         .d(last_nan__d),
         .q(last_nan__q),
         .clock(last_nan__clock)
     );
-    dynrt_processor_core__add__big_sign last_inf(
+    dynrt_processor__display__dark_d last_inf(
         .d(last_inf__d),
         .q(last_inf__q),
         .clock(last_inf__clock)
     );
-    dynrt_processor_core__add__big_sign last_zero(
+    dynrt_processor__display__dark_d last_zero(
         .d(last_zero__d),
         .q(last_zero__q),
         .clock(last_zero__clock)
     );
-    dynrt_processor_core__add__big_sign last_valid(
+    dynrt_processor__display__dark_d last_valid(
         .d(last_valid__d),
         .q(last_valid__q),
         .clock(last_valid__clock)
     );
-    dynrt_processor_core__byte_unit__scale__pack pack(
+    dynrt_processor__engine__fp_units__byte_unit__scale__pack pack(
         .clock(pack__clock),
         .in_valid(pack__in_valid),
         .sig(pack__sig),
@@ -6435,7 +6813,7 @@ module dynrt_processor_core__div(clock,in_valid,a,b,out_valid,result);
         out_valid = pack__out_valid;
     end
     
-endmodule // dynrt_processor_core__div
+endmodule // dynrt_processor__engine__fp_units__div
 
 
 
@@ -6786,7 +7164,7 @@ endmodule // dynrt_processor_core__div
 
 
 
-module dynrt_processor_core__div_delay(clock,data_in,data_out);
+module dynrt_processor__engine__fp_units__div_delay(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -6799,7 +7177,7 @@ module dynrt_processor_core__div_delay(clock,data_in,data_out);
     reg  stage__0__clock;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a stage__0(
+    dynrt_processor__display__rgb_q stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
@@ -6812,349 +7190,92 @@ module dynrt_processor_core__div_delay(clock,data_in,data_out);
         data_out = stage__0__q;
     end
     
-endmodule // dynrt_processor_core__div_delay
+endmodule // dynrt_processor__engine__fp_units__div_delay
 
 
 
 
-
-
-module dynrt_processor_core__fast_delay(clock,data_in,data_out);
+module dynrt_processor__engine__fp_units__eq_delay(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
-    input wire  [31:0] data_in;
-    output reg  [31:0] data_out;
+    input wire  data_in;
+    output reg  data_out;
     
     // Stub signals
-    reg  [31:0] stage__0__d;
-    wire  [31:0] stage__0__q;
+    reg  stage__0__d;
+    wire  stage__0__q;
     reg  stage__0__clock;
-    reg  [31:0] stage__1__d;
-    wire  [31:0] stage__1__q;
+    reg  stage__1__d;
+    wire  stage__1__q;
     reg  stage__1__clock;
-    reg  [31:0] stage__2__d;
-    wire  [31:0] stage__2__q;
+    reg  stage__2__d;
+    wire  stage__2__q;
     reg  stage__2__clock;
-    
-    // Sub module instances
-    dynrt_processor_core__asleep stage__0(
-        .d(stage__0__d),
-        .q(stage__0__q),
-        .clock(stage__0__clock)
-    );
-    dynrt_processor_core__asleep stage__1(
-        .d(stage__1__d),
-        .q(stage__1__q),
-        .clock(stage__1__clock)
-    );
-    dynrt_processor_core__asleep stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        stage__0__clock = clock;
-        stage__1__clock = clock;
-        stage__2__clock = clock;
-        stage__0__d = data_in;
-        stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-    end
-    
-endmodule // dynrt_processor_core__fast_delay
-
-
-
-
-
-
-
-
-module dynrt_processor_core__fast_kind_line__0(d,q,clock);
-    
-    // Module arguments
-    input wire  [2:0] d;
-    output reg  [2:0] q;
-    input wire  clock;
-    
-    // Enums
-    localparam FastKind__Computed = 0;
-    localparam FastKind__Scratch = 1;
-    localparam FastKind__Memory = 2;
-    localparam FastKind__TrianglesUv = 3;
-    localparam FastKind__TrianglesT = 4;
-    localparam FastKind__Nodes = 5;
-    
-    // Update code (custom)
-    initial begin
-       q = 64'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_core__fast_kind_line__0
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor_core__halted_count(d,q,clock);
-    
-    // Module arguments
-    input wire  [7:0] d;
-    output reg  [7:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 8'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_core__halted_count
-
-
-
-
-
-
-
-
-module dynrt_processor_core__itof(value,word);
-    
-    // Module arguments
-    input wire  [15:0] value;
-    output reg  [23:0] word;
-    
-    // Constant declarations
-    localparam  c_shift__0 = 8'h8;
-    localparam  c_shift__1 = 8'h4;
-    localparam  c_shift__2 = 8'h2;
-    localparam  c_shift__3 = 8'h1;
-    localparam  c_shift_e__0 = 7'b1000;
-    localparam  c_shift_e__1 = 7'b100;
-    localparam  c_shift_e__2 = 7'b10;
-    localparam  c_shift_e__3 = 7'b1;
-    localparam  c_top_mask__0 = 16'hff00;
-    localparam  c_top_mask__1 = 16'hf000;
-    localparam  c_top_mask__2 = 16'hc000;
-    localparam  c_top_mask__3 = 16'h8000;
-    localparam  c_exp_top = 7'b1001110;
-    localparam  c_man_bits = 8'h10;
-    localparam  c_fraction_pos = 8'h10;
-    localparam  c_fraction_shift = 8'h11;
-    
-    // Local signals
-    reg  [15:0] norm__0;
-    reg  [15:0] norm__1;
-    reg  [15:0] norm__2;
-    reg  [15:0] norm__3;
-    reg  [15:0] norm__4;
-    reg  [6:0] exp__0;
-    reg  [6:0] exp__1;
-    reg  [6:0] exp__2;
-    reg  [6:0] exp__3;
-    reg  [6:0] exp__4;
-    reg  [31:0] fraction;
-    
-    // Update code
-    always @(*) begin
-        norm__0 = value;
-        exp__0 = c_exp_top;
-        norm__1 = norm__0;
-        exp__1 = exp__0;
-        if ((norm__0 & c_top_mask__0) == 32'h0) begin
-            norm__1 = norm__0 << c_shift__0;
-            exp__1 = exp__0 - c_shift_e__0;
-        end
-        norm__2 = norm__1;
-        exp__2 = exp__1;
-        if ((norm__1 & c_top_mask__1) == 32'h0) begin
-            norm__2 = norm__1 << c_shift__1;
-            exp__2 = exp__1 - c_shift_e__1;
-        end
-        norm__3 = norm__2;
-        exp__3 = exp__2;
-        if ((norm__2 & c_top_mask__2) == 32'h0) begin
-            norm__3 = norm__2 << c_shift__2;
-            exp__3 = exp__2 - c_shift_e__2;
-        end
-        norm__4 = norm__3;
-        exp__4 = exp__3;
-        if ((norm__3 & c_top_mask__3) == 32'h0) begin
-            norm__4 = norm__3 << c_shift__3;
-            exp__4 = exp__3 - c_shift_e__3;
-        end
-        fraction = ((norm__4) & 32'hffffffff) << c_fraction_shift;
-        word = (((exp__4) & 24'hffffff) << c_man_bits) | ((fraction[(c_fraction_pos)+:(16)]) & 24'hffffff);
-        if (value == 32'h0) begin
-            word = 32'h0;
-        end
-    end
-    
-endmodule // dynrt_processor_core__itof
-
-
-module dynrt_processor_core__last_pick(d,q,clock);
-    
-    // Module arguments
-    input wire  [4:0] d;
-    output reg  [4:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 5'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_core__last_pick
-
-
-module dynrt_processor_core__long_ctl(clock,data_in,data_out);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  [20:0] data_in;
-    output reg  [20:0] data_out;
-    
-    // Stub signals
-    reg  [20:0] stage__0__d;
-    wire  [20:0] stage__0__q;
-    reg  stage__0__clock;
-    reg  [20:0] stage__1__d;
-    wire  [20:0] stage__1__q;
-    reg  stage__1__clock;
-    reg  [20:0] stage__2__d;
-    wire  [20:0] stage__2__q;
-    reg  stage__2__clock;
-    reg  [20:0] stage__3__d;
-    wire  [20:0] stage__3__q;
+    reg  stage__3__d;
+    wire  stage__3__q;
     reg  stage__3__clock;
-    reg  [20:0] stage__4__d;
-    wire  [20:0] stage__4__q;
+    reg  stage__4__d;
+    wire  stage__4__q;
     reg  stage__4__clock;
-    reg  [20:0] stage__5__d;
-    wire  [20:0] stage__5__q;
+    reg  stage__5__d;
+    wire  stage__5__q;
     reg  stage__5__clock;
-    reg  [20:0] stage__6__d;
-    wire  [20:0] stage__6__q;
+    reg  stage__6__d;
+    wire  stage__6__q;
     reg  stage__6__clock;
-    reg  [20:0] stage__7__d;
-    wire  [20:0] stage__7__q;
+    reg  stage__7__d;
+    wire  stage__7__q;
     reg  stage__7__clock;
-    reg  [20:0] stage__8__d;
-    wire  [20:0] stage__8__q;
+    reg  stage__8__d;
+    wire  stage__8__q;
     reg  stage__8__clock;
-    reg  [20:0] stage__9__d;
-    wire  [20:0] stage__9__q;
-    reg  stage__9__clock;
-    reg  [20:0] stage__10__d;
-    wire  [20:0] stage__10__q;
-    reg  stage__10__clock;
     
     // Sub module instances
-    dynrt_processor_core__add__mid_norm stage__0(
+    dynrt_processor__display__dark_d stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__add__mid_norm stage__1(
+    dynrt_processor__display__dark_d stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__add__mid_norm stage__2(
+    dynrt_processor__display__dark_d stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__add__mid_norm stage__3(
+    dynrt_processor__display__dark_d stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__add__mid_norm stage__4(
+    dynrt_processor__display__dark_d stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__add__mid_norm stage__5(
+    dynrt_processor__display__dark_d stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__add__mid_norm stage__6(
+    dynrt_processor__display__dark_d stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor_core__add__mid_norm stage__7(
+    dynrt_processor__display__dark_d stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor_core__add__mid_norm stage__8(
+    dynrt_processor__display__dark_d stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
-    );
-    dynrt_processor_core__add__mid_norm stage__9(
-        .d(stage__9__d),
-        .q(stage__9__q),
-        .clock(stage__9__clock)
-    );
-    dynrt_processor_core__add__mid_norm stage__10(
-        .d(stage__10__d),
-        .q(stage__10__q),
-        .clock(stage__10__clock)
     );
     
     // Update code
@@ -7168,8 +7289,6 @@ module dynrt_processor_core__long_ctl(clock,data_in,data_out);
         stage__6__clock = clock;
         stage__7__clock = clock;
         stage__8__clock = clock;
-        stage__9__clock = clock;
-        stage__10__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -7179,8 +7298,6 @@ module dynrt_processor_core__long_ctl(clock,data_in,data_out);
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
         stage__8__d = stage__7__q;
-        stage__9__d = stage__8__q;
-        stage__10__d = stage__9__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -7190,332 +7307,9 @@ module dynrt_processor_core__long_ctl(clock,data_in,data_out);
         data_out = stage__6__q;
         data_out = stage__7__q;
         data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
     end
     
-endmodule // dynrt_processor_core__long_ctl
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor_core__long_pc(clock,data_in,data_out);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  [23:0] data_in;
-    output reg  [23:0] data_out;
-    
-    // Stub signals
-    reg  [23:0] stage__0__d;
-    wire  [23:0] stage__0__q;
-    reg  stage__0__clock;
-    reg  [23:0] stage__1__d;
-    wire  [23:0] stage__1__q;
-    reg  stage__1__clock;
-    reg  [23:0] stage__2__d;
-    wire  [23:0] stage__2__q;
-    reg  stage__2__clock;
-    reg  [23:0] stage__3__d;
-    wire  [23:0] stage__3__q;
-    reg  stage__3__clock;
-    reg  [23:0] stage__4__d;
-    wire  [23:0] stage__4__q;
-    reg  stage__4__clock;
-    reg  [23:0] stage__5__d;
-    wire  [23:0] stage__5__q;
-    reg  stage__5__clock;
-    reg  [23:0] stage__6__d;
-    wire  [23:0] stage__6__q;
-    reg  stage__6__clock;
-    reg  [23:0] stage__7__d;
-    wire  [23:0] stage__7__q;
-    reg  stage__7__clock;
-    reg  [23:0] stage__8__d;
-    wire  [23:0] stage__8__q;
-    reg  stage__8__clock;
-    reg  [23:0] stage__9__d;
-    wire  [23:0] stage__9__q;
-    reg  stage__9__clock;
-    reg  [23:0] stage__10__d;
-    wire  [23:0] stage__10__q;
-    reg  stage__10__clock;
-    
-    // Sub module instances
-    dynrt_processor_core__add__in_a stage__0(
-        .d(stage__0__d),
-        .q(stage__0__q),
-        .clock(stage__0__clock)
-    );
-    dynrt_processor_core__add__in_a stage__1(
-        .d(stage__1__d),
-        .q(stage__1__q),
-        .clock(stage__1__clock)
-    );
-    dynrt_processor_core__add__in_a stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
-    dynrt_processor_core__add__in_a stage__3(
-        .d(stage__3__d),
-        .q(stage__3__q),
-        .clock(stage__3__clock)
-    );
-    dynrt_processor_core__add__in_a stage__4(
-        .d(stage__4__d),
-        .q(stage__4__q),
-        .clock(stage__4__clock)
-    );
-    dynrt_processor_core__add__in_a stage__5(
-        .d(stage__5__d),
-        .q(stage__5__q),
-        .clock(stage__5__clock)
-    );
-    dynrt_processor_core__add__in_a stage__6(
-        .d(stage__6__d),
-        .q(stage__6__q),
-        .clock(stage__6__clock)
-    );
-    dynrt_processor_core__add__in_a stage__7(
-        .d(stage__7__d),
-        .q(stage__7__q),
-        .clock(stage__7__clock)
-    );
-    dynrt_processor_core__add__in_a stage__8(
-        .d(stage__8__d),
-        .q(stage__8__q),
-        .clock(stage__8__clock)
-    );
-    dynrt_processor_core__add__in_a stage__9(
-        .d(stage__9__d),
-        .q(stage__9__q),
-        .clock(stage__9__clock)
-    );
-    dynrt_processor_core__add__in_a stage__10(
-        .d(stage__10__d),
-        .q(stage__10__q),
-        .clock(stage__10__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        stage__0__clock = clock;
-        stage__1__clock = clock;
-        stage__2__clock = clock;
-        stage__3__clock = clock;
-        stage__4__clock = clock;
-        stage__5__clock = clock;
-        stage__6__clock = clock;
-        stage__7__clock = clock;
-        stage__8__clock = clock;
-        stage__9__clock = clock;
-        stage__10__clock = clock;
-        stage__0__d = data_in;
-        stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        stage__3__d = stage__2__q;
-        stage__4__d = stage__3__q;
-        stage__5__d = stage__4__q;
-        stage__6__d = stage__5__q;
-        stage__7__d = stage__6__q;
-        stage__8__d = stage__7__q;
-        stage__9__d = stage__8__q;
-        stage__10__d = stage__9__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-    end
-    
-endmodule // dynrt_processor_core__long_pc
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor_core__mailbox__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [5:0] read_address;
-    input wire  read_clock;
-    output reg  [31:0] read_data;
-    input wire  [5:0] write_address;
-    input wire  write_clock;
-    input wire  [31:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[31:0] mem[63:0];
-    
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor_core__mailbox__0
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor_core__mailbox_meta(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [5:0] read_address;
-    input wire  read_clock;
-    output reg  [7:0] read_data;
-    input wire  [5:0] write_address;
-    input wire  write_clock;
-    input wire  [7:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[7:0] mem[63:0];
-    
-    initial begin
-    mem[6'b0] = 8'h0;
-    mem[6'b1] = 8'h0;
-    mem[6'b10] = 8'h0;
-    mem[6'b11] = 8'h0;
-    mem[6'b100] = 8'h0;
-    mem[6'b101] = 8'h0;
-    mem[6'b110] = 8'h0;
-    mem[6'b111] = 8'h0;
-    mem[6'b1000] = 8'h0;
-    mem[6'b1001] = 8'h0;
-    mem[6'b1010] = 8'h0;
-    mem[6'b1011] = 8'h0;
-    mem[6'b1100] = 8'h0;
-    mem[6'b1101] = 8'h0;
-    mem[6'b1110] = 8'h0;
-    mem[6'b1111] = 8'h0;
-    mem[6'b10000] = 8'h0;
-    mem[6'b10001] = 8'h0;
-    mem[6'b10010] = 8'h0;
-    mem[6'b10011] = 8'h0;
-    mem[6'b10100] = 8'h0;
-    mem[6'b10101] = 8'h0;
-    mem[6'b10110] = 8'h0;
-    mem[6'b10111] = 8'h0;
-    mem[6'b11000] = 8'h0;
-    mem[6'b11001] = 8'h0;
-    mem[6'b11010] = 8'h0;
-    mem[6'b11011] = 8'h0;
-    mem[6'b11100] = 8'h0;
-    mem[6'b11101] = 8'h0;
-    mem[6'b11110] = 8'h0;
-    mem[6'b11111] = 8'h0;
-    mem[6'b100000] = 8'h0;
-    mem[6'b100001] = 8'h0;
-    mem[6'b100010] = 8'h0;
-    mem[6'b100011] = 8'h0;
-    mem[6'b100100] = 8'h0;
-    mem[6'b100101] = 8'h0;
-    mem[6'b100110] = 8'h0;
-    mem[6'b100111] = 8'h0;
-    mem[6'b101000] = 8'h0;
-    mem[6'b101001] = 8'h0;
-    mem[6'b101010] = 8'h0;
-    mem[6'b101011] = 8'h0;
-    mem[6'b101100] = 8'h0;
-    mem[6'b101101] = 8'h0;
-    mem[6'b101110] = 8'h0;
-    mem[6'b101111] = 8'h0;
-    mem[6'b110000] = 8'h0;
-    mem[6'b110001] = 8'h0;
-    mem[6'b110010] = 8'h0;
-    mem[6'b110011] = 8'h0;
-    mem[6'b110100] = 8'h0;
-    mem[6'b110101] = 8'h0;
-    mem[6'b110110] = 8'h0;
-    mem[6'b110111] = 8'h0;
-    mem[6'b111000] = 8'h0;
-    mem[6'b111001] = 8'h0;
-    mem[6'b111010] = 8'h0;
-    mem[6'b111011] = 8'h0;
-    mem[6'b111100] = 8'h0;
-    mem[6'b111101] = 8'h0;
-    mem[6'b111110] = 8'h0;
-    mem[6'b111111] = 8'h0;
-    end
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor_core__mailbox_meta
+endmodule // dynrt_processor__engine__fp_units__eq_delay
 
 
 
@@ -7568,7 +7362,59 @@ endmodule // dynrt_processor_core__mailbox_meta
 
 
 
-module dynrt_processor_core__mul_delay(clock,data_in,data_out);
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__fp_units__mul_delay(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -7599,37 +7445,37 @@ module dynrt_processor_core__mul_delay(clock,data_in,data_out);
     reg  stage__6__clock;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a stage__0(
+    dynrt_processor__display__rgb_q stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__add__in_a stage__1(
+    dynrt_processor__display__rgb_q stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__add__in_a stage__2(
+    dynrt_processor__display__rgb_q stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__add__in_a stage__3(
+    dynrt_processor__display__rgb_q stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__add__in_a stage__4(
+    dynrt_processor__display__rgb_q stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__add__in_a stage__5(
+    dynrt_processor__display__rgb_q stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__add__in_a stage__6(
+    dynrt_processor__display__rgb_q stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
@@ -7660,7 +7506,7 @@ module dynrt_processor_core__mul_delay(clock,data_in,data_out);
         data_out = stage__6__q;
     end
     
-endmodule // dynrt_processor_core__mul_delay
+endmodule // dynrt_processor__engine__fp_units__mul_delay
 
 
 
@@ -7677,794 +7523,7 @@ endmodule // dynrt_processor_core__mul_delay
 
 
 
-module dynrt_processor_core__pc2(d,q,clock);
-    
-    // Module arguments
-    input wire  [11:0] d;
-    output reg  [11:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 12'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_core__pc2
-
-
-
-
-module dynrt_processor_core__pc_delay(clock,data_in,data_out);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  [23:0] data_in;
-    output reg  [23:0] data_out;
-    
-    // Stub signals
-    reg  [23:0] stage__0__d;
-    wire  [23:0] stage__0__q;
-    reg  stage__0__clock;
-    reg  [23:0] stage__1__d;
-    wire  [23:0] stage__1__q;
-    reg  stage__1__clock;
-    reg  [23:0] stage__2__d;
-    wire  [23:0] stage__2__q;
-    reg  stage__2__clock;
-    
-    // Sub module instances
-    dynrt_processor_core__add__in_a stage__0(
-        .d(stage__0__d),
-        .q(stage__0__q),
-        .clock(stage__0__clock)
-    );
-    dynrt_processor_core__add__in_a stage__1(
-        .d(stage__1__d),
-        .q(stage__1__q),
-        .clock(stage__1__clock)
-    );
-    dynrt_processor_core__add__in_a stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        stage__0__clock = clock;
-        stage__1__clock = clock;
-        stage__2__clock = clock;
-        stage__0__d = data_in;
-        stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-    end
-    
-endmodule // dynrt_processor_core__pc_delay
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor_core__pc_ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [4:0] read_address;
-    input wire  read_clock;
-    output reg  [15:0] read_data;
-    input wire  [4:0] write_address;
-    input wire  write_clock;
-    input wire  [15:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[15:0] mem[31:0];
-    
-    initial begin
-    mem[5'b0] = 16'h0;
-    mem[5'b1] = 16'h0;
-    mem[5'b10] = 16'h0;
-    mem[5'b11] = 16'h0;
-    mem[5'b100] = 16'h0;
-    mem[5'b101] = 16'h0;
-    mem[5'b110] = 16'h0;
-    mem[5'b111] = 16'h0;
-    mem[5'b1000] = 16'h0;
-    mem[5'b1001] = 16'h0;
-    mem[5'b1010] = 16'h0;
-    mem[5'b1011] = 16'h0;
-    mem[5'b1100] = 16'h0;
-    mem[5'b1101] = 16'h0;
-    mem[5'b1110] = 16'h0;
-    mem[5'b1111] = 16'h0;
-    mem[5'b10000] = 16'h0;
-    mem[5'b10001] = 16'h0;
-    mem[5'b10010] = 16'h0;
-    mem[5'b10011] = 16'h0;
-    mem[5'b10100] = 16'h0;
-    mem[5'b10101] = 16'h0;
-    mem[5'b10110] = 16'h0;
-    mem[5'b10111] = 16'h0;
-    mem[5'b11000] = 16'h0;
-    mem[5'b11001] = 16'h0;
-    mem[5'b11010] = 16'h0;
-    mem[5'b11011] = 16'h0;
-    mem[5'b11100] = 16'h0;
-    mem[5'b11101] = 16'h0;
-    mem[5'b11110] = 16'h0;
-    mem[5'b11111] = 16'h0;
-    end
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor_core__pc_ram
-
-
-module dynrt_processor_core__px(d,q,clock);
-    
-    // Module arguments
-    input wire  [15:0] d;
-    output reg  [15:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_core__px
-
-
-
-
-
-
-module dynrt_processor_core__regs_a(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [12:0] read_address;
-    input wire  read_clock;
-    output reg  [31:0] read_data;
-    input wire  [12:0] write_address;
-    input wire  write_clock;
-    input wire  [31:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[31:0] mem[8191:0];
-    
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor_core__regs_a
-
-
-
-
-
-
-module dynrt_processor_core__rom_aux(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [11:0] read_address;
-    input wire  read_clock;
-    output reg  [31:0] read_data;
-    input wire  [11:0] write_address;
-    input wire  write_clock;
-    input wire  [31:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[31:0] mem[4095:0];
-    
-    initial begin
-    mem[12'h0] = 32'h5000;
-    mem[12'h1] = 32'h5000;
-    mem[12'h2] = 32'h5000;
-    mem[12'h3] = 32'h5000;
-    mem[12'h4] = 32'h5000;
-    mem[12'h5] = 32'h5000;
-    mem[12'h6] = 32'h5000;
-    mem[12'h7] = 32'h5000;
-    mem[12'h8] = 32'h5000;
-    mem[12'h9] = 32'h0;
-    mem[12'ha] = 32'h5000;
-    mem[12'hb] = 32'h5000;
-    mem[12'hc] = 32'h5000;
-    mem[12'hd] = 32'h5000;
-    mem[12'he] = 32'h5000;
-    mem[12'hf] = 32'h5000;
-    mem[12'h10] = 32'h5000;
-    mem[12'h11] = 32'h5000;
-    mem[12'h12] = 32'h5000;
-    mem[12'h13] = 32'h5000;
-    mem[12'h14] = 32'h5000;
-    mem[12'h15] = 32'h5000;
-    mem[12'h16] = 32'h5000;
-    mem[12'h17] = 32'h5026;
-    mem[12'h18] = 32'h26;
-    mem[12'h19] = 32'h0;
-    mem[12'h1a] = 32'h0;
-    mem[12'h1b] = 32'h0;
-    mem[12'h1c] = 32'h0;
-    mem[12'h1d] = 32'h0;
-    mem[12'h1e] = 32'h0;
-    mem[12'h1f] = 32'h0;
-    mem[12'h20] = 32'h0;
-    mem[12'h21] = 32'h0;
-    mem[12'h22] = 32'h24;
-    mem[12'h23] = 32'h24;
-    mem[12'h24] = 32'h0;
-    mem[12'h25] = 32'h0;
-    mem[12'h26] = 32'h95;
-    mem[12'h27] = 32'h0;
-    mem[12'h28] = 32'h0;
-    mem[12'h29] = 32'h0;
-    mem[12'h2a] = 32'h0;
-    mem[12'h2b] = 32'h0;
-    mem[12'h2c] = 32'h0;
-    mem[12'h2d] = 32'h0;
-    mem[12'h2e] = 32'h0;
-    mem[12'h2f] = 32'h0;
-    mem[12'h30] = 32'h0;
-    mem[12'h31] = 32'h0;
-    mem[12'h32] = 32'h0;
-    mem[12'h33] = 32'h0;
-    mem[12'h34] = 32'h0;
-    mem[12'h35] = 32'h0;
-    mem[12'h36] = 32'h0;
-    mem[12'h37] = 32'h0;
-    mem[12'h38] = 32'h0;
-    mem[12'h39] = 32'h0;
-    mem[12'h3a] = 32'h0;
-    mem[12'h3b] = 32'h0;
-    mem[12'h3c] = 32'h0;
-    mem[12'h3d] = 32'h0;
-    mem[12'h3e] = 32'h0;
-    mem[12'h3f] = 32'h19;
-    mem[12'h40] = 32'h91;
-    mem[12'h41] = 32'h0;
-    mem[12'h42] = 32'h0;
-    mem[12'h43] = 32'h0;
-    mem[12'h44] = 32'h0;
-    mem[12'h45] = 32'h0;
-    mem[12'h46] = 32'h0;
-    mem[12'h47] = 32'h0;
-    mem[12'h48] = 32'h1b000;
-    mem[12'h49] = 32'h1b000;
-    mem[12'h4a] = 32'h1b000;
-    mem[12'h4b] = 32'h1b000;
-    mem[12'h4c] = 32'h0;
-    mem[12'h4d] = 32'h0;
-    mem[12'h4e] = 32'h0;
-    mem[12'h4f] = 32'h0;
-    mem[12'h50] = 32'h0;
-    mem[12'h51] = 32'h0;
-    mem[12'h52] = 32'h0;
-    mem[12'h53] = 32'h0;
-    mem[12'h54] = 32'h0;
-    mem[12'h55] = 32'h0;
-    mem[12'h56] = 32'h0;
-    mem[12'h57] = 32'h0;
-    mem[12'h58] = 32'h0;
-    mem[12'h59] = 32'h0;
-    mem[12'h5a] = 32'h0;
-    mem[12'h5b] = 32'h5f;
-    mem[12'h5c] = 32'h0;
-    mem[12'h5d] = 32'h0;
-    mem[12'h5e] = 32'h0;
-    mem[12'h5f] = 32'h15000;
-    mem[12'h60] = 32'h15000;
-    mem[12'h61] = 32'h15000;
-    mem[12'h62] = 32'h15000;
-    mem[12'h63] = 32'h0;
-    mem[12'h64] = 32'h0;
-    mem[12'h65] = 32'h0;
-    mem[12'h66] = 32'h0;
-    mem[12'h67] = 32'h0;
-    mem[12'h68] = 32'h0;
-    mem[12'h69] = 32'h0;
-    mem[12'h6a] = 32'h0;
-    mem[12'h6b] = 32'h0;
-    mem[12'h6c] = 32'h0;
-    mem[12'h6d] = 32'h0;
-    mem[12'h6e] = 32'h8c;
-    mem[12'h6f] = 32'h0;
-    mem[12'h70] = 32'h0;
-    mem[12'h71] = 32'h0;
-    mem[12'h72] = 32'h0;
-    mem[12'h73] = 32'h0;
-    mem[12'h74] = 32'h0;
-    mem[12'h75] = 32'h0;
-    mem[12'h76] = 32'h0;
-    mem[12'h77] = 32'h0;
-    mem[12'h78] = 32'h0;
-    mem[12'h79] = 32'h0;
-    mem[12'h7a] = 32'h0;
-    mem[12'h7b] = 32'h0;
-    mem[12'h7c] = 32'h0;
-    mem[12'h7d] = 32'h0;
-    mem[12'h7e] = 32'h0;
-    mem[12'h7f] = 32'h0;
-    mem[12'h80] = 32'h0;
-    mem[12'h81] = 32'h19;
-    mem[12'h82] = 32'h8c;
-    mem[12'h83] = 32'h0;
-    mem[12'h84] = 32'h0;
-    mem[12'h85] = 32'h0;
-    mem[12'h86] = 32'h0;
-    mem[12'h87] = 32'h0;
-    mem[12'h88] = 32'h0;
-    mem[12'h89] = 32'h0;
-    mem[12'h8a] = 32'h0;
-    mem[12'h8b] = 32'h0;
-    mem[12'h8c] = 32'h0;
-    mem[12'h8d] = 32'h0;
-    mem[12'h8e] = 32'h0;
-    mem[12'h8f] = 32'h26;
-    mem[12'h90] = 32'h26;
-    mem[12'h91] = 32'h0;
-    mem[12'h92] = 32'h0;
-    mem[12'h93] = 32'h8c;
-    mem[12'h94] = 32'h8c;
-    mem[12'h95] = 32'h0;
-    end
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor_core__rom_aux
-
-
-module dynrt_processor_core__rom_ctl(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [11:0] read_address;
-    input wire  read_clock;
-    output reg  [31:0] read_data;
-    input wire  [11:0] write_address;
-    input wire  write_clock;
-    input wire  [31:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[31:0] mem[4095:0];
-    
-    initial begin
-    mem[12'h0] = 32'h38480000;
-    mem[12'h1] = 32'h384c0000;
-    mem[12'h2] = 32'h38500000;
-    mem[12'h3] = 32'h38540000;
-    mem[12'h4] = 32'h38580000;
-    mem[12'h5] = 32'h385c0000;
-    mem[12'h6] = 32'h38600000;
-    mem[12'h7] = 32'h38640000;
-    mem[12'h8] = 32'h38680000;
-    mem[12'h9] = 32'h286c0002;
-    mem[12'ha] = 32'h38700000;
-    mem[12'hb] = 32'h38740000;
-    mem[12'hc] = 32'h38780000;
-    mem[12'hd] = 32'h387c0000;
-    mem[12'he] = 32'h38800000;
-    mem[12'hf] = 32'h38840000;
-    mem[12'h10] = 32'h38880000;
-    mem[12'h11] = 32'h388c0000;
-    mem[12'h12] = 32'h38900000;
-    mem[12'h13] = 32'h38940000;
-    mem[12'h14] = 32'h38980000;
-    mem[12'h15] = 32'h389c0000;
-    mem[12'h16] = 32'h38a00000;
-    mem[12'h17] = 32'h38a40001;
-    mem[12'h18] = 32'h5c000000;
-    mem[12'h19] = 32'h74001c20;
-    mem[12'h1a] = 32'h7400282c;
-    mem[12'h1b] = 32'h74000408;
-    mem[12'h1c] = 32'h74000c10;
-    mem[12'h1d] = 32'h74001418;
-    mem[12'h1e] = 32'h78002420;
-    mem[12'h1f] = 32'h78000000;
-    mem[12'h20] = 32'h74340000;
-    mem[12'h21] = 32'h74300000;
-    mem[12'h22] = 32'h54003002;
-    mem[12'h23] = 32'h54002403;
-    mem[12'h24] = 32'h743c0000;
-    mem[12'h25] = 32'h60004000;
-    mem[12'h26] = 32'h6ca80000;
-    mem[12'h27] = 32'h24aca802;
-    mem[12'h28] = 32'h30b0a802;
-    mem[12'h29] = 32'h18c4ac02;
-    mem[12'h2a] = 32'h18c8b002;
-    mem[12'h2b] = 32'hccc48c4;
-    mem[12'h2c] = 32'hcd04cc8;
-    mem[12'h2d] = 32'h4d4ccd0;
-    mem[12'h2e] = 32'h410d450;
-    mem[12'h2f] = 32'hcdc54c4;
-    mem[12'h30] = 32'hce058c8;
-    mem[12'h31] = 32'h4e4dce0;
-    mem[12'h32] = 32'h414e45c;
-    mem[12'h33] = 32'hcec60c4;
-    mem[12'h34] = 32'hcf064c8;
-    mem[12'h35] = 32'h4f4ecf0;
-    mem[12'h36] = 32'h418f468;
-    mem[12'h37] = 32'h28047002;
-    mem[12'h38] = 32'h28087402;
-    mem[12'h39] = 32'h280c7802;
-    mem[12'h3a] = 32'h281c0002;
-    mem[12'h3b] = 32'h28280002;
-    mem[12'h3c] = 32'h282c0002;
-    mem[12'h3d] = 32'h28200002;
-    mem[12'h3e] = 32'h28240002;
-    mem[12'h3f] = 32'h5c400000;
-    mem[12'h40] = 32'h54003002;
-    mem[12'h41] = 32'h28f83c02;
-    mem[12'h42] = 32'hcf43410;
-    mem[12'h43] = 32'h4f004f4;
-    mem[12'h44] = 32'hcec3414;
-    mem[12'h45] = 32'h4e808ec;
-    mem[12'h46] = 32'hce43418;
-    mem[12'h47] = 32'h4e00ce4;
-    mem[12'h48] = 32'h38ecf800;
-    mem[12'h49] = 32'h38e4f800;
-    mem[12'h4a] = 32'h38f4f800;
-    mem[12'h4b] = 32'h38dcf800;
-    mem[12'h4c] = 32'hcd8ecec;
-    mem[12'h4d] = 32'hcd4e4e4;
-    mem[12'h4e] = 32'h4d0d8d4;
-    mem[12'h4f] = 32'hcccf4f4;
-    mem[12'h50] = 32'h4c8d0cc;
-    mem[12'h51] = 32'h14c4c802;
-    mem[12'h52] = 32'h10fc6cc4;
-    mem[12'h53] = 32'hd00ecfc;
-    mem[12'h54] = 32'hd04e4fc;
-    mem[12'h55] = 32'hd08f4fc;
-    mem[12'h56] = 32'hd0d0010;
-    mem[12'h57] = 32'hd110414;
-    mem[12'h58] = 32'h5150d10;
-    mem[12'h59] = 32'hd190818;
-    mem[12'h5a] = 32'h51d1518;
-    mem[12'h5b] = 32'h4800011d;
-    mem[12'h5c] = 32'h2d010002;
-    mem[12'h5d] = 32'h2d050402;
-    mem[12'h5e] = 32'h2d090802;
-    mem[12'h5f] = 32'h3928dc00;
-    mem[12'h60] = 32'h3924dc00;
-    mem[12'h61] = 32'h3920dc00;
-    mem[12'h62] = 32'h3910dc00;
-    mem[12'h63] = 32'hcb9287c;
-    mem[12'h64] = 32'hcbd247c;
-    mem[12'h65] = 32'hcc1207c;
-    mem[12'h66] = 32'h91490f0;
-    mem[12'h67] = 32'h90c94e8;
-    mem[12'h68] = 32'h8dc98e0;
-    mem[12'h69] = 32'hd190114;
-    mem[12'h6a] = 32'hd1d050c;
-    mem[12'h6b] = 32'h4fd191c;
-    mem[12'h6c] = 32'hcc508dc;
-    mem[12'h6d] = 32'h4c8fcc4;
-    mem[12'h6e] = 32'h480000c9;
-    mem[12'h6f] = 32'hccd1514;
-    mem[12'h70] = 32'hcd10d0c;
-    mem[12'h71] = 32'h4d4ccd0;
-    mem[12'h72] = 32'hcd8dcdc;
-    mem[12'h73] = 32'h4f4d4d8;
-    mem[12'h74] = 32'h14e4f402;
-    mem[12'h75] = 32'h10ecc8e4;
-    mem[12'h76] = 32'h2804f002;
-    mem[12'h77] = 32'h2808e802;
-    mem[12'h78] = 32'h280ce002;
-    mem[12'h79] = 32'h28111402;
-    mem[12'h7a] = 32'h28150c02;
-    mem[12'h7b] = 32'h2818dc02;
-    mem[12'h7c] = 32'h281c8c02;
-    mem[12'h7d] = 32'h28200002;
-    mem[12'h7e] = 32'h28240002;
-    mem[12'h7f] = 32'h28280002;
-    mem[12'h80] = 32'h282cf802;
-    mem[12'h81] = 32'h5c400000;
-    mem[12'h82] = 32'h54003003;
-    mem[12'h83] = 32'hce5289c;
-    mem[12'h84] = 32'hcf4e4ec;
-    mem[12'h85] = 32'h4b8b8f4;
-    mem[12'h86] = 32'hcd524a0;
-    mem[12'h87] = 32'hcd0d4ec;
-    mem[12'h88] = 32'h4bcbcd0;
-    mem[12'h89] = 32'hcc920a4;
-    mem[12'h8a] = 32'hcc4c8ec;
-    mem[12'h8b] = 32'h4c0c0c4;
-    mem[12'h8c] = 32'h7cf8b802;
-    mem[12'h8d] = 32'h7cf8bcf8;
-    mem[12'h8e] = 32'h7cf8c0f8;
-    mem[12'h8f] = 32'h3c00a8f9;
-    mem[12'h90] = 32'h5c000000;
-    mem[12'h91] = 32'h28b88002;
-    mem[12'h92] = 32'h28bc8402;
-    mem[12'h93] = 32'h28c08803;
-    mem[12'h94] = 32'h5c000000;
-    mem[12'h95] = 32'h70000000;
-    end
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor_core__rom_ctl
-
-
-module dynrt_processor_core__rom_imm(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [11:0] read_address;
-    input wire  read_clock;
-    output reg  [31:0] read_data;
-    input wire  [11:0] write_address;
-    input wire  write_clock;
-    input wire  [31:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[31:0] mem[4095:0];
-    
-    initial begin
-    mem[12'h0] = 32'h0;
-    mem[12'h1] = 32'h1;
-    mem[12'h2] = 32'h3;
-    mem[12'h3] = 32'h4;
-    mem[12'h4] = 32'h5;
-    mem[12'h5] = 32'h7;
-    mem[12'h6] = 32'h8;
-    mem[12'h7] = 32'h9;
-    mem[12'h8] = 32'hb;
-    mem[12'h9] = 32'h3f0000;
-    mem[12'ha] = 32'hc;
-    mem[12'hb] = 32'hd;
-    mem[12'hc] = 32'he;
-    mem[12'hd] = 32'hf;
-    mem[12'he] = 32'h10;
-    mem[12'hf] = 32'h11;
-    mem[12'h10] = 32'h12;
-    mem[12'h11] = 32'h13;
-    mem[12'h12] = 32'h18;
-    mem[12'h13] = 32'h19;
-    mem[12'h14] = 32'h1a;
-    mem[12'h15] = 32'h1b;
-    mem[12'h16] = 32'h1c;
-    mem[12'h17] = 32'h1d;
-    mem[12'h18] = 32'h0;
-    mem[12'h19] = 32'h3;
-    mem[12'h1a] = 32'ha;
-    mem[12'h1b] = 32'h0;
-    mem[12'h1c] = 32'h1;
-    mem[12'h1d] = 32'h2;
-    mem[12'h1e] = 32'h0;
-    mem[12'h1f] = 32'h1;
-    mem[12'h20] = 32'h5;
-    mem[12'h21] = 32'h6;
-    mem[12'h22] = 32'h0;
-    mem[12'h23] = 32'h0;
-    mem[12'h24] = 32'h8;
-    mem[12'h25] = 32'h0;
-    mem[12'h26] = 32'h0;
-    mem[12'h27] = 32'h3f;
-    mem[12'h28] = 32'h6;
-    mem[12'h29] = 32'h0;
-    mem[12'h2a] = 32'h0;
-    mem[12'h2b] = 32'h0;
-    mem[12'h2c] = 32'h0;
-    mem[12'h2d] = 32'h0;
-    mem[12'h2e] = 32'h0;
-    mem[12'h2f] = 32'h0;
-    mem[12'h30] = 32'h0;
-    mem[12'h31] = 32'h0;
-    mem[12'h32] = 32'h0;
-    mem[12'h33] = 32'h0;
-    mem[12'h34] = 32'h0;
-    mem[12'h35] = 32'h0;
-    mem[12'h36] = 32'h0;
-    mem[12'h37] = 32'h0;
-    mem[12'h38] = 32'h0;
-    mem[12'h39] = 32'h0;
-    mem[12'h3a] = 32'h0;
-    mem[12'h3b] = 32'hffffffff;
-    mem[12'h3c] = 32'hffffffff;
-    mem[12'h3d] = 32'h7f0000;
-    mem[12'h3e] = 32'h0;
-    mem[12'h3f] = 32'h0;
-    mem[12'h40] = 32'h0;
-    mem[12'h41] = 32'h0;
-    mem[12'h42] = 32'h0;
-    mem[12'h43] = 32'h0;
-    mem[12'h44] = 32'h0;
-    mem[12'h45] = 32'h0;
-    mem[12'h46] = 32'h0;
-    mem[12'h47] = 32'h0;
-    mem[12'h48] = 32'h4;
-    mem[12'h49] = 32'h5;
-    mem[12'h4a] = 32'h6;
-    mem[12'h4b] = 32'h7;
-    mem[12'h4c] = 32'h0;
-    mem[12'h4d] = 32'h0;
-    mem[12'h4e] = 32'h0;
-    mem[12'h4f] = 32'h0;
-    mem[12'h50] = 32'h0;
-    mem[12'h51] = 32'h0;
-    mem[12'h52] = 32'h0;
-    mem[12'h53] = 32'h0;
-    mem[12'h54] = 32'h0;
-    mem[12'h55] = 32'h0;
-    mem[12'h56] = 32'h0;
-    mem[12'h57] = 32'h0;
-    mem[12'h58] = 32'h0;
-    mem[12'h59] = 32'h0;
-    mem[12'h5a] = 32'h0;
-    mem[12'h5b] = 32'h0;
-    mem[12'h5c] = 32'h800000;
-    mem[12'h5d] = 32'h800000;
-    mem[12'h5e] = 32'h800000;
-    mem[12'h5f] = 32'h1e;
-    mem[12'h60] = 32'h1f;
-    mem[12'h61] = 32'h20;
-    mem[12'h62] = 32'h21;
-    mem[12'h63] = 32'h0;
-    mem[12'h64] = 32'h0;
-    mem[12'h65] = 32'h0;
-    mem[12'h66] = 32'h0;
-    mem[12'h67] = 32'h0;
-    mem[12'h68] = 32'h0;
-    mem[12'h69] = 32'h0;
-    mem[12'h6a] = 32'h0;
-    mem[12'h6b] = 32'h0;
-    mem[12'h6c] = 32'h0;
-    mem[12'h6d] = 32'h0;
-    mem[12'h6e] = 32'h0;
-    mem[12'h6f] = 32'h0;
-    mem[12'h70] = 32'h0;
-    mem[12'h71] = 32'h0;
-    mem[12'h72] = 32'h0;
-    mem[12'h73] = 32'h0;
-    mem[12'h74] = 32'h0;
-    mem[12'h75] = 32'h0;
-    mem[12'h76] = 32'h0;
-    mem[12'h77] = 32'h0;
-    mem[12'h78] = 32'h0;
-    mem[12'h79] = 32'h0;
-    mem[12'h7a] = 32'h0;
-    mem[12'h7b] = 32'h0;
-    mem[12'h7c] = 32'h0;
-    mem[12'h7d] = 32'h3f0000;
-    mem[12'h7e] = 32'h80000000;
-    mem[12'h7f] = 32'h0;
-    mem[12'h80] = 32'h0;
-    mem[12'h81] = 32'h0;
-    mem[12'h82] = 32'h0;
-    mem[12'h83] = 32'h0;
-    mem[12'h84] = 32'h0;
-    mem[12'h85] = 32'h0;
-    mem[12'h86] = 32'h0;
-    mem[12'h87] = 32'h0;
-    mem[12'h88] = 32'h0;
-    mem[12'h89] = 32'h0;
-    mem[12'h8a] = 32'h0;
-    mem[12'h8b] = 32'h0;
-    mem[12'h8c] = 32'h0;
-    mem[12'h8d] = 32'h0;
-    mem[12'h8e] = 32'h0;
-    mem[12'h8f] = 32'h2e;
-    mem[12'h90] = 32'h0;
-    mem[12'h91] = 32'h0;
-    mem[12'h92] = 32'h0;
-    mem[12'h93] = 32'h0;
-    mem[12'h94] = 32'h0;
-    mem[12'h95] = 32'h0;
-    end
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor_core__rom_imm
-
-
-
-
-module dynrt_processor_core__scratch(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [11:0] read_address;
-    input wire  read_clock;
-    output reg  [31:0] read_data;
-    input wire  [11:0] write_address;
-    input wire  write_clock;
-    input wire  [31:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[31:0] mem[4095:0];
-    
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor_core__scratch
-
-
-module dynrt_processor_core__sqrt(clock,in_valid,a,out_valid,result);
+module dynrt_processor__engine__fp_units__sqrt(clock,in_valid,a,out_valid,result);
     
     // Module arguments
     input wire  clock;
@@ -9020,862 +8079,862 @@ module dynrt_processor_core__sqrt(clock,in_valid,a,out_valid,result);
     reg  [23:0] packed_word;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a in_a(
+    dynrt_processor__display__rgb_q in_a(
         .d(in_a__d),
         .q(in_a__q),
         .clock(in_a__clock)
     );
-    dynrt_processor_core__add__big_sign in_valid_r(
+    dynrt_processor__display__dark_d in_valid_r(
         .d(in_valid_r__d),
         .q(in_valid_r__q),
         .clock(in_valid_r__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__0(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__0(
         .d(rem__0__d),
         .q(rem__0__q),
         .clock(rem__0__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__1(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__1(
         .d(rem__1__d),
         .q(rem__1__q),
         .clock(rem__1__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__2(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__2(
         .d(rem__2__d),
         .q(rem__2__q),
         .clock(rem__2__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__3(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__3(
         .d(rem__3__d),
         .q(rem__3__q),
         .clock(rem__3__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__4(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__4(
         .d(rem__4__d),
         .q(rem__4__q),
         .clock(rem__4__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__5(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__5(
         .d(rem__5__d),
         .q(rem__5__q),
         .clock(rem__5__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__6(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__6(
         .d(rem__6__d),
         .q(rem__6__q),
         .clock(rem__6__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__7(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__7(
         .d(rem__7__d),
         .q(rem__7__q),
         .clock(rem__7__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__8(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__8(
         .d(rem__8__d),
         .q(rem__8__q),
         .clock(rem__8__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__9(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__9(
         .d(rem__9__d),
         .q(rem__9__q),
         .clock(rem__9__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__10(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__10(
         .d(rem__10__d),
         .q(rem__10__q),
         .clock(rem__10__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__11(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__11(
         .d(rem__11__d),
         .q(rem__11__q),
         .clock(rem__11__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__12(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__12(
         .d(rem__12__d),
         .q(rem__12__q),
         .clock(rem__12__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__13(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__13(
         .d(rem__13__d),
         .q(rem__13__q),
         .clock(rem__13__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__14(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__14(
         .d(rem__14__d),
         .q(rem__14__q),
         .clock(rem__14__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__15(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__15(
         .d(rem__15__d),
         .q(rem__15__q),
         .clock(rem__15__clock)
     );
-    dynrt_processor_core__add__mid_norm rem__16(
+    dynrt_processor__engine__fp_units__add__mid_norm rem__16(
         .d(rem__16__d),
         .q(rem__16__q),
         .clock(rem__16__clock)
     );
-    dynrt_processor_core__add__mid_norm root__0(
+    dynrt_processor__engine__fp_units__add__mid_norm root__0(
         .d(root__0__d),
         .q(root__0__q),
         .clock(root__0__clock)
     );
-    dynrt_processor_core__add__mid_norm root__1(
+    dynrt_processor__engine__fp_units__add__mid_norm root__1(
         .d(root__1__d),
         .q(root__1__q),
         .clock(root__1__clock)
     );
-    dynrt_processor_core__add__mid_norm root__2(
+    dynrt_processor__engine__fp_units__add__mid_norm root__2(
         .d(root__2__d),
         .q(root__2__q),
         .clock(root__2__clock)
     );
-    dynrt_processor_core__add__mid_norm root__3(
+    dynrt_processor__engine__fp_units__add__mid_norm root__3(
         .d(root__3__d),
         .q(root__3__q),
         .clock(root__3__clock)
     );
-    dynrt_processor_core__add__mid_norm root__4(
+    dynrt_processor__engine__fp_units__add__mid_norm root__4(
         .d(root__4__d),
         .q(root__4__q),
         .clock(root__4__clock)
     );
-    dynrt_processor_core__add__mid_norm root__5(
+    dynrt_processor__engine__fp_units__add__mid_norm root__5(
         .d(root__5__d),
         .q(root__5__q),
         .clock(root__5__clock)
     );
-    dynrt_processor_core__add__mid_norm root__6(
+    dynrt_processor__engine__fp_units__add__mid_norm root__6(
         .d(root__6__d),
         .q(root__6__q),
         .clock(root__6__clock)
     );
-    dynrt_processor_core__add__mid_norm root__7(
+    dynrt_processor__engine__fp_units__add__mid_norm root__7(
         .d(root__7__d),
         .q(root__7__q),
         .clock(root__7__clock)
     );
-    dynrt_processor_core__add__mid_norm root__8(
+    dynrt_processor__engine__fp_units__add__mid_norm root__8(
         .d(root__8__d),
         .q(root__8__q),
         .clock(root__8__clock)
     );
-    dynrt_processor_core__add__mid_norm root__9(
+    dynrt_processor__engine__fp_units__add__mid_norm root__9(
         .d(root__9__d),
         .q(root__9__q),
         .clock(root__9__clock)
     );
-    dynrt_processor_core__add__mid_norm root__10(
+    dynrt_processor__engine__fp_units__add__mid_norm root__10(
         .d(root__10__d),
         .q(root__10__q),
         .clock(root__10__clock)
     );
-    dynrt_processor_core__add__mid_norm root__11(
+    dynrt_processor__engine__fp_units__add__mid_norm root__11(
         .d(root__11__d),
         .q(root__11__q),
         .clock(root__11__clock)
     );
-    dynrt_processor_core__add__mid_norm root__12(
+    dynrt_processor__engine__fp_units__add__mid_norm root__12(
         .d(root__12__d),
         .q(root__12__q),
         .clock(root__12__clock)
     );
-    dynrt_processor_core__add__mid_norm root__13(
+    dynrt_processor__engine__fp_units__add__mid_norm root__13(
         .d(root__13__d),
         .q(root__13__q),
         .clock(root__13__clock)
     );
-    dynrt_processor_core__add__mid_norm root__14(
+    dynrt_processor__engine__fp_units__add__mid_norm root__14(
         .d(root__14__d),
         .q(root__14__q),
         .clock(root__14__clock)
     );
-    dynrt_processor_core__add__mid_norm root__15(
+    dynrt_processor__engine__fp_units__add__mid_norm root__15(
         .d(root__15__d),
         .q(root__15__q),
         .clock(root__15__clock)
     );
-    dynrt_processor_core__add__mid_norm root__16(
+    dynrt_processor__engine__fp_units__add__mid_norm root__16(
         .d(root__16__d),
         .q(root__16__q),
         .clock(root__16__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__0(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__0(
         .d(rest__0__d),
         .q(rest__0__q),
         .clock(rest__0__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__1(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__1(
         .d(rest__1__d),
         .q(rest__1__q),
         .clock(rest__1__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__2(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__2(
         .d(rest__2__d),
         .q(rest__2__q),
         .clock(rest__2__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__3(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__3(
         .d(rest__3__d),
         .q(rest__3__q),
         .clock(rest__3__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__4(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__4(
         .d(rest__4__d),
         .q(rest__4__q),
         .clock(rest__4__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__5(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__5(
         .d(rest__5__d),
         .q(rest__5__q),
         .clock(rest__5__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__6(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__6(
         .d(rest__6__d),
         .q(rest__6__q),
         .clock(rest__6__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__7(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__7(
         .d(rest__7__d),
         .q(rest__7__q),
         .clock(rest__7__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__8(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__8(
         .d(rest__8__d),
         .q(rest__8__q),
         .clock(rest__8__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__9(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__9(
         .d(rest__9__d),
         .q(rest__9__q),
         .clock(rest__9__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__10(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__10(
         .d(rest__10__d),
         .q(rest__10__q),
         .clock(rest__10__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__11(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__11(
         .d(rest__11__d),
         .q(rest__11__q),
         .clock(rest__11__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__12(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__12(
         .d(rest__12__d),
         .q(rest__12__q),
         .clock(rest__12__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__13(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__13(
         .d(rest__13__d),
         .q(rest__13__q),
         .clock(rest__13__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__14(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__14(
         .d(rest__14__d),
         .q(rest__14__q),
         .clock(rest__14__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__15(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__15(
         .d(rest__15__d),
         .q(rest__15__q),
         .clock(rest__15__clock)
     );
-    dynrt_processor_core__add__mid_norm rest__16(
+    dynrt_processor__engine__fp_units__add__mid_norm rest__16(
         .d(rest__16__d),
         .q(rest__16__q),
         .clock(rest__16__clock)
     );
-    dynrt_processor_core__add__big_exp exp__0(
+    dynrt_processor__engine__fp_units__add__big_exp exp__0(
         .d(exp__0__d),
         .q(exp__0__q),
         .clock(exp__0__clock)
     );
-    dynrt_processor_core__add__big_exp exp__1(
+    dynrt_processor__engine__fp_units__add__big_exp exp__1(
         .d(exp__1__d),
         .q(exp__1__q),
         .clock(exp__1__clock)
     );
-    dynrt_processor_core__add__big_exp exp__2(
+    dynrt_processor__engine__fp_units__add__big_exp exp__2(
         .d(exp__2__d),
         .q(exp__2__q),
         .clock(exp__2__clock)
     );
-    dynrt_processor_core__add__big_exp exp__3(
+    dynrt_processor__engine__fp_units__add__big_exp exp__3(
         .d(exp__3__d),
         .q(exp__3__q),
         .clock(exp__3__clock)
     );
-    dynrt_processor_core__add__big_exp exp__4(
+    dynrt_processor__engine__fp_units__add__big_exp exp__4(
         .d(exp__4__d),
         .q(exp__4__q),
         .clock(exp__4__clock)
     );
-    dynrt_processor_core__add__big_exp exp__5(
+    dynrt_processor__engine__fp_units__add__big_exp exp__5(
         .d(exp__5__d),
         .q(exp__5__q),
         .clock(exp__5__clock)
     );
-    dynrt_processor_core__add__big_exp exp__6(
+    dynrt_processor__engine__fp_units__add__big_exp exp__6(
         .d(exp__6__d),
         .q(exp__6__q),
         .clock(exp__6__clock)
     );
-    dynrt_processor_core__add__big_exp exp__7(
+    dynrt_processor__engine__fp_units__add__big_exp exp__7(
         .d(exp__7__d),
         .q(exp__7__q),
         .clock(exp__7__clock)
     );
-    dynrt_processor_core__add__big_exp exp__8(
+    dynrt_processor__engine__fp_units__add__big_exp exp__8(
         .d(exp__8__d),
         .q(exp__8__q),
         .clock(exp__8__clock)
     );
-    dynrt_processor_core__add__big_exp exp__9(
+    dynrt_processor__engine__fp_units__add__big_exp exp__9(
         .d(exp__9__d),
         .q(exp__9__q),
         .clock(exp__9__clock)
     );
-    dynrt_processor_core__add__big_exp exp__10(
+    dynrt_processor__engine__fp_units__add__big_exp exp__10(
         .d(exp__10__d),
         .q(exp__10__q),
         .clock(exp__10__clock)
     );
-    dynrt_processor_core__add__big_exp exp__11(
+    dynrt_processor__engine__fp_units__add__big_exp exp__11(
         .d(exp__11__d),
         .q(exp__11__q),
         .clock(exp__11__clock)
     );
-    dynrt_processor_core__add__big_exp exp__12(
+    dynrt_processor__engine__fp_units__add__big_exp exp__12(
         .d(exp__12__d),
         .q(exp__12__q),
         .clock(exp__12__clock)
     );
-    dynrt_processor_core__add__big_exp exp__13(
+    dynrt_processor__engine__fp_units__add__big_exp exp__13(
         .d(exp__13__d),
         .q(exp__13__q),
         .clock(exp__13__clock)
     );
-    dynrt_processor_core__add__big_exp exp__14(
+    dynrt_processor__engine__fp_units__add__big_exp exp__14(
         .d(exp__14__d),
         .q(exp__14__q),
         .clock(exp__14__clock)
     );
-    dynrt_processor_core__add__big_exp exp__15(
+    dynrt_processor__engine__fp_units__add__big_exp exp__15(
         .d(exp__15__d),
         .q(exp__15__q),
         .clock(exp__15__clock)
     );
-    dynrt_processor_core__add__big_exp exp__16(
+    dynrt_processor__engine__fp_units__add__big_exp exp__16(
         .d(exp__16__d),
         .q(exp__16__q),
         .clock(exp__16__clock)
     );
-    dynrt_processor_core__add__big_sign sign__0(
+    dynrt_processor__display__dark_d sign__0(
         .d(sign__0__d),
         .q(sign__0__q),
         .clock(sign__0__clock)
     );
-    dynrt_processor_core__add__big_sign sign__1(
+    dynrt_processor__display__dark_d sign__1(
         .d(sign__1__d),
         .q(sign__1__q),
         .clock(sign__1__clock)
     );
-    dynrt_processor_core__add__big_sign sign__2(
+    dynrt_processor__display__dark_d sign__2(
         .d(sign__2__d),
         .q(sign__2__q),
         .clock(sign__2__clock)
     );
-    dynrt_processor_core__add__big_sign sign__3(
+    dynrt_processor__display__dark_d sign__3(
         .d(sign__3__d),
         .q(sign__3__q),
         .clock(sign__3__clock)
     );
-    dynrt_processor_core__add__big_sign sign__4(
+    dynrt_processor__display__dark_d sign__4(
         .d(sign__4__d),
         .q(sign__4__q),
         .clock(sign__4__clock)
     );
-    dynrt_processor_core__add__big_sign sign__5(
+    dynrt_processor__display__dark_d sign__5(
         .d(sign__5__d),
         .q(sign__5__q),
         .clock(sign__5__clock)
     );
-    dynrt_processor_core__add__big_sign sign__6(
+    dynrt_processor__display__dark_d sign__6(
         .d(sign__6__d),
         .q(sign__6__q),
         .clock(sign__6__clock)
     );
-    dynrt_processor_core__add__big_sign sign__7(
+    dynrt_processor__display__dark_d sign__7(
         .d(sign__7__d),
         .q(sign__7__q),
         .clock(sign__7__clock)
     );
-    dynrt_processor_core__add__big_sign sign__8(
+    dynrt_processor__display__dark_d sign__8(
         .d(sign__8__d),
         .q(sign__8__q),
         .clock(sign__8__clock)
     );
-    dynrt_processor_core__add__big_sign sign__9(
+    dynrt_processor__display__dark_d sign__9(
         .d(sign__9__d),
         .q(sign__9__q),
         .clock(sign__9__clock)
     );
-    dynrt_processor_core__add__big_sign sign__10(
+    dynrt_processor__display__dark_d sign__10(
         .d(sign__10__d),
         .q(sign__10__q),
         .clock(sign__10__clock)
     );
-    dynrt_processor_core__add__big_sign sign__11(
+    dynrt_processor__display__dark_d sign__11(
         .d(sign__11__d),
         .q(sign__11__q),
         .clock(sign__11__clock)
     );
-    dynrt_processor_core__add__big_sign sign__12(
+    dynrt_processor__display__dark_d sign__12(
         .d(sign__12__d),
         .q(sign__12__q),
         .clock(sign__12__clock)
     );
-    dynrt_processor_core__add__big_sign sign__13(
+    dynrt_processor__display__dark_d sign__13(
         .d(sign__13__d),
         .q(sign__13__q),
         .clock(sign__13__clock)
     );
-    dynrt_processor_core__add__big_sign sign__14(
+    dynrt_processor__display__dark_d sign__14(
         .d(sign__14__d),
         .q(sign__14__q),
         .clock(sign__14__clock)
     );
-    dynrt_processor_core__add__big_sign sign__15(
+    dynrt_processor__display__dark_d sign__15(
         .d(sign__15__d),
         .q(sign__15__q),
         .clock(sign__15__clock)
     );
-    dynrt_processor_core__add__big_sign sign__16(
+    dynrt_processor__display__dark_d sign__16(
         .d(sign__16__d),
         .q(sign__16__q),
         .clock(sign__16__clock)
     );
-    dynrt_processor_core__add__big_sign nan__0(
+    dynrt_processor__display__dark_d nan__0(
         .d(nan__0__d),
         .q(nan__0__q),
         .clock(nan__0__clock)
     );
-    dynrt_processor_core__add__big_sign nan__1(
+    dynrt_processor__display__dark_d nan__1(
         .d(nan__1__d),
         .q(nan__1__q),
         .clock(nan__1__clock)
     );
-    dynrt_processor_core__add__big_sign nan__2(
+    dynrt_processor__display__dark_d nan__2(
         .d(nan__2__d),
         .q(nan__2__q),
         .clock(nan__2__clock)
     );
-    dynrt_processor_core__add__big_sign nan__3(
+    dynrt_processor__display__dark_d nan__3(
         .d(nan__3__d),
         .q(nan__3__q),
         .clock(nan__3__clock)
     );
-    dynrt_processor_core__add__big_sign nan__4(
+    dynrt_processor__display__dark_d nan__4(
         .d(nan__4__d),
         .q(nan__4__q),
         .clock(nan__4__clock)
     );
-    dynrt_processor_core__add__big_sign nan__5(
+    dynrt_processor__display__dark_d nan__5(
         .d(nan__5__d),
         .q(nan__5__q),
         .clock(nan__5__clock)
     );
-    dynrt_processor_core__add__big_sign nan__6(
+    dynrt_processor__display__dark_d nan__6(
         .d(nan__6__d),
         .q(nan__6__q),
         .clock(nan__6__clock)
     );
-    dynrt_processor_core__add__big_sign nan__7(
+    dynrt_processor__display__dark_d nan__7(
         .d(nan__7__d),
         .q(nan__7__q),
         .clock(nan__7__clock)
     );
-    dynrt_processor_core__add__big_sign nan__8(
+    dynrt_processor__display__dark_d nan__8(
         .d(nan__8__d),
         .q(nan__8__q),
         .clock(nan__8__clock)
     );
-    dynrt_processor_core__add__big_sign nan__9(
+    dynrt_processor__display__dark_d nan__9(
         .d(nan__9__d),
         .q(nan__9__q),
         .clock(nan__9__clock)
     );
-    dynrt_processor_core__add__big_sign nan__10(
+    dynrt_processor__display__dark_d nan__10(
         .d(nan__10__d),
         .q(nan__10__q),
         .clock(nan__10__clock)
     );
-    dynrt_processor_core__add__big_sign nan__11(
+    dynrt_processor__display__dark_d nan__11(
         .d(nan__11__d),
         .q(nan__11__q),
         .clock(nan__11__clock)
     );
-    dynrt_processor_core__add__big_sign nan__12(
+    dynrt_processor__display__dark_d nan__12(
         .d(nan__12__d),
         .q(nan__12__q),
         .clock(nan__12__clock)
     );
-    dynrt_processor_core__add__big_sign nan__13(
+    dynrt_processor__display__dark_d nan__13(
         .d(nan__13__d),
         .q(nan__13__q),
         .clock(nan__13__clock)
     );
-    dynrt_processor_core__add__big_sign nan__14(
+    dynrt_processor__display__dark_d nan__14(
         .d(nan__14__d),
         .q(nan__14__q),
         .clock(nan__14__clock)
     );
-    dynrt_processor_core__add__big_sign nan__15(
+    dynrt_processor__display__dark_d nan__15(
         .d(nan__15__d),
         .q(nan__15__q),
         .clock(nan__15__clock)
     );
-    dynrt_processor_core__add__big_sign nan__16(
+    dynrt_processor__display__dark_d nan__16(
         .d(nan__16__d),
         .q(nan__16__q),
         .clock(nan__16__clock)
     );
-    dynrt_processor_core__add__big_sign inf__0(
+    dynrt_processor__display__dark_d inf__0(
         .d(inf__0__d),
         .q(inf__0__q),
         .clock(inf__0__clock)
     );
-    dynrt_processor_core__add__big_sign inf__1(
+    dynrt_processor__display__dark_d inf__1(
         .d(inf__1__d),
         .q(inf__1__q),
         .clock(inf__1__clock)
     );
-    dynrt_processor_core__add__big_sign inf__2(
+    dynrt_processor__display__dark_d inf__2(
         .d(inf__2__d),
         .q(inf__2__q),
         .clock(inf__2__clock)
     );
-    dynrt_processor_core__add__big_sign inf__3(
+    dynrt_processor__display__dark_d inf__3(
         .d(inf__3__d),
         .q(inf__3__q),
         .clock(inf__3__clock)
     );
-    dynrt_processor_core__add__big_sign inf__4(
+    dynrt_processor__display__dark_d inf__4(
         .d(inf__4__d),
         .q(inf__4__q),
         .clock(inf__4__clock)
     );
-    dynrt_processor_core__add__big_sign inf__5(
+    dynrt_processor__display__dark_d inf__5(
         .d(inf__5__d),
         .q(inf__5__q),
         .clock(inf__5__clock)
     );
-    dynrt_processor_core__add__big_sign inf__6(
+    dynrt_processor__display__dark_d inf__6(
         .d(inf__6__d),
         .q(inf__6__q),
         .clock(inf__6__clock)
     );
-    dynrt_processor_core__add__big_sign inf__7(
+    dynrt_processor__display__dark_d inf__7(
         .d(inf__7__d),
         .q(inf__7__q),
         .clock(inf__7__clock)
     );
-    dynrt_processor_core__add__big_sign inf__8(
+    dynrt_processor__display__dark_d inf__8(
         .d(inf__8__d),
         .q(inf__8__q),
         .clock(inf__8__clock)
     );
-    dynrt_processor_core__add__big_sign inf__9(
+    dynrt_processor__display__dark_d inf__9(
         .d(inf__9__d),
         .q(inf__9__q),
         .clock(inf__9__clock)
     );
-    dynrt_processor_core__add__big_sign inf__10(
+    dynrt_processor__display__dark_d inf__10(
         .d(inf__10__d),
         .q(inf__10__q),
         .clock(inf__10__clock)
     );
-    dynrt_processor_core__add__big_sign inf__11(
+    dynrt_processor__display__dark_d inf__11(
         .d(inf__11__d),
         .q(inf__11__q),
         .clock(inf__11__clock)
     );
-    dynrt_processor_core__add__big_sign inf__12(
+    dynrt_processor__display__dark_d inf__12(
         .d(inf__12__d),
         .q(inf__12__q),
         .clock(inf__12__clock)
     );
-    dynrt_processor_core__add__big_sign inf__13(
+    dynrt_processor__display__dark_d inf__13(
         .d(inf__13__d),
         .q(inf__13__q),
         .clock(inf__13__clock)
     );
-    dynrt_processor_core__add__big_sign inf__14(
+    dynrt_processor__display__dark_d inf__14(
         .d(inf__14__d),
         .q(inf__14__q),
         .clock(inf__14__clock)
     );
-    dynrt_processor_core__add__big_sign inf__15(
+    dynrt_processor__display__dark_d inf__15(
         .d(inf__15__d),
         .q(inf__15__q),
         .clock(inf__15__clock)
     );
-    dynrt_processor_core__add__big_sign inf__16(
+    dynrt_processor__display__dark_d inf__16(
         .d(inf__16__d),
         .q(inf__16__q),
         .clock(inf__16__clock)
     );
-    dynrt_processor_core__add__big_sign zero__0(
+    dynrt_processor__display__dark_d zero__0(
         .d(zero__0__d),
         .q(zero__0__q),
         .clock(zero__0__clock)
     );
-    dynrt_processor_core__add__big_sign zero__1(
+    dynrt_processor__display__dark_d zero__1(
         .d(zero__1__d),
         .q(zero__1__q),
         .clock(zero__1__clock)
     );
-    dynrt_processor_core__add__big_sign zero__2(
+    dynrt_processor__display__dark_d zero__2(
         .d(zero__2__d),
         .q(zero__2__q),
         .clock(zero__2__clock)
     );
-    dynrt_processor_core__add__big_sign zero__3(
+    dynrt_processor__display__dark_d zero__3(
         .d(zero__3__d),
         .q(zero__3__q),
         .clock(zero__3__clock)
     );
-    dynrt_processor_core__add__big_sign zero__4(
+    dynrt_processor__display__dark_d zero__4(
         .d(zero__4__d),
         .q(zero__4__q),
         .clock(zero__4__clock)
     );
-    dynrt_processor_core__add__big_sign zero__5(
+    dynrt_processor__display__dark_d zero__5(
         .d(zero__5__d),
         .q(zero__5__q),
         .clock(zero__5__clock)
     );
-    dynrt_processor_core__add__big_sign zero__6(
+    dynrt_processor__display__dark_d zero__6(
         .d(zero__6__d),
         .q(zero__6__q),
         .clock(zero__6__clock)
     );
-    dynrt_processor_core__add__big_sign zero__7(
+    dynrt_processor__display__dark_d zero__7(
         .d(zero__7__d),
         .q(zero__7__q),
         .clock(zero__7__clock)
     );
-    dynrt_processor_core__add__big_sign zero__8(
+    dynrt_processor__display__dark_d zero__8(
         .d(zero__8__d),
         .q(zero__8__q),
         .clock(zero__8__clock)
     );
-    dynrt_processor_core__add__big_sign zero__9(
+    dynrt_processor__display__dark_d zero__9(
         .d(zero__9__d),
         .q(zero__9__q),
         .clock(zero__9__clock)
     );
-    dynrt_processor_core__add__big_sign zero__10(
+    dynrt_processor__display__dark_d zero__10(
         .d(zero__10__d),
         .q(zero__10__q),
         .clock(zero__10__clock)
     );
-    dynrt_processor_core__add__big_sign zero__11(
+    dynrt_processor__display__dark_d zero__11(
         .d(zero__11__d),
         .q(zero__11__q),
         .clock(zero__11__clock)
     );
-    dynrt_processor_core__add__big_sign zero__12(
+    dynrt_processor__display__dark_d zero__12(
         .d(zero__12__d),
         .q(zero__12__q),
         .clock(zero__12__clock)
     );
-    dynrt_processor_core__add__big_sign zero__13(
+    dynrt_processor__display__dark_d zero__13(
         .d(zero__13__d),
         .q(zero__13__q),
         .clock(zero__13__clock)
     );
-    dynrt_processor_core__add__big_sign zero__14(
+    dynrt_processor__display__dark_d zero__14(
         .d(zero__14__d),
         .q(zero__14__q),
         .clock(zero__14__clock)
     );
-    dynrt_processor_core__add__big_sign zero__15(
+    dynrt_processor__display__dark_d zero__15(
         .d(zero__15__d),
         .q(zero__15__q),
         .clock(zero__15__clock)
     );
-    dynrt_processor_core__add__big_sign zero__16(
+    dynrt_processor__display__dark_d zero__16(
         .d(zero__16__d),
         .q(zero__16__q),
         .clock(zero__16__clock)
     );
-    dynrt_processor_core__add__big_sign valid__0(
+    dynrt_processor__display__dark_d valid__0(
         .d(valid__0__d),
         .q(valid__0__q),
         .clock(valid__0__clock)
     );
-    dynrt_processor_core__add__big_sign valid__1(
+    dynrt_processor__display__dark_d valid__1(
         .d(valid__1__d),
         .q(valid__1__q),
         .clock(valid__1__clock)
     );
-    dynrt_processor_core__add__big_sign valid__2(
+    dynrt_processor__display__dark_d valid__2(
         .d(valid__2__d),
         .q(valid__2__q),
         .clock(valid__2__clock)
     );
-    dynrt_processor_core__add__big_sign valid__3(
+    dynrt_processor__display__dark_d valid__3(
         .d(valid__3__d),
         .q(valid__3__q),
         .clock(valid__3__clock)
     );
-    dynrt_processor_core__add__big_sign valid__4(
+    dynrt_processor__display__dark_d valid__4(
         .d(valid__4__d),
         .q(valid__4__q),
         .clock(valid__4__clock)
     );
-    dynrt_processor_core__add__big_sign valid__5(
+    dynrt_processor__display__dark_d valid__5(
         .d(valid__5__d),
         .q(valid__5__q),
         .clock(valid__5__clock)
     );
-    dynrt_processor_core__add__big_sign valid__6(
+    dynrt_processor__display__dark_d valid__6(
         .d(valid__6__d),
         .q(valid__6__q),
         .clock(valid__6__clock)
     );
-    dynrt_processor_core__add__big_sign valid__7(
+    dynrt_processor__display__dark_d valid__7(
         .d(valid__7__d),
         .q(valid__7__q),
         .clock(valid__7__clock)
     );
-    dynrt_processor_core__add__big_sign valid__8(
+    dynrt_processor__display__dark_d valid__8(
         .d(valid__8__d),
         .q(valid__8__q),
         .clock(valid__8__clock)
     );
-    dynrt_processor_core__add__big_sign valid__9(
+    dynrt_processor__display__dark_d valid__9(
         .d(valid__9__d),
         .q(valid__9__q),
         .clock(valid__9__clock)
     );
-    dynrt_processor_core__add__big_sign valid__10(
+    dynrt_processor__display__dark_d valid__10(
         .d(valid__10__d),
         .q(valid__10__q),
         .clock(valid__10__clock)
     );
-    dynrt_processor_core__add__big_sign valid__11(
+    dynrt_processor__display__dark_d valid__11(
         .d(valid__11__d),
         .q(valid__11__q),
         .clock(valid__11__clock)
     );
-    dynrt_processor_core__add__big_sign valid__12(
+    dynrt_processor__display__dark_d valid__12(
         .d(valid__12__d),
         .q(valid__12__q),
         .clock(valid__12__clock)
     );
-    dynrt_processor_core__add__big_sign valid__13(
+    dynrt_processor__display__dark_d valid__13(
         .d(valid__13__d),
         .q(valid__13__q),
         .clock(valid__13__clock)
     );
-    dynrt_processor_core__add__big_sign valid__14(
+    dynrt_processor__display__dark_d valid__14(
         .d(valid__14__d),
         .q(valid__14__q),
         .clock(valid__14__clock)
     );
-    dynrt_processor_core__add__big_sign valid__15(
+    dynrt_processor__display__dark_d valid__15(
         .d(valid__15__d),
         .q(valid__15__q),
         .clock(valid__15__clock)
     );
-    dynrt_processor_core__add__big_sign valid__16(
+    dynrt_processor__display__dark_d valid__16(
         .d(valid__16__d),
         .q(valid__16__q),
         .clock(valid__16__clock)
     );
-    dynrt_processor_core__add__mid_norm last_rem(
+    dynrt_processor__engine__fp_units__add__mid_norm last_rem(
         .d(last_rem__d),
         .q(last_rem__q),
         .clock(last_rem__clock)
     );
-    dynrt_processor_core__add__big_sig last_root(
+    dynrt_processor__engine__fp_units__add__big_sig last_root(
         .d(last_root__d),
         .q(last_root__q),
         .clock(last_root__clock)
     );
-    dynrt_processor_core__add__big_exp last_exp(
+    dynrt_processor__engine__fp_units__add__big_exp last_exp(
         .d(last_exp__d),
         .q(last_exp__q),
         .clock(last_exp__clock)
     );
-    dynrt_processor_core__add__big_sign last_sign(
+    dynrt_processor__display__dark_d last_sign(
         .d(last_sign__d),
         .q(last_sign__q),
         .clock(last_sign__clock)
     );
-    dynrt_processor_core__add__big_sign last_nan(
+    dynrt_processor__display__dark_d last_nan(
         .d(last_nan__d),
         .q(last_nan__q),
         .clock(last_nan__clock)
     );
-    dynrt_processor_core__add__big_sign last_inf(
+    dynrt_processor__display__dark_d last_inf(
         .d(last_inf__d),
         .q(last_inf__q),
         .clock(last_inf__clock)
     );
-    dynrt_processor_core__add__big_sign last_zero(
+    dynrt_processor__display__dark_d last_zero(
         .d(last_zero__d),
         .q(last_zero__q),
         .clock(last_zero__clock)
     );
-    dynrt_processor_core__add__big_sign last_valid(
+    dynrt_processor__display__dark_d last_valid(
         .d(last_valid__d),
         .q(last_valid__q),
         .clock(last_valid__clock)
     );
-    dynrt_processor_core__px rnd_man(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man rnd_man(
         .d(rnd_man__d),
         .q(rnd_man__q),
         .clock(rnd_man__clock)
     );
-    dynrt_processor_core__add__big_exp rnd_exp(
+    dynrt_processor__engine__fp_units__add__big_exp rnd_exp(
         .d(rnd_exp__d),
         .q(rnd_exp__q),
         .clock(rnd_exp__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_sign(
+    dynrt_processor__display__dark_d rnd_sign(
         .d(rnd_sign__d),
         .q(rnd_sign__q),
         .clock(rnd_sign__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_nan(
+    dynrt_processor__display__dark_d rnd_nan(
         .d(rnd_nan__d),
         .q(rnd_nan__q),
         .clock(rnd_nan__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_inf(
+    dynrt_processor__display__dark_d rnd_inf(
         .d(rnd_inf__d),
         .q(rnd_inf__q),
         .clock(rnd_inf__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_zero(
+    dynrt_processor__display__dark_d rnd_zero(
         .d(rnd_zero__d),
         .q(rnd_zero__q),
         .clock(rnd_zero__clock)
     );
-    dynrt_processor_core__add__big_sign rnd_valid(
+    dynrt_processor__display__dark_d rnd_valid(
         .d(rnd_valid__d),
         .q(rnd_valid__q),
         .clock(rnd_valid__clock)
     );
-    dynrt_processor_core__add__in_a out_result(
+    dynrt_processor__display__rgb_q out_result(
         .d(out_result__d),
         .q(out_result__q),
         .clock(out_result__clock)
     );
-    dynrt_processor_core__add__big_sign out_valid_r(
+    dynrt_processor__display__dark_d out_valid_r(
         .d(out_valid_r__d),
         .q(out_valid_r__q),
         .clock(out_valid_r__clock)
@@ -10381,7 +9440,7 @@ module dynrt_processor_core__sqrt(clock,in_valid,a,out_valid,result);
         out_valid = out_valid_r__q;
     end
     
-endmodule // dynrt_processor_core__sqrt
+endmodule // dynrt_processor__engine__fp_units__sqrt
 
 
 
@@ -10582,6 +9641,23 @@ endmodule // dynrt_processor_core__sqrt
 
 
 
+module dynrt_processor__engine__fp_units__sqrt__rnd_man(d,q,clock);
+    
+    // Module arguments
+    input wire  [15:0] d;
+    output reg  [15:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__fp_units__sqrt__rnd_man
 
 
 
@@ -10732,44 +9808,2772 @@ endmodule // dynrt_processor_core__sqrt
 
 
 
+module dynrt_processor__engine__halted_count(d,q,clock);
+    
+    // Module arguments
+    input wire  [7:0] d;
+    output reg  [7:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 8'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__halted_count
 
 
 
 
 
 
-module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pair,enqueue,queue_kind,full,query_thread,pending,hit,best_t,best_instance,best_triangle,engine_read,engine_bank,engine_addr,uv_read,uv_addr,uv_rdata,t_read,t_addr,t_rdata,list_read,list_addr,list_rdata,done_event,done_thread,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy);
+module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,which,value,insert,clear,hit);
     
     // Module arguments
     input wire  clock;
+    input wire  [4:0] read_thread;
+    input wire  read_which;
     input wire  [4:0] thread;
-    input wire  [31:0] word_a;
-    input wire  [31:0] word_b;
-    input wire  ray_write;
-    input wire  [1:0] ray_pair;
-    input wire  enqueue;
+    input wire  which;
+    input wire  [31:0] value;
+    input wire  insert;
+    input wire  clear;
+    output reg  hit;
+    
+    // Constant declarations
+    localparam  c_index__0 = 8'h0;
+    localparam  c_index__1 = 8'h1;
+    localparam  c_index__2 = 8'h2;
+    localparam  c_index__3 = 8'h3;
+    localparam  c_index__4 = 8'h4;
+    localparam  c_index__5 = 8'h5;
+    localparam  c_index__6 = 8'h6;
+    localparam  c_index__7 = 8'h7;
+    
+    // Stub signals
+    reg  [5:0] entries__0__read_address;
+    reg  entries__0__read_clock;
+    wire  [31:0] entries__0__read_data;
+    reg  [5:0] entries__0__write_address;
+    reg  entries__0__write_clock;
+    reg  [31:0] entries__0__write_data;
+    reg  entries__0__write_enable;
+    reg  [5:0] entries__1__read_address;
+    reg  entries__1__read_clock;
+    wire  [31:0] entries__1__read_data;
+    reg  [5:0] entries__1__write_address;
+    reg  entries__1__write_clock;
+    reg  [31:0] entries__1__write_data;
+    reg  entries__1__write_enable;
+    reg  [5:0] entries__2__read_address;
+    reg  entries__2__read_clock;
+    wire  [31:0] entries__2__read_data;
+    reg  [5:0] entries__2__write_address;
+    reg  entries__2__write_clock;
+    reg  [31:0] entries__2__write_data;
+    reg  entries__2__write_enable;
+    reg  [5:0] entries__3__read_address;
+    reg  entries__3__read_clock;
+    wire  [31:0] entries__3__read_data;
+    reg  [5:0] entries__3__write_address;
+    reg  entries__3__write_clock;
+    reg  [31:0] entries__3__write_data;
+    reg  entries__3__write_enable;
+    reg  [5:0] entries__4__read_address;
+    reg  entries__4__read_clock;
+    wire  [31:0] entries__4__read_data;
+    reg  [5:0] entries__4__write_address;
+    reg  entries__4__write_clock;
+    reg  [31:0] entries__4__write_data;
+    reg  entries__4__write_enable;
+    reg  [5:0] entries__5__read_address;
+    reg  entries__5__read_clock;
+    wire  [31:0] entries__5__read_data;
+    reg  [5:0] entries__5__write_address;
+    reg  entries__5__write_clock;
+    reg  [31:0] entries__5__write_data;
+    reg  entries__5__write_enable;
+    reg  [5:0] entries__6__read_address;
+    reg  entries__6__read_clock;
+    wire  [31:0] entries__6__read_data;
+    reg  [5:0] entries__6__write_address;
+    reg  entries__6__write_clock;
+    reg  [31:0] entries__6__write_data;
+    reg  entries__6__write_enable;
+    reg  [5:0] entries__7__read_address;
+    reg  entries__7__read_clock;
+    wire  [31:0] entries__7__read_data;
+    reg  [5:0] entries__7__write_address;
+    reg  entries__7__write_clock;
+    reg  [31:0] entries__7__write_data;
+    reg  entries__7__write_enable;
+    reg  [5:0] meta__read_address;
+    reg  meta__read_clock;
+    wire  [7:0] meta__read_data;
+    reg  [5:0] meta__write_address;
+    reg  meta__write_clock;
+    reg  [7:0] meta__write_data;
+    reg  meta__write_enable;
+    
+    // Local signals
+    reg  [3:0] len;
+    reg  [2:0] next_slot;
+    reg  found;
+    reg  [5:0] read_address;
+    reg  [5:0] write_address;
+    
+    // Sub module instances
+    dynrt_processor__engine__mailboxes__entries__0 entries__0(
+        .read_address(entries__0__read_address),
+        .read_clock(entries__0__read_clock),
+        .read_data(entries__0__read_data),
+        .write_address(entries__0__write_address),
+        .write_clock(entries__0__write_clock),
+        .write_data(entries__0__write_data),
+        .write_enable(entries__0__write_enable)
+    );
+    dynrt_processor__engine__mailboxes__entries__0 entries__1(
+        .read_address(entries__1__read_address),
+        .read_clock(entries__1__read_clock),
+        .read_data(entries__1__read_data),
+        .write_address(entries__1__write_address),
+        .write_clock(entries__1__write_clock),
+        .write_data(entries__1__write_data),
+        .write_enable(entries__1__write_enable)
+    );
+    dynrt_processor__engine__mailboxes__entries__0 entries__2(
+        .read_address(entries__2__read_address),
+        .read_clock(entries__2__read_clock),
+        .read_data(entries__2__read_data),
+        .write_address(entries__2__write_address),
+        .write_clock(entries__2__write_clock),
+        .write_data(entries__2__write_data),
+        .write_enable(entries__2__write_enable)
+    );
+    dynrt_processor__engine__mailboxes__entries__0 entries__3(
+        .read_address(entries__3__read_address),
+        .read_clock(entries__3__read_clock),
+        .read_data(entries__3__read_data),
+        .write_address(entries__3__write_address),
+        .write_clock(entries__3__write_clock),
+        .write_data(entries__3__write_data),
+        .write_enable(entries__3__write_enable)
+    );
+    dynrt_processor__engine__mailboxes__entries__0 entries__4(
+        .read_address(entries__4__read_address),
+        .read_clock(entries__4__read_clock),
+        .read_data(entries__4__read_data),
+        .write_address(entries__4__write_address),
+        .write_clock(entries__4__write_clock),
+        .write_data(entries__4__write_data),
+        .write_enable(entries__4__write_enable)
+    );
+    dynrt_processor__engine__mailboxes__entries__0 entries__5(
+        .read_address(entries__5__read_address),
+        .read_clock(entries__5__read_clock),
+        .read_data(entries__5__read_data),
+        .write_address(entries__5__write_address),
+        .write_clock(entries__5__write_clock),
+        .write_data(entries__5__write_data),
+        .write_enable(entries__5__write_enable)
+    );
+    dynrt_processor__engine__mailboxes__entries__0 entries__6(
+        .read_address(entries__6__read_address),
+        .read_clock(entries__6__read_clock),
+        .read_data(entries__6__read_data),
+        .write_address(entries__6__write_address),
+        .write_clock(entries__6__write_clock),
+        .write_data(entries__6__write_data),
+        .write_enable(entries__6__write_enable)
+    );
+    dynrt_processor__engine__mailboxes__entries__0 entries__7(
+        .read_address(entries__7__read_address),
+        .read_clock(entries__7__read_clock),
+        .read_data(entries__7__read_data),
+        .write_address(entries__7__write_address),
+        .write_clock(entries__7__write_clock),
+        .write_data(entries__7__write_data),
+        .write_enable(entries__7__write_enable)
+    );
+    dynrt_processor__engine__mailboxes__meta meta(
+        .read_address(meta__read_address),
+        .read_clock(meta__read_clock),
+        .read_data(meta__read_data),
+        .write_address(meta__write_address),
+        .write_clock(meta__write_clock),
+        .write_data(meta__write_data),
+        .write_enable(meta__write_enable)
+    );
+    
+    // Update code
+    always @(*) begin
+        meta__read_clock = clock;
+        meta__write_clock = clock;
+        entries__0__read_clock = clock;
+        entries__0__write_clock = clock;
+        entries__1__read_clock = clock;
+        entries__1__write_clock = clock;
+        entries__2__read_clock = clock;
+        entries__2__write_clock = clock;
+        entries__3__read_clock = clock;
+        entries__3__write_clock = clock;
+        entries__4__read_clock = clock;
+        entries__4__write_clock = clock;
+        entries__5__read_clock = clock;
+        entries__5__write_clock = clock;
+        entries__6__read_clock = clock;
+        entries__6__write_clock = clock;
+        entries__7__read_clock = clock;
+        entries__7__write_clock = clock;
+        read_address = (((read_thread) & 6'h3f) << 32'h1) | ((read_which) & 6'h3f);
+        meta__read_address = read_address;
+        entries__0__read_address = read_address;
+        entries__1__read_address = read_address;
+        entries__2__read_address = read_address;
+        entries__3__read_address = read_address;
+        entries__4__read_address = read_address;
+        entries__5__read_address = read_address;
+        entries__6__read_address = read_address;
+        entries__7__read_address = read_address;
+        len = meta__read_data[(32'h0)+:(4)];
+        next_slot = meta__read_data[(32'h4)+:(3)];
+        found = 1'b0;
+        if ((entries__0__read_data == value) & (((len) & 8'hff) > c_index__0)) begin
+            found = 1'b1;
+        end
+        if ((entries__1__read_data == value) & (((len) & 8'hff) > c_index__1)) begin
+            found = 1'b1;
+        end
+        if ((entries__2__read_data == value) & (((len) & 8'hff) > c_index__2)) begin
+            found = 1'b1;
+        end
+        if ((entries__3__read_data == value) & (((len) & 8'hff) > c_index__3)) begin
+            found = 1'b1;
+        end
+        if ((entries__4__read_data == value) & (((len) & 8'hff) > c_index__4)) begin
+            found = 1'b1;
+        end
+        if ((entries__5__read_data == value) & (((len) & 8'hff) > c_index__5)) begin
+            found = 1'b1;
+        end
+        if ((entries__6__read_data == value) & (((len) & 8'hff) > c_index__6)) begin
+            found = 1'b1;
+        end
+        if ((entries__7__read_data == value) & (((len) & 8'hff) > c_index__7)) begin
+            found = 1'b1;
+        end
+        hit = found;
+        write_address = (((thread) & 6'h3f) << 32'h1) | ((which) & 6'h3f);
+        meta__write_address = write_address;
+        meta__write_enable = 1'b0;
+        meta__write_data = 32'h0;
+        entries__0__write_address = write_address;
+        entries__0__write_data = value;
+        entries__0__write_enable = 1'b0;
+        entries__1__write_address = write_address;
+        entries__1__write_data = value;
+        entries__1__write_enable = 1'b0;
+        entries__2__write_address = write_address;
+        entries__2__write_data = value;
+        entries__2__write_enable = 1'b0;
+        entries__3__write_address = write_address;
+        entries__3__write_data = value;
+        entries__3__write_enable = 1'b0;
+        entries__4__write_address = write_address;
+        entries__4__write_data = value;
+        entries__4__write_enable = 1'b0;
+        entries__5__write_address = write_address;
+        entries__5__write_data = value;
+        entries__5__write_enable = 1'b0;
+        entries__6__write_address = write_address;
+        entries__6__write_data = value;
+        entries__6__write_enable = 1'b0;
+        entries__7__write_address = write_address;
+        entries__7__write_data = value;
+        entries__7__write_enable = 1'b0;
+        if (clear) begin
+            meta__write_enable = 1'b1;
+        end
+        if (insert & (~found)) begin
+            meta__write_enable = 1'b1;
+            if (len == 32'h8) begin
+                meta__write_data = (((next_slot + 32'h1) & 8'hff) << 32'h4) | (c_index__7 + 32'h1);
+            end
+            else begin
+                meta__write_data = (((next_slot + 32'h1) & 8'hff) << 32'h4) | ((len + 32'h1) & 8'hff);
+            end
+            if (((next_slot) & 8'hff) == c_index__0) begin
+                entries__0__write_enable = 1'b1;
+            end
+            if (((next_slot) & 8'hff) == c_index__1) begin
+                entries__1__write_enable = 1'b1;
+            end
+            if (((next_slot) & 8'hff) == c_index__2) begin
+                entries__2__write_enable = 1'b1;
+            end
+            if (((next_slot) & 8'hff) == c_index__3) begin
+                entries__3__write_enable = 1'b1;
+            end
+            if (((next_slot) & 8'hff) == c_index__4) begin
+                entries__4__write_enable = 1'b1;
+            end
+            if (((next_slot) & 8'hff) == c_index__5) begin
+                entries__5__write_enable = 1'b1;
+            end
+            if (((next_slot) & 8'hff) == c_index__6) begin
+                entries__6__write_enable = 1'b1;
+            end
+            if (((next_slot) & 8'hff) == c_index__7) begin
+                entries__7__write_enable = 1'b1;
+            end
+        end
+    end
+    
+endmodule // dynrt_processor__engine__mailboxes
+
+
+module dynrt_processor__engine__mailboxes__entries__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [5:0] read_address;
+    input wire  read_clock;
+    output reg  [31:0] read_data;
+    input wire  [5:0] write_address;
+    input wire  write_clock;
+    input wire  [31:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[31:0] mem[63:0];
+    
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__mailboxes__entries__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__mailboxes__meta(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [5:0] read_address;
+    input wire  read_clock;
+    output reg  [7:0] read_data;
+    input wire  [5:0] write_address;
+    input wire  write_clock;
+    input wire  [7:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[7:0] mem[63:0];
+    
+    initial begin
+    mem[6'b0] = 8'h0;
+    mem[6'b1] = 8'h0;
+    mem[6'b10] = 8'h0;
+    mem[6'b11] = 8'h0;
+    mem[6'b100] = 8'h0;
+    mem[6'b101] = 8'h0;
+    mem[6'b110] = 8'h0;
+    mem[6'b111] = 8'h0;
+    mem[6'b1000] = 8'h0;
+    mem[6'b1001] = 8'h0;
+    mem[6'b1010] = 8'h0;
+    mem[6'b1011] = 8'h0;
+    mem[6'b1100] = 8'h0;
+    mem[6'b1101] = 8'h0;
+    mem[6'b1110] = 8'h0;
+    mem[6'b1111] = 8'h0;
+    mem[6'b10000] = 8'h0;
+    mem[6'b10001] = 8'h0;
+    mem[6'b10010] = 8'h0;
+    mem[6'b10011] = 8'h0;
+    mem[6'b10100] = 8'h0;
+    mem[6'b10101] = 8'h0;
+    mem[6'b10110] = 8'h0;
+    mem[6'b10111] = 8'h0;
+    mem[6'b11000] = 8'h0;
+    mem[6'b11001] = 8'h0;
+    mem[6'b11010] = 8'h0;
+    mem[6'b11011] = 8'h0;
+    mem[6'b11100] = 8'h0;
+    mem[6'b11101] = 8'h0;
+    mem[6'b11110] = 8'h0;
+    mem[6'b11111] = 8'h0;
+    mem[6'b100000] = 8'h0;
+    mem[6'b100001] = 8'h0;
+    mem[6'b100010] = 8'h0;
+    mem[6'b100011] = 8'h0;
+    mem[6'b100100] = 8'h0;
+    mem[6'b100101] = 8'h0;
+    mem[6'b100110] = 8'h0;
+    mem[6'b100111] = 8'h0;
+    mem[6'b101000] = 8'h0;
+    mem[6'b101001] = 8'h0;
+    mem[6'b101010] = 8'h0;
+    mem[6'b101011] = 8'h0;
+    mem[6'b101100] = 8'h0;
+    mem[6'b101101] = 8'h0;
+    mem[6'b101110] = 8'h0;
+    mem[6'b101111] = 8'h0;
+    mem[6'b110000] = 8'h0;
+    mem[6'b110001] = 8'h0;
+    mem[6'b110010] = 8'h0;
+    mem[6'b110011] = 8'h0;
+    mem[6'b110100] = 8'h0;
+    mem[6'b110101] = 8'h0;
+    mem[6'b110110] = 8'h0;
+    mem[6'b110111] = 8'h0;
+    mem[6'b111000] = 8'h0;
+    mem[6'b111001] = 8'h0;
+    mem[6'b111010] = 8'h0;
+    mem[6'b111011] = 8'h0;
+    mem[6'b111100] = 8'h0;
+    mem[6'b111101] = 8'h0;
+    mem[6'b111110] = 8'h0;
+    mem[6'b111111] = 8'h0;
+    end
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__mailboxes__meta
+
+
+
+
+module dynrt_processor__engine__mem_bank_r(d,q,clock);
+    
+    // Module arguments
+    input wire  [2:0] d;
+    output reg  [2:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 3'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__mem_bank_r
+
+
+
+
+module dynrt_processor__engine__pixels(clock,frame_start,take,word,exhausted);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  frame_start;
+    input wire  take;
+    output reg  [31:0] word;
+    output reg  exhausted;
+    
+    // Constant declarations
+    localparam  c_width = 16'h40;
+    localparam  c_height = 16'h30;
+    localparam  c_pixel_shift = 5'b110;
+    
+    // Stub signals
+    reg  [15:0] x__d;
+    wire  [15:0] x__q;
+    reg  x__clock;
+    reg  [15:0] y__d;
+    wire  [15:0] y__q;
+    reg  y__clock;
+    
+    // Local signals
+    reg  done;
+    
+    // Sub module instances
+    dynrt_processor__engine__fp_units__sqrt__rnd_man x(
+        .d(x__d),
+        .q(x__q),
+        .clock(x__clock)
+    );
+    dynrt_processor__engine__fp_units__sqrt__rnd_man y(
+        .d(y__d),
+        .q(y__q),
+        .clock(y__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        x__clock = clock;
+        y__clock = clock;
+        x__d = x__q;
+        y__d = y__q;
+        done = ~(y__q < c_height);
+        exhausted = done;
+        word = (((y__q) & 32'hffffffff) << c_pixel_shift) | ((x__q) & 32'hffffffff);
+        if (take & (~done)) begin
+            if ((x__q + 32'h1) == c_width) begin
+                x__d = 32'h0;
+                y__d = y__q + 32'h1;
+            end
+            else begin
+                x__d = x__q + 32'h1;
+            end
+        end
+        if (frame_start) begin
+            x__d = 32'h0;
+            y__d = 32'h0;
+        end
+    end
+    
+endmodule // dynrt_processor__engine__pixels
+
+
+
+
+
+
+module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,target,is_wait,kd_busy,tri_busy,jr_target,int_eq,int_lt,mb_hit,pix_done,fast,kind,scratch_data,mem_data,nodes_data,uv_data,t_data,wb_valid,wb_op,wb_dst,wb_thread,wb_invert,wb_next,wb_target,wb_wait,wb_kd_busy,wb_tri_busy,wb_jr_target,wb_int_eq,wb_int_lt,wb_mb_hit,wb_pix_done,wb_fast);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  valid;
+    input wire  [4:0] op;
+    input wire  [7:0] dst;
+    input wire  [4:0] thread;
+    input wire  invert;
+    input wire  [11:0] pc;
+    input wire  [11:0] target;
+    input wire  is_wait;
+    input wire  kd_busy;
+    input wire  tri_busy;
+    input wire  [11:0] jr_target;
+    input wire  int_eq;
+    input wire  int_lt;
+    input wire  mb_hit;
+    input wire  pix_done;
+    input wire  [31:0] fast;
+    input wire  [2:0] kind;
+    input wire  [31:0] scratch_data;
+    input wire  [31:0] mem_data;
+    input wire  [31:0] nodes_data;
+    input wire  [31:0] uv_data;
+    input wire  [31:0] t_data;
+    output reg  wb_valid;
+    output reg  [4:0] wb_op;
+    output reg  [7:0] wb_dst;
+    output reg  [4:0] wb_thread;
+    output reg  wb_invert;
+    output reg  [11:0] wb_next;
+    output reg  [11:0] wb_target;
+    output reg  wb_wait;
+    output reg  wb_kd_busy;
+    output reg  wb_tri_busy;
+    output reg  [11:0] wb_jr_target;
+    output reg  wb_int_eq;
+    output reg  wb_int_lt;
+    output reg  wb_mb_hit;
+    output reg  wb_pix_done;
+    output reg  [31:0] wb_fast;
+    
+    // Constant declarations
+    localparam  c_mem_latency = 8'h2;
+    localparam  c_index__0 = 8'h0;
+    localparam  c_index__1 = 8'h1;
+    localparam  c_index__2 = 8'h2;
+    localparam  c_index__3 = 8'h3;
+    localparam  c_index__4 = 8'h4;
+    localparam  c_index__5 = 8'h5;
+    localparam  c_index__6 = 8'h6;
+    localparam  c_index__7 = 8'h7;
+    localparam  op_fdiv = 5'b100;
+    localparam  op_fsqrt = 5'b101;
+    
+    // Enums
+    localparam FastKind__Computed = 0;
+    localparam FastKind__Scratch = 1;
+    localparam FastKind__Memory = 2;
+    localparam FastKind__TrianglesUv = 3;
+    localparam FastKind__TrianglesT = 4;
+    localparam FastKind__Nodes = 5;
+    
+    // Stub signals
+    reg  valid_line__clock;
+    reg  valid_line__data_in;
+    wire  valid_line__data_out;
+    reg  op_line__clock;
+    reg  [4:0] op_line__data_in;
+    wire  [4:0] op_line__data_out;
+    reg  dst_line__clock;
+    reg  [7:0] dst_line__data_in;
+    wire  [7:0] dst_line__data_out;
+    reg  thread_line__clock;
+    reg  [4:0] thread_line__data_in;
+    wire  [4:0] thread_line__data_out;
+    reg  invert_line__clock;
+    reg  invert_line__data_in;
+    wire  invert_line__data_out;
+    reg  next_line__clock;
+    reg  [11:0] next_line__data_in;
+    wire  [11:0] next_line__data_out;
+    reg  target_line__clock;
+    reg  [11:0] target_line__data_in;
+    wire  [11:0] target_line__data_out;
+    reg  wait_line__clock;
+    reg  wait_line__data_in;
+    wire  wait_line__data_out;
+    reg  kd_busy_line__clock;
+    reg  kd_busy_line__data_in;
+    wire  kd_busy_line__data_out;
+    reg  tri_busy_line__clock;
+    reg  tri_busy_line__data_in;
+    wire  tri_busy_line__data_out;
+    reg  jr_target_line__clock;
+    reg  [11:0] jr_target_line__data_in;
+    wire  [11:0] jr_target_line__data_out;
+    reg  int_eq_line__clock;
+    reg  int_eq_line__data_in;
+    wire  int_eq_line__data_out;
+    reg  int_lt_line__clock;
+    reg  int_lt_line__data_in;
+    wire  int_lt_line__data_out;
+    reg  mb_hit_line__clock;
+    reg  mb_hit_line__data_in;
+    wire  mb_hit_line__data_out;
+    reg  pix_done_line__clock;
+    reg  pix_done_line__data_in;
+    wire  pix_done_line__data_out;
+    reg  [31:0] fast_line__0__d;
+    wire  [31:0] fast_line__0__q;
+    reg  fast_line__0__clock;
+    reg  [31:0] fast_line__1__d;
+    wire  [31:0] fast_line__1__q;
+    reg  fast_line__1__clock;
+    reg  [31:0] fast_line__2__d;
+    wire  [31:0] fast_line__2__q;
+    reg  fast_line__2__clock;
+    reg  [31:0] fast_line__3__d;
+    wire  [31:0] fast_line__3__q;
+    reg  fast_line__3__clock;
+    reg  [31:0] fast_line__4__d;
+    wire  [31:0] fast_line__4__q;
+    reg  fast_line__4__clock;
+    reg  [31:0] fast_line__5__d;
+    wire  [31:0] fast_line__5__q;
+    reg  fast_line__5__clock;
+    reg  [31:0] fast_line__6__d;
+    wire  [31:0] fast_line__6__q;
+    reg  fast_line__6__clock;
+    reg  [31:0] fast_line__7__d;
+    wire  [31:0] fast_line__7__q;
+    reg  fast_line__7__clock;
+    reg  [2:0] kind_line__0__d;
+    wire  [2:0] kind_line__0__q;
+    reg  kind_line__0__clock;
+    reg  [2:0] kind_line__1__d;
+    wire  [2:0] kind_line__1__q;
+    reg  kind_line__1__clock;
+    reg  [2:0] kind_line__2__d;
+    wire  [2:0] kind_line__2__q;
+    reg  kind_line__2__clock;
+    reg  [2:0] kind_line__3__d;
+    wire  [2:0] kind_line__3__q;
+    reg  kind_line__3__clock;
+    reg  [2:0] kind_line__4__d;
+    wire  [2:0] kind_line__4__q;
+    reg  kind_line__4__clock;
+    reg  [2:0] kind_line__5__d;
+    wire  [2:0] kind_line__5__q;
+    reg  kind_line__5__clock;
+    reg  [2:0] kind_line__6__d;
+    wire  [2:0] kind_line__6__q;
+    reg  kind_line__6__clock;
+    reg  [2:0] kind_line__7__d;
+    wire  [2:0] kind_line__7__q;
+    reg  kind_line__7__clock;
+    reg  fast_tail__clock;
+    reg  [31:0] fast_tail__data_in;
+    wire  [31:0] fast_tail__data_out;
+    reg  long_valid__clock;
+    reg  long_valid__data_in;
+    wire  long_valid__data_out;
+    reg  long_op__clock;
+    reg  [4:0] long_op__data_in;
+    wire  [4:0] long_op__data_out;
+    reg  long_dst__clock;
+    reg  [7:0] long_dst__data_in;
+    wire  [7:0] long_dst__data_out;
+    reg  long_thread__clock;
+    reg  [4:0] long_thread__data_in;
+    wire  [4:0] long_thread__data_out;
+    reg  long_invert__clock;
+    reg  long_invert__data_in;
+    wire  long_invert__data_out;
+    reg  long_next__clock;
+    reg  [11:0] long_next__data_in;
+    wire  [11:0] long_next__data_out;
+    reg  long_target__clock;
+    reg  [11:0] long_target__data_in;
+    wire  [11:0] long_target__data_out;
+    
+    // Local signals
+    reg  is_long;
+    
+    // Sub module instances
+    dynrt_processor__engine__result_line__int_eq_line valid_line(
+        .clock(valid_line__clock),
+        .data_in(valid_line__data_in),
+        .data_out(valid_line__data_out)
+    );
+    dynrt_processor__engine__result_line__long_op op_line(
+        .clock(op_line__clock),
+        .data_in(op_line__data_in),
+        .data_out(op_line__data_out)
+    );
+    dynrt_processor__engine__result_line__dst_line dst_line(
+        .clock(dst_line__clock),
+        .data_in(dst_line__data_in),
+        .data_out(dst_line__data_out)
+    );
+    dynrt_processor__engine__result_line__long_op thread_line(
+        .clock(thread_line__clock),
+        .data_in(thread_line__data_in),
+        .data_out(thread_line__data_out)
+    );
+    dynrt_processor__engine__result_line__int_eq_line invert_line(
+        .clock(invert_line__clock),
+        .data_in(invert_line__data_in),
+        .data_out(invert_line__data_out)
+    );
+    dynrt_processor__engine__result_line__jr_target_line next_line(
+        .clock(next_line__clock),
+        .data_in(next_line__data_in),
+        .data_out(next_line__data_out)
+    );
+    dynrt_processor__engine__result_line__jr_target_line target_line(
+        .clock(target_line__clock),
+        .data_in(target_line__data_in),
+        .data_out(target_line__data_out)
+    );
+    dynrt_processor__engine__result_line__int_eq_line wait_line(
+        .clock(wait_line__clock),
+        .data_in(wait_line__data_in),
+        .data_out(wait_line__data_out)
+    );
+    dynrt_processor__engine__result_line__int_eq_line kd_busy_line(
+        .clock(kd_busy_line__clock),
+        .data_in(kd_busy_line__data_in),
+        .data_out(kd_busy_line__data_out)
+    );
+    dynrt_processor__engine__result_line__int_eq_line tri_busy_line(
+        .clock(tri_busy_line__clock),
+        .data_in(tri_busy_line__data_in),
+        .data_out(tri_busy_line__data_out)
+    );
+    dynrt_processor__engine__result_line__jr_target_line jr_target_line(
+        .clock(jr_target_line__clock),
+        .data_in(jr_target_line__data_in),
+        .data_out(jr_target_line__data_out)
+    );
+    dynrt_processor__engine__result_line__int_eq_line int_eq_line(
+        .clock(int_eq_line__clock),
+        .data_in(int_eq_line__data_in),
+        .data_out(int_eq_line__data_out)
+    );
+    dynrt_processor__engine__result_line__int_eq_line int_lt_line(
+        .clock(int_lt_line__clock),
+        .data_in(int_lt_line__data_in),
+        .data_out(int_lt_line__data_out)
+    );
+    dynrt_processor__engine__result_line__int_eq_line mb_hit_line(
+        .clock(mb_hit_line__clock),
+        .data_in(mb_hit_line__data_in),
+        .data_out(mb_hit_line__data_out)
+    );
+    dynrt_processor__engine__result_line__int_eq_line pix_done_line(
+        .clock(pix_done_line__clock),
+        .data_in(pix_done_line__data_in),
+        .data_out(pix_done_line__data_out)
+    );
+    dynrt_processor__engine__cycle_count fast_line__0(
+        .d(fast_line__0__d),
+        .q(fast_line__0__q),
+        .clock(fast_line__0__clock)
+    );
+    dynrt_processor__engine__cycle_count fast_line__1(
+        .d(fast_line__1__d),
+        .q(fast_line__1__q),
+        .clock(fast_line__1__clock)
+    );
+    dynrt_processor__engine__cycle_count fast_line__2(
+        .d(fast_line__2__d),
+        .q(fast_line__2__q),
+        .clock(fast_line__2__clock)
+    );
+    dynrt_processor__engine__cycle_count fast_line__3(
+        .d(fast_line__3__d),
+        .q(fast_line__3__q),
+        .clock(fast_line__3__clock)
+    );
+    dynrt_processor__engine__cycle_count fast_line__4(
+        .d(fast_line__4__d),
+        .q(fast_line__4__q),
+        .clock(fast_line__4__clock)
+    );
+    dynrt_processor__engine__cycle_count fast_line__5(
+        .d(fast_line__5__d),
+        .q(fast_line__5__q),
+        .clock(fast_line__5__clock)
+    );
+    dynrt_processor__engine__cycle_count fast_line__6(
+        .d(fast_line__6__d),
+        .q(fast_line__6__q),
+        .clock(fast_line__6__clock)
+    );
+    dynrt_processor__engine__cycle_count fast_line__7(
+        .d(fast_line__7__d),
+        .q(fast_line__7__q),
+        .clock(fast_line__7__clock)
+    );
+    dynrt_processor__engine__result_line__kind_line__0 kind_line__0(
+        .d(kind_line__0__d),
+        .q(kind_line__0__q),
+        .clock(kind_line__0__clock)
+    );
+    dynrt_processor__engine__result_line__kind_line__0 kind_line__1(
+        .d(kind_line__1__d),
+        .q(kind_line__1__q),
+        .clock(kind_line__1__clock)
+    );
+    dynrt_processor__engine__result_line__kind_line__0 kind_line__2(
+        .d(kind_line__2__d),
+        .q(kind_line__2__q),
+        .clock(kind_line__2__clock)
+    );
+    dynrt_processor__engine__result_line__kind_line__0 kind_line__3(
+        .d(kind_line__3__d),
+        .q(kind_line__3__q),
+        .clock(kind_line__3__clock)
+    );
+    dynrt_processor__engine__result_line__kind_line__0 kind_line__4(
+        .d(kind_line__4__d),
+        .q(kind_line__4__q),
+        .clock(kind_line__4__clock)
+    );
+    dynrt_processor__engine__result_line__kind_line__0 kind_line__5(
+        .d(kind_line__5__d),
+        .q(kind_line__5__q),
+        .clock(kind_line__5__clock)
+    );
+    dynrt_processor__engine__result_line__kind_line__0 kind_line__6(
+        .d(kind_line__6__d),
+        .q(kind_line__6__q),
+        .clock(kind_line__6__clock)
+    );
+    dynrt_processor__engine__result_line__kind_line__0 kind_line__7(
+        .d(kind_line__7__d),
+        .q(kind_line__7__q),
+        .clock(kind_line__7__clock)
+    );
+    dynrt_processor__engine__result_line__fast_tail fast_tail(
+        .clock(fast_tail__clock),
+        .data_in(fast_tail__data_in),
+        .data_out(fast_tail__data_out)
+    );
+    dynrt_processor__engine__result_line__int_eq_line long_valid(
+        .clock(long_valid__clock),
+        .data_in(long_valid__data_in),
+        .data_out(long_valid__data_out)
+    );
+    dynrt_processor__engine__result_line__long_op long_op(
+        .clock(long_op__clock),
+        .data_in(long_op__data_in),
+        .data_out(long_op__data_out)
+    );
+    dynrt_processor__engine__result_line__dst_line long_dst(
+        .clock(long_dst__clock),
+        .data_in(long_dst__data_in),
+        .data_out(long_dst__data_out)
+    );
+    dynrt_processor__engine__result_line__long_op long_thread(
+        .clock(long_thread__clock),
+        .data_in(long_thread__data_in),
+        .data_out(long_thread__data_out)
+    );
+    dynrt_processor__engine__result_line__int_eq_line long_invert(
+        .clock(long_invert__clock),
+        .data_in(long_invert__data_in),
+        .data_out(long_invert__data_out)
+    );
+    dynrt_processor__engine__result_line__jr_target_line long_next(
+        .clock(long_next__clock),
+        .data_in(long_next__data_in),
+        .data_out(long_next__data_out)
+    );
+    dynrt_processor__engine__result_line__jr_target_line long_target(
+        .clock(long_target__clock),
+        .data_in(long_target__data_in),
+        .data_out(long_target__data_out)
+    );
+    
+    // Update code
+    always @(*) begin
+        valid_line__clock = clock;
+        op_line__clock = clock;
+        dst_line__clock = clock;
+        thread_line__clock = clock;
+        invert_line__clock = clock;
+        next_line__clock = clock;
+        target_line__clock = clock;
+        wait_line__clock = clock;
+        kd_busy_line__clock = clock;
+        tri_busy_line__clock = clock;
+        jr_target_line__clock = clock;
+        int_eq_line__clock = clock;
+        int_lt_line__clock = clock;
+        mb_hit_line__clock = clock;
+        pix_done_line__clock = clock;
+        fast_tail__clock = clock;
+        long_valid__clock = clock;
+        long_op__clock = clock;
+        long_dst__clock = clock;
+        long_thread__clock = clock;
+        long_invert__clock = clock;
+        long_next__clock = clock;
+        long_target__clock = clock;
+        fast_line__0__clock = clock;
+        kind_line__0__clock = clock;
+        fast_line__1__clock = clock;
+        kind_line__1__clock = clock;
+        fast_line__2__clock = clock;
+        kind_line__2__clock = clock;
+        fast_line__3__clock = clock;
+        kind_line__3__clock = clock;
+        fast_line__4__clock = clock;
+        kind_line__4__clock = clock;
+        fast_line__5__clock = clock;
+        kind_line__5__clock = clock;
+        fast_line__6__clock = clock;
+        kind_line__6__clock = clock;
+        fast_line__7__clock = clock;
+        kind_line__7__clock = clock;
+        valid_line__data_in = valid;
+        op_line__data_in = op;
+        dst_line__data_in = dst;
+        thread_line__data_in = thread;
+        invert_line__data_in = invert;
+        next_line__data_in = pc + 32'h1;
+        target_line__data_in = target;
+        wait_line__data_in = is_wait;
+        kd_busy_line__data_in = kd_busy;
+        tri_busy_line__data_in = tri_busy;
+        jr_target_line__data_in = jr_target;
+        int_eq_line__data_in = int_eq;
+        int_lt_line__data_in = int_lt;
+        mb_hit_line__data_in = mb_hit;
+        pix_done_line__data_in = pix_done;
+        fast_line__0__d = fast;
+        kind_line__0__d = kind;
+        fast_line__1__d = fast_line__0__q;
+        kind_line__1__d = kind_line__0__q;
+        fast_line__2__d = fast_line__1__q;
+        kind_line__2__d = kind_line__1__q;
+        fast_line__3__d = fast_line__2__q;
+        kind_line__3__d = kind_line__2__q;
+        fast_line__4__d = fast_line__3__q;
+        kind_line__4__d = kind_line__3__q;
+        fast_line__5__d = fast_line__4__q;
+        kind_line__5__d = kind_line__4__q;
+        fast_line__6__d = fast_line__5__q;
+        kind_line__6__d = kind_line__5__q;
+        fast_line__7__d = fast_line__6__q;
+        kind_line__7__d = kind_line__6__q;
+        if (kind_line__0__q == FastKind__Scratch) begin
+            fast_line__1__d = scratch_data;
+        end
+        if (c_mem_latency == c_index__1) begin
+            if (kind_line__1__q == FastKind__Memory) begin
+                fast_line__2__d = mem_data;
+            end
+            if (kind_line__1__q == FastKind__TrianglesUv) begin
+                fast_line__2__d = uv_data;
+            end
+            if (kind_line__1__q == FastKind__TrianglesT) begin
+                fast_line__2__d = t_data;
+            end
+            if (kind_line__1__q == FastKind__Nodes) begin
+                fast_line__2__d = nodes_data;
+            end
+        end
+        if (c_mem_latency == c_index__2) begin
+            if (kind_line__2__q == FastKind__Memory) begin
+                fast_line__3__d = mem_data;
+            end
+            if (kind_line__2__q == FastKind__TrianglesUv) begin
+                fast_line__3__d = uv_data;
+            end
+            if (kind_line__2__q == FastKind__TrianglesT) begin
+                fast_line__3__d = t_data;
+            end
+            if (kind_line__2__q == FastKind__Nodes) begin
+                fast_line__3__d = nodes_data;
+            end
+        end
+        if (c_mem_latency == c_index__3) begin
+            if (kind_line__3__q == FastKind__Memory) begin
+                fast_line__4__d = mem_data;
+            end
+            if (kind_line__3__q == FastKind__TrianglesUv) begin
+                fast_line__4__d = uv_data;
+            end
+            if (kind_line__3__q == FastKind__TrianglesT) begin
+                fast_line__4__d = t_data;
+            end
+            if (kind_line__3__q == FastKind__Nodes) begin
+                fast_line__4__d = nodes_data;
+            end
+        end
+        if (c_mem_latency == c_index__4) begin
+            if (kind_line__4__q == FastKind__Memory) begin
+                fast_line__5__d = mem_data;
+            end
+            if (kind_line__4__q == FastKind__TrianglesUv) begin
+                fast_line__5__d = uv_data;
+            end
+            if (kind_line__4__q == FastKind__TrianglesT) begin
+                fast_line__5__d = t_data;
+            end
+            if (kind_line__4__q == FastKind__Nodes) begin
+                fast_line__5__d = nodes_data;
+            end
+        end
+        if (c_mem_latency == c_index__5) begin
+            if (kind_line__5__q == FastKind__Memory) begin
+                fast_line__6__d = mem_data;
+            end
+            if (kind_line__5__q == FastKind__TrianglesUv) begin
+                fast_line__6__d = uv_data;
+            end
+            if (kind_line__5__q == FastKind__TrianglesT) begin
+                fast_line__6__d = t_data;
+            end
+            if (kind_line__5__q == FastKind__Nodes) begin
+                fast_line__6__d = nodes_data;
+            end
+        end
+        if (c_mem_latency == c_index__6) begin
+            if (kind_line__6__q == FastKind__Memory) begin
+                fast_line__7__d = mem_data;
+            end
+            if (kind_line__6__q == FastKind__TrianglesUv) begin
+                fast_line__7__d = uv_data;
+            end
+            if (kind_line__6__q == FastKind__TrianglesT) begin
+                fast_line__7__d = t_data;
+            end
+            if (kind_line__6__q == FastKind__Nodes) begin
+                fast_line__7__d = nodes_data;
+            end
+        end
+        fast_tail__data_in = fast_line__7__q;
+        is_long = (op_line__data_out == op_fdiv) | (op_line__data_out == op_fsqrt);
+        long_valid__data_in = valid_line__data_out & is_long;
+        long_op__data_in = op_line__data_out;
+        long_dst__data_in = dst_line__data_out;
+        long_thread__data_in = thread_line__data_out;
+        long_invert__data_in = invert_line__data_out;
+        long_next__data_in = next_line__data_out;
+        long_target__data_in = target_line__data_out;
+        if (long_valid__data_out) begin
+            wb_valid = 1'b1;
+            wb_op = long_op__data_out;
+            wb_dst = long_dst__data_out;
+            wb_thread = long_thread__data_out;
+            wb_invert = long_invert__data_out;
+            wb_next = long_next__data_out;
+            wb_target = long_target__data_out;
+        end
+        else begin
+            wb_valid = valid_line__data_out & (~is_long);
+            wb_op = op_line__data_out;
+            wb_dst = dst_line__data_out;
+            wb_thread = thread_line__data_out;
+            wb_invert = invert_line__data_out;
+            wb_next = next_line__data_out;
+            wb_target = target_line__data_out;
+        end
+        wb_wait = wait_line__data_out;
+        wb_kd_busy = kd_busy_line__data_out;
+        wb_tri_busy = tri_busy_line__data_out;
+        wb_jr_target = jr_target_line__data_out;
+        wb_int_eq = int_eq_line__data_out;
+        wb_int_lt = int_lt_line__data_out;
+        wb_mb_hit = mb_hit_line__data_out;
+        wb_pix_done = pix_done_line__data_out;
+        wb_fast = fast_tail__data_out;
+    end
+    
+endmodule // dynrt_processor__engine__result_line
+
+
+module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [7:0] data_in;
+    output reg  [7:0] data_out;
+    
+    // Stub signals
+    reg  [7:0] stage__0__d;
+    wire  [7:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [7:0] stage__1__d;
+    wire  [7:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [7:0] stage__2__d;
+    wire  [7:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [7:0] stage__3__d;
+    wire  [7:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [7:0] stage__4__d;
+    wire  [7:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [7:0] stage__5__d;
+    wire  [7:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [7:0] stage__6__d;
+    wire  [7:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [7:0] stage__7__d;
+    wire  [7:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [7:0] stage__8__d;
+    wire  [7:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [7:0] stage__9__d;
+    wire  [7:0] stage__9__q;
+    reg  stage__9__clock;
+    reg  [7:0] stage__10__d;
+    wire  [7:0] stage__10__q;
+    reg  stage__10__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__halted_count stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__halted_count stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__halted_count stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__engine__halted_count stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__engine__halted_count stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__engine__halted_count stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__engine__halted_count stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__engine__halted_count stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__engine__halted_count stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__engine__halted_count stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__engine__halted_count stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__dst_line
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__result_line__fast_tail(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] data_in;
+    output reg  [31:0] data_out;
+    
+    // Stub signals
+    reg  [31:0] stage__0__d;
+    wire  [31:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [31:0] stage__1__d;
+    wire  [31:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [31:0] stage__2__d;
+    wire  [31:0] stage__2__q;
+    reg  stage__2__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__cycle_count stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__fast_tail
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  data_in;
+    output reg  data_out;
+    
+    // Stub signals
+    reg  stage__0__d;
+    wire  stage__0__q;
+    reg  stage__0__clock;
+    reg  stage__1__d;
+    wire  stage__1__q;
+    reg  stage__1__clock;
+    reg  stage__2__d;
+    wire  stage__2__q;
+    reg  stage__2__clock;
+    reg  stage__3__d;
+    wire  stage__3__q;
+    reg  stage__3__clock;
+    reg  stage__4__d;
+    wire  stage__4__q;
+    reg  stage__4__clock;
+    reg  stage__5__d;
+    wire  stage__5__q;
+    reg  stage__5__clock;
+    reg  stage__6__d;
+    wire  stage__6__q;
+    reg  stage__6__clock;
+    reg  stage__7__d;
+    wire  stage__7__q;
+    reg  stage__7__clock;
+    reg  stage__8__d;
+    wire  stage__8__q;
+    reg  stage__8__clock;
+    reg  stage__9__d;
+    wire  stage__9__q;
+    reg  stage__9__clock;
+    reg  stage__10__d;
+    wire  stage__10__q;
+    reg  stage__10__clock;
+    
+    // Sub module instances
+    dynrt_processor__display__dark_d stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__display__dark_d stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__display__dark_d stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__display__dark_d stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__display__dark_d stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__display__dark_d stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__display__dark_d stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__display__dark_d stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__display__dark_d stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__display__dark_d stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__display__dark_d stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__int_eq_line
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__result_line__jr_target_line(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [11:0] data_in;
+    output reg  [11:0] data_out;
+    
+    // Stub signals
+    reg  [11:0] stage__0__d;
+    wire  [11:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [11:0] stage__1__d;
+    wire  [11:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [11:0] stage__2__d;
+    wire  [11:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [11:0] stage__3__d;
+    wire  [11:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [11:0] stage__4__d;
+    wire  [11:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [11:0] stage__5__d;
+    wire  [11:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [11:0] stage__6__d;
+    wire  [11:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [11:0] stage__7__d;
+    wire  [11:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [11:0] stage__8__d;
+    wire  [11:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [11:0] stage__9__d;
+    wire  [11:0] stage__9__q;
+    reg  stage__9__clock;
+    reg  [11:0] stage__10__d;
+    wire  [11:0] stage__10__q;
+    reg  stage__10__clock;
+    
+    // Sub module instances
+    dynrt_processor__display__timing__col stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__display__timing__col stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__display__timing__col stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__display__timing__col stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__display__timing__col stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__display__timing__col stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__display__timing__col stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__display__timing__col stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__display__timing__col stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__display__timing__col stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__display__timing__col stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__jr_target_line
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__result_line__kind_line__0(d,q,clock);
+    
+    // Module arguments
+    input wire  [2:0] d;
+    output reg  [2:0] q;
+    input wire  clock;
+    
+    // Enums
+    localparam FastKind__Computed = 0;
+    localparam FastKind__Scratch = 1;
+    localparam FastKind__Memory = 2;
+    localparam FastKind__TrianglesUv = 3;
+    localparam FastKind__TrianglesT = 4;
+    localparam FastKind__Nodes = 5;
+    
+    // Update code (custom)
+    initial begin
+       q = 64'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__result_line__kind_line__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__result_line__long_op(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [4:0] data_in;
+    output reg  [4:0] data_out;
+    
+    // Stub signals
+    reg  [4:0] stage__0__d;
+    wire  [4:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [4:0] stage__1__d;
+    wire  [4:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [4:0] stage__2__d;
+    wire  [4:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [4:0] stage__3__d;
+    wire  [4:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [4:0] stage__4__d;
+    wire  [4:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [4:0] stage__5__d;
+    wire  [4:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [4:0] stage__6__d;
+    wire  [4:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [4:0] stage__7__d;
+    wire  [4:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [4:0] stage__8__d;
+    wire  [4:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [4:0] stage__9__d;
+    wire  [4:0] stage__9__q;
+    reg  stage__9__clock;
+    reg  [4:0] stage__10__d;
+    wire  [4:0] stage__10__q;
+    reg  stage__10__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__decode__t3 stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__long_op
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,wb_valid,wb_thread,wb_halt,wb_wait_pending,tester_done,tester_done_thread,walk_done,walk_done_thread,issue,pick);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  running;
+    input wire  frame_start;
+    input wire  long_at_i3;
+    input wire  wb_valid;
+    input wire  [4:0] wb_thread;
+    input wire  wb_halt;
+    input wire  wb_wait_pending;
+    input wire  tester_done;
+    input wire  [4:0] tester_done_thread;
+    input wire  walk_done;
+    input wire  [4:0] walk_done_thread;
+    output reg  issue;
+    output reg  [4:0] pick;
+    
+    // Constant declarations
+    localparam  c_thread_mask = 32'hffffffff;
+    localparam  c_one = 32'h1;
+    localparam  c_ones = 32'hffffffff;
+    localparam  c_thread_ids__0 = 5'b0;
+    localparam  c_thread_ids__1 = 5'b1;
+    localparam  c_thread_ids__2 = 5'b10;
+    localparam  c_thread_ids__3 = 5'b11;
+    localparam  c_thread_ids__4 = 5'b100;
+    localparam  c_thread_ids__5 = 5'b101;
+    localparam  c_thread_ids__6 = 5'b110;
+    localparam  c_thread_ids__7 = 5'b111;
+    localparam  c_thread_ids__8 = 5'b1000;
+    localparam  c_thread_ids__9 = 5'b1001;
+    localparam  c_thread_ids__10 = 5'b1010;
+    localparam  c_thread_ids__11 = 5'b1011;
+    localparam  c_thread_ids__12 = 5'b1100;
+    localparam  c_thread_ids__13 = 5'b1101;
+    localparam  c_thread_ids__14 = 5'b1110;
+    localparam  c_thread_ids__15 = 5'b1111;
+    localparam  c_thread_ids__16 = 5'b10000;
+    localparam  c_thread_ids__17 = 5'b10001;
+    localparam  c_thread_ids__18 = 5'b10010;
+    localparam  c_thread_ids__19 = 5'b10011;
+    localparam  c_thread_ids__20 = 5'b10100;
+    localparam  c_thread_ids__21 = 5'b10101;
+    localparam  c_thread_ids__22 = 5'b10110;
+    localparam  c_thread_ids__23 = 5'b10111;
+    localparam  c_thread_ids__24 = 5'b11000;
+    localparam  c_thread_ids__25 = 5'b11001;
+    localparam  c_thread_ids__26 = 5'b11010;
+    localparam  c_thread_ids__27 = 5'b11011;
+    localparam  c_thread_ids__28 = 5'b11100;
+    localparam  c_thread_ids__29 = 5'b11101;
+    localparam  c_thread_ids__30 = 5'b11110;
+    localparam  c_thread_ids__31 = 5'b11111;
+    localparam  c_reserve_bit = 32'h7;
+    
+    // Stub signals
+    reg  [31:0] ready__d;
+    wire  [31:0] ready__q;
+    reg  ready__clock;
+    reg  [31:0] asleep__d;
+    wire  [31:0] asleep__q;
+    reg  asleep__clock;
+    reg  [31:0] woken__d;
+    wire  [31:0] woken__q;
+    reg  woken__clock;
+    reg  [4:0] last_pick__d;
+    wire  [4:0] last_pick__q;
+    reg  last_pick__clock;
+    reg  [31:0] reserved__d;
+    wire  [31:0] reserved__q;
+    reg  reserved__clock;
+    
+    // Local signals
+    reg  [31:0] below;
+    reg  [4:0] choice;
+    reg  issues;
+    reg  [31:0] issue_mask;
+    reg  [31:0] wb_mask;
+    reg  [31:0] tester_event;
+    reg  [31:0] walk_event;
+    reg  [31:0] event_mask;
+    reg  wb_sleep;
+    reg  [31:0] wake_mask;
+    reg  [31:0] sleep_mask;
+    
+    // Sub module instances
+    dynrt_processor__engine__cycle_count ready(
+        .d(ready__d),
+        .q(ready__q),
+        .clock(ready__clock)
+    );
+    dynrt_processor__engine__cycle_count asleep(
+        .d(asleep__d),
+        .q(asleep__q),
+        .clock(asleep__clock)
+    );
+    dynrt_processor__engine__cycle_count woken(
+        .d(woken__d),
+        .q(woken__q),
+        .clock(woken__clock)
+    );
+    dynrt_processor__engine__decode__t3 last_pick(
+        .d(last_pick__d),
+        .q(last_pick__q),
+        .clock(last_pick__clock)
+    );
+    dynrt_processor__engine__cycle_count reserved(
+        .d(reserved__d),
+        .q(reserved__q),
+        .clock(reserved__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        ready__clock = clock;
+        asleep__clock = clock;
+        woken__clock = clock;
+        last_pick__clock = clock;
+        reserved__clock = clock;
+        ready__d = ready__q;
+        asleep__d = asleep__q;
+        woken__d = woken__q;
+        last_pick__d = last_pick__q;
+        reserved__d = reserved__q;
+        below = ready__q & (~(c_ones << last_pick__q));
+        choice = 32'h0;
+        if (ready__q[0]) begin
+            choice = c_thread_ids__0;
+        end
+        if (ready__q[1]) begin
+            choice = c_thread_ids__1;
+        end
+        if (ready__q[2]) begin
+            choice = c_thread_ids__2;
+        end
+        if (ready__q[3]) begin
+            choice = c_thread_ids__3;
+        end
+        if (ready__q[4]) begin
+            choice = c_thread_ids__4;
+        end
+        if (ready__q[5]) begin
+            choice = c_thread_ids__5;
+        end
+        if (ready__q[6]) begin
+            choice = c_thread_ids__6;
+        end
+        if (ready__q[7]) begin
+            choice = c_thread_ids__7;
+        end
+        if (ready__q[8]) begin
+            choice = c_thread_ids__8;
+        end
+        if (ready__q[9]) begin
+            choice = c_thread_ids__9;
+        end
+        if (ready__q[10]) begin
+            choice = c_thread_ids__10;
+        end
+        if (ready__q[11]) begin
+            choice = c_thread_ids__11;
+        end
+        if (ready__q[12]) begin
+            choice = c_thread_ids__12;
+        end
+        if (ready__q[13]) begin
+            choice = c_thread_ids__13;
+        end
+        if (ready__q[14]) begin
+            choice = c_thread_ids__14;
+        end
+        if (ready__q[15]) begin
+            choice = c_thread_ids__15;
+        end
+        if (ready__q[16]) begin
+            choice = c_thread_ids__16;
+        end
+        if (ready__q[17]) begin
+            choice = c_thread_ids__17;
+        end
+        if (ready__q[18]) begin
+            choice = c_thread_ids__18;
+        end
+        if (ready__q[19]) begin
+            choice = c_thread_ids__19;
+        end
+        if (ready__q[20]) begin
+            choice = c_thread_ids__20;
+        end
+        if (ready__q[21]) begin
+            choice = c_thread_ids__21;
+        end
+        if (ready__q[22]) begin
+            choice = c_thread_ids__22;
+        end
+        if (ready__q[23]) begin
+            choice = c_thread_ids__23;
+        end
+        if (ready__q[24]) begin
+            choice = c_thread_ids__24;
+        end
+        if (ready__q[25]) begin
+            choice = c_thread_ids__25;
+        end
+        if (ready__q[26]) begin
+            choice = c_thread_ids__26;
+        end
+        if (ready__q[27]) begin
+            choice = c_thread_ids__27;
+        end
+        if (ready__q[28]) begin
+            choice = c_thread_ids__28;
+        end
+        if (ready__q[29]) begin
+            choice = c_thread_ids__29;
+        end
+        if (ready__q[30]) begin
+            choice = c_thread_ids__30;
+        end
+        if (ready__q[31]) begin
+            choice = c_thread_ids__31;
+        end
+        if (below[0]) begin
+            choice = c_thread_ids__0;
+        end
+        if (below[1]) begin
+            choice = c_thread_ids__1;
+        end
+        if (below[2]) begin
+            choice = c_thread_ids__2;
+        end
+        if (below[3]) begin
+            choice = c_thread_ids__3;
+        end
+        if (below[4]) begin
+            choice = c_thread_ids__4;
+        end
+        if (below[5]) begin
+            choice = c_thread_ids__5;
+        end
+        if (below[6]) begin
+            choice = c_thread_ids__6;
+        end
+        if (below[7]) begin
+            choice = c_thread_ids__7;
+        end
+        if (below[8]) begin
+            choice = c_thread_ids__8;
+        end
+        if (below[9]) begin
+            choice = c_thread_ids__9;
+        end
+        if (below[10]) begin
+            choice = c_thread_ids__10;
+        end
+        if (below[11]) begin
+            choice = c_thread_ids__11;
+        end
+        if (below[12]) begin
+            choice = c_thread_ids__12;
+        end
+        if (below[13]) begin
+            choice = c_thread_ids__13;
+        end
+        if (below[14]) begin
+            choice = c_thread_ids__14;
+        end
+        if (below[15]) begin
+            choice = c_thread_ids__15;
+        end
+        if (below[16]) begin
+            choice = c_thread_ids__16;
+        end
+        if (below[17]) begin
+            choice = c_thread_ids__17;
+        end
+        if (below[18]) begin
+            choice = c_thread_ids__18;
+        end
+        if (below[19]) begin
+            choice = c_thread_ids__19;
+        end
+        if (below[20]) begin
+            choice = c_thread_ids__20;
+        end
+        if (below[21]) begin
+            choice = c_thread_ids__21;
+        end
+        if (below[22]) begin
+            choice = c_thread_ids__22;
+        end
+        if (below[23]) begin
+            choice = c_thread_ids__23;
+        end
+        if (below[24]) begin
+            choice = c_thread_ids__24;
+        end
+        if (below[25]) begin
+            choice = c_thread_ids__25;
+        end
+        if (below[26]) begin
+            choice = c_thread_ids__26;
+        end
+        if (below[27]) begin
+            choice = c_thread_ids__27;
+        end
+        if (below[28]) begin
+            choice = c_thread_ids__28;
+        end
+        if (below[29]) begin
+            choice = c_thread_ids__29;
+        end
+        if (below[30]) begin
+            choice = c_thread_ids__30;
+        end
+        if (below[31]) begin
+            choice = c_thread_ids__31;
+        end
+        issues = running & (ready__q != 32'h0) & (~reserved__q[32'h0]);
+        pick = choice;
+        issue = issues;
+        issue_mask = 32'h0;
+        if (issues) begin
+            issue_mask = c_one << choice;
+            last_pick__d = choice;
+        end
+        reserved__d = (reserved__q >> 32'h1) | (((long_at_i3) & 32'hffffffff) << c_reserve_bit);
+        wb_mask = c_one << wb_thread;
+        tester_event = 32'h0;
+        if (tester_done) begin
+            tester_event = c_one << tester_done_thread;
+        end
+        walk_event = 32'h0;
+        if (walk_done) begin
+            walk_event = c_one << walk_done_thread;
+        end
+        event_mask = tester_event | walk_event;
+        wb_sleep = wb_valid & wb_wait_pending & (((woken__q | event_mask) & wb_mask) == 32'h0);
+        wake_mask = 32'h0;
+        sleep_mask = 32'h0;
+        if (wb_valid & (~wb_halt)) begin
+            if (wb_sleep) begin
+                sleep_mask = wb_mask;
+            end
+            else begin
+                wake_mask = wb_mask;
+            end
+        end
+        ready__d = (ready__q & (~issue_mask)) | wake_mask | (asleep__q & event_mask);
+        asleep__d = (asleep__q & (~event_mask)) | sleep_mask;
+        woken__d = (woken__q & (~issue_mask)) | event_mask;
+        if (frame_start) begin
+            ready__d = c_thread_mask;
+            asleep__d = 32'h0;
+            woken__d = 32'h0;
+            reserved__d = 32'h0;
+        end
+    end
+    
+endmodule // dynrt_processor__engine__scheduler
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__scratch(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [11:0] read_address;
+    input wire  read_clock;
+    output reg  [31:0] read_data;
+    input wire  [11:0] write_address;
+    input wire  write_clock;
+    input wire  [31:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[31:0] mem[4095:0];
+    
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__scratch
+
+
+module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_read,engine__load_bank,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,uv_words__read,uv_words__addr,uv_words__rdata,t_words__read,t_words__addr,t_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [4:0] engine__thread;
+    input wire  [31:0] engine__word_a;
+    input wire  [31:0] engine__word_b;
+    input wire  engine__ray_write;
+    input wire  [1:0] engine__ray_pair;
+    input wire  engine__enqueue;
+    output reg  engine__full;
+    input wire  [4:0] engine__query_thread;
+    output reg  engine__pending;
+    output reg  engine__done;
+    output reg  [4:0] engine__done_thread;
+    input wire  engine__load_read;
+    input wire  [2:0] engine__load_bank;
+    input wire  [23:0] engine__load_addr;
     input wire  [1:0] queue_kind;
-    output reg  full;
-    input wire  [4:0] query_thread;
-    output reg  pending;
     output reg  hit;
     output reg  [23:0] best_t;
     output reg  [31:0] best_instance;
     output reg  [31:0] best_triangle;
-    input wire  engine_read;
-    input wire  [2:0] engine_bank;
-    input wire  [23:0] engine_addr;
-    output reg  uv_read;
-    output reg  [23:0] uv_addr;
-    input wire  [31:0] uv_rdata;
-    output reg  t_read;
-    output reg  [23:0] t_addr;
-    input wire  [31:0] t_rdata;
-    output reg  list_read;
-    output reg  [23:0] list_addr;
-    input wire  [31:0] list_rdata;
-    output reg  done_event;
-    output reg  [4:0] done_thread;
+    output reg  uv_words__read;
+    output reg  [23:0] uv_words__addr;
+    input wire  [31:0] uv_words__rdata;
+    output reg  t_words__read;
+    output reg  [23:0] t_words__addr;
+    input wire  [31:0] t_words__rdata;
+    output reg  lists__read;
+    output reg  [23:0] lists__addr;
+    input wire  [31:0] lists__rdata;
     input wire  walk_list_valid;
     input wire  [4:0] walk_list_thread;
     input wire  [31:0] walk_list_from;
@@ -11236,7 +13040,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
     reg  [15:0] launch_tag;
     
     // Sub module instances
-    dynrt_processor_core__tester__list_unit list_unit(
+    dynrt_processor__engine__tester__list_unit list_unit(
         .clock(list_unit__clock),
         .enqueue(list_unit__enqueue),
         .kind(list_unit__kind),
@@ -11253,7 +13057,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .test_entry(list_unit__test_entry),
         .test_take(list_unit__test_take)
     );
-    dynrt_processor_core__tester__ray ray(
+    dynrt_processor__engine__tester__ray ray(
         .clock(ray__clock),
         .thread(ray__thread),
         .word_a(ray__word_a),
@@ -11271,7 +13075,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .t_min_thread(ray__t_min_thread),
         .t_min(ray__t_min)
     );
-    dynrt_processor_core__tester__done_e issued(
+    dynrt_processor__engine__tester__done_e issued(
         .read_address(issued__read_address),
         .read_clock(issued__read_clock),
         .read_data(issued__read_data),
@@ -11280,7 +13084,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(issued__write_data),
         .write_enable(issued__write_enable)
     );
-    dynrt_processor_core__tester__done_e done_e(
+    dynrt_processor__engine__tester__done_e done_e(
         .read_address(done_e__read_address),
         .read_clock(done_e__read_clock),
         .read_data(done_e__read_data),
@@ -11289,7 +13093,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(done_e__write_data),
         .write_enable(done_e__write_enable)
     );
-    dynrt_processor_core__tester__best_e best_e(
+    dynrt_processor__engine__tester__best_e best_e(
         .read_address(best_e__read_address),
         .read_clock(best_e__read_clock),
         .read_data(best_e__read_data),
@@ -11298,7 +13102,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(best_e__write_data),
         .write_enable(best_e__write_enable)
     );
-    dynrt_processor_core__tester__flight_a instance_e(
+    dynrt_processor__engine__tester__flight_a instance_e(
         .read_address(instance_e__read_address),
         .read_clock(instance_e__read_clock),
         .read_data(instance_e__read_data),
@@ -11307,7 +13111,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(instance_e__write_data),
         .write_enable(instance_e__write_enable)
     );
-    dynrt_processor_core__tester__flight_a triangle_e(
+    dynrt_processor__engine__tester__flight_a triangle_e(
         .read_address(triangle_e__read_address),
         .read_clock(triangle_e__read_clock),
         .read_data(triangle_e__read_data),
@@ -11316,7 +13120,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(triangle_e__write_data),
         .write_enable(triangle_e__write_enable)
     );
-    dynrt_processor_core__tester__done_e done_m(
+    dynrt_processor__engine__tester__done_e done_m(
         .read_address(done_m__read_address),
         .read_clock(done_m__read_clock),
         .read_data(done_m__read_data),
@@ -11325,7 +13129,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(done_m__write_data),
         .write_enable(done_m__write_enable)
     );
-    dynrt_processor_core__tester__best_e best_m(
+    dynrt_processor__engine__tester__best_e best_m(
         .read_address(best_m__read_address),
         .read_clock(best_m__read_clock),
         .read_data(best_m__read_data),
@@ -11334,7 +13138,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(best_m__write_data),
         .write_enable(best_m__write_enable)
     );
-    dynrt_processor_core__tester__flight_t_min flight_t_min(
+    dynrt_processor__engine__tester__flight_t_min flight_t_min(
         .read_address(flight_t_min__read_address),
         .read_clock(flight_t_min__read_clock),
         .read_data(flight_t_min__read_data),
@@ -11343,7 +13147,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(flight_t_min__write_data),
         .write_enable(flight_t_min__write_enable)
     );
-    dynrt_processor_core__tester__flight_a flight_a(
+    dynrt_processor__engine__tester__flight_a flight_a(
         .read_address(flight_a__read_address),
         .read_clock(flight_a__read_clock),
         .read_data(flight_a__read_data),
@@ -11352,7 +13156,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(flight_a__write_data),
         .write_enable(flight_a__write_enable)
     );
-    dynrt_processor_core__tester__flight_a flight_b(
+    dynrt_processor__engine__tester__flight_a flight_b(
         .read_address(flight_b__read_address),
         .read_clock(flight_b__read_clock),
         .read_data(flight_b__read_data),
@@ -11361,282 +13165,282 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .write_data(flight_b__write_data),
         .write_enable(flight_b__write_enable)
     );
-    dynrt_processor_core__add__big_sign fetching(
+    dynrt_processor__display__dark_d fetching(
         .d(fetching__d),
         .q(fetching__q),
         .clock(fetching__clock)
     );
-    dynrt_processor_core__add__big_sign fb(
+    dynrt_processor__display__dark_d fb(
         .d(fb__d),
         .q(fb__q),
         .clock(fb__clock)
     );
-    dynrt_processor_core__add__big_sign lb(
+    dynrt_processor__display__dark_d lb(
         .d(lb__d),
         .q(lb__q),
         .clock(lb__clock)
     );
-    dynrt_processor_core__tester__lphase lphase(
+    dynrt_processor__engine__tester__lphase lphase(
         .d(lphase__d),
         .q(lphase__q),
         .clock(lphase__clock)
     );
-    dynrt_processor_core__add__big_sign loaded__0(
+    dynrt_processor__display__dark_d loaded__0(
         .d(loaded__0__d),
         .q(loaded__0__q),
         .clock(loaded__0__clock)
     );
-    dynrt_processor_core__add__big_sign loaded__1(
+    dynrt_processor__display__dark_d loaded__1(
         .d(loaded__1__d),
         .q(loaded__1__q),
         .clock(loaded__1__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 cur_kind__0(
+    dynrt_processor__engine__tester__cur_kind__0 cur_kind__0(
         .d(cur_kind__0__d),
         .q(cur_kind__0__q),
         .clock(cur_kind__0__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 cur_kind__1(
+    dynrt_processor__engine__tester__cur_kind__0 cur_kind__1(
         .d(cur_kind__1__d),
         .q(cur_kind__1__q),
         .clock(cur_kind__1__clock)
     );
-    dynrt_processor_core__last_pick cur_thread__0(
+    dynrt_processor__engine__decode__t3 cur_thread__0(
         .d(cur_thread__0__d),
         .q(cur_thread__0__q),
         .clock(cur_thread__0__clock)
     );
-    dynrt_processor_core__last_pick cur_thread__1(
+    dynrt_processor__engine__decode__t3 cur_thread__1(
         .d(cur_thread__1__d),
         .q(cur_thread__1__q),
         .clock(cur_thread__1__clock)
     );
-    dynrt_processor_core__asleep cur_a__0(
+    dynrt_processor__engine__cycle_count cur_a__0(
         .d(cur_a__0__d),
         .q(cur_a__0__q),
         .clock(cur_a__0__clock)
     );
-    dynrt_processor_core__asleep cur_a__1(
+    dynrt_processor__engine__cycle_count cur_a__1(
         .d(cur_a__1__d),
         .q(cur_a__1__q),
         .clock(cur_a__1__clock)
     );
-    dynrt_processor_core__asleep cur_b__0(
+    dynrt_processor__engine__cycle_count cur_b__0(
         .d(cur_b__0__d),
         .q(cur_b__0__q),
         .clock(cur_b__0__clock)
     );
-    dynrt_processor_core__asleep cur_b__1(
+    dynrt_processor__engine__cycle_count cur_b__1(
         .d(cur_b__1__d),
         .q(cur_b__1__q),
         .clock(cur_b__1__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight received__0(
+    dynrt_processor__engine__tester__list_unit__flight received__0(
         .d(received__0__d),
         .q(received__0__q),
         .clock(received__0__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight received__1(
+    dynrt_processor__engine__tester__list_unit__flight received__1(
         .d(received__1__d),
         .q(received__1__q),
         .clock(received__1__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight uv_issued(
+    dynrt_processor__engine__tester__list_unit__flight uv_issued(
         .d(uv_issued__d),
         .q(uv_issued__q),
         .clock(uv_issued__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight t_issued(
+    dynrt_processor__engine__tester__list_unit__flight t_issued(
         .d(t_issued__d),
         .q(t_issued__q),
         .clock(t_issued__clock)
     );
-    dynrt_processor_core__last_pick seq(
+    dynrt_processor__engine__decode__t3 seq(
         .d(seq__d),
         .q(seq__q),
         .clock(seq__clock)
     );
-    dynrt_processor_core__add__in_a words__0(
+    dynrt_processor__display__rgb_q words__0(
         .d(words__0__d),
         .q(words__0__q),
         .clock(words__0__clock)
     );
-    dynrt_processor_core__add__in_a words__1(
+    dynrt_processor__display__rgb_q words__1(
         .d(words__1__d),
         .q(words__1__q),
         .clock(words__1__clock)
     );
-    dynrt_processor_core__add__in_a words__2(
+    dynrt_processor__display__rgb_q words__2(
         .d(words__2__d),
         .q(words__2__q),
         .clock(words__2__clock)
     );
-    dynrt_processor_core__add__in_a words__3(
+    dynrt_processor__display__rgb_q words__3(
         .d(words__3__d),
         .q(words__3__q),
         .clock(words__3__clock)
     );
-    dynrt_processor_core__add__in_a words__4(
+    dynrt_processor__display__rgb_q words__4(
         .d(words__4__d),
         .q(words__4__q),
         .clock(words__4__clock)
     );
-    dynrt_processor_core__add__in_a words__5(
+    dynrt_processor__display__rgb_q words__5(
         .d(words__5__d),
         .q(words__5__q),
         .clock(words__5__clock)
     );
-    dynrt_processor_core__add__in_a words__6(
+    dynrt_processor__display__rgb_q words__6(
         .d(words__6__d),
         .q(words__6__q),
         .clock(words__6__clock)
     );
-    dynrt_processor_core__add__in_a words__7(
+    dynrt_processor__display__rgb_q words__7(
         .d(words__7__d),
         .q(words__7__q),
         .clock(words__7__clock)
     );
-    dynrt_processor_core__add__in_a words__8(
+    dynrt_processor__display__rgb_q words__8(
         .d(words__8__d),
         .q(words__8__q),
         .clock(words__8__clock)
     );
-    dynrt_processor_core__add__in_a words__9(
+    dynrt_processor__display__rgb_q words__9(
         .d(words__9__d),
         .q(words__9__q),
         .clock(words__9__clock)
     );
-    dynrt_processor_core__add__in_a words__10(
+    dynrt_processor__display__rgb_q words__10(
         .d(words__10__d),
         .q(words__10__q),
         .clock(words__10__clock)
     );
-    dynrt_processor_core__add__in_a words__11(
+    dynrt_processor__display__rgb_q words__11(
         .d(words__11__d),
         .q(words__11__q),
         .clock(words__11__clock)
     );
-    dynrt_processor_core__add__in_a words__12(
+    dynrt_processor__display__rgb_q words__12(
         .d(words__12__d),
         .q(words__12__q),
         .clock(words__12__clock)
     );
-    dynrt_processor_core__add__in_a words__13(
+    dynrt_processor__display__rgb_q words__13(
         .d(words__13__d),
         .q(words__13__q),
         .clock(words__13__clock)
     );
-    dynrt_processor_core__add__in_a words__14(
+    dynrt_processor__display__rgb_q words__14(
         .d(words__14__d),
         .q(words__14__q),
         .clock(words__14__clock)
     );
-    dynrt_processor_core__add__in_a words__15(
+    dynrt_processor__display__rgb_q words__15(
         .d(words__15__d),
         .q(words__15__q),
         .clock(words__15__clock)
     );
-    dynrt_processor_core__add__in_a words__16(
+    dynrt_processor__display__rgb_q words__16(
         .d(words__16__d),
         .q(words__16__q),
         .clock(words__16__clock)
     );
-    dynrt_processor_core__add__in_a words__17(
+    dynrt_processor__display__rgb_q words__17(
         .d(words__17__d),
         .q(words__17__q),
         .clock(words__17__clock)
     );
-    dynrt_processor_core__add__in_a words__18(
+    dynrt_processor__display__rgb_q words__18(
         .d(words__18__d),
         .q(words__18__q),
         .clock(words__18__clock)
     );
-    dynrt_processor_core__add__in_a words__19(
+    dynrt_processor__display__rgb_q words__19(
         .d(words__19__d),
         .q(words__19__q),
         .clock(words__19__clock)
     );
-    dynrt_processor_core__add__in_a words__20(
+    dynrt_processor__display__rgb_q words__20(
         .d(words__20__d),
         .q(words__20__q),
         .clock(words__20__clock)
     );
-    dynrt_processor_core__add__in_a words__21(
+    dynrt_processor__display__rgb_q words__21(
         .d(words__21__d),
         .q(words__21__q),
         .clock(words__21__clock)
     );
-    dynrt_processor_core__add__in_a words__22(
+    dynrt_processor__display__rgb_q words__22(
         .d(words__22__d),
         .q(words__22__q),
         .clock(words__22__clock)
     );
-    dynrt_processor_core__add__in_a words__23(
+    dynrt_processor__display__rgb_q words__23(
         .d(words__23__d),
         .q(words__23__q),
         .clock(words__23__clock)
     );
-    dynrt_processor_core__last_pick uv_line__0(
+    dynrt_processor__engine__decode__t3 uv_line__0(
         .d(uv_line__0__d),
         .q(uv_line__0__q),
         .clock(uv_line__0__clock)
     );
-    dynrt_processor_core__last_pick uv_line__1(
+    dynrt_processor__engine__decode__t3 uv_line__1(
         .d(uv_line__1__d),
         .q(uv_line__1__q),
         .clock(uv_line__1__clock)
     );
-    dynrt_processor_core__last_pick uv_line__2(
+    dynrt_processor__engine__decode__t3 uv_line__2(
         .d(uv_line__2__d),
         .q(uv_line__2__q),
         .clock(uv_line__2__clock)
     );
-    dynrt_processor_core__last_pick uv_line__3(
+    dynrt_processor__engine__decode__t3 uv_line__3(
         .d(uv_line__3__d),
         .q(uv_line__3__q),
         .clock(uv_line__3__clock)
     );
-    dynrt_processor_core__last_pick uv_line__4(
+    dynrt_processor__engine__decode__t3 uv_line__4(
         .d(uv_line__4__d),
         .q(uv_line__4__q),
         .clock(uv_line__4__clock)
     );
-    dynrt_processor_core__last_pick uv_line__5(
+    dynrt_processor__engine__decode__t3 uv_line__5(
         .d(uv_line__5__d),
         .q(uv_line__5__q),
         .clock(uv_line__5__clock)
     );
-    dynrt_processor_core__last_pick t_line__0(
+    dynrt_processor__engine__decode__t3 t_line__0(
         .d(t_line__0__d),
         .q(t_line__0__q),
         .clock(t_line__0__clock)
     );
-    dynrt_processor_core__last_pick t_line__1(
+    dynrt_processor__engine__decode__t3 t_line__1(
         .d(t_line__1__d),
         .q(t_line__1__q),
         .clock(t_line__1__clock)
     );
-    dynrt_processor_core__last_pick t_line__2(
+    dynrt_processor__engine__decode__t3 t_line__2(
         .d(t_line__2__d),
         .q(t_line__2__q),
         .clock(t_line__2__clock)
     );
-    dynrt_processor_core__last_pick t_line__3(
+    dynrt_processor__engine__decode__t3 t_line__3(
         .d(t_line__3__d),
         .q(t_line__3__q),
         .clock(t_line__3__clock)
     );
-    dynrt_processor_core__last_pick t_line__4(
+    dynrt_processor__engine__decode__t3 t_line__4(
         .d(t_line__4__d),
         .q(t_line__4__q),
         .clock(t_line__4__clock)
     );
-    dynrt_processor_core__last_pick t_line__5(
+    dynrt_processor__engine__decode__t3 t_line__5(
         .d(t_line__5__d),
         .q(t_line__5__q),
         .clock(t_line__5__clock)
     );
-    dynrt_processor_core__tester__transform_unit transform_unit(
+    dynrt_processor__engine__tester__transform_unit transform_unit(
         .clock(transform_unit__clock),
         .in_valid(transform_unit__in_valid),
         .m__0(transform_unit__m__0),
@@ -11662,22 +13466,22 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .result__2(transform_unit__result__2),
         .out_tag(transform_unit__out_tag)
     );
-    dynrt_processor_core__add__in_a o_hold__0(
+    dynrt_processor__display__rgb_q o_hold__0(
         .d(o_hold__0__d),
         .q(o_hold__0__q),
         .clock(o_hold__0__clock)
     );
-    dynrt_processor_core__add__in_a o_hold__1(
+    dynrt_processor__display__rgb_q o_hold__1(
         .d(o_hold__1__d),
         .q(o_hold__1__q),
         .clock(o_hold__1__clock)
     );
-    dynrt_processor_core__add__in_a o_hold__2(
+    dynrt_processor__display__rgb_q o_hold__2(
         .d(o_hold__2__d),
         .q(o_hold__2__q),
         .clock(o_hold__2__clock)
     );
-    dynrt_processor_core__tester__intersect_unit intersect_unit(
+    dynrt_processor__engine__tester__intersect_unit intersect_unit(
         .clock(intersect_unit__clock),
         .in_valid(intersect_unit__in_valid),
         .o__0(intersect_unit__o__0),
@@ -11696,7 +13500,7 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .hit(intersect_unit__hit),
         .out_tag(intersect_unit__out_tag)
     );
-    dynrt_processor_core__cmp cmp(
+    dynrt_processor__engine__fp_units__cmp cmp(
         .clock(cmp__clock),
         .in_valid(cmp__in_valid),
         .a(cmp__a),
@@ -11706,117 +13510,117 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         .le(cmp__le),
         .eq(cmp__eq)
     );
-    dynrt_processor_core__add__big_sign m1_valid(
+    dynrt_processor__display__dark_d m1_valid(
         .d(m1_valid__d),
         .q(m1_valid__q),
         .clock(m1_valid__clock)
     );
-    dynrt_processor_core__add__big_sign m1_hit(
+    dynrt_processor__display__dark_d m1_hit(
         .d(m1_hit__d),
         .q(m1_hit__q),
         .clock(m1_hit__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 m1_kind(
+    dynrt_processor__engine__tester__cur_kind__0 m1_kind(
         .d(m1_kind__d),
         .q(m1_kind__q),
         .clock(m1_kind__clock)
     );
-    dynrt_processor_core__last_pick m1_thread(
+    dynrt_processor__engine__decode__t3 m1_thread(
         .d(m1_thread__d),
         .q(m1_thread__q),
         .clock(m1_thread__clock)
     );
-    dynrt_processor_core__add__in_a m1_t(
+    dynrt_processor__display__rgb_q m1_t(
         .d(m1_t__d),
         .q(m1_t__q),
         .clock(m1_t__clock)
     );
-    dynrt_processor_core__add__big_sign m2_valid(
+    dynrt_processor__display__dark_d m2_valid(
         .d(m2_valid__d),
         .q(m2_valid__q),
         .clock(m2_valid__clock)
     );
-    dynrt_processor_core__add__big_sign m2_hit(
+    dynrt_processor__display__dark_d m2_hit(
         .d(m2_hit__d),
         .q(m2_hit__q),
         .clock(m2_hit__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 m2_kind(
+    dynrt_processor__engine__tester__cur_kind__0 m2_kind(
         .d(m2_kind__d),
         .q(m2_kind__q),
         .clock(m2_kind__clock)
     );
-    dynrt_processor_core__last_pick m2_thread(
+    dynrt_processor__engine__decode__t3 m2_thread(
         .d(m2_thread__d),
         .q(m2_thread__q),
         .clock(m2_thread__clock)
     );
-    dynrt_processor_core__add__in_a m2_t(
+    dynrt_processor__display__rgb_q m2_t(
         .d(m2_t__d),
         .q(m2_t__q),
         .clock(m2_t__clock)
     );
-    dynrt_processor_core__asleep m2_a(
+    dynrt_processor__engine__cycle_count m2_a(
         .d(m2_a__d),
         .q(m2_a__q),
         .clock(m2_a__clock)
     );
-    dynrt_processor_core__asleep m2_b(
+    dynrt_processor__engine__cycle_count m2_b(
         .d(m2_b__d),
         .q(m2_b__q),
         .clock(m2_b__clock)
     );
-    dynrt_processor_core__halted_count m2_done(
+    dynrt_processor__engine__halted_count m2_done(
         .d(m2_done__d),
         .q(m2_done__q),
         .clock(m2_done__clock)
     );
-    dynrt_processor_core__tester__m2_best m2_best(
+    dynrt_processor__engine__tester__m2_best m2_best(
         .d(m2_best__d),
         .q(m2_best__q),
         .clock(m2_best__clock)
     );
-    dynrt_processor_core__add__big_sign m3_valid(
+    dynrt_processor__display__dark_d m3_valid(
         .d(m3_valid__d),
         .q(m3_valid__q),
         .clock(m3_valid__clock)
     );
-    dynrt_processor_core__add__big_sign m3_hit(
+    dynrt_processor__display__dark_d m3_hit(
         .d(m3_hit__d),
         .q(m3_hit__q),
         .clock(m3_hit__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 m3_kind(
+    dynrt_processor__engine__tester__cur_kind__0 m3_kind(
         .d(m3_kind__d),
         .q(m3_kind__q),
         .clock(m3_kind__clock)
     );
-    dynrt_processor_core__last_pick m3_thread(
+    dynrt_processor__engine__decode__t3 m3_thread(
         .d(m3_thread__d),
         .q(m3_thread__q),
         .clock(m3_thread__clock)
     );
-    dynrt_processor_core__add__in_a m3_t(
+    dynrt_processor__display__rgb_q m3_t(
         .d(m3_t__d),
         .q(m3_t__q),
         .clock(m3_t__clock)
     );
-    dynrt_processor_core__asleep m3_a(
+    dynrt_processor__engine__cycle_count m3_a(
         .d(m3_a__d),
         .q(m3_a__q),
         .clock(m3_a__clock)
     );
-    dynrt_processor_core__asleep m3_b(
+    dynrt_processor__engine__cycle_count m3_b(
         .d(m3_b__d),
         .q(m3_b__q),
         .clock(m3_b__clock)
     );
-    dynrt_processor_core__halted_count m3_done(
+    dynrt_processor__engine__halted_count m3_done(
         .d(m3_done__d),
         .q(m3_done__q),
         .clock(m3_done__clock)
     );
-    dynrt_processor_core__tester__m2_best m3_best(
+    dynrt_processor__engine__tester__m2_best m3_best(
         .d(m3_best__d),
         .q(m3_best__q),
         .clock(m3_best__clock)
@@ -11996,20 +13800,20 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         o_hold__0__clock = clock;
         o_hold__1__clock = clock;
         o_hold__2__clock = clock;
-        ray__thread = thread;
-        ray__word_a = word_a;
-        ray__word_b = word_b;
-        ray__ray_write = ray_write;
-        ray__ray_pair = ray_pair;
-        ray__t_min_write = enqueue & (queue_kind == c_cmd_init);
-        walk_take = walk_list_valid & (~enqueue) & (~list_unit__full);
+        ray__thread = engine__thread;
+        ray__word_a = engine__word_a;
+        ray__word_b = engine__word_b;
+        ray__ray_write = engine__ray_write;
+        ray__ray_pair = engine__ray_pair;
+        ray__t_min_write = engine__enqueue & (queue_kind == c_cmd_init);
+        walk_take = walk_list_valid & (~engine__enqueue) & (~list_unit__full);
         walk_list_take = walk_take;
-        list_unit__enqueue = enqueue | walk_take;
-        if (enqueue) begin
+        list_unit__enqueue = engine__enqueue | walk_take;
+        if (engine__enqueue) begin
             list_unit__kind = queue_kind;
-            list_unit__thread = thread;
-            list_unit__word_a = word_a;
-            list_unit__word_b = word_b;
+            list_unit__thread = engine__thread;
+            list_unit__word_a = engine__word_a;
+            list_unit__word_b = engine__word_b;
         end
         else begin
             list_unit__kind = c_cmd_list;
@@ -12017,42 +13821,42 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
             list_unit__word_a = walk_list_from;
             list_unit__word_b = walk_list_to | c_list_of_walk;
         end
-        full = list_unit__full;
-        list_unit__engine_read = engine_read;
-        list_unit__engine_bank = engine_bank;
-        list_read = list_unit__list_read;
-        list_addr = list_unit__list_addr;
-        list_unit__list_rdata = list_rdata;
-        issued__read_address = query_thread;
-        done_e__read_address = query_thread;
-        best_e__read_address = query_thread;
-        instance_e__read_address = query_thread;
-        triangle_e__read_address = query_thread;
-        pending = issued__read_data != done_e__read_data;
+        engine__full = list_unit__full;
+        list_unit__engine_read = engine__load_read;
+        list_unit__engine_bank = engine__load_bank;
+        lists__read = list_unit__list_read;
+        lists__addr = list_unit__list_addr;
+        list_unit__list_rdata = lists__rdata;
+        issued__read_address = engine__query_thread;
+        done_e__read_address = engine__query_thread;
+        best_e__read_address = engine__query_thread;
+        instance_e__read_address = engine__query_thread;
+        triangle_e__read_address = engine__query_thread;
+        engine__pending = issued__read_data != done_e__read_data;
         hit = best_e__read_data[32'h20];
         best_t = best_e__read_data[(32'h0)+:(24)];
         best_instance = instance_e__read_data;
         best_triangle = triangle_e__read_data;
-        issued__write_address = thread;
+        issued__write_address = engine__thread;
         issued__write_data = issued__read_data + 32'h1;
-        issued__write_enable = enqueue & (~list_unit__full) & ((queue_kind == c_cmd_list) | (queue_kind == c_cmd_init));
+        issued__write_enable = engine__enqueue & (~list_unit__full) & ((queue_kind == c_cmd_list) | (queue_kind == c_cmd_init));
         list_unit__test_take = 1'b0;
-        uv_take = fetching__q & (uv_issued__q < 32'h8) & (~(engine_read & (engine_bank == c_bank_uv)));
-        t_take = fetching__q & (t_issued__q < 32'h4) & (~(engine_read & (engine_bank == c_bank_t)));
-        uv_read = uv_take | (engine_read & (engine_bank == c_bank_uv));
-        t_read = t_take | (engine_read & (engine_bank == c_bank_t));
-        uv_addr = engine_addr;
-        t_addr = engine_addr;
+        uv_take = fetching__q & (uv_issued__q < 32'h8) & (~(engine__load_read & (engine__load_bank == c_bank_uv)));
+        t_take = fetching__q & (t_issued__q < 32'h4) & (~(engine__load_read & (engine__load_bank == c_bank_t)));
+        uv_words__read = uv_take | (engine__load_read & (engine__load_bank == c_bank_uv));
+        t_words__read = t_take | (engine__load_read & (engine__load_bank == c_bank_t));
+        uv_words__addr = engine__load_addr;
+        t_words__addr = engine__load_addr;
         fetch_a = cur_a__0__q;
         if (fb__q) begin
             fetch_a = cur_a__1__q;
         end
         if (uv_take) begin
-            uv_addr = (fetch_a[(32'h0)+:(24)] << 32'h3) + ((uv_issued__q) & 24'hffffff);
+            uv_words__addr = (fetch_a[(32'h0)+:(24)] << 32'h3) + ((uv_issued__q) & 24'hffffff);
             uv_issued__d = uv_issued__q + 32'h1;
         end
         if (t_take) begin
-            t_addr = (fetch_a[(32'h0)+:(24)] << 32'h3) + ((t_issued__q) & 24'hffffff);
+            t_words__addr = (fetch_a[(32'h0)+:(24)] << 32'h3) + ((t_issued__q) & 24'hffffff);
             t_issued__d = t_issued__q + 32'h1;
         end
         uv_line__0__d = (((uv_take) & 5'h1f) << 32'h4) | (((fb__q) & 5'h1f) << 32'h3) | ((uv_issued__q[(32'h0)+:(3)]) & 5'h1f);
@@ -12137,98 +13941,98 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         end
         if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__0)) begin
             if (uv_arrive[32'h3]) begin
-                words__12__d = uv_rdata[(32'h0)+:(24)];
+                words__12__d = uv_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__0__d = uv_rdata[(32'h0)+:(24)];
+                words__0__d = uv_words__rdata[(32'h0)+:(24)];
             end
         end
         if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__1)) begin
             if (uv_arrive[32'h3]) begin
-                words__13__d = uv_rdata[(32'h0)+:(24)];
+                words__13__d = uv_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__1__d = uv_rdata[(32'h0)+:(24)];
+                words__1__d = uv_words__rdata[(32'h0)+:(24)];
             end
         end
         if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__2)) begin
             if (uv_arrive[32'h3]) begin
-                words__14__d = uv_rdata[(32'h0)+:(24)];
+                words__14__d = uv_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__2__d = uv_rdata[(32'h0)+:(24)];
+                words__2__d = uv_words__rdata[(32'h0)+:(24)];
             end
         end
         if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__3)) begin
             if (uv_arrive[32'h3]) begin
-                words__15__d = uv_rdata[(32'h0)+:(24)];
+                words__15__d = uv_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__3__d = uv_rdata[(32'h0)+:(24)];
+                words__3__d = uv_words__rdata[(32'h0)+:(24)];
             end
         end
         if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__4)) begin
             if (uv_arrive[32'h3]) begin
-                words__16__d = uv_rdata[(32'h0)+:(24)];
+                words__16__d = uv_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__4__d = uv_rdata[(32'h0)+:(24)];
+                words__4__d = uv_words__rdata[(32'h0)+:(24)];
             end
         end
         if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__5)) begin
             if (uv_arrive[32'h3]) begin
-                words__17__d = uv_rdata[(32'h0)+:(24)];
+                words__17__d = uv_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__5__d = uv_rdata[(32'h0)+:(24)];
+                words__5__d = uv_words__rdata[(32'h0)+:(24)];
             end
         end
         if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__6)) begin
             if (uv_arrive[32'h3]) begin
-                words__18__d = uv_rdata[(32'h0)+:(24)];
+                words__18__d = uv_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__6__d = uv_rdata[(32'h0)+:(24)];
+                words__6__d = uv_words__rdata[(32'h0)+:(24)];
             end
         end
         if (uv_arrive[32'h4] & (((uv_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__7)) begin
             if (uv_arrive[32'h3]) begin
-                words__19__d = uv_rdata[(32'h0)+:(24)];
+                words__19__d = uv_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__7__d = uv_rdata[(32'h0)+:(24)];
+                words__7__d = uv_words__rdata[(32'h0)+:(24)];
             end
         end
         if (t_arrive[32'h4] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__0)) begin
             if (t_arrive[32'h3]) begin
-                words__20__d = t_rdata[(32'h0)+:(24)];
+                words__20__d = t_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__8__d = t_rdata[(32'h0)+:(24)];
+                words__8__d = t_words__rdata[(32'h0)+:(24)];
             end
         end
         if (t_arrive[32'h4] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__1)) begin
             if (t_arrive[32'h3]) begin
-                words__21__d = t_rdata[(32'h0)+:(24)];
+                words__21__d = t_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__9__d = t_rdata[(32'h0)+:(24)];
+                words__9__d = t_words__rdata[(32'h0)+:(24)];
             end
         end
         if (t_arrive[32'h4] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__2)) begin
             if (t_arrive[32'h3]) begin
-                words__22__d = t_rdata[(32'h0)+:(24)];
+                words__22__d = t_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__10__d = t_rdata[(32'h0)+:(24)];
+                words__10__d = t_words__rdata[(32'h0)+:(24)];
             end
         end
         if (t_arrive[32'h4] & (((t_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__3)) begin
             if (t_arrive[32'h3]) begin
-                words__23__d = t_rdata[(32'h0)+:(24)];
+                words__23__d = t_words__rdata[(32'h0)+:(24)];
             end
             else begin
-                words__11__d = t_rdata[(32'h0)+:(24)];
+                words__11__d = t_words__rdata[(32'h0)+:(24)];
             end
         end
         uv_here__0 = uv_arrive[32'h4] & (uv_arrive[32'h3] == c_buffer__0);
@@ -12398,8 +14202,8 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         m3_counts = m3_valid__q & ((m3_kind__q == c_test_init) | (m3_kind__q == c_test_list_end));
         done_m__write_enable = m3_counts;
         done_e__write_enable = m3_counts;
-        done_event = m3_counts;
-        done_thread = m3_thread__q;
+        engine__done = m3_counts;
+        engine__done_thread = m3_thread__q;
         walk_end_event = m3_valid__q & (m3_kind__q == c_test_walk_end);
         walk_end_thread = m3_thread__q;
         walk_end_t = ((m3_best__q[(32'h0)+:(24)]) & 32'hffffffff);
@@ -12419,10 +14223,10 @@ module dynrt_processor_core__tester(clock,thread,word_a,word_b,ray_write,ray_pai
         triangle_e__write_enable = m3_valid__q & merge_hit;
     end
     
-endmodule // dynrt_processor_core__tester
+endmodule // dynrt_processor__engine__tester
 
 
-module dynrt_processor_core__tester__best_e(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__tester__best_e(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -12448,7 +14252,7 @@ module dynrt_processor_core__tester__best_e(read_address,read_clock,read_data,wr
        end
     end
                 
-endmodule // dynrt_processor_core__tester__best_e
+endmodule // dynrt_processor__engine__tester__best_e
 
 
 
@@ -12477,7 +14281,7 @@ endmodule // dynrt_processor_core__tester__best_e
 
 
 
-module dynrt_processor_core__tester__cur_kind__0(d,q,clock);
+module dynrt_processor__engine__tester__cur_kind__0(d,q,clock);
     
     // Module arguments
     input wire  [1:0] d;
@@ -12493,7 +14297,7 @@ module dynrt_processor_core__tester__cur_kind__0(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__tester__cur_kind__0
+endmodule // dynrt_processor__engine__tester__cur_kind__0
 
 
 
@@ -12502,7 +14306,7 @@ endmodule // dynrt_processor_core__tester__cur_kind__0
 
 
 
-module dynrt_processor_core__tester__done_e(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__tester__done_e(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -12562,7 +14366,7 @@ module dynrt_processor_core__tester__done_e(read_address,read_clock,read_data,wr
        end
     end
                 
-endmodule // dynrt_processor_core__tester__done_e
+endmodule // dynrt_processor__engine__tester__done_e
 
 
 
@@ -12571,7 +14375,7 @@ endmodule // dynrt_processor_core__tester__done_e
 
 
 
-module dynrt_processor_core__tester__flight_a(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__tester__flight_a(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -12597,12 +14401,12 @@ module dynrt_processor_core__tester__flight_a(read_address,read_clock,read_data,
        end
     end
                 
-endmodule // dynrt_processor_core__tester__flight_a
+endmodule // dynrt_processor__engine__tester__flight_a
 
 
 
 
-module dynrt_processor_core__tester__flight_t_min(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__tester__flight_t_min(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -12628,12 +14432,12 @@ module dynrt_processor_core__tester__flight_t_min(read_address,read_clock,read_d
        end
     end
                 
-endmodule // dynrt_processor_core__tester__flight_t_min
+endmodule // dynrt_processor__engine__tester__flight_t_min
 
 
 
 
-module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__2,d__0,d__1,d__2,t_min,t_max,tag,out_valid,t,u,v,hit,out_tag);
+module dynrt_processor__engine__tester__intersect_unit(clock,in_valid,o__0,o__1,o__2,d__0,d__1,d__2,t_min,t_max,tag,out_valid,t,u,v,hit,out_tag);
     
     // Module arguments
     input wire  clock;
@@ -12792,7 +14596,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
     wire  [15:0] tag_delay_rest__data_out;
     
     // Sub module instances
-    dynrt_processor_core__div div(
+    dynrt_processor__engine__fp_units__div div(
         .clock(div__clock),
         .in_valid(div__in_valid),
         .a(div__a),
@@ -12800,7 +14604,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         .out_valid(div__out_valid),
         .result(div__result)
     );
-    dynrt_processor_core__byte_unit__scale mul__0(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul__0(
         .clock(mul__0__clock),
         .in_valid(mul__0__in_valid),
         .a(mul__0__a),
@@ -12808,7 +14612,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         .out_valid(mul__0__out_valid),
         .result(mul__0__result)
     );
-    dynrt_processor_core__byte_unit__scale mul__1(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul__1(
         .clock(mul__1__clock),
         .in_valid(mul__1__in_valid),
         .a(mul__1__a),
@@ -12816,7 +14620,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         .out_valid(mul__1__out_valid),
         .result(mul__1__result)
     );
-    dynrt_processor_core__add add__0(
+    dynrt_processor__engine__fp_units__add add__0(
         .clock(add__0__clock),
         .in_valid(add__0__in_valid),
         .a(add__0__a),
@@ -12825,7 +14629,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         .out_valid(add__0__out_valid),
         .result(add__0__result)
     );
-    dynrt_processor_core__add add__1(
+    dynrt_processor__engine__fp_units__add add__1(
         .clock(add__1__clock),
         .in_valid(add__1__in_valid),
         .a(add__1__a),
@@ -12834,7 +14638,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         .out_valid(add__1__out_valid),
         .result(add__1__result)
     );
-    dynrt_processor_core__add add__2(
+    dynrt_processor__engine__fp_units__add add__2(
         .clock(add__2__clock),
         .in_valid(add__2__in_valid),
         .a(add__2__a),
@@ -12843,7 +14647,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         .out_valid(add__2__out_valid),
         .result(add__2__result)
     );
-    dynrt_processor_core__cmp cmp__0(
+    dynrt_processor__engine__fp_units__cmp cmp__0(
         .clock(cmp__0__clock),
         .in_valid(cmp__0__in_valid),
         .a(cmp__0__a),
@@ -12853,7 +14657,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         .le(cmp__0__le),
         .eq(cmp__0__eq)
     );
-    dynrt_processor_core__cmp cmp__1(
+    dynrt_processor__engine__fp_units__cmp cmp__1(
         .clock(cmp__1__clock),
         .in_valid(cmp__1__in_valid),
         .a(cmp__1__a),
@@ -12863,7 +14667,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         .le(cmp__1__le),
         .eq(cmp__1__eq)
     );
-    dynrt_processor_core__cmp cmp__2(
+    dynrt_processor__engine__fp_units__cmp cmp__2(
         .clock(cmp__2__clock),
         .in_valid(cmp__2__in_valid),
         .a(cmp__2__a),
@@ -12873,7 +14677,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         .le(cmp__2__le),
         .eq(cmp__2__eq)
     );
-    dynrt_processor_core__cmp cmp__3(
+    dynrt_processor__engine__fp_units__cmp cmp__3(
         .clock(cmp__3__clock),
         .in_valid(cmp__3__in_valid),
         .a(cmp__3__a),
@@ -12883,7 +14687,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         .le(cmp__3__le),
         .eq(cmp__3__eq)
     );
-    dynrt_processor_core__cmp cmp__4(
+    dynrt_processor__engine__fp_units__cmp cmp__4(
         .clock(cmp__4__clock),
         .in_valid(cmp__4__in_valid),
         .a(cmp__4__a),
@@ -12893,87 +14697,87 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         .le(cmp__4__le),
         .eq(cmp__4__eq)
     );
-    dynrt_processor_core__tester__intersect_unit__operand_delay__0 operand_delay__0(
+    dynrt_processor__engine__tester__intersect_unit__operand_delay__0 operand_delay__0(
         .clock(operand_delay__0__clock),
         .data_in(operand_delay__0__data_in),
         .data_out(operand_delay__0__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__operand_delay__0 operand_delay__1(
+    dynrt_processor__engine__tester__intersect_unit__operand_delay__0 operand_delay__1(
         .clock(operand_delay__1__clock),
         .data_in(operand_delay__1__data_in),
         .data_out(operand_delay__1__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__operand_delay__0 operand_delay__2(
+    dynrt_processor__engine__tester__intersect_unit__operand_delay__0 operand_delay__2(
         .clock(operand_delay__2__clock),
         .data_in(operand_delay__2__data_in),
         .data_out(operand_delay__2__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__operand_delay__0 operand_delay__3(
+    dynrt_processor__engine__tester__intersect_unit__operand_delay__0 operand_delay__3(
         .clock(operand_delay__3__clock),
         .data_in(operand_delay__3__data_in),
         .data_out(operand_delay__3__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__operand_delay__0 operand_delay__4(
+    dynrt_processor__engine__tester__intersect_unit__operand_delay__0 operand_delay__4(
         .clock(operand_delay__4__clock),
         .data_in(operand_delay__4__data_in),
         .data_out(operand_delay__4__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__operand_delay__0 operand_delay__5(
+    dynrt_processor__engine__tester__intersect_unit__operand_delay__0 operand_delay__5(
         .clock(operand_delay__5__clock),
         .data_in(operand_delay__5__data_in),
         .data_out(operand_delay__5__data_out)
     );
-    dynrt_processor_core__add_delay o_delay__0(
+    dynrt_processor__engine__fp_units__add_delay o_delay__0(
         .clock(o_delay__0__clock),
         .data_in(o_delay__0__data_in),
         .data_out(o_delay__0__data_out)
     );
-    dynrt_processor_core__add_delay o_delay__1(
+    dynrt_processor__engine__fp_units__add_delay o_delay__1(
         .clock(o_delay__1__clock),
         .data_in(o_delay__1__data_in),
         .data_out(o_delay__1__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__t_delay t_delay(
+    dynrt_processor__engine__tester__intersect_unit__t_delay t_delay(
         .clock(t_delay__clock),
         .data_in(t_delay__data_in),
         .data_out(t_delay__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__uv_delay__0 uv_delay__0(
+    dynrt_processor__engine__tester__intersect_unit__uv_delay__0 uv_delay__0(
         .clock(uv_delay__0__clock),
         .data_in(uv_delay__0__data_in),
         .data_out(uv_delay__0__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__uv_delay__0 uv_delay__1(
+    dynrt_processor__engine__tester__intersect_unit__uv_delay__0 uv_delay__1(
         .clock(uv_delay__1__clock),
         .data_in(uv_delay__1__data_in),
         .data_out(uv_delay__1__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__t_cmp_delay__0 t_cmp_delay__0(
+    dynrt_processor__engine__tester__intersect_unit__t_cmp_delay__0 t_cmp_delay__0(
         .clock(t_cmp_delay__0__clock),
         .data_in(t_cmp_delay__0__data_in),
         .data_out(t_cmp_delay__0__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__t_cmp_delay__0 t_cmp_delay__1(
+    dynrt_processor__engine__tester__intersect_unit__t_cmp_delay__0 t_cmp_delay__1(
         .clock(t_cmp_delay__1__clock),
         .data_in(t_cmp_delay__1__data_in),
         .data_out(t_cmp_delay__1__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__uv_cmp_delay__0 uv_cmp_delay__0(
+    dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0 uv_cmp_delay__0(
         .clock(uv_cmp_delay__0__clock),
         .data_in(uv_cmp_delay__0__data_in),
         .data_out(uv_cmp_delay__0__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__uv_cmp_delay__0 uv_cmp_delay__1(
+    dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0 uv_cmp_delay__1(
         .clock(uv_cmp_delay__1__clock),
         .data_in(uv_cmp_delay__1__data_in),
         .data_out(uv_cmp_delay__1__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__tag_delay_div tag_delay_div(
+    dynrt_processor__engine__tester__intersect_unit__tag_delay_div tag_delay_div(
         .clock(tag_delay_div__clock),
         .data_in(tag_delay_div__data_in),
         .data_out(tag_delay_div__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__tag_delay_rest tag_delay_rest(
+    dynrt_processor__engine__tester__intersect_unit__tag_delay_rest tag_delay_rest(
         .clock(tag_delay_rest__clock),
         .data_in(tag_delay_rest__data_in),
         .data_out(tag_delay_rest__data_out)
@@ -13070,7 +14874,7 @@ module dynrt_processor_core__tester__intersect_unit(clock,in_valid,o__0,o__1,o__
         out_tag = tag_delay_rest__data_out;
     end
     
-endmodule // dynrt_processor_core__tester__intersect_unit
+endmodule // dynrt_processor__engine__tester__intersect_unit
 
 
 
@@ -13941,7 +15745,7 @@ endmodule // dynrt_processor_core__tester__intersect_unit
 
 
 
-module dynrt_processor_core__tester__intersect_unit__operand_delay__0(clock,data_in,data_out);
+module dynrt_processor__engine__tester__intersect_unit__operand_delay__0(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -14014,107 +15818,107 @@ module dynrt_processor_core__tester__intersect_unit__operand_delay__0(clock,data
     reg  stage__20__clock;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a stage__0(
+    dynrt_processor__display__rgb_q stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__add__in_a stage__1(
+    dynrt_processor__display__rgb_q stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__add__in_a stage__2(
+    dynrt_processor__display__rgb_q stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__add__in_a stage__3(
+    dynrt_processor__display__rgb_q stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__add__in_a stage__4(
+    dynrt_processor__display__rgb_q stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__add__in_a stage__5(
+    dynrt_processor__display__rgb_q stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__add__in_a stage__6(
+    dynrt_processor__display__rgb_q stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor_core__add__in_a stage__7(
+    dynrt_processor__display__rgb_q stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor_core__add__in_a stage__8(
+    dynrt_processor__display__rgb_q stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor_core__add__in_a stage__9(
+    dynrt_processor__display__rgb_q stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor_core__add__in_a stage__10(
+    dynrt_processor__display__rgb_q stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor_core__add__in_a stage__11(
+    dynrt_processor__display__rgb_q stage__11(
         .d(stage__11__d),
         .q(stage__11__q),
         .clock(stage__11__clock)
     );
-    dynrt_processor_core__add__in_a stage__12(
+    dynrt_processor__display__rgb_q stage__12(
         .d(stage__12__d),
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor_core__add__in_a stage__13(
+    dynrt_processor__display__rgb_q stage__13(
         .d(stage__13__d),
         .q(stage__13__q),
         .clock(stage__13__clock)
     );
-    dynrt_processor_core__add__in_a stage__14(
+    dynrt_processor__display__rgb_q stage__14(
         .d(stage__14__d),
         .q(stage__14__q),
         .clock(stage__14__clock)
     );
-    dynrt_processor_core__add__in_a stage__15(
+    dynrt_processor__display__rgb_q stage__15(
         .d(stage__15__d),
         .q(stage__15__q),
         .clock(stage__15__clock)
     );
-    dynrt_processor_core__add__in_a stage__16(
+    dynrt_processor__display__rgb_q stage__16(
         .d(stage__16__d),
         .q(stage__16__q),
         .clock(stage__16__clock)
     );
-    dynrt_processor_core__add__in_a stage__17(
+    dynrt_processor__display__rgb_q stage__17(
         .d(stage__17__d),
         .q(stage__17__q),
         .clock(stage__17__clock)
     );
-    dynrt_processor_core__add__in_a stage__18(
+    dynrt_processor__display__rgb_q stage__18(
         .d(stage__18__d),
         .q(stage__18__q),
         .clock(stage__18__clock)
     );
-    dynrt_processor_core__add__in_a stage__19(
+    dynrt_processor__display__rgb_q stage__19(
         .d(stage__19__d),
         .q(stage__19__q),
         .clock(stage__19__clock)
     );
-    dynrt_processor_core__add__in_a stage__20(
+    dynrt_processor__display__rgb_q stage__20(
         .d(stage__20__d),
         .q(stage__20__q),
         .clock(stage__20__clock)
@@ -14187,7 +15991,7 @@ module dynrt_processor_core__tester__intersect_unit__operand_delay__0(clock,data
         data_out = stage__20__q;
     end
     
-endmodule // dynrt_processor_core__tester__intersect_unit__operand_delay__0
+endmodule // dynrt_processor__engine__tester__intersect_unit__operand_delay__0
 
 
 
@@ -14452,7 +16256,7 @@ endmodule // dynrt_processor_core__tester__intersect_unit__operand_delay__0
 
 
 
-module dynrt_processor_core__tester__intersect_unit__t_cmp_delay__0(clock,data_in,data_out);
+module dynrt_processor__engine__tester__intersect_unit__t_cmp_delay__0(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -14516,92 +16320,92 @@ module dynrt_processor_core__tester__intersect_unit__t_cmp_delay__0(clock,data_i
     reg  stage__17__clock;
     
     // Sub module instances
-    dynrt_processor_core__add__big_sign stage__0(
+    dynrt_processor__display__dark_d stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__add__big_sign stage__1(
+    dynrt_processor__display__dark_d stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__add__big_sign stage__2(
+    dynrt_processor__display__dark_d stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__add__big_sign stage__3(
+    dynrt_processor__display__dark_d stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__add__big_sign stage__4(
+    dynrt_processor__display__dark_d stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__add__big_sign stage__5(
+    dynrt_processor__display__dark_d stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__add__big_sign stage__6(
+    dynrt_processor__display__dark_d stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor_core__add__big_sign stage__7(
+    dynrt_processor__display__dark_d stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor_core__add__big_sign stage__8(
+    dynrt_processor__display__dark_d stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor_core__add__big_sign stage__9(
+    dynrt_processor__display__dark_d stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor_core__add__big_sign stage__10(
+    dynrt_processor__display__dark_d stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor_core__add__big_sign stage__11(
+    dynrt_processor__display__dark_d stage__11(
         .d(stage__11__d),
         .q(stage__11__q),
         .clock(stage__11__clock)
     );
-    dynrt_processor_core__add__big_sign stage__12(
+    dynrt_processor__display__dark_d stage__12(
         .d(stage__12__d),
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor_core__add__big_sign stage__13(
+    dynrt_processor__display__dark_d stage__13(
         .d(stage__13__d),
         .q(stage__13__q),
         .clock(stage__13__clock)
     );
-    dynrt_processor_core__add__big_sign stage__14(
+    dynrt_processor__display__dark_d stage__14(
         .d(stage__14__d),
         .q(stage__14__q),
         .clock(stage__14__clock)
     );
-    dynrt_processor_core__add__big_sign stage__15(
+    dynrt_processor__display__dark_d stage__15(
         .d(stage__15__d),
         .q(stage__15__q),
         .clock(stage__15__clock)
     );
-    dynrt_processor_core__add__big_sign stage__16(
+    dynrt_processor__display__dark_d stage__16(
         .d(stage__16__d),
         .q(stage__16__q),
         .clock(stage__16__clock)
     );
-    dynrt_processor_core__add__big_sign stage__17(
+    dynrt_processor__display__dark_d stage__17(
         .d(stage__17__d),
         .q(stage__17__q),
         .clock(stage__17__clock)
@@ -14665,7 +16469,7 @@ module dynrt_processor_core__tester__intersect_unit__t_cmp_delay__0(clock,data_i
         data_out = stage__17__q;
     end
     
-endmodule // dynrt_processor_core__tester__intersect_unit__t_cmp_delay__0
+endmodule // dynrt_processor__engine__tester__intersect_unit__t_cmp_delay__0
 
 
 
@@ -14742,7 +16546,7 @@ endmodule // dynrt_processor_core__tester__intersect_unit__t_cmp_delay__0
 
 
 
-module dynrt_processor_core__tester__intersect_unit__t_delay(clock,data_in,data_out);
+module dynrt_processor__engine__tester__intersect_unit__t_delay(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -14812,102 +16616,102 @@ module dynrt_processor_core__tester__intersect_unit__t_delay(clock,data_in,data_
     reg  stage__19__clock;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a stage__0(
+    dynrt_processor__display__rgb_q stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__add__in_a stage__1(
+    dynrt_processor__display__rgb_q stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__add__in_a stage__2(
+    dynrt_processor__display__rgb_q stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__add__in_a stage__3(
+    dynrt_processor__display__rgb_q stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__add__in_a stage__4(
+    dynrt_processor__display__rgb_q stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__add__in_a stage__5(
+    dynrt_processor__display__rgb_q stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__add__in_a stage__6(
+    dynrt_processor__display__rgb_q stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor_core__add__in_a stage__7(
+    dynrt_processor__display__rgb_q stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor_core__add__in_a stage__8(
+    dynrt_processor__display__rgb_q stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor_core__add__in_a stage__9(
+    dynrt_processor__display__rgb_q stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor_core__add__in_a stage__10(
+    dynrt_processor__display__rgb_q stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor_core__add__in_a stage__11(
+    dynrt_processor__display__rgb_q stage__11(
         .d(stage__11__d),
         .q(stage__11__q),
         .clock(stage__11__clock)
     );
-    dynrt_processor_core__add__in_a stage__12(
+    dynrt_processor__display__rgb_q stage__12(
         .d(stage__12__d),
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor_core__add__in_a stage__13(
+    dynrt_processor__display__rgb_q stage__13(
         .d(stage__13__d),
         .q(stage__13__q),
         .clock(stage__13__clock)
     );
-    dynrt_processor_core__add__in_a stage__14(
+    dynrt_processor__display__rgb_q stage__14(
         .d(stage__14__d),
         .q(stage__14__q),
         .clock(stage__14__clock)
     );
-    dynrt_processor_core__add__in_a stage__15(
+    dynrt_processor__display__rgb_q stage__15(
         .d(stage__15__d),
         .q(stage__15__q),
         .clock(stage__15__clock)
     );
-    dynrt_processor_core__add__in_a stage__16(
+    dynrt_processor__display__rgb_q stage__16(
         .d(stage__16__d),
         .q(stage__16__q),
         .clock(stage__16__clock)
     );
-    dynrt_processor_core__add__in_a stage__17(
+    dynrt_processor__display__rgb_q stage__17(
         .d(stage__17__d),
         .q(stage__17__q),
         .clock(stage__17__clock)
     );
-    dynrt_processor_core__add__in_a stage__18(
+    dynrt_processor__display__rgb_q stage__18(
         .d(stage__18__d),
         .q(stage__18__q),
         .clock(stage__18__clock)
     );
-    dynrt_processor_core__add__in_a stage__19(
+    dynrt_processor__display__rgb_q stage__19(
         .d(stage__19__d),
         .q(stage__19__q),
         .clock(stage__19__clock)
@@ -14977,7 +16781,7 @@ module dynrt_processor_core__tester__intersect_unit__t_delay(clock,data_in,data_
         data_out = stage__19__q;
     end
     
-endmodule // dynrt_processor_core__tester__intersect_unit__t_delay
+endmodule // dynrt_processor__engine__tester__intersect_unit__t_delay
 
 
 
@@ -15020,7 +16824,7 @@ endmodule // dynrt_processor_core__tester__intersect_unit__t_delay
 
 
 
-module dynrt_processor_core__tester__intersect_unit__tag_delay_div(clock,data_in,data_out);
+module dynrt_processor__engine__tester__intersect_unit__tag_delay_div(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -15093,107 +16897,107 @@ module dynrt_processor_core__tester__intersect_unit__tag_delay_div(clock,data_in
     reg  stage__20__clock;
     
     // Sub module instances
-    dynrt_processor_core__px stage__0(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__px stage__1(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__px stage__2(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__px stage__3(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__px stage__4(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__px stage__5(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__px stage__6(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor_core__px stage__7(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor_core__px stage__8(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor_core__px stage__9(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor_core__px stage__10(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor_core__px stage__11(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__11(
         .d(stage__11__d),
         .q(stage__11__q),
         .clock(stage__11__clock)
     );
-    dynrt_processor_core__px stage__12(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__12(
         .d(stage__12__d),
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor_core__px stage__13(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__13(
         .d(stage__13__d),
         .q(stage__13__q),
         .clock(stage__13__clock)
     );
-    dynrt_processor_core__px stage__14(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__14(
         .d(stage__14__d),
         .q(stage__14__q),
         .clock(stage__14__clock)
     );
-    dynrt_processor_core__px stage__15(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__15(
         .d(stage__15__d),
         .q(stage__15__q),
         .clock(stage__15__clock)
     );
-    dynrt_processor_core__px stage__16(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__16(
         .d(stage__16__d),
         .q(stage__16__q),
         .clock(stage__16__clock)
     );
-    dynrt_processor_core__px stage__17(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__17(
         .d(stage__17__d),
         .q(stage__17__q),
         .clock(stage__17__clock)
     );
-    dynrt_processor_core__px stage__18(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__18(
         .d(stage__18__d),
         .q(stage__18__q),
         .clock(stage__18__clock)
     );
-    dynrt_processor_core__px stage__19(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__19(
         .d(stage__19__d),
         .q(stage__19__q),
         .clock(stage__19__clock)
     );
-    dynrt_processor_core__px stage__20(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__20(
         .d(stage__20__d),
         .q(stage__20__q),
         .clock(stage__20__clock)
@@ -15266,7 +17070,7 @@ module dynrt_processor_core__tester__intersect_unit__tag_delay_div(clock,data_in
         data_out = stage__20__q;
     end
     
-endmodule // dynrt_processor_core__tester__intersect_unit__tag_delay_div
+endmodule // dynrt_processor__engine__tester__intersect_unit__tag_delay_div
 
 
 
@@ -15311,7 +17115,7 @@ endmodule // dynrt_processor_core__tester__intersect_unit__tag_delay_div
 
 
 
-module dynrt_processor_core__tester__intersect_unit__tag_delay_rest(clock,data_in,data_out);
+module dynrt_processor__engine__tester__intersect_unit__tag_delay_rest(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -15381,102 +17185,102 @@ module dynrt_processor_core__tester__intersect_unit__tag_delay_rest(clock,data_i
     reg  stage__19__clock;
     
     // Sub module instances
-    dynrt_processor_core__px stage__0(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__px stage__1(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__px stage__2(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__px stage__3(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__px stage__4(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__px stage__5(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__px stage__6(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor_core__px stage__7(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor_core__px stage__8(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor_core__px stage__9(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor_core__px stage__10(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor_core__px stage__11(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__11(
         .d(stage__11__d),
         .q(stage__11__q),
         .clock(stage__11__clock)
     );
-    dynrt_processor_core__px stage__12(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__12(
         .d(stage__12__d),
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor_core__px stage__13(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__13(
         .d(stage__13__d),
         .q(stage__13__q),
         .clock(stage__13__clock)
     );
-    dynrt_processor_core__px stage__14(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__14(
         .d(stage__14__d),
         .q(stage__14__q),
         .clock(stage__14__clock)
     );
-    dynrt_processor_core__px stage__15(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__15(
         .d(stage__15__d),
         .q(stage__15__q),
         .clock(stage__15__clock)
     );
-    dynrt_processor_core__px stage__16(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__16(
         .d(stage__16__d),
         .q(stage__16__q),
         .clock(stage__16__clock)
     );
-    dynrt_processor_core__px stage__17(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__17(
         .d(stage__17__d),
         .q(stage__17__q),
         .clock(stage__17__clock)
     );
-    dynrt_processor_core__px stage__18(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__18(
         .d(stage__18__d),
         .q(stage__18__q),
         .clock(stage__18__clock)
     );
-    dynrt_processor_core__px stage__19(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__19(
         .d(stage__19__d),
         .q(stage__19__q),
         .clock(stage__19__clock)
@@ -15546,7 +17350,7 @@ module dynrt_processor_core__tester__intersect_unit__tag_delay_rest(clock,data_i
         data_out = stage__19__q;
     end
     
-endmodule // dynrt_processor_core__tester__intersect_unit__tag_delay_rest
+endmodule // dynrt_processor__engine__tester__intersect_unit__tag_delay_rest
 
 
 
@@ -15589,7 +17393,7 @@ endmodule // dynrt_processor_core__tester__intersect_unit__tag_delay_rest
 
 
 
-module dynrt_processor_core__tester__intersect_unit__uv_cmp_delay__0(clock,data_in,data_out);
+module dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -15620,37 +17424,37 @@ module dynrt_processor_core__tester__intersect_unit__uv_cmp_delay__0(clock,data_
     reg  stage__6__clock;
     
     // Sub module instances
-    dynrt_processor_core__add__big_sign stage__0(
+    dynrt_processor__display__dark_d stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__add__big_sign stage__1(
+    dynrt_processor__display__dark_d stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__add__big_sign stage__2(
+    dynrt_processor__display__dark_d stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__add__big_sign stage__3(
+    dynrt_processor__display__dark_d stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__add__big_sign stage__4(
+    dynrt_processor__display__dark_d stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__add__big_sign stage__5(
+    dynrt_processor__display__dark_d stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__add__big_sign stage__6(
+    dynrt_processor__display__dark_d stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
@@ -15681,7 +17485,7 @@ module dynrt_processor_core__tester__intersect_unit__uv_cmp_delay__0(clock,data_
         data_out = stage__6__q;
     end
     
-endmodule // dynrt_processor_core__tester__intersect_unit__uv_cmp_delay__0
+endmodule // dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0
 
 
 
@@ -15714,7 +17518,7 @@ endmodule // dynrt_processor_core__tester__intersect_unit__uv_cmp_delay__0
 
 
 
-module dynrt_processor_core__tester__intersect_unit__uv_delay__0(clock,data_in,data_out);
+module dynrt_processor__engine__tester__intersect_unit__uv_delay__0(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -15751,47 +17555,47 @@ module dynrt_processor_core__tester__intersect_unit__uv_delay__0(clock,data_in,d
     reg  stage__8__clock;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a stage__0(
+    dynrt_processor__display__rgb_q stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__add__in_a stage__1(
+    dynrt_processor__display__rgb_q stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__add__in_a stage__2(
+    dynrt_processor__display__rgb_q stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__add__in_a stage__3(
+    dynrt_processor__display__rgb_q stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__add__in_a stage__4(
+    dynrt_processor__display__rgb_q stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__add__in_a stage__5(
+    dynrt_processor__display__rgb_q stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__add__in_a stage__6(
+    dynrt_processor__display__rgb_q stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor_core__add__in_a stage__7(
+    dynrt_processor__display__rgb_q stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor_core__add__in_a stage__8(
+    dynrt_processor__display__rgb_q stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
@@ -15828,7 +17632,7 @@ module dynrt_processor_core__tester__intersect_unit__uv_delay__0(clock,data_in,d
         data_out = stage__8__q;
     end
     
-endmodule // dynrt_processor_core__tester__intersect_unit__uv_delay__0
+endmodule // dynrt_processor__engine__tester__intersect_unit__uv_delay__0
 
 
 
@@ -15873,7 +17677,7 @@ endmodule // dynrt_processor_core__tester__intersect_unit__uv_delay__0
 
 
 
-module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,word_b,full,engine_read,engine_bank,list_read,list_addr,list_rdata,test_valid,test_entry,test_take);
+module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word_a,word_b,full,engine_read,engine_bank,list_read,list_addr,list_rdata,test_valid,test_entry,test_take);
     
     // Module arguments
     input wire  clock;
@@ -16114,7 +17918,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
     reg  [1:0] head_kind;
     
     // Sub module instances
-    dynrt_processor_core__tester__list_unit__commands commands(
+    dynrt_processor__engine__tester__list_unit__commands commands(
         .clock(commands__clock),
         .read(commands__read),
         .data_out(commands__data_out),
@@ -16127,7 +17931,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .almost_full(commands__almost_full),
         .overflow(commands__overflow)
     );
-    dynrt_processor_core__tester__list_unit__tests tests(
+    dynrt_processor__engine__tester__list_unit__tests tests(
         .clock(tests__clock),
         .read(tests__read),
         .data_out(tests__data_out),
@@ -16140,7 +17944,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .almost_full(tests__almost_full),
         .overflow(tests__overflow)
     );
-    dynrt_processor_core__tester__list_unit__object_ram object_ram(
+    dynrt_processor__engine__tester__list_unit__object_ram object_ram(
         .read_address(object_ram__read_address),
         .read_clock(object_ram__read_clock),
         .read_data(object_ram__read_data),
@@ -16149,7 +17953,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(object_ram__write_data),
         .write_enable(object_ram__write_enable)
     );
-    dynrt_processor_core__tester__list_unit__skip_object_ram skip_object_ram(
+    dynrt_processor__engine__tester__list_unit__skip_object_ram skip_object_ram(
         .read_address(skip_object_ram__read_address),
         .read_clock(skip_object_ram__read_clock),
         .read_data(skip_object_ram__read_data),
@@ -16158,7 +17962,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(skip_object_ram__write_data),
         .write_enable(skip_object_ram__write_enable)
     );
-    dynrt_processor_core__tester__list_unit__skip_object_ram skip_triangle_ram(
+    dynrt_processor__engine__tester__list_unit__skip_object_ram skip_triangle_ram(
         .read_address(skip_triangle_ram__read_address),
         .read_clock(skip_triangle_ram__read_clock),
         .read_data(skip_triangle_ram__read_data),
@@ -16167,7 +17971,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(skip_triangle_ram__write_data),
         .write_enable(skip_triangle_ram__write_enable)
     );
-    dynrt_processor_core__tester__flight_a mailbox_ids__0(
+    dynrt_processor__engine__tester__flight_a mailbox_ids__0(
         .read_address(mailbox_ids__0__read_address),
         .read_clock(mailbox_ids__0__read_clock),
         .read_data(mailbox_ids__0__read_data),
@@ -16176,7 +17980,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__0__write_data),
         .write_enable(mailbox_ids__0__write_enable)
     );
-    dynrt_processor_core__tester__flight_a mailbox_ids__1(
+    dynrt_processor__engine__tester__flight_a mailbox_ids__1(
         .read_address(mailbox_ids__1__read_address),
         .read_clock(mailbox_ids__1__read_clock),
         .read_data(mailbox_ids__1__read_data),
@@ -16185,7 +17989,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__1__write_data),
         .write_enable(mailbox_ids__1__write_enable)
     );
-    dynrt_processor_core__tester__flight_a mailbox_ids__2(
+    dynrt_processor__engine__tester__flight_a mailbox_ids__2(
         .read_address(mailbox_ids__2__read_address),
         .read_clock(mailbox_ids__2__read_clock),
         .read_data(mailbox_ids__2__read_data),
@@ -16194,7 +17998,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__2__write_data),
         .write_enable(mailbox_ids__2__write_enable)
     );
-    dynrt_processor_core__tester__flight_a mailbox_ids__3(
+    dynrt_processor__engine__tester__flight_a mailbox_ids__3(
         .read_address(mailbox_ids__3__read_address),
         .read_clock(mailbox_ids__3__read_clock),
         .read_data(mailbox_ids__3__read_data),
@@ -16203,7 +18007,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__3__write_data),
         .write_enable(mailbox_ids__3__write_enable)
     );
-    dynrt_processor_core__tester__flight_a mailbox_ids__4(
+    dynrt_processor__engine__tester__flight_a mailbox_ids__4(
         .read_address(mailbox_ids__4__read_address),
         .read_clock(mailbox_ids__4__read_clock),
         .read_data(mailbox_ids__4__read_data),
@@ -16212,7 +18016,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__4__write_data),
         .write_enable(mailbox_ids__4__write_enable)
     );
-    dynrt_processor_core__tester__flight_a mailbox_ids__5(
+    dynrt_processor__engine__tester__flight_a mailbox_ids__5(
         .read_address(mailbox_ids__5__read_address),
         .read_clock(mailbox_ids__5__read_clock),
         .read_data(mailbox_ids__5__read_data),
@@ -16221,7 +18025,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__5__write_data),
         .write_enable(mailbox_ids__5__write_enable)
     );
-    dynrt_processor_core__tester__flight_a mailbox_ids__6(
+    dynrt_processor__engine__tester__flight_a mailbox_ids__6(
         .read_address(mailbox_ids__6__read_address),
         .read_clock(mailbox_ids__6__read_clock),
         .read_data(mailbox_ids__6__read_data),
@@ -16230,7 +18034,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__6__write_data),
         .write_enable(mailbox_ids__6__write_enable)
     );
-    dynrt_processor_core__tester__flight_a mailbox_ids__7(
+    dynrt_processor__engine__tester__flight_a mailbox_ids__7(
         .read_address(mailbox_ids__7__read_address),
         .read_clock(mailbox_ids__7__read_clock),
         .read_data(mailbox_ids__7__read_data),
@@ -16239,7 +18043,7 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_ids__7__write_data),
         .write_enable(mailbox_ids__7__write_enable)
     );
-    dynrt_processor_core__tester__list_unit__mailbox_meta mailbox_meta(
+    dynrt_processor__engine__tester__list_unit__mailbox_meta mailbox_meta(
         .read_address(mailbox_meta__read_address),
         .read_clock(mailbox_meta__read_clock),
         .read_data(mailbox_meta__read_data),
@@ -16248,132 +18052,132 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         .write_data(mailbox_meta__write_data),
         .write_enable(mailbox_meta__write_enable)
     );
-    dynrt_processor_core__tester__list_unit__phase phase(
+    dynrt_processor__engine__tester__list_unit__phase phase(
         .d(phase__d),
         .q(phase__q),
         .clock(phase__clock)
     );
-    dynrt_processor_core__last_pick walk_thread(
+    dynrt_processor__engine__decode__t3 walk_thread(
         .d(walk_thread__d),
         .q(walk_thread__q),
         .clock(walk_thread__clock)
     );
-    dynrt_processor_core__add__in_a cursor(
+    dynrt_processor__display__rgb_q cursor(
         .d(cursor__d),
         .q(cursor__q),
         .clock(cursor__clock)
     );
-    dynrt_processor_core__add__in_a list_end(
+    dynrt_processor__display__rgb_q list_end(
         .d(list_end__d),
         .q(list_end__q),
         .clock(list_end__clock)
     );
-    dynrt_processor_core__add__big_sign of_walk(
+    dynrt_processor__display__dark_d of_walk(
         .d(of_walk__d),
         .q(of_walk__q),
         .clock(of_walk__clock)
     );
-    dynrt_processor_core__asleep object_id(
+    dynrt_processor__engine__cycle_count object_id(
         .d(object_id__d),
         .q(object_id__q),
         .clock(object_id__clock)
     );
-    dynrt_processor_core__asleep skip_object(
+    dynrt_processor__engine__cycle_count skip_object(
         .d(skip_object__d),
         .q(skip_object__q),
         .clock(skip_object__clock)
     );
-    dynrt_processor_core__asleep skip_triangle(
+    dynrt_processor__engine__cycle_count skip_triangle(
         .d(skip_triangle__d),
         .q(skip_triangle__q),
         .clock(skip_triangle__clock)
     );
-    dynrt_processor_core__asleep ids__0(
+    dynrt_processor__engine__cycle_count ids__0(
         .d(ids__0__d),
         .q(ids__0__q),
         .clock(ids__0__clock)
     );
-    dynrt_processor_core__asleep ids__1(
+    dynrt_processor__engine__cycle_count ids__1(
         .d(ids__1__d),
         .q(ids__1__q),
         .clock(ids__1__clock)
     );
-    dynrt_processor_core__asleep ids__2(
+    dynrt_processor__engine__cycle_count ids__2(
         .d(ids__2__d),
         .q(ids__2__q),
         .clock(ids__2__clock)
     );
-    dynrt_processor_core__asleep ids__3(
+    dynrt_processor__engine__cycle_count ids__3(
         .d(ids__3__d),
         .q(ids__3__q),
         .clock(ids__3__clock)
     );
-    dynrt_processor_core__asleep ids__4(
+    dynrt_processor__engine__cycle_count ids__4(
         .d(ids__4__d),
         .q(ids__4__q),
         .clock(ids__4__clock)
     );
-    dynrt_processor_core__asleep ids__5(
+    dynrt_processor__engine__cycle_count ids__5(
         .d(ids__5__d),
         .q(ids__5__q),
         .clock(ids__5__clock)
     );
-    dynrt_processor_core__asleep ids__6(
+    dynrt_processor__engine__cycle_count ids__6(
         .d(ids__6__d),
         .q(ids__6__q),
         .clock(ids__6__clock)
     );
-    dynrt_processor_core__asleep ids__7(
+    dynrt_processor__engine__cycle_count ids__7(
         .d(ids__7__d),
         .q(ids__7__q),
         .clock(ids__7__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight mb_len(
+    dynrt_processor__engine__tester__list_unit__flight mb_len(
         .d(mb_len__d),
         .q(mb_len__q),
         .clock(mb_len__clock)
     );
-    dynrt_processor_core__cmp_delay__stage__0 mb_next(
+    dynrt_processor__engine__mem_bank_r mb_next(
         .d(mb_next__d),
         .q(mb_next__q),
         .clock(mb_next__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight flight(
+    dynrt_processor__engine__tester__list_unit__flight flight(
         .d(flight__d),
         .q(flight__q),
         .clock(flight__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight queued(
+    dynrt_processor__engine__tester__list_unit__flight queued(
         .d(queued__d),
         .q(queued__q),
         .clock(queued__clock)
     );
-    dynrt_processor_core__add__big_sign flight_line__0(
+    dynrt_processor__display__dark_d flight_line__0(
         .d(flight_line__0__d),
         .q(flight_line__0__q),
         .clock(flight_line__0__clock)
     );
-    dynrt_processor_core__add__big_sign flight_line__1(
+    dynrt_processor__display__dark_d flight_line__1(
         .d(flight_line__1__d),
         .q(flight_line__1__q),
         .clock(flight_line__1__clock)
     );
-    dynrt_processor_core__add__big_sign flight_line__2(
+    dynrt_processor__display__dark_d flight_line__2(
         .d(flight_line__2__d),
         .q(flight_line__2__q),
         .clock(flight_line__2__clock)
     );
-    dynrt_processor_core__add__big_sign flight_line__3(
+    dynrt_processor__display__dark_d flight_line__3(
         .d(flight_line__3__d),
         .q(flight_line__3__q),
         .clock(flight_line__3__clock)
     );
-    dynrt_processor_core__add__big_sign flight_line__4(
+    dynrt_processor__display__dark_d flight_line__4(
         .d(flight_line__4__d),
         .q(flight_line__4__q),
         .clock(flight_line__4__clock)
     );
-    dynrt_processor_core__add__big_sign flight_line__5(
+    dynrt_processor__display__dark_d flight_line__5(
         .d(flight_line__5__d),
         .q(flight_line__5__q),
         .clock(flight_line__5__clock)
@@ -16683,10 +18487,10 @@ module dynrt_processor_core__tester__list_unit(clock,enqueue,kind,thread,word_a,
         end
     end
     
-endmodule // dynrt_processor_core__tester__list_unit
+endmodule // dynrt_processor__engine__tester__list_unit
 
 
-module dynrt_processor_core__tester__list_unit__commands(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
     
     // Module arguments
     input wire  clock;
@@ -16736,7 +18540,7 @@ module dynrt_processor_core__tester__list_unit__commands(clock,read,data_out,emp
     wire  [4:0] write_logic__fill_level;
     
     // Sub module instances
-    dynrt_processor_core__tester__list_unit__commands__ram ram(
+    dynrt_processor__engine__tester__list_unit__commands__ram ram(
         .read_address(ram__read_address),
         .read_clock(ram__read_clock),
         .read_data(ram__read_data),
@@ -16745,7 +18549,7 @@ module dynrt_processor_core__tester__list_unit__commands(clock,read,data_out,emp
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor_core__tester__list_unit__commands__read_logic read_logic(
+    dynrt_processor__engine__tester__list_unit__commands__read_logic read_logic(
         .clock(read_logic__clock),
         .read(read_logic__read),
         .data_out(read_logic__data_out),
@@ -16759,7 +18563,7 @@ module dynrt_processor_core__tester__list_unit__commands(clock,read,data_out,emp
         .read_address_out(read_logic__read_address_out),
         .fill_level(read_logic__fill_level)
     );
-    dynrt_processor_core__tester__list_unit__commands__write_logic write_logic(
+    dynrt_processor__engine__tester__list_unit__commands__write_logic write_logic(
         .write(write_logic__write),
         .data_in(write_logic__data_in),
         .full(write_logic__full),
@@ -16800,10 +18604,10 @@ module dynrt_processor_core__tester__list_unit__commands(clock,read,data_out,emp
         write_logic__read_address = read_logic__read_address_out;
     end
     
-endmodule // dynrt_processor_core__tester__list_unit__commands
+endmodule // dynrt_processor__engine__tester__list_unit__commands
 
 
-module dynrt_processor_core__tester__list_unit__commands__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__tester__list_unit__commands__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [3:0] read_address;
@@ -16829,10 +18633,10 @@ module dynrt_processor_core__tester__list_unit__commands__ram(read_address,read_
        end
     end
                 
-endmodule // dynrt_processor_core__tester__list_unit__commands__ram
+endmodule // dynrt_processor__engine__tester__list_unit__commands__ram
 
 
-module dynrt_processor_core__tester__list_unit__commands__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
+module dynrt_processor__engine__tester__list_unit__commands__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
     
     // Module arguments
     input wire  clock;
@@ -16866,12 +18670,12 @@ module dynrt_processor_core__tester__list_unit__commands__read_logic(clock,read,
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__last_pick read_address(
+    dynrt_processor__engine__decode__t3 read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
     );
-    dynrt_processor_core__add__big_sign dff_underflow(
+    dynrt_processor__display__dark_d dff_underflow(
         .d(dff_underflow__d),
         .q(dff_underflow__q),
         .clock(dff_underflow__clock)
@@ -16906,14 +18710,14 @@ module dynrt_processor_core__tester__list_unit__commands__read_logic(clock,read,
         read_address_out = read_address__q;
     end
     
-endmodule // dynrt_processor_core__tester__list_unit__commands__read_logic
+endmodule // dynrt_processor__engine__tester__list_unit__commands__read_logic
 
 
 
 
 
 
-module dynrt_processor_core__tester__list_unit__commands__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
+module dynrt_processor__engine__tester__list_unit__commands__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
     
     // Module arguments
     input wire  write;
@@ -16951,17 +18755,17 @@ module dynrt_processor_core__tester__list_unit__commands__write_logic(write,data
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__last_pick write_address(
+    dynrt_processor__engine__decode__t3 write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor_core__last_pick dff_write_address_delay(
+    dynrt_processor__engine__decode__t3 dff_write_address_delay(
         .d(dff_write_address_delay__d),
         .q(dff_write_address_delay__q),
         .clock(dff_write_address_delay__clock)
     );
-    dynrt_processor_core__add__big_sign dff_overflow(
+    dynrt_processor__display__dark_d dff_overflow(
         .d(dff_overflow__d),
         .q(dff_overflow__q),
         .clock(dff_overflow__clock)
@@ -17001,7 +18805,7 @@ module dynrt_processor_core__tester__list_unit__commands__write_logic(write,data
         overflow = dff_overflow__q;
     end
     
-endmodule // dynrt_processor_core__tester__list_unit__commands__write_logic
+endmodule // dynrt_processor__engine__tester__list_unit__commands__write_logic
 
 
 
@@ -17012,7 +18816,7 @@ endmodule // dynrt_processor_core__tester__list_unit__commands__write_logic
 
 
 
-module dynrt_processor_core__tester__list_unit__flight(d,q,clock);
+module dynrt_processor__engine__tester__list_unit__flight(d,q,clock);
     
     // Module arguments
     input wire  [3:0] d;
@@ -17028,7 +18832,7 @@ module dynrt_processor_core__tester__list_unit__flight(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__tester__list_unit__flight
+endmodule // dynrt_processor__engine__tester__list_unit__flight
 
 
 
@@ -17077,7 +18881,7 @@ endmodule // dynrt_processor_core__tester__list_unit__flight
 
 
 
-module dynrt_processor_core__tester__list_unit__mailbox_meta(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__tester__list_unit__mailbox_meta(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -17103,7 +18907,7 @@ module dynrt_processor_core__tester__list_unit__mailbox_meta(read_address,read_c
        end
     end
                 
-endmodule // dynrt_processor_core__tester__list_unit__mailbox_meta
+endmodule // dynrt_processor__engine__tester__list_unit__mailbox_meta
 
 
 
@@ -17112,7 +18916,7 @@ endmodule // dynrt_processor_core__tester__list_unit__mailbox_meta
 
 
 
-module dynrt_processor_core__tester__list_unit__object_ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__tester__list_unit__object_ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -17172,12 +18976,12 @@ module dynrt_processor_core__tester__list_unit__object_ram(read_address,read_clo
        end
     end
                 
-endmodule // dynrt_processor_core__tester__list_unit__object_ram
+endmodule // dynrt_processor__engine__tester__list_unit__object_ram
 
 
 
 
-module dynrt_processor_core__tester__list_unit__phase(d,q,clock);
+module dynrt_processor__engine__tester__list_unit__phase(d,q,clock);
     
     // Module arguments
     input wire  [1:0] d;
@@ -17199,14 +19003,14 @@ module dynrt_processor_core__tester__list_unit__phase(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__tester__list_unit__phase
+endmodule // dynrt_processor__engine__tester__list_unit__phase
 
 
 
 
 
 
-module dynrt_processor_core__tester__list_unit__skip_object_ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__tester__list_unit__skip_object_ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -17266,14 +19070,14 @@ module dynrt_processor_core__tester__list_unit__skip_object_ram(read_address,rea
        end
     end
                 
-endmodule // dynrt_processor_core__tester__list_unit__skip_object_ram
+endmodule // dynrt_processor__engine__tester__list_unit__skip_object_ram
 
 
 
 
 
 
-module dynrt_processor_core__tester__list_unit__tests(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
     
     // Module arguments
     input wire  clock;
@@ -17323,7 +19127,7 @@ module dynrt_processor_core__tester__list_unit__tests(clock,read,data_out,empty,
     wire  [3:0] write_logic__fill_level;
     
     // Sub module instances
-    dynrt_processor_core__tester__list_unit__tests__ram ram(
+    dynrt_processor__engine__tester__list_unit__tests__ram ram(
         .read_address(ram__read_address),
         .read_clock(ram__read_clock),
         .read_data(ram__read_data),
@@ -17332,7 +19136,7 @@ module dynrt_processor_core__tester__list_unit__tests(clock,read,data_out,empty,
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor_core__tester__list_unit__tests__read_logic read_logic(
+    dynrt_processor__engine__tester__list_unit__tests__read_logic read_logic(
         .clock(read_logic__clock),
         .read(read_logic__read),
         .data_out(read_logic__data_out),
@@ -17346,7 +19150,7 @@ module dynrt_processor_core__tester__list_unit__tests(clock,read,data_out,empty,
         .read_address_out(read_logic__read_address_out),
         .fill_level(read_logic__fill_level)
     );
-    dynrt_processor_core__tester__list_unit__tests__write_logic write_logic(
+    dynrt_processor__engine__tester__list_unit__tests__write_logic write_logic(
         .write(write_logic__write),
         .data_in(write_logic__data_in),
         .full(write_logic__full),
@@ -17387,10 +19191,10 @@ module dynrt_processor_core__tester__list_unit__tests(clock,read,data_out,empty,
         write_logic__read_address = read_logic__read_address_out;
     end
     
-endmodule // dynrt_processor_core__tester__list_unit__tests
+endmodule // dynrt_processor__engine__tester__list_unit__tests
 
 
-module dynrt_processor_core__tester__list_unit__tests__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__tester__list_unit__tests__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [2:0] read_address;
@@ -17416,10 +19220,10 @@ module dynrt_processor_core__tester__list_unit__tests__ram(read_address,read_clo
        end
     end
                 
-endmodule // dynrt_processor_core__tester__list_unit__tests__ram
+endmodule // dynrt_processor__engine__tester__list_unit__tests__ram
 
 
-module dynrt_processor_core__tester__list_unit__tests__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
+module dynrt_processor__engine__tester__list_unit__tests__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
     
     // Module arguments
     input wire  clock;
@@ -17453,12 +19257,12 @@ module dynrt_processor_core__tester__list_unit__tests__read_logic(clock,read,dat
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__tester__list_unit__flight read_address(
+    dynrt_processor__engine__tester__list_unit__flight read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
     );
-    dynrt_processor_core__add__big_sign dff_underflow(
+    dynrt_processor__display__dark_d dff_underflow(
         .d(dff_underflow__d),
         .q(dff_underflow__q),
         .clock(dff_underflow__clock)
@@ -17493,14 +19297,14 @@ module dynrt_processor_core__tester__list_unit__tests__read_logic(clock,read,dat
         read_address_out = read_address__q;
     end
     
-endmodule // dynrt_processor_core__tester__list_unit__tests__read_logic
+endmodule // dynrt_processor__engine__tester__list_unit__tests__read_logic
 
 
 
 
 
 
-module dynrt_processor_core__tester__list_unit__tests__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
+module dynrt_processor__engine__tester__list_unit__tests__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
     
     // Module arguments
     input wire  write;
@@ -17538,17 +19342,17 @@ module dynrt_processor_core__tester__list_unit__tests__write_logic(write,data_in
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__tester__list_unit__flight write_address(
+    dynrt_processor__engine__tester__list_unit__flight write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight dff_write_address_delay(
+    dynrt_processor__engine__tester__list_unit__flight dff_write_address_delay(
         .d(dff_write_address_delay__d),
         .q(dff_write_address_delay__q),
         .clock(dff_write_address_delay__clock)
     );
-    dynrt_processor_core__add__big_sign dff_overflow(
+    dynrt_processor__display__dark_d dff_overflow(
         .d(dff_overflow__d),
         .q(dff_overflow__q),
         .clock(dff_overflow__clock)
@@ -17588,7 +19392,7 @@ module dynrt_processor_core__tester__list_unit__tests__write_logic(write,data_in
         overflow = dff_overflow__q;
     end
     
-endmodule // dynrt_processor_core__tester__list_unit__tests__write_logic
+endmodule // dynrt_processor__engine__tester__list_unit__tests__write_logic
 
 
 
@@ -17603,7 +19407,7 @@ endmodule // dynrt_processor_core__tester__list_unit__tests__write_logic
 
 
 
-module dynrt_processor_core__tester__lphase(d,q,clock);
+module dynrt_processor__engine__tester__lphase(d,q,clock);
     
     // Module arguments
     input wire  [1:0] d;
@@ -17625,7 +19429,7 @@ module dynrt_processor_core__tester__lphase(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__tester__lphase
+endmodule // dynrt_processor__engine__tester__lphase
 
 
 
@@ -17642,7 +19446,7 @@ endmodule // dynrt_processor_core__tester__lphase
 
 
 
-module dynrt_processor_core__tester__m2_best(d,q,clock);
+module dynrt_processor__engine__tester__m2_best(d,q,clock);
     
     // Module arguments
     input wire  [32:0] d;
@@ -17658,7 +19462,7 @@ module dynrt_processor_core__tester__m2_best(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__tester__m2_best
+endmodule // dynrt_processor__engine__tester__m2_best
 
 
 
@@ -17697,7 +19501,7 @@ endmodule // dynrt_processor_core__tester__m2_best
 
 
 
-module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ray_pair,t_min_write,ray_thread,o__0,o__1,o__2,d__0,d__1,d__2,t_min_thread,t_min);
+module dynrt_processor__engine__tester__ray(clock,thread,word_a,word_b,ray_write,ray_pair,t_min_write,ray_thread,o__0,o__1,o__2,d__0,d__1,d__2,t_min_thread,t_min);
     
     // Module arguments
     input wire  clock;
@@ -17769,7 +19573,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
     reg  words__6__write_enable;
     
     // Sub module instances
-    dynrt_processor_core__tester__flight_t_min words__0(
+    dynrt_processor__engine__tester__flight_t_min words__0(
         .read_address(words__0__read_address),
         .read_clock(words__0__read_clock),
         .read_data(words__0__read_data),
@@ -17778,7 +19582,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__0__write_data),
         .write_enable(words__0__write_enable)
     );
-    dynrt_processor_core__tester__flight_t_min words__1(
+    dynrt_processor__engine__tester__flight_t_min words__1(
         .read_address(words__1__read_address),
         .read_clock(words__1__read_clock),
         .read_data(words__1__read_data),
@@ -17787,7 +19591,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__1__write_data),
         .write_enable(words__1__write_enable)
     );
-    dynrt_processor_core__tester__flight_t_min words__2(
+    dynrt_processor__engine__tester__flight_t_min words__2(
         .read_address(words__2__read_address),
         .read_clock(words__2__read_clock),
         .read_data(words__2__read_data),
@@ -17796,7 +19600,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__2__write_data),
         .write_enable(words__2__write_enable)
     );
-    dynrt_processor_core__tester__flight_t_min words__3(
+    dynrt_processor__engine__tester__flight_t_min words__3(
         .read_address(words__3__read_address),
         .read_clock(words__3__read_clock),
         .read_data(words__3__read_data),
@@ -17805,7 +19609,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__3__write_data),
         .write_enable(words__3__write_enable)
     );
-    dynrt_processor_core__tester__flight_t_min words__4(
+    dynrt_processor__engine__tester__flight_t_min words__4(
         .read_address(words__4__read_address),
         .read_clock(words__4__read_clock),
         .read_data(words__4__read_data),
@@ -17814,7 +19618,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__4__write_data),
         .write_enable(words__4__write_enable)
     );
-    dynrt_processor_core__tester__flight_t_min words__5(
+    dynrt_processor__engine__tester__flight_t_min words__5(
         .read_address(words__5__read_address),
         .read_clock(words__5__read_clock),
         .read_data(words__5__read_data),
@@ -17823,7 +19627,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         .write_data(words__5__write_data),
         .write_enable(words__5__write_enable)
     );
-    dynrt_processor_core__tester__flight_t_min words__6(
+    dynrt_processor__engine__tester__flight_t_min words__6(
         .read_address(words__6__read_address),
         .read_clock(words__6__read_clock),
         .read_data(words__6__read_data),
@@ -17904,7 +19708,7 @@ module dynrt_processor_core__tester__ray(clock,thread,word_a,word_b,ray_write,ra
         t_min = words__6__read_data;
     end
     
-endmodule // dynrt_processor_core__tester__ray
+endmodule // dynrt_processor__engine__tester__ray
 
 
 
@@ -17941,7 +19745,7 @@ endmodule // dynrt_processor_core__tester__ray
 
 
 
-module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__2,m__3,m__4,m__5,m__6,m__7,m__8,m__9,m__10,m__11,v__0,v__1,v__2,point,tag,out_valid,result__0,result__1,result__2,out_tag);
+module dynrt_processor__engine__tester__transform_unit(clock,in_valid,m__0,m__1,m__2,m__3,m__4,m__5,m__6,m__7,m__8,m__9,m__10,m__11,v__0,v__1,v__2,point,tag,out_valid,result__0,result__1,result__2,out_tag);
     
     // Module arguments
     input wire  clock;
@@ -18118,7 +19922,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
     reg  [23:0] offset__2;
     
     // Sub module instances
-    dynrt_processor_core__byte_unit__scale mul__0(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul__0(
         .clock(mul__0__clock),
         .in_valid(mul__0__in_valid),
         .a(mul__0__a),
@@ -18126,7 +19930,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(mul__0__out_valid),
         .result(mul__0__result)
     );
-    dynrt_processor_core__byte_unit__scale mul__1(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul__1(
         .clock(mul__1__clock),
         .in_valid(mul__1__in_valid),
         .a(mul__1__a),
@@ -18134,7 +19938,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(mul__1__out_valid),
         .result(mul__1__result)
     );
-    dynrt_processor_core__byte_unit__scale mul__2(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul__2(
         .clock(mul__2__clock),
         .in_valid(mul__2__in_valid),
         .a(mul__2__a),
@@ -18142,7 +19946,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(mul__2__out_valid),
         .result(mul__2__result)
     );
-    dynrt_processor_core__byte_unit__scale mul__3(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul__3(
         .clock(mul__3__clock),
         .in_valid(mul__3__in_valid),
         .a(mul__3__a),
@@ -18150,7 +19954,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(mul__3__out_valid),
         .result(mul__3__result)
     );
-    dynrt_processor_core__byte_unit__scale mul__4(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul__4(
         .clock(mul__4__clock),
         .in_valid(mul__4__in_valid),
         .a(mul__4__a),
@@ -18158,7 +19962,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(mul__4__out_valid),
         .result(mul__4__result)
     );
-    dynrt_processor_core__byte_unit__scale mul__5(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul__5(
         .clock(mul__5__clock),
         .in_valid(mul__5__in_valid),
         .a(mul__5__a),
@@ -18166,7 +19970,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(mul__5__out_valid),
         .result(mul__5__result)
     );
-    dynrt_processor_core__byte_unit__scale mul__6(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul__6(
         .clock(mul__6__clock),
         .in_valid(mul__6__in_valid),
         .a(mul__6__a),
@@ -18174,7 +19978,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(mul__6__out_valid),
         .result(mul__6__result)
     );
-    dynrt_processor_core__byte_unit__scale mul__7(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul__7(
         .clock(mul__7__clock),
         .in_valid(mul__7__in_valid),
         .a(mul__7__a),
@@ -18182,7 +19986,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(mul__7__out_valid),
         .result(mul__7__result)
     );
-    dynrt_processor_core__byte_unit__scale mul__8(
+    dynrt_processor__engine__fp_units__byte_unit__scale mul__8(
         .clock(mul__8__clock),
         .in_valid(mul__8__in_valid),
         .a(mul__8__a),
@@ -18190,7 +19994,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(mul__8__out_valid),
         .result(mul__8__result)
     );
-    dynrt_processor_core__add add__0(
+    dynrt_processor__engine__fp_units__add add__0(
         .clock(add__0__clock),
         .in_valid(add__0__in_valid),
         .a(add__0__a),
@@ -18199,7 +20003,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(add__0__out_valid),
         .result(add__0__result)
     );
-    dynrt_processor_core__add add__1(
+    dynrt_processor__engine__fp_units__add add__1(
         .clock(add__1__clock),
         .in_valid(add__1__in_valid),
         .a(add__1__a),
@@ -18208,7 +20012,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(add__1__out_valid),
         .result(add__1__result)
     );
-    dynrt_processor_core__add add__2(
+    dynrt_processor__engine__fp_units__add add__2(
         .clock(add__2__clock),
         .in_valid(add__2__in_valid),
         .a(add__2__a),
@@ -18217,7 +20021,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(add__2__out_valid),
         .result(add__2__result)
     );
-    dynrt_processor_core__add add__3(
+    dynrt_processor__engine__fp_units__add add__3(
         .clock(add__3__clock),
         .in_valid(add__3__in_valid),
         .a(add__3__a),
@@ -18226,7 +20030,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(add__3__out_valid),
         .result(add__3__result)
     );
-    dynrt_processor_core__add add__4(
+    dynrt_processor__engine__fp_units__add add__4(
         .clock(add__4__clock),
         .in_valid(add__4__in_valid),
         .a(add__4__a),
@@ -18235,7 +20039,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(add__4__out_valid),
         .result(add__4__result)
     );
-    dynrt_processor_core__add add__5(
+    dynrt_processor__engine__fp_units__add add__5(
         .clock(add__5__clock),
         .in_valid(add__5__in_valid),
         .a(add__5__a),
@@ -18244,7 +20048,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(add__5__out_valid),
         .result(add__5__result)
     );
-    dynrt_processor_core__add add__6(
+    dynrt_processor__engine__fp_units__add add__6(
         .clock(add__6__clock),
         .in_valid(add__6__in_valid),
         .a(add__6__a),
@@ -18253,7 +20057,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(add__6__out_valid),
         .result(add__6__result)
     );
-    dynrt_processor_core__add add__7(
+    dynrt_processor__engine__fp_units__add add__7(
         .clock(add__7__clock),
         .in_valid(add__7__in_valid),
         .a(add__7__a),
@@ -18262,7 +20066,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(add__7__out_valid),
         .result(add__7__result)
     );
-    dynrt_processor_core__add add__8(
+    dynrt_processor__engine__fp_units__add add__8(
         .clock(add__8__clock),
         .in_valid(add__8__in_valid),
         .a(add__8__a),
@@ -18271,37 +20075,37 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         .out_valid(add__8__out_valid),
         .result(add__8__result)
     );
-    dynrt_processor_core__mul_delay p2_delay__0(
+    dynrt_processor__engine__fp_units__mul_delay p2_delay__0(
         .clock(p2_delay__0__clock),
         .data_in(p2_delay__0__data_in),
         .data_out(p2_delay__0__data_out)
     );
-    dynrt_processor_core__mul_delay p2_delay__1(
+    dynrt_processor__engine__fp_units__mul_delay p2_delay__1(
         .clock(p2_delay__1__clock),
         .data_in(p2_delay__1__data_in),
         .data_out(p2_delay__1__data_out)
     );
-    dynrt_processor_core__mul_delay p2_delay__2(
+    dynrt_processor__engine__fp_units__mul_delay p2_delay__2(
         .clock(p2_delay__2__clock),
         .data_in(p2_delay__2__data_in),
         .data_out(p2_delay__2__data_out)
     );
-    dynrt_processor_core__tester__transform_unit__offset_delay__0 offset_delay__0(
+    dynrt_processor__engine__tester__transform_unit__offset_delay__0 offset_delay__0(
         .clock(offset_delay__0__clock),
         .data_in(offset_delay__0__data_in),
         .data_out(offset_delay__0__data_out)
     );
-    dynrt_processor_core__tester__transform_unit__offset_delay__0 offset_delay__1(
+    dynrt_processor__engine__tester__transform_unit__offset_delay__0 offset_delay__1(
         .clock(offset_delay__1__clock),
         .data_in(offset_delay__1__data_in),
         .data_out(offset_delay__1__data_out)
     );
-    dynrt_processor_core__tester__transform_unit__offset_delay__0 offset_delay__2(
+    dynrt_processor__engine__tester__transform_unit__offset_delay__0 offset_delay__2(
         .clock(offset_delay__2__clock),
         .data_in(offset_delay__2__data_in),
         .data_out(offset_delay__2__data_out)
     );
-    dynrt_processor_core__tester__transform_unit__tag_delay tag_delay(
+    dynrt_processor__engine__tester__transform_unit__tag_delay tag_delay(
         .clock(tag_delay__clock),
         .data_in(tag_delay__data_in),
         .data_out(tag_delay__data_out)
@@ -18423,7 +20227,7 @@ module dynrt_processor_core__tester__transform_unit(clock,in_valid,m__0,m__1,m__
         out_valid = add__2__out_valid;
     end
     
-endmodule // dynrt_processor_core__tester__transform_unit
+endmodule // dynrt_processor__engine__tester__transform_unit
 
 
 
@@ -19812,7 +21616,7 @@ endmodule // dynrt_processor_core__tester__transform_unit
 
 
 
-module dynrt_processor_core__tester__transform_unit__offset_delay__0(clock,data_in,data_out);
+module dynrt_processor__engine__tester__transform_unit__offset_delay__0(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -19876,92 +21680,92 @@ module dynrt_processor_core__tester__transform_unit__offset_delay__0(clock,data_
     reg  stage__17__clock;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a stage__0(
+    dynrt_processor__display__rgb_q stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__add__in_a stage__1(
+    dynrt_processor__display__rgb_q stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__add__in_a stage__2(
+    dynrt_processor__display__rgb_q stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__add__in_a stage__3(
+    dynrt_processor__display__rgb_q stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__add__in_a stage__4(
+    dynrt_processor__display__rgb_q stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__add__in_a stage__5(
+    dynrt_processor__display__rgb_q stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__add__in_a stage__6(
+    dynrt_processor__display__rgb_q stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor_core__add__in_a stage__7(
+    dynrt_processor__display__rgb_q stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor_core__add__in_a stage__8(
+    dynrt_processor__display__rgb_q stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor_core__add__in_a stage__9(
+    dynrt_processor__display__rgb_q stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor_core__add__in_a stage__10(
+    dynrt_processor__display__rgb_q stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor_core__add__in_a stage__11(
+    dynrt_processor__display__rgb_q stage__11(
         .d(stage__11__d),
         .q(stage__11__q),
         .clock(stage__11__clock)
     );
-    dynrt_processor_core__add__in_a stage__12(
+    dynrt_processor__display__rgb_q stage__12(
         .d(stage__12__d),
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor_core__add__in_a stage__13(
+    dynrt_processor__display__rgb_q stage__13(
         .d(stage__13__d),
         .q(stage__13__q),
         .clock(stage__13__clock)
     );
-    dynrt_processor_core__add__in_a stage__14(
+    dynrt_processor__display__rgb_q stage__14(
         .d(stage__14__d),
         .q(stage__14__q),
         .clock(stage__14__clock)
     );
-    dynrt_processor_core__add__in_a stage__15(
+    dynrt_processor__display__rgb_q stage__15(
         .d(stage__15__d),
         .q(stage__15__q),
         .clock(stage__15__clock)
     );
-    dynrt_processor_core__add__in_a stage__16(
+    dynrt_processor__display__rgb_q stage__16(
         .d(stage__16__d),
         .q(stage__16__q),
         .clock(stage__16__clock)
     );
-    dynrt_processor_core__add__in_a stage__17(
+    dynrt_processor__display__rgb_q stage__17(
         .d(stage__17__d),
         .q(stage__17__q),
         .clock(stage__17__clock)
@@ -20025,7 +21829,7 @@ module dynrt_processor_core__tester__transform_unit__offset_delay__0(clock,data_
         data_out = stage__17__q;
     end
     
-endmodule // dynrt_processor_core__tester__transform_unit__offset_delay__0
+endmodule // dynrt_processor__engine__tester__transform_unit__offset_delay__0
 
 
 
@@ -20188,7 +21992,7 @@ endmodule // dynrt_processor_core__tester__transform_unit__offset_delay__0
 
 
 
-module dynrt_processor_core__tester__transform_unit__tag_delay(clock,data_in,data_out);
+module dynrt_processor__engine__tester__transform_unit__tag_delay(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -20273,127 +22077,127 @@ module dynrt_processor_core__tester__transform_unit__tag_delay(clock,data_in,dat
     reg  stage__24__clock;
     
     // Sub module instances
-    dynrt_processor_core__px stage__0(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__px stage__1(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__px stage__2(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__px stage__3(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__px stage__4(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__px stage__5(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__px stage__6(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor_core__px stage__7(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor_core__px stage__8(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor_core__px stage__9(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor_core__px stage__10(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor_core__px stage__11(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__11(
         .d(stage__11__d),
         .q(stage__11__q),
         .clock(stage__11__clock)
     );
-    dynrt_processor_core__px stage__12(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__12(
         .d(stage__12__d),
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor_core__px stage__13(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__13(
         .d(stage__13__d),
         .q(stage__13__q),
         .clock(stage__13__clock)
     );
-    dynrt_processor_core__px stage__14(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__14(
         .d(stage__14__d),
         .q(stage__14__q),
         .clock(stage__14__clock)
     );
-    dynrt_processor_core__px stage__15(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__15(
         .d(stage__15__d),
         .q(stage__15__q),
         .clock(stage__15__clock)
     );
-    dynrt_processor_core__px stage__16(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__16(
         .d(stage__16__d),
         .q(stage__16__q),
         .clock(stage__16__clock)
     );
-    dynrt_processor_core__px stage__17(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__17(
         .d(stage__17__d),
         .q(stage__17__q),
         .clock(stage__17__clock)
     );
-    dynrt_processor_core__px stage__18(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__18(
         .d(stage__18__d),
         .q(stage__18__q),
         .clock(stage__18__clock)
     );
-    dynrt_processor_core__px stage__19(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__19(
         .d(stage__19__d),
         .q(stage__19__q),
         .clock(stage__19__clock)
     );
-    dynrt_processor_core__px stage__20(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__20(
         .d(stage__20__d),
         .q(stage__20__q),
         .clock(stage__20__clock)
     );
-    dynrt_processor_core__px stage__21(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__21(
         .d(stage__21__d),
         .q(stage__21__q),
         .clock(stage__21__clock)
     );
-    dynrt_processor_core__px stage__22(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__22(
         .d(stage__22__d),
         .q(stage__22__q),
         .clock(stage__22__clock)
     );
-    dynrt_processor_core__px stage__23(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__23(
         .d(stage__23__d),
         .q(stage__23__q),
         .clock(stage__23__clock)
     );
-    dynrt_processor_core__px stage__24(
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__24(
         .d(stage__24__d),
         .q(stage__24__q),
         .clock(stage__24__clock)
@@ -20478,7 +22282,7 @@ module dynrt_processor_core__tester__transform_unit__tag_delay(clock,data_in,dat
         data_out = stage__24__q;
     end
     
-endmodule // dynrt_processor_core__tester__transform_unit__tag_delay
+endmodule // dynrt_processor__engine__tester__transform_unit__tag_delay
 
 
 
@@ -20599,29 +22403,29 @@ endmodule // dynrt_processor_core__tester__transform_unit__tag_delay
 
 
 
-module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write,ray_pair,t_min_write,enqueue,full,query_thread,pending,engine_read,engine_bank,engine_addr,node_read,node_addr,node_rdata,step_busy,done_event,done_thread,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit);
+module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_read,engine__load_bank,engine__load_addr,t_min_write,nodes__read,nodes__addr,nodes__rdata,step_busy,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit);
     
     // Module arguments
     input wire  clock;
-    input wire  [4:0] thread;
-    input wire  [31:0] word_a;
-    input wire  [31:0] word_b;
-    input wire  ray_write;
-    input wire  [1:0] ray_pair;
+    input wire  [4:0] engine__thread;
+    input wire  [31:0] engine__word_a;
+    input wire  [31:0] engine__word_b;
+    input wire  engine__ray_write;
+    input wire  [1:0] engine__ray_pair;
+    input wire  engine__enqueue;
+    output reg  engine__full;
+    input wire  [4:0] engine__query_thread;
+    output reg  engine__pending;
+    output reg  engine__done;
+    output reg  [4:0] engine__done_thread;
+    input wire  engine__load_read;
+    input wire  [2:0] engine__load_bank;
+    input wire  [23:0] engine__load_addr;
     input wire  t_min_write;
-    input wire  enqueue;
-    output reg  full;
-    input wire  [4:0] query_thread;
-    output reg  pending;
-    input wire  engine_read;
-    input wire  [2:0] engine_bank;
-    input wire  [23:0] engine_addr;
-    output reg  node_read;
-    output reg  [23:0] node_addr;
-    input wire  [31:0] node_rdata;
+    output reg  nodes__read;
+    output reg  [23:0] nodes__addr;
+    input wire  [31:0] nodes__rdata;
     output reg  step_busy;
-    output reg  done_event;
-    output reg  [4:0] done_thread;
     output reg  leaf_valid;
     output reg  [4:0] leaf_thread;
     output reg  [31:0] leaf_from;
@@ -21080,7 +22884,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
     reg  [25:0] d_far;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__entry_fifo entry_fifo(
+    dynrt_processor__engine__traversal_unit__entry_fifo entry_fifo(
         .clock(entry_fifo__clock),
         .read(entry_fifo__read),
         .data_out(entry_fifo__data_out),
@@ -21093,7 +22897,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .almost_full(entry_fifo__almost_full),
         .overflow(entry_fifo__overflow)
     );
-    dynrt_processor_core__traversal_unit__leaf_fifo leaf_fifo(
+    dynrt_processor__engine__traversal_unit__leaf_fifo leaf_fifo(
         .clock(leaf_fifo__clock),
         .read(leaf_fifo__read),
         .data_out(leaf_fifo__data_out),
@@ -21106,7 +22910,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .almost_full(leaf_fifo__almost_full),
         .overflow(leaf_fifo__overflow)
     );
-    dynrt_processor_core__traversal_unit__any_hit any_hit(
+    dynrt_processor__engine__traversal_unit__any_hit any_hit(
         .read_address(any_hit__read_address),
         .read_clock(any_hit__read_clock),
         .read_data(any_hit__read_data),
@@ -21115,7 +22919,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(any_hit__write_data),
         .write_enable(any_hit__write_enable)
     );
-    dynrt_processor_core__traversal_unit__front_fifo front_fifo(
+    dynrt_processor__engine__traversal_unit__front_fifo front_fifo(
         .clock(front_fifo__clock),
         .read(front_fifo__read),
         .data_out(front_fifo__data_out),
@@ -21128,7 +22932,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .almost_full(front_fifo__almost_full),
         .overflow(front_fifo__overflow)
     );
-    dynrt_processor_core__traversal_unit__front_fifo loop_fifo(
+    dynrt_processor__engine__traversal_unit__front_fifo loop_fifo(
         .clock(loop_fifo__clock),
         .read(loop_fifo__read),
         .data_out(loop_fifo__data_out),
@@ -21141,7 +22945,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .almost_full(loop_fifo__almost_full),
         .overflow(loop_fifo__overflow)
     );
-    dynrt_processor_core__tester__ray ray(
+    dynrt_processor__engine__tester__ray ray(
         .clock(ray__clock),
         .thread(ray__thread),
         .word_a(ray__word_a),
@@ -21159,7 +22963,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .t_min_thread(ray__t_min_thread),
         .t_min(ray__t_min)
     );
-    dynrt_processor_core__tester__done_e issued(
+    dynrt_processor__engine__tester__done_e issued(
         .read_address(issued__read_address),
         .read_clock(issued__read_clock),
         .read_data(issued__read_data),
@@ -21168,7 +22972,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(issued__write_data),
         .write_enable(issued__write_enable)
     );
-    dynrt_processor_core__tester__done_e done_e(
+    dynrt_processor__engine__tester__done_e done_e(
         .read_address(done_e__read_address),
         .read_clock(done_e__read_clock),
         .read_data(done_e__read_data),
@@ -21177,7 +22981,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(done_e__write_data),
         .write_enable(done_e__write_enable)
     );
-    dynrt_processor_core__tester__done_e done_u(
+    dynrt_processor__engine__tester__done_e done_u(
         .read_address(done_u__read_address),
         .read_clock(done_u__read_clock),
         .read_data(done_u__read_data),
@@ -21186,7 +22990,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(done_u__write_data),
         .write_enable(done_u__write_enable)
     );
-    dynrt_processor_core__tester__flight_t_min leaf_hi(
+    dynrt_processor__engine__tester__flight_t_min leaf_hi(
         .read_address(leaf_hi__read_address),
         .read_clock(leaf_hi__read_clock),
         .read_data(leaf_hi__read_data),
@@ -21195,7 +22999,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(leaf_hi__write_data),
         .write_enable(leaf_hi__write_enable)
     );
-    dynrt_processor_core__traversal_unit__leaf_sp leaf_sp(
+    dynrt_processor__engine__traversal_unit__leaf_sp leaf_sp(
         .read_address(leaf_sp__read_address),
         .read_clock(leaf_sp__read_clock),
         .read_data(leaf_sp__read_data),
@@ -21204,7 +23008,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(leaf_sp__write_data),
         .write_enable(leaf_sp__write_enable)
     );
-    dynrt_processor_core__traversal_unit__stack_node stack_node(
+    dynrt_processor__engine__traversal_unit__stack_node stack_node(
         .read_address(stack_node__read_address),
         .read_clock(stack_node__read_clock),
         .read_data(stack_node__read_data),
@@ -21213,7 +23017,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(stack_node__write_data),
         .write_enable(stack_node__write_enable)
     );
-    dynrt_processor_core__traversal_unit__stack_hi stack_lo(
+    dynrt_processor__engine__traversal_unit__stack_hi stack_lo(
         .read_address(stack_lo__read_address),
         .read_clock(stack_lo__read_clock),
         .read_data(stack_lo__read_data),
@@ -21222,7 +23026,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(stack_lo__write_data),
         .write_enable(stack_lo__write_enable)
     );
-    dynrt_processor_core__traversal_unit__stack_hi stack_hi(
+    dynrt_processor__engine__traversal_unit__stack_hi stack_hi(
         .read_address(stack_hi__read_address),
         .read_clock(stack_hi__read_clock),
         .read_data(stack_hi__read_data),
@@ -21231,197 +23035,197 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .write_data(stack_hi__write_data),
         .write_enable(stack_hi__write_enable)
     );
-    dynrt_processor_core__add__big_sign f1_valid(
+    dynrt_processor__display__dark_d f1_valid(
         .d(f1_valid__d),
         .q(f1_valid__q),
         .clock(f1_valid__clock)
     );
-    dynrt_processor_core__add__big_sign f1_next(
+    dynrt_processor__display__dark_d f1_next(
         .d(f1_next__d),
         .q(f1_next__q),
         .clock(f1_next__clock)
     );
-    dynrt_processor_core__last_pick f1_thread(
+    dynrt_processor__engine__decode__t3 f1_thread(
         .d(f1_thread__d),
         .q(f1_thread__q),
         .clock(f1_thread__clock)
     );
-    dynrt_processor_core__asleep f1_a(
+    dynrt_processor__engine__cycle_count f1_a(
         .d(f1_a__d),
         .q(f1_a__q),
         .clock(f1_a__clock)
     );
-    dynrt_processor_core__asleep f1_b(
+    dynrt_processor__engine__cycle_count f1_b(
         .d(f1_b__d),
         .q(f1_b__q),
         .clock(f1_b__clock)
     );
-    dynrt_processor_core__add__big_sign f2_valid(
+    dynrt_processor__display__dark_d f2_valid(
         .d(f2_valid__d),
         .q(f2_valid__q),
         .clock(f2_valid__clock)
     );
-    dynrt_processor_core__add__big_sign f2_next(
+    dynrt_processor__display__dark_d f2_next(
         .d(f2_next__d),
         .q(f2_next__q),
         .clock(f2_next__clock)
     );
-    dynrt_processor_core__last_pick f2_thread(
+    dynrt_processor__engine__decode__t3 f2_thread(
         .d(f2_thread__d),
         .q(f2_thread__q),
         .clock(f2_thread__clock)
     );
-    dynrt_processor_core__asleep f2_a(
+    dynrt_processor__engine__cycle_count f2_a(
         .d(f2_a__d),
         .q(f2_a__q),
         .clock(f2_a__clock)
     );
-    dynrt_processor_core__asleep f2_b(
+    dynrt_processor__engine__cycle_count f2_b(
         .d(f2_b__d),
         .q(f2_b__q),
         .clock(f2_b__clock)
     );
-    dynrt_processor_core__add__big_sign f3_valid(
+    dynrt_processor__display__dark_d f3_valid(
         .d(f3_valid__d),
         .q(f3_valid__q),
         .clock(f3_valid__clock)
     );
-    dynrt_processor_core__add__big_sign f3_next(
+    dynrt_processor__display__dark_d f3_next(
         .d(f3_next__d),
         .q(f3_next__q),
         .clock(f3_next__clock)
     );
-    dynrt_processor_core__last_pick f3_thread(
+    dynrt_processor__engine__decode__t3 f3_thread(
         .d(f3_thread__d),
         .q(f3_thread__q),
         .clock(f3_thread__clock)
     );
-    dynrt_processor_core__asleep f3_a(
+    dynrt_processor__engine__cycle_count f3_a(
         .d(f3_a__d),
         .q(f3_a__q),
         .clock(f3_a__clock)
     );
-    dynrt_processor_core__asleep f3_b(
+    dynrt_processor__engine__cycle_count f3_b(
         .d(f3_b__d),
         .q(f3_b__q),
         .clock(f3_b__clock)
     );
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address f3_sp(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address f3_sp(
         .d(f3_sp__d),
         .q(f3_sp__q),
         .clock(f3_sp__clock)
     );
-    dynrt_processor_core__add__in_a f3_t_min(
+    dynrt_processor__display__rgb_q f3_t_min(
         .d(f3_t_min__d),
         .q(f3_t_min__q),
         .clock(f3_t_min__clock)
     );
-    dynrt_processor_core__add__big_sign f4_valid(
+    dynrt_processor__display__dark_d f4_valid(
         .d(f4_valid__d),
         .q(f4_valid__q),
         .clock(f4_valid__clock)
     );
-    dynrt_processor_core__add__big_sign f4_next(
+    dynrt_processor__display__dark_d f4_next(
         .d(f4_next__d),
         .q(f4_next__q),
         .clock(f4_next__clock)
     );
-    dynrt_processor_core__last_pick f4_thread(
+    dynrt_processor__engine__decode__t3 f4_thread(
         .d(f4_thread__d),
         .q(f4_thread__q),
         .clock(f4_thread__clock)
     );
-    dynrt_processor_core__asleep f4_a(
+    dynrt_processor__engine__cycle_count f4_a(
         .d(f4_a__d),
         .q(f4_a__q),
         .clock(f4_a__clock)
     );
-    dynrt_processor_core__asleep f4_b(
+    dynrt_processor__engine__cycle_count f4_b(
         .d(f4_b__d),
         .q(f4_b__q),
         .clock(f4_b__clock)
     );
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address f4_sp(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address f4_sp(
         .d(f4_sp__d),
         .q(f4_sp__q),
         .clock(f4_sp__clock)
     );
-    dynrt_processor_core__add__in_a f4_t_min(
+    dynrt_processor__display__rgb_q f4_t_min(
         .d(f4_t_min__d),
         .q(f4_t_min__q),
         .clock(f4_t_min__clock)
     );
-    dynrt_processor_core__traversal_unit__f4_node f4_node(
+    dynrt_processor__engine__traversal_unit__f4_node f4_node(
         .d(f4_node__d),
         .q(f4_node__q),
         .clock(f4_node__clock)
     );
-    dynrt_processor_core__add__in_a f4_lo(
+    dynrt_processor__display__rgb_q f4_lo(
         .d(f4_lo__d),
         .q(f4_lo__q),
         .clock(f4_lo__clock)
     );
-    dynrt_processor_core__add__in_a f4_hi(
+    dynrt_processor__display__rgb_q f4_hi(
         .d(f4_hi__d),
         .q(f4_hi__q),
         .clock(f4_hi__clock)
     );
-    dynrt_processor_core__add__big_sign f5_valid(
+    dynrt_processor__display__dark_d f5_valid(
         .d(f5_valid__d),
         .q(f5_valid__q),
         .clock(f5_valid__clock)
     );
-    dynrt_processor_core__add__big_sign f5_next(
+    dynrt_processor__display__dark_d f5_next(
         .d(f5_next__d),
         .q(f5_next__q),
         .clock(f5_next__clock)
     );
-    dynrt_processor_core__last_pick f5_thread(
+    dynrt_processor__engine__decode__t3 f5_thread(
         .d(f5_thread__d),
         .q(f5_thread__q),
         .clock(f5_thread__clock)
     );
-    dynrt_processor_core__asleep f5_a(
+    dynrt_processor__engine__cycle_count f5_a(
         .d(f5_a__d),
         .q(f5_a__q),
         .clock(f5_a__clock)
     );
-    dynrt_processor_core__asleep f5_b(
+    dynrt_processor__engine__cycle_count f5_b(
         .d(f5_b__d),
         .q(f5_b__q),
         .clock(f5_b__clock)
     );
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address f5_sp(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address f5_sp(
         .d(f5_sp__d),
         .q(f5_sp__q),
         .clock(f5_sp__clock)
     );
-    dynrt_processor_core__add__in_a f5_t_min(
+    dynrt_processor__display__rgb_q f5_t_min(
         .d(f5_t_min__d),
         .q(f5_t_min__q),
         .clock(f5_t_min__clock)
     );
-    dynrt_processor_core__traversal_unit__f4_node f5_node(
+    dynrt_processor__engine__traversal_unit__f4_node f5_node(
         .d(f5_node__d),
         .q(f5_node__q),
         .clock(f5_node__clock)
     );
-    dynrt_processor_core__add__in_a f5_lo(
+    dynrt_processor__display__rgb_q f5_lo(
         .d(f5_lo__d),
         .q(f5_lo__q),
         .clock(f5_lo__clock)
     );
-    dynrt_processor_core__add__in_a f5_hi(
+    dynrt_processor__display__rgb_q f5_hi(
         .d(f5_hi__d),
         .q(f5_hi__q),
         .clock(f5_hi__clock)
     );
-    dynrt_processor_core__add__big_sign f5_in_leaf(
+    dynrt_processor__display__dark_d f5_in_leaf(
         .d(f5_in_leaf__d),
         .q(f5_in_leaf__q),
         .clock(f5_in_leaf__clock)
     );
-    dynrt_processor_core__cmp cmp_leaf(
+    dynrt_processor__engine__fp_units__cmp cmp_leaf(
         .clock(cmp_leaf__clock),
         .in_valid(cmp_leaf__in_valid),
         .a(cmp_leaf__a),
@@ -21431,7 +23235,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .le(cmp_leaf__le),
         .eq(cmp_leaf__eq)
     );
-    dynrt_processor_core__cmp cmp_pop(
+    dynrt_processor__engine__fp_units__cmp cmp_pop(
         .clock(cmp_pop__clock),
         .in_valid(cmp_pop__in_valid),
         .a(cmp_pop__a),
@@ -21441,17 +23245,17 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .le(cmp_pop__le),
         .eq(cmp_pop__eq)
     );
-    dynrt_processor_core__traversal_unit__phase phase(
+    dynrt_processor__engine__traversal_unit__phase phase(
         .d(phase__d),
         .q(phase__q),
         .clock(phase__clock)
     );
-    dynrt_processor_core__traversal_unit__fetch_job fetch_job(
+    dynrt_processor__engine__traversal_unit__fetch_job fetch_job(
         .d(fetch_job__d),
         .q(fetch_job__q),
         .clock(fetch_job__clock)
     );
-    dynrt_processor_core__traversal_unit__in_flight in_flight(
+    dynrt_processor__engine__traversal_unit__in_flight in_flight(
         .clock(in_flight__clock),
         .read(in_flight__read),
         .data_out(in_flight__data_out),
@@ -21464,57 +23268,57 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .almost_full(in_flight__almost_full),
         .overflow(in_flight__overflow)
     );
-    dynrt_processor_core__traversal_unit__fetch_job job(
+    dynrt_processor__engine__traversal_unit__fetch_job job(
         .d(job__d),
         .q(job__q),
         .clock(job__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 words_in(
+    dynrt_processor__engine__tester__cur_kind__0 words_in(
         .d(words_in__d),
         .q(words_in__q),
         .clock(words_in__clock)
     );
-    dynrt_processor_core__asleep w0(
+    dynrt_processor__engine__cycle_count w0(
         .d(w0__d),
         .q(w0__q),
         .clock(w0__clock)
     );
-    dynrt_processor_core__asleep w1(
+    dynrt_processor__engine__cycle_count w1(
         .d(w1__d),
         .q(w1__q),
         .clock(w1__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 node_line__0(
+    dynrt_processor__engine__tester__cur_kind__0 node_line__0(
         .d(node_line__0__d),
         .q(node_line__0__q),
         .clock(node_line__0__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 node_line__1(
+    dynrt_processor__engine__tester__cur_kind__0 node_line__1(
         .d(node_line__1__d),
         .q(node_line__1__q),
         .clock(node_line__1__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 node_line__2(
+    dynrt_processor__engine__tester__cur_kind__0 node_line__2(
         .d(node_line__2__d),
         .q(node_line__2__q),
         .clock(node_line__2__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 node_line__3(
+    dynrt_processor__engine__tester__cur_kind__0 node_line__3(
         .d(node_line__3__d),
         .q(node_line__3__q),
         .clock(node_line__3__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 node_line__4(
+    dynrt_processor__engine__tester__cur_kind__0 node_line__4(
         .d(node_line__4__d),
         .q(node_line__4__q),
         .clock(node_line__4__clock)
     );
-    dynrt_processor_core__tester__cur_kind__0 node_line__5(
+    dynrt_processor__engine__tester__cur_kind__0 node_line__5(
         .d(node_line__5__d),
         .q(node_line__5__q),
         .clock(node_line__5__clock)
     );
-    dynrt_processor_core__add sub(
+    dynrt_processor__engine__fp_units__add sub(
         .clock(sub__clock),
         .in_valid(sub__in_valid),
         .a(sub__a),
@@ -21523,7 +23327,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .out_valid(sub__out_valid),
         .result(sub__result)
     );
-    dynrt_processor_core__div div(
+    dynrt_processor__engine__fp_units__div div(
         .clock(div__clock),
         .in_valid(div__in_valid),
         .a(div__a),
@@ -21531,72 +23335,72 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .out_valid(div__out_valid),
         .result(div__result)
     );
-    dynrt_processor_core__mul_delay o_delay__0(
+    dynrt_processor__engine__fp_units__mul_delay o_delay__0(
         .clock(o_delay__0__clock),
         .data_in(o_delay__0__data_in),
         .data_out(o_delay__0__data_out)
     );
-    dynrt_processor_core__mul_delay o_delay__1(
+    dynrt_processor__engine__fp_units__mul_delay o_delay__1(
         .clock(o_delay__1__clock),
         .data_in(o_delay__1__data_in),
         .data_out(o_delay__1__data_out)
     );
-    dynrt_processor_core__mul_delay o_delay__2(
+    dynrt_processor__engine__fp_units__mul_delay o_delay__2(
         .clock(o_delay__2__clock),
         .data_in(o_delay__2__data_in),
         .data_out(o_delay__2__data_out)
     );
-    dynrt_processor_core__mul_delay o_delay__3(
+    dynrt_processor__engine__fp_units__mul_delay o_delay__3(
         .clock(o_delay__3__clock),
         .data_in(o_delay__3__data_in),
         .data_out(o_delay__3__data_out)
     );
-    dynrt_processor_core__mul_delay o_delay__4(
+    dynrt_processor__engine__fp_units__mul_delay o_delay__4(
         .clock(o_delay__4__clock),
         .data_in(o_delay__4__data_in),
         .data_out(o_delay__4__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__operand_delay__0 o_delay_div__0(
+    dynrt_processor__engine__tester__intersect_unit__operand_delay__0 o_delay_div__0(
         .clock(o_delay_div__0__clock),
         .data_in(o_delay_div__0__data_in),
         .data_out(o_delay_div__0__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__operand_delay__0 o_delay_div__1(
+    dynrt_processor__engine__tester__intersect_unit__operand_delay__0 o_delay_div__1(
         .clock(o_delay_div__1__clock),
         .data_in(o_delay_div__1__data_in),
         .data_out(o_delay_div__1__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__operand_delay__0 o_delay_div__2(
+    dynrt_processor__engine__tester__intersect_unit__operand_delay__0 o_delay_div__2(
         .clock(o_delay_div__2__clock),
         .data_in(o_delay_div__2__data_in),
         .data_out(o_delay_div__2__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__operand_delay__0 o_delay_div__3(
+    dynrt_processor__engine__tester__intersect_unit__operand_delay__0 o_delay_div__3(
         .clock(o_delay_div__3__clock),
         .data_in(o_delay_div__3__data_in),
         .data_out(o_delay_div__3__data_out)
     );
-    dynrt_processor_core__tester__intersect_unit__operand_delay__0 o_delay_div__4(
+    dynrt_processor__engine__tester__intersect_unit__operand_delay__0 o_delay_div__4(
         .clock(o_delay_div__4__clock),
         .data_in(o_delay_div__4__data_in),
         .data_out(o_delay_div__4__data_out)
     );
-    dynrt_processor_core__traversal_unit__control_delay control_delay(
+    dynrt_processor__engine__traversal_unit__control_delay control_delay(
         .clock(control_delay__clock),
         .data_in(control_delay__data_in),
         .data_out(control_delay__data_out)
     );
-    dynrt_processor_core__traversal_unit__control_delay_div control_delay_div(
+    dynrt_processor__engine__traversal_unit__control_delay_div control_delay_div(
         .clock(control_delay_div__clock),
         .data_in(control_delay_div__data_in),
         .data_out(control_delay_div__data_out)
     );
-    dynrt_processor_core__traversal_unit__control_delay_cmp control_delay_cmp(
+    dynrt_processor__engine__traversal_unit__control_delay_cmp control_delay_cmp(
         .clock(control_delay_cmp__clock),
         .data_in(control_delay_cmp__data_in),
         .data_out(control_delay_cmp__data_out)
     );
-    dynrt_processor_core__cmp cmp__0(
+    dynrt_processor__engine__fp_units__cmp cmp__0(
         .clock(cmp__0__clock),
         .in_valid(cmp__0__in_valid),
         .a(cmp__0__a),
@@ -21606,7 +23410,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .le(cmp__0__le),
         .eq(cmp__0__eq)
     );
-    dynrt_processor_core__cmp cmp__1(
+    dynrt_processor__engine__fp_units__cmp cmp__1(
         .clock(cmp__1__clock),
         .in_valid(cmp__1__in_valid),
         .a(cmp__1__a),
@@ -21616,7 +23420,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .le(cmp__1__le),
         .eq(cmp__1__eq)
     );
-    dynrt_processor_core__cmp cmp__2(
+    dynrt_processor__engine__fp_units__cmp cmp__2(
         .clock(cmp__2__clock),
         .in_valid(cmp__2__in_valid),
         .a(cmp__2__a),
@@ -21626,7 +23430,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .le(cmp__2__le),
         .eq(cmp__2__eq)
     );
-    dynrt_processor_core__cmp cmp__3(
+    dynrt_processor__engine__fp_units__cmp cmp__3(
         .clock(cmp__3__clock),
         .in_valid(cmp__3__in_valid),
         .a(cmp__3__a),
@@ -21636,7 +23440,7 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .le(cmp__3__le),
         .eq(cmp__3__eq)
     );
-    dynrt_processor_core__cmp cmp__4(
+    dynrt_processor__engine__fp_units__cmp cmp__4(
         .clock(cmp__4__clock),
         .in_valid(cmp__4__in_valid),
         .a(cmp__4__a),
@@ -21646,17 +23450,17 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         .le(cmp__4__le),
         .eq(cmp__4__eq)
     );
-    dynrt_processor_core__traversal_unit__hi_delay ts_delay(
+    dynrt_processor__engine__traversal_unit__hi_delay ts_delay(
         .clock(ts_delay__clock),
         .data_in(ts_delay__data_in),
         .data_out(ts_delay__data_out)
     );
-    dynrt_processor_core__traversal_unit__hi_delay lo_delay(
+    dynrt_processor__engine__traversal_unit__hi_delay lo_delay(
         .clock(lo_delay__clock),
         .data_in(lo_delay__data_in),
         .data_out(lo_delay__data_out)
     );
-    dynrt_processor_core__traversal_unit__hi_delay hi_delay(
+    dynrt_processor__engine__traversal_unit__hi_delay hi_delay(
         .clock(hi_delay__clock),
         .data_in(hi_delay__data_in),
         .data_out(hi_delay__data_out)
@@ -21807,28 +23611,28 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         cmp__2__clock = clock;
         cmp__3__clock = clock;
         cmp__4__clock = clock;
-        ray__thread = thread;
-        ray__word_a = word_a;
-        ray__word_b = word_b;
-        ray__ray_write = ray_write;
-        ray__ray_pair = ray_pair;
+        ray__thread = engine__thread;
+        ray__word_a = engine__word_a;
+        ray__word_b = engine__word_b;
+        ray__ray_write = engine__ray_write;
+        ray__ray_pair = engine__ray_pair;
         ray__t_min_write = t_min_write;
         engine_full = entry_fifo__full | answer_valid;
-        full = engine_full;
-        entry_fifo__write = (enqueue & (~engine_full)) | answer_valid;
-        entry_fifo__data_in = (((thread) & 70'h3fffffffffffffffff) << 32'h40) | (((word_a) & 70'h3fffffffffffffffff) << 32'h20) | ((word_b) & 70'h3fffffffffffffffff);
+        engine__full = engine_full;
+        entry_fifo__write = (engine__enqueue & (~engine_full)) | answer_valid;
+        entry_fifo__data_in = (((engine__thread) & 70'h3fffffffffffffffff) << 32'h40) | (((engine__word_a) & 70'h3fffffffffffffffff) << 32'h20) | ((engine__word_b) & 70'h3fffffffffffffffff);
         if (answer_valid) begin
             entry_fifo__data_in = (((1'b1) & 70'h3fffffffffffffffff) << 32'h45) | (((answer_thread) & 70'h3fffffffffffffffff) << 32'h40) | (((answer_t) & 70'h3fffffffffffffffff) << 32'h20) | ((answer_hit) & 70'h3fffffffffffffffff);
         end
-        any_hit__write_address = thread;
-        any_hit__write_data = ((word_a[32'h1f]) & 1'h1);
-        any_hit__write_enable = enqueue & (~engine_full);
-        issued__read_address = query_thread;
-        done_e__read_address = query_thread;
-        pending = issued__read_data != done_e__read_data;
-        issued__write_address = thread;
+        any_hit__write_address = engine__thread;
+        any_hit__write_data = ((engine__word_a[32'h1f]) & 1'h1);
+        any_hit__write_enable = engine__enqueue & (~engine_full);
+        issued__read_address = engine__query_thread;
+        done_e__read_address = engine__query_thread;
+        engine__pending = issued__read_data != done_e__read_data;
+        issued__write_address = engine__thread;
         issued__write_data = issued__read_data + 32'h1;
-        issued__write_enable = enqueue & (~engine_full);
+        issued__write_enable = engine__enqueue & (~engine_full);
         entry_fifo__read = ~entry_fifo__empty;
         f1_valid__d = ~entry_fifo__empty;
         f1_next__d = entry_fifo__data_out[32'h45];
@@ -21894,11 +23698,11 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         loop_fifo__read = 1'b0;
         front_fifo__read = 1'b0;
         in_flight__read = 1'b0;
-        take = (phase__q != Fetch__Idle) & (~(engine_read & (engine_bank == c_bank_nodes)));
-        node_read = take | (engine_read & (engine_bank == c_bank_nodes));
-        node_addr = engine_addr;
+        take = (phase__q != Fetch__Idle) & (~(engine__load_read & (engine__load_bank == c_bank_nodes)));
+        nodes__read = take | (engine__load_read & (engine__load_bank == c_bank_nodes));
+        nodes__addr = engine__load_addr;
         if (take) begin
-            node_addr = (((fetch_job__q[(32'h40)+:(26)]) & 24'hffffff) << 32'h1) | (((phase__q == Fetch__Word1)) & 24'hffffff);
+            nodes__addr = (((fetch_job__q[(32'h40)+:(26)]) & 24'hffffff) << 32'h1) | (((phase__q == Fetch__Word1)) & 24'hffffff);
             phase__d = Fetch__Word1;
             if (phase__q == Fetch__Word1) begin
                 phase__d = Fetch__Idle;
@@ -21933,11 +23737,11 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
             arrive = node_line__5__q;
         end
         if (arrive == 32'h2) begin
-            w0__d = node_rdata;
+            w0__d = nodes__rdata;
         end
         next_a_thread = job__q[(32'h60)+:(5)];
         if (arrive == 32'h3) begin
-            w1__d = node_rdata;
+            w1__d = nodes__rdata;
             job__d = in_flight__data_out;
             next_a_thread = in_flight__data_out[(32'h60)+:(5)];
             in_flight__read = 1'b1;
@@ -21999,8 +23803,8 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         done_u__write_data = done_u__read_data + 32'h1;
         done_u__write_enable = a_end;
         done_e__write_enable = a_end;
-        done_event = a_end;
-        done_thread = job__q[(32'h60)+:(5)];
+        engine__done = a_end;
+        engine__done_thread = job__q[(32'h60)+:(5)];
         leaf_hi__write_enable = at_a & a_leaf;
         leaf_sp__write_enable = at_a & a_leaf;
         step_busy = a_inner;
@@ -22077,10 +23881,10 @@ module dynrt_processor_core__traversal_unit(clock,thread,word_a,word_b,ray_write
         loop_fifo__write = d_valid;
     end
     
-endmodule // dynrt_processor_core__traversal_unit
+endmodule // dynrt_processor__engine__traversal_unit
 
 
-module dynrt_processor_core__traversal_unit__any_hit(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__traversal_unit__any_hit(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -22106,7 +23910,7 @@ module dynrt_processor_core__traversal_unit__any_hit(read_address,read_clock,rea
        end
     end
                 
-endmodule // dynrt_processor_core__traversal_unit__any_hit
+endmodule // dynrt_processor__engine__traversal_unit__any_hit
 
 
 
@@ -22221,7 +24025,7 @@ endmodule // dynrt_processor_core__traversal_unit__any_hit
 
 
 
-module dynrt_processor_core__traversal_unit__control_delay(clock,data_in,data_out);
+module dynrt_processor__engine__traversal_unit__control_delay(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -22252,37 +24056,37 @@ module dynrt_processor_core__traversal_unit__control_delay(clock,data_in,data_ou
     reg  stage__6__clock;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__0(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__1(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__2(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__3(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__4(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__5(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__6(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
@@ -22313,10 +24117,10 @@ module dynrt_processor_core__traversal_unit__control_delay(clock,data_in,data_ou
         data_out = stage__6__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__control_delay
+endmodule // dynrt_processor__engine__traversal_unit__control_delay
 
 
-module dynrt_processor_core__traversal_unit__control_delay__stage__0(d,q,clock);
+module dynrt_processor__engine__traversal_unit__control_delay__stage__0(d,q,clock);
     
     // Module arguments
     input wire  [37:0] d;
@@ -22332,7 +24136,7 @@ module dynrt_processor_core__traversal_unit__control_delay__stage__0(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__traversal_unit__control_delay__stage__0
+endmodule // dynrt_processor__engine__traversal_unit__control_delay__stage__0
 
 
 
@@ -22347,7 +24151,7 @@ endmodule // dynrt_processor_core__traversal_unit__control_delay__stage__0
 
 
 
-module dynrt_processor_core__traversal_unit__control_delay_cmp(clock,data_in,data_out);
+module dynrt_processor__engine__traversal_unit__control_delay_cmp(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -22363,12 +24167,12 @@ module dynrt_processor_core__traversal_unit__control_delay_cmp(clock,data_in,dat
     reg  stage__1__clock;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__0(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__1(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
@@ -22384,14 +24188,14 @@ module dynrt_processor_core__traversal_unit__control_delay_cmp(clock,data_in,dat
         data_out = stage__1__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__control_delay_cmp
+endmodule // dynrt_processor__engine__traversal_unit__control_delay_cmp
 
 
 
 
 
 
-module dynrt_processor_core__traversal_unit__control_delay_div(clock,data_in,data_out);
+module dynrt_processor__engine__traversal_unit__control_delay_div(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -22464,107 +24268,107 @@ module dynrt_processor_core__traversal_unit__control_delay_div(clock,data_in,dat
     reg  stage__20__clock;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__0(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__1(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__2(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__3(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__4(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__5(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__6(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__7(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__8(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__9(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__10(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__11(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__11(
         .d(stage__11__d),
         .q(stage__11__q),
         .clock(stage__11__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__12(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__12(
         .d(stage__12__d),
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__13(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__13(
         .d(stage__13__d),
         .q(stage__13__q),
         .clock(stage__13__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__14(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__14(
         .d(stage__14__d),
         .q(stage__14__q),
         .clock(stage__14__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__15(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__15(
         .d(stage__15__d),
         .q(stage__15__q),
         .clock(stage__15__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__16(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__16(
         .d(stage__16__d),
         .q(stage__16__q),
         .clock(stage__16__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__17(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__17(
         .d(stage__17__d),
         .q(stage__17__q),
         .clock(stage__17__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__18(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__18(
         .d(stage__18__d),
         .q(stage__18__q),
         .clock(stage__18__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__19(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__19(
         .d(stage__19__d),
         .q(stage__19__q),
         .clock(stage__19__clock)
     );
-    dynrt_processor_core__traversal_unit__control_delay__stage__0 stage__20(
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__20(
         .d(stage__20__d),
         .q(stage__20__q),
         .clock(stage__20__clock)
@@ -22637,7 +24441,7 @@ module dynrt_processor_core__traversal_unit__control_delay_div(clock,data_in,dat
         data_out = stage__20__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__control_delay_div
+endmodule // dynrt_processor__engine__traversal_unit__control_delay_div
 
 
 
@@ -23036,7 +24840,7 @@ endmodule // dynrt_processor_core__traversal_unit__control_delay_div
 
 
 
-module dynrt_processor_core__traversal_unit__entry_fifo(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
     
     // Module arguments
     input wire  clock;
@@ -23086,7 +24890,7 @@ module dynrt_processor_core__traversal_unit__entry_fifo(clock,read,data_out,empt
     wire  [5:0] write_logic__fill_level;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__entry_fifo__ram ram(
+    dynrt_processor__engine__traversal_unit__entry_fifo__ram ram(
         .read_address(ram__read_address),
         .read_clock(ram__read_clock),
         .read_data(ram__read_data),
@@ -23095,7 +24899,7 @@ module dynrt_processor_core__traversal_unit__entry_fifo(clock,read,data_out,empt
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic read_logic(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic read_logic(
         .clock(read_logic__clock),
         .read(read_logic__read),
         .data_out(read_logic__data_out),
@@ -23109,7 +24913,7 @@ module dynrt_processor_core__traversal_unit__entry_fifo(clock,read,data_out,empt
         .read_address_out(read_logic__read_address_out),
         .fill_level(read_logic__fill_level)
     );
-    dynrt_processor_core__traversal_unit__entry_fifo__write_logic write_logic(
+    dynrt_processor__engine__traversal_unit__entry_fifo__write_logic write_logic(
         .write(write_logic__write),
         .data_in(write_logic__data_in),
         .full(write_logic__full),
@@ -23150,10 +24954,10 @@ module dynrt_processor_core__traversal_unit__entry_fifo(clock,read,data_out,empt
         write_logic__read_address = read_logic__read_address_out;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__entry_fifo
+endmodule // dynrt_processor__engine__traversal_unit__entry_fifo
 
 
-module dynrt_processor_core__traversal_unit__entry_fifo__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__traversal_unit__entry_fifo__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -23179,10 +24983,10 @@ module dynrt_processor_core__traversal_unit__entry_fifo__ram(read_address,read_c
        end
     end
                 
-endmodule // dynrt_processor_core__traversal_unit__entry_fifo__ram
+endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__ram
 
 
-module dynrt_processor_core__traversal_unit__entry_fifo__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
+module dynrt_processor__engine__traversal_unit__entry_fifo__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
     
     // Module arguments
     input wire  clock;
@@ -23216,12 +25020,12 @@ module dynrt_processor_core__traversal_unit__entry_fifo__read_logic(clock,read,d
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address read_address(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
     );
-    dynrt_processor_core__add__big_sign dff_underflow(
+    dynrt_processor__display__dark_d dff_underflow(
         .d(dff_underflow__d),
         .q(dff_underflow__q),
         .clock(dff_underflow__clock)
@@ -23256,12 +25060,12 @@ module dynrt_processor_core__traversal_unit__entry_fifo__read_logic(clock,read,d
         read_address_out = read_address__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__entry_fifo__read_logic
+endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__read_logic
 
 
 
 
-module dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address(d,q,clock);
+module dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address(d,q,clock);
     
     // Module arguments
     input wire  [5:0] d;
@@ -23277,10 +25081,10 @@ module dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_addres
        q <= d;
     end
           
-endmodule // dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address
+endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address
 
 
-module dynrt_processor_core__traversal_unit__entry_fifo__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
+module dynrt_processor__engine__traversal_unit__entry_fifo__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
     
     // Module arguments
     input wire  write;
@@ -23318,17 +25122,17 @@ module dynrt_processor_core__traversal_unit__entry_fifo__write_logic(write,data_
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address write_address(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address dff_write_address_delay(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address dff_write_address_delay(
         .d(dff_write_address_delay__d),
         .q(dff_write_address_delay__q),
         .clock(dff_write_address_delay__clock)
     );
-    dynrt_processor_core__add__big_sign dff_overflow(
+    dynrt_processor__display__dark_d dff_overflow(
         .d(dff_overflow__d),
         .q(dff_overflow__q),
         .clock(dff_overflow__clock)
@@ -23368,7 +25172,7 @@ module dynrt_processor_core__traversal_unit__entry_fifo__write_logic(write,data_
         overflow = dff_overflow__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__entry_fifo__write_logic
+endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__write_logic
 
 
 
@@ -23421,7 +25225,7 @@ endmodule // dynrt_processor_core__traversal_unit__entry_fifo__write_logic
 
 
 
-module dynrt_processor_core__traversal_unit__f4_node(d,q,clock);
+module dynrt_processor__engine__traversal_unit__f4_node(d,q,clock);
     
     // Module arguments
     input wire  [25:0] d;
@@ -23437,7 +25241,7 @@ module dynrt_processor_core__traversal_unit__f4_node(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__traversal_unit__f4_node
+endmodule // dynrt_processor__engine__traversal_unit__f4_node
 
 
 
@@ -23470,7 +25274,7 @@ endmodule // dynrt_processor_core__traversal_unit__f4_node
 
 
 
-module dynrt_processor_core__traversal_unit__fetch_job(d,q,clock);
+module dynrt_processor__engine__traversal_unit__fetch_job(d,q,clock);
     
     // Module arguments
     input wire  [101:0] d;
@@ -23486,10 +25290,10 @@ module dynrt_processor_core__traversal_unit__fetch_job(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__traversal_unit__fetch_job
+endmodule // dynrt_processor__engine__traversal_unit__fetch_job
 
 
-module dynrt_processor_core__traversal_unit__front_fifo(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
     
     // Module arguments
     input wire  clock;
@@ -23539,7 +25343,7 @@ module dynrt_processor_core__traversal_unit__front_fifo(clock,read,data_out,empt
     wire  [5:0] write_logic__fill_level;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__front_fifo__ram ram(
+    dynrt_processor__engine__traversal_unit__front_fifo__ram ram(
         .read_address(ram__read_address),
         .read_clock(ram__read_clock),
         .read_data(ram__read_data),
@@ -23548,7 +25352,7 @@ module dynrt_processor_core__traversal_unit__front_fifo(clock,read,data_out,empt
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor_core__traversal_unit__front_fifo__read_logic read_logic(
+    dynrt_processor__engine__traversal_unit__front_fifo__read_logic read_logic(
         .clock(read_logic__clock),
         .read(read_logic__read),
         .data_out(read_logic__data_out),
@@ -23562,7 +25366,7 @@ module dynrt_processor_core__traversal_unit__front_fifo(clock,read,data_out,empt
         .read_address_out(read_logic__read_address_out),
         .fill_level(read_logic__fill_level)
     );
-    dynrt_processor_core__traversal_unit__front_fifo__write_logic write_logic(
+    dynrt_processor__engine__traversal_unit__front_fifo__write_logic write_logic(
         .write(write_logic__write),
         .data_in(write_logic__data_in),
         .full(write_logic__full),
@@ -23603,10 +25407,10 @@ module dynrt_processor_core__traversal_unit__front_fifo(clock,read,data_out,empt
         write_logic__read_address = read_logic__read_address_out;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__front_fifo
+endmodule // dynrt_processor__engine__traversal_unit__front_fifo
 
 
-module dynrt_processor_core__traversal_unit__front_fifo__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__traversal_unit__front_fifo__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -23632,10 +25436,10 @@ module dynrt_processor_core__traversal_unit__front_fifo__ram(read_address,read_c
        end
     end
                 
-endmodule // dynrt_processor_core__traversal_unit__front_fifo__ram
+endmodule // dynrt_processor__engine__traversal_unit__front_fifo__ram
 
 
-module dynrt_processor_core__traversal_unit__front_fifo__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
+module dynrt_processor__engine__traversal_unit__front_fifo__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
     
     // Module arguments
     input wire  clock;
@@ -23669,12 +25473,12 @@ module dynrt_processor_core__traversal_unit__front_fifo__read_logic(clock,read,d
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address read_address(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
     );
-    dynrt_processor_core__add__big_sign dff_underflow(
+    dynrt_processor__display__dark_d dff_underflow(
         .d(dff_underflow__d),
         .q(dff_underflow__q),
         .clock(dff_underflow__clock)
@@ -23709,14 +25513,14 @@ module dynrt_processor_core__traversal_unit__front_fifo__read_logic(clock,read,d
         read_address_out = read_address__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__front_fifo__read_logic
+endmodule // dynrt_processor__engine__traversal_unit__front_fifo__read_logic
 
 
 
 
 
 
-module dynrt_processor_core__traversal_unit__front_fifo__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
+module dynrt_processor__engine__traversal_unit__front_fifo__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
     
     // Module arguments
     input wire  write;
@@ -23754,17 +25558,17 @@ module dynrt_processor_core__traversal_unit__front_fifo__write_logic(write,data_
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address write_address(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address dff_write_address_delay(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address dff_write_address_delay(
         .d(dff_write_address_delay__d),
         .q(dff_write_address_delay__q),
         .clock(dff_write_address_delay__clock)
     );
-    dynrt_processor_core__add__big_sign dff_overflow(
+    dynrt_processor__display__dark_d dff_overflow(
         .d(dff_overflow__d),
         .q(dff_overflow__q),
         .clock(dff_overflow__clock)
@@ -23804,7 +25608,7 @@ module dynrt_processor_core__traversal_unit__front_fifo__write_logic(write,data_
         overflow = dff_overflow__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__front_fifo__write_logic
+endmodule // dynrt_processor__engine__traversal_unit__front_fifo__write_logic
 
 
 
@@ -23813,7 +25617,7 @@ endmodule // dynrt_processor_core__traversal_unit__front_fifo__write_logic
 
 
 
-module dynrt_processor_core__traversal_unit__hi_delay(clock,data_in,data_out);
+module dynrt_processor__engine__traversal_unit__hi_delay(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -23829,12 +25633,12 @@ module dynrt_processor_core__traversal_unit__hi_delay(clock,data_in,data_out);
     reg  stage__1__clock;
     
     // Sub module instances
-    dynrt_processor_core__add__in_a stage__0(
+    dynrt_processor__display__rgb_q stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor_core__add__in_a stage__1(
+    dynrt_processor__display__rgb_q stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
@@ -23850,14 +25654,14 @@ module dynrt_processor_core__traversal_unit__hi_delay(clock,data_in,data_out);
         data_out = stage__1__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__hi_delay
+endmodule // dynrt_processor__engine__traversal_unit__hi_delay
 
 
 
 
 
 
-module dynrt_processor_core__traversal_unit__in_flight(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
     
     // Module arguments
     input wire  clock;
@@ -23907,7 +25711,7 @@ module dynrt_processor_core__traversal_unit__in_flight(clock,read,data_out,empty
     wire  [3:0] write_logic__fill_level;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__in_flight__ram ram(
+    dynrt_processor__engine__traversal_unit__in_flight__ram ram(
         .read_address(ram__read_address),
         .read_clock(ram__read_clock),
         .read_data(ram__read_data),
@@ -23916,7 +25720,7 @@ module dynrt_processor_core__traversal_unit__in_flight(clock,read,data_out,empty
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor_core__traversal_unit__in_flight__read_logic read_logic(
+    dynrt_processor__engine__traversal_unit__in_flight__read_logic read_logic(
         .clock(read_logic__clock),
         .read(read_logic__read),
         .data_out(read_logic__data_out),
@@ -23930,7 +25734,7 @@ module dynrt_processor_core__traversal_unit__in_flight(clock,read,data_out,empty
         .read_address_out(read_logic__read_address_out),
         .fill_level(read_logic__fill_level)
     );
-    dynrt_processor_core__traversal_unit__in_flight__write_logic write_logic(
+    dynrt_processor__engine__traversal_unit__in_flight__write_logic write_logic(
         .write(write_logic__write),
         .data_in(write_logic__data_in),
         .full(write_logic__full),
@@ -23971,10 +25775,10 @@ module dynrt_processor_core__traversal_unit__in_flight(clock,read,data_out,empty
         write_logic__read_address = read_logic__read_address_out;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__in_flight
+endmodule // dynrt_processor__engine__traversal_unit__in_flight
 
 
-module dynrt_processor_core__traversal_unit__in_flight__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__traversal_unit__in_flight__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [2:0] read_address;
@@ -24000,10 +25804,10 @@ module dynrt_processor_core__traversal_unit__in_flight__ram(read_address,read_cl
        end
     end
                 
-endmodule // dynrt_processor_core__traversal_unit__in_flight__ram
+endmodule // dynrt_processor__engine__traversal_unit__in_flight__ram
 
 
-module dynrt_processor_core__traversal_unit__in_flight__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
+module dynrt_processor__engine__traversal_unit__in_flight__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
     
     // Module arguments
     input wire  clock;
@@ -24037,12 +25841,12 @@ module dynrt_processor_core__traversal_unit__in_flight__read_logic(clock,read,da
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__tester__list_unit__flight read_address(
+    dynrt_processor__engine__tester__list_unit__flight read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
     );
-    dynrt_processor_core__add__big_sign dff_underflow(
+    dynrt_processor__display__dark_d dff_underflow(
         .d(dff_underflow__d),
         .q(dff_underflow__q),
         .clock(dff_underflow__clock)
@@ -24077,14 +25881,14 @@ module dynrt_processor_core__traversal_unit__in_flight__read_logic(clock,read,da
         read_address_out = read_address__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__in_flight__read_logic
+endmodule // dynrt_processor__engine__traversal_unit__in_flight__read_logic
 
 
 
 
 
 
-module dynrt_processor_core__traversal_unit__in_flight__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
+module dynrt_processor__engine__traversal_unit__in_flight__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
     
     // Module arguments
     input wire  write;
@@ -24122,17 +25926,17 @@ module dynrt_processor_core__traversal_unit__in_flight__write_logic(write,data_i
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__tester__list_unit__flight write_address(
+    dynrt_processor__engine__tester__list_unit__flight write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor_core__tester__list_unit__flight dff_write_address_delay(
+    dynrt_processor__engine__tester__list_unit__flight dff_write_address_delay(
         .d(dff_write_address_delay__d),
         .q(dff_write_address_delay__q),
         .clock(dff_write_address_delay__clock)
     );
-    dynrt_processor_core__add__big_sign dff_overflow(
+    dynrt_processor__display__dark_d dff_overflow(
         .d(dff_overflow__d),
         .q(dff_overflow__q),
         .clock(dff_overflow__clock)
@@ -24172,7 +25976,7 @@ module dynrt_processor_core__traversal_unit__in_flight__write_logic(write,data_i
         overflow = dff_overflow__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__in_flight__write_logic
+endmodule // dynrt_processor__engine__traversal_unit__in_flight__write_logic
 
 
 
@@ -24185,7 +25989,7 @@ endmodule // dynrt_processor_core__traversal_unit__in_flight__write_logic
 
 
 
-module dynrt_processor_core__traversal_unit__leaf_fifo(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
     
     // Module arguments
     input wire  clock;
@@ -24235,7 +26039,7 @@ module dynrt_processor_core__traversal_unit__leaf_fifo(clock,read,data_out,empty
     wire  [5:0] write_logic__fill_level;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__leaf_fifo__ram ram(
+    dynrt_processor__engine__traversal_unit__leaf_fifo__ram ram(
         .read_address(ram__read_address),
         .read_clock(ram__read_clock),
         .read_data(ram__read_data),
@@ -24244,7 +26048,7 @@ module dynrt_processor_core__traversal_unit__leaf_fifo(clock,read,data_out,empty
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor_core__traversal_unit__leaf_fifo__read_logic read_logic(
+    dynrt_processor__engine__traversal_unit__leaf_fifo__read_logic read_logic(
         .clock(read_logic__clock),
         .read(read_logic__read),
         .data_out(read_logic__data_out),
@@ -24258,7 +26062,7 @@ module dynrt_processor_core__traversal_unit__leaf_fifo(clock,read,data_out,empty
         .read_address_out(read_logic__read_address_out),
         .fill_level(read_logic__fill_level)
     );
-    dynrt_processor_core__traversal_unit__leaf_fifo__write_logic write_logic(
+    dynrt_processor__engine__traversal_unit__leaf_fifo__write_logic write_logic(
         .write(write_logic__write),
         .data_in(write_logic__data_in),
         .full(write_logic__full),
@@ -24299,10 +26103,10 @@ module dynrt_processor_core__traversal_unit__leaf_fifo(clock,read,data_out,empty
         write_logic__read_address = read_logic__read_address_out;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__leaf_fifo
+endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo
 
 
-module dynrt_processor_core__traversal_unit__leaf_fifo__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__traversal_unit__leaf_fifo__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -24328,10 +26132,10 @@ module dynrt_processor_core__traversal_unit__leaf_fifo__ram(read_address,read_cl
        end
     end
                 
-endmodule // dynrt_processor_core__traversal_unit__leaf_fifo__ram
+endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo__ram
 
 
-module dynrt_processor_core__traversal_unit__leaf_fifo__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
+module dynrt_processor__engine__traversal_unit__leaf_fifo__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
     
     // Module arguments
     input wire  clock;
@@ -24365,12 +26169,12 @@ module dynrt_processor_core__traversal_unit__leaf_fifo__read_logic(clock,read,da
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address read_address(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
     );
-    dynrt_processor_core__add__big_sign dff_underflow(
+    dynrt_processor__display__dark_d dff_underflow(
         .d(dff_underflow__d),
         .q(dff_underflow__q),
         .clock(dff_underflow__clock)
@@ -24405,14 +26209,14 @@ module dynrt_processor_core__traversal_unit__leaf_fifo__read_logic(clock,read,da
         read_address_out = read_address__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__leaf_fifo__read_logic
+endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo__read_logic
 
 
 
 
 
 
-module dynrt_processor_core__traversal_unit__leaf_fifo__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
+module dynrt_processor__engine__traversal_unit__leaf_fifo__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
     
     // Module arguments
     input wire  write;
@@ -24450,17 +26254,17 @@ module dynrt_processor_core__traversal_unit__leaf_fifo__write_logic(write,data_i
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address write_address(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor_core__traversal_unit__entry_fifo__read_logic__read_address dff_write_address_delay(
+    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address dff_write_address_delay(
         .d(dff_write_address_delay__d),
         .q(dff_write_address_delay__q),
         .clock(dff_write_address_delay__clock)
     );
-    dynrt_processor_core__add__big_sign dff_overflow(
+    dynrt_processor__display__dark_d dff_overflow(
         .d(dff_overflow__d),
         .q(dff_overflow__q),
         .clock(dff_overflow__clock)
@@ -24500,7 +26304,7 @@ module dynrt_processor_core__traversal_unit__leaf_fifo__write_logic(write,data_i
         overflow = dff_overflow__q;
     end
     
-endmodule // dynrt_processor_core__traversal_unit__leaf_fifo__write_logic
+endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo__write_logic
 
 
 
@@ -24511,7 +26315,7 @@ endmodule // dynrt_processor_core__traversal_unit__leaf_fifo__write_logic
 
 
 
-module dynrt_processor_core__traversal_unit__leaf_sp(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__traversal_unit__leaf_sp(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -24537,7 +26341,7 @@ module dynrt_processor_core__traversal_unit__leaf_sp(read_address,read_clock,rea
        end
     end
                 
-endmodule // dynrt_processor_core__traversal_unit__leaf_sp
+endmodule // dynrt_processor__engine__traversal_unit__leaf_sp
 
 
 
@@ -24876,7 +26680,7 @@ endmodule // dynrt_processor_core__traversal_unit__leaf_sp
 
 
 
-module dynrt_processor_core__traversal_unit__phase(d,q,clock);
+module dynrt_processor__engine__traversal_unit__phase(d,q,clock);
     
     // Module arguments
     input wire  [1:0] d;
@@ -24897,7 +26701,7 @@ module dynrt_processor_core__traversal_unit__phase(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor_core__traversal_unit__phase
+endmodule // dynrt_processor__engine__traversal_unit__phase
 
 
 
@@ -24916,7 +26720,7 @@ endmodule // dynrt_processor_core__traversal_unit__phase
 
 
 
-module dynrt_processor_core__traversal_unit__stack_hi(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__traversal_unit__stack_hi(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [10:0] read_address;
@@ -24942,12 +26746,12 @@ module dynrt_processor_core__traversal_unit__stack_hi(read_address,read_clock,re
        end
     end
                 
-endmodule // dynrt_processor_core__traversal_unit__stack_hi
+endmodule // dynrt_processor__engine__traversal_unit__stack_hi
 
 
 
 
-module dynrt_processor_core__traversal_unit__stack_node(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__traversal_unit__stack_node(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [10:0] read_address;
@@ -24973,7 +26777,7 @@ module dynrt_processor_core__traversal_unit__stack_node(read_address,read_clock,
        end
     end
                 
-endmodule // dynrt_processor_core__traversal_unit__stack_node
+endmodule // dynrt_processor__engine__traversal_unit__stack_node
 
 
 
@@ -25098,590 +26902,138 @@ endmodule // dynrt_processor_core__traversal_unit__stack_node
 
 
 
-
-
-
-
-
-
-
-
-
-module dynrt_processor_vga(clock,reset,fb_addr,fb_data,hsync,vsync,rgb,frame_start);
+module dynrt_processor__engine__write_back(valid,op,dst,invert,pc_plus_one,target,is_wait,kd_busy,tri_busy,jr_target,int_eq,int_lt,mb_hit,pix_done,fast,sum,product,quotient,root,lt,le,eq,colour_byte,write,data,next_pc,halt,retired,wait_pending);
     
     // Module arguments
-    input wire  clock;
-    input wire  reset;
-    output reg  [23:0] fb_addr;
-    input wire  [31:0] fb_data;
-    output reg  hsync;
-    output reg  vsync;
-    output reg  [23:0] rgb;
-    output reg  frame_start;
-    
-    // Stub signals
-    reg  timing__clock;
-    reg  timing__reset;
-    wire  timing__hsync;
-    wire  timing__vsync;
-    wire  timing__blank;
-    wire  timing__border;
-    wire  [11:0] timing__x;
-    wire  [11:0] timing__y;
-    wire  [23:0] timing__fb_addr;
-    wire  timing__frame_start;
-    reg  hsync_d__d;
-    wire  hsync_d__q;
-    reg  hsync_d__clock;
-    reg  vsync_d__d;
-    wire  vsync_d__q;
-    reg  vsync_d__clock;
-    reg  dark_d__d;
-    wire  dark_d__q;
-    reg  dark_d__clock;
-    reg  start_d__d;
-    wire  start_d__q;
-    reg  start_d__clock;
-    reg  hsync_q__d;
-    wire  hsync_q__q;
-    reg  hsync_q__clock;
-    reg  vsync_q__d;
-    wire  vsync_q__q;
-    reg  vsync_q__clock;
-    reg  start_q__d;
-    wire  start_q__q;
-    reg  start_q__clock;
-    reg  [23:0] rgb_q__d;
-    wire  [23:0] rgb_q__q;
-    reg  rgb_q__clock;
-    
-    // Sub module instances
-    dynrt_processor_vga__timing timing(
-        .clock(timing__clock),
-        .reset(timing__reset),
-        .hsync(timing__hsync),
-        .vsync(timing__vsync),
-        .blank(timing__blank),
-        .border(timing__border),
-        .x(timing__x),
-        .y(timing__y),
-        .fb_addr(timing__fb_addr),
-        .frame_start(timing__frame_start)
-    );
-    dynrt_processor_vga__dark_d hsync_d(
-        .d(hsync_d__d),
-        .q(hsync_d__q),
-        .clock(hsync_d__clock)
-    );
-    dynrt_processor_vga__dark_d vsync_d(
-        .d(vsync_d__d),
-        .q(vsync_d__q),
-        .clock(vsync_d__clock)
-    );
-    dynrt_processor_vga__dark_d dark_d(
-        .d(dark_d__d),
-        .q(dark_d__q),
-        .clock(dark_d__clock)
-    );
-    dynrt_processor_vga__dark_d start_d(
-        .d(start_d__d),
-        .q(start_d__q),
-        .clock(start_d__clock)
-    );
-    dynrt_processor_vga__dark_d hsync_q(
-        .d(hsync_q__d),
-        .q(hsync_q__q),
-        .clock(hsync_q__clock)
-    );
-    dynrt_processor_vga__dark_d vsync_q(
-        .d(vsync_q__d),
-        .q(vsync_q__q),
-        .clock(vsync_q__clock)
-    );
-    dynrt_processor_vga__dark_d start_q(
-        .d(start_q__d),
-        .q(start_q__q),
-        .clock(start_q__clock)
-    );
-    dynrt_processor_vga__rgb_q rgb_q(
-        .d(rgb_q__d),
-        .q(rgb_q__q),
-        .clock(rgb_q__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        hsync_d__clock = clock;
-        vsync_d__clock = clock;
-        dark_d__clock = clock;
-        start_d__clock = clock;
-        hsync_q__clock = clock;
-        vsync_q__clock = clock;
-        start_q__clock = clock;
-        rgb_q__clock = clock;
-        hsync_d__d = hsync_d__q;
-        vsync_d__d = vsync_d__q;
-        dark_d__d = dark_d__q;
-        start_d__d = start_d__q;
-        hsync_q__d = hsync_q__q;
-        vsync_q__d = vsync_q__q;
-        start_q__d = start_q__q;
-        rgb_q__d = rgb_q__q;
-        timing__clock = clock;
-        timing__reset = reset;
-        fb_addr = timing__fb_addr;
-        hsync_d__d = timing__hsync;
-        vsync_d__d = timing__vsync;
-        dark_d__d = timing__blank | timing__border;
-        start_d__d = timing__frame_start;
-        hsync_q__d = hsync_d__q;
-        vsync_q__d = vsync_d__q;
-        start_q__d = start_d__q;
-        if (dark_d__q) begin
-            rgb_q__d = 32'h0;
-        end
-        else begin
-            rgb_q__d = fb_data[(32'h0)+:(24)];
-        end
-        hsync = hsync_q__q;
-        vsync = vsync_q__q;
-        frame_start = start_q__q;
-        rgb = rgb_q__q;
-    end
-    
-endmodule // dynrt_processor_vga
-
-
-module dynrt_processor_vga__dark_d(d,q,clock);
-    
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_vga__dark_d
-
-
-
-
-
-
-module dynrt_processor_vga__rgb_q(d,q,clock);
-    
-    // Module arguments
-    input wire  [23:0] d;
-    output reg  [23:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 24'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_vga__rgb_q
-
-
-
-
-
-
-module dynrt_processor_vga__timing(clock,reset,hsync,vsync,blank,border,x,y,fb_addr,frame_start);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  reset;
-    output reg  hsync;
-    output reg  vsync;
-    output reg  blank;
-    output reg  border;
-    output reg  [11:0] x;
-    output reg  [11:0] y;
-    output reg  [23:0] fb_addr;
-    output reg  frame_start;
+    input wire  valid;
+    input wire  [4:0] op;
+    input wire  [7:0] dst;
+    input wire  invert;
+    input wire  [11:0] pc_plus_one;
+    input wire  [11:0] target;
+    input wire  is_wait;
+    input wire  kd_busy;
+    input wire  tri_busy;
+    input wire  [11:0] jr_target;
+    input wire  int_eq;
+    input wire  int_lt;
+    input wire  mb_hit;
+    input wire  pix_done;
+    input wire  [31:0] fast;
+    input wire  [23:0] sum;
+    input wire  [23:0] product;
+    input wire  [23:0] quotient;
+    input wire  [23:0] root;
+    input wire  lt;
+    input wire  le;
+    input wire  eq;
+    input wire  [7:0] colour_byte;
+    output reg  write;
+    output reg  [31:0] data;
+    output reg  [11:0] next_pc;
+    output reg  halt;
+    output reg  retired;
+    output reg  wait_pending;
     
     // Constant declarations
-    localparam  c_h_last = 12'h31f;
-    localparam  c_v_last = 12'h20c;
-    localparam  c_h_visible = 12'h280;
-    localparam  c_v_visible = 12'h1e0;
-    localparam  c_hs_start = 12'h290;
-    localparam  c_hs_end = 12'h2f0;
-    localparam  c_vs_start = 12'h1ea;
-    localparam  c_vs_end = 12'h1ec;
-    localparam  c_x0 = 12'h0;
-    localparam  c_x1 = 12'h280;
-    localparam  c_y0 = 12'h0;
-    localparam  c_y1 = 12'h1e0;
-    localparam  c_rep_last = 12'h9;
-    localparam  c_fb_width = 24'h40;
-    localparam  c_fb_base = 24'h2e;
-    localparam  c_hs_negative = 1'b1;
-    localparam  c_vs_negative = 1'b1;
-    
-    // Stub signals
-    reg  [11:0] h__d;
-    wire  [11:0] h__q;
-    reg  h__clock;
-    reg  [11:0] v__d;
-    wire  [11:0] v__q;
-    reg  v__clock;
-    reg  [11:0] col__d;
-    wire  [11:0] col__q;
-    reg  col__clock;
-    reg  [11:0] hrep__d;
-    wire  [11:0] hrep__q;
-    reg  hrep__clock;
-    reg  [11:0] vrep__d;
-    wire  [11:0] vrep__q;
-    reg  vrep__clock;
-    reg  [23:0] row_base__d;
-    wire  [23:0] row_base__q;
-    reg  row_base__clock;
-    reg  hsync_q__d;
-    wire  hsync_q__q;
-    reg  hsync_q__clock;
-    reg  vsync_q__d;
-    wire  vsync_q__q;
-    reg  vsync_q__clock;
-    reg  blank_q__d;
-    wire  blank_q__q;
-    reg  blank_q__clock;
-    reg  border_q__d;
-    wire  border_q__q;
-    reg  border_q__clock;
-    reg  start_q__d;
-    wire  start_q__q;
-    reg  start_q__clock;
-    reg  [11:0] x_q__d;
-    wire  [11:0] x_q__q;
-    reg  x_q__clock;
-    reg  [11:0] y_q__d;
-    wire  [11:0] y_q__q;
-    reg  y_q__clock;
-    reg  [23:0] addr_q__d;
-    wire  [23:0] addr_q__q;
-    reg  addr_q__clock;
+    localparam  op_fadd = 5'b1;
+    localparam  op_fsub = 5'b10;
+    localparam  op_fmul = 5'b11;
+    localparam  op_fdiv = 5'b100;
+    localparam  op_fsqrt = 5'b101;
+    localparam  op_bflt = 5'b10010;
+    localparam  op_bfle = 5'b10011;
+    localparam  op_bfeq = 5'b10100;
+    localparam  op_beq = 5'b10101;
+    localparam  op_bltu = 5'b10110;
+    localparam  op_jal = 5'b10111;
+    localparam  op_jr = 5'b11000;
+    localparam  op_mbx = 5'b11001;
+    localparam  op_pixel = 5'b11011;
+    localparam  op_halt = 5'b11100;
+    localparam  op_tri = 5'b11101;
+    localparam  op_kd = 5'b11110;
+    localparam  op_byte = 5'b11111;
+    localparam  op_writes = 32'ha8817ffe;
     
     // Local signals
-    reg  line_end;
-    reg  in_x;
-    reg  in_y;
-    reg  visible;
-    reg  hs_active;
-    reg  vs_active;
-    
-    // Sub module instances
-    dynrt_processor_vga__timing__col h(
-        .d(h__d),
-        .q(h__q),
-        .clock(h__clock)
-    );
-    dynrt_processor_vga__timing__col v(
-        .d(v__d),
-        .q(v__q),
-        .clock(v__clock)
-    );
-    dynrt_processor_vga__timing__col col(
-        .d(col__d),
-        .q(col__q),
-        .clock(col__clock)
-    );
-    dynrt_processor_vga__timing__col hrep(
-        .d(hrep__d),
-        .q(hrep__q),
-        .clock(hrep__clock)
-    );
-    dynrt_processor_vga__timing__col vrep(
-        .d(vrep__d),
-        .q(vrep__q),
-        .clock(vrep__clock)
-    );
-    dynrt_processor_vga__rgb_q row_base(
-        .d(row_base__d),
-        .q(row_base__q),
-        .clock(row_base__clock)
-    );
-    dynrt_processor_vga__dark_d hsync_q(
-        .d(hsync_q__d),
-        .q(hsync_q__q),
-        .clock(hsync_q__clock)
-    );
-    dynrt_processor_vga__dark_d vsync_q(
-        .d(vsync_q__d),
-        .q(vsync_q__q),
-        .clock(vsync_q__clock)
-    );
-    dynrt_processor_vga__dark_d blank_q(
-        .d(blank_q__d),
-        .q(blank_q__q),
-        .clock(blank_q__clock)
-    );
-    dynrt_processor_vga__dark_d border_q(
-        .d(border_q__d),
-        .q(border_q__q),
-        .clock(border_q__clock)
-    );
-    dynrt_processor_vga__dark_d start_q(
-        .d(start_q__d),
-        .q(start_q__q),
-        .clock(start_q__clock)
-    );
-    dynrt_processor_vga__timing__col x_q(
-        .d(x_q__d),
-        .q(x_q__q),
-        .clock(x_q__clock)
-    );
-    dynrt_processor_vga__timing__col y_q(
-        .d(y_q__d),
-        .q(y_q__q),
-        .clock(y_q__clock)
-    );
-    dynrt_processor_vga__rgb_q addr_q(
-        .d(addr_q__d),
-        .q(addr_q__q),
-        .clock(addr_q__clock)
-    );
+    reg  cond;
+    reg  repeats;
+    reg  [11:0] pc;
+    reg  [31:0] result;
     
     // Update code
     always @(*) begin
-        h__clock = clock;
-        v__clock = clock;
-        col__clock = clock;
-        hrep__clock = clock;
-        vrep__clock = clock;
-        row_base__clock = clock;
-        hsync_q__clock = clock;
-        vsync_q__clock = clock;
-        blank_q__clock = clock;
-        border_q__clock = clock;
-        start_q__clock = clock;
-        x_q__clock = clock;
-        y_q__clock = clock;
-        addr_q__clock = clock;
-        h__d = h__q;
-        v__d = v__q;
-        col__d = col__q;
-        hrep__d = hrep__q;
-        vrep__d = vrep__q;
-        row_base__d = row_base__q;
-        hsync_q__d = hsync_q__q;
-        vsync_q__d = vsync_q__q;
-        blank_q__d = blank_q__q;
-        border_q__d = border_q__q;
-        start_q__d = start_q__q;
-        x_q__d = x_q__q;
-        y_q__d = y_q__q;
-        addr_q__d = addr_q__q;
-        line_end = h__q == c_h_last;
-        in_x = (h__q >= c_x0) & (h__q < c_x1);
-        in_y = (v__q >= c_y0) & (v__q < c_y1);
-        visible = (h__q < c_h_visible) & (v__q < c_v_visible);
-        hs_active = (h__q >= c_hs_start) & (h__q < c_hs_end);
-        vs_active = (v__q >= c_vs_start) & (v__q < c_vs_end);
-        hsync_q__d = hs_active ^ c_hs_negative;
-        vsync_q__d = vs_active ^ c_vs_negative;
-        blank_q__d = ~visible;
-        border_q__d = visible & ~(in_x & in_y);
-        start_q__d = (h__q == 32'h0) & (v__q == 32'h0);
-        x_q__d = h__q;
-        y_q__d = v__q;
-        if (in_x & in_y) begin
-            addr_q__d = row_base__q + ((col__q) & 24'hffffff);
+        cond = 1'b0;
+        if (op == op_bflt) begin
+            cond = lt;
+        end
+        if (op == op_bfle) begin
+            cond = le;
+        end
+        if (op == op_bfeq) begin
+            cond = eq;
+        end
+        if (op == op_beq) begin
+            cond = int_eq;
+        end
+        if (op == op_bltu) begin
+            cond = int_lt;
+        end
+        if (op == op_mbx) begin
+            cond = mb_hit;
+        end
+        if (op == op_pixel) begin
+            cond = pix_done;
+        end
+        if (op == op_jal) begin
+            cond = 1'b1;
+        end
+        if (op == op_tri) begin
+            cond = tri_busy;
+        end
+        if (op == op_kd) begin
+            cond = kd_busy;
+        end
+        repeats = ((op == op_tri) | (op == op_kd)) & cond;
+        if (cond != invert) begin
+            pc = target;
         end
         else begin
-            addr_q__d = c_fb_base;
+            pc = pc_plus_one;
         end
-        if (line_end) begin
-            h__d = 32'h0;
-            if (v__q == c_v_last) begin
-                v__d = 32'h0;
-            end
-            else begin
-                v__d = v__q + 32'h1;
-            end
-            if (in_y) begin
-                if (vrep__q == c_rep_last) begin
-                    vrep__d = 32'h0;
-                    row_base__d = row_base__q + c_fb_width;
-                end
-                else begin
-                    vrep__d = vrep__q + 32'h1;
-                end
-            end
-            else begin
-                vrep__d = 32'h0;
-                row_base__d = c_fb_base;
-            end
+        if (op == op_jr) begin
+            pc = jr_target;
         end
-        else begin
-            h__d = h__q + 32'h1;
+        if ((op == op_halt) | repeats) begin
+            pc = pc_plus_one - 32'h1;
         end
-        if (in_x) begin
-            if (hrep__q == c_rep_last) begin
-                hrep__d = 32'h0;
-                col__d = col__q + 32'h1;
-            end
-            else begin
-                hrep__d = hrep__q + 32'h1;
-            end
+        result = fast;
+        if ((op == op_fadd) | (op == op_fsub)) begin
+            result = ((sum) & 32'hffffffff);
         end
-        else begin
-            hrep__d = 32'h0;
-            col__d = 32'h0;
+        if (op == op_fmul) begin
+            result = ((product) & 32'hffffffff);
         end
-        if (reset) begin
-            h__d = 32'h0;
-            v__d = 32'h0;
-            col__d = 32'h0;
-            hrep__d = 32'h0;
-            vrep__d = 32'h0;
-            row_base__d = c_fb_base;
+        if (op == op_fdiv) begin
+            result = ((quotient) & 32'hffffffff);
         end
-        hsync = hsync_q__q;
-        vsync = vsync_q__q;
-        blank = blank_q__q;
-        border = border_q__q;
-        frame_start = start_q__q;
-        x = x_q__q;
-        y = y_q__q;
-        fb_addr = addr_q__q;
+        if (op == op_fsqrt) begin
+            result = ((root) & 32'hffffffff);
+        end
+        if (op == op_byte) begin
+            result = fast | ((colour_byte) & 32'hffffffff);
+        end
+        next_pc = pc;
+        data = result;
+        halt = op == op_halt;
+        write = valid & (dst != 32'h0) & op_writes[op] & (~((op == op_pixel) & pix_done));
+        retired = valid & (~repeats);
+        wait_pending = cond & is_wait;
     end
     
-endmodule // dynrt_processor_vga__timing
-
-
-
-
-
-
-
-
-module dynrt_processor_vga__timing__col(d,q,clock);
-    
-    // Module arguments
-    input wire  [11:0] d;
-    output reg  [11:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 12'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor_vga__timing__col
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
+endmodule // dynrt_processor__engine__write_back
 
 /* verilator lint_on UNUSEDSIGNAL */
 /* verilator lint_on DECLFILENAME */
 /* verilator lint_on WIDTH */
-module dynrt_processor(
-    input wire clock,
-    input wire start,
-    output wire done,
-    output wire [31:0] cycles,
-    output wire [31:0] instructions,
-    output wire mem_read,
-    output wire [2:0] mem_bank,
-    output wire [23:0] mem_addr,
-    input wire [31:0] mem_rdata,
-    output wire fb_write,
-    output wire [23:0] fb_addr,
-    output wire [31:0] fb_data,
-    output wire bank0_read,
-    output wire [23:0] bank0_addr,
-    input wire [31:0] bank0_rdata,
-    output wire bank2_read,
-    output wire [23:0] bank2_addr,
-    input wire [31:0] bank2_rdata,
-    output wire bank3_read,
-    output wire [23:0] bank3_addr,
-    input wire [31:0] bank3_rdata,
-    output wire [31:0] transform_busy,
-    output wire [31:0] intersect_busy,
-    output wire [31:0] traversal_busy,
-    input wire vga_clock,
-    input wire vga_reset,
-    output wire [23:0] vga_fb_addr,
-    input wire [31:0] vga_fb_data,
-    output wire vga_hsync,
-    output wire vga_vsync,
-    output wire [23:0] vga_rgb,
-    output wire vga_frame_start
-);
-    dynrt_processor_core core(
-        .clock(clock),
-        .start(start),
-        .done(done),
-        .cycles(cycles),
-        .instructions(instructions),
-        .mem_read(mem_read),
-        .mem_bank(mem_bank),
-        .mem_addr(mem_addr),
-        .mem_rdata(mem_rdata),
-        .fb_write(fb_write),
-        .fb_addr(fb_addr),
-        .fb_data(fb_data),
-        .bank0_read(bank0_read),
-        .bank0_addr(bank0_addr),
-        .bank0_rdata(bank0_rdata),
-        .bank2_read(bank2_read),
-        .bank2_addr(bank2_addr),
-        .bank2_rdata(bank2_rdata),
-        .bank3_read(bank3_read),
-        .bank3_addr(bank3_addr),
-        .bank3_rdata(bank3_rdata),
-        .transform_busy(transform_busy),
-        .intersect_busy(intersect_busy),
-        .traversal_busy(traversal_busy)
-    );
-    dynrt_processor_vga display(
-        .clock(vga_clock),
-        .reset(vga_reset),
-        .fb_addr(vga_fb_addr),
-        .fb_data(vga_fb_data),
-        .hsync(vga_hsync),
-        .vsync(vga_vsync),
-        .rgb(vga_rgb),
-        .frame_start(vga_frame_start)
-    );
-endmodule

@@ -4,7 +4,8 @@ module tb;
   reg clock = 1'b0;
   reg start = 1'b0;
   wire done;
-  wire [31:0] cycles, instructions;
+  wire [31:0] cycles;
+  wire [31:0] instructions;
   wire mem_read;
   wire [2:0] mem_bank;
   wire [23:0] mem_addr;
@@ -12,15 +13,26 @@ module tb;
   wire fb_write;
   wire [23:0] fb_addr;
   wire [31:0] fb_data;
-  wire bank0_read, bank2_read, bank3_read;
-  wire [23:0] bank0_addr, bank2_addr, bank3_addr;
-  wire [31:0] bank0_rdata, bank2_rdata, bank3_rdata;
-  wire [31:0] transform_busy, intersect_busy, traversal_busy;
+  wire bank0_read;
+  wire [23:0] bank0_addr;
+  wire [31:0] bank0_rdata;
+  wire bank2_read;
+  wire [23:0] bank2_addr;
+  wire [31:0] bank2_rdata;
+  wire bank3_read;
+  wire [23:0] bank3_addr;
+  wire [31:0] bank3_rdata;
+  wire [31:0] transform_busy;
+  wire [31:0] intersect_busy;
+  wire [31:0] traversal_busy;
   reg vga_clock = 1'b0;
   reg vga_reset = 1'b1;
-  wire [23:0] vga_fb_addr, vga_rgb;
+  wire [23:0] vga_fb_addr;
   reg [31:0] vga_fb_data = 32'd0;
-  wire vga_hsync, vga_vsync, vga_frame_start;
+  wire vga_hsync;
+  wire vga_vsync;
+  wire [23:0] vga_rgb;
+  wire vga_frame_start;
   integer px;
   reg [31:0] bank0 [0:525]; // nodes
   reg [31:0] bank1 [0:342]; // lists
@@ -34,18 +46,7 @@ module tb;
   reg [31:0] rd3 [0:1];
   integer k, n, f, fd;
   reg timeout = 1'b0;
-  dynrt_processor dut(.clock(clock), .start(start), .done(done), .cycles(cycles),
-    .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank),
-    .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write),
-    .fb_addr(fb_addr), .fb_data(fb_data), .bank0_read(bank0_read),
-    .bank0_addr(bank0_addr), .bank0_rdata(bank0_rdata), .bank2_read(bank2_read),
-    .bank2_addr(bank2_addr), .bank2_rdata(bank2_rdata), .bank3_read(bank3_read),
-    .bank3_addr(bank3_addr), .bank3_rdata(bank3_rdata),
-    .transform_busy(transform_busy), .intersect_busy(intersect_busy),
-    .traversal_busy(traversal_busy),
-    .vga_clock(vga_clock), .vga_reset(vga_reset),
-    .vga_fb_addr(vga_fb_addr), .vga_fb_data(vga_fb_data), .vga_hsync(vga_hsync),
-    .vga_vsync(vga_vsync), .vga_rgb(vga_rgb), .vga_frame_start(vga_frame_start));
+  dynrt_processor dut(.clock(clock), .start(start), .done(done), .cycles(cycles), .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank), .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write), .fb_addr(fb_addr), .fb_data(fb_data), .bank0_read(bank0_read), .bank0_addr(bank0_addr), .bank0_rdata(bank0_rdata), .bank2_read(bank2_read), .bank2_addr(bank2_addr), .bank2_rdata(bank2_rdata), .bank3_read(bank3_read), .bank3_addr(bank3_addr), .bank3_rdata(bank3_rdata), .transform_busy(transform_busy), .intersect_busy(intersect_busy), .traversal_busy(traversal_busy), .vga_clock(vga_clock), .vga_reset(vga_reset), .vga_fb_addr(vga_fb_addr), .vga_fb_data(vga_fb_data), .vga_hsync(vga_hsync), .vga_vsync(vga_vsync), .vga_rgb(vga_rgb), .vga_frame_start(vga_frame_start));
   always #5 clock = ~clock;
   // The display's pixel clock (25 MHz against the core's 100 MHz here; running only with
   // +vga, so that frame runs do not simulate it) and its read port on the frame bank,
