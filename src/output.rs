@@ -121,19 +121,23 @@ fn resolved(path: &Path) -> PathBuf {
     }
 }
 
-/// Refuses two entries of `paths` (role, path) that are the same file.
-pub fn check_distinct(paths: &[(&str, &Path)]) -> Result<()> {
-    let resolved: Vec<PathBuf> = paths.iter().map(|(_, p)| resolved(p)).collect();
-    for i in 0..paths.len() {
-        for j in i + 1..paths.len() {
-            if resolved[i] == resolved[j] {
-                bail!(
-                    "{} and {} are the same file '{}'; give each its own path",
-                    paths[i].0,
-                    paths[j].0,
-                    paths[j].1.display()
-                );
-            }
+/// Refuses an output (role, path) that is the same file as another output or as one of the
+/// command's inputs; two inputs may well be one file (comparing an image with itself).
+pub fn check_distinct(outputs: &[(&str, &Path)], inputs: &[(&str, &Path)]) -> Result<()> {
+    let all: Vec<(&str, &Path, PathBuf)> = inputs
+        .iter()
+        .chain(outputs)
+        .map(|&(role, p)| (role, p, resolved(p)))
+        .collect();
+    let first_output = inputs.len();
+    for j in first_output..all.len() {
+        if let Some(i) = (0..j).find(|&i| all[i].2 == all[j].2) {
+            bail!(
+                "{} and {} are the same file '{}'; give each its own path",
+                all[i].0,
+                all[j].0,
+                all[j].1.display()
+            );
         }
     }
     Ok(())
@@ -350,11 +354,21 @@ mod tests {
         let a = dir.path().join("x.csv");
         let b = dir.path().join("sub/../x.csv");
         std::fs::create_dir(dir.path().join("sub")).unwrap();
-        let e = check_distinct(&[("--out", &a), ("--hits", &b)])
+        let e = check_distinct(&[("--out", &a), ("--hits", &b)], &[])
             .unwrap_err()
             .to_string();
         assert!(e.contains("--out and --hits are the same file"), "{e}");
-        check_distinct(&[("--out", &a), ("--hits", &dir.path().join("y.csv"))]).unwrap();
+        check_distinct(&[("--out", &a), ("--hits", &dir.path().join("y.csv"))], &[]).unwrap();
+        // Two inputs may be one file; an output may not be an input.
+        check_distinct(
+            &[("--diff", &dir.path().join("d.png"))],
+            &[("A", &a), ("B", &b)],
+        )
+        .unwrap();
+        let e = check_distinct(&[("--diff", &b)], &[("A", &a)])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("A and --diff are the same file"), "{e}");
     }
 
     #[test]

@@ -78,6 +78,11 @@ pub fn run() -> i32 {
         Err(e) => {
             dynrt::sim::process::wait_if_interrupted();
             eprintln!("error: {e:#}");
+            if disk_full(&e) {
+                eprintln!(
+                    "the disk is full: free space in the output's file system or name an output elsewhere, then run again"
+                );
+            }
             exit_code_of(&e)
         }
     }
@@ -90,16 +95,34 @@ pub const EXIT_USAGE: i32 = 2;
 /// Exit status when a tool or the machine failed (a simulator missing, a timeout, a full disk).
 pub const EXIT_TOOL: i32 = 3;
 
-/// [`EXIT_TOOL`] when a tool error is in the chain, else [`EXIT_USAGE`].
+/// Whether `io` says the disk or the quota is full. The kind is asked as well as the OS code:
+/// tempfile wraps the OS error with its path, and the wrapper keeps only the kind.
+fn is_disk_full(io: &std::io::Error) -> bool {
+    matches!(io.raw_os_error(), Some(libc::ENOSPC | libc::EDQUOT))
+        || matches!(
+            io.kind(),
+            std::io::ErrorKind::StorageFull | std::io::ErrorKind::QuotaExceeded
+        )
+}
+
+/// Whether the machine, not the input, failed a write or read: a full disk, an I/O error.
+fn machine_failed(io: &std::io::Error) -> bool {
+    is_disk_full(io) || io.raw_os_error() == Some(libc::EIO)
+}
+
+/// Whether the error chain holds a full disk or quota.
+fn disk_full(e: &anyhow::Error) -> bool {
+    e.chain()
+        .any(|c| c.downcast_ref::<std::io::Error>().is_some_and(is_disk_full))
+}
+
+/// [`EXIT_TOOL`] when a tool error or a failure of the machine is in the chain, else
+/// [`EXIT_USAGE`].
 fn exit_code_of(e: &anyhow::Error) -> i32 {
     let tool = e.chain().any(|c| {
         c.downcast_ref::<dynrt::sim::ToolError>().is_some()
-            || c.downcast_ref::<std::io::Error>().is_some_and(|io| {
-                matches!(
-                    io.raw_os_error(),
-                    Some(libc::ENOSPC | libc::EDQUOT | libc::EIO)
-                )
-            })
+            || c.downcast_ref::<std::io::Error>()
+                .is_some_and(machine_failed)
     });
     if tool {
         EXIT_TOOL

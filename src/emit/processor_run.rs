@@ -60,7 +60,8 @@ pub fn write_processor_files(
     }
     let rtl = processor_rtl(program, params, scene_name)?;
     let rtl_path = rtl_dir.join(format!("{}.v", super::processor::PROCESSOR_TOP));
-    write_atomically(&rtl_path, rtl.as_bytes())?;
+    write_atomically(&rtl_path, rtl.as_bytes())
+        .with_context(|| format!("writing {}", rtl_path.display()))?;
     write_memory_images(first, &mem_dir)?;
     let mut updates = Vec::new();
     for (k, pair) in layouts.windows(2).enumerate() {
@@ -95,7 +96,8 @@ pub fn write_processor_files(
         vga: display_mode(first.info.width, first.info.height)?,
     };
     let tb_path = tb_dir.join("tb.v");
-    write_atomically(&tb_path, processor_testbench(params, &frames).as_bytes())?;
+    write_atomically(&tb_path, processor_testbench(params, &frames).as_bytes())
+        .with_context(|| format!("writing {}", tb_path.display()))?;
     Ok((rtl_path, tb_path))
 }
 
