@@ -506,7 +506,7 @@ fn corpus() -> Vec<Case> {
             &[("s.toml", &mesh_scene("."))],
             "render $D/s.toml --out $D/o.png",
             USAGE,
-            &["s.toml:11", "a directory"],
+            &["s.toml:12", "a directory"],
         ),
         case(
             "scene is binary garbage",
@@ -646,7 +646,7 @@ fn corpus() -> Vec<Case> {
             &[("s.toml", &GOOD.replace("fov_y = 40.0", "fov_y = nan"))],
             "render $D/s.toml --out $D/o.png",
             USAGE,
-            &["s.toml:4", "fov_y = NaN", "not finite"],
+            &["s.toml:5", "fov_y = NaN", "not finite"],
         ),
         case(
             "infinite light position",
@@ -673,7 +673,7 @@ fn corpus() -> Vec<Case> {
             )],
             "render $D/s.toml --out $D/o.png",
             USAGE,
-            &["s.toml:11", "box size"],
+            &["s.toml:12", "box size"],
         ),
         case(
             "zero scale",
@@ -690,7 +690,7 @@ fn corpus() -> Vec<Case> {
             &[("s.toml", &GOOD.replace("width = 8", "width = 100000"))],
             "render $D/s.toml --out $D/o.png",
             USAGE,
-            &["s.toml:5", "100000x6", "1..=4096"],
+            &["s.toml:6", "100000x6", "1..=4096"],
         ),
         case(
             "zero resolution on the command line",
@@ -885,7 +885,7 @@ fn corpus() -> Vec<Case> {
             &[("s.toml", &huge_terrain)],
             "render $D/s.toml --out $D/o.png",
             USAGE,
-            &["s.toml:11", "8388608 triangles", "131072"],
+            &["s.toml:12", "8388608 triangles", "131072"],
         ),
         case(
             "1024x1024 terrain",

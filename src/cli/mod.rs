@@ -130,3 +130,28 @@ fn exit_code_of(e: &anyhow::Error) -> i32 {
         EXIT_USAGE
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_full_disk_is_the_machines_failure_even_when_wrapped_with_its_path() {
+        // What tempfile returns when the disk fills: the kind kept, the OS code lost in the
+        // wrapper that adds the path.
+        let wrapped = std::io::Error::new(
+            std::io::ErrorKind::StorageFull,
+            "No space left on device (os error 28) at path x",
+        );
+        let e = anyhow::Error::new(wrapped).context("writing x");
+        assert!(disk_full(&e));
+        assert_eq!(exit_code_of(&e), EXIT_TOOL);
+        let os = anyhow::Error::new(std::io::Error::from_raw_os_error(libc::ENOSPC));
+        assert_eq!(exit_code_of(&os), EXIT_TOOL);
+        // A folder the user may not write to is a bad path, not a broken machine.
+        let denied = anyhow::Error::new(std::io::Error::from_raw_os_error(libc::EACCES))
+            .context("writing x");
+        assert!(!disk_full(&denied));
+        assert_eq!(exit_code_of(&denied), EXIT_USAGE);
+    }
+}
