@@ -66,6 +66,26 @@ pub fn check_output_file(path: &Path, what: &str) -> Result<()> {
         );
     }
     refuse_non_regular(path, what)?;
+    check_names_and_folders(path, what)
+}
+
+/// The longest name of one file or folder on Linux file systems (NAME_MAX).
+const MAX_NAME_BYTES: usize = 255;
+
+/// Checks, before any work, what would otherwise fail only at the write: every name in `path`
+/// fits NAME_MAX, and the nearest existing folder above it is a folder, not a file.
+fn check_names_and_folders(path: &Path, what: &str) -> Result<()> {
+    if let Some(long) = path
+        .components()
+        .map(|c| c.as_os_str())
+        .find(|c| c.len() > MAX_NAME_BYTES)
+    {
+        let shown: String = long.to_string_lossy().chars().take(40).collect();
+        bail!(
+            "{what}: the name '{shown}...' is {} bytes, longer than the {MAX_NAME_BYTES} a file or folder name may have; give a shorter name",
+            long.len()
+        );
+    }
     let mut ancestor = parent_of(path);
     loop {
         match std::fs::metadata(ancestor) {
@@ -103,7 +123,7 @@ pub fn check_output_dir(path: &Path, what: &str) -> Result<()> {
                     path.display()
                 );
             }
-            check_output_file(&path.join("x"), what)
+            check_names_and_folders(path, what)
         }
     }
 }
@@ -345,7 +365,22 @@ mod tests {
             .to_string();
         assert!(e.contains("is a file, not a folder"), "{e}");
         let e = check_output_dir(&file, "--out").unwrap_err().to_string();
-        assert!(e.contains("not a folder"), "{e}");
+        assert!(e.contains("a regular file, not a folder"), "{e}");
+        // A folder under a file is named as given, not with a made-up child.
+        let under = file.join("run");
+        let e = check_output_dir(&under, "--out").unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("'{}':", under.display())) && e.contains("is a file, not a folder"),
+            "{e}"
+        );
+        // A name longer than NAME_MAX fails before any work, not at the write.
+        let long = d.join(format!("{}.png", "x".repeat(300)));
+        let e = check_output_file(&long, "--out").unwrap_err().to_string();
+        assert!(e.contains("304 bytes, longer than the 255"), "{e}");
+        let e = check_output_dir(&d.join("y".repeat(256)), "--out")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("256 bytes"), "{e}");
     }
 
     #[test]

@@ -545,6 +545,20 @@ fn corpus() -> Vec<Case> {
             &["--hits", "is a file, not a folder"],
         ),
         case(
+            "--out name longer than a file name may be",
+            &[("s.toml", &good)],
+            &format!("render $D/s.toml --out $D/{}.png", "x".repeat(300)),
+            USAGE,
+            &["304 bytes", "longer than the 255"],
+        ),
+        case(
+            "rtl --out under a file",
+            &[("s.toml", &good), ("f", "x")],
+            "rtl $D/s.toml --out $D/f/r",
+            USAGE,
+            &["f/r':", "is a file, not a folder"],
+        ),
+        case(
             "--out inside the scene's path",
             &[("s.toml", &good)],
             "render $D/s.toml --out $D/s.toml/o.png",
