@@ -234,8 +234,10 @@ pub fn generate_rtl(
         cycle_limit(&predicted, period),
         out,
     )?;
-    let ucf = out.join("constraints").join("dynrt.ucf");
-    std::fs::create_dir_all(ucf.parent().unwrap())?;
+    let constraints = out.join("constraints");
+    std::fs::create_dir_all(&constraints)
+        .with_context(|| format!("creating {}", constraints.display()))?;
+    let ucf = constraints.join("dynrt.ucf");
     let info = &layouts[0].info;
     let display = display_mode(info.width, info.height)?;
     let ports = crate::emit::processor::processor_ports(&program, params)?;
@@ -245,7 +247,8 @@ pub fn generate_rtl(
         &UcfOptions::default(),
     )?;
     let listing = out.join("program.lst");
-    crate::output::write_atomically(&listing, program.listing().as_bytes())?;
+    crate::output::write_atomically(&listing, program.listing().as_bytes())
+        .with_context(|| format!("writing {}", listing.display()))?;
     Ok(RtlReport {
         program,
         frames: layouts.len(),
@@ -451,7 +454,8 @@ pub fn simulate_scene(
                     )
                 })
                 .collect();
-            crate::output::write_atomically(&trace, text.as_bytes())?;
+            crate::output::write_atomically(&trace, text.as_bytes())
+                .with_context(|| format!("writing {}", trace.display()))?;
         }
         reports.push(FrameReport {
             cycles: fr.cycles,

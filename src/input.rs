@@ -18,7 +18,7 @@ use thiserror::Error;
 /// above any scene that fits, and far below what would exhaust the machine.
 pub const MAX_MESH_BYTES: u64 = 256 << 20;
 /// A scene TOML is a camera, lights and a list of objects and instances: 16 MiB is thousands of
-/// times the bundled ones and still more than `MAX_FIELD_INSTANCES` written out by hand.
+/// times the bundled ones and still more than the 43,690 instances the processor holds written out by hand.
 pub const MAX_SCENE_BYTES: u64 = 16 << 20;
 /// A material library: 16 MiB is millions of materials.
 pub const MAX_MTL_BYTES: u64 = 16 << 20;
@@ -63,7 +63,9 @@ pub enum InputError {
 /// What kind of file system object `t` is, for messages.
 pub(crate) fn kind_name(t: std::fs::FileType) -> &'static str {
     use std::os::unix::fs::FileTypeExt;
-    if t.is_dir() {
+    if t.is_file() {
+        "a regular file"
+    } else if t.is_dir() {
         "a directory"
     } else if t.is_fifo() {
         "a named pipe (FIFO)"

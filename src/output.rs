@@ -66,6 +66,26 @@ pub fn check_output_file(path: &Path, what: &str) -> Result<()> {
         );
     }
     refuse_non_regular(path, what)?;
+    check_names_and_folders(path, what)
+}
+
+/// The longest name of one file or folder on Linux file systems (NAME_MAX).
+const MAX_NAME_BYTES: usize = 255;
+
+/// Checks, before any work, what would otherwise fail only at the write: every name in `path`
+/// fits NAME_MAX, and the nearest existing folder above it is a folder, not a file.
+fn check_names_and_folders(path: &Path, what: &str) -> Result<()> {
+    if let Some(long) = path
+        .components()
+        .map(|c| c.as_os_str())
+        .find(|c| c.len() > MAX_NAME_BYTES)
+    {
+        let shown: String = long.to_string_lossy().chars().take(40).collect();
+        bail!(
+            "{what}: the name '{shown}...' is {} bytes, longer than the {MAX_NAME_BYTES} a file or folder name may have; give a shorter name",
+            long.len()
+        );
+    }
     let mut ancestor = parent_of(path);
     loop {
         match std::fs::metadata(ancestor) {
@@ -103,7 +123,7 @@ pub fn check_output_dir(path: &Path, what: &str) -> Result<()> {
                     path.display()
                 );
             }
-            check_output_file(&path.join("x"), what)
+            check_names_and_folders(path, what)
         }
     }
 }
@@ -121,19 +141,23 @@ fn resolved(path: &Path) -> PathBuf {
     }
 }
 
-/// Refuses two entries of `paths` (role, path) that are the same file.
-pub fn check_distinct(paths: &[(&str, &Path)]) -> Result<()> {
-    let resolved: Vec<PathBuf> = paths.iter().map(|(_, p)| resolved(p)).collect();
-    for i in 0..paths.len() {
-        for j in i + 1..paths.len() {
-            if resolved[i] == resolved[j] {
-                bail!(
-                    "{} and {} are the same file '{}'; give each its own path",
-                    paths[i].0,
-                    paths[j].0,
-                    paths[j].1.display()
-                );
-            }
+/// Refuses an output (role, path) that is the same file as another output or as one of the
+/// command's inputs; two inputs may well be one file (comparing an image with itself).
+pub fn check_distinct(outputs: &[(&str, &Path)], inputs: &[(&str, &Path)]) -> Result<()> {
+    let all: Vec<(&str, &Path, PathBuf)> = inputs
+        .iter()
+        .chain(outputs)
+        .map(|&(role, p)| (role, p, resolved(p)))
+        .collect();
+    let first_output = inputs.len();
+    for j in first_output..all.len() {
+        if let Some(i) = (0..j).find(|&i| all[i].2 == all[j].2) {
+            bail!(
+                "{} and {} are the same file '{}'; give each its own path",
+                all[i].0,
+                all[j].0,
+                all[j].1.display()
+            );
         }
     }
     Ok(())
@@ -341,7 +365,22 @@ mod tests {
             .to_string();
         assert!(e.contains("is a file, not a folder"), "{e}");
         let e = check_output_dir(&file, "--out").unwrap_err().to_string();
-        assert!(e.contains("not a folder"), "{e}");
+        assert!(e.contains("a regular file, not a folder"), "{e}");
+        // A folder under a file is named as given, not with a made-up child.
+        let under = file.join("run");
+        let e = check_output_dir(&under, "--out").unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("'{}':", under.display())) && e.contains("is a file, not a folder"),
+            "{e}"
+        );
+        // A name longer than NAME_MAX fails before any work, not at the write.
+        let long = d.join(format!("{}.png", "x".repeat(300)));
+        let e = check_output_file(&long, "--out").unwrap_err().to_string();
+        assert!(e.contains("304 bytes, longer than the 255"), "{e}");
+        let e = check_output_dir(&d.join("y".repeat(256)), "--out")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("256 bytes"), "{e}");
     }
 
     #[test]
@@ -350,11 +389,21 @@ mod tests {
         let a = dir.path().join("x.csv");
         let b = dir.path().join("sub/../x.csv");
         std::fs::create_dir(dir.path().join("sub")).unwrap();
-        let e = check_distinct(&[("--out", &a), ("--hits", &b)])
+        let e = check_distinct(&[("--out", &a), ("--hits", &b)], &[])
             .unwrap_err()
             .to_string();
         assert!(e.contains("--out and --hits are the same file"), "{e}");
-        check_distinct(&[("--out", &a), ("--hits", &dir.path().join("y.csv"))]).unwrap();
+        check_distinct(&[("--out", &a), ("--hits", &dir.path().join("y.csv"))], &[]).unwrap();
+        // Two inputs may be one file; an output may not be an input.
+        check_distinct(
+            &[("--diff", &dir.path().join("d.png"))],
+            &[("A", &a), ("B", &b)],
+        )
+        .unwrap();
+        let e = check_distinct(&[("--diff", &b)], &[("A", &a)])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("A and --diff are the same file"), "{e}");
     }
 
     #[test]

@@ -54,6 +54,16 @@ struct Case {
     code: i32,
     /// Words the message (stderr) must contain, in any case.
     words: Vec<&'static str>,
+    /// Files the run must create in the folder (a run that succeeds); nothing else may appear.
+    creates: Vec<&'static str>,
+}
+
+impl Case {
+    /// The run succeeds and writes exactly `names` into the folder.
+    fn creates(mut self, names: &[&'static str]) -> Case {
+        self.creates = names.to_vec();
+        self
+    }
 }
 
 fn case(
@@ -72,7 +82,18 @@ fn case(
         args: args.split_whitespace().map(String::from).collect(),
         code,
         words: words.to_vec(),
+        creates: Vec::new(),
     }
+}
+
+/// [`GOOD`] with its Cornell box replaced by the generator `generate` (a TOML inline table).
+fn generated(generate: &str) -> String {
+    GOOD.replace("{ kind = \"cornell_box\" }", generate)
+}
+
+/// [`GOOD`] with `extra` appended (tables after the object).
+fn good_with(extra: &str) -> String {
+    format!("{GOOD}{extra}")
 }
 
 fn corpus() -> Vec<Case> {
@@ -88,6 +109,25 @@ fn corpus() -> Vec<Case> {
     let good = GOOD.to_string();
     let no_objects = good_without_objects();
     let obj = mesh_scene("m.obj");
+    // 2,000,000 faces over three vertices: 16 MB that the line scan refuses at face 131,073
+    // (line 131,076), long before tobj would have parsed them all.
+    let two_million_faces = format!(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\n{}",
+        "f 1 2 3\n".repeat(2_000_000)
+    );
+    let huge_terrain = generated("{ kind = \"terrain\", size = 2048 }");
+    let million_terrain = generated("{ kind = \"terrain\", size = 1024 }");
+    let huge_field =
+        good_with("[[fields]]\nobject = \"box\"\ncount_x = 1000\ncount_z = 1000\nspacing = 3.0\n");
+    let two_fields = good_with(
+        "[[fields]]\nobject = \"box\"\ncount_x = 200\ncount_z = 200\nspacing = 3.0\n\
+         [[fields]]\nobject = \"box\"\ncount_x = 200\ncount_z = 200\nspacing = 3.0\n",
+    );
+    let translated = good_with("[[instances]]\nobject = \"box\"\ntranslate = [1e30, 0.0, 0.0]\n");
+    let lights_90 = format!(
+        "{GOOD}{}",
+        "[[lights]]\nposition = [0.0, 1.9, 0.8]\n".repeat(89)
+    );
     vec![
         // Panics.
         case(
@@ -220,7 +260,7 @@ fn corpus() -> Vec<Case> {
             &[("s.toml", &good), ("r", "x")],
             "rtl $D/s.toml --out $D/r",
             USAGE,
-            &["not a folder"],
+            &["is a regular file, not a folder"],
         ),
         // Silent garbage.
         case(
@@ -401,7 +441,497 @@ fn corpus() -> Vec<Case> {
             USAGE,
             &["docs/ARCHITECTURE.md"],
         ),
+        // Panics, in every verb that builds the processor or the golden model.
+        case(
+            "no objects: sim",
+            &[("s.toml", &no_objects)],
+            "sim $D/s.toml --out $D/r",
+            USAGE,
+            &["no [[objects]]"],
+        ),
+        case(
+            "no objects: demo",
+            &[("s.toml", &no_objects)],
+            "demo $D/s.toml --out $D/r",
+            USAGE,
+            &["no [[objects]]"],
+        ),
+        case(
+            "too many lights for the ROM: sim",
+            &[("s.toml", &many_lights)],
+            "sim $D/s.toml --out $D/r",
+            USAGE,
+            &["ROM holds 4096", "use at most"],
+        ),
+        case(
+            "too many lights for the ROM: demo",
+            &[("s.toml", &many_lights)],
+            "demo $D/s.toml --out $D/r",
+            USAGE,
+            &["ROM holds 4096", "use at most"],
+        ),
+        case(
+            "90 lights fit the ROM",
+            &[("s.toml", &lights_90)],
+            "rtl $D/s.toml --out $D/r",
+            0,
+            &[],
+        )
+        .creates(&["r"]),
+        case(
+            "render takes many lights",
+            &[("s.toml", &many_lights)],
+            "render $D/s.toml --out $D/o.png",
+            0,
+            &[],
+        )
+        .creates(&["o.png"]),
+        // Hangs and unbounded reads.
+        case(
+            "hits file is a FIFO",
+            &[("a.png", ""), ("fifo:h.csv", "")],
+            "compare $D/a.png $D/a.png --hits $D/h.csv $D/h.csv",
+            USAGE,
+            &["named pipe", "h.csv"],
+        ),
+        case(
+            "image to compare is a FIFO",
+            &[("fifo:a.png", "")],
+            "compare $D/a.png $D/a.png",
+            USAGE,
+            &["named pipe", "a.png"],
+        ),
+        case(
+            "mesh is a directory",
+            &[("s.toml", &mesh_scene("."))],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["s.toml:12", "a directory"],
+        ),
+        case(
+            "scene is binary garbage",
+            &[("s.toml", "\u{1}\u{2}\u{0}\u{7f}garbage")],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["s.toml"],
+        ),
+        case(
+            "scene is empty",
+            &[("s.toml", "")],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["s.toml", "missing field `camera`"],
+        ),
+        case(
+            "scene does not exist",
+            &[],
+            "render $D/nope.toml --out $D/o.png",
+            USAGE,
+            &["nope.toml", "does not exist"],
+        ),
+        case(
+            "fp vector file is empty",
+            &[("v.txt", "")],
+            "fp --op add --vectors $D/v.txt --out $D/r.txt",
+            USAGE,
+            &["v.txt", "no vectors"],
+        ),
+        // Destroyed files.
+        case(
+            "--hits under a file",
+            &[("s.toml", &good), ("f", "x")],
+            "render $D/s.toml --out $D/o.png --hits $D/f/h.csv",
+            USAGE,
+            &["--hits", "is a file, not a folder"],
+        ),
+        case(
+            "--out name longer than a file name may be",
+            &[("s.toml", &good)],
+            &format!("render $D/s.toml --out $D/{}.png", "x".repeat(300)),
+            USAGE,
+            &["304 bytes", "longer than the 255"],
+        ),
+        case(
+            "rtl --out under a file",
+            &[("s.toml", &good), ("f", "x")],
+            "rtl $D/s.toml --out $D/f/r",
+            USAGE,
+            &["f/r':", "is a file, not a folder"],
+        ),
+        case(
+            "--out inside the scene's path",
+            &[("s.toml", &good)],
+            "render $D/s.toml --out $D/s.toml/o.png",
+            USAGE,
+            &["is a file, not a folder"],
+        ),
+        case(
+            "--out is the scene by another spelling",
+            &[("s.toml", &good)],
+            "render $D/s.toml --out $D/./s.toml",
+            USAGE,
+            &["the scene and --out are the same file"],
+        ),
+        case(
+            "fp --out is its vectors",
+            &[("v.txt", "0 0\n")],
+            "fp --op add --vectors $D/v.txt --out $D/v.txt",
+            USAGE,
+            &["--vectors and --out are the same file"],
+        ),
+        case(
+            "compare --diff is an input image",
+            &[("a.png", ""), ("b.png", "")],
+            "compare $D/a.png $D/b.png --diff $D/b.png",
+            USAGE,
+            &["image B and --diff are the same file"],
+        ),
+        case(
+            "stress --out is a device",
+            &[],
+            "stress --out /dev/null --margins 0",
+            USAGE,
+            &["/dev/null", "character device"],
+        ),
+        case(
+            "timing --out is a file",
+            &[("t", "x")],
+            "timing --unit add --out $D/t",
+            USAGE,
+            &["is a regular file, not a folder"],
+        ),
+        // Silent garbage: refused when a value does not fit the format, warned when the frame
+        // is far from the reference.
+        case(
+            "instance scale named with its value",
+            &[("s.toml", &scaled)],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["object-to-world matrix", "1.0000e39", "overflows"],
+        ),
+        case(
+            "instance translation names its value",
+            &[("s.toml", &translated)],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["instance 'box#0'", "1.0000e30", "overflows e7m16"],
+        ),
+        case(
+            "a format too narrow for the scene: render",
+            &[("s.toml", &good)],
+            "render $D/s.toml --out $D/o.png --format e2m1",
+            USAGE,
+            &["camera", "e2m1"],
+        ),
+        case(
+            "a format too narrow for the scene: rtl",
+            &[("s.toml", &good)],
+            "rtl $D/s.toml --out $D/r --format e2m1",
+            USAGE,
+            &["camera", "e2m1"],
+        ),
+        case(
+            "a format too narrow for the scene: demo",
+            &[("s.toml", &good)],
+            "demo $D/s.toml --out $D/r --format e2m1",
+            USAGE,
+            &["camera", "e2m1"],
+        ),
+        case(
+            "a golden frame far from the reference is warned about",
+            &[("s.toml", &good)],
+            "render $D/s.toml --out $D/o.png --format e4m3",
+            0,
+            &["warning", "differ from the f64 reference", "e4m3"],
+        )
+        .creates(&["o.png"]),
+        case(
+            "light colour beyond the format",
+            &[(
+                "s.toml",
+                &good_with("[[lights]]\nposition = [0.0, 1.9, 0.8]\ncolor = [1e39, 1.0, 1.0]\n"),
+            )],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["light 1", "1.0000e39", "overflows"],
+        ),
+        case(
+            "NaN field of view",
+            &[("s.toml", &GOOD.replace("fov_y = 40.0", "fov_y = nan"))],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["s.toml:5", "fov_y = NaN", "not finite"],
+        ),
+        case(
+            "infinite light position",
+            &[(
+                "s.toml",
+                &good_with("[[lights]]\nposition = [inf, 0.0, 0.0]\n"),
+            )],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["light 1", "not finite"],
+        ),
+        case(
+            "NaN ambient",
+            &[("s.toml", &good_with("[render]\nambient = nan\n"))],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["ambient = NaN"],
+        ),
+        case(
+            "negative box size",
+            &[(
+                "s.toml",
+                &generated("{ kind = \"box\", size = [-1.0, 1.0, 1.0] }"),
+            )],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["s.toml:12", "box size"],
+        ),
+        case(
+            "zero scale",
+            &[(
+                "s.toml",
+                &good_with("[[instances]]\nobject = \"box\"\nscale = [1.0, 0.0, 1.0]\n"),
+            )],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["zero component"],
+        ),
+        case(
+            "huge resolution in the scene",
+            &[("s.toml", &GOOD.replace("width = 8", "width = 100000"))],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["s.toml:6", "100000x6", "1..=4096"],
+        ),
+        case(
+            "zero resolution on the command line",
+            &[("s.toml", &good)],
+            "render $D/s.toml --out $D/o.png --width 0",
+            USAGE,
+            &["0x6", "1..=4096"],
+        ),
+        case(
+            "a resolution whose frame buffer does not fit",
+            &[("s.toml", &good)],
+            "render $D/s.toml --out $D/o.png --width 4096 --height 4096",
+            USAGE,
+            &["frame", "--width/--height"],
+        ),
+        case(
+            "negative field spacing",
+            &[(
+                "s.toml",
+                &good_with(
+                    "[[fields]]\nobject = \"box\"\ncount_x = 2\ncount_z = 2\nspacing = -1.0\n",
+                ),
+            )],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["field 'field0'", "spacing"],
+        ),
+        case(
+            "hits with a negative distance",
+            &[
+                ("a.png", ""),
+                ("h.csv", "x,y,instance,triangle,dist\n0,0,0,1,-5\n"),
+            ],
+            "compare $D/a.png $D/a.png --hits $D/h.csv $D/h.csv",
+            USAGE,
+            &["h.csv: line 2", "finite distance >= 0"],
+        ),
+        case(
+            "hits beyond the largest frame",
+            &[
+                ("a.png", ""),
+                (
+                    "h.csv",
+                    "x,y,instance,triangle,dist\n4000000000,0,-1,-1,inf\n",
+                ),
+            ],
+            "compare $D/a.png $D/a.png --hits $D/h.csv $D/h.csv",
+            USAGE,
+            &["h.csv: line 2", "beyond the largest frame"],
+        ),
+        case(
+            "hits with a missing pixel",
+            &[
+                ("a.png", ""),
+                (
+                    "h.csv",
+                    "x,y,instance,triangle,dist\n0,0,-1,-1,inf\n1,1,-1,-1,inf\n",
+                ),
+            ],
+            "compare $D/a.png $D/a.png --hits $D/h.csv $D/h.csv",
+            USAGE,
+            &["h.csv", "one row for every pixel"],
+        ),
+        case(
+            "image that is not a PNG",
+            &[("a.png", "not a png at all")],
+            "compare $D/a.png $D/a.png",
+            USAGE,
+            &["a.png", "cannot be decoded"],
+        ),
+        // Runaway output.
+        case(
+            "100,000 animated frames: sim",
+            &[("s.toml", &animated)],
+            "sim $D/s.toml --out $D/r",
+            USAGE,
+            &["100000 frames", "--frames N"],
+        ),
+        case(
+            "--frames beyond the scene",
+            &[("s.toml", &good)],
+            "rtl $D/s.toml --out $D/r --frames 5",
+            USAGE,
+            &["--frames 5", "1 frame(s)"],
+        ),
+        // Partial output: refused before the output folder exists.
+        case(
+            "bad --threads: sim",
+            &[("s.toml", &good)],
+            "sim $D/s.toml --out $D/r --threads 0",
+            USAGE,
+            &["--threads 0", "1..=32"],
+        ),
+        case(
+            "bad --mem-latency: rtl",
+            &[("s.toml", &good)],
+            "rtl $D/s.toml --out $D/r --mem-latency 99",
+            USAGE,
+            &["--mem-latency 99", "1..=6"],
+        ),
+        case(
+            "bad --format: rtl",
+            &[("s.toml", &good)],
+            "rtl $D/s.toml --out $D/r --format e99m99",
+            USAGE,
+            &["e99m99", "2..=8"],
+        ),
+        case(
+            "bad --format: demo",
+            &[("s.toml", &good)],
+            "demo $D/s.toml --out $D/r --format e1m0",
+            USAGE,
+            &["e1m0"],
+        ),
+        // Unclear messages.
+        case(
+            "MTL with a negative colour names its line",
+            &[
+                ("s.toml", &obj),
+                ("m.obj", &format!("mtllib m.mtl\n{TRIANGLE_OBJ}")),
+                ("m.mtl", "newmtl a\nKd -1 0.5 0.5\n"),
+            ],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["m.mtl:2", "negative"],
+        ),
+        case(
+            "missing mtllib",
+            &[
+                ("s.toml", &obj),
+                ("m.obj", &format!("mtllib nope.mtl\n{TRIANGLE_OBJ}")),
+            ],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["nope.mtl", "does not exist"],
+        ),
+        case(
+            "OBJ with no faces",
+            &[("s.toml", &obj), ("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n")],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["m.obj", "no usable triangles"],
+        ),
+        case(
+            "OBJ of control characters",
+            &[("s.toml", &obj), ("m.obj", "v 0 0 0\n\u{0}\u{1}\u{7f}")],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["m.obj"],
+        ),
+        case(
+            "OBJ vertex beyond f32",
+            &[
+                ("s.toml", &obj),
+                ("m.obj", &TRIANGLE_OBJ.replace("v 1 0 0", "v 1e39 0 0")),
+            ],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["m.obj:2", "1e39", "not finite"],
+        ),
+        case(
+            "OBJ face index zero",
+            &[
+                ("s.toml", &obj),
+                ("m.obj", &TRIANGLE_OBJ.replace("f 1 2 3", "f 0 1 2")),
+            ],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["m.obj:4", "index 0 is out of range"],
+        ),
+        case(
+            "a unicode object name is fine",
+            &[(
+                "s.toml",
+                &GOOD.replace("name = \"box\"", "name = \"bøx ✓\""),
+            )],
+            "render $D/s.toml --out $D/o.png",
+            0,
+            &[],
+        )
+        .creates(&["o.png"]),
+        // Late failure on big inputs: refused from counts, before the triangles are built.
+        case(
+            "2,000,000-face OBJ",
+            &[("s.toml", &obj), ("m.obj", &two_million_faces)],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["m.obj:131076", "131072", "triangles"],
+        ),
+        case(
+            "2048x2048 terrain",
+            &[("s.toml", &huge_terrain)],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["s.toml:12", "8388608 triangles", "131072"],
+        ),
+        case(
+            "1024x1024 terrain",
+            &[("s.toml", &million_terrain)],
+            "rtl $D/s.toml --out $D/r",
+            USAGE,
+            &["2097152 triangles", "131072"],
+        ),
+        case(
+            "a field of a million instances",
+            &[("s.toml", &huge_field)],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["field 'field0'", "43690"],
+        ),
+        case(
+            "two fields that do not fit together",
+            &[("s.toml", &two_fields)],
+            "render $D/s.toml --out $D/o.png",
+            USAGE,
+            &["field 'field1'", "80000 instances", "43690"],
+        ),
     ]
+}
+
+/// A message that says the same thing twice in a row ("writing X: writing X: ...").
+fn repeats_itself(message: &str) -> Option<String> {
+    let parts: Vec<&str> = message.split(": ").collect();
+    parts
+        .windows(2)
+        .find(|w| w[0].trim() == w[1].trim() && !w[0].trim().is_empty())
+        .map(|w| w[0].to_string())
 }
 
 fn make_files(dir: &Path, files: &[(String, String)]) {
@@ -496,13 +1026,28 @@ fn every_bad_input_gets_its_exit_status_and_a_clear_message_and_leaves_nothing_b
         if err.contains("panicked") {
             problems.push("the message is a panic".into());
         }
+        if let Some(part) = repeats_itself(&err) {
+            problems.push(format!("the message repeats `{part}`"));
+        }
+        // Errors cite the repository's own documents, never a path outside it.
+        if err.contains("../") || err.contains(".pdf") {
+            problems.push("the message cites a file outside the repository".into());
+        }
         let after = snapshot(d);
-        if after != before {
-            let added: Vec<_> = after
-                .difference(&before)
-                .map(|(p, _)| p.display().to_string())
-                .collect();
-            problems.push(format!("the folder changed: {added:?}"));
+        let created: BTreeSet<PathBuf> = c.creates.iter().map(|n| d.join(n)).collect();
+        let changed: Vec<String> = after
+            .symmetric_difference(&before)
+            .map(|(p, _)| p)
+            .filter(|p| !created.iter().any(|c| p.starts_with(c)))
+            .map(|p| p.display().to_string())
+            .collect();
+        if !changed.is_empty() {
+            problems.push(format!("the folder changed: {changed:?}"));
+        }
+        for name in &created {
+            if !name.exists() {
+                problems.push(format!("{} was not written", name.display()));
+            }
         }
         if !problems.is_empty() {
             failures.push(format!(

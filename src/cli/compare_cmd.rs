@@ -27,12 +27,11 @@ fn open(p: &std::path::Path) -> anyhow::Result<image::RgbImage> {
 pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
     if let Some(d) = &a.diff {
         dynrt::output::check_output_file(d, "--diff")?;
-        let mut roles: Vec<(&str, &std::path::Path)> =
-            vec![("image A", &a.a), ("image B", &a.b), ("--diff", d)];
+        let mut inputs: Vec<(&str, &std::path::Path)> = vec![("image A", &a.a), ("image B", &a.b)];
         if let Some(h) = &a.hits {
-            roles.extend([("HITS_A", h[0].as_path()), ("HITS_B", h[1].as_path())]);
+            inputs.extend([("HITS_A", h[0].as_path()), ("HITS_B", h[1].as_path())]);
         }
-        dynrt::output::check_distinct(&roles)?;
+        dynrt::output::check_distinct(&[("--diff", d)], &inputs)?;
     }
     // Every input is read and checked before anything is computed or written.
     let hits = match &a.hits {

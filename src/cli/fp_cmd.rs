@@ -41,8 +41,16 @@ fn parse_op(s: &str) -> Result<BinOp, String> {
 pub fn run(a: FpArgs) -> anyhow::Result<i32> {
     let f = a.format;
     dynrt::output::check_output_file(&a.out, "--out")?;
-    dynrt::output::check_distinct(&[("--vectors", &a.vectors), ("--out", &a.out)])?;
+    dynrt::output::check_distinct(&[("--out", &a.out)], &[("--vectors", &a.vectors)])?;
     let vectors = read_vector_file(&a.vectors, f.width())?;
+    // An empty file would give an empty result file and a report of 0 vectors: a path mix-up
+    // more often than a wish.
+    if vectors.is_empty() {
+        anyhow::bail!(
+            "vector file '{}' holds no vectors; write one vector a line, two hex words `a b` of the format's width",
+            a.vectors.display()
+        );
+    }
     let results: Vec<u32> = match a.sim {
         FpEngine::Model => vectors.iter().map(|&(x, y)| a.op.eval(f, x, y)).collect(),
         FpEngine::Iverilog | FpEngine::Verilator => {

@@ -78,6 +78,11 @@ pub fn run() -> i32 {
         Err(e) => {
             dynrt::sim::process::wait_if_interrupted();
             eprintln!("error: {e:#}");
+            if disk_full(&e) {
+                eprintln!(
+                    "the disk is full: free space in the output's file system or name an output elsewhere, then run again"
+                );
+            }
             exit_code_of(&e)
         }
     }
@@ -90,20 +95,63 @@ pub const EXIT_USAGE: i32 = 2;
 /// Exit status when a tool or the machine failed (a simulator missing, a timeout, a full disk).
 pub const EXIT_TOOL: i32 = 3;
 
-/// [`EXIT_TOOL`] when a tool error is in the chain, else [`EXIT_USAGE`].
+/// Whether `io` says the disk or the quota is full. The kind is asked as well as the OS code:
+/// tempfile wraps the OS error with its path, and the wrapper keeps only the kind.
+fn is_disk_full(io: &std::io::Error) -> bool {
+    matches!(io.raw_os_error(), Some(libc::ENOSPC | libc::EDQUOT))
+        || matches!(
+            io.kind(),
+            std::io::ErrorKind::StorageFull | std::io::ErrorKind::QuotaExceeded
+        )
+}
+
+/// Whether the machine, not the input, failed a write or read: a full disk, an I/O error.
+fn machine_failed(io: &std::io::Error) -> bool {
+    is_disk_full(io) || io.raw_os_error() == Some(libc::EIO)
+}
+
+/// Whether the error chain holds a full disk or quota.
+fn disk_full(e: &anyhow::Error) -> bool {
+    e.chain()
+        .any(|c| c.downcast_ref::<std::io::Error>().is_some_and(is_disk_full))
+}
+
+/// [`EXIT_TOOL`] when a tool error or a failure of the machine is in the chain, else
+/// [`EXIT_USAGE`].
 fn exit_code_of(e: &anyhow::Error) -> i32 {
     let tool = e.chain().any(|c| {
         c.downcast_ref::<dynrt::sim::ToolError>().is_some()
-            || c.downcast_ref::<std::io::Error>().is_some_and(|io| {
-                matches!(
-                    io.raw_os_error(),
-                    Some(libc::ENOSPC | libc::EDQUOT | libc::EIO)
-                )
-            })
+            || c.downcast_ref::<std::io::Error>()
+                .is_some_and(machine_failed)
     });
     if tool {
         EXIT_TOOL
     } else {
         EXIT_USAGE
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_full_disk_is_the_machines_failure_even_when_wrapped_with_its_path() {
+        // What tempfile returns when the disk fills: the kind kept, the OS code lost in the
+        // wrapper that adds the path.
+        let wrapped = std::io::Error::new(
+            std::io::ErrorKind::StorageFull,
+            "No space left on device (os error 28) at path x",
+        );
+        let e = anyhow::Error::new(wrapped).context("writing x");
+        assert!(disk_full(&e));
+        assert_eq!(exit_code_of(&e), EXIT_TOOL);
+        let os = anyhow::Error::new(std::io::Error::from_raw_os_error(libc::ENOSPC));
+        assert_eq!(exit_code_of(&os), EXIT_TOOL);
+        // A folder the user may not write to is a bad path, not a broken machine.
+        let denied = anyhow::Error::new(std::io::Error::from_raw_os_error(libc::EACCES))
+            .context("writing x");
+        assert!(!disk_full(&denied));
+        assert_eq!(exit_code_of(&denied), EXIT_USAGE);
     }
 }

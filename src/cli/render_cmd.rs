@@ -58,12 +58,12 @@ pub fn load_scene(
 
 pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
     dynrt::output::check_output_file(&a.out, "--out")?;
-    let mut roles: Vec<(&str, &std::path::Path)> = vec![("the scene", &a.scene), ("--out", &a.out)];
+    let mut outputs: Vec<(&str, &std::path::Path)> = vec![("--out", &a.out)];
     if let Some(h) = &a.hits {
         dynrt::output::check_output_file(h, "--hits")?;
-        roles.push(("--hits", h));
+        outputs.push(("--hits", h));
     }
-    dynrt::output::check_distinct(&roles)?;
+    dynrt::output::check_distinct(&outputs, &[("the scene", &a.scene)])?;
     let scene = load_scene(&a.scene, a.width, a.height)?;
     if a.frame >= scene.frames {
         anyhow::bail!(

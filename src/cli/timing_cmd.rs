@@ -143,8 +143,10 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
         designs.push(parse_unit(u)?);
     }
     for path in &a.scenes {
-        let scene = super::render_cmd::load_scene(path, None, None)
-            .with_context(|| format!("scene {}", path.display()))?;
+        // The scene's errors name its file; the processor's limits are checked before any
+        // tool runs, as `dynrt rtl` does.
+        let scene = super::render_cmd::load_scene(path, None, None)?;
+        flow::preflight(&scene, a.format, params, None)?;
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -163,6 +165,7 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
             w[0]
         );
     }
+    dynrt::output::check_output_dir(&a.out, "--out")?;
     let tools = ecp5::timing_tools()?;
     println!(
         "ECP5 timing ({}, out of context, {} MHz, seeds {}): yosys {}, nextpnr-ecp5 {}",
@@ -177,7 +180,7 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
         tools.nextpnr_version
     );
     std::fs::create_dir_all(&a.out)
-        .with_context(|| format!("cannot create {}", a.out.display()))?;
+        .with_context(|| format!("creating --out '{}'", a.out.display()))?;
     // The binary's own path depends on the target directory; the verb and its arguments are
     // what reproduces the table.
     let command = std::iter::once("dynrt".to_string())

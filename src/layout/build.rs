@@ -68,7 +68,7 @@ fn bank_advice(bank: usize) -> &'static str {
         NODES | LISTS => "use fewer triangles per object (simplify the mesh) or instance repeated parts",
         TRIANGLES_UV | TRIANGLES_T => "use fewer triangles (simplify the mesh, a coarser generator) or instance repeated objects",
         INSTANCES => "use fewer instances",
-        _ => "use a lower resolution (--width/--height), fewer lights or fewer materials",
+        _ => "use a lower resolution (the scene's [camera] width and height, or --width/--height of render, rtl and sim), fewer lights or fewer materials",
     }
 }
 
@@ -128,10 +128,10 @@ fn checked_words(
     for (i, &x) in values.iter().enumerate() {
         let w = f.from_f64(x);
         if !x.is_finite() || f.is_nan(w) || f.is_inf(w) {
-            return Err(refuse(i, "overflows", "bring the scene's coordinates, scales and colours into the format's range, or choose a format with more exponent bits (--format e8m16)"));
+            return Err(refuse(i, "overflows", "bring the scene's coordinates, scales and colours into the format's range, or choose a format with more exponent bits (e.g. --format e8m16)"));
         }
         if x != 0.0 && f.is_zero(w) && x.abs() >= matters {
-            return Err(refuse(i, "underflows to zero in", "avoid extreme scales (an instance's scale and its inverse both go into the hardware), or choose a format with more exponent bits (--format e8m16)"));
+            return Err(refuse(i, "underflows to zero in", "bring the scene's sizes nearer 1 (an instance's scale and its inverse both go into the hardware), or choose a format with more exponent bits (e.g. --format e8m16)"));
         }
         words.push(w);
     }
@@ -444,7 +444,7 @@ pub fn build(
             .map(|(inst, m)| {
                 let b = instance_box(f, &trees.trees[inst.object].bounds, m);
                 let values = [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z];
-                checked_words(
+                let box_words = checked_words(
                     f,
                     scene,
                     &|i| {
@@ -456,7 +456,22 @@ pub fn build(
                         )
                     },
                     &values,
-                )?;
+                );
+                if let Err(box_error) = box_words {
+                    // A box that overflows is the consequence; the user wrote the matrix's
+                    // translate, rotate or scale, so name the entry of it that does not fit
+                    // when there is one.
+                    checked_affine_words(
+                        f,
+                        scene,
+                        &format!(
+                            "instance '{}': its object-to-world matrix at frame {frame} (from its translate, rotate and scale; relative to the eye)",
+                            inst.name
+                        ),
+                        m,
+                    )?;
+                    return Err(box_error);
+                }
                 Ok(b)
             })
             .collect::<Result<_, LayoutError>>()?;

@@ -98,6 +98,15 @@ impl MemoryConfig {
     pub fn bank_words(&self) -> usize {
         self.bank_bytes / 4
     }
+    /// Most triangles the memory holds: each takes `TRIANGLE_BANK_WORDS` in each triangle bank
+    /// (131,072 on the paper's board).
+    pub fn max_triangles(&self) -> usize {
+        self.bank_words() / TRIANGLE_BANK_WORDS
+    }
+    /// Most instances the instance bank holds (43,690 on the paper's board).
+    pub fn max_instances(&self) -> usize {
+        self.bank_words() / INSTANCE_WORDS
+    }
 }
 
 impl Default for MemoryConfig {

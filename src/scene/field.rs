@@ -27,7 +27,12 @@ use rand_chacha::ChaCha8Rng;
 
 use super::transform::{Animation, Instance, Transform};
 
-pub const MAX_FIELD_INSTANCES: u64 = 1_000_000;
+/// Most instances a scene may place: what the processor's instance bank holds
+/// (`MemoryConfig::max_instances`, 43,690 on the board). Fields are counted before they are
+/// expanded, so a field of a million instances costs nothing but its message.
+pub fn max_scene_instances() -> u64 {
+    crate::layout::MemoryConfig::default().max_instances() as u64
+}
 
 /// A field with object names resolved and values validated.
 #[derive(Debug, Clone)]

@@ -82,8 +82,9 @@ pub fn expected_triangles(def: &GenerateDef) -> u64 {
     }
 }
 
-/// Builds the mesh; `material` is used by single-material generators.
-pub fn generate(def: &GenerateDef, material: Material) -> Result<RawMesh, ParamError> {
+/// Builds the mesh; `material` is used by single-material generators. Parameters that give
+/// more than `budget` triangles are refused from the count alone.
+pub fn generate(def: &GenerateDef, material: Material, budget: u64) -> Result<RawMesh, ParamError> {
     // Counted before anything is built: a 2048x2048 terrain is 8.4 M triangles, gigabytes of
     // trees, and can never fit the processor's memory.
     let n = expected_triangles(def);
@@ -96,12 +97,12 @@ pub fn generate(def: &GenerateDef, material: Material) -> Result<RawMesh, ParamE
         _ => true,
     };
     // Out-of-range parameters get their own message from `build`.
-    if in_range && n > super::mesh::MAX_OBJ_TRIANGLES {
+    if in_range && n > budget {
         return Err((
-            "the generator's parameters".into(),
+            "the generator's triangle count".into(),
             format!(
-                "they give {n} triangles, more than the {} one object may have (the processor's memory holds 131,072); use a smaller size or fewer subdivisions",
-                super::mesh::MAX_OBJ_TRIANGLES
+                "its parameters give {n} triangles, {}",
+                super::mesh::too_many_triangles(budget)
             ),
         ));
     }
@@ -412,7 +413,7 @@ mod tests {
     }
 
     fn gen(def: GenerateDef) -> RawMesh {
-        generate(&def, Material::DEFAULT).unwrap()
+        generate(&def, Material::DEFAULT, u64::MAX).unwrap()
     }
 
     #[test]
@@ -574,7 +575,8 @@ mod tests {
             &GenerateDef::Box {
                 size: [1.0, 0.0, 1.0]
             },
-            m
+            m,
+            u64::MAX
         )
         .is_err());
         assert!(generate(
@@ -582,7 +584,8 @@ mod tests {
                 radius: 1.0,
                 subdivisions: 9
             },
-            m
+            m,
+            u64::MAX
         )
         .is_err());
         assert!(generate(
@@ -590,7 +593,8 @@ mod tests {
                 radius: f64::NAN,
                 subdivisions: 1
             },
-            m
+            m,
+            u64::MAX
         )
         .is_err());
         let e = generate(
@@ -603,8 +607,26 @@ mod tests {
                 frequency: 1.0,
             },
             m,
+            u64::MAX,
         )
         .unwrap_err();
         assert_eq!(e.0, "terrain size");
+        // A terrain the memory cannot hold is refused from its count (2 x 300^2 = 180,000
+        // triangles against a budget of 131,072) without building it.
+        let terrain = GenerateDef::Terrain {
+            size: 300,
+            seed: 0,
+            amplitude: 1.0,
+            extent: 1.0,
+            octaves: 1,
+            frequency: 1.0,
+        };
+        let e = generate(&terrain, m, 131_072).unwrap_err();
+        assert!(
+            e.1.contains("give 180000 triangles, more than the 131072"),
+            "{}",
+            e.1
+        );
+        assert!(generate(&terrain, m, 180_000).is_ok());
     }
 }

@@ -147,11 +147,27 @@ struct ObjScan {
     mtllibs: Vec<PathBuf>,
 }
 
-/// Most triangles one OBJ may give: far more than the board's banks hold (131,072 triangles
-/// at 16 words each), so that only the memory-map check decides for a real mesh, while a file
-/// of millions of faces is refused before tobj builds them (its parse costs about 80 bytes of
-/// memory per triangle).
-pub const MAX_OBJ_TRIANGLES: u64 = 4_000_000;
+/// Most triangles the scene's objects may have together: what the processor's memory holds
+/// (`MemoryConfig::max_triangles`, 131,072 on the board). Counted from the OBJ's face lines and
+/// the generators' parameters before any triangle is built, so a mesh of millions of faces is
+/// refused in the time of a line scan instead of after gigabytes of parsing and trees. The
+/// count is taken before degenerate triangles are dropped.
+pub fn max_scene_triangles() -> u64 {
+    crate::layout::MemoryConfig::default().max_triangles() as u64
+}
+
+/// What is wrong with an object whose triangles do not fit: `budget` triangles were left for it.
+pub(crate) fn too_many_triangles(budget: u64) -> String {
+    let max = max_scene_triangles();
+    let room = if budget < max {
+        format!("the {budget} triangles left in the processor's memory after the objects before it ({max} in all, ")
+    } else {
+        format!("the {max} triangles the processor's memory holds (")
+    };
+    format!(
+        "more than {room}six 4 MB banks, docs/ARCHITECTURE.md \"Memory map\"); simplify the mesh, use a coarser generator, or instance repeated parts"
+    )
+}
 
 /// Parses `words` as numbers (the way tobj will, as f32), naming the line's `what` in errors.
 fn numbers(
@@ -191,7 +207,7 @@ fn numbers(
 /// `vn x y z`, faces `v[/vt][/vn]` with 1-based or negative indices), so that a broken line is
 /// reported with its number; tobj itself says only "position parse error" (and panics on some
 /// MTL lines, see [`scan_mtl`]).
-fn scan_obj(path: &Path, text: &str, item: &str) -> Result<ObjScan, SceneError> {
+fn scan_obj(path: &Path, text: &str, item: &str, budget: u64) -> Result<ObjScan, SceneError> {
     let dir = path.parent().unwrap_or(Path::new(""));
     let (mut vertices, mut texcoords, mut normals): (i64, i64, i64) = (0, 0, 0);
     let mut mtllibs = Vec::new();
@@ -294,10 +310,16 @@ fn scan_obj(path: &Path, text: &str, item: &str) -> Result<ObjScan, SceneError> 
                 }
                 if key == "f" {
                     triangles += args.len() as u64 - 2;
-                    if triangles > MAX_OBJ_TRIANGLES {
-                        return Err(broken(format!(
-                            "more than {MAX_OBJ_TRIANGLES} triangles; the processor's memory holds at most 131,072 (six 4 MB banks): simplify the mesh or split it into instanced objects"
-                        )));
+                    if triangles > budget {
+                        return Err(obj_error(
+                            path,
+                            lineno,
+                            item,
+                            Problem::Invalid {
+                                what: "the mesh's triangle count".into(),
+                                expected: too_many_triangles(budget),
+                            },
+                        ));
                     }
                 }
             }
@@ -327,11 +349,19 @@ fn scan_mtl(path: &Path, text: &str, item: &str) -> Result<(), SceneError> {
         let broken = |message: String| obj_error(path, lineno, item, Problem::BrokenMtl(message));
         match key {
             "Ka" | "Kd" | "Ks" | "Ke" => {
-                let colour =
-                    args.len() >= 3 && numbers(&args[..3], path, lineno, item, key).is_ok();
-                if !colour {
+                let colour = match args.get(..3) {
+                    Some(rgb) => numbers(rgb, path, lineno, item, key).ok(),
+                    None => None,
+                };
+                let Some(colour) = colour else {
                     return Err(broken(format!(
                         "`{key}` needs three numbers (r g b), found `{}`",
+                        args.join(" ")
+                    )));
+                };
+                if colour.iter().any(|&c| c < 0.0) {
+                    return Err(broken(format!(
+                        "`{key} {}` has a negative component; colours are >= 0",
                         args.join(" ")
                     )));
                 }
@@ -367,13 +397,22 @@ fn scan_mtl(path: &Path, text: &str, item: &str) -> Result<(), SceneError> {
 fn read_obj_text(path: &Path, item: &str) -> Result<String, SceneError> {
     let text = crate::input::read_text(path, "mesh", crate::input::MAX_MESH_BYTES)
         .map_err(|e| obj_error(path, None, item, Problem::Input(e)))?;
-    Ok(crate::input::normalize_line_endings(&text).into_owned())
+    // Most meshes have no CR: keep the text as read rather than copy a file of up to 256 MiB.
+    Ok(match crate::input::normalize_line_endings(&text) {
+        std::borrow::Cow::Borrowed(_) => text,
+        std::borrow::Cow::Owned(normalized) => normalized,
+    })
 }
 
-/// Loads an OBJ file (and its MTL) as a raw mesh in file order, plus warnings.
-pub(crate) fn load_obj(path: &Path, item: &str) -> Result<(RawMesh, Vec<String>), SceneError> {
+/// Loads an OBJ file (and its MTL) as a raw mesh in file order, plus warnings; more than
+/// `budget` triangles are refused from the face lines alone.
+pub(crate) fn load_obj(
+    path: &Path,
+    item: &str,
+    budget: u64,
+) -> Result<(RawMesh, Vec<String>), SceneError> {
     let text = read_obj_text(path, item)?;
-    let scan = scan_obj(path, &text, item)?;
+    let scan = scan_obj(path, &text, item, budget)?;
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: false,

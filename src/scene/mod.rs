@@ -63,8 +63,8 @@ use toml::Spanned;
 
 pub use camera::{Camera, CameraBasis};
 pub use error::{Problem, SceneError};
-pub use field::MAX_FIELD_INSTANCES;
-pub use mesh::{is_degenerate, Material, Object, DEGENERATE_RELATIVE_EPSILON};
+pub use field::max_scene_instances;
+pub use mesh::{is_degenerate, max_scene_triangles, Material, Object, DEGENERATE_RELATIVE_EPSILON};
 pub use transform::{Animation, Instance, Transform};
 
 use error::ErrorContext;
@@ -320,6 +320,25 @@ impl Builder<'_> {
             })
         };
 
+        let max_instances = max_scene_instances();
+        let too_many_instances = |span: Range<usize>, item: &str, count: u64| {
+            self.invalid(
+                span,
+                item,
+                "the number of instances",
+                &format!(
+                    "the scene would place {count} instances, the processor's instance bank holds {max_instances} (docs/ARCHITECTURE.md, \"Memory map\"); use fewer [[instances]] or smaller [[fields]]"
+                ),
+            )
+        };
+        if file.instances.len() as u64 > max_instances {
+            let last = &file.instances[max_instances as usize];
+            return Err(too_many_instances(
+                last.span(),
+                "[[instances]]",
+                file.instances.len() as u64,
+            ));
+        }
         let mut instances = Vec::new();
         for (k, inst) in file.instances.iter().enumerate() {
             let def = inst.get_ref();
@@ -333,6 +352,14 @@ impl Builder<'_> {
         }
         for (k, f) in file.fields.iter().enumerate() {
             let spec = self.field(f, k, &resolve)?;
+            let count = instances.len() as u64 + u64::from(spec.count_x) * u64::from(spec.count_z);
+            if count > max_instances {
+                return Err(too_many_instances(
+                    f.span(),
+                    &format!("field '{}'", spec.name),
+                    count,
+                ));
+            }
             instances.extend(field::expand(&spec));
         }
         if file.instances.is_empty() && file.fields.is_empty() {
@@ -516,6 +543,9 @@ impl Builder<'_> {
 
     fn objects(&mut self, file: &SceneFile) -> Res<Vec<Object>> {
         let mut objects = Vec::new();
+        // Triangles the memory has left for the objects still to load (counted before they are
+        // read or generated, see `max_scene_triangles`).
+        let mut budget = max_scene_triangles();
         let mut first_line: HashMap<String, usize> = HashMap::new();
         for o in &file.objects {
             let def = o.get_ref();
@@ -561,14 +591,15 @@ impl Builder<'_> {
             let (raw, file_for_errors) = match (&def.mesh, &def.generate) {
                 (Some(mesh), None) => {
                     let path = self.base_dir.join(mesh.get_ref());
-                    let (mut raw, warnings) = mesh::load_obj(&path, &item).map_err(|mut e| {
-                        // A missing mesh is the scene's fault: point at the `mesh =` line.
-                        if matches!(e.problem, Problem::Input(_)) && e.file == path {
-                            e.file = self.ctx.file.clone();
-                            e.line = Some(self.ctx.line_of(mesh.span().start));
-                        }
-                        e
-                    })?;
+                    let (mut raw, warnings) =
+                        mesh::load_obj(&path, &item, budget).map_err(|mut e| {
+                            // A missing mesh is the scene's fault: point at the `mesh =` line.
+                            if matches!(e.problem, Problem::Input(_)) && e.file == path {
+                                e.file = self.ctx.file.clone();
+                                e.line = Some(self.ctx.line_of(mesh.span().start));
+                            }
+                            e
+                        })?;
                     self.warnings.extend(warnings);
                     if let Some(m) = override_material {
                         raw.materials = vec![m];
@@ -586,15 +617,20 @@ impl Builder<'_> {
                             "not accepted for cornell_box (it has its own colours); use mirror_tall_block",
                         ));
                     }
-                    let raw = generate::generate(g, override_material.unwrap_or(Material::DEFAULT))
-                        .map_err(|(what, expected)| {
-                            self.invalid(gen.span(), &item, &what, &expected)
-                        })?;
+                    let raw = generate::generate(
+                        g,
+                        override_material.unwrap_or(Material::DEFAULT),
+                        budget,
+                    )
+                    .map_err(|(what, expected)| {
+                        self.invalid(gen.span(), &item, &what, &expected)
+                    })?;
                     (raw, self.ctx.file.clone())
                 }
                 _ => return Err(self.err(o.span(), &item, Problem::ObjectSource)),
             };
             let total = raw.triangles.len();
+            budget = budget.saturating_sub(total as u64);
             match mesh::finish_object(&name, raw) {
                 Ok((object, dropped)) => {
                     if dropped > 0 {
@@ -731,12 +767,13 @@ impl Builder<'_> {
             }
         };
         let (cx, cz) = (*f.count_x.get_ref(), *f.count_z.get_ref());
-        if cx == 0 || cz == 0 || u64::from(cx) * u64::from(cz) > MAX_FIELD_INSTANCES {
+        let max = max_scene_instances();
+        if cx == 0 || cz == 0 || u64::from(cx) * u64::from(cz) > max {
             return Err(self.invalid(
                 f.count_x.span(),
                 item,
                 "count_x * count_z",
-                &format!("both >= 1 and at most {MAX_FIELD_INSTANCES} instances per field"),
+                &format!("both >= 1 and at most {max} instances (what the processor's instance bank holds)"),
             ));
         }
         let spacing = self.finite(&f.spacing, item, "spacing")?;

@@ -828,14 +828,17 @@ fn error_other_ranges() {
 
 /// Seeded mutation fuzzing of the scene and OBJ/MTL parsers: random edits of valid files (bytes
 /// flipped, lines cut, duplicated or swapped, hostile numbers spliced into number positions)
-/// must give a scene or a `SceneError` naming a file, never a panic. Bounded: a fixed number
-/// of cases from a fixed seed, a few seconds in release.
+/// must give a scene or a `SceneError` naming a file, never a panic, and a scene they give must
+/// pass through the processor's preflight, trees and memory map without a panic. Bounded: a
+/// fixed number of cases from a fixed seed, a few seconds in release.
 mod fuzz {
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    const HOSTILE: [&str; 14] = [
+    const HOSTILE: [&str; 16] = [
+        "2048",
+        "1000000",
         "nan",
         "inf",
         "-inf",
@@ -908,10 +911,28 @@ mod fuzz {
         lines.join(sep)
     }
 
+    /// What every verb does with an accepted scene next: the processor's preflight, the trees
+    /// and the memory map of frame 0 (which refuse values the format cannot hold). None of it
+    /// may panic on a scene that validation let through.
+    fn build_survives(scene: &Scene) -> Result<(), String> {
+        let f = crate::fp::Format::E7M16;
+        let built = std::panic::catch_unwind(|| {
+            let params = crate::emit::processor::ProcessorParams::default();
+            if crate::flow::preflight(scene, f, params, None).is_err() {
+                return;
+            }
+            if let Ok(trees) = crate::layout::SceneTrees::build(scene, f) {
+                let _ =
+                    crate::layout::build(scene, &trees, 0, &crate::layout::MemoryConfig::default());
+            }
+        });
+        built.map_err(|_| "accepted, then panicked while building its layout".to_string())
+    }
+
     fn load_survives(path: &Path) -> Result<(), String> {
         match std::panic::catch_unwind(|| Scene::load(path)) {
             Err(_) => Err("panicked".into()),
-            Ok(Ok(_)) => Ok(()),
+            Ok(Ok(scene)) => build_survives(&scene),
             Ok(Err(e)) => {
                 let text = e.to_string();
                 if e.file.as_os_str().is_empty() || !text.starts_with(&e.file.display().to_string())

@@ -137,6 +137,10 @@ pub(crate) fn run_tool(
         .stderr(Stdio::piped())
         .process_group(0);
     let start = Instant::now();
+    // The list stays locked from before the spawn until the group is in it, so a signal that
+    // arrives meanwhile waits for the list and finds the new group there (else the tool would
+    // run on after dynrt exits).
+    let mut groups = running_groups();
     let mut child = cmd.spawn().map_err(|e| {
         if e.kind() == std::io::ErrorKind::NotFound {
             ToolError::NotFound {
@@ -150,7 +154,8 @@ pub(crate) fn run_tool(
         }
     })?;
     let pgid = child.id() as i32;
-    running_groups().push(pgid);
+    groups.push(pgid);
+    drop(groups);
     let out_reader = drain(child.stdout.take());
     let err_reader = drain(child.stderr.take());
 

@@ -60,7 +60,8 @@ pub fn write_processor_files(
     }
     let rtl = processor_rtl(program, params, scene_name)?;
     let rtl_path = rtl_dir.join(format!("{}.v", crate::emit::processor::PROCESSOR_TOP));
-    write_atomically(&rtl_path, rtl.verilog.as_bytes())?;
+    write_atomically(&rtl_path, rtl.verilog.as_bytes())
+        .with_context(|| format!("writing {}", rtl_path.display()))?;
     write_memory_images(first, &mem_dir)?;
     let mut updates = Vec::new();
     for (k, pair) in layouts.windows(2).enumerate() {
@@ -98,7 +99,8 @@ pub fn write_processor_files(
     write_atomically(
         &tb_path,
         processor_testbench(params, &frames, &rtl.ports)?.as_bytes(),
-    )?;
+    )
+    .with_context(|| format!("writing {}", tb_path.display()))?;
     Ok((rtl_path, tb_path))
 }
 
