@@ -23,7 +23,8 @@ pub const MAILBOX_ENTRIES: usize = 8;
 
 /// A ray's mailbox: the ids it tested most recently, first in first out, as the hardware keeps
 /// them (the golden model and the engine's twin share it). Golden twin of the mailbox check in
-/// [`hw::ListUnit`](crate::hw::ListUnit) (src/hw/list_unit.rs).
+/// [`hw::ListUnit`](crate::hw::ListUnit) (src/hw/list_unit.rs) and of the engine's
+/// [`MailboxUnit`](crate::hw::engine::MailboxUnit) (`mbx`, `mbc`; src/hw/engine/mailbox.rs).
 #[derive(Clone, Debug, Default)]
 pub struct Mailbox {
     ids: [u32; MAILBOX_ENTRIES],

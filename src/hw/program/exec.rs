@@ -9,6 +9,13 @@
 //! the frame). [`Machine::run_pixel`] runs a single
 //! pixel on one thread (threads never share state, so its result is the same; rayon runs
 //! those in parallel), optionally recording every register write for traces.
+//!
+//! The hardware it is the twin of: [`crate::hw::engine::ThreadEngine`] and its stage blocks
+//! (the fields of [`crate::hw::engine::Decode`], the results of
+//! [`crate::hw::engine::Execute`] and [`crate::hw::engine::FpUnits`], the condition and next pc
+//! of [`crate::hw::engine::WriteBack`], the mailboxes of [`crate::hw::engine::MailboxUnit`],
+//! the pixels of [`crate::hw::engine::PixelCounter`]); `kd` stands for the
+//! [`crate::hw::TraversalUnit`]'s walk and `tri` for the [`crate::hw::TriangleTester`].
 
 use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_ANY_HIT, REGISTERS};
 use super::Program;
