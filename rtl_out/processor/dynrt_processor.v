@@ -817,37 +817,38 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [31:0] result_line__nodes_data;
     reg  [31:0] result_line__uv_data;
     reg  [31:0] result_line__t_data;
-    wire  result_line__wb_valid;
-    wire  [4:0] result_line__wb_op;
-    wire  [7:0] result_line__wb_dst;
-    wire  [4:0] result_line__wb_thread;
-    wire  result_line__wb_invert;
-    wire  [11:0] result_line__wb_next;
-    wire  [11:0] result_line__wb_target;
-    wire  result_line__wb_wait;
-    wire  result_line__wb_kd_busy;
-    wire  result_line__wb_tri_busy;
-    wire  [11:0] result_line__wb_jr_target;
-    wire  result_line__wb_int_eq;
-    wire  result_line__wb_int_lt;
-    wire  result_line__wb_mb_hit;
-    wire  result_line__wb_pix_done;
-    wire  [31:0] result_line__wb_fast;
-    reg  write_back__valid;
-    reg  [4:0] write_back__op;
-    reg  [7:0] write_back__dst;
-    reg  write_back__invert;
-    reg  [11:0] write_back__pc_plus_one;
-    reg  [11:0] write_back__target;
-    reg  write_back__is_wait;
-    reg  write_back__kd_busy;
-    reg  write_back__tri_busy;
-    reg  [11:0] write_back__jr_target;
-    reg  write_back__int_eq;
-    reg  write_back__int_lt;
-    reg  write_back__mb_hit;
-    reg  write_back__pix_done;
-    reg  [31:0] write_back__fast;
+    wire  result_line__retiring__valid;
+    wire  [4:0] result_line__retiring__op;
+    wire  [7:0] result_line__retiring__dst;
+    wire  [4:0] result_line__retiring__thread;
+    wire  result_line__retiring__invert;
+    wire  [11:0] result_line__retiring__pc_plus_one;
+    wire  [11:0] result_line__retiring__target;
+    wire  result_line__retiring__is_wait;
+    wire  result_line__retiring__kd_busy;
+    wire  result_line__retiring__tri_busy;
+    wire  [11:0] result_line__retiring__jr_target;
+    wire  result_line__retiring__int_eq;
+    wire  result_line__retiring__int_lt;
+    wire  result_line__retiring__mb_hit;
+    wire  result_line__retiring__pix_done;
+    wire  [31:0] result_line__retiring__fast;
+    reg  write_back__retiring__valid;
+    reg  [4:0] write_back__retiring__op;
+    reg  [7:0] write_back__retiring__dst;
+    reg  [4:0] write_back__retiring__thread;
+    reg  write_back__retiring__invert;
+    reg  [11:0] write_back__retiring__pc_plus_one;
+    reg  [11:0] write_back__retiring__target;
+    reg  write_back__retiring__is_wait;
+    reg  write_back__retiring__kd_busy;
+    reg  write_back__retiring__tri_busy;
+    reg  [11:0] write_back__retiring__jr_target;
+    reg  write_back__retiring__int_eq;
+    reg  write_back__retiring__int_lt;
+    reg  write_back__retiring__mb_hit;
+    reg  write_back__retiring__pix_done;
+    reg  [31:0] write_back__retiring__fast;
     reg  [23:0] write_back__sum;
     reg  [23:0] write_back__product;
     reg  [23:0] write_back__quotient;
@@ -1117,39 +1118,40 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .nodes_data(result_line__nodes_data),
         .uv_data(result_line__uv_data),
         .t_data(result_line__t_data),
-        .wb_valid(result_line__wb_valid),
-        .wb_op(result_line__wb_op),
-        .wb_dst(result_line__wb_dst),
-        .wb_thread(result_line__wb_thread),
-        .wb_invert(result_line__wb_invert),
-        .wb_next(result_line__wb_next),
-        .wb_target(result_line__wb_target),
-        .wb_wait(result_line__wb_wait),
-        .wb_kd_busy(result_line__wb_kd_busy),
-        .wb_tri_busy(result_line__wb_tri_busy),
-        .wb_jr_target(result_line__wb_jr_target),
-        .wb_int_eq(result_line__wb_int_eq),
-        .wb_int_lt(result_line__wb_int_lt),
-        .wb_mb_hit(result_line__wb_mb_hit),
-        .wb_pix_done(result_line__wb_pix_done),
-        .wb_fast(result_line__wb_fast)
+        .retiring__valid(result_line__retiring__valid),
+        .retiring__op(result_line__retiring__op),
+        .retiring__dst(result_line__retiring__dst),
+        .retiring__thread(result_line__retiring__thread),
+        .retiring__invert(result_line__retiring__invert),
+        .retiring__pc_plus_one(result_line__retiring__pc_plus_one),
+        .retiring__target(result_line__retiring__target),
+        .retiring__is_wait(result_line__retiring__is_wait),
+        .retiring__kd_busy(result_line__retiring__kd_busy),
+        .retiring__tri_busy(result_line__retiring__tri_busy),
+        .retiring__jr_target(result_line__retiring__jr_target),
+        .retiring__int_eq(result_line__retiring__int_eq),
+        .retiring__int_lt(result_line__retiring__int_lt),
+        .retiring__mb_hit(result_line__retiring__mb_hit),
+        .retiring__pix_done(result_line__retiring__pix_done),
+        .retiring__fast(result_line__retiring__fast)
     );
     dynrt_processor__engine__write_back write_back(
-        .valid(write_back__valid),
-        .op(write_back__op),
-        .dst(write_back__dst),
-        .invert(write_back__invert),
-        .pc_plus_one(write_back__pc_plus_one),
-        .target(write_back__target),
-        .is_wait(write_back__is_wait),
-        .kd_busy(write_back__kd_busy),
-        .tri_busy(write_back__tri_busy),
-        .jr_target(write_back__jr_target),
-        .int_eq(write_back__int_eq),
-        .int_lt(write_back__int_lt),
-        .mb_hit(write_back__mb_hit),
-        .pix_done(write_back__pix_done),
-        .fast(write_back__fast),
+        .retiring__valid(write_back__retiring__valid),
+        .retiring__op(write_back__retiring__op),
+        .retiring__dst(write_back__retiring__dst),
+        .retiring__thread(write_back__retiring__thread),
+        .retiring__invert(write_back__retiring__invert),
+        .retiring__pc_plus_one(write_back__retiring__pc_plus_one),
+        .retiring__target(write_back__retiring__target),
+        .retiring__is_wait(write_back__retiring__is_wait),
+        .retiring__kd_busy(write_back__retiring__kd_busy),
+        .retiring__tri_busy(write_back__retiring__tri_busy),
+        .retiring__jr_target(write_back__retiring__jr_target),
+        .retiring__int_eq(write_back__retiring__int_eq),
+        .retiring__int_lt(write_back__retiring__int_lt),
+        .retiring__mb_hit(write_back__retiring__mb_hit),
+        .retiring__pix_done(write_back__retiring__pix_done),
+        .retiring__fast(write_back__retiring__fast),
         .sum(write_back__sum),
         .product(write_back__product),
         .quotient(write_back__quotient),
@@ -1517,21 +1519,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         result_line__nodes_data = bank0_rdata;
         result_line__uv_data = bank2_rdata;
         result_line__t_data = bank3_rdata;
-        write_back__valid = result_line__wb_valid;
-        write_back__op = result_line__wb_op;
-        write_back__dst = result_line__wb_dst;
-        write_back__invert = result_line__wb_invert;
-        write_back__pc_plus_one = result_line__wb_next;
-        write_back__target = result_line__wb_target;
-        write_back__is_wait = result_line__wb_wait;
-        write_back__kd_busy = result_line__wb_kd_busy;
-        write_back__tri_busy = result_line__wb_tri_busy;
-        write_back__jr_target = result_line__wb_jr_target;
-        write_back__int_eq = result_line__wb_int_eq;
-        write_back__int_lt = result_line__wb_int_lt;
-        write_back__mb_hit = result_line__wb_mb_hit;
-        write_back__pix_done = result_line__wb_pix_done;
-        write_back__fast = result_line__wb_fast;
         write_back__sum = fp_units__sum;
         write_back__product = fp_units__product;
         write_back__quotient = fp_units__quotient;
@@ -1541,15 +1528,15 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         write_back__eq = fp_units__eq;
         write_back__colour_byte = fp_units__colour_byte;
         decode__wb_write = write_back__write;
-        decode__wb_thread = result_line__wb_thread;
-        decode__wb_dst = result_line__wb_dst;
+        decode__wb_thread = result_line__retiring__thread;
+        decode__wb_dst = result_line__retiring__dst;
         decode__wb_data = write_back__data;
-        fetch__wb_valid = result_line__wb_valid;
-        fetch__wb_thread = result_line__wb_thread;
+        fetch__wb_valid = result_line__retiring__valid;
+        fetch__wb_thread = result_line__retiring__thread;
         fetch__wb_halt = write_back__halt;
         fetch__wb_next_pc = write_back__next_pc;
-        scheduler__wb_valid = result_line__wb_valid;
-        scheduler__wb_thread = result_line__wb_thread;
+        scheduler__wb_valid = result_line__retiring__valid;
+        scheduler__wb_thread = result_line__retiring__thread;
         scheduler__wb_halt = write_back__halt;
         scheduler__wb_wait_pending = write_back__wait_pending;
         scheduler__tester_done = tester__engine__done;
@@ -1559,7 +1546,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         if (write_back__retired) begin
             instr_count__d = instr_count__q + 32'h1;
         end
-        if (result_line__wb_valid & write_back__halt) begin
+        if (result_line__retiring__valid & write_back__halt) begin
             halted_count__d = halted_count__q + 32'h1;
             if ((halted_count__q + 32'h1) == c_threads) begin
                 running__d = 1'b0;
@@ -1577,6 +1564,22 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         end
     end
     
+    always @(*) write_back__retiring__valid = result_line__retiring__valid;
+    always @(*) write_back__retiring__op = result_line__retiring__op;
+    always @(*) write_back__retiring__dst = result_line__retiring__dst;
+    always @(*) write_back__retiring__thread = result_line__retiring__thread;
+    always @(*) write_back__retiring__invert = result_line__retiring__invert;
+    always @(*) write_back__retiring__pc_plus_one = result_line__retiring__pc_plus_one;
+    always @(*) write_back__retiring__target = result_line__retiring__target;
+    always @(*) write_back__retiring__is_wait = result_line__retiring__is_wait;
+    always @(*) write_back__retiring__kd_busy = result_line__retiring__kd_busy;
+    always @(*) write_back__retiring__tri_busy = result_line__retiring__tri_busy;
+    always @(*) write_back__retiring__jr_target = result_line__retiring__jr_target;
+    always @(*) write_back__retiring__int_eq = result_line__retiring__int_eq;
+    always @(*) write_back__retiring__int_lt = result_line__retiring__int_lt;
+    always @(*) write_back__retiring__mb_hit = result_line__retiring__mb_hit;
+    always @(*) write_back__retiring__pix_done = result_line__retiring__pix_done;
+    always @(*) write_back__retiring__fast = result_line__retiring__fast;
 endmodule // dynrt_processor__engine
 
 
@@ -10365,7 +10368,7 @@ endmodule // dynrt_processor__engine__pixels
 
 
 
-module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,target,is_wait,kd_busy,tri_busy,jr_target,int_eq,int_lt,mb_hit,pix_done,fast,kind,scratch_data,mem_data,nodes_data,uv_data,t_data,wb_valid,wb_op,wb_dst,wb_thread,wb_invert,wb_next,wb_target,wb_wait,wb_kd_busy,wb_tri_busy,wb_jr_target,wb_int_eq,wb_int_lt,wb_mb_hit,wb_pix_done,wb_fast);
+module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,target,is_wait,kd_busy,tri_busy,jr_target,int_eq,int_lt,mb_hit,pix_done,fast,kind,scratch_data,mem_data,nodes_data,uv_data,t_data,retiring__valid,retiring__op,retiring__dst,retiring__thread,retiring__invert,retiring__pc_plus_one,retiring__target,retiring__is_wait,retiring__kd_busy,retiring__tri_busy,retiring__jr_target,retiring__int_eq,retiring__int_lt,retiring__mb_hit,retiring__pix_done,retiring__fast);
     
     // Module arguments
     input wire  clock;
@@ -10391,22 +10394,22 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     input wire  [31:0] nodes_data;
     input wire  [31:0] uv_data;
     input wire  [31:0] t_data;
-    output reg  wb_valid;
-    output reg  [4:0] wb_op;
-    output reg  [7:0] wb_dst;
-    output reg  [4:0] wb_thread;
-    output reg  wb_invert;
-    output reg  [11:0] wb_next;
-    output reg  [11:0] wb_target;
-    output reg  wb_wait;
-    output reg  wb_kd_busy;
-    output reg  wb_tri_busy;
-    output reg  [11:0] wb_jr_target;
-    output reg  wb_int_eq;
-    output reg  wb_int_lt;
-    output reg  wb_mb_hit;
-    output reg  wb_pix_done;
-    output reg  [31:0] wb_fast;
+    output reg  retiring__valid;
+    output reg  [4:0] retiring__op;
+    output reg  [7:0] retiring__dst;
+    output reg  [4:0] retiring__thread;
+    output reg  retiring__invert;
+    output reg  [11:0] retiring__pc_plus_one;
+    output reg  [11:0] retiring__target;
+    output reg  retiring__is_wait;
+    output reg  retiring__kd_busy;
+    output reg  retiring__tri_busy;
+    output reg  [11:0] retiring__jr_target;
+    output reg  retiring__int_eq;
+    output reg  retiring__int_lt;
+    output reg  retiring__mb_hit;
+    output reg  retiring__pix_done;
+    output reg  [31:0] retiring__fast;
     
     // Constant declarations
     localparam  c_mem_latency = 8'h2;
@@ -10917,32 +10920,32 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         long_next__data_in = next_line__data_out;
         long_target__data_in = target_line__data_out;
         if (long_valid__data_out) begin
-            wb_valid = 1'b1;
-            wb_op = long_op__data_out;
-            wb_dst = long_dst__data_out;
-            wb_thread = long_thread__data_out;
-            wb_invert = long_invert__data_out;
-            wb_next = long_next__data_out;
-            wb_target = long_target__data_out;
+            retiring__valid = 1'b1;
+            retiring__op = long_op__data_out;
+            retiring__dst = long_dst__data_out;
+            retiring__thread = long_thread__data_out;
+            retiring__invert = long_invert__data_out;
+            retiring__pc_plus_one = long_next__data_out;
+            retiring__target = long_target__data_out;
         end
         else begin
-            wb_valid = valid_line__data_out & (~is_long);
-            wb_op = op_line__data_out;
-            wb_dst = dst_line__data_out;
-            wb_thread = thread_line__data_out;
-            wb_invert = invert_line__data_out;
-            wb_next = next_line__data_out;
-            wb_target = target_line__data_out;
+            retiring__valid = valid_line__data_out & (~is_long);
+            retiring__op = op_line__data_out;
+            retiring__dst = dst_line__data_out;
+            retiring__thread = thread_line__data_out;
+            retiring__invert = invert_line__data_out;
+            retiring__pc_plus_one = next_line__data_out;
+            retiring__target = target_line__data_out;
         end
-        wb_wait = wait_line__data_out;
-        wb_kd_busy = kd_busy_line__data_out;
-        wb_tri_busy = tri_busy_line__data_out;
-        wb_jr_target = jr_target_line__data_out;
-        wb_int_eq = int_eq_line__data_out;
-        wb_int_lt = int_lt_line__data_out;
-        wb_mb_hit = mb_hit_line__data_out;
-        wb_pix_done = pix_done_line__data_out;
-        wb_fast = fast_tail__data_out;
+        retiring__is_wait = wait_line__data_out;
+        retiring__kd_busy = kd_busy_line__data_out;
+        retiring__tri_busy = tri_busy_line__data_out;
+        retiring__jr_target = jr_target_line__data_out;
+        retiring__int_eq = int_eq_line__data_out;
+        retiring__int_lt = int_lt_line__data_out;
+        retiring__mb_hit = mb_hit_line__data_out;
+        retiring__pix_done = pix_done_line__data_out;
+        retiring__fast = fast_tail__data_out;
     end
     
 endmodule // dynrt_processor__engine__result_line
@@ -26902,24 +26905,25 @@ endmodule // dynrt_processor__engine__traversal_unit__stack_node
 
 
 
-module dynrt_processor__engine__write_back(valid,op,dst,invert,pc_plus_one,target,is_wait,kd_busy,tri_busy,jr_target,int_eq,int_lt,mb_hit,pix_done,fast,sum,product,quotient,root,lt,le,eq,colour_byte,write,data,next_pc,halt,retired,wait_pending);
+module dynrt_processor__engine__write_back(retiring__valid,retiring__op,retiring__dst,retiring__thread,retiring__invert,retiring__pc_plus_one,retiring__target,retiring__is_wait,retiring__kd_busy,retiring__tri_busy,retiring__jr_target,retiring__int_eq,retiring__int_lt,retiring__mb_hit,retiring__pix_done,retiring__fast,sum,product,quotient,root,lt,le,eq,colour_byte,write,data,next_pc,halt,retired,wait_pending);
     
     // Module arguments
-    input wire  valid;
-    input wire  [4:0] op;
-    input wire  [7:0] dst;
-    input wire  invert;
-    input wire  [11:0] pc_plus_one;
-    input wire  [11:0] target;
-    input wire  is_wait;
-    input wire  kd_busy;
-    input wire  tri_busy;
-    input wire  [11:0] jr_target;
-    input wire  int_eq;
-    input wire  int_lt;
-    input wire  mb_hit;
-    input wire  pix_done;
-    input wire  [31:0] fast;
+    input wire  retiring__valid;
+    input wire  [4:0] retiring__op;
+    input wire  [7:0] retiring__dst;
+    input wire  [4:0] retiring__thread;
+    input wire  retiring__invert;
+    input wire  [11:0] retiring__pc_plus_one;
+    input wire  [11:0] retiring__target;
+    input wire  retiring__is_wait;
+    input wire  retiring__kd_busy;
+    input wire  retiring__tri_busy;
+    input wire  [11:0] retiring__jr_target;
+    input wire  retiring__int_eq;
+    input wire  retiring__int_lt;
+    input wire  retiring__mb_hit;
+    input wire  retiring__pix_done;
+    input wire  [31:0] retiring__fast;
     input wire  [23:0] sum;
     input wire  [23:0] product;
     input wire  [23:0] quotient;
@@ -26965,71 +26969,71 @@ module dynrt_processor__engine__write_back(valid,op,dst,invert,pc_plus_one,targe
     // Update code
     always @(*) begin
         cond = 1'b0;
-        if (op == op_bflt) begin
+        if (retiring__op == op_bflt) begin
             cond = lt;
         end
-        if (op == op_bfle) begin
+        if (retiring__op == op_bfle) begin
             cond = le;
         end
-        if (op == op_bfeq) begin
+        if (retiring__op == op_bfeq) begin
             cond = eq;
         end
-        if (op == op_beq) begin
-            cond = int_eq;
+        if (retiring__op == op_beq) begin
+            cond = retiring__int_eq;
         end
-        if (op == op_bltu) begin
-            cond = int_lt;
+        if (retiring__op == op_bltu) begin
+            cond = retiring__int_lt;
         end
-        if (op == op_mbx) begin
-            cond = mb_hit;
+        if (retiring__op == op_mbx) begin
+            cond = retiring__mb_hit;
         end
-        if (op == op_pixel) begin
-            cond = pix_done;
+        if (retiring__op == op_pixel) begin
+            cond = retiring__pix_done;
         end
-        if (op == op_jal) begin
+        if (retiring__op == op_jal) begin
             cond = 1'b1;
         end
-        if (op == op_tri) begin
-            cond = tri_busy;
+        if (retiring__op == op_tri) begin
+            cond = retiring__tri_busy;
         end
-        if (op == op_kd) begin
-            cond = kd_busy;
+        if (retiring__op == op_kd) begin
+            cond = retiring__kd_busy;
         end
-        repeats = ((op == op_tri) | (op == op_kd)) & cond;
-        if (cond != invert) begin
-            pc = target;
+        repeats = ((retiring__op == op_tri) | (retiring__op == op_kd)) & cond;
+        if (cond != retiring__invert) begin
+            pc = retiring__target;
         end
         else begin
-            pc = pc_plus_one;
+            pc = retiring__pc_plus_one;
         end
-        if (op == op_jr) begin
-            pc = jr_target;
+        if (retiring__op == op_jr) begin
+            pc = retiring__jr_target;
         end
-        if ((op == op_halt) | repeats) begin
-            pc = pc_plus_one - 32'h1;
+        if ((retiring__op == op_halt) | repeats) begin
+            pc = retiring__pc_plus_one - 32'h1;
         end
-        result = fast;
-        if ((op == op_fadd) | (op == op_fsub)) begin
+        result = retiring__fast;
+        if ((retiring__op == op_fadd) | (retiring__op == op_fsub)) begin
             result = ((sum) & 32'hffffffff);
         end
-        if (op == op_fmul) begin
+        if (retiring__op == op_fmul) begin
             result = ((product) & 32'hffffffff);
         end
-        if (op == op_fdiv) begin
+        if (retiring__op == op_fdiv) begin
             result = ((quotient) & 32'hffffffff);
         end
-        if (op == op_fsqrt) begin
+        if (retiring__op == op_fsqrt) begin
             result = ((root) & 32'hffffffff);
         end
-        if (op == op_byte) begin
-            result = fast | ((colour_byte) & 32'hffffffff);
+        if (retiring__op == op_byte) begin
+            result = retiring__fast | ((colour_byte) & 32'hffffffff);
         end
         next_pc = pc;
         data = result;
-        halt = op == op_halt;
-        write = valid & (dst != 32'h0) & op_writes[op] & (~((op == op_pixel) & pix_done));
-        retired = valid & (~repeats);
-        wait_pending = cond & is_wait;
+        halt = retiring__op == op_halt;
+        write = retiring__valid & (retiring__dst != 32'h0) & op_writes[retiring__op] & (~((retiring__op == op_pixel) & retiring__pix_done));
+        retired = retiring__valid & (~repeats);
+        wait_pending = cond & retiring__is_wait;
     end
     
 endmodule // dynrt_processor__engine__write_back

@@ -72,6 +72,7 @@ mod fp_units;
 mod mailbox;
 mod pixel_counter;
 mod result_line;
+mod retiring;
 mod scheduler;
 mod write_back;
 
@@ -82,6 +83,7 @@ pub use fp_units::FpUnits;
 pub use mailbox::MailboxUnit;
 pub use pixel_counter::PixelCounter;
 pub use result_line::ResultLine;
+pub use retiring::{Retiring, RetiringIn};
 pub use scheduler::Scheduler;
 pub use write_back::WriteBack;
 
@@ -636,21 +638,10 @@ impl<
         self.result_line.t_data.next = self.bank3.rdata.val();
 
         // Write back.
-        self.write_back.valid.next = self.result_line.wb_valid.val();
-        self.write_back.op.next = self.result_line.wb_op.val();
-        self.write_back.dst.next = self.result_line.wb_dst.val();
-        self.write_back.invert.next = self.result_line.wb_invert.val();
-        self.write_back.pc_plus_one.next = self.result_line.wb_next.val();
-        self.write_back.target.next = self.result_line.wb_target.val();
-        self.write_back.is_wait.next = self.result_line.wb_wait.val();
-        self.write_back.kd_busy.next = self.result_line.wb_kd_busy.val();
-        self.write_back.tri_busy.next = self.result_line.wb_tri_busy.val();
-        self.write_back.jr_target.next = self.result_line.wb_jr_target.val();
-        self.write_back.int_eq.next = self.result_line.wb_int_eq.val();
-        self.write_back.int_lt.next = self.result_line.wb_int_lt.val();
-        self.write_back.mb_hit.next = self.result_line.wb_mb_hit.val();
-        self.write_back.pix_done.next = self.result_line.wb_pix_done.val();
-        self.write_back.fast.next = self.result_line.wb_fast.val();
+        Retiring::join(
+            &mut self.result_line.retiring,
+            &mut self.write_back.retiring,
+        );
         self.write_back.sum.next = self.fp_units.sum.val();
         self.write_back.product.next = self.fp_units.product.val();
         self.write_back.quotient.next = self.fp_units.quotient.val();
@@ -660,15 +651,15 @@ impl<
         self.write_back.eq.next = self.fp_units.eq.val();
         self.write_back.colour_byte.next = self.fp_units.colour_byte.val();
         self.decode.wb_write.next = self.write_back.write.val();
-        self.decode.wb_thread.next = self.result_line.wb_thread.val();
-        self.decode.wb_dst.next = self.result_line.wb_dst.val();
+        self.decode.wb_thread.next = self.result_line.retiring.thread.val();
+        self.decode.wb_dst.next = self.result_line.retiring.dst.val();
         self.decode.wb_data.next = self.write_back.data.val();
-        self.fetch.wb_valid.next = self.result_line.wb_valid.val();
-        self.fetch.wb_thread.next = self.result_line.wb_thread.val();
+        self.fetch.wb_valid.next = self.result_line.retiring.valid.val();
+        self.fetch.wb_thread.next = self.result_line.retiring.thread.val();
         self.fetch.wb_halt.next = self.write_back.halt.val();
         self.fetch.wb_next_pc.next = self.write_back.next_pc.val();
-        self.scheduler.wb_valid.next = self.result_line.wb_valid.val();
-        self.scheduler.wb_thread.next = self.result_line.wb_thread.val();
+        self.scheduler.wb_valid.next = self.result_line.retiring.valid.val();
+        self.scheduler.wb_thread.next = self.result_line.retiring.thread.val();
         self.scheduler.wb_halt.next = self.write_back.halt.val();
         self.scheduler.wb_wait_pending.next = self.write_back.wait_pending.val();
         self.scheduler.tester_done.next = self.tester.engine.done.val();
@@ -680,7 +671,7 @@ impl<
         if self.write_back.retired.val() {
             self.instr_count.d.next = self.instr_count.q.val() + 1;
         }
-        if self.result_line.wb_valid.val() & self.write_back.halt.val() {
+        if self.result_line.retiring.valid.val() & self.write_back.halt.val() {
             self.halted_count.d.next = self.halted_count.q.val() + 1;
             if (self.halted_count.q.val() + 1) == self.c_threads.val() {
                 self.running.d.next = false;

@@ -17,7 +17,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::{op_code, FastKind, MAX_MEM_LATENCY};
+use super::{op_code, FastKind, Retiring, MAX_MEM_LATENCY};
 use crate::hw::program::isa::{Op, OP_BITS, PC_BITS, REG_BITS};
 use crate::hw::Delay;
 
@@ -61,22 +61,7 @@ pub struct ResultLine<const DX: usize> {
     pub t_data: Signal<In, Bits<32>>,
 
     /// Write back: the instruction leaving the line (from the long line when one leaves it).
-    pub wb_valid: Signal<Out, Bit>,
-    pub wb_op: Signal<Out, Bits<OP_BITS>>,
-    pub wb_dst: Signal<Out, Bits<REG_BITS>>,
-    pub wb_thread: Signal<Out, Bits<5>>,
-    pub wb_invert: Signal<Out, Bit>,
-    pub wb_next: Signal<Out, Bits<PC_BITS>>,
-    pub wb_target: Signal<Out, Bits<PC_BITS>>,
-    pub wb_wait: Signal<Out, Bit>,
-    pub wb_kd_busy: Signal<Out, Bit>,
-    pub wb_tri_busy: Signal<Out, Bit>,
-    pub wb_jr_target: Signal<Out, Bits<PC_BITS>>,
-    pub wb_int_eq: Signal<Out, Bit>,
-    pub wb_int_lt: Signal<Out, Bit>,
-    pub wb_mb_hit: Signal<Out, Bit>,
-    pub wb_pix_done: Signal<Out, Bit>,
-    pub wb_fast: Signal<Out, Bits<32>>,
+    pub retiring: Retiring,
 
     valid_line: Delay<Bit, LINE>,
     op_line: Delay<Bits<OP_BITS>, LINE>,
@@ -144,22 +129,7 @@ impl<const DX: usize> ResultLine<DX> {
             nodes_data: Default::default(),
             uv_data: Default::default(),
             t_data: Default::default(),
-            wb_valid: Default::default(),
-            wb_op: Default::default(),
-            wb_dst: Default::default(),
-            wb_thread: Default::default(),
-            wb_invert: Default::default(),
-            wb_next: Default::default(),
-            wb_target: Default::default(),
-            wb_wait: Default::default(),
-            wb_kd_busy: Default::default(),
-            wb_tri_busy: Default::default(),
-            wb_jr_target: Default::default(),
-            wb_int_eq: Default::default(),
-            wb_int_lt: Default::default(),
-            wb_mb_hit: Default::default(),
-            wb_pix_done: Default::default(),
-            wb_fast: Default::default(),
+            retiring: Default::default(),
             valid_line: Default::default(),
             op_line: Default::default(),
             dst_line: Default::default(),
@@ -283,30 +253,30 @@ impl<const DX: usize> Logic for ResultLine<DX> {
         self.long_next.data_in.next = self.next_line.data_out.val();
         self.long_target.data_in.next = self.target_line.data_out.val();
         if self.long_valid.data_out.val() {
-            self.wb_valid.next = true;
-            self.wb_op.next = self.long_op.data_out.val();
-            self.wb_dst.next = self.long_dst.data_out.val();
-            self.wb_thread.next = self.long_thread.data_out.val();
-            self.wb_invert.next = self.long_invert.data_out.val();
-            self.wb_next.next = self.long_next.data_out.val();
-            self.wb_target.next = self.long_target.data_out.val();
+            self.retiring.valid.next = true;
+            self.retiring.op.next = self.long_op.data_out.val();
+            self.retiring.dst.next = self.long_dst.data_out.val();
+            self.retiring.thread.next = self.long_thread.data_out.val();
+            self.retiring.invert.next = self.long_invert.data_out.val();
+            self.retiring.pc_plus_one.next = self.long_next.data_out.val();
+            self.retiring.target.next = self.long_target.data_out.val();
         } else {
-            self.wb_valid.next = self.valid_line.data_out.val() & (!self.is_long.val());
-            self.wb_op.next = self.op_line.data_out.val();
-            self.wb_dst.next = self.dst_line.data_out.val();
-            self.wb_thread.next = self.thread_line.data_out.val();
-            self.wb_invert.next = self.invert_line.data_out.val();
-            self.wb_next.next = self.next_line.data_out.val();
-            self.wb_target.next = self.target_line.data_out.val();
+            self.retiring.valid.next = self.valid_line.data_out.val() & (!self.is_long.val());
+            self.retiring.op.next = self.op_line.data_out.val();
+            self.retiring.dst.next = self.dst_line.data_out.val();
+            self.retiring.thread.next = self.thread_line.data_out.val();
+            self.retiring.invert.next = self.invert_line.data_out.val();
+            self.retiring.pc_plus_one.next = self.next_line.data_out.val();
+            self.retiring.target.next = self.target_line.data_out.val();
         }
-        self.wb_wait.next = self.wait_line.data_out.val();
-        self.wb_kd_busy.next = self.kd_busy_line.data_out.val();
-        self.wb_tri_busy.next = self.tri_busy_line.data_out.val();
-        self.wb_jr_target.next = self.jr_target_line.data_out.val();
-        self.wb_int_eq.next = self.int_eq_line.data_out.val();
-        self.wb_int_lt.next = self.int_lt_line.data_out.val();
-        self.wb_mb_hit.next = self.mb_hit_line.data_out.val();
-        self.wb_pix_done.next = self.pix_done_line.data_out.val();
-        self.wb_fast.next = self.fast_tail.data_out.val();
+        self.retiring.is_wait.next = self.wait_line.data_out.val();
+        self.retiring.kd_busy.next = self.kd_busy_line.data_out.val();
+        self.retiring.tri_busy.next = self.tri_busy_line.data_out.val();
+        self.retiring.jr_target.next = self.jr_target_line.data_out.val();
+        self.retiring.int_eq.next = self.int_eq_line.data_out.val();
+        self.retiring.int_lt.next = self.int_lt_line.data_out.val();
+        self.retiring.mb_hit.next = self.mb_hit_line.data_out.val();
+        self.retiring.pix_done.next = self.pix_done_line.data_out.val();
+        self.retiring.fast.next = self.fast_tail.data_out.val();
     }
 }

@@ -21,27 +21,13 @@
 
 use rust_hdl::prelude::*;
 
-use super::op_code;
-use crate::hw::program::isa::{Op, OPS, OP_BITS, PC_BITS, REG_BITS};
+use super::{op_code, RetiringIn};
+use crate::hw::program::isa::{Op, OPS, PC_BITS};
 
 #[derive(LogicBlock)]
 pub struct WriteBack<const W: usize> {
     /// The instruction leaving the result line.
-    pub valid: Signal<In, Bit>,
-    pub op: Signal<In, Bits<OP_BITS>>,
-    pub dst: Signal<In, Bits<REG_BITS>>,
-    pub invert: Signal<In, Bit>,
-    pub pc_plus_one: Signal<In, Bits<PC_BITS>>,
-    pub target: Signal<In, Bits<PC_BITS>>,
-    pub is_wait: Signal<In, Bit>,
-    pub kd_busy: Signal<In, Bit>,
-    pub tri_busy: Signal<In, Bit>,
-    pub jr_target: Signal<In, Bits<PC_BITS>>,
-    pub int_eq: Signal<In, Bit>,
-    pub int_lt: Signal<In, Bit>,
-    pub mb_hit: Signal<In, Bit>,
-    pub pix_done: Signal<In, Bit>,
-    pub fast: Signal<In, Bits<32>>,
+    pub retiring: RetiringIn,
     /// The floating-point units' results of this clock.
     pub sum: Signal<In, Bits<W>>,
     pub product: Signal<In, Bits<W>>,
@@ -89,21 +75,7 @@ pub struct WriteBack<const W: usize> {
 impl<const W: usize> Default for WriteBack<W> {
     fn default() -> Self {
         Self {
-            valid: Default::default(),
-            op: Default::default(),
-            dst: Default::default(),
-            invert: Default::default(),
-            pc_plus_one: Default::default(),
-            target: Default::default(),
-            is_wait: Default::default(),
-            kd_busy: Default::default(),
-            tri_busy: Default::default(),
-            jr_target: Default::default(),
-            int_eq: Default::default(),
-            int_lt: Default::default(),
-            mb_hit: Default::default(),
-            pix_done: Default::default(),
-            fast: Default::default(),
+            retiring: Default::default(),
             sum: Default::default(),
             product: Default::default(),
             quotient: Default::default(),
@@ -154,80 +126,82 @@ impl<const W: usize> Logic for WriteBack<W> {
     #[hdl_gen]
     fn update(&mut self) {
         self.cond.next = false;
-        if self.op.val() == self.op_bflt.val() {
+        if self.retiring.op.val() == self.op_bflt.val() {
             self.cond.next = self.lt.val();
         }
-        if self.op.val() == self.op_bfle.val() {
+        if self.retiring.op.val() == self.op_bfle.val() {
             self.cond.next = self.le.val();
         }
-        if self.op.val() == self.op_bfeq.val() {
+        if self.retiring.op.val() == self.op_bfeq.val() {
             self.cond.next = self.eq.val();
         }
-        if self.op.val() == self.op_beq.val() {
-            self.cond.next = self.int_eq.val();
+        if self.retiring.op.val() == self.op_beq.val() {
+            self.cond.next = self.retiring.int_eq.val();
         }
-        if self.op.val() == self.op_bltu.val() {
-            self.cond.next = self.int_lt.val();
+        if self.retiring.op.val() == self.op_bltu.val() {
+            self.cond.next = self.retiring.int_lt.val();
         }
-        if self.op.val() == self.op_mbx.val() {
-            self.cond.next = self.mb_hit.val();
+        if self.retiring.op.val() == self.op_mbx.val() {
+            self.cond.next = self.retiring.mb_hit.val();
         }
-        if self.op.val() == self.op_pixel.val() {
-            self.cond.next = self.pix_done.val();
+        if self.retiring.op.val() == self.op_pixel.val() {
+            self.cond.next = self.retiring.pix_done.val();
         }
-        if self.op.val() == self.op_jal.val() {
+        if self.retiring.op.val() == self.op_jal.val() {
             self.cond.next = true;
         }
-        if self.op.val() == self.op_tri.val() {
-            self.cond.next = self.tri_busy.val();
+        if self.retiring.op.val() == self.op_tri.val() {
+            self.cond.next = self.retiring.tri_busy.val();
         }
-        if self.op.val() == self.op_kd.val() {
-            self.cond.next = self.kd_busy.val();
+        if self.retiring.op.val() == self.op_kd.val() {
+            self.cond.next = self.retiring.kd_busy.val();
         }
         // A coprocessor refused the entry (queue full) or has not finished (a wait).
-        self.repeats.next = ((self.op.val() == self.op_tri.val())
-            | (self.op.val() == self.op_kd.val()))
+        self.repeats.next = ((self.retiring.op.val() == self.op_tri.val())
+            | (self.retiring.op.val() == self.op_kd.val()))
             & self.cond.val();
 
-        if self.cond.val() != self.invert.val() {
-            self.pc.next = self.target.val();
+        if self.cond.val() != self.retiring.invert.val() {
+            self.pc.next = self.retiring.target.val();
         } else {
-            self.pc.next = self.pc_plus_one.val();
+            self.pc.next = self.retiring.pc_plus_one.val();
         }
-        if self.op.val() == self.op_jr.val() {
-            self.pc.next = self.jr_target.val();
+        if self.retiring.op.val() == self.op_jr.val() {
+            self.pc.next = self.retiring.jr_target.val();
         }
-        if (self.op.val() == self.op_halt.val()) | self.repeats.val() {
+        if (self.retiring.op.val() == self.op_halt.val()) | self.repeats.val() {
             // A halted thread keeps its pc; a repeat comes back to it on the next turn.
-            self.pc.next = self.pc_plus_one.val() - 1;
+            self.pc.next = self.retiring.pc_plus_one.val() - 1;
         }
 
-        self.result.next = self.fast.val();
-        if (self.op.val() == self.op_fadd.val()) | (self.op.val() == self.op_fsub.val()) {
+        self.result.next = self.retiring.fast.val();
+        if (self.retiring.op.val() == self.op_fadd.val())
+            | (self.retiring.op.val() == self.op_fsub.val())
+        {
             self.result.next = bit_cast::<32, W>(self.sum.val());
         }
-        if self.op.val() == self.op_fmul.val() {
+        if self.retiring.op.val() == self.op_fmul.val() {
             self.result.next = bit_cast::<32, W>(self.product.val());
         }
-        if self.op.val() == self.op_fdiv.val() {
+        if self.retiring.op.val() == self.op_fdiv.val() {
             self.result.next = bit_cast::<32, W>(self.quotient.val());
         }
-        if self.op.val() == self.op_fsqrt.val() {
+        if self.retiring.op.val() == self.op_fsqrt.val() {
             self.result.next = bit_cast::<32, W>(self.root.val());
         }
-        if self.op.val() == self.op_byte.val() {
-            self.result.next = self.fast.val() | bit_cast::<32, 8>(self.colour_byte.val());
+        if self.retiring.op.val() == self.op_byte.val() {
+            self.result.next = self.retiring.fast.val() | bit_cast::<32, 8>(self.colour_byte.val());
         }
 
         self.next_pc.next = self.pc.val();
         self.data.next = self.result.val();
-        self.halt.next = self.op.val() == self.op_halt.val();
+        self.halt.next = self.retiring.op.val() == self.op_halt.val();
         // `pixel` writes nothing once the frame's pixels are exhausted.
-        self.write.next = self.valid.val()
-            & (self.dst.val() != 0)
-            & self.op_writes.val().get_bit(self.op.val().index())
-            & (!((self.op.val() == self.op_pixel.val()) & self.pix_done.val()));
-        self.retired.next = self.valid.val() & (!self.repeats.val());
-        self.wait_pending.next = self.cond.val() & self.is_wait.val();
+        self.write.next = self.retiring.valid.val()
+            & (self.retiring.dst.val() != 0)
+            & self.op_writes.val().get_bit(self.retiring.op.val().index())
+            & (!((self.retiring.op.val() == self.op_pixel.val()) & self.retiring.pix_done.val()));
+        self.retired.next = self.retiring.valid.val() & (!self.repeats.val());
+        self.wait_pending.next = self.cond.val() & self.retiring.is_wait.val();
     }
 }
