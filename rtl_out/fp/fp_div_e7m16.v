@@ -2107,7 +2107,6 @@ module fp_div_e7m16_core__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero
     
     // Constant declarations
     localparam  c_man_bits = 8'h10;
-    localparam  c_carry_pos = 8'h11;
     localparam  c_exp_sign_pos = 8'h8;
     localparam  c_exp_max = 9'b1111111;
     localparam  c_qnan = 24'h7f8000;
@@ -2145,6 +2144,7 @@ module fp_div_e7m16_core__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero
     
     // Local signals
     reg  [17:0] sig_rounded;
+    reg  carry;
     reg  [8:0] exp_final;
     reg  exp_negative;
     reg  [23:0] sign_word;
@@ -2218,7 +2218,8 @@ module fp_div_e7m16_core__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero
         out_result__d = out_result__q;
         out_valid_r__d = out_valid_r__q;
         sig_rounded = ((sig) & 18'h3ffff) + round_up;
-        exp_final = exp + sig_rounded[c_carry_pos];
+        carry = &sig & round_up;
+        exp_final = exp + carry;
         rnd_sig__d = sig_rounded;
         rnd_exp__d = exp_final;
         rnd_sign__d = sign;

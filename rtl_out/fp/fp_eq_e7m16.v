@@ -52,13 +52,18 @@ module fp_eq_e7m16_core(clock,in_valid,a,b,out_valid,lt,le,eq);
     reg  out_valid_r__clock;
     
     // Local signals
-    reg  [23:0] a_clean;
-    reg  [23:0] b_clean;
+    reg  a_zero;
+    reg  b_zero;
     reg  [23:0] a_mag;
     reg  [23:0] b_mag;
     reg  a_neg;
     reg  b_neg;
     reg  any_nan;
+    reg  raw_eq;
+    reg  mag_lt_ab;
+    reg  mag_lt_ba;
+    reg  clean_lt_ab;
+    reg  clean_lt_ba;
     reg  is_eq;
     reg  is_lt;
     
@@ -118,28 +123,34 @@ module fp_eq_e7m16_core(clock,in_valid,a,b,out_valid,lt,le,eq);
         in_a__d = a;
         in_b__d = b;
         in_valid_r__d = in_valid;
-        a_clean = in_a__q;
-        if (in_a__q[(c_man_bits)+:(7)] == 32'h0) begin
-            a_clean = 32'h0;
-        end
-        b_clean = in_b__q;
-        if (in_b__q[(c_man_bits)+:(7)] == 32'h0) begin
-            b_clean = 32'h0;
-        end
-        a_mag = a_clean & c_mag_mask;
-        b_mag = b_clean & c_mag_mask;
-        a_neg = a_clean[c_sign_pos];
-        b_neg = b_clean[c_sign_pos];
+        a_zero = in_a__q[(c_man_bits)+:(7)] == 32'h0;
+        b_zero = in_b__q[(c_man_bits)+:(7)] == 32'h0;
+        a_mag = in_a__q & c_mag_mask;
+        b_mag = in_b__q & c_mag_mask;
+        a_neg = in_a__q[c_sign_pos] & ~a_zero;
+        b_neg = in_b__q[c_sign_pos] & ~b_zero;
         any_nan = (&(in_a__q[(c_man_bits)+:(7)]) & (|in_a__q[(32'h0)+:(16)])) | (&(in_b__q[(c_man_bits)+:(7)]) & (|in_b__q[(32'h0)+:(16)]));
-        is_eq = a_clean == b_clean;
+        raw_eq = in_a__q == in_b__q;
+        mag_lt_ab = a_mag < b_mag;
+        mag_lt_ba = b_mag < a_mag;
+        is_eq = raw_eq;
+        if (a_zero | b_zero) begin
+            is_eq = a_zero & b_zero;
+        end
+        clean_lt_ab = mag_lt_ab;
+        clean_lt_ba = mag_lt_ba;
+        if (a_zero | b_zero) begin
+            clean_lt_ab = ~b_zero;
+            clean_lt_ba = ~a_zero;
+        end
         if (a_neg ^ b_neg) begin
             is_lt = a_neg;
         end
         else if (a_neg) begin
-            is_lt = b_mag < a_mag;
+            is_lt = clean_lt_ba;
         end
         else begin
-            is_lt = a_mag < b_mag;
+            is_lt = clean_lt_ab;
         end
         out_eq__d = is_eq & ~any_nan;
         out_lt__d = is_lt & ~any_nan;

@@ -3128,7 +3128,6 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
     localparam  c_top2 = 21'h180000;
     localparam  c_top1 = 21'h100000;
     localparam  c_sticky_mask = 21'h7;
-    localparam  c_carry_pos = 8'h11;
     localparam  c_exp_sign_pos = 8'h8;
     localparam  c_exp_max = 9'b1111111;
     localparam  c_qnan = 24'h7f8000;
@@ -3157,9 +3156,9 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
     reg  [6:0] big_exp__d;
     wire  [6:0] big_exp__q;
     reg  big_exp__clock;
-    reg  [6:0] exp_diff__d;
-    wire  [6:0] exp_diff__q;
-    reg  exp_diff__clock;
+    reg  [6:0] shift__d;
+    wire  [6:0] shift__q;
+    reg  shift__clock;
     reg  big_sign__d;
     wire  big_sign__q;
     reg  big_sign__clock;
@@ -3181,6 +3180,36 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
     reg  valid2__d;
     wire  valid2__q;
     reg  valid2__clock;
+    reg  [16:0] al_big__d;
+    wire  [16:0] al_big__q;
+    reg  al_big__clock;
+    reg  [20:0] al_small__d;
+    wire  [20:0] al_small__q;
+    reg  al_small__clock;
+    reg  [6:0] al_exp__d;
+    wire  [6:0] al_exp__q;
+    reg  al_exp__clock;
+    reg  al_sign__d;
+    wire  al_sign__q;
+    reg  al_sign__clock;
+    reg  al_eff_sub__d;
+    wire  al_eff_sub__q;
+    reg  al_eff_sub__clock;
+    reg  al_nan__d;
+    wire  al_nan__q;
+    reg  al_nan__clock;
+    reg  al_inf__d;
+    wire  al_inf__q;
+    reg  al_inf__clock;
+    reg  al_inf_sign__d;
+    wire  al_inf_sign__q;
+    reg  al_inf_sign__clock;
+    reg  al_zero_sign__d;
+    wire  al_zero_sign__q;
+    reg  al_zero_sign__clock;
+    reg  al_valid__d;
+    wire  al_valid__q;
+    reg  al_valid__clock;
     reg  [20:0] sum__d;
     wire  [20:0] sum__q;
     reg  sum__clock;
@@ -3314,7 +3343,10 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
     reg  [23:0] mag_b;
     reg  [16:0] sig_a;
     reg  [16:0] sig_b;
-    reg  [6:0] shift;
+    reg  [6:0] diff_ab;
+    reg  [6:0] diff_ba;
+    reg  [6:0] shift_ab;
+    reg  [6:0] shift_ba;
     reg  [20:0] small_ext;
     reg  [20:0] small_aligned;
     reg  [20:0] lost_mask;
@@ -3336,6 +3368,7 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
     reg  sticky;
     reg  round_up;
     reg  [17:0] sig_rounded;
+    reg  carry;
     reg  [8:0] exp_final;
     reg  exp_negative;
     reg  [23:0] sign_word;
@@ -3364,25 +3397,25 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         .q(in_valid_r__q),
         .clock(in_valid_r__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_sig big_sig(
+    dynrt_processor__engine__fp_units__add__al_big big_sig(
         .d(big_sig__d),
         .q(big_sig__q),
         .clock(big_sig__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_sig small_sig(
+    dynrt_processor__engine__fp_units__add__al_big small_sig(
         .d(small_sig__d),
         .q(small_sig__q),
         .clock(small_sig__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp big_exp(
+    dynrt_processor__engine__fp_units__add__al_exp big_exp(
         .d(big_exp__d),
         .q(big_exp__q),
         .clock(big_exp__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp_diff(
-        .d(exp_diff__d),
-        .q(exp_diff__q),
-        .clock(exp_diff__clock)
+    dynrt_processor__engine__fp_units__add__al_exp shift(
+        .d(shift__d),
+        .q(shift__q),
+        .clock(shift__clock)
     );
     dynrt_processor__display__dark_d big_sign(
         .d(big_sign__d),
@@ -3419,12 +3452,62 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         .q(valid2__q),
         .clock(valid2__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm sum(
+    dynrt_processor__engine__fp_units__add__al_big al_big(
+        .d(al_big__d),
+        .q(al_big__q),
+        .clock(al_big__clock)
+    );
+    dynrt_processor__engine__fp_units__add__al_small al_small(
+        .d(al_small__d),
+        .q(al_small__q),
+        .clock(al_small__clock)
+    );
+    dynrt_processor__engine__fp_units__add__al_exp al_exp(
+        .d(al_exp__d),
+        .q(al_exp__q),
+        .clock(al_exp__clock)
+    );
+    dynrt_processor__display__dark_d al_sign(
+        .d(al_sign__d),
+        .q(al_sign__q),
+        .clock(al_sign__clock)
+    );
+    dynrt_processor__display__dark_d al_eff_sub(
+        .d(al_eff_sub__d),
+        .q(al_eff_sub__q),
+        .clock(al_eff_sub__clock)
+    );
+    dynrt_processor__display__dark_d al_nan(
+        .d(al_nan__d),
+        .q(al_nan__q),
+        .clock(al_nan__clock)
+    );
+    dynrt_processor__display__dark_d al_inf(
+        .d(al_inf__d),
+        .q(al_inf__q),
+        .clock(al_inf__clock)
+    );
+    dynrt_processor__display__dark_d al_inf_sign(
+        .d(al_inf_sign__d),
+        .q(al_inf_sign__q),
+        .clock(al_inf_sign__clock)
+    );
+    dynrt_processor__display__dark_d al_zero_sign(
+        .d(al_zero_sign__d),
+        .q(al_zero_sign__q),
+        .clock(al_zero_sign__clock)
+    );
+    dynrt_processor__display__dark_d al_valid(
+        .d(al_valid__d),
+        .q(al_valid__q),
+        .clock(al_valid__clock)
+    );
+    dynrt_processor__engine__fp_units__add__al_small sum(
         .d(sum__d),
         .q(sum__q),
         .clock(sum__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp sum_exp(
+    dynrt_processor__engine__fp_units__add__al_exp sum_exp(
         .d(sum_exp__d),
         .q(sum_exp__q),
         .clock(sum_exp__clock)
@@ -3459,7 +3542,7 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         .q(valid3__q),
         .clock(valid3__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm mid_norm(
+    dynrt_processor__engine__fp_units__add__al_small mid_norm(
         .d(mid_norm__d),
         .q(mid_norm__q),
         .clock(mid_norm__clock)
@@ -3469,7 +3552,7 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         .q(mid_lz__q),
         .clock(mid_lz__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp mid_exp(
+    dynrt_processor__engine__fp_units__add__al_exp mid_exp(
         .d(mid_exp__d),
         .q(mid_exp__q),
         .clock(mid_exp__clock)
@@ -3509,7 +3592,7 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         .q(mid_valid__q),
         .clock(mid_valid__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm norm(
+    dynrt_processor__engine__fp_units__add__al_small norm(
         .d(norm__d),
         .q(norm__q),
         .clock(norm__clock)
@@ -3519,7 +3602,7 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         .q(lz__q),
         .clock(lz__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp4(
+    dynrt_processor__engine__fp_units__add__al_exp exp4(
         .d(exp4__d),
         .q(exp4__q),
         .clock(exp4__clock)
@@ -3624,7 +3707,7 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         big_sig__clock = clock;
         small_sig__clock = clock;
         big_exp__clock = clock;
-        exp_diff__clock = clock;
+        shift__clock = clock;
         big_sign__clock = clock;
         eff_sub__clock = clock;
         nan__clock = clock;
@@ -3632,6 +3715,16 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         inf_sign__clock = clock;
         zero_sign__clock = clock;
         valid2__clock = clock;
+        al_big__clock = clock;
+        al_small__clock = clock;
+        al_exp__clock = clock;
+        al_sign__clock = clock;
+        al_eff_sub__clock = clock;
+        al_nan__clock = clock;
+        al_inf__clock = clock;
+        al_inf_sign__clock = clock;
+        al_zero_sign__clock = clock;
+        al_valid__clock = clock;
         sum__clock = clock;
         sum_exp__clock = clock;
         sum_sign__clock = clock;
@@ -3678,7 +3771,7 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         big_sig__d = big_sig__q;
         small_sig__d = small_sig__q;
         big_exp__d = big_exp__q;
-        exp_diff__d = exp_diff__q;
+        shift__d = shift__q;
         big_sign__d = big_sign__q;
         eff_sub__d = eff_sub__q;
         nan__d = nan__q;
@@ -3686,6 +3779,16 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         inf_sign__d = inf_sign__q;
         zero_sign__d = zero_sign__q;
         valid2__d = valid2__q;
+        al_big__d = al_big__q;
+        al_small__d = al_small__q;
+        al_exp__d = al_exp__q;
+        al_sign__d = al_sign__q;
+        al_eff_sub__d = al_eff_sub__q;
+        al_nan__d = al_nan__q;
+        al_inf__d = al_inf__q;
+        al_inf_sign__d = al_inf_sign__q;
+        al_zero_sign__d = al_zero_sign__q;
+        al_valid__d = al_valid__q;
         sum__d = sum__q;
         sum_exp__d = sum_exp__q;
         sum_sign__d = sum_sign__q;
@@ -3751,18 +3854,28 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
             mag_b = 32'h0;
             sig_b = 32'h0;
         end
+        diff_ab = exp_a - exp_b;
+        diff_ba = exp_b - exp_a;
+        shift_ab = diff_ab;
+        if (diff_ab > c_shift_max) begin
+            shift_ab = c_shift_max;
+        end
+        shift_ba = diff_ba;
+        if (diff_ba > c_shift_max) begin
+            shift_ba = c_shift_max;
+        end
         if (mag_a >= mag_b) begin
             big_sig__d = sig_a;
             small_sig__d = sig_b;
             big_exp__d = exp_a;
-            exp_diff__d = exp_a - exp_b;
+            shift__d = shift_ab;
             big_sign__d = sign_a;
         end
         else begin
             big_sig__d = sig_b;
             small_sig__d = sig_a;
             big_exp__d = exp_b;
-            exp_diff__d = exp_b - exp_a;
+            shift__d = shift_ba;
             big_sign__d = sign_b;
         end
         eff_sub__d = sign_a ^ sign_b;
@@ -3776,32 +3889,38 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         end
         zero_sign__d = sign_a & sign_b;
         valid2__d = in_valid_r__q;
-        shift = exp_diff__q;
-        if (exp_diff__q > c_shift_max) begin
-            shift = c_shift_max;
-        end
         small_ext = ((small_sig__q) & 21'h1fffff) << 32'h3;
-        big_ext = ((big_sig__q) & 21'h1fffff) << 32'h3;
-        small_aligned = small_ext >> shift;
-        lost_mask = ~(c_ones << shift);
+        small_aligned = small_ext >> shift__q;
+        lost_mask = ~(c_ones << shift__q);
         sticky_in = |(small_ext & lost_mask);
         small_final = small_aligned;
         if (sticky_in) begin
             small_final = small_aligned | c_one;
         end
-        if (eff_sub__q) begin
-            sum__d = big_ext - small_final;
+        al_big__d = big_sig__q;
+        al_small__d = small_final;
+        al_exp__d = big_exp__q;
+        al_sign__d = big_sign__q;
+        al_eff_sub__d = eff_sub__q;
+        al_nan__d = nan__q;
+        al_inf__d = inf__q;
+        al_inf_sign__d = inf_sign__q;
+        al_zero_sign__d = zero_sign__q;
+        al_valid__d = valid2__q;
+        big_ext = ((al_big__q) & 21'h1fffff) << 32'h3;
+        if (al_eff_sub__q) begin
+            sum__d = big_ext - al_small__q;
         end
         else begin
-            sum__d = big_ext + small_final;
+            sum__d = big_ext + al_small__q;
         end
-        sum_exp__d = big_exp__q;
-        sum_sign__d = big_sign__q;
-        nan3__d = nan__q;
-        inf3__d = inf__q;
-        inf_sign3__d = inf_sign__q;
-        zero_sign3__d = zero_sign__q;
-        valid3__d = valid2__q;
+        sum_exp__d = al_exp__q;
+        sum_sign__d = al_sign__q;
+        nan3__d = al_nan__q;
+        inf3__d = al_inf__q;
+        inf_sign3__d = al_inf_sign__q;
+        zero_sign3__d = al_zero_sign__q;
+        valid3__d = al_valid__q;
         norm16 = sum__q;
         lz16 = 32'h0;
         if ((sum__q & c_top16) == 32'h0) begin
@@ -3857,7 +3976,8 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         sticky = |(norm__q & c_sticky_mask);
         round_up = round_bit & (sticky | sig[32'h0]);
         sig_rounded = ((sig) & 18'h3ffff) + round_up;
-        exp_final = ((((exp4__q) & 9'h1ff) + 32'h1) - lz__q) + sig_rounded[c_carry_pos];
+        carry = &sig & round_up;
+        exp_final = ((((exp4__q) & 9'h1ff) + 32'h1) - lz__q) + carry;
         rnd_sig__d = sig_rounded;
         rnd_exp__d = exp_final;
         rnd_sign__d = sign4__q;
@@ -3907,26 +4027,7 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
 endmodule // dynrt_processor__engine__fp_units__add
 
 
-module dynrt_processor__engine__fp_units__add__big_exp(d,q,clock);
-    
-    // Module arguments
-    input wire  [6:0] d;
-    output reg  [6:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 7'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor__engine__fp_units__add__big_exp
-
-
-module dynrt_processor__engine__fp_units__add__big_sig(d,q,clock);
+module dynrt_processor__engine__fp_units__add__al_big(d,q,clock);
     
     // Module arguments
     input wire  [16:0] d;
@@ -3942,7 +4043,61 @@ module dynrt_processor__engine__fp_units__add__big_sig(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor__engine__fp_units__add__big_sig
+endmodule // dynrt_processor__engine__fp_units__add__al_big
+
+
+
+
+module dynrt_processor__engine__fp_units__add__al_exp(d,q,clock);
+    
+    // Module arguments
+    input wire  [6:0] d;
+    output reg  [6:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 7'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__fp_units__add__al_exp
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__fp_units__add__al_small(d,q,clock);
+    
+    // Module arguments
+    input wire  [20:0] d;
+    output reg  [20:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 21'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__fp_units__add__al_small
+
+
+
+
+
+
 
 
 
@@ -4006,23 +4161,6 @@ endmodule // dynrt_processor__engine__fp_units__add__lz
 
 
 
-module dynrt_processor__engine__fp_units__add__mid_norm(d,q,clock);
-    
-    // Module arguments
-    input wire  [20:0] d;
-    output reg  [20:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 21'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor__engine__fp_units__add__mid_norm
 
 
 
@@ -4070,6 +4208,8 @@ module dynrt_processor__engine__fp_units__add__rnd_sig(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__fp_units__add__rnd_sig
+
+
 
 
 
@@ -4249,6 +4389,26 @@ module dynrt_processor__engine__fp_units__byte_unit(clock,in_valid,word,out_vali
     end
     
 endmodule // dynrt_processor__engine__fp_units__byte_unit
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -4621,7 +4781,6 @@ module dynrt_processor__engine__fp_units__byte_unit__scale__pack(clock,in_valid,
     
     // Constant declarations
     localparam  c_man_bits = 8'h10;
-    localparam  c_carry_pos = 8'h11;
     localparam  c_exp_sign_pos = 8'h8;
     localparam  c_exp_max = 9'b1111111;
     localparam  c_qnan = 24'h7f8000;
@@ -4659,6 +4818,7 @@ module dynrt_processor__engine__fp_units__byte_unit__scale__pack(clock,in_valid,
     
     // Local signals
     reg  [17:0] sig_rounded;
+    reg  carry;
     reg  [8:0] exp_final;
     reg  exp_negative;
     reg  [23:0] sign_word;
@@ -4732,7 +4892,8 @@ module dynrt_processor__engine__fp_units__byte_unit__scale__pack(clock,in_valid,
         out_result__d = out_result__q;
         out_valid_r__d = out_valid_r__q;
         sig_rounded = ((sig) & 18'h3ffff) + round_up;
-        exp_final = exp + sig_rounded[c_carry_pos];
+        carry = &sig & round_up;
+        exp_final = exp + carry;
         rnd_sig__d = sig_rounded;
         rnd_exp__d = exp_final;
         rnd_sign__d = sign;
@@ -4850,13 +5011,18 @@ module dynrt_processor__engine__fp_units__cmp(clock,in_valid,a,b,out_valid,lt,le
     reg  out_valid_r__clock;
     
     // Local signals
-    reg  [23:0] a_clean;
-    reg  [23:0] b_clean;
+    reg  a_zero;
+    reg  b_zero;
     reg  [23:0] a_mag;
     reg  [23:0] b_mag;
     reg  a_neg;
     reg  b_neg;
     reg  any_nan;
+    reg  raw_eq;
+    reg  mag_lt_ab;
+    reg  mag_lt_ba;
+    reg  clean_lt_ab;
+    reg  clean_lt_ba;
     reg  is_eq;
     reg  is_lt;
     
@@ -4916,28 +5082,34 @@ module dynrt_processor__engine__fp_units__cmp(clock,in_valid,a,b,out_valid,lt,le
         in_a__d = a;
         in_b__d = b;
         in_valid_r__d = in_valid;
-        a_clean = in_a__q;
-        if (in_a__q[(c_man_bits)+:(7)] == 32'h0) begin
-            a_clean = 32'h0;
-        end
-        b_clean = in_b__q;
-        if (in_b__q[(c_man_bits)+:(7)] == 32'h0) begin
-            b_clean = 32'h0;
-        end
-        a_mag = a_clean & c_mag_mask;
-        b_mag = b_clean & c_mag_mask;
-        a_neg = a_clean[c_sign_pos];
-        b_neg = b_clean[c_sign_pos];
+        a_zero = in_a__q[(c_man_bits)+:(7)] == 32'h0;
+        b_zero = in_b__q[(c_man_bits)+:(7)] == 32'h0;
+        a_mag = in_a__q & c_mag_mask;
+        b_mag = in_b__q & c_mag_mask;
+        a_neg = in_a__q[c_sign_pos] & ~a_zero;
+        b_neg = in_b__q[c_sign_pos] & ~b_zero;
         any_nan = (&(in_a__q[(c_man_bits)+:(7)]) & (|in_a__q[(32'h0)+:(16)])) | (&(in_b__q[(c_man_bits)+:(7)]) & (|in_b__q[(32'h0)+:(16)]));
-        is_eq = a_clean == b_clean;
+        raw_eq = in_a__q == in_b__q;
+        mag_lt_ab = a_mag < b_mag;
+        mag_lt_ba = b_mag < a_mag;
+        is_eq = raw_eq;
+        if (a_zero | b_zero) begin
+            is_eq = a_zero & b_zero;
+        end
+        clean_lt_ab = mag_lt_ab;
+        clean_lt_ba = mag_lt_ba;
+        if (a_zero | b_zero) begin
+            clean_lt_ab = ~b_zero;
+            clean_lt_ba = ~a_zero;
+        end
         if (a_neg ^ b_neg) begin
             is_lt = a_neg;
         end
         else if (a_neg) begin
-            is_lt = b_mag < a_mag;
+            is_lt = clean_lt_ba;
         end
         else begin
-            is_lt = a_mag < b_mag;
+            is_lt = clean_lt_ab;
         end
         out_eq__d = is_eq & ~any_nan;
         out_lt__d = is_lt & ~any_nan;
@@ -7233,6 +7405,9 @@ module dynrt_processor__engine__fp_units__eq_delay(clock,data_in,data_out);
     reg  stage__8__d;
     wire  stage__8__q;
     reg  stage__8__clock;
+    reg  stage__9__d;
+    wire  stage__9__q;
+    reg  stage__9__clock;
     
     // Sub module instances
     dynrt_processor__display__dark_d stage__0(
@@ -7280,6 +7455,11 @@ module dynrt_processor__engine__fp_units__eq_delay(clock,data_in,data_out);
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
+    dynrt_processor__display__dark_d stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -7292,6 +7472,7 @@ module dynrt_processor__engine__fp_units__eq_delay(clock,data_in,data_out);
         stage__6__clock = clock;
         stage__7__clock = clock;
         stage__8__clock = clock;
+        stage__9__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -7301,6 +7482,7 @@ module dynrt_processor__engine__fp_units__eq_delay(clock,data_in,data_out);
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
         stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -7310,9 +7492,16 @@ module dynrt_processor__engine__fp_units__eq_delay(clock,data_in,data_out);
         data_out = stage__6__q;
         data_out = stage__7__q;
         data_out = stage__8__q;
+        data_out = stage__9__q;
     end
     
 endmodule // dynrt_processor__engine__fp_units__eq_delay
+
+
+
+
+
+
 
 
 
@@ -7446,6 +7635,9 @@ module dynrt_processor__engine__fp_units__mul_delay(clock,data_in,data_out);
     reg  [23:0] stage__6__d;
     wire  [23:0] stage__6__q;
     reg  stage__6__clock;
+    reg  [23:0] stage__7__d;
+    wire  [23:0] stage__7__q;
+    reg  stage__7__clock;
     
     // Sub module instances
     dynrt_processor__display__rgb_q stage__0(
@@ -7483,6 +7675,11 @@ module dynrt_processor__engine__fp_units__mul_delay(clock,data_in,data_out);
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
+    dynrt_processor__display__rgb_q stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -7493,6 +7690,7 @@ module dynrt_processor__engine__fp_units__mul_delay(clock,data_in,data_out);
         stage__4__clock = clock;
         stage__5__clock = clock;
         stage__6__clock = clock;
+        stage__7__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -7500,6 +7698,7 @@ module dynrt_processor__engine__fp_units__mul_delay(clock,data_in,data_out);
         stage__4__d = stage__3__q;
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -7507,9 +7706,12 @@ module dynrt_processor__engine__fp_units__mul_delay(clock,data_in,data_out);
         data_out = stage__4__q;
         data_out = stage__5__q;
         data_out = stage__6__q;
+        data_out = stage__7__q;
     end
     
 endmodule // dynrt_processor__engine__fp_units__mul_delay
+
+
 
 
 
@@ -8092,342 +8294,342 @@ module dynrt_processor__engine__fp_units__sqrt(clock,in_valid,a,out_valid,result
         .q(in_valid_r__q),
         .clock(in_valid_r__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__0(
+    dynrt_processor__engine__fp_units__add__al_small rem__0(
         .d(rem__0__d),
         .q(rem__0__q),
         .clock(rem__0__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__1(
+    dynrt_processor__engine__fp_units__add__al_small rem__1(
         .d(rem__1__d),
         .q(rem__1__q),
         .clock(rem__1__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__2(
+    dynrt_processor__engine__fp_units__add__al_small rem__2(
         .d(rem__2__d),
         .q(rem__2__q),
         .clock(rem__2__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__3(
+    dynrt_processor__engine__fp_units__add__al_small rem__3(
         .d(rem__3__d),
         .q(rem__3__q),
         .clock(rem__3__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__4(
+    dynrt_processor__engine__fp_units__add__al_small rem__4(
         .d(rem__4__d),
         .q(rem__4__q),
         .clock(rem__4__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__5(
+    dynrt_processor__engine__fp_units__add__al_small rem__5(
         .d(rem__5__d),
         .q(rem__5__q),
         .clock(rem__5__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__6(
+    dynrt_processor__engine__fp_units__add__al_small rem__6(
         .d(rem__6__d),
         .q(rem__6__q),
         .clock(rem__6__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__7(
+    dynrt_processor__engine__fp_units__add__al_small rem__7(
         .d(rem__7__d),
         .q(rem__7__q),
         .clock(rem__7__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__8(
+    dynrt_processor__engine__fp_units__add__al_small rem__8(
         .d(rem__8__d),
         .q(rem__8__q),
         .clock(rem__8__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__9(
+    dynrt_processor__engine__fp_units__add__al_small rem__9(
         .d(rem__9__d),
         .q(rem__9__q),
         .clock(rem__9__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__10(
+    dynrt_processor__engine__fp_units__add__al_small rem__10(
         .d(rem__10__d),
         .q(rem__10__q),
         .clock(rem__10__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__11(
+    dynrt_processor__engine__fp_units__add__al_small rem__11(
         .d(rem__11__d),
         .q(rem__11__q),
         .clock(rem__11__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__12(
+    dynrt_processor__engine__fp_units__add__al_small rem__12(
         .d(rem__12__d),
         .q(rem__12__q),
         .clock(rem__12__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__13(
+    dynrt_processor__engine__fp_units__add__al_small rem__13(
         .d(rem__13__d),
         .q(rem__13__q),
         .clock(rem__13__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__14(
+    dynrt_processor__engine__fp_units__add__al_small rem__14(
         .d(rem__14__d),
         .q(rem__14__q),
         .clock(rem__14__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__15(
+    dynrt_processor__engine__fp_units__add__al_small rem__15(
         .d(rem__15__d),
         .q(rem__15__q),
         .clock(rem__15__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rem__16(
+    dynrt_processor__engine__fp_units__add__al_small rem__16(
         .d(rem__16__d),
         .q(rem__16__q),
         .clock(rem__16__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__0(
+    dynrt_processor__engine__fp_units__add__al_small root__0(
         .d(root__0__d),
         .q(root__0__q),
         .clock(root__0__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__1(
+    dynrt_processor__engine__fp_units__add__al_small root__1(
         .d(root__1__d),
         .q(root__1__q),
         .clock(root__1__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__2(
+    dynrt_processor__engine__fp_units__add__al_small root__2(
         .d(root__2__d),
         .q(root__2__q),
         .clock(root__2__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__3(
+    dynrt_processor__engine__fp_units__add__al_small root__3(
         .d(root__3__d),
         .q(root__3__q),
         .clock(root__3__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__4(
+    dynrt_processor__engine__fp_units__add__al_small root__4(
         .d(root__4__d),
         .q(root__4__q),
         .clock(root__4__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__5(
+    dynrt_processor__engine__fp_units__add__al_small root__5(
         .d(root__5__d),
         .q(root__5__q),
         .clock(root__5__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__6(
+    dynrt_processor__engine__fp_units__add__al_small root__6(
         .d(root__6__d),
         .q(root__6__q),
         .clock(root__6__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__7(
+    dynrt_processor__engine__fp_units__add__al_small root__7(
         .d(root__7__d),
         .q(root__7__q),
         .clock(root__7__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__8(
+    dynrt_processor__engine__fp_units__add__al_small root__8(
         .d(root__8__d),
         .q(root__8__q),
         .clock(root__8__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__9(
+    dynrt_processor__engine__fp_units__add__al_small root__9(
         .d(root__9__d),
         .q(root__9__q),
         .clock(root__9__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__10(
+    dynrt_processor__engine__fp_units__add__al_small root__10(
         .d(root__10__d),
         .q(root__10__q),
         .clock(root__10__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__11(
+    dynrt_processor__engine__fp_units__add__al_small root__11(
         .d(root__11__d),
         .q(root__11__q),
         .clock(root__11__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__12(
+    dynrt_processor__engine__fp_units__add__al_small root__12(
         .d(root__12__d),
         .q(root__12__q),
         .clock(root__12__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__13(
+    dynrt_processor__engine__fp_units__add__al_small root__13(
         .d(root__13__d),
         .q(root__13__q),
         .clock(root__13__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__14(
+    dynrt_processor__engine__fp_units__add__al_small root__14(
         .d(root__14__d),
         .q(root__14__q),
         .clock(root__14__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__15(
+    dynrt_processor__engine__fp_units__add__al_small root__15(
         .d(root__15__d),
         .q(root__15__q),
         .clock(root__15__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm root__16(
+    dynrt_processor__engine__fp_units__add__al_small root__16(
         .d(root__16__d),
         .q(root__16__q),
         .clock(root__16__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__0(
+    dynrt_processor__engine__fp_units__add__al_small rest__0(
         .d(rest__0__d),
         .q(rest__0__q),
         .clock(rest__0__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__1(
+    dynrt_processor__engine__fp_units__add__al_small rest__1(
         .d(rest__1__d),
         .q(rest__1__q),
         .clock(rest__1__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__2(
+    dynrt_processor__engine__fp_units__add__al_small rest__2(
         .d(rest__2__d),
         .q(rest__2__q),
         .clock(rest__2__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__3(
+    dynrt_processor__engine__fp_units__add__al_small rest__3(
         .d(rest__3__d),
         .q(rest__3__q),
         .clock(rest__3__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__4(
+    dynrt_processor__engine__fp_units__add__al_small rest__4(
         .d(rest__4__d),
         .q(rest__4__q),
         .clock(rest__4__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__5(
+    dynrt_processor__engine__fp_units__add__al_small rest__5(
         .d(rest__5__d),
         .q(rest__5__q),
         .clock(rest__5__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__6(
+    dynrt_processor__engine__fp_units__add__al_small rest__6(
         .d(rest__6__d),
         .q(rest__6__q),
         .clock(rest__6__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__7(
+    dynrt_processor__engine__fp_units__add__al_small rest__7(
         .d(rest__7__d),
         .q(rest__7__q),
         .clock(rest__7__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__8(
+    dynrt_processor__engine__fp_units__add__al_small rest__8(
         .d(rest__8__d),
         .q(rest__8__q),
         .clock(rest__8__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__9(
+    dynrt_processor__engine__fp_units__add__al_small rest__9(
         .d(rest__9__d),
         .q(rest__9__q),
         .clock(rest__9__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__10(
+    dynrt_processor__engine__fp_units__add__al_small rest__10(
         .d(rest__10__d),
         .q(rest__10__q),
         .clock(rest__10__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__11(
+    dynrt_processor__engine__fp_units__add__al_small rest__11(
         .d(rest__11__d),
         .q(rest__11__q),
         .clock(rest__11__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__12(
+    dynrt_processor__engine__fp_units__add__al_small rest__12(
         .d(rest__12__d),
         .q(rest__12__q),
         .clock(rest__12__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__13(
+    dynrt_processor__engine__fp_units__add__al_small rest__13(
         .d(rest__13__d),
         .q(rest__13__q),
         .clock(rest__13__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__14(
+    dynrt_processor__engine__fp_units__add__al_small rest__14(
         .d(rest__14__d),
         .q(rest__14__q),
         .clock(rest__14__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__15(
+    dynrt_processor__engine__fp_units__add__al_small rest__15(
         .d(rest__15__d),
         .q(rest__15__q),
         .clock(rest__15__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm rest__16(
+    dynrt_processor__engine__fp_units__add__al_small rest__16(
         .d(rest__16__d),
         .q(rest__16__q),
         .clock(rest__16__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__0(
+    dynrt_processor__engine__fp_units__add__al_exp exp__0(
         .d(exp__0__d),
         .q(exp__0__q),
         .clock(exp__0__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__1(
+    dynrt_processor__engine__fp_units__add__al_exp exp__1(
         .d(exp__1__d),
         .q(exp__1__q),
         .clock(exp__1__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__2(
+    dynrt_processor__engine__fp_units__add__al_exp exp__2(
         .d(exp__2__d),
         .q(exp__2__q),
         .clock(exp__2__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__3(
+    dynrt_processor__engine__fp_units__add__al_exp exp__3(
         .d(exp__3__d),
         .q(exp__3__q),
         .clock(exp__3__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__4(
+    dynrt_processor__engine__fp_units__add__al_exp exp__4(
         .d(exp__4__d),
         .q(exp__4__q),
         .clock(exp__4__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__5(
+    dynrt_processor__engine__fp_units__add__al_exp exp__5(
         .d(exp__5__d),
         .q(exp__5__q),
         .clock(exp__5__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__6(
+    dynrt_processor__engine__fp_units__add__al_exp exp__6(
         .d(exp__6__d),
         .q(exp__6__q),
         .clock(exp__6__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__7(
+    dynrt_processor__engine__fp_units__add__al_exp exp__7(
         .d(exp__7__d),
         .q(exp__7__q),
         .clock(exp__7__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__8(
+    dynrt_processor__engine__fp_units__add__al_exp exp__8(
         .d(exp__8__d),
         .q(exp__8__q),
         .clock(exp__8__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__9(
+    dynrt_processor__engine__fp_units__add__al_exp exp__9(
         .d(exp__9__d),
         .q(exp__9__q),
         .clock(exp__9__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__10(
+    dynrt_processor__engine__fp_units__add__al_exp exp__10(
         .d(exp__10__d),
         .q(exp__10__q),
         .clock(exp__10__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__11(
+    dynrt_processor__engine__fp_units__add__al_exp exp__11(
         .d(exp__11__d),
         .q(exp__11__q),
         .clock(exp__11__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__12(
+    dynrt_processor__engine__fp_units__add__al_exp exp__12(
         .d(exp__12__d),
         .q(exp__12__q),
         .clock(exp__12__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__13(
+    dynrt_processor__engine__fp_units__add__al_exp exp__13(
         .d(exp__13__d),
         .q(exp__13__q),
         .clock(exp__13__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__14(
+    dynrt_processor__engine__fp_units__add__al_exp exp__14(
         .d(exp__14__d),
         .q(exp__14__q),
         .clock(exp__14__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__15(
+    dynrt_processor__engine__fp_units__add__al_exp exp__15(
         .d(exp__15__d),
         .q(exp__15__q),
         .clock(exp__15__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp exp__16(
+    dynrt_processor__engine__fp_units__add__al_exp exp__16(
         .d(exp__16__d),
         .q(exp__16__q),
         .clock(exp__16__clock)
@@ -8857,17 +9059,17 @@ module dynrt_processor__engine__fp_units__sqrt(clock,in_valid,a,out_valid,result
         .q(valid__16__q),
         .clock(valid__16__clock)
     );
-    dynrt_processor__engine__fp_units__add__mid_norm last_rem(
+    dynrt_processor__engine__fp_units__add__al_small last_rem(
         .d(last_rem__d),
         .q(last_rem__q),
         .clock(last_rem__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_sig last_root(
+    dynrt_processor__engine__fp_units__add__al_big last_root(
         .d(last_root__d),
         .q(last_root__q),
         .clock(last_root__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp last_exp(
+    dynrt_processor__engine__fp_units__add__al_exp last_exp(
         .d(last_exp__d),
         .q(last_exp__q),
         .clock(last_exp__clock)
@@ -8902,7 +9104,7 @@ module dynrt_processor__engine__fp_units__sqrt(clock,in_valid,a,out_valid,result
         .q(rnd_man__q),
         .clock(rnd_man__clock)
     );
-    dynrt_processor__engine__fp_units__add__big_exp rnd_exp(
+    dynrt_processor__engine__fp_units__add__al_exp rnd_exp(
         .d(rnd_exp__d),
         .q(rnd_exp__q),
         .clock(rnd_exp__clock)
@@ -10560,7 +10762,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .data_in(valid_line__data_in),
         .data_out(valid_line__data_out)
     );
-    dynrt_processor__engine__result_line__long_op op_line(
+    dynrt_processor__engine__result_line__op_line op_line(
         .clock(op_line__clock),
         .data_in(op_line__data_in),
         .data_out(op_line__data_out)
@@ -10570,7 +10772,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .data_in(dst_line__data_in),
         .data_out(dst_line__data_out)
     );
-    dynrt_processor__engine__result_line__long_op thread_line(
+    dynrt_processor__engine__result_line__op_line thread_line(
         .clock(thread_line__clock),
         .data_in(thread_line__data_in),
         .data_out(thread_line__data_out)
@@ -10715,7 +10917,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .data_in(fast_tail__data_in),
         .data_out(fast_tail__data_out)
     );
-    dynrt_processor__engine__result_line__int_eq_line long_valid(
+    dynrt_processor__engine__fp_units__eq_delay long_valid(
         .clock(long_valid__clock),
         .data_in(long_valid__data_in),
         .data_out(long_valid__data_out)
@@ -10725,7 +10927,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .data_in(long_op__data_in),
         .data_out(long_op__data_out)
     );
-    dynrt_processor__engine__result_line__dst_line long_dst(
+    dynrt_processor__engine__result_line__long_dst long_dst(
         .clock(long_dst__clock),
         .data_in(long_dst__data_in),
         .data_out(long_dst__data_out)
@@ -10735,17 +10937,17 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .data_in(long_thread__data_in),
         .data_out(long_thread__data_out)
     );
-    dynrt_processor__engine__result_line__int_eq_line long_invert(
+    dynrt_processor__engine__fp_units__eq_delay long_invert(
         .clock(long_invert__clock),
         .data_in(long_invert__data_in),
         .data_out(long_invert__data_out)
     );
-    dynrt_processor__engine__result_line__jr_target_line long_next(
+    dynrt_processor__engine__result_line__long_next long_next(
         .clock(long_next__clock),
         .data_in(long_next__data_in),
         .data_out(long_next__data_out)
     );
-    dynrt_processor__engine__result_line__jr_target_line long_target(
+    dynrt_processor__engine__result_line__long_next long_target(
         .clock(long_target__clock),
         .data_in(long_target__data_in),
         .data_out(long_target__data_out)
@@ -10992,6 +11194,9 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
     reg  [7:0] stage__10__d;
     wire  [7:0] stage__10__q;
     reg  stage__10__clock;
+    reg  [7:0] stage__11__d;
+    wire  [7:0] stage__11__q;
+    reg  stage__11__clock;
     
     // Sub module instances
     dynrt_processor__engine__halted_count stage__0(
@@ -11049,6 +11254,11 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
+    dynrt_processor__engine__halted_count stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -11063,6 +11273,7 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         stage__8__clock = clock;
         stage__9__clock = clock;
         stage__10__clock = clock;
+        stage__11__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -11074,6 +11285,7 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
         stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -11085,9 +11297,12 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         data_out = stage__8__q;
         data_out = stage__9__q;
         data_out = stage__10__q;
+        data_out = stage__11__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__dst_line
+
+
 
 
 
@@ -11145,6 +11360,9 @@ module dynrt_processor__engine__result_line__fast_tail(clock,data_in,data_out);
     reg  [31:0] stage__2__d;
     wire  [31:0] stage__2__q;
     reg  stage__2__clock;
+    reg  [31:0] stage__3__d;
+    wire  [31:0] stage__3__q;
+    reg  stage__3__clock;
     
     // Sub module instances
     dynrt_processor__engine__cycle_count stage__0(
@@ -11162,21 +11380,31 @@ module dynrt_processor__engine__result_line__fast_tail(clock,data_in,data_out);
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
+    dynrt_processor__engine__cycle_count stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
     
     // Update code
     always @(*) begin
         stage__0__clock = clock;
         stage__1__clock = clock;
         stage__2__clock = clock;
+        stage__3__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
+        data_out = stage__3__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__fast_tail
+
+
 
 
 
@@ -11226,6 +11454,9 @@ module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out)
     reg  stage__10__d;
     wire  stage__10__q;
     reg  stage__10__clock;
+    reg  stage__11__d;
+    wire  stage__11__q;
+    reg  stage__11__clock;
     
     // Sub module instances
     dynrt_processor__display__dark_d stage__0(
@@ -11283,6 +11514,11 @@ module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out)
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
+    dynrt_processor__display__dark_d stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -11297,6 +11533,7 @@ module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out)
         stage__8__clock = clock;
         stage__9__clock = clock;
         stage__10__clock = clock;
+        stage__11__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -11308,6 +11545,7 @@ module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out)
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
         stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -11319,9 +11557,16 @@ module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out)
         data_out = stage__8__q;
         data_out = stage__9__q;
         data_out = stage__10__q;
+        data_out = stage__11__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__int_eq_line
+
+
+
+
+
+
 
 
 
@@ -11435,6 +11680,9 @@ module dynrt_processor__engine__result_line__jr_target_line(clock,data_in,data_o
     reg  [11:0] stage__10__d;
     wire  [11:0] stage__10__q;
     reg  stage__10__clock;
+    reg  [11:0] stage__11__d;
+    wire  [11:0] stage__11__q;
+    reg  stage__11__clock;
     
     // Sub module instances
     dynrt_processor__display__timing__col stage__0(
@@ -11492,6 +11740,11 @@ module dynrt_processor__engine__result_line__jr_target_line(clock,data_in,data_o
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
+    dynrt_processor__display__timing__col stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -11506,6 +11759,7 @@ module dynrt_processor__engine__result_line__jr_target_line(clock,data_in,data_o
         stage__8__clock = clock;
         stage__9__clock = clock;
         stage__10__clock = clock;
+        stage__11__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -11517,6 +11771,7 @@ module dynrt_processor__engine__result_line__jr_target_line(clock,data_in,data_o
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
         stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -11528,9 +11783,14 @@ module dynrt_processor__engine__result_line__jr_target_line(clock,data_in,data_o
         data_out = stage__8__q;
         data_out = stage__9__q;
         data_out = stage__10__q;
+        data_out = stage__11__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__jr_target_line
+
+
+
+
 
 
 
@@ -11620,6 +11880,132 @@ endmodule // dynrt_processor__engine__result_line__kind_line__0
 
 
 
+module dynrt_processor__engine__result_line__long_dst(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [7:0] data_in;
+    output reg  [7:0] data_out;
+    
+    // Stub signals
+    reg  [7:0] stage__0__d;
+    wire  [7:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [7:0] stage__1__d;
+    wire  [7:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [7:0] stage__2__d;
+    wire  [7:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [7:0] stage__3__d;
+    wire  [7:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [7:0] stage__4__d;
+    wire  [7:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [7:0] stage__5__d;
+    wire  [7:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [7:0] stage__6__d;
+    wire  [7:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [7:0] stage__7__d;
+    wire  [7:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [7:0] stage__8__d;
+    wire  [7:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [7:0] stage__9__d;
+    wire  [7:0] stage__9__q;
+    reg  stage__9__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__halted_count stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__halted_count stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__halted_count stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__engine__halted_count stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__engine__halted_count stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__engine__halted_count stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__engine__halted_count stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__engine__halted_count stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__engine__halted_count stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__engine__halted_count stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__long_dst
 
 
 
@@ -11664,12 +12050,132 @@ endmodule // dynrt_processor__engine__result_line__kind_line__0
 
 
 
-
-
-
-
-
-
+module dynrt_processor__engine__result_line__long_next(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [11:0] data_in;
+    output reg  [11:0] data_out;
+    
+    // Stub signals
+    reg  [11:0] stage__0__d;
+    wire  [11:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [11:0] stage__1__d;
+    wire  [11:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [11:0] stage__2__d;
+    wire  [11:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [11:0] stage__3__d;
+    wire  [11:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [11:0] stage__4__d;
+    wire  [11:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [11:0] stage__5__d;
+    wire  [11:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [11:0] stage__6__d;
+    wire  [11:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [11:0] stage__7__d;
+    wire  [11:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [11:0] stage__8__d;
+    wire  [11:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [11:0] stage__9__d;
+    wire  [11:0] stage__9__q;
+    reg  stage__9__clock;
+    
+    // Sub module instances
+    dynrt_processor__display__timing__col stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__display__timing__col stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__display__timing__col stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__display__timing__col stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__display__timing__col stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__display__timing__col stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__display__timing__col stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__display__timing__col stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__display__timing__col stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__display__timing__col stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__long_next
 
 
 
@@ -11730,9 +12236,6 @@ module dynrt_processor__engine__result_line__long_op(clock,data_in,data_out);
     reg  [4:0] stage__9__d;
     wire  [4:0] stage__9__q;
     reg  stage__9__clock;
-    reg  [4:0] stage__10__d;
-    wire  [4:0] stage__10__q;
-    reg  stage__10__clock;
     
     // Sub module instances
     dynrt_processor__engine__decode__t3 stage__0(
@@ -11785,11 +12288,6 @@ module dynrt_processor__engine__result_line__long_op(clock,data_in,data_out);
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__10(
-        .d(stage__10__d),
-        .q(stage__10__q),
-        .clock(stage__10__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -11803,7 +12301,6 @@ module dynrt_processor__engine__result_line__long_op(clock,data_in,data_out);
         stage__7__clock = clock;
         stage__8__clock = clock;
         stage__9__clock = clock;
-        stage__10__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -11814,7 +12311,6 @@ module dynrt_processor__engine__result_line__long_op(clock,data_in,data_out);
         stage__7__d = stage__6__q;
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
-        stage__10__d = stage__9__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -11825,7 +12321,6 @@ module dynrt_processor__engine__result_line__long_op(clock,data_in,data_out);
         data_out = stage__7__q;
         data_out = stage__8__q;
         data_out = stage__9__q;
-        data_out = stage__10__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__long_op
@@ -11959,6 +12454,164 @@ endmodule // dynrt_processor__engine__result_line__long_op
 
 
 
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__result_line__op_line(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [4:0] data_in;
+    output reg  [4:0] data_out;
+    
+    // Stub signals
+    reg  [4:0] stage__0__d;
+    wire  [4:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [4:0] stage__1__d;
+    wire  [4:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [4:0] stage__2__d;
+    wire  [4:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [4:0] stage__3__d;
+    wire  [4:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [4:0] stage__4__d;
+    wire  [4:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [4:0] stage__5__d;
+    wire  [4:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [4:0] stage__6__d;
+    wire  [4:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [4:0] stage__7__d;
+    wire  [4:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [4:0] stage__8__d;
+    wire  [4:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [4:0] stage__9__d;
+    wire  [4:0] stage__9__q;
+    reg  stage__9__clock;
+    reg  [4:0] stage__10__d;
+    wire  [4:0] stage__10__q;
+    reg  stage__10__clock;
+    reg  [4:0] stage__11__d;
+    wire  [4:0] stage__11__q;
+    reg  stage__11__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__decode__t3 stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    dynrt_processor__engine__decode__t3 stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__11__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+        data_out = stage__11__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__op_line
 
 
 
@@ -12197,7 +12850,7 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     localparam  c_thread_ids__29 = 5'b11101;
     localparam  c_thread_ids__30 = 5'b11110;
     localparam  c_thread_ids__31 = 5'b11111;
-    localparam  c_reserve_bit = 32'h7;
+    localparam  c_reserve_bit = 32'h6;
     
     // Stub signals
     reg  [31:0] ready__d;
@@ -15748,6 +16401,66 @@ endmodule // dynrt_processor__engine__tester__intersect_unit
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__tester__intersect_unit__operand_delay__0(clock,data_in,data_out);
     
     // Module arguments
@@ -16321,6 +17034,12 @@ module dynrt_processor__engine__tester__intersect_unit__t_cmp_delay__0(clock,dat
     reg  stage__17__d;
     wire  stage__17__q;
     reg  stage__17__clock;
+    reg  stage__18__d;
+    wire  stage__18__q;
+    reg  stage__18__clock;
+    reg  stage__19__d;
+    wire  stage__19__q;
+    reg  stage__19__clock;
     
     // Sub module instances
     dynrt_processor__display__dark_d stage__0(
@@ -16413,6 +17132,16 @@ module dynrt_processor__engine__tester__intersect_unit__t_cmp_delay__0(clock,dat
         .q(stage__17__q),
         .clock(stage__17__clock)
     );
+    dynrt_processor__display__dark_d stage__18(
+        .d(stage__18__d),
+        .q(stage__18__q),
+        .clock(stage__18__clock)
+    );
+    dynrt_processor__display__dark_d stage__19(
+        .d(stage__19__d),
+        .q(stage__19__q),
+        .clock(stage__19__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -16434,6 +17163,8 @@ module dynrt_processor__engine__tester__intersect_unit__t_cmp_delay__0(clock,dat
         stage__15__clock = clock;
         stage__16__clock = clock;
         stage__17__clock = clock;
+        stage__18__clock = clock;
+        stage__19__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -16452,6 +17183,8 @@ module dynrt_processor__engine__tester__intersect_unit__t_cmp_delay__0(clock,dat
         stage__15__d = stage__14__q;
         stage__16__d = stage__15__q;
         stage__17__d = stage__16__q;
+        stage__18__d = stage__17__q;
+        stage__19__d = stage__18__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -16470,9 +17203,19 @@ module dynrt_processor__engine__tester__intersect_unit__t_cmp_delay__0(clock,dat
         data_out = stage__15__q;
         data_out = stage__16__q;
         data_out = stage__17__q;
+        data_out = stage__18__q;
+        data_out = stage__19__q;
     end
     
 endmodule // dynrt_processor__engine__tester__intersect_unit__t_cmp_delay__0
+
+
+
+
+
+
+
+
 
 
 
@@ -16617,6 +17360,12 @@ module dynrt_processor__engine__tester__intersect_unit__t_delay(clock,data_in,da
     reg  [23:0] stage__19__d;
     wire  [23:0] stage__19__q;
     reg  stage__19__clock;
+    reg  [23:0] stage__20__d;
+    wire  [23:0] stage__20__q;
+    reg  stage__20__clock;
+    reg  [23:0] stage__21__d;
+    wire  [23:0] stage__21__q;
+    reg  stage__21__clock;
     
     // Sub module instances
     dynrt_processor__display__rgb_q stage__0(
@@ -16719,6 +17468,16 @@ module dynrt_processor__engine__tester__intersect_unit__t_delay(clock,data_in,da
         .q(stage__19__q),
         .clock(stage__19__clock)
     );
+    dynrt_processor__display__rgb_q stage__20(
+        .d(stage__20__d),
+        .q(stage__20__q),
+        .clock(stage__20__clock)
+    );
+    dynrt_processor__display__rgb_q stage__21(
+        .d(stage__21__d),
+        .q(stage__21__q),
+        .clock(stage__21__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -16742,6 +17501,8 @@ module dynrt_processor__engine__tester__intersect_unit__t_delay(clock,data_in,da
         stage__17__clock = clock;
         stage__18__clock = clock;
         stage__19__clock = clock;
+        stage__20__clock = clock;
+        stage__21__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -16762,6 +17523,8 @@ module dynrt_processor__engine__tester__intersect_unit__t_delay(clock,data_in,da
         stage__17__d = stage__16__q;
         stage__18__d = stage__17__q;
         stage__19__d = stage__18__q;
+        stage__20__d = stage__19__q;
+        stage__21__d = stage__20__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -16782,9 +17545,15 @@ module dynrt_processor__engine__tester__intersect_unit__t_delay(clock,data_in,da
         data_out = stage__17__q;
         data_out = stage__18__q;
         data_out = stage__19__q;
+        data_out = stage__20__q;
+        data_out = stage__21__q;
     end
     
 endmodule // dynrt_processor__engine__tester__intersect_unit__t_delay
+
+
+
+
 
 
 
@@ -17186,6 +17955,12 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_rest(clock,dat
     reg  [15:0] stage__19__d;
     wire  [15:0] stage__19__q;
     reg  stage__19__clock;
+    reg  [15:0] stage__20__d;
+    wire  [15:0] stage__20__q;
+    reg  stage__20__clock;
+    reg  [15:0] stage__21__d;
+    wire  [15:0] stage__21__q;
+    reg  stage__21__clock;
     
     // Sub module instances
     dynrt_processor__engine__fp_units__sqrt__rnd_man stage__0(
@@ -17288,6 +18063,16 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_rest(clock,dat
         .q(stage__19__q),
         .clock(stage__19__clock)
     );
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__20(
+        .d(stage__20__d),
+        .q(stage__20__q),
+        .clock(stage__20__clock)
+    );
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__21(
+        .d(stage__21__d),
+        .q(stage__21__q),
+        .clock(stage__21__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -17311,6 +18096,8 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_rest(clock,dat
         stage__17__clock = clock;
         stage__18__clock = clock;
         stage__19__clock = clock;
+        stage__20__clock = clock;
+        stage__21__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -17331,6 +18118,8 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_rest(clock,dat
         stage__17__d = stage__16__q;
         stage__18__d = stage__17__q;
         stage__19__d = stage__18__q;
+        stage__20__d = stage__19__q;
+        stage__21__d = stage__20__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -17351,9 +18140,15 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_rest(clock,dat
         data_out = stage__17__q;
         data_out = stage__18__q;
         data_out = stage__19__q;
+        data_out = stage__20__q;
+        data_out = stage__21__q;
     end
     
 endmodule // dynrt_processor__engine__tester__intersect_unit__tag_delay_rest
+
+
+
+
 
 
 
@@ -17425,6 +18220,9 @@ module dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0(clock,da
     reg  stage__6__d;
     wire  stage__6__q;
     reg  stage__6__clock;
+    reg  stage__7__d;
+    wire  stage__7__q;
+    reg  stage__7__clock;
     
     // Sub module instances
     dynrt_processor__display__dark_d stage__0(
@@ -17462,6 +18260,11 @@ module dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0(clock,da
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
+    dynrt_processor__display__dark_d stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -17472,6 +18275,7 @@ module dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0(clock,da
         stage__4__clock = clock;
         stage__5__clock = clock;
         stage__6__clock = clock;
+        stage__7__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -17479,6 +18283,7 @@ module dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0(clock,da
         stage__4__d = stage__3__q;
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -17486,9 +18291,14 @@ module dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0(clock,da
         data_out = stage__4__q;
         data_out = stage__5__q;
         data_out = stage__6__q;
+        data_out = stage__7__q;
     end
     
 endmodule // dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0
+
+
+
+
 
 
 
@@ -17556,6 +18366,9 @@ module dynrt_processor__engine__tester__intersect_unit__uv_delay__0(clock,data_i
     reg  [23:0] stage__8__d;
     wire  [23:0] stage__8__q;
     reg  stage__8__clock;
+    reg  [23:0] stage__9__d;
+    wire  [23:0] stage__9__q;
+    reg  stage__9__clock;
     
     // Sub module instances
     dynrt_processor__display__rgb_q stage__0(
@@ -17603,6 +18416,11 @@ module dynrt_processor__engine__tester__intersect_unit__uv_delay__0(clock,data_i
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
+    dynrt_processor__display__rgb_q stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -17615,6 +18433,7 @@ module dynrt_processor__engine__tester__intersect_unit__uv_delay__0(clock,data_i
         stage__6__clock = clock;
         stage__7__clock = clock;
         stage__8__clock = clock;
+        stage__9__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -17624,6 +18443,7 @@ module dynrt_processor__engine__tester__intersect_unit__uv_delay__0(clock,data_i
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
         stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -17633,9 +18453,14 @@ module dynrt_processor__engine__tester__intersect_unit__uv_delay__0(clock,data_i
         data_out = stage__6__q;
         data_out = stage__7__q;
         data_out = stage__8__q;
+        data_out = stage__9__q;
     end
     
 endmodule // dynrt_processor__engine__tester__intersect_unit__uv_delay__0
+
+
+
+
 
 
 
@@ -21619,6 +22444,186 @@ endmodule // dynrt_processor__engine__tester__transform_unit
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__tester__transform_unit__offset_delay__0(clock,data_in,data_out);
     
     // Module arguments
@@ -21681,6 +22686,12 @@ module dynrt_processor__engine__tester__transform_unit__offset_delay__0(clock,da
     reg  [23:0] stage__17__d;
     wire  [23:0] stage__17__q;
     reg  stage__17__clock;
+    reg  [23:0] stage__18__d;
+    wire  [23:0] stage__18__q;
+    reg  stage__18__clock;
+    reg  [23:0] stage__19__d;
+    wire  [23:0] stage__19__q;
+    reg  stage__19__clock;
     
     // Sub module instances
     dynrt_processor__display__rgb_q stage__0(
@@ -21773,6 +22784,16 @@ module dynrt_processor__engine__tester__transform_unit__offset_delay__0(clock,da
         .q(stage__17__q),
         .clock(stage__17__clock)
     );
+    dynrt_processor__display__rgb_q stage__18(
+        .d(stage__18__d),
+        .q(stage__18__q),
+        .clock(stage__18__clock)
+    );
+    dynrt_processor__display__rgb_q stage__19(
+        .d(stage__19__d),
+        .q(stage__19__q),
+        .clock(stage__19__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -21794,6 +22815,8 @@ module dynrt_processor__engine__tester__transform_unit__offset_delay__0(clock,da
         stage__15__clock = clock;
         stage__16__clock = clock;
         stage__17__clock = clock;
+        stage__18__clock = clock;
+        stage__19__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -21812,6 +22835,8 @@ module dynrt_processor__engine__tester__transform_unit__offset_delay__0(clock,da
         stage__15__d = stage__14__q;
         stage__16__d = stage__15__q;
         stage__17__d = stage__16__q;
+        stage__18__d = stage__17__q;
+        stage__19__d = stage__18__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -21830,9 +22855,29 @@ module dynrt_processor__engine__tester__transform_unit__offset_delay__0(clock,da
         data_out = stage__15__q;
         data_out = stage__16__q;
         data_out = stage__17__q;
+        data_out = stage__18__q;
+        data_out = stage__19__q;
     end
     
 endmodule // dynrt_processor__engine__tester__transform_unit__offset_delay__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -22078,6 +23123,15 @@ module dynrt_processor__engine__tester__transform_unit__tag_delay(clock,data_in,
     reg  [15:0] stage__24__d;
     wire  [15:0] stage__24__q;
     reg  stage__24__clock;
+    reg  [15:0] stage__25__d;
+    wire  [15:0] stage__25__q;
+    reg  stage__25__clock;
+    reg  [15:0] stage__26__d;
+    wire  [15:0] stage__26__q;
+    reg  stage__26__clock;
+    reg  [15:0] stage__27__d;
+    wire  [15:0] stage__27__q;
+    reg  stage__27__clock;
     
     // Sub module instances
     dynrt_processor__engine__fp_units__sqrt__rnd_man stage__0(
@@ -22205,6 +23259,21 @@ module dynrt_processor__engine__tester__transform_unit__tag_delay(clock,data_in,
         .q(stage__24__q),
         .clock(stage__24__clock)
     );
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__25(
+        .d(stage__25__d),
+        .q(stage__25__q),
+        .clock(stage__25__clock)
+    );
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__26(
+        .d(stage__26__d),
+        .q(stage__26__q),
+        .clock(stage__26__clock)
+    );
+    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__27(
+        .d(stage__27__d),
+        .q(stage__27__q),
+        .clock(stage__27__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -22233,6 +23302,9 @@ module dynrt_processor__engine__tester__transform_unit__tag_delay(clock,data_in,
         stage__22__clock = clock;
         stage__23__clock = clock;
         stage__24__clock = clock;
+        stage__25__clock = clock;
+        stage__26__clock = clock;
+        stage__27__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -22258,6 +23330,9 @@ module dynrt_processor__engine__tester__transform_unit__tag_delay(clock,data_in,
         stage__22__d = stage__21__q;
         stage__23__d = stage__22__q;
         stage__24__d = stage__23__q;
+        stage__25__d = stage__24__q;
+        stage__26__d = stage__25__q;
+        stage__27__d = stage__26__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -22283,9 +23358,18 @@ module dynrt_processor__engine__tester__transform_unit__tag_delay(clock,data_in,
         data_out = stage__22__q;
         data_out = stage__23__q;
         data_out = stage__24__q;
+        data_out = stage__25__q;
+        data_out = stage__26__q;
+        data_out = stage__27__q;
     end
     
 endmodule // dynrt_processor__engine__tester__transform_unit__tag_delay
+
+
+
+
+
+
 
 
 
@@ -24057,6 +25141,9 @@ module dynrt_processor__engine__traversal_unit__control_delay(clock,data_in,data
     reg  [37:0] stage__6__d;
     wire  [37:0] stage__6__q;
     reg  stage__6__clock;
+    reg  [37:0] stage__7__d;
+    wire  [37:0] stage__7__q;
+    reg  stage__7__clock;
     
     // Sub module instances
     dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__0(
@@ -24094,6 +25181,11 @@ module dynrt_processor__engine__traversal_unit__control_delay(clock,data_in,data
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
+    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -24104,6 +25196,7 @@ module dynrt_processor__engine__traversal_unit__control_delay(clock,data_in,data
         stage__4__clock = clock;
         stage__5__clock = clock;
         stage__6__clock = clock;
+        stage__7__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -24111,6 +25204,7 @@ module dynrt_processor__engine__traversal_unit__control_delay(clock,data_in,data
         stage__4__d = stage__3__q;
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -24118,6 +25212,7 @@ module dynrt_processor__engine__traversal_unit__control_delay(clock,data_in,data
         data_out = stage__4__q;
         data_out = stage__5__q;
         data_out = stage__6__q;
+        data_out = stage__7__q;
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__control_delay
@@ -24140,6 +25235,8 @@ module dynrt_processor__engine__traversal_unit__control_delay__stage__0(d,q,cloc
     end
           
 endmodule // dynrt_processor__engine__traversal_unit__control_delay__stage__0
+
+
 
 
 
@@ -26683,6 +27780,16 @@ endmodule // dynrt_processor__engine__traversal_unit__leaf_sp
 
 
 
+
+
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__traversal_unit__phase(d,q,clock);
     
     // Module arguments
@@ -26781,6 +27888,26 @@ module dynrt_processor__engine__traversal_unit__stack_node(read_address,read_clo
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__stack_node
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 

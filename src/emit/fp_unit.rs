@@ -387,7 +387,7 @@ mod tests {
     fn top_module_has_the_contract_ports() {
         let unit = fp_unit_rtl(BinOp::Add, Format::E7M16).unwrap();
         assert_eq!(unit.top, "fp_add_e7m16");
-        assert_eq!(unit.latency, 7);
+        assert_eq!(unit.latency, 8);
         assert!(unit.verilog.contains("module fp_add_e7m16(\n"));
         for port in [
             "input wire clock,",

@@ -35,7 +35,7 @@ use crate::layout::BANK_NAMES;
 pub const PROCESSOR_TOP: &str = "dynrt_processor";
 
 /// Dispatches to `func::<W, E, M, S, S1, X2, T, P, DX, DL>(args)` for the engine: `DX =
-/// long_latency - ENGINE_LATENCY = M - 5` (the long line of `fdiv` and `fsqrt`) and `DL =
+/// long_latency - ENGINE_LATENCY = M - 6` (the long line of `fdiv` and `fsqrt`) and `DL =
 /// div_latency = M + 5` (the IntersectUnit's divider).
 #[macro_export]
 macro_rules! dispatch_engine_format {
@@ -45,7 +45,12 @@ macro_rules! dispatch_engine_format {
             $(
                 ($e, $m) => Ok($func::<
                     { 1 + $e + $m }, $e, $m, { $m + 1 }, { $m + 2 }, { $e + 2 }, { $m + 5 },
-                    { 2 * ($m + 1) }, { $m - 5 }, { $m + 5 },
+                    { 2 * ($m + 1) },
+                    {
+                        ($crate::hw::engine::long_latency($m)
+                            - $crate::hw::engine::ENGINE_LATENCY) as usize
+                    },
+                    { $m + 5 },
                 >$args),
             )*
             _ => Err($crate::hw::fp::UnsupportedFormat(format)),

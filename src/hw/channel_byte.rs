@@ -9,7 +9,7 @@
 //! [`units::clamp_unit_word`]: crate::units::clamp_unit_word
 //! [`units::channel_byte_word`]: crate::units::channel_byte_word
 //!
-//! Latency [`CHANNEL_BYTE_LATENCY`] (11) from `in_valid` to `out_valid`, one word per clock;
+//! Latency [`CHANNEL_BYTE_LATENCY`] (12) from `in_valid` to `out_valid`, one word per clock;
 //! the clamp is combinational in front of the multiplier's input registers.
 
 use rust_hdl::prelude::*;

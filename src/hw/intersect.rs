@@ -26,8 +26,8 @@
 //! t_max and the tag wait out the divider's `M + 5` clocks); yosys 0.23 does not map them to
 //! SRL16s.
 //!
-//! Latency [`intersect_latency`] = div (`M + 5`) + mul (4) + add (7) + add (7) + compare (2):
-//! 41 clocks for e7m16, 48 for e8m23; one test per clock. `tag` travels with the data.
+//! Latency [`intersect_latency`] = div (`M + 5`) + mul (4) + add (8) + add (8) + compare (2):
+//! 43 clocks for e7m16, 50 for e8m23; one test per clock. `tag` travels with the data.
 //!
 //! Timeline (clock offsets from the input, with the operators' latencies `Lm`, `La`, `Lc`): t
 //! at `DL`; the two products at `DL + Lm`; u and v at `DL + Lm + La`; u + v at

@@ -29,7 +29,7 @@
 //! into shifts (the exponent and NaN/infinity logic stay: `inf * 0` is still NaN). In the full
 //! design RayGen uses the shared unit and adds no multiplier.
 //!
-//! [`RayGenUnit`]: latency [`TRANSFORM_LATENCY`] (25) from the issue clock to `out_valid` with
+//! [`RayGenUnit`]: latency [`TRANSFORM_LATENCY`] (28) from the issue clock to `out_valid` with
 //! `out_thread`, `dir` and `origin` (the eye), one primary ray per clock.
 
 use rust_hdl::prelude::*;

@@ -13,9 +13,9 @@
 //! context, `synth::synth_unit`): e7m16 4712 LUTs, 3693 FFs, 9 MULT18X18, 0 BRAM, depth 15
 //! LUT levels; e8m23 7074 LUTs, 4788 FFs, 36 MULT18X18, 0 BRAM, depth 16.
 //!
-//! Latency [`TRANSFORM_LATENCY`] = mul (4) + 3 adds (7 each) = 25 clocks for every format, one
+//! Latency [`TRANSFORM_LATENCY`] = mul (4) + 3 adds (8 each) = 28 clocks for every format, one
 //! transform per clock. `tag` (client and thread id, [`TAG_BITS`]) travels with the data and
-//! leaves with the result; `out_valid` is `in_valid` 25 clocks later.
+//! leaves with the result; `out_valid` is `in_valid` 28 clocks later.
 //!
 //! Matrix words are row-major `m00 m01 m02 n0 m10 m11 m12 n1 m20 m21 m22 n2`
 //! ([`units::Mat34W`](crate::units::Mat34W), the layout's matrix order).

@@ -15,7 +15,7 @@
 //! whenever they come; each picks out its own by `out_client` and routes them by `out_thread`.
 //! Results of one client leave in the order its requests were taken.
 //!
-//! Latency [`TRANSFORM_LATENCY`] (25) from the taken request to the result; the arbiter is
+//! Latency [`TRANSFORM_LATENCY`] (28) from the taken request to the result; the arbiter is
 //! combinational in front of the unit's input registers, so it adds no clock. Throughput one
 //! request per clock, shared by the clients.
 //!

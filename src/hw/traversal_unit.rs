@@ -26,7 +26,8 @@
 //! two words of bank 0 a job, the next job's requests right behind (the engine's own loads of
 //! bank 0 go first; the words come back in order), then the decision pipeline: `split - o`
 //! (FpAddSub), `/ d` (FpDiv), then five FpCompares; at its end a push and the next step.
-//! Latency per inner node: `mem_latency + 3` clocks of fetch plus `7 + DL + 2` of decision;
+//! Latency per inner node: `mem_latency + 3` clocks of fetch plus `8 + DL + 2` of decision
+//! (`ADD_SUB_LATENCY + DL + COMPARE_LATENCY`);
 //! throughput one node per [`FETCH_CLOCKS_PER_NODE`] (2) clocks, while other threads' jobs
 //! fill the decision pipeline. Each thread has at most one job in
 //! the unit, so the 32-entry queues never overflow.
@@ -46,6 +47,11 @@ use super::ray_store::{zero_counters, RayStore};
 use super::Delay;
 use crate::fp::Format;
 use crate::layout;
+
+/// The decision's delay lines: o, d, lo, hi, the split plane and the control wait for
+/// `split - o`, then for the comparisons.
+const SUB_DELAY: usize = ADD_SUB_LATENCY as usize;
+const CMP_DELAY: usize = COMPARE_LATENCY as usize;
 
 /// Entries of each thread's kd stack (the deepest object tree the unit walks).
 pub const STACK_LEVELS: usize = 64;
@@ -207,16 +213,16 @@ pub struct TraversalUnit<
     sub: FpAddSub<W, E, M, S, S1, X2, T>,
     div: FpDiv<W, E, M, S, S1, X2>,
     /// o, d, lo, hi and the split plane wait for t_split.
-    o_delay: [Delay<Bits<W>, 7>; 5],
+    o_delay: [Delay<Bits<W>, SUB_DELAY>; 5],
     o_delay_div: [Delay<Bits<W>, DL>; 5],
-    control_delay: Delay<Control, 7>,
+    control_delay: Delay<Control, SUB_DELAY>,
     control_delay_div: Delay<Control, DL>,
-    control_delay_cmp: Delay<Control, 2>,
+    control_delay_cmp: Delay<Control, CMP_DELAY>,
     /// (o, split), (d, 0), (hi, t_split), (t_split, 0), (t_split, lo).
     cmp: [FpCompare<W, E, M>; 5],
-    ts_delay: Delay<Bits<W>, 2>,
-    lo_delay: Delay<Bits<W>, 2>,
-    hi_delay: Delay<Bits<W>, 2>,
+    ts_delay: Delay<Bits<W>, CMP_DELAY>,
+    lo_delay: Delay<Bits<W>, CMP_DELAY>,
+    hi_delay: Delay<Bits<W>, CMP_DELAY>,
     d_valid: Signal<Local, Bit>,
     d_thread: Signal<Local, Bits<5>>,
     d_sp: Signal<Local, Bits<6>>,
@@ -246,8 +252,6 @@ impl<
     /// The unit for SRAM read latency `mem_latency` (1..=6).
     pub fn new(mem_latency: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
-        // The decision's delay lines are spelled with these latencies.
-        assert!(ADD_SUB_LATENCY == 7 && COMPARE_LATENCY == 2);
         assert!(DL == div_latency(M as u32) as usize);
         let f = Format::new(E as u32, M as u32).expect("a supported format");
         Self {

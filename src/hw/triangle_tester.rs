@@ -41,8 +41,8 @@
 //! best hit in 4 clocks). The engine's own loads of banks 2 and 3 (shading data) take the
 //! bank in their clock; the fetch waits for it.
 //!
-//! Latency from launch to the merged hit: `TRANSFORM_LATENCY` (25) + 1 + `intersect_latency`
-//! (41 at e7m16) + 3. Up to [`FLIGHT_SLOTS`] entries are in flight in that time, each with its
+//! Latency from launch to the merged hit: `TRANSFORM_LATENCY` (28) + 1 + `intersect_latency`
+//! (43 at e7m16) + 3. Up to [`FLIGHT_SLOTS`] entries are in flight in that time, each with its
 //! own slot for the words the merge needs. Const parameters: the operators' `W, E, M, S, S1,
 //! X2, T, P` and `DL = div_latency(M)` (the IntersectUnit's).
 

@@ -62,7 +62,7 @@ module tb;
         end else begin
             in_valid <= 1'b0;
         end
-        if (cycles > 1107) begin
+        if (cycles > 1108) begin
             $display("tb: timeout after %0d clocks", cycles);
             $finish;
         end

@@ -9,7 +9,8 @@
 //! unit takes an input every clock whether the instruction uses it or not; the write back
 //! picks the one its opcode names.
 //!
-//! Latency: 11 clocks (`quotient`, `root`: `M + 6`). Throughput: one operation per clock.
+//! Latency: `ENGINE_LATENCY` (12) clocks (`quotient`, `root`: `M + 6`). Throughput: one
+//! operation per clock.
 //!
 //! Golden twin: each operator's own (`Format::add`, `sub`, `mul`, `div`, `sqrt`, `lt`, `le`,
 //! `eq` in `crate::fp::arith`, and `units::channel_byte`), as the engine's twin
@@ -18,8 +19,17 @@
 
 use rust_hdl::prelude::*;
 
+use super::ENGINE_LATENCY;
+use crate::hw::fp::add_sub::ADD_SUB_LATENCY;
+use crate::hw::fp::compare::COMPARE_LATENCY;
+use crate::hw::fp::mul::MUL_LATENCY;
 use crate::hw::fp::{FpAddSub, FpCompare, FpDiv, FpMul, FpSqrt};
 use crate::hw::ChannelByte;
+
+/// Each delay brings its unit's result to the write back at `ENGINE_LATENCY`.
+const ADD_DELAY: usize = (ENGINE_LATENCY - ADD_SUB_LATENCY) as usize;
+const MUL_DELAY: usize = (ENGINE_LATENCY - MUL_LATENCY) as usize;
+const CMP_DELAY: usize = (ENGINE_LATENCY - COMPARE_LATENCY) as usize;
 
 #[derive(LogicBlock, Default)]
 pub struct FpUnits<
@@ -53,17 +63,17 @@ pub struct FpUnits<
     sqrt: FpSqrt<W, E, M, S, S1, T>,
     cmp: FpCompare<W, E, M>,
     byte_unit: ChannelByte<W, E, M, S, S1, X2, T, P>,
-    // Each delay brings its unit's result to the write back at `ENGINE_LATENCY` (11): 11 - 7
-    // for the adder, 11 - 4 for the multiplier, 11 - 2 for the comparator; the divider and
+    // Each delay brings its unit's result to the write back at `ENGINE_LATENCY` (12): 12 - 8
+    // for the adder, 12 - 4 for the multiplier, 12 - 2 for the comparator; the divider and
     // square root (`M + 5`) write back one clock later, at `long_latency`. `ChannelByte` takes
-    // the 11 clocks itself.
-    add_delay: crate::hw::Delay<Bits<W>, 4>,
-    mul_delay: crate::hw::Delay<Bits<W>, 7>,
+    // the 12 clocks itself (`ENGINE_LATENCY` is its latency).
+    add_delay: crate::hw::Delay<Bits<W>, ADD_DELAY>,
+    mul_delay: crate::hw::Delay<Bits<W>, MUL_DELAY>,
     div_delay: crate::hw::Delay<Bits<W>, 1>,
     sqrt_delay: crate::hw::Delay<Bits<W>, 1>,
-    lt_delay: crate::hw::Delay<Bit, 9>,
-    le_delay: crate::hw::Delay<Bit, 9>,
-    eq_delay: crate::hw::Delay<Bit, 9>,
+    lt_delay: crate::hw::Delay<Bit, CMP_DELAY>,
+    le_delay: crate::hw::Delay<Bit, CMP_DELAY>,
+    eq_delay: crate::hw::Delay<Bit, CMP_DELAY>,
 }
 
 impl<

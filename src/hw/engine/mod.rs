@@ -2,13 +2,13 @@
 //! 32 ray threads, one instruction per clock, on pipelined floating-point units.
 //!
 //! A scheduler issues one ready thread per clock, round robin. An instruction writes back
-//! exactly [`ENGINE_LATENCY`] (11) clocks after its operands are read, `fdiv` and `fsqrt`
+//! exactly [`ENGINE_LATENCY`] (12) clocks after its operands are read, `fdiv` and `fsqrt`
 //! [`long_latency`] (`M + 6`) clocks after, and a thread is ready again only at its write
 //! back, so there is no hazard, stall or forwarding logic: memory and unit latency are hidden
 //! by the other threads (the paper's 32 threads). A long instruction reserves its write-back
 //! clock: the scheduler issues nothing in the one clock whose instruction would write back
 //! with it (one bubble per `fdiv` or `fsqrt`). A thread issues at most once per `period =
-//! ENGINE_LATENCY + 4` (15) clocks (`engine_period`). A thread whose coprocessor wait (`tri.wait`,
+//! ENGINE_LATENCY + 4` (16) clocks (`engine_period`). A thread whose coprocessor wait (`tri.wait`,
 //! `kd.wait`) is still pending sleeps: it is not ready until the coprocessor finishes work for
 //! it, so the clocks it waits go to the other threads (an offer to a full queue repeats at
 //! once).
@@ -25,7 +25,7 @@
 //!   coprocessors (their answer, refused or pending, makes the thread repeat the instruction
 //!   on its next turn, after a sleep for a wait).
 //! - I4..: the [`ResultLine`]; scratch data joins at I4, memory data at I4 + `mem_latency`.
-//! - I3 + 11 (`I3 + M + 6` for `fdiv`, `fsqrt`, which go on in the long line): the
+//! - I3 + 12 (`I3 + M + 6` for `fdiv`, `fsqrt`, which go on in the long line): the
 //!   [`WriteBack`] writes the register and the next pc: `target` when the condition differs
 //!   from `invert` (a non-branching instruction's condition is false, so its `invert` is a jump
 //!   after it), else `pc + 1`; the condition comes from the compare, integer, mailbox, pixel
@@ -36,7 +36,7 @@
 //! engine's (`tests/processor_sim.rs`). The arithmetic of the ray, in both, is the sequences of
 //! [`crate::units`].
 //!
-//! Throughput: one instruction per clock while at least 15 threads are awake; a frame
+//! Throughput: one instruction per clock while at least 16 threads are awake; a frame
 //! ends when every thread has executed `halt` (`done`). Counters: clocks of the frame,
 //! instructions retired, and clocks in which the triangle tester's TransformUnit and
 //! IntersectUnit took an input.
@@ -95,7 +95,7 @@ pub const MAX_MEM_LATENCY: u32 = 6;
 pub const SCRATCH_WORDS: u32 = 128;
 
 /// Clocks from operand read to write back of every instruction but `fdiv` and `fsqrt`: the
-/// longest of them is `byte` ([`CHANNEL_BYTE_LATENCY`]; `fadd` takes 7, loads at most 8).
+/// longest of them is `byte` ([`CHANNEL_BYTE_LATENCY`]; `fadd` takes 8, loads at most 8).
 pub const ENGINE_LATENCY: u32 = CHANNEL_BYTE_LATENCY;
 
 /// Clocks from operand read to write back of `fdiv` and `fsqrt` for mantissa width `m` (the

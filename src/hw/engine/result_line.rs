@@ -2,14 +2,14 @@
 //! pcs, its conditions and its fast result, into which scratch and memory data join on the
 //! way. `fdiv` and `fsqrt` go on from there through a long line of `DX` more clocks.
 //!
-//! Contract: what enters at I3 leaves at the write back [`super::ENGINE_LATENCY`] (11) clocks
+//! Contract: what enters at I3 leaves at the write back [`super::ENGINE_LATENCY`] (12) clocks
 //! later; a long instruction's control and pcs leave `DX = long_latency - ENGINE_LATENCY`
 //! clocks later still (the scheduler reserved that clock, so no other instruction leaves with
 //! it; its conditions and fast result are not used). The fast result of `lds` is replaced by
 //! the scratch word one clock after I3, that of `ld` by the word of its bank's port
 //! `mem_latency` clocks after the request (which leaves the engine one clock after I3).
 //!
-//! Latency: 11 clocks (`fdiv`, `fsqrt`: `11 + DX`). Throughput: one instruction per clock.
+//! Latency: 12 clocks (`fdiv`, `fsqrt`: `12 + DX`). Throughput: one instruction per clock.
 //!
 //! Golden twin: none (it computes nothing); the engine's twin `hw::program::exec` sees every
 //! result at once, and the frames' equality checks that the line keeps each result with its
@@ -22,11 +22,13 @@ use crate::hw::program::isa::{Op, OP_BITS, PC_BITS, REG_BITS};
 use crate::hw::Delay;
 
 /// Registers of the fast line up to the last clock a load's data can join (the `0..8`
-/// loops of `update` spell it out: rust-hdl's Verilog cannot name Rust constants); three
+/// loops of `update` spell it out: rust-hdl's Verilog cannot name Rust constants); `TAIL`
 /// more follow.
 const FAST_STAGES: usize = 8;
+/// Registers of the fast line after the last join, up to the write back.
+const TAIL: usize = 4;
 /// Clocks from I3 to the write back.
-const LINE: usize = 11;
+const LINE: usize = FAST_STAGES + TAIL;
 
 #[derive(LogicBlock)]
 pub struct ResultLine<const DX: usize> {
@@ -81,7 +83,7 @@ pub struct ResultLine<const DX: usize> {
     /// The fast result and its source, a register per clock up to the last join.
     fast_line: [DFF<Bits<32>>; FAST_STAGES],
     kind_line: [DFF<FastKind>; FAST_STAGES],
-    fast_tail: Delay<Bits<32>, 3>,
+    fast_tail: Delay<Bits<32>, TAIL>,
     /// The long line of `fdiv` and `fsqrt`.
     long_valid: Delay<Bit, DX>,
     long_op: Delay<Bits<OP_BITS>, DX>,
@@ -103,7 +105,7 @@ impl<const DX: usize> ResultLine<DX> {
     pub fn new(mem_latency: u32) -> Self {
         assert!((1..=MAX_MEM_LATENCY).contains(&mem_latency));
         // A load's data joins at stage `mem_latency + 1 <= FAST_STAGES - 1`.
-        assert!(MAX_MEM_LATENCY as usize + 1 < FAST_STAGES && LINE == FAST_STAGES + 3);
+        assert!(MAX_MEM_LATENCY as usize + 1 < FAST_STAGES);
         assert_eq!(LINE as u32, super::ENGINE_LATENCY);
         Self {
             clock: Default::default(),

@@ -9,7 +9,12 @@
 //! [`Format::eq`]: crate::fp::Format::eq
 //!
 //! Latency 2 clocks, throughput one comparison per clock: stage 1 registers the inputs,
-//! stage 2 registers the three results. `out_valid` is `in_valid` delayed by 2.
+//! stage 2 registers the three results. `out_valid` is `in_valid` delayed by 2. The
+//! magnitude comparators read the registered words directly; the DAZ zero tests run beside
+//! them and only steer their results (clearing a zero operand before comparing put the zero
+//! test in front of the carry chain: `in_b.q -> out_lt.q` at 128 MHz on the ECP5, issue 16).
+//! The latency stays 2 because the triangle tester's hit merge reads, compares and writes a
+//! thread's best hit in 4 clocks.
 //!
 //! Const parameters: `W = 1 + E + M` (word width), `E` exponent bits, `M` stored mantissa bits.
 
@@ -35,13 +40,18 @@ pub struct FpCompare<const W: usize, const E: usize, const M: usize> {
     in_b: DFF<Bits<W>>,
     in_valid_r: DFF<Bit>,
     // Combinational compare between stage 1 and 2.
-    a_clean: Signal<Local, Bits<W>>,
-    b_clean: Signal<Local, Bits<W>>,
+    a_zero: Signal<Local, Bit>,
+    b_zero: Signal<Local, Bit>,
     a_mag: Signal<Local, Bits<W>>,
     b_mag: Signal<Local, Bits<W>>,
     a_neg: Signal<Local, Bit>,
     b_neg: Signal<Local, Bit>,
     any_nan: Signal<Local, Bit>,
+    raw_eq: Signal<Local, Bit>,
+    mag_lt_ab: Signal<Local, Bit>,
+    mag_lt_ba: Signal<Local, Bit>,
+    clean_lt_ab: Signal<Local, Bit>,
+    clean_lt_ba: Signal<Local, Bit>,
     is_eq: Signal<Local, Bit>,
     is_lt: Signal<Local, Bit>,
     // Stage 2: output registers.
@@ -70,13 +80,18 @@ impl<const W: usize, const E: usize, const M: usize> Default for FpCompare<W, E,
             in_a: Default::default(),
             in_b: Default::default(),
             in_valid_r: Default::default(),
-            a_clean: Default::default(),
-            b_clean: Default::default(),
+            a_zero: Default::default(),
+            b_zero: Default::default(),
             a_mag: Default::default(),
             b_mag: Default::default(),
             a_neg: Default::default(),
             b_neg: Default::default(),
             any_nan: Default::default(),
+            raw_eq: Default::default(),
+            mag_lt_ab: Default::default(),
+            mag_lt_ba: Default::default(),
+            clean_lt_ab: Default::default(),
+            clean_lt_ba: Default::default(),
             is_eq: Default::default(),
             is_lt: Default::default(),
             out_lt: Default::default(),
@@ -108,31 +123,29 @@ impl<const W: usize, const E: usize, const M: usize> Logic for FpCompare<W, E, M
         self.in_b.d.next = self.b.val();
         self.in_valid_r.d.next = self.in_valid.val();
 
-        // DAZ: a zero exponent field means zero, and zero compares without its sign.
-        self.a_clean.next = self.in_a.q.val();
-        if self
+        // DAZ: a zero exponent field means zero, and zero compares without its sign. A word
+        // read as zero compares as the all-zero word; any other word has a nonzero exponent
+        // field, so its magnitude is above zero. The raw comparisons below are therefore
+        // those of the cleared words except where a zero is involved, which the zero flags
+        // decide.
+        self.a_zero.next = self
             .in_a
             .q
             .val()
             .get_bits::<E>(self.c_man_bits.val().index())
-            == 0
-        {
-            self.a_clean.next = 0.into();
-        }
-        self.b_clean.next = self.in_b.q.val();
-        if self
+            == 0;
+        self.b_zero.next = self
             .in_b
             .q
             .val()
             .get_bits::<E>(self.c_man_bits.val().index())
-            == 0
-        {
-            self.b_clean.next = 0.into();
-        }
-        self.a_mag.next = self.a_clean.val() & self.c_mag_mask.val();
-        self.b_mag.next = self.b_clean.val() & self.c_mag_mask.val();
-        self.a_neg.next = self.a_clean.val().get_bit(self.c_sign_pos.val().index());
-        self.b_neg.next = self.b_clean.val().get_bit(self.c_sign_pos.val().index());
+            == 0;
+        self.a_mag.next = self.in_a.q.val() & self.c_mag_mask.val();
+        self.b_mag.next = self.in_b.q.val() & self.c_mag_mask.val();
+        self.a_neg.next =
+            self.in_a.q.val().get_bit(self.c_sign_pos.val().index()) & !self.a_zero.val();
+        self.b_neg.next =
+            self.in_b.q.val().get_bit(self.c_sign_pos.val().index()) & !self.b_zero.val();
         // A NaN has the exponent field all ones and a nonzero mantissa.
         self.any_nan.next = ((self
             .in_a
@@ -148,13 +161,27 @@ impl<const W: usize, const E: usize, const M: usize> Logic for FpCompare<W, E, M
                 .get_bits::<E>(self.c_man_bits.val().index()))
             .all()
                 & (self.in_b.q.val().get_bits::<M>(0).any()));
-        self.is_eq.next = self.a_clean.val() == self.b_clean.val();
+        self.raw_eq.next = self.in_a.q.val() == self.in_b.q.val();
+        self.mag_lt_ab.next = self.a_mag.val() < self.b_mag.val();
+        self.mag_lt_ba.next = self.b_mag.val() < self.a_mag.val();
+        // Cleared words: equal when both are zero, unequal when one is, else the raw words.
+        self.is_eq.next = self.raw_eq.val();
+        if self.a_zero.val() | self.b_zero.val() {
+            self.is_eq.next = self.a_zero.val() & self.b_zero.val();
+        }
+        // |a| < |b| of the cleared words: 0 < |b| when only a is zero, false when b is.
+        self.clean_lt_ab.next = self.mag_lt_ab.val();
+        self.clean_lt_ba.next = self.mag_lt_ba.val();
+        if self.a_zero.val() | self.b_zero.val() {
+            self.clean_lt_ab.next = !self.b_zero.val();
+            self.clean_lt_ba.next = !self.a_zero.val();
+        }
         if self.a_neg.val() ^ self.b_neg.val() {
             self.is_lt.next = self.a_neg.val();
         } else if self.a_neg.val() {
-            self.is_lt.next = self.b_mag.val() < self.a_mag.val();
+            self.is_lt.next = self.clean_lt_ba.val();
         } else {
-            self.is_lt.next = self.a_mag.val() < self.b_mag.val();
+            self.is_lt.next = self.clean_lt_ab.val();
         }
 
         self.out_eq.d.next = self.is_eq.val() & !self.any_nan.val();

@@ -13,7 +13,10 @@
 //! software operation.
 //!
 //! Latency 2 clocks (round and its carry into the exponent, registered; range check and pack,
-//! registered), throughput one word per clock.
+//! registered), throughput one word per clock. The carry into the exponent is read off the
+//! significand (all ones and rounding up) beside the rounding increment, not from its carry
+//! out: the exponent's add no longer waits for the increment's carry chain (`prod.q ->
+//! exp_negative`, 125.6 MHz on the ECP5 in `FpMul`: issue 16).
 //!
 //! Const parameters as the parent's: `W = 1+E+M`, `S = M+1`, `S1 = S+1`, `X2 = E+2`.
 
@@ -46,6 +49,7 @@ pub struct FpRoundPack<
     pub result: Signal<Out, Bits<W>>,
     // Round (combinational).
     sig_rounded: Signal<Local, Bits<S1>>,
+    carry: Signal<Local, Bit>,
     exp_final: Signal<Local, Bits<X2>>,
     // Rounded result registers.
     rnd_sig: DFF<Bits<S1>>,
@@ -64,7 +68,6 @@ pub struct FpRoundPack<
     out_valid_r: DFF<Bit>,
     // Format constants.
     c_man_bits: Constant<Bits<8>>,
-    c_carry_pos: Constant<Bits<8>>,
     c_exp_sign_pos: Constant<Bits<8>>,
     c_exp_max: Constant<Bits<X2>>,
     c_qnan: Constant<Bits<W>>,
@@ -96,6 +99,7 @@ impl<
             out_valid: Default::default(),
             result: Default::default(),
             sig_rounded: Default::default(),
+            carry: Default::default(),
             exp_final: Default::default(),
             rnd_sig: Default::default(),
             rnd_exp: Default::default(),
@@ -110,7 +114,6 @@ impl<
             out_result: Default::default(),
             out_valid_r: Default::default(),
             c_man_bits: const_index(M),
-            c_carry_pos: const_index(S),
             c_exp_sign_pos: const_index(X2 - 1),
             c_exp_max: const_bits::<X2>((1 << E) - 1),
             c_qnan: const_bits::<W>(qnan_word(E, M)),
@@ -144,13 +147,12 @@ impl<
             out_result,
             out_valid_r
         );
-        // A carry out of rounding leaves the mantissa field zero and bumps the exponent.
+        // A carry out of rounding leaves the mantissa field zero and bumps the exponent. The
+        // increment carries out exactly when the significand is all ones and rounds up: bit
+        // `S` of `sig_rounded`, formed without the increment's chain.
         self.sig_rounded.next = bit_cast::<S1, S>(self.sig.val()) + self.round_up.val();
-        self.exp_final.next = self.exp.val()
-            + self
-                .sig_rounded
-                .val()
-                .get_bit(self.c_carry_pos.val().index());
+        self.carry.next = self.sig.val().all() & self.round_up.val();
+        self.exp_final.next = self.exp.val() + self.carry.val();
         // Registered: the rounded significand and exponent (splits the logic depth).
         self.rnd_sig.d.next = self.sig_rounded.val();
         self.rnd_exp.d.next = self.exp_final.val();
