@@ -626,8 +626,8 @@ impl<
         // The top bit of the sum weighs 2^(big_exp + 1). The rounding's carry out (bit S of
         // `sig_rounded`) is read off `sig` (all ones, rounding up), beside the increment.
         self.carry.next = self.sig.val().all() & self.round_up.val();
-        self.exp_final.next = ((bit_cast::<X2, E>(self.exp4.q.val()) + 1) - self.lz.q.val())
-            + self.carry.val();
+        self.exp_final.next =
+            ((bit_cast::<X2, E>(self.exp4.q.val()) + 1) - self.lz.q.val()) + self.carry.val();
         // Stage 7, registered: the rounded significand and exponent (splits the logic depth).
         self.rnd_sig.d.next = self.sig_rounded.val();
         self.rnd_exp.d.next = self.exp_final.val();
