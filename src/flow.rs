@@ -226,7 +226,7 @@ pub fn generate_rtl(
         twin: predicted,
         period,
     } = prepare(scene, f, params, frames)?;
-    let (rtl, tb) = write_processor_files(
+    let written = write_processor_files(
         &program,
         &layouts,
         params,
@@ -240,10 +240,9 @@ pub fn generate_rtl(
     let ucf = constraints.join("dynrt.ucf");
     let info = &layouts[0].info;
     let display = display_mode(info.width, info.height)?;
-    let ports = crate::emit::processor::processor_ports(&program, params)?;
     write_ucf(
         &ucf,
-        &processor_ports(&ports, &display),
+        &processor_ports(&written.ports, &display),
         &UcfOptions::default(),
     )?;
     let listing = out.join("program.lst");
@@ -252,7 +251,13 @@ pub fn generate_rtl(
     Ok(RtlReport {
         program,
         frames: layouts.len(),
-        files: vec![rtl, tb, ucf, listing, out.join("mem")],
+        files: vec![
+            written.rtl,
+            written.testbench,
+            ucf,
+            listing,
+            out.join("mem"),
+        ],
         predicted,
         period,
     })

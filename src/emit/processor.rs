@@ -78,7 +78,6 @@ fn processor_verilog<
     program: &Program,
     params: ProcessorParams,
     mode: &VgaMode,
-    verilog: bool,
 ) -> Result<(String, Vec<TopPort>)> {
     let mut uut = Processor::<W, E, M, S, S1, X2, T, P, DX, DL>::new(
         program,
@@ -87,13 +86,7 @@ fn processor_verilog<
         mode,
     )?;
     uut.connect_all();
-    let ports = uut.ports();
-    let text = if verilog {
-        generate_verilog(&uut)
-    } else {
-        String::new()
-    };
-    Ok((text, ports))
+    Ok((generate_verilog(&uut), uut.ports()))
 }
 
 /// Runs `f` on a thread with a 256 MB stack: rust-hdl builds and prints the design by
@@ -160,7 +153,7 @@ fn name_top_ports(verilog: &str, ports: &[TopPort]) -> Result<String> {
         .map(|p| (p.hdl_name.clone(), p.name.clone()))
         .collect();
     for module in verilog.split("\nmodule ") {
-        let names = identifiers(module);
+        let names = own_identifiers(module);
         for (hdl, clean) in &renames {
             anyhow::ensure!(
                 !(names.contains(hdl.as_str()) && names.contains(clean.as_str())),
@@ -170,40 +163,18 @@ fn name_top_ports(verilog: &str, ports: &[TopPort]) -> Result<String> {
             );
         }
     }
-    Ok(super::verilog_tidy::rename_identifiers(verilog, |w| {
+    Ok(super::verilog_tidy::map_identifiers(verilog, |w| {
         renames.get(w).cloned()
     }))
 }
 
 /// The identifiers a module declares or uses, without the child ports named in its
 /// instantiations (`.port(...)`: those are the child's names, not this module's).
-fn identifiers(verilog: &str) -> std::collections::HashSet<&str> {
-    let is_ident = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '$';
-    let mut names = std::collections::HashSet::new();
-    let mut rest = verilog;
-    while let Some(start) = rest.find(is_ident) {
-        let len = rest[start..]
-            .find(|c| !is_ident(c))
-            .unwrap_or(rest.len() - start);
-        if !rest[..start].ends_with('.') {
-            names.insert(&rest[start..start + len]);
-        }
-        rest = &rest[start + len..];
-    }
-    names
-}
-
-/// The processor's top ports, as [`processor_rtl`] names them (without generating the
-/// Verilog).
-pub fn processor_ports(program: &Program, params: ProcessorParams) -> Result<Vec<TopPort>> {
-    let mode = display_mode(program.config.width, program.config.height)?;
-    let (_, ports) = on_large_stack(|| {
-        dispatch_engine_format!(
-            program.config.format,
-            processor_verilog(program, params, &mode, false)
-        )
-    })??;
-    Ok(ports)
+fn own_identifiers(module: &str) -> std::collections::HashSet<&str> {
+    super::verilog_tidy::identifiers(module)
+        .filter(|&(at, _)| !module[..at].ends_with('.'))
+        .map(|(_, word)| word)
+        .collect()
 }
 
 /// The processor's Verilog (one file, top module [`PROCESSOR_TOP`]).
@@ -232,9 +203,8 @@ pub fn processor_rtl(
         crate::hw::engine::SCRATCH_WORDS
     );
     let mode = display_mode(program.config.width, program.config.height)?;
-    let (verilog, ports) = on_large_stack(|| {
-        dispatch_engine_format!(f, processor_verilog(program, params, &mode, true))
-    })??;
+    let (verilog, ports) =
+        on_large_stack(|| dispatch_engine_format!(f, processor_verilog(program, params, &mode)))??;
     let verilog = merge_identical_modules(&rename_rust_hdl_names(
         &name_top_ports(&verilog, &ports)?,
         PROCESSOR_TOP,

@@ -7,40 +7,46 @@
 //! copy of modules whose text differs only in their name (e.g. the 25-bit pipeline registers of
 //! a divider), which shrinks files and simulator build times without changing behaviour.
 
-/// Rewrites every identifier of `verilog` for which `f` returns a replacement. Identifiers are
-/// maximal runs of `[A-Za-z0-9_$]` starting with a letter or `_` (so `$signed` and the digits
-/// of sized literals such as `8'hff` are left alone).
-fn map_identifiers(verilog: &str, f: impl Fn(&str) -> Option<String>) -> String {
-    let mut out = String::with_capacity(verilog.len() + verilog.len() / 8);
+/// The identifiers of `verilog`, each with its byte offset: maximal runs of `[A-Za-z0-9_$]`
+/// starting with a letter or `_` (so `$signed` and the digits of sized literals such as
+/// `8'hff` are left out).
+pub fn identifiers(verilog: &str) -> impl Iterator<Item = (usize, &str)> {
     let bytes = verilog.as_bytes();
     let is_ident = |c: u8| c.is_ascii_alphanumeric() || c == b'_' || c == b'$';
     let mut i = 0;
+    std::iter::from_fn(move || {
+        while i < bytes.len() {
+            let c = bytes[i];
+            let starts_ident = (c.is_ascii_alphabetic() || c == b'_')
+                && (i == 0 || !(is_ident(bytes[i - 1]) || bytes[i - 1] == b'\''));
+            if !starts_ident {
+                i += 1;
+                continue;
+            }
+            let start = i;
+            while i < bytes.len() && is_ident(bytes[i]) {
+                i += 1;
+            }
+            return Some((start, &verilog[start..i]));
+        }
+        None
+    })
+}
+
+/// Rewrites every identifier of `verilog` (see [`identifiers`]) for which `f` returns a
+/// replacement.
+pub fn map_identifiers(verilog: &str, f: impl Fn(&str) -> Option<String>) -> String {
+    let mut out = String::with_capacity(verilog.len() + verilog.len() / 8);
     let mut copied = 0;
-    while i < bytes.len() {
-        let c = bytes[i];
-        let starts_ident = (c.is_ascii_alphabetic() || c == b'_')
-            && (i == 0 || !(is_ident(bytes[i - 1]) || bytes[i - 1] == b'\''));
-        if !starts_ident {
-            i += 1;
-            continue;
-        }
-        let start = i;
-        while i < bytes.len() && is_ident(bytes[i]) {
-            i += 1;
-        }
-        if let Some(new) = f(&verilog[start..i]) {
+    for (start, word) in identifiers(verilog) {
+        if let Some(new) = f(word) {
             out.push_str(&verilog[copied..start]);
             out.push_str(&new);
-            copied = i;
+            copied = start + word.len();
         }
     }
     out.push_str(&verilog[copied..]);
     out
-}
-
-/// Rewrites every identifier for which `f` returns a new name (see `map_identifiers`).
-pub fn rename_identifiers(verilog: &str, f: impl Fn(&str) -> Option<String>) -> String {
-    map_identifiers(verilog, f)
 }
 
 /// Renames rust-hdl's module `top` to `core_name`, its sub-modules `top$x$y` to

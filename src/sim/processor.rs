@@ -11,6 +11,7 @@ use crate::emit::memory_images::{write_frame_update, write_memory_images};
 use crate::emit::processor::{
     display_mode, processor_rtl, processor_testbench, ProcessorParams, TestbenchFrames,
 };
+use crate::hw::processor::TopPort;
 use crate::hw::program::Program;
 use crate::layout::Layout;
 use crate::output::write_atomically;
@@ -44,7 +45,7 @@ pub struct ProcessorSim {
 
 /// Writes everything a simulation of `layouts` (frame 0, 1, ...) needs into `dir`: the
 /// processor Verilog (`rtl/dynrt_processor.v`), the testbench (`testbench/tb.v`) and the
-/// memory images (`mem/`). Returns the two Verilog paths.
+/// memory images (`mem/`).
 pub fn write_processor_files(
     program: &Program,
     layouts: &[Layout],
@@ -52,7 +53,7 @@ pub fn write_processor_files(
     scene_name: &str,
     cycle_limit: u64,
     dir: &Path,
-) -> Result<(PathBuf, PathBuf)> {
+) -> Result<ProcessorFiles> {
     let first = layouts.first().context("no frame to simulate")?;
     let (rtl_dir, tb_dir, mem_dir) = (dir.join("rtl"), dir.join("testbench"), dir.join("mem"));
     for d in [&rtl_dir, &tb_dir, &mem_dir] {
@@ -101,7 +102,20 @@ pub fn write_processor_files(
         processor_testbench(params, &frames, &rtl.ports)?.as_bytes(),
     )
     .with_context(|| format!("writing {}", tb_path.display()))?;
-    Ok((rtl_path, tb_path))
+    Ok(ProcessorFiles {
+        rtl: rtl_path,
+        testbench: tb_path,
+        ports: rtl.ports,
+    })
+}
+
+/// What [`write_processor_files`] wrote: the two Verilog files, and the processor's top ports
+/// (for the constraints file).
+#[derive(Clone, Debug)]
+pub struct ProcessorFiles {
+    pub rtl: PathBuf,
+    pub testbench: PathBuf,
+    pub ports: Vec<TopPort>,
 }
 
 /// How to run a processor simulation.
@@ -129,13 +143,13 @@ pub fn simulate_processor(
         cycle_limit,
         capture_vga,
     } = run;
-    let (rtl, tb) = write_processor_files(program, layouts, params, scene_name, cycle_limit, dir)?;
+    let files = write_processor_files(program, layouts, params, scene_name, cycle_limit, dir)?;
     for k in 0..layouts.len() {
         let _ = std::fs::remove_file(dir.join(format!("frame{k}.hex")));
     }
     let vga_path = dir.join("vga.hex");
     let _ = std::fs::remove_file(&vga_path);
-    let mut job = SimJob::new(dir, vec![rtl, tb], "tb")
+    let mut job = SimJob::new(dir, vec![files.rtl, files.testbench], "tb")
         .timeout(Duration::from_secs(3600))
         .verilator_build(VerilatorBuild::Fast);
     if capture_vga {

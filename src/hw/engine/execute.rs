@@ -17,7 +17,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::{op_code, FastKind};
+use super::{bank, op_code, tri_fn, FastKind};
 use crate::hw::program::isa::{Op, TriFn, BANK_BITS, OP_BITS, PC_BITS, SHIFT_BITS};
 use crate::hw::UIntToFloat;
 use crate::layout;
@@ -75,8 +75,6 @@ pub struct Execute<const W: usize, const E: usize, const M: usize> {
 
 impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M> {
     fn default() -> Self {
-        let tri_fn = |f: TriFn| Constant::new((f as u64).into());
-        let bank = |b: usize| Constant::new((b as u64).into());
         Self {
             op: Default::default(),
             a: Default::default(),
