@@ -4,7 +4,7 @@
 //! seen, and hands the tests on to the tester's launch in a second queue. A leaf costs the
 //! thread one engine turn (`tri.list`) instead of five per triangle.
 //!
-//! Engine side (the engine's I3): `enqueue` offers a command of `thread`, taken when `full`
+//! Engine side (the engine's I4): `enqueue` offers a command of `thread`, taken when `full`
 //! is low in that clock. Commands by `kind`: [`CMD_LIST`] the list `word_a..word_b` (bank-1
 //! word addresses); [`CMD_INIT`] a new query (passed on as it is; it empties the thread's mailbox); [`CMD_OBJECT`] the object
 //! (instance) `word_a` the next lists belong to, which empties the thread's mailbox;
@@ -23,9 +23,10 @@
 //!
 //! State machine: idle (apply object and skip commands, pass inits on, take a list: 1 clock
 //! each), load the thread's mailbox, object and skip (2 clocks), walk: one list word a clock
-//! while the test queue has room for the words in flight. The mailbox check and update is one
-//! clock on the word's arrival ([`units::Mailbox`]: the first `len` of 8 ids, first in first
-//! out), so a list of n words takes about `n + 3 + mem_latency` clocks (latency) at one list
+//! while the test queue has room for the words in flight. A word is compared with the
+//! mailbox on its arrival and checked and recorded the clock after ([`units::Mailbox`]: the
+//! first `len` of 8 ids, first in first out; the slot written in between is compared with the
+//! word before), so a list of n words takes about `n + 4 + mem_latency` clocks (latency) at one list
 //! word per clock (throughput); a thread has at most one list queued (it waits for its tests
 //! before the next).
 //!
@@ -111,6 +112,15 @@ pub struct ListUnit {
     queued: DFF<Bits<4>>,
     /// Request valid per clock of SRAM latency.
     flight_line: [DFF<Bit>; 6],
+    /// The word that arrived last clock (`arrive_r`) and what was compared on its arrival:
+    /// each mailbox id against it, the skipped pair, the word before it (then in this stage);
+    /// the mailbox slot this stage wrote last clock, which the compare did not see yet.
+    arrive_r: DFF<Bit>,
+    word_r: DFF<Bits<32>>,
+    hit_r: [DFF<Bit>; 8],
+    skip_r: DFF<Bit>,
+    same_r: DFF<Bit>,
+    wrote_r: [DFF<Bit>; 8],
     take: Signal<Local, Bit>,
     arrive: Signal<Local, Bit>,
     seen: Signal<Local, Bit>,
@@ -188,6 +198,12 @@ impl ListUnit {
             flight: Default::default(),
             queued: Default::default(),
             flight_line: Default::default(),
+            arrive_r: Default::default(),
+            word_r: Default::default(),
+            hit_r: Default::default(),
+            skip_r: Default::default(),
+            same_r: Default::default(),
+            wrote_r: Default::default(),
             take: Default::default(),
             arrive: Default::default(),
             seen: Default::default(),
@@ -227,7 +243,11 @@ impl Logic for ListUnit {
             mb_len,
             mb_next,
             flight,
-            queued
+            queued,
+            arrive_r,
+            word_r,
+            skip_r,
+            same_r
         );
         clock!(self, clock, commands, tests);
         self.object_ram.read_clock.next = self.clock.val();
@@ -243,6 +263,9 @@ impl Logic for ListUnit {
             self.mailbox_ids[k].write_clock.next = self.clock.val();
             self.ids[k].clock.next = self.clock.val();
             self.ids[k].d.next = self.ids[k].q.val();
+            self.hit_r[k].clock.next = self.clock.val();
+            self.wrote_r[k].clock.next = self.clock.val();
+            self.wrote_r[k].d.next = false;
         }
         for k in 0..6 {
             self.flight_line[k].clock.next = self.clock.val();
@@ -286,7 +309,7 @@ impl Logic for ListUnit {
         for k in 0..8 {
             self.mailbox_ids[k].read_address.next = self.walk_thread.q.val();
             self.mailbox_ids[k].write_address.next = self.walk_thread.q.val();
-            self.mailbox_ids[k].write_data.next = self.list_rdata.val();
+            self.mailbox_ids[k].write_data.next = self.word_r.q.val();
             self.mailbox_ids[k].write_enable.next = false;
         }
 
@@ -341,8 +364,11 @@ impl Logic for ListUnit {
         // list's end entry; the engine's loads of banks 1, 4 and 5 take the bus first.
         self.take.next = (self.phase.q.val() == ListPhase::Walk)
             & (self.cursor.q.val() != self.list_end.q.val())
-            // (of the queue's 8: the words in flight and the end entry)
-            & ((bit_cast::<5, 4>(self.queued.q.val()) + bit_cast::<5, 4>(self.flight.q.val())) < 7)
+            // (of the queue's 8: the words in flight or being checked and the end entry)
+            & ((bit_cast::<5, 4>(self.queued.q.val())
+                + bit_cast::<5, 4>(self.flight.q.val())
+                + bit_cast::<5, 1>(self.arrive_r.q.val().into()))
+                < 7)
             & (!(self.engine_read.val()
                 & (self.engine_bank.val() != self.c_bank_nodes.val())
                 & (self.engine_bank.val() != self.c_bank_uv.val())
@@ -370,20 +396,34 @@ impl Logic for ListUnit {
             self.flight.d.next = self.flight.q.val() - 1;
         }
 
-        // A word arrives: skip the query's own triangle, then the mailbox (hit: the first
-        // `len` ids; miss: record it first in, first out).
+        // A word arrives: compare it with the mailbox's ids, the skipped pair and the word
+        // being checked, and check it the clock after (two 32-bit compares and the mailbox
+        // update do not fit one clock).
+        self.arrive_r.d.next = self.arrive.val();
+        self.word_r.d.next = self.list_rdata.val();
+        for k in 0..8 {
+            self.hit_r[k].d.next = self.ids[k].q.val() == self.list_rdata.val();
+        }
+        self.skip_r.d.next = (self.list_rdata.val() == self.skip_triangle.q.val())
+            & (self.object_id.q.val() == self.skip_object.q.val());
+        self.same_r.d.next = self.list_rdata.val() == self.word_r.q.val();
+
+        // The word is checked: skip the query's own triangle, then the mailbox (hit: the
+        // first `len` ids, where the slot written last clock holds the word before; miss:
+        // record it first in, first out).
         self.seen.next = false;
         for k in 0..8 {
-            if (self.c_index[k].val() < self.mb_len.q.val())
-                & (self.ids[k].q.val() == self.list_rdata.val())
-            {
-                self.seen.next = true;
+            if self.c_index[k].val() < self.mb_len.q.val() {
+                if self.wrote_r[k].q.val() {
+                    if self.same_r.q.val() {
+                        self.seen.next = true;
+                    }
+                } else if self.hit_r[k].q.val() {
+                    self.seen.next = true;
+                }
             }
         }
-        self.fresh.next = self.arrive.val()
-            & (!self.seen.val())
-            & (!((self.list_rdata.val() == self.skip_triangle.q.val())
-                & (self.object_id.q.val() == self.skip_object.q.val())));
+        self.fresh.next = self.arrive_r.q.val() & (!self.seen.val()) & (!self.skip_r.q.val());
         self.next_after.next = self.mb_next.q.val() + 1;
         self.len_after.next = self.mb_len.q.val();
         if self.mb_len.q.val() != 8 {
@@ -392,12 +432,13 @@ impl Logic for ListUnit {
         if self.fresh.val() {
             self.push.next = true;
             self.tests.data_in.next = (bit_cast::<71, 5>(self.walk_thread.q.val()) << 64)
-                | (bit_cast::<71, 32>(self.list_rdata.val()) << 32)
+                | (bit_cast::<71, 32>(self.word_r.q.val()) << 32)
                 | bit_cast::<71, 32>(self.object_id.q.val());
             for k in 0..8 {
                 if bit_cast::<4, 3>(self.mb_next.q.val()) == self.c_index[k].val() {
-                    self.ids[k].d.next = self.list_rdata.val();
+                    self.ids[k].d.next = self.word_r.q.val();
                     self.mailbox_ids[k].write_enable.next = true;
+                    self.wrote_r[k].d.next = true;
                 }
             }
             self.mb_next.d.next = self.next_after.val();
@@ -406,10 +447,12 @@ impl Logic for ListUnit {
             self.mailbox_meta.write_data.next = (bit_cast::<8, 3>(self.next_after.val()) << 4)
                 | bit_cast::<8, 4>(self.len_after.val());
         }
-        // The list is done when every word has arrived: its end entry follows its tests.
+        // The list is done when every word has arrived and been checked: its end entry
+        // follows its tests.
         if (self.phase.q.val() == ListPhase::Walk)
             & (self.cursor.q.val() == self.list_end.q.val())
             & (self.flight.q.val() == 0)
+            & (!self.arrive_r.q.val())
             & (!self.tests.full.val())
         {
             self.push.next = true;

@@ -1,22 +1,29 @@
-//! `Decode`: the engine's stages I2 and I3 up to the operands. It reads the instruction's two
+//! `Decode`: the engine's stages I2 to I4 up to the operands. It reads the instruction's two
 //! source registers from the register file (one block RAM per read port, both written by the
-//! write back), splits the ROM words into their fields and selects the operands.
+//! write back), selects the operands as the block RAMs' words arrive (I3) and registers them,
+//! and splits the ROM words into their fields.
 //!
 //! Contract: an instruction at I2 (`valid`, `thread`, `pc`, `ctl`, `imm`, `aux` from
-//! [`super::Fetch`]) comes out at I3 with its fields and operands: `a` is register `A` (r0
+//! [`super::Fetch`]) comes out at I4 with its fields and operands: `a` is register `A` (r0
 //! reads 0), `b` the immediate when `B_IMM` is set, else register `B`; `store` is register
-//! `B` as read (the data of `st` and `sts`). The field offsets are `isa::CTL_*` and
-//! `isa::AUX_*`, the one encoding `isa::Instr::encode` writes into the ROM. The write back
-//! writes `wb_data` to `wb_dst` of `wb_thread` when `wb_write` is set.
+//! `B` as read (the data of `st` and `sts`). At I3 it shows the instruction's `valid_i3`,
+//! `op_i3`, `thread_i3`, `imm_i3` and `long_i3` (an `fdiv` or `fsqrt`), for the units that
+//! read per-thread state, and the glue that decodes coprocessor functions, one clock ahead of
+//! the operands. The field offsets are `isa::CTL_*` and `isa::AUX_*`, the one
+//! encoding `isa::Instr::encode` writes into the ROM. The write back writes `wb_data` to
+//! `wb_dst` of `wb_thread` when `wb_write` is set.
 //!
-//! Latency: 1 clock (the register read). Throughput: one instruction per clock.
+//! Latency: 2 clocks (the register read, then a register after the operand select: the block
+//! RAMs' clock-to-out, about 6 ns on an ECP5, leaves no room for the integer unit behind it
+//! in one clock). Throughput: one instruction per clock.
 //!
 //! Golden twin: `isa::Instr::decode` (the fields) and `hw::program::exec` (operands: r0 reads
 //! 0, `b` or the immediate).
 
 use rust_hdl::prelude::*;
 
-use crate::hw::program::isa::{self, BANK_BITS, OP_BITS, PC_BITS, REG_BITS, SHIFT_BITS};
+use super::op_code;
+use crate::hw::program::isa::{self, Op, BANK_BITS, OP_BITS, PC_BITS, REG_BITS, SHIFT_BITS};
 
 #[derive(LogicBlock)]
 pub struct Decode {
@@ -28,7 +35,14 @@ pub struct Decode {
     pub ctl_i2: Signal<In, Bits<32>>,
     pub imm_i2: Signal<In, Bits<32>>,
     pub aux_i2: Signal<In, Bits<32>>,
-    /// I3: the instruction's fields and operands.
+    /// I3: the instruction (`valid_i3`, its opcode, thread and immediate) and whether it is
+    /// `fdiv` or `fsqrt`.
+    pub valid_i3: Signal<Out, Bit>,
+    pub op_i3: Signal<Out, Bits<OP_BITS>>,
+    pub thread_i3: Signal<Out, Bits<5>>,
+    pub long_i3: Signal<Out, Bit>,
+    pub imm_i3: Signal<Out, Bits<32>>,
+    /// I4: the instruction's fields and operands.
     pub valid: Signal<Out, Bit>,
     pub thread: Signal<Out, Bits<5>>,
     pub pc: Signal<Out, Bits<PC_BITS>>,
@@ -57,6 +71,15 @@ pub struct Decode {
     ctl3: DFF<Bits<32>>,
     imm3: DFF<Bits<32>>,
     aux3: DFF<Bits<32>>,
+    v4: DFF<Bit>,
+    t4: DFF<Bits<5>>,
+    pc4: DFF<Bits<PC_BITS>>,
+    ctl4: DFF<Bits<32>>,
+    imm4: DFF<Bits<32>>,
+    aux4: DFF<Bits<32>>,
+    a4: DFF<Bits<32>>,
+    b4: DFF<Bits<32>>,
+    store4: DFF<Bits<32>>,
     reg_a: Signal<Local, Bits<REG_BITS>>,
     reg_b: Signal<Local, Bits<REG_BITS>>,
     wb_address: Signal<Local, Bits<13>>,
@@ -71,6 +94,8 @@ pub struct Decode {
     f_shift: Constant<Bits<5>>,
     f_bank: Constant<Bits<5>>,
     f_target: Constant<Bits<5>>,
+    op_fdiv: Constant<Bits<5>>,
+    op_fsqrt: Constant<Bits<5>>,
 }
 
 fn field(at: usize) -> Constant<Bits<5>> {
@@ -99,6 +124,11 @@ impl Decode {
             shift: Default::default(),
             bank: Default::default(),
             target: Default::default(),
+            valid_i3: Default::default(),
+            op_i3: Default::default(),
+            thread_i3: Default::default(),
+            long_i3: Default::default(),
+            imm_i3: Default::default(),
             a: Default::default(),
             b: Default::default(),
             store: Default::default(),
@@ -114,6 +144,15 @@ impl Decode {
             ctl3: Default::default(),
             imm3: Default::default(),
             aux3: Default::default(),
+            v4: Default::default(),
+            t4: Default::default(),
+            pc4: Default::default(),
+            ctl4: Default::default(),
+            imm4: Default::default(),
+            aux4: Default::default(),
+            a4: Default::default(),
+            b4: Default::default(),
+            store4: Default::default(),
             reg_a: Default::default(),
             reg_b: Default::default(),
             wb_address: Default::default(),
@@ -126,6 +165,8 @@ impl Decode {
             f_shift: field(isa::AUX_SHIFT),
             f_bank: field(isa::AUX_BANK),
             f_target: field(isa::AUX_TARGET),
+            op_fdiv: op_code(Op::FDiv),
+            op_fsqrt: op_code(Op::FSqrt),
         }
     }
 }
@@ -133,7 +174,10 @@ impl Decode {
 impl Logic for Decode {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, v3, t3, pc3, ctl3, imm3, aux3);
+        dff_setup!(
+            self, clock, v3, t3, pc3, ctl3, imm3, aux3, v4, t4, pc4, ctl4, imm4, aux4, a4, b4,
+            store4
+        );
         self.regs_a.read_clock.next = self.clock.val();
         self.regs_a.write_clock.next = self.clock.val();
         self.regs_b.read_clock.next = self.clock.val();
@@ -159,37 +203,34 @@ impl Logic for Decode {
         self.imm3.d.next = self.imm_i2.val();
         self.aux3.d.next = self.aux_i2.val();
 
-        // I3: fields and operands (r0 always reads 0).
-        self.valid.next = self.v3.q.val();
-        self.thread.next = self.t3.q.val();
-        self.pc.next = self.pc3.q.val();
-        self.op.next = self
+        // I3: the operands (r0 always reads 0) as the register words arrive.
+        self.valid_i3.next = self.v3.q.val();
+        self.op_i3.next = self
             .ctl3
             .q
             .val()
             .get_bits::<OP_BITS>(self.f_op.val().index());
-        self.dst.next = self
-            .ctl3
-            .q
-            .val()
-            .get_bits::<REG_BITS>(self.f_dst.val().index());
-        self.invert.next = self.ctl3.q.val().get_bit(self.f_invert.val().index());
-        self.imm.next = self.imm3.q.val();
-        self.shift.next = self
-            .aux3
-            .q
-            .val()
-            .get_bits::<SHIFT_BITS>(self.f_shift.val().index());
-        self.bank.next = self
-            .aux3
-            .q
-            .val()
-            .get_bits::<BANK_BITS>(self.f_bank.val().index());
-        self.target.next = self
-            .aux3
-            .q
-            .val()
-            .get_bits::<PC_BITS>(self.f_target.val().index());
+        self.thread_i3.next = self.t3.q.val();
+        self.imm_i3.next = self.imm3.q.val();
+        self.long_i3.next = self.v3.q.val()
+            & ((self
+                .ctl3
+                .q
+                .val()
+                .get_bits::<OP_BITS>(self.f_op.val().index())
+                == self.op_fdiv.val())
+                | (self
+                    .ctl3
+                    .q
+                    .val()
+                    .get_bits::<OP_BITS>(self.f_op.val().index())
+                    == self.op_fsqrt.val()));
+        self.v4.d.next = self.v3.q.val();
+        self.t4.d.next = self.t3.q.val();
+        self.pc4.d.next = self.pc3.q.val();
+        self.ctl4.d.next = self.ctl3.q.val();
+        self.imm4.d.next = self.imm3.q.val();
+        self.aux4.d.next = self.aux3.q.val();
         if self
             .ctl3
             .q
@@ -197,12 +238,12 @@ impl Logic for Decode {
             .get_bits::<REG_BITS>(self.f_a.val().index())
             == 0
         {
-            self.a.next = 0.into();
+            self.a4.d.next = 0.into();
         } else {
-            self.a.next = self.regs_a.read_data.val();
+            self.a4.d.next = self.regs_a.read_data.val();
         }
         if self.ctl3.q.val().get_bit(self.f_b_imm.val().index()) {
-            self.b.next = self.imm3.q.val();
+            self.b4.d.next = self.imm3.q.val();
         } else if self
             .ctl3
             .q
@@ -210,11 +251,46 @@ impl Logic for Decode {
             .get_bits::<REG_BITS>(self.f_b.val().index())
             == 0
         {
-            self.b.next = 0.into();
+            self.b4.d.next = 0.into();
         } else {
-            self.b.next = self.regs_b.read_data.val();
+            self.b4.d.next = self.regs_b.read_data.val();
         }
-        self.store.next = self.regs_b.read_data.val();
+        self.store4.d.next = self.regs_b.read_data.val();
+
+        // I4: the fields and operands.
+        self.valid.next = self.v4.q.val();
+        self.thread.next = self.t4.q.val();
+        self.pc.next = self.pc4.q.val();
+        self.op.next = self
+            .ctl4
+            .q
+            .val()
+            .get_bits::<OP_BITS>(self.f_op.val().index());
+        self.dst.next = self
+            .ctl4
+            .q
+            .val()
+            .get_bits::<REG_BITS>(self.f_dst.val().index());
+        self.invert.next = self.ctl4.q.val().get_bit(self.f_invert.val().index());
+        self.imm.next = self.imm4.q.val();
+        self.shift.next = self
+            .aux4
+            .q
+            .val()
+            .get_bits::<SHIFT_BITS>(self.f_shift.val().index());
+        self.bank.next = self
+            .aux4
+            .q
+            .val()
+            .get_bits::<BANK_BITS>(self.f_bank.val().index());
+        self.target.next = self
+            .aux4
+            .q
+            .val()
+            .get_bits::<PC_BITS>(self.f_target.val().index());
+        self.a.next = self.a4.q.val();
+        self.b.next = self.b4.q.val();
+        self.store.next = self.store4.q.val();
 
         // Write back.
         self.wb_address.next = (bit_cast::<13, 5>(self.wb_thread.val()) << 8)

@@ -1,17 +1,17 @@
-//! `Execute`: the engine's single-clock work at I3. It computes the integer, conversion,
+//! `Execute`: the engine's single-clock work at I4. It computes the integer, conversion,
 //! link, pixel and coprocessor-reading results (the *fast* result), the integer conditions,
 //! and the addresses of loads, stores and scratch accesses, and names where a load's data
 //! will come from.
 //!
 //! Contract: from an instruction's `op`, operands `a`, `b`, `imm`, `shift`, `bank` and `pc`
-//! at I3: `fast` is `add`/`sub`/`and`/`or`/`xor`/`shr`/`shl` of `a` and `b`, `itof a`, `jal`'s
+//! at I4: `fast` is `add`/`sub`/`and`/`or`/`xor`/`shr`/`shl` of `a` and `b`, `itof a`, `jal`'s
 //! link `pc + 1`, `byte`'s `b << 8` (the unit's byte joins it at the write back), the
 //! pixel word, or what `tri.wait`/`tri.hit`/`tri.instance`/`tri.triangle` read from the
 //! triangle tester; `kind` says whether the result line fills in a scratch or memory word
 //! later (`ld` by its bank, `lds`). `mem_address = (a << shift) + imm` (loads and frame-buffer
 //! stores), `scratch_address = a + imm`; `int_eq`, `int_lt`: `a == b`, `a < b` unsigned.
 //!
-//! Latency: combinational (I3). Throughput: one instruction per clock.
+//! Latency: combinational (I4). Throughput: one instruction per clock.
 //!
 //! Golden twin: `hw::program::exec` (the engine's twin), the same operations per opcode.
 
@@ -24,7 +24,7 @@ use crate::layout;
 
 #[derive(LogicBlock)]
 pub struct Execute<const W: usize, const E: usize, const M: usize> {
-    /// I3: the instruction.
+    /// I4: the instruction.
     pub op: Signal<In, Bits<OP_BITS>>,
     pub a: Signal<In, Bits<32>>,
     pub b: Signal<In, Bits<32>>,
@@ -34,7 +34,7 @@ pub struct Execute<const W: usize, const E: usize, const M: usize> {
     pub pc: Signal<In, Bits<PC_BITS>>,
     /// The pixel counter's word.
     pub pixel: Signal<In, Bits<32>>,
-    /// The triangle tester's answers for the thread at I3.
+    /// The triangle tester's answers for the thread at I4.
     pub tester_best_t: Signal<In, Bits<W>>,
     pub tester_hit: Signal<In, Bit>,
     pub tester_instance: Signal<In, Bits<32>>,

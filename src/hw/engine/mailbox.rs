@@ -2,13 +2,13 @@
 //! mailbox 0, instances in mailbox 1), the paper's mailboxing against testing an object
 //! twice, for the `mbx` (test and insert) and `mbc` (clear) instructions.
 //!
-//! Contract: the mailbox `which` of a thread is read at I2 (`read_thread`, `read_which`). At
-//! I3 `hit` is set when `value` is one of its first `len` entries; `insert` (an `mbx`) puts a
+//! Contract: the mailbox `which` of a thread is read at I3 (`read_thread`, `read_which`). At
+//! I4 `hit` is set when `value` is one of its first `len` entries; `insert` (an `mbx`) puts a
 //! value that missed in the next slot, round robin, and `clear` (an `mbc`) empties the
 //! mailbox. Entries start undefined and count only below `len`.
 //!
-//! Latency: the hit is ready at I3, one clock after the read; the update is written at the
-//! end of I3. A thread issues at most once per `ENGINE_LATENCY + 4` clocks, so its next read
+//! Latency: the hit is ready at I4, one clock after the read; the update is written at the
+//! end of I4. A thread issues at most once per `engine_period` clocks, so its next read
 //! sees the update. Throughput: one instruction per clock.
 //!
 //! Golden twin: [`crate::units::Mailbox`] (`seen` is `mbx`; a new mailbox is `mbc`), which the
@@ -21,10 +21,10 @@ use crate::units::MAILBOX_ENTRIES;
 #[derive(LogicBlock)]
 pub struct MailboxUnit {
     pub clock: Signal<In, Clock>,
-    /// I2: which thread's mailbox (`read_which`: 0 triangles, 1 instances) to read.
+    /// I3: which thread's mailbox (`read_which`: 0 triangles, 1 instances) to read.
     pub read_thread: Signal<In, Bits<5>>,
     pub read_which: Signal<In, Bit>,
-    /// I3: the instruction's thread, mailbox, value (operand A) and what it does.
+    /// I4: the instruction's thread, mailbox, value (operand A) and what it does.
     pub thread: Signal<In, Bits<5>>,
     pub which: Signal<In, Bit>,
     pub value: Signal<In, Bits<32>>,
@@ -79,7 +79,7 @@ impl Logic for MailboxUnit {
             self.entries[k].read_clock.next = self.clock.val();
             self.entries[k].write_clock.next = self.clock.val();
         }
-        // I2: read.
+        // I3: read.
         self.read_address.next = (bit_cast::<6, 5>(self.read_thread.val()) << 1)
             | bit_cast::<6, 1>(self.read_which.val().into());
         self.meta.read_address.next = self.read_address.val();
@@ -87,7 +87,7 @@ impl Logic for MailboxUnit {
             self.entries[k].read_address.next = self.read_address.val();
         }
 
-        // I3: a hit when the value is one of the first `len` entries.
+        // I4: a hit when the value is one of the first `len` entries.
         self.len.next = self.meta.read_data.val().get_bits::<4>(0);
         self.next_slot.next = self.meta.read_data.val().get_bits::<3>(4);
         self.found.next = false;
@@ -100,7 +100,7 @@ impl Logic for MailboxUnit {
         }
         self.hit.next = self.found.val();
 
-        // I3: update.
+        // I4: update.
         self.write_address.next =
             (bit_cast::<6, 5>(self.thread.val()) << 1) | bit_cast::<6, 1>(self.which.val().into());
         self.meta.write_address.next = self.write_address.val();

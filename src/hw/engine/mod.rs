@@ -8,7 +8,7 @@
 //! by the other threads (the paper's 32 threads). A long instruction reserves its write-back
 //! clock: the scheduler issues nothing in the one clock whose instruction would write back
 //! with it (one bubble per `fdiv` or `fsqrt`). A thread issues at most once per `period =
-//! ENGINE_LATENCY + 4` (16) clocks (`engine_period`). A thread whose coprocessor wait (`tri.wait`,
+//! OPERAND_STAGE + ENGINE_LATENCY + WAKE_UP` (19) clocks (`engine_period`). A thread whose coprocessor wait (`tri.wait`,
 //! `kd.wait`) is still pending sleeps: it is not ready until the coprocessor finishes work for
 //! it, so the clocks it waits go to the other threads (an offer to a full queue repeats at
 //! once).
@@ -17,16 +17,17 @@
 //! - I0: [`Scheduler`] picks a ready thread.
 //! - I0..I2: [`Fetch`] reads the thread's `{epoch, halted, pc}` (a stale epoch means "new
 //!   frame": pc 0), then the instruction ROM's three words.
-//! - I2..I3: [`Decode`] reads the two source registers and splits the fields; the
-//!   [`MailboxUnit`] reads the thread's mailbox and the triangle tester its state.
-//! - I3: [`Execute`] computes the integer result and the addresses, the [`PixelCounter`]
+//! - I2..I4: [`Decode`] reads the two source registers, selects and registers the operands
+//!   and splits the fields; at I3 the [`MailboxUnit`] reads the thread's mailbox and the
+//!   coprocessors their state of the thread, and a long instruction reserves its write back.
+//! - I4 ([`OPERAND_STAGE`]): [`Execute`] computes the integer result and the addresses, the [`PixelCounter`]
 //!   hands out a pixel, the mailbox tests and updates, [`FpUnits`] take their operands; this
 //!   block drives the memory and frame-buffer ports and offers `tri` and `kd` entries to the
 //!   coprocessors (their answer, refused or pending, makes the thread repeat the instruction
 //!   on its next turn, after a sleep for a wait).
-//! - I4..: the [`ResultLine`]; scratch data joins at I4, memory data at I4 + `mem_latency`.
-//! - I3 + 12 (`I3 + M + 6` for `fdiv`, `fsqrt`, which go on in the long line): the
-//!   [`WriteBack`] writes the register and the next pc: `target` when the condition differs
+//! - I5..: the [`ResultLine`]; scratch data joins at I5, memory data at I5 + `mem_latency`.
+//! - I4 + 12 (`I4 + M + 6` for `fdiv`, `fsqrt`, which go on in the long line): the
+//!   [`WriteBack`] chooses, and a clock later writes, the register and the next pc: `target` when the condition differs
 //!   from `invert` (a non-branching instruction's condition is false, so its `invert` is a jump
 //!   after it), else `pc + 1`; the condition comes from the compare, integer, mailbox, pixel
 //!   unit or triangle tester.
@@ -104,13 +105,21 @@ pub const fn long_latency(m: u32) -> u32 {
     m + 6
 }
 
+/// Clocks from the issue (I0) to the operands (I4): the pc read, the ROM read, the register
+/// read and the operand register.
+pub const OPERAND_STAGE: u32 = 4;
+
+/// Clocks from a write back to the thread's next issue: the write back's register, the
+/// scheduler's ready register and its pick register.
+pub const WAKE_UP: u32 = 3;
+
 /// The clocks of one round of `threads` threads, each issuing once: a thread issues at most
-/// once per `ENGINE_LATENCY + 4` clocks.
+/// once per `OPERAND_STAGE + ENGINE_LATENCY + WAKE_UP` clocks.
 pub fn engine_period(threads: u32) -> u32 {
-    threads.max(ENGINE_LATENCY + 4)
+    threads.max(OPERAND_STAGE + ENGINE_LATENCY + WAKE_UP)
 }
 
-/// Where an instruction's result comes from on the fast line: computed at I3, or the data of
+/// Where an instruction's result comes from on the fast line: computed at I4, or the data of
 /// a scratch read or of a load from the shared memory port or a bank's own port.
 #[derive(Copy, Clone, Debug, PartialEq, LogicState)]
 pub enum FastKind {
@@ -222,22 +231,26 @@ pub struct ThreadEngine<
     fb_write_r: DFF<Bit>,
     fb_addr_r: DFF<Bits<24>>,
     fb_data_r: DFF<Bits<32>>,
-    // The coprocessor glue at I3.
-    is_tri: Signal<Local, Bit>,
-    ray_write: Signal<Local, Bit>,
-    tri_queues: Signal<Local, Bit>,
-    tri_kind: Signal<Local, Bits<2>>,
+    // The coprocessor glue: the function an instruction names, decoded at I3 and registered
+    // for I4 (a 32-bit immediate's compares would otherwise sit in front of the
+    // coprocessors' queues); the answers at I4.
+    ray_write: DFF<Bit>,
+    t_min_write: DFF<Bit>,
+    tri_enqueue: DFF<Bit>,
+    tri_queues: DFF<Bit>,
+    tri_kind: DFF<Bits<2>>,
+    tri_waits: DFF<Bit>,
+    kd_enqueue: DFF<Bit>,
+    kd_waits: DFF<Bit>,
+    wait_fn: DFF<Bit>,
     tri_busy: Signal<Local, Bit>,
     kd_busy: Signal<Local, Bit>,
-    wait_fn: Signal<Local, Bit>,
 
     c_threads: Constant<Bits<8>>,
     // The glue's names, every one from its definition in `isa` (`Op`, `TriFn`, `KdFn`),
     // `layout` (banks) and `list_unit` (command kinds): the Verilog's localparams follow the
     // twin's numbering by construction.
     op_fsub: Constant<Bits<5>>,
-    op_fdiv: Constant<Bits<5>>,
-    op_fsqrt: Constant<Bits<5>>,
     op_ld: Constant<Bits<5>>,
     op_st: Constant<Bits<5>>,
     op_sts: Constant<Bits<5>>,
@@ -285,8 +298,9 @@ impl<
         assert!(P == 2 * S);
         assert!(super::fp::div::div_latency(M as u32) + 1 == long_latency(M as u32));
         assert!(super::fp::sqrt::sqrt_latency(M as u32) + 1 == long_latency(M as u32));
-        // The reservation is made at I3 for an issue `DX - 4` clocks later (I3 + DX - 4 + 3 +
-        // ENGINE_LATENCY = I3 + long_latency).
+        // The reservation is made at I3 for the issue `1 + (DX - 4)` clocks later, whose write
+        // back is the long one's: I3 + 1 + (DX - 4) + OPERAND_STAGE + ENGINE_LATENCY = I4 +
+        // long_latency.
         assert!(DX == (long_latency(M as u32) - ENGINE_LATENCY) as usize && DX >= 4);
         assert!(DL == super::fp::div::div_latency(M as u32) as usize);
         assert!((1..=MAX_THREADS as u32).contains(&threads));
@@ -340,17 +354,19 @@ impl<
             fb_write_r: Default::default(),
             fb_addr_r: Default::default(),
             fb_data_r: Default::default(),
-            is_tri: Default::default(),
             ray_write: Default::default(),
+            t_min_write: Default::default(),
+            tri_enqueue: Default::default(),
             tri_queues: Default::default(),
             tri_kind: Default::default(),
+            tri_waits: Default::default(),
+            kd_enqueue: Default::default(),
+            kd_waits: Default::default(),
+            wait_fn: Default::default(),
             tri_busy: Default::default(),
             kd_busy: Default::default(),
-            wait_fn: Default::default(),
             c_threads: Constant::new(u64::from(threads).into()),
             op_fsub: op_code(Op::FSub),
-            op_fdiv: op_code(Op::FDiv),
-            op_fsqrt: op_code(Op::FSqrt),
             op_ld: op_code(Op::Ld),
             op_st: op_code(Op::St),
             op_sts: op_code(Op::Sts),
@@ -410,7 +426,16 @@ impl<
             mem_addr_r,
             fb_write_r,
             fb_addr_r,
-            fb_data_r
+            fb_data_r,
+            ray_write,
+            t_min_write,
+            tri_enqueue,
+            tri_queues,
+            tri_kind,
+            tri_waits,
+            kd_enqueue,
+            kd_waits,
+            wait_fn
         );
         clock!(
             self,
@@ -422,6 +447,7 @@ impl<
             pixels,
             fp_units,
             result_line,
+            write_back,
             tester,
             traversal_unit
         );
@@ -462,15 +488,15 @@ impl<
         self.decode.ctl_i2.next = self.fetch.ctl.val();
         self.decode.imm_i2.next = self.fetch.imm.val();
         self.decode.aux_i2.next = self.fetch.aux.val();
-        self.mailboxes.read_thread.next = self.fetch.thread.val();
-        self.mailboxes.read_which.next = self.fetch.imm.val().get_bit(0);
-        self.tester.engine.query_thread.next = self.fetch.thread.val();
-        self.traversal_unit.engine.query_thread.next = self.fetch.thread.val();
 
-        // I3.
-        self.scheduler.long_at_i3.next = self.decode.valid.val()
-            & ((self.decode.op.val() == self.op_fdiv.val())
-                | (self.decode.op.val() == self.op_fsqrt.val()));
+        // I3: the per-thread state the units read one clock ahead of the operands.
+        self.mailboxes.read_thread.next = self.decode.thread_i3.val();
+        self.mailboxes.read_which.next = self.decode.imm_i3.val().get_bit(0);
+        self.tester.engine.query_thread.next = self.decode.thread_i3.val();
+        self.traversal_unit.engine.query_thread.next = self.decode.thread_i3.val();
+        self.scheduler.long_at_i3.next = self.decode.long_i3.val();
+
+        // I4.
         self.fp_units.a.next = self.decode.a.val().get_bits::<W>(0);
         self.fp_units.b.next = self.decode.b.val().get_bits::<W>(0);
         self.fp_units.sub.next = self.decode.op.val() == self.op_fsub.val();
@@ -537,10 +563,47 @@ impl<
         SramRead::link(&mut self.bank0, &mut self.traversal_unit.nodes);
         SramRead::link(&mut self.bank2, &mut self.tester.uv_words);
         SramRead::link(&mut self.bank3, &mut self.tester.t_words);
-        // Both coprocessors see the engine's loads, the thread at I3 and its ray words.
-        self.is_tri.next = self.decode.valid.val() & (self.decode.op.val() == self.op_tri.val());
-        self.ray_write.next =
-            self.is_tri.val() & (self.decode.imm.val() < self.tri_ray_words.val());
+        // I3: the coprocessor function the instruction names (`tri` with its `TriFn`, `kd`
+        // with its `KdFn`, in imm), for I4. The queued `TriFn`s go to the list unit as its
+        // command kinds.
+        self.ray_write.d.next = self.decode.valid_i3.val()
+            & (self.decode.op_i3.val() == self.op_tri.val())
+            & (self.decode.imm_i3.val() < self.tri_ray_words.val());
+        self.t_min_write.d.next = self.decode.valid_i3.val()
+            & (self.decode.op_i3.val() == self.op_tri.val())
+            & (self.decode.imm_i3.val() == self.tri_init.val());
+        self.tri_queues.d.next = (self.decode.imm_i3.val() == self.tri_init.val())
+            | (self.decode.imm_i3.val() == self.tri_list.val())
+            | (self.decode.imm_i3.val() == self.tri_object.val())
+            | (self.decode.imm_i3.val() == self.tri_skip.val());
+        self.tri_enqueue.d.next = self.decode.valid_i3.val()
+            & (self.decode.op_i3.val() == self.op_tri.val())
+            & ((self.decode.imm_i3.val() == self.tri_init.val())
+                | (self.decode.imm_i3.val() == self.tri_list.val())
+                | (self.decode.imm_i3.val() == self.tri_object.val())
+                | (self.decode.imm_i3.val() == self.tri_skip.val()));
+        self.tri_kind.d.next = self.cmd_list.val();
+        if self.decode.imm_i3.val() == self.tri_init.val() {
+            self.tri_kind.d.next = self.cmd_init.val();
+        }
+        if self.decode.imm_i3.val() == self.tri_object.val() {
+            self.tri_kind.d.next = self.cmd_object.val();
+        }
+        if self.decode.imm_i3.val() == self.tri_skip.val() {
+            self.tri_kind.d.next = self.cmd_skip.val();
+        }
+        self.tri_waits.d.next = self.decode.imm_i3.val() == self.tri_wait.val();
+        self.kd_enqueue.d.next = self.decode.valid_i3.val()
+            & (self.decode.op_i3.val() == self.op_kd.val())
+            & (self.decode.imm_i3.val() == self.kd_start.val());
+        self.kd_waits.d.next = self.decode.imm_i3.val() == self.kd_wait.val();
+        // The waits (`tri.wait`, `kd.wait`): a pending one sleeps instead of repeating.
+        self.wait_fn.d.next = ((self.decode.op_i3.val() == self.op_tri.val())
+            & (self.decode.imm_i3.val() == self.tri_wait.val()))
+            | ((self.decode.op_i3.val() == self.op_kd.val())
+                & (self.decode.imm_i3.val() == self.kd_wait.val()));
+
+        // I4: both coprocessors see the engine's loads, the thread and its ray words.
         self.traversal_unit.engine.load_read.next = self.mem_read_r.q.val();
         self.traversal_unit.engine.load_bank.next = self.mem_bank_r.q.val();
         self.traversal_unit.engine.load_addr.next = self.mem_addr_r.q.val();
@@ -548,7 +611,7 @@ impl<
         self.traversal_unit.engine.word_a.next = self.decode.a.val();
         self.traversal_unit.engine.word_b.next = self.decode.b.val();
         self.traversal_unit.engine.ray_pair.next = self.decode.imm.val().get_bits::<2>(0);
-        self.traversal_unit.engine.ray_write.next = self.ray_write.val();
+        self.traversal_unit.engine.ray_write.next = self.ray_write.q.val();
         self.tester.engine.load_read.next = self.mem_read_r.q.val();
         self.tester.engine.load_bank.next = self.mem_bank_r.q.val();
         self.tester.engine.load_addr.next = self.mem_addr_r.q.val();
@@ -556,38 +619,20 @@ impl<
         self.tester.engine.word_a.next = self.decode.a.val();
         self.tester.engine.word_b.next = self.decode.b.val();
         self.tester.engine.ray_pair.next = self.decode.imm.val().get_bits::<2>(0);
-        self.tester.engine.ray_write.next = self.ray_write.val();
+        self.tester.engine.ray_write.next = self.ray_write.q.val();
 
-        // Triangle tester (`tri`, its `TriFn` in imm); the queued functions go to the list
-        // unit as its command kinds.
-        self.tri_queues.next = (self.decode.imm.val() == self.tri_init.val())
-            | (self.decode.imm.val() == self.tri_list.val())
-            | (self.decode.imm.val() == self.tri_object.val())
-            | (self.decode.imm.val() == self.tri_skip.val());
-        self.tester.engine.enqueue.next = self.is_tri.val() & self.tri_queues.val();
-        // The kind is settled in a local signal and given to the tester in one assignment: a
-        // default overridden on the tester's input itself would glitch it, the tester's
-        // outputs feed back here, and Icarus would loop forever.
-        self.tri_kind.next = self.cmd_list.val();
-        if self.decode.imm.val() == self.tri_init.val() {
-            self.tri_kind.next = self.cmd_init.val();
-        }
-        if self.decode.imm.val() == self.tri_object.val() {
-            self.tri_kind.next = self.cmd_object.val();
-        }
-        if self.decode.imm.val() == self.tri_skip.val() {
-            self.tri_kind.next = self.cmd_skip.val();
-        }
-        self.tester.queue_kind.next = self.tri_kind.val();
+        // Triangle tester: the entry and its answer (refused, or the wait pending).
+        self.tester.engine.enqueue.next = self.tri_enqueue.q.val();
+        self.tester.queue_kind.next = self.tri_kind.q.val();
         self.tri_busy.next = false;
-        if self.tri_queues.val() {
+        if self.tri_queues.q.val() {
             self.tri_busy.next = self.tester.engine.full.val();
         }
-        if self.decode.imm.val() == self.tri_wait.val() {
+        if self.tri_waits.q.val() {
             self.tri_busy.next = self.tester.engine.pending.val();
         }
-        // Traversal unit (`kd`, its `KdFn` in imm). It sees the object-space ray and t_min the
-        // thread gives the tester, hands its leaves to the tester and takes the answers back.
+        // Traversal unit. It sees the object-space ray and t_min the thread gives the tester,
+        // hands its leaves to the tester and takes the answers back.
         self.tester.walk_list_valid.next = self.traversal_unit.leaf_valid.val();
         self.tester.walk_list_thread.next = self.traversal_unit.leaf_thread.val();
         self.tester.walk_list_from.next = self.traversal_unit.leaf_from.val();
@@ -597,23 +642,15 @@ impl<
         self.traversal_unit.answer_thread.next = self.tester.walk_end_thread.val();
         self.traversal_unit.answer_t.next = self.tester.walk_end_t.val();
         self.traversal_unit.answer_hit.next = self.tester.walk_end_hit.val();
-        self.traversal_unit.t_min_write.next =
-            self.is_tri.val() & (self.decode.imm.val() == self.tri_init.val());
-        self.traversal_unit.engine.enqueue.next = self.decode.valid.val()
-            & (self.decode.op.val() == self.op_kd.val())
-            & (self.decode.imm.val() == self.kd_start.val());
-        if self.decode.imm.val() == self.kd_wait.val() {
+        self.traversal_unit.t_min_write.next = self.t_min_write.q.val();
+        self.traversal_unit.engine.enqueue.next = self.kd_enqueue.q.val();
+        if self.kd_waits.q.val() {
             self.kd_busy.next = self.traversal_unit.engine.pending.val();
         } else {
             self.kd_busy.next = self.traversal_unit.engine.full.val();
         }
-        // The waits (`tri.wait`, `kd.wait`): a pending one sleeps instead of repeating.
-        self.wait_fn.next = ((self.decode.op.val() == self.op_tri.val())
-            & (self.decode.imm.val() == self.tri_wait.val()))
-            | ((self.decode.op.val() == self.op_kd.val())
-                & (self.decode.imm.val() == self.kd_wait.val()));
 
-        // I3 into the result line.
+        // I4 into the result line.
         self.result_line.valid.next = self.decode.valid.val();
         self.result_line.op.next = self.decode.op.val();
         self.result_line.dst.next = self.decode.dst.val();
@@ -621,7 +658,7 @@ impl<
         self.result_line.invert.next = self.decode.invert.val();
         self.result_line.pc.next = self.decode.pc.val();
         self.result_line.target.next = self.decode.target.val();
-        self.result_line.is_wait.next = self.wait_fn.val();
+        self.result_line.is_wait.next = self.wait_fn.q.val();
         self.result_line.kd_busy.next = self.kd_busy.val();
         self.result_line.tri_busy.next = self.tri_busy.val();
         self.result_line.jr_target.next = self.decode.a.val().get_bits::<PC_BITS>(0);
@@ -651,15 +688,15 @@ impl<
         self.write_back.eq.next = self.fp_units.eq.val();
         self.write_back.colour_byte.next = self.fp_units.colour_byte.val();
         self.decode.wb_write.next = self.write_back.write.val();
-        self.decode.wb_thread.next = self.result_line.retiring.thread.val();
-        self.decode.wb_dst.next = self.result_line.retiring.dst.val();
+        self.decode.wb_thread.next = self.write_back.thread.val();
+        self.decode.wb_dst.next = self.write_back.dst.val();
         self.decode.wb_data.next = self.write_back.data.val();
-        self.fetch.wb_valid.next = self.result_line.retiring.valid.val();
-        self.fetch.wb_thread.next = self.result_line.retiring.thread.val();
+        self.fetch.wb_valid.next = self.write_back.valid.val();
+        self.fetch.wb_thread.next = self.write_back.thread.val();
         self.fetch.wb_halt.next = self.write_back.halt.val();
         self.fetch.wb_next_pc.next = self.write_back.next_pc.val();
-        self.scheduler.wb_valid.next = self.result_line.retiring.valid.val();
-        self.scheduler.wb_thread.next = self.result_line.retiring.thread.val();
+        self.scheduler.wb_valid.next = self.write_back.valid.val();
+        self.scheduler.wb_thread.next = self.write_back.thread.val();
         self.scheduler.wb_halt.next = self.write_back.halt.val();
         self.scheduler.wb_wait_pending.next = self.write_back.wait_pending.val();
         self.scheduler.tester_done.next = self.tester.engine.done.val();
@@ -671,7 +708,7 @@ impl<
         if self.write_back.retired.val() {
             self.instr_count.d.next = self.instr_count.q.val() + 1;
         }
-        if self.result_line.retiring.valid.val() & self.write_back.halt.val() {
+        if self.write_back.valid.val() & self.write_back.halt.val() {
             self.halted_count.d.next = self.halted_count.q.val() + 1;
             if (self.halted_count.q.val() + 1) == self.c_threads.val() {
                 self.running.d.next = false;

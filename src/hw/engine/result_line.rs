@@ -1,13 +1,13 @@
-//! `ResultLine`: carries each instruction from I3 to its write back: its control fields, its
+//! `ResultLine`: carries each instruction from I4 to its write back: its control fields, its
 //! pcs, its conditions and its fast result, into which scratch and memory data join on the
 //! way. `fdiv` and `fsqrt` go on from there through a long line of `DX` more clocks.
 //!
-//! Contract: what enters at I3 leaves at the write back [`super::ENGINE_LATENCY`] (12) clocks
+//! Contract: what enters at I4 leaves at the write back [`super::ENGINE_LATENCY`] (12) clocks
 //! later; a long instruction's control and pcs leave `DX = long_latency - ENGINE_LATENCY`
 //! clocks later still (the scheduler reserved that clock, so no other instruction leaves with
 //! it; its conditions and fast result are not used). The fast result of `lds` is replaced by
-//! the scratch word one clock after I3, that of `ld` by the word of its bank's port
-//! `mem_latency` clocks after the request (which leaves the engine one clock after I3).
+//! the scratch word one clock after I4, that of `ld` by the word of its bank's port
+//! `mem_latency` clocks after the request (which leaves the engine one clock after I4).
 //!
 //! Latency: 12 clocks (`fdiv`, `fsqrt`: `12 + DX`). Throughput: one instruction per clock.
 //!
@@ -27,13 +27,13 @@ use crate::hw::Delay;
 const FAST_STAGES: usize = 8;
 /// Registers of the fast line after the last join, up to the write back.
 const TAIL: usize = 4;
-/// Clocks from I3 to the write back.
+/// Clocks from I4 to the write back.
 const LINE: usize = FAST_STAGES + TAIL;
 
 #[derive(LogicBlock)]
 pub struct ResultLine<const DX: usize> {
     pub clock: Signal<In, Clock>,
-    /// I3: the instruction.
+    /// I4: the instruction.
     pub valid: Signal<In, Bit>,
     pub op: Signal<In, Bits<OP_BITS>>,
     pub dst: Signal<In, Bits<REG_BITS>>,
@@ -41,7 +41,7 @@ pub struct ResultLine<const DX: usize> {
     pub invert: Signal<In, Bit>,
     pub pc: Signal<In, Bits<PC_BITS>>,
     pub target: Signal<In, Bits<PC_BITS>>,
-    /// I3: its conditions: a coprocessor wait; the traversal unit or the triangle tester
+    /// I4: its conditions: a coprocessor wait; the traversal unit or the triangle tester
     /// refused the entry or has not finished; operand A's low bits (`jr`'s target); the
     /// integer compares; the mailbox hit; the pixels exhausted.
     pub is_wait: Signal<In, Bit>,
@@ -52,10 +52,10 @@ pub struct ResultLine<const DX: usize> {
     pub int_lt: Signal<In, Bit>,
     pub mb_hit: Signal<In, Bit>,
     pub pix_done: Signal<In, Bit>,
-    /// I3: the fast result and where a load's data comes from.
+    /// I4: the fast result and where a load's data comes from.
     pub fast: Signal<In, Bits<32>>,
     pub kind: Signal<In, FastKind>,
-    /// The data that joins: the scratch word (I4) and the ports' words.
+    /// The data that joins: the scratch word (I5) and the ports' words.
     pub scratch_data: Signal<In, Bits<32>>,
     pub mem_data: Signal<In, Bits<32>>,
     pub nodes_data: Signal<In, Bits<32>>,
@@ -216,7 +216,7 @@ impl<const DX: usize> Logic for ResultLine<DX> {
         self.mb_hit_line.data_in.next = self.mb_hit.val();
         self.pix_done_line.data_in.next = self.pix_done.val();
 
-        // The fast line: scratch data at I4, memory data at I4 + latency.
+        // The fast line: scratch data at I5, memory data at I5 + latency.
         self.fast_line[0].d.next = self.fast.val();
         self.kind_line[0].d.next = self.kind.val();
         for k in 1..8 {

@@ -9,8 +9,15 @@
 //! instruction (`fdiv`, `fsqrt`) at I3 reserves the clock its write back will take: the
 //! scheduler issues nothing in the one clock whose instruction would write back with it.
 //!
-//! Latency: `issue`/`pick` are combinational from the registered state (I0). Throughput: one
-//! issue per clock while a thread is ready and the clock is not reserved.
+//! The pick is made a clock ahead: the thread that issues is a register (it addresses the pc
+//! store directly), chosen the clock before among the threads ready then, less the one
+//! issuing then. Round robin: the choice is the highest of them below a pointer that moves
+//! down one thread per clock (a register, so no shifter sits in the choice), else the highest;
+//! every ready thread is first in line at least once per 32 clocks.
+//!
+//! Latency: `issue`/`pick` are registers (I0); a thread written back (`wb_*`, registered by
+//! the write back) in clock c is ready at c + 1 and issues at c + 2 at the earliest.
+//! Throughput: one issue per clock while a thread is ready and the clock is not reserved.
 //!
 //! Golden twin: none of its own. The engine's twin (`hw::program::exec`, see
 //! `ThreadEngine`) runs threads in an order of its own and never waits; the scheduler may
@@ -46,19 +53,26 @@ pub struct Scheduler {
     pub issue: Signal<Out, Bit>,
     pub pick: Signal<Out, Bits<5>>,
 
-    /// Threads that may issue (written back, not asleep); threads asleep on a coprocessor
-    /// wait; threads a coprocessor finished work for since their issue; the thread issued
-    /// last (the search for the next starts below it).
+    /// Threads that may issue (written back, not asleep, not picked); threads asleep on a
+    /// coprocessor wait; threads a coprocessor finished work for since their issue.
     ready: DFF<Bits<32>>,
     asleep: DFF<Bits<32>>,
     woken: DFF<Bits<32>>,
-    last_pick: DFF<Bits<5>>,
+    /// The thread that issues next (`picked`, as its number and one-hot) and the round-robin
+    /// pointer with its mask (the threads below it).
+    picked: DFF<Bit>,
+    pick_r: DFF<Bits<5>>,
+    pick_onehot: DFF<Bits<32>>,
+    pointer: DFF<Bits<5>>,
+    below_pointer: DFF<Bits<32>>,
     /// Clocks in which no thread may issue: a long instruction writes back in the clock where
     /// that issue's instruction would (bit 0 is this clock).
     reserved: DFF<Bits<32>>,
 
+    candidates: Signal<Local, Bits<32>>,
     below: Signal<Local, Bits<32>>,
     choice: Signal<Local, Bits<5>>,
+    choice_onehot: Signal<Local, Bits<32>>,
     issues: Signal<Local, Bit>,
     issue_mask: Signal<Local, Bits<32>>,
     wb_mask: Signal<Local, Bits<32>>,
@@ -69,11 +83,13 @@ pub struct Scheduler {
     wake_mask: Signal<Local, Bits<32>>,
     sleep_mask: Signal<Local, Bits<32>>,
 
-    /// Bit `t` set for every thread `t` of the design; one; all ones; each thread's number.
+    /// Bit `t` set for every thread `t` of the design; one; all ones; each thread's number
+    /// and one-hot bit.
     c_thread_mask: Constant<Bits<32>>,
     c_one: Constant<Bits<32>>,
     c_ones: Constant<Bits<32>>,
     c_thread_ids: [Constant<Bits<5>>; MAX_THREADS],
+    c_thread_bits: [Constant<Bits<32>>; MAX_THREADS],
     /// The bit of `reserved` a long instruction at I3 sets: the issue `reserve_ahead` clocks
     /// after this one would write back with it.
     c_reserve_bit: Constant<Bits<32>>,
@@ -102,10 +118,16 @@ impl Scheduler {
             ready: Default::default(),
             asleep: Default::default(),
             woken: Default::default(),
-            last_pick: Default::default(),
+            picked: Default::default(),
+            pick_r: Default::default(),
+            pick_onehot: Default::default(),
+            pointer: Default::default(),
+            below_pointer: Default::default(),
             reserved: Default::default(),
+            candidates: Default::default(),
             below: Default::default(),
             choice: Default::default(),
+            choice_onehot: Default::default(),
             issues: Default::default(),
             issue_mask: Default::default(),
             wb_mask: Default::default(),
@@ -119,6 +141,7 @@ impl Scheduler {
             c_one: Constant::new(1u64.into()),
             c_ones: Constant::new(0xffff_ffffu64.into()),
             c_thread_ids: std::array::from_fn(|k| Constant::new((k as u64).into())),
+            c_thread_bits: std::array::from_fn(|k| Constant::new((1u64 << k).into())),
             c_reserve_bit: Constant::new(u64::from(reserve_ahead).into()),
         }
     }
@@ -127,33 +150,55 @@ impl Scheduler {
 impl Logic for Scheduler {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, ready, asleep, woken, last_pick, reserved);
+        dff_setup!(
+            self,
+            clock,
+            ready,
+            asleep,
+            woken,
+            picked,
+            pick_r,
+            pick_onehot,
+            pointer,
+            below_pointer,
+            reserved
+        );
 
-        // The pick: the highest ready thread below the last pick, else the highest. It is
-        // settled in a local and given to the output once (the output leaves the block).
-        self.below.next = self.ready.q.val() & (!(self.c_ones.val() << self.last_pick.q.val()));
+        // Issue the thread picked last clock, unless the clock is reserved.
+        self.issues.next =
+            self.running.val() & self.picked.q.val() & (!self.reserved.q.val().get_bit(0));
+        self.issue.next = self.issues.val();
+        self.pick.next = self.pick_r.q.val();
+        self.issue_mask.next = 0.into();
+        if self.issues.val() {
+            self.issue_mask.next = self.pick_onehot.q.val();
+        }
+        self.reserved.d.next = (self.reserved.q.val() >> 1)
+            | (bit_cast::<32, 1>(self.long_at_i3.val().into()) << self.c_reserve_bit.val());
+
+        // The next pick: the highest candidate below the pointer, else the highest. It is
+        // settled in locals and registered (the pick leaves the block).
+        self.candidates.next = self.ready.q.val() & (!self.issue_mask.val());
+        self.below.next = self.candidates.val() & self.below_pointer.q.val();
         self.choice.next = 0.into();
+        self.choice_onehot.next = 0.into();
         for k in 0..32 {
-            if self.ready.q.val().get_bit(k) {
+            if self.candidates.val().get_bit(k) {
                 self.choice.next = self.c_thread_ids[k].val();
+                self.choice_onehot.next = self.c_thread_bits[k].val();
             }
         }
         for k in 0..32 {
             if self.below.val().get_bit(k) {
                 self.choice.next = self.c_thread_ids[k].val();
+                self.choice_onehot.next = self.c_thread_bits[k].val();
             }
         }
-        self.issues.next =
-            self.running.val() & (self.ready.q.val() != 0) & (!self.reserved.q.val().get_bit(0));
-        self.pick.next = self.choice.val();
-        self.issue.next = self.issues.val();
-        self.issue_mask.next = 0.into();
-        if self.issues.val() {
-            self.issue_mask.next = self.c_one.val() << self.choice.val();
-            self.last_pick.d.next = self.choice.val();
-        }
-        self.reserved.d.next = (self.reserved.q.val() >> 1)
-            | (bit_cast::<32, 1>(self.long_at_i3.val().into()) << self.c_reserve_bit.val());
+        self.picked.d.next = self.candidates.val() != 0;
+        self.pick_r.d.next = self.choice.val();
+        self.pick_onehot.d.next = self.choice_onehot.val();
+        self.pointer.d.next = self.pointer.q.val() - 1;
+        self.below_pointer.d.next = !(self.c_ones.val() << (self.pointer.q.val() - 1));
 
         // Write back: the thread is ready again unless it halted or sleeps on a wait that no
         // finish has answered since its issue.
@@ -179,7 +224,7 @@ impl Logic for Scheduler {
                 self.wake_mask.next = self.wb_mask.val();
             }
         }
-        self.ready.d.next = (self.ready.q.val() & (!self.issue_mask.val()))
+        self.ready.d.next = self.candidates.val()
             | self.wake_mask.val()
             | (self.asleep.q.val() & self.event_mask.val());
         self.asleep.d.next =
@@ -191,6 +236,7 @@ impl Logic for Scheduler {
             self.asleep.d.next = 0.into();
             self.woken.d.next = 0.into();
             self.reserved.d.next = 0.into();
+            self.picked.d.next = false;
         }
     }
 }

@@ -1,5 +1,5 @@
 //! `WriteBack`: the engine's last stage. It chooses an instruction's result and its thread's
-//! next pc, and says what the scheduler and the counters need to know.
+//! next pc, and says what the scheduler and the counters need to know, one clock later.
 //!
 //! Contract: for the instruction leaving the [`super::ResultLine`] (`valid`, `op`, ...) and
 //! the floating-point units' results of the same clock: `data` is the result its opcode names
@@ -14,7 +14,11 @@
 //! repeats (the twin never repeats); `wait_pending` tells the scheduler that a wait is not
 //! answered yet.
 //!
-//! Latency: combinational (the write back clock). Throughput: one instruction per clock.
+//! Latency: 1 clock: every output is a register, so the register file, the pc store and the
+//! scheduler see the write back (`valid`, `thread`, `dst` with the rest) the clock after the
+//! instruction leaves the result line; the result and condition select in between would leave
+//! no room for their block-RAM and wake-up logic in the same clock. Throughput: one
+//! instruction per clock.
 //!
 //! Golden twin: `hw::program::exec` (the engine's twin): the same result, condition and next
 //! pc per opcode.
@@ -22,10 +26,11 @@
 use rust_hdl::prelude::*;
 
 use super::{op_code, RetiringIn};
-use crate::hw::program::isa::{Op, OPS, PC_BITS};
+use crate::hw::program::isa::{Op, OPS, PC_BITS, REG_BITS};
 
 #[derive(LogicBlock)]
 pub struct WriteBack<const W: usize> {
+    pub clock: Signal<In, Clock>,
     /// The instruction leaving the result line.
     pub retiring: RetiringIn,
     /// The floating-point units' results of this clock.
@@ -38,6 +43,10 @@ pub struct WriteBack<const W: usize> {
     pub eq: Signal<In, Bit>,
     pub colour_byte: Signal<In, Bits<8>>,
 
+    /// The clock after the instruction left the line: it, its thread and destination.
+    pub valid: Signal<Out, Bit>,
+    pub thread: Signal<Out, Bits<5>>,
+    pub dst: Signal<Out, Bits<REG_BITS>>,
     pub write: Signal<Out, Bit>,
     pub data: Signal<Out, Bits<32>>,
     pub next_pc: Signal<Out, Bits<PC_BITS>>,
@@ -49,6 +58,15 @@ pub struct WriteBack<const W: usize> {
     repeats: Signal<Local, Bit>,
     pc: Signal<Local, Bits<PC_BITS>>,
     result: Signal<Local, Bits<32>>,
+    valid_r: DFF<Bit>,
+    thread_r: DFF<Bits<5>>,
+    dst_r: DFF<Bits<REG_BITS>>,
+    write_r: DFF<Bit>,
+    data_r: DFF<Bits<32>>,
+    next_pc_r: DFF<Bits<PC_BITS>>,
+    halt_r: DFF<Bit>,
+    retired_r: DFF<Bit>,
+    wait_pending_r: DFF<Bit>,
 
     op_fadd: Constant<Bits<5>>,
     op_fsub: Constant<Bits<5>>,
@@ -75,6 +93,7 @@ pub struct WriteBack<const W: usize> {
 impl<const W: usize> Default for WriteBack<W> {
     fn default() -> Self {
         Self {
+            clock: Default::default(),
             retiring: Default::default(),
             sum: Default::default(),
             product: Default::default(),
@@ -84,6 +103,9 @@ impl<const W: usize> Default for WriteBack<W> {
             le: Default::default(),
             eq: Default::default(),
             colour_byte: Default::default(),
+            valid: Default::default(),
+            thread: Default::default(),
+            dst: Default::default(),
             write: Default::default(),
             data: Default::default(),
             next_pc: Default::default(),
@@ -94,6 +116,15 @@ impl<const W: usize> Default for WriteBack<W> {
             repeats: Default::default(),
             pc: Default::default(),
             result: Default::default(),
+            valid_r: Default::default(),
+            thread_r: Default::default(),
+            dst_r: Default::default(),
+            write_r: Default::default(),
+            data_r: Default::default(),
+            next_pc_r: Default::default(),
+            halt_r: Default::default(),
+            retired_r: Default::default(),
+            wait_pending_r: Default::default(),
             op_fadd: op_code(Op::FAdd),
             op_fsub: op_code(Op::FSub),
             op_fmul: op_code(Op::FMul),
@@ -125,6 +156,19 @@ impl<const W: usize> Default for WriteBack<W> {
 impl<const W: usize> Logic for WriteBack<W> {
     #[hdl_gen]
     fn update(&mut self) {
+        dff_setup!(
+            self,
+            clock,
+            valid_r,
+            thread_r,
+            dst_r,
+            write_r,
+            data_r,
+            next_pc_r,
+            halt_r,
+            retired_r,
+            wait_pending_r
+        );
         self.cond.next = false;
         if self.retiring.op.val() == self.op_bflt.val() {
             self.cond.next = self.lt.val();
@@ -193,15 +237,28 @@ impl<const W: usize> Logic for WriteBack<W> {
             self.result.next = self.retiring.fast.val() | bit_cast::<32, 8>(self.colour_byte.val());
         }
 
-        self.next_pc.next = self.pc.val();
-        self.data.next = self.result.val();
-        self.halt.next = self.retiring.op.val() == self.op_halt.val();
+        self.valid_r.d.next = self.retiring.valid.val();
+        self.thread_r.d.next = self.retiring.thread.val();
+        self.dst_r.d.next = self.retiring.dst.val();
+        self.next_pc_r.d.next = self.pc.val();
+        self.data_r.d.next = self.result.val();
+        self.halt_r.d.next = self.retiring.op.val() == self.op_halt.val();
         // `pixel` writes nothing once the frame's pixels are exhausted.
-        self.write.next = self.retiring.valid.val()
+        self.write_r.d.next = self.retiring.valid.val()
             & (self.retiring.dst.val() != 0)
             & self.op_writes.val().get_bit(self.retiring.op.val().index())
             & (!((self.retiring.op.val() == self.op_pixel.val()) & self.retiring.pix_done.val()));
-        self.retired.next = self.retiring.valid.val() & (!self.repeats.val());
-        self.wait_pending.next = self.cond.val() & self.retiring.is_wait.val();
+        self.retired_r.d.next = self.retiring.valid.val() & (!self.repeats.val());
+        self.wait_pending_r.d.next = self.cond.val() & self.retiring.is_wait.val();
+
+        self.valid.next = self.valid_r.q.val();
+        self.thread.next = self.thread_r.q.val();
+        self.dst.next = self.dst_r.q.val();
+        self.write.next = self.write_r.q.val();
+        self.data.next = self.data_r.q.val();
+        self.next_pc.next = self.next_pc_r.q.val();
+        self.halt.next = self.halt_r.q.val();
+        self.retired.next = self.retired_r.q.val();
+        self.wait_pending.next = self.wait_pending_r.q.val();
     }
 }
