@@ -4,14 +4,17 @@
 //! will come from.
 //!
 //! Contract: from an instruction's `op`, operands `a`, `b`, `imm`, `shift`, `bank` and `pc`
-//! at I4: `fast` is `add`/`sub`/`and`/`or`/`xor`/`shr`/`shl` of `a` and `b`, `itof a`, `jal`'s
+//! at I4: `fast` is `add`/`sub`/`and`/`or`/`xor`/`shr`/`shl` of `a` and `b`, `jal`'s
 //! link `pc + 1`, `byte`'s `b << 8` (the unit's byte joins it at the write back), the
 //! pixel word, or what `tri.wait`/`tri.hit`/`tri.instance`/`tri.triangle` read from the
 //! triangle tester; `kind` says whether the result line fills in a scratch or memory word
-//! later (`ld` by its bank, `lds`). `mem_address = (a << shift) + imm` (loads and frame-buffer
+//! later (`ld` by its bank, `lds`) or `itof`'s `converted` word. `mem_address = (a << shift) + imm` (loads and frame-buffer
 //! stores), `scratch_address = a + imm`; `int_eq`, `int_lt`: `a == b`, `a < b` unsigned.
 //!
-//! Latency: combinational (I4). Throughput: one instruction per clock.
+//! `itof`'s word comes a clock later, registered (`converted`, I5: the leading-zero shifter
+//! and the result select do not fit one clock), and joins the result line there.
+//!
+//! Latency: combinational (I4), `converted` 1 clock. Throughput: one instruction per clock.
 //!
 //! Golden twin: `hw::program::exec` (the engine's twin), the same operations per opcode.
 
@@ -24,6 +27,7 @@ use crate::layout;
 
 #[derive(LogicBlock)]
 pub struct Execute<const W: usize, const E: usize, const M: usize> {
+    pub clock: Signal<In, Clock>,
     /// I4: the instruction.
     pub op: Signal<In, Bits<OP_BITS>>,
     pub a: Signal<In, Bits<32>>,
@@ -40,6 +44,8 @@ pub struct Execute<const W: usize, const E: usize, const M: usize> {
     pub tester_instance: Signal<In, Bits<32>>,
     pub tester_triangle: Signal<In, Bits<32>>,
     pub fast: Signal<Out, Bits<32>>,
+    /// I5: `itof a` of the instruction at I4 the clock before.
+    pub converted: Signal<Out, Bits<32>>,
     pub kind: Signal<Out, FastKind>,
     pub int_eq: Signal<Out, Bit>,
     pub int_lt: Signal<Out, Bit>,
@@ -47,6 +53,7 @@ pub struct Execute<const W: usize, const E: usize, const M: usize> {
     pub scratch_address: Signal<Out, Bits<32>>,
 
     itof: UIntToFloat<W, E, M>,
+    itof_r: DFF<Bits<32>>,
     result: Signal<Local, Bits<32>>,
     source: Signal<Local, FastKind>,
 
@@ -76,6 +83,7 @@ pub struct Execute<const W: usize, const E: usize, const M: usize> {
 impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M> {
     fn default() -> Self {
         Self {
+            clock: Default::default(),
             op: Default::default(),
             a: Default::default(),
             b: Default::default(),
@@ -89,12 +97,14 @@ impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M
             tester_instance: Default::default(),
             tester_triangle: Default::default(),
             fast: Default::default(),
+            converted: Default::default(),
             kind: Default::default(),
             int_eq: Default::default(),
             int_lt: Default::default(),
             mem_address: Default::default(),
             scratch_address: Default::default(),
             itof: Default::default(),
+            itof_r: Default::default(),
             result: Default::default(),
             source: Default::default(),
             op_itof: op_code(Op::IToF),
@@ -125,7 +135,10 @@ impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M
 impl<const W: usize, const E: usize, const M: usize> Logic for Execute<W, E, M> {
     #[hdl_gen]
     fn update(&mut self) {
+        dff_setup!(self, clock, itof_r);
         self.itof.value.next = self.a.val().get_bits::<16>(0);
+        self.itof_r.d.next = bit_cast::<32, W>(self.itof.word.val());
+        self.converted.next = self.itof_r.q.val();
         self.int_eq.next = self.a.val() == self.b.val();
         self.int_lt.next = self.a.val() < self.b.val();
         self.mem_address.next = (self.a.val() << self.shift.val()) + self.imm.val();
@@ -135,7 +148,7 @@ impl<const W: usize, const E: usize, const M: usize> Logic for Execute<W, E, M> 
         self.source.next = FastKind::Computed;
         self.result.next = 0.into();
         if self.op.val() == self.op_itof.val() {
-            self.result.next = bit_cast::<32, W>(self.itof.word.val());
+            self.source.next = FastKind::Converted;
         }
         if self.op.val() == self.op_add.val() {
             self.result.next = self.a.val() + self.b.val();

@@ -2,14 +2,17 @@
 //! mailbox 0, instances in mailbox 1), the paper's mailboxing against testing an object
 //! twice, for the `mbx` (test and insert) and `mbc` (clear) instructions.
 //!
-//! Contract: the mailbox `which` of a thread is read at I3 (`read_thread`, `read_which`). At
-//! I4 `hit` is set when `value` is one of its first `len` entries; `insert` (an `mbx`) puts a
-//! value that missed in the next slot, round robin, and `clear` (an `mbc`) empties the
-//! mailbox. Entries start undefined and count only below `len`.
+//! Contract: the mailbox `which` of a thread is read at I3 (`read_thread`, `read_which`); at
+//! I4 come the instruction's `thread`, `which`, `value`, `insert`, `clear`. At I5 `hit` is set
+//! when `value` is one of the mailbox's first `len` entries; `insert` (an `mbx`) puts a value
+//! that missed in the next slot, round robin, and `clear` (an `mbc`) empties the mailbox.
+//! Entries start undefined and count only below `len`.
 //!
-//! Latency: the hit is ready at I4, one clock after the read; the update is written at the
-//! end of I4. A thread issues at most once per `engine_period` clocks, so its next read
-//! sees the update. Throughput: one instruction per clock.
+//! Latency: the entries are compared with the value at I4 and the hit is ready at I5, two
+//! clocks after the read (the 32-bit compares, the hit and the update do not fit one clock);
+//! the update is written at the end of I5. A thread issues at most once per `engine_period`
+//! clocks, and threads have mailboxes of their own, so every read sees every earlier update.
+//! Throughput: one instruction per clock.
 //!
 //! Golden twin: [`crate::units::Mailbox`] (`seen` is `mbx`; a new mailbox is `mbc`), which the
 //! engine's twin runs for these instructions and the golden model for every ray.
@@ -30,8 +33,17 @@ pub struct MailboxUnit {
     pub value: Signal<In, Bits<32>>,
     pub insert: Signal<In, Bit>,
     pub clear: Signal<In, Bit>,
+    /// I5: the value was in the mailbox.
     pub hit: Signal<Out, Bit>,
 
+    /// I5: the compares of I4 and what the update needs.
+    matches: [DFF<Bit>; MAILBOX_ENTRIES],
+    meta_r: DFF<Bits<8>>,
+    thread_r: DFF<Bits<5>>,
+    which_r: DFF<Bit>,
+    value_r: DFF<Bits<32>>,
+    insert_r: DFF<Bit>,
+    clear_r: DFF<Bit>,
     entries: [RAM<Bits<32>, 6>; MAILBOX_ENTRIES],
     /// `{next slot (bits 6..4), len (bits 3..0)}` per `{thread, mailbox}`.
     meta: RAM<Bits<8>, 6>,
@@ -58,6 +70,13 @@ impl Default for MailboxUnit {
             insert: Default::default(),
             clear: Default::default(),
             hit: Default::default(),
+            matches: Default::default(),
+            meta_r: Default::default(),
+            thread_r: Default::default(),
+            which_r: Default::default(),
+            value_r: Default::default(),
+            insert_r: Default::default(),
+            clear_r: Default::default(),
             entries: Default::default(),
             meta: RAM::new(super::word_map((0..64).map(|_| Bits::<8>::from(0u64)))),
             len: Default::default(),
@@ -73,6 +92,7 @@ impl Default for MailboxUnit {
 impl Logic for MailboxUnit {
     #[hdl_gen]
     fn update(&mut self) {
+        dff_setup!(self, clock, meta_r, thread_r, which_r, value_r, insert_r, clear_r);
         self.meta.read_clock.next = self.clock.val();
         self.meta.write_clock.next = self.clock.val();
         for k in 0..8 {
@@ -87,34 +107,45 @@ impl Logic for MailboxUnit {
             self.entries[k].read_address.next = self.read_address.val();
         }
 
-        // I4: a hit when the value is one of the first `len` entries.
-        self.len.next = self.meta.read_data.val().get_bits::<4>(0);
-        self.next_slot.next = self.meta.read_data.val().get_bits::<3>(4);
+        // I4: compare the value with every entry.
+        for k in 0..8 {
+            self.matches[k].clock.next = self.clock.val();
+            self.matches[k].d.next = self.entries[k].read_data.val() == self.value.val();
+        }
+        self.meta_r.d.next = self.meta.read_data.val();
+        self.thread_r.d.next = self.thread.val();
+        self.which_r.d.next = self.which.val();
+        self.value_r.d.next = self.value.val();
+        self.insert_r.d.next = self.insert.val();
+        self.clear_r.d.next = self.clear.val();
+
+        // I5: a hit when the value is one of the first `len` entries.
+        self.len.next = self.meta_r.q.val().get_bits::<4>(0);
+        self.next_slot.next = self.meta_r.q.val().get_bits::<3>(4);
         self.found.next = false;
         for k in 0..8 {
-            if (self.entries[k].read_data.val() == self.value.val())
-                & (bit_cast::<8, 4>(self.len.val()) > self.c_index[k].val())
+            if self.matches[k].q.val() & (bit_cast::<8, 4>(self.len.val()) > self.c_index[k].val())
             {
                 self.found.next = true;
             }
         }
         self.hit.next = self.found.val();
 
-        // I4: update.
-        self.write_address.next =
-            (bit_cast::<6, 5>(self.thread.val()) << 1) | bit_cast::<6, 1>(self.which.val().into());
+        // I5: update.
+        self.write_address.next = (bit_cast::<6, 5>(self.thread_r.q.val()) << 1)
+            | bit_cast::<6, 1>(self.which_r.q.val().into());
         self.meta.write_address.next = self.write_address.val();
         self.meta.write_enable.next = false;
         self.meta.write_data.next = 0.into();
         for k in 0..8 {
             self.entries[k].write_address.next = self.write_address.val();
-            self.entries[k].write_data.next = self.value.val();
+            self.entries[k].write_data.next = self.value_r.q.val();
             self.entries[k].write_enable.next = false;
         }
-        if self.clear.val() {
+        if self.clear_r.q.val() {
             self.meta.write_enable.next = true;
         }
-        if self.insert.val() & (!self.found.val()) {
+        if self.insert_r.q.val() & (!self.found.val()) {
             self.meta.write_enable.next = true;
             if self.len.val() == 8 {
                 self.meta.write_data.next =

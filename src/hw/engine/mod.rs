@@ -21,7 +21,7 @@
 //!   and splits the fields; at I3 the [`MailboxUnit`] reads the thread's mailbox and the
 //!   coprocessors their state of the thread, and a long instruction reserves its write back.
 //! - I4 ([`OPERAND_STAGE`]): [`Execute`] computes the integer result and the addresses, the [`PixelCounter`]
-//!   hands out a pixel, the mailbox tests and updates, [`FpUnits`] take their operands; this
+//!   hands out a pixel, the mailbox compares (its hit and update follow at I5), [`FpUnits`] take their operands; this
 //!   block drives the memory and frame-buffer ports and offers `tri` and `kd` entries to the
 //!   coprocessors (their answer, refused or pending, makes the thread repeat the instruction
 //!   on its next turn, after a sleep for a wait).
@@ -119,11 +119,13 @@ pub fn engine_period(threads: u32) -> u32 {
     threads.max(OPERAND_STAGE + ENGINE_LATENCY + WAKE_UP)
 }
 
-/// Where an instruction's result comes from on the fast line: computed at I4, or the data of
-/// a scratch read or of a load from the shared memory port or a bank's own port.
+/// Where an instruction's result comes from on the fast line: computed at I4, converted at I5
+/// (`itof`), or the data of a scratch read or of a load from the shared memory port or a
+/// bank's own port.
 #[derive(Copy, Clone, Debug, PartialEq, LogicState)]
 pub enum FastKind {
     Computed,
+    Converted,
     Scratch,
     Memory,
     TrianglesUv,
@@ -445,6 +447,7 @@ impl<
             decode,
             mailboxes,
             pixels,
+            execute,
             fp_units,
             result_line,
             write_back,
@@ -668,6 +671,7 @@ impl<
         self.result_line.pix_done.next = self.pixels.exhausted.val();
         self.result_line.fast.next = self.execute.fast.val();
         self.result_line.kind.next = self.execute.kind.val();
+        self.result_line.converted.next = self.execute.converted.val();
         self.result_line.scratch_data.next = self.scratch.read_data.val();
         self.result_line.mem_data.next = self.mem.rdata.val();
         self.result_line.nodes_data.next = self.bank0.rdata.val();

@@ -5,8 +5,8 @@
 //! Contract: what enters at I4 leaves at the write back [`super::ENGINE_LATENCY`] (12) clocks
 //! later; a long instruction's control and pcs leave `DX = long_latency - ENGINE_LATENCY`
 //! clocks later still (the scheduler reserved that clock, so no other instruction leaves with
-//! it; its conditions and fast result are not used). The fast result of `lds` is replaced by
-//! the scratch word one clock after I4, that of `ld` by the word of its bank's port
+//! it; its conditions and fast result are not used). The fast result of `lds` and `itof` is
+//! replaced by the scratch word or the converted word one clock after I4, that of `ld` by the word of its bank's port
 //! `mem_latency` clocks after the request (which leaves the engine one clock after I4).
 //!
 //! Latency: 12 clocks (`fdiv`, `fsqrt`: `12 + DX`). Throughput: one instruction per clock.
@@ -29,6 +29,8 @@ const FAST_STAGES: usize = 8;
 const TAIL: usize = 4;
 /// Clocks from I4 to the write back.
 const LINE: usize = FAST_STAGES + TAIL;
+/// Clocks from I5 to the write back (the mailbox hit joins there).
+const FROM_I5: usize = LINE - 1;
 
 #[derive(LogicBlock)]
 pub struct ResultLine<const DX: usize> {
@@ -43,7 +45,7 @@ pub struct ResultLine<const DX: usize> {
     pub target: Signal<In, Bits<PC_BITS>>,
     /// I4: its conditions: a coprocessor wait; the traversal unit or the triangle tester
     /// refused the entry or has not finished; operand A's low bits (`jr`'s target); the
-    /// integer compares; the mailbox hit; the pixels exhausted.
+    /// integer compares; the pixels exhausted. I5: the mailbox hit.
     pub is_wait: Signal<In, Bit>,
     pub kd_busy: Signal<In, Bit>,
     pub tri_busy: Signal<In, Bit>,
@@ -55,7 +57,8 @@ pub struct ResultLine<const DX: usize> {
     /// I4: the fast result and where a load's data comes from.
     pub fast: Signal<In, Bits<32>>,
     pub kind: Signal<In, FastKind>,
-    /// The data that joins: the scratch word (I5) and the ports' words.
+    /// The data that joins: `itof`'s word and the scratch word (I5) and the ports' words.
+    pub converted: Signal<In, Bits<32>>,
     pub scratch_data: Signal<In, Bits<32>>,
     pub mem_data: Signal<In, Bits<32>>,
     pub nodes_data: Signal<In, Bits<32>>,
@@ -78,7 +81,7 @@ pub struct ResultLine<const DX: usize> {
     jr_target_line: Delay<Bits<PC_BITS>, LINE>,
     int_eq_line: Delay<Bit, LINE>,
     int_lt_line: Delay<Bit, LINE>,
-    mb_hit_line: Delay<Bit, LINE>,
+    mb_hit_line: Delay<Bit, FROM_I5>,
     pix_done_line: Delay<Bit, LINE>,
     /// The fast result and its source, a register per clock up to the last join.
     fast_line: [DFF<Bits<32>>; FAST_STAGES],
@@ -126,6 +129,7 @@ impl<const DX: usize> ResultLine<DX> {
             pix_done: Default::default(),
             fast: Default::default(),
             kind: Default::default(),
+            converted: Default::default(),
             scratch_data: Default::default(),
             mem_data: Default::default(),
             nodes_data: Default::default(),
@@ -222,6 +226,9 @@ impl<const DX: usize> Logic for ResultLine<DX> {
         for k in 1..8 {
             self.fast_line[k].d.next = self.fast_line[k - 1].q.val();
             self.kind_line[k].d.next = self.kind_line[k - 1].q.val();
+        }
+        if self.kind_line[0].q.val() == FastKind::Converted {
+            self.fast_line[1].d.next = self.converted.val();
         }
         if self.kind_line[0].q.val() == FastKind::Scratch {
             self.fast_line[1].d.next = self.scratch_data.val();

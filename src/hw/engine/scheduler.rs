@@ -11,7 +11,7 @@
 //!
 //! The pick is made a clock ahead: the thread that issues is a register (it addresses the pc
 //! store directly), chosen the clock before among the threads ready then, less the one
-//! issuing then. Round robin: the choice is the highest of them below a pointer that moves
+//! picked then. Round robin: the choice is the highest of them below a pointer that moves
 //! down one thread per clock (a register, so no shifter sits in the choice), else the highest;
 //! every ready thread is first in line at least once per 32 clocks.
 //!
@@ -176,9 +176,12 @@ impl Logic for Scheduler {
         self.reserved.d.next = (self.reserved.q.val() >> 1)
             | (bit_cast::<32, 1>(self.long_at_i3.val().into()) << self.c_reserve_bit.val());
 
-        // The next pick: the highest candidate below the pointer, else the highest. It is
-        // settled in locals and registered (the pick leaves the block).
-        self.candidates.next = self.ready.q.val() & (!self.issue_mask.val());
+        // The next pick: the highest candidate below the pointer, else the highest. The
+        // candidates leave out the thread picked now whether or not it issues (the issue's
+        // reservation and `running` stay out of the choice's path; a thread whose issue a
+        // reservation deferred is simply picked again later). Settled in locals and
+        // registered (the pick leaves the block).
+        self.candidates.next = self.ready.q.val() & (!self.pick_onehot.q.val());
         self.below.next = self.candidates.val() & self.below_pointer.q.val();
         self.choice.next = 0.into();
         self.choice_onehot.next = 0.into();
@@ -224,7 +227,7 @@ impl Logic for Scheduler {
                 self.wake_mask.next = self.wb_mask.val();
             }
         }
-        self.ready.d.next = self.candidates.val()
+        self.ready.d.next = (self.ready.q.val() & (!self.issue_mask.val()))
             | self.wake_mask.val()
             | (self.asleep.q.val() & self.event_mask.val());
         self.asleep.d.next =
