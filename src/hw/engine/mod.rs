@@ -245,6 +245,7 @@ pub struct ThreadEngine<
     kd_enqueue: DFF<Bit>,
     kd_waits: DFF<Bit>,
     wait_fn: DFF<Bit>,
+    queued_fn: Signal<Local, Bit>,
     tri_busy: Signal<Local, Bit>,
     kd_busy: Signal<Local, Bit>,
 
@@ -365,6 +366,7 @@ impl<
             kd_enqueue: Default::default(),
             kd_waits: Default::default(),
             wait_fn: Default::default(),
+            queued_fn: Default::default(),
             tri_busy: Default::default(),
             kd_busy: Default::default(),
             c_threads: Constant::new(u64::from(threads).into()),
@@ -575,16 +577,14 @@ impl<
         self.t_min_write.d.next = self.decode.valid_i3.val()
             & (self.decode.op_i3.val() == self.op_tri.val())
             & (self.decode.imm_i3.val() == self.tri_init.val());
-        self.tri_queues.d.next = (self.decode.imm_i3.val() == self.tri_init.val())
+        self.queued_fn.next = (self.decode.imm_i3.val() == self.tri_init.val())
             | (self.decode.imm_i3.val() == self.tri_list.val())
             | (self.decode.imm_i3.val() == self.tri_object.val())
             | (self.decode.imm_i3.val() == self.tri_skip.val());
+        self.tri_queues.d.next = self.queued_fn.val();
         self.tri_enqueue.d.next = self.decode.valid_i3.val()
             & (self.decode.op_i3.val() == self.op_tri.val())
-            & ((self.decode.imm_i3.val() == self.tri_init.val())
-                | (self.decode.imm_i3.val() == self.tri_list.val())
-                | (self.decode.imm_i3.val() == self.tri_object.val())
-                | (self.decode.imm_i3.val() == self.tri_skip.val()));
+            & self.queued_fn.val();
         self.tri_kind.d.next = self.cmd_list.val();
         if self.decode.imm_i3.val() == self.tri_init.val() {
             self.tri_kind.d.next = self.cmd_init.val();
