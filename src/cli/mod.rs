@@ -6,6 +6,7 @@ mod compare_cmd;
 mod demo_cmd;
 mod emit_fp_cmd;
 mod fp_cmd;
+mod info_cmd;
 mod render_cmd;
 mod rtl_cmd;
 mod stress_cmd;
@@ -18,7 +19,14 @@ use clap::{Parser, Subcommand};
 #[command(
     name = "dynrt",
     version,
-    about = "Generates a SaarCOR DynRT-style ray tracing processor from a 3D scene"
+    about = "Generates a SaarCOR DynRT-style ray tracing processor from a 3D scene",
+    after_help = "Examples:\n  \
+dynrt rtl scenes/tiny.toml --out out/tiny        # Verilog, testbench, images, FuseSoC core\n  \
+dynrt sim scenes/cornell.toml --out out/cornell  # simulate and compare with the golden model\n  \
+dynrt compare a.png b.png --fail-pixels 0        # exit 1 when any pixel differs\n  \
+dynrt info                                       # versions of dynrt and its tools\n\n\
+Exit status: 0 success, 1 frames or results differ, 2 usage error or bad input, 3 a tool or \
+the machine failed (a simulator missing, a timeout, a full disk), 128+N after signal N."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -50,6 +58,9 @@ enum Command {
     Sim(rtl_cmd::SimArgs),
     /// Run operand vectors through one floating-point operator (RTL or software model).
     Fp(fp_cmd::FpArgs),
+    /// The versions of dynrt and of every tool it finds (simulators, yosys, nextpnr, FuseSoC,
+    /// cocotb).
+    Info(info_cmd::InfoArgs),
 }
 
 /// Runs the command line and returns the process exit status.
@@ -72,6 +83,7 @@ pub fn run() -> i32 {
         Command::EmitFp(a) => emit_fp_cmd::run(a),
         Command::Rtl(a) => rtl_cmd::run_rtl(a),
         Command::Sim(a) => rtl_cmd::run_sim(a),
+        Command::Info(a) => info_cmd::run(a),
     };
     match result {
         Ok(code) => code,

@@ -485,3 +485,38 @@ fn compile_verilator(job: &SimJob, p: Prepared) -> Result<CompiledSim, ToolError
 
 #[cfg(test)]
 mod tests;
+
+/// The project's FuseSoC and cocotb environment (`make deps`), in the source tree dynrt was
+/// built from.
+pub const EDA_VENV: &str = ".venv-eda";
+
+/// A tool of [`EDA_VENV`] (`fusesoc`, `cocotb-config`, `python`).
+pub fn eda_tool(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(EDA_VENV)
+        .join("bin")
+        .join(name)
+}
+
+/// The first word that starts with a digit in what `binary args` prints (`fusesoc
+/// --version`: "2.4.7").
+pub fn any_tool_version(binary: &Path, args: &[&str]) -> Result<String, ToolError> {
+    let name = binary
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let out = run_tool(
+        &name,
+        "asking its version",
+        Command::new(binary).args(args),
+        QUERY_TIMEOUT,
+    )?;
+    out.combined()
+        .split_whitespace()
+        .find(|w| w.starts_with(|c: char| c.is_ascii_digit()))
+        .map(|w| w.trim_end_matches([',', ')']).to_string())
+        .ok_or_else(|| ToolError::Parse {
+            tool: name,
+            message: format!("no version number in: {}", out.combined().trim()),
+        })
+}
