@@ -11,7 +11,7 @@ use crate::emit::fp_unit_rtl;
 use crate::fp::{vectors, BinOp, Format};
 use crate::layout::{self, MemoryConfig, SceneTrees};
 use crate::model::{render_golden, Reference};
-use crate::report::{FrameResult, RunSummary, SceneInfo};
+use crate::report::{RunSummary, SceneInfo};
 use crate::scene::Scene;
 use crate::sim::{self, run_fp_unit, Simulator};
 use anyhow::Context;
@@ -163,7 +163,9 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
                 .count();
             ok &= bad == 0;
             let version = sim::tool_version(simulator).unwrap_or_default();
-            summary.tools.insert(simulator.name().to_string(), version.clone());
+            summary
+                .tools
+                .insert(simulator.name().to_string(), version.clone());
             summary.add_check(
                 &format!("{op} in {simulator}"),
                 bad == 0,
@@ -190,6 +192,7 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
         None,
         &c.out.join("processor"),
         &c.generated_by,
+        None,
     )?;
     writeln!(
         md,
@@ -228,16 +231,7 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
         let f0 = &r.frames[0];
         let differing: usize = r.frames.iter().map(|f| f.differing_pixels).sum();
         for (k, f) in r.frames.iter().enumerate() {
-            summary.add_frame(FrameResult {
-                frame: k,
-                simulator: format!("{simulator} ({dir}/)"),
-                cycles: f.cycles,
-                instructions: f.instructions,
-                rays: f.pixels,
-                cycles_per_ray: f.cycles_per_ray(),
-                differing_pixels: f.differing_pixels,
-                pass: f.differing_pixels == 0,
-            });
+            summary.add_frame(f.result(k, format!("{simulator} ({dir}/)")));
         }
         processor_ok &= differing == 0;
         writeln!(

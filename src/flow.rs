@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use crate::emit::constraints::{write_ucf, Port, PortDirection, UcfOptions};
+use crate::emit::constraints::{write_ucf, BoardPins, Port, PortDirection, UcfOptions};
 use crate::emit::package;
 use crate::emit::processor::{display_mode, ProcessorParams, PROCESSOR_TOP};
 use crate::fp::Format;
@@ -179,6 +179,7 @@ fn prepare(
     frames: Option<u32>,
 ) -> Result<Prepared> {
     preflight(scene, f, params, frames)?;
+    crate::progress::report("building the kd-trees and memory layouts");
     let layouts = scene_layouts(scene, f, frames)?;
     let deepest = layouts
         .iter()
@@ -214,8 +215,10 @@ fn cycle_limit(predicted: &RunStats, period: u32) -> u64 {
 
 /// Writes the processor for `scene` into `out`: `rtl/`, `testbench/`, `mem/`, `cocotb/`,
 /// `constraints/dynrt.ucf`, `program.lst` (the microprogram listing), the FuseSoC core
-/// `dynrt_processor.core`, `files.f` and the golden frames `golden<k>.hex`; the generated
-/// files start with `generated_by`'s header.
+/// `dynrt_processor.core`, `files.f`, `PORTS.md`, frame 0's banks as raw binary in `bin/`
+/// and the golden frames `golden<k>.hex`; the generated text files start with
+/// `generated_by`'s header. With a `board` (boards/README.md), the UCF places the ports on its
+/// pins.
 #[allow(clippy::too_many_arguments)]
 pub fn generate_rtl(
     scene: &Scene,
@@ -225,6 +228,7 @@ pub fn generate_rtl(
     frames: Option<u32>,
     out: &Path,
     generated_by: &GeneratedBy,
+    board: Option<&BoardPins>,
 ) -> Result<RtlReport> {
     let Prepared {
         layouts,
@@ -232,6 +236,7 @@ pub fn generate_rtl(
         twin: predicted,
         period,
     } = prepare(scene, f, params, frames)?;
+    crate::progress::report("writing the Verilog, testbench and memory images");
     let written = write_processor_files(
         &program,
         &layouts,
@@ -252,6 +257,7 @@ pub fn generate_rtl(
         &processor_ports(&written.ports, &display),
         &UcfOptions {
             generated_by: generated_by.clone(),
+            board: board.cloned(),
             ..UcfOptions::default()
         },
     )?;
@@ -299,10 +305,30 @@ pub fn generate_rtl(
         generated_by,
     );
     let list_text = package::files_f(&[rtl, tb], generated_by);
-    crate::output::write_all_atomically(&[
+    let ports_md = out.join("PORTS.md");
+    let ports_text = package::ports_md(
+        &written.ports,
+        params.mem_latency,
+        &written.frames,
+        generated_by,
+    );
+    let bin_dir = out.join("bin");
+    let bins: Vec<(PathBuf, Vec<u8>)> = layouts[0]
+        .banks
+        .iter()
+        .enumerate()
+        .map(|(b, words)| {
+            let name = crate::emit::bank_file_name(b).replace(".hex", ".bin");
+            (bin_dir.join(name), package::bank_bin(words))
+        })
+        .collect();
+    let mut writes: Vec<(&Path, &[u8])> = vec![
         (&core, core_text.as_bytes()),
         (&files_f, list_text.as_bytes()),
-    ])?;
+        (&ports_md, ports_text.as_bytes()),
+    ];
+    writes.extend(bins.iter().map(|(p, b)| (p.as_path(), b.as_slice())));
+    crate::output::write_all_atomically(&writes)?;
     Ok(RtlReport {
         program,
         frames: layouts.len(),
@@ -314,6 +340,8 @@ pub fn generate_rtl(
             out.join("mem"),
             core,
             files_f,
+            ports_md,
+            bin_dir,
             out.join("cocotb"),
         ]
         .into_iter()
@@ -373,6 +401,19 @@ pub struct FrameReport {
 }
 
 impl FrameReport {
+    /// The frame's entry in a run's summary (`report::RunSummary::add_frame`).
+    pub fn result(&self, frame: usize, simulator: String) -> crate::report::FrameResult {
+        crate::report::FrameResult {
+            frame,
+            simulator,
+            cycles: self.cycles,
+            instructions: self.instructions,
+            rays: self.pixels,
+            cycles_per_ray: self.cycles_per_ray(),
+            differing_pixels: self.differing_pixels,
+            pass: self.differing_pixels == 0,
+        }
+    }
     pub fn cycles_per_ray(&self) -> f64 {
         self.cycles as f64 / self.pixels as f64
     }
@@ -415,6 +456,8 @@ pub struct SimReport {
     pub period: u32,
     pub compile_seconds: f64,
     pub run_seconds: f64,
+    /// The simulator's build of an earlier run in `out` was reused (nothing compiled).
+    pub reused_build: bool,
     pub program_len: usize,
     pub left_out: Vec<String>,
 }
@@ -474,6 +517,7 @@ pub fn simulate_scene(
     )?;
     let mut reports = Vec::new();
     for (k, (l, fr)) in layouts.iter().zip(&run.frames).enumerate() {
+        crate::progress::report(&format!("comparing frame {k} with the golden model"));
         let golden = model::render_golden(l, false);
         let (w, h) = (l.info.width, l.info.height);
         let rtl_frame = model::Frame {
@@ -551,6 +595,7 @@ pub fn simulate_scene(
         period,
         compile_seconds: run.compile_seconds,
         run_seconds: run.run_seconds,
+        reused_build: run.reused_build,
         program_len: program.code.len(),
         left_out: program.left_out.clone(),
     })

@@ -25,6 +25,7 @@ pub mod input;
 pub mod layout;
 pub mod model;
 pub mod output;
+pub mod progress;
 pub mod provenance;
 pub mod report;
 pub mod scene;

@@ -2,8 +2,10 @@
 //! `dynrt rtl` writes, the testbench runs from another folder with `+mem_dir=` and
 //! `+out_dir=`, and the cocotb test drives the processor and checks its frame against
 //! `golden0.hex`. FuseSoC and cocotb come from PyPI, pinned, in `.venv-eda/` (`make deps`);
-//! a missing tool fails these tests, it never skips them. All on a 2x2 frame of
-//! `scenes/tiny.toml` with 4 threads, so that Icarus needs seconds.
+//! a missing tool fails these tests, it never skips them. All on `tests/data/one_box.toml`
+//! (2x2 pixels, one box, no shadows: about 1,500 clocks) with 4 threads, since Icarus runs the
+//! whole processor at about 150 clocks/s (a 2x2 frame of `scenes/tiny.toml` takes 13,700
+//! clocks, a minute and a half per run).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -34,15 +36,11 @@ fn run(cmd: &mut Command) -> String {
     text
 }
 
-/// `dynrt rtl` of tiny at 2x2 with 4 threads into `dir`.
-fn tiny_rtl(dir: &Path) {
+/// `dynrt rtl` of the one-box scene with 4 threads into `dir`.
+fn box_rtl(dir: &Path) {
     run(Command::new(env!("CARGO_BIN_EXE_dynrt")).args([
         "rtl",
-        root().join("scenes/tiny.toml").to_str().unwrap(),
-        "--width",
-        "2",
-        "--height",
-        "2",
+        root().join("tests/data/one_box.toml").to_str().unwrap(),
         "--threads",
         "4",
         "--out",
@@ -53,6 +51,10 @@ fn tiny_rtl(dir: &Path) {
 fn golden(dir: &Path) -> String {
     let g = std::fs::read_to_string(dir.join("golden0.hex")).unwrap();
     assert_eq!(g.lines().count(), 4, "golden0.hex of a 2x2 frame: {g}");
+    assert!(
+        g.lines().any(|p| p != "000000"),
+        "the box is in the frame: {g}"
+    );
     g
 }
 
@@ -64,7 +66,7 @@ fn fusesoc_runs_the_core_in_icarus_and_the_testbench_runs_from_any_folder() {
         tmp.path().join("build"),
         tmp.path().join("frames"),
     );
-    tiny_rtl(&proc_dir);
+    box_rtl(&proc_dir);
     let want = golden(&proc_dir);
     let files_f = std::fs::read_to_string(proc_dir.join("files.f")).unwrap();
     assert!(
@@ -80,7 +82,7 @@ fn fusesoc_runs_the_core_in_icarus_and_the_testbench_runs_from_any_folder() {
         .args([
             "--target",
             "sim_icarus",
-            "dynrt:processor:tiny",
+            "dynrt:processor:one_box",
             "--out_dir",
         ])
         .arg(&frames));
@@ -91,42 +93,71 @@ fn fusesoc_runs_the_core_in_icarus_and_the_testbench_runs_from_any_folder() {
     );
     // The compiled testbench, run from a folder without mem/, reads the images named by
     // +mem_dir and writes where +out_dir says.
-    let vvp = walk(&build)
-        .into_iter()
-        .find(|p| p.extension().is_some_and(|e| e == "vvp"))
-        .unwrap_or_else(|| panic!("no .vvp file in FuseSoC's build folder:\n{out}"));
+    // Edalize names the compiled testbench after the core: dynrt_processor_one_box_<version>.
+    let core_id = format!("dynrt_processor_one_box_{}", env!("CARGO_PKG_VERSION"));
+    let vvp = build
+        .join(&core_id)
+        .join("sim_icarus-icarus")
+        .join(&core_id);
+    assert!(
+        vvp.is_file(),
+        "no {} after FuseSoC's run:\n{out}",
+        vvp.display()
+    );
+    // `elsewhere` has no mem/: the images can only come through +mem_dir.
     let elsewhere = tmp.path().join("elsewhere");
     std::fs::create_dir(&elsewhere).unwrap();
-    run(Command::new("vvp")
+    let log = run(Command::new("vvp")
         .current_dir(&elsewhere)
         .arg("-n")
         .arg(&vvp)
         .arg(format!("+mem_dir={}", proc_dir.join("mem").display()))
-        .arg("+out_dir=."));
+        .arg("+out_dir=.")
+        .arg("+heartbeat=200"));
+    // +heartbeat=N: a progress line every N clocks, which dynrt streams while it waits.
+    assert!(log.contains("dynrt-heartbeat frame 0: "), "{log}");
     assert_eq!(
         std::fs::read_to_string(elsewhere.join("frame0.hex")).unwrap_or_default(),
         want
     );
-    // Without +mem_dir the testbench looks in ./mem, which is not there: no frame to compare.
-    let empty = tmp.path().join("empty");
-    std::fs::create_dir(&empty).unwrap();
-    let _ = Command::new("vvp")
-        .current_dir(&empty)
-        .arg("-n")
-        .arg(&vvp)
-        .output();
-    let frame = std::fs::read_to_string(empty.join("frame0.hex")).unwrap_or_default();
-    assert_ne!(
-        frame, want,
-        "a run without the images cannot render the frame"
+}
+
+/// The core's Verilator target sets up (the compile itself takes a minute or more for the
+/// whole processor, so CI only checks what FuseSoC hands Verilator): both sources, top `tb`,
+/// `--binary --timing`, and the memory images copied beside the model.
+#[test]
+fn fusesoc_sets_up_the_verilator_target() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (proc_dir, build) = (tmp.path().join("proc"), tmp.path().join("build"));
+    box_rtl(&proc_dir);
+    let out = run(Command::new(venv_tool("fusesoc"))
+        .arg("--cores-root")
+        .arg(&proc_dir)
+        .args(["run", "--setup", "--build-root"])
+        .arg(&build)
+        .args(["--target", "sim_verilator", "dynrt:processor:one_box"]));
+    let core_id = format!("dynrt_processor_one_box_{}", env!("CARGO_PKG_VERSION"));
+    let work = build.join(&core_id).join("sim_verilator-verilator");
+    let vc = std::fs::read_to_string(work.join(format!("{core_id}.vc")))
+        .unwrap_or_else(|e| panic!("{e}:\n{out}"));
+    assert!(
+        vc.contains("rtl/dynrt_processor.v") && vc.contains("testbench/tb.v"),
+        "{vc}"
     );
+    assert!(vc.contains("--top-module tb"), "{vc}");
+    let config = std::fs::read_to_string(work.join("config.mk")).unwrap();
+    assert!(config.contains("--timing"), "{config}");
+    assert!(work.join("mem/bank0_nodes.hex").is_file());
+    // Edalize builds with `make binary` (Verilator --binary) in this mode.
+    let eda = std::fs::read_to_string(work.join(format!("{core_id}.eda.yml"))).unwrap();
+    assert!(eda.contains("mode: binary"), "{eda}");
 }
 
 #[test]
 fn the_cocotb_test_drives_the_processor_and_checks_the_golden_frame() {
     let tmp = tempfile::tempdir().unwrap();
     let proc_dir = tmp.path().join("proc");
-    tiny_rtl(&proc_dir);
+    box_rtl(&proc_dir);
     golden(&proc_dir);
     let python = venv_tool("python");
     let runner = proc_dir.join("cocotb/run.py");
@@ -157,19 +188,4 @@ fn the_cocotb_test_drives_the_processor_and_checks_the_golden_frame() {
         text.contains("1 pixels differ from golden0.hex, first at pixel 0"),
         "{text}"
     );
-}
-
-fn walk(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    if let Ok(entries) = std::fs::read_dir(dir) {
-        for e in entries.flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                out.extend(walk(&p));
-            } else {
-                out.push(p);
-            }
-        }
-    }
-    out
 }

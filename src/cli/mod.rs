@@ -71,6 +71,7 @@ pub fn run() -> i32 {
             "warning: cannot take Ctrl-C and SIGTERM to end the simulators dynrt starts: {e}"
         );
     }
+    let spinner = progress_spinner();
     let result = match cli.command {
         Command::Render(a) => render_cmd::run(a),
         Command::Compare(a) => compare_cmd::run(a),
@@ -85,6 +86,7 @@ pub fn run() -> i32 {
         Command::Sim(a) => rtl_cmd::run_sim(a),
         Command::Info(a) => info_cmd::run(a),
     };
+    spinner.finish_and_clear();
     match result {
         Ok(code) => code,
         Err(e) => {
@@ -98,6 +100,29 @@ pub fn run() -> i32 {
             exit_code_of(&e)
         }
     }
+}
+
+/// A spinner on stderr that shows the library's progress reports (stages, the testbench's
+/// heartbeat) with the time since the last stage began; indicatif draws nothing when stderr is
+/// not a terminal, so logs and tests see no spinner.
+fn progress_spinner() -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let shown = bar.clone();
+    dynrt::progress::listen(move |m| {
+        // A heartbeat continues its stage; any other report starts a new one.
+        if m.starts_with("frame ") {
+            shown.set_message(format!("simulating {m}"));
+        } else {
+            shown.reset_elapsed();
+            shown.set_message(m.to_string());
+        }
+    });
+    bar
 }
 
 /// Exit status when a command ran into results that differ (frames, vectors, invariants).

@@ -6,7 +6,7 @@ use dynrt::flow;
 use dynrt::fp::Format;
 use dynrt::output::OutputDir;
 use dynrt::provenance::GeneratedBy;
-use dynrt::report::{FrameResult, RunSummary, SceneInfo};
+use dynrt::report::{RunSummary, SceneInfo};
 use dynrt::sim::Simulator;
 use std::path::PathBuf;
 
@@ -35,6 +35,10 @@ pub struct RtlArgs {
     /// XC2V6000 (takes minutes).
     #[arg(long)]
     pub synth: bool,
+    /// Board file (TOML, boards/README.md): pin locations and I/O standards for the UCF
+    /// (`rtl` only).
+    #[arg(long, value_name = "FILE")]
+    pub board: Option<PathBuf>,
     /// Leave the commit out of the generated files' headers, so that files checked into
     /// version control do not change with every commit (`make rtl` uses it).
     #[arg(long)]
@@ -144,6 +148,16 @@ pub fn run_rtl(a: RtlArgs) -> anyhow::Result<i32> {
     let (scene, name, params) = setup(&a)?;
     let mut s = summary("rtl", &a, &scene, &name);
     let generated_by = GeneratedBy::this_run(a.stable_header);
+    // The board file is read and checked before anything is written; its pins are checked
+    // against the ports when the UCF is written (a failed run leaves nothing behind).
+    let board = a
+        .board
+        .as_deref()
+        .map(dynrt::emit::load_board)
+        .transpose()?;
+    if let Some(b) = &a.board {
+        s.option("board", b);
+    }
     let out = OutputDir::create(&a.out, "--out")?;
     let r = flow::generate_rtl(
         &scene,
@@ -153,6 +167,7 @@ pub fn run_rtl(a: RtlArgs) -> anyhow::Result<i32> {
         a.frames,
         &a.out,
         &generated_by,
+        board.as_ref(),
     )?;
     record_generated(&mut s, &r, params.threads);
     if !a.json {
@@ -190,6 +205,10 @@ fn synthesis(a: &RtlArgs, s: &mut RunSummary) -> anyhow::Result<()> {
 }
 
 pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
+    anyhow::ensure!(
+        a.rtl.board.is_none(),
+        "--board: dynrt sim writes no constraints; give the board to dynrt rtl"
+    );
     let (scene, name, params) = setup(&a.rtl)?;
     let (mhz, clock_source) = fps_clock(&a)?;
     let out = OutputDir::create(&a.rtl.out, "--out")?;
@@ -219,16 +238,7 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         text.push(format!("  left out: {l}"));
     }
     for (k, f) in r.frames.iter().enumerate() {
-        s.add_frame(FrameResult {
-            frame: k,
-            simulator: sim.name().to_string(),
-            cycles: f.cycles,
-            instructions: f.instructions,
-            rays: f.pixels,
-            cycles_per_ray: f.cycles_per_ray(),
-            differing_pixels: f.differing_pixels,
-            pass: f.differing_pixels == 0,
-        });
+        s.add_frame(f.result(k, sim.name().to_string()));
         text.push(format!(
             "  frame {k}: {} cycles, {} instructions, {:.1} cycles per primary ray, {:.1} fps at {mhz:.1} MHz ({:.2} fps at 512x384): {}",
             f.cycles,
@@ -265,9 +275,13 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         ),
         format!("engine issue slots by routine: {}", shares.join(", ")),
         format!(
-            "simulated {:.0} cycles/s (compile {:.1} s, run {:.1} s)",
+            "simulated {:.0} cycles/s ({}, run {:.1} s)",
             r.simulated_cycles_per_second(),
-            r.compile_seconds,
+            if r.reused_build {
+                "the build of the last run reused".to_string()
+            } else {
+                format!("compile {:.1} s", r.compile_seconds)
+            },
             r.run_seconds
         ),
     ];

@@ -1,9 +1,9 @@
 //! `dynrt stress`: the seeded numerical stress suite; exits non-zero when an invariant breaks.
 
 use clap::Args;
+use dynrt::fp::Format;
 use dynrt::provenance::GeneratedBy;
 use dynrt::report::RunSummary;
-use dynrt::fp::Format;
 use dynrt::stress::{run_stress, StressConfig};
 use std::path::PathBuf;
 
@@ -60,11 +60,14 @@ pub fn run(a: StressArgs) -> anyhow::Result<i32> {
     }
     dynrt::output::check_output_dir(&a.out, "--out")?;
     let mut s = RunSummary::new("stress", &GeneratedBy::this_run(false));
-    s.option("formats", c.formats.iter().map(|f| f.to_string()).collect::<Vec<_>>())
-        .option("rays", c.rays)
-        .option("margins", &c.edge_margins)
-        .option("meshes", &a.meshes)
-        .option("seed", format!("{:#x}", a.seed));
+    s.option(
+        "formats",
+        c.formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
+    )
+    .option("rays", c.rays)
+    .option("margins", &c.edge_margins)
+    .option("meshes", &a.meshes)
+    .option("seed", format!("{:#x}", a.seed));
     c.mesh_dir = a.meshes;
     c.seed = a.seed;
     if !a.json {
@@ -76,14 +79,18 @@ pub fn run(a: StressArgs) -> anyhow::Result<i32> {
     report.save_csv(&csv)?;
     for r in &report.rows {
         s.add_check(
-            &format!("{} / {} / {} / margin {}", r.case, r.subject, r.format, r.edge_margin),
+            &format!(
+                "{} / {} / {} / margin {}",
+                r.case, r.subject, r.format, r.edge_margin
+            ),
             r.held,
             &format!(
                 "{} failures in {} rays ({:.1} ppm, bound {}){}{}",
                 r.failures,
                 r.rays,
                 r.ppm(),
-                r.bound_ppm.map_or("none".to_string(), |b| format!("{b} ppm")),
+                r.bound_ppm
+                    .map_or("none".to_string(), |b| format!("{b} ppm")),
                 if r.nonfinite > 0 {
                     format!(", {} non-finite colours", r.nonfinite)
                 } else {

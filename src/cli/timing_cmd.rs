@@ -109,6 +109,7 @@ fn emit(
                 None,
                 &gen,
                 &dynrt::provenance::GeneratedBy::this_run(false),
+                None,
             )?;
             let src = gen.join("rtl").join(format!("{PROCESSOR_TOP}.v"));
             (

@@ -327,7 +327,7 @@ pub fn processor_testbench(
         v,
         "// tb: runs {} frame(s) of {PROCESSOR_TOP}. Plusargs: +mem_dir=DIR (the memory images, \
          default mem),\n// +out_dir=DIR (where frame<k>.hex and frame<k>.stats go, default .), \
-         +vga (capture a displayed frame).\n\
+         +vga (capture a displayed frame),\n// +heartbeat=N (a progress line every N clocks).\n\
          `timescale 1ns/1ps\nmodule tb;",
         frames.updates.len() + 1
     );
@@ -341,7 +341,10 @@ pub fn processor_testbench(
             }
         }
     }
-    let _ = writeln!(v, "  integer px;\n  string mem_dir, out_dir;");
+    let _ = writeln!(
+        v,
+        "  integer px;\n  string mem_dir, out_dir;\n  reg [63:0] clocks = 0, heartbeat = 0;\n  integer frame = 0, rays = 0;"
+    );
     for (b, name) in BANK_NAMES.iter().enumerate() {
         let _ = writeln!(
             v,
@@ -359,6 +362,14 @@ pub fn processor_testbench(
         v,
         "  {PROCESSOR_TOP} dut({});\n\
          \x20 always #5 clock = ~clock;\n\
+         \x20 // +heartbeat=N: a progress line every N clocks (frame, clocks, pixels written).\n\
+         \x20 initial if (!$value$plusargs(\"heartbeat=%d\", heartbeat)) heartbeat = 0;\n\
+         \x20 always @(posedge clock) begin\n\
+         \x20   clocks <= clocks + 1;\n\
+         \x20   if (fb_write) rays <= rays + 1;\n\
+         \x20   if (heartbeat != 0 && clocks % heartbeat == 0 && clocks != 0)\n\
+         \x20     $display(\"dynrt-heartbeat frame %0d: %0d cycles, %0d rays\", frame, cycles, rays);\n\
+         \x20 end\n\
          \x20 // The display's pixel clock (25 MHz against the core's 100 MHz here; running only with\n\
          \x20 // +vga, so that frame runs do not simulate it) and its read port on the frame bank,\n\
          \x20 // one clock of latency.\n\
@@ -421,7 +432,7 @@ pub fn processor_testbench(
         }
         let _ = writeln!(
             v,
-            "    @(negedge clock) start = 1'b1;\n    @(negedge clock) start = 1'b0;\n\
+            "    frame = {fr}; rays = 0;\n    @(negedge clock) start = 1'b1;\n    @(negedge clock) start = 1'b0;\n\
              \x20   n = 0;\n    while (!done && n < {limit}) begin @(posedge clock); n = n + 1; end\n\
              \x20   if (!done) begin\n      $display(\"TIMEOUT: frame {fr} not done after {limit} clocks\");\n\
              \x20     $fatal(1, \"timeout\");\n    end\n\

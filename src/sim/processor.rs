@@ -39,6 +39,8 @@ pub struct ProcessorSim {
     pub frames: Vec<SimFrame>,
     pub compile_seconds: f64,
     pub run_seconds: f64,
+    /// The build folder of an earlier run with the same Verilog was run again.
+    pub reused_build: bool,
     pub tool_version: String,
     /// With `capture_vga`: the visible pixels of the display's next frame after the last
     /// rendered one, `0xRRGGBB` in raster order.
@@ -119,6 +121,7 @@ pub fn write_processor_files(
         testbench: tb_path,
         mem,
         ports: rtl.ports,
+        frames,
     })
 }
 
@@ -131,6 +134,8 @@ pub struct ProcessorFiles {
     pub testbench: PathBuf,
     pub mem: Vec<PathBuf>,
     pub ports: Vec<TopPort>,
+    /// What the testbench knows about the frames (bank sizes, updates, frame buffer).
+    pub frames: TestbenchFrames,
 }
 
 /// How to run a processor simulation.
@@ -144,7 +149,8 @@ pub struct SimRun {
     pub capture_vga: bool,
 }
 
-/// Simulates the processor for `program` on `layouts` as `run` says, in `dir`.
+/// Simulates the processor for `program` on `layouts` as `run` says, in `dir`. The build
+/// folder `dir/build_tb_<simulator>` is kept and reused while the Verilog does not change.
 pub fn simulate_processor(
     program: &Program,
     layouts: &[Layout],
@@ -175,10 +181,17 @@ pub fn simulate_processor(
     let _ = std::fs::remove_file(&vga_path);
     let mut job = SimJob::new(dir, vec![files.rtl, files.testbench], "tb")
         .timeout(Duration::from_secs(3600))
-        .verilator_build(VerilatorBuild::Fast);
+        .verilator_build(VerilatorBuild::Fast)
+        .reuse_build(true);
     if capture_vga {
         job = job.plusarg("vga");
     }
+    // A heartbeat every few seconds of either simulator (Icarus runs the processor at
+    // 150-400 clocks/s, Verilator at about 250k).
+    job = job.plusarg(match sim {
+        Simulator::Icarus => "heartbeat=2000",
+        Simulator::Verilator => "heartbeat=1000000",
+    });
     let timeout = |detail: &str| {
         anyhow::anyhow!(
             "{}: the processor did not finish a frame within {cycle_limit} clocks (the \
@@ -188,7 +201,14 @@ pub fn simulate_processor(
         )
     };
     // The testbench ends a timed-out run with $fatal, so the tool reports a failure.
-    let run = match sim::run(sim, &job) {
+    crate::progress::report(&format!("compiling the processor for {}", sim.name()));
+    let compiled = sim::compile(sim, &job)?;
+    crate::progress::report(&format!(
+        "simulating {} frame(s) in {}",
+        layouts.len(),
+        sim.name()
+    ));
+    let run = match compiled.run(&job.plusargs, job.timeout) {
         Ok(run) => run,
         Err(e) if e.to_string().contains("TIMEOUT") => return Err(timeout(&e.to_string())),
         Err(e) => return Err(e.into()),
@@ -265,6 +285,7 @@ pub fn simulate_processor(
         vga,
         compile_seconds: run.compile_seconds,
         run_seconds: run.run_seconds,
+        reused_build: run.reused_build,
         tool_version: sim::tool_version(sim).unwrap_or_default(),
     })
 }
