@@ -536,3 +536,34 @@ fn rtl_takes_a_board_file_for_the_ucf() {
     );
     assert!(!bad.exists(), "a refused board leaves no output folder");
 }
+
+/// `dynrt stress --out DIR` writes its CSV beside summary.json, report.md and junit.xml, one
+/// check and one test case per row of the CSV.
+#[test]
+fn stress_writes_its_table_and_a_summary_into_its_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("stress");
+    let (code, stdout, err) = dynrt(&[
+        "stress",
+        "--formats",
+        "e7m16",
+        "--rays",
+        "100",
+        "--margins",
+        "64",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value = serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}"));
+    let csv = std::fs::read_to_string(out.join("stress.csv")).unwrap();
+    let rows = csv.lines().count() - 1;
+    let checks = j["checks"].as_array().unwrap();
+    assert!(rows > 10, "{csv}");
+    assert_eq!(checks.len(), rows, "one check per CSV row");
+    assert_eq!(j["pass"], checks.iter().all(|c| c["pass"] == true));
+    let xml = std::fs::read_to_string(out.join("junit.xml")).unwrap();
+    assert!(xml.contains(&format!("tests=\"{rows}\"")), "{xml}");
+    assert!(out.join("report.md").is_file() && out.join("summary.json").is_file());
+}
