@@ -567,3 +567,32 @@ fn stress_writes_its_table_and_a_summary_into_its_folder() {
     assert!(xml.contains(&format!("tests=\"{rows}\"")), "{xml}");
     assert!(out.join("report.md").is_file() && out.join("summary.json").is_file());
 }
+
+/// `dynrt bench scenes` leaves summary.json and report.md beside its tables, naming them.
+#[test]
+fn bench_writes_a_summary_beside_its_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let tiny = scene("tiny.toml");
+    let (code, _, err) = dynrt(&[
+        "bench",
+        "scenes",
+        &tiny,
+        "--formats",
+        "e7m16",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(j["verb"], "bench scenes");
+    assert_eq!(j["options"]["formats"], serde_json::json!(["e7m16"]));
+    assert_eq!(
+        j["files"],
+        serde_json::json!(["report.md", "scenes.csv", "scenes.md", "summary.json"])
+    );
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let table = std::fs::read_to_string(out.join("scenes.md")).unwrap();
+    assert!(md.contains(table.trim()), "report.md holds the table:\n{md}");
+}
