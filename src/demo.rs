@@ -11,6 +11,7 @@ use crate::emit::fp_unit_rtl;
 use crate::fp::{vectors, BinOp, Format};
 use crate::layout::{self, MemoryConfig, SceneTrees};
 use crate::model::{render_golden, Reference};
+use crate::report::{RunSummary, SceneInfo};
 use crate::scene::Scene;
 use crate::sim::{self, run_fp_unit, Simulator};
 use anyhow::Context;
@@ -24,6 +25,8 @@ pub struct DemoConfig {
     pub out: PathBuf,
     /// Random vectors per operator and simulator (edge cases come on top).
     pub vectors: usize,
+    /// The header of the generated files and the report.
+    pub generated_by: crate::provenance::GeneratedBy,
 }
 
 /// What the demo found; `ok` is false when any RTL result differed from the model.
@@ -39,8 +42,18 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
     let params = crate::emit::processor::ProcessorParams::default();
     crate::flow::preflight(&scene, c.format, params, None)?;
     let out_dir = crate::output::OutputDir::create(&c.out, "--out")?;
+    let name = c
+        .scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut summary = RunSummary::new("demo", &c.generated_by);
+    summary.scene = Some(SceneInfo::of(&scene, &name));
+    summary
+        .option("format", c.format.to_string())
+        .option("vectors", c.vectors);
     let mut md = String::new();
-    writeln!(md, "# dynrt demo: {}\n", c.scene.display())?;
+    writeln!(md, "## Scene {}\n", c.scene.display())?;
     writeln!(
         md,
         "{} triangles, {} instances, {}x{} pixels, number format {}.\n",
@@ -132,7 +145,10 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
     let mut ok = true;
     for op in BinOp::ALL {
         let unit = fp_unit_rtl(op, c.format)?;
-        std::fs::write(rtl_dir.join(format!("{}.v", unit.top)), &unit.verilog)?;
+        let path = rtl_dir.join(format!("{}.v", unit.top));
+        let text = format!("{}{}", c.generated_by.comment("//"), unit.verilog);
+        crate::output::write_atomically(&path, text.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
         let want: Vec<u32> = pairs
             .iter()
             .map(|&(a, b)| op.eval(c.format, a, b))
@@ -146,13 +162,20 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
                 .filter(|(a, b)| a != b)
                 .count();
             ok &= bad == 0;
+            let version = sim::tool_version(simulator).unwrap_or_default();
+            summary
+                .tools
+                .insert(simulator.name().to_string(), version.clone());
+            summary.add_check(
+                &format!("{op} in {simulator}"),
+                bad == 0,
+                &format!("{bad} of {} results differ from the model", pairs.len()),
+                Some(run.compile_seconds + run.run_seconds),
+            );
             writeln!(
                 md,
-                "| {op} | {} | {simulator} {} | {:.1} | {:.2} | {bad} |",
-                unit.latency,
-                sim::tool_version(simulator).unwrap_or_default(),
-                run.compile_seconds,
-                run.run_seconds
+                "| {op} | {} | {simulator} {version} | {:.1} | {:.2} | {bad} |",
+                unit.latency, run.compile_seconds, run.run_seconds
             )?;
         }
     }
@@ -161,11 +184,6 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
     // 3. The whole processor: every frame in Verilator at the scene's resolution, and a
     // small frame in Icarus (about 2k simulated clocks per second), against the golden model.
     writeln!(md, "## The ray tracing processor in RTL\n")?;
-    let name = c
-        .scene
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
     let generated = crate::flow::generate_rtl(
         &scene,
         &name,
@@ -173,6 +191,8 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
         params,
         None,
         &c.out.join("processor"),
+        &c.generated_by,
+        None,
     )?;
     writeln!(
         md,
@@ -206,9 +226,13 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
             None,
             simulator,
             &c.out.join(dir),
+            &c.generated_by,
         )?;
         let f0 = &r.frames[0];
         let differing: usize = r.frames.iter().map(|f| f.differing_pixels).sum();
+        for (k, f) in r.frames.iter().enumerate() {
+            summary.add_frame(f.result(k, format!("{simulator} ({dir}/)")));
+        }
         processor_ok &= differing == 0;
         writeln!(
             md,
@@ -229,9 +253,19 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
         "\nFrames: sim_verilator/frame0.png (RTL) and golden0.png; a mismatch writes diff<k>.png and mismatch<k>.txt there."
     )?;
     ok &= processor_ok;
-    let report = c.out.join("report.md");
-    crate::output::write_atomically(&report, md.as_bytes())
-        .with_context(|| format!("writing {}", report.display()))?;
+    summary.left_out = generated.program.left_out.clone();
+    summary.generated.push(format!(
+        "every FP operator of {} (rtl/), the processor (processor/), its simulations (sim_verilator/, sim_icarus/)",
+        c.format
+    ));
+    summary.notes.push(format!(
+        "golden vs reference: {:.3}% equivalent primary hits, PSNR {:.2} dB",
+        100.0 * hits.equivalent_ratio(),
+        img.psnr_db
+    ));
+    summary.details_md = md;
+    summary.write(&c.out, true)?;
+    let report = c.out.join(crate::report::REPORT_MD);
     out_dir.keep();
     let summary = format!(
         "{}: golden {} vs reference: {:.3}% equivalent hits, PSNR {:.1} dB; FP operators and the processor's frames in Icarus and Verilator against the model: {}",

@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use crate::emit::constraints::{write_ucf, Port, PortDirection, UcfOptions};
+use crate::emit::constraints::{write_ucf, BoardPins, Port, PortDirection, UcfOptions};
+use crate::emit::package;
 use crate::emit::processor::{display_mode, ProcessorParams, PROCESSOR_TOP};
 use crate::fp::Format;
 use crate::hw::engine::engine_period;
@@ -20,6 +21,7 @@ use crate::hw::triangle_tester::CLOCKS_PER_TEST;
 use crate::hw::vga::VgaMode;
 use crate::layout::{self, Layout, MemoryConfig, SceneTrees};
 use crate::model::{self, golden::Golden};
+use crate::provenance::GeneratedBy;
 use crate::scene::Scene;
 use crate::sim::processor::{simulate_processor, write_processor_files, ProcessorSim, SimRun};
 use crate::sim::Simulator;
@@ -177,6 +179,7 @@ fn prepare(
     frames: Option<u32>,
 ) -> Result<Prepared> {
     preflight(scene, f, params, frames)?;
+    crate::progress::report("building the kd-trees and memory layouts");
     let layouts = scene_layouts(scene, f, frames)?;
     let deepest = layouts
         .iter()
@@ -210,8 +213,13 @@ fn cycle_limit(predicted: &RunStats, period: u32) -> u64 {
     2 * (engine + tester + traversal) + 100_000
 }
 
-/// Writes the processor for `scene` into `out`: `rtl/`, `testbench/`, `mem/`,
-/// `constraints/dynrt.ucf` and `program.lst` (the microprogram listing).
+/// Writes the processor for `scene` into `out`: `rtl/`, `testbench/`, `mem/`, `cocotb/`,
+/// `constraints/dynrt.ucf`, `program.lst` (the microprogram listing), the FuseSoC core
+/// `dynrt_processor.core`, `files.f`, `PORTS.md`, frame 0's banks as raw binary in `bin/`
+/// and the golden frames `golden<k>.hex`; the generated text files start with
+/// `generated_by`'s header. With a `board` (boards/README.md), the UCF places the ports on its
+/// pins.
+#[allow(clippy::too_many_arguments)]
 pub fn generate_rtl(
     scene: &Scene,
     name: &str,
@@ -219,6 +227,8 @@ pub fn generate_rtl(
     params: ProcessorParams,
     frames: Option<u32>,
     out: &Path,
+    generated_by: &GeneratedBy,
+    board: Option<&BoardPins>,
 ) -> Result<RtlReport> {
     let Prepared {
         layouts,
@@ -226,6 +236,7 @@ pub fn generate_rtl(
         twin: predicted,
         period,
     } = prepare(scene, f, params, frames)?;
+    crate::progress::report("writing the Verilog, testbench and memory images");
     let written = write_processor_files(
         &program,
         &layouts,
@@ -233,6 +244,7 @@ pub fn generate_rtl(
         name,
         cycle_limit(&predicted, period),
         out,
+        generated_by,
     )?;
     let constraints = out.join("constraints");
     std::fs::create_dir_all(&constraints)
@@ -243,11 +255,80 @@ pub fn generate_rtl(
     write_ucf(
         &ucf,
         &processor_ports(&written.ports, &display),
-        &UcfOptions::default(),
+        &UcfOptions {
+            generated_by: generated_by.clone(),
+            board: board.cloned(),
+            ..UcfOptions::default()
+        },
     )?;
     let listing = out.join("program.lst");
     crate::output::write_atomically(&listing, program.listing().as_bytes())
         .with_context(|| format!("writing {}", listing.display()))?;
+    // The golden frames, as the testbench dumps its own (for the cocotb test and any other
+    // testbench that checks the processor: `cmp frame<k>.hex golden<k>.hex`).
+    let mut goldens = Vec::new();
+    for (k, l) in layouts.iter().enumerate() {
+        let path = out.join(format!("golden{k}.hex"));
+        crate::output::write_atomically(
+            &path,
+            frame_hex(&model::render_golden(l, false).rgb).as_bytes(),
+        )
+        .with_context(|| format!("writing {}", path.display()))?;
+        goldens.push(path);
+    }
+    let relative = |p: &Path| {
+        p.strip_prefix(out)
+            .unwrap_or(p)
+            .to_string_lossy()
+            .into_owned()
+    };
+    let (rtl, tb) = (relative(&written.rtl), relative(&written.testbench));
+    let mem: Vec<String> = written.mem.iter().map(|p| relative(p)).collect();
+    let description = format!(
+        "dynrt ray tracing processor for scene {name}: format {f}, {}x{} pixels, {} threads, SRAM read latency {}, {} frame(s)",
+        info.width,
+        info.height,
+        params.threads,
+        params.mem_latency,
+        layouts.len()
+    );
+    let core = out.join(package::CORE_FILE);
+    let files_f = out.join(package::FILES_F);
+    let core_text = package::fusesoc_core(
+        &package::CoreFiles {
+            scene_name: name,
+            description: &description,
+            rtl: &rtl,
+            testbench: &tb,
+            mem: &mem,
+        },
+        generated_by,
+    );
+    let list_text = package::files_f(&[rtl, tb], generated_by);
+    let ports_md = out.join("PORTS.md");
+    let ports_text = package::ports_md(
+        &written.ports,
+        params.mem_latency,
+        &written.frames,
+        generated_by,
+    );
+    let bin_dir = out.join("bin");
+    let bins: Vec<(PathBuf, Vec<u8>)> = layouts[0]
+        .banks
+        .iter()
+        .enumerate()
+        .map(|(b, words)| {
+            let name = crate::emit::bank_file_name(b).replace(".hex", ".bin");
+            (bin_dir.join(name), package::bank_bin(words))
+        })
+        .collect();
+    let mut writes: Vec<(&Path, &[u8])> = vec![
+        (&core, core_text.as_bytes()),
+        (&files_f, list_text.as_bytes()),
+        (&ports_md, ports_text.as_bytes()),
+    ];
+    writes.extend(bins.iter().map(|(p, b)| (p.as_path(), b.as_slice())));
+    crate::output::write_all_atomically(&writes)?;
     Ok(RtlReport {
         program,
         frames: layouts.len(),
@@ -257,7 +338,15 @@ pub fn generate_rtl(
             ucf,
             listing,
             out.join("mem"),
-        ],
+            core,
+            files_f,
+            ports_md,
+            bin_dir,
+            out.join("cocotb"),
+        ]
+        .into_iter()
+        .chain(goldens)
+        .collect(),
         predicted,
         period,
     })
@@ -312,6 +401,19 @@ pub struct FrameReport {
 }
 
 impl FrameReport {
+    /// The frame's entry in a run's summary (`report::RunSummary::add_frame`).
+    pub fn result(&self, frame: usize, simulator: String) -> crate::report::FrameResult {
+        crate::report::FrameResult {
+            frame,
+            simulator,
+            cycles: self.cycles,
+            instructions: self.instructions,
+            rays: self.pixels,
+            cycles_per_ray: self.cycles_per_ray(),
+            differing_pixels: self.differing_pixels,
+            pass: self.differing_pixels == 0,
+        }
+    }
     pub fn cycles_per_ray(&self) -> f64 {
         self.cycles as f64 / self.pixels as f64
     }
@@ -354,6 +456,8 @@ pub struct SimReport {
     pub period: u32,
     pub compile_seconds: f64,
     pub run_seconds: f64,
+    /// The simulator's build of an earlier run in `out` was reused (nothing compiled).
+    pub reused_build: bool,
     pub program_len: usize,
     pub left_out: Vec<String>,
 }
@@ -376,8 +480,11 @@ impl SimReport {
     }
 }
 
-/// Generates, simulates and compares every frame of `scene` with the golden model. On a
-/// mismatch writes `diff<k>.png` and a trace of the first differing pixels into `out`.
+/// Generates, simulates and compares every frame of `scene` with the golden model; writes
+/// `frame<k>.png`, `golden<k>.png` and `golden<k>.hex` (the golden frame as the testbench
+/// dumps `frame<k>.hex`, for other testbenches to check against). On a mismatch writes
+/// `diff<k>.png` and a trace of the first differing pixels into `out`.
+#[allow(clippy::too_many_arguments)]
 pub fn simulate_scene(
     scene: &Scene,
     name: &str,
@@ -386,6 +493,7 @@ pub fn simulate_scene(
     frames: Option<u32>,
     sim: Simulator,
     out: &Path,
+    generated_by: &GeneratedBy,
 ) -> Result<SimReport> {
     let Prepared {
         layouts,
@@ -393,6 +501,7 @@ pub fn simulate_scene(
         twin,
         period,
     } = prepare(scene, f, params, frames)?;
+    remove_stale_mismatches(out)?;
     let run: ProcessorSim = simulate_processor(
         &program,
         &layouts,
@@ -404,9 +513,11 @@ pub fn simulate_scene(
             capture_vga: false,
         },
         out,
+        generated_by,
     )?;
     let mut reports = Vec::new();
     for (k, (l, fr)) in layouts.iter().zip(&run.frames).enumerate() {
+        crate::progress::report(&format!("comparing frame {k} with the golden model"));
         let golden = model::render_golden(l, false);
         let (w, h) = (l.info.width, l.info.height);
         let rtl_frame = model::Frame {
@@ -415,6 +526,9 @@ pub fn simulate_scene(
         };
         rtl_frame.save_png(&out.join(format!("frame{k}.png")))?;
         golden.save_png(&out.join(format!("golden{k}.png")))?;
+        let golden_hex = out.join(format!("golden{k}.hex"));
+        crate::output::write_atomically(&golden_hex, frame_hex(&golden.rgb).as_bytes())
+            .with_context(|| format!("writing {}", golden_hex.display()))?;
         let differing: Vec<usize> = (0..(w * h) as usize)
             .filter(|&i| fr.pixels[i] != golden.rgb[i])
             .collect();
@@ -481,9 +595,38 @@ pub fn simulate_scene(
         period,
         compile_seconds: run.compile_seconds,
         run_seconds: run.run_seconds,
+        reused_build: run.reused_build,
         program_len: program.code.len(),
         left_out: program.left_out.clone(),
     })
+}
+
+/// Removes the `diff<k>.png` and `mismatch<k>.txt` of an earlier run in `out`, so that only
+/// this run's mismatches are there afterwards.
+fn remove_stale_mismatches(out: &Path) -> Result<()> {
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let numbered = |prefix: &str, ext: &str| {
+            name.strip_prefix(prefix)
+                .and_then(|r| r.strip_suffix(ext))
+                .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()))
+        };
+        if numbered("diff", ".png") || numbered("mismatch", ".txt") {
+            std::fs::remove_file(e.path())
+                .with_context(|| format!("removing the stale {}", e.path().display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// A frame as the testbench dumps it (`frame<k>.hex`): one `rrggbb` word a line, raster order.
+pub fn frame_hex(rgb: &[u32]) -> String {
+    rgb.iter()
+        .map(|p| format!("{:06x}\n", p & 0xff_ffff))
+        .collect()
 }
 
 fn describe(p: &Program, f: Format, w: &Write) -> String {

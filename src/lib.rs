@@ -7,7 +7,7 @@
 //! `sim`. Outside its tests a stage imports only the stages before it: `emit` writes text and
 //! runs nothing, `sim` runs the simulators on that text and `synth` runs yosys and nextpnr on
 //! it (both through `sim::process`). `fp` (the number format), `units` (the arithmetic
-//! sequences the hardware and the golden model share), `input` and `output` serve every stage.
+//! sequences the hardware and the golden model share), `input`, `output` and `provenance` serve every stage.
 //! `hw` and `model` never import each other: both take their arithmetic from `units`, and
 //! they meet in the tests. `flow`, `demo`, `bench` and `stress` drive whole runs and may use
 //! any stage; nothing here imports the CLI. Tests may reach later stages to check a stage's
@@ -25,6 +25,9 @@ pub mod input;
 pub mod layout;
 pub mod model;
 pub mod output;
+pub mod progress;
+pub mod provenance;
+pub mod report;
 pub mod scene;
 pub mod sim;
 pub mod stress;

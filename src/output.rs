@@ -3,7 +3,8 @@
 //!
 //! Contract:
 //! - [`write_atomically`] writes the bytes to a temporary file beside the target and renames it
-//!   over the target (the temporary file is removed if anything fails). It replaces only a
+//!   over the target (the temporary file is removed if anything fails). A new file gets the
+//!   usual mode (0666 less the umask: 0644), a replaced one keeps its mode. It replaces only a
 //!   regular file or nothing: a symlink, a device node, a FIFO or a directory at the path is
 //!   refused, since the rename would replace the node itself (as root, `/dev/null`).
 //! - [`check_output_file`] and [`check_output_dir`] say before any work whether a path can take
@@ -163,12 +164,38 @@ pub fn check_distinct(outputs: &[(&str, &Path)], inputs: &[(&str, &Path)]) -> Re
     Ok(())
 }
 
+/// The process's umask, from /proc (reading it with umask(2) would change it for a moment
+/// under the other threads); 022 when /proc does not say.
+fn umask() -> u32 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("Umask:"))
+                .and_then(|v| u32::from_str_radix(v.trim(), 8).ok())
+        })
+        .unwrap_or(0o022)
+}
+
+/// The mode a file written to `path` gets: the mode of the regular file it replaces, else
+/// what any program's new file gets (0666 less the umask: 0644 under the usual 022).
+/// tempfile's own 0600 would make every output private to its owner.
+fn output_mode(path: &Path) -> u32 {
+    use std::os::unix::fs::PermissionsExt;
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.is_file() => m.permissions().mode() & 0o7777,
+        _ => 0o666 & !umask(),
+    }
+}
+
 /// A temporary file beside `path`, written and synced, ready to be renamed over it.
 fn staged(path: &Path, bytes: &[u8]) -> std::io::Result<tempfile::NamedTempFile> {
+    use std::os::unix::fs::PermissionsExt;
     let dir = parent_of(path);
     std::fs::create_dir_all(dir)?;
     let mut tmp = tempfile::Builder::new()
         .prefix(".dynrt-partial-")
+        .permissions(std::fs::Permissions::from_mode(output_mode(path)))
         .tempfile_in(dir)?;
     tmp.write_all(bytes)?;
     tmp.as_file().sync_all()?;
@@ -381,6 +408,22 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("256 bytes"), "{e}");
+    }
+
+    #[test]
+    fn outputs_get_the_usual_mode_and_a_replaced_file_keeps_its_own() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let a = dir.path().join("a.txt");
+        write_atomically(&a, b"1").unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&a), 0o666 & !umask());
+        std::fs::set_permissions(&a, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_atomically(&a, b"2").unwrap();
+        assert_eq!(mode(&a), 0o640);
+        let b = dir.path().join("b.txt");
+        write_all_atomically(&[(&b, b"x")]).unwrap();
+        assert_eq!(mode(&b), 0o666 & !umask());
     }
 
     #[test]

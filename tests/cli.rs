@@ -220,3 +220,385 @@ fn rtl_with_synth_reports_the_processors_resources_against_the_device() {
     assert!(out.contains("XC2V6000: LUTs"), "{out}");
     assert!(dir.path().join("synth").is_dir());
 }
+
+/// `dynrt compare` exits 1 when a difference passes a threshold, like OpenImageIO's `idiff`,
+/// and 0 within it; `--json` gives the same figures to a machine.
+#[test]
+fn compare_fails_above_its_thresholds_and_reports_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+    let base = image::RgbImage::from_pixel(4, 2, image::Rgb([100, 100, 100]));
+    let mut other = base.clone();
+    // Two pixels off by 10 in one channel: MSE = 2 * 100 / (3 * 8), PSNR = 38.92 dB.
+    other.put_pixel(0, 0, image::Rgb([110, 100, 100]));
+    other.put_pixel(3, 1, image::Rgb([100, 100, 90]));
+    base.save(&a).unwrap();
+    other.save(&b).unwrap();
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    for (flags, want) in [
+        (vec![], 0),
+        (vec!["--fail-pixels", "2"], 0),
+        (vec!["--fail-pixels", "1"], 1),
+        (vec!["--fail-psnr", "38.9"], 0),
+        (vec!["--fail-psnr", "39"], 1),
+        (vec!["--fail-psnr", "30", "--fail-pixels", "0"], 1),
+    ] {
+        let mut args = vec!["compare", a, b];
+        args.extend(&flags);
+        let (code, out, err) = dynrt(&args);
+        assert_eq!(code, want, "{flags:?}: {out}{err}");
+        assert_eq!(out.contains("FAIL:"), want == 1, "{flags:?}: {out}");
+    }
+    // An image compared with itself passes the strictest thresholds.
+    let (code, _, err) = dynrt(&["compare", a, a, "--fail-pixels", "0", "--fail-psnr", "200"]);
+    assert_eq!(code, 0, "{err}");
+    let (code, out, err) = dynrt(&["compare", a, b, "--fail-pixels", "1", "--json"]);
+    assert_eq!(code, 1, "{err}");
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {out}"));
+    assert_eq!(j["differing_pixels"], 2);
+    assert_eq!(j["pixels"], 8);
+    assert_eq!(j["max_channel_error"], 10);
+    assert_eq!(j["pass"], false);
+    let psnr = j["psnr_db"].as_f64().unwrap();
+    assert!((psnr - 38.92).abs() < 0.01, "{psnr}");
+    // A threshold that is no number is a usage error (2), not a failed comparison.
+    let (code, _, err) = dynrt(&["compare", a, b, "--fail-psnr", "nan"]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, _) = dynrt(&["compare", a, b, "--fail-pixels", "-1"]);
+    assert_eq!(code, 2);
+}
+
+/// The mode a new file gets here: 0666 less the umask.
+fn new_file_mode() -> u32 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap();
+    let umask = status
+        .lines()
+        .find_map(|l| l.strip_prefix("Umask:"))
+        .map(|v| u32::from_str_radix(v.trim(), 8).unwrap())
+        .unwrap();
+    0o666 & !umask
+}
+
+/// The source tree's commit, as git says (None outside a git work tree).
+fn git_head() -> Option<String> {
+    let o = Command::new("git")
+        .args(["-C", env!("CARGO_MANIFEST_DIR"), "rev-parse", "HEAD"])
+        .output()
+        .ok()?;
+    o.status
+        .success()
+        .then(|| String::from_utf8_lossy(&o.stdout).trim().to_string())
+}
+
+/// `dynrt rtl` records its run in summary.json and report.md, starts every generated file with
+/// dynrt's version, the commit and the command, and writes files others can read.
+#[test]
+fn rtl_writes_a_summary_headers_and_readable_files() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tiny");
+    let tiny = scene("tiny.toml");
+    let args = [
+        "rtl",
+        &tiny,
+        "--width",
+        "2",
+        "--height",
+        "2",
+        "--threads",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ];
+    let (code, stdout, err) = dynrt(&args);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value =
+        serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}: {stdout}"));
+    let on_disk: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(j, on_disk, "--json prints the summary.json it writes");
+    assert_eq!(j["verb"], "rtl");
+    assert_eq!(j["pass"], true);
+    assert_eq!(j["dynrt_version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(j["scene"]["name"], "tiny");
+    assert_eq!(j["scene"]["width"], 2);
+    assert_eq!(j["scene"]["triangles"], 40);
+    assert_eq!(j["options"]["threads"], 4);
+    assert_eq!(j["options"]["format"], "e7m16");
+    let command = format!("dynrt {}", args.join(" "));
+    assert_eq!(j["command"], command.as_str());
+    let files: Vec<String> = j["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap().to_string())
+        .collect();
+    for want in [
+        "rtl/dynrt_processor.v",
+        "testbench/tb.v",
+        "mem/bank0_nodes.hex",
+        "constraints/dynrt.ucf",
+        "dynrt_processor.core",
+        "files.f",
+        "golden0.hex",
+        "cocotb/test_dynrt_processor.py",
+        "cocotb/processor.json",
+        "program.lst",
+        "PORTS.md",
+        "bin/bank0_nodes.bin",
+        "summary.json",
+        "report.md",
+    ] {
+        assert!(files.iter().any(|f| f == want), "{want} not in {files:?}");
+    }
+    // Every file listed is there, and readable by others like any program's new file.
+    for f in &files {
+        let mode = std::fs::metadata(out.join(f))
+            .unwrap_or_else(|e| panic!("{f}: {e}"))
+            .permissions()
+            .mode();
+        assert_eq!(mode & 0o777, new_file_mode(), "{f}: mode {mode:o}");
+    }
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.starts_with("# dynrt rtl: PASS"), "{md}");
+    assert!(md.contains("| --threads | 4 |"), "{md}");
+    let first = format!("generated by dynrt {}", env!("CARGO_PKG_VERSION"));
+    let commit = git_head().map(|h| format!("(commit {}", &h[..12]));
+    for (f, marker) in [
+        ("rtl/dynrt_processor.v", "//"),
+        ("testbench/tb.v", "//"),
+        ("mem/bank0_nodes.hex", "//"),
+        ("constraints/dynrt.ucf", "#"),
+        ("files.f", "//"),
+    ] {
+        let text = std::fs::read_to_string(out.join(f)).unwrap();
+        let mut lines = text.lines();
+        let (l1, l2) = (lines.next().unwrap(), lines.next().unwrap());
+        assert!(l1.starts_with(&format!("{marker} {first}")), "{f}: {l1}");
+        if let Some(c) = &commit {
+            assert!(l1.contains(c.as_str()), "{f}: {l1} names no commit {c}");
+        }
+        assert_eq!(l2, format!("{marker} command: {command}"), "{f}");
+    }
+    // PORTS.md documents every port of the top module, and bin/ holds each bank's words.
+    let ports = std::fs::read_to_string(out.join("PORTS.md")).unwrap();
+    let v = std::fs::read_to_string(out.join("rtl/dynrt_processor.v")).unwrap();
+    let header = &v[v.find("\nmodule dynrt_processor(").unwrap()..];
+    let names: Vec<&str> = header[24..header.find(");").unwrap()].split(',').collect();
+    assert!(names.len() > 25, "{names:?}");
+    for n in &names {
+        assert!(ports.contains(&format!("| `{n}` |")), "PORTS.md lacks {n}");
+    }
+    assert!(!ports.contains("(undocumented)"), "{ports}");
+    assert!(ports.contains("exactly 2 clocks after"), "{ports}");
+    let hex = std::fs::read_to_string(out.join("mem/bank2_triangles_uv.hex")).unwrap();
+    let words: Vec<u32> = hex
+        .lines()
+        .filter(|l| !l.starts_with("//") && !l.starts_with('@'))
+        .map(|l| u32::from_str_radix(l, 16).unwrap())
+        .collect();
+    let bin = std::fs::read(out.join("bin/bank2_triangles_uv.bin")).unwrap();
+    let from_bin: Vec<u32> = bin
+        .chunks(4)
+        .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    assert!(!words.is_empty());
+    assert_eq!(
+        from_bin, words,
+        "bin/ holds the .hex image's words, little endian"
+    );
+    let core = std::fs::read_to_string(out.join("dynrt_processor.core")).unwrap();
+    assert!(core.starts_with("CAPI=2:\n# generated by dynrt"), "{core}");
+    // --stable-header leaves the commit out (for checked-in files).
+    let stable = dir.path().join("stable");
+    let (code, _, err) = dynrt(&[
+        "rtl",
+        &tiny,
+        "--width",
+        "2",
+        "--height",
+        "2",
+        "--out",
+        stable.to_str().unwrap(),
+        "--stable-header",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v = std::fs::read_to_string(stable.join("rtl/dynrt_processor.v")).unwrap();
+    assert!(
+        v.starts_with(&format!("// {first}; do not edit")),
+        "{}",
+        v.lines().next().unwrap()
+    );
+}
+
+/// `dynrt sim` in Icarus on a 2x2 frame of one box (about 10 s): the frame equals golden0.hex, which it writes beside
+/// the PNG; summary.json and junit.xml record the frame; an earlier run's diff images go.
+#[test]
+fn sim_writes_golden_hex_junit_and_removes_stale_diffs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sim");
+    std::fs::create_dir(&out).unwrap();
+    for stale in ["diff0.png", "mismatch3.txt"] {
+        std::fs::write(out.join(stale), "old").unwrap();
+    }
+    std::fs::write(out.join("diffuse.png"), "mine").unwrap();
+    let one_box = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/one_box.toml");
+    let (code, stdout, err) = dynrt(&[
+        "sim",
+        one_box.to_str().unwrap(),
+        "--threads",
+        "4",
+        "--sim",
+        "iverilog",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}{err}");
+    assert!(!out.join("diff0.png").exists() && !out.join("mismatch3.txt").exists());
+    assert!(
+        out.join("diffuse.png").exists(),
+        "only dynrt's own names go"
+    );
+    let golden = std::fs::read_to_string(out.join("golden0.hex")).unwrap();
+    assert_eq!(golden.lines().count(), 4);
+    assert_eq!(
+        std::fs::read_to_string(out.join("frame0.hex")).unwrap(),
+        golden,
+        "the testbench's frame equals the golden frame word for word"
+    );
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(j["verb"], "sim");
+    assert_eq!(j["frames"][0]["pass"], true);
+    assert_eq!(j["frames"][0]["rays"], 4);
+    assert!(j["frames"][0]["cycles"].as_u64().unwrap() > 100, "{j}");
+    assert!(
+        j["tools"]["iverilog"].as_str().unwrap().starts_with("1"),
+        "{j}"
+    );
+    let xml = std::fs::read_to_string(out.join("junit.xml")).unwrap();
+    assert!(
+        xml.contains("tests=\"1\"") && xml.contains("failures=\"0\""),
+        "{xml}"
+    );
+}
+
+/// `dynrt rtl --board FILE` places the ports on the board's pins in the UCF; a board that
+/// names a port the processor lacks is refused with the file and the entry, and nothing is
+/// left behind.
+#[test]
+fn rtl_takes_a_board_file_for_the_ucf() {
+    let dir = tempfile::tempdir().unwrap();
+    let board = dir.path().join("b.toml");
+    std::fs::write(
+        &board,
+        "name = \"test board\"\n[pins]\nclock = \"ak17\"\n\"fb_data<3>\" = \"C7\"\n[iostandard]\nvga_rgb = \"LVCMOS33\"\n",
+    )
+    .unwrap();
+    let out = dir.path().join("r");
+    let tiny = scene("tiny.toml");
+    let (code, _, err) = dynrt(&[
+        "rtl",
+        &tiny,
+        "--width",
+        "2",
+        "--height",
+        "2",
+        "--board",
+        board.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let ucf = std::fs::read_to_string(out.join("constraints/dynrt.ucf")).unwrap();
+    assert!(ucf.contains("NET \"clock\" LOC = \"AK17\";"), "{ucf}");
+    assert!(ucf.contains("NET \"fb_data<3>\" LOC = \"C7\";"), "{ucf}");
+    assert!(
+        ucf.contains("NET \"vga_rgb<*>\" IOSTANDARD = LVCMOS33;"),
+        "{ucf}"
+    );
+    std::fs::write(&board, "[pins]\nno_such_port = \"A1\"\n").unwrap();
+    let bad = dir.path().join("bad");
+    let (code, _, err) = dynrt(&[
+        "rtl",
+        &tiny,
+        "--width",
+        "2",
+        "--height",
+        "2",
+        "--board",
+        board.to_str().unwrap(),
+        "--out",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("b.toml") && err.contains("no_such_port"),
+        "{err}"
+    );
+    assert!(!bad.exists(), "a refused board leaves no output folder");
+}
+
+/// `dynrt stress --out DIR` writes its CSV beside summary.json, report.md and junit.xml, one
+/// check and one test case per row of the CSV.
+#[test]
+fn stress_writes_its_table_and_a_summary_into_its_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("stress");
+    let (code, stdout, err) = dynrt(&[
+        "stress",
+        "--formats",
+        "e7m16",
+        "--rays",
+        "100",
+        "--margins",
+        "64",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value = serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}"));
+    let csv = std::fs::read_to_string(out.join("stress.csv")).unwrap();
+    let rows = csv.lines().count() - 1;
+    let checks = j["checks"].as_array().unwrap();
+    assert!(rows > 10, "{csv}");
+    assert_eq!(checks.len(), rows, "one check per CSV row");
+    assert_eq!(j["pass"], checks.iter().all(|c| c["pass"] == true));
+    let xml = std::fs::read_to_string(out.join("junit.xml")).unwrap();
+    assert!(xml.contains(&format!("tests=\"{rows}\"")), "{xml}");
+    assert!(out.join("report.md").is_file() && out.join("summary.json").is_file());
+}
+
+/// `dynrt bench scenes` leaves summary.json and report.md beside its tables, naming them.
+#[test]
+fn bench_writes_a_summary_beside_its_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let tiny = scene("tiny.toml");
+    let (code, _, err) = dynrt(&[
+        "bench",
+        "scenes",
+        &tiny,
+        "--formats",
+        "e7m16",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(j["verb"], "bench scenes");
+    assert_eq!(j["options"]["formats"], serde_json::json!(["e7m16"]));
+    assert_eq!(
+        j["files"],
+        serde_json::json!(["report.md", "scenes.csv", "scenes.md", "summary.json"])
+    );
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let table = std::fs::read_to_string(out.join("scenes.md")).unwrap();
+    assert!(
+        md.contains(table.trim()),
+        "report.md holds the table:\n{md}"
+    );
+}

@@ -1,13 +1,42 @@
 //! The checked-in generated files (rtl_out/, testbench/) are exactly what the generator
 //! writes today; `make rtl` regenerates them after a generator change.
+//!
+//! Their headers name dynrt's version and the `make rtl` command that made them, without a
+//! commit (`--stable-header`), so they are compared whole, header included: the headers here
+//! are built from the commands in the Makefile's `rtl` target, and a version bump or a changed
+//! command makes them stale like any other change of the generator's output.
 
 use dynrt::emit::{fp_unit_rtl, fp_unit_testbench};
 use dynrt::fp::{BinOp, Format};
+use dynrt::provenance::GeneratedBy;
 use std::path::Path;
+
+/// The header of the files `make rtl` makes with `command` (its arguments after `dynrt`).
+fn make_rtl_header(command: &str) -> GeneratedBy {
+    let makefile =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("Makefile")).unwrap();
+    let make_line = format!(
+        "$(DYNRT) {}",
+        command.replace("out/rtl/cornell", "$(RTL_TMP)")
+    );
+    assert!(
+        makefile.contains(&make_line),
+        "the Makefile's rtl target no longer runs `{make_line}`: keep this test in step"
+    );
+    GeneratedBy {
+        version: dynrt::provenance::VERSION.to_string(),
+        commit: None,
+        command: Some(format!("dynrt {command}")),
+    }
+}
 
 #[test]
 fn checked_in_fp_operator_verilog_matches_the_generator() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let header = make_rtl_header(
+        "emit-fp --format e7m16 --rtl rtl_out/fp --testbench testbench/fp --stable-header",
+    )
+    .comment("//");
     for op in BinOp::ALL {
         let unit = fp_unit_rtl(op, Format::E7M16).unwrap();
         let rtl = root.join("rtl_out/fp").join(format!("{}.v", unit.top));
@@ -20,14 +49,14 @@ fn checked_in_fp_operator_verilog_matches_the_generator() {
         };
         assert_eq!(
             std::fs::read_to_string(&rtl).unwrap_or_default(),
-            unit.verilog,
+            format!("{header}{}", unit.verilog),
             "{}",
             stale(&rtl)
         );
         let want_tb = fp_unit_testbench(&unit, Format::E7M16, 1000, "vectors.hex", "results.hex");
         assert_eq!(
             std::fs::read_to_string(&tb).unwrap_or_default(),
-            want_tb,
+            format!("{header}{want_tb}"),
             "{}",
             stale(&tb)
         );
@@ -47,6 +76,8 @@ fn checked_in_processor_of_the_default_scene_matches_the_generator() {
         ProcessorParams::default(),
         None,
         dir.path(),
+        &make_rtl_header("rtl scenes/cornell.toml --out out/rtl/cornell --stable-header"),
+        None,
     )
     .unwrap();
     let mut pairs = vec![

@@ -5,6 +5,7 @@
 use dynrt::emit::processor::ProcessorParams;
 use dynrt::flow;
 use dynrt::fp::Format;
+use dynrt::provenance::GeneratedBy;
 use dynrt::scene::Scene;
 use dynrt::sim::Simulator;
 use std::path::Path;
@@ -29,6 +30,7 @@ fn check(name: &str, w: u32, h: u32, frames: Option<u32>, sim: Simulator) {
         frames,
         sim,
         dir.path(),
+        &GeneratedBy::library(),
     )
     .unwrap_or_else(|e| panic!("{name} in {}: {e:#}", sim.name()));
     for (k, f) in r.frames.iter().enumerate() {
@@ -106,6 +108,7 @@ fn a_frame_that_cannot_finish_in_time_is_a_clear_timeout_error() {
             capture_vga: false,
         },
         dir.path(),
+        &GeneratedBy::library(),
     )
     .unwrap_err();
     let msg = format!("{e:#}");
@@ -140,6 +143,7 @@ fn the_display_shows_the_rendered_frame_magnified_and_centred() {
             capture_vga: true,
         },
         dir.path(),
+        &GeneratedBy::library(),
     )
     .unwrap_or_else(|e| panic!("{e:#}"));
     let fb = &r.frames.last().unwrap().pixels;

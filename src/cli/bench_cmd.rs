@@ -3,6 +3,8 @@
 use clap::{Args, Subcommand};
 use dynrt::bench;
 use dynrt::fp::Format;
+use dynrt::provenance::GeneratedBy;
+use dynrt::report::RunSummary;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -62,6 +64,14 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 
 pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
     dynrt::output::check_output_dir(&a.out, "--out")?;
+    let verb = match &a.what {
+        BenchWhat::Fp { .. } => "bench fp",
+        BenchWhat::Precision { .. } => "bench precision",
+        BenchWhat::Scenes { .. } => "bench scenes",
+    };
+    // The folder's summary.json and report.md describe its latest bench run (every bench
+    // writes its own tables beside them).
+    let mut s = RunSummary::new(verb, &GeneratedBy::this_run(false));
     match a.what {
         BenchWhat::Fp { formats, vectors } => {
             let work = tempfile::tempdir()?;
@@ -70,8 +80,16 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             let t = bench::fp::fp_table(&rows);
             t.save(&a.out, "fp")?;
             print!("{}", t.to_markdown());
+            s.option(
+                "formats",
+                formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
+            )
+            .option("vectors", vectors);
+            s.details_md = t.to_markdown();
             if let Some(r) = rows.first() {
                 println!("yosys: {} ({})", r.synth.yosys_version, r.synth.command);
+                s.tools
+                    .insert("yosys".into(), r.synth.yosys_version.clone());
             }
         }
         BenchWhat::Precision {
@@ -89,10 +107,15 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             for p in bench::write_outputs(&rows, &a.out)? {
                 println!("wrote {}", p.display());
             }
-            let s = bench::summarize(&rows);
-            print!("{}", bench::precision::summary_csv(&s));
-            if let Some(r) = bench::recommend(&s, 1e-3, 100.0) {
+            let summary = bench::summarize(&rows);
+            let csv = bench::precision::summary_csv(&summary);
+            print!("{csv}");
+            s.option("margin", margin)
+                .option("resolution", resolution.map(|(w, h)| format!("{w}x{h}")));
+            s.details_md = format!("## Summary (CSV)\n\n```\n{csv}```\n");
+            if let Some(r) = bench::recommend(&summary, 1e-3, 100.0) {
                 println!("recommended: {}", r.format);
+                s.notes.push(format!("recommended format: {}", r.format));
             }
         }
         BenchWhat::Scenes {
@@ -109,8 +132,16 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             let t = bench::scenes::scenes_table(&rows);
             t.save(&a.out, "scenes")?;
             print!("{}", t.to_markdown());
+            s.option("scenes", &scenes)
+                .option(
+                    "formats",
+                    formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
+                )
+                .option("resolution", resolution.map(|(w, h)| format!("{w}x{h}")));
+            s.details_md = t.to_markdown();
         }
     }
+    s.write(&a.out, false)?;
     println!("written to {}", a.out.display());
     Ok(0)
 }

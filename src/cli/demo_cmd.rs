@@ -24,6 +24,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<i32> {
         format: a.format,
         out: a.out,
         vectors: a.vectors,
+        generated_by: dynrt::provenance::GeneratedBy::this_run(false),
     };
     let r = run_demo(&config)?;
     println!("{}", r.summary);

@@ -21,19 +21,24 @@ pub struct EmitFpArgs {
     /// Number of vectors the testbenches read.
     #[arg(long, default_value_t = 1000)]
     pub vectors: usize,
+    /// Leave the commit out of the files' headers (for files checked into version control;
+    /// `make rtl` uses it).
+    #[arg(long)]
+    pub stable_header: bool,
 }
 
 pub fn run(a: EmitFpArgs) -> anyhow::Result<i32> {
     dynrt::output::check_output_dir(&a.rtl, "--rtl")?;
     dynrt::output::check_output_dir(&a.testbench, "--testbench")?;
+    let header = dynrt::provenance::GeneratedBy::this_run(a.stable_header).comment("//");
     for op in BinOp::ALL {
         let unit = fp_unit_rtl(op, a.format)?;
         let rtl = a.rtl.join(format!("{}.v", unit.top));
-        write_atomically(&rtl, unit.verilog.as_bytes())
+        write_atomically(&rtl, format!("{header}{}", unit.verilog).as_bytes())
             .with_context(|| format!("writing {}", rtl.display()))?;
         let tb = fp_unit_testbench(&unit, a.format, a.vectors, "vectors.hex", "results.hex");
         let tb_path = a.testbench.join(format!("tb_{}.v", unit.top));
-        write_atomically(&tb_path, tb.as_bytes())
+        write_atomically(&tb_path, format!("{header}{tb}").as_bytes())
             .with_context(|| format!("writing {}", tb_path.display()))?;
         println!(
             "{} (latency {}) -> {}, {}",

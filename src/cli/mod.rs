@@ -6,6 +6,7 @@ mod compare_cmd;
 mod demo_cmd;
 mod emit_fp_cmd;
 mod fp_cmd;
+mod info_cmd;
 mod render_cmd;
 mod rtl_cmd;
 mod stress_cmd;
@@ -18,7 +19,14 @@ use clap::{Parser, Subcommand};
 #[command(
     name = "dynrt",
     version,
-    about = "Generates a SaarCOR DynRT-style ray tracing processor from a 3D scene"
+    about = "Generates a SaarCOR DynRT-style ray tracing processor from a 3D scene",
+    after_help = "Examples:\n  \
+dynrt rtl scenes/tiny.toml --out out/tiny        # Verilog, testbench, images, FuseSoC core\n  \
+dynrt sim scenes/cornell.toml --out out/cornell  # simulate and compare with the golden model\n  \
+dynrt compare a.png b.png --fail-pixels 0        # exit 1 when any pixel differs\n  \
+dynrt info                                       # versions of dynrt and its tools\n\n\
+Exit status: 0 success, 1 frames or results differ, 2 usage error or bad input, 3 a tool or \
+the machine failed (a simulator missing, a timeout, a full disk), 128+N after signal N."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -50,6 +58,9 @@ enum Command {
     Sim(rtl_cmd::SimArgs),
     /// Run operand vectors through one floating-point operator (RTL or software model).
     Fp(fp_cmd::FpArgs),
+    /// The versions of dynrt and of every tool it finds (simulators, yosys, nextpnr, FuseSoC,
+    /// cocotb).
+    Info(info_cmd::InfoArgs),
 }
 
 /// Runs the command line and returns the process exit status.
@@ -60,6 +71,7 @@ pub fn run() -> i32 {
             "warning: cannot take Ctrl-C and SIGTERM to end the simulators dynrt starts: {e}"
         );
     }
+    let spinner = progress_spinner();
     let result = match cli.command {
         Command::Render(a) => render_cmd::run(a),
         Command::Compare(a) => compare_cmd::run(a),
@@ -72,7 +84,9 @@ pub fn run() -> i32 {
         Command::EmitFp(a) => emit_fp_cmd::run(a),
         Command::Rtl(a) => rtl_cmd::run_rtl(a),
         Command::Sim(a) => rtl_cmd::run_sim(a),
+        Command::Info(a) => info_cmd::run(a),
     };
+    spinner.finish_and_clear();
     match result {
         Ok(code) => code,
         Err(e) => {
@@ -86,6 +100,29 @@ pub fn run() -> i32 {
             exit_code_of(&e)
         }
     }
+}
+
+/// A spinner on stderr that shows the library's progress reports (stages, the testbench's
+/// heartbeat) with the time since the last stage began; indicatif draws nothing when stderr is
+/// not a terminal, so logs and tests see no spinner.
+fn progress_spinner() -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let shown = bar.clone();
+    dynrt::progress::listen(move |m| {
+        // A heartbeat continues its stage; any other report starts a new one.
+        if m.starts_with("frame ") {
+            shown.set_message(format!("simulating {m}"));
+        } else {
+            shown.reset_elapsed();
+            shown.set_message(m.to_string());
+        }
+    });
+    bar
 }
 
 /// Exit status when a command ran into results that differ (frames, vectors, invariants).

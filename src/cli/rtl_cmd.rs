@@ -5,6 +5,8 @@ use dynrt::emit::processor::ProcessorParams;
 use dynrt::flow;
 use dynrt::fp::Format;
 use dynrt::output::OutputDir;
+use dynrt::provenance::GeneratedBy;
+use dynrt::report::{RunSummary, SceneInfo};
 use dynrt::sim::Simulator;
 use std::path::PathBuf;
 
@@ -33,6 +35,17 @@ pub struct RtlArgs {
     /// XC2V6000 (takes minutes).
     #[arg(long)]
     pub synth: bool,
+    /// Board file (TOML, boards/README.md): pin locations and I/O standards for the UCF
+    /// (`rtl` only).
+    #[arg(long, value_name = "FILE")]
+    pub board: Option<PathBuf>,
+    /// Leave the commit out of the generated files' headers, so that files checked into
+    /// version control do not change with every commit (`make rtl` uses it).
+    #[arg(long)]
+    pub stable_header: bool,
+    /// Print the run's summary.json on stdout instead of the text report.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -97,42 +110,105 @@ fn setup(a: &RtlArgs) -> anyhow::Result<(dynrt::scene::Scene, String, ProcessorP
     Ok((scene, name, params))
 }
 
-pub fn run_rtl(a: RtlArgs) -> anyhow::Result<i32> {
-    let (scene, name, params) = setup(&a)?;
-    let out = OutputDir::create(&a.out, "--out")?;
-    let r = flow::generate_rtl(&scene, &name, a.format, params, a.frames, &a.out)?;
-    println!(
-        "{name}: microprogram of {} instructions, {} registers, {} scratch words per thread; {} frame(s)",
+/// The summary of an `rtl` or `sim` run: the scene and the options it ran with.
+fn summary(verb: &str, a: &RtlArgs, scene: &dynrt::scene::Scene, name: &str) -> RunSummary {
+    let mut s = RunSummary::new(verb, &GeneratedBy::this_run(a.stable_header));
+    s.scene = Some(SceneInfo::of(scene, name));
+    s.option("format", a.format.to_string())
+        .option("threads", a.threads)
+        .option("mem_latency", a.mem_latency)
+        .option("frames", a.frames)
+        .option("width", scene.camera.width)
+        .option("height", scene.camera.height)
+        .option("synth", a.synth);
+    s
+}
+
+/// What `rtl` generated, for the summary.
+fn record_generated(s: &mut RunSummary, r: &flow::RtlReport, threads: u32) {
+    s.generated.push(format!(
+        "microprogram of {} instructions, {} registers, {} scratch words per thread",
         r.program.code.len(),
         r.program.registers_used,
-        r.program.scratch.words,
+        r.program.scratch.words
+    ));
+    s.generated.push(format!(
+        "{} frame(s) of memory images; Verilog, testbench, UCF, FuseSoC core, files.f",
         r.frames
-    );
-    for l in &r.program.left_out {
-        println!("left out: {l}");
-    }
-    println!(
-        "predicted frame 0: {} clocks before coprocessor waits ({} threads, a round of {} clocks)",
+    ));
+    s.left_out = r.program.left_out.clone();
+    s.notes.push(format!(
+        "predicted frame 0: {} clocks before coprocessor waits ({threads} threads, a round of {} clocks)",
         r.predicted.rounds * u64::from(r.period),
-        params.threads,
         r.period
-    );
-    for f in &r.files {
-        println!("wrote {}", f.display());
+    ));
+}
+
+pub fn run_rtl(a: RtlArgs) -> anyhow::Result<i32> {
+    let (scene, name, params) = setup(&a)?;
+    let mut s = summary("rtl", &a, &scene, &name);
+    let generated_by = GeneratedBy::this_run(a.stable_header);
+    // The board file is read and checked before anything is written; its pins are checked
+    // against the ports when the UCF is written (a failed run leaves nothing behind).
+    let board = a
+        .board
+        .as_deref()
+        .map(dynrt::emit::load_board)
+        .transpose()?;
+    if let Some(b) = &a.board {
+        s.option("board", b);
     }
-    print_synthesis(&a)?;
+    let out = OutputDir::create(&a.out, "--out")?;
+    let r = flow::generate_rtl(
+        &scene,
+        &name,
+        a.format,
+        params,
+        a.frames,
+        &a.out,
+        &generated_by,
+        board.as_ref(),
+    )?;
+    record_generated(&mut s, &r, params.threads);
+    if !a.json {
+        println!("{name}: {}; {} frame(s)", s.generated[0], r.frames);
+        for l in &s.left_out {
+            println!("left out: {l}");
+        }
+        println!("{}", s.notes[0]);
+        for f in &r.files {
+            println!("wrote {}", f.display());
+        }
+    }
+    synthesis(&a, &mut s)?;
+    s.write(&a.out, false)?;
+    if a.json {
+        println!("{}", s.json());
+    } else {
+        println!("report: {}", a.out.join(dynrt::report::REPORT_MD).display());
+    }
     out.keep();
     Ok(0)
 }
 
-fn print_synthesis(a: &RtlArgs) -> anyhow::Result<()> {
+/// With `--synth`: synthesizes the processor, prints the report (unless `--json`) and puts it
+/// in the summary.
+fn synthesis(a: &RtlArgs, s: &mut RunSummary) -> anyhow::Result<()> {
     if a.synth {
-        println!("{}", flow::synthesize_processor(&a.out)?);
+        let report = flow::synthesize_processor(&a.out)?.to_string();
+        if !a.json {
+            println!("{report}");
+        }
+        s.notes.extend(report.lines().map(str::to_string));
     }
     Ok(())
 }
 
 pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
+    anyhow::ensure!(
+        a.rtl.board.is_none(),
+        "--board: dynrt sim writes no constraints; give the board to dynrt rtl"
+    );
     let (scene, name, params) = setup(&a.rtl)?;
     let (mhz, clock_source) = fps_clock(&a)?;
     let out = OutputDir::create(&a.rtl.out, "--out")?;
@@ -140,6 +216,9 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         SimKind::Iverilog => Simulator::Icarus,
         SimKind::Verilator => Simulator::Verilator,
     };
+    let generated_by = GeneratedBy::this_run(a.rtl.stable_header);
+    let mut s = summary("sim", &a.rtl, &scene, &name);
+    s.option("sim", sim.name()).option("clock_mhz", mhz);
     let r = flow::simulate_scene(
         &scene,
         &name,
@@ -148,14 +227,19 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         a.rtl.frames,
         sim,
         &a.rtl.out,
+        &generated_by,
     )?;
-    println!("{name} in {} ({}):", sim.name(), r.tool_version);
-    println!("  fps at {mhz:.1} MHz ({clock_source})");
+    s.tools
+        .insert(sim.name().to_string(), r.tool_version.clone());
+    s.left_out = r.left_out.clone();
+    let mut text = vec![format!("{name} in {} ({}):", sim.name(), r.tool_version)];
+    text.push(format!("  fps at {mhz:.1} MHz ({clock_source})"));
     for l in &r.left_out {
-        println!("  left out: {l}");
+        text.push(format!("  left out: {l}"));
     }
     for (k, f) in r.frames.iter().enumerate() {
-        println!(
+        s.add_frame(f.result(k, sim.name().to_string()));
+        text.push(format!(
             "  frame {k}: {} cycles, {} instructions, {:.1} cycles per primary ray, {:.1} fps at {mhz:.1} MHz ({:.2} fps at 512x384): {}",
             f.cycles,
             f.instructions,
@@ -167,12 +251,12 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
             } else {
                 format!("{} pixels DIFFER from the golden model", f.differing_pixels)
             }
-        );
+        ));
         for m in &f.mismatches {
-            println!(
+            text.push(format!(
                 "    pixel ({}, {}): rtl {:06x}, golden {:06x}, engine twin {:06x}; golden {}",
                 m.x, m.y, m.rtl, m.golden, m.twin, m.golden_trace
-            );
+            ));
         }
     }
     let shares: Vec<String> = r
@@ -181,30 +265,48 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         .map(|(s, v)| format!("{s} {:.0}%", 100.0 * v))
         .collect();
     let [transform, intersect, traversal] = r.frames[0].unit_busy_shares();
-    println!(
-        "  busy (frame 0): TransformUnit {:.1}%, IntersectUnit {:.1}%, traversal unit {:.1}% of the clocks",
-        100.0 * transform,
-        100.0 * intersect,
-        100.0 * traversal
-    );
-    println!("  engine issue slots by routine: {}", shares.join(", "));
-    println!(
-        "  simulated {:.0} cycles/s (compile {:.1} s, run {:.1} s)",
-        r.simulated_cycles_per_second(),
-        r.compile_seconds,
-        r.run_seconds
-    );
-    print_synthesis(&a.rtl)?;
+    let notes = [
+        format!("fps at {mhz:.1} MHz ({clock_source})"),
+        format!(
+            "busy (frame 0): TransformUnit {:.1}%, IntersectUnit {:.1}%, traversal unit {:.1}% of the clocks",
+            100.0 * transform,
+            100.0 * intersect,
+            100.0 * traversal
+        ),
+        format!("engine issue slots by routine: {}", shares.join(", ")),
+        format!(
+            "simulated {:.0} cycles/s ({}, run {:.1} s)",
+            r.simulated_cycles_per_second(),
+            if r.reused_build {
+                "the build of the last run reused".to_string()
+            } else {
+                format!("compile {:.1} s", r.compile_seconds)
+            },
+            r.run_seconds
+        ),
+    ];
+    text.extend(notes[1..].iter().map(|n| format!("  {n}")));
+    s.notes.extend(notes);
+    if !a.rtl.json {
+        println!("{}", text.join("\n"));
+    }
+    synthesis(&a.rtl, &mut s)?;
+    s.write(&a.rtl.out, true)?;
     // A mismatch is a result, with its diff images and traces: keep them.
     out.keep();
-    if r.identical() {
+    if a.rtl.json {
+        println!("{}", s.json());
+    } else if r.identical() {
         println!("every pixel of every frame is identical");
-        Ok(0)
     } else {
         println!(
             "MISMATCH: diff images and traces in {}",
             a.rtl.out.display()
         );
-        Ok(super::EXIT_DIFFERS)
     }
+    Ok(if r.identical() {
+        0
+    } else {
+        super::EXIT_DIFFERS
+    })
 }

@@ -2,6 +2,8 @@
 
 use clap::Args;
 use dynrt::fp::Format;
+use dynrt::provenance::GeneratedBy;
+use dynrt::report::RunSummary;
 use dynrt::stress::{run_stress, StressConfig};
 use std::path::PathBuf;
 
@@ -19,10 +21,15 @@ pub struct StressArgs {
     /// Directory of public meshes; closed ones join the watertightness cases.
     #[arg(long)]
     pub meshes: Option<PathBuf>,
+    /// Seed of the random rays and cases.
     #[arg(long, default_value_t = 0x5EED)]
     pub seed: u64,
-    #[arg(long, default_value = "out/stress/stress.csv")]
+    /// Output folder: stress.csv, summary.json, report.md, junit.xml.
+    #[arg(long, default_value = "out/stress")]
     pub out: PathBuf,
+    /// Print the run's summary.json on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 pub fn run(a: StressArgs) -> anyhow::Result<i32> {
@@ -51,14 +58,62 @@ pub fn run(a: StressArgs) -> anyhow::Result<i32> {
             "--rays {r}: give 1..=100000000 rays per case"
         );
     }
-    dynrt::output::check_output_file(&a.out, "--out")?;
+    dynrt::output::check_output_dir(&a.out, "--out")?;
+    let mut s = RunSummary::new("stress", &GeneratedBy::this_run(false));
+    s.option(
+        "formats",
+        c.formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
+    )
+    .option("rays", c.rays)
+    .option("margins", &c.edge_margins)
+    .option("meshes", &a.meshes)
+    .option("seed", format!("{:#x}", a.seed));
     c.mesh_dir = a.meshes;
     c.seed = a.seed;
-    println!("seed {:#x}", c.seed);
+    if !a.json {
+        println!("seed {:#x}", c.seed);
+    }
     let report = run_stress(&c, &mut |l| eprintln!("{l}"))?;
-    print!("{}", report.table());
-    report.save_csv(&a.out)?;
-    println!("written to {}", a.out.display());
+    let out = dynrt::output::OutputDir::create(&a.out, "--out")?;
+    let csv = a.out.join("stress.csv");
+    report.save_csv(&csv)?;
+    for r in &report.rows {
+        s.add_check(
+            &format!(
+                "{} / {} / {} / margin {}",
+                r.case, r.subject, r.format, r.edge_margin
+            ),
+            r.held,
+            &format!(
+                "{} failures in {} rays ({:.1} ppm, bound {}){}{}",
+                r.failures,
+                r.rays,
+                r.ppm(),
+                r.bound_ppm
+                    .map_or("none".to_string(), |b| format!("{b} ppm")),
+                if r.nonfinite > 0 {
+                    format!(", {} non-finite colours", r.nonfinite)
+                } else {
+                    String::new()
+                },
+                if r.note.is_empty() {
+                    String::new()
+                } else {
+                    format!("; {}", r.note)
+                }
+            ),
+            None,
+        );
+    }
+    s.details_md = format!("## Cases\n\n{}", report.table());
+    s.write(&a.out, true)?;
+    out.keep();
+    if a.json {
+        println!("{}", s.json());
+    } else {
+        print!("{}", report.table());
+        println!("written to {}", a.out.display());
+    }
     Ok(if report.all_held() {
         0
     } else {

@@ -101,7 +101,16 @@ fn emit(
         }
         Design::Processor { name, scene, .. } => {
             let gen = dir.join("generated");
-            flow::generate_rtl(scene, name, f, params, None, &gen)?;
+            flow::generate_rtl(
+                scene,
+                name,
+                f,
+                params,
+                None,
+                &gen,
+                &dynrt::provenance::GeneratedBy::this_run(false),
+                None,
+            )?;
             let src = gen.join("rtl").join(format!("{PROCESSOR_TOP}.v"));
             (
                 format!("{name} ({} threads, {f})", params.threads),

@@ -1,12 +1,13 @@
 //! Emission: the text the tools read, from the `hw` modules and the layout. Verilog (tidied
-//! rust-hdl output under clean top modules), testbenches, `$readmemh` memory images and UCF
-//! constraints. Nothing here runs a tool: running the text is `crate::sim` (simulators) and
+//! rust-hdl output under clean top modules), testbenches, `$readmemh` memory images, UCF
+//! constraints, and the FuseSoC core and file list of the processor (`package`). Nothing here runs a tool: running the text is `crate::sim` (simulators) and
 //! `crate::synth` (yosys, nextpnr).
 
 pub mod constraints;
 pub mod fp_unit;
 pub mod geometry_unit;
 pub mod memory_images;
+pub mod package;
 pub mod processor;
 pub mod stream_bench;
 pub mod verilog_tidy;

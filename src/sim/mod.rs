@@ -7,7 +7,9 @@
 //! hint), the design does not compile (quoting the tool's first error lines, with the first
 //! error's file and line), the simulation exits non-zero (quoting its last lines), or it
 //! exceeds `SimJob::timeout` (the process group is killed). Each job builds into its own fresh
-//! directory inside `work_dir`, so jobs sharing a `work_dir` never clobber each other.
+//! directory inside `work_dir`, so jobs sharing a `work_dir` never clobber each other; or,
+//! with `SimJob::reuse_build`, into one kept folder per top and simulator that a job with the
+//! same inputs runs again without compiling.
 //! [`compile`] + [`CompiledSim::run`] split the two steps, to run one build many times.
 //!
 //! [`lint`] runs `verilator --lint-only -Wall` and returns structured warnings; [`vectors`]
@@ -148,6 +150,11 @@ pub struct SimJob {
     pub verilator_jobs: u32,
     /// How hard g++ optimises the Verilator model.
     pub verilator_build: VerilatorBuild,
+    /// Build into `work_dir/build_<top>_<simulator>` and keep it: a later job with the same
+    /// inputs (simulator and its version, sources' contents, defines, include folders, build
+    /// profile) runs the kept build without compiling ([`CompiledSim::reused`]). Off: a fresh
+    /// build folder per job.
+    pub reuse_build: bool,
 }
 
 /// C++ optimisation of a Verilator model: a trade of build time against run time.
@@ -202,7 +209,14 @@ impl SimJob {
             compile_timeout: Duration::from_secs(1800),
             verilator_jobs: 2,
             verilator_build: VerilatorBuild::Quick,
+            reuse_build: false,
         }
+    }
+
+    /// See [`SimJob::reuse_build`].
+    pub fn reuse_build(mut self, reuse: bool) -> SimJob {
+        self.reuse_build = reuse;
+        self
     }
 
     pub fn timeout(mut self, timeout: Duration) -> SimJob {
@@ -238,6 +252,8 @@ pub struct SimRun {
     pub stderr: String,
     /// The directory holding this job's build products (vvp file or Verilator obj_dir).
     pub build_dir: PathBuf,
+    /// The build of an earlier job was reused (see [`SimJob::reuse_build`]).
+    pub reused_build: bool,
 }
 
 /// Compiles and runs `job` in `sim`. See the module doc for the contract.
@@ -260,15 +276,89 @@ pub struct CompiledSim {
     pub compile_seconds: f64,
     /// Everything the compiler printed (Verilator's warnings land here).
     pub compile_log: String,
+    /// The build of an earlier job with the same inputs was run, nothing was compiled.
+    pub reused: bool,
 }
 
-/// Compiles `job` in `sim` into a fresh build directory inside `job.work_dir`.
+/// Compiles `job` in `sim` into a fresh build directory inside `job.work_dir` (or reuses the
+/// kept one, see [`SimJob::reuse_build`]).
 pub fn compile(sim: Simulator, job: &SimJob) -> Result<CompiledSim, ToolError> {
-    let prepared = prepare(job)?;
-    match sim {
+    let prepared = prepare(job, sim)?;
+    let stamp_path = prepared.build_dir.join(BUILD_STAMP);
+    let stamp = if job.reuse_build {
+        let stamp = build_stamp(sim, job, &prepared)?;
+        let artifact = artifact_path(sim, job, &prepared.build_dir);
+        if artifact.is_file()
+            && std::fs::read_to_string(&stamp_path).ok().as_deref() == Some(&stamp)
+        {
+            return Ok(CompiledSim {
+                simulator: sim,
+                top: job.top.clone(),
+                work_dir: prepared.work_dir,
+                build_dir: prepared.build_dir,
+                artifact,
+                compile_seconds: 0.0,
+                compile_log: String::new(),
+                reused: true,
+            });
+        }
+        // Stale or half-built: start clean, so that no old object survives a change.
+        let _ = std::fs::remove_dir_all(&prepared.build_dir);
+        std::fs::create_dir_all(&prepared.build_dir).map_err(|e| ToolError::Io {
+            context: format!("cannot create {}", prepared.build_dir.display()),
+            source: e,
+        })?;
+        Some(stamp)
+    } else {
+        None
+    };
+    let compiled = match sim {
         Simulator::Icarus => compile_icarus(job, prepared),
         Simulator::Verilator => compile_verilator(job, prepared),
+    }?;
+    if let Some(stamp) = stamp {
+        std::fs::write(&stamp_path, stamp).map_err(|e| ToolError::Io {
+            context: format!("writing {}", stamp_path.display()),
+            source: e,
+        })?;
     }
+    Ok(compiled)
+}
+
+/// The file in a kept build folder that says what it was built from.
+const BUILD_STAMP: &str = "dynrt-build-inputs";
+
+/// The vvp file or the Verilator model of `job` in `build_dir`.
+fn artifact_path(sim: Simulator, job: &SimJob, build_dir: &Path) -> PathBuf {
+    match sim {
+        Simulator::Icarus => build_dir.join(format!("{}.vvp", job.top)),
+        Simulator::Verilator => build_dir.join(format!("V{}", job.top)),
+    }
+}
+
+/// What a build depends on, as text: the simulator and its version, the build settings, and
+/// of each source its path, length and 64-bit FNV-1a hash.
+fn build_stamp(sim: Simulator, job: &SimJob, p: &Prepared) -> Result<String, ToolError> {
+    let mut stamp = format!(
+        "{sim} {}\ntop {}\ndefines {:?}\nincludes {:?}\nverilator {:?} -j{}\n",
+        tool_version(sim)?,
+        job.top,
+        job.defines,
+        p.include_dirs,
+        job.verilator_build,
+        job.verilator_jobs
+    );
+    for s in &p.sources {
+        let bytes = std::fs::read(s).map_err(|e| ToolError::Io {
+            context: format!("reading {}", s.display()),
+            source: e,
+        })?;
+        let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+        });
+        stamp.push_str(&format!("{} {} {hash:016x}\n", s.display(), bytes.len()));
+    }
+    Ok(stamp)
 }
 
 impl CompiledSim {
@@ -300,6 +390,7 @@ impl CompiledSim {
             stdout: ran.stdout,
             stderr: ran.stderr,
             build_dir: self.build_dir.clone(),
+            reused_build: self.reused,
         })
     }
 }
@@ -311,7 +402,7 @@ struct Prepared {
     build_dir: PathBuf,
 }
 
-fn prepare(job: &SimJob) -> Result<Prepared, ToolError> {
+fn prepare(job: &SimJob, sim: Simulator) -> Result<Prepared, ToolError> {
     if job.sources.is_empty() {
         return Err(ToolError::BadJob(format!(
             "simulation of `{}` has no source files",
@@ -345,14 +436,22 @@ fn prepare(job: &SimJob) -> Result<Prepared, ToolError> {
         .iter()
         .map(|d| absolute(d))
         .collect::<Result<Vec<_>, _>>()?;
-    let build_dir = tempfile::Builder::new()
-        .prefix(&format!("build_{}_", job.top.replace('$', "_")))
-        .tempdir_in(&work_dir)
-        .map_err(|e| ToolError::Io {
-            context: format!("cannot create a build directory in {}", work_dir.display()),
-            source: e,
-        })?
-        .keep();
+    let build_dir = if job.reuse_build {
+        work_dir.join(format!(
+            "build_{}_{}",
+            job.top.replace('$', "_"),
+            sim.name()
+        ))
+    } else {
+        tempfile::Builder::new()
+            .prefix(&format!("build_{}_", job.top.replace('$', "_")))
+            .tempdir_in(&work_dir)
+            .map_err(|e| ToolError::Io {
+                context: format!("cannot create a build directory in {}", work_dir.display()),
+                source: e,
+            })?
+            .keep()
+    };
     Ok(Prepared {
         work_dir,
         sources,
@@ -435,6 +534,7 @@ fn compile_icarus(job: &SimJob, p: Prepared) -> Result<CompiledSim, ToolError> {
         artifact: vvp_file,
         compile_seconds: built.seconds,
         compile_log: built.combined(),
+        reused: false,
     })
 }
 
@@ -480,8 +580,44 @@ fn compile_verilator(job: &SimJob, p: Prepared) -> Result<CompiledSim, ToolError
         artifact: exe,
         compile_seconds: built.seconds,
         compile_log: built.combined(),
+        reused: false,
     })
 }
 
 #[cfg(test)]
 mod tests;
+
+/// The project's FuseSoC and cocotb environment (`make deps`), in the source tree dynrt was
+/// built from.
+pub const EDA_VENV: &str = ".venv-eda";
+
+/// A tool of [`EDA_VENV`] (`fusesoc`, `cocotb-config`, `python`).
+pub fn eda_tool(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(EDA_VENV)
+        .join("bin")
+        .join(name)
+}
+
+/// The first word that starts with a digit in what `binary args` prints (`fusesoc
+/// --version`: "2.4.7").
+pub fn any_tool_version(binary: &Path, args: &[&str]) -> Result<String, ToolError> {
+    let name = binary
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let out = run_tool(
+        &name,
+        "asking its version",
+        Command::new(binary).args(args),
+        QUERY_TIMEOUT,
+    )?;
+    out.combined()
+        .split_whitespace()
+        .find(|w| w.starts_with(|c: char| c.is_ascii_digit()))
+        .map(|w| w.trim_end_matches([',', ')']).to_string())
+        .ok_or_else(|| ToolError::Parse {
+            tool: name,
+            message: format!("no version number in: {}", out.combined().trim()),
+        })
+}

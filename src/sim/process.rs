@@ -2,7 +2,8 @@
 //!
 //! Contract: the child runs in its own process group so that a timeout kills the whole tree
 //! (Verilator starts make, which starts g++); stdout and stderr are drained on their own threads
-//! so a chatty simulation can never block on a full pipe; a missing binary becomes
+//! so a chatty simulation can never block on a full pipe, and lines starting with
+//! `crate::progress::HEARTBEAT` are reported as they arrive; a missing binary becomes
 //! [`ToolError::NotFound`] with the install hint, never a bare "No such file or directory".
 //!
 //! Since the child's group is not the terminal's, Ctrl-C reaches only dynrt: with
@@ -222,13 +223,28 @@ fn drain<R: Read + Send + 'static>(pipe: Option<R>) -> Option<Reader> {
         let sink = Arc::clone(&buffer);
         let handle = std::thread::spawn(move || {
             let mut chunk = [0u8; 8192];
+            // The unfinished last line, scanned for the testbench's heartbeat.
+            let mut line = Vec::new();
             loop {
                 match p.read(&mut chunk) {
                     Ok(0) | Err(_) => break,
-                    Ok(n) => sink
-                        .lock()
-                        .unwrap_or_else(|e| e.into_inner())
-                        .extend_from_slice(&chunk[..n]),
+                    Ok(n) => {
+                        sink.lock()
+                            .unwrap_or_else(|e| e.into_inner())
+                            .extend_from_slice(&chunk[..n]);
+                        for &b in &chunk[..n] {
+                            if b == b'\n' {
+                                if let Some(h) =
+                                    line.strip_prefix(crate::progress::HEARTBEAT.as_bytes())
+                                {
+                                    crate::progress::report(&String::from_utf8_lossy(h));
+                                }
+                                line.clear();
+                            } else if line.len() < 256 {
+                                line.push(b);
+                            }
+                        }
+                    }
                 }
             }
         });
@@ -273,5 +289,38 @@ pub(crate) fn describe_status(status: &ExitStatus) -> String {
         (Some(code), _) => format!("exit status {code}"),
         (None, Some(sig)) => format!("killed by signal {sig}"),
         _ => status.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Heartbeat lines reach the progress listener while the tool runs; others do not.
+    #[test]
+    fn heartbeat_lines_are_reported_as_they_arrive() {
+        static SEEN: Mutex<Vec<String>> = Mutex::new(Vec::new());
+        crate::progress::listen(|m| SEEN.lock().unwrap().push(m.to_string()));
+        let out = run_tool(
+            "sh",
+            "testing",
+            Command::new("sh").args([
+                "-c",
+                "echo dynrt-heartbeat frame 0: 10 cycles, 1 rays; echo other; \
+                 printf 'dynrt-heartbeat frame 1: 20 cycles, 2 rays\\n'",
+            ]),
+            Duration::from_secs(30),
+        )
+        .unwrap();
+        assert!(out.stdout.contains("other"));
+        // (Other tests' simulations may report beside these.)
+        let seen = SEEN.lock().unwrap().clone();
+        let first = seen.iter().position(|m| m == "frame 0: 10 cycles, 1 rays");
+        let second = seen.iter().position(|m| m == "frame 1: 20 cycles, 2 rays");
+        assert!(
+            matches!((first, second), (Some(a), Some(b)) if a < b),
+            "{seen:?}"
+        );
+        assert!(!seen.iter().any(|m| m.contains("other")), "{seen:?}");
     }
 }

@@ -8,6 +8,7 @@ use std::time::Duration;
 use anyhow::{bail, Context, Result};
 
 use crate::emit::memory_images::{write_frame_update, write_memory_images};
+use crate::emit::package::cocotb_files;
 use crate::emit::processor::{
     display_mode, processor_rtl, processor_testbench, ProcessorParams, TestbenchFrames,
 };
@@ -15,6 +16,7 @@ use crate::hw::processor::TopPort;
 use crate::hw::program::Program;
 use crate::layout::Layout;
 use crate::output::write_atomically;
+use crate::provenance::GeneratedBy;
 use crate::sim::{self, SimJob, Simulator, VerilatorBuild};
 
 /// One simulated frame.
@@ -37,6 +39,8 @@ pub struct ProcessorSim {
     pub frames: Vec<SimFrame>,
     pub compile_seconds: f64,
     pub run_seconds: f64,
+    /// The build folder of an earlier run with the same Verilog was run again.
+    pub reused_build: bool,
     pub tool_version: String,
     /// With `capture_vga`: the visible pixels of the display's next frame after the last
     /// rendered one, `0xRRGGBB` in raster order.
@@ -44,8 +48,8 @@ pub struct ProcessorSim {
 }
 
 /// Writes everything a simulation of `layouts` (frame 0, 1, ...) needs into `dir`: the
-/// processor Verilog (`rtl/dynrt_processor.v`), the testbench (`testbench/tb.v`) and the
-/// memory images (`mem/`).
+/// processor Verilog (`rtl/dynrt_processor.v`), the testbench (`testbench/tb.v`), the
+/// memory images (`mem/`) and the cocotb test (`cocotb/`).
 pub fn write_processor_files(
     program: &Program,
     layouts: &[Layout],
@@ -53,20 +57,22 @@ pub fn write_processor_files(
     scene_name: &str,
     cycle_limit: u64,
     dir: &Path,
+    generated_by: &GeneratedBy,
 ) -> Result<ProcessorFiles> {
     let first = layouts.first().context("no frame to simulate")?;
     let (rtl_dir, tb_dir, mem_dir) = (dir.join("rtl"), dir.join("testbench"), dir.join("mem"));
     for d in [&rtl_dir, &tb_dir, &mem_dir] {
         std::fs::create_dir_all(d).with_context(|| format!("cannot create {}", d.display()))?;
     }
-    let rtl = processor_rtl(program, params, scene_name)?;
+    let rtl = processor_rtl(program, params, scene_name, generated_by)?;
     let rtl_path = rtl_dir.join(format!("{}.v", crate::emit::processor::PROCESSOR_TOP));
     write_atomically(&rtl_path, rtl.verilog.as_bytes())
         .with_context(|| format!("writing {}", rtl_path.display()))?;
-    write_memory_images(first, &mem_dir)?;
+    let mut mem = write_memory_images(first, &mem_dir, generated_by)?;
     let mut updates = Vec::new();
     for (k, pair) in layouts.windows(2).enumerate() {
-        let files = write_frame_update(&pair[0], &pair[1], k as u32 + 1, &mem_dir)?;
+        let files = write_frame_update(&pair[0], &pair[1], k as u32 + 1, &mem_dir, generated_by)?;
+        mem.extend(files.iter().map(|(_, p)| p.clone()));
         updates.push(
             files
                 .into_iter()
@@ -96,26 +102,40 @@ pub fn write_processor_files(
         cycle_limit,
         vga: display_mode(first.info.width, first.info.height)?,
     };
+    let cocotb_dir = dir.join("cocotb");
+    std::fs::create_dir_all(&cocotb_dir)
+        .with_context(|| format!("cannot create {}", cocotb_dir.display()))?;
+    for (name, text) in cocotb_files(params.mem_latency, &frames, generated_by) {
+        let p = cocotb_dir.join(name);
+        write_atomically(&p, text.as_bytes())
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
     let tb_path = tb_dir.join("tb.v");
     write_atomically(
         &tb_path,
-        processor_testbench(params, &frames, &rtl.ports)?.as_bytes(),
+        processor_testbench(params, &frames, &rtl.ports, generated_by)?.as_bytes(),
     )
     .with_context(|| format!("writing {}", tb_path.display()))?;
     Ok(ProcessorFiles {
         rtl: rtl_path,
         testbench: tb_path,
+        mem,
         ports: rtl.ports,
+        frames,
     })
 }
 
-/// What [`write_processor_files`] wrote: the two Verilog files, and the processor's top ports
-/// (for the constraints file).
+/// What [`write_processor_files`] wrote: the two Verilog files, the memory images (frame 0's
+/// banks, then the frames' updates), and the processor's top ports (for the constraints
+/// file).
 #[derive(Clone, Debug)]
 pub struct ProcessorFiles {
     pub rtl: PathBuf,
     pub testbench: PathBuf,
+    pub mem: Vec<PathBuf>,
     pub ports: Vec<TopPort>,
+    /// What the testbench knows about the frames (bank sizes, updates, frame buffer).
+    pub frames: TestbenchFrames,
 }
 
 /// How to run a processor simulation.
@@ -129,7 +149,8 @@ pub struct SimRun {
     pub capture_vga: bool,
 }
 
-/// Simulates the processor for `program` on `layouts` as `run` says, in `dir`.
+/// Simulates the processor for `program` on `layouts` as `run` says, in `dir`. The build
+/// folder `dir/build_tb_<simulator>` is kept and reused while the Verilog does not change.
 pub fn simulate_processor(
     program: &Program,
     layouts: &[Layout],
@@ -137,13 +158,22 @@ pub fn simulate_processor(
     scene_name: &str,
     run: SimRun,
     dir: &Path,
+    generated_by: &GeneratedBy,
 ) -> Result<ProcessorSim> {
     let SimRun {
         sim,
         cycle_limit,
         capture_vga,
     } = run;
-    let files = write_processor_files(program, layouts, params, scene_name, cycle_limit, dir)?;
+    let files = write_processor_files(
+        program,
+        layouts,
+        params,
+        scene_name,
+        cycle_limit,
+        dir,
+        generated_by,
+    )?;
     for k in 0..layouts.len() {
         let _ = std::fs::remove_file(dir.join(format!("frame{k}.hex")));
     }
@@ -151,10 +181,17 @@ pub fn simulate_processor(
     let _ = std::fs::remove_file(&vga_path);
     let mut job = SimJob::new(dir, vec![files.rtl, files.testbench], "tb")
         .timeout(Duration::from_secs(3600))
-        .verilator_build(VerilatorBuild::Fast);
+        .verilator_build(VerilatorBuild::Fast)
+        .reuse_build(true);
     if capture_vga {
         job = job.plusarg("vga");
     }
+    // A heartbeat every few seconds of either simulator (Icarus runs the processor at
+    // 150-400 clocks/s, Verilator at about 250k).
+    job = job.plusarg(match sim {
+        Simulator::Icarus => "heartbeat=2000",
+        Simulator::Verilator => "heartbeat=1000000",
+    });
     let timeout = |detail: &str| {
         anyhow::anyhow!(
             "{}: the processor did not finish a frame within {cycle_limit} clocks (the \
@@ -164,7 +201,14 @@ pub fn simulate_processor(
         )
     };
     // The testbench ends a timed-out run with $fatal, so the tool reports a failure.
-    let run = match sim::run(sim, &job) {
+    crate::progress::report(&format!("compiling the processor for {}", sim.name()));
+    let compiled = sim::compile(sim, &job)?;
+    crate::progress::report(&format!(
+        "simulating {} frame(s) in {}",
+        layouts.len(),
+        sim.name()
+    ));
+    let run = match compiled.run(&job.plusargs, job.timeout) {
         Ok(run) => run,
         Err(e) if e.to_string().contains("TIMEOUT") => return Err(timeout(&e.to_string())),
         Err(e) => return Err(e.into()),
@@ -241,6 +285,7 @@ pub fn simulate_processor(
         vga,
         compile_seconds: run.compile_seconds,
         run_seconds: run.run_seconds,
+        reused_build: run.reused_build,
         tool_version: sim::tool_version(sim).unwrap_or_default(),
     })
 }

@@ -152,6 +152,55 @@ fn two_jobs_in_one_work_dir_get_separate_build_dirs() {
     assert!(first.build_dir.join("tb_adder.vvp").is_file());
 }
 
+/// With `reuse_build` a job runs the kept build of an earlier job with the same inputs, and
+/// compiles again (in the same folder) when a source, a define or the simulator changes.
+#[test]
+fn a_kept_build_is_reused_until_its_inputs_change() {
+    for sim in Simulator::ALL {
+        let dir = tempfile::tempdir().unwrap();
+        let vectors = adder_vectors(7, 8);
+        let src = write_adder_bench(dir.path(), &vectors);
+        let job = SimJob::new(dir.path(), vec![src.clone()], "tb_adder")
+            .define("NVEC", Some("8".into()))
+            .plusarg("out=a.hex")
+            .reuse_build(true);
+        let first = compile(sim, &job).unwrap();
+        assert!(!first.reused, "{sim}: nothing to reuse yet");
+        let again = compile(sim, &job).unwrap();
+        assert!(again.reused && again.compile_seconds == 0.0, "{sim}");
+        assert_eq!(first.build_dir, again.build_dir);
+        again.run(&job.plusargs, Duration::from_secs(60)).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("a.hex"))
+                .unwrap()
+                .lines()
+                .count(),
+            8,
+            "{sim}: the reused build runs"
+        );
+        // A changed source (another message in the testbench) is compiled again.
+        let text = std::fs::read_to_string(&src).unwrap();
+        std::fs::write(&src, text.replace("DONE %0d", "FINISHED %0d")).unwrap();
+        let changed = compile(sim, &job).unwrap();
+        assert!(!changed.reused, "{sim}: a changed source must be compiled");
+        let out = changed.run(&job.plusargs, Duration::from_secs(60)).unwrap();
+        assert!(out.stdout.contains("FINISHED 8"), "{sim}: {}", out.stdout);
+        let other = compile(sim, &job.clone().define("EXTRA", None)).unwrap();
+        assert!(!other.reused, "{sim}: a new define must be compiled");
+        let builds = std::fs::read_dir(dir.path())
+            .unwrap()
+            .filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .file_name()
+                    .to_string_lossy()
+                    .starts_with("build_")
+            })
+            .count();
+        assert_eq!(builds, 1, "{sim}: one build folder, not one per run");
+    }
+}
+
 /// A testbench whose line 4 has a syntax error.
 const SYNTAX_ERROR_V: &str =
     "module tb_broken;\n  reg a;\n  initial begin\n    a = ;\n    $finish;\n  end\nendmodule\n";

@@ -3,7 +3,8 @@
 //!
 //! Contract:
 //! - [`write_memory_images`] writes one file per bank, `bank<k>_<name>.hex`
-//!   (`bank0_nodes.hex` .. `bank5_frame.hex`, see [`bank_file_name`]): a comment header, an
+//!   (`bank0_nodes.hex` .. `bank5_frame.hex`, see [`bank_file_name`]): a comment header (the
+//!   [`GeneratedBy`] lines, then what the bank holds), an
 //!   `@0` record, then every word of the bank's used part (the whole `Layout::banks[k]`, frame
 //!   buffer included, so the simulated memory holds no X where the processor may read),
 //!   8 hex digits a line. Words past the used part are not written. Each file is written
@@ -46,6 +47,7 @@ use anyhow::{bail, Context, Result};
 
 use crate::layout::{Layout, BANK_NAMES};
 use crate::output::write_atomically;
+use crate::provenance::GeneratedBy;
 
 /// `bank<k>_<name>.hex`, e.g. `bank0_nodes.hex`.
 pub fn bank_file_name(bank: usize) -> String {
@@ -77,7 +79,11 @@ pub fn memh_text(header: &str, words: &[(u32, u32)]) -> String {
 
 /// Writes the six bank images of `layout` into `dir` (created if needed); returns their
 /// paths in bank order.
-pub fn write_memory_images(layout: &Layout, dir: &Path) -> Result<Vec<PathBuf>> {
+pub fn write_memory_images(
+    layout: &Layout,
+    dir: &Path,
+    generated_by: &GeneratedBy,
+) -> Result<Vec<PathBuf>> {
     let mut paths = Vec::new();
     for (bank, words) in layout.banks.iter().enumerate() {
         let path = dir.join(bank_file_name(bank));
@@ -87,7 +93,8 @@ pub fn write_memory_images(layout: &Layout, dir: &Path) -> Result<Vec<PathBuf>> 
             .map(|(a, &w)| (a as u32, w))
             .collect();
         let header = format!(
-            "dynrt memory image: bank {bank} ({}), {} words of 32 bits, format {}",
+            "{}\ndynrt memory image: bank {bank} ({}), {} words of 32 bits, format {}",
+            generated_by.lines().join("\n"),
             BANK_NAMES[bank],
             words.len(),
             layout.format
@@ -143,6 +150,7 @@ pub fn write_frame_update(
     next: &Layout,
     frame: u32,
     dir: &Path,
+    generated_by: &GeneratedBy,
 ) -> Result<Vec<(usize, PathBuf)>> {
     let updates = frame_update(prev, next)?;
     let mut written = Vec::new();
@@ -157,7 +165,8 @@ pub fn write_frame_update(
         }
         let path = dir.join(update_file_name(frame, bank));
         let header = format!(
-            "dynrt frame update: frame {frame}, bank {bank} ({name}), {} changed words",
+            "{}\ndynrt frame update: frame {frame}, bank {bank} ({name}), {} changed words",
+            generated_by.lines().join("\n"),
             pairs.len()
         );
         write_atomically(&path, memh_text(&header, &pairs).as_bytes())

@@ -108,7 +108,7 @@ fn extents_give_the_address_width() {
 fn images_read_back_to_the_layout_words() {
     let l = &animated_layouts()[0];
     let dir = temp("images");
-    let paths = write_memory_images(l, dir.path()).unwrap();
+    let paths = write_memory_images(l, dir.path(), &GeneratedBy::library()).unwrap();
     let names: Vec<String> = paths
         .iter()
         .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
@@ -154,7 +154,7 @@ fn scene_layouts(name: &str, frames: u32) -> Vec<Layout> {
 /// files, read back, give every frame's words exactly.
 fn checked_updates(name: &str, layouts: &[Layout]) -> Vec<Vec<WordUpdate>> {
     let dir = temp("updates");
-    let images = write_memory_images(&layouts[0], dir.path()).unwrap();
+    let images = write_memory_images(&layouts[0], dir.path(), &GeneratedBy::library()).unwrap();
     // Memory as the simulation would hold it: frame 0's images read from the files.
     let mut memory: Vec<Vec<u32>> = images
         .iter()
@@ -195,7 +195,8 @@ fn checked_updates(name: &str, layouts: &[Layout]) -> Vec<Vec<WordUpdate>> {
             );
         }
 
-        let files = write_frame_update(prev, next, f as u32, dir.path()).unwrap();
+        let files =
+            write_frame_update(prev, next, f as u32, dir.path(), &GeneratedBy::library()).unwrap();
         let file_banks: BTreeSet<usize> = files.iter().map(|(b, _)| *b).collect();
         assert_eq!(file_banks, banks);
         for (bank, path) in &files {
@@ -368,10 +369,10 @@ fn readmemh_in(simulator: Simulator) {
     let layouts = animated_layouts();
     let (prev, next) = (&layouts[0], &layouts[1]);
     let dir = temp(simulator.name());
-    write_memory_images(prev, dir.path()).unwrap();
+    write_memory_images(prev, dir.path(), &GeneratedBy::library()).unwrap();
     // A frame 0 -> 1 update in which the frame grows or shrinks still loads: the memories
     // are sized for the larger of the two.
-    let updates = write_frame_update(prev, next, 1, dir.path()).unwrap();
+    let updates = write_frame_update(prev, next, 1, dir.path(), &GeneratedBy::library()).unwrap();
     assert!(!updates.is_empty());
     let tb_path = dir.path().join("tb_readmemh.v");
     std::fs::write(&tb_path, readmemh_bench(prev, next, &updates)).unwrap();
