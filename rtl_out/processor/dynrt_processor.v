@@ -664,8 +664,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     // Constant declarations
     localparam  c_threads = 8'h20;
     localparam  op_fsub = 5'b10;
-    localparam  op_fdiv = 5'b100;
-    localparam  op_fsqrt = 5'b101;
     localparam  op_ld = 5'b1110;
     localparam  op_st = 5'b1111;
     localparam  op_sts = 5'b10001;
@@ -693,11 +691,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     
     // Enums
     localparam FastKind__Computed = 0;
-    localparam FastKind__Scratch = 1;
-    localparam FastKind__Memory = 2;
-    localparam FastKind__TrianglesUv = 3;
-    localparam FastKind__TrianglesT = 4;
-    localparam FastKind__Nodes = 5;
+    localparam FastKind__Converted = 1;
+    localparam FastKind__Scratch = 2;
+    localparam FastKind__Memory = 3;
+    localparam FastKind__TrianglesUv = 4;
+    localparam FastKind__TrianglesT = 5;
+    localparam FastKind__Nodes = 6;
     
     // Stub signals
     reg  scheduler__clock;
@@ -735,6 +734,11 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [31:0] decode__ctl_i2;
     reg  [31:0] decode__imm_i2;
     reg  [31:0] decode__aux_i2;
+    wire  decode__valid_i3;
+    wire  [4:0] decode__op_i3;
+    wire  [4:0] decode__thread_i3;
+    wire  decode__long_i3;
+    wire  [31:0] decode__imm_i3;
     wire  decode__valid;
     wire  [4:0] decode__thread;
     wire  [11:0] decode__pc;
@@ -766,6 +770,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  pixels__take;
     wire  [31:0] pixels__word;
     wire  pixels__exhausted;
+    reg  execute__clock;
     reg  [4:0] execute__op;
     reg  [31:0] execute__a;
     reg  [31:0] execute__b;
@@ -779,6 +784,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [31:0] execute__tester_instance;
     reg  [31:0] execute__tester_triangle;
     wire  [31:0] execute__fast;
+    wire  [31:0] execute__converted;
     wire  [2:0] execute__kind;
     wire  execute__int_eq;
     wire  execute__int_lt;
@@ -814,6 +820,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  result_line__pix_done;
     reg  [31:0] result_line__fast;
     reg  [2:0] result_line__kind;
+    reg  [31:0] result_line__converted;
     reg  [31:0] result_line__scratch_data;
     reg  [31:0] result_line__mem_data;
     reg  [31:0] result_line__nodes_data;
@@ -835,6 +842,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     wire  result_line__retiring__mb_hit;
     wire  result_line__retiring__pix_done;
     wire  [31:0] result_line__retiring__fast;
+    reg  write_back__clock;
     reg  write_back__retiring__valid;
     reg  [4:0] write_back__retiring__op;
     reg  [7:0] write_back__retiring__dst;
@@ -859,6 +867,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  write_back__le;
     reg  write_back__eq;
     reg  [7:0] write_back__colour_byte;
+    wire  write_back__valid;
+    wire  [4:0] write_back__thread;
+    wire  [7:0] write_back__dst;
     wire  write_back__write;
     wire  [31:0] write_back__data;
     wire  [11:0] write_back__next_pc;
@@ -974,16 +985,39 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [31:0] fb_data_r__d;
     wire  [31:0] fb_data_r__q;
     reg  fb_data_r__clock;
+    reg  ray_write__d;
+    wire  ray_write__q;
+    reg  ray_write__clock;
+    reg  t_min_write__d;
+    wire  t_min_write__q;
+    reg  t_min_write__clock;
+    reg  tri_enqueue__d;
+    wire  tri_enqueue__q;
+    reg  tri_enqueue__clock;
+    reg  tri_queues__d;
+    wire  tri_queues__q;
+    reg  tri_queues__clock;
+    reg  [1:0] tri_kind__d;
+    wire  [1:0] tri_kind__q;
+    reg  tri_kind__clock;
+    reg  tri_waits__d;
+    wire  tri_waits__q;
+    reg  tri_waits__clock;
+    reg  kd_enqueue__d;
+    wire  kd_enqueue__q;
+    reg  kd_enqueue__clock;
+    reg  kd_waits__d;
+    wire  kd_waits__q;
+    reg  kd_waits__clock;
+    reg  wait_fn__d;
+    wire  wait_fn__q;
+    reg  wait_fn__clock;
     
     // Local signals
     reg  frame_start;
-    reg  is_tri;
-    reg  ray_write;
-    reg  tri_queues;
-    reg  [1:0] tri_kind;
+    reg  queued_fn;
     reg  tri_busy;
     reg  kd_busy;
-    reg  wait_fn;
     
     // Sub module instances
     dynrt_processor__engine__scheduler scheduler(
@@ -1026,6 +1060,11 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .ctl_i2(decode__ctl_i2),
         .imm_i2(decode__imm_i2),
         .aux_i2(decode__aux_i2),
+        .valid_i3(decode__valid_i3),
+        .op_i3(decode__op_i3),
+        .thread_i3(decode__thread_i3),
+        .long_i3(decode__long_i3),
+        .imm_i3(decode__imm_i3),
         .valid(decode__valid),
         .thread(decode__thread),
         .pc(decode__pc),
@@ -1063,6 +1102,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .exhausted(pixels__exhausted)
     );
     dynrt_processor__engine__execute execute(
+        .clock(execute__clock),
         .op(execute__op),
         .a(execute__a),
         .b(execute__b),
@@ -1076,6 +1116,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .tester_instance(execute__tester_instance),
         .tester_triangle(execute__tester_triangle),
         .fast(execute__fast),
+        .converted(execute__converted),
         .kind(execute__kind),
         .int_eq(execute__int_eq),
         .int_lt(execute__int_lt),
@@ -1115,6 +1156,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .pix_done(result_line__pix_done),
         .fast(result_line__fast),
         .kind(result_line__kind),
+        .converted(result_line__converted),
         .scratch_data(result_line__scratch_data),
         .mem_data(result_line__mem_data),
         .nodes_data(result_line__nodes_data),
@@ -1138,6 +1180,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .retiring__fast(result_line__retiring__fast)
     );
     dynrt_processor__engine__write_back write_back(
+        .clock(write_back__clock),
         .retiring__valid(write_back__retiring__valid),
         .retiring__op(write_back__retiring__op),
         .retiring__dst(write_back__retiring__dst),
@@ -1162,6 +1205,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .le(write_back__le),
         .eq(write_back__eq),
         .colour_byte(write_back__colour_byte),
+        .valid(write_back__valid),
+        .thread(write_back__thread),
+        .dst(write_back__dst),
         .write(write_back__write),
         .data(write_back__data),
         .next_pc(write_back__next_pc),
@@ -1321,6 +1367,51 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(fb_data_r__q),
         .clock(fb_data_r__clock)
     );
+    dynrt_processor__display__dark_d ray_write(
+        .d(ray_write__d),
+        .q(ray_write__q),
+        .clock(ray_write__clock)
+    );
+    dynrt_processor__display__dark_d t_min_write(
+        .d(t_min_write__d),
+        .q(t_min_write__q),
+        .clock(t_min_write__clock)
+    );
+    dynrt_processor__display__dark_d tri_enqueue(
+        .d(tri_enqueue__d),
+        .q(tri_enqueue__q),
+        .clock(tri_enqueue__clock)
+    );
+    dynrt_processor__display__dark_d tri_queues(
+        .d(tri_queues__d),
+        .q(tri_queues__q),
+        .clock(tri_queues__clock)
+    );
+    dynrt_processor__engine__tester__cur_kind__0 tri_kind(
+        .d(tri_kind__d),
+        .q(tri_kind__q),
+        .clock(tri_kind__clock)
+    );
+    dynrt_processor__display__dark_d tri_waits(
+        .d(tri_waits__d),
+        .q(tri_waits__q),
+        .clock(tri_waits__clock)
+    );
+    dynrt_processor__display__dark_d kd_enqueue(
+        .d(kd_enqueue__d),
+        .q(kd_enqueue__q),
+        .clock(kd_enqueue__clock)
+    );
+    dynrt_processor__display__dark_d kd_waits(
+        .d(kd_waits__d),
+        .q(kd_waits__q),
+        .clock(kd_waits__clock)
+    );
+    dynrt_processor__display__dark_d wait_fn(
+        .d(wait_fn__d),
+        .q(wait_fn__q),
+        .clock(wait_fn__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -1338,6 +1429,15 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         fb_write_r__clock = clock;
         fb_addr_r__clock = clock;
         fb_data_r__clock = clock;
+        ray_write__clock = clock;
+        t_min_write__clock = clock;
+        tri_enqueue__clock = clock;
+        tri_queues__clock = clock;
+        tri_kind__clock = clock;
+        tri_waits__clock = clock;
+        kd_enqueue__clock = clock;
+        kd_waits__clock = clock;
+        wait_fn__clock = clock;
         running__d = running__q;
         epoch__d = epoch__q;
         halted_count__d = halted_count__q;
@@ -1352,13 +1452,24 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         fb_write_r__d = fb_write_r__q;
         fb_addr_r__d = fb_addr_r__q;
         fb_data_r__d = fb_data_r__q;
+        ray_write__d = ray_write__q;
+        t_min_write__d = t_min_write__q;
+        tri_enqueue__d = tri_enqueue__q;
+        tri_queues__d = tri_queues__q;
+        tri_kind__d = tri_kind__q;
+        tri_waits__d = tri_waits__q;
+        kd_enqueue__d = kd_enqueue__q;
+        kd_waits__d = kd_waits__q;
+        wait_fn__d = wait_fn__q;
         scheduler__clock = clock;
         fetch__clock = clock;
         decode__clock = clock;
         mailboxes__clock = clock;
         pixels__clock = clock;
+        execute__clock = clock;
         fp_units__clock = clock;
         result_line__clock = clock;
+        write_back__clock = clock;
         tester__clock = clock;
         traversal_unit__clock = clock;
         scratch__read_clock = clock;
@@ -1393,11 +1504,11 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         decode__ctl_i2 = fetch__ctl;
         decode__imm_i2 = fetch__imm;
         decode__aux_i2 = fetch__aux;
-        mailboxes__read_thread = fetch__thread;
-        mailboxes__read_which = fetch__imm[32'h0];
-        tester__engine__query_thread = fetch__thread;
-        traversal_unit__engine__query_thread = fetch__thread;
-        scheduler__long_at_i3 = decode__valid & ((decode__op == op_fdiv) | (decode__op == op_fsqrt));
+        mailboxes__read_thread = decode__thread_i3;
+        mailboxes__read_which = decode__imm_i3[32'h0];
+        tester__engine__query_thread = decode__thread_i3;
+        traversal_unit__engine__query_thread = decode__thread_i3;
+        scheduler__long_at_i3 = decode__long_i3;
         fp_units__a = decode__a[(32'h0)+:(24)];
         fp_units__b = decode__b[(32'h0)+:(24)];
         fp_units__sub = decode__op == op_fsub;
@@ -1443,8 +1554,25 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             mem_addr = mem_addr_r__q;
         end
         tester__lists__rdata = mem_rdata;
-        is_tri = decode__valid & (decode__op == op_tri);
-        ray_write = is_tri & (decode__imm < tri_ray_words);
+        ray_write__d = decode__valid_i3 & (decode__op_i3 == op_tri) & (decode__imm_i3 < tri_ray_words);
+        t_min_write__d = decode__valid_i3 & (decode__op_i3 == op_tri) & (decode__imm_i3 == tri_init);
+        queued_fn = (decode__imm_i3 == tri_init) | (decode__imm_i3 == tri_list) | (decode__imm_i3 == tri_object) | (decode__imm_i3 == tri_skip);
+        tri_queues__d = queued_fn;
+        tri_enqueue__d = decode__valid_i3 & (decode__op_i3 == op_tri) & queued_fn;
+        tri_kind__d = cmd_list;
+        if (decode__imm_i3 == tri_init) begin
+            tri_kind__d = cmd_init;
+        end
+        if (decode__imm_i3 == tri_object) begin
+            tri_kind__d = cmd_object;
+        end
+        if (decode__imm_i3 == tri_skip) begin
+            tri_kind__d = cmd_skip;
+        end
+        tri_waits__d = decode__imm_i3 == tri_wait;
+        kd_enqueue__d = decode__valid_i3 & (decode__op_i3 == op_kd) & (decode__imm_i3 == kd_start);
+        kd_waits__d = decode__imm_i3 == kd_wait;
+        wait_fn__d = ((decode__op_i3 == op_tri) & (decode__imm_i3 == tri_wait)) | ((decode__op_i3 == op_kd) & (decode__imm_i3 == kd_wait));
         traversal_unit__engine__load_read = mem_read_r__q;
         traversal_unit__engine__load_bank = mem_bank_r__q;
         traversal_unit__engine__load_addr = mem_addr_r__q;
@@ -1452,7 +1580,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         traversal_unit__engine__word_a = decode__a;
         traversal_unit__engine__word_b = decode__b;
         traversal_unit__engine__ray_pair = decode__imm[(32'h0)+:(2)];
-        traversal_unit__engine__ray_write = ray_write;
+        traversal_unit__engine__ray_write = ray_write__q;
         tester__engine__load_read = mem_read_r__q;
         tester__engine__load_bank = mem_bank_r__q;
         tester__engine__load_addr = mem_addr_r__q;
@@ -1460,25 +1588,14 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tester__engine__word_a = decode__a;
         tester__engine__word_b = decode__b;
         tester__engine__ray_pair = decode__imm[(32'h0)+:(2)];
-        tester__engine__ray_write = ray_write;
-        tri_queues = (decode__imm == tri_init) | (decode__imm == tri_list) | (decode__imm == tri_object) | (decode__imm == tri_skip);
-        tester__engine__enqueue = is_tri & tri_queues;
-        tri_kind = cmd_list;
-        if (decode__imm == tri_init) begin
-            tri_kind = cmd_init;
-        end
-        if (decode__imm == tri_object) begin
-            tri_kind = cmd_object;
-        end
-        if (decode__imm == tri_skip) begin
-            tri_kind = cmd_skip;
-        end
-        tester__queue_kind = tri_kind;
+        tester__engine__ray_write = ray_write__q;
+        tester__engine__enqueue = tri_enqueue__q;
+        tester__queue_kind = tri_kind__q;
         tri_busy = 1'b0;
-        if (tri_queues) begin
+        if (tri_queues__q) begin
             tri_busy = tester__engine__full;
         end
-        if (decode__imm == tri_wait) begin
+        if (tri_waits__q) begin
             tri_busy = tester__engine__pending;
         end
         tester__walk_list_valid = traversal_unit__leaf_valid;
@@ -1490,15 +1607,14 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         traversal_unit__answer_thread = tester__walk_end_thread;
         traversal_unit__answer_t = tester__walk_end_t;
         traversal_unit__answer_hit = tester__walk_end_hit;
-        traversal_unit__t_min_write = is_tri & (decode__imm == tri_init);
-        traversal_unit__engine__enqueue = decode__valid & (decode__op == op_kd) & (decode__imm == kd_start);
-        if (decode__imm == kd_wait) begin
+        traversal_unit__t_min_write = t_min_write__q;
+        traversal_unit__engine__enqueue = kd_enqueue__q;
+        if (kd_waits__q) begin
             kd_busy = traversal_unit__engine__pending;
         end
         else begin
             kd_busy = traversal_unit__engine__full;
         end
-        wait_fn = ((decode__op == op_tri) & (decode__imm == tri_wait)) | ((decode__op == op_kd) & (decode__imm == kd_wait));
         result_line__valid = decode__valid;
         result_line__op = decode__op;
         result_line__dst = decode__dst;
@@ -1506,7 +1622,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         result_line__invert = decode__invert;
         result_line__pc = decode__pc;
         result_line__target = decode__target;
-        result_line__is_wait = wait_fn;
+        result_line__is_wait = wait_fn__q;
         result_line__kd_busy = kd_busy;
         result_line__tri_busy = tri_busy;
         result_line__jr_target = decode__a[(32'h0)+:(12)];
@@ -1516,6 +1632,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         result_line__pix_done = pixels__exhausted;
         result_line__fast = execute__fast;
         result_line__kind = execute__kind;
+        result_line__converted = execute__converted;
         result_line__scratch_data = scratch__read_data;
         result_line__mem_data = mem_rdata;
         result_line__nodes_data = bank0_rdata;
@@ -1530,15 +1647,15 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         write_back__eq = fp_units__eq;
         write_back__colour_byte = fp_units__colour_byte;
         decode__wb_write = write_back__write;
-        decode__wb_thread = result_line__retiring__thread;
-        decode__wb_dst = result_line__retiring__dst;
+        decode__wb_thread = write_back__thread;
+        decode__wb_dst = write_back__dst;
         decode__wb_data = write_back__data;
-        fetch__wb_valid = result_line__retiring__valid;
-        fetch__wb_thread = result_line__retiring__thread;
+        fetch__wb_valid = write_back__valid;
+        fetch__wb_thread = write_back__thread;
         fetch__wb_halt = write_back__halt;
         fetch__wb_next_pc = write_back__next_pc;
-        scheduler__wb_valid = result_line__retiring__valid;
-        scheduler__wb_thread = result_line__retiring__thread;
+        scheduler__wb_valid = write_back__valid;
+        scheduler__wb_thread = write_back__thread;
         scheduler__wb_halt = write_back__halt;
         scheduler__wb_wait_pending = write_back__wait_pending;
         scheduler__tester_done = tester__engine__done;
@@ -1548,7 +1665,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         if (write_back__retired) begin
             instr_count__d = instr_count__q + 32'h1;
         end
-        if (result_line__retiring__valid & write_back__halt) begin
+        if (write_back__valid & write_back__halt) begin
             halted_count__d = halted_count__q + 32'h1;
             if ((halted_count__q + 32'h1) == c_threads) begin
                 running__d = 1'b0;
@@ -1604,7 +1721,7 @@ module dynrt_processor__engine__cycle_count(d,q,clock);
 endmodule // dynrt_processor__engine__cycle_count
 
 
-module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm_i2,aux_i2,valid,thread,pc,op,dst,invert,imm,shift,bank,target,a,b,store,wb_write,wb_thread,wb_dst,wb_data);
+module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm_i2,aux_i2,valid_i3,op_i3,thread_i3,long_i3,imm_i3,valid,thread,pc,op,dst,invert,imm,shift,bank,target,a,b,store,wb_write,wb_thread,wb_dst,wb_data);
     
     // Module arguments
     input wire  clock;
@@ -1614,6 +1731,11 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
     input wire  [31:0] ctl_i2;
     input wire  [31:0] imm_i2;
     input wire  [31:0] aux_i2;
+    output reg  valid_i3;
+    output reg  [4:0] op_i3;
+    output reg  [4:0] thread_i3;
+    output reg  long_i3;
+    output reg  [31:0] imm_i3;
     output reg  valid;
     output reg  [4:0] thread;
     output reg  [11:0] pc;
@@ -1642,6 +1764,8 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
     localparam  f_shift = 5'b1111;
     localparam  f_bank = 5'b1100;
     localparam  f_target = 5'b0;
+    localparam  op_fdiv = 5'b100;
+    localparam  op_fsqrt = 5'b101;
     
     // Stub signals
     reg  [12:0] regs_a__read_address;
@@ -1676,6 +1800,33 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
     reg  [31:0] aux3__d;
     wire  [31:0] aux3__q;
     reg  aux3__clock;
+    reg  v4__d;
+    wire  v4__q;
+    reg  v4__clock;
+    reg  [4:0] t4__d;
+    wire  [4:0] t4__q;
+    reg  t4__clock;
+    reg  [11:0] pc4__d;
+    wire  [11:0] pc4__q;
+    reg  pc4__clock;
+    reg  [31:0] ctl4__d;
+    wire  [31:0] ctl4__q;
+    reg  ctl4__clock;
+    reg  [31:0] imm4__d;
+    wire  [31:0] imm4__q;
+    reg  imm4__clock;
+    reg  [31:0] aux4__d;
+    wire  [31:0] aux4__q;
+    reg  aux4__clock;
+    reg  [31:0] a4__d;
+    wire  [31:0] a4__q;
+    reg  a4__clock;
+    reg  [31:0] b4__d;
+    wire  [31:0] b4__q;
+    reg  b4__clock;
+    reg  [31:0] store4__d;
+    wire  [31:0] store4__q;
+    reg  store4__clock;
     
     // Local signals
     reg  [7:0] reg_a;
@@ -1731,6 +1882,51 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
         .q(aux3__q),
         .clock(aux3__clock)
     );
+    dynrt_processor__display__dark_d v4(
+        .d(v4__d),
+        .q(v4__q),
+        .clock(v4__clock)
+    );
+    dynrt_processor__engine__decode__t3 t4(
+        .d(t4__d),
+        .q(t4__q),
+        .clock(t4__clock)
+    );
+    dynrt_processor__display__timing__col pc4(
+        .d(pc4__d),
+        .q(pc4__q),
+        .clock(pc4__clock)
+    );
+    dynrt_processor__engine__cycle_count ctl4(
+        .d(ctl4__d),
+        .q(ctl4__q),
+        .clock(ctl4__clock)
+    );
+    dynrt_processor__engine__cycle_count imm4(
+        .d(imm4__d),
+        .q(imm4__q),
+        .clock(imm4__clock)
+    );
+    dynrt_processor__engine__cycle_count aux4(
+        .d(aux4__d),
+        .q(aux4__q),
+        .clock(aux4__clock)
+    );
+    dynrt_processor__engine__cycle_count a4(
+        .d(a4__d),
+        .q(a4__q),
+        .clock(a4__clock)
+    );
+    dynrt_processor__engine__cycle_count b4(
+        .d(b4__d),
+        .q(b4__q),
+        .clock(b4__clock)
+    );
+    dynrt_processor__engine__cycle_count store4(
+        .d(store4__d),
+        .q(store4__q),
+        .clock(store4__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -1740,12 +1936,30 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
         ctl3__clock = clock;
         imm3__clock = clock;
         aux3__clock = clock;
+        v4__clock = clock;
+        t4__clock = clock;
+        pc4__clock = clock;
+        ctl4__clock = clock;
+        imm4__clock = clock;
+        aux4__clock = clock;
+        a4__clock = clock;
+        b4__clock = clock;
+        store4__clock = clock;
         v3__d = v3__q;
         t3__d = t3__q;
         pc3__d = pc3__q;
         ctl3__d = ctl3__q;
         imm3__d = imm3__q;
         aux3__d = aux3__q;
+        v4__d = v4__q;
+        t4__d = t4__q;
+        pc4__d = pc4__q;
+        ctl4__d = ctl4__q;
+        imm4__d = imm4__q;
+        aux4__d = aux4__q;
+        a4__d = a4__q;
+        b4__d = b4__q;
+        store4__d = store4__q;
         regs_a__read_clock = clock;
         regs_a__write_clock = clock;
         regs_b__read_clock = clock;
@@ -1760,32 +1974,46 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
         ctl3__d = ctl_i2;
         imm3__d = imm_i2;
         aux3__d = aux_i2;
-        valid = v3__q;
-        thread = t3__q;
-        pc = pc3__q;
-        op = ctl3__q[(f_op)+:(5)];
-        dst = ctl3__q[(f_dst)+:(8)];
-        invert = ctl3__q[f_invert];
-        imm = imm3__q;
-        shift = aux3__q[(f_shift)+:(3)];
-        bank = aux3__q[(f_bank)+:(3)];
-        target = aux3__q[(f_target)+:(12)];
+        valid_i3 = v3__q;
+        op_i3 = ctl3__q[(f_op)+:(5)];
+        thread_i3 = t3__q;
+        imm_i3 = imm3__q;
+        long_i3 = v3__q & ((ctl3__q[(f_op)+:(5)] == op_fdiv) | (ctl3__q[(f_op)+:(5)] == op_fsqrt));
+        v4__d = v3__q;
+        t4__d = t3__q;
+        pc4__d = pc3__q;
+        ctl4__d = ctl3__q;
+        imm4__d = imm3__q;
+        aux4__d = aux3__q;
         if (ctl3__q[(f_a)+:(8)] == 32'h0) begin
-            a = 32'h0;
+            a4__d = 32'h0;
         end
         else begin
-            a = regs_a__read_data;
+            a4__d = regs_a__read_data;
         end
         if (ctl3__q[f_b_imm]) begin
-            b = imm3__q;
+            b4__d = imm3__q;
         end
         else if (ctl3__q[(f_b)+:(8)] == 32'h0) begin
-            b = 32'h0;
+            b4__d = 32'h0;
         end
         else begin
-            b = regs_b__read_data;
+            b4__d = regs_b__read_data;
         end
-        store = regs_b__read_data;
+        store4__d = regs_b__read_data;
+        valid = v4__q;
+        thread = t4__q;
+        pc = pc4__q;
+        op = ctl4__q[(f_op)+:(5)];
+        dst = ctl4__q[(f_dst)+:(8)];
+        invert = ctl4__q[f_invert];
+        imm = imm4__q;
+        shift = aux4__q[(f_shift)+:(3)];
+        bank = aux4__q[(f_bank)+:(3)];
+        target = aux4__q[(f_target)+:(12)];
+        a = a4__q;
+        b = b4__q;
+        store = store4__q;
         wb_address = (((wb_thread) & 13'h1fff) << 32'h8) | ((wb_dst) & 13'h1fff);
         regs_a__write_address = wb_address;
         regs_b__write_address = wb_address;
@@ -1796,6 +2024,18 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
     end
     
 endmodule // dynrt_processor__engine__decode
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -1837,6 +2077,8 @@ endmodule // dynrt_processor__engine__decode__regs_a
 
 
 
+
+
 module dynrt_processor__engine__decode__t3(d,q,clock);
     
     // Module arguments
@@ -1860,9 +2102,14 @@ endmodule // dynrt_processor__engine__decode__t3
 
 
 
-module dynrt_processor__engine__execute(op,a,b,imm,shift,bank,pc,pixel,tester_best_t,tester_hit,tester_instance,tester_triangle,fast,kind,int_eq,int_lt,mem_address,scratch_address);
+
+
+
+
+module dynrt_processor__engine__execute(clock,op,a,b,imm,shift,bank,pc,pixel,tester_best_t,tester_hit,tester_instance,tester_triangle,fast,converted,kind,int_eq,int_lt,mem_address,scratch_address);
     
     // Module arguments
+    input wire  clock;
     input wire  [4:0] op;
     input wire  [31:0] a;
     input wire  [31:0] b;
@@ -1876,6 +2123,7 @@ module dynrt_processor__engine__execute(op,a,b,imm,shift,bank,pc,pixel,tester_be
     input wire  [31:0] tester_instance;
     input wire  [31:0] tester_triangle;
     output reg  [31:0] fast;
+    output reg  [31:0] converted;
     output reg  [2:0] kind;
     output reg  int_eq;
     output reg  int_lt;
@@ -1907,15 +2155,19 @@ module dynrt_processor__engine__execute(op,a,b,imm,shift,bank,pc,pixel,tester_be
     
     // Enums
     localparam FastKind__Computed = 0;
-    localparam FastKind__Scratch = 1;
-    localparam FastKind__Memory = 2;
-    localparam FastKind__TrianglesUv = 3;
-    localparam FastKind__TrianglesT = 4;
-    localparam FastKind__Nodes = 5;
+    localparam FastKind__Converted = 1;
+    localparam FastKind__Scratch = 2;
+    localparam FastKind__Memory = 3;
+    localparam FastKind__TrianglesUv = 4;
+    localparam FastKind__TrianglesT = 5;
+    localparam FastKind__Nodes = 6;
     
     // Stub signals
     reg  [15:0] itof__value;
     wire  [23:0] itof__word;
+    reg  [31:0] itof_r__d;
+    wire  [31:0] itof_r__q;
+    reg  itof_r__clock;
     
     // Local signals
     reg  [31:0] result;
@@ -1926,10 +2178,19 @@ module dynrt_processor__engine__execute(op,a,b,imm,shift,bank,pc,pixel,tester_be
         .value(itof__value),
         .word(itof__word)
     );
+    dynrt_processor__engine__cycle_count itof_r(
+        .d(itof_r__d),
+        .q(itof_r__q),
+        .clock(itof_r__clock)
+    );
     
     // Update code
     always @(*) begin
+        itof_r__clock = clock;
+        itof_r__d = itof_r__q;
         itof__value = a[(32'h0)+:(16)];
+        itof_r__d = ((itof__word) & 32'hffffffff);
+        converted = itof_r__q;
         int_eq = a == b;
         int_lt = a < b;
         mem_address = (a << shift) + imm;
@@ -1937,7 +2198,7 @@ module dynrt_processor__engine__execute(op,a,b,imm,shift,bank,pc,pixel,tester_be
         source = FastKind__Computed;
         result = 32'h0;
         if (op == op_itof) begin
-            result = ((itof__word) & 32'hffffffff);
+            source = FastKind__Converted;
         end
         if (op == op_add) begin
             result = a + b;
@@ -2078,6 +2339,8 @@ module dynrt_processor__engine__execute__itof(value,word);
     end
     
 endmodule // dynrt_processor__engine__execute__itof
+
+
 
 
 
@@ -10038,6 +10301,10 @@ endmodule // dynrt_processor__engine__halted_count
 
 
 
+
+
+
+
 module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,which,value,insert,clear,hit);
     
     // Module arguments
@@ -10062,6 +10329,48 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
     localparam  c_index__7 = 8'h7;
     
     // Stub signals
+    reg  matches__0__d;
+    wire  matches__0__q;
+    reg  matches__0__clock;
+    reg  matches__1__d;
+    wire  matches__1__q;
+    reg  matches__1__clock;
+    reg  matches__2__d;
+    wire  matches__2__q;
+    reg  matches__2__clock;
+    reg  matches__3__d;
+    wire  matches__3__q;
+    reg  matches__3__clock;
+    reg  matches__4__d;
+    wire  matches__4__q;
+    reg  matches__4__clock;
+    reg  matches__5__d;
+    wire  matches__5__q;
+    reg  matches__5__clock;
+    reg  matches__6__d;
+    wire  matches__6__q;
+    reg  matches__6__clock;
+    reg  matches__7__d;
+    wire  matches__7__q;
+    reg  matches__7__clock;
+    reg  [7:0] meta_r__d;
+    wire  [7:0] meta_r__q;
+    reg  meta_r__clock;
+    reg  [4:0] thread_r__d;
+    wire  [4:0] thread_r__q;
+    reg  thread_r__clock;
+    reg  which_r__d;
+    wire  which_r__q;
+    reg  which_r__clock;
+    reg  [31:0] value_r__d;
+    wire  [31:0] value_r__q;
+    reg  value_r__clock;
+    reg  insert_r__d;
+    wire  insert_r__q;
+    reg  insert_r__clock;
+    reg  clear_r__d;
+    wire  clear_r__q;
+    reg  clear_r__clock;
     reg  [5:0] entries__0__read_address;
     reg  entries__0__read_clock;
     wire  [31:0] entries__0__read_data;
@@ -10134,6 +10443,76 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
     reg  [5:0] write_address;
     
     // Sub module instances
+    dynrt_processor__display__dark_d matches__0(
+        .d(matches__0__d),
+        .q(matches__0__q),
+        .clock(matches__0__clock)
+    );
+    dynrt_processor__display__dark_d matches__1(
+        .d(matches__1__d),
+        .q(matches__1__q),
+        .clock(matches__1__clock)
+    );
+    dynrt_processor__display__dark_d matches__2(
+        .d(matches__2__d),
+        .q(matches__2__q),
+        .clock(matches__2__clock)
+    );
+    dynrt_processor__display__dark_d matches__3(
+        .d(matches__3__d),
+        .q(matches__3__q),
+        .clock(matches__3__clock)
+    );
+    dynrt_processor__display__dark_d matches__4(
+        .d(matches__4__d),
+        .q(matches__4__q),
+        .clock(matches__4__clock)
+    );
+    dynrt_processor__display__dark_d matches__5(
+        .d(matches__5__d),
+        .q(matches__5__q),
+        .clock(matches__5__clock)
+    );
+    dynrt_processor__display__dark_d matches__6(
+        .d(matches__6__d),
+        .q(matches__6__q),
+        .clock(matches__6__clock)
+    );
+    dynrt_processor__display__dark_d matches__7(
+        .d(matches__7__d),
+        .q(matches__7__q),
+        .clock(matches__7__clock)
+    );
+    dynrt_processor__engine__halted_count meta_r(
+        .d(meta_r__d),
+        .q(meta_r__q),
+        .clock(meta_r__clock)
+    );
+    dynrt_processor__engine__decode__t3 thread_r(
+        .d(thread_r__d),
+        .q(thread_r__q),
+        .clock(thread_r__clock)
+    );
+    dynrt_processor__display__dark_d which_r(
+        .d(which_r__d),
+        .q(which_r__q),
+        .clock(which_r__clock)
+    );
+    dynrt_processor__engine__cycle_count value_r(
+        .d(value_r__d),
+        .q(value_r__q),
+        .clock(value_r__clock)
+    );
+    dynrt_processor__display__dark_d insert_r(
+        .d(insert_r__d),
+        .q(insert_r__q),
+        .clock(insert_r__clock)
+    );
+    dynrt_processor__display__dark_d clear_r(
+        .d(clear_r__d),
+        .q(clear_r__q),
+        .clock(clear_r__clock)
+    );
     dynrt_processor__engine__mailboxes__entries__0 entries__0(
         .read_address(entries__0__read_address),
         .read_clock(entries__0__read_clock),
@@ -10218,6 +10597,18 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
     
     // Update code
     always @(*) begin
+        meta_r__clock = clock;
+        thread_r__clock = clock;
+        which_r__clock = clock;
+        value_r__clock = clock;
+        insert_r__clock = clock;
+        clear_r__clock = clock;
+        meta_r__d = meta_r__q;
+        thread_r__d = thread_r__q;
+        which_r__d = which_r__q;
+        value_r__d = value_r__q;
+        insert_r__d = insert_r__q;
+        clear_r__d = clear_r__q;
         meta__read_clock = clock;
         meta__write_clock = clock;
         entries__0__read_clock = clock;
@@ -10246,66 +10637,88 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
         entries__5__read_address = read_address;
         entries__6__read_address = read_address;
         entries__7__read_address = read_address;
-        len = meta__read_data[(32'h0)+:(4)];
-        next_slot = meta__read_data[(32'h4)+:(3)];
+        matches__0__clock = clock;
+        matches__0__d = entries__0__read_data == value;
+        matches__1__clock = clock;
+        matches__1__d = entries__1__read_data == value;
+        matches__2__clock = clock;
+        matches__2__d = entries__2__read_data == value;
+        matches__3__clock = clock;
+        matches__3__d = entries__3__read_data == value;
+        matches__4__clock = clock;
+        matches__4__d = entries__4__read_data == value;
+        matches__5__clock = clock;
+        matches__5__d = entries__5__read_data == value;
+        matches__6__clock = clock;
+        matches__6__d = entries__6__read_data == value;
+        matches__7__clock = clock;
+        matches__7__d = entries__7__read_data == value;
+        meta_r__d = meta__read_data;
+        thread_r__d = thread;
+        which_r__d = which;
+        value_r__d = value;
+        insert_r__d = insert;
+        clear_r__d = clear;
+        len = meta_r__q[(32'h0)+:(4)];
+        next_slot = meta_r__q[(32'h4)+:(3)];
         found = 1'b0;
-        if ((entries__0__read_data == value) & (((len) & 8'hff) > c_index__0)) begin
+        if (matches__0__q & (((len) & 8'hff) > c_index__0)) begin
             found = 1'b1;
         end
-        if ((entries__1__read_data == value) & (((len) & 8'hff) > c_index__1)) begin
+        if (matches__1__q & (((len) & 8'hff) > c_index__1)) begin
             found = 1'b1;
         end
-        if ((entries__2__read_data == value) & (((len) & 8'hff) > c_index__2)) begin
+        if (matches__2__q & (((len) & 8'hff) > c_index__2)) begin
             found = 1'b1;
         end
-        if ((entries__3__read_data == value) & (((len) & 8'hff) > c_index__3)) begin
+        if (matches__3__q & (((len) & 8'hff) > c_index__3)) begin
             found = 1'b1;
         end
-        if ((entries__4__read_data == value) & (((len) & 8'hff) > c_index__4)) begin
+        if (matches__4__q & (((len) & 8'hff) > c_index__4)) begin
             found = 1'b1;
         end
-        if ((entries__5__read_data == value) & (((len) & 8'hff) > c_index__5)) begin
+        if (matches__5__q & (((len) & 8'hff) > c_index__5)) begin
             found = 1'b1;
         end
-        if ((entries__6__read_data == value) & (((len) & 8'hff) > c_index__6)) begin
+        if (matches__6__q & (((len) & 8'hff) > c_index__6)) begin
             found = 1'b1;
         end
-        if ((entries__7__read_data == value) & (((len) & 8'hff) > c_index__7)) begin
+        if (matches__7__q & (((len) & 8'hff) > c_index__7)) begin
             found = 1'b1;
         end
         hit = found;
-        write_address = (((thread) & 6'h3f) << 32'h1) | ((which) & 6'h3f);
+        write_address = (((thread_r__q) & 6'h3f) << 32'h1) | ((which_r__q) & 6'h3f);
         meta__write_address = write_address;
         meta__write_enable = 1'b0;
         meta__write_data = 32'h0;
         entries__0__write_address = write_address;
-        entries__0__write_data = value;
+        entries__0__write_data = value_r__q;
         entries__0__write_enable = 1'b0;
         entries__1__write_address = write_address;
-        entries__1__write_data = value;
+        entries__1__write_data = value_r__q;
         entries__1__write_enable = 1'b0;
         entries__2__write_address = write_address;
-        entries__2__write_data = value;
+        entries__2__write_data = value_r__q;
         entries__2__write_enable = 1'b0;
         entries__3__write_address = write_address;
-        entries__3__write_data = value;
+        entries__3__write_data = value_r__q;
         entries__3__write_enable = 1'b0;
         entries__4__write_address = write_address;
-        entries__4__write_data = value;
+        entries__4__write_data = value_r__q;
         entries__4__write_enable = 1'b0;
         entries__5__write_address = write_address;
-        entries__5__write_data = value;
+        entries__5__write_data = value_r__q;
         entries__5__write_enable = 1'b0;
         entries__6__write_address = write_address;
-        entries__6__write_data = value;
+        entries__6__write_data = value_r__q;
         entries__6__write_enable = 1'b0;
         entries__7__write_address = write_address;
-        entries__7__write_data = value;
+        entries__7__write_data = value_r__q;
         entries__7__write_enable = 1'b0;
-        if (clear) begin
+        if (clear_r__q) begin
             meta__write_enable = 1'b1;
         end
-        if (insert & (~found)) begin
+        if (insert_r__q & (~found)) begin
             meta__write_enable = 1'b1;
             if (len == 32'h8) begin
                 meta__write_data = (((next_slot + 32'h1) & 8'hff) << 32'h4) | (c_index__7 + 32'h1);
@@ -10343,6 +10756,8 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
 endmodule // dynrt_processor__engine__mailboxes
 
 
+
+
 module dynrt_processor__engine__mailboxes__entries__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -10370,6 +10785,24 @@ module dynrt_processor__engine__mailboxes__entries__0(read_address,read_clock,re
     end
                 
 endmodule // dynrt_processor__engine__mailboxes__entries__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -10483,6 +10916,14 @@ endmodule // dynrt_processor__engine__mailboxes__meta
 
 
 
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__mem_bank_r(d,q,clock);
     
     // Module arguments
@@ -10572,7 +11013,9 @@ endmodule // dynrt_processor__engine__pixels
 
 
 
-module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,target,is_wait,kd_busy,tri_busy,jr_target,int_eq,int_lt,mb_hit,pix_done,fast,kind,scratch_data,mem_data,nodes_data,uv_data,t_data,retiring__valid,retiring__op,retiring__dst,retiring__thread,retiring__invert,retiring__pc_plus_one,retiring__target,retiring__is_wait,retiring__kd_busy,retiring__tri_busy,retiring__jr_target,retiring__int_eq,retiring__int_lt,retiring__mb_hit,retiring__pix_done,retiring__fast);
+
+
+module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,target,is_wait,kd_busy,tri_busy,jr_target,int_eq,int_lt,mb_hit,pix_done,fast,kind,converted,scratch_data,mem_data,nodes_data,uv_data,t_data,retiring__valid,retiring__op,retiring__dst,retiring__thread,retiring__invert,retiring__pc_plus_one,retiring__target,retiring__is_wait,retiring__kd_busy,retiring__tri_busy,retiring__jr_target,retiring__int_eq,retiring__int_lt,retiring__mb_hit,retiring__pix_done,retiring__fast);
     
     // Module arguments
     input wire  clock;
@@ -10593,6 +11036,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     input wire  pix_done;
     input wire  [31:0] fast;
     input wire  [2:0] kind;
+    input wire  [31:0] converted;
     input wire  [31:0] scratch_data;
     input wire  [31:0] mem_data;
     input wire  [31:0] nodes_data;
@@ -10630,11 +11074,12 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     
     // Enums
     localparam FastKind__Computed = 0;
-    localparam FastKind__Scratch = 1;
-    localparam FastKind__Memory = 2;
-    localparam FastKind__TrianglesUv = 3;
-    localparam FastKind__TrianglesT = 4;
-    localparam FastKind__Nodes = 5;
+    localparam FastKind__Converted = 1;
+    localparam FastKind__Scratch = 2;
+    localparam FastKind__Memory = 3;
+    localparam FastKind__TrianglesUv = 4;
+    localparam FastKind__TrianglesT = 5;
+    localparam FastKind__Nodes = 6;
     
     // Stub signals
     reg  valid_line__clock;
@@ -10824,7 +11269,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .data_in(int_lt_line__data_in),
         .data_out(int_lt_line__data_out)
     );
-    dynrt_processor__engine__result_line__int_eq_line mb_hit_line(
+    dynrt_processor__engine__result_line__mb_hit_line mb_hit_line(
         .clock(mb_hit_line__clock),
         .data_in(mb_hit_line__data_in),
         .data_out(mb_hit_line__data_out)
@@ -11027,6 +11472,9 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         kind_line__6__d = kind_line__5__q;
         fast_line__7__d = fast_line__6__q;
         kind_line__7__d = kind_line__6__q;
+        if (kind_line__0__q == FastKind__Converted) begin
+            fast_line__1__d = converted;
+        end
         if (kind_line__0__q == FastKind__Scratch) begin
             fast_line__1__d = scratch_data;
         end
@@ -11850,11 +12298,12 @@ module dynrt_processor__engine__result_line__kind_line__0(d,q,clock);
     
     // Enums
     localparam FastKind__Computed = 0;
-    localparam FastKind__Scratch = 1;
-    localparam FastKind__Memory = 2;
-    localparam FastKind__TrianglesUv = 3;
-    localparam FastKind__TrianglesT = 4;
-    localparam FastKind__Nodes = 5;
+    localparam FastKind__Converted = 1;
+    localparam FastKind__Scratch = 2;
+    localparam FastKind__Memory = 3;
+    localparam FastKind__TrianglesUv = 4;
+    localparam FastKind__TrianglesT = 5;
+    localparam FastKind__Nodes = 6;
     
     // Update code (custom)
     initial begin
@@ -12414,8 +12863,143 @@ endmodule // dynrt_processor__engine__result_line__long_op
 
 
 
-
-
+module dynrt_processor__engine__result_line__mb_hit_line(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  data_in;
+    output reg  data_out;
+    
+    // Stub signals
+    reg  stage__0__d;
+    wire  stage__0__q;
+    reg  stage__0__clock;
+    reg  stage__1__d;
+    wire  stage__1__q;
+    reg  stage__1__clock;
+    reg  stage__2__d;
+    wire  stage__2__q;
+    reg  stage__2__clock;
+    reg  stage__3__d;
+    wire  stage__3__q;
+    reg  stage__3__clock;
+    reg  stage__4__d;
+    wire  stage__4__q;
+    reg  stage__4__clock;
+    reg  stage__5__d;
+    wire  stage__5__q;
+    reg  stage__5__clock;
+    reg  stage__6__d;
+    wire  stage__6__q;
+    reg  stage__6__clock;
+    reg  stage__7__d;
+    wire  stage__7__q;
+    reg  stage__7__clock;
+    reg  stage__8__d;
+    wire  stage__8__q;
+    reg  stage__8__clock;
+    reg  stage__9__d;
+    wire  stage__9__q;
+    reg  stage__9__clock;
+    reg  stage__10__d;
+    wire  stage__10__q;
+    reg  stage__10__clock;
+    
+    // Sub module instances
+    dynrt_processor__display__dark_d stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__display__dark_d stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__display__dark_d stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__display__dark_d stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__display__dark_d stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__display__dark_d stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__display__dark_d stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__display__dark_d stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__display__dark_d stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__display__dark_d stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__display__dark_d stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__mb_hit_line
 
 
 
@@ -12852,6 +13436,38 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     localparam  c_thread_ids__29 = 5'b11101;
     localparam  c_thread_ids__30 = 5'b11110;
     localparam  c_thread_ids__31 = 5'b11111;
+    localparam  c_thread_bits__0 = 32'h1;
+    localparam  c_thread_bits__1 = 32'h2;
+    localparam  c_thread_bits__2 = 32'h4;
+    localparam  c_thread_bits__3 = 32'h8;
+    localparam  c_thread_bits__4 = 32'h10;
+    localparam  c_thread_bits__5 = 32'h20;
+    localparam  c_thread_bits__6 = 32'h40;
+    localparam  c_thread_bits__7 = 32'h80;
+    localparam  c_thread_bits__8 = 32'h100;
+    localparam  c_thread_bits__9 = 32'h200;
+    localparam  c_thread_bits__10 = 32'h400;
+    localparam  c_thread_bits__11 = 32'h800;
+    localparam  c_thread_bits__12 = 32'h1000;
+    localparam  c_thread_bits__13 = 32'h2000;
+    localparam  c_thread_bits__14 = 32'h4000;
+    localparam  c_thread_bits__15 = 32'h8000;
+    localparam  c_thread_bits__16 = 32'h10000;
+    localparam  c_thread_bits__17 = 32'h20000;
+    localparam  c_thread_bits__18 = 32'h40000;
+    localparam  c_thread_bits__19 = 32'h80000;
+    localparam  c_thread_bits__20 = 32'h100000;
+    localparam  c_thread_bits__21 = 32'h200000;
+    localparam  c_thread_bits__22 = 32'h400000;
+    localparam  c_thread_bits__23 = 32'h800000;
+    localparam  c_thread_bits__24 = 32'h1000000;
+    localparam  c_thread_bits__25 = 32'h2000000;
+    localparam  c_thread_bits__26 = 32'h4000000;
+    localparam  c_thread_bits__27 = 32'h8000000;
+    localparam  c_thread_bits__28 = 32'h10000000;
+    localparam  c_thread_bits__29 = 32'h20000000;
+    localparam  c_thread_bits__30 = 32'h40000000;
+    localparam  c_thread_bits__31 = 32'h80000000;
     localparam  c_reserve_bit = 32'h6;
     
     // Stub signals
@@ -12864,16 +13480,30 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     reg  [31:0] woken__d;
     wire  [31:0] woken__q;
     reg  woken__clock;
-    reg  [4:0] last_pick__d;
-    wire  [4:0] last_pick__q;
-    reg  last_pick__clock;
+    reg  picked__d;
+    wire  picked__q;
+    reg  picked__clock;
+    reg  [4:0] pick_r__d;
+    wire  [4:0] pick_r__q;
+    reg  pick_r__clock;
+    reg  [31:0] pick_onehot__d;
+    wire  [31:0] pick_onehot__q;
+    reg  pick_onehot__clock;
+    reg  [4:0] pointer__d;
+    wire  [4:0] pointer__q;
+    reg  pointer__clock;
+    reg  [31:0] below_pointer__d;
+    wire  [31:0] below_pointer__q;
+    reg  below_pointer__clock;
     reg  [31:0] reserved__d;
     wire  [31:0] reserved__q;
     reg  reserved__clock;
     
     // Local signals
+    reg  [31:0] candidates;
     reg  [31:0] below;
     reg  [4:0] choice;
+    reg  [31:0] choice_onehot;
     reg  issues;
     reg  [31:0] issue_mask;
     reg  [31:0] wb_mask;
@@ -12900,10 +13530,30 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         .q(woken__q),
         .clock(woken__clock)
     );
-    dynrt_processor__engine__decode__t3 last_pick(
-        .d(last_pick__d),
-        .q(last_pick__q),
-        .clock(last_pick__clock)
+    dynrt_processor__display__dark_d picked(
+        .d(picked__d),
+        .q(picked__q),
+        .clock(picked__clock)
+    );
+    dynrt_processor__engine__decode__t3 pick_r(
+        .d(pick_r__d),
+        .q(pick_r__q),
+        .clock(pick_r__clock)
+    );
+    dynrt_processor__engine__cycle_count pick_onehot(
+        .d(pick_onehot__d),
+        .q(pick_onehot__q),
+        .clock(pick_onehot__clock)
+    );
+    dynrt_processor__engine__decode__t3 pointer(
+        .d(pointer__d),
+        .q(pointer__q),
+        .clock(pointer__clock)
+    );
+    dynrt_processor__engine__cycle_count below_pointer(
+        .d(below_pointer__d),
+        .q(below_pointer__q),
+        .clock(below_pointer__clock)
     );
     dynrt_processor__engine__cycle_count reserved(
         .d(reserved__d),
@@ -12916,216 +13566,294 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         ready__clock = clock;
         asleep__clock = clock;
         woken__clock = clock;
-        last_pick__clock = clock;
+        picked__clock = clock;
+        pick_r__clock = clock;
+        pick_onehot__clock = clock;
+        pointer__clock = clock;
+        below_pointer__clock = clock;
         reserved__clock = clock;
         ready__d = ready__q;
         asleep__d = asleep__q;
         woken__d = woken__q;
-        last_pick__d = last_pick__q;
+        picked__d = picked__q;
+        pick_r__d = pick_r__q;
+        pick_onehot__d = pick_onehot__q;
+        pointer__d = pointer__q;
+        below_pointer__d = below_pointer__q;
         reserved__d = reserved__q;
-        below = ready__q & (~(c_ones << last_pick__q));
+        issues = running & picked__q & (~reserved__q[32'h0]);
+        issue = issues;
+        pick = pick_r__q;
+        issue_mask = 32'h0;
+        if (issues) begin
+            issue_mask = pick_onehot__q;
+        end
+        reserved__d = (reserved__q >> 32'h1) | (((long_at_i3) & 32'hffffffff) << c_reserve_bit);
+        candidates = ready__q & (~pick_onehot__q);
+        below = candidates & below_pointer__q;
         choice = 32'h0;
-        if (ready__q[0]) begin
+        choice_onehot = 32'h0;
+        if (candidates[0]) begin
             choice = c_thread_ids__0;
+            choice_onehot = c_thread_bits__0;
         end
-        if (ready__q[1]) begin
+        if (candidates[1]) begin
             choice = c_thread_ids__1;
+            choice_onehot = c_thread_bits__1;
         end
-        if (ready__q[2]) begin
+        if (candidates[2]) begin
             choice = c_thread_ids__2;
+            choice_onehot = c_thread_bits__2;
         end
-        if (ready__q[3]) begin
+        if (candidates[3]) begin
             choice = c_thread_ids__3;
+            choice_onehot = c_thread_bits__3;
         end
-        if (ready__q[4]) begin
+        if (candidates[4]) begin
             choice = c_thread_ids__4;
+            choice_onehot = c_thread_bits__4;
         end
-        if (ready__q[5]) begin
+        if (candidates[5]) begin
             choice = c_thread_ids__5;
+            choice_onehot = c_thread_bits__5;
         end
-        if (ready__q[6]) begin
+        if (candidates[6]) begin
             choice = c_thread_ids__6;
+            choice_onehot = c_thread_bits__6;
         end
-        if (ready__q[7]) begin
+        if (candidates[7]) begin
             choice = c_thread_ids__7;
+            choice_onehot = c_thread_bits__7;
         end
-        if (ready__q[8]) begin
+        if (candidates[8]) begin
             choice = c_thread_ids__8;
+            choice_onehot = c_thread_bits__8;
         end
-        if (ready__q[9]) begin
+        if (candidates[9]) begin
             choice = c_thread_ids__9;
+            choice_onehot = c_thread_bits__9;
         end
-        if (ready__q[10]) begin
+        if (candidates[10]) begin
             choice = c_thread_ids__10;
+            choice_onehot = c_thread_bits__10;
         end
-        if (ready__q[11]) begin
+        if (candidates[11]) begin
             choice = c_thread_ids__11;
+            choice_onehot = c_thread_bits__11;
         end
-        if (ready__q[12]) begin
+        if (candidates[12]) begin
             choice = c_thread_ids__12;
+            choice_onehot = c_thread_bits__12;
         end
-        if (ready__q[13]) begin
+        if (candidates[13]) begin
             choice = c_thread_ids__13;
+            choice_onehot = c_thread_bits__13;
         end
-        if (ready__q[14]) begin
+        if (candidates[14]) begin
             choice = c_thread_ids__14;
+            choice_onehot = c_thread_bits__14;
         end
-        if (ready__q[15]) begin
+        if (candidates[15]) begin
             choice = c_thread_ids__15;
+            choice_onehot = c_thread_bits__15;
         end
-        if (ready__q[16]) begin
+        if (candidates[16]) begin
             choice = c_thread_ids__16;
+            choice_onehot = c_thread_bits__16;
         end
-        if (ready__q[17]) begin
+        if (candidates[17]) begin
             choice = c_thread_ids__17;
+            choice_onehot = c_thread_bits__17;
         end
-        if (ready__q[18]) begin
+        if (candidates[18]) begin
             choice = c_thread_ids__18;
+            choice_onehot = c_thread_bits__18;
         end
-        if (ready__q[19]) begin
+        if (candidates[19]) begin
             choice = c_thread_ids__19;
+            choice_onehot = c_thread_bits__19;
         end
-        if (ready__q[20]) begin
+        if (candidates[20]) begin
             choice = c_thread_ids__20;
+            choice_onehot = c_thread_bits__20;
         end
-        if (ready__q[21]) begin
+        if (candidates[21]) begin
             choice = c_thread_ids__21;
+            choice_onehot = c_thread_bits__21;
         end
-        if (ready__q[22]) begin
+        if (candidates[22]) begin
             choice = c_thread_ids__22;
+            choice_onehot = c_thread_bits__22;
         end
-        if (ready__q[23]) begin
+        if (candidates[23]) begin
             choice = c_thread_ids__23;
+            choice_onehot = c_thread_bits__23;
         end
-        if (ready__q[24]) begin
+        if (candidates[24]) begin
             choice = c_thread_ids__24;
+            choice_onehot = c_thread_bits__24;
         end
-        if (ready__q[25]) begin
+        if (candidates[25]) begin
             choice = c_thread_ids__25;
+            choice_onehot = c_thread_bits__25;
         end
-        if (ready__q[26]) begin
+        if (candidates[26]) begin
             choice = c_thread_ids__26;
+            choice_onehot = c_thread_bits__26;
         end
-        if (ready__q[27]) begin
+        if (candidates[27]) begin
             choice = c_thread_ids__27;
+            choice_onehot = c_thread_bits__27;
         end
-        if (ready__q[28]) begin
+        if (candidates[28]) begin
             choice = c_thread_ids__28;
+            choice_onehot = c_thread_bits__28;
         end
-        if (ready__q[29]) begin
+        if (candidates[29]) begin
             choice = c_thread_ids__29;
+            choice_onehot = c_thread_bits__29;
         end
-        if (ready__q[30]) begin
+        if (candidates[30]) begin
             choice = c_thread_ids__30;
+            choice_onehot = c_thread_bits__30;
         end
-        if (ready__q[31]) begin
+        if (candidates[31]) begin
             choice = c_thread_ids__31;
+            choice_onehot = c_thread_bits__31;
         end
         if (below[0]) begin
             choice = c_thread_ids__0;
+            choice_onehot = c_thread_bits__0;
         end
         if (below[1]) begin
             choice = c_thread_ids__1;
+            choice_onehot = c_thread_bits__1;
         end
         if (below[2]) begin
             choice = c_thread_ids__2;
+            choice_onehot = c_thread_bits__2;
         end
         if (below[3]) begin
             choice = c_thread_ids__3;
+            choice_onehot = c_thread_bits__3;
         end
         if (below[4]) begin
             choice = c_thread_ids__4;
+            choice_onehot = c_thread_bits__4;
         end
         if (below[5]) begin
             choice = c_thread_ids__5;
+            choice_onehot = c_thread_bits__5;
         end
         if (below[6]) begin
             choice = c_thread_ids__6;
+            choice_onehot = c_thread_bits__6;
         end
         if (below[7]) begin
             choice = c_thread_ids__7;
+            choice_onehot = c_thread_bits__7;
         end
         if (below[8]) begin
             choice = c_thread_ids__8;
+            choice_onehot = c_thread_bits__8;
         end
         if (below[9]) begin
             choice = c_thread_ids__9;
+            choice_onehot = c_thread_bits__9;
         end
         if (below[10]) begin
             choice = c_thread_ids__10;
+            choice_onehot = c_thread_bits__10;
         end
         if (below[11]) begin
             choice = c_thread_ids__11;
+            choice_onehot = c_thread_bits__11;
         end
         if (below[12]) begin
             choice = c_thread_ids__12;
+            choice_onehot = c_thread_bits__12;
         end
         if (below[13]) begin
             choice = c_thread_ids__13;
+            choice_onehot = c_thread_bits__13;
         end
         if (below[14]) begin
             choice = c_thread_ids__14;
+            choice_onehot = c_thread_bits__14;
         end
         if (below[15]) begin
             choice = c_thread_ids__15;
+            choice_onehot = c_thread_bits__15;
         end
         if (below[16]) begin
             choice = c_thread_ids__16;
+            choice_onehot = c_thread_bits__16;
         end
         if (below[17]) begin
             choice = c_thread_ids__17;
+            choice_onehot = c_thread_bits__17;
         end
         if (below[18]) begin
             choice = c_thread_ids__18;
+            choice_onehot = c_thread_bits__18;
         end
         if (below[19]) begin
             choice = c_thread_ids__19;
+            choice_onehot = c_thread_bits__19;
         end
         if (below[20]) begin
             choice = c_thread_ids__20;
+            choice_onehot = c_thread_bits__20;
         end
         if (below[21]) begin
             choice = c_thread_ids__21;
+            choice_onehot = c_thread_bits__21;
         end
         if (below[22]) begin
             choice = c_thread_ids__22;
+            choice_onehot = c_thread_bits__22;
         end
         if (below[23]) begin
             choice = c_thread_ids__23;
+            choice_onehot = c_thread_bits__23;
         end
         if (below[24]) begin
             choice = c_thread_ids__24;
+            choice_onehot = c_thread_bits__24;
         end
         if (below[25]) begin
             choice = c_thread_ids__25;
+            choice_onehot = c_thread_bits__25;
         end
         if (below[26]) begin
             choice = c_thread_ids__26;
+            choice_onehot = c_thread_bits__26;
         end
         if (below[27]) begin
             choice = c_thread_ids__27;
+            choice_onehot = c_thread_bits__27;
         end
         if (below[28]) begin
             choice = c_thread_ids__28;
+            choice_onehot = c_thread_bits__28;
         end
         if (below[29]) begin
             choice = c_thread_ids__29;
+            choice_onehot = c_thread_bits__29;
         end
         if (below[30]) begin
             choice = c_thread_ids__30;
+            choice_onehot = c_thread_bits__30;
         end
         if (below[31]) begin
             choice = c_thread_ids__31;
+            choice_onehot = c_thread_bits__31;
         end
-        issues = running & (ready__q != 32'h0) & (~reserved__q[32'h0]);
-        pick = choice;
-        issue = issues;
-        issue_mask = 32'h0;
-        if (issues) begin
-            issue_mask = c_one << choice;
-            last_pick__d = choice;
-        end
-        reserved__d = (reserved__q >> 32'h1) | (((long_at_i3) & 32'hffffffff) << c_reserve_bit);
+        picked__d = candidates != 32'h0;
+        pick_r__d = choice;
+        pick_onehot__d = choice_onehot;
+        pointer__d = pointer__q - 32'h1;
+        below_pointer__d = ~(c_ones << (pointer__q - 32'h1));
         wb_mask = c_one << wb_thread;
         tester_event = 32'h0;
         if (tester_done) begin
@@ -13155,10 +13883,19 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
             asleep__d = 32'h0;
             woken__d = 32'h0;
             reserved__d = 32'h0;
+            picked__d = 1'b0;
         end
     end
     
 endmodule // dynrt_processor__engine__scheduler
+
+
+
+
+
+
+
+
 
 
 
@@ -13198,6 +13935,8 @@ module dynrt_processor__engine__scratch(read_address,read_clock,read_data,write_
     end
                 
 endmodule // dynrt_processor__engine__scratch
+
+
 
 
 module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_read,engine__load_bank,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,uv_words__read,uv_words__addr,uv_words__rdata,t_words__read,t_words__addr,t_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy);
@@ -18736,6 +19475,66 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
     reg  flight_line__5__d;
     wire  flight_line__5__q;
     reg  flight_line__5__clock;
+    reg  arrive_r__d;
+    wire  arrive_r__q;
+    reg  arrive_r__clock;
+    reg  [31:0] word_r__d;
+    wire  [31:0] word_r__q;
+    reg  word_r__clock;
+    reg  hit_r__0__d;
+    wire  hit_r__0__q;
+    reg  hit_r__0__clock;
+    reg  hit_r__1__d;
+    wire  hit_r__1__q;
+    reg  hit_r__1__clock;
+    reg  hit_r__2__d;
+    wire  hit_r__2__q;
+    reg  hit_r__2__clock;
+    reg  hit_r__3__d;
+    wire  hit_r__3__q;
+    reg  hit_r__3__clock;
+    reg  hit_r__4__d;
+    wire  hit_r__4__q;
+    reg  hit_r__4__clock;
+    reg  hit_r__5__d;
+    wire  hit_r__5__q;
+    reg  hit_r__5__clock;
+    reg  hit_r__6__d;
+    wire  hit_r__6__q;
+    reg  hit_r__6__clock;
+    reg  hit_r__7__d;
+    wire  hit_r__7__q;
+    reg  hit_r__7__clock;
+    reg  skip_r__d;
+    wire  skip_r__q;
+    reg  skip_r__clock;
+    reg  same_r__d;
+    wire  same_r__q;
+    reg  same_r__clock;
+    reg  wrote_r__0__d;
+    wire  wrote_r__0__q;
+    reg  wrote_r__0__clock;
+    reg  wrote_r__1__d;
+    wire  wrote_r__1__q;
+    reg  wrote_r__1__clock;
+    reg  wrote_r__2__d;
+    wire  wrote_r__2__q;
+    reg  wrote_r__2__clock;
+    reg  wrote_r__3__d;
+    wire  wrote_r__3__q;
+    reg  wrote_r__3__clock;
+    reg  wrote_r__4__d;
+    wire  wrote_r__4__q;
+    reg  wrote_r__4__clock;
+    reg  wrote_r__5__d;
+    wire  wrote_r__5__q;
+    reg  wrote_r__5__clock;
+    reg  wrote_r__6__d;
+    wire  wrote_r__6__q;
+    reg  wrote_r__6__clock;
+    reg  wrote_r__7__d;
+    wire  wrote_r__7__q;
+    reg  wrote_r__7__clock;
     
     // Local signals
     reg  take;
@@ -19012,6 +19811,106 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .q(flight_line__5__q),
         .clock(flight_line__5__clock)
     );
+    dynrt_processor__display__dark_d arrive_r(
+        .d(arrive_r__d),
+        .q(arrive_r__q),
+        .clock(arrive_r__clock)
+    );
+    dynrt_processor__engine__cycle_count word_r(
+        .d(word_r__d),
+        .q(word_r__q),
+        .clock(word_r__clock)
+    );
+    dynrt_processor__display__dark_d hit_r__0(
+        .d(hit_r__0__d),
+        .q(hit_r__0__q),
+        .clock(hit_r__0__clock)
+    );
+    dynrt_processor__display__dark_d hit_r__1(
+        .d(hit_r__1__d),
+        .q(hit_r__1__q),
+        .clock(hit_r__1__clock)
+    );
+    dynrt_processor__display__dark_d hit_r__2(
+        .d(hit_r__2__d),
+        .q(hit_r__2__q),
+        .clock(hit_r__2__clock)
+    );
+    dynrt_processor__display__dark_d hit_r__3(
+        .d(hit_r__3__d),
+        .q(hit_r__3__q),
+        .clock(hit_r__3__clock)
+    );
+    dynrt_processor__display__dark_d hit_r__4(
+        .d(hit_r__4__d),
+        .q(hit_r__4__q),
+        .clock(hit_r__4__clock)
+    );
+    dynrt_processor__display__dark_d hit_r__5(
+        .d(hit_r__5__d),
+        .q(hit_r__5__q),
+        .clock(hit_r__5__clock)
+    );
+    dynrt_processor__display__dark_d hit_r__6(
+        .d(hit_r__6__d),
+        .q(hit_r__6__q),
+        .clock(hit_r__6__clock)
+    );
+    dynrt_processor__display__dark_d hit_r__7(
+        .d(hit_r__7__d),
+        .q(hit_r__7__q),
+        .clock(hit_r__7__clock)
+    );
+    dynrt_processor__display__dark_d skip_r(
+        .d(skip_r__d),
+        .q(skip_r__q),
+        .clock(skip_r__clock)
+    );
+    dynrt_processor__display__dark_d same_r(
+        .d(same_r__d),
+        .q(same_r__q),
+        .clock(same_r__clock)
+    );
+    dynrt_processor__display__dark_d wrote_r__0(
+        .d(wrote_r__0__d),
+        .q(wrote_r__0__q),
+        .clock(wrote_r__0__clock)
+    );
+    dynrt_processor__display__dark_d wrote_r__1(
+        .d(wrote_r__1__d),
+        .q(wrote_r__1__q),
+        .clock(wrote_r__1__clock)
+    );
+    dynrt_processor__display__dark_d wrote_r__2(
+        .d(wrote_r__2__d),
+        .q(wrote_r__2__q),
+        .clock(wrote_r__2__clock)
+    );
+    dynrt_processor__display__dark_d wrote_r__3(
+        .d(wrote_r__3__d),
+        .q(wrote_r__3__q),
+        .clock(wrote_r__3__clock)
+    );
+    dynrt_processor__display__dark_d wrote_r__4(
+        .d(wrote_r__4__d),
+        .q(wrote_r__4__q),
+        .clock(wrote_r__4__clock)
+    );
+    dynrt_processor__display__dark_d wrote_r__5(
+        .d(wrote_r__5__d),
+        .q(wrote_r__5__q),
+        .clock(wrote_r__5__clock)
+    );
+    dynrt_processor__display__dark_d wrote_r__6(
+        .d(wrote_r__6__d),
+        .q(wrote_r__6__q),
+        .clock(wrote_r__6__clock)
+    );
+    dynrt_processor__display__dark_d wrote_r__7(
+        .d(wrote_r__7__d),
+        .q(wrote_r__7__q),
+        .clock(wrote_r__7__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -19027,6 +19926,10 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         mb_next__clock = clock;
         flight__clock = clock;
         queued__clock = clock;
+        arrive_r__clock = clock;
+        word_r__clock = clock;
+        skip_r__clock = clock;
+        same_r__clock = clock;
         phase__d = phase__q;
         walk_thread__d = walk_thread__q;
         cursor__d = cursor__q;
@@ -19039,6 +19942,10 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         mb_next__d = mb_next__q;
         flight__d = flight__q;
         queued__d = queued__q;
+        arrive_r__d = arrive_r__q;
+        word_r__d = word_r__q;
+        skip_r__d = skip_r__q;
+        same_r__d = same_r__q;
         commands__clock = clock;
         tests__clock = clock;
         object_ram__read_clock = clock;
@@ -19053,34 +19960,58 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         mailbox_ids__0__write_clock = clock;
         ids__0__clock = clock;
         ids__0__d = ids__0__q;
+        hit_r__0__clock = clock;
+        wrote_r__0__clock = clock;
+        wrote_r__0__d = 1'b0;
         mailbox_ids__1__read_clock = clock;
         mailbox_ids__1__write_clock = clock;
         ids__1__clock = clock;
         ids__1__d = ids__1__q;
+        hit_r__1__clock = clock;
+        wrote_r__1__clock = clock;
+        wrote_r__1__d = 1'b0;
         mailbox_ids__2__read_clock = clock;
         mailbox_ids__2__write_clock = clock;
         ids__2__clock = clock;
         ids__2__d = ids__2__q;
+        hit_r__2__clock = clock;
+        wrote_r__2__clock = clock;
+        wrote_r__2__d = 1'b0;
         mailbox_ids__3__read_clock = clock;
         mailbox_ids__3__write_clock = clock;
         ids__3__clock = clock;
         ids__3__d = ids__3__q;
+        hit_r__3__clock = clock;
+        wrote_r__3__clock = clock;
+        wrote_r__3__d = 1'b0;
         mailbox_ids__4__read_clock = clock;
         mailbox_ids__4__write_clock = clock;
         ids__4__clock = clock;
         ids__4__d = ids__4__q;
+        hit_r__4__clock = clock;
+        wrote_r__4__clock = clock;
+        wrote_r__4__d = 1'b0;
         mailbox_ids__5__read_clock = clock;
         mailbox_ids__5__write_clock = clock;
         ids__5__clock = clock;
         ids__5__d = ids__5__q;
+        hit_r__5__clock = clock;
+        wrote_r__5__clock = clock;
+        wrote_r__5__d = 1'b0;
         mailbox_ids__6__read_clock = clock;
         mailbox_ids__6__write_clock = clock;
         ids__6__clock = clock;
         ids__6__d = ids__6__q;
+        hit_r__6__clock = clock;
+        wrote_r__6__clock = clock;
+        wrote_r__6__d = 1'b0;
         mailbox_ids__7__read_clock = clock;
         mailbox_ids__7__write_clock = clock;
         ids__7__clock = clock;
         ids__7__d = ids__7__q;
+        hit_r__7__clock = clock;
+        wrote_r__7__clock = clock;
+        wrote_r__7__d = 1'b0;
         flight_line__0__clock = clock;
         flight_line__1__clock = clock;
         flight_line__2__clock = clock;
@@ -19115,35 +20046,35 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         mailbox_meta__write_data = 32'h0;
         mailbox_ids__0__read_address = walk_thread__q;
         mailbox_ids__0__write_address = walk_thread__q;
-        mailbox_ids__0__write_data = list_rdata;
+        mailbox_ids__0__write_data = word_r__q;
         mailbox_ids__0__write_enable = 1'b0;
         mailbox_ids__1__read_address = walk_thread__q;
         mailbox_ids__1__write_address = walk_thread__q;
-        mailbox_ids__1__write_data = list_rdata;
+        mailbox_ids__1__write_data = word_r__q;
         mailbox_ids__1__write_enable = 1'b0;
         mailbox_ids__2__read_address = walk_thread__q;
         mailbox_ids__2__write_address = walk_thread__q;
-        mailbox_ids__2__write_data = list_rdata;
+        mailbox_ids__2__write_data = word_r__q;
         mailbox_ids__2__write_enable = 1'b0;
         mailbox_ids__3__read_address = walk_thread__q;
         mailbox_ids__3__write_address = walk_thread__q;
-        mailbox_ids__3__write_data = list_rdata;
+        mailbox_ids__3__write_data = word_r__q;
         mailbox_ids__3__write_enable = 1'b0;
         mailbox_ids__4__read_address = walk_thread__q;
         mailbox_ids__4__write_address = walk_thread__q;
-        mailbox_ids__4__write_data = list_rdata;
+        mailbox_ids__4__write_data = word_r__q;
         mailbox_ids__4__write_enable = 1'b0;
         mailbox_ids__5__read_address = walk_thread__q;
         mailbox_ids__5__write_address = walk_thread__q;
-        mailbox_ids__5__write_data = list_rdata;
+        mailbox_ids__5__write_data = word_r__q;
         mailbox_ids__5__write_enable = 1'b0;
         mailbox_ids__6__read_address = walk_thread__q;
         mailbox_ids__6__write_address = walk_thread__q;
-        mailbox_ids__6__write_data = list_rdata;
+        mailbox_ids__6__write_data = word_r__q;
         mailbox_ids__6__write_enable = 1'b0;
         mailbox_ids__7__read_address = walk_thread__q;
         mailbox_ids__7__write_address = walk_thread__q;
-        mailbox_ids__7__write_data = list_rdata;
+        mailbox_ids__7__write_data = word_r__q;
         mailbox_ids__7__write_enable = 1'b0;
         if ((phase__q == ListPhase__Idle) & (~commands__empty)) begin
             if (head_kind == c_cmd_init) begin
@@ -19193,7 +20124,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
             ids__7__d = mailbox_ids__7__read_data;
             phase__d = ListPhase__Walk;
         end
-        take = (phase__q == ListPhase__Walk) & (cursor__q != list_end__q) & ((((queued__q) & 5'h1f) + ((flight__q) & 5'h1f)) < 32'h7) & (~(engine_read & (engine_bank != c_bank_nodes) & (engine_bank != c_bank_uv) & (engine_bank != c_bank_t)));
+        take = (phase__q == ListPhase__Walk) & (cursor__q != list_end__q) & ((((queued__q) & 5'h1f) + ((flight__q) & 5'h1f) + ((arrive_r__q) & 5'h1f)) < 32'h7) & (~(engine_read & (engine_bank != c_bank_nodes) & (engine_bank != c_bank_uv) & (engine_bank != c_bank_t)));
         list_read = take;
         list_addr = cursor__q;
         if (take) begin
@@ -19231,32 +20162,100 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         if (arrive & (~take)) begin
             flight__d = flight__q - 32'h1;
         end
+        arrive_r__d = arrive;
+        word_r__d = list_rdata;
+        hit_r__0__d = ids__0__q == list_rdata;
+        hit_r__1__d = ids__1__q == list_rdata;
+        hit_r__2__d = ids__2__q == list_rdata;
+        hit_r__3__d = ids__3__q == list_rdata;
+        hit_r__4__d = ids__4__q == list_rdata;
+        hit_r__5__d = ids__5__q == list_rdata;
+        hit_r__6__d = ids__6__q == list_rdata;
+        hit_r__7__d = ids__7__q == list_rdata;
+        skip_r__d = (list_rdata == skip_triangle__q) & (object_id__q == skip_object__q);
+        same_r__d = list_rdata == word_r__q;
         seen = 1'b0;
-        if ((c_index__0 < mb_len__q) & (ids__0__q == list_rdata)) begin
-            seen = 1'b1;
+        if (c_index__0 < mb_len__q) begin
+            if (wrote_r__0__q) begin
+                if (same_r__q) begin
+                    seen = 1'b1;
+                end
+            end
+            else if (hit_r__0__q) begin
+                seen = 1'b1;
+            end
         end
-        if ((c_index__1 < mb_len__q) & (ids__1__q == list_rdata)) begin
-            seen = 1'b1;
+        if (c_index__1 < mb_len__q) begin
+            if (wrote_r__1__q) begin
+                if (same_r__q) begin
+                    seen = 1'b1;
+                end
+            end
+            else if (hit_r__1__q) begin
+                seen = 1'b1;
+            end
         end
-        if ((c_index__2 < mb_len__q) & (ids__2__q == list_rdata)) begin
-            seen = 1'b1;
+        if (c_index__2 < mb_len__q) begin
+            if (wrote_r__2__q) begin
+                if (same_r__q) begin
+                    seen = 1'b1;
+                end
+            end
+            else if (hit_r__2__q) begin
+                seen = 1'b1;
+            end
         end
-        if ((c_index__3 < mb_len__q) & (ids__3__q == list_rdata)) begin
-            seen = 1'b1;
+        if (c_index__3 < mb_len__q) begin
+            if (wrote_r__3__q) begin
+                if (same_r__q) begin
+                    seen = 1'b1;
+                end
+            end
+            else if (hit_r__3__q) begin
+                seen = 1'b1;
+            end
         end
-        if ((c_index__4 < mb_len__q) & (ids__4__q == list_rdata)) begin
-            seen = 1'b1;
+        if (c_index__4 < mb_len__q) begin
+            if (wrote_r__4__q) begin
+                if (same_r__q) begin
+                    seen = 1'b1;
+                end
+            end
+            else if (hit_r__4__q) begin
+                seen = 1'b1;
+            end
         end
-        if ((c_index__5 < mb_len__q) & (ids__5__q == list_rdata)) begin
-            seen = 1'b1;
+        if (c_index__5 < mb_len__q) begin
+            if (wrote_r__5__q) begin
+                if (same_r__q) begin
+                    seen = 1'b1;
+                end
+            end
+            else if (hit_r__5__q) begin
+                seen = 1'b1;
+            end
         end
-        if ((c_index__6 < mb_len__q) & (ids__6__q == list_rdata)) begin
-            seen = 1'b1;
+        if (c_index__6 < mb_len__q) begin
+            if (wrote_r__6__q) begin
+                if (same_r__q) begin
+                    seen = 1'b1;
+                end
+            end
+            else if (hit_r__6__q) begin
+                seen = 1'b1;
+            end
         end
-        if ((c_index__7 < mb_len__q) & (ids__7__q == list_rdata)) begin
-            seen = 1'b1;
+        if (c_index__7 < mb_len__q) begin
+            if (wrote_r__7__q) begin
+                if (same_r__q) begin
+                    seen = 1'b1;
+                end
+            end
+            else if (hit_r__7__q) begin
+                seen = 1'b1;
+            end
         end
-        fresh = arrive & (~seen) & (~((list_rdata == skip_triangle__q) & (object_id__q == skip_object__q)));
+        fresh = arrive_r__q & (~seen) & (~skip_r__q);
         next_after = mb_next__q + 32'h1;
         len_after = mb_len__q;
         if (mb_len__q != 32'h8) begin
@@ -19264,45 +20263,53 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         end
         if (fresh) begin
             push = 1'b1;
-            tests__data_in = (((walk_thread__q) & 71'h7fffffffffffffffff) << 32'h40) | (((list_rdata) & 71'h7fffffffffffffffff) << 32'h20) | ((object_id__q) & 71'h7fffffffffffffffff);
+            tests__data_in = (((walk_thread__q) & 71'h7fffffffffffffffff) << 32'h40) | (((word_r__q) & 71'h7fffffffffffffffff) << 32'h20) | ((object_id__q) & 71'h7fffffffffffffffff);
             if (((mb_next__q) & 4'hf) == c_index__0) begin
-                ids__0__d = list_rdata;
+                ids__0__d = word_r__q;
                 mailbox_ids__0__write_enable = 1'b1;
+                wrote_r__0__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__1) begin
-                ids__1__d = list_rdata;
+                ids__1__d = word_r__q;
                 mailbox_ids__1__write_enable = 1'b1;
+                wrote_r__1__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__2) begin
-                ids__2__d = list_rdata;
+                ids__2__d = word_r__q;
                 mailbox_ids__2__write_enable = 1'b1;
+                wrote_r__2__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__3) begin
-                ids__3__d = list_rdata;
+                ids__3__d = word_r__q;
                 mailbox_ids__3__write_enable = 1'b1;
+                wrote_r__3__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__4) begin
-                ids__4__d = list_rdata;
+                ids__4__d = word_r__q;
                 mailbox_ids__4__write_enable = 1'b1;
+                wrote_r__4__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__5) begin
-                ids__5__d = list_rdata;
+                ids__5__d = word_r__q;
                 mailbox_ids__5__write_enable = 1'b1;
+                wrote_r__5__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__6) begin
-                ids__6__d = list_rdata;
+                ids__6__d = word_r__q;
                 mailbox_ids__6__write_enable = 1'b1;
+                wrote_r__6__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__7) begin
-                ids__7__d = list_rdata;
+                ids__7__d = word_r__q;
                 mailbox_ids__7__write_enable = 1'b1;
+                wrote_r__7__d = 1'b1;
             end
             mb_next__d = next_after;
             mb_len__d = len_after;
             mailbox_meta__write_enable = 1'b1;
             mailbox_meta__write_data = (((next_after) & 8'hff) << 32'h4) | ((len_after) & 8'hff);
         end
-        if ((phase__q == ListPhase__Walk) & (cursor__q == list_end__q) & (flight__q == 32'h0) & (~tests__full)) begin
+        if ((phase__q == ListPhase__Walk) & (cursor__q == list_end__q) & (flight__q == 32'h0) & (~arrive_r__q) & (~tests__full)) begin
             push = 1'b1;
             tests__data_in = c_list_end | (((of_walk__q) & 71'h7fffffffffffffffff) << 32'h45) | (((walk_thread__q) & 71'h7fffffffffffffffff) << 32'h40);
             phase__d = ListPhase__Idle;
@@ -19318,6 +20325,8 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
     end
     
 endmodule // dynrt_processor__engine__tester__list_unit
+
+
 
 
 module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
@@ -19711,6 +20720,22 @@ endmodule // dynrt_processor__engine__tester__list_unit__flight
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__tester__list_unit__mailbox_meta(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -19840,6 +20865,8 @@ endmodule // dynrt_processor__engine__tester__list_unit__phase
 
 
 
+
+
 module dynrt_processor__engine__tester__list_unit__skip_object_ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -19901,6 +20928,8 @@ module dynrt_processor__engine__tester__list_unit__skip_object_ram(read_address,
     end
                 
 endmodule // dynrt_processor__engine__tester__list_unit__skip_object_ram
+
+
 
 
 
@@ -20223,6 +21252,24 @@ module dynrt_processor__engine__tester__list_unit__tests__write_logic(write,data
     end
     
 endmodule // dynrt_processor__engine__tester__list_unit__tests__write_logic
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -28034,9 +29081,20 @@ endmodule // dynrt_processor__engine__traversal_unit__stack_node
 
 
 
-module dynrt_processor__engine__write_back(retiring__valid,retiring__op,retiring__dst,retiring__thread,retiring__invert,retiring__pc_plus_one,retiring__target,retiring__is_wait,retiring__kd_busy,retiring__tri_busy,retiring__jr_target,retiring__int_eq,retiring__int_lt,retiring__mb_hit,retiring__pix_done,retiring__fast,sum,product,quotient,root,lt,le,eq,colour_byte,write,data,next_pc,halt,retired,wait_pending);
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__op,retiring__dst,retiring__thread,retiring__invert,retiring__pc_plus_one,retiring__target,retiring__is_wait,retiring__kd_busy,retiring__tri_busy,retiring__jr_target,retiring__int_eq,retiring__int_lt,retiring__mb_hit,retiring__pix_done,retiring__fast,sum,product,quotient,root,lt,le,eq,colour_byte,valid,thread,dst,write,data,next_pc,halt,retired,wait_pending);
     
     // Module arguments
+    input wire  clock;
     input wire  retiring__valid;
     input wire  [4:0] retiring__op;
     input wire  [7:0] retiring__dst;
@@ -28061,6 +29119,9 @@ module dynrt_processor__engine__write_back(retiring__valid,retiring__op,retiring
     input wire  le;
     input wire  eq;
     input wire  [7:0] colour_byte;
+    output reg  valid;
+    output reg  [4:0] thread;
+    output reg  [7:0] dst;
     output reg  write;
     output reg  [31:0] data;
     output reg  [11:0] next_pc;
@@ -28089,14 +29150,108 @@ module dynrt_processor__engine__write_back(retiring__valid,retiring__op,retiring
     localparam  op_byte = 5'b11111;
     localparam  op_writes = 32'ha8817ffe;
     
+    // Stub signals
+    reg  valid_r__d;
+    wire  valid_r__q;
+    reg  valid_r__clock;
+    reg  [4:0] thread_r__d;
+    wire  [4:0] thread_r__q;
+    reg  thread_r__clock;
+    reg  [7:0] dst_r__d;
+    wire  [7:0] dst_r__q;
+    reg  dst_r__clock;
+    reg  write_r__d;
+    wire  write_r__q;
+    reg  write_r__clock;
+    reg  [31:0] data_r__d;
+    wire  [31:0] data_r__q;
+    reg  data_r__clock;
+    reg  [11:0] next_pc_r__d;
+    wire  [11:0] next_pc_r__q;
+    reg  next_pc_r__clock;
+    reg  halt_r__d;
+    wire  halt_r__q;
+    reg  halt_r__clock;
+    reg  retired_r__d;
+    wire  retired_r__q;
+    reg  retired_r__clock;
+    reg  wait_pending_r__d;
+    wire  wait_pending_r__q;
+    reg  wait_pending_r__clock;
+    
     // Local signals
     reg  cond;
     reg  repeats;
     reg  [11:0] pc;
     reg  [31:0] result;
     
+    // Sub module instances
+    dynrt_processor__display__dark_d valid_r(
+        .d(valid_r__d),
+        .q(valid_r__q),
+        .clock(valid_r__clock)
+    );
+    dynrt_processor__engine__decode__t3 thread_r(
+        .d(thread_r__d),
+        .q(thread_r__q),
+        .clock(thread_r__clock)
+    );
+    dynrt_processor__engine__halted_count dst_r(
+        .d(dst_r__d),
+        .q(dst_r__q),
+        .clock(dst_r__clock)
+    );
+    dynrt_processor__display__dark_d write_r(
+        .d(write_r__d),
+        .q(write_r__q),
+        .clock(write_r__clock)
+    );
+    dynrt_processor__engine__cycle_count data_r(
+        .d(data_r__d),
+        .q(data_r__q),
+        .clock(data_r__clock)
+    );
+    dynrt_processor__display__timing__col next_pc_r(
+        .d(next_pc_r__d),
+        .q(next_pc_r__q),
+        .clock(next_pc_r__clock)
+    );
+    dynrt_processor__display__dark_d halt_r(
+        .d(halt_r__d),
+        .q(halt_r__q),
+        .clock(halt_r__clock)
+    );
+    dynrt_processor__display__dark_d retired_r(
+        .d(retired_r__d),
+        .q(retired_r__q),
+        .clock(retired_r__clock)
+    );
+    dynrt_processor__display__dark_d wait_pending_r(
+        .d(wait_pending_r__d),
+        .q(wait_pending_r__q),
+        .clock(wait_pending_r__clock)
+    );
+    
     // Update code
     always @(*) begin
+        valid_r__clock = clock;
+        thread_r__clock = clock;
+        dst_r__clock = clock;
+        write_r__clock = clock;
+        data_r__clock = clock;
+        next_pc_r__clock = clock;
+        halt_r__clock = clock;
+        retired_r__clock = clock;
+        wait_pending_r__clock = clock;
+        valid_r__d = valid_r__q;
+        thread_r__d = thread_r__q;
+        dst_r__d = dst_r__q;
+        write_r__d = write_r__q;
+        data_r__d = data_r__q;
+        next_pc_r__d = next_pc_r__q;
+        halt_r__d = halt_r__q;
+        retired_r__d = retired_r__q;
+        wait_pending_r__d = wait_pending_r__q;
         cond = 1'b0;
         if (retiring__op == op_bflt) begin
             cond = lt;
@@ -28157,15 +29312,45 @@ module dynrt_processor__engine__write_back(retiring__valid,retiring__op,retiring
         if (retiring__op == op_byte) begin
             result = retiring__fast | ((colour_byte) & 32'hffffffff);
         end
-        next_pc = pc;
-        data = result;
-        halt = retiring__op == op_halt;
-        write = retiring__valid & (retiring__dst != 32'h0) & op_writes[retiring__op] & (~((retiring__op == op_pixel) & retiring__pix_done));
-        retired = retiring__valid & (~repeats);
-        wait_pending = cond & retiring__is_wait;
+        valid_r__d = retiring__valid;
+        thread_r__d = retiring__thread;
+        dst_r__d = retiring__dst;
+        next_pc_r__d = pc;
+        data_r__d = result;
+        halt_r__d = retiring__op == op_halt;
+        write_r__d = retiring__valid & (retiring__dst != 32'h0) & op_writes[retiring__op] & (~((retiring__op == op_pixel) & retiring__pix_done));
+        retired_r__d = retiring__valid & (~repeats);
+        wait_pending_r__d = cond & retiring__is_wait;
+        valid = valid_r__q;
+        thread = thread_r__q;
+        dst = dst_r__q;
+        write = write_r__q;
+        data = data_r__q;
+        next_pc = next_pc_r__q;
+        halt = halt_r__q;
+        retired = retired_r__q;
+        wait_pending = wait_pending_r__q;
     end
     
 endmodule // dynrt_processor__engine__write_back
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 /* verilator lint_on UNUSEDSIGNAL */
 /* verilator lint_on DECLFILENAME */
