@@ -664,6 +664,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     // Constant declarations
     localparam  c_threads = 8'h20;
     localparam  op_fsub = 5'b10;
+    localparam  op_fdiv = 5'b100;
+    localparam  op_fsqrt = 5'b101;
     localparam  op_ld = 5'b1110;
     localparam  op_st = 5'b1111;
     localparam  op_sts = 5'b10001;
@@ -737,7 +739,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     wire  decode__valid_i3;
     wire  [4:0] decode__op_i3;
     wire  [4:0] decode__thread_i3;
-    wire  decode__long_i3;
     wire  [31:0] decode__imm_i3;
     wire  decode__valid;
     wire  [4:0] decode__thread;
@@ -1015,6 +1016,10 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     
     // Local signals
     reg  frame_start;
+    reg  tri_op;
+    reg  kd_op;
+    reg  tri_wait_fn;
+    reg  kd_wait_fn;
     reg  queued_fn;
     reg  tri_busy;
     reg  kd_busy;
@@ -1063,7 +1068,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .valid_i3(decode__valid_i3),
         .op_i3(decode__op_i3),
         .thread_i3(decode__thread_i3),
-        .long_i3(decode__long_i3),
         .imm_i3(decode__imm_i3),
         .valid(decode__valid),
         .thread(decode__thread),
@@ -1508,7 +1512,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         mailboxes__read_which = decode__imm_i3[32'h0];
         tester__engine__query_thread = decode__thread_i3;
         traversal_unit__engine__query_thread = decode__thread_i3;
-        scheduler__long_at_i3 = decode__long_i3;
+        scheduler__long_at_i3 = decode__valid_i3 & ((decode__op_i3 == op_fdiv) | (decode__op_i3 == op_fsqrt));
         fp_units__a = decode__a[(32'h0)+:(24)];
         fp_units__b = decode__b[(32'h0)+:(24)];
         fp_units__sub = decode__op == op_fsub;
@@ -1554,11 +1558,15 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             mem_addr = mem_addr_r__q;
         end
         tester__lists__rdata = mem_rdata;
-        ray_write__d = decode__valid_i3 & (decode__op_i3 == op_tri) & (decode__imm_i3 < tri_ray_words);
-        t_min_write__d = decode__valid_i3 & (decode__op_i3 == op_tri) & (decode__imm_i3 == tri_init);
+        tri_op = decode__op_i3 == op_tri;
+        kd_op = decode__op_i3 == op_kd;
+        tri_wait_fn = decode__imm_i3 == tri_wait;
+        kd_wait_fn = decode__imm_i3 == kd_wait;
         queued_fn = (decode__imm_i3 == tri_init) | (decode__imm_i3 == tri_list) | (decode__imm_i3 == tri_object) | (decode__imm_i3 == tri_skip);
+        ray_write__d = decode__valid_i3 & tri_op & (decode__imm_i3 < tri_ray_words);
+        t_min_write__d = decode__valid_i3 & tri_op & (decode__imm_i3 == tri_init);
         tri_queues__d = queued_fn;
-        tri_enqueue__d = decode__valid_i3 & (decode__op_i3 == op_tri) & queued_fn;
+        tri_enqueue__d = decode__valid_i3 & tri_op & queued_fn;
         tri_kind__d = cmd_list;
         if (decode__imm_i3 == tri_init) begin
             tri_kind__d = cmd_init;
@@ -1569,10 +1577,10 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         if (decode__imm_i3 == tri_skip) begin
             tri_kind__d = cmd_skip;
         end
-        tri_waits__d = decode__imm_i3 == tri_wait;
-        kd_enqueue__d = decode__valid_i3 & (decode__op_i3 == op_kd) & (decode__imm_i3 == kd_start);
-        kd_waits__d = decode__imm_i3 == kd_wait;
-        wait_fn__d = ((decode__op_i3 == op_tri) & (decode__imm_i3 == tri_wait)) | ((decode__op_i3 == op_kd) & (decode__imm_i3 == kd_wait));
+        tri_waits__d = tri_wait_fn;
+        kd_enqueue__d = decode__valid_i3 & kd_op & (decode__imm_i3 == kd_start);
+        kd_waits__d = kd_wait_fn;
+        wait_fn__d = (tri_op & tri_wait_fn) | (kd_op & kd_wait_fn);
         traversal_unit__engine__load_read = mem_read_r__q;
         traversal_unit__engine__load_bank = mem_bank_r__q;
         traversal_unit__engine__load_addr = mem_addr_r__q;
@@ -1721,7 +1729,7 @@ module dynrt_processor__engine__cycle_count(d,q,clock);
 endmodule // dynrt_processor__engine__cycle_count
 
 
-module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm_i2,aux_i2,valid_i3,op_i3,thread_i3,long_i3,imm_i3,valid,thread,pc,op,dst,invert,imm,shift,bank,target,a,b,store,wb_write,wb_thread,wb_dst,wb_data);
+module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm_i2,aux_i2,valid_i3,op_i3,thread_i3,imm_i3,valid,thread,pc,op,dst,invert,imm,shift,bank,target,a,b,store,wb_write,wb_thread,wb_dst,wb_data);
     
     // Module arguments
     input wire  clock;
@@ -1734,7 +1742,6 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
     output reg  valid_i3;
     output reg  [4:0] op_i3;
     output reg  [4:0] thread_i3;
-    output reg  long_i3;
     output reg  [31:0] imm_i3;
     output reg  valid;
     output reg  [4:0] thread;
@@ -1764,8 +1771,6 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
     localparam  f_shift = 5'b1111;
     localparam  f_bank = 5'b1100;
     localparam  f_target = 5'b0;
-    localparam  op_fdiv = 5'b100;
-    localparam  op_fsqrt = 5'b101;
     
     // Stub signals
     reg  [12:0] regs_a__read_address;
@@ -1978,7 +1983,6 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
         op_i3 = ctl3__q[(f_op)+:(5)];
         thread_i3 = t3__q;
         imm_i3 = imm3__q;
-        long_i3 = v3__q & ((ctl3__q[(f_op)+:(5)] == op_fdiv) | (ctl3__q[(f_op)+:(5)] == op_fsqrt));
         v4__d = v3__q;
         t4__d = t3__q;
         pc4__d = pc3__q;

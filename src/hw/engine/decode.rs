@@ -7,8 +7,8 @@
 //! [`super::Fetch`]) comes out at I4 with its fields and operands: `a` is register `A` (r0
 //! reads 0), `b` the immediate when `B_IMM` is set, else register `B`; `store` is register
 //! `B` as read (the data of `st` and `sts`). At I3 it shows the instruction's `valid_i3`,
-//! `op_i3`, `thread_i3`, `imm_i3` and `long_i3` (an `fdiv` or `fsqrt`), for the units that
-//! read per-thread state, and the glue that decodes coprocessor functions, one clock ahead of
+//! `op_i3`, `thread_i3` and `imm_i3`, for the units that read per-thread state, the glue that
+//! decodes coprocessor functions and the long instructions' reservation, one clock ahead of
 //! the operands. The field offsets are `isa::CTL_*` and `isa::AUX_*`, the one
 //! encoding `isa::Instr::encode` writes into the ROM. The write back writes `wb_data` to
 //! `wb_dst` of `wb_thread` when `wb_write` is set.
@@ -22,8 +22,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::op_code;
-use crate::hw::program::isa::{self, Op, BANK_BITS, OP_BITS, PC_BITS, REG_BITS, SHIFT_BITS};
+use crate::hw::program::isa::{self, BANK_BITS, OP_BITS, PC_BITS, REG_BITS, SHIFT_BITS};
 
 #[derive(LogicBlock)]
 pub struct Decode {
@@ -35,12 +34,10 @@ pub struct Decode {
     pub ctl_i2: Signal<In, Bits<32>>,
     pub imm_i2: Signal<In, Bits<32>>,
     pub aux_i2: Signal<In, Bits<32>>,
-    /// I3: the instruction (`valid_i3`, its opcode, thread and immediate) and whether it is
-    /// `fdiv` or `fsqrt`.
+    /// I3: the instruction (`valid_i3`, its opcode, thread and immediate).
     pub valid_i3: Signal<Out, Bit>,
     pub op_i3: Signal<Out, Bits<OP_BITS>>,
     pub thread_i3: Signal<Out, Bits<5>>,
-    pub long_i3: Signal<Out, Bit>,
     pub imm_i3: Signal<Out, Bits<32>>,
     /// I4: the instruction's fields and operands.
     pub valid: Signal<Out, Bit>,
@@ -94,8 +91,6 @@ pub struct Decode {
     f_shift: Constant<Bits<5>>,
     f_bank: Constant<Bits<5>>,
     f_target: Constant<Bits<5>>,
-    op_fdiv: Constant<Bits<5>>,
-    op_fsqrt: Constant<Bits<5>>,
 }
 
 fn field(at: usize) -> Constant<Bits<5>> {
@@ -127,7 +122,6 @@ impl Decode {
             valid_i3: Default::default(),
             op_i3: Default::default(),
             thread_i3: Default::default(),
-            long_i3: Default::default(),
             imm_i3: Default::default(),
             a: Default::default(),
             b: Default::default(),
@@ -165,8 +159,6 @@ impl Decode {
             f_shift: field(isa::AUX_SHIFT),
             f_bank: field(isa::AUX_BANK),
             f_target: field(isa::AUX_TARGET),
-            op_fdiv: op_code(Op::FDiv),
-            op_fsqrt: op_code(Op::FSqrt),
         }
     }
 }
@@ -212,19 +204,6 @@ impl Logic for Decode {
             .get_bits::<OP_BITS>(self.f_op.val().index());
         self.thread_i3.next = self.t3.q.val();
         self.imm_i3.next = self.imm3.q.val();
-        self.long_i3.next = self.v3.q.val()
-            & ((self
-                .ctl3
-                .q
-                .val()
-                .get_bits::<OP_BITS>(self.f_op.val().index())
-                == self.op_fdiv.val())
-                | (self
-                    .ctl3
-                    .q
-                    .val()
-                    .get_bits::<OP_BITS>(self.f_op.val().index())
-                    == self.op_fsqrt.val()));
         self.v4.d.next = self.v3.q.val();
         self.t4.d.next = self.t3.q.val();
         self.pc4.d.next = self.pc3.q.val();

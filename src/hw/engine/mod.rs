@@ -245,6 +245,10 @@ pub struct ThreadEngine<
     kd_enqueue: DFF<Bit>,
     kd_waits: DFF<Bit>,
     wait_fn: DFF<Bit>,
+    tri_op: Signal<Local, Bit>,
+    kd_op: Signal<Local, Bit>,
+    tri_wait_fn: Signal<Local, Bit>,
+    kd_wait_fn: Signal<Local, Bit>,
     queued_fn: Signal<Local, Bit>,
     tri_busy: Signal<Local, Bit>,
     kd_busy: Signal<Local, Bit>,
@@ -254,6 +258,8 @@ pub struct ThreadEngine<
     // `layout` (banks) and `list_unit` (command kinds): the Verilog's localparams follow the
     // twin's numbering by construction.
     op_fsub: Constant<Bits<5>>,
+    op_fdiv: Constant<Bits<5>>,
+    op_fsqrt: Constant<Bits<5>>,
     op_ld: Constant<Bits<5>>,
     op_st: Constant<Bits<5>>,
     op_sts: Constant<Bits<5>>,
@@ -366,11 +372,17 @@ impl<
             kd_enqueue: Default::default(),
             kd_waits: Default::default(),
             wait_fn: Default::default(),
+            tri_op: Default::default(),
+            kd_op: Default::default(),
+            tri_wait_fn: Default::default(),
+            kd_wait_fn: Default::default(),
             queued_fn: Default::default(),
             tri_busy: Default::default(),
             kd_busy: Default::default(),
             c_threads: Constant::new(u64::from(threads).into()),
             op_fsub: op_code(Op::FSub),
+            op_fdiv: op_code(Op::FDiv),
+            op_fsqrt: op_code(Op::FSqrt),
             op_ld: op_code(Op::Ld),
             op_st: op_code(Op::St),
             op_sts: op_code(Op::Sts),
@@ -499,7 +511,9 @@ impl<
         self.mailboxes.read_which.next = self.decode.imm_i3.val().get_bit(0);
         self.tester.engine.query_thread.next = self.decode.thread_i3.val();
         self.traversal_unit.engine.query_thread.next = self.decode.thread_i3.val();
-        self.scheduler.long_at_i3.next = self.decode.long_i3.val();
+        self.scheduler.long_at_i3.next = self.decode.valid_i3.val()
+            & ((self.decode.op_i3.val() == self.op_fdiv.val())
+                | (self.decode.op_i3.val() == self.op_fsqrt.val()));
 
         // I4.
         self.fp_units.a.next = self.decode.a.val().get_bits::<W>(0);
@@ -571,20 +585,23 @@ impl<
         // I3: the coprocessor function the instruction names (`tri` with its `TriFn`, `kd`
         // with its `KdFn`, in imm), for I4. The queued `TriFn`s go to the list unit as its
         // command kinds.
-        self.ray_write.d.next = self.decode.valid_i3.val()
-            & (self.decode.op_i3.val() == self.op_tri.val())
-            & (self.decode.imm_i3.val() < self.tri_ray_words.val());
-        self.t_min_write.d.next = self.decode.valid_i3.val()
-            & (self.decode.op_i3.val() == self.op_tri.val())
-            & (self.decode.imm_i3.val() == self.tri_init.val());
+        self.tri_op.next = self.decode.op_i3.val() == self.op_tri.val();
+        self.kd_op.next = self.decode.op_i3.val() == self.op_kd.val();
+        self.tri_wait_fn.next = self.decode.imm_i3.val() == self.tri_wait.val();
+        self.kd_wait_fn.next = self.decode.imm_i3.val() == self.kd_wait.val();
         self.queued_fn.next = (self.decode.imm_i3.val() == self.tri_init.val())
             | (self.decode.imm_i3.val() == self.tri_list.val())
             | (self.decode.imm_i3.val() == self.tri_object.val())
             | (self.decode.imm_i3.val() == self.tri_skip.val());
+        self.ray_write.d.next = self.decode.valid_i3.val()
+            & self.tri_op.val()
+            & (self.decode.imm_i3.val() < self.tri_ray_words.val());
+        self.t_min_write.d.next = self.decode.valid_i3.val()
+            & self.tri_op.val()
+            & (self.decode.imm_i3.val() == self.tri_init.val());
         self.tri_queues.d.next = self.queued_fn.val();
-        self.tri_enqueue.d.next = self.decode.valid_i3.val()
-            & (self.decode.op_i3.val() == self.op_tri.val())
-            & self.queued_fn.val();
+        self.tri_enqueue.d.next =
+            self.decode.valid_i3.val() & self.tri_op.val() & self.queued_fn.val();
         self.tri_kind.d.next = self.cmd_list.val();
         if self.decode.imm_i3.val() == self.tri_init.val() {
             self.tri_kind.d.next = self.cmd_init.val();
@@ -595,16 +612,14 @@ impl<
         if self.decode.imm_i3.val() == self.tri_skip.val() {
             self.tri_kind.d.next = self.cmd_skip.val();
         }
-        self.tri_waits.d.next = self.decode.imm_i3.val() == self.tri_wait.val();
+        self.tri_waits.d.next = self.tri_wait_fn.val();
         self.kd_enqueue.d.next = self.decode.valid_i3.val()
-            & (self.decode.op_i3.val() == self.op_kd.val())
+            & self.kd_op.val()
             & (self.decode.imm_i3.val() == self.kd_start.val());
-        self.kd_waits.d.next = self.decode.imm_i3.val() == self.kd_wait.val();
+        self.kd_waits.d.next = self.kd_wait_fn.val();
         // The waits (`tri.wait`, `kd.wait`): a pending one sleeps instead of repeating.
-        self.wait_fn.d.next = ((self.decode.op_i3.val() == self.op_tri.val())
-            & (self.decode.imm_i3.val() == self.tri_wait.val()))
-            | ((self.decode.op_i3.val() == self.op_kd.val())
-                & (self.decode.imm_i3.val() == self.kd_wait.val()));
+        self.wait_fn.d.next = (self.tri_op.val() & self.tri_wait_fn.val())
+            | (self.kd_op.val() & self.kd_wait_fn.val());
 
         // I4: both coprocessors see the engine's loads, the thread and its ray words.
         self.traversal_unit.engine.load_read.next = self.mem_read_r.q.val();
