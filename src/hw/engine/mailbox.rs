@@ -3,15 +3,16 @@
 //! twice, for the `mbx` (test and insert) and `mbc` (clear) instructions.
 //!
 //! Contract: the mailbox `which` of a thread is read at I3 (`read_thread`, `read_which`); at
-//! I4 come the instruction's `thread`, `which`, `value`, `insert`, `clear`. At I5 `hit` is set
+//! I4 come the instruction's `thread`, `which`, `value`, `insert`, `clear`. At I6 `hit` is set
 //! when `value` is one of the mailbox's first `len` entries; `insert` (an `mbx`) puts a value
 //! that missed in the next slot, round robin, and `clear` (an `mbc`) empties the mailbox.
 //! Entries start undefined and count only below `len`.
 //!
-//! Latency: the entries are compared with the value at I4 and the hit is ready at I5, two
-//! clocks after the read (the 32-bit compares, the hit and the update do not fit one clock);
-//! the update is written at the end of I5. A thread issues at most once per `engine_period`
-//! clocks, and threads have mailboxes of their own, so every read sees every earlier update.
+//! Latency: the entries leave their block RAMs into registers at I4 (a block RAM's output
+//! arrives late in the clock, too late for a 32-bit compare behind it), are compared with the
+//! value at I5, and the hit is ready at I6, three clocks after the read; the update is written
+//! at the end of I6. A thread issues at most once per `engine_period` clocks, and threads have
+//! mailboxes of their own, so every read sees every earlier update.
 //! Throughput: one instruction per clock.
 //!
 //! Golden twin: [`crate::units::Mailbox`] (`seen` is `mbx`; a new mailbox is `mbc`), which the
@@ -33,10 +34,18 @@ pub struct MailboxUnit {
     pub value: Signal<In, Bits<32>>,
     pub insert: Signal<In, Bit>,
     pub clear: Signal<In, Bit>,
-    /// I5: the value was in the mailbox.
+    /// I6: the value was in the mailbox.
     pub hit: Signal<Out, Bit>,
 
-    /// I5: the compares of I4 and what the update needs.
+    /// I5: the entries and metadata read, and the instruction.
+    entries_r: [DFF<Bits<32>>; MAILBOX_ENTRIES],
+    meta_i5: DFF<Bits<8>>,
+    thread_i5: DFF<Bits<5>>,
+    which_i5: DFF<Bit>,
+    value_i5: DFF<Bits<32>>,
+    insert_i5: DFF<Bit>,
+    clear_i5: DFF<Bit>,
+    /// I6: the compares of I5 and what the update needs.
     matches: [DFF<Bit>; MAILBOX_ENTRIES],
     meta_r: DFF<Bits<8>>,
     thread_r: DFF<Bits<5>>,
@@ -70,6 +79,13 @@ impl Default for MailboxUnit {
             insert: Default::default(),
             clear: Default::default(),
             hit: Default::default(),
+            entries_r: Default::default(),
+            meta_i5: Default::default(),
+            thread_i5: Default::default(),
+            which_i5: Default::default(),
+            value_i5: Default::default(),
+            insert_i5: Default::default(),
+            clear_i5: Default::default(),
             matches: Default::default(),
             meta_r: Default::default(),
             thread_r: Default::default(),
@@ -92,7 +108,10 @@ impl Default for MailboxUnit {
 impl Logic for MailboxUnit {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, meta_r, thread_r, which_r, value_r, insert_r, clear_r);
+        dff_setup!(
+            self, clock, meta_i5, thread_i5, which_i5, value_i5, insert_i5, clear_i5, meta_r,
+            thread_r, which_r, value_r, insert_r, clear_r
+        );
         self.meta.read_clock.next = self.clock.val();
         self.meta.write_clock.next = self.clock.val();
         for k in 0..8 {
@@ -107,19 +126,31 @@ impl Logic for MailboxUnit {
             self.entries[k].read_address.next = self.read_address.val();
         }
 
-        // I4: compare the value with every entry.
+        // I4: the entries into registers.
+        for k in 0..8 {
+            self.entries_r[k].clock.next = self.clock.val();
+            self.entries_r[k].d.next = self.entries[k].read_data.val();
+        }
+        self.meta_i5.d.next = self.meta.read_data.val();
+        self.thread_i5.d.next = self.thread.val();
+        self.which_i5.d.next = self.which.val();
+        self.value_i5.d.next = self.value.val();
+        self.insert_i5.d.next = self.insert.val();
+        self.clear_i5.d.next = self.clear.val();
+
+        // I5: compare the value with every entry.
         for k in 0..8 {
             self.matches[k].clock.next = self.clock.val();
-            self.matches[k].d.next = self.entries[k].read_data.val() == self.value.val();
+            self.matches[k].d.next = self.entries_r[k].q.val() == self.value_i5.q.val();
         }
-        self.meta_r.d.next = self.meta.read_data.val();
-        self.thread_r.d.next = self.thread.val();
-        self.which_r.d.next = self.which.val();
-        self.value_r.d.next = self.value.val();
-        self.insert_r.d.next = self.insert.val();
-        self.clear_r.d.next = self.clear.val();
+        self.meta_r.d.next = self.meta_i5.q.val();
+        self.thread_r.d.next = self.thread_i5.q.val();
+        self.which_r.d.next = self.which_i5.q.val();
+        self.value_r.d.next = self.value_i5.q.val();
+        self.insert_r.d.next = self.insert_i5.q.val();
+        self.clear_r.d.next = self.clear_i5.q.val();
 
-        // I5: a hit when the value is one of the first `len` entries.
+        // I6: a hit when the value is one of the first `len` entries.
         self.len.next = self.meta_r.q.val().get_bits::<4>(0);
         self.next_slot.next = self.meta_r.q.val().get_bits::<3>(4);
         self.found.next = false;
@@ -131,7 +162,7 @@ impl Logic for MailboxUnit {
         }
         self.hit.next = self.found.val();
 
-        // I5: update.
+        // I6: update.
         self.write_address.next = (bit_cast::<6, 5>(self.thread_r.q.val()) << 1)
             | bit_cast::<6, 1>(self.which_r.q.val().into());
         self.meta.write_address.next = self.write_address.val();

@@ -20,11 +20,12 @@
 //! - I2..I4: [`Decode`] reads the two source registers, selects and registers the operands
 //!   and splits the fields; at I3 the [`MailboxUnit`] reads the thread's mailbox and the
 //!   coprocessors their state of the thread, and a long instruction reserves its write back.
-//! - I4 ([`OPERAND_STAGE`]): [`Execute`] computes the integer result and the addresses, the [`PixelCounter`]
-//!   hands out a pixel, the mailbox compares (its hit and update follow at I5), [`FpUnits`] take their operands; this
-//!   block drives the memory and frame-buffer ports and offers `tri` and `kd` entries to the
-//!   coprocessors (their answer, refused or pending, makes the thread repeat the instruction
-//!   on its next turn, after a sleep for a wait).
+//! - I4 ([`OPERAND_STAGE`]): [`Execute`] computes the integer result and the addresses, the
+//!   [`PixelCounter`] hands out a pixel, the mailbox registers the entries it read (it compares
+//!   at I5, hits and updates at I6), [`FpUnits`] take their operands; this block drives the
+//!   memory and frame-buffer ports and offers `tri` and `kd` entries to the coprocessors (their
+//!   answer, refused or pending, makes the thread repeat the instruction on its next turn, after
+//!   a sleep for a wait).
 //! - I5..: the [`ResultLine`]; scratch data joins at I5, memory data at I5 + `mem_latency`.
 //! - I4 + 12 (`I4 + M + 6` for `fdiv`, `fsqrt`, which go on in the long line): the
 //!   [`WriteBack`] chooses, and a clock later writes, the register and the next pc: `target` when the condition differs

@@ -29,8 +29,8 @@ const FAST_STAGES: usize = 8;
 const TAIL: usize = 4;
 /// Clocks from I4 to the write back.
 const LINE: usize = FAST_STAGES + TAIL;
-/// Clocks from I5 to the write back (the mailbox hit joins there).
-const FROM_I5: usize = LINE - 1;
+/// Clocks from I6 to the write back (the mailbox hit joins there).
+const FROM_I6: usize = LINE - 2;
 
 #[derive(LogicBlock)]
 pub struct ResultLine<const DX: usize> {
@@ -45,7 +45,7 @@ pub struct ResultLine<const DX: usize> {
     pub target: Signal<In, Bits<PC_BITS>>,
     /// I4: its conditions: a coprocessor wait; the traversal unit or the triangle tester
     /// refused the entry or has not finished; operand A's low bits (`jr`'s target); the
-    /// integer compares; the pixels exhausted. I5: the mailbox hit.
+    /// integer compares; the pixels exhausted. I6: the mailbox hit.
     pub is_wait: Signal<In, Bit>,
     pub kd_busy: Signal<In, Bit>,
     pub tri_busy: Signal<In, Bit>,
@@ -81,7 +81,7 @@ pub struct ResultLine<const DX: usize> {
     jr_target_line: Delay<Bits<PC_BITS>, LINE>,
     int_eq_line: Delay<Bit, LINE>,
     int_lt_line: Delay<Bit, LINE>,
-    mb_hit_line: Delay<Bit, FROM_I5>,
+    mb_hit_line: Delay<Bit, FROM_I6>,
     pix_done_line: Delay<Bit, LINE>,
     /// The fast result and its source, a register per clock up to the last join.
     fast_line: [DFF<Bits<32>>; FAST_STAGES],
