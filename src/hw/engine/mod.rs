@@ -26,12 +26,13 @@
 //!   memory and frame-buffer ports and offers `tri` and `kd` entries to the coprocessors (their
 //!   answer, refused or pending, makes the thread repeat the instruction on its next turn, after
 //!   a sleep for a wait).
-//! - I5..: the [`ResultLine`]; scratch data joins at I5, memory data at I5 + `mem_latency`.
+//! - I5..: the [`ResultLine`] decodes the opcode at I5; scratch data joins at I5, the mailbox
+//!   hit at I6, memory data at I5 + `mem_latency`.
 //! - I4 + 12 (`I4 + M + 6` for `fdiv`, `fsqrt`, which go on in the long line): the
-//!   [`WriteBack`] chooses, and a clock later writes, the register and the next pc: `target` when the condition differs
-//!   from `invert` (a non-branching instruction's condition is false, so its `invert` is a jump
-//!   after it), else `pc + 1`; the condition comes from the compare, integer, mailbox, pixel
-//!   unit or triangle tester.
+//!   [`WriteBack`] chooses, and a clock later writes, the register and the next pc: `target`
+//!   when the condition differs from `invert` (a non-branching instruction's condition is
+//!   false, so its `invert` is a jump after it), else `pc + 1`; the condition comes from the
+//!   compare, integer, mailbox, pixel unit or triangle tester.
 //!
 //! Golden twin: [`crate::hw::program::exec`] runs the same microprogram instruction by
 //! instruction (the engine's twin); its retired-instruction count and every frame equal the
@@ -132,6 +133,19 @@ pub enum FastKind {
     TrianglesUv,
     TrianglesT,
     Nodes,
+}
+
+/// Which result an instruction writes, decoded by the [`ResultLine`] for the [`WriteBack`]: the
+/// fast result, a floating-point unit's, or (`byte`) the fast result with the colour unit's
+/// byte in its low bits.
+#[derive(Copy, Clone, Debug, PartialEq, LogicState)]
+pub enum ResultSource {
+    Fast,
+    Sum,
+    Product,
+    Quotient,
+    Root,
+    Byte,
 }
 
 /// An opcode as the decoders compare it, from its one definition in `isa::Op`.

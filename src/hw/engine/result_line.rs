@@ -3,11 +3,22 @@
 //! way. `fdiv` and `fsqrt` go on from there through a long line of `DX` more clocks.
 //!
 //! Contract: what enters at I4 leaves at the write back [`super::ENGINE_LATENCY`] (12) clocks
-//! later; a long instruction's control and pcs leave `DX = long_latency - ENGINE_LATENCY`
+//! later; a long instruction's control and pc leave `DX = long_latency - ENGINE_LATENCY`
 //! clocks later still (the scheduler reserved that clock, so no other instruction leaves with
-//! it; its conditions and fast result are not used). The fast result of `lds` and `itof` is
-//! replaced by the scratch word or the converted word one clock after I4, that of `ld` by the word of its bank's port
-//! `mem_latency` clocks after the request (which leaves the engine one clock after I4).
+//! it). The fast result of `lds` and `itof` is replaced by the scratch word or the converted
+//! word one clock after I4, that of `ld` by the word of its bank's port `mem_latency` clocks
+//! after the request (which leaves the engine one clock after I4).
+//!
+//! The line decodes the opcode at I5, so that the [`super::WriteBack`] has only the
+//! floating-point units' flags and results to add: it leaves with `write` (the op writes a
+//! register other than r0, and is not a `pixel` after the last pixel), `source` (which result
+//! is written), `cond` (the condition of a branch on an integer compare, the mailbox (its hit
+//! joins at I6), the pixels, `jal`, or a coprocessor's refusal), `sel_lt`/`sel_le`/`sel_eq`
+//! (a branch on the floating-point compare instead), and the two next pcs, `pc_taken` when the
+//! condition holds and `pc_not_taken` when it does not: `target` when the condition differs
+//! from `invert`, else `pc + 1`; `jr`'s operand; the pc itself for `halt` and for a refused or
+//! pending coprocessor instruction (the thread repeats it on its next turn), which does not
+//! retire. A long instruction never branches (both of its pcs are the same).
 //!
 //! Latency: 12 clocks (`fdiv`, `fsqrt`: `12 + DX`). Throughput: one instruction per clock.
 //!
@@ -17,8 +28,8 @@
 
 use rust_hdl::prelude::*;
 
-use super::{op_code, FastKind, Retiring, MAX_MEM_LATENCY};
-use crate::hw::program::isa::{Op, OP_BITS, PC_BITS, REG_BITS};
+use super::{op_code, FastKind, ResultSource, Retiring, MAX_MEM_LATENCY};
+use crate::hw::program::isa::{Op, OPS, OP_BITS, PC_BITS, REG_BITS};
 use crate::hw::Delay;
 
 /// Registers of the fast line up to the last clock a load's data can join (the `0..8`
@@ -29,7 +40,8 @@ const FAST_STAGES: usize = 8;
 const TAIL: usize = 4;
 /// Clocks from I4 to the write back.
 const LINE: usize = FAST_STAGES + TAIL;
-/// Clocks from I6 to the write back (the mailbox hit joins there).
+/// Clocks from I5 (the decode) and from I6 (the mailbox hit) to the write back.
+const FROM_I5: usize = LINE - 1;
 const FROM_I6: usize = LINE - 2;
 
 #[derive(LogicBlock)]
@@ -68,39 +80,86 @@ pub struct ResultLine<const DX: usize> {
     /// Write back: the instruction leaving the line (from the long line when one leaves it).
     pub retiring: Retiring,
 
-    valid_line: Delay<Bit, LINE>,
-    op_line: Delay<Bits<OP_BITS>, LINE>,
-    dst_line: Delay<Bits<REG_BITS>, LINE>,
-    thread_line: Delay<Bits<5>, LINE>,
-    invert_line: Delay<Bit, LINE>,
-    next_line: Delay<Bits<PC_BITS>, LINE>,
-    target_line: Delay<Bits<PC_BITS>, LINE>,
-    wait_line: Delay<Bit, LINE>,
-    kd_busy_line: Delay<Bit, LINE>,
-    tri_busy_line: Delay<Bit, LINE>,
-    jr_target_line: Delay<Bits<PC_BITS>, LINE>,
-    int_eq_line: Delay<Bit, LINE>,
-    int_lt_line: Delay<Bit, LINE>,
-    mb_hit_line: Delay<Bit, FROM_I6>,
-    pix_done_line: Delay<Bit, LINE>,
+    /// I5: the instruction as it entered.
+    valid_i5: DFF<Bit>,
+    op_i5: DFF<Bits<OP_BITS>>,
+    dst_i5: DFF<Bits<REG_BITS>>,
+    thread_i5: DFF<Bits<5>>,
+    invert_i5: DFF<Bit>,
+    pc_i5: DFF<Bits<PC_BITS>>,
+    pc_plus_one_i5: DFF<Bits<PC_BITS>>,
+    target_i5: DFF<Bits<PC_BITS>>,
+    is_wait_i5: DFF<Bit>,
+    kd_busy_i5: DFF<Bit>,
+    tri_busy_i5: DFF<Bit>,
+    jr_target_i5: DFF<Bits<PC_BITS>>,
+    int_eq_i5: DFF<Bit>,
+    int_lt_i5: DFF<Bit>,
+    pix_done_i5: DFF<Bit>,
+    /// I5: the decode.
+    is_long: Signal<Local, Bit>,
+    is_mbx: Signal<Local, Bit>,
+    halts: Signal<Local, Bit>,
+    repeats: Signal<Local, Bit>,
+    keeps_pc: Signal<Local, Bit>,
+    cond_i5: Signal<Local, Bit>,
+    pc_other: Signal<Local, Bits<PC_BITS>>,
+    pc_target: Signal<Local, Bits<PC_BITS>>,
+    pc_next: Signal<Local, Bits<PC_BITS>>,
+    source_i5: Signal<Local, ResultSource>,
+    /// I6: the condition but the mailbox's, and whether the mailbox's counts.
+    cond_i6: DFF<Bit>,
+    is_mbx_i6: DFF<Bit>,
+    /// The decoded instruction on its way to the write back.
+    valid_line: Delay<Bit, FROM_I5>,
+    is_long_line: Delay<Bit, FROM_I5>,
+    dst_line: Delay<Bits<REG_BITS>, FROM_I5>,
+    thread_line: Delay<Bits<5>, FROM_I5>,
+    write_line: Delay<Bit, FROM_I5>,
+    source_line: Delay<ResultSource, FROM_I5>,
+    cond_line: Delay<Bit, FROM_I6>,
+    sel_lt_line: Delay<Bit, FROM_I5>,
+    sel_le_line: Delay<Bit, FROM_I5>,
+    sel_eq_line: Delay<Bit, FROM_I5>,
+    pc_taken_line: Delay<Bits<PC_BITS>, FROM_I5>,
+    pc_not_taken_line: Delay<Bits<PC_BITS>, FROM_I5>,
+    halt_line: Delay<Bit, FROM_I5>,
+    retired_line: Delay<Bit, FROM_I5>,
+    wait_pending_line: Delay<Bit, FROM_I5>,
     /// The fast result and its source, a register per clock up to the last join.
     fast_line: [DFF<Bits<32>>; FAST_STAGES],
     kind_line: [DFF<FastKind>; FAST_STAGES],
     fast_tail: Delay<Bits<32>, TAIL>,
     /// The long line of `fdiv` and `fsqrt`.
     long_valid: Delay<Bit, DX>,
-    long_op: Delay<Bits<OP_BITS>, DX>,
     long_dst: Delay<Bits<REG_BITS>, DX>,
     long_thread: Delay<Bits<5>, DX>,
-    long_invert: Delay<Bit, DX>,
-    long_next: Delay<Bits<PC_BITS>, DX>,
-    long_target: Delay<Bits<PC_BITS>, DX>,
-    is_long: Signal<Local, Bit>,
+    long_write: Delay<Bit, DX>,
+    long_source: Delay<ResultSource, DX>,
+    long_pc: Delay<Bits<PC_BITS>, DX>,
 
     c_mem_latency: Constant<Bits<8>>,
     c_index: [Constant<Bits<8>>; FAST_STAGES],
+    op_fadd: Constant<Bits<5>>,
+    op_fsub: Constant<Bits<5>>,
+    op_fmul: Constant<Bits<5>>,
     op_fdiv: Constant<Bits<5>>,
     op_fsqrt: Constant<Bits<5>>,
+    op_bflt: Constant<Bits<5>>,
+    op_bfle: Constant<Bits<5>>,
+    op_bfeq: Constant<Bits<5>>,
+    op_beq: Constant<Bits<5>>,
+    op_bltu: Constant<Bits<5>>,
+    op_jal: Constant<Bits<5>>,
+    op_jr: Constant<Bits<5>>,
+    op_mbx: Constant<Bits<5>>,
+    op_pixel: Constant<Bits<5>>,
+    op_halt: Constant<Bits<5>>,
+    op_tri: Constant<Bits<5>>,
+    op_kd: Constant<Bits<5>>,
+    op_byte: Constant<Bits<5>>,
+    /// Bit `op` set for every op that writes `dst` (`Op::writes`).
+    op_writes: Constant<Bits<32>>,
 }
 
 impl<const DX: usize> ResultLine<DX> {
@@ -136,36 +195,83 @@ impl<const DX: usize> ResultLine<DX> {
             uv_data: Default::default(),
             t_data: Default::default(),
             retiring: Default::default(),
+            valid_i5: Default::default(),
+            op_i5: Default::default(),
+            dst_i5: Default::default(),
+            thread_i5: Default::default(),
+            invert_i5: Default::default(),
+            pc_i5: Default::default(),
+            pc_plus_one_i5: Default::default(),
+            target_i5: Default::default(),
+            is_wait_i5: Default::default(),
+            kd_busy_i5: Default::default(),
+            tri_busy_i5: Default::default(),
+            jr_target_i5: Default::default(),
+            int_eq_i5: Default::default(),
+            int_lt_i5: Default::default(),
+            pix_done_i5: Default::default(),
+            is_long: Default::default(),
+            is_mbx: Default::default(),
+            halts: Default::default(),
+            repeats: Default::default(),
+            keeps_pc: Default::default(),
+            cond_i5: Default::default(),
+            pc_other: Default::default(),
+            pc_target: Default::default(),
+            pc_next: Default::default(),
+            source_i5: Default::default(),
+            cond_i6: Default::default(),
+            is_mbx_i6: Default::default(),
             valid_line: Default::default(),
-            op_line: Default::default(),
+            is_long_line: Default::default(),
             dst_line: Default::default(),
             thread_line: Default::default(),
-            invert_line: Default::default(),
-            next_line: Default::default(),
-            target_line: Default::default(),
-            wait_line: Default::default(),
-            kd_busy_line: Default::default(),
-            tri_busy_line: Default::default(),
-            jr_target_line: Default::default(),
-            int_eq_line: Default::default(),
-            int_lt_line: Default::default(),
-            mb_hit_line: Default::default(),
-            pix_done_line: Default::default(),
+            write_line: Default::default(),
+            source_line: Default::default(),
+            cond_line: Default::default(),
+            sel_lt_line: Default::default(),
+            sel_le_line: Default::default(),
+            sel_eq_line: Default::default(),
+            pc_taken_line: Default::default(),
+            pc_not_taken_line: Default::default(),
+            halt_line: Default::default(),
+            retired_line: Default::default(),
+            wait_pending_line: Default::default(),
             fast_line: Default::default(),
             kind_line: Default::default(),
             fast_tail: Default::default(),
             long_valid: Default::default(),
-            long_op: Default::default(),
             long_dst: Default::default(),
             long_thread: Default::default(),
-            long_invert: Default::default(),
-            long_next: Default::default(),
-            long_target: Default::default(),
-            is_long: Default::default(),
+            long_write: Default::default(),
+            long_source: Default::default(),
+            long_pc: Default::default(),
             c_mem_latency: Constant::new(u64::from(mem_latency).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
+            op_fadd: op_code(Op::FAdd),
+            op_fsub: op_code(Op::FSub),
+            op_fmul: op_code(Op::FMul),
             op_fdiv: op_code(Op::FDiv),
             op_fsqrt: op_code(Op::FSqrt),
+            op_bflt: op_code(Op::BFlt),
+            op_bfle: op_code(Op::BFle),
+            op_bfeq: op_code(Op::BFeq),
+            op_beq: op_code(Op::Beq),
+            op_bltu: op_code(Op::Bltu),
+            op_jal: op_code(Op::Jal),
+            op_jr: op_code(Op::Jr),
+            op_mbx: op_code(Op::Mbx),
+            op_pixel: op_code(Op::Pixel),
+            op_halt: op_code(Op::Halt),
+            op_tri: op_code(Op::Tri),
+            op_kd: op_code(Op::Kd),
+            op_byte: op_code(Op::Byte),
+            op_writes: Constant::new(
+                OPS.iter()
+                    .filter(|o| o.writes())
+                    .fold(0u64, |m, &o| m | 1 << (o as u64))
+                    .into(),
+            ),
         }
     }
 }
@@ -173,52 +279,145 @@ impl<const DX: usize> ResultLine<DX> {
 impl<const DX: usize> Logic for ResultLine<DX> {
     #[hdl_gen]
     fn update(&mut self) {
+        dff_setup!(
+            self,
+            clock,
+            valid_i5,
+            op_i5,
+            dst_i5,
+            thread_i5,
+            invert_i5,
+            pc_i5,
+            pc_plus_one_i5,
+            target_i5,
+            is_wait_i5,
+            kd_busy_i5,
+            tri_busy_i5,
+            jr_target_i5,
+            int_eq_i5,
+            int_lt_i5,
+            pix_done_i5,
+            cond_i6,
+            is_mbx_i6
+        );
         clock!(
             self,
             clock,
             valid_line,
-            op_line,
+            is_long_line,
             dst_line,
             thread_line,
-            invert_line,
-            next_line,
-            target_line,
-            wait_line,
-            kd_busy_line,
-            tri_busy_line,
-            jr_target_line,
-            int_eq_line,
-            int_lt_line,
-            mb_hit_line,
-            pix_done_line,
+            write_line,
+            source_line,
+            cond_line,
+            sel_lt_line,
+            sel_le_line,
+            sel_eq_line,
+            pc_taken_line,
+            pc_not_taken_line,
+            halt_line,
+            retired_line,
+            wait_pending_line,
             fast_tail,
             long_valid,
-            long_op,
             long_dst,
             long_thread,
-            long_invert,
-            long_next,
-            long_target
+            long_write,
+            long_source,
+            long_pc
         );
         for k in 0..8 {
             self.fast_line[k].clock.next = self.clock.val();
             self.kind_line[k].clock.next = self.clock.val();
         }
-        self.valid_line.data_in.next = self.valid.val();
-        self.op_line.data_in.next = self.op.val();
-        self.dst_line.data_in.next = self.dst.val();
-        self.thread_line.data_in.next = self.thread.val();
-        self.invert_line.data_in.next = self.invert.val();
-        self.next_line.data_in.next = self.pc.val() + 1;
-        self.target_line.data_in.next = self.target.val();
-        self.wait_line.data_in.next = self.is_wait.val();
-        self.kd_busy_line.data_in.next = self.kd_busy.val();
-        self.tri_busy_line.data_in.next = self.tri_busy.val();
-        self.jr_target_line.data_in.next = self.jr_target.val();
-        self.int_eq_line.data_in.next = self.int_eq.val();
-        self.int_lt_line.data_in.next = self.int_lt.val();
-        self.mb_hit_line.data_in.next = self.mb_hit.val();
-        self.pix_done_line.data_in.next = self.pix_done.val();
+        // I4: the instruction into registers (its conditions arrive late in the clock).
+        self.valid_i5.d.next = self.valid.val();
+        self.op_i5.d.next = self.op.val();
+        self.dst_i5.d.next = self.dst.val();
+        self.thread_i5.d.next = self.thread.val();
+        self.invert_i5.d.next = self.invert.val();
+        self.pc_i5.d.next = self.pc.val();
+        self.pc_plus_one_i5.d.next = self.pc.val() + 1;
+        self.target_i5.d.next = self.target.val();
+        self.is_wait_i5.d.next = self.is_wait.val();
+        self.kd_busy_i5.d.next = self.kd_busy.val();
+        self.tri_busy_i5.d.next = self.tri_busy.val();
+        self.jr_target_i5.d.next = self.jr_target.val();
+        self.int_eq_i5.d.next = self.int_eq.val();
+        self.int_lt_i5.d.next = self.int_lt.val();
+        self.pix_done_i5.d.next = self.pix_done.val();
+
+        // I5: decode.
+        self.is_long.next = (self.op_i5.q.val() == self.op_fdiv.val())
+            | (self.op_i5.q.val() == self.op_fsqrt.val());
+        self.is_mbx.next = self.op_i5.q.val() == self.op_mbx.val();
+        self.halts.next = self.op_i5.q.val() == self.op_halt.val();
+        // A coprocessor refused the entry (queue full) or has not finished (a wait).
+        self.repeats.next = ((self.op_i5.q.val() == self.op_tri.val()) & self.tri_busy_i5.q.val())
+            | ((self.op_i5.q.val() == self.op_kd.val()) & self.kd_busy_i5.q.val());
+        self.keeps_pc.next = self.halts.val() | self.repeats.val();
+        self.cond_i5.next = ((self.op_i5.q.val() == self.op_beq.val()) & self.int_eq_i5.q.val())
+            | ((self.op_i5.q.val() == self.op_bltu.val()) & self.int_lt_i5.q.val())
+            | ((self.op_i5.q.val() == self.op_pixel.val()) & self.pix_done_i5.q.val())
+            | (self.op_i5.q.val() == self.op_jal.val())
+            | self.repeats.val();
+        // The next pc when the condition holds (`pc_target`) and when not (`pc_next`), unless
+        // the op sets it whatever the condition (`pc_other`).
+        self.pc_target.next = self.target_i5.q.val();
+        self.pc_next.next = self.pc_plus_one_i5.q.val();
+        if self.invert_i5.q.val() {
+            self.pc_target.next = self.pc_plus_one_i5.q.val();
+            self.pc_next.next = self.target_i5.q.val();
+        }
+        self.pc_other.next = self.jr_target_i5.q.val();
+        if self.keeps_pc.val() {
+            self.pc_other.next = self.pc_i5.q.val();
+        }
+        if self.keeps_pc.val() | (self.op_i5.q.val() == self.op_jr.val()) {
+            self.pc_target.next = self.pc_other.val();
+            self.pc_next.next = self.pc_other.val();
+        }
+        self.source_i5.next = ResultSource::Fast;
+        if (self.op_i5.q.val() == self.op_fadd.val()) | (self.op_i5.q.val() == self.op_fsub.val()) {
+            self.source_i5.next = ResultSource::Sum;
+        }
+        if self.op_i5.q.val() == self.op_fmul.val() {
+            self.source_i5.next = ResultSource::Product;
+        }
+        if self.op_i5.q.val() == self.op_fdiv.val() {
+            self.source_i5.next = ResultSource::Quotient;
+        }
+        if self.op_i5.q.val() == self.op_fsqrt.val() {
+            self.source_i5.next = ResultSource::Root;
+        }
+        if self.op_i5.q.val() == self.op_byte.val() {
+            self.source_i5.next = ResultSource::Byte;
+        }
+        self.valid_line.data_in.next = self.valid_i5.q.val();
+        self.is_long_line.data_in.next = self.is_long.val();
+        self.dst_line.data_in.next = self.dst_i5.q.val();
+        self.thread_line.data_in.next = self.thread_i5.q.val();
+        // `pixel` writes nothing once the frame's pixels are exhausted.
+        self.write_line.data_in.next = self.valid_i5.q.val()
+            & (self.dst_i5.q.val() != 0)
+            & self.op_writes.val().get_bit(self.op_i5.q.val().index())
+            & (!((self.op_i5.q.val() == self.op_pixel.val()) & self.pix_done_i5.q.val()));
+        self.source_line.data_in.next = self.source_i5.val();
+        self.sel_lt_line.data_in.next = self.op_i5.q.val() == self.op_bflt.val();
+        self.sel_le_line.data_in.next = self.op_i5.q.val() == self.op_bfle.val();
+        self.sel_eq_line.data_in.next = self.op_i5.q.val() == self.op_bfeq.val();
+        self.pc_taken_line.data_in.next = self.pc_target.val();
+        self.pc_not_taken_line.data_in.next = self.pc_next.val();
+        self.halt_line.data_in.next = self.halts.val();
+        self.retired_line.data_in.next = self.valid_i5.q.val() & (!self.repeats.val());
+        // Only the coprocessor waits set `is_wait`, and their condition is `repeats`.
+        self.wait_pending_line.data_in.next = self.repeats.val() & self.is_wait_i5.q.val();
+        self.cond_i6.d.next = self.cond_i5.val();
+        self.is_mbx_i6.d.next = self.is_mbx.val();
+
+        // I6: the mailbox's hit.
+        self.cond_line.data_in.next =
+            self.cond_i6.q.val() | (self.is_mbx_i6.q.val() & self.mb_hit.val());
 
         // The fast line: scratch data at I5, memory data at I5 + latency.
         self.fast_line[0].d.next = self.fast.val();
@@ -252,40 +451,47 @@ impl<const DX: usize> Logic for ResultLine<DX> {
         self.fast_tail.data_in.next = self.fast_line[7].q.val();
 
         // `fdiv` and `fsqrt` go on into the long line and leave from there.
-        self.is_long.next = (self.op_line.data_out.val() == self.op_fdiv.val())
-            | (self.op_line.data_out.val() == self.op_fsqrt.val());
-        self.long_valid.data_in.next = self.valid_line.data_out.val() & self.is_long.val();
-        self.long_op.data_in.next = self.op_line.data_out.val();
+        self.long_valid.data_in.next =
+            self.valid_line.data_out.val() & self.is_long_line.data_out.val();
         self.long_dst.data_in.next = self.dst_line.data_out.val();
         self.long_thread.data_in.next = self.thread_line.data_out.val();
-        self.long_invert.data_in.next = self.invert_line.data_out.val();
-        self.long_next.data_in.next = self.next_line.data_out.val();
-        self.long_target.data_in.next = self.target_line.data_out.val();
+        self.long_write.data_in.next = self.write_line.data_out.val();
+        self.long_source.data_in.next = self.source_line.data_out.val();
+        self.long_pc.data_in.next = self.pc_not_taken_line.data_out.val();
         if self.long_valid.data_out.val() {
             self.retiring.valid.next = true;
-            self.retiring.op.next = self.long_op.data_out.val();
             self.retiring.dst.next = self.long_dst.data_out.val();
             self.retiring.thread.next = self.long_thread.data_out.val();
-            self.retiring.invert.next = self.long_invert.data_out.val();
-            self.retiring.pc_plus_one.next = self.long_next.data_out.val();
-            self.retiring.target.next = self.long_target.data_out.val();
+            self.retiring.write.next = self.long_write.data_out.val();
+            self.retiring.source.next = self.long_source.data_out.val();
+            self.retiring.cond.next = false;
+            self.retiring.sel_lt.next = false;
+            self.retiring.sel_le.next = false;
+            self.retiring.sel_eq.next = false;
+            self.retiring.pc_taken.next = self.long_pc.data_out.val();
+            self.retiring.pc_not_taken.next = self.long_pc.data_out.val();
+            self.retiring.halt.next = false;
+            self.retiring.retired.next = true;
+            self.retiring.wait_pending.next = false;
         } else {
-            self.retiring.valid.next = self.valid_line.data_out.val() & (!self.is_long.val());
-            self.retiring.op.next = self.op_line.data_out.val();
+            self.retiring.valid.next =
+                self.valid_line.data_out.val() & (!self.is_long_line.data_out.val());
             self.retiring.dst.next = self.dst_line.data_out.val();
             self.retiring.thread.next = self.thread_line.data_out.val();
-            self.retiring.invert.next = self.invert_line.data_out.val();
-            self.retiring.pc_plus_one.next = self.next_line.data_out.val();
-            self.retiring.target.next = self.target_line.data_out.val();
+            self.retiring.write.next =
+                self.write_line.data_out.val() & (!self.is_long_line.data_out.val());
+            self.retiring.source.next = self.source_line.data_out.val();
+            self.retiring.cond.next = self.cond_line.data_out.val();
+            self.retiring.sel_lt.next = self.sel_lt_line.data_out.val();
+            self.retiring.sel_le.next = self.sel_le_line.data_out.val();
+            self.retiring.sel_eq.next = self.sel_eq_line.data_out.val();
+            self.retiring.pc_taken.next = self.pc_taken_line.data_out.val();
+            self.retiring.pc_not_taken.next = self.pc_not_taken_line.data_out.val();
+            self.retiring.halt.next = self.halt_line.data_out.val();
+            self.retiring.retired.next =
+                self.retired_line.data_out.val() & (!self.is_long_line.data_out.val());
+            self.retiring.wait_pending.next = self.wait_pending_line.data_out.val();
         }
-        self.retiring.is_wait.next = self.wait_line.data_out.val();
-        self.retiring.kd_busy.next = self.kd_busy_line.data_out.val();
-        self.retiring.tri_busy.next = self.tri_busy_line.data_out.val();
-        self.retiring.jr_target.next = self.jr_target_line.data_out.val();
-        self.retiring.int_eq.next = self.int_eq_line.data_out.val();
-        self.retiring.int_lt.next = self.int_lt_line.data_out.val();
-        self.retiring.mb_hit.next = self.mb_hit_line.data_out.val();
-        self.retiring.pix_done.next = self.pix_done_line.data_out.val();
         self.retiring.fast.next = self.fast_tail.data_out.val();
     }
 }

@@ -2,30 +2,31 @@
 
 use rust_hdl::prelude::*;
 
-use crate::hw::program::isa::{OP_BITS, PC_BITS, REG_BITS};
+use super::ResultSource;
+use crate::hw::program::isa::{PC_BITS, REG_BITS};
 
-/// The instruction leaving the [`ResultLine`](super::ResultLine) for the [`WriteBack`](super::WriteBack): its control fields,
-/// `pc + 1` and the branch target, its conditions (a coprocessor wait; the traversal unit or
-/// the triangle tester refused or has not finished; `jr`'s target; the integer compares; the
-/// mailbox hit; the pixels exhausted) and its fast result.
+/// The instruction leaving the [`ResultLine`](super::ResultLine) for the
+/// [`WriteBack`](super::WriteBack), decoded: whether and from which source it writes its
+/// destination; its condition (`cond`, or the floating-point compare flag one of `sel_lt`,
+/// `sel_le`, `sel_eq` names) and its next pc when the condition holds and when not; whether it
+/// is `halt`, retires, or is a coprocessor wait not answered yet; its fast result.
 #[derive(LogicInterface, Default)]
 #[join = "RetiringIn"]
 pub struct Retiring {
     pub valid: Signal<Out, Bit>,
-    pub op: Signal<Out, Bits<OP_BITS>>,
     pub dst: Signal<Out, Bits<REG_BITS>>,
     pub thread: Signal<Out, Bits<5>>,
-    pub invert: Signal<Out, Bit>,
-    pub pc_plus_one: Signal<Out, Bits<PC_BITS>>,
-    pub target: Signal<Out, Bits<PC_BITS>>,
-    pub is_wait: Signal<Out, Bit>,
-    pub kd_busy: Signal<Out, Bit>,
-    pub tri_busy: Signal<Out, Bit>,
-    pub jr_target: Signal<Out, Bits<PC_BITS>>,
-    pub int_eq: Signal<Out, Bit>,
-    pub int_lt: Signal<Out, Bit>,
-    pub mb_hit: Signal<Out, Bit>,
-    pub pix_done: Signal<Out, Bit>,
+    pub write: Signal<Out, Bit>,
+    pub source: Signal<Out, ResultSource>,
+    pub cond: Signal<Out, Bit>,
+    pub sel_lt: Signal<Out, Bit>,
+    pub sel_le: Signal<Out, Bit>,
+    pub sel_eq: Signal<Out, Bit>,
+    pub pc_taken: Signal<Out, Bits<PC_BITS>>,
+    pub pc_not_taken: Signal<Out, Bits<PC_BITS>>,
+    pub halt: Signal<Out, Bit>,
+    pub retired: Signal<Out, Bit>,
+    pub wait_pending: Signal<Out, Bit>,
     pub fast: Signal<Out, Bits<32>>,
 }
 
@@ -34,19 +35,18 @@ pub struct Retiring {
 #[join = "Retiring"]
 pub struct RetiringIn {
     pub valid: Signal<In, Bit>,
-    pub op: Signal<In, Bits<OP_BITS>>,
     pub dst: Signal<In, Bits<REG_BITS>>,
     pub thread: Signal<In, Bits<5>>,
-    pub invert: Signal<In, Bit>,
-    pub pc_plus_one: Signal<In, Bits<PC_BITS>>,
-    pub target: Signal<In, Bits<PC_BITS>>,
-    pub is_wait: Signal<In, Bit>,
-    pub kd_busy: Signal<In, Bit>,
-    pub tri_busy: Signal<In, Bit>,
-    pub jr_target: Signal<In, Bits<PC_BITS>>,
-    pub int_eq: Signal<In, Bit>,
-    pub int_lt: Signal<In, Bit>,
-    pub mb_hit: Signal<In, Bit>,
-    pub pix_done: Signal<In, Bit>,
+    pub write: Signal<In, Bit>,
+    pub source: Signal<In, ResultSource>,
+    pub cond: Signal<In, Bit>,
+    pub sel_lt: Signal<In, Bit>,
+    pub sel_le: Signal<In, Bit>,
+    pub sel_eq: Signal<In, Bit>,
+    pub pc_taken: Signal<In, Bits<PC_BITS>>,
+    pub pc_not_taken: Signal<In, Bits<PC_BITS>>,
+    pub halt: Signal<In, Bit>,
+    pub retired: Signal<In, Bit>,
+    pub wait_pending: Signal<In, Bit>,
     pub fast: Signal<In, Bits<32>>,
 }
