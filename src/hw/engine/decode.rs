@@ -91,6 +91,9 @@ pub struct Decode {
     f_shift: Constant<Bits<5>>,
     f_bank: Constant<Bits<5>>,
     f_target: Constant<Bits<5>>,
+    /// The operand-is-zero bits the assembler decoded ahead (`isa::AUX_A_ZERO`, `AUX_B_ZERO`).
+    f_a_zero: Constant<Bits<5>>,
+    f_b_zero: Constant<Bits<5>>,
 }
 
 fn field(at: usize) -> Constant<Bits<5>> {
@@ -159,6 +162,8 @@ impl Decode {
             f_shift: field(isa::AUX_SHIFT),
             f_bank: field(isa::AUX_BANK),
             f_target: field(isa::AUX_TARGET),
+            f_a_zero: field(isa::AUX_A_ZERO),
+            f_b_zero: field(isa::AUX_B_ZERO),
         }
     }
 }
@@ -210,26 +215,14 @@ impl Logic for Decode {
         self.ctl4.d.next = self.ctl3.q.val();
         self.imm4.d.next = self.imm3.q.val();
         self.aux4.d.next = self.aux3.q.val();
-        if self
-            .ctl3
-            .q
-            .val()
-            .get_bits::<REG_BITS>(self.f_a.val().index())
-            == 0
-        {
+        if self.aux3.q.val().get_bit(self.f_a_zero.val().index()) {
             self.a4.d.next = 0.into();
         } else {
             self.a4.d.next = self.regs_a.read_data.val();
         }
         if self.ctl3.q.val().get_bit(self.f_b_imm.val().index()) {
             self.b4.d.next = self.imm3.q.val();
-        } else if self
-            .ctl3
-            .q
-            .val()
-            .get_bits::<REG_BITS>(self.f_b.val().index())
-            == 0
-        {
+        } else if self.aux3.q.val().get_bit(self.f_b_zero.val().index()) {
             self.b4.d.next = 0.into();
         } else {
             self.b4.d.next = self.regs_b.read_data.val();

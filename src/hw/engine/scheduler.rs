@@ -12,8 +12,9 @@
 //! The pick is made a clock ahead: the thread that issues is a register (it addresses the pc
 //! store directly), chosen the clock before among the threads ready then, less the one
 //! picked then. Round robin: the choice is the highest of them below a pointer that moves
-//! down one thread per clock (a register, so no shifter sits in the choice), else the highest;
-//! every ready thread is first in line at least once per 32 clocks.
+//! down one thread per clock (a register, so no shifter sits in the choice), else the highest
+//! ([`super::FirstReady`], a tree); every ready thread is first in line at least once per 32
+//! clocks.
 //!
 //! Latency: `issue`/`pick` are registers (I0); a thread written back (`wb_*`, registered by
 //! the write back) in clock c is ready at c + 1 and issues at c + 2 at the earliest.
@@ -26,7 +27,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::MAX_THREADS;
+use super::{FirstReady, MAX_THREADS};
 
 #[derive(LogicBlock)]
 pub struct Scheduler {
@@ -71,8 +72,8 @@ pub struct Scheduler {
 
     candidates: Signal<Local, Bits<32>>,
     below: Signal<Local, Bits<32>>,
-    choice: Signal<Local, Bits<5>>,
-    choice_onehot: Signal<Local, Bits<32>>,
+    /// The next pick: the highest of `{below, candidates}`.
+    first_ready: FirstReady,
     issues: Signal<Local, Bit>,
     issue_mask: Signal<Local, Bits<32>>,
     wb_mask: Signal<Local, Bits<32>>,
@@ -88,8 +89,6 @@ pub struct Scheduler {
     c_thread_mask: Constant<Bits<32>>,
     c_one: Constant<Bits<32>>,
     c_ones: Constant<Bits<32>>,
-    c_thread_ids: [Constant<Bits<5>>; MAX_THREADS],
-    c_thread_bits: [Constant<Bits<32>>; MAX_THREADS],
     /// The bit of `reserved` a long instruction at I3 sets: the issue `reserve_ahead` clocks
     /// after this one would write back with it.
     c_reserve_bit: Constant<Bits<32>>,
@@ -126,8 +125,7 @@ impl Scheduler {
             reserved: Default::default(),
             candidates: Default::default(),
             below: Default::default(),
-            choice: Default::default(),
-            choice_onehot: Default::default(),
+            first_ready: Default::default(),
             issues: Default::default(),
             issue_mask: Default::default(),
             wb_mask: Default::default(),
@@ -140,8 +138,6 @@ impl Scheduler {
             c_thread_mask: Constant::new(((1u64 << threads) - 1).into()),
             c_one: Constant::new(1u64.into()),
             c_ones: Constant::new(0xffff_ffffu64.into()),
-            c_thread_ids: std::array::from_fn(|k| Constant::new((k as u64).into())),
-            c_thread_bits: std::array::from_fn(|k| Constant::new((1u64 << k).into())),
             c_reserve_bit: Constant::new(u64::from(reserve_ahead).into()),
         }
     }
@@ -183,23 +179,11 @@ impl Logic for Scheduler {
         // registered (the pick leaves the block).
         self.candidates.next = self.ready.q.val() & (!self.pick_onehot.q.val());
         self.below.next = self.candidates.val() & self.below_pointer.q.val();
-        self.choice.next = 0.into();
-        self.choice_onehot.next = 0.into();
-        for k in 0..32 {
-            if self.candidates.val().get_bit(k) {
-                self.choice.next = self.c_thread_ids[k].val();
-                self.choice_onehot.next = self.c_thread_bits[k].val();
-            }
-        }
-        for k in 0..32 {
-            if self.below.val().get_bit(k) {
-                self.choice.next = self.c_thread_ids[k].val();
-                self.choice_onehot.next = self.c_thread_bits[k].val();
-            }
-        }
-        self.picked.d.next = self.candidates.val() != 0;
-        self.pick_r.d.next = self.choice.val();
-        self.pick_onehot.d.next = self.choice_onehot.val();
+        self.first_ready.preferred.next = self.below.val();
+        self.first_ready.others.next = self.candidates.val();
+        self.picked.d.next = self.first_ready.found.val();
+        self.pick_r.d.next = self.first_ready.number.val();
+        self.pick_onehot.d.next = self.first_ready.onehot.val();
         self.pointer.d.next = self.pointer.q.val() - 1;
         self.below_pointer.d.next = !(self.c_ones.val() << (self.pointer.q.val() - 1));
 

@@ -11,9 +11,12 @@
 //! listing prints them, the twin runs what they decode to): [`ROM_WORDS`] words of 32 bits,
 //! - control: `op[30:26] dst[25:18] a[17:10] b[9:2] b_imm[1] invert[0]`,
 //! - immediate: `imm[31:0]`,
-//! - auxiliary: `shift[17:15] bank[14:12] target[11:0]`,
+//! - auxiliary: `b_zero[19] a_zero[18] shift[17:15] bank[14:12] target[11:0]`,
 //!
 //! each field at its `CTL_*` / `AUX_*` bit, which the engine's decoder takes from here.
+//! `a_zero` (`a` is r0) and `b_zero` (`b` is r0 and no immediate replaces it) are decoded
+//! ahead into the ROM: the engine's decoder chooses a zero operand with one bit as the
+//! register word arrives, with no compare behind the ROM's late output.
 
 use std::fmt;
 
@@ -40,6 +43,8 @@ pub const CTL_INVERT: usize = 0;
 pub const AUX_SHIFT: usize = 15;
 pub const AUX_BANK: usize = 12;
 pub const AUX_TARGET: usize = 0;
+pub const AUX_A_ZERO: usize = 18;
+pub const AUX_B_ZERO: usize = 19;
 /// Bits of `shift` and of `bank`.
 pub const SHIFT_BITS: usize = 3;
 pub const BANK_BITS: usize = 3;
@@ -455,7 +460,9 @@ impl Instr {
             | field(self.b.into(), REG_BITS, CTL_B)
             | field(self.b_imm.into(), 1, CTL_B_IMM)
             | field(self.invert.into(), 1, CTL_INVERT);
-        let aux = field(self.shift.into(), SHIFT_BITS, AUX_SHIFT)
+        let aux = field((self.a == 0).into(), 1, AUX_A_ZERO)
+            | field((self.b == 0 && !self.b_imm).into(), 1, AUX_B_ZERO)
+            | field(self.shift.into(), SHIFT_BITS, AUX_SHIFT)
             | field(self.bank.into(), BANK_BITS, AUX_BANK)
             | field(self.target.into(), PC_BITS, AUX_TARGET);
         [ctl, self.imm, aux]
@@ -584,12 +591,18 @@ mod tests {
                 };
                 let w = i.encode();
                 assert_eq!(Instr::decode(w), Some(i), "{i:?}");
-                // The words' free bits: ctl 31, aux 31..18.
-                let stray = [1u32 << 31, 0, 1 << rng.gen_range(18..32)];
+                // The words' free bits (ctl 31, aux 31..20) set, and the operand-is-zero bits
+                // decoded ahead (aux 18, 19) contradicting the operands.
+                let stray = [1u32 << 31, 0, 1 << rng.gen_range(20..32)];
                 for (k, bit) in stray.into_iter().enumerate().filter(|(_, b)| *b != 0) {
                     let mut bad = w;
                     bad[k] |= bit;
                     assert_eq!(Instr::decode(bad), None, "{i:?} with word {k} bit {bit:#x}");
+                }
+                for bit in [AUX_A_ZERO, AUX_B_ZERO] {
+                    let mut bad = w;
+                    bad[2] ^= 1 << bit;
+                    assert_eq!(Instr::decode(bad), None, "{i:?} with aux bit {bit} flipped");
                 }
             }
             count += 1;
