@@ -1125,7 +1125,7 @@ pub fn scene_toml(file: &str) -> Option<String> {
         "quake3" => {
             header(
                 "Quake3 (39,424 triangles, 1 object): a game arena (pillars, arches, galleries, ramps, jump pads, torches), one mesh.",
-                [0.0, 6.0, 17.0],
+                [0.0, 6.5, 15.0],
                 [0.0, 1.5, 0.0],
                 65.0,
                 [0.0; 3],
@@ -1135,7 +1135,7 @@ pub fn scene_toml(file: &str) -> Option<String> {
         "quake3_p" => {
             let mut s = header(
                 "Quake3-p (52,790 triangles, 17 objects): the Quake3 arena with 16 players running over 8 frames.",
-                [0.0, 6.0, 17.0],
+                [0.0, 6.5, 15.0],
                 [0.0, 1.5, 0.0],
                 65.0,
                 [0.0; 3],
@@ -1197,7 +1197,7 @@ pub fn scene_toml(file: &str) -> Option<String> {
             let mut s = header(
                 "Terrain (10.47 M instanced triangles, 264 tiles): one 141x141-cell tile instanced 24 x 11 times, \
                  mirrored in x and z on alternate tiles so that neighbours share their edges.",
-                [0.0, 40.0, 80.0],
+                [0.0, 30.0, 60.0],
                 [0.0, 0.0, 0.0],
                 60.0,
                 SKY,
