@@ -1181,15 +1181,16 @@ pub fn scene_toml(file: &str) -> Option<String> {
             }
             s.push_str(&instance("hall", "hall", [0.0; 3], 0.0, one));
             s.push_str(&instance("lectern", "lectern", [0.0, 0.6, -9.5], 0.0, one));
-            let mut k = 0;
-            for (tx, tz) in [(-8.0, -2.0), (8.0, -2.0), (-8.0, 6.0), (8.0, 6.0)] {
+            for (k, (tx, tz)) in [(-8.0, -2.0), (8.0, -2.0), (-8.0, 6.0), (8.0, 6.0)]
+                .into_iter()
+                .enumerate()
+            {
                 s.push_str(&instance("table", &format!("table{k}"), [tx, 0.0, tz], 0.0, one));
                 for i in 0..6 {
-                    let x = tx - 3.75 + 1.5 * f64::from(i);
+                    let x = tx - 3.75 + 1.5 * i as f64;
                     s.push_str(&instance("chair", &format!("chair{}", 12 * k + 2 * i), [x, 0.0, tz - 1.3], 0.0, one));
                     s.push_str(&instance("chair", &format!("chair{}", 12 * k + 2 * i + 1), [x, 0.0, tz + 1.3], 180.0, one));
                 }
-                k += 1;
             }
             s
         }
