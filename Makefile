@@ -12,6 +12,8 @@
 #   make timing  place and route for ECP5 (nextpnr): the whole processor of cornell and dynamic,
 #                every FP operator and geometry unit alone; tables in out/timing/*/timing.md (hours)
 #   make images  regenerate the README's pictures in docs/
+#   make paper-scenes  regenerate scenes/paper/ (the paper's Table 3 scenes, src/scene/paper.rs)
+#   make bench-paper   the Table 3 comparison: out/bench/paper.md (about 15 minutes on 2 cores)
 
 SHELL := /bin/bash
 CARGO ?= cargo
@@ -19,7 +21,7 @@ FORMAT ?= e7m16
 DYNRT := $(or $(CARGO_TARGET_DIR),target)/release/dynrt
 OUT ?= out
 
-.PHONY: deps build test demo rtl sim bench synth timing images fmt
+.PHONY: deps build test demo rtl sim bench bench-paper synth timing images paper-scenes fmt
 
 # The ECP5 timing flow (`dynrt timing`) uses YoWASP's WebAssembly builds of yosys and
 # nextpnr-ecp5 from PyPI, pinned, in a project-local virtual environment (Debian's yosys 0.23
@@ -117,6 +119,15 @@ bench: deps build
 	$(DYNRT) bench scenes --out $(OUT)/bench
 	$(CARGO) bench --bench accel -- $(OUT)/bench/accel.csv
 
+# fps stated at the processor's placed-and-routed clock (cornell, README "Placed and routed
+# timing"); give PAPER_CLOCK=... or run `dynrt bench paper --timing-report timing.csv`. The
+# processor runs at 128x96, the same view as the 512x384 golden frames (Terrain and SunCOR take
+# about a billion clocks at 512x384, most of an hour each in Verilator); PAPER_SIM=512x384 for all.
+PAPER_CLOCK ?= 81.4
+PAPER_SIM ?= 128x96
+bench-paper: deps build
+	$(DYNRT) bench paper --sim-resolution $(PAPER_SIM) --clock $(PAPER_CLOCK) --out $(OUT)/bench
+
 synth: deps build
 	$(DYNRT) bench fp --vectors 0 --formats e6m11,e7m12,e7m14,e7m16,e8m16,e7m18,e8m20,e8m23 --out $(OUT)/synth
 
@@ -133,6 +144,9 @@ timing: deps build
 	  --format $(FORMAT) --freq $(UNIT_FREQ) --seeds $(TIMING_SEEDS) --out $(OUT)/timing/units
 	$(DYNRT) timing scenes/cornell.toml scenes/dynamic.toml --format $(FORMAT) \
 	  --freq $(PROCESSOR_FREQ) --seeds $(TIMING_SEEDS) --out $(OUT)/timing/processor
+
+paper-scenes: build
+	$(DYNRT) paper-scenes --out scenes/paper
 
 images: build
 	for s in cornell mirror dynamic terrain; do $(DYNRT) render scenes/$$s.toml --width 256 --height 192 --out docs/$$s.png; done

@@ -602,3 +602,78 @@ fn bench_writes_a_summary_beside_its_tables() {
         "report.md holds the table:\n{md}"
     );
 }
+
+/// `dynrt paper-scenes` writes the suite; `dynrt bench paper` measures it, reports a scene the
+/// banks cannot hold with the bytes it needs instead of leaving it out, and refuses a missing
+/// scene file or an unknown scene before writing anything.
+#[test]
+fn bench_paper_reports_every_scene_and_what_does_not_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let suite = dir.path().join("suite");
+    let (code, _, err) = dynrt(&["paper-scenes", "--out", suite.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    for name in ["scene6.toml", "conference.toml", "suncor.toml"] {
+        let ours = std::fs::read_to_string(suite.join(name)).unwrap();
+        let checked_in = std::fs::read_to_string(scene(&format!("paper/{name}"))).unwrap();
+        assert_eq!(ours, checked_in, "{name}");
+    }
+    let out = dir.path().join("bench");
+    let bench = |only: &str, scenes: &Path| {
+        dynrt(&[
+            "bench",
+            "paper",
+            "--scenes",
+            scenes.to_str().unwrap(),
+            "--only",
+            only,
+            "--resolution",
+            "32x24",
+            "--no-sim",
+            "--clock",
+            "81.4",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let (code, _, err) = bench("scene6,conference", &suite);
+    assert_eq!(code, 0, "{err}");
+    let csv = std::fs::read_to_string(out.join("paper.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows.len(), 3, "{csv}");
+    assert!(rows[0].contains("fps at 81.4 MHz (512x384)"), "{csv}");
+    assert!(
+        rows[1].starts_with("Scene6,806,820,820,1,") && rows[1].contains(",yes,"),
+        "{csv}"
+    );
+    assert!(rows[1].contains("no: left out (--no-sim)"), "{csv}");
+    assert!(
+        rows[2].starts_with("Conference,") && rows[2].contains(",no: nodes needs "),
+        "{csv}"
+    );
+    assert!(rows[2].contains("no: does not fit the banks"), "{csv}");
+    let frame = image::open(out.join("paper_conference.png")).unwrap();
+    assert_eq!((frame.width(), frame.height()), (32, 24));
+    assert!(out.join("paper.png").is_file() && out.join("paper.md").is_file());
+
+    std::fs::remove_file(suite.join("castle.toml")).unwrap();
+    let fresh = dir.path().join("fresh");
+    for (only, words) in [
+        ("castle", "dynrt paper-scenes"),
+        ("bunny", "not a scene of the suite"),
+    ] {
+        let (code, _, err) = dynrt(&[
+            "bench",
+            "paper",
+            "--scenes",
+            suite.to_str().unwrap(),
+            "--only",
+            only,
+            "--no-sim",
+            "--out",
+            fresh.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(words), "{err}");
+        assert!(!fresh.exists(), "nothing written");
+    }
+}

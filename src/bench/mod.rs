@@ -4,6 +4,8 @@
 //! - [`fp`]: FP operators' latency, yosys xc2v resources and Verilator speed (`dynrt bench fp`);
 //! - [`scenes`]: per bundled scene, tree build, layout size, renderer speed and golden error
 //!   (`dynrt bench scenes`);
+//! - [`paper`]: the scenes of the paper's Table 3, golden frames, memory against the banks,
+//!   the processor's Verilator runs and fps beside the paper's (`dynrt bench paper`);
 //! - [`cost`]: per-format operator cost from yosys (cached CSV) and the datapath estimate;
 //! - [`precision`]: the sweep over scenes and formats, CSV, summaries, recommendation
 //!   (`dynrt bench precision`);
@@ -12,6 +14,7 @@
 
 pub mod cost;
 pub mod fp;
+pub mod paper;
 pub mod pareto;
 pub mod plot;
 pub mod precision;

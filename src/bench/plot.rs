@@ -13,7 +13,7 @@ use std::sync::Once;
 
 static FONT: Once = Once::new();
 
-fn register_font() {
+pub(super) fn register_font() {
     FONT.call_once(|| {
         // The font is a valid TTF shipped in the crate; failure would be a packaging bug.
         let _ = plotters::style::register_font(

@@ -50,6 +50,32 @@ pub enum BenchWhat {
         #[arg(long, value_parser = parse_resolution)]
         resolution: Option<(u32, u32)>,
     },
+    /// The paper's Table 3 scenes (scenes/paper/): golden frames, memory against the six
+    /// 4 MB banks, the processor in Verilator for the scenes that fit, fps beside the paper's.
+    Paper {
+        /// Folder of the suite's scene files (`dynrt paper-scenes` writes them).
+        #[arg(long, default_value = "scenes/paper")]
+        scenes: PathBuf,
+        /// Only these scenes (file stems, comma-separated), e.g. scene6,castle.
+        #[arg(long, value_delimiter = ',')]
+        only: Vec<String>,
+        /// Resolution of the golden frames and memory maps (default: the paper's 512x384).
+        #[arg(long, value_parser = parse_resolution)]
+        resolution: Option<(u32, u32)>,
+        /// Resolution of the processor's Verilator runs, the same view (default: the golden
+        /// frames'); fps are always stated for 512x384 at the run's cycles per pixel.
+        #[arg(long, value_parser = parse_resolution)]
+        sim_resolution: Option<(u32, u32)>,
+        /// Leave the processor's Verilator runs out.
+        #[arg(long)]
+        no_sim: bool,
+        /// State fps at this clock, MHz (default: the paper's 90 MHz, assumed).
+        #[arg(long, conflicts_with = "timing_report")]
+        clock: Option<f64>,
+        /// State fps at the clock measured in this `dynrt timing` report (timing.csv).
+        #[arg(long)]
+        timing_report: Option<PathBuf>,
+    },
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -68,6 +94,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
         BenchWhat::Fp { .. } => "bench fp",
         BenchWhat::Precision { .. } => "bench precision",
         BenchWhat::Scenes { .. } => "bench scenes",
+        BenchWhat::Paper { .. } => "bench paper",
     };
     // The folder's summary.json and report.md describe its latest bench run (every bench
     // writes its own tables beside them).
@@ -139,6 +166,42 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
                 )
                 .option("resolution", resolution.map(|(w, h)| format!("{w}x{h}")));
             s.details_md = t.to_markdown();
+        }
+        BenchWhat::Paper {
+            scenes,
+            only,
+            resolution,
+            sim_resolution,
+            no_sim,
+            clock,
+            timing_report,
+        } => {
+            let (mhz, clock_source) = super::rtl_cmd::clock_mhz(clock, timing_report.as_deref())?;
+            let o = bench::paper::Options {
+                scenes: &scenes,
+                only: &only,
+                resolution,
+                sim_resolution: sim_resolution.or(resolution),
+                sim: !no_sim,
+            };
+            let (md, differs) = bench::paper::run(&o, &a.out, mhz, &clock_source)?;
+            s.option("scenes", &scenes)
+                .option("only", &only)
+                .option("resolution", resolution.map(|(w, h)| format!("{w}x{h}")))
+                .option(
+                    "sim_resolution",
+                    sim_resolution.map(|(w, h)| format!("{w}x{h}")),
+                )
+                .option("sim", !no_sim)
+                .option("clock_mhz", mhz);
+            s.notes
+                .push(format!("fps at {mhz:.1} MHz ({clock_source})"));
+            s.details_md = md;
+            if differs {
+                s.write(&a.out, false)?;
+                println!("MISMATCH: a processor frame differs from the golden model");
+                return Ok(super::EXIT_DIFFERS);
+            }
         }
     }
     s.write(&a.out, false)?;

@@ -7,6 +7,7 @@ mod demo_cmd;
 mod emit_fp_cmd;
 mod fp_cmd;
 mod info_cmd;
+mod paper_scenes_cmd;
 mod render_cmd;
 mod rtl_cmd;
 mod stress_cmd;
@@ -52,6 +53,8 @@ enum Command {
     /// Placed-and-routed timing (ECP5, nextpnr, out of context) of units alone or of the whole
     /// processor of scenes: fmax per clock, critical paths, utilization; timing.md/.csv.
     Timing(timing_cmd::TimingArgs),
+    /// Write the scene files of the paper's Table 3 (scenes/paper/).
+    PaperScenes(paper_scenes_cmd::PaperScenesArgs),
     /// Write the ray tracing processor of a scene: Verilog, testbench, memory images, UCF.
     Rtl(rtl_cmd::RtlArgs),
     /// Generate, simulate (Icarus or Verilator) and compare every frame with the golden model.
@@ -85,6 +88,7 @@ pub fn run() -> i32 {
         Command::Rtl(a) => rtl_cmd::run_rtl(a),
         Command::Sim(a) => rtl_cmd::run_sim(a),
         Command::Info(a) => info_cmd::run(a),
+        Command::PaperScenes(a) => paper_scenes_cmd::run(a),
     };
     spinner.finish_and_clear();
     match result {

@@ -71,13 +71,22 @@ pub struct SimArgs {
 
 /// The clock fps are stated at, in MHz, and where it comes from.
 fn fps_clock(a: &SimArgs) -> anyhow::Result<(f64, String)> {
-    if let Some(mhz) = a.clock {
+    clock_mhz(a.clock, a.timing_report.as_deref())
+}
+
+/// The clock of `--clock MHZ` or `--timing-report FILE` (the paper's 90 MHz, stated as
+/// assumed, without either), in MHz, and where it comes from.
+pub(super) fn clock_mhz(
+    clock: Option<f64>,
+    timing_report: Option<&std::path::Path>,
+) -> anyhow::Result<(f64, String)> {
+    if let Some(mhz) = clock {
         if !(mhz.is_finite() && mhz > 0.0 && mhz <= 1000.0) {
             anyhow::bail!("--clock {mhz}: give the clock in MHz, in (0, 1000], e.g. --clock 90");
         }
         return Ok((mhz, "given with --clock".into()));
     }
-    if let Some(path) = &a.timing_report {
+    if let Some(path) = timing_report {
         let mhz = dynrt::synth::ecp5::measured_clock_mhz(path).map_err(|m| {
             anyhow::anyhow!("--timing-report: {m} (make one with `dynrt timing SCENE --out DIR`)")
         })?;

@@ -10,6 +10,7 @@
 //! | `sphere` | `radius = 1`, `subdivisions = 2` (0..=8); subdivided icosahedron | 20 · 4^s |
 //! | `cornell_box` | `closed_front = false`, `mirror_tall_block = 0` | 30 (32 closed) |
 //! | `terrain` | `size` (1..=2048, required), `seed = 0`, `amplitude = 1`, `extent = 10`, `octaves = 5` (1..=16), `frequency = 4` | 2 size² |
+//! | `paper` | `model` (required): a model of the paper suite, `paper::MODELS` | the model's |
 //!
 //! Cornell box: x in [-1, 1], y in [0, 2], z in [-1, 1]; floor, ceiling and back wall (z = -1)
 //! white (0.725, 0.71, 0.68), left wall (x = -1) red (0.63, 0.065, 0.05), right wall (x = 1)
@@ -25,7 +26,7 @@
 //! grid); each cell (row z, then column x) gives two triangles.
 //!
 //! Generated objects have one material (`Material::DEFAULT` or the object's `color`/`mirror`),
-//! except the Cornell box, which has its own.
+//! except the Cornell box and the paper models, which have their own.
 
 use glam::{DMat3, DVec3};
 
@@ -58,13 +59,20 @@ fn positive(v: f64) -> bool {
 
 /// Whether the generator brings its own materials (then `color`/`mirror` are refused).
 pub fn has_own_materials(def: &GenerateDef) -> bool {
-    matches!(def, GenerateDef::CornellBox { .. })
+    matches!(
+        def,
+        GenerateDef::CornellBox { .. } | GenerateDef::Paper { .. }
+    )
 }
 
 /// Number of triangles `generate` will produce (before the degenerate filter, which none of the
-/// generators should trigger).
+/// generators should trigger); a paper model's is counted by building it (at most a few
+/// ten thousand triangles, milliseconds), 0 for an unknown model.
 pub fn expected_triangles(def: &GenerateDef) -> u64 {
     match def {
+        GenerateDef::Paper { model } => {
+            super::paper::model(model).map_or(0, |m| m.triangles.len() as u64)
+        }
         GenerateDef::Box { .. } => 12,
         // Saturating: the count is taken before the parameters' ranges are checked.
         GenerateDef::Plane { subdivisions, .. } => 2 * u64::from(*subdivisions).pow(2),
@@ -113,6 +121,12 @@ pub fn generate(def: &GenerateDef, material: Material, budget: u64) -> Result<Ra
 
 fn build(def: &GenerateDef, material: Material) -> Result<RawMesh, ParamError> {
     match def {
+        GenerateDef::Paper { model } => super::paper::model(model).ok_or_else(|| {
+            (
+                format!("paper model '{model}'"),
+                format!("one of {}", super::paper::MODELS.join(", ")),
+            )
+        }),
         GenerateDef::Box { size } => {
             check(
                 size.iter().all(|&s| positive(s)),
@@ -220,7 +234,12 @@ fn quad(out: &mut Vec<[DVec3; 3]>, centre: DVec3, u: DVec3, v: DVec3) {
 }
 
 /// A box with half extents `half`, turned `yaw_deg` about Y around `centre`, outward normals.
-fn box_triangles(centre: DVec3, half: DVec3, yaw_deg: f64, bottom: bool) -> Vec<[DVec3; 3]> {
+pub(super) fn box_triangles(
+    centre: DVec3,
+    half: DVec3,
+    yaw_deg: f64,
+    bottom: bool,
+) -> Vec<[DVec3; 3]> {
     let r = DMat3::from_rotation_y(yaw_deg.to_radians());
     let (x, y, z) = (
         r * DVec3::X * half.x,
@@ -299,7 +318,7 @@ const ICOSAHEDRON_FACES: [[usize; 3]; 20] = [
     [9, 8, 1],
 ];
 
-fn sphere_triangles(radius: f64, subdivisions: u32) -> Vec<[DVec3; 3]> {
+pub(super) fn sphere_triangles(radius: f64, subdivisions: u32) -> Vec<[DVec3; 3]> {
     let t = (1.0 + 5f64.sqrt()) / 2.0;
     let v = [
         DVec3::new(-1.0, t, 0.0),

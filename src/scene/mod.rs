@@ -51,6 +51,7 @@ mod field;
 pub(crate) mod generate;
 mod mesh;
 mod noise;
+pub mod paper;
 mod schema;
 mod transform;
 

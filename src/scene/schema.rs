@@ -159,6 +159,9 @@ pub enum GenerateDef {
         #[serde(default = "four")]
         frequency: f64,
     },
+    /// One of the paper suite's models (`scene/paper.rs`, `paper::MODELS`), with its own
+    /// materials.
+    Paper { model: String },
 }
 
 #[derive(Debug, Deserialize)]

@@ -194,6 +194,49 @@ fn every_bundled_scene_is_tested() {
     }
 }
 
+/// The checked-in `scenes/paper/` are what `dynrt paper-scenes` writes, and scenes/README.md's
+/// table of them states their counts.
+#[test]
+fn paper_scenes_are_current_and_counted_in_the_readme() {
+    let dir = repo().join("scenes").join("paper");
+    let files = paper::suite_files();
+    let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    on_disk.sort();
+    let mut expected: Vec<String> = files.iter().map(|(n, _)| n.clone()).collect();
+    expected.sort();
+    assert_eq!(on_disk, expected, "scenes/paper/ holds exactly the suite");
+    for (name, text) in &files {
+        let have = std::fs::read_to_string(dir.join(name)).unwrap();
+        assert!(
+            &have == text,
+            "scenes/paper/{name} is stale: run `make paper-scenes`"
+        );
+    }
+    let readme = std::fs::read_to_string(repo().join("scenes").join("README.md")).unwrap();
+    let rows: Vec<Vec<String>> = readme
+        .lines()
+        .filter(|l| l.starts_with("| `paper/"))
+        .map(|l| l.split('|').map(|c| c.trim().replace(',', "")).collect())
+        .collect();
+    assert_eq!(rows.len(), files.len(), "one README row per scene");
+    for row in rows {
+        let file = row[1].trim_matches('`');
+        let s = bundled(file);
+        let number = |k: usize| row[k].parse::<usize>().unwrap();
+        assert_eq!(number(3), s.instances.len(), "{file}: objects");
+        assert_eq!(number(4), s.triangle_count(), "{file}: unique triangles");
+        assert_eq!(
+            number(5),
+            s.instanced_triangle_count(),
+            "{file}: instanced triangles"
+        );
+    }
+}
+
 // ---------------------------------------------------------------- public meshes
 
 /// Parses an OBJ without tobj: fan-triangulated faces in file order with their `usemtl` name.
