@@ -4,6 +4,8 @@
 //! - [`fp`]: FP operators' latency, yosys xc2v resources and Verilator speed (`dynrt bench fp`);
 //! - [`scenes`]: per bundled scene, tree build, layout size, renderer speed and golden error
 //!   (`dynrt bench scenes`);
+//! - [`trees`]: kd-tree size and traversal work with and without the node budget
+//!   (`dynrt bench trees`);
 //! - [`cost`]: per-format operator cost from yosys (cached CSV) and the datapath estimate;
 //! - [`precision`]: the sweep over scenes and formats, CSV, summaries, recommendation
 //!   (`dynrt bench precision`);
@@ -17,6 +19,7 @@ pub mod plot;
 pub mod precision;
 pub mod scenes;
 pub mod table;
+pub mod trees;
 
 pub use precision::{
     precision_sweep, recommend, summarize, write_outputs, FormatSummary, Row, SweepConfig,

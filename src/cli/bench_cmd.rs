@@ -50,6 +50,15 @@ pub enum BenchWhat {
         #[arg(long, value_parser = parse_resolution)]
         resolution: Option<(u32, u32)>,
     },
+    /// kd-trees with and without the node budget: nodes per triangle, SAH cost, nodes visited
+    /// and triangle tests per ray of the f64 reference (out/bench/trees.csv and .md).
+    Trees {
+        /// Scene files; default: every scene in scenes/.
+        scenes: Vec<PathBuf>,
+        /// Directory of public OBJ meshes (default: the shared mesh folder).
+        #[arg(long)]
+        meshes: Option<PathBuf>,
+    },
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -68,6 +77,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
         BenchWhat::Fp { .. } => "bench fp",
         BenchWhat::Precision { .. } => "bench precision",
         BenchWhat::Scenes { .. } => "bench scenes",
+        BenchWhat::Trees { .. } => "bench trees",
     };
     // The folder's summary.json and report.md describe its latest bench run (every bench
     // writes its own tables beside them).
@@ -138,6 +148,20 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
                     formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
                 )
                 .option("resolution", resolution.map(|(w, h)| format!("{w}x{h}")));
+            s.details_md = t.to_markdown();
+        }
+        BenchWhat::Trees { scenes, meshes } => {
+            let scenes = if scenes.is_empty() {
+                bench::scenes::bundled_scenes(std::path::Path::new("scenes"))?
+            } else {
+                scenes
+            };
+            let meshes = meshes.unwrap_or_else(dynrt::scene::shared_mesh_dir);
+            let rows = bench::trees::bench_trees(&bench::trees::mesh_files(&meshes)?, &scenes)?;
+            let t = bench::trees::trees_table(&rows);
+            t.save(&a.out, "trees")?;
+            print!("{}", t.to_markdown());
+            s.option("scenes", &scenes).option("meshes", &meshes);
             s.details_md = t.to_markdown();
         }
     }
