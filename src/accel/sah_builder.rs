@@ -97,7 +97,16 @@ struct Builder<'a, P: KdPrimitives> {
     nodes: Vec<KdNode>,
     prim_indices: Vec<u32>,
     depth: u32,
+    /// Event lists of finished nodes, kept for reuse (most nodes are small, and allocating
+    /// their lists cost more than filling them).
+    pool: Vec<Events>,
+    /// The straddling primitives of the node being split.
+    both: Vec<u32>,
 }
+
+/// Lists longer than this are freed rather than pooled (a handful of nodes near the root; the
+/// pool then holds at most a few lists per level of the tree).
+const POOL_MAX_EVENTS: usize = 1 << 12;
 
 /// Builds a kd-tree over `prims` (see the module doc).
 pub fn build<P: KdPrimitives>(prims: &P, params: &KdParams) -> KdTree {
@@ -129,6 +138,8 @@ pub fn build<P: KdPrimitives>(prims: &P, params: &KdParams) -> KdTree {
         nodes: vec![KdNode::Leaf { first: 0, count: 0 }],
         prim_indices: Vec::new(),
         depth: 0,
+        pool: Vec::new(),
+        both: Vec::new(),
     };
     builder.build_node(0, bounds, events, count, 0, params.node_budget(count));
     KdTree {
@@ -158,6 +169,7 @@ impl<P: KdPrimitives> Builder<'_, P> {
         };
         let Some(plane) = plane else {
             self.make_leaf(node, &events, depth);
+            self.recycle(events);
             return 1;
         };
         let (vl, vr) = voxel.split(plane.axis, plane.pos);
@@ -179,6 +191,21 @@ impl<P: KdPrimitives> Builder<'_, P> {
             self.build_node(children, vl, left, nl, depth + 1, share.clamp(1, rest - 1));
         let used_right = self.build_node(children + 1, vr, right, nr, depth + 1, rest - used_left);
         1 + used_left + used_right
+    }
+
+    /// Empty event lists, from the pool when it has some.
+    fn fresh(&mut self) -> Events {
+        self.pool.pop().unwrap_or_default()
+    }
+
+    /// Returns small lists to the pool.
+    fn recycle(&mut self, mut events: Events) {
+        if events.iter().all(|l| l.capacity() <= POOL_MAX_EVENTS) {
+            for l in events.iter_mut() {
+                l.clear();
+            }
+            self.pool.push(events);
+        }
     }
 
     fn make_leaf(&mut self, node: usize, events: &Events, depth: u32) {
@@ -325,44 +352,46 @@ impl<P: KdPrimitives> Builder<'_, P> {
         vr: &Aabb,
     ) -> (Events, usize, Events, usize) {
         let s = plane.pos;
-        for e in &events[0] {
-            if e.kind != END {
-                self.side[e.prim as usize] = SIDE_BOTH;
-            }
-        }
+        // One pass over the split axis' list classifies every primitive: a Start at or after
+        // the plane puts it right; one before it makes it straddle until an End at or before
+        // the plane (which comes later in the list) puts it left.
+        let (mut nl, mut nr) = (0, 0);
+        let mut both = std::mem::take(&mut self.both);
+        both.clear();
         for e in &events[plane.axis] {
             let side = &mut self.side[e.prim as usize];
             match e.kind {
-                END if e.pos <= s => *side = SIDE_LEFT,
-                START if e.pos >= s => *side = SIDE_RIGHT,
+                START if e.pos >= s => {
+                    *side = SIDE_RIGHT;
+                    nr += 1;
+                }
+                START => {
+                    *side = SIDE_BOTH;
+                    both.push(e.prim);
+                }
+                END if e.pos <= s => {
+                    *side = SIDE_LEFT;
+                    nl += 1;
+                }
                 PLANAR => {
-                    *side = if e.pos < s || (e.pos == s && plane.planar_left) {
-                        SIDE_LEFT
+                    if e.pos < s || (e.pos == s && plane.planar_left) {
+                        *side = SIDE_LEFT;
+                        nl += 1;
                     } else {
-                        SIDE_RIGHT
+                        *side = SIDE_RIGHT;
+                        nr += 1;
                     }
                 }
                 _ => {}
             }
         }
-        let mut nl = 0;
-        let mut nr = 0;
-        let mut both = Vec::new();
-        for e in &events[0] {
-            if e.kind == END {
-                continue;
-            }
-            match self.side[e.prim as usize] {
-                SIDE_LEFT => nl += 1,
-                SIDE_RIGHT => nr += 1,
-                _ => both.push(e.prim),
-            }
-        }
+        // Those that ended before the plane are left, not straddling.
+        both.retain(|&p| self.side[p as usize] == SIDE_BOTH);
         let clip = self.params.clip_splits;
         // Straddling primitives clipped to each child; their events are sorted separately and
         // merged in (there are few of them, so sorting them keeps the build O(N log N)).
-        let mut new_left: Events = Default::default();
-        let mut new_right: Events = Default::default();
+        let mut new_left = self.fresh();
+        let mut new_right = self.fresh();
         if clip {
             for &p in &both {
                 if let Some(b) = self.prims.clipped_bounds(p as usize, vl) {
@@ -381,14 +410,16 @@ impl<P: KdPrimitives> Builder<'_, P> {
             nl += both.len();
             nr += both.len();
         }
-        let mut left: Events = Default::default();
-        let mut right: Events = Default::default();
+        self.both = both;
+        let mut left = self.fresh();
+        let mut right = self.fresh();
         for axis in 0..3 {
             let list = &events[axis];
             let (new_l, new_r) = (&new_left[axis], &new_right[axis]);
             // Each event belongs to one primitive; a primitive's events per axis are 1 or 2.
-            let mut l = Vec::with_capacity(2 * nl);
-            let mut r = Vec::with_capacity(2 * nr);
+            let (l, r) = (&mut left[axis], &mut right[axis]);
+            l.reserve(2 * nl);
+            r.reserve(2 * nr);
             // Filter the parent's list and merge the clipped primitives' events in, in one pass.
             let (mut il, mut ir) = (0, 0);
             for e in list {
@@ -410,10 +441,10 @@ impl<P: KdPrimitives> Builder<'_, P> {
             }
             l.extend_from_slice(&new_l[il..]);
             r.extend_from_slice(&new_r[ir..]);
-            left[axis] = l;
-            right[axis] = r;
         }
-        drop(events);
+        self.recycle(new_left);
+        self.recycle(new_right);
+        self.recycle(events);
         (left, nl, right, nr)
     }
 }
