@@ -856,14 +856,14 @@ fn corpus() -> Vec<Case> {
             &["m.obj"],
         ),
         case(
-            "OBJ vertex beyond f32",
+            "OBJ vertex beyond f64",
             &[
                 ("s.toml", &obj),
-                ("m.obj", &TRIANGLE_OBJ.replace("v 1 0 0", "v 1e39 0 0")),
+                ("m.obj", &TRIANGLE_OBJ.replace("v 1 0 0", "v 1e309 0 0")),
             ],
             "render $D/s.toml --out $D/o.png",
             USAGE,
-            &["m.obj:2", "1e39", "not finite"],
+            &["m.obj:2", "1e309", "not finite"],
         ),
         case(
             "OBJ face index zero",

@@ -48,11 +48,7 @@ pub fn load_obj_triangles(path: &Path) -> anyhow::Result<Vec<[DVec3; 3]>> {
                     pos.len() / 3
                 );
             }
-            Ok(DVec3::new(
-                pos[i] as f64,
-                pos[i + 1] as f64,
-                pos[i + 2] as f64,
-            ))
+            Ok(DVec3::new(pos[i], pos[i + 1], pos[i + 2]))
         };
         for f in m.mesh.indices.chunks_exact(3) {
             tris.push([vertex(f[0])?, vertex(f[1])?, vertex(f[2])?]);

@@ -30,6 +30,33 @@ use glam::DVec3;
 /// Relative slack of every interval decision (see the module doc).
 const REL_SLACK: f64 = 1e-9;
 
+/// Work of traversals (summed over rays): nodes visited (inner nodes and leaves) and primitive
+/// tests made (after the mailbox).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TraversalCounts {
+    pub rays: u64,
+    pub nodes: u64,
+    pub tests: u64,
+}
+
+impl TraversalCounts {
+    pub fn add(&mut self, other: &TraversalCounts) {
+        self.rays += other.rays;
+        self.nodes += other.nodes;
+        self.tests += other.tests;
+    }
+
+    /// Nodes visited per ray (0 without rays).
+    pub fn nodes_per_ray(&self) -> f64 {
+        self.nodes as f64 / self.rays.max(1) as f64
+    }
+
+    /// Primitive tests per ray (0 without rays).
+    pub fn tests_per_ray(&self) -> f64 {
+        self.tests as f64 / self.rays.max(1) as f64
+    }
+}
+
 /// A closest hit with a caller-defined payload (e.g. barycentrics, or the instance's triangle).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct KdHit<P> {
@@ -115,14 +142,15 @@ impl KdTree {
     /// Visits the leaves the ray segment `[t_min, t_max]` passes through, front to back.
     /// `visit(prims, t_near, t_far)` gets the leaf's primitives and the ray's parameter interval
     /// inside the leaf, and returns the (possibly lowered) end of the segment of interest:
-    /// leaves starting at or after it are skipped (return `-inf` to stop).
+    /// leaves starting at or after it are skipped (return `-inf` to stop). Returns the number
+    /// of nodes visited (inner nodes and leaves).
     pub fn traverse_leaves(
         &self,
         ray: &Ray,
         t_min: f64,
         t_max: f64,
         mut visit: impl FnMut(&[u32], f64, f64) -> f64,
-    ) {
+    ) -> u64 {
         // Rounding must never lose a cell the ray touches, so all interval decisions are
         // widened by a relative slack (see the module doc).
         let scale = self
@@ -133,12 +161,14 @@ impl KdTree {
             .max_element();
         let root = self.bounds.expanded(scale * REL_SLACK);
         let Some((mut tn, mut tf)) = ray.intersect_aabb(&root, t_min, t_max) else {
-            return;
+            return 0;
         };
         let mut t_end = t_max;
         let mut stack = Stack::new();
         let mut node = 0u32;
+        let mut visited = 0u64;
         loop {
+            visited += 1;
             match self.nodes[node as usize] {
                 KdNode::Inner {
                     axis,
@@ -186,7 +216,7 @@ impl KdTree {
                         t_end = new_end;
                     }
                     if t_end == f64::NEG_INFINITY {
-                        return;
+                        return visited;
                     }
                     // Pending entries start at or after this leaf's end, except the second
                     // child of a plane the ray lies in; so rather than stopping once
@@ -198,7 +228,7 @@ impl KdTree {
                     };
                     loop {
                         let Some((n, a, b)) = stack.pop() else {
-                            return;
+                            return visited;
                         };
                         if a <= limit {
                             node = n;
@@ -219,16 +249,31 @@ impl KdTree {
         ray: &Ray,
         t_min: f64,
         t_max: f64,
+        test: impl FnMut(u32, f64) -> Option<(f64, H)>,
+    ) -> Option<KdHit<H>> {
+        self.closest_hit_counted(ray, t_min, t_max, &mut TraversalCounts::default(), test)
+    }
+
+    /// [`KdTree::closest_hit_with`], adding its nodes and tests (one ray) to `counts`.
+    pub fn closest_hit_counted<H>(
+        &self,
+        ray: &Ray,
+        t_min: f64,
+        t_max: f64,
+        counts: &mut TraversalCounts,
         mut test: impl FnMut(u32, f64) -> Option<(f64, H)>,
     ) -> Option<KdHit<H>> {
         let mut best: Option<KdHit<H>> = None;
         let mut t_best = t_max;
         let mut mailbox = Mailbox::new();
-        self.traverse_leaves(ray, t_min, t_max, |prims, _, _| {
+        let mut tests = 0;
+        counts.rays += 1;
+        counts.nodes += self.traverse_leaves(ray, t_min, t_max, |prims, _, _| {
             for &p in prims {
                 if mailbox.seen(p) {
                     continue;
                 }
+                tests += 1;
                 if let Some((t, payload)) = test(p, t_best) {
                     if t >= t_min && t < t_best {
                         t_best = t;
@@ -242,6 +287,7 @@ impl KdTree {
             }
             t_best
         });
+        counts.tests += tests;
         best
     }
 
@@ -298,15 +344,30 @@ impl KdTree {
         ray: &Ray,
         t_min: f64,
         t_max: f64,
+        test: impl FnMut(u32, f64) -> Option<f64>,
+    ) -> Option<u32> {
+        self.any_hit_counted(ray, t_min, t_max, &mut TraversalCounts::default(), test)
+    }
+
+    /// [`KdTree::any_hit`], adding its nodes and tests (one ray) to `counts`.
+    pub fn any_hit_counted(
+        &self,
+        ray: &Ray,
+        t_min: f64,
+        t_max: f64,
+        counts: &mut TraversalCounts,
         mut test: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<u32> {
         let mut found = None;
         let mut mailbox = Mailbox::new();
-        self.traverse_leaves(ray, t_min, t_max, |prims, _, _| {
+        let mut tests = 0;
+        counts.rays += 1;
+        counts.nodes += self.traverse_leaves(ray, t_min, t_max, |prims, _, _| {
             for &p in prims {
                 if mailbox.seen(p) {
                     continue;
                 }
+                tests += 1;
                 if let Some(t) = test(p, t_max) {
                     if t >= t_min && t < t_max {
                         found = Some(p);
@@ -316,6 +377,7 @@ impl KdTree {
             }
             t_max
         });
+        counts.tests += tests;
         found
     }
 }

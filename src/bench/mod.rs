@@ -6,6 +6,8 @@
 //!   (`dynrt bench scenes`);
 //! - [`paper`]: the scenes of the paper's Table 3, golden frames, memory against the banks,
 //!   the processor's Verilator runs and fps beside the paper's (`dynrt bench paper`);
+//! - [`trees`]: kd-tree size and traversal work with and without the node budget
+//!   (`dynrt bench trees`);
 //! - [`cost`]: per-format operator cost from yosys (cached CSV) and the datapath estimate;
 //! - [`precision`]: the sweep over scenes and formats, CSV, summaries, recommendation
 //!   (`dynrt bench precision`);
@@ -20,6 +22,7 @@ pub mod plot;
 pub mod precision;
 pub mod scenes;
 pub mod table;
+pub mod trees;
 
 pub use precision::{
     precision_sweep, recommend, summarize, write_outputs, FormatSummary, Row, SweepConfig,

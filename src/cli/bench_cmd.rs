@@ -76,6 +76,15 @@ pub enum BenchWhat {
         #[arg(long)]
         timing_report: Option<PathBuf>,
     },
+    /// kd-trees with and without the node budget: nodes per triangle, SAH cost, nodes visited
+    /// and triangle tests per ray of the f64 reference (out/bench/trees.csv and .md).
+    Trees {
+        /// Scene files; default: every scene in scenes/.
+        scenes: Vec<PathBuf>,
+        /// Directory of public OBJ meshes (default: the shared mesh folder).
+        #[arg(long)]
+        meshes: Option<PathBuf>,
+    },
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -95,6 +104,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
         BenchWhat::Precision { .. } => "bench precision",
         BenchWhat::Scenes { .. } => "bench scenes",
         BenchWhat::Paper { .. } => "bench paper",
+        BenchWhat::Trees { .. } => "bench trees",
     };
     // The folder's summary.json and report.md describe its latest bench run (every bench
     // writes its own tables beside them).
@@ -202,6 +212,20 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
                 println!("MISMATCH: a processor frame differs from the golden model");
                 return Ok(super::EXIT_DIFFERS);
             }
+        }
+        BenchWhat::Trees { scenes, meshes } => {
+            let scenes = if scenes.is_empty() {
+                bench::scenes::bundled_scenes(std::path::Path::new("scenes"))?
+            } else {
+                scenes
+            };
+            let meshes = meshes.unwrap_or_else(dynrt::scene::shared_mesh_dir);
+            let rows = bench::trees::bench_trees(&bench::trees::mesh_files(&meshes)?, &scenes)?;
+            let t = bench::trees::trees_table(&rows);
+            t.save(&a.out, "trees")?;
+            print!("{}", t.to_markdown());
+            s.option("scenes", &scenes).option("meshes", &meshes);
+            s.details_md = t.to_markdown();
         }
     }
     s.write(&a.out, false)?;

@@ -189,10 +189,19 @@ pub struct SceneTrees {
 
 impl SceneTrees {
     pub fn build(scene: &Scene, format: Format) -> Result<SceneTrees, LayoutError> {
+        Self::build_with(scene, format, &KdParams::default())
+    }
+
+    /// [`SceneTrees::build`] with other tree parameters (their `split_format` is `format`).
+    pub fn build_with(
+        scene: &Scene,
+        format: Format,
+        params: &KdParams,
+    ) -> Result<SceneTrees, LayoutError> {
         check_capacity(scene, &MemoryConfig::default())?;
         let params = KdParams {
             split_format: Some(format),
-            ..KdParams::default()
+            ..params.clone()
         };
         let mut out = SceneTrees {
             format,

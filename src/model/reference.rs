@@ -7,6 +7,7 @@
 //! f64's rounding of the hit point, far below any feature of a scene.
 
 use super::{Frame, HitRecord};
+use crate::accel::kd_traversal::TraversalCounts;
 use crate::accel::kd_tree::{self, KdParams, KdTree};
 use crate::accel::{triangle, Aabb, Ray};
 use crate::scene::Scene;
@@ -16,6 +17,7 @@ use rayon::prelude::*;
 /// Object trees built once per scene.
 pub struct Reference<'a> {
     scene: &'a Scene,
+    params: KdParams,
     trees: Vec<KdTree>,
 }
 
@@ -36,13 +38,27 @@ struct RefHit {
 
 impl<'a> Reference<'a> {
     pub fn new(scene: &'a Scene) -> Self {
-        let params = KdParams::default();
+        Self::with_params(scene, KdParams::default())
+    }
+
+    /// The reference with object and top-level trees built with `params` (for measuring tree
+    /// parameters; [`Reference::new`] is the yardstick).
+    pub fn with_params(scene: &'a Scene, params: KdParams) -> Self {
         let trees = scene
             .objects
             .iter()
             .map(|o| kd_tree::build_sah(&o.triangles, &params))
             .collect();
-        Reference { scene, trees }
+        Reference {
+            scene,
+            params,
+            trees,
+        }
+    }
+
+    /// The object trees, in the scene's object order.
+    pub fn trees(&self) -> &[KdTree] {
+        &self.trees
     }
 
     /// Renders one frame at the scene camera's resolution.
@@ -50,33 +66,30 @@ impl<'a> Reference<'a> {
         self.render_with_progress(frame, false)
     }
 
+    /// Traversal work of the frame's primary rays (closest hit, one per pixel): kd nodes
+    /// visited in the top-level and object trees together, and triangle tests.
+    pub fn primary_counts(&self, frame: u32) -> TraversalCounts {
+        let s = self.scene;
+        let geo = self.frame_geometry(frame);
+        let (w, h) = (s.camera.width, s.camera.height);
+        (0..w * h)
+            .into_par_iter()
+            .map(|i| {
+                let (o, d) = s.camera.primary_ray(i % w, i / w);
+                let mut c = TraversalCounts::default();
+                self.trace(&geo, o, d, 0.0, f64::INFINITY, None, false, &mut c);
+                c
+            })
+            .reduce(TraversalCounts::default, |mut a, b| {
+                a.add(&b);
+                a
+            })
+    }
+
     /// [`Reference::render`] with a progress bar (rows) when `progress`.
     pub fn render_with_progress(&self, frame: u32, progress: bool) -> Frame {
         let s = self.scene;
-        let to_world: Vec<DAffine3> = s
-            .instances
-            .iter()
-            .map(|i| i.object_to_world(frame))
-            .collect();
-        let boxes: Vec<Aabb> = s
-            .instances
-            .iter()
-            .zip(&to_world)
-            .map(|(i, m)| self.trees[i.object].bounds.transformed(m))
-            .collect();
-        let mut extent = Aabb::from_points(std::iter::once(&s.camera.eye));
-        for b in &boxes {
-            extent = extent.union(b);
-        }
-        let geo = FrameGeometry {
-            to_object: to_world.iter().map(|m| m.inverse()).collect(),
-            normal: to_world
-                .iter()
-                .map(|m| m.matrix3.inverse().transpose())
-                .collect(),
-            top: kd_tree::build_sah_boxes(&boxes, &KdParams::default()),
-            t_eps: 1e-6 * (extent.max - extent.min).max_element().max(1.0),
-        };
+        let geo = self.frame_geometry(frame);
         let (w, h) = (s.camera.width, s.camera.height);
         let bar = super::progress_bar(progress, h, "reference");
         let pixels: Vec<(u32, Option<HitRecord>)> = (0..w * h)
@@ -100,6 +113,34 @@ impl<'a> Reference<'a> {
         Frame::from_pixels(w, h, pixels)
     }
 
+    fn frame_geometry(&self, frame: u32) -> FrameGeometry {
+        let s = self.scene;
+        let to_world: Vec<DAffine3> = s
+            .instances
+            .iter()
+            .map(|i| i.object_to_world(frame))
+            .collect();
+        let boxes: Vec<Aabb> = s
+            .instances
+            .iter()
+            .zip(&to_world)
+            .map(|(i, m)| self.trees[i.object].bounds.transformed(m))
+            .collect();
+        let mut extent = Aabb::from_points(std::iter::once(&s.camera.eye));
+        for b in &boxes {
+            extent = extent.union(b);
+        }
+        FrameGeometry {
+            to_object: to_world.iter().map(|m| m.inverse()).collect(),
+            normal: to_world
+                .iter()
+                .map(|m| m.matrix3.inverse().transpose())
+                .collect(),
+            top: kd_tree::build_sah_boxes(&boxes, &self.params),
+            t_eps: 1e-6 * (extent.max - extent.min).max_element().max(1.0),
+        }
+    }
+
     fn shade(
         &self,
         g: &FrameGeometry,
@@ -110,7 +151,8 @@ impl<'a> Reference<'a> {
         depth: u32,
     ) -> (DVec3, Option<RefHit>) {
         let s = self.scene;
-        let Some(hit) = self.trace(g, o, d, t_min, f64::INFINITY, skip, false) else {
+        let counts = &mut TraversalCounts::default();
+        let Some(hit) = self.trace(g, o, d, t_min, f64::INFINITY, skip, false, counts) else {
             return (DVec3::from_array(s.render.background), None);
         };
         let object = &s.objects[s.instances[hit.instance as usize].object];
@@ -131,7 +173,11 @@ impl<'a> Reference<'a> {
             if n_dot_l <= 0.0 {
                 continue;
             }
-            if s.render.shadows && self.trace(g, p, to_light, 1e-6, 1.0, me, true).is_some() {
+            if s.render.shadows
+                && self
+                    .trace(g, p, to_light, 1e-6, 1.0, me, true, counts)
+                    .is_some()
+            {
                 continue;
             }
             acc += kd * DVec3::from_array(light.color) * (n_dot_l / to_light.length());
@@ -144,6 +190,9 @@ impl<'a> Reference<'a> {
         (acc, Some(hit))
     }
 
+    /// Closest (or, with `any`, any) hit along `o + t d`, `t` in `[t_min, t_max)`; adds one
+    /// ray, the nodes visited in the top-level and object trees and the triangle tests to
+    /// `counts`.
     #[allow(clippy::too_many_arguments)]
     fn trace(
         &self,
@@ -154,11 +203,14 @@ impl<'a> Reference<'a> {
         t_max: f64,
         skip: Option<(u32, u32)>,
         any: bool,
+        counts: &mut TraversalCounts,
     ) -> Option<RefHit> {
         let s = self.scene;
         let world = Ray::new(o, d);
-        g.top
-            .closest_hit_with(&world, t_min, t_max, |instance, t_best| {
+        let (mut top, mut objects) = (TraversalCounts::default(), TraversalCounts::default());
+        let hit = g
+            .top
+            .closest_hit_counted(&world, t_min, t_max, &mut top, |instance, t_best| {
                 let inst = &s.instances[instance as usize];
                 let m = &g.to_object[instance as usize];
                 let local = Ray::new(m.transform_point3(o), m.transform_vector3(d));
@@ -171,18 +223,24 @@ impl<'a> Reference<'a> {
                 };
                 let tree = &self.trees[inst.object];
                 if any {
-                    tree.any_hit(&local, t_min, t_best, test)
+                    tree.any_hit_counted(&local, t_min, t_best, &mut objects, test)
                         .map(|tri| (t_min, tri))
                 } else {
-                    tree.closest_hit(&local, t_min, t_best, test)
-                        .map(|(tri, t)| (t, tri))
+                    tree.closest_hit_counted(&local, t_min, t_best, &mut objects, |p, tb| {
+                        test(p, tb).map(|t| (t, ()))
+                    })
+                    .map(|h| (h.t, h.prim))
                 }
             })
             .map(|h| RefHit {
                 t: h.t,
                 instance: h.prim,
                 triangle: h.payload,
-            })
+            });
+        counts.rays += 1;
+        counts.nodes += top.nodes + objects.nodes;
+        counts.tests += objects.tests;
+        hit
     }
 }
 

@@ -5,7 +5,8 @@
 //! points and lines are ignored; triangles keep file order (faces in the order they appear,
 //! across `o`/`g`/`usemtl` switches). Before tobj parses the file a line scan checks every `v`
 //! and `f` line, so a broken or non-finite vertex or an out-of-range face index is reported with
-//! its line number.
+//! its line number. Numbers are read as f64 (tobj's `use_f64`): a vertex is the f64 nearest its
+//! decimal text, so a small mesh far from the origin keeps its shape (f32 has 1/16 steps at 10^6).
 //!
 //! MTL rules: diffuse = `Kd` (default 0.8 grey when absent); mirror reflectivity = mean of the
 //! three `Ks` components when `illum 3` (the MTL "reflection on, ray traced" model), else 0,
@@ -169,18 +170,18 @@ pub(crate) fn too_many_triangles(budget: u64) -> String {
     )
 }
 
-/// Parses `words` as numbers (the way tobj will, as f32), naming the line's `what` in errors.
+/// Parses `words` as numbers (the way tobj will, as f64), naming the line's `what` in errors.
 fn numbers(
     words: &[&str],
     path: &Path,
     lineno: Option<usize>,
     item: &str,
     what: &str,
-) -> Result<Vec<f32>, SceneError> {
+) -> Result<Vec<f64>, SceneError> {
     words
         .iter()
         .map(|w| {
-            let v: f32 = w.parse().map_err(|_| {
+            let v: f64 = w.parse().map_err(|_| {
                 obj_error(
                     path,
                     lineno,
@@ -194,7 +195,7 @@ fn numbers(
                     lineno,
                     item,
                     Problem::NonFinite {
-                        what: format!("{what} '{w}' (as f32)"),
+                        what: format!("{what} '{w}'"),
                     },
                 ));
             }
@@ -203,7 +204,7 @@ fn numbers(
         .collect()
 }
 
-/// Checks every line the way tobj will read it (f32 numbers; `v x y z [w | r g b]`, `vt u v [w]`,
+/// Checks every line the way tobj will read it (f64 numbers; `v x y z [w | r g b]`, `vt u v [w]`,
 /// `vn x y z`, faces `v[/vt][/vn]` with 1-based or negative indices), so that a broken line is
 /// reported with its number; tobj itself says only "position parse error" (and panics on some
 /// MTL lines, see [`scan_mtl`]).
@@ -367,7 +368,7 @@ fn scan_mtl(path: &Path, text: &str, item: &str) -> Result<(), SceneError> {
                 }
             }
             "Ns" | "Ni" | "d" | "Tr" => {
-                if args.first().and_then(|w| w.parse::<f32>().ok()).is_none() {
+                if args.first().and_then(|w| w.parse::<f64>().ok()).is_none() {
                     return Err(broken(format!(
                         "`{key}` needs a number, found `{}`",
                         args.join(" ")
@@ -465,9 +466,7 @@ pub(crate) fn load_obj(
     let mut warnings = Vec::new();
     let mut out = RawMesh::default();
     for m in &tobj_materials {
-        let diffuse = m
-            .diffuse
-            .map_or(Material::DEFAULT.diffuse, |d| d.map(f64::from));
+        let diffuse = m.diffuse.unwrap_or(Material::DEFAULT.diffuse);
         let what = format!("material '{}'", m.name);
         if diffuse.iter().any(|c| !c.is_finite()) {
             return Err(obj_error(
@@ -489,7 +488,7 @@ pub(crate) fn load_obj(
         }
         let mut mirror = 0.0;
         if m.illumination_model == Some(3) {
-            let ks = m.specular.unwrap_or([0.0; 3]).map(f64::from);
+            let ks = m.specular.unwrap_or([0.0; 3]);
             if ks.iter().any(|c| !c.is_finite()) {
                 return Err(obj_error(
                     &mtl_file(),
@@ -523,7 +522,7 @@ pub(crate) fn load_obj(
         let p = &mesh.positions;
         let vertex = |i: u32| {
             let i = i as usize * 3;
-            DVec3::new(f64::from(p[i]), f64::from(p[i + 1]), f64::from(p[i + 2]))
+            DVec3::new(p[i], p[i + 1], p[i + 2])
         };
         for tri in mesh.indices.chunks_exact(3) {
             out.triangles
@@ -559,5 +558,36 @@ mod tests {
         assert!(!is_degenerate(&[a, x * s, y * s]));
         assert!(is_degenerate(&[a, x, DVec3::new(0.5, 1e-14, 0.0)]));
         assert!(is_degenerate(&[a, x, DVec3::new(f64::NAN, 1.0, 0.0)]));
+    }
+
+    /// A centimetre-sized triangle a million units from the origin: f32 (1/16 steps there)
+    /// would merge its vertices into one point and drop it as degenerate.
+    #[test]
+    fn positions_are_read_as_f64() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("far.obj");
+        let text = "v 1000000.01 -2000000.003 3000000.5\n\
+                    v 1000000.02 -2000000.003 3000000.5\n\
+                    v 1000000.01 -2000000.013 3000000.51\n\
+                    f 1 2 3\n";
+        std::fs::write(&path, text).unwrap();
+        let (mesh, warnings) = load_obj(&path, "far", 100).unwrap();
+        assert!(warnings.is_empty(), "{warnings:?}");
+        let v = |x: &str, y: &str, z: &str| {
+            DVec3::new(x.parse().unwrap(), y.parse().unwrap(), z.parse().unwrap())
+        };
+        let expected = [
+            v("1000000.01", "-2000000.003", "3000000.5"),
+            v("1000000.02", "-2000000.003", "3000000.5"),
+            v("1000000.01", "-2000000.013", "3000000.51"),
+        ];
+        assert_eq!(mesh.triangles, vec![expected]);
+        assert!(!is_degenerate(&mesh.triangles[0]));
+        // What an f32 parse would have made of it: one point.
+        let as_f32 = expected.map(|p| p.as_vec3().as_dvec3());
+        assert!(is_degenerate(&as_f32), "{as_f32:?}");
+        // The benchmark's loader reads the same numbers.
+        let tris = crate::accel::bench::load_obj_triangles(&path).unwrap();
+        assert_eq!(tris, vec![expected]);
     }
 }

@@ -249,10 +249,7 @@ fn parse_obj_by_hand(path: &Path) -> Vec<([DVec3; 3], Option<String>)> {
         let w: Vec<&str> = line.split_whitespace().collect();
         match w.first().copied() {
             Some("v") => {
-                let c: Vec<f64> = w[1..4]
-                    .iter()
-                    .map(|s| f64::from(s.parse::<f32>().unwrap()))
-                    .collect();
+                let c: Vec<f64> = w[1..4].iter().map(|s| s.parse::<f64>().unwrap()).collect();
                 v.push(DVec3::new(c[0], c[1], c[2]));
             }
             Some("usemtl") => mtl = Some(w[1].to_string()),
@@ -669,10 +666,10 @@ fn error_non_finite_everywhere() {
     assert!(matches!(e.problem, Problem::NonFinite { .. }));
     assert_eq!(e.line, Some(2));
     assert!(s.contains("n.obj:2") && s.contains("not finite"), "{s}");
-    // 1e39 is finite in f64 but not in the f32 the OBJ loader uses.
+    // 1e309 is beyond f64 (the OBJ loader reads f64).
     std::fs::write(
         dir.path().join("n.obj"),
-        "v 0 0 0\nv 1 0 0\nv 0 1e39 0\nf 1 2 3\n",
+        "v 0 0 0\nv 1 0 0\nv 0 1e309 0\nf 1 2 3\n",
     )
     .unwrap();
     let (e, _) = fail_in(dir.path(), "[[objects]]\nname = \"n\"\nmesh = \"n.obj\"\n");

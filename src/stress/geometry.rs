@@ -256,9 +256,9 @@ fn fmt3(v: [f64; 3]) -> String {
     format!("[{:?}, {:?}, {:?}]", v[0], v[1], v[2])
 }
 
-/// Writes `tris` as an OBJ and a scene TOML into `dir` and loads the scene. The OBJ loader
-/// reads f32, so the scene's vertices are `tris` rounded to f32: take world-space geometry from
-/// the returned scene ([`world_triangles`]), not from `tris`.
+/// Writes `tris` as an OBJ and a scene TOML into `dir` and loads the scene. Vertices are
+/// written as the shortest text of their f64 and read back as f64, so the scene holds `tris`
+/// exactly; world-space geometry is taken from the returned scene ([`world_triangles`]).
 pub fn write_scene(dir: &Path, name: &str, tris: &[[DVec3; 3]], s: &TestScene) -> Result<Scene> {
     let mut obj = String::new();
     for t in tris {
@@ -412,14 +412,9 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let tris = icosphere(1).unwrap();
         let s = write_scene(dir.path(), "ball", &tris, &TestScene::default()).unwrap();
-        // The OBJ loader reads f32: the scene holds the vertices rounded once to f32, which
-        // is why the cases take their world triangles from the loaded scene.
-        let as_f32: Tris = tris
-            .iter()
-            .map(|t| t.map(|v| v.as_vec3().as_dvec3()))
-            .collect();
-        assert_eq!(s.objects[0].triangles, as_f32);
-        assert_eq!(world_triangles(&s), as_f32);
+        // The OBJ loader reads f64: the scene holds the very vertices written.
+        assert_eq!(s.objects[0].triangles, tris);
+        assert_eq!(world_triangles(&s), tris);
         assert!(s.is_single_untransformed_object());
         let caster = ExactCaster::new(&tris);
         assert!(caster.closest(DVec3::ZERO, DVec3::X, 0.0).is_some());
