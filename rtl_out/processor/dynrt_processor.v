@@ -699,6 +699,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam FastKind__TrianglesUv = 4;
     localparam FastKind__TrianglesT = 5;
     localparam FastKind__Nodes = 6;
+    localparam ResultSource__Fast = 0;
+    localparam ResultSource__Sum = 1;
+    localparam ResultSource__Product = 2;
+    localparam ResultSource__Quotient = 3;
+    localparam ResultSource__Root = 4;
+    localparam ResultSource__Byte = 5;
     
     // Stub signals
     reg  scheduler__clock;
@@ -828,37 +834,35 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [31:0] result_line__uv_data;
     reg  [31:0] result_line__t_data;
     wire  result_line__retiring__valid;
-    wire  [4:0] result_line__retiring__op;
     wire  [7:0] result_line__retiring__dst;
     wire  [4:0] result_line__retiring__thread;
-    wire  result_line__retiring__invert;
-    wire  [11:0] result_line__retiring__pc_plus_one;
-    wire  [11:0] result_line__retiring__target;
-    wire  result_line__retiring__is_wait;
-    wire  result_line__retiring__kd_busy;
-    wire  result_line__retiring__tri_busy;
-    wire  [11:0] result_line__retiring__jr_target;
-    wire  result_line__retiring__int_eq;
-    wire  result_line__retiring__int_lt;
-    wire  result_line__retiring__mb_hit;
-    wire  result_line__retiring__pix_done;
+    wire  result_line__retiring__write;
+    wire  [2:0] result_line__retiring__source;
+    wire  result_line__retiring__cond;
+    wire  result_line__retiring__sel_lt;
+    wire  result_line__retiring__sel_le;
+    wire  result_line__retiring__sel_eq;
+    wire  [11:0] result_line__retiring__pc_taken;
+    wire  [11:0] result_line__retiring__pc_not_taken;
+    wire  result_line__retiring__halt;
+    wire  result_line__retiring__retired;
+    wire  result_line__retiring__wait_pending;
     wire  [31:0] result_line__retiring__fast;
     reg  write_back__clock;
     reg  write_back__retiring__valid;
-    reg  [4:0] write_back__retiring__op;
     reg  [7:0] write_back__retiring__dst;
     reg  [4:0] write_back__retiring__thread;
-    reg  write_back__retiring__invert;
-    reg  [11:0] write_back__retiring__pc_plus_one;
-    reg  [11:0] write_back__retiring__target;
-    reg  write_back__retiring__is_wait;
-    reg  write_back__retiring__kd_busy;
-    reg  write_back__retiring__tri_busy;
-    reg  [11:0] write_back__retiring__jr_target;
-    reg  write_back__retiring__int_eq;
-    reg  write_back__retiring__int_lt;
-    reg  write_back__retiring__mb_hit;
-    reg  write_back__retiring__pix_done;
+    reg  write_back__retiring__write;
+    reg  [2:0] write_back__retiring__source;
+    reg  write_back__retiring__cond;
+    reg  write_back__retiring__sel_lt;
+    reg  write_back__retiring__sel_le;
+    reg  write_back__retiring__sel_eq;
+    reg  [11:0] write_back__retiring__pc_taken;
+    reg  [11:0] write_back__retiring__pc_not_taken;
+    reg  write_back__retiring__halt;
+    reg  write_back__retiring__retired;
+    reg  write_back__retiring__wait_pending;
     reg  [31:0] write_back__retiring__fast;
     reg  [23:0] write_back__sum;
     reg  [23:0] write_back__product;
@@ -1167,39 +1171,37 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .uv_data(result_line__uv_data),
         .t_data(result_line__t_data),
         .retiring__valid(result_line__retiring__valid),
-        .retiring__op(result_line__retiring__op),
         .retiring__dst(result_line__retiring__dst),
         .retiring__thread(result_line__retiring__thread),
-        .retiring__invert(result_line__retiring__invert),
-        .retiring__pc_plus_one(result_line__retiring__pc_plus_one),
-        .retiring__target(result_line__retiring__target),
-        .retiring__is_wait(result_line__retiring__is_wait),
-        .retiring__kd_busy(result_line__retiring__kd_busy),
-        .retiring__tri_busy(result_line__retiring__tri_busy),
-        .retiring__jr_target(result_line__retiring__jr_target),
-        .retiring__int_eq(result_line__retiring__int_eq),
-        .retiring__int_lt(result_line__retiring__int_lt),
-        .retiring__mb_hit(result_line__retiring__mb_hit),
-        .retiring__pix_done(result_line__retiring__pix_done),
+        .retiring__write(result_line__retiring__write),
+        .retiring__source(result_line__retiring__source),
+        .retiring__cond(result_line__retiring__cond),
+        .retiring__sel_lt(result_line__retiring__sel_lt),
+        .retiring__sel_le(result_line__retiring__sel_le),
+        .retiring__sel_eq(result_line__retiring__sel_eq),
+        .retiring__pc_taken(result_line__retiring__pc_taken),
+        .retiring__pc_not_taken(result_line__retiring__pc_not_taken),
+        .retiring__halt(result_line__retiring__halt),
+        .retiring__retired(result_line__retiring__retired),
+        .retiring__wait_pending(result_line__retiring__wait_pending),
         .retiring__fast(result_line__retiring__fast)
     );
     dynrt_processor__engine__write_back write_back(
         .clock(write_back__clock),
         .retiring__valid(write_back__retiring__valid),
-        .retiring__op(write_back__retiring__op),
         .retiring__dst(write_back__retiring__dst),
         .retiring__thread(write_back__retiring__thread),
-        .retiring__invert(write_back__retiring__invert),
-        .retiring__pc_plus_one(write_back__retiring__pc_plus_one),
-        .retiring__target(write_back__retiring__target),
-        .retiring__is_wait(write_back__retiring__is_wait),
-        .retiring__kd_busy(write_back__retiring__kd_busy),
-        .retiring__tri_busy(write_back__retiring__tri_busy),
-        .retiring__jr_target(write_back__retiring__jr_target),
-        .retiring__int_eq(write_back__retiring__int_eq),
-        .retiring__int_lt(write_back__retiring__int_lt),
-        .retiring__mb_hit(write_back__retiring__mb_hit),
-        .retiring__pix_done(write_back__retiring__pix_done),
+        .retiring__write(write_back__retiring__write),
+        .retiring__source(write_back__retiring__source),
+        .retiring__cond(write_back__retiring__cond),
+        .retiring__sel_lt(write_back__retiring__sel_lt),
+        .retiring__sel_le(write_back__retiring__sel_le),
+        .retiring__sel_eq(write_back__retiring__sel_eq),
+        .retiring__pc_taken(write_back__retiring__pc_taken),
+        .retiring__pc_not_taken(write_back__retiring__pc_not_taken),
+        .retiring__halt(write_back__retiring__halt),
+        .retiring__retired(write_back__retiring__retired),
+        .retiring__wait_pending(write_back__retiring__wait_pending),
         .retiring__fast(write_back__retiring__fast),
         .sum(write_back__sum),
         .product(write_back__product),
@@ -1692,20 +1694,19 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     end
     
     always @(*) write_back__retiring__valid = result_line__retiring__valid;
-    always @(*) write_back__retiring__op = result_line__retiring__op;
     always @(*) write_back__retiring__dst = result_line__retiring__dst;
     always @(*) write_back__retiring__thread = result_line__retiring__thread;
-    always @(*) write_back__retiring__invert = result_line__retiring__invert;
-    always @(*) write_back__retiring__pc_plus_one = result_line__retiring__pc_plus_one;
-    always @(*) write_back__retiring__target = result_line__retiring__target;
-    always @(*) write_back__retiring__is_wait = result_line__retiring__is_wait;
-    always @(*) write_back__retiring__kd_busy = result_line__retiring__kd_busy;
-    always @(*) write_back__retiring__tri_busy = result_line__retiring__tri_busy;
-    always @(*) write_back__retiring__jr_target = result_line__retiring__jr_target;
-    always @(*) write_back__retiring__int_eq = result_line__retiring__int_eq;
-    always @(*) write_back__retiring__int_lt = result_line__retiring__int_lt;
-    always @(*) write_back__retiring__mb_hit = result_line__retiring__mb_hit;
-    always @(*) write_back__retiring__pix_done = result_line__retiring__pix_done;
+    always @(*) write_back__retiring__write = result_line__retiring__write;
+    always @(*) write_back__retiring__source = result_line__retiring__source;
+    always @(*) write_back__retiring__cond = result_line__retiring__cond;
+    always @(*) write_back__retiring__sel_lt = result_line__retiring__sel_lt;
+    always @(*) write_back__retiring__sel_le = result_line__retiring__sel_le;
+    always @(*) write_back__retiring__sel_eq = result_line__retiring__sel_eq;
+    always @(*) write_back__retiring__pc_taken = result_line__retiring__pc_taken;
+    always @(*) write_back__retiring__pc_not_taken = result_line__retiring__pc_not_taken;
+    always @(*) write_back__retiring__halt = result_line__retiring__halt;
+    always @(*) write_back__retiring__retired = result_line__retiring__retired;
+    always @(*) write_back__retiring__wait_pending = result_line__retiring__wait_pending;
     always @(*) write_back__retiring__fast = result_line__retiring__fast;
 endmodule // dynrt_processor__engine
 
@@ -1771,6 +1772,8 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
     localparam  f_shift = 5'b1111;
     localparam  f_bank = 5'b1100;
     localparam  f_target = 5'b0;
+    localparam  f_a_zero = 5'b10010;
+    localparam  f_b_zero = 5'b10011;
     
     // Stub signals
     reg  [12:0] regs_a__read_address;
@@ -1989,7 +1992,7 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
         ctl4__d = ctl3__q;
         imm4__d = imm3__q;
         aux4__d = aux3__q;
-        if (ctl3__q[(f_a)+:(8)] == 32'h0) begin
+        if (aux3__q[f_a_zero]) begin
             a4__d = 32'h0;
         end
         else begin
@@ -1998,7 +2001,7 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
         if (ctl3__q[f_b_imm]) begin
             b4__d = imm3__q;
         end
-        else if (ctl3__q[(f_b)+:(8)] == 32'h0) begin
+        else if (aux3__q[f_b_zero]) begin
             b4__d = 32'h0;
         end
         else begin
@@ -2622,45 +2625,45 @@ module dynrt_processor__engine__fetch__rom_aux(read_address,read_clock,read_data
     reg[31:0] mem[4095:0];
     
     initial begin
-    mem[12'h0] = 32'h5000;
-    mem[12'h1] = 32'h5000;
-    mem[12'h2] = 32'h5000;
-    mem[12'h3] = 32'h5000;
-    mem[12'h4] = 32'h5000;
-    mem[12'h5] = 32'h5000;
-    mem[12'h6] = 32'h5000;
-    mem[12'h7] = 32'h5000;
-    mem[12'h8] = 32'h5000;
-    mem[12'h9] = 32'h0;
-    mem[12'ha] = 32'h5000;
-    mem[12'hb] = 32'h5000;
-    mem[12'hc] = 32'h5000;
-    mem[12'hd] = 32'h5000;
-    mem[12'he] = 32'h5000;
-    mem[12'hf] = 32'h5000;
-    mem[12'h10] = 32'h5000;
-    mem[12'h11] = 32'h5000;
-    mem[12'h12] = 32'h5000;
-    mem[12'h13] = 32'h5000;
-    mem[12'h14] = 32'h5000;
-    mem[12'h15] = 32'h5000;
-    mem[12'h16] = 32'h5000;
-    mem[12'h17] = 32'h5026;
-    mem[12'h18] = 32'h26;
+    mem[12'h0] = 32'hc5000;
+    mem[12'h1] = 32'hc5000;
+    mem[12'h2] = 32'hc5000;
+    mem[12'h3] = 32'hc5000;
+    mem[12'h4] = 32'hc5000;
+    mem[12'h5] = 32'hc5000;
+    mem[12'h6] = 32'hc5000;
+    mem[12'h7] = 32'hc5000;
+    mem[12'h8] = 32'hc5000;
+    mem[12'h9] = 32'h40000;
+    mem[12'ha] = 32'hc5000;
+    mem[12'hb] = 32'hc5000;
+    mem[12'hc] = 32'hc5000;
+    mem[12'hd] = 32'hc5000;
+    mem[12'he] = 32'hc5000;
+    mem[12'hf] = 32'hc5000;
+    mem[12'h10] = 32'hc5000;
+    mem[12'h11] = 32'hc5000;
+    mem[12'h12] = 32'hc5000;
+    mem[12'h13] = 32'hc5000;
+    mem[12'h14] = 32'hc5000;
+    mem[12'h15] = 32'hc5000;
+    mem[12'h16] = 32'hc5000;
+    mem[12'h17] = 32'hc5026;
+    mem[12'h18] = 32'hc0026;
     mem[12'h19] = 32'h0;
     mem[12'h1a] = 32'h0;
     mem[12'h1b] = 32'h0;
     mem[12'h1c] = 32'h0;
     mem[12'h1d] = 32'h0;
     mem[12'h1e] = 32'h0;
-    mem[12'h1f] = 32'h0;
-    mem[12'h20] = 32'h0;
-    mem[12'h21] = 32'h0;
+    mem[12'h1f] = 32'hc0000;
+    mem[12'h20] = 32'hc0000;
+    mem[12'h21] = 32'hc0000;
     mem[12'h22] = 32'h24;
     mem[12'h23] = 32'h24;
-    mem[12'h24] = 32'h0;
-    mem[12'h25] = 32'h0;
-    mem[12'h26] = 32'h95;
+    mem[12'h24] = 32'hc0000;
+    mem[12'h25] = 32'h80000;
+    mem[12'h26] = 32'hc0095;
     mem[12'h27] = 32'h0;
     mem[12'h28] = 32'h0;
     mem[12'h29] = 32'h0;
@@ -2680,12 +2683,12 @@ module dynrt_processor__engine__fetch__rom_aux(read_address,read_clock,read_data
     mem[12'h37] = 32'h0;
     mem[12'h38] = 32'h0;
     mem[12'h39] = 32'h0;
-    mem[12'h3a] = 32'h0;
-    mem[12'h3b] = 32'h0;
-    mem[12'h3c] = 32'h0;
-    mem[12'h3d] = 32'h0;
-    mem[12'h3e] = 32'h0;
-    mem[12'h3f] = 32'h19;
+    mem[12'h3a] = 32'h40000;
+    mem[12'h3b] = 32'h40000;
+    mem[12'h3c] = 32'h40000;
+    mem[12'h3d] = 32'h40000;
+    mem[12'h3e] = 32'h40000;
+    mem[12'h3f] = 32'hc0019;
     mem[12'h40] = 32'h91;
     mem[12'h41] = 32'h0;
     mem[12'h42] = 32'h0;
@@ -2694,10 +2697,10 @@ module dynrt_processor__engine__fetch__rom_aux(read_address,read_clock,read_data
     mem[12'h45] = 32'h0;
     mem[12'h46] = 32'h0;
     mem[12'h47] = 32'h0;
-    mem[12'h48] = 32'h1b000;
-    mem[12'h49] = 32'h1b000;
-    mem[12'h4a] = 32'h1b000;
-    mem[12'h4b] = 32'h1b000;
+    mem[12'h48] = 32'h9b000;
+    mem[12'h49] = 32'h9b000;
+    mem[12'h4a] = 32'h9b000;
+    mem[12'h4b] = 32'h9b000;
     mem[12'h4c] = 32'h0;
     mem[12'h4d] = 32'h0;
     mem[12'h4e] = 32'h0;
@@ -2713,14 +2716,14 @@ module dynrt_processor__engine__fetch__rom_aux(read_address,read_clock,read_data
     mem[12'h58] = 32'h0;
     mem[12'h59] = 32'h0;
     mem[12'h5a] = 32'h0;
-    mem[12'h5b] = 32'h5f;
+    mem[12'h5b] = 32'h4005f;
     mem[12'h5c] = 32'h0;
     mem[12'h5d] = 32'h0;
     mem[12'h5e] = 32'h0;
-    mem[12'h5f] = 32'h15000;
-    mem[12'h60] = 32'h15000;
-    mem[12'h61] = 32'h15000;
-    mem[12'h62] = 32'h15000;
+    mem[12'h5f] = 32'h95000;
+    mem[12'h60] = 32'h95000;
+    mem[12'h61] = 32'h95000;
+    mem[12'h62] = 32'h95000;
     mem[12'h63] = 32'h0;
     mem[12'h64] = 32'h0;
     mem[12'h65] = 32'h0;
@@ -2732,7 +2735,7 @@ module dynrt_processor__engine__fetch__rom_aux(read_address,read_clock,read_data
     mem[12'h6b] = 32'h0;
     mem[12'h6c] = 32'h0;
     mem[12'h6d] = 32'h0;
-    mem[12'h6e] = 32'h8c;
+    mem[12'h6e] = 32'h4008c;
     mem[12'h6f] = 32'h0;
     mem[12'h70] = 32'h0;
     mem[12'h71] = 32'h0;
@@ -2747,11 +2750,11 @@ module dynrt_processor__engine__fetch__rom_aux(read_address,read_clock,read_data
     mem[12'h7a] = 32'h0;
     mem[12'h7b] = 32'h0;
     mem[12'h7c] = 32'h0;
-    mem[12'h7d] = 32'h0;
-    mem[12'h7e] = 32'h0;
-    mem[12'h7f] = 32'h0;
+    mem[12'h7d] = 32'h40000;
+    mem[12'h7e] = 32'h40000;
+    mem[12'h7f] = 32'h40000;
     mem[12'h80] = 32'h0;
-    mem[12'h81] = 32'h19;
+    mem[12'h81] = 32'hc0019;
     mem[12'h82] = 32'h8c;
     mem[12'h83] = 32'h0;
     mem[12'h84] = 32'h0;
@@ -2766,12 +2769,12 @@ module dynrt_processor__engine__fetch__rom_aux(read_address,read_clock,read_data
     mem[12'h8d] = 32'h0;
     mem[12'h8e] = 32'h0;
     mem[12'h8f] = 32'h26;
-    mem[12'h90] = 32'h26;
+    mem[12'h90] = 32'hc0026;
     mem[12'h91] = 32'h0;
     mem[12'h92] = 32'h0;
     mem[12'h93] = 32'h8c;
-    mem[12'h94] = 32'h8c;
-    mem[12'h95] = 32'h0;
+    mem[12'h94] = 32'hc008c;
+    mem[12'h95] = 32'hc0000;
     end
     
     
@@ -10333,6 +10336,48 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
     localparam  c_index__7 = 8'h7;
     
     // Stub signals
+    reg  [31:0] entries_r__0__d;
+    wire  [31:0] entries_r__0__q;
+    reg  entries_r__0__clock;
+    reg  [31:0] entries_r__1__d;
+    wire  [31:0] entries_r__1__q;
+    reg  entries_r__1__clock;
+    reg  [31:0] entries_r__2__d;
+    wire  [31:0] entries_r__2__q;
+    reg  entries_r__2__clock;
+    reg  [31:0] entries_r__3__d;
+    wire  [31:0] entries_r__3__q;
+    reg  entries_r__3__clock;
+    reg  [31:0] entries_r__4__d;
+    wire  [31:0] entries_r__4__q;
+    reg  entries_r__4__clock;
+    reg  [31:0] entries_r__5__d;
+    wire  [31:0] entries_r__5__q;
+    reg  entries_r__5__clock;
+    reg  [31:0] entries_r__6__d;
+    wire  [31:0] entries_r__6__q;
+    reg  entries_r__6__clock;
+    reg  [31:0] entries_r__7__d;
+    wire  [31:0] entries_r__7__q;
+    reg  entries_r__7__clock;
+    reg  [7:0] meta_i5__d;
+    wire  [7:0] meta_i5__q;
+    reg  meta_i5__clock;
+    reg  [4:0] thread_i5__d;
+    wire  [4:0] thread_i5__q;
+    reg  thread_i5__clock;
+    reg  which_i5__d;
+    wire  which_i5__q;
+    reg  which_i5__clock;
+    reg  [31:0] value_i5__d;
+    wire  [31:0] value_i5__q;
+    reg  value_i5__clock;
+    reg  insert_i5__d;
+    wire  insert_i5__q;
+    reg  insert_i5__clock;
+    reg  clear_i5__d;
+    wire  clear_i5__q;
+    reg  clear_i5__clock;
     reg  matches__0__d;
     wire  matches__0__q;
     reg  matches__0__clock;
@@ -10447,6 +10492,76 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
     reg  [5:0] write_address;
     
     // Sub module instances
+    dynrt_processor__engine__cycle_count entries_r__0(
+        .d(entries_r__0__d),
+        .q(entries_r__0__q),
+        .clock(entries_r__0__clock)
+    );
+    dynrt_processor__engine__cycle_count entries_r__1(
+        .d(entries_r__1__d),
+        .q(entries_r__1__q),
+        .clock(entries_r__1__clock)
+    );
+    dynrt_processor__engine__cycle_count entries_r__2(
+        .d(entries_r__2__d),
+        .q(entries_r__2__q),
+        .clock(entries_r__2__clock)
+    );
+    dynrt_processor__engine__cycle_count entries_r__3(
+        .d(entries_r__3__d),
+        .q(entries_r__3__q),
+        .clock(entries_r__3__clock)
+    );
+    dynrt_processor__engine__cycle_count entries_r__4(
+        .d(entries_r__4__d),
+        .q(entries_r__4__q),
+        .clock(entries_r__4__clock)
+    );
+    dynrt_processor__engine__cycle_count entries_r__5(
+        .d(entries_r__5__d),
+        .q(entries_r__5__q),
+        .clock(entries_r__5__clock)
+    );
+    dynrt_processor__engine__cycle_count entries_r__6(
+        .d(entries_r__6__d),
+        .q(entries_r__6__q),
+        .clock(entries_r__6__clock)
+    );
+    dynrt_processor__engine__cycle_count entries_r__7(
+        .d(entries_r__7__d),
+        .q(entries_r__7__q),
+        .clock(entries_r__7__clock)
+    );
+    dynrt_processor__engine__halted_count meta_i5(
+        .d(meta_i5__d),
+        .q(meta_i5__q),
+        .clock(meta_i5__clock)
+    );
+    dynrt_processor__engine__decode__t3 thread_i5(
+        .d(thread_i5__d),
+        .q(thread_i5__q),
+        .clock(thread_i5__clock)
+    );
+    dynrt_processor__display__dark_d which_i5(
+        .d(which_i5__d),
+        .q(which_i5__q),
+        .clock(which_i5__clock)
+    );
+    dynrt_processor__engine__cycle_count value_i5(
+        .d(value_i5__d),
+        .q(value_i5__q),
+        .clock(value_i5__clock)
+    );
+    dynrt_processor__display__dark_d insert_i5(
+        .d(insert_i5__d),
+        .q(insert_i5__q),
+        .clock(insert_i5__clock)
+    );
+    dynrt_processor__display__dark_d clear_i5(
+        .d(clear_i5__d),
+        .q(clear_i5__q),
+        .clock(clear_i5__clock)
+    );
     dynrt_processor__display__dark_d matches__0(
         .d(matches__0__d),
         .q(matches__0__q),
@@ -10601,12 +10716,24 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
     
     // Update code
     always @(*) begin
+        meta_i5__clock = clock;
+        thread_i5__clock = clock;
+        which_i5__clock = clock;
+        value_i5__clock = clock;
+        insert_i5__clock = clock;
+        clear_i5__clock = clock;
         meta_r__clock = clock;
         thread_r__clock = clock;
         which_r__clock = clock;
         value_r__clock = clock;
         insert_r__clock = clock;
         clear_r__clock = clock;
+        meta_i5__d = meta_i5__q;
+        thread_i5__d = thread_i5__q;
+        which_i5__d = which_i5__q;
+        value_i5__d = value_i5__q;
+        insert_i5__d = insert_i5__q;
+        clear_i5__d = clear_i5__q;
         meta_r__d = meta_r__q;
         thread_r__d = thread_r__q;
         which_r__d = which_r__q;
@@ -10641,28 +10768,50 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
         entries__5__read_address = read_address;
         entries__6__read_address = read_address;
         entries__7__read_address = read_address;
+        entries_r__0__clock = clock;
+        entries_r__0__d = entries__0__read_data;
+        entries_r__1__clock = clock;
+        entries_r__1__d = entries__1__read_data;
+        entries_r__2__clock = clock;
+        entries_r__2__d = entries__2__read_data;
+        entries_r__3__clock = clock;
+        entries_r__3__d = entries__3__read_data;
+        entries_r__4__clock = clock;
+        entries_r__4__d = entries__4__read_data;
+        entries_r__5__clock = clock;
+        entries_r__5__d = entries__5__read_data;
+        entries_r__6__clock = clock;
+        entries_r__6__d = entries__6__read_data;
+        entries_r__7__clock = clock;
+        entries_r__7__d = entries__7__read_data;
+        meta_i5__d = meta__read_data;
+        thread_i5__d = thread;
+        which_i5__d = which;
+        value_i5__d = value;
+        insert_i5__d = insert;
+        clear_i5__d = clear;
         matches__0__clock = clock;
-        matches__0__d = entries__0__read_data == value;
+        matches__0__d = entries_r__0__q == value_i5__q;
         matches__1__clock = clock;
-        matches__1__d = entries__1__read_data == value;
+        matches__1__d = entries_r__1__q == value_i5__q;
         matches__2__clock = clock;
-        matches__2__d = entries__2__read_data == value;
+        matches__2__d = entries_r__2__q == value_i5__q;
         matches__3__clock = clock;
-        matches__3__d = entries__3__read_data == value;
+        matches__3__d = entries_r__3__q == value_i5__q;
         matches__4__clock = clock;
-        matches__4__d = entries__4__read_data == value;
+        matches__4__d = entries_r__4__q == value_i5__q;
         matches__5__clock = clock;
-        matches__5__d = entries__5__read_data == value;
+        matches__5__d = entries_r__5__q == value_i5__q;
         matches__6__clock = clock;
-        matches__6__d = entries__6__read_data == value;
+        matches__6__d = entries_r__6__q == value_i5__q;
         matches__7__clock = clock;
-        matches__7__d = entries__7__read_data == value;
-        meta_r__d = meta__read_data;
-        thread_r__d = thread;
-        which_r__d = which;
-        value_r__d = value;
-        insert_r__d = insert;
-        clear_r__d = clear;
+        matches__7__d = entries_r__7__q == value_i5__q;
+        meta_r__d = meta_i5__q;
+        thread_r__d = thread_i5__q;
+        which_r__d = which_i5__q;
+        value_r__d = value_i5__q;
+        insert_r__d = insert_i5__q;
+        clear_r__d = clear_i5__q;
         len = meta_r__q[(32'h0)+:(4)];
         next_slot = meta_r__q[(32'h4)+:(3)];
         found = 1'b0;
@@ -10762,6 +10911,8 @@ endmodule // dynrt_processor__engine__mailboxes
 
 
 
+
+
 module dynrt_processor__engine__mailboxes__entries__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -10789,6 +10940,24 @@ module dynrt_processor__engine__mailboxes__entries__0(read_address,read_clock,re
     end
                 
 endmodule // dynrt_processor__engine__mailboxes__entries__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -10928,6 +11097,14 @@ endmodule // dynrt_processor__engine__mailboxes__meta
 
 
 
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__mem_bank_r(d,q,clock);
     
     // Module arguments
@@ -11019,7 +11196,7 @@ endmodule // dynrt_processor__engine__pixels
 
 
 
-module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,target,is_wait,kd_busy,tri_busy,jr_target,int_eq,int_lt,mb_hit,pix_done,fast,kind,converted,scratch_data,mem_data,nodes_data,uv_data,t_data,retiring__valid,retiring__op,retiring__dst,retiring__thread,retiring__invert,retiring__pc_plus_one,retiring__target,retiring__is_wait,retiring__kd_busy,retiring__tri_busy,retiring__jr_target,retiring__int_eq,retiring__int_lt,retiring__mb_hit,retiring__pix_done,retiring__fast);
+module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,target,is_wait,kd_busy,tri_busy,jr_target,int_eq,int_lt,mb_hit,pix_done,fast,kind,converted,scratch_data,mem_data,nodes_data,uv_data,t_data,retiring__valid,retiring__dst,retiring__thread,retiring__write,retiring__source,retiring__cond,retiring__sel_lt,retiring__sel_le,retiring__sel_eq,retiring__pc_taken,retiring__pc_not_taken,retiring__halt,retiring__retired,retiring__wait_pending,retiring__fast);
     
     // Module arguments
     input wire  clock;
@@ -11047,20 +11224,19 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     input wire  [31:0] uv_data;
     input wire  [31:0] t_data;
     output reg  retiring__valid;
-    output reg  [4:0] retiring__op;
     output reg  [7:0] retiring__dst;
     output reg  [4:0] retiring__thread;
-    output reg  retiring__invert;
-    output reg  [11:0] retiring__pc_plus_one;
-    output reg  [11:0] retiring__target;
-    output reg  retiring__is_wait;
-    output reg  retiring__kd_busy;
-    output reg  retiring__tri_busy;
-    output reg  [11:0] retiring__jr_target;
-    output reg  retiring__int_eq;
-    output reg  retiring__int_lt;
-    output reg  retiring__mb_hit;
-    output reg  retiring__pix_done;
+    output reg  retiring__write;
+    output reg  [2:0] retiring__source;
+    output reg  retiring__cond;
+    output reg  retiring__sel_lt;
+    output reg  retiring__sel_le;
+    output reg  retiring__sel_eq;
+    output reg  [11:0] retiring__pc_taken;
+    output reg  [11:0] retiring__pc_not_taken;
+    output reg  retiring__halt;
+    output reg  retiring__retired;
+    output reg  retiring__wait_pending;
     output reg  [31:0] retiring__fast;
     
     // Constant declarations
@@ -11073,8 +11249,25 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     localparam  c_index__5 = 8'h5;
     localparam  c_index__6 = 8'h6;
     localparam  c_index__7 = 8'h7;
+    localparam  op_fadd = 5'b1;
+    localparam  op_fsub = 5'b10;
+    localparam  op_fmul = 5'b11;
     localparam  op_fdiv = 5'b100;
     localparam  op_fsqrt = 5'b101;
+    localparam  op_bflt = 5'b10010;
+    localparam  op_bfle = 5'b10011;
+    localparam  op_bfeq = 5'b10100;
+    localparam  op_beq = 5'b10101;
+    localparam  op_bltu = 5'b10110;
+    localparam  op_jal = 5'b10111;
+    localparam  op_jr = 5'b11000;
+    localparam  op_mbx = 5'b11001;
+    localparam  op_pixel = 5'b11011;
+    localparam  op_halt = 5'b11100;
+    localparam  op_tri = 5'b11101;
+    localparam  op_kd = 5'b11110;
+    localparam  op_byte = 5'b11111;
+    localparam  op_writes = 32'ha8817ffe;
     
     // Enums
     localparam FastKind__Computed = 0;
@@ -11084,53 +11277,110 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     localparam FastKind__TrianglesUv = 4;
     localparam FastKind__TrianglesT = 5;
     localparam FastKind__Nodes = 6;
+    localparam ResultSource__Fast = 0;
+    localparam ResultSource__Sum = 1;
+    localparam ResultSource__Product = 2;
+    localparam ResultSource__Quotient = 3;
+    localparam ResultSource__Root = 4;
+    localparam ResultSource__Byte = 5;
     
     // Stub signals
+    reg  valid_i5__d;
+    wire  valid_i5__q;
+    reg  valid_i5__clock;
+    reg  [4:0] op_i5__d;
+    wire  [4:0] op_i5__q;
+    reg  op_i5__clock;
+    reg  [7:0] dst_i5__d;
+    wire  [7:0] dst_i5__q;
+    reg  dst_i5__clock;
+    reg  [4:0] thread_i5__d;
+    wire  [4:0] thread_i5__q;
+    reg  thread_i5__clock;
+    reg  invert_i5__d;
+    wire  invert_i5__q;
+    reg  invert_i5__clock;
+    reg  [11:0] pc_i5__d;
+    wire  [11:0] pc_i5__q;
+    reg  pc_i5__clock;
+    reg  [11:0] pc_plus_one_i5__d;
+    wire  [11:0] pc_plus_one_i5__q;
+    reg  pc_plus_one_i5__clock;
+    reg  [11:0] target_i5__d;
+    wire  [11:0] target_i5__q;
+    reg  target_i5__clock;
+    reg  is_wait_i5__d;
+    wire  is_wait_i5__q;
+    reg  is_wait_i5__clock;
+    reg  kd_busy_i5__d;
+    wire  kd_busy_i5__q;
+    reg  kd_busy_i5__clock;
+    reg  tri_busy_i5__d;
+    wire  tri_busy_i5__q;
+    reg  tri_busy_i5__clock;
+    reg  [11:0] jr_target_i5__d;
+    wire  [11:0] jr_target_i5__q;
+    reg  jr_target_i5__clock;
+    reg  int_eq_i5__d;
+    wire  int_eq_i5__q;
+    reg  int_eq_i5__clock;
+    reg  int_lt_i5__d;
+    wire  int_lt_i5__q;
+    reg  int_lt_i5__clock;
+    reg  pix_done_i5__d;
+    wire  pix_done_i5__q;
+    reg  pix_done_i5__clock;
+    reg  cond_i6__d;
+    wire  cond_i6__q;
+    reg  cond_i6__clock;
+    reg  is_mbx_i6__d;
+    wire  is_mbx_i6__q;
+    reg  is_mbx_i6__clock;
     reg  valid_line__clock;
     reg  valid_line__data_in;
     wire  valid_line__data_out;
-    reg  op_line__clock;
-    reg  [4:0] op_line__data_in;
-    wire  [4:0] op_line__data_out;
+    reg  is_long_line__clock;
+    reg  is_long_line__data_in;
+    wire  is_long_line__data_out;
     reg  dst_line__clock;
     reg  [7:0] dst_line__data_in;
     wire  [7:0] dst_line__data_out;
     reg  thread_line__clock;
     reg  [4:0] thread_line__data_in;
     wire  [4:0] thread_line__data_out;
-    reg  invert_line__clock;
-    reg  invert_line__data_in;
-    wire  invert_line__data_out;
-    reg  next_line__clock;
-    reg  [11:0] next_line__data_in;
-    wire  [11:0] next_line__data_out;
-    reg  target_line__clock;
-    reg  [11:0] target_line__data_in;
-    wire  [11:0] target_line__data_out;
-    reg  wait_line__clock;
-    reg  wait_line__data_in;
-    wire  wait_line__data_out;
-    reg  kd_busy_line__clock;
-    reg  kd_busy_line__data_in;
-    wire  kd_busy_line__data_out;
-    reg  tri_busy_line__clock;
-    reg  tri_busy_line__data_in;
-    wire  tri_busy_line__data_out;
-    reg  jr_target_line__clock;
-    reg  [11:0] jr_target_line__data_in;
-    wire  [11:0] jr_target_line__data_out;
-    reg  int_eq_line__clock;
-    reg  int_eq_line__data_in;
-    wire  int_eq_line__data_out;
-    reg  int_lt_line__clock;
-    reg  int_lt_line__data_in;
-    wire  int_lt_line__data_out;
-    reg  mb_hit_line__clock;
-    reg  mb_hit_line__data_in;
-    wire  mb_hit_line__data_out;
-    reg  pix_done_line__clock;
-    reg  pix_done_line__data_in;
-    wire  pix_done_line__data_out;
+    reg  write_line__clock;
+    reg  write_line__data_in;
+    wire  write_line__data_out;
+    reg  source_line__clock;
+    reg  [2:0] source_line__data_in;
+    wire  [2:0] source_line__data_out;
+    reg  cond_line__clock;
+    reg  cond_line__data_in;
+    wire  cond_line__data_out;
+    reg  sel_lt_line__clock;
+    reg  sel_lt_line__data_in;
+    wire  sel_lt_line__data_out;
+    reg  sel_le_line__clock;
+    reg  sel_le_line__data_in;
+    wire  sel_le_line__data_out;
+    reg  sel_eq_line__clock;
+    reg  sel_eq_line__data_in;
+    wire  sel_eq_line__data_out;
+    reg  pc_taken_line__clock;
+    reg  [11:0] pc_taken_line__data_in;
+    wire  [11:0] pc_taken_line__data_out;
+    reg  pc_not_taken_line__clock;
+    reg  [11:0] pc_not_taken_line__data_in;
+    wire  [11:0] pc_not_taken_line__data_out;
+    reg  halt_line__clock;
+    reg  halt_line__data_in;
+    wire  halt_line__data_out;
+    reg  retired_line__clock;
+    reg  retired_line__data_in;
+    wire  retired_line__data_out;
+    reg  wait_pending_line__clock;
+    reg  wait_pending_line__data_in;
+    wire  wait_pending_line__data_out;
     reg  [31:0] fast_line__0__d;
     wire  [31:0] fast_line__0__q;
     reg  fast_line__0__clock;
@@ -11185,103 +11435,194 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     reg  long_valid__clock;
     reg  long_valid__data_in;
     wire  long_valid__data_out;
-    reg  long_op__clock;
-    reg  [4:0] long_op__data_in;
-    wire  [4:0] long_op__data_out;
     reg  long_dst__clock;
     reg  [7:0] long_dst__data_in;
     wire  [7:0] long_dst__data_out;
     reg  long_thread__clock;
     reg  [4:0] long_thread__data_in;
     wire  [4:0] long_thread__data_out;
-    reg  long_invert__clock;
-    reg  long_invert__data_in;
-    wire  long_invert__data_out;
-    reg  long_next__clock;
-    reg  [11:0] long_next__data_in;
-    wire  [11:0] long_next__data_out;
-    reg  long_target__clock;
-    reg  [11:0] long_target__data_in;
-    wire  [11:0] long_target__data_out;
+    reg  long_write__clock;
+    reg  long_write__data_in;
+    wire  long_write__data_out;
+    reg  long_source__clock;
+    reg  [2:0] long_source__data_in;
+    wire  [2:0] long_source__data_out;
+    reg  long_pc__clock;
+    reg  [11:0] long_pc__data_in;
+    wire  [11:0] long_pc__data_out;
     
     // Local signals
     reg  is_long;
+    reg  is_mbx;
+    reg  halts;
+    reg  repeats;
+    reg  keeps_pc;
+    reg  cond_i5;
+    reg  [11:0] pc_other;
+    reg  [11:0] pc_target;
+    reg  [11:0] pc_next;
+    reg  [2:0] source_i5;
     
     // Sub module instances
-    dynrt_processor__engine__result_line__int_eq_line valid_line(
+    dynrt_processor__display__dark_d valid_i5(
+        .d(valid_i5__d),
+        .q(valid_i5__q),
+        .clock(valid_i5__clock)
+    );
+    dynrt_processor__engine__decode__t3 op_i5(
+        .d(op_i5__d),
+        .q(op_i5__q),
+        .clock(op_i5__clock)
+    );
+    dynrt_processor__engine__halted_count dst_i5(
+        .d(dst_i5__d),
+        .q(dst_i5__q),
+        .clock(dst_i5__clock)
+    );
+    dynrt_processor__engine__decode__t3 thread_i5(
+        .d(thread_i5__d),
+        .q(thread_i5__q),
+        .clock(thread_i5__clock)
+    );
+    dynrt_processor__display__dark_d invert_i5(
+        .d(invert_i5__d),
+        .q(invert_i5__q),
+        .clock(invert_i5__clock)
+    );
+    dynrt_processor__display__timing__col pc_i5(
+        .d(pc_i5__d),
+        .q(pc_i5__q),
+        .clock(pc_i5__clock)
+    );
+    dynrt_processor__display__timing__col pc_plus_one_i5(
+        .d(pc_plus_one_i5__d),
+        .q(pc_plus_one_i5__q),
+        .clock(pc_plus_one_i5__clock)
+    );
+    dynrt_processor__display__timing__col target_i5(
+        .d(target_i5__d),
+        .q(target_i5__q),
+        .clock(target_i5__clock)
+    );
+    dynrt_processor__display__dark_d is_wait_i5(
+        .d(is_wait_i5__d),
+        .q(is_wait_i5__q),
+        .clock(is_wait_i5__clock)
+    );
+    dynrt_processor__display__dark_d kd_busy_i5(
+        .d(kd_busy_i5__d),
+        .q(kd_busy_i5__q),
+        .clock(kd_busy_i5__clock)
+    );
+    dynrt_processor__display__dark_d tri_busy_i5(
+        .d(tri_busy_i5__d),
+        .q(tri_busy_i5__q),
+        .clock(tri_busy_i5__clock)
+    );
+    dynrt_processor__display__timing__col jr_target_i5(
+        .d(jr_target_i5__d),
+        .q(jr_target_i5__q),
+        .clock(jr_target_i5__clock)
+    );
+    dynrt_processor__display__dark_d int_eq_i5(
+        .d(int_eq_i5__d),
+        .q(int_eq_i5__q),
+        .clock(int_eq_i5__clock)
+    );
+    dynrt_processor__display__dark_d int_lt_i5(
+        .d(int_lt_i5__d),
+        .q(int_lt_i5__q),
+        .clock(int_lt_i5__clock)
+    );
+    dynrt_processor__display__dark_d pix_done_i5(
+        .d(pix_done_i5__d),
+        .q(pix_done_i5__q),
+        .clock(pix_done_i5__clock)
+    );
+    dynrt_processor__display__dark_d cond_i6(
+        .d(cond_i6__d),
+        .q(cond_i6__q),
+        .clock(cond_i6__clock)
+    );
+    dynrt_processor__display__dark_d is_mbx_i6(
+        .d(is_mbx_i6__d),
+        .q(is_mbx_i6__q),
+        .clock(is_mbx_i6__clock)
+    );
+    dynrt_processor__engine__result_line__halt_line valid_line(
         .clock(valid_line__clock),
         .data_in(valid_line__data_in),
         .data_out(valid_line__data_out)
     );
-    dynrt_processor__engine__result_line__op_line op_line(
-        .clock(op_line__clock),
-        .data_in(op_line__data_in),
-        .data_out(op_line__data_out)
+    dynrt_processor__engine__result_line__halt_line is_long_line(
+        .clock(is_long_line__clock),
+        .data_in(is_long_line__data_in),
+        .data_out(is_long_line__data_out)
     );
     dynrt_processor__engine__result_line__dst_line dst_line(
         .clock(dst_line__clock),
         .data_in(dst_line__data_in),
         .data_out(dst_line__data_out)
     );
-    dynrt_processor__engine__result_line__op_line thread_line(
+    dynrt_processor__engine__result_line__thread_line thread_line(
         .clock(thread_line__clock),
         .data_in(thread_line__data_in),
         .data_out(thread_line__data_out)
     );
-    dynrt_processor__engine__result_line__int_eq_line invert_line(
-        .clock(invert_line__clock),
-        .data_in(invert_line__data_in),
-        .data_out(invert_line__data_out)
+    dynrt_processor__engine__result_line__halt_line write_line(
+        .clock(write_line__clock),
+        .data_in(write_line__data_in),
+        .data_out(write_line__data_out)
     );
-    dynrt_processor__engine__result_line__jr_target_line next_line(
-        .clock(next_line__clock),
-        .data_in(next_line__data_in),
-        .data_out(next_line__data_out)
+    dynrt_processor__engine__result_line__source_line source_line(
+        .clock(source_line__clock),
+        .data_in(source_line__data_in),
+        .data_out(source_line__data_out)
     );
-    dynrt_processor__engine__result_line__jr_target_line target_line(
-        .clock(target_line__clock),
-        .data_in(target_line__data_in),
-        .data_out(target_line__data_out)
+    dynrt_processor__engine__fp_units__eq_delay cond_line(
+        .clock(cond_line__clock),
+        .data_in(cond_line__data_in),
+        .data_out(cond_line__data_out)
     );
-    dynrt_processor__engine__result_line__int_eq_line wait_line(
-        .clock(wait_line__clock),
-        .data_in(wait_line__data_in),
-        .data_out(wait_line__data_out)
+    dynrt_processor__engine__result_line__halt_line sel_lt_line(
+        .clock(sel_lt_line__clock),
+        .data_in(sel_lt_line__data_in),
+        .data_out(sel_lt_line__data_out)
     );
-    dynrt_processor__engine__result_line__int_eq_line kd_busy_line(
-        .clock(kd_busy_line__clock),
-        .data_in(kd_busy_line__data_in),
-        .data_out(kd_busy_line__data_out)
+    dynrt_processor__engine__result_line__halt_line sel_le_line(
+        .clock(sel_le_line__clock),
+        .data_in(sel_le_line__data_in),
+        .data_out(sel_le_line__data_out)
     );
-    dynrt_processor__engine__result_line__int_eq_line tri_busy_line(
-        .clock(tri_busy_line__clock),
-        .data_in(tri_busy_line__data_in),
-        .data_out(tri_busy_line__data_out)
+    dynrt_processor__engine__result_line__halt_line sel_eq_line(
+        .clock(sel_eq_line__clock),
+        .data_in(sel_eq_line__data_in),
+        .data_out(sel_eq_line__data_out)
     );
-    dynrt_processor__engine__result_line__jr_target_line jr_target_line(
-        .clock(jr_target_line__clock),
-        .data_in(jr_target_line__data_in),
-        .data_out(jr_target_line__data_out)
+    dynrt_processor__engine__result_line__pc_not_taken_line pc_taken_line(
+        .clock(pc_taken_line__clock),
+        .data_in(pc_taken_line__data_in),
+        .data_out(pc_taken_line__data_out)
     );
-    dynrt_processor__engine__result_line__int_eq_line int_eq_line(
-        .clock(int_eq_line__clock),
-        .data_in(int_eq_line__data_in),
-        .data_out(int_eq_line__data_out)
+    dynrt_processor__engine__result_line__pc_not_taken_line pc_not_taken_line(
+        .clock(pc_not_taken_line__clock),
+        .data_in(pc_not_taken_line__data_in),
+        .data_out(pc_not_taken_line__data_out)
     );
-    dynrt_processor__engine__result_line__int_eq_line int_lt_line(
-        .clock(int_lt_line__clock),
-        .data_in(int_lt_line__data_in),
-        .data_out(int_lt_line__data_out)
+    dynrt_processor__engine__result_line__halt_line halt_line(
+        .clock(halt_line__clock),
+        .data_in(halt_line__data_in),
+        .data_out(halt_line__data_out)
     );
-    dynrt_processor__engine__result_line__mb_hit_line mb_hit_line(
-        .clock(mb_hit_line__clock),
-        .data_in(mb_hit_line__data_in),
-        .data_out(mb_hit_line__data_out)
+    dynrt_processor__engine__result_line__halt_line retired_line(
+        .clock(retired_line__clock),
+        .data_in(retired_line__data_in),
+        .data_out(retired_line__data_out)
     );
-    dynrt_processor__engine__result_line__int_eq_line pix_done_line(
-        .clock(pix_done_line__clock),
-        .data_in(pix_done_line__data_in),
-        .data_out(pix_done_line__data_out)
+    dynrt_processor__engine__result_line__halt_line wait_pending_line(
+        .clock(wait_pending_line__clock),
+        .data_in(wait_pending_line__data_in),
+        .data_out(wait_pending_line__data_out)
     );
     dynrt_processor__engine__cycle_count fast_line__0(
         .d(fast_line__0__d),
@@ -11373,62 +11714,90 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .data_in(long_valid__data_in),
         .data_out(long_valid__data_out)
     );
-    dynrt_processor__engine__result_line__long_op long_op(
-        .clock(long_op__clock),
-        .data_in(long_op__data_in),
-        .data_out(long_op__data_out)
-    );
     dynrt_processor__engine__result_line__long_dst long_dst(
         .clock(long_dst__clock),
         .data_in(long_dst__data_in),
         .data_out(long_dst__data_out)
     );
-    dynrt_processor__engine__result_line__long_op long_thread(
+    dynrt_processor__engine__result_line__long_thread long_thread(
         .clock(long_thread__clock),
         .data_in(long_thread__data_in),
         .data_out(long_thread__data_out)
     );
-    dynrt_processor__engine__fp_units__eq_delay long_invert(
-        .clock(long_invert__clock),
-        .data_in(long_invert__data_in),
-        .data_out(long_invert__data_out)
+    dynrt_processor__engine__fp_units__eq_delay long_write(
+        .clock(long_write__clock),
+        .data_in(long_write__data_in),
+        .data_out(long_write__data_out)
     );
-    dynrt_processor__engine__result_line__long_next long_next(
-        .clock(long_next__clock),
-        .data_in(long_next__data_in),
-        .data_out(long_next__data_out)
+    dynrt_processor__engine__result_line__long_source long_source(
+        .clock(long_source__clock),
+        .data_in(long_source__data_in),
+        .data_out(long_source__data_out)
     );
-    dynrt_processor__engine__result_line__long_next long_target(
-        .clock(long_target__clock),
-        .data_in(long_target__data_in),
-        .data_out(long_target__data_out)
+    dynrt_processor__engine__result_line__long_pc long_pc(
+        .clock(long_pc__clock),
+        .data_in(long_pc__data_in),
+        .data_out(long_pc__data_out)
     );
     
     // Update code
     always @(*) begin
+        valid_i5__clock = clock;
+        op_i5__clock = clock;
+        dst_i5__clock = clock;
+        thread_i5__clock = clock;
+        invert_i5__clock = clock;
+        pc_i5__clock = clock;
+        pc_plus_one_i5__clock = clock;
+        target_i5__clock = clock;
+        is_wait_i5__clock = clock;
+        kd_busy_i5__clock = clock;
+        tri_busy_i5__clock = clock;
+        jr_target_i5__clock = clock;
+        int_eq_i5__clock = clock;
+        int_lt_i5__clock = clock;
+        pix_done_i5__clock = clock;
+        cond_i6__clock = clock;
+        is_mbx_i6__clock = clock;
+        valid_i5__d = valid_i5__q;
+        op_i5__d = op_i5__q;
+        dst_i5__d = dst_i5__q;
+        thread_i5__d = thread_i5__q;
+        invert_i5__d = invert_i5__q;
+        pc_i5__d = pc_i5__q;
+        pc_plus_one_i5__d = pc_plus_one_i5__q;
+        target_i5__d = target_i5__q;
+        is_wait_i5__d = is_wait_i5__q;
+        kd_busy_i5__d = kd_busy_i5__q;
+        tri_busy_i5__d = tri_busy_i5__q;
+        jr_target_i5__d = jr_target_i5__q;
+        int_eq_i5__d = int_eq_i5__q;
+        int_lt_i5__d = int_lt_i5__q;
+        pix_done_i5__d = pix_done_i5__q;
+        cond_i6__d = cond_i6__q;
+        is_mbx_i6__d = is_mbx_i6__q;
         valid_line__clock = clock;
-        op_line__clock = clock;
+        is_long_line__clock = clock;
         dst_line__clock = clock;
         thread_line__clock = clock;
-        invert_line__clock = clock;
-        next_line__clock = clock;
-        target_line__clock = clock;
-        wait_line__clock = clock;
-        kd_busy_line__clock = clock;
-        tri_busy_line__clock = clock;
-        jr_target_line__clock = clock;
-        int_eq_line__clock = clock;
-        int_lt_line__clock = clock;
-        mb_hit_line__clock = clock;
-        pix_done_line__clock = clock;
+        write_line__clock = clock;
+        source_line__clock = clock;
+        cond_line__clock = clock;
+        sel_lt_line__clock = clock;
+        sel_le_line__clock = clock;
+        sel_eq_line__clock = clock;
+        pc_taken_line__clock = clock;
+        pc_not_taken_line__clock = clock;
+        halt_line__clock = clock;
+        retired_line__clock = clock;
+        wait_pending_line__clock = clock;
         fast_tail__clock = clock;
         long_valid__clock = clock;
-        long_op__clock = clock;
         long_dst__clock = clock;
         long_thread__clock = clock;
-        long_invert__clock = clock;
-        long_next__clock = clock;
-        long_target__clock = clock;
+        long_write__clock = clock;
+        long_source__clock = clock;
+        long_pc__clock = clock;
         fast_line__0__clock = clock;
         kind_line__0__clock = clock;
         fast_line__1__clock = clock;
@@ -11445,21 +11814,74 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         kind_line__6__clock = clock;
         fast_line__7__clock = clock;
         kind_line__7__clock = clock;
-        valid_line__data_in = valid;
-        op_line__data_in = op;
-        dst_line__data_in = dst;
-        thread_line__data_in = thread;
-        invert_line__data_in = invert;
-        next_line__data_in = pc + 32'h1;
-        target_line__data_in = target;
-        wait_line__data_in = is_wait;
-        kd_busy_line__data_in = kd_busy;
-        tri_busy_line__data_in = tri_busy;
-        jr_target_line__data_in = jr_target;
-        int_eq_line__data_in = int_eq;
-        int_lt_line__data_in = int_lt;
-        mb_hit_line__data_in = mb_hit;
-        pix_done_line__data_in = pix_done;
+        valid_i5__d = valid;
+        op_i5__d = op;
+        dst_i5__d = dst;
+        thread_i5__d = thread;
+        invert_i5__d = invert;
+        pc_i5__d = pc;
+        pc_plus_one_i5__d = pc + 32'h1;
+        target_i5__d = target;
+        is_wait_i5__d = is_wait;
+        kd_busy_i5__d = kd_busy;
+        tri_busy_i5__d = tri_busy;
+        jr_target_i5__d = jr_target;
+        int_eq_i5__d = int_eq;
+        int_lt_i5__d = int_lt;
+        pix_done_i5__d = pix_done;
+        is_long = (op_i5__q == op_fdiv) | (op_i5__q == op_fsqrt);
+        is_mbx = op_i5__q == op_mbx;
+        halts = op_i5__q == op_halt;
+        repeats = ((op_i5__q == op_tri) & tri_busy_i5__q) | ((op_i5__q == op_kd) & kd_busy_i5__q);
+        keeps_pc = halts | repeats;
+        cond_i5 = ((op_i5__q == op_beq) & int_eq_i5__q) | ((op_i5__q == op_bltu) & int_lt_i5__q) | ((op_i5__q == op_pixel) & pix_done_i5__q) | (op_i5__q == op_jal) | repeats;
+        pc_target = target_i5__q;
+        pc_next = pc_plus_one_i5__q;
+        if (invert_i5__q) begin
+            pc_target = pc_plus_one_i5__q;
+            pc_next = target_i5__q;
+        end
+        pc_other = jr_target_i5__q;
+        if (keeps_pc) begin
+            pc_other = pc_i5__q;
+        end
+        if (keeps_pc | (op_i5__q == op_jr)) begin
+            pc_target = pc_other;
+            pc_next = pc_other;
+        end
+        source_i5 = ResultSource__Fast;
+        if ((op_i5__q == op_fadd) | (op_i5__q == op_fsub)) begin
+            source_i5 = ResultSource__Sum;
+        end
+        if (op_i5__q == op_fmul) begin
+            source_i5 = ResultSource__Product;
+        end
+        if (op_i5__q == op_fdiv) begin
+            source_i5 = ResultSource__Quotient;
+        end
+        if (op_i5__q == op_fsqrt) begin
+            source_i5 = ResultSource__Root;
+        end
+        if (op_i5__q == op_byte) begin
+            source_i5 = ResultSource__Byte;
+        end
+        valid_line__data_in = valid_i5__q;
+        is_long_line__data_in = is_long;
+        dst_line__data_in = dst_i5__q;
+        thread_line__data_in = thread_i5__q;
+        write_line__data_in = valid_i5__q & (dst_i5__q != 32'h0) & op_writes[op_i5__q] & (~((op_i5__q == op_pixel) & pix_done_i5__q));
+        source_line__data_in = source_i5;
+        sel_lt_line__data_in = op_i5__q == op_bflt;
+        sel_le_line__data_in = op_i5__q == op_bfle;
+        sel_eq_line__data_in = op_i5__q == op_bfeq;
+        pc_taken_line__data_in = pc_target;
+        pc_not_taken_line__data_in = pc_next;
+        halt_line__data_in = halts;
+        retired_line__data_in = valid_i5__q & (~repeats);
+        wait_pending_line__data_in = repeats & is_wait_i5__q;
+        cond_i6__d = cond_i5;
+        is_mbx_i6__d = is_mbx;
+        cond_line__data_in = cond_i6__q | (is_mbx_i6__q & mb_hit);
         fast_line__0__d = fast;
         kind_line__0__d = kind;
         fast_line__1__d = fast_line__0__q;
@@ -11567,44 +11989,74 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
             end
         end
         fast_tail__data_in = fast_line__7__q;
-        is_long = (op_line__data_out == op_fdiv) | (op_line__data_out == op_fsqrt);
-        long_valid__data_in = valid_line__data_out & is_long;
-        long_op__data_in = op_line__data_out;
+        long_valid__data_in = valid_line__data_out & is_long_line__data_out;
         long_dst__data_in = dst_line__data_out;
         long_thread__data_in = thread_line__data_out;
-        long_invert__data_in = invert_line__data_out;
-        long_next__data_in = next_line__data_out;
-        long_target__data_in = target_line__data_out;
+        long_write__data_in = write_line__data_out;
+        long_source__data_in = source_line__data_out;
+        long_pc__data_in = pc_not_taken_line__data_out;
         if (long_valid__data_out) begin
             retiring__valid = 1'b1;
-            retiring__op = long_op__data_out;
             retiring__dst = long_dst__data_out;
             retiring__thread = long_thread__data_out;
-            retiring__invert = long_invert__data_out;
-            retiring__pc_plus_one = long_next__data_out;
-            retiring__target = long_target__data_out;
+            retiring__write = long_write__data_out;
+            retiring__source = long_source__data_out;
+            retiring__cond = 1'b0;
+            retiring__sel_lt = 1'b0;
+            retiring__sel_le = 1'b0;
+            retiring__sel_eq = 1'b0;
+            retiring__pc_taken = long_pc__data_out;
+            retiring__pc_not_taken = long_pc__data_out;
+            retiring__halt = 1'b0;
+            retiring__retired = 1'b1;
+            retiring__wait_pending = 1'b0;
         end
         else begin
-            retiring__valid = valid_line__data_out & (~is_long);
-            retiring__op = op_line__data_out;
+            retiring__valid = valid_line__data_out & (~is_long_line__data_out);
             retiring__dst = dst_line__data_out;
             retiring__thread = thread_line__data_out;
-            retiring__invert = invert_line__data_out;
-            retiring__pc_plus_one = next_line__data_out;
-            retiring__target = target_line__data_out;
+            retiring__write = write_line__data_out & (~is_long_line__data_out);
+            retiring__source = source_line__data_out;
+            retiring__cond = cond_line__data_out;
+            retiring__sel_lt = sel_lt_line__data_out;
+            retiring__sel_le = sel_le_line__data_out;
+            retiring__sel_eq = sel_eq_line__data_out;
+            retiring__pc_taken = pc_taken_line__data_out;
+            retiring__pc_not_taken = pc_not_taken_line__data_out;
+            retiring__halt = halt_line__data_out;
+            retiring__retired = retired_line__data_out & (~is_long_line__data_out);
+            retiring__wait_pending = wait_pending_line__data_out;
         end
-        retiring__is_wait = wait_line__data_out;
-        retiring__kd_busy = kd_busy_line__data_out;
-        retiring__tri_busy = tri_busy_line__data_out;
-        retiring__jr_target = jr_target_line__data_out;
-        retiring__int_eq = int_eq_line__data_out;
-        retiring__int_lt = int_lt_line__data_out;
-        retiring__mb_hit = mb_hit_line__data_out;
-        retiring__pix_done = pix_done_line__data_out;
         retiring__fast = fast_tail__data_out;
     end
     
 endmodule // dynrt_processor__engine__result_line
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
@@ -11648,9 +12100,6 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
     reg  [7:0] stage__10__d;
     wire  [7:0] stage__10__q;
     reg  stage__10__clock;
-    reg  [7:0] stage__11__d;
-    wire  [7:0] stage__11__q;
-    reg  stage__11__clock;
     
     // Sub module instances
     dynrt_processor__engine__halted_count stage__0(
@@ -11708,11 +12157,6 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor__engine__halted_count stage__11(
-        .d(stage__11__d),
-        .q(stage__11__q),
-        .clock(stage__11__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -11727,7 +12171,6 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         stage__8__clock = clock;
         stage__9__clock = clock;
         stage__10__clock = clock;
-        stage__11__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -11739,7 +12182,6 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
         stage__10__d = stage__9__q;
-        stage__11__d = stage__10__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -11751,12 +12193,9 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         data_out = stage__8__q;
         data_out = stage__9__q;
         data_out = stage__10__q;
-        data_out = stage__11__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__dst_line
-
-
 
 
 
@@ -11867,7 +12306,7 @@ endmodule // dynrt_processor__engine__result_line__fast_tail
 
 
 
-module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out);
+module dynrt_processor__engine__result_line__halt_line(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -11908,9 +12347,6 @@ module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out)
     reg  stage__10__d;
     wire  stage__10__q;
     reg  stage__10__clock;
-    reg  stage__11__d;
-    wire  stage__11__q;
-    reg  stage__11__clock;
     
     // Sub module instances
     dynrt_processor__display__dark_d stage__0(
@@ -11968,11 +12404,6 @@ module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out)
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor__display__dark_d stage__11(
-        .d(stage__11__d),
-        .q(stage__11__q),
-        .clock(stage__11__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -11987,7 +12418,6 @@ module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out)
         stage__8__clock = clock;
         stage__9__clock = clock;
         stage__10__clock = clock;
-        stage__11__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -11999,7 +12429,6 @@ module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out)
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
         stage__10__d = stage__9__q;
-        stage__11__d = stage__10__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -12011,10 +12440,9 @@ module dynrt_processor__engine__result_line__int_eq_line(clock,data_in,data_out)
         data_out = stage__8__q;
         data_out = stage__9__q;
         data_out = stage__10__q;
-        data_out = stage__11__q;
     end
     
-endmodule // dynrt_processor__engine__result_line__int_eq_line
+endmodule // dynrt_processor__engine__result_line__halt_line
 
 
 
@@ -12025,222 +12453,6 @@ endmodule // dynrt_processor__engine__result_line__int_eq_line
 
 
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor__engine__result_line__jr_target_line(clock,data_in,data_out);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  [11:0] data_in;
-    output reg  [11:0] data_out;
-    
-    // Stub signals
-    reg  [11:0] stage__0__d;
-    wire  [11:0] stage__0__q;
-    reg  stage__0__clock;
-    reg  [11:0] stage__1__d;
-    wire  [11:0] stage__1__q;
-    reg  stage__1__clock;
-    reg  [11:0] stage__2__d;
-    wire  [11:0] stage__2__q;
-    reg  stage__2__clock;
-    reg  [11:0] stage__3__d;
-    wire  [11:0] stage__3__q;
-    reg  stage__3__clock;
-    reg  [11:0] stage__4__d;
-    wire  [11:0] stage__4__q;
-    reg  stage__4__clock;
-    reg  [11:0] stage__5__d;
-    wire  [11:0] stage__5__q;
-    reg  stage__5__clock;
-    reg  [11:0] stage__6__d;
-    wire  [11:0] stage__6__q;
-    reg  stage__6__clock;
-    reg  [11:0] stage__7__d;
-    wire  [11:0] stage__7__q;
-    reg  stage__7__clock;
-    reg  [11:0] stage__8__d;
-    wire  [11:0] stage__8__q;
-    reg  stage__8__clock;
-    reg  [11:0] stage__9__d;
-    wire  [11:0] stage__9__q;
-    reg  stage__9__clock;
-    reg  [11:0] stage__10__d;
-    wire  [11:0] stage__10__q;
-    reg  stage__10__clock;
-    reg  [11:0] stage__11__d;
-    wire  [11:0] stage__11__q;
-    reg  stage__11__clock;
-    
-    // Sub module instances
-    dynrt_processor__display__timing__col stage__0(
-        .d(stage__0__d),
-        .q(stage__0__q),
-        .clock(stage__0__clock)
-    );
-    dynrt_processor__display__timing__col stage__1(
-        .d(stage__1__d),
-        .q(stage__1__q),
-        .clock(stage__1__clock)
-    );
-    dynrt_processor__display__timing__col stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
-    dynrt_processor__display__timing__col stage__3(
-        .d(stage__3__d),
-        .q(stage__3__q),
-        .clock(stage__3__clock)
-    );
-    dynrt_processor__display__timing__col stage__4(
-        .d(stage__4__d),
-        .q(stage__4__q),
-        .clock(stage__4__clock)
-    );
-    dynrt_processor__display__timing__col stage__5(
-        .d(stage__5__d),
-        .q(stage__5__q),
-        .clock(stage__5__clock)
-    );
-    dynrt_processor__display__timing__col stage__6(
-        .d(stage__6__d),
-        .q(stage__6__q),
-        .clock(stage__6__clock)
-    );
-    dynrt_processor__display__timing__col stage__7(
-        .d(stage__7__d),
-        .q(stage__7__q),
-        .clock(stage__7__clock)
-    );
-    dynrt_processor__display__timing__col stage__8(
-        .d(stage__8__d),
-        .q(stage__8__q),
-        .clock(stage__8__clock)
-    );
-    dynrt_processor__display__timing__col stage__9(
-        .d(stage__9__d),
-        .q(stage__9__q),
-        .clock(stage__9__clock)
-    );
-    dynrt_processor__display__timing__col stage__10(
-        .d(stage__10__d),
-        .q(stage__10__q),
-        .clock(stage__10__clock)
-    );
-    dynrt_processor__display__timing__col stage__11(
-        .d(stage__11__d),
-        .q(stage__11__q),
-        .clock(stage__11__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        stage__0__clock = clock;
-        stage__1__clock = clock;
-        stage__2__clock = clock;
-        stage__3__clock = clock;
-        stage__4__clock = clock;
-        stage__5__clock = clock;
-        stage__6__clock = clock;
-        stage__7__clock = clock;
-        stage__8__clock = clock;
-        stage__9__clock = clock;
-        stage__10__clock = clock;
-        stage__11__clock = clock;
-        stage__0__d = data_in;
-        stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        stage__3__d = stage__2__q;
-        stage__4__d = stage__3__q;
-        stage__5__d = stage__4__q;
-        stage__6__d = stage__5__q;
-        stage__7__d = stage__6__q;
-        stage__8__d = stage__7__q;
-        stage__9__d = stage__8__q;
-        stage__10__d = stage__9__q;
-        stage__11__d = stage__10__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
-    end
-    
-endmodule // dynrt_processor__engine__result_line__jr_target_line
 
 
 
@@ -12483,29 +12695,7 @@ endmodule // dynrt_processor__engine__result_line__long_dst
 
 
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor__engine__result_line__long_next(clock,data_in,data_out);
+module dynrt_processor__engine__result_line__long_pc(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -12630,7 +12820,7 @@ module dynrt_processor__engine__result_line__long_next(clock,data_in,data_out);
         data_out = stage__9__q;
     end
     
-endmodule // dynrt_processor__engine__result_line__long_next
+endmodule // dynrt_processor__engine__result_line__long_pc
 
 
 
@@ -12653,7 +12843,188 @@ endmodule // dynrt_processor__engine__result_line__long_next
 
 
 
-module dynrt_processor__engine__result_line__long_op(clock,data_in,data_out);
+module dynrt_processor__engine__result_line__long_source(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [2:0] data_in;
+    output reg  [2:0] data_out;
+    
+    // Enums
+    localparam ResultSource__Fast = 0;
+    localparam ResultSource__Sum = 1;
+    localparam ResultSource__Product = 2;
+    localparam ResultSource__Quotient = 3;
+    localparam ResultSource__Root = 4;
+    localparam ResultSource__Byte = 5;
+    
+    // Stub signals
+    reg  [2:0] stage__0__d;
+    wire  [2:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [2:0] stage__1__d;
+    wire  [2:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [2:0] stage__2__d;
+    wire  [2:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [2:0] stage__3__d;
+    wire  [2:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [2:0] stage__4__d;
+    wire  [2:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [2:0] stage__5__d;
+    wire  [2:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [2:0] stage__6__d;
+    wire  [2:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [2:0] stage__7__d;
+    wire  [2:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [2:0] stage__8__d;
+    wire  [2:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [2:0] stage__9__d;
+    wire  [2:0] stage__9__q;
+    reg  stage__9__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__long_source
+
+
+module dynrt_processor__engine__result_line__long_source__stage__0(d,q,clock);
+    
+    // Module arguments
+    input wire  [2:0] d;
+    output reg  [2:0] q;
+    input wire  clock;
+    
+    // Enums
+    localparam ResultSource__Fast = 0;
+    localparam ResultSource__Sum = 1;
+    localparam ResultSource__Product = 2;
+    localparam ResultSource__Quotient = 3;
+    localparam ResultSource__Root = 4;
+    localparam ResultSource__Byte = 5;
+    
+    // Update code (custom)
+    initial begin
+       q = 64'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__result_line__long_source__stage__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__result_line__long_thread(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -12778,7 +13149,7 @@ module dynrt_processor__engine__result_line__long_op(clock,data_in,data_out);
         data_out = stage__9__q;
     end
     
-endmodule // dynrt_processor__engine__result_line__long_op
+endmodule // dynrt_processor__engine__result_line__long_thread
 
 
 
@@ -12849,118 +13220,100 @@ endmodule // dynrt_processor__engine__result_line__long_op
 
 
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor__engine__result_line__mb_hit_line(clock,data_in,data_out);
+module dynrt_processor__engine__result_line__pc_not_taken_line(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
-    input wire  data_in;
-    output reg  data_out;
+    input wire  [11:0] data_in;
+    output reg  [11:0] data_out;
     
     // Stub signals
-    reg  stage__0__d;
-    wire  stage__0__q;
+    reg  [11:0] stage__0__d;
+    wire  [11:0] stage__0__q;
     reg  stage__0__clock;
-    reg  stage__1__d;
-    wire  stage__1__q;
+    reg  [11:0] stage__1__d;
+    wire  [11:0] stage__1__q;
     reg  stage__1__clock;
-    reg  stage__2__d;
-    wire  stage__2__q;
+    reg  [11:0] stage__2__d;
+    wire  [11:0] stage__2__q;
     reg  stage__2__clock;
-    reg  stage__3__d;
-    wire  stage__3__q;
+    reg  [11:0] stage__3__d;
+    wire  [11:0] stage__3__q;
     reg  stage__3__clock;
-    reg  stage__4__d;
-    wire  stage__4__q;
+    reg  [11:0] stage__4__d;
+    wire  [11:0] stage__4__q;
     reg  stage__4__clock;
-    reg  stage__5__d;
-    wire  stage__5__q;
+    reg  [11:0] stage__5__d;
+    wire  [11:0] stage__5__q;
     reg  stage__5__clock;
-    reg  stage__6__d;
-    wire  stage__6__q;
+    reg  [11:0] stage__6__d;
+    wire  [11:0] stage__6__q;
     reg  stage__6__clock;
-    reg  stage__7__d;
-    wire  stage__7__q;
+    reg  [11:0] stage__7__d;
+    wire  [11:0] stage__7__q;
     reg  stage__7__clock;
-    reg  stage__8__d;
-    wire  stage__8__q;
+    reg  [11:0] stage__8__d;
+    wire  [11:0] stage__8__q;
     reg  stage__8__clock;
-    reg  stage__9__d;
-    wire  stage__9__q;
+    reg  [11:0] stage__9__d;
+    wire  [11:0] stage__9__q;
     reg  stage__9__clock;
-    reg  stage__10__d;
-    wire  stage__10__q;
+    reg  [11:0] stage__10__d;
+    wire  [11:0] stage__10__q;
     reg  stage__10__clock;
     
     // Sub module instances
-    dynrt_processor__display__dark_d stage__0(
+    dynrt_processor__display__timing__col stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor__display__dark_d stage__1(
+    dynrt_processor__display__timing__col stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor__display__dark_d stage__2(
+    dynrt_processor__display__timing__col stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor__display__dark_d stage__3(
+    dynrt_processor__display__timing__col stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor__display__dark_d stage__4(
+    dynrt_processor__display__timing__col stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor__display__dark_d stage__5(
+    dynrt_processor__display__timing__col stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor__display__dark_d stage__6(
+    dynrt_processor__display__timing__col stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor__display__dark_d stage__7(
+    dynrt_processor__display__timing__col stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor__display__dark_d stage__8(
+    dynrt_processor__display__timing__col stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor__display__dark_d stage__9(
+    dynrt_processor__display__timing__col stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor__display__dark_d stage__10(
+    dynrt_processor__display__timing__col stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
@@ -13003,7 +13356,7 @@ module dynrt_processor__engine__result_line__mb_hit_line(clock,data_in,data_out)
         data_out = stage__10__q;
     end
     
-endmodule // dynrt_processor__engine__result_line__mb_hit_line
+endmodule // dynrt_processor__engine__result_line__pc_not_taken_line
 
 
 
@@ -13054,7 +13407,278 @@ endmodule // dynrt_processor__engine__result_line__mb_hit_line
 
 
 
-module dynrt_processor__engine__result_line__op_line(clock,data_in,data_out);
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__result_line__source_line(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [2:0] data_in;
+    output reg  [2:0] data_out;
+    
+    // Enums
+    localparam ResultSource__Fast = 0;
+    localparam ResultSource__Sum = 1;
+    localparam ResultSource__Product = 2;
+    localparam ResultSource__Quotient = 3;
+    localparam ResultSource__Root = 4;
+    localparam ResultSource__Byte = 5;
+    
+    // Stub signals
+    reg  [2:0] stage__0__d;
+    wire  [2:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [2:0] stage__1__d;
+    wire  [2:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [2:0] stage__2__d;
+    wire  [2:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [2:0] stage__3__d;
+    wire  [2:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [2:0] stage__4__d;
+    wire  [2:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [2:0] stage__5__d;
+    wire  [2:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [2:0] stage__6__d;
+    wire  [2:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [2:0] stage__7__d;
+    wire  [2:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [2:0] stage__8__d;
+    wire  [2:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [2:0] stage__9__d;
+    wire  [2:0] stage__9__q;
+    reg  stage__9__clock;
+    reg  [2:0] stage__10__d;
+    wire  [2:0] stage__10__q;
+    reg  stage__10__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__source_line
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__result_line__thread_line(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
@@ -13095,9 +13719,6 @@ module dynrt_processor__engine__result_line__op_line(clock,data_in,data_out);
     reg  [4:0] stage__10__d;
     wire  [4:0] stage__10__q;
     reg  stage__10__clock;
-    reg  [4:0] stage__11__d;
-    wire  [4:0] stage__11__q;
-    reg  stage__11__clock;
     
     // Sub module instances
     dynrt_processor__engine__decode__t3 stage__0(
@@ -13155,11 +13776,6 @@ module dynrt_processor__engine__result_line__op_line(clock,data_in,data_out);
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__11(
-        .d(stage__11__d),
-        .q(stage__11__q),
-        .clock(stage__11__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -13174,7 +13790,6 @@ module dynrt_processor__engine__result_line__op_line(clock,data_in,data_out);
         stage__8__clock = clock;
         stage__9__clock = clock;
         stage__10__clock = clock;
-        stage__11__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -13186,7 +13801,6 @@ module dynrt_processor__engine__result_line__op_line(clock,data_in,data_out);
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
         stage__10__d = stage__9__q;
-        stage__11__d = stage__10__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -13198,92 +13812,9 @@ module dynrt_processor__engine__result_line__op_line(clock,data_in,data_out);
         data_out = stage__8__q;
         data_out = stage__9__q;
         data_out = stage__10__q;
-        data_out = stage__11__q;
     end
     
-endmodule // dynrt_processor__engine__result_line__op_line
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
+endmodule // dynrt_processor__engine__result_line__thread_line
 
 
 
@@ -13408,70 +13939,6 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     localparam  c_thread_mask = 32'hffffffff;
     localparam  c_one = 32'h1;
     localparam  c_ones = 32'hffffffff;
-    localparam  c_thread_ids__0 = 5'b0;
-    localparam  c_thread_ids__1 = 5'b1;
-    localparam  c_thread_ids__2 = 5'b10;
-    localparam  c_thread_ids__3 = 5'b11;
-    localparam  c_thread_ids__4 = 5'b100;
-    localparam  c_thread_ids__5 = 5'b101;
-    localparam  c_thread_ids__6 = 5'b110;
-    localparam  c_thread_ids__7 = 5'b111;
-    localparam  c_thread_ids__8 = 5'b1000;
-    localparam  c_thread_ids__9 = 5'b1001;
-    localparam  c_thread_ids__10 = 5'b1010;
-    localparam  c_thread_ids__11 = 5'b1011;
-    localparam  c_thread_ids__12 = 5'b1100;
-    localparam  c_thread_ids__13 = 5'b1101;
-    localparam  c_thread_ids__14 = 5'b1110;
-    localparam  c_thread_ids__15 = 5'b1111;
-    localparam  c_thread_ids__16 = 5'b10000;
-    localparam  c_thread_ids__17 = 5'b10001;
-    localparam  c_thread_ids__18 = 5'b10010;
-    localparam  c_thread_ids__19 = 5'b10011;
-    localparam  c_thread_ids__20 = 5'b10100;
-    localparam  c_thread_ids__21 = 5'b10101;
-    localparam  c_thread_ids__22 = 5'b10110;
-    localparam  c_thread_ids__23 = 5'b10111;
-    localparam  c_thread_ids__24 = 5'b11000;
-    localparam  c_thread_ids__25 = 5'b11001;
-    localparam  c_thread_ids__26 = 5'b11010;
-    localparam  c_thread_ids__27 = 5'b11011;
-    localparam  c_thread_ids__28 = 5'b11100;
-    localparam  c_thread_ids__29 = 5'b11101;
-    localparam  c_thread_ids__30 = 5'b11110;
-    localparam  c_thread_ids__31 = 5'b11111;
-    localparam  c_thread_bits__0 = 32'h1;
-    localparam  c_thread_bits__1 = 32'h2;
-    localparam  c_thread_bits__2 = 32'h4;
-    localparam  c_thread_bits__3 = 32'h8;
-    localparam  c_thread_bits__4 = 32'h10;
-    localparam  c_thread_bits__5 = 32'h20;
-    localparam  c_thread_bits__6 = 32'h40;
-    localparam  c_thread_bits__7 = 32'h80;
-    localparam  c_thread_bits__8 = 32'h100;
-    localparam  c_thread_bits__9 = 32'h200;
-    localparam  c_thread_bits__10 = 32'h400;
-    localparam  c_thread_bits__11 = 32'h800;
-    localparam  c_thread_bits__12 = 32'h1000;
-    localparam  c_thread_bits__13 = 32'h2000;
-    localparam  c_thread_bits__14 = 32'h4000;
-    localparam  c_thread_bits__15 = 32'h8000;
-    localparam  c_thread_bits__16 = 32'h10000;
-    localparam  c_thread_bits__17 = 32'h20000;
-    localparam  c_thread_bits__18 = 32'h40000;
-    localparam  c_thread_bits__19 = 32'h80000;
-    localparam  c_thread_bits__20 = 32'h100000;
-    localparam  c_thread_bits__21 = 32'h200000;
-    localparam  c_thread_bits__22 = 32'h400000;
-    localparam  c_thread_bits__23 = 32'h800000;
-    localparam  c_thread_bits__24 = 32'h1000000;
-    localparam  c_thread_bits__25 = 32'h2000000;
-    localparam  c_thread_bits__26 = 32'h4000000;
-    localparam  c_thread_bits__27 = 32'h8000000;
-    localparam  c_thread_bits__28 = 32'h10000000;
-    localparam  c_thread_bits__29 = 32'h20000000;
-    localparam  c_thread_bits__30 = 32'h40000000;
-    localparam  c_thread_bits__31 = 32'h80000000;
     localparam  c_reserve_bit = 32'h6;
     
     // Stub signals
@@ -13502,12 +13969,15 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     reg  [31:0] reserved__d;
     wire  [31:0] reserved__q;
     reg  reserved__clock;
+    reg  [31:0] first_ready__preferred;
+    reg  [31:0] first_ready__others;
+    wire  first_ready__found;
+    wire  [31:0] first_ready__onehot;
+    wire  [4:0] first_ready__number;
     
     // Local signals
     reg  [31:0] candidates;
     reg  [31:0] below;
-    reg  [4:0] choice;
-    reg  [31:0] choice_onehot;
     reg  issues;
     reg  [31:0] issue_mask;
     reg  [31:0] wb_mask;
@@ -13564,6 +14034,13 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         .q(reserved__q),
         .clock(reserved__clock)
     );
+    dynrt_processor__engine__scheduler__first_ready first_ready(
+        .preferred(first_ready__preferred),
+        .others(first_ready__others),
+        .found(first_ready__found),
+        .onehot(first_ready__onehot),
+        .number(first_ready__number)
+    );
     
     // Update code
     always @(*) begin
@@ -13595,267 +14072,11 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         reserved__d = (reserved__q >> 32'h1) | (((long_at_i3) & 32'hffffffff) << c_reserve_bit);
         candidates = ready__q & (~pick_onehot__q);
         below = candidates & below_pointer__q;
-        choice = 32'h0;
-        choice_onehot = 32'h0;
-        if (candidates[0]) begin
-            choice = c_thread_ids__0;
-            choice_onehot = c_thread_bits__0;
-        end
-        if (candidates[1]) begin
-            choice = c_thread_ids__1;
-            choice_onehot = c_thread_bits__1;
-        end
-        if (candidates[2]) begin
-            choice = c_thread_ids__2;
-            choice_onehot = c_thread_bits__2;
-        end
-        if (candidates[3]) begin
-            choice = c_thread_ids__3;
-            choice_onehot = c_thread_bits__3;
-        end
-        if (candidates[4]) begin
-            choice = c_thread_ids__4;
-            choice_onehot = c_thread_bits__4;
-        end
-        if (candidates[5]) begin
-            choice = c_thread_ids__5;
-            choice_onehot = c_thread_bits__5;
-        end
-        if (candidates[6]) begin
-            choice = c_thread_ids__6;
-            choice_onehot = c_thread_bits__6;
-        end
-        if (candidates[7]) begin
-            choice = c_thread_ids__7;
-            choice_onehot = c_thread_bits__7;
-        end
-        if (candidates[8]) begin
-            choice = c_thread_ids__8;
-            choice_onehot = c_thread_bits__8;
-        end
-        if (candidates[9]) begin
-            choice = c_thread_ids__9;
-            choice_onehot = c_thread_bits__9;
-        end
-        if (candidates[10]) begin
-            choice = c_thread_ids__10;
-            choice_onehot = c_thread_bits__10;
-        end
-        if (candidates[11]) begin
-            choice = c_thread_ids__11;
-            choice_onehot = c_thread_bits__11;
-        end
-        if (candidates[12]) begin
-            choice = c_thread_ids__12;
-            choice_onehot = c_thread_bits__12;
-        end
-        if (candidates[13]) begin
-            choice = c_thread_ids__13;
-            choice_onehot = c_thread_bits__13;
-        end
-        if (candidates[14]) begin
-            choice = c_thread_ids__14;
-            choice_onehot = c_thread_bits__14;
-        end
-        if (candidates[15]) begin
-            choice = c_thread_ids__15;
-            choice_onehot = c_thread_bits__15;
-        end
-        if (candidates[16]) begin
-            choice = c_thread_ids__16;
-            choice_onehot = c_thread_bits__16;
-        end
-        if (candidates[17]) begin
-            choice = c_thread_ids__17;
-            choice_onehot = c_thread_bits__17;
-        end
-        if (candidates[18]) begin
-            choice = c_thread_ids__18;
-            choice_onehot = c_thread_bits__18;
-        end
-        if (candidates[19]) begin
-            choice = c_thread_ids__19;
-            choice_onehot = c_thread_bits__19;
-        end
-        if (candidates[20]) begin
-            choice = c_thread_ids__20;
-            choice_onehot = c_thread_bits__20;
-        end
-        if (candidates[21]) begin
-            choice = c_thread_ids__21;
-            choice_onehot = c_thread_bits__21;
-        end
-        if (candidates[22]) begin
-            choice = c_thread_ids__22;
-            choice_onehot = c_thread_bits__22;
-        end
-        if (candidates[23]) begin
-            choice = c_thread_ids__23;
-            choice_onehot = c_thread_bits__23;
-        end
-        if (candidates[24]) begin
-            choice = c_thread_ids__24;
-            choice_onehot = c_thread_bits__24;
-        end
-        if (candidates[25]) begin
-            choice = c_thread_ids__25;
-            choice_onehot = c_thread_bits__25;
-        end
-        if (candidates[26]) begin
-            choice = c_thread_ids__26;
-            choice_onehot = c_thread_bits__26;
-        end
-        if (candidates[27]) begin
-            choice = c_thread_ids__27;
-            choice_onehot = c_thread_bits__27;
-        end
-        if (candidates[28]) begin
-            choice = c_thread_ids__28;
-            choice_onehot = c_thread_bits__28;
-        end
-        if (candidates[29]) begin
-            choice = c_thread_ids__29;
-            choice_onehot = c_thread_bits__29;
-        end
-        if (candidates[30]) begin
-            choice = c_thread_ids__30;
-            choice_onehot = c_thread_bits__30;
-        end
-        if (candidates[31]) begin
-            choice = c_thread_ids__31;
-            choice_onehot = c_thread_bits__31;
-        end
-        if (below[0]) begin
-            choice = c_thread_ids__0;
-            choice_onehot = c_thread_bits__0;
-        end
-        if (below[1]) begin
-            choice = c_thread_ids__1;
-            choice_onehot = c_thread_bits__1;
-        end
-        if (below[2]) begin
-            choice = c_thread_ids__2;
-            choice_onehot = c_thread_bits__2;
-        end
-        if (below[3]) begin
-            choice = c_thread_ids__3;
-            choice_onehot = c_thread_bits__3;
-        end
-        if (below[4]) begin
-            choice = c_thread_ids__4;
-            choice_onehot = c_thread_bits__4;
-        end
-        if (below[5]) begin
-            choice = c_thread_ids__5;
-            choice_onehot = c_thread_bits__5;
-        end
-        if (below[6]) begin
-            choice = c_thread_ids__6;
-            choice_onehot = c_thread_bits__6;
-        end
-        if (below[7]) begin
-            choice = c_thread_ids__7;
-            choice_onehot = c_thread_bits__7;
-        end
-        if (below[8]) begin
-            choice = c_thread_ids__8;
-            choice_onehot = c_thread_bits__8;
-        end
-        if (below[9]) begin
-            choice = c_thread_ids__9;
-            choice_onehot = c_thread_bits__9;
-        end
-        if (below[10]) begin
-            choice = c_thread_ids__10;
-            choice_onehot = c_thread_bits__10;
-        end
-        if (below[11]) begin
-            choice = c_thread_ids__11;
-            choice_onehot = c_thread_bits__11;
-        end
-        if (below[12]) begin
-            choice = c_thread_ids__12;
-            choice_onehot = c_thread_bits__12;
-        end
-        if (below[13]) begin
-            choice = c_thread_ids__13;
-            choice_onehot = c_thread_bits__13;
-        end
-        if (below[14]) begin
-            choice = c_thread_ids__14;
-            choice_onehot = c_thread_bits__14;
-        end
-        if (below[15]) begin
-            choice = c_thread_ids__15;
-            choice_onehot = c_thread_bits__15;
-        end
-        if (below[16]) begin
-            choice = c_thread_ids__16;
-            choice_onehot = c_thread_bits__16;
-        end
-        if (below[17]) begin
-            choice = c_thread_ids__17;
-            choice_onehot = c_thread_bits__17;
-        end
-        if (below[18]) begin
-            choice = c_thread_ids__18;
-            choice_onehot = c_thread_bits__18;
-        end
-        if (below[19]) begin
-            choice = c_thread_ids__19;
-            choice_onehot = c_thread_bits__19;
-        end
-        if (below[20]) begin
-            choice = c_thread_ids__20;
-            choice_onehot = c_thread_bits__20;
-        end
-        if (below[21]) begin
-            choice = c_thread_ids__21;
-            choice_onehot = c_thread_bits__21;
-        end
-        if (below[22]) begin
-            choice = c_thread_ids__22;
-            choice_onehot = c_thread_bits__22;
-        end
-        if (below[23]) begin
-            choice = c_thread_ids__23;
-            choice_onehot = c_thread_bits__23;
-        end
-        if (below[24]) begin
-            choice = c_thread_ids__24;
-            choice_onehot = c_thread_bits__24;
-        end
-        if (below[25]) begin
-            choice = c_thread_ids__25;
-            choice_onehot = c_thread_bits__25;
-        end
-        if (below[26]) begin
-            choice = c_thread_ids__26;
-            choice_onehot = c_thread_bits__26;
-        end
-        if (below[27]) begin
-            choice = c_thread_ids__27;
-            choice_onehot = c_thread_bits__27;
-        end
-        if (below[28]) begin
-            choice = c_thread_ids__28;
-            choice_onehot = c_thread_bits__28;
-        end
-        if (below[29]) begin
-            choice = c_thread_ids__29;
-            choice_onehot = c_thread_bits__29;
-        end
-        if (below[30]) begin
-            choice = c_thread_ids__30;
-            choice_onehot = c_thread_bits__30;
-        end
-        if (below[31]) begin
-            choice = c_thread_ids__31;
-            choice_onehot = c_thread_bits__31;
-        end
-        picked__d = candidates != 32'h0;
-        pick_r__d = choice;
-        pick_onehot__d = choice_onehot;
+        first_ready__preferred = below;
+        first_ready__others = candidates;
+        picked__d = first_ready__found;
+        pick_r__d = first_ready__number;
+        pick_onehot__d = first_ready__onehot;
         pointer__d = pointer__q - 32'h1;
         below_pointer__d = ~(c_ones << (pointer__q - 32'h1));
         wb_mask = c_one << wb_thread;
@@ -13896,6 +14117,71 @@ endmodule // dynrt_processor__engine__scheduler
 
 
 
+
+
+module dynrt_processor__engine__scheduler__first_ready(preferred,others,found,onehot,number);
+    
+    // Module arguments
+    input wire  [31:0] preferred;
+    input wire  [31:0] others;
+    output reg  found;
+    output reg  [31:0] onehot;
+    output reg  [4:0] number;
+    
+    // Constant declarations
+    localparam  c_group_low = 64'h1111111111111111;
+    localparam  c_below_3 = 64'h7777777777777777;
+    localparam  c_below_2 = 64'h3333333333333333;
+    localparam  c_number_bit__0 = 32'haaaaaaaa;
+    localparam  c_number_bit__1 = 32'hcccccccc;
+    localparam  c_number_bit__2 = 32'hf0f0f0f0;
+    localparam  c_number_bit__3 = 32'hff00ff00;
+    localparam  c_number_bit__4 = 32'hffff0000;
+    
+    // Local signals
+    reg  [63:0] both;
+    reg  [63:0] spread;
+    reg  [63:0] group_any;
+    reg  [63:0] above_1;
+    reg  [63:0] above_2;
+    reg  [63:0] above_4;
+    reg  [63:0] above_8;
+    reg  [63:0] above_16;
+    reg  [63:0] group_first;
+    reg  [63:0] group_mask;
+    reg  [63:0] higher_in_group;
+    reg  [63:0] first;
+    reg  number_bits__0;
+    reg  number_bits__1;
+    reg  number_bits__2;
+    reg  number_bits__3;
+    reg  number_bits__4;
+    
+    // Update code
+    always @(*) begin
+        both = (((preferred) & 64'hffffffffffffffff) << 32'h20) | ((others) & 64'hffffffffffffffff);
+        spread = both | (both >> 32'h1);
+        group_any = (spread | (spread >> 32'h2)) & c_group_low;
+        above_1 = group_any >> 32'h4;
+        above_2 = above_1 | (above_1 >> 32'h4);
+        above_4 = above_2 | (above_2 >> 32'h8);
+        above_8 = above_4 | (above_4 >> 32'h10);
+        above_16 = above_8 | (above_8 >> 32'h20);
+        group_first = group_any & (~above_16);
+        group_mask = group_first | (group_first << 32'h1) | (group_first << 32'h2) | (group_first << 32'h3);
+        higher_in_group = ((both >> 32'h1) & c_below_3) | ((both >> 32'h2) & c_below_2) | ((both >> 32'h3) & c_group_low);
+        first = both & (~higher_in_group) & group_mask;
+        onehot = first[(32'h0)+:(32)] | first[(32'h20)+:(32)];
+        number_bits__0 = (onehot & c_number_bit__0) != 32'h0;
+        number_bits__1 = (onehot & c_number_bit__1) != 32'h0;
+        number_bits__2 = (onehot & c_number_bit__2) != 32'h0;
+        number_bits__3 = (onehot & c_number_bit__3) != 32'h0;
+        number_bits__4 = (onehot & c_number_bit__4) != 32'h0;
+        number = ((number_bits__0) & 5'h1f) | (((number_bits__1) & 5'h1f) << 32'h1) | (((number_bits__2) & 5'h1f) << 32'h2) | (((number_bits__3) & 5'h1f) << 32'h3) | (((number_bits__4) & 5'h1f) << 32'h4);
+        found = both != 32'h0;
+    end
+    
+endmodule // dynrt_processor__engine__scheduler__first_ready
 
 
 
@@ -29095,25 +29381,24 @@ endmodule // dynrt_processor__engine__traversal_unit__stack_node
 
 
 
-module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__op,retiring__dst,retiring__thread,retiring__invert,retiring__pc_plus_one,retiring__target,retiring__is_wait,retiring__kd_busy,retiring__tri_busy,retiring__jr_target,retiring__int_eq,retiring__int_lt,retiring__mb_hit,retiring__pix_done,retiring__fast,sum,product,quotient,root,lt,le,eq,colour_byte,valid,thread,dst,write,data,next_pc,halt,retired,wait_pending);
+module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,retiring__thread,retiring__write,retiring__source,retiring__cond,retiring__sel_lt,retiring__sel_le,retiring__sel_eq,retiring__pc_taken,retiring__pc_not_taken,retiring__halt,retiring__retired,retiring__wait_pending,retiring__fast,sum,product,quotient,root,lt,le,eq,colour_byte,valid,thread,dst,write,data,next_pc,halt,retired,wait_pending);
     
     // Module arguments
     input wire  clock;
     input wire  retiring__valid;
-    input wire  [4:0] retiring__op;
     input wire  [7:0] retiring__dst;
     input wire  [4:0] retiring__thread;
-    input wire  retiring__invert;
-    input wire  [11:0] retiring__pc_plus_one;
-    input wire  [11:0] retiring__target;
-    input wire  retiring__is_wait;
-    input wire  retiring__kd_busy;
-    input wire  retiring__tri_busy;
-    input wire  [11:0] retiring__jr_target;
-    input wire  retiring__int_eq;
-    input wire  retiring__int_lt;
-    input wire  retiring__mb_hit;
-    input wire  retiring__pix_done;
+    input wire  retiring__write;
+    input wire  [2:0] retiring__source;
+    input wire  retiring__cond;
+    input wire  retiring__sel_lt;
+    input wire  retiring__sel_le;
+    input wire  retiring__sel_eq;
+    input wire  [11:0] retiring__pc_taken;
+    input wire  [11:0] retiring__pc_not_taken;
+    input wire  retiring__halt;
+    input wire  retiring__retired;
+    input wire  retiring__wait_pending;
     input wire  [31:0] retiring__fast;
     input wire  [23:0] sum;
     input wire  [23:0] product;
@@ -29133,26 +29418,13 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__op,re
     output reg  retired;
     output reg  wait_pending;
     
-    // Constant declarations
-    localparam  op_fadd = 5'b1;
-    localparam  op_fsub = 5'b10;
-    localparam  op_fmul = 5'b11;
-    localparam  op_fdiv = 5'b100;
-    localparam  op_fsqrt = 5'b101;
-    localparam  op_bflt = 5'b10010;
-    localparam  op_bfle = 5'b10011;
-    localparam  op_bfeq = 5'b10100;
-    localparam  op_beq = 5'b10101;
-    localparam  op_bltu = 5'b10110;
-    localparam  op_jal = 5'b10111;
-    localparam  op_jr = 5'b11000;
-    localparam  op_mbx = 5'b11001;
-    localparam  op_pixel = 5'b11011;
-    localparam  op_halt = 5'b11100;
-    localparam  op_tri = 5'b11101;
-    localparam  op_kd = 5'b11110;
-    localparam  op_byte = 5'b11111;
-    localparam  op_writes = 32'ha8817ffe;
+    // Enums
+    localparam ResultSource__Fast = 0;
+    localparam ResultSource__Sum = 1;
+    localparam ResultSource__Product = 2;
+    localparam ResultSource__Quotient = 3;
+    localparam ResultSource__Root = 4;
+    localparam ResultSource__Byte = 5;
     
     // Stub signals
     reg  valid_r__d;
@@ -29184,9 +29456,7 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__op,re
     reg  wait_pending_r__clock;
     
     // Local signals
-    reg  cond;
-    reg  repeats;
-    reg  [11:0] pc;
+    reg  taken;
     reg  [31:0] result;
     
     // Sub module instances
@@ -29256,75 +29526,45 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__op,re
         halt_r__d = halt_r__q;
         retired_r__d = retired_r__q;
         wait_pending_r__d = wait_pending_r__q;
-        cond = 1'b0;
-        if (retiring__op == op_bflt) begin
-            cond = lt;
-        end
-        if (retiring__op == op_bfle) begin
-            cond = le;
-        end
-        if (retiring__op == op_bfeq) begin
-            cond = eq;
-        end
-        if (retiring__op == op_beq) begin
-            cond = retiring__int_eq;
-        end
-        if (retiring__op == op_bltu) begin
-            cond = retiring__int_lt;
-        end
-        if (retiring__op == op_mbx) begin
-            cond = retiring__mb_hit;
-        end
-        if (retiring__op == op_pixel) begin
-            cond = retiring__pix_done;
-        end
-        if (retiring__op == op_jal) begin
-            cond = 1'b1;
-        end
-        if (retiring__op == op_tri) begin
-            cond = retiring__tri_busy;
-        end
-        if (retiring__op == op_kd) begin
-            cond = retiring__kd_busy;
-        end
-        repeats = ((retiring__op == op_tri) | (retiring__op == op_kd)) & cond;
-        if (cond != retiring__invert) begin
-            pc = retiring__target;
-        end
-        else begin
-            pc = retiring__pc_plus_one;
-        end
-        if (retiring__op == op_jr) begin
-            pc = retiring__jr_target;
-        end
-        if ((retiring__op == op_halt) | repeats) begin
-            pc = retiring__pc_plus_one - 32'h1;
+        taken = retiring__cond | (retiring__sel_lt & lt) | (retiring__sel_le & le) | (retiring__sel_eq & eq);
+        next_pc_r__d = retiring__pc_not_taken;
+        if (taken) begin
+            next_pc_r__d = retiring__pc_taken;
         end
         result = retiring__fast;
-        if ((retiring__op == op_fadd) | (retiring__op == op_fsub)) begin
-            result = ((sum) & 32'hffffffff);
-        end
-        if (retiring__op == op_fmul) begin
-            result = ((product) & 32'hffffffff);
-        end
-        if (retiring__op == op_fdiv) begin
-            result = ((quotient) & 32'hffffffff);
-        end
-        if (retiring__op == op_fsqrt) begin
-            result = ((root) & 32'hffffffff);
-        end
-        if (retiring__op == op_byte) begin
-            result = retiring__fast | ((colour_byte) & 32'hffffffff);
-        end
+        case (retiring__source)
+            ResultSource__Fast:
+                begin
+                end
+            ResultSource__Sum:
+                begin
+                    result = ((sum) & 32'hffffffff);
+                end
+            ResultSource__Product:
+                begin
+                    result = ((product) & 32'hffffffff);
+                end
+            ResultSource__Quotient:
+                begin
+                    result = ((quotient) & 32'hffffffff);
+                end
+            ResultSource__Root:
+                begin
+                    result = ((root) & 32'hffffffff);
+                end
+            ResultSource__Byte:
+                begin
+                    result = retiring__fast | ((colour_byte) & 32'hffffffff);
+                end
+        endcase
         valid_r__d = retiring__valid;
         thread_r__d = retiring__thread;
         dst_r__d = retiring__dst;
-        next_pc_r__d = pc;
         data_r__d = result;
-        halt_r__d = retiring__op == op_halt;
-        write_r__d = retiring__valid & (retiring__dst != 32'h0) & op_writes[retiring__op] & (~((retiring__op == op_pixel) & retiring__pix_done));
-        retired_r__d = retiring__valid & (~repeats);
-        wait_pending_r__d = cond & retiring__is_wait;
+        write_r__d = retiring__write;
+        halt_r__d = retiring__halt;
+        retired_r__d = retiring__retired;
+        wait_pending_r__d = retiring__wait_pending;
         valid = valid_r__q;
         thread = thread_r__q;
         dst = dst_r__q;
