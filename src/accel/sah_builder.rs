@@ -264,8 +264,13 @@ impl<P: KdPrimitives> Builder<'_, P> {
                 }
                 let pl = 2.0 * (cap + (p - lo) * ring) * inv_area;
                 let pr = 2.0 * (cap + (hi - p) * ring) * inv_area;
-                let cl = cost(pl, pr, nl + planars, nr);
                 let cr = cost(pl, pr, nl, nr + planars);
+                // Without primitives in the plane both sides cost the same.
+                let cl = if planars == 0 {
+                    cr
+                } else {
+                    cost(pl, pr, nl + planars, nr)
+                };
                 let planar_left = cl < cr;
                 let c = if planar_left { cl } else { cr };
                 let plane = Plane {
