@@ -84,8 +84,7 @@ pub struct Scheduler {
     wake_mask: Signal<Local, Bits<32>>,
     sleep_mask: Signal<Local, Bits<32>>,
 
-    /// Bit `t` set for every thread `t` of the design; one; all ones; each thread's number
-    /// and one-hot bit.
+    /// Bit `t` set for every thread `t` of the design; one; all ones.
     c_thread_mask: Constant<Bits<32>>,
     c_one: Constant<Bits<32>>,
     c_ones: Constant<Bits<32>>,
