@@ -34,6 +34,9 @@ use super::{const_bits, const_index, inf_word, qnan_word};
 /// Latency of [`FpAddSub`] in clocks.
 pub const ADD_SUB_LATENCY: u32 = 8;
 
+/// Bits of the clamped alignment shift: `S + 3` is below 32 for every format (`T <= 32`).
+const ALIGN_SHIFT_BITS: usize = 5;
+
 #[derive(LogicBlock)]
 pub struct FpAddSub<
     const W: usize,
@@ -80,8 +83,10 @@ pub struct FpAddSub<
     big_sig: DFF<Bits<S>>,
     small_sig: DFF<Bits<S>>,
     big_exp: DFF<Bits<E>>,
-    /// The exponent difference, clamped to `S + 3`.
-    shift: DFF<Bits<E>>,
+    /// The exponent difference, clamped to `S + 3`, in [`ALIGN_SHIFT_BITS`] bits: the align
+    /// shifter then has 5 levels, not `E` (the two unused levels sat in the processor's
+    /// `add.shift -> add.al_small` paths, issue 16).
+    shift: DFF<Bits<ALIGN_SHIFT_BITS>>,
     big_sign: DFF<Bit>,
     eff_sub: DFF<Bit>,
     nan: DFF<Bit>,
@@ -223,6 +228,10 @@ impl<
             "FpAddSub: the normalizer handles at most 31 leading zeros"
         );
         assert!(S + 3 < (1 << E), "FpAddSub: shift clamp must fit in E bits");
+        assert!(
+            S + 3 < (1 << ALIGN_SHIFT_BITS),
+            "FpAddSub: shift clamp must fit the align shifter"
+        );
         Self {
             clock: Default::default(),
             in_valid: Default::default(),
@@ -504,13 +513,13 @@ impl<
             self.big_sig.d.next = self.sig_a.val();
             self.small_sig.d.next = self.sig_b.val();
             self.big_exp.d.next = self.exp_a.val();
-            self.shift.d.next = self.shift_ab.val();
+            self.shift.d.next = bit_cast::<ALIGN_SHIFT_BITS, E>(self.shift_ab.val());
             self.big_sign.d.next = self.sign_a.val();
         } else {
             self.big_sig.d.next = self.sig_b.val();
             self.small_sig.d.next = self.sig_a.val();
             self.big_exp.d.next = self.exp_b.val();
-            self.shift.d.next = self.shift_ba.val();
+            self.shift.d.next = bit_cast::<ALIGN_SHIFT_BITS, E>(self.shift_ba.val());
             self.big_sign.d.next = self.sign_b.val();
         }
         self.eff_sub.d.next = self.sign_a.val() ^ self.sign_b.val();
