@@ -23,6 +23,7 @@
 use rust_hdl::prelude::*;
 
 use crate::hw::program::isa::{self, BANK_BITS, OP_BITS, PC_BITS, REG_BITS, SHIFT_BITS};
+use crate::hw::NoCollisionRam;
 
 #[derive(LogicBlock)]
 pub struct Decode {
@@ -60,8 +61,11 @@ pub struct Decode {
     pub wb_data: Signal<In, Bits<32>>,
 
     /// The register file, `{thread, register}`-addressed, once per read port.
-    regs_a: RAM<Bits<32>, 13>,
-    regs_b: RAM<Bits<32>, 13>,
+    // A thread's write back and its next register read are never in one clock (one
+    // instruction per thread in flight, the thread in the address's top bits), so the
+    // block RAMs need no read-first emulation.
+    regs_a: NoCollisionRam<Bits<32>, 13>,
+    regs_b: NoCollisionRam<Bits<32>, 13>,
     v3: DFF<Bit>,
     t3: DFF<Bits<5>>,
     pc3: DFF<Bits<PC_BITS>>,

@@ -63,7 +63,9 @@ pub struct FpDiv<
     sig_a: Signal<Local, Bits<S1>>,
     sig_b: Signal<Local, Bits<S1>>,
     a_below_b: Signal<Local, Bit>,
-    dividend: Signal<Local, Bits<S1>>,
+    // The first remainder for either dividend, formed beside the compare that picks one.
+    rem_first: Signal<Local, Bits<S1>>,
+    rem_first_doubled: Signal<Local, Bits<S1>>,
     // Quotient stages: stage i holds the remainder after quotient bit i, already doubled.
     rem: [DFF<Bits<S1>>; S],
     quo: [DFF<Bits<S1>>; S],
@@ -131,7 +133,8 @@ impl<
             sig_a: Default::default(),
             sig_b: Default::default(),
             a_below_b: Default::default(),
-            dividend: Default::default(),
+            rem_first: Default::default(),
+            rem_first_doubled: Default::default(),
             rem: std::array::from_fn(|_| Default::default()),
             quo: std::array::from_fn(|_| Default::default()),
             divisor: std::array::from_fn(|_| Default::default()),
@@ -225,15 +228,18 @@ impl<
             bit_cast::<S1, M>(self.in_a.q.val().get_bits::<M>(0)) | self.c_hidden.val();
         self.sig_b.next =
             bit_cast::<S1, M>(self.in_b.q.val().get_bits::<M>(0)) | self.c_hidden.val();
-        // Doubling a smaller dividend puts the quotient in [1, 2): its first bit is 1.
+        // Doubling a smaller dividend puts the quotient in [1, 2): its first bit is 1. Both
+        // first remainders are formed beside the compare (the compare's carry chain in front
+        // of the subtraction's was the unit's critical path, 28 carries: issue 16).
         self.a_below_b.next = self.sig_a.val() < self.sig_b.val();
-        self.dividend.next = self.sig_a.val();
-        if self.a_below_b.val() {
-            self.dividend.next = self.sig_a.val() << 1;
-        }
+        self.rem_first.next = self.sig_a.val() - self.sig_b.val();
+        self.rem_first_doubled.next = (self.sig_a.val() << 1) - self.sig_b.val();
 
         // Stage 2: quotient bit 0 (always 1) and the flags.
-        self.rem[0].d.next = (self.dividend.val() - self.sig_b.val()) << 1;
+        self.rem[0].d.next = self.rem_first.val() << 1;
+        if self.a_below_b.val() {
+            self.rem[0].d.next = self.rem_first_doubled.val() << 1;
+        }
         self.quo[0].d.next = self.c_one.val();
         self.divisor[0].d.next = self.sig_b.val();
         self.exp[0].d.next = (bit_cast::<X2, E>(self.exp_a.val())
