@@ -25,6 +25,10 @@ pub trait KdPrimitives {
     fn bounds(&self, i: usize) -> Aabb;
     /// Bounds of the part of primitive `i` inside `voxel` (see the module contract).
     fn clipped_bounds(&self, i: usize, voxel: &Aabb) -> Option<Aabb>;
+    /// Whether clipping a primitive to one side of a plane changes its bounds along the
+    /// plane's axis only (so the builder keeps its events on the other axes). True of boxes:
+    /// a box cut to a child voxel is the box cut to the parent voxel, cut by the plane.
+    const CLIPPING_KEEPS_OTHER_AXES: bool = false;
 }
 
 /// Triangles given by their three vertices.
@@ -52,6 +56,7 @@ impl KdPrimitives for Triangles<'_> {
 }
 
 impl KdPrimitives for Boxes<'_> {
+    const CLIPPING_KEEPS_OTHER_AXES: bool = true;
     fn len(&self) -> usize {
         self.0.len()
     }

@@ -32,7 +32,8 @@
 //! stores its position as order-preserving bits, so sorting and merging compare one integer;
 //! the f64 sweep is compiled apart from the rounded one; the lists are split without a branch
 //! on the side of each event; the clipped primitives' events are merged in by binary search
-//! and block moves.
+//! and block moves; boxes (the top level), whose clipping changes only the split axis, keep
+//! their events on the other two axes instead of having them clipped, sorted and merged anew.
 
 use super::aabb::Aabb;
 use super::kd_tree::{KdNode, KdParams, KdTree};
@@ -498,8 +499,16 @@ impl<P: KdPrimitives> Builder<'_, P> {
                     nr += 1;
                 }
             }
-            for list in new_left.iter_mut().chain(new_right.iter_mut()) {
-                list.sort_unstable_by_key(Event::sort_key);
+            for axis in 0..3 {
+                if P::CLIPPING_KEEPS_OTHER_AXES && axis != plane.axis {
+                    // The clipped bounds are the old ones on this axis: the primitives keep
+                    // their events, on both sides (below).
+                    new_left[axis].clear();
+                    new_right[axis].clear();
+                } else {
+                    new_left[axis].sort_unstable_by_key(Event::sort_key);
+                    new_right[axis].sort_unstable_by_key(Event::sort_key);
+                }
             }
         } else {
             nl += both.len();
@@ -510,10 +519,11 @@ impl<P: KdPrimitives> Builder<'_, P> {
         let mut right = self.fresh();
         // Whether an event of a primitive on each side goes to the left / right child's lists
         // (indexed by side); straddlers' own events go to both only without clipping.
-        let both_too = usize::from(!clip);
-        let to_left = [both_too, 1, 0];
-        let to_right = [both_too, 0, 1];
         for axis in 0..3 {
+            let both_too =
+                usize::from(!clip || (P::CLIPPING_KEEPS_OTHER_AXES && axis != plane.axis));
+            let to_left = [both_too, 1, 0];
+            let to_right = [both_too, 0, 1];
             let list = &events[axis];
             // Every event is written to both lists and kept where its primitive goes: no
             // branch on the (unpredictable) side.
