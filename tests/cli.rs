@@ -643,7 +643,7 @@ fn bench_paper_reports_every_scene_and_what_does_not_fit() {
     assert_eq!(rows.len(), 3, "{csv}");
     assert!(rows[0].contains("fps at 81.4 MHz (512x384)"), "{csv}");
     assert!(
-        rows[1].starts_with("Scene6,806,820,820,1,") && rows[1].contains(",yes,"),
+        rows[1].starts_with("Scene6,806,820,820,1,") && rows[1].contains(",yes,static,"),
         "{csv}"
     );
     assert!(rows[1].contains("no: left out (--no-sim)"), "{csv}");

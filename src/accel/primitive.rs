@@ -25,6 +25,10 @@ pub trait KdPrimitives {
     fn bounds(&self, i: usize) -> Aabb;
     /// Bounds of the part of primitive `i` inside `voxel` (see the module contract).
     fn clipped_bounds(&self, i: usize, voxel: &Aabb) -> Option<Aabb>;
+    /// Whether clipping a primitive to one side of a plane changes its bounds along the
+    /// plane's axis only (so the builder keeps its events on the other axes). True of boxes:
+    /// a box cut to a child voxel is the box cut to the parent voxel, cut by the plane.
+    const CLIPPING_KEEPS_OTHER_AXES: bool = false;
 }
 
 /// Triangles given by their three vertices.
@@ -52,6 +56,7 @@ impl KdPrimitives for Triangles<'_> {
 }
 
 impl KdPrimitives for Boxes<'_> {
+    const CLIPPING_KEEPS_OTHER_AXES: bool = true;
     fn len(&self) -> usize {
         self.0.len()
     }
@@ -73,15 +78,12 @@ struct Polygon {
 }
 
 impl Polygon {
-    /// Keeps the part with `sign * (p[axis] - pos) >= 0`.
-    fn clip(&self, axis: usize, pos: f64, sign: f64) -> Polygon {
-        let mut out = Polygon {
-            v: [DVec3::ZERO; MAX_POLY + 1],
-            n: 0,
-        };
+    /// Writes into `out` the part with `sign * (p[axis] - pos) >= 0`.
+    fn clip_into(&self, axis: usize, pos: f64, sign: f64, out: &mut Polygon) {
+        out.n = 0;
         for i in 0..self.n {
             let a = self.v[i];
-            let b = self.v[(i + 1) % self.n];
+            let b = self.v[if i + 1 == self.n { 0 } else { i + 1 }];
             let da = sign * (a[axis] - pos);
             let db = sign * (b[axis] - pos);
             if da >= 0.0 {
@@ -97,7 +99,46 @@ impl Polygon {
                 out.n += 1;
             }
         }
-        out
+    }
+}
+
+/// A polygon cut plane by plane, in two buffers that take turns (a new polygon per plane cost
+/// more than the clipping).
+struct Clipper {
+    buffers: [Polygon; 2],
+    /// The buffer holding the polygon.
+    current: usize,
+}
+
+impl Clipper {
+    fn new(tri: &[DVec3; 3]) -> Clipper {
+        let mut first = Polygon {
+            v: [DVec3::ZERO; MAX_POLY + 1],
+            n: 3,
+        };
+        first.v[..3].copy_from_slice(tri);
+        Clipper {
+            buffers: [
+                first,
+                Polygon {
+                    v: [DVec3::ZERO; MAX_POLY + 1],
+                    n: 0,
+                },
+            ],
+            current: 0,
+        }
+    }
+
+    fn polygon(&self) -> &Polygon {
+        &self.buffers[self.current]
+    }
+
+    /// Keeps the part of the polygon with `sign * (p[axis] - pos) >= 0`.
+    fn cut(&mut self, axis: usize, pos: f64, sign: f64) {
+        let [a, b] = &mut self.buffers;
+        let (from, to) = if self.current == 0 { (a, b) } else { (b, a) };
+        from.clip_into(axis, pos, sign, to);
+        self.current ^= 1;
     }
 }
 
@@ -118,23 +159,20 @@ pub fn clip_triangle_bounds(tri: &[DVec3; 3], voxel: &Aabb) -> Option<Aabb> {
         .max(voxel.max.abs())
         .max_element();
     let grown = voxel.expanded(scale * 1e-12 + f64::MIN_POSITIVE);
-    let mut poly = Polygon {
-        v: [DVec3::ZERO; MAX_POLY + 1],
-        n: 3,
-    };
-    poly.v[..3].copy_from_slice(tri);
+    let mut clipper = Clipper::new(tri);
     for axis in 0..3 {
         // Only cut planes the triangle actually crosses; this keeps vertices exact otherwise.
         if tb.min[axis] < grown.min[axis] {
-            poly = poly.clip(axis, grown.min[axis], 1.0);
+            clipper.cut(axis, grown.min[axis], 1.0);
         }
-        if poly.n > 0 && tb.max[axis] > grown.max[axis] {
-            poly = poly.clip(axis, grown.max[axis], -1.0);
+        if clipper.polygon().n > 0 && tb.max[axis] > grown.max[axis] {
+            clipper.cut(axis, grown.max[axis], -1.0);
         }
-        if poly.n == 0 {
+        if clipper.polygon().n == 0 {
             return None;
         }
     }
+    let poly = clipper.polygon();
     let b = Aabb::from_points(poly.v[..poly.n].iter()).intersection(voxel);
     (!b.is_empty()).then_some(b)
 }

@@ -8,7 +8,7 @@
 //! with the bytes each bank needs; only the processor's run is left out.
 
 use super::table::Table;
-use crate::layout::{self, Layout, MemoryConfig, SceneTrees, BANK_NAMES};
+use crate::layout::{self, FrameUpdate, Layout, MemoryConfig, SceneTrees, BANK_NAMES};
 use crate::model::{render_golden, Frame};
 use crate::scene::paper::{PaperRow, HEIGHT, WIDTH};
 use crate::scene::Scene;
@@ -87,6 +87,10 @@ pub struct PaperResult {
     pub objects: usize,
     /// Bytes each bank needs (frame buffer included).
     pub bank_bytes: Vec<usize>,
+    /// For an animated scene, the largest of its frame updates (the bytes the host writes to
+    /// the banks to turn one frame's memory map into the next one's), measured on the memory
+    /// maps of frames 1 to the last; `None` for a static scene.
+    pub update: Option<FrameUpdate>,
     pub rays: Rays,
     pub sim: Sim,
 }
@@ -121,6 +125,20 @@ pub fn measure(row: PaperRow, scene: &Scene) -> Result<Measured> {
     let l: Layout = layout::build(scene, &trees, 0, &UNBOUNDED)
         .with_context(|| format!("{}: building the memory map", scene.source.display()))?;
     let frame = render_golden(&l, false);
+    let mut update: Option<FrameUpdate> = None;
+    for f in 1..scene.frames {
+        let u = layout::build(scene, &trees, f, &UNBOUNDED)
+            .with_context(|| {
+                format!(
+                    "{}: building the memory map of frame {f}",
+                    scene.source.display()
+                )
+            })?
+            .frame_update();
+        if update.is_none_or(|largest| u.bytes() > largest.bytes()) {
+            update = Some(u);
+        }
+    }
     Ok(Measured {
         result: PaperResult {
             row,
@@ -128,6 +146,7 @@ pub fn measure(row: PaperRow, scene: &Scene) -> Result<Measured> {
             instanced_triangles: scene.instanced_triangle_count(),
             objects: scene.instances.len(),
             bank_bytes: l.used_words().iter().map(|w| w * 4).collect(),
+            update,
             rays: Rays::of(&frame),
             sim: Sim::NotRun("not run yet".into()),
         },
@@ -162,6 +181,7 @@ pub fn paper_table(results: &[PaperResult], clock_mhz: f64) -> Table {
         "objects",
         "memory MiB",
         "fits 6 x 4 MiB",
+        "bytes per frame update",
         "rays/pixel primary",
         "rays/pixel shadow",
         "rays/pixel mirror",
@@ -212,6 +232,8 @@ pub fn paper_table(results: &[PaperResult], clock_mhz: f64) -> Table {
             thousands(r.objects as u64),
             mib(r.bank_bytes.iter().sum()),
             fits,
+            r.update
+                .map_or_else(|| "static".into(), |u| thousands(u.bytes() as u64)),
             format!("{:.2}", r.rays.per_pixel(r.rays.primary)),
             format!("{:.2}", r.rays.per_pixel(r.rays.shadow)),
             format!("{:.2}", r.rays.per_pixel(r.rays.mirror)),
@@ -239,16 +261,39 @@ pub fn paper_markdown(results: &[PaperResult], clock_mhz: f64, clock_source: &st
             format!("- {}: {} MiB", r.row.name, sizes.join(", "))
         })
         .collect();
+    let updates: String = results
+        .iter()
+        .filter_map(|r| {
+            r.update.map(|u| {
+                format!(
+                    "- {}: top-level nodes {}, top-level lists {}, instance matrices {}\n",
+                    r.row.name,
+                    thousands(u.top_nodes as u64),
+                    thousands(u.top_lists as u64),
+                    thousands(u.instance_matrices as u64)
+                )
+            })
+        })
+        .collect();
+    let updates = if updates.is_empty() {
+        updates
+    } else {
+        format!("\nFrame updates (bytes):\n\n{updates}")
+    };
     format!(
         "# The paper's Table 3 scenes (`dynrt bench paper`)\n\n\
          Golden model and processor in e7m16, frame 0 at 512x384; the processor with 32 threads \
          and SRAM latency 2, simulated in Verilator. fps at {clock_mhz:.1} MHz ({clock_source}); \
          the paper's fps are one pipeline at 90 MHz. Memory against six banks of 4 MiB: a scene \
-         that does not fit is rendered by the golden model from larger banks and not simulated.\n\n\
+         that does not fit is rendered by the golden model from larger banks and not simulated. \
+         Bytes per frame update: what the host writes to the banks between two frames of an \
+         animated scene (the top-level tree's nodes and leaf lists, the instances' matrices), \
+         the largest over the animation, measured on its memory maps.\n\n\
          {}\n\
-         Bank sizes (MiB):\n\n{}\n",
+         Bank sizes (MiB):\n\n{}\n{}",
         paper_table(results, clock_mhz).to_markdown(),
-        banks.join("\n")
+        banks.join("\n"),
+        updates
     )
 }
 
@@ -544,6 +589,7 @@ mod tests {
             instanced_triangles: 820,
             objects: 1,
             bank_bytes: vec![nodes, 1000, 2000, 2000, 0, 800_000],
+            update: None,
             rays: Rays {
                 pixels: 4,
                 primary: 4,
@@ -565,10 +611,15 @@ mod tests {
             differing_pixels: 0,
         });
         let big = 9 << 20;
-        let results = [
+        let mut results = [
             result(0, 1 << 20, ran),
             result(2, big, Sim::NotRun("does not fit the banks".into())),
         ];
+        results[1].update = Some(FrameUpdate {
+            top_nodes: 1000,
+            top_lists: 234,
+            instance_matrices: 1_000_000,
+        });
         assert!(results[0].fits() && !results[1].fits());
         assert_eq!(results[1].overfull_banks(), [("nodes", big)]);
         let csv = paper_table(&results, 90.0).to_csv();
@@ -581,11 +632,13 @@ mod tests {
         );
         assert_eq!(
             lines[1],
-            "Scene6,806,820,806,1,1.77,yes,1.00,0.75,0.00,\
+            "Scene6,806,820,806,1,1.77,yes,static,1.00,0.75,0.00,\
              \"128x96 (same view, fps scaled to 512x384)\",32.0,14.305,60.8,4"
         );
         assert!(
-            lines[2].starts_with("Office,\"34,312\",820,806,1,9.77,no: nodes needs 9.00 MiB,"),
+            lines[2].starts_with(
+                "Office,\"34,312\",820,806,1,9.77,no: nodes needs 9.00 MiB,\"1,001,234\","
+            ),
             "{}",
             lines[2]
         );
@@ -597,6 +650,16 @@ mod tests {
         let md = paper_markdown(&results, 81.4, "given with --clock");
         assert!(md.contains("fps at 81.4 MHz (given with --clock)"));
         assert!(md.contains("- Office: nodes 9.00, lists 0.00"), "{md}");
+        assert!(
+            md.contains(
+                "- Office: top-level nodes 1,000, top-level lists 234, instance matrices 1,000,000"
+            ),
+            "{md}"
+        );
+        assert!(
+            !md.contains("- Scene6: top-level"),
+            "a static scene has no update"
+        );
     }
 
     #[test]

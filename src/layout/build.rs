@@ -512,6 +512,7 @@ pub fn build(
         )?;
     }
     let mut top_root = None;
+    let top_lists = lists.len() as u32;
     if let Some(top) = &top {
         let node_base = (nodes.len() / NODE_WORDS) as u32;
         top_root = Some(node_base);
@@ -677,6 +678,7 @@ pub fn build(
         reflection_depth: scene.render.reflection_depth,
         light_count: scene.lights.len() as u32,
         top_root,
+        top_lists,
         materials,
         object_root: object_roots[0],
         instance_count: scene.instances.len() as u32,
@@ -765,6 +767,66 @@ scale = [0.5, 0.5, 0.5]
         }
         let n = (t[0] - t[2]).cross(t[1] - t[2]).normalize();
         assert!((m.transform_vector3(n) - DVec3::Z).length() < 1e-12);
+    }
+
+    /// Between two frames of an animated scene only the words the frame update names change,
+    /// and its sizes are the top-level tree's (what the banks hold beyond the object trees)
+    /// and two matrices (12 + 9 words) per instance.
+    #[test]
+    fn a_frame_update_is_the_top_level_tree_and_the_instance_matrices() {
+        let text =
+            format!("{SCENE}[instances.animate]\nframes = 3\ntranslate = [-0.5, -1.0, 1.0]\n");
+        let s = Scene::from_toml_str(&text, Path::new("."), "test.toml").unwrap();
+        let trees = SceneTrees::build(&s, Format::E7M16).unwrap();
+        let memory = MemoryConfig::default();
+        let before = build(&s, &trees, 0, &memory).unwrap();
+        let after = build(&s, &trees, 1, &memory).unwrap();
+        let u = after.frame_update();
+        let object_nodes: usize = trees.trees.iter().map(|t| t.nodes.len()).sum();
+        let object_refs: usize = trees.trees.iter().map(|t| t.prim_indices.len()).sum();
+        assert_eq!(
+            u.top_nodes,
+            (after.banks[NODES].len() - object_nodes * NODE_WORDS) * 4
+        );
+        assert!(u.top_nodes >= NODE_WORDS * 4);
+        assert_eq!(u.top_lists, (after.banks[LISTS].len() - object_refs) * 4);
+        assert!(
+            u.top_lists >= 2 * 4,
+            "each instance is listed at least once"
+        );
+        assert_eq!(u.instance_matrices, 2 * (12 + 9) * 4);
+        assert_eq!(u.bytes(), u.top_nodes + u.top_lists + u.instance_matrices);
+        let top_root = after.info.top_root.unwrap() as usize;
+        let written = |bank: usize, addr: usize| match bank {
+            NODES => addr >= top_root * NODE_WORDS,
+            LISTS => addr >= after.info.top_lists as usize,
+            INSTANCES => addr % INSTANCE_WORDS < 12 + 9,
+            _ => false,
+        };
+        let mut changed = 0;
+        for bank in 0..6 {
+            let (a, b) = (&before.banks[bank], &after.banks[bank]);
+            if !written(bank, a.len().min(b.len())) {
+                assert_eq!(a.len(), b.len(), "bank {bank} changed size");
+            }
+            for (addr, (x, y)) in a.iter().zip(b).enumerate() {
+                if x != y {
+                    changed += 1;
+                    assert!(written(bank, addr), "bank {bank} word {addr} changed");
+                }
+            }
+        }
+        assert!(changed > 0, "the moving instance changes its matrix");
+        // One untransformed object has no top level and nothing to update.
+        let single = Scene::from_toml_str(
+            &SCENE[..SCENE.find("[[instances]]").unwrap()],
+            Path::new("."),
+            "test.toml",
+        )
+        .unwrap();
+        let trees = SceneTrees::build(&single, Format::E7M16).unwrap();
+        let l = build(&single, &trees, 0, &memory).unwrap();
+        assert_eq!(l.frame_update().bytes(), 0);
     }
 
     #[test]

@@ -155,6 +155,9 @@ pub struct LayoutInfo {
     pub light_count: u32,
     /// `None` for a scene of one untransformed object: rays enter the object tree directly.
     pub top_root: Option<u32>,
+    /// Bank-1 address of the top-level tree's leaf lists, which run to the end of the bank
+    /// (the bank's length when there is no top level).
+    pub top_lists: u32,
     /// Bank-5 address of the material table.
     pub materials: u32,
     /// Root node of the only object when there is no top level.
@@ -172,6 +175,23 @@ pub struct LayoutInfo {
     pub origin: [f64; 3],
 }
 
+/// What the host writes to the banks between two frames of an animated scene: the top-level
+/// tree (its nodes and its leaf lists, rebuilt every frame and stored after the object trees)
+/// and the instances' matrices (world-to-object and normal matrix; the rest of an instance
+/// record, its object's root, first triangle and index, does not change). Bytes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameUpdate {
+    pub top_nodes: usize,
+    pub top_lists: usize,
+    pub instance_matrices: usize,
+}
+
+impl FrameUpdate {
+    pub fn bytes(&self) -> usize {
+        self.top_nodes + self.top_lists + self.instance_matrices
+    }
+}
+
 /// The banks' contents plus what the hardware is parameterized with.
 #[derive(Clone, Debug)]
 pub struct Layout {
@@ -182,6 +202,25 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// The bytes a host writes to make this layout's frame out of another frame's (see
+    /// [`FrameUpdate`]), measured on this layout's banks. All zero without a top level.
+    pub fn frame_update(&self) -> FrameUpdate {
+        let Some(top_root) = self.info.top_root else {
+            return FrameUpdate {
+                top_nodes: 0,
+                top_lists: 0,
+                instance_matrices: 0,
+            };
+        };
+        let word_bytes = 4;
+        FrameUpdate {
+            top_nodes: (self.banks[NODES].len() - top_root as usize * NODE_WORDS) * word_bytes,
+            top_lists: (self.banks[LISTS].len() - self.info.top_lists as usize) * word_bytes,
+            // The two matrices are the first words of a record, up to the object's root.
+            instance_matrices: self.info.instance_count as usize * instance_word::ROOT * word_bytes,
+        }
+    }
+
     pub fn word(&self, bank: usize, addr: u32) -> u32 {
         self.banks[bank][addr as usize]
     }
