@@ -99,6 +99,10 @@ pub struct ListUnit {
     walk_thread: DFF<Bits<5>>,
     cursor: DFF<Bits<24>>,
     list_end: DFF<Bits<24>>,
+    /// `cursor == list_end`, registered beside the cursor: the 24-bit compare sat in front
+    /// of both the read decision and the list's end entry (`list_end -> tests`, issue 16).
+    walked: DFF<Bit>,
+    cursor_next: Signal<Local, Bits<24>>,
     /// The list being walked is a leaf of a traversal-unit walk.
     of_walk: DFF<Bit>,
     object_id: DFF<Bits<32>>,
@@ -188,6 +192,8 @@ impl ListUnit {
             walk_thread: Default::default(),
             cursor: Default::default(),
             list_end: Default::default(),
+            walked: Default::default(),
+            cursor_next: Default::default(),
             of_walk: Default::default(),
             object_id: Default::default(),
             skip_object: Default::default(),
@@ -236,6 +242,7 @@ impl Logic for ListUnit {
             walk_thread,
             cursor,
             list_end,
+            walked,
             of_walk,
             object_id,
             skip_object,
@@ -340,6 +347,8 @@ impl Logic for ListUnit {
                 self.walk_thread.d.next = self.commands.data_out.val().get_bits::<5>(64);
                 self.cursor.d.next = self.commands.data_out.val().get_bits::<24>(32);
                 self.list_end.d.next = self.commands.data_out.val().get_bits::<24>(0);
+                self.walked.d.next = self.commands.data_out.val().get_bits::<24>(32)
+                    == self.commands.data_out.val().get_bits::<24>(0);
                 self.of_walk.d.next = self.commands.data_out.val().get_bit(31);
                 self.commands.read.next = true;
                 self.phase.d.next = ListPhase::Read;
@@ -363,7 +372,7 @@ impl Logic for ListUnit {
         // Walk: a read while the test queue has room for every word in flight and for the
         // list's end entry; the engine's loads of banks 1, 4 and 5 take the bus first.
         self.take.next = (self.phase.q.val() == ListPhase::Walk)
-            & (self.cursor.q.val() != self.list_end.q.val())
+            & (!self.walked.q.val())
             // (of the queue's 8: the words in flight or being checked and the end entry)
             & ((bit_cast::<5, 4>(self.queued.q.val())
                 + bit_cast::<5, 4>(self.flight.q.val())
@@ -375,8 +384,10 @@ impl Logic for ListUnit {
                 & (self.engine_bank.val() != self.c_bank_t.val())));
         self.list_read.next = self.take.val();
         self.list_addr.next = self.cursor.q.val();
+        self.cursor_next.next = self.cursor.q.val() + 1;
         if self.take.val() {
-            self.cursor.d.next = self.cursor.q.val() + 1;
+            self.cursor.d.next = self.cursor_next.val();
+            self.walked.d.next = self.cursor_next.val() == self.list_end.q.val();
         }
         self.flight_line[0].d.next = self.take.val();
         for k in 1..6 {
@@ -450,7 +461,7 @@ impl Logic for ListUnit {
         // The list is done when every word has arrived and been checked: its end entry
         // follows its tests.
         if (self.phase.q.val() == ListPhase::Walk)
-            & (self.cursor.q.val() == self.list_end.q.val())
+            & self.walked.q.val()
             & (self.flight.q.val() == 0)
             & (!self.arrive_r.q.val())
             & (!self.tests.full.val())

@@ -1,8 +1,9 @@
 //! `FirstReady`: the scheduler's choice of the next thread, the highest set bit of
-//! `preferred` if it has one, else of `others`, as a number and one-hot.
+//! `preferred` if it has one, else of `others`, one-hot.
 //!
 //! Contract: `found` is set when either word has a bit set; `onehot` then has exactly the
-//! chosen bit and `number` its index; with no bit set both are zero. The scheduler passes the
+//! chosen bit; with no bit set it is zero. (The thread's number is encoded from the
+//! registered one-hot by the scheduler, a clock later, out of this path.) The scheduler passes the
 //! ready threads below its round-robin pointer as `preferred` and all ready threads as
 //! `others`.
 //!
@@ -25,7 +26,6 @@ pub struct FirstReady {
     pub others: Signal<In, Bits<32>>,
     pub found: Signal<Out, Bit>,
     pub onehot: Signal<Out, Bits<32>>,
-    pub number: Signal<Out, Bits<5>>,
 
     both: Signal<Local, Bits<64>>,
     spread: Signal<Local, Bits<64>>,
@@ -42,14 +42,12 @@ pub struct FirstReady {
     /// A higher bit of the same group is set.
     higher_in_group: Signal<Local, Bits<64>>,
     first: Signal<Local, Bits<64>>,
-    number_bits: [Signal<Local, Bit>; 5],
 
     /// The lowest bit of every group of four; the bits of a group with three and with two
-    /// bits above them in the group; the indices whose bit `b` is set.
+    /// bits above them in the group.
     c_group_low: Constant<Bits<64>>,
     c_below_3: Constant<Bits<64>>,
     c_below_2: Constant<Bits<64>>,
-    c_number_bit: [Constant<Bits<32>>; 5],
 }
 
 impl Default for FirstReady {
@@ -59,7 +57,6 @@ impl Default for FirstReady {
             others: Default::default(),
             found: Default::default(),
             onehot: Default::default(),
-            number: Default::default(),
             both: Default::default(),
             spread: Default::default(),
             group_any: Default::default(),
@@ -72,18 +69,9 @@ impl Default for FirstReady {
             group_mask: Default::default(),
             higher_in_group: Default::default(),
             first: Default::default(),
-            number_bits: Default::default(),
             c_group_low: Constant::new(0x1111_1111_1111_1111u64.into()),
             c_below_3: Constant::new(0x7777_7777_7777_7777u64.into()),
             c_below_2: Constant::new(0x3333_3333_3333_3333u64.into()),
-            c_number_bit: std::array::from_fn(|b| {
-                Constant::new(
-                    (0..32u64)
-                        .filter(|t| t >> b & 1 == 1)
-                        .fold(0u64, |m, t| m | 1 << t)
-                        .into(),
-                )
-            }),
         }
     }
 }
@@ -111,14 +99,6 @@ impl Logic for FirstReady {
             | ((self.both.val() >> 3) & self.c_group_low.val());
         self.first.next = self.both.val() & (!self.higher_in_group.val()) & self.group_mask.val();
         self.onehot.next = self.first.val().get_bits::<32>(0) | self.first.val().get_bits::<32>(32);
-        for b in 0..5 {
-            self.number_bits[b].next = (self.onehot.val() & self.c_number_bit[b].val()) != 0;
-        }
-        self.number.next = bit_cast::<5, 1>(self.number_bits[0].val().into())
-            | (bit_cast::<5, 1>(self.number_bits[1].val().into()) << 1)
-            | (bit_cast::<5, 1>(self.number_bits[2].val().into()) << 2)
-            | (bit_cast::<5, 1>(self.number_bits[3].val().into()) << 3)
-            | (bit_cast::<5, 1>(self.number_bits[4].val().into()) << 4);
         self.found.next = self.both.val() != 0;
     }
 }
@@ -166,11 +146,6 @@ mod tests {
             assert_eq!(
                 unit.onehot.val().to_u64(),
                 want.map_or(0, |k| 1u64 << k),
-                "{case}"
-            );
-            assert_eq!(
-                unit.number.val().to_u64(),
-                u64::from(want.unwrap_or(0)),
                 "{case}"
             );
         }
