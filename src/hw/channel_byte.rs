@@ -5,18 +5,26 @@
 //! gives 1), multiplied by 255 in an [`FpMul`] and rounded to an integer by adding `2^M` in an
 //! [`FpAddSub`] ([`units::channel_byte_word`]); the sum's low 8 bits are the byte.
 //!
+//! The clamp is applied after the multiplier, not before it: the word itself is multiplied,
+//! and the clamp's decision (+0 or 1) travels beside the multiplier to replace the product
+//! by +0 or by 255 (which is 1 x 255, exactly). The same bytes, but the word's compares no
+//! longer sit between the engine's operand register and the multiplier's input registers
+//! (`fp_units.a -> byte_unit.scale.in_a`, the processor's critical path at 80.8 MHz: issue
+//! 16).
+//!
 //! [`units::channel_byte`]: crate::units::channel_byte
 //! [`units::clamp_unit_word`]: crate::units::clamp_unit_word
 //! [`units::channel_byte_word`]: crate::units::channel_byte_word
 //!
 //! Latency [`CHANNEL_BYTE_LATENCY`] (12) from `in_valid` to `out_valid`, one word per clock;
-//! the clamp is combinational in front of the multiplier's input registers.
+//! the clamp's decision is registered as the word enters the multiplier.
 
 use rust_hdl::prelude::*;
 
 use super::fp::add_sub::ADD_SUB_LATENCY;
 use super::fp::mul::MUL_LATENCY;
 use super::fp::{const_bits, FpAddSub, FpMul};
+use super::Delay;
 use crate::fp::Format;
 
 /// Clocks from `in_valid` to `out_valid`.
@@ -39,7 +47,9 @@ pub struct ChannelByte<
     pub out_valid: Signal<Out, Bit>,
     /// The byte (`byte` is a SystemVerilog keyword).
     pub result: Signal<Out, Bits<8>>,
-    clamped: Signal<Local, Bits<W>>,
+    /// The clamp's decision: bit 0 the word gives +0, bit 1 it gives 1.
+    clamp: Signal<Local, Bits<2>>,
+    clamp_line: Delay<Bits<2>, { MUL_LATENCY as usize }>,
     scale: FpMul<W, E, M, S, S1, X2, P>,
     round: FpAddSub<W, E, M, S, S1, X2, T>,
     /// The sign bit, the exponent field's mask, 1.0, 255.0 and `2^M` (the rounding addend).
@@ -74,7 +84,8 @@ impl<
             word: Default::default(),
             out_valid: Default::default(),
             result: Default::default(),
-            clamped: Default::default(),
+            clamp: Default::default(),
+            clamp_line: Default::default(),
             scale: Default::default(),
             round: Default::default(),
             c_sign: const_bits::<W>(1 << (W - 1)),
@@ -102,6 +113,7 @@ impl<
     fn update(&mut self) {
         self.scale.clock.next = self.clock.val();
         self.round.clock.next = self.clock.val();
+        self.clamp_line.clock.next = self.clock.val();
         // Negative, zero or subnormal (exponent field 0), NaN: +0. Positive non-NaN words
         // compare as unsigned integers.
         if ((self.word.val() & self.c_sign.val()) != 0)
@@ -109,17 +121,23 @@ impl<
             | (((self.word.val() & self.c_exp_mask.val()) == self.c_exp_mask.val())
                 & ((self.word.val() & self.c_man_mask.val()) != 0))
         {
-            self.clamped.next = 0.into();
+            self.clamp.next = 1.into();
         } else if self.word.val() > self.c_one.val() {
-            self.clamped.next = self.c_one.val();
+            self.clamp.next = 2.into();
         } else {
-            self.clamped.next = self.word.val();
+            self.clamp.next = 0.into();
         }
+        self.clamp_line.data_in.next = self.clamp.val();
         self.scale.in_valid.next = self.in_valid.val();
-        self.scale.a.next = self.clamped.val();
+        self.scale.a.next = self.word.val();
         self.scale.b.next = self.c_255.val();
         self.round.in_valid.next = self.scale.out_valid.val();
         self.round.a.next = self.scale.result.val();
+        if self.clamp_line.data_out.val().get_bit(0) {
+            self.round.a.next = 0.into();
+        } else if self.clamp_line.data_out.val().get_bit(1) {
+            self.round.a.next = self.c_255.val();
+        }
         self.round.b.next = self.c_round.val();
         self.round.sub.next = false;
         self.out_valid.next = self.round.out_valid.val();
