@@ -23,7 +23,9 @@ use crate::layout::{self, Layout, MemoryConfig, SceneTrees};
 use crate::model::{self, golden::Golden};
 use crate::provenance::GeneratedBy;
 use crate::scene::Scene;
-use crate::sim::processor::{simulate_processor, write_processor_files, ProcessorSim, SimRun};
+use crate::sim::processor::{
+    simulate_processor, write_processor_files, ProcessorSim, SimRun, TraceWindow,
+};
 use crate::sim::Simulator;
 use crate::synth::{self, SynthOptions, SynthReport};
 
@@ -460,6 +462,8 @@ pub struct SimReport {
     pub reused_build: bool,
     pub program_len: usize,
     pub left_out: Vec<String>,
+    /// With a trace window: the waveform file.
+    pub trace: Option<PathBuf>,
 }
 
 impl SimReport {
@@ -483,7 +487,8 @@ impl SimReport {
 /// Generates, simulates and compares every frame of `scene` with the golden model; writes
 /// `frame<k>.png`, `golden<k>.png` and `golden<k>.hex` (the golden frame as the testbench
 /// dumps `frame<k>.hex`, for other testbenches to check against). On a mismatch writes
-/// `diff<k>.png` and a trace of the first differing pixels into `out`.
+/// `diff<k>.png` and a trace of the first differing pixels into `out`. With `trace`, the
+/// waveforms of that window of clocks go to `out/trace.<vcd|fst>`.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_scene(
     scene: &Scene,
@@ -492,6 +497,7 @@ pub fn simulate_scene(
     params: ProcessorParams,
     frames: Option<u32>,
     sim: Simulator,
+    trace: Option<TraceWindow>,
     out: &Path,
     generated_by: &GeneratedBy,
 ) -> Result<SimReport> {
@@ -511,6 +517,7 @@ pub fn simulate_scene(
             sim,
             cycle_limit: cycle_limit(&twin, period),
             capture_vga: false,
+            trace,
         },
         out,
         generated_by,
@@ -598,6 +605,7 @@ pub fn simulate_scene(
         reused_build: run.reused_build,
         program_len: program.code.len(),
         left_out: program.left_out.clone(),
+        trace: run.trace,
     })
 }
 

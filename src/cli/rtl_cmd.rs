@@ -7,7 +7,8 @@ use dynrt::fp::Format;
 use dynrt::output::OutputDir;
 use dynrt::provenance::GeneratedBy;
 use dynrt::report::{RunSummary, SceneInfo};
-use dynrt::sim::Simulator;
+use dynrt::sim::processor::TraceWindow;
+use dynrt::sim::{Simulator, TraceFormat};
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -54,6 +55,15 @@ pub enum SimKind {
     Verilator,
 }
 
+/// The waveform formats of `--trace`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TraceArg {
+    /// GTKWave's compressed Fast Signal Trace.
+    Fst,
+    /// Value change dump, text.
+    Vcd,
+}
+
 #[derive(Args)]
 pub struct SimArgs {
     #[command(flatten)]
@@ -67,6 +77,35 @@ pub struct SimArgs {
     /// SCENE`'s timing.csv or a seed's report.json (the slowest seed's clock is taken).
     #[arg(long)]
     pub timing_report: Option<PathBuf>,
+    /// Dump every signal's waveforms into OUT/trace.fst or OUT/trace.vcd (`--trace` alone:
+    /// fst). A whole frame is large: narrow it with --trace-start/--trace-end (README,
+    /// "Waveforms").
+    #[arg(long, value_enum, value_name = "FORMAT", num_args = 0..=1, default_missing_value = "fst")]
+    pub trace: Option<TraceArg>,
+    /// First clock of the waveform window, counted from the start of the run, frame after
+    /// frame (default 0).
+    #[arg(long, value_name = "CLOCK", requires = "trace")]
+    pub trace_start: Option<u64>,
+    /// The clock the waveform window ends at (default: the end of the run).
+    #[arg(long, value_name = "CLOCK", requires = "trace")]
+    pub trace_end: Option<u64>,
+}
+
+/// The waveform window of `--trace`, checked.
+fn trace_window(a: &SimArgs) -> anyhow::Result<Option<TraceWindow>> {
+    let Some(format) = a.trace else {
+        return Ok(None);
+    };
+    let w = TraceWindow {
+        format: match format {
+            TraceArg::Fst => TraceFormat::Fst,
+            TraceArg::Vcd => TraceFormat::Vcd,
+        },
+        start: a.trace_start.unwrap_or(0),
+        end: a.trace_end,
+    };
+    w.check()?;
+    Ok(Some(w))
 }
 
 /// The clock fps are stated at, in MHz, and where it comes from.
@@ -220,6 +259,7 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
     );
     let (scene, name, params) = setup(&a.rtl)?;
     let (mhz, clock_source) = fps_clock(&a)?;
+    let trace = trace_window(&a)?;
     let out = OutputDir::create(&a.rtl.out, "--out")?;
     let sim = match a.sim {
         SimKind::Iverilog => Simulator::Icarus,
@@ -228,6 +268,11 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
     let generated_by = GeneratedBy::this_run(a.rtl.stable_header);
     let mut s = summary("sim", &a.rtl, &scene, &name);
     s.option("sim", sim.name()).option("clock_mhz", mhz);
+    if let Some(t) = &trace {
+        s.option("trace", t.format.extension())
+            .option("trace_start", t.start)
+            .option("trace_end", t.end);
+    }
     let r = flow::simulate_scene(
         &scene,
         &name,
@@ -235,6 +280,7 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         params,
         a.rtl.frames,
         sim,
+        trace,
         &a.rtl.out,
         &generated_by,
     )?;
@@ -296,6 +342,16 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
     ];
     text.extend(notes[1..].iter().map(|n| format!("  {n}")));
     s.notes.extend(notes);
+    if let (Some(path), Some(t)) = (&r.trace, &trace) {
+        let note = format!(
+            "waveforms of clocks {} to {}: {}",
+            t.start,
+            t.end.map_or("the end".to_string(), |e| e.to_string()),
+            path.display()
+        );
+        text.push(format!("  {note}"));
+        s.notes.push(note);
+    }
     if !a.rtl.json {
         println!("{}", text.join("\n"));
     }
