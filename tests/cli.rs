@@ -677,3 +677,65 @@ fn bench_paper_reports_every_scene_and_what_does_not_fit() {
         assert!(!fresh.exists(), "nothing written");
     }
 }
+
+/// The command line's shared conventions: completions for every shell clap knows, every
+/// operation of `fp --op` listed (sqrt too), one `--size WxH` on render with the older
+/// `--width`/`--height` still taken, and a malformed size refused naming the flag.
+#[test]
+fn completions_op_list_and_one_size_syntax() {
+    let (code, script, err) = dynrt(&["completions", "bash"]);
+    assert_eq!(code, 0, "{err}");
+    for word in [
+        "completions",
+        "--trace-start",
+        "--size",
+        "sqrt",
+        "verilator",
+    ] {
+        assert!(script.contains(word), "bash completion lacks {word}");
+    }
+    for shell in ["zsh", "fish", "elvish", "powershell"] {
+        let (code, script, err) = dynrt(&["completions", shell]);
+        assert_eq!(code, 0, "{shell}: {err}");
+        assert!(script.contains("trace-end"), "{shell}");
+    }
+    let (code, _, err) = dynrt(&["completions", "tcsh"]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, err) = dynrt(&["fp", "--op", "pow", "--vectors", "v", "--out", "o"]);
+    assert_eq!(code, 2, "{err}");
+    for op in ["add", "sub", "mul", "div", "sqrt", "lt", "le", "eq"] {
+        assert!(err.contains(op), "the error lists {op}: {err}");
+    }
+    let (_, help, _) = dynrt(&["fp", "--help"]);
+    assert!(help.contains("sqrt"), "{help}");
+    let dir = tempfile::tempdir().unwrap();
+    let tiny = scene("tiny.toml");
+    for args in [vec!["--size", "4x3"], vec!["--width", "4", "--height", "3"]] {
+        let png = dir.path().join("f.png");
+        let mut all = vec!["render", tiny.as_str(), "--out", png.to_str().unwrap()];
+        all.extend(args.iter().copied());
+        let (code, out, err) = dynrt(&all);
+        assert_eq!(code, 0, "{args:?}: {out}{err}");
+        let img = image::open(&png).unwrap();
+        assert_eq!((img.width(), img.height()), (4, 3), "{args:?}");
+    }
+    let o = dir.path().join("g.png");
+    let (code, _, err) = dynrt(&["render", &tiny, "--size", "4", "--out", o.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("--size") && err.contains("WIDTHxHEIGHT"),
+        "{err}"
+    );
+    assert!(!o.exists());
+    let (code, _, err) = dynrt(&[
+        "render",
+        &tiny,
+        "--size",
+        "4x3",
+        "--width",
+        "5",
+        "--out",
+        o.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "--size and --width together: {err}");
+}

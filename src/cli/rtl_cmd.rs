@@ -15,8 +15,10 @@ use std::path::PathBuf;
 pub struct RtlArgs {
     /// Scene file (TOML).
     pub scene: PathBuf,
-    #[arg(long)]
+    /// Output folder (created if missing): Verilog, testbench, memory images, reports.
+    #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    /// Number format eXmY of the processor's floating point.
     #[arg(long, default_value = "e7m16")]
     pub format: Format,
     /// Ray threads in flight (1..=32).
@@ -28,10 +30,8 @@ pub struct RtlArgs {
     /// Frames of an animated scene (default: all).
     #[arg(long)]
     pub frames: Option<u32>,
-    #[arg(long)]
-    pub width: Option<u32>,
-    #[arg(long)]
-    pub height: Option<u32>,
+    #[command(flatten)]
+    pub size: super::SizeArgs,
     /// Also synthesize the processor with yosys (xc2v) and print its resources against an
     /// XC2V6000 (takes minutes).
     #[arg(long)]
@@ -68,6 +68,7 @@ pub enum TraceArg {
 pub struct SimArgs {
     #[command(flatten)]
     pub rtl: RtlArgs,
+    /// The simulator: verilator (slow to build, fast to run) or iverilog.
     #[arg(long, value_enum, default_value = "verilator")]
     pub sim: SimKind,
     /// State fps at this clock, MHz (default: the paper's 90 MHz, assumed, not measured).
@@ -144,7 +145,8 @@ pub(super) fn clock_mhz(
 /// anything is written.
 fn setup(a: &RtlArgs) -> anyhow::Result<(dynrt::scene::Scene, String, ProcessorParams)> {
     dynrt::output::check_output_dir(&a.out, "--out")?;
-    let scene = super::render_cmd::load_scene(&a.scene, a.width, a.height)?;
+    let (width, height) = a.size.width_height();
+    let scene = super::render_cmd::load_scene(&a.scene, width, height)?;
     let params = ProcessorParams {
         threads: a.threads,
         mem_latency: a.mem_latency,
