@@ -261,6 +261,8 @@ fn compare_fails_above_its_thresholds_and_reports_json() {
     assert_eq!(j["pass"], false);
     let psnr = j["psnr_db"].as_f64().unwrap();
     assert!((psnr - 38.92).abs() < 0.01, "{psnr}");
+    let ssim = j["ssim"].as_f64().unwrap();
+    assert!(ssim > 0.0 && ssim < 1.0, "differing images: SSIM {ssim}");
     // A threshold that is no number is a usage error (2), not a failed comparison.
     let (code, _, err) = dynrt(&["compare", a, b, "--fail-psnr", "nan"]);
     assert_eq!(code, 2, "{err}");
@@ -462,6 +464,13 @@ fn sim_writes_golden_hex_junit_and_removes_stale_diffs() {
     );
     let golden = std::fs::read_to_string(out.join("golden0.hex")).unwrap();
     assert_eq!(golden.lines().count(), 4);
+    let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        page.contains("src=\"frame0.png\"")
+            && page.contains("src=\"golden0.png\"")
+            && page.contains("frame 0: identical to the golden model"),
+        "{page}"
+    );
     assert_eq!(
         std::fs::read_to_string(out.join("frame0.hex")).unwrap(),
         golden,
