@@ -126,7 +126,7 @@ bench: deps build
 PAPER_CLOCK ?= 81.4
 PAPER_SIM ?= 128x96
 bench-paper: deps build
-	$(DYNRT) bench paper --sim-resolution $(PAPER_SIM) --clock $(PAPER_CLOCK) --out $(OUT)/bench
+	$(DYNRT) bench paper --sim-size $(PAPER_SIM) --clock $(PAPER_CLOCK) --out $(OUT)/bench
 
 synth: deps build
 	$(DYNRT) bench fp --vectors 0 --formats e6m11,e7m12,e7m14,e7m16,e8m16,e7m18,e8m20,e8m23 --out $(OUT)/synth
@@ -149,7 +149,7 @@ paper-scenes: build
 	$(DYNRT) paper-scenes --out scenes/paper
 
 images: build
-	for s in cornell mirror dynamic terrain; do $(DYNRT) render scenes/$$s.toml --width 256 --height 192 --out docs/$$s.png; done
+	for s in cornell mirror dynamic terrain; do $(DYNRT) render scenes/$$s.toml --size 256x192 --out docs/$$s.png; done
 
 fmt:
 	$(CARGO) fmt

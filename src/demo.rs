@@ -225,6 +225,7 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
             params,
             None,
             simulator,
+            None,
             &c.out.join(dir),
             &c.generated_by,
         )?;

@@ -23,7 +23,9 @@ use crate::layout::{self, Layout, MemoryConfig, SceneTrees};
 use crate::model::{self, golden::Golden};
 use crate::provenance::GeneratedBy;
 use crate::scene::Scene;
-use crate::sim::processor::{simulate_processor, write_processor_files, ProcessorSim, SimRun};
+use crate::sim::processor::{
+    simulate_processor, write_processor_files, ProcessorSim, SimRun, TraceWindow,
+};
 use crate::sim::Simulator;
 use crate::synth::{self, SynthOptions, SynthReport};
 
@@ -460,6 +462,8 @@ pub struct SimReport {
     pub reused_build: bool,
     pub program_len: usize,
     pub left_out: Vec<String>,
+    /// With a trace window: the waveform file.
+    pub trace: Option<PathBuf>,
 }
 
 impl SimReport {
@@ -483,7 +487,9 @@ impl SimReport {
 /// Generates, simulates and compares every frame of `scene` with the golden model; writes
 /// `frame<k>.png`, `golden<k>.png` and `golden<k>.hex` (the golden frame as the testbench
 /// dumps `frame<k>.hex`, for other testbenches to check against). On a mismatch writes
-/// `diff<k>.png` and a trace of the first differing pixels into `out`.
+/// `diff<k>.png` and a trace of the first differing pixels into `out`; `index.html` shows the
+/// RTL, golden and diff images of every frame side by side. With `trace`, the
+/// waveforms of that window of clocks go to `out/trace.<vcd|fst>`.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_scene(
     scene: &Scene,
@@ -492,6 +498,7 @@ pub fn simulate_scene(
     params: ProcessorParams,
     frames: Option<u32>,
     sim: Simulator,
+    trace: Option<TraceWindow>,
     out: &Path,
     generated_by: &GeneratedBy,
 ) -> Result<SimReport> {
@@ -511,11 +518,13 @@ pub fn simulate_scene(
             sim,
             cycle_limit: cycle_limit(&twin, period),
             capture_vga: false,
+            trace,
         },
         out,
         generated_by,
     )?;
     let mut reports = Vec::new();
+    let mut page = Vec::new();
     for (k, (l, fr)) in layouts.iter().zip(&run.frames).enumerate() {
         crate::progress::report(&format!("comparing frame {k} with the golden model"));
         let golden = model::render_golden(l, false);
@@ -532,6 +541,10 @@ pub fn simulate_scene(
         let differing: Vec<usize> = (0..(w * h) as usize)
             .filter(|&i| fr.pixels[i] != golden.rgb[i])
             .collect();
+        page.push(crate::compare::PageFrame {
+            metrics: crate::compare::compare_images(&rtl_frame.to_image(), &golden.to_image())?,
+            diff: !differing.is_empty(),
+        });
         let mut mismatches = Vec::new();
         if !differing.is_empty() {
             let diff = crate::compare::diff_image(&rtl_frame.to_image(), &golden.to_image());
@@ -587,6 +600,16 @@ pub fn simulate_scene(
             mismatches,
         });
     }
+    let html = out.join("index.html");
+    let title = format!(
+        "{name} in {}: the RTL frames and the golden model's",
+        sim.name()
+    );
+    crate::output::write_atomically(
+        &html,
+        crate::compare::sim_page_html(&title, &page).as_bytes(),
+    )
+    .with_context(|| format!("writing {}", html.display()))?;
     Ok(SimReport {
         simulator: sim,
         tool_version: run.tool_version,
@@ -598,6 +621,7 @@ pub fn simulate_scene(
         reused_build: run.reused_build,
         program_len: program.code.len(),
         left_out: program.left_out.clone(),
+        trace: run.trace,
     })
 }
 

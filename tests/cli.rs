@@ -261,6 +261,8 @@ fn compare_fails_above_its_thresholds_and_reports_json() {
     assert_eq!(j["pass"], false);
     let psnr = j["psnr_db"].as_f64().unwrap();
     assert!((psnr - 38.92).abs() < 0.01, "{psnr}");
+    let ssim = j["ssim"].as_f64().unwrap();
+    assert!(ssim > 0.0 && ssim < 1.0, "differing images: SSIM {ssim}");
     // A threshold that is no number is a usage error (2), not a failed comparison.
     let (code, _, err) = dynrt(&["compare", a, b, "--fail-psnr", "nan"]);
     assert_eq!(code, 2, "{err}");
@@ -462,6 +464,13 @@ fn sim_writes_golden_hex_junit_and_removes_stale_diffs() {
     );
     let golden = std::fs::read_to_string(out.join("golden0.hex")).unwrap();
     assert_eq!(golden.lines().count(), 4);
+    let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        page.contains("src=\"frame0.png\"")
+            && page.contains("src=\"golden0.png\"")
+            && page.contains("frame 0: identical to the golden model"),
+        "{page}"
+    );
     assert_eq!(
         std::fs::read_to_string(out.join("frame0.hex")).unwrap(),
         golden,
@@ -676,4 +685,66 @@ fn bench_paper_reports_every_scene_and_what_does_not_fit() {
         assert!(err.contains(words), "{err}");
         assert!(!fresh.exists(), "nothing written");
     }
+}
+
+/// The command line's shared conventions: completions for every shell clap knows, every
+/// operation of `fp --op` listed (sqrt too), one `--size WxH` on render with the older
+/// `--width`/`--height` still taken, and a malformed size refused naming the flag.
+#[test]
+fn completions_op_list_and_one_size_syntax() {
+    let (code, script, err) = dynrt(&["completions", "bash"]);
+    assert_eq!(code, 0, "{err}");
+    for word in [
+        "completions",
+        "--trace-start",
+        "--size",
+        "sqrt",
+        "verilator",
+    ] {
+        assert!(script.contains(word), "bash completion lacks {word}");
+    }
+    for shell in ["zsh", "fish", "elvish", "powershell"] {
+        let (code, script, err) = dynrt(&["completions", shell]);
+        assert_eq!(code, 0, "{shell}: {err}");
+        assert!(script.contains("trace-end"), "{shell}");
+    }
+    let (code, _, err) = dynrt(&["completions", "tcsh"]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, err) = dynrt(&["fp", "--op", "pow", "--vectors", "v", "--out", "o"]);
+    assert_eq!(code, 2, "{err}");
+    for op in ["add", "sub", "mul", "div", "sqrt", "lt", "le", "eq"] {
+        assert!(err.contains(op), "the error lists {op}: {err}");
+    }
+    let (_, help, _) = dynrt(&["fp", "--help"]);
+    assert!(help.contains("sqrt"), "{help}");
+    let dir = tempfile::tempdir().unwrap();
+    let tiny = scene("tiny.toml");
+    for args in [vec!["--size", "4x3"], vec!["--width", "4", "--height", "3"]] {
+        let png = dir.path().join("f.png");
+        let mut all = vec!["render", tiny.as_str(), "--out", png.to_str().unwrap()];
+        all.extend(args.iter().copied());
+        let (code, out, err) = dynrt(&all);
+        assert_eq!(code, 0, "{args:?}: {out}{err}");
+        let img = image::open(&png).unwrap();
+        assert_eq!((img.width(), img.height()), (4, 3), "{args:?}");
+    }
+    let o = dir.path().join("g.png");
+    let (code, _, err) = dynrt(&["render", &tiny, "--size", "4", "--out", o.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("--size") && err.contains("WIDTHxHEIGHT"),
+        "{err}"
+    );
+    assert!(!o.exists());
+    let (code, _, err) = dynrt(&[
+        "render",
+        &tiny,
+        "--size",
+        "4x3",
+        "--width",
+        "5",
+        "--out",
+        o.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "--size and --width together: {err}");
 }

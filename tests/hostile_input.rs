@@ -718,7 +718,7 @@ fn corpus() -> Vec<Case> {
             &[("s.toml", &good)],
             "render $D/s.toml --out $D/o.png --width 4096 --height 4096",
             USAGE,
-            &["frame", "--width/--height"],
+            &["frame", "--size WxH"],
         ),
         case(
             "negative field spacing",

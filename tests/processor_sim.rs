@@ -29,6 +29,7 @@ fn check(name: &str, w: u32, h: u32, frames: Option<u32>, sim: Simulator) {
         ProcessorParams::default(),
         frames,
         sim,
+        None,
         dir.path(),
         &GeneratedBy::library(),
     )
@@ -106,6 +107,7 @@ fn a_frame_that_cannot_finish_in_time_is_a_clear_timeout_error() {
             sim: Simulator::Verilator,
             cycle_limit: 500,
             capture_vga: false,
+            trace: None,
         },
         dir.path(),
         &GeneratedBy::library(),
@@ -141,6 +143,7 @@ fn the_display_shows_the_rendered_frame_magnified_and_centred() {
             sim: Simulator::Verilator,
             cycle_limit: 20_000_000,
             capture_vga: true,
+            trace: None,
         },
         dir.path(),
         &GeneratedBy::library(),

@@ -547,6 +547,7 @@ fn simulate(
         params,
         Some(1),
         crate::sim::Simulator::Verilator,
+        None,
         &dir,
         &crate::provenance::GeneratedBy::this_run(false),
     )?;

@@ -37,17 +37,19 @@ pub enum BenchWhat {
         /// Directory of public OBJ meshes to add to the bundled scenes.
         #[arg(long)]
         meshes: Option<PathBuf>,
-        #[arg(long, value_parser = parse_resolution)]
+        /// Override every scene's frame size, e.g. 64x48.
+        #[arg(long = "size", alias = "resolution", value_name = "WxH", value_parser = super::parse_size)]
         resolution: Option<(u32, u32)>,
     },
     /// Bundled scenes: tree build rate, layout size, golden and reference speed, golden error.
     Scenes {
         /// Scene files; default: every scene in scenes/.
         scenes: Vec<PathBuf>,
+        /// Number formats to measure, comma-separated.
         #[arg(long, value_delimiter = ',', default_values = ["e7m16", "e8m23"])]
         formats: Vec<Format>,
-        /// Override every scene's resolution, e.g. 128x96.
-        #[arg(long, value_parser = parse_resolution)]
+        /// Override every scene's frame size, e.g. 128x96.
+        #[arg(long = "size", alias = "resolution", value_name = "WxH", value_parser = super::parse_size)]
         resolution: Option<(u32, u32)>,
     },
     /// The paper's Table 3 scenes (scenes/paper/): golden frames, memory against the six
@@ -59,12 +61,12 @@ pub enum BenchWhat {
         /// Only these scenes (file stems, comma-separated), e.g. scene6,castle.
         #[arg(long, value_delimiter = ',')]
         only: Vec<String>,
-        /// Resolution of the golden frames and memory maps (default: the paper's 512x384).
-        #[arg(long, value_parser = parse_resolution)]
+        /// Frame size of the golden frames and memory maps (default: the paper's 512x384).
+        #[arg(long = "size", alias = "resolution", value_name = "WxH", value_parser = super::parse_size)]
         resolution: Option<(u32, u32)>,
-        /// Resolution of the processor's Verilator runs, the same view (default: the golden
+        /// Frame size of the processor's Verilator runs, the same view (default: the golden
         /// frames'); fps are always stated for 512x384 at the run's cycles per pixel.
-        #[arg(long, value_parser = parse_resolution)]
+        #[arg(long = "sim-size", alias = "sim-resolution", value_name = "WxH", value_parser = super::parse_size)]
         sim_resolution: Option<(u32, u32)>,
         /// Leave the processor's Verilator runs out.
         #[arg(long)]
@@ -85,16 +87,6 @@ pub enum BenchWhat {
         #[arg(long)]
         meshes: Option<PathBuf>,
     },
-}
-
-fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once('x')
-        .ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT such as 128x96"))?;
-    Ok((
-        w.parse().map_err(|_| format!("`{w}` is not a width"))?,
-        h.parse().map_err(|_| format!("`{h}` is not a height"))?,
-    ))
 }
 
 pub fn run(a: BenchArgs) -> anyhow::Result<i32> {

@@ -119,6 +119,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
             "max_channel_error": m.max_channel_error,
             // JSON has no infinity: identical images give null.
             "psnr_db": m.psnr_db.is_finite().then_some(m.psnr_db),
+            "ssim": m.ssim,
             "diff": a.diff,
             "failed": failed,
             "pass": failed.is_empty(),
@@ -141,6 +142,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
         );
         println!("max channel err  {}", m.max_channel_error);
         println!("PSNR             {:.2} dB", m.psnr_db);
+        println!("SSIM             {:.4}", m.ssim);
         if let Some(hm) = &hit_metrics {
             println!(
                 "identical hits   {} of {} ({:.4}%)",

@@ -9,9 +9,11 @@ use std::path::PathBuf;
 pub struct DemoArgs {
     /// Scene file (default: scenes/cornell.toml).
     pub scene: Option<PathBuf>,
+    /// Number format eXmY: X exponent bits (2..8), Y mantissa bits (1..23).
     #[arg(long, default_value = "e7m16")]
     pub format: Format,
-    #[arg(long, default_value = "out/demo")]
+    /// Output folder (created if missing): frames, diff image, reports.
+    #[arg(long, value_name = "DIR", default_value = "out/demo")]
     pub out: PathBuf,
     /// Random vectors per operator and simulator.
     #[arg(long, default_value_t = 20_000)]

@@ -10,6 +10,7 @@ use std::path::PathBuf;
 
 #[derive(Args)]
 pub struct EmitFpArgs {
+    /// Number format eXmY: X exponent bits (2..8), Y mantissa bits (1..23).
     #[arg(long, default_value = "e7m16")]
     pub format: Format,
     /// Directory for the operators' Verilog.

@@ -17,9 +17,10 @@ pub enum FpEngine {
 
 #[derive(Args)]
 pub struct FpArgs {
-    /// add, sub, mul, div, sqrt (of the first word), lt, le or eq.
-    #[arg(long, value_parser = parse_op)]
+    /// The operation (sqrt takes the first word of each vector).
+    #[arg(long, value_parser = op_parser())]
     pub op: BinOp,
+    /// Number format eXmY: X exponent bits (2..8), Y mantissa bits (1..23).
     #[arg(long, default_value = "e7m16")]
     pub format: Format,
     /// One vector a line: two hex words `a b` of the format's width.
@@ -28,14 +29,17 @@ pub struct FpArgs {
     /// One hex result a line (0 or 1 for comparisons).
     #[arg(long)]
     pub out: PathBuf,
+    /// Who computes: the operator's RTL in iverilog or verilator, or the software model.
     #[arg(long, value_enum, default_value = "model")]
     pub sim: FpEngine,
 }
 
-fn parse_op(s: &str) -> Result<BinOp, String> {
-    BinOp::parse(s).ok_or_else(|| {
-        format!("unknown operator `{s}`: expected one of add, sub, mul, div, sqrt, lt, le, eq")
-    })
+/// Every operation of [`BinOp::ALL`] as a possible value, so that `--help`, the error for an
+/// unknown name and the shell completions list them all.
+fn op_parser() -> impl clap::builder::TypedValueParser<Value = BinOp> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(BinOp::ALL.map(BinOp::name))
+        .try_map(|name| BinOp::parse(&name).ok_or_else(|| format!("unknown operation `{name}`")))
 }
 
 pub fn run(a: FpArgs) -> anyhow::Result<i32> {

@@ -14,7 +14,7 @@ mod stress_cmd;
 mod synth_cmd;
 mod timing_cmd;
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(
@@ -25,7 +25,8 @@ use clap::{Parser, Subcommand};
 dynrt rtl scenes/tiny.toml --out out/tiny        # Verilog, testbench, images, FuseSoC core\n  \
 dynrt sim scenes/cornell.toml --out out/cornell  # simulate and compare with the golden model\n  \
 dynrt compare a.png b.png --fail-pixels 0        # exit 1 when any pixel differs\n  \
-dynrt info                                       # versions of dynrt and its tools\n\n\
+dynrt info                                       # versions of dynrt and its tools\n  \
+dynrt completions bash > ~/.local/share/bash-completion/completions/dynrt\n\n\
 Exit status: 0 success, 1 frames or results differ, 2 usage error or bad input, 3 a tool or \
 the machine failed (a simulator missing, a timeout, a full disk), 128+N after signal N."
 )]
@@ -64,6 +65,66 @@ enum Command {
     /// The versions of dynrt and of every tool it finds (simulators, yosys, nextpnr, FuseSoC,
     /// cocotb).
     Info(info_cmd::InfoArgs),
+    /// Print a shell completion script, e.g. `dynrt completions bash >
+    /// ~/.local/share/bash-completion/completions/dynrt`.
+    Completions(CompletionsArgs),
+}
+
+#[derive(Args)]
+struct CompletionsArgs {
+    /// The shell the script is for.
+    #[arg(value_enum)]
+    shell: clap_complete::Shell,
+}
+
+/// Writes the completion script of `shell` for the whole command tree to stdout.
+fn completions(a: CompletionsArgs) -> anyhow::Result<i32> {
+    use clap::CommandFactory;
+    clap_complete::generate(
+        a.shell,
+        &mut Cli::command(),
+        "dynrt",
+        &mut std::io::stdout(),
+    );
+    Ok(0)
+}
+
+/// `WIDTHxHEIGHT` in pixels, e.g. `128x96`: the one resolution syntax of every command.
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT such as 128x96"))?;
+    Ok((
+        w.parse()
+            .map_err(|_| format!("`{w}` is not a width in pixels"))?,
+        h.parse()
+            .map_err(|_| format!("`{h}` is not a height in pixels"))?,
+    ))
+}
+
+/// The frame size of `render`, `rtl` and `sim`: `--size WxH`, or the `--width`/`--height` of
+/// older scripts (hidden from the help; either one alone keeps the scene's other number).
+#[derive(Args, Clone, Copy, Debug)]
+pub struct SizeArgs {
+    /// Frame size in pixels, e.g. 64x48 (default: the scene's [camera] width and height).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// The frame's width alone (the older spelling of --size's first number).
+    #[arg(long, hide = true, conflicts_with = "size")]
+    pub width: Option<u32>,
+    /// The frame's height alone (the older spelling of --size's second number).
+    #[arg(long, hide = true, conflicts_with = "size")]
+    pub height: Option<u32>,
+}
+
+impl SizeArgs {
+    /// The width and the height asked for, each `None` to keep the scene's.
+    pub fn width_height(&self) -> (Option<u32>, Option<u32>) {
+        match self.size {
+            Some((w, h)) => (Some(w), Some(h)),
+            None => (self.width, self.height),
+        }
+    }
 }
 
 /// Runs the command line and returns the process exit status.
@@ -89,6 +150,7 @@ pub fn run() -> i32 {
         Command::Sim(a) => rtl_cmd::run_sim(a),
         Command::Info(a) => info_cmd::run(a),
         Command::PaperScenes(a) => paper_scenes_cmd::run(a),
+        Command::Completions(a) => completions(a),
     };
     spinner.finish_and_clear();
     match result {
@@ -175,6 +237,40 @@ fn exit_code_of(e: &anyhow::Error) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use clap::CommandFactory;
+
+    /// Every subcommand and every argument of every subcommand, with its path.
+    fn walk(cmd: &clap::Command, path: &str, missing: &mut Vec<String>) {
+        for arg in cmd.get_arguments() {
+            let id = arg.get_id().as_str();
+            // clap's own --help and --version carry their help text.
+            if matches!(id, "help" | "version") {
+                continue;
+            }
+            if arg.get_help().is_none() && arg.get_long_help().is_none() {
+                missing.push(format!("{path} {id}"));
+            }
+        }
+        for sub in cmd.get_subcommands() {
+            if sub.get_about().is_none() && sub.get_name() != "help" {
+                missing.push(format!("{path} {} (the command)", sub.get_name()));
+            }
+            walk(sub, &format!("{path} {}", sub.get_name()), missing);
+        }
+    }
+
+    #[test]
+    fn every_command_and_every_flag_has_a_help_text() {
+        let cmd = Cli::command();
+        cmd.clone().debug_assert();
+        let mut missing = Vec::new();
+        walk(&cmd, "dynrt", &mut missing);
+        assert!(
+            missing.is_empty(),
+            "without help text:\n{}",
+            missing.join("\n")
+        );
+    }
 
     #[test]
     fn a_full_disk_is_the_machines_failure_even_when_wrapped_with_its_path() {

@@ -18,6 +18,7 @@ pub enum ModelKind {
 pub struct RenderArgs {
     /// Scene file (TOML).
     pub scene: PathBuf,
+    /// golden: the eXmY model the hardware matches bit for bit; reference: f64.
     #[arg(long, value_enum, default_value = "golden")]
     pub model: ModelKind,
     /// Number format eXmY of the golden model.
@@ -26,11 +27,8 @@ pub struct RenderArgs {
     /// Frame of an animated scene (0-based).
     #[arg(long, default_value_t = 0)]
     pub frame: u32,
-    /// Override the scene's resolution.
-    #[arg(long)]
-    pub width: Option<u32>,
-    #[arg(long)]
-    pub height: Option<u32>,
+    #[command(flatten)]
+    pub size: super::SizeArgs,
     /// Output PNG.
     #[arg(long)]
     pub out: PathBuf,
@@ -64,7 +62,8 @@ pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
         outputs.push(("--hits", h));
     }
     dynrt::output::check_distinct(&outputs, &[("the scene", &a.scene)])?;
-    let scene = load_scene(&a.scene, a.width, a.height)?;
+    let (width, height) = a.size.width_height();
+    let scene = load_scene(&a.scene, width, height)?;
     if a.frame >= scene.frames {
         anyhow::bail!(
             "{}: frame {} does not exist; the scene has {} frame(s) (0..{})",

@@ -7,15 +7,18 @@ use dynrt::fp::Format;
 use dynrt::output::OutputDir;
 use dynrt::provenance::GeneratedBy;
 use dynrt::report::{RunSummary, SceneInfo};
-use dynrt::sim::Simulator;
+use dynrt::sim::processor::TraceWindow;
+use dynrt::sim::{Simulator, TraceFormat};
 use std::path::PathBuf;
 
 #[derive(Args)]
 pub struct RtlArgs {
     /// Scene file (TOML).
     pub scene: PathBuf,
-    #[arg(long)]
+    /// Output folder (created if missing): Verilog, testbench, memory images, reports.
+    #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    /// Number format eXmY of the processor's floating point.
     #[arg(long, default_value = "e7m16")]
     pub format: Format,
     /// Ray threads in flight (1..=32).
@@ -27,10 +30,8 @@ pub struct RtlArgs {
     /// Frames of an animated scene (default: all).
     #[arg(long)]
     pub frames: Option<u32>,
-    #[arg(long)]
-    pub width: Option<u32>,
-    #[arg(long)]
-    pub height: Option<u32>,
+    #[command(flatten)]
+    pub size: super::SizeArgs,
     /// Also synthesize the processor with yosys (xc2v) and print its resources against an
     /// XC2V6000 (takes minutes).
     #[arg(long)]
@@ -54,10 +55,20 @@ pub enum SimKind {
     Verilator,
 }
 
+/// The waveform formats of `--trace`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TraceArg {
+    /// GTKWave's compressed Fast Signal Trace.
+    Fst,
+    /// Value change dump, text.
+    Vcd,
+}
+
 #[derive(Args)]
 pub struct SimArgs {
     #[command(flatten)]
     pub rtl: RtlArgs,
+    /// The simulator: verilator (slow to build, fast to run) or iverilog.
     #[arg(long, value_enum, default_value = "verilator")]
     pub sim: SimKind,
     /// State fps at this clock, MHz (default: the paper's 90 MHz, assumed, not measured).
@@ -67,6 +78,35 @@ pub struct SimArgs {
     /// SCENE`'s timing.csv or a seed's report.json (the slowest seed's clock is taken).
     #[arg(long)]
     pub timing_report: Option<PathBuf>,
+    /// Dump every signal's waveforms into OUT/trace.fst or OUT/trace.vcd (`--trace` alone:
+    /// fst). A whole frame is large: narrow it with --trace-start/--trace-end (README,
+    /// "Waveforms").
+    #[arg(long, value_enum, value_name = "FORMAT", num_args = 0..=1, default_missing_value = "fst")]
+    pub trace: Option<TraceArg>,
+    /// First clock of the waveform window, counted from the start of the run, frame after
+    /// frame (default 0).
+    #[arg(long, value_name = "CLOCK", requires = "trace")]
+    pub trace_start: Option<u64>,
+    /// The clock the waveform window ends at (default: the end of the run).
+    #[arg(long, value_name = "CLOCK", requires = "trace")]
+    pub trace_end: Option<u64>,
+}
+
+/// The waveform window of `--trace`, checked.
+fn trace_window(a: &SimArgs) -> anyhow::Result<Option<TraceWindow>> {
+    let Some(format) = a.trace else {
+        return Ok(None);
+    };
+    let w = TraceWindow {
+        format: match format {
+            TraceArg::Fst => TraceFormat::Fst,
+            TraceArg::Vcd => TraceFormat::Vcd,
+        },
+        start: a.trace_start.unwrap_or(0),
+        end: a.trace_end,
+    };
+    w.check()?;
+    Ok(Some(w))
 }
 
 /// The clock fps are stated at, in MHz, and where it comes from.
@@ -105,7 +145,8 @@ pub(super) fn clock_mhz(
 /// anything is written.
 fn setup(a: &RtlArgs) -> anyhow::Result<(dynrt::scene::Scene, String, ProcessorParams)> {
     dynrt::output::check_output_dir(&a.out, "--out")?;
-    let scene = super::render_cmd::load_scene(&a.scene, a.width, a.height)?;
+    let (width, height) = a.size.width_height();
+    let scene = super::render_cmd::load_scene(&a.scene, width, height)?;
     let params = ProcessorParams {
         threads: a.threads,
         mem_latency: a.mem_latency,
@@ -220,6 +261,7 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
     );
     let (scene, name, params) = setup(&a.rtl)?;
     let (mhz, clock_source) = fps_clock(&a)?;
+    let trace = trace_window(&a)?;
     let out = OutputDir::create(&a.rtl.out, "--out")?;
     let sim = match a.sim {
         SimKind::Iverilog => Simulator::Icarus,
@@ -228,6 +270,11 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
     let generated_by = GeneratedBy::this_run(a.rtl.stable_header);
     let mut s = summary("sim", &a.rtl, &scene, &name);
     s.option("sim", sim.name()).option("clock_mhz", mhz);
+    if let Some(t) = &trace {
+        s.option("trace", t.format.extension())
+            .option("trace_start", t.start)
+            .option("trace_end", t.end);
+    }
     let r = flow::simulate_scene(
         &scene,
         &name,
@@ -235,6 +282,7 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         params,
         a.rtl.frames,
         sim,
+        trace,
         &a.rtl.out,
         &generated_by,
     )?;
@@ -296,6 +344,16 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
     ];
     text.extend(notes[1..].iter().map(|n| format!("  {n}")));
     s.notes.extend(notes);
+    if let (Some(path), Some(t)) = (&r.trace, &trace) {
+        let note = format!(
+            "waveforms of clocks {} to {}: {}",
+            t.start,
+            t.end.map_or("the end".to_string(), |e| e.to_string()),
+            path.display()
+        );
+        text.push(format!("  {note}"));
+        s.notes.push(note);
+    }
     if !a.rtl.json {
         println!("{}", text.join("\n"));
     }

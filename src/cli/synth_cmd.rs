@@ -10,6 +10,7 @@ pub struct SynthArgs {
     /// transform, shared_transform, intersect or raygen.
     #[arg(long)]
     pub unit: GeometryUnit,
+    /// Number format eXmY: X exponent bits (2..8), Y mantissa bits (1..23).
     #[arg(long, default_value = "e7m16")]
     pub format: Format,
 }

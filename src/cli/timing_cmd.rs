@@ -29,6 +29,7 @@ pub struct TimingArgs {
     /// units transform, shared_transform, intersect, raygen.
     #[arg(long, value_delimiter = ',')]
     pub unit: Vec<String>,
+    /// Number format eXmY: X exponent bits (2..8), Y mantissa bits (1..23).
     #[arg(long, default_value = "e7m16")]
     pub format: Format,
     /// Clock constraint for every clock of the design, MHz.

@@ -13,6 +13,9 @@ pub struct ImageMetrics {
     pub max_channel_error: u8,
     /// Peak signal-to-noise ratio in dB over all channels (infinite for identical images).
     pub psnr_db: f64,
+    /// Structural similarity (image-compare's mean SSIM over 8x8 windows, the lowest of the
+    /// three channels): 1 for identical images, lower as structure and contrast differ.
+    pub ssim: f64,
 }
 
 impl ImageMetrics {
@@ -55,12 +58,71 @@ pub fn compare_images(a: &image::RgbImage, b: &image::RgbImage) -> anyhow::Resul
     } else {
         10.0 * (255.0f64 * 255.0 / mse).log10()
     };
+    let ssim =
+        image_compare::rgb_similarity_structure(&image_compare::Algorithm::MSSIMSimple, a, b)
+            .map_err(|e| anyhow::anyhow!("computing the SSIM: {e}"))?
+            .score;
     Ok(ImageMetrics {
         pixels,
         differing_pixels: differing,
         max_channel_error: max_err,
         psnr_db,
+        ssim,
     })
+}
+
+/// One frame of a simulation folder's page ([`sim_page_html`]).
+#[derive(Clone, Copy, Debug)]
+pub struct PageFrame {
+    /// The RTL frame against the golden one.
+    pub metrics: ImageMetrics,
+    /// `diff<k>.png` was written (the frames differ).
+    pub diff: bool,
+}
+
+/// `index.html` of a simulation folder: per frame the RTL frame (`frame<k>.png`), the golden
+/// frame (`golden<k>.png`) and the diff (`diff<k>.png`, written only when they differ) side
+/// by side, magnified without smoothing, with the differing pixels, PSNR and SSIM.
+pub fn sim_page_html(title: &str, frames: &[PageFrame]) -> String {
+    let esc = |s: &str| {
+        s.replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;")
+            .replace('"', "&quot;")
+    };
+    let mut h = format!(
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{0}</title>\n<style>\n\
+         body {{ font-family: sans-serif; }}\n\
+         figure {{ display: inline-block; margin: 0 1em 1em 0; }}\n\
+         img {{ width: 320px; image-rendering: pixelated; border: 1px solid #888; }}\n\
+         </style></head><body>\n<h1>{0}</h1>\n",
+        esc(title)
+    );
+    for (k, f) in frames.iter().enumerate() {
+        let m = &f.metrics;
+        let verdict = if m.identical() {
+            "identical to the golden model".to_string()
+        } else {
+            format!(
+                "{} of {} pixels differ, PSNR {:.2} dB, SSIM {:.4}",
+                m.differing_pixels, m.pixels, m.psnr_db, m.ssim
+            )
+        };
+        h.push_str(&format!(
+            "<h2>frame {k}: {verdict}</h2>\n\
+             <figure><img src=\"frame{k}.png\" alt=\"RTL frame {k}\"><figcaption>RTL</figcaption></figure>\n\
+             <figure><img src=\"golden{k}.png\" alt=\"golden frame {k}\"><figcaption>golden model</figcaption></figure>\n"
+        ));
+        if f.diff {
+            h.push_str(&format!(
+                "<figure><img src=\"diff{k}.png\" alt=\"diff of frame {k}\"><figcaption>diff (x8)</figcaption></figure>\n"
+            ));
+        } else {
+            h.push_str("<figure><figcaption>no diff: every pixel equal</figcaption></figure>\n");
+        }
+    }
+    h.push_str("</body></html>\n");
+    h
 }
 
 /// A diff image: black where equal, the absolute difference amplified 8x (at least 64 so any
@@ -304,6 +366,75 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("differ in size"));
+    }
+
+    /// A seeded test image with structure: gradients and a checkerboard.
+    fn pattern() -> image::RgbImage {
+        image::RgbImage::from_fn(64, 48, |x, y| {
+            let check = if (x / 8 + y / 8) % 2 == 0 { 60 } else { 0 };
+            image::Rgb([(x * 3) as u8 + check, (y * 4) as u8 + check, 128])
+        })
+    }
+
+    #[test]
+    fn the_sim_page_shows_each_frame_its_golden_frame_and_a_diff_where_they_differ() {
+        let a = pattern();
+        let mut b = a.clone();
+        b.get_pixel_mut(3, 4)[1] ^= 0x40;
+        let frames = [
+            PageFrame {
+                metrics: compare_images(&a, &a).unwrap(),
+                diff: false,
+            },
+            PageFrame {
+                metrics: compare_images(&a, &b).unwrap(),
+                diff: true,
+            },
+        ];
+        let h = sim_page_html("a<b> in verilator", &frames);
+        assert!(h.contains("<title>a&lt;b&gt; in verilator</title>"), "{h}");
+        for src in [
+            "frame0.png",
+            "golden0.png",
+            "frame1.png",
+            "golden1.png",
+            "diff1.png",
+        ] {
+            assert!(h.contains(&format!("src=\"{src}\"")), "{src}");
+        }
+        assert!(
+            !h.contains("diff0.png"),
+            "no diff image for an identical frame"
+        );
+        assert!(h.contains("frame 0: identical"));
+        assert!(h.contains("frame 1: 1 of 3072 pixels differ"), "{h}");
+        assert!(h.contains("SSIM 0.99"), "{h}");
+    }
+
+    #[test]
+    fn ssim_is_one_for_identical_images_and_falls_with_distortion() {
+        use rand::{Rng, SeedableRng};
+        let a = pattern();
+        assert_eq!(compare_images(&a, &a).unwrap().ssim, 1.0);
+        // Noise of +-24 on every channel, seeded.
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut noisy = a.clone();
+        for p in noisy.pixels_mut() {
+            for c in 0..3 {
+                p[c] = (i32::from(p[c]) + rng.gen_range(-24..=24)).clamp(0, 255) as u8;
+            }
+        }
+        let n = compare_images(&a, &noisy).unwrap();
+        // A blur keeps the mean but loses the checkerboard's edges.
+        let blurred = image::imageops::blur(&a, 2.0);
+        let b = compare_images(&a, &blurred).unwrap();
+        // One pixel off by one: almost no structure lost.
+        let mut one = a.clone();
+        one.get_pixel_mut(10, 10)[0] ^= 1;
+        let o = compare_images(&a, &one).unwrap();
+        assert!(o.ssim < 1.0 && o.ssim > 0.999, "{o:?}");
+        assert!(n.ssim < 0.9 && b.ssim < 0.95, "noise {n:?}, blur {b:?}");
+        assert!(n.ssim < o.ssim && b.ssim < o.ssim);
     }
 
     #[test]

@@ -294,6 +294,47 @@ const TESTBENCH_USES: [&str; 20] = [
     "vga_fb_addr",
 ];
 
+/// The define under which the frame testbench closes a Verilator trace at the end of its
+/// window; give it to a Verilator built with `--trace` or `--trace-fst`.
+pub const TRACE_DEFINE: &str = "DYNRT_TRACE";
+
+/// The testbench's waveform window. Icarus ends it with `$dumpoff`; Verilator 5.006 ignores
+/// `$dumpoff`, so the testbench closes the model's trace itself (`_traceDumpClose`, the call
+/// Verilator's own `$finish` makes), which exists only in a model built with tracing, hence
+/// the define.
+const TRACE_WINDOW: &str =
+    "  // +trace=FILE: every signal's waveforms into FILE from the clock +trace_start=C (default 0)
+  // to the clock +trace_end=C (default: the end of the run); clocks count from the start of
+  // the run, frame after frame, and clock c begins at 10c - 5 ns. Icarus writes VCD, FST with
+  // vvp's -fst; Verilator the format it was built with (--trace or --trace-fst, and
+  // -D{define}).
+  string trace_file;
+  reg [63:0] trace_start = 0, trace_end = 0;
+  initial if ($value$plusargs(\"trace=%s\", trace_file)) begin
+    if (!$value$plusargs(\"trace_start=%d\", trace_start)) trace_start = 0;
+    if (!$value$plusargs(\"trace_end=%d\", trace_end)) trace_end = 0;
+`ifdef VERILATOR
+`ifndef {define}
+    $display(\"+trace: this Verilator model was built without --trace; no waveforms\");
+`endif
+`endif
+    wait (clocks == trace_start);
+    $dumpfile(trace_file);
+    $dumpvars(0, tb);
+    if (trace_end != 0) begin
+      wait (clocks == trace_end);
+`ifdef VERILATOR
+`ifdef {define}
+      $c(\"vlSymsp->_traceDumpClose();\");
+`endif
+`else
+      $dumpoff;
+      $dumpflush;
+`endif
+    end
+  end
+";
+
 /// The frame testbench (module `tb`) of a processor with the top ports `ports`
 /// ([`ProcessorRtl::ports`]): the device under test is instantiated from that list, so a port
 /// the testbench needs and the processor lacks is an error here, not in a simulator.
@@ -327,7 +368,8 @@ pub fn processor_testbench(
         v,
         "// tb: runs {} frame(s) of {PROCESSOR_TOP}. Plusargs: +mem_dir=DIR (the memory images, \
          default mem),\n// +out_dir=DIR (where frame<k>.hex and frame<k>.stats go, default .), \
-         +vga (capture a displayed frame),\n// +heartbeat=N (a progress line every N clocks).\n\
+         +vga (capture a displayed frame),\n// +heartbeat=N (a progress line every N clocks), \
+         +trace=FILE +trace_start=C +trace_end=C (waveforms).\n\
          `timescale 1ns/1ps\nmodule tb;",
         frames.updates.len() + 1
     );
@@ -370,6 +412,7 @@ pub fn processor_testbench(
          \x20   if (heartbeat != 0 && clocks % heartbeat == 0 && clocks != 0)\n\
          \x20     $display(\"dynrt-heartbeat frame %0d: %0d cycles, %0d rays\", frame, cycles, rays);\n\
          \x20 end\n\
+         {trace}\
          \x20 // The display's pixel clock (25 MHz against the core's 100 MHz here; running only with\n\
          \x20 // +vga, so that frame runs do not simulate it) and its read port on the frame bank,\n\
          \x20 // one clock of latency.\n\
@@ -384,7 +427,8 @@ pub fn processor_testbench(
             .iter()
             .map(|p| format!(".{0}({0})", p.name))
             .collect::<Vec<_>>()
-            .join(", ")
+            .join(", "),
+        trace = TRACE_WINDOW.replace("{define}", TRACE_DEFINE)
     );
     for b in [1, 4, 5] {
         let _ = writeln!(

@@ -68,7 +68,7 @@ fn bank_advice(bank: usize) -> &'static str {
         NODES | LISTS => "use fewer triangles per object (simplify the mesh) or instance repeated parts",
         TRIANGLES_UV | TRIANGLES_T => "use fewer triangles (simplify the mesh, a coarser generator) or instance repeated objects",
         INSTANCES => "use fewer instances",
-        _ => "use a lower resolution (the scene's [camera] width and height, or --width/--height of render, rtl and sim), fewer lights or fewer materials",
+        _ => "use a lower resolution (the scene's [camera] width and height, or --size WxH of render, rtl and sim), fewer lights or fewer materials",
     }
 }
 

@@ -127,6 +127,25 @@ pub(crate) fn version_after(text: &str, marker: &str) -> Option<String> {
     })
 }
 
+/// The waveform file format of a traced simulation ([`SimJob::trace`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum TraceFormat {
+    /// Value change dump (IEEE 1364): text, read by every waveform viewer, large.
+    Vcd,
+    /// GTKWave's Fast Signal Trace: compressed, 10-50x smaller than VCD.
+    Fst,
+}
+
+impl TraceFormat {
+    /// The file extension (and the CLI name).
+    pub fn extension(self) -> &'static str {
+        match self {
+            TraceFormat::Vcd => "vcd",
+            TraceFormat::Fst => "fst",
+        }
+    }
+}
+
 /// One simulation: sources, testbench top, where to run, how long it may take.
 #[derive(Debug, Clone)]
 pub struct SimJob {
@@ -155,6 +174,11 @@ pub struct SimJob {
     /// profile) runs the kept build without compiling ([`CompiledSim::reused`]). Off: a fresh
     /// build folder per job.
     pub reuse_build: bool,
+    /// Build and run so that the testbench's `$dumpfile`/`$dumpvars` write this format:
+    /// Verilator is built with `--trace` or `--trace-fst`; Icarus's `vvp` gets `-fst` for FST
+    /// (it writes VCD without). `None`: Verilator ignores the dump calls, and runs at full
+    /// speed.
+    pub trace: Option<TraceFormat>,
 }
 
 /// C++ optimisation of a Verilator model: a trade of build time against run time.
@@ -210,7 +234,14 @@ impl SimJob {
             verilator_jobs: 2,
             verilator_build: VerilatorBuild::Quick,
             reuse_build: false,
+            trace: None,
         }
+    }
+
+    /// See [`SimJob::trace`].
+    pub fn trace(mut self, format: Option<TraceFormat>) -> SimJob {
+        self.trace = format;
+        self
     }
 
     /// See [`SimJob::reuse_build`].
@@ -278,6 +309,8 @@ pub struct CompiledSim {
     pub compile_log: String,
     /// The build of an earlier job with the same inputs was run, nothing was compiled.
     pub reused: bool,
+    /// The waveform format the testbench's dump calls write (see [`SimJob::trace`]).
+    pub trace: Option<TraceFormat>,
 }
 
 /// Compiles `job` in `sim` into a fresh build directory inside `job.work_dir` (or reuses the
@@ -300,6 +333,7 @@ pub fn compile(sim: Simulator, job: &SimJob) -> Result<CompiledSim, ToolError> {
                 compile_seconds: 0.0,
                 compile_log: String::new(),
                 reused: true,
+                trace: job.trace,
             });
         }
         // Stale or half-built: start clean, so that no old object survives a change.
@@ -337,28 +371,50 @@ fn artifact_path(sim: Simulator, job: &SimJob, build_dir: &Path) -> PathBuf {
 }
 
 /// What a build depends on, as text: the simulator and its version, the build settings, and
-/// of each source its path, length and 64-bit FNV-1a hash.
+/// of each source its path, length and 64-bit FNV-1a hash, without the source's provenance
+/// header ([`without_provenance`]).
 fn build_stamp(sim: Simulator, job: &SimJob, p: &Prepared) -> Result<String, ToolError> {
     let mut stamp = format!(
-        "{sim} {}\ntop {}\ndefines {:?}\nincludes {:?}\nverilator {:?} -j{}\n",
+        "{sim} {}\ntop {}\ndefines {:?}\nincludes {:?}\nverilator {:?} -j{}\ntrace {:?}\n",
         tool_version(sim)?,
         job.top,
         job.defines,
         p.include_dirs,
         job.verilator_build,
-        job.verilator_jobs
+        job.verilator_jobs,
+        job.trace
     );
     for s in &p.sources {
         let bytes = std::fs::read(s).map_err(|e| ToolError::Io {
             context: format!("reading {}", s.display()),
             source: e,
         })?;
+        let bytes = without_provenance(&bytes);
         let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
             (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
         });
         stamp.push_str(&format!("{} {} {hash:016x}\n", s.display(), bytes.len()));
     }
     Ok(stamp)
+}
+
+/// `source` without the provenance header dynrt writes at the top of a generated file (the
+/// comment lines of [`crate::provenance::GeneratedBy::comment`]): it names the command line,
+/// which changes with every flag (a new `--trace-start`, another `--out`), and a comment
+/// changes nothing a simulator builds.
+fn without_provenance(source: &[u8]) -> &[u8] {
+    let first = format!("// {}", crate::provenance::HEADER_PREFIX);
+    if !source.starts_with(first.as_bytes()) {
+        return source;
+    }
+    let mut rest = source;
+    while rest.starts_with(first.as_bytes()) || rest.starts_with(b"// command: ") {
+        rest = match rest.iter().position(|&b| b == b'\n') {
+            Some(end) => &rest[end + 1..],
+            None => &[],
+        };
+    }
+    rest
 }
 
 impl CompiledSim {
@@ -370,6 +426,10 @@ impl CompiledSim {
                 let mut c = Command::new("vvp");
                 // -n: $stop ends the run instead of dropping into the interactive prompt.
                 c.arg("-n").arg(&self.artifact);
+                // An extended argument (after the file): $dumpfile writes FST, not VCD.
+                if self.trace == Some(TraceFormat::Fst) {
+                    c.arg("-fst");
+                }
                 ("vvp".to_string(), c)
             }
             Simulator::Verilator => (format!("V{}", self.top), Command::new(&self.artifact)),
@@ -535,6 +595,7 @@ fn compile_icarus(job: &SimJob, p: Prepared) -> Result<CompiledSim, ToolError> {
         compile_seconds: built.seconds,
         compile_log: built.combined(),
         reused: false,
+        trace: job.trace,
     })
 }
 
@@ -559,6 +620,11 @@ fn compile_verilator(job: &SimJob, p: Prepared) -> Result<CompiledSim, ToolError
     for flag in job.verilator_build.make_flags() {
         compile.args(["-MAKEFLAGS", flag]);
     }
+    match job.trace {
+        Some(TraceFormat::Vcd) => compile.arg("--trace"),
+        Some(TraceFormat::Fst) => compile.arg("--trace-fst"),
+        None => &mut compile,
+    };
     for (name, value) in &job.defines {
         compile.arg(format!("-D{}", define_arg(name, value)));
     }
@@ -581,6 +647,7 @@ fn compile_verilator(job: &SimJob, p: Prepared) -> Result<CompiledSim, ToolError
         compile_seconds: built.seconds,
         compile_log: built.combined(),
         reused: false,
+        trace: job.trace,
     })
 }
 

@@ -11,13 +11,14 @@ use crate::emit::memory_images::{write_frame_update, write_memory_images};
 use crate::emit::package::cocotb_files;
 use crate::emit::processor::{
     display_mode, processor_rtl, processor_testbench, ProcessorParams, TestbenchFrames,
+    TRACE_DEFINE,
 };
 use crate::hw::processor::TopPort;
 use crate::hw::program::Program;
 use crate::layout::Layout;
 use crate::output::write_atomically;
 use crate::provenance::GeneratedBy;
-use crate::sim::{self, SimJob, Simulator, VerilatorBuild};
+use crate::sim::{self, SimJob, Simulator, TraceFormat, VerilatorBuild};
 
 /// One simulated frame.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -42,6 +43,8 @@ pub struct ProcessorSim {
     /// The build folder of an earlier run with the same Verilog was run again.
     pub reused_build: bool,
     pub tool_version: String,
+    /// With [`SimRun::trace`]: the waveform file written.
+    pub trace: Option<PathBuf>,
     /// With `capture_vga`: the visible pixels of the display's next frame after the last
     /// rendered one, `0xRRGGBB` in raster order.
     pub vga: Option<Vec<u32>>,
@@ -147,6 +150,41 @@ pub struct SimRun {
     /// Also capture one frame of the display's output after the last rendered frame (about
     /// 420,000 pixel clocks: minutes in Icarus).
     pub capture_vga: bool,
+    /// Dump the waveforms of every signal for a window of clocks.
+    pub trace: Option<TraceWindow>,
+}
+
+/// Waveforms of a window of clocks: the testbench counts clocks from the start of the run
+/// (frame after frame) and dumps from the rising edge that begins clock `start` to the one
+/// that begins clock `end` (the end of the run without `end`). In the testbench's time, clock
+/// `c` begins at `10 * c - 5` ns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TraceWindow {
+    pub format: TraceFormat,
+    pub start: u64,
+    pub end: Option<u64>,
+}
+
+impl TraceWindow {
+    /// The file the waveforms go to, in the simulation's folder.
+    pub fn file_name(&self) -> String {
+        format!("trace.{}", self.format.extension())
+    }
+
+    /// Refuses an empty window, naming the flags.
+    pub fn check(&self) -> Result<()> {
+        if let Some(end) = self.end {
+            if end <= self.start {
+                bail!(
+                    "--trace-end {end} is not after --trace-start {}: give a window of at least one clock, e.g. --trace-start {} --trace-end {}",
+                    self.start,
+                    self.start,
+                    self.start + 1000
+                );
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Simulates the processor for `program` on `layouts` as `run` says, in `dir`. The build
@@ -164,7 +202,11 @@ pub fn simulate_processor(
         sim,
         cycle_limit,
         capture_vga,
+        trace,
     } = run;
+    if let Some(t) = &trace {
+        t.check()?;
+    }
     let files = write_processor_files(
         program,
         layouts,
@@ -179,12 +221,26 @@ pub fn simulate_processor(
     }
     let vga_path = dir.join("vga.hex");
     let _ = std::fs::remove_file(&vga_path);
+    // An earlier run's waveforms in either format would pass for this run's.
+    for format in [TraceFormat::Vcd, TraceFormat::Fst] {
+        let _ = std::fs::remove_file(dir.join(format!("trace.{}", format.extension())));
+    }
     let mut job = SimJob::new(dir, vec![files.rtl, files.testbench], "tb")
         .timeout(Duration::from_secs(3600))
         .verilator_build(VerilatorBuild::Fast)
-        .reuse_build(true);
+        .reuse_build(true)
+        .trace(trace.map(|t| t.format));
     if capture_vga {
         job = job.plusarg("vga");
+    }
+    if let Some(t) = &trace {
+        job = job
+            .define(TRACE_DEFINE, None)
+            .plusarg(format!("trace={}", t.file_name()))
+            .plusarg(format!("trace_start={}", t.start));
+        if let Some(end) = t.end {
+            job = job.plusarg(format!("trace_end={end}"));
+        }
     }
     // A heartbeat every few seconds of either simulator (Icarus runs the processor at
     // 150-400 clocks/s, Verilator at about 250k).
@@ -280,9 +336,25 @@ pub fn simulate_processor(
     } else {
         None
     };
+    let trace = match trace {
+        Some(t) => {
+            let path = dir.join(t.file_name());
+            if !path.is_file() {
+                let clocks: u64 = frames.iter().map(|f| f.cycles).sum();
+                bail!(
+                    "--trace-start {}: the run ended before that clock, so no waveforms were \
+                     written (its frames took {clocks} clocks in all); give a start below {clocks}",
+                    t.start
+                );
+            }
+            Some(path)
+        }
+        None => None,
+    };
     Ok(ProcessorSim {
         frames,
         vga,
+        trace,
         compile_seconds: run.compile_seconds,
         run_seconds: run.run_seconds,
         reused_build: run.reused_build,

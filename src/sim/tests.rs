@@ -187,6 +187,28 @@ fn a_kept_build_is_reused_until_its_inputs_change() {
         assert!(out.stdout.contains("FINISHED 8"), "{sim}: {}", out.stdout);
         let other = compile(sim, &job.clone().define("EXTRA", None)).unwrap();
         assert!(!other.reused, "{sim}: a new define must be compiled");
+        // Another command line in the provenance header is no change; tracing is.
+        let text = std::fs::read_to_string(&src).unwrap();
+        let header = |command: &str| {
+            crate::provenance::GeneratedBy {
+                version: "0.1.0".into(),
+                commit: Some("abc".into()),
+                command: Some(command.into()),
+            }
+            .comment("//")
+        };
+        std::fs::write(&src, header("dynrt sim a.toml --out x") + &text).unwrap();
+        assert!(
+            !compile(sim, &job).unwrap().reused,
+            "{sim}: the define went"
+        );
+        std::fs::write(&src, header("dynrt sim a.toml --trace --out y") + &text).unwrap();
+        assert!(
+            compile(sim, &job).unwrap().reused,
+            "{sim}: only the header's command line changed"
+        );
+        let traced = compile(sim, &job.clone().trace(Some(TraceFormat::Fst))).unwrap();
+        assert!(!traced.reused, "{sim}: a traced build is another build");
         let builds = std::fs::read_dir(dir.path())
             .unwrap()
             .filter(|e| {

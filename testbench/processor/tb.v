@@ -2,7 +2,7 @@
 // command: dynrt rtl scenes/cornell.toml --out out/rtl/cornell --stable-header
 // tb: runs 1 frame(s) of dynrt_processor. Plusargs: +mem_dir=DIR (the memory images, default mem),
 // +out_dir=DIR (where frame<k>.hex and frame<k>.stats go, default .), +vga (capture a displayed frame),
-// +heartbeat=N (a progress line every N clocks).
+// +heartbeat=N (a progress line every N clocks), +trace=FILE +trace_start=C +trace_end=C (waveforms).
 `timescale 1ns/1ps
 module tb;
   reg clock = 1'b0;
@@ -62,6 +62,36 @@ module tb;
     if (fb_write) rays <= rays + 1;
     if (heartbeat != 0 && clocks % heartbeat == 0 && clocks != 0)
       $display("dynrt-heartbeat frame %0d: %0d cycles, %0d rays", frame, cycles, rays);
+  end
+  // +trace=FILE: every signal's waveforms into FILE from the clock +trace_start=C (default 0)
+  // to the clock +trace_end=C (default: the end of the run); clocks count from the start of
+  // the run, frame after frame, and clock c begins at 10c - 5 ns. Icarus writes VCD, FST with
+  // vvp's -fst; Verilator the format it was built with (--trace or --trace-fst, and
+  // -DDYNRT_TRACE).
+  string trace_file;
+  reg [63:0] trace_start = 0, trace_end = 0;
+  initial if ($value$plusargs("trace=%s", trace_file)) begin
+    if (!$value$plusargs("trace_start=%d", trace_start)) trace_start = 0;
+    if (!$value$plusargs("trace_end=%d", trace_end)) trace_end = 0;
+`ifdef VERILATOR
+`ifndef DYNRT_TRACE
+    $display("+trace: this Verilator model was built without --trace; no waveforms");
+`endif
+`endif
+    wait (clocks == trace_start);
+    $dumpfile(trace_file);
+    $dumpvars(0, tb);
+    if (trace_end != 0) begin
+      wait (clocks == trace_end);
+`ifdef VERILATOR
+`ifdef DYNRT_TRACE
+      $c("vlSymsp->_traceDumpClose();");
+`endif
+`else
+      $dumpoff;
+      $dumpflush;
+`endif
+    end
   end
   // The display's pixel clock (25 MHz against the core's 100 MHz here; running only with
   // +vga, so that frame runs do not simulate it) and its read port on the frame bank,
