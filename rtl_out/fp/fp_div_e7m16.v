@@ -500,9 +500,9 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
     reg  valid__16__d;
     wire  valid__16__q;
     reg  valid__16__clock;
-    reg  [17:0] last_rem__d;
-    wire  [17:0] last_rem__q;
-    reg  last_rem__clock;
+    reg  last_sticky__d;
+    wire  last_sticky__q;
+    reg  last_sticky__clock;
     reg  [17:0] last_quo__d;
     wire  [17:0] last_quo__q;
     reg  last_quo__clock;
@@ -548,7 +548,8 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
     reg  [17:0] sig_a;
     reg  [17:0] sig_b;
     reg  a_below_b;
-    reg  [17:0] dividend;
+    reg  [17:0] rem_first;
+    reg  [17:0] rem_first_doubled;
     reg  [16:0] sig;
     reg  round_up;
     
@@ -1333,10 +1334,10 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         .q(valid__16__q),
         .clock(valid__16__clock)
     );
-    fp_div_e7m16_core__divisor__0 last_rem(
-        .d(last_rem__d),
-        .q(last_rem__q),
-        .clock(last_rem__clock)
+    fp_div_e7m16_core__in_valid_r last_sticky(
+        .d(last_sticky__d),
+        .q(last_sticky__q),
+        .clock(last_sticky__clock)
     );
     fp_div_e7m16_core__divisor__0 last_quo(
         .d(last_quo__d),
@@ -1392,7 +1393,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         in_a__clock = clock;
         in_b__clock = clock;
         in_valid_r__clock = clock;
-        last_rem__clock = clock;
+        last_sticky__clock = clock;
         last_quo__clock = clock;
         last_exp__clock = clock;
         last_sign__clock = clock;
@@ -1403,7 +1404,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         in_a__d = in_a__q;
         in_b__d = in_b__q;
         in_valid_r__d = in_valid_r__q;
-        last_rem__d = last_rem__q;
+        last_sticky__d = last_sticky__q;
         last_quo__d = last_quo__q;
         last_exp__d = last_exp__q;
         last_sign__d = last_sign__q;
@@ -1578,11 +1579,12 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         sig_a = ((in_a__q[(32'h0)+:(16)]) & 18'h3ffff) | c_hidden;
         sig_b = ((in_b__q[(32'h0)+:(16)]) & 18'h3ffff) | c_hidden;
         a_below_b = sig_a < sig_b;
-        dividend = sig_a;
+        rem_first = sig_a - sig_b;
+        rem_first_doubled = (sig_a << 32'h1) - sig_b;
+        rem__0__d = rem_first << 32'h1;
         if (a_below_b) begin
-            dividend = sig_a << 32'h1;
+            rem__0__d = rem_first_doubled << 32'h1;
         end
-        rem__0__d = (dividend - sig_b) << 32'h1;
         quo__0__d = c_one;
         divisor__0__d = sig_b;
         exp__0__d = (((exp_a) & 9'h1ff) - ((exp_b) & 9'h1ff)) + c_bias;
@@ -1835,11 +1837,11 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         zero__16__d = zero__15__q;
         valid__16__d = valid__15__q;
         if (rem__16__q >= divisor__16__q) begin
-            last_rem__d = rem__16__q - divisor__16__q;
+            last_sticky__d = rem__16__q != divisor__16__q;
             last_quo__d = (quo__16__q << 32'h1) | c_one;
         end
         else begin
-            last_rem__d = rem__16__q;
+            last_sticky__d = |rem__16__q;
             last_quo__d = quo__16__q << 32'h1;
         end
         last_exp__d = exp__16__q;
@@ -1849,7 +1851,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         last_zero__d = zero__16__q;
         last_valid__d = valid__16__q;
         sig = last_quo__q[(32'h1)+:(17)];
-        round_up = last_quo__q[32'h0] & ((|last_rem__q) | sig[32'h0]);
+        round_up = last_quo__q[32'h0] & (last_sticky__q | sig[32'h0]);
         pack__clock = clock;
         pack__in_valid = last_valid__q;
         pack__sig = sig;

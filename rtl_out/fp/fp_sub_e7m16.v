@@ -66,8 +66,8 @@ module fp_sub_e7m16_core(clock,in_valid,a,b,sub,out_valid,result);
     reg  [6:0] big_exp__d;
     wire  [6:0] big_exp__q;
     reg  big_exp__clock;
-    reg  [6:0] shift__d;
-    wire  [6:0] shift__q;
+    reg  [4:0] shift__d;
+    wire  [4:0] shift__q;
     reg  shift__clock;
     reg  big_sign__d;
     wire  big_sign__q;
@@ -251,6 +251,7 @@ module fp_sub_e7m16_core(clock,in_valid,a,b,sub,out_valid,result);
     reg  nan_b;
     reg  [23:0] mag_a;
     reg  [23:0] mag_b;
+    reg  a_first;
     reg  [16:0] sig_a;
     reg  [16:0] sig_b;
     reg  [6:0] diff_ab;
@@ -322,7 +323,7 @@ module fp_sub_e7m16_core(clock,in_valid,a,b,sub,out_valid,result);
         .q(big_exp__q),
         .clock(big_exp__clock)
     );
-    fp_sub_e7m16_core__al_exp shift(
+    fp_sub_e7m16_core__shift shift(
         .d(shift__d),
         .q(shift__q),
         .clock(shift__clock)
@@ -755,13 +756,11 @@ module fp_sub_e7m16_core(clock,in_valid,a,b,sub,out_valid,result);
         mag_a = in_a__q & c_mag_mask;
         sig_a = ((in_a__q[(32'h0)+:(16)]) & 17'h1ffff) | c_hidden;
         if (zero_a) begin
-            mag_a = 32'h0;
             sig_a = 32'h0;
         end
         mag_b = in_b__q & c_mag_mask;
         sig_b = ((in_b__q[(32'h0)+:(16)]) & 17'h1ffff) | c_hidden;
         if (zero_b) begin
-            mag_b = 32'h0;
             sig_b = 32'h0;
         end
         diff_ab = exp_a - exp_b;
@@ -774,18 +773,19 @@ module fp_sub_e7m16_core(clock,in_valid,a,b,sub,out_valid,result);
         if (diff_ba > c_shift_max) begin
             shift_ba = c_shift_max;
         end
-        if (mag_a >= mag_b) begin
+        a_first = zero_b | ((~zero_a) & (mag_a >= mag_b));
+        if (a_first) begin
             big_sig__d = sig_a;
             small_sig__d = sig_b;
             big_exp__d = exp_a;
-            shift__d = shift_ab;
+            shift__d = ((shift_ab) & 5'h1f);
             big_sign__d = sign_a;
         end
         else begin
             big_sig__d = sig_b;
             small_sig__d = sig_a;
             big_exp__d = exp_b;
-            shift__d = shift_ba;
+            shift__d = ((shift_ba) & 5'h1f);
             big_sign__d = sign_b;
         end
         eff_sub__d = sign_a ^ sign_b;
@@ -1160,6 +1160,23 @@ endmodule // fp_sub_e7m16_core__rnd_sig
 
 
 
+module fp_sub_e7m16_core__shift(d,q,clock);
+    
+    // Module arguments
+    input wire  [4:0] d;
+    output reg  [4:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 5'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // fp_sub_e7m16_core__shift
 
 
 

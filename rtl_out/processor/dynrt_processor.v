@@ -1393,7 +1393,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(tri_queues__q),
         .clock(tri_queues__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 tri_kind(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 tri_kind(
         .d(tri_kind__d),
         .q(tri_kind__q),
         .clock(tri_kind__clock)
@@ -2065,12 +2065,16 @@ module dynrt_processor__engine__decode__regs_a(read_address,read_clock,read_data
     input wire  write_enable;
     
     // Update code (custom)
+    (* no_rw_check *)
     reg[31:0] mem[8191:0];
     
-    
-    
     always @(posedge read_clock) begin
+    `ifdef SYNTHESIS
        read_data <= mem[read_address];
+    `else
+       // The owner never uses a word read in the clock that writes its address.
+       read_data <= (write_enable && read_address == write_address) ? 32'bx : mem[read_address];
+    `endif
     end
     
     always @(posedge write_clock) begin
@@ -2078,7 +2082,6 @@ module dynrt_processor__engine__decode__regs_a(read_address,read_clock,read_data
           mem[write_address] <= write_data;
        end
     end
-                
 endmodule // dynrt_processor__engine__decode__regs_a
 
 
@@ -3428,8 +3431,8 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
     reg  [6:0] big_exp__d;
     wire  [6:0] big_exp__q;
     reg  big_exp__clock;
-    reg  [6:0] shift__d;
-    wire  [6:0] shift__q;
+    reg  [4:0] shift__d;
+    wire  [4:0] shift__q;
     reg  shift__clock;
     reg  big_sign__d;
     wire  big_sign__q;
@@ -3613,6 +3616,7 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
     reg  nan_b;
     reg  [23:0] mag_a;
     reg  [23:0] mag_b;
+    reg  a_first;
     reg  [16:0] sig_a;
     reg  [16:0] sig_b;
     reg  [6:0] diff_ab;
@@ -3684,7 +3688,7 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         .q(big_exp__q),
         .clock(big_exp__clock)
     );
-    dynrt_processor__engine__fp_units__add__al_exp shift(
+    dynrt_processor__engine__decode__t3 shift(
         .d(shift__d),
         .q(shift__q),
         .clock(shift__clock)
@@ -4117,13 +4121,11 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         mag_a = in_a__q & c_mag_mask;
         sig_a = ((in_a__q[(32'h0)+:(16)]) & 17'h1ffff) | c_hidden;
         if (zero_a) begin
-            mag_a = 32'h0;
             sig_a = 32'h0;
         end
         mag_b = in_b__q & c_mag_mask;
         sig_b = ((in_b__q[(32'h0)+:(16)]) & 17'h1ffff) | c_hidden;
         if (zero_b) begin
-            mag_b = 32'h0;
             sig_b = 32'h0;
         end
         diff_ab = exp_a - exp_b;
@@ -4136,18 +4138,19 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         if (diff_ba > c_shift_max) begin
             shift_ba = c_shift_max;
         end
-        if (mag_a >= mag_b) begin
+        a_first = zero_b | ((~zero_a) & (mag_a >= mag_b));
+        if (a_first) begin
             big_sig__d = sig_a;
             small_sig__d = sig_b;
             big_exp__d = exp_a;
-            shift__d = shift_ab;
+            shift__d = ((shift_ab) & 5'h1f);
             big_sign__d = sign_a;
         end
         else begin
             big_sig__d = sig_b;
             small_sig__d = sig_a;
             big_exp__d = exp_b;
-            shift__d = shift_ba;
+            shift__d = ((shift_ba) & 5'h1f);
             big_sign__d = sign_b;
         end
         eff_sub__d = sign_a ^ sign_b;
@@ -4600,6 +4603,9 @@ module dynrt_processor__engine__fp_units__byte_unit(clock,in_valid,word,out_vali
     localparam  c_round = 24'h4f0000;
     
     // Stub signals
+    reg  clamp_line__clock;
+    reg  [1:0] clamp_line__data_in;
+    wire  [1:0] clamp_line__data_out;
     reg  scale__clock;
     reg  scale__in_valid;
     reg  [23:0] scale__a;
@@ -4615,9 +4621,14 @@ module dynrt_processor__engine__fp_units__byte_unit(clock,in_valid,word,out_vali
     wire  [23:0] round__result;
     
     // Local signals
-    reg  [23:0] clamped;
+    reg  [1:0] clamp;
     
     // Sub module instances
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line clamp_line(
+        .clock(clamp_line__clock),
+        .data_in(clamp_line__data_in),
+        .data_out(clamp_line__data_out)
+    );
     dynrt_processor__engine__fp_units__byte_unit__scale scale(
         .clock(scale__clock),
         .in_valid(scale__in_valid),
@@ -4640,20 +4651,28 @@ module dynrt_processor__engine__fp_units__byte_unit(clock,in_valid,word,out_vali
     always @(*) begin
         scale__clock = clock;
         round__clock = clock;
+        clamp_line__clock = clock;
         if (((word & c_sign) != 32'h0) | ((word & c_exp_mask) == 32'h0) | (((word & c_exp_mask) == c_exp_mask) & ((word & c_man_mask) != 32'h0))) begin
-            clamped = 32'h0;
+            clamp = 32'h1;
         end
         else if (word > c_one) begin
-            clamped = c_one;
+            clamp = 32'h2;
         end
         else begin
-            clamped = word;
+            clamp = 32'h0;
         end
+        clamp_line__data_in = clamp;
         scale__in_valid = in_valid;
-        scale__a = clamped;
+        scale__a = word;
         scale__b = c_255;
         round__in_valid = scale__out_valid;
         round__a = scale__result;
+        if (clamp_line__data_out[32'h0]) begin
+            round__a = 32'h0;
+        end
+        else if (clamp_line__data_out[32'h1]) begin
+            round__a = c_255;
+        end
         round__b = c_round;
         round__sub = 1'b0;
         out_valid = round__out_valid;
@@ -4661,6 +4680,93 @@ module dynrt_processor__engine__fp_units__byte_unit(clock,in_valid,word,out_vali
     end
     
 endmodule // dynrt_processor__engine__fp_units__byte_unit
+
+
+module dynrt_processor__engine__fp_units__byte_unit__clamp_line(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [1:0] data_in;
+    output reg  [1:0] data_out;
+    
+    // Stub signals
+    reg  [1:0] stage__0__d;
+    wire  [1:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [1:0] stage__1__d;
+    wire  [1:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [1:0] stage__2__d;
+    wire  [1:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [1:0] stage__3__d;
+    wire  [1:0] stage__3__q;
+    reg  stage__3__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+    end
+    
+endmodule // dynrt_processor__engine__fp_units__byte_unit__clamp_line
+
+
+module dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0(d,q,clock);
+    
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0
+
+
+
+
+
+
 
 
 
@@ -5897,9 +6003,9 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  valid__16__d;
     wire  valid__16__q;
     reg  valid__16__clock;
-    reg  [17:0] last_rem__d;
-    wire  [17:0] last_rem__q;
-    reg  last_rem__clock;
+    reg  last_sticky__d;
+    wire  last_sticky__q;
+    reg  last_sticky__clock;
     reg  [17:0] last_quo__d;
     wire  [17:0] last_quo__q;
     reg  last_quo__clock;
@@ -5945,7 +6051,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  [17:0] sig_a;
     reg  [17:0] sig_b;
     reg  a_below_b;
-    reg  [17:0] dividend;
+    reg  [17:0] rem_first;
+    reg  [17:0] rem_first_doubled;
     reg  [16:0] sig;
     reg  round_up;
     
@@ -6730,10 +6837,10 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         .q(valid__16__q),
         .clock(valid__16__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig last_rem(
-        .d(last_rem__d),
-        .q(last_rem__q),
-        .clock(last_rem__clock)
+    dynrt_processor__display__dark_d last_sticky(
+        .d(last_sticky__d),
+        .q(last_sticky__q),
+        .clock(last_sticky__clock)
     );
     dynrt_processor__engine__fp_units__add__rnd_sig last_quo(
         .d(last_quo__d),
@@ -6789,7 +6896,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         in_a__clock = clock;
         in_b__clock = clock;
         in_valid_r__clock = clock;
-        last_rem__clock = clock;
+        last_sticky__clock = clock;
         last_quo__clock = clock;
         last_exp__clock = clock;
         last_sign__clock = clock;
@@ -6800,7 +6907,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         in_a__d = in_a__q;
         in_b__d = in_b__q;
         in_valid_r__d = in_valid_r__q;
-        last_rem__d = last_rem__q;
+        last_sticky__d = last_sticky__q;
         last_quo__d = last_quo__q;
         last_exp__d = last_exp__q;
         last_sign__d = last_sign__q;
@@ -6975,11 +7082,12 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         sig_a = ((in_a__q[(32'h0)+:(16)]) & 18'h3ffff) | c_hidden;
         sig_b = ((in_b__q[(32'h0)+:(16)]) & 18'h3ffff) | c_hidden;
         a_below_b = sig_a < sig_b;
-        dividend = sig_a;
+        rem_first = sig_a - sig_b;
+        rem_first_doubled = (sig_a << 32'h1) - sig_b;
+        rem__0__d = rem_first << 32'h1;
         if (a_below_b) begin
-            dividend = sig_a << 32'h1;
+            rem__0__d = rem_first_doubled << 32'h1;
         end
-        rem__0__d = (dividend - sig_b) << 32'h1;
         quo__0__d = c_one;
         divisor__0__d = sig_b;
         exp__0__d = (((exp_a) & 9'h1ff) - ((exp_b) & 9'h1ff)) + c_bias;
@@ -7232,11 +7340,11 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         zero__16__d = zero__15__q;
         valid__16__d = valid__15__q;
         if (rem__16__q >= divisor__16__q) begin
-            last_rem__d = rem__16__q - divisor__16__q;
+            last_sticky__d = rem__16__q != divisor__16__q;
             last_quo__d = (quo__16__q << 32'h1) | c_one;
         end
         else begin
-            last_rem__d = rem__16__q;
+            last_sticky__d = |rem__16__q;
             last_quo__d = quo__16__q << 32'h1;
         end
         last_exp__d = exp__16__q;
@@ -7246,7 +7354,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         last_zero__d = zero__16__q;
         last_valid__d = valid__16__q;
         sig = last_quo__q[(32'h1)+:(17)];
-        round_up = last_quo__q[32'h0] & ((|last_rem__q) | sig[32'h0]);
+        round_up = last_quo__q[32'h0] & (last_sticky__q | sig[32'h0]);
         pack__clock = clock;
         pack__in_valid = last_valid__q;
         pack__sig = sig;
@@ -13939,6 +14047,11 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     localparam  c_thread_mask = 32'hffffffff;
     localparam  c_one = 32'h1;
     localparam  c_ones = 32'hffffffff;
+    localparam  c_number_bit__0 = 32'haaaaaaaa;
+    localparam  c_number_bit__1 = 32'hcccccccc;
+    localparam  c_number_bit__2 = 32'hf0f0f0f0;
+    localparam  c_number_bit__3 = 32'hff00ff00;
+    localparam  c_number_bit__4 = 32'hffff0000;
     localparam  c_reserve_bit = 32'h6;
     
     // Stub signals
@@ -13954,9 +14067,6 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     reg  picked__d;
     wire  picked__q;
     reg  picked__clock;
-    reg  [4:0] pick_r__d;
-    wire  [4:0] pick_r__q;
-    reg  pick_r__clock;
     reg  [31:0] pick_onehot__d;
     wire  [31:0] pick_onehot__q;
     reg  pick_onehot__clock;
@@ -13973,9 +14083,13 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     reg  [31:0] first_ready__others;
     wire  first_ready__found;
     wire  [31:0] first_ready__onehot;
-    wire  [4:0] first_ready__number;
     
     // Local signals
+    reg  pick_bits__0;
+    reg  pick_bits__1;
+    reg  pick_bits__2;
+    reg  pick_bits__3;
+    reg  pick_bits__4;
     reg  [31:0] candidates;
     reg  [31:0] below;
     reg  issues;
@@ -14009,11 +14123,6 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         .q(picked__q),
         .clock(picked__clock)
     );
-    dynrt_processor__engine__decode__t3 pick_r(
-        .d(pick_r__d),
-        .q(pick_r__q),
-        .clock(pick_r__clock)
-    );
     dynrt_processor__engine__cycle_count pick_onehot(
         .d(pick_onehot__d),
         .q(pick_onehot__q),
@@ -14038,8 +14147,7 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         .preferred(first_ready__preferred),
         .others(first_ready__others),
         .found(first_ready__found),
-        .onehot(first_ready__onehot),
-        .number(first_ready__number)
+        .onehot(first_ready__onehot)
     );
     
     // Update code
@@ -14048,7 +14156,6 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         asleep__clock = clock;
         woken__clock = clock;
         picked__clock = clock;
-        pick_r__clock = clock;
         pick_onehot__clock = clock;
         pointer__clock = clock;
         below_pointer__clock = clock;
@@ -14057,14 +14164,18 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         asleep__d = asleep__q;
         woken__d = woken__q;
         picked__d = picked__q;
-        pick_r__d = pick_r__q;
         pick_onehot__d = pick_onehot__q;
         pointer__d = pointer__q;
         below_pointer__d = below_pointer__q;
         reserved__d = reserved__q;
         issues = running & picked__q & (~reserved__q[32'h0]);
         issue = issues;
-        pick = pick_r__q;
+        pick_bits__0 = (pick_onehot__q & c_number_bit__0) != 32'h0;
+        pick_bits__1 = (pick_onehot__q & c_number_bit__1) != 32'h0;
+        pick_bits__2 = (pick_onehot__q & c_number_bit__2) != 32'h0;
+        pick_bits__3 = (pick_onehot__q & c_number_bit__3) != 32'h0;
+        pick_bits__4 = (pick_onehot__q & c_number_bit__4) != 32'h0;
+        pick = ((pick_bits__0) & 5'h1f) | (((pick_bits__1) & 5'h1f) << 32'h1) | (((pick_bits__2) & 5'h1f) << 32'h2) | (((pick_bits__3) & 5'h1f) << 32'h3) | (((pick_bits__4) & 5'h1f) << 32'h4);
         issue_mask = 32'h0;
         if (issues) begin
             issue_mask = pick_onehot__q;
@@ -14075,7 +14186,6 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         first_ready__preferred = below;
         first_ready__others = candidates;
         picked__d = first_ready__found;
-        pick_r__d = first_ready__number;
         pick_onehot__d = first_ready__onehot;
         pointer__d = pointer__q - 32'h1;
         below_pointer__d = ~(c_ones << (pointer__q - 32'h1));
@@ -14119,24 +14229,18 @@ endmodule // dynrt_processor__engine__scheduler
 
 
 
-module dynrt_processor__engine__scheduler__first_ready(preferred,others,found,onehot,number);
+module dynrt_processor__engine__scheduler__first_ready(preferred,others,found,onehot);
     
     // Module arguments
     input wire  [31:0] preferred;
     input wire  [31:0] others;
     output reg  found;
     output reg  [31:0] onehot;
-    output reg  [4:0] number;
     
     // Constant declarations
     localparam  c_group_low = 64'h1111111111111111;
     localparam  c_below_3 = 64'h7777777777777777;
     localparam  c_below_2 = 64'h3333333333333333;
-    localparam  c_number_bit__0 = 32'haaaaaaaa;
-    localparam  c_number_bit__1 = 32'hcccccccc;
-    localparam  c_number_bit__2 = 32'hf0f0f0f0;
-    localparam  c_number_bit__3 = 32'hff00ff00;
-    localparam  c_number_bit__4 = 32'hffff0000;
     
     // Local signals
     reg  [63:0] both;
@@ -14151,11 +14255,6 @@ module dynrt_processor__engine__scheduler__first_ready(preferred,others,found,on
     reg  [63:0] group_mask;
     reg  [63:0] higher_in_group;
     reg  [63:0] first;
-    reg  number_bits__0;
-    reg  number_bits__1;
-    reg  number_bits__2;
-    reg  number_bits__3;
-    reg  number_bits__4;
     
     // Update code
     always @(*) begin
@@ -14172,18 +14271,10 @@ module dynrt_processor__engine__scheduler__first_ready(preferred,others,found,on
         higher_in_group = ((both >> 32'h1) & c_below_3) | ((both >> 32'h2) & c_below_2) | ((both >> 32'h3) & c_group_low);
         first = both & (~higher_in_group) & group_mask;
         onehot = first[(32'h0)+:(32)] | first[(32'h20)+:(32)];
-        number_bits__0 = (onehot & c_number_bit__0) != 32'h0;
-        number_bits__1 = (onehot & c_number_bit__1) != 32'h0;
-        number_bits__2 = (onehot & c_number_bit__2) != 32'h0;
-        number_bits__3 = (onehot & c_number_bit__3) != 32'h0;
-        number_bits__4 = (onehot & c_number_bit__4) != 32'h0;
-        number = ((number_bits__0) & 5'h1f) | (((number_bits__1) & 5'h1f) << 32'h1) | (((number_bits__2) & 5'h1f) << 32'h2) | (((number_bits__3) & 5'h1f) << 32'h3) | (((number_bits__4) & 5'h1f) << 32'h4);
         found = both != 32'h0;
     end
     
 endmodule // dynrt_processor__engine__scheduler__first_ready
-
-
 
 
 
@@ -14882,12 +14973,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(loaded__1__q),
         .clock(loaded__1__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 cur_kind__0(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 cur_kind__0(
         .d(cur_kind__0__d),
         .q(cur_kind__0__q),
         .clock(cur_kind__0__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 cur_kind__1(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 cur_kind__1(
         .d(cur_kind__1__d),
         .q(cur_kind__1__q),
         .clock(cur_kind__1__clock)
@@ -15207,7 +15298,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m1_hit__q),
         .clock(m1_hit__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 m1_kind(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 m1_kind(
         .d(m1_kind__d),
         .q(m1_kind__q),
         .clock(m1_kind__clock)
@@ -15232,7 +15323,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m2_hit__q),
         .clock(m2_hit__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 m2_kind(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 m2_kind(
         .d(m2_kind__d),
         .q(m2_kind__q),
         .clock(m2_kind__clock)
@@ -15277,7 +15368,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m3_hit__q),
         .clock(m3_hit__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 m3_kind(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 m3_kind(
         .d(m3_kind__d),
         .q(m3_kind__q),
         .clock(m3_kind__clock)
@@ -15968,23 +16059,6 @@ endmodule // dynrt_processor__engine__tester__best_e
 
 
 
-module dynrt_processor__engine__tester__cur_kind__0(d,q,clock);
-    
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor__engine__tester__cur_kind__0
 
 
 
@@ -19699,6 +19773,9 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
     reg  [23:0] list_end__d;
     wire  [23:0] list_end__q;
     reg  list_end__clock;
+    reg  walked__d;
+    wire  walked__q;
+    reg  walked__clock;
     reg  of_walk__d;
     wire  of_walk__q;
     reg  of_walk__clock;
@@ -19827,6 +19904,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
     reg  wrote_r__7__clock;
     
     // Local signals
+    reg  [23:0] cursor_next;
     reg  take;
     reg  arrive;
     reg  seen;
@@ -19990,6 +20068,11 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .d(list_end__d),
         .q(list_end__q),
         .clock(list_end__clock)
+    );
+    dynrt_processor__display__dark_d walked(
+        .d(walked__d),
+        .q(walked__q),
+        .clock(walked__clock)
     );
     dynrt_processor__display__dark_d of_walk(
         .d(of_walk__d),
@@ -20208,6 +20291,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         walk_thread__clock = clock;
         cursor__clock = clock;
         list_end__clock = clock;
+        walked__clock = clock;
         of_walk__clock = clock;
         object_id__clock = clock;
         skip_object__clock = clock;
@@ -20224,6 +20308,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         walk_thread__d = walk_thread__q;
         cursor__d = cursor__q;
         list_end__d = list_end__q;
+        walked__d = walked__q;
         of_walk__d = of_walk__q;
         object_id__d = object_id__q;
         skip_object__d = skip_object__q;
@@ -20390,6 +20475,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
                 walk_thread__d = commands__data_out[(32'h40)+:(5)];
                 cursor__d = commands__data_out[(32'h20)+:(24)];
                 list_end__d = commands__data_out[(32'h0)+:(24)];
+                walked__d = commands__data_out[(32'h20)+:(24)] == commands__data_out[(32'h0)+:(24)];
                 of_walk__d = commands__data_out[32'h1f];
                 commands__read = 1'b1;
                 phase__d = ListPhase__Read;
@@ -20414,11 +20500,13 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
             ids__7__d = mailbox_ids__7__read_data;
             phase__d = ListPhase__Walk;
         end
-        take = (phase__q == ListPhase__Walk) & (cursor__q != list_end__q) & ((((queued__q) & 5'h1f) + ((flight__q) & 5'h1f) + ((arrive_r__q) & 5'h1f)) < 32'h7) & (~(engine_read & (engine_bank != c_bank_nodes) & (engine_bank != c_bank_uv) & (engine_bank != c_bank_t)));
+        take = (phase__q == ListPhase__Walk) & (~walked__q) & ((((queued__q) & 5'h1f) + ((flight__q) & 5'h1f) + ((arrive_r__q) & 5'h1f)) < 32'h7) & (~(engine_read & (engine_bank != c_bank_nodes) & (engine_bank != c_bank_uv) & (engine_bank != c_bank_t)));
         list_read = take;
         list_addr = cursor__q;
+        cursor_next = cursor__q + 32'h1;
         if (take) begin
-            cursor__d = cursor__q + 32'h1;
+            cursor__d = cursor_next;
+            walked__d = cursor_next == list_end__q;
         end
         flight_line__0__d = take;
         flight_line__1__d = flight_line__0__q;
@@ -20599,7 +20687,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
             mailbox_meta__write_enable = 1'b1;
             mailbox_meta__write_data = (((next_after) & 8'hff) << 32'h4) | ((len_after) & 8'hff);
         end
-        if ((phase__q == ListPhase__Walk) & (cursor__q == list_end__q) & (flight__q == 32'h0) & (~arrive_r__q) & (~tests__full)) begin
+        if ((phase__q == ListPhase__Walk) & walked__q & (flight__q == 32'h0) & (~arrive_r__q) & (~tests__full)) begin
             push = 1'b1;
             tests__data_in = c_list_end | (((of_walk__q) & 71'h7fffffffffffffffff) << 32'h45) | (((walk_thread__q) & 71'h7fffffffffffffffff) << 32'h40);
             phase__d = ListPhase__Idle;
@@ -21542,6 +21630,8 @@ module dynrt_processor__engine__tester__list_unit__tests__write_logic(write,data
     end
     
 endmodule // dynrt_processor__engine__tester__list_unit__tests__write_logic
+
+
 
 
 
@@ -25699,7 +25789,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(job__q),
         .clock(job__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 words_in(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 words_in(
         .d(words_in__d),
         .q(words_in__q),
         .clock(words_in__clock)
@@ -25714,32 +25804,32 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(w1__q),
         .clock(w1__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 node_line__0(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__0(
         .d(node_line__0__d),
         .q(node_line__0__q),
         .clock(node_line__0__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 node_line__1(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__1(
         .d(node_line__1__d),
         .q(node_line__1__q),
         .clock(node_line__1__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 node_line__2(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__2(
         .d(node_line__2__d),
         .q(node_line__2__q),
         .clock(node_line__2__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 node_line__3(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__3(
         .d(node_line__3__d),
         .q(node_line__3__q),
         .clock(node_line__3__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 node_line__4(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__4(
         .d(node_line__4__d),
         .q(node_line__4__q),
         .clock(node_line__4__clock)
     );
-    dynrt_processor__engine__tester__cur_kind__0 node_line__5(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__5(
         .d(node_line__5__d),
         .q(node_line__5__q),
         .clock(node_line__5__clock)
