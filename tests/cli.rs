@@ -132,7 +132,7 @@ fn bad_input_gets_one_clear_error_and_no_output_file() {
                 "--out",
                 o,
             ],
-            "unknown operator `pow`",
+            "invalid value 'pow' for '--op <OP>'",
         ),
         (
             vec![
