@@ -10,14 +10,14 @@
 //! scheduler issues nothing in the one clock whose instruction would write back with it.
 //!
 //! The pick is made a clock ahead: the thread that issues is a one-hot register (its number,
-//! encoded from it, addresses the pc store), chosen the clock before among the threads ready then, less the one
-//! picked then. Round robin: the choice is the highest of them below a pointer that moves
+//! encoded from it, addresses the pc store), chosen the clock before among the threads ready
+//! then, less the one picked then. Round robin: the choice is the highest of them below a pointer that moves
 //! down one thread per clock (a register, so no shifter sits in the choice), else the highest
 //! ([`super::FirstReady`], a tree); every ready thread is first in line at least once per 32
 //! clocks.
 //!
-//! Latency: `issue` and `pick` come from registers (I0); a thread written back (`wb_*`, registered by
-//! the write back) in clock c is ready at c + 1 and issues at c + 2 at the earliest.
+//! Latency: `issue` and `pick` come from registers (I0); a thread written back (`wb_*`,
+//! registered by the write back) in clock c is ready at c + 1 and issues at c + 2 at the earliest.
 //! Throughput: one issue per clock while a thread is ready and the clock is not reserved.
 //!
 //! Golden twin: none of its own. The engine's twin (`hw::program::exec`, see
