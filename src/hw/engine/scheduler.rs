@@ -11,9 +11,10 @@
 //!
 //! The pick is made a clock ahead: the thread that issues is a one-hot register (its number,
 //! encoded from it, addresses the pc store), chosen the clock before among the threads ready
-//! then, less the one picked then. Round robin: the choice is the highest of them below a pointer that moves
-//! down one thread per clock (a register, so no shifter sits in the choice), else the highest
-//! ([`super::FirstReady`], a tree); every ready thread is first in line at least once per 32
+//! then, less the one picked then. Round robin: the choice is the highest of them below a
+//! pointer that moves down one thread per clock (a register, so no shifter sits in the
+//! choice), else the highest ([`super::FirstReady`], a tree); every ready thread is first in
+//! line at least once per 32
 //! clocks.
 //!
 //! Latency: `issue` and `pick` come from registers (I0); a thread written back (`wb_*`,
