@@ -14,8 +14,7 @@
 //! then, less the one picked then. Round robin: the choice is the highest of them below a
 //! pointer that moves down one thread per clock (a register, so no shifter sits in the
 //! choice), else the highest ([`super::FirstReady`], a tree); every ready thread is first in
-//! line at least once per 32
-//! clocks.
+//! line at least once per 32 clocks.
 //!
 //! Latency: `issue` and `pick` come from registers (I0); a thread written back (`wb_*`,
 //! registered by the write back) in clock c is ready at c + 1 and issues at c + 2 at the earliest.
