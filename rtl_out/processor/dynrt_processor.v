@@ -1974,8 +1974,8 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
         regs_b__write_clock = clock;
         reg_a = ctl_i2[(f_a)+:(8)];
         reg_b = ctl_i2[(f_b)+:(8)];
-        regs_a__read_address = (((thread_i2) & 13'h1fff) << 32'h8) | ((reg_a) & 13'h1fff);
-        regs_b__read_address = (((thread_i2) & 13'h1fff) << 32'h8) | ((reg_b) & 13'h1fff);
+        regs_a__read_address = (((reg_a) & 13'h1fff) << 32'h5) | ((thread_i2) & 13'h1fff);
+        regs_b__read_address = (((reg_b) & 13'h1fff) << 32'h5) | ((thread_i2) & 13'h1fff);
         v3__d = valid_i2;
         t3__d = thread_i2;
         pc3__d = pc_i2;
@@ -2021,7 +2021,7 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
         a = a4__q;
         b = b4__q;
         store = store4__q;
-        wb_address = (((wb_thread) & 13'h1fff) << 32'h8) | ((wb_dst) & 13'h1fff);
+        wb_address = (((wb_dst) & 13'h1fff) << 32'h5) | ((wb_thread) & 13'h1fff);
         regs_a__write_address = wb_address;
         regs_b__write_address = wb_address;
         regs_a__write_data = wb_data;
@@ -2066,20 +2066,21 @@ module dynrt_processor__engine__decode__regs_a(read_address,read_clock,read_data
     
     // Update code (custom)
     (* no_rw_check *)
-    reg[31:0] mem[8191:0];
+    reg[31:0] mem[4095:0];
     
     always @(posedge read_clock) begin
     `ifdef SYNTHESIS
-       read_data <= mem[read_address];
+       read_data <= mem[read_address[11:0]];
     `else
        // The owner never uses a word read in the clock that writes its address.
-       read_data <= (write_enable && read_address == write_address) ? 32'bx : mem[read_address];
+       read_data <= (write_enable && read_address[11:0] == write_address[11:0])
+          ? 32'bx : mem[read_address[11:0]];
     `endif
     end
     
     always @(posedge write_clock) begin
        if (write_enable) begin
-          mem[write_address] <= write_data;
+          mem[write_address[11:0]] <= write_data;
        end
     end
 endmodule // dynrt_processor__engine__decode__regs_a
@@ -2379,39 +2380,25 @@ module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl
     
     // Stub signals
     reg  [4:0] pc_ram__read_address;
-    reg  pc_ram__read_clock;
     wire  [15:0] pc_ram__read_data;
-    reg  [4:0] pc_ram__write_address;
     reg  pc_ram__write_clock;
+    reg  [4:0] pc_ram__write_address;
     reg  [15:0] pc_ram__write_data;
     reg  pc_ram__write_enable;
-    reg  [11:0] rom_ctl__read_address;
-    reg  rom_ctl__read_clock;
-    wire  [31:0] rom_ctl__read_data;
-    reg  [11:0] rom_ctl__write_address;
-    reg  rom_ctl__write_clock;
-    reg  [31:0] rom_ctl__write_data;
-    reg  rom_ctl__write_enable;
-    reg  [11:0] rom_imm__read_address;
-    reg  rom_imm__read_clock;
-    wire  [31:0] rom_imm__read_data;
-    reg  [11:0] rom_imm__write_address;
-    reg  rom_imm__write_clock;
-    reg  [31:0] rom_imm__write_data;
-    reg  rom_imm__write_enable;
-    reg  [11:0] rom_aux__read_address;
-    reg  rom_aux__read_clock;
-    wire  [31:0] rom_aux__read_data;
-    reg  [11:0] rom_aux__write_address;
-    reg  rom_aux__write_clock;
-    reg  [31:0] rom_aux__write_data;
-    reg  rom_aux__write_enable;
+    reg  rom__clock;
+    reg  [11:0] rom__address;
+    wire  [31:0] rom__ctl;
+    wire  [31:0] rom__imm;
+    wire  [31:0] rom__aux;
     reg  v1__d;
     wire  v1__q;
     reg  v1__clock;
     reg  [4:0] t1__d;
     wire  [4:0] t1__q;
     reg  t1__clock;
+    reg  [11:0] pc1__d;
+    wire  [11:0] pc1__q;
+    reg  pc1__clock;
     reg  v2__d;
     wire  v2__q;
     reg  v2__clock;
@@ -2421,47 +2408,35 @@ module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl
     reg  [11:0] pc2__d;
     wire  [11:0] pc2__q;
     reg  pc2__clock;
+    reg  [31:0] ctl2__d;
+    wire  [31:0] ctl2__q;
+    reg  ctl2__clock;
+    reg  [31:0] imm2__d;
+    wire  [31:0] imm2__q;
+    reg  imm2__clock;
+    reg  [31:0] aux2__d;
+    wire  [31:0] aux2__q;
+    reg  aux2__clock;
     
     // Local signals
     reg  fresh;
-    reg  [11:0] pc1;
+    reg  [11:0] pc0;
     
     // Sub module instances
     dynrt_processor__engine__fetch__pc_ram pc_ram(
         .read_address(pc_ram__read_address),
-        .read_clock(pc_ram__read_clock),
         .read_data(pc_ram__read_data),
-        .write_address(pc_ram__write_address),
         .write_clock(pc_ram__write_clock),
+        .write_address(pc_ram__write_address),
         .write_data(pc_ram__write_data),
         .write_enable(pc_ram__write_enable)
     );
-    dynrt_processor__engine__fetch__rom_ctl rom_ctl(
-        .read_address(rom_ctl__read_address),
-        .read_clock(rom_ctl__read_clock),
-        .read_data(rom_ctl__read_data),
-        .write_address(rom_ctl__write_address),
-        .write_clock(rom_ctl__write_clock),
-        .write_data(rom_ctl__write_data),
-        .write_enable(rom_ctl__write_enable)
-    );
-    dynrt_processor__engine__fetch__rom_imm rom_imm(
-        .read_address(rom_imm__read_address),
-        .read_clock(rom_imm__read_clock),
-        .read_data(rom_imm__read_data),
-        .write_address(rom_imm__write_address),
-        .write_clock(rom_imm__write_clock),
-        .write_data(rom_imm__write_data),
-        .write_enable(rom_imm__write_enable)
-    );
-    dynrt_processor__engine__fetch__rom_aux rom_aux(
-        .read_address(rom_aux__read_address),
-        .read_clock(rom_aux__read_clock),
-        .read_data(rom_aux__read_data),
-        .write_address(rom_aux__write_address),
-        .write_clock(rom_aux__write_clock),
-        .write_data(rom_aux__write_data),
-        .write_enable(rom_aux__write_enable)
+    dynrt_processor__engine__fetch__rom rom(
+        .clock(rom__clock),
+        .address(rom__address),
+        .ctl(rom__ctl),
+        .imm(rom__imm),
+        .aux(rom__aux)
     );
     dynrt_processor__display__dark_d v1(
         .d(v1__d),
@@ -2472,6 +2447,11 @@ module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl
         .d(t1__d),
         .q(t1__q),
         .clock(t1__clock)
+    );
+    dynrt_processor__display__timing__col pc1(
+        .d(pc1__d),
+        .q(pc1__q),
+        .clock(pc1__clock)
     );
     dynrt_processor__display__dark_d v2(
         .d(v2__d),
@@ -2488,58 +2468,68 @@ module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl
         .q(pc2__q),
         .clock(pc2__clock)
     );
+    dynrt_processor__engine__cycle_count ctl2(
+        .d(ctl2__d),
+        .q(ctl2__q),
+        .clock(ctl2__clock)
+    );
+    dynrt_processor__engine__cycle_count imm2(
+        .d(imm2__d),
+        .q(imm2__q),
+        .clock(imm2__clock)
+    );
+    dynrt_processor__engine__cycle_count aux2(
+        .d(aux2__d),
+        .q(aux2__q),
+        .clock(aux2__clock)
+    );
     
     // Update code
     always @(*) begin
         v1__clock = clock;
         t1__clock = clock;
+        pc1__clock = clock;
         v2__clock = clock;
         t2__clock = clock;
         pc2__clock = clock;
+        ctl2__clock = clock;
+        imm2__clock = clock;
+        aux2__clock = clock;
         v1__d = v1__q;
         t1__d = t1__q;
+        pc1__d = pc1__q;
         v2__d = v2__q;
         t2__d = t2__q;
         pc2__d = pc2__q;
-        pc_ram__read_clock = clock;
+        ctl2__d = ctl2__q;
+        imm2__d = imm2__q;
+        aux2__d = aux2__q;
         pc_ram__write_clock = clock;
-        rom_ctl__read_clock = clock;
-        rom_ctl__write_clock = clock;
-        rom_imm__read_clock = clock;
-        rom_imm__write_clock = clock;
-        rom_aux__read_clock = clock;
-        rom_aux__write_clock = clock;
-        rom_ctl__write_enable = 1'b0;
-        rom_imm__write_enable = 1'b0;
-        rom_aux__write_enable = 1'b0;
-        rom_ctl__write_address = 32'h0;
-        rom_imm__write_address = 32'h0;
-        rom_aux__write_address = 32'h0;
-        rom_ctl__write_data = 32'h0;
-        rom_imm__write_data = 32'h0;
-        rom_aux__write_data = 32'h0;
+        rom__clock = clock;
         pc_ram__read_address = pick;
-        v1__d = issue;
-        t1__d = pick;
         fresh = pc_ram__read_data[32'hd] != epoch;
         if (fresh) begin
-            pc1 = 32'h0;
+            pc0 = 32'h0;
         end
         else begin
-            pc1 = pc_ram__read_data[(32'h0)+:(12)];
+            pc0 = pc_ram__read_data[(32'h0)+:(12)];
         end
-        rom_ctl__read_address = pc1;
-        rom_imm__read_address = pc1;
-        rom_aux__read_address = pc1;
-        v2__d = v1__q & (fresh | (~pc_ram__read_data[32'hc]));
+        rom__address = pc0;
+        v1__d = issue & (fresh | (~pc_ram__read_data[32'hc]));
+        t1__d = pick;
+        pc1__d = pc0;
+        v2__d = v1__q;
         t2__d = t1__q;
-        pc2__d = pc1;
+        pc2__d = pc1__q;
+        ctl2__d = rom__ctl;
+        imm2__d = rom__imm;
+        aux2__d = rom__aux;
         valid = v2__q;
         thread = t2__q;
         pc = pc2__q;
-        ctl = rom_ctl__read_data;
-        imm = rom_imm__read_data;
-        aux = rom_aux__read_data;
+        ctl = ctl2__q;
+        imm = imm2__q;
+        aux = aux2__q;
         pc_ram__write_address = wb_thread;
         pc_ram__write_data = (((epoch) & 16'hffff) << 32'hd) | (((wb_halt) & 16'hffff) << 32'hc) | ((wb_next_pc) & 16'hffff);
         pc_ram__write_enable = wb_valid;
@@ -2550,14 +2540,21 @@ endmodule // dynrt_processor__engine__fetch
 
 
 
-module dynrt_processor__engine__fetch__pc_ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__fetch__pc_ram(read_address,read_data,write_clock,write_address,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
-    input wire  read_clock;
     output reg  [15:0] read_data;
-    input wire  [4:0] write_address;
     input wire  write_clock;
+    input wire  [4:0] write_address;
     input wire  [15:0] write_data;
     input wire  write_enable;
     
@@ -2565,43 +2562,42 @@ module dynrt_processor__engine__fetch__pc_ram(read_address,read_clock,read_data,
     reg[15:0] mem[31:0];
     
     initial begin
-    mem[5'b0] = 16'h0;
-    mem[5'b1] = 16'h0;
-    mem[5'b10] = 16'h0;
-    mem[5'b11] = 16'h0;
-    mem[5'b100] = 16'h0;
-    mem[5'b101] = 16'h0;
-    mem[5'b110] = 16'h0;
-    mem[5'b111] = 16'h0;
-    mem[5'b1000] = 16'h0;
-    mem[5'b1001] = 16'h0;
-    mem[5'b1010] = 16'h0;
-    mem[5'b1011] = 16'h0;
-    mem[5'b1100] = 16'h0;
-    mem[5'b1101] = 16'h0;
-    mem[5'b1110] = 16'h0;
-    mem[5'b1111] = 16'h0;
-    mem[5'b10000] = 16'h0;
-    mem[5'b10001] = 16'h0;
-    mem[5'b10010] = 16'h0;
-    mem[5'b10011] = 16'h0;
-    mem[5'b10100] = 16'h0;
-    mem[5'b10101] = 16'h0;
-    mem[5'b10110] = 16'h0;
-    mem[5'b10111] = 16'h0;
-    mem[5'b11000] = 16'h0;
-    mem[5'b11001] = 16'h0;
-    mem[5'b11010] = 16'h0;
-    mem[5'b11011] = 16'h0;
-    mem[5'b11100] = 16'h0;
-    mem[5'b11101] = 16'h0;
-    mem[5'b11110] = 16'h0;
-    mem[5'b11111] = 16'h0;
+       mem[0] = 16'h0;
+       mem[1] = 16'h0;
+       mem[2] = 16'h0;
+       mem[3] = 16'h0;
+       mem[4] = 16'h0;
+       mem[5] = 16'h0;
+       mem[6] = 16'h0;
+       mem[7] = 16'h0;
+       mem[8] = 16'h0;
+       mem[9] = 16'h0;
+       mem[10] = 16'h0;
+       mem[11] = 16'h0;
+       mem[12] = 16'h0;
+       mem[13] = 16'h0;
+       mem[14] = 16'h0;
+       mem[15] = 16'h0;
+       mem[16] = 16'h0;
+       mem[17] = 16'h0;
+       mem[18] = 16'h0;
+       mem[19] = 16'h0;
+       mem[20] = 16'h0;
+       mem[21] = 16'h0;
+       mem[22] = 16'h0;
+       mem[23] = 16'h0;
+       mem[24] = 16'h0;
+       mem[25] = 16'h0;
+       mem[26] = 16'h0;
+       mem[27] = 16'h0;
+       mem[28] = 16'h0;
+       mem[29] = 16'h0;
+       mem[30] = 16'h0;
+       mem[31] = 16'h0;
     end
     
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
+    always @(*) begin
+       read_data = mem[read_address];
     end
     
     always @(posedge write_clock) begin
@@ -2609,551 +2605,288 @@ module dynrt_processor__engine__fetch__pc_ram(read_address,read_clock,read_data,
           mem[write_address] <= write_data;
        end
     end
-                
 endmodule // dynrt_processor__engine__fetch__pc_ram
 
 
-module dynrt_processor__engine__fetch__rom_aux(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__fetch__rom(clock,address,ctl,imm,aux);
     
     // Module arguments
-    input wire  [11:0] read_address;
-    input wire  read_clock;
-    output reg  [31:0] read_data;
-    input wire  [11:0] write_address;
-    input wire  write_clock;
-    input wire  [31:0] write_data;
-    input wire  write_enable;
+    input wire  clock;
+    input wire  [11:0] address;
+    output reg  [31:0] ctl;
+    output reg  [31:0] imm;
+    output reg  [31:0] aux;
     
     // Update code (custom)
-    reg[31:0] mem[4095:0];
+    reg[31:0] ctl_words[255:0];
+    reg[31:0] imm_words[255:0];
+    reg[31:0] aux_words[255:0];
     
     initial begin
-    mem[12'h0] = 32'hc5000;
-    mem[12'h1] = 32'hc5000;
-    mem[12'h2] = 32'hc5000;
-    mem[12'h3] = 32'hc5000;
-    mem[12'h4] = 32'hc5000;
-    mem[12'h5] = 32'hc5000;
-    mem[12'h6] = 32'hc5000;
-    mem[12'h7] = 32'hc5000;
-    mem[12'h8] = 32'hc5000;
-    mem[12'h9] = 32'h40000;
-    mem[12'ha] = 32'hc5000;
-    mem[12'hb] = 32'hc5000;
-    mem[12'hc] = 32'hc5000;
-    mem[12'hd] = 32'hc5000;
-    mem[12'he] = 32'hc5000;
-    mem[12'hf] = 32'hc5000;
-    mem[12'h10] = 32'hc5000;
-    mem[12'h11] = 32'hc5000;
-    mem[12'h12] = 32'hc5000;
-    mem[12'h13] = 32'hc5000;
-    mem[12'h14] = 32'hc5000;
-    mem[12'h15] = 32'hc5000;
-    mem[12'h16] = 32'hc5000;
-    mem[12'h17] = 32'hc5026;
-    mem[12'h18] = 32'hc0026;
-    mem[12'h19] = 32'h0;
-    mem[12'h1a] = 32'h0;
-    mem[12'h1b] = 32'h0;
-    mem[12'h1c] = 32'h0;
-    mem[12'h1d] = 32'h0;
-    mem[12'h1e] = 32'h0;
-    mem[12'h1f] = 32'hc0000;
-    mem[12'h20] = 32'hc0000;
-    mem[12'h21] = 32'hc0000;
-    mem[12'h22] = 32'h24;
-    mem[12'h23] = 32'h24;
-    mem[12'h24] = 32'hc0000;
-    mem[12'h25] = 32'h80000;
-    mem[12'h26] = 32'hc0095;
-    mem[12'h27] = 32'h0;
-    mem[12'h28] = 32'h0;
-    mem[12'h29] = 32'h0;
-    mem[12'h2a] = 32'h0;
-    mem[12'h2b] = 32'h0;
-    mem[12'h2c] = 32'h0;
-    mem[12'h2d] = 32'h0;
-    mem[12'h2e] = 32'h0;
-    mem[12'h2f] = 32'h0;
-    mem[12'h30] = 32'h0;
-    mem[12'h31] = 32'h0;
-    mem[12'h32] = 32'h0;
-    mem[12'h33] = 32'h0;
-    mem[12'h34] = 32'h0;
-    mem[12'h35] = 32'h0;
-    mem[12'h36] = 32'h0;
-    mem[12'h37] = 32'h0;
-    mem[12'h38] = 32'h0;
-    mem[12'h39] = 32'h0;
-    mem[12'h3a] = 32'h40000;
-    mem[12'h3b] = 32'h40000;
-    mem[12'h3c] = 32'h40000;
-    mem[12'h3d] = 32'h40000;
-    mem[12'h3e] = 32'h40000;
-    mem[12'h3f] = 32'hc0019;
-    mem[12'h40] = 32'h91;
-    mem[12'h41] = 32'h0;
-    mem[12'h42] = 32'h0;
-    mem[12'h43] = 32'h0;
-    mem[12'h44] = 32'h0;
-    mem[12'h45] = 32'h0;
-    mem[12'h46] = 32'h0;
-    mem[12'h47] = 32'h0;
-    mem[12'h48] = 32'h9b000;
-    mem[12'h49] = 32'h9b000;
-    mem[12'h4a] = 32'h9b000;
-    mem[12'h4b] = 32'h9b000;
-    mem[12'h4c] = 32'h0;
-    mem[12'h4d] = 32'h0;
-    mem[12'h4e] = 32'h0;
-    mem[12'h4f] = 32'h0;
-    mem[12'h50] = 32'h0;
-    mem[12'h51] = 32'h0;
-    mem[12'h52] = 32'h0;
-    mem[12'h53] = 32'h0;
-    mem[12'h54] = 32'h0;
-    mem[12'h55] = 32'h0;
-    mem[12'h56] = 32'h0;
-    mem[12'h57] = 32'h0;
-    mem[12'h58] = 32'h0;
-    mem[12'h59] = 32'h0;
-    mem[12'h5a] = 32'h0;
-    mem[12'h5b] = 32'h4005f;
-    mem[12'h5c] = 32'h0;
-    mem[12'h5d] = 32'h0;
-    mem[12'h5e] = 32'h0;
-    mem[12'h5f] = 32'h95000;
-    mem[12'h60] = 32'h95000;
-    mem[12'h61] = 32'h95000;
-    mem[12'h62] = 32'h95000;
-    mem[12'h63] = 32'h0;
-    mem[12'h64] = 32'h0;
-    mem[12'h65] = 32'h0;
-    mem[12'h66] = 32'h0;
-    mem[12'h67] = 32'h0;
-    mem[12'h68] = 32'h0;
-    mem[12'h69] = 32'h0;
-    mem[12'h6a] = 32'h0;
-    mem[12'h6b] = 32'h0;
-    mem[12'h6c] = 32'h0;
-    mem[12'h6d] = 32'h0;
-    mem[12'h6e] = 32'h4008c;
-    mem[12'h6f] = 32'h0;
-    mem[12'h70] = 32'h0;
-    mem[12'h71] = 32'h0;
-    mem[12'h72] = 32'h0;
-    mem[12'h73] = 32'h0;
-    mem[12'h74] = 32'h0;
-    mem[12'h75] = 32'h0;
-    mem[12'h76] = 32'h0;
-    mem[12'h77] = 32'h0;
-    mem[12'h78] = 32'h0;
-    mem[12'h79] = 32'h0;
-    mem[12'h7a] = 32'h0;
-    mem[12'h7b] = 32'h0;
-    mem[12'h7c] = 32'h0;
-    mem[12'h7d] = 32'h40000;
-    mem[12'h7e] = 32'h40000;
-    mem[12'h7f] = 32'h40000;
-    mem[12'h80] = 32'h0;
-    mem[12'h81] = 32'hc0019;
-    mem[12'h82] = 32'h8c;
-    mem[12'h83] = 32'h0;
-    mem[12'h84] = 32'h0;
-    mem[12'h85] = 32'h0;
-    mem[12'h86] = 32'h0;
-    mem[12'h87] = 32'h0;
-    mem[12'h88] = 32'h0;
-    mem[12'h89] = 32'h0;
-    mem[12'h8a] = 32'h0;
-    mem[12'h8b] = 32'h0;
-    mem[12'h8c] = 32'h0;
-    mem[12'h8d] = 32'h0;
-    mem[12'h8e] = 32'h0;
-    mem[12'h8f] = 32'h26;
-    mem[12'h90] = 32'hc0026;
-    mem[12'h91] = 32'h0;
-    mem[12'h92] = 32'h0;
-    mem[12'h93] = 32'h8c;
-    mem[12'h94] = 32'hc008c;
-    mem[12'h95] = 32'hc0000;
+       ctl_words[0] = 32'h38480000; imm_words[0] = 32'h00000000; aux_words[0] = 32'h000c5000;
+       ctl_words[1] = 32'h384c0000; imm_words[1] = 32'h00000001; aux_words[1] = 32'h000c5000;
+       ctl_words[2] = 32'h38500000; imm_words[2] = 32'h00000003; aux_words[2] = 32'h000c5000;
+       ctl_words[3] = 32'h38540000; imm_words[3] = 32'h00000004; aux_words[3] = 32'h000c5000;
+       ctl_words[4] = 32'h38580000; imm_words[4] = 32'h00000005; aux_words[4] = 32'h000c5000;
+       ctl_words[5] = 32'h385c0000; imm_words[5] = 32'h00000007; aux_words[5] = 32'h000c5000;
+       ctl_words[6] = 32'h38600000; imm_words[6] = 32'h00000008; aux_words[6] = 32'h000c5000;
+       ctl_words[7] = 32'h38640000; imm_words[7] = 32'h00000009; aux_words[7] = 32'h000c5000;
+       ctl_words[8] = 32'h38680000; imm_words[8] = 32'h0000000b; aux_words[8] = 32'h000c5000;
+       ctl_words[9] = 32'h286c0002; imm_words[9] = 32'h003f0000; aux_words[9] = 32'h00040000;
+       ctl_words[10] = 32'h38700000; imm_words[10] = 32'h0000000c; aux_words[10] = 32'h000c5000;
+       ctl_words[11] = 32'h38740000; imm_words[11] = 32'h0000000d; aux_words[11] = 32'h000c5000;
+       ctl_words[12] = 32'h38780000; imm_words[12] = 32'h0000000e; aux_words[12] = 32'h000c5000;
+       ctl_words[13] = 32'h387c0000; imm_words[13] = 32'h0000000f; aux_words[13] = 32'h000c5000;
+       ctl_words[14] = 32'h38800000; imm_words[14] = 32'h00000010; aux_words[14] = 32'h000c5000;
+       ctl_words[15] = 32'h38840000; imm_words[15] = 32'h00000011; aux_words[15] = 32'h000c5000;
+       ctl_words[16] = 32'h38880000; imm_words[16] = 32'h00000012; aux_words[16] = 32'h000c5000;
+       ctl_words[17] = 32'h388c0000; imm_words[17] = 32'h00000013; aux_words[17] = 32'h000c5000;
+       ctl_words[18] = 32'h38900000; imm_words[18] = 32'h00000018; aux_words[18] = 32'h000c5000;
+       ctl_words[19] = 32'h38940000; imm_words[19] = 32'h00000019; aux_words[19] = 32'h000c5000;
+       ctl_words[20] = 32'h38980000; imm_words[20] = 32'h0000001a; aux_words[20] = 32'h000c5000;
+       ctl_words[21] = 32'h389c0000; imm_words[21] = 32'h0000001b; aux_words[21] = 32'h000c5000;
+       ctl_words[22] = 32'h38a00000; imm_words[22] = 32'h0000001c; aux_words[22] = 32'h000c5000;
+       ctl_words[23] = 32'h38a40001; imm_words[23] = 32'h0000001d; aux_words[23] = 32'h000c5026;
+       ctl_words[24] = 32'h5c000000; imm_words[24] = 32'h00000000; aux_words[24] = 32'h000c0026;
+       ctl_words[25] = 32'h74001c20; imm_words[25] = 32'h00000003; aux_words[25] = 32'h00000000;
+       ctl_words[26] = 32'h7400282c; imm_words[26] = 32'h0000000a; aux_words[26] = 32'h00000000;
+       ctl_words[27] = 32'h74000408; imm_words[27] = 32'h00000000; aux_words[27] = 32'h00000000;
+       ctl_words[28] = 32'h74000c10; imm_words[28] = 32'h00000001; aux_words[28] = 32'h00000000;
+       ctl_words[29] = 32'h74001418; imm_words[29] = 32'h00000002; aux_words[29] = 32'h00000000;
+       ctl_words[30] = 32'h78002420; imm_words[30] = 32'h00000000; aux_words[30] = 32'h00000000;
+       ctl_words[31] = 32'h78000000; imm_words[31] = 32'h00000001; aux_words[31] = 32'h000c0000;
+       ctl_words[32] = 32'h74340000; imm_words[32] = 32'h00000005; aux_words[32] = 32'h000c0000;
+       ctl_words[33] = 32'h74300000; imm_words[33] = 32'h00000006; aux_words[33] = 32'h000c0000;
+       ctl_words[34] = 32'h54003002; imm_words[34] = 32'h00000000; aux_words[34] = 32'h00000024;
+       ctl_words[35] = 32'h54002403; imm_words[35] = 32'h00000000; aux_words[35] = 32'h00000024;
+       ctl_words[36] = 32'h743c0000; imm_words[36] = 32'h00000008; aux_words[36] = 32'h000c0000;
+       ctl_words[37] = 32'h60004000; imm_words[37] = 32'h00000000; aux_words[37] = 32'h00080000;
+       ctl_words[38] = 32'h6ca80000; imm_words[38] = 32'h00000000; aux_words[38] = 32'h000c0095;
+       ctl_words[39] = 32'h24aca802; imm_words[39] = 32'h0000003f; aux_words[39] = 32'h00000000;
+       ctl_words[40] = 32'h30b0a802; imm_words[40] = 32'h00000006; aux_words[40] = 32'h00000000;
+       ctl_words[41] = 32'h18c4ac02; imm_words[41] = 32'h00000000; aux_words[41] = 32'h00000000;
+       ctl_words[42] = 32'h18c8b002; imm_words[42] = 32'h00000000; aux_words[42] = 32'h00000000;
+       ctl_words[43] = 32'h0ccc48c4; imm_words[43] = 32'h00000000; aux_words[43] = 32'h00000000;
+       ctl_words[44] = 32'h0cd04cc8; imm_words[44] = 32'h00000000; aux_words[44] = 32'h00000000;
+       ctl_words[45] = 32'h04d4ccd0; imm_words[45] = 32'h00000000; aux_words[45] = 32'h00000000;
+       ctl_words[46] = 32'h0410d450; imm_words[46] = 32'h00000000; aux_words[46] = 32'h00000000;
+       ctl_words[47] = 32'h0cdc54c4; imm_words[47] = 32'h00000000; aux_words[47] = 32'h00000000;
+       ctl_words[48] = 32'h0ce058c8; imm_words[48] = 32'h00000000; aux_words[48] = 32'h00000000;
+       ctl_words[49] = 32'h04e4dce0; imm_words[49] = 32'h00000000; aux_words[49] = 32'h00000000;
+       ctl_words[50] = 32'h0414e45c; imm_words[50] = 32'h00000000; aux_words[50] = 32'h00000000;
+       ctl_words[51] = 32'h0cec60c4; imm_words[51] = 32'h00000000; aux_words[51] = 32'h00000000;
+       ctl_words[52] = 32'h0cf064c8; imm_words[52] = 32'h00000000; aux_words[52] = 32'h00000000;
+       ctl_words[53] = 32'h04f4ecf0; imm_words[53] = 32'h00000000; aux_words[53] = 32'h00000000;
+       ctl_words[54] = 32'h0418f468; imm_words[54] = 32'h00000000; aux_words[54] = 32'h00000000;
+       ctl_words[55] = 32'h28047002; imm_words[55] = 32'h00000000; aux_words[55] = 32'h00000000;
+       ctl_words[56] = 32'h28087402; imm_words[56] = 32'h00000000; aux_words[56] = 32'h00000000;
+       ctl_words[57] = 32'h280c7802; imm_words[57] = 32'h00000000; aux_words[57] = 32'h00000000;
+       ctl_words[58] = 32'h281c0002; imm_words[58] = 32'h00000000; aux_words[58] = 32'h00040000;
+       ctl_words[59] = 32'h28280002; imm_words[59] = 32'hffffffff; aux_words[59] = 32'h00040000;
+       ctl_words[60] = 32'h282c0002; imm_words[60] = 32'hffffffff; aux_words[60] = 32'h00040000;
+       ctl_words[61] = 32'h28200002; imm_words[61] = 32'h007f0000; aux_words[61] = 32'h00040000;
+       ctl_words[62] = 32'h28240002; imm_words[62] = 32'h00000000; aux_words[62] = 32'h00040000;
+       ctl_words[63] = 32'h5c400000; imm_words[63] = 32'h00000000; aux_words[63] = 32'h000c0019;
+       ctl_words[64] = 32'h54003002; imm_words[64] = 32'h00000000; aux_words[64] = 32'h00000091;
+       ctl_words[65] = 32'h28f83c02; imm_words[65] = 32'h00000000; aux_words[65] = 32'h00000000;
+       ctl_words[66] = 32'h0cf43410; imm_words[66] = 32'h00000000; aux_words[66] = 32'h00000000;
+       ctl_words[67] = 32'h04f004f4; imm_words[67] = 32'h00000000; aux_words[67] = 32'h00000000;
+       ctl_words[68] = 32'h0cec3414; imm_words[68] = 32'h00000000; aux_words[68] = 32'h00000000;
+       ctl_words[69] = 32'h04e808ec; imm_words[69] = 32'h00000000; aux_words[69] = 32'h00000000;
+       ctl_words[70] = 32'h0ce43418; imm_words[70] = 32'h00000000; aux_words[70] = 32'h00000000;
+       ctl_words[71] = 32'h04e00ce4; imm_words[71] = 32'h00000000; aux_words[71] = 32'h00000000;
+       ctl_words[72] = 32'h38ecf800; imm_words[72] = 32'h00000004; aux_words[72] = 32'h0009b000;
+       ctl_words[73] = 32'h38e4f800; imm_words[73] = 32'h00000005; aux_words[73] = 32'h0009b000;
+       ctl_words[74] = 32'h38f4f800; imm_words[74] = 32'h00000006; aux_words[74] = 32'h0009b000;
+       ctl_words[75] = 32'h38dcf800; imm_words[75] = 32'h00000007; aux_words[75] = 32'h0009b000;
+       ctl_words[76] = 32'h0cd8ecec; imm_words[76] = 32'h00000000; aux_words[76] = 32'h00000000;
+       ctl_words[77] = 32'h0cd4e4e4; imm_words[77] = 32'h00000000; aux_words[77] = 32'h00000000;
+       ctl_words[78] = 32'h04d0d8d4; imm_words[78] = 32'h00000000; aux_words[78] = 32'h00000000;
+       ctl_words[79] = 32'h0cccf4f4; imm_words[79] = 32'h00000000; aux_words[79] = 32'h00000000;
+       ctl_words[80] = 32'h04c8d0cc; imm_words[80] = 32'h00000000; aux_words[80] = 32'h00000000;
+       ctl_words[81] = 32'h14c4c802; imm_words[81] = 32'h00000000; aux_words[81] = 32'h00000000;
+       ctl_words[82] = 32'h10fc6cc4; imm_words[82] = 32'h00000000; aux_words[82] = 32'h00000000;
+       ctl_words[83] = 32'h0d00ecfc; imm_words[83] = 32'h00000000; aux_words[83] = 32'h00000000;
+       ctl_words[84] = 32'h0d04e4fc; imm_words[84] = 32'h00000000; aux_words[84] = 32'h00000000;
+       ctl_words[85] = 32'h0d08f4fc; imm_words[85] = 32'h00000000; aux_words[85] = 32'h00000000;
+       ctl_words[86] = 32'h0d0d0010; imm_words[86] = 32'h00000000; aux_words[86] = 32'h00000000;
+       ctl_words[87] = 32'h0d110414; imm_words[87] = 32'h00000000; aux_words[87] = 32'h00000000;
+       ctl_words[88] = 32'h05150d10; imm_words[88] = 32'h00000000; aux_words[88] = 32'h00000000;
+       ctl_words[89] = 32'h0d190818; imm_words[89] = 32'h00000000; aux_words[89] = 32'h00000000;
+       ctl_words[90] = 32'h051d1518; imm_words[90] = 32'h00000000; aux_words[90] = 32'h00000000;
+       ctl_words[91] = 32'h4800011d; imm_words[91] = 32'h00000000; aux_words[91] = 32'h0004005f;
+       ctl_words[92] = 32'h2d010002; imm_words[92] = 32'h00800000; aux_words[92] = 32'h00000000;
+       ctl_words[93] = 32'h2d050402; imm_words[93] = 32'h00800000; aux_words[93] = 32'h00000000;
+       ctl_words[94] = 32'h2d090802; imm_words[94] = 32'h00800000; aux_words[94] = 32'h00000000;
+       ctl_words[95] = 32'h3928dc00; imm_words[95] = 32'h0000001e; aux_words[95] = 32'h00095000;
+       ctl_words[96] = 32'h3924dc00; imm_words[96] = 32'h0000001f; aux_words[96] = 32'h00095000;
+       ctl_words[97] = 32'h3920dc00; imm_words[97] = 32'h00000020; aux_words[97] = 32'h00095000;
+       ctl_words[98] = 32'h3910dc00; imm_words[98] = 32'h00000021; aux_words[98] = 32'h00095000;
+       ctl_words[99] = 32'h0cb9287c; imm_words[99] = 32'h00000000; aux_words[99] = 32'h00000000;
+       ctl_words[100] = 32'h0cbd247c; imm_words[100] = 32'h00000000; aux_words[100] = 32'h00000000;
+       ctl_words[101] = 32'h0cc1207c; imm_words[101] = 32'h00000000; aux_words[101] = 32'h00000000;
+       ctl_words[102] = 32'h091490f0; imm_words[102] = 32'h00000000; aux_words[102] = 32'h00000000;
+       ctl_words[103] = 32'h090c94e8; imm_words[103] = 32'h00000000; aux_words[103] = 32'h00000000;
+       ctl_words[104] = 32'h08dc98e0; imm_words[104] = 32'h00000000; aux_words[104] = 32'h00000000;
+       ctl_words[105] = 32'h0d190114; imm_words[105] = 32'h00000000; aux_words[105] = 32'h00000000;
+       ctl_words[106] = 32'h0d1d050c; imm_words[106] = 32'h00000000; aux_words[106] = 32'h00000000;
+       ctl_words[107] = 32'h04fd191c; imm_words[107] = 32'h00000000; aux_words[107] = 32'h00000000;
+       ctl_words[108] = 32'h0cc508dc; imm_words[108] = 32'h00000000; aux_words[108] = 32'h00000000;
+       ctl_words[109] = 32'h04c8fcc4; imm_words[109] = 32'h00000000; aux_words[109] = 32'h00000000;
+       ctl_words[110] = 32'h480000c9; imm_words[110] = 32'h00000000; aux_words[110] = 32'h0004008c;
+       ctl_words[111] = 32'h0ccd1514; imm_words[111] = 32'h00000000; aux_words[111] = 32'h00000000;
+       ctl_words[112] = 32'h0cd10d0c; imm_words[112] = 32'h00000000; aux_words[112] = 32'h00000000;
+       ctl_words[113] = 32'h04d4ccd0; imm_words[113] = 32'h00000000; aux_words[113] = 32'h00000000;
+       ctl_words[114] = 32'h0cd8dcdc; imm_words[114] = 32'h00000000; aux_words[114] = 32'h00000000;
+       ctl_words[115] = 32'h04f4d4d8; imm_words[115] = 32'h00000000; aux_words[115] = 32'h00000000;
+       ctl_words[116] = 32'h14e4f402; imm_words[116] = 32'h00000000; aux_words[116] = 32'h00000000;
+       ctl_words[117] = 32'h10ecc8e4; imm_words[117] = 32'h00000000; aux_words[117] = 32'h00000000;
+       ctl_words[118] = 32'h2804f002; imm_words[118] = 32'h00000000; aux_words[118] = 32'h00000000;
+       ctl_words[119] = 32'h2808e802; imm_words[119] = 32'h00000000; aux_words[119] = 32'h00000000;
+       ctl_words[120] = 32'h280ce002; imm_words[120] = 32'h00000000; aux_words[120] = 32'h00000000;
+       ctl_words[121] = 32'h28111402; imm_words[121] = 32'h00000000; aux_words[121] = 32'h00000000;
+       ctl_words[122] = 32'h28150c02; imm_words[122] = 32'h00000000; aux_words[122] = 32'h00000000;
+       ctl_words[123] = 32'h2818dc02; imm_words[123] = 32'h00000000; aux_words[123] = 32'h00000000;
+       ctl_words[124] = 32'h281c8c02; imm_words[124] = 32'h00000000; aux_words[124] = 32'h00000000;
+       ctl_words[125] = 32'h28200002; imm_words[125] = 32'h003f0000; aux_words[125] = 32'h00040000;
+       ctl_words[126] = 32'h28240002; imm_words[126] = 32'h80000000; aux_words[126] = 32'h00040000;
+       ctl_words[127] = 32'h28280002; imm_words[127] = 32'h00000000; aux_words[127] = 32'h00040000;
+       ctl_words[128] = 32'h282cf802; imm_words[128] = 32'h00000000; aux_words[128] = 32'h00000000;
+       ctl_words[129] = 32'h5c400000; imm_words[129] = 32'h00000000; aux_words[129] = 32'h000c0019;
+       ctl_words[130] = 32'h54003003; imm_words[130] = 32'h00000000; aux_words[130] = 32'h0000008c;
+       ctl_words[131] = 32'h0ce5289c; imm_words[131] = 32'h00000000; aux_words[131] = 32'h00000000;
+       ctl_words[132] = 32'h0cf4e4ec; imm_words[132] = 32'h00000000; aux_words[132] = 32'h00000000;
+       ctl_words[133] = 32'h04b8b8f4; imm_words[133] = 32'h00000000; aux_words[133] = 32'h00000000;
+       ctl_words[134] = 32'h0cd524a0; imm_words[134] = 32'h00000000; aux_words[134] = 32'h00000000;
+       ctl_words[135] = 32'h0cd0d4ec; imm_words[135] = 32'h00000000; aux_words[135] = 32'h00000000;
+       ctl_words[136] = 32'h04bcbcd0; imm_words[136] = 32'h00000000; aux_words[136] = 32'h00000000;
+       ctl_words[137] = 32'h0cc920a4; imm_words[137] = 32'h00000000; aux_words[137] = 32'h00000000;
+       ctl_words[138] = 32'h0cc4c8ec; imm_words[138] = 32'h00000000; aux_words[138] = 32'h00000000;
+       ctl_words[139] = 32'h04c0c0c4; imm_words[139] = 32'h00000000; aux_words[139] = 32'h00000000;
+       ctl_words[140] = 32'h7cf8b802; imm_words[140] = 32'h00000000; aux_words[140] = 32'h00000000;
+       ctl_words[141] = 32'h7cf8bcf8; imm_words[141] = 32'h00000000; aux_words[141] = 32'h00000000;
+       ctl_words[142] = 32'h7cf8c0f8; imm_words[142] = 32'h00000000; aux_words[142] = 32'h00000000;
+       ctl_words[143] = 32'h3c00a8f9; imm_words[143] = 32'h0000002e; aux_words[143] = 32'h00000026;
+       ctl_words[144] = 32'h5c000000; imm_words[144] = 32'h00000000; aux_words[144] = 32'h000c0026;
+       ctl_words[145] = 32'h28b88002; imm_words[145] = 32'h00000000; aux_words[145] = 32'h00000000;
+       ctl_words[146] = 32'h28bc8402; imm_words[146] = 32'h00000000; aux_words[146] = 32'h00000000;
+       ctl_words[147] = 32'h28c08803; imm_words[147] = 32'h00000000; aux_words[147] = 32'h0000008c;
+       ctl_words[148] = 32'h5c000000; imm_words[148] = 32'h00000000; aux_words[148] = 32'h000c008c;
+       ctl_words[149] = 32'h70000000; imm_words[149] = 32'h00000000; aux_words[149] = 32'h000c0000;
+       ctl_words[150] = 32'h00000000; imm_words[150] = 32'h00000000; aux_words[150] = 32'h00000000;
+       ctl_words[151] = 32'h00000000; imm_words[151] = 32'h00000000; aux_words[151] = 32'h00000000;
+       ctl_words[152] = 32'h00000000; imm_words[152] = 32'h00000000; aux_words[152] = 32'h00000000;
+       ctl_words[153] = 32'h00000000; imm_words[153] = 32'h00000000; aux_words[153] = 32'h00000000;
+       ctl_words[154] = 32'h00000000; imm_words[154] = 32'h00000000; aux_words[154] = 32'h00000000;
+       ctl_words[155] = 32'h00000000; imm_words[155] = 32'h00000000; aux_words[155] = 32'h00000000;
+       ctl_words[156] = 32'h00000000; imm_words[156] = 32'h00000000; aux_words[156] = 32'h00000000;
+       ctl_words[157] = 32'h00000000; imm_words[157] = 32'h00000000; aux_words[157] = 32'h00000000;
+       ctl_words[158] = 32'h00000000; imm_words[158] = 32'h00000000; aux_words[158] = 32'h00000000;
+       ctl_words[159] = 32'h00000000; imm_words[159] = 32'h00000000; aux_words[159] = 32'h00000000;
+       ctl_words[160] = 32'h00000000; imm_words[160] = 32'h00000000; aux_words[160] = 32'h00000000;
+       ctl_words[161] = 32'h00000000; imm_words[161] = 32'h00000000; aux_words[161] = 32'h00000000;
+       ctl_words[162] = 32'h00000000; imm_words[162] = 32'h00000000; aux_words[162] = 32'h00000000;
+       ctl_words[163] = 32'h00000000; imm_words[163] = 32'h00000000; aux_words[163] = 32'h00000000;
+       ctl_words[164] = 32'h00000000; imm_words[164] = 32'h00000000; aux_words[164] = 32'h00000000;
+       ctl_words[165] = 32'h00000000; imm_words[165] = 32'h00000000; aux_words[165] = 32'h00000000;
+       ctl_words[166] = 32'h00000000; imm_words[166] = 32'h00000000; aux_words[166] = 32'h00000000;
+       ctl_words[167] = 32'h00000000; imm_words[167] = 32'h00000000; aux_words[167] = 32'h00000000;
+       ctl_words[168] = 32'h00000000; imm_words[168] = 32'h00000000; aux_words[168] = 32'h00000000;
+       ctl_words[169] = 32'h00000000; imm_words[169] = 32'h00000000; aux_words[169] = 32'h00000000;
+       ctl_words[170] = 32'h00000000; imm_words[170] = 32'h00000000; aux_words[170] = 32'h00000000;
+       ctl_words[171] = 32'h00000000; imm_words[171] = 32'h00000000; aux_words[171] = 32'h00000000;
+       ctl_words[172] = 32'h00000000; imm_words[172] = 32'h00000000; aux_words[172] = 32'h00000000;
+       ctl_words[173] = 32'h00000000; imm_words[173] = 32'h00000000; aux_words[173] = 32'h00000000;
+       ctl_words[174] = 32'h00000000; imm_words[174] = 32'h00000000; aux_words[174] = 32'h00000000;
+       ctl_words[175] = 32'h00000000; imm_words[175] = 32'h00000000; aux_words[175] = 32'h00000000;
+       ctl_words[176] = 32'h00000000; imm_words[176] = 32'h00000000; aux_words[176] = 32'h00000000;
+       ctl_words[177] = 32'h00000000; imm_words[177] = 32'h00000000; aux_words[177] = 32'h00000000;
+       ctl_words[178] = 32'h00000000; imm_words[178] = 32'h00000000; aux_words[178] = 32'h00000000;
+       ctl_words[179] = 32'h00000000; imm_words[179] = 32'h00000000; aux_words[179] = 32'h00000000;
+       ctl_words[180] = 32'h00000000; imm_words[180] = 32'h00000000; aux_words[180] = 32'h00000000;
+       ctl_words[181] = 32'h00000000; imm_words[181] = 32'h00000000; aux_words[181] = 32'h00000000;
+       ctl_words[182] = 32'h00000000; imm_words[182] = 32'h00000000; aux_words[182] = 32'h00000000;
+       ctl_words[183] = 32'h00000000; imm_words[183] = 32'h00000000; aux_words[183] = 32'h00000000;
+       ctl_words[184] = 32'h00000000; imm_words[184] = 32'h00000000; aux_words[184] = 32'h00000000;
+       ctl_words[185] = 32'h00000000; imm_words[185] = 32'h00000000; aux_words[185] = 32'h00000000;
+       ctl_words[186] = 32'h00000000; imm_words[186] = 32'h00000000; aux_words[186] = 32'h00000000;
+       ctl_words[187] = 32'h00000000; imm_words[187] = 32'h00000000; aux_words[187] = 32'h00000000;
+       ctl_words[188] = 32'h00000000; imm_words[188] = 32'h00000000; aux_words[188] = 32'h00000000;
+       ctl_words[189] = 32'h00000000; imm_words[189] = 32'h00000000; aux_words[189] = 32'h00000000;
+       ctl_words[190] = 32'h00000000; imm_words[190] = 32'h00000000; aux_words[190] = 32'h00000000;
+       ctl_words[191] = 32'h00000000; imm_words[191] = 32'h00000000; aux_words[191] = 32'h00000000;
+       ctl_words[192] = 32'h00000000; imm_words[192] = 32'h00000000; aux_words[192] = 32'h00000000;
+       ctl_words[193] = 32'h00000000; imm_words[193] = 32'h00000000; aux_words[193] = 32'h00000000;
+       ctl_words[194] = 32'h00000000; imm_words[194] = 32'h00000000; aux_words[194] = 32'h00000000;
+       ctl_words[195] = 32'h00000000; imm_words[195] = 32'h00000000; aux_words[195] = 32'h00000000;
+       ctl_words[196] = 32'h00000000; imm_words[196] = 32'h00000000; aux_words[196] = 32'h00000000;
+       ctl_words[197] = 32'h00000000; imm_words[197] = 32'h00000000; aux_words[197] = 32'h00000000;
+       ctl_words[198] = 32'h00000000; imm_words[198] = 32'h00000000; aux_words[198] = 32'h00000000;
+       ctl_words[199] = 32'h00000000; imm_words[199] = 32'h00000000; aux_words[199] = 32'h00000000;
+       ctl_words[200] = 32'h00000000; imm_words[200] = 32'h00000000; aux_words[200] = 32'h00000000;
+       ctl_words[201] = 32'h00000000; imm_words[201] = 32'h00000000; aux_words[201] = 32'h00000000;
+       ctl_words[202] = 32'h00000000; imm_words[202] = 32'h00000000; aux_words[202] = 32'h00000000;
+       ctl_words[203] = 32'h00000000; imm_words[203] = 32'h00000000; aux_words[203] = 32'h00000000;
+       ctl_words[204] = 32'h00000000; imm_words[204] = 32'h00000000; aux_words[204] = 32'h00000000;
+       ctl_words[205] = 32'h00000000; imm_words[205] = 32'h00000000; aux_words[205] = 32'h00000000;
+       ctl_words[206] = 32'h00000000; imm_words[206] = 32'h00000000; aux_words[206] = 32'h00000000;
+       ctl_words[207] = 32'h00000000; imm_words[207] = 32'h00000000; aux_words[207] = 32'h00000000;
+       ctl_words[208] = 32'h00000000; imm_words[208] = 32'h00000000; aux_words[208] = 32'h00000000;
+       ctl_words[209] = 32'h00000000; imm_words[209] = 32'h00000000; aux_words[209] = 32'h00000000;
+       ctl_words[210] = 32'h00000000; imm_words[210] = 32'h00000000; aux_words[210] = 32'h00000000;
+       ctl_words[211] = 32'h00000000; imm_words[211] = 32'h00000000; aux_words[211] = 32'h00000000;
+       ctl_words[212] = 32'h00000000; imm_words[212] = 32'h00000000; aux_words[212] = 32'h00000000;
+       ctl_words[213] = 32'h00000000; imm_words[213] = 32'h00000000; aux_words[213] = 32'h00000000;
+       ctl_words[214] = 32'h00000000; imm_words[214] = 32'h00000000; aux_words[214] = 32'h00000000;
+       ctl_words[215] = 32'h00000000; imm_words[215] = 32'h00000000; aux_words[215] = 32'h00000000;
+       ctl_words[216] = 32'h00000000; imm_words[216] = 32'h00000000; aux_words[216] = 32'h00000000;
+       ctl_words[217] = 32'h00000000; imm_words[217] = 32'h00000000; aux_words[217] = 32'h00000000;
+       ctl_words[218] = 32'h00000000; imm_words[218] = 32'h00000000; aux_words[218] = 32'h00000000;
+       ctl_words[219] = 32'h00000000; imm_words[219] = 32'h00000000; aux_words[219] = 32'h00000000;
+       ctl_words[220] = 32'h00000000; imm_words[220] = 32'h00000000; aux_words[220] = 32'h00000000;
+       ctl_words[221] = 32'h00000000; imm_words[221] = 32'h00000000; aux_words[221] = 32'h00000000;
+       ctl_words[222] = 32'h00000000; imm_words[222] = 32'h00000000; aux_words[222] = 32'h00000000;
+       ctl_words[223] = 32'h00000000; imm_words[223] = 32'h00000000; aux_words[223] = 32'h00000000;
+       ctl_words[224] = 32'h00000000; imm_words[224] = 32'h00000000; aux_words[224] = 32'h00000000;
+       ctl_words[225] = 32'h00000000; imm_words[225] = 32'h00000000; aux_words[225] = 32'h00000000;
+       ctl_words[226] = 32'h00000000; imm_words[226] = 32'h00000000; aux_words[226] = 32'h00000000;
+       ctl_words[227] = 32'h00000000; imm_words[227] = 32'h00000000; aux_words[227] = 32'h00000000;
+       ctl_words[228] = 32'h00000000; imm_words[228] = 32'h00000000; aux_words[228] = 32'h00000000;
+       ctl_words[229] = 32'h00000000; imm_words[229] = 32'h00000000; aux_words[229] = 32'h00000000;
+       ctl_words[230] = 32'h00000000; imm_words[230] = 32'h00000000; aux_words[230] = 32'h00000000;
+       ctl_words[231] = 32'h00000000; imm_words[231] = 32'h00000000; aux_words[231] = 32'h00000000;
+       ctl_words[232] = 32'h00000000; imm_words[232] = 32'h00000000; aux_words[232] = 32'h00000000;
+       ctl_words[233] = 32'h00000000; imm_words[233] = 32'h00000000; aux_words[233] = 32'h00000000;
+       ctl_words[234] = 32'h00000000; imm_words[234] = 32'h00000000; aux_words[234] = 32'h00000000;
+       ctl_words[235] = 32'h00000000; imm_words[235] = 32'h00000000; aux_words[235] = 32'h00000000;
+       ctl_words[236] = 32'h00000000; imm_words[236] = 32'h00000000; aux_words[236] = 32'h00000000;
+       ctl_words[237] = 32'h00000000; imm_words[237] = 32'h00000000; aux_words[237] = 32'h00000000;
+       ctl_words[238] = 32'h00000000; imm_words[238] = 32'h00000000; aux_words[238] = 32'h00000000;
+       ctl_words[239] = 32'h00000000; imm_words[239] = 32'h00000000; aux_words[239] = 32'h00000000;
+       ctl_words[240] = 32'h00000000; imm_words[240] = 32'h00000000; aux_words[240] = 32'h00000000;
+       ctl_words[241] = 32'h00000000; imm_words[241] = 32'h00000000; aux_words[241] = 32'h00000000;
+       ctl_words[242] = 32'h00000000; imm_words[242] = 32'h00000000; aux_words[242] = 32'h00000000;
+       ctl_words[243] = 32'h00000000; imm_words[243] = 32'h00000000; aux_words[243] = 32'h00000000;
+       ctl_words[244] = 32'h00000000; imm_words[244] = 32'h00000000; aux_words[244] = 32'h00000000;
+       ctl_words[245] = 32'h00000000; imm_words[245] = 32'h00000000; aux_words[245] = 32'h00000000;
+       ctl_words[246] = 32'h00000000; imm_words[246] = 32'h00000000; aux_words[246] = 32'h00000000;
+       ctl_words[247] = 32'h00000000; imm_words[247] = 32'h00000000; aux_words[247] = 32'h00000000;
+       ctl_words[248] = 32'h00000000; imm_words[248] = 32'h00000000; aux_words[248] = 32'h00000000;
+       ctl_words[249] = 32'h00000000; imm_words[249] = 32'h00000000; aux_words[249] = 32'h00000000;
+       ctl_words[250] = 32'h00000000; imm_words[250] = 32'h00000000; aux_words[250] = 32'h00000000;
+       ctl_words[251] = 32'h00000000; imm_words[251] = 32'h00000000; aux_words[251] = 32'h00000000;
+       ctl_words[252] = 32'h00000000; imm_words[252] = 32'h00000000; aux_words[252] = 32'h00000000;
+       ctl_words[253] = 32'h00000000; imm_words[253] = 32'h00000000; aux_words[253] = 32'h00000000;
+       ctl_words[254] = 32'h00000000; imm_words[254] = 32'h00000000; aux_words[254] = 32'h00000000;
+       ctl_words[255] = 32'h00000000; imm_words[255] = 32'h00000000; aux_words[255] = 32'h00000000;
     end
     
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
+    always @(posedge clock) begin
+       ctl <= ctl_words[address[7:0]];
+       imm <= imm_words[address[7:0]];
+       aux <= aux_words[address[7:0]];
     end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor__engine__fetch__rom_aux
-
-
-module dynrt_processor__engine__fetch__rom_ctl(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [11:0] read_address;
-    input wire  read_clock;
-    output reg  [31:0] read_data;
-    input wire  [11:0] write_address;
-    input wire  write_clock;
-    input wire  [31:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[31:0] mem[4095:0];
-    
-    initial begin
-    mem[12'h0] = 32'h38480000;
-    mem[12'h1] = 32'h384c0000;
-    mem[12'h2] = 32'h38500000;
-    mem[12'h3] = 32'h38540000;
-    mem[12'h4] = 32'h38580000;
-    mem[12'h5] = 32'h385c0000;
-    mem[12'h6] = 32'h38600000;
-    mem[12'h7] = 32'h38640000;
-    mem[12'h8] = 32'h38680000;
-    mem[12'h9] = 32'h286c0002;
-    mem[12'ha] = 32'h38700000;
-    mem[12'hb] = 32'h38740000;
-    mem[12'hc] = 32'h38780000;
-    mem[12'hd] = 32'h387c0000;
-    mem[12'he] = 32'h38800000;
-    mem[12'hf] = 32'h38840000;
-    mem[12'h10] = 32'h38880000;
-    mem[12'h11] = 32'h388c0000;
-    mem[12'h12] = 32'h38900000;
-    mem[12'h13] = 32'h38940000;
-    mem[12'h14] = 32'h38980000;
-    mem[12'h15] = 32'h389c0000;
-    mem[12'h16] = 32'h38a00000;
-    mem[12'h17] = 32'h38a40001;
-    mem[12'h18] = 32'h5c000000;
-    mem[12'h19] = 32'h74001c20;
-    mem[12'h1a] = 32'h7400282c;
-    mem[12'h1b] = 32'h74000408;
-    mem[12'h1c] = 32'h74000c10;
-    mem[12'h1d] = 32'h74001418;
-    mem[12'h1e] = 32'h78002420;
-    mem[12'h1f] = 32'h78000000;
-    mem[12'h20] = 32'h74340000;
-    mem[12'h21] = 32'h74300000;
-    mem[12'h22] = 32'h54003002;
-    mem[12'h23] = 32'h54002403;
-    mem[12'h24] = 32'h743c0000;
-    mem[12'h25] = 32'h60004000;
-    mem[12'h26] = 32'h6ca80000;
-    mem[12'h27] = 32'h24aca802;
-    mem[12'h28] = 32'h30b0a802;
-    mem[12'h29] = 32'h18c4ac02;
-    mem[12'h2a] = 32'h18c8b002;
-    mem[12'h2b] = 32'hccc48c4;
-    mem[12'h2c] = 32'hcd04cc8;
-    mem[12'h2d] = 32'h4d4ccd0;
-    mem[12'h2e] = 32'h410d450;
-    mem[12'h2f] = 32'hcdc54c4;
-    mem[12'h30] = 32'hce058c8;
-    mem[12'h31] = 32'h4e4dce0;
-    mem[12'h32] = 32'h414e45c;
-    mem[12'h33] = 32'hcec60c4;
-    mem[12'h34] = 32'hcf064c8;
-    mem[12'h35] = 32'h4f4ecf0;
-    mem[12'h36] = 32'h418f468;
-    mem[12'h37] = 32'h28047002;
-    mem[12'h38] = 32'h28087402;
-    mem[12'h39] = 32'h280c7802;
-    mem[12'h3a] = 32'h281c0002;
-    mem[12'h3b] = 32'h28280002;
-    mem[12'h3c] = 32'h282c0002;
-    mem[12'h3d] = 32'h28200002;
-    mem[12'h3e] = 32'h28240002;
-    mem[12'h3f] = 32'h5c400000;
-    mem[12'h40] = 32'h54003002;
-    mem[12'h41] = 32'h28f83c02;
-    mem[12'h42] = 32'hcf43410;
-    mem[12'h43] = 32'h4f004f4;
-    mem[12'h44] = 32'hcec3414;
-    mem[12'h45] = 32'h4e808ec;
-    mem[12'h46] = 32'hce43418;
-    mem[12'h47] = 32'h4e00ce4;
-    mem[12'h48] = 32'h38ecf800;
-    mem[12'h49] = 32'h38e4f800;
-    mem[12'h4a] = 32'h38f4f800;
-    mem[12'h4b] = 32'h38dcf800;
-    mem[12'h4c] = 32'hcd8ecec;
-    mem[12'h4d] = 32'hcd4e4e4;
-    mem[12'h4e] = 32'h4d0d8d4;
-    mem[12'h4f] = 32'hcccf4f4;
-    mem[12'h50] = 32'h4c8d0cc;
-    mem[12'h51] = 32'h14c4c802;
-    mem[12'h52] = 32'h10fc6cc4;
-    mem[12'h53] = 32'hd00ecfc;
-    mem[12'h54] = 32'hd04e4fc;
-    mem[12'h55] = 32'hd08f4fc;
-    mem[12'h56] = 32'hd0d0010;
-    mem[12'h57] = 32'hd110414;
-    mem[12'h58] = 32'h5150d10;
-    mem[12'h59] = 32'hd190818;
-    mem[12'h5a] = 32'h51d1518;
-    mem[12'h5b] = 32'h4800011d;
-    mem[12'h5c] = 32'h2d010002;
-    mem[12'h5d] = 32'h2d050402;
-    mem[12'h5e] = 32'h2d090802;
-    mem[12'h5f] = 32'h3928dc00;
-    mem[12'h60] = 32'h3924dc00;
-    mem[12'h61] = 32'h3920dc00;
-    mem[12'h62] = 32'h3910dc00;
-    mem[12'h63] = 32'hcb9287c;
-    mem[12'h64] = 32'hcbd247c;
-    mem[12'h65] = 32'hcc1207c;
-    mem[12'h66] = 32'h91490f0;
-    mem[12'h67] = 32'h90c94e8;
-    mem[12'h68] = 32'h8dc98e0;
-    mem[12'h69] = 32'hd190114;
-    mem[12'h6a] = 32'hd1d050c;
-    mem[12'h6b] = 32'h4fd191c;
-    mem[12'h6c] = 32'hcc508dc;
-    mem[12'h6d] = 32'h4c8fcc4;
-    mem[12'h6e] = 32'h480000c9;
-    mem[12'h6f] = 32'hccd1514;
-    mem[12'h70] = 32'hcd10d0c;
-    mem[12'h71] = 32'h4d4ccd0;
-    mem[12'h72] = 32'hcd8dcdc;
-    mem[12'h73] = 32'h4f4d4d8;
-    mem[12'h74] = 32'h14e4f402;
-    mem[12'h75] = 32'h10ecc8e4;
-    mem[12'h76] = 32'h2804f002;
-    mem[12'h77] = 32'h2808e802;
-    mem[12'h78] = 32'h280ce002;
-    mem[12'h79] = 32'h28111402;
-    mem[12'h7a] = 32'h28150c02;
-    mem[12'h7b] = 32'h2818dc02;
-    mem[12'h7c] = 32'h281c8c02;
-    mem[12'h7d] = 32'h28200002;
-    mem[12'h7e] = 32'h28240002;
-    mem[12'h7f] = 32'h28280002;
-    mem[12'h80] = 32'h282cf802;
-    mem[12'h81] = 32'h5c400000;
-    mem[12'h82] = 32'h54003003;
-    mem[12'h83] = 32'hce5289c;
-    mem[12'h84] = 32'hcf4e4ec;
-    mem[12'h85] = 32'h4b8b8f4;
-    mem[12'h86] = 32'hcd524a0;
-    mem[12'h87] = 32'hcd0d4ec;
-    mem[12'h88] = 32'h4bcbcd0;
-    mem[12'h89] = 32'hcc920a4;
-    mem[12'h8a] = 32'hcc4c8ec;
-    mem[12'h8b] = 32'h4c0c0c4;
-    mem[12'h8c] = 32'h7cf8b802;
-    mem[12'h8d] = 32'h7cf8bcf8;
-    mem[12'h8e] = 32'h7cf8c0f8;
-    mem[12'h8f] = 32'h3c00a8f9;
-    mem[12'h90] = 32'h5c000000;
-    mem[12'h91] = 32'h28b88002;
-    mem[12'h92] = 32'h28bc8402;
-    mem[12'h93] = 32'h28c08803;
-    mem[12'h94] = 32'h5c000000;
-    mem[12'h95] = 32'h70000000;
-    end
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor__engine__fetch__rom_ctl
-
-
-module dynrt_processor__engine__fetch__rom_imm(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [11:0] read_address;
-    input wire  read_clock;
-    output reg  [31:0] read_data;
-    input wire  [11:0] write_address;
-    input wire  write_clock;
-    input wire  [31:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[31:0] mem[4095:0];
-    
-    initial begin
-    mem[12'h0] = 32'h0;
-    mem[12'h1] = 32'h1;
-    mem[12'h2] = 32'h3;
-    mem[12'h3] = 32'h4;
-    mem[12'h4] = 32'h5;
-    mem[12'h5] = 32'h7;
-    mem[12'h6] = 32'h8;
-    mem[12'h7] = 32'h9;
-    mem[12'h8] = 32'hb;
-    mem[12'h9] = 32'h3f0000;
-    mem[12'ha] = 32'hc;
-    mem[12'hb] = 32'hd;
-    mem[12'hc] = 32'he;
-    mem[12'hd] = 32'hf;
-    mem[12'he] = 32'h10;
-    mem[12'hf] = 32'h11;
-    mem[12'h10] = 32'h12;
-    mem[12'h11] = 32'h13;
-    mem[12'h12] = 32'h18;
-    mem[12'h13] = 32'h19;
-    mem[12'h14] = 32'h1a;
-    mem[12'h15] = 32'h1b;
-    mem[12'h16] = 32'h1c;
-    mem[12'h17] = 32'h1d;
-    mem[12'h18] = 32'h0;
-    mem[12'h19] = 32'h3;
-    mem[12'h1a] = 32'ha;
-    mem[12'h1b] = 32'h0;
-    mem[12'h1c] = 32'h1;
-    mem[12'h1d] = 32'h2;
-    mem[12'h1e] = 32'h0;
-    mem[12'h1f] = 32'h1;
-    mem[12'h20] = 32'h5;
-    mem[12'h21] = 32'h6;
-    mem[12'h22] = 32'h0;
-    mem[12'h23] = 32'h0;
-    mem[12'h24] = 32'h8;
-    mem[12'h25] = 32'h0;
-    mem[12'h26] = 32'h0;
-    mem[12'h27] = 32'h3f;
-    mem[12'h28] = 32'h6;
-    mem[12'h29] = 32'h0;
-    mem[12'h2a] = 32'h0;
-    mem[12'h2b] = 32'h0;
-    mem[12'h2c] = 32'h0;
-    mem[12'h2d] = 32'h0;
-    mem[12'h2e] = 32'h0;
-    mem[12'h2f] = 32'h0;
-    mem[12'h30] = 32'h0;
-    mem[12'h31] = 32'h0;
-    mem[12'h32] = 32'h0;
-    mem[12'h33] = 32'h0;
-    mem[12'h34] = 32'h0;
-    mem[12'h35] = 32'h0;
-    mem[12'h36] = 32'h0;
-    mem[12'h37] = 32'h0;
-    mem[12'h38] = 32'h0;
-    mem[12'h39] = 32'h0;
-    mem[12'h3a] = 32'h0;
-    mem[12'h3b] = 32'hffffffff;
-    mem[12'h3c] = 32'hffffffff;
-    mem[12'h3d] = 32'h7f0000;
-    mem[12'h3e] = 32'h0;
-    mem[12'h3f] = 32'h0;
-    mem[12'h40] = 32'h0;
-    mem[12'h41] = 32'h0;
-    mem[12'h42] = 32'h0;
-    mem[12'h43] = 32'h0;
-    mem[12'h44] = 32'h0;
-    mem[12'h45] = 32'h0;
-    mem[12'h46] = 32'h0;
-    mem[12'h47] = 32'h0;
-    mem[12'h48] = 32'h4;
-    mem[12'h49] = 32'h5;
-    mem[12'h4a] = 32'h6;
-    mem[12'h4b] = 32'h7;
-    mem[12'h4c] = 32'h0;
-    mem[12'h4d] = 32'h0;
-    mem[12'h4e] = 32'h0;
-    mem[12'h4f] = 32'h0;
-    mem[12'h50] = 32'h0;
-    mem[12'h51] = 32'h0;
-    mem[12'h52] = 32'h0;
-    mem[12'h53] = 32'h0;
-    mem[12'h54] = 32'h0;
-    mem[12'h55] = 32'h0;
-    mem[12'h56] = 32'h0;
-    mem[12'h57] = 32'h0;
-    mem[12'h58] = 32'h0;
-    mem[12'h59] = 32'h0;
-    mem[12'h5a] = 32'h0;
-    mem[12'h5b] = 32'h0;
-    mem[12'h5c] = 32'h800000;
-    mem[12'h5d] = 32'h800000;
-    mem[12'h5e] = 32'h800000;
-    mem[12'h5f] = 32'h1e;
-    mem[12'h60] = 32'h1f;
-    mem[12'h61] = 32'h20;
-    mem[12'h62] = 32'h21;
-    mem[12'h63] = 32'h0;
-    mem[12'h64] = 32'h0;
-    mem[12'h65] = 32'h0;
-    mem[12'h66] = 32'h0;
-    mem[12'h67] = 32'h0;
-    mem[12'h68] = 32'h0;
-    mem[12'h69] = 32'h0;
-    mem[12'h6a] = 32'h0;
-    mem[12'h6b] = 32'h0;
-    mem[12'h6c] = 32'h0;
-    mem[12'h6d] = 32'h0;
-    mem[12'h6e] = 32'h0;
-    mem[12'h6f] = 32'h0;
-    mem[12'h70] = 32'h0;
-    mem[12'h71] = 32'h0;
-    mem[12'h72] = 32'h0;
-    mem[12'h73] = 32'h0;
-    mem[12'h74] = 32'h0;
-    mem[12'h75] = 32'h0;
-    mem[12'h76] = 32'h0;
-    mem[12'h77] = 32'h0;
-    mem[12'h78] = 32'h0;
-    mem[12'h79] = 32'h0;
-    mem[12'h7a] = 32'h0;
-    mem[12'h7b] = 32'h0;
-    mem[12'h7c] = 32'h0;
-    mem[12'h7d] = 32'h3f0000;
-    mem[12'h7e] = 32'h80000000;
-    mem[12'h7f] = 32'h0;
-    mem[12'h80] = 32'h0;
-    mem[12'h81] = 32'h0;
-    mem[12'h82] = 32'h0;
-    mem[12'h83] = 32'h0;
-    mem[12'h84] = 32'h0;
-    mem[12'h85] = 32'h0;
-    mem[12'h86] = 32'h0;
-    mem[12'h87] = 32'h0;
-    mem[12'h88] = 32'h0;
-    mem[12'h89] = 32'h0;
-    mem[12'h8a] = 32'h0;
-    mem[12'h8b] = 32'h0;
-    mem[12'h8c] = 32'h0;
-    mem[12'h8d] = 32'h0;
-    mem[12'h8e] = 32'h0;
-    mem[12'h8f] = 32'h2e;
-    mem[12'h90] = 32'h0;
-    mem[12'h91] = 32'h0;
-    mem[12'h92] = 32'h0;
-    mem[12'h93] = 32'h0;
-    mem[12'h94] = 32'h0;
-    mem[12'h95] = 32'h0;
-    end
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor__engine__fetch__rom_imm
+endmodule // dynrt_processor__engine__fetch__rom
 
 
 

@@ -60,10 +60,13 @@ pub struct Decode {
     pub wb_dst: Signal<In, Bits<REG_BITS>>,
     pub wb_data: Signal<In, Bits<32>>,
 
-    /// The register file, `{thread, register}`-addressed, once per read port.
+    /// The register file, `{register, thread}`-addressed, once per read port; it decodes
+    /// the thread and the register bits the program uses (the register on top, so the
+    /// unused bits are the top ones), 8 block RAMs a port for 75 registers where all 256
+    /// took 16.
     // A thread's write back and its next register read are never in one clock (one
-    // instruction per thread in flight, the thread in the address's top bits), so the
-    // block RAMs need no read-first emulation.
+    // instruction per thread in flight, the thread in the address), so the block RAMs need
+    // no read-first emulation.
     regs_a: NoCollisionRam<Bits<32>, 13>,
     regs_b: NoCollisionRam<Bits<32>, 13>,
     v3: DFF<Bit>,
@@ -105,7 +108,10 @@ fn field(at: usize) -> Constant<Bits<5>> {
 }
 
 impl Decode {
-    pub fn new() -> Self {
+    /// The decode of a program that uses registers `0..registers`.
+    pub fn new(registers: usize) -> Self {
+        let register_bits = registers.max(2).next_power_of_two().trailing_zeros() as usize;
+        assert!(register_bits <= REG_BITS);
         Self {
             // Registers start undefined: the program writes every register before reading it
             // (so the generated Verilog stays small and Icarus compiles it quickly).
@@ -137,8 +143,8 @@ impl Decode {
             wb_thread: Default::default(),
             wb_dst: Default::default(),
             wb_data: Default::default(),
-            regs_a: Default::default(),
-            regs_b: Default::default(),
+            regs_a: NoCollisionRam::decoding(5 + register_bits),
+            regs_b: NoCollisionRam::decoding(5 + register_bits),
             v3: Default::default(),
             t3: Default::default(),
             pc3: Default::default(),
@@ -193,10 +199,10 @@ impl Logic for Decode {
             .ctl_i2
             .val()
             .get_bits::<REG_BITS>(self.f_b.val().index());
-        self.regs_a.read_address.next = (bit_cast::<13, 5>(self.thread_i2.val()) << 8)
-            | bit_cast::<13, REG_BITS>(self.reg_a.val());
-        self.regs_b.read_address.next = (bit_cast::<13, 5>(self.thread_i2.val()) << 8)
-            | bit_cast::<13, REG_BITS>(self.reg_b.val());
+        self.regs_a.read_address.next = (bit_cast::<13, REG_BITS>(self.reg_a.val()) << 5)
+            | bit_cast::<13, 5>(self.thread_i2.val());
+        self.regs_b.read_address.next = (bit_cast::<13, REG_BITS>(self.reg_b.val()) << 5)
+            | bit_cast::<13, 5>(self.thread_i2.val());
         self.v3.d.next = self.valid_i2.val();
         self.t3.d.next = self.thread_i2.val();
         self.pc3.d.next = self.pc_i2.val();
@@ -269,8 +275,8 @@ impl Logic for Decode {
         self.store.next = self.store4.q.val();
 
         // Write back.
-        self.wb_address.next = (bit_cast::<13, 5>(self.wb_thread.val()) << 8)
-            | bit_cast::<13, REG_BITS>(self.wb_dst.val());
+        self.wb_address.next = (bit_cast::<13, REG_BITS>(self.wb_dst.val()) << 5)
+            | bit_cast::<13, 5>(self.wb_thread.val());
         self.regs_a.write_address.next = self.wb_address.val();
         self.regs_b.write_address.next = self.wb_address.val();
         self.regs_a.write_data.next = self.wb_data.val();

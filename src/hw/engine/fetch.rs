@@ -1,23 +1,31 @@
 //! `Fetch`: the engine's stages I0 to I2. It reads the picked thread's `{epoch, halted, pc}`
-//! and then the microprogram ROM's three words of the instruction at that pc.
+//! and addresses the microprogram ROM with the pc in the same clock (I0), then registers the
+//! ROM's three words of the instruction (I1).
 //!
 //! Contract: a thread picked at I0 (`issue`, `pick`) shows its instruction at I2 (`valid`,
-//! `thread`, `pc`, `ctl`, `imm`, `aux`: the three ROM words of `isa::Instr::encode`). A thread
-//! whose stored epoch differs from `epoch` belongs to an earlier frame and starts at pc 0; a
-//! halted thread of this frame shows `valid` low. The write back stores a thread's next pc
-//! (`wb_*`), tagged with this frame's epoch.
+//! `thread`, `pc`, `ctl`, `imm`, `aux`: the three ROM words of `isa::Instr::encode`), every
+//! output from a register. A thread whose stored epoch differs from `epoch` belongs to an
+//! earlier frame and starts at pc 0; a halted thread of this frame shows `valid` low. The
+//! write back stores a thread's next pc (`wb_*`), tagged with this frame's epoch.
 //!
-//! Latency: 2 clocks (block-RAM reads of the pc, then of the ROM). Throughput: one thread per
-//! clock.
+//! Why the pc store reads combinationally ([`LutRam`]) and the ROM's words are registered: the
+//! register file's address must come from a register. A block RAM's clock-to-out (5.8 ns on
+//! an ECP5) routed to the sixteen block RAMs of a register-file port was the processor's
+//! critical path at 78.0 MHz (issue 16). The pc store is 32 words, so its read (LUTs) and the
+//! epoch check fit in front of the ROM's address, and the latency stays 2.
+//!
+//! Latency: 2 clocks (the pc read and the ROM read, then the ROM words' register).
+//! Throughput: one thread per clock.
 //!
 //! Golden twin: `hw::program::exec` (the engine's twin) reads the same words through
 //! `isa::Instr::decode` of `Program::rom`, the words this ROM holds.
 
 use rust_hdl::prelude::*;
 
-use super::word_map;
+use super::{word_map, ProgramRom};
 use crate::hw::program::isa::PC_BITS;
 use crate::hw::program::Program;
+use crate::hw::LutRam;
 
 #[derive(LogicBlock)]
 pub struct Fetch {
@@ -41,28 +49,24 @@ pub struct Fetch {
     pub wb_next_pc: Signal<In, Bits<PC_BITS>>,
 
     /// Per thread `{epoch (bit 13), halted (bit 12), pc}`.
-    pc_ram: RAM<Bits<16>, 5>,
-    rom_ctl: RAM<Bits<32>, PC_BITS>,
-    rom_imm: RAM<Bits<32>, PC_BITS>,
-    rom_aux: RAM<Bits<32>, PC_BITS>,
+    pc_ram: LutRam<Bits<16>, 5>,
+    rom: ProgramRom,
     v1: DFF<Bit>,
     t1: DFF<Bits<5>>,
+    pc1: DFF<Bits<PC_BITS>>,
     v2: DFF<Bit>,
     t2: DFF<Bits<5>>,
     pc2: DFF<Bits<PC_BITS>>,
+    ctl2: DFF<Bits<32>>,
+    imm2: DFF<Bits<32>>,
+    aux2: DFF<Bits<32>>,
     fresh: Signal<Local, Bit>,
-    pc1: Signal<Local, Bits<PC_BITS>>,
+    pc0: Signal<Local, Bits<PC_BITS>>,
 }
 
 impl Fetch {
     /// The fetch stage of `program` (its ROM words).
     pub fn new(program: &Program) -> Self {
-        let words = program.rom();
-        let rom = |k: usize| -> RAM<Bits<32>, PC_BITS> {
-            RAM::new(word_map(
-                words.iter().map(|w| Bits::<32>::from(u64::from(w[k]))),
-            ))
-        };
         Self {
             clock: Default::default(),
             epoch: Default::default(),
@@ -78,17 +82,19 @@ impl Fetch {
             wb_thread: Default::default(),
             wb_halt: Default::default(),
             wb_next_pc: Default::default(),
-            pc_ram: RAM::new(word_map((0..32).map(|_| Bits::<16>::from(0u64)))),
-            rom_ctl: rom(0),
-            rom_imm: rom(1),
-            rom_aux: rom(2),
+            pc_ram: LutRam::new(word_map((0..32).map(|_| Bits::<16>::from(0u64)))),
+            rom: ProgramRom::new(program.rom()),
             v1: Default::default(),
             t1: Default::default(),
+            pc1: Default::default(),
             v2: Default::default(),
             t2: Default::default(),
             pc2: Default::default(),
+            ctl2: Default::default(),
+            imm2: Default::default(),
+            aux2: Default::default(),
             fresh: Default::default(),
-            pc1: Default::default(),
+            pc0: Default::default(),
         }
     }
 }
@@ -96,53 +102,39 @@ impl Fetch {
 impl Logic for Fetch {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, v1, t1, v2, t2, pc2);
-        self.pc_ram.read_clock.next = self.clock.val();
+        dff_setup!(self, clock, v1, t1, pc1, v2, t2, pc2, ctl2, imm2, aux2);
         self.pc_ram.write_clock.next = self.clock.val();
-        self.rom_ctl.read_clock.next = self.clock.val();
-        self.rom_ctl.write_clock.next = self.clock.val();
-        self.rom_imm.read_clock.next = self.clock.val();
-        self.rom_imm.write_clock.next = self.clock.val();
-        self.rom_aux.read_clock.next = self.clock.val();
-        self.rom_aux.write_clock.next = self.clock.val();
-        // The ROMs are never written.
-        self.rom_ctl.write_enable.next = false;
-        self.rom_imm.write_enable.next = false;
-        self.rom_aux.write_enable.next = false;
-        self.rom_ctl.write_address.next = 0.into();
-        self.rom_imm.write_address.next = 0.into();
-        self.rom_aux.write_address.next = 0.into();
-        self.rom_ctl.write_data.next = 0.into();
-        self.rom_imm.write_data.next = 0.into();
-        self.rom_aux.write_data.next = 0.into();
+        self.rom.clock.next = self.clock.val();
 
-        // I0: the picked thread's state.
+        // I0: the picked thread's state; another epoch is a thread of an earlier frame: pc 0.
         self.pc_ram.read_address.next = self.pick.val();
-        self.v1.d.next = self.issue.val();
-        self.t1.d.next = self.pick.val();
-
-        // I1: another epoch is a thread of an earlier frame: pc 0.
         self.fresh.next = self.pc_ram.read_data.val().get_bit(13) != self.epoch.val();
         if self.fresh.val() {
-            self.pc1.next = 0.into();
+            self.pc0.next = 0.into();
         } else {
-            self.pc1.next = self.pc_ram.read_data.val().get_bits::<PC_BITS>(0);
+            self.pc0.next = self.pc_ram.read_data.val().get_bits::<PC_BITS>(0);
         }
-        self.rom_ctl.read_address.next = self.pc1.val();
-        self.rom_imm.read_address.next = self.pc1.val();
-        self.rom_aux.read_address.next = self.pc1.val();
-        self.v2.d.next =
-            self.v1.q.val() & (self.fresh.val() | (!self.pc_ram.read_data.val().get_bit(12)));
+        self.rom.address.next = self.pc0.val();
+        self.v1.d.next =
+            self.issue.val() & (self.fresh.val() | (!self.pc_ram.read_data.val().get_bit(12)));
+        self.t1.d.next = self.pick.val();
+        self.pc1.d.next = self.pc0.val();
+
+        // I1: the ROM's words.
+        self.v2.d.next = self.v1.q.val();
         self.t2.d.next = self.t1.q.val();
-        self.pc2.d.next = self.pc1.val();
+        self.pc2.d.next = self.pc1.q.val();
+        self.ctl2.d.next = self.rom.ctl.val();
+        self.imm2.d.next = self.rom.imm.val();
+        self.aux2.d.next = self.rom.aux.val();
 
         // I2.
         self.valid.next = self.v2.q.val();
         self.thread.next = self.t2.q.val();
         self.pc.next = self.pc2.q.val();
-        self.ctl.next = self.rom_ctl.read_data.val();
-        self.imm.next = self.rom_imm.read_data.val();
-        self.aux.next = self.rom_aux.read_data.val();
+        self.ctl.next = self.ctl2.q.val();
+        self.imm.next = self.imm2.q.val();
+        self.aux.next = self.aux2.q.val();
 
         // Write back.
         self.pc_ram.write_address.next = self.wb_thread.val();

@@ -16,7 +16,8 @@
 //! Pipeline (clock offsets from the issue), one block per stage, each with its own contract:
 //! - I0: [`Scheduler`] picks a ready thread.
 //! - I0..I2: [`Fetch`] reads the thread's `{epoch, halted, pc}` (a stale epoch means "new
-//!   frame": pc 0), then the instruction ROM's three words.
+//!   frame": pc 0) and, in the same clock, addresses the [`ProgramRom`]; it registers the
+//!   instruction's three words at I1.
 //! - I2..I4: [`Decode`] reads the two source registers, selects and registers the operands
 //!   and splits the fields; at I3 the [`MailboxUnit`] reads the thread's mailbox and the
 //!   coprocessors their state of the thread, and a long instruction reserves its write back.
@@ -75,6 +76,7 @@ mod first_ready;
 mod fp_units;
 mod mailbox;
 mod pixel_counter;
+mod program_rom;
 mod result_line;
 mod retiring;
 mod scheduler;
@@ -87,6 +89,7 @@ pub use first_ready::FirstReady;
 pub use fp_units::FpUnits;
 pub use mailbox::MailboxUnit;
 pub use pixel_counter::PixelCounter;
+pub use program_rom::ProgramRom;
 pub use result_line::ResultLine;
 pub use retiring::{Retiring, RetiringIn};
 pub use scheduler::Scheduler;
@@ -109,8 +112,8 @@ pub const fn long_latency(m: u32) -> u32 {
     m + 6
 }
 
-/// Clocks from the issue (I0) to the operands (I4): the pc read, the ROM read, the register
-/// read and the operand register.
+/// Clocks from the issue (I0) to the operands (I4): the pc and ROM reads, the ROM words'
+/// register, the register read and the operand register.
 pub const OPERAND_STAGE: u32 = 4;
 
 /// Clocks from a write back to the thread's next issue: the write back's register, the
@@ -354,7 +357,7 @@ impl<
             traversal_busy: Default::default(),
             scheduler: Scheduler::new(threads, DX as u32 - 4),
             fetch: Fetch::new(program),
-            decode: Decode::new(),
+            decode: Decode::new(program.registers_used),
             mailboxes: Default::default(),
             pixels: PixelCounter::new(&program.config),
             execute: Default::default(),
