@@ -8,8 +8,8 @@
 //! Latency 8 clocks, throughput one operation per clock:
 //! 1. input registers;
 //! 2. unpack (DAZ), special cases, magnitude compare and swap so that |big| >= |small|,
-//!    exponent difference clamped to the alignment's range (both differences and their
-//!    clamps are formed beside the magnitude compare, which picks one); registered;
+//!    exponent difference saturated to the align shifter's 5 bits (both differences are
+//!    formed beside the magnitude compare, which picks one); registered;
 //! 3. align the small significand (guard, round and sticky bits below it); registered;
 //! 4. add or subtract the aligned significands; registered (the alignment shifter and the
 //!    carry chain shared one stage at latency 7, 33 levels, 92.7 MHz on the ECP5: issue 16);
@@ -79,14 +79,14 @@ pub struct FpAddSub<
     sig_b: Signal<Local, Bits<S>>,
     diff_ab: Signal<Local, Bits<E>>,
     diff_ba: Signal<Local, Bits<E>>,
-    shift_ab: Signal<Local, Bits<E>>,
-    shift_ba: Signal<Local, Bits<E>>,
+    shift_ab: Signal<Local, Bits<ALIGN_SHIFT_BITS>>,
+    shift_ba: Signal<Local, Bits<ALIGN_SHIFT_BITS>>,
     // Stage 2 registers.
     big_sig: DFF<Bits<S>>,
     small_sig: DFF<Bits<S>>,
     big_exp: DFF<Bits<E>>,
-    /// The exponent difference, clamped to `S + 3`, in [`ALIGN_SHIFT_BITS`] bits: the align
-    /// shifter then has 5 levels, not `E` (the two unused levels sat in the processor's
+    /// The exponent difference, saturated to [`ALIGN_SHIFT_BITS`] bits: the align shifter
+    /// then has 5 levels, not `E` (the two unused levels sat in the processor's
     /// `add.shift -> add.al_small` paths, issue 16).
     shift: DFF<Bits<ALIGN_SHIFT_BITS>>,
     big_sign: DFF<Bit>,
@@ -187,7 +187,8 @@ pub struct FpAddSub<
     c_sign_pos: Constant<Bits<8>>,
     c_hidden: Constant<Bits<S>>,
     c_mag_mask: Constant<Bits<W>>,
-    c_shift_max: Constant<Bits<E>>,
+    c_shift_max: Constant<Bits<ALIGN_SHIFT_BITS>>,
+    c_align_bits: Constant<Bits<8>>,
     c_ones: Constant<Bits<T>>,
     c_one: Constant<Bits<T>>,
     c_top16: Constant<Bits<T>>,
@@ -229,7 +230,6 @@ impl<
             T <= 32,
             "FpAddSub: the normalizer handles at most 31 leading zeros"
         );
-        assert!(S + 3 < (1 << E), "FpAddSub: shift clamp must fit in E bits");
         assert!(
             S + 3 < (1 << ALIGN_SHIFT_BITS),
             "FpAddSub: shift clamp must fit the align shifter"
@@ -357,7 +357,8 @@ impl<
             c_sign_pos: const_index(W - 1),
             c_hidden: const_bits::<S>(1 << M),
             c_mag_mask: const_bits::<W>((1 << (W - 1)) - 1),
-            c_shift_max: const_bits::<E>((S + 3) as u64),
+            c_shift_max: const_bits::<ALIGN_SHIFT_BITS>((1 << ALIGN_SHIFT_BITS) - 1),
+            c_align_bits: const_bits::<8>(ALIGN_SHIFT_BITS as u64),
             c_ones: const_bits::<T>((1 << T) - 1),
             c_one: const_bits::<T>(1),
             c_top16: const_bits::<T>(top_mask(T, 16)),
@@ -494,18 +495,20 @@ impl<
             self.sig_b.next = 0.into();
         }
 
-        // The alignment shift for either order: the exponent difference, clamped because
-        // shifts beyond S+3 all leave nothing but sticky. Both are ready when the magnitude
-        // compare picks one (clamping after the pick put the clamp's carry chain in front
-        // of the align shifter: 123 MHz).
+        // The alignment shift for either order: the exponent difference, saturated to 31
+        // because every shift from S+3 on leaves nothing but sticky (S + 3 <= 31, checked
+        // in `default()`). Saturating tests the bits above the shifter's five, one LUT after
+        // the subtraction; clamping to S+3 took a second carry chain (`in_a -> shift`, 139.1
+        // MHz alone on the ECP5, issue 16). Both are ready when the magnitude compare picks
+        // one (clamping after the pick: 123 MHz).
         self.diff_ab.next = self.exp_a.val() - self.exp_b.val();
         self.diff_ba.next = self.exp_b.val() - self.exp_a.val();
-        self.shift_ab.next = self.diff_ab.val();
-        if self.diff_ab.val() > self.c_shift_max.val() {
+        self.shift_ab.next = bit_cast::<ALIGN_SHIFT_BITS, E>(self.diff_ab.val());
+        if (self.diff_ab.val() >> self.c_align_bits.val()).any() {
             self.shift_ab.next = self.c_shift_max.val();
         }
-        self.shift_ba.next = self.diff_ba.val();
-        if self.diff_ba.val() > self.c_shift_max.val() {
+        self.shift_ba.next = bit_cast::<ALIGN_SHIFT_BITS, E>(self.diff_ba.val());
+        if (self.diff_ba.val() >> self.c_align_bits.val()).any() {
             self.shift_ba.next = self.c_shift_max.val();
         }
 
@@ -519,13 +522,13 @@ impl<
             self.big_sig.d.next = self.sig_a.val();
             self.small_sig.d.next = self.sig_b.val();
             self.big_exp.d.next = self.exp_a.val();
-            self.shift.d.next = bit_cast::<ALIGN_SHIFT_BITS, E>(self.shift_ab.val());
+            self.shift.d.next = self.shift_ab.val();
             self.big_sign.d.next = self.sign_a.val();
         } else {
             self.big_sig.d.next = self.sig_b.val();
             self.small_sig.d.next = self.sig_a.val();
             self.big_exp.d.next = self.exp_b.val();
-            self.shift.d.next = bit_cast::<ALIGN_SHIFT_BITS, E>(self.shift_ba.val());
+            self.shift.d.next = self.shift_ba.val();
             self.big_sign.d.next = self.sign_b.val();
         }
         self.eff_sub.d.next = self.sign_a.val() ^ self.sign_b.val();
