@@ -664,7 +664,16 @@ fn stress_writes_its_table_and_a_summary_into_its_folder() {
     assert_eq!(code, 0, "{err}");
     let j: serde_json::Value = serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}"));
     let csv = std::fs::read_to_string(out.join("stress.csv")).unwrap();
-    let rows = csv.lines().count() - 1;
+    let rows = csv::Reader::from_reader(csv.as_bytes()).records().count();
+    // stderr is a pipe here: the case lines, and no progress display (no redraws, no estimate).
+    assert!(
+        err.contains("edge_rays / inside_camera: icosphere"),
+        "{err}"
+    );
+    assert!(
+        !err.contains('\r') && !err.contains('\u{1b}') && !err.contains(" left ("),
+        "{err}"
+    );
     let checks = j["checks"].as_array().unwrap();
     assert!(rows > 10, "{csv}");
     assert_eq!(checks.len(), rows, "one check per CSV row");

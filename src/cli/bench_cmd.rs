@@ -132,7 +132,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             if let Some((w, h)) = resolution {
                 (c.width, c.height) = (w, h);
             }
-            let rows = bench::precision_sweep(&c, &mut |l| eprintln!("{l}"))?;
+            let rows = bench::precision_sweep(&c, &mut |l| super::log_line(l))?;
             for p in bench::write_outputs(&rows, &a.out)? {
                 println!("wrote {}", p.display());
             }

@@ -168,27 +168,69 @@ pub fn run() -> i32 {
     }
 }
 
+/// The one progress display of a run (stderr), also the way [`log_line`] prints around it.
+static PROGRESS: std::sync::OnceLock<indicatif::ProgressBar> = std::sync::OnceLock::new();
+
 /// A spinner on stderr that shows the library's progress reports (stages, the testbench's
-/// heartbeat) with the time since the last stage began; indicatif draws nothing when stderr is
-/// not a terminal, so logs and tests see no spinner.
+/// heartbeat) with the time since the last stage began, and runs of like steps (the precision
+/// sweep, the stress suite) as N of total with the time left; indicatif draws nothing when
+/// stderr is not a terminal, so logs and tests see no spinner.
 fn progress_spinner() -> indicatif::ProgressBar {
     let bar = indicatif::ProgressBar::new_spinner();
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
-    );
+    bar.set_style(stage_style());
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
     let shown = bar.clone();
-    dynrt::progress::listen(move |m| {
-        // A heartbeat continues its stage; any other report starts a new one.
-        if m.starts_with("frame ") {
-            shown.set_message(format!("simulating {m}"));
-        } else {
-            shown.reset_elapsed();
-            shown.set_message(m.to_string());
-        }
-    });
+    dynrt::progress::listen(move |e| show_progress(&shown, e));
+    let _ = PROGRESS.set(bar.clone());
     bar
+}
+
+fn stage_style() -> indicatif::ProgressStyle {
+    indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner())
+}
+
+fn step_style() -> indicatif::ProgressStyle {
+    indicatif::ProgressStyle::with_template(
+        "{spinner} {pos} of {len}, about {eta} left ({elapsed}): {msg}",
+    )
+    .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner())
+}
+
+/// Shows one progress report on `bar`.
+fn show_progress(bar: &indicatif::ProgressBar, e: dynrt::progress::Event) {
+    use dynrt::progress::Event;
+    match e {
+        // A heartbeat continues its stage.
+        Event::Stage(m) if m.starts_with("frame ") => bar.set_message(format!("simulating {m}")),
+        Event::Stage(m) => {
+            if bar.length().is_some() {
+                bar.unset_length();
+                bar.set_style(stage_style());
+            }
+            bar.reset_elapsed();
+            bar.set_message(m.to_string());
+        }
+        Event::Step { done, total, next } => {
+            // A new run of steps: the estimate starts from its first step, not from whatever
+            // ran before it (cost synthesis, a stage).
+            if bar.length() != Some(total) || done == 0 {
+                bar.set_style(step_style());
+                bar.set_length(total);
+                bar.reset();
+            }
+            bar.set_position(done);
+            bar.set_message(next.to_string());
+        }
+    }
+}
+
+/// Prints a log line on stderr without tearing the progress display.
+pub(crate) fn log_line(line: &str) {
+    match PROGRESS.get() {
+        Some(bar) => bar.suspend(|| eprintln!("{line}")),
+        None => eprintln!("{line}"),
+    }
 }
 
 /// Exit status when a command ran into results that differ (frames, vectors, invariants).
@@ -270,6 +312,36 @@ mod tests {
             "without help text:\n{}",
             missing.join("\n")
         );
+    }
+
+    #[test]
+    fn steps_show_as_n_of_total_and_stages_as_a_spinner_again() {
+        use dynrt::progress::Event;
+        let bar = indicatif::ProgressBar::hidden();
+        let step = |done, next| {
+            show_progress(
+                &bar,
+                Event::Step {
+                    done,
+                    total: 7,
+                    next,
+                },
+            )
+        };
+        show_progress(&bar, Event::Stage("building the kd-trees"));
+        assert_eq!(bar.length(), None);
+        step(0, "acne: box");
+        step(3, "scale: far_small");
+        assert_eq!((bar.position(), bar.length()), (3, Some(7)));
+        assert_eq!(bar.message(), "scale: far_small");
+        // A heartbeat keeps the count; a new stage drops it.
+        show_progress(&bar, Event::Stage("frame 0: 10 cycles, 1 rays"));
+        assert_eq!(bar.length(), Some(7));
+        show_progress(&bar, Event::Stage("comparing"));
+        assert_eq!(bar.length(), None);
+        // A second run of steps counts from its own start.
+        step(0, "again");
+        assert_eq!((bar.position(), bar.length()), (0, Some(7)));
     }
 
     #[test]
