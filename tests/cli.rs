@@ -685,6 +685,41 @@ fn stress_writes_its_table_and_a_summary_into_its_folder() {
 
 /// `dynrt bench scenes` leaves summary.json and report.md beside its tables, naming them.
 #[test]
+fn bench_measures_the_scenes_of_scenes_dir_from_any_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = dir.path().join("s");
+    std::fs::create_dir(&scenes).unwrap();
+    std::fs::create_dir(scenes.join("meshes")).unwrap();
+    std::fs::copy(scene("tiny.toml"), scenes.join("tiny.toml")).unwrap();
+    for mesh in ["pyramid.obj", "pyramid.mtl"] {
+        let to = scenes.join("meshes").join(mesh);
+        std::fs::copy(scene(&format!("meshes/{mesh}")), to).unwrap();
+    }
+    let run = |scenes_dir: &Path| {
+        Command::new(env!("CARGO_BIN_EXE_dynrt"))
+            .current_dir(dir.path())
+            .args(["bench", "scenes", "--formats", "e7m16", "--size", "8x6"])
+            .arg("--scenes-dir")
+            .arg(scenes_dir)
+            .args(["--out", "b"])
+            .output()
+            .unwrap()
+    };
+    let o = run(&scenes);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.path().join("b/scenes.csv")).unwrap();
+    assert!(csv.contains("tiny"), "{csv}");
+    // Outside the repository without --scenes-dir: a usage error that says what to give.
+    let o = run(&dir.path().join("none"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--scenes-dir") && err.contains("none"),
+        "{err}"
+    );
+}
+
+#[test]
 fn bench_writes_a_summary_beside_its_tables() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("bench");
