@@ -38,35 +38,67 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// The main job on a scene: golden vs reference, FP operators simulated and checked; report.
+    #[command(
+        after_help = "Examples:\n  dynrt demo                                 # the Cornell box, every check, out/demo\n  dynrt demo scenes/mirror.toml --out out/mirror"
+    )]
     Demo(demo_cmd::DemoArgs),
     /// Render one frame with the golden model (eXmY) or the f64 reference.
+    #[command(
+        after_help = "Examples:\n  dynrt render scenes/cornell.toml --out out/render --hits   # frame0.png, hits0.csv\n  dynrt render scenes/dynamic.toml --frame 3 --model reference --size 128x96 --out out/ref"
+    )]
     Render(render_cmd::RenderArgs),
     /// Error metrics between two images (and hits files); writes a diff image.
     Compare(compare_cmd::CompareArgs),
     /// Measure speed, area and error; CSV and Markdown reports under --out.
+    #[command(
+        after_help = "Examples:\n  dynrt bench scenes --formats e7m16 --out out/bench\n  dynrt bench precision --size 64x48 --scenes-dir ~/dynrt/scenes"
+    )]
     Bench(bench_cmd::BenchArgs),
     /// Write the Verilog and testbenches of every FP operator of a format.
+    #[command(
+        after_help = "Examples:\n  dynrt emit-fp --format e8m23 --out out/fp   # out/fp/rtl/*.v, out/fp/testbench/tb_*.v"
+    )]
     EmitFp(emit_fp_cmd::EmitFpArgs),
     /// The seeded numerical stress suite; exits non-zero when an invariant breaks.
+    #[command(
+        after_help = "Examples:\n  dynrt stress --formats e7m16 --rays 2000 --out out/stress\n  dynrt stress --margins 0,64 --json"
+    )]
     Stress(stress_cmd::StressArgs),
     /// yosys synth_xilinx -family xc2v of one geometry unit: resources and logic depth.
+    #[command(after_help = "Examples:\n  dynrt synth --unit intersect --format e7m16")]
     Synth(synth_cmd::SynthArgs),
     /// Placed-and-routed timing (ECP5, nextpnr, out of context) of units alone or of the whole
     /// processor of scenes: fmax per clock, critical paths, utilization; timing.md/.csv.
+    #[command(
+        after_help = "Examples:\n  dynrt timing --unit add,mul --freq 120\n  dynrt timing scenes/cornell.toml --seeds 1,2,3 --out out/timing"
+    )]
     Timing(timing_cmd::TimingArgs),
     /// Write the scene files of the paper's Table 3 (scenes/paper/).
+    #[command(after_help = "Examples:\n  dynrt paper-scenes --out scenes/paper")]
     PaperScenes(paper_scenes_cmd::PaperScenesArgs),
     /// Write the ray tracing processor of a scene: Verilog, testbench, memory images, UCF.
+    #[command(
+        after_help = "Examples:\n  dynrt rtl scenes/tiny.toml --out out/tiny\n  dynrt rtl scenes/cornell.toml --out out/cornell --board my_board.toml --synth"
+    )]
     Rtl(rtl_cmd::RtlArgs),
     /// Generate, simulate (Icarus or Verilator) and compare every frame with the golden model.
+    #[command(
+        after_help = "Examples:\n  dynrt sim scenes/tiny.toml --out out/tiny --sim iverilog --size 8x6\n  dynrt sim scenes/cornell.toml --out out/cornell --trace fst --trace-start 1000 --trace-end 5000"
+    )]
     Sim(rtl_cmd::SimArgs),
     /// Run operand vectors through one floating-point operator (RTL or software model).
+    #[command(
+        after_help = "Examples:\n  dynrt fp --op div --vectors v.hex --out out/fp --sim verilator   # out/fp/results.hex"
+    )]
     Fp(fp_cmd::FpArgs),
     /// The versions of dynrt and of every tool it finds (simulators, yosys, nextpnr, FuseSoC,
     /// cocotb).
     Info(info_cmd::InfoArgs),
     /// Print a shell completion script, e.g. `dynrt completions bash >
     /// ~/.local/share/bash-completion/completions/dynrt`.
+    #[command(
+        after_help = "Examples:\n  dynrt completions bash > ~/.local/share/bash-completion/completions/dynrt"
+    )]
     Completions(CompletionsArgs),
 }
 
@@ -342,6 +374,21 @@ mod tests {
         // A second run of steps counts from its own start.
         step(0, "again");
         assert_eq!((bar.position(), bar.length()), (0, Some(7)));
+    }
+
+    #[test]
+    fn every_command_shows_examples_in_its_help() {
+        let cmd = Cli::command();
+        let without: Vec<&str> = cmd
+            .get_subcommands()
+            .filter(|c| c.get_name() != "help")
+            .filter(|c| {
+                !c.get_after_help()
+                    .is_some_and(|h| h.to_string().contains("\n  dynrt "))
+            })
+            .map(|c| c.get_name())
+            .collect();
+        assert!(without.is_empty(), "no examples: {without:?}");
     }
 
     #[test]
