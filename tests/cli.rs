@@ -685,7 +685,7 @@ fn stress_writes_its_table_and_a_summary_into_its_folder() {
 
 /// `dynrt bench scenes` leaves summary.json and report.md beside its tables, naming them.
 #[test]
-fn bench_measures_the_scenes_of_scenes_dir_from_any_folder() {
+fn outside_the_repository_bench_takes_scenes_dir_and_demo_asks_for_a_scene() {
     let dir = tempfile::tempdir().unwrap();
     let scenes = dir.path().join("s");
     std::fs::create_dir(&scenes).unwrap();
@@ -717,6 +717,16 @@ fn bench_measures_the_scenes_of_scenes_dir_from_any_folder() {
         err.contains("--scenes-dir") && err.contains("none"),
         "{err}"
     );
+    // demo's default scene is the repository's too: elsewhere it asks for a scene file.
+    let o = Command::new(env!("CARGO_BIN_EXE_dynrt"))
+        .current_dir(dir.path())
+        .args(["demo", "--out", "d"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("give a scene file"), "{err}");
+    assert!(!dir.path().join("d").exists());
 }
 
 #[test]
