@@ -32,4 +32,5 @@ pub mod scene;
 pub mod sim;
 pub mod stress;
 pub mod synth;
+pub mod tables;
 pub mod units;

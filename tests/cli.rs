@@ -3,6 +3,16 @@
 use std::path::Path;
 use std::process::Command;
 
+/// The names in a folder, sorted.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
 fn dynrt(args: &[&str]) -> (i32, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_dynrt"))
         .args(args)
@@ -24,10 +34,9 @@ fn scene(name: &str) -> String {
 }
 
 #[test]
-fn render_writes_a_png_and_a_hits_file_with_one_row_per_pixel() {
+fn render_writes_a_png_and_a_hits_file_with_one_row_per_pixel_into_its_folder() {
     let dir = tempfile::tempdir().unwrap();
-    let png = dir.path().join("tiny.png");
-    let hits = dir.path().join("tiny.csv");
+    let out_dir = dir.path().join("tiny");
     let (code, _, err) = dynrt(&[
         "render",
         &scene("tiny.toml"),
@@ -36,11 +45,15 @@ fn render_writes_a_png_and_a_hits_file_with_one_row_per_pixel() {
         "--height",
         "6",
         "--out",
-        png.to_str().unwrap(),
+        out_dir.to_str().unwrap(),
         "--hits",
-        hits.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
+    // --out is the folder: the frame and its hits inside it, nothing beside it.
+    assert_eq!(entries(dir.path()), ["tiny"]);
+    assert_eq!(entries(&out_dir), ["frame0.png", "hits0.csv"]);
+    let png = out_dir.join("frame0.png");
+    let hits = out_dir.join("hits0.csv");
     let img = image::open(&png).unwrap().to_rgb8();
     assert_eq!(img.dimensions(), (10, 6));
     let text = std::fs::read_to_string(&hits).unwrap();
@@ -52,6 +65,36 @@ fn render_writes_a_png_and_a_hits_file_with_one_row_per_pixel() {
         lines.iter().skip(1).any(|l| !l.ends_with(",-1,-1,inf")),
         "some pixel must hit"
     );
+    // The older `--hits FILE` still names the file; `--out IMG.png`, the older image path,
+    // is refused with the new meaning rather than becoming a folder named like an image.
+    let legacy = dir.path().join("legacy.csv");
+    let (code, _, err) = dynrt(&[
+        "render",
+        &scene("tiny.toml"),
+        "--size",
+        "4x3",
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--frame",
+        "0",
+        "--hits",
+        legacy.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        std::fs::read_to_string(&legacy).unwrap().lines().count(),
+        1 + 12
+    );
+    let old = dir.path().join("old.png");
+    let (code, _, err) = dynrt(&[
+        "render",
+        &scene("tiny.toml"),
+        "--out",
+        old.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--out") && err.contains("folder"), "{err}");
+    assert!(!old.exists());
     // The same image compared with itself: no differing pixel, infinite PSNR.
     let (code, out, _) = dynrt(&["compare", png.to_str().unwrap(), png.to_str().unwrap()]);
     assert_eq!(code, 0);
@@ -62,10 +105,11 @@ fn render_writes_a_png_and_a_hits_file_with_one_row_per_pixel() {
 }
 
 #[test]
-fn fp_model_results_follow_the_vectors() {
+fn fp_model_results_follow_the_vectors_into_its_folder() {
     let dir = tempfile::tempdir().unwrap();
     let v = dir.path().join("v.txt");
-    let out = dir.path().join("out.txt");
+    let out_dir = dir.path().join("out");
+    let out = out_dir.join("results.hex");
     // 1 + 1.5 = 2.5, inf + -inf = NaN, 1 < 1.5.
     std::fs::write(&v, "3f0000 3f8000\n7f0000 ff0000\n").unwrap();
     let (code, _, err) = dynrt(&[
@@ -77,7 +121,7 @@ fn fp_model_results_follow_the_vectors() {
         "--vectors",
         v.to_str().unwrap(),
         "--out",
-        out.to_str().unwrap(),
+        out_dir.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "404000\n7f8000\n");
@@ -90,16 +134,66 @@ fn fp_model_results_follow_the_vectors() {
         "--vectors",
         v.to_str().unwrap(),
         "--out",
-        out.to_str().unwrap(),
+        out_dir.to_str().unwrap(),
     ]);
     assert_eq!(code, 0);
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "1\n0\n");
+    // Only results.hex in --out, and nothing beside it but the vectors.
+    assert_eq!(entries(&out_dir), ["results.hex"]);
+    assert_eq!(entries(dir.path()), ["out", "v.txt"]);
+}
+
+/// `emit-fp --out DIR` writes the Verilog into DIR/rtl and the testbenches into DIR/testbench,
+/// nothing else; the hidden `--rtl`/`--testbench` of `make rtl` still place each part.
+#[test]
+fn emit_fp_writes_into_its_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("fp");
+    let (code, _, err) = dynrt(&["emit-fp", "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(entries(dir.path()), ["fp"]);
+    assert_eq!(entries(&out), ["rtl", "testbench"]);
+    assert!(entries(&out.join("rtl")).contains(&"fp_add_e7m16.v".to_string()));
+    assert!(entries(&out.join("testbench")).contains(&"tb_fp_sqrt_e7m16.v".to_string()));
+    let (r, t) = (dir.path().join("r"), dir.path().join("t"));
+    let (code, _, err) = dynrt(&[
+        "emit-fp",
+        "--out",
+        out.to_str().unwrap(),
+        "--rtl",
+        r.to_str().unwrap(),
+        "--testbench",
+        t.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(entries(dir.path()), ["fp", "r", "t"]);
+    assert_eq!(entries(&r).len(), 8);
+    assert_eq!(entries(&t).len(), 8);
+}
+
+/// `compare --out DIR` writes diff.png inside DIR; without --out nothing is written.
+#[test]
+fn compare_writes_its_diff_into_its_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.png");
+    image::RgbImage::from_pixel(2, 2, image::Rgb([1, 2, 3]))
+        .save(&a)
+        .unwrap();
+    let a = a.to_str().unwrap();
+    let (code, _, err) = dynrt(&["compare", a, a]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(entries(dir.path()), ["a.png"]);
+    let out = dir.path().join("cmp");
+    let (code, stdout, err) = dynrt(&["compare", a, a, "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(entries(&out), ["diff.png"]);
+    assert!(stdout.contains("diff.png"), "{stdout}");
 }
 
 #[test]
 fn bad_input_gets_one_clear_error_and_no_output_file() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("out.txt");
+    let out = dir.path().join("out");
     let o = out.to_str().unwrap();
     let v = dir.path().join("v.txt");
     std::fs::write(&v, "3f0000 3f8000\n3f0000 zz\n").unwrap();
@@ -570,7 +664,16 @@ fn stress_writes_its_table_and_a_summary_into_its_folder() {
     assert_eq!(code, 0, "{err}");
     let j: serde_json::Value = serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}"));
     let csv = std::fs::read_to_string(out.join("stress.csv")).unwrap();
-    let rows = csv.lines().count() - 1;
+    let rows = csv::Reader::from_reader(csv.as_bytes()).records().count();
+    // stderr is a pipe here: the case lines, and no progress display (no redraws, no estimate).
+    assert!(
+        err.contains("edge_rays / inside_camera: icosphere"),
+        "{err}"
+    );
+    assert!(
+        !err.contains('\r') && !err.contains('\u{1b}') && !err.contains(" left ("),
+        "{err}"
+    );
     let checks = j["checks"].as_array().unwrap();
     assert!(rows > 10, "{csv}");
     assert_eq!(checks.len(), rows, "one check per CSV row");
@@ -581,6 +684,51 @@ fn stress_writes_its_table_and_a_summary_into_its_folder() {
 }
 
 /// `dynrt bench scenes` leaves summary.json and report.md beside its tables, naming them.
+#[test]
+fn outside_the_repository_bench_takes_scenes_dir_and_demo_asks_for_a_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = dir.path().join("s");
+    std::fs::create_dir(&scenes).unwrap();
+    std::fs::create_dir(scenes.join("meshes")).unwrap();
+    std::fs::copy(scene("tiny.toml"), scenes.join("tiny.toml")).unwrap();
+    for mesh in ["pyramid.obj", "pyramid.mtl"] {
+        let to = scenes.join("meshes").join(mesh);
+        std::fs::copy(scene(&format!("meshes/{mesh}")), to).unwrap();
+    }
+    let run = |scenes_dir: &Path| {
+        Command::new(env!("CARGO_BIN_EXE_dynrt"))
+            .current_dir(dir.path())
+            .args(["bench", "scenes", "--formats", "e7m16", "--size", "8x6"])
+            .arg("--scenes-dir")
+            .arg(scenes_dir)
+            .args(["--out", "b"])
+            .output()
+            .unwrap()
+    };
+    let o = run(&scenes);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.path().join("b/scenes.csv")).unwrap();
+    assert!(csv.contains("tiny"), "{csv}");
+    // Outside the repository without --scenes-dir: a usage error that says what to give.
+    let o = run(&dir.path().join("none"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--scenes-dir") && err.contains("none"),
+        "{err}"
+    );
+    // demo's default scene is the repository's too: elsewhere it asks for a scene file.
+    let o = Command::new(env!("CARGO_BIN_EXE_dynrt"))
+        .current_dir(dir.path())
+        .args(["demo", "--out", "d"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("give a scene file"), "{err}");
+    assert!(!dir.path().join("d").exists());
+}
+
 #[test]
 fn bench_writes_a_summary_beside_its_tables() {
     let dir = tempfile::tempdir().unwrap();
@@ -720,15 +868,15 @@ fn completions_op_list_and_one_size_syntax() {
     let dir = tempfile::tempdir().unwrap();
     let tiny = scene("tiny.toml");
     for args in [vec!["--size", "4x3"], vec!["--width", "4", "--height", "3"]] {
-        let png = dir.path().join("f.png");
-        let mut all = vec!["render", tiny.as_str(), "--out", png.to_str().unwrap()];
+        let f = dir.path().join("f");
+        let mut all = vec!["render", tiny.as_str(), "--out", f.to_str().unwrap()];
         all.extend(args.iter().copied());
         let (code, out, err) = dynrt(&all);
         assert_eq!(code, 0, "{args:?}: {out}{err}");
-        let img = image::open(&png).unwrap();
+        let img = image::open(f.join("frame0.png")).unwrap();
         assert_eq!((img.width(), img.height()), (4, 3), "{args:?}");
     }
-    let o = dir.path().join("g.png");
+    let o = dir.path().join("g");
     let (code, _, err) = dynrt(&["render", &tiny, "--size", "4", "--out", o.to_str().unwrap()]);
     assert_eq!(code, 2, "{err}");
     assert!(

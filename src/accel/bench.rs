@@ -23,7 +23,6 @@ use anyhow::{bail, Context};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -366,36 +365,48 @@ fn write_csv(path: &Path, rows: &[BenchRow]) -> anyhow::Result<()> {
     };
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("cannot create directory {}", dir.display()))?;
-    let mut tmp = tempfile::NamedTempFile::new_in(&dir)
-        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
-    writeln!(
-        tmp,
-        "case,kind,items,seconds,items_per_second,nodes,leaves,empty_leaves,references,depth,sah_cost,max_prims_per_leaf,mean_prims_per_leaf,rays,nodes_per_ray,tests_per_ray"
-    )?;
-    for r in rows {
-        let s = &r.stats;
-        writeln!(
-            tmp,
-            "{},{},{},{:.6},{:.0},{},{},{},{},{},{:.4},{},{:.3},{},{:.3},{:.3}",
-            r.case,
-            r.kind,
-            r.items,
-            r.seconds,
-            r.items_per_second,
-            s.nodes,
-            s.leaves,
-            s.empty_leaves,
-            s.references,
-            s.depth,
-            s.sah_cost,
-            s.max_tris_per_leaf,
-            s.mean_tris_per_leaf,
-            r.counts.rays,
-            r.counts.nodes_per_ray(),
-            r.counts.tests_per_ray()
-        )?;
-    }
-    tmp.persist(path)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(())
+    let header = [
+        "case",
+        "kind",
+        "items",
+        "seconds",
+        "items_per_second",
+        "nodes",
+        "leaves",
+        "empty_leaves",
+        "references",
+        "depth",
+        "sah_cost",
+        "max_prims_per_leaf",
+        "mean_prims_per_leaf",
+        "rays",
+        "nodes_per_ray",
+        "tests_per_ray",
+    ];
+    let lines: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            let s = &r.stats;
+            vec![
+                r.case.to_string(),
+                r.kind.to_string(),
+                r.items.to_string(),
+                format!("{:.6}", r.seconds),
+                format!("{:.0}", r.items_per_second),
+                s.nodes.to_string(),
+                s.leaves.to_string(),
+                s.empty_leaves.to_string(),
+                s.references.to_string(),
+                s.depth.to_string(),
+                format!("{:.4}", s.sah_cost),
+                s.max_tris_per_leaf.to_string(),
+                format!("{:.3}", s.mean_tris_per_leaf),
+                r.counts.rays.to_string(),
+                format!("{:.3}", r.counts.nodes_per_ray()),
+                format!("{:.3}", r.counts.tests_per_ray()),
+            ]
+        })
+        .collect();
+    crate::output::write_atomically(path, crate::tables::csv_text(&header, &lines).as_bytes())
+        .with_context(|| format!("cannot write {}", path.display()))
 }

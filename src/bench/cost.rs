@@ -98,39 +98,68 @@ impl DatapathCost {
 
 const HEADER: &str = "format,op,luts,flip_flops,mult18x18,yosys_seconds";
 
-/// Reads a cost CSV, naming the file and line of any error.
+/// One line of a cost CSV; the seconds as text so that a rewritten cache keeps its `5.10`.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct CostRow {
+    format: String,
+    op: String,
+    luts: u64,
+    flip_flops: u64,
+    mult18x18: u64,
+    yosys_seconds: String,
+}
+
+/// Reads a cost CSV, naming the file, the line and the column of any error.
 pub fn read_costs(path: &Path) -> Result<Vec<OpCost>> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let mut lines = text.lines().enumerate();
-    match lines.next() {
-        Some((_, h)) if h.trim() == HEADER => {}
+    let mut r = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    match r.headers() {
+        Ok(h) if h.iter().eq(HEADER.split(',')) => {}
         _ => bail!("{}: line 1: expected the header `{HEADER}`", path.display()),
     }
     let mut out = Vec::new();
-    for (i, line) in lines {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let bad =
-            |what: &str| anyhow::anyhow!("{}: line {}: {what}: `{line}`", path.display(), i + 1);
-        let f: Vec<&str> = line.split(',').map(str::trim).collect();
-        if f.len() != 6 {
-            return Err(bad("expected 6 comma-separated fields"));
-        }
-        let num = |s: &str, what: &str| s.parse::<u64>().map_err(|_| bad(what));
+    for row in r.deserialize::<CostRow>() {
+        let row = row.map_err(|e| csv_error(path, &e))?;
+        let line = out.len() + 2;
+        let bad = |what: String| anyhow::anyhow!("{}: line {line}: {what}", path.display());
         out.push(OpCost {
-            format: Format::parse(f[0]).map_err(|e| bad(&e.to_string()))?,
-            op: BinOp::parse(f[1]).ok_or_else(|| bad("unknown operator"))?,
-            luts: num(f[2], "luts is not a count")?,
-            flip_flops: num(f[3], "flip_flops is not a count")?,
-            mult18x18: num(f[4], "mult18x18 is not a count")?,
-            yosys_seconds: f[5]
-                .parse()
-                .map_err(|_| bad("yosys_seconds is not a number"))?,
+            format: Format::parse(&row.format).map_err(|e| bad(e.to_string()))?,
+            op: BinOp::parse(&row.op)
+                .ok_or_else(|| bad(format!("unknown operator `{}`", row.op)))?,
+            luts: row.luts,
+            flip_flops: row.flip_flops,
+            mult18x18: row.mult18x18,
+            yosys_seconds: row.yosys_seconds.parse().map_err(|_| {
+                bad(format!(
+                    "yosys_seconds `{}` is not a number",
+                    row.yosys_seconds
+                ))
+            })?,
         });
     }
     Ok(out)
+}
+
+/// A CSV reading error as `FILE: line N: column `NAME`: what`.
+fn csv_error(path: &Path, e: &csv::Error) -> anyhow::Error {
+    let line = e.position().map_or(0, |p| p.line());
+    match e.kind() {
+        csv::ErrorKind::Deserialize { err, .. } => {
+            let column = err
+                .field()
+                .and_then(|f| HEADER.split(',').nth(f as usize))
+                .unwrap_or("?");
+            anyhow::anyhow!(
+                "{}: line {line}: column `{column}`: {}",
+                path.display(),
+                err.kind()
+            )
+        }
+        _ => anyhow::anyhow!("{}: line {line}: {e}", path.display()),
+    }
 }
 
 /// Writes a cost CSV (sorted by format and operator), atomically.
@@ -139,19 +168,22 @@ pub fn write_costs(path: &Path, costs: &[OpCost]) -> Result<()> {
     for c in costs {
         sorted.insert((c.format.exp_bits, c.format.man_bits, c.op.name()), c);
     }
-    let mut text = String::from(HEADER);
-    text.push('\n');
-    for c in sorted.values() {
-        text += &format!(
-            "{},{},{},{},{},{:.2}\n",
-            c.format,
-            c.op.name(),
-            c.luts,
-            c.flip_flops,
-            c.mult18x18,
-            c.yosys_seconds
-        );
-    }
+    let rows: Vec<CostRow> = sorted
+        .values()
+        .map(|c| CostRow {
+            format: c.format.to_string(),
+            op: c.op.name().to_string(),
+            luts: c.luts,
+            flip_flops: c.flip_flops,
+            mult18x18: c.mult18x18,
+            yosys_seconds: format!("{:.2}", c.yosys_seconds),
+        })
+        .collect();
+    let text = if rows.is_empty() {
+        format!("{HEADER}\n")
+    } else {
+        crate::tables::csv_of(&rows)?
+    };
     crate::output::write_atomically(path, text.as_bytes())
         .with_context(|| format!("writing {}", path.display()))
 }
@@ -270,5 +302,20 @@ mod tests {
         std::fs::write(&p, format!("{HEADER}\ne7m16,add,x,1,0,1.0\n")).unwrap();
         let err = read_costs(&p).unwrap_err().to_string();
         assert!(err.contains("line 2") && err.contains("luts"), "{err}");
+        std::fs::write(
+            &p,
+            format!("{HEADER}\ne7m16,add,1,1,0,1.0\ne7m16,pow,1,1,0,1.0\n"),
+        )
+        .unwrap();
+        let err = read_costs(&p).unwrap_err().to_string();
+        assert!(err.contains("line 3") && err.contains("pow"), "{err}");
+        // The checked-in cache reads and writes back byte for byte.
+        let cache = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/data/fp_cost_xc2v.csv");
+        let costs = read_costs(&cache).unwrap();
+        write_costs(&p, &costs).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&p).unwrap(),
+            std::fs::read_to_string(&cache).unwrap()
+        );
     }
 }

@@ -282,6 +282,7 @@ pub fn precision_sweep(config: &SweepConfig, log: &mut dyn FnMut(&str)) -> Resul
     }
 
     let mut rows = Vec::new();
+    let mut steps = crate::progress::Steps::new(subjects.len() * config.formats.len());
     for sub in &subjects {
         let reference = Reference::new(&sub.scene);
         let (r_on, reference_seconds) = timed(|| reference.render(0));
@@ -297,6 +298,7 @@ pub fn precision_sweep(config: &SweepConfig, log: &mut dyn FnMut(&str)) -> Resul
             (world, rays)
         });
         for &f in &config.formats {
+            steps.start(&format!("{} {f}", sub.name));
             let mut row = Row {
                 scene: sub.name.clone(),
                 format: f,
@@ -388,6 +390,7 @@ pub fn precision_sweep(config: &SweepConfig, log: &mut dyn FnMut(&str)) -> Resul
             rows.push(row);
         }
     }
+    steps.finish();
     Ok(rows)
 }
 
@@ -399,41 +402,90 @@ fn opt_pair(p: Option<(u64, u64)>) -> (String, String) {
 
 /// The rows as CSV.
 pub fn rows_csv(rows: &[Row]) -> String {
-    let mut s = String::from(
-        "scene,format,triangles,pixels,identical_hit_ratio,equivalent_hit_ratio,psnr_db,max_channel_error,\
-         mean_rel_dist_error,max_rel_dist_error,acne_pixels,inside_leaked_pixels,inside_pixels,\
-         edge_leaked_rays,edge_rays,margin_changed_pixels,margin_changed_hits,margin_fixed_hits,\
-         margin_broken_hits,golden_seconds,reference_seconds,dropped_triangles,datapath_luts,\
-         datapath_flip_flops,datapath_mult18x18,note\n",
-    );
-    for r in rows {
-        let (il, ip) = opt_pair(r.inside_leaks);
-        let (el, er) = opt_pair(r.edge_leaks);
-        let (mp, mh, mf, mb) = r.margin_changes.map_or(Default::default(), |c| {
-            (
-                c.changed_pixels.to_string(),
-                c.changed_hits.to_string(),
-                c.fixed_hits.to_string(),
-                c.broken_hits.to_string(),
-            )
-        });
-        let (l, ff, m) = r
-            .datapath
-            .map_or((String::new(), String::new(), String::new()), |d| {
+    let header = [
+        "scene",
+        "format",
+        "triangles",
+        "pixels",
+        "identical_hit_ratio",
+        "equivalent_hit_ratio",
+        "psnr_db",
+        "max_channel_error",
+        "mean_rel_dist_error",
+        "max_rel_dist_error",
+        "acne_pixels",
+        "inside_leaked_pixels",
+        "inside_pixels",
+        "edge_leaked_rays",
+        "edge_rays",
+        "margin_changed_pixels",
+        "margin_changed_hits",
+        "margin_fixed_hits",
+        "margin_broken_hits",
+        "golden_seconds",
+        "reference_seconds",
+        "dropped_triangles",
+        "datapath_luts",
+        "datapath_flip_flops",
+        "datapath_mult18x18",
+        "note",
+    ];
+    let lines: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            let (il, ip) = opt_pair(r.inside_leaks);
+            let (el, er) = opt_pair(r.edge_leaks);
+            let (mp, mh, mf, mb) = r.margin_changes.map_or(Default::default(), |c| {
                 (
-                    d.luts.to_string(),
-                    d.flip_flops.to_string(),
-                    d.mult18x18.to_string(),
+                    c.changed_pixels.to_string(),
+                    c.changed_hits.to_string(),
+                    c.fixed_hits.to_string(),
+                    c.broken_hits.to_string(),
                 )
             });
-        s += &format!(
-            "{},{},{},{},{:.6},{:.6},{:.3},{},{:.3e},{:.3e},{},{il},{ip},{el},{er},{mp},{mh},{mf},{mb},{:.4},{:.4},{},{l},{ff},{m},\"{}\"\n",
-            r.scene, r.format, r.triangles, r.pixels, r.identical_hit_ratio, r.equivalent_hit_ratio,
-            r.psnr_db, r.max_channel_error, r.mean_rel_dist_error, r.max_rel_dist_error, r.acne_pixels,
-            r.golden_seconds, r.reference_seconds, r.dropped_triangles, r.note.replace('"', "'")
-        );
-    }
-    s
+            let (l, ff, m) = datapath_fields(r.datapath);
+            vec![
+                r.scene.clone(),
+                r.format.to_string(),
+                r.triangles.to_string(),
+                r.pixels.to_string(),
+                format!("{:.6}", r.identical_hit_ratio),
+                format!("{:.6}", r.equivalent_hit_ratio),
+                format!("{:.3}", r.psnr_db),
+                r.max_channel_error.to_string(),
+                format!("{:.3e}", r.mean_rel_dist_error),
+                format!("{:.3e}", r.max_rel_dist_error),
+                r.acne_pixels.to_string(),
+                il,
+                ip,
+                el,
+                er,
+                mp,
+                mh,
+                mf,
+                mb,
+                format!("{:.4}", r.golden_seconds),
+                format!("{:.4}", r.reference_seconds),
+                r.dropped_triangles.to_string(),
+                l,
+                ff,
+                m,
+                r.note.clone(),
+            ]
+        })
+        .collect();
+    crate::tables::csv_text(&header, &lines)
+}
+
+/// LUTs, flip-flops and multipliers of a datapath estimate, empty without one.
+fn datapath_fields(d: Option<DatapathCost>) -> (String, String, String) {
+    d.map_or((String::new(), String::new(), String::new()), |d| {
+        (
+            d.luts.to_string(),
+            d.flip_flops.to_string(),
+            d.mult18x18.to_string(),
+        )
+    })
 }
 
 /// The sweep folded per format (over the scenes every format rendered).
@@ -530,45 +582,61 @@ pub fn summarize(rows: &[Row]) -> Vec<FormatSummary> {
 
 /// The summaries as CSV.
 pub fn summary_csv(s: &[FormatSummary]) -> String {
-    let mut out = String::from(
-        "format,width_bits,scenes,refused,refused_other,mean_mismatch,worst_mismatch,mean_identical,mean_psnr_db,min_psnr_db,\
-         acne_pixels,pixels,inside_leak_ppm,edge_leak_ppm,margin_changed_pixels,margin_changed_hits,margin_fixed_hits,\
-         margin_broken_hits,golden_seconds,datapath_luts,datapath_flip_flops,datapath_mult18x18\n",
-    );
-    for x in s {
-        let (l, ff, m) = x
-            .datapath
-            .map_or((String::new(), String::new(), String::new()), |d| {
-                (
-                    d.luts.to_string(),
-                    d.flip_flops.to_string(),
-                    d.mult18x18.to_string(),
-                )
-            });
-        out += &format!(
-            "{},{},{},{},{},{:.6},{:.6},{:.6},{:.2},{:.2},{},{},{:.1},{:.1},{},{},{},{},{:.3},{l},{ff},{m}\n",
-            x.format,
-            x.format.width(),
-            x.scenes,
-            x.refused,
-            x.refused_other,
-            x.mean_mismatch,
-            x.worst_mismatch,
-            x.mean_identical,
-            x.mean_psnr_db,
-            x.min_psnr_db,
-            x.acne_pixels,
-            x.pixels,
-            x.inside_leak_ppm(),
-            x.edge_leak_ppm(),
-            x.margin_changes.changed_pixels,
-            x.margin_changes.changed_hits,
-            x.margin_changes.fixed_hits,
-            x.margin_changes.broken_hits,
-            x.golden_seconds
-        );
-    }
-    out
+    let header = [
+        "format",
+        "width_bits",
+        "scenes",
+        "refused",
+        "refused_other",
+        "mean_mismatch",
+        "worst_mismatch",
+        "mean_identical",
+        "mean_psnr_db",
+        "min_psnr_db",
+        "acne_pixels",
+        "pixels",
+        "inside_leak_ppm",
+        "edge_leak_ppm",
+        "margin_changed_pixels",
+        "margin_changed_hits",
+        "margin_fixed_hits",
+        "margin_broken_hits",
+        "golden_seconds",
+        "datapath_luts",
+        "datapath_flip_flops",
+        "datapath_mult18x18",
+    ];
+    let lines: Vec<Vec<String>> = s
+        .iter()
+        .map(|x| {
+            let (l, ff, m) = datapath_fields(x.datapath);
+            vec![
+                x.format.to_string(),
+                x.format.width().to_string(),
+                x.scenes.to_string(),
+                x.refused.to_string(),
+                x.refused_other.to_string(),
+                format!("{:.6}", x.mean_mismatch),
+                format!("{:.6}", x.worst_mismatch),
+                format!("{:.6}", x.mean_identical),
+                format!("{:.2}", x.mean_psnr_db),
+                format!("{:.2}", x.min_psnr_db),
+                x.acne_pixels.to_string(),
+                x.pixels.to_string(),
+                format!("{:.1}", x.inside_leak_ppm()),
+                format!("{:.1}", x.edge_leak_ppm()),
+                x.margin_changes.changed_pixels.to_string(),
+                x.margin_changes.changed_hits.to_string(),
+                x.margin_changes.fixed_hits.to_string(),
+                x.margin_changes.broken_hits.to_string(),
+                format!("{:.3}", x.golden_seconds),
+                l,
+                ff,
+                m,
+            ]
+        })
+        .collect();
+    crate::tables::csv_text(&header, &lines)
 }
 
 /// The cheapest format (datapath LUTs) that refused no scene but for its size, whose inside
@@ -825,8 +893,18 @@ mod tests {
         c.height = 24;
         c.synthesize = false;
         c.cost_csv = dir.path().join("none.csv");
+        crate::progress::seen_in_tests();
         let rows = precision_sweep(&c, &mut |_| {}).unwrap();
         assert_eq!(rows.len(), 2);
+        // Each scene and format is a step of the progress display, counted against the total.
+        let seen = crate::progress::seen_in_tests();
+        for want in [
+            "step 0/2: cornell e5m10",
+            "step 1/2: cornell e8m23",
+            "step 2/2: done",
+        ] {
+            assert!(seen.iter().any(|l| l == want), "no `{want}` in {seen:?}");
+        }
         let (narrow, wide) = (&rows[0], &rows[1]);
         assert!(wide.equivalent_hit_ratio > 0.99, "{wide:?}");
         assert!(

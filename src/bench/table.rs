@@ -24,28 +24,12 @@ impl Table {
     }
 
     pub fn to_csv(&self) -> String {
-        let quote = |s: &String| {
-            if s.contains(',') {
-                format!("\"{s}\"")
-            } else {
-                s.clone()
-            }
-        };
-        let mut out = String::new();
-        for line in std::iter::once(&self.header).chain(&self.rows) {
-            out.push_str(&line.iter().map(quote).collect::<Vec<_>>().join(","));
-            out.push('\n');
-        }
-        out
+        crate::tables::csv_text(&self.header, &self.rows)
     }
 
+    /// A Markdown table whose columns line up in the text as well as when rendered.
     pub fn to_markdown(&self) -> String {
-        let mut out = format!("| {} |\n", self.header.join(" | "));
-        out.push_str(&format!("|{}\n", "---|".repeat(self.header.len())));
-        for r in &self.rows {
-            out.push_str(&format!("| {} |\n", r.join(" | ")));
-        }
-        out
+        crate::tables::markdown_table(&self.header, &self.rows)
     }
 
     /// Writes `DIR/NAME.csv` and `DIR/NAME.md`.
@@ -64,14 +48,41 @@ mod tests {
     use super::*;
 
     #[test]
-    fn csv_quotes_commas_and_markdown_has_one_row_per_result() {
+    fn csv_fields_with_commas_quotes_and_newlines_read_back_whole() {
+        let mut t = Table::new(&["scene", "value"]);
+        let hostile = "say \"hi\",\nthen go";
+        t.push(vec!["a,b".into(), "1.5".into()]);
+        t.push(vec![hostile.into(), "2".into()]);
+        t.push(vec!["c".into(), String::new()]);
+        let text = t.to_csv();
+        // Plain fields stay bare, as the bench CSVs always were.
+        assert!(text.starts_with("scene,value\n\"a,b\",1.5\n"), "{text}");
+        let mut r = csv::Reader::from_reader(text.as_bytes());
+        assert_eq!(r.headers().unwrap(), vec!["scene", "value"]);
+        let back: Vec<Vec<String>> = r
+            .records()
+            .map(|rec| rec.unwrap().iter().map(String::from).collect())
+            .collect();
+        assert_eq!(back, t.rows);
+    }
+
+    #[test]
+    fn markdown_has_one_row_per_result_and_aligned_columns() {
         let mut t = Table::new(&["scene", "value"]);
         t.push(vec!["a,b".into(), "1.5".into()]);
-        t.push(vec!["c".into(), "2".into()]);
-        assert_eq!(t.to_csv(), "scene,value\n\"a,b\",1.5\nc,2\n");
+        t.push(vec!["cornell_noshadow".into(), "2".into()]);
+        let md = t.to_markdown();
+        let lines: Vec<&str> = md.lines().collect();
+        assert_eq!(lines.len(), 4, "{md}");
+        assert!(lines[1].chars().all(|c| c == '|' || c == '-'), "{md}");
+        // Every line has its `|` at the same columns.
+        let bars = |l: &str| -> Vec<usize> { l.match_indices('|').map(|(i, _)| i).collect() };
+        for l in &lines {
+            assert_eq!(bars(l), bars(lines[0]), "{md}");
+        }
         assert_eq!(
-            t.to_markdown(),
-            "| scene | value |\n|---|---|\n| a,b | 1.5 |\n| c | 2 |\n"
+            lines[3].split('|').nth(1).unwrap().trim(),
+            "cornell_noshadow"
         );
     }
 }

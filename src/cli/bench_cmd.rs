@@ -14,6 +14,11 @@ pub struct BenchArgs {
     /// Report directory.
     #[arg(long, default_value = "out/bench", global = true)]
     pub out: PathBuf,
+    /// Folder of the bundled scenes that `precision`, `scenes` and `trees` measure by default
+    /// (the repository's scenes/; name it to run from another folder). `precision` reads its
+    /// operator cost cache from benches/data/ beside it.
+    #[arg(long, value_name = "DIR", default_value = "scenes", global = true)]
+    pub scenes_dir: PathBuf,
 }
 
 #[derive(Subcommand)]
@@ -89,6 +94,17 @@ pub enum BenchWhat {
     },
 }
 
+/// `dir` when it is a folder; else the error says what to do (outside the repository the
+/// default `scenes` is not there).
+fn scenes_dir(dir: &std::path::Path) -> anyhow::Result<PathBuf> {
+    anyhow::ensure!(
+        dir.is_dir(),
+        "--scenes-dir '{}' is not a folder of scene files; run dynrt from the repository or give --scenes-dir DIR (the repository's scenes/)",
+        dir.display()
+    );
+    Ok(dir.to_path_buf())
+}
+
 pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
     dynrt::output::check_output_dir(&a.out, "--out")?;
     let verb = match &a.what {
@@ -126,13 +142,13 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             meshes,
             resolution,
         } => {
-            let mut c = bench::SweepConfig::new(std::path::Path::new("scenes"))?;
+            let mut c = bench::SweepConfig::new(&scenes_dir(&a.scenes_dir)?)?;
             c.edge_margin_ulps = margin;
             c.mesh_dir = meshes;
             if let Some((w, h)) = resolution {
                 (c.width, c.height) = (w, h);
             }
-            let rows = bench::precision_sweep(&c, &mut |l| eprintln!("{l}"))?;
+            let rows = bench::precision_sweep(&c, &mut |l| super::log_line(l))?;
             for p in bench::write_outputs(&rows, &a.out)? {
                 println!("wrote {}", p.display());
             }
@@ -153,7 +169,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             resolution,
         } => {
             let scenes = if scenes.is_empty() {
-                bench::scenes::bundled_scenes(std::path::Path::new("scenes"))?
+                bench::scenes::bundled_scenes(&scenes_dir(&a.scenes_dir)?)?
             } else {
                 scenes
             };
@@ -207,7 +223,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
         }
         BenchWhat::Trees { scenes, meshes } => {
             let scenes = if scenes.is_empty() {
-                bench::scenes::bundled_scenes(std::path::Path::new("scenes"))?
+                bench::scenes::bundled_scenes(&scenes_dir(&a.scenes_dir)?)?
             } else {
                 scenes
             };

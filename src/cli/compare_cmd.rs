@@ -11,7 +11,7 @@ use std::path::PathBuf;
 #[derive(Args)]
 #[command(
     after_help = "Examples:\n  dynrt compare out/sim/frame0.png out/sim/golden0.png --fail-pixels 0\n  \
-dynrt compare golden.png reference.png --fail-psnr 40 --diff diff.png --json\n\n\
+dynrt compare golden.png reference.png --fail-psnr 40 --out out/diff --json\n\n\
 Exit status: 0 within the thresholds (or none given), 1 a threshold failed, 2 bad input."
 )]
 pub struct CompareArgs {
@@ -19,8 +19,12 @@ pub struct CompareArgs {
     pub a: PathBuf,
     /// Second image (PNG), of the same size.
     pub b: PathBuf,
-    /// Write a diff image (amplified absolute difference).
-    #[arg(long)]
+    /// Output folder (created if missing) for diff.png, the amplified absolute difference;
+    /// without it nothing is written.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// The diff image as a file of its own (the older form of --out).
+    #[arg(long, value_name = "FILE", hide = true, conflicts_with = "out")]
     pub diff: Option<PathBuf>,
     /// Hits files of A and B: adds the identical-hit ratio and distance errors.
     #[arg(long, num_args = 2, value_names = ["HITS_A", "HITS_B"])]
@@ -72,13 +76,23 @@ pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
             "--fail-psnr {db}: give a PSNR in dB, e.g. --fail-psnr 40"
         );
     }
-    if let Some(d) = &a.diff {
-        dynrt::output::check_output_file(d, "--diff")?;
+    let diff = match (&a.out, &a.diff) {
+        (Some(dir), _) => {
+            dynrt::output::check_output_dir(dir, "--out")?;
+            Some(("--out", dir.join("diff.png")))
+        }
+        (None, Some(file)) => {
+            dynrt::output::check_output_file(file, "--diff")?;
+            Some(("--diff", file.clone()))
+        }
+        (None, None) => None,
+    };
+    if let Some((flag, d)) = &diff {
         let mut inputs: Vec<(&str, &std::path::Path)> = vec![("image A", &a.a), ("image B", &a.b)];
         if let Some(h) = &a.hits {
             inputs.extend([("HITS_A", h[0].as_path()), ("HITS_B", h[1].as_path())]);
         }
-        dynrt::output::check_distinct(&[("--diff", d)], &inputs)?;
+        dynrt::output::check_distinct(&[(flag, d)], &inputs)?;
     }
     // Every input is read and checked before anything is computed or written.
     let hits = match &a.hits {
@@ -106,8 +120,16 @@ pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
         )?),
         None => None,
     };
-    if let Some(d) = &a.diff {
+    if let Some((_, d)) = &diff {
+        let out = a
+            .out
+            .as_deref()
+            .map(|o| dynrt::output::OutputDir::create(o, "--out"))
+            .transpose()?;
         dynrt::output::write_png(d, &compare::diff_image(&ia, &ib))?;
+        if let Some(o) = out {
+            o.keep();
+        }
     }
     let failed = failed_thresholds(&a, &m);
     if a.json {
@@ -120,7 +142,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
             // JSON has no infinity: identical images give null.
             "psnr_db": m.psnr_db.is_finite().then_some(m.psnr_db),
             "ssim": m.ssim,
-            "diff": a.diff,
+            "diff": diff.as_ref().map(|(_, d)| d),
             "failed": failed,
             "pass": failed.is_empty(),
         });
@@ -155,7 +177,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<i32> {
                 hm.mean_rel_dist_error, hm.max_rel_dist_error
             );
         }
-        if let Some(d) = &a.diff {
+        if let Some((_, d)) = &diff {
             println!("diff image       {}", d.display());
         }
         for f in &failed {

@@ -21,6 +21,13 @@ pub struct DemoArgs {
 }
 
 pub fn run(a: DemoArgs) -> anyhow::Result<i32> {
+    // The default is relative to the repository: elsewhere say what to give instead.
+    if a.scene.is_none() && !default_scene().is_file() {
+        anyhow::bail!(
+            "the default scene {} is not here (dynrt runs outside the repository); give a scene file, e.g. dynrt demo ~/dynrt/scenes/cornell.toml",
+            default_scene().display()
+        );
+    }
     let config = DemoConfig {
         scene: a.scene.unwrap_or_else(|| default_scene().to_path_buf()),
         format: a.format,

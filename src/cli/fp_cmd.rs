@@ -26,13 +26,17 @@ pub struct FpArgs {
     /// One vector a line: two hex words `a b` of the format's width.
     #[arg(long)]
     pub vectors: PathBuf,
-    /// One hex result a line (0 or 1 for comparisons).
-    #[arg(long)]
+    /// Output folder (created if missing): results.hex, one hex result a line (0 or 1 for
+    /// comparisons).
+    #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Who computes: the operator's RTL in iverilog or verilator, or the software model.
     #[arg(long, value_enum, default_value = "model")]
     pub sim: FpEngine,
 }
+
+/// The results file in --out: the name the operator testbenches write (`dynrt emit-fp`).
+pub(crate) const RESULTS: &str = "results.hex";
 
 /// Every operation of [`BinOp::ALL`] as a possible value, so that `--help`, the error for an
 /// unknown name and the shell completions list them all.
@@ -44,8 +48,9 @@ fn op_parser() -> impl clap::builder::TypedValueParser<Value = BinOp> {
 
 pub fn run(a: FpArgs) -> anyhow::Result<i32> {
     let f = a.format;
-    dynrt::output::check_output_file(&a.out, "--out")?;
-    dynrt::output::check_distinct(&[("--out", &a.out)], &[("--vectors", &a.vectors)])?;
+    dynrt::output::check_output_dir(&a.out, "--out")?;
+    let results_path = a.out.join(RESULTS);
+    dynrt::output::check_distinct(&[("--out", &results_path)], &[("--vectors", &a.vectors)])?;
     let vectors = read_vector_file(&a.vectors, f.width())?;
     // An empty file would give an empty result file and a report of 0 vectors: a path mix-up
     // more often than a wish.
@@ -80,14 +85,16 @@ pub fn run(a: FpArgs) -> anyhow::Result<i32> {
     } else {
         f.hex_digits()
     };
-    write_results_atomically(&a.out, &results, digits)?;
+    let out = dynrt::output::OutputDir::create(&a.out, "--out")?;
+    write_results_atomically(&results_path, &results, digits)?;
+    out.keep();
     eprintln!(
         "{} {} vectors through {} {} -> {}",
         vectors.len(),
         f,
         a.op,
         format!("{:?}", a.sim).to_lowercase(),
-        a.out.display()
+        results_path.display()
     );
     Ok(0)
 }

@@ -38,35 +38,67 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// The main job on a scene: golden vs reference, FP operators simulated and checked; report.
+    #[command(
+        after_help = "Examples:\n  dynrt demo                                 # the Cornell box, every check, out/demo\n  dynrt demo scenes/mirror.toml --out out/mirror"
+    )]
     Demo(demo_cmd::DemoArgs),
     /// Render one frame with the golden model (eXmY) or the f64 reference.
+    #[command(
+        after_help = "Examples:\n  dynrt render scenes/cornell.toml --out out/render --hits   # frame0.png, hits0.csv\n  dynrt render scenes/dynamic.toml --frame 3 --model reference --size 128x96 --out out/ref"
+    )]
     Render(render_cmd::RenderArgs),
     /// Error metrics between two images (and hits files); writes a diff image.
     Compare(compare_cmd::CompareArgs),
     /// Measure speed, area and error; CSV and Markdown reports under --out.
+    #[command(
+        after_help = "Examples:\n  dynrt bench scenes --formats e7m16 --out out/bench\n  dynrt bench precision --size 64x48 --scenes-dir ~/dynrt/scenes"
+    )]
     Bench(bench_cmd::BenchArgs),
     /// Write the Verilog and testbenches of every FP operator of a format.
+    #[command(
+        after_help = "Examples:\n  dynrt emit-fp --format e8m23 --out out/fp   # out/fp/rtl/*.v, out/fp/testbench/tb_*.v"
+    )]
     EmitFp(emit_fp_cmd::EmitFpArgs),
     /// The seeded numerical stress suite; exits non-zero when an invariant breaks.
+    #[command(
+        after_help = "Examples:\n  dynrt stress --formats e7m16 --rays 2000 --out out/stress\n  dynrt stress --margins 0,64 --json"
+    )]
     Stress(stress_cmd::StressArgs),
     /// yosys synth_xilinx -family xc2v of one geometry unit: resources and logic depth.
+    #[command(after_help = "Examples:\n  dynrt synth --unit intersect --format e7m16")]
     Synth(synth_cmd::SynthArgs),
     /// Placed-and-routed timing (ECP5, nextpnr, out of context) of units alone or of the whole
     /// processor of scenes: fmax per clock, critical paths, utilization; timing.md/.csv.
+    #[command(
+        after_help = "Examples:\n  dynrt timing --unit add,mul --freq 120\n  dynrt timing scenes/cornell.toml --seeds 1,2,3 --out out/timing"
+    )]
     Timing(timing_cmd::TimingArgs),
     /// Write the scene files of the paper's Table 3 (scenes/paper/).
+    #[command(after_help = "Examples:\n  dynrt paper-scenes --out scenes/paper")]
     PaperScenes(paper_scenes_cmd::PaperScenesArgs),
     /// Write the ray tracing processor of a scene: Verilog, testbench, memory images, UCF.
+    #[command(
+        after_help = "Examples:\n  dynrt rtl scenes/tiny.toml --out out/tiny\n  dynrt rtl scenes/cornell.toml --out out/cornell --board my_board.toml --synth"
+    )]
     Rtl(rtl_cmd::RtlArgs),
     /// Generate, simulate (Icarus or Verilator) and compare every frame with the golden model.
+    #[command(
+        after_help = "Examples:\n  dynrt sim scenes/tiny.toml --out out/tiny --sim iverilog --size 8x6\n  dynrt sim scenes/cornell.toml --out out/cornell --trace fst --trace-start 1000 --trace-end 5000"
+    )]
     Sim(rtl_cmd::SimArgs),
     /// Run operand vectors through one floating-point operator (RTL or software model).
+    #[command(
+        after_help = "Examples:\n  dynrt fp --op div --vectors v.hex --out out/fp --sim verilator   # out/fp/results.hex"
+    )]
     Fp(fp_cmd::FpArgs),
     /// The versions of dynrt and of every tool it finds (simulators, yosys, nextpnr, FuseSoC,
     /// cocotb).
     Info(info_cmd::InfoArgs),
     /// Print a shell completion script, e.g. `dynrt completions bash >
     /// ~/.local/share/bash-completion/completions/dynrt`.
+    #[command(
+        after_help = "Examples:\n  dynrt completions bash > ~/.local/share/bash-completion/completions/dynrt"
+    )]
     Completions(CompletionsArgs),
 }
 
@@ -168,27 +200,69 @@ pub fn run() -> i32 {
     }
 }
 
+/// The one progress display of a run (stderr), also the way [`log_line`] prints around it.
+static PROGRESS: std::sync::OnceLock<indicatif::ProgressBar> = std::sync::OnceLock::new();
+
 /// A spinner on stderr that shows the library's progress reports (stages, the testbench's
-/// heartbeat) with the time since the last stage began; indicatif draws nothing when stderr is
-/// not a terminal, so logs and tests see no spinner.
+/// heartbeat) with the time since the last stage began, and runs of like steps (the precision
+/// sweep, the stress suite) as N of total with the time left; indicatif draws nothing when
+/// stderr is not a terminal, so logs and tests see no spinner.
 fn progress_spinner() -> indicatif::ProgressBar {
     let bar = indicatif::ProgressBar::new_spinner();
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
-    );
+    bar.set_style(stage_style());
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
     let shown = bar.clone();
-    dynrt::progress::listen(move |m| {
-        // A heartbeat continues its stage; any other report starts a new one.
-        if m.starts_with("frame ") {
-            shown.set_message(format!("simulating {m}"));
-        } else {
-            shown.reset_elapsed();
-            shown.set_message(m.to_string());
-        }
-    });
+    dynrt::progress::listen(move |e| show_progress(&shown, e));
+    let _ = PROGRESS.set(bar.clone());
     bar
+}
+
+fn stage_style() -> indicatif::ProgressStyle {
+    indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner())
+}
+
+fn step_style() -> indicatif::ProgressStyle {
+    indicatif::ProgressStyle::with_template(
+        "{spinner} {pos} of {len}, about {eta} left ({elapsed}): {msg}",
+    )
+    .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner())
+}
+
+/// Shows one progress report on `bar`.
+fn show_progress(bar: &indicatif::ProgressBar, e: dynrt::progress::Event) {
+    use dynrt::progress::Event;
+    match e {
+        // A heartbeat continues its stage.
+        Event::Stage(m) if m.starts_with("frame ") => bar.set_message(format!("simulating {m}")),
+        Event::Stage(m) => {
+            if bar.length().is_some() {
+                bar.unset_length();
+                bar.set_style(stage_style());
+            }
+            bar.reset_elapsed();
+            bar.set_message(m.to_string());
+        }
+        Event::Step { done, total, next } => {
+            // A new run of steps: the estimate starts from its first step, not from whatever
+            // ran before it (cost synthesis, a stage).
+            if bar.length() != Some(total) || done == 0 {
+                bar.set_style(step_style());
+                bar.set_length(total);
+                bar.reset();
+            }
+            bar.set_position(done);
+            bar.set_message(next.to_string());
+        }
+    }
+}
+
+/// Prints a log line on stderr without tearing the progress display.
+pub(crate) fn log_line(line: &str) {
+    match PROGRESS.get() {
+        Some(bar) => bar.suspend(|| eprintln!("{line}")),
+        None => eprintln!("{line}"),
+    }
 }
 
 /// Exit status when a command ran into results that differ (frames, vectors, invariants).
@@ -270,6 +344,51 @@ mod tests {
             "without help text:\n{}",
             missing.join("\n")
         );
+    }
+
+    #[test]
+    fn steps_show_as_n_of_total_and_stages_as_a_spinner_again() {
+        use dynrt::progress::Event;
+        let bar = indicatif::ProgressBar::hidden();
+        let step = |done, next| {
+            show_progress(
+                &bar,
+                Event::Step {
+                    done,
+                    total: 7,
+                    next,
+                },
+            )
+        };
+        show_progress(&bar, Event::Stage("building the kd-trees"));
+        assert_eq!(bar.length(), None);
+        step(0, "acne: box");
+        step(3, "scale: far_small");
+        assert_eq!((bar.position(), bar.length()), (3, Some(7)));
+        assert_eq!(bar.message(), "scale: far_small");
+        // A heartbeat keeps the count; a new stage drops it.
+        show_progress(&bar, Event::Stage("frame 0: 10 cycles, 1 rays"));
+        assert_eq!(bar.length(), Some(7));
+        show_progress(&bar, Event::Stage("comparing"));
+        assert_eq!(bar.length(), None);
+        // A second run of steps counts from its own start.
+        step(0, "again");
+        assert_eq!((bar.position(), bar.length()), (0, Some(7)));
+    }
+
+    #[test]
+    fn every_command_shows_examples_in_its_help() {
+        let cmd = Cli::command();
+        let without: Vec<&str> = cmd
+            .get_subcommands()
+            .filter(|c| c.get_name() != "help")
+            .filter(|c| {
+                !c.get_after_help()
+                    .is_some_and(|h| h.to_string().contains("\n  dynrt "))
+            })
+            .map(|c| c.get_name())
+            .collect();
+        assert!(without.is_empty(), "no examples: {without:?}");
     }
 
     #[test]

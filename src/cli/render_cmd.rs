@@ -29,12 +29,13 @@ pub struct RenderArgs {
     pub frame: u32,
     #[command(flatten)]
     pub size: super::SizeArgs,
-    /// Output PNG.
-    #[arg(long)]
+    /// Output folder (created if missing): frame<N>.png, and hits<N>.csv with --hits.
+    #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Hits file (CSV: x,y,instance,triangle,dist).
-    #[arg(long)]
-    pub hits: Option<PathBuf>,
+    /// Also write the primary hit of every pixel (CSV: x,y,instance,triangle,dist) as
+    /// hits<N>.csv into --out; `--hits FILE`, the older form, writes it to FILE instead.
+    #[arg(long, value_name = "FILE", num_args = 0..=1)]
+    pub hits: Option<Option<PathBuf>>,
 }
 
 /// Loads a scene and applies a resolution override (checked like the scene's own).
@@ -55,10 +56,32 @@ pub fn load_scene(
 }
 
 pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
-    dynrt::output::check_output_file(&a.out, "--out")?;
-    let mut outputs: Vec<(&str, &std::path::Path)> = vec![("--out", &a.out)];
-    if let Some(h) = &a.hits {
-        dynrt::output::check_output_file(h, "--hits")?;
+    // `--out IMG.png` was the image itself before --out became a folder on every command: an
+    // old script would otherwise get a folder named like an image.
+    if a.out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+        && !a.out.is_dir()
+    {
+        anyhow::bail!(
+            "--out '{}' names an image, but --out is the folder render writes into (frame{}.png, hits{}.csv with --hits); name a folder, e.g. --out out/render",
+            a.out.display(),
+            a.frame,
+            a.frame
+        );
+    }
+    dynrt::output::check_output_dir(&a.out, "--out")?;
+    let png_path = a.out.join(format!("frame{}.png", a.frame));
+    let hits_path = match &a.hits {
+        None => None,
+        Some(None) => Some(a.out.join(format!("hits{}.csv", a.frame))),
+        Some(Some(h)) => {
+            dynrt::output::check_output_file(h, "--hits")?;
+            Some(h.clone())
+        }
+    };
+    let mut outputs: Vec<(&str, &std::path::Path)> = vec![("--out", &png_path)];
+    if let Some(h) = &hits_path {
         outputs.push(("--hits", h));
     }
     dynrt::output::check_distinct(&outputs, &[("the scene", &a.scene)])?;
@@ -117,12 +140,14 @@ pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
     };
     let secs = start.elapsed().as_secs_f64();
     let png = dynrt::output::png_bytes(&frame.to_image())?;
-    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&a.out, &png)];
+    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&png_path, &png)];
     let hits_text = frame.hits_text();
-    if let Some(h) = &a.hits {
+    if let Some(h) = &hits_path {
         files.push((h, &hits_text));
     }
+    let out = dynrt::output::OutputDir::create(&a.out, "--out")?;
     dynrt::output::write_all_atomically(&files)?;
+    out.keep();
     let pixels = u64::from(frame.width) * u64::from(frame.height);
     let hits = frame.hits.iter().filter(|h| h.is_some()).count();
     println!(
@@ -143,7 +168,7 @@ pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
         pixels,
         secs,
         pixels as f64 / secs / 1e6,
-        a.out.display()
+        png_path.display()
     );
     Ok(0)
 }

@@ -73,7 +73,7 @@ pub fn run(a: StressArgs) -> anyhow::Result<i32> {
     if !a.json {
         println!("seed {:#x}", c.seed);
     }
-    let report = run_stress(&c, &mut |l| eprintln!("{l}"))?;
+    let report = run_stress(&c, &mut |l| super::log_line(l))?;
     let out = dynrt::output::OutputDir::create(&a.out, "--out")?;
     let csv = a.out.join("stress.csv");
     report.save_csv(&csv)?;
@@ -105,7 +105,7 @@ pub fn run(a: StressArgs) -> anyhow::Result<i32> {
             None,
         );
     }
-    s.details_md = format!("## Cases\n\n{}", report.table());
+    s.details_md = format!("## Cases\n\n{}", report.markdown());
     s.write(&a.out, true)?;
     out.keep();
     if a.json {

@@ -11,7 +11,6 @@ use crate::layout::Layout;
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use std::io::Write;
 use std::path::Path;
 
 pub use golden::{Golden, RayResult, RayStats};
@@ -75,17 +74,24 @@ impl Frame {
 
     /// The hits file (docs/ARCHITECTURE.md, "Hits files"): `x,y,instance,triangle,dist`.
     pub fn hits_text(&self) -> Vec<u8> {
-        let mut text = Vec::new();
-        // Writing into a Vec cannot fail.
-        let _ = writeln!(text, "x,y,instance,triangle,dist");
-        for (i, h) in self.hits.iter().enumerate() {
-            let (x, y) = (i as u32 % self.width, i as u32 / self.width);
-            let _ = match h {
-                Some(h) => writeln!(text, "{x},{y},{},{},{}", h.instance, h.triangle, h.dist),
-                None => writeln!(text, "{x},{y},-1,-1,inf"),
-            };
-        }
-        text
+        let rows: Vec<Vec<String>> = self
+            .hits
+            .iter()
+            .enumerate()
+            .map(|(i, h)| {
+                let (x, y) = (i as u32 % self.width, i as u32 / self.width);
+                let (instance, triangle, dist) = match h {
+                    Some(h) => (
+                        h.instance.to_string(),
+                        h.triangle.to_string(),
+                        h.dist.to_string(),
+                    ),
+                    None => ("-1".into(), "-1".into(), "inf".into()),
+                };
+                vec![x.to_string(), y.to_string(), instance, triangle, dist]
+            })
+            .collect();
+        crate::tables::csv_text(&["x", "y", "instance", "triangle", "dist"], &rows).into_bytes()
     }
 
     /// Writes the hits file ([`Frame::hits_text`]) atomically.

@@ -299,8 +299,7 @@ mod tests {
     /// Heartbeat lines reach the progress listener while the tool runs; others do not.
     #[test]
     fn heartbeat_lines_are_reported_as_they_arrive() {
-        static SEEN: Mutex<Vec<String>> = Mutex::new(Vec::new());
-        crate::progress::listen(|m| SEEN.lock().unwrap().push(m.to_string()));
+        crate::progress::seen_in_tests();
         let out = run_tool(
             "sh",
             "testing",
@@ -314,7 +313,7 @@ mod tests {
         .unwrap();
         assert!(out.stdout.contains("other"));
         // (Other tests' simulations may report beside these.)
-        let seen = SEEN.lock().unwrap().clone();
+        let seen = crate::progress::seen_in_tests();
         let first = seen.iter().position(|m| m == "frame 0: 10 cycles, 1 rays");
         let second = seen.iter().position(|m| m == "frame 1: 20 cycles, 2 rays");
         assert!(

@@ -202,11 +202,9 @@ impl StressReport {
             r.case == case && r.subject == subject && r.format == format && r.edge_margin == margin
         })
     }
-    /// A fixed-width text table.
-    pub fn table(&self) -> String {
-        let mut s = format!(
-            "stress seed {}\n{:<20} {:<22} {:<6} {:>7} {:>8} {:>7} {:>11} {:>9} {:>5}  {}\n",
-            self.seed,
+    /// The table's header and each row's cells, for the text and Markdown tables.
+    fn cells(&self) -> (Vec<&'static str>, Vec<Vec<String>>) {
+        let header = vec![
             "case",
             "subject",
             "format",
@@ -216,60 +214,87 @@ impl StressReport {
             "per million",
             "bound",
             "ok",
-            "note"
-        );
-        for r in &self.rows {
-            s += &format!(
-                "{:<20} {:<22} {:<6} {:>7} {:>8} {:>7} {:>11.1} {:>9} {:>5}  {}{}\n",
-                r.case,
-                r.subject,
-                r.format,
-                r.edge_margin,
-                r.rays,
-                r.failures,
-                r.ppm(),
-                r.bound_ppm.map_or("-".into(), |b| format!("{b}")),
-                if r.held { "yes" } else { "NO" },
-                if r.nonfinite > 0 {
-                    format!("{} non-finite pixels; ", r.nonfinite)
-                } else {
-                    String::new()
-                },
-                r.note
-            );
-        }
-        s += &format!(
-            "{} rows, {} broke an invariant\n",
+            "note",
+        ];
+        let rows = self
+            .rows
+            .iter()
+            .map(|r| {
+                vec![
+                    r.case.clone(),
+                    r.subject.clone(),
+                    r.format.clone(),
+                    r.edge_margin.to_string(),
+                    r.rays.to_string(),
+                    r.failures.to_string(),
+                    format!("{:.1}", r.ppm()),
+                    r.bound_ppm.map_or("-".into(), |b| format!("{b}")),
+                    if r.held { "yes" } else { "NO" }.into(),
+                    if r.nonfinite > 0 {
+                        format!("{} non-finite pixels; {}", r.nonfinite, r.note)
+                    } else {
+                        r.note.clone()
+                    },
+                ]
+            })
+            .collect();
+        (header, rows)
+    }
+    /// A text table for the terminal, every column as wide as its widest cell.
+    pub fn table(&self) -> String {
+        let (header, rows) = self.cells();
+        format!(
+            "stress seed {}\n{}{} rows, {} broke an invariant\n",
+            self.seed,
+            crate::tables::text_table(&header, &rows, &[3, 4, 5, 6, 7]),
             self.rows.len(),
             self.broken().len()
-        );
-        s
+        )
+    }
+    /// The same table in Markdown (report.md).
+    pub fn markdown(&self) -> String {
+        let (header, rows) = self.cells();
+        crate::tables::markdown_table(&header, &rows)
     }
     /// The rows as CSV.
-    pub fn csv(&self) -> String {
-        let mut s = String::from(
-            "case,subject,format,edge_margin,rays,failures,per_million,nonfinite,bound_per_million,held,note\n",
-        );
-        for r in &self.rows {
-            s += &format!(
-                "{},{},{},{},{},{},{:.3},{},{},{},\"{}\"\n",
-                r.case,
-                r.subject,
-                r.format,
-                r.edge_margin,
-                r.rays,
-                r.failures,
-                r.ppm(),
-                r.nonfinite,
-                r.bound_ppm.map_or(String::new(), |b| b.to_string()),
-                r.held,
-                r.note.replace('"', "'")
-            );
+    pub fn csv(&self) -> Result<String> {
+        /// One row of stress.csv: the columns of earlier runs, in their order, the numbers
+        /// written as before (`64`, not serde's `64.0`).
+        #[derive(serde::Serialize)]
+        struct CsvRow<'a> {
+            case: &'a str,
+            subject: &'a str,
+            format: &'a str,
+            edge_margin: String,
+            rays: u64,
+            failures: u64,
+            per_million: String,
+            nonfinite: u64,
+            bound_per_million: Option<String>,
+            held: bool,
+            note: &'a str,
         }
-        s
+        let rows: Vec<CsvRow> = self
+            .rows
+            .iter()
+            .map(|r| CsvRow {
+                case: &r.case,
+                subject: &r.subject,
+                format: &r.format,
+                edge_margin: r.edge_margin.to_string(),
+                rays: r.rays,
+                failures: r.failures,
+                per_million: format!("{:.3}", r.ppm()),
+                nonfinite: r.nonfinite,
+                bound_per_million: r.bound_ppm.map(|b| b.to_string()),
+                held: r.held,
+                note: &r.note,
+            })
+            .collect();
+        crate::tables::csv_of(&rows)
     }
     pub fn save_csv(&self, path: &Path) -> Result<()> {
-        crate::output::write_atomically(path, self.csv().as_bytes())
+        crate::output::write_atomically(path, self.csv()?.as_bytes())
             .with_context(|| format!("writing {}", path.display()))
     }
 }
@@ -351,8 +376,15 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
             closed.push((name, tris, None, Limit::Documented));
         }
     }
+    // A step per closed mesh, then the fixed groups below: needle and pancake, degenerate,
+    // four scales, two axis/grazing subjects and two acne subjects.
+    let mut steps = crate::progress::Steps::new(closed.len() + 2 + 1 + 4 + 2 + 2);
+    let mut begin = |what: &str| {
+        log(what);
+        steps.start(what);
+    };
     for (name, tris, instance, edge_limit) in &closed {
-        log(&format!("edge_rays / inside_camera: {name}"));
+        begin(&format!("edge_rays / inside_camera: {name}"));
         let s = TestScene {
             instance: *instance,
             ..outside.clone()
@@ -400,7 +432,7 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
         ),
     ];
     for (name, tris) in shapes {
-        log(&format!("interior rays: {name}"));
+        begin(&format!("interior rays: {name}"));
         let subject = Subject::new(dir, name, &tris, &outside)?;
         let rays = cases::interior_rays(&subject.world, n, &mut rng);
         let case = RayCase {
@@ -413,7 +445,7 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
         rows.extend(cases::ray_case_rows(&case, config));
     }
     {
-        log("degenerate");
+        begin("degenerate");
         let mut tris = geometry::box_mesh(DVec3::ONE);
         let (a, b) = (DVec3::new(-0.2, 0.1, 0.0), DVec3::new(0.3, -0.1, 0.2));
         tris.push([a, a, b]); // repeated vertex
@@ -480,7 +512,7 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
         ),
     ];
     for (name, tris, instance, limit) in scaled {
-        log(&format!("scale: {name}"));
+        begin(&format!("scale: {name}"));
         let probe = TestScene {
             instance,
             ..outside.clone()
@@ -515,7 +547,7 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
         ("box", geometry::box_mesh(DVec3::new(1.0, 0.7, 1.3))),
         ("icosphere", ico2.clone()),
     ] {
-        log(&format!("axis_rays / grazing: {name}"));
+        begin(&format!("axis_rays / grazing: {name}"));
         let subject = Subject::new(dir, name, &tris, &outside)?;
         let rays = cases::axis_rays(&subject, n, &mut rng);
         let case = RayCase {
@@ -543,7 +575,7 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
         ("icosphere", sphere.clone()),
         ("box", geometry::box_mesh(DVec3::new(1.0, 0.7, 1.3))),
     ] {
-        log(&format!("acne: {name}"));
+        begin(&format!("acne: {name}"));
         let light = DVec3::new(2.0, 3.0, 2.5);
         let eye = DVec3::new(0.5, 1.0, 4.0);
         let s = TestScene {
@@ -576,6 +608,7 @@ pub fn run_stress(config: &StressConfig, log: &mut dyn FnMut(&str)) -> Result<St
             Limit::NonFiniteOnly,
         ));
     }
+    steps.finish();
 
     Ok(StressReport {
         seed: config.seed,
@@ -588,7 +621,8 @@ mod tests {
     use super::*;
 
     /// The suite at CI size: every case, three formats, both margins, a few thousand rays.
-    fn quick_report() -> StressReport {
+    /// The report and the lines logged as each case started.
+    fn quick_report() -> (StressReport, Vec<String>) {
         let config = StressConfig {
             formats: ["e5m10", "e7m16", "e8m23"]
                 .iter()
@@ -602,9 +636,11 @@ mod tests {
             ..StressConfig::default()
         };
         println!("stress seed {}", config.seed);
-        let report = run_stress(&config, &mut |_| {}).unwrap();
+        crate::progress::seen_in_tests();
+        let mut logged = Vec::new();
+        let report = run_stress(&config, &mut |l| logged.push(l.to_string())).unwrap();
         println!("{}", report.table());
-        report
+        (report, logged)
     }
 
     fn ppm(r: &StressReport, case: &str, subject: &str, format: &str, margin: f64) -> f64 {
@@ -614,8 +650,61 @@ mod tests {
     }
 
     #[test]
+    fn csv_notes_read_back_whole_and_the_table_keeps_its_columns_in_line() {
+        let mut a = CaseResult::new("edge_rays", "icosphere", None, 0.0, Limit::EdgeAimed);
+        a.rays = 20_000;
+        a.note = "leaks \"here\", and\nthere".into();
+        let mut b = CaseResult::new(
+            "far_small_instanced_camera",
+            "a_public_mesh_with_a_long_name",
+            Some(Format::E7M16),
+            64.0,
+            Limit::Documented,
+        );
+        b.rays = 7;
+        b.failures = 1;
+        let report = StressReport {
+            seed: 1,
+            rows: vec![a.finish(), b.finish()],
+        };
+        let text = report.csv().unwrap();
+        assert!(text.starts_with(
+            "case,subject,format,edge_margin,rays,failures,per_million,nonfinite,bound_per_million,held,note\n\
+             edge_rays,icosphere,f64,0,20000,0,0.000,0,0,true,"
+        ), "{text}");
+        let mut r = csv::Reader::from_reader(text.as_bytes());
+        let notes: Vec<String> = r.records().map(|x| x.unwrap()[10].to_string()).collect();
+        assert_eq!(notes, [report.rows[0].note.as_str(), ""]);
+        // The long names of the second row do not push the numbers out of line: "rays" ends
+        // where 20000 and 7 end.
+        let table = report.table();
+        let lines: Vec<&str> = table.lines().collect();
+        let header = lines.iter().find(|l| l.contains("subject")).unwrap();
+        let rays_end = header.find("rays").unwrap() + 4;
+        for (row, n) in [("edge_rays ", "20000"), ("far_small", "7")] {
+            let l = lines
+                .iter()
+                .find(|l| l.trim_start().starts_with(row))
+                .unwrap();
+            assert_eq!(&l[rays_end - n.len()..rays_end], n, "{table}");
+        }
+        assert!(report
+            .markdown()
+            .contains("| a_public_mesh_with_a_long_name |"));
+    }
+
+    #[test]
     fn stress_suite_invariants_hold_and_measured_limits_stay_within_bounds() {
-        let r = quick_report();
+        let (r, logged) = quick_report();
+        // Every case started is a step of the progress display, counted against the total
+        // announced at the start: a case added without its step would show 13 of 12.
+        let n = logged.len();
+        let seen = crate::progress::seen_in_tests();
+        for (k, line) in logged.iter().enumerate() {
+            let want = format!("step {k}/{n}: {line}");
+            assert!(seen.contains(&want), "no `{want}` in {seen:?}");
+        }
+        assert!(seen.contains(&format!("step {n}/{n}: done")), "{seen:?}");
         let broken: Vec<String> = r.broken().iter().map(|b| format!("{b:?}")).collect();
         assert!(
             broken.is_empty(),

@@ -26,17 +26,9 @@ const CSV_HEADER: &str = "design,kind,top,seed,clock,constraint_mhz,achieved_mhz
 path_from,path_to,start_block,end_block,logic_levels,carry_cells,logic_ns,routing_ns,\
 lut4,lut4_available,ff,ff_available,dp16kd,mult18x18d,pnr_seconds,synth_seconds,yosys,nextpnr";
 
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
 /// `timing.csv`.
 pub fn csv(designs: &[DesignTiming]) -> String {
-    let mut out = format!("{CSV_HEADER}\n");
+    let mut lines: Vec<Vec<String>> = Vec::new();
     for d in designs {
         let r = &d.report;
         for run in &r.runs {
@@ -77,13 +69,12 @@ pub fn csv(designs: &[DesignTiming]) -> String {
                     r.tools.yosys_version.clone(),
                     r.tools.nextpnr_version.clone(),
                 ];
-                let line: Vec<String> = fields.iter().map(|f| csv_field(f)).collect();
-                out.push_str(&line.join(","));
-                out.push('\n');
+                lines.push(fields.to_vec());
             }
         }
     }
-    out
+    let header: Vec<&str> = CSV_HEADER.split(',').collect();
+    crate::tables::csv_text(&header, &lines)
 }
 
 /// `timing.md`; `command` is the command line that made it.
@@ -207,11 +198,17 @@ pub fn markdown(designs: &[DesignTiming], command: &str) -> String {
 /// The worst achieved main clock (`clock`) over the seeds of the one processor in a
 /// `timing.csv`.
 pub fn processor_clock_from_csv(text: &str) -> Result<f64, String> {
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines
+    let mut r = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(text.as_bytes());
+    let mut records = r.records();
+    let header: Vec<String> = records
         .next()
         .ok_or("empty file: not a timing.csv of `dynrt timing`")?
-        .split(',')
+        .map_err(|e| format!("not a CSV file: {e}"))?
+        .iter()
+        .map(String::from)
         .collect();
     let col = |name: &str| {
         header
@@ -227,15 +224,16 @@ pub fn processor_clock_from_csv(text: &str) -> Result<f64, String> {
     );
     let mut designs: Vec<String> = Vec::new();
     let mut worst: Option<f64> = None;
-    for (n, line) in lines.enumerate() {
-        let fields = split_csv(line);
-        let get = |i: usize| fields.get(i).map(String::as_str).unwrap_or("");
+    for fields in records {
+        let fields = fields.map_err(|e| format!("not a CSV file: {e}"))?;
+        let line = fields.position().map_or(0, |p| p.line());
+        let get = |i: usize| fields.get(i).unwrap_or("");
         if get(kind) != PROCESSOR_KIND || get(clock) != "clock" {
             continue;
         }
         let mhz: f64 = get(achieved)
             .parse()
-            .map_err(|_| format!("line {}: `{}` is not a frequency", n + 2, get(achieved)))?;
+            .map_err(|_| format!("line {line}: `{}` is not a frequency", get(achieved)))?;
         if !designs.iter().any(|d| d == get(design)) {
             designs.push(get(design).to_string());
         }
@@ -257,40 +255,24 @@ pub fn processor_clock_from_csv(text: &str) -> Result<f64, String> {
     }
 }
 
-fn split_csv(line: &str) -> Vec<String> {
-    let mut fields = vec![String::new()];
-    let mut quoted = false;
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match c {
-            '"' if quoted && chars.peek() == Some(&'"') => {
-                chars.next();
-                fields.last_mut().unwrap().push('"');
-            }
-            '"' => quoted = !quoted,
-            ',' if !quoted => fields.push(String::new()),
-            _ => fields.last_mut().unwrap().push(c),
-        }
-    }
-    fields
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn csv_with(rows: &[(&str, &str, &str, &str)]) -> String {
-        let mut s = format!("{CSV_HEADER}\n");
-        for (design, kind, clock, mhz) in rows {
-            let mut f = vec![String::new(); CSV_HEADER.split(',').count()];
-            f[0] = csv_field(design);
-            f[1] = kind.to_string();
-            f[4] = clock.to_string();
-            f[6] = mhz.to_string();
-            s.push_str(&f.join(","));
-            s.push('\n');
-        }
-        s
+        let header: Vec<&str> = CSV_HEADER.split(',').collect();
+        let lines: Vec<Vec<String>> = rows
+            .iter()
+            .map(|(design, kind, clock, mhz)| {
+                let mut f = vec![String::new(); header.len()];
+                f[0] = design.to_string();
+                f[1] = kind.to_string();
+                f[4] = clock.to_string();
+                f[6] = mhz.to_string();
+                f
+            })
+            .collect();
+        crate::tables::csv_text(&header, &lines)
     }
 
     #[test]
@@ -323,6 +305,6 @@ mod tests {
         let bad = csv_with(&[("cornell", "processor", "clock", "fast")]);
         assert!(processor_clock_from_csv(&bad)
             .unwrap_err()
-            .contains("not a frequency"));
+            .contains("line 2: `fast` is not a frequency"));
     }
 }
