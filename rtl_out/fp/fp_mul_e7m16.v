@@ -363,6 +363,7 @@ module fp_mul_e7m16_core__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero
     reg  [17:0] sig_rounded;
     reg  carry;
     reg  [8:0] exp_final;
+    reg  [8:0] exp_up;
     reg  exp_negative;
     reg  [23:0] sign_word;
     reg  [23:0] packed_word;
@@ -436,7 +437,11 @@ module fp_mul_e7m16_core__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero
         out_valid_r__d = out_valid_r__q;
         sig_rounded = ((sig) & 18'h3ffff) + round_up;
         carry = &sig & round_up;
-        exp_final = exp + carry;
+        exp_up = exp + 32'h1;
+        exp_final = exp;
+        if (carry) begin
+            exp_final = exp_up;
+        end
         rnd_sig__d = sig_rounded;
         rnd_exp__d = exp_final;
         rnd_sign__d = sign;

@@ -3127,7 +3127,8 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
     localparam  c_sign_pos = 8'h17;
     localparam  c_hidden = 17'b10000000000000000;
     localparam  c_mag_mask = 24'h7fffff;
-    localparam  c_shift_max = 7'b10100;
+    localparam  c_shift_max = 5'b11111;
+    localparam  c_align_bits = 8'h5;
     localparam  c_ones = 21'h1fffff;
     localparam  c_one = 21'h1;
     localparam  c_top16 = 21'h1fffe0;
@@ -3354,8 +3355,8 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
     reg  [16:0] sig_b;
     reg  [6:0] diff_ab;
     reg  [6:0] diff_ba;
-    reg  [6:0] shift_ab;
-    reg  [6:0] shift_ba;
+    reg  [4:0] shift_ab;
+    reg  [4:0] shift_ba;
     reg  [20:0] small_ext;
     reg  [20:0] small_aligned;
     reg  [20:0] lost_mask;
@@ -3863,12 +3864,12 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         end
         diff_ab = exp_a - exp_b;
         diff_ba = exp_b - exp_a;
-        shift_ab = diff_ab;
-        if (diff_ab > c_shift_max) begin
+        shift_ab = ((diff_ab) & 5'h1f);
+        if (|(diff_ab >> c_align_bits)) begin
             shift_ab = c_shift_max;
         end
-        shift_ba = diff_ba;
-        if (diff_ba > c_shift_max) begin
+        shift_ba = ((diff_ba) & 5'h1f);
+        if (|(diff_ba >> c_align_bits)) begin
             shift_ba = c_shift_max;
         end
         a_first = zero_b | ((~zero_a) & (mag_a >= mag_b));
@@ -3876,14 +3877,14 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
             big_sig__d = sig_a;
             small_sig__d = sig_b;
             big_exp__d = exp_a;
-            shift__d = ((shift_ab) & 5'h1f);
+            shift__d = shift_ab;
             big_sign__d = sign_a;
         end
         else begin
             big_sig__d = sig_b;
             small_sig__d = sig_a;
             big_exp__d = exp_b;
-            shift__d = ((shift_ba) & 5'h1f);
+            shift__d = shift_ba;
             big_sign__d = sign_b;
         end
         eff_sub__d = sign_a ^ sign_b;
@@ -4931,6 +4932,7 @@ module dynrt_processor__engine__fp_units__byte_unit__scale__pack(clock,in_valid,
     reg  [17:0] sig_rounded;
     reg  carry;
     reg  [8:0] exp_final;
+    reg  [8:0] exp_up;
     reg  exp_negative;
     reg  [23:0] sign_word;
     reg  [23:0] packed_word;
@@ -5004,7 +5006,11 @@ module dynrt_processor__engine__fp_units__byte_unit__scale__pack(clock,in_valid,
         out_valid_r__d = out_valid_r__q;
         sig_rounded = ((sig) & 18'h3ffff) + round_up;
         carry = &sig & round_up;
-        exp_final = exp + carry;
+        exp_up = exp + 32'h1;
+        exp_final = exp;
+        if (carry) begin
+            exp_final = exp_up;
+        end
         rnd_sig__d = sig_rounded;
         rnd_exp__d = exp_final;
         rnd_sign__d = sign;
