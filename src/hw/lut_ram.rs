@@ -144,7 +144,11 @@ mod tests {
         b.ram.write_data.next = 42.into();
         b.ram.write_enable.next = true;
         settle(&mut b);
-        assert_eq!(b.ram.read_data.val(), Bits::<8>::from(103), "before the edge");
+        assert_eq!(
+            b.ram.read_data.val(),
+            Bits::<8>::from(103),
+            "before the edge"
+        );
         clock_cycle(&mut b, |b, c| b.clock.next = Clock { clk: c });
         b.ram.write_enable.next = false;
         settle(&mut b);
@@ -157,7 +161,10 @@ mod tests {
             Verilog::Custom(text) => text,
             _ => panic!("LutRam writes its own Verilog"),
         };
-        assert!(v.contains("always @(*) begin\n   read_data = mem[read_address];"), "{v}");
+        assert!(
+            v.contains("always @(*) begin\n   read_data = mem[read_address];"),
+            "{v}"
+        );
         assert!(v.contains("mem[7] = 8'h6b;"), "{v}");
     }
 }

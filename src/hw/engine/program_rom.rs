@@ -124,7 +124,9 @@ mod tests {
 
     /// Five instructions whose words say where they are.
     fn words() -> Vec<[u32; ROM_WORDS]> {
-        (0..5u32).map(|pc| [0x100 + pc, 0x200 + pc, 0x300 + pc]).collect()
+        (0..5u32)
+            .map(|pc| [0x100 + pc, 0x200 + pc, 0x300 + pc])
+            .collect()
     }
 
     #[test]
@@ -140,7 +142,11 @@ mod tests {
             let before = b.rom.ctl.val();
             clock_cycle(&mut b, |b, c| b.clock.next = Clock { clk: c });
             let pc32 = pc as u32;
-            assert_ne!(before, Bits::<32>::from(u64::from(0x100 + pc32)), "pc {pc} early");
+            assert_ne!(
+                before,
+                Bits::<32>::from(u64::from(0x100 + pc32)),
+                "pc {pc} early"
+            );
             assert_eq!(b.rom.ctl.val(), Bits::<32>::from(u64::from(0x100 + pc32)));
             assert_eq!(b.rom.imm.val(), Bits::<32>::from(u64::from(0x200 + pc32)));
             assert_eq!(b.rom.aux.val(), Bits::<32>::from(u64::from(0x300 + pc32)));
