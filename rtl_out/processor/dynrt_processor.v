@@ -686,10 +686,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam  cmd_init = 2'b1;
     localparam  cmd_object = 2'b10;
     localparam  cmd_skip = 2'b11;
-    localparam  bank_nodes = 3'b0;
     localparam  bank_lists = 3'b1;
-    localparam  bank_uv = 3'b10;
-    localparam  bank_t = 3'b11;
+    localparam  one_bank = 6'b1;
+    localparam  shared_banks = 6'b110010;
     
     // Enums
     localparam FastKind__Computed = 0;
@@ -900,8 +899,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     wire  tester__engine__pending;
     wire  tester__engine__done;
     wire  [4:0] tester__engine__done_thread;
-    reg  tester__engine__load_read;
-    reg  [2:0] tester__engine__load_bank;
+    reg  [5:0] tester__engine__load_banks;
     reg  [23:0] tester__engine__load_addr;
     reg  [1:0] tester__queue_kind;
     wire  tester__hit;
@@ -934,8 +932,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     wire  traversal_unit__engine__pending;
     wire  traversal_unit__engine__done;
     wire  [4:0] traversal_unit__engine__done_thread;
-    reg  traversal_unit__engine__load_read;
-    reg  [2:0] traversal_unit__engine__load_bank;
+    reg  [5:0] traversal_unit__engine__load_banks;
     reg  [23:0] traversal_unit__engine__load_addr;
     reg  traversal_unit__t_min_write;
     wire  traversal_unit__step_busy;
@@ -972,9 +969,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [31:0] traversal_count__d;
     wire  [31:0] traversal_count__q;
     reg  traversal_count__clock;
-    reg  mem_read_r__d;
-    wire  mem_read_r__q;
-    reg  mem_read_r__clock;
+    reg  [5:0] mem_load_r__d;
+    wire  [5:0] mem_load_r__q;
+    reg  mem_load_r__clock;
     reg  [2:0] mem_bank_r__d;
     wire  [2:0] mem_bank_r__q;
     reg  mem_bank_r__clock;
@@ -1243,8 +1240,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .engine__pending(tester__engine__pending),
         .engine__done(tester__engine__done),
         .engine__done_thread(tester__engine__done_thread),
-        .engine__load_read(tester__engine__load_read),
-        .engine__load_bank(tester__engine__load_bank),
+        .engine__load_banks(tester__engine__load_banks),
         .engine__load_addr(tester__engine__load_addr),
         .queue_kind(tester__queue_kind),
         .hit(tester__hit),
@@ -1285,8 +1281,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .engine__pending(traversal_unit__engine__pending),
         .engine__done(traversal_unit__engine__done),
         .engine__done_thread(traversal_unit__engine__done_thread),
-        .engine__load_read(traversal_unit__engine__load_read),
-        .engine__load_bank(traversal_unit__engine__load_bank),
+        .engine__load_banks(traversal_unit__engine__load_banks),
         .engine__load_addr(traversal_unit__engine__load_addr),
         .t_min_write(traversal_unit__t_min_write),
         .nodes__read(bank0_read),
@@ -1343,10 +1338,10 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(traversal_count__q),
         .clock(traversal_count__clock)
     );
-    dynrt_processor__display__dark_d mem_read_r(
-        .d(mem_read_r__d),
-        .q(mem_read_r__q),
-        .clock(mem_read_r__clock)
+    dynrt_processor__engine__mem_load_r mem_load_r(
+        .d(mem_load_r__d),
+        .q(mem_load_r__q),
+        .clock(mem_load_r__clock)
     );
     dynrt_processor__engine__mem_bank_r mem_bank_r(
         .d(mem_bank_r__d),
@@ -1429,7 +1424,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         transform_count__clock = clock;
         intersect_count__clock = clock;
         traversal_count__clock = clock;
-        mem_read_r__clock = clock;
+        mem_load_r__clock = clock;
         mem_bank_r__clock = clock;
         mem_addr_r__clock = clock;
         fb_write_r__clock = clock;
@@ -1452,7 +1447,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         transform_count__d = transform_count__q;
         intersect_count__d = intersect_count__q;
         traversal_count__d = traversal_count__q;
-        mem_read_r__d = mem_read_r__q;
+        mem_load_r__d = mem_load_r__q;
         mem_bank_r__d = mem_bank_r__q;
         mem_addr_r__d = mem_addr_r__q;
         fb_write_r__d = fb_write_r__q;
@@ -1541,7 +1536,10 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         scratch__write_address = (((decode__thread) & 12'hfff) << 32'h7) | ((execute__scratch_address[(32'h0)+:(7)]) & 12'hfff);
         scratch__write_data = decode__store;
         scratch__write_enable = decode__valid & (decode__op == op_sts);
-        mem_read_r__d = decode__valid & (decode__op == op_ld);
+        mem_load_r__d = 32'h0;
+        if (decode__valid & (decode__op == op_ld)) begin
+            mem_load_r__d = one_bank << decode__bank;
+        end
         mem_bank_r__d = decode__bank;
         mem_addr_r__d = execute__mem_address[(32'h0)+:(24)];
         fb_write_r__d = decode__valid & (decode__op == op_st);
@@ -1550,7 +1548,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         fb_write = fb_write_r__q;
         fb_addr = fb_addr_r__q;
         fb_data = fb_data_r__q;
-        mem_read = (mem_read_r__q & (mem_bank_r__q != bank_nodes) & (mem_bank_r__q != bank_uv) & (mem_bank_r__q != bank_t)) | tester__lists__read;
+        mem_read = ((mem_load_r__q & shared_banks) != 32'h0) | tester__lists__read;
         if (tester__lists__read) begin
             mem_bank = bank_lists;
             mem_addr = tester__lists__addr;
@@ -1583,16 +1581,14 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         kd_enqueue__d = decode__valid_i3 & kd_op & (decode__imm_i3 == kd_start);
         kd_waits__d = kd_wait_fn;
         wait_fn__d = (tri_op & tri_wait_fn) | (kd_op & kd_wait_fn);
-        traversal_unit__engine__load_read = mem_read_r__q;
-        traversal_unit__engine__load_bank = mem_bank_r__q;
+        traversal_unit__engine__load_banks = mem_load_r__q;
         traversal_unit__engine__load_addr = mem_addr_r__q;
         traversal_unit__engine__thread = decode__thread;
         traversal_unit__engine__word_a = decode__a;
         traversal_unit__engine__word_b = decode__b;
         traversal_unit__engine__ray_pair = decode__imm[(32'h0)+:(2)];
         traversal_unit__engine__ray_write = ray_write__q;
-        tester__engine__load_read = mem_read_r__q;
-        tester__engine__load_bank = mem_bank_r__q;
+        tester__engine__load_banks = mem_load_r__q;
         tester__engine__load_addr = mem_addr_r__q;
         tester__engine__thread = decode__thread;
         tester__engine__word_a = decode__a;
@@ -10971,6 +10967,23 @@ module dynrt_processor__engine__mem_bank_r(d,q,clock);
 endmodule // dynrt_processor__engine__mem_bank_r
 
 
+module dynrt_processor__engine__mem_load_r(d,q,clock);
+    
+    // Module arguments
+    input wire  [5:0] d;
+    output reg  [5:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 6'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__mem_load_r
 
 
 module dynrt_processor__engine__pixels(clock,frame_start,take,word,exhausted);
@@ -14059,7 +14072,7 @@ endmodule // dynrt_processor__engine__scratch
 
 
 
-module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_read,engine__load_bank,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,uv_words__read,uv_words__addr,uv_words__rdata,t_words__read,t_words__addr,t_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy);
+module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,uv_words__read,uv_words__addr,uv_words__rdata,t_words__read,t_words__addr,t_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy);
     
     // Module arguments
     input wire  clock;
@@ -14074,8 +14087,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     output reg  engine__pending;
     output reg  engine__done;
     output reg  [4:0] engine__done_thread;
-    input wire  engine__load_read;
-    input wire  [2:0] engine__load_bank;
+    input wire  [5:0] engine__load_banks;
     input wire  [23:0] engine__load_addr;
     input wire  [1:0] queue_kind;
     output reg  hit;
@@ -14129,8 +14141,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     localparam  c_test_init = 2'b1;
     localparam  c_test_list_end = 2'b10;
     localparam  c_test_walk_end = 2'b11;
-    localparam  c_bank_uv = 3'b10;
-    localparam  c_bank_t = 3'b11;
+    localparam  c_bank_uv = 6'b100;
+    localparam  c_bank_t = 6'b1000;
     
     // Enums
     localparam Launch__Wait = 0;
@@ -14146,8 +14158,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [31:0] list_unit__word_a;
     reg  [31:0] list_unit__word_b;
     wire  list_unit__full;
-    reg  list_unit__engine_read;
-    reg  [2:0] list_unit__engine_bank;
+    reg  [5:0] list_unit__engine_banks;
     wire  list_unit__list_read;
     wire  [23:0] list_unit__list_addr;
     reg  [31:0] list_unit__list_rdata;
@@ -14565,8 +14576,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .word_a(list_unit__word_a),
         .word_b(list_unit__word_b),
         .full(list_unit__full),
-        .engine_read(list_unit__engine_read),
-        .engine_bank(list_unit__engine_bank),
+        .engine_banks(list_unit__engine_banks),
         .list_read(list_unit__list_read),
         .list_addr(list_unit__list_addr),
         .list_rdata(list_unit__list_rdata),
@@ -15339,8 +15349,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             list_unit__word_b = walk_list_to | c_list_of_walk;
         end
         engine__full = list_unit__full;
-        list_unit__engine_read = engine__load_read;
-        list_unit__engine_bank = engine__load_bank;
+        list_unit__engine_banks = engine__load_banks;
         lists__read = list_unit__list_read;
         lists__addr = list_unit__list_addr;
         list_unit__list_rdata = lists__rdata;
@@ -15358,10 +15367,10 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         issued__write_data = issued__read_data + 32'h1;
         issued__write_enable = engine__enqueue & (~list_unit__full) & ((queue_kind == c_cmd_list) | (queue_kind == c_cmd_init));
         list_unit__test_take = 1'b0;
-        uv_take = fetching__q & (uv_issued__q < 32'h8) & (~(engine__load_read & (engine__load_bank == c_bank_uv)));
-        t_take = fetching__q & (t_issued__q < 32'h4) & (~(engine__load_read & (engine__load_bank == c_bank_t)));
-        uv_words__read = uv_take | (engine__load_read & (engine__load_bank == c_bank_uv));
-        t_words__read = t_take | (engine__load_read & (engine__load_bank == c_bank_t));
+        uv_take = fetching__q & (uv_issued__q < 32'h8) & ((engine__load_banks & c_bank_uv) == 32'h0);
+        t_take = fetching__q & (t_issued__q < 32'h4) & ((engine__load_banks & c_bank_t) == 32'h0);
+        uv_words__read = uv_take | ((engine__load_banks & c_bank_uv) != 32'h0);
+        t_words__read = t_take | ((engine__load_banks & c_bank_t) != 32'h0);
         uv_words__addr = engine__load_addr;
         t_words__addr = engine__load_addr;
         fetch_a = cur_a__0__q;
@@ -19349,7 +19358,7 @@ endmodule // dynrt_processor__engine__tester__intersect_unit__uv_delay__0
 
 
 
-module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word_a,word_b,full,engine_read,engine_bank,list_read,list_addr,list_rdata,test_valid,test_entry,test_take);
+module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word_a,word_b,full,engine_banks,list_read,list_addr,list_rdata,test_valid,test_entry,test_take);
     
     // Module arguments
     input wire  clock;
@@ -19359,8 +19368,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
     input wire  [31:0] word_a;
     input wire  [31:0] word_b;
     output reg  full;
-    input wire  engine_read;
-    input wire  [2:0] engine_bank;
+    input wire  [5:0] engine_banks;
     output reg  list_read;
     output reg  [23:0] list_addr;
     input wire  [31:0] list_rdata;
@@ -19383,9 +19391,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
     localparam  c_cmd_init = 2'b1;
     localparam  c_cmd_object = 2'b10;
     localparam  c_cmd_skip = 2'b11;
-    localparam  c_bank_nodes = 3'b0;
-    localparam  c_bank_uv = 3'b10;
-    localparam  c_bank_t = 3'b11;
+    localparam  c_shared_banks = 6'b110010;
     
     // Enums
     localparam ListPhase__Idle = 0;
@@ -20239,7 +20245,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
             ids__7__d = mailbox_ids__7__read_data;
             phase__d = ListPhase__Walk;
         end
-        take = (phase__q == ListPhase__Walk) & (~walked__q) & ((((queued__q) & 5'h1f) + ((flight__q) & 5'h1f) + ((arrive_r__q) & 5'h1f)) < 32'h7) & (~(engine_read & (engine_bank != c_bank_nodes) & (engine_bank != c_bank_uv) & (engine_bank != c_bank_t)));
+        take = (phase__q == ListPhase__Walk) & (~walked__q) & ((((queued__q) & 5'h1f) + ((flight__q) & 5'h1f) + ((arrive_r__q) & 5'h1f)) < 32'h7) & ((engine_banks & c_shared_banks) == 32'h0);
         list_read = take;
         list_addr = cursor__q;
         cursor_next = cursor__q + 32'h1;
@@ -24658,7 +24664,7 @@ endmodule // dynrt_processor__engine__tester__transform_unit__tag_delay
 
 
 
-module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_read,engine__load_bank,engine__load_addr,t_min_write,nodes__read,nodes__addr,nodes__rdata,step_busy,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit);
+module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,t_min_write,nodes__read,nodes__addr,nodes__rdata,step_busy,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit);
     
     // Module arguments
     input wire  clock;
@@ -24673,8 +24679,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     output reg  engine__pending;
     output reg  engine__done;
     output reg  [4:0] engine__done_thread;
-    input wire  engine__load_read;
-    input wire  [2:0] engine__load_bank;
+    input wire  [5:0] engine__load_banks;
     input wire  [23:0] engine__load_addr;
     input wire  t_min_write;
     output reg  nodes__read;
@@ -24700,7 +24705,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     localparam  c_index__4 = 4'h4;
     localparam  c_index__5 = 4'h5;
     localparam  c_zero = 24'h0;
-    localparam  c_bank_nodes = 3'b0;
+    localparam  c_bank_nodes = 6'b1;
     localparam  c_leaf_tag = 2'b11;
     
     // Enums
@@ -25365,7 +25370,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f3_b__q),
         .clock(f3_b__clock)
     );
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address f3_sp(
+    dynrt_processor__engine__mem_load_r f3_sp(
         .d(f3_sp__d),
         .q(f3_sp__q),
         .clock(f3_sp__clock)
@@ -25400,7 +25405,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f4_b__q),
         .clock(f4_b__clock)
     );
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address f4_sp(
+    dynrt_processor__engine__mem_load_r f4_sp(
         .d(f4_sp__d),
         .q(f4_sp__q),
         .clock(f4_sp__clock)
@@ -25450,7 +25455,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f5_b__q),
         .clock(f5_b__clock)
     );
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address f5_sp(
+    dynrt_processor__engine__mem_load_r f5_sp(
         .d(f5_sp__d),
         .q(f5_sp__q),
         .clock(f5_sp__clock)
@@ -25953,8 +25958,8 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         loop_fifo__read = 1'b0;
         front_fifo__read = 1'b0;
         in_flight__read = 1'b0;
-        take = (phase__q != Fetch__Idle) & (~(engine__load_read & (engine__load_bank == c_bank_nodes)));
-        nodes__read = take | (engine__load_read & (engine__load_bank == c_bank_nodes));
+        take = (phase__q != Fetch__Idle) & ((engine__load_banks & c_bank_nodes) == 32'h0);
+        nodes__read = take | ((engine__load_banks & c_bank_nodes) != 32'h0);
         nodes__addr = engine__load_addr;
         if (take) begin
             nodes__addr = (((fetch_job__q[(32'h40)+:(26)]) & 24'hffffff) << 32'h1) | (((phase__q == Fetch__Word1)) & 24'hffffff);
@@ -27288,7 +27293,7 @@ module dynrt_processor__engine__traversal_unit__entry_fifo__read_logic(clock,rea
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address read_address(
+    dynrt_processor__engine__mem_load_r read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
@@ -27333,23 +27338,6 @@ endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__read_logic
 
 
 
-module dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address(d,q,clock);
-    
-    // Module arguments
-    input wire  [5:0] d;
-    output reg  [5:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 6'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address
 
 
 module dynrt_processor__engine__traversal_unit__entry_fifo__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
@@ -27390,12 +27378,12 @@ module dynrt_processor__engine__traversal_unit__entry_fifo__write_logic(write,da
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address write_address(
+    dynrt_processor__engine__mem_load_r write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address dff_write_address_delay(
+    dynrt_processor__engine__mem_load_r dff_write_address_delay(
         .d(dff_write_address_delay__d),
         .q(dff_write_address_delay__q),
         .clock(dff_write_address_delay__clock)
@@ -27741,7 +27729,7 @@ module dynrt_processor__engine__traversal_unit__front_fifo__read_logic(clock,rea
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address read_address(
+    dynrt_processor__engine__mem_load_r read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
@@ -27826,12 +27814,12 @@ module dynrt_processor__engine__traversal_unit__front_fifo__write_logic(write,da
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address write_address(
+    dynrt_processor__engine__mem_load_r write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address dff_write_address_delay(
+    dynrt_processor__engine__mem_load_r dff_write_address_delay(
         .d(dff_write_address_delay__d),
         .q(dff_write_address_delay__q),
         .clock(dff_write_address_delay__clock)
@@ -28437,7 +28425,7 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo__read_logic(clock,read
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address read_address(
+    dynrt_processor__engine__mem_load_r read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
@@ -28522,12 +28510,12 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo__write_logic(write,dat
     reg  is_full;
     
     // Sub module instances
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address write_address(
+    dynrt_processor__engine__mem_load_r write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic__read_address dff_write_address_delay(
+    dynrt_processor__engine__mem_load_r dff_write_address_delay(
         .d(dff_write_address_delay__d),
         .q(dff_write_address_delay__q),
         .clock(dff_write_address_delay__clock)

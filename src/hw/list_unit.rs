@@ -19,7 +19,7 @@
 //! traversal unit with the closest hit instead).
 //!
 //! Memory: one bank-1 read per clock on `list_*`, the word `mem_latency` clocks later; the
-//! engine's port shares the bus (`engine_read` of banks 1, 4, 5 goes first).
+//! engine's port shares the bus (`engine_banks`: its loads of banks 1, 4, 5 go first).
 //!
 //! State machine: idle (apply object and skip commands, pass inits on, take a list: 1 clock
 //! each), load the thread's mailbox, object and skip (2 clocks), walk: one list word a clock
@@ -76,8 +76,8 @@ pub struct ListUnit {
     pub word_a: Signal<In, Bits<32>>,
     pub word_b: Signal<In, Bits<32>>,
     pub full: Signal<Out, Bit>,
-    pub engine_read: Signal<In, Bit>,
-    pub engine_bank: Signal<In, Bits<3>>,
+    /// The engine's loads, a bit per bank (`CoprocessorPort::load_banks`).
+    pub engine_banks: Signal<In, Bits<{ layout::BANKS }>>,
     pub list_read: Signal<Out, Bit>,
     pub list_addr: Signal<Out, Bits<24>>,
     pub list_rdata: Signal<In, Bits<32>>,
@@ -141,11 +141,9 @@ pub struct ListUnit {
     c_cmd_init: Constant<Bits<2>>,
     c_cmd_object: Constant<Bits<2>>,
     c_cmd_skip: Constant<Bits<2>>,
-    /// The banks with their own ports (`layout`): the engine's loads of them leave the bus
-    /// free.
-    c_bank_nodes: Constant<Bits<3>>,
-    c_bank_uv: Constant<Bits<3>>,
-    c_bank_t: Constant<Bits<3>>,
+    /// The banks on the shared bus (lists, instances, frame): the engine's loads of the
+    /// others go out on their coprocessor's port and leave the bus free.
+    c_shared_banks: Constant<Bits<{ layout::BANKS }>>,
 }
 
 /// A per-thread RAM of `value` words: the skip words start all ones (no triangle is skipped
@@ -172,8 +170,7 @@ impl ListUnit {
             word_a: Default::default(),
             word_b: Default::default(),
             full: Default::default(),
-            engine_read: Default::default(),
-            engine_bank: Default::default(),
+            engine_banks: Default::default(),
             list_read: Default::default(),
             list_addr: Default::default(),
             list_rdata: Default::default(),
@@ -225,9 +222,9 @@ impl ListUnit {
             c_cmd_init: Constant::new(CMD_INIT.into()),
             c_cmd_object: Constant::new(CMD_OBJECT.into()),
             c_cmd_skip: Constant::new(CMD_SKIP.into()),
-            c_bank_nodes: Constant::new((layout::NODES as u64).into()),
-            c_bank_uv: Constant::new((layout::TRIANGLES_UV as u64).into()),
-            c_bank_t: Constant::new((layout::TRIANGLES_T as u64).into()),
+            c_shared_banks: Constant::new(
+                ((1u64 << layout::LISTS) | (1 << layout::INSTANCES) | (1 << layout::FRAME)).into(),
+            ),
         }
     }
 }
@@ -378,10 +375,7 @@ impl Logic for ListUnit {
                 + bit_cast::<5, 4>(self.flight.q.val())
                 + bit_cast::<5, 1>(self.arrive_r.q.val().into()))
                 < 7)
-            & (!(self.engine_read.val()
-                & (self.engine_bank.val() != self.c_bank_nodes.val())
-                & (self.engine_bank.val() != self.c_bank_uv.val())
-                & (self.engine_bank.val() != self.c_bank_t.val())));
+            & ((self.engine_banks.val() & self.c_shared_banks.val()) == 0);
         self.list_read.next = self.take.val();
         self.list_addr.next = self.cursor.q.val();
         self.cursor_next.next = self.cursor.q.val() + 1;
@@ -624,8 +618,7 @@ mod tests {
             let steal = rng
                 .gen_ratio(1, 4)
                 .then(|| [0, 1, 2, 4, 5][rng.gen_range(0..5)]);
-            u.engine_read.next = steal.is_some();
-            u.engine_bank.next = steal.unwrap_or(0u64).into();
+            u.engine_banks.next = steal.map_or(0u64, |b| 1 << b).into();
             u.test_take.next = false;
             settle(&mut u);
             let take = u.test_valid.val() && rng.gen_ratio(1, 2);

@@ -6,6 +6,8 @@
 
 use rust_hdl::prelude::*;
 
+use crate::layout::BANKS;
+
 /// A read port of an SRAM bank: a request (`read`, `addr`) per clock; `rdata` is the word
 /// requested exactly `mem_latency` clocks earlier (the board's SRAMs, or a testbench's).
 #[derive(LogicInterface, Default)]
@@ -39,7 +41,11 @@ pub struct FrameBufferWrite {
 /// (the thread repeats it). At I3 the engine asks whether `query_thread`'s work is `pending`
 /// (a wait). `done` and `done_thread` report a finished piece of work, which wakes a sleeping
 /// waiter. `load_*` is the engine's registered load request (a load of the coprocessor's bank
-/// goes out on the coprocessor's own port, in the clocks the coprocessor leaves free).
+/// goes out on the coprocessor's own port, in the clocks the coprocessor leaves free):
+/// `load_banks` bit k is high in the clock the engine loads bank k, one flip-flop a bank, so
+/// that a coprocessor yields its port on one flip-flop's output rather than on a decode of
+/// the bank number (that decode, fanned out to every port, was the processor's critical path
+/// at 89.3 MHz).
 #[derive(LogicInterface, Default)]
 pub struct CoprocessorPort {
     pub thread: Signal<In, Bits<5>>,
@@ -53,8 +59,7 @@ pub struct CoprocessorPort {
     pub pending: Signal<Out, Bit>,
     pub done: Signal<Out, Bit>,
     pub done_thread: Signal<Out, Bits<5>>,
-    pub load_read: Signal<In, Bit>,
-    pub load_bank: Signal<In, Bits<3>>,
+    pub load_banks: Signal<In, Bits<BANKS>>,
     pub load_addr: Signal<In, Bits<24>>,
 }
 

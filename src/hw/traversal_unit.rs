@@ -234,7 +234,8 @@ pub struct TraversalUnit<
     c_ml_last: Constant<Bits<4>>,
     c_index: [Constant<Bits<4>>; 6],
     c_zero: Constant<Bits<W>>,
-    c_bank_nodes: Constant<Bits<3>>,
+    /// Bank 0's bit of the engine's `load_banks`.
+    c_bank_nodes: Constant<Bits<{ layout::BANKS }>>,
     c_leaf_tag: Constant<Bits<2>>,
 }
 
@@ -370,7 +371,7 @@ impl<
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_zero: const_bits::<W>(u64::from(f.zero(false))),
-            c_bank_nodes: Constant::new((layout::NODES as u64).into()),
+            c_bank_nodes: Constant::new((1u64 << layout::NODES).into()),
             c_leaf_tag: Constant::new(u64::from(layout::LEAF_TAG).into()),
         }
     }
@@ -570,11 +571,9 @@ impl<
         self.front_fifo.read.next = false;
         self.in_flight.read.next = false;
         self.take.next = (self.phase.q.val() != Fetch::Idle)
-            & (!(self.engine.load_read.val()
-                & (self.engine.load_bank.val() == self.c_bank_nodes.val())));
-        self.nodes.read.next = self.take.val()
-            | (self.engine.load_read.val()
-                & (self.engine.load_bank.val() == self.c_bank_nodes.val()));
+            & ((self.engine.load_banks.val() & self.c_bank_nodes.val()) == 0);
+        self.nodes.read.next =
+            self.take.val() | ((self.engine.load_banks.val() & self.c_bank_nodes.val()) != 0);
         self.nodes.addr.next = self.engine.load_addr.val();
         if self.take.val() {
             self.nodes.addr.next = (bit_cast::<24, 26>(self.fetch_job.q.val().get_bits::<26>(64))
@@ -921,8 +920,7 @@ mod tests {
             let steal = rng
                 .gen_ratio(1, 6)
                 .then(|| rng.gen_range(0..nodes.len() as u64));
-            u.engine.load_read.next = steal.is_some();
-            u.engine.load_bank.next = 0.into();
+            u.engine.load_banks.next = u64::from(steal.is_some()).into();
             u.engine.load_addr.next = steal.unwrap_or(0).into();
             // The tester answers one due leaf a clock.
             let answer = b.due.iter().position(|d| d.0 <= b.clock || offer);

@@ -239,8 +239,9 @@ pub struct TriangleTester<
     c_test_init: Constant<Bits<2>>,
     c_test_list_end: Constant<Bits<2>>,
     c_test_walk_end: Constant<Bits<2>>,
-    c_bank_uv: Constant<Bits<3>>,
-    c_bank_t: Constant<Bits<3>>,
+    /// The triangle banks' bits of the engine's `load_banks`.
+    c_bank_uv: Constant<Bits<{ layout::BANKS }>>,
+    c_bank_t: Constant<Bits<{ layout::BANKS }>>,
 }
 
 /// The launch of a buffered entry: wait for a loaded buffer, launch the origin, then the
@@ -380,8 +381,8 @@ impl<
             c_test_init: Constant::new(TEST_INIT.into()),
             c_test_list_end: Constant::new(TEST_LIST_END.into()),
             c_test_walk_end: Constant::new(TEST_WALK_END.into()),
-            c_bank_uv: Constant::new((layout::TRIANGLES_UV as u64).into()),
-            c_bank_t: Constant::new((layout::TRIANGLES_T as u64).into()),
+            c_bank_uv: Constant::new((1u64 << layout::TRIANGLES_UV).into()),
+            c_bank_t: Constant::new((1u64 << layout::TRIANGLES_T).into()),
         }
     }
 }
@@ -487,8 +488,7 @@ impl<
             self.list_unit.word_b.next = self.walk_list_to.val() | self.c_list_of_walk.val();
         }
         self.engine.full.next = self.list_unit.full.val();
-        self.list_unit.engine_read.next = self.engine.load_read.val();
-        self.list_unit.engine_bank.next = self.engine.load_bank.val();
+        self.list_unit.engine_banks.next = self.engine.load_banks.val();
         self.lists.read.next = self.list_unit.list_read.val();
         self.lists.addr.next = self.list_unit.list_addr.val();
         self.list_unit.list_rdata.next = self.lists.rdata.val();
@@ -518,16 +518,14 @@ impl<
         self.list_unit.test_take.next = false;
         self.uv_take.next = self.fetching.q.val()
             & (self.uv_issued.q.val() < 8)
-            & (!(self.engine.load_read.val()
-                & (self.engine.load_bank.val() == self.c_bank_uv.val())));
+            & ((self.engine.load_banks.val() & self.c_bank_uv.val()) == 0);
         self.t_take.next = self.fetching.q.val()
             & (self.t_issued.q.val() < 4)
-            & (!(self.engine.load_read.val()
-                & (self.engine.load_bank.val() == self.c_bank_t.val())));
-        self.uv_words.read.next = self.uv_take.val()
-            | (self.engine.load_read.val() & (self.engine.load_bank.val() == self.c_bank_uv.val()));
-        self.t_words.read.next = self.t_take.val()
-            | (self.engine.load_read.val() & (self.engine.load_bank.val() == self.c_bank_t.val()));
+            & ((self.engine.load_banks.val() & self.c_bank_t.val()) == 0);
+        self.uv_words.read.next =
+            self.uv_take.val() | ((self.engine.load_banks.val() & self.c_bank_uv.val()) != 0);
+        self.t_words.read.next =
+            self.t_take.val() | ((self.engine.load_banks.val() & self.c_bank_t.val()) != 0);
         self.uv_words.addr.next = self.engine.load_addr.val();
         self.t_words.addr.next = self.engine.load_addr.val();
         self.fetch_a.next = self.cur_a[0].q.val();
@@ -969,8 +967,7 @@ mod tests {
             }
             let steal = (steal_one_in > 0 && rng.gen_ratio(1, steal_one_in.max(1)))
                 .then(|| (rng.gen_range(1..=3u64), rng.gen_range(0..64u64)));
-            u.engine.load_read.next = steal.is_some();
-            u.engine.load_bank.next = steal.map_or(0, |s| s.0).into();
+            u.engine.load_banks.next = steal.map_or(0, |s| 1 << s.0).into();
             u.engine.load_addr.next = steal.map_or(0, |s| s.1).into();
             settle(&mut u);
             if let Some((1, _)) = steal {
@@ -1004,7 +1001,7 @@ mod tests {
             cycle(&mut u);
         }
         u.engine.enqueue.next = false;
-        u.engine.load_read.next = false;
+        u.engine.load_banks.next = 0.into();
         for (th, want) in want.iter().enumerate() {
             u.engine.query_thread.next = (th as u64).into();
             cycle(&mut u);

@@ -56,7 +56,9 @@ pub const TRIANGLES_UV: usize = 2;
 pub const TRIANGLES_T: usize = 3;
 pub const INSTANCES: usize = 4;
 pub const FRAME: usize = 5;
-pub const BANK_NAMES: [&str; 6] = [
+/// The board's memory banks (6 of 4 MB, as the paper's prototype).
+pub const BANKS: usize = 6;
+pub const BANK_NAMES: [&str; BANKS] = [
     "nodes",
     "lists",
     "triangles_uv",

@@ -247,7 +247,8 @@ pub struct ThreadEngine<
     traversal_count: DFF<Bits<32>>,
     frame_start: Signal<Local, Bit>,
     // The memory and frame-buffer ports' request registers.
-    mem_read_r: DFF<Bit>,
+    /// The load's bank one-hot (`CoprocessorPort::load_banks`), and its number for the shared bus.
+    mem_load_r: DFF<Bits<{ layout::BANKS }>>,
     mem_bank_r: DFF<Bits<3>>,
     mem_addr_r: DFF<Bits<24>>,
     fb_write_r: DFF<Bit>,
@@ -301,10 +302,12 @@ pub struct ThreadEngine<
     cmd_init: Constant<Bits<2>>,
     cmd_object: Constant<Bits<2>>,
     cmd_skip: Constant<Bits<2>>,
-    bank_nodes: Constant<Bits<3>>,
     bank_lists: Constant<Bits<3>>,
-    bank_uv: Constant<Bits<3>>,
-    bank_t: Constant<Bits<3>>,
+    /// `mem_load_r`'s bit 0, shifted to the load's bank.
+    one_bank: Constant<Bits<{ layout::BANKS }>>,
+    /// The banks on the shared bus: lists, instances, frame (the others have their
+    /// coprocessor's port).
+    shared_banks: Constant<Bits<{ layout::BANKS }>>,
 }
 
 impl<
@@ -377,7 +380,7 @@ impl<
             intersect_count: Default::default(),
             traversal_count: Default::default(),
             frame_start: Default::default(),
-            mem_read_r: Default::default(),
+            mem_load_r: Default::default(),
             mem_bank_r: Default::default(),
             mem_addr_r: Default::default(),
             fb_write_r: Default::default(),
@@ -423,10 +426,11 @@ impl<
             cmd_init: cmd(list_unit::CMD_INIT),
             cmd_object: cmd(list_unit::CMD_OBJECT),
             cmd_skip: cmd(list_unit::CMD_SKIP),
-            bank_nodes: bank(layout::NODES),
             bank_lists: bank(layout::LISTS),
-            bank_uv: bank(layout::TRIANGLES_UV),
-            bank_t: bank(layout::TRIANGLES_T),
+            one_bank: Constant::new(1u64.into()),
+            shared_banks: Constant::new(
+                ((1u64 << layout::LISTS) | (1 << layout::INSTANCES) | (1 << layout::FRAME)).into(),
+            ),
         }
     }
 }
@@ -457,7 +461,7 @@ impl<
             transform_count,
             intersect_count,
             traversal_count,
-            mem_read_r,
+            mem_load_r,
             mem_bank_r,
             mem_addr_r,
             fb_write_r,
@@ -573,8 +577,10 @@ impl<
             self.decode.valid.val() & (self.decode.op.val() == self.op_sts.val());
 
         // Memory and frame-buffer ports (registered).
-        self.mem_read_r.d.next =
-            self.decode.valid.val() & (self.decode.op.val() == self.op_ld.val());
+        self.mem_load_r.d.next = 0.into();
+        if self.decode.valid.val() & (self.decode.op.val() == self.op_ld.val()) {
+            self.mem_load_r.d.next = self.one_bank.val() << self.decode.bank.val();
+        }
         self.mem_bank_r.d.next = self.decode.bank.val();
         self.mem_addr_r.d.next = self.execute.mem_address.val().get_bits::<24>(0);
         self.fb_write_r.d.next =
@@ -586,10 +592,7 @@ impl<
         self.fb.data.next = self.fb_data_r.q.val();
         // Bank 0 goes through the traversal unit's port, banks 2 and 3 through the triangle
         // tester's; the tester's list reads (bank 1) use this bus when the engine does not.
-        self.mem.read.next = (self.mem_read_r.q.val()
-            & (self.mem_bank_r.q.val() != self.bank_nodes.val())
-            & (self.mem_bank_r.q.val() != self.bank_uv.val())
-            & (self.mem_bank_r.q.val() != self.bank_t.val()))
+        self.mem.read.next = ((self.mem_load_r.q.val() & self.shared_banks.val()) != 0)
             | self.tester.lists.read.val();
         if self.tester.lists.read.val() {
             self.mem.bank.next = self.bank_lists.val();
@@ -642,16 +645,14 @@ impl<
             | (self.kd_op.val() & self.kd_wait_fn.val());
 
         // I4: both coprocessors see the engine's loads, the thread and its ray words.
-        self.traversal_unit.engine.load_read.next = self.mem_read_r.q.val();
-        self.traversal_unit.engine.load_bank.next = self.mem_bank_r.q.val();
+        self.traversal_unit.engine.load_banks.next = self.mem_load_r.q.val();
         self.traversal_unit.engine.load_addr.next = self.mem_addr_r.q.val();
         self.traversal_unit.engine.thread.next = self.decode.thread.val();
         self.traversal_unit.engine.word_a.next = self.decode.a.val();
         self.traversal_unit.engine.word_b.next = self.decode.b.val();
         self.traversal_unit.engine.ray_pair.next = self.decode.imm.val().get_bits::<2>(0);
         self.traversal_unit.engine.ray_write.next = self.ray_write.q.val();
-        self.tester.engine.load_read.next = self.mem_read_r.q.val();
-        self.tester.engine.load_bank.next = self.mem_bank_r.q.val();
+        self.tester.engine.load_banks.next = self.mem_load_r.q.val();
         self.tester.engine.load_addr.next = self.mem_addr_r.q.val();
         self.tester.engine.thread.next = self.decode.thread.val();
         self.tester.engine.word_a.next = self.decode.a.val();
