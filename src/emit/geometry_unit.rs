@@ -31,8 +31,8 @@ use crate::dispatch_geometry_format;
 use crate::fp::Format;
 use crate::hw::transform_arbiter::THREAD_BITS;
 use crate::hw::{
-    intersect_latency, IntersectUnit, RayGenUnit, SharedTransformUnit, TransformUnit, TAG_BITS,
-    TRANSFORM_LATENCY,
+    intersect_latency, IntersectUnit, RayGenUnit, SharedTransformUnit, TransformUnit,
+    SHARED_TRANSFORM_LATENCY, TAG_BITS, TRANSFORM_LATENCY,
 };
 
 /// The geometry units that can be emitted and synthesized on their own.
@@ -320,6 +320,7 @@ pub fn geometry_unit_rtl(unit: GeometryUnit, fmt: Format) -> Result<GeometryUnit
     let core = merge_identical_modules(&rename_rust_hdl_names(&core, &core_name));
     let latency = match unit {
         GeometryUnit::Intersect => intersect_latency(fmt),
+        GeometryUnit::SharedTransform => SHARED_TRANSFORM_LATENCY,
         _ => TRANSFORM_LATENCY,
     };
     let ports = top_ports(unit, fmt.width());

@@ -38,6 +38,7 @@
 
 use rust_hdl::prelude::*;
 
+use super::SyncFifo;
 use crate::layout;
 
 /// Command kinds (the engine's `kind`).
@@ -85,8 +86,8 @@ pub struct ListUnit {
     pub test_entry: Signal<Out, ListEntry>,
     pub test_take: Signal<In, Bit>,
 
-    commands: SynchronousFIFO<ListEntry, 4, 5, 1>,
-    tests: SynchronousFIFO<ListEntry, 3, 4, 1>,
+    commands: SyncFifo<ListEntry, 4, 5>,
+    tests: SyncFifo<ListEntry, 3, 4>,
     /// Per thread: the object of its lists, the skipped pair, its mailbox.
     object_ram: RAM<Bits<32>, 5>,
     skip_object_ram: RAM<Bits<32>, 5>,

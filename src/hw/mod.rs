@@ -27,6 +27,7 @@ pub mod ray_store;
 pub mod raygen;
 #[cfg(test)]
 mod sim_harness;
+pub mod sync_fifo;
 pub mod transform;
 pub mod transform_arbiter;
 pub mod traversal_unit;
@@ -42,8 +43,9 @@ pub use list_unit::ListUnit;
 pub use lut_ram::LutRam;
 pub use no_collision_ram::NoCollisionRam;
 pub use raygen::{RayGen, RayGenUnit};
+pub use sync_fifo::SyncFifo;
 pub use transform::{TransformUnit, TRANSFORM_LATENCY};
-pub use transform_arbiter::{SharedTransformUnit, TRANSFORM_CLIENTS};
+pub use transform_arbiter::{SharedTransformUnit, SHARED_TRANSFORM_LATENCY, TRANSFORM_CLIENTS};
 pub use traversal_unit::TraversalUnit;
 pub use triangle_tester::TriangleTester;
 pub use vga::{VgaError, VgaMode, VgaPlacement, VgaTiming};

@@ -44,7 +44,7 @@ use super::fp::div::div_latency;
 use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
 use super::ports::{CoprocessorPort, SramRead};
 use super::ray_store::{zero_counters, RayStore};
-use super::Delay;
+use super::{Delay, SyncFifo};
 use crate::fp::Format;
 use crate::layout;
 
@@ -112,17 +112,17 @@ pub struct TraversalUnit<
     pub answer_t: Signal<In, Bits<32>>,
     pub answer_hit: Signal<In, Bit>,
 
-    entry_fifo: SynchronousFIFO<Entry, 5, 6, 1>,
+    entry_fifo: SyncFifo<Entry, 5, 6>,
     /// `{thread[68:64], from[63:32], to[31:0]}`: a thread has at most one leaf out.
-    leaf_fifo: SynchronousFIFO<Bits<69>, 5, 6, 1>,
+    leaf_fifo: SyncFifo<Bits<69>, 5, 6>,
     /// Per thread: the walk answers any hit (a shadow query: `kd.start`'s root bit 31).
     any_hit: RAM<Bits<1>, 5>,
     engine_full: Signal<Local, Bit>,
     a_end: Signal<Local, Bit>,
     /// The leaf's list end: list address plus count.
     a_list_end: Signal<Local, Bits<32>>,
-    front_fifo: SynchronousFIFO<Job, 5, 6, 1>,
-    loop_fifo: SynchronousFIFO<Job, 5, 6, 1>,
+    front_fifo: SyncFifo<Job, 5, 6>,
+    loop_fifo: SyncFifo<Job, 5, 6>,
     /// Per thread: ray o, d and t_min (engine-written); entries taken (engine); entries done
     /// (unit, read by the engine); leaf segment end and stack depth (unit).
     ray: RayStore<W>,
@@ -192,7 +192,7 @@ pub struct TraversalUnit<
     fetch_free: Signal<Local, Bit>,
     next_a_thread: Signal<Local, Bits<5>>,
     /// Jobs whose words are requested, oldest first (at most `mem_latency / 2 + 2`).
-    in_flight: SynchronousFIFO<Job, 3, 4, 1>,
+    in_flight: SyncFifo<Job, 3, 4>,
     job: DFF<Job>,
     words_in: DFF<Bits<2>>,
     w0: DFF<Bits<32>>,
