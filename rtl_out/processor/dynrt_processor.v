@@ -19404,24 +19404,16 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
     reg  commands__read;
     wire  [70:0] commands__data_out;
     wire  commands__empty;
-    wire  commands__almost_empty;
-    wire  commands__underflow;
     reg  commands__write;
     reg  [70:0] commands__data_in;
     wire  commands__full;
-    wire  commands__almost_full;
-    wire  commands__overflow;
     reg  tests__clock;
     reg  tests__read;
     wire  [70:0] tests__data_out;
     wire  tests__empty;
-    wire  tests__almost_empty;
-    wire  tests__underflow;
     reg  tests__write;
     reg  [70:0] tests__data_in;
     wire  tests__full;
-    wire  tests__almost_full;
-    wire  tests__overflow;
     reg  [4:0] object_ram__read_address;
     reg  object_ram__read_clock;
     wire  [31:0] object_ram__read_data;
@@ -19665,26 +19657,18 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .read(commands__read),
         .data_out(commands__data_out),
         .empty(commands__empty),
-        .almost_empty(commands__almost_empty),
-        .underflow(commands__underflow),
         .write(commands__write),
         .data_in(commands__data_in),
-        .full(commands__full),
-        .almost_full(commands__almost_full),
-        .overflow(commands__overflow)
+        .full(commands__full)
     );
     dynrt_processor__engine__tester__list_unit__tests tests(
         .clock(tests__clock),
         .read(tests__read),
         .data_out(tests__data_out),
         .empty(tests__empty),
-        .almost_empty(tests__almost_empty),
-        .underflow(tests__underflow),
         .write(tests__write),
         .data_in(tests__data_in),
-        .full(tests__full),
-        .almost_full(tests__almost_full),
-        .overflow(tests__overflow)
+        .full(tests__full)
     );
     dynrt_processor__engine__tester__list_unit__object_ram object_ram(
         .read_address(object_ram__read_address),
@@ -20452,20 +20436,16 @@ endmodule // dynrt_processor__engine__tester__list_unit
 
 
 
-module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,empty,write,data_in,full);
     
     // Module arguments
     input wire  clock;
     input wire  read;
     output reg  [70:0] data_out;
     output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
     input wire  write;
     input wire  [70:0] data_in;
     output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
     
     // Stub signals
     reg  [3:0] ram__read_address;
@@ -20475,31 +20455,23 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
     reg  ram__write_clock;
     reg  [70:0] ram__write_data;
     reg  ram__write_enable;
-    reg  read_logic__clock;
-    reg  read_logic__read;
-    wire  [70:0] read_logic__data_out;
-    wire  read_logic__empty;
-    wire  read_logic__almost_empty;
-    wire  read_logic__underflow;
-    reg  [4:0] read_logic__write_address_delayed;
-    wire  [3:0] read_logic__ram_read_address;
-    reg  [70:0] read_logic__ram_read_data;
-    wire  read_logic__ram_read_clock;
-    wire  [4:0] read_logic__read_address_out;
-    wire  [4:0] read_logic__fill_level;
-    reg  write_logic__write;
-    reg  [70:0] write_logic__data_in;
-    wire  write_logic__full;
-    wire  write_logic__almost_full;
-    wire  write_logic__overflow;
-    reg  write_logic__clock;
-    wire  [3:0] write_logic__ram_write_address;
-    wire  write_logic__ram_write_clock;
-    wire  [70:0] write_logic__ram_write_data;
-    wire  write_logic__ram_write_enable;
-    reg  [4:0] write_logic__read_address;
-    wire  [4:0] write_logic__write_address_delayed;
-    wire  [4:0] write_logic__fill_level;
+    reg  [4:0] read_address__d;
+    wire  [4:0] read_address__q;
+    reg  read_address__clock;
+    reg  [4:0] write_address__d;
+    wire  [4:0] write_address__q;
+    reg  write_address__clock;
+    reg  [4:0] write_address_delayed__d;
+    wire  [4:0] write_address_delayed__q;
+    reg  write_address_delayed__clock;
+    reg  filled__d;
+    wire  filled__q;
+    reg  filled__clock;
+    
+    // Local signals
+    reg  [4:0] read_next;
+    reg  pop;
+    reg  push;
     
     // Sub module instances
     dynrt_processor__engine__tester__list_unit__commands__ram ram(
@@ -20511,62 +20483,66 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor__engine__tester__list_unit__commands__read_logic read_logic(
-        .clock(read_logic__clock),
-        .read(read_logic__read),
-        .data_out(read_logic__data_out),
-        .empty(read_logic__empty),
-        .almost_empty(read_logic__almost_empty),
-        .underflow(read_logic__underflow),
-        .write_address_delayed(read_logic__write_address_delayed),
-        .ram_read_address(read_logic__ram_read_address),
-        .ram_read_data(read_logic__ram_read_data),
-        .ram_read_clock(read_logic__ram_read_clock),
-        .read_address_out(read_logic__read_address_out),
-        .fill_level(read_logic__fill_level)
+    dynrt_processor__engine__decode__t3 read_address(
+        .d(read_address__d),
+        .q(read_address__q),
+        .clock(read_address__clock)
     );
-    dynrt_processor__engine__tester__list_unit__commands__write_logic write_logic(
-        .write(write_logic__write),
-        .data_in(write_logic__data_in),
-        .full(write_logic__full),
-        .almost_full(write_logic__almost_full),
-        .overflow(write_logic__overflow),
-        .clock(write_logic__clock),
-        .ram_write_address(write_logic__ram_write_address),
-        .ram_write_clock(write_logic__ram_write_clock),
-        .ram_write_data(write_logic__ram_write_data),
-        .ram_write_enable(write_logic__ram_write_enable),
-        .read_address(write_logic__read_address),
-        .write_address_delayed(write_logic__write_address_delayed),
-        .fill_level(write_logic__fill_level)
+    dynrt_processor__engine__decode__t3 write_address(
+        .d(write_address__d),
+        .q(write_address__q),
+        .clock(write_address__clock)
+    );
+    dynrt_processor__engine__decode__t3 write_address_delayed(
+        .d(write_address_delayed__d),
+        .q(write_address_delayed__q),
+        .clock(write_address_delayed__clock)
+    );
+    dynrt_processor__display__dark_d filled(
+        .d(filled__d),
+        .q(filled__q),
+        .clock(filled__clock)
     );
     
     // Update code
     always @(*) begin
-        read_logic__clock = clock;
-        write_logic__clock = clock;
-        read_logic__read = read;
-        empty = read_logic__empty;
-        almost_empty = read_logic__almost_empty;
-        data_out = read_logic__data_out;
-        underflow = read_logic__underflow;
-        overflow = write_logic__overflow;
-        almost_full = write_logic__almost_full;
-        full = write_logic__full;
-        write_logic__write = write;
-        write_logic__data_in = data_in;
-        ram__write_clock = clock;
-        ram__write_enable = write_logic__ram_write_enable;
-        ram__write_address = write_logic__ram_write_address;
-        ram__write_data = write_logic__ram_write_data;
+        read_address__clock = clock;
+        write_address__clock = clock;
+        write_address_delayed__clock = clock;
+        filled__clock = clock;
+        read_address__d = read_address__q;
+        write_address__d = write_address__q;
+        write_address_delayed__d = write_address_delayed__q;
+        filled__d = filled__q;
         ram__read_clock = clock;
-        ram__read_address = read_logic__ram_read_address;
-        read_logic__ram_read_data = ram__read_data;
-        read_logic__write_address_delayed = write_logic__write_address_delayed;
-        write_logic__read_address = read_logic__read_address_out;
+        ram__write_clock = clock;
+        empty = ~filled__q;
+        full = filled__q & (((read_address__q) & 4'hf) == ((write_address__q) & 4'hf));
+        pop = read & filled__q;
+        push = write & (~full);
+        ram__write_enable = push;
+        ram__write_address = ((write_address__q) & 4'hf);
+        ram__write_data = data_in;
+        write_address__d = write_address__q;
+        if (push) begin
+            write_address__d = write_address__q + 32'h1;
+        end
+        write_address_delayed__d = write_address__q;
+        read_next = read_address__q + 32'h1;
+        ram__read_address = ((read_address__q) & 4'hf);
+        read_address__d = read_address__q;
+        filled__d = read_address__q != write_address__q;
+        if (pop) begin
+            ram__read_address = ((read_next) & 4'hf);
+            read_address__d = read_next;
+            filled__d = read_next != write_address__q;
+        end
+        data_out = ram__read_data;
     end
     
 endmodule // dynrt_processor__engine__tester__list_unit__commands
+
+
 
 
 module dynrt_processor__engine__tester__list_unit__commands__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
@@ -20596,178 +20572,6 @@ module dynrt_processor__engine__tester__list_unit__commands__ram(read_address,re
     end
                 
 endmodule // dynrt_processor__engine__tester__list_unit__commands__ram
-
-
-module dynrt_processor__engine__tester__list_unit__commands__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  read;
-    output reg  [70:0] data_out;
-    output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
-    input wire  [4:0] write_address_delayed;
-    output reg  [3:0] ram_read_address;
-    input wire  [70:0] ram_read_data;
-    output reg  ram_read_clock;
-    output reg  [4:0] read_address_out;
-    output reg  [4:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 5'b1111;
-    localparam  fifo_size = 5'b10000;
-    localparam  block_size = 5'b1;
-    
-    // Stub signals
-    reg  [4:0] read_address__d;
-    wire  [4:0] read_address__q;
-    reg  read_address__clock;
-    reg  dff_underflow__d;
-    wire  dff_underflow__q;
-    reg  dff_underflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__decode__t3 read_address(
-        .d(read_address__d),
-        .q(read_address__q),
-        .clock(read_address__clock)
-    );
-    dynrt_processor__display__dark_d dff_underflow(
-        .d(dff_underflow__d),
-        .q(dff_underflow__q),
-        .clock(dff_underflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        read_address__clock = clock;
-        dff_underflow__clock = clock;
-        read_address__d = read_address__q;
-        dff_underflow__d = dff_underflow__q;
-        ram_read_clock = clock;
-        is_empty = (read_address__q == write_address_delayed);
-        is_full = ~is_empty & ((read_address__q & fifo_address_mask) == (write_address_delayed & fifo_address_mask));
-        fill_level = ((write_address_delayed & fifo_address_mask) + fifo_size - (read_address__q & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_empty = (fill_level < block_size);
-        empty = is_empty;
-        ram_read_address = ((read_address__q & fifo_address_mask) & 4'hf);
-        data_out = ram_read_data;
-        if (read & ~is_empty) begin
-            read_address__d = read_address__q + 32'h1;
-            ram_read_address = (((read_address__q + 32'h1) & fifo_address_mask) & 4'hf);
-        end
-        else begin
-            read_address__d = read_address__q;
-        end
-        dff_underflow__d = dff_underflow__q | (is_empty & read);
-        underflow = dff_underflow__q;
-        read_address_out = read_address__q;
-    end
-    
-endmodule // dynrt_processor__engine__tester__list_unit__commands__read_logic
-
-
-
-
-
-
-module dynrt_processor__engine__tester__list_unit__commands__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
-    
-    // Module arguments
-    input wire  write;
-    input wire  [70:0] data_in;
-    output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
-    input wire  clock;
-    output reg  [3:0] ram_write_address;
-    output reg  ram_write_clock;
-    output reg  [70:0] ram_write_data;
-    output reg  ram_write_enable;
-    input wire  [4:0] read_address;
-    output reg  [4:0] write_address_delayed;
-    output reg  [4:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 5'b1111;
-    localparam  fifo_size = 5'b10000;
-    localparam  almost_full_level = 5'b1111;
-    
-    // Stub signals
-    reg  [4:0] write_address__d;
-    wire  [4:0] write_address__q;
-    reg  write_address__clock;
-    reg  [4:0] dff_write_address_delay__d;
-    wire  [4:0] dff_write_address_delay__q;
-    reg  dff_write_address_delay__clock;
-    reg  dff_overflow__d;
-    wire  dff_overflow__q;
-    reg  dff_overflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__decode__t3 write_address(
-        .d(write_address__d),
-        .q(write_address__q),
-        .clock(write_address__clock)
-    );
-    dynrt_processor__engine__decode__t3 dff_write_address_delay(
-        .d(dff_write_address_delay__d),
-        .q(dff_write_address_delay__q),
-        .clock(dff_write_address_delay__clock)
-    );
-    dynrt_processor__display__dark_d dff_overflow(
-        .d(dff_overflow__d),
-        .q(dff_overflow__q),
-        .clock(dff_overflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        dff_overflow__clock = clock;
-        write_address__clock = clock;
-        dff_write_address_delay__clock = clock;
-        dff_overflow__d = dff_overflow__q;
-        write_address__d = write_address__q;
-        dff_write_address_delay__d = dff_write_address_delay__q;
-        ram_write_clock = clock;
-        dff_write_address_delay__d = write_address__q;
-        write_address_delayed = dff_write_address_delay__q;
-        ram_write_enable = 1'b0;
-        is_empty = (read_address == dff_write_address_delay__q);
-        is_full = ~is_empty & ((read_address & fifo_address_mask) == (write_address__q & fifo_address_mask));
-        fill_level = ((dff_write_address_delay__q & fifo_address_mask) + fifo_size - (read_address & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_full = (fill_level >= almost_full_level);
-        full = is_full;
-        ram_write_address = ((write_address__q & fifo_address_mask) & 4'hf);
-        ram_write_data = data_in;
-        if (write & ~is_full) begin
-            write_address__d = write_address__q + 32'h1;
-            ram_write_enable = 1'b1;
-        end
-        else begin
-            write_address__d = write_address__q;
-            ram_write_enable = 1'b0;
-        end
-        dff_overflow__d = dff_overflow__q | (is_full & write);
-        overflow = dff_overflow__q;
-    end
-    
-endmodule // dynrt_processor__engine__tester__list_unit__commands__write_logic
 
 
 
@@ -21059,20 +20863,16 @@ endmodule // dynrt_processor__engine__tester__list_unit__skip_object_ram
 
 
 
-module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,empty,write,data_in,full);
     
     // Module arguments
     input wire  clock;
     input wire  read;
     output reg  [70:0] data_out;
     output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
     input wire  write;
     input wire  [70:0] data_in;
     output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
     
     // Stub signals
     reg  [2:0] ram__read_address;
@@ -21082,31 +20882,23 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
     reg  ram__write_clock;
     reg  [70:0] ram__write_data;
     reg  ram__write_enable;
-    reg  read_logic__clock;
-    reg  read_logic__read;
-    wire  [70:0] read_logic__data_out;
-    wire  read_logic__empty;
-    wire  read_logic__almost_empty;
-    wire  read_logic__underflow;
-    reg  [3:0] read_logic__write_address_delayed;
-    wire  [2:0] read_logic__ram_read_address;
-    reg  [70:0] read_logic__ram_read_data;
-    wire  read_logic__ram_read_clock;
-    wire  [3:0] read_logic__read_address_out;
-    wire  [3:0] read_logic__fill_level;
-    reg  write_logic__write;
-    reg  [70:0] write_logic__data_in;
-    wire  write_logic__full;
-    wire  write_logic__almost_full;
-    wire  write_logic__overflow;
-    reg  write_logic__clock;
-    wire  [2:0] write_logic__ram_write_address;
-    wire  write_logic__ram_write_clock;
-    wire  [70:0] write_logic__ram_write_data;
-    wire  write_logic__ram_write_enable;
-    reg  [3:0] write_logic__read_address;
-    wire  [3:0] write_logic__write_address_delayed;
-    wire  [3:0] write_logic__fill_level;
+    reg  [3:0] read_address__d;
+    wire  [3:0] read_address__q;
+    reg  read_address__clock;
+    reg  [3:0] write_address__d;
+    wire  [3:0] write_address__q;
+    reg  write_address__clock;
+    reg  [3:0] write_address_delayed__d;
+    wire  [3:0] write_address_delayed__q;
+    reg  write_address_delayed__clock;
+    reg  filled__d;
+    wire  filled__q;
+    reg  filled__clock;
+    
+    // Local signals
+    reg  [3:0] read_next;
+    reg  pop;
+    reg  push;
     
     // Sub module instances
     dynrt_processor__engine__tester__list_unit__tests__ram ram(
@@ -21118,62 +20910,66 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor__engine__tester__list_unit__tests__read_logic read_logic(
-        .clock(read_logic__clock),
-        .read(read_logic__read),
-        .data_out(read_logic__data_out),
-        .empty(read_logic__empty),
-        .almost_empty(read_logic__almost_empty),
-        .underflow(read_logic__underflow),
-        .write_address_delayed(read_logic__write_address_delayed),
-        .ram_read_address(read_logic__ram_read_address),
-        .ram_read_data(read_logic__ram_read_data),
-        .ram_read_clock(read_logic__ram_read_clock),
-        .read_address_out(read_logic__read_address_out),
-        .fill_level(read_logic__fill_level)
+    dynrt_processor__engine__tester__list_unit__flight read_address(
+        .d(read_address__d),
+        .q(read_address__q),
+        .clock(read_address__clock)
     );
-    dynrt_processor__engine__tester__list_unit__tests__write_logic write_logic(
-        .write(write_logic__write),
-        .data_in(write_logic__data_in),
-        .full(write_logic__full),
-        .almost_full(write_logic__almost_full),
-        .overflow(write_logic__overflow),
-        .clock(write_logic__clock),
-        .ram_write_address(write_logic__ram_write_address),
-        .ram_write_clock(write_logic__ram_write_clock),
-        .ram_write_data(write_logic__ram_write_data),
-        .ram_write_enable(write_logic__ram_write_enable),
-        .read_address(write_logic__read_address),
-        .write_address_delayed(write_logic__write_address_delayed),
-        .fill_level(write_logic__fill_level)
+    dynrt_processor__engine__tester__list_unit__flight write_address(
+        .d(write_address__d),
+        .q(write_address__q),
+        .clock(write_address__clock)
+    );
+    dynrt_processor__engine__tester__list_unit__flight write_address_delayed(
+        .d(write_address_delayed__d),
+        .q(write_address_delayed__q),
+        .clock(write_address_delayed__clock)
+    );
+    dynrt_processor__display__dark_d filled(
+        .d(filled__d),
+        .q(filled__q),
+        .clock(filled__clock)
     );
     
     // Update code
     always @(*) begin
-        read_logic__clock = clock;
-        write_logic__clock = clock;
-        read_logic__read = read;
-        empty = read_logic__empty;
-        almost_empty = read_logic__almost_empty;
-        data_out = read_logic__data_out;
-        underflow = read_logic__underflow;
-        overflow = write_logic__overflow;
-        almost_full = write_logic__almost_full;
-        full = write_logic__full;
-        write_logic__write = write;
-        write_logic__data_in = data_in;
-        ram__write_clock = clock;
-        ram__write_enable = write_logic__ram_write_enable;
-        ram__write_address = write_logic__ram_write_address;
-        ram__write_data = write_logic__ram_write_data;
+        read_address__clock = clock;
+        write_address__clock = clock;
+        write_address_delayed__clock = clock;
+        filled__clock = clock;
+        read_address__d = read_address__q;
+        write_address__d = write_address__q;
+        write_address_delayed__d = write_address_delayed__q;
+        filled__d = filled__q;
         ram__read_clock = clock;
-        ram__read_address = read_logic__ram_read_address;
-        read_logic__ram_read_data = ram__read_data;
-        read_logic__write_address_delayed = write_logic__write_address_delayed;
-        write_logic__read_address = read_logic__read_address_out;
+        ram__write_clock = clock;
+        empty = ~filled__q;
+        full = filled__q & (((read_address__q) & 3'h7) == ((write_address__q) & 3'h7));
+        pop = read & filled__q;
+        push = write & (~full);
+        ram__write_enable = push;
+        ram__write_address = ((write_address__q) & 3'h7);
+        ram__write_data = data_in;
+        write_address__d = write_address__q;
+        if (push) begin
+            write_address__d = write_address__q + 32'h1;
+        end
+        write_address_delayed__d = write_address__q;
+        read_next = read_address__q + 32'h1;
+        ram__read_address = ((read_address__q) & 3'h7);
+        read_address__d = read_address__q;
+        filled__d = read_address__q != write_address__q;
+        if (pop) begin
+            ram__read_address = ((read_next) & 3'h7);
+            read_address__d = read_next;
+            filled__d = read_next != write_address__q;
+        end
+        data_out = ram__read_data;
     end
     
 endmodule // dynrt_processor__engine__tester__list_unit__tests
+
+
 
 
 module dynrt_processor__engine__tester__list_unit__tests__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
@@ -21203,178 +20999,6 @@ module dynrt_processor__engine__tester__list_unit__tests__ram(read_address,read_
     end
                 
 endmodule // dynrt_processor__engine__tester__list_unit__tests__ram
-
-
-module dynrt_processor__engine__tester__list_unit__tests__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  read;
-    output reg  [70:0] data_out;
-    output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
-    input wire  [3:0] write_address_delayed;
-    output reg  [2:0] ram_read_address;
-    input wire  [70:0] ram_read_data;
-    output reg  ram_read_clock;
-    output reg  [3:0] read_address_out;
-    output reg  [3:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 4'h7;
-    localparam  fifo_size = 4'h8;
-    localparam  block_size = 4'h1;
-    
-    // Stub signals
-    reg  [3:0] read_address__d;
-    wire  [3:0] read_address__q;
-    reg  read_address__clock;
-    reg  dff_underflow__d;
-    wire  dff_underflow__q;
-    reg  dff_underflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__tester__list_unit__flight read_address(
-        .d(read_address__d),
-        .q(read_address__q),
-        .clock(read_address__clock)
-    );
-    dynrt_processor__display__dark_d dff_underflow(
-        .d(dff_underflow__d),
-        .q(dff_underflow__q),
-        .clock(dff_underflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        read_address__clock = clock;
-        dff_underflow__clock = clock;
-        read_address__d = read_address__q;
-        dff_underflow__d = dff_underflow__q;
-        ram_read_clock = clock;
-        is_empty = (read_address__q == write_address_delayed);
-        is_full = ~is_empty & ((read_address__q & fifo_address_mask) == (write_address_delayed & fifo_address_mask));
-        fill_level = ((write_address_delayed & fifo_address_mask) + fifo_size - (read_address__q & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_empty = (fill_level < block_size);
-        empty = is_empty;
-        ram_read_address = ((read_address__q & fifo_address_mask) & 3'h7);
-        data_out = ram_read_data;
-        if (read & ~is_empty) begin
-            read_address__d = read_address__q + 32'h1;
-            ram_read_address = (((read_address__q + 32'h1) & fifo_address_mask) & 3'h7);
-        end
-        else begin
-            read_address__d = read_address__q;
-        end
-        dff_underflow__d = dff_underflow__q | (is_empty & read);
-        underflow = dff_underflow__q;
-        read_address_out = read_address__q;
-    end
-    
-endmodule // dynrt_processor__engine__tester__list_unit__tests__read_logic
-
-
-
-
-
-
-module dynrt_processor__engine__tester__list_unit__tests__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
-    
-    // Module arguments
-    input wire  write;
-    input wire  [70:0] data_in;
-    output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
-    input wire  clock;
-    output reg  [2:0] ram_write_address;
-    output reg  ram_write_clock;
-    output reg  [70:0] ram_write_data;
-    output reg  ram_write_enable;
-    input wire  [3:0] read_address;
-    output reg  [3:0] write_address_delayed;
-    output reg  [3:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 4'h7;
-    localparam  fifo_size = 4'h8;
-    localparam  almost_full_level = 4'h7;
-    
-    // Stub signals
-    reg  [3:0] write_address__d;
-    wire  [3:0] write_address__q;
-    reg  write_address__clock;
-    reg  [3:0] dff_write_address_delay__d;
-    wire  [3:0] dff_write_address_delay__q;
-    reg  dff_write_address_delay__clock;
-    reg  dff_overflow__d;
-    wire  dff_overflow__q;
-    reg  dff_overflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__tester__list_unit__flight write_address(
-        .d(write_address__d),
-        .q(write_address__q),
-        .clock(write_address__clock)
-    );
-    dynrt_processor__engine__tester__list_unit__flight dff_write_address_delay(
-        .d(dff_write_address_delay__d),
-        .q(dff_write_address_delay__q),
-        .clock(dff_write_address_delay__clock)
-    );
-    dynrt_processor__display__dark_d dff_overflow(
-        .d(dff_overflow__d),
-        .q(dff_overflow__q),
-        .clock(dff_overflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        dff_overflow__clock = clock;
-        write_address__clock = clock;
-        dff_write_address_delay__clock = clock;
-        dff_overflow__d = dff_overflow__q;
-        write_address__d = write_address__q;
-        dff_write_address_delay__d = dff_write_address_delay__q;
-        ram_write_clock = clock;
-        dff_write_address_delay__d = write_address__q;
-        write_address_delayed = dff_write_address_delay__q;
-        ram_write_enable = 1'b0;
-        is_empty = (read_address == dff_write_address_delay__q);
-        is_full = ~is_empty & ((read_address & fifo_address_mask) == (write_address__q & fifo_address_mask));
-        fill_level = ((dff_write_address_delay__q & fifo_address_mask) + fifo_size - (read_address & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_full = (fill_level >= almost_full_level);
-        full = is_full;
-        ram_write_address = ((write_address__q & fifo_address_mask) & 3'h7);
-        ram_write_data = data_in;
-        if (write & ~is_full) begin
-            write_address__d = write_address__q + 32'h1;
-            ram_write_enable = 1'b1;
-        end
-        else begin
-            write_address__d = write_address__q;
-            ram_write_enable = 1'b0;
-        end
-        dff_overflow__d = dff_overflow__q | (is_full & write);
-        overflow = dff_overflow__q;
-    end
-    
-endmodule // dynrt_processor__engine__tester__list_unit__tests__write_logic
 
 
 
@@ -24718,24 +24342,16 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  entry_fifo__read;
     wire  [69:0] entry_fifo__data_out;
     wire  entry_fifo__empty;
-    wire  entry_fifo__almost_empty;
-    wire  entry_fifo__underflow;
     reg  entry_fifo__write;
     reg  [69:0] entry_fifo__data_in;
     wire  entry_fifo__full;
-    wire  entry_fifo__almost_full;
-    wire  entry_fifo__overflow;
     reg  leaf_fifo__clock;
     reg  leaf_fifo__read;
     wire  [68:0] leaf_fifo__data_out;
     wire  leaf_fifo__empty;
-    wire  leaf_fifo__almost_empty;
-    wire  leaf_fifo__underflow;
     reg  leaf_fifo__write;
     reg  [68:0] leaf_fifo__data_in;
     wire  leaf_fifo__full;
-    wire  leaf_fifo__almost_full;
-    wire  leaf_fifo__overflow;
     reg  [4:0] any_hit__read_address;
     reg  any_hit__read_clock;
     wire  any_hit__read_data;
@@ -24747,24 +24363,16 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  front_fifo__read;
     wire  [101:0] front_fifo__data_out;
     wire  front_fifo__empty;
-    wire  front_fifo__almost_empty;
-    wire  front_fifo__underflow;
     reg  front_fifo__write;
     reg  [101:0] front_fifo__data_in;
     wire  front_fifo__full;
-    wire  front_fifo__almost_full;
-    wire  front_fifo__overflow;
     reg  loop_fifo__clock;
     reg  loop_fifo__read;
     wire  [101:0] loop_fifo__data_out;
     wire  loop_fifo__empty;
-    wire  loop_fifo__almost_empty;
-    wire  loop_fifo__underflow;
     reg  loop_fifo__write;
     reg  [101:0] loop_fifo__data_in;
     wire  loop_fifo__full;
-    wire  loop_fifo__almost_full;
-    wire  loop_fifo__overflow;
     reg  ray__clock;
     reg  [4:0] ray__thread;
     reg  [31:0] ray__word_a;
@@ -24977,13 +24585,9 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  in_flight__read;
     wire  [101:0] in_flight__data_out;
     wire  in_flight__empty;
-    wire  in_flight__almost_empty;
-    wire  in_flight__underflow;
     reg  in_flight__write;
     reg  [101:0] in_flight__data_in;
     wire  in_flight__full;
-    wire  in_flight__almost_full;
-    wire  in_flight__overflow;
     reg  [101:0] job__d;
     wire  [101:0] job__q;
     reg  job__clock;
@@ -25149,26 +24753,18 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .read(entry_fifo__read),
         .data_out(entry_fifo__data_out),
         .empty(entry_fifo__empty),
-        .almost_empty(entry_fifo__almost_empty),
-        .underflow(entry_fifo__underflow),
         .write(entry_fifo__write),
         .data_in(entry_fifo__data_in),
-        .full(entry_fifo__full),
-        .almost_full(entry_fifo__almost_full),
-        .overflow(entry_fifo__overflow)
+        .full(entry_fifo__full)
     );
     dynrt_processor__engine__traversal_unit__leaf_fifo leaf_fifo(
         .clock(leaf_fifo__clock),
         .read(leaf_fifo__read),
         .data_out(leaf_fifo__data_out),
         .empty(leaf_fifo__empty),
-        .almost_empty(leaf_fifo__almost_empty),
-        .underflow(leaf_fifo__underflow),
         .write(leaf_fifo__write),
         .data_in(leaf_fifo__data_in),
-        .full(leaf_fifo__full),
-        .almost_full(leaf_fifo__almost_full),
-        .overflow(leaf_fifo__overflow)
+        .full(leaf_fifo__full)
     );
     dynrt_processor__engine__traversal_unit__any_hit any_hit(
         .read_address(any_hit__read_address),
@@ -25184,26 +24780,18 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .read(front_fifo__read),
         .data_out(front_fifo__data_out),
         .empty(front_fifo__empty),
-        .almost_empty(front_fifo__almost_empty),
-        .underflow(front_fifo__underflow),
         .write(front_fifo__write),
         .data_in(front_fifo__data_in),
-        .full(front_fifo__full),
-        .almost_full(front_fifo__almost_full),
-        .overflow(front_fifo__overflow)
+        .full(front_fifo__full)
     );
     dynrt_processor__engine__traversal_unit__front_fifo loop_fifo(
         .clock(loop_fifo__clock),
         .read(loop_fifo__read),
         .data_out(loop_fifo__data_out),
         .empty(loop_fifo__empty),
-        .almost_empty(loop_fifo__almost_empty),
-        .underflow(loop_fifo__underflow),
         .write(loop_fifo__write),
         .data_in(loop_fifo__data_in),
-        .full(loop_fifo__full),
-        .almost_full(loop_fifo__almost_full),
-        .overflow(loop_fifo__overflow)
+        .full(loop_fifo__full)
     );
     dynrt_processor__engine__tester__ray ray(
         .clock(ray__clock),
@@ -25520,13 +25108,9 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .read(in_flight__read),
         .data_out(in_flight__data_out),
         .empty(in_flight__empty),
-        .almost_empty(in_flight__almost_empty),
-        .underflow(in_flight__underflow),
         .write(in_flight__write),
         .data_in(in_flight__data_in),
-        .full(in_flight__full),
-        .almost_full(in_flight__almost_full),
-        .overflow(in_flight__overflow)
+        .full(in_flight__full)
     );
     dynrt_processor__engine__traversal_unit__fetch_job job(
         .d(job__d),
@@ -27113,20 +26697,16 @@ endmodule // dynrt_processor__engine__traversal_unit__control_delay_div
 
 
 
-module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,empty,write,data_in,full);
     
     // Module arguments
     input wire  clock;
     input wire  read;
     output reg  [69:0] data_out;
     output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
     input wire  write;
     input wire  [69:0] data_in;
     output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
     
     // Stub signals
     reg  [4:0] ram__read_address;
@@ -27136,31 +26716,23 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
     reg  ram__write_clock;
     reg  [69:0] ram__write_data;
     reg  ram__write_enable;
-    reg  read_logic__clock;
-    reg  read_logic__read;
-    wire  [69:0] read_logic__data_out;
-    wire  read_logic__empty;
-    wire  read_logic__almost_empty;
-    wire  read_logic__underflow;
-    reg  [5:0] read_logic__write_address_delayed;
-    wire  [4:0] read_logic__ram_read_address;
-    reg  [69:0] read_logic__ram_read_data;
-    wire  read_logic__ram_read_clock;
-    wire  [5:0] read_logic__read_address_out;
-    wire  [5:0] read_logic__fill_level;
-    reg  write_logic__write;
-    reg  [69:0] write_logic__data_in;
-    wire  write_logic__full;
-    wire  write_logic__almost_full;
-    wire  write_logic__overflow;
-    reg  write_logic__clock;
-    wire  [4:0] write_logic__ram_write_address;
-    wire  write_logic__ram_write_clock;
-    wire  [69:0] write_logic__ram_write_data;
-    wire  write_logic__ram_write_enable;
-    reg  [5:0] write_logic__read_address;
-    wire  [5:0] write_logic__write_address_delayed;
-    wire  [5:0] write_logic__fill_level;
+    reg  [5:0] read_address__d;
+    wire  [5:0] read_address__q;
+    reg  read_address__clock;
+    reg  [5:0] write_address__d;
+    wire  [5:0] write_address__q;
+    reg  write_address__clock;
+    reg  [5:0] write_address_delayed__d;
+    wire  [5:0] write_address_delayed__q;
+    reg  write_address_delayed__clock;
+    reg  filled__d;
+    wire  filled__q;
+    reg  filled__clock;
+    
+    // Local signals
+    reg  [5:0] read_next;
+    reg  pop;
+    reg  push;
     
     // Sub module instances
     dynrt_processor__engine__traversal_unit__entry_fifo__ram ram(
@@ -27172,62 +26744,66 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor__engine__traversal_unit__entry_fifo__read_logic read_logic(
-        .clock(read_logic__clock),
-        .read(read_logic__read),
-        .data_out(read_logic__data_out),
-        .empty(read_logic__empty),
-        .almost_empty(read_logic__almost_empty),
-        .underflow(read_logic__underflow),
-        .write_address_delayed(read_logic__write_address_delayed),
-        .ram_read_address(read_logic__ram_read_address),
-        .ram_read_data(read_logic__ram_read_data),
-        .ram_read_clock(read_logic__ram_read_clock),
-        .read_address_out(read_logic__read_address_out),
-        .fill_level(read_logic__fill_level)
+    dynrt_processor__engine__mem_load_r read_address(
+        .d(read_address__d),
+        .q(read_address__q),
+        .clock(read_address__clock)
     );
-    dynrt_processor__engine__traversal_unit__entry_fifo__write_logic write_logic(
-        .write(write_logic__write),
-        .data_in(write_logic__data_in),
-        .full(write_logic__full),
-        .almost_full(write_logic__almost_full),
-        .overflow(write_logic__overflow),
-        .clock(write_logic__clock),
-        .ram_write_address(write_logic__ram_write_address),
-        .ram_write_clock(write_logic__ram_write_clock),
-        .ram_write_data(write_logic__ram_write_data),
-        .ram_write_enable(write_logic__ram_write_enable),
-        .read_address(write_logic__read_address),
-        .write_address_delayed(write_logic__write_address_delayed),
-        .fill_level(write_logic__fill_level)
+    dynrt_processor__engine__mem_load_r write_address(
+        .d(write_address__d),
+        .q(write_address__q),
+        .clock(write_address__clock)
+    );
+    dynrt_processor__engine__mem_load_r write_address_delayed(
+        .d(write_address_delayed__d),
+        .q(write_address_delayed__q),
+        .clock(write_address_delayed__clock)
+    );
+    dynrt_processor__display__dark_d filled(
+        .d(filled__d),
+        .q(filled__q),
+        .clock(filled__clock)
     );
     
     // Update code
     always @(*) begin
-        read_logic__clock = clock;
-        write_logic__clock = clock;
-        read_logic__read = read;
-        empty = read_logic__empty;
-        almost_empty = read_logic__almost_empty;
-        data_out = read_logic__data_out;
-        underflow = read_logic__underflow;
-        overflow = write_logic__overflow;
-        almost_full = write_logic__almost_full;
-        full = write_logic__full;
-        write_logic__write = write;
-        write_logic__data_in = data_in;
-        ram__write_clock = clock;
-        ram__write_enable = write_logic__ram_write_enable;
-        ram__write_address = write_logic__ram_write_address;
-        ram__write_data = write_logic__ram_write_data;
+        read_address__clock = clock;
+        write_address__clock = clock;
+        write_address_delayed__clock = clock;
+        filled__clock = clock;
+        read_address__d = read_address__q;
+        write_address__d = write_address__q;
+        write_address_delayed__d = write_address_delayed__q;
+        filled__d = filled__q;
         ram__read_clock = clock;
-        ram__read_address = read_logic__ram_read_address;
-        read_logic__ram_read_data = ram__read_data;
-        read_logic__write_address_delayed = write_logic__write_address_delayed;
-        write_logic__read_address = read_logic__read_address_out;
+        ram__write_clock = clock;
+        empty = ~filled__q;
+        full = filled__q & (((read_address__q) & 5'h1f) == ((write_address__q) & 5'h1f));
+        pop = read & filled__q;
+        push = write & (~full);
+        ram__write_enable = push;
+        ram__write_address = ((write_address__q) & 5'h1f);
+        ram__write_data = data_in;
+        write_address__d = write_address__q;
+        if (push) begin
+            write_address__d = write_address__q + 32'h1;
+        end
+        write_address_delayed__d = write_address__q;
+        read_next = read_address__q + 32'h1;
+        ram__read_address = ((read_address__q) & 5'h1f);
+        read_address__d = read_address__q;
+        filled__d = read_address__q != write_address__q;
+        if (pop) begin
+            ram__read_address = ((read_next) & 5'h1f);
+            read_address__d = read_next;
+            filled__d = read_next != write_address__q;
+        end
+        data_out = ram__read_data;
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__entry_fifo
+
+
 
 
 module dynrt_processor__engine__traversal_unit__entry_fifo__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
@@ -27257,178 +26833,6 @@ module dynrt_processor__engine__traversal_unit__entry_fifo__ram(read_address,rea
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__ram
-
-
-module dynrt_processor__engine__traversal_unit__entry_fifo__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  read;
-    output reg  [69:0] data_out;
-    output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
-    input wire  [5:0] write_address_delayed;
-    output reg  [4:0] ram_read_address;
-    input wire  [69:0] ram_read_data;
-    output reg  ram_read_clock;
-    output reg  [5:0] read_address_out;
-    output reg  [5:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 6'b11111;
-    localparam  fifo_size = 6'b100000;
-    localparam  block_size = 6'b1;
-    
-    // Stub signals
-    reg  [5:0] read_address__d;
-    wire  [5:0] read_address__q;
-    reg  read_address__clock;
-    reg  dff_underflow__d;
-    wire  dff_underflow__q;
-    reg  dff_underflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__mem_load_r read_address(
-        .d(read_address__d),
-        .q(read_address__q),
-        .clock(read_address__clock)
-    );
-    dynrt_processor__display__dark_d dff_underflow(
-        .d(dff_underflow__d),
-        .q(dff_underflow__q),
-        .clock(dff_underflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        read_address__clock = clock;
-        dff_underflow__clock = clock;
-        read_address__d = read_address__q;
-        dff_underflow__d = dff_underflow__q;
-        ram_read_clock = clock;
-        is_empty = (read_address__q == write_address_delayed);
-        is_full = ~is_empty & ((read_address__q & fifo_address_mask) == (write_address_delayed & fifo_address_mask));
-        fill_level = ((write_address_delayed & fifo_address_mask) + fifo_size - (read_address__q & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_empty = (fill_level < block_size);
-        empty = is_empty;
-        ram_read_address = ((read_address__q & fifo_address_mask) & 5'h1f);
-        data_out = ram_read_data;
-        if (read & ~is_empty) begin
-            read_address__d = read_address__q + 32'h1;
-            ram_read_address = (((read_address__q + 32'h1) & fifo_address_mask) & 5'h1f);
-        end
-        else begin
-            read_address__d = read_address__q;
-        end
-        dff_underflow__d = dff_underflow__q | (is_empty & read);
-        underflow = dff_underflow__q;
-        read_address_out = read_address__q;
-    end
-    
-endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__read_logic
-
-
-
-
-
-
-module dynrt_processor__engine__traversal_unit__entry_fifo__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
-    
-    // Module arguments
-    input wire  write;
-    input wire  [69:0] data_in;
-    output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
-    input wire  clock;
-    output reg  [4:0] ram_write_address;
-    output reg  ram_write_clock;
-    output reg  [69:0] ram_write_data;
-    output reg  ram_write_enable;
-    input wire  [5:0] read_address;
-    output reg  [5:0] write_address_delayed;
-    output reg  [5:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 6'b11111;
-    localparam  fifo_size = 6'b100000;
-    localparam  almost_full_level = 6'b11111;
-    
-    // Stub signals
-    reg  [5:0] write_address__d;
-    wire  [5:0] write_address__q;
-    reg  write_address__clock;
-    reg  [5:0] dff_write_address_delay__d;
-    wire  [5:0] dff_write_address_delay__q;
-    reg  dff_write_address_delay__clock;
-    reg  dff_overflow__d;
-    wire  dff_overflow__q;
-    reg  dff_overflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__mem_load_r write_address(
-        .d(write_address__d),
-        .q(write_address__q),
-        .clock(write_address__clock)
-    );
-    dynrt_processor__engine__mem_load_r dff_write_address_delay(
-        .d(dff_write_address_delay__d),
-        .q(dff_write_address_delay__q),
-        .clock(dff_write_address_delay__clock)
-    );
-    dynrt_processor__display__dark_d dff_overflow(
-        .d(dff_overflow__d),
-        .q(dff_overflow__q),
-        .clock(dff_overflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        dff_overflow__clock = clock;
-        write_address__clock = clock;
-        dff_write_address_delay__clock = clock;
-        dff_overflow__d = dff_overflow__q;
-        write_address__d = write_address__q;
-        dff_write_address_delay__d = dff_write_address_delay__q;
-        ram_write_clock = clock;
-        dff_write_address_delay__d = write_address__q;
-        write_address_delayed = dff_write_address_delay__q;
-        ram_write_enable = 1'b0;
-        is_empty = (read_address == dff_write_address_delay__q);
-        is_full = ~is_empty & ((read_address & fifo_address_mask) == (write_address__q & fifo_address_mask));
-        fill_level = ((dff_write_address_delay__q & fifo_address_mask) + fifo_size - (read_address & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_full = (fill_level >= almost_full_level);
-        full = is_full;
-        ram_write_address = ((write_address__q & fifo_address_mask) & 5'h1f);
-        ram_write_data = data_in;
-        if (write & ~is_full) begin
-            write_address__d = write_address__q + 32'h1;
-            ram_write_enable = 1'b1;
-        end
-        else begin
-            write_address__d = write_address__q;
-            ram_write_enable = 1'b0;
-        end
-        dff_overflow__d = dff_overflow__q | (is_full & write);
-        overflow = dff_overflow__q;
-    end
-    
-endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__write_logic
 
 
 
@@ -27549,20 +26953,16 @@ module dynrt_processor__engine__traversal_unit__fetch_job(d,q,clock);
 endmodule // dynrt_processor__engine__traversal_unit__fetch_job
 
 
-module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,empty,write,data_in,full);
     
     // Module arguments
     input wire  clock;
     input wire  read;
     output reg  [101:0] data_out;
     output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
     input wire  write;
     input wire  [101:0] data_in;
     output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
     
     // Stub signals
     reg  [4:0] ram__read_address;
@@ -27572,31 +26972,23 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
     reg  ram__write_clock;
     reg  [101:0] ram__write_data;
     reg  ram__write_enable;
-    reg  read_logic__clock;
-    reg  read_logic__read;
-    wire  [101:0] read_logic__data_out;
-    wire  read_logic__empty;
-    wire  read_logic__almost_empty;
-    wire  read_logic__underflow;
-    reg  [5:0] read_logic__write_address_delayed;
-    wire  [4:0] read_logic__ram_read_address;
-    reg  [101:0] read_logic__ram_read_data;
-    wire  read_logic__ram_read_clock;
-    wire  [5:0] read_logic__read_address_out;
-    wire  [5:0] read_logic__fill_level;
-    reg  write_logic__write;
-    reg  [101:0] write_logic__data_in;
-    wire  write_logic__full;
-    wire  write_logic__almost_full;
-    wire  write_logic__overflow;
-    reg  write_logic__clock;
-    wire  [4:0] write_logic__ram_write_address;
-    wire  write_logic__ram_write_clock;
-    wire  [101:0] write_logic__ram_write_data;
-    wire  write_logic__ram_write_enable;
-    reg  [5:0] write_logic__read_address;
-    wire  [5:0] write_logic__write_address_delayed;
-    wire  [5:0] write_logic__fill_level;
+    reg  [5:0] read_address__d;
+    wire  [5:0] read_address__q;
+    reg  read_address__clock;
+    reg  [5:0] write_address__d;
+    wire  [5:0] write_address__q;
+    reg  write_address__clock;
+    reg  [5:0] write_address_delayed__d;
+    wire  [5:0] write_address_delayed__q;
+    reg  write_address_delayed__clock;
+    reg  filled__d;
+    wire  filled__q;
+    reg  filled__clock;
+    
+    // Local signals
+    reg  [5:0] read_next;
+    reg  pop;
+    reg  push;
     
     // Sub module instances
     dynrt_processor__engine__traversal_unit__front_fifo__ram ram(
@@ -27608,62 +27000,66 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor__engine__traversal_unit__front_fifo__read_logic read_logic(
-        .clock(read_logic__clock),
-        .read(read_logic__read),
-        .data_out(read_logic__data_out),
-        .empty(read_logic__empty),
-        .almost_empty(read_logic__almost_empty),
-        .underflow(read_logic__underflow),
-        .write_address_delayed(read_logic__write_address_delayed),
-        .ram_read_address(read_logic__ram_read_address),
-        .ram_read_data(read_logic__ram_read_data),
-        .ram_read_clock(read_logic__ram_read_clock),
-        .read_address_out(read_logic__read_address_out),
-        .fill_level(read_logic__fill_level)
+    dynrt_processor__engine__mem_load_r read_address(
+        .d(read_address__d),
+        .q(read_address__q),
+        .clock(read_address__clock)
     );
-    dynrt_processor__engine__traversal_unit__front_fifo__write_logic write_logic(
-        .write(write_logic__write),
-        .data_in(write_logic__data_in),
-        .full(write_logic__full),
-        .almost_full(write_logic__almost_full),
-        .overflow(write_logic__overflow),
-        .clock(write_logic__clock),
-        .ram_write_address(write_logic__ram_write_address),
-        .ram_write_clock(write_logic__ram_write_clock),
-        .ram_write_data(write_logic__ram_write_data),
-        .ram_write_enable(write_logic__ram_write_enable),
-        .read_address(write_logic__read_address),
-        .write_address_delayed(write_logic__write_address_delayed),
-        .fill_level(write_logic__fill_level)
+    dynrt_processor__engine__mem_load_r write_address(
+        .d(write_address__d),
+        .q(write_address__q),
+        .clock(write_address__clock)
+    );
+    dynrt_processor__engine__mem_load_r write_address_delayed(
+        .d(write_address_delayed__d),
+        .q(write_address_delayed__q),
+        .clock(write_address_delayed__clock)
+    );
+    dynrt_processor__display__dark_d filled(
+        .d(filled__d),
+        .q(filled__q),
+        .clock(filled__clock)
     );
     
     // Update code
     always @(*) begin
-        read_logic__clock = clock;
-        write_logic__clock = clock;
-        read_logic__read = read;
-        empty = read_logic__empty;
-        almost_empty = read_logic__almost_empty;
-        data_out = read_logic__data_out;
-        underflow = read_logic__underflow;
-        overflow = write_logic__overflow;
-        almost_full = write_logic__almost_full;
-        full = write_logic__full;
-        write_logic__write = write;
-        write_logic__data_in = data_in;
-        ram__write_clock = clock;
-        ram__write_enable = write_logic__ram_write_enable;
-        ram__write_address = write_logic__ram_write_address;
-        ram__write_data = write_logic__ram_write_data;
+        read_address__clock = clock;
+        write_address__clock = clock;
+        write_address_delayed__clock = clock;
+        filled__clock = clock;
+        read_address__d = read_address__q;
+        write_address__d = write_address__q;
+        write_address_delayed__d = write_address_delayed__q;
+        filled__d = filled__q;
         ram__read_clock = clock;
-        ram__read_address = read_logic__ram_read_address;
-        read_logic__ram_read_data = ram__read_data;
-        read_logic__write_address_delayed = write_logic__write_address_delayed;
-        write_logic__read_address = read_logic__read_address_out;
+        ram__write_clock = clock;
+        empty = ~filled__q;
+        full = filled__q & (((read_address__q) & 5'h1f) == ((write_address__q) & 5'h1f));
+        pop = read & filled__q;
+        push = write & (~full);
+        ram__write_enable = push;
+        ram__write_address = ((write_address__q) & 5'h1f);
+        ram__write_data = data_in;
+        write_address__d = write_address__q;
+        if (push) begin
+            write_address__d = write_address__q + 32'h1;
+        end
+        write_address_delayed__d = write_address__q;
+        read_next = read_address__q + 32'h1;
+        ram__read_address = ((read_address__q) & 5'h1f);
+        read_address__d = read_address__q;
+        filled__d = read_address__q != write_address__q;
+        if (pop) begin
+            ram__read_address = ((read_next) & 5'h1f);
+            read_address__d = read_next;
+            filled__d = read_next != write_address__q;
+        end
+        data_out = ram__read_data;
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__front_fifo
+
+
 
 
 module dynrt_processor__engine__traversal_unit__front_fifo__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
@@ -27693,178 +27089,6 @@ module dynrt_processor__engine__traversal_unit__front_fifo__ram(read_address,rea
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__front_fifo__ram
-
-
-module dynrt_processor__engine__traversal_unit__front_fifo__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  read;
-    output reg  [101:0] data_out;
-    output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
-    input wire  [5:0] write_address_delayed;
-    output reg  [4:0] ram_read_address;
-    input wire  [101:0] ram_read_data;
-    output reg  ram_read_clock;
-    output reg  [5:0] read_address_out;
-    output reg  [5:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 6'b11111;
-    localparam  fifo_size = 6'b100000;
-    localparam  block_size = 6'b1;
-    
-    // Stub signals
-    reg  [5:0] read_address__d;
-    wire  [5:0] read_address__q;
-    reg  read_address__clock;
-    reg  dff_underflow__d;
-    wire  dff_underflow__q;
-    reg  dff_underflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__mem_load_r read_address(
-        .d(read_address__d),
-        .q(read_address__q),
-        .clock(read_address__clock)
-    );
-    dynrt_processor__display__dark_d dff_underflow(
-        .d(dff_underflow__d),
-        .q(dff_underflow__q),
-        .clock(dff_underflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        read_address__clock = clock;
-        dff_underflow__clock = clock;
-        read_address__d = read_address__q;
-        dff_underflow__d = dff_underflow__q;
-        ram_read_clock = clock;
-        is_empty = (read_address__q == write_address_delayed);
-        is_full = ~is_empty & ((read_address__q & fifo_address_mask) == (write_address_delayed & fifo_address_mask));
-        fill_level = ((write_address_delayed & fifo_address_mask) + fifo_size - (read_address__q & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_empty = (fill_level < block_size);
-        empty = is_empty;
-        ram_read_address = ((read_address__q & fifo_address_mask) & 5'h1f);
-        data_out = ram_read_data;
-        if (read & ~is_empty) begin
-            read_address__d = read_address__q + 32'h1;
-            ram_read_address = (((read_address__q + 32'h1) & fifo_address_mask) & 5'h1f);
-        end
-        else begin
-            read_address__d = read_address__q;
-        end
-        dff_underflow__d = dff_underflow__q | (is_empty & read);
-        underflow = dff_underflow__q;
-        read_address_out = read_address__q;
-    end
-    
-endmodule // dynrt_processor__engine__traversal_unit__front_fifo__read_logic
-
-
-
-
-
-
-module dynrt_processor__engine__traversal_unit__front_fifo__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
-    
-    // Module arguments
-    input wire  write;
-    input wire  [101:0] data_in;
-    output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
-    input wire  clock;
-    output reg  [4:0] ram_write_address;
-    output reg  ram_write_clock;
-    output reg  [101:0] ram_write_data;
-    output reg  ram_write_enable;
-    input wire  [5:0] read_address;
-    output reg  [5:0] write_address_delayed;
-    output reg  [5:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 6'b11111;
-    localparam  fifo_size = 6'b100000;
-    localparam  almost_full_level = 6'b11111;
-    
-    // Stub signals
-    reg  [5:0] write_address__d;
-    wire  [5:0] write_address__q;
-    reg  write_address__clock;
-    reg  [5:0] dff_write_address_delay__d;
-    wire  [5:0] dff_write_address_delay__q;
-    reg  dff_write_address_delay__clock;
-    reg  dff_overflow__d;
-    wire  dff_overflow__q;
-    reg  dff_overflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__mem_load_r write_address(
-        .d(write_address__d),
-        .q(write_address__q),
-        .clock(write_address__clock)
-    );
-    dynrt_processor__engine__mem_load_r dff_write_address_delay(
-        .d(dff_write_address_delay__d),
-        .q(dff_write_address_delay__q),
-        .clock(dff_write_address_delay__clock)
-    );
-    dynrt_processor__display__dark_d dff_overflow(
-        .d(dff_overflow__d),
-        .q(dff_overflow__q),
-        .clock(dff_overflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        dff_overflow__clock = clock;
-        write_address__clock = clock;
-        dff_write_address_delay__clock = clock;
-        dff_overflow__d = dff_overflow__q;
-        write_address__d = write_address__q;
-        dff_write_address_delay__d = dff_write_address_delay__q;
-        ram_write_clock = clock;
-        dff_write_address_delay__d = write_address__q;
-        write_address_delayed = dff_write_address_delay__q;
-        ram_write_enable = 1'b0;
-        is_empty = (read_address == dff_write_address_delay__q);
-        is_full = ~is_empty & ((read_address & fifo_address_mask) == (write_address__q & fifo_address_mask));
-        fill_level = ((dff_write_address_delay__q & fifo_address_mask) + fifo_size - (read_address & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_full = (fill_level >= almost_full_level);
-        full = is_full;
-        ram_write_address = ((write_address__q & fifo_address_mask) & 5'h1f);
-        ram_write_data = data_in;
-        if (write & ~is_full) begin
-            write_address__d = write_address__q + 32'h1;
-            ram_write_enable = 1'b1;
-        end
-        else begin
-            write_address__d = write_address__q;
-            ram_write_enable = 1'b0;
-        end
-        dff_overflow__d = dff_overflow__q | (is_full & write);
-        overflow = dff_overflow__q;
-    end
-    
-endmodule // dynrt_processor__engine__traversal_unit__front_fifo__write_logic
 
 
 
@@ -27917,20 +27141,16 @@ endmodule // dynrt_processor__engine__traversal_unit__hi_delay
 
 
 
-module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,empty,write,data_in,full);
     
     // Module arguments
     input wire  clock;
     input wire  read;
     output reg  [101:0] data_out;
     output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
     input wire  write;
     input wire  [101:0] data_in;
     output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
     
     // Stub signals
     reg  [2:0] ram__read_address;
@@ -27940,31 +27160,23 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
     reg  ram__write_clock;
     reg  [101:0] ram__write_data;
     reg  ram__write_enable;
-    reg  read_logic__clock;
-    reg  read_logic__read;
-    wire  [101:0] read_logic__data_out;
-    wire  read_logic__empty;
-    wire  read_logic__almost_empty;
-    wire  read_logic__underflow;
-    reg  [3:0] read_logic__write_address_delayed;
-    wire  [2:0] read_logic__ram_read_address;
-    reg  [101:0] read_logic__ram_read_data;
-    wire  read_logic__ram_read_clock;
-    wire  [3:0] read_logic__read_address_out;
-    wire  [3:0] read_logic__fill_level;
-    reg  write_logic__write;
-    reg  [101:0] write_logic__data_in;
-    wire  write_logic__full;
-    wire  write_logic__almost_full;
-    wire  write_logic__overflow;
-    reg  write_logic__clock;
-    wire  [2:0] write_logic__ram_write_address;
-    wire  write_logic__ram_write_clock;
-    wire  [101:0] write_logic__ram_write_data;
-    wire  write_logic__ram_write_enable;
-    reg  [3:0] write_logic__read_address;
-    wire  [3:0] write_logic__write_address_delayed;
-    wire  [3:0] write_logic__fill_level;
+    reg  [3:0] read_address__d;
+    wire  [3:0] read_address__q;
+    reg  read_address__clock;
+    reg  [3:0] write_address__d;
+    wire  [3:0] write_address__q;
+    reg  write_address__clock;
+    reg  [3:0] write_address_delayed__d;
+    wire  [3:0] write_address_delayed__q;
+    reg  write_address_delayed__clock;
+    reg  filled__d;
+    wire  filled__q;
+    reg  filled__clock;
+    
+    // Local signals
+    reg  [3:0] read_next;
+    reg  pop;
+    reg  push;
     
     // Sub module instances
     dynrt_processor__engine__traversal_unit__in_flight__ram ram(
@@ -27976,62 +27188,66 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor__engine__traversal_unit__in_flight__read_logic read_logic(
-        .clock(read_logic__clock),
-        .read(read_logic__read),
-        .data_out(read_logic__data_out),
-        .empty(read_logic__empty),
-        .almost_empty(read_logic__almost_empty),
-        .underflow(read_logic__underflow),
-        .write_address_delayed(read_logic__write_address_delayed),
-        .ram_read_address(read_logic__ram_read_address),
-        .ram_read_data(read_logic__ram_read_data),
-        .ram_read_clock(read_logic__ram_read_clock),
-        .read_address_out(read_logic__read_address_out),
-        .fill_level(read_logic__fill_level)
+    dynrt_processor__engine__tester__list_unit__flight read_address(
+        .d(read_address__d),
+        .q(read_address__q),
+        .clock(read_address__clock)
     );
-    dynrt_processor__engine__traversal_unit__in_flight__write_logic write_logic(
-        .write(write_logic__write),
-        .data_in(write_logic__data_in),
-        .full(write_logic__full),
-        .almost_full(write_logic__almost_full),
-        .overflow(write_logic__overflow),
-        .clock(write_logic__clock),
-        .ram_write_address(write_logic__ram_write_address),
-        .ram_write_clock(write_logic__ram_write_clock),
-        .ram_write_data(write_logic__ram_write_data),
-        .ram_write_enable(write_logic__ram_write_enable),
-        .read_address(write_logic__read_address),
-        .write_address_delayed(write_logic__write_address_delayed),
-        .fill_level(write_logic__fill_level)
+    dynrt_processor__engine__tester__list_unit__flight write_address(
+        .d(write_address__d),
+        .q(write_address__q),
+        .clock(write_address__clock)
+    );
+    dynrt_processor__engine__tester__list_unit__flight write_address_delayed(
+        .d(write_address_delayed__d),
+        .q(write_address_delayed__q),
+        .clock(write_address_delayed__clock)
+    );
+    dynrt_processor__display__dark_d filled(
+        .d(filled__d),
+        .q(filled__q),
+        .clock(filled__clock)
     );
     
     // Update code
     always @(*) begin
-        read_logic__clock = clock;
-        write_logic__clock = clock;
-        read_logic__read = read;
-        empty = read_logic__empty;
-        almost_empty = read_logic__almost_empty;
-        data_out = read_logic__data_out;
-        underflow = read_logic__underflow;
-        overflow = write_logic__overflow;
-        almost_full = write_logic__almost_full;
-        full = write_logic__full;
-        write_logic__write = write;
-        write_logic__data_in = data_in;
-        ram__write_clock = clock;
-        ram__write_enable = write_logic__ram_write_enable;
-        ram__write_address = write_logic__ram_write_address;
-        ram__write_data = write_logic__ram_write_data;
+        read_address__clock = clock;
+        write_address__clock = clock;
+        write_address_delayed__clock = clock;
+        filled__clock = clock;
+        read_address__d = read_address__q;
+        write_address__d = write_address__q;
+        write_address_delayed__d = write_address_delayed__q;
+        filled__d = filled__q;
         ram__read_clock = clock;
-        ram__read_address = read_logic__ram_read_address;
-        read_logic__ram_read_data = ram__read_data;
-        read_logic__write_address_delayed = write_logic__write_address_delayed;
-        write_logic__read_address = read_logic__read_address_out;
+        ram__write_clock = clock;
+        empty = ~filled__q;
+        full = filled__q & (((read_address__q) & 3'h7) == ((write_address__q) & 3'h7));
+        pop = read & filled__q;
+        push = write & (~full);
+        ram__write_enable = push;
+        ram__write_address = ((write_address__q) & 3'h7);
+        ram__write_data = data_in;
+        write_address__d = write_address__q;
+        if (push) begin
+            write_address__d = write_address__q + 32'h1;
+        end
+        write_address_delayed__d = write_address__q;
+        read_next = read_address__q + 32'h1;
+        ram__read_address = ((read_address__q) & 3'h7);
+        read_address__d = read_address__q;
+        filled__d = read_address__q != write_address__q;
+        if (pop) begin
+            ram__read_address = ((read_next) & 3'h7);
+            read_address__d = read_next;
+            filled__d = read_next != write_address__q;
+        end
+        data_out = ram__read_data;
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__in_flight
+
+
 
 
 module dynrt_processor__engine__traversal_unit__in_flight__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
@@ -28063,176 +27279,6 @@ module dynrt_processor__engine__traversal_unit__in_flight__ram(read_address,read
 endmodule // dynrt_processor__engine__traversal_unit__in_flight__ram
 
 
-module dynrt_processor__engine__traversal_unit__in_flight__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  read;
-    output reg  [101:0] data_out;
-    output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
-    input wire  [3:0] write_address_delayed;
-    output reg  [2:0] ram_read_address;
-    input wire  [101:0] ram_read_data;
-    output reg  ram_read_clock;
-    output reg  [3:0] read_address_out;
-    output reg  [3:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 4'h7;
-    localparam  fifo_size = 4'h8;
-    localparam  block_size = 4'h1;
-    
-    // Stub signals
-    reg  [3:0] read_address__d;
-    wire  [3:0] read_address__q;
-    reg  read_address__clock;
-    reg  dff_underflow__d;
-    wire  dff_underflow__q;
-    reg  dff_underflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__tester__list_unit__flight read_address(
-        .d(read_address__d),
-        .q(read_address__q),
-        .clock(read_address__clock)
-    );
-    dynrt_processor__display__dark_d dff_underflow(
-        .d(dff_underflow__d),
-        .q(dff_underflow__q),
-        .clock(dff_underflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        read_address__clock = clock;
-        dff_underflow__clock = clock;
-        read_address__d = read_address__q;
-        dff_underflow__d = dff_underflow__q;
-        ram_read_clock = clock;
-        is_empty = (read_address__q == write_address_delayed);
-        is_full = ~is_empty & ((read_address__q & fifo_address_mask) == (write_address_delayed & fifo_address_mask));
-        fill_level = ((write_address_delayed & fifo_address_mask) + fifo_size - (read_address__q & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_empty = (fill_level < block_size);
-        empty = is_empty;
-        ram_read_address = ((read_address__q & fifo_address_mask) & 3'h7);
-        data_out = ram_read_data;
-        if (read & ~is_empty) begin
-            read_address__d = read_address__q + 32'h1;
-            ram_read_address = (((read_address__q + 32'h1) & fifo_address_mask) & 3'h7);
-        end
-        else begin
-            read_address__d = read_address__q;
-        end
-        dff_underflow__d = dff_underflow__q | (is_empty & read);
-        underflow = dff_underflow__q;
-        read_address_out = read_address__q;
-    end
-    
-endmodule // dynrt_processor__engine__traversal_unit__in_flight__read_logic
-
-
-
-
-
-
-module dynrt_processor__engine__traversal_unit__in_flight__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
-    
-    // Module arguments
-    input wire  write;
-    input wire  [101:0] data_in;
-    output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
-    input wire  clock;
-    output reg  [2:0] ram_write_address;
-    output reg  ram_write_clock;
-    output reg  [101:0] ram_write_data;
-    output reg  ram_write_enable;
-    input wire  [3:0] read_address;
-    output reg  [3:0] write_address_delayed;
-    output reg  [3:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 4'h7;
-    localparam  fifo_size = 4'h8;
-    localparam  almost_full_level = 4'h7;
-    
-    // Stub signals
-    reg  [3:0] write_address__d;
-    wire  [3:0] write_address__q;
-    reg  write_address__clock;
-    reg  [3:0] dff_write_address_delay__d;
-    wire  [3:0] dff_write_address_delay__q;
-    reg  dff_write_address_delay__clock;
-    reg  dff_overflow__d;
-    wire  dff_overflow__q;
-    reg  dff_overflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__tester__list_unit__flight write_address(
-        .d(write_address__d),
-        .q(write_address__q),
-        .clock(write_address__clock)
-    );
-    dynrt_processor__engine__tester__list_unit__flight dff_write_address_delay(
-        .d(dff_write_address_delay__d),
-        .q(dff_write_address_delay__q),
-        .clock(dff_write_address_delay__clock)
-    );
-    dynrt_processor__display__dark_d dff_overflow(
-        .d(dff_overflow__d),
-        .q(dff_overflow__q),
-        .clock(dff_overflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        dff_overflow__clock = clock;
-        write_address__clock = clock;
-        dff_write_address_delay__clock = clock;
-        dff_overflow__d = dff_overflow__q;
-        write_address__d = write_address__q;
-        dff_write_address_delay__d = dff_write_address_delay__q;
-        ram_write_clock = clock;
-        dff_write_address_delay__d = write_address__q;
-        write_address_delayed = dff_write_address_delay__q;
-        ram_write_enable = 1'b0;
-        is_empty = (read_address == dff_write_address_delay__q);
-        is_full = ~is_empty & ((read_address & fifo_address_mask) == (write_address__q & fifo_address_mask));
-        fill_level = ((dff_write_address_delay__q & fifo_address_mask) + fifo_size - (read_address & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_full = (fill_level >= almost_full_level);
-        full = is_full;
-        ram_write_address = ((write_address__q & fifo_address_mask) & 3'h7);
-        ram_write_data = data_in;
-        if (write & ~is_full) begin
-            write_address__d = write_address__q + 32'h1;
-            ram_write_enable = 1'b1;
-        end
-        else begin
-            write_address__d = write_address__q;
-            ram_write_enable = 1'b0;
-        end
-        dff_overflow__d = dff_overflow__q | (is_full & write);
-        overflow = dff_overflow__q;
-    end
-    
-endmodule // dynrt_processor__engine__traversal_unit__in_flight__write_logic
 
 
 
@@ -28243,22 +27289,16 @@ endmodule // dynrt_processor__engine__traversal_unit__in_flight__write_logic
 
 
 
-
-
-module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,empty,almost_empty,underflow,write,data_in,full,almost_full,overflow);
+module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,empty,write,data_in,full);
     
     // Module arguments
     input wire  clock;
     input wire  read;
     output reg  [68:0] data_out;
     output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
     input wire  write;
     input wire  [68:0] data_in;
     output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
     
     // Stub signals
     reg  [4:0] ram__read_address;
@@ -28268,31 +27308,23 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
     reg  ram__write_clock;
     reg  [68:0] ram__write_data;
     reg  ram__write_enable;
-    reg  read_logic__clock;
-    reg  read_logic__read;
-    wire  [68:0] read_logic__data_out;
-    wire  read_logic__empty;
-    wire  read_logic__almost_empty;
-    wire  read_logic__underflow;
-    reg  [5:0] read_logic__write_address_delayed;
-    wire  [4:0] read_logic__ram_read_address;
-    reg  [68:0] read_logic__ram_read_data;
-    wire  read_logic__ram_read_clock;
-    wire  [5:0] read_logic__read_address_out;
-    wire  [5:0] read_logic__fill_level;
-    reg  write_logic__write;
-    reg  [68:0] write_logic__data_in;
-    wire  write_logic__full;
-    wire  write_logic__almost_full;
-    wire  write_logic__overflow;
-    reg  write_logic__clock;
-    wire  [4:0] write_logic__ram_write_address;
-    wire  write_logic__ram_write_clock;
-    wire  [68:0] write_logic__ram_write_data;
-    wire  write_logic__ram_write_enable;
-    reg  [5:0] write_logic__read_address;
-    wire  [5:0] write_logic__write_address_delayed;
-    wire  [5:0] write_logic__fill_level;
+    reg  [5:0] read_address__d;
+    wire  [5:0] read_address__q;
+    reg  read_address__clock;
+    reg  [5:0] write_address__d;
+    wire  [5:0] write_address__q;
+    reg  write_address__clock;
+    reg  [5:0] write_address_delayed__d;
+    wire  [5:0] write_address_delayed__q;
+    reg  write_address_delayed__clock;
+    reg  filled__d;
+    wire  filled__q;
+    reg  filled__clock;
+    
+    // Local signals
+    reg  [5:0] read_next;
+    reg  pop;
+    reg  push;
     
     // Sub module instances
     dynrt_processor__engine__traversal_unit__leaf_fifo__ram ram(
@@ -28304,62 +27336,66 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor__engine__traversal_unit__leaf_fifo__read_logic read_logic(
-        .clock(read_logic__clock),
-        .read(read_logic__read),
-        .data_out(read_logic__data_out),
-        .empty(read_logic__empty),
-        .almost_empty(read_logic__almost_empty),
-        .underflow(read_logic__underflow),
-        .write_address_delayed(read_logic__write_address_delayed),
-        .ram_read_address(read_logic__ram_read_address),
-        .ram_read_data(read_logic__ram_read_data),
-        .ram_read_clock(read_logic__ram_read_clock),
-        .read_address_out(read_logic__read_address_out),
-        .fill_level(read_logic__fill_level)
+    dynrt_processor__engine__mem_load_r read_address(
+        .d(read_address__d),
+        .q(read_address__q),
+        .clock(read_address__clock)
     );
-    dynrt_processor__engine__traversal_unit__leaf_fifo__write_logic write_logic(
-        .write(write_logic__write),
-        .data_in(write_logic__data_in),
-        .full(write_logic__full),
-        .almost_full(write_logic__almost_full),
-        .overflow(write_logic__overflow),
-        .clock(write_logic__clock),
-        .ram_write_address(write_logic__ram_write_address),
-        .ram_write_clock(write_logic__ram_write_clock),
-        .ram_write_data(write_logic__ram_write_data),
-        .ram_write_enable(write_logic__ram_write_enable),
-        .read_address(write_logic__read_address),
-        .write_address_delayed(write_logic__write_address_delayed),
-        .fill_level(write_logic__fill_level)
+    dynrt_processor__engine__mem_load_r write_address(
+        .d(write_address__d),
+        .q(write_address__q),
+        .clock(write_address__clock)
+    );
+    dynrt_processor__engine__mem_load_r write_address_delayed(
+        .d(write_address_delayed__d),
+        .q(write_address_delayed__q),
+        .clock(write_address_delayed__clock)
+    );
+    dynrt_processor__display__dark_d filled(
+        .d(filled__d),
+        .q(filled__q),
+        .clock(filled__clock)
     );
     
     // Update code
     always @(*) begin
-        read_logic__clock = clock;
-        write_logic__clock = clock;
-        read_logic__read = read;
-        empty = read_logic__empty;
-        almost_empty = read_logic__almost_empty;
-        data_out = read_logic__data_out;
-        underflow = read_logic__underflow;
-        overflow = write_logic__overflow;
-        almost_full = write_logic__almost_full;
-        full = write_logic__full;
-        write_logic__write = write;
-        write_logic__data_in = data_in;
-        ram__write_clock = clock;
-        ram__write_enable = write_logic__ram_write_enable;
-        ram__write_address = write_logic__ram_write_address;
-        ram__write_data = write_logic__ram_write_data;
+        read_address__clock = clock;
+        write_address__clock = clock;
+        write_address_delayed__clock = clock;
+        filled__clock = clock;
+        read_address__d = read_address__q;
+        write_address__d = write_address__q;
+        write_address_delayed__d = write_address_delayed__q;
+        filled__d = filled__q;
         ram__read_clock = clock;
-        ram__read_address = read_logic__ram_read_address;
-        read_logic__ram_read_data = ram__read_data;
-        read_logic__write_address_delayed = write_logic__write_address_delayed;
-        write_logic__read_address = read_logic__read_address_out;
+        ram__write_clock = clock;
+        empty = ~filled__q;
+        full = filled__q & (((read_address__q) & 5'h1f) == ((write_address__q) & 5'h1f));
+        pop = read & filled__q;
+        push = write & (~full);
+        ram__write_enable = push;
+        ram__write_address = ((write_address__q) & 5'h1f);
+        ram__write_data = data_in;
+        write_address__d = write_address__q;
+        if (push) begin
+            write_address__d = write_address__q + 32'h1;
+        end
+        write_address_delayed__d = write_address__q;
+        read_next = read_address__q + 32'h1;
+        ram__read_address = ((read_address__q) & 5'h1f);
+        read_address__d = read_address__q;
+        filled__d = read_address__q != write_address__q;
+        if (pop) begin
+            ram__read_address = ((read_next) & 5'h1f);
+            read_address__d = read_next;
+            filled__d = read_next != write_address__q;
+        end
+        data_out = ram__read_data;
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo
+
+
 
 
 module dynrt_processor__engine__traversal_unit__leaf_fifo__ram(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
@@ -28389,178 +27425,6 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo__ram(read_address,read
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo__ram
-
-
-module dynrt_processor__engine__traversal_unit__leaf_fifo__read_logic(clock,read,data_out,empty,almost_empty,underflow,write_address_delayed,ram_read_address,ram_read_data,ram_read_clock,read_address_out,fill_level);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  read;
-    output reg  [68:0] data_out;
-    output reg  empty;
-    output reg  almost_empty;
-    output reg  underflow;
-    input wire  [5:0] write_address_delayed;
-    output reg  [4:0] ram_read_address;
-    input wire  [68:0] ram_read_data;
-    output reg  ram_read_clock;
-    output reg  [5:0] read_address_out;
-    output reg  [5:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 6'b11111;
-    localparam  fifo_size = 6'b100000;
-    localparam  block_size = 6'b1;
-    
-    // Stub signals
-    reg  [5:0] read_address__d;
-    wire  [5:0] read_address__q;
-    reg  read_address__clock;
-    reg  dff_underflow__d;
-    wire  dff_underflow__q;
-    reg  dff_underflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__mem_load_r read_address(
-        .d(read_address__d),
-        .q(read_address__q),
-        .clock(read_address__clock)
-    );
-    dynrt_processor__display__dark_d dff_underflow(
-        .d(dff_underflow__d),
-        .q(dff_underflow__q),
-        .clock(dff_underflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        read_address__clock = clock;
-        dff_underflow__clock = clock;
-        read_address__d = read_address__q;
-        dff_underflow__d = dff_underflow__q;
-        ram_read_clock = clock;
-        is_empty = (read_address__q == write_address_delayed);
-        is_full = ~is_empty & ((read_address__q & fifo_address_mask) == (write_address_delayed & fifo_address_mask));
-        fill_level = ((write_address_delayed & fifo_address_mask) + fifo_size - (read_address__q & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_empty = (fill_level < block_size);
-        empty = is_empty;
-        ram_read_address = ((read_address__q & fifo_address_mask) & 5'h1f);
-        data_out = ram_read_data;
-        if (read & ~is_empty) begin
-            read_address__d = read_address__q + 32'h1;
-            ram_read_address = (((read_address__q + 32'h1) & fifo_address_mask) & 5'h1f);
-        end
-        else begin
-            read_address__d = read_address__q;
-        end
-        dff_underflow__d = dff_underflow__q | (is_empty & read);
-        underflow = dff_underflow__q;
-        read_address_out = read_address__q;
-    end
-    
-endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo__read_logic
-
-
-
-
-
-
-module dynrt_processor__engine__traversal_unit__leaf_fifo__write_logic(write,data_in,full,almost_full,overflow,clock,ram_write_address,ram_write_clock,ram_write_data,ram_write_enable,read_address,write_address_delayed,fill_level);
-    
-    // Module arguments
-    input wire  write;
-    input wire  [68:0] data_in;
-    output reg  full;
-    output reg  almost_full;
-    output reg  overflow;
-    input wire  clock;
-    output reg  [4:0] ram_write_address;
-    output reg  ram_write_clock;
-    output reg  [68:0] ram_write_data;
-    output reg  ram_write_enable;
-    input wire  [5:0] read_address;
-    output reg  [5:0] write_address_delayed;
-    output reg  [5:0] fill_level;
-    
-    // Constant declarations
-    localparam  fifo_address_mask = 6'b11111;
-    localparam  fifo_size = 6'b100000;
-    localparam  almost_full_level = 6'b11111;
-    
-    // Stub signals
-    reg  [5:0] write_address__d;
-    wire  [5:0] write_address__q;
-    reg  write_address__clock;
-    reg  [5:0] dff_write_address_delay__d;
-    wire  [5:0] dff_write_address_delay__q;
-    reg  dff_write_address_delay__clock;
-    reg  dff_overflow__d;
-    wire  dff_overflow__q;
-    reg  dff_overflow__clock;
-    
-    // Local signals
-    reg  is_empty;
-    reg  is_full;
-    
-    // Sub module instances
-    dynrt_processor__engine__mem_load_r write_address(
-        .d(write_address__d),
-        .q(write_address__q),
-        .clock(write_address__clock)
-    );
-    dynrt_processor__engine__mem_load_r dff_write_address_delay(
-        .d(dff_write_address_delay__d),
-        .q(dff_write_address_delay__q),
-        .clock(dff_write_address_delay__clock)
-    );
-    dynrt_processor__display__dark_d dff_overflow(
-        .d(dff_overflow__d),
-        .q(dff_overflow__q),
-        .clock(dff_overflow__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        dff_overflow__clock = clock;
-        write_address__clock = clock;
-        dff_write_address_delay__clock = clock;
-        dff_overflow__d = dff_overflow__q;
-        write_address__d = write_address__q;
-        dff_write_address_delay__d = dff_write_address_delay__q;
-        ram_write_clock = clock;
-        dff_write_address_delay__d = write_address__q;
-        write_address_delayed = dff_write_address_delay__q;
-        ram_write_enable = 1'b0;
-        is_empty = (read_address == dff_write_address_delay__q);
-        is_full = ~is_empty & ((read_address & fifo_address_mask) == (write_address__q & fifo_address_mask));
-        fill_level = ((dff_write_address_delay__q & fifo_address_mask) + fifo_size - (read_address & fifo_address_mask)) & fifo_address_mask;
-        if (is_full) begin
-            fill_level = fifo_size;
-        end
-        almost_full = (fill_level >= almost_full_level);
-        full = is_full;
-        ram_write_address = ((write_address__q & fifo_address_mask) & 5'h1f);
-        ram_write_data = data_in;
-        if (write & ~is_full) begin
-            write_address__d = write_address__q + 32'h1;
-            ram_write_enable = 1'b1;
-        end
-        else begin
-            write_address__d = write_address__q;
-            ram_write_enable = 1'b0;
-        end
-        dff_overflow__d = dff_overflow__q | (is_full & write);
-        overflow = dff_overflow__q;
-    end
-    
-endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo__write_logic
 
 
 
@@ -28598,12 +27462,6 @@ module dynrt_processor__engine__traversal_unit__leaf_sp(read_address,read_clock,
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__leaf_sp
-
-
-
-
-
-
 
 
 
