@@ -86,12 +86,14 @@ pub struct KdParams {
     pub split_format: Option<Format>,
     /// Node budget: a tree over `n` primitives gets at most `nodes_per_prim * n` nodes (at
     /// least 1). The builder makes the splits it would make without a budget, those that save
-    /// the most SAH cost first, while the budget pays for two more children. `None`: no budget
+    /// the most SAH cost first, while the budget pays for two more children (depth first
+    /// when the whole tree fits). `None`: no budget
     /// (the SAH, the leaf size cap and the depth limit alone decide). The default 3 keeps
     /// object trees within 3 nodes per triangle (the Stanford bunny took 19 without it).
     pub nodes_per_prim: Option<u32>,
-    /// With `split_format`: wrap the tree in planes at its primitives' bounds (rounded outward
-    /// into the format), each with an empty leaf outside, out of the node budget. The
+    /// With `split_format`: wrap the tree in planes just outside its primitives' bounds (the
+    /// format values next below and above them, so that no plane coincides with a
+    /// primitive), each with an empty leaf outside, out of the node budget. The
     /// hardware starts its walk with the whole ray, not clipped to the root box, so without
     /// them every leaf on the box's surface reaches to infinity for it: cornell's primary rays
     /// tested 14.3 triangles each in the golden model, 3.9 in the f64 reference that clips.

@@ -430,6 +430,27 @@ impl Format {
         }
     }
 
+    /// The largest format value < x (x finite): one representable step below
+    /// [`Format::round_down`] when that is `x` itself.
+    pub fn below(self, x: f64) -> f64 {
+        let v = self.round_down(x);
+        if v < x {
+            v
+        } else {
+            self.step(self.from_f64(v), false)
+        }
+    }
+
+    /// The smallest format value > x (x finite).
+    pub fn above(self, x: f64) -> f64 {
+        let v = self.round_up(x);
+        if v > x {
+            v
+        } else {
+            self.step(self.from_f64(v), true)
+        }
+    }
+
     /// The neighbour of word `w` towards +inf (`up`) or -inf.
     fn step(self, w: u32, up: bool) -> f64 {
         if self.is_zero(w) {
