@@ -230,6 +230,8 @@ fn build_in_order<P: KdPrimitives>(prims: &P, params: &KdParams, best_first_only
     } else {
         (Vec::new(), bounds)
     };
+    // What the planes kept cost (none when they were left out: the whole budget is the tree's).
+    let chain = 2 * clips.len() as u64;
     let mut node = 0;
     for &(axis, pos, empty_below) in &clips {
         let plane = Plane {
@@ -1225,9 +1227,30 @@ mod tests {
             );
             node = next;
         }
-        // Too small a budget for the planes: none.
+        // Too small a budget for the planes: none, and the tree gets the whole budget (the
+        // planes' cost was taken from it, 3 - 6 overflowed).
         let one = vec![tris[0]];
         assert_eq!(build_sah(&one, &clipped).nodes.len(), 1);
+        let two = vec![
+            [
+                DVec3::ZERO,
+                DVec3::new(1.0, 0.1, 0.2),
+                DVec3::new(0.1, 1.0, 0.3),
+            ],
+            [
+                DVec3::new(5.0, 5.0, 5.0),
+                DVec3::new(6.0, 5.1, 5.2),
+                DVec3::new(5.1, 6.0, 5.3),
+            ],
+        ];
+        let tree = build_sah(&two, &clipped);
+        tree.validate_against(&Triangles(&two)).unwrap();
+        let n = tree.nodes.len();
+        assert!(n > 1 && n <= 6, "{n} nodes: {tree:?}");
+        assert!(
+            !matches!(tree.nodes[0], KdNode::Inner { split, .. } if split < 0.0 || split > 6.0),
+            "no planes: {tree:?}"
+        );
     }
 
     /// Rounded split planes are scored with the counts of the rounded plane: the tree in e7m16
