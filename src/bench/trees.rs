@@ -10,16 +10,19 @@
 //!   through the reference renderer's two levels ([`Reference::primary_counts`]: nodes of the
 //!   top-level and object trees together); its nodes are those of its object trees (the
 //!   top-level tree is rebuilt per frame), in f64 and as the layout builds them (split planes
-//!   rounded into e7m16).
+//!   rounded into e7m16). The same primary rays are also traced by the golden model through
+//!   the layout ([`Golden::primary_ray`]): the nodes and triangle tests of the trees the
+//!   hardware walks, in its arithmetic (mailbox skips are not tests).
 
 use super::table::Table;
 use crate::accel::bench::{load_obj_triangles, random_rays_at};
 use crate::accel::kd_traversal::TraversalCounts;
 use crate::accel::kd_tree::{build_sah, KdParams, KdStats};
 use crate::fp::Format;
-use crate::layout::SceneTrees;
-use crate::model::Reference;
+use crate::layout::{MemoryConfig, SceneTrees};
+use crate::model::{Golden, Reference};
 use crate::scene::Scene;
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -39,6 +42,9 @@ pub struct TreeRow {
     pub nodes: usize,
     /// Object-tree nodes in the layout (e7m16 split planes), or why there is no layout.
     pub layout_nodes: Result<usize, String>,
+    /// The golden model's traversal work for the primary rays through the layout (scenes
+    /// only).
+    pub layout_counts: Option<TraversalCounts>,
     /// SAH cost of the largest object's tree.
     pub sah_cost: f64,
     /// Deepest object tree.
@@ -68,11 +74,40 @@ fn stem(path: &Path) -> String {
     )
 }
 
-/// Object-tree nodes of `scene`'s layout in `format`.
-fn layout_nodes(scene: &Scene, format: Format, params: &KdParams) -> Result<usize, String> {
-    SceneTrees::build_with(scene, format, params)
-        .map(|l| l.trees.iter().map(|t| t.nodes.len()).sum())
-        .map_err(|e| e.to_string())
+/// Object-tree nodes of `scene`'s layout in `format`, and the layout itself.
+fn layout_trees(
+    scene: &Scene,
+    format: Format,
+    params: &KdParams,
+) -> (Result<usize, String>, Option<SceneTrees>) {
+    match SceneTrees::build_with(scene, format, params) {
+        Ok(t) => (Ok(t.trees.iter().map(|t| t.nodes.len()).sum()), Some(t)),
+        Err(e) => (Err(e.to_string()), None),
+    }
+}
+
+/// The golden model's traversal work for frame 0's primary rays through the layout of
+/// `trees` (`None` if the layout cannot be built).
+fn golden_primary_counts(scene: &Scene, trees: &SceneTrees) -> Option<TraversalCounts> {
+    let layout = crate::layout::build(scene, trees, 0, &MemoryConfig::default()).ok()?;
+    let golden = Golden::new(&layout);
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    Some(
+        (0..w * h)
+            .into_par_iter()
+            .map(|i| {
+                let s = golden.primary_ray(i % w, i / w).stats;
+                TraversalCounts {
+                    rays: s.rays,
+                    nodes: s.traversal_steps + s.leaves,
+                    tests: s.triangle_tests,
+                }
+            })
+            .reduce(TraversalCounts::default, |mut a, b| {
+                a.add(&b);
+                a
+            }),
+    )
 }
 
 /// Measures one mesh under `params` (its layout's trees in `format`).
@@ -104,7 +139,8 @@ pub fn mesh_row(path: &Path, params: &KdParams, format: Format) -> anyhow::Resul
         budget: budget_name(params),
         triangles: tris.len(),
         nodes: s.nodes,
-        layout_nodes: layout_nodes(&scene, format, params),
+        layout_nodes: layout_trees(&scene, format, params).0,
+        layout_counts: None,
         sah_cost: s.sah_cost,
         depth: s.depth,
         references: s.references,
@@ -125,13 +161,15 @@ pub fn scene_row(path: &Path, params: &KdParams, format: Format) -> anyhow::Resu
     let largest = (0..trees.len())
         .max_by_key(|&i| trees[i].num_prims)
         .map_or(0.0, |i| stats[i].sah_cost);
+    let (layout_nodes, layout) = layout_trees(&scene, format, params);
     Ok(TreeRow {
         case: stem(path),
         kind: "scene",
         budget: budget_name(params),
         triangles: scene.triangle_count(),
         nodes: stats.iter().map(|s| s.nodes).sum(),
-        layout_nodes: layout_nodes(&scene, format, params),
+        layout_nodes,
+        layout_counts: layout.and_then(|t| golden_primary_counts(&scene, &t)),
         sah_cost: largest,
         depth: stats.iter().map(|s| s.depth).max().unwrap_or(0),
         references: stats.iter().map(|s| s.references).sum(),
@@ -188,6 +226,8 @@ pub fn trees_table(rows: &[TreeRow]) -> Table {
         "rays",
         "nodes per ray",
         "triangle tests per ray",
+        "layout nodes per ray",
+        "layout triangle tests per ray",
         "build ms",
     ]);
     for r in rows {
@@ -208,8 +248,71 @@ pub fn trees_table(rows: &[TreeRow]) -> Table {
             r.counts.rays.to_string(),
             format!("{:.2}", r.counts.nodes_per_ray()),
             format!("{:.2}", r.counts.tests_per_ray()),
+            r.layout_counts
+                .map_or("-".into(), |c| format!("{:.2}", c.nodes_per_ray())),
+            r.layout_counts
+                .map_or("-".into(), |c| format!("{:.2}", c.tests_per_ray())),
             format!("{:.1}", r.build_seconds * 1e3),
         ]);
     }
     t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(name: &str) -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(name)
+    }
+
+    /// Issue 20: the node budget may cost the bundled scenes' primary rays at most 10% more
+    /// nodes or triangle tests, in the f64 reference and in the golden model's walk of the
+    /// layout.
+    #[test]
+    fn the_budget_costs_small_scenes_at_most_ten_percent_per_ray() {
+        let budget = KdParams::default();
+        let free = KdParams {
+            nodes_per_prim: None,
+            ..budget.clone()
+        };
+        for name in ["cornell.toml", "mirror.toml", "dynamic.toml", "tiny.toml"] {
+            let [a, b] =
+                [&free, &budget].map(|p| scene_row(&scene(name), p, Format::E7M16).unwrap());
+            let (ga, gb) = (a.layout_counts.unwrap(), b.layout_counts.unwrap());
+            for (what, before, after) in [
+                (
+                    "f64 nodes",
+                    a.counts.nodes_per_ray(),
+                    b.counts.nodes_per_ray(),
+                ),
+                (
+                    "f64 tests",
+                    a.counts.tests_per_ray(),
+                    b.counts.tests_per_ray(),
+                ),
+                ("layout nodes", ga.nodes_per_ray(), gb.nodes_per_ray()),
+                ("layout tests", ga.tests_per_ray(), gb.tests_per_ray()),
+            ] {
+                assert!(after <= 1.1 * before, "{name} {what}: {before} -> {after}");
+            }
+        }
+    }
+
+    /// The layout's trees are wrapped in their bounds (`KdParams::root_clip`): without that,
+    /// the golden model's primary rays on cornell tested 14.3 triangles each against the
+    /// reference's 3.9, walking the leaves on the box's surface from the eye on.
+    #[test]
+    fn the_hardware_walk_of_cornell_stays_near_the_reference() {
+        let row = scene_row(&scene("cornell.toml"), &KdParams::default(), Format::E7M16).unwrap();
+        let golden = row.layout_counts.unwrap();
+        assert!(
+            golden.tests_per_ray() < 2.5 * row.counts.tests_per_ray(),
+            "{} tests per ray in the layout, {} in the reference",
+            golden.tests_per_ray(),
+            row.counts.tests_per_ray()
+        );
+    }
 }

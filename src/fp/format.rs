@@ -406,3 +406,59 @@ impl FromStr for Format {
         Format::parse(s)
     }
 }
+
+impl Format {
+    /// The largest format value <= x (x finite).
+    pub fn round_down(self, x: f64) -> f64 {
+        let w = self.from_f64(x);
+        let v = self.to_f64(w);
+        if v <= x {
+            v
+        } else {
+            self.step(w, false)
+        }
+    }
+
+    /// The smallest format value >= x (x finite).
+    pub fn round_up(self, x: f64) -> f64 {
+        let w = self.from_f64(x);
+        let v = self.to_f64(w);
+        if v >= x {
+            v
+        } else {
+            self.step(w, true)
+        }
+    }
+
+    /// The largest format value < x (x finite): one representable step below
+    /// [`Format::round_down`] when that is `x` itself.
+    pub fn below(self, x: f64) -> f64 {
+        let v = self.round_down(x);
+        if v < x {
+            v
+        } else {
+            self.step(self.from_f64(v), false)
+        }
+    }
+
+    /// The smallest format value > x (x finite).
+    pub fn above(self, x: f64) -> f64 {
+        let v = self.round_up(x);
+        if v > x {
+            v
+        } else {
+            self.step(self.from_f64(v), true)
+        }
+    }
+
+    /// The neighbour of word `w` towards +inf (`up`) or -inf.
+    fn step(self, w: u32, up: bool) -> f64 {
+        if self.is_zero(w) {
+            let m = self.to_f64(self.min_normal(false));
+            return if up { m } else { -m };
+        }
+        let away = up != self.sign_of(w); // moving away from zero grows the magnitude
+        let n = if away { w + 1 } else { w - 1 };
+        self.to_f64(if self.is_zero(n) { self.zero(false) } else { n })
+    }
+}

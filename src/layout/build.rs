@@ -201,6 +201,7 @@ impl SceneTrees {
         check_capacity(scene, &MemoryConfig::default())?;
         let params = KdParams {
             split_format: Some(format),
+            root_clip: true,
             ..params.clone()
         };
         let mut out = SceneTrees {
@@ -274,39 +275,6 @@ fn is_flat(t: &[DVec3; 3]) -> bool {
     (t[0] - t[2]).cross(t[1] - t[2]).length_squared() == 0.0
 }
 
-/// The largest format value <= x (x finite).
-fn round_down(f: Format, x: f64) -> f64 {
-    let w = f.from_f64(x);
-    let v = f.to_f64(w);
-    if v <= x {
-        v
-    } else {
-        step(f, w, false)
-    }
-}
-
-/// The smallest format value >= x (x finite).
-fn round_up(f: Format, x: f64) -> f64 {
-    let w = f.from_f64(x);
-    let v = f.to_f64(w);
-    if v >= x {
-        v
-    } else {
-        step(f, w, true)
-    }
-}
-
-/// The neighbour of word `w` towards +inf (`up`) or -inf.
-fn step(f: Format, w: u32, up: bool) -> f64 {
-    if f.is_zero(w) {
-        let m = f.to_f64(f.min_normal(false));
-        return if up { m } else { -m };
-    }
-    let away = up != f.sign_of(w); // moving away from zero grows the magnitude
-    let n = if away { w + 1 } else { w - 1 };
-    f.to_f64(if f.is_zero(n) { f.zero(false) } else { n })
-}
-
 /// An instance's world bounds rounded outward to format values, plus a margin of a few ulps
 /// so that rays transformed with rounding still find the instance where they hit it.
 fn instance_box(f: Format, local: &Aabb, to_world: &DAffine3) -> Aabb {
@@ -316,12 +284,8 @@ fn instance_box(f: Format, local: &Aabb, to_world: &DAffine3) -> Aabb {
     let lo = b.min - DVec3::splat(margin);
     let hi = b.max + DVec3::splat(margin);
     Aabb::new(
-        DVec3::new(
-            round_down(f, lo.x),
-            round_down(f, lo.y),
-            round_down(f, lo.z),
-        ),
-        DVec3::new(round_up(f, hi.x), round_up(f, hi.y), round_up(f, hi.z)),
+        DVec3::new(f.round_down(lo.x), f.round_down(lo.y), f.round_down(lo.z)),
+        DVec3::new(f.round_up(hi.x), f.round_up(hi.y), f.round_up(hi.z)),
     )
 }
 
@@ -1075,13 +1039,13 @@ scale = [0.5, 0.5, 0.5]
         }
         assert!(r.min.max_element() < 0.1 && r.max.min_element() > 0.3);
         assert_eq!(
-            round_down(f, 0.1),
-            f.to_f64(f.from_f64(0.1)).min(round_down(f, 0.1))
+            f.round_down(0.1),
+            f.to_f64(f.from_f64(0.1)).min(f.round_down(0.1))
         );
         assert!(
-            round_down(f, 0.1) <= 0.1
-                && round_up(f, 0.1) >= 0.1
-                && round_up(f, 0.1) > round_down(f, 0.1)
+            f.round_down(0.1) <= 0.1
+                && f.round_up(0.1) >= 0.1
+                && f.round_up(0.1) > f.round_down(0.1)
         );
     }
 }

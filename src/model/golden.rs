@@ -152,30 +152,42 @@ impl<'a> Golden<'a> {
         self.layout.words::<N>(FRAME, addr)
     }
 
-    /// Renders pixel (x, y).
-    pub fn pixel(&self, x: u32, y: u32) -> Pixel {
+    /// The primary ray of pixel (x, y), counted in `stats`.
+    fn primary_query(&self, x: u32, y: u32, stats: &mut RayStats) -> Query {
         let f = self.f;
         let camera = self.frame_words::<12>(FrameMap::CAMERA);
-        let eye = self.frame_words::<3>(FrameMap::EYE);
-        let mut stats = RayStats::default();
-        let dir = units::primary_direction(f, &camera, x, y);
         stats.transforms += 1;
-        let query = Query {
-            o: eye,
-            d: dir,
+        Query {
+            o: self.frame_words::<3>(FrameMap::EYE),
+            d: units::primary_direction(f, &camera, x, y),
             t_min: 0,
             t_max: f.infinity(false),
             skip: None,
             any: false,
-        };
+        }
+    }
+
+    /// Renders pixel (x, y).
+    pub fn pixel(&self, x: u32, y: u32) -> Pixel {
+        let mut stats = RayStats::default();
+        let query = self.primary_query(x, y, &mut stats);
         let (color, hit) = self.shade(query, 0, &mut stats);
         Pixel {
-            rgb: units::pack_rgb(f, color),
+            rgb: units::pack_rgb(self.f, color),
             color,
-            dir,
+            dir: query.d,
             hit,
             stats,
         }
+    }
+
+    /// Traces only the primary ray of pixel (x, y) (closest hit, no shading): the traversal
+    /// work that the tree's shape decides.
+    pub fn primary_ray(&self, x: u32, y: u32) -> RayResult {
+        let mut stats = RayStats::default();
+        let query = self.primary_query(x, y, &mut stats);
+        let hit = self.trace(query, &mut stats);
+        RayResult { hit, stats }
     }
 
     /// Traces a ray and shades what it hits; returns the colour and the hit.

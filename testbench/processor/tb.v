@@ -41,7 +41,7 @@ module tb;
   string mem_dir, out_dir;
   reg [63:0] clocks = 0, heartbeat = 0;
   integer frame = 0, rays = 0;
-  reg [31:0] bank0 [0:93]; // nodes
+  reg [31:0] bank0 [0:117]; // nodes
   reg [31:0] bank1 [0:104]; // lists
   reg [31:0] bank2 [0:239]; // triangles_uv
   reg [31:0] bank3 [0:239]; // triangles_t
@@ -109,7 +109,7 @@ module tb;
       3'd5: rd[0] <= (mem_addr < 3118) ? bank5[mem_addr] : 32'hdeadbeef;
       default: rd[0] <= 32'hdeadbeef; // banks 0, 2 and 3 have their own ports
     endcase
-    rd0[0] <= (bank0_addr < 94) ? bank0[bank0_addr] : 32'hdeadbeef;
+    rd0[0] <= (bank0_addr < 118) ? bank0[bank0_addr] : 32'hdeadbeef;
     rd2[0] <= (bank2_addr < 240) ? bank2[bank2_addr] : 32'hdeadbeef;
     rd3[0] <= (bank3_addr < 240) ? bank3[bank3_addr] : 32'hdeadbeef;
     for (k = 1; k < 2; k = k + 1) begin
@@ -137,9 +137,9 @@ module tb;
     @(negedge clock) start = 1'b1;
     @(negedge clock) start = 1'b0;
     n = 0;
-    while (!done && n < 2276010) begin @(posedge clock); n = n + 1; end
+    while (!done && n < 2002940) begin @(posedge clock); n = n + 1; end
     if (!done) begin
-      $display("TIMEOUT: frame 0 not done after 2276010 clocks");
+      $display("TIMEOUT: frame 0 not done after 2002940 clocks");
       $fatal(1, "timeout");
     end
     fd = $fopen({out_dir, "/frame0.hex"}, "w");
