@@ -465,7 +465,12 @@ pub fn run(o: &Options, out: &Path, clock_mhz: f64, clock_source: &str) -> Resul
     let mut scenes = Vec::new();
     for r in &rows {
         let path = o.scenes.join(format!("{}.toml", r.file));
-        if !path.exists() {
+        let there = if crate::bundled::is_bundled(&path) {
+            crate::bundled::is_file(&path)
+        } else {
+            path.exists()
+        };
+        if !there {
             anyhow::bail!(
                 "{}: missing; write the suite's scene files with `dynrt paper-scenes --out {}`",
                 path.display(),
