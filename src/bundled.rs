@@ -204,13 +204,20 @@ mod tests {
         let bundled: Vec<String> = FILES.iter().map(|(f, _)| f.to_string()).collect();
         assert_eq!(bundled, on_disk, "update bundled::FILES");
         for (f, bytes) in FILES {
-            assert_eq!(*bytes, std::fs::read(root.join(f)).unwrap().as_slice(), "{f}");
+            assert_eq!(
+                *bytes,
+                std::fs::read(root.join(f)).unwrap().as_slice(),
+                "{f}"
+            );
         }
     }
 
     #[test]
     fn bundled_paths_resolve_like_files() {
-        assert_eq!(name_of(Path::new("bundled:tiny.toml")).unwrap(), "tiny.toml");
+        assert_eq!(
+            name_of(Path::new("bundled:tiny.toml")).unwrap(),
+            "tiny.toml"
+        );
         assert_eq!(
             canonical(Path::new("bundled:./paper/../tiny.toml")),
             Path::new("bundled:/tiny.toml")

@@ -700,9 +700,15 @@ fn dynrt_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
 /// A temporary folder that is not inside the repository (so no `scenes/` is at hand).
 fn outside_dir() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
-    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).canonicalize().unwrap();
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .canonicalize()
+        .unwrap();
     let here = dir.path().canonicalize().unwrap();
-    assert!(!here.starts_with(&repo), "{} is in the repository", here.display());
+    assert!(
+        !here.starts_with(&repo),
+        "{} is in the repository",
+        here.display()
+    );
     assert!(!here.join("scenes").exists());
     dir
 }
@@ -722,7 +728,17 @@ fn outside_the_repository_bench_measures_the_bundled_scenes_and_prints_json() {
     let dir = outside_dir();
     let (code, out, err) = dynrt_in(
         dir.path(),
-        &["bench", "scenes", "--formats", "e7m16", "--size", "8x6", "--out", "b", "--json"],
+        &[
+            "bench",
+            "scenes",
+            "--formats",
+            "e7m16",
+            "--size",
+            "8x6",
+            "--out",
+            "b",
+            "--json",
+        ],
     );
     assert_eq!(code, 0, "{err}");
     let j = json_doc(&out);
@@ -772,30 +788,61 @@ fn outside_the_repository_bench_measures_the_bundled_scenes_and_prints_json() {
     let (code, out, err) = dynrt_in(
         dir.path(),
         &[
-            "bench", "scenes", "--formats", "e7m16,e8m23", "--size", "8x6", "--scenes-dir", "s",
-            "--out", "b2", "--json",
+            "bench",
+            "scenes",
+            "--formats",
+            "e7m16,e8m23",
+            "--size",
+            "8x6",
+            "--scenes-dir",
+            "s",
+            "--out",
+            "b2",
+            "--json",
         ],
     );
     assert_eq!(code, 0, "{err}");
     let j = json_doc(&out);
     let rows = j["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 2, "{j}");
-    assert!(rows.iter().all(|r| r["scene"] == "tiny" && r["triangles"] == 40));
-    assert_eq!(j["options"]["formats"], serde_json::json!(["e7m16", "e8m23"]));
+    assert!(rows
+        .iter()
+        .all(|r| r["scene"] == "tiny" && r["triangles"] == 40));
+    assert_eq!(
+        j["options"]["formats"],
+        serde_json::json!(["e7m16", "e8m23"])
+    );
     // Without --json: the table on stdout.
     let (code, out, err) = dynrt_in(
         dir.path(),
-        &["bench", "scenes", "--formats", "e7m16", "--size", "8x6", "--scenes-dir", "s", "--out", "b3"],
+        &[
+            "bench",
+            "scenes",
+            "--formats",
+            "e7m16",
+            "--size",
+            "8x6",
+            "--scenes-dir",
+            "s",
+            "--out",
+            "b3",
+        ],
     );
     assert_eq!(code, 0, "{err}");
-    assert!(out.contains("| tiny") && out.contains("written to b3"), "{out}");
+    assert!(
+        out.contains("| tiny") && out.contains("written to b3"),
+        "{out}"
+    );
     // A --scenes-dir that is not a folder: a usage error that names it.
     let (code, _, err) = dynrt_in(
         dir.path(),
         &["bench", "scenes", "--scenes-dir", "none", "--out", "b4"],
     );
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("--scenes-dir") && err.contains("'none'"), "{err}");
+    assert!(
+        err.contains("--scenes-dir") && err.contains("'none'"),
+        "{err}"
+    );
     assert!(!dir.path().join("b4").exists());
 }
 
@@ -807,13 +854,24 @@ fn bundled_scenes_are_listed_exported_and_rendered_by_name_with_json() {
     let dir = outside_dir();
     let (code, out, err) = dynrt_in(dir.path(), &["scenes", "list"]);
     assert_eq!(code, 0, "{err}");
-    for f in ["bundled:/cornell.toml", "bundled:/tiny.toml", "bundled:/meshes/pyramid.obj", "bundled:/paper/castle.toml"] {
+    for f in [
+        "bundled:/cornell.toml",
+        "bundled:/tiny.toml",
+        "bundled:/meshes/pyramid.obj",
+        "bundled:/paper/castle.toml",
+    ] {
         assert!(out.lines().any(|l| l == f), "{f} not in:\n{out}");
     }
     let (code, out, err) = dynrt_in(dir.path(), &["scenes", "export", "mine"]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("mine"), "{out}");
-    for f in ["tiny.toml", "cornell.toml", "meshes/pyramid.obj", "meshes/pyramid.mtl", "paper/scene6.toml"] {
+    for f in [
+        "tiny.toml",
+        "cornell.toml",
+        "meshes/pyramid.obj",
+        "meshes/pyramid.mtl",
+        "paper/scene6.toml",
+    ] {
         assert_eq!(
             std::fs::read(dir.path().join("mine").join(f)).unwrap(),
             std::fs::read(scene(f)).unwrap(),
@@ -825,29 +883,52 @@ fn bundled_scenes_are_listed_exported_and_rendered_by_name_with_json() {
     let (code, _, err) = dynrt_in(dir.path(), &["scenes", "export", "mine"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("tiny.toml") || err.contains("exists"), "{err}");
-    assert_eq!(std::fs::read_to_string(dir.path().join("mine/tiny.toml")).unwrap(), "edited");
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("mine/tiny.toml")).unwrap(),
+        "edited"
+    );
 
     // render of a bundled scene by name, as one JSON document.
     let (code, out, err) = dynrt_in(
         dir.path(),
-        &["render", "bundled:tiny.toml", "--size", "8x6", "--out", "r", "--hits", "--json"],
+        &[
+            "render",
+            "bundled:tiny.toml",
+            "--size",
+            "8x6",
+            "--out",
+            "r",
+            "--hits",
+            "--json",
+        ],
     );
     assert_eq!(code, 0, "{err}");
     let j = json_doc(&out);
     assert_eq!(j["verb"], "render");
     assert_eq!(j["scene"], "bundled:/tiny.toml");
-    assert_eq!((j["width"].as_u64(), j["height"].as_u64()), (Some(8), Some(6)));
+    assert_eq!(
+        (j["width"].as_u64(), j["height"].as_u64()),
+        (Some(8), Some(6))
+    );
     assert_eq!(j["pixels"], 48);
-    assert_eq!((j["model"].as_str(), j["format"].as_str()), (Some("golden"), Some("e7m16")));
+    assert_eq!(
+        (j["model"].as_str(), j["format"].as_str()),
+        (Some("golden"), Some("e7m16"))
+    );
     let hits = j["primary_hits"].as_u64().unwrap();
     assert!(hits > 0 && hits <= 48, "{j}");
-    assert_eq!(j["files"], serde_json::json!(["r/frame0.png", "r/hits0.csv"]));
+    assert_eq!(
+        j["files"],
+        serde_json::json!(["r/frame0.png", "r/hits0.csv"])
+    );
     assert!(dir.path().join("r/frame0.png").is_file());
     // A bundled name that is not bundled.
     let (code, _, err) = dynrt_in(dir.path(), &["render", "bundled:/nope.toml", "--out", "n"]);
     assert_eq!(code, 2, "{err}");
     assert!(
-        err.contains("bundled:/nope.toml") && err.contains("tiny.toml") && err.contains("not bundled"),
+        err.contains("bundled:/nope.toml")
+            && err.contains("tiny.toml")
+            && err.contains("not bundled"),
         "{err}"
     );
 }
@@ -860,7 +941,16 @@ fn outside_the_repository_demo_runs_the_bundled_cornell_box_and_prints_json() {
     let dir = outside_dir();
     let (code, out, err) = dynrt_in(
         dir.path(),
-        &["demo", "--size", "2x2", "--vectors", "0", "--out", "d", "--json"],
+        &[
+            "demo",
+            "--size",
+            "2x2",
+            "--vectors",
+            "0",
+            "--out",
+            "d",
+            "--json",
+        ],
     );
     assert_eq!(code, 0, "{err}\n{out}");
     let j = json_doc(&out);
@@ -869,7 +959,10 @@ fn outside_the_repository_demo_runs_the_bundled_cornell_box_and_prints_json() {
     assert_eq!(j["scene"]["name"], "cornell");
     assert_eq!(j["scene"]["path"], "bundled:/cornell.toml");
     assert_eq!(j["scene"]["triangles"], 30);
-    assert_eq!((j["scene"]["width"].as_u64(), j["scene"]["height"].as_u64()), (Some(2), Some(2)));
+    assert_eq!(
+        (j["scene"]["width"].as_u64(), j["scene"]["height"].as_u64()),
+        (Some(2), Some(2))
+    );
     assert_eq!(j["options"]["size"], "2x2");
     // Eight FP operators (add, sub, mul, div, sqrt, lt, le, eq) in two simulators, and the
     // processor's frame in each.
@@ -878,7 +971,9 @@ fn outside_the_repository_demo_runs_the_bundled_cornell_box_and_prints_json() {
     assert!(checks.iter().all(|c| c["pass"] == true), "{j}");
     let frames = j["frames"].as_array().unwrap();
     assert_eq!(frames.len(), 2, "{j}");
-    assert!(frames.iter().all(|f| f["differing_pixels"] == 0 && f["cycles"].as_u64().unwrap() > 0));
+    assert!(frames
+        .iter()
+        .all(|f| f["differing_pixels"] == 0 && f["cycles"].as_u64().unwrap() > 0));
     let on_disk: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("d/summary.json")).unwrap())
             .unwrap();

@@ -305,8 +305,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
                 scenes
             };
             let meshes = meshes.unwrap_or_else(dynrt::scene::shared_mesh_dir);
-            let measured =
-                bench::trees::bench_trees(&bench::trees::mesh_files(&meshes)?, &scenes)?;
+            let measured = bench::trees::bench_trees(&bench::trees::mesh_files(&meshes)?, &scenes)?;
             let t = bench::trees::trees_table(&measured);
             t.save(&a.out, "trees")?;
             say(json, t.to_markdown().trim_end());
