@@ -777,6 +777,36 @@ fn outside_the_repository_bench_measures_the_bundled_scenes_and_prints_json() {
     assert_eq!(csv.lines().count(), 1 + 8, "{csv}");
     assert!(!out.contains("written to"), "{out}");
 
+    // bench precision on the bundled scenes, with the bundled operator cost cache (no yosys
+    // run): every format with hardware, each over the eight scenes.
+    let (code, out, err) = dynrt_in(
+        dir.path(),
+        &[
+            "bench",
+            "precision",
+            "--size",
+            "8x6",
+            "--out",
+            "p",
+            "--json",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let j = json_doc(&out);
+    assert_eq!(j["verb"], "bench precision");
+    assert_eq!(j["options"]["scenes_dir"], "bundled:/");
+    let rows = j["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 13, "{j}");
+    assert!(
+        rows.iter()
+            .all(|r| r["scenes"] == 8 && r["pixels"] == 8 * 6 * 8),
+        "{j}"
+    );
+    let e7m16 = rows.iter().find(|r| r["format"] == "e7m16").unwrap();
+    assert!(e7m16["datapath_luts"].as_u64().unwrap() > 0, "{e7m16}");
+    assert!(!err.contains("synthesized"), "{err}");
+    assert!(dir.path().join("p/summary.json").is_file());
+
     // --scenes-dir overrides the bundled scenes: a folder with tiny alone.
     let scenes = dir.path().join("s");
     std::fs::create_dir_all(scenes.join("meshes")).unwrap();
