@@ -266,6 +266,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
                 resolution,
                 sim_resolution: sim_resolution.or(resolution),
                 sim: !no_sim,
+                stdout: !json,
             };
             let (md, differs) = bench::paper::run(&o, &a.out, mhz, &clock_source)?;
             s.option("scenes", &scenes)
