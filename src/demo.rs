@@ -16,7 +16,7 @@ use crate::scene::Scene;
 use crate::sim::{self, run_fp_unit, Simulator};
 use anyhow::Context;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 pub struct DemoConfig {
@@ -25,6 +25,9 @@ pub struct DemoConfig {
     pub out: PathBuf,
     /// Random vectors per operator and simulator (edge cases come on top).
     pub vectors: usize,
+    /// Frame size of the whole run (the scene's own when `None`); the small Icarus frame is
+    /// 4x3 or this, whichever is smaller.
+    pub size: Option<(u32, u32)>,
     /// The header of the generated files and the report.
     pub generated_by: crate::provenance::GeneratedBy,
 }
@@ -34,11 +37,16 @@ pub struct DemoReport {
     pub ok: bool,
     pub report: PathBuf,
     pub summary: String,
+    /// The run's summary.json.
+    pub json: String,
 }
 
 pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
     crate::output::check_output_dir(&c.out, "--out")?;
-    let scene = Scene::load(&c.scene)?;
+    let mut scene = Scene::load(&c.scene)?;
+    if let Some((w, h)) = c.size {
+        scene.set_resolution(w, h)?;
+    }
     let params = crate::emit::processor::ProcessorParams::default();
     crate::flow::preflight(&scene, c.format, params, None)?;
     let out_dir = crate::output::OutputDir::create(&c.out, "--out")?;
@@ -51,7 +59,8 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
     summary.scene = Some(SceneInfo::of(&scene, &name));
     summary
         .option("format", c.format.to_string())
-        .option("vectors", c.vectors);
+        .option("vectors", c.vectors)
+        .option("size", c.size.map(|(w, h)| format!("{w}x{h}")));
     let mut md = String::new();
     writeln!(md, "## Scene {}\n", c.scene.display())?;
     writeln!(
@@ -212,7 +221,7 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
         "| simulator | pixels | frames | cycles (frame 0) | cycles per primary ray | fps at 90 MHz | fps at 512x384 | sim cycles/s | differing pixels |\n|---|---|---|---|---|---|---|---|---|"
     )?;
     let mut small = scene.clone();
-    small.set_resolution(4, 3)?;
+    small.set_resolution(scene.camera.width.min(4), scene.camera.height.min(3))?;
     let mut processor_ok = true;
     for (simulator, sc, dir) in [
         (Simulator::Verilator, &scene, "sim_verilator"),
@@ -266,6 +275,7 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
     ));
     summary.details_md = md;
     summary.write(&c.out, true)?;
+    let json = summary.json();
     let report = c.out.join(crate::report::REPORT_MD);
     out_dir.keep();
     let summary = format!(
@@ -280,10 +290,12 @@ pub fn run_demo(c: &DemoConfig) -> anyhow::Result<DemoReport> {
         ok,
         report,
         summary,
+        json,
     })
 }
 
-/// The bundled default scene, relative to the repository root.
-pub fn default_scene() -> &'static Path {
-    Path::new("scenes/cornell.toml")
+/// The default scene: the Cornell box bundled with the binary (`bundled:/cornell.toml`), so
+/// that `dynrt demo` runs from any folder.
+pub fn default_scene() -> PathBuf {
+    crate::bundled::path("cornell.toml")
 }

@@ -52,6 +52,12 @@ pub enum InputError {
         path: PathBuf,
         offset: usize,
     },
+    #[error("{what} '{path}' is not bundled with dynrt; the bundled scenes are {known} (`dynrt scenes list` names every bundled file)")]
+    NotBundled {
+        what: String,
+        path: PathBuf,
+        known: String,
+    },
     #[error("{what} '{path}' cannot be read: {source}; check the path and permissions")]
     Io {
         what: String,
@@ -83,8 +89,25 @@ pub(crate) fn kind_name(t: std::fs::FileType) -> &'static str {
 }
 
 /// The bytes of the regular file `path`, at most `cap` of them; `what` names the file's role
-/// ("scene file", "mesh", ...) in errors.
+/// ("scene file", "mesh", ...) in errors. A bundled path (`bundled:/tiny.toml`, see
+/// [`crate::bundled`]) is served from the binary, under the same cap.
 pub fn read_bytes(path: &Path, what: &str, cap: u64) -> Result<Vec<u8>, InputError> {
+    if crate::bundled::is_bundled(path) {
+        let bytes = crate::bundled::contents(path).ok_or_else(|| InputError::NotBundled {
+            what: what.to_string(),
+            path: path.to_path_buf(),
+            known: crate::bundled::scene_names().join(", "),
+        })?;
+        if bytes.len() as u64 > cap {
+            return Err(InputError::TooLarge {
+                what: what.to_string(),
+                path: path.to_path_buf(),
+                size: bytes.len() as u64,
+                cap,
+            });
+        }
+        return Ok(bytes.to_vec());
+    }
     let io = |source: std::io::Error| InputError::Io {
         what: what.to_string(),
         path: path.to_path_buf(),

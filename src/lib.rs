@@ -15,6 +15,7 @@
 
 pub mod accel;
 pub mod bench;
+pub mod bundled;
 pub mod compare;
 pub mod demo;
 pub mod emit;

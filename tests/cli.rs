@@ -683,50 +683,331 @@ fn stress_writes_its_table_and_a_summary_into_its_folder() {
     assert!(out.join("report.md").is_file() && out.join("summary.json").is_file());
 }
 
-/// `dynrt bench scenes` leaves summary.json and report.md beside its tables, naming them.
-#[test]
-fn outside_the_repository_bench_takes_scenes_dir_and_demo_asks_for_a_scene() {
+/// `dynrt` run from `dir` (a folder outside the repository): status, stdout, stderr.
+fn dynrt_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_dynrt"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("run dynrt");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A temporary folder that is not inside the repository (so no `scenes/` is at hand).
+fn outside_dir() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .canonicalize()
+        .unwrap();
+    let here = dir.path().canonicalize().unwrap();
+    assert!(
+        !here.starts_with(&repo),
+        "{} is in the repository",
+        here.display()
+    );
+    assert!(!here.join("scenes").exists());
+    dir
+}
+
+/// stdout as the one JSON document `--json` prints (nothing else may be on stdout).
+fn json_doc(stdout: &str) -> serde_json::Value {
+    serde_json::from_str(stdout)
+        .unwrap_or_else(|e| panic!("stdout is not one JSON document ({e}):\n{stdout}"))
+}
+
+/// Outside the repository, with no scenes folder: `bench scenes` measures the scenes bundled
+/// with the binary (tiny's OBJ pyramid included), `--json` prints its summary with the table's
+/// rows, `--scenes-dir` still names another folder, and a folder that is not one is a usage
+/// error.
+#[test]
+fn outside_the_repository_bench_measures_the_bundled_scenes_and_prints_json() {
+    let dir = outside_dir();
+    let (code, out, err) = dynrt_in(
+        dir.path(),
+        &[
+            "bench",
+            "scenes",
+            "--formats",
+            "e7m16",
+            "--size",
+            "8x6",
+            "--out",
+            "b",
+            "--json",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let j = json_doc(&out);
+    assert_eq!(j["verb"], "bench scenes");
+    assert_eq!(j["pass"], true);
+    let rows = j["rows"].as_array().unwrap();
+    let mut names: Vec<&str> = rows.iter().map(|r| r["scene"].as_str().unwrap()).collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "cornell",
+            "cornell_noshadow",
+            "dynamic",
+            "mirror",
+            "terrain",
+            "terrain_small",
+            "tiny",
+            "tiny_animated"
+        ]
+    );
+    let tiny = rows.iter().find(|r| r["scene"] == "tiny").unwrap();
+    // The pyramid mesh of tiny.toml is bundled too: 40 triangles in 4 instances.
+    assert_eq!(tiny["triangles"], 40, "{tiny}");
+    assert_eq!(tiny["instances"], 4, "{tiny}");
+    assert_eq!(tiny["format"], "e7m16");
+    assert_eq!(tiny["resolution"], "8x6");
+    let terrain = rows.iter().find(|r| r["scene"] == "terrain").unwrap();
+    assert_eq!(terrain["triangles"], 131_072, "{terrain}");
+    assert!(j["options"]["scenes"]
+        .as_array()
+        .unwrap()
+        .contains(&serde_json::json!("bundled:/tiny.toml")));
+    // The table is written as well, and --json printed nothing else on stdout.
+    let csv = std::fs::read_to_string(dir.path().join("b/scenes.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 8, "{csv}");
+    assert!(!out.contains("written to"), "{out}");
+
+    // bench precision on the bundled scenes, with the bundled operator cost cache (no yosys
+    // run): every format with hardware, each over the eight scenes.
+    let (code, out, err) = dynrt_in(
+        dir.path(),
+        &[
+            "bench",
+            "precision",
+            "--size",
+            "8x6",
+            "--out",
+            "p",
+            "--json",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let j = json_doc(&out);
+    assert_eq!(j["verb"], "bench precision");
+    assert_eq!(j["options"]["scenes_dir"], "bundled:/");
+    let rows = j["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 13, "{j}");
+    assert!(
+        rows.iter()
+            .all(|r| r["scenes"] == 8 && r["pixels"] == 8 * 6 * 8),
+        "{j}"
+    );
+    let e7m16 = rows.iter().find(|r| r["format"] == "e7m16").unwrap();
+    assert!(e7m16["datapath_luts"].as_u64().unwrap() > 0, "{e7m16}");
+    assert!(!err.contains("synthesized"), "{err}");
+    assert!(dir.path().join("p/summary.json").is_file());
+
+    // --scenes-dir overrides the bundled scenes: a folder with tiny alone.
     let scenes = dir.path().join("s");
-    std::fs::create_dir(&scenes).unwrap();
-    std::fs::create_dir(scenes.join("meshes")).unwrap();
+    std::fs::create_dir_all(scenes.join("meshes")).unwrap();
     std::fs::copy(scene("tiny.toml"), scenes.join("tiny.toml")).unwrap();
     for mesh in ["pyramid.obj", "pyramid.mtl"] {
         let to = scenes.join("meshes").join(mesh);
         std::fs::copy(scene(&format!("meshes/{mesh}")), to).unwrap();
     }
-    let run = |scenes_dir: &Path| {
-        Command::new(env!("CARGO_BIN_EXE_dynrt"))
-            .current_dir(dir.path())
-            .args(["bench", "scenes", "--formats", "e7m16", "--size", "8x6"])
-            .arg("--scenes-dir")
-            .arg(scenes_dir)
-            .args(["--out", "b"])
-            .output()
-            .unwrap()
-    };
-    let o = run(&scenes);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let csv = std::fs::read_to_string(dir.path().join("b/scenes.csv")).unwrap();
-    assert!(csv.contains("tiny"), "{csv}");
-    // Outside the repository without --scenes-dir: a usage error that says what to give.
-    let o = run(&dir.path().join("none"));
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let (code, out, err) = dynrt_in(
+        dir.path(),
+        &[
+            "bench",
+            "scenes",
+            "--formats",
+            "e7m16,e8m23",
+            "--size",
+            "8x6",
+            "--scenes-dir",
+            "s",
+            "--out",
+            "b2",
+            "--json",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let j = json_doc(&out);
+    let rows = j["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2, "{j}");
+    assert!(rows
+        .iter()
+        .all(|r| r["scene"] == "tiny" && r["triangles"] == 40));
+    assert_eq!(
+        j["options"]["formats"],
+        serde_json::json!(["e7m16", "e8m23"])
+    );
+    // Without --json: the table on stdout.
+    let (code, out, err) = dynrt_in(
+        dir.path(),
+        &[
+            "bench",
+            "scenes",
+            "--formats",
+            "e7m16",
+            "--size",
+            "8x6",
+            "--scenes-dir",
+            "s",
+            "--out",
+            "b3",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
     assert!(
-        err.contains("--scenes-dir") && err.contains("none"),
+        out.contains("| tiny") && out.contains("written to b3"),
+        "{out}"
+    );
+    // A --scenes-dir that is not a folder: a usage error that names it.
+    let (code, _, err) = dynrt_in(
+        dir.path(),
+        &["bench", "scenes", "--scenes-dir", "none", "--out", "b4"],
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("--scenes-dir") && err.contains("'none'"),
         "{err}"
     );
-    // demo's default scene is the repository's too: elsewhere it asks for a scene file.
-    let o = Command::new(env!("CARGO_BIN_EXE_dynrt"))
-        .current_dir(dir.path())
-        .args(["demo", "--out", "d"])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("give a scene file"), "{err}");
-    assert!(!dir.path().join("d").exists());
+    assert!(!dir.path().join("b4").exists());
+}
+
+/// The bundled scenes are files again with `dynrt scenes export`, listed by `dynrt scenes
+/// list`, and usable by name anywhere a scene file is (`bundled:NAME`); a name that is not
+/// bundled is an error that names it and the bundled scenes.
+#[test]
+fn bundled_scenes_are_listed_exported_and_rendered_by_name_with_json() {
+    let dir = outside_dir();
+    let (code, out, err) = dynrt_in(dir.path(), &["scenes", "list"]);
+    assert_eq!(code, 0, "{err}");
+    for f in [
+        "bundled:/cornell.toml",
+        "bundled:/tiny.toml",
+        "bundled:/meshes/pyramid.obj",
+        "bundled:/paper/castle.toml",
+    ] {
+        assert!(out.lines().any(|l| l == f), "{f} not in:\n{out}");
+    }
+    let (code, out, err) = dynrt_in(dir.path(), &["scenes", "export", "mine"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("mine"), "{out}");
+    for f in [
+        "tiny.toml",
+        "cornell.toml",
+        "meshes/pyramid.obj",
+        "meshes/pyramid.mtl",
+        "paper/scene6.toml",
+    ] {
+        assert_eq!(
+            std::fs::read(dir.path().join("mine").join(f)).unwrap(),
+            std::fs::read(scene(f)).unwrap(),
+            "{f}"
+        );
+    }
+    // Nothing is overwritten.
+    std::fs::write(dir.path().join("mine/tiny.toml"), "edited").unwrap();
+    let (code, _, err) = dynrt_in(dir.path(), &["scenes", "export", "mine"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("tiny.toml") || err.contains("exists"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("mine/tiny.toml")).unwrap(),
+        "edited"
+    );
+
+    // render of a bundled scene by name, as one JSON document.
+    let (code, out, err) = dynrt_in(
+        dir.path(),
+        &[
+            "render",
+            "bundled:tiny.toml",
+            "--size",
+            "8x6",
+            "--out",
+            "r",
+            "--hits",
+            "--json",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let j = json_doc(&out);
+    assert_eq!(j["verb"], "render");
+    assert_eq!(j["scene"], "bundled:/tiny.toml");
+    assert_eq!(
+        (j["width"].as_u64(), j["height"].as_u64()),
+        (Some(8), Some(6))
+    );
+    assert_eq!(j["pixels"], 48);
+    assert_eq!(
+        (j["model"].as_str(), j["format"].as_str()),
+        (Some("golden"), Some("e7m16"))
+    );
+    let hits = j["primary_hits"].as_u64().unwrap();
+    assert!(hits > 0 && hits <= 48, "{j}");
+    assert_eq!(
+        j["files"],
+        serde_json::json!(["r/frame0.png", "r/hits0.csv"])
+    );
+    assert!(dir.path().join("r/frame0.png").is_file());
+    // A bundled name that is not bundled.
+    let (code, _, err) = dynrt_in(dir.path(), &["render", "bundled:/nope.toml", "--out", "n"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("bundled:/nope.toml")
+            && err.contains("tiny.toml")
+            && err.contains("not bundled"),
+        "{err}"
+    );
+}
+
+/// `dynrt demo` with no scene argument, outside the repository: the bundled Cornell box,
+/// every check run and passed (at 2x2 pixels, edge-case vectors only, to stay short), and
+/// `--json` prints the run's summary.json alone on stdout.
+#[test]
+fn outside_the_repository_demo_runs_the_bundled_cornell_box_and_prints_json() {
+    let dir = outside_dir();
+    let (code, out, err) = dynrt_in(
+        dir.path(),
+        &[
+            "demo",
+            "--size",
+            "2x2",
+            "--vectors",
+            "0",
+            "--out",
+            "d",
+            "--json",
+        ],
+    );
+    assert_eq!(code, 0, "{err}\n{out}");
+    let j = json_doc(&out);
+    assert_eq!(j["verb"], "demo");
+    assert_eq!(j["pass"], true, "{j}");
+    assert_eq!(j["scene"]["name"], "cornell");
+    assert_eq!(j["scene"]["path"], "bundled:/cornell.toml");
+    assert_eq!(j["scene"]["triangles"], 30);
+    assert_eq!(
+        (j["scene"]["width"].as_u64(), j["scene"]["height"].as_u64()),
+        (Some(2), Some(2))
+    );
+    assert_eq!(j["options"]["size"], "2x2");
+    // Eight FP operators (add, sub, mul, div, sqrt, lt, le, eq) in two simulators, and the
+    // processor's frame in each.
+    let checks = j["checks"].as_array().unwrap();
+    assert_eq!(checks.len(), 16, "{j}");
+    assert!(checks.iter().all(|c| c["pass"] == true), "{j}");
+    let frames = j["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 2, "{j}");
+    assert!(frames
+        .iter()
+        .all(|f| f["differing_pixels"] == 0 && f["cycles"].as_u64().unwrap() > 0));
+    let on_disk: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("d/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(on_disk, j, "--json prints the folder's summary.json");
 }
 
 #[test]

@@ -438,6 +438,18 @@ pub struct Options<'a> {
     pub sim_resolution: Option<(u32, u32)>,
     /// Run the processor in Verilator for the scenes that fit.
     pub sim: bool,
+    /// Print the progress lines and the report on stdout; on stderr when false (`--json`
+    /// keeps stdout for its one document).
+    pub stdout: bool,
+}
+
+/// Prints `text` on stdout or stderr.
+fn say(stdout: bool, text: &str) {
+    if stdout {
+        println!("{text}");
+    } else {
+        eprintln!("{text}");
+    }
 }
 
 /// Measures the suite and writes the report into `out` (see [`write_report`]); each
@@ -465,7 +477,12 @@ pub fn run(o: &Options, out: &Path, clock_mhz: f64, clock_source: &str) -> Resul
     let mut scenes = Vec::new();
     for r in &rows {
         let path = o.scenes.join(format!("{}.toml", r.file));
-        if !path.exists() {
+        let there = if crate::bundled::is_bundled(&path) {
+            crate::bundled::is_file(&path)
+        } else {
+            path.exists()
+        };
+        if !there {
             anyhow::bail!(
                 "{}: missing; write the suite's scene files with `dynrt paper-scenes --out {}`",
                 path.display(),
@@ -493,7 +510,7 @@ pub fn run(o: &Options, out: &Path, clock_mhz: f64, clock_source: &str) -> Resul
             Sim::NotRun("left out (--no-sim)".into())
         } else {
             crate::progress::report(&format!("{}: the processor in Verilator", r.name));
-            let (sim, dir) = simulate(r, scene, o.sim_resolution, out)?;
+            let (sim, dir) = simulate(r, scene, o.sim_resolution, out, o.stdout)?;
             kept.extend(dir);
             sim
         };
@@ -503,7 +520,7 @@ pub fn run(o: &Options, out: &Path, clock_mhz: f64, clock_source: &str) -> Resul
         measured.push((result, png));
     }
     for f in write_report(out, &measured, clock_mhz, clock_source)? {
-        println!("wrote {}", f.display());
+        say(o.stdout, &format!("wrote {}", f.display()));
     }
     // The report is written: the processor runs' folders stay.
     for k in kept {
@@ -511,7 +528,7 @@ pub fn run(o: &Options, out: &Path, clock_mhz: f64, clock_source: &str) -> Resul
     }
     let results: Vec<PaperResult> = measured.into_iter().map(|(r, _)| r).collect();
     let md = paper_markdown(&results, clock_mhz, clock_source);
-    print!("{md}");
+    say(o.stdout, md.trim_end());
     Ok((md, differs))
 }
 
@@ -524,6 +541,7 @@ fn simulate(
     scene: &Scene,
     resolution: Option<(u32, u32)>,
     out: &Path,
+    stdout: bool,
 ) -> Result<(Sim, Option<crate::output::OutputDir>)> {
     use crate::emit::processor::ProcessorParams;
     let mut scene = scene.clone();
@@ -558,22 +576,25 @@ fn simulate(
         cycles: frame.cycles,
         differing_pixels: frame.differing_pixels,
     };
-    println!(
-        "{}: {} cycles at {}x{}, {:.1} cycles per pixel, {} (Verilator {:.1} s)",
-        row.name,
-        frame.cycles,
-        sim.width,
-        sim.height,
-        sim.cycles_per_pixel(),
-        if frame.differing_pixels == 0 {
-            "identical to the golden model".to_string()
-        } else {
-            format!(
-                "{} pixels DIFFER from the golden model",
-                frame.differing_pixels
-            )
-        },
-        r.run_seconds
+    say(
+        stdout,
+        &format!(
+            "{}: {} cycles at {}x{}, {:.1} cycles per pixel, {} (Verilator {:.1} s)",
+            row.name,
+            frame.cycles,
+            sim.width,
+            sim.height,
+            sim.cycles_per_pixel(),
+            if frame.differing_pixels == 0 {
+                "identical to the golden model".to_string()
+            } else {
+                format!(
+                    "{} pixels DIFFER from the golden model",
+                    frame.differing_pixels
+                )
+            },
+            r.run_seconds
+        ),
     );
     Ok((Sim::Ran(sim), Some(guard)))
 }

@@ -54,18 +54,25 @@ pub struct SweepConfig {
 }
 
 impl SweepConfig {
-    /// The bundled scenes of `scenes_dir`, every format with hardware operators, 96x72, the
-    /// hardware's unit-triangle test (edge margin `units::EDGE_MARGIN_ULPS`), and the operator
-    /// costs measured
-    /// once and kept in the repository (`benches/data/fp_cost_xc2v.csv` beside `scenes_dir`;
-    /// missing rows are synthesized and appended).
+    /// The scenes of `scenes_dir` (a folder, or the bundled one `bundled:/`), every format
+    /// with hardware operators, 96x72, the hardware's unit-triangle test (edge margin
+    /// `units::EDGE_MARGIN_ULPS`), and the operator costs measured once and kept in the
+    /// repository (`benches/data/fp_cost_xc2v.csv` beside `scenes_dir`; for the bundled scenes,
+    /// or when that file is not there, a copy of the one bundled with the binary in the temp
+    /// folder, see [`bundled_cost_csv`]); missing rows are synthesized and appended.
     pub fn new(scenes_dir: &Path) -> Result<SweepConfig> {
-        let mut scenes: Vec<PathBuf> = std::fs::read_dir(scenes_dir)
-            .with_context(|| format!("reading {}", scenes_dir.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-            .collect();
-        scenes.sort();
+        let scenes = crate::bundled::scene_files(scenes_dir)
+            .with_context(|| format!("reading {}", scenes_dir.display()))?;
+        let beside = scenes_dir
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join("benches/data/fp_cost_xc2v.csv");
+        let synth_dir = std::env::temp_dir().join("dynrt-fp-cost");
+        let cost_csv = if !crate::bundled::is_bundled(scenes_dir) && beside.is_file() {
+            beside
+        } else {
+            bundled_cost_csv(&synth_dir)?
+        };
         Ok(SweepConfig {
             scenes,
             mesh_dir: None,
@@ -73,16 +80,32 @@ impl SweepConfig {
             width: 96,
             height: 72,
             edge_margin_ulps: f64::from(units::EDGE_MARGIN_ULPS),
-            cost_csv: scenes_dir
-                .parent()
-                .unwrap_or(Path::new("."))
-                .join("benches/data/fp_cost_xc2v.csv"),
-            synth_dir: std::env::temp_dir().join("dynrt-fp-cost"),
+            cost_csv,
+            synth_dir,
             synthesize: true,
             seed: 6,
             leak_rays: 20_000,
         })
     }
+}
+
+/// The operator cost cache bundled with the binary, copied (once) to `dir` under a name
+/// that changes with its contents, so that rows synthesized later are appended to a file
+/// of this build's costs, never to the repository's or another build's.
+pub fn bundled_cost_csv(dir: &Path) -> Result<PathBuf> {
+    // FNV-1a: a name that stays the same across Rust versions, unlike std's hasher.
+    let hash = crate::bundled::FP_COST_CSV
+        .iter()
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+            (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3)
+        });
+    let path = dir.join(format!("fp_cost_xc2v-{hash:016x}.csv"));
+    if !path.is_file() {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        crate::output::write_atomically(&path, crate::bundled::FP_COST_CSV)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(path)
 }
 
 /// One scene in one format.

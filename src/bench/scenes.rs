@@ -148,13 +148,8 @@ pub fn scenes_table(rows: &[SceneRow]) -> Table {
     t
 }
 
-/// The bundled scenes under `dir` (every `*.toml`), sorted by name.
+/// The scenes under `dir` (every `*.toml`; `bundled:/` for the ones bundled with the
+/// binary), sorted by name.
 pub fn bundled_scenes(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(|e| anyhow::anyhow!("reading scene directory {}: {e}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    v.sort();
-    Ok(v)
+    crate::bundled::scene_files(dir)
 }

@@ -10,6 +10,7 @@ mod info_cmd;
 mod paper_scenes_cmd;
 mod render_cmd;
 mod rtl_cmd;
+mod scenes_cmd;
 mod stress_cmd;
 mod synth_cmd;
 mod timing_cmd;
@@ -39,7 +40,7 @@ struct Cli {
 enum Command {
     /// The main job on a scene: golden vs reference, FP operators simulated and checked; report.
     #[command(
-        after_help = "Examples:\n  dynrt demo                                 # the Cornell box, every check, out/demo\n  dynrt demo scenes/mirror.toml --out out/mirror"
+        after_help = "Examples:\n  dynrt demo                                 # the bundled Cornell box, every check, out/demo\n  dynrt demo scenes/mirror.toml --out out/mirror\n  dynrt demo bundled:/tiny.toml --json"
     )]
     Demo(demo_cmd::DemoArgs),
     /// Render one frame with the golden model (eXmY) or the f64 reference.
@@ -51,7 +52,7 @@ enum Command {
     Compare(compare_cmd::CompareArgs),
     /// Measure speed, area and error; CSV and Markdown reports under --out.
     #[command(
-        after_help = "Examples:\n  dynrt bench scenes --formats e7m16 --out out/bench\n  dynrt bench precision --size 64x48 --scenes-dir ~/dynrt/scenes"
+        after_help = "Examples:\n  dynrt bench scenes --formats e7m16 --out out/bench       # the bundled scenes\n  dynrt bench precision --size 64x48 --scenes-dir my_scenes\n  dynrt bench scenes bundled:/tiny.toml --size 8x6 --json"
     )]
     Bench(bench_cmd::BenchArgs),
     /// Write the Verilog and testbenches of every FP operator of a format.
@@ -73,6 +74,11 @@ enum Command {
         after_help = "Examples:\n  dynrt timing --unit add,mul --freq 120\n  dynrt timing scenes/cornell.toml --seeds 1,2,3 --out out/timing"
     )]
     Timing(timing_cmd::TimingArgs),
+    /// The scenes bundled with the binary: list their paths (bundled:/NAME) or write them out.
+    #[command(
+        after_help = "Examples:\n  dynrt scenes list\n  dynrt scenes export my_scenes     # my_scenes/cornell.toml, my_scenes/meshes/, ...\n  dynrt render bundled:/tiny.toml --out out/tiny"
+    )]
+    Scenes(scenes_cmd::ScenesArgs),
     /// Write the scene files of the paper's Table 3 (scenes/paper/).
     #[command(after_help = "Examples:\n  dynrt paper-scenes --out scenes/paper")]
     PaperScenes(paper_scenes_cmd::PaperScenesArgs),
@@ -182,6 +188,7 @@ pub fn run() -> i32 {
         Command::Sim(a) => rtl_cmd::run_sim(a),
         Command::Info(a) => info_cmd::run(a),
         Command::PaperScenes(a) => paper_scenes_cmd::run(a),
+        Command::Scenes(a) => scenes_cmd::run(a),
         Command::Completions(a) => completions(a),
     };
     spinner.finish_and_clear();

@@ -36,6 +36,10 @@ pub struct RenderArgs {
     /// hits<N>.csv into --out; `--hits FILE`, the older form, writes it to FILE instead.
     #[arg(long, value_name = "FILE", num_args = 0..=1)]
     pub hits: Option<Option<PathBuf>>,
+    /// Print the result as one JSON document on stdout (model, format, scene, size, frame,
+    /// rays that hit, seconds, files) instead of the one-line summary.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Loads a scene and applies a resolution override (checked like the scene's own).
@@ -150,20 +154,41 @@ pub fn run(a: RenderArgs) -> anyhow::Result<i32> {
     out.keep();
     let pixels = u64::from(frame.width) * u64::from(frame.height);
     let hits = frame.hits.iter().filter(|h| h.is_some()).count();
+    let model = match a.model {
+        ModelKind::Golden => "golden",
+        ModelKind::Reference => "reference",
+    };
+    let number_format = if a.model == ModelKind::Golden {
+        a.format.to_string()
+    } else {
+        "f64".into()
+    };
+    if a.json {
+        let mut written = vec![png_path.display().to_string()];
+        written.extend(hits_path.iter().map(|h| h.display().to_string()));
+        let j = serde_json::json!({
+            "verb": "render",
+            "dynrt_version": env!("CARGO_PKG_VERSION"),
+            "scene": scene.source,
+            "model": model,
+            "format": number_format,
+            "frame": a.frame,
+            "width": frame.width,
+            "height": frame.height,
+            "pixels": pixels,
+            "primary_hits": hits,
+            "seconds": secs,
+            "primary_rays_per_second": pixels as f64 / secs,
+            "files": written,
+        });
+        println!("{}", serde_json::to_string_pretty(&j)?);
+        return Ok(0);
+    }
     println!(
-        "{} {}x{} frame {} ({}): {} of {} primary rays hit, frame {:.3} s, {:.3} M primary rays/s -> {}",
-        match a.model {
-            ModelKind::Golden => "golden",
-            ModelKind::Reference => "reference",
-        },
+        "{model} {}x{} frame {} ({number_format}): {} of {} primary rays hit, frame {:.3} s, {:.3} M primary rays/s -> {}",
         frame.width,
         frame.height,
         a.frame,
-        if a.model == ModelKind::Golden {
-            a.format.to_string()
-        } else {
-            "f64".into()
-        },
         hits,
         pixels,
         secs,

@@ -47,6 +47,10 @@ pub struct TimingArgs {
     /// Report directory: timing.md, timing.csv and a folder per design.
     #[arg(long, default_value = "out/timing")]
     pub out: PathBuf,
+    /// Print the result as one JSON document on stdout (the rows of timing.csv under "rows",
+    /// the designs that failed under "failed"); the per-design lines go to stderr.
+    #[arg(long)]
+    pub json: bool,
 }
 
 enum Design {
@@ -177,7 +181,14 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
     }
     dynrt::output::check_output_dir(&a.out, "--out")?;
     let tools = ecp5::timing_tools()?;
-    println!(
+    let say = |text: &str| {
+        if a.json {
+            super::log_line(text.trim_end());
+        } else {
+            println!("{}", text.trim_end());
+        }
+    };
+    say(&format!(
         "ECP5 timing ({}, out of context, {} MHz, seeds {}): yosys {}, nextpnr-ecp5 {}",
         ecp5::DEVICE,
         a.freq,
@@ -188,7 +199,7 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
             .join(","),
         tools.yosys_version,
         tools.nextpnr_version
-    );
+    ));
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("creating --out '{}'", a.out.display()))?;
     // The binary's own path depends on the target directory; the verb and its arguments are
@@ -211,7 +222,7 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
         });
         match result {
             Ok(t) => {
-                print_design(&t);
+                say(&design_text(&t));
                 done.push(t);
                 write_tables(&a.out, &done, &command)?;
             }
@@ -226,10 +237,16 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
         }
     }
     if !done.is_empty() {
-        println!(
+        say(&format!(
             "wrote {} and {}",
             a.out.join("timing.md").display(),
             a.out.join("timing.csv").display()
+        ));
+    }
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&timing_json(&done, &failed, &a, &tools))?
         );
     }
     if failed.is_empty() {
@@ -249,9 +266,13 @@ fn write_tables(out: &Path, done: &[DesignTiming], command: &str) -> anyhow::Res
     Ok(())
 }
 
-fn print_design(t: &DesignTiming) {
+/// The lines printed for one measured design.
+fn design_text(t: &DesignTiming) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
     let r = &t.report;
-    println!(
+    let _ = writeln!(
+        out,
         "{} (yosys {:.0} s, place and route {:.0} s over {} seed(s)):",
         t.name,
         r.synth_seconds,
@@ -266,7 +287,8 @@ fn print_design(t: &DesignTiming) {
                     p.start.block, p.end.block, p.logic_levels, p.carry_cells, p.logic_ns, p.routing_ns
                 )
             });
-            println!(
+            let _ = writeln!(
+                out,
                 "  seed {}: {} {:.1} MHz ({} at {} MHz){path}",
                 run.seed,
                 c.clock,
@@ -275,7 +297,8 @@ fn print_design(t: &DesignTiming) {
                 c.constraint_mhz
             );
         }
-        println!(
+        let _ = writeln!(
+            out,
             "  seed {}: LUT4 {}, FF {}, DP16KD {}, MULT18X18D {} ({})",
             run.seed,
             run.report.used("TRELLIS_COMB"),
@@ -288,11 +311,36 @@ fn print_design(t: &DesignTiming) {
     if r.runs.len() > 1 {
         for clock in r.clocks() {
             if let Some(s) = r.fmax_spread(&clock) {
-                println!(
+                let _ = writeln!(
+                    out,
                     "  {clock} over the seeds: min {:.1}, median {:.1}, max {:.1} MHz",
                     s.min, s.median, s.max
                 );
             }
         }
     }
+    out
+}
+
+/// The `--json` document: what was asked, the tools, the rows of timing.csv, what failed.
+fn timing_json(
+    done: &[DesignTiming],
+    failed: &[String],
+    a: &TimingArgs,
+    tools: &ecp5::TimingTools,
+) -> serde_json::Value {
+    let files = ["timing.md", "timing.csv"].map(|f| a.out.join(f).display().to_string());
+    serde_json::json!({
+        "verb": "timing",
+        "pass": failed.is_empty(),
+        "dynrt_version": env!("CARGO_PKG_VERSION"),
+        "device": ecp5::DEVICE,
+        "freq_mhz": a.freq,
+        "format": a.format.to_string(),
+        "seeds": a.seeds,
+        "tools": { "yosys": tools.yosys_version, "nextpnr-ecp5": tools.nextpnr_version },
+        "rows": super::bench_cmd::csv_rows_json(&timing_table::csv(done)),
+        "failed": failed,
+        "files": files,
+    })
 }

@@ -106,7 +106,8 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Loads a scene file; meshes are found relative to its directory.
+    /// Loads a scene file; meshes are found relative to its directory. A bundled scene
+    /// (`bundled:/cornell.toml`, see [`crate::bundled`]) finds the bundled meshes.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let text = crate::input::read_text(path, "scene file", crate::input::MAX_SCENE_BYTES)
             .map_err(|e| SceneError {
@@ -116,6 +117,8 @@ impl Scene {
                 problem: Problem::Input(e),
             })?;
         let text = crate::input::normalize_line_endings(&text);
+        // `bundled:tiny.toml` has the bundled folder as its parent once canonical.
+        let path = &crate::bundled::canonical(path);
         let base = path.parent().unwrap_or(Path::new(""));
         Scene::from_toml_str(&text, base, path)
     }
