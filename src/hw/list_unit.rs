@@ -38,6 +38,7 @@
 
 use rust_hdl::prelude::*;
 
+use super::ports::SHARED_BUS_BANKS;
 use super::SyncFifo;
 use crate::layout;
 
@@ -142,8 +143,8 @@ pub struct ListUnit {
     c_cmd_init: Constant<Bits<2>>,
     c_cmd_object: Constant<Bits<2>>,
     c_cmd_skip: Constant<Bits<2>>,
-    /// The banks on the shared bus (lists, instances, frame): the engine's loads of the
-    /// others go out on their coprocessor's port and leave the bus free.
+    /// [`SHARED_BUS_BANKS`]: the engine's loads of the others go out on their coprocessor's
+    /// port and leave the bus free.
     c_shared_banks: Constant<Bits<{ layout::BANKS }>>,
 }
 
@@ -223,9 +224,7 @@ impl ListUnit {
             c_cmd_init: Constant::new(CMD_INIT.into()),
             c_cmd_object: Constant::new(CMD_OBJECT.into()),
             c_cmd_skip: Constant::new(CMD_SKIP.into()),
-            c_shared_banks: Constant::new(
-                ((1u64 << layout::LISTS) | (1 << layout::INSTANCES) | (1 << layout::FRAME)).into(),
-            ),
+            c_shared_banks: Constant::new(SHARED_BUS_BANKS.into()),
         }
     }
 }

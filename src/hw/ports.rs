@@ -6,7 +6,12 @@
 
 use rust_hdl::prelude::*;
 
-use crate::layout::BANKS;
+use crate::layout::{self, BANKS};
+
+/// The banks on the engine's shared memory bus (lists, instances, frame), as a mask of
+/// [`CoprocessorPort::load_banks`]: the others have their coprocessor's own port.
+pub const SHARED_BUS_BANKS: u64 =
+    (1 << layout::LISTS) | (1 << layout::INSTANCES) | (1 << layout::FRAME);
 
 /// A read port of an SRAM bank: a request (`read`, `addr`) per clock; `rdata` is the word
 /// requested exactly `mem_latency` clocks earlier (the board's SRAMs, or a testbench's).

@@ -63,7 +63,7 @@
 use rust_hdl::prelude::*;
 
 use super::list_unit;
-use super::ports::{BankedSramRead, FrameBufferWrite, SramRead};
+use super::ports::{BankedSramRead, FrameBufferWrite, SramRead, SHARED_BUS_BANKS};
 use super::program::isa::{KdFn, Op, TriFn, PC_BITS};
 use super::program::Program;
 use super::{TraversalUnit, TriangleTester, CHANNEL_BYTE_LATENCY};
@@ -247,7 +247,8 @@ pub struct ThreadEngine<
     traversal_count: DFF<Bits<32>>,
     frame_start: Signal<Local, Bit>,
     // The memory and frame-buffer ports' request registers.
-    /// The load's bank one-hot (`CoprocessorPort::load_banks`), and its number for the shared bus.
+    /// The load's bank one-hot (`CoprocessorPort::load_banks`); `mem_bank_r` its number, for
+    /// the shared bus.
     mem_load_r: DFF<Bits<{ layout::BANKS }>>,
     mem_bank_r: DFF<Bits<3>>,
     mem_addr_r: DFF<Bits<24>>,
@@ -305,8 +306,7 @@ pub struct ThreadEngine<
     bank_lists: Constant<Bits<3>>,
     /// `mem_load_r`'s bit 0, shifted to the load's bank.
     one_bank: Constant<Bits<{ layout::BANKS }>>,
-    /// The banks on the shared bus: lists, instances, frame (the others have their
-    /// coprocessor's port).
+    /// [`SHARED_BUS_BANKS`].
     shared_banks: Constant<Bits<{ layout::BANKS }>>,
 }
 
@@ -428,9 +428,7 @@ impl<
             cmd_skip: cmd(list_unit::CMD_SKIP),
             bank_lists: bank(layout::LISTS),
             one_bank: Constant::new(1u64.into()),
-            shared_banks: Constant::new(
-                ((1u64 << layout::LISTS) | (1 << layout::INSTANCES) | (1 << layout::FRAME)).into(),
-            ),
+            shared_banks: Constant::new(SHARED_BUS_BANKS.into()),
         }
     }
 }
