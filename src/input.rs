@@ -92,6 +92,12 @@ pub(crate) fn kind_name(t: std::fs::FileType) -> &'static str {
 /// ("scene file", "mesh", ...) in errors. A bundled path (`bundled:/tiny.toml`, see
 /// [`crate::bundled`]) is served from the binary, under the same cap.
 pub fn read_bytes(path: &Path, what: &str, cap: u64) -> Result<Vec<u8>, InputError> {
+    let too_large = |size| InputError::TooLarge {
+        what: what.to_string(),
+        path: path.to_path_buf(),
+        size,
+        cap,
+    };
     if crate::bundled::is_bundled(path) {
         let bytes = crate::bundled::contents(path).ok_or_else(|| InputError::NotBundled {
             what: what.to_string(),
@@ -99,12 +105,7 @@ pub fn read_bytes(path: &Path, what: &str, cap: u64) -> Result<Vec<u8>, InputErr
             known: crate::bundled::scene_names().join(", "),
         })?;
         if bytes.len() as u64 > cap {
-            return Err(InputError::TooLarge {
-                what: what.to_string(),
-                path: path.to_path_buf(),
-                size: bytes.len() as u64,
-                cap,
-            });
+            return Err(too_large(bytes.len() as u64));
         }
         return Ok(bytes.to_vec());
     }
@@ -130,12 +131,6 @@ pub fn read_bytes(path: &Path, what: &str, cap: u64) -> Result<Vec<u8>, InputErr
             kind: kind_name(meta.file_type()),
         });
     }
-    let too_large = |size| InputError::TooLarge {
-        what: what.to_string(),
-        path: path.to_path_buf(),
-        size,
-        cap,
-    };
     if meta.len() > cap {
         return Err(too_large(meta.len()));
     }

@@ -13,16 +13,9 @@ fn entries(dir: &Path) -> Vec<String> {
     names
 }
 
+/// `dynrt` run from the test's own folder: status, stdout, stderr.
 fn dynrt(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_dynrt"))
-        .args(args)
-        .output()
-        .expect("run dynrt");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    dynrt_in(Path::new("."), args)
 }
 
 fn scene(name: &str) -> String {
