@@ -4,7 +4,7 @@
 //! seen, and hands the tests on to the tester's launch in a second queue. A leaf costs the
 //! thread one engine turn (`tri.list`) instead of five per triangle.
 //!
-//! Engine side (the engine's I4): `enqueue` offers a command of `thread`, taken when `full`
+//! Engine side (the engine's I5): `enqueue` offers a command of `thread`, taken when `full`
 //! is low in that clock. Commands by `kind`: [`CMD_LIST`] the list `word_a..word_b` (bank-1
 //! word addresses); [`CMD_INIT`] a new query (passed on as it is; it empties the thread's mailbox); [`CMD_OBJECT`] the object
 //! (instance) `word_a` the next lists belong to, which empties the thread's mailbox;

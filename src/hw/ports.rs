@@ -41,9 +41,9 @@ pub struct FrameBufferWrite {
 }
 
 /// The engine's side of a coprocessor (the traversal unit, the triangle tester), seen from the
-/// coprocessor: at I4 the engine writes a ray word pair (`ray_write`, `ray_pair`: which pair,
+/// coprocessor: at I5 the engine writes a ray word pair (`ray_write`, `ray_pair`: which pair,
 /// `word_a`, `word_b`) or offers an entry (`enqueue`) for `thread`; `full` refuses the entry
-/// (the thread repeats it). At I3 the engine asks whether `query_thread`'s work is `pending`
+/// (the thread repeats it). At I4 the engine asks whether `query_thread`'s work is `pending`
 /// (a wait). `done` and `done_thread` report a finished piece of work, which wakes a sleeping
 /// waiter. `load_*` is the engine's registered load request (a load of the coprocessor's bank
 /// goes out on the coprocessor's own port, in the clocks the coprocessor leaves free):

@@ -2,7 +2,7 @@
 //! coprocessor (the triangle tester and the traversal unit each keep one), and the per-thread
 //! counters both coprocessors start from.
 //!
-//! Write side (the engine's I4): `ray_write` with `ray_pair` 0, 1, 2 writes `(o.x, o.y)`,
+//! Write side (the engine's I5): `ray_write` with `ray_pair` 0, 1, 2 writes `(o.x, o.y)`,
 //! `(o.z, d.x)`, `(d.y, d.z)` of `thread` from `word_a`, `word_b`; `t_min_write` writes t_min
 //! from `word_a`. Read side: `ray_thread` gives `o`, `d` one clock later; `t_min_thread` gives
 //! `t_min` one clock later (block RAMs, one read port each).

@@ -13,11 +13,11 @@
 //! [`units::split_distance`](crate::units::split_distance) for each inner node; they name this
 //! unit back. Latency and throughput: see "Structure" below.
 //!
-//! Engine side (I3/I4, like the triangle tester): `enqueue` offers the start of a walk of
+//! Engine side (I4/I5, like the triangle tester): `enqueue` offers the start of a walk of
 //! `thread` (root `word_a`, t_max `word_b`, t_min the thread's `t_min` written with the
-//! tester's init), taken when `full` is low. `query_thread` at I3; at I4 `pending` (the
-//! thread's walk has not ended). The entry offered at I4 must be of the thread presented at
-//! I3 the clock before (its count of entries taken is read there), and a thread never offers
+//! tester's init), taken when `full` is low. `query_thread` at I4; at I5 `pending` (the
+//! thread's walk has not ended). The entry offered at I5 must be of the thread presented at
+//! I4 the clock before (its count of entries taken is read there), and a thread never offers
 //! in two clocks in a row (the engine's scheduler guarantees both).
 //!
 //! Structure: entries go through the front (an engine's start becomes a step job; a tester's
@@ -973,7 +973,7 @@ mod tests {
         let mut th = 0;
         while b.got.iter().zip(&want).any(|(g, w)| g.len() < w.len()) {
             assert!(b.clock < 400_000, "the walks do not end: got {:?}", b.got);
-            // Two clocks per turn of a thread, as the engine's I3 and I4: present the thread
+            // Two clocks per turn of a thread, as the engine's I4 and I5: present the thread
             // to the counters, then read its state and offer its start.
             th = (th + 1) % threads;
             u.engine.query_thread.next = (th as u64).into();

@@ -12,7 +12,7 @@
 //! (src/units.rs), bit for bit; both name this unit back. Latency and throughput: see "Fetch
 //! and launch" and "Latency from launch" below.
 //!
-//! Engine side (the engine's I3/I4 stages):
+//! Engine side (the engine's I4/I5 stages):
 //! - Ray words: `ray_write` with `ray_pair` 0, 1, 2 writes `(o.x, o.y)`, `(o.z, d.x)`,
 //!   `(d.y, d.z)` of `thread` from `word_a`, `word_b`.
 //! - Queue: `enqueue` offers a command of `thread` (`queue_kind`, the [`ListUnit`]'s): a list,
@@ -20,9 +20,9 @@
 //!   the thread's earlier entries), the object of the next lists, the pair to skip. It is
 //!   taken when `full` is low in that clock; the engine then counts a list or a query as
 //!   issued.
-//! - Answers: `query_thread` at I3; at I4 `pending` (lists and queries of the thread not yet
+//! - Answers: `query_thread` at I4; at I5 `pending` (lists and queries of the thread not yet
 //!   done), `hit`, `best_t`, `best_instance`, `best_triangle` of its closest hit. An entry
-//!   offered at I4 must be of the thread presented at I3 the clock before (its count of
+//!   offered at I5 must be of the thread presented at I4 the clock before (its count of
 //!   entries taken is read there), and a thread never offers in two clocks in a row (the
 //!   engine's scheduler guarantees both).
 //!
@@ -108,7 +108,7 @@ pub struct TriangleTester<
     pub engine: CoprocessorPort,
     /// `list_unit::CMD_*`.
     pub queue_kind: Signal<In, Bits<2>>,
-    /// The thread's closest hit so far (`engine.query_thread`, read at I3 for I4).
+    /// The thread's closest hit so far (`engine.query_thread`, read at I4 for I5).
     pub hit: Signal<Out, Bit>,
     pub best_t: Signal<Out, Bits<W>>,
     pub best_instance: Signal<Out, Bits<32>>,
@@ -493,7 +493,7 @@ impl<
         self.lists.addr.next = self.list_unit.list_addr.val();
         self.list_unit.list_rdata.next = self.lists.rdata.val();
 
-        // Engine answers (address at I3, data at I4).
+        // Engine answers (address at I4, data at I5).
         self.issued.read_address.next = self.engine.query_thread.val();
         self.done_e.read_address.next = self.engine.query_thread.val();
         self.best_e.read_address.next = self.engine.query_thread.val();
@@ -934,7 +934,7 @@ mod tests {
             stolen: 0,
         };
         let mut drain = 0;
-        // The thread whose counters were read last clock (the engine's I3): only it may offer.
+        // The thread whose counters were read last clock (the engine's I4): only it may offer.
         let mut queried: Option<usize> = None;
         while offers.iter().any(|q| !q.is_empty()) || drain < 4000 {
             if offers.iter().all(|q| q.is_empty()) {

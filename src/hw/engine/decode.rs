@@ -1,17 +1,17 @@
-//! `Decode`: the engine's stages I2 to I4 up to the operands. It reads the instruction's two
+//! `Decode`: the engine's stages I3 to I5 up to the operands. It reads the instruction's two
 //! source registers from the register file (one block RAM per read port, both written by the
-//! write back), selects the operands as the block RAMs' words arrive (I3) and registers them,
+//! write back), selects the operands as the block RAMs' words arrive (I4) and registers them,
 //! and splits the ROM words into their fields.
 //!
-//! Contract: an instruction at I2 (`valid`, `thread`, `pc`, `ctl`, `imm`, `aux` from
-//! [`super::Fetch`]) comes out at I4 with its fields and operands: `a` is register `A` (r0
+//! Contract: an instruction at I3 (`valid`, `thread`, `pc`, `ctl`, `imm`, `aux` from
+//! [`super::Fetch`]) comes out at I5 with its fields and operands: `a` is register `A` (r0
 //! reads 0), `b` the immediate when `B_IMM` is set, else register `B`; `store` is register
-//! `B` as read (the data of `st` and `sts`). At I3 it shows the instruction's `valid_i3`,
-//! `op_i3`, `thread_i3` and `imm_i3`, for the units that read per-thread state, the glue that
-//! decodes coprocessor functions and the long instructions' reservation, one clock ahead of
-//! the operands. The field offsets are `isa::CTL_*` and `isa::AUX_*`, the one
-//! encoding `isa::Instr::encode` writes into the ROM. The write back writes `wb_data` to
-//! `wb_dst` of `wb_thread` when `wb_write` is set.
+//! `B` as read (the data of `st` and `sts`). At I3 it shows the fetched word's opcode
+//! (`op_i3`, for the long instructions' reservation); at I4 the instruction's `valid_i4`,
+//! `op_i4`, `thread_i4` and `imm_i4`, for the units that read per-thread state and the glue
+//! that decodes coprocessor functions, one clock ahead of the operands. The field offsets are
+//! `isa::CTL_*` and `isa::AUX_*`, the one encoding `isa::Instr::encode` writes into the ROM.
+//! The write back writes `wb_data` to `wb_dst` of `wb_thread` when `wb_write` is set.
 //!
 //! Latency: 2 clocks (the register read, then a register after the operand select: the block
 //! RAMs' clock-to-out, about 6 ns on an ECP5, leaves no room for the integer unit behind it
@@ -28,19 +28,22 @@ use crate::hw::NoCollisionRam;
 #[derive(LogicBlock)]
 pub struct Decode {
     pub clock: Signal<In, Clock>,
-    /// I2: the instruction from the fetch.
-    pub valid_i2: Signal<In, Bit>,
-    pub thread_i2: Signal<In, Bits<5>>,
-    pub pc_i2: Signal<In, Bits<PC_BITS>>,
-    pub ctl_i2: Signal<In, Bits<32>>,
-    pub imm_i2: Signal<In, Bits<32>>,
-    pub aux_i2: Signal<In, Bits<32>>,
-    /// I3: the instruction (`valid_i3`, its opcode, thread and immediate).
-    pub valid_i3: Signal<Out, Bit>,
+    /// I3: the instruction from the fetch.
+    pub valid_i3: Signal<In, Bit>,
+    pub thread_i3: Signal<In, Bits<5>>,
+    pub pc_i3: Signal<In, Bits<PC_BITS>>,
+    pub ctl_i3: Signal<In, Bits<32>>,
+    pub imm_i3: Signal<In, Bits<32>>,
+    pub aux_i3: Signal<In, Bits<32>>,
+    /// I3: the fetched word's opcode (no register: the long instructions reserve their write
+    /// back from it, a clock ahead of `op_i4`).
     pub op_i3: Signal<Out, Bits<OP_BITS>>,
-    pub thread_i3: Signal<Out, Bits<5>>,
-    pub imm_i3: Signal<Out, Bits<32>>,
-    /// I4: the instruction's fields and operands.
+    /// I4: the instruction (`valid_i4`, its opcode, thread and immediate).
+    pub valid_i4: Signal<Out, Bit>,
+    pub op_i4: Signal<Out, Bits<OP_BITS>>,
+    pub thread_i4: Signal<Out, Bits<5>>,
+    pub imm_i4: Signal<Out, Bits<32>>,
+    /// I5: the instruction's fields and operands.
     pub valid: Signal<Out, Bit>,
     pub thread: Signal<Out, Bits<5>>,
     pub pc: Signal<Out, Bits<PC_BITS>>,
@@ -69,21 +72,21 @@ pub struct Decode {
     // no read-first emulation.
     regs_a: NoCollisionRam<Bits<32>, 13>,
     regs_b: NoCollisionRam<Bits<32>, 13>,
-    v3: DFF<Bit>,
-    t3: DFF<Bits<5>>,
-    pc3: DFF<Bits<PC_BITS>>,
-    ctl3: DFF<Bits<32>>,
-    imm3: DFF<Bits<32>>,
-    aux3: DFF<Bits<32>>,
     v4: DFF<Bit>,
     t4: DFF<Bits<5>>,
     pc4: DFF<Bits<PC_BITS>>,
     ctl4: DFF<Bits<32>>,
     imm4: DFF<Bits<32>>,
     aux4: DFF<Bits<32>>,
-    a4: DFF<Bits<32>>,
-    b4: DFF<Bits<32>>,
-    store4: DFF<Bits<32>>,
+    v5: DFF<Bit>,
+    t5: DFF<Bits<5>>,
+    pc5: DFF<Bits<PC_BITS>>,
+    ctl5: DFF<Bits<32>>,
+    imm5: DFF<Bits<32>>,
+    aux5: DFF<Bits<32>>,
+    a5: DFF<Bits<32>>,
+    b5: DFF<Bits<32>>,
+    store5: DFF<Bits<32>>,
     reg_a: Signal<Local, Bits<REG_BITS>>,
     reg_b: Signal<Local, Bits<REG_BITS>>,
     wb_address: Signal<Local, Bits<13>>,
@@ -116,12 +119,13 @@ impl Decode {
             // Registers start undefined: the program writes every register before reading it
             // (so the generated Verilog stays small and Icarus compiles it quickly).
             clock: Default::default(),
-            valid_i2: Default::default(),
-            thread_i2: Default::default(),
-            pc_i2: Default::default(),
-            ctl_i2: Default::default(),
-            imm_i2: Default::default(),
-            aux_i2: Default::default(),
+            valid_i3: Default::default(),
+            thread_i3: Default::default(),
+            pc_i3: Default::default(),
+            ctl_i3: Default::default(),
+            imm_i3: Default::default(),
+            aux_i3: Default::default(),
+            op_i3: Default::default(),
             valid: Default::default(),
             thread: Default::default(),
             pc: Default::default(),
@@ -132,10 +136,10 @@ impl Decode {
             shift: Default::default(),
             bank: Default::default(),
             target: Default::default(),
-            valid_i3: Default::default(),
-            op_i3: Default::default(),
-            thread_i3: Default::default(),
-            imm_i3: Default::default(),
+            valid_i4: Default::default(),
+            op_i4: Default::default(),
+            thread_i4: Default::default(),
+            imm_i4: Default::default(),
             a: Default::default(),
             b: Default::default(),
             store: Default::default(),
@@ -145,21 +149,21 @@ impl Decode {
             wb_data: Default::default(),
             regs_a: NoCollisionRam::decoding(5 + register_bits),
             regs_b: NoCollisionRam::decoding(5 + register_bits),
-            v3: Default::default(),
-            t3: Default::default(),
-            pc3: Default::default(),
-            ctl3: Default::default(),
-            imm3: Default::default(),
-            aux3: Default::default(),
             v4: Default::default(),
             t4: Default::default(),
             pc4: Default::default(),
             ctl4: Default::default(),
             imm4: Default::default(),
             aux4: Default::default(),
-            a4: Default::default(),
-            b4: Default::default(),
-            store4: Default::default(),
+            v5: Default::default(),
+            t5: Default::default(),
+            pc5: Default::default(),
+            ctl5: Default::default(),
+            imm5: Default::default(),
+            aux5: Default::default(),
+            a5: Default::default(),
+            b5: Default::default(),
+            store5: Default::default(),
             reg_a: Default::default(),
             reg_b: Default::default(),
             wb_address: Default::default(),
@@ -182,97 +186,101 @@ impl Logic for Decode {
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self, clock, v3, t3, pc3, ctl3, imm3, aux3, v4, t4, pc4, ctl4, imm4, aux4, a4, b4,
-            store4
+            self, clock, v4, t4, pc4, ctl4, imm4, aux4, v5, t5, pc5, ctl5, imm5, aux5, a5, b5,
+            store5
         );
         self.regs_a.read_clock.next = self.clock.val();
         self.regs_a.write_clock.next = self.clock.val();
         self.regs_b.read_clock.next = self.clock.val();
         self.regs_b.write_clock.next = self.clock.val();
 
-        // I2: read the source registers.
+        // I3: read the source registers.
+        self.op_i3.next = self
+            .ctl_i3
+            .val()
+            .get_bits::<OP_BITS>(self.f_op.val().index());
         self.reg_a.next = self
-            .ctl_i2
+            .ctl_i3
             .val()
             .get_bits::<REG_BITS>(self.f_a.val().index());
         self.reg_b.next = self
-            .ctl_i2
+            .ctl_i3
             .val()
             .get_bits::<REG_BITS>(self.f_b.val().index());
         self.regs_a.read_address.next = (bit_cast::<13, REG_BITS>(self.reg_a.val()) << 5)
-            | bit_cast::<13, 5>(self.thread_i2.val());
+            | bit_cast::<13, 5>(self.thread_i3.val());
         self.regs_b.read_address.next = (bit_cast::<13, REG_BITS>(self.reg_b.val()) << 5)
-            | bit_cast::<13, 5>(self.thread_i2.val());
-        self.v3.d.next = self.valid_i2.val();
-        self.t3.d.next = self.thread_i2.val();
-        self.pc3.d.next = self.pc_i2.val();
-        self.ctl3.d.next = self.ctl_i2.val();
-        self.imm3.d.next = self.imm_i2.val();
-        self.aux3.d.next = self.aux_i2.val();
+            | bit_cast::<13, 5>(self.thread_i3.val());
+        self.v4.d.next = self.valid_i3.val();
+        self.t4.d.next = self.thread_i3.val();
+        self.pc4.d.next = self.pc_i3.val();
+        self.ctl4.d.next = self.ctl_i3.val();
+        self.imm4.d.next = self.imm_i3.val();
+        self.aux4.d.next = self.aux_i3.val();
 
-        // I3: the operands (r0 always reads 0) as the register words arrive.
-        self.valid_i3.next = self.v3.q.val();
-        self.op_i3.next = self
-            .ctl3
+        // I4: the operands (r0 always reads 0) as the register words arrive.
+        self.valid_i4.next = self.v4.q.val();
+        self.op_i4.next = self
+            .ctl4
             .q
             .val()
             .get_bits::<OP_BITS>(self.f_op.val().index());
-        self.thread_i3.next = self.t3.q.val();
-        self.imm_i3.next = self.imm3.q.val();
-        self.v4.d.next = self.v3.q.val();
-        self.t4.d.next = self.t3.q.val();
-        self.pc4.d.next = self.pc3.q.val();
-        self.ctl4.d.next = self.ctl3.q.val();
-        self.imm4.d.next = self.imm3.q.val();
-        self.aux4.d.next = self.aux3.q.val();
-        if self.aux3.q.val().get_bit(self.f_a_zero.val().index()) {
-            self.a4.d.next = 0.into();
+        self.thread_i4.next = self.t4.q.val();
+        self.imm_i4.next = self.imm4.q.val();
+        self.v5.d.next = self.v4.q.val();
+        self.t5.d.next = self.t4.q.val();
+        self.pc5.d.next = self.pc4.q.val();
+        self.ctl5.d.next = self.ctl4.q.val();
+        self.imm5.d.next = self.imm4.q.val();
+        self.aux5.d.next = self.aux4.q.val();
+        if self.aux4.q.val().get_bit(self.f_a_zero.val().index()) {
+            self.a5.d.next = 0.into();
         } else {
-            self.a4.d.next = self.regs_a.read_data.val();
+            self.a5.d.next = self.regs_a.read_data.val();
         }
-        if self.ctl3.q.val().get_bit(self.f_b_imm.val().index()) {
-            self.b4.d.next = self.imm3.q.val();
-        } else if self.aux3.q.val().get_bit(self.f_b_zero.val().index()) {
-            self.b4.d.next = 0.into();
+        if self.ctl4.q.val().get_bit(self.f_b_imm.val().index()) {
+            self.b5.d.next = self.imm4.q.val();
+        } else if self.aux4.q.val().get_bit(self.f_b_zero.val().index()) {
+            self.b5.d.next = 0.into();
         } else {
-            self.b4.d.next = self.regs_b.read_data.val();
+            self.b5.d.next = self.regs_b.read_data.val();
         }
-        self.store4.d.next = self.regs_b.read_data.val();
+        self.store5.d.next = self.regs_b.read_data.val();
 
-        // I4: the fields and operands.
-        self.valid.next = self.v4.q.val();
-        self.thread.next = self.t4.q.val();
-        self.pc.next = self.pc4.q.val();
+        // I5: the fields and operands.
+        self.valid.next = self.v5.q.val();
+        self.thread.next = self.t5.q.val();
+        self.pc.next = self.pc5.q.val();
         self.op.next = self
-            .ctl4
+            .ctl5
             .q
             .val()
             .get_bits::<OP_BITS>(self.f_op.val().index());
         self.dst.next = self
-            .ctl4
+            .ctl5
             .q
             .val()
             .get_bits::<REG_BITS>(self.f_dst.val().index());
-        self.invert.next = self.ctl4.q.val().get_bit(self.f_invert.val().index());
-        self.imm.next = self.imm4.q.val();
+        self.invert.next = self.ctl5.q.val().get_bit(self.f_invert.val().index());
+        self.imm.next = self.imm5.q.val();
         self.shift.next = self
-            .aux4
+            .aux5
             .q
             .val()
             .get_bits::<SHIFT_BITS>(self.f_shift.val().index());
         self.bank.next = self
-            .aux4
+            .aux5
             .q
             .val()
             .get_bits::<BANK_BITS>(self.f_bank.val().index());
         self.target.next = self
-            .aux4
+            .aux5
             .q
             .val()
             .get_bits::<PC_BITS>(self.f_target.val().index());
-        self.a.next = self.a4.q.val();
-        self.b.next = self.b4.q.val();
-        self.store.next = self.store4.q.val();
+        self.a.next = self.a5.q.val();
+        self.b.next = self.b5.q.val();
+        self.store.next = self.store5.q.val();
 
         // Write back.
         self.wb_address.next = (bit_cast::<13, REG_BITS>(self.wb_dst.val()) << 5)

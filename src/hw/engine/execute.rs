@@ -1,20 +1,20 @@
-//! `Execute`: the engine's single-clock work at I4. It computes the integer, conversion,
+//! `Execute`: the engine's single-clock work at I5. It computes the integer, conversion,
 //! link, pixel and coprocessor-reading results (the *fast* result), the integer conditions,
 //! and the addresses of loads, stores and scratch accesses, and names where a load's data
 //! will come from.
 //!
 //! Contract: from an instruction's `op`, operands `a`, `b`, `imm`, `shift`, `bank` and `pc`
-//! at I4: `fast` is `add`/`sub`/`and`/`or`/`xor`/`shr`/`shl` of `a` and `b`, `jal`'s
+//! at I5: `fast` is `add`/`sub`/`and`/`or`/`xor`/`shr`/`shl` of `a` and `b`, `jal`'s
 //! link `pc + 1`, `byte`'s `b << 8` (the unit's byte joins it at the write back), the
 //! pixel word, or what `tri.wait`/`tri.hit`/`tri.instance`/`tri.triangle` read from the
 //! triangle tester; `kind` says whether the result line fills in a scratch or memory word
 //! later (`ld` by its bank, `lds`) or `itof`'s `converted` word. `mem_address = (a << shift) + imm` (loads and frame-buffer
 //! stores), `scratch_address = a + imm`; `int_eq`, `int_lt`: `a == b`, `a < b` unsigned.
 //!
-//! `itof`'s word comes a clock later, registered (`converted`, I5: the leading-zero shifter
+//! `itof`'s word comes a clock later, registered (`converted`, I6: the leading-zero shifter
 //! and the result select do not fit one clock), and joins the result line there.
 //!
-//! Latency: combinational (I4), `converted` 1 clock. Throughput: one instruction per clock.
+//! Latency: combinational (I5), `converted` 1 clock. Throughput: one instruction per clock.
 //!
 //! Golden twin: `hw::program::exec` (the engine's twin), the same operations per opcode.
 
@@ -28,7 +28,7 @@ use crate::layout;
 #[derive(LogicBlock)]
 pub struct Execute<const W: usize, const E: usize, const M: usize> {
     pub clock: Signal<In, Clock>,
-    /// I4: the instruction.
+    /// I5: the instruction.
     pub op: Signal<In, Bits<OP_BITS>>,
     pub a: Signal<In, Bits<32>>,
     pub b: Signal<In, Bits<32>>,
@@ -38,13 +38,13 @@ pub struct Execute<const W: usize, const E: usize, const M: usize> {
     pub pc: Signal<In, Bits<PC_BITS>>,
     /// The pixel counter's word.
     pub pixel: Signal<In, Bits<32>>,
-    /// The triangle tester's answers for the thread at I4.
+    /// The triangle tester's answers for the thread at I5.
     pub tester_best_t: Signal<In, Bits<W>>,
     pub tester_hit: Signal<In, Bit>,
     pub tester_instance: Signal<In, Bits<32>>,
     pub tester_triangle: Signal<In, Bits<32>>,
     pub fast: Signal<Out, Bits<32>>,
-    /// I5: `itof a` of the instruction at I4 the clock before.
+    /// I6: `itof a` of the instruction at I5 the clock before.
     pub converted: Signal<Out, Bits<32>>,
     pub kind: Signal<Out, FastKind>,
     pub int_eq: Signal<Out, Bit>,

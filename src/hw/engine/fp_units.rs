@@ -1,8 +1,8 @@
 //! `FpUnits`: the engine's floating-point units (add/sub, multiply, divide, square root,
-//! compare, the colour-channel byte), fed every clock from I4, and the delays that bring each
+//! compare, the colour-channel byte), fed every clock from I5, and the delays that bring each
 //! result to the write back.
 //!
-//! Contract: operands `a`, `b` (and `sub` for `fsub`) given at I4 come out at the write back,
+//! Contract: operands `a`, `b` (and `sub` for `fsub`) given at I5 come out at the write back,
 //! [`super::ENGINE_LATENCY`] clocks later: `sum`, `product`, the compare flags `lt`, `le`,
 //! `eq`, `byte` (`ChannelByte`); `quotient` and `root` come
 //! [`super::long_latency`]`(M)` clocks later, the clock the long line writes them back. Every
@@ -43,7 +43,7 @@ pub struct FpUnits<
     const P: usize,
 > {
     pub clock: Signal<In, Clock>,
-    /// I4: the operands; `sub`: the adder subtracts.
+    /// I5: the operands; `sub`: the adder subtracts.
     pub a: Signal<In, Bits<W>>,
     pub b: Signal<In, Bits<W>>,
     pub sub: Signal<In, Bit>,

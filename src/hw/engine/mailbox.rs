@@ -2,16 +2,16 @@
 //! mailbox 0, instances in mailbox 1), the paper's mailboxing against testing an object
 //! twice, for the `mbx` (test and insert) and `mbc` (clear) instructions.
 //!
-//! Contract: the mailbox `which` of a thread is read at I3 (`read_thread`, `read_which`); at
-//! I4 come the instruction's `thread`, `which`, `value`, `insert`, `clear`. At I6 `hit` is set
+//! Contract: the mailbox `which` of a thread is read at I4 (`read_thread`, `read_which`); at
+//! I5 come the instruction's `thread`, `which`, `value`, `insert`, `clear`. At I7 `hit` is set
 //! when `value` is one of the mailbox's first `len` entries; `insert` (an `mbx`) puts a value
 //! that missed in the next slot, round robin, and `clear` (an `mbc`) empties the mailbox.
 //! Entries start undefined and count only below `len`.
 //!
-//! Latency: the entries leave their block RAMs into registers at I4 (a block RAM's output
+//! Latency: the entries leave their block RAMs into registers at I5 (a block RAM's output
 //! arrives late in the clock, too late for a 32-bit compare behind it), are compared with the
-//! value at I5, and the hit is ready at I6, three clocks after the read; the update is written
-//! at the end of I6. A thread issues at most once per `engine_period` clocks, and threads have
+//! value at I6, and the hit is ready at I7, three clocks after the read; the update is written
+//! at the end of I7. A thread issues at most once per `engine_period` clocks, and threads have
 //! mailboxes of their own, so every read sees every earlier update.
 //! Throughput: one instruction per clock.
 //!
@@ -25,27 +25,27 @@ use crate::units::MAILBOX_ENTRIES;
 #[derive(LogicBlock)]
 pub struct MailboxUnit {
     pub clock: Signal<In, Clock>,
-    /// I3: which thread's mailbox (`read_which`: 0 triangles, 1 instances) to read.
+    /// I4: which thread's mailbox (`read_which`: 0 triangles, 1 instances) to read.
     pub read_thread: Signal<In, Bits<5>>,
     pub read_which: Signal<In, Bit>,
-    /// I4: the instruction's thread, mailbox, value (operand A) and what it does.
+    /// I5: the instruction's thread, mailbox, value (operand A) and what it does.
     pub thread: Signal<In, Bits<5>>,
     pub which: Signal<In, Bit>,
     pub value: Signal<In, Bits<32>>,
     pub insert: Signal<In, Bit>,
     pub clear: Signal<In, Bit>,
-    /// I6: the value was in the mailbox.
+    /// I7: the value was in the mailbox.
     pub hit: Signal<Out, Bit>,
 
-    /// I5: the entries and metadata read, and the instruction.
+    /// I6: the entries and metadata read, and the instruction.
     entries_r: [DFF<Bits<32>>; MAILBOX_ENTRIES],
-    meta_i5: DFF<Bits<8>>,
-    thread_i5: DFF<Bits<5>>,
-    which_i5: DFF<Bit>,
-    value_i5: DFF<Bits<32>>,
-    insert_i5: DFF<Bit>,
-    clear_i5: DFF<Bit>,
-    /// I6: the compares of I5 and what the update needs.
+    meta_i6: DFF<Bits<8>>,
+    thread_i6: DFF<Bits<5>>,
+    which_i6: DFF<Bit>,
+    value_i6: DFF<Bits<32>>,
+    insert_i6: DFF<Bit>,
+    clear_i6: DFF<Bit>,
+    /// I7: the compares of I6 and what the update needs.
     matches: [DFF<Bit>; MAILBOX_ENTRIES],
     meta_r: DFF<Bits<8>>,
     thread_r: DFF<Bits<5>>,
@@ -80,12 +80,12 @@ impl Default for MailboxUnit {
             clear: Default::default(),
             hit: Default::default(),
             entries_r: Default::default(),
-            meta_i5: Default::default(),
-            thread_i5: Default::default(),
-            which_i5: Default::default(),
-            value_i5: Default::default(),
-            insert_i5: Default::default(),
-            clear_i5: Default::default(),
+            meta_i6: Default::default(),
+            thread_i6: Default::default(),
+            which_i6: Default::default(),
+            value_i6: Default::default(),
+            insert_i6: Default::default(),
+            clear_i6: Default::default(),
             matches: Default::default(),
             meta_r: Default::default(),
             thread_r: Default::default(),
@@ -109,7 +109,7 @@ impl Logic for MailboxUnit {
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self, clock, meta_i5, thread_i5, which_i5, value_i5, insert_i5, clear_i5, meta_r,
+            self, clock, meta_i6, thread_i6, which_i6, value_i6, insert_i6, clear_i6, meta_r,
             thread_r, which_r, value_r, insert_r, clear_r
         );
         self.meta.read_clock.next = self.clock.val();
@@ -118,7 +118,7 @@ impl Logic for MailboxUnit {
             self.entries[k].read_clock.next = self.clock.val();
             self.entries[k].write_clock.next = self.clock.val();
         }
-        // I3: read.
+        // I4: read.
         self.read_address.next = (bit_cast::<6, 5>(self.read_thread.val()) << 1)
             | bit_cast::<6, 1>(self.read_which.val().into());
         self.meta.read_address.next = self.read_address.val();
@@ -126,31 +126,31 @@ impl Logic for MailboxUnit {
             self.entries[k].read_address.next = self.read_address.val();
         }
 
-        // I4: the entries into registers.
+        // I5: the entries into registers.
         for k in 0..8 {
             self.entries_r[k].clock.next = self.clock.val();
             self.entries_r[k].d.next = self.entries[k].read_data.val();
         }
-        self.meta_i5.d.next = self.meta.read_data.val();
-        self.thread_i5.d.next = self.thread.val();
-        self.which_i5.d.next = self.which.val();
-        self.value_i5.d.next = self.value.val();
-        self.insert_i5.d.next = self.insert.val();
-        self.clear_i5.d.next = self.clear.val();
+        self.meta_i6.d.next = self.meta.read_data.val();
+        self.thread_i6.d.next = self.thread.val();
+        self.which_i6.d.next = self.which.val();
+        self.value_i6.d.next = self.value.val();
+        self.insert_i6.d.next = self.insert.val();
+        self.clear_i6.d.next = self.clear.val();
 
-        // I5: compare the value with every entry.
+        // I6: compare the value with every entry.
         for k in 0..8 {
             self.matches[k].clock.next = self.clock.val();
-            self.matches[k].d.next = self.entries_r[k].q.val() == self.value_i5.q.val();
+            self.matches[k].d.next = self.entries_r[k].q.val() == self.value_i6.q.val();
         }
-        self.meta_r.d.next = self.meta_i5.q.val();
-        self.thread_r.d.next = self.thread_i5.q.val();
-        self.which_r.d.next = self.which_i5.q.val();
-        self.value_r.d.next = self.value_i5.q.val();
-        self.insert_r.d.next = self.insert_i5.q.val();
-        self.clear_r.d.next = self.clear_i5.q.val();
+        self.meta_r.d.next = self.meta_i6.q.val();
+        self.thread_r.d.next = self.thread_i6.q.val();
+        self.which_r.d.next = self.which_i6.q.val();
+        self.value_r.d.next = self.value_i6.q.val();
+        self.insert_r.d.next = self.insert_i6.q.val();
+        self.clear_r.d.next = self.clear_i6.q.val();
 
-        // I6: a hit when the value is one of the first `len` entries.
+        // I7: a hit when the value is one of the first `len` entries.
         self.len.next = self.meta_r.q.val().get_bits::<4>(0);
         self.next_slot.next = self.meta_r.q.val().get_bits::<3>(4);
         self.found.next = false;
@@ -162,7 +162,7 @@ impl Logic for MailboxUnit {
         }
         self.hit.next = self.found.val();
 
-        // I6: update.
+        // I7: update.
         self.write_address.next = (bit_cast::<6, 5>(self.thread_r.q.val()) << 1)
             | bit_cast::<6, 1>(self.which_r.q.val().into());
         self.meta.write_address.next = self.write_address.val();

@@ -8,28 +8,29 @@
 //! by the other threads (the paper's 32 threads). A long instruction reserves its write-back
 //! clock: the scheduler issues nothing in the one clock whose instruction would write back
 //! with it (one bubble per `fdiv` or `fsqrt`). A thread issues at most once per `period =
-//! OPERAND_STAGE + ENGINE_LATENCY + WAKE_UP` (19) clocks (`engine_period`). A thread whose coprocessor wait (`tri.wait`,
+//! OPERAND_STAGE + ENGINE_LATENCY + WAKE_UP` (20) clocks (`engine_period`). A thread whose coprocessor wait (`tri.wait`,
 //! `kd.wait`) is still pending sleeps: it is not ready until the coprocessor finishes work for
 //! it, so the clocks it waits go to the other threads (an offer to a full queue repeats at
 //! once).
 //!
 //! Pipeline (clock offsets from the issue), one block per stage, each with its own contract:
 //! - I0: [`Scheduler`] picks a ready thread.
-//! - I0..I2: [`Fetch`] reads the thread's `{epoch, halted, pc}` (a stale epoch means "new
-//!   frame": pc 0) and, in the same clock, addresses the [`ProgramRom`]; it registers the
-//!   instruction's three words at I1.
-//! - I2..I4: [`Decode`] reads the two source registers, selects and registers the operands
-//!   and splits the fields; at I3 the [`MailboxUnit`] reads the thread's mailbox and the
-//!   coprocessors their state of the thread, and a long instruction reserves its write back.
-//! - I4 ([`OPERAND_STAGE`]): [`Execute`] computes the integer result and the addresses, the
+//! - I0..I3: [`Fetch`] reads the thread's `{epoch, halted, pc}` (a stale epoch means "new
+//!   frame": pc 0) and registers the pc, addresses the [`ProgramRom`] at I1 and registers the
+//!   instruction's three words at I2.
+//! - I3..I5: [`Decode`] reads the two source registers, selects and registers the operands
+//!   and splits the fields; at I3 a long instruction reserves its write back; at I4 the
+//!   [`MailboxUnit`] reads the thread's mailbox and the coprocessors their state of the
+//!   thread.
+//! - I5 ([`OPERAND_STAGE`]): [`Execute`] computes the integer result and the addresses, the
 //!   [`PixelCounter`] hands out a pixel, the mailbox registers the entries it read (it compares
-//!   at I5, hits and updates at I6), [`FpUnits`] take their operands; this block drives the
+//!   at I6, hits and updates at I7), [`FpUnits`] take their operands; this block drives the
 //!   memory and frame-buffer ports and offers `tri` and `kd` entries to the coprocessors (their
 //!   answer, refused or pending, makes the thread repeat the instruction on its next turn, after
 //!   a sleep for a wait).
-//! - I5..: the [`ResultLine`] decodes the opcode at I5; scratch data joins at I5, the mailbox
-//!   hit at I6, memory data at I5 + `mem_latency`.
-//! - I4 + 12 (`I4 + M + 6` for `fdiv`, `fsqrt`, which go on in the long line): the
+//! - I6..: the [`ResultLine`] decodes the opcode at I6; scratch data joins at I6, the mailbox
+//!   hit at I7, memory data at I6 + `mem_latency`.
+//! - I5 + 12 (`I5 + M + 6` for `fdiv`, `fsqrt`, which go on in the long line): the
 //!   [`WriteBack`] chooses, and a clock later writes, the register and the next pc: `target`
 //!   when the condition differs from `invert` (a non-branching instruction's condition is
 //!   false, so its `invert` is a jump after it), else `pc + 1`; the condition comes from the
@@ -112,9 +113,9 @@ pub const fn long_latency(m: u32) -> u32 {
     m + 6
 }
 
-/// Clocks from the issue (I0) to the operands (I4): the pc and ROM reads, the ROM words'
-/// register, the register read and the operand register.
-pub const OPERAND_STAGE: u32 = 4;
+/// Clocks from the issue (I0) to the operands (I5): the pc read and its register, the ROM
+/// read, the ROM words' register, the register read and the operand register.
+pub const OPERAND_STAGE: u32 = 5;
 
 /// Clocks from a write back to the thread's next issue: the write back's register, the
 /// scheduler's ready register and its pick register.
@@ -126,7 +127,7 @@ pub fn engine_period(threads: u32) -> u32 {
     threads.max(OPERAND_STAGE + ENGINE_LATENCY + WAKE_UP)
 }
 
-/// Where an instruction's result comes from on the fast line: computed at I4, converted at I5
+/// Where an instruction's result comes from on the fast line: computed at I5, converted at I6
 /// (`itof`), or the data of a scratch read or of a load from the shared memory port or a
 /// bank's own port.
 #[derive(Copy, Clone, Debug, PartialEq, LogicState)]
@@ -255,9 +256,9 @@ pub struct ThreadEngine<
     fb_write_r: DFF<Bit>,
     fb_addr_r: DFF<Bits<24>>,
     fb_data_r: DFF<Bits<32>>,
-    // The coprocessor glue: the function an instruction names, decoded at I3 and registered
-    // for I4 (a 32-bit immediate's compares would otherwise sit in front of the
-    // coprocessors' queues); the answers at I4.
+    // The coprocessor glue: the function an instruction names, decoded at I4 and registered
+    // for I5 (a 32-bit immediate's compares would otherwise sit in front of the
+    // coprocessors' queues); the answers at I5.
     ray_write: DFF<Bit>,
     t_min_write: DFF<Bit>,
     tri_enqueue: DFF<Bit>,
@@ -331,7 +332,7 @@ impl<
         assert!(super::fp::div::div_latency(M as u32) + 1 == long_latency(M as u32));
         assert!(super::fp::sqrt::sqrt_latency(M as u32) + 1 == long_latency(M as u32));
         // The reservation is made at I3 for the issue `1 + (DX - 4)` clocks later, whose write
-        // back is the long one's: I3 + 1 + (DX - 4) + OPERAND_STAGE + ENGINE_LATENCY = I4 +
+        // back is the long one's: I3 + 1 + (DX - 4) + OPERAND_STAGE + ENGINE_LATENCY = I5 +
         // long_latency.
         assert!(DX == (long_latency(M as u32) - ENGINE_LATENCY) as usize && DX >= 4);
         assert!(DL == super::fp::div::div_latency(M as u32) as usize);
@@ -515,29 +516,29 @@ impl<
             }
         }
 
-        // I0..I2.
+        // I0..I3.
         self.scheduler.running.next = self.running.q.val();
         self.scheduler.frame_start.next = self.frame_start.val();
         self.fetch.epoch.next = self.epoch.q.val();
         self.fetch.issue.next = self.scheduler.issue.val();
         self.fetch.pick.next = self.scheduler.pick.val();
-        self.decode.valid_i2.next = self.fetch.valid.val();
-        self.decode.thread_i2.next = self.fetch.thread.val();
-        self.decode.pc_i2.next = self.fetch.pc.val();
-        self.decode.ctl_i2.next = self.fetch.ctl.val();
-        self.decode.imm_i2.next = self.fetch.imm.val();
-        self.decode.aux_i2.next = self.fetch.aux.val();
-
-        // I3: the per-thread state the units read one clock ahead of the operands.
-        self.mailboxes.read_thread.next = self.decode.thread_i3.val();
-        self.mailboxes.read_which.next = self.decode.imm_i3.val().get_bit(0);
-        self.tester.engine.query_thread.next = self.decode.thread_i3.val();
-        self.traversal_unit.engine.query_thread.next = self.decode.thread_i3.val();
-        self.scheduler.long_at_i3.next = self.decode.valid_i3.val()
+        self.decode.valid_i3.next = self.fetch.valid.val();
+        self.decode.thread_i3.next = self.fetch.thread.val();
+        self.decode.pc_i3.next = self.fetch.pc.val();
+        self.decode.ctl_i3.next = self.fetch.ctl.val();
+        self.decode.imm_i3.next = self.fetch.imm.val();
+        self.decode.aux_i3.next = self.fetch.aux.val();
+        self.scheduler.long_at_i3.next = self.fetch.valid.val()
             & ((self.decode.op_i3.val() == self.op_fdiv.val())
                 | (self.decode.op_i3.val() == self.op_fsqrt.val()));
 
-        // I4.
+        // I4: the per-thread state the units read one clock ahead of the operands.
+        self.mailboxes.read_thread.next = self.decode.thread_i4.val();
+        self.mailboxes.read_which.next = self.decode.imm_i4.val().get_bit(0);
+        self.tester.engine.query_thread.next = self.decode.thread_i4.val();
+        self.traversal_unit.engine.query_thread.next = self.decode.thread_i4.val();
+
+        // I5.
         self.fp_units.a.next = self.decode.a.val().get_bits::<W>(0);
         self.fp_units.b.next = self.decode.b.val().get_bits::<W>(0);
         self.fp_units.sub.next = self.decode.op.val() == self.op_fsub.val();
@@ -603,46 +604,46 @@ impl<
         SramRead::link(&mut self.bank0, &mut self.traversal_unit.nodes);
         SramRead::link(&mut self.bank2, &mut self.tester.uv_words);
         SramRead::link(&mut self.bank3, &mut self.tester.t_words);
-        // I3: the coprocessor function the instruction names (`tri` with its `TriFn`, `kd`
-        // with its `KdFn`, in imm), for I4. The queued `TriFn`s go to the list unit as its
+        // I4: the coprocessor function the instruction names (`tri` with its `TriFn`, `kd`
+        // with its `KdFn`, in imm), for I5. The queued `TriFn`s go to the list unit as its
         // command kinds.
-        self.tri_op.next = self.decode.op_i3.val() == self.op_tri.val();
-        self.kd_op.next = self.decode.op_i3.val() == self.op_kd.val();
-        self.tri_wait_fn.next = self.decode.imm_i3.val() == self.tri_wait.val();
-        self.kd_wait_fn.next = self.decode.imm_i3.val() == self.kd_wait.val();
-        self.queued_fn.next = (self.decode.imm_i3.val() == self.tri_init.val())
-            | (self.decode.imm_i3.val() == self.tri_list.val())
-            | (self.decode.imm_i3.val() == self.tri_object.val())
-            | (self.decode.imm_i3.val() == self.tri_skip.val());
-        self.ray_write.d.next = self.decode.valid_i3.val()
+        self.tri_op.next = self.decode.op_i4.val() == self.op_tri.val();
+        self.kd_op.next = self.decode.op_i4.val() == self.op_kd.val();
+        self.tri_wait_fn.next = self.decode.imm_i4.val() == self.tri_wait.val();
+        self.kd_wait_fn.next = self.decode.imm_i4.val() == self.kd_wait.val();
+        self.queued_fn.next = (self.decode.imm_i4.val() == self.tri_init.val())
+            | (self.decode.imm_i4.val() == self.tri_list.val())
+            | (self.decode.imm_i4.val() == self.tri_object.val())
+            | (self.decode.imm_i4.val() == self.tri_skip.val());
+        self.ray_write.d.next = self.decode.valid_i4.val()
             & self.tri_op.val()
-            & (self.decode.imm_i3.val() < self.tri_ray_words.val());
-        self.t_min_write.d.next = self.decode.valid_i3.val()
+            & (self.decode.imm_i4.val() < self.tri_ray_words.val());
+        self.t_min_write.d.next = self.decode.valid_i4.val()
             & self.tri_op.val()
-            & (self.decode.imm_i3.val() == self.tri_init.val());
+            & (self.decode.imm_i4.val() == self.tri_init.val());
         self.tri_queues.d.next = self.queued_fn.val();
         self.tri_enqueue.d.next =
-            self.decode.valid_i3.val() & self.tri_op.val() & self.queued_fn.val();
+            self.decode.valid_i4.val() & self.tri_op.val() & self.queued_fn.val();
         self.tri_kind.d.next = self.cmd_list.val();
-        if self.decode.imm_i3.val() == self.tri_init.val() {
+        if self.decode.imm_i4.val() == self.tri_init.val() {
             self.tri_kind.d.next = self.cmd_init.val();
         }
-        if self.decode.imm_i3.val() == self.tri_object.val() {
+        if self.decode.imm_i4.val() == self.tri_object.val() {
             self.tri_kind.d.next = self.cmd_object.val();
         }
-        if self.decode.imm_i3.val() == self.tri_skip.val() {
+        if self.decode.imm_i4.val() == self.tri_skip.val() {
             self.tri_kind.d.next = self.cmd_skip.val();
         }
         self.tri_waits.d.next = self.tri_wait_fn.val();
-        self.kd_enqueue.d.next = self.decode.valid_i3.val()
+        self.kd_enqueue.d.next = self.decode.valid_i4.val()
             & self.kd_op.val()
-            & (self.decode.imm_i3.val() == self.kd_start.val());
+            & (self.decode.imm_i4.val() == self.kd_start.val());
         self.kd_waits.d.next = self.kd_wait_fn.val();
         // The waits (`tri.wait`, `kd.wait`): a pending one sleeps instead of repeating.
         self.wait_fn.d.next = (self.tri_op.val() & self.tri_wait_fn.val())
             | (self.kd_op.val() & self.kd_wait_fn.val());
 
-        // I4: both coprocessors see the engine's loads, the thread and its ray words.
+        // I5: both coprocessors see the engine's loads, the thread and its ray words.
         self.traversal_unit.engine.load_banks.next = self.mem_load_r.q.val();
         self.traversal_unit.engine.load_addr.next = self.mem_addr_r.q.val();
         self.traversal_unit.engine.thread.next = self.decode.thread.val();
@@ -687,7 +688,7 @@ impl<
             self.kd_busy.next = self.traversal_unit.engine.full.val();
         }
 
-        // I4 into the result line.
+        // I5 into the result line.
         self.result_line.valid.next = self.decode.valid.val();
         self.result_line.op.next = self.decode.op.val();
         self.result_line.dst.next = self.decode.dst.val();

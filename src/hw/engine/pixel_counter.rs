@@ -3,12 +3,12 @@
 //!
 //! Contract: while pixels remain (`exhausted` low), `word` is the next pixel's word `y <<
 //! pixel_shift | x` (`ProgramConfig::pixel_shift`; with a power-of-two width it is the
-//! pixel's index in the frame) and `take` (a `pixel` at I4) moves on to the next. When every
+//! pixel's index in the frame) and `take` (a `pixel` at I5) moves on to the next. When every
 //! pixel is handed out, `exhausted` is set and the `pixel` instruction branches (the thread
 //! halts). A frame start begins again at (0, 0).
 //!
-//! Latency: `word` and `exhausted` are combinational at I4; the count moves at the end of
-//! I4. Throughput: one pixel per clock.
+//! Latency: `word` and `exhausted` are combinational at I5; the count moves at the end of
+//! I5. Throughput: one pixel per clock.
 //!
 //! Golden twin: the engine's twin (`hw::program::exec`, op `pixel`) counts the same pixels in
 //! the same order; the golden model renders each pixel's ray from the same `(x, y)`.

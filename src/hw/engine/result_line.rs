@@ -1,19 +1,19 @@
-//! `ResultLine`: carries each instruction from I4 to its write back: its control fields, its
+//! `ResultLine`: carries each instruction from I5 to its write back: its control fields, its
 //! pcs, its conditions and its fast result, into which scratch and memory data join on the
 //! way. `fdiv` and `fsqrt` go on from there through a long line of `DX` more clocks.
 //!
-//! Contract: what enters at I4 leaves at the write back [`super::ENGINE_LATENCY`] (12) clocks
+//! Contract: what enters at I5 leaves at the write back [`super::ENGINE_LATENCY`] (12) clocks
 //! later; a long instruction's control and pc leave `DX = long_latency - ENGINE_LATENCY`
 //! clocks later still (the scheduler reserved that clock, so no other instruction leaves with
 //! it). The fast result of `lds` and `itof` is replaced by the scratch word or the converted
-//! word one clock after I4, that of `ld` by the word of its bank's port `mem_latency` clocks
-//! after the request (which leaves the engine one clock after I4).
+//! word one clock after I5, that of `ld` by the word of its bank's port `mem_latency` clocks
+//! after the request (which leaves the engine one clock after I5).
 //!
-//! The line decodes the opcode at I5, so that the [`super::WriteBack`] has only the
+//! The line decodes the opcode at I6, so that the [`super::WriteBack`] has only the
 //! floating-point units' flags and results to add: it leaves with `write` (the op writes a
 //! register other than r0, and is not a `pixel` after the last pixel), `source` (which result
 //! is written), `cond` (the condition of a branch on an integer compare, the mailbox (its hit
-//! joins at I6), the pixels, `jal`, or a coprocessor's refusal), `sel_lt`/`sel_le`/`sel_eq`
+//! joins at I7), the pixels, `jal`, or a coprocessor's refusal), `sel_lt`/`sel_le`/`sel_eq`
 //! (a branch on the floating-point compare instead), and the two next pcs, `pc_taken` when the
 //! condition holds and `pc_not_taken` when it does not: `target` when the condition differs
 //! from `invert`, else `pc + 1`; `jr`'s operand; the pc itself for `halt` and for a refused or
@@ -38,16 +38,16 @@ use crate::hw::Delay;
 const FAST_STAGES: usize = 8;
 /// Registers of the fast line after the last join, up to the write back.
 const TAIL: usize = 4;
-/// Clocks from I4 to the write back.
+/// Clocks from I5 to the write back.
 const LINE: usize = FAST_STAGES + TAIL;
-/// Clocks from I5 (the decode) and from I6 (the mailbox hit) to the write back.
-const FROM_I5: usize = LINE - 1;
-const FROM_I6: usize = LINE - 2;
+/// Clocks from I6 (the decode) and from I7 (the mailbox hit) to the write back.
+const FROM_I6: usize = LINE - 1;
+const FROM_I7: usize = LINE - 2;
 
 #[derive(LogicBlock)]
 pub struct ResultLine<const DX: usize> {
     pub clock: Signal<In, Clock>,
-    /// I4: the instruction.
+    /// I5: the instruction.
     pub valid: Signal<In, Bit>,
     pub op: Signal<In, Bits<OP_BITS>>,
     pub dst: Signal<In, Bits<REG_BITS>>,
@@ -55,9 +55,9 @@ pub struct ResultLine<const DX: usize> {
     pub invert: Signal<In, Bit>,
     pub pc: Signal<In, Bits<PC_BITS>>,
     pub target: Signal<In, Bits<PC_BITS>>,
-    /// I4: its conditions: a coprocessor wait; the traversal unit or the triangle tester
+    /// I5: its conditions: a coprocessor wait; the traversal unit or the triangle tester
     /// refused the entry or has not finished; operand A's low bits (`jr`'s target); the
-    /// integer compares; the pixels exhausted. I6: the mailbox hit.
+    /// integer compares; the pixels exhausted. I7: the mailbox hit.
     pub is_wait: Signal<In, Bit>,
     pub kd_busy: Signal<In, Bit>,
     pub tri_busy: Signal<In, Bit>,
@@ -66,10 +66,10 @@ pub struct ResultLine<const DX: usize> {
     pub int_lt: Signal<In, Bit>,
     pub mb_hit: Signal<In, Bit>,
     pub pix_done: Signal<In, Bit>,
-    /// I4: the fast result and where a load's data comes from.
+    /// I5: the fast result and where a load's data comes from.
     pub fast: Signal<In, Bits<32>>,
     pub kind: Signal<In, FastKind>,
-    /// The data that joins: `itof`'s word and the scratch word (I5) and the ports' words.
+    /// The data that joins: `itof`'s word and the scratch word (I6) and the ports' words.
     pub converted: Signal<In, Bits<32>>,
     pub scratch_data: Signal<In, Bits<32>>,
     pub mem_data: Signal<In, Bits<32>>,
@@ -80,52 +80,52 @@ pub struct ResultLine<const DX: usize> {
     /// Write back: the instruction leaving the line (from the long line when one leaves it).
     pub retiring: Retiring,
 
-    /// I5: the instruction as it entered.
-    valid_i5: DFF<Bit>,
-    op_i5: DFF<Bits<OP_BITS>>,
-    dst_i5: DFF<Bits<REG_BITS>>,
-    thread_i5: DFF<Bits<5>>,
-    invert_i5: DFF<Bit>,
-    pc_i5: DFF<Bits<PC_BITS>>,
-    pc_plus_one_i5: DFF<Bits<PC_BITS>>,
-    target_i5: DFF<Bits<PC_BITS>>,
-    is_wait_i5: DFF<Bit>,
-    kd_busy_i5: DFF<Bit>,
-    tri_busy_i5: DFF<Bit>,
-    jr_target_i5: DFF<Bits<PC_BITS>>,
-    int_eq_i5: DFF<Bit>,
-    int_lt_i5: DFF<Bit>,
-    pix_done_i5: DFF<Bit>,
-    /// I5: the decode.
+    /// I6: the instruction as it entered.
+    valid_i6: DFF<Bit>,
+    op_i6: DFF<Bits<OP_BITS>>,
+    dst_i6: DFF<Bits<REG_BITS>>,
+    thread_i6: DFF<Bits<5>>,
+    invert_i6: DFF<Bit>,
+    pc_i6: DFF<Bits<PC_BITS>>,
+    pc_plus_one_i6: DFF<Bits<PC_BITS>>,
+    target_i6: DFF<Bits<PC_BITS>>,
+    is_wait_i6: DFF<Bit>,
+    kd_busy_i6: DFF<Bit>,
+    tri_busy_i6: DFF<Bit>,
+    jr_target_i6: DFF<Bits<PC_BITS>>,
+    int_eq_i6: DFF<Bit>,
+    int_lt_i6: DFF<Bit>,
+    pix_done_i6: DFF<Bit>,
+    /// I6: the decode.
     is_long: Signal<Local, Bit>,
     is_mbx: Signal<Local, Bit>,
     halts: Signal<Local, Bit>,
     repeats: Signal<Local, Bit>,
     keeps_pc: Signal<Local, Bit>,
-    cond_i5: Signal<Local, Bit>,
+    cond_i6: Signal<Local, Bit>,
     pc_other: Signal<Local, Bits<PC_BITS>>,
     pc_target: Signal<Local, Bits<PC_BITS>>,
     pc_next: Signal<Local, Bits<PC_BITS>>,
-    source_i5: Signal<Local, ResultSource>,
-    /// I6: the condition but the mailbox's, and whether the mailbox's counts.
-    cond_i6: DFF<Bit>,
-    is_mbx_i6: DFF<Bit>,
+    source_i6: Signal<Local, ResultSource>,
+    /// I7: the condition but the mailbox's, and whether the mailbox's counts.
+    cond_i7: DFF<Bit>,
+    is_mbx_i7: DFF<Bit>,
     /// The decoded instruction on its way to the write back.
-    valid_line: Delay<Bit, FROM_I5>,
-    is_long_line: Delay<Bit, FROM_I5>,
-    dst_line: Delay<Bits<REG_BITS>, FROM_I5>,
-    thread_line: Delay<Bits<5>, FROM_I5>,
-    write_line: Delay<Bit, FROM_I5>,
-    source_line: Delay<ResultSource, FROM_I5>,
-    cond_line: Delay<Bit, FROM_I6>,
-    sel_lt_line: Delay<Bit, FROM_I5>,
-    sel_le_line: Delay<Bit, FROM_I5>,
-    sel_eq_line: Delay<Bit, FROM_I5>,
-    pc_taken_line: Delay<Bits<PC_BITS>, FROM_I5>,
-    pc_not_taken_line: Delay<Bits<PC_BITS>, FROM_I5>,
-    halt_line: Delay<Bit, FROM_I5>,
-    retired_line: Delay<Bit, FROM_I5>,
-    wait_pending_line: Delay<Bit, FROM_I5>,
+    valid_line: Delay<Bit, FROM_I6>,
+    is_long_line: Delay<Bit, FROM_I6>,
+    dst_line: Delay<Bits<REG_BITS>, FROM_I6>,
+    thread_line: Delay<Bits<5>, FROM_I6>,
+    write_line: Delay<Bit, FROM_I6>,
+    source_line: Delay<ResultSource, FROM_I6>,
+    cond_line: Delay<Bit, FROM_I7>,
+    sel_lt_line: Delay<Bit, FROM_I6>,
+    sel_le_line: Delay<Bit, FROM_I6>,
+    sel_eq_line: Delay<Bit, FROM_I6>,
+    pc_taken_line: Delay<Bits<PC_BITS>, FROM_I6>,
+    pc_not_taken_line: Delay<Bits<PC_BITS>, FROM_I6>,
+    halt_line: Delay<Bit, FROM_I6>,
+    retired_line: Delay<Bit, FROM_I6>,
+    wait_pending_line: Delay<Bit, FROM_I6>,
     /// The fast result and its source, a register per clock up to the last join.
     fast_line: [DFF<Bits<32>>; FAST_STAGES],
     kind_line: [DFF<FastKind>; FAST_STAGES],
@@ -195,33 +195,33 @@ impl<const DX: usize> ResultLine<DX> {
             uv_data: Default::default(),
             t_data: Default::default(),
             retiring: Default::default(),
-            valid_i5: Default::default(),
-            op_i5: Default::default(),
-            dst_i5: Default::default(),
-            thread_i5: Default::default(),
-            invert_i5: Default::default(),
-            pc_i5: Default::default(),
-            pc_plus_one_i5: Default::default(),
-            target_i5: Default::default(),
-            is_wait_i5: Default::default(),
-            kd_busy_i5: Default::default(),
-            tri_busy_i5: Default::default(),
-            jr_target_i5: Default::default(),
-            int_eq_i5: Default::default(),
-            int_lt_i5: Default::default(),
-            pix_done_i5: Default::default(),
+            valid_i6: Default::default(),
+            op_i6: Default::default(),
+            dst_i6: Default::default(),
+            thread_i6: Default::default(),
+            invert_i6: Default::default(),
+            pc_i6: Default::default(),
+            pc_plus_one_i6: Default::default(),
+            target_i6: Default::default(),
+            is_wait_i6: Default::default(),
+            kd_busy_i6: Default::default(),
+            tri_busy_i6: Default::default(),
+            jr_target_i6: Default::default(),
+            int_eq_i6: Default::default(),
+            int_lt_i6: Default::default(),
+            pix_done_i6: Default::default(),
             is_long: Default::default(),
             is_mbx: Default::default(),
             halts: Default::default(),
             repeats: Default::default(),
             keeps_pc: Default::default(),
-            cond_i5: Default::default(),
+            cond_i6: Default::default(),
             pc_other: Default::default(),
             pc_target: Default::default(),
             pc_next: Default::default(),
-            source_i5: Default::default(),
-            cond_i6: Default::default(),
-            is_mbx_i6: Default::default(),
+            source_i6: Default::default(),
+            cond_i7: Default::default(),
+            is_mbx_i7: Default::default(),
             valid_line: Default::default(),
             is_long_line: Default::default(),
             dst_line: Default::default(),
@@ -282,23 +282,23 @@ impl<const DX: usize> Logic for ResultLine<DX> {
         dff_setup!(
             self,
             clock,
-            valid_i5,
-            op_i5,
-            dst_i5,
-            thread_i5,
-            invert_i5,
-            pc_i5,
-            pc_plus_one_i5,
-            target_i5,
-            is_wait_i5,
-            kd_busy_i5,
-            tri_busy_i5,
-            jr_target_i5,
-            int_eq_i5,
-            int_lt_i5,
-            pix_done_i5,
-            cond_i6,
-            is_mbx_i6
+            valid_i6,
+            op_i6,
+            dst_i6,
+            thread_i6,
+            invert_i6,
+            pc_i6,
+            pc_plus_one_i6,
+            target_i6,
+            is_wait_i6,
+            kd_busy_i6,
+            tri_busy_i6,
+            jr_target_i6,
+            int_eq_i6,
+            int_lt_i6,
+            pix_done_i6,
+            cond_i7,
+            is_mbx_i7
         );
         clock!(
             self,
@@ -330,96 +330,96 @@ impl<const DX: usize> Logic for ResultLine<DX> {
             self.fast_line[k].clock.next = self.clock.val();
             self.kind_line[k].clock.next = self.clock.val();
         }
-        // I4: the instruction into registers (its conditions arrive late in the clock).
-        self.valid_i5.d.next = self.valid.val();
-        self.op_i5.d.next = self.op.val();
-        self.dst_i5.d.next = self.dst.val();
-        self.thread_i5.d.next = self.thread.val();
-        self.invert_i5.d.next = self.invert.val();
-        self.pc_i5.d.next = self.pc.val();
-        self.pc_plus_one_i5.d.next = self.pc.val() + 1;
-        self.target_i5.d.next = self.target.val();
-        self.is_wait_i5.d.next = self.is_wait.val();
-        self.kd_busy_i5.d.next = self.kd_busy.val();
-        self.tri_busy_i5.d.next = self.tri_busy.val();
-        self.jr_target_i5.d.next = self.jr_target.val();
-        self.int_eq_i5.d.next = self.int_eq.val();
-        self.int_lt_i5.d.next = self.int_lt.val();
-        self.pix_done_i5.d.next = self.pix_done.val();
+        // I5: the instruction into registers (its conditions arrive late in the clock).
+        self.valid_i6.d.next = self.valid.val();
+        self.op_i6.d.next = self.op.val();
+        self.dst_i6.d.next = self.dst.val();
+        self.thread_i6.d.next = self.thread.val();
+        self.invert_i6.d.next = self.invert.val();
+        self.pc_i6.d.next = self.pc.val();
+        self.pc_plus_one_i6.d.next = self.pc.val() + 1;
+        self.target_i6.d.next = self.target.val();
+        self.is_wait_i6.d.next = self.is_wait.val();
+        self.kd_busy_i6.d.next = self.kd_busy.val();
+        self.tri_busy_i6.d.next = self.tri_busy.val();
+        self.jr_target_i6.d.next = self.jr_target.val();
+        self.int_eq_i6.d.next = self.int_eq.val();
+        self.int_lt_i6.d.next = self.int_lt.val();
+        self.pix_done_i6.d.next = self.pix_done.val();
 
-        // I5: decode.
-        self.is_long.next = (self.op_i5.q.val() == self.op_fdiv.val())
-            | (self.op_i5.q.val() == self.op_fsqrt.val());
-        self.is_mbx.next = self.op_i5.q.val() == self.op_mbx.val();
-        self.halts.next = self.op_i5.q.val() == self.op_halt.val();
+        // I6: decode.
+        self.is_long.next = (self.op_i6.q.val() == self.op_fdiv.val())
+            | (self.op_i6.q.val() == self.op_fsqrt.val());
+        self.is_mbx.next = self.op_i6.q.val() == self.op_mbx.val();
+        self.halts.next = self.op_i6.q.val() == self.op_halt.val();
         // A coprocessor refused the entry (queue full) or has not finished (a wait).
-        self.repeats.next = ((self.op_i5.q.val() == self.op_tri.val()) & self.tri_busy_i5.q.val())
-            | ((self.op_i5.q.val() == self.op_kd.val()) & self.kd_busy_i5.q.val());
+        self.repeats.next = ((self.op_i6.q.val() == self.op_tri.val()) & self.tri_busy_i6.q.val())
+            | ((self.op_i6.q.val() == self.op_kd.val()) & self.kd_busy_i6.q.val());
         self.keeps_pc.next = self.halts.val() | self.repeats.val();
-        self.cond_i5.next = ((self.op_i5.q.val() == self.op_beq.val()) & self.int_eq_i5.q.val())
-            | ((self.op_i5.q.val() == self.op_bltu.val()) & self.int_lt_i5.q.val())
-            | ((self.op_i5.q.val() == self.op_pixel.val()) & self.pix_done_i5.q.val())
-            | (self.op_i5.q.val() == self.op_jal.val())
+        self.cond_i6.next = ((self.op_i6.q.val() == self.op_beq.val()) & self.int_eq_i6.q.val())
+            | ((self.op_i6.q.val() == self.op_bltu.val()) & self.int_lt_i6.q.val())
+            | ((self.op_i6.q.val() == self.op_pixel.val()) & self.pix_done_i6.q.val())
+            | (self.op_i6.q.val() == self.op_jal.val())
             | self.repeats.val();
         // The next pc when the condition holds (`pc_target`) and when not (`pc_next`), unless
         // the op sets it whatever the condition (`pc_other`).
-        self.pc_target.next = self.target_i5.q.val();
-        self.pc_next.next = self.pc_plus_one_i5.q.val();
-        if self.invert_i5.q.val() {
-            self.pc_target.next = self.pc_plus_one_i5.q.val();
-            self.pc_next.next = self.target_i5.q.val();
+        self.pc_target.next = self.target_i6.q.val();
+        self.pc_next.next = self.pc_plus_one_i6.q.val();
+        if self.invert_i6.q.val() {
+            self.pc_target.next = self.pc_plus_one_i6.q.val();
+            self.pc_next.next = self.target_i6.q.val();
         }
-        self.pc_other.next = self.jr_target_i5.q.val();
+        self.pc_other.next = self.jr_target_i6.q.val();
         if self.keeps_pc.val() {
-            self.pc_other.next = self.pc_i5.q.val();
+            self.pc_other.next = self.pc_i6.q.val();
         }
-        if self.keeps_pc.val() | (self.op_i5.q.val() == self.op_jr.val()) {
+        if self.keeps_pc.val() | (self.op_i6.q.val() == self.op_jr.val()) {
             self.pc_target.next = self.pc_other.val();
             self.pc_next.next = self.pc_other.val();
         }
-        self.source_i5.next = ResultSource::Fast;
-        if (self.op_i5.q.val() == self.op_fadd.val()) | (self.op_i5.q.val() == self.op_fsub.val()) {
-            self.source_i5.next = ResultSource::Sum;
+        self.source_i6.next = ResultSource::Fast;
+        if (self.op_i6.q.val() == self.op_fadd.val()) | (self.op_i6.q.val() == self.op_fsub.val()) {
+            self.source_i6.next = ResultSource::Sum;
         }
-        if self.op_i5.q.val() == self.op_fmul.val() {
-            self.source_i5.next = ResultSource::Product;
+        if self.op_i6.q.val() == self.op_fmul.val() {
+            self.source_i6.next = ResultSource::Product;
         }
-        if self.op_i5.q.val() == self.op_fdiv.val() {
-            self.source_i5.next = ResultSource::Quotient;
+        if self.op_i6.q.val() == self.op_fdiv.val() {
+            self.source_i6.next = ResultSource::Quotient;
         }
-        if self.op_i5.q.val() == self.op_fsqrt.val() {
-            self.source_i5.next = ResultSource::Root;
+        if self.op_i6.q.val() == self.op_fsqrt.val() {
+            self.source_i6.next = ResultSource::Root;
         }
-        if self.op_i5.q.val() == self.op_byte.val() {
-            self.source_i5.next = ResultSource::Byte;
+        if self.op_i6.q.val() == self.op_byte.val() {
+            self.source_i6.next = ResultSource::Byte;
         }
-        self.valid_line.data_in.next = self.valid_i5.q.val();
+        self.valid_line.data_in.next = self.valid_i6.q.val();
         self.is_long_line.data_in.next = self.is_long.val();
-        self.dst_line.data_in.next = self.dst_i5.q.val();
-        self.thread_line.data_in.next = self.thread_i5.q.val();
+        self.dst_line.data_in.next = self.dst_i6.q.val();
+        self.thread_line.data_in.next = self.thread_i6.q.val();
         // `pixel` writes nothing once the frame's pixels are exhausted.
-        self.write_line.data_in.next = self.valid_i5.q.val()
-            & (self.dst_i5.q.val() != 0)
-            & self.op_writes.val().get_bit(self.op_i5.q.val().index())
-            & (!((self.op_i5.q.val() == self.op_pixel.val()) & self.pix_done_i5.q.val()));
-        self.source_line.data_in.next = self.source_i5.val();
-        self.sel_lt_line.data_in.next = self.op_i5.q.val() == self.op_bflt.val();
-        self.sel_le_line.data_in.next = self.op_i5.q.val() == self.op_bfle.val();
-        self.sel_eq_line.data_in.next = self.op_i5.q.val() == self.op_bfeq.val();
+        self.write_line.data_in.next = self.valid_i6.q.val()
+            & (self.dst_i6.q.val() != 0)
+            & self.op_writes.val().get_bit(self.op_i6.q.val().index())
+            & (!((self.op_i6.q.val() == self.op_pixel.val()) & self.pix_done_i6.q.val()));
+        self.source_line.data_in.next = self.source_i6.val();
+        self.sel_lt_line.data_in.next = self.op_i6.q.val() == self.op_bflt.val();
+        self.sel_le_line.data_in.next = self.op_i6.q.val() == self.op_bfle.val();
+        self.sel_eq_line.data_in.next = self.op_i6.q.val() == self.op_bfeq.val();
         self.pc_taken_line.data_in.next = self.pc_target.val();
         self.pc_not_taken_line.data_in.next = self.pc_next.val();
         self.halt_line.data_in.next = self.halts.val();
-        self.retired_line.data_in.next = self.valid_i5.q.val() & (!self.repeats.val());
+        self.retired_line.data_in.next = self.valid_i6.q.val() & (!self.repeats.val());
         // Only the coprocessor waits set `is_wait`, and their condition is `repeats`.
-        self.wait_pending_line.data_in.next = self.repeats.val() & self.is_wait_i5.q.val();
-        self.cond_i6.d.next = self.cond_i5.val();
-        self.is_mbx_i6.d.next = self.is_mbx.val();
+        self.wait_pending_line.data_in.next = self.repeats.val() & self.is_wait_i6.q.val();
+        self.cond_i7.d.next = self.cond_i6.val();
+        self.is_mbx_i7.d.next = self.is_mbx.val();
 
-        // I6: the mailbox's hit.
+        // I7: the mailbox's hit.
         self.cond_line.data_in.next =
-            self.cond_i6.q.val() | (self.is_mbx_i6.q.val() & self.mb_hit.val());
+            self.cond_i7.q.val() | (self.is_mbx_i7.q.val() & self.mb_hit.val());
 
-        // The fast line: scratch data at I5, memory data at I5 + latency.
+        // The fast line: scratch data at I6, memory data at I6 + latency.
         self.fast_line[0].d.next = self.fast.val();
         self.kind_line[0].d.next = self.kind.val();
         for k in 1..8 {
