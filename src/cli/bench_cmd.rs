@@ -124,8 +124,10 @@ fn say(json: bool, line: &str) {
     }
 }
 
-/// The rows of a CSV table as JSON objects keyed by its header (numbers as numbers).
-pub(crate) fn csv_rows_json(csv_text: &str) -> serde_json::Value {
+/// The rows of a CSV table as JSON objects keyed by its header (numbers as numbers, `true` and
+/// `false` as booleans), but the cells of `text_columns` as text: a version such as yosys
+/// "0.70" read as a number would print as 0.7.
+pub(crate) fn csv_rows_json(csv_text: &str, text_columns: &[&str]) -> serde_json::Value {
     let mut r = csv::Reader::from_reader(csv_text.as_bytes());
     let header: Vec<String> = match r.headers() {
         Ok(h) => h.iter().map(str::to_string).collect(),
@@ -138,7 +140,14 @@ pub(crate) fn csv_rows_json(csv_text: &str) -> serde_json::Value {
             let m: serde_json::Map<String, serde_json::Value> = header
                 .iter()
                 .zip(rec.iter())
-                .map(|(k, v)| (k.clone(), cell_json(v)))
+                .map(|(k, v)| {
+                    let cell = if text_columns.contains(&k.as_str()) {
+                        v.into()
+                    } else {
+                        cell_json(v)
+                    };
+                    (k.clone(), cell)
+                })
                 .collect();
             serde_json::Value::Object(m)
         })
@@ -146,8 +155,12 @@ pub(crate) fn csv_rows_json(csv_text: &str) -> serde_json::Value {
     serde_json::Value::Array(rows)
 }
 
-/// A CSV cell as JSON: an integer or a finite number when it reads as one, else the text.
+/// A CSV cell as JSON: an integer, a finite number or a boolean when it reads as one, else
+/// the text.
 fn cell_json(v: &str) -> serde_json::Value {
+    if let Ok(b) = v.parse::<bool>() {
+        return b.into();
+    }
     if let Ok(i) = v.parse::<i64>() {
         return i.into();
     }
@@ -181,7 +194,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             let t = bench::fp::fp_table(&measured);
             t.save(&a.out, "fp")?;
             say(json, t.to_markdown().trim_end());
-            rows = csv_rows_json(&t.to_csv());
+            rows = csv_rows_json(&t.to_csv(), &[]);
             s.option(
                 "formats",
                 formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
@@ -216,7 +229,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             let summary = bench::summarize(&measured);
             let csv = bench::precision::summary_csv(&summary);
             say(json, csv.trim_end());
-            rows = csv_rows_json(&csv);
+            rows = csv_rows_json(&csv, &[]);
             s.option("margin", margin)
                 .option("scenes_dir", &dir)
                 .option("resolution", resolution.map(|(w, h)| format!("{w}x{h}")));
@@ -240,7 +253,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             let t = bench::scenes::scenes_table(&measured);
             t.save(&a.out, "scenes")?;
             say(json, t.to_markdown().trim_end());
-            rows = csv_rows_json(&t.to_csv());
+            rows = csv_rows_json(&t.to_csv(), &[]);
             s.option("scenes", &scenes)
                 .option(
                     "formats",
@@ -282,7 +295,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
                 .push(format!("fps at {mhz:.1} MHz ({clock_source})"));
             s.details_md = md;
             rows = std::fs::read_to_string(a.out.join("paper.csv"))
-                .map(|t| csv_rows_json(&t))
+                .map(|t| csv_rows_json(&t, &[]))
                 .unwrap_or_default();
             if differs {
                 s.pass = false;
@@ -310,7 +323,7 @@ pub fn run(a: BenchArgs) -> anyhow::Result<i32> {
             let t = bench::trees::trees_table(&measured);
             t.save(&a.out, "trees")?;
             say(json, t.to_markdown().trim_end());
-            rows = csv_rows_json(&t.to_csv());
+            rows = csv_rows_json(&t.to_csv(), &[]);
             s.option("scenes", &scenes).option("meshes", &meshes);
             s.details_md = t.to_markdown();
         }

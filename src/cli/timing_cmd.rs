@@ -339,7 +339,7 @@ fn timing_json(
         "format": a.format.to_string(),
         "seeds": a.seeds,
         "tools": { "yosys": tools.yosys_version, "nextpnr-ecp5": tools.nextpnr_version },
-        "rows": super::bench_cmd::csv_rows_json(&timing_table::csv(done)),
+        "rows": super::bench_cmd::csv_rows_json(&timing_table::csv(done), &["yosys", "nextpnr"]),
         "failed": failed,
         "files": files,
     })

@@ -11,7 +11,8 @@ pub struct ImageMetrics {
     pub differing_pixels: usize,
     /// Largest absolute difference of one 8-bit channel.
     pub max_channel_error: u8,
-    /// Peak signal-to-noise ratio in dB over all channels (infinite for identical images).
+    /// Peak signal-to-noise ratio in dB over all channels, peak 255 (imageproc's; infinite for
+    /// identical images).
     pub psnr_db: f64,
     /// Structural similarity (image-compare's mean SSIM over 8x8 windows, the lowest of the
     /// three channels): 1 for identical images, lower as structure and contrast differ.
@@ -40,24 +41,17 @@ pub fn compare_images(a: &image::RgbImage, b: &image::RgbImage) -> anyhow::Resul
     }
     let mut differing = 0;
     let mut max_err = 0u8;
-    let mut sq = 0f64;
     for (pa, pb) in a.pixels().zip(b.pixels()) {
         let mut differs = false;
         for c in 0..3 {
             let e = pa[c].abs_diff(pb[c]);
             differs |= e != 0;
             max_err = max_err.max(e);
-            sq += f64::from(e).powi(2);
         }
         differing += usize::from(differs);
     }
     let pixels = (a.width() * a.height()) as usize;
-    let mse = sq / (3 * pixels.max(1)) as f64;
-    let psnr_db = if mse == 0.0 {
-        f64::INFINITY
-    } else {
-        10.0 * (255.0f64 * 255.0 / mse).log10()
-    };
+    let psnr_db = imageproc::stats::peak_signal_to_noise_ratio(a, b);
     let ssim =
         image_compare::rgb_similarity_structure(&image_compare::Algorithm::MSSIMSimple, a, b)
             .map_err(|e| anyhow::anyhow!("computing the SSIM: {e}"))?
@@ -354,10 +348,11 @@ mod tests {
             (m.pixels, m.differing_pixels, m.max_channel_error),
             (8, 2, 4)
         );
-        // MSE = (16 + 9) / 24.
+        // MSE = (16 + 9) / 24 over the 24 subpixels: 47.95 dB.
         let want = 10.0 * (255.0f64.powi(2) / (25.0 / 24.0)).log10();
-        assert!((m.psnr_db - want).abs() < 1e-12);
-        assert!(compare_images(&a, &a).unwrap().psnr_db.is_infinite());
+        assert!((m.psnr_db - want).abs() < 1e-12, "{} dB", m.psnr_db);
+        assert!((m.psnr_db - 47.9535).abs() < 1e-4, "{} dB", m.psnr_db);
+        assert_eq!(compare_images(&a, &a).unwrap().psnr_db, f64::INFINITY);
         let d = diff_image(&a, &b);
         assert_eq!(d.get_pixel(1, 1).0, [0, 64, 0]);
         assert_eq!(d.get_pixel(0, 0).0, [0, 0, 0]);
