@@ -180,6 +180,8 @@ struct Builder<'a, P: KdPrimitives> {
     /// [`Builder::build_best_first`] pops every split itself (the reference the tests
     /// compare the pruned finish with).
     plain_best_first: bool,
+    /// Whether the budget stopped [`Builder::build_best_first`] (candidates were left).
+    budget_bound: bool,
 }
 
 /// Lists longer than this are freed rather than pooled (a handful of nodes near the root; the
@@ -228,6 +230,7 @@ fn build_in_order<P: KdPrimitives>(prims: &P, params: &KdParams, best_first_only
         over_budget: false,
         lost_prim: false,
         plain_best_first: false,
+        budget_bound: false,
     };
     let budget = params.node_budget(count);
     let (clips, root_box) = match params.split_format {
@@ -273,6 +276,24 @@ fn build_in_order<P: KdPrimitives>(prims: &P, params: &KdParams, best_first_only
         let budget = budget - chain;
         builder.plain_best_first = best_first_only;
         builder.build_best_first(node, voxel, events, count, depth, budget);
+        if !builder.budget_bound {
+            // The tree the depth-first build makes, whose clip planes' empty leaves start at
+            // 0 (renumbered, they start where the primitives before them end): the layout
+            // of a tree within its budget stays what it was.
+            let mut at = 0;
+            for &(_, _, empty_below) in &clips {
+                let KdNode::Inner { children, .. } = builder.nodes[at] else {
+                    break;
+                };
+                let (empty, next) = if empty_below {
+                    (children as usize, children as usize + 1)
+                } else {
+                    (children as usize + 1, children as usize)
+                };
+                builder.nodes[empty] = KdNode::Leaf { first: 0, count: 0 };
+                at = next;
+            }
+        }
     }
     KdTree {
         nodes: builder.nodes,
@@ -654,6 +675,7 @@ impl<P: KdPrimitives> Builder<'_, P> {
                 &mut waiting,
             );
         }
+        self.budget_bound = !heap.is_empty();
         for c in waiting.into_iter().flatten() {
             self.make_leaf(c.node, &c.events, c.depth);
             self.recycle(c.events);
@@ -739,12 +761,15 @@ impl<P: KdPrimitives> Builder<'_, P> {
             let fits = (self.nodes.len() - nodes0) as u64 + used + 2 <= budget;
             let keep = match (fits, seeds.is_empty()) {
                 (true, false) => None,
-                (true, true) => Some(
-                    self.nodes
-                        .iter()
-                        .map(|n| matches!(n, KdNode::Inner { .. }))
-                        .collect(),
-                ),
+                (true, true) => {
+                    self.budget_bound = false;
+                    Some(
+                        self.nodes
+                            .iter()
+                            .map(|n| matches!(n, KdNode::Inner { .. }))
+                            .collect(),
+                    )
+                }
                 (false, _) => self.replay(heap, waiting, used, budget, &made, &keys),
             };
             if let Some(keep) = keep {
@@ -777,7 +802,7 @@ impl<P: KdPrimitives> Builder<'_, P> {
     /// nodes it splits (`made`: those it made before, and clip planes), or `None` if it wants
     /// a split the pruned build left out.
     fn replay(
-        &self,
+        &mut self,
         heap: &std::collections::BinaryHeap<(u64, std::cmp::Reverse<usize>, usize)>,
         waiting: &[Option<Candidate>],
         mut used: u64,
@@ -808,6 +833,7 @@ impl<P: KdPrimitives> Builder<'_, P> {
                 }
             }
         }
+        self.budget_bound = !heap.is_empty();
         Some(keep)
     }
 
@@ -1506,6 +1532,21 @@ mod tests {
                     "{name} {per_prim}"
                 );
             }
+            // Wrapped in the root clip's planes too, whose empty leaves start at 0 in the
+            // depth-first build (the layout's node bank holds that field).
+            let clipped = |nodes_per_prim| KdParams {
+                nodes_per_prim,
+                split_format: Some(crate::fp::Format::E7M16),
+                root_clip: true,
+                ..KdParams::default()
+            };
+            let tree = build_sah(&tris, &clipped(None));
+            assert_eq!(tree, build_sah(&tris, &clipped(Some(1000))), "{name} clip");
+            assert_eq!(
+                tree,
+                build_in_order(&Triangles(&tris), &clipped(Some(1000)), true),
+                "{name} clip"
+            );
         }
     }
 
