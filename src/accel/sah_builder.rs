@@ -14,7 +14,7 @@
 //!   the tree best split first (the largest SAH saving) makes until the budget is spent,
 //!   renumbered into the depth-first order; built best first for the top splits, then depth
 //!   first below them, pruned at a guessed saving and checked by replaying best first's
-//!   order on the savings found ([`Builder::finish_pruned`]).
+//!   order on the savings found (`Builder::finish_pruned`).
 //! - With `root_clip`, the tree sits below a chain of planes at the primitives' bounds that
 //!   cut off empty space, for a walk that does not clip rays to the root box.
 //! - Primitives are classified left / right / both from the split axis' events; the lists are
