@@ -86,8 +86,8 @@ pub struct KdParams {
     pub split_format: Option<Format>,
     /// Node budget: a tree over `n` primitives gets at most `nodes_per_prim * n` nodes (at
     /// least 1). The builder makes the splits it would make without a budget, those that save
-    /// the most SAH cost first, while the budget pays for two more children (depth first
-    /// when the whole tree fits). `None`: no budget
+    /// the most SAH cost first, while the budget pays for two more children (built mostly
+    /// depth first, see `sah_builder`). `None`: no budget
     /// (the SAH, the leaf size cap and the depth limit alone decide). The default 3 keeps
     /// object trees within 3 nodes per triangle (the Stanford bunny took 19 without it).
     pub nodes_per_prim: Option<u32>,

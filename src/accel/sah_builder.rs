@@ -10,9 +10,11 @@
 //!   lying in the plane go to whichever side is cheaper.
 //! - The best plane splits the node if it is cheaper than a leaf (`C_i N`), or if the leaf would
 //!   exceed `max_leaf_prims` and some plane separates primitives; never below the depth limit.
-//!   The tree is built depth first; under a node budget (`nodes_per_prim`) that the tree
-//!   outgrows, it is built again best split first (the largest SAH saving) until the budget
-//!   is spent, then renumbered into the depth-first order.
+//!   Without a node budget the tree is built depth first. Under one (`nodes_per_prim`) it is
+//!   the tree best split first (the largest SAH saving) makes until the budget is spent,
+//!   renumbered into the depth-first order; built best first for the top splits, then depth
+//!   first below them, pruned at a guessed saving and checked by replaying best first's
+//!   order on the savings found (`Builder::finish_pruned`).
 //! - With `root_clip`, the tree sits below a chain of planes at the primitives' bounds that
 //!   cut off empty space, for a walk that does not clip rays to the root box.
 //! - Primitives are classified left / right / both from the split axis' events; the lists are
@@ -171,6 +173,15 @@ struct Builder<'a, P: KdPrimitives> {
     /// sets `over_budget` instead and stops.
     node_cap: usize,
     over_budget: bool,
+    /// Set when a straddling primitive touched neither child (conservative clipping makes
+    /// this all but impossible): the pruned best-first build then falls back, since it
+    /// takes a collapsed node's primitives from the leaves below it.
+    lost_prim: bool,
+    /// [`Builder::build_best_first`] pops every split itself (the reference the tests
+    /// compare the pruned finish with).
+    plain_best_first: bool,
+    /// Whether the budget stopped [`Builder::build_best_first`] (candidates were left).
+    budget_bound: bool,
 }
 
 /// Lists longer than this are freed rather than pooled (a handful of nodes near the root; the
@@ -182,8 +193,8 @@ pub fn build<P: KdPrimitives>(prims: &P, params: &KdParams) -> KdTree {
     build_in_order(prims, params, false)
 }
 
-/// [`build`]; `best_first_only` skips the depth-first attempt under a node budget (for the
-/// tests that compare the two orders).
+/// [`build`]; `best_first_only` makes every split under a node budget best first, without
+/// the pruned depth-first finish (the reference the tests compare it with).
 fn build_in_order<P: KdPrimitives>(prims: &P, params: &KdParams, best_first_only: bool) -> KdTree {
     let n = prims.len();
     let mut events: Events = [
@@ -217,6 +228,9 @@ fn build_in_order<P: KdPrimitives>(prims: &P, params: &KdParams, best_first_only
         both: Vec::new(),
         node_cap: usize::MAX,
         over_budget: false,
+        lost_prim: false,
+        plain_best_first: false,
+        budget_bound: false,
     };
     let budget = params.node_budget(count);
     let (clips, root_box) = match params.split_format {
@@ -260,24 +274,25 @@ fn build_in_order<P: KdPrimitives>(prims: &P, params: &KdParams, best_first_only
         // once the budget binds. Best first keeps the lists of the whole frontier and visits
         // nodes out of order: it built the unbudgeted terrain's f64 tree about 3x slower.
         let budget = budget - chain;
-        let first_nodes = builder.nodes.len();
-        let retry = (!best_first_only).then(|| events.clone());
-        let events = match retry {
-            Some(copy) => {
-                builder.node_cap = (first_nodes - 1).saturating_add(budget as usize);
-                builder.build_node(node, voxel, copy, count, depth);
-                builder.node_cap = usize::MAX;
-                builder.over_budget.then_some(events)
+        builder.plain_best_first = best_first_only;
+        builder.build_best_first(node, voxel, events, count, depth, budget);
+        if !builder.budget_bound {
+            // The tree the depth-first build makes, whose clip planes' empty leaves start at
+            // 0 (renumbered, they start where the primitives before them end): the layout
+            // of a tree within its budget stays what it was.
+            let mut at = 0;
+            for &(_, _, empty_below) in &clips {
+                let KdNode::Inner { children, .. } = builder.nodes[at] else {
+                    break;
+                };
+                let (empty, next) = if empty_below {
+                    (children as usize, children as usize + 1)
+                } else {
+                    (children as usize + 1, children as usize)
+                };
+                builder.nodes[empty] = KdNode::Leaf { first: 0, count: 0 };
+                at = next;
             }
-            None => Some(events),
-        };
-        if let Some(events) = events {
-            builder.nodes.truncate(first_nodes);
-            builder.nodes[node] = KdNode::Leaf { first: 0, count: 0 };
-            builder.prim_indices.clear();
-            builder.depth = depth;
-            builder.over_budget = false;
-            builder.build_best_first(node, voxel, events, count, depth, budget);
         }
     }
     KdTree {
@@ -324,27 +339,144 @@ fn root_clips(f: crate::fp::Format, bounds: &Aabb) -> (Vec<(usize, f64, bool)>, 
     (clips, outer)
 }
 
+/// [`Builder::build_best_first`] pops `1 / PRUNE_TOP_SHARE` of the splits itself before it
+/// guesses the saving of its last split and finishes pruned depth first.
+const PRUNE_TOP_SHARE: usize = 256;
+/// Fewer splits than this at the top are too few to guess from (small trees).
+const PRUNE_MIN_TOP_POPS: usize = 32;
+
+/// A guess somewhat below the saving of the last of `total_pops` best-first splits, from the
+/// smallest savings after a quarter of the first `top_pops` splits and after all of them: the
+/// number of splits saving at least `t` taken to fall as a power of `t`, and halved for a
+/// margin. Negative infinity (no pruning) where that says nothing.
+fn pruning_threshold(quarter: f64, lowest: f64, top_pops: usize, total_pops: usize) -> f64 {
+    if !(lowest > 0.0 && quarter > lowest && quarter.is_finite()) {
+        return f64::NEG_INFINITY;
+    }
+    // splits(t) ~ t^-alpha: four times the splits at `lowest` as at `quarter`.
+    let alpha = 4f64.ln() / (quarter / lowest).ln();
+    let guess = lowest * (total_pops as f64 / top_pops as f64).powf(-1.0 / alpha);
+    if guess.is_finite() && guess > 0.0 {
+        0.5 * guess
+    } else {
+        f64::NEG_INFINITY
+    }
+}
+
+/// The candidates a pruned round left out, their lists copied into one buffer so that theirs
+/// go back to the pool at once (kept apart, they drained it: the terrain's 131,072 triangles
+/// built 40% slower).
+#[derive(Default)]
+struct LeftOut {
+    events: Vec<Event>,
+    /// Each candidate with its lists' lengths (`events` holds them one after the other).
+    candidates: Vec<(Candidate, [usize; 3])>,
+}
+
+impl LeftOut {
+    fn push(&mut self, c: &Candidate) {
+        for list in &c.events {
+            self.events.extend_from_slice(list);
+        }
+        let lens = [0, 1, 2].map(|a| c.events[a].len());
+        let shell = Candidate {
+            events: Default::default(),
+            ..*c
+        };
+        self.candidates.push((shell, lens));
+    }
+
+    fn into_candidates<P: KdPrimitives>(self, builder: &mut Builder<P>) -> Vec<Candidate> {
+        let mut at = 0;
+        let mut out = Vec::with_capacity(self.candidates.len());
+        for (mut c, lens) in self.candidates {
+            c.events = builder.fresh();
+            for (list, len) in c.events.iter_mut().zip(lens) {
+                list.extend_from_slice(&self.events[at..at + len]);
+                at += len;
+            }
+            out.push(c);
+        }
+        out
+    }
+}
+
 /// A node waiting to be split: its lists and the plane its split would use.
 struct Candidate {
     node: usize,
     voxel: Aabb,
     events: Events,
+    n: usize,
     depth: u32,
     plane: Plane,
+}
+
+/// The inverse of [`ordered_bits`].
+fn from_ordered_bits(key: u64) -> f64 {
+    f64::from_bits(if key >> 63 == 1 {
+        key & !(1 << 63)
+    } else {
+        !key
+    })
 }
 
 /// Renumbers a tree into the order [`Builder::build_node`] creates it in: depth first, left
 /// before right, each node's children allocated when it is split, leaves' primitives laid out
 /// in that order.
 fn depth_first_order(nodes: &[KdNode], prims: &[u32]) -> (Vec<KdNode>, Vec<u32>) {
+    let (nodes, prims, _) = depth_first_order_kept(nodes, prims, None);
+    (nodes, prims)
+}
+
+/// [`depth_first_order`], with the inner nodes that `keep` does not hold made leaves of the
+/// primitives of the leaves below them (sorted, each once); also returns the depth of the
+/// deepest leaf.
+fn depth_first_order_kept(
+    nodes: &[KdNode],
+    prims: &[u32],
+    keep: Option<&[bool]>,
+) -> (Vec<KdNode>, Vec<u32>, u32) {
+    fn gather(nodes: &[KdNode], prims: &[u32], old: usize, out: &mut Vec<u32>) {
+        match nodes[old] {
+            KdNode::Inner { children, .. } => {
+                gather(nodes, prims, children as usize, out);
+                gather(nodes, prims, children as usize + 1, out);
+            }
+            KdNode::Leaf { first, count } => {
+                out.extend_from_slice(&prims[first as usize..(first + count) as usize]);
+            }
+        }
+    }
+    #[allow(clippy::too_many_arguments)]
     fn visit(
         nodes: &[KdNode],
         prims: &[u32],
+        keep: Option<&[bool]>,
         old: usize,
         new: usize,
+        depth: u32,
+        max_depth: &mut u32,
         out: &mut (Vec<KdNode>, Vec<u32>),
     ) {
         match nodes[old] {
+            KdNode::Inner { .. } if keep.is_some_and(|k| !k[old]) => {
+                let f = out.1.len();
+                gather(nodes, prims, old, &mut out.1);
+                out.1[f..].sort_unstable();
+                let mut w = f;
+                for r in f..out.1.len() {
+                    if w == f || out.1[r] != out.1[w - 1] {
+                        out.1[w] = out.1[r];
+                        w += 1;
+                    }
+                }
+                out.1.truncate(w);
+                out.0[new] = KdNode::Leaf {
+                    first: f as u32,
+                    count: (w - f) as u32,
+                };
+                *max_depth = (*max_depth).max(depth);
+            }
             KdNode::Inner {
                 axis,
                 split,
@@ -358,8 +490,18 @@ fn depth_first_order(nodes: &[KdNode], prims: &[u32]) -> (Vec<KdNode>, Vec<u32>)
                 };
                 out.0.push(KdNode::Leaf { first: 0, count: 0 });
                 out.0.push(KdNode::Leaf { first: 0, count: 0 });
-                visit(nodes, prims, children as usize, c, out);
-                visit(nodes, prims, children as usize + 1, c + 1, out);
+                let d = depth + 1;
+                visit(nodes, prims, keep, children as usize, c, d, max_depth, out);
+                visit(
+                    nodes,
+                    prims,
+                    keep,
+                    children as usize + 1,
+                    c + 1,
+                    d,
+                    max_depth,
+                    out,
+                );
             }
             KdNode::Leaf { first, count } => {
                 let f = out.1.len();
@@ -369,6 +511,7 @@ fn depth_first_order(nodes: &[KdNode], prims: &[u32]) -> (Vec<KdNode>, Vec<u32>)
                     first: f as u32,
                     count,
                 };
+                *max_depth = (*max_depth).max(depth);
             }
         }
     }
@@ -377,8 +520,9 @@ fn depth_first_order(nodes: &[KdNode], prims: &[u32]) -> (Vec<KdNode>, Vec<u32>)
         Vec::with_capacity(prims.len()),
     );
     out.0.push(KdNode::Leaf { first: 0, count: 0 });
-    visit(nodes, prims, 0, 0, &mut out);
-    out
+    let mut max_depth = 0;
+    visit(nodes, prims, keep, 0, 0, 0, &mut max_depth, &mut out);
+    (out.0, out.1, max_depth)
 }
 
 impl<P: KdPrimitives> Builder<'_, P> {
@@ -472,8 +616,38 @@ impl<P: KdPrimitives> Builder<'_, P> {
             &mut waiting,
         );
         let mut used = 1;
-        while used + 2 <= budget {
-            let Some((_, _, i)) = heap.pop() else { break };
+        // The splits the budget pays for (`used + 2 <= budget` before each).
+        let total_pops = (budget.saturating_sub(1) / 2) as usize;
+        let top_pops = (total_pops / PRUNE_TOP_SHARE).max((total_pops / 16).min(512));
+        let mut pops = 0;
+        // The smallest saving popped after a quarter of `top_pops`, and after all of them.
+        let (mut quarter, mut lowest) = (f64::INFINITY, f64::INFINITY);
+        loop {
+            if pops == top_pops
+                && top_pops >= PRUNE_MIN_TOP_POPS
+                && used + 2 <= budget
+                && !self.plain_best_first
+            {
+                // The guess first, a lower one, then none but a cap at the budget (a tree
+                // the budget does not bind wants every split there is); each round goes on
+                // from the candidates the one before left out. If all fail, best first goes
+                // on.
+                let guess = pruning_threshold(quarter, lowest, top_pops, total_pops);
+                let rounds = [(guess, 4), (guess / 16.0, 4), (f64::NEG_INFINITY, 1)];
+                let r = self.finish_pruned(&heap, &waiting, used, budget, root_area, &rounds);
+                if r {
+                    return;
+                }
+            }
+            if used + 2 > budget {
+                break;
+            }
+            let Some((key, _, i)) = heap.pop() else { break };
+            lowest = lowest.min(from_ordered_bits(key));
+            pops += 1;
+            if pops == top_pops / 4 {
+                quarter = lowest;
+            }
             let c: Candidate = waiting[i].take().expect("a candidate is split once");
             let (vl, vr) = c.voxel.split(c.plane.axis, c.plane.pos);
             let (left, nl, right, nr) = self.split_events(c.events, &c.plane, &vl, &vr);
@@ -501,6 +675,7 @@ impl<P: KdPrimitives> Builder<'_, P> {
                 &mut waiting,
             );
         }
+        self.budget_bound = !heap.is_empty();
         for c in waiting.into_iter().flatten() {
             self.make_leaf(c.node, &c.events, c.depth);
             self.recycle(c.events);
@@ -508,6 +683,227 @@ impl<P: KdPrimitives> Builder<'_, P> {
         let (nodes, prims) = depth_first_order(&self.nodes, &self.prim_indices);
         self.nodes = nodes;
         self.prim_indices = prims;
+    }
+
+    /// Finishes [`Builder::build_best_first`] from the state its heap and candidates are in,
+    /// with the locality of the depth-first build (best first keeps a whole frontier of lists
+    /// and splits them out of order: the same tree took it 2.3 times as long as depth first).
+    ///
+    /// Best first splits a node exactly when the smallest saving on its path from the root
+    /// is high enough: the savings it pops, taken as that minimum, never rise, so it splits
+    /// every node whose minimum is above that of its last split before any other. So below
+    /// each candidate the tree is built depth first, splitting only nodes whose saving is at
+    /// least a round's threshold and recording every candidate's saving; best first's order
+    /// is then replayed on the recorded savings (the same heap, keys and tie-breaks), and the
+    /// nodes it does not split are made leaves of the primitives of the leaves below them.
+    /// If the replay wants a split the threshold left out, the next round goes on from the
+    /// candidates left out with its lower threshold. Returns false, the builder as it was,
+    /// if the rounds run out, the pruned tree outgrows a round's cap (`cap` times the budget
+    /// left), or a primitive was lost to clipping; the tree is otherwise best first's bit
+    /// for bit.
+    fn finish_pruned(
+        &mut self,
+        heap: &std::collections::BinaryHeap<(u64, std::cmp::Reverse<usize>, usize)>,
+        waiting: &[Option<Candidate>],
+        used: u64,
+        budget: u64,
+        root_area: f64,
+        rounds: &[(f64, usize)],
+    ) -> bool {
+        let (nodes0, prims0, depth0) = (self.nodes.len(), self.prim_indices.len(), self.depth);
+        self.over_budget = false;
+        self.lost_prim = false;
+        // The heap key of every candidate the pruned build evaluates.
+        let mut keys: Vec<Option<u64>> = vec![None; nodes0];
+        // The splits made so far (and clip planes); the rounds split the candidates among
+        // nodes0 too.
+        let made: Vec<bool> = self
+            .nodes
+            .iter()
+            .map(|n| matches!(n, KdNode::Inner { .. }))
+            .collect();
+        let mut seeds: Vec<Candidate> = waiting
+            .iter()
+            .flatten()
+            .map(|c| Candidate {
+                node: c.node,
+                voxel: c.voxel,
+                events: c.events.clone(),
+                n: c.n,
+                depth: c.depth,
+                plane: c.plane,
+            })
+            .collect();
+        let mut built = false;
+        for &(threshold, cap) in rounds {
+            // Overshooting the budget costs little (a threshold at half the right one grew
+            // the bunny's tree by a fifth); beyond the cap the guess was far off.
+            self.node_cap = nodes0.saturating_add(cap.saturating_mul((budget - used) as usize));
+            let mut left_out = LeftOut::default();
+            for c in seeds.drain(..) {
+                let saving = self.saving(&c.voxel, c.n, &c.plane, root_area);
+                self.build_pruned(
+                    c,
+                    saving,
+                    threshold,
+                    root_area,
+                    &mut keys,
+                    Some(&mut left_out),
+                );
+            }
+            seeds = left_out.into_candidates(self);
+            if self.over_budget || self.lost_prim {
+                break;
+            }
+            // The pruned tree's splits with two more children fit the budget: best first
+            // makes them all (they save at least `threshold`) and then one it left out, if
+            // there is one; if there is none, the tree is the unbudgeted one.
+            let fits = (self.nodes.len() - nodes0) as u64 + used + 2 <= budget;
+            let keep = match (fits, seeds.is_empty()) {
+                (true, false) => None,
+                (true, true) => {
+                    self.budget_bound = false;
+                    Some(
+                        self.nodes
+                            .iter()
+                            .map(|n| matches!(n, KdNode::Inner { .. }))
+                            .collect(),
+                    )
+                }
+                (false, _) => self.replay(heap, waiting, used, budget, &made, &keys),
+            };
+            if let Some(keep) = keep {
+                let (nodes, prims, depth) =
+                    depth_first_order_kept(&self.nodes, &self.prim_indices, Some(&keep));
+                self.nodes = nodes;
+                self.prim_indices = prims;
+                self.depth = depth0.max(depth);
+                built = true;
+                break;
+            }
+        }
+        for c in seeds {
+            self.recycle(c.events);
+        }
+        self.node_cap = usize::MAX;
+        self.over_budget = false;
+        if !built {
+            self.nodes.truncate(nodes0);
+            for c in waiting.iter().flatten() {
+                self.nodes[c.node] = KdNode::Leaf { first: 0, count: 0 };
+            }
+            self.prim_indices.truncate(prims0);
+            self.depth = depth0;
+        }
+        built
+    }
+
+    /// Best first's remaining splits replayed on the savings the pruned build recorded: which
+    /// nodes it splits (`made`: those it made before, and clip planes), or `None` if it wants
+    /// a split the pruned build left out.
+    fn replay(
+        &mut self,
+        heap: &std::collections::BinaryHeap<(u64, std::cmp::Reverse<usize>, usize)>,
+        waiting: &[Option<Candidate>],
+        mut used: u64,
+        budget: u64,
+        made: &[bool],
+        keys: &[Option<u64>],
+    ) -> Option<Vec<bool>> {
+        let mut keep = made.to_vec();
+        keep.resize(self.nodes.len(), false);
+        let mut heap = heap.clone();
+        let mut node_of: Vec<usize> = waiting
+            .iter()
+            .map(|c| c.as_ref().map_or(usize::MAX, |c| c.node))
+            .collect();
+        while used + 2 <= budget {
+            let Some((_, _, i)) = heap.pop() else { break };
+            let v = node_of[i];
+            let KdNode::Inner { children, .. } = self.nodes[v] else {
+                return None;
+            };
+            keep[v] = true;
+            used += 2;
+            for c in [children as usize, children as usize + 1] {
+                if let Some(key) = keys[c] {
+                    let j = node_of.len();
+                    heap.push((key, std::cmp::Reverse(j), j));
+                    node_of.push(c);
+                }
+            }
+        }
+        self.budget_bound = !heap.is_empty();
+        Some(keep)
+    }
+
+    /// The subtree of a candidate (`plane`, `saving`) depth first, splitting the nodes whose
+    /// saving is at least `threshold` (see [`Builder::finish_pruned`]) and recording the heap
+    /// key of every candidate in `keys`.
+    #[allow(clippy::too_many_arguments)]
+    fn build_pruned(
+        &mut self,
+        c: Candidate,
+        saving: f64,
+        threshold: f64,
+        root_area: f64,
+        keys: &mut Vec<Option<u64>>,
+        mut left_out: Option<&mut LeftOut>,
+    ) {
+        // `!(a >= b)`: a NaN saving is not split either.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        let below = !(saving >= threshold);
+        if self.over_budget || below || self.nodes.len() + 2 > self.node_cap {
+            if !below && !self.over_budget {
+                self.over_budget = true;
+            }
+            if !self.over_budget {
+                self.make_leaf(c.node, &c.events, c.depth);
+                if let Some(out) = left_out {
+                    out.push(&c);
+                }
+            }
+            self.recycle(c.events);
+            return;
+        }
+        let (vl, vr) = c.voxel.split(c.plane.axis, c.plane.pos);
+        let (left, nl, right, nr) = self.split_events(c.events, &c.plane, &vl, &vr);
+        let children = self.split_node(c.node, &c.plane);
+        keys.resize(self.nodes.len(), None);
+        let depth = c.depth + 1;
+        for (child, voxel, events, n) in [(children, vl, left, nl), (children + 1, vr, right, nr)] {
+            if let Some((plane, events)) = self.plane_or_leaf(child, &voxel, events, n, depth) {
+                let s = self.saving(&voxel, n, &plane, root_area);
+                keys[child] = Some(ordered_bits(s));
+                let child = Candidate {
+                    node: child,
+                    voxel,
+                    events,
+                    n,
+                    depth,
+                    plane,
+                };
+                self.build_pruned(
+                    child,
+                    s,
+                    threshold,
+                    root_area,
+                    keys,
+                    left_out.as_deref_mut(),
+                );
+            }
+        }
+    }
+
+    /// What splitting a candidate saves: its share of the root's area times its leaf cost
+    /// minus its split cost (the best-first order).
+    fn saving(&self, voxel: &Aabb, n: usize, plane: &Plane, root_area: f64) -> f64 {
+        let prob = if root_area > 0.0 {
+            voxel.surface_area() / root_area
+        } else {
+            1.0
+        };
+        prob * (self.params.intersection_cost * n as f64 - plane.cost)
     }
 
     /// Makes `node` a leaf, or a candidate for [`Builder::build_best_first`] if the
@@ -527,18 +923,14 @@ impl<P: KdPrimitives> Builder<'_, P> {
         let Some((plane, events)) = self.plane_or_leaf(node, &voxel, events, n, depth) else {
             return;
         };
-        let prob = if root_area > 0.0 {
-            voxel.surface_area() / root_area
-        } else {
-            1.0
-        };
-        let saving = prob * (self.params.intersection_cost * n as f64 - plane.cost);
+        let saving = self.saving(&voxel, n, &plane, root_area);
         let i = waiting.len();
         heap.push((ordered_bits(saving), std::cmp::Reverse(i), i));
         waiting.push(Some(Candidate {
             node,
             voxel,
             events,
+            n,
             depth,
             plane,
         }));
@@ -779,14 +1171,18 @@ impl<P: KdPrimitives> Builder<'_, P> {
         let mut new_right = self.fresh();
         if clip {
             for &p in &both {
+                let mut touched = false;
                 if let Some(b) = self.prims.clipped_bounds(p as usize, vl) {
                     push_events(&mut new_left, p, &b);
                     nl += 1;
+                    touched = true;
                 }
                 if let Some(b) = self.prims.clipped_bounds(p as usize, vr) {
                     push_events(&mut new_right, p, &b);
                     nr += 1;
+                    touched = true;
                 }
+                self.lost_prim |= !touched;
             }
             for axis in 0..3 {
                 if P::CLIPPING_KEEPS_OTHER_AXES && axis != plane.axis {
@@ -1106,7 +1502,7 @@ mod tests {
     }
 
     /// With budget to spare the best-first build is the depth-first one, node for node; and
-    /// a budget the depth-first attempt outgrows gives the best-first tree.
+    /// a budget that binds gives the tree of best first alone.
     #[test]
     fn a_budget_that_does_not_bind_changes_nothing() {
         for (name, tris) in meshes() {
@@ -1136,12 +1532,85 @@ mod tests {
                     "{name} {per_prim}"
                 );
             }
+            // Wrapped in the root clip's planes too, whose empty leaves start at 0 in the
+            // depth-first build (the layout's node bank holds that field).
+            let clipped = |nodes_per_prim| KdParams {
+                nodes_per_prim,
+                split_format: Some(crate::fp::Format::E7M16),
+                root_clip: true,
+                ..KdParams::default()
+            };
+            let tree = build_sah(&tris, &clipped(None));
+            assert_eq!(tree, build_sah(&tris, &clipped(Some(1000))), "{name} clip");
+            assert_eq!(
+                tree,
+                build_in_order(&Triangles(&tris), &clipped(Some(1000)), true),
+                "{name} clip"
+            );
+        }
+    }
+
+    /// The pruned depth-first finish of the budgeted build is best first's tree bit for bit,
+    /// whichever of its rounds succeeds: budgets that bind hard, loosely and not at all, on
+    /// triangles with and without clipping and rounding, and on boxes.
+    #[test]
+    fn pruned_finish_is_best_first() {
+        let mut cases: Vec<(String, Vec<[DVec3; 3]>)> = vec![
+            ("sphere(5)".into(), sphere(5)),
+            (
+                "terrain 48x48".into(),
+                crate::accel::bench::heightfield_triangles(48, 3),
+            ),
+        ];
+        cases.extend(
+            meshes()
+                .into_iter()
+                .map(|(name, tris)| (name.to_string(), tris)),
+        );
+        for (name, tris) in &cases {
+            for per_prim in [1, 2, 3, 5, 8] {
+                for (clip, format) in [
+                    (true, None),
+                    (false, None),
+                    (true, Some(crate::fp::Format::E7M16)),
+                ] {
+                    let params = KdParams {
+                        nodes_per_prim: Some(per_prim),
+                        clip_splits: clip,
+                        split_format: format,
+                        ..KdParams::default()
+                    };
+                    let tree = build_sah(tris, &params);
+                    assert_eq!(
+                        tree,
+                        build_in_order(&Triangles(tris), &params, true),
+                        "{name} {per_prim} {clip} {format:?}"
+                    );
+                }
+            }
+        }
+        for count in [300, 2000, 5622] {
+            let boxes = crate::accel::bench::random_instance_boxes(count, 7);
+            for per_prim in [1, 3, 6] {
+                let params = KdParams {
+                    nodes_per_prim: Some(per_prim),
+                    ..KdParams::default()
+                };
+                let tree = build_sah_boxes(&boxes, &params);
+                tree.validate_against(&Boxes(&boxes)).unwrap();
+                assert_eq!(
+                    tree,
+                    build_in_order(&Boxes(&boxes), &params, true),
+                    "{count} boxes {per_prim}"
+                );
+            }
         }
     }
 
     /// Build times of the bundled terrain's object tree (131,072 triangles; the default
-    /// budget of 3 nodes per triangle does not bind, 2.70): unbudgeted, depth first until the
-    /// budget binds ([`build`]), and best first from the start. A timing, not a check:
+    /// budget of 3 nodes per triangle does not bind, 2.70): unbudgeted, under the budget
+    /// ([`build`]: best first for the top splits, then depth first), and best first alone. A
+    /// timing, not a check:
     /// `cargo test --release --lib build_order_timing -- --ignored --nocapture`.
     #[test]
     #[ignore = "a timing"]
@@ -1168,8 +1637,8 @@ mod tests {
         let (b, tb) = time(&|| build(&Triangles(tris), &budget));
         let (c, tc) = time(&|| build_in_order(&Triangles(tris), &budget, true));
         println!(
-            "terrain, {} triangles, best of 5: unbudgeted {a:.1} ms, budget 3 depth first until \
-             it binds {b:.1} ms, budget 3 best first {c:.1} ms ({} / {} / {} nodes)",
+            "terrain, {} triangles, best of 5: unbudgeted {a:.1} ms, budget 3 {b:.1} ms, \
+             budget 3 best first alone {c:.1} ms ({} / {} / {} nodes)",
             tris.len(),
             ta.nodes.len(),
             tb.nodes.len(),
