@@ -506,6 +506,9 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
     reg  [17:0] last_quo__d;
     wire  [17:0] last_quo__q;
     reg  last_quo__clock;
+    reg  last_sig_ones__d;
+    wire  last_sig_ones__q;
+    reg  last_sig_ones__clock;
     reg  [8:0] last_exp__d;
     wire  [8:0] last_exp__q;
     reg  last_exp__clock;
@@ -527,6 +530,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
     reg  pack__clock;
     reg  pack__in_valid;
     reg  [16:0] pack__sig;
+    reg  pack__sig_ones;
     reg  pack__round_up;
     reg  [8:0] pack__exp;
     reg  pack__sign;
@@ -1344,6 +1348,11 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         .q(last_quo__q),
         .clock(last_quo__clock)
     );
+    fp_div_e7m16_core__in_valid_r last_sig_ones(
+        .d(last_sig_ones__d),
+        .q(last_sig_ones__q),
+        .clock(last_sig_ones__clock)
+    );
     fp_div_e7m16_core__exp__0 last_exp(
         .d(last_exp__d),
         .q(last_exp__q),
@@ -1378,6 +1387,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         .clock(pack__clock),
         .in_valid(pack__in_valid),
         .sig(pack__sig),
+        .sig_ones(pack__sig_ones),
         .round_up(pack__round_up),
         .exp(pack__exp),
         .sign(pack__sign),
@@ -1395,6 +1405,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         in_valid_r__clock = clock;
         last_sticky__clock = clock;
         last_quo__clock = clock;
+        last_sig_ones__clock = clock;
         last_exp__clock = clock;
         last_sign__clock = clock;
         last_nan__clock = clock;
@@ -1406,6 +1417,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         in_valid_r__d = in_valid_r__q;
         last_sticky__d = last_sticky__q;
         last_quo__d = last_quo__q;
+        last_sig_ones__d = last_sig_ones__q;
         last_exp__d = last_exp__q;
         last_sign__d = last_sign__q;
         last_nan__d = last_nan__q;
@@ -1844,6 +1856,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
             last_sticky__d = |rem__16__q;
             last_quo__d = quo__16__q << 32'h1;
         end
+        last_sig_ones__d = &quo__16__q[(32'h0)+:(17)];
         last_exp__d = exp__16__q;
         last_sign__d = sign__16__q;
         last_nan__d = nan__16__q;
@@ -1855,6 +1868,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         pack__clock = clock;
         pack__in_valid = last_valid__q;
         pack__sig = sig;
+        pack__sig_ones = last_sig_ones__q;
         pack__round_up = round_up;
         pack__exp = last_exp__q;
         pack__sign = last_sign__q;
@@ -2094,12 +2108,15 @@ endmodule // fp_div_e7m16_core__in_valid_r
 
 
 
-module fp_div_e7m16_core__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero,out_valid,result);
+
+
+module fp_div_e7m16_core__pack(clock,in_valid,sig,sig_ones,round_up,exp,sign,nan,inf,zero,out_valid,result);
     
     // Module arguments
     input wire  clock;
     input wire  in_valid;
     input wire  [16:0] sig;
+    input wire  sig_ones;
     input wire  round_up;
     input wire  [8:0] exp;
     input wire  sign;
@@ -2223,7 +2240,7 @@ module fp_div_e7m16_core__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero
         out_result__d = out_result__q;
         out_valid_r__d = out_valid_r__q;
         sig_rounded = ((sig) & 18'h3ffff) + round_up;
-        carry = &sig & round_up;
+        carry = sig_ones & round_up;
         exp_up = exp + 32'h1;
         exp_final = exp;
         if (carry) begin

@@ -70,6 +70,7 @@ module fp_mul_e7m16_core(clock,in_valid,a,b,out_valid,result);
     reg  pack__clock;
     reg  pack__in_valid;
     reg  [16:0] pack__sig;
+    reg  pack__sig_ones;
     reg  pack__round_up;
     reg  [8:0] pack__exp;
     reg  pack__sign;
@@ -155,6 +156,7 @@ module fp_mul_e7m16_core(clock,in_valid,a,b,out_valid,result);
         .clock(pack__clock),
         .in_valid(pack__in_valid),
         .sig(pack__sig),
+        .sig_ones(pack__sig_ones),
         .round_up(pack__round_up),
         .exp(pack__exp),
         .sign(pack__sign),
@@ -219,6 +221,7 @@ module fp_mul_e7m16_core(clock,in_valid,a,b,out_valid,result);
         pack__clock = clock;
         pack__in_valid = valid2__q;
         pack__sig = sig;
+        pack__sig_ones = &sig;
         pack__round_up = round_up;
         pack__exp = exp_sum__q + prod_top;
         pack__sign = sign__q;
@@ -307,12 +310,13 @@ endmodule // fp_mul_e7m16_core__multiplier
 
 
 
-module fp_mul_e7m16_core__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero,out_valid,result);
+module fp_mul_e7m16_core__pack(clock,in_valid,sig,sig_ones,round_up,exp,sign,nan,inf,zero,out_valid,result);
     
     // Module arguments
     input wire  clock;
     input wire  in_valid;
     input wire  [16:0] sig;
+    input wire  sig_ones;
     input wire  round_up;
     input wire  [8:0] exp;
     input wire  sign;
@@ -436,7 +440,7 @@ module fp_mul_e7m16_core__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero
         out_result__d = out_result__q;
         out_valid_r__d = out_valid_r__q;
         sig_rounded = ((sig) & 18'h3ffff) + round_up;
-        carry = &sig & round_up;
+        carry = sig_ones & round_up;
         exp_up = exp + 32'h1;
         exp_final = exp;
         if (carry) begin

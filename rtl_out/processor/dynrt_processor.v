@@ -735,16 +735,17 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  fetch__wb_halt;
     reg  [11:0] fetch__wb_next_pc;
     reg  decode__clock;
-    reg  decode__valid_i2;
-    reg  [4:0] decode__thread_i2;
-    reg  [11:0] decode__pc_i2;
-    reg  [31:0] decode__ctl_i2;
-    reg  [31:0] decode__imm_i2;
-    reg  [31:0] decode__aux_i2;
-    wire  decode__valid_i3;
+    reg  decode__valid_i3;
+    reg  [4:0] decode__thread_i3;
+    reg  [11:0] decode__pc_i3;
+    reg  [31:0] decode__ctl_i3;
+    reg  [31:0] decode__imm_i3;
+    reg  [31:0] decode__aux_i3;
     wire  [4:0] decode__op_i3;
-    wire  [4:0] decode__thread_i3;
-    wire  [31:0] decode__imm_i3;
+    wire  decode__valid_i4;
+    wire  [4:0] decode__op_i4;
+    wire  [4:0] decode__thread_i4;
+    wire  [31:0] decode__imm_i4;
     wire  decode__valid;
     wire  [4:0] decode__thread;
     wire  [11:0] decode__pc;
@@ -1060,16 +1061,17 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     );
     dynrt_processor__engine__decode decode(
         .clock(decode__clock),
-        .valid_i2(decode__valid_i2),
-        .thread_i2(decode__thread_i2),
-        .pc_i2(decode__pc_i2),
-        .ctl_i2(decode__ctl_i2),
-        .imm_i2(decode__imm_i2),
-        .aux_i2(decode__aux_i2),
         .valid_i3(decode__valid_i3),
-        .op_i3(decode__op_i3),
         .thread_i3(decode__thread_i3),
+        .pc_i3(decode__pc_i3),
+        .ctl_i3(decode__ctl_i3),
         .imm_i3(decode__imm_i3),
+        .aux_i3(decode__aux_i3),
+        .op_i3(decode__op_i3),
+        .valid_i4(decode__valid_i4),
+        .op_i4(decode__op_i4),
+        .thread_i4(decode__thread_i4),
+        .imm_i4(decode__imm_i4),
         .valid(decode__valid),
         .thread(decode__thread),
         .pc(decode__pc),
@@ -1499,17 +1501,17 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         fetch__epoch = epoch__q;
         fetch__issue = scheduler__issue;
         fetch__pick = scheduler__pick;
-        decode__valid_i2 = fetch__valid;
-        decode__thread_i2 = fetch__thread;
-        decode__pc_i2 = fetch__pc;
-        decode__ctl_i2 = fetch__ctl;
-        decode__imm_i2 = fetch__imm;
-        decode__aux_i2 = fetch__aux;
-        mailboxes__read_thread = decode__thread_i3;
-        mailboxes__read_which = decode__imm_i3[32'h0];
-        tester__engine__query_thread = decode__thread_i3;
-        traversal_unit__engine__query_thread = decode__thread_i3;
-        scheduler__long_at_i3 = decode__valid_i3 & ((decode__op_i3 == op_fdiv) | (decode__op_i3 == op_fsqrt));
+        decode__valid_i3 = fetch__valid;
+        decode__thread_i3 = fetch__thread;
+        decode__pc_i3 = fetch__pc;
+        decode__ctl_i3 = fetch__ctl;
+        decode__imm_i3 = fetch__imm;
+        decode__aux_i3 = fetch__aux;
+        scheduler__long_at_i3 = fetch__valid & ((decode__op_i3 == op_fdiv) | (decode__op_i3 == op_fsqrt));
+        mailboxes__read_thread = decode__thread_i4;
+        mailboxes__read_which = decode__imm_i4[32'h0];
+        tester__engine__query_thread = decode__thread_i4;
+        traversal_unit__engine__query_thread = decode__thread_i4;
         fp_units__a = decode__a[(32'h0)+:(24)];
         fp_units__b = decode__b[(32'h0)+:(24)];
         fp_units__sub = decode__op == op_fsub;
@@ -1558,27 +1560,27 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             mem_addr = mem_addr_r__q;
         end
         tester__lists__rdata = mem_rdata;
-        tri_op = decode__op_i3 == op_tri;
-        kd_op = decode__op_i3 == op_kd;
-        tri_wait_fn = decode__imm_i3 == tri_wait;
-        kd_wait_fn = decode__imm_i3 == kd_wait;
-        queued_fn = (decode__imm_i3 == tri_init) | (decode__imm_i3 == tri_list) | (decode__imm_i3 == tri_object) | (decode__imm_i3 == tri_skip);
-        ray_write__d = decode__valid_i3 & tri_op & (decode__imm_i3 < tri_ray_words);
-        t_min_write__d = decode__valid_i3 & tri_op & (decode__imm_i3 == tri_init);
+        tri_op = decode__op_i4 == op_tri;
+        kd_op = decode__op_i4 == op_kd;
+        tri_wait_fn = decode__imm_i4 == tri_wait;
+        kd_wait_fn = decode__imm_i4 == kd_wait;
+        queued_fn = (decode__imm_i4 == tri_init) | (decode__imm_i4 == tri_list) | (decode__imm_i4 == tri_object) | (decode__imm_i4 == tri_skip);
+        ray_write__d = decode__valid_i4 & tri_op & (decode__imm_i4 < tri_ray_words);
+        t_min_write__d = decode__valid_i4 & tri_op & (decode__imm_i4 == tri_init);
         tri_queues__d = queued_fn;
-        tri_enqueue__d = decode__valid_i3 & tri_op & queued_fn;
+        tri_enqueue__d = decode__valid_i4 & tri_op & queued_fn;
         tri_kind__d = cmd_list;
-        if (decode__imm_i3 == tri_init) begin
+        if (decode__imm_i4 == tri_init) begin
             tri_kind__d = cmd_init;
         end
-        if (decode__imm_i3 == tri_object) begin
+        if (decode__imm_i4 == tri_object) begin
             tri_kind__d = cmd_object;
         end
-        if (decode__imm_i3 == tri_skip) begin
+        if (decode__imm_i4 == tri_skip) begin
             tri_kind__d = cmd_skip;
         end
         tri_waits__d = tri_wait_fn;
-        kd_enqueue__d = decode__valid_i3 & kd_op & (decode__imm_i3 == kd_start);
+        kd_enqueue__d = decode__valid_i4 & kd_op & (decode__imm_i4 == kd_start);
         kd_waits__d = kd_wait_fn;
         wait_fn__d = (tri_op & tri_wait_fn) | (kd_op & kd_wait_fn);
         traversal_unit__engine__load_banks = mem_load_r__q;
@@ -1726,20 +1728,21 @@ module dynrt_processor__engine__cycle_count(d,q,clock);
 endmodule // dynrt_processor__engine__cycle_count
 
 
-module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm_i2,aux_i2,valid_i3,op_i3,thread_i3,imm_i3,valid,thread,pc,op,dst,invert,imm,shift,bank,target,a,b,store,wb_write,wb_thread,wb_dst,wb_data);
+module dynrt_processor__engine__decode(clock,valid_i3,thread_i3,pc_i3,ctl_i3,imm_i3,aux_i3,op_i3,valid_i4,op_i4,thread_i4,imm_i4,valid,thread,pc,op,dst,invert,imm,shift,bank,target,a,b,store,wb_write,wb_thread,wb_dst,wb_data);
     
     // Module arguments
     input wire  clock;
-    input wire  valid_i2;
-    input wire  [4:0] thread_i2;
-    input wire  [11:0] pc_i2;
-    input wire  [31:0] ctl_i2;
-    input wire  [31:0] imm_i2;
-    input wire  [31:0] aux_i2;
-    output reg  valid_i3;
+    input wire  valid_i3;
+    input wire  [4:0] thread_i3;
+    input wire  [11:0] pc_i3;
+    input wire  [31:0] ctl_i3;
+    input wire  [31:0] imm_i3;
+    input wire  [31:0] aux_i3;
     output reg  [4:0] op_i3;
-    output reg  [4:0] thread_i3;
-    output reg  [31:0] imm_i3;
+    output reg  valid_i4;
+    output reg  [4:0] op_i4;
+    output reg  [4:0] thread_i4;
+    output reg  [31:0] imm_i4;
     output reg  valid;
     output reg  [4:0] thread;
     output reg  [11:0] pc;
@@ -1786,24 +1789,6 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
     reg  regs_b__write_clock;
     reg  [31:0] regs_b__write_data;
     reg  regs_b__write_enable;
-    reg  v3__d;
-    wire  v3__q;
-    reg  v3__clock;
-    reg  [4:0] t3__d;
-    wire  [4:0] t3__q;
-    reg  t3__clock;
-    reg  [11:0] pc3__d;
-    wire  [11:0] pc3__q;
-    reg  pc3__clock;
-    reg  [31:0] ctl3__d;
-    wire  [31:0] ctl3__q;
-    reg  ctl3__clock;
-    reg  [31:0] imm3__d;
-    wire  [31:0] imm3__q;
-    reg  imm3__clock;
-    reg  [31:0] aux3__d;
-    wire  [31:0] aux3__q;
-    reg  aux3__clock;
     reg  v4__d;
     wire  v4__q;
     reg  v4__clock;
@@ -1822,15 +1807,33 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
     reg  [31:0] aux4__d;
     wire  [31:0] aux4__q;
     reg  aux4__clock;
-    reg  [31:0] a4__d;
-    wire  [31:0] a4__q;
-    reg  a4__clock;
-    reg  [31:0] b4__d;
-    wire  [31:0] b4__q;
-    reg  b4__clock;
-    reg  [31:0] store4__d;
-    wire  [31:0] store4__q;
-    reg  store4__clock;
+    reg  v5__d;
+    wire  v5__q;
+    reg  v5__clock;
+    reg  [4:0] t5__d;
+    wire  [4:0] t5__q;
+    reg  t5__clock;
+    reg  [11:0] pc5__d;
+    wire  [11:0] pc5__q;
+    reg  pc5__clock;
+    reg  [31:0] ctl5__d;
+    wire  [31:0] ctl5__q;
+    reg  ctl5__clock;
+    reg  [31:0] imm5__d;
+    wire  [31:0] imm5__q;
+    reg  imm5__clock;
+    reg  [31:0] aux5__d;
+    wire  [31:0] aux5__q;
+    reg  aux5__clock;
+    reg  [31:0] a5__d;
+    wire  [31:0] a5__q;
+    reg  a5__clock;
+    reg  [31:0] b5__d;
+    wire  [31:0] b5__q;
+    reg  b5__clock;
+    reg  [31:0] store5__d;
+    wire  [31:0] store5__q;
+    reg  store5__clock;
     
     // Local signals
     reg  [7:0] reg_a;
@@ -1856,42 +1859,12 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
         .write_data(regs_b__write_data),
         .write_enable(regs_b__write_enable)
     );
-    dynrt_processor__display__dark_d v3(
-        .d(v3__d),
-        .q(v3__q),
-        .clock(v3__clock)
-    );
-    dynrt_processor__engine__decode__t3 t3(
-        .d(t3__d),
-        .q(t3__q),
-        .clock(t3__clock)
-    );
-    dynrt_processor__display__timing__col pc3(
-        .d(pc3__d),
-        .q(pc3__q),
-        .clock(pc3__clock)
-    );
-    dynrt_processor__engine__cycle_count ctl3(
-        .d(ctl3__d),
-        .q(ctl3__q),
-        .clock(ctl3__clock)
-    );
-    dynrt_processor__engine__cycle_count imm3(
-        .d(imm3__d),
-        .q(imm3__q),
-        .clock(imm3__clock)
-    );
-    dynrt_processor__engine__cycle_count aux3(
-        .d(aux3__d),
-        .q(aux3__q),
-        .clock(aux3__clock)
-    );
     dynrt_processor__display__dark_d v4(
         .d(v4__d),
         .q(v4__q),
         .clock(v4__clock)
     );
-    dynrt_processor__engine__decode__t3 t4(
+    dynrt_processor__engine__decode__t4 t4(
         .d(t4__d),
         .q(t4__q),
         .clock(t4__clock)
@@ -1916,107 +1889,138 @@ module dynrt_processor__engine__decode(clock,valid_i2,thread_i2,pc_i2,ctl_i2,imm
         .q(aux4__q),
         .clock(aux4__clock)
     );
-    dynrt_processor__engine__cycle_count a4(
-        .d(a4__d),
-        .q(a4__q),
-        .clock(a4__clock)
+    dynrt_processor__display__dark_d v5(
+        .d(v5__d),
+        .q(v5__q),
+        .clock(v5__clock)
     );
-    dynrt_processor__engine__cycle_count b4(
-        .d(b4__d),
-        .q(b4__q),
-        .clock(b4__clock)
+    dynrt_processor__engine__decode__t4 t5(
+        .d(t5__d),
+        .q(t5__q),
+        .clock(t5__clock)
     );
-    dynrt_processor__engine__cycle_count store4(
-        .d(store4__d),
-        .q(store4__q),
-        .clock(store4__clock)
+    dynrt_processor__display__timing__col pc5(
+        .d(pc5__d),
+        .q(pc5__q),
+        .clock(pc5__clock)
+    );
+    dynrt_processor__engine__cycle_count ctl5(
+        .d(ctl5__d),
+        .q(ctl5__q),
+        .clock(ctl5__clock)
+    );
+    dynrt_processor__engine__cycle_count imm5(
+        .d(imm5__d),
+        .q(imm5__q),
+        .clock(imm5__clock)
+    );
+    dynrt_processor__engine__cycle_count aux5(
+        .d(aux5__d),
+        .q(aux5__q),
+        .clock(aux5__clock)
+    );
+    dynrt_processor__engine__cycle_count a5(
+        .d(a5__d),
+        .q(a5__q),
+        .clock(a5__clock)
+    );
+    dynrt_processor__engine__cycle_count b5(
+        .d(b5__d),
+        .q(b5__q),
+        .clock(b5__clock)
+    );
+    dynrt_processor__engine__cycle_count store5(
+        .d(store5__d),
+        .q(store5__q),
+        .clock(store5__clock)
     );
     
     // Update code
     always @(*) begin
-        v3__clock = clock;
-        t3__clock = clock;
-        pc3__clock = clock;
-        ctl3__clock = clock;
-        imm3__clock = clock;
-        aux3__clock = clock;
         v4__clock = clock;
         t4__clock = clock;
         pc4__clock = clock;
         ctl4__clock = clock;
         imm4__clock = clock;
         aux4__clock = clock;
-        a4__clock = clock;
-        b4__clock = clock;
-        store4__clock = clock;
-        v3__d = v3__q;
-        t3__d = t3__q;
-        pc3__d = pc3__q;
-        ctl3__d = ctl3__q;
-        imm3__d = imm3__q;
-        aux3__d = aux3__q;
+        v5__clock = clock;
+        t5__clock = clock;
+        pc5__clock = clock;
+        ctl5__clock = clock;
+        imm5__clock = clock;
+        aux5__clock = clock;
+        a5__clock = clock;
+        b5__clock = clock;
+        store5__clock = clock;
         v4__d = v4__q;
         t4__d = t4__q;
         pc4__d = pc4__q;
         ctl4__d = ctl4__q;
         imm4__d = imm4__q;
         aux4__d = aux4__q;
-        a4__d = a4__q;
-        b4__d = b4__q;
-        store4__d = store4__q;
+        v5__d = v5__q;
+        t5__d = t5__q;
+        pc5__d = pc5__q;
+        ctl5__d = ctl5__q;
+        imm5__d = imm5__q;
+        aux5__d = aux5__q;
+        a5__d = a5__q;
+        b5__d = b5__q;
+        store5__d = store5__q;
         regs_a__read_clock = clock;
         regs_a__write_clock = clock;
         regs_b__read_clock = clock;
         regs_b__write_clock = clock;
-        reg_a = ctl_i2[(f_a)+:(8)];
-        reg_b = ctl_i2[(f_b)+:(8)];
-        regs_a__read_address = (((reg_a) & 13'h1fff) << 32'h5) | ((thread_i2) & 13'h1fff);
-        regs_b__read_address = (((reg_b) & 13'h1fff) << 32'h5) | ((thread_i2) & 13'h1fff);
-        v3__d = valid_i2;
-        t3__d = thread_i2;
-        pc3__d = pc_i2;
-        ctl3__d = ctl_i2;
-        imm3__d = imm_i2;
-        aux3__d = aux_i2;
-        valid_i3 = v3__q;
-        op_i3 = ctl3__q[(f_op)+:(5)];
-        thread_i3 = t3__q;
-        imm_i3 = imm3__q;
-        v4__d = v3__q;
-        t4__d = t3__q;
-        pc4__d = pc3__q;
-        ctl4__d = ctl3__q;
-        imm4__d = imm3__q;
-        aux4__d = aux3__q;
-        if (aux3__q[f_a_zero]) begin
-            a4__d = 32'h0;
+        op_i3 = ctl_i3[(f_op)+:(5)];
+        reg_a = ctl_i3[(f_a)+:(8)];
+        reg_b = ctl_i3[(f_b)+:(8)];
+        regs_a__read_address = (((reg_a) & 13'h1fff) << 32'h5) | ((thread_i3) & 13'h1fff);
+        regs_b__read_address = (((reg_b) & 13'h1fff) << 32'h5) | ((thread_i3) & 13'h1fff);
+        v4__d = valid_i3;
+        t4__d = thread_i3;
+        pc4__d = pc_i3;
+        ctl4__d = ctl_i3;
+        imm4__d = imm_i3;
+        aux4__d = aux_i3;
+        valid_i4 = v4__q;
+        op_i4 = ctl4__q[(f_op)+:(5)];
+        thread_i4 = t4__q;
+        imm_i4 = imm4__q;
+        v5__d = v4__q;
+        t5__d = t4__q;
+        pc5__d = pc4__q;
+        ctl5__d = ctl4__q;
+        imm5__d = imm4__q;
+        aux5__d = aux4__q;
+        if (aux4__q[f_a_zero]) begin
+            a5__d = 32'h0;
         end
         else begin
-            a4__d = regs_a__read_data;
+            a5__d = regs_a__read_data;
         end
-        if (ctl3__q[f_b_imm]) begin
-            b4__d = imm3__q;
+        if (ctl4__q[f_b_imm]) begin
+            b5__d = imm4__q;
         end
-        else if (aux3__q[f_b_zero]) begin
-            b4__d = 32'h0;
+        else if (aux4__q[f_b_zero]) begin
+            b5__d = 32'h0;
         end
         else begin
-            b4__d = regs_b__read_data;
+            b5__d = regs_b__read_data;
         end
-        store4__d = regs_b__read_data;
-        valid = v4__q;
-        thread = t4__q;
-        pc = pc4__q;
-        op = ctl4__q[(f_op)+:(5)];
-        dst = ctl4__q[(f_dst)+:(8)];
-        invert = ctl4__q[f_invert];
-        imm = imm4__q;
-        shift = aux4__q[(f_shift)+:(3)];
-        bank = aux4__q[(f_bank)+:(3)];
-        target = aux4__q[(f_target)+:(12)];
-        a = a4__q;
-        b = b4__q;
-        store = store4__q;
+        store5__d = regs_b__read_data;
+        valid = v5__q;
+        thread = t5__q;
+        pc = pc5__q;
+        op = ctl5__q[(f_op)+:(5)];
+        dst = ctl5__q[(f_dst)+:(8)];
+        invert = ctl5__q[f_invert];
+        imm = imm5__q;
+        shift = aux5__q[(f_shift)+:(3)];
+        bank = aux5__q[(f_bank)+:(3)];
+        target = aux5__q[(f_target)+:(12)];
+        a = a5__q;
+        b = b5__q;
+        store = store5__q;
         wb_address = (((wb_dst) & 13'h1fff) << 32'h5) | ((wb_thread) & 13'h1fff);
         regs_a__write_address = wb_address;
         regs_b__write_address = wb_address;
@@ -2086,7 +2090,7 @@ endmodule // dynrt_processor__engine__decode__regs_a
 
 
 
-module dynrt_processor__engine__decode__t3(d,q,clock);
+module dynrt_processor__engine__decode__t4(d,q,clock);
     
     // Module arguments
     input wire  [4:0] d;
@@ -2102,7 +2106,7 @@ module dynrt_processor__engine__decode__t3(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor__engine__decode__t3
+endmodule // dynrt_processor__engine__decode__t4
 
 
 
@@ -2404,15 +2408,24 @@ module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl
     reg  [11:0] pc2__d;
     wire  [11:0] pc2__q;
     reg  pc2__clock;
-    reg  [31:0] ctl2__d;
-    wire  [31:0] ctl2__q;
-    reg  ctl2__clock;
-    reg  [31:0] imm2__d;
-    wire  [31:0] imm2__q;
-    reg  imm2__clock;
-    reg  [31:0] aux2__d;
-    wire  [31:0] aux2__q;
-    reg  aux2__clock;
+    reg  v3__d;
+    wire  v3__q;
+    reg  v3__clock;
+    reg  [4:0] t3__d;
+    wire  [4:0] t3__q;
+    reg  t3__clock;
+    reg  [11:0] pc3__d;
+    wire  [11:0] pc3__q;
+    reg  pc3__clock;
+    reg  [31:0] ctl3__d;
+    wire  [31:0] ctl3__q;
+    reg  ctl3__clock;
+    reg  [31:0] imm3__d;
+    wire  [31:0] imm3__q;
+    reg  imm3__clock;
+    reg  [31:0] aux3__d;
+    wire  [31:0] aux3__q;
+    reg  aux3__clock;
     
     // Local signals
     reg  fresh;
@@ -2439,7 +2452,7 @@ module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl
         .q(v1__q),
         .clock(v1__clock)
     );
-    dynrt_processor__engine__decode__t3 t1(
+    dynrt_processor__engine__decode__t4 t1(
         .d(t1__d),
         .q(t1__q),
         .clock(t1__clock)
@@ -2454,7 +2467,7 @@ module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl
         .q(v2__q),
         .clock(v2__clock)
     );
-    dynrt_processor__engine__decode__t3 t2(
+    dynrt_processor__engine__decode__t4 t2(
         .d(t2__d),
         .q(t2__q),
         .clock(t2__clock)
@@ -2464,20 +2477,35 @@ module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl
         .q(pc2__q),
         .clock(pc2__clock)
     );
-    dynrt_processor__engine__cycle_count ctl2(
-        .d(ctl2__d),
-        .q(ctl2__q),
-        .clock(ctl2__clock)
+    dynrt_processor__display__dark_d v3(
+        .d(v3__d),
+        .q(v3__q),
+        .clock(v3__clock)
     );
-    dynrt_processor__engine__cycle_count imm2(
-        .d(imm2__d),
-        .q(imm2__q),
-        .clock(imm2__clock)
+    dynrt_processor__engine__decode__t4 t3(
+        .d(t3__d),
+        .q(t3__q),
+        .clock(t3__clock)
     );
-    dynrt_processor__engine__cycle_count aux2(
-        .d(aux2__d),
-        .q(aux2__q),
-        .clock(aux2__clock)
+    dynrt_processor__display__timing__col pc3(
+        .d(pc3__d),
+        .q(pc3__q),
+        .clock(pc3__clock)
+    );
+    dynrt_processor__engine__cycle_count ctl3(
+        .d(ctl3__d),
+        .q(ctl3__q),
+        .clock(ctl3__clock)
+    );
+    dynrt_processor__engine__cycle_count imm3(
+        .d(imm3__d),
+        .q(imm3__q),
+        .clock(imm3__clock)
+    );
+    dynrt_processor__engine__cycle_count aux3(
+        .d(aux3__d),
+        .q(aux3__q),
+        .clock(aux3__clock)
     );
     
     // Update code
@@ -2488,18 +2516,24 @@ module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl
         v2__clock = clock;
         t2__clock = clock;
         pc2__clock = clock;
-        ctl2__clock = clock;
-        imm2__clock = clock;
-        aux2__clock = clock;
+        v3__clock = clock;
+        t3__clock = clock;
+        pc3__clock = clock;
+        ctl3__clock = clock;
+        imm3__clock = clock;
+        aux3__clock = clock;
         v1__d = v1__q;
         t1__d = t1__q;
         pc1__d = pc1__q;
         v2__d = v2__q;
         t2__d = t2__q;
         pc2__d = pc2__q;
-        ctl2__d = ctl2__q;
-        imm2__d = imm2__q;
-        aux2__d = aux2__q;
+        v3__d = v3__q;
+        t3__d = t3__q;
+        pc3__d = pc3__q;
+        ctl3__d = ctl3__q;
+        imm3__d = imm3__q;
+        aux3__d = aux3__q;
         pc_ram__write_clock = clock;
         rom__clock = clock;
         pc_ram__read_address = pick;
@@ -2510,28 +2544,33 @@ module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl
         else begin
             pc0 = pc_ram__read_data[(32'h0)+:(12)];
         end
-        rom__address = pc0;
         v1__d = issue & (fresh | (~pc_ram__read_data[32'hc]));
         t1__d = pick;
         pc1__d = pc0;
+        rom__address = pc1__q;
         v2__d = v1__q;
         t2__d = t1__q;
         pc2__d = pc1__q;
-        ctl2__d = rom__ctl;
-        imm2__d = rom__imm;
-        aux2__d = rom__aux;
-        valid = v2__q;
-        thread = t2__q;
-        pc = pc2__q;
-        ctl = ctl2__q;
-        imm = imm2__q;
-        aux = aux2__q;
+        v3__d = v2__q;
+        t3__d = t2__q;
+        pc3__d = pc2__q;
+        ctl3__d = rom__ctl;
+        imm3__d = rom__imm;
+        aux3__d = rom__aux;
+        valid = v3__q;
+        thread = t3__q;
+        pc = pc3__q;
+        ctl = ctl3__q;
+        imm = imm3__q;
+        aux = aux3__q;
         pc_ram__write_address = wb_thread;
         pc_ram__write_data = (((epoch) & 16'hffff) << 32'hd) | (((wb_halt) & 16'hffff) << 32'hc) | ((wb_next_pc) & 16'hffff);
         pc_ram__write_enable = wb_valid;
     end
     
 endmodule // dynrt_processor__engine__fetch
+
+
 
 
 
@@ -2883,6 +2922,10 @@ module dynrt_processor__engine__fetch__rom(clock,address,ctl,imm,aux);
        aux <= aux_words[address[7:0]];
     end
 endmodule // dynrt_processor__engine__fetch__rom
+
+
+
+
 
 
 
@@ -3418,7 +3461,7 @@ module dynrt_processor__engine__fp_units__add(clock,in_valid,a,b,sub,out_valid,r
         .q(big_exp__q),
         .clock(big_exp__clock)
     );
-    dynrt_processor__engine__decode__t3 shift(
+    dynrt_processor__engine__decode__t4 shift(
         .d(shift__d),
         .q(shift__q),
         .clock(shift__clock)
@@ -4686,6 +4729,7 @@ module dynrt_processor__engine__fp_units__byte_unit__scale(clock,in_valid,a,b,ou
     reg  pack__clock;
     reg  pack__in_valid;
     reg  [16:0] pack__sig;
+    reg  pack__sig_ones;
     reg  pack__round_up;
     reg  [8:0] pack__exp;
     reg  pack__sign;
@@ -4771,6 +4815,7 @@ module dynrt_processor__engine__fp_units__byte_unit__scale(clock,in_valid,a,b,ou
         .clock(pack__clock),
         .in_valid(pack__in_valid),
         .sig(pack__sig),
+        .sig_ones(pack__sig_ones),
         .round_up(pack__round_up),
         .exp(pack__exp),
         .sign(pack__sign),
@@ -4835,6 +4880,7 @@ module dynrt_processor__engine__fp_units__byte_unit__scale(clock,in_valid,a,b,ou
         pack__clock = clock;
         pack__in_valid = valid2__q;
         pack__sig = sig;
+        pack__sig_ones = &sig;
         pack__round_up = round_up;
         pack__exp = exp_sum__q + prod_top;
         pack__sign = sign__q;
@@ -4872,12 +4918,13 @@ endmodule // dynrt_processor__engine__fp_units__byte_unit__scale__multiplier
 
 
 
-module dynrt_processor__engine__fp_units__byte_unit__scale__pack(clock,in_valid,sig,round_up,exp,sign,nan,inf,zero,out_valid,result);
+module dynrt_processor__engine__fp_units__byte_unit__scale__pack(clock,in_valid,sig,sig_ones,round_up,exp,sign,nan,inf,zero,out_valid,result);
     
     // Module arguments
     input wire  clock;
     input wire  in_valid;
     input wire  [16:0] sig;
+    input wire  sig_ones;
     input wire  round_up;
     input wire  [8:0] exp;
     input wire  sign;
@@ -5001,7 +5048,7 @@ module dynrt_processor__engine__fp_units__byte_unit__scale__pack(clock,in_valid,
         out_result__d = out_result__q;
         out_valid_r__d = out_valid_r__q;
         sig_rounded = ((sig) & 18'h3ffff) + round_up;
-        carry = &sig & round_up;
+        carry = sig_ones & round_up;
         exp_up = exp + 32'h1;
         exp_final = exp;
         if (carry) begin
@@ -5744,6 +5791,9 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  [17:0] last_quo__d;
     wire  [17:0] last_quo__q;
     reg  last_quo__clock;
+    reg  last_sig_ones__d;
+    wire  last_sig_ones__q;
+    reg  last_sig_ones__clock;
     reg  [8:0] last_exp__d;
     wire  [8:0] last_exp__q;
     reg  last_exp__clock;
@@ -5765,6 +5815,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  pack__clock;
     reg  pack__in_valid;
     reg  [16:0] pack__sig;
+    reg  pack__sig_ones;
     reg  pack__round_up;
     reg  [8:0] pack__exp;
     reg  pack__sign;
@@ -6582,6 +6633,11 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         .q(last_quo__q),
         .clock(last_quo__clock)
     );
+    dynrt_processor__display__dark_d last_sig_ones(
+        .d(last_sig_ones__d),
+        .q(last_sig_ones__q),
+        .clock(last_sig_ones__clock)
+    );
     dynrt_processor__engine__fp_units__add__lz last_exp(
         .d(last_exp__d),
         .q(last_exp__q),
@@ -6616,6 +6672,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         .clock(pack__clock),
         .in_valid(pack__in_valid),
         .sig(pack__sig),
+        .sig_ones(pack__sig_ones),
         .round_up(pack__round_up),
         .exp(pack__exp),
         .sign(pack__sign),
@@ -6633,6 +6690,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         in_valid_r__clock = clock;
         last_sticky__clock = clock;
         last_quo__clock = clock;
+        last_sig_ones__clock = clock;
         last_exp__clock = clock;
         last_sign__clock = clock;
         last_nan__clock = clock;
@@ -6644,6 +6702,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         in_valid_r__d = in_valid_r__q;
         last_sticky__d = last_sticky__q;
         last_quo__d = last_quo__q;
+        last_sig_ones__d = last_sig_ones__q;
         last_exp__d = last_exp__q;
         last_sign__d = last_sign__q;
         last_nan__d = last_nan__q;
@@ -7082,6 +7141,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
             last_sticky__d = |rem__16__q;
             last_quo__d = quo__16__q << 32'h1;
         end
+        last_sig_ones__d = &quo__16__q[(32'h0)+:(17)];
         last_exp__d = exp__16__q;
         last_sign__d = sign__16__q;
         last_nan__d = nan__16__q;
@@ -7093,6 +7153,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         pack__clock = clock;
         pack__in_valid = last_valid__q;
         pack__sig = sig;
+        pack__sig_ones = last_sig_ones__q;
         pack__round_up = round_up;
         pack__exp = last_exp__q;
         pack__sign = last_sign__q;
@@ -7104,6 +7165,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     end
     
 endmodule // dynrt_processor__engine__fp_units__div
+
+
 
 
 
@@ -10203,24 +10266,24 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
     reg  [31:0] entries_r__7__d;
     wire  [31:0] entries_r__7__q;
     reg  entries_r__7__clock;
-    reg  [7:0] meta_i5__d;
-    wire  [7:0] meta_i5__q;
-    reg  meta_i5__clock;
-    reg  [4:0] thread_i5__d;
-    wire  [4:0] thread_i5__q;
-    reg  thread_i5__clock;
-    reg  which_i5__d;
-    wire  which_i5__q;
-    reg  which_i5__clock;
-    reg  [31:0] value_i5__d;
-    wire  [31:0] value_i5__q;
-    reg  value_i5__clock;
-    reg  insert_i5__d;
-    wire  insert_i5__q;
-    reg  insert_i5__clock;
-    reg  clear_i5__d;
-    wire  clear_i5__q;
-    reg  clear_i5__clock;
+    reg  [7:0] meta_i6__d;
+    wire  [7:0] meta_i6__q;
+    reg  meta_i6__clock;
+    reg  [4:0] thread_i6__d;
+    wire  [4:0] thread_i6__q;
+    reg  thread_i6__clock;
+    reg  which_i6__d;
+    wire  which_i6__q;
+    reg  which_i6__clock;
+    reg  [31:0] value_i6__d;
+    wire  [31:0] value_i6__q;
+    reg  value_i6__clock;
+    reg  insert_i6__d;
+    wire  insert_i6__q;
+    reg  insert_i6__clock;
+    reg  clear_i6__d;
+    wire  clear_i6__q;
+    reg  clear_i6__clock;
     reg  matches__0__d;
     wire  matches__0__q;
     reg  matches__0__clock;
@@ -10375,35 +10438,35 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
         .q(entries_r__7__q),
         .clock(entries_r__7__clock)
     );
-    dynrt_processor__engine__halted_count meta_i5(
-        .d(meta_i5__d),
-        .q(meta_i5__q),
-        .clock(meta_i5__clock)
+    dynrt_processor__engine__halted_count meta_i6(
+        .d(meta_i6__d),
+        .q(meta_i6__q),
+        .clock(meta_i6__clock)
     );
-    dynrt_processor__engine__decode__t3 thread_i5(
-        .d(thread_i5__d),
-        .q(thread_i5__q),
-        .clock(thread_i5__clock)
+    dynrt_processor__engine__decode__t4 thread_i6(
+        .d(thread_i6__d),
+        .q(thread_i6__q),
+        .clock(thread_i6__clock)
     );
-    dynrt_processor__display__dark_d which_i5(
-        .d(which_i5__d),
-        .q(which_i5__q),
-        .clock(which_i5__clock)
+    dynrt_processor__display__dark_d which_i6(
+        .d(which_i6__d),
+        .q(which_i6__q),
+        .clock(which_i6__clock)
     );
-    dynrt_processor__engine__cycle_count value_i5(
-        .d(value_i5__d),
-        .q(value_i5__q),
-        .clock(value_i5__clock)
+    dynrt_processor__engine__cycle_count value_i6(
+        .d(value_i6__d),
+        .q(value_i6__q),
+        .clock(value_i6__clock)
     );
-    dynrt_processor__display__dark_d insert_i5(
-        .d(insert_i5__d),
-        .q(insert_i5__q),
-        .clock(insert_i5__clock)
+    dynrt_processor__display__dark_d insert_i6(
+        .d(insert_i6__d),
+        .q(insert_i6__q),
+        .clock(insert_i6__clock)
     );
-    dynrt_processor__display__dark_d clear_i5(
-        .d(clear_i5__d),
-        .q(clear_i5__q),
-        .clock(clear_i5__clock)
+    dynrt_processor__display__dark_d clear_i6(
+        .d(clear_i6__d),
+        .q(clear_i6__q),
+        .clock(clear_i6__clock)
     );
     dynrt_processor__display__dark_d matches__0(
         .d(matches__0__d),
@@ -10450,7 +10513,7 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
         .q(meta_r__q),
         .clock(meta_r__clock)
     );
-    dynrt_processor__engine__decode__t3 thread_r(
+    dynrt_processor__engine__decode__t4 thread_r(
         .d(thread_r__d),
         .q(thread_r__q),
         .clock(thread_r__clock)
@@ -10559,24 +10622,24 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
     
     // Update code
     always @(*) begin
-        meta_i5__clock = clock;
-        thread_i5__clock = clock;
-        which_i5__clock = clock;
-        value_i5__clock = clock;
-        insert_i5__clock = clock;
-        clear_i5__clock = clock;
+        meta_i6__clock = clock;
+        thread_i6__clock = clock;
+        which_i6__clock = clock;
+        value_i6__clock = clock;
+        insert_i6__clock = clock;
+        clear_i6__clock = clock;
         meta_r__clock = clock;
         thread_r__clock = clock;
         which_r__clock = clock;
         value_r__clock = clock;
         insert_r__clock = clock;
         clear_r__clock = clock;
-        meta_i5__d = meta_i5__q;
-        thread_i5__d = thread_i5__q;
-        which_i5__d = which_i5__q;
-        value_i5__d = value_i5__q;
-        insert_i5__d = insert_i5__q;
-        clear_i5__d = clear_i5__q;
+        meta_i6__d = meta_i6__q;
+        thread_i6__d = thread_i6__q;
+        which_i6__d = which_i6__q;
+        value_i6__d = value_i6__q;
+        insert_i6__d = insert_i6__q;
+        clear_i6__d = clear_i6__q;
         meta_r__d = meta_r__q;
         thread_r__d = thread_r__q;
         which_r__d = which_r__q;
@@ -10627,34 +10690,34 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
         entries_r__6__d = entries__6__read_data;
         entries_r__7__clock = clock;
         entries_r__7__d = entries__7__read_data;
-        meta_i5__d = meta__read_data;
-        thread_i5__d = thread;
-        which_i5__d = which;
-        value_i5__d = value;
-        insert_i5__d = insert;
-        clear_i5__d = clear;
+        meta_i6__d = meta__read_data;
+        thread_i6__d = thread;
+        which_i6__d = which;
+        value_i6__d = value;
+        insert_i6__d = insert;
+        clear_i6__d = clear;
         matches__0__clock = clock;
-        matches__0__d = entries_r__0__q == value_i5__q;
+        matches__0__d = entries_r__0__q == value_i6__q;
         matches__1__clock = clock;
-        matches__1__d = entries_r__1__q == value_i5__q;
+        matches__1__d = entries_r__1__q == value_i6__q;
         matches__2__clock = clock;
-        matches__2__d = entries_r__2__q == value_i5__q;
+        matches__2__d = entries_r__2__q == value_i6__q;
         matches__3__clock = clock;
-        matches__3__d = entries_r__3__q == value_i5__q;
+        matches__3__d = entries_r__3__q == value_i6__q;
         matches__4__clock = clock;
-        matches__4__d = entries_r__4__q == value_i5__q;
+        matches__4__d = entries_r__4__q == value_i6__q;
         matches__5__clock = clock;
-        matches__5__d = entries_r__5__q == value_i5__q;
+        matches__5__d = entries_r__5__q == value_i6__q;
         matches__6__clock = clock;
-        matches__6__d = entries_r__6__q == value_i5__q;
+        matches__6__d = entries_r__6__q == value_i6__q;
         matches__7__clock = clock;
-        matches__7__d = entries_r__7__q == value_i5__q;
-        meta_r__d = meta_i5__q;
-        thread_r__d = thread_i5__q;
-        which_r__d = which_i5__q;
-        value_r__d = value_i5__q;
-        insert_r__d = insert_i5__q;
-        clear_r__d = clear_i5__q;
+        matches__7__d = entries_r__7__q == value_i6__q;
+        meta_r__d = meta_i6__q;
+        thread_r__d = thread_i6__q;
+        which_r__d = which_i6__q;
+        value_r__d = value_i6__q;
+        insert_r__d = insert_i6__q;
+        clear_r__d = clear_i6__q;
         len = meta_r__q[(32'h0)+:(4)];
         next_slot = meta_r__q[(32'h4)+:(3)];
         found = 1'b0;
@@ -11145,57 +11208,57 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     localparam ResultSource__Byte = 5;
     
     // Stub signals
-    reg  valid_i5__d;
-    wire  valid_i5__q;
-    reg  valid_i5__clock;
-    reg  [4:0] op_i5__d;
-    wire  [4:0] op_i5__q;
-    reg  op_i5__clock;
-    reg  [7:0] dst_i5__d;
-    wire  [7:0] dst_i5__q;
-    reg  dst_i5__clock;
-    reg  [4:0] thread_i5__d;
-    wire  [4:0] thread_i5__q;
-    reg  thread_i5__clock;
-    reg  invert_i5__d;
-    wire  invert_i5__q;
-    reg  invert_i5__clock;
-    reg  [11:0] pc_i5__d;
-    wire  [11:0] pc_i5__q;
-    reg  pc_i5__clock;
-    reg  [11:0] pc_plus_one_i5__d;
-    wire  [11:0] pc_plus_one_i5__q;
-    reg  pc_plus_one_i5__clock;
-    reg  [11:0] target_i5__d;
-    wire  [11:0] target_i5__q;
-    reg  target_i5__clock;
-    reg  is_wait_i5__d;
-    wire  is_wait_i5__q;
-    reg  is_wait_i5__clock;
-    reg  kd_busy_i5__d;
-    wire  kd_busy_i5__q;
-    reg  kd_busy_i5__clock;
-    reg  tri_busy_i5__d;
-    wire  tri_busy_i5__q;
-    reg  tri_busy_i5__clock;
-    reg  [11:0] jr_target_i5__d;
-    wire  [11:0] jr_target_i5__q;
-    reg  jr_target_i5__clock;
-    reg  int_eq_i5__d;
-    wire  int_eq_i5__q;
-    reg  int_eq_i5__clock;
-    reg  int_lt_i5__d;
-    wire  int_lt_i5__q;
-    reg  int_lt_i5__clock;
-    reg  pix_done_i5__d;
-    wire  pix_done_i5__q;
-    reg  pix_done_i5__clock;
-    reg  cond_i6__d;
-    wire  cond_i6__q;
-    reg  cond_i6__clock;
-    reg  is_mbx_i6__d;
-    wire  is_mbx_i6__q;
-    reg  is_mbx_i6__clock;
+    reg  valid_i6__d;
+    wire  valid_i6__q;
+    reg  valid_i6__clock;
+    reg  [4:0] op_i6__d;
+    wire  [4:0] op_i6__q;
+    reg  op_i6__clock;
+    reg  [7:0] dst_i6__d;
+    wire  [7:0] dst_i6__q;
+    reg  dst_i6__clock;
+    reg  [4:0] thread_i6__d;
+    wire  [4:0] thread_i6__q;
+    reg  thread_i6__clock;
+    reg  invert_i6__d;
+    wire  invert_i6__q;
+    reg  invert_i6__clock;
+    reg  [11:0] pc_i6__d;
+    wire  [11:0] pc_i6__q;
+    reg  pc_i6__clock;
+    reg  [11:0] pc_plus_one_i6__d;
+    wire  [11:0] pc_plus_one_i6__q;
+    reg  pc_plus_one_i6__clock;
+    reg  [11:0] target_i6__d;
+    wire  [11:0] target_i6__q;
+    reg  target_i6__clock;
+    reg  is_wait_i6__d;
+    wire  is_wait_i6__q;
+    reg  is_wait_i6__clock;
+    reg  kd_busy_i6__d;
+    wire  kd_busy_i6__q;
+    reg  kd_busy_i6__clock;
+    reg  tri_busy_i6__d;
+    wire  tri_busy_i6__q;
+    reg  tri_busy_i6__clock;
+    reg  [11:0] jr_target_i6__d;
+    wire  [11:0] jr_target_i6__q;
+    reg  jr_target_i6__clock;
+    reg  int_eq_i6__d;
+    wire  int_eq_i6__q;
+    reg  int_eq_i6__clock;
+    reg  int_lt_i6__d;
+    wire  int_lt_i6__q;
+    reg  int_lt_i6__clock;
+    reg  pix_done_i6__d;
+    wire  pix_done_i6__q;
+    reg  pix_done_i6__clock;
+    reg  cond_i7__d;
+    wire  cond_i7__q;
+    reg  cond_i7__clock;
+    reg  is_mbx_i7__d;
+    wire  is_mbx_i7__q;
+    reg  is_mbx_i7__clock;
     reg  valid_line__clock;
     reg  valid_line__data_in;
     wire  valid_line__data_out;
@@ -11317,97 +11380,97 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     reg  halts;
     reg  repeats;
     reg  keeps_pc;
-    reg  cond_i5;
+    reg  cond_i6;
     reg  [11:0] pc_other;
     reg  [11:0] pc_target;
     reg  [11:0] pc_next;
-    reg  [2:0] source_i5;
+    reg  [2:0] source_i6;
     
     // Sub module instances
-    dynrt_processor__display__dark_d valid_i5(
-        .d(valid_i5__d),
-        .q(valid_i5__q),
-        .clock(valid_i5__clock)
+    dynrt_processor__display__dark_d valid_i6(
+        .d(valid_i6__d),
+        .q(valid_i6__q),
+        .clock(valid_i6__clock)
     );
-    dynrt_processor__engine__decode__t3 op_i5(
-        .d(op_i5__d),
-        .q(op_i5__q),
-        .clock(op_i5__clock)
+    dynrt_processor__engine__decode__t4 op_i6(
+        .d(op_i6__d),
+        .q(op_i6__q),
+        .clock(op_i6__clock)
     );
-    dynrt_processor__engine__halted_count dst_i5(
-        .d(dst_i5__d),
-        .q(dst_i5__q),
-        .clock(dst_i5__clock)
+    dynrt_processor__engine__halted_count dst_i6(
+        .d(dst_i6__d),
+        .q(dst_i6__q),
+        .clock(dst_i6__clock)
     );
-    dynrt_processor__engine__decode__t3 thread_i5(
-        .d(thread_i5__d),
-        .q(thread_i5__q),
-        .clock(thread_i5__clock)
+    dynrt_processor__engine__decode__t4 thread_i6(
+        .d(thread_i6__d),
+        .q(thread_i6__q),
+        .clock(thread_i6__clock)
     );
-    dynrt_processor__display__dark_d invert_i5(
-        .d(invert_i5__d),
-        .q(invert_i5__q),
-        .clock(invert_i5__clock)
+    dynrt_processor__display__dark_d invert_i6(
+        .d(invert_i6__d),
+        .q(invert_i6__q),
+        .clock(invert_i6__clock)
     );
-    dynrt_processor__display__timing__col pc_i5(
-        .d(pc_i5__d),
-        .q(pc_i5__q),
-        .clock(pc_i5__clock)
+    dynrt_processor__display__timing__col pc_i6(
+        .d(pc_i6__d),
+        .q(pc_i6__q),
+        .clock(pc_i6__clock)
     );
-    dynrt_processor__display__timing__col pc_plus_one_i5(
-        .d(pc_plus_one_i5__d),
-        .q(pc_plus_one_i5__q),
-        .clock(pc_plus_one_i5__clock)
+    dynrt_processor__display__timing__col pc_plus_one_i6(
+        .d(pc_plus_one_i6__d),
+        .q(pc_plus_one_i6__q),
+        .clock(pc_plus_one_i6__clock)
     );
-    dynrt_processor__display__timing__col target_i5(
-        .d(target_i5__d),
-        .q(target_i5__q),
-        .clock(target_i5__clock)
+    dynrt_processor__display__timing__col target_i6(
+        .d(target_i6__d),
+        .q(target_i6__q),
+        .clock(target_i6__clock)
     );
-    dynrt_processor__display__dark_d is_wait_i5(
-        .d(is_wait_i5__d),
-        .q(is_wait_i5__q),
-        .clock(is_wait_i5__clock)
+    dynrt_processor__display__dark_d is_wait_i6(
+        .d(is_wait_i6__d),
+        .q(is_wait_i6__q),
+        .clock(is_wait_i6__clock)
     );
-    dynrt_processor__display__dark_d kd_busy_i5(
-        .d(kd_busy_i5__d),
-        .q(kd_busy_i5__q),
-        .clock(kd_busy_i5__clock)
+    dynrt_processor__display__dark_d kd_busy_i6(
+        .d(kd_busy_i6__d),
+        .q(kd_busy_i6__q),
+        .clock(kd_busy_i6__clock)
     );
-    dynrt_processor__display__dark_d tri_busy_i5(
-        .d(tri_busy_i5__d),
-        .q(tri_busy_i5__q),
-        .clock(tri_busy_i5__clock)
+    dynrt_processor__display__dark_d tri_busy_i6(
+        .d(tri_busy_i6__d),
+        .q(tri_busy_i6__q),
+        .clock(tri_busy_i6__clock)
     );
-    dynrt_processor__display__timing__col jr_target_i5(
-        .d(jr_target_i5__d),
-        .q(jr_target_i5__q),
-        .clock(jr_target_i5__clock)
+    dynrt_processor__display__timing__col jr_target_i6(
+        .d(jr_target_i6__d),
+        .q(jr_target_i6__q),
+        .clock(jr_target_i6__clock)
     );
-    dynrt_processor__display__dark_d int_eq_i5(
-        .d(int_eq_i5__d),
-        .q(int_eq_i5__q),
-        .clock(int_eq_i5__clock)
+    dynrt_processor__display__dark_d int_eq_i6(
+        .d(int_eq_i6__d),
+        .q(int_eq_i6__q),
+        .clock(int_eq_i6__clock)
     );
-    dynrt_processor__display__dark_d int_lt_i5(
-        .d(int_lt_i5__d),
-        .q(int_lt_i5__q),
-        .clock(int_lt_i5__clock)
+    dynrt_processor__display__dark_d int_lt_i6(
+        .d(int_lt_i6__d),
+        .q(int_lt_i6__q),
+        .clock(int_lt_i6__clock)
     );
-    dynrt_processor__display__dark_d pix_done_i5(
-        .d(pix_done_i5__d),
-        .q(pix_done_i5__q),
-        .clock(pix_done_i5__clock)
+    dynrt_processor__display__dark_d pix_done_i6(
+        .d(pix_done_i6__d),
+        .q(pix_done_i6__q),
+        .clock(pix_done_i6__clock)
     );
-    dynrt_processor__display__dark_d cond_i6(
-        .d(cond_i6__d),
-        .q(cond_i6__q),
-        .clock(cond_i6__clock)
+    dynrt_processor__display__dark_d cond_i7(
+        .d(cond_i7__d),
+        .q(cond_i7__q),
+        .clock(cond_i7__clock)
     );
-    dynrt_processor__display__dark_d is_mbx_i6(
-        .d(is_mbx_i6__d),
-        .q(is_mbx_i6__q),
-        .clock(is_mbx_i6__clock)
+    dynrt_processor__display__dark_d is_mbx_i7(
+        .d(is_mbx_i7__d),
+        .q(is_mbx_i7__q),
+        .clock(is_mbx_i7__clock)
     );
     dynrt_processor__engine__result_line__halt_line valid_line(
         .clock(valid_line__clock),
@@ -11602,40 +11665,40 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     
     // Update code
     always @(*) begin
-        valid_i5__clock = clock;
-        op_i5__clock = clock;
-        dst_i5__clock = clock;
-        thread_i5__clock = clock;
-        invert_i5__clock = clock;
-        pc_i5__clock = clock;
-        pc_plus_one_i5__clock = clock;
-        target_i5__clock = clock;
-        is_wait_i5__clock = clock;
-        kd_busy_i5__clock = clock;
-        tri_busy_i5__clock = clock;
-        jr_target_i5__clock = clock;
-        int_eq_i5__clock = clock;
-        int_lt_i5__clock = clock;
-        pix_done_i5__clock = clock;
-        cond_i6__clock = clock;
-        is_mbx_i6__clock = clock;
-        valid_i5__d = valid_i5__q;
-        op_i5__d = op_i5__q;
-        dst_i5__d = dst_i5__q;
-        thread_i5__d = thread_i5__q;
-        invert_i5__d = invert_i5__q;
-        pc_i5__d = pc_i5__q;
-        pc_plus_one_i5__d = pc_plus_one_i5__q;
-        target_i5__d = target_i5__q;
-        is_wait_i5__d = is_wait_i5__q;
-        kd_busy_i5__d = kd_busy_i5__q;
-        tri_busy_i5__d = tri_busy_i5__q;
-        jr_target_i5__d = jr_target_i5__q;
-        int_eq_i5__d = int_eq_i5__q;
-        int_lt_i5__d = int_lt_i5__q;
-        pix_done_i5__d = pix_done_i5__q;
-        cond_i6__d = cond_i6__q;
-        is_mbx_i6__d = is_mbx_i6__q;
+        valid_i6__clock = clock;
+        op_i6__clock = clock;
+        dst_i6__clock = clock;
+        thread_i6__clock = clock;
+        invert_i6__clock = clock;
+        pc_i6__clock = clock;
+        pc_plus_one_i6__clock = clock;
+        target_i6__clock = clock;
+        is_wait_i6__clock = clock;
+        kd_busy_i6__clock = clock;
+        tri_busy_i6__clock = clock;
+        jr_target_i6__clock = clock;
+        int_eq_i6__clock = clock;
+        int_lt_i6__clock = clock;
+        pix_done_i6__clock = clock;
+        cond_i7__clock = clock;
+        is_mbx_i7__clock = clock;
+        valid_i6__d = valid_i6__q;
+        op_i6__d = op_i6__q;
+        dst_i6__d = dst_i6__q;
+        thread_i6__d = thread_i6__q;
+        invert_i6__d = invert_i6__q;
+        pc_i6__d = pc_i6__q;
+        pc_plus_one_i6__d = pc_plus_one_i6__q;
+        target_i6__d = target_i6__q;
+        is_wait_i6__d = is_wait_i6__q;
+        kd_busy_i6__d = kd_busy_i6__q;
+        tri_busy_i6__d = tri_busy_i6__q;
+        jr_target_i6__d = jr_target_i6__q;
+        int_eq_i6__d = int_eq_i6__q;
+        int_lt_i6__d = int_lt_i6__q;
+        pix_done_i6__d = pix_done_i6__q;
+        cond_i7__d = cond_i7__q;
+        is_mbx_i7__d = is_mbx_i7__q;
         valid_line__clock = clock;
         is_long_line__clock = clock;
         dst_line__clock = clock;
@@ -11674,74 +11737,74 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         kind_line__6__clock = clock;
         fast_line__7__clock = clock;
         kind_line__7__clock = clock;
-        valid_i5__d = valid;
-        op_i5__d = op;
-        dst_i5__d = dst;
-        thread_i5__d = thread;
-        invert_i5__d = invert;
-        pc_i5__d = pc;
-        pc_plus_one_i5__d = pc + 32'h1;
-        target_i5__d = target;
-        is_wait_i5__d = is_wait;
-        kd_busy_i5__d = kd_busy;
-        tri_busy_i5__d = tri_busy;
-        jr_target_i5__d = jr_target;
-        int_eq_i5__d = int_eq;
-        int_lt_i5__d = int_lt;
-        pix_done_i5__d = pix_done;
-        is_long = (op_i5__q == op_fdiv) | (op_i5__q == op_fsqrt);
-        is_mbx = op_i5__q == op_mbx;
-        halts = op_i5__q == op_halt;
-        repeats = ((op_i5__q == op_tri) & tri_busy_i5__q) | ((op_i5__q == op_kd) & kd_busy_i5__q);
+        valid_i6__d = valid;
+        op_i6__d = op;
+        dst_i6__d = dst;
+        thread_i6__d = thread;
+        invert_i6__d = invert;
+        pc_i6__d = pc;
+        pc_plus_one_i6__d = pc + 32'h1;
+        target_i6__d = target;
+        is_wait_i6__d = is_wait;
+        kd_busy_i6__d = kd_busy;
+        tri_busy_i6__d = tri_busy;
+        jr_target_i6__d = jr_target;
+        int_eq_i6__d = int_eq;
+        int_lt_i6__d = int_lt;
+        pix_done_i6__d = pix_done;
+        is_long = (op_i6__q == op_fdiv) | (op_i6__q == op_fsqrt);
+        is_mbx = op_i6__q == op_mbx;
+        halts = op_i6__q == op_halt;
+        repeats = ((op_i6__q == op_tri) & tri_busy_i6__q) | ((op_i6__q == op_kd) & kd_busy_i6__q);
         keeps_pc = halts | repeats;
-        cond_i5 = ((op_i5__q == op_beq) & int_eq_i5__q) | ((op_i5__q == op_bltu) & int_lt_i5__q) | ((op_i5__q == op_pixel) & pix_done_i5__q) | (op_i5__q == op_jal) | repeats;
-        pc_target = target_i5__q;
-        pc_next = pc_plus_one_i5__q;
-        if (invert_i5__q) begin
-            pc_target = pc_plus_one_i5__q;
-            pc_next = target_i5__q;
+        cond_i6 = ((op_i6__q == op_beq) & int_eq_i6__q) | ((op_i6__q == op_bltu) & int_lt_i6__q) | ((op_i6__q == op_pixel) & pix_done_i6__q) | (op_i6__q == op_jal) | repeats;
+        pc_target = target_i6__q;
+        pc_next = pc_plus_one_i6__q;
+        if (invert_i6__q) begin
+            pc_target = pc_plus_one_i6__q;
+            pc_next = target_i6__q;
         end
-        pc_other = jr_target_i5__q;
+        pc_other = jr_target_i6__q;
         if (keeps_pc) begin
-            pc_other = pc_i5__q;
+            pc_other = pc_i6__q;
         end
-        if (keeps_pc | (op_i5__q == op_jr)) begin
+        if (keeps_pc | (op_i6__q == op_jr)) begin
             pc_target = pc_other;
             pc_next = pc_other;
         end
-        source_i5 = ResultSource__Fast;
-        if ((op_i5__q == op_fadd) | (op_i5__q == op_fsub)) begin
-            source_i5 = ResultSource__Sum;
+        source_i6 = ResultSource__Fast;
+        if ((op_i6__q == op_fadd) | (op_i6__q == op_fsub)) begin
+            source_i6 = ResultSource__Sum;
         end
-        if (op_i5__q == op_fmul) begin
-            source_i5 = ResultSource__Product;
+        if (op_i6__q == op_fmul) begin
+            source_i6 = ResultSource__Product;
         end
-        if (op_i5__q == op_fdiv) begin
-            source_i5 = ResultSource__Quotient;
+        if (op_i6__q == op_fdiv) begin
+            source_i6 = ResultSource__Quotient;
         end
-        if (op_i5__q == op_fsqrt) begin
-            source_i5 = ResultSource__Root;
+        if (op_i6__q == op_fsqrt) begin
+            source_i6 = ResultSource__Root;
         end
-        if (op_i5__q == op_byte) begin
-            source_i5 = ResultSource__Byte;
+        if (op_i6__q == op_byte) begin
+            source_i6 = ResultSource__Byte;
         end
-        valid_line__data_in = valid_i5__q;
+        valid_line__data_in = valid_i6__q;
         is_long_line__data_in = is_long;
-        dst_line__data_in = dst_i5__q;
-        thread_line__data_in = thread_i5__q;
-        write_line__data_in = valid_i5__q & (dst_i5__q != 32'h0) & op_writes[op_i5__q] & (~((op_i5__q == op_pixel) & pix_done_i5__q));
-        source_line__data_in = source_i5;
-        sel_lt_line__data_in = op_i5__q == op_bflt;
-        sel_le_line__data_in = op_i5__q == op_bfle;
-        sel_eq_line__data_in = op_i5__q == op_bfeq;
+        dst_line__data_in = dst_i6__q;
+        thread_line__data_in = thread_i6__q;
+        write_line__data_in = valid_i6__q & (dst_i6__q != 32'h0) & op_writes[op_i6__q] & (~((op_i6__q == op_pixel) & pix_done_i6__q));
+        source_line__data_in = source_i6;
+        sel_lt_line__data_in = op_i6__q == op_bflt;
+        sel_le_line__data_in = op_i6__q == op_bfle;
+        sel_eq_line__data_in = op_i6__q == op_bfeq;
         pc_taken_line__data_in = pc_target;
         pc_not_taken_line__data_in = pc_next;
         halt_line__data_in = halts;
-        retired_line__data_in = valid_i5__q & (~repeats);
-        wait_pending_line__data_in = repeats & is_wait_i5__q;
-        cond_i6__d = cond_i5;
-        is_mbx_i6__d = is_mbx;
-        cond_line__data_in = cond_i6__q | (is_mbx_i6__q & mb_hit);
+        retired_line__data_in = valid_i6__q & (~repeats);
+        wait_pending_line__data_in = repeats & is_wait_i6__q;
+        cond_i7__d = cond_i6;
+        is_mbx_i7__d = is_mbx;
+        cond_line__data_in = cond_i7__q | (is_mbx_i7__q & mb_hit);
         fast_line__0__d = fast;
         kind_line__0__d = kind;
         fast_line__1__d = fast_line__0__q;
@@ -12924,52 +12987,52 @@ module dynrt_processor__engine__result_line__long_thread(clock,data_in,data_out)
     reg  stage__9__clock;
     
     // Sub module instances
-    dynrt_processor__engine__decode__t3 stage__0(
+    dynrt_processor__engine__decode__t4 stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__1(
+    dynrt_processor__engine__decode__t4 stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__2(
+    dynrt_processor__engine__decode__t4 stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__3(
+    dynrt_processor__engine__decode__t4 stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__4(
+    dynrt_processor__engine__decode__t4 stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__5(
+    dynrt_processor__engine__decode__t4 stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__6(
+    dynrt_processor__engine__decode__t4 stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__7(
+    dynrt_processor__engine__decode__t4 stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__8(
+    dynrt_processor__engine__decode__t4 stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__9(
+    dynrt_processor__engine__decode__t4 stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
@@ -13581,57 +13644,57 @@ module dynrt_processor__engine__result_line__thread_line(clock,data_in,data_out)
     reg  stage__10__clock;
     
     // Sub module instances
-    dynrt_processor__engine__decode__t3 stage__0(
+    dynrt_processor__engine__decode__t4 stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__1(
+    dynrt_processor__engine__decode__t4 stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__2(
+    dynrt_processor__engine__decode__t4 stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__3(
+    dynrt_processor__engine__decode__t4 stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__4(
+    dynrt_processor__engine__decode__t4 stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__5(
+    dynrt_processor__engine__decode__t4 stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__6(
+    dynrt_processor__engine__decode__t4 stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__7(
+    dynrt_processor__engine__decode__t4 stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__8(
+    dynrt_processor__engine__decode__t4 stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__9(
+    dynrt_processor__engine__decode__t4 stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor__engine__decode__t3 stage__10(
+    dynrt_processor__engine__decode__t4 stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
@@ -13880,7 +13943,7 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         .q(pick_onehot__q),
         .clock(pick_onehot__clock)
     );
-    dynrt_processor__engine__decode__t3 pointer(
+    dynrt_processor__engine__decode__t4 pointer(
         .d(pointer__d),
         .q(pointer__q),
         .clock(pointer__clock)
@@ -14732,12 +14795,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(cur_kind__1__q),
         .clock(cur_kind__1__clock)
     );
-    dynrt_processor__engine__decode__t3 cur_thread__0(
+    dynrt_processor__engine__decode__t4 cur_thread__0(
         .d(cur_thread__0__d),
         .q(cur_thread__0__q),
         .clock(cur_thread__0__clock)
     );
-    dynrt_processor__engine__decode__t3 cur_thread__1(
+    dynrt_processor__engine__decode__t4 cur_thread__1(
         .d(cur_thread__1__d),
         .q(cur_thread__1__q),
         .clock(cur_thread__1__clock)
@@ -14782,7 +14845,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(t_issued__q),
         .clock(t_issued__clock)
     );
-    dynrt_processor__engine__decode__t3 seq(
+    dynrt_processor__engine__decode__t4 seq(
         .d(seq__d),
         .q(seq__q),
         .clock(seq__clock)
@@ -14907,62 +14970,62 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(words__23__q),
         .clock(words__23__clock)
     );
-    dynrt_processor__engine__decode__t3 uv_line__0(
+    dynrt_processor__engine__decode__t4 uv_line__0(
         .d(uv_line__0__d),
         .q(uv_line__0__q),
         .clock(uv_line__0__clock)
     );
-    dynrt_processor__engine__decode__t3 uv_line__1(
+    dynrt_processor__engine__decode__t4 uv_line__1(
         .d(uv_line__1__d),
         .q(uv_line__1__q),
         .clock(uv_line__1__clock)
     );
-    dynrt_processor__engine__decode__t3 uv_line__2(
+    dynrt_processor__engine__decode__t4 uv_line__2(
         .d(uv_line__2__d),
         .q(uv_line__2__q),
         .clock(uv_line__2__clock)
     );
-    dynrt_processor__engine__decode__t3 uv_line__3(
+    dynrt_processor__engine__decode__t4 uv_line__3(
         .d(uv_line__3__d),
         .q(uv_line__3__q),
         .clock(uv_line__3__clock)
     );
-    dynrt_processor__engine__decode__t3 uv_line__4(
+    dynrt_processor__engine__decode__t4 uv_line__4(
         .d(uv_line__4__d),
         .q(uv_line__4__q),
         .clock(uv_line__4__clock)
     );
-    dynrt_processor__engine__decode__t3 uv_line__5(
+    dynrt_processor__engine__decode__t4 uv_line__5(
         .d(uv_line__5__d),
         .q(uv_line__5__q),
         .clock(uv_line__5__clock)
     );
-    dynrt_processor__engine__decode__t3 t_line__0(
+    dynrt_processor__engine__decode__t4 t_line__0(
         .d(t_line__0__d),
         .q(t_line__0__q),
         .clock(t_line__0__clock)
     );
-    dynrt_processor__engine__decode__t3 t_line__1(
+    dynrt_processor__engine__decode__t4 t_line__1(
         .d(t_line__1__d),
         .q(t_line__1__q),
         .clock(t_line__1__clock)
     );
-    dynrt_processor__engine__decode__t3 t_line__2(
+    dynrt_processor__engine__decode__t4 t_line__2(
         .d(t_line__2__d),
         .q(t_line__2__q),
         .clock(t_line__2__clock)
     );
-    dynrt_processor__engine__decode__t3 t_line__3(
+    dynrt_processor__engine__decode__t4 t_line__3(
         .d(t_line__3__d),
         .q(t_line__3__q),
         .clock(t_line__3__clock)
     );
-    dynrt_processor__engine__decode__t3 t_line__4(
+    dynrt_processor__engine__decode__t4 t_line__4(
         .d(t_line__4__d),
         .q(t_line__4__q),
         .clock(t_line__4__clock)
     );
-    dynrt_processor__engine__decode__t3 t_line__5(
+    dynrt_processor__engine__decode__t4 t_line__5(
         .d(t_line__5__d),
         .q(t_line__5__q),
         .clock(t_line__5__clock)
@@ -15052,7 +15115,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m1_kind__q),
         .clock(m1_kind__clock)
     );
-    dynrt_processor__engine__decode__t3 m1_thread(
+    dynrt_processor__engine__decode__t4 m1_thread(
         .d(m1_thread__d),
         .q(m1_thread__q),
         .clock(m1_thread__clock)
@@ -15077,7 +15140,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m2_kind__q),
         .clock(m2_kind__clock)
     );
-    dynrt_processor__engine__decode__t3 m2_thread(
+    dynrt_processor__engine__decode__t4 m2_thread(
         .d(m2_thread__d),
         .q(m2_thread__q),
         .clock(m2_thread__clock)
@@ -15122,7 +15185,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m3_kind__q),
         .clock(m3_kind__clock)
     );
-    dynrt_processor__engine__decode__t3 m3_thread(
+    dynrt_processor__engine__decode__t4 m3_thread(
         .d(m3_thread__d),
         .q(m3_thread__q),
         .clock(m3_thread__clock)
@@ -16384,6 +16447,8 @@ module dynrt_processor__engine__tester__intersect_unit(clock,in_valid,o__0,o__1,
     end
     
 endmodule // dynrt_processor__engine__tester__intersect_unit
+
+
 
 
 
@@ -19783,7 +19848,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .q(phase__q),
         .clock(phase__clock)
     );
-    dynrt_processor__engine__decode__t3 walk_thread(
+    dynrt_processor__engine__decode__t4 walk_thread(
         .d(walk_thread__d),
         .q(walk_thread__q),
         .clock(walk_thread__clock)
@@ -20483,17 +20548,17 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor__engine__decode__t3 read_address(
+    dynrt_processor__engine__decode__t4 read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
     );
-    dynrt_processor__engine__decode__t3 write_address(
+    dynrt_processor__engine__decode__t4 write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor__engine__decode__t3 write_address_delayed(
+    dynrt_processor__engine__decode__t4 write_address_delayed(
         .d(write_address_delayed__d),
         .q(write_address_delayed__q),
         .clock(write_address_delayed__clock)
@@ -24893,7 +24958,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f1_next__q),
         .clock(f1_next__clock)
     );
-    dynrt_processor__engine__decode__t3 f1_thread(
+    dynrt_processor__engine__decode__t4 f1_thread(
         .d(f1_thread__d),
         .q(f1_thread__q),
         .clock(f1_thread__clock)
@@ -24918,7 +24983,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f2_next__q),
         .clock(f2_next__clock)
     );
-    dynrt_processor__engine__decode__t3 f2_thread(
+    dynrt_processor__engine__decode__t4 f2_thread(
         .d(f2_thread__d),
         .q(f2_thread__q),
         .clock(f2_thread__clock)
@@ -24943,7 +25008,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f3_next__q),
         .clock(f3_next__clock)
     );
-    dynrt_processor__engine__decode__t3 f3_thread(
+    dynrt_processor__engine__decode__t4 f3_thread(
         .d(f3_thread__d),
         .q(f3_thread__q),
         .clock(f3_thread__clock)
@@ -24978,7 +25043,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f4_next__q),
         .clock(f4_next__clock)
     );
-    dynrt_processor__engine__decode__t3 f4_thread(
+    dynrt_processor__engine__decode__t4 f4_thread(
         .d(f4_thread__d),
         .q(f4_thread__q),
         .clock(f4_thread__clock)
@@ -25028,7 +25093,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f5_next__q),
         .clock(f5_next__clock)
     );
-    dynrt_processor__engine__decode__t3 f5_thread(
+    dynrt_processor__engine__decode__t4 f5_thread(
         .d(f5_thread__d),
         .q(f5_thread__q),
         .clock(f5_thread__clock)
@@ -26299,6 +26364,8 @@ module dynrt_processor__engine__traversal_unit__control_delay_div(clock,data_in,
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__control_delay_div
+
+
 
 
 
@@ -28140,7 +28207,7 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
         .q(valid_r__q),
         .clock(valid_r__clock)
     );
-    dynrt_processor__engine__decode__t3 thread_r(
+    dynrt_processor__engine__decode__t4 thread_r(
         .d(thread_r__d),
         .q(thread_r__q),
         .clock(thread_r__clock)

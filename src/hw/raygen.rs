@@ -73,12 +73,12 @@ pub struct RayGen<const W: usize, const E: usize, const M: usize> {
     pub req_thread: Signal<Out, Bits<THREAD_BITS>>,
     x: DFF<Bits<16>>,
     y: DFF<Bits<16>>,
-    /// `x + 1` and `y + 1`, counted beside `x` and `y`: the last column and row are then an
-    /// equality with `width` and `height`, not an increment's carry chain followed by a compare
-    /// (that chain into `running` bounded the unit at 94.2 MHz on the ECP5).
+    /// `x + 1`, `y + 1`, `x + 2` and `y + 2`, counted beside `x` and `y`: no increment's carry
+    /// chain sits in front of a compare (such a chain into `running` bounded the unit at 94.2
+    /// MHz on the ECP5). `x + 2` and `y + 2` are compared with `width` and `height` a pixel
+    /// ahead, and where they are powers of two the float step halves.
     x_next: DFF<Bits<16>>,
     y_next: DFF<Bits<16>>,
-    /// `x + 2` and `y + 2`: where they are powers of two, the float step halves.
     x_after: DFF<Bits<16>>,
     y_after: DFF<Bits<16>>,
     /// The words of `x`, `y` (the request's point), `x + 1` and `y + 1`, and the steps from
@@ -91,8 +91,11 @@ pub struct RayGen<const W: usize, const E: usize, const M: usize> {
     y_step: DFF<Bits<W>>,
     running: DFF<Bit>,
     taken: Signal<Local, Bit>,
-    last_column: Signal<Local, Bit>,
-    last_row: Signal<Local, Bit>,
+    /// The current pixel is the last of its row; its row is the frame's last. Registers, kept
+    /// a pixel ahead: with the compares in front of them, `taken`'s fan-out (every counter's
+    /// enable) and the loop back into `running` reached 74.0 MHz on the ECP5.
+    last_column: DFF<Bit>,
+    last_row: DFF<Bit>,
     /// `x + 2` (`y + 2`) is a power of two: `(x + 1) & (x + 2)` is zero.
     x_after_power: Signal<Local, Bit>,
     y_after_power: Signal<Local, Bit>,
@@ -165,7 +168,9 @@ impl<const W: usize, const E: usize, const M: usize> Logic for RayGen<W, E, M> {
             y_next_float,
             x_step,
             y_step,
-            running
+            running,
+            last_column,
+            last_row
         );
         for k in 0..12 {
             self.req_m[k].next = self.camera[k].val();
@@ -184,12 +189,11 @@ impl<const W: usize, const E: usize, const M: usize> Logic for RayGen<W, E, M> {
         self.issued_thread.next = self.thread_id.val();
         self.active.next = self.running.q.val();
 
-        self.last_column.next = self.x_next.q.val() == self.width.val();
-        self.last_row.next = self.y_next.q.val() == self.height.val();
         self.x_after_power.next = (self.x_next.q.val() & self.x_after.q.val()) == 0;
         self.y_after_power.next = (self.y_next.q.val() & self.y_after.q.val()) == 0;
-        if self.start.val() | (self.taken.val() & self.last_column.val()) {
+        if self.start.val() | (self.taken.val() & self.last_column.q.val()) {
             // The row's first pixel.
+            self.last_column.d.next = self.width.val() == 1;
             self.x.d.next = 0.into();
             self.x_next.d.next = 1.into();
             self.x_after.d.next = 2.into();
@@ -200,6 +204,7 @@ impl<const W: usize, const E: usize, const M: usize> Logic for RayGen<W, E, M> {
             self.x.d.next = self.x_next.q.val();
             self.x_next.d.next = self.x_after.q.val();
             self.x_after.d.next = self.x_after.q.val() + 1;
+            self.last_column.d.next = self.x_after.q.val() == self.width.val();
             self.x_float.d.next = self.x_next_float.q.val();
             self.x_next_float.d.next = self.x_next_float.q.val() + self.x_step.q.val();
             if self.x_after_power.val() {
@@ -213,17 +218,19 @@ impl<const W: usize, const E: usize, const M: usize> Logic for RayGen<W, E, M> {
             self.y_float.d.next = 0.into();
             self.y_next_float.d.next = self.c_one.val();
             self.y_step.d.next = self.c_first_step.val();
+            self.last_row.d.next = self.height.val() == 1;
             self.running.d.next = (self.width.val() != 0) & (self.height.val() != 0);
-        } else if self.taken.val() & self.last_column.val() {
+        } else if self.taken.val() & self.last_column.q.val() {
             self.y.d.next = self.y_next.q.val();
             self.y_next.d.next = self.y_after.q.val();
             self.y_after.d.next = self.y_after.q.val() + 1;
+            self.last_row.d.next = self.y_after.q.val() == self.height.val();
             self.y_float.d.next = self.y_next_float.q.val();
             self.y_next_float.d.next = self.y_next_float.q.val() + self.y_step.q.val();
             if self.y_after_power.val() {
                 self.y_step.d.next = self.y_step.q.val() >> 1;
             }
-            if self.last_row.val() {
+            if self.last_row.q.val() {
                 self.running.d.next = false;
             }
         }

@@ -209,6 +209,7 @@ impl<
         self.pack.clock.next = self.clock.val();
         self.pack.in_valid.next = self.valid2.q.val();
         self.pack.sig.next = self.sig.val();
+        self.pack.sig_ones.next = self.sig.val().all();
         self.pack.round_up.next = self.round_up.val();
         self.pack.exp.next = self.exp_sum.q.val() + self.prod_top.val();
         self.pack.sign.next = self.sign.q.val();

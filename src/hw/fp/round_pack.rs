@@ -2,7 +2,8 @@
 //! significand to nearest even and pack the word.
 //!
 //! Contract: the parent drives the truncated significand `sig` (hidden bit at `M`), whether it
-//! rounds up (`round_up`: round bit and (sticky or lsb), decided by the parent), the biased
+//! is all ones (`sig_ones`: the parent may know it a clock ahead), whether it rounds up
+//! (`round_up`: round bit and (sticky or lsb), decided by the parent), the biased
 //! exponent `exp` in `X2`-bit two's complement (unbounded: it may be negative or beyond the
 //! largest), the sign and the special-case flags `nan`, `inf`, `zero` (exclusive of a normal
 //! result, `nan` first). `result` is the packed word: the canonical NaN; a signed infinity for
@@ -40,6 +41,7 @@ pub struct FpRoundPack<
     pub clock: Signal<In, Clock>,
     pub in_valid: Signal<In, Bit>,
     pub sig: Signal<In, Bits<S>>,
+    pub sig_ones: Signal<In, Bit>,
     pub round_up: Signal<In, Bit>,
     pub exp: Signal<In, Bits<X2>>,
     pub sign: Signal<In, Bit>,
@@ -93,6 +95,7 @@ impl<
             in_valid: Default::default(),
             sig: Default::default(),
             round_up: Default::default(),
+            sig_ones: Default::default(),
             exp: Default::default(),
             sign: Default::default(),
             nan: Default::default(),
@@ -154,7 +157,7 @@ impl<
         // increment carries out exactly when the significand is all ones and rounds up: bit
         // `S` of `sig_rounded`, formed without the increment's chain.
         self.sig_rounded.next = bit_cast::<S1, S>(self.sig.val()) + self.round_up.val();
-        self.carry.next = self.sig.val().all() & self.round_up.val();
+        self.carry.next = self.sig_ones.val() & self.round_up.val();
         // The exponent's increment starts at `exp`, and the carry only picks it: an add of the
         // carry put the increment's chain behind the rounding decision
         // (`div.last_sticky -> pack.rnd_exp`, the processor's critical path at 79.8 MHz).
