@@ -4,12 +4,12 @@
 //! the benchmark's 5,622 instance boxes (five times the runs); `terrain` the benchmark's
 //! 131,072-triangle terrain, a tree the budget does not bind. Prints the fastest and the
 //! median of `RUNS` builds (thread CPU time: `CLOCK_THREAD_CPUTIME_ID`), the tree's node
-//! count, SAH cost and a fingerprint (the builder test's), so that two builders can be
+//! count, SAH cost and a fingerprint (`KdTree::fingerprint`), so that two builders can be
 //! compared in alternating runs of their binaries.
 //!
 //! `cargo run --release --example kd_build_time -- [RUNS=9] [both|bunny|top|terrain]`
 use dynrt::accel::bench::{load_obj_triangles, random_instance_boxes};
-use dynrt::accel::{build_sah, build_sah_boxes, KdNode, KdParams, KdTree};
+use dynrt::accel::{build_sah, build_sah_boxes, KdParams, KdTree};
 
 fn thread_cpu_seconds() -> f64 {
     let mut ts = libc::timespec {
@@ -20,38 +20,6 @@ fn thread_cpu_seconds() -> f64 {
     let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
     assert_eq!(rc, 0);
     ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
-
-/// FNV-1a over nodes and primitive lists (the builder test's fingerprint).
-fn fingerprint(tree: &KdTree) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    let mut eat = |x: u64| {
-        for b in x.to_le_bytes() {
-            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
-        }
-    };
-    for node in &tree.nodes {
-        match *node {
-            KdNode::Inner {
-                axis,
-                split,
-                children,
-            } => {
-                eat(u64::from(axis));
-                eat(split.to_bits());
-                eat(u64::from(children));
-            }
-            KdNode::Leaf { first, count } => {
-                eat(3);
-                eat(u64::from(first));
-                eat(u64::from(count));
-            }
-        }
-    }
-    for &p in &tree.prim_indices {
-        eat(u64::from(p));
-    }
-    h
 }
 
 fn time(name: &str, runs: usize, params: &KdParams, build: &dyn Fn() -> KdTree) {
@@ -76,7 +44,7 @@ fn time(name: &str, runs: usize, params: &KdParams, build: &dyn Fn() -> KdTree) 
         all[runs / 2],
         tree.nodes.len(),
         s.sah_cost,
-        fingerprint(&tree)
+        tree.fingerprint()
     );
 }
 

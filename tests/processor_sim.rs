@@ -60,6 +60,16 @@ fn check(name: &str, w: u32, h: u32, frames: Option<u32>, sim: Simulator, format
     assert_eq!(r.frames.len(), frames.unwrap_or(s.frames) as usize);
 }
 
+/// The processor's number format: e7m16 unless a test names another.
+macro_rules! processor_format {
+    () => {
+        Format::E7M16
+    };
+    ($format:ident) => {
+        Format::$format
+    };
+}
+
 /// One test per scene and simulator, so that the test harness spreads the simulations over the
 /// machine's cores.
 macro_rules! frames_equal_the_golden_model {
@@ -67,9 +77,7 @@ macro_rules! frames_equal_the_golden_model {
         $(
             #[test]
             fn $test() {
-                let format = Format::E7M16;
-                $(let format = Format::$format;)?
-                check($name, $w, $h, $frames, Simulator::$sim, format);
+                check($name, $w, $h, $frames, Simulator::$sim, processor_format!($($format)?));
             }
         )*
     };

@@ -207,6 +207,40 @@ pub struct LeafInfo {
 }
 
 impl KdTree {
+    /// FNV-1a over a tree's nodes (axis, split bits, children; leaf ranges) and primitive
+    /// lists: equal fingerprints mean the same tree bit for bit (the builder's tests hold
+    /// those of earlier builders' trees; `examples/kd_build_time.rs` prints it).
+    pub fn fingerprint(&self) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut eat = |x: u64| {
+            for b in x.to_le_bytes() {
+                h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+            }
+        };
+        for node in &self.nodes {
+            match *node {
+                KdNode::Inner {
+                    axis,
+                    split,
+                    children,
+                } => {
+                    eat(u64::from(axis));
+                    eat(split.to_bits());
+                    eat(u64::from(children));
+                }
+                KdNode::Leaf { first, count } => {
+                    eat(3);
+                    eat(u64::from(first));
+                    eat(u64::from(count));
+                }
+            }
+        }
+        for &p in &self.prim_indices {
+            eat(u64::from(p));
+        }
+        h
+    }
+
     /// Primitive ids of a leaf's range.
     pub fn leaf_prims(&self, first: u32, count: u32) -> &[u32] {
         &self.prim_indices[first as usize..(first + count) as usize]

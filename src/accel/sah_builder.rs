@@ -1289,39 +1289,6 @@ mod tests {
         }
     }
 
-    /// FNV-1a over a tree's nodes (axis, split bits, children; leaf ranges) and primitive
-    /// lists: equal fingerprints mean the same tree bit for bit.
-    fn fingerprint(tree: &KdTree) -> u64 {
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        let mut eat = |x: u64| {
-            for b in x.to_le_bytes() {
-                h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
-            }
-        };
-        for node in &tree.nodes {
-            match *node {
-                KdNode::Inner {
-                    axis,
-                    split,
-                    children,
-                } => {
-                    eat(u64::from(axis));
-                    eat(split.to_bits());
-                    eat(u64::from(children));
-                }
-                KdNode::Leaf { first, count } => {
-                    eat(3);
-                    eat(u64::from(first));
-                    eat(u64::from(count));
-                }
-            }
-        }
-        for &p in &tree.prim_indices {
-            eat(u64::from(p));
-        }
-        h
-    }
-
     /// The layout, and with it the golden model's and the hardware's frames, depends on the
     /// trees bit for bit: the builder's speed-ups (one-key event order, one sweep per number
     /// format, branch-free list split, block merge of clipped events) must build the very
@@ -1357,7 +1324,7 @@ mod tests {
         let mut wrong = Vec::new();
         for (mesh, params, want, nodes) in cases {
             let tree = build_sah(&public_mesh(mesh), params);
-            let got = (fingerprint(&tree), tree.nodes.len());
+            let got = (tree.fingerprint(), tree.nodes.len());
             if got != (want, nodes) {
                 wrong.push(format!("{mesh} {params:?}: {:#x} {}", got.0, got.1));
             }
@@ -1365,7 +1332,7 @@ mod tests {
         // The top level over the benchmark's 5,622 instance boxes (seed 2).
         let boxes = crate::accel::bench::random_instance_boxes(5622, 2);
         let tree = build_sah_boxes(&boxes, &defaults);
-        let got = (fingerprint(&tree), tree.nodes.len());
+        let got = (tree.fingerprint(), tree.nodes.len());
         if got != (0xa867_610a_7a3d_1352, 16865) {
             wrong.push(format!("top level: {:#x} {}", got.0, got.1));
         }
