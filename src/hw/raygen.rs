@@ -31,8 +31,8 @@
 //! (the transform unit registers its inputs), so a pixel costs no latency beyond the transform
 //! unit's and RayGen issues one pixel per clock the request is taken.
 //!
-//! [`RayGenUnit`] measured (yosys xc2v, out of context): e7m16 4708 LUTs, 3522 FFs,
-//! 6 MULT18X18, depth 15; e8m23 6784 LUTs, 4574 FFs, 24 MULT18X18. Six, not nine, products:
+//! [`RayGenUnit`] measured (yosys xc2v, out of context, stop 31): e7m16 4550 LUTs, 6420 FFs,
+//! 6 MULT18X18, depth 5; e8m23 6639 LUTs, 8258 FFs, 24 MULT18X18. Six, not nine, products:
 //! the point's z is the constant 0, so yosys turns the three `m[r][2] * z` significand products
 //! into shifts (the exponent and NaN/infinity logic stay: `inf * 0` is still NaN). In the full
 //! design RayGen uses the shared unit and adds no multiplier.
