@@ -32,6 +32,10 @@ use crate::hw::program::isa::PC_BITS;
 use crate::hw::program::Program;
 use crate::hw::LutRam;
 
+/// Clocks from the pick (I0) to the fetched instruction (I3), where a long instruction
+/// reserves its write back.
+pub const FETCH_LATENCY: u32 = 3;
+
 #[derive(LogicBlock)]
 pub struct Fetch {
     pub clock: Signal<In, Clock>,

@@ -85,7 +85,7 @@ mod write_back;
 
 pub use decode::Decode;
 pub use execute::Execute;
-pub use fetch::Fetch;
+pub use fetch::{Fetch, FETCH_LATENCY};
 pub use first_ready::FirstReady;
 pub use fp_units::FpUnits;
 pub use mailbox::MailboxUnit;
@@ -331,10 +331,15 @@ impl<
         assert!(P == 2 * S);
         assert!(super::fp::div::div_latency(M as u32) + 1 == long_latency(M as u32));
         assert!(super::fp::sqrt::sqrt_latency(M as u32) + 1 == long_latency(M as u32));
-        // The reservation is made at I3 for the issue `1 + (DX - 4)` clocks later, whose write
-        // back is the long one's: I3 + 1 + (DX - 4) + OPERAND_STAGE + ENGINE_LATENCY = I5 +
-        // long_latency.
-        assert!(DX == (long_latency(M as u32) - ENGINE_LATENCY) as usize && DX >= 4);
+        // The reservation is made as the long instruction is fetched (I3, `FETCH_LATENCY`) for
+        // the issue `1 + reserve_ahead` clocks later, whose write back is the long one's:
+        // I3 + 1 + (DX - 4) + OPERAND_STAGE + ENGINE_LATENCY = I5 + long_latency.
+        assert!(DX == (long_latency(M as u32) - ENGINE_LATENCY) as usize);
+        assert!(
+            DX > FETCH_LATENCY as usize,
+            "the reservation would come too late"
+        );
+        let reserve_ahead = DX as u32 - (FETCH_LATENCY + 1);
         assert!(DL == super::fp::div::div_latency(M as u32) as usize);
         assert!((1..=MAX_THREADS as u32).contains(&threads));
         assert!((1..=MAX_MEM_LATENCY).contains(&mem_latency));
@@ -359,7 +364,7 @@ impl<
             transform_busy: Default::default(),
             intersect_busy: Default::default(),
             traversal_busy: Default::default(),
-            scheduler: Scheduler::new(threads, DX as u32 - 4),
+            scheduler: Scheduler::new(threads, reserve_ahead),
             fetch: Fetch::new(program),
             decode: Decode::new(program.registers_used),
             mailboxes: Default::default(),
