@@ -19620,12 +19620,42 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
     reg  [2:0] mb_next__d;
     wire  [2:0] mb_next__q;
     reg  mb_next__clock;
+    reg  live__0__d;
+    wire  live__0__q;
+    reg  live__0__clock;
+    reg  live__1__d;
+    wire  live__1__q;
+    reg  live__1__clock;
+    reg  live__2__d;
+    wire  live__2__q;
+    reg  live__2__clock;
+    reg  live__3__d;
+    wire  live__3__q;
+    reg  live__3__clock;
+    reg  live__4__d;
+    wire  live__4__q;
+    reg  live__4__clock;
+    reg  live__5__d;
+    wire  live__5__q;
+    reg  live__5__clock;
+    reg  live__6__d;
+    wire  live__6__q;
+    reg  live__6__clock;
+    reg  live__7__d;
+    wire  live__7__q;
+    reg  live__7__clock;
+    reg  recorded__d;
+    wire  recorded__q;
+    reg  recorded__clock;
     reg  [3:0] flight__d;
     wire  [3:0] flight__q;
     reg  flight__clock;
     reg  [3:0] queued__d;
     wire  [3:0] queued__q;
     reg  queued__clock;
+    reg  room__d;
+    wire  room__q;
+    reg  room__clock;
     reg  flight_line__0__d;
     wire  flight_line__0__q;
     reg  flight_line__0__clock;
@@ -19938,6 +19968,51 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .q(mb_next__q),
         .clock(mb_next__clock)
     );
+    dynrt_processor__display__dark_d live__0(
+        .d(live__0__d),
+        .q(live__0__q),
+        .clock(live__0__clock)
+    );
+    dynrt_processor__display__dark_d live__1(
+        .d(live__1__d),
+        .q(live__1__q),
+        .clock(live__1__clock)
+    );
+    dynrt_processor__display__dark_d live__2(
+        .d(live__2__d),
+        .q(live__2__q),
+        .clock(live__2__clock)
+    );
+    dynrt_processor__display__dark_d live__3(
+        .d(live__3__d),
+        .q(live__3__q),
+        .clock(live__3__clock)
+    );
+    dynrt_processor__display__dark_d live__4(
+        .d(live__4__d),
+        .q(live__4__q),
+        .clock(live__4__clock)
+    );
+    dynrt_processor__display__dark_d live__5(
+        .d(live__5__d),
+        .q(live__5__q),
+        .clock(live__5__clock)
+    );
+    dynrt_processor__display__dark_d live__6(
+        .d(live__6__d),
+        .q(live__6__q),
+        .clock(live__6__clock)
+    );
+    dynrt_processor__display__dark_d live__7(
+        .d(live__7__d),
+        .q(live__7__q),
+        .clock(live__7__clock)
+    );
+    dynrt_processor__display__dark_d recorded(
+        .d(recorded__d),
+        .q(recorded__q),
+        .clock(recorded__clock)
+    );
     dynrt_processor__engine__tester__list_unit__flight flight(
         .d(flight__d),
         .q(flight__q),
@@ -19947,6 +20022,11 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .d(queued__d),
         .q(queued__q),
         .clock(queued__clock)
+    );
+    dynrt_processor__display__dark_d room(
+        .d(room__d),
+        .q(room__q),
+        .clock(room__clock)
     );
     dynrt_processor__display__dark_d flight_line__0(
         .d(flight_line__0__d),
@@ -20092,8 +20172,10 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         skip_triangle__clock = clock;
         mb_len__clock = clock;
         mb_next__clock = clock;
+        recorded__clock = clock;
         flight__clock = clock;
         queued__clock = clock;
+        room__clock = clock;
         arrive_r__clock = clock;
         word_r__clock = clock;
         skip_r__clock = clock;
@@ -20109,8 +20191,10 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         skip_triangle__d = skip_triangle__q;
         mb_len__d = mb_len__q;
         mb_next__d = mb_next__q;
+        recorded__d = recorded__q;
         flight__d = flight__q;
         queued__d = queued__q;
+        room__d = room__q;
         arrive_r__d = arrive_r__q;
         word_r__d = word_r__q;
         skip_r__d = skip_r__q;
@@ -20132,6 +20216,8 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         hit_r__0__clock = clock;
         wrote_r__0__clock = clock;
         wrote_r__0__d = 1'b0;
+        live__0__clock = clock;
+        live__0__d = live__0__q;
         mailbox_ids__1__read_clock = clock;
         mailbox_ids__1__write_clock = clock;
         ids__1__clock = clock;
@@ -20139,6 +20225,8 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         hit_r__1__clock = clock;
         wrote_r__1__clock = clock;
         wrote_r__1__d = 1'b0;
+        live__1__clock = clock;
+        live__1__d = live__1__q;
         mailbox_ids__2__read_clock = clock;
         mailbox_ids__2__write_clock = clock;
         ids__2__clock = clock;
@@ -20146,6 +20234,8 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         hit_r__2__clock = clock;
         wrote_r__2__clock = clock;
         wrote_r__2__d = 1'b0;
+        live__2__clock = clock;
+        live__2__d = live__2__q;
         mailbox_ids__3__read_clock = clock;
         mailbox_ids__3__write_clock = clock;
         ids__3__clock = clock;
@@ -20153,6 +20243,8 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         hit_r__3__clock = clock;
         wrote_r__3__clock = clock;
         wrote_r__3__d = 1'b0;
+        live__3__clock = clock;
+        live__3__d = live__3__q;
         mailbox_ids__4__read_clock = clock;
         mailbox_ids__4__write_clock = clock;
         ids__4__clock = clock;
@@ -20160,6 +20252,8 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         hit_r__4__clock = clock;
         wrote_r__4__clock = clock;
         wrote_r__4__d = 1'b0;
+        live__4__clock = clock;
+        live__4__d = live__4__q;
         mailbox_ids__5__read_clock = clock;
         mailbox_ids__5__write_clock = clock;
         ids__5__clock = clock;
@@ -20167,6 +20261,8 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         hit_r__5__clock = clock;
         wrote_r__5__clock = clock;
         wrote_r__5__d = 1'b0;
+        live__5__clock = clock;
+        live__5__d = live__5__q;
         mailbox_ids__6__read_clock = clock;
         mailbox_ids__6__write_clock = clock;
         ids__6__clock = clock;
@@ -20174,6 +20270,8 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         hit_r__6__clock = clock;
         wrote_r__6__clock = clock;
         wrote_r__6__d = 1'b0;
+        live__6__clock = clock;
+        live__6__d = live__6__q;
         mailbox_ids__7__read_clock = clock;
         mailbox_ids__7__write_clock = clock;
         ids__7__clock = clock;
@@ -20181,6 +20279,8 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         hit_r__7__clock = clock;
         wrote_r__7__clock = clock;
         wrote_r__7__d = 1'b0;
+        live__7__clock = clock;
+        live__7__d = live__7__q;
         flight_line__0__clock = clock;
         flight_line__1__clock = clock;
         flight_line__2__clock = clock;
@@ -20211,52 +20311,54 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         object_ram__write_enable = 1'b0;
         skip_object_ram__write_enable = 1'b0;
         skip_triangle_ram__write_enable = 1'b0;
-        mailbox_meta__write_enable = 1'b0;
-        mailbox_meta__write_data = 32'h0;
+        mailbox_meta__write_enable = recorded__q;
+        mailbox_meta__write_data = (((mb_next__q) & 8'hff) << 32'h4) | ((mb_len__q) & 8'hff);
         mailbox_ids__0__read_address = walk_thread__q;
         mailbox_ids__0__write_address = walk_thread__q;
-        mailbox_ids__0__write_data = word_r__q;
-        mailbox_ids__0__write_enable = 1'b0;
+        mailbox_ids__0__write_data = ids__0__q;
+        mailbox_ids__0__write_enable = wrote_r__0__q;
         mailbox_ids__1__read_address = walk_thread__q;
         mailbox_ids__1__write_address = walk_thread__q;
-        mailbox_ids__1__write_data = word_r__q;
-        mailbox_ids__1__write_enable = 1'b0;
+        mailbox_ids__1__write_data = ids__1__q;
+        mailbox_ids__1__write_enable = wrote_r__1__q;
         mailbox_ids__2__read_address = walk_thread__q;
         mailbox_ids__2__write_address = walk_thread__q;
-        mailbox_ids__2__write_data = word_r__q;
-        mailbox_ids__2__write_enable = 1'b0;
+        mailbox_ids__2__write_data = ids__2__q;
+        mailbox_ids__2__write_enable = wrote_r__2__q;
         mailbox_ids__3__read_address = walk_thread__q;
         mailbox_ids__3__write_address = walk_thread__q;
-        mailbox_ids__3__write_data = word_r__q;
-        mailbox_ids__3__write_enable = 1'b0;
+        mailbox_ids__3__write_data = ids__3__q;
+        mailbox_ids__3__write_enable = wrote_r__3__q;
         mailbox_ids__4__read_address = walk_thread__q;
         mailbox_ids__4__write_address = walk_thread__q;
-        mailbox_ids__4__write_data = word_r__q;
-        mailbox_ids__4__write_enable = 1'b0;
+        mailbox_ids__4__write_data = ids__4__q;
+        mailbox_ids__4__write_enable = wrote_r__4__q;
         mailbox_ids__5__read_address = walk_thread__q;
         mailbox_ids__5__write_address = walk_thread__q;
-        mailbox_ids__5__write_data = word_r__q;
-        mailbox_ids__5__write_enable = 1'b0;
+        mailbox_ids__5__write_data = ids__5__q;
+        mailbox_ids__5__write_enable = wrote_r__5__q;
         mailbox_ids__6__read_address = walk_thread__q;
         mailbox_ids__6__write_address = walk_thread__q;
-        mailbox_ids__6__write_data = word_r__q;
-        mailbox_ids__6__write_enable = 1'b0;
+        mailbox_ids__6__write_data = ids__6__q;
+        mailbox_ids__6__write_enable = wrote_r__6__q;
         mailbox_ids__7__read_address = walk_thread__q;
         mailbox_ids__7__write_address = walk_thread__q;
-        mailbox_ids__7__write_data = word_r__q;
-        mailbox_ids__7__write_enable = 1'b0;
+        mailbox_ids__7__write_data = ids__7__q;
+        mailbox_ids__7__write_enable = wrote_r__7__q;
         if ((phase__q == ListPhase__Idle) & (~commands__empty)) begin
             if (head_kind == c_cmd_init) begin
                 if (~tests__full) begin
                     push = 1'b1;
                     commands__read = 1'b1;
                     mailbox_meta__write_address = commands__data_out[(32'h40)+:(5)];
+                    mailbox_meta__write_data = 32'h0;
                     mailbox_meta__write_enable = 1'b1;
                 end
             end
             if (head_kind == c_cmd_object) begin
                 object_ram__write_enable = 1'b1;
                 mailbox_meta__write_address = commands__data_out[(32'h40)+:(5)];
+                mailbox_meta__write_data = 32'h0;
                 mailbox_meta__write_enable = 1'b1;
                 commands__read = 1'b1;
             end
@@ -20285,16 +20387,25 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
             mb_len__d = mailbox_meta__read_data[(32'h0)+:(4)];
             mb_next__d = mailbox_meta__read_data[(32'h4)+:(3)];
             ids__0__d = mailbox_ids__0__read_data;
+            live__0__d = c_index__0 < mailbox_meta__read_data[(32'h0)+:(4)];
             ids__1__d = mailbox_ids__1__read_data;
+            live__1__d = c_index__1 < mailbox_meta__read_data[(32'h0)+:(4)];
             ids__2__d = mailbox_ids__2__read_data;
+            live__2__d = c_index__2 < mailbox_meta__read_data[(32'h0)+:(4)];
             ids__3__d = mailbox_ids__3__read_data;
+            live__3__d = c_index__3 < mailbox_meta__read_data[(32'h0)+:(4)];
             ids__4__d = mailbox_ids__4__read_data;
+            live__4__d = c_index__4 < mailbox_meta__read_data[(32'h0)+:(4)];
             ids__5__d = mailbox_ids__5__read_data;
+            live__5__d = c_index__5 < mailbox_meta__read_data[(32'h0)+:(4)];
             ids__6__d = mailbox_ids__6__read_data;
+            live__6__d = c_index__6 < mailbox_meta__read_data[(32'h0)+:(4)];
             ids__7__d = mailbox_ids__7__read_data;
+            live__7__d = c_index__7 < mailbox_meta__read_data[(32'h0)+:(4)];
             phase__d = ListPhase__Walk;
         end
-        take = (phase__q == ListPhase__Walk) & (~walked__q) & ((((queued__q) & 5'h1f) + ((flight__q) & 5'h1f) + ((arrive_r__q) & 5'h1f)) < 32'h7) & ((engine_banks & c_shared_banks) == 32'h0);
+        take = (phase__q == ListPhase__Walk) & (~walked__q) & room__q & ((engine_banks & c_shared_banks) == 32'h0);
+        room__d = (((queued__q) & 5'h1f) + ((flight__q) & 5'h1f) + ((arrive_r__q) & 5'h1f) + ((take) & 5'h1f)) < 32'h7;
         list_read = take;
         list_addr = cursor__q;
         cursor_next = cursor__q + 32'h1;
@@ -20347,7 +20458,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         skip_r__d = (list_rdata == skip_triangle__q) & (object_id__q == skip_object__q);
         same_r__d = list_rdata == word_r__q;
         seen = 1'b0;
-        if (c_index__0 < mb_len__q) begin
+        if (live__0__q) begin
             if (wrote_r__0__q) begin
                 if (same_r__q) begin
                     seen = 1'b1;
@@ -20357,7 +20468,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
                 seen = 1'b1;
             end
         end
-        if (c_index__1 < mb_len__q) begin
+        if (live__1__q) begin
             if (wrote_r__1__q) begin
                 if (same_r__q) begin
                     seen = 1'b1;
@@ -20367,7 +20478,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
                 seen = 1'b1;
             end
         end
-        if (c_index__2 < mb_len__q) begin
+        if (live__2__q) begin
             if (wrote_r__2__q) begin
                 if (same_r__q) begin
                     seen = 1'b1;
@@ -20377,7 +20488,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
                 seen = 1'b1;
             end
         end
-        if (c_index__3 < mb_len__q) begin
+        if (live__3__q) begin
             if (wrote_r__3__q) begin
                 if (same_r__q) begin
                     seen = 1'b1;
@@ -20387,7 +20498,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
                 seen = 1'b1;
             end
         end
-        if (c_index__4 < mb_len__q) begin
+        if (live__4__q) begin
             if (wrote_r__4__q) begin
                 if (same_r__q) begin
                     seen = 1'b1;
@@ -20397,7 +20508,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
                 seen = 1'b1;
             end
         end
-        if (c_index__5 < mb_len__q) begin
+        if (live__5__q) begin
             if (wrote_r__5__q) begin
                 if (same_r__q) begin
                     seen = 1'b1;
@@ -20407,7 +20518,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
                 seen = 1'b1;
             end
         end
-        if (c_index__6 < mb_len__q) begin
+        if (live__6__q) begin
             if (wrote_r__6__q) begin
                 if (same_r__q) begin
                     seen = 1'b1;
@@ -20417,7 +20528,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
                 seen = 1'b1;
             end
         end
-        if (c_index__7 < mb_len__q) begin
+        if (live__7__q) begin
             if (wrote_r__7__q) begin
                 if (same_r__q) begin
                     seen = 1'b1;
@@ -20433,57 +20544,60 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         if (mb_len__q != 32'h8) begin
             len_after = mb_len__q + 32'h1;
         end
+        if (arrive_r__q) begin
+            tests__data_in = (((walk_thread__q) & 71'h7fffffffffffffffff) << 32'h40) | (((word_r__q) & 71'h7fffffffffffffffff) << 32'h20) | ((object_id__q) & 71'h7fffffffffffffffff);
+        end
+        else if (phase__q == ListPhase__Walk) begin
+            tests__data_in = c_list_end | (((of_walk__q) & 71'h7fffffffffffffffff) << 32'h45) | (((walk_thread__q) & 71'h7fffffffffffffffff) << 32'h40);
+        end
+        recorded__d = fresh;
         if (fresh) begin
             push = 1'b1;
-            tests__data_in = (((walk_thread__q) & 71'h7fffffffffffffffff) << 32'h40) | (((word_r__q) & 71'h7fffffffffffffffff) << 32'h20) | ((object_id__q) & 71'h7fffffffffffffffff);
             if (((mb_next__q) & 4'hf) == c_index__0) begin
                 ids__0__d = word_r__q;
-                mailbox_ids__0__write_enable = 1'b1;
                 wrote_r__0__d = 1'b1;
+                live__0__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__1) begin
                 ids__1__d = word_r__q;
-                mailbox_ids__1__write_enable = 1'b1;
                 wrote_r__1__d = 1'b1;
+                live__1__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__2) begin
                 ids__2__d = word_r__q;
-                mailbox_ids__2__write_enable = 1'b1;
                 wrote_r__2__d = 1'b1;
+                live__2__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__3) begin
                 ids__3__d = word_r__q;
-                mailbox_ids__3__write_enable = 1'b1;
                 wrote_r__3__d = 1'b1;
+                live__3__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__4) begin
                 ids__4__d = word_r__q;
-                mailbox_ids__4__write_enable = 1'b1;
                 wrote_r__4__d = 1'b1;
+                live__4__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__5) begin
                 ids__5__d = word_r__q;
-                mailbox_ids__5__write_enable = 1'b1;
                 wrote_r__5__d = 1'b1;
+                live__5__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__6) begin
                 ids__6__d = word_r__q;
-                mailbox_ids__6__write_enable = 1'b1;
                 wrote_r__6__d = 1'b1;
+                live__6__d = 1'b1;
             end
             if (((mb_next__q) & 4'hf) == c_index__7) begin
                 ids__7__d = word_r__q;
-                mailbox_ids__7__write_enable = 1'b1;
                 wrote_r__7__d = 1'b1;
+                live__7__d = 1'b1;
             end
             mb_next__d = next_after;
             mb_len__d = len_after;
-            mailbox_meta__write_enable = 1'b1;
-            mailbox_meta__write_data = (((next_after) & 8'hff) << 32'h4) | ((len_after) & 8'hff);
         end
         if ((phase__q == ListPhase__Walk) & walked__q & (flight__q == 32'h0) & (~arrive_r__q) & (~tests__full)) begin
             push = 1'b1;
-            tests__data_in = c_list_end | (((of_walk__q) & 71'h7fffffffffffffffff) << 32'h45) | (((walk_thread__q) & 71'h7fffffffffffffffff) << 32'h40);
             phase__d = ListPhase__Idle;
         end
         tests__write = push;
@@ -20728,6 +20842,22 @@ endmodule // dynrt_processor__engine__tester__list_unit__flight
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__tester__list_unit__mailbox_meta(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -20851,6 +20981,10 @@ module dynrt_processor__engine__tester__list_unit__phase(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__tester__list_unit__phase
+
+
+
+
 
 
 

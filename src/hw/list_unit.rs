@@ -26,9 +26,10 @@
 //! while the test queue has room for the words in flight. A word is compared with the
 //! mailbox on its arrival and checked and recorded the clock after ([`units::Mailbox`]: the
 //! first `len` of 8 ids, first in first out; the slot written in between is compared with the
-//! word before), so a list of n words takes about `n + 4 + mem_latency` clocks (latency) at one list
-//! word per clock (throughput); a thread has at most one list queued (it waits for its tests
-//! before the next).
+//! word before; the thread's RAM copy is written the clock after that), so a list of n words
+//! takes about `n + 4 + mem_latency` clocks (latency) at one list word per clock
+//! (throughput); a thread has at most one list queued (it waits for its tests before the
+//! next).
 //!
 //! Golden twin: [`units::Mailbox`] (src/units.rs) and the skip rule of the golden model's
 //! `test_triangles` (src/model/golden.rs): the tests leave in the order, and with the drops,
@@ -113,9 +114,27 @@ pub struct ListUnit {
     ids: [DFF<Bits<32>>; 8],
     mb_len: DFF<Bits<4>>,
     mb_next: DFF<Bits<3>>,
+    /// Slot k holds one of the mailbox's ids (`k < mb_len`), kept beside `mb_len` so that
+    /// the check reads a bit instead of eight compares with the length (`mb_len ->
+    /// mailbox_ids`, issue 16). While the mailbox fills, a new id goes to slot `len`
+    /// (`mb_next == mb_len` below 8), so recording one sets that slot's bit.
+    live: [DFF<Bit>; 8],
+    /// A word was recorded last clock: the thread's RAM copies (`mailbox_ids`,
+    /// `mailbox_meta`) are written now, from `ids` and `mb_next`/`mb_len`, a clock after
+    /// the registers. The check's result then reaches only registers; the RAMs' write
+    /// enables hang on a flip-flop. They are read again only for a later list, at least
+    /// three clocks after a walk's last check.
+    recorded: DFF<Bit>,
     /// Reads in flight; entries in the test queue.
     flight: DFF<Bits<4>>,
     queued: DFF<Bits<4>>,
+    /// The test queue has room for one more read: the sum of its entries, the reads in
+    /// flight and the word being checked, with this clock's read, below 7 (of its 8 entries,
+    /// one kept for the list's end entry). A clock old, which is safe: during a walk only a
+    /// read adds to the sum. The sum's adders and compare in front of the read decision were
+    /// 10-11 levels into the bus (`flight -> list_addr`, `queued -> flight`, issue 16); a
+    /// queue entry taken last clock is seen a clock later.
+    room: DFF<Bit>,
     /// Request valid per clock of SRAM latency.
     flight_line: [DFF<Bit>; 6],
     /// The word that arrived last clock (`arrive_r`) and what was compared on its arrival:
@@ -200,8 +219,11 @@ impl ListUnit {
             ids: Default::default(),
             mb_len: Default::default(),
             mb_next: Default::default(),
+            live: Default::default(),
+            recorded: Default::default(),
             flight: Default::default(),
             queued: Default::default(),
+            room: Default::default(),
             flight_line: Default::default(),
             arrive_r: Default::default(),
             word_r: Default::default(),
@@ -246,8 +268,10 @@ impl Logic for ListUnit {
             skip_triangle,
             mb_len,
             mb_next,
+            recorded,
             flight,
             queued,
+            room,
             arrive_r,
             word_r,
             skip_r,
@@ -270,6 +294,8 @@ impl Logic for ListUnit {
             self.hit_r[k].clock.next = self.clock.val();
             self.wrote_r[k].clock.next = self.clock.val();
             self.wrote_r[k].d.next = false;
+            self.live[k].clock.next = self.clock.val();
+            self.live[k].d.next = self.live[k].q.val();
         }
         for k in 0..6 {
             self.flight_line[k].clock.next = self.clock.val();
@@ -308,13 +334,14 @@ impl Logic for ListUnit {
         self.object_ram.write_enable.next = false;
         self.skip_object_ram.write_enable.next = false;
         self.skip_triangle_ram.write_enable.next = false;
-        self.mailbox_meta.write_enable.next = false;
-        self.mailbox_meta.write_data.next = 0.into();
+        self.mailbox_meta.write_enable.next = self.recorded.q.val();
+        self.mailbox_meta.write_data.next =
+            (bit_cast::<8, 3>(self.mb_next.q.val()) << 4) | bit_cast::<8, 4>(self.mb_len.q.val());
         for k in 0..8 {
             self.mailbox_ids[k].read_address.next = self.walk_thread.q.val();
             self.mailbox_ids[k].write_address.next = self.walk_thread.q.val();
-            self.mailbox_ids[k].write_data.next = self.word_r.q.val();
-            self.mailbox_ids[k].write_enable.next = false;
+            self.mailbox_ids[k].write_data.next = self.ids[k].q.val();
+            self.mailbox_ids[k].write_enable.next = self.wrote_r[k].q.val();
         }
 
         if (self.phase.q.val() == ListPhase::Idle) & (!self.commands.empty.val()) {
@@ -325,6 +352,7 @@ impl Logic for ListUnit {
                     self.commands.read.next = true;
                     self.mailbox_meta.write_address.next =
                         self.commands.data_out.val().get_bits::<5>(64);
+                    self.mailbox_meta.write_data.next = 0.into();
                     self.mailbox_meta.write_enable.next = true;
                 }
             }
@@ -332,6 +360,7 @@ impl Logic for ListUnit {
                 self.object_ram.write_enable.next = true;
                 self.mailbox_meta.write_address.next =
                     self.commands.data_out.val().get_bits::<5>(64);
+                self.mailbox_meta.write_data.next = 0.into();
                 self.mailbox_meta.write_enable.next = true;
                 self.commands.read.next = true;
             }
@@ -362,6 +391,8 @@ impl Logic for ListUnit {
             self.mb_next.d.next = self.mailbox_meta.read_data.val().get_bits::<3>(4);
             for k in 0..8 {
                 self.ids[k].d.next = self.mailbox_ids[k].read_data.val();
+                self.live[k].d.next =
+                    self.c_index[k].val() < self.mailbox_meta.read_data.val().get_bits::<4>(0);
             }
             self.phase.d.next = ListPhase::Walk;
         }
@@ -370,12 +401,13 @@ impl Logic for ListUnit {
         // list's end entry; the engine's loads of banks 1, 4 and 5 take the bus first.
         self.take.next = (self.phase.q.val() == ListPhase::Walk)
             & (!self.walked.q.val())
-            // (of the queue's 8: the words in flight or being checked and the end entry)
-            & ((bit_cast::<5, 4>(self.queued.q.val())
-                + bit_cast::<5, 4>(self.flight.q.val())
-                + bit_cast::<5, 1>(self.arrive_r.q.val().into()))
-                < 7)
+            & self.room.q.val()
             & ((self.engine_banks.val() & self.c_shared_banks.val()) == 0);
+        self.room.d.next = (bit_cast::<5, 4>(self.queued.q.val())
+            + bit_cast::<5, 4>(self.flight.q.val())
+            + bit_cast::<5, 1>(self.arrive_r.q.val().into())
+            + bit_cast::<5, 1>(self.take.val().into()))
+            < 7;
         self.list_read.next = self.take.val();
         self.list_addr.next = self.cursor.q.val();
         self.cursor_next.next = self.cursor.q.val() + 1;
@@ -418,7 +450,7 @@ impl Logic for ListUnit {
         // record it first in, first out).
         self.seen.next = false;
         for k in 0..8 {
-            if self.c_index[k].val() < self.mb_len.q.val() {
+            if self.live[k].q.val() {
                 if self.wrote_r[k].q.val() {
                     if self.same_r.q.val() {
                         self.seen.next = true;
@@ -434,23 +466,29 @@ impl Logic for ListUnit {
         if self.mb_len.q.val() != 8 {
             self.len_after.next = self.mb_len.q.val() + 1;
         }
-        if self.fresh.val() {
-            self.push.next = true;
+        // The queue's entry is chosen by registers (a checked word, else the walk's end,
+        // else an init passed on), so that the check's result only enables the write.
+        if self.arrive_r.q.val() {
             self.tests.data_in.next = (bit_cast::<71, 5>(self.walk_thread.q.val()) << 64)
                 | (bit_cast::<71, 32>(self.word_r.q.val()) << 32)
                 | bit_cast::<71, 32>(self.object_id.q.val());
+        } else if self.phase.q.val() == ListPhase::Walk {
+            self.tests.data_in.next = self.c_list_end.val()
+                | (bit_cast::<71, 1>(self.of_walk.q.val().into()) << 69)
+                | (bit_cast::<71, 5>(self.walk_thread.q.val()) << 64);
+        }
+        self.recorded.d.next = self.fresh.val();
+        if self.fresh.val() {
+            self.push.next = true;
             for k in 0..8 {
                 if bit_cast::<4, 3>(self.mb_next.q.val()) == self.c_index[k].val() {
                     self.ids[k].d.next = self.word_r.q.val();
-                    self.mailbox_ids[k].write_enable.next = true;
                     self.wrote_r[k].d.next = true;
+                    self.live[k].d.next = true;
                 }
             }
             self.mb_next.d.next = self.next_after.val();
             self.mb_len.d.next = self.len_after.val();
-            self.mailbox_meta.write_enable.next = true;
-            self.mailbox_meta.write_data.next = (bit_cast::<8, 3>(self.next_after.val()) << 4)
-                | bit_cast::<8, 4>(self.len_after.val());
         }
         // The list is done when every word has arrived and been checked: its end entry
         // follows its tests.
@@ -461,9 +499,6 @@ impl Logic for ListUnit {
             & (!self.tests.full.val())
         {
             self.push.next = true;
-            self.tests.data_in.next = self.c_list_end.val()
-                | (bit_cast::<71, 1>(self.of_walk.q.val().into()) << 69)
-                | (bit_cast::<71, 5>(self.walk_thread.q.val()) << 64);
             self.phase.d.next = ListPhase::Idle;
         }
         self.tests.write.next = self.push.val();
