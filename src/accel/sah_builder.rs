@@ -122,6 +122,47 @@ fn merge_into_tail(list: &mut Vec<Event>, kept: usize, new: &[Event]) {
     list.truncate(kept + new.len());
 }
 
+/// Sorts the root's events of one axis, pushed in primitive order, into the lists' order
+/// ([`Event::sort_key`]) by a least significant digit first radix sort: its passes are stable,
+/// so sorting by kind and then by position leaves the events of a position and kind in
+/// primitive order. Comparison sorts spent 5% of the bunny's build on these three lists.
+fn sort_root_events(list: &mut Vec<Event>) {
+    const BITS: u32 = 11;
+    const BUCKETS: usize = 1 << BITS;
+    // The digits, least significant first: the kind, then the position 11 bits at a time.
+    let digit = |e: &Event, d: usize| {
+        if d == 0 {
+            usize::from(e.kind)
+        } else {
+            (e.key >> ((d as u32 - 1) * BITS)) as usize & (BUCKETS - 1)
+        }
+    };
+    let passes = 1 + 64usize.div_ceil(BITS as usize);
+    let mut counts = vec![[0usize; BUCKETS]; passes];
+    for e in list.iter() {
+        for (d, c) in counts.iter_mut().enumerate() {
+            c[digit(e, d)] += 1;
+        }
+    }
+    let mut buffer = vec![PAD_EVENT; list.len()];
+    for (d, c) in counts.iter_mut().enumerate() {
+        // A digit every event shares orders nothing.
+        if c.iter().any(|&k| k == list.len()) {
+            continue;
+        }
+        let mut at = 0;
+        for k in c.iter_mut() {
+            (*k, at) = (at, at + *k);
+        }
+        for e in list.iter() {
+            let b = &mut c[digit(e, d)];
+            buffer[*b] = *e;
+            *b += 1;
+        }
+        std::mem::swap(list, &mut buffer);
+    }
+}
+
 /// Appends the events of one primitive with bounds `b`.
 fn push_events(events: &mut Events, prim: u32, b: &Aabb) {
     for (axis, list) in events.iter_mut().enumerate() {
@@ -214,7 +255,7 @@ fn build_in_order<P: KdPrimitives>(prims: &P, params: &KdParams, best_first_only
         count += 1;
     }
     for list in events.iter_mut() {
-        list.sort_unstable_by_key(Event::sort_key);
+        sort_root_events(list);
     }
     let mut builder = Builder {
         prims,
