@@ -763,25 +763,28 @@ impl<P: KdPrimitives> Builder<'_, P> {
             .iter()
             .map(|n| matches!(n, KdNode::Inner { .. }))
             .collect();
-        let mut seeds: Vec<Candidate> = waiting
-            .iter()
-            .flatten()
-            .map(|c| Candidate {
-                node: c.node,
-                voxel: c.voxel,
-                events: c.events.clone(),
-                n: c.n,
-                depth: c.depth,
-                plane: c.plane,
-            })
-            .collect();
         let mut built = false;
-        for &(threshold, cap) in rounds {
+        // The candidates the last round left out, for the next one.
+        let mut left_out = LeftOut::default();
+        for (round, &(threshold, cap)) in rounds.iter().enumerate() {
             // Overshooting the budget costs little (a threshold at half the right one grew
             // the bunny's tree by a fifth); beyond the cap the guess was far off.
             self.node_cap = nodes0.saturating_add(cap.saturating_mul((budget - used) as usize));
-            let mut left_out = LeftOut::default();
-            for c in seeds.drain(..) {
+            // Lists are made of the left out ones only for a round that needs them (the
+            // first usually succeeds: making them anyway cost the bunny's build 5%).
+            let seeds: Vec<Candidate> = if round == 0 {
+                waiting
+                    .iter()
+                    .flatten()
+                    .map(|c| Candidate {
+                        events: c.events.clone(),
+                        ..*c
+                    })
+                    .collect()
+            } else {
+                std::mem::take(&mut left_out).into_candidates(self)
+            };
+            for c in seeds {
                 let saving = self.saving(&c.voxel, c.n, &c.plane, root_area);
                 self.build_pruned(
                     c,
@@ -792,7 +795,6 @@ impl<P: KdPrimitives> Builder<'_, P> {
                     Some(&mut left_out),
                 );
             }
-            seeds = left_out.into_candidates(self);
             if self.over_budget || self.lost_prim {
                 break;
             }
@@ -800,7 +802,7 @@ impl<P: KdPrimitives> Builder<'_, P> {
             // makes them all (they save at least `threshold`) and then one it left out, if
             // there is one; if there is none, the tree is the unbudgeted one.
             let fits = (self.nodes.len() - nodes0) as u64 + used + 2 <= budget;
-            let keep = match (fits, seeds.is_empty()) {
+            let keep = match (fits, left_out.candidates.is_empty()) {
                 (true, false) => None,
                 (true, true) => {
                     self.budget_bound = false;
@@ -822,9 +824,6 @@ impl<P: KdPrimitives> Builder<'_, P> {
                 built = true;
                 break;
             }
-        }
-        for c in seeds {
-            self.recycle(c.events);
         }
         self.node_cap = usize::MAX;
         self.over_budget = false;
