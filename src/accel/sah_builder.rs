@@ -38,7 +38,10 @@
 //! the f64 sweep is compiled apart from the rounded one; the lists are split without a branch
 //! on the side of each event; the clipped primitives' events are merged in by binary search
 //! and block moves; boxes (the top level), whose clipping changes only the split axis, keep
-//! their events on the other two axes instead of having them clipped, sorted and merged anew.
+//! their events on the other two axes instead of having them clipped, sorted and merged anew;
+//! the root's lists are radix sorted; the pruned finish replays best first by selection on
+//! the path minimum of the savings rather than with a heap, and turns the candidates a round
+//! left out back into lists only for a round that needs them.
 
 use super::aabb::Aabb;
 use super::kd_tree::{KdNode, KdParams, KdTree};
