@@ -150,7 +150,7 @@ fn sort_root_events(list: &mut Vec<Event>) {
     let mut buffer = vec![PAD_EVENT; list.len()];
     for (d, c) in counts.iter_mut().enumerate() {
         // A digit every event shares orders nothing.
-        if c.iter().any(|&k| k == list.len()) {
+        if c.contains(&list.len()) {
             continue;
         }
         let mut at = 0;
