@@ -481,13 +481,13 @@ fn rtl_writes_a_summary_headers_and_readable_files() {
     }
     assert!(!ports.contains("(undocumented)"), "{ports}");
     assert!(ports.contains("exactly 2 clocks after"), "{ports}");
-    let hex = std::fs::read_to_string(out.join("mem/bank2_triangles_uv.hex")).unwrap();
+    let hex = std::fs::read_to_string(out.join("mem/bank2_triangles_a.hex")).unwrap();
     let words: Vec<u32> = hex
         .lines()
         .filter(|l| !l.starts_with("//") && !l.starts_with('@'))
         .map(|l| u32::from_str_radix(l, 16).unwrap())
         .collect();
-    let bin = std::fs::read(out.join("bin/bank2_triangles_uv.bin")).unwrap();
+    let bin = std::fs::read(out.join("bin/bank2_triangles_a.bin")).unwrap();
     let from_bin: Vec<u32> = bin
         .chunks(4)
         .map(|c| u32::from_le_bytes(c.try_into().unwrap()))

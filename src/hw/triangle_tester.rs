@@ -30,13 +30,13 @@
 //! (the first of equal ts stays), as in the golden model.
 //!
 //! Fetch and launch, two state machines around two entry buffers: the fetch takes an entry
-//! from the list unit's test queue into a free buffer (1 clock) and requests the triangle's 8
-//! words of bank 2 and 4 of bank 3 (8 clocks when the engine leaves the banks alone; an init
+//! from the list unit's test queue into a free buffer (1 clock) and requests the triangle's 6
+//! words of bank 2 and 6 of bank 3 (6 clocks when the engine leaves the banks alone; an init
 //! or a list end fetches nothing), then goes on with the next entry in the other buffer. The
 //! launch waits for its buffer's words (the SRAM latency after their requests), launches the
 //! origin and then the direction into the TransformUnit (2 clocks), frees the buffer and
 //! waits a clock for the next entry's ray words. Throughput: one test per [`CLOCKS_PER_TEST`]
-//! (9) clocks, one init or list end per [`LAUNCH_SPACING`] (4); entries leave the launch at
+//! (7) clocks, one init or list end per [`LAUNCH_SPACING`] (4); entries leave the launch at
 //! least 4 clocks apart, which the hit merge needs (it reads, compares and writes a thread's
 //! best hit in 4 clocks). The engine's own loads of banks 2 and 3 (shading data) take the
 //! bank in their clock; the fetch waits for it.
@@ -83,11 +83,12 @@ pub fn flight_slots_suffice(fmt: Format) -> bool {
 }
 
 /// Clocks between two tests when the engine leaves banks 2 and 3 alone (the tester's
-/// throughput bound): the take and the 8 words of bank 2.
-pub const CLOCKS_PER_TEST: u32 = 9;
+/// throughput bound): the take and the 6 words of each bank (the layout splits a triangle's
+/// transform 6 + 6 for this; 8 + 4 took 9 clocks).
+pub const CLOCKS_PER_TEST: u32 = 7;
 // `update` spells out its numbers (rust-hdl's Verilog cannot name Rust constants): a
-// triangle is 8 words of bank 2 (the u and v rows) and 4 of bank 3 (the t row), buffer 1's
-// words follow buffer 0's 12.
+// triangle is 6 words of bank 2 (words 0-5 of its transform) and 6 of bank 3 (words 6-11,
+// `layout::TRANSFORM_BANK_WORDS`), buffer 1's words follow buffer 0's 12.
 
 #[derive(LogicBlock)]
 pub struct TriangleTester<
@@ -113,10 +114,10 @@ pub struct TriangleTester<
     pub best_t: Signal<Out, Bits<W>>,
     pub best_instance: Signal<Out, Bits<32>>,
     pub best_triangle: Signal<Out, Bits<32>>,
-    /// Bank 2 (u and v rows) and bank 3 (t row, shading): one read per clock each, the word
+    /// Bank 2 (transform words 0-5) and bank 3 (words 6-11): one read per clock each, the word
     /// `mem_latency` clocks after the request.
-    pub uv_words: SramRead,
-    pub t_words: SramRead,
+    pub a_words: SramRead,
+    pub b_words: SramRead,
     /// Bank 1 (triangle lists), on the engine's bus when the engine leaves it free.
     pub lists: SramRead,
     /// The traversal unit's leaves: a list of `walk_list_thread`, bank-1 words
@@ -167,10 +168,10 @@ pub struct TriangleTester<
     cur_b: [DFF<Bits<32>>; 2],
     received: [DFF<Bits<4>>; 2],
     /// A word of bank 2, of bank 3 arrives for each buffer this clock.
-    uv_here: [Signal<Local, Bit>; 2],
-    t_here: [Signal<Local, Bit>; 2],
-    uv_issued: DFF<Bits<4>>,
-    t_issued: DFF<Bits<4>>,
+    a_here: [Signal<Local, Bit>; 2],
+    b_here: [Signal<Local, Bit>; 2],
+    a_issued: DFF<Bits<4>>,
+    b_issued: DFF<Bits<4>>,
     seq: DFF<Bits<5>>,
     words: [DFF<Bits<W>>; 24],
     fetch_a: Signal<Local, Bits<32>>,
@@ -180,13 +181,13 @@ pub struct TriangleTester<
     l_a: Signal<Local, Bits<32>>,
     l_b: Signal<Local, Bits<32>>,
     l_ready: Signal<Local, Bit>,
-    uv_take: Signal<Local, Bit>,
-    t_take: Signal<Local, Bit>,
+    a_take: Signal<Local, Bit>,
+    b_take: Signal<Local, Bit>,
     /// Requests in flight to the banks: `{valid, buffer, word index}` per clock of latency.
-    uv_line: [DFF<Bits<5>>; 6],
-    t_line: [DFF<Bits<5>>; 6],
-    uv_arrive: Signal<Local, Bits<5>>,
-    t_arrive: Signal<Local, Bits<5>>,
+    a_line: [DFF<Bits<5>>; 6],
+    b_line: [DFF<Bits<5>>; 6],
+    a_arrive: Signal<Local, Bits<5>>,
+    b_arrive: Signal<Local, Bits<5>>,
     transform_unit: TransformUnit<W, E, M, S, S1, X2, T, P>,
     o_hold: [DFF<Bits<W>>; 3],
     intersect_unit: IntersectUnit<W, E, M, S, S1, X2, T, P, DL>,
@@ -240,8 +241,8 @@ pub struct TriangleTester<
     c_test_list_end: Constant<Bits<2>>,
     c_test_walk_end: Constant<Bits<2>>,
     /// The triangle banks' bits of the engine's `load_banks`.
-    c_bank_uv: Constant<Bits<{ layout::BANKS }>>,
-    c_bank_t: Constant<Bits<{ layout::BANKS }>>,
+    c_bank_a: Constant<Bits<{ layout::BANKS }>>,
+    c_bank_b: Constant<Bits<{ layout::BANKS }>>,
 }
 
 /// The launch of a buffered entry: wait for a loaded buffer, launch the origin, then the
@@ -274,8 +275,8 @@ impl<
         Self {
             clock: Default::default(),
             engine: Default::default(),
-            uv_words: Default::default(),
-            t_words: Default::default(),
+            a_words: Default::default(),
+            b_words: Default::default(),
             lists: Default::default(),
             queue_kind: Default::default(),
             hit: Default::default(),
@@ -315,8 +316,8 @@ impl<
             cur_thread: Default::default(),
             cur_a: Default::default(),
             cur_b: Default::default(),
-            uv_here: Default::default(),
-            t_here: Default::default(),
+            a_here: Default::default(),
+            b_here: Default::default(),
             fetch_a: Default::default(),
             fb_free: Default::default(),
             l_kind: Default::default(),
@@ -324,17 +325,17 @@ impl<
             l_a: Default::default(),
             l_b: Default::default(),
             l_ready: Default::default(),
-            uv_issued: Default::default(),
-            t_issued: Default::default(),
+            a_issued: Default::default(),
+            b_issued: Default::default(),
             received: Default::default(),
             seq: Default::default(),
             words: Default::default(),
-            uv_take: Default::default(),
-            t_take: Default::default(),
-            uv_line: Default::default(),
-            t_line: Default::default(),
-            uv_arrive: Default::default(),
-            t_arrive: Default::default(),
+            a_take: Default::default(),
+            b_take: Default::default(),
+            a_line: Default::default(),
+            b_line: Default::default(),
+            a_arrive: Default::default(),
+            b_arrive: Default::default(),
             transform_unit: Default::default(),
             o_hold: Default::default(),
             intersect_unit: Default::default(),
@@ -381,8 +382,8 @@ impl<
             c_test_init: Constant::new(TEST_INIT.into()),
             c_test_list_end: Constant::new(TEST_LIST_END.into()),
             c_test_walk_end: Constant::new(TEST_WALK_END.into()),
-            c_bank_uv: Constant::new((1u64 << layout::TRIANGLES_UV).into()),
-            c_bank_t: Constant::new((1u64 << layout::TRIANGLES_T).into()),
+            c_bank_a: Constant::new((1u64 << layout::TRIANGLES_A).into()),
+            c_bank_b: Constant::new((1u64 << layout::TRIANGLES_B).into()),
         }
     }
 }
@@ -402,7 +403,7 @@ impl<
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self, clock, fetching, fb, lb, lphase, uv_issued, t_issued, seq, m1_valid, m1_hit,
+            self, clock, fetching, fb, lb, lphase, a_issued, b_issued, seq, m1_valid, m1_hit,
             m1_kind, m1_thread, m1_t, m2_valid, m2_hit, m2_kind, m2_thread, m2_t, m2_a, m2_b,
             m2_done, m2_best, m3_valid, m3_hit, m3_kind, m3_thread, m3_t, m3_a, m3_b, m3_done,
             m3_best
@@ -455,8 +456,8 @@ impl<
             self.received[k].d.next = self.received[k].q.val();
         }
         for k in 0..6 {
-            self.uv_line[k].clock.next = self.clock.val();
-            self.t_line[k].clock.next = self.clock.val();
+            self.a_line[k].clock.next = self.clock.val();
+            self.b_line[k].clock.next = self.clock.val();
         }
         for k in 0..3 {
             self.o_hold[k].clock.next = self.clock.val();
@@ -513,50 +514,50 @@ impl<
                 | (self.queue_kind.val() == self.c_cmd_init.val()));
 
         // Fetch into buffer `fb`: take the list unit's next entry when the buffer is free,
-        // then request its 8 + 4 words (the banks serve the engine first). An init or a list
+        // then request its 6 + 6 words (the banks serve the engine first). An init or a list
         // end fetches nothing. The next entry's fetch goes on while this one is launched.
         self.list_unit.test_take.next = false;
-        self.uv_take.next = self.fetching.q.val()
-            & (self.uv_issued.q.val() < 8)
-            & ((self.engine.load_banks.val() & self.c_bank_uv.val()) == 0);
-        self.t_take.next = self.fetching.q.val()
-            & (self.t_issued.q.val() < 4)
-            & ((self.engine.load_banks.val() & self.c_bank_t.val()) == 0);
-        self.uv_words.read.next =
-            self.uv_take.val() | ((self.engine.load_banks.val() & self.c_bank_uv.val()) != 0);
-        self.t_words.read.next =
-            self.t_take.val() | ((self.engine.load_banks.val() & self.c_bank_t.val()) != 0);
-        self.uv_words.addr.next = self.engine.load_addr.val();
-        self.t_words.addr.next = self.engine.load_addr.val();
+        self.a_take.next = self.fetching.q.val()
+            & (self.a_issued.q.val() < 6)
+            & ((self.engine.load_banks.val() & self.c_bank_a.val()) == 0);
+        self.b_take.next = self.fetching.q.val()
+            & (self.b_issued.q.val() < 6)
+            & ((self.engine.load_banks.val() & self.c_bank_b.val()) == 0);
+        self.a_words.read.next =
+            self.a_take.val() | ((self.engine.load_banks.val() & self.c_bank_a.val()) != 0);
+        self.b_words.read.next =
+            self.b_take.val() | ((self.engine.load_banks.val() & self.c_bank_b.val()) != 0);
+        self.a_words.addr.next = self.engine.load_addr.val();
+        self.b_words.addr.next = self.engine.load_addr.val();
         self.fetch_a.next = self.cur_a[0].q.val();
         if self.fb.q.val() {
             self.fetch_a.next = self.cur_a[1].q.val();
         }
-        if self.uv_take.val() {
-            self.uv_words.addr.next = (self.fetch_a.val().get_bits::<24>(0) << 3)
-                + bit_cast::<24, 4>(self.uv_issued.q.val());
-            self.uv_issued.d.next = self.uv_issued.q.val() + 1;
+        if self.a_take.val() {
+            self.a_words.addr.next = (self.fetch_a.val().get_bits::<24>(0) << 3)
+                + bit_cast::<24, 4>(self.a_issued.q.val());
+            self.a_issued.d.next = self.a_issued.q.val() + 1;
         }
-        if self.t_take.val() {
-            self.t_words.addr.next = (self.fetch_a.val().get_bits::<24>(0) << 3)
-                + bit_cast::<24, 4>(self.t_issued.q.val());
-            self.t_issued.d.next = self.t_issued.q.val() + 1;
+        if self.b_take.val() {
+            self.b_words.addr.next = (self.fetch_a.val().get_bits::<24>(0) << 3)
+                + bit_cast::<24, 4>(self.b_issued.q.val());
+            self.b_issued.d.next = self.b_issued.q.val() + 1;
         }
         // Requests in flight: `{valid, buffer, word index}`.
-        self.uv_line[0].d.next = (bit_cast::<5, 1>(self.uv_take.val().into()) << 4)
+        self.a_line[0].d.next = (bit_cast::<5, 1>(self.a_take.val().into()) << 4)
             | (bit_cast::<5, 1>(self.fb.q.val().into()) << 3)
-            | bit_cast::<5, 3>(self.uv_issued.q.val().get_bits::<3>(0));
-        self.t_line[0].d.next = (bit_cast::<5, 1>(self.t_take.val().into()) << 4)
+            | bit_cast::<5, 3>(self.a_issued.q.val().get_bits::<3>(0));
+        self.b_line[0].d.next = (bit_cast::<5, 1>(self.b_take.val().into()) << 4)
             | (bit_cast::<5, 1>(self.fb.q.val().into()) << 3)
-            | bit_cast::<5, 3>(self.t_issued.q.val().get_bits::<3>(0));
+            | bit_cast::<5, 3>(self.b_issued.q.val().get_bits::<3>(0));
         for k in 1..6 {
-            self.uv_line[k].d.next = self.uv_line[k - 1].q.val();
-            self.t_line[k].d.next = self.t_line[k - 1].q.val();
+            self.a_line[k].d.next = self.a_line[k - 1].q.val();
+            self.b_line[k].d.next = self.b_line[k - 1].q.val();
         }
         // The fetch is done with the buffer once its last words are requested.
         if self.fetching.q.val()
-            & ((self.uv_issued.q.val() == 8) | (self.uv_take.val() & (self.uv_issued.q.val() == 7)))
-            & ((self.t_issued.q.val() == 4) | (self.t_take.val() & (self.t_issued.q.val() == 3)))
+            & ((self.a_issued.q.val() == 6) | (self.a_take.val() & (self.a_issued.q.val() == 5)))
+            & ((self.b_issued.q.val() == 6) | (self.b_take.val() & (self.b_issued.q.val() == 5)))
         {
             self.fetching.d.next = false;
             self.fb.d.next = !self.fb.q.val();
@@ -567,13 +568,13 @@ impl<
         }
         if (!self.fetching.q.val()) & self.fb_free.val() & self.list_unit.test_valid.val() {
             self.list_unit.test_take.next = true;
-            self.uv_issued.d.next = 0.into();
-            self.t_issued.d.next = 0.into();
+            self.a_issued.d.next = 0.into();
+            self.b_issued.d.next = 0.into();
             self.fetching.d.next = true;
             if self.list_unit.test_entry.val().get_bits::<2>(69) != self.c_test_triangle.val() {
                 // An init or a list end fetches nothing.
-                self.uv_issued.d.next = 8.into();
-                self.t_issued.d.next = 4.into();
+                self.a_issued.d.next = 6.into();
+                self.b_issued.d.next = 6.into();
                 self.fetching.d.next = false;
                 self.fb.d.next = !self.fb.q.val();
             }
@@ -594,45 +595,45 @@ impl<
             }
         }
         // The word of the request `mem_latency` clocks ago.
-        self.uv_arrive.next = 0.into();
-        self.t_arrive.next = 0.into();
+        self.a_arrive.next = 0.into();
+        self.b_arrive.next = 0.into();
         for k in 0..6 {
             if self.c_ml_last.val() == self.c_index[k].val() {
-                self.uv_arrive.next = self.uv_line[k].q.val();
-                self.t_arrive.next = self.t_line[k].q.val();
+                self.a_arrive.next = self.a_line[k].q.val();
+                self.b_arrive.next = self.b_line[k].q.val();
             }
         }
-        for k in 0..8 {
-            if self.uv_arrive.val().get_bit(4)
-                & (bit_cast::<4, 3>(self.uv_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
+        for k in 0..6 {
+            if self.a_arrive.val().get_bit(4)
+                & (bit_cast::<4, 3>(self.a_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
             {
-                if self.uv_arrive.val().get_bit(3) {
-                    self.words[12 + k].d.next = self.uv_words.rdata.val().get_bits::<W>(0);
+                if self.a_arrive.val().get_bit(3) {
+                    self.words[12 + k].d.next = self.a_words.rdata.val().get_bits::<W>(0);
                 } else {
-                    self.words[k].d.next = self.uv_words.rdata.val().get_bits::<W>(0);
+                    self.words[k].d.next = self.a_words.rdata.val().get_bits::<W>(0);
                 }
             }
         }
-        for k in 0..4 {
-            if self.t_arrive.val().get_bit(4)
-                & (bit_cast::<4, 3>(self.t_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
+        for k in 0..6 {
+            if self.b_arrive.val().get_bit(4)
+                & (bit_cast::<4, 3>(self.b_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
             {
-                if self.t_arrive.val().get_bit(3) {
-                    self.words[20 + k].d.next = self.t_words.rdata.val().get_bits::<W>(0);
+                if self.b_arrive.val().get_bit(3) {
+                    self.words[18 + k].d.next = self.b_words.rdata.val().get_bits::<W>(0);
                 } else {
-                    self.words[8 + k].d.next = self.t_words.rdata.val().get_bits::<W>(0);
+                    self.words[6 + k].d.next = self.b_words.rdata.val().get_bits::<W>(0);
                 }
             }
         }
         for k in 0..2 {
-            self.uv_here[k].next = self.uv_arrive.val().get_bit(4)
-                & (self.uv_arrive.val().get_bit(3) == self.c_buffer[k].val());
-            self.t_here[k].next = self.t_arrive.val().get_bit(4)
-                & (self.t_arrive.val().get_bit(3) == self.c_buffer[k].val());
-            if self.uv_here[k].val() | self.t_here[k].val() {
+            self.a_here[k].next = self.a_arrive.val().get_bit(4)
+                & (self.a_arrive.val().get_bit(3) == self.c_buffer[k].val());
+            self.b_here[k].next = self.b_arrive.val().get_bit(4)
+                & (self.b_arrive.val().get_bit(3) == self.c_buffer[k].val());
+            if self.a_here[k].val() | self.b_here[k].val() {
                 self.received[k].d.next = self.received[k].q.val() + 1;
             }
-            if self.uv_here[k].val() & self.t_here[k].val() {
+            if self.a_here[k].val() & self.b_here[k].val() {
                 self.received[k].d.next = self.received[k].q.val() + 2;
             }
         }
@@ -901,10 +902,12 @@ mod tests {
         let mut bank2 = vec![0u32; 8 * triangles.len()];
         let mut bank3 = vec![0u32; 8 * triangles.len()];
         for (k, m) in triangles.iter().enumerate() {
-            bank2[8 * k..8 * k + 8].copy_from_slice(&m[..8]);
-            bank3[8 * k..8 * k + 4].copy_from_slice(&m[8..]);
-            for j in 4..8 {
-                bank3[8 * k + j] = rng.gen::<u32>() & 0xff_ffff; // shading words
+            bank2[8 * k..8 * k + 6].copy_from_slice(&m[..6]);
+            bank3[8 * k..8 * k + 6].copy_from_slice(&m[6..]);
+            for j in 6..8 {
+                // shading words
+                bank2[8 * k + j] = rng.gen::<u32>() & 0xff_ffff;
+                bank3[8 * k + j] = rng.gen::<u32>() & 0xff_ffff;
             }
         }
         let threads = rays.len();
@@ -942,8 +945,8 @@ mod tests {
             }
             // The SRAMs answer the request of `mem_latency` clocks ago.
             let [uv, t, list] = requests.pop_front().unwrap();
-            u.uv_words.rdata.next = u64::from(uv.map_or(0xdead, |a| bank2[a as usize])).into();
-            u.t_words.rdata.next = u64::from(t.map_or(0xdead, |a| bank3[a as usize])).into();
+            u.a_words.rdata.next = u64::from(uv.map_or(0xdead, |a| bank2[a as usize])).into();
+            u.b_words.rdata.next = u64::from(t.map_or(0xdead, |a| bank3[a as usize])).into();
             u.lists.rdata.next = u64::from(list.map_or(0xdead, |a| bank1[a as usize])).into();
             // Round robin over the threads with something to offer (like the engine's turns).
             let th = queried.filter(|&t| !offers[t].is_empty());
@@ -976,9 +979,9 @@ mod tests {
             if let Some((bank @ 2..=3, addr)) = steal {
                 drive.stolen += 1;
                 let (read, port) = if bank == 2 {
-                    (u.uv_words.read.val(), u.uv_words.addr.val())
+                    (u.a_words.read.val(), u.a_words.addr.val())
                 } else {
-                    (u.t_words.read.val(), u.t_words.addr.val())
+                    (u.b_words.read.val(), u.b_words.addr.val())
                 };
                 assert!(
                     read && port.to_u64() == addr,
@@ -987,8 +990,8 @@ mod tests {
             }
             let port = |read: bool, addr: Bits<24>| read.then(|| addr.to_u64() as u32);
             requests.push_back([
-                port(u.uv_words.read.val(), u.uv_words.addr.val()),
-                port(u.t_words.read.val(), u.t_words.addr.val()),
+                port(u.a_words.read.val(), u.a_words.addr.val()),
+                port(u.b_words.read.val(), u.b_words.addr.val()),
                 port(u.lists.read.val(), u.lists.addr.val()),
             ]);
             if let Some(th) = th {

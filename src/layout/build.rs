@@ -66,7 +66,7 @@ pub enum LayoutError {
 fn bank_advice(bank: usize) -> &'static str {
     match bank {
         NODES | LISTS => "use fewer triangles per object (simplify the mesh) or instance repeated parts",
-        TRIANGLES_UV | TRIANGLES_T => "use fewer triangles (simplify the mesh, a coarser generator) or instance repeated objects",
+        TRIANGLES_A | TRIANGLES_B => "use fewer triangles (simplify the mesh, a coarser generator) or instance repeated objects",
         INSTANCES => "use fewer instances",
         _ => "use a lower resolution (the scene's [camera] width and height, or --size WxH of render, rtl and sim), fewer lights or fewer materials",
     }
@@ -82,8 +82,8 @@ pub fn check_capacity(scene: &Scene, memory: &MemoryConfig) -> Result<(), Layout
     let mut needed = [0usize; 6];
     needed[NODES] = NODE_WORDS * (scene.objects.len() + 1);
     needed[LISTS] = triangles;
-    needed[TRIANGLES_UV] = TRIANGLE_BANK_WORDS * triangles;
-    needed[TRIANGLES_T] = TRIANGLE_BANK_WORDS * triangles;
+    needed[TRIANGLES_A] = TRIANGLE_BANK_WORDS * triangles;
+    needed[TRIANGLES_B] = TRIANGLE_BANK_WORDS * triangles;
     needed[INSTANCES] = INSTANCE_WORDS * scene.instances.len();
     needed[FRAME] = FrameMap::LIGHTS
         + LIGHT_WORDS * scene.lights.len()
@@ -379,10 +379,11 @@ pub fn build(
                 (t[0] - t[2]).cross(t[1] - t[2]).normalize()
             };
             let t = &trees.transforms[o][i];
-            banks[TRIANGLES_UV].extend(&t[..8]);
-            banks[TRIANGLES_T].extend(&t[8..]);
-            banks[TRIANGLES_T].extend([normal.x, normal.y, normal.z].map(|c| f.from_f64(c)));
-            banks[TRIANGLES_T].push(mat_count + object.triangle_material[i]);
+            let [nx, ny, nz] = [normal.x, normal.y, normal.z].map(|c| f.from_f64(c));
+            banks[TRIANGLES_A].extend(&t[..TRANSFORM_BANK_WORDS]);
+            banks[TRIANGLES_A].extend([nx, ny]);
+            banks[TRIANGLES_B].extend(&t[TRANSFORM_BANK_WORDS..]);
+            banks[TRIANGLES_B].extend([nz, mat_count + object.triangle_material[i]]);
         }
         tri_count += object.triangles.len() as u32;
         mat_count += object.materials.len() as u32;
@@ -733,6 +734,29 @@ scale = [0.5, 0.5, 0.5]
         assert!((m.transform_vector3(n) - DVec3::Z).length() < 1e-12);
     }
 
+    /// The shader of a scene without instances uses the stored normals as they are
+    /// (`units::world_normal`): each must be unit to the format's precision, its length within
+    /// two units in the last place of 1, in both formats.
+    #[test]
+    fn stored_normals_are_unit_to_the_formats_precision() {
+        for f in [Format::E7M16, Format::E8M23] {
+            let s = scene();
+            let trees = SceneTrees::build(&s, f).unwrap();
+            let l = build(&s, &trees, 0, &MemoryConfig::default()).unwrap();
+            let triangles = s.objects[0].triangles.len() as u32;
+            assert!(triangles >= 80);
+            let ulp = 2f64.powi(-(f.man_bits as i32));
+            for t in 0..triangles {
+                let (n, _) = l.triangle_shading(t);
+                let length = DVec3::from_array(n.map(|c| f.to_f64(c))).length();
+                assert!(
+                    (length - 1.0).abs() <= 2.0 * ulp,
+                    "{f}: triangle {t}'s stored normal has length {length}"
+                );
+            }
+        }
+    }
+
     /// Between two frames of an animated scene only the words the frame update names change,
     /// and its sizes are the top-level tree's (what the banks hold beyond the object trees)
     /// and two matrices (12 + 9 words) per instance.
@@ -800,8 +824,8 @@ scale = [0.5, 0.5, 0.5]
         let l = build(&s, &trees, 0, &MemoryConfig::default()).unwrap();
         assert_eq!(l.info.instance_count, 2);
         assert_eq!(l.info.triangle_count, 80);
-        assert_eq!(l.banks[TRIANGLES_UV].len(), 80 * TRIANGLE_BANK_WORDS);
-        assert_eq!(l.banks[TRIANGLES_T].len(), 80 * TRIANGLE_BANK_WORDS);
+        assert_eq!(l.banks[TRIANGLES_A].len(), 80 * TRIANGLE_BANK_WORDS);
+        assert_eq!(l.banks[TRIANGLES_B].len(), 80 * TRIANGLE_BANK_WORDS);
         // The transform reassembled from both banks is the one the trees were built with.
         assert_eq!(l.triangle_transform(17), trees.transforms[0][17]);
         assert_eq!(l.banks[INSTANCES].len(), 2 * INSTANCE_WORDS);

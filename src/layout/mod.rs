@@ -12,13 +12,15 @@
 //! |---|---|---|
 //! | 0 `NODES` | kd nodes: every object tree, then the top-level tree (rewritten each frame) | 2 per node |
 //! | 1 `LISTS` | leaf lists: global triangle ids of object leaves, then instance ids of top-level leaves | 1 per reference |
-//! | 2 `TRIANGLES_UV` | rows 0 and 1 of the Woop unit-triangle transforms `T` (the u and v rows) | 8 per triangle |
-//! | 3 `TRIANGLES_T` | row 2 of `T` (the t row), then the object-space unit normal (3 floats) and the material index | 8 per triangle |
+//! | 2 `TRIANGLES_A` | words 0-5 of the Woop unit-triangle transform `T` (the u row and half the v row), then the object-space unit normal's x and y | 8 per triangle |
+//! | 3 `TRIANGLES_B` | words 6-11 of `T` (the v row's other half and the t row), then the normal's z and the material index | 8 per triangle |
 //! | 4 `INSTANCES` | per instance: world-to-object 3x4 (12), normal matrix 3x3 object-to-world (9), object root node, first global triangle, object index (rewritten each frame) | 24 per instance |
 //! | 5 `FRAME` | camera 3x4 and eye, render constants, lights, materials (diffuse r, g, b, mirror), then the frame buffer | see [`FrameMap`] |
 //!
 //! Splitting a triangle's 16 words over two banks lets the intersection read them in parallel
-//! and fits 131,072 triangles (a 256x256 terrain) in the paper's 4 MB banks.
+//! and fits 131,072 triangles (a 256x256 terrain) in the paper's 4 MB banks. The transform's
+//! 12 words are split evenly, 6 and 6 ([`TRANSFORM_BANK_WORDS`]), so that the triangle tester
+//! fetches a triangle in 6 clocks from both banks at once (an 8 + 4 split took 8).
 //!
 //! # Word formats
 //! - A float word holds an `eXmY` value right-aligned (the format is at most 32 bits wide).
@@ -52,8 +54,8 @@ use crate::fp::Format;
 
 pub const NODES: usize = 0;
 pub const LISTS: usize = 1;
-pub const TRIANGLES_UV: usize = 2;
-pub const TRIANGLES_T: usize = 3;
+pub const TRIANGLES_A: usize = 2;
+pub const TRIANGLES_B: usize = 3;
 pub const INSTANCES: usize = 4;
 pub const FRAME: usize = 5;
 /// The board's memory banks (6 of 4 MB, as the paper's prototype).
@@ -61,8 +63,8 @@ pub const BANKS: usize = 6;
 pub const BANK_NAMES: [&str; BANKS] = [
     "nodes",
     "lists",
-    "triangles_uv",
-    "triangles_t",
+    "triangles_a",
+    "triangles_b",
     "instances",
     "frame",
 ];
@@ -70,6 +72,9 @@ pub const BANK_NAMES: [&str; BANKS] = [
 pub const NODE_WORDS: usize = 2;
 /// Words per triangle in each of the two triangle banks.
 pub const TRIANGLE_BANK_WORDS: usize = 8;
+/// Words of a triangle's unit-triangle transform in each triangle bank (the first of its
+/// `TRIANGLE_BANK_WORDS`); the two shading words follow.
+pub const TRANSFORM_BANK_WORDS: usize = 6;
 pub const MATERIAL_WORDS: usize = 4;
 pub const INSTANCE_WORDS: usize = 24;
 pub const LIGHT_WORDS: usize = 6;
@@ -252,18 +257,18 @@ impl Layout {
     /// The 12 words of a triangle's unit-triangle transform, assembled from both banks.
     pub fn triangle_transform(&self, triangle: u32) -> [u32; 12] {
         let a = triangle as usize * TRIANGLE_BANK_WORDS;
+        let n = TRANSFORM_BANK_WORDS;
         let mut m = [0; 12];
-        m[..8].copy_from_slice(&self.banks[TRIANGLES_UV][a..a + 8]);
-        m[8..].copy_from_slice(&self.banks[TRIANGLES_T][a..a + 4]);
+        m[..n].copy_from_slice(&self.banks[TRIANGLES_A][a..a + n]);
+        m[n..].copy_from_slice(&self.banks[TRIANGLES_B][a..a + n]);
         m
     }
-    /// A triangle's object-space unit normal and material index.
+    /// A triangle's object-space unit normal and material index (the two shading words of
+    /// each triangle bank: `n.x n.y` and `n.z material`).
     pub fn triangle_shading(&self, triangle: u32) -> ([u32; 3], u32) {
-        let a = triangle as usize * TRIANGLE_BANK_WORDS + 4;
-        (
-            self.words::<3>(TRIANGLES_T, a),
-            self.banks[TRIANGLES_T][a + 3],
-        )
+        let a = triangle as usize * TRIANGLE_BANK_WORDS + TRANSFORM_BANK_WORDS;
+        let (xy, z_material) = (&self.banks[TRIANGLES_A], &self.banks[TRIANGLES_B]);
+        ([xy[a], xy[a + 1], z_material[a]], z_material[a + 1])
     }
     /// A material's diffuse colour and mirror reflectivity.
     pub fn material(&self, material: u32) -> ([u32; 3], u32) {

@@ -199,14 +199,13 @@ impl<'a> Golden<'a> {
         let l = self.layout;
         let p = units::ray_point(f, q.o, q.d, hit.t);
         let (n_obj, material) = l.triangle_shading(hit.triangle);
-        let n_world = if l.info.top_root.is_some() {
+        let normal_matrix = l.info.top_root.map(|_| {
             stats.transforms += 1;
             let base = hit.instance as usize * crate::layout::INSTANCE_WORDS + iw::NORMAL_MATRIX;
-            units::transform3(f, &l.words::<9>(INSTANCES, base), n_obj)
-        } else {
-            n_obj
-        };
-        let n = units::facing_unit_normal(f, n_world, q.d);
+            l.words::<9>(INSTANCES, base)
+        });
+        let n_world = units::world_normal(f, n_obj, normal_matrix.as_ref());
+        let n = units::facing_normal(f, n_world, q.d);
         let (kd, mirror) = l.material(material);
 
         let mut acc = units::ambient(f, kd, self.frame_words::<1>(FrameMap::AMBIENT)[0]);

@@ -43,8 +43,8 @@ module tb;
   integer frame = 0, rays = 0;
   reg [31:0] bank0 [0:117]; // nodes
   reg [31:0] bank1 [0:104]; // lists
-  reg [31:0] bank2 [0:239]; // triangles_uv
-  reg [31:0] bank3 [0:239]; // triangles_t
+  reg [31:0] bank2 [0:239]; // triangles_a
+  reg [31:0] bank3 [0:239]; // triangles_b
   reg [31:0] bank4 [0:23]; // instances
   reg [31:0] bank5 [0:3117]; // frame
   reg [31:0] rd [0:1];
@@ -129,17 +129,17 @@ module tb;
     if (!$value$plusargs("out_dir=%s", out_dir)) out_dir = ".";
     $readmemh({mem_dir, "/bank0_nodes.hex"}, bank0);
     $readmemh({mem_dir, "/bank1_lists.hex"}, bank1);
-    $readmemh({mem_dir, "/bank2_triangles_uv.hex"}, bank2);
-    $readmemh({mem_dir, "/bank3_triangles_t.hex"}, bank3);
+    $readmemh({mem_dir, "/bank2_triangles_a.hex"}, bank2);
+    $readmemh({mem_dir, "/bank3_triangles_b.hex"}, bank3);
     $readmemh({mem_dir, "/bank4_instances.hex"}, bank4);
     $readmemh({mem_dir, "/bank5_frame.hex"}, bank5);
     frame = 0; rays = 0;
     @(negedge clock) start = 1'b1;
     @(negedge clock) start = 1'b0;
     n = 0;
-    while (!done && n < 2002940) begin @(posedge clock); n = n + 1; end
+    while (!done && n < 1747932) begin @(posedge clock); n = n + 1; end
     if (!done) begin
-      $display("TIMEOUT: frame 0 not done after 2002940 clocks");
+      $display("TIMEOUT: frame 0 not done after 1747932 clocks");
       $fatal(1, "timeout");
     end
     fd = $fopen({out_dir, "/frame0.hex"}, "w");

@@ -8,8 +8,8 @@ use std::path::PathBuf;
 use super::*;
 use crate::fp::Format;
 use crate::layout::{
-    self, MemoryConfig, SceneTrees, FRAME, INSTANCES, INSTANCE_WORDS, LISTS, NODES, TRIANGLES_T,
-    TRIANGLES_UV,
+    self, MemoryConfig, SceneTrees, FRAME, INSTANCES, INSTANCE_WORDS, LISTS, NODES, TRIANGLES_B,
+    TRIANGLES_A,
 };
 use crate::scene::Scene;
 use crate::sim::{self, SimJob, Simulator};
@@ -118,8 +118,8 @@ fn images_read_back_to_the_layout_words() {
         [
             "bank0_nodes.hex",
             "bank1_lists.hex",
-            "bank2_triangles_uv.hex",
-            "bank3_triangles_t.hex",
+            "bank2_triangles_a.hex",
+            "bank3_triangles_b.hex",
             "bank4_instances.hex",
             "bank5_frame.hex"
         ]
@@ -174,7 +174,7 @@ fn checked_updates(name: &str, layouts: &[Layout]) -> Vec<Vec<WordUpdate>> {
                 prev.banks[bank].len()
             );
         }
-        for bank in [TRIANGLES_UV, TRIANGLES_T, FRAME] {
+        for bank in [TRIANGLES_A, TRIANGLES_B, FRAME] {
             assert!(
                 !banks.contains(&bank),
                 "frame {f}: static bank {bank} changed"

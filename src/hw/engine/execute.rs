@@ -76,8 +76,8 @@ pub struct Execute<const W: usize, const E: usize, const M: usize> {
     tri_instance: Constant<Bits<32>>,
     tri_triangle: Constant<Bits<32>>,
     bank_nodes: Constant<Bits<3>>,
-    bank_uv: Constant<Bits<3>>,
-    bank_t: Constant<Bits<3>>,
+    bank_a: Constant<Bits<3>>,
+    bank_b: Constant<Bits<3>>,
 }
 
 impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M> {
@@ -126,8 +126,8 @@ impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M
             tri_instance: tri_fn(TriFn::Instance),
             tri_triangle: tri_fn(TriFn::Triangle),
             bank_nodes: bank(layout::NODES),
-            bank_uv: bank(layout::TRIANGLES_UV),
-            bank_t: bank(layout::TRIANGLES_T),
+            bank_a: bank(layout::TRIANGLES_A),
+            bank_b: bank(layout::TRIANGLES_B),
         }
     }
 }
@@ -173,11 +173,11 @@ impl<const W: usize, const E: usize, const M: usize> Logic for Execute<W, E, M> 
         }
         if self.op.val() == self.op_ld.val() {
             self.source.next = FastKind::Memory;
-            if self.bank.val() == self.bank_uv.val() {
-                self.source.next = FastKind::TrianglesUv;
+            if self.bank.val() == self.bank_a.val() {
+                self.source.next = FastKind::TrianglesA;
             }
-            if self.bank.val() == self.bank_t.val() {
-                self.source.next = FastKind::TrianglesT;
+            if self.bank.val() == self.bank_b.val() {
+                self.source.next = FastKind::TrianglesB;
             }
             if self.bank.val() == self.bank_nodes.val() {
                 self.source.next = FastKind::Nodes;

@@ -136,8 +136,8 @@ pub enum FastKind {
     Converted,
     Scratch,
     Memory,
-    TrianglesUv,
-    TrianglesT,
+    TrianglesA,
+    TrianglesB,
     Nodes,
 }
 
@@ -607,8 +607,8 @@ impl<
         }
         self.tester.lists.rdata.next = self.mem.rdata.val();
         SramRead::link(&mut self.bank0, &mut self.traversal_unit.nodes);
-        SramRead::link(&mut self.bank2, &mut self.tester.uv_words);
-        SramRead::link(&mut self.bank3, &mut self.tester.t_words);
+        SramRead::link(&mut self.bank2, &mut self.tester.a_words);
+        SramRead::link(&mut self.bank3, &mut self.tester.b_words);
         // I4: the coprocessor function the instruction names (`tri` with its `TriFn`, `kd`
         // with its `KdFn`, in imm), for I5. The queued `TriFn`s go to the list unit as its
         // command kinds.
@@ -715,8 +715,8 @@ impl<
         self.result_line.scratch_data.next = self.scratch.read_data.val();
         self.result_line.mem_data.next = self.mem.rdata.val();
         self.result_line.nodes_data.next = self.bank0.rdata.val();
-        self.result_line.uv_data.next = self.bank2.rdata.val();
-        self.result_line.t_data.next = self.bank3.rdata.val();
+        self.result_line.a_data.next = self.bank2.rdata.val();
+        self.result_line.b_data.next = self.bank3.rdata.val();
 
         // Write back.
         Retiring::join(

@@ -74,8 +74,8 @@ pub struct ResultLine<const DX: usize> {
     pub scratch_data: Signal<In, Bits<32>>,
     pub mem_data: Signal<In, Bits<32>>,
     pub nodes_data: Signal<In, Bits<32>>,
-    pub uv_data: Signal<In, Bits<32>>,
-    pub t_data: Signal<In, Bits<32>>,
+    pub a_data: Signal<In, Bits<32>>,
+    pub b_data: Signal<In, Bits<32>>,
 
     /// Write back: the instruction leaving the line (from the long line when one leaves it).
     pub retiring: Retiring,
@@ -192,8 +192,8 @@ impl<const DX: usize> ResultLine<DX> {
             scratch_data: Default::default(),
             mem_data: Default::default(),
             nodes_data: Default::default(),
-            uv_data: Default::default(),
-            t_data: Default::default(),
+            a_data: Default::default(),
+            b_data: Default::default(),
             retiring: Default::default(),
             valid_i6: Default::default(),
             op_i6: Default::default(),
@@ -437,11 +437,11 @@ impl<const DX: usize> Logic for ResultLine<DX> {
                 if self.kind_line[k].q.val() == FastKind::Memory {
                     self.fast_line[k + 1].d.next = self.mem_data.val();
                 }
-                if self.kind_line[k].q.val() == FastKind::TrianglesUv {
-                    self.fast_line[k + 1].d.next = self.uv_data.val();
+                if self.kind_line[k].q.val() == FastKind::TrianglesA {
+                    self.fast_line[k + 1].d.next = self.a_data.val();
                 }
-                if self.kind_line[k].q.val() == FastKind::TrianglesT {
-                    self.fast_line[k + 1].d.next = self.t_data.val();
+                if self.kind_line[k].q.val() == FastKind::TrianglesB {
+                    self.fast_line[k + 1].d.next = self.b_data.val();
                 }
                 if self.kind_line[k].q.val() == FastKind::Nodes {
                     self.fast_line[k + 1].d.next = self.nodes_data.val();

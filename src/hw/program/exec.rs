@@ -21,7 +21,7 @@ use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_ANY_HIT, REGISTERS};
 use super::Program;
 use crate::fp::Format;
 use crate::hw::traversal_unit::STACK_LEVELS;
-use crate::layout::{Layout, Node, LISTS, NODES, NODE_WORDS, TRIANGLES_T, TRIANGLE_BANK_WORDS};
+use crate::layout::{Layout, Node, LISTS, NODES, NODE_WORDS, TRIANGLES_B, TRIANGLE_BANK_WORDS};
 use crate::units::{self, Mailbox};
 
 /// A failure of the program on this memory (a generator bug or a layout that does not belong
@@ -423,7 +423,7 @@ impl<'a> Machine<'a> {
         let list = self.layout.banks[LISTS].get(from as usize..to as usize);
         let list =
             list.ok_or_else(|| format!("triangle list {from}..{to} beyond the list bank"))?;
-        let words = self.layout.banks[TRIANGLES_T].len() / TRIANGLE_BANK_WORDS;
+        let words = self.layout.banks[TRIANGLES_B].len() / TRIANGLE_BANK_WORDS;
         for &triangle in list {
             if (tt.object, triangle) == tt.skip || tt.mailbox.seen(triangle) {
                 continue;

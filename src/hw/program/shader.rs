@@ -19,7 +19,9 @@
 use super::asm::{Reg, Val};
 use super::isa::{Op, KD_ANY_HIT};
 use super::{Gen, CHAIN_ENTRY_WORDS};
-use crate::layout::{instance_word as iw, FrameMap, FRAME, INSTANCES, TRIANGLES_T};
+use crate::layout::{
+    instance_word as iw, FrameMap, FRAME, INSTANCES, TRANSFORM_BANK_WORDS, TRIANGLES_A, TRIANGLES_B,
+};
 use crate::units;
 use crate::units::Arith;
 
@@ -183,18 +185,24 @@ impl Gen<'_> {
         let p = units::ray_point(a, ray_o.map(Val::R), ray_d.map(Val::R), s.best_t.into())
             .map(|v| a.keep(v));
         a.end_temps();
-        let shading: [Val; 4] = a.load_n(TRIANGLES_T, hit_triangle.into(), 3, 4);
-        let n_obj = [shading[0], shading[1], shading[2]];
-        let material = a.keep(shading[3]);
-        let n_world = if c.top_root.is_some() {
+        // The shading words follow the transform's in each triangle bank (`n.x n.y`,
+        // `n.z material`: `Layout::triangle_shading`).
+        let shading = TRANSFORM_BANK_WORDS as u32;
+        let xy: [Val; 2] = a.load_n(TRIANGLES_A, hit_triangle.into(), 3, shading);
+        let z_material: [Val; 2] = a.load_n(TRIANGLES_B, hit_triangle.into(), 3, shading);
+        let n_obj = [xy[0], xy[1], z_material[0]];
+        let material = a.keep(z_material[1]);
+        // `units::world_normal`: the stored normal is unit; only an instance's normal matrix
+        // changes its length.
+        let n = if c.top_root.is_some() {
             let record = self.instance_record(hit_instance);
             let m: [Val; 9] = a.load_n(INSTANCES, record, 0, iw::NORMAL_MATRIX as u32);
-            units::transform3(a, &m, n_obj)
+            units::unit_length(a, units::transform3(a, &m, n_obj))
         } else {
             n_obj
-        };
-        let (unit, along) = units::unit_normal(a, n_world, ray_d.map(Val::R));
-        let n = unit.map(|v| a.keep(v));
+        }
+        .map(|v| a.keep(v));
+        let along = units::dot(a, n.map(Val::R), ray_d.map(Val::R));
         let facing = a.label();
         a.branch(Op::BFlt, Val::K(0), along, true, facing);
         for k in 0..3 {
