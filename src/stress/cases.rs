@@ -193,7 +193,10 @@ fn surface(golden: &Golden, o: Vec3W, d: Vec3W, hit: crate::model::golden::Hit) 
     let f = golden.layout().format;
     let p = units::ray_point(f, o, d, hit.t);
     let (n_obj, _) = golden.layout().triangle_shading(hit.triangle);
-    (p, units::facing_normal(f, units::world_normal(f, n_obj, None), d))
+    (
+        p,
+        units::facing_normal(f, units::world_normal(f, n_obj, None), d),
+    )
 }
 
 /// Renders the subject's camera with the golden model: (pixels, pixels that hit nothing,

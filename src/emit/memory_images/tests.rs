@@ -8,8 +8,8 @@ use std::path::PathBuf;
 use super::*;
 use crate::fp::Format;
 use crate::layout::{
-    self, MemoryConfig, SceneTrees, FRAME, INSTANCES, INSTANCE_WORDS, LISTS, NODES, TRIANGLES_B,
-    TRIANGLES_A,
+    self, MemoryConfig, SceneTrees, FRAME, INSTANCES, INSTANCE_WORDS, LISTS, NODES, TRIANGLES_A,
+    TRIANGLES_B,
 };
 use crate::scene::Scene;
 use crate::sim::{self, SimJob, Simulator};
