@@ -101,7 +101,6 @@ pub fn preflight(
         frame_buffer: 0,
         stack_entries: STACK_LEVELS as u32,
         object_depth: STACK_LEVELS as u32,
-        planar_camera: false,
     };
     let length = |lights: u32| {
         build_program(&ProgramConfig {
@@ -397,6 +396,8 @@ pub struct FrameReport {
     pub intersect_busy: u64,
     /// Clocks in which the traversal unit started a node decision.
     pub traversal_busy: u64,
+    /// Clocks in which ray generation's requests took the TransformUnit.
+    pub raygen_busy: u64,
     pub pixels: u64,
     pub mismatches: Vec<Mismatch>,
     pub differing_pixels: usize,
@@ -427,12 +428,13 @@ impl FrameReport {
     pub fn fps_at(&self, hz: f64) -> f64 {
         hz / self.cycles as f64
     }
-    /// Shares of the frame's clocks in which the TransformUnit, the IntersectUnit and the
-    /// traversal unit's decision took an input.
-    pub fn unit_busy_shares(&self) -> [f64; 3] {
+    /// Shares of the frame's clocks in which the TransformUnit (for triangle tests, for ray
+    /// generation), the IntersectUnit and the traversal unit's decision took an input.
+    pub fn unit_busy_shares(&self) -> [f64; 4] {
         let c = self.cycles.max(1) as f64;
         [
             self.transform_busy,
+            self.raygen_busy,
             self.intersect_busy,
             self.traversal_busy,
         ]
@@ -595,6 +597,7 @@ pub fn simulate_scene(
             transform_busy: fr.transform_busy,
             intersect_busy: fr.intersect_busy,
             traversal_busy: fr.traversal_busy,
+            raygen_busy: fr.raygen_busy,
             pixels: u64::from(w * h),
             differing_pixels: differing.len(),
             mismatches,

@@ -137,50 +137,15 @@ pub fn transform3<A: Arith>(a: A, m: &[A::V; 9], v: [A::V; 3]) -> [A::V; 3] {
     [row(0), row(1), row(2)]
 }
 
-/// RayGen: the primary ray direction of pixel (x, y) is the camera matrix applied to the point
-/// (x, y, 0) (the layout bakes the pixel-centre offsets into the matrix's offset column). The
-/// hardware is [`hw::RayGen`](crate::hw::RayGen) (src/hw/raygen.rs); its twin in words is
-/// [`primary_direction`].
-pub fn primary_direction_of<A: Arith>(a: A, camera: &[A::V; 12], x: A::V, y: A::V) -> [A::V; 3] {
-    let zero = a.word(0);
-    transform(a, camera, [a.from_uint(x), a.from_uint(y), zero], true)
-}
-
-/// Whether [`primary_direction_planar`] gives [`primary_direction_of`]'s words for every pixel
-/// of `camera` (row-major 3x4 words). It does when each row's z entry `m2` is finite and its
-/// product with the point's z (+0) adds nothing: that product is -0 (a negative `m2`), or +0
-/// and the row's `n` is not a negative zero (a sum `v` of -0 turns into +0 there, which only an
-/// `n` of -0, or a negative subnormal that reads as -0, would keep apart). The layout's camera
-/// has `m2 = +0`.
-pub fn camera_z_column_vanishes(f: Format, camera: &Mat34W) -> bool {
-    (0..3).all(|r| {
-        let (m2, n) = (camera[r * 4 + 2], camera[r * 4 + 3]);
-        let finite = !f.is_nan(m2) && !f.is_inf(m2);
-        finite && (f.sign_of(m2) || !(f.is_zero(n) && f.sign_of(n)))
-    })
-}
-
-/// [`primary_direction_of`] without the z column: `(m0*x + m1*y) + n` per row, for a camera
-/// where [`camera_z_column_vanishes`] (6 operations fewer per primary ray).
-pub fn primary_direction_planar<A: Arith>(
-    a: A,
-    camera: &[A::V; 12],
-    x: A::V,
-    y: A::V,
-) -> [A::V; 3] {
-    let (px, py) = (a.from_uint(x), a.from_uint(y));
-    [0, 1, 2].map(|r| {
-        let row = &camera[r * 4..r * 4 + 4];
-        a.add(a.add(a.mul(row[0], px), a.mul(row[1], py)), row[3])
-    })
-}
-
-/// [`primary_direction_of`] for pixel (x, y) in format words: the golden twin of
-/// [`hw::RayGen`](crate::hw::RayGen) and [`hw::RayGenUnit`](crate::hw::RayGenUnit)
-/// (src/hw/raygen.rs), whose coordinates go through
-/// [`hw::UIntToFloat`](crate::hw::UIntToFloat) as `from_uint` here.
+/// RayGen: the primary ray direction of pixel (x, y) in format words is the camera matrix
+/// applied to the point (x, y, 0) (the layout bakes the pixel-centre offsets into the matrix's
+/// offset column): the golden twin of [`hw::RayGen`](crate::hw::RayGen) and
+/// [`hw::RayGenUnit`](crate::hw::RayGenUnit) (src/hw/raygen.rs), which count the coordinates'
+/// floats (equal to `from_uint` here), and of the processor's
+/// [`hw::engine::PrimaryRays`](crate::hw::engine::PrimaryRays), which sends the request
+/// through the triangle tester's TransformUnit.
 pub fn primary_direction(f: Format, camera: &Mat34W, x: u32, y: u32) -> Vec3W {
-    primary_direction_of(f, camera, x, y)
+    transform(f, camera, [f.from_uint(x), f.from_uint(y), 0], true)
 }
 
 /// The result of one unit-triangle test.
@@ -568,55 +533,6 @@ mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
-
-    // Planar camera directions.
-
-    /// Random cameras with the layout's shape (m2 = +0) and others (m2 of either sign, zero,
-    /// infinite), rows whose `n` is +-0 or a negative subnormal, on every pixel of a 17x9 frame
-    /// (pixel (0, 0) makes `m0*x + m1*y` a signed zero).
-    #[test]
-    fn planar_directions_equal_the_full_transform_exactly_when_the_z_column_vanishes() {
-        let seed = 71;
-        println!("seed {seed}");
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        for f in [Format::E7M16, Format::E8M23] {
-            let neg_sub = f.zero(true) | 1;
-            let (mut agreed, mut differed) = (0, 0);
-            for _ in 0..400 {
-                let mut camera: Mat34W = [0; 12];
-                for (k, w) in camera.iter_mut().enumerate() {
-                    *w = match (k % 4, rng.gen_range(0..6)) {
-                        (2, 0) => f.zero(false),
-                        (2, 1) => f.zero(true),
-                        (2, 2) => f.infinity(rng.gen()),
-                        (3, 0) => f.zero(true),
-                        (3, 1) => f.zero(false),
-                        (3, 2) => neg_sub,
-                        (_, 3) => f.zero(rng.gen()),
-                        _ => f.from_f64(rng.gen_range(-2.0..2.0)),
-                    };
-                }
-                let same = (0..9u32).all(|y| {
-                    (0..17u32).all(|x| {
-                        primary_direction(f, &camera, x, y)
-                            == primary_direction_planar(f, &camera, x, y)
-                    })
-                });
-                if camera_z_column_vanishes(f, &camera) {
-                    assert!(same, "{f}: camera {camera:x?}");
-                    agreed += 1;
-                } else {
-                    differed += usize::from(!same);
-                }
-            }
-            // Both sides of the rule occur: cameras it accepts, and rejected ones that do
-            // differ somewhere.
-            assert!(
-                agreed > 20 && differed > 20,
-                "{f}: {agreed} agreed, {differed} differed"
-            );
-        }
-    }
 
     // Channel bytes.
 

@@ -4,7 +4,9 @@
 //!
 //! Write side (the engine's I5): `ray_write` with `ray_pair` 0, 1, 2 writes `(o.x, o.y)`,
 //! `(o.z, d.x)`, `(d.y, d.z)` of `thread` from `word_a`, `word_b`; `t_min_write` writes t_min
-//! from `word_a`. Read side: `ray_thread` gives `o`, `d` one clock later; `t_min_thread` gives
+//! from `word_a`; `primary_write` writes the whole ray `(primary_o, primary_d)` of
+//! `primary_thread` (a primary ray from ray generation; the engine writes no pair in that
+//! clock). Read side: `ray_thread` gives `o`, `d` one clock later; `t_min_thread` gives
 //! `t_min` one clock later (block RAMs, one read port each).
 //!
 //! Latency 1 clock per read; throughput one write and one read of each memory per clock.
@@ -23,6 +25,10 @@ pub struct RayStore<const W: usize> {
     pub ray_write: Signal<In, Bit>,
     pub ray_pair: Signal<In, Bits<2>>,
     pub t_min_write: Signal<In, Bit>,
+    pub primary_write: Signal<In, Bit>,
+    pub primary_thread: Signal<In, Bits<5>>,
+    pub primary_o: [Signal<In, Bits<W>>; 3],
+    pub primary_d: [Signal<In, Bits<W>>; 3],
     pub ray_thread: Signal<In, Bits<5>>,
     pub o: [Signal<Out, Bits<W>>; 3],
     pub d: [Signal<Out, Bits<W>>; 3],
@@ -57,6 +63,16 @@ impl<const W: usize> Logic for RayStore<W> {
                 self.words[4].write_enable.next = true;
                 self.words[5].write_enable.next = true;
                 self.words[5].write_data.next = self.word_b.val().get_bits::<W>(0);
+            }
+        }
+        if self.primary_write.val() {
+            for k in 0..3 {
+                self.words[k].write_address.next = self.primary_thread.val();
+                self.words[k].write_enable.next = true;
+                self.words[k].write_data.next = self.primary_o[k].val();
+                self.words[3 + k].write_address.next = self.primary_thread.val();
+                self.words[3 + k].write_enable.next = true;
+                self.words[3 + k].write_data.next = self.primary_d[k].val();
             }
         }
         self.words[6].write_enable.next = self.t_min_write.val();

@@ -94,6 +94,12 @@ pub struct TraversalUnit<
     pub engine: CoprocessorPort,
     /// `t_min_write`: the thread's t_min, in `engine.word_a` (the tester's `tri.init`).
     pub t_min_write: Signal<In, Bit>,
+    /// A primary ray from ray generation, the whole ray of `primary_thread` at once
+    /// ([`RayStore`]'s `primary_write`).
+    pub primary_write: Signal<In, Bit>,
+    pub primary_thread: Signal<In, Bits<5>>,
+    pub primary_o: [Signal<In, Bits<W>>; 3],
+    pub primary_d: [Signal<In, Bits<W>>; 3],
     /// Bank 0 (the kd nodes): one read per clock, the word `mem_latency` clocks later.
     pub nodes: SramRead,
     /// High in the clocks a node decision starts.
@@ -260,6 +266,10 @@ impl<
             engine: Default::default(),
             nodes: Default::default(),
             t_min_write: Default::default(),
+            primary_write: Default::default(),
+            primary_thread: Default::default(),
+            primary_o: Default::default(),
+            primary_d: Default::default(),
             step_busy: Default::default(),
             leaf_valid: Default::default(),
             leaf_thread: Default::default(),
@@ -453,6 +463,12 @@ impl<
         self.ray.ray_write.next = self.engine.ray_write.val();
         self.ray.ray_pair.next = self.engine.ray_pair.val();
         self.ray.t_min_write.next = self.t_min_write.val();
+        self.ray.primary_write.next = self.primary_write.val();
+        self.ray.primary_thread.next = self.primary_thread.val();
+        for k in 0..3 {
+            self.ray.primary_o[k].next = self.primary_o[k].val();
+            self.ray.primary_d[k].next = self.primary_d[k].val();
+        }
         // The tester's answer takes the queue first (a thread has one entry in the unit at a
         // time, so the queue never overflows with it).
         self.engine_full.next = self.entry_fifo.full.val() | self.answer_valid.val();

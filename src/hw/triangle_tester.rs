@@ -133,9 +133,27 @@ pub struct TriangleTester<
     pub walk_end_thread: Signal<Out, Bits<5>>,
     pub walk_end_t: Signal<Out, Bits<32>>,
     pub walk_end_hit: Signal<Out, Bit>,
-    /// High in the clocks the TransformUnit and the IntersectUnit take an input.
+    /// High in the clocks the TransformUnit and the IntersectUnit take a triangle test's
+    /// input.
     pub transform_busy: Signal<Out, Bit>,
     pub intersect_busy: Signal<Out, Bit>,
+    /// Ray generation's client port on the TransformUnit: a request (`gen_valid`, the camera
+    /// matrix `gen_m`, the pixel's point `gen_v`, `gen_thread`) is taken (`gen_take`) in a
+    /// clock the launch leaves the unit free (the tests come first, so their latency stays
+    /// fixed); its direction leaves [`TRANSFORM_LATENCY`] clocks later on `gen_out_*`.
+    pub gen_valid: Signal<In, Bit>,
+    pub gen_m: [Signal<In, Bits<W>>; 12],
+    pub gen_v: [Signal<In, Bits<W>>; 3],
+    pub gen_thread: Signal<In, Bits<5>>,
+    pub gen_take: Signal<Out, Bit>,
+    pub gen_out_valid: Signal<Out, Bit>,
+    pub gen_out_thread: Signal<Out, Bits<5>>,
+    pub gen_out_dir: [Signal<Out, Bits<W>>; 3],
+    /// A primary ray written whole into the thread's ray ([`RayStore`]'s `primary_write`).
+    pub primary_write: Signal<In, Bit>,
+    pub primary_thread: Signal<In, Bits<5>>,
+    pub primary_o: [Signal<In, Bits<W>>; 3],
+    pub primary_d: [Signal<In, Bits<W>>; 3],
 
     list_unit: ListUnit,
     /// Per thread: the ray (o, d), t_min; entries taken; (engine copies) entries done, best
@@ -225,6 +243,11 @@ pub struct TriangleTester<
     merge_best: Signal<Local, Bits<33>>,
     merge_write: Signal<Local, Bit>,
     launch_tag: Signal<Local, Bits<16>>,
+    /// The launch sends a test's origin or direction this clock; else ray generation may.
+    launching: Signal<Local, Bit>,
+    gen_taken: Signal<Local, Bit>,
+    /// Tag bit 14: a primary ray's direction (ray generation's request).
+    c_primary: Constant<Bits<16>>,
 
     c_ml_last: Constant<Bits<4>>,
     c_index: [Constant<Bits<4>>; 12],
@@ -294,6 +317,21 @@ impl<
             walk_end_hit: Default::default(),
             transform_busy: Default::default(),
             intersect_busy: Default::default(),
+            gen_valid: Default::default(),
+            gen_m: Default::default(),
+            gen_v: Default::default(),
+            gen_thread: Default::default(),
+            gen_take: Default::default(),
+            gen_out_valid: Default::default(),
+            gen_out_thread: Default::default(),
+            gen_out_dir: Default::default(),
+            primary_write: Default::default(),
+            primary_thread: Default::default(),
+            primary_o: Default::default(),
+            primary_d: Default::default(),
+            gen_taken: Default::default(),
+            launching: Default::default(),
+            c_primary: Constant::new((1u64 << 14).into()),
             list_unit: ListUnit::new(mem_latency),
             ray: Default::default(),
             // The counters start equal (nothing pending) at power-up.
@@ -469,6 +507,12 @@ impl<
         self.ray.word_b.next = self.engine.word_b.val();
         self.ray.ray_write.next = self.engine.ray_write.val();
         self.ray.ray_pair.next = self.engine.ray_pair.val();
+        self.ray.primary_write.next = self.primary_write.val();
+        self.ray.primary_thread.next = self.primary_thread.val();
+        for k in 0..3 {
+            self.ray.primary_o[k].next = self.primary_o[k].val();
+            self.ray.primary_d[k].next = self.primary_d[k].val();
+        }
         self.ray.t_min_write.next =
             self.engine.enqueue.val() & (self.queue_kind.val() == self.c_cmd_init.val());
         // The engine's entries first; a walk's list in the other clocks.
@@ -709,15 +753,38 @@ impl<
             self.lb.d.next = !self.lb.q.val();
             self.lphase.d.next = Launch::Wait;
         }
+        // Ray generation's request takes the unit in a clock the launch leaves free.
+        self.launching.next =
+            (self.lphase.q.val() == Launch::Origin) | (self.lphase.q.val() == Launch::Direction);
+        self.gen_taken.next = self.gen_valid.val() & (!self.launching.val());
+        self.gen_take.next = self.gen_taken.val();
+        if self.gen_taken.val() {
+            self.transform_unit.in_valid.next = true;
+            for k in 0..12 {
+                self.transform_unit.m[k].next = self.gen_m[k].val();
+            }
+            for k in 0..3 {
+                self.transform_unit.v[k].next = self.gen_v[k].val();
+            }
+            self.transform_unit.tag.next =
+                self.c_primary.val() | (bit_cast::<16, 5>(self.gen_thread.val()) << 5);
+        }
+        self.gen_out_valid.next =
+            self.transform_unit.out_valid.val() & self.transform_unit.out_tag.val().get_bit(14);
+        self.gen_out_thread.next = self.transform_unit.out_tag.val().get_bits::<5>(5);
+        for k in 0..3 {
+            self.gen_out_dir[k].next = self.transform_unit.result[k].val();
+        }
         // Busy counts tests only (inits and list ends pass the units to keep their order).
         self.transform_busy.next =
-            self.transform_unit.in_valid.val() & (self.l_kind.val() == self.c_test_triangle.val());
+            self.launching.val() & (self.l_kind.val() == self.c_test_triangle.val());
 
         // O' waits a clock for D'; then the unit-triangle test.
         for k in 0..3 {
             self.o_hold[k].d.next = self.o_hold[k].q.val();
             if self.transform_unit.out_valid.val()
                 & (!self.transform_unit.out_tag.val().get_bit(13))
+                & (!self.transform_unit.out_tag.val().get_bit(14))
             {
                 self.o_hold[k].d.next = self.transform_unit.result[k].val();
             }

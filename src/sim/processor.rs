@@ -32,6 +32,8 @@ pub struct SimFrame {
     pub intersect_busy: u64,
     /// Clocks in which the traversal unit started a node decision.
     pub traversal_busy: u64,
+    /// Clocks in which ray generation's requests took the TransformUnit.
+    pub raygen_busy: u64,
 }
 
 /// What a processor simulation produced.
@@ -296,9 +298,10 @@ pub fn simulate_processor(
             .split_whitespace()
             .filter_map(|w| w.parse().ok())
             .collect();
-        if nums.len() != 5 {
+        if nums.len() != 6 {
             bail!(
-                "{}: expected `cycles instructions transform_busy intersect_busy traversal_busy`, \
+                "{}: expected `cycles instructions transform_busy intersect_busy traversal_busy \
+                 raygen_busy`, \
                  got `{}`",
                 stats_path.display(),
                 stats.trim()
@@ -311,6 +314,7 @@ pub fn simulate_processor(
             transform_busy: nums[2],
             intersect_busy: nums[3],
             traversal_busy: nums[4],
+            raygen_busy: nums[5],
         });
     }
     let vga = if capture_vga {

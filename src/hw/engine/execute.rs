@@ -36,13 +36,15 @@ pub struct Execute<const W: usize, const E: usize, const M: usize> {
     pub shift: Signal<In, Bits<SHIFT_BITS>>,
     pub bank: Signal<In, Bits<BANK_BITS>>,
     pub pc: Signal<In, Bits<PC_BITS>>,
-    /// The pixel counter's word.
+    /// Ray generation's pixel word (`PrimaryRays::word`).
     pub pixel: Signal<In, Bits<32>>,
     /// The triangle tester's answers for the thread at I5.
     pub tester_best_t: Signal<In, Bits<W>>,
     pub tester_hit: Signal<In, Bit>,
     pub tester_instance: Signal<In, Bits<32>>,
     pub tester_triangle: Signal<In, Bits<32>>,
+    /// The thread's primary direction (ray generation's answer at I5), for `tri.dir`.
+    pub primary_dir: [Signal<In, Bits<W>>; 3],
     pub fast: Signal<Out, Bits<32>>,
     /// I6: `itof a` of the instruction at I5 the clock before.
     pub converted: Signal<Out, Bits<32>>,
@@ -75,6 +77,9 @@ pub struct Execute<const W: usize, const E: usize, const M: usize> {
     tri_hit: Constant<Bits<32>>,
     tri_instance: Constant<Bits<32>>,
     tri_triangle: Constant<Bits<32>>,
+    tri_dir: Constant<Bits<32>>,
+    dir_word: Signal<Local, Bits<W>>,
+    c_component: [Constant<Bits<SHIFT_BITS>>; 3],
     bank_nodes: Constant<Bits<3>>,
     bank_a: Constant<Bits<3>>,
     bank_b: Constant<Bits<3>>,
@@ -96,6 +101,7 @@ impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M
             tester_hit: Default::default(),
             tester_instance: Default::default(),
             tester_triangle: Default::default(),
+            primary_dir: Default::default(),
             fast: Default::default(),
             converted: Default::default(),
             kind: Default::default(),
@@ -125,6 +131,9 @@ impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M
             tri_hit: tri_fn(TriFn::Hit),
             tri_instance: tri_fn(TriFn::Instance),
             tri_triangle: tri_fn(TriFn::Triangle),
+            tri_dir: tri_fn(TriFn::Dir),
+            dir_word: Default::default(),
+            c_component: std::array::from_fn(|k| Constant::new((k as u64).into())),
             bank_nodes: bank(layout::NODES),
             bank_a: bank(layout::TRIANGLES_A),
             bank_b: bank(layout::TRIANGLES_B),
@@ -208,6 +217,16 @@ impl<const W: usize, const E: usize, const M: usize> Logic for Execute<W, E, M> 
             if self.imm.val() == self.tri_triangle.val() {
                 self.result.next = self.tester_triangle.val();
             }
+        }
+        // `tri.dir`: the primary direction's component named by the shift field.
+        self.dir_word.next = self.primary_dir[0].val();
+        for k in 0..3 {
+            if self.shift.val() == self.c_component[k].val() {
+                self.dir_word.next = self.primary_dir[k].val();
+            }
+        }
+        if (self.op.val() == self.op_tri.val()) & (self.imm.val() == self.tri_dir.val()) {
+            self.result.next = bit_cast::<32, W>(self.dir_word.val());
         }
         self.fast.next = self.result.val();
         self.kind.next = self.source.val();

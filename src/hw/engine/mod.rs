@@ -23,7 +23,7 @@
 //!   [`MailboxUnit`] reads the thread's mailbox and the coprocessors their state of the
 //!   thread.
 //! - I5 ([`OPERAND_STAGE`]): [`Execute`] computes the integer result and the addresses, the
-//!   [`PixelCounter`] hands out a pixel, the mailbox registers the entries it read (it compares
+//!   [`PrimaryRays`] hands out a pixel (and requests its primary ray), the mailbox registers the entries it read (it compares
 //!   at I6, hits and updates at I7), [`FpUnits`] take their operands; this block drives the
 //!   memory and frame-buffer ports and offers `tri` and `kd` entries to the coprocessors (their
 //!   answer, refused or pending, makes the thread repeat the instruction on its next turn, after
@@ -76,7 +76,7 @@ mod fetch;
 mod first_ready;
 mod fp_units;
 mod mailbox;
-mod pixel_counter;
+mod primary_rays;
 mod program_rom;
 mod result_line;
 mod retiring;
@@ -89,7 +89,7 @@ pub use fetch::{Fetch, FETCH_LATENCY};
 pub use first_ready::FirstReady;
 pub use fp_units::FpUnits;
 pub use mailbox::MailboxUnit;
-pub use pixel_counter::PixelCounter;
+pub use primary_rays::{PrimaryRays, CAMERA_WORDS};
 pub use program_rom::ProgramRom;
 pub use result_line::ResultLine;
 pub use retiring::{Retiring, RetiringIn};
@@ -219,13 +219,15 @@ pub struct ThreadEngine<
     pub intersect_busy: Signal<Out, Bits<32>>,
     /// Clocks of the frame in which the traversal unit started a node decision.
     pub traversal_busy: Signal<Out, Bits<32>>,
+    /// Clocks of the frame in which ray generation's request took the TransformUnit.
+    pub raygen_busy: Signal<Out, Bits<32>>,
 
     // The pipeline's stages.
     scheduler: Scheduler,
     fetch: Fetch,
     decode: Decode,
     mailboxes: MailboxUnit,
-    pixels: PixelCounter,
+    rays: PrimaryRays<W, E, M>,
     execute: Execute<W, E, M>,
     fp_units: FpUnits<W, E, M, S, S1, X2, T, P>,
     result_line: ResultLine<DX>,
@@ -246,6 +248,7 @@ pub struct ThreadEngine<
     transform_count: DFF<Bits<32>>,
     intersect_count: DFF<Bits<32>>,
     traversal_count: DFF<Bits<32>>,
+    raygen_count: DFF<Bits<32>>,
     frame_start: Signal<Local, Bit>,
     // The memory and frame-buffer ports' request registers.
     /// The load's bank one-hot (`CoprocessorPort::load_banks`); `mem_bank_r` its number, for
@@ -261,6 +264,7 @@ pub struct ThreadEngine<
     // coprocessors' queues); the answers at I5.
     ray_write: DFF<Bit>,
     t_min_write: DFF<Bit>,
+    camera_write: DFF<Bit>,
     tri_enqueue: DFF<Bit>,
     tri_queues: DFF<Bit>,
     tri_kind: DFF<Bits<2>>,
@@ -298,6 +302,7 @@ pub struct ThreadEngine<
     tri_wait: Constant<Bits<32>>,
     tri_object: Constant<Bits<32>>,
     tri_skip: Constant<Bits<32>>,
+    tri_camera: Constant<Bits<32>>,
     kd_start: Constant<Bits<32>>,
     kd_wait: Constant<Bits<32>>,
     cmd_list: Constant<Bits<2>>,
@@ -362,13 +367,14 @@ impl<
             bank2: Default::default(),
             bank3: Default::default(),
             transform_busy: Default::default(),
+            raygen_busy: Default::default(),
             intersect_busy: Default::default(),
             traversal_busy: Default::default(),
             scheduler: Scheduler::new(threads, reserve_ahead),
             fetch: Fetch::new(program),
             decode: Decode::new(program.registers_used),
             mailboxes: Default::default(),
-            pixels: PixelCounter::new(&program.config),
+            rays: PrimaryRays::new(&program.config),
             execute: Default::default(),
             fp_units: Default::default(),
             result_line: ResultLine::new(mem_latency),
@@ -383,6 +389,7 @@ impl<
             cycle_count: Default::default(),
             instr_count: Default::default(),
             transform_count: Default::default(),
+            raygen_count: Default::default(),
             intersect_count: Default::default(),
             traversal_count: Default::default(),
             frame_start: Default::default(),
@@ -394,6 +401,7 @@ impl<
             fb_data_r: Default::default(),
             ray_write: Default::default(),
             t_min_write: Default::default(),
+            camera_write: Default::default(),
             tri_enqueue: Default::default(),
             tri_queues: Default::default(),
             tri_kind: Default::default(),
@@ -426,6 +434,7 @@ impl<
             tri_wait: tri_fn(TriFn::Wait),
             tri_object: tri_fn(TriFn::Object),
             tri_skip: tri_fn(TriFn::Skip),
+            tri_camera: tri_fn(TriFn::Camera),
             kd_start: kd_fn(KdFn::Start),
             kd_wait: kd_fn(KdFn::Wait),
             cmd_list: cmd(list_unit::CMD_LIST),
@@ -463,6 +472,7 @@ impl<
             cycle_count,
             instr_count,
             transform_count,
+            raygen_count,
             intersect_count,
             traversal_count,
             mem_load_r,
@@ -473,6 +483,7 @@ impl<
             fb_data_r,
             ray_write,
             t_min_write,
+            camera_write,
             tri_enqueue,
             tri_queues,
             tri_kind,
@@ -488,7 +499,7 @@ impl<
             fetch,
             decode,
             mailboxes,
-            pixels,
+            rays,
             execute,
             fp_units,
             result_line,
@@ -508,6 +519,7 @@ impl<
         self.transform_busy.next = self.transform_count.q.val();
         self.intersect_busy.next = self.intersect_count.q.val();
         self.traversal_busy.next = self.traversal_count.q.val();
+        self.raygen_busy.next = self.raygen_count.q.val();
         if self.running.q.val() {
             self.cycle_count.d.next = self.cycle_count.q.val() + 1;
             if self.tester.transform_busy.val() {
@@ -518,6 +530,9 @@ impl<
             }
             if self.traversal_unit.step_busy.val() {
                 self.traversal_count.d.next = self.traversal_count.q.val() + 1;
+            }
+            if self.tester.gen_take.val() {
+                self.raygen_count.d.next = self.raygen_count.q.val() + 1;
             }
         }
 
@@ -554,7 +569,10 @@ impl<
         self.execute.shift.next = self.decode.shift.val();
         self.execute.bank.next = self.decode.bank.val();
         self.execute.pc.next = self.decode.pc.val();
-        self.execute.pixel.next = self.pixels.word.val();
+        self.execute.pixel.next = self.rays.word.val();
+        for k in 0..3 {
+            self.execute.primary_dir[k].next = self.rays.dir[k].val();
+        }
         self.execute.tester_best_t.next = self.tester.best_t.val();
         self.execute.tester_hit.next = self.tester.hit.val();
         self.execute.tester_instance.next = self.tester.best_instance.val();
@@ -566,10 +584,16 @@ impl<
             self.decode.valid.val() & (self.decode.op.val() == self.op_mbx.val());
         self.mailboxes.clear.next =
             self.decode.valid.val() & (self.decode.op.val() == self.op_mbc.val());
-        self.pixels.frame_start.next = self.frame_start.val();
-        self.pixels.take.next = self.running.q.val()
+        self.rays.frame_start.next = self.frame_start.val();
+        self.rays.offer.next = self.running.q.val()
             & self.decode.valid.val()
             & (self.decode.op.val() == self.op_pixel.val());
+        self.rays.thread.next = self.decode.thread.val();
+        self.rays.camera_write.next = self.camera_write.q.val();
+        self.rays.camera_pair.next = self.decode.shift.val().get_bits::<3>(0);
+        self.rays.word_a.next = self.decode.a.val();
+        self.rays.word_b.next = self.decode.b.val();
+        self.rays.query_thread.next = self.decode.thread_i4.val();
 
         // Scratch memory.
         self.scratch.read_address.next = (bit_cast::<12, 5>(self.decode.thread.val()) << 7)
@@ -623,6 +647,9 @@ impl<
         self.ray_write.d.next = self.decode.valid_i4.val()
             & self.tri_op.val()
             & (self.decode.imm_i4.val() < self.tri_ray_words.val());
+        self.camera_write.d.next = self.decode.valid_i4.val()
+            & self.tri_op.val()
+            & (self.decode.imm_i4.val() == self.tri_camera.val());
         self.t_min_write.d.next = self.decode.valid_i4.val()
             & self.tri_op.val()
             & (self.decode.imm_i4.val() == self.tri_init.val());
@@ -655,14 +682,41 @@ impl<
         self.traversal_unit.engine.word_a.next = self.decode.a.val();
         self.traversal_unit.engine.word_b.next = self.decode.b.val();
         self.traversal_unit.engine.ray_pair.next = self.decode.imm.val().get_bits::<2>(0);
-        self.traversal_unit.engine.ray_write.next = self.ray_write.q.val();
+        self.traversal_unit.engine.ray_write.next =
+            self.ray_write.q.val() & (!self.rays.primary_write.val());
         self.tester.engine.load_banks.next = self.mem_load_r.q.val();
         self.tester.engine.load_addr.next = self.mem_addr_r.q.val();
         self.tester.engine.thread.next = self.decode.thread.val();
         self.tester.engine.word_a.next = self.decode.a.val();
         self.tester.engine.word_b.next = self.decode.b.val();
         self.tester.engine.ray_pair.next = self.decode.imm.val().get_bits::<2>(0);
-        self.tester.engine.ray_write.next = self.ray_write.q.val();
+        self.tester.engine.ray_write.next =
+            self.ray_write.q.val() & (!self.rays.primary_write.val());
+        // Ray generation: its requests take the tester's TransformUnit in the clocks the
+        // launch leaves free, and its primary rays are written whole into both ray stores
+        // (the engine's ray words are refused in that clock).
+        self.tester.gen_valid.next = self.rays.gen_valid.val();
+        for k in 0..12 {
+            self.tester.gen_m[k].next = self.rays.gen_m[k].val();
+        }
+        for k in 0..3 {
+            self.tester.gen_v[k].next = self.rays.gen_v[k].val();
+        }
+        self.tester.gen_thread.next = self.rays.gen_thread.val();
+        self.rays.gen_take.next = self.tester.gen_take.val();
+        self.rays.gen_out_valid.next = self.tester.gen_out_valid.val();
+        self.rays.gen_out_thread.next = self.tester.gen_out_thread.val();
+        self.tester.primary_write.next = self.rays.primary_write.val();
+        self.tester.primary_thread.next = self.rays.primary_thread.val();
+        self.traversal_unit.primary_write.next = self.rays.primary_write.val();
+        self.traversal_unit.primary_thread.next = self.rays.primary_thread.val();
+        for k in 0..3 {
+            self.rays.gen_out_dir[k].next = self.tester.gen_out_dir[k].val();
+            self.tester.primary_o[k].next = self.rays.primary_o[k].val();
+            self.tester.primary_d[k].next = self.rays.primary_d[k].val();
+            self.traversal_unit.primary_o[k].next = self.rays.primary_o[k].val();
+            self.traversal_unit.primary_d[k].next = self.rays.primary_d[k].val();
+        }
 
         // Triangle tester: the entry and its answer (refused, or the wait pending).
         self.tester.engine.enqueue.next = self.tri_enqueue.q.val();
@@ -672,7 +726,10 @@ impl<
             self.tri_busy.next = self.tester.engine.full.val();
         }
         if self.tri_waits.q.val() {
-            self.tri_busy.next = self.tester.engine.pending.val();
+            self.tri_busy.next = self.tester.engine.pending.val() | self.rays.pending.val();
+        }
+        if self.ray_write.q.val() & self.rays.primary_write.val() {
+            self.tri_busy.next = true;
         }
         // Traversal unit. It sees the object-space ray and t_min the thread gives the tester,
         // hands its leaves to the tester and takes the answers back.
@@ -708,7 +765,8 @@ impl<
         self.result_line.int_eq.next = self.execute.int_eq.val();
         self.result_line.int_lt.next = self.execute.int_lt.val();
         self.result_line.mb_hit.next = self.mailboxes.hit.val();
-        self.result_line.pix_done.next = self.pixels.exhausted.val();
+        self.result_line.pix_done.next = self.rays.exhausted.val();
+        self.result_line.pix_busy.next = self.rays.refused.val();
         self.result_line.fast.next = self.execute.fast.val();
         self.result_line.kind.next = self.execute.kind.val();
         self.result_line.converted.next = self.execute.converted.val();
@@ -747,6 +805,8 @@ impl<
         self.scheduler.tester_done_thread.next = self.tester.engine.done_thread.val();
         self.scheduler.walk_done.next = self.traversal_unit.engine.done.val();
         self.scheduler.walk_done_thread.next = self.traversal_unit.engine.done_thread.val();
+        self.scheduler.ray_done.next = self.rays.primary_write.val();
+        self.scheduler.ray_done_thread.next = self.rays.primary_thread.val();
         // Instructions retired: every write back but a turn spent offering again to a full
         // coprocessor queue or waiting for a coprocessor (the twin never repeats those).
         if self.write_back.retired.val() {
@@ -769,6 +829,7 @@ impl<
             self.transform_count.d.next = 0.into();
             self.intersect_count.d.next = 0.into();
             self.traversal_count.d.next = 0.into();
+            self.raygen_count.d.next = 0.into();
         }
     }
 }

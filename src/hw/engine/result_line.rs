@@ -66,6 +66,8 @@ pub struct ResultLine<const DX: usize> {
     pub int_lt: Signal<In, Bit>,
     pub mb_hit: Signal<In, Bit>,
     pub pix_done: Signal<In, Bit>,
+    /// Ray generation refuses the `pixel` (its request slot is taken): the thread repeats it.
+    pub pix_busy: Signal<In, Bit>,
     /// I5: the fast result and where a load's data comes from.
     pub fast: Signal<In, Bits<32>>,
     pub kind: Signal<In, FastKind>,
@@ -96,6 +98,7 @@ pub struct ResultLine<const DX: usize> {
     int_eq_i6: DFF<Bit>,
     int_lt_i6: DFF<Bit>,
     pix_done_i6: DFF<Bit>,
+    pix_busy_i6: DFF<Bit>,
     /// I6: the decode.
     is_long: Signal<Local, Bit>,
     is_mbx: Signal<Local, Bit>,
@@ -186,6 +189,7 @@ impl<const DX: usize> ResultLine<DX> {
             int_lt: Default::default(),
             mb_hit: Default::default(),
             pix_done: Default::default(),
+            pix_busy: Default::default(),
             fast: Default::default(),
             kind: Default::default(),
             converted: Default::default(),
@@ -210,6 +214,7 @@ impl<const DX: usize> ResultLine<DX> {
             int_eq_i6: Default::default(),
             int_lt_i6: Default::default(),
             pix_done_i6: Default::default(),
+            pix_busy_i6: Default::default(),
             is_long: Default::default(),
             is_mbx: Default::default(),
             halts: Default::default(),
@@ -297,6 +302,7 @@ impl<const DX: usize> Logic for ResultLine<DX> {
             int_eq_i6,
             int_lt_i6,
             pix_done_i6,
+            pix_busy_i6,
             cond_i7,
             is_mbx_i7
         );
@@ -346,15 +352,18 @@ impl<const DX: usize> Logic for ResultLine<DX> {
         self.int_eq_i6.d.next = self.int_eq.val();
         self.int_lt_i6.d.next = self.int_lt.val();
         self.pix_done_i6.d.next = self.pix_done.val();
+        self.pix_busy_i6.d.next = self.pix_busy.val();
 
         // I6: decode.
         self.is_long.next = (self.op_i6.q.val() == self.op_fdiv.val())
             | (self.op_i6.q.val() == self.op_fsqrt.val());
         self.is_mbx.next = self.op_i6.q.val() == self.op_mbx.val();
         self.halts.next = self.op_i6.q.val() == self.op_halt.val();
-        // A coprocessor refused the entry (queue full) or has not finished (a wait).
+        // A coprocessor refused the entry (queue full) or has not finished (a wait); ray
+        // generation refused the pixel.
         self.repeats.next = ((self.op_i6.q.val() == self.op_tri.val()) & self.tri_busy_i6.q.val())
-            | ((self.op_i6.q.val() == self.op_kd.val()) & self.kd_busy_i6.q.val());
+            | ((self.op_i6.q.val() == self.op_kd.val()) & self.kd_busy_i6.q.val())
+            | ((self.op_i6.q.val() == self.op_pixel.val()) & self.pix_busy_i6.q.val());
         self.keeps_pc.next = self.halts.val() | self.repeats.val();
         self.cond_i6.next = ((self.op_i6.q.val() == self.op_beq.val()) & self.int_eq_i6.q.val())
             | ((self.op_i6.q.val() == self.op_bltu.val()) & self.int_lt_i6.q.val())
@@ -397,11 +406,12 @@ impl<const DX: usize> Logic for ResultLine<DX> {
         self.is_long_line.data_in.next = self.is_long.val();
         self.dst_line.data_in.next = self.dst_i6.q.val();
         self.thread_line.data_in.next = self.thread_i6.q.val();
-        // `pixel` writes nothing once the frame's pixels are exhausted.
+        // `pixel` writes nothing once the frame's pixels are exhausted, nor when refused.
         self.write_line.data_in.next = self.valid_i6.q.val()
             & (self.dst_i6.q.val() != 0)
             & self.op_writes.val().get_bit(self.op_i6.q.val().index())
-            & (!((self.op_i6.q.val() == self.op_pixel.val()) & self.pix_done_i6.q.val()));
+            & (!((self.op_i6.q.val() == self.op_pixel.val())
+                & (self.pix_done_i6.q.val() | self.pix_busy_i6.q.val())));
         self.source_line.data_in.next = self.source_i6.val();
         self.sel_lt_line.data_in.next = self.op_i6.q.val() == self.op_bflt.val();
         self.sel_le_line.data_in.next = self.op_i6.q.val() == self.op_bfle.val();

@@ -435,6 +435,27 @@ impl Asm {
         self.coprocessor(Op::Tri, f as u32, dst, Reg::ZERO, Reg::ZERO);
     }
 
+    /// Ray generation's camera words `2 pair`, `2 pair + 1` = `a`, `b`.
+    pub fn tri_camera(&self, pair: u8, a: Reg, b: Reg) {
+        self.emit(Instr {
+            a: a.0,
+            b: b.0,
+            imm: TriFn::Camera as u32,
+            shift: pair,
+            ..Instr::new(Op::Tri)
+        });
+    }
+
+    /// `dst` = component `k` of the thread's primary direction (after a `tri.wait`).
+    pub fn tri_dir(&self, k: u8, dst: Reg) {
+        self.emit(Instr {
+            dst: dst.0,
+            imm: TriFn::Dir as u32,
+            shift: k,
+            ..Instr::new(Op::Tri)
+        });
+    }
+
     /// Offers `kd.start a, b` (root, t_max) to the traversal unit (again while refused).
     pub fn kd_start(&self, a: Reg, b: Reg) {
         self.coprocessor(Op::Kd, KdFn::Start as u32, Reg::ZERO, a, b);

@@ -14,12 +14,13 @@
 //! (the fields of [`crate::hw::engine::Decode`], the results of
 //! [`crate::hw::engine::Execute`] and [`crate::hw::engine::FpUnits`], the condition and next pc
 //! of [`crate::hw::engine::WriteBack`], the mailboxes of [`crate::hw::engine::MailboxUnit`],
-//! the pixels of [`crate::hw::engine::PixelCounter`]); `kd` stands for the
+//! the pixels and primary rays of [`crate::hw::engine::PrimaryRays`]); `kd` stands for the
 //! [`crate::hw::TraversalUnit`]'s walk and `tri` for the [`crate::hw::TriangleTester`].
 
 use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_ANY_HIT, REGISTERS};
 use super::Program;
 use crate::fp::Format;
+use crate::hw::engine::CAMERA_WORDS;
 use crate::hw::traversal_unit::STACK_LEVELS;
 use crate::layout::{Layout, Node, LISTS, NODES, NODE_WORDS, TRIANGLES_B, TRIANGLE_BANK_WORDS};
 use crate::units::{self, Mailbox};
@@ -87,6 +88,10 @@ struct Thread {
     scratch: Vec<u32>,
     mailboxes: [Mailbox; 2],
     tester: TesterState,
+    /// Ray generation's camera words (`tri.camera`; shared in the engine, where every
+    /// thread writes the same frame words) and the thread's last primary direction.
+    camera: [u32; CAMERA_WORDS],
+    primary_d: [u32; 3],
     halted: bool,
 }
 
@@ -98,6 +103,8 @@ impl Thread {
             scratch: vec![0; scratch_words],
             mailboxes: Default::default(),
             tester: TesterState::default(),
+            camera: [0; CAMERA_WORDS],
+            primary_d: [0; 3],
             halted: false,
         }
     }
@@ -305,21 +312,25 @@ impl<'a> Machine<'a> {
             }
             Op::Mbc => t.mailboxes[(i.imm & 1) as usize] = Mailbox::default(),
             Op::Pixel => {
-                let shift = self.program.config.pixel_shift();
-                match pixels {
-                    Pixels::Raster { next: n, count } => {
-                        if *n < *count {
-                            let w = self.program.config.width;
-                            result = Some(((*n / w) << shift) | (*n % w));
-                            *n += 1;
-                        } else {
-                            next = i.target as usize;
-                        }
+                let taken = match pixels {
+                    Pixels::Raster { next: n, count } => (*n < *count).then(|| {
+                        let w = self.program.config.width;
+                        *n += 1;
+                        ((*n - 1) % w, (*n - 1) / w)
+                    }),
+                    Pixels::One(p) => p.take(),
+                };
+                match taken {
+                    // The pixel's primary ray, written whole into the thread's ray.
+                    Some((x, y)) => {
+                        result = Some((y << self.program.config.pixel_shift()) | x);
+                        let camera: &units::Mat34W = t.camera[..12].try_into().unwrap();
+                        let d = units::primary_direction(f, camera, x, y);
+                        t.tester.o = t.camera[12..15].try_into().unwrap();
+                        t.tester.d = d;
+                        t.primary_d = d;
                     }
-                    Pixels::One(p) => match p.take() {
-                        Some((x, y)) => result = Some((y << shift) | x),
-                        None => next = i.target as usize,
-                    },
+                    None => next = i.target as usize,
                 }
             }
             Op::Halt => {
@@ -348,6 +359,19 @@ impl<'a> Machine<'a> {
                     TriFn::Hit => result = Some(u32::from(tt.hit)),
                     TriFn::Instance => result = Some(tt.best_instance),
                     TriFn::Triangle => result = Some(tt.best_triangle),
+                    TriFn::Camera => {
+                        let pair = usize::from(i.shift);
+                        let words = t
+                            .camera
+                            .get_mut(2 * pair..2 * pair + 2)
+                            .ok_or_else(|| fail(format!("no camera word pair {pair}")))?;
+                        words.copy_from_slice(&[a, b]);
+                    }
+                    TriFn::Dir => {
+                        let k = usize::from(i.shift);
+                        let d = t.primary_d.get(k);
+                        result = Some(*d.ok_or_else(|| fail(format!("no direction word {k}")))?);
+                    }
                 }
                 // The twin's queue never refuses and its tests are done at once, so the
                 // instruction never repeats.

@@ -164,7 +164,8 @@ pub enum TriFn {
     /// that is not the query's skipped one and not in the thread's triangle mailbox (which
     /// records it), in list order (the tester's list unit reads the list).
     List,
-    /// Repeat while tests are in flight; `dst` = best t.
+    /// Repeat while tests are in flight or the thread's primary ray (its last `pixel`'s) is
+    /// not written yet; `dst` = best t.
     Wait,
     /// `dst` = 1 when some test hit, else 0.
     Hit,
@@ -175,10 +176,16 @@ pub enum TriFn {
     Object,
     /// Queue: the query does not test triangle `B` of instance `A` (the one it starts on).
     Skip,
+    /// Ray generation's camera words `2 s`, `2 s + 1` = `A`, `B` for the instruction's shift
+    /// field `s` (0..8: the camera 3x4 `FrameMap::CAMERA`, then the eye `FrameMap::EYE`).
+    Camera,
+    /// `dst` = component `s` (the shift field, 0..3) of the thread's primary direction (after
+    /// a wait).
+    Dir,
 }
 
 impl TriFn {
-    pub const ALL: [TriFn; 11] = [
+    pub const ALL: [TriFn; 13] = [
         TriFn::RayOxy,
         TriFn::RayOzDx,
         TriFn::RayDyz,
@@ -190,6 +197,8 @@ impl TriFn {
         TriFn::Triangle,
         TriFn::Object,
         TriFn::Skip,
+        TriFn::Camera,
+        TriFn::Dir,
     ];
     pub fn from_imm(imm: u32) -> Option<TriFn> {
         Self::ALL.get(imm as usize).copied()
@@ -207,6 +216,8 @@ impl TriFn {
             TriFn::Triangle => "triangle",
             TriFn::Object => "object",
             TriFn::Skip => "skip",
+            TriFn::Camera => "camera",
+            TriFn::Dir => "dir",
         }
     }
     /// Whether the function puts an entry in the tester's queue.
@@ -306,7 +317,7 @@ impl Op {
             Ld | St => Unit::Memory,
             Lds | Sts => Unit::Scratch,
             Mbx | Mbc => Unit::Mailbox,
-            Pixel => Unit::PixelCounter,
+            Pixel => Unit::RayGeneration,
             Tri => Unit::TriangleTester,
             Kd => Unit::TraversalUnit,
             Byte => Unit::ChannelByte,
@@ -367,7 +378,7 @@ pub enum Unit {
     Memory,
     Scratch,
     Mailbox,
-    PixelCounter,
+    RayGeneration,
     TriangleTester,
     TraversalUnit,
     ChannelByte,
@@ -385,7 +396,7 @@ impl Unit {
         Unit::Memory,
         Unit::Scratch,
         Unit::Mailbox,
-        Unit::PixelCounter,
+        Unit::RayGeneration,
         Unit::TriangleTester,
         Unit::TraversalUnit,
         Unit::ChannelByte,
@@ -402,7 +413,7 @@ impl Unit {
             Unit::Memory => "memory",
             Unit::Scratch => "scratch",
             Unit::Mailbox => "mailbox",
-            Unit::PixelCounter => "pixel counter",
+            Unit::RayGeneration => "ray generation",
             Unit::TriangleTester => "triangle tester",
             Unit::TraversalUnit => "traversal unit",
             Unit::ChannelByte => "channel byte",
@@ -531,10 +542,17 @@ impl fmt::Display for Instr {
             Op::Mbx => write!(f, "mbx{} r{}, @{}", self.imm, self.a, self.target),
             Op::Mbc => write!(f, "mbc{}", self.imm),
             Op::Pixel => write!(f, "pixel r{}, @{}", self.dst, self.target),
-            Op::Tri => {
-                let name = TriFn::from_imm(self.imm).map_or("?", TriFn::name);
-                write!(f, "tri.{name} r{}, r{}, r{}", self.dst, self.a, self.b)
-            }
+            Op::Tri => match TriFn::from_imm(self.imm) {
+                // Their word or pair index is the shift field.
+                Some(TriFn::Camera) => {
+                    write!(f, "tri.camera{} r{}, r{}", self.shift, self.a, self.b)
+                }
+                Some(TriFn::Dir) => write!(f, "tri.dir{} r{}", self.shift, self.dst),
+                other => {
+                    let name = other.map_or("?", TriFn::name);
+                    write!(f, "tri.{name} r{}, r{}, r{}", self.dst, self.a, self.b)
+                }
+            },
             Op::Kd => {
                 let name = KdFn::from_imm(self.imm).map_or("?", KdFn::name);
                 write!(f, "kd.{name} r{}, r{}", self.a, self.b)

@@ -49,9 +49,6 @@ pub struct ProgramConfig {
     pub stack_entries: u32,
     /// The deepest object tree (the traversal unit's stack holds that many entries).
     pub object_depth: u32,
-    /// Primary rays leave out the camera's z column (`units::camera_z_column_vanishes`; the
-    /// processor keeps frame 0's camera for every frame).
-    pub planar_camera: bool,
 }
 
 impl ProgramConfig {
@@ -67,7 +64,6 @@ impl ProgramConfig {
 
     pub fn from_layout(layout: &Layout) -> Self {
         let (format, info) = (layout.format, &layout.info);
-        let camera = layout.words(crate::layout::FRAME, crate::layout::FrameMap::CAMERA);
         ProgramConfig {
             format,
             width: info.width,
@@ -85,7 +81,6 @@ impl ProgramConfig {
                 0
             },
             object_depth: info.object_depth,
-            planar_camera: crate::units::camera_z_column_vanishes(format, &camera),
         }
     }
 }

@@ -1,9 +1,11 @@
 //! Shader and ray generation: the pixel loop of the microprogram (`model::golden`'s `pixel`
 //! and `shade`, step for step).
 //!
-//! State machine per thread: take a pixel (or halt when the frame is done); the primary ray is
-//! the camera transform of (x, y, 0) (`units::primary_direction_of`, or without the z column
-//! when that is the same: `units::primary_direction_planar`); trace it. On a hit: the
+//! State machine per thread: take a pixel (or halt when the frame is done), which also asks
+//! ray generation (`hw::engine::PrimaryRays`) for its primary ray, the camera transform of
+//! (x, y, 0) through the one TransformUnit (`units::primary_direction`); wait for the ray
+//! (written into both coprocessors) and trace it; the direction comes back into registers
+//! (`tri.dir`) where the shading or the top level needs it. On a hit: the
 //! hit point, the triangle's normal (through the instance's normal matrix when there is a top
 //! level) made unit and facing the ray, the ambient term, and per light (unrolled) the Lambert
 //! term, after a shadow query when shadows are on. A mirror material within the reflection
@@ -34,9 +36,9 @@ fn light_base(light: u32) -> u32 {
 /// a scene with more loads them at each use.
 const KEPT_LIGHTS: u32 = 8;
 
-/// Frame constants every thread loads once, at its start.
+/// Frame constants every thread loads once, at its start (the camera goes to ray
+/// generation).
 pub(super) struct Constants {
-    camera: [Reg; 12],
     eye: [Reg; 3],
     ambient: Reg,
     background: [Reg; 3],
@@ -53,15 +55,19 @@ impl Gen<'_> {
         a.section("init");
         let load = |addr: usize| a.keep(self.frame_word(addr as u32));
         let s = &self.s;
-        // A planar camera's z column is never read.
-        let camera = std::array::from_fn(|k| {
-            if c.planar_camera && k % 4 == 2 {
-                Reg::ZERO
-            } else {
-                load(FrameMap::CAMERA + k)
-            }
-        });
-        // 1 / |n| of every hit's normal.
+        // Ray generation's camera: the 3x4 and the eye, a pair of words per `tri.camera`.
+        let words: Vec<Reg> = (0..15)
+            .map(|k| load(FrameMap::CAMERA + k))
+            .chain([Reg::ZERO])
+            .collect();
+        debug_assert_eq!(FrameMap::EYE, FrameMap::CAMERA + 12);
+        for (pair, w) in words.chunks(2).enumerate() {
+            a.tri_camera(pair as u8, w[0], w[1]);
+        }
+        for r in words.into_iter().filter(|r| *r != Reg::ZERO) {
+            a.free(r);
+        }
+        // 1 / |n| of a hit's normal through an instance's normal matrix.
         a.keep_constant(c.format.one());
         // Without secondary rays every query starts at the eye with t_min 0 and t_max
         // infinity: the query registers hold them for the whole frame.
@@ -84,7 +90,6 @@ impl Gen<'_> {
             a.mov(s.q_t_max, Val::K(c.format.infinity(false)));
         }
         Constants {
-            camera,
             eye,
             ambient: load(FrameMap::AMBIENT),
             background: std::array::from_fn(|k| load(FrameMap::BACKGROUND + k)),
@@ -106,7 +111,6 @@ impl Gen<'_> {
         let c = self.c;
         let f = c.format;
         let Constants {
-            camera,
             eye,
             ambient,
             background,
@@ -132,16 +136,23 @@ impl Gen<'_> {
         a.bind(next_pixel);
         a.section("raygen");
         a.next_pixel(pixel, frame_done);
-        let shift = c.pixel_shift();
-        a.op_to(Op::And, x, pixel.into(), Val::K((1 << shift) - 1));
-        a.op_to(Op::Shr, y, pixel.into(), Val::K(shift));
-        let dir = if c.planar_camera {
-            units::primary_direction_planar(a, &camera.map(Val::R), x.into(), y.into())
-        } else {
-            units::primary_direction_of(a, &camera.map(Val::R), x.into(), y.into())
-        };
-        a.assign3(ray_d, dir);
-        a.end_temps();
+        // x and y only for the frame-buffer address of a width that is not a power of two
+        // (else the pixel word is the pixel's index).
+        if !c.width.is_power_of_two() {
+            let shift = c.pixel_shift();
+            a.op_to(Op::And, x, pixel.into(), Val::K((1 << shift) - 1));
+            a.op_to(Op::Shr, y, pixel.into(), Val::K(shift));
+        }
+        // The primary ray is written into both coprocessors; its direction comes into
+        // registers before the trace where the trace routine or the top level reads it, else
+        // only for a hit's shading.
+        a.tri_wait(Reg::ZERO);
+        let direction_first = secondary || c.top_root.is_some();
+        if direction_first {
+            for k in 0..3 {
+                a.tri_dir(k as u8, ray_d[k]);
+            }
+        }
         if secondary {
             a.mov3(ray_o, eye.map(Val::R));
             a.mov(ray_t_min, Val::K(0));
@@ -169,6 +180,11 @@ impl Gen<'_> {
             a.branch(Op::BFlt, s.best_t.into(), s.q_t_max.into(), true, miss);
         } else {
             a.branch(Op::Beq, s.hit.into(), Val::K(0), false, miss);
+        }
+        if !direction_first {
+            for k in 0..3 {
+                a.tri_dir(k as u8, ray_d[k]);
+            }
         }
         // The hit outlives the next trace only in a scene with secondary rays; a scene of one
         // object hits instance 0.

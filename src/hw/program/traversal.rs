@@ -84,7 +84,11 @@ impl Gen<'_> {
                 self.traverse(Val::K(root), world, done);
             }
             None => {
-                tester_ray(a, world.o, world.d, None);
+                // Traced in line, the trace is the primary ray's, which ray generation has
+                // written into both coprocessors already.
+                if routine {
+                    tester_ray(a, world.o, world.d, None);
+                }
                 self.walk_object(Val::K(self.c.object_root), s.q_t_max, done);
             }
         }
