@@ -10,12 +10,15 @@
 //! and tie-breaks, the classification, and best split first under the node budget with the
 //! same heap keys and tie-breaks, renumbered into the depth-first order.
 //!
-//! What makes it faster (the general builder took 10.2-10.5 ms for 5,622 boxes): no clipping,
-//! merging or event structs; each node's events are two arrays (positions and tags: kind and
-//! box id in one `u32`) per axis, split into the children by one branch-free pass that writes
-//! every event to both and keeps it where its box goes; buffers come from a pool by size
-//! class; and best first pops every split itself (its frontier of lists fits the caches for a
-//! top level, so the general builder's pruned depth-first finish does not pay).
+//! What makes it faster (the general builder took 10.2-10.5 ms for 5,622 boxes; figures in
+//! the README's "kd-tree build"): no clipping, merging or event structs; each node's events
+//! are two arrays (positions and tags: kind and box id in one `u32`) per axis, split into the
+//! children by one branch-free pass that writes every event to both and keeps it where its
+//! box goes; buffers come from a pool by size class; the f64 sweep scores an axis in two
+//! passes without branches on the data ([`Builder::sweep_unflat`]); and best first pops
+//! every split itself (its frontier of lists fits the caches for a top level, so the general
+//! builder's pruned depth-first finish does not pay). One core; the sweeps (about 40%) and the
+//! list splits (about 20%) are what is left.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -511,8 +514,9 @@ impl Builder<'_> {
         // The bonus as a factor (`c * 1.0` is `c`).
         let factor = [1.0, self.params.empty_bonus];
         // The events strictly inside the box: `pos[a..b]`.
-        let a = pos.partition_point(|&p| p <= lo);
-        let b = pos.partition_point(|&p| p < hi);
+        // (Few events lie outside: straddlers of splits on this axis.)
+        let a = pos.iter().position(|&p| p > lo).unwrap_or(pos.len());
+        let b = pos.iter().rposition(|&p| p < hi).map_or(0, |i| i + 1);
         if a >= b {
             return !tag.iter().any(|&t| t >> KIND_SHIFT == PLANAR);
         }
@@ -725,8 +729,11 @@ impl Builder<'_> {
     /// Buffers for at least `len` events, from the pool when it has some.
     fn fresh(&mut self, len: usize) -> Lists {
         let class = len.max(1).next_power_of_two().trailing_zeros() as usize;
-        if let Some(lists) = self.pool.get_mut(class).and_then(Vec::pop) {
-            return lists;
+        // A buffer up to four times as large will do (fewer allocations).
+        for c in class..(class + 3).min(self.pool.len()) {
+            if let Some(lists) = self.pool[c].pop() {
+                return lists;
+            }
         }
         Lists {
             pos: vec![0.0; 1 << class],
