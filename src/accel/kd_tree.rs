@@ -191,9 +191,16 @@ pub fn build_sah(tris: &[[DVec3; 3]], params: &KdParams) -> KdTree {
     super::sah_builder::build(&Triangles(tris), params)
 }
 
-/// Builds a kd-tree over boxes (the top-level tree over instance world bounds).
+/// Builds a kd-tree over boxes (the top-level tree over instance world bounds): the tree of
+/// [`super::sah_builder`], built by [`super::box_builder`] (without a root clip, which only
+/// the general builder makes).
 pub fn build_sah_boxes(boxes: &[Aabb], params: &KdParams) -> KdTree {
-    super::sah_builder::build(&Boxes(boxes), params)
+    let root_clip = params.root_clip && params.split_format.is_some();
+    if root_clip || boxes.len() >= super::box_builder::MAX_BOXES {
+        super::sah_builder::build(&Boxes(boxes), params)
+    } else {
+        super::box_builder::build(boxes, params)
+    }
 }
 
 /// A leaf as seen by a walk from the root.

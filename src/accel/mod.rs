@@ -7,6 +7,8 @@
 //!   points [`build_sah`] / [`build_sah_boxes`];
 //! - [`sah_builder`]: Wald & Havran's O(N log N) SAH builder with perfect splits, generic over
 //!   [`primitive::KdPrimitives`];
+//! - [`box_builder`]: the same builder's tree over boxes (the top level, rebuilt every frame),
+//!   with a layout for boxes and faster;
 //! - [`kd_traversal`]: front-to-back closest-hit and any-hit traversal (the reference renderer's);
 //! - [`top_level::TopLevel`]: the per-frame tree over instances;
 //! - [`mod@bench`]: build-rate benchmark (called by `benches/accel.rs`).
@@ -18,6 +20,7 @@
 
 pub mod aabb;
 pub mod bench;
+pub mod box_builder;
 pub mod kd_traversal;
 pub mod kd_tree;
 pub mod primitive;

@@ -66,7 +66,7 @@ struct Event {
 /// The bits of `pos` mapped so that their unsigned order is `f64::total_cmp` order: negative
 /// numbers with all bits flipped (a larger magnitude sorts first), others with the sign bit set
 /// (above every negative).
-fn ordered_bits(pos: f64) -> u64 {
+pub(super) fn ordered_bits(pos: f64) -> u64 {
     let bits = pos.to_bits();
     if bits >> 63 == 1 {
         !bits
@@ -456,7 +456,7 @@ struct Candidate {
 }
 
 /// The inverse of [`ordered_bits`].
-fn from_ordered_bits(key: u64) -> f64 {
+pub(super) fn from_ordered_bits(key: u64) -> f64 {
     f64::from_bits(if key >> 63 == 1 {
         key & !(1 << 63)
     } else {
@@ -467,7 +467,7 @@ fn from_ordered_bits(key: u64) -> f64 {
 /// Renumbers a tree into the order [`Builder::build_node`] creates it in: depth first, left
 /// before right, each node's children allocated when it is split, leaves' primitives laid out
 /// in that order.
-fn depth_first_order(nodes: &[KdNode], prims: &[u32]) -> (Vec<KdNode>, Vec<u32>) {
+pub(super) fn depth_first_order(nodes: &[KdNode], prims: &[u32]) -> (Vec<KdNode>, Vec<u32>) {
     let (nodes, prims, _) = depth_first_order_kept(nodes, prims, None);
     (nodes, prims)
 }
