@@ -725,8 +725,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [4:0] scheduler__tester_done_thread;
     reg  scheduler__walk_done;
     reg  [4:0] scheduler__walk_done_thread;
-    reg  scheduler__ray_done;
-    reg  [4:0] scheduler__ray_done_thread;
+    reg  [31:0] scheduler__ray_done_mask;
     wire  scheduler__issue;
     wire  [4:0] scheduler__pick;
     reg  fetch__clock;
@@ -823,6 +822,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     wire  [23:0] rays__primary_d__0;
     wire  [23:0] rays__primary_d__1;
     wire  [23:0] rays__primary_d__2;
+    wire  [31:0] rays__done_mask;
     reg  [4:0] rays__query_thread;
     wire  rays__pending;
     wire  [23:0] rays__dir__0;
@@ -1140,8 +1140,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .tester_done_thread(scheduler__tester_done_thread),
         .walk_done(scheduler__walk_done),
         .walk_done_thread(scheduler__walk_done_thread),
-        .ray_done(scheduler__ray_done),
-        .ray_done_thread(scheduler__ray_done_thread),
+        .ray_done_mask(scheduler__ray_done_mask),
         .issue(scheduler__issue),
         .pick(scheduler__pick)
     );
@@ -1246,6 +1245,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .primary_d__0(rays__primary_d__0),
         .primary_d__1(rays__primary_d__1),
         .primary_d__2(rays__primary_d__2),
+        .done_mask(rays__done_mask),
         .query_thread(rays__query_thread),
         .pending(rays__pending),
         .dir__0(rays__dir__0),
@@ -1928,8 +1928,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         scheduler__tester_done_thread = tester__engine__done_thread;
         scheduler__walk_done = traversal_unit__engine__done;
         scheduler__walk_done_thread = traversal_unit__engine__done_thread;
-        scheduler__ray_done = rays__primary_write;
-        scheduler__ray_done_thread = rays__primary_thread;
+        scheduler__ray_done_mask = rays__done_mask;
         if (write_back__retired) begin
             instr_count__d = instr_count__q + 32'h1;
         end
@@ -11337,7 +11336,7 @@ endmodule // dynrt_processor__engine__mem_load_r
 
 
 
-module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,word_a,word_b,offer,thread,word,exhausted,refused,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_thread,gen_take,gen_out_valid,gen_out_thread,gen_out_dir__0,gen_out_dir__1,gen_out_dir__2,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2,query_thread,pending,dir__0,dir__1,dir__2);
+module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,word_a,word_b,offer,thread,word,exhausted,refused,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_thread,gen_take,gen_out_valid,gen_out_thread,gen_out_dir__0,gen_out_dir__1,gen_out_dir__2,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2,done_mask,query_thread,pending,dir__0,dir__1,dir__2);
     
     // Module arguments
     input wire  clock;
@@ -11382,6 +11381,7 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
     output reg  [23:0] primary_d__0;
     output reg  [23:0] primary_d__1;
     output reg  [23:0] primary_d__2;
+    output reg  [31:0] done_mask;
     input wire  [4:0] query_thread;
     output reg  pending;
     output reg  [23:0] dir__0;
@@ -11515,6 +11515,9 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
     reg  [23:0] result_dir__2__d;
     wire  [23:0] result_dir__2__q;
     reg  result_dir__2__clock;
+    reg  [31:0] result_mask__d;
+    wire  [31:0] result_mask__q;
+    reg  result_mask__clock;
     reg  [31:0] waiting__d;
     wire  [31:0] waiting__q;
     reg  waiting__clock;
@@ -11545,7 +11548,6 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
     
     // Local signals
     reg  taken;
-    reg  [31:0] written_mask;
     reg  [31:0] taken_mask;
     
     // Sub module instances
@@ -11709,6 +11711,11 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         .q(result_dir__2__q),
         .clock(result_dir__2__clock)
     );
+    dynrt_processor__engine__cycle_count result_mask(
+        .d(result_mask__d),
+        .q(result_mask__q),
+        .clock(result_mask__clock)
+    );
     dynrt_processor__engine__cycle_count waiting(
         .d(waiting__d),
         .q(waiting__q),
@@ -11753,12 +11760,14 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         slot_thread__clock = clock;
         result_valid__clock = clock;
         result_thread__clock = clock;
+        result_mask__clock = clock;
         waiting__clock = clock;
         pending_r__clock = clock;
         slot_valid__d = slot_valid__q;
         slot_thread__d = slot_thread__q;
         result_valid__d = result_valid__q;
         result_thread__d = result_thread__q;
+        result_mask__d = result_mask__q;
         waiting__d = waiting__q;
         pending_r__d = pending_r__q;
         camera__0__clock = clock;
@@ -11886,6 +11895,11 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         end
         result_valid__d = gen_out_valid;
         result_thread__d = gen_out_thread;
+        result_mask__d = 32'h0;
+        if (gen_out_valid) begin
+            result_mask__d = c_one << gen_out_thread;
+        end
+        done_mask = result_mask__q;
         primary_write = result_valid__q;
         primary_thread = result_thread__q;
         primary_o__0 = camera__12__q;
@@ -11909,15 +11923,11 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         dirs__2__write_enable = result_valid__q;
         dirs__2__read_address = query_thread;
         dir__2 = dirs__2__read_data;
-        written_mask = 32'h0;
-        if (result_valid__q) begin
-            written_mask = c_one << result_thread__q;
-        end
         taken_mask = 32'h0;
         if (taken) begin
             taken_mask = c_one << thread;
         end
-        waiting__d = (waiting__q & (~written_mask)) | taken_mask;
+        waiting__d = (waiting__q & (~result_mask__q)) | taken_mask;
         pending_r__d = waiting__q[query_thread];
         pending = pending_r__q;
         if (frame_start) begin
@@ -12282,6 +12292,8 @@ module dynrt_processor__engine__rays__raygen(clock,start,width,height,camera__0,
     end
     
 endmodule // dynrt_processor__engine__rays__raygen
+
+
 
 
 
@@ -15065,7 +15077,7 @@ endmodule // dynrt_processor__engine__result_line__thread_line
 
 
 
-module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,wb_valid,wb_thread,wb_halt,wb_wait_pending,tester_done,tester_done_thread,walk_done,walk_done_thread,ray_done,ray_done_thread,issue,pick);
+module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,wb_valid,wb_thread,wb_halt,wb_wait_pending,tester_done,tester_done_thread,walk_done,walk_done_thread,ray_done_mask,issue,pick);
     
     // Module arguments
     input wire  clock;
@@ -15080,8 +15092,7 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     input wire  [4:0] tester_done_thread;
     input wire  walk_done;
     input wire  [4:0] walk_done_thread;
-    input wire  ray_done;
-    input wire  [4:0] ray_done_thread;
+    input wire  [31:0] ray_done_mask;
     output reg  issue;
     output reg  [4:0] pick;
     
@@ -15139,7 +15150,6 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     reg  [31:0] wb_mask;
     reg  [31:0] tester_event;
     reg  [31:0] walk_event;
-    reg  [31:0] ray_event;
     reg  [31:0] event_mask;
     reg  wb_sleep;
     reg  [31:0] wake_mask;
@@ -15241,11 +15251,7 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         if (walk_done) begin
             walk_event = c_one << walk_done_thread;
         end
-        ray_event = 32'h0;
-        if (ray_done) begin
-            ray_event = c_one << ray_done_thread;
-        end
-        event_mask = tester_event | walk_event | ray_event;
+        event_mask = tester_event | walk_event | ray_done_mask;
         wb_sleep = wb_valid & wb_wait_pending & (((woken__q | event_mask) & wb_mask) == 32'h0);
         wake_mask = 32'h0;
         sleep_mask = 32'h0;
@@ -15885,7 +15891,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  b_here__0;
     reg  b_here__1;
     reg  [31:0] fetch_a;
-    reg  fb_free;
+    reg  ending;
+    reg  take_buffer;
+    reg  take_free;
     reg  [1:0] l_kind;
     reg  [4:0] l_thread;
     reg  [31:0] l_a;
@@ -16750,26 +16758,29 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         b_line__4__d = b_line__3__q;
         a_line__5__d = a_line__4__q;
         b_line__5__d = b_line__4__q;
-        if (fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)))) begin
+        ending = fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)));
+        if (ending) begin
             fetching__d = 1'b0;
             fb__d = ~fb__q;
         end
-        fb_free = ~loaded__0__q;
-        if (fb__q) begin
-            fb_free = ~loaded__1__q;
+        take_buffer = fb__q ^ ending;
+        take_free = ~loaded__0__q;
+        if (take_buffer) begin
+            take_free = ~loaded__1__q;
         end
-        if ((~fetching__q) & fb_free & list_unit__test_valid) begin
+        if (((~fetching__q) | ending) & take_free & list_unit__test_valid) begin
             list_unit__test_take = 1'b1;
             a_issued__d = 32'h0;
             b_issued__d = 32'h0;
             fetching__d = 1'b1;
+            fb__d = take_buffer;
             if (list_unit__test_entry[(32'h45)+:(2)] != c_test_triangle) begin
                 a_issued__d = 32'h6;
                 b_issued__d = 32'h6;
                 fetching__d = 1'b0;
-                fb__d = ~fb__q;
+                fb__d = ~take_buffer;
             end
-            if (fb__q == c_buffer__0) begin
+            if (take_buffer == c_buffer__0) begin
                 loaded__0__d = 1'b1;
                 cur_kind__0__d = list_unit__test_entry[(32'h45)+:(2)];
                 cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
@@ -16780,7 +16791,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
                     received__0__d = 32'hc;
                 end
             end
-            if (fb__q == c_buffer__1) begin
+            if (take_buffer == c_buffer__1) begin
                 loaded__1__d = 1'b1;
                 cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
                 cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];

@@ -805,8 +805,7 @@ impl<
         self.scheduler.tester_done_thread.next = self.tester.engine.done_thread.val();
         self.scheduler.walk_done.next = self.traversal_unit.engine.done.val();
         self.scheduler.walk_done_thread.next = self.traversal_unit.engine.done_thread.val();
-        self.scheduler.ray_done.next = self.rays.primary_write.val();
-        self.scheduler.ray_done_thread.next = self.rays.primary_thread.val();
+        self.scheduler.ray_done_mask.next = self.rays.done_mask.val();
         // Instructions retired: every write back but a turn spent offering again to a full
         // coprocessor queue or waiting for a coprocessor (the twin never repeats those).
         if self.write_back.retired.val() {

@@ -20,8 +20,8 @@
 //!   port) until `gen_take`; the direction comes back on `gen_out_*`.
 //! - Write (a clock after `gen_out_valid`): `primary_write` with `primary_thread`,
 //!   `primary_o` (the eye) and `primary_d` for both coprocessors' [`RayStore`]s (the engine
-//!   writes no ray words in that clock: it refuses them); the same clock is the thread's
-//!   `done` event, and its direction is kept for `dir`.
+//!   writes no ray words in that clock: it refuses them); `done_mask` (bit `thread`) in the
+//!   same clock is the thread's wake-up, and its direction is kept for `dir`.
 //! - Answers: `query_thread` at I4; at I5 `pending` (the thread's ray is not written yet) and
 //!   `dir` (its last primary direction).
 //!
@@ -69,6 +69,7 @@ pub struct PrimaryRays<const W: usize, const E: usize, const M: usize> {
     pub primary_thread: Signal<Out, Bits<5>>,
     pub primary_o: [Signal<Out, Bits<W>>; 3],
     pub primary_d: [Signal<Out, Bits<W>>; 3],
+    pub done_mask: Signal<Out, Bits<32>>,
     pub query_thread: Signal<In, Bits<5>>,
     pub pending: Signal<Out, Bit>,
     pub dir: [Signal<Out, Bits<W>>; 3],
@@ -83,9 +84,12 @@ pub struct PrimaryRays<const W: usize, const E: usize, const M: usize> {
     result_valid: DFF<Bit>,
     result_thread: DFF<Bits<5>>,
     result_dir: [DFF<Bits<W>>; 3],
+    /// The written thread as a one-hot mask, decoded before its register: the scheduler's
+    /// wake-up took the thread number's decoder, after `result_valid`'s fan-out into the ray
+    /// stores, to 88.8 MHz on the ECP5.
+    result_mask: DFF<Bits<32>>,
     /// Per thread: its ray is not written yet (bit `thread`).
     waiting: DFF<Bits<32>>,
-    written_mask: Signal<Local, Bits<32>>,
     taken_mask: Signal<Local, Bits<32>>,
     pending_r: DFF<Bit>,
     /// Per thread: its last primary direction (`tri.dir`).
@@ -124,6 +128,7 @@ impl<const W: usize, const E: usize, const M: usize> PrimaryRays<W, E, M> {
             primary_thread: Default::default(),
             primary_o: Default::default(),
             primary_d: Default::default(),
+            done_mask: Default::default(),
             query_thread: Default::default(),
             pending: Default::default(),
             dir: Default::default(),
@@ -135,8 +140,8 @@ impl<const W: usize, const E: usize, const M: usize> PrimaryRays<W, E, M> {
             result_valid: Default::default(),
             result_thread: Default::default(),
             result_dir: Default::default(),
+            result_mask: Default::default(),
             waiting: Default::default(),
-            written_mask: Default::default(),
             taken_mask: Default::default(),
             pending_r: Default::default(),
             dirs: Default::default(),
@@ -159,6 +164,7 @@ impl<const W: usize, const E: usize, const M: usize> Logic for PrimaryRays<W, E,
             slot_thread,
             result_valid,
             result_thread,
+            result_mask,
             waiting,
             pending_r
         );
@@ -218,6 +224,11 @@ impl<const W: usize, const E: usize, const M: usize> Logic for PrimaryRays<W, E,
         // The direction, written with the eye as origin.
         self.result_valid.d.next = self.gen_out_valid.val();
         self.result_thread.d.next = self.gen_out_thread.val();
+        self.result_mask.d.next = 0.into();
+        if self.gen_out_valid.val() {
+            self.result_mask.d.next = self.c_one.val() << self.gen_out_thread.val();
+        }
+        self.done_mask.next = self.result_mask.q.val();
         self.primary_write.next = self.result_valid.q.val();
         self.primary_thread.next = self.result_thread.q.val();
         for k in 0..3 {
@@ -229,16 +240,12 @@ impl<const W: usize, const E: usize, const M: usize> Logic for PrimaryRays<W, E,
             self.dirs[k].read_address.next = self.query_thread.val();
             self.dir[k].next = self.dirs[k].read_data.val();
         }
-        self.written_mask.next = 0.into();
-        if self.result_valid.q.val() {
-            self.written_mask.next = self.c_one.val() << self.result_thread.q.val();
-        }
         self.taken_mask.next = 0.into();
         if self.taken.val() {
             self.taken_mask.next = self.c_one.val() << self.thread.val();
         }
         self.waiting.d.next =
-            (self.waiting.q.val() & (!self.written_mask.val())) | self.taken_mask.val();
+            (self.waiting.q.val() & (!self.result_mask.q.val())) | self.taken_mask.val();
         self.pending_r.d.next = self
             .waiting
             .q
@@ -360,6 +367,9 @@ mod tests {
                 let t = u.gen_thread.val().to_u64() as u32;
                 (t, units::transform(f, &req_m, req_v, true))
             }));
+            if !u.primary_write.val() {
+                assert_eq!(u.done_mask.val().to_u64(), 0, "a wake-up without a ray");
+            }
             if u.primary_write.val() {
                 let t = u.primary_thread.val().to_u64() as usize;
                 let (x, y) = given[t]
@@ -377,6 +387,11 @@ mod tests {
                     .collect();
                 assert_eq!(o, eye, "origin of pixel ({x}, {y})");
                 assert_eq!(d, units::primary_direction(f, &m, x, y), "pixel ({x}, {y})");
+                assert_eq!(
+                    u.done_mask.val().to_u64(),
+                    1 << t,
+                    "the wake-up of thread {t}"
+                );
                 last_dir[t] = d.try_into().unwrap();
                 written += 1;
             }
