@@ -15891,9 +15891,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  b_here__0;
     reg  b_here__1;
     reg  [31:0] fetch_a;
-    reg  ending;
-    reg  take_buffer;
-    reg  take_free;
+    reg  fb_free;
     reg  [1:0] l_kind;
     reg  [4:0] l_thread;
     reg  [31:0] l_a;
@@ -16758,29 +16756,26 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         b_line__4__d = b_line__3__q;
         a_line__5__d = a_line__4__q;
         b_line__5__d = b_line__4__q;
-        ending = fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)));
-        if (ending) begin
+        if (fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)))) begin
             fetching__d = 1'b0;
             fb__d = ~fb__q;
         end
-        take_buffer = fb__q ^ ending;
-        take_free = ~loaded__0__q;
-        if (take_buffer) begin
-            take_free = ~loaded__1__q;
+        fb_free = ~loaded__0__q;
+        if (fb__q) begin
+            fb_free = ~loaded__1__q;
         end
-        if (((~fetching__q) | ending) & take_free & list_unit__test_valid) begin
+        if ((~fetching__q) & fb_free & list_unit__test_valid) begin
             list_unit__test_take = 1'b1;
             a_issued__d = 32'h0;
             b_issued__d = 32'h0;
             fetching__d = 1'b1;
-            fb__d = take_buffer;
             if (list_unit__test_entry[(32'h45)+:(2)] != c_test_triangle) begin
                 a_issued__d = 32'h6;
                 b_issued__d = 32'h6;
                 fetching__d = 1'b0;
-                fb__d = ~take_buffer;
+                fb__d = ~fb__q;
             end
-            if (take_buffer == c_buffer__0) begin
+            if (fb__q == c_buffer__0) begin
                 loaded__0__d = 1'b1;
                 cur_kind__0__d = list_unit__test_entry[(32'h45)+:(2)];
                 cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
@@ -16791,7 +16786,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
                     received__0__d = 32'hc;
                 end
             end
-            if (take_buffer == c_buffer__1) begin
+            if (fb__q == c_buffer__1) begin
                 loaded__1__d = 1'b1;
                 cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
                 cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];

@@ -30,14 +30,13 @@
 //! (the first of equal ts stays), as in the golden model.
 //!
 //! Fetch and launch, two state machines around two entry buffers: the fetch takes an entry
-//! from the list unit's test queue into a free buffer (in the clock of the last requests
-//! before) and requests the triangle's 6 words of bank 2 and 6 of bank 3 (6 clocks when the
-//! engine leaves the banks alone; an init or a list end fetches nothing), then goes on with
-//! the next entry in the other buffer. The
+//! from the list unit's test queue into a free buffer (1 clock) and requests the triangle's 6
+//! words of bank 2 and 6 of bank 3 (6 clocks when the engine leaves the banks alone; an init
+//! or a list end fetches nothing), then goes on with the next entry in the other buffer. The
 //! launch waits for its buffer's words (the SRAM latency after their requests), launches the
 //! origin and then the direction into the TransformUnit (2 clocks), frees the buffer and
 //! waits a clock for the next entry's ray words. Throughput: one test per [`CLOCKS_PER_TEST`]
-//! (6) clocks, one init or list end per [`LAUNCH_SPACING`] (4); entries leave the launch at
+//! (7) clocks, one init or list end per [`LAUNCH_SPACING`] (4); entries leave the launch at
 //! least 4 clocks apart, which the hit merge needs (it reads, compares and writes a thread's
 //! best hit in 4 clocks). The engine's own loads of banks 2 and 3 (shading data) take the
 //! bank in their clock; the fetch waits for it.
@@ -84,10 +83,9 @@ pub fn flight_slots_suffice(fmt: Format) -> bool {
 }
 
 /// Clocks between two tests when the engine leaves banks 2 and 3 alone (the tester's
-/// throughput bound): the 6 words of each bank, the next entry taken in the clock of the last
-/// requests (the layout splits a triangle's transform 6 + 6 for this; 8 + 4 took 9 clocks,
-/// and a take of its own 7).
-pub const CLOCKS_PER_TEST: u32 = 6;
+/// throughput bound): the take and the 6 words of each bank (the layout splits a triangle's
+/// transform 6 + 6 for this; 8 + 4 took 9 clocks).
+pub const CLOCKS_PER_TEST: u32 = 7;
 // `update` spells out its numbers (rust-hdl's Verilog cannot name Rust constants): a
 // triangle is 6 words of bank 2 (words 0-5 of its transform) and 6 of bank 3 (words 6-11,
 // `layout::TRANSFORM_BANK_WORDS`), buffer 1's words follow buffer 0's 12.
@@ -195,11 +193,7 @@ pub struct TriangleTester<
     seq: DFF<Bits<5>>,
     words: [DFF<Bits<W>>; 24],
     fetch_a: Signal<Local, Bits<32>>,
-    /// The fetch requests its entry's last words this clock; the buffer the next entry
-    /// goes to, and whether it is free.
-    ending: Signal<Local, Bit>,
-    take_buffer: Signal<Local, Bit>,
-    take_free: Signal<Local, Bit>,
+    fb_free: Signal<Local, Bit>,
     l_kind: Signal<Local, Bits<2>>,
     l_thread: Signal<Local, Bits<5>>,
     l_a: Signal<Local, Bits<32>>,
@@ -363,9 +357,7 @@ impl<
             a_here: Default::default(),
             b_here: Default::default(),
             fetch_a: Default::default(),
-            ending: Default::default(),
-            take_buffer: Default::default(),
-            take_free: Default::default(),
+            fb_free: Default::default(),
             l_kind: Default::default(),
             l_thread: Default::default(),
             l_a: Default::default(),
@@ -606,40 +598,32 @@ impl<
             self.a_line[k].d.next = self.a_line[k - 1].q.val();
             self.b_line[k].d.next = self.b_line[k - 1].q.val();
         }
-        // The fetch is done with the buffer once its last words are requested; the next entry
-        // is taken in that clock already, into the other buffer (`take_buffer`), so a test
-        // costs its 6 requests and no clock more.
-        self.ending.next = self.fetching.q.val()
+        // The fetch is done with the buffer once its last words are requested.
+        if self.fetching.q.val()
             & ((self.a_issued.q.val() == 6) | (self.a_take.val() & (self.a_issued.q.val() == 5)))
-            & ((self.b_issued.q.val() == 6) | (self.b_take.val() & (self.b_issued.q.val() == 5)));
-        if self.ending.val() {
+            & ((self.b_issued.q.val() == 6) | (self.b_take.val() & (self.b_issued.q.val() == 5)))
+        {
             self.fetching.d.next = false;
             self.fb.d.next = !self.fb.q.val();
         }
-        self.take_buffer.next = self.fb.q.val() ^ self.ending.val();
-        self.take_free.next = !self.loaded[0].q.val();
-        if self.take_buffer.val() {
-            self.take_free.next = !self.loaded[1].q.val();
+        self.fb_free.next = !self.loaded[0].q.val();
+        if self.fb.q.val() {
+            self.fb_free.next = !self.loaded[1].q.val();
         }
-        if ((!self.fetching.q.val()) | self.ending.val())
-            & self.take_free.val()
-            & self.list_unit.test_valid.val()
-        {
+        if (!self.fetching.q.val()) & self.fb_free.val() & self.list_unit.test_valid.val() {
             self.list_unit.test_take.next = true;
             self.a_issued.d.next = 0.into();
             self.b_issued.d.next = 0.into();
             self.fetching.d.next = true;
-            self.fb.d.next = self.take_buffer.val();
             if self.list_unit.test_entry.val().get_bits::<2>(69) != self.c_test_triangle.val() {
-                // An init or a list end fetches nothing: the next entry goes to the other
-                // buffer.
+                // An init or a list end fetches nothing.
                 self.a_issued.d.next = 6.into();
                 self.b_issued.d.next = 6.into();
                 self.fetching.d.next = false;
-                self.fb.d.next = !self.take_buffer.val();
+                self.fb.d.next = !self.fb.q.val();
             }
             for k in 0..2 {
-                if self.take_buffer.val() == self.c_buffer[k].val() {
+                if self.fb.q.val() == self.c_buffer[k].val() {
                     self.loaded[k].d.next = true;
                     self.cur_kind[k].d.next = self.list_unit.test_entry.val().get_bits::<2>(69);
                     self.cur_thread[k].d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
