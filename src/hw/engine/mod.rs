@@ -22,9 +22,10 @@
 //!   and splits the fields; at I3 a long instruction reserves its write back; at I4 the
 //!   [`MailboxUnit`] reads the thread's mailbox and the coprocessors their state of the
 //!   thread.
-//! - I5 ([`OPERAND_STAGE`]): [`Execute`] computes the integer result and the addresses, the
-//!   [`PrimaryRays`] hands out a pixel (and requests its primary ray), the mailbox registers the entries it read (it compares
-//!   at I6, hits and updates at I7), [`FpUnits`] take their operands; this block drives the
+//! - I5 ([`OPERAND_STAGE`]): [`Execute`] computes the integer result and the addresses,
+//!   [`PrimaryRays`] hands out a pixel (and requests its primary ray), the mailbox registers
+//!   the entries it read (it compares at I6, hits and updates at I7), [`FpUnits`] take their
+//!   operands; this block drives the
 //!   memory and frame-buffer ports and offers `tri` and `kd` entries to the coprocessors (their
 //!   answer, refused or pending, makes the thread repeat the instruction on its next turn, after
 //!   a sleep for a wait).
@@ -43,8 +44,9 @@
 //!
 //! Throughput: one instruction per clock while at least 16 threads are awake; a frame
 //! ends when every thread has executed `halt` (`done`). Counters: clocks of the frame,
-//! instructions retired, and clocks in which the triangle tester's TransformUnit and
-//! IntersectUnit took an input.
+//! instructions retired, clocks in which the triangle tester's TransformUnit and
+//! IntersectUnit took a test's input, and clocks in which ray generation took the
+//! TransformUnit.
 //! `instructions` counts retired instructions: not the turns a thread spends offering an entry
 //! again to a full coprocessor queue or waiting for a coprocessor, so it equals the count of
 //! the engine's twin, which never waits.
@@ -53,7 +55,9 @@
 //! tree (a thread starts the walk and sleeps until it ends, instead of 15-23 turns per inner
 //! node in microcode); it hands each leaf's list to the [`TriangleTester`], whose list unit
 //! reads it and queues its triangles, and which answers the traversal unit with the closest
-//! hit. A walk costs the thread four turns, whatever its leaves.
+//! hit. A walk costs the thread four turns, whatever its leaves. [`PrimaryRays`] sends each
+//! pixel's primary ray through the tester's TransformUnit, in the clocks the tests leave it
+//! free, and writes the ray into both coprocessors (a `pixel`, then a `tri.wait`).
 //!
 //! Memory: one read per clock on the `mem_*` port (banks 0, 1, 4, 5; the tester's list reads
 //! of bank 1 use it in the clocks the engine leaves free) and on each of the
