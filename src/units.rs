@@ -67,8 +67,6 @@ pub trait Arith: Copy {
     fn neg(self, a: Self::V) -> Self::V;
     /// A constant format word.
     fn word(self, w: u32) -> Self::V;
-    /// An unsigned integer converted to the format (exact for the pixel coordinates).
-    fn from_uint(self, i: Self::V) -> Self::V;
     fn format(self) -> Format;
 }
 
@@ -94,9 +92,6 @@ impl Arith for Format {
     }
     fn word(self, w: u32) -> u32 {
         w
-    }
-    fn from_uint(self, i: u32) -> u32 {
-        self.from_int(i64::from(i))
     }
     fn format(self) -> Format {
         self
@@ -141,11 +136,12 @@ pub fn transform3<A: Arith>(a: A, m: &[A::V; 9], v: [A::V; 3]) -> [A::V; 3] {
 /// applied to the point (x, y, 0) (the layout bakes the pixel-centre offsets into the matrix's
 /// offset column): the golden twin of [`hw::RayGen`](crate::hw::RayGen) and
 /// [`hw::RayGenUnit`](crate::hw::RayGenUnit) (src/hw/raygen.rs), which count the coordinates'
-/// floats (equal to `from_uint` here), and of the processor's
+/// floats (equal to `from_int` here), and of the processor's
 /// [`hw::engine::PrimaryRays`](crate::hw::engine::PrimaryRays), which sends the request
 /// through the triangle tester's TransformUnit.
 pub fn primary_direction(f: Format, camera: &Mat34W, x: u32, y: u32) -> Vec3W {
-    transform(f, camera, [f.from_uint(x), f.from_uint(y), 0], true)
+    let coordinate = |i: u32| f.from_int(i64::from(i));
+    transform(f, camera, [coordinate(x), coordinate(y), 0], true)
 }
 
 /// The result of one unit-triangle test.

@@ -4,7 +4,6 @@
 // Format e7m16, 64x48 pixels, 32 threads, SRAM read latency 2 clocks, 142 instructions of microprogram.
 // Left out: top-level traversal, instance mailbox and instance transforms (one untransformed object).
 // Left out: mirror rays and the mirror chain (reflection_depth = 0).
-// Left out: int to float unit (no instruction uses it).
 // Left out: scratch unit (no instruction uses it).
 // Left out: mailbox unit (no instruction uses it).
 // Display: 640x480 at 25.18 MHz pixel clock (vga_clock), frame buffer shown from word 46.
@@ -672,14 +671,14 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam  op_fsub = 5'b10;
     localparam  op_fdiv = 5'b100;
     localparam  op_fsqrt = 5'b101;
-    localparam  op_ld = 5'b1110;
-    localparam  op_st = 5'b1111;
-    localparam  op_sts = 5'b10001;
-    localparam  op_mbx = 5'b11001;
-    localparam  op_mbc = 5'b11010;
-    localparam  op_pixel = 5'b11011;
-    localparam  op_tri = 5'b11101;
-    localparam  op_kd = 5'b11110;
+    localparam  op_ld = 5'b1101;
+    localparam  op_st = 5'b1110;
+    localparam  op_sts = 5'b10000;
+    localparam  op_mbx = 5'b11000;
+    localparam  op_mbc = 5'b11001;
+    localparam  op_pixel = 5'b11010;
+    localparam  op_tri = 5'b11100;
+    localparam  op_kd = 5'b11101;
     localparam  tri_ray_words = 32'h3;
     localparam  tri_init = 32'h3;
     localparam  tri_list = 32'h4;
@@ -699,12 +698,11 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     
     // Enums
     localparam FastKind__Computed = 0;
-    localparam FastKind__Converted = 1;
-    localparam FastKind__Scratch = 2;
-    localparam FastKind__Memory = 3;
-    localparam FastKind__TrianglesA = 4;
-    localparam FastKind__TrianglesB = 5;
-    localparam FastKind__Nodes = 6;
+    localparam FastKind__Scratch = 1;
+    localparam FastKind__Memory = 2;
+    localparam FastKind__TrianglesA = 3;
+    localparam FastKind__TrianglesB = 4;
+    localparam FastKind__Nodes = 5;
     localparam ResultSource__Fast = 0;
     localparam ResultSource__Sum = 1;
     localparam ResultSource__Product = 2;
@@ -828,7 +826,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     wire  [23:0] rays__dir__0;
     wire  [23:0] rays__dir__1;
     wire  [23:0] rays__dir__2;
-    reg  execute__clock;
     reg  [4:0] execute__op;
     reg  [31:0] execute__a;
     reg  [31:0] execute__b;
@@ -845,7 +842,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [23:0] execute__primary_dir__1;
     reg  [23:0] execute__primary_dir__2;
     wire  [31:0] execute__fast;
-    wire  [31:0] execute__converted;
     wire  [2:0] execute__kind;
     wire  execute__int_eq;
     wire  execute__int_lt;
@@ -882,7 +878,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  result_line__pix_busy;
     reg  [31:0] result_line__fast;
     reg  [2:0] result_line__kind;
-    reg  [31:0] result_line__converted;
     reg  [31:0] result_line__scratch_data;
     reg  [31:0] result_line__mem_data;
     reg  [31:0] result_line__nodes_data;
@@ -1253,7 +1248,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .dir__2(rays__dir__2)
     );
     dynrt_processor__engine__execute execute(
-        .clock(execute__clock),
         .op(execute__op),
         .a(execute__a),
         .b(execute__b),
@@ -1270,7 +1264,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .primary_dir__1(execute__primary_dir__1),
         .primary_dir__2(execute__primary_dir__2),
         .fast(execute__fast),
-        .converted(execute__converted),
         .kind(execute__kind),
         .int_eq(execute__int_eq),
         .int_lt(execute__int_lt),
@@ -1311,7 +1304,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .pix_busy(result_line__pix_busy),
         .fast(result_line__fast),
         .kind(result_line__kind),
-        .converted(result_line__converted),
         .scratch_data(result_line__scratch_data),
         .mem_data(result_line__mem_data),
         .nodes_data(result_line__nodes_data),
@@ -1670,7 +1662,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         decode__clock = clock;
         mailboxes__clock = clock;
         rays__clock = clock;
-        execute__clock = clock;
         fp_units__clock = clock;
         result_line__clock = clock;
         write_back__clock = clock;
@@ -1898,7 +1889,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         result_line__pix_busy = rays__refused;
         result_line__fast = execute__fast;
         result_line__kind = execute__kind;
-        result_line__converted = execute__converted;
         result_line__scratch_data = scratch__read_data;
         result_line__mem_data = mem_rdata;
         result_line__nodes_data = bank0_rdata;
@@ -2379,10 +2369,9 @@ endmodule // dynrt_processor__engine__decode__t4
 
 
 
-module dynrt_processor__engine__execute(clock,op,a,b,imm,shift,bank,pc,pixel,tester_best_t,tester_hit,tester_instance,tester_triangle,primary_dir__0,primary_dir__1,primary_dir__2,fast,converted,kind,int_eq,int_lt,mem_address,scratch_address);
+module dynrt_processor__engine__execute(op,a,b,imm,shift,bank,pc,pixel,tester_best_t,tester_hit,tester_instance,tester_triangle,primary_dir__0,primary_dir__1,primary_dir__2,fast,kind,int_eq,int_lt,mem_address,scratch_address);
     
     // Module arguments
-    input wire  clock;
     input wire  [4:0] op;
     input wire  [31:0] a;
     input wire  [31:0] b;
@@ -2399,7 +2388,6 @@ module dynrt_processor__engine__execute(clock,op,a,b,imm,shift,bank,pc,pixel,tes
     input wire  [23:0] primary_dir__1;
     input wire  [23:0] primary_dir__2;
     output reg  [31:0] fast;
-    output reg  [31:0] converted;
     output reg  [2:0] kind;
     output reg  int_eq;
     output reg  int_lt;
@@ -2407,20 +2395,19 @@ module dynrt_processor__engine__execute(clock,op,a,b,imm,shift,bank,pc,pixel,tes
     output reg  [31:0] scratch_address;
     
     // Constant declarations
-    localparam  op_itof = 5'b110;
-    localparam  op_add = 5'b111;
-    localparam  op_sub = 5'b1000;
-    localparam  op_and = 5'b1001;
-    localparam  op_or = 5'b1010;
-    localparam  op_xor = 5'b1011;
-    localparam  op_shr = 5'b1100;
-    localparam  op_shl = 5'b1101;
-    localparam  op_ld = 5'b1110;
-    localparam  op_lds = 5'b10000;
-    localparam  op_jal = 5'b10111;
-    localparam  op_byte = 5'b11111;
-    localparam  op_pixel = 5'b11011;
-    localparam  op_tri = 5'b11101;
+    localparam  op_add = 5'b110;
+    localparam  op_sub = 5'b111;
+    localparam  op_and = 5'b1000;
+    localparam  op_or = 5'b1001;
+    localparam  op_xor = 5'b1010;
+    localparam  op_shr = 5'b1011;
+    localparam  op_shl = 5'b1100;
+    localparam  op_ld = 5'b1101;
+    localparam  op_lds = 5'b1111;
+    localparam  op_jal = 5'b10110;
+    localparam  op_byte = 5'b11110;
+    localparam  op_pixel = 5'b11010;
+    localparam  op_tri = 5'b11100;
     localparam  tri_wait = 32'h5;
     localparam  tri_hit = 32'h6;
     localparam  tri_instance = 32'h7;
@@ -2435,52 +2422,25 @@ module dynrt_processor__engine__execute(clock,op,a,b,imm,shift,bank,pc,pixel,tes
     
     // Enums
     localparam FastKind__Computed = 0;
-    localparam FastKind__Converted = 1;
-    localparam FastKind__Scratch = 2;
-    localparam FastKind__Memory = 3;
-    localparam FastKind__TrianglesA = 4;
-    localparam FastKind__TrianglesB = 5;
-    localparam FastKind__Nodes = 6;
-    
-    // Stub signals
-    reg  [15:0] itof__value;
-    wire  [23:0] itof__word;
-    reg  [31:0] itof_r__d;
-    wire  [31:0] itof_r__q;
-    reg  itof_r__clock;
+    localparam FastKind__Scratch = 1;
+    localparam FastKind__Memory = 2;
+    localparam FastKind__TrianglesA = 3;
+    localparam FastKind__TrianglesB = 4;
+    localparam FastKind__Nodes = 5;
     
     // Local signals
     reg  [31:0] result;
     reg  [2:0] source;
     reg  [23:0] dir_word;
     
-    // Sub module instances
-    dynrt_processor__engine__execute__itof itof(
-        .value(itof__value),
-        .word(itof__word)
-    );
-    dynrt_processor__engine__cycle_count itof_r(
-        .d(itof_r__d),
-        .q(itof_r__q),
-        .clock(itof_r__clock)
-    );
-    
     // Update code
     always @(*) begin
-        itof_r__clock = clock;
-        itof_r__d = itof_r__q;
-        itof__value = a[(32'h0)+:(16)];
-        itof_r__d = ((itof__word) & 32'hffffffff);
-        converted = itof_r__q;
         int_eq = a == b;
         int_lt = a < b;
         mem_address = (a << shift) + imm;
         scratch_address = a + imm;
         source = FastKind__Computed;
         result = 32'h0;
-        if (op == op_itof) begin
-            source = FastKind__Converted;
-        end
         if (op == op_add) begin
             result = a + b;
         end
@@ -2558,83 +2518,6 @@ module dynrt_processor__engine__execute(clock,op,a,b,imm,shift,bank,pc,pixel,tes
     end
     
 endmodule // dynrt_processor__engine__execute
-
-
-module dynrt_processor__engine__execute__itof(value,word);
-    
-    // Module arguments
-    input wire  [15:0] value;
-    output reg  [23:0] word;
-    
-    // Constant declarations
-    localparam  c_shift__0 = 8'h8;
-    localparam  c_shift__1 = 8'h4;
-    localparam  c_shift__2 = 8'h2;
-    localparam  c_shift__3 = 8'h1;
-    localparam  c_shift_e__0 = 7'b1000;
-    localparam  c_shift_e__1 = 7'b100;
-    localparam  c_shift_e__2 = 7'b10;
-    localparam  c_shift_e__3 = 7'b1;
-    localparam  c_top_mask__0 = 16'hff00;
-    localparam  c_top_mask__1 = 16'hf000;
-    localparam  c_top_mask__2 = 16'hc000;
-    localparam  c_top_mask__3 = 16'h8000;
-    localparam  c_exp_top = 7'b1001110;
-    localparam  c_man_bits = 8'h10;
-    localparam  c_fraction_pos = 8'h10;
-    localparam  c_fraction_shift = 8'h11;
-    
-    // Local signals
-    reg  [15:0] norm__0;
-    reg  [15:0] norm__1;
-    reg  [15:0] norm__2;
-    reg  [15:0] norm__3;
-    reg  [15:0] norm__4;
-    reg  [6:0] exp__0;
-    reg  [6:0] exp__1;
-    reg  [6:0] exp__2;
-    reg  [6:0] exp__3;
-    reg  [6:0] exp__4;
-    reg  [31:0] fraction;
-    
-    // Update code
-    always @(*) begin
-        norm__0 = value;
-        exp__0 = c_exp_top;
-        norm__1 = norm__0;
-        exp__1 = exp__0;
-        if ((norm__0 & c_top_mask__0) == 32'h0) begin
-            norm__1 = norm__0 << c_shift__0;
-            exp__1 = exp__0 - c_shift_e__0;
-        end
-        norm__2 = norm__1;
-        exp__2 = exp__1;
-        if ((norm__1 & c_top_mask__1) == 32'h0) begin
-            norm__2 = norm__1 << c_shift__1;
-            exp__2 = exp__1 - c_shift_e__1;
-        end
-        norm__3 = norm__2;
-        exp__3 = exp__2;
-        if ((norm__2 & c_top_mask__2) == 32'h0) begin
-            norm__3 = norm__2 << c_shift__2;
-            exp__3 = exp__2 - c_shift_e__2;
-        end
-        norm__4 = norm__3;
-        exp__4 = exp__3;
-        if ((norm__3 & c_top_mask__3) == 32'h0) begin
-            norm__4 = norm__3 << c_shift__3;
-            exp__4 = exp__3 - c_shift_e__3;
-        end
-        fraction = ((norm__4) & 32'hffffffff) << c_fraction_shift;
-        word = (((exp__4) & 24'hffffff) << c_man_bits) | ((fraction[(c_fraction_pos)+:(16)]) & 24'hffffff);
-        if (value == 32'h0) begin
-            word = 32'h0;
-        end
-    end
-    
-endmodule // dynrt_processor__engine__execute__itof
-
-
 
 
 
@@ -2941,97 +2824,97 @@ module dynrt_processor__engine__fetch__rom(clock,address,ctl,imm,aux);
     reg[31:0] aux_words[255:0];
     
     initial begin
-       ctl_words[0] = 32'h38480000; imm_words[0] = 32'h00000000; aux_words[0] = 32'h000c5000;
-       ctl_words[1] = 32'h384c0000; imm_words[1] = 32'h00000001; aux_words[1] = 32'h000c5000;
-       ctl_words[2] = 32'h38500000; imm_words[2] = 32'h00000002; aux_words[2] = 32'h000c5000;
-       ctl_words[3] = 32'h38540000; imm_words[3] = 32'h00000003; aux_words[3] = 32'h000c5000;
-       ctl_words[4] = 32'h38580000; imm_words[4] = 32'h00000004; aux_words[4] = 32'h000c5000;
-       ctl_words[5] = 32'h385c0000; imm_words[5] = 32'h00000005; aux_words[5] = 32'h000c5000;
-       ctl_words[6] = 32'h38600000; imm_words[6] = 32'h00000006; aux_words[6] = 32'h000c5000;
-       ctl_words[7] = 32'h38640000; imm_words[7] = 32'h00000007; aux_words[7] = 32'h000c5000;
-       ctl_words[8] = 32'h38680000; imm_words[8] = 32'h00000008; aux_words[8] = 32'h000c5000;
-       ctl_words[9] = 32'h386c0000; imm_words[9] = 32'h00000009; aux_words[9] = 32'h000c5000;
-       ctl_words[10] = 32'h38700000; imm_words[10] = 32'h0000000a; aux_words[10] = 32'h000c5000;
-       ctl_words[11] = 32'h38740000; imm_words[11] = 32'h0000000b; aux_words[11] = 32'h000c5000;
-       ctl_words[12] = 32'h38780000; imm_words[12] = 32'h0000000c; aux_words[12] = 32'h000c5000;
-       ctl_words[13] = 32'h387c0000; imm_words[13] = 32'h0000000d; aux_words[13] = 32'h000c5000;
-       ctl_words[14] = 32'h38800000; imm_words[14] = 32'h0000000e; aux_words[14] = 32'h000c5000;
-       ctl_words[15] = 32'h7400484c; imm_words[15] = 32'h0000000b; aux_words[15] = 32'h00000000;
-       ctl_words[16] = 32'h74005054; imm_words[16] = 32'h0000000b; aux_words[16] = 32'h00008000;
-       ctl_words[17] = 32'h7400585c; imm_words[17] = 32'h0000000b; aux_words[17] = 32'h00010000;
-       ctl_words[18] = 32'h74006064; imm_words[18] = 32'h0000000b; aux_words[18] = 32'h00018000;
-       ctl_words[19] = 32'h7400686c; imm_words[19] = 32'h0000000b; aux_words[19] = 32'h00020000;
-       ctl_words[20] = 32'h74007074; imm_words[20] = 32'h0000000b; aux_words[20] = 32'h00028000;
-       ctl_words[21] = 32'h7400787c; imm_words[21] = 32'h0000000b; aux_words[21] = 32'h00030000;
-       ctl_words[22] = 32'h74008000; imm_words[22] = 32'h0000000b; aux_words[22] = 32'h000b8000;
-       ctl_words[23] = 32'h28800002; imm_words[23] = 32'h003f0000; aux_words[23] = 32'h00040000;
-       ctl_words[24] = 32'h387c0000; imm_words[24] = 32'h0000000c; aux_words[24] = 32'h000c5000;
-       ctl_words[25] = 32'h38780000; imm_words[25] = 32'h0000000d; aux_words[25] = 32'h000c5000;
-       ctl_words[26] = 32'h38740000; imm_words[26] = 32'h0000000e; aux_words[26] = 32'h000c5000;
-       ctl_words[27] = 32'h38700000; imm_words[27] = 32'h0000000f; aux_words[27] = 32'h000c5000;
-       ctl_words[28] = 32'h386c0000; imm_words[28] = 32'h00000010; aux_words[28] = 32'h000c5000;
-       ctl_words[29] = 32'h38680000; imm_words[29] = 32'h00000011; aux_words[29] = 32'h000c5000;
-       ctl_words[30] = 32'h38640000; imm_words[30] = 32'h00000012; aux_words[30] = 32'h000c5000;
-       ctl_words[31] = 32'h38600000; imm_words[31] = 32'h00000013; aux_words[31] = 32'h000c5000;
-       ctl_words[32] = 32'h385c0000; imm_words[32] = 32'h00000018; aux_words[32] = 32'h000c5000;
-       ctl_words[33] = 32'h38580000; imm_words[33] = 32'h00000019; aux_words[33] = 32'h000c5000;
-       ctl_words[34] = 32'h38540000; imm_words[34] = 32'h0000001a; aux_words[34] = 32'h000c5000;
-       ctl_words[35] = 32'h38500000; imm_words[35] = 32'h0000001b; aux_words[35] = 32'h000c5000;
-       ctl_words[36] = 32'h384c0000; imm_words[36] = 32'h0000001c; aux_words[36] = 32'h000c5000;
-       ctl_words[37] = 32'h38480001; imm_words[37] = 32'h0000001d; aux_words[37] = 32'h000c5034;
-       ctl_words[38] = 32'h5c000000; imm_words[38] = 32'h00000000; aux_words[38] = 32'h000c0034;
-       ctl_words[39] = 32'h74001c20; imm_words[39] = 32'h00000003; aux_words[39] = 32'h00000000;
-       ctl_words[40] = 32'h7400282c; imm_words[40] = 32'h0000000a; aux_words[40] = 32'h00000000;
-       ctl_words[41] = 32'h74000408; imm_words[41] = 32'h00000000; aux_words[41] = 32'h00000000;
-       ctl_words[42] = 32'h74000c10; imm_words[42] = 32'h00000001; aux_words[42] = 32'h00000000;
-       ctl_words[43] = 32'h74001418; imm_words[43] = 32'h00000002; aux_words[43] = 32'h00000000;
-       ctl_words[44] = 32'h78002420; imm_words[44] = 32'h00000000; aux_words[44] = 32'h00000000;
-       ctl_words[45] = 32'h78000000; imm_words[45] = 32'h00000001; aux_words[45] = 32'h000c0000;
-       ctl_words[46] = 32'h74340000; imm_words[46] = 32'h00000005; aux_words[46] = 32'h000c0000;
-       ctl_words[47] = 32'h74300000; imm_words[47] = 32'h00000006; aux_words[47] = 32'h000c0000;
-       ctl_words[48] = 32'h54003002; imm_words[48] = 32'h00000000; aux_words[48] = 32'h00000032;
-       ctl_words[49] = 32'h54002403; imm_words[49] = 32'h00000000; aux_words[49] = 32'h00000032;
-       ctl_words[50] = 32'h743c0000; imm_words[50] = 32'h00000008; aux_words[50] = 32'h000c0000;
-       ctl_words[51] = 32'h60004000; imm_words[51] = 32'h00000000; aux_words[51] = 32'h00080000;
-       ctl_words[52] = 32'h6c840000; imm_words[52] = 32'h00000000; aux_words[52] = 32'h000c008d;
-       ctl_words[53] = 32'h74000000; imm_words[53] = 32'h00000005; aux_words[53] = 32'h000c0000;
-       ctl_words[54] = 32'h74100000; imm_words[54] = 32'h0000000c; aux_words[54] = 32'h000c0000;
-       ctl_words[55] = 32'h74140000; imm_words[55] = 32'h0000000c; aux_words[55] = 32'h000c8000;
-       ctl_words[56] = 32'h74180000; imm_words[56] = 32'h0000000c; aux_words[56] = 32'h000d0000;
-       ctl_words[57] = 32'h28047c02; imm_words[57] = 32'h00000000; aux_words[57] = 32'h00000000;
-       ctl_words[58] = 32'h28087802; imm_words[58] = 32'h00000000; aux_words[58] = 32'h00000000;
-       ctl_words[59] = 32'h280c7402; imm_words[59] = 32'h00000000; aux_words[59] = 32'h00000000;
-       ctl_words[60] = 32'h281c0002; imm_words[60] = 32'h00000000; aux_words[60] = 32'h00040000;
-       ctl_words[61] = 32'h28280002; imm_words[61] = 32'hffffffff; aux_words[61] = 32'h00040000;
-       ctl_words[62] = 32'h282c0002; imm_words[62] = 32'hffffffff; aux_words[62] = 32'h00040000;
-       ctl_words[63] = 32'h28200002; imm_words[63] = 32'h007f0000; aux_words[63] = 32'h00040000;
-       ctl_words[64] = 32'h28240002; imm_words[64] = 32'h00000000; aux_words[64] = 32'h00040000;
-       ctl_words[65] = 32'h5c400000; imm_words[65] = 32'h00000000; aux_words[65] = 32'h000c0027;
-       ctl_words[66] = 32'h54003002; imm_words[66] = 32'h00000000; aux_words[66] = 32'h00000089;
-       ctl_words[67] = 32'h28a03c02; imm_words[67] = 32'h00000000; aux_words[67] = 32'h00000000;
+       ctl_words[0] = 32'h34480000; imm_words[0] = 32'h00000000; aux_words[0] = 32'h000c5000;
+       ctl_words[1] = 32'h344c0000; imm_words[1] = 32'h00000001; aux_words[1] = 32'h000c5000;
+       ctl_words[2] = 32'h34500000; imm_words[2] = 32'h00000002; aux_words[2] = 32'h000c5000;
+       ctl_words[3] = 32'h34540000; imm_words[3] = 32'h00000003; aux_words[3] = 32'h000c5000;
+       ctl_words[4] = 32'h34580000; imm_words[4] = 32'h00000004; aux_words[4] = 32'h000c5000;
+       ctl_words[5] = 32'h345c0000; imm_words[5] = 32'h00000005; aux_words[5] = 32'h000c5000;
+       ctl_words[6] = 32'h34600000; imm_words[6] = 32'h00000006; aux_words[6] = 32'h000c5000;
+       ctl_words[7] = 32'h34640000; imm_words[7] = 32'h00000007; aux_words[7] = 32'h000c5000;
+       ctl_words[8] = 32'h34680000; imm_words[8] = 32'h00000008; aux_words[8] = 32'h000c5000;
+       ctl_words[9] = 32'h346c0000; imm_words[9] = 32'h00000009; aux_words[9] = 32'h000c5000;
+       ctl_words[10] = 32'h34700000; imm_words[10] = 32'h0000000a; aux_words[10] = 32'h000c5000;
+       ctl_words[11] = 32'h34740000; imm_words[11] = 32'h0000000b; aux_words[11] = 32'h000c5000;
+       ctl_words[12] = 32'h34780000; imm_words[12] = 32'h0000000c; aux_words[12] = 32'h000c5000;
+       ctl_words[13] = 32'h347c0000; imm_words[13] = 32'h0000000d; aux_words[13] = 32'h000c5000;
+       ctl_words[14] = 32'h34800000; imm_words[14] = 32'h0000000e; aux_words[14] = 32'h000c5000;
+       ctl_words[15] = 32'h7000484c; imm_words[15] = 32'h0000000b; aux_words[15] = 32'h00000000;
+       ctl_words[16] = 32'h70005054; imm_words[16] = 32'h0000000b; aux_words[16] = 32'h00008000;
+       ctl_words[17] = 32'h7000585c; imm_words[17] = 32'h0000000b; aux_words[17] = 32'h00010000;
+       ctl_words[18] = 32'h70006064; imm_words[18] = 32'h0000000b; aux_words[18] = 32'h00018000;
+       ctl_words[19] = 32'h7000686c; imm_words[19] = 32'h0000000b; aux_words[19] = 32'h00020000;
+       ctl_words[20] = 32'h70007074; imm_words[20] = 32'h0000000b; aux_words[20] = 32'h00028000;
+       ctl_words[21] = 32'h7000787c; imm_words[21] = 32'h0000000b; aux_words[21] = 32'h00030000;
+       ctl_words[22] = 32'h70008000; imm_words[22] = 32'h0000000b; aux_words[22] = 32'h000b8000;
+       ctl_words[23] = 32'h24800002; imm_words[23] = 32'h003f0000; aux_words[23] = 32'h00040000;
+       ctl_words[24] = 32'h347c0000; imm_words[24] = 32'h0000000c; aux_words[24] = 32'h000c5000;
+       ctl_words[25] = 32'h34780000; imm_words[25] = 32'h0000000d; aux_words[25] = 32'h000c5000;
+       ctl_words[26] = 32'h34740000; imm_words[26] = 32'h0000000e; aux_words[26] = 32'h000c5000;
+       ctl_words[27] = 32'h34700000; imm_words[27] = 32'h0000000f; aux_words[27] = 32'h000c5000;
+       ctl_words[28] = 32'h346c0000; imm_words[28] = 32'h00000010; aux_words[28] = 32'h000c5000;
+       ctl_words[29] = 32'h34680000; imm_words[29] = 32'h00000011; aux_words[29] = 32'h000c5000;
+       ctl_words[30] = 32'h34640000; imm_words[30] = 32'h00000012; aux_words[30] = 32'h000c5000;
+       ctl_words[31] = 32'h34600000; imm_words[31] = 32'h00000013; aux_words[31] = 32'h000c5000;
+       ctl_words[32] = 32'h345c0000; imm_words[32] = 32'h00000018; aux_words[32] = 32'h000c5000;
+       ctl_words[33] = 32'h34580000; imm_words[33] = 32'h00000019; aux_words[33] = 32'h000c5000;
+       ctl_words[34] = 32'h34540000; imm_words[34] = 32'h0000001a; aux_words[34] = 32'h000c5000;
+       ctl_words[35] = 32'h34500000; imm_words[35] = 32'h0000001b; aux_words[35] = 32'h000c5000;
+       ctl_words[36] = 32'h344c0000; imm_words[36] = 32'h0000001c; aux_words[36] = 32'h000c5000;
+       ctl_words[37] = 32'h34480001; imm_words[37] = 32'h0000001d; aux_words[37] = 32'h000c5034;
+       ctl_words[38] = 32'h58000000; imm_words[38] = 32'h00000000; aux_words[38] = 32'h000c0034;
+       ctl_words[39] = 32'h70001c20; imm_words[39] = 32'h00000003; aux_words[39] = 32'h00000000;
+       ctl_words[40] = 32'h7000282c; imm_words[40] = 32'h0000000a; aux_words[40] = 32'h00000000;
+       ctl_words[41] = 32'h70000408; imm_words[41] = 32'h00000000; aux_words[41] = 32'h00000000;
+       ctl_words[42] = 32'h70000c10; imm_words[42] = 32'h00000001; aux_words[42] = 32'h00000000;
+       ctl_words[43] = 32'h70001418; imm_words[43] = 32'h00000002; aux_words[43] = 32'h00000000;
+       ctl_words[44] = 32'h74002420; imm_words[44] = 32'h00000000; aux_words[44] = 32'h00000000;
+       ctl_words[45] = 32'h74000000; imm_words[45] = 32'h00000001; aux_words[45] = 32'h000c0000;
+       ctl_words[46] = 32'h70340000; imm_words[46] = 32'h00000005; aux_words[46] = 32'h000c0000;
+       ctl_words[47] = 32'h70300000; imm_words[47] = 32'h00000006; aux_words[47] = 32'h000c0000;
+       ctl_words[48] = 32'h50003002; imm_words[48] = 32'h00000000; aux_words[48] = 32'h00000032;
+       ctl_words[49] = 32'h50002403; imm_words[49] = 32'h00000000; aux_words[49] = 32'h00000032;
+       ctl_words[50] = 32'h703c0000; imm_words[50] = 32'h00000008; aux_words[50] = 32'h000c0000;
+       ctl_words[51] = 32'h5c004000; imm_words[51] = 32'h00000000; aux_words[51] = 32'h00080000;
+       ctl_words[52] = 32'h68840000; imm_words[52] = 32'h00000000; aux_words[52] = 32'h000c008d;
+       ctl_words[53] = 32'h70000000; imm_words[53] = 32'h00000005; aux_words[53] = 32'h000c0000;
+       ctl_words[54] = 32'h70100000; imm_words[54] = 32'h0000000c; aux_words[54] = 32'h000c0000;
+       ctl_words[55] = 32'h70140000; imm_words[55] = 32'h0000000c; aux_words[55] = 32'h000c8000;
+       ctl_words[56] = 32'h70180000; imm_words[56] = 32'h0000000c; aux_words[56] = 32'h000d0000;
+       ctl_words[57] = 32'h24047c02; imm_words[57] = 32'h00000000; aux_words[57] = 32'h00000000;
+       ctl_words[58] = 32'h24087802; imm_words[58] = 32'h00000000; aux_words[58] = 32'h00000000;
+       ctl_words[59] = 32'h240c7402; imm_words[59] = 32'h00000000; aux_words[59] = 32'h00000000;
+       ctl_words[60] = 32'h241c0002; imm_words[60] = 32'h00000000; aux_words[60] = 32'h00040000;
+       ctl_words[61] = 32'h24280002; imm_words[61] = 32'hffffffff; aux_words[61] = 32'h00040000;
+       ctl_words[62] = 32'h242c0002; imm_words[62] = 32'hffffffff; aux_words[62] = 32'h00040000;
+       ctl_words[63] = 32'h24200002; imm_words[63] = 32'h007f0000; aux_words[63] = 32'h00040000;
+       ctl_words[64] = 32'h24240002; imm_words[64] = 32'h00000000; aux_words[64] = 32'h00040000;
+       ctl_words[65] = 32'h58400000; imm_words[65] = 32'h00000000; aux_words[65] = 32'h000c0027;
+       ctl_words[66] = 32'h50003002; imm_words[66] = 32'h00000000; aux_words[66] = 32'h00000089;
+       ctl_words[67] = 32'h24a03c02; imm_words[67] = 32'h00000000; aux_words[67] = 32'h00000000;
        ctl_words[68] = 32'h0ca43410; imm_words[68] = 32'h00000000; aux_words[68] = 32'h00000000;
        ctl_words[69] = 32'h04a804a4; imm_words[69] = 32'h00000000; aux_words[69] = 32'h00000000;
        ctl_words[70] = 32'h0cac3414; imm_words[70] = 32'h00000000; aux_words[70] = 32'h00000000;
        ctl_words[71] = 32'h04b008ac; imm_words[71] = 32'h00000000; aux_words[71] = 32'h00000000;
        ctl_words[72] = 32'h0cb43418; imm_words[72] = 32'h00000000; aux_words[72] = 32'h00000000;
        ctl_words[73] = 32'h04b80cb4; imm_words[73] = 32'h00000000; aux_words[73] = 32'h00000000;
-       ctl_words[74] = 32'h38aca000; imm_words[74] = 32'h00000006; aux_words[74] = 32'h0009a000;
-       ctl_words[75] = 32'h38b4a000; imm_words[75] = 32'h00000007; aux_words[75] = 32'h0009a000;
-       ctl_words[76] = 32'h38a4a000; imm_words[76] = 32'h00000006; aux_words[76] = 32'h0009b000;
-       ctl_words[77] = 32'h38bca000; imm_words[77] = 32'h00000007; aux_words[77] = 32'h0009b000;
+       ctl_words[74] = 32'h34aca000; imm_words[74] = 32'h00000006; aux_words[74] = 32'h0009a000;
+       ctl_words[75] = 32'h34b4a000; imm_words[75] = 32'h00000007; aux_words[75] = 32'h0009a000;
+       ctl_words[76] = 32'h34a4a000; imm_words[76] = 32'h00000006; aux_words[76] = 32'h0009b000;
+       ctl_words[77] = 32'h34bca000; imm_words[77] = 32'h00000007; aux_words[77] = 32'h0009b000;
        ctl_words[78] = 32'h0cc0ac10; imm_words[78] = 32'h00000000; aux_words[78] = 32'h00000000;
        ctl_words[79] = 32'h0cc4b414; imm_words[79] = 32'h00000000; aux_words[79] = 32'h00000000;
        ctl_words[80] = 32'h04c8c0c4; imm_words[80] = 32'h00000000; aux_words[80] = 32'h00000000;
        ctl_words[81] = 32'h0ccca418; imm_words[81] = 32'h00000000; aux_words[81] = 32'h00000000;
        ctl_words[82] = 32'h04d0c8cc; imm_words[82] = 32'h00000000; aux_words[82] = 32'h00000000;
-       ctl_words[83] = 32'h480000d1; imm_words[83] = 32'h00000000; aux_words[83] = 32'h00040057;
-       ctl_words[84] = 32'h2cacac02; imm_words[84] = 32'h00800000; aux_words[84] = 32'h00000000;
-       ctl_words[85] = 32'h2cb4b402; imm_words[85] = 32'h00800000; aux_words[85] = 32'h00000000;
-       ctl_words[86] = 32'h2ca4a402; imm_words[86] = 32'h00800000; aux_words[86] = 32'h00000000;
-       ctl_words[87] = 32'h38dcbc00; imm_words[87] = 32'h0000001e; aux_words[87] = 32'h00095000;
-       ctl_words[88] = 32'h38d8bc00; imm_words[88] = 32'h0000001f; aux_words[88] = 32'h00095000;
-       ctl_words[89] = 32'h38d4bc00; imm_words[89] = 32'h00000020; aux_words[89] = 32'h00095000;
-       ctl_words[90] = 32'h38d0bc00; imm_words[90] = 32'h00000021; aux_words[90] = 32'h00095000;
+       ctl_words[83] = 32'h440000d1; imm_words[83] = 32'h00000000; aux_words[83] = 32'h00040057;
+       ctl_words[84] = 32'h28acac02; imm_words[84] = 32'h00800000; aux_words[84] = 32'h00000000;
+       ctl_words[85] = 32'h28b4b402; imm_words[85] = 32'h00800000; aux_words[85] = 32'h00000000;
+       ctl_words[86] = 32'h28a4a402; imm_words[86] = 32'h00800000; aux_words[86] = 32'h00000000;
+       ctl_words[87] = 32'h34dcbc00; imm_words[87] = 32'h0000001e; aux_words[87] = 32'h00095000;
+       ctl_words[88] = 32'h34d8bc00; imm_words[88] = 32'h0000001f; aux_words[88] = 32'h00095000;
+       ctl_words[89] = 32'h34d4bc00; imm_words[89] = 32'h00000020; aux_words[89] = 32'h00095000;
+       ctl_words[90] = 32'h34d0bc00; imm_words[90] = 32'h00000021; aux_words[90] = 32'h00095000;
        ctl_words[91] = 32'h0c94dc70; imm_words[91] = 32'h00000000; aux_words[91] = 32'h00000000;
        ctl_words[92] = 32'h0c98d870; imm_words[92] = 32'h00000000; aux_words[92] = 32'h00000000;
        ctl_words[93] = 32'h0c9cd470; imm_words[93] = 32'h00000000; aux_words[93] = 32'h00000000;
@@ -3043,7 +2926,7 @@ module dynrt_processor__engine__fetch__rom(clock,address,ctl,imm,aux);
        ctl_words[99] = 32'h04e0c4c0; imm_words[99] = 32'h00000000; aux_words[99] = 32'h00000000;
        ctl_words[100] = 32'h0ce4a4bc; imm_words[100] = 32'h00000000; aux_words[100] = 32'h00000000;
        ctl_words[101] = 32'h04e8e0e4; imm_words[101] = 32'h00000000; aux_words[101] = 32'h00000000;
-       ctl_words[102] = 32'h480000e9; imm_words[102] = 32'h00000000; aux_words[102] = 32'h00040084;
+       ctl_words[102] = 32'h440000e9; imm_words[102] = 32'h00000000; aux_words[102] = 32'h00040084;
        ctl_words[103] = 32'h0cecc8c8; imm_words[103] = 32'h00000000; aux_words[103] = 32'h00000000;
        ctl_words[104] = 32'h0cf0cccc; imm_words[104] = 32'h00000000; aux_words[104] = 32'h00000000;
        ctl_words[105] = 32'h04f4ecf0; imm_words[105] = 32'h00000000; aux_words[105] = 32'h00000000;
@@ -3051,19 +2934,19 @@ module dynrt_processor__engine__fetch__rom(clock,address,ctl,imm,aux);
        ctl_words[107] = 32'h04fcf4f8; imm_words[107] = 32'h00000000; aux_words[107] = 32'h00000000;
        ctl_words[108] = 32'h1500fc02; imm_words[108] = 32'h00000000; aux_words[108] = 32'h00000000;
        ctl_words[109] = 32'h1104e900; imm_words[109] = 32'h00000000; aux_words[109] = 32'h00000000;
-       ctl_words[110] = 32'h2804a802; imm_words[110] = 32'h00000000; aux_words[110] = 32'h00000000;
-       ctl_words[111] = 32'h2808b002; imm_words[111] = 32'h00000000; aux_words[111] = 32'h00000000;
-       ctl_words[112] = 32'h280cb802; imm_words[112] = 32'h00000000; aux_words[112] = 32'h00000000;
-       ctl_words[113] = 32'h2810c802; imm_words[113] = 32'h00000000; aux_words[113] = 32'h00000000;
-       ctl_words[114] = 32'h2814cc02; imm_words[114] = 32'h00000000; aux_words[114] = 32'h00000000;
-       ctl_words[115] = 32'h2818bc02; imm_words[115] = 32'h00000000; aux_words[115] = 32'h00000000;
-       ctl_words[116] = 32'h281c6002; imm_words[116] = 32'h00000000; aux_words[116] = 32'h00000000;
-       ctl_words[117] = 32'h28200002; imm_words[117] = 32'h003f0000; aux_words[117] = 32'h00040000;
-       ctl_words[118] = 32'h28240002; imm_words[118] = 32'h80000000; aux_words[118] = 32'h00040000;
-       ctl_words[119] = 32'h28280002; imm_words[119] = 32'h00000000; aux_words[119] = 32'h00040000;
-       ctl_words[120] = 32'h282ca002; imm_words[120] = 32'h00000000; aux_words[120] = 32'h00000000;
-       ctl_words[121] = 32'h5c400000; imm_words[121] = 32'h00000000; aux_words[121] = 32'h000c0027;
-       ctl_words[122] = 32'h54003003; imm_words[122] = 32'h00000000; aux_words[122] = 32'h00000084;
+       ctl_words[110] = 32'h2404a802; imm_words[110] = 32'h00000000; aux_words[110] = 32'h00000000;
+       ctl_words[111] = 32'h2408b002; imm_words[111] = 32'h00000000; aux_words[111] = 32'h00000000;
+       ctl_words[112] = 32'h240cb802; imm_words[112] = 32'h00000000; aux_words[112] = 32'h00000000;
+       ctl_words[113] = 32'h2410c802; imm_words[113] = 32'h00000000; aux_words[113] = 32'h00000000;
+       ctl_words[114] = 32'h2414cc02; imm_words[114] = 32'h00000000; aux_words[114] = 32'h00000000;
+       ctl_words[115] = 32'h2418bc02; imm_words[115] = 32'h00000000; aux_words[115] = 32'h00000000;
+       ctl_words[116] = 32'h241c6002; imm_words[116] = 32'h00000000; aux_words[116] = 32'h00000000;
+       ctl_words[117] = 32'h24200002; imm_words[117] = 32'h003f0000; aux_words[117] = 32'h00040000;
+       ctl_words[118] = 32'h24240002; imm_words[118] = 32'h80000000; aux_words[118] = 32'h00040000;
+       ctl_words[119] = 32'h24280002; imm_words[119] = 32'h00000000; aux_words[119] = 32'h00040000;
+       ctl_words[120] = 32'h242ca002; imm_words[120] = 32'h00000000; aux_words[120] = 32'h00000000;
+       ctl_words[121] = 32'h58400000; imm_words[121] = 32'h00000000; aux_words[121] = 32'h000c0027;
+       ctl_words[122] = 32'h50003003; imm_words[122] = 32'h00000000; aux_words[122] = 32'h00000084;
        ctl_words[123] = 32'h0d00dc50; imm_words[123] = 32'h00000000; aux_words[123] = 32'h00000000;
        ctl_words[124] = 32'h0cfd0104; imm_words[124] = 32'h00000000; aux_words[124] = 32'h00000000;
        ctl_words[125] = 32'h049494fc; imm_words[125] = 32'h00000000; aux_words[125] = 32'h00000000;
@@ -3073,16 +2956,16 @@ module dynrt_processor__engine__fetch__rom(clock,address,ctl,imm,aux);
        ctl_words[129] = 32'h0ce8d448; imm_words[129] = 32'h00000000; aux_words[129] = 32'h00000000;
        ctl_words[130] = 32'h0ce4e904; imm_words[130] = 32'h00000000; aux_words[130] = 32'h00000000;
        ctl_words[131] = 32'h049c9ce4; imm_words[131] = 32'h00000000; aux_words[131] = 32'h00000000;
-       ctl_words[132] = 32'h7ca09402; imm_words[132] = 32'h00000000; aux_words[132] = 32'h00000000;
-       ctl_words[133] = 32'h7ca098a0; imm_words[133] = 32'h00000000; aux_words[133] = 32'h00000000;
-       ctl_words[134] = 32'h7ca09ca0; imm_words[134] = 32'h00000000; aux_words[134] = 32'h00000000;
-       ctl_words[135] = 32'h3c0084a1; imm_words[135] = 32'h0000002e; aux_words[135] = 32'h00000034;
-       ctl_words[136] = 32'h5c000000; imm_words[136] = 32'h00000000; aux_words[136] = 32'h000c0034;
-       ctl_words[137] = 32'h28946c02; imm_words[137] = 32'h00000000; aux_words[137] = 32'h00000000;
-       ctl_words[138] = 32'h28986802; imm_words[138] = 32'h00000000; aux_words[138] = 32'h00000000;
-       ctl_words[139] = 32'h289c6403; imm_words[139] = 32'h00000000; aux_words[139] = 32'h00000084;
-       ctl_words[140] = 32'h5c000000; imm_words[140] = 32'h00000000; aux_words[140] = 32'h000c0084;
-       ctl_words[141] = 32'h70000000; imm_words[141] = 32'h00000000; aux_words[141] = 32'h000c0000;
+       ctl_words[132] = 32'h78a09402; imm_words[132] = 32'h00000000; aux_words[132] = 32'h00000000;
+       ctl_words[133] = 32'h78a098a0; imm_words[133] = 32'h00000000; aux_words[133] = 32'h00000000;
+       ctl_words[134] = 32'h78a09ca0; imm_words[134] = 32'h00000000; aux_words[134] = 32'h00000000;
+       ctl_words[135] = 32'h380084a1; imm_words[135] = 32'h0000002e; aux_words[135] = 32'h00000034;
+       ctl_words[136] = 32'h58000000; imm_words[136] = 32'h00000000; aux_words[136] = 32'h000c0034;
+       ctl_words[137] = 32'h24946c02; imm_words[137] = 32'h00000000; aux_words[137] = 32'h00000000;
+       ctl_words[138] = 32'h24986802; imm_words[138] = 32'h00000000; aux_words[138] = 32'h00000000;
+       ctl_words[139] = 32'h249c6403; imm_words[139] = 32'h00000000; aux_words[139] = 32'h00000084;
+       ctl_words[140] = 32'h58000000; imm_words[140] = 32'h00000000; aux_words[140] = 32'h000c0084;
+       ctl_words[141] = 32'h6c000000; imm_words[141] = 32'h00000000; aux_words[141] = 32'h000c0000;
        ctl_words[142] = 32'h00000000; imm_words[142] = 32'h00000000; aux_words[142] = 32'h00000000;
        ctl_words[143] = 32'h00000000; imm_words[143] = 32'h00000000; aux_words[143] = 32'h00000000;
        ctl_words[144] = 32'h00000000; imm_words[144] = 32'h00000000; aux_words[144] = 32'h00000000;
@@ -12342,7 +12225,7 @@ endmodule // dynrt_processor__engine__rays__raygen
 
 
 
-module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,target,is_wait,kd_busy,tri_busy,jr_target,int_eq,int_lt,mb_hit,pix_done,pix_busy,fast,kind,converted,scratch_data,mem_data,nodes_data,a_data,b_data,retiring__valid,retiring__dst,retiring__thread,retiring__write,retiring__source,retiring__cond,retiring__sel_lt,retiring__sel_le,retiring__sel_eq,retiring__pc_taken,retiring__pc_not_taken,retiring__halt,retiring__retired,retiring__wait_pending,retiring__fast);
+module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,target,is_wait,kd_busy,tri_busy,jr_target,int_eq,int_lt,mb_hit,pix_done,pix_busy,fast,kind,scratch_data,mem_data,nodes_data,a_data,b_data,retiring__valid,retiring__dst,retiring__thread,retiring__write,retiring__source,retiring__cond,retiring__sel_lt,retiring__sel_le,retiring__sel_eq,retiring__pc_taken,retiring__pc_not_taken,retiring__halt,retiring__retired,retiring__wait_pending,retiring__fast);
     
     // Module arguments
     input wire  clock;
@@ -12364,7 +12247,6 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     input wire  pix_busy;
     input wire  [31:0] fast;
     input wire  [2:0] kind;
-    input wire  [31:0] converted;
     input wire  [31:0] scratch_data;
     input wire  [31:0] mem_data;
     input wire  [31:0] nodes_data;
@@ -12401,29 +12283,28 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     localparam  op_fmul = 5'b11;
     localparam  op_fdiv = 5'b100;
     localparam  op_fsqrt = 5'b101;
-    localparam  op_bflt = 5'b10010;
-    localparam  op_bfle = 5'b10011;
-    localparam  op_bfeq = 5'b10100;
-    localparam  op_beq = 5'b10101;
-    localparam  op_bltu = 5'b10110;
-    localparam  op_jal = 5'b10111;
-    localparam  op_jr = 5'b11000;
-    localparam  op_mbx = 5'b11001;
-    localparam  op_pixel = 5'b11011;
-    localparam  op_halt = 5'b11100;
-    localparam  op_tri = 5'b11101;
-    localparam  op_kd = 5'b11110;
-    localparam  op_byte = 5'b11111;
-    localparam  op_writes = 32'ha8817ffe;
+    localparam  op_bflt = 5'b10001;
+    localparam  op_bfle = 5'b10010;
+    localparam  op_bfeq = 5'b10011;
+    localparam  op_beq = 5'b10100;
+    localparam  op_bltu = 5'b10101;
+    localparam  op_jal = 5'b10110;
+    localparam  op_jr = 5'b10111;
+    localparam  op_mbx = 5'b11000;
+    localparam  op_pixel = 5'b11010;
+    localparam  op_halt = 5'b11011;
+    localparam  op_tri = 5'b11100;
+    localparam  op_kd = 5'b11101;
+    localparam  op_byte = 5'b11110;
+    localparam  op_writes = 32'h5440bffe;
     
     // Enums
     localparam FastKind__Computed = 0;
-    localparam FastKind__Converted = 1;
-    localparam FastKind__Scratch = 2;
-    localparam FastKind__Memory = 3;
-    localparam FastKind__TrianglesA = 4;
-    localparam FastKind__TrianglesB = 5;
-    localparam FastKind__Nodes = 6;
+    localparam FastKind__Scratch = 1;
+    localparam FastKind__Memory = 2;
+    localparam FastKind__TrianglesA = 3;
+    localparam FastKind__TrianglesB = 4;
+    localparam FastKind__Nodes = 5;
     localparam ResultSource__Fast = 0;
     localparam ResultSource__Sum = 1;
     localparam ResultSource__Product = 2;
@@ -13056,9 +12937,6 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         kind_line__6__d = kind_line__5__q;
         fast_line__7__d = fast_line__6__q;
         kind_line__7__d = kind_line__6__q;
-        if (kind_line__0__q == FastKind__Converted) begin
-            fast_line__1__d = converted;
-        end
         if (kind_line__0__q == FastKind__Scratch) begin
             fast_line__1__d = scratch_data;
         end
@@ -13672,12 +13550,11 @@ module dynrt_processor__engine__result_line__kind_line__0(d,q,clock);
     
     // Enums
     localparam FastKind__Computed = 0;
-    localparam FastKind__Converted = 1;
-    localparam FastKind__Scratch = 2;
-    localparam FastKind__Memory = 3;
-    localparam FastKind__TrianglesA = 4;
-    localparam FastKind__TrianglesB = 5;
-    localparam FastKind__Nodes = 6;
+    localparam FastKind__Scratch = 1;
+    localparam FastKind__Memory = 2;
+    localparam FastKind__TrianglesA = 3;
+    localparam FastKind__TrianglesB = 4;
+    localparam FastKind__Nodes = 5;
     
     // Update code (custom)
     initial begin

@@ -36,6 +36,11 @@ pub struct RtlArgs {
     /// XC2V6000 (takes minutes).
     #[arg(long)]
     pub synth: bool,
+    /// Also synthesize the processor with its hierarchy kept and itemize LUTs, flip-flops,
+    /// multipliers and block RAMs per block (the engine's units one level further), into
+    /// OUT/synth/blocks.md and blocks.csv (takes minutes).
+    #[arg(long)]
+    pub synth_blocks: bool,
     /// Board file (TOML, boards/README.md): pin locations and I/O standards for the UCF
     /// (`rtl` only).
     #[arg(long, value_name = "FILE")]
@@ -170,7 +175,8 @@ fn summary(verb: &str, a: &RtlArgs, scene: &dynrt::scene::Scene, name: &str) -> 
         .option("frames", a.frames)
         .option("width", scene.camera.width)
         .option("height", scene.camera.height)
-        .option("synth", a.synth);
+        .option("synth", a.synth)
+        .option("synth_blocks", a.synth_blocks);
     s
 }
 
@@ -250,6 +256,21 @@ fn synthesis(a: &RtlArgs, s: &mut RunSummary) -> anyhow::Result<()> {
             println!("{report}");
         }
         s.notes.extend(report.lines().map(str::to_string));
+    }
+    if a.synth_blocks {
+        let report = flow::synthesize_processor_blocks(&a.out)?;
+        let text = format!(
+            "{} per block (yosys {}: {}, {:.1} s; each block optimized on its own):\n{}",
+            report.top,
+            report.yosys_version,
+            report.command,
+            report.seconds,
+            report.markdown()
+        );
+        if !a.json {
+            println!("{text}");
+        }
+        s.notes.extend(text.lines().map(str::to_string));
     }
     Ok(())
 }

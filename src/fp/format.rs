@@ -310,9 +310,8 @@ impl Format {
     }
 
     /// Exact conversion of a small integer (pixel coordinates, loop counts); rounds like any
-    /// other conversion when the integer needs more than `man_bits + 1` bits. Golden twin of
-    /// [`hw::UIntToFloat`](crate::hw::UIntToFloat) (src/hw/int_to_float.rs) for values below
-    /// `2^(man_bits + 1)`.
+    /// other conversion when the integer needs more than `man_bits + 1` bits. The floats
+    /// [`hw::RayGen`](crate::hw::RayGen) counts are its values for the pixel coordinates.
     pub fn from_int(self, i: i64) -> u32 {
         self.round_pack64(i < 0, i.unsigned_abs(), 0, false)
     }

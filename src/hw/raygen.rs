@@ -16,9 +16,9 @@
 //! `n + 1` is the word of `n` plus the integer `2^(M - floor(log2 n))` (the unit in the last
 //! place of `n`; where `n + 1` is a power of two the mantissa's carry steps the exponent). So
 //! RayGen counts `x + 1` as a float by one adder and halves the step where `x + 2` is a power
-//! of two. Converting the counter with a leading-zero shifter ([`UIntToFloat`], as the
-//! engine's `itof` does) put 11 levels of logic in front of the transform unit's inputs, and
-//! the unit reached 111.2 MHz on the ECP5.
+//! of two. Converting the counter with a leading-zero shifter (the engine's `itof` had one,
+//! until no program used it) put 11 levels of logic in front of the transform unit's inputs,
+//! and the unit reached 111.2 MHz on the ECP5.
 //!
 //! [`RayGen`] protocol: a `start` pulse (with `width`, `height` > 0; `width`, `height` and
 //! `camera` held until the frame is done) resets the pixel counter to (0, 0) and sets
@@ -44,9 +44,9 @@ use rust_hdl::prelude::*;
 
 use super::fp::{bias, const_bits};
 use super::transform_arbiter::THREAD_BITS;
-use super::{TransformUnit, TAG_BITS};
 #[cfg(doc)]
-use super::{UIntToFloat, TRANSFORM_LATENCY};
+use super::TRANSFORM_LATENCY;
+use super::{TransformUnit, TAG_BITS};
 
 #[derive(LogicBlock)]
 pub struct RayGen<const W: usize, const E: usize, const M: usize> {

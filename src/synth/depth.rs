@@ -29,6 +29,10 @@ pub(crate) struct Netlist {
 
 #[derive(Debug, Deserialize)]
 pub(crate) struct Module {
+    /// Yosys's module attributes: the cell library's primitives carry `blackbox` (or
+    /// `whitebox`) in a netlist that keeps its hierarchy.
+    #[serde(default)]
+    pub attributes: BTreeMap<String, serde_json::Value>,
     #[serde(default)]
     pub cells: BTreeMap<String, Cell>,
     #[serde(default)]
@@ -373,6 +377,7 @@ mod tests {
 
     fn module(cells: Vec<(&str, Cell)>) -> Module {
         Module {
+            attributes: BTreeMap::new(),
             cells: cells.into_iter().map(|(n, c)| (n.to_string(), c)).collect(),
             ports: BTreeMap::new(),
             netnames: BTreeMap::new(),

@@ -5,6 +5,9 @@
 //! -top TOP -nowidelut; stat; write_json` in `work_dir` (see [`SynthOptions`]) (script, log, `stat` text and netlist stay there
 //! for inspection) under a time limit, and reads the cell counts from the flattened netlist.
 //! `-flatten` makes the counts whole-design totals and lets the depth analysis see every path.
+//! [`synth_xc2v_blocks`] runs the same script without `-flatten` and itemizes the resources per
+//! block instance ([`blocks`]): each block is optimized on its own, so the sum is a little
+//! above the flattened total, which optimizes across block boundaries.
 //! Yosys marks xc2v support EXPERIMENTAL; it maps products to `MULT18X18` (17x17 -> 1,
 //! 24x24 -> 4 plus adders), registers to `FD*`, logic to `LUT1`..`LUT4` + `MUXF5`..`MUXF8`,
 //! adders to `MUXCY`/`XORCY`, memories to `RAMB16_*`. Logic depth is defined in [`depth`].
@@ -12,6 +15,7 @@
 //! Placed-and-routed timing (ECP5, nextpnr) is [`ecp5`]; its report is read in
 //! [`nextpnr_report`] and tabled in [`timing_table`].
 
+pub mod blocks;
 mod depth;
 pub mod device;
 pub mod ecp5;
@@ -176,6 +180,75 @@ pub fn synth_xc2v_with(
     work_dir: &Path,
     options: &SynthOptions,
 ) -> Result<SynthReport, ToolError> {
+    let run = run_yosys(sources, top, work_dir, options, true)?;
+    let module = run
+        .netlist
+        .modules
+        .get(top)
+        .ok_or_else(|| ToolError::Parse {
+            tool: "yosys".into(),
+            message: format!("{} has no module `{top}`", run.json_file.display()),
+        })?;
+    let deepest = depth::longest_paths(module).map_err(|m| ToolError::Parse {
+        tool: "yosys".into(),
+        message: format!("netlist of `{top}`: {m}"),
+    })?;
+    let mut all_cells = BTreeMap::new();
+    for c in module.cells.values() {
+        *all_cells.entry(c.cell_type.clone()).or_insert(0u64) += 1;
+    }
+    Ok(summarize(
+        top,
+        run.command,
+        run.yosys_version,
+        all_cells,
+        deepest,
+        run.stat_text,
+        run.seconds,
+        run.json_file,
+    ))
+}
+
+/// Synthesizes `top` like [`synth_xc2v_with`] but keeps the hierarchy, and itemizes the
+/// resources of every block instance down to `max_depth` levels below the top.
+pub fn synth_xc2v_blocks(
+    sources: &[PathBuf],
+    top: &str,
+    work_dir: &Path,
+    options: &SynthOptions,
+    max_depth: usize,
+) -> Result<blocks::BlockReport, ToolError> {
+    let run = run_yosys(sources, top, work_dir, options, false)?;
+    let rows = blocks::itemize(&run.netlist, top, max_depth).map_err(|m| ToolError::Parse {
+        tool: "yosys".into(),
+        message: format!("{}: {m}", run.json_file.display()),
+    })?;
+    Ok(blocks::BlockReport {
+        top: top.to_string(),
+        command: run.command,
+        yosys_version: run.yosys_version,
+        rows,
+        seconds: run.seconds,
+    })
+}
+
+/// What one yosys run left: the command, the `stat` text and the netlist.
+struct YosysRun {
+    command: String,
+    yosys_version: String,
+    stat_text: String,
+    netlist: depth::Netlist,
+    json_file: PathBuf,
+    seconds: f64,
+}
+
+fn run_yosys(
+    sources: &[PathBuf],
+    top: &str,
+    work_dir: &Path,
+    options: &SynthOptions,
+    flatten: bool,
+) -> Result<YosysRun, ToolError> {
     if sources.is_empty() {
         return Err(ToolError::BadJob(format!(
             "synthesis of `{top}`: no source files"
@@ -220,7 +293,11 @@ pub fn synth_xc2v_with(
         read.push(' ');
         read.push_str(&text);
     }
-    let stem = format!("synth_{}", top.replace('$', "_"));
+    let stem = format!(
+        "synth_{}{}",
+        top.replace('$', "_"),
+        if flatten { "" } else { "_blocks" }
+    );
     let stat_file = work_dir.join(format!("{stem}.stat.txt"));
     let json_file = work_dir.join(format!("{stem}.json"));
     let log_file = work_dir.join(format!("{stem}.log"));
@@ -228,7 +305,10 @@ pub fn synth_xc2v_with(
     for stale in [&stat_file, &json_file] {
         let _ = std::fs::remove_file(stale);
     }
-    let mut command = format!("synth_xilinx -family xc2v -flatten -top {top}");
+    let mut command = format!(
+        "synth_xilinx -family xc2v{} -top {top}",
+        if flatten { " -flatten" } else { "" }
+    );
     if !options.io_pads {
         command.push_str(" -noiopad -noclkbuf");
     }
@@ -281,28 +361,69 @@ pub fn synth_xc2v_with(
         tool: "yosys".into(),
         message: format!("{}: {e}", json_file.display()),
     })?;
-    let module = netlist.modules.get(top).ok_or_else(|| ToolError::Parse {
-        tool: "yosys".into(),
-        message: format!("{} has no module `{top}`", json_file.display()),
-    })?;
-    let deepest = depth::longest_paths(module).map_err(|m| ToolError::Parse {
-        tool: "yosys".into(),
-        message: format!("netlist of `{top}`: {m}"),
-    })?;
-    let mut all_cells = BTreeMap::new();
-    for c in module.cells.values() {
-        *all_cells.entry(c.cell_type.clone()).or_insert(0u64) += 1;
-    }
-    Ok(summarize(
-        top,
+    Ok(YosysRun {
         command,
         yosys_version,
-        all_cells,
-        deepest,
         stat_text,
-        out.seconds,
+        netlist,
         json_file,
-    ))
+        seconds: out.seconds,
+    })
+}
+
+fn is_lut(t: &str) -> bool {
+    t == "INV" || (t.starts_with("LUT") && t[3..].parse::<u32>().is_ok())
+}
+
+/// The resources a set of Virtex-II primitives takes (the columns of the device's budget).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Resources {
+    /// Logic LUTs (`LUT1`..`LUT6`, `INV`).
+    pub luts: u64,
+    /// LUTs used as distributed RAM or shift registers.
+    pub lut_ram_luts: u64,
+    pub flip_flops: u64,
+    pub mult18x18: u64,
+    pub block_rams: u64,
+}
+
+impl Resources {
+    /// The resources of `count` cells of each primitive type.
+    pub fn of_cells(cells: &BTreeMap<String, u64>) -> Self {
+        let mut r = Resources::default();
+        for (t, &n) in cells {
+            r.add_cell(t, n);
+        }
+        r
+    }
+
+    /// Adds `n` cells of primitive type `t` (types that are none of the columns add nothing).
+    pub fn add_cell(&mut self, t: &str, n: u64) {
+        if is_lut(t) {
+            self.luts += n;
+        } else if t.starts_with("SRL") || depth::is_distributed_ram(t) {
+            self.lut_ram_luts += lut_ram_size(t) * n;
+        } else if depth::is_flip_flop(t) {
+            self.flip_flops += n;
+        } else if t.starts_with("MULT18X18") {
+            self.mult18x18 += n;
+        } else if t.starts_with("RAMB16") {
+            self.block_rams += n;
+        }
+    }
+
+    pub fn add(&mut self, other: &Resources) {
+        self.luts += other.luts;
+        self.lut_ram_luts += other.lut_ram_luts;
+        self.flip_flops += other.flip_flops;
+        self.mult18x18 += other.mult18x18;
+        self.block_rams += other.block_rams;
+    }
+
+    /// All LUTs: logic plus distributed RAM / shift registers.
+    pub fn total_luts(&self) -> u64 {
+        self.luts + self.lut_ram_luts
+    }
 }
 
 /// LUTs a distributed RAM or shift-register primitive occupies on Virtex-II.
@@ -344,27 +465,22 @@ fn summarize(
             .map(|(_, n)| n)
             .sum()
     };
-    let is_lut = |t: &str| t == "INV" || (t.starts_with("LUT") && t[3..].parse::<u32>().is_ok());
     let lut_types = all_cells
         .iter()
         .filter(|(t, _)| is_lut(t))
         .map(|(t, n)| (t.clone(), *n))
         .collect();
-    let lut_ram_luts = all_cells
-        .iter()
-        .filter(|(t, _)| t.starts_with("SRL") || depth::is_distributed_ram(t))
-        .map(|(t, n)| lut_ram_size(t) * n)
-        .sum();
+    let r = Resources::of_cells(&all_cells);
     SynthReport {
         top: top.to_string(),
         command,
         yosys_version,
-        luts: sum(&is_lut),
+        luts: r.luts,
         lut_types,
-        lut_ram_luts,
-        flip_flops: sum(&|t| depth::is_flip_flop(t)),
-        mult18x18: sum(&|t| t.starts_with("MULT18X18")),
-        block_rams: sum(&|t| t.starts_with("RAMB16")),
+        lut_ram_luts: r.lut_ram_luts,
+        flip_flops: r.flip_flops,
+        mult18x18: r.mult18x18,
+        block_rams: r.block_rams,
         muxf: sum(&|t| t.starts_with("MUXF")),
         carry: sum(&|t| matches!(t, "MUXCY" | "XORCY" | "MULT_AND")),
         logic_depth: deepest.logic_depth,

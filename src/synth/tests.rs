@@ -237,3 +237,48 @@ fn memories_map_to_block_ram_and_distributed_ram() {
     assert_eq!(small.logic_depth, 1);
     assert_eq!(small.block_rams, 0);
 }
+
+#[test]
+fn blocks_are_itemized_per_instance_with_shared_modules_counted_per_use() {
+    // Two instances of one 8-bit register module, one 4-bit register module holding a
+    // function of its inputs: each row counts its own instance only; the top adds its own
+    // 3-bit register.
+    let verilog = "\
+module reg8 (input wire clk, input wire [7:0] d, output reg [7:0] q);\n\
+  always @(posedge clk) q <= d;\n\
+endmodule\n\
+module xor4 (input wire clk, input wire [7:0] a, input wire [7:0] b, output reg [3:0] q);\n\
+  always @(posedge clk) q <= a[3:0] ^ a[7:4] ^ b[3:0] ^ b[7:4];\n\
+endmodule\n\
+module top (input wire clk, input wire [7:0] x, input wire [7:0] y, output reg [2:0] z);\n\
+  wire [7:0] qa, qb; wire [3:0] f;\n\
+  reg8 first (.clk(clk), .d(x), .q(qa));\n\
+  reg8 second (.clk(clk), .d(y), .q(qb));\n\
+  xor4 mix (.clk(clk), .a(qa), .b(qb), .q(f));\n\
+  always @(posedge clk) z <= f[2:0];\n\
+endmodule\n";
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("top.v");
+    std::fs::write(&src, verilog).unwrap();
+    let options = SynthOptions {
+        io_pads: false,
+        ..SynthOptions::default()
+    };
+    let report = synth_xc2v_blocks(&[src], "top", dir.path(), &options, 1).unwrap();
+    println!("{}", report.markdown());
+    let ffs: Vec<(&str, u64)> = report
+        .rows
+        .iter()
+        .map(|r| (r.path.as_str(), r.resources.flip_flops))
+        .collect();
+    assert_eq!(
+        ffs,
+        vec![("", 8 + 8 + 4 + 3), ("first", 8), ("mix", 4), ("second", 8)]
+    );
+    // The 4-bit XOR of four inputs is one LUT4 per bit, and the registers take none.
+    let luts: Vec<u64> = report.rows.iter().map(|r| r.resources.luts).collect();
+    assert_eq!(luts, vec![4, 0, 4, 0]);
+    assert!(report.command.contains("-top top") && !report.command.contains("-flatten"));
+    assert!(report.csv().starts_with("block,depth,luts,"));
+    assert!(report.csv().contains("\nmix,1,4,0,4,0,0\n"));
+}

@@ -1,4 +1,4 @@
-//! `Execute`: the engine's single-clock work at I5. It computes the integer, conversion,
+//! `Execute`: the engine's single-clock work at I5. It computes the integer,
 //! link, pixel and coprocessor-reading results (the *fast* result), the integer conditions,
 //! and the addresses of loads, stores and scratch accesses, and names where a load's data
 //! will come from.
@@ -8,13 +8,11 @@
 //! link `pc + 1`, `byte`'s `b << 8` (the unit's byte joins it at the write back), the
 //! pixel word, or what `tri.wait`/`tri.hit`/`tri.instance`/`tri.triangle` read from the
 //! triangle tester; `kind` says whether the result line fills in a scratch or memory word
-//! later (`ld` by its bank, `lds`) or `itof`'s `converted` word. `mem_address = (a << shift) + imm` (loads and frame-buffer
-//! stores), `scratch_address = a + imm`; `int_eq`, `int_lt`: `a == b`, `a < b` unsigned.
+//! later (`ld` by its bank, `lds`). `mem_address = (a << shift) + imm` (loads and
+//! frame-buffer stores), `scratch_address = a + imm`; `int_eq`, `int_lt`: `a == b`, `a < b`
+//! unsigned.
 //!
-//! `itof`'s word comes a clock later, registered (`converted`, I6: the leading-zero shifter
-//! and the result select do not fit one clock), and joins the result line there.
-//!
-//! Latency: combinational (I5), `converted` 1 clock. Throughput: one instruction per clock.
+//! Latency: combinational (I5). Throughput: one instruction per clock.
 //!
 //! Golden twin: `hw::program::exec` (the engine's twin), the same operations per opcode.
 
@@ -22,12 +20,10 @@ use rust_hdl::prelude::*;
 
 use super::{bank, op_code, tri_fn, FastKind};
 use crate::hw::program::isa::{Op, TriFn, BANK_BITS, OP_BITS, PC_BITS, SHIFT_BITS};
-use crate::hw::UIntToFloat;
 use crate::layout;
 
 #[derive(LogicBlock)]
-pub struct Execute<const W: usize, const E: usize, const M: usize> {
-    pub clock: Signal<In, Clock>,
+pub struct Execute<const W: usize> {
     /// I5: the instruction.
     pub op: Signal<In, Bits<OP_BITS>>,
     pub a: Signal<In, Bits<32>>,
@@ -46,20 +42,15 @@ pub struct Execute<const W: usize, const E: usize, const M: usize> {
     /// The thread's primary direction (ray generation's answer at I5), for `tri.dir`.
     pub primary_dir: [Signal<In, Bits<W>>; 3],
     pub fast: Signal<Out, Bits<32>>,
-    /// I6: `itof a` of the instruction at I5 the clock before.
-    pub converted: Signal<Out, Bits<32>>,
     pub kind: Signal<Out, FastKind>,
     pub int_eq: Signal<Out, Bit>,
     pub int_lt: Signal<Out, Bit>,
     pub mem_address: Signal<Out, Bits<32>>,
     pub scratch_address: Signal<Out, Bits<32>>,
 
-    itof: UIntToFloat<W, E, M>,
-    itof_r: DFF<Bits<32>>,
     result: Signal<Local, Bits<32>>,
     source: Signal<Local, FastKind>,
 
-    op_itof: Constant<Bits<5>>,
     op_add: Constant<Bits<5>>,
     op_sub: Constant<Bits<5>>,
     op_and: Constant<Bits<5>>,
@@ -85,10 +76,9 @@ pub struct Execute<const W: usize, const E: usize, const M: usize> {
     bank_b: Constant<Bits<3>>,
 }
 
-impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M> {
+impl<const W: usize> Default for Execute<W> {
     fn default() -> Self {
         Self {
-            clock: Default::default(),
             op: Default::default(),
             a: Default::default(),
             b: Default::default(),
@@ -103,17 +93,13 @@ impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M
             tester_triangle: Default::default(),
             primary_dir: Default::default(),
             fast: Default::default(),
-            converted: Default::default(),
             kind: Default::default(),
             int_eq: Default::default(),
             int_lt: Default::default(),
             mem_address: Default::default(),
             scratch_address: Default::default(),
-            itof: Default::default(),
-            itof_r: Default::default(),
             result: Default::default(),
             source: Default::default(),
-            op_itof: op_code(Op::IToF),
             op_add: op_code(Op::Add),
             op_sub: op_code(Op::Sub),
             op_and: op_code(Op::And),
@@ -141,13 +127,9 @@ impl<const W: usize, const E: usize, const M: usize> Default for Execute<W, E, M
     }
 }
 
-impl<const W: usize, const E: usize, const M: usize> Logic for Execute<W, E, M> {
+impl<const W: usize> Logic for Execute<W> {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, itof_r);
-        self.itof.value.next = self.a.val().get_bits::<16>(0);
-        self.itof_r.d.next = bit_cast::<32, W>(self.itof.word.val());
-        self.converted.next = self.itof_r.q.val();
         self.int_eq.next = self.a.val() == self.b.val();
         self.int_lt.next = self.a.val() < self.b.val();
         self.mem_address.next = (self.a.val() << self.shift.val()) + self.imm.val();
@@ -156,9 +138,6 @@ impl<const W: usize, const E: usize, const M: usize> Logic for Execute<W, E, M> 
         // Settled in locals and given to the outputs once (they leave the block).
         self.source.next = FastKind::Computed;
         self.result.next = 0.into();
-        if self.op.val() == self.op_itof.val() {
-            self.source.next = FastKind::Converted;
-        }
         if self.op.val() == self.op_add.val() {
             self.result.next = self.a.val() + self.b.val();
         }

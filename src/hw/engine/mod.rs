@@ -131,13 +131,11 @@ pub fn engine_period(threads: u32) -> u32 {
     threads.max(OPERAND_STAGE + ENGINE_LATENCY + WAKE_UP)
 }
 
-/// Where an instruction's result comes from on the fast line: computed at I5, converted at I6
-/// (`itof`), or the data of a scratch read or of a load from the shared memory port or a
+/// Where an instruction's result comes from on the fast line: computed at I5, or the data of a scratch read or of a load from the shared memory port or a
 /// bank's own port.
 #[derive(Copy, Clone, Debug, PartialEq, LogicState)]
 pub enum FastKind {
     Computed,
-    Converted,
     Scratch,
     Memory,
     TrianglesA,
@@ -232,7 +230,7 @@ pub struct ThreadEngine<
     decode: Decode,
     mailboxes: MailboxUnit,
     rays: PrimaryRays<W, E, M>,
-    execute: Execute<W, E, M>,
+    execute: Execute<W>,
     fp_units: FpUnits<W, E, M, S, S1, X2, T, P>,
     result_line: ResultLine<DX>,
     write_back: WriteBack<W>,
@@ -504,7 +502,6 @@ impl<
             decode,
             mailboxes,
             rays,
-            execute,
             fp_units,
             result_line,
             write_back,
@@ -773,7 +770,6 @@ impl<
         self.result_line.pix_busy.next = self.rays.refused.val();
         self.result_line.fast.next = self.execute.fast.val();
         self.result_line.kind.next = self.execute.kind.val();
-        self.result_line.converted.next = self.execute.converted.val();
         self.result_line.scratch_data.next = self.scratch.read_data.val();
         self.result_line.mem_data.next = self.mem.rdata.val();
         self.result_line.nodes_data.next = self.bank0.rdata.val();

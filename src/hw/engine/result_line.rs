@@ -5,9 +5,9 @@
 //! Contract: what enters at I5 leaves at the write back [`super::ENGINE_LATENCY`] (12) clocks
 //! later; a long instruction's control and pc leave `DX = long_latency - ENGINE_LATENCY`
 //! clocks later still (the scheduler reserved that clock, so no other instruction leaves with
-//! it). The fast result of `lds` and `itof` is replaced by the scratch word or the converted
-//! word one clock after I5, that of `ld` by the word of its bank's port `mem_latency` clocks
-//! after the request (which leaves the engine one clock after I5).
+//! it). The fast result of `lds` is replaced by the scratch word one clock after I5, that of
+//! `ld` by the word of its bank's port `mem_latency` clocks after the request (which leaves
+//! the engine one clock after I5).
 //!
 //! The line decodes the opcode at I6, so that the [`super::WriteBack`] has only the
 //! floating-point units' flags and results to add: it leaves with `write` (the op writes a
@@ -71,8 +71,7 @@ pub struct ResultLine<const DX: usize> {
     /// I5: the fast result and where a load's data comes from.
     pub fast: Signal<In, Bits<32>>,
     pub kind: Signal<In, FastKind>,
-    /// The data that joins: `itof`'s word and the scratch word (I6) and the ports' words.
-    pub converted: Signal<In, Bits<32>>,
+    /// The data that joins: the scratch word (I6) and the ports' words.
     pub scratch_data: Signal<In, Bits<32>>,
     pub mem_data: Signal<In, Bits<32>>,
     pub nodes_data: Signal<In, Bits<32>>,
@@ -192,7 +191,6 @@ impl<const DX: usize> ResultLine<DX> {
             pix_busy: Default::default(),
             fast: Default::default(),
             kind: Default::default(),
-            converted: Default::default(),
             scratch_data: Default::default(),
             mem_data: Default::default(),
             nodes_data: Default::default(),
@@ -435,9 +433,6 @@ impl<const DX: usize> Logic for ResultLine<DX> {
         for k in 1..8 {
             self.fast_line[k].d.next = self.fast_line[k - 1].q.val();
             self.kind_line[k].d.next = self.kind_line[k - 1].q.val();
-        }
-        if self.kind_line[0].q.val() == FastKind::Converted {
-            self.fast_line[1].d.next = self.converted.val();
         }
         if self.kind_line[0].q.val() == FastKind::Scratch {
             self.fast_line[1].d.next = self.scratch_data.val();

@@ -543,9 +543,6 @@ impl<'a> Arith for &'a Asm {
     fn word(self, w: u32) -> Val {
         Val::K(w)
     }
-    fn from_uint(self, i: Val) -> Val {
-        self.op(Op::IToF, i, Val::K(0))
-    }
     fn format(self) -> Format {
         self.format
     }

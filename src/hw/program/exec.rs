@@ -247,7 +247,6 @@ impl<'a> Machine<'a> {
             Op::FMul => result = Some(f.mul(a, b)),
             Op::FDiv => result = Some(f.div(a, b)),
             Op::FSqrt => result = Some(f.sqrt(a)),
-            Op::IToF => result = Some(f.from_int(i64::from(a))),
             Op::Byte => result = Some((b << 8) | crate::units::channel_byte(f, a)),
             Op::Add => result = Some(a.wrapping_add(b)),
             Op::Sub => result = Some(a.wrapping_sub(b)),

@@ -21,6 +21,7 @@ use crate::fp::vectors;
 use crate::layout::unit_triangle_transform;
 use crate::sim;
 use crate::units;
+use rust_hdl::prelude::*;
 
 /// A random word: a third uniform bit patterns, a third edge cases, a third "geometric" values
 /// (magnitudes 2^-8..2^8, either sign).
@@ -740,6 +741,325 @@ fn raygen_e8m23_both() {
     for sim in Simulator::ALL {
         raygen_case(Format::E8M23, &[(64, 48), (7, 3)], 4302, sim);
     }
+}
+
+// ---------------------------------------------------------------------------------------
+// The processor's ray generation: `engine::PrimaryRays` on a TransformUnit
+
+/// `engine::PrimaryRays` with a TransformUnit on its client port, as the triangle tester
+/// serves it in the processor: the unit takes the request in the clocks `take` is high (the
+/// clocks a test's launch leaves free) and its results come back tagged with the thread.
+/// `issued` marks the clock a `pixel` is handed out.
+#[derive(LogicBlock)]
+struct PrimaryRaysBench<
+    const W: usize,
+    const E: usize,
+    const M: usize,
+    const S: usize,
+    const S1: usize,
+    const X2: usize,
+    const T: usize,
+    const P: usize,
+> {
+    pub clock: Signal<In, Clock>,
+    pub frame_start: Signal<In, Bit>,
+    pub camera_write: Signal<In, Bit>,
+    pub camera_pair: Signal<In, Bits<3>>,
+    pub word_a: Signal<In, Bits<32>>,
+    pub word_b: Signal<In, Bits<32>>,
+    pub offer: Signal<In, Bit>,
+    pub thread: Signal<In, Bits<5>>,
+    pub take: Signal<In, Bit>,
+    pub issued: Signal<Out, Bit>,
+    pub word: Signal<Out, Bits<32>>,
+    pub issued_thread: Signal<Out, Bits<5>>,
+    pub primary_write: Signal<Out, Bit>,
+    pub primary_thread: Signal<Out, Bits<5>>,
+    pub primary_o: [Signal<Out, Bits<W>>; 3],
+    pub primary_d: [Signal<Out, Bits<W>>; 3],
+    pub done_mask: Signal<Out, Bits<32>>,
+    rays: crate::hw::engine::PrimaryRays<W, E, M>,
+    unit: crate::hw::TransformUnit<W, E, M, S, S1, X2, T, P>,
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+    > PrimaryRaysBench<W, E, M, S, S1, X2, T, P>
+{
+    fn new(config: &crate::hw::program::ProgramConfig) -> Self {
+        Self {
+            clock: Default::default(),
+            frame_start: Default::default(),
+            camera_write: Default::default(),
+            camera_pair: Default::default(),
+            word_a: Default::default(),
+            word_b: Default::default(),
+            offer: Default::default(),
+            thread: Default::default(),
+            take: Default::default(),
+            issued: Default::default(),
+            word: Default::default(),
+            issued_thread: Default::default(),
+            primary_write: Default::default(),
+            primary_thread: Default::default(),
+            primary_o: Default::default(),
+            primary_d: Default::default(),
+            done_mask: Default::default(),
+            rays: crate::hw::engine::PrimaryRays::new(config),
+            unit: Default::default(),
+        }
+    }
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+    > Logic for PrimaryRaysBench<W, E, M, S, S1, X2, T, P>
+{
+    #[hdl_gen]
+    fn update(&mut self) {
+        self.rays.clock.next = self.clock.val();
+        self.unit.clock.next = self.clock.val();
+        self.rays.frame_start.next = self.frame_start.val();
+        self.rays.camera_write.next = self.camera_write.val();
+        self.rays.camera_pair.next = self.camera_pair.val();
+        self.rays.word_a.next = self.word_a.val();
+        self.rays.word_b.next = self.word_b.val();
+        self.rays.offer.next = self.offer.val();
+        self.rays.thread.next = self.thread.val();
+        self.rays.query_thread.next = 0.into();
+        self.issued.next = self.offer.val() & !self.rays.refused.val() & !self.rays.exhausted.val();
+        self.word.next = self.rays.word.val();
+        self.issued_thread.next = self.thread.val();
+
+        self.rays.gen_take.next = self.take.val();
+        self.unit.in_valid.next = self.rays.gen_valid.val() & self.take.val();
+        for k in 0..12 {
+            self.unit.m[k].next = self.rays.gen_m[k].val();
+        }
+        for k in 0..3 {
+            self.unit.v[k].next = self.rays.gen_v[k].val();
+        }
+        self.unit.point.next = true;
+        self.unit.tag.next = bit_cast::<16, 5>(self.rays.gen_thread.val());
+        self.rays.gen_out_valid.next = self.unit.out_valid.val();
+        self.rays.gen_out_thread.next = self.unit.out_tag.val().get_bits::<5>(0);
+        for k in 0..3 {
+            self.rays.gen_out_dir[k].next = self.unit.result[k].val();
+            self.primary_o[k].next = self.rays.primary_o[k].val();
+            self.primary_d[k].next = self.rays.primary_d[k].val();
+        }
+        self.primary_write.next = self.rays.primary_write.val();
+        self.primary_thread.next = self.rays.primary_thread.val();
+        self.done_mask.next = self.rays.done_mask.val();
+    }
+}
+
+/// PrimaryRays' generated Verilog in `sim`, e7m16, on a frame of the Cornell box's camera:
+/// the camera written a pair of words a clock, a frame start, then threads 0..32 in turn
+/// offering `pixel`s (sometimes after a pause) while the unit takes requests in random
+/// clocks. Asserts: every pixel is handed out once, in raster order, with its word; each
+/// thread's ray is written whole with the eye as origin and `units::primary_direction` of its
+/// pixel as direction, in the order the pixels were handed out, with the thread's bit as
+/// wake-up.
+fn primary_rays_case(width: u16, height: u16, seed: u64, sim: Simulator) {
+    use crate::emit::stream_bench::{BenchPort, InputStream, OutputSink, StreamBench};
+    use crate::emit::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
+    use crate::hw::program::ProgramConfig;
+    use crate::sim::stream_bench::run_stream_bench;
+    assert_eq!(crate::hw::TAG_BITS, 16, "the bench's tag cast");
+    let f = Format::E7M16;
+    let frame = raygen_frames(f, &[(width, height)])[0];
+    let config = ProgramConfig {
+        format: f,
+        width: width.into(),
+        height: height.into(),
+        shadows: false,
+        reflection_depth: 0,
+        light_count: 1,
+        top_root: None,
+        object_root: 0,
+        materials: 0,
+        frame_buffer: 0,
+        stack_entries: 0,
+        object_depth: 1,
+    };
+    let shift = config.pixel_shift();
+    let mut uut = PrimaryRaysBench::<24, 7, 16, 17, 18, 9, 21, 34>::new(&config);
+    uut.connect_all();
+    let top = "primary_rays_bench";
+    let verilog = merge_identical_modules(&rename_rust_hdl_names(&generate_verilog(&uut), top));
+
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let pixels = usize::from(width) * usize::from(height);
+    // The camera and eye words (the 16th word is unused), then the frame start.
+    let words: Vec<u32> = frame.camera.iter().chain(&frame.eye).copied().collect();
+    let word = |k: usize| u64::from(words.get(k).copied().unwrap_or(0));
+    let mut control: Vec<(u32, Vec<u64>)> = (0..8)
+        .map(|pair| {
+            (
+                0,
+                vec![0, 1, pair as u64, word(2 * pair), word(2 * pair + 1)],
+            )
+        })
+        .collect();
+    control.push((0, vec![1, 0, 0, 0, 0]));
+    control.push((0, vec![0, 0, 0, 0, 0]));
+    let offers = (0..pixels)
+        .map(|i| {
+            let gap = if i == 0 {
+                12
+            } else if rng.gen_bool(0.1) {
+                rng.gen_range(1..6)
+            } else {
+                0
+            };
+            (gap, vec![(i % 32) as u64])
+        })
+        .collect();
+    let mut takes: Vec<(u32, Vec<u64>)> = (0..4 * pixels)
+        .map(|_| (0, vec![u64::from(rng.gen_bool(0.5))]))
+        .collect();
+    takes.push((0, vec![1]));
+    let mut ports = vec![BenchPort::input("clock", 1)];
+    for (name, width) in [
+        ("frame_start", 1),
+        ("camera_write", 1),
+        ("camera_pair", 3),
+        ("word_a", 32),
+        ("word_b", 32),
+        ("offer", 1),
+        ("thread", 5),
+        ("take", 1),
+    ] {
+        ports.push(BenchPort::input(name, width));
+    }
+    for (name, width) in [
+        ("issued", 1),
+        ("word", 32),
+        ("issued_thread", 5),
+        ("primary_write", 1),
+        ("primary_thread", 5),
+        ("done_mask", 32),
+    ] {
+        ports.push(BenchPort::output(name, width));
+    }
+    let xyz = |name: &'static str| (0..3).map(move |k| format!("{name}__{k}"));
+    for name in xyz("primary_o").chain(xyz("primary_d")) {
+        ports.push(BenchPort::output(name, 24));
+    }
+    let mut ray_fields = vec!["primary_thread".to_string()];
+    ray_fields.extend(xyz("primary_o").chain(xyz("primary_d")));
+    ray_fields.push("done_mask".into());
+    let bench = StreamBench {
+        dut: top.into(),
+        ports,
+        streams: vec![
+            InputStream {
+                name: "control".into(),
+                fields: [
+                    "frame_start",
+                    "camera_write",
+                    "camera_pair",
+                    "word_a",
+                    "word_b",
+                ]
+                .map(String::from)
+                .to_vec(),
+                valid: None,
+                ready: None,
+                lines: control,
+            },
+            InputStream {
+                name: "offers".into(),
+                fields: vec!["thread".into()],
+                valid: Some("offer".into()),
+                ready: Some("issued".into()),
+                lines: offers,
+            },
+            InputStream {
+                name: "takes".into(),
+                fields: vec!["take".into()],
+                valid: None,
+                ready: None,
+                lines: takes,
+            },
+        ],
+        sinks: vec![
+            OutputSink {
+                name: "issued".into(),
+                valid: "issued".into(),
+                fields: vec!["word".into(), "issued_thread".into()],
+                expected: pixels,
+            },
+            OutputSink {
+                name: "rays".into(),
+                valid: "primary_write".into(),
+                fields: ray_fields,
+                expected: pixels,
+            },
+        ],
+        max_cycles: 20 * pixels as u64 + 1000,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let run = run_stream_bench(&bench, &verilog, sim, dir.path()).unwrap();
+    println!(
+        "{sim} primary rays {width}x{height}: compile {:.1} s, run {:.1} s",
+        run.compile_seconds, run.run_seconds
+    );
+    let (issued, rays) = (&run.sinks[0], &run.sinks[1]);
+    assert_eq!(issued.len(), pixels, "{sim}: pixels handed out");
+    assert_eq!(rays.len(), pixels, "{sim}: rays written");
+    let mut bad = 0;
+    for (i, (given, ray)) in issued.iter().zip(rays).enumerate() {
+        let (x, y) = (
+            (i % usize::from(width)) as u32,
+            (i / usize::from(width)) as u32,
+        );
+        assert_eq!(
+            given[0],
+            u64::from(y << shift | x),
+            "{sim}: word of pixel {i}"
+        );
+        assert_eq!(given[1], (i % 32) as u64, "{sim}: thread of pixel {i}");
+        let thread = given[1];
+        let want_d = units::primary_direction(f, &frame.camera, x, y);
+        let got_o: Vec<u32> = ray[1..4].iter().map(|&w| w as u32).collect();
+        let got_d: Vec<u32> = ray[4..7].iter().map(|&w| w as u32).collect();
+        if ray[0] != thread || got_o != frame.eye || got_d != want_d || ray[7] != 1 << thread {
+            if bad < 5 {
+                eprintln!(
+                    "{sim} pixel ({x}, {y}): got thread {} o {got_o:x?} d {got_d:x?} wake-up {:x}, want {thread} {:x?} {want_d:x?} {:x}",
+                    ray[0], ray[7], frame.eye, 1u64 << thread
+                );
+            }
+            bad += 1;
+        }
+    }
+    assert_eq!(bad, 0, "{sim}: {bad} of {pixels} primary rays differ");
+}
+
+#[test]
+fn primary_rays_e7m16_icarus() {
+    primary_rays_case(40, 30, 3401, Simulator::Icarus);
+}
+
+#[test]
+fn primary_rays_e7m16_verilator() {
+    primary_rays_case(64, 48, 3402, Simulator::Verilator);
 }
 
 // ---------------------------------------------------------------------------------------
