@@ -11383,6 +11383,18 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
     reg  [4:0] slot_thread__d;
     wire  [4:0] slot_thread__q;
     reg  slot_thread__clock;
+    reg  req_full__d;
+    wire  req_full__q;
+    reg  req_full__clock;
+    reg  [4:0] req_thread__d;
+    wire  [4:0] req_thread__q;
+    reg  req_thread__clock;
+    reg  [23:0] req_xy__0__d;
+    wire  [23:0] req_xy__0__q;
+    reg  req_xy__0__clock;
+    reg  [23:0] req_xy__1__d;
+    wire  [23:0] req_xy__1__q;
+    reg  req_xy__1__clock;
     reg  result_valid__d;
     wire  result_valid__q;
     reg  result_valid__clock;
@@ -11569,6 +11581,26 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         .q(slot_thread__q),
         .clock(slot_thread__clock)
     );
+    dynrt_processor__display__dark_d req_full(
+        .d(req_full__d),
+        .q(req_full__q),
+        .clock(req_full__clock)
+    );
+    dynrt_processor__engine__decode__t4 req_thread(
+        .d(req_thread__d),
+        .q(req_thread__q),
+        .clock(req_thread__clock)
+    );
+    dynrt_processor__display__rgb_q req_xy__0(
+        .d(req_xy__0__d),
+        .q(req_xy__0__q),
+        .clock(req_xy__0__clock)
+    );
+    dynrt_processor__display__rgb_q req_xy__1(
+        .d(req_xy__1__d),
+        .q(req_xy__1__q),
+        .clock(req_xy__1__clock)
+    );
     dynrt_processor__display__dark_d result_valid(
         .d(result_valid__d),
         .q(result_valid__q),
@@ -11641,6 +11673,8 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
     always @(*) begin
         slot_valid__clock = clock;
         slot_thread__clock = clock;
+        req_full__clock = clock;
+        req_thread__clock = clock;
         result_valid__clock = clock;
         result_thread__clock = clock;
         result_mask__clock = clock;
@@ -11648,6 +11682,8 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         pending_r__clock = clock;
         slot_valid__d = slot_valid__q;
         slot_thread__d = slot_thread__q;
+        req_full__d = req_full__q;
+        req_thread__d = req_thread__q;
         result_valid__d = result_valid__q;
         result_thread__d = result_thread__q;
         result_mask__d = result_mask__q;
@@ -11685,6 +11721,10 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         camera__14__d = camera__14__q;
         camera__15__clock = clock;
         camera__15__d = camera__15__q;
+        req_xy__0__clock = clock;
+        req_xy__0__d = req_xy__0__q;
+        req_xy__1__clock = clock;
+        req_xy__1__d = req_xy__1__q;
         result_dir__0__clock = clock;
         result_dir__0__d = gen_out_dir__0;
         dirs__0__read_clock = clock;
@@ -11755,26 +11795,33 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         end
         raygen__thread_valid = slot_valid__q;
         raygen__thread_id = ((slot_thread__q) & 8'hff);
-        raygen__req_ready = gen_take;
-        gen_valid = raygen__req_valid;
-        gen_m__0 = raygen__req_m__0;
-        gen_m__1 = raygen__req_m__1;
-        gen_m__2 = raygen__req_m__2;
-        gen_m__3 = raygen__req_m__3;
-        gen_m__4 = raygen__req_m__4;
-        gen_m__5 = raygen__req_m__5;
-        gen_m__6 = raygen__req_m__6;
-        gen_m__7 = raygen__req_m__7;
-        gen_m__8 = raygen__req_m__8;
-        gen_m__9 = raygen__req_m__9;
-        gen_m__10 = raygen__req_m__10;
-        gen_m__11 = raygen__req_m__11;
-        gen_v__0 = raygen__req_v__0;
-        gen_v__1 = raygen__req_v__1;
-        gen_v__2 = raygen__req_v__2;
-        gen_thread = slot_thread__q;
+        raygen__req_ready = ~req_full__q;
         if (raygen__thread_ready) begin
             slot_valid__d = 1'b0;
+            req_full__d = 1'b1;
+            req_thread__d = slot_thread__q;
+            req_xy__0__d = raygen__req_v__0;
+            req_xy__1__d = raygen__req_v__1;
+        end
+        gen_valid = req_full__q;
+        gen_m__0 = camera__0__q;
+        gen_m__1 = camera__1__q;
+        gen_m__2 = camera__2__q;
+        gen_m__3 = camera__3__q;
+        gen_m__4 = camera__4__q;
+        gen_m__5 = camera__5__q;
+        gen_m__6 = camera__6__q;
+        gen_m__7 = camera__7__q;
+        gen_m__8 = camera__8__q;
+        gen_m__9 = camera__9__q;
+        gen_m__10 = camera__10__q;
+        gen_m__11 = camera__11__q;
+        gen_v__0 = req_xy__0__q;
+        gen_v__1 = req_xy__1__q;
+        gen_v__2 = 32'h0;
+        gen_thread = req_thread__q;
+        if (req_full__q & gen_take) begin
+            req_full__d = 1'b0;
         end
         result_valid__d = gen_out_valid;
         result_thread__d = gen_out_thread;
@@ -11815,6 +11862,7 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         pending = pending_r__q;
         if (frame_start) begin
             slot_valid__d = 1'b0;
+            req_full__d = 1'b0;
             waiting__d = 32'h0;
         end
     end
@@ -12175,6 +12223,14 @@ module dynrt_processor__engine__rays__raygen(clock,start,width,height,camera__0,
     end
     
 endmodule // dynrt_processor__engine__rays__raygen
+
+
+
+
+
+
+
+
 
 
 

@@ -16,8 +16,11 @@
 //!   the pixel before (the thread repeats its `pixel`); an `offer` that is neither refused
 //!   nor exhausted takes the pixel for `thread` and marks its ray pending. A frame start
 //!   begins again at (0, 0).
-//! - Request: the slot offers RayGen, whose request goes out on `gen_*` (the tester's client
-//!   port) until `gen_take`; the direction comes back on `gen_out_*`.
+//! - Request: the slot offers RayGen, whose request waits in a register of its own and goes
+//!   out on `gen_*` (the tester's client port) until `gen_take`; the direction comes back on
+//!   `gen_out_*`. The register keeps the tester's take out of RayGen's counters: with the take
+//!   deciding their advance in the same clock, the path from the slot through the tester and
+//!   back into the counters' fan-out was the processor's slowest (86.5 MHz on one placement).
 //! - Write (a clock after `gen_out_valid`): `primary_write` with `primary_thread`,
 //!   `primary_o` (the eye) and `primary_d` for both coprocessors' [`RayStore`]s (the engine
 //!   writes no ray words in that clock: it refuses them); `done_mask` (bit `thread`) in the
@@ -25,7 +28,7 @@
 //! - Answers: `query_thread` at I4; at I5 `pending` (the thread's ray is not written yet) and
 //!   `dir` (its last primary direction).
 //!
-//! Latency: from the `pixel` at I5 to the request 1 clock, then at most 2 clocks of a test's
+//! Latency: from the `pixel` at I5 to the request 2 clocks, then at most 2 clocks of a test's
 //! launch, [`TRANSFORM_LATENCY`] (28) in the unit and 1 to the write. Throughput: one pixel
 //! per 2 clocks (the slot refills the clock after RayGen takes it).
 //!
@@ -80,6 +83,10 @@ pub struct PrimaryRays<const W: usize, const E: usize, const M: usize> {
     slot_valid: DFF<Bit>,
     slot_thread: DFF<Bits<5>>,
     taken: Signal<Local, Bit>,
+    /// The request RayGen made, until the tester takes it: the point's x and y.
+    req_full: DFF<Bit>,
+    req_thread: DFF<Bits<5>>,
+    req_xy: [DFF<Bits<W>>; 2],
     /// The direction back from the unit, registered before it is written.
     result_valid: DFF<Bit>,
     result_thread: DFF<Bits<5>>,
@@ -137,6 +144,9 @@ impl<const W: usize, const E: usize, const M: usize> PrimaryRays<W, E, M> {
             slot_valid: Default::default(),
             slot_thread: Default::default(),
             taken: Default::default(),
+            req_full: Default::default(),
+            req_thread: Default::default(),
+            req_xy: Default::default(),
             result_valid: Default::default(),
             result_thread: Default::default(),
             result_dir: Default::default(),
@@ -162,6 +172,8 @@ impl<const W: usize, const E: usize, const M: usize> Logic for PrimaryRays<W, E,
             clock,
             slot_valid,
             slot_thread,
+            req_full,
+            req_thread,
             result_valid,
             result_thread,
             result_mask,
@@ -171,6 +183,10 @@ impl<const W: usize, const E: usize, const M: usize> Logic for PrimaryRays<W, E,
         for k in 0..16 {
             self.camera[k].clock.next = self.clock.val();
             self.camera[k].d.next = self.camera[k].q.val();
+        }
+        for k in 0..2 {
+            self.req_xy[k].clock.next = self.clock.val();
+            self.req_xy[k].d.next = self.req_xy[k].q.val();
         }
         for k in 0..3 {
             self.result_dir[k].clock.next = self.clock.val();
@@ -205,20 +221,28 @@ impl<const W: usize, const E: usize, const M: usize> Logic for PrimaryRays<W, E,
             self.slot_valid.d.next = true;
             self.slot_thread.d.next = self.thread.val();
         }
-        // The request, until the unit takes it.
+        // The request into its register while that is empty, then to the unit until it takes
+        // it (RayGen's point is (x, y, 0), its matrix the camera).
         self.raygen.thread_valid.next = self.slot_valid.q.val();
         self.raygen.thread_id.next = bit_cast::<8, 5>(self.slot_thread.q.val());
-        self.raygen.req_ready.next = self.gen_take.val();
-        self.gen_valid.next = self.raygen.req_valid.val();
-        for k in 0..12 {
-            self.gen_m[k].next = self.raygen.req_m[k].val();
-        }
-        for k in 0..3 {
-            self.gen_v[k].next = self.raygen.req_v[k].val();
-        }
-        self.gen_thread.next = self.slot_thread.q.val();
+        self.raygen.req_ready.next = !self.req_full.q.val();
         if self.raygen.thread_ready.val() {
             self.slot_valid.d.next = false;
+            self.req_full.d.next = true;
+            self.req_thread.d.next = self.slot_thread.q.val();
+            self.req_xy[0].d.next = self.raygen.req_v[0].val();
+            self.req_xy[1].d.next = self.raygen.req_v[1].val();
+        }
+        self.gen_valid.next = self.req_full.q.val();
+        for k in 0..12 {
+            self.gen_m[k].next = self.camera[k].q.val();
+        }
+        self.gen_v[0].next = self.req_xy[0].q.val();
+        self.gen_v[1].next = self.req_xy[1].q.val();
+        self.gen_v[2].next = 0.into();
+        self.gen_thread.next = self.req_thread.q.val();
+        if self.req_full.q.val() & self.gen_take.val() {
+            self.req_full.d.next = false;
         }
 
         // The direction, written with the eye as origin.
@@ -255,6 +279,7 @@ impl<const W: usize, const E: usize, const M: usize> Logic for PrimaryRays<W, E,
 
         if self.frame_start.val() {
             self.slot_valid.d.next = false;
+            self.req_full.d.next = false;
             self.waiting.d.next = 0.into();
         }
     }
