@@ -138,9 +138,9 @@ module tb;
     @(negedge clock) start = 1'b1;
     @(negedge clock) start = 1'b0;
     n = 0;
-    while (!done && n < 1675036) begin @(posedge clock); n = n + 1; end
+    while (!done && n < 1674844) begin @(posedge clock); n = n + 1; end
     if (!done) begin
-      $display("TIMEOUT: frame 0 not done after 1675036 clocks");
+      $display("TIMEOUT: frame 0 not done after 1674844 clocks");
       $fatal(1, "timeout");
     end
     fd = $fopen({out_dir, "/frame0.hex"}, "w");

@@ -64,7 +64,10 @@ impl Gen<'_> {
         for (pair, w) in words.chunks(2).enumerate() {
             a.tri_camera(pair as u8, w[0], w[1]);
         }
-        for r in words.into_iter().filter(|r| *r != Reg::ZERO) {
+        // The eye's words stay (a secondary ray's shading starts its rays there); the
+        // camera's are done with.
+        let eye_words = [words[12], words[13], words[14]];
+        for r in words[..12].iter().copied().filter(|r| *r != Reg::ZERO) {
             a.free(r);
         }
         // 1 / |n| of a hit's normal through an instance's normal matrix.
@@ -72,16 +75,11 @@ impl Gen<'_> {
         // Without secondary rays every query starts at the eye with t_min 0 and t_max
         // infinity: the query registers hold them for the whole frame.
         let eye = if self.secondary_rays() {
-            std::array::from_fn(|k| load(FrameMap::EYE + k))
+            eye_words
         } else {
-            for k in 0..3 {
-                a.load_to(
-                    s.q_o[k],
-                    crate::layout::FRAME,
-                    Val::K(0),
-                    0,
-                    (FrameMap::EYE + k) as u32,
-                );
+            a.mov3(s.q_o, eye_words.map(Val::R));
+            for r in eye_words {
+                a.free(r);
             }
             a.mov(s.q_t_min, Val::K(0));
             s.q_o
