@@ -371,7 +371,8 @@ pub fn synthesize_processor(out: &Path) -> Result<SynthReport> {
 }
 
 /// Synthesizes the processor in `out` like [`synthesize_processor`] but with its hierarchy
-/// kept, and itemizes its resources per block down to the engine's units (two levels), into
+/// kept, and itemizes its resources per block down to the coprocessors' units (three levels:
+/// `engine.tester.transform_unit`), into
 /// `out/synth/` (`blocks.md`, `blocks.csv` beside yosys's files). Takes minutes.
 pub fn synthesize_processor_blocks(out: &Path) -> Result<synth::blocks::BlockReport> {
     let rtl = out.join("rtl").join(format!("{PROCESSOR_TOP}.v"));
@@ -380,7 +381,7 @@ pub fn synthesize_processor_blocks(out: &Path) -> Result<synth::blocks::BlockRep
         ..SynthOptions::default()
     };
     let dir = out.join("synth");
-    let report = synth::synth_xc2v_blocks(&[rtl], PROCESSOR_TOP, &dir, &options, 2)?;
+    let report = synth::synth_xc2v_blocks(&[rtl], PROCESSOR_TOP, &dir, &options, 3)?;
     std::fs::write(dir.join("blocks.md"), report.markdown())?;
     std::fs::write(dir.join("blocks.csv"), report.csv())?;
     Ok(report)

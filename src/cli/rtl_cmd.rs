@@ -37,8 +37,8 @@ pub struct RtlArgs {
     #[arg(long)]
     pub synth: bool,
     /// Also synthesize the processor with its hierarchy kept and itemize LUTs, flip-flops,
-    /// multipliers and block RAMs per block (the engine's units one level further), into
-    /// OUT/synth/blocks.md and blocks.csv (takes minutes).
+    /// multipliers and block RAMs per block (three levels down: the coprocessors' units), into
+    /// OUT/synth/blocks.md and blocks.csv (about a minute: each block is optimized alone).
     #[arg(long)]
     pub synth_blocks: bool,
     /// Board file (TOML, boards/README.md): pin locations and I/O standards for the UCF

@@ -138,16 +138,20 @@ fn walk<'a>(
 
 impl BlockReport {
     /// A Markdown table: one row per block, indented by depth, with its share of the top's
-    /// LUTs.
+    /// LUTs; blocks under half a percent of the LUTs with no multiplier or block RAM (the
+    /// many single registers) are left out, the CSV has them.
     pub fn markdown(&self) -> String {
         let top = self.rows.first().map(|r| r.resources).unwrap_or_default();
+        let shown = |r: &Resources| {
+            200 * r.total_luts() >= top.total_luts() || r.mult18x18 > 0 || r.block_rams > 0
+        };
         let mut s = String::new();
         let _ = writeln!(
             s,
             "| block | LUTs | of which RAM/SRL | FFs | MULT18X18 | RAMB16 | share of LUTs |"
         );
         let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|");
-        for row in &self.rows {
+        for row in self.rows.iter().filter(|row| shown(&row.resources)) {
             let r = &row.resources;
             let name = if row.path.is_empty() {
                 format!("**{}** (whole)", self.top)

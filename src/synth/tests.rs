@@ -281,4 +281,12 @@ endmodule\n";
     assert!(report.command.contains("-top top") && !report.command.contains("-flatten"));
     assert!(report.csv().starts_with("block,depth,luts,"));
     assert!(report.csv().contains("\nmix,1,4,0,4,0,0\n"));
+    // The table leaves out blocks under half a percent of the LUTs with no multiplier or
+    // block RAM (the two registers); the CSV keeps every one.
+    let table = report.markdown();
+    assert!(
+        table.contains("`mix` | 4 |") && !table.contains("`first`"),
+        "{table}"
+    );
+    assert!(report.csv().contains("\nfirst,1,0,0,8,0,0\n"));
 }
