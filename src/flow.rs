@@ -373,7 +373,8 @@ pub fn synthesize_processor(out: &Path) -> Result<SynthReport> {
 /// Synthesizes the processor in `out` like [`synthesize_processor`] but with its hierarchy
 /// kept, and itemizes its resources per block down to the coprocessors' units (three levels:
 /// `engine.tester.transform_unit`), into
-/// `out/synth/` (`blocks.md`, `blocks.csv` beside yosys's files). Takes minutes.
+/// `out/synth/` (`blocks.md`, `blocks.csv` beside yosys's files). About a minute: no
+/// flattening, each block is optimized alone.
 pub fn synthesize_processor_blocks(out: &Path) -> Result<synth::blocks::BlockReport> {
     let rtl = out.join("rtl").join(format!("{PROCESSOR_TOP}.v"));
     let options = SynthOptions {

@@ -6,8 +6,9 @@
 //! for inspection) under a time limit, and reads the cell counts from the flattened netlist.
 //! `-flatten` makes the counts whole-design totals and lets the depth analysis see every path.
 //! [`synth_xc2v_blocks`] runs the same script without `-flatten` and itemizes the resources per
-//! block instance ([`blocks`]): each block is optimized on its own, so the sum is a little
-//! above the flattened total, which optimizes across block boundaries.
+//! block instance ([`blocks`]): each block is optimized on its own, so the sum is above the
+//! flattened total, which optimizes across block boundaries (the processor at stop 34: 22,880
+//! LUTs against 17,371); its rows are for shares.
 //! Yosys marks xc2v support EXPERIMENTAL; it maps products to `MULT18X18` (17x17 -> 1,
 //! 24x24 -> 4 plus adders), registers to `FD*`, logic to `LUT1`..`LUT4` + `MUXF5`..`MUXF8`,
 //! adders to `MUXCY`/`XORCY`, memories to `RAMB16_*`. Logic depth is defined in [`depth`].

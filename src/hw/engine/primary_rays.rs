@@ -295,23 +295,6 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use std::collections::VecDeque;
 
-    fn config(width: u32, height: u32) -> ProgramConfig {
-        ProgramConfig {
-            format: Format::E7M16,
-            width,
-            height,
-            shadows: false,
-            reflection_depth: 0,
-            light_count: 1,
-            top_root: None,
-            object_root: 0,
-            materials: 0,
-            frame_buffer: 0,
-            stack_entries: 0,
-            object_depth: 1,
-        }
-    }
-
     /// PrimaryRays in rust-hdl simulation, with threads offering `pixel`s at random and a
     /// model of the tester's TransformUnit that takes a request in a random clock and returns
     /// `units::transform` of the request's words 28 clocks later. Asserts: every pixel is
@@ -323,7 +306,7 @@ mod tests {
     fn every_pixel_gets_its_primary_ray_through_the_shared_unit() {
         let f = Format::E7M16;
         let (w, h) = (13u32, 5u32);
-        let c = config(w, h);
+        let c = ProgramConfig::frame_only(f, w, h);
         let shift = c.pixel_shift();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(33);
         let camera: [u32; 15] = std::array::from_fn(|_| f.from_f64(rng.gen_range(-2.0..2.0)));

@@ -52,6 +52,26 @@ pub struct ProgramConfig {
 }
 
 impl ProgramConfig {
+    /// A frame of `width` x `height` with nothing else in it (one object at node 0, no
+    /// shadows, mirrors or top level): what the tests of ray generation's units need.
+    #[cfg(test)]
+    pub(crate) fn frame_only(format: Format, width: u32, height: u32) -> Self {
+        ProgramConfig {
+            format,
+            width,
+            height,
+            shadows: false,
+            reflection_depth: 0,
+            light_count: 1,
+            top_root: None,
+            object_root: 0,
+            materials: 0,
+            frame_buffer: 0,
+            stack_entries: 0,
+            object_depth: 1,
+        }
+    }
+
     /// Where `pixel` puts y: above x's bits, so that with a power-of-two width the word is the
     /// pixel's index in the frame buffer (no address arithmetic); else at bit 16.
     pub fn pixel_shift(&self) -> u32 {

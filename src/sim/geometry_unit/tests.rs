@@ -883,20 +883,7 @@ fn primary_rays_case(width: u16, height: u16, seed: u64, sim: Simulator) {
     assert_eq!(crate::hw::TAG_BITS, 16, "the bench's tag cast");
     let f = Format::E7M16;
     let frame = raygen_frames(f, &[(width, height)])[0];
-    let config = ProgramConfig {
-        format: f,
-        width: width.into(),
-        height: height.into(),
-        shadows: false,
-        reflection_depth: 0,
-        light_count: 1,
-        top_root: None,
-        object_root: 0,
-        materials: 0,
-        frame_buffer: 0,
-        stack_entries: 0,
-        object_depth: 1,
-    };
+    let config = ProgramConfig::frame_only(f, width.into(), height.into());
     let shift = config.pixel_shift();
     let mut uut = PrimaryRaysBench::<24, 7, 16, 17, 18, 9, 21, 34>::new(&config);
     uut.connect_all();
