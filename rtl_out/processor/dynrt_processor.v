@@ -60,6 +60,7 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
     wire  [31:0] engine__intersect_busy;
     wire  [31:0] engine__traversal_busy;
     wire  [31:0] engine__raygen_busy;
+    wire  [31:0] engine__instance_busy;
     reg  display__clock;
     reg  display__reset;
     wire  [23:0] display__fb_addr;
@@ -95,7 +96,8 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
         .transform_busy(engine__transform_busy),
         .intersect_busy(engine__intersect_busy),
         .traversal_busy(engine__traversal_busy),
-        .raygen_busy(engine__raygen_busy)
+        .raygen_busy(engine__raygen_busy),
+        .instance_busy(engine__instance_busy)
     );
     dynrt_processor__display display(
         .clock(display__clock),
@@ -637,7 +639,7 @@ endmodule // dynrt_processor__display__timing__col
 
 
 
-module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy);
+module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy);
     
     // Module arguments
     input wire  clock;
@@ -665,6 +667,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     output reg  [31:0] intersect_busy;
     output reg  [31:0] traversal_busy;
     output reg  [31:0] raygen_busy;
+    output reg  [31:0] instance_busy;
     
     // Constant declarations
     localparam  c_threads = 8'h20;
@@ -686,6 +689,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam  tri_object = 32'h9;
     localparam  tri_skip = 32'ha;
     localparam  tri_camera = 32'hb;
+    localparam  tri_world = 32'hd;
+    localparam  tri_enter = 32'he;
     localparam  kd_start = 32'h0;
     localparam  kd_wait = 32'h1;
     localparam  cmd_list = 2'b0;
@@ -693,6 +698,10 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam  cmd_object = 2'b10;
     localparam  cmd_skip = 2'b11;
     localparam  bank_lists = 3'b1;
+    localparam  bank_instances = 3'b100;
+    localparam  client_primary = 2'b0;
+    localparam  client_origin = 2'b1;
+    localparam  client_direction = 2'b11;
     localparam  one_bank = 6'b1;
     localparam  shared_banks = 6'b110010;
     
@@ -826,6 +835,57 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     wire  [23:0] rays__dir__0;
     wire  [23:0] rays__dir__1;
     wire  [23:0] rays__dir__2;
+    reg  instances__clock;
+    reg  instances__frame_start;
+    reg  instances__world_write;
+    reg  [1:0] instances__world_pair;
+    reg  [31:0] instances__word_a;
+    reg  [31:0] instances__word_b;
+    reg  [4:0] instances__thread;
+    reg  instances__offer;
+    reg  [23:0] instances__record;
+    wire  instances__refused;
+    reg  instances__bus_free;
+    wire  instances__read;
+    wire  [23:0] instances__addr;
+    reg  [31:0] instances__rdata;
+    wire  instances__gen_valid;
+    wire  [23:0] instances__gen_m__0;
+    wire  [23:0] instances__gen_m__1;
+    wire  [23:0] instances__gen_m__2;
+    wire  [23:0] instances__gen_m__3;
+    wire  [23:0] instances__gen_m__4;
+    wire  [23:0] instances__gen_m__5;
+    wire  [23:0] instances__gen_m__6;
+    wire  [23:0] instances__gen_m__7;
+    wire  [23:0] instances__gen_m__8;
+    wire  [23:0] instances__gen_m__9;
+    wire  [23:0] instances__gen_m__10;
+    wire  [23:0] instances__gen_m__11;
+    wire  [23:0] instances__gen_v__0;
+    wire  [23:0] instances__gen_v__1;
+    wire  [23:0] instances__gen_v__2;
+    wire  instances__gen_point;
+    wire  instances__gen_direction;
+    wire  [4:0] instances__gen_thread;
+    reg  instances__gen_take;
+    reg  instances__out_valid;
+    reg  instances__out_direction;
+    reg  [4:0] instances__out_thread;
+    reg  [23:0] instances__out_v__0;
+    reg  [23:0] instances__out_v__1;
+    reg  [23:0] instances__out_v__2;
+    wire  instances__ray_write;
+    wire  [4:0] instances__ray_thread;
+    wire  [23:0] instances__ray_o__0;
+    wire  [23:0] instances__ray_o__1;
+    wire  [23:0] instances__ray_o__2;
+    wire  [23:0] instances__ray_d__0;
+    wire  [23:0] instances__ray_d__1;
+    wire  [23:0] instances__ray_d__2;
+    wire  [31:0] instances__done_mask;
+    reg  [4:0] instances__query_thread;
+    wire  instances__pending;
     reg  [4:0] execute__op;
     reg  [31:0] execute__a;
     reg  [31:0] execute__b;
@@ -987,9 +1047,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [23:0] tester__gen_v__0;
     reg  [23:0] tester__gen_v__1;
     reg  [23:0] tester__gen_v__2;
+    reg  tester__gen_point;
+    reg  [1:0] tester__gen_client;
     reg  [4:0] tester__gen_thread;
     wire  tester__gen_take;
     wire  tester__gen_out_valid;
+    wire  [1:0] tester__gen_out_client;
     wire  [4:0] tester__gen_out_thread;
     wire  [23:0] tester__gen_out_dir__0;
     wire  [23:0] tester__gen_out_dir__1;
@@ -1062,6 +1125,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [31:0] raygen_count__d;
     wire  [31:0] raygen_count__q;
     reg  raygen_count__clock;
+    reg  [31:0] instance_count__d;
+    wire  [31:0] instance_count__q;
+    reg  instance_count__clock;
     reg  [5:0] mem_load_r__d;
     wire  [5:0] mem_load_r__q;
     reg  mem_load_r__clock;
@@ -1089,6 +1155,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  camera_write__d;
     wire  camera_write__q;
     reg  camera_write__clock;
+    reg  world_write__d;
+    wire  world_write__q;
+    reg  world_write__clock;
+    reg  enter_offer__d;
+    wire  enter_offer__q;
+    reg  enter_offer__clock;
     reg  tri_enqueue__d;
     wire  tri_enqueue__q;
     reg  tri_enqueue__clock;
@@ -1120,6 +1192,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  queued_fn;
     reg  tri_busy;
     reg  kd_busy;
+    reg  gen_instance;
+    reg  store_write;
     
     // Sub module instances
     dynrt_processor__engine__scheduler scheduler(
@@ -1246,6 +1320,59 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .dir__0(rays__dir__0),
         .dir__1(rays__dir__1),
         .dir__2(rays__dir__2)
+    );
+    dynrt_processor__engine__instances instances(
+        .clock(instances__clock),
+        .frame_start(instances__frame_start),
+        .world_write(instances__world_write),
+        .world_pair(instances__world_pair),
+        .word_a(instances__word_a),
+        .word_b(instances__word_b),
+        .thread(instances__thread),
+        .offer(instances__offer),
+        .record(instances__record),
+        .refused(instances__refused),
+        .bus_free(instances__bus_free),
+        .read(instances__read),
+        .addr(instances__addr),
+        .rdata(instances__rdata),
+        .gen_valid(instances__gen_valid),
+        .gen_m__0(instances__gen_m__0),
+        .gen_m__1(instances__gen_m__1),
+        .gen_m__2(instances__gen_m__2),
+        .gen_m__3(instances__gen_m__3),
+        .gen_m__4(instances__gen_m__4),
+        .gen_m__5(instances__gen_m__5),
+        .gen_m__6(instances__gen_m__6),
+        .gen_m__7(instances__gen_m__7),
+        .gen_m__8(instances__gen_m__8),
+        .gen_m__9(instances__gen_m__9),
+        .gen_m__10(instances__gen_m__10),
+        .gen_m__11(instances__gen_m__11),
+        .gen_v__0(instances__gen_v__0),
+        .gen_v__1(instances__gen_v__1),
+        .gen_v__2(instances__gen_v__2),
+        .gen_point(instances__gen_point),
+        .gen_direction(instances__gen_direction),
+        .gen_thread(instances__gen_thread),
+        .gen_take(instances__gen_take),
+        .out_valid(instances__out_valid),
+        .out_direction(instances__out_direction),
+        .out_thread(instances__out_thread),
+        .out_v__0(instances__out_v__0),
+        .out_v__1(instances__out_v__1),
+        .out_v__2(instances__out_v__2),
+        .ray_write(instances__ray_write),
+        .ray_thread(instances__ray_thread),
+        .ray_o__0(instances__ray_o__0),
+        .ray_o__1(instances__ray_o__1),
+        .ray_o__2(instances__ray_o__2),
+        .ray_d__0(instances__ray_d__0),
+        .ray_d__1(instances__ray_d__1),
+        .ray_d__2(instances__ray_d__2),
+        .done_mask(instances__done_mask),
+        .query_thread(instances__query_thread),
+        .pending(instances__pending)
     );
     dynrt_processor__engine__execute execute(
         .op(execute__op),
@@ -1425,9 +1552,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .gen_v__0(tester__gen_v__0),
         .gen_v__1(tester__gen_v__1),
         .gen_v__2(tester__gen_v__2),
+        .gen_point(tester__gen_point),
+        .gen_client(tester__gen_client),
         .gen_thread(tester__gen_thread),
         .gen_take(tester__gen_take),
         .gen_out_valid(tester__gen_out_valid),
+        .gen_out_client(tester__gen_out_client),
         .gen_out_thread(tester__gen_out_thread),
         .gen_out_dir__0(tester__gen_out_dir__0),
         .gen_out_dir__1(tester__gen_out_dir__1),
@@ -1524,6 +1654,11 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(raygen_count__q),
         .clock(raygen_count__clock)
     );
+    dynrt_processor__engine__cycle_count instance_count(
+        .d(instance_count__d),
+        .q(instance_count__q),
+        .clock(instance_count__clock)
+    );
     dynrt_processor__engine__mem_load_r mem_load_r(
         .d(mem_load_r__d),
         .q(mem_load_r__q),
@@ -1568,6 +1703,16 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .d(camera_write__d),
         .q(camera_write__q),
         .clock(camera_write__clock)
+    );
+    dynrt_processor__display__dark_d world_write(
+        .d(world_write__d),
+        .q(world_write__q),
+        .clock(world_write__clock)
+    );
+    dynrt_processor__display__dark_d enter_offer(
+        .d(enter_offer__d),
+        .q(enter_offer__q),
+        .clock(enter_offer__clock)
     );
     dynrt_processor__display__dark_d tri_enqueue(
         .d(tri_enqueue__d),
@@ -1614,6 +1759,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         instr_count__clock = clock;
         transform_count__clock = clock;
         raygen_count__clock = clock;
+        instance_count__clock = clock;
         intersect_count__clock = clock;
         traversal_count__clock = clock;
         mem_load_r__clock = clock;
@@ -1625,6 +1771,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         ray_write__clock = clock;
         t_min_write__clock = clock;
         camera_write__clock = clock;
+        world_write__clock = clock;
+        enter_offer__clock = clock;
         tri_enqueue__clock = clock;
         tri_queues__clock = clock;
         tri_kind__clock = clock;
@@ -1639,6 +1787,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         instr_count__d = instr_count__q;
         transform_count__d = transform_count__q;
         raygen_count__d = raygen_count__q;
+        instance_count__d = instance_count__q;
         intersect_count__d = intersect_count__q;
         traversal_count__d = traversal_count__q;
         mem_load_r__d = mem_load_r__q;
@@ -1650,6 +1799,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         ray_write__d = ray_write__q;
         t_min_write__d = t_min_write__q;
         camera_write__d = camera_write__q;
+        world_write__d = world_write__q;
+        enter_offer__d = enter_offer__q;
         tri_enqueue__d = tri_enqueue__q;
         tri_queues__d = tri_queues__q;
         tri_kind__d = tri_kind__q;
@@ -1662,6 +1813,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         decode__clock = clock;
         mailboxes__clock = clock;
         rays__clock = clock;
+        instances__clock = clock;
         fp_units__clock = clock;
         result_line__clock = clock;
         write_back__clock = clock;
@@ -1669,6 +1821,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         traversal_unit__clock = clock;
         scratch__read_clock = clock;
         scratch__write_clock = clock;
+        gen_instance = instances__gen_valid & (~rays__gen_valid);
+        store_write = rays__primary_write | instances__ray_write;
         frame_start = start & (~running__q);
         done = (~running__q) & (halted_count__q == c_threads);
         cycles = cycle_count__q;
@@ -1677,6 +1831,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         intersect_busy = intersect_count__q;
         traversal_busy = traversal_count__q;
         raygen_busy = raygen_count__q;
+        instance_busy = instance_count__q;
         if (running__q) begin
             cycle_count__d = cycle_count__q + 32'h1;
             if (tester__transform_busy) begin
@@ -1688,8 +1843,11 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             if (traversal_unit__step_busy) begin
                 traversal_count__d = traversal_count__q + 32'h1;
             end
-            if (tester__gen_take) begin
+            if (tester__gen_take & (~gen_instance)) begin
                 raygen_count__d = raygen_count__q + 32'h1;
+            end
+            if (tester__gen_take & gen_instance) begin
+                instance_count__d = instance_count__q + 32'h1;
             end
         end
         scheduler__running = running__q;
@@ -1708,6 +1866,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         mailboxes__read_which = decode__imm_i4[32'h0];
         tester__engine__query_thread = decode__thread_i4;
         traversal_unit__engine__query_thread = decode__thread_i4;
+        instances__query_thread = decode__thread_i4;
         fp_units__a = decode__a[(32'h0)+:(24)];
         fp_units__b = decode__b[(32'h0)+:(24)];
         fp_units__sub = decode__op == op_fsub;
@@ -1739,6 +1898,14 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         rays__word_a = decode__a;
         rays__word_b = decode__b;
         rays__query_thread = decode__thread_i4;
+        instances__frame_start = frame_start;
+        instances__thread = decode__thread;
+        instances__world_write = world_write__q;
+        instances__world_pair = decode__shift[(32'h0)+:(2)];
+        instances__word_a = decode__a;
+        instances__word_b = decode__b;
+        instances__offer = enter_offer__q;
+        instances__record = decode__a[(32'h0)+:(24)];
         scratch__read_address = (((decode__thread) & 12'hfff) << 32'h7) | ((execute__scratch_address[(32'h0)+:(7)]) & 12'hfff);
         scratch__write_address = (((decode__thread) & 12'hfff) << 32'h7) | ((execute__scratch_address[(32'h0)+:(7)]) & 12'hfff);
         scratch__write_data = decode__store;
@@ -1755,16 +1922,22 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         fb_write = fb_write_r__q;
         fb_addr = fb_addr_r__q;
         fb_data = fb_data_r__q;
-        mem_read = ((mem_load_r__q & shared_banks) != 32'h0) | tester__lists__read;
+        instances__bus_free = ((mem_load_r__q & shared_banks) == 32'h0) & (~tester__lists__read);
+        mem_read = ((mem_load_r__q & shared_banks) != 32'h0) | tester__lists__read | instances__read;
         if (tester__lists__read) begin
             mem_bank = bank_lists;
             mem_addr = tester__lists__addr;
+        end
+        else if (instances__read) begin
+            mem_bank = bank_instances;
+            mem_addr = instances__addr;
         end
         else begin
             mem_bank = mem_bank_r__q;
             mem_addr = mem_addr_r__q;
         end
         tester__lists__rdata = mem_rdata;
+        instances__rdata = mem_rdata;
         tri_op = decode__op_i4 == op_tri;
         kd_op = decode__op_i4 == op_kd;
         tri_wait_fn = decode__imm_i4 == tri_wait;
@@ -1772,6 +1945,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         queued_fn = (decode__imm_i4 == tri_init) | (decode__imm_i4 == tri_list) | (decode__imm_i4 == tri_object) | (decode__imm_i4 == tri_skip);
         ray_write__d = decode__valid_i4 & tri_op & (decode__imm_i4 < tri_ray_words);
         camera_write__d = decode__valid_i4 & tri_op & (decode__imm_i4 == tri_camera);
+        world_write__d = decode__valid_i4 & tri_op & (decode__imm_i4 == tri_world);
+        enter_offer__d = decode__valid_i4 & tri_op & (decode__imm_i4 == tri_enter);
         t_min_write__d = decode__valid_i4 & tri_op & (decode__imm_i4 == tri_init);
         tri_queues__d = queued_fn;
         tri_enqueue__d = decode__valid_i4 & tri_op & queued_fn;
@@ -1795,53 +1970,105 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         traversal_unit__engine__word_a = decode__a;
         traversal_unit__engine__word_b = decode__b;
         traversal_unit__engine__ray_pair = decode__imm[(32'h0)+:(2)];
-        traversal_unit__engine__ray_write = ray_write__q & (~rays__primary_write);
+        traversal_unit__engine__ray_write = ray_write__q & (~store_write);
         tester__engine__load_banks = mem_load_r__q;
         tester__engine__load_addr = mem_addr_r__q;
         tester__engine__thread = decode__thread;
         tester__engine__word_a = decode__a;
         tester__engine__word_b = decode__b;
         tester__engine__ray_pair = decode__imm[(32'h0)+:(2)];
-        tester__engine__ray_write = ray_write__q & (~rays__primary_write);
-        tester__gen_valid = rays__gen_valid;
-        tester__gen_m__0 = rays__gen_m__0;
-        tester__gen_m__1 = rays__gen_m__1;
-        tester__gen_m__2 = rays__gen_m__2;
-        tester__gen_m__3 = rays__gen_m__3;
-        tester__gen_m__4 = rays__gen_m__4;
-        tester__gen_m__5 = rays__gen_m__5;
-        tester__gen_m__6 = rays__gen_m__6;
-        tester__gen_m__7 = rays__gen_m__7;
-        tester__gen_m__8 = rays__gen_m__8;
-        tester__gen_m__9 = rays__gen_m__9;
-        tester__gen_m__10 = rays__gen_m__10;
-        tester__gen_m__11 = rays__gen_m__11;
-        tester__gen_v__0 = rays__gen_v__0;
-        tester__gen_v__1 = rays__gen_v__1;
-        tester__gen_v__2 = rays__gen_v__2;
-        tester__gen_thread = rays__gen_thread;
+        tester__engine__ray_write = ray_write__q & (~store_write);
+        tester__gen_valid = rays__gen_valid | instances__gen_valid;
+        if (gen_instance) begin
+            tester__gen_m__0 = instances__gen_m__0;
+            tester__gen_m__1 = instances__gen_m__1;
+            tester__gen_m__2 = instances__gen_m__2;
+            tester__gen_m__3 = instances__gen_m__3;
+            tester__gen_m__4 = instances__gen_m__4;
+            tester__gen_m__5 = instances__gen_m__5;
+            tester__gen_m__6 = instances__gen_m__6;
+            tester__gen_m__7 = instances__gen_m__7;
+            tester__gen_m__8 = instances__gen_m__8;
+            tester__gen_m__9 = instances__gen_m__9;
+            tester__gen_m__10 = instances__gen_m__10;
+            tester__gen_m__11 = instances__gen_m__11;
+            tester__gen_v__0 = instances__gen_v__0;
+            tester__gen_v__1 = instances__gen_v__1;
+            tester__gen_v__2 = instances__gen_v__2;
+            tester__gen_point = instances__gen_point;
+            tester__gen_client = client_origin;
+            if (instances__gen_direction) begin
+                tester__gen_client = client_direction;
+            end
+            tester__gen_thread = instances__gen_thread;
+        end
+        else begin
+            tester__gen_m__0 = rays__gen_m__0;
+            tester__gen_m__1 = rays__gen_m__1;
+            tester__gen_m__2 = rays__gen_m__2;
+            tester__gen_m__3 = rays__gen_m__3;
+            tester__gen_m__4 = rays__gen_m__4;
+            tester__gen_m__5 = rays__gen_m__5;
+            tester__gen_m__6 = rays__gen_m__6;
+            tester__gen_m__7 = rays__gen_m__7;
+            tester__gen_m__8 = rays__gen_m__8;
+            tester__gen_m__9 = rays__gen_m__9;
+            tester__gen_m__10 = rays__gen_m__10;
+            tester__gen_m__11 = rays__gen_m__11;
+            tester__gen_v__0 = rays__gen_v__0;
+            tester__gen_v__1 = rays__gen_v__1;
+            tester__gen_v__2 = rays__gen_v__2;
+            tester__gen_point = 1'b1;
+            tester__gen_client = client_primary;
+            tester__gen_thread = rays__gen_thread;
+        end
         rays__gen_take = tester__gen_take;
-        rays__gen_out_valid = tester__gen_out_valid;
+        instances__gen_take = tester__gen_take & gen_instance;
+        rays__gen_out_valid = tester__gen_out_valid & (~tester__gen_out_client[32'h0]);
         rays__gen_out_thread = tester__gen_out_thread;
-        tester__primary_write = rays__primary_write;
-        tester__primary_thread = rays__primary_thread;
-        traversal_unit__primary_write = rays__primary_write;
-        traversal_unit__primary_thread = rays__primary_thread;
+        instances__out_valid = tester__gen_out_valid & tester__gen_out_client[32'h0];
+        instances__out_direction = tester__gen_out_client[32'h1];
+        instances__out_thread = tester__gen_out_thread;
         rays__gen_out_dir__0 = tester__gen_out_dir__0;
-        tester__primary_o__0 = rays__primary_o__0;
-        tester__primary_d__0 = rays__primary_d__0;
-        traversal_unit__primary_o__0 = rays__primary_o__0;
-        traversal_unit__primary_d__0 = rays__primary_d__0;
+        instances__out_v__0 = tester__gen_out_dir__0;
         rays__gen_out_dir__1 = tester__gen_out_dir__1;
-        tester__primary_o__1 = rays__primary_o__1;
-        tester__primary_d__1 = rays__primary_d__1;
-        traversal_unit__primary_o__1 = rays__primary_o__1;
-        traversal_unit__primary_d__1 = rays__primary_d__1;
+        instances__out_v__1 = tester__gen_out_dir__1;
         rays__gen_out_dir__2 = tester__gen_out_dir__2;
-        tester__primary_o__2 = rays__primary_o__2;
-        tester__primary_d__2 = rays__primary_d__2;
-        traversal_unit__primary_o__2 = rays__primary_o__2;
-        traversal_unit__primary_d__2 = rays__primary_d__2;
+        instances__out_v__2 = tester__gen_out_dir__2;
+        tester__primary_write = store_write;
+        traversal_unit__primary_write = store_write;
+        if (instances__ray_write) begin
+            tester__primary_thread = instances__ray_thread;
+            traversal_unit__primary_thread = instances__ray_thread;
+            tester__primary_o__0 = instances__ray_o__0;
+            tester__primary_d__0 = instances__ray_d__0;
+            traversal_unit__primary_o__0 = instances__ray_o__0;
+            traversal_unit__primary_d__0 = instances__ray_d__0;
+            tester__primary_o__1 = instances__ray_o__1;
+            tester__primary_d__1 = instances__ray_d__1;
+            traversal_unit__primary_o__1 = instances__ray_o__1;
+            traversal_unit__primary_d__1 = instances__ray_d__1;
+            tester__primary_o__2 = instances__ray_o__2;
+            tester__primary_d__2 = instances__ray_d__2;
+            traversal_unit__primary_o__2 = instances__ray_o__2;
+            traversal_unit__primary_d__2 = instances__ray_d__2;
+        end
+        else begin
+            tester__primary_thread = rays__primary_thread;
+            traversal_unit__primary_thread = rays__primary_thread;
+            tester__primary_o__0 = rays__primary_o__0;
+            tester__primary_d__0 = rays__primary_d__0;
+            traversal_unit__primary_o__0 = rays__primary_o__0;
+            traversal_unit__primary_d__0 = rays__primary_d__0;
+            tester__primary_o__1 = rays__primary_o__1;
+            tester__primary_d__1 = rays__primary_d__1;
+            traversal_unit__primary_o__1 = rays__primary_o__1;
+            traversal_unit__primary_d__1 = rays__primary_d__1;
+            tester__primary_o__2 = rays__primary_o__2;
+            tester__primary_d__2 = rays__primary_d__2;
+            traversal_unit__primary_o__2 = rays__primary_o__2;
+            traversal_unit__primary_d__2 = rays__primary_d__2;
+        end
         tester__engine__enqueue = tri_enqueue__q;
         tester__queue_kind = tri_kind__q;
         tri_busy = 1'b0;
@@ -1849,9 +2076,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             tri_busy = tester__engine__full;
         end
         if (tri_waits__q) begin
-            tri_busy = tester__engine__pending | rays__pending;
+            tri_busy = tester__engine__pending | rays__pending | instances__pending;
         end
-        if (ray_write__q & rays__primary_write) begin
+        if (enter_offer__q) begin
+            tri_busy = instances__refused;
+        end
+        if (ray_write__q & store_write) begin
             tri_busy = 1'b1;
         end
         tester__walk_list_valid = traversal_unit__leaf_valid;
@@ -1918,7 +2148,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         scheduler__tester_done_thread = tester__engine__done_thread;
         scheduler__walk_done = traversal_unit__engine__done;
         scheduler__walk_done_thread = traversal_unit__engine__done_thread;
-        scheduler__ray_done_mask = rays__done_mask;
+        scheduler__ray_done_mask = rays__done_mask | instances__done_mask;
         if (write_back__retired) begin
             instr_count__d = instr_count__q + 32'h1;
         end
@@ -1938,6 +2168,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             intersect_count__d = 32'h0;
             traversal_count__d = 32'h0;
             raygen_count__d = 32'h0;
+            instance_count__d = 32'h0;
         end
     end
     
@@ -2359,6 +2590,8 @@ module dynrt_processor__engine__decode__t4(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__decode__t4
+
+
 
 
 
@@ -10378,6 +10611,840 @@ endmodule // dynrt_processor__engine__halted_count
 
 
 
+module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pair,word_a,word_b,thread,offer,record,refused,bus_free,read,addr,rdata,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_direction,gen_thread,gen_take,out_valid,out_direction,out_thread,out_v__0,out_v__1,out_v__2,ray_write,ray_thread,ray_o__0,ray_o__1,ray_o__2,ray_d__0,ray_d__1,ray_d__2,done_mask,query_thread,pending);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  frame_start;
+    input wire  world_write;
+    input wire  [1:0] world_pair;
+    input wire  [31:0] word_a;
+    input wire  [31:0] word_b;
+    input wire  [4:0] thread;
+    input wire  offer;
+    input wire  [23:0] record;
+    output reg  refused;
+    input wire  bus_free;
+    output reg  read;
+    output reg  [23:0] addr;
+    input wire  [31:0] rdata;
+    output reg  gen_valid;
+    output reg  [23:0] gen_m__0;
+    output reg  [23:0] gen_m__1;
+    output reg  [23:0] gen_m__2;
+    output reg  [23:0] gen_m__3;
+    output reg  [23:0] gen_m__4;
+    output reg  [23:0] gen_m__5;
+    output reg  [23:0] gen_m__6;
+    output reg  [23:0] gen_m__7;
+    output reg  [23:0] gen_m__8;
+    output reg  [23:0] gen_m__9;
+    output reg  [23:0] gen_m__10;
+    output reg  [23:0] gen_m__11;
+    output reg  [23:0] gen_v__0;
+    output reg  [23:0] gen_v__1;
+    output reg  [23:0] gen_v__2;
+    output reg  gen_point;
+    output reg  gen_direction;
+    output reg  [4:0] gen_thread;
+    input wire  gen_take;
+    input wire  out_valid;
+    input wire  out_direction;
+    input wire  [4:0] out_thread;
+    input wire  [23:0] out_v__0;
+    input wire  [23:0] out_v__1;
+    input wire  [23:0] out_v__2;
+    output reg  ray_write;
+    output reg  [4:0] ray_thread;
+    output reg  [23:0] ray_o__0;
+    output reg  [23:0] ray_o__1;
+    output reg  [23:0] ray_o__2;
+    output reg  [23:0] ray_d__0;
+    output reg  [23:0] ray_d__1;
+    output reg  [23:0] ray_d__2;
+    output reg  [31:0] done_mask;
+    input wire  [4:0] query_thread;
+    output reg  pending;
+    
+    // Constant declarations
+    localparam  c_one = 32'h1;
+    localparam  c_pair__0 = 2'b0;
+    localparam  c_pair__1 = 2'b1;
+    localparam  c_pair__2 = 2'b10;
+    localparam  c_words = 4'hc;
+    localparam  c_last_word = 4'hb;
+    localparam  c_first_word = 24'h0;
+    localparam  c_ml_last = 3'b1;
+    
+    // Enums
+    localparam EntryPhase__Idle = 0;
+    localparam EntryPhase__Fetch = 1;
+    localparam EntryPhase__Origin = 2;
+    localparam EntryPhase__Direction = 3;
+    
+    // Stub signals
+    reg  [4:0] world__0__read_address;
+    reg  world__0__read_clock;
+    wire  [23:0] world__0__read_data;
+    reg  [4:0] world__0__write_address;
+    reg  world__0__write_clock;
+    reg  [23:0] world__0__write_data;
+    reg  world__0__write_enable;
+    reg  [4:0] world__1__read_address;
+    reg  world__1__read_clock;
+    wire  [23:0] world__1__read_data;
+    reg  [4:0] world__1__write_address;
+    reg  world__1__write_clock;
+    reg  [23:0] world__1__write_data;
+    reg  world__1__write_enable;
+    reg  [4:0] world__2__read_address;
+    reg  world__2__read_clock;
+    wire  [23:0] world__2__read_data;
+    reg  [4:0] world__2__write_address;
+    reg  world__2__write_clock;
+    reg  [23:0] world__2__write_data;
+    reg  world__2__write_enable;
+    reg  [4:0] world__3__read_address;
+    reg  world__3__read_clock;
+    wire  [23:0] world__3__read_data;
+    reg  [4:0] world__3__write_address;
+    reg  world__3__write_clock;
+    reg  [23:0] world__3__write_data;
+    reg  world__3__write_enable;
+    reg  [4:0] world__4__read_address;
+    reg  world__4__read_clock;
+    wire  [23:0] world__4__read_data;
+    reg  [4:0] world__4__write_address;
+    reg  world__4__write_clock;
+    reg  [23:0] world__4__write_data;
+    reg  world__4__write_enable;
+    reg  [4:0] world__5__read_address;
+    reg  world__5__read_clock;
+    wire  [23:0] world__5__read_data;
+    reg  [4:0] world__5__write_address;
+    reg  world__5__write_clock;
+    reg  [23:0] world__5__write_data;
+    reg  world__5__write_enable;
+    reg  slot_valid__d;
+    wire  slot_valid__q;
+    reg  slot_valid__clock;
+    reg  [4:0] slot_thread__d;
+    wire  [4:0] slot_thread__q;
+    reg  slot_thread__clock;
+    reg  [23:0] slot_record__d;
+    wire  [23:0] slot_record__q;
+    reg  slot_record__clock;
+    reg  [1:0] phase__d;
+    wire  [1:0] phase__q;
+    reg  phase__clock;
+    reg  [4:0] entry_thread__d;
+    wire  [4:0] entry_thread__q;
+    reg  entry_thread__clock;
+    reg  [23:0] entry_record__d;
+    wire  [23:0] entry_record__q;
+    reg  entry_record__clock;
+    reg  [3:0] issued__d;
+    wire  [3:0] issued__q;
+    reg  issued__clock;
+    reg  [3:0] arrived__d;
+    wire  [3:0] arrived__q;
+    reg  arrived__clock;
+    reg  [7:0] flight__d;
+    wire  [7:0] flight__q;
+    reg  flight__clock;
+    reg  [23:0] matrix__0__d;
+    wire  [23:0] matrix__0__q;
+    reg  matrix__0__clock;
+    reg  [23:0] matrix__1__d;
+    wire  [23:0] matrix__1__q;
+    reg  matrix__1__clock;
+    reg  [23:0] matrix__2__d;
+    wire  [23:0] matrix__2__q;
+    reg  matrix__2__clock;
+    reg  [23:0] matrix__3__d;
+    wire  [23:0] matrix__3__q;
+    reg  matrix__3__clock;
+    reg  [23:0] matrix__4__d;
+    wire  [23:0] matrix__4__q;
+    reg  matrix__4__clock;
+    reg  [23:0] matrix__5__d;
+    wire  [23:0] matrix__5__q;
+    reg  matrix__5__clock;
+    reg  [23:0] matrix__6__d;
+    wire  [23:0] matrix__6__q;
+    reg  matrix__6__clock;
+    reg  [23:0] matrix__7__d;
+    wire  [23:0] matrix__7__q;
+    reg  matrix__7__clock;
+    reg  [23:0] matrix__8__d;
+    wire  [23:0] matrix__8__q;
+    reg  matrix__8__clock;
+    reg  [23:0] matrix__9__d;
+    wire  [23:0] matrix__9__q;
+    reg  matrix__9__clock;
+    reg  [23:0] matrix__10__d;
+    wire  [23:0] matrix__10__q;
+    reg  matrix__10__clock;
+    reg  [23:0] matrix__11__d;
+    wire  [23:0] matrix__11__q;
+    reg  matrix__11__clock;
+    reg  [23:0] origin__0__d;
+    wire  [23:0] origin__0__q;
+    reg  origin__0__clock;
+    reg  [23:0] origin__1__d;
+    wire  [23:0] origin__1__q;
+    reg  origin__1__clock;
+    reg  [23:0] origin__2__d;
+    wire  [23:0] origin__2__q;
+    reg  origin__2__clock;
+    reg  write_valid__d;
+    wire  write_valid__q;
+    reg  write_valid__clock;
+    reg  [4:0] write_thread__d;
+    wire  [4:0] write_thread__q;
+    reg  write_thread__clock;
+    reg  [23:0] write_o__0__d;
+    wire  [23:0] write_o__0__q;
+    reg  write_o__0__clock;
+    reg  [23:0] write_o__1__d;
+    wire  [23:0] write_o__1__q;
+    reg  write_o__1__clock;
+    reg  [23:0] write_o__2__d;
+    wire  [23:0] write_o__2__q;
+    reg  write_o__2__clock;
+    reg  [23:0] write_d__0__d;
+    wire  [23:0] write_d__0__q;
+    reg  write_d__0__clock;
+    reg  [23:0] write_d__1__d;
+    wire  [23:0] write_d__1__q;
+    reg  write_d__1__clock;
+    reg  [23:0] write_d__2__d;
+    wire  [23:0] write_d__2__q;
+    reg  write_d__2__clock;
+    reg  [31:0] write_mask__d;
+    wire  [31:0] write_mask__q;
+    reg  write_mask__clock;
+    reg  [31:0] waiting__d;
+    wire  [31:0] waiting__q;
+    reg  waiting__clock;
+    reg  pending_r__d;
+    wire  pending_r__q;
+    reg  pending_r__clock;
+    
+    // Local signals
+    reg  taken;
+    reg  reading;
+    reg  arrives;
+    reg  [31:0] taken_mask;
+    
+    // Sub module instances
+    dynrt_processor__engine__instances__world__0 world__0(
+        .read_address(world__0__read_address),
+        .read_clock(world__0__read_clock),
+        .read_data(world__0__read_data),
+        .write_address(world__0__write_address),
+        .write_clock(world__0__write_clock),
+        .write_data(world__0__write_data),
+        .write_enable(world__0__write_enable)
+    );
+    dynrt_processor__engine__instances__world__0 world__1(
+        .read_address(world__1__read_address),
+        .read_clock(world__1__read_clock),
+        .read_data(world__1__read_data),
+        .write_address(world__1__write_address),
+        .write_clock(world__1__write_clock),
+        .write_data(world__1__write_data),
+        .write_enable(world__1__write_enable)
+    );
+    dynrt_processor__engine__instances__world__0 world__2(
+        .read_address(world__2__read_address),
+        .read_clock(world__2__read_clock),
+        .read_data(world__2__read_data),
+        .write_address(world__2__write_address),
+        .write_clock(world__2__write_clock),
+        .write_data(world__2__write_data),
+        .write_enable(world__2__write_enable)
+    );
+    dynrt_processor__engine__instances__world__0 world__3(
+        .read_address(world__3__read_address),
+        .read_clock(world__3__read_clock),
+        .read_data(world__3__read_data),
+        .write_address(world__3__write_address),
+        .write_clock(world__3__write_clock),
+        .write_data(world__3__write_data),
+        .write_enable(world__3__write_enable)
+    );
+    dynrt_processor__engine__instances__world__0 world__4(
+        .read_address(world__4__read_address),
+        .read_clock(world__4__read_clock),
+        .read_data(world__4__read_data),
+        .write_address(world__4__write_address),
+        .write_clock(world__4__write_clock),
+        .write_data(world__4__write_data),
+        .write_enable(world__4__write_enable)
+    );
+    dynrt_processor__engine__instances__world__0 world__5(
+        .read_address(world__5__read_address),
+        .read_clock(world__5__read_clock),
+        .read_data(world__5__read_data),
+        .write_address(world__5__write_address),
+        .write_clock(world__5__write_clock),
+        .write_data(world__5__write_data),
+        .write_enable(world__5__write_enable)
+    );
+    dynrt_processor__display__dark_d slot_valid(
+        .d(slot_valid__d),
+        .q(slot_valid__q),
+        .clock(slot_valid__clock)
+    );
+    dynrt_processor__engine__decode__t4 slot_thread(
+        .d(slot_thread__d),
+        .q(slot_thread__q),
+        .clock(slot_thread__clock)
+    );
+    dynrt_processor__display__rgb_q slot_record(
+        .d(slot_record__d),
+        .q(slot_record__q),
+        .clock(slot_record__clock)
+    );
+    dynrt_processor__engine__instances__phase phase(
+        .d(phase__d),
+        .q(phase__q),
+        .clock(phase__clock)
+    );
+    dynrt_processor__engine__decode__t4 entry_thread(
+        .d(entry_thread__d),
+        .q(entry_thread__q),
+        .clock(entry_thread__clock)
+    );
+    dynrt_processor__display__rgb_q entry_record(
+        .d(entry_record__d),
+        .q(entry_record__q),
+        .clock(entry_record__clock)
+    );
+    dynrt_processor__engine__instances__arrived issued(
+        .d(issued__d),
+        .q(issued__q),
+        .clock(issued__clock)
+    );
+    dynrt_processor__engine__instances__arrived arrived(
+        .d(arrived__d),
+        .q(arrived__q),
+        .clock(arrived__clock)
+    );
+    dynrt_processor__engine__halted_count flight(
+        .d(flight__d),
+        .q(flight__q),
+        .clock(flight__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__0(
+        .d(matrix__0__d),
+        .q(matrix__0__q),
+        .clock(matrix__0__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__1(
+        .d(matrix__1__d),
+        .q(matrix__1__q),
+        .clock(matrix__1__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__2(
+        .d(matrix__2__d),
+        .q(matrix__2__q),
+        .clock(matrix__2__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__3(
+        .d(matrix__3__d),
+        .q(matrix__3__q),
+        .clock(matrix__3__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__4(
+        .d(matrix__4__d),
+        .q(matrix__4__q),
+        .clock(matrix__4__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__5(
+        .d(matrix__5__d),
+        .q(matrix__5__q),
+        .clock(matrix__5__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__6(
+        .d(matrix__6__d),
+        .q(matrix__6__q),
+        .clock(matrix__6__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__7(
+        .d(matrix__7__d),
+        .q(matrix__7__q),
+        .clock(matrix__7__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__8(
+        .d(matrix__8__d),
+        .q(matrix__8__q),
+        .clock(matrix__8__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__9(
+        .d(matrix__9__d),
+        .q(matrix__9__q),
+        .clock(matrix__9__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__10(
+        .d(matrix__10__d),
+        .q(matrix__10__q),
+        .clock(matrix__10__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__11(
+        .d(matrix__11__d),
+        .q(matrix__11__q),
+        .clock(matrix__11__clock)
+    );
+    dynrt_processor__display__rgb_q origin__0(
+        .d(origin__0__d),
+        .q(origin__0__q),
+        .clock(origin__0__clock)
+    );
+    dynrt_processor__display__rgb_q origin__1(
+        .d(origin__1__d),
+        .q(origin__1__q),
+        .clock(origin__1__clock)
+    );
+    dynrt_processor__display__rgb_q origin__2(
+        .d(origin__2__d),
+        .q(origin__2__q),
+        .clock(origin__2__clock)
+    );
+    dynrt_processor__display__dark_d write_valid(
+        .d(write_valid__d),
+        .q(write_valid__q),
+        .clock(write_valid__clock)
+    );
+    dynrt_processor__engine__decode__t4 write_thread(
+        .d(write_thread__d),
+        .q(write_thread__q),
+        .clock(write_thread__clock)
+    );
+    dynrt_processor__display__rgb_q write_o__0(
+        .d(write_o__0__d),
+        .q(write_o__0__q),
+        .clock(write_o__0__clock)
+    );
+    dynrt_processor__display__rgb_q write_o__1(
+        .d(write_o__1__d),
+        .q(write_o__1__q),
+        .clock(write_o__1__clock)
+    );
+    dynrt_processor__display__rgb_q write_o__2(
+        .d(write_o__2__d),
+        .q(write_o__2__q),
+        .clock(write_o__2__clock)
+    );
+    dynrt_processor__display__rgb_q write_d__0(
+        .d(write_d__0__d),
+        .q(write_d__0__q),
+        .clock(write_d__0__clock)
+    );
+    dynrt_processor__display__rgb_q write_d__1(
+        .d(write_d__1__d),
+        .q(write_d__1__q),
+        .clock(write_d__1__clock)
+    );
+    dynrt_processor__display__rgb_q write_d__2(
+        .d(write_d__2__d),
+        .q(write_d__2__q),
+        .clock(write_d__2__clock)
+    );
+    dynrt_processor__engine__cycle_count write_mask(
+        .d(write_mask__d),
+        .q(write_mask__q),
+        .clock(write_mask__clock)
+    );
+    dynrt_processor__engine__cycle_count waiting(
+        .d(waiting__d),
+        .q(waiting__q),
+        .clock(waiting__clock)
+    );
+    dynrt_processor__display__dark_d pending_r(
+        .d(pending_r__d),
+        .q(pending_r__q),
+        .clock(pending_r__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        slot_valid__clock = clock;
+        slot_thread__clock = clock;
+        slot_record__clock = clock;
+        phase__clock = clock;
+        entry_thread__clock = clock;
+        entry_record__clock = clock;
+        issued__clock = clock;
+        arrived__clock = clock;
+        flight__clock = clock;
+        write_valid__clock = clock;
+        write_thread__clock = clock;
+        write_mask__clock = clock;
+        waiting__clock = clock;
+        pending_r__clock = clock;
+        slot_valid__d = slot_valid__q;
+        slot_thread__d = slot_thread__q;
+        slot_record__d = slot_record__q;
+        phase__d = phase__q;
+        entry_thread__d = entry_thread__q;
+        entry_record__d = entry_record__q;
+        issued__d = issued__q;
+        arrived__d = arrived__q;
+        flight__d = flight__q;
+        write_valid__d = write_valid__q;
+        write_thread__d = write_thread__q;
+        write_mask__d = write_mask__q;
+        waiting__d = waiting__q;
+        pending_r__d = pending_r__q;
+        matrix__0__clock = clock;
+        matrix__0__d = matrix__0__q;
+        matrix__1__clock = clock;
+        matrix__1__d = matrix__1__q;
+        matrix__2__clock = clock;
+        matrix__2__d = matrix__2__q;
+        matrix__3__clock = clock;
+        matrix__3__d = matrix__3__q;
+        matrix__4__clock = clock;
+        matrix__4__d = matrix__4__q;
+        matrix__5__clock = clock;
+        matrix__5__d = matrix__5__q;
+        matrix__6__clock = clock;
+        matrix__6__d = matrix__6__q;
+        matrix__7__clock = clock;
+        matrix__7__d = matrix__7__q;
+        matrix__8__clock = clock;
+        matrix__8__d = matrix__8__q;
+        matrix__9__clock = clock;
+        matrix__9__d = matrix__9__q;
+        matrix__10__clock = clock;
+        matrix__10__d = matrix__10__q;
+        matrix__11__clock = clock;
+        matrix__11__d = matrix__11__q;
+        origin__0__clock = clock;
+        origin__0__d = origin__0__q;
+        write_o__0__clock = clock;
+        write_o__0__d = origin__0__q;
+        write_d__0__clock = clock;
+        write_d__0__d = out_v__0;
+        origin__1__clock = clock;
+        origin__1__d = origin__1__q;
+        write_o__1__clock = clock;
+        write_o__1__d = origin__1__q;
+        write_d__1__clock = clock;
+        write_d__1__d = out_v__1;
+        origin__2__clock = clock;
+        origin__2__d = origin__2__q;
+        write_o__2__clock = clock;
+        write_o__2__d = origin__2__q;
+        write_d__2__clock = clock;
+        write_d__2__d = out_v__2;
+        world__0__read_clock = clock;
+        world__0__write_clock = clock;
+        world__0__write_address = thread;
+        world__0__read_address = entry_thread__q;
+        world__1__read_clock = clock;
+        world__1__write_clock = clock;
+        world__1__write_address = thread;
+        world__1__read_address = entry_thread__q;
+        world__2__read_clock = clock;
+        world__2__write_clock = clock;
+        world__2__write_address = thread;
+        world__2__read_address = entry_thread__q;
+        world__3__read_clock = clock;
+        world__3__write_clock = clock;
+        world__3__write_address = thread;
+        world__3__read_address = entry_thread__q;
+        world__4__read_clock = clock;
+        world__4__write_clock = clock;
+        world__4__write_address = thread;
+        world__4__read_address = entry_thread__q;
+        world__5__read_clock = clock;
+        world__5__write_clock = clock;
+        world__5__write_address = thread;
+        world__5__read_address = entry_thread__q;
+        world__0__write_data = word_a[(32'h0)+:(24)];
+        world__1__write_data = word_b[(32'h0)+:(24)];
+        world__0__write_enable = world_write & (world_pair == c_pair__0);
+        world__1__write_enable = world_write & (world_pair == c_pair__0);
+        world__2__write_data = word_a[(32'h0)+:(24)];
+        world__3__write_data = word_b[(32'h0)+:(24)];
+        world__2__write_enable = world_write & (world_pair == c_pair__1);
+        world__3__write_enable = world_write & (world_pair == c_pair__1);
+        world__4__write_data = word_a[(32'h0)+:(24)];
+        world__5__write_data = word_b[(32'h0)+:(24)];
+        world__4__write_enable = world_write & (world_pair == c_pair__2);
+        world__5__write_enable = world_write & (world_pair == c_pair__2);
+        refused = slot_valid__q;
+        taken = offer & (~slot_valid__q);
+        if (taken) begin
+            slot_valid__d = 1'b1;
+            slot_thread__d = thread;
+            slot_record__d = record;
+        end
+        if ((phase__q == EntryPhase__Idle) & slot_valid__q) begin
+            slot_valid__d = 1'b0;
+            entry_thread__d = slot_thread__q;
+            entry_record__d = slot_record__q + c_first_word;
+            issued__d = 32'h0;
+            arrived__d = 32'h0;
+            phase__d = EntryPhase__Fetch;
+        end
+        reading = (phase__q == EntryPhase__Fetch) & (issued__q != c_words) & bus_free;
+        read = reading;
+        addr = entry_record__q + ((issued__q) & 24'hffffff);
+        if (reading) begin
+            issued__d = issued__q + 32'h1;
+        end
+        flight__d = (flight__q << 32'h1) | ((reading) & 8'hff);
+        arrives = flight__q[c_ml_last];
+        if (arrives) begin
+            matrix__0__d = matrix__1__q;
+            matrix__1__d = matrix__2__q;
+            matrix__2__d = matrix__3__q;
+            matrix__3__d = matrix__4__q;
+            matrix__4__d = matrix__5__q;
+            matrix__5__d = matrix__6__q;
+            matrix__6__d = matrix__7__q;
+            matrix__7__d = matrix__8__q;
+            matrix__8__d = matrix__9__q;
+            matrix__9__d = matrix__10__q;
+            matrix__10__d = matrix__11__q;
+            matrix__11__d = rdata[(32'h0)+:(24)];
+            arrived__d = arrived__q + 32'h1;
+            if (arrived__q == c_last_word) begin
+                phase__d = EntryPhase__Origin;
+            end
+        end
+        gen_valid = (phase__q == EntryPhase__Origin) | (phase__q == EntryPhase__Direction);
+        gen_point = phase__q == EntryPhase__Origin;
+        gen_direction = phase__q == EntryPhase__Direction;
+        gen_thread = entry_thread__q;
+        gen_m__0 = matrix__0__q;
+        gen_m__1 = matrix__1__q;
+        gen_m__2 = matrix__2__q;
+        gen_m__3 = matrix__3__q;
+        gen_m__4 = matrix__4__q;
+        gen_m__5 = matrix__5__q;
+        gen_m__6 = matrix__6__q;
+        gen_m__7 = matrix__7__q;
+        gen_m__8 = matrix__8__q;
+        gen_m__9 = matrix__9__q;
+        gen_m__10 = matrix__10__q;
+        gen_m__11 = matrix__11__q;
+        if (phase__q == EntryPhase__Origin) begin
+            gen_v__0 = world__0__read_data;
+        end
+        else begin
+            gen_v__0 = world__3__read_data;
+        end
+        if (phase__q == EntryPhase__Origin) begin
+            gen_v__1 = world__1__read_data;
+        end
+        else begin
+            gen_v__1 = world__4__read_data;
+        end
+        if (phase__q == EntryPhase__Origin) begin
+            gen_v__2 = world__2__read_data;
+        end
+        else begin
+            gen_v__2 = world__5__read_data;
+        end
+        if (gen_take & (phase__q == EntryPhase__Origin)) begin
+            phase__d = EntryPhase__Direction;
+        end
+        if (gen_take & (phase__q == EntryPhase__Direction)) begin
+            phase__d = EntryPhase__Idle;
+        end
+        if (out_valid & (~out_direction)) begin
+            origin__0__d = out_v__0;
+            origin__1__d = out_v__1;
+            origin__2__d = out_v__2;
+        end
+        write_valid__d = out_valid & out_direction;
+        write_thread__d = out_thread;
+        write_mask__d = 32'h0;
+        if (out_valid & out_direction) begin
+            write_mask__d = c_one << out_thread;
+        end
+        ray_write = write_valid__q;
+        ray_thread = write_thread__q;
+        ray_o__0 = write_o__0__q;
+        ray_d__0 = write_d__0__q;
+        ray_o__1 = write_o__1__q;
+        ray_d__1 = write_d__1__q;
+        ray_o__2 = write_o__2__q;
+        ray_d__2 = write_d__2__q;
+        done_mask = write_mask__q;
+        taken_mask = 32'h0;
+        if (taken) begin
+            taken_mask = c_one << thread;
+        end
+        waiting__d = (waiting__q & (~write_mask__q)) | taken_mask;
+        pending_r__d = waiting__q[query_thread];
+        pending = pending_r__q;
+        if (frame_start) begin
+            slot_valid__d = 1'b0;
+            phase__d = EntryPhase__Idle;
+            waiting__d = 32'h0;
+        end
+    end
+    
+endmodule // dynrt_processor__engine__instances
+
+
+module dynrt_processor__engine__instances__arrived(d,q,clock);
+    
+    // Module arguments
+    input wire  [3:0] d;
+    output reg  [3:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 4'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__instances__arrived
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__instances__phase(d,q,clock);
+    
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+    
+    // Enums
+    localparam EntryPhase__Idle = 0;
+    localparam EntryPhase__Fetch = 1;
+    localparam EntryPhase__Origin = 2;
+    localparam EntryPhase__Direction = 3;
+    
+    // Update code (custom)
+    initial begin
+       q = 64'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__instances__phase
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__instances__world__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [4:0] read_address;
+    input wire  read_clock;
+    output reg  [23:0] read_data;
+    input wire  [4:0] write_address;
+    input wire  write_clock;
+    input wire  [23:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[23:0] mem[31:0];
+    
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__instances__world__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -11641,7 +12708,7 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         .q(pending_r__q),
         .clock(pending_r__clock)
     );
-    dynrt_processor__engine__rays__dirs__0 dirs__0(
+    dynrt_processor__engine__instances__world__0 dirs__0(
         .read_address(dirs__0__read_address),
         .read_clock(dirs__0__read_clock),
         .read_data(dirs__0__read_data),
@@ -11650,7 +12717,7 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         .write_data(dirs__0__write_data),
         .write_enable(dirs__0__write_enable)
     );
-    dynrt_processor__engine__rays__dirs__0 dirs__1(
+    dynrt_processor__engine__instances__world__0 dirs__1(
         .read_address(dirs__1__read_address),
         .read_clock(dirs__1__read_clock),
         .read_data(dirs__1__read_data),
@@ -11659,7 +12726,7 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         .write_data(dirs__1__write_data),
         .write_enable(dirs__1__write_enable)
     );
-    dynrt_processor__engine__rays__dirs__0 dirs__2(
+    dynrt_processor__engine__instances__world__0 dirs__2(
         .read_address(dirs__2__read_address),
         .read_clock(dirs__2__read_clock),
         .read_data(dirs__2__read_data),
@@ -11902,33 +12969,6 @@ endmodule // dynrt_processor__engine__rays
 
 
 
-module dynrt_processor__engine__rays__dirs__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [4:0] read_address;
-    input wire  read_clock;
-    output reg  [23:0] read_data;
-    input wire  [4:0] write_address;
-    input wire  write_clock;
-    input wire  [23:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[23:0] mem[31:0];
-    
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor__engine__rays__dirs__0
 
 
 
@@ -15033,11 +16073,6 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     localparam  c_thread_mask = 32'hffffffff;
     localparam  c_one = 32'h1;
     localparam  c_ones = 32'hffffffff;
-    localparam  c_number_bit__0 = 32'haaaaaaaa;
-    localparam  c_number_bit__1 = 32'hcccccccc;
-    localparam  c_number_bit__2 = 32'hf0f0f0f0;
-    localparam  c_number_bit__3 = 32'hff00ff00;
-    localparam  c_number_bit__4 = 32'hffff0000;
     localparam  c_reserve_bit = 32'h6;
     
     // Stub signals
@@ -15056,6 +16091,9 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     reg  [31:0] pick_onehot__d;
     wire  [31:0] pick_onehot__q;
     reg  pick_onehot__clock;
+    reg  [4:0] pick_number__d;
+    wire  [4:0] pick_number__q;
+    reg  pick_number__clock;
     reg  [4:0] pointer__d;
     wire  [4:0] pointer__q;
     reg  pointer__clock;
@@ -15069,13 +16107,9 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     reg  [31:0] first_ready__others;
     wire  first_ready__found;
     wire  [31:0] first_ready__onehot;
+    wire  [4:0] first_ready__number;
     
     // Local signals
-    reg  pick_bits__0;
-    reg  pick_bits__1;
-    reg  pick_bits__2;
-    reg  pick_bits__3;
-    reg  pick_bits__4;
     reg  [31:0] candidates;
     reg  [31:0] below;
     reg  issues;
@@ -15114,6 +16148,11 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         .q(pick_onehot__q),
         .clock(pick_onehot__clock)
     );
+    dynrt_processor__engine__decode__t4 pick_number(
+        .d(pick_number__d),
+        .q(pick_number__q),
+        .clock(pick_number__clock)
+    );
     dynrt_processor__engine__decode__t4 pointer(
         .d(pointer__d),
         .q(pointer__q),
@@ -15133,7 +16172,8 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         .preferred(first_ready__preferred),
         .others(first_ready__others),
         .found(first_ready__found),
-        .onehot(first_ready__onehot)
+        .onehot(first_ready__onehot),
+        .number(first_ready__number)
     );
     
     // Update code
@@ -15143,6 +16183,7 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         woken__clock = clock;
         picked__clock = clock;
         pick_onehot__clock = clock;
+        pick_number__clock = clock;
         pointer__clock = clock;
         below_pointer__clock = clock;
         reserved__clock = clock;
@@ -15151,17 +16192,13 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         woken__d = woken__q;
         picked__d = picked__q;
         pick_onehot__d = pick_onehot__q;
+        pick_number__d = pick_number__q;
         pointer__d = pointer__q;
         below_pointer__d = below_pointer__q;
         reserved__d = reserved__q;
         issues = running & picked__q & (~reserved__q[32'h0]);
         issue = issues;
-        pick_bits__0 = (pick_onehot__q & c_number_bit__0) != 32'h0;
-        pick_bits__1 = (pick_onehot__q & c_number_bit__1) != 32'h0;
-        pick_bits__2 = (pick_onehot__q & c_number_bit__2) != 32'h0;
-        pick_bits__3 = (pick_onehot__q & c_number_bit__3) != 32'h0;
-        pick_bits__4 = (pick_onehot__q & c_number_bit__4) != 32'h0;
-        pick = ((pick_bits__0) & 5'h1f) | (((pick_bits__1) & 5'h1f) << 32'h1) | (((pick_bits__2) & 5'h1f) << 32'h2) | (((pick_bits__3) & 5'h1f) << 32'h3) | (((pick_bits__4) & 5'h1f) << 32'h4);
+        pick = pick_number__q;
         issue_mask = 32'h0;
         if (issues) begin
             issue_mask = pick_onehot__q;
@@ -15173,6 +16210,7 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         first_ready__others = candidates;
         picked__d = first_ready__found;
         pick_onehot__d = first_ready__onehot;
+        pick_number__d = first_ready__number;
         pointer__d = pointer__q - 32'h1;
         below_pointer__d = ~(c_ones << (pointer__q - 32'h1));
         wb_mask = c_one << wb_thread;
@@ -15215,18 +16253,22 @@ endmodule // dynrt_processor__engine__scheduler
 
 
 
-module dynrt_processor__engine__scheduler__first_ready(preferred,others,found,onehot);
+module dynrt_processor__engine__scheduler__first_ready(preferred,others,found,onehot,number);
     
     // Module arguments
     input wire  [31:0] preferred;
     input wire  [31:0] others;
     output reg  found;
     output reg  [31:0] onehot;
+    output reg  [4:0] number;
     
     // Constant declarations
     localparam  c_group_low = 64'h1111111111111111;
     localparam  c_below_3 = 64'h7777777777777777;
     localparam  c_below_2 = 64'h3333333333333333;
+    localparam  c_group_number_bit__0 = 64'h1010101010101010;
+    localparam  c_group_number_bit__1 = 64'h1100110011001100;
+    localparam  c_group_number_bit__2 = 64'h1111000011110000;
     
     // Local signals
     reg  [63:0] both;
@@ -15241,6 +16283,13 @@ module dynrt_processor__engine__scheduler__first_ready(preferred,others,found,on
     reg  [63:0] group_mask;
     reg  [63:0] higher_in_group;
     reg  [63:0] first;
+    reg  [63:0] position_hi;
+    reg  [63:0] position_lo;
+    reg  number_bits__0;
+    reg  number_bits__1;
+    reg  number_bits__2;
+    reg  number_bits__3;
+    reg  number_bits__4;
     
     // Update code
     always @(*) begin
@@ -15258,9 +16307,19 @@ module dynrt_processor__engine__scheduler__first_ready(preferred,others,found,on
         first = both & (~higher_in_group) & group_mask;
         onehot = first[(32'h0)+:(32)] | first[(32'h20)+:(32)];
         found = both != 32'h0;
+        position_hi = ((both >> 32'h2) | (both >> 32'h3)) & c_group_low;
+        position_lo = ((both >> 32'h3) | ((~(both >> 32'h2)) & (both >> 32'h1))) & c_group_low;
+        number_bits__0 = (group_first & position_lo) != 32'h0;
+        number_bits__1 = (group_first & position_hi) != 32'h0;
+        number_bits__2 = (group_first & c_group_number_bit__0) != 32'h0;
+        number_bits__3 = (group_first & c_group_number_bit__1) != 32'h0;
+        number_bits__4 = (group_first & c_group_number_bit__2) != 32'h0;
+        number = ((number_bits__0) & 5'h1f) | (((number_bits__1) & 5'h1f) << 32'h1) | (((number_bits__2) & 5'h1f) << 32'h2) | (((number_bits__3) & 5'h1f) << 32'h3) | (((number_bits__4) & 5'h1f) << 32'h4);
     end
     
 endmodule // dynrt_processor__engine__scheduler__first_ready
+
+
 
 
 
@@ -15306,7 +16365,7 @@ endmodule // dynrt_processor__engine__scratch
 
 
 
-module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,a_words__read,a_words__addr,a_words__rdata,b_words__read,b_words__addr,b_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_thread,gen_take,gen_out_valid,gen_out_thread,gen_out_dir__0,gen_out_dir__1,gen_out_dir__2,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2);
+module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,a_words__read,a_words__addr,a_words__rdata,b_words__read,b_words__addr,b_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_client,gen_thread,gen_take,gen_out_valid,gen_out_client,gen_out_thread,gen_out_dir__0,gen_out_dir__1,gen_out_dir__2,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2);
     
     // Module arguments
     input wire  clock;
@@ -15364,9 +16423,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     input wire  [23:0] gen_v__0;
     input wire  [23:0] gen_v__1;
     input wire  [23:0] gen_v__2;
+    input wire  gen_point;
+    input wire  [1:0] gen_client;
     input wire  [4:0] gen_thread;
     output reg  gen_take;
     output reg  gen_out_valid;
+    output reg  [1:0] gen_out_client;
     output reg  [4:0] gen_out_thread;
     output reg  [23:0] gen_out_dir__0;
     output reg  [23:0] gen_out_dir__1;
@@ -15949,7 +17011,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(best_m__write_data),
         .write_enable(best_m__write_enable)
     );
-    dynrt_processor__engine__rays__dirs__0 flight_t_min(
+    dynrt_processor__engine__instances__world__0 flight_t_min(
         .read_address(flight_t_min__read_address),
         .read_clock(flight_t_min__read_clock),
         .read_data(flight_t_min__read_data),
@@ -16046,22 +17108,22 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(cur_b__1__q),
         .clock(cur_b__1__clock)
     );
-    dynrt_processor__engine__tester__a_issued received__0(
+    dynrt_processor__engine__instances__arrived received__0(
         .d(received__0__d),
         .q(received__0__q),
         .clock(received__0__clock)
     );
-    dynrt_processor__engine__tester__a_issued received__1(
+    dynrt_processor__engine__instances__arrived received__1(
         .d(received__1__d),
         .q(received__1__q),
         .clock(received__1__clock)
     );
-    dynrt_processor__engine__tester__a_issued a_issued(
+    dynrt_processor__engine__instances__arrived a_issued(
         .d(a_issued__d),
         .q(a_issued__q),
         .clock(a_issued__clock)
     );
-    dynrt_processor__engine__tester__a_issued b_issued(
+    dynrt_processor__engine__instances__arrived b_issued(
         .d(b_issued__d),
         .q(b_issued__q),
         .clock(b_issued__clock)
@@ -16973,9 +18035,11 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             transform_unit__v__0 = gen_v__0;
             transform_unit__v__1 = gen_v__1;
             transform_unit__v__2 = gen_v__2;
-            transform_unit__tag = c_primary | (((gen_thread) & 16'hffff) << 32'h5);
+            transform_unit__point = gen_point;
+            transform_unit__tag = c_primary | (((gen_client) & 16'hffff) << 32'ha) | (((gen_thread) & 16'hffff) << 32'h5);
         end
         gen_out_valid = transform_unit__out_valid & transform_unit__out_tag[32'he];
+        gen_out_client = transform_unit__out_tag[(32'ha)+:(2)];
         gen_out_thread = transform_unit__out_tag[(32'h5)+:(5)];
         gen_out_dir__0 = transform_unit__result__0;
         gen_out_dir__1 = transform_unit__result__1;
@@ -17071,23 +18135,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
 endmodule // dynrt_processor__engine__tester
 
 
-module dynrt_processor__engine__tester__a_issued(d,q,clock);
-    
-    // Module arguments
-    input wire  [3:0] d;
-    output reg  [3:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 4'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor__engine__tester__a_issued
 
 
 
@@ -21232,7 +22279,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .q(ids__7__q),
         .clock(ids__7__clock)
     );
-    dynrt_processor__engine__tester__a_issued mb_len(
+    dynrt_processor__engine__instances__arrived mb_len(
         .d(mb_len__d),
         .q(mb_len__q),
         .clock(mb_len__clock)
@@ -21287,12 +22334,12 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .q(recorded__q),
         .clock(recorded__clock)
     );
-    dynrt_processor__engine__tester__a_issued flight(
+    dynrt_processor__engine__instances__arrived flight(
         .d(flight__d),
         .q(flight__q),
         .clock(flight__clock)
     );
-    dynrt_processor__engine__tester__a_issued queued(
+    dynrt_processor__engine__instances__arrived queued(
         .d(queued__d),
         .q(queued__q),
         .clock(queued__clock)
@@ -22366,17 +23413,17 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor__engine__tester__a_issued read_address(
+    dynrt_processor__engine__instances__arrived read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
     );
-    dynrt_processor__engine__tester__a_issued write_address(
+    dynrt_processor__engine__instances__arrived write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor__engine__tester__a_issued write_address_delayed(
+    dynrt_processor__engine__instances__arrived write_address_delayed(
         .d(write_address_delayed__d),
         .q(write_address_delayed__q),
         .clock(write_address_delayed__clock)
@@ -22663,7 +23710,7 @@ module dynrt_processor__engine__tester__ray(clock,thread,word_a,word_b,ray_write
     reg  words__6__write_enable;
     
     // Sub module instances
-    dynrt_processor__engine__rays__dirs__0 words__0(
+    dynrt_processor__engine__instances__world__0 words__0(
         .read_address(words__0__read_address),
         .read_clock(words__0__read_clock),
         .read_data(words__0__read_data),
@@ -22672,7 +23719,7 @@ module dynrt_processor__engine__tester__ray(clock,thread,word_a,word_b,ray_write
         .write_data(words__0__write_data),
         .write_enable(words__0__write_enable)
     );
-    dynrt_processor__engine__rays__dirs__0 words__1(
+    dynrt_processor__engine__instances__world__0 words__1(
         .read_address(words__1__read_address),
         .read_clock(words__1__read_clock),
         .read_data(words__1__read_data),
@@ -22681,7 +23728,7 @@ module dynrt_processor__engine__tester__ray(clock,thread,word_a,word_b,ray_write
         .write_data(words__1__write_data),
         .write_enable(words__1__write_enable)
     );
-    dynrt_processor__engine__rays__dirs__0 words__2(
+    dynrt_processor__engine__instances__world__0 words__2(
         .read_address(words__2__read_address),
         .read_clock(words__2__read_clock),
         .read_data(words__2__read_data),
@@ -22690,7 +23737,7 @@ module dynrt_processor__engine__tester__ray(clock,thread,word_a,word_b,ray_write
         .write_data(words__2__write_data),
         .write_enable(words__2__write_enable)
     );
-    dynrt_processor__engine__rays__dirs__0 words__3(
+    dynrt_processor__engine__instances__world__0 words__3(
         .read_address(words__3__read_address),
         .read_clock(words__3__read_clock),
         .read_data(words__3__read_data),
@@ -22699,7 +23746,7 @@ module dynrt_processor__engine__tester__ray(clock,thread,word_a,word_b,ray_write
         .write_data(words__3__write_data),
         .write_enable(words__3__write_enable)
     );
-    dynrt_processor__engine__rays__dirs__0 words__4(
+    dynrt_processor__engine__instances__world__0 words__4(
         .read_address(words__4__read_address),
         .read_clock(words__4__read_clock),
         .read_data(words__4__read_data),
@@ -22708,7 +23755,7 @@ module dynrt_processor__engine__tester__ray(clock,thread,word_a,word_b,ray_write
         .write_data(words__4__write_data),
         .write_enable(words__4__write_enable)
     );
-    dynrt_processor__engine__rays__dirs__0 words__5(
+    dynrt_processor__engine__instances__world__0 words__5(
         .read_address(words__5__read_address),
         .read_clock(words__5__read_clock),
         .read_data(words__5__read_data),
@@ -22717,7 +23764,7 @@ module dynrt_processor__engine__tester__ray(clock,thread,word_a,word_b,ray_write
         .write_data(words__5__write_data),
         .write_enable(words__5__write_enable)
     );
-    dynrt_processor__engine__rays__dirs__0 words__6(
+    dynrt_processor__engine__instances__world__0 words__6(
         .read_address(words__6__read_address),
         .read_clock(words__6__read_clock),
         .read_data(words__6__read_data),
@@ -26318,7 +27365,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .write_data(done_u__write_data),
         .write_enable(done_u__write_enable)
     );
-    dynrt_processor__engine__rays__dirs__0 leaf_hi(
+    dynrt_processor__engine__instances__world__0 leaf_hi(
         .read_address(leaf_hi__read_address),
         .read_clock(leaf_hi__read_clock),
         .read_data(leaf_hi__read_data),
@@ -28678,17 +29725,17 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
     );
-    dynrt_processor__engine__tester__a_issued read_address(
+    dynrt_processor__engine__instances__arrived read_address(
         .d(read_address__d),
         .q(read_address__q),
         .clock(read_address__clock)
     );
-    dynrt_processor__engine__tester__a_issued write_address(
+    dynrt_processor__engine__instances__arrived write_address(
         .d(write_address__d),
         .q(write_address__q),
         .clock(write_address__clock)
     );
-    dynrt_processor__engine__tester__a_issued write_address_delayed(
+    dynrt_processor__engine__instances__arrived write_address_delayed(
         .d(write_address_delayed__d),
         .q(write_address_delayed__q),
         .clock(write_address_delayed__clock)
@@ -29392,6 +30439,8 @@ module dynrt_processor__engine__traversal_unit__stack_node(read_address,read_clo
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__stack_node
+
+
 
 
 

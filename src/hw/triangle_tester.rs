@@ -137,16 +137,21 @@ pub struct TriangleTester<
     /// input.
     pub transform_busy: Signal<Out, Bit>,
     pub intersect_busy: Signal<Out, Bit>,
-    /// Ray generation's client port on the TransformUnit: a request (`gen_valid`, the camera
-    /// matrix `gen_m`, the pixel's point `gen_v`, `gen_thread`) is taken (`gen_take`) in a
-    /// clock the launch leaves the unit free (the tests come first, so their latency stays
-    /// fixed); its direction leaves [`TRANSFORM_LATENCY`] clocks later on `gen_out_*`.
+    /// The other clients' port on the TransformUnit (ray generation, instance entry): a
+    /// request (`gen_valid`, the matrix `gen_m`, the point or vector `gen_v`, `gen_point`,
+    /// `gen_thread` and the `gen_client` bits the requester chooses) is taken (`gen_take`) in
+    /// a clock the launch leaves the unit free (the tests come first, so their latency stays
+    /// fixed); its result leaves [`TRANSFORM_LATENCY`] clocks later on `gen_out_*`, with the
+    /// request's client bits.
     pub gen_valid: Signal<In, Bit>,
     pub gen_m: [Signal<In, Bits<W>>; 12],
     pub gen_v: [Signal<In, Bits<W>>; 3],
+    pub gen_point: Signal<In, Bit>,
+    pub gen_client: Signal<In, Bits<2>>,
     pub gen_thread: Signal<In, Bits<5>>,
     pub gen_take: Signal<Out, Bit>,
     pub gen_out_valid: Signal<Out, Bit>,
+    pub gen_out_client: Signal<Out, Bits<2>>,
     pub gen_out_thread: Signal<Out, Bits<5>>,
     pub gen_out_dir: [Signal<Out, Bits<W>>; 3],
     /// A primary ray written whole into the thread's ray ([`RayStore`]'s `primary_write`).
@@ -320,9 +325,12 @@ impl<
             gen_valid: Default::default(),
             gen_m: Default::default(),
             gen_v: Default::default(),
+            gen_point: Default::default(),
+            gen_client: Default::default(),
             gen_thread: Default::default(),
             gen_take: Default::default(),
             gen_out_valid: Default::default(),
+            gen_out_client: Default::default(),
             gen_out_thread: Default::default(),
             gen_out_dir: Default::default(),
             primary_write: Default::default(),
@@ -753,7 +761,8 @@ impl<
             self.lb.d.next = !self.lb.q.val();
             self.lphase.d.next = Launch::Wait;
         }
-        // Ray generation's request takes the unit in a clock the launch leaves free.
+        // The other clients' request takes the unit in a clock the launch leaves free; its
+        // tag is `{gen[14], client[11:10], thread[9:5]}`.
         self.launching.next =
             (self.lphase.q.val() == Launch::Origin) | (self.lphase.q.val() == Launch::Direction);
         self.gen_taken.next = self.gen_valid.val() & (!self.launching.val());
@@ -766,11 +775,14 @@ impl<
             for k in 0..3 {
                 self.transform_unit.v[k].next = self.gen_v[k].val();
             }
-            self.transform_unit.tag.next =
-                self.c_primary.val() | (bit_cast::<16, 5>(self.gen_thread.val()) << 5);
+            self.transform_unit.point.next = self.gen_point.val();
+            self.transform_unit.tag.next = self.c_primary.val()
+                | (bit_cast::<16, 2>(self.gen_client.val()) << 10)
+                | (bit_cast::<16, 5>(self.gen_thread.val()) << 5);
         }
         self.gen_out_valid.next =
             self.transform_unit.out_valid.val() & self.transform_unit.out_tag.val().get_bit(14);
+        self.gen_out_client.next = self.transform_unit.out_tag.val().get_bits::<2>(10);
         self.gen_out_thread.next = self.transform_unit.out_tag.val().get_bits::<5>(5);
         for k in 0..3 {
             self.gen_out_dir[k].next = self.transform_unit.result[k].val();

@@ -2,17 +2,22 @@
 //! `preferred` if it has one, else of `others`, one-hot.
 //!
 //! Contract: `found` is set when either word has a bit set; `onehot` then has exactly the
-//! chosen bit; with no bit set it is zero. (The thread's number is encoded from the
-//! registered one-hot by the scheduler, a clock later, out of this path.) The scheduler passes the
-//! ready threads below its round-robin pointer as `preferred` and all ready threads as
-//! `others`.
+//! chosen bit and `number` its index (0-31, whichever word it came from); with no bit set
+//! both are zero. The scheduler passes the ready threads below its round-robin pointer as
+//! `preferred` and all ready threads as `others`, and registers both forms: the one-hot for
+//! its own bookkeeping, the number for the pc store's address.
 //!
 //! Structure: a search for the highest set bit of the 64-bit `{preferred, others}` in groups
 //! of four, not a chain of 64 priority multiplexers: whether a group has a bit set, whether
 //! any higher group has (spread down one, two, four, eight and sixteen groups), and whether a
 //! higher bit of the same group has; the chosen bit is the one whose group is the first and
 //! who is first in its group. It settles in about six levels of logic, where the chain took
-//! eleven (the scheduler's pick was among the processor's slowest paths).
+//! eleven (the scheduler's pick was among the processor's slowest paths). The number comes
+//! from the same first group: its group's number (an OR over the groups) and, beside it, the
+//! position of the highest bit within the group (one level from the group's four bits,
+//! chosen by the first group): a level or two more than the one-hot, here, where an encode
+//! of the registered one-hot sat in front of the pc store's read on the processor's slowest
+//! placed path (86.3 MHz: the encode, the pc store and the epoch check, 9.6 ns of routing).
 //!
 //! Latency: combinational (the scheduler registers the choice). Throughput: one choice per
 //! clock. Golden twin: none (it computes no ray arithmetic); the test below checks it against
@@ -26,6 +31,7 @@ pub struct FirstReady {
     pub others: Signal<In, Bits<32>>,
     pub found: Signal<Out, Bit>,
     pub onehot: Signal<Out, Bits<32>>,
+    pub number: Signal<Out, Bits<5>>,
 
     both: Signal<Local, Bits<64>>,
     spread: Signal<Local, Bits<64>>,
@@ -42,12 +48,19 @@ pub struct FirstReady {
     /// A higher bit of the same group is set.
     higher_in_group: Signal<Local, Bits<64>>,
     first: Signal<Local, Bits<64>>,
+    /// At the lowest bit of each group: bit 1 and bit 0 of the position of the group's
+    /// highest set bit.
+    position_hi: Signal<Local, Bits<64>>,
+    position_lo: Signal<Local, Bits<64>>,
+    number_bits: [Signal<Local, Bit>; 5],
 
     /// The lowest bit of every group of four; the bits of a group with three and with two
     /// bits above them in the group.
     c_group_low: Constant<Bits<64>>,
     c_below_3: Constant<Bits<64>>,
     c_below_2: Constant<Bits<64>>,
+    /// The lowest bit of every group whose number (0-15) has bit `k` set.
+    c_group_number_bit: [Constant<Bits<64>>; 3],
 }
 
 impl Default for FirstReady {
@@ -57,6 +70,7 @@ impl Default for FirstReady {
             others: Default::default(),
             found: Default::default(),
             onehot: Default::default(),
+            number: Default::default(),
             both: Default::default(),
             spread: Default::default(),
             group_any: Default::default(),
@@ -69,9 +83,20 @@ impl Default for FirstReady {
             group_mask: Default::default(),
             higher_in_group: Default::default(),
             first: Default::default(),
+            position_hi: Default::default(),
+            position_lo: Default::default(),
+            number_bits: Default::default(),
             c_group_low: Constant::new(0x1111_1111_1111_1111u64.into()),
             c_below_3: Constant::new(0x7777_7777_7777_7777u64.into()),
             c_below_2: Constant::new(0x3333_3333_3333_3333u64.into()),
+            c_group_number_bit: std::array::from_fn(|k| {
+                Constant::new(
+                    (0..16u64)
+                        .filter(|g| g >> k & 1 == 1)
+                        .fold(0u64, |m, g| m | 1 << (4 * g))
+                        .into(),
+                )
+            }),
         }
     }
 }
@@ -100,6 +125,25 @@ impl Logic for FirstReady {
         self.first.next = self.both.val() & (!self.higher_in_group.val()) & self.group_mask.val();
         self.onehot.next = self.first.val().get_bits::<32>(0) | self.first.val().get_bits::<32>(32);
         self.found.next = self.both.val() != 0;
+
+        // The number: the first group's number (bits 4..2; bit 5, which word, is dropped) and
+        // the position of the highest bit in it (bits 1..0).
+        self.position_hi.next =
+            ((self.both.val() >> 2) | (self.both.val() >> 3)) & self.c_group_low.val();
+        self.position_lo.next = ((self.both.val() >> 3)
+            | ((!(self.both.val() >> 2)) & (self.both.val() >> 1)))
+            & self.c_group_low.val();
+        self.number_bits[0].next = (self.group_first.val() & self.position_lo.val()) != 0;
+        self.number_bits[1].next = (self.group_first.val() & self.position_hi.val()) != 0;
+        for k in 0..3 {
+            self.number_bits[k + 2].next =
+                (self.group_first.val() & self.c_group_number_bit[k].val()) != 0;
+        }
+        self.number.next = bit_cast::<5, 1>(self.number_bits[0].val().into())
+            | (bit_cast::<5, 1>(self.number_bits[1].val().into()) << 1)
+            | (bit_cast::<5, 1>(self.number_bits[2].val().into()) << 2)
+            | (bit_cast::<5, 1>(self.number_bits[3].val().into()) << 3)
+            | (bit_cast::<5, 1>(self.number_bits[4].val().into()) << 4);
     }
 }
 
@@ -146,6 +190,11 @@ mod tests {
             assert_eq!(
                 unit.onehot.val().to_u64(),
                 want.map_or(0, |k| 1u64 << k),
+                "{case}"
+            );
+            assert_eq!(
+                unit.number.val().to_u64(),
+                want.map_or(0, u64::from),
                 "{case}"
             );
         }

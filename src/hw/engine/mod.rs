@@ -79,6 +79,7 @@ mod execute;
 mod fetch;
 mod first_ready;
 mod fp_units;
+mod instance_rays;
 mod mailbox;
 mod primary_rays;
 mod program_rom;
@@ -92,6 +93,7 @@ pub use execute::Execute;
 pub use fetch::{Fetch, FETCH_LATENCY};
 pub use first_ready::FirstReady;
 pub use fp_units::FpUnits;
+pub use instance_rays::{EntryPhase, InstanceRays};
 pub use mailbox::MailboxUnit;
 pub use primary_rays::{PrimaryRays, CAMERA_WORDS};
 pub use program_rom::ProgramRom;
@@ -154,6 +156,16 @@ pub enum ResultSource {
     Quotient,
     Root,
     Byte,
+}
+
+/// Whose request the tester's TransformUnit computes besides the triangle tests (its
+/// `gen_client` bits, echoed with the result): bit 0 is set for instance entry, bit 1 for its
+/// direction.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum GenClient {
+    Primary = 0b00,
+    InstanceOrigin = 0b01,
+    InstanceDirection = 0b11,
 }
 
 /// An opcode as the decoders compare it, from its one definition in `isa::Op`.
@@ -221,8 +233,10 @@ pub struct ThreadEngine<
     pub intersect_busy: Signal<Out, Bits<32>>,
     /// Clocks of the frame in which the traversal unit started a node decision.
     pub traversal_busy: Signal<Out, Bits<32>>,
-    /// Clocks of the frame in which ray generation's request took the TransformUnit.
+    /// Clocks of the frame in which ray generation's and instance entry's requests took the
+    /// TransformUnit.
     pub raygen_busy: Signal<Out, Bits<32>>,
+    pub instance_busy: Signal<Out, Bits<32>>,
 
     // The pipeline's stages.
     scheduler: Scheduler,
@@ -230,6 +244,7 @@ pub struct ThreadEngine<
     decode: Decode,
     mailboxes: MailboxUnit,
     rays: PrimaryRays<W, E, M>,
+    instances: InstanceRays<W>,
     execute: Execute<W>,
     fp_units: FpUnits<W, E, M, S, S1, X2, T, P>,
     result_line: ResultLine<DX>,
@@ -251,6 +266,7 @@ pub struct ThreadEngine<
     intersect_count: DFF<Bits<32>>,
     traversal_count: DFF<Bits<32>>,
     raygen_count: DFF<Bits<32>>,
+    instance_count: DFF<Bits<32>>,
     frame_start: Signal<Local, Bit>,
     // The memory and frame-buffer ports' request registers.
     /// The load's bank one-hot (`CoprocessorPort::load_banks`); `mem_bank_r` its number, for
@@ -267,6 +283,8 @@ pub struct ThreadEngine<
     ray_write: DFF<Bit>,
     t_min_write: DFF<Bit>,
     camera_write: DFF<Bit>,
+    world_write: DFF<Bit>,
+    enter_offer: DFF<Bit>,
     tri_enqueue: DFF<Bit>,
     tri_queues: DFF<Bit>,
     tri_kind: DFF<Bits<2>>,
@@ -281,6 +299,11 @@ pub struct ThreadEngine<
     queued_fn: Signal<Local, Bit>,
     tri_busy: Signal<Local, Bit>,
     kd_busy: Signal<Local, Bit>,
+    /// Instance entry's request goes to the TransformUnit (ray generation's, when both ask,
+    /// goes first); a ray written whole into both ray stores, by ray generation or instance
+    /// entry.
+    gen_instance: Signal<Local, Bit>,
+    store_write: Signal<Local, Bit>,
 
     c_threads: Constant<Bits<8>>,
     // The glue's names, every one from its definition in `isa` (`Op`, `TriFn`, `KdFn`),
@@ -305,6 +328,8 @@ pub struct ThreadEngine<
     tri_object: Constant<Bits<32>>,
     tri_skip: Constant<Bits<32>>,
     tri_camera: Constant<Bits<32>>,
+    tri_world: Constant<Bits<32>>,
+    tri_enter: Constant<Bits<32>>,
     kd_start: Constant<Bits<32>>,
     kd_wait: Constant<Bits<32>>,
     cmd_list: Constant<Bits<2>>,
@@ -312,6 +337,10 @@ pub struct ThreadEngine<
     cmd_object: Constant<Bits<2>>,
     cmd_skip: Constant<Bits<2>>,
     bank_lists: Constant<Bits<3>>,
+    bank_instances: Constant<Bits<3>>,
+    client_primary: Constant<Bits<2>>,
+    client_origin: Constant<Bits<2>>,
+    client_direction: Constant<Bits<2>>,
     /// `mem_load_r`'s bit 0, shifted to the load's bank.
     one_bank: Constant<Bits<{ layout::BANKS }>>,
     /// [`SHARED_BUS_BANKS`].
@@ -370,6 +399,7 @@ impl<
             bank3: Default::default(),
             transform_busy: Default::default(),
             raygen_busy: Default::default(),
+            instance_busy: Default::default(),
             intersect_busy: Default::default(),
             traversal_busy: Default::default(),
             scheduler: Scheduler::new(threads, reserve_ahead),
@@ -377,6 +407,7 @@ impl<
             decode: Decode::new(program.registers_used),
             mailboxes: Default::default(),
             rays: PrimaryRays::new(&program.config),
+            instances: InstanceRays::new(mem_latency),
             execute: Default::default(),
             fp_units: Default::default(),
             result_line: ResultLine::new(mem_latency),
@@ -392,6 +423,7 @@ impl<
             instr_count: Default::default(),
             transform_count: Default::default(),
             raygen_count: Default::default(),
+            instance_count: Default::default(),
             intersect_count: Default::default(),
             traversal_count: Default::default(),
             frame_start: Default::default(),
@@ -404,6 +436,8 @@ impl<
             ray_write: Default::default(),
             t_min_write: Default::default(),
             camera_write: Default::default(),
+            world_write: Default::default(),
+            enter_offer: Default::default(),
             tri_enqueue: Default::default(),
             tri_queues: Default::default(),
             tri_kind: Default::default(),
@@ -418,6 +452,8 @@ impl<
             queued_fn: Default::default(),
             tri_busy: Default::default(),
             kd_busy: Default::default(),
+            gen_instance: Default::default(),
+            store_write: Default::default(),
             c_threads: Constant::new(u64::from(threads).into()),
             op_fsub: op_code(Op::FSub),
             op_fdiv: op_code(Op::FDiv),
@@ -437,6 +473,8 @@ impl<
             tri_object: tri_fn(TriFn::Object),
             tri_skip: tri_fn(TriFn::Skip),
             tri_camera: tri_fn(TriFn::Camera),
+            tri_world: tri_fn(TriFn::World),
+            tri_enter: tri_fn(TriFn::Enter),
             kd_start: kd_fn(KdFn::Start),
             kd_wait: kd_fn(KdFn::Wait),
             cmd_list: cmd(list_unit::CMD_LIST),
@@ -444,6 +482,10 @@ impl<
             cmd_object: cmd(list_unit::CMD_OBJECT),
             cmd_skip: cmd(list_unit::CMD_SKIP),
             bank_lists: bank(layout::LISTS),
+            bank_instances: bank(layout::INSTANCES),
+            client_primary: Constant::new((GenClient::Primary as u64).into()),
+            client_origin: Constant::new((GenClient::InstanceOrigin as u64).into()),
+            client_direction: Constant::new((GenClient::InstanceDirection as u64).into()),
             one_bank: Constant::new(1u64.into()),
             shared_banks: Constant::new(SHARED_BUS_BANKS.into()),
         }
@@ -475,6 +517,7 @@ impl<
             instr_count,
             transform_count,
             raygen_count,
+            instance_count,
             intersect_count,
             traversal_count,
             mem_load_r,
@@ -486,6 +529,8 @@ impl<
             ray_write,
             t_min_write,
             camera_write,
+            world_write,
+            enter_offer,
             tri_enqueue,
             tri_queues,
             tri_kind,
@@ -502,6 +547,7 @@ impl<
             decode,
             mailboxes,
             rays,
+            instances,
             fp_units,
             result_line,
             write_back,
@@ -510,6 +556,12 @@ impl<
         );
         self.scratch.read_clock.next = self.clock.val();
         self.scratch.write_clock.next = self.clock.val();
+
+        // Instance entry's request goes to the TransformUnit when ray generation has none; a
+        // ray is written whole into both ray stores by one or the other (never both: each
+        // writes the clock after a result of its own).
+        self.gen_instance.next = self.instances.gen_valid.val() & (!self.rays.gen_valid.val());
+        self.store_write.next = self.rays.primary_write.val() | self.instances.ray_write.val();
 
         // Frame control and counters.
         self.frame_start.next = self.start.val() & (!self.running.q.val());
@@ -521,6 +573,7 @@ impl<
         self.intersect_busy.next = self.intersect_count.q.val();
         self.traversal_busy.next = self.traversal_count.q.val();
         self.raygen_busy.next = self.raygen_count.q.val();
+        self.instance_busy.next = self.instance_count.q.val();
         if self.running.q.val() {
             self.cycle_count.d.next = self.cycle_count.q.val() + 1;
             if self.tester.transform_busy.val() {
@@ -532,8 +585,11 @@ impl<
             if self.traversal_unit.step_busy.val() {
                 self.traversal_count.d.next = self.traversal_count.q.val() + 1;
             }
-            if self.tester.gen_take.val() {
+            if self.tester.gen_take.val() & (!self.gen_instance.val()) {
                 self.raygen_count.d.next = self.raygen_count.q.val() + 1;
+            }
+            if self.tester.gen_take.val() & self.gen_instance.val() {
+                self.instance_count.d.next = self.instance_count.q.val() + 1;
             }
         }
 
@@ -558,6 +614,7 @@ impl<
         self.mailboxes.read_which.next = self.decode.imm_i4.val().get_bit(0);
         self.tester.engine.query_thread.next = self.decode.thread_i4.val();
         self.traversal_unit.engine.query_thread.next = self.decode.thread_i4.val();
+        self.instances.query_thread.next = self.decode.thread_i4.val();
 
         // I5.
         self.fp_units.a.next = self.decode.a.val().get_bits::<W>(0);
@@ -595,6 +652,14 @@ impl<
         self.rays.word_a.next = self.decode.a.val();
         self.rays.word_b.next = self.decode.b.val();
         self.rays.query_thread.next = self.decode.thread_i4.val();
+        self.instances.frame_start.next = self.frame_start.val();
+        self.instances.thread.next = self.decode.thread.val();
+        self.instances.world_write.next = self.world_write.q.val();
+        self.instances.world_pair.next = self.decode.shift.val().get_bits::<2>(0);
+        self.instances.word_a.next = self.decode.a.val();
+        self.instances.word_b.next = self.decode.b.val();
+        self.instances.offer.next = self.enter_offer.q.val();
+        self.instances.record.next = self.decode.a.val().get_bits::<24>(0);
 
         // Scratch memory.
         self.scratch.read_address.next = (bit_cast::<12, 5>(self.decode.thread.val()) << 7)
@@ -620,17 +685,25 @@ impl<
         self.fb.addr.next = self.fb_addr_r.q.val();
         self.fb.data.next = self.fb_data_r.q.val();
         // Bank 0 goes through the traversal unit's port, banks 2 and 3 through the triangle
-        // tester's; the tester's list reads (bank 1) use this bus when the engine does not.
+        // tester's; the tester's list reads (bank 1) use this bus when the engine does not,
+        // instance entry's reads (bank 4) when neither does.
+        self.instances.bus_free.next = ((self.mem_load_r.q.val() & self.shared_banks.val()) == 0)
+            & (!self.tester.lists.read.val());
         self.mem.read.next = ((self.mem_load_r.q.val() & self.shared_banks.val()) != 0)
-            | self.tester.lists.read.val();
+            | self.tester.lists.read.val()
+            | self.instances.read.val();
         if self.tester.lists.read.val() {
             self.mem.bank.next = self.bank_lists.val();
             self.mem.addr.next = self.tester.lists.addr.val();
+        } else if self.instances.read.val() {
+            self.mem.bank.next = self.bank_instances.val();
+            self.mem.addr.next = self.instances.addr.val();
         } else {
             self.mem.bank.next = self.mem_bank_r.q.val();
             self.mem.addr.next = self.mem_addr_r.q.val();
         }
         self.tester.lists.rdata.next = self.mem.rdata.val();
+        self.instances.rdata.next = self.mem.rdata.val();
         SramRead::link(&mut self.bank0, &mut self.traversal_unit.nodes);
         SramRead::link(&mut self.bank2, &mut self.tester.a_words);
         SramRead::link(&mut self.bank3, &mut self.tester.b_words);
@@ -651,6 +724,12 @@ impl<
         self.camera_write.d.next = self.decode.valid_i4.val()
             & self.tri_op.val()
             & (self.decode.imm_i4.val() == self.tri_camera.val());
+        self.world_write.d.next = self.decode.valid_i4.val()
+            & self.tri_op.val()
+            & (self.decode.imm_i4.val() == self.tri_world.val());
+        self.enter_offer.d.next = self.decode.valid_i4.val()
+            & self.tri_op.val()
+            & (self.decode.imm_i4.val() == self.tri_enter.val());
         self.t_min_write.d.next = self.decode.valid_i4.val()
             & self.tri_op.val()
             & (self.decode.imm_i4.val() == self.tri_init.val());
@@ -684,39 +763,76 @@ impl<
         self.traversal_unit.engine.word_b.next = self.decode.b.val();
         self.traversal_unit.engine.ray_pair.next = self.decode.imm.val().get_bits::<2>(0);
         self.traversal_unit.engine.ray_write.next =
-            self.ray_write.q.val() & (!self.rays.primary_write.val());
+            self.ray_write.q.val() & (!self.store_write.val());
         self.tester.engine.load_banks.next = self.mem_load_r.q.val();
         self.tester.engine.load_addr.next = self.mem_addr_r.q.val();
         self.tester.engine.thread.next = self.decode.thread.val();
         self.tester.engine.word_a.next = self.decode.a.val();
         self.tester.engine.word_b.next = self.decode.b.val();
         self.tester.engine.ray_pair.next = self.decode.imm.val().get_bits::<2>(0);
-        self.tester.engine.ray_write.next =
-            self.ray_write.q.val() & (!self.rays.primary_write.val());
-        // Ray generation: its requests take the tester's TransformUnit in the clocks the
-        // launch leaves free, and its primary rays are written whole into both ray stores
-        // (the engine's ray words are refused in that clock).
-        self.tester.gen_valid.next = self.rays.gen_valid.val();
-        for k in 0..12 {
-            self.tester.gen_m[k].next = self.rays.gen_m[k].val();
+        self.tester.engine.ray_write.next = self.ray_write.q.val() & (!self.store_write.val());
+        // Ray generation and instance entry: their requests take the tester's TransformUnit
+        // in the clocks the launch leaves free (ray generation's first), and their rays are
+        // written whole into both ray stores (the engine's ray words are refused in that
+        // clock). The client bits say whose result it is (`GenClient`).
+        self.tester.gen_valid.next = self.rays.gen_valid.val() | self.instances.gen_valid.val();
+        if self.gen_instance.val() {
+            for k in 0..12 {
+                self.tester.gen_m[k].next = self.instances.gen_m[k].val();
+            }
+            for k in 0..3 {
+                self.tester.gen_v[k].next = self.instances.gen_v[k].val();
+            }
+            self.tester.gen_point.next = self.instances.gen_point.val();
+            self.tester.gen_client.next = self.client_origin.val();
+            if self.instances.gen_direction.val() {
+                self.tester.gen_client.next = self.client_direction.val();
+            }
+            self.tester.gen_thread.next = self.instances.gen_thread.val();
+        } else {
+            for k in 0..12 {
+                self.tester.gen_m[k].next = self.rays.gen_m[k].val();
+            }
+            for k in 0..3 {
+                self.tester.gen_v[k].next = self.rays.gen_v[k].val();
+            }
+            self.tester.gen_point.next = true;
+            self.tester.gen_client.next = self.client_primary.val();
+            self.tester.gen_thread.next = self.rays.gen_thread.val();
         }
-        for k in 0..3 {
-            self.tester.gen_v[k].next = self.rays.gen_v[k].val();
-        }
-        self.tester.gen_thread.next = self.rays.gen_thread.val();
         self.rays.gen_take.next = self.tester.gen_take.val();
-        self.rays.gen_out_valid.next = self.tester.gen_out_valid.val();
+        self.instances.gen_take.next = self.tester.gen_take.val() & self.gen_instance.val();
+        self.rays.gen_out_valid.next =
+            self.tester.gen_out_valid.val() & (!self.tester.gen_out_client.val().get_bit(0));
         self.rays.gen_out_thread.next = self.tester.gen_out_thread.val();
-        self.tester.primary_write.next = self.rays.primary_write.val();
-        self.tester.primary_thread.next = self.rays.primary_thread.val();
-        self.traversal_unit.primary_write.next = self.rays.primary_write.val();
-        self.traversal_unit.primary_thread.next = self.rays.primary_thread.val();
+        self.instances.out_valid.next =
+            self.tester.gen_out_valid.val() & self.tester.gen_out_client.val().get_bit(0);
+        self.instances.out_direction.next = self.tester.gen_out_client.val().get_bit(1);
+        self.instances.out_thread.next = self.tester.gen_out_thread.val();
         for k in 0..3 {
             self.rays.gen_out_dir[k].next = self.tester.gen_out_dir[k].val();
-            self.tester.primary_o[k].next = self.rays.primary_o[k].val();
-            self.tester.primary_d[k].next = self.rays.primary_d[k].val();
-            self.traversal_unit.primary_o[k].next = self.rays.primary_o[k].val();
-            self.traversal_unit.primary_d[k].next = self.rays.primary_d[k].val();
+            self.instances.out_v[k].next = self.tester.gen_out_dir[k].val();
+        }
+        self.tester.primary_write.next = self.store_write.val();
+        self.traversal_unit.primary_write.next = self.store_write.val();
+        if self.instances.ray_write.val() {
+            self.tester.primary_thread.next = self.instances.ray_thread.val();
+            self.traversal_unit.primary_thread.next = self.instances.ray_thread.val();
+            for k in 0..3 {
+                self.tester.primary_o[k].next = self.instances.ray_o[k].val();
+                self.tester.primary_d[k].next = self.instances.ray_d[k].val();
+                self.traversal_unit.primary_o[k].next = self.instances.ray_o[k].val();
+                self.traversal_unit.primary_d[k].next = self.instances.ray_d[k].val();
+            }
+        } else {
+            self.tester.primary_thread.next = self.rays.primary_thread.val();
+            self.traversal_unit.primary_thread.next = self.rays.primary_thread.val();
+            for k in 0..3 {
+                self.tester.primary_o[k].next = self.rays.primary_o[k].val();
+                self.tester.primary_d[k].next = self.rays.primary_d[k].val();
+                self.traversal_unit.primary_o[k].next = self.rays.primary_o[k].val();
+                self.traversal_unit.primary_d[k].next = self.rays.primary_d[k].val();
+            }
         }
 
         // Triangle tester: the entry and its answer (refused, or the wait pending).
@@ -727,9 +843,14 @@ impl<
             self.tri_busy.next = self.tester.engine.full.val();
         }
         if self.tri_waits.q.val() {
-            self.tri_busy.next = self.tester.engine.pending.val() | self.rays.pending.val();
+            self.tri_busy.next = self.tester.engine.pending.val()
+                | self.rays.pending.val()
+                | self.instances.pending.val();
         }
-        if self.ray_write.q.val() & self.rays.primary_write.val() {
+        if self.enter_offer.q.val() {
+            self.tri_busy.next = self.instances.refused.val();
+        }
+        if self.ray_write.q.val() & self.store_write.val() {
             self.tri_busy.next = true;
         }
         // Traversal unit. It sees the object-space ray and t_min the thread gives the tester,
@@ -805,7 +926,8 @@ impl<
         self.scheduler.tester_done_thread.next = self.tester.engine.done_thread.val();
         self.scheduler.walk_done.next = self.traversal_unit.engine.done.val();
         self.scheduler.walk_done_thread.next = self.traversal_unit.engine.done_thread.val();
-        self.scheduler.ray_done_mask.next = self.rays.done_mask.val();
+        self.scheduler.ray_done_mask.next =
+            self.rays.done_mask.val() | self.instances.done_mask.val();
         // Instructions retired: every write back but a turn spent offering again to a full
         // coprocessor queue or waiting for a coprocessor (the twin never repeats those).
         if self.write_back.retired.val() {
@@ -829,6 +951,7 @@ impl<
             self.intersect_count.d.next = 0.into();
             self.traversal_count.d.next = 0.into();
             self.raygen_count.d.next = 0.into();
+            self.instance_count.d.next = 0.into();
         }
     }
 }

@@ -10,9 +10,10 @@
 //! instruction (`fdiv`, `fsqrt`) at I3 reserves the clock its write back will take: the
 //! scheduler issues nothing in the one clock whose instruction would write back with it.
 //!
-//! The pick is made a clock ahead: the thread that issues is a one-hot register (its number,
-//! encoded from it, addresses the pc store), chosen the clock before among the threads ready
-//! then, less the one picked then. Round robin: the choice is the highest of them below a
+//! The pick is made a clock ahead: the thread that issues is a register, one-hot for the
+//! scheduler's bookkeeping and beside it its number (which addresses the pc store, with no
+//! encode in front of the read), chosen the clock before among the threads ready then, less
+//! the one picked then. Round robin: the choice is the highest of them below a
 //! pointer that moves down one thread per clock (a register, so no shifter sits in the
 //! choice), else the highest ([`super::FirstReady`], a tree); every ready thread is first in
 //! line at least once per 32 clocks.
@@ -67,13 +68,13 @@ pub struct Scheduler {
     /// mask (the threads below it).
     picked: DFF<Bit>,
     pick_onehot: DFF<Bits<32>>,
+    pick_number: DFF<Bits<5>>,
     pointer: DFF<Bits<5>>,
     below_pointer: DFF<Bits<32>>,
     /// Clocks in which no thread may issue: a long instruction writes back in the clock where
     /// that issue's instruction would (bit 0 is this clock).
     reserved: DFF<Bits<32>>,
 
-    pick_bits: [Signal<Local, Bit>; 5],
     candidates: Signal<Local, Bits<32>>,
     below: Signal<Local, Bits<32>>,
     /// The next pick: the highest of `{below, candidates}`.
@@ -92,8 +93,6 @@ pub struct Scheduler {
     c_thread_mask: Constant<Bits<32>>,
     c_one: Constant<Bits<32>>,
     c_ones: Constant<Bits<32>>,
-    /// The threads whose number has bit `b` set.
-    c_number_bit: [Constant<Bits<32>>; 5],
     /// The bit of `reserved` a long instruction at I3 sets: the issue `reserve_ahead` clocks
     /// after this one would write back with it.
     c_reserve_bit: Constant<Bits<32>>,
@@ -125,10 +124,10 @@ impl Scheduler {
             woken: Default::default(),
             picked: Default::default(),
             pick_onehot: Default::default(),
+            pick_number: Default::default(),
             pointer: Default::default(),
             below_pointer: Default::default(),
             reserved: Default::default(),
-            pick_bits: Default::default(),
             candidates: Default::default(),
             below: Default::default(),
             first_ready: Default::default(),
@@ -144,14 +143,6 @@ impl Scheduler {
             c_thread_mask: Constant::new(((1u64 << threads) - 1).into()),
             c_one: Constant::new(1u64.into()),
             c_ones: Constant::new(0xffff_ffffu64.into()),
-            c_number_bit: std::array::from_fn(|b| {
-                Constant::new(
-                    (0..32u64)
-                        .filter(|t| t >> b & 1 == 1)
-                        .fold(0u64, |m, t| m | 1 << t)
-                        .into(),
-                )
-            }),
             c_reserve_bit: Constant::new(u64::from(reserve_ahead).into()),
         }
     }
@@ -168,6 +159,7 @@ impl Logic for Scheduler {
             woken,
             picked,
             pick_onehot,
+            pick_number,
             pointer,
             below_pointer,
             reserved
@@ -177,17 +169,7 @@ impl Logic for Scheduler {
         self.issues.next =
             self.running.val() & self.picked.q.val() & (!self.reserved.q.val().get_bit(0));
         self.issue.next = self.issues.val();
-        // The picked thread's number, encoded from the registered one-hot: the encode's two
-        // levels of logic sit in front of the pc store's address, not behind the choice
-        // (`ready -> pick` was the slowest estimated engine path after stop 27).
-        for b in 0..5 {
-            self.pick_bits[b].next = (self.pick_onehot.q.val() & self.c_number_bit[b].val()) != 0;
-        }
-        self.pick.next = bit_cast::<5, 1>(self.pick_bits[0].val().into())
-            | (bit_cast::<5, 1>(self.pick_bits[1].val().into()) << 1)
-            | (bit_cast::<5, 1>(self.pick_bits[2].val().into()) << 2)
-            | (bit_cast::<5, 1>(self.pick_bits[3].val().into()) << 3)
-            | (bit_cast::<5, 1>(self.pick_bits[4].val().into()) << 4);
+        self.pick.next = self.pick_number.q.val();
         self.issue_mask.next = 0.into();
         if self.issues.val() {
             self.issue_mask.next = self.pick_onehot.q.val();
@@ -206,6 +188,7 @@ impl Logic for Scheduler {
         self.first_ready.others.next = self.candidates.val();
         self.picked.d.next = self.first_ready.found.val();
         self.pick_onehot.d.next = self.first_ready.onehot.val();
+        self.pick_number.d.next = self.first_ready.number.val();
         self.pointer.d.next = self.pointer.q.val() - 1;
         self.below_pointer.d.next = !(self.c_ones.val() << (self.pointer.q.val() - 1));
 

@@ -424,6 +424,25 @@ impl Asm {
         self.coprocessor(Op::Tri, f as u32, Reg::ZERO, a, b);
     }
 
+    /// The world ray's words `2 pair`, `2 pair + 1` (of `o.x o.y o.z d.x d.y d.z`) = `a`, `b`,
+    /// for instance entry.
+    pub fn tri_world(&self, pair: u8, a: Reg, b: Reg) {
+        self.emit(Instr {
+            a: a.0,
+            b: b.0,
+            imm: TriFn::World as u32,
+            shift: pair,
+            ..Instr::new(Op::Tri)
+        });
+    }
+
+    /// Enters the instance whose record starts at `record` (bank 4): the world ray in its
+    /// object space becomes the thread's ray in both coprocessors (repeated while refused;
+    /// a `tri.wait` waits for the ray).
+    pub fn tri_enter(&self, record: Reg) {
+        self.coprocessor(Op::Tri, TriFn::Enter as u32, Reg::ZERO, record, Reg::ZERO);
+    }
+
     /// Waits until the thread's queued entries are done; `dst` = the best t.
     pub fn tri_wait(&self, dst: Reg) {
         self.coprocessor(Op::Tri, TriFn::Wait as u32, dst, Reg::ZERO, Reg::ZERO);

@@ -22,7 +22,10 @@ use super::Program;
 use crate::fp::Format;
 use crate::hw::engine::CAMERA_WORDS;
 use crate::hw::traversal_unit::STACK_LEVELS;
-use crate::layout::{Layout, Node, LISTS, NODES, NODE_WORDS, TRIANGLES_B, TRIANGLE_BANK_WORDS};
+use crate::layout::{
+    instance_word, Layout, Node, INSTANCES, LISTS, NODES, NODE_WORDS, TRIANGLES_B,
+    TRIANGLE_BANK_WORDS,
+};
 use crate::units::{self, Mailbox};
 
 /// A failure of the program on this memory (a generator bug or a layout that does not belong
@@ -92,6 +95,8 @@ struct Thread {
     /// thread writes the same frame words) and the thread's last primary direction.
     camera: [u32; CAMERA_WORDS],
     primary_d: [u32; 3],
+    /// The world ray's words (`tri.world`), which `tri.enter` transforms.
+    world: [u32; 6],
     halted: bool,
 }
 
@@ -105,6 +110,7 @@ impl Thread {
             tester: TesterState::default(),
             camera: [0; CAMERA_WORDS],
             primary_d: [0; 3],
+            world: [0; 6],
             halted: false,
         }
     }
@@ -370,6 +376,32 @@ impl<'a> Machine<'a> {
                         let k = usize::from(i.shift);
                         let d = t.primary_d.get(k);
                         result = Some(*d.ok_or_else(|| fail(format!("no direction word {k}")))?);
+                    }
+                    TriFn::World => {
+                        let pair = usize::from(i.shift);
+                        let words = t
+                            .world
+                            .get_mut(2 * pair..2 * pair + 2)
+                            .ok_or_else(|| fail(format!("no world ray word pair {pair}")))?;
+                        words.copy_from_slice(&[a, b]);
+                    }
+                    TriFn::Enter => {
+                        // `hw::engine::InstanceRays`: origin, then direction, through the
+                        // TransformUnit (its twin, `units::transform`).
+                        let bank = &self.layout.banks[INSTANCES];
+                        let at = a as usize + instance_word::WORLD_TO_OBJECT;
+                        let m: units::Mat34W = bank
+                            .get(at..at + 12)
+                            .and_then(|w| w.try_into().ok())
+                            .ok_or_else(|| {
+                                fail(format!(
+                                    "instance record {a} beyond the instance bank's {} words",
+                                    bank.len()
+                                ))
+                            })?;
+                        let (o, d) = t.world.split_at(3);
+                        tt.o = units::transform(f, &m, o.try_into().unwrap(), true);
+                        tt.d = units::transform(f, &m, d.try_into().unwrap(), false);
                     }
                 }
                 // The twin's queue never refuses and its tests are done at once, so the

@@ -180,10 +180,18 @@ pub enum TriFn {
     /// `dst` = component `s` (the shift field, 0..3) of the thread's primary direction (after
     /// a wait).
     Dir,
+    /// World ray words of the thread's trace, for instance entry (`hw::engine::InstanceRays`):
+    /// pair `s` (the shift field, 0..3, the ray words' pairs: `o.x o.y`, `o.z d.x`, `d.y d.z`)
+    /// = `A`, `B`.
+    World,
+    /// Enter instance record `A` (its word address in bank 4): the thread's world ray through
+    /// the record's world-to-object 3x4 (`units::transform`, origin then direction) becomes
+    /// its ray in both coprocessors; the next `wait` waits for it. Repeats while refused.
+    Enter,
 }
 
 impl TriFn {
-    pub const ALL: [TriFn; 13] = [
+    pub const ALL: [TriFn; 15] = [
         TriFn::RayOxy,
         TriFn::RayOzDx,
         TriFn::RayDyz,
@@ -197,6 +205,8 @@ impl TriFn {
         TriFn::Skip,
         TriFn::Camera,
         TriFn::Dir,
+        TriFn::World,
+        TriFn::Enter,
     ];
     pub fn from_imm(imm: u32) -> Option<TriFn> {
         Self::ALL.get(imm as usize).copied()
@@ -216,6 +226,8 @@ impl TriFn {
             TriFn::Skip => "skip",
             TriFn::Camera => "camera",
             TriFn::Dir => "dir",
+            TriFn::World => "world",
+            TriFn::Enter => "enter",
         }
     }
     /// Whether the function puts an entry in the tester's queue.

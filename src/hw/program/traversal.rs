@@ -29,16 +29,12 @@ use super::{Gen, STACK_ENTRY_WORDS};
 use crate::layout::{instance_word as iw, INSTANCES, LEAF_TAG, LISTS, NODES};
 use crate::units;
 
-/// Gives the triangle tester and the traversal unit the object-space ray of `instance`
-/// (which empties the tester's triangle mailbox); of the one object when `None` (object 0,
+/// Gives the triangle tester and the traversal unit the ray of the one object (object 0,
 /// whose mailbox the query's init emptied).
-fn tester_ray(a: &Asm, o: [Reg; 3], d: [Reg; 3], instance: Option<Reg>) {
+fn tester_ray(a: &Asm, o: [Reg; 3], d: [Reg; 3]) {
     a.tri_ray(TriFn::RayOxy, o[0], o[1]);
     a.tri_ray(TriFn::RayOzDx, o[2], d[0]);
     a.tri_ray(TriFn::RayDyz, d[1], d[2]);
-    if let Some(instance) = instance {
-        a.tri_queue(TriFn::Object, instance, Reg::ZERO);
-    }
 }
 
 /// The ray one traversal level walks: registers, and where scratch holds a copy for the
@@ -80,6 +76,17 @@ impl Gen<'_> {
                 a.mov(s.best_t, s.q_t_max.into());
                 a.mov(s.sp, Val::K(self.scratch.stack));
                 self.store_ray(world);
+                // The world ray instance entry transforms.
+                for (pair, [x, y]) in [
+                    [world.o[0], world.o[1]],
+                    [world.o[2], world.d[0]],
+                    [world.d[1], world.d[2]],
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    a.tri_world(pair as u8, x, y);
+                }
                 a.mailbox_clear(MAILBOX_INSTANCES);
                 self.traverse(Val::K(root), world, done);
             }
@@ -87,7 +94,7 @@ impl Gen<'_> {
                 // Traced in line, the trace is the primary ray's, which ray generation has
                 // written into both coprocessors already.
                 if routine {
-                    tester_ray(a, world.o, world.d, None);
+                    tester_ray(a, world.o, world.d);
                 }
                 self.walk_object(Val::K(self.c.object_root), s.q_t_max, done);
             }
@@ -256,18 +263,16 @@ impl Gen<'_> {
         a.load_to(instance, LISTS, p.into(), 0, 0);
         a.op_to(Op::Add, p, p.into(), Val::K(1));
         a.mailbox_check(MAILBOX_INSTANCES, instance, next);
+        // Instance entry (`hw::engine::InstanceRays`): the world ray in the instance's object
+        // space becomes the thread's ray in both coprocessors; the wait waits for it.
         let record = a.keep(self.instance_record(instance));
-        let m: [Val; 12] = a.load_n(INSTANCES, record.into(), 0, iw::WORLD_TO_OBJECT as u32);
+        a.tri_enter(record);
         let root = a.keep(a.load(INSTANCES, record.into(), 0, iw::ROOT as u32));
-        let local_o = units::transform(a, &m, s.q_o.map(Val::R), true).map(|v| a.keep(v));
-        let local_d = units::transform(a, &m, s.q_d.map(Val::R), false).map(|v| a.keep(v));
-        a.end_temps();
         a.free(record);
-        tester_ray(a, local_o, local_d, Some(instance));
+        a.tri_queue(TriFn::Object, instance, Reg::ZERO);
+        a.tri_wait(Reg::ZERO);
         self.walk_object(root.into(), s.best_t, answered);
-        for r in local_o.into_iter().chain(local_d).chain([root]) {
-            a.free(r);
-        }
+        a.free(root);
         a.jump(next);
         a.bind(done);
         a.free(p);

@@ -1050,6 +1050,332 @@ fn primary_rays_e7m16_verilator() {
 }
 
 // ---------------------------------------------------------------------------------------
+// The processor's instance entry: `engine::InstanceRays` on a TransformUnit and a bank 4
+
+/// Words of the instance bank the instance-entry bench holds (16 records).
+const ENTRY_BANK_WORDS: usize = 16 * crate::layout::INSTANCE_WORDS;
+
+/// `engine::InstanceRays` with a TransformUnit on its client port (taking requests in the
+/// clocks `take` is high) and bank 4 as a ROM behind two registers (SRAM latency 2) on a bus
+/// that is free in the clocks `free` is high. World words (`world_*`) and entries
+/// (`enter_*`) come in on separate ports; the unit sees one at a time, as from the engine.
+#[derive(LogicBlock)]
+struct InstanceRaysBench<
+    const W: usize,
+    const E: usize,
+    const M: usize,
+    const S: usize,
+    const S1: usize,
+    const X2: usize,
+    const T: usize,
+    const P: usize,
+> {
+    pub clock: Signal<In, Clock>,
+    pub world_write: Signal<In, Bit>,
+    pub world_pair: Signal<In, Bits<2>>,
+    pub world_thread: Signal<In, Bits<5>>,
+    pub word_a: Signal<In, Bits<32>>,
+    pub word_b: Signal<In, Bits<32>>,
+    pub enter: Signal<In, Bit>,
+    pub enter_thread: Signal<In, Bits<5>>,
+    pub record: Signal<In, Bits<24>>,
+    pub take: Signal<In, Bit>,
+    pub free: Signal<In, Bit>,
+    pub accepted: Signal<Out, Bit>,
+    pub ray_write: Signal<Out, Bit>,
+    pub ray_thread: Signal<Out, Bits<5>>,
+    pub ray_o: [Signal<Out, Bits<W>>; 3],
+    pub ray_d: [Signal<Out, Bits<W>>; 3],
+    pub done_mask: Signal<Out, Bits<32>>,
+    /// A read in a clock the bus was not free (never).
+    pub busy_read: Signal<Out, Bit>,
+    entries: crate::hw::engine::InstanceRays<W>,
+    unit: crate::hw::TransformUnit<W, E, M, S, S1, X2, T, P>,
+    bank: ROM<Bits<32>, 9>,
+    data_1: DFF<Bits<32>>,
+    data_2: DFF<Bits<32>>,
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+    > InstanceRaysBench<W, E, M, S, S1, X2, T, P>
+{
+    fn new(bank: &[u32]) -> Self {
+        assert!(bank.len() <= 512);
+        Self {
+            clock: Default::default(),
+            world_write: Default::default(),
+            world_pair: Default::default(),
+            world_thread: Default::default(),
+            word_a: Default::default(),
+            word_b: Default::default(),
+            enter: Default::default(),
+            enter_thread: Default::default(),
+            record: Default::default(),
+            take: Default::default(),
+            free: Default::default(),
+            accepted: Default::default(),
+            ray_write: Default::default(),
+            ray_thread: Default::default(),
+            ray_o: Default::default(),
+            ray_d: Default::default(),
+            done_mask: Default::default(),
+            busy_read: Default::default(),
+            entries: crate::hw::engine::InstanceRays::new(2),
+            unit: Default::default(),
+            bank: ROM::new(
+                bank.iter()
+                    .enumerate()
+                    .map(|(a, &w)| (Bits::<9>::from(a as u64), Bits::<32>::from(u64::from(w))))
+                    .collect(),
+            ),
+            data_1: Default::default(),
+            data_2: Default::default(),
+        }
+    }
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+    > Logic for InstanceRaysBench<W, E, M, S, S1, X2, T, P>
+{
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(self, clock, data_1, data_2);
+        self.entries.clock.next = self.clock.val();
+        self.unit.clock.next = self.clock.val();
+        self.entries.frame_start.next = false;
+        self.entries.world_write.next = self.world_write.val();
+        self.entries.world_pair.next = self.world_pair.val();
+        self.entries.word_a.next = self.word_a.val();
+        self.entries.word_b.next = self.word_b.val();
+        self.entries.thread.next = self.enter_thread.val();
+        if self.world_write.val() {
+            self.entries.thread.next = self.world_thread.val();
+        }
+        self.entries.offer.next = self.enter.val() & (!self.world_write.val());
+        self.entries.record.next = self.record.val();
+        self.accepted.next =
+            self.enter.val() & (!self.world_write.val()) & (!self.entries.refused.val());
+        self.entries.query_thread.next = 0.into();
+
+        self.entries.bus_free.next = self.free.val();
+        self.busy_read.next = self.entries.read.val() & (!self.free.val());
+        self.bank.address.next = self.entries.addr.val().get_bits::<9>(0);
+        self.data_1.d.next = self.bank.data.val();
+        self.data_2.d.next = self.data_1.q.val();
+        self.entries.rdata.next = self.data_2.q.val();
+
+        self.entries.gen_take.next = self.take.val();
+        self.unit.in_valid.next = self.entries.gen_valid.val() & self.take.val();
+        for k in 0..12 {
+            self.unit.m[k].next = self.entries.gen_m[k].val();
+        }
+        for k in 0..3 {
+            self.unit.v[k].next = self.entries.gen_v[k].val();
+        }
+        self.unit.point.next = self.entries.gen_point.val();
+        self.unit.tag.next = bit_cast::<16, 5>(self.entries.gen_thread.val())
+            | (bit_cast::<16, 1>(self.entries.gen_direction.val().into()) << 5);
+        self.entries.out_valid.next = self.unit.out_valid.val();
+        self.entries.out_thread.next = self.unit.out_tag.val().get_bits::<5>(0);
+        self.entries.out_direction.next = self.unit.out_tag.val().get_bit(5);
+        for k in 0..3 {
+            self.entries.out_v[k].next = self.unit.result[k].val();
+            self.ray_o[k].next = self.entries.ray_o[k].val();
+            self.ray_d[k].next = self.entries.ray_d[k].val();
+        }
+        self.ray_write.next = self.entries.ray_write.val();
+        self.ray_thread.next = self.entries.ray_thread.val();
+        self.done_mask.next = self.entries.done_mask.val();
+    }
+}
+
+/// InstanceRays' generated Verilog in `sim`, e7m16: every thread's world ray written (random
+/// words), then `entries` entries of threads 0..32 in turn into random records of a bank of
+/// random matrices, offered again while refused, the unit taking requests and the bus free in
+/// random clocks. Asserts: each entry's ray is written whole for its thread, in entry order,
+/// as `units::transform` of the thread's world origin (a point) and direction (a vector) by
+/// the record's world-to-object words, with the thread's bit as wake-up; no read goes out on a
+/// busy bus.
+fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
+    use crate::emit::stream_bench::{BenchPort, InputStream, OutputSink, StreamBench};
+    use crate::emit::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
+    use crate::layout::{instance_word, INSTANCE_WORDS};
+    use crate::sim::stream_bench::run_stream_bench;
+    let f = Format::E7M16;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let bank: Vec<u32> = (0..ENTRY_BANK_WORDS)
+        .map(|_| geometric(f, &mut rng, 4))
+        .collect();
+    let world: Vec<[u32; 6]> = (0..32)
+        .map(|_| std::array::from_fn(|_| word(f, rng.gen_range(-4.0..4.0))))
+        .collect();
+    let mut uut = InstanceRaysBench::<24, 7, 16, 17, 18, 9, 21, 34>::new(&bank);
+    uut.connect_all();
+    let top = "instance_rays_bench";
+    let verilog = merge_identical_modules(&rename_rust_hdl_names(&generate_verilog(&uut), top));
+
+    let mut writes: Vec<(u32, Vec<u64>)> = (0..96)
+        .map(|k| {
+            let (thread, pair) = (k / 3, k % 3);
+            let w = |i: usize| u64::from(world[thread][2 * pair + i]);
+            (0, vec![1, pair as u64, thread as u64, w(0), w(1)])
+        })
+        .collect();
+    writes.push((0, vec![0, 0, 0, 0, 0]));
+    let records: Vec<usize> = (0..entries).map(|_| rng.gen_range(0..16)).collect();
+    let offers = records
+        .iter()
+        .enumerate()
+        .map(|(i, &r)| {
+            let gap = if i == 0 { 100 } else { rng.gen_range(0..4) };
+            (gap, vec![(i % 32) as u64, (r * INSTANCE_WORDS) as u64])
+        })
+        .collect();
+    let random_bits = |rng: &mut ChaCha8Rng, n: usize| -> Vec<(u32, Vec<u64>)> {
+        let mut bits: Vec<(u32, Vec<u64>)> = (0..n)
+            .map(|_| (0, vec![u64::from(rng.gen_bool(0.5))]))
+            .collect();
+        bits.push((0, vec![1]));
+        bits
+    };
+    let takes = random_bits(&mut rng, 40 * entries);
+    let frees = random_bits(&mut rng, 40 * entries);
+    let mut ports = vec![BenchPort::input("clock", 1)];
+    for (name, width) in [
+        ("world_write", 1),
+        ("world_pair", 2),
+        ("world_thread", 5),
+        ("word_a", 32),
+        ("word_b", 32),
+        ("enter", 1),
+        ("enter_thread", 5),
+        ("record", 24),
+        ("take", 1),
+        ("free", 1),
+    ] {
+        ports.push(BenchPort::input(name, width));
+    }
+    for (name, width) in [
+        ("accepted", 1),
+        ("ray_write", 1),
+        ("ray_thread", 5),
+        ("done_mask", 32),
+        ("busy_read", 1),
+    ] {
+        ports.push(BenchPort::output(name, width));
+    }
+    let xyz = |name: &'static str| (0..3).map(move |k| format!("{name}__{k}"));
+    for name in xyz("ray_o").chain(xyz("ray_d")) {
+        ports.push(BenchPort::output(name, 24));
+    }
+    let mut ray_fields = vec!["ray_thread".to_string()];
+    ray_fields.extend(xyz("ray_o").chain(xyz("ray_d")));
+    ray_fields.push("done_mask".into());
+    let stream = |name: &str, fields: &[&str], lines| InputStream {
+        name: name.into(),
+        fields: fields.iter().map(|s| s.to_string()).collect(),
+        valid: None,
+        ready: None,
+        lines,
+    };
+    let bench = StreamBench {
+        dut: top.into(),
+        ports,
+        streams: vec![
+            stream(
+                "world",
+                &[
+                    "world_write",
+                    "world_pair",
+                    "world_thread",
+                    "word_a",
+                    "word_b",
+                ],
+                writes,
+            ),
+            InputStream {
+                valid: Some("enter".into()),
+                ready: Some("accepted".into()),
+                ..stream("entries", &["enter_thread", "record"], offers)
+            },
+            stream("takes", &["take"], takes),
+            stream("frees", &["free"], frees),
+        ],
+        sinks: vec![
+            OutputSink {
+                name: "rays".into(),
+                valid: "ray_write".into(),
+                fields: ray_fields,
+                expected: entries,
+            },
+            OutputSink {
+                name: "busy_reads".into(),
+                valid: "busy_read".into(),
+                fields: vec!["busy_read".into()],
+                expected: 0,
+            },
+        ],
+        max_cycles: 40 * entries as u64 + 1000,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let run = run_stream_bench(&bench, &verilog, sim, dir.path()).unwrap();
+    println!(
+        "{sim} instance entry, {entries} entries: compile {:.1} s, run {:.1} s",
+        run.compile_seconds, run.run_seconds
+    );
+    let (rays, busy_reads) = (&run.sinks[0], &run.sinks[1]);
+    assert!(busy_reads.is_empty(), "{sim}: reads on a busy bus");
+    assert_eq!(rays.len(), entries, "{sim}: rays written");
+    let mut bad = 0;
+    for (i, (ray, &r)) in rays.iter().zip(&records).enumerate() {
+        let thread = i % 32;
+        let at = r * INSTANCE_WORDS + instance_word::WORLD_TO_OBJECT;
+        let m: units::Mat34W = bank[at..at + 12].try_into().unwrap();
+        let [ox, oy, oz, dx, dy, dz] = world[thread];
+        let want_o = units::transform(f, &m, [ox, oy, oz], true);
+        let want_d = units::transform(f, &m, [dx, dy, dz], false);
+        let got_o: Vec<u32> = ray[1..4].iter().map(|&w| w as u32).collect();
+        let got_d: Vec<u32> = ray[4..7].iter().map(|&w| w as u32).collect();
+        if ray[0] != thread as u64 || got_o != want_o || got_d != want_d || ray[7] != 1 << thread {
+            if bad < 5 {
+                eprintln!(
+                    "{sim} entry {i}: got thread {} o {got_o:x?} d {got_d:x?} wake-up {:x}, want {thread} {want_o:x?} {want_d:x?}",
+                    ray[0], ray[7]
+                );
+            }
+            bad += 1;
+        }
+    }
+    assert_eq!(bad, 0, "{sim}: {bad} of {entries} entered rays differ");
+}
+
+#[test]
+fn instance_rays_e7m16_icarus() {
+    instance_rays_case(120, 3501, Simulator::Icarus);
+}
+
+#[test]
+fn instance_rays_e7m16_verilator() {
+    instance_rays_case(400, 3502, Simulator::Verilator);
+}
+
+// ---------------------------------------------------------------------------------------
 // Lint
 
 /// `verilator --lint-only -Wall` is clean on every unit in e7m16 and e8m23 (with the waiver

@@ -1,0 +1,509 @@
+//! `InstanceRays`: instance entry in hardware. A `tri.enter` names an instance's record; the
+//! unit reads the record's world-to-object 3x4 from bank 4 on the engine's shared bus (in the
+//! clocks the engine's loads and the tester's list reads leave it free), sends the thread's
+//! world ray through the triangle tester's TransformUnit, the one transformation unit (the
+//! origin as a point, then the direction as a vector), and writes the object-space ray whole
+//! into the thread's ray in both coprocessors, which wakes the thread's `tri.wait`. Before,
+//! the microprogram did this in about 40 instructions per instance entered: 12 loads, 33
+//! floating-point operations and the three ray words.
+//!
+//! Contract (engine stages):
+//! - World ray (I5): `world_write` writes words `2 world_pair` and `2 world_pair + 1` of
+//!   thread `thread`'s world ray `o.x o.y o.z d.x d.y d.z` from `word_a` and `word_b`
+//!   (`tri.world`, three per trace in a scene with a top level).
+//! - Enter (I5): an `offer` of `record` (the record's word address in bank 4) for `thread`
+//!   is taken unless `refused` (the entry slot still holds the entry before; the thread
+//!   repeats its `tri.enter`); taking it marks the thread's ray pending.
+//! - Memory: `read` with `addr` (bank 4) only in a clock with `bus_free`; the word arrives on
+//!   `rdata` `mem_latency` clocks later. Twelve reads per entry.
+//! - Requests (`gen_*`, the tester's client port): the origin (`gen_point`) and then the
+//!   direction (`gen_direction`), each held until `gen_take`; results come back on `out_*`
+//!   (`out_direction` tells which), in request order, [`TRANSFORM_LATENCY`] clocks later.
+//! - Write (a clock after the direction's result): `ray_write` with `ray_thread`, `ray_o`,
+//!   `ray_d` for both coprocessors' [`RayStore`]s; `done_mask` (bit `ray_thread`) in the same
+//!   clock is the thread's wake-up. The engine's ray words are refused in that clock, and
+//!   ray generation's write never falls in it: each writes the clock after a result of its
+//!   own, and the unit gives one result per clock.
+//! - Answers: `query_thread` at I4; at I5 `pending` (the entered ray is not written yet).
+//!
+//! Latency: from the `tri.enter` at I5, 1 clock to start the entry, 12 reads (one per free
+//! bus clock) and `mem_latency` for the last word, then the two requests and
+//! [`TRANSFORM_LATENCY`] (28) in the unit, and 1 to the write: about 45 clocks with
+//! `mem_latency` 2 and a free bus. Throughput: one entry per about `15 + mem_latency` clocks
+//! (the next entry's reads start while this one's requests are in the unit).
+//!
+//! Golden twin: [`units::transform`](crate::units::transform) of the world origin (a point)
+//! and direction (a vector) by the record's `instance_word::WORLD_TO_OBJECT` words, as the
+//! engine's twin (`hw::program::exec`, `tri.enter`) and the golden model's `enter_instance`
+//! compute them.
+//!
+//! [`RayStore`]: crate::hw::ray_store::RayStore
+//! [`TRANSFORM_LATENCY`]: crate::hw::TRANSFORM_LATENCY
+
+use rust_hdl::prelude::*;
+
+use crate::layout::instance_word;
+
+/// Words of a world-to-object matrix (3x4), read per entry.
+const MATRIX_WORDS: u64 = 12;
+
+/// What the unit is doing with the entry it has begun.
+#[derive(Copy, Clone, Debug, PartialEq, LogicState)]
+pub enum EntryPhase {
+    /// No entry begun: the slot's entry, if any, begins.
+    Idle,
+    /// Reading the matrix's twelve words.
+    Fetch,
+    /// The origin's request waits for the unit; then the direction's.
+    Origin,
+    Direction,
+}
+
+#[derive(LogicBlock)]
+pub struct InstanceRays<const W: usize> {
+    pub clock: Signal<In, Clock>,
+    pub frame_start: Signal<In, Bit>,
+    pub world_write: Signal<In, Bit>,
+    pub world_pair: Signal<In, Bits<2>>,
+    pub word_a: Signal<In, Bits<32>>,
+    pub word_b: Signal<In, Bits<32>>,
+    pub thread: Signal<In, Bits<5>>,
+    pub offer: Signal<In, Bit>,
+    pub record: Signal<In, Bits<24>>,
+    pub refused: Signal<Out, Bit>,
+    pub bus_free: Signal<In, Bit>,
+    pub read: Signal<Out, Bit>,
+    pub addr: Signal<Out, Bits<24>>,
+    pub rdata: Signal<In, Bits<32>>,
+    pub gen_valid: Signal<Out, Bit>,
+    pub gen_m: [Signal<Out, Bits<W>>; 12],
+    pub gen_v: [Signal<Out, Bits<W>>; 3],
+    pub gen_point: Signal<Out, Bit>,
+    pub gen_direction: Signal<Out, Bit>,
+    pub gen_thread: Signal<Out, Bits<5>>,
+    pub gen_take: Signal<In, Bit>,
+    pub out_valid: Signal<In, Bit>,
+    pub out_direction: Signal<In, Bit>,
+    pub out_thread: Signal<In, Bits<5>>,
+    pub out_v: [Signal<In, Bits<W>>; 3],
+    pub ray_write: Signal<Out, Bit>,
+    pub ray_thread: Signal<Out, Bits<5>>,
+    pub ray_o: [Signal<Out, Bits<W>>; 3],
+    pub ray_d: [Signal<Out, Bits<W>>; 3],
+    pub done_mask: Signal<Out, Bits<32>>,
+    pub query_thread: Signal<In, Bits<5>>,
+    pub pending: Signal<Out, Bit>,
+
+    /// Per thread, each word of its world ray.
+    world: [RAM<Bits<W>, 5>; 6],
+    /// The entry slot: a thread's record that no entry has begun for yet.
+    slot_valid: DFF<Bit>,
+    slot_thread: DFF<Bits<5>>,
+    slot_record: DFF<Bits<24>>,
+    taken: Signal<Local, Bit>,
+    /// The entry begun: its thread and record, the matrix's words read and arrived, and the
+    /// reads in flight (bit k: a read k + 1 clocks ago).
+    phase: DFF<EntryPhase>,
+    entry_thread: DFF<Bits<5>>,
+    entry_record: DFF<Bits<24>>,
+    issued: DFF<Bits<4>>,
+    arrived: DFF<Bits<4>>,
+    flight: DFF<Bits<8>>,
+    reading: Signal<Local, Bit>,
+    arrives: Signal<Local, Bit>,
+    /// The matrix, its words shifted in from the top as they arrive (word 0 ends in `matrix[0]`).
+    matrix: [DFF<Bits<W>>; 12],
+    /// The origin's result, until the direction's comes.
+    origin: [DFF<Bits<W>>; 3],
+    /// The ray being written.
+    write_valid: DFF<Bit>,
+    write_thread: DFF<Bits<5>>,
+    write_o: [DFF<Bits<W>>; 3],
+    write_d: [DFF<Bits<W>>; 3],
+    write_mask: DFF<Bits<32>>,
+    /// Per thread: its entered ray is not written yet (bit `thread`).
+    waiting: DFF<Bits<32>>,
+    taken_mask: Signal<Local, Bits<32>>,
+    pending_r: DFF<Bit>,
+    c_one: Constant<Bits<32>>,
+    c_pair: [Constant<Bits<2>>; 3],
+    c_words: Constant<Bits<4>>,
+    c_last_word: Constant<Bits<4>>,
+    c_first_word: Constant<Bits<24>>,
+    c_ml_last: Constant<Bits<3>>,
+}
+
+impl<const W: usize> InstanceRays<W> {
+    /// The unit for SRAM read latency `mem_latency` (1..=6).
+    pub fn new(mem_latency: u32) -> Self {
+        assert!((1..=6).contains(&mem_latency));
+        Self {
+            clock: Default::default(),
+            frame_start: Default::default(),
+            world_write: Default::default(),
+            world_pair: Default::default(),
+            word_a: Default::default(),
+            word_b: Default::default(),
+            thread: Default::default(),
+            offer: Default::default(),
+            record: Default::default(),
+            refused: Default::default(),
+            bus_free: Default::default(),
+            read: Default::default(),
+            addr: Default::default(),
+            rdata: Default::default(),
+            gen_valid: Default::default(),
+            gen_m: Default::default(),
+            gen_v: Default::default(),
+            gen_point: Default::default(),
+            gen_direction: Default::default(),
+            gen_thread: Default::default(),
+            gen_take: Default::default(),
+            out_valid: Default::default(),
+            out_direction: Default::default(),
+            out_thread: Default::default(),
+            out_v: Default::default(),
+            ray_write: Default::default(),
+            ray_thread: Default::default(),
+            ray_o: Default::default(),
+            ray_d: Default::default(),
+            done_mask: Default::default(),
+            query_thread: Default::default(),
+            pending: Default::default(),
+            world: Default::default(),
+            slot_valid: Default::default(),
+            slot_thread: Default::default(),
+            slot_record: Default::default(),
+            taken: Default::default(),
+            phase: Default::default(),
+            entry_thread: Default::default(),
+            entry_record: Default::default(),
+            issued: Default::default(),
+            arrived: Default::default(),
+            flight: Default::default(),
+            reading: Default::default(),
+            arrives: Default::default(),
+            matrix: Default::default(),
+            origin: Default::default(),
+            write_valid: Default::default(),
+            write_thread: Default::default(),
+            write_o: Default::default(),
+            write_d: Default::default(),
+            write_mask: Default::default(),
+            waiting: Default::default(),
+            taken_mask: Default::default(),
+            pending_r: Default::default(),
+            c_one: Constant::new(1u64.into()),
+            c_pair: std::array::from_fn(|k| Constant::new((k as u64).into())),
+            c_words: Constant::new(MATRIX_WORDS.into()),
+            c_last_word: Constant::new((MATRIX_WORDS - 1).into()),
+            c_first_word: Constant::new((instance_word::WORLD_TO_OBJECT as u64).into()),
+            c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
+        }
+    }
+}
+
+impl<const W: usize> Logic for InstanceRays<W> {
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(
+            self,
+            clock,
+            slot_valid,
+            slot_thread,
+            slot_record,
+            phase,
+            entry_thread,
+            entry_record,
+            issued,
+            arrived,
+            flight,
+            write_valid,
+            write_thread,
+            write_mask,
+            waiting,
+            pending_r
+        );
+        for k in 0..12 {
+            self.matrix[k].clock.next = self.clock.val();
+            self.matrix[k].d.next = self.matrix[k].q.val();
+        }
+        for k in 0..3 {
+            self.origin[k].clock.next = self.clock.val();
+            self.origin[k].d.next = self.origin[k].q.val();
+            self.write_o[k].clock.next = self.clock.val();
+            self.write_o[k].d.next = self.origin[k].q.val();
+            self.write_d[k].clock.next = self.clock.val();
+            self.write_d[k].d.next = self.out_v[k].val();
+        }
+
+        // The world ray, a pair of words per `tri.world`; read for the entry's thread.
+        for k in 0..6 {
+            self.world[k].read_clock.next = self.clock.val();
+            self.world[k].write_clock.next = self.clock.val();
+            self.world[k].write_address.next = self.thread.val();
+            self.world[k].read_address.next = self.entry_thread.q.val();
+        }
+        for k in 0..3 {
+            self.world[2 * k].write_data.next = self.word_a.val().get_bits::<W>(0);
+            self.world[2 * k + 1].write_data.next = self.word_b.val().get_bits::<W>(0);
+            self.world[2 * k].write_enable.next =
+                self.world_write.val() & (self.world_pair.val() == self.c_pair[k].val());
+            self.world[2 * k + 1].write_enable.next =
+                self.world_write.val() & (self.world_pair.val() == self.c_pair[k].val());
+        }
+
+        // The slot takes an entry while it is empty; an idle unit begins the slot's entry.
+        self.refused.next = self.slot_valid.q.val();
+        self.taken.next = self.offer.val() & (!self.slot_valid.q.val());
+        if self.taken.val() {
+            self.slot_valid.d.next = true;
+            self.slot_thread.d.next = self.thread.val();
+            self.slot_record.d.next = self.record.val();
+        }
+        if (self.phase.q.val() == EntryPhase::Idle) & self.slot_valid.q.val() {
+            self.slot_valid.d.next = false;
+            self.entry_thread.d.next = self.slot_thread.q.val();
+            self.entry_record.d.next = self.slot_record.q.val() + self.c_first_word.val();
+            self.issued.d.next = 0.into();
+            self.arrived.d.next = 0.into();
+            self.phase.d.next = EntryPhase::Fetch;
+        }
+
+        // Fetch: a read in each clock the bus is free; each word shifts in as it arrives.
+        self.reading.next = (self.phase.q.val() == EntryPhase::Fetch)
+            & (self.issued.q.val() != self.c_words.val())
+            & self.bus_free.val();
+        self.read.next = self.reading.val();
+        self.addr.next = self.entry_record.q.val() + bit_cast::<24, 4>(self.issued.q.val());
+        if self.reading.val() {
+            self.issued.d.next = self.issued.q.val() + 1;
+        }
+        self.flight.d.next =
+            (self.flight.q.val() << 1) | bit_cast::<8, 1>(self.reading.val().into());
+        self.arrives.next = self.flight.q.val().get_bit(self.c_ml_last.val().index());
+        if self.arrives.val() {
+            for k in 0..11 {
+                self.matrix[k].d.next = self.matrix[k + 1].q.val();
+            }
+            self.matrix[11].d.next = self.rdata.val().get_bits::<W>(0);
+            self.arrived.d.next = self.arrived.q.val() + 1;
+            if self.arrived.q.val() == self.c_last_word.val() {
+                self.phase.d.next = EntryPhase::Origin;
+            }
+        }
+
+        // The requests: the origin as a point, then the direction as a vector.
+        self.gen_valid.next = (self.phase.q.val() == EntryPhase::Origin)
+            | (self.phase.q.val() == EntryPhase::Direction);
+        self.gen_point.next = self.phase.q.val() == EntryPhase::Origin;
+        self.gen_direction.next = self.phase.q.val() == EntryPhase::Direction;
+        self.gen_thread.next = self.entry_thread.q.val();
+        for k in 0..12 {
+            self.gen_m[k].next = self.matrix[k].q.val();
+        }
+        for k in 0..3 {
+            if self.phase.q.val() == EntryPhase::Origin {
+                self.gen_v[k].next = self.world[k].read_data.val();
+            } else {
+                self.gen_v[k].next = self.world[3 + k].read_data.val();
+            }
+        }
+        if self.gen_take.val() & (self.phase.q.val() == EntryPhase::Origin) {
+            self.phase.d.next = EntryPhase::Direction;
+        }
+        if self.gen_take.val() & (self.phase.q.val() == EntryPhase::Direction) {
+            self.phase.d.next = EntryPhase::Idle;
+        }
+
+        // The results: the origin waits for the direction; then the ray is written.
+        if self.out_valid.val() & (!self.out_direction.val()) {
+            for k in 0..3 {
+                self.origin[k].d.next = self.out_v[k].val();
+            }
+        }
+        self.write_valid.d.next = self.out_valid.val() & self.out_direction.val();
+        self.write_thread.d.next = self.out_thread.val();
+        self.write_mask.d.next = 0.into();
+        if self.out_valid.val() & self.out_direction.val() {
+            self.write_mask.d.next = self.c_one.val() << self.out_thread.val();
+        }
+        self.ray_write.next = self.write_valid.q.val();
+        self.ray_thread.next = self.write_thread.q.val();
+        for k in 0..3 {
+            self.ray_o[k].next = self.write_o[k].q.val();
+            self.ray_d[k].next = self.write_d[k].q.val();
+        }
+        self.done_mask.next = self.write_mask.q.val();
+
+        // Pending from the `tri.enter` until the write.
+        self.taken_mask.next = 0.into();
+        if self.taken.val() {
+            self.taken_mask.next = self.c_one.val() << self.thread.val();
+        }
+        self.waiting.d.next =
+            (self.waiting.q.val() & (!self.write_mask.q.val())) | self.taken_mask.val();
+        self.pending_r.d.next = self
+            .waiting
+            .q
+            .val()
+            .get_bit(self.query_thread.val().index());
+        self.pending.next = self.pending_r.q.val();
+
+        if self.frame_start.val() {
+            self.slot_valid.d.next = false;
+            self.phase.d.next = EntryPhase::Idle;
+            self.waiting.d.next = 0.into();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fp::Format;
+    use crate::hw::sim_harness::{clock_cycle, settle};
+    use crate::layout::INSTANCE_WORDS;
+    use crate::units;
+    use rand::{Rng, SeedableRng};
+    use std::collections::VecDeque;
+
+    /// InstanceRays in rust-hdl simulation, with threads writing world rays and entering
+    /// instances at random, a bank 4 of random matrices behind a bus that is free in random
+    /// clocks (SRAM latency 3), and a model of the tester's TransformUnit that takes a request
+    /// in a random clock and returns `units::transform` of its words 28 clocks later. Asserts:
+    /// every entry's ray is written whole, once, for its thread, and is `units::transform` of
+    /// the thread's world origin (a point) and direction (a vector) by the record's
+    /// world-to-object words; `done_mask` is the written thread's bit; `pending` is high from
+    /// the `tri.enter` until the write; a full slot refuses; reads go out only in free clocks,
+    /// twelve per entry, each in its record.
+    #[test]
+    fn every_entry_gets_its_object_ray_through_the_shared_unit() {
+        let f = Format::E7M16;
+        let mem_latency = 3;
+        let records = 16;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(35);
+        let bank: Vec<u32> = (0..records * INSTANCE_WORDS)
+            .map(|_| f.from_f64(rng.gen_range(-2.0..2.0)))
+            .collect();
+        let mut u = InstanceRays::<24>::new(mem_latency);
+        u.connect_all();
+        let cycle =
+            |u: &mut InstanceRays<24>| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
+        u.frame_start.next = true;
+        cycle(&mut u);
+        u.frame_start.next = false;
+
+        let mut world = [[0u32; 6]; 32];
+        // Per thread: the ray its entry must write.
+        let mut entered: [Option<([u32; 3], [u32; 3])>; 32] = [None; 32];
+        let mut memory: VecDeque<Option<u32>> = vec![None; mem_latency as usize].into();
+        let mut in_unit: VecDeque<Option<(u32, bool, [u32; 3])>> = vec![None; 28].into();
+        let (mut offers, mut refused, mut written, mut reads) = (0, 0, 0, 0);
+        for clock in 0..6000 {
+            let thread = rng.gen_range(0..32u32);
+            let t = thread as usize;
+            // The first 96 clocks write every thread's world ray; then world words and entries
+            // at random, never for a thread whose entry is pending.
+            let (write, offer) = if clock < 96 {
+                (true, false)
+            } else if entered[t].is_none() {
+                let r = rng.gen_range(0..10);
+                (r == 0, r >= 7)
+            } else {
+                (false, false)
+            };
+            let pair = if clock < 96 {
+                clock % 3
+            } else {
+                rng.gen_range(0..3)
+            };
+            let words = [0, 1].map(|_| f.from_f64(rng.gen_range(-3.0..3.0)));
+            let thread = if clock < 96 { clock as u32 / 3 } else { thread };
+            let record = rng.gen_range(0..records) * INSTANCE_WORDS;
+            u.thread.next = u64::from(thread).into();
+            u.world_write.next = write;
+            u.world_pair.next = (pair as u64).into();
+            u.word_a.next = u64::from(words[0]).into();
+            u.word_b.next = u64::from(words[1]).into();
+            u.offer.next = offer;
+            u.record.next = (record as u64).into();
+            u.bus_free.next = rng.gen_bool(0.6);
+            u.rdata.next = u64::from(memory.pop_front().unwrap().unwrap_or(0xdead)).into();
+            u.gen_take.next = rng.gen_bool(0.5);
+            let back = in_unit.pop_front().unwrap();
+            u.out_valid.next = back.is_some();
+            if let Some((t, direction, v)) = back {
+                u.out_thread.next = u64::from(t).into();
+                u.out_direction.next = direction;
+                for k in 0..3 {
+                    u.out_v[k].next = u64::from(v[k]).into();
+                }
+            }
+            let asked = rng.gen_range(0..32usize);
+            u.query_thread.next = (asked as u64).into();
+            let want_pending = entered[asked].is_some();
+            u.clock.next = Clock { clk: false };
+            settle(&mut u);
+
+            let t = thread as usize;
+            if write {
+                world[t][2 * pair] = words[0];
+                world[t][2 * pair + 1] = words[1];
+            }
+            if offer {
+                offers += 1;
+                if u.refused.val() {
+                    refused += 1;
+                } else {
+                    let m: units::Mat34W = bank[record..record + 12].try_into().unwrap();
+                    let [ox, oy, oz, dx, dy, dz] = world[t];
+                    entered[t] = Some((
+                        units::transform(f, &m, [ox, oy, oz], true),
+                        units::transform(f, &m, [dx, dy, dz], false),
+                    ));
+                }
+            }
+            assert!(u.bus_free.val() || !u.read.val(), "a read on a busy bus");
+            memory.push_back(u.read.val().then(|| {
+                reads += 1;
+                let addr = u.addr.val().to_u64() as usize;
+                bank[addr]
+            }));
+            let taken = u.gen_valid.val() && u.gen_take.val();
+            in_unit.push_back(taken.then(|| {
+                let word = |s: &Signal<Out, Bits<24>>| s.val().to_u64() as u32;
+                let m: units::Mat34W = std::array::from_fn(|k| word(&u.gen_m[k]));
+                let v: [u32; 3] = std::array::from_fn(|k| word(&u.gen_v[k]));
+                assert_ne!(u.gen_point.val(), u.gen_direction.val());
+                let t = u.gen_thread.val().to_u64() as u32;
+                let result = units::transform(f, &m, v, u.gen_point.val());
+                (t, u.gen_direction.val(), result)
+            }));
+            if u.ray_write.val() {
+                let t = u.ray_thread.val().to_u64() as usize;
+                let (o, d) = entered[t].take().expect("a ray for a thread that entered");
+                let o_got: [u32; 3] = std::array::from_fn(|k| u.ray_o[k].val().to_u64() as u32);
+                let d_got: [u32; 3] = std::array::from_fn(|k| u.ray_d[k].val().to_u64() as u32);
+                assert_eq!((o_got, d_got), (o, d), "thread {t}'s object-space ray");
+                assert_eq!(u.done_mask.val().to_u64(), 1 << t, "the wake-up of {t}");
+                written += 1;
+            } else {
+                assert_eq!(u.done_mask.val().to_u64(), 0, "a wake-up without a ray");
+            }
+            cycle(&mut u);
+            assert_eq!(u.pending.val(), want_pending, "thread {asked} pending");
+        }
+        let left = entered.iter().filter(|e| e.is_some()).count();
+        assert!(left <= 3, "{left} entries unfinished");
+        assert!(written > 200, "entries written: {written}");
+        assert!(
+            (12 * written..=12 * (written + left)).contains(&reads),
+            "{reads} reads for {written} entries written and {left} begun"
+        );
+        assert!(
+            refused > 10,
+            "the slot refused entries ({refused} of {offers})"
+        );
+    }
+}
