@@ -414,8 +414,10 @@ pub struct FrameReport {
     pub intersect_busy: u64,
     /// Clocks in which the traversal unit started a node decision.
     pub traversal_busy: u64,
-    /// Clocks in which ray generation's requests took the TransformUnit.
+    /// Clocks in which ray generation's and instance entry's requests took the
+    /// TransformUnit.
     pub raygen_busy: u64,
+    pub instance_busy: u64,
     pub pixels: u64,
     pub mismatches: Vec<Mismatch>,
     pub differing_pixels: usize,
@@ -447,12 +449,14 @@ impl FrameReport {
         hz / self.cycles as f64
     }
     /// Shares of the frame's clocks in which the TransformUnit (for triangle tests, for ray
-    /// generation), the IntersectUnit and the traversal unit's decision took an input.
-    pub fn unit_busy_shares(&self) -> [f64; 4] {
+    /// generation, for instance entry), the IntersectUnit and the traversal unit's decision
+    /// took an input.
+    pub fn unit_busy_shares(&self) -> [f64; 5] {
         let c = self.cycles.max(1) as f64;
         [
             self.transform_busy,
             self.raygen_busy,
+            self.instance_busy,
             self.intersect_busy,
             self.traversal_busy,
         ]
@@ -616,6 +620,7 @@ pub fn simulate_scene(
             intersect_busy: fr.intersect_busy,
             traversal_busy: fr.traversal_busy,
             raygen_busy: fr.raygen_busy,
+            instance_busy: fr.instance_busy,
             pixels: u64::from(w * h),
             differing_pixels: differing.len(),
             mismatches,

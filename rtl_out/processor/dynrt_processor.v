@@ -13,7 +13,7 @@
 /* verilator lint_off UNUSEDSIGNAL */
 
 
-module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,vga_clock,vga_reset,vga_fb_addr,vga_fb_data,vga_hsync,vga_vsync,vga_rgb,vga_frame_start);
+module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,vga_clock,vga_reset,vga_fb_addr,vga_fb_data,vga_hsync,vga_vsync,vga_rgb,vga_frame_start);
     
     // Module arguments
     input wire  clock;
@@ -41,6 +41,7 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
     output reg  [31:0] intersect_busy;
     output reg  [31:0] traversal_busy;
     output reg  [31:0] raygen_busy;
+    output reg  [31:0] instance_busy;
     input wire  vga_clock;
     input wire  vga_reset;
     output reg  [23:0] vga_fb_addr;
@@ -121,6 +122,7 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
         intersect_busy = engine__intersect_busy;
         traversal_busy = engine__traversal_busy;
         raygen_busy = engine__raygen_busy;
+        instance_busy = engine__instance_busy;
         display__clock = vga_clock;
         display__reset = vga_reset;
         vga_fb_addr = ((display__fb_addr) & 24'hffffff);

@@ -32,8 +32,10 @@ pub struct SimFrame {
     pub intersect_busy: u64,
     /// Clocks in which the traversal unit started a node decision.
     pub traversal_busy: u64,
-    /// Clocks in which ray generation's requests took the TransformUnit.
+    /// Clocks in which ray generation's and instance entry's requests took the
+    /// TransformUnit.
     pub raygen_busy: u64,
+    pub instance_busy: u64,
 }
 
 /// What a processor simulation produced.
@@ -298,10 +300,10 @@ pub fn simulate_processor(
             .split_whitespace()
             .filter_map(|w| w.parse().ok())
             .collect();
-        if nums.len() != 6 {
+        if nums.len() != 7 {
             bail!(
                 "{}: expected `cycles instructions transform_busy intersect_busy traversal_busy \
-                 raygen_busy`, \
+                 raygen_busy instance_busy`, \
                  got `{}`",
                 stats_path.display(),
                 stats.trim()
@@ -315,6 +317,7 @@ pub fn simulate_processor(
             intersect_busy: nums[3],
             traversal_busy: nums[4],
             raygen_busy: nums[5],
+            instance_busy: nums[6],
         });
     }
     let vga = if capture_vga {

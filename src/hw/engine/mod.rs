@@ -23,7 +23,8 @@
 //!   [`MailboxUnit`] reads the thread's mailbox and the coprocessors their state of the
 //!   thread.
 //! - I5 ([`OPERAND_STAGE`]): [`Execute`] computes the integer result and the addresses,
-//!   [`PrimaryRays`] hands out a pixel (and requests its primary ray), the mailbox registers
+//!   [`PrimaryRays`] hands out a pixel (and requests its primary ray), [`InstanceRays`] takes
+//!   an instance entry (`tri.enter`) or world ray words (`tri.world`), the mailbox registers
 //!   the entries it read (it compares at I6, hits and updates at I7), [`FpUnits`] take their
 //!   operands; this block drives the
 //!   memory and frame-buffer ports and offers `tri` and `kd` entries to the coprocessors (their
@@ -57,7 +58,10 @@
 //! reads it and queues its triangles, and which answers the traversal unit with the closest
 //! hit. A walk costs the thread four turns, whatever its leaves. [`PrimaryRays`] sends each
 //! pixel's primary ray through the tester's TransformUnit, in the clocks the tests leave it
-//! free, and writes the ray into both coprocessors (a `pixel`, then a `tri.wait`).
+//! free, and writes the ray into both coprocessors (a `pixel`, then a `tri.wait`);
+//! [`InstanceRays`] does the same for the world ray entering an instance (a `tri.enter`, then
+//! a `tri.wait`), after ray generation's requests, with the instance's matrix read from bank
+//! 4 in the clocks the engine's and the list unit's reads leave the `mem_*` bus free.
 //!
 //! Memory: one read per clock on the `mem_*` port (banks 0, 1, 4, 5; the tester's list reads
 //! of bank 1 use it in the clocks the engine leaves free) and on each of the

@@ -13,14 +13,17 @@
 //! inner node read the world ray's origin and direction along the split axis from scratch
 //! (indexed by the axis), pick near and far child, compute `t_split` with the shared
 //! `units::split_distance` and visit near, far or both (pushing far on the scratch kd stack);
-//! at a leaf enter each instance not yet in the instance mailbox (world-to-object transform of
-//! the ray, given to both coprocessors, then the object walk); then pop the stack until a
-//! segment can still hold a closer hit.
+//! at a leaf enter each instance not yet in the instance mailbox (`tri.enter`: the instance
+//! entry unit, `hw::engine::InstanceRays`, transforms the world ray that `tri.world` gave it at
+//! the trace's start into the object's space through the one TransformUnit and writes it
+//! into both coprocessors; the thread loads the object's root and waits for the ray), then
+//! walk the object; then pop the stack until a segment can still hold a closer hit.
 //!
 //! Cost (instructions = engine turns): per object walk 4 (start, wait, the closest hit's t
 //! and flag), whatever its leaves; a waiting thread sleeps until the walk ends (the tree's
 //! nodes and the leaves' triangles cost it no instruction); per top-level inner node 15-23,
-//! per instance about 40 (the transforms).
+//! per instance about 17 (the list and the mailbox, the record's address, `tri.enter`, the
+//! root, `tri.object`, the wait and the walk); 3 per trace for the world ray.
 
 use super::asm::Asm;
 use super::asm::{Label, Reg, Val};
