@@ -868,6 +868,39 @@ impl<
     }
 }
 
+/// The ports of a bench whose unit writes whole rays: the clock, `inputs` and `outputs`, and
+/// the ray's `{ray}_write`, `{ray}_thread`, `{ray}_o__k`, `{ray}_d__k` (24 bits) and
+/// `done_mask`; with the fields of the rays' sink (thread, origin, direction, wake-up).
+fn ray_bench_ports(
+    inputs: &[(&str, u32)],
+    outputs: &[(&str, u32)],
+    ray: &str,
+) -> (Vec<crate::emit::stream_bench::BenchPort>, Vec<String>) {
+    use crate::emit::stream_bench::BenchPort;
+    let words: Vec<String> = ["o", "d"]
+        .iter()
+        .flat_map(|v| (0..3).map(move |k| format!("{ray}_{v}__{k}")))
+        .collect();
+    let thread = format!("{ray}_thread");
+    let ports = [BenchPort::input("clock", 1)]
+        .into_iter()
+        .chain(inputs.iter().map(|&(n, w)| BenchPort::input(n, w)))
+        .chain(outputs.iter().map(|&(n, w)| BenchPort::output(n, w)))
+        .chain([
+            BenchPort::output(format!("{ray}_write"), 1),
+            BenchPort::output(thread.clone(), 5),
+            BenchPort::output("done_mask", 32),
+        ])
+        .chain(words.iter().map(|n| BenchPort::output(n.clone(), 24)))
+        .collect();
+    let fields = [thread]
+        .into_iter()
+        .chain(words)
+        .chain(["done_mask".to_string()])
+        .collect();
+    (ports, fields)
+}
+
 /// PrimaryRays' generated Verilog in `sim`, e7m16, on a frame of the Cornell box's camera:
 /// the camera written a pair of words a clock, a frame start, then threads 0..32 in turn
 /// offering `pixel`s (sometimes after a pause) while the unit takes requests in random
@@ -876,7 +909,7 @@ impl<
 /// pixel as direction, in the order the pixels were handed out, with the thread's bit as
 /// wake-up.
 fn primary_rays_case(width: u16, height: u16, seed: u64, sim: Simulator) {
-    use crate::emit::stream_bench::{BenchPort, InputStream, OutputSink, StreamBench};
+    use crate::emit::stream_bench::{InputStream, OutputSink, StreamBench};
     use crate::emit::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
     use crate::hw::program::ProgramConfig;
     use crate::sim::stream_bench::run_stream_bench;
@@ -921,36 +954,20 @@ fn primary_rays_case(width: u16, height: u16, seed: u64, sim: Simulator) {
         .map(|_| (0, vec![u64::from(rng.gen_bool(0.5))]))
         .collect();
     takes.push((0, vec![1]));
-    let mut ports = vec![BenchPort::input("clock", 1)];
-    for (name, width) in [
-        ("frame_start", 1),
-        ("camera_write", 1),
-        ("camera_pair", 3),
-        ("word_a", 32),
-        ("word_b", 32),
-        ("offer", 1),
-        ("thread", 5),
-        ("take", 1),
-    ] {
-        ports.push(BenchPort::input(name, width));
-    }
-    for (name, width) in [
-        ("issued", 1),
-        ("word", 32),
-        ("issued_thread", 5),
-        ("primary_write", 1),
-        ("primary_thread", 5),
-        ("done_mask", 32),
-    ] {
-        ports.push(BenchPort::output(name, width));
-    }
-    let xyz = |name: &'static str| (0..3).map(move |k| format!("{name}__{k}"));
-    for name in xyz("primary_o").chain(xyz("primary_d")) {
-        ports.push(BenchPort::output(name, 24));
-    }
-    let mut ray_fields = vec!["primary_thread".to_string()];
-    ray_fields.extend(xyz("primary_o").chain(xyz("primary_d")));
-    ray_fields.push("done_mask".into());
+    let (ports, ray_fields) = ray_bench_ports(
+        &[
+            ("frame_start", 1),
+            ("camera_write", 1),
+            ("camera_pair", 3),
+            ("word_a", 32),
+            ("word_b", 32),
+            ("offer", 1),
+            ("thread", 5),
+            ("take", 1),
+        ],
+        &[("issued", 1), ("word", 32), ("issued_thread", 5)],
+        "primary",
+    );
     let bench = StreamBench {
         dut: top.into(),
         ports,
@@ -1213,7 +1230,7 @@ impl<
 /// the record's world-to-object words, with the thread's bit as wake-up; no read goes out on a
 /// busy bus.
 fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
-    use crate::emit::stream_bench::{BenchPort, InputStream, OutputSink, StreamBench};
+    use crate::emit::stream_bench::{InputStream, OutputSink, StreamBench};
     use crate::emit::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
     use crate::layout::{instance_word, INSTANCE_WORDS};
     use crate::sim::stream_bench::run_stream_bench;
@@ -1256,37 +1273,22 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
     };
     let takes = random_bits(&mut rng, 40 * entries);
     let frees = random_bits(&mut rng, 40 * entries);
-    let mut ports = vec![BenchPort::input("clock", 1)];
-    for (name, width) in [
-        ("world_write", 1),
-        ("world_pair", 2),
-        ("world_thread", 5),
-        ("word_a", 32),
-        ("word_b", 32),
-        ("enter", 1),
-        ("enter_thread", 5),
-        ("record", 24),
-        ("take", 1),
-        ("free", 1),
-    ] {
-        ports.push(BenchPort::input(name, width));
-    }
-    for (name, width) in [
-        ("accepted", 1),
-        ("ray_write", 1),
-        ("ray_thread", 5),
-        ("done_mask", 32),
-        ("busy_read", 1),
-    ] {
-        ports.push(BenchPort::output(name, width));
-    }
-    let xyz = |name: &'static str| (0..3).map(move |k| format!("{name}__{k}"));
-    for name in xyz("ray_o").chain(xyz("ray_d")) {
-        ports.push(BenchPort::output(name, 24));
-    }
-    let mut ray_fields = vec!["ray_thread".to_string()];
-    ray_fields.extend(xyz("ray_o").chain(xyz("ray_d")));
-    ray_fields.push("done_mask".into());
+    let (ports, ray_fields) = ray_bench_ports(
+        &[
+            ("world_write", 1),
+            ("world_pair", 2),
+            ("world_thread", 5),
+            ("word_a", 32),
+            ("word_b", 32),
+            ("enter", 1),
+            ("enter_thread", 5),
+            ("record", 24),
+            ("take", 1),
+            ("free", 1),
+        ],
+        &[("accepted", 1), ("busy_read", 1)],
+        "ray",
+    );
     let stream = |name: &str, fields: &[&str], lines| InputStream {
         name: name.into(),
         fields: fields.iter().map(|s| s.to_string()).collect(),
