@@ -64,7 +64,8 @@
 //! 4 in the clocks the engine's and the list unit's reads leave the `mem_*` bus free.
 //!
 //! Memory: one read per clock on the `mem_*` port (banks 0, 1, 4, 5; the tester's list reads
-//! of bank 1 use it in the clocks the engine leaves free) and on each of the
+//! of bank 1 use it in the clocks the engine leaves free, instance entry's reads of bank 4 in
+//! the clocks both leave free) and on each of the
 //! `bank2_*` and `bank3_*` ports (the triangles; the tester fetches from both at once, the
 //! engine's loads of these banks go there too, first); a word must arrive exactly
 //! `mem_latency` clocks after its request (1..=6). Frame-buffer writes come out on `fb_*`.
@@ -97,7 +98,7 @@ pub use execute::Execute;
 pub use fetch::{Fetch, FETCH_LATENCY};
 pub use first_ready::FirstReady;
 pub use fp_units::FpUnits;
-pub use instance_rays::{EntryPhase, InstanceRays};
+pub use instance_rays::InstanceRays;
 pub use mailbox::MailboxUnit;
 pub use primary_rays::{PrimaryRays, CAMERA_WORDS};
 pub use program_rom::ProgramRom;
