@@ -195,7 +195,7 @@ fn cmd(c: u64) -> Constant<Bits<2>> {
 }
 
 /// A RAM's initial contents: word `i` at address `i`.
-fn word_map<const N: usize, D: Synth>(
+pub(crate) fn word_map<const N: usize, D: Synth>(
     words: impl Iterator<Item = D>,
 ) -> std::collections::BTreeMap<Bits<N>, D> {
     words

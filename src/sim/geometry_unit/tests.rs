@@ -1147,12 +1147,9 @@ impl<
             busy_read: Default::default(),
             entries: crate::hw::engine::InstanceRays::new(2),
             unit: Default::default(),
-            bank: ROM::new(
-                bank.iter()
-                    .enumerate()
-                    .map(|(a, &w)| (Bits::<9>::from(a as u64), Bits::<32>::from(u64::from(w))))
-                    .collect(),
-            ),
+            bank: ROM::new(crate::hw::engine::word_map(
+                bank.iter().map(|&w| Bits::<32>::from(u64::from(w))),
+            )),
             data_1: Default::default(),
             data_2: Default::default(),
         }
