@@ -16,7 +16,7 @@ use crate::hw::program::exec::{Machine, RunStats, Write};
 use crate::hw::program::isa::MAX_PROGRAM;
 use crate::hw::program::{build_program, Program, ProgramConfig};
 use crate::hw::traversal_unit::FETCH_CLOCKS_PER_NODE;
-use crate::hw::traversal_unit::STACK_LEVELS;
+use crate::hw::traversal_unit::{STACK_LEVELS, TOP_STACK_BASE, TOP_STACK_LEVELS};
 use crate::hw::triangle_tester::CLOCKS_PER_TEST;
 use crate::hw::vga::VgaMode;
 use crate::layout::{self, Layout, MemoryConfig, SceneTrees};
@@ -99,8 +99,6 @@ pub fn preflight(
         object_root: 0,
         materials: 0,
         frame_buffer: 0,
-        stack_entries: STACK_LEVELS as u32,
-        object_depth: STACK_LEVELS as u32,
     };
     let length = |lights: u32| {
         build_program(&ProgramConfig {
@@ -182,16 +180,7 @@ fn prepare(
     preflight(scene, f, params, frames)?;
     crate::progress::report("building the kd-trees and memory layouts");
     let layouts = scene_layouts(scene, f, frames)?;
-    let deepest = layouts
-        .iter()
-        .map(|l| l.info.object_depth)
-        .max()
-        .unwrap_or(0);
-    anyhow::ensure!(
-        deepest as usize <= STACK_LEVELS,
-        "the scene's deepest object kd tree has {deepest} levels; the traversal unit's stack \
-         holds {STACK_LEVELS}: use fewer triangles per object or split the mesh into instances"
-    );
+    check_stack_depths(&layouts)?;
     let program = build_program(&ProgramConfig::from_layout(&layouts[0]));
     let twin = Machine::new(&program, &layouts[0])
         .run_frame(params.threads as usize)
@@ -689,4 +678,32 @@ fn describe(p: &Program, f: Format, w: &Write) -> String {
         w.value,
         f.to_f64(w.value)
     )
+}
+
+/// The traversal unit's stack holds every walk's pushes: an object walk's from entry 0, a
+/// top-level walk's from `TOP_STACK_BASE` (so that under a top level an object walk has the
+/// entries below it).
+fn check_stack_depths(layouts: &[Layout]) -> Result<()> {
+    let deepest = |depth: fn(&Layout) -> u32| layouts.iter().map(depth).max().unwrap_or(0);
+    let (object, top) = (
+        deepest(|l| l.info.object_depth),
+        deepest(|l| l.info.top_depth),
+    );
+    let (object_levels, what) = if layouts.iter().any(|l| l.info.top_root.is_some()) {
+        (TOP_STACK_BASE, "below the top-level walk's")
+    } else {
+        (STACK_LEVELS, "in all")
+    };
+    anyhow::ensure!(
+        object as usize <= object_levels,
+        "the scene's deepest object kd tree has {object} levels; the traversal unit's stack \
+         holds {object_levels} for an object walk ({what}): use fewer triangles per object or \
+         split the mesh into instances"
+    );
+    anyhow::ensure!(
+        top as usize <= TOP_STACK_LEVELS,
+        "the scene's top-level kd tree has {top} levels; the traversal unit's stack holds \
+         {TOP_STACK_LEVELS} for the top-level walk: use fewer instances"
+    );
+    Ok(())
 }

@@ -8,6 +8,14 @@
 //! stack is empty or the popped segment starts behind the hit), exactly as
 //! `model::golden`'s `traverse`.
 //!
+//! The same pipeline walks a scene's top-level tree (`kd.start` with `KD_TOP`) on the thread's
+//! world ray (`world_write`, the engine's `tri.world`), with its stack at
+//! [`TOP_STACK_BASE`] and its leaf's segment kept apart from the object walks': at each leaf it
+//! wakes the thread, which reads the leaf's list (`top_from`, `top_to`), walks the instances'
+//! objects (object walks of this unit), and goes on with `next` (`kd.next`: the closest hit
+//! so far, taken like the tester's answer for an object leaf). At the walk's end `top_from`
+//! is `KD_WALK_ENDED`.
+//!
 //! Golden twin: [`units::KdWalk`](crate::units::KdWalk) (src/units.rs), one walk resumable at
 //! each leaf, with [`units::traversal_step`](crate::units::traversal_step) and
 //! [`units::split_distance`](crate::units::split_distance) for each inner node; they name this
@@ -43,6 +51,7 @@ use super::fp::compare::COMPARE_LATENCY;
 use super::fp::div::div_latency;
 use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
 use super::ports::{CoprocessorPort, SramRead};
+use super::program::isa::KD_WALK_ENDED;
 use super::ray_store::{zero_counters, RayStore};
 use super::{Delay, SyncFifo};
 use crate::fp::Format;
@@ -55,17 +64,21 @@ const CMP_DELAY: usize = COMPARE_LATENCY as usize;
 
 /// Entries of each thread's kd stack (the deepest object tree the unit walks).
 pub const STACK_LEVELS: usize = 64;
+/// Where a top-level walk's stack starts in the thread's stack: an object walk under a top
+/// level has the entries below it, the top-level walk the [`TOP_STACK_LEVELS`] above.
+pub const TOP_STACK_BASE: usize = 32;
+pub const TOP_STACK_LEVELS: usize = STACK_LEVELS - TOP_STACK_BASE;
 
 /// Clocks the fetch spends on one node, its two words (the unit's throughput bound).
 pub const FETCH_CLOCKS_PER_NODE: u32 = 2;
 
-/// Engine queue entry: `{next[69], thread[68:64], a[63:32], b[31:0]}`.
-type Entry = Bits<70>;
-/// Step job: `{finish[101], thread[100:96], sp[95:90], node[89:64], lo[63:32], hi[31:0]}`
-/// (nodes below 2^26).
-type Job = Bits<102>;
-/// Decision control: `{valid[37], thread[36:32], sp[31:26], left[25:0]}`.
-type Control = Bits<38>;
+/// Engine queue entry: `{top[70], next[69], thread[68:64], a[63:32], b[31:0]}`.
+type Entry = Bits<71>;
+/// Step job: `{top[102], finish[101], thread[100:96], sp[95:90], node[89:64], lo[63:32],
+/// hi[31:0]}` (nodes below 2^26).
+type Job = Bits<103>;
+/// Decision control: `{top[38], valid[37], thread[36:32], sp[31:26], left[25:0]}`.
+type Control = Bits<39>;
 
 /// The node fetch: idle, or requesting word 0 or word 1 of a node (two words a node).
 #[derive(Copy, Clone, Debug, PartialEq, LogicState)]
@@ -117,6 +130,17 @@ pub struct TraversalUnit<
     pub answer_thread: Signal<In, Bits<5>>,
     pub answer_t: Signal<In, Bits<32>>,
     pub answer_hit: Signal<In, Bit>,
+    /// The engine's offer is `kd.next` (`word_a` best t, `word_b` bit 0 the hit flag) for the
+    /// thread's top-level walk, not a start.
+    pub engine_next: Signal<In, Bit>,
+    /// The thread's world ray, pair `world_pair` (0, 1, 2 as `ray_pair`) from `word_a`,
+    /// `word_b`.
+    pub world_write: Signal<In, Bit>,
+    pub world_pair: Signal<In, Bits<2>>,
+    /// At I5, for the thread at I4 (`query_thread`): its top-level walk's leaf, the list's
+    /// first bank-1 address (or `KD_WALK_ENDED` at the walk's end) and its end.
+    pub top_from: Signal<Out, Bits<32>>,
+    pub top_to: Signal<Out, Bits<32>>,
 
     entry_fifo: SyncFifo<Entry, 5, 6>,
     /// `{thread[68:64], from[63:32], to[31:0]}`: a thread has at most one leaf out.
@@ -129,14 +153,19 @@ pub struct TraversalUnit<
     a_list_end: Signal<Local, Bits<32>>,
     front_fifo: SyncFifo<Job, 5, 6>,
     loop_fifo: SyncFifo<Job, 5, 6>,
-    /// Per thread: ray o, d and t_min (engine-written); entries taken (engine); entries done
-    /// (unit, read by the engine); leaf segment end and stack depth (unit).
+    /// Per thread: ray o, d and t_min (engine-written); the world ray (engine-written);
+    /// entries taken (engine); entries done (unit, read by the engine); per walk level (top
+    /// or object) and thread the leaf segment end and stack depth (unit); the top-level
+    /// leaf's list (unit, read by the engine).
     ray: RayStore<W>,
+    world: RayStore<W>,
     issued: RAM<Bits<8>, 5>,
     done_e: RAM<Bits<8>, 5>,
     done_u: RAM<Bits<8>, 5>,
-    leaf_hi: RAM<Bits<W>, 5>,
-    leaf_sp: RAM<Bits<6>, 5>,
+    leaf_hi: RAM<Bits<W>, 6>,
+    leaf_sp: RAM<Bits<6>, 6>,
+    top_from_ram: RAM<Bits<32>, 5>,
+    top_to_ram: RAM<Bits<32>, 5>,
     stack_node: RAM<Bits<26>, 11>,
     stack_lo: RAM<Bits<W>, 11>,
     stack_hi: RAM<Bits<W>, 11>,
@@ -146,16 +175,19 @@ pub struct TraversalUnit<
     // popped lo; f5 writes the job.
     f1_valid: DFF<Bit>,
     f1_next: DFF<Bit>,
+    f1_top: DFF<Bit>,
     f1_thread: DFF<Bits<5>>,
     f1_a: DFF<Bits<32>>,
     f1_b: DFF<Bits<32>>,
     f2_valid: DFF<Bit>,
     f2_next: DFF<Bit>,
+    f2_top: DFF<Bit>,
     f2_thread: DFF<Bits<5>>,
     f2_a: DFF<Bits<32>>,
     f2_b: DFF<Bits<32>>,
     f3_valid: DFF<Bit>,
     f3_next: DFF<Bit>,
+    f3_top: DFF<Bit>,
     f3_thread: DFF<Bits<5>>,
     f3_a: DFF<Bits<32>>,
     f3_b: DFF<Bits<32>>,
@@ -163,6 +195,7 @@ pub struct TraversalUnit<
     f3_t_min: DFF<Bits<W>>,
     f4_valid: DFF<Bit>,
     f4_next: DFF<Bit>,
+    f4_top: DFF<Bit>,
     f4_thread: DFF<Bits<5>>,
     f4_a: DFF<Bits<32>>,
     f4_b: DFF<Bits<32>>,
@@ -173,6 +206,7 @@ pub struct TraversalUnit<
     f4_hi: DFF<Bits<W>>,
     f5_valid: DFF<Bit>,
     f5_next: DFF<Bit>,
+    f5_top: DFF<Bit>,
     f5_thread: DFF<Bits<5>>,
     f5_a: DFF<Bits<32>>,
     f5_b: DFF<Bits<32>>,
@@ -189,6 +223,9 @@ pub struct TraversalUnit<
     /// Depths after a pop, wrapped in 6 bits (the Verilog of an expression would widen it).
     f2_pop: Signal<Local, Bits<6>>,
     f5_pop: Signal<Local, Bits<6>>,
+    /// The empty stack's depth of the walk's level (0, or `TOP_STACK_BASE`).
+    f5_base: Signal<Local, Bits<6>>,
+    f1_leaf_address: Signal<Local, Bits<6>>,
     front_end: Signal<Local, Bit>,
     front_job: Signal<Local, Job>,
 
@@ -214,6 +251,10 @@ pub struct TraversalUnit<
     a_o: Signal<Local, Bits<W>>,
     a_d: Signal<Local, Bits<W>>,
     a_inner: Signal<Local, Bit>,
+    a_top: Signal<Local, Bit>,
+    a_top_leaf: Signal<Local, Bit>,
+    a_leaf_address: Signal<Local, Bits<6>>,
+    a_done: Signal<Local, Bit>,
 
     // Decision.
     sub: FpAddSub<W, E, M, S, S1, X2, T>,
@@ -236,6 +277,7 @@ pub struct TraversalUnit<
     d_near_left: Signal<Local, Bit>,
     d_near: Signal<Local, Bits<26>>,
     d_far: Signal<Local, Bits<26>>,
+    d_top: Signal<Local, Bit>,
 
     c_ml_last: Constant<Bits<4>>,
     c_index: [Constant<Bits<4>>; 6],
@@ -243,6 +285,8 @@ pub struct TraversalUnit<
     /// Bank 0's bit of the engine's `load_banks`.
     c_bank_nodes: Constant<Bits<{ layout::BANKS }>>,
     c_leaf_tag: Constant<Bits<2>>,
+    c_top_base: Constant<Bits<6>>,
+    c_walk_ended: Constant<Bits<32>>,
 }
 
 impl<
@@ -280,6 +324,11 @@ impl<
             answer_thread: Default::default(),
             answer_t: Default::default(),
             answer_hit: Default::default(),
+            engine_next: Default::default(),
+            world_write: Default::default(),
+            world_pair: Default::default(),
+            top_from: Default::default(),
+            top_to: Default::default(),
             entry_fifo: Default::default(),
             leaf_fifo: Default::default(),
             any_hit: Default::default(),
@@ -289,26 +338,32 @@ impl<
             front_fifo: Default::default(),
             loop_fifo: Default::default(),
             ray: Default::default(),
+            world: Default::default(),
             issued: zero_counters(),
             done_e: zero_counters(),
             done_u: zero_counters(),
             leaf_hi: Default::default(),
             leaf_sp: Default::default(),
+            top_from_ram: Default::default(),
+            top_to_ram: Default::default(),
             stack_node: Default::default(),
             stack_lo: Default::default(),
             stack_hi: Default::default(),
             f1_valid: Default::default(),
             f1_next: Default::default(),
+            f1_top: Default::default(),
             f1_thread: Default::default(),
             f1_a: Default::default(),
             f1_b: Default::default(),
             f2_valid: Default::default(),
             f2_next: Default::default(),
+            f2_top: Default::default(),
             f2_thread: Default::default(),
             f2_a: Default::default(),
             f2_b: Default::default(),
             f3_valid: Default::default(),
             f3_next: Default::default(),
+            f3_top: Default::default(),
             f3_thread: Default::default(),
             f3_a: Default::default(),
             f3_b: Default::default(),
@@ -316,6 +371,7 @@ impl<
             f3_t_min: Default::default(),
             f4_valid: Default::default(),
             f4_next: Default::default(),
+            f4_top: Default::default(),
             f4_thread: Default::default(),
             f4_a: Default::default(),
             f4_b: Default::default(),
@@ -326,6 +382,7 @@ impl<
             f4_hi: Default::default(),
             f5_valid: Default::default(),
             f5_next: Default::default(),
+            f5_top: Default::default(),
             f5_thread: Default::default(),
             f5_a: Default::default(),
             f5_b: Default::default(),
@@ -340,6 +397,8 @@ impl<
             f2_sp: Default::default(),
             f2_pop: Default::default(),
             f5_pop: Default::default(),
+            f5_base: Default::default(),
+            f1_leaf_address: Default::default(),
             front_end: Default::default(),
             front_job: Default::default(),
             phase: Default::default(),
@@ -360,6 +419,10 @@ impl<
             a_o: Default::default(),
             a_d: Default::default(),
             a_inner: Default::default(),
+            a_top: Default::default(),
+            a_top_leaf: Default::default(),
+            a_leaf_address: Default::default(),
+            a_done: Default::default(),
             sub: Default::default(),
             div: Default::default(),
             o_delay: Default::default(),
@@ -378,11 +441,14 @@ impl<
             d_near_left: Default::default(),
             d_near: Default::default(),
             d_far: Default::default(),
+            d_top: Default::default(),
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_zero: const_bits::<W>(u64::from(f.zero(false))),
             c_bank_nodes: Constant::new((1u64 << layout::NODES).into()),
             c_leaf_tag: Constant::new(u64::from(layout::LEAF_TAG).into()),
+            c_top_base: Constant::new((TOP_STACK_BASE as u64).into()),
+            c_walk_ended: Constant::new(u64::from(KD_WALK_ENDED).into()),
         }
     }
 }
@@ -401,11 +467,11 @@ impl<
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self, clock, f1_valid, f1_next, f1_thread, f1_a, f1_b, f2_valid, f2_next, f2_thread,
-            f2_a, f2_b, f3_valid, f3_next, f3_thread, f3_a, f3_b, f3_sp, f3_t_min, f4_valid,
-            f4_next, f4_thread, f4_a, f4_b, f4_sp, f4_t_min, f4_node, f4_lo, f4_hi, f5_valid,
-            f5_next, f5_thread, f5_a, f5_b, f5_sp, f5_t_min, f5_node, f5_lo, f5_hi, f5_in_leaf,
-            phase, fetch_job, job, words_in, w0, w1
+            self, clock, f1_valid, f1_next, f1_top, f1_thread, f1_a, f1_b, f2_valid, f2_next,
+            f2_top, f2_thread, f2_a, f2_b, f3_valid, f3_next, f3_top, f3_thread, f3_a, f3_b, f3_sp,
+            f3_t_min, f4_valid, f4_next, f4_top, f4_thread, f4_a, f4_b, f4_sp, f4_t_min, f4_node,
+            f4_lo, f4_hi, f5_valid, f5_next, f5_top, f5_thread, f5_a, f5_b, f5_sp, f5_t_min,
+            f5_node, f5_lo, f5_hi, f5_in_leaf, phase, fetch_job, job, words_in, w0, w1
         );
         clock!(
             self,
@@ -416,6 +482,7 @@ impl<
             front_fifo,
             loop_fifo,
             ray,
+            world,
             cmp_leaf,
             cmp_pop,
             sub,
@@ -439,6 +506,10 @@ impl<
         self.leaf_hi.write_clock.next = self.clock.val();
         self.leaf_sp.read_clock.next = self.clock.val();
         self.leaf_sp.write_clock.next = self.clock.val();
+        self.top_from_ram.read_clock.next = self.clock.val();
+        self.top_from_ram.write_clock.next = self.clock.val();
+        self.top_to_ram.read_clock.next = self.clock.val();
+        self.top_to_ram.write_clock.next = self.clock.val();
         self.stack_node.read_clock.next = self.clock.val();
         self.stack_node.write_clock.next = self.clock.val();
         self.stack_lo.read_clock.next = self.clock.val();
@@ -469,26 +540,49 @@ impl<
             self.ray.primary_o[k].next = self.primary_o[k].val();
             self.ray.primary_d[k].next = self.primary_d[k].val();
         }
+        self.world.thread.next = self.engine.thread.val();
+        self.world.word_a.next = self.engine.word_a.val();
+        self.world.word_b.next = self.engine.word_b.val();
+        self.world.ray_write.next = self.world_write.val();
+        self.world.ray_pair.next = self.world_pair.val();
+        self.world.t_min_write.next = false;
+        self.world.primary_write.next = false;
+        self.world.primary_thread.next = 0.into();
+        for k in 0..3 {
+            self.world.primary_o[k].next = 0.into();
+            self.world.primary_d[k].next = 0.into();
+        }
+        self.world.t_min_thread.next = 0.into();
+        self.top_from_ram.read_address.next = self.engine.query_thread.val();
+        self.top_to_ram.read_address.next = self.engine.query_thread.val();
+        self.top_from.next = self.top_from_ram.read_data.val();
+        self.top_to.next = self.top_to_ram.read_data.val();
         // The tester's answer takes the queue first (a thread has one entry in the unit at a
         // time, so the queue never overflows with it).
         self.engine_full.next = self.entry_fifo.full.val() | self.answer_valid.val();
         self.engine.full.next = self.engine_full.val();
         self.entry_fifo.write.next =
             (self.engine.enqueue.val() & (!self.engine_full.val())) | self.answer_valid.val();
-        // Bit 69: an answer (0: the engine's start).
-        self.entry_fifo.data_in.next = (bit_cast::<70, 5>(self.engine.thread.val()) << 64)
-            | (bit_cast::<70, 32>(self.engine.word_a.val()) << 32)
-            | bit_cast::<70, 32>(self.engine.word_b.val());
+        // Bit 69: an answer (0: the engine's start); bit 70: of the top-level walk (an
+        // engine's `next`, or a start with `KD_TOP`).
+        self.entry_fifo.data_in.next = (bit_cast::<71, 1>(
+            (self.engine_next.val() | self.engine.word_a.val().get_bit(30)).into(),
+        ) << 70)
+            | (bit_cast::<71, 1>(self.engine_next.val().into()) << 69)
+            | (bit_cast::<71, 5>(self.engine.thread.val()) << 64)
+            | (bit_cast::<71, 32>(self.engine.word_a.val()) << 32)
+            | bit_cast::<71, 32>(self.engine.word_b.val());
         if self.answer_valid.val() {
-            self.entry_fifo.data_in.next = (bit_cast::<70, 1>(true.into()) << 69)
-                | (bit_cast::<70, 5>(self.answer_thread.val()) << 64)
-                | (bit_cast::<70, 32>(self.answer_t.val()) << 32)
-                | bit_cast::<70, 1>(self.answer_hit.val().into());
+            self.entry_fifo.data_in.next = (bit_cast::<71, 1>(true.into()) << 69)
+                | (bit_cast::<71, 5>(self.answer_thread.val()) << 64)
+                | (bit_cast::<71, 32>(self.answer_t.val()) << 32)
+                | bit_cast::<71, 1>(self.answer_hit.val().into());
         }
         self.any_hit.write_address.next = self.engine.thread.val();
         self.any_hit.write_data.next =
             bit_cast::<1, 1>(self.engine.word_a.val().get_bit(31).into());
-        self.any_hit.write_enable.next = self.engine.enqueue.val() & (!self.engine_full.val());
+        self.any_hit.write_enable.next =
+            self.engine.enqueue.val() & (!self.engine_full.val()) & (!self.engine_next.val());
         self.issued.read_address.next = self.engine.query_thread.val();
         self.done_e.read_address.next = self.engine.query_thread.val();
         self.engine.pending.next = self.issued.read_data.val() != self.done_e.read_data.val();
@@ -500,14 +594,18 @@ impl<
         self.entry_fifo.read.next = !self.entry_fifo.empty.val();
         self.f1_valid.d.next = !self.entry_fifo.empty.val();
         self.f1_next.d.next = self.entry_fifo.data_out.val().get_bit(69);
+        self.f1_top.d.next = self.entry_fifo.data_out.val().get_bit(70);
         self.f1_thread.d.next = self.entry_fifo.data_out.val().get_bits::<5>(64);
         self.f1_a.d.next = self.entry_fifo.data_out.val().get_bits::<32>(32);
         self.f1_b.d.next = self.entry_fifo.data_out.val().get_bits::<32>(0);
-        self.leaf_hi.read_address.next = self.f1_thread.q.val();
-        self.leaf_sp.read_address.next = self.f1_thread.q.val();
+        self.f1_leaf_address.next = (bit_cast::<6, 1>(self.f1_top.q.val().into()) << 5)
+            | bit_cast::<6, 5>(self.f1_thread.q.val());
+        self.leaf_hi.read_address.next = self.f1_leaf_address.val();
+        self.leaf_sp.read_address.next = self.f1_leaf_address.val();
         self.ray.t_min_thread.next = self.f1_thread.q.val();
         self.f2_valid.d.next = self.f1_valid.q.val();
         self.f2_next.d.next = self.f1_next.q.val();
+        self.f2_top.d.next = self.f1_top.q.val();
         self.f2_thread.d.next = self.f1_thread.q.val();
         self.f2_a.d.next = self.f1_a.q.val();
         self.f2_b.d.next = self.f1_b.q.val();
@@ -525,6 +623,7 @@ impl<
             (bit_cast::<11, 5>(self.f2_thread.q.val()) << 6) | bit_cast::<11, 6>(self.f2_pop.val());
         self.f3_valid.d.next = self.f2_valid.q.val();
         self.f3_next.d.next = self.f2_next.q.val();
+        self.f3_top.d.next = self.f2_top.q.val();
         self.f3_thread.d.next = self.f2_thread.q.val();
         self.f3_a.d.next = self.f2_a.q.val();
         self.f3_b.d.next = self.f2_b.q.val();
@@ -536,6 +635,7 @@ impl<
         self.cmp_pop.b.next = self.stack_lo.read_data.val();
         self.f4_valid.d.next = self.f3_valid.q.val();
         self.f4_next.d.next = self.f3_next.q.val();
+        self.f4_top.d.next = self.f3_top.q.val();
         self.f4_thread.d.next = self.f3_thread.q.val();
         self.f4_a.d.next = self.f3_a.q.val();
         self.f4_b.d.next = self.f3_b.q.val();
@@ -546,6 +646,7 @@ impl<
         self.f4_hi.d.next = self.stack_hi.read_data.val();
         self.f5_valid.d.next = self.f4_valid.q.val();
         self.f5_next.d.next = self.f4_next.q.val();
+        self.f5_top.d.next = self.f4_top.q.val();
         self.f5_thread.d.next = self.f4_thread.q.val();
         self.f5_a.d.next = self.f4_a.q.val();
         self.f5_b.d.next = self.f4_b.q.val();
@@ -559,23 +660,32 @@ impl<
         // f5: a start steps from the root (`a`) with [t_min, t_max = `b`]; a next ends the
         // walk when the hit lies in the leaf's segment, the walk answers any hit, the stack is
         // empty or the popped segment starts behind the hit, else steps from the popped entry.
+        // A top-level walk's stack starts at `TOP_STACK_BASE` (its `next` never comes after
+        // an answered any-hit query, so the thread's any-hit flag is that of no walk of its).
         self.f5_pop.next = self.f5_sp.q.val() - 1;
+        self.f5_base.next = 0.into();
+        if self.f5_top.q.val() {
+            self.f5_base.next = self.c_top_base.val();
+        }
         self.front_end.next = self.f5_next.q.val()
             & ((self.f5_b.q.val().get_bit(0) & self.f5_in_leaf.q.val())
                 | (self.f5_b.q.val().get_bit(0) & (self.any_hit.read_data.val() != 0))
-                | (self.f5_sp.q.val() == 0)
+                | (self.f5_sp.q.val() == self.f5_base.val())
                 | (self.f5_b.q.val().get_bit(0) & self.cmp_pop.lt.val()));
-        self.front_job.next = (bit_cast::<102, 1>(self.front_end.val().into()) << 101)
-            | (bit_cast::<102, 5>(self.f5_thread.q.val()) << 96)
-            | (bit_cast::<102, 6>(self.f5_pop.val()) << 90)
-            | (bit_cast::<102, 26>(self.f5_node.q.val()) << 64)
-            | (bit_cast::<102, W>(self.f5_lo.q.val()) << 32)
-            | bit_cast::<102, W>(self.f5_hi.q.val());
+        self.front_job.next = (bit_cast::<103, 1>(self.f5_top.q.val().into()) << 102)
+            | (bit_cast::<103, 1>(self.front_end.val().into()) << 101)
+            | (bit_cast::<103, 5>(self.f5_thread.q.val()) << 96)
+            | (bit_cast::<103, 6>(self.f5_pop.val()) << 90)
+            | (bit_cast::<103, 26>(self.f5_node.q.val()) << 64)
+            | (bit_cast::<103, W>(self.f5_lo.q.val()) << 32)
+            | bit_cast::<103, W>(self.f5_hi.q.val());
         if !self.f5_next.q.val() {
-            self.front_job.next = (bit_cast::<102, 5>(self.f5_thread.q.val()) << 96)
-                | (bit_cast::<102, 26>(self.f5_a.q.val().get_bits::<26>(0)) << 64)
-                | (bit_cast::<102, W>(self.f5_t_min.q.val()) << 32)
-                | bit_cast::<102, W>(self.f5_b.q.val().get_bits::<W>(0));
+            self.front_job.next = (bit_cast::<103, 1>(self.f5_top.q.val().into()) << 102)
+                | (bit_cast::<103, 5>(self.f5_thread.q.val()) << 96)
+                | (bit_cast::<103, 6>(self.f5_base.val()) << 90)
+                | (bit_cast::<103, 26>(self.f5_a.q.val().get_bits::<26>(0)) << 64)
+                | (bit_cast::<103, W>(self.f5_t_min.q.val()) << 32)
+                | bit_cast::<103, W>(self.f5_b.q.val().get_bits::<W>(0));
         }
         self.front_fifo.write.next = self.f5_valid.q.val();
         self.front_fifo.data_in.next = self.front_job.val();
@@ -650,12 +760,15 @@ impl<
         // The ray's words for A: read for the oldest job in flight, a clock before it gets
         // there.
         self.ray.ray_thread.next = self.in_flight.data_out.val().get_bits::<5>(96);
+        self.world.ray_thread.next = self.in_flight.data_out.val().get_bits::<5>(96);
 
         // A: both words are here (or the walk ended).
         self.at_a.next = self.words_in.q.val() == 1;
         self.a_leaf.next = self.job.q.val().get_bit(101)
             | (self.w0.q.val().get_bits::<2>(30) == self.c_leaf_tag.val());
         self.a_axis.next = self.w0.q.val().get_bits::<2>(30);
+        self.a_top.next = self.job.q.val().get_bit(102);
+        // The object walk's ray, or the top-level walk's world ray.
         self.a_o.next = self.ray.o[0].val();
         self.a_d.next = self.ray.d[0].val();
         if self.a_axis.val() == 1 {
@@ -666,13 +779,36 @@ impl<
             self.a_o.next = self.ray.o[2].val();
             self.a_d.next = self.ray.d[2].val();
         }
+        if self.a_top.val() {
+            self.a_o.next = self.world.o[0].val();
+            self.a_d.next = self.world.d[0].val();
+            if self.a_axis.val() == 1 {
+                self.a_o.next = self.world.o[1].val();
+                self.a_d.next = self.world.d[1].val();
+            }
+            if self.a_axis.val() == 2 {
+                self.a_o.next = self.world.o[2].val();
+                self.a_d.next = self.world.d[2].val();
+            }
+        }
         self.a_inner.next = self.at_a.val() & (!self.a_leaf.val());
-        // A leaf goes to the tester; the end to the engine. Either keeps the segment end and
-        // depth for the answer.
+        // An object leaf goes to the tester; a top-level leaf, and the end of a walk, to the
+        // engine. Each keeps the segment end and depth for the answer.
         self.a_end.next = self.at_a.val() & self.job.q.val().get_bit(101);
+        self.a_top_leaf.next = self.at_a.val() & self.a_leaf.val() & self.a_top.val();
         self.a_list_end.next =
             bit_cast::<32, 30>(self.w0.q.val().get_bits::<30>(0)) + self.w1.q.val();
-        self.leaf_fifo.write.next = self.at_a.val() & self.a_leaf.val() & (!self.a_end.val());
+        self.leaf_fifo.write.next =
+            self.at_a.val() & self.a_leaf.val() & (!self.a_end.val()) & (!self.a_top.val());
+        self.top_from_ram.write_address.next = self.job.q.val().get_bits::<5>(96);
+        self.top_to_ram.write_address.next = self.job.q.val().get_bits::<5>(96);
+        self.top_from_ram.write_data.next = bit_cast::<32, 30>(self.w0.q.val().get_bits::<30>(0));
+        if self.a_end.val() {
+            self.top_from_ram.write_data.next = self.c_walk_ended.val();
+        }
+        self.top_to_ram.write_data.next = self.a_list_end.val();
+        self.top_from_ram.write_enable.next = self.a_top_leaf.val();
+        self.top_to_ram.write_enable.next = self.a_top_leaf.val() & (!self.a_end.val());
         self.leaf_fifo.data_in.next = (bit_cast::<69, 5>(self.job.q.val().get_bits::<5>(96)) << 64)
             | (bit_cast::<69, 30>(self.w0.q.val().get_bits::<30>(0)) << 32)
             | bit_cast::<69, 32>(self.a_list_end.val());
@@ -682,8 +818,10 @@ impl<
         self.leaf_to.next = self.leaf_fifo.data_out.val().get_bits::<32>(0);
         self.leaf_fifo.read.next = self.leaf_take.val();
         self.done_e.write_address.next = self.job.q.val().get_bits::<5>(96);
-        self.leaf_hi.write_address.next = self.job.q.val().get_bits::<5>(96);
-        self.leaf_sp.write_address.next = self.job.q.val().get_bits::<5>(96);
+        self.a_leaf_address.next = (bit_cast::<6, 1>(self.a_top.val().into()) << 5)
+            | bit_cast::<6, 5>(self.job.q.val().get_bits::<5>(96));
+        self.leaf_hi.write_address.next = self.a_leaf_address.val();
+        self.leaf_sp.write_address.next = self.a_leaf_address.val();
         self.leaf_hi.write_data.next = self.job.q.val().get_bits::<W>(0);
         self.leaf_sp.write_data.next = self.job.q.val().get_bits::<6>(90);
         // Entries done: the unit's copy is read a clock ahead at the thread of the job coming
@@ -692,9 +830,11 @@ impl<
         self.done_u.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.done_e.write_data.next = self.done_u.read_data.val() + 1;
         self.done_u.write_data.next = self.done_u.read_data.val() + 1;
-        self.done_u.write_enable.next = self.a_end.val();
-        self.done_e.write_enable.next = self.a_end.val();
-        self.engine.done.next = self.a_end.val();
+        // A walk's end, or a top-level leaf, wakes the thread.
+        self.a_done.next = self.a_end.val() | self.a_top_leaf.val();
+        self.done_u.write_enable.next = self.a_done.val();
+        self.done_e.write_enable.next = self.a_done.val();
+        self.engine.done.next = self.a_done.val();
         self.engine.done_thread.next = self.job.q.val().get_bits::<5>(96);
         self.leaf_hi.write_enable.next = self.at_a.val() & self.a_leaf.val();
         self.leaf_sp.write_enable.next = self.at_a.val() & self.a_leaf.val();
@@ -717,10 +857,11 @@ impl<
         for k in 0..5 {
             self.o_delay_div[k].data_in.next = self.o_delay[k].data_out.val();
         }
-        self.control_delay.data_in.next = (bit_cast::<38, 1>(self.a_inner.val().into()) << 37)
-            | (bit_cast::<38, 5>(self.job.q.val().get_bits::<5>(96)) << 32)
-            | (bit_cast::<38, 6>(self.job.q.val().get_bits::<6>(90)) << 26)
-            | bit_cast::<38, 26>(self.w0.q.val().get_bits::<26>(0));
+        self.control_delay.data_in.next = (bit_cast::<39, 1>(self.a_top.val().into()) << 38)
+            | (bit_cast::<39, 1>(self.a_inner.val().into()) << 37)
+            | (bit_cast::<39, 5>(self.job.q.val().get_bits::<5>(96)) << 32)
+            | (bit_cast::<39, 6>(self.job.q.val().get_bits::<6>(90)) << 26)
+            | bit_cast::<39, 26>(self.w0.q.val().get_bits::<26>(0));
         self.control_delay_div.data_in.next = self.control_delay.data_out.val();
         self.control_delay_cmp.data_in.next = self.control_delay_div.data_out.val();
         // The split plane waits with o: compare o with it when t_split is done.
@@ -743,6 +884,7 @@ impl<
 
         // D: the decision, a push for both children, the next step.
         self.d_valid.next = self.control_delay_cmp.data_out.val().get_bit(37);
+        self.d_top.next = self.control_delay_cmp.data_out.val().get_bit(38);
         self.d_thread.next = self.control_delay_cmp.data_out.val().get_bits::<5>(32);
         self.d_sp.next = self.control_delay_cmp.data_out.val().get_bits::<6>(26);
         self.d_left.next = self.control_delay_cmp.data_out.val().get_bits::<26>(0);
@@ -765,29 +907,32 @@ impl<
         self.stack_lo.write_enable.next = false;
         self.stack_hi.write_enable.next = false;
         // Near with the whole segment.
-        self.loop_fifo.data_in.next = (bit_cast::<102, 5>(self.d_thread.val()) << 96)
-            | (bit_cast::<102, 6>(self.d_sp.val()) << 90)
-            | (bit_cast::<102, 26>(self.d_near.val()) << 64)
-            | (bit_cast::<102, W>(self.lo_delay.data_out.val()) << 32)
-            | bit_cast::<102, W>(self.hi_delay.data_out.val());
+        self.loop_fifo.data_in.next = (bit_cast::<103, 1>(self.d_top.val().into()) << 102)
+            | (bit_cast::<103, 5>(self.d_thread.val()) << 96)
+            | (bit_cast::<103, 6>(self.d_sp.val()) << 90)
+            | (bit_cast::<103, 26>(self.d_near.val()) << 64)
+            | (bit_cast::<103, W>(self.lo_delay.data_out.val()) << 32)
+            | bit_cast::<103, W>(self.hi_delay.data_out.val());
         if (!self.cmp[1].eq.val()) & (!self.cmp[2].lt.val()) & (!self.cmp[3].le.val()) {
             if self.cmp[4].lt.val() {
                 // Far with the whole segment.
-                self.loop_fifo.data_in.next = (bit_cast::<102, 5>(self.d_thread.val()) << 96)
-                    | (bit_cast::<102, 6>(self.d_sp.val()) << 90)
-                    | (bit_cast::<102, 26>(self.d_far.val()) << 64)
-                    | (bit_cast::<102, W>(self.lo_delay.data_out.val()) << 32)
-                    | bit_cast::<102, W>(self.hi_delay.data_out.val());
+                self.loop_fifo.data_in.next = (bit_cast::<103, 1>(self.d_top.val().into()) << 102)
+                    | (bit_cast::<103, 5>(self.d_thread.val()) << 96)
+                    | (bit_cast::<103, 6>(self.d_sp.val()) << 90)
+                    | (bit_cast::<103, 26>(self.d_far.val()) << 64)
+                    | (bit_cast::<103, W>(self.lo_delay.data_out.val()) << 32)
+                    | bit_cast::<103, W>(self.hi_delay.data_out.val());
             } else {
                 // Both: push (far, t_split, hi), near with [lo, t_split].
                 self.stack_node.write_enable.next = self.d_valid.val();
                 self.stack_lo.write_enable.next = self.d_valid.val();
                 self.stack_hi.write_enable.next = self.d_valid.val();
-                self.loop_fifo.data_in.next = (bit_cast::<102, 5>(self.d_thread.val()) << 96)
-                    | (bit_cast::<102, 6>(self.d_sp.val() + 1) << 90)
-                    | (bit_cast::<102, 26>(self.d_near.val()) << 64)
-                    | (bit_cast::<102, W>(self.lo_delay.data_out.val()) << 32)
-                    | bit_cast::<102, W>(self.ts_delay.data_out.val());
+                self.loop_fifo.data_in.next = (bit_cast::<103, 1>(self.d_top.val().into()) << 102)
+                    | (bit_cast::<103, 5>(self.d_thread.val()) << 96)
+                    | (bit_cast::<103, 6>(self.d_sp.val() + 1) << 90)
+                    | (bit_cast::<103, 26>(self.d_near.val()) << 64)
+                    | (bit_cast::<103, W>(self.lo_delay.data_out.val()) << 32)
+                    | bit_cast::<103, W>(self.ts_delay.data_out.val());
             }
         }
         self.loop_fifo.write.next = self.d_valid.val();
@@ -1020,5 +1165,266 @@ mod tests {
         assert!(b.stolen > 0);
         assert!(b.refused > 0, "no start was refused for an answer");
         assert_eq!(b.got, want, "leaves per thread");
+    }
+
+    /// rust-hdl simulation of top-level walks on the dynamic scene's trees (1,202 instances):
+    /// eight threads write a world ray and an object ray, start a top-level walk (`KD_TOP`),
+    /// and at each top-level leaf the test reads the leaf (`top_from`, `top_to`), runs an
+    /// object walk of one instance's tree for the thread (the test plays the tester, answering
+    /// each object leaf with no hit in random clocks), then sends `next` with an answer (no
+    /// hit, or from a thread's second leaf on, one thread in two, a hit at a random distance).
+    /// Every top-level walk stops at `units::KdWalk`'s leaves on the world ray and ends where
+    /// it ends, and every object walk in between visits `KdWalk`'s leaves on the object ray:
+    /// the two walks keep their segments and stacks apart.
+    #[test]
+    fn rust_hdl_simulation_walks_the_top_level_between_object_walks() {
+        use crate::hw::program::isa::{KD_TOP, KD_WALK_ENDED};
+        let f = Format::E7M16;
+        let seed = 43;
+        println!("seed {seed}");
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/dynamic.toml");
+        let scene = Scene::load(&path).unwrap();
+        let trees = SceneTrees::build(&scene, f).unwrap();
+        let lay = layout::build(&scene, &trees, 0, &MemoryConfig::default()).unwrap();
+        let nodes = lay.banks[NODES].clone();
+        let top_root = lay.info.top_root.expect("a top level");
+        let eye = lay.words::<3>(FRAME, FrameMap::EYE);
+        let mem_latency = 3;
+        let threads = 8usize;
+        let w = |x: f64| f.from_f64(x);
+        let random_ray = |rng: &mut rand_chacha::ChaCha8Rng, o: [u32; 3]| {
+            let d = [
+                w(rng.gen_range(-0.6..0.6)),
+                w(rng.gen_range(-0.8..-0.2)),
+                w(rng.gen_range(-1.0..-0.5)),
+            ];
+            (o, d)
+        };
+        let worlds: Vec<_> = (0..threads).map(|_| random_ray(&mut rng, eye)).collect();
+        // Object rays from near the object space's origin, through it.
+        let objects: Vec<_> = (0..threads)
+            .map(|_| {
+                let o = [w(0.1), w(0.3), w(0.5)];
+                let d = [-0.1, -0.3, -0.5].map(|x: f64| w(x + rng.gen_range(-0.05..0.05)));
+                (o, d)
+            })
+            .collect();
+        let answers: Vec<Vec<(u32, bool)>> = (0..threads)
+            .map(|th| {
+                (0..64)
+                    .map(|k| {
+                        if th % 2 == 1 && k >= 1 {
+                            (w(rng.gen_range(20.0..40.0)), true)
+                        } else {
+                            (f.infinity(false), false)
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        let fetch = |n: u32| Ok(lay.node(n));
+        let t_max = f.infinity(false);
+        let no_hit = (t_max, false);
+        let object_leaves = |root: u32, ray| {
+            let levels = TOP_STACK_BASE;
+            let (mut walk, mut stop) =
+                KdWalk::start(f, ray, root, (0, t_max), levels, fetch).unwrap();
+            let mut stops = vec![stop];
+            while stop != KdStop::Finished {
+                stop = walk.next(f, ray, no_hit, levels, fetch).unwrap();
+                stops.push(stop);
+            }
+            stops
+        };
+        // The object of the instance whose walk of the first object ray has the most leaves.
+        let object_root = (0..lay.info.instance_count)
+            .map(|i| {
+                let at = i * layout::INSTANCE_WORDS as u32 + layout::instance_word::ROOT as u32;
+                lay.word(layout::INSTANCES, at)
+            })
+            .max_by_key(|&root| object_leaves(root, objects[0]).len())
+            .unwrap();
+        let top_want: Vec<Vec<KdStop>> = (0..threads)
+            .map(|th| {
+                let levels = TOP_STACK_LEVELS;
+                let (mut walk, mut stop) =
+                    KdWalk::start(f, worlds[th], top_root, (0, t_max), levels, fetch).unwrap();
+                let mut stops = vec![stop];
+                while stop != KdStop::Finished {
+                    let answer = answers[th][stops.len() - 1];
+                    stop = walk.next(f, worlds[th], answer, levels, fetch).unwrap();
+                    stops.push(stop);
+                }
+                stops
+            })
+            .collect();
+        let object_want: Vec<Vec<KdStop>> = (0..threads)
+            .map(|th| object_leaves(object_root, objects[th]))
+            .collect();
+        let top_leaves: usize = top_want.iter().map(|s| s.len() - 1).sum();
+        assert!(
+            top_leaves > 3 * threads,
+            "too few top-level leaves: {top_leaves}"
+        );
+        let object_leaf_count: usize = object_want.iter().map(|s| s.len() - 1).sum();
+        assert!(
+            object_leaf_count >= 2 * threads,
+            "too few object leaves: {object_leaf_count}"
+        );
+
+        let mut u = Unit::new(mem_latency);
+        u.connect_all();
+        let cycle = |u: &mut Unit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
+        for th in 0..threads {
+            u.engine.thread.next = (th as u64).into();
+            for (write_world, (o, d)) in [(true, worlds[th]), (false, objects[th])] {
+                for (pair, (a, b)) in [(o[0], o[1]), (o[2], d[0]), (d[1], d[2])]
+                    .into_iter()
+                    .enumerate()
+                {
+                    u.world_write.next = write_world;
+                    u.engine.ray_write.next = !write_world;
+                    u.world_pair.next = (pair as u64).into();
+                    u.engine.ray_pair.next = (pair as u64).into();
+                    u.engine.word_a.next = u64::from(a).into();
+                    u.engine.word_b.next = u64::from(b).into();
+                    cycle(&mut u);
+                }
+            }
+            u.world_write.next = false;
+            u.engine.ray_write.next = false;
+            u.t_min_write.next = true;
+            u.engine.word_a.next = 0.into();
+            cycle(&mut u);
+            u.t_min_write.next = false;
+        }
+        #[derive(Clone, Copy, PartialEq, Debug)]
+        enum Step {
+            StartTop,
+            StartObject,
+            Next,
+            /// Waiting for the top-level walk, or for an object walk.
+            WaitTop,
+            WaitObject,
+            Done,
+        }
+        let mut steps = vec![Step::StartTop; threads];
+        let mut top_got: Vec<Vec<KdStop>> = vec![Vec::new(); threads];
+        /// The SRAM's requests, the object leaves taken (answered with no hit at a due clock),
+        /// the object walks' leaves.
+        struct Bench {
+            requests: VecDeque<Option<u32>>,
+            due: Vec<(u64, usize)>,
+            clock: u64,
+            object_got: Vec<Vec<KdStop>>,
+        }
+        let mut b = Bench {
+            requests: std::iter::repeat(None).take(mem_latency as usize).collect(),
+            due: Vec::new(),
+            clock: 0,
+            object_got: vec![Vec::new(); threads],
+        };
+        let mut th = 0;
+        let tick = |u: &mut Unit, b: &mut Bench, rng: &mut rand_chacha::ChaCha8Rng, offer: bool| {
+            b.clock += 1;
+            let addr = b.requests.pop_front().unwrap();
+            u.nodes.rdata.next = u64::from(addr.map_or(0xdead_beef, |a| nodes[a as usize])).into();
+            let answer = b.due.iter().position(|d| d.0 <= b.clock || offer);
+            u.answer_valid.next = answer.is_some();
+            if let Some(k) = answer {
+                let (_, th) = b.due.remove(k);
+                u.answer_thread.next = (th as u64).into();
+                u.answer_t.next = u64::from(t_max).into();
+                u.answer_hit.next = false;
+            }
+            u.leaf_take.next = false;
+            settle(u);
+            if u.leaf_valid.val() && rng.gen_bool(0.5) {
+                u.leaf_take.next = true;
+                settle(u);
+                let th = u.leaf_thread.val().to_u64() as usize;
+                let from = u.leaf_from.val().to_u64() as u32;
+                let to = u.leaf_to.val().to_u64() as u32;
+                b.object_got[th].push(KdStop::Leaf {
+                    list: from,
+                    count: to - from,
+                });
+                b.due.push((b.clock + rng.gen_range(4..40), th));
+            }
+            b.requests.push_back(
+                u.nodes
+                    .read
+                    .val()
+                    .then(|| u.nodes.addr.val().to_u64() as u32),
+            );
+            let full = u.engine.full.val();
+            cycle(u);
+            !full
+        };
+        while steps.iter().any(|&s| s != Step::Done) {
+            assert!(b.clock < 400_000, "the walks do not end: {steps:?}");
+            th = (th + 1) % threads;
+            u.engine.query_thread.next = (th as u64).into();
+            u.engine.enqueue.next = false;
+            u.engine_next.next = false;
+            tick(&mut u, &mut b, &mut rng, false);
+            // I5 of the thread presented at I4: its walk's state and top-level leaf.
+            if !u.engine.pending.val() {
+                match steps[th] {
+                    Step::WaitTop => {
+                        let from = u.top_from.val().to_u64() as u32;
+                        let to = u.top_to.val().to_u64() as u32;
+                        if from == KD_WALK_ENDED {
+                            top_got[th].push(KdStop::Finished);
+                            steps[th] = Step::Done;
+                        } else {
+                            top_got[th].push(KdStop::Leaf {
+                                list: from,
+                                count: to - from,
+                            });
+                            b.object_got[th].clear();
+                            steps[th] = Step::StartObject;
+                        }
+                    }
+                    Step::WaitObject => {
+                        b.object_got[th].push(KdStop::Finished);
+                        assert_eq!(
+                            b.object_got[th], object_want[th],
+                            "thread {th}'s object walk"
+                        );
+                        steps[th] = Step::Next;
+                    }
+                    _ => {}
+                }
+            }
+            let offer = matches!(steps[th], Step::StartTop | Step::StartObject | Step::Next);
+            u.engine.enqueue.next = offer;
+            u.engine.thread.next = (th as u64).into();
+            match steps[th] {
+                Step::StartTop => {
+                    u.engine.word_a.next = (u64::from(top_root) | u64::from(KD_TOP)).into();
+                    u.engine.word_b.next = u64::from(t_max).into();
+                }
+                Step::StartObject => {
+                    u.engine.word_a.next = u64::from(object_root).into();
+                    u.engine.word_b.next = u64::from(t_max).into();
+                }
+                Step::Next => {
+                    let (t, hit) = answers[th][top_got[th].len() - 1];
+                    u.engine_next.next = true;
+                    u.engine.word_a.next = u64::from(t).into();
+                    u.engine.word_b.next = u64::from(hit).into();
+                }
+                _ => {}
+            }
+            if tick(&mut u, &mut b, &mut rng, offer) && offer {
+                steps[th] = match steps[th] {
+                    Step::StartObject => Step::WaitObject,
+                    _ => Step::WaitTop,
+                };
+            }
+        }
+        assert_eq!(top_got, top_want, "top-level stops per thread");
     }
 }

@@ -7,7 +7,7 @@
 //! at I5: `fast` is `add`/`sub`/`and`/`or`/`xor`/`shr`/`shl` of `a` and `b`, `jal`'s
 //! link `pc + 1`, `byte`'s `b << 8` (the unit's byte joins it at the write back), the
 //! pixel word, or what `tri.wait`/`tri.hit`/`tri.instance`/`tri.triangle` read from the
-//! triangle tester; `kind` says whether the result line fills in a scratch or memory word
+//! triangle tester and `kd.wait`/`kd.leaf` from the traversal unit (the top-level leaf); `kind` says whether the result line fills in a scratch or memory word
 //! later (`ld` by its bank, `lds`). `mem_address = (a << shift) + imm` (loads and
 //! frame-buffer stores), `scratch_address = a + imm`; `int_eq`, `int_lt`: `a == b`, `a < b`
 //! unsigned.
@@ -18,8 +18,8 @@
 
 use rust_hdl::prelude::*;
 
-use super::{bank, op_code, tri_fn, FastKind};
-use crate::hw::program::isa::{Op, TriFn, BANK_BITS, OP_BITS, PC_BITS, SHIFT_BITS};
+use super::{bank, kd_fn, op_code, tri_fn, FastKind};
+use crate::hw::program::isa::{KdFn, Op, TriFn, BANK_BITS, OP_BITS, PC_BITS, SHIFT_BITS};
 use crate::layout;
 
 #[derive(LogicBlock)]
@@ -39,6 +39,9 @@ pub struct Execute<const W: usize> {
     pub tester_hit: Signal<In, Bit>,
     pub tester_instance: Signal<In, Bits<32>>,
     pub tester_triangle: Signal<In, Bits<32>>,
+    /// The traversal unit's top-level leaf for the thread at I5, for `kd.wait` and `kd.leaf`.
+    pub top_from: Signal<In, Bits<32>>,
+    pub top_to: Signal<In, Bits<32>>,
     /// The thread's primary direction (ray generation's answer at I5), for `tri.dir`.
     pub primary_dir: [Signal<In, Bits<W>>; 3],
     pub fast: Signal<Out, Bits<32>>,
@@ -64,6 +67,9 @@ pub struct Execute<const W: usize> {
     op_byte: Constant<Bits<5>>,
     op_pixel: Constant<Bits<5>>,
     op_tri: Constant<Bits<5>>,
+    op_kd: Constant<Bits<5>>,
+    kd_wait: Constant<Bits<32>>,
+    kd_leaf: Constant<Bits<32>>,
     tri_wait: Constant<Bits<32>>,
     tri_hit: Constant<Bits<32>>,
     tri_instance: Constant<Bits<32>>,
@@ -91,6 +97,8 @@ impl<const W: usize> Default for Execute<W> {
             tester_hit: Default::default(),
             tester_instance: Default::default(),
             tester_triangle: Default::default(),
+            top_from: Default::default(),
+            top_to: Default::default(),
             primary_dir: Default::default(),
             fast: Default::default(),
             kind: Default::default(),
@@ -113,6 +121,9 @@ impl<const W: usize> Default for Execute<W> {
             op_byte: op_code(Op::Byte),
             op_pixel: op_code(Op::Pixel),
             op_tri: op_code(Op::Tri),
+            op_kd: op_code(Op::Kd),
+            kd_wait: kd_fn(KdFn::Wait),
+            kd_leaf: kd_fn(KdFn::Leaf),
             tri_wait: tri_fn(TriFn::Wait),
             tri_hit: tri_fn(TriFn::Hit),
             tri_instance: tri_fn(TriFn::Instance),
@@ -195,6 +206,14 @@ impl<const W: usize> Logic for Execute<W> {
             }
             if self.imm.val() == self.tri_triangle.val() {
                 self.result.next = self.tester_triangle.val();
+            }
+        }
+        if self.op.val() == self.op_kd.val() {
+            if self.imm.val() == self.kd_wait.val() {
+                self.result.next = self.top_from.val();
+            }
+            if self.imm.val() == self.kd_leaf.val() {
+                self.result.next = self.top_to.val();
             }
         }
         // `tri.dir`: the primary direction's component named by the shift field.

@@ -295,6 +295,8 @@ pub struct ThreadEngine<
     tri_kind: DFF<Bits<2>>,
     tri_waits: DFF<Bit>,
     kd_enqueue: DFF<Bit>,
+    kd_queues: DFF<Bit>,
+    kd_next: DFF<Bit>,
     kd_waits: DFF<Bit>,
     wait_fn: DFF<Bit>,
     tri_op: Signal<Local, Bit>,
@@ -302,6 +304,7 @@ pub struct ThreadEngine<
     tri_wait_fn: Signal<Local, Bit>,
     kd_wait_fn: Signal<Local, Bit>,
     queued_fn: Signal<Local, Bit>,
+    kd_queued_fn: Signal<Local, Bit>,
     tri_busy: Signal<Local, Bit>,
     kd_busy: Signal<Local, Bit>,
     /// Instance entry's request goes to the TransformUnit (ray generation's, when both ask,
@@ -337,6 +340,7 @@ pub struct ThreadEngine<
     tri_enter: Constant<Bits<32>>,
     kd_start: Constant<Bits<32>>,
     kd_wait: Constant<Bits<32>>,
+    kd_next_fn: Constant<Bits<32>>,
     cmd_list: Constant<Bits<2>>,
     cmd_init: Constant<Bits<2>>,
     cmd_object: Constant<Bits<2>>,
@@ -448,6 +452,8 @@ impl<
             tri_kind: Default::default(),
             tri_waits: Default::default(),
             kd_enqueue: Default::default(),
+            kd_queues: Default::default(),
+            kd_next: Default::default(),
             kd_waits: Default::default(),
             wait_fn: Default::default(),
             tri_op: Default::default(),
@@ -455,6 +461,7 @@ impl<
             tri_wait_fn: Default::default(),
             kd_wait_fn: Default::default(),
             queued_fn: Default::default(),
+            kd_queued_fn: Default::default(),
             tri_busy: Default::default(),
             kd_busy: Default::default(),
             gen_instance: Default::default(),
@@ -482,6 +489,7 @@ impl<
             tri_enter: tri_fn(TriFn::Enter),
             kd_start: kd_fn(KdFn::Start),
             kd_wait: kd_fn(KdFn::Wait),
+            kd_next_fn: kd_fn(KdFn::Next),
             cmd_list: cmd(list_unit::CMD_LIST),
             cmd_init: cmd(list_unit::CMD_INIT),
             cmd_object: cmd(list_unit::CMD_OBJECT),
@@ -541,6 +549,8 @@ impl<
             tri_kind,
             tri_waits,
             kd_enqueue,
+            kd_queues,
+            kd_next,
             kd_waits,
             wait_fn
         );
@@ -640,6 +650,8 @@ impl<
         self.execute.tester_hit.next = self.tester.hit.val();
         self.execute.tester_instance.next = self.tester.best_instance.val();
         self.execute.tester_triangle.next = self.tester.best_triangle.val();
+        self.execute.top_from.next = self.traversal_unit.top_from.val();
+        self.execute.top_to.next = self.traversal_unit.top_to.val();
         self.mailboxes.thread.next = self.decode.thread.val();
         self.mailboxes.which.next = self.decode.imm.val().get_bit(0);
         self.mailboxes.value.next = self.decode.a.val();
@@ -752,9 +764,13 @@ impl<
             self.tri_kind.d.next = self.cmd_skip.val();
         }
         self.tri_waits.d.next = self.tri_wait_fn.val();
-        self.kd_enqueue.d.next = self.decode.valid_i4.val()
-            & self.kd_op.val()
-            & (self.decode.imm_i4.val() == self.kd_start.val());
+        // `kd.start` and `kd.next` queue (`kd.next` is the top-level walk's answer).
+        self.kd_queued_fn.next = (self.decode.imm_i4.val() == self.kd_start.val())
+            | (self.decode.imm_i4.val() == self.kd_next_fn.val());
+        self.kd_queues.d.next = self.kd_queued_fn.val();
+        self.kd_enqueue.d.next =
+            self.decode.valid_i4.val() & self.kd_op.val() & self.kd_queued_fn.val();
+        self.kd_next.d.next = self.decode.imm_i4.val() == self.kd_next_fn.val();
         self.kd_waits.d.next = self.kd_wait_fn.val();
         // The waits (`tri.wait`, `kd.wait`): a pending one sleeps instead of repeating.
         self.wait_fn.d.next = (self.tri_op.val() & self.tri_wait_fn.val())
@@ -871,10 +887,15 @@ impl<
         self.traversal_unit.answer_hit.next = self.tester.walk_end_hit.val();
         self.traversal_unit.t_min_write.next = self.t_min_write.q.val();
         self.traversal_unit.engine.enqueue.next = self.kd_enqueue.q.val();
+        self.traversal_unit.engine_next.next = self.kd_next.q.val();
+        self.traversal_unit.world_write.next = self.world_write.q.val();
+        self.traversal_unit.world_pair.next = self.decode.shift.val().get_bits::<2>(0);
+        self.kd_busy.next = false;
+        if self.kd_queues.q.val() {
+            self.kd_busy.next = self.traversal_unit.engine.full.val();
+        }
         if self.kd_waits.q.val() {
             self.kd_busy.next = self.traversal_unit.engine.pending.val();
-        } else {
-            self.kd_busy.next = self.traversal_unit.engine.full.val();
         }
 
         // I5 into the result line.

@@ -480,9 +480,20 @@ impl Asm {
         self.coprocessor(Op::Kd, KdFn::Start as u32, Reg::ZERO, a, b);
     }
 
-    /// Waits for the traversal unit's walk to end.
-    pub fn kd_wait(&self) {
-        self.coprocessor(Op::Kd, KdFn::Wait as u32, Reg::ZERO, Reg::ZERO, Reg::ZERO);
+    /// Waits for the traversal unit's walk to end or (a top-level walk) to reach a leaf;
+    /// `dst` = that leaf's list address or `isa::KD_WALK_ENDED`.
+    pub fn kd_wait(&self, dst: Reg) {
+        self.coprocessor(Op::Kd, KdFn::Wait as u32, dst, Reg::ZERO, Reg::ZERO);
+    }
+
+    /// Offers `kd.next best_t, hit`: the top-level walk goes on after its leaf.
+    pub fn kd_next(&self, best_t: Reg, hit: Reg) {
+        self.coprocessor(Op::Kd, KdFn::Next as u32, Reg::ZERO, best_t, hit);
+    }
+
+    /// `dst` = the top-level leaf's list end.
+    pub fn kd_leaf(&self, dst: Reg) {
+        self.coprocessor(Op::Kd, KdFn::Leaf as u32, dst, Reg::ZERO, Reg::ZERO);
     }
 
     /// A coprocessor instruction: function `function`, operands `a`, `b`, result `dst`.

@@ -17,11 +17,11 @@
 //! the pixels and primary rays of [`crate::hw::engine::PrimaryRays`]); `kd` stands for the
 //! [`crate::hw::TraversalUnit`]'s walk and `tri` for the [`crate::hw::TriangleTester`].
 
-use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_ANY_HIT, REGISTERS};
+use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_ANY_HIT, KD_TOP, KD_WALK_ENDED, REGISTERS};
 use super::Program;
 use crate::fp::Format;
 use crate::hw::engine::CAMERA_WORDS;
-use crate::hw::traversal_unit::STACK_LEVELS;
+use crate::hw::traversal_unit::{STACK_LEVELS, TOP_STACK_BASE, TOP_STACK_LEVELS};
 use crate::layout::{
     instance_word, Layout, Node, INSTANCES, LISTS, NODES, NODE_WORDS, TRIANGLES_B,
     TRIANGLE_BANK_WORDS,
@@ -95,8 +95,13 @@ struct Thread {
     /// thread writes the same frame words) and the thread's last primary direction.
     camera: [u32; CAMERA_WORDS],
     primary_d: [u32; 3],
-    /// The world ray's words (`tri.world`), which `tri.enter` transforms.
+    /// The world ray's words (`tri.world`), which `tri.enter` and the top-level walk
+    /// transform and walk.
     world: [u32; 6],
+    /// The top-level walk (`kd.start` with `KD_TOP`), stopped at its leaf, and what `kd.wait`
+    /// and `kd.leaf` read of that leaf: its list's start (or `KD_WALK_ENDED`) and end.
+    top_walk: units::KdWalk,
+    top_leaf: [u32; 2],
     halted: bool,
 }
 
@@ -111,6 +116,8 @@ impl Thread {
             camera: [0; CAMERA_WORDS],
             primary_d: [0; 3],
             world: [0; 6],
+            top_walk: units::KdWalk::default(),
+            top_leaf: [0; 2],
             halted: false,
         }
     }
@@ -410,34 +417,71 @@ impl<'a> Machine<'a> {
             Op::Kd => {
                 let function = KdFn::from_imm(i.imm)
                     .ok_or_else(|| fail(format!("no traversal unit function {}", i.imm)))?;
-                // `wait` has nothing to do: the twin's walk is over when it starts.
-                if function == KdFn::Start {
-                    // The whole walk: each leaf's list goes to the tester, whose closest hit
-                    // answers the unit (an any-hit walk ends at the first hit).
-                    let tt = &mut t.tester;
-                    let ray = (tt.o, tt.d);
-                    let nodes = std::cell::Cell::new(0u64);
-                    let fetch = |n| {
-                        nodes.set(nodes.get() + 1);
-                        self.kd_node(n)
-                    };
-                    let any_hit = a & KD_ANY_HIT != 0;
-                    let root = a & !KD_ANY_HIT;
-                    let (mut walk, mut stop) =
-                        units::KdWalk::start(f, ray, root, (tt.t_min, b), STACK_LEVELS, fetch)
-                            .map_err(fail)?;
-                    while let units::KdStop::Leaf { list, count } = stop {
-                        self.test_list(tt, list, list.wrapping_add(count), stats)
-                            .map_err(fail)?;
-                        stop = if any_hit && tt.hit {
-                            units::KdStop::Finished
-                        } else {
-                            walk.next(f, ray, (tt.best_t, tt.hit), STACK_LEVELS, fetch)
-                                .map_err(fail)?
-                        };
+                let nodes = std::cell::Cell::new(0u64);
+                let fetch = |n| {
+                    nodes.set(nodes.get() + 1);
+                    self.kd_node(n)
+                };
+                let root = a & !(KD_ANY_HIT | KD_TOP);
+                let world = (
+                    t.world[..3].try_into().unwrap(),
+                    t.world[3..].try_into().unwrap(),
+                );
+                // The unit's top-level walk stops at a leaf or its end.
+                let top_stop = |t: &mut Thread, stop| match stop {
+                    units::KdStop::Leaf { list, count } => {
+                        t.top_leaf = [list, list.wrapping_add(count)];
                     }
-                    stats.kd_nodes += nodes.get();
+                    units::KdStop::Finished => t.top_leaf[0] = KD_WALK_ENDED,
+                };
+                match function {
+                    KdFn::Start if a & KD_TOP != 0 => {
+                        let segment = (t.tester.t_min, b);
+                        let (walk, stop) =
+                            units::KdWalk::start(f, world, root, segment, TOP_STACK_LEVELS, fetch)
+                                .map_err(fail)?;
+                        t.top_walk = walk;
+                        top_stop(t, stop);
+                    }
+                    KdFn::Start => {
+                        // The whole walk: each leaf's list goes to the tester, whose closest
+                        // hit answers the unit (an any-hit walk ends at the first hit). Under
+                        // a top level the object walks have the stack below its region.
+                        let levels = if self.program.config.top_root.is_some() {
+                            TOP_STACK_BASE
+                        } else {
+                            STACK_LEVELS
+                        };
+                        let tt = &mut t.tester;
+                        let ray = (tt.o, tt.d);
+                        let any_hit = a & KD_ANY_HIT != 0;
+                        let (mut walk, mut stop) =
+                            units::KdWalk::start(f, ray, root, (tt.t_min, b), levels, fetch)
+                                .map_err(fail)?;
+                        while let units::KdStop::Leaf { list, count } = stop {
+                            self.test_list(tt, list, list.wrapping_add(count), stats)
+                                .map_err(fail)?;
+                            stop = if any_hit && tt.hit {
+                                units::KdStop::Finished
+                            } else {
+                                walk.next(f, ray, (tt.best_t, tt.hit), levels, fetch)
+                                    .map_err(fail)?
+                            };
+                        }
+                    }
+                    KdFn::Next => {
+                        let answer = (a, b & 1 != 0);
+                        let stop = t
+                            .top_walk
+                            .next(f, world, answer, TOP_STACK_LEVELS, fetch)
+                            .map_err(fail)?;
+                        top_stop(t, stop);
+                    }
+                    // The twin's walk has stopped when it starts, so `wait` never waits.
+                    KdFn::Wait => result = Some(t.top_leaf[0]),
+                    KdFn::Leaf => result = Some(t.top_leaf[1]),
                 }
+                stats.kd_nodes += nodes.get();
             }
         }
         if i.jumps_after() {

@@ -111,8 +111,9 @@ pub enum Op {
     /// `wait` repeats while tests are in flight (neither repeat counts as retired).
     Tri,
     /// The traversal unit (`hw::TraversalUnit`), function `imm` ([`KdFn`]): walk an object's
-    /// kd tree, its leaves' triangles tested by the triangle tester. `start` repeats while
-    /// refused, `wait` while the walk is in flight. It writes no register.
+    /// kd tree, its leaves' triangles tested by the triangle tester, or the top-level tree,
+    /// whose leaves come back to the thread. `start` and `next` repeat while refused, `wait`
+    /// while the walk is in flight.
     Kd,
     /// A colour channel's byte shifted in: `dst = (B << 8) | byte(A)`, where `byte` clamps `A`
     /// to [0, 1] and rounds 255 times it to an integer (`units::channel_byte`); three in a row
@@ -124,19 +125,32 @@ pub enum Op {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(u32)]
 pub enum KdFn {
-    /// Walk from root `A` (bits 25..0; [`KD_ANY_HIT`] for a walk that ends at the first hit)
-    /// with the segment `[t_min, B]` (t_min from the tester's init). The unit hands each leaf's
-    /// list to the triangle tester and goes on with its closest hit, to the walk's end.
+    /// Walk from root `A` (bits 25..0) with the segment `[t_min, B]` (t_min from the tester's
+    /// init). An object walk ([`KD_ANY_HIT`] for one that ends at the first hit) hands each
+    /// leaf's list to the triangle tester and goes on with its closest hit, to the walk's end.
+    /// A top-level walk ([`KD_TOP`]) walks the world ray (`tri.world`) and stops at each leaf
+    /// until the thread says `next`.
     Start = 0,
-    /// Repeat while the walk is in flight (asleep); the closest hit is the tester's.
+    /// Repeat while the walk is in flight (asleep); the closest hit is the tester's. `dst` =
+    /// the top-level walk's leaf: its list's first bank-1 address, or [`KD_WALK_ENDED`].
     Wait,
+    /// The top-level walk goes on after its leaf with the closest hit so far: best t `A`,
+    /// hit flag `B` (0 or 1); it ends when the hit lies in the leaf's segment, the stack is
+    /// empty or the popped segment starts behind the hit (`units::KdWalk::next`).
+    Next,
+    /// `dst` = the top-level leaf's list end (after a `wait` that gave a leaf).
+    Leaf,
 }
 
 /// Bit 31 of `kd.start`'s root: the walk answers a shadow query, and ends at the first hit.
 pub const KD_ANY_HIT: u32 = 1 << 31;
+/// Bit 30 of `kd.start`'s root: the walk is of the top-level tree.
+pub const KD_TOP: u32 = 1 << 30;
+/// `kd.wait`'s result when the top-level walk has ended.
+pub const KD_WALK_ENDED: u32 = 1 << 31;
 
 impl KdFn {
-    pub const ALL: [KdFn; 2] = [KdFn::Start, KdFn::Wait];
+    pub const ALL: [KdFn; 4] = [KdFn::Start, KdFn::Wait, KdFn::Next, KdFn::Leaf];
     pub fn from_imm(imm: u32) -> Option<KdFn> {
         Self::ALL.get(imm as usize).copied()
     }
@@ -144,6 +158,8 @@ impl KdFn {
         match self {
             KdFn::Start => "start",
             KdFn::Wait => "wait",
+            KdFn::Next => "next",
+            KdFn::Leaf => "leaf",
         }
     }
 }
@@ -295,6 +311,7 @@ impl Op {
                 | Jal
                 | Pixel
                 | Tri
+                | Kd
                 | Byte
         )
     }
@@ -559,7 +576,7 @@ impl fmt::Display for Instr {
             },
             Op::Kd => {
                 let name = KdFn::from_imm(self.imm).map_or("?", KdFn::name);
-                write!(f, "kd.{name} r{}, r{}", self.a, self.b)
+                write!(f, "kd.{name} r{}, r{}, r{}", self.dst, self.a, self.b)
             }
             Op::FSqrt => write!(f, "{} r{}, r{}", self.op.name(), self.dst, self.a),
             _ => write!(f, "{} r{}, r{}, {}", self.op.name(), self.dst, self.a, b),

@@ -1,5 +1,5 @@
-//! The microprogram of the ray thread engine: ray generation, the top-level kd traversal and
-//! instance entry, the object walk and the mailboxed triangle lists it hands to the
+//! The microprogram of the ray thread engine: ray generation, the top-level walk's leaves and
+//! instance entry, the object walks and the mailboxed triangle lists it hands to the
 //! coprocessors (`tri` and `kd` instructions: `hw::TriangleTester`, `hw::TraversalUnit`),
 //! shading, shadow and mirror rays, and the frame-buffer write, as one program every thread
 //! runs.
@@ -7,7 +7,7 @@
 //! The program is generated per scene from the layout's parameters, so it holds only what the
 //! scene needs: no top level and no instance transform for a scene of one untransformed
 //! object, no shadow rays when shadows are off, no mirror path for `reflection_depth = 0`,
-//! exactly the scene's lights, and a kd stack as deep as the scene's trees. The arithmetic is
+//! exactly the scene's lights, and a mirror chain as long as its reflection depth. The arithmetic is
 //! emitted by the shared sequences of `crate::units` (through [`asm::Asm`]'s `Arith`), so the
 //! engine computes what the golden model computes, operation for operation; the control flow
 //! follows `model::golden` step for step (the tests compare the two renderers on every pixel).
@@ -45,10 +45,6 @@ pub struct ProgramConfig {
     pub object_root: u32,
     pub materials: u32,
     pub frame_buffer: u32,
-    /// Kd stack entries per thread in scratch: the deepest top-level tree.
-    pub stack_entries: u32,
-    /// The deepest object tree (the traversal unit's stack holds that many entries).
-    pub object_depth: u32,
 }
 
 impl ProgramConfig {
@@ -67,8 +63,6 @@ impl ProgramConfig {
             object_root: 0,
             materials: 0,
             frame_buffer: 0,
-            stack_entries: 0,
-            object_depth: 1,
         }
     }
 
@@ -95,42 +89,27 @@ impl ProgramConfig {
             object_root: info.object_root,
             materials: info.materials,
             frame_buffer: info.frame_buffer,
-            stack_entries: if info.top_root.is_some() {
-                info.top_depth
-            } else {
-                0
-            },
-            object_depth: info.object_depth,
         }
     }
 }
 
-/// Words of a thread's scratch memory: the world ray the top-level traversal reads by axis
-/// index, its kd stack, then the mirror chain (object trees are walked by the traversal unit,
-/// which keeps its own ray and stack).
+/// Words of a thread's scratch memory: the mirror chain (kd trees are walked by the traversal
+/// unit, which keeps its own rays and stacks).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ScratchMap {
-    /// World ray (o then d) as the top level traverses it.
-    pub ray_top: u32,
-    pub stack: u32,
     /// Per mirror bounce: the local colour (3 words) and the mirror reflectivity.
     pub chain: u32,
     /// Total words, a power of two.
     pub words: u32,
 }
 
-pub const STACK_ENTRY_WORDS: u32 = 3;
 pub const CHAIN_ENTRY_WORDS: u32 = 4;
 
 impl ScratchMap {
     pub fn for_config(c: &ProgramConfig) -> Self {
-        let ray_top = 0;
-        let stack = 6;
-        let chain = stack + STACK_ENTRY_WORDS * c.stack_entries;
+        let chain = 0;
         let used = chain + CHAIN_ENTRY_WORDS * c.reflection_depth;
         ScratchMap {
-            ray_top,
-            stack,
             chain,
             words: used.next_power_of_two().max(16),
         }
@@ -194,9 +173,8 @@ pub(crate) struct Shared {
     pub best_t: Reg,
     pub best_instance: Reg,
     pub best_triangle: Reg,
-    /// Return address of the trace routine; the kd stack pointer (scratch word index).
+    /// Return address of the trace routine.
     pub link: Reg,
-    pub sp: Reg,
 }
 
 pub(crate) struct Gen<'a> {
@@ -223,7 +201,6 @@ pub fn build_program(config: &ProgramConfig) -> Program {
         best_instance: a.reg(),
         best_triangle: a.reg(),
         link: a.reg(),
-        sp: a.reg(),
     };
     let gen = Gen {
         asm: a,
