@@ -137,8 +137,13 @@ pub struct TraversalUnit<
     /// `word_b`.
     pub world_write: Signal<In, Bit>,
     pub world_pair: Signal<In, Bits<2>>,
+    /// The object root of `root_thread`'s last instance entry (`KD_ENTERED` walks it).
+    pub root_write: Signal<In, Bit>,
+    pub root_thread: Signal<In, Bits<5>>,
+    pub root: Signal<In, Bits<26>>,
     /// At I5, for the thread at I4 (`query_thread`): its top-level walk's leaf, the list's
-    /// first bank-1 address (or `KD_WALK_ENDED` at the walk's end) and its end.
+    /// first bank-1 address (or `KD_WALK_ENDED` at the walk's end) and its end; after an
+    /// object walk, `top_from` is the hit flag of the walk's last answer.
     pub top_from: Signal<Out, Bits<32>>,
     pub top_to: Signal<Out, Bits<32>>,
 
@@ -166,6 +171,18 @@ pub struct TraversalUnit<
     leaf_sp: RAM<Bits<6>, 6>,
     top_from_ram: RAM<Bits<32>, 5>,
     top_to_ram: RAM<Bits<32>, 5>,
+    /// Per thread: the entered object's root; the last answer to an object walk (or the
+    /// top-level walk's t_max and no hit, from its start), read at f1 and (the hit) for A.
+    entered_root: RAM<Bits<26>, 5>,
+    last_t: RAM<Bits<W>, 5>,
+    last_hit: RAM<Bits<1>, 5>,
+    last_hit_a: RAM<Bits<1>, 5>,
+    f1_answer: Signal<Local, Bit>,
+    f1_top_start: Signal<Local, Bit>,
+    f1_last_hit: Signal<Local, Bits<1>>,
+    f1_last_write: Signal<Local, Bit>,
+    f2_top_next: Signal<Local, Bit>,
+    f2_entered: Signal<Local, Bit>,
     stack_node: RAM<Bits<26>, 11>,
     stack_lo: RAM<Bits<W>, 11>,
     stack_hi: RAM<Bits<W>, 11>,
@@ -225,6 +242,7 @@ pub struct TraversalUnit<
     f5_pop: Signal<Local, Bits<6>>,
     /// The empty stack's depth of the walk's level (0, or `TOP_STACK_BASE`).
     f5_base: Signal<Local, Bits<6>>,
+    f5_root: Signal<Local, Bits<26>>,
     f1_leaf_address: Signal<Local, Bits<6>>,
     front_end: Signal<Local, Bit>,
     front_job: Signal<Local, Job>,
@@ -327,6 +345,9 @@ impl<
             engine_next: Default::default(),
             world_write: Default::default(),
             world_pair: Default::default(),
+            root_write: Default::default(),
+            root_thread: Default::default(),
+            root: Default::default(),
             top_from: Default::default(),
             top_to: Default::default(),
             entry_fifo: Default::default(),
@@ -346,6 +367,16 @@ impl<
             leaf_sp: Default::default(),
             top_from_ram: Default::default(),
             top_to_ram: Default::default(),
+            entered_root: Default::default(),
+            last_t: Default::default(),
+            last_hit: Default::default(),
+            last_hit_a: Default::default(),
+            f1_answer: Default::default(),
+            f1_top_start: Default::default(),
+            f1_last_hit: Default::default(),
+            f1_last_write: Default::default(),
+            f2_top_next: Default::default(),
+            f2_entered: Default::default(),
             stack_node: Default::default(),
             stack_lo: Default::default(),
             stack_hi: Default::default(),
@@ -398,6 +429,7 @@ impl<
             f2_pop: Default::default(),
             f5_pop: Default::default(),
             f5_base: Default::default(),
+            f5_root: Default::default(),
             f1_leaf_address: Default::default(),
             front_end: Default::default(),
             front_job: Default::default(),
@@ -510,6 +542,14 @@ impl<
         self.top_from_ram.write_clock.next = self.clock.val();
         self.top_to_ram.read_clock.next = self.clock.val();
         self.top_to_ram.write_clock.next = self.clock.val();
+        self.entered_root.read_clock.next = self.clock.val();
+        self.entered_root.write_clock.next = self.clock.val();
+        self.last_t.read_clock.next = self.clock.val();
+        self.last_t.write_clock.next = self.clock.val();
+        self.last_hit.read_clock.next = self.clock.val();
+        self.last_hit.write_clock.next = self.clock.val();
+        self.last_hit_a.read_clock.next = self.clock.val();
+        self.last_hit_a.write_clock.next = self.clock.val();
         self.stack_node.read_clock.next = self.clock.val();
         self.stack_node.write_clock.next = self.clock.val();
         self.stack_lo.read_clock.next = self.clock.val();
@@ -603,6 +643,27 @@ impl<
         self.leaf_hi.read_address.next = self.f1_leaf_address.val();
         self.leaf_sp.read_address.next = self.f1_leaf_address.val();
         self.ray.t_min_thread.next = self.f1_thread.q.val();
+        // The last answer: a tester's answer, or a top-level start's (t_max, no hit).
+        self.f1_answer.next = self.f1_next.q.val() & (!self.f1_top.q.val());
+        self.f1_top_start.next = (!self.f1_next.q.val()) & self.f1_top.q.val();
+        self.last_t.write_address.next = self.f1_thread.q.val();
+        self.last_hit.write_address.next = self.f1_thread.q.val();
+        self.last_hit_a.write_address.next = self.f1_thread.q.val();
+        self.last_t.write_data.next = self.f1_a.q.val().get_bits::<W>(0);
+        self.f1_last_hit.next = bit_cast::<1, 1>(self.f1_b.q.val().get_bit(0).into());
+        if self.f1_top_start.val() {
+            self.last_t.write_data.next = self.f1_b.q.val().get_bits::<W>(0);
+            self.f1_last_hit.next = 0.into();
+        }
+        self.last_hit.write_data.next = self.f1_last_hit.val();
+        self.last_hit_a.write_data.next = self.f1_last_hit.val();
+        self.f1_last_write.next =
+            self.f1_valid.q.val() & (self.f1_answer.val() | self.f1_top_start.val());
+        self.last_t.write_enable.next = self.f1_last_write.val();
+        self.last_hit.write_enable.next = self.f1_last_write.val();
+        self.last_hit_a.write_enable.next = self.f1_last_write.val();
+        self.last_t.read_address.next = self.f1_thread.q.val();
+        self.last_hit.read_address.next = self.f1_thread.q.val();
         self.f2_valid.d.next = self.f1_valid.q.val();
         self.f2_next.d.next = self.f1_next.q.val();
         self.f2_top.d.next = self.f1_top.q.val();
@@ -612,8 +673,16 @@ impl<
         // f2: the thread's leaf end, depth and t_min are here.
         self.f2_sp.next = self.leaf_sp.read_data.val();
         self.f2_pop.next = self.f2_sp.val() - 1;
+        // A top-level `next` goes on with the last answer; an entered object's start walks
+        // its root up to the last answer's t.
+        self.f2_top_next.next = self.f2_next.q.val() & self.f2_top.q.val();
+        self.f2_entered.next =
+            (!self.f2_next.q.val()) & (!self.f2_top.q.val()) & self.f2_a.q.val().get_bit(29);
         self.cmp_leaf.in_valid.next = true;
         self.cmp_leaf.a.next = self.f2_a.q.val().get_bits::<W>(0);
+        if self.f2_top_next.val() {
+            self.cmp_leaf.a.next = self.last_t.read_data.val();
+        }
         self.cmp_leaf.b.next = self.leaf_hi.read_data.val();
         self.stack_node.read_address.next =
             (bit_cast::<11, 5>(self.f2_thread.q.val()) << 6) | bit_cast::<11, 6>(self.f2_pop.val());
@@ -627,6 +696,13 @@ impl<
         self.f3_thread.d.next = self.f2_thread.q.val();
         self.f3_a.d.next = self.f2_a.q.val();
         self.f3_b.d.next = self.f2_b.q.val();
+        if self.f2_top_next.val() {
+            self.f3_a.d.next = bit_cast::<32, W>(self.last_t.read_data.val());
+            self.f3_b.d.next = bit_cast::<32, 1>(self.last_hit.read_data.val());
+        }
+        if self.f2_entered.val() {
+            self.f3_b.d.next = bit_cast::<32, W>(self.last_t.read_data.val());
+        }
         self.f3_sp.d.next = self.f2_sp.val();
         self.f3_t_min.d.next = self.ray.t_min.val();
         // f3: the popped entry is here.
@@ -657,6 +733,10 @@ impl<
         self.f5_hi.d.next = self.f4_hi.q.val();
         self.f5_in_leaf.d.next = self.cmp_leaf.le.val();
         self.any_hit.read_address.next = self.f4_thread.q.val();
+        self.entered_root.read_address.next = self.f4_thread.q.val();
+        self.entered_root.write_address.next = self.root_thread.val();
+        self.entered_root.write_data.next = self.root.val();
+        self.entered_root.write_enable.next = self.root_write.val();
         // f5: a start steps from the root (`a`) with [t_min, t_max = `b`]; a next ends the
         // walk when the hit lies in the leaf's segment, the walk answers any hit, the stack is
         // empty or the popped segment starts behind the hit, else steps from the popped entry.
@@ -679,11 +759,15 @@ impl<
             | (bit_cast::<103, 26>(self.f5_node.q.val()) << 64)
             | (bit_cast::<103, W>(self.f5_lo.q.val()) << 32)
             | bit_cast::<103, W>(self.f5_hi.q.val());
+        self.f5_root.next = self.f5_a.q.val().get_bits::<26>(0);
+        if self.f5_a.q.val().get_bit(29) {
+            self.f5_root.next = self.entered_root.read_data.val();
+        }
         if !self.f5_next.q.val() {
             self.front_job.next = (bit_cast::<103, 1>(self.f5_top.q.val().into()) << 102)
                 | (bit_cast::<103, 5>(self.f5_thread.q.val()) << 96)
                 | (bit_cast::<103, 6>(self.f5_base.val()) << 90)
-                | (bit_cast::<103, 26>(self.f5_a.q.val().get_bits::<26>(0)) << 64)
+                | (bit_cast::<103, 26>(self.f5_root.val()) << 64)
                 | (bit_cast::<103, W>(self.f5_t_min.q.val()) << 32)
                 | bit_cast::<103, W>(self.f5_b.q.val().get_bits::<W>(0));
         }
@@ -802,12 +886,17 @@ impl<
             self.at_a.val() & self.a_leaf.val() & (!self.a_end.val()) & (!self.a_top.val());
         self.top_from_ram.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.top_to_ram.write_address.next = self.job.q.val().get_bits::<5>(96);
+        // What `kd.wait` gives: a top-level leaf's list, the top-level walk's end, or the hit
+        // flag of an object walk's last answer.
         self.top_from_ram.write_data.next = bit_cast::<32, 30>(self.w0.q.val().get_bits::<30>(0));
         if self.a_end.val() {
-            self.top_from_ram.write_data.next = self.c_walk_ended.val();
+            self.top_from_ram.write_data.next = bit_cast::<32, 1>(self.last_hit_a.read_data.val());
+            if self.a_top.val() {
+                self.top_from_ram.write_data.next = self.c_walk_ended.val();
+            }
         }
         self.top_to_ram.write_data.next = self.a_list_end.val();
-        self.top_from_ram.write_enable.next = self.a_top_leaf.val();
+        self.top_from_ram.write_enable.next = self.a_top_leaf.val() | self.a_end.val();
         self.top_to_ram.write_enable.next = self.a_top_leaf.val() & (!self.a_end.val());
         self.leaf_fifo.data_in.next = (bit_cast::<69, 5>(self.job.q.val().get_bits::<5>(96)) << 64)
             | (bit_cast::<69, 30>(self.w0.q.val().get_bits::<30>(0)) << 32)
@@ -827,6 +916,7 @@ impl<
         // Entries done: the unit's copy is read a clock ahead at the thread of the job coming
         // to A, the engine's at its own.
         self.done_u.read_address.next = self.next_a_thread.val();
+        self.last_hit_a.read_address.next = self.next_a_thread.val();
         self.done_u.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.done_e.write_data.next = self.done_u.read_data.val() + 1;
         self.done_u.write_data.next = self.done_u.read_data.val() + 1;
@@ -1169,16 +1259,18 @@ mod tests {
 
     /// rust-hdl simulation of top-level walks on the dynamic scene's trees (1,202 instances):
     /// eight threads write a world ray and an object ray, start a top-level walk (`KD_TOP`),
-    /// and at each top-level leaf the test reads the leaf (`top_from`, `top_to`), runs an
-    /// object walk of one instance's tree for the thread (the test plays the tester, answering
-    /// each object leaf with no hit in random clocks), then sends `next` with an answer (no
-    /// hit, or from a thread's second leaf on, one thread in two, a hit at a random distance).
-    /// Every top-level walk stops at `units::KdWalk`'s leaves on the world ray and ends where
-    /// it ends, and every object walk in between visits `KdWalk`'s leaves on the object ray:
-    /// the two walks keep their segments and stacks apart.
+    /// and at each top-level leaf the test reads the leaf (`top_from`, `top_to`), gives the
+    /// thread an entered root (`root_write`, as instance entry does) and starts an object walk
+    /// with `KD_ENTERED` (the test plays the tester, answering each object leaf in random
+    /// clocks with the thread's closest hit so far: none, or from its second top-level leaf
+    /// on, one thread in two, a hit at a random distance), checks `kd.wait`'s hit flag after
+    /// it, then sends `next`. Every top-level walk stops at `units::KdWalk`'s leaves on the
+    /// world ray, going on with the last answer, and ends where it ends; every object walk
+    /// visits `KdWalk`'s leaves on the object ray from the entered root up to the last
+    /// answer's t: the two walks keep their segments and stacks apart.
     #[test]
     fn rust_hdl_simulation_walks_the_top_level_between_object_walks() {
-        use crate::hw::program::isa::{KD_TOP, KD_WALK_ENDED};
+        use crate::hw::program::isa::{KD_ENTERED, KD_TOP, KD_WALK_ENDED};
         let f = Format::E7M16;
         let seed = 43;
         println!("seed {seed}");
@@ -1193,15 +1285,16 @@ mod tests {
         let mem_latency = 3;
         let threads = 8usize;
         let w = |x: f64| f.from_f64(x);
-        let random_ray = |rng: &mut rand_chacha::ChaCha8Rng, o: [u32; 3]| {
-            let d = [
-                w(rng.gen_range(-0.6..0.6)),
-                w(rng.gen_range(-0.8..-0.2)),
-                w(rng.gen_range(-1.0..-0.5)),
-            ];
-            (o, d)
-        };
-        let worlds: Vec<_> = (0..threads).map(|_| random_ray(&mut rng, eye)).collect();
+        let worlds: Vec<_> = (0..threads)
+            .map(|_| {
+                let d = [
+                    w(rng.gen_range(-0.6..0.6)),
+                    w(rng.gen_range(-0.8..-0.2)),
+                    w(rng.gen_range(-1.0..-0.5)),
+                ];
+                (eye, d)
+            })
+            .collect();
         // Object rays from near the object space's origin, through it.
         let objects: Vec<_> = (0..threads)
             .map(|_| {
@@ -1210,40 +1303,43 @@ mod tests {
                 (o, d)
             })
             .collect();
+        let t_max = f.infinity(false);
+        // The tester's closest hit during a thread's k-th top-level leaf (and after it).
         let answers: Vec<Vec<(u32, bool)>> = (0..threads)
             .map(|th| {
+                let mut t = 40.0;
                 (0..64)
                     .map(|k| {
                         if th % 2 == 1 && k >= 1 {
-                            (w(rng.gen_range(20.0..40.0)), true)
+                            t -= rng.gen_range(0.0..4.0);
+                            (w(t), true)
                         } else {
-                            (f.infinity(false), false)
+                            (t_max, false)
                         }
                     })
                     .collect()
             })
             .collect();
         let fetch = |n: u32| Ok(lay.node(n));
-        let t_max = f.infinity(false);
-        let no_hit = (t_max, false);
-        let object_leaves = |root: u32, ray| {
+        // An object walk up to `hi` whose every leaf is answered with `answer`.
+        let object_walk = |root: u32, ray, hi: u32, answer: (u32, bool)| {
             let levels = TOP_STACK_BASE;
-            let (mut walk, mut stop) =
-                KdWalk::start(f, ray, root, (0, t_max), levels, fetch).unwrap();
+            let (mut walk, mut stop) = KdWalk::start(f, ray, root, (0, hi), levels, fetch).unwrap();
             let mut stops = vec![stop];
             while stop != KdStop::Finished {
-                stop = walk.next(f, ray, no_hit, levels, fetch).unwrap();
+                stop = walk.next(f, ray, answer, levels, fetch).unwrap();
                 stops.push(stop);
             }
             stops
         };
-        // The object of the instance whose walk of the first object ray has the most leaves.
+        // The entered object: the instance's whose walk of the first object ray has the most
+        // leaves.
         let object_root = (0..lay.info.instance_count)
             .map(|i| {
                 let at = i * layout::INSTANCE_WORDS as u32 + layout::instance_word::ROOT as u32;
                 lay.word(layout::INSTANCES, at)
             })
-            .max_by_key(|&root| object_leaves(root, objects[0]).len())
+            .max_by_key(|&root| object_walk(root, objects[0], t_max, (t_max, false)).len())
             .unwrap();
         let top_want: Vec<Vec<KdStop>> = (0..threads)
             .map(|th| {
@@ -1259,18 +1355,26 @@ mod tests {
                 stops
             })
             .collect();
-        let object_want: Vec<Vec<KdStop>> = (0..threads)
-            .map(|th| object_leaves(object_root, objects[th]))
-            .collect();
+        // The object walk during top-level leaf k: up to the answer before it.
+        let object_want = |th: usize, k: usize| {
+            let hi = if k == 0 { t_max } else { answers[th][k - 1].0 };
+            object_walk(object_root, objects[th], hi, answers[th][k])
+        };
         let top_leaves: usize = top_want.iter().map(|s| s.len() - 1).sum();
         assert!(
             top_leaves > 3 * threads,
             "too few top-level leaves: {top_leaves}"
         );
-        let object_leaf_count: usize = object_want.iter().map(|s| s.len() - 1).sum();
+        let object_leaves: usize = (0..threads)
+            .map(|th| {
+                (0..top_want[th].len() - 1)
+                    .map(|k| object_want(th, k).len() - 1)
+                    .sum::<usize>()
+            })
+            .sum();
         assert!(
-            object_leaf_count >= 2 * threads,
-            "too few object leaves: {object_leaf_count}"
+            object_leaves >= 2 * top_leaves,
+            "too few object leaves: {object_leaves}"
         );
 
         let mut u = Unit::new(mem_latency);
@@ -1311,19 +1415,21 @@ mod tests {
         }
         let mut steps = vec![Step::StartTop; threads];
         let mut top_got: Vec<Vec<KdStop>> = vec![Vec::new(); threads];
-        /// The SRAM's requests, the object leaves taken (answered with no hit at a due clock),
-        /// the object walks' leaves.
+        /// The SRAM's requests, the object leaves taken (answered at a due clock with the
+        /// thread's answer), the object walks' leaves, each thread's current answer.
         struct Bench {
             requests: VecDeque<Option<u32>>,
             due: Vec<(u64, usize)>,
             clock: u64,
             object_got: Vec<Vec<KdStop>>,
+            answer: Vec<(u32, bool)>,
         }
         let mut b = Bench {
             requests: std::iter::repeat(None).take(mem_latency as usize).collect(),
             due: Vec::new(),
             clock: 0,
             object_got: vec![Vec::new(); threads],
+            answer: vec![(t_max, false); threads],
         };
         let mut th = 0;
         let tick = |u: &mut Unit, b: &mut Bench, rng: &mut rand_chacha::ChaCha8Rng, offer: bool| {
@@ -1335,8 +1441,8 @@ mod tests {
             if let Some(k) = answer {
                 let (_, th) = b.due.remove(k);
                 u.answer_thread.next = (th as u64).into();
-                u.answer_t.next = u64::from(t_max).into();
-                u.answer_hit.next = false;
+                u.answer_t.next = u64::from(b.answer[th].0).into();
+                u.answer_hit.next = b.answer[th].1;
             }
             u.leaf_take.next = false;
             settle(u);
@@ -1369,11 +1475,12 @@ mod tests {
             u.engine.enqueue.next = false;
             u.engine_next.next = false;
             tick(&mut u, &mut b, &mut rng, false);
-            // I5 of the thread presented at I4: its walk's state and top-level leaf.
+            // I5 of the thread presented at I4: its walk's state and what `kd.wait` gives.
             if !u.engine.pending.val() {
+                let from = u.top_from.val().to_u64() as u32;
+                let k = top_got[th].len();
                 match steps[th] {
                     Step::WaitTop => {
-                        let from = u.top_from.val().to_u64() as u32;
                         let to = u.top_to.val().to_u64() as u32;
                         if from == KD_WALK_ENDED {
                             top_got[th].push(KdStop::Finished);
@@ -1384,15 +1491,15 @@ mod tests {
                                 count: to - from,
                             });
                             b.object_got[th].clear();
+                            b.answer[th] = answers[th][k];
                             steps[th] = Step::StartObject;
                         }
                     }
                     Step::WaitObject => {
                         b.object_got[th].push(KdStop::Finished);
-                        assert_eq!(
-                            b.object_got[th], object_want[th],
-                            "thread {th}'s object walk"
-                        );
+                        let want = object_want(th, k - 1);
+                        assert_eq!(b.object_got[th], want, "thread {th}'s object walk {k}");
+                        assert_eq!(from, u32::from(b.answer[th].1), "thread {th}'s hit flag");
                         steps[th] = Step::Next;
                     }
                     _ => {}
@@ -1401,24 +1508,27 @@ mod tests {
             let offer = matches!(steps[th], Step::StartTop | Step::StartObject | Step::Next);
             u.engine.enqueue.next = offer;
             u.engine.thread.next = (th as u64).into();
+            // Words a start with a root of its own, or a `next`, must not read.
+            u.engine.word_a.next = u64::from(w(1.0)).into();
+            u.engine.word_b.next = 1.into();
             match steps[th] {
                 Step::StartTop => {
                     u.engine.word_a.next = (u64::from(top_root) | u64::from(KD_TOP)).into();
                     u.engine.word_b.next = u64::from(t_max).into();
                 }
                 Step::StartObject => {
-                    u.engine.word_a.next = u64::from(object_root).into();
-                    u.engine.word_b.next = u64::from(t_max).into();
+                    // Instance entry has given the thread's root by now.
+                    u.engine.word_a.next = u64::from(KD_ENTERED).into();
+                    u.root_write.next = true;
+                    u.root_thread.next = (th as u64).into();
+                    u.root.next = u64::from(object_root).into();
                 }
-                Step::Next => {
-                    let (t, hit) = answers[th][top_got[th].len() - 1];
-                    u.engine_next.next = true;
-                    u.engine.word_a.next = u64::from(t).into();
-                    u.engine.word_b.next = u64::from(hit).into();
-                }
+                Step::Next => u.engine_next.next = true,
                 _ => {}
             }
-            if tick(&mut u, &mut b, &mut rng, offer) && offer {
+            let taken = tick(&mut u, &mut b, &mut rng, offer);
+            u.root_write.next = false;
+            if taken && offer {
                 steps[th] = match steps[th] {
                     Step::StartObject => Step::WaitObject,
                     _ => Step::WaitTop,

@@ -1,21 +1,24 @@
-//! `InstanceRays`: instance entry in hardware. A `tri.enter` names an instance's record; the
-//! unit reads the record's world-to-object 3x4 from bank 4 on the engine's shared bus (in the
-//! clocks the engine's loads and the tester's list reads leave it free), sends the thread's
+//! `InstanceRays`: instance entry in hardware. A `tri.enter` names an instance; the unit reads
+//! its record's world-to-object 3x4 and object root from bank 4 on the engine's shared bus (in
+//! the clocks the engine's loads and the tester's list reads leave it free), gives the root to
+//! the traversal unit (the thread's next `kd.start` with `KD_ENTERED` walks it), sends the thread's
 //! world ray through the triangle tester's TransformUnit, the one transformation unit (the
 //! origin as a point, then the direction as a vector), and writes the object-space ray whole
 //! into the thread's ray in both coprocessors, which wakes the thread's `tri.wait`. Before,
-//! the microprogram did this in about 40 instructions per instance entered: 12 loads, 33
-//! floating-point operations and the three ray words.
+//! the microprogram did this in about 40 instructions per instance entered: 13 loads, the
+//! record's address, 33 floating-point operations and the three ray words.
 //!
 //! Contract (engine stages):
 //! - World ray (I5): `world_write` writes words `2 world_pair` and `2 world_pair + 1` of
 //!   thread `thread`'s world ray `o.x o.y o.z d.x d.y d.z` from `word_a` and `word_b`
 //!   (`tri.world`, three per trace in a scene with a top level).
-//! - Enter (I5): an `offer` of `record` (the record's word address in bank 4) for `thread`
-//!   is taken unless `refused` (the entry slot still holds the entry before; the thread
-//!   repeats its `tri.enter`); taking it marks the thread's ray pending.
+//! - Enter (I5): an `offer` of `instance_id` (its record at `instance * INSTANCE_WORDS` in bank
+//!   4) for `thread` is taken unless `refused` (the entry slot still holds the entry before;
+//!   the thread repeats its `tri.enter`); taking it marks the thread's ray pending.
 //! - Memory: `read` with `addr` (bank 4) only in a clock with `bus_free`; the word arrives on
-//!   `rdata` `mem_latency` clocks later. Twelve reads per entry.
+//!   `rdata` `mem_latency` clocks later. Thirteen reads per entry, the matrix's and the root.
+//! - Root: `root_write` with `root_thread` and `root` in the clock the root's word arrives
+//!   (before the ray: the thread waits for both, and its last walk is over).
 //! - Requests (`gen_*`, the tester's client port): the origin (`gen_point`) and then the
 //!   direction (`gen_direction`), each held until `gen_take`; results come back on `out_*`
 //!   (`out_direction` tells which), in request order, [`TRANSFORM_LATENCY`] clocks later.
@@ -26,16 +29,16 @@
 //!   own, and the unit gives one result per clock.
 //! - Answers: `query_thread` at I4; at I5 `pending` (the entered ray is not written yet).
 //!
-//! Latency: from the `tri.enter` at I5, 1 clock to start the entry, 12 reads (one per free
+//! Latency: from the `tri.enter` at I5, 1 clock to start the entry, 13 reads (one per free
 //! bus clock) and `mem_latency` for the last word, then the two requests and
-//! [`TRANSFORM_LATENCY`] (28) in the unit, and 1 to the write: about 45 clocks with
-//! `mem_latency` 2 and a free bus. Throughput: one entry per about `15 + mem_latency` clocks
+//! [`TRANSFORM_LATENCY`] (28) in the unit, and 1 to the write: about 46 clocks with
+//! `mem_latency` 2 and a free bus. Throughput: one entry per about `16 + mem_latency` clocks
 //! (the next entry's reads start while this one's requests are in the unit).
 //!
 //! Golden twin: [`units::transform`](crate::units::transform) of the world origin (a point)
-//! and direction (a vector) by the record's `instance_word::WORLD_TO_OBJECT` words, as the
-//! engine's twin (`hw::program::exec`, `tri.enter`) and the golden model's `enter_instance`
-//! compute them.
+//! and direction (a vector) by the record's `instance_word::WORLD_TO_OBJECT` words, and the
+//! record's `instance_word::ROOT`, as the engine's twin (`hw::program::exec`, `tri.enter`) and
+//! the golden model's `enter_instance` compute and read them.
 //!
 //! [`RayStore`]: crate::hw::ray_store::RayStore
 //! [`TRANSFORM_LATENCY`]: crate::hw::TRANSFORM_LATENCY
@@ -44,7 +47,7 @@ use rust_hdl::prelude::*;
 
 use crate::layout::instance_word;
 
-/// Words of a world-to-object matrix (3x4), read per entry.
+/// Words of a world-to-object matrix (3x4), read per entry, then the root's.
 const MATRIX_WORDS: u64 = 12;
 
 /// What the unit is doing with the entry it has begun.
@@ -52,7 +55,7 @@ const MATRIX_WORDS: u64 = 12;
 pub enum EntryPhase {
     /// No entry begun: the slot's entry, if any, begins.
     Idle,
-    /// Reading the matrix's twelve words.
+    /// Reading the matrix's twelve words and the root.
     Fetch,
     /// The origin's request waits for the unit; then the direction's.
     Origin,
@@ -69,12 +72,15 @@ pub struct InstanceRays<const W: usize> {
     pub word_b: Signal<In, Bits<32>>,
     pub thread: Signal<In, Bits<5>>,
     pub offer: Signal<In, Bit>,
-    pub record: Signal<In, Bits<24>>,
+    pub instance_id: Signal<In, Bits<24>>,
     pub refused: Signal<Out, Bit>,
     pub bus_free: Signal<In, Bit>,
     pub read: Signal<Out, Bit>,
     pub addr: Signal<Out, Bits<24>>,
     pub rdata: Signal<In, Bits<32>>,
+    pub root_write: Signal<Out, Bit>,
+    pub root_thread: Signal<Out, Bits<5>>,
+    pub root: Signal<Out, Bits<26>>,
     pub gen_valid: Signal<Out, Bit>,
     pub gen_m: [Signal<Out, Bits<W>>; 12],
     pub gen_v: [Signal<Out, Bits<W>>; 3],
@@ -96,12 +102,12 @@ pub struct InstanceRays<const W: usize> {
 
     /// Per thread, each word of its world ray.
     world: [RAM<Bits<W>, 5>; 6],
-    /// The entry slot: a thread's record that no entry has begun for yet.
+    /// The entry slot: a thread's instance that no entry has begun for yet.
     slot_valid: DFF<Bit>,
     slot_thread: DFF<Bits<5>>,
-    slot_record: DFF<Bits<24>>,
+    slot_instance: DFF<Bits<24>>,
     taken: Signal<Local, Bit>,
-    /// The entry begun: its thread and record, the matrix's words read and arrived, and the
+    /// The entry begun: its thread and matrix's address, the words read and arrived, and the
     /// reads in flight (bit k: a read k + 1 clocks ago).
     phase: DFF<EntryPhase>,
     entry_thread: DFF<Bits<5>>,
@@ -111,6 +117,7 @@ pub struct InstanceRays<const W: usize> {
     flight: DFF<Bits<8>>,
     reading: Signal<Local, Bit>,
     arrives: Signal<Local, Bit>,
+    root_arrives: Signal<Local, Bit>,
     /// The matrix, its words shifted in from the top as they arrive (word 0 ends in `matrix[0]`).
     matrix: [DFF<Bits<W>>; 12],
     /// The origin's result, until the direction's comes.
@@ -130,6 +137,8 @@ pub struct InstanceRays<const W: usize> {
     c_words: Constant<Bits<4>>,
     c_last_word: Constant<Bits<4>>,
     c_first_word: Constant<Bits<24>>,
+    /// The root's word after the matrix's first.
+    c_root_offset: Constant<Bits<24>>,
     c_ml_last: Constant<Bits<3>>,
 }
 
@@ -146,12 +155,15 @@ impl<const W: usize> InstanceRays<W> {
             word_b: Default::default(),
             thread: Default::default(),
             offer: Default::default(),
-            record: Default::default(),
+            instance_id: Default::default(),
             refused: Default::default(),
             bus_free: Default::default(),
             read: Default::default(),
             addr: Default::default(),
             rdata: Default::default(),
+            root_write: Default::default(),
+            root_thread: Default::default(),
+            root: Default::default(),
             gen_valid: Default::default(),
             gen_m: Default::default(),
             gen_v: Default::default(),
@@ -173,7 +185,7 @@ impl<const W: usize> InstanceRays<W> {
             world: Default::default(),
             slot_valid: Default::default(),
             slot_thread: Default::default(),
-            slot_record: Default::default(),
+            slot_instance: Default::default(),
             taken: Default::default(),
             phase: Default::default(),
             entry_thread: Default::default(),
@@ -183,6 +195,7 @@ impl<const W: usize> InstanceRays<W> {
             flight: Default::default(),
             reading: Default::default(),
             arrives: Default::default(),
+            root_arrives: Default::default(),
             matrix: Default::default(),
             origin: Default::default(),
             write_valid: Default::default(),
@@ -195,9 +208,12 @@ impl<const W: usize> InstanceRays<W> {
             pending_r: Default::default(),
             c_one: Constant::new(1u64.into()),
             c_pair: std::array::from_fn(|k| Constant::new((k as u64).into())),
-            c_words: Constant::new(MATRIX_WORDS.into()),
-            c_last_word: Constant::new((MATRIX_WORDS - 1).into()),
+            c_words: Constant::new((MATRIX_WORDS + 1).into()),
+            c_last_word: Constant::new(MATRIX_WORDS.into()),
             c_first_word: Constant::new((instance_word::WORLD_TO_OBJECT as u64).into()),
+            c_root_offset: Constant::new(
+                ((instance_word::ROOT - instance_word::WORLD_TO_OBJECT) as u64).into(),
+            ),
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
         }
     }
@@ -211,7 +227,7 @@ impl<const W: usize> Logic for InstanceRays<W> {
             clock,
             slot_valid,
             slot_thread,
-            slot_record,
+            slot_instance,
             phase,
             entry_thread,
             entry_record,
@@ -259,12 +275,15 @@ impl<const W: usize> Logic for InstanceRays<W> {
         if self.taken.val() {
             self.slot_valid.d.next = true;
             self.slot_thread.d.next = self.thread.val();
-            self.slot_record.d.next = self.record.val();
+            self.slot_instance.d.next = self.instance_id.val();
         }
         if (self.phase.q.val() == EntryPhase::Idle) & self.slot_valid.q.val() {
             self.slot_valid.d.next = false;
             self.entry_thread.d.next = self.slot_thread.q.val();
-            self.entry_record.d.next = self.slot_record.q.val() + self.c_first_word.val();
+            // `INSTANCE_WORDS` = 24 = 16 + 8.
+            self.entry_record.d.next = (self.slot_instance.q.val() << 4)
+                + (self.slot_instance.q.val() << 3)
+                + self.c_first_word.val();
             self.issued.d.next = 0.into();
             self.arrived.d.next = 0.into();
             self.phase.d.next = EntryPhase::Fetch;
@@ -276,22 +295,32 @@ impl<const W: usize> Logic for InstanceRays<W> {
             & self.bus_free.val();
         self.read.next = self.reading.val();
         self.addr.next = self.entry_record.q.val() + bit_cast::<24, 4>(self.issued.q.val());
+        if self.issued.q.val() == self.c_last_word.val() {
+            self.addr.next = self.entry_record.q.val() + self.c_root_offset.val();
+        }
         if self.reading.val() {
             self.issued.d.next = self.issued.q.val() + 1;
         }
         self.flight.d.next =
             (self.flight.q.val() << 1) | bit_cast::<8, 1>(self.reading.val().into());
         self.arrives.next = self.flight.q.val().get_bit(self.c_ml_last.val().index());
-        if self.arrives.val() {
+        self.root_arrives.next =
+            self.arrives.val() & (self.arrived.q.val() == self.c_last_word.val());
+        if self.arrives.val() & (!self.root_arrives.val()) {
             for k in 0..11 {
                 self.matrix[k].d.next = self.matrix[k + 1].q.val();
             }
             self.matrix[11].d.next = self.rdata.val().get_bits::<W>(0);
-            self.arrived.d.next = self.arrived.q.val() + 1;
-            if self.arrived.q.val() == self.c_last_word.val() {
-                self.phase.d.next = EntryPhase::Origin;
-            }
         }
+        if self.arrives.val() {
+            self.arrived.d.next = self.arrived.q.val() + 1;
+        }
+        if self.root_arrives.val() {
+            self.phase.d.next = EntryPhase::Origin;
+        }
+        self.root_write.next = self.root_arrives.val();
+        self.root_thread.next = self.entry_thread.q.val();
+        self.root.next = self.rdata.val().get_bits::<26>(0);
 
         // The requests: the origin as a point, then the direction as a vector.
         self.gen_valid.next = (self.phase.q.val() == EntryPhase::Origin)
@@ -369,22 +398,29 @@ mod tests {
     use std::collections::VecDeque;
 
     /// InstanceRays in rust-hdl simulation, with threads writing world rays and entering
-    /// instances at random, a bank 4 of random matrices behind a bus that is free in random
+    /// instances at random, a bank 4 of random records behind a bus that is free in random
     /// clocks (SRAM latency 3), and a model of the tester's TransformUnit that takes a request
     /// in a random clock and returns `units::transform` of its words 28 clocks later. Asserts:
     /// every entry's ray is written whole, once, for its thread, and is `units::transform` of
     /// the thread's world origin (a point) and direction (a vector) by the record's
-    /// world-to-object words; `done_mask` is the written thread's bit; `pending` is high from
-    /// the `tri.enter` until the write; a full slot refuses; reads go out only in free clocks,
-    /// twelve per entry, each in its record.
+    /// world-to-object words; the record's root goes to the thread before its ray;
+    /// `done_mask` is the written thread's bit; `pending` is high from the `tri.enter` until
+    /// the write; a full slot refuses; reads go out only in free clocks, thirteen per entry.
     #[test]
     fn every_entry_gets_its_object_ray_through_the_shared_unit() {
         let f = Format::E7M16;
         let mem_latency = 3;
         let records = 16;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(35);
+        // Random floats, and random roots in each record's root word.
         let bank: Vec<u32> = (0..records * INSTANCE_WORDS)
-            .map(|_| f.from_f64(rng.gen_range(-2.0..2.0)))
+            .map(|k| {
+                if k % INSTANCE_WORDS == instance_word::ROOT {
+                    rng.gen_range(0..1 << 26)
+                } else {
+                    f.from_f64(rng.gen_range(-2.0..2.0))
+                }
+            })
             .collect();
         let mut u = InstanceRays::<24>::new(mem_latency);
         u.connect_all();
@@ -395,8 +431,10 @@ mod tests {
         u.frame_start.next = false;
 
         let mut world = [[0u32; 6]; 32];
-        // Per thread: the ray its entry must write.
+        // Per thread: the ray its entry must write, and the root before it.
         let mut entered: [Option<([u32; 3], [u32; 3])>; 32] = [None; 32];
+        let mut roots: [Option<u32>; 32] = [None; 32];
+        let mut roots_written = 0;
         let mut memory: VecDeque<Option<u32>> = vec![None; mem_latency as usize].into();
         let mut in_unit: VecDeque<Option<(u32, bool, [u32; 3])>> = vec![None; 28].into();
         let (mut offers, mut refused, mut written, mut reads) = (0, 0, 0, 0);
@@ -420,14 +458,15 @@ mod tests {
             };
             let words = [0, 1].map(|_| f.from_f64(rng.gen_range(-3.0..3.0)));
             let thread = if clock < 96 { clock as u32 / 3 } else { thread };
-            let record = rng.gen_range(0..records) * INSTANCE_WORDS;
+            let instance = rng.gen_range(0..records);
+            let record = instance * INSTANCE_WORDS;
             u.thread.next = u64::from(thread).into();
             u.world_write.next = write;
             u.world_pair.next = (pair as u64).into();
             u.word_a.next = u64::from(words[0]).into();
             u.word_b.next = u64::from(words[1]).into();
             u.offer.next = offer;
-            u.record.next = (record as u64).into();
+            u.instance_id.next = (instance as u64).into();
             u.bus_free.next = rng.gen_bool(0.6);
             u.rdata.next = u64::from(memory.pop_front().unwrap().unwrap_or(0xdead)).into();
             u.gen_take.next = rng.gen_bool(0.5);
@@ -462,6 +501,7 @@ mod tests {
                         units::transform(f, &m, [ox, oy, oz], true),
                         units::transform(f, &m, [dx, dy, dz], false),
                     ));
+                    roots[t] = Some(bank[record + instance_word::ROOT]);
                 }
             }
             assert!(u.bus_free.val() || !u.read.val(), "a read on a busy bus");
@@ -480,8 +520,15 @@ mod tests {
                 let result = units::transform(f, &m, v, u.gen_point.val());
                 (t, u.gen_direction.val(), result)
             }));
+            if u.root_write.val() {
+                let t = u.root_thread.val().to_u64() as usize;
+                let root = roots[t].take().expect("one root for a thread that entered");
+                assert_eq!(u.root.val().to_u64(), u64::from(root), "thread {t}'s root");
+                roots_written += 1;
+            }
             if u.ray_write.val() {
                 let t = u.ray_thread.val().to_u64() as usize;
+                assert!(roots[t].is_none(), "thread {t}'s ray before its root");
                 let (o, d) = entered[t].take().expect("a ray for a thread that entered");
                 let o_got: [u32; 3] = std::array::from_fn(|k| u.ray_o[k].val().to_u64() as u32);
                 let d_got: [u32; 3] = std::array::from_fn(|k| u.ray_d[k].val().to_u64() as u32);
@@ -496,9 +543,10 @@ mod tests {
         }
         let left = entered.iter().filter(|e| e.is_some()).count();
         assert!(left <= 3, "{left} entries unfinished");
-        assert!(written > 200, "entries written: {written}");
+        assert!(written > 150, "entries written: {written}");
+        assert!((written..=written + left).contains(&roots_written));
         assert!(
-            (12 * written..=12 * (written + left)).contains(&reads),
+            (13 * written..=13 * (written + left)).contains(&reads),
             "{reads} reads for {written} entries written and {left} begun"
         );
         assert!(

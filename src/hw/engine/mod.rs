@@ -676,7 +676,7 @@ impl<
         self.instances.word_a.next = self.decode.a.val();
         self.instances.word_b.next = self.decode.b.val();
         self.instances.offer.next = self.enter_offer.q.val();
-        self.instances.record.next = self.decode.a.val().get_bits::<24>(0);
+        self.instances.instance_id.next = self.decode.a.val().get_bits::<24>(0);
 
         // Scratch memory.
         self.scratch.read_address.next = (bit_cast::<12, 5>(self.decode.thread.val()) << 7)
@@ -889,6 +889,9 @@ impl<
         self.traversal_unit.engine.enqueue.next = self.kd_enqueue.q.val();
         self.traversal_unit.engine_next.next = self.kd_next.q.val();
         self.traversal_unit.world_write.next = self.world_write.q.val();
+        self.traversal_unit.root_write.next = self.instances.root_write.val();
+        self.traversal_unit.root_thread.next = self.instances.root_thread.val();
+        self.traversal_unit.root.next = self.instances.root.val();
         self.traversal_unit.world_pair.next = self.decode.shift.val().get_bits::<2>(0);
         self.kd_busy.next = false;
         if self.kd_queues.q.val() {

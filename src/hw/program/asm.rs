@@ -436,11 +436,11 @@ impl Asm {
         });
     }
 
-    /// Enters the instance whose record starts at `record` (bank 4): the world ray in its
-    /// object space becomes the thread's ray in both coprocessors (repeated while refused;
-    /// a `tri.wait` waits for the ray).
-    pub fn tri_enter(&self, record: Reg) {
-        self.coprocessor(Op::Tri, TriFn::Enter as u32, Reg::ZERO, record, Reg::ZERO);
+    /// Enters `instance`: the world ray in its object space becomes the thread's ray in both
+    /// coprocessors, its object root the root of the next `kd.start` with `KD_ENTERED`
+    /// (repeated while refused; a `tri.wait` waits for both).
+    pub fn tri_enter(&self, instance: Reg) {
+        self.coprocessor(Op::Tri, TriFn::Enter as u32, Reg::ZERO, instance, Reg::ZERO);
     }
 
     /// Waits until the thread's queued entries are done; `dst` = the best t.
@@ -481,14 +481,15 @@ impl Asm {
     }
 
     /// Waits for the traversal unit's walk to end or (a top-level walk) to reach a leaf;
-    /// `dst` = that leaf's list address or `isa::KD_WALK_ENDED`.
+    /// `dst` = the query's hit flag after an object walk, the leaf's list address or
+    /// `isa::KD_WALK_ENDED` after a top-level walk.
     pub fn kd_wait(&self, dst: Reg) {
         self.coprocessor(Op::Kd, KdFn::Wait as u32, dst, Reg::ZERO, Reg::ZERO);
     }
 
-    /// Offers `kd.next best_t, hit`: the top-level walk goes on after its leaf.
-    pub fn kd_next(&self, best_t: Reg, hit: Reg) {
-        self.coprocessor(Op::Kd, KdFn::Next as u32, Reg::ZERO, best_t, hit);
+    /// Offers `kd.next`: the top-level walk goes on after its leaf.
+    pub fn kd_next(&self) {
+        self.coprocessor(Op::Kd, KdFn::Next as u32, Reg::ZERO, Reg::ZERO, Reg::ZERO);
     }
 
     /// `dst` = the top-level leaf's list end.

@@ -17,13 +17,15 @@
 //! the pixels and primary rays of [`crate::hw::engine::PrimaryRays`]); `kd` stands for the
 //! [`crate::hw::TraversalUnit`]'s walk and `tri` for the [`crate::hw::TriangleTester`].
 
-use super::isa::{Instr, KdFn, Op, TriFn, Unit, KD_ANY_HIT, KD_TOP, KD_WALK_ENDED, REGISTERS};
+use super::isa::{
+    Instr, KdFn, Op, TriFn, Unit, KD_ANY_HIT, KD_ENTERED, KD_TOP, KD_WALK_ENDED, REGISTERS,
+};
 use super::Program;
 use crate::fp::Format;
 use crate::hw::engine::CAMERA_WORDS;
 use crate::hw::traversal_unit::{STACK_LEVELS, TOP_STACK_BASE, TOP_STACK_LEVELS};
 use crate::layout::{
-    instance_word, Layout, Node, INSTANCES, LISTS, NODES, NODE_WORDS, TRIANGLES_B,
+    instance_word, Layout, Node, INSTANCES, INSTANCE_WORDS, LISTS, NODES, NODE_WORDS, TRIANGLES_B,
     TRIANGLE_BANK_WORDS,
 };
 use crate::units::{self, Mailbox};
@@ -98,10 +100,15 @@ struct Thread {
     /// The world ray's words (`tri.world`), which `tri.enter` and the top-level walk
     /// transform and walk.
     world: [u32; 6],
-    /// The top-level walk (`kd.start` with `KD_TOP`), stopped at its leaf, and what `kd.wait`
-    /// and `kd.leaf` read of that leaf: its list's start (or `KD_WALK_ENDED`) and end.
+    /// The top-level walk (`kd.start` with `KD_TOP`), stopped at its leaf; what `kd.wait` and
+    /// `kd.leaf` read (the top-level leaf's list start, or `KD_WALK_ENDED`, and end; after an
+    /// object walk, the hit flag); the object root of the last `tri.enter`; the tester's
+    /// last answer to an object walk (best t, hit), which `kd.next` and an entered object's
+    /// walk go on with.
     top_walk: units::KdWalk,
-    top_leaf: [u32; 2],
+    walk_words: [u32; 2],
+    entered_root: u32,
+    last_answer: (u32, bool),
     halted: bool,
 }
 
@@ -117,7 +124,9 @@ impl Thread {
             primary_d: [0; 3],
             world: [0; 6],
             top_walk: units::KdWalk::default(),
-            top_leaf: [0; 2],
+            walk_words: [0; 2],
+            entered_root: 0,
+            last_answer: (0, false),
             halted: false,
         }
     }
@@ -394,21 +403,21 @@ impl<'a> Machine<'a> {
                     }
                     TriFn::Enter => {
                         // `hw::engine::InstanceRays`: origin, then direction, through the
-                        // TransformUnit (its twin, `units::transform`).
+                        // TransformUnit (its twin, `units::transform`), and the object root.
                         let bank = &self.layout.banks[INSTANCES];
-                        let at = a as usize + instance_word::WORLD_TO_OBJECT;
-                        let m: units::Mat34W = bank
-                            .get(at..at + 12)
-                            .and_then(|w| w.try_into().ok())
-                            .ok_or_else(|| {
-                                fail(format!(
-                                    "instance record {a} beyond the instance bank's {} words",
-                                    bank.len()
-                                ))
-                            })?;
+                        let record = a as usize * INSTANCE_WORDS;
+                        let words = bank.get(record..record + INSTANCE_WORDS).ok_or_else(|| {
+                            fail(format!(
+                                "instance {a} beyond the instance bank's {} words",
+                                bank.len()
+                            ))
+                        })?;
+                        let at = instance_word::WORLD_TO_OBJECT;
+                        let m: units::Mat34W = words[at..at + 12].try_into().unwrap();
                         let (o, d) = t.world.split_at(3);
                         tt.o = units::transform(f, &m, o.try_into().unwrap(), true);
                         tt.d = units::transform(f, &m, d.try_into().unwrap(), false);
+                        t.entered_root = words[instance_word::ROOT];
                     }
                 }
                 // The twin's queue never refuses and its tests are done at once, so the
@@ -422,7 +431,7 @@ impl<'a> Machine<'a> {
                     nodes.set(nodes.get() + 1);
                     self.kd_node(n)
                 };
-                let root = a & !(KD_ANY_HIT | KD_TOP);
+                let root = a & !(KD_ANY_HIT | KD_TOP | KD_ENTERED);
                 let world = (
                     t.world[..3].try_into().unwrap(),
                     t.world[3..].try_into().unwrap(),
@@ -430,12 +439,13 @@ impl<'a> Machine<'a> {
                 // The unit's top-level walk stops at a leaf or its end.
                 let top_stop = |t: &mut Thread, stop| match stop {
                     units::KdStop::Leaf { list, count } => {
-                        t.top_leaf = [list, list.wrapping_add(count)];
+                        t.walk_words = [list, list.wrapping_add(count)];
                     }
-                    units::KdStop::Finished => t.top_leaf[0] = KD_WALK_ENDED,
+                    units::KdStop::Finished => t.walk_words[0] = KD_WALK_ENDED,
                 };
                 match function {
                     KdFn::Start if a & KD_TOP != 0 => {
+                        t.last_answer = (b, false);
                         let segment = (t.tester.t_min, b);
                         let (walk, stop) =
                             units::KdWalk::start(f, world, root, segment, TOP_STACK_LEVELS, fetch)
@@ -452,34 +462,40 @@ impl<'a> Machine<'a> {
                         } else {
                             STACK_LEVELS
                         };
+                        let (root, t_max) = if a & KD_ENTERED != 0 {
+                            (t.entered_root, t.last_answer.0)
+                        } else {
+                            (root, b)
+                        };
                         let tt = &mut t.tester;
                         let ray = (tt.o, tt.d);
                         let any_hit = a & KD_ANY_HIT != 0;
                         let (mut walk, mut stop) =
-                            units::KdWalk::start(f, ray, root, (tt.t_min, b), levels, fetch)
+                            units::KdWalk::start(f, ray, root, (tt.t_min, t_max), levels, fetch)
                                 .map_err(fail)?;
                         while let units::KdStop::Leaf { list, count } = stop {
                             self.test_list(tt, list, list.wrapping_add(count), stats)
                                 .map_err(fail)?;
+                            t.last_answer = (tt.best_t, tt.hit);
                             stop = if any_hit && tt.hit {
                                 units::KdStop::Finished
                             } else {
-                                walk.next(f, ray, (tt.best_t, tt.hit), levels, fetch)
+                                walk.next(f, ray, t.last_answer, levels, fetch)
                                     .map_err(fail)?
                             };
                         }
+                        t.walk_words[0] = u32::from(t.last_answer.1);
                     }
                     KdFn::Next => {
-                        let answer = (a, b & 1 != 0);
                         let stop = t
                             .top_walk
-                            .next(f, world, answer, TOP_STACK_LEVELS, fetch)
+                            .next(f, world, t.last_answer, TOP_STACK_LEVELS, fetch)
                             .map_err(fail)?;
                         top_stop(t, stop);
                     }
                     // The twin's walk has stopped when it starts, so `wait` never waits.
-                    KdFn::Wait => result = Some(t.top_leaf[0]),
-                    KdFn::Leaf => result = Some(t.top_leaf[1]),
+                    KdFn::Wait => result = Some(t.walk_words[0]),
+                    KdFn::Leaf => result = Some(t.walk_words[1]),
                 }
                 stats.kd_nodes += nodes.get();
             }

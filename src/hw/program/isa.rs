@@ -127,16 +127,21 @@ pub enum Op {
 pub enum KdFn {
     /// Walk from root `A` (bits 25..0) with the segment `[t_min, B]` (t_min from the tester's
     /// init). An object walk ([`KD_ANY_HIT`] for one that ends at the first hit) hands each
-    /// leaf's list to the triangle tester and goes on with its closest hit, to the walk's end.
-    /// A top-level walk ([`KD_TOP`]) walks the world ray (`tri.world`) and stops at each leaf
-    /// until the thread says `next`.
+    /// leaf's list to the triangle tester and goes on with its closest hit, to the walk's end;
+    /// with [`KD_ENTERED`] its root is the object root of the thread's last `tri.enter` and its
+    /// segment ends at the closest hit so far (the tester's last answer, or the top-level
+    /// walk's t_max before any). A top-level walk ([`KD_TOP`]) walks the world ray
+    /// (`tri.world`) and stops at each leaf until the thread says `next`.
     Start = 0,
     /// Repeat while the walk is in flight (asleep); the closest hit is the tester's. `dst` =
-    /// the top-level walk's leaf: its list's first bank-1 address, or [`KD_WALK_ENDED`].
+    /// after an object walk, the query's hit flag (1 when some test hit so far, else 0);
+    /// after a top-level walk's stop, its leaf's list's first bank-1 address, or
+    /// [`KD_WALK_ENDED`].
     Wait,
-    /// The top-level walk goes on after its leaf with the closest hit so far: best t `A`,
-    /// hit flag `B` (0 or 1); it ends when the hit lies in the leaf's segment, the stack is
-    /// empty or the popped segment starts behind the hit (`units::KdWalk::next`).
+    /// The top-level walk goes on after its leaf with the closest hit so far (the tester's
+    /// last answer to an object walk of the thread, or none): it ends when the hit lies in the
+    /// leaf's segment, the stack is empty or the popped segment starts behind the hit
+    /// (`units::KdWalk::next`).
     Next,
     /// `dst` = the top-level leaf's list end (after a `wait` that gave a leaf).
     Leaf,
@@ -146,6 +151,9 @@ pub enum KdFn {
 pub const KD_ANY_HIT: u32 = 1 << 31;
 /// Bit 30 of `kd.start`'s root: the walk is of the top-level tree.
 pub const KD_TOP: u32 = 1 << 30;
+/// Bit 29 of `kd.start`'s root: the walk is of the object the thread entered last
+/// (`tri.enter`), up to the closest hit so far.
+pub const KD_ENTERED: u32 = 1 << 29;
 /// `kd.wait`'s result when the top-level walk has ended.
 pub const KD_WALK_ENDED: u32 = 1 << 31;
 
@@ -200,9 +208,11 @@ pub enum TriFn {
     /// pair `s` (the shift field, 0..3, the ray words' pairs: `o.x o.y`, `o.z d.x`, `d.y d.z`)
     /// = `A`, `B`.
     World,
-    /// Enter instance record `A` (its word address in bank 4): the thread's world ray through
-    /// the record's world-to-object 3x4 (`units::transform`, origin then direction) becomes
-    /// its ray in both coprocessors; the next `wait` waits for it. Repeats while refused.
+    /// Enter instance `A` (its record at `A * INSTANCE_WORDS` in bank 4): the thread's world
+    /// ray through the record's world-to-object 3x4 (`units::transform`, origin then
+    /// direction) becomes its ray in both coprocessors, and the record's object root the
+    /// root of its next `kd.start` with [`KD_ENTERED`]; the next `wait` waits for both.
+    /// Repeats while refused.
     Enter,
 }
 

@@ -393,4 +393,13 @@ impl Gen<'_> {
         a.section("raygen");
         a.halt();
     }
+
+    /// `instance * INSTANCE_WORDS` (24 = 16 + 8).
+    fn instance_record(&self, instance: Reg) -> Val {
+        let a = self.asm;
+        debug_assert_eq!(crate::layout::INSTANCE_WORDS, 24);
+        let x16 = a.op(Op::Shl, instance.into(), Val::K(4));
+        let x8 = a.op(Op::Shl, instance.into(), Val::K(3));
+        a.op(Op::Add, x16, x8)
+    }
 }

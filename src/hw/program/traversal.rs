@@ -18,19 +18,21 @@
 //! and waits for the ray), walks the object, and sends the closest hit back (`kd.next`), with
 //! which the unit ends the walk or pops its top-level stack, as `units::KdWalk` does.
 //!
-//! Cost (instructions = engine turns): per object walk 4 (start, wait, the closest hit's t
-//! and flag), whatever its leaves; a waiting thread sleeps until the walk ends (the tree's
-//! nodes and the leaves' triangles cost it no instruction); per top-level leaf 5 (the wait,
-//! the list's end, the end check, `kd.next` and the loop's jump) and no instruction per
-//! top-level inner node; per instance about 17 (the list and the mailbox, the record's
-//! address, `tri.enter`, the root, `tri.object`, the wait and the walk); 3 per trace for the
-//! world ray and 2 for the top-level walk's start.
+//! Cost (instructions = engine turns): per object walk 2 or 3 (start, wait with the hit flag,
+//! and the closest hit's t without a top level), whatever its leaves; a waiting thread sleeps
+//! until the walk ends (the tree's nodes and the leaves' triangles cost it no instruction);
+//! per top-level leaf 5 (the wait, the list's end, the end check, `kd.next` and the loop's
+//! jump) and no instruction per top-level inner node; per instance entered 10 (the list and
+//! the mailbox, `tri.enter` with the instance, `tri.object`, the wait, the walk from the root
+//! the entry found, up to the closest hit the unit keeps, the loop) and 4 per instance the
+//! mailbox skips; per trace 3 for the world ray, 2 for the top-level walk's start and 1 for
+//! the closest hit's t.
 
 use super::asm::Asm;
 use super::asm::{Label, Reg, Val};
-use super::isa::{Op, TriFn, KD_TOP, KD_WALK_ENDED, MAILBOX_INSTANCES};
+use super::isa::{Op, TriFn, KD_ENTERED, KD_TOP, KD_WALK_ENDED, MAILBOX_INSTANCES};
 use super::Gen;
-use crate::layout::{instance_word as iw, INSTANCES, LISTS};
+use crate::layout::LISTS;
 
 /// Gives the triangle tester and the traversal unit the ray of the one object (object 0,
 /// whose mailbox the query's init emptied).
@@ -62,8 +64,6 @@ impl Gen<'_> {
         }
         match self.c.top_root {
             Some(root) => {
-                // The closest hit so far bounds every instance's walk.
-                a.mov(s.best_t, s.q_t_max.into());
                 // The world ray that the top-level walk and instance entry transform.
                 for (pair, [x, y]) in [
                     [world.0[0], world.0[1]],
@@ -84,12 +84,18 @@ impl Gen<'_> {
                 if routine {
                     tester_ray(a, world.0, world.1);
                 }
-                self.walk_object(Val::K(self.c.object_root), s.q_t_max, done);
+                let from = self.walk_root(Val::K(self.c.object_root));
+                self.walk_object(from, s.q_t_max, done);
+                self.free_root(from);
+                a.section("intersect");
+                a.tri_wait(s.best_t);
             }
         }
         a.bind(done);
         a.section("trace");
         if self.c.top_root.is_some() {
+            // The instances' walks leave the closest hit in the tester.
+            a.tri_wait(s.best_t);
             a.tri_read(TriFn::Instance, s.best_instance);
         }
         a.tri_read(TriFn::Triangle, s.best_triangle);
@@ -98,29 +104,31 @@ impl Gen<'_> {
         }
     }
 
-    /// An object's kd tree, walked by the traversal unit from `root`, which hands each leaf's
-    /// triangles to the triangle tester and goes on with its closest hit by itself; the
-    /// thread sleeps until the walk ends and reads the hit. An answered any-hit query jumps to
-    /// `answered`. `t_max` bounds the walk's segment.
-    fn walk_object(&self, root: Val, t_max: Reg, answered: Label) {
+    /// The word `kd.start` walks an object with: `root` (a node, or `KD_ENTERED`), and for a
+    /// shadow query (`q_any` is `KD_ANY_HIT` or 0) the flag that ends it at its first hit.
+    fn walk_root(&self, root: Val) -> Reg {
         let a = self.asm;
         let s = &self.s;
-        a.section("traversal");
-        // A shadow query's walk ends at its first hit (`q_any` is `KD_ANY_HIT` or 0).
-        let from = match (root, self.c.shadows) {
+        match (root, self.c.shadows) {
             (Val::K(0), false) => Reg::ZERO,
             (Val::K(0), true) => s.q_any,
             (Val::R(r), false) => r,
             (root, true) => a.keep(a.op(Op::Or, s.q_any.into(), root)),
             (k, false) => a.keep(k),
-        };
-        a.kd_start(from, t_max);
-        a.kd_wait(Reg::ZERO);
-        a.section("intersect");
-        a.tri_wait(s.best_t);
-        if !self.hit_by_t() {
-            a.tri_read(TriFn::Hit, s.hit);
         }
+    }
+
+    /// An object's kd tree, walked by the traversal unit from `from` (see `walk_root`), which
+    /// hands each leaf's triangles to the triangle tester and goes on with its closest hit by
+    /// itself; the thread sleeps until the walk ends and reads the hit flag. An answered
+    /// any-hit query jumps to `answered`. `t_max` bounds the walk's segment (but for an
+    /// entered object's, which the closest hit so far bounds).
+    fn walk_object(&self, from: Reg, t_max: Reg, answered: Label) {
+        let a = self.asm;
+        let s = &self.s;
+        a.section("traversal");
+        a.kd_start(from, t_max);
+        a.kd_wait(if self.hit_by_t() { Reg::ZERO } else { s.hit });
         if self.c.shadows {
             // A shadow query is answered by any hit.
             let closest = a.label();
@@ -128,8 +136,12 @@ impl Gen<'_> {
             a.branch(Op::Beq, s.q_any.into(), Val::K(0), true, answered);
             a.bind(closest);
         }
-        if from != Reg::ZERO && from != s.q_any && Val::R(from) != root {
-            a.free(from);
+    }
+
+    /// Frees a register `walk_root` kept.
+    fn free_root(&self, from: Reg) {
+        if from != Reg::ZERO && from != self.s.q_any {
+            self.asm.free(from);
         }
     }
 
@@ -141,28 +153,31 @@ impl Gen<'_> {
         let s = &self.s;
         a.section("traversal");
         let [list, end] = a.regs::<2>();
-        let from = a.keep(Val::K(root | KD_TOP));
-        a.kd_start(from, s.best_t);
-        a.free(from);
+        let top = a.keep(Val::K(root | KD_TOP));
+        a.kd_start(top, s.q_t_max);
+        a.free(top);
+        // Every instance's walk starts from the root of the instance entered last.
+        let entered = self.walk_root(Val::K(KD_ENTERED));
         let (leaf, finished) = (a.label(), a.label());
         a.bind(leaf);
         a.section("traversal");
         a.kd_wait(list);
         a.branch(Op::Beq, list.into(), Val::K(KD_WALK_ENDED), false, finished);
         a.kd_leaf(end);
-        self.instance_list(list, end, answered);
+        self.instance_list(list, end, entered, answered);
         a.section("traversal");
-        a.kd_next(s.best_t, s.hit);
+        a.kd_next();
         a.jump(leaf);
         a.bind(finished);
         a.free(list);
         a.free(end);
+        self.free_root(entered);
     }
 
-    /// The instances of a top-level leaf, `list..end` in bank 1 (`list` moves on to `end`).
-    fn instance_list(&self, list: Reg, end: Reg, answered: Label) {
+    /// The instances of a top-level leaf, `list..end` in bank 1 (`list` moves on to `end`),
+    /// each walked with `kd.start entered` (`walk_root` of `KD_ENTERED`).
+    fn instance_list(&self, list: Reg, end: Reg, entered: Reg, answered: Label) {
         let a = self.asm;
-        let s = &self.s;
         a.section("instances");
         let (p, instance) = (list, a.reg());
         let (next, done) = (a.label(), a.label());
@@ -173,26 +188,14 @@ impl Gen<'_> {
         a.op_to(Op::Add, p, p.into(), Val::K(1));
         a.mailbox_check(MAILBOX_INSTANCES, instance, next);
         // Instance entry (`hw::engine::InstanceRays`): the world ray in the instance's object
-        // space becomes the thread's ray in both coprocessors; the wait waits for it.
-        let record = a.keep(self.instance_record(instance));
-        a.tri_enter(record);
-        let root = a.keep(a.load(INSTANCES, record.into(), 0, iw::ROOT as u32));
-        a.free(record);
+        // space becomes the thread's ray in both coprocessors, its object's root the walk's;
+        // the wait waits for both.
+        a.tri_enter(instance);
         a.tri_queue(TriFn::Object, instance, Reg::ZERO);
         a.tri_wait(Reg::ZERO);
-        self.walk_object(root.into(), s.best_t, answered);
-        a.free(root);
+        self.walk_object(entered, Reg::ZERO, answered);
         a.jump(next);
         a.bind(done);
         a.free(instance);
-    }
-
-    /// `instance * INSTANCE_WORDS` (24 = 16 + 8).
-    pub(super) fn instance_record(&self, instance: Reg) -> Val {
-        let a = self.asm;
-        debug_assert_eq!(crate::layout::INSTANCE_WORDS, 24);
-        let x16 = a.op(Op::Shl, instance.into(), Val::K(4));
-        let x8 = a.op(Op::Shl, instance.into(), Val::K(3));
-        a.op(Op::Add, x16, x8)
     }
 }

@@ -1095,7 +1095,7 @@ struct InstanceRaysBench<
     pub word_b: Signal<In, Bits<32>>,
     pub enter: Signal<In, Bit>,
     pub enter_thread: Signal<In, Bits<5>>,
-    pub record: Signal<In, Bits<24>>,
+    pub instance_id: Signal<In, Bits<24>>,
     pub take: Signal<In, Bit>,
     pub free: Signal<In, Bit>,
     pub accepted: Signal<Out, Bit>,
@@ -1104,6 +1104,9 @@ struct InstanceRaysBench<
     pub ray_o: [Signal<Out, Bits<W>>; 3],
     pub ray_d: [Signal<Out, Bits<W>>; 3],
     pub done_mask: Signal<Out, Bits<32>>,
+    pub root_write: Signal<Out, Bit>,
+    pub root_thread: Signal<Out, Bits<5>>,
+    pub root: Signal<Out, Bits<26>>,
     /// A read in a clock the bus was not free (never).
     pub busy_read: Signal<Out, Bit>,
     entries: crate::hw::engine::InstanceRays<W>,
@@ -1135,7 +1138,7 @@ impl<
             word_b: Default::default(),
             enter: Default::default(),
             enter_thread: Default::default(),
-            record: Default::default(),
+            instance_id: Default::default(),
             take: Default::default(),
             free: Default::default(),
             accepted: Default::default(),
@@ -1144,6 +1147,9 @@ impl<
             ray_o: Default::default(),
             ray_d: Default::default(),
             done_mask: Default::default(),
+            root_write: Default::default(),
+            root_thread: Default::default(),
+            root: Default::default(),
             busy_read: Default::default(),
             entries: crate::hw::engine::InstanceRays::new(2),
             unit: Default::default(),
@@ -1182,7 +1188,7 @@ impl<
             self.entries.thread.next = self.world_thread.val();
         }
         self.entries.offer.next = self.enter.val() & (!self.world_write.val());
-        self.entries.record.next = self.record.val();
+        self.entries.instance_id.next = self.instance_id.val();
         self.accepted.next =
             self.enter.val() & (!self.world_write.val()) & (!self.entries.refused.val());
         self.entries.query_thread.next = 0.into();
@@ -1216,16 +1222,19 @@ impl<
         self.ray_write.next = self.entries.ray_write.val();
         self.ray_thread.next = self.entries.ray_thread.val();
         self.done_mask.next = self.entries.done_mask.val();
+        self.root_write.next = self.entries.root_write.val();
+        self.root_thread.next = self.entries.root_thread.val();
+        self.root.next = self.entries.root.val();
     }
 }
 
 /// InstanceRays' generated Verilog in `sim`, e7m16: every thread's world ray written (random
-/// words), then `entries` entries of threads 0..32 in turn into random records of a bank of
-/// random matrices, offered again while refused, the unit taking requests and the bus free in
+/// words), then `entries` entries of threads 0..32 in turn into random instances of a bank
+/// of random words, offered again while refused, the unit taking requests and the bus free in
 /// random clocks. Asserts: each entry's ray is written whole for its thread, in entry order,
 /// as `units::transform` of the thread's world origin (a point) and direction (a vector) by
-/// the record's world-to-object words, with the thread's bit as wake-up; no read goes out on a
-/// busy bus.
+/// the record's world-to-object words, with the thread's bit as wake-up, and its root (the
+/// record's root word's 26 bits) given for its thread; no read goes out on a busy bus.
 fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
     use crate::emit::stream_bench::{InputStream, OutputSink, StreamBench};
     use crate::emit::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
@@ -1258,7 +1267,7 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
         .enumerate()
         .map(|(i, &r)| {
             let gap = if i == 0 { 100 } else { rng.gen_range(0..4) };
-            (gap, vec![(i % 32) as u64, (r * INSTANCE_WORDS) as u64])
+            (gap, vec![(i % 32) as u64, r as u64])
         })
         .collect();
     let random_bits = |rng: &mut ChaCha8Rng, n: usize| -> Vec<(u32, Vec<u64>)> {
@@ -1279,11 +1288,17 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
             ("word_b", 32),
             ("enter", 1),
             ("enter_thread", 5),
-            ("record", 24),
+            ("instance_id", 24),
             ("take", 1),
             ("free", 1),
         ],
-        &[("accepted", 1), ("busy_read", 1)],
+        &[
+            ("accepted", 1),
+            ("busy_read", 1),
+            ("root_write", 1),
+            ("root_thread", 5),
+            ("root", 26),
+        ],
         "ray",
     );
     let stream = |name: &str, fields: &[&str], lines| InputStream {
@@ -1311,7 +1326,7 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
             InputStream {
                 valid: Some("enter".into()),
                 ready: Some("accepted".into()),
-                ..stream("entries", &["enter_thread", "record"], offers)
+                ..stream("entries", &["enter_thread", "instance_id"], offers)
             },
             stream("takes", &["take"], takes),
             stream("frees", &["free"], frees),
@@ -1321,6 +1336,12 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
                 name: "rays".into(),
                 valid: "ray_write".into(),
                 fields: ray_fields,
+                expected: entries,
+            },
+            OutputSink {
+                name: "roots".into(),
+                valid: "root_write".into(),
+                fields: vec!["root_thread".into(), "root".into()],
                 expected: entries,
             },
             OutputSink {
@@ -1338,9 +1359,18 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
         "{sim} instance entry, {entries} entries: compile {:.1} s, run {:.1} s",
         run.compile_seconds, run.run_seconds
     );
-    let (rays, busy_reads) = (&run.sinks[0], &run.sinks[1]);
+    let (rays, roots, busy_reads) = (&run.sinks[0], &run.sinks[1], &run.sinks[2]);
     assert!(busy_reads.is_empty(), "{sim}: reads on a busy bus");
     assert_eq!(rays.len(), entries, "{sim}: rays written");
+    let want_roots: Vec<Vec<u64>> = records
+        .iter()
+        .enumerate()
+        .map(|(i, &r)| {
+            let root = bank[r * INSTANCE_WORDS + instance_word::ROOT] & ((1 << 26) - 1);
+            vec![(i % 32) as u64, u64::from(root)]
+        })
+        .collect();
+    assert_eq!(roots, &want_roots, "{sim}: roots given");
     let mut bad = 0;
     for (i, (ray, &r)) in rays.iter().zip(&records).enumerate() {
         let thread = i % 32;
