@@ -270,6 +270,8 @@ pub struct TraversalUnit<
     a_d: Signal<Local, Bits<W>>,
     a_inner: Signal<Local, Bit>,
     a_top: Signal<Local, Bit>,
+    a_ray_o: [Signal<Local, Bits<W>>; 3],
+    a_ray_d: [Signal<Local, Bits<W>>; 3],
     a_top_leaf: Signal<Local, Bit>,
     a_leaf_address: Signal<Local, Bits<6>>,
     a_done: Signal<Local, Bit>,
@@ -452,6 +454,8 @@ impl<
             a_d: Default::default(),
             a_inner: Default::default(),
             a_top: Default::default(),
+            a_ray_o: Default::default(),
+            a_ray_d: Default::default(),
             a_top_leaf: Default::default(),
             a_leaf_address: Default::default(),
             a_done: Default::default(),
@@ -852,28 +856,24 @@ impl<
             | (self.w0.q.val().get_bits::<2>(30) == self.c_leaf_tag.val());
         self.a_axis.next = self.w0.q.val().get_bits::<2>(30);
         self.a_top.next = self.job.q.val().get_bit(102);
-        // The object walk's ray, or the top-level walk's world ray.
-        self.a_o.next = self.ray.o[0].val();
-        self.a_d.next = self.ray.d[0].val();
+        // The object walk's ray, or the top-level walk's world ray; its split axis.
+        for k in 0..3 {
+            self.a_ray_o[k].next = self.ray.o[k].val();
+            self.a_ray_d[k].next = self.ray.d[k].val();
+            if self.a_top.val() {
+                self.a_ray_o[k].next = self.world.o[k].val();
+                self.a_ray_d[k].next = self.world.d[k].val();
+            }
+        }
+        self.a_o.next = self.a_ray_o[0].val();
+        self.a_d.next = self.a_ray_d[0].val();
         if self.a_axis.val() == 1 {
-            self.a_o.next = self.ray.o[1].val();
-            self.a_d.next = self.ray.d[1].val();
+            self.a_o.next = self.a_ray_o[1].val();
+            self.a_d.next = self.a_ray_d[1].val();
         }
         if self.a_axis.val() == 2 {
-            self.a_o.next = self.ray.o[2].val();
-            self.a_d.next = self.ray.d[2].val();
-        }
-        if self.a_top.val() {
-            self.a_o.next = self.world.o[0].val();
-            self.a_d.next = self.world.d[0].val();
-            if self.a_axis.val() == 1 {
-                self.a_o.next = self.world.o[1].val();
-                self.a_d.next = self.world.d[1].val();
-            }
-            if self.a_axis.val() == 2 {
-                self.a_o.next = self.world.o[2].val();
-                self.a_d.next = self.world.d[2].val();
-            }
+            self.a_o.next = self.a_ray_o[2].val();
+            self.a_d.next = self.a_ray_d[2].val();
         }
         self.a_inner.next = self.at_a.val() & (!self.a_leaf.val());
         // An object leaf goes to the tester; a top-level leaf, and the end of a walk, to the
