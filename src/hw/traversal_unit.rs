@@ -13,8 +13,9 @@
 //! [`TOP_STACK_BASE`] and its leaf's segment kept apart from the object walks': at each leaf it
 //! wakes the thread, which reads the leaf's list (`top_from`, `top_to`), walks the instances'
 //! objects (object walks of this unit), and goes on with `next` (`kd.next`: the closest hit
-//! so far, taken like the tester's answer for an object leaf). At the walk's end `top_from`
-//! is `KD_WALK_ENDED`.
+//! so far, the thread's last answer, taken like the tester's answer for an object leaf); an
+//! empty leaf (two in three on the dynamic scene) it passes by itself, with that answer. At
+//! the walk's end `top_from` is `KD_WALK_ENDED`.
 //!
 //! Golden twin: [`units::KdWalk`](crate::units::KdWalk) (src/units.rs), one walk resumable at
 //! each leaf, with [`units::traversal_step`](crate::units::traversal_step) and
@@ -275,6 +276,10 @@ pub struct TraversalUnit<
     a_top_leaf: Signal<Local, Bit>,
     a_leaf_address: Signal<Local, Bits<6>>,
     a_done: Signal<Local, Bit>,
+    a_empty_top: Signal<Local, Bit>,
+    /// An empty top-level leaf's thread, whose walk goes on in the front's next clock.
+    skip_valid: DFF<Bit>,
+    skip_thread: DFF<Bits<5>>,
 
     // Decision.
     sub: FpAddSub<W, E, M, S, S1, X2, T>,
@@ -459,6 +464,9 @@ impl<
             a_top_leaf: Default::default(),
             a_leaf_address: Default::default(),
             a_done: Default::default(),
+            a_empty_top: Default::default(),
+            skip_valid: Default::default(),
+            skip_thread: Default::default(),
             sub: Default::default(),
             div: Default::default(),
             o_delay: Default::default(),
@@ -503,11 +511,59 @@ impl<
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self, clock, f1_valid, f1_next, f1_top, f1_thread, f1_a, f1_b, f2_valid, f2_next,
-            f2_top, f2_thread, f2_a, f2_b, f3_valid, f3_next, f3_top, f3_thread, f3_a, f3_b, f3_sp,
-            f3_t_min, f4_valid, f4_next, f4_top, f4_thread, f4_a, f4_b, f4_sp, f4_t_min, f4_node,
-            f4_lo, f4_hi, f5_valid, f5_next, f5_top, f5_thread, f5_a, f5_b, f5_sp, f5_t_min,
-            f5_node, f5_lo, f5_hi, f5_in_leaf, phase, fetch_job, job, words_in, w0, w1
+            self,
+            clock,
+            f1_valid,
+            f1_next,
+            f1_top,
+            f1_thread,
+            f1_a,
+            f1_b,
+            f2_valid,
+            f2_next,
+            f2_top,
+            f2_thread,
+            f2_a,
+            f2_b,
+            f3_valid,
+            f3_next,
+            f3_top,
+            f3_thread,
+            f3_a,
+            f3_b,
+            f3_sp,
+            f3_t_min,
+            f4_valid,
+            f4_next,
+            f4_top,
+            f4_thread,
+            f4_a,
+            f4_b,
+            f4_sp,
+            f4_t_min,
+            f4_node,
+            f4_lo,
+            f4_hi,
+            f5_valid,
+            f5_next,
+            f5_top,
+            f5_thread,
+            f5_a,
+            f5_b,
+            f5_sp,
+            f5_t_min,
+            f5_node,
+            f5_lo,
+            f5_hi,
+            f5_in_leaf,
+            phase,
+            fetch_job,
+            job,
+            words_in,
+            w0,
+            w1,
+            skip_valid,
+            skip_thread
         );
         clock!(
             self,
@@ -635,13 +691,20 @@ impl<
         self.issued.write_enable.next = self.engine.enqueue.val() & (!self.engine_full.val());
 
         // Front: one engine entry a clock, a job five clocks later.
-        self.entry_fifo.read.next = !self.entry_fifo.empty.val();
-        self.f1_valid.d.next = !self.entry_fifo.empty.val();
+        // An empty top-level leaf goes on at once, as a `next` with the thread's last answer,
+        // ahead of the queue's entry (which waits a clock).
+        self.entry_fifo.read.next = (!self.entry_fifo.empty.val()) & (!self.skip_valid.q.val());
+        self.f1_valid.d.next = (!self.entry_fifo.empty.val()) | self.skip_valid.q.val();
         self.f1_next.d.next = self.entry_fifo.data_out.val().get_bit(69);
         self.f1_top.d.next = self.entry_fifo.data_out.val().get_bit(70);
         self.f1_thread.d.next = self.entry_fifo.data_out.val().get_bits::<5>(64);
         self.f1_a.d.next = self.entry_fifo.data_out.val().get_bits::<32>(32);
         self.f1_b.d.next = self.entry_fifo.data_out.val().get_bits::<32>(0);
+        if self.skip_valid.q.val() {
+            self.f1_next.d.next = true;
+            self.f1_top.d.next = true;
+            self.f1_thread.d.next = self.skip_thread.q.val();
+        }
         self.f1_leaf_address.next = (bit_cast::<6, 1>(self.f1_top.q.val().into()) << 5)
             | bit_cast::<6, 5>(self.f1_thread.q.val());
         self.leaf_hi.read_address.next = self.f1_leaf_address.val();
@@ -880,6 +943,10 @@ impl<
         // engine. Each keeps the segment end and depth for the answer.
         self.a_end.next = self.at_a.val() & self.job.q.val().get_bit(101);
         self.a_top_leaf.next = self.at_a.val() & self.a_leaf.val() & self.a_top.val();
+        self.a_empty_top.next =
+            self.a_top_leaf.val() & (!self.a_end.val()) & (self.w1.q.val() == 0);
+        self.skip_valid.d.next = self.a_empty_top.val();
+        self.skip_thread.d.next = self.job.q.val().get_bits::<5>(96);
         self.a_list_end.next =
             bit_cast::<32, 30>(self.w0.q.val().get_bits::<30>(0)) + self.w1.q.val();
         self.leaf_fifo.write.next =
@@ -896,8 +963,10 @@ impl<
             }
         }
         self.top_to_ram.write_data.next = self.a_list_end.val();
-        self.top_from_ram.write_enable.next = self.a_top_leaf.val() | self.a_end.val();
-        self.top_to_ram.write_enable.next = self.a_top_leaf.val() & (!self.a_end.val());
+        self.top_from_ram.write_enable.next =
+            (self.a_top_leaf.val() & (!self.a_empty_top.val())) | self.a_end.val();
+        self.top_to_ram.write_enable.next =
+            self.a_top_leaf.val() & (!self.a_end.val()) & (!self.a_empty_top.val());
         self.leaf_fifo.data_in.next = (bit_cast::<69, 5>(self.job.q.val().get_bits::<5>(96)) << 64)
             | (bit_cast::<69, 30>(self.w0.q.val().get_bits::<30>(0)) << 32)
             | bit_cast::<69, 32>(self.a_list_end.val());
@@ -920,8 +989,8 @@ impl<
         self.done_u.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.done_e.write_data.next = self.done_u.read_data.val() + 1;
         self.done_u.write_data.next = self.done_u.read_data.val() + 1;
-        // A walk's end, or a top-level leaf, wakes the thread.
-        self.a_done.next = self.a_end.val() | self.a_top_leaf.val();
+        // A walk's end, or a top-level leaf with instances, wakes the thread.
+        self.a_done.next = self.a_end.val() | (self.a_top_leaf.val() & (!self.a_empty_top.val()));
         self.done_u.write_enable.next = self.a_done.val();
         self.done_e.write_enable.next = self.a_done.val();
         self.engine.done.next = self.a_done.val();
@@ -1259,7 +1328,8 @@ mod tests {
 
     /// rust-hdl simulation of top-level walks on the dynamic scene's trees (1,202 instances):
     /// eight threads write a world ray and an object ray, start a top-level walk (`KD_TOP`),
-    /// and at each top-level leaf the test reads the leaf (`top_from`, `top_to`), gives the
+    /// and at each top-level leaf with instances (the unit passes the empty ones by itself,
+    /// with the last answer) the test reads the leaf (`top_from`, `top_to`), gives the
     /// thread an entered root (`root_write`, as instance entry does) and starts an object walk
     /// with `KD_ENTERED` (the test plays the tester, answering each object leaf in random
     /// clocks with the thread's closest hit so far: none, or from its second top-level leaf
@@ -1341,20 +1411,34 @@ mod tests {
             })
             .max_by_key(|&root| object_walk(root, objects[0], t_max, (t_max, false)).len())
             .unwrap();
+        // The top-level walk's stops at leaves with instances; it passes the empty ones with
+        // the last answer.
+        let mut empty_leaves = 0;
         let top_want: Vec<Vec<KdStop>> = (0..threads)
             .map(|th| {
                 let levels = TOP_STACK_LEVELS;
                 let (mut walk, mut stop) =
                     KdWalk::start(f, worlds[th], top_root, (0, t_max), levels, fetch).unwrap();
-                let mut stops = vec![stop];
-                while stop != KdStop::Finished {
-                    let answer = answers[th][stops.len() - 1];
-                    stop = walk.next(f, worlds[th], answer, levels, fetch).unwrap();
+                let mut stops = vec![];
+                let mut answer = (t_max, false);
+                loop {
+                    while let KdStop::Leaf { count: 0, .. } = stop {
+                        empty_leaves += 1;
+                        stop = walk.next(f, worlds[th], answer, levels, fetch).unwrap();
+                    }
                     stops.push(stop);
+                    if stop == KdStop::Finished {
+                        break stops;
+                    }
+                    answer = answers[th][stops.len() - 1];
+                    stop = walk.next(f, worlds[th], answer, levels, fetch).unwrap();
                 }
-                stops
             })
             .collect();
+        assert!(
+            empty_leaves > threads,
+            "too few empty top-level leaves: {empty_leaves}"
+        );
         // The object walk during top-level leaf k: up to the answer before it.
         let object_want = |th: usize, k: usize| {
             let hi = if k == 0 { t_max } else { answers[th][k - 1].0 };

@@ -254,7 +254,8 @@ impl<'a> Machine<'a> {
         };
         let a = t.regs[i.a as usize];
         let b = if i.b_imm { i.imm } else { t.regs[i.b as usize] };
-        let fail = |what: String| self.error(k, t.pc, Some(i), &what);
+        let pc = t.pc;
+        let fail = |what: String| self.error(k, pc, Some(i), &what);
         let mut next = t.pc + 1;
         let mut result = None;
         let branch_if = |cond: bool, next: &mut usize| {
@@ -436,12 +437,23 @@ impl<'a> Machine<'a> {
                     t.world[..3].try_into().unwrap(),
                     t.world[3..].try_into().unwrap(),
                 );
-                // The unit's top-level walk stops at a leaf or its end.
-                let top_stop = |t: &mut Thread, stop| match stop {
-                    units::KdStop::Leaf { list, count } => {
-                        t.walk_words = [list, list.wrapping_add(count)];
+                // The unit's top-level walk stops at a leaf with instances (an empty one it
+                // passes with the thread's last answer) or its end.
+                let top_stop = |t: &mut Thread, mut stop| -> Result<(), ExecError> {
+                    while let units::KdStop::Leaf { count: 0, .. } = stop {
+                        let answer = t.last_answer;
+                        stop = t
+                            .top_walk
+                            .next(f, world, answer, TOP_STACK_LEVELS, fetch)
+                            .map_err(fail)?;
                     }
-                    units::KdStop::Finished => t.walk_words[0] = KD_WALK_ENDED,
+                    match stop {
+                        units::KdStop::Leaf { list, count } => {
+                            t.walk_words = [list, list.wrapping_add(count)];
+                        }
+                        units::KdStop::Finished => t.walk_words[0] = KD_WALK_ENDED,
+                    }
+                    Ok(())
                 };
                 match function {
                     KdFn::Start if a & KD_TOP != 0 => {
@@ -451,7 +463,7 @@ impl<'a> Machine<'a> {
                             units::KdWalk::start(f, world, root, segment, TOP_STACK_LEVELS, fetch)
                                 .map_err(fail)?;
                         t.top_walk = walk;
-                        top_stop(t, stop);
+                        top_stop(t, stop)?;
                     }
                     KdFn::Start => {
                         // The whole walk: each leaf's list goes to the tester, whose closest
@@ -491,7 +503,7 @@ impl<'a> Machine<'a> {
                             .top_walk
                             .next(f, world, t.last_answer, TOP_STACK_LEVELS, fetch)
                             .map_err(fail)?;
-                        top_stop(t, stop);
+                        top_stop(t, stop)?;
                     }
                     // The twin's walk has stopped when it starts, so `wait` never waits.
                     KdFn::Wait => result = Some(t.walk_words[0]),
