@@ -695,7 +695,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam  tri_enter = 32'he;
     localparam  kd_start = 32'h0;
     localparam  kd_wait = 32'h1;
-    localparam  kd_next_fn = 32'h2;
+    localparam  kd_next = 32'h2;
     localparam  cmd_list = 2'b0;
     localparam  cmd_init = 2'b1;
     localparam  cmd_object = 2'b10;
@@ -1195,9 +1195,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  kd_queues__d;
     wire  kd_queues__q;
     reg  kd_queues__clock;
-    reg  kd_next__d;
-    wire  kd_next__q;
-    reg  kd_next__clock;
+    reg  kd_answers__d;
+    wire  kd_answers__q;
+    reg  kd_answers__clock;
     reg  kd_waits__d;
     wire  kd_waits__q;
     reg  kd_waits__clock;
@@ -1780,10 +1780,10 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(kd_queues__q),
         .clock(kd_queues__clock)
     );
-    dynrt_processor__display__dark_d kd_next(
-        .d(kd_next__d),
-        .q(kd_next__q),
-        .clock(kd_next__clock)
+    dynrt_processor__display__dark_d kd_answers(
+        .d(kd_answers__d),
+        .q(kd_answers__q),
+        .clock(kd_answers__clock)
     );
     dynrt_processor__display__dark_d kd_waits(
         .d(kd_waits__d),
@@ -1825,7 +1825,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tri_waits__clock = clock;
         kd_enqueue__clock = clock;
         kd_queues__clock = clock;
-        kd_next__clock = clock;
+        kd_answers__clock = clock;
         kd_waits__clock = clock;
         wait_fn__clock = clock;
         running__d = running__q;
@@ -1855,7 +1855,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tri_waits__d = tri_waits__q;
         kd_enqueue__d = kd_enqueue__q;
         kd_queues__d = kd_queues__q;
-        kd_next__d = kd_next__q;
+        kd_answers__d = kd_answers__q;
         kd_waits__d = kd_waits__q;
         wait_fn__d = wait_fn__q;
         scheduler__clock = clock;
@@ -2013,10 +2013,10 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             tri_kind__d = cmd_skip;
         end
         tri_waits__d = tri_wait_fn;
-        kd_queued_fn = (decode__imm_i4 == kd_start) | (decode__imm_i4 == kd_next_fn);
+        kd_queued_fn = (decode__imm_i4 == kd_start) | (decode__imm_i4 == kd_next);
         kd_queues__d = kd_queued_fn;
         kd_enqueue__d = decode__valid_i4 & kd_op & kd_queued_fn;
-        kd_next__d = decode__imm_i4 == kd_next_fn;
+        kd_answers__d = decode__imm_i4 == kd_next;
         kd_waits__d = kd_wait_fn;
         wait_fn__d = (tri_op & tri_wait_fn) | (kd_op & kd_wait_fn);
         traversal_unit__engine__load_banks = mem_load_r__q;
@@ -2150,7 +2150,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         traversal_unit__answer_hit = tester__walk_end_hit;
         traversal_unit__t_min_write = t_min_write__q;
         traversal_unit__engine__enqueue = kd_enqueue__q;
-        traversal_unit__engine_next = kd_next__q;
+        traversal_unit__engine_next = kd_answers__q;
         traversal_unit__world_write = world_write__q;
         traversal_unit__root_write = instances__root_write;
         traversal_unit__root_thread = instances__root_thread;

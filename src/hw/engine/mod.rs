@@ -296,7 +296,7 @@ pub struct ThreadEngine<
     tri_waits: DFF<Bit>,
     kd_enqueue: DFF<Bit>,
     kd_queues: DFF<Bit>,
-    kd_next: DFF<Bit>,
+    kd_answers: DFF<Bit>,
     kd_waits: DFF<Bit>,
     wait_fn: DFF<Bit>,
     tri_op: Signal<Local, Bit>,
@@ -340,7 +340,7 @@ pub struct ThreadEngine<
     tri_enter: Constant<Bits<32>>,
     kd_start: Constant<Bits<32>>,
     kd_wait: Constant<Bits<32>>,
-    kd_next_fn: Constant<Bits<32>>,
+    kd_next: Constant<Bits<32>>,
     cmd_list: Constant<Bits<2>>,
     cmd_init: Constant<Bits<2>>,
     cmd_object: Constant<Bits<2>>,
@@ -453,7 +453,7 @@ impl<
             tri_waits: Default::default(),
             kd_enqueue: Default::default(),
             kd_queues: Default::default(),
-            kd_next: Default::default(),
+            kd_answers: Default::default(),
             kd_waits: Default::default(),
             wait_fn: Default::default(),
             tri_op: Default::default(),
@@ -489,7 +489,7 @@ impl<
             tri_enter: tri_fn(TriFn::Enter),
             kd_start: kd_fn(KdFn::Start),
             kd_wait: kd_fn(KdFn::Wait),
-            kd_next_fn: kd_fn(KdFn::Next),
+            kd_next: kd_fn(KdFn::Next),
             cmd_list: cmd(list_unit::CMD_LIST),
             cmd_init: cmd(list_unit::CMD_INIT),
             cmd_object: cmd(list_unit::CMD_OBJECT),
@@ -550,7 +550,7 @@ impl<
             tri_waits,
             kd_enqueue,
             kd_queues,
-            kd_next,
+            kd_answers,
             kd_waits,
             wait_fn
         );
@@ -766,11 +766,11 @@ impl<
         self.tri_waits.d.next = self.tri_wait_fn.val();
         // `kd.start` and `kd.next` queue (`kd.next` is the top-level walk's answer).
         self.kd_queued_fn.next = (self.decode.imm_i4.val() == self.kd_start.val())
-            | (self.decode.imm_i4.val() == self.kd_next_fn.val());
+            | (self.decode.imm_i4.val() == self.kd_next.val());
         self.kd_queues.d.next = self.kd_queued_fn.val();
         self.kd_enqueue.d.next =
             self.decode.valid_i4.val() & self.kd_op.val() & self.kd_queued_fn.val();
-        self.kd_next.d.next = self.decode.imm_i4.val() == self.kd_next_fn.val();
+        self.kd_answers.d.next = self.decode.imm_i4.val() == self.kd_next.val();
         self.kd_waits.d.next = self.kd_wait_fn.val();
         // The waits (`tri.wait`, `kd.wait`): a pending one sleeps instead of repeating.
         self.wait_fn.d.next = (self.tri_op.val() & self.tri_wait_fn.val())
@@ -887,7 +887,7 @@ impl<
         self.traversal_unit.answer_hit.next = self.tester.walk_end_hit.val();
         self.traversal_unit.t_min_write.next = self.t_min_write.q.val();
         self.traversal_unit.engine.enqueue.next = self.kd_enqueue.q.val();
-        self.traversal_unit.engine_next.next = self.kd_next.q.val();
+        self.traversal_unit.engine_next.next = self.kd_answers.q.val();
         self.traversal_unit.world_write.next = self.world_write.q.val();
         self.traversal_unit.root_write.next = self.instances.root_write.val();
         self.traversal_unit.root_thread.next = self.instances.root_thread.val();
