@@ -7,8 +7,8 @@
 //! at I5: `fast` is `add`/`sub`/`and`/`or`/`xor`/`shr`/`shl` of `a` and `b`, `jal`'s
 //! link `pc + 1`, `byte`'s `b << 8` (the unit's byte joins it at the write back), the
 //! pixel word, or what `tri.wait`/`tri.hit`/`tri.instance`/`tri.triangle` read from the
-//! triangle tester and `kd.wait`/`kd.leaf` from the traversal unit (the top-level leaf); `kind` says whether the result line fills in a scratch or memory word
-//! later (`ld` by its bank, `lds`). `mem_address = (a << shift) + imm` (loads and
+//! triangle tester and `kd.wait`/`kd.leaf` from the traversal unit; `kind` says whether the
+//! result line fills in a scratch or memory word later (`ld` by its bank, `lds`). `mem_address = (a << shift) + imm` (loads and
 //! frame-buffer stores), `scratch_address = a + imm`; `int_eq`, `int_lt`: `a == b`, `a < b`
 //! unsigned.
 //!
@@ -39,7 +39,8 @@ pub struct Execute<const W: usize> {
     pub tester_hit: Signal<In, Bit>,
     pub tester_instance: Signal<In, Bits<32>>,
     pub tester_triangle: Signal<In, Bits<32>>,
-    /// The traversal unit's top-level leaf for the thread at I5, for `kd.wait` and `kd.leaf`.
+    /// The traversal unit's words for the thread at I5: `kd.wait`'s (the top-level leaf's list
+    /// start, or after an object walk its hit flag) and `kd.leaf`'s (the list's end).
     pub top_from: Signal<In, Bits<32>>,
     pub top_to: Signal<In, Bits<32>>,
     /// The thread's primary direction (ray generation's answer at I5), for `tri.dir`.

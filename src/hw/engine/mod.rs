@@ -56,12 +56,15 @@
 //! tree (a thread starts the walk and sleeps until it ends, instead of 15-23 turns per inner
 //! node in microcode); it hands each leaf's list to the [`TriangleTester`], whose list unit
 //! reads it and queues its triangles, and which answers the traversal unit with the closest
-//! hit. A walk costs the thread four turns, whatever its leaves. [`PrimaryRays`] sends each
+//! hit. A walk costs the thread two or three turns, whatever its leaves. The unit walks the
+//! top-level tree too, waking the thread at each leaf with instances (`kd.wait`, `kd.leaf`
+//! read it; `kd.next` goes on). [`PrimaryRays`] sends each
 //! pixel's primary ray through the tester's TransformUnit, in the clocks the tests leave it
 //! free, and writes the ray into both coprocessors (a `pixel`, then a `tri.wait`);
 //! [`InstanceRays`] does the same for the world ray entering an instance (a `tri.enter`, then
-//! a `tri.wait`), after ray generation's requests, with the instance's matrix read from bank
-//! 4 in the clocks the engine's and the list unit's reads leave the `mem_*` bus free.
+//! a `tri.wait`), after ray generation's requests, with the instance's matrix and object root
+//! read from bank 4 in the clocks the engine's and the list unit's reads leave the `mem_*`
+//! bus free (the root goes to the traversal unit).
 //!
 //! Memory: one read per clock on the `mem_*` port (banks 0, 1, 4, 5; the tester's list reads
 //! of bank 1 use it in the clocks the engine leaves free, instance entry's reads of bank 4 in
