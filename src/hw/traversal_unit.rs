@@ -131,8 +131,8 @@ pub struct TraversalUnit<
     pub answer_thread: Signal<In, Bits<5>>,
     pub answer_t: Signal<In, Bits<32>>,
     pub answer_hit: Signal<In, Bit>,
-    /// The engine's offer is `kd.next` (`word_a` best t, `word_b` bit 0 the hit flag) for the
-    /// thread's top-level walk, not a start.
+    /// The engine's offer is `kd.next` for the thread's top-level walk, not a start (the walk
+    /// goes on with the thread's last answer; `word_a`, `word_b` are not read).
     pub engine_next: Signal<In, Bit>,
     /// The thread's world ray, pair `world_pair` (0, 1, 2 as `ray_pair`) from `word_a`,
     /// `word_b`.
