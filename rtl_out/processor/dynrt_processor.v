@@ -2741,27 +2741,6 @@ module dynrt_processor__engine__execute(op,a,b,imm,shift,bank,pc,pixel,tester_be
         scratch_address = a + imm;
         source = FastKind__Computed;
         result = 32'h0;
-        if (op == op_add) begin
-            result = a + b;
-        end
-        if (op == op_sub) begin
-            result = a - b;
-        end
-        if (op == op_and) begin
-            result = a & b;
-        end
-        if (op == op_or) begin
-            result = a | b;
-        end
-        if (op == op_xor) begin
-            result = a ^ b;
-        end
-        if (op == op_shr) begin
-            result = a >> b[(32'h0)+:(5)];
-        end
-        if (op == op_shl) begin
-            result = a << b[(32'h0)+:(5)];
-        end
         if (op == op_ld) begin
             source = FastKind__Memory;
             if (bank == bank_a) begin
@@ -2820,6 +2799,27 @@ module dynrt_processor__engine__execute(op,a,b,imm,shift,bank,pc,pixel,tester_be
         end
         if ((op == op_tri) & (imm == tri_dir)) begin
             result = ((dir_word) & 32'hffffffff);
+        end
+        if (op == op_and) begin
+            result = a & b;
+        end
+        if (op == op_or) begin
+            result = a | b;
+        end
+        if (op == op_xor) begin
+            result = a ^ b;
+        end
+        if (op == op_shr) begin
+            result = a >> b[(32'h0)+:(5)];
+        end
+        if (op == op_shl) begin
+            result = a << b[(32'h0)+:(5)];
+        end
+        if (op == op_sub) begin
+            result = a - b;
+        end
+        if (op == op_add) begin
+            result = a + b;
         end
         fast = result;
         kind = source;
