@@ -1111,6 +1111,49 @@ mod tests {
 
     type Unit = TraversalUnit<24, 7, 16, 17, 18, 9, 21, { div_latency(16) as usize }>;
 
+    /// The bench's side of one clock that both tests share, up to the clock edge: bank 0's
+    /// word for the request `requests` holds from `mem_latency` clocks ago, the tester's
+    /// answer `(thread, best t, hit)` if any, and in random clocks the take of the unit's
+    /// leaf, returned with its thread; then this clock's request joins `requests`.
+    fn bench_clock(
+        u: &mut Unit,
+        requests: &mut VecDeque<Option<u32>>,
+        nodes: &[u32],
+        answer: Option<(usize, u32, bool)>,
+        rng: &mut rand_chacha::ChaCha8Rng,
+    ) -> Option<(usize, KdStop)> {
+        let addr = requests.pop_front().unwrap();
+        u.nodes.rdata.next = u64::from(addr.map_or(0xdead_beef, |a| nodes[a as usize])).into();
+        u.answer_valid.next = answer.is_some();
+        if let Some((th, t, hit)) = answer {
+            u.answer_thread.next = (th as u64).into();
+            u.answer_t.next = u64::from(t).into();
+            u.answer_hit.next = hit;
+        }
+        u.leaf_take.next = false;
+        settle(u);
+        let mut taken = None;
+        if u.leaf_valid.val() && rng.gen_bool(0.5) {
+            u.leaf_take.next = true;
+            settle(u);
+            let th = u.leaf_thread.val().to_u64() as usize;
+            let from = u.leaf_from.val().to_u64() as u32;
+            let to = u.leaf_to.val().to_u64() as u32;
+            let leaf = KdStop::Leaf {
+                list: from,
+                count: to - from,
+            };
+            taken = Some((th, leaf));
+        }
+        requests.push_back(
+            u.nodes
+                .read
+                .val()
+                .then(|| u.nodes.addr.val().to_u64() as u32),
+        );
+        taken
+    }
+
     /// rust-hdl simulation on the Cornell box's kd tree with an SRAM model behind bank 0:
     /// eight threads start walks from the root with rays from around the eye (two of them
     /// any-hit walks); the test plays the triangle tester: it takes each leaf in random
@@ -1235,8 +1278,6 @@ mod tests {
         // early when the engine offers, so that the two meet.
         let tick = |u: &mut Unit, b: &mut Bench, rng: &mut rand_chacha::ChaCha8Rng, offer: bool| {
             b.clock += 1;
-            let addr = b.requests.pop_front().unwrap();
-            u.nodes.rdata.next = u64::from(addr.map_or(0xdead_beef, |a| nodes[a as usize])).into();
             let steal = rng
                 .gen_ratio(1, 6)
                 .then(|| rng.gen_range(0..nodes.len() as u64));
@@ -1244,42 +1285,21 @@ mod tests {
             u.engine.load_addr.next = steal.unwrap_or(0).into();
             // The tester answers one due leaf a clock.
             let answer = b.due.iter().position(|d| d.0 <= b.clock || offer);
-            u.answer_valid.next = answer.is_some();
-            if let Some(k) = answer {
+            let answer = answer.map(|k| {
                 let (_, th, t, hit) = b.due.remove(k);
-                u.answer_thread.next = (th as u64).into();
-                u.answer_t.next = u64::from(t).into();
-                u.answer_hit.next = hit;
-            }
-            u.leaf_take.next = false;
-            settle(u);
-            if u.leaf_valid.val() && rng.gen_bool(0.5) {
-                u.leaf_take.next = true;
-                settle(u);
-                let th = u.leaf_thread.val().to_u64() as usize;
-                let from = u.leaf_from.val().to_u64() as u32;
-                let to = u.leaf_to.val().to_u64() as u32;
+                (th, t, hit)
+            });
+            if let Some((th, leaf)) = bench_clock(u, &mut b.requests, &nodes, answer, rng) {
                 let k = b.got[th].len() - b.walk_from[th];
-                b.got[th].push(KdStop::Leaf {
-                    list: from,
-                    count: to - from,
-                });
+                b.got[th].push(leaf);
                 let (t, hit) = answers[th][k];
                 b.due.push((b.clock + rng.gen_range(4..60), th, t, hit));
             }
             if let Some(a) = steal {
                 b.stolen += 1;
-                assert!(
-                    u.nodes.read.val() && u.nodes.addr.val().to_u64() == a,
-                    "the engine's read"
-                );
+                let request = b.requests.back().unwrap();
+                assert_eq!(*request, Some(a as u32), "the engine's read");
             }
-            b.requests.push_back(
-                u.nodes
-                    .read
-                    .val()
-                    .then(|| u.nodes.addr.val().to_u64() as u32),
-            );
             let full = u.engine.full.val();
             if full && u.engine.enqueue.val() {
                 b.refused += 1;
@@ -1518,36 +1538,15 @@ mod tests {
         let mut th = 0;
         let tick = |u: &mut Unit, b: &mut Bench, rng: &mut rand_chacha::ChaCha8Rng, offer: bool| {
             b.clock += 1;
-            let addr = b.requests.pop_front().unwrap();
-            u.nodes.rdata.next = u64::from(addr.map_or(0xdead_beef, |a| nodes[a as usize])).into();
             let answer = b.due.iter().position(|d| d.0 <= b.clock || offer);
-            u.answer_valid.next = answer.is_some();
-            if let Some(k) = answer {
+            let answer = answer.map(|k| {
                 let (_, th) = b.due.remove(k);
-                u.answer_thread.next = (th as u64).into();
-                u.answer_t.next = u64::from(b.answer[th].0).into();
-                u.answer_hit.next = b.answer[th].1;
-            }
-            u.leaf_take.next = false;
-            settle(u);
-            if u.leaf_valid.val() && rng.gen_bool(0.5) {
-                u.leaf_take.next = true;
-                settle(u);
-                let th = u.leaf_thread.val().to_u64() as usize;
-                let from = u.leaf_from.val().to_u64() as u32;
-                let to = u.leaf_to.val().to_u64() as u32;
-                b.object_got[th].push(KdStop::Leaf {
-                    list: from,
-                    count: to - from,
-                });
+                (th, b.answer[th].0, b.answer[th].1)
+            });
+            if let Some((th, leaf)) = bench_clock(u, &mut b.requests, &nodes, answer, rng) {
+                b.object_got[th].push(leaf);
                 b.due.push((b.clock + rng.gen_range(4..40), th));
             }
-            b.requests.push_back(
-                u.nodes
-                    .read
-                    .val()
-                    .then(|| u.nodes.addr.val().to_u64() as u32),
-            );
             let full = u.engine.full.val();
             cycle(u);
             !full
