@@ -52,7 +52,7 @@ use super::fp::compare::COMPARE_LATENCY;
 use super::fp::div::div_latency;
 use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
 use super::ports::{CoprocessorPort, SramRead};
-use super::program::isa::KD_WALK_ENDED;
+use super::program::isa::{KD_ENTERED, KD_WALK_ENDED};
 use super::ray_store::{zero_counters, RayStore};
 use super::{Delay, SyncFifo};
 use crate::fp::Format;
@@ -138,6 +138,13 @@ pub struct TraversalUnit<
     /// `word_b`.
     pub world_write: Signal<In, Bit>,
     pub world_pair: Signal<In, Bits<2>>,
+    /// `tri.enter` (I5, with the engine's `thread`; all-or-none with the entry itself): the
+    /// thread's walk of the entered object is counted (its `kd.wait` waits for it), any-hit
+    /// when `word_b` has `KD_ANY_HIT`.
+    pub enter: Signal<In, Bit>,
+    /// The entered ray is written (with `primary_write`, of `primary_thread`): the unit
+    /// starts the thread's walk of the entered object, as a start with `KD_ENTERED`.
+    pub entered: Signal<In, Bit>,
     /// The object root of `root_thread`'s last instance entry (`KD_ENTERED` walks it).
     pub root_write: Signal<In, Bit>,
     pub root_thread: Signal<In, Bits<5>>,
@@ -279,6 +286,10 @@ pub struct TraversalUnit<
     a_empty_top: Signal<Local, Bit>,
     /// An empty top-level leaf's thread, whose walk goes on in the front's next clock.
     skip_valid: DFF<Bit>,
+    /// An entered object's walk to start: it takes the entry queue in a clock without a
+    /// tester's answer (those come at least 4 clocks apart, entries 16), ahead of the engine.
+    entered_valid: DFF<Bit>,
+    entered_thread: DFF<Bits<5>>,
     skip_thread: DFF<Bits<5>>,
 
     // Decision.
@@ -312,6 +323,8 @@ pub struct TraversalUnit<
     c_leaf_tag: Constant<Bits<2>>,
     c_top_base: Constant<Bits<6>>,
     c_walk_ended: Constant<Bits<32>>,
+    /// An entered object's start: `KD_ENTERED`.
+    c_entered: Constant<Bits<32>>,
 }
 
 impl<
@@ -350,6 +363,8 @@ impl<
             answer_t: Default::default(),
             answer_hit: Default::default(),
             engine_next: Default::default(),
+            enter: Default::default(),
+            entered: Default::default(),
             world_write: Default::default(),
             world_pair: Default::default(),
             root_write: Default::default(),
@@ -467,6 +482,8 @@ impl<
             a_empty_top: Default::default(),
             skip_valid: Default::default(),
             skip_thread: Default::default(),
+            entered_valid: Default::default(),
+            entered_thread: Default::default(),
             sub: Default::default(),
             div: Default::default(),
             o_delay: Default::default(),
@@ -493,6 +510,7 @@ impl<
             c_leaf_tag: Constant::new(u64::from(layout::LEAF_TAG).into()),
             c_top_base: Constant::new((TOP_STACK_BASE as u64).into()),
             c_walk_ended: Constant::new(u64::from(KD_WALK_ENDED).into()),
+            c_entered: Constant::new(u64::from(KD_ENTERED).into()),
         }
     }
 }
@@ -563,7 +581,9 @@ impl<
             w0,
             w1,
             skip_valid,
-            skip_thread
+            skip_thread,
+            entered_valid,
+            entered_thread
         );
         clock!(
             self,
@@ -657,12 +677,21 @@ impl<
         self.top_to_ram.read_address.next = self.engine.query_thread.val();
         self.top_from.next = self.top_from_ram.read_data.val();
         self.top_to.next = self.top_to_ram.read_data.val();
-        // The tester's answer takes the queue first (a thread has one entry in the unit at a
-        // time, so the queue never overflows with it).
-        self.engine_full.next = self.entry_fifo.full.val() | self.answer_valid.val();
+        // The tester's answer takes the queue first, then an entered object's start (a
+        // thread has one entry in the unit at a time, so the queue never overflows with
+        // them).
+        if self.entered.val() {
+            self.entered_valid.d.next = true;
+            self.entered_thread.d.next = self.primary_thread.val();
+        } else if !self.answer_valid.val() {
+            self.entered_valid.d.next = false;
+        }
+        self.engine_full.next =
+            self.entry_fifo.full.val() | self.answer_valid.val() | self.entered_valid.q.val();
         self.engine.full.next = self.engine_full.val();
-        self.entry_fifo.write.next =
-            (self.engine.enqueue.val() & (!self.engine_full.val())) | self.answer_valid.val();
+        self.entry_fifo.write.next = (self.engine.enqueue.val() & (!self.engine_full.val()))
+            | self.answer_valid.val()
+            | self.entered_valid.q.val();
         // Bit 69: an answer (0: the engine's start); bit 70: of the top-level walk (an
         // engine's `next`, or a start with `KD_TOP`).
         self.entry_fifo.data_in.next = (bit_cast::<71, 1>(
@@ -672,6 +701,10 @@ impl<
             | (bit_cast::<71, 5>(self.engine.thread.val()) << 64)
             | (bit_cast::<71, 32>(self.engine.word_a.val()) << 32)
             | bit_cast::<71, 32>(self.engine.word_b.val());
+        if self.entered_valid.q.val() {
+            self.entry_fifo.data_in.next = (bit_cast::<71, 5>(self.entered_thread.q.val()) << 64)
+                | (bit_cast::<71, 32>(self.c_entered.val()) << 32);
+        }
         if self.answer_valid.val() {
             self.entry_fifo.data_in.next = (bit_cast::<71, 1>(true.into()) << 69)
                 | (bit_cast::<71, 5>(self.answer_thread.val()) << 64)
@@ -681,14 +714,20 @@ impl<
         self.any_hit.write_address.next = self.engine.thread.val();
         self.any_hit.write_data.next =
             bit_cast::<1, 1>(self.engine.word_a.val().get_bit(31).into());
+        if self.enter.val() {
+            self.any_hit.write_data.next =
+                bit_cast::<1, 1>(self.engine.word_b.val().get_bit(31).into());
+        }
         self.any_hit.write_enable.next =
-            self.engine.enqueue.val() & (!self.engine_full.val()) & (!self.engine_next.val());
+            (self.engine.enqueue.val() & (!self.engine_full.val()) & (!self.engine_next.val()))
+                | self.enter.val();
         self.issued.read_address.next = self.engine.query_thread.val();
         self.done_e.read_address.next = self.engine.query_thread.val();
         self.engine.pending.next = self.issued.read_data.val() != self.done_e.read_data.val();
         self.issued.write_address.next = self.engine.thread.val();
         self.issued.write_data.next = self.issued.read_data.val() + 1;
-        self.issued.write_enable.next = self.engine.enqueue.val() & (!self.engine_full.val());
+        self.issued.write_enable.next =
+            (self.engine.enqueue.val() & (!self.engine_full.val())) | self.enter.val();
 
         // Front: one engine entry a clock, a job five clocks later.
         // An empty top-level leaf goes on at once, as a `next` with the thread's last answer,
@@ -1350,14 +1389,17 @@ mod tests {
     /// eight threads write a world ray and an object ray, start a top-level walk (`KD_TOP`),
     /// and at each top-level leaf with instances (the unit passes the empty ones by itself,
     /// with the last answer) the test reads the leaf (`top_from`, `top_to`), gives the
-    /// thread an entered root (`root_write`, as instance entry does) and starts an object walk
-    /// with `KD_ENTERED` (the test plays the tester, answering each object leaf in random
-    /// clocks with the thread's closest hit so far: none, or from its second top-level leaf
-    /// on, one thread in two, a hit at a random distance), checks `kd.wait`'s hit flag after
-    /// it, then sends `next`. Every top-level walk stops at `units::KdWalk`'s leaves on the
-    /// world ray, going on with the last answer, and ends where it ends; every object walk
-    /// visits `KdWalk`'s leaves on the object ray from the entered root up to the last
-    /// answer's t: the two walks keep their segments and stacks apart.
+    /// thread an entered root (`root_write`, as instance entry does) and has the unit walk
+    /// that object: every other walk starts with `kd.start KD_ENTERED`, the others as
+    /// `tri.enter` starts them (`enter`, and some clocks later `entered` with the ray, as
+    /// instance entry writes it, half of them in the clock of a tester's answer). The test
+    /// plays the tester, answering each object leaf in random clocks with the thread's
+    /// closest hit so far (none, or from its second top-level leaf on, one thread in two, a
+    /// hit at a random distance), checks `kd.wait`'s hit flag after each object walk, then
+    /// sends `next`. Every top-level walk stops at `units::KdWalk`'s leaves on the world ray,
+    /// going on with the last answer, and ends where it ends; every object walk visits
+    /// `KdWalk`'s leaves on the object ray from the entered root up to the last answer's t:
+    /// the two walks keep their segments and stacks apart.
     #[test]
     fn rust_hdl_simulation_walks_the_top_level_between_object_walks() {
         use crate::hw::program::isa::{KD_ENTERED, KD_TOP, KD_WALK_ENDED};
@@ -1527,6 +1569,9 @@ mod tests {
             clock: u64,
             object_got: Vec<Vec<KdStop>>,
             answer: Vec<(u32, bool)>,
+            /// Entered rays to write (clock, thread); how many in the clock of an answer.
+            entering: Vec<(u64, usize)>,
+            entered_with_answer: usize,
         }
         let mut b = Bench {
             requests: std::iter::repeat(None).take(mem_latency as usize).collect(),
@@ -1534,6 +1579,8 @@ mod tests {
             clock: 0,
             object_got: vec![Vec::new(); threads],
             answer: vec![(t_max, false); threads],
+            entering: Vec::new(),
+            entered_with_answer: 0,
         };
         let mut th = 0;
         let tick = |u: &mut Unit, b: &mut Bench, rng: &mut rand_chacha::ChaCha8Rng, offer: bool| {
@@ -1543,6 +1590,18 @@ mod tests {
                 let (_, th) = b.due.remove(k);
                 (th, b.answer[th].0, b.answer[th].1)
             });
+            let entered = b.entering.iter().position(|e| e.0 <= b.clock);
+            u.entered.next = entered.is_some();
+            u.primary_write.next = entered.is_some();
+            if let Some(k) = entered {
+                let (_, th) = b.entering.remove(k);
+                u.primary_thread.next = (th as u64).into();
+                for k in 0..3 {
+                    u.primary_o[k].next = u64::from(objects[th].0[k]).into();
+                    u.primary_d[k].next = u64::from(objects[th].1[k]).into();
+                }
+                b.entered_with_answer += usize::from(answer.is_some());
+            }
             if let Some((th, leaf)) = bench_clock(u, &mut b.requests, &nodes, answer, rng) {
                 b.object_got[th].push(leaf);
                 b.due.push((b.clock + rng.gen_range(4..40), th));
@@ -1557,6 +1616,7 @@ mod tests {
             u.engine.query_thread.next = (th as u64).into();
             u.engine.enqueue.next = false;
             u.engine_next.next = false;
+            u.enter.next = false;
             tick(&mut u, &mut b, &mut rng, false);
             // I5 of the thread presented at I4: its walk's state and what `kd.wait` gives.
             if !u.engine.pending.val() {
@@ -1588,8 +1648,11 @@ mod tests {
                     _ => {}
                 }
             }
-            let offer = matches!(steps[th], Step::StartTop | Step::StartObject | Step::Next);
+            let via_enter = steps[th] == Step::StartObject && (th + top_got[th].len()) % 2 == 0;
+            let offer =
+                matches!(steps[th], Step::StartTop | Step::StartObject | Step::Next) && !via_enter;
             u.engine.enqueue.next = offer;
+            u.enter.next = via_enter;
             u.engine.thread.next = (th as u64).into();
             // Words a start with a root of its own, or a `next`, must not read.
             u.engine.word_a.next = u64::from(w(1.0)).into();
@@ -1611,6 +1674,16 @@ mod tests {
             }
             let taken = tick(&mut u, &mut b, &mut rng, offer);
             u.root_write.next = false;
+            u.enter.next = false;
+            if via_enter {
+                // The ray comes a while later, half the time with a tester's answer.
+                let due = match b.due.first() {
+                    Some(&(clock, _)) if rng.gen_bool(0.5) => clock.max(b.clock + 1),
+                    _ => b.clock + rng.gen_range(5..60),
+                };
+                b.entering.push((due, th));
+                steps[th] = Step::WaitObject;
+            }
             if taken && offer {
                 steps[th] = match steps[th] {
                     Step::StartObject => Step::WaitObject,
@@ -1619,5 +1692,9 @@ mod tests {
             }
         }
         assert_eq!(top_got, top_want, "top-level stops per thread");
+        assert!(
+            b.entered_with_answer > 0,
+            "no entered ray came with a tester's answer"
+        );
     }
 }

@@ -336,7 +336,6 @@ pub struct ThreadEngine<
     tri_init: Constant<Bits<32>>,
     tri_list: Constant<Bits<32>>,
     tri_wait: Constant<Bits<32>>,
-    tri_object: Constant<Bits<32>>,
     tri_skip: Constant<Bits<32>>,
     tri_camera: Constant<Bits<32>>,
     tri_world: Constant<Bits<32>>,
@@ -485,7 +484,6 @@ impl<
             tri_init: tri_fn(TriFn::Init),
             tri_list: tri_fn(TriFn::List),
             tri_wait: tri_fn(TriFn::Wait),
-            tri_object: tri_fn(TriFn::Object),
             tri_skip: tri_fn(TriFn::Skip),
             tri_camera: tri_fn(TriFn::Camera),
             tri_world: tri_fn(TriFn::World),
@@ -678,7 +676,10 @@ impl<
         self.instances.world_pair.next = self.decode.shift.val().get_bits::<2>(0);
         self.instances.word_a.next = self.decode.a.val();
         self.instances.word_b.next = self.decode.b.val();
-        self.instances.offer.next = self.enter_offer.q.val();
+        // `tri.enter` enters (InstanceRays), queues the instance as the tester's object and
+        // counts the walk the traversal unit starts when the ray is written: all three or
+        // none (the thread repeats it while the entry slot or the tester's queue is full).
+        self.instances.offer.next = self.enter_offer.q.val() & (!self.tester.engine.full.val());
         self.instances.instance_id.next = self.decode.a.val().get_bits::<24>(0);
 
         // Scratch memory.
@@ -736,7 +737,7 @@ impl<
         self.kd_wait_fn.next = self.decode.imm_i4.val() == self.kd_wait.val();
         self.queued_fn.next = (self.decode.imm_i4.val() == self.tri_init.val())
             | (self.decode.imm_i4.val() == self.tri_list.val())
-            | (self.decode.imm_i4.val() == self.tri_object.val())
+            | (self.decode.imm_i4.val() == self.tri_enter.val())
             | (self.decode.imm_i4.val() == self.tri_skip.val());
         self.ray_write.d.next = self.decode.valid_i4.val()
             & self.tri_op.val()
@@ -760,7 +761,7 @@ impl<
         if self.decode.imm_i4.val() == self.tri_init.val() {
             self.tri_kind.d.next = self.cmd_init.val();
         }
-        if self.decode.imm_i4.val() == self.tri_object.val() {
+        if self.decode.imm_i4.val() == self.tri_enter.val() {
             self.tri_kind.d.next = self.cmd_object.val();
         }
         if self.decode.imm_i4.val() == self.tri_skip.val() {
@@ -860,7 +861,8 @@ impl<
         }
 
         // Triangle tester: the entry and its answer (refused, or the wait pending).
-        self.tester.engine.enqueue.next = self.tri_enqueue.q.val();
+        self.tester.engine.enqueue.next =
+            self.tri_enqueue.q.val() & (!(self.enter_offer.q.val() & self.instances.refused.val()));
         self.tester.queue_kind.next = self.tri_kind.q.val();
         self.tri_busy.next = false;
         if self.tri_queues.q.val() {
@@ -872,7 +874,7 @@ impl<
                 | self.instances.pending.val();
         }
         if self.enter_offer.q.val() {
-            self.tri_busy.next = self.instances.refused.val();
+            self.tri_busy.next = self.instances.refused.val() | self.tester.engine.full.val();
         }
         if self.ray_write.q.val() & self.store_write.val() {
             self.tri_busy.next = true;
@@ -891,6 +893,10 @@ impl<
         self.traversal_unit.t_min_write.next = self.t_min_write.q.val();
         self.traversal_unit.engine.enqueue.next = self.kd_enqueue.q.val();
         self.traversal_unit.engine_next.next = self.kd_answers.q.val();
+        self.traversal_unit.enter.next = self.enter_offer.q.val()
+            & (!self.instances.refused.val())
+            & (!self.tester.engine.full.val());
+        self.traversal_unit.entered.next = self.instances.ray_write.val();
         self.traversal_unit.world_write.next = self.world_write.q.val();
         self.traversal_unit.root_write.next = self.instances.root_write.val();
         self.traversal_unit.root_thread.next = self.instances.root_thread.val();

@@ -436,11 +436,12 @@ impl Asm {
         });
     }
 
-    /// Enters `instance`: the world ray in its object space becomes the thread's ray in both
-    /// coprocessors, its object root the root of the next `kd.start` with `KD_ENTERED`
-    /// (repeated while refused; a `tri.wait` waits for both).
-    pub fn tri_enter(&self, instance: Reg) {
-        self.coprocessor(Op::Tri, TriFn::Enter as u32, Reg::ZERO, instance, Reg::ZERO);
+    /// Enters `instance` and walks its object (`TriFn::Enter`): the world ray in its object
+    /// space becomes the thread's ray in both coprocessors, the traversal unit walks the
+    /// object from its root up to the last answer, answering any hit when `walk` has
+    /// `KD_ANY_HIT` (repeated while refused; a `kd.wait` waits for the walk's end).
+    pub fn tri_enter(&self, instance: Reg, walk: Reg) {
+        self.coprocessor(Op::Tri, TriFn::Enter as u32, Reg::ZERO, instance, walk);
     }
 
     /// Waits until the thread's queued entries are done; `dst` = the best t.

@@ -374,7 +374,6 @@ impl<'a> Machine<'a> {
                         tt.hit = false;
                         tt.best_t = b;
                     }
-                    TriFn::Object => (tt.object, tt.mailbox) = (a, Mailbox::default()),
                     TriFn::Skip => tt.skip = (a, b),
                     TriFn::List => self.test_list(tt, a, b, stats).map_err(fail)?,
                     TriFn::Wait => result = Some(tt.best_t),
@@ -419,6 +418,12 @@ impl<'a> Machine<'a> {
                         tt.o = units::transform(f, &m, o.try_into().unwrap(), true);
                         tt.d = units::transform(f, &m, d.try_into().unwrap(), false);
                         t.entered_root = words[instance_word::ROOT];
+                        // The next lists are the instance's (its `tri.object`, queued with
+                        // the entry), and the traversal unit walks its object from the
+                        // entered root once the ray is written.
+                        (t.tester.object, t.tester.mailbox) = (a, Mailbox::default());
+                        let walk = KD_ENTERED | (b & KD_ANY_HIT);
+                        stats.kd_nodes += self.object_walk(t, walk, 0, stats).map_err(fail)?;
                     }
                 }
                 // The twin's queue never refuses and its tests are done at once, so the
@@ -466,37 +471,8 @@ impl<'a> Machine<'a> {
                         top_stop(t, stop)?;
                     }
                     KdFn::Start => {
-                        // The whole walk: each leaf's list goes to the tester, whose closest
-                        // hit answers the unit (an any-hit walk ends at the first hit). Under
-                        // a top level the object walks have the stack below its region.
-                        let levels = if self.program.config.top_root.is_some() {
-                            TOP_STACK_BASE
-                        } else {
-                            STACK_LEVELS
-                        };
-                        let (root, t_max) = if a & KD_ENTERED != 0 {
-                            (t.entered_root, t.last_answer.0)
-                        } else {
-                            (root, b)
-                        };
-                        let tt = &mut t.tester;
-                        let ray = (tt.o, tt.d);
-                        let any_hit = a & KD_ANY_HIT != 0;
-                        let (mut walk, mut stop) =
-                            units::KdWalk::start(f, ray, root, (tt.t_min, t_max), levels, fetch)
-                                .map_err(fail)?;
-                        while let units::KdStop::Leaf { list, count } = stop {
-                            self.test_list(tt, list, list.wrapping_add(count), stats)
-                                .map_err(fail)?;
-                            t.last_answer = (tt.best_t, tt.hit);
-                            stop = if any_hit && tt.hit {
-                                units::KdStop::Finished
-                            } else {
-                                walk.next(f, ray, t.last_answer, levels, fetch)
-                                    .map_err(fail)?
-                            };
-                        }
-                        t.walk_words[0] = u32::from(t.last_answer.1);
+                        let n = self.object_walk(t, a, b, stats).map_err(fail)?;
+                        nodes.set(nodes.get() + n);
                     }
                     KdFn::Next => {
                         let stop = t
@@ -535,6 +511,52 @@ impl<'a> Machine<'a> {
         stats.instructions += 1;
         t.pc = next;
         Ok(())
+    }
+
+    /// An object's whole walk by the traversal unit (`kd.start` of an object, or the walk of
+    /// `tri.enter`): from `root` (its word, with `KD_ANY_HIT` and `KD_ENTERED`) up to `t_max`
+    /// (an entered object's: the thread's last answer), each leaf's list to the tester,
+    /// whose closest hit answers the unit (an any-hit walk ends at the first hit). Under a
+    /// top level the object walks have the stack below its region. Gives the nodes fetched.
+    fn object_walk(
+        &self,
+        t: &mut Thread,
+        root: u32,
+        t_max: u32,
+        stats: &mut RunStats,
+    ) -> Result<u64, String> {
+        let f = self.f;
+        let mut nodes = 0u64;
+        let mut fetch = |n| {
+            nodes += 1;
+            self.kd_node(n)
+        };
+        let levels = if self.program.config.top_root.is_some() {
+            TOP_STACK_BASE
+        } else {
+            STACK_LEVELS
+        };
+        let (node, t_max) = if root & KD_ENTERED != 0 {
+            (t.entered_root, t.last_answer.0)
+        } else {
+            (root & !(KD_ANY_HIT | KD_TOP | KD_ENTERED), t_max)
+        };
+        let tt = &mut t.tester;
+        let ray = (tt.o, tt.d);
+        let any_hit = root & KD_ANY_HIT != 0;
+        let (mut walk, mut stop) =
+            units::KdWalk::start(f, ray, node, (tt.t_min, t_max), levels, &mut fetch)?;
+        while let units::KdStop::Leaf { list, count } = stop {
+            self.test_list(tt, list, list.wrapping_add(count), stats)?;
+            t.last_answer = (tt.best_t, tt.hit);
+            stop = if any_hit && tt.hit {
+                units::KdStop::Finished
+            } else {
+                walk.next(f, ray, t.last_answer, levels, &mut fetch)?
+            };
+        }
+        t.walk_words[0] = u32::from(t.last_answer.1);
+        Ok(nodes)
     }
 
     /// The tester's work on the triangle list `from..to` of bank 1: the list unit's skip and

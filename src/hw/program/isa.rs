@@ -194,8 +194,6 @@ pub enum TriFn {
     /// `dst` = the instance, the triangle of the closest hit.
     Instance,
     Triangle,
-    /// Queue: the next lists are of instance `A`; empty the triangle mailbox.
-    Object,
     /// Queue: the query does not test triangle `B` of instance `A` (the one it starts on).
     Skip,
     /// Ray generation's camera words `2 s`, `2 s + 1` = `A`, `B` for the instruction's shift
@@ -208,16 +206,18 @@ pub enum TriFn {
     /// pair `s` (the shift field, 0..3, the ray words' pairs: `o.x o.y`, `o.z d.x`, `d.y d.z`)
     /// = `A`, `B`.
     World,
-    /// Enter instance `A` (its record at `A * INSTANCE_WORDS` in bank 4): the thread's world
-    /// ray through the record's world-to-object 3x4 (`units::transform`, origin then
-    /// direction) becomes its ray in both coprocessors, and the record's object root the
-    /// root of its next `kd.start` with [`KD_ENTERED`]; the next `wait` waits for both.
-    /// Repeats while refused.
+    /// Enter instance `A` (its record at `A * INSTANCE_WORDS` in bank 4) and walk its object:
+    /// the thread's world ray through the record's world-to-object 3x4 (`units::transform`,
+    /// origin then direction) becomes its ray in both coprocessors, the next lists are the
+    /// instance's (an `Object` queued with the entry), and once the ray is written the
+    /// traversal unit walks the record's object root up to the thread's last answer (as
+    /// `kd.start` with [`KD_ENTERED`], answering any hit when `B` has [`KD_ANY_HIT`]); the
+    /// thread's next `kd.wait` waits for the walk's end. Repeats while refused.
     Enter,
 }
 
 impl TriFn {
-    pub const ALL: [TriFn; 15] = [
+    pub const ALL: [TriFn; 14] = [
         TriFn::RayOxy,
         TriFn::RayOzDx,
         TriFn::RayDyz,
@@ -227,7 +227,6 @@ impl TriFn {
         TriFn::Hit,
         TriFn::Instance,
         TriFn::Triangle,
-        TriFn::Object,
         TriFn::Skip,
         TriFn::Camera,
         TriFn::Dir,
@@ -248,7 +247,6 @@ impl TriFn {
             TriFn::Hit => "hit",
             TriFn::Instance => "instance",
             TriFn::Triangle => "triangle",
-            TriFn::Object => "object",
             TriFn::Skip => "skip",
             TriFn::Camera => "camera",
             TriFn::Dir => "dir",
@@ -258,10 +256,7 @@ impl TriFn {
     }
     /// Whether the function puts an entry in the tester's queue.
     pub fn queues(self) -> bool {
-        matches!(
-            self,
-            TriFn::Init | TriFn::List | TriFn::Object | TriFn::Skip
-        )
+        matches!(self, TriFn::Init | TriFn::List | TriFn::Skip)
     }
 }
 

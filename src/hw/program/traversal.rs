@@ -11,26 +11,26 @@
 //! The top-level tree of a scene with instances is walked by the traversal unit too
 //! (`kd.start` with `KD_TOP`), on the world ray that `tri.world` gave it (and instance entry)
 //! at the trace's start: the unit steps through the inner nodes and stops at each leaf, and
-//! the thread, woken, reads the leaf's instance list (`kd.wait`, `kd.leaf`), enters each
+//! the thread, woken, reads the leaf's instance list (`kd.wait`, `kd.leaf`) and enters each
 //! instance not yet in the instance mailbox (`tri.enter`: the instance entry unit,
 //! `hw::engine::InstanceRays`, transforms the world ray into the object's space through the
-//! one TransformUnit and writes it into both coprocessors; the thread loads the object's root
-//! and waits for the ray), walks the object, and sends the closest hit back (`kd.next`), with
+//! one TransformUnit and writes it into both coprocessors, and the traversal unit then walks
+//! the object from the root the entry read, up to the closest hit so far); the thread sleeps
+//! until that walk ends, and after the list sends the closest hit back (`kd.next`), with
 //! which the unit ends the walk or pops its top-level stack, as `units::KdWalk` does.
 //!
 //! Cost (instructions = engine turns): per object walk 2 or 3 (start, wait with the hit flag,
 //! and the closest hit's t without a top level), whatever its leaves; a waiting thread sleeps
 //! until the walk ends (the tree's nodes and the leaves' triangles cost it no instruction);
 //! per top-level leaf 5 (the wait, the list's end, the end check, `kd.next` and the loop's
-//! jump) and no instruction per top-level inner node; per instance entered 10 (the list and
-//! the mailbox, `tri.enter` with the instance, `tri.object`, the wait, the walk from the root
-//! the entry found, up to the closest hit the unit keeps, the loop) and 4 per instance the
-//! mailbox skips; per trace 3 for the world ray, 2 for the top-level walk's start and 1 for
-//! the closest hit's t.
+//! jump) and no instruction per top-level inner node; per instance entered 6 (the list word,
+//! its address, the mailbox, `tri.enter`, the walk's wait, the loop) and 4 per instance the
+//! mailbox skips, with 2 more per walk of a shadow query (its answer); per trace 3 for the
+//! world ray, 2 for the top-level walk's start and 1 for the closest hit's t.
 
 use super::asm::Asm;
 use super::asm::{Label, Reg, Val};
-use super::isa::{Op, TriFn, KD_ENTERED, KD_TOP, KD_WALK_ENDED, MAILBOX_INSTANCES};
+use super::isa::{Op, TriFn, KD_TOP, KD_WALK_ENDED, MAILBOX_INSTANCES};
 use super::Gen;
 use crate::layout::LISTS;
 
@@ -121,13 +121,19 @@ impl Gen<'_> {
     /// An object's kd tree, walked by the traversal unit from `from` (see `walk_root`), which
     /// hands each leaf's triangles to the triangle tester and goes on with its closest hit by
     /// itself; the thread sleeps until the walk ends and reads the hit flag. An answered
-    /// any-hit query jumps to `answered`. `t_max` bounds the walk's segment (but for an
-    /// entered object's, which the closest hit so far bounds).
+    /// any-hit query jumps to `answered`. `t_max` bounds the walk's segment.
     fn walk_object(&self, from: Reg, t_max: Reg, answered: Label) {
         let a = self.asm;
-        let s = &self.s;
         a.section("traversal");
         a.kd_start(from, t_max);
+        self.walk_end(answered);
+    }
+
+    /// Sleeps until the thread's object walk ends and reads its hit flag; an answered any-hit
+    /// query jumps to `answered`.
+    fn walk_end(&self, answered: Label) {
+        let a = self.asm;
+        let s = &self.s;
         a.kd_wait(if self.hit_by_t() { Reg::ZERO } else { s.hit });
         if self.c.shadows {
             // A shadow query is answered by any hit.
@@ -156,46 +162,46 @@ impl Gen<'_> {
         let top = a.keep(Val::K(root | KD_TOP));
         a.kd_start(top, s.q_t_max);
         a.free(top);
-        // Every instance's walk starts from the root of the instance entered last.
-        let entered = self.walk_root(Val::K(KD_ENTERED));
+        // Each instance's walk answers a shadow query with its first hit.
+        let walk = self.walk_root(Val::K(0));
         let (leaf, finished) = (a.label(), a.label());
         a.bind(leaf);
         a.section("traversal");
         a.kd_wait(list);
         a.branch(Op::Beq, list.into(), Val::K(KD_WALK_ENDED), false, finished);
         a.kd_leaf(end);
-        self.instance_list(list, end, entered, answered);
+        self.instance_list(list, end, walk, answered);
         a.section("traversal");
         a.kd_next();
         a.jump(leaf);
         a.bind(finished);
         a.free(list);
         a.free(end);
-        self.free_root(entered);
+        self.free_root(walk);
     }
 
-    /// The instances of a top-level leaf, `list..end` in bank 1 (`list` moves on to `end`),
-    /// each walked with `kd.start entered` (`walk_root` of `KD_ENTERED`).
-    fn instance_list(&self, list: Reg, end: Reg, entered: Reg, answered: Label) {
+    /// The instances of a top-level leaf, `list..end` in bank 1 (`list` moves on to `end`;
+    /// the traversal unit stops only at leaves with instances), each entered and walked with
+    /// `tri.enter` (`walk`: see `walk_root`).
+    fn instance_list(&self, list: Reg, end: Reg, walk: Reg, answered: Label) {
         let a = self.asm;
         a.section("instances");
         let (p, instance) = (list, a.reg());
-        let (next, done) = (a.label(), a.label());
+        let (next, seen) = (a.label(), a.label());
         a.bind(next);
         a.section("instances");
-        a.branch(Op::Beq, p.into(), end.into(), false, done);
         a.load_to(instance, LISTS, p.into(), 0, 0);
         a.op_to(Op::Add, p, p.into(), Val::K(1));
-        a.mailbox_check(MAILBOX_INSTANCES, instance, next);
-        // Instance entry (`hw::engine::InstanceRays`): the world ray in the instance's object
-        // space becomes the thread's ray in both coprocessors, its object's root the walk's;
-        // the wait waits for both.
-        a.tri_enter(instance);
-        a.tri_queue(TriFn::Object, instance, Reg::ZERO);
-        a.tri_wait(Reg::ZERO);
-        self.walk_object(entered, Reg::ZERO, answered);
-        a.jump(next);
-        a.bind(done);
+        a.mailbox_check(MAILBOX_INSTANCES, instance, seen);
+        // Instance entry (`hw::engine::InstanceRays`) writes the world ray in the instance's
+        // object space into both coprocessors and the object's root into the traversal unit,
+        // which then walks it; the thread sleeps until the walk ends.
+        a.tri_enter(instance, walk);
+        a.section("traversal");
+        self.walk_end(answered);
+        a.section("instances");
+        a.bind(seen);
+        a.branch(Op::Beq, p.into(), end.into(), true, next);
         a.free(instance);
     }
 }
