@@ -403,10 +403,11 @@ pub struct FrameReport {
     pub intersect_busy: u64,
     /// Clocks in which the traversal unit started a node decision.
     pub traversal_busy: u64,
-    /// Clocks in which ray generation's and instance entry's requests took the
-    /// TransformUnit.
+    /// Clocks in which ray generation's, instance entry's and shading's (world normals)
+    /// requests took the TransformUnit.
     pub raygen_busy: u64,
     pub instance_busy: u64,
+    pub shading_busy: u64,
     pub pixels: u64,
     pub mismatches: Vec<Mismatch>,
     pub differing_pixels: usize,
@@ -438,14 +439,15 @@ impl FrameReport {
         hz / self.cycles as f64
     }
     /// Shares of the frame's clocks in which the TransformUnit (for triangle tests, for ray
-    /// generation, for instance entry), the IntersectUnit and the traversal unit's decision
-    /// took an input.
-    pub fn unit_busy_shares(&self) -> [f64; 5] {
+    /// generation, for instance entry, for shading), the IntersectUnit and the traversal
+    /// unit's decision took an input.
+    pub fn unit_busy_shares(&self) -> [f64; 6] {
         let c = self.cycles.max(1) as f64;
         [
             self.transform_busy,
             self.raygen_busy,
             self.instance_busy,
+            self.shading_busy,
             self.intersect_busy,
             self.traversal_busy,
         ]
@@ -610,6 +612,7 @@ pub fn simulate_scene(
             traversal_busy: fr.traversal_busy,
             raygen_busy: fr.raygen_busy,
             instance_busy: fr.instance_busy,
+            shading_busy: fr.shading_busy,
             pixels: u64::from(w * h),
             differing_pixels: differing.len(),
             mismatches,

@@ -342,16 +342,19 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         .iter()
         .map(|(s, v)| format!("{s} {:.0}%", 100.0 * v))
         .collect();
-    let [triangles, raygen, instances, intersect, traversal] = r.frames[0].unit_busy_shares();
+    let [triangles, raygen, instances, shading, intersect, traversal] =
+        r.frames[0].unit_busy_shares();
     let notes = [
         format!("fps at {mhz:.1} MHz ({clock_source})"),
         format!(
             "busy (frame 0): TransformUnit {:.1}% (triangle tests {:.1}%, ray generation {:.1}%, \
-             instance entry {:.1}%), IntersectUnit {:.1}%, traversal unit {:.1}% of the clocks",
-            100.0 * (triangles + raygen + instances),
+             instance entry {:.1}%, shading {:.1}%), IntersectUnit {:.1}%, traversal unit {:.1}% \
+             of the clocks",
+            100.0 * (triangles + raygen + instances + shading),
             100.0 * triangles,
             100.0 * raygen,
             100.0 * instances,
+            100.0 * shading,
             100.0 * intersect,
             100.0 * traversal
         ),

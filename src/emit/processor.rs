@@ -8,7 +8,8 @@
 //! `bank0_read, bank0_addr[23:0], bank0_rdata[31:0]` (the kd nodes, read by the traversal
 //! unit) and the same for banks 2 and 3 (the triangles, which the triangle tester reads in
 //! parallel), `transform_busy[31:0], intersect_busy[31:0], traversal_busy[31:0],
-//! raygen_busy[31:0], instance_busy[31:0]` (activity counters of the frame), and the `vga_`
+//! raygen_busy[31:0], instance_busy[31:0], shading_busy[31:0]` (activity counters of the
+//! frame), and the `vga_`
 //! display ports.
 //!
 //! [`processor_testbench`] writes module `tb` for Icarus (`iverilog -g2012`) and Verilator 5
@@ -19,7 +20,8 @@
 //! (only the words that changed), a start pulse, a wait for `done` or the cycle limit (then
 //! `TIMEOUT` and a non-zero exit), and the frame buffer written to `frame<k>.hex` (one
 //! `RRGGBB` word a line) with `cycles instructions transform_busy intersect_busy
-//! traversal_busy raygen_busy instance_busy` in `frame<k>.stats`, in the current folder or
+//! traversal_busy raygen_busy instance_busy shading_busy` in `frame<k>.stats`, in the current
+//! folder or
 //! `+out_dir=DIR`. Both files start with the [`GeneratedBy`] header.
 
 use std::fmt::Write as _;
@@ -272,7 +274,7 @@ const TESTBENCH_DRIVES: [(&str, &str); 5] = [
 ];
 
 /// The ports the testbench's memory model and frame loop use by name.
-const TESTBENCH_USES: [&str; 22] = [
+const TESTBENCH_USES: [&str; 23] = [
     "done",
     "cycles",
     "instructions",
@@ -294,6 +296,7 @@ const TESTBENCH_USES: [&str; 22] = [
     "traversal_busy",
     "raygen_busy",
     "instance_busy",
+    "shading_busy",
     "vga_fb_addr",
 ];
 
@@ -486,8 +489,9 @@ pub fn processor_testbench(
              \x20   fd = $fopen({{out_dir, \"/frame{fr}.hex\"}}, \"w\");\n\
              \x20   for (k = 0; k < {px}; k = k + 1) $fwrite(fd, \"%06h\\n\", bank5[{fb} + k][23:0]);\n\
              \x20   $fclose(fd);\n    fd = $fopen({{out_dir, \"/frame{fr}.stats\"}}, \"w\");\n\
-             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d\\n\", cycles, instructions, transform_busy,\n\
-             \x20     intersect_busy, traversal_busy, raygen_busy, instance_busy);\n    $fclose(fd);\n\
+             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d %0d\\n\", cycles, instructions,\n\
+             \x20     transform_busy, intersect_busy, traversal_busy, raygen_busy, instance_busy,\n\
+             \x20     shading_busy);\n    $fclose(fd);\n\
              \x20   $display(\"frame {fr}: %0d cycles, %0d instructions\", cycles, instructions);",
             limit = frames.cycle_limit,
             px = frames.pixels,

@@ -7,9 +7,9 @@
 //! 1, 4 and 5, `bank0`, `bank2`, `bank3` read the kd nodes and the two triangle banks, each
 //! port one word per clock `mem_latency` clocks after the request; `fb` writes the frame
 //! buffer (bank 5); `transform_busy`, `intersect_busy`, `traversal_busy` count the frame's
-//! clocks in which those units took work (the TransformUnit's triangle tests), `raygen_busy`
-//! and `instance_busy` the clocks in which ray generation's and instance entry's requests
-//! took the TransformUnit. In the pixel clock (`vga.clock`): the display reads
+//! clocks in which those units took work (the TransformUnit's triangle tests), `raygen_busy`,
+//! `instance_busy` and `shading_busy` the clocks in which ray generation's, instance entry's
+//! and shading's (world normals) requests took the TransformUnit. In the pixel clock (`vga.clock`): the display reads
 //! the frame buffer and drives the monitor. The Verilog names a bundle's port
 //! `<bundle>_<port>` (`mem_read`, `vga_hsync`): `Processor::ports` lists them, and the
 //! constraints and testbench are written from that list.
@@ -57,6 +57,7 @@ pub struct Processor<
     pub traversal_busy: Signal<Out, Bits<32>>,
     pub raygen_busy: Signal<Out, Bits<32>>,
     pub instance_busy: Signal<Out, Bits<32>>,
+    pub shading_busy: Signal<Out, Bits<32>>,
     pub vga: VgaPort,
     engine: ThreadEngine<W, E, M, S, S1, X2, T, P, DX, DL>,
     display: VgaDisplay,
@@ -113,6 +114,7 @@ impl<
             traversal_busy: Default::default(),
             raygen_busy: Default::default(),
             instance_busy: Default::default(),
+            shading_busy: Default::default(),
             vga: Default::default(),
             engine: ThreadEngine::new(program, threads, mem_latency),
             display: VgaDisplay::new(mode, c.width, c.height, c.frame_buffer)?,
@@ -201,6 +203,7 @@ impl<
         self.traversal_busy.next = self.engine.traversal_busy.val();
         self.raygen_busy.next = self.engine.raygen_busy.val();
         self.instance_busy.next = self.engine.instance_busy.val();
+        self.shading_busy.next = self.engine.shading_busy.val();
 
         self.display.clock.next = self.vga.clock.val();
         self.display.reset.next = self.vga.reset.val();

@@ -32,10 +32,11 @@ pub struct SimFrame {
     pub intersect_busy: u64,
     /// Clocks in which the traversal unit started a node decision.
     pub traversal_busy: u64,
-    /// Clocks in which ray generation's and instance entry's requests took the
-    /// TransformUnit.
+    /// Clocks in which ray generation's, instance entry's and shading's (world normals)
+    /// requests took the TransformUnit.
     pub raygen_busy: u64,
     pub instance_busy: u64,
+    pub shading_busy: u64,
 }
 
 /// What a processor simulation produced.
@@ -300,10 +301,10 @@ pub fn simulate_processor(
             .split_whitespace()
             .filter_map(|w| w.parse().ok())
             .collect();
-        if nums.len() != 7 {
+        if nums.len() != 8 {
             bail!(
                 "{}: expected `cycles instructions transform_busy intersect_busy traversal_busy \
-                 raygen_busy instance_busy`, \
+                 raygen_busy instance_busy shading_busy`, \
                  got `{}`",
                 stats_path.display(),
                 stats.trim()
@@ -318,6 +319,7 @@ pub fn simulate_processor(
             traversal_busy: nums[4],
             raygen_busy: nums[5],
             instance_busy: nums[6],
+            shading_busy: nums[7],
         });
     }
     let vga = if capture_vga {

@@ -55,11 +55,13 @@ const MATRIX_WORDS: u64 = 12;
 pub enum EntryPhase {
     /// No entry begun: the slot's entry, if any, begins.
     Idle,
-    /// Reading the matrix's twelve words and the root.
+    /// Reading the matrix's twelve words and the root (a normal's: its nine words as twelve).
     Fetch,
     /// The origin's request waits for the unit; then the direction's.
     Origin,
     Direction,
+    /// A normal's one request waits for the unit.
+    Normal,
 }
 
 #[derive(LogicBlock)]
@@ -72,6 +74,9 @@ pub struct InstanceRays<const W: usize> {
     pub word_b: Signal<In, Bits<32>>,
     pub thread: Signal<In, Bits<5>>,
     pub offer: Signal<In, Bit>,
+    /// The offer is a normal's (`tri.normal`): `word_b` is its z, x and y are the thread's
+    /// world words 0 and 1.
+    pub offer_normal: Signal<In, Bit>,
     pub instance_id: Signal<In, Bits<24>>,
     pub refused: Signal<Out, Bit>,
     pub bus_free: Signal<In, Bit>,
@@ -86,16 +91,21 @@ pub struct InstanceRays<const W: usize> {
     pub gen_v: [Signal<Out, Bits<W>>; 3],
     pub gen_point: Signal<Out, Bit>,
     pub gen_direction: Signal<Out, Bit>,
+    pub gen_normal: Signal<Out, Bit>,
     pub gen_thread: Signal<Out, Bits<5>>,
     pub gen_take: Signal<In, Bit>,
     pub out_valid: Signal<In, Bit>,
     pub out_direction: Signal<In, Bit>,
+    pub out_normal: Signal<In, Bit>,
     pub out_thread: Signal<In, Bits<5>>,
     pub out_v: [Signal<In, Bits<W>>; 3],
     pub ray_write: Signal<Out, Bit>,
     pub ray_thread: Signal<Out, Bits<5>>,
     pub ray_o: [Signal<Out, Bits<W>>; 3],
     pub ray_d: [Signal<Out, Bits<W>>; 3],
+    /// A world normal for `ray_thread`, on `ray_d` (for ray generation's direction store,
+    /// which `tri.dir` reads).
+    pub normal_write: Signal<Out, Bit>,
     pub done_mask: Signal<Out, Bits<32>>,
     pub query_thread: Signal<In, Bits<5>>,
     pub pending: Signal<Out, Bit>,
@@ -106,18 +116,28 @@ pub struct InstanceRays<const W: usize> {
     slot_valid: DFF<Bit>,
     slot_thread: DFF<Bits<5>>,
     slot_instance: DFF<Bits<24>>,
+    slot_normal: DFF<Bit>,
+    slot_nz: DFF<Bits<W>>,
     taken: Signal<Local, Bit>,
     /// The entry begun: its thread and matrix's address, the words read and arrived, and the
     /// reads in flight (bit k: a read k + 1 clocks ago).
     phase: DFF<EntryPhase>,
     entry_thread: DFF<Bits<5>>,
     entry_record: DFF<Bits<24>>,
+    entry_normal: DFF<Bit>,
+    entry_nz: DFF<Bits<W>>,
+    /// Words the entry reads: 13, or a normal's 12.
+    entry_words: Signal<Local, Bits<4>>,
+    /// A normal's word `issued`: row `issued / 4`, column `issued % 4` (the fourth, which a
+    /// vector never reads, repeats the third).
+    normal_offset: Signal<Local, Bits<24>>,
     issued: DFF<Bits<4>>,
     arrived: DFF<Bits<4>>,
     flight: DFF<Bits<8>>,
     reading: Signal<Local, Bit>,
     arrives: Signal<Local, Bit>,
     root_arrives: Signal<Local, Bit>,
+    last_normal_word: Signal<Local, Bit>,
     /// The matrix, its words shifted in from the top as they arrive (word 0 ends in `matrix[0]`).
     matrix: [DFF<Bits<W>>; 12],
     /// The origin's result, until the direction's comes.
@@ -128,6 +148,7 @@ pub struct InstanceRays<const W: usize> {
     write_o: [DFF<Bits<W>>; 3],
     write_d: [DFF<Bits<W>>; 3],
     write_mask: DFF<Bits<32>>,
+    normal_valid: DFF<Bit>,
     /// Per thread: its entered ray is not written yet (bit `thread`).
     waiting: DFF<Bits<32>>,
     taken_mask: Signal<Local, Bits<32>>,
@@ -137,6 +158,8 @@ pub struct InstanceRays<const W: usize> {
     c_words: Constant<Bits<4>>,
     c_last_word: Constant<Bits<4>>,
     c_first_word: Constant<Bits<24>>,
+    c_normal_first: Constant<Bits<24>>,
+    c_normal_words: Constant<Bits<4>>,
     /// The root's word after the matrix's first.
     c_root_offset: Constant<Bits<24>>,
     c_ml_last: Constant<Bits<3>>,
@@ -155,6 +178,7 @@ impl<const W: usize> InstanceRays<W> {
             word_b: Default::default(),
             thread: Default::default(),
             offer: Default::default(),
+            offer_normal: Default::default(),
             instance_id: Default::default(),
             refused: Default::default(),
             bus_free: Default::default(),
@@ -169,16 +193,19 @@ impl<const W: usize> InstanceRays<W> {
             gen_v: Default::default(),
             gen_point: Default::default(),
             gen_direction: Default::default(),
+            gen_normal: Default::default(),
             gen_thread: Default::default(),
             gen_take: Default::default(),
             out_valid: Default::default(),
             out_direction: Default::default(),
+            out_normal: Default::default(),
             out_thread: Default::default(),
             out_v: Default::default(),
             ray_write: Default::default(),
             ray_thread: Default::default(),
             ray_o: Default::default(),
             ray_d: Default::default(),
+            normal_write: Default::default(),
             done_mask: Default::default(),
             query_thread: Default::default(),
             pending: Default::default(),
@@ -186,16 +213,23 @@ impl<const W: usize> InstanceRays<W> {
             slot_valid: Default::default(),
             slot_thread: Default::default(),
             slot_instance: Default::default(),
+            slot_normal: Default::default(),
+            slot_nz: Default::default(),
             taken: Default::default(),
             phase: Default::default(),
             entry_thread: Default::default(),
             entry_record: Default::default(),
+            entry_normal: Default::default(),
+            entry_nz: Default::default(),
+            entry_words: Default::default(),
+            normal_offset: Default::default(),
             issued: Default::default(),
             arrived: Default::default(),
             flight: Default::default(),
             reading: Default::default(),
             arrives: Default::default(),
             root_arrives: Default::default(),
+            last_normal_word: Default::default(),
             matrix: Default::default(),
             origin: Default::default(),
             write_valid: Default::default(),
@@ -203,6 +237,7 @@ impl<const W: usize> InstanceRays<W> {
             write_o: Default::default(),
             write_d: Default::default(),
             write_mask: Default::default(),
+            normal_valid: Default::default(),
             waiting: Default::default(),
             taken_mask: Default::default(),
             pending_r: Default::default(),
@@ -211,6 +246,8 @@ impl<const W: usize> InstanceRays<W> {
             c_words: Constant::new((MATRIX_WORDS + 1).into()),
             c_last_word: Constant::new(MATRIX_WORDS.into()),
             c_first_word: Constant::new((instance_word::WORLD_TO_OBJECT as u64).into()),
+            c_normal_first: Constant::new((instance_word::NORMAL_MATRIX as u64).into()),
+            c_normal_words: Constant::new(MATRIX_WORDS.into()),
             c_root_offset: Constant::new(
                 ((instance_word::ROOT - instance_word::WORLD_TO_OBJECT) as u64).into(),
             ),
@@ -228,15 +265,20 @@ impl<const W: usize> Logic for InstanceRays<W> {
             slot_valid,
             slot_thread,
             slot_instance,
+            slot_normal,
+            slot_nz,
             phase,
             entry_thread,
             entry_record,
+            entry_normal,
+            entry_nz,
             issued,
             arrived,
             flight,
             write_valid,
             write_thread,
             write_mask,
+            normal_valid,
             waiting,
             pending_r
         );
@@ -276,27 +318,52 @@ impl<const W: usize> Logic for InstanceRays<W> {
             self.slot_valid.d.next = true;
             self.slot_thread.d.next = self.thread.val();
             self.slot_instance.d.next = self.instance_id.val();
+            self.slot_normal.d.next = self.offer_normal.val();
+            self.slot_nz.d.next = self.word_b.val().get_bits::<W>(0);
         }
         if (self.phase.q.val() == EntryPhase::Idle) & self.slot_valid.q.val() {
             self.slot_valid.d.next = false;
             self.entry_thread.d.next = self.slot_thread.q.val();
+            self.entry_normal.d.next = self.slot_normal.q.val();
+            self.entry_nz.d.next = self.slot_nz.q.val();
             // `INSTANCE_WORDS` = 24 = 16 + 8.
             self.entry_record.d.next = (self.slot_instance.q.val() << 4)
                 + (self.slot_instance.q.val() << 3)
                 + self.c_first_word.val();
+            if self.slot_normal.q.val() {
+                self.entry_record.d.next = (self.slot_instance.q.val() << 4)
+                    + (self.slot_instance.q.val() << 3)
+                    + self.c_normal_first.val();
+            }
             self.issued.d.next = 0.into();
             self.arrived.d.next = 0.into();
             self.phase.d.next = EntryPhase::Fetch;
         }
 
         // Fetch: a read in each clock the bus is free; each word shifts in as it arrives.
+        self.entry_words.next = self.c_words.val();
+        if self.entry_normal.q.val() {
+            self.entry_words.next = self.c_normal_words.val();
+        }
         self.reading.next = (self.phase.q.val() == EntryPhase::Fetch)
-            & (self.issued.q.val() != self.c_words.val())
+            & (self.issued.q.val() != self.entry_words.val())
             & self.bus_free.val();
         self.read.next = self.reading.val();
         self.addr.next = self.entry_record.q.val() + bit_cast::<24, 4>(self.issued.q.val());
         if self.issued.q.val() == self.c_last_word.val() {
             self.addr.next = self.entry_record.q.val() + self.c_root_offset.val();
+        }
+        self.normal_offset.next = (bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(2)) << 1)
+            + bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(2))
+            + bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(0));
+        if self.issued.q.val().get_bits::<2>(0) == 3 {
+            self.normal_offset.next = (bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(2))
+                << 1)
+                + bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(2))
+                + 2;
+        }
+        if self.entry_normal.q.val() {
+            self.addr.next = self.entry_record.q.val() + self.normal_offset.val();
         }
         if self.reading.val() {
             self.issued.d.next = self.issued.q.val() + 1;
@@ -318,15 +385,24 @@ impl<const W: usize> Logic for InstanceRays<W> {
         if self.root_arrives.val() {
             self.phase.d.next = EntryPhase::Origin;
         }
+        self.last_normal_word.next = self.arrives.val()
+            & self.entry_normal.q.val()
+            & (self.arrived.q.val() == self.c_last_word.val() - 1);
+        if self.last_normal_word.val() {
+            self.phase.d.next = EntryPhase::Normal;
+        }
         self.root_write.next = self.root_arrives.val();
         self.root_thread.next = self.entry_thread.q.val();
         self.root.next = self.rdata.val().get_bits::<26>(0);
 
-        // The requests: the origin as a point, then the direction as a vector.
+        // The requests: the origin as a point, then the direction as a vector; or the normal
+        // as a vector.
         self.gen_valid.next = (self.phase.q.val() == EntryPhase::Origin)
-            | (self.phase.q.val() == EntryPhase::Direction);
+            | (self.phase.q.val() == EntryPhase::Direction)
+            | (self.phase.q.val() == EntryPhase::Normal);
         self.gen_point.next = self.phase.q.val() == EntryPhase::Origin;
         self.gen_direction.next = self.phase.q.val() == EntryPhase::Direction;
+        self.gen_normal.next = self.phase.q.val() == EntryPhase::Normal;
         self.gen_thread.next = self.entry_thread.q.val();
         for k in 0..12 {
             self.gen_m[k].next = self.matrix[k].q.val();
@@ -338,25 +414,35 @@ impl<const W: usize> Logic for InstanceRays<W> {
                 self.gen_v[k].next = self.world[3 + k].read_data.val();
             }
         }
+        if self.phase.q.val() == EntryPhase::Normal {
+            self.gen_v[0].next = self.world[0].read_data.val();
+            self.gen_v[1].next = self.world[1].read_data.val();
+            self.gen_v[2].next = self.entry_nz.q.val();
+        }
         if self.gen_take.val() & (self.phase.q.val() == EntryPhase::Origin) {
             self.phase.d.next = EntryPhase::Direction;
         }
-        if self.gen_take.val() & (self.phase.q.val() == EntryPhase::Direction) {
+        if self.gen_take.val()
+            & ((self.phase.q.val() == EntryPhase::Direction)
+                | (self.phase.q.val() == EntryPhase::Normal))
+        {
             self.phase.d.next = EntryPhase::Idle;
         }
 
         // The results: the origin waits for the direction; then the ray is written.
-        if self.out_valid.val() & (!self.out_direction.val()) {
+        if self.out_valid.val() & (!self.out_direction.val()) & (!self.out_normal.val()) {
             for k in 0..3 {
                 self.origin[k].d.next = self.out_v[k].val();
             }
         }
         self.write_valid.d.next = self.out_valid.val() & self.out_direction.val();
+        self.normal_valid.d.next = self.out_valid.val() & self.out_normal.val();
         self.write_thread.d.next = self.out_thread.val();
         self.write_mask.d.next = 0.into();
-        if self.out_valid.val() & self.out_direction.val() {
+        if self.out_valid.val() & (self.out_direction.val() | self.out_normal.val()) {
             self.write_mask.d.next = self.c_one.val() << self.out_thread.val();
         }
+        self.normal_write.next = self.normal_valid.q.val();
         self.ray_write.next = self.write_valid.q.val();
         self.ray_thread.next = self.write_thread.q.val();
         for k in 0..3 {

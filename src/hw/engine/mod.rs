@@ -167,13 +167,14 @@ pub enum ResultSource {
 }
 
 /// Whose request the tester's TransformUnit computes besides the triangle tests (its
-/// `gen_client` bits, echoed with the result): bit 0 is set for instance entry, bit 1 for its
-/// direction.
+/// `gen_client` bits, echoed with the result): ray generation's, or instance entry's (the
+/// ray's origin and direction, or a world normal for shading).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub enum GenClient {
     Primary = 0b00,
     InstanceOrigin = 0b01,
     InstanceDirection = 0b11,
+    InstanceNormal = 0b10,
 }
 
 /// An opcode as the decoders compare it, from its one definition in `isa::Op`.
@@ -245,6 +246,7 @@ pub struct ThreadEngine<
     /// TransformUnit.
     pub raygen_busy: Signal<Out, Bits<32>>,
     pub instance_busy: Signal<Out, Bits<32>>,
+    pub shading_busy: Signal<Out, Bits<32>>,
 
     // The pipeline's stages.
     scheduler: Scheduler,
@@ -275,6 +277,7 @@ pub struct ThreadEngine<
     traversal_count: DFF<Bits<32>>,
     raygen_count: DFF<Bits<32>>,
     instance_count: DFF<Bits<32>>,
+    shading_count: DFF<Bits<32>>,
     frame_start: Signal<Local, Bit>,
     // The memory and frame-buffer ports' request registers.
     /// The load's bank one-hot (`CoprocessorPort::load_banks`); `mem_bank_r` its number, for
@@ -293,6 +296,7 @@ pub struct ThreadEngine<
     camera_write: DFF<Bit>,
     world_write: DFF<Bit>,
     enter_offer: DFF<Bit>,
+    normal_offer: DFF<Bit>,
     tri_enqueue: DFF<Bit>,
     tri_queues: DFF<Bit>,
     tri_kind: DFF<Bits<2>>,
@@ -340,6 +344,7 @@ pub struct ThreadEngine<
     tri_camera: Constant<Bits<32>>,
     tri_world: Constant<Bits<32>>,
     tri_enter: Constant<Bits<32>>,
+    tri_normal: Constant<Bits<32>>,
     kd_start: Constant<Bits<32>>,
     kd_wait: Constant<Bits<32>>,
     kd_next: Constant<Bits<32>>,
@@ -351,6 +356,7 @@ pub struct ThreadEngine<
     bank_instances: Constant<Bits<3>>,
     client_primary: Constant<Bits<2>>,
     client_origin: Constant<Bits<2>>,
+    client_normal: Constant<Bits<2>>,
     client_direction: Constant<Bits<2>>,
     /// `mem_load_r`'s bit 0, shifted to the load's bank.
     one_bank: Constant<Bits<{ layout::BANKS }>>,
@@ -411,6 +417,7 @@ impl<
             transform_busy: Default::default(),
             raygen_busy: Default::default(),
             instance_busy: Default::default(),
+            shading_busy: Default::default(),
             intersect_busy: Default::default(),
             traversal_busy: Default::default(),
             scheduler: Scheduler::new(threads, reserve_ahead),
@@ -435,6 +442,7 @@ impl<
             transform_count: Default::default(),
             raygen_count: Default::default(),
             instance_count: Default::default(),
+            shading_count: Default::default(),
             intersect_count: Default::default(),
             traversal_count: Default::default(),
             frame_start: Default::default(),
@@ -449,6 +457,7 @@ impl<
             camera_write: Default::default(),
             world_write: Default::default(),
             enter_offer: Default::default(),
+            normal_offer: Default::default(),
             tri_enqueue: Default::default(),
             tri_queues: Default::default(),
             tri_kind: Default::default(),
@@ -488,6 +497,7 @@ impl<
             tri_camera: tri_fn(TriFn::Camera),
             tri_world: tri_fn(TriFn::World),
             tri_enter: tri_fn(TriFn::Enter),
+            tri_normal: tri_fn(TriFn::Normal),
             kd_start: kd_fn(KdFn::Start),
             kd_wait: kd_fn(KdFn::Wait),
             kd_next: kd_fn(KdFn::Next),
@@ -499,6 +509,7 @@ impl<
             bank_instances: bank(layout::INSTANCES),
             client_primary: Constant::new((GenClient::Primary as u64).into()),
             client_origin: Constant::new((GenClient::InstanceOrigin as u64).into()),
+            client_normal: Constant::new((GenClient::InstanceNormal as u64).into()),
             client_direction: Constant::new((GenClient::InstanceDirection as u64).into()),
             one_bank: Constant::new(1u64.into()),
             shared_banks: Constant::new(SHARED_BUS_BANKS.into()),
@@ -532,6 +543,7 @@ impl<
             transform_count,
             raygen_count,
             instance_count,
+            shading_count,
             intersect_count,
             traversal_count,
             mem_load_r,
@@ -545,6 +557,7 @@ impl<
             camera_write,
             world_write,
             enter_offer,
+            normal_offer,
             tri_enqueue,
             tri_queues,
             tri_kind,
@@ -590,6 +603,7 @@ impl<
         self.traversal_busy.next = self.traversal_count.q.val();
         self.raygen_busy.next = self.raygen_count.q.val();
         self.instance_busy.next = self.instance_count.q.val();
+        self.shading_busy.next = self.shading_count.q.val();
         if self.running.q.val() {
             self.cycle_count.d.next = self.cycle_count.q.val() + 1;
             if self.tester.transform_busy.val() {
@@ -605,7 +619,11 @@ impl<
                 self.raygen_count.d.next = self.raygen_count.q.val() + 1;
             }
             if self.tester.gen_take.val() & self.gen_instance.val() {
-                self.instance_count.d.next = self.instance_count.q.val() + 1;
+                if self.instances.gen_normal.val() {
+                    self.shading_count.d.next = self.shading_count.q.val() + 1;
+                } else {
+                    self.instance_count.d.next = self.instance_count.q.val() + 1;
+                }
             }
         }
 
@@ -679,7 +697,9 @@ impl<
         // `tri.enter` enters (InstanceRays), queues the instance as the tester's object and
         // counts the walk the traversal unit starts when the ray is written: all three or
         // none (the thread repeats it while the entry slot or the tester's queue is full).
-        self.instances.offer.next = self.enter_offer.q.val() & (!self.tester.engine.full.val());
+        self.instances.offer.next = (self.enter_offer.q.val() & (!self.tester.engine.full.val()))
+            | self.normal_offer.q.val();
+        self.instances.offer_normal.next = self.normal_offer.q.val();
         self.instances.instance_id.next = self.decode.a.val().get_bits::<24>(0);
 
         // Scratch memory.
@@ -751,6 +771,9 @@ impl<
         self.enter_offer.d.next = self.decode.valid_i4.val()
             & self.tri_op.val()
             & (self.decode.imm_i4.val() == self.tri_enter.val());
+        self.normal_offer.d.next = self.decode.valid_i4.val()
+            & self.tri_op.val()
+            & (self.decode.imm_i4.val() == self.tri_normal.val());
         self.t_min_write.d.next = self.decode.valid_i4.val()
             & self.tri_op.val()
             & (self.decode.imm_i4.val() == self.tri_init.val());
@@ -813,6 +836,9 @@ impl<
             if self.instances.gen_direction.val() {
                 self.tester.gen_client.next = self.client_direction.val();
             }
+            if self.instances.gen_normal.val() {
+                self.tester.gen_client.next = self.client_normal.val();
+            }
             self.tester.gen_thread.next = self.instances.gen_thread.val();
         } else {
             for k in 0..12 {
@@ -827,12 +853,21 @@ impl<
         }
         self.rays.gen_take.next = self.tester.gen_take.val();
         self.instances.gen_take.next = self.tester.gen_take.val() & self.gen_instance.val();
-        self.rays.gen_out_valid.next =
-            self.tester.gen_out_valid.val() & (!self.tester.gen_out_client.val().get_bit(0));
+        self.rays.gen_out_valid.next = self.tester.gen_out_valid.val()
+            & (self.tester.gen_out_client.val() == self.client_primary.val());
         self.rays.gen_out_thread.next = self.tester.gen_out_thread.val();
-        self.instances.out_valid.next =
-            self.tester.gen_out_valid.val() & self.tester.gen_out_client.val().get_bit(0);
-        self.instances.out_direction.next = self.tester.gen_out_client.val().get_bit(1);
+        self.instances.out_valid.next = self.tester.gen_out_valid.val()
+            & (self.tester.gen_out_client.val() != self.client_primary.val());
+        self.instances.out_direction.next =
+            self.tester.gen_out_client.val() == self.client_direction.val();
+        self.instances.out_normal.next =
+            self.tester.gen_out_client.val() == self.client_normal.val();
+        // A world normal goes to ray generation's direction store, which `tri.dir` reads.
+        self.rays.normal_write.next = self.instances.normal_write.val();
+        self.rays.normal_thread.next = self.instances.ray_thread.val();
+        for k in 0..3 {
+            self.rays.normal[k].next = self.instances.ray_d[k].val();
+        }
         self.instances.out_thread.next = self.tester.gen_out_thread.val();
         for k in 0..3 {
             self.rays.gen_out_dir[k].next = self.tester.gen_out_dir[k].val();
@@ -875,6 +910,9 @@ impl<
         }
         if self.enter_offer.q.val() {
             self.tri_busy.next = self.instances.refused.val() | self.tester.engine.full.val();
+        }
+        if self.normal_offer.q.val() {
+            self.tri_busy.next = self.instances.refused.val();
         }
         if self.ray_write.q.val() & self.store_write.val() {
             self.tri_busy.next = true;
@@ -990,6 +1028,7 @@ impl<
             self.traversal_count.d.next = 0.into();
             self.raygen_count.d.next = 0.into();
             self.instance_count.d.next = 0.into();
+            self.shading_count.d.next = 0.into();
         }
     }
 }

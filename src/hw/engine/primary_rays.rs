@@ -76,6 +76,12 @@ pub struct PrimaryRays<const W: usize, const E: usize, const M: usize> {
     pub query_thread: Signal<In, Bits<5>>,
     pub pending: Signal<Out, Bit>,
     pub dir: [Signal<Out, Bits<W>>; 3],
+    /// A world normal from instance entry (`tri.normal`) for `normal_thread`, kept for `dir`
+    /// in the primary direction's place (never in the clock of a primary write: each writes
+    /// a clock after its own result, and the TransformUnit gives one result a clock).
+    pub normal_write: Signal<In, Bit>,
+    pub normal_thread: Signal<In, Bits<5>>,
+    pub normal: [Signal<In, Bits<W>>; 3],
 
     raygen: RayGen<W, E, M>,
     camera: [DFF<Bits<W>>; CAMERA_WORDS],
@@ -139,6 +145,9 @@ impl<const W: usize, const E: usize, const M: usize> PrimaryRays<W, E, M> {
             query_thread: Default::default(),
             pending: Default::default(),
             dir: Default::default(),
+            normal_write: Default::default(),
+            normal_thread: Default::default(),
+            normal: Default::default(),
             raygen: Default::default(),
             camera: Default::default(),
             slot_valid: Default::default(),
@@ -260,7 +269,11 @@ impl<const W: usize, const E: usize, const M: usize> Logic for PrimaryRays<W, E,
             self.primary_d[k].next = self.result_dir[k].q.val();
             self.dirs[k].write_address.next = self.result_thread.q.val();
             self.dirs[k].write_data.next = self.result_dir[k].q.val();
-            self.dirs[k].write_enable.next = self.result_valid.q.val();
+            if self.normal_write.val() {
+                self.dirs[k].write_address.next = self.normal_thread.val();
+                self.dirs[k].write_data.next = self.normal[k].val();
+            }
+            self.dirs[k].write_enable.next = self.result_valid.q.val() | self.normal_write.val();
             self.dirs[k].read_address.next = self.query_thread.val();
             self.dir[k].next = self.dirs[k].read_data.val();
         }

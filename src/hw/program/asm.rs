@@ -444,6 +444,13 @@ impl Asm {
         self.coprocessor(Op::Tri, TriFn::Enter as u32, Reg::ZERO, instance, walk);
     }
 
+    /// The world normal of `instance`'s normal matrix times `(x, y, z)` (`TriFn::Normal`):
+    /// `x`, `y` as world words 0 and 1, then the request; `tri.dir` reads it after a wait.
+    pub fn tri_normal(&self, instance: Reg, [x, y, z]: [Reg; 3]) {
+        self.tri_world(0, x, y);
+        self.coprocessor(Op::Tri, TriFn::Normal as u32, Reg::ZERO, instance, z);
+    }
+
     /// Waits until the thread's queued entries are done; `dst` = the best t.
     pub fn tri_wait(&self, dst: Reg) {
         self.coprocessor(Op::Tri, TriFn::Wait as u32, dst, Reg::ZERO, Reg::ZERO);

@@ -425,6 +425,22 @@ impl<'a> Machine<'a> {
                         let walk = KD_ENTERED | (b & KD_ANY_HIT);
                         stats.kd_nodes += self.object_walk(t, walk, 0, stats).map_err(fail)?;
                     }
+                    TriFn::Normal => {
+                        // `hw::engine::InstanceRays`: the normal matrix through the
+                        // TransformUnit (a vector), kept where `tri.dir` reads.
+                        let bank = &self.layout.banks[INSTANCES];
+                        let at = a as usize * INSTANCE_WORDS + instance_word::NORMAL_MATRIX;
+                        let m: &[u32; 9] = bank
+                            .get(at..at + 9)
+                            .and_then(|w| w.try_into().ok())
+                            .ok_or_else(|| {
+                                fail(format!(
+                                    "instance {a} beyond the instance bank's {} words",
+                                    bank.len()
+                                ))
+                            })?;
+                        t.primary_d = units::transform3(f, m, [t.world[0], t.world[1], b]);
+                    }
                 }
                 // The twin's queue never refuses and its tests are done at once, so the
                 // instruction never repeats.

@@ -199,8 +199,8 @@ pub enum TriFn {
     /// Ray generation's camera words `2 s`, `2 s + 1` = `A`, `B` for the instruction's shift
     /// field `s` (0..8: the camera 3x4 `FrameMap::CAMERA`, then the eye `FrameMap::EYE`).
     Camera,
-    /// `dst` = component `s` (the shift field, 0..3) of the thread's primary direction (after
-    /// a wait).
+    /// `dst` = component `s` (the shift field, 0..3) of the thread's primary direction, or
+    /// of the world normal of its last `Normal` (after a wait).
     Dir,
     /// World ray words of the thread's trace, for instance entry (`hw::engine::InstanceRays`):
     /// pair `s` (the shift field, 0..3, the ray words' pairs: `o.x o.y`, `o.z d.x`, `d.y d.z`)
@@ -214,10 +214,17 @@ pub enum TriFn {
     /// `kd.start` with [`KD_ENTERED`], answering any hit when `B` has [`KD_ANY_HIT`]); the
     /// thread's next `kd.wait` waits for the walk's end. Repeats while refused.
     Enter,
+    /// Shading's world normal through the one TransformUnit: instance `A`'s normal matrix
+    /// (`instance_word::NORMAL_MATRIX`, by instance entry, `hw::engine::InstanceRays`) times
+    /// the object-space normal `(x, y, B)`, whose x and y are the thread's world words 0 and 1
+    /// (`World` pair 0: the trace that needed the world ray is over). `Dir` reads the result
+    /// after a `wait` ([`units::transform3`](crate::units::transform3), not unit length).
+    /// Repeats while refused.
+    Normal,
 }
 
 impl TriFn {
-    pub const ALL: [TriFn; 14] = [
+    pub const ALL: [TriFn; 15] = [
         TriFn::RayOxy,
         TriFn::RayOzDx,
         TriFn::RayDyz,
@@ -232,6 +239,7 @@ impl TriFn {
         TriFn::Dir,
         TriFn::World,
         TriFn::Enter,
+        TriFn::Normal,
     ];
     pub fn from_imm(imm: u32) -> Option<TriFn> {
         Self::ALL.get(imm as usize).copied()
@@ -252,6 +260,7 @@ impl TriFn {
             TriFn::Dir => "dir",
             TriFn::World => "world",
             TriFn::Enter => "enter",
+            TriFn::Normal => "normal",
         }
     }
     /// Whether the function puts an entry in the tester's queue.

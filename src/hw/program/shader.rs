@@ -21,9 +21,7 @@
 use super::asm::{Reg, Val};
 use super::isa::{Op, KD_ANY_HIT};
 use super::{Gen, CHAIN_ENTRY_WORDS};
-use crate::layout::{
-    instance_word as iw, FrameMap, FRAME, INSTANCES, TRANSFORM_BANK_WORDS, TRIANGLES_A, TRIANGLES_B,
-};
+use crate::layout::{FrameMap, FRAME, TRANSFORM_BANK_WORDS, TRIANGLES_A, TRIANGLES_B};
 use crate::units;
 use crate::units::Arith;
 
@@ -207,15 +205,23 @@ impl Gen<'_> {
         let n_obj = [xy[0], xy[1], z_material[0]];
         let material = a.keep(z_material[1]);
         // `units::world_normal`: the stored normal is unit; only an instance's normal matrix
-        // changes its length.
+        // changes its length. The matrix goes through the one TransformUnit (instance entry
+        // reads it: `tri.normal`), the unit length through the engine's operators.
         let n = if c.top_root.is_some() {
-            let record = self.instance_record(hit_instance);
-            let m: [Val; 9] = a.load_n(INSTANCES, record, 0, iw::NORMAL_MATRIX as u32);
-            units::unit_length(a, units::transform3(a, &m, n_obj))
+            let n_obj = n_obj.map(|v| a.keep(v));
+            a.tri_normal(hit_instance, n_obj);
+            a.tri_wait(Reg::ZERO);
+            for k in 0..3 {
+                a.tri_dir(k as u8, n_obj[k]);
+            }
+            let n = units::unit_length(a, n_obj.map(Val::R)).map(|v| a.keep(v));
+            for r in n_obj {
+                a.free(r);
+            }
+            n
         } else {
-            n_obj
-        }
-        .map(|v| a.keep(v));
+            n_obj.map(|v| a.keep(v))
+        };
         let along = units::dot(a, n.map(Val::R), ray_d.map(Val::R));
         let facing = a.label();
         a.branch(Op::BFlt, Val::K(0), along, true, facing);
@@ -392,14 +398,5 @@ impl Gen<'_> {
         a.bind(frame_done);
         a.section("raygen");
         a.halt();
-    }
-
-    /// `instance * INSTANCE_WORDS` (24 = 16 + 8).
-    fn instance_record(&self, instance: Reg) -> Val {
-        let a = self.asm;
-        debug_assert_eq!(crate::layout::INSTANCE_WORDS, 24);
-        let x16 = a.op(Op::Shl, instance.into(), Val::K(4));
-        let x8 = a.op(Op::Shl, instance.into(), Val::K(3));
-        a.op(Op::Add, x16, x8)
     }
 }
