@@ -205,7 +205,9 @@ pub fn port_meaning(name: &str) -> Option<&'static str> {
         "transform_busy" => "clocks in which the TransformUnit took a triangle test's input",
         "raygen_busy" => "clocks in which ray generation's requests took the TransformUnit",
         "instance_busy" => "clocks in which instance entry's requests took the TransformUnit",
-        "shading_busy" => "clocks in which shading's requests (world normals) took the TransformUnit",
+        "shading_busy" => {
+            "clocks in which shading's requests (world normals) took the TransformUnit"
+        }
         "intersect_busy" => "clocks in which the IntersectUnit took an input",
         "traversal_busy" => "clocks in which the traversal unit started a node decision",
         "mem_read" => "read request on the shared port (banks 1, 4, 5)",

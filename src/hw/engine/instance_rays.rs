@@ -1,12 +1,15 @@
-//! `InstanceRays`: instance entry in hardware. A `tri.enter` names an instance; the unit reads
-//! its record's world-to-object 3x4 and object root from bank 4 on the engine's shared bus (in
-//! the clocks the engine's loads and the tester's list reads leave it free), gives the root to
-//! the traversal unit (the thread's next `kd.start` with `KD_ENTERED` walks it), sends the thread's
-//! world ray through the triangle tester's TransformUnit, the one transformation unit (the
-//! origin as a point, then the direction as a vector), and writes the object-space ray whole
-//! into the thread's ray in both coprocessors, which wakes the thread's `tri.wait`. Before,
-//! the microprogram did this in about 40 instructions per instance entered: 13 loads, the
-//! record's address, 33 floating-point operations and the three ray words.
+//! `InstanceRays`: instance entry in hardware, and shading's world normals. A `tri.enter` names
+//! an instance; the unit reads its record's world-to-object 3x4 and object root from bank 4 on
+//! the engine's shared bus (in the clocks the engine's loads and the tester's list reads leave
+//! it free), gives the root to the traversal unit, sends the thread's world ray through the
+//! triangle tester's TransformUnit, the one transformation unit (the origin as a point, then
+//! the direction as a vector), and writes the object-space ray whole into the thread's ray in
+//! both coprocessors; that write starts the traversal unit's walk of the entered object. A
+//! `tri.normal` names an instance and the hit's object-space normal: the unit reads the
+//! record's normal matrix and sends the normal through the same unit (a vector), for ray
+//! generation's direction store (`tri.dir`). Before, the microprogram did the entry in about
+//! 40 instructions per instance entered (13 loads, the record's address, 33 floating-point
+//! operations and the three ray words), and a world normal in 27.
 //!
 //! Contract (engine stages):
 //! - World ray (I5): `world_write` writes words `2 world_pair` and `2 world_pair + 1` of
@@ -14,19 +17,25 @@
 //!   (`tri.world`, three per trace in a scene with a top level).
 //! - Enter (I5): an `offer` of `instance_id` (its record at `instance * INSTANCE_WORDS` in bank
 //!   4) for `thread` is taken unless `refused` (the entry slot still holds the entry before;
-//!   the thread repeats its `tri.enter`); taking it marks the thread's ray pending.
+//!   the thread repeats its `tri.enter`); taking it marks the thread's ray pending. With
+//!   `offer_normal` it is a normal's: `word_b` is the normal's z, its x and y the thread's
+//!   world words 0 and 1 (`tri.world` pair 0 after the trace).
 //! - Memory: `read` with `addr` (bank 4) only in a clock with `bus_free`; the word arrives on
-//!   `rdata` `mem_latency` clocks later. Thirteen reads per entry, the matrix's and the root.
+//!   `rdata` `mem_latency` clocks later. Thirteen reads per entry, the matrix's and the root;
+//!   twelve per normal, the normal matrix's nine with each row's last read twice (the
+//!   TransformUnit's fourth column, which a vector never reads).
 //! - Root: `root_write` with `root_thread` and `root` in the clock the root's word arrives
 //!   (before the ray: the thread waits for both, and its last walk is over).
 //! - Requests (`gen_*`, the tester's client port): the origin (`gen_point`) and then the
-//!   direction (`gen_direction`), each held until `gen_take`; results come back on `out_*`
-//!   (`out_direction` tells which), in request order, [`TRANSFORM_LATENCY`] clocks later.
+//!   direction (`gen_direction`), or the normal (`gen_normal`), each held until `gen_take`;
+//!   results come back on `out_*` (`out_direction`, `out_normal` tell which), in request
+//!   order, [`TRANSFORM_LATENCY`] clocks later.
 //! - Write (a clock after the direction's result): `ray_write` with `ray_thread`, `ray_o`,
 //!   `ray_d` for both coprocessors' [`RayStore`]s; `done_mask` (bit `ray_thread`) in the same
 //!   clock is the thread's wake-up. The engine's ray words are refused in that clock, and
 //!   ray generation's write never falls in it: each writes the clock after a result of its
-//!   own, and the unit gives one result per clock.
+//!   own, and the unit gives one result per clock. A normal: `normal_write` with
+//!   `ray_thread` and the normal on `ray_d`, and the same wake-up.
 //! - Answers: `query_thread` at I4; at I5 `pending` (the entered ray is not written yet).
 //!
 //! Latency: from the `tri.enter` at I5, 1 clock to start the entry, 13 reads (one per free
@@ -38,7 +47,9 @@
 //! Golden twin: [`units::transform`](crate::units::transform) of the world origin (a point)
 //! and direction (a vector) by the record's `instance_word::WORLD_TO_OBJECT` words, and the
 //! record's `instance_word::ROOT`, as the engine's twin (`hw::program::exec`, `tri.enter`) and
-//! the golden model's `enter_instance` compute and read them.
+//! the golden model's `enter_instance` compute and read them; for a normal,
+//! [`units::transform3`](crate::units::transform3) by `instance_word::NORMAL_MATRIX`, as
+//! `units::world_normal` and the twin's `tri.normal` compute it.
 //!
 //! [`RayStore`]: crate::hw::ray_store::RayStore
 //! [`TRANSFORM_LATENCY`]: crate::hw::TRANSFORM_LATENCY
@@ -492,6 +503,9 @@ mod tests {
     /// world-to-object words; the record's root goes to the thread before its ray;
     /// `done_mask` is the written thread's bit; `pending` is high from the `tri.enter` until
     /// the write; a full slot refuses; reads go out only in free clocks, thirteen per entry.
+    /// Four offers in ten are normals' (`tri.normal`): each gives `units::transform3` of the
+    /// record's normal matrix and the thread's world words 0, 1 and the offer's z, once, on
+    /// `normal_write`, with no root and no ray, in twelve reads.
     #[test]
     fn every_entry_gets_its_object_ray_through_the_shared_unit() {
         let f = Format::E7M16;
@@ -517,12 +531,14 @@ mod tests {
         u.frame_start.next = false;
 
         let mut world = [[0u32; 6]; 32];
-        // Per thread: the ray its entry must write, and the root before it.
+        // Per thread: the ray its entry must write, and the root before it; or the normal.
         let mut entered: [Option<([u32; 3], [u32; 3])>; 32] = [None; 32];
+        let mut normals: [Option<[u32; 3]>; 32] = [None; 32];
+        let mut normals_written = 0;
         let mut roots: [Option<u32>; 32] = [None; 32];
         let mut roots_written = 0;
         let mut memory: VecDeque<Option<u32>> = vec![None; mem_latency as usize].into();
-        let mut in_unit: VecDeque<Option<(u32, bool, [u32; 3])>> = vec![None; 28].into();
+        let mut in_unit: VecDeque<Option<(u32, bool, bool, [u32; 3])>> = vec![None; 28].into();
         let (mut offers, mut refused, mut written, mut reads) = (0, 0, 0, 0);
         for clock in 0..6000 {
             let thread = rng.gen_range(0..32u32);
@@ -531,7 +547,7 @@ mod tests {
             // at random, never for a thread whose entry is pending.
             let (write, offer) = if clock < 96 {
                 (true, false)
-            } else if entered[t].is_none() {
+            } else if entered[t].is_none() && normals[t].is_none() {
                 let r = rng.gen_range(0..10);
                 (r == 0, r >= 7)
             } else {
@@ -551,23 +567,26 @@ mod tests {
             u.world_pair.next = (pair as u64).into();
             u.word_a.next = u64::from(words[0]).into();
             u.word_b.next = u64::from(words[1]).into();
+            let normal = offer && rng.gen_bool(0.4);
             u.offer.next = offer;
+            u.offer_normal.next = normal;
             u.instance_id.next = (instance as u64).into();
             u.bus_free.next = rng.gen_bool(0.6);
             u.rdata.next = u64::from(memory.pop_front().unwrap().unwrap_or(0xdead)).into();
             u.gen_take.next = rng.gen_bool(0.5);
             let back = in_unit.pop_front().unwrap();
             u.out_valid.next = back.is_some();
-            if let Some((t, direction, v)) = back {
+            if let Some((t, direction, normal, v)) = back {
                 u.out_thread.next = u64::from(t).into();
                 u.out_direction.next = direction;
+                u.out_normal.next = normal;
                 for k in 0..3 {
                     u.out_v[k].next = u64::from(v[k]).into();
                 }
             }
             let asked = rng.gen_range(0..32usize);
             u.query_thread.next = (asked as u64).into();
-            let want_pending = entered[asked].is_some();
+            let want_pending = entered[asked].is_some() || normals[asked].is_some();
             u.clock.next = Clock { clk: false };
             settle(&mut u);
 
@@ -580,6 +599,14 @@ mod tests {
                 offers += 1;
                 if u.refused.val() {
                     refused += 1;
+                } else if normal {
+                    let at = record + instance_word::NORMAL_MATRIX;
+                    let m: &[u32; 9] = bank[at..at + 9].try_into().unwrap();
+                    normals[t] = Some(units::transform3(
+                        f,
+                        m,
+                        [world[t][0], world[t][1], words[1]],
+                    ));
                 } else {
                     let m: units::Mat34W = bank[record..record + 12].try_into().unwrap();
                     let [ox, oy, oz, dx, dy, dz] = world[t];
@@ -601,10 +628,11 @@ mod tests {
                 let word = |s: &Signal<Out, Bits<24>>| s.val().to_u64() as u32;
                 let m: units::Mat34W = std::array::from_fn(|k| word(&u.gen_m[k]));
                 let v: [u32; 3] = std::array::from_fn(|k| word(&u.gen_v[k]));
-                assert_ne!(u.gen_point.val(), u.gen_direction.val());
+                let kinds = [u.gen_point.val(), u.gen_direction.val(), u.gen_normal.val()];
+                assert_eq!(kinds.iter().filter(|&&k| k).count(), 1, "one request kind");
                 let t = u.gen_thread.val().to_u64() as u32;
                 let result = units::transform(f, &m, v, u.gen_point.val());
-                (t, u.gen_direction.val(), result)
+                (t, u.gen_direction.val(), u.gen_normal.val(), result)
             }));
             if u.root_write.val() {
                 let t = u.root_thread.val().to_u64() as usize;
@@ -621,6 +649,13 @@ mod tests {
                 assert_eq!((o_got, d_got), (o, d), "thread {t}'s object-space ray");
                 assert_eq!(u.done_mask.val().to_u64(), 1 << t, "the wake-up of {t}");
                 written += 1;
+            } else if u.normal_write.val() {
+                let t = u.ray_thread.val().to_u64() as usize;
+                let n = normals[t].take().expect("a normal for a thread that asked");
+                let got: [u32; 3] = std::array::from_fn(|k| u.ray_d[k].val().to_u64() as u32);
+                assert_eq!(got, n, "thread {t}'s world normal");
+                assert_eq!(u.done_mask.val().to_u64(), 1 << t, "the wake-up of {t}");
+                normals_written += 1;
             } else {
                 assert_eq!(u.done_mask.val().to_u64(), 0, "a wake-up without a ray");
             }
@@ -628,12 +663,16 @@ mod tests {
             assert_eq!(u.pending.val(), want_pending, "thread {asked} pending");
         }
         let left = entered.iter().filter(|e| e.is_some()).count();
-        assert!(left <= 3, "{left} entries unfinished");
-        assert!(written > 150, "entries written: {written}");
+        let normals_left = normals.iter().filter(|e| e.is_some()).count();
+        assert!(left + normals_left <= 3, "{left} entries unfinished");
+        assert!(written > 80, "entries written: {written}");
+        assert!(normals_written > 60, "normals written: {normals_written}");
         assert!((written..=written + left).contains(&roots_written));
+        let done_reads = 13 * written + 12 * normals_written;
         assert!(
-            (13 * written..=13 * (written + left)).contains(&reads),
-            "{reads} reads for {written} entries written and {left} begun"
+            (done_reads..=done_reads + 13 * (left + normals_left)).contains(&reads),
+            "{reads} reads for {written} entries and {normals_written} normals written and \
+             {left} + {normals_left} begun"
         );
         assert!(
             refused > 10,

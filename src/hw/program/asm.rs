@@ -196,21 +196,25 @@ impl Asm {
         self.state.borrow_mut().fixups.push((at, target));
     }
 
-    /// An instruction reading `a` and `b` (a constant `b` becomes the immediate; a constant
-    /// `a` is loaded into a temporary first).
     /// Puts `k` in a register for the rest of the program: an operation whose first operand
-    /// is `k` reads it there (the first operand cannot be an immediate). For the program's
-    /// start, before any branch.
+    /// is `k` reads it there (the first operand cannot be an immediate), as does a
+    /// coprocessor's operand ([`Asm::kept_constant`]). For the program's start, before any
+    /// branch.
     pub fn keep_constant(&self, k: u32) {
         let r = self.keep(Val::K(k));
         self.state.borrow_mut().constants.push((k, r));
     }
 
+    /// The register [`Asm::keep_constant`] keeps `k` in.
+    pub fn kept_constant(&self, k: u32) -> Option<Reg> {
+        let s = self.state.borrow();
+        s.constants.iter().find(|c| c.0 == k).map(|c| c.1)
+    }
+
+    /// An instruction reading `a` and `b` (a constant `b` becomes the immediate; a constant
+    /// `a` is loaded into a temporary first).
     fn operands(&self, op: Op, a: Val, b: Val) -> Instr {
-        let kept = |k: u32| {
-            let s = self.state.borrow();
-            s.constants.iter().find(|c| c.0 == k).map(|c| c.1)
-        };
+        let kept = |k: u32| self.kept_constant(k);
         let a = match a {
             Val::R(r) => r,
             Val::K(0) => Reg::ZERO,

@@ -159,13 +159,12 @@ impl Program {
 
 /// Registers every routine shares.
 pub(crate) struct Shared {
-    /// The trace query: origin, direction, t range, any-hit flag, the (instance, triangle)
-    /// to skip.
+    /// The trace query: origin, direction, t range (a closest hit's), the (instance,
+    /// triangle) to skip.
     pub q_o: [Reg; 3],
     pub q_d: [Reg; 3],
     pub q_t_min: Reg,
     pub q_t_max: Reg,
-    pub q_any: Reg,
     pub skip_instance: Reg,
     pub skip_triangle: Reg,
     /// The closest hit so far (`hit` is 0 or 1; `best_t` starts at `q_t_max`).
@@ -193,7 +192,6 @@ pub fn build_program(config: &ProgramConfig) -> Program {
         q_d: a.regs(),
         q_t_min: a.reg(),
         q_t_max: a.reg(),
-        q_any: a.reg(),
         skip_instance: a.reg(),
         skip_triangle: a.reg(),
         hit: a.reg(),
@@ -210,18 +208,30 @@ pub fn build_program(config: &ProgramConfig) -> Program {
     };
     let constants = gen.load_constants();
     // With secondary rays the trace is a routine, whose registers are its own (the shader's
-    // values live across its calls); else the one primary trace is written in line.
-    let trace = gen.secondary_rays().then(|| {
-        let (trace, pixels) = (a.label(), a.label());
-        a.jump(pixels);
+    // values live across its calls), and a shadow ray's another; else the one primary trace
+    // is written in line.
+    let routine = |query| {
+        let (trace, after) = (a.label(), a.label());
+        a.jump(after);
         a.bind(trace);
         let start = a.len();
-        gen.trace_routine(true);
+        gen.trace_routine(true, query);
         a.reserve_registers_of(start);
-        a.bind(pixels);
+        a.bind(after);
         trace
+    };
+    let trace = gen
+        .secondary_rays()
+        .then(|| routine(traversal::Query::Closest));
+    let shadow = constants.shadow_t_min.map(|t_min| {
+        routine(traversal::Query::Any {
+            t_min,
+            one: a
+                .kept_constant(config.format.one())
+                .expect("kept at the program's start"),
+        })
     });
-    gen.pixel_loop(&constants, trace);
+    gen.pixel_loop(&constants, trace, shadow);
     let scratch = gen.scratch;
     let mut left_out = Vec::new();
     if config.top_root.is_none() {
@@ -272,10 +282,11 @@ impl Gen<'_> {
     }
 
     /// Whether the shader tells a hit by `best_t < q_t_max` instead of the tester's hit flag
-    /// (the same: a hit only ever lowers the best t from t_max), which saves reading the flag:
-    /// for the one primary trace of a scene of one object.
+    /// (the same: a hit only ever lowers the best t from t_max): for the one primary trace of
+    /// a scene of one object (which saves reading the flag), and under a top level (whose
+    /// trace may enter no instance, so no walk may write the flag, and ends with the best t).
     pub fn hit_by_t(&self) -> bool {
-        !self.secondary_rays() && self.c.top_root.is_none()
+        !self.secondary_rays() || self.c.top_root.is_some()
     }
 
     /// A frame word (bank 5) at a fixed address.

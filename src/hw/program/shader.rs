@@ -19,7 +19,8 @@
 //! (`cornell_noshadow`: 118 per primary ray, the walk included).
 
 use super::asm::{Reg, Val};
-use super::isa::{Op, KD_ANY_HIT};
+use super::isa::{Op, TriFn, KD_TOP};
+use super::traversal::Query;
 use super::{Gen, CHAIN_ENTRY_WORDS};
 use crate::layout::{FrameMap, FRAME, TRANSFORM_BANK_WORDS, TRIANGLES_A, TRIANGLES_B};
 use crate::units;
@@ -40,7 +41,7 @@ pub(super) struct Constants {
     eye: [Reg; 3],
     ambient: Reg,
     background: [Reg; 3],
-    shadow_t_min: Option<Reg>,
+    pub(super) shadow_t_min: Option<Reg>,
     mirror_t_min: Option<Reg>,
     /// Each light's position and colour words, when the scene has at most [`KEPT_LIGHTS`].
     lights: Option<Vec<[Reg; 6]>>,
@@ -68,8 +69,15 @@ impl Gen<'_> {
         for r in words[..12].iter().copied().filter(|r| *r != Reg::ZERO) {
             a.free(r);
         }
-        // 1 / |n| of a hit's normal through an instance's normal matrix.
+        // 1 / |n| of a hit's normal through an instance's normal matrix and a shadow ray's
+        // t_max; the top-level walk's start; the object walks' words.
         a.keep_constant(c.format.one());
+        if let Some(root) = c.top_root {
+            a.keep_constant(root | KD_TOP);
+        }
+        for w in self.walk_words() {
+            a.keep_constant(w);
+        }
         // Without secondary rays every query starts at the eye with t_min 0 and t_max
         // infinity: the query registers hold them for the whole frame.
         let eye = if self.secondary_rays() {
@@ -82,8 +90,11 @@ impl Gen<'_> {
             a.mov(s.q_t_min, Val::K(0));
             s.q_o
         };
-        if !c.shadows {
-            a.mov(s.q_t_max, Val::K(c.format.infinity(false)));
+        // A closest hit's t_max (a shadow ray's is 1), and the skip pair's instance in a scene
+        // of one object (instance 0; its triangle none until a hit).
+        a.mov(s.q_t_max, Val::K(c.format.infinity(false)));
+        if self.secondary_rays() && c.top_root.is_none() {
+            a.mov(s.skip_instance, Val::K(0));
         }
         Constants {
             eye,
@@ -101,7 +112,12 @@ impl Gen<'_> {
 
     /// One pixel after another until the frame is done; `trace` is the trace routine (none:
     /// the trace is written in line, for a scene without secondary rays).
-    pub(super) fn pixel_loop(&self, k: &Constants, trace: Option<super::asm::Label>) {
+    pub(super) fn pixel_loop(
+        &self,
+        k: &Constants,
+        trace: Option<super::asm::Label>,
+        shadow: Option<super::asm::Label>,
+    ) {
         let a = self.asm;
         let s = &self.s;
         let c = self.c;
@@ -110,7 +126,7 @@ impl Gen<'_> {
             eye,
             ambient,
             background,
-            shadow_t_min,
+            shadow_t_min: _,
             mirror_t_min,
             ref lights,
         } = *k;
@@ -149,11 +165,16 @@ impl Gen<'_> {
                 a.tri_dir(k as u8, ray_d[k]);
             }
         }
+        // A primary ray skips no triangle: under a top level no instance has the number
+        // u32::MAX, in one object no triangle.
         if secondary {
             a.mov3(ray_o, eye.map(Val::R));
             a.mov(ray_t_min, Val::K(0));
-            a.mov(s.skip_instance, Val::K(u32::MAX));
-            a.mov(s.skip_triangle, Val::K(u32::MAX));
+            if c.top_root.is_some() {
+                a.mov(s.skip_instance, Val::K(u32::MAX));
+            } else {
+                a.mov(s.skip_triangle, Val::K(u32::MAX));
+            }
         }
         if c.reflection_depth > 0 {
             a.mov(depth, Val::K(0));
@@ -162,13 +183,9 @@ impl Gen<'_> {
         // Shade the ray (ray_o, ray_d, ray_t_min, skip) at mirror depth `depth`.
         a.bind(shade);
         a.section("shader");
-        if c.shadows {
-            a.mov(s.q_t_max, Val::K(f.infinity(false)));
-            a.mov(s.q_any, Val::K(0));
-        }
         match trace {
             Some(trace) => a.call(s.link, trace),
-            None => self.trace_routine(false),
+            None => self.trace_routine(false, Query::Closest),
         }
         a.section("shader");
         let miss = a.label();
@@ -182,20 +199,36 @@ impl Gen<'_> {
                 a.tri_dir(k as u8, ray_d[k]);
             }
         }
-        // The hit outlives the next trace only in a scene with secondary rays; a scene of one
+        // The hit's instance and triangle, from the tester. With secondary rays they go where
+        // the next query reads its skip pair (every ray from the hit skips it); a scene of one
         // object hits instance 0.
-        let hit_instance = match (c.top_root.is_some(), secondary) {
-            (false, _) => Reg::ZERO,
-            (true, true) => a.keep(s.best_instance.into()),
-            (true, false) => s.best_instance,
-        };
-        let hit_triangle = if secondary {
-            a.keep(s.best_triangle.into())
+        let (hit_instance, hit_triangle) = if secondary {
+            (s.skip_instance, s.skip_triangle)
         } else {
-            s.best_triangle
+            (s.best_instance, s.best_triangle)
         };
-        let p = units::ray_point(a, ray_o.map(Val::R), ray_d.map(Val::R), s.best_t.into())
-            .map(|v| a.keep(v));
+        if c.top_root.is_some() {
+            a.tri_read(TriFn::Instance, hit_instance);
+        }
+        a.tri_read(TriFn::Triangle, hit_triangle);
+        let hit_instance = match c.top_root {
+            Some(_) => hit_instance,
+            None => Reg::ZERO,
+        };
+        // With shadows the hit point is the shadow queries' origin: it takes the place of the
+        // ray's origin (`units::ray_point` per component, in place), and each light's vector
+        // that of its direction (the incoming direction is kept apart for a mirror), so that
+        // a shadow query moves no register.
+        let p = if c.shadows {
+            for k in 0..3 {
+                let along = a.op(Op::FMul, s.best_t.into(), ray_d[k].into());
+                a.op_to(Op::FAdd, ray_o[k], ray_o[k].into(), along);
+            }
+            ray_o
+        } else {
+            units::ray_point(a, ray_o.map(Val::R), ray_d.map(Val::R), s.best_t.into())
+                .map(|v| a.keep(v))
+        };
         a.end_temps();
         // The shading words follow the transform's in each triangle bank (`n.x n.y`,
         // `n.z material`: `Layout::triangle_shading`).
@@ -248,25 +281,33 @@ impl Gen<'_> {
         for light in 0..c.light_count {
             a.section("light");
             let position: [Val; 3] = std::array::from_fn(|k| light_word(light, k as u32));
-            let to_light = units::sub3(a, position, p.map(Val::R)).map(|v| a.keep(v));
+            let to_light = if c.shadows {
+                for k in 0..3 {
+                    a.op_to(Op::FSub, s.q_d[k], position[k], p[k].into());
+                }
+                s.q_d
+            } else {
+                units::sub3(a, position, p.map(Val::R)).map(|v| a.keep(v))
+            };
             a.end_temps();
             let skip_light = a.label();
             let n_dot_l = units::dot(a, n.map(Val::R), to_light.map(Val::R));
             a.branch(Op::BFlt, Val::K(0), n_dot_l, true, skip_light);
             let cos = a.keep(units::lambert_from_dot(a, n_dot_l, to_light.map(Val::R)));
             a.end_temps();
-            if let Some(shadow_t_min) = shadow_t_min {
+            if let Some(shadow) = shadow {
+                // The shadow ray's query is in place: the hit point, the light's vector and
+                // the hit as the pair to skip.
                 a.section("shadow");
-                a.mov3(s.q_o, p.map(Val::R));
-                a.mov3(s.q_d, to_light.map(Val::R));
-                a.mov(s.q_t_min, shadow_t_min.into());
-                a.mov(s.q_t_max, Val::K(f.one()));
-                a.mov(s.q_any, Val::K(KD_ANY_HIT));
-                a.mov(s.skip_instance, hit_instance.into());
-                a.mov(s.skip_triangle, hit_triangle.into());
-                a.call(s.link, trace.expect("a trace routine for secondary rays"));
+                debug_assert!(p == s.q_o && to_light == s.q_d);
+                a.call(s.link, shadow);
                 a.section("light");
-                a.branch(Op::Beq, s.hit.into(), Val::K(0), true, skip_light);
+                if self.hit_by_t() {
+                    let one = a.kept_constant(f.one()).expect("kept at the start");
+                    a.branch(Op::BFlt, s.best_t.into(), one.into(), false, skip_light);
+                } else {
+                    a.branch(Op::Beq, s.hit.into(), Val::K(0), true, skip_light);
+                }
             }
             let color_words: [Val; 3] = std::array::from_fn(|k| light_word(light, 3 + k as u32));
             let lit = units::add_light(
@@ -280,8 +321,10 @@ impl Gen<'_> {
             a.end_temps();
             a.free(cos);
             a.bind(skip_light);
-            for r in to_light {
-                a.free(r);
+            if !c.shadows {
+                for r in to_light {
+                    a.free(r);
+                }
             }
         }
         a.section("shader");
@@ -308,15 +351,23 @@ impl Gen<'_> {
             a.op_to(Op::Add, depth, depth.into(), Val::K(1));
             let r = units::reflect(a, incoming.map(Val::R), n.map(Val::R));
             a.assign3(ray_d, r);
-            a.mov3(ray_o, p.map(Val::R));
+            if p != ray_o {
+                a.mov3(ray_o, p.map(Val::R));
+            }
             a.mov(ray_t_min, mirror_t_min.into());
-            a.mov(s.skip_instance, hit_instance.into());
-            a.mov(s.skip_triangle, hit_triangle.into());
+            // The hit is the skip pair already (see `hit_instance`).
             a.end_temps();
             a.jump(shade);
         }
         a.bind(local_done);
-        let owned = |r: &Reg| *r != Reg::ZERO && !s.best_instance.eq(r) && !s.best_triangle.eq(r);
+        let owned = |r: &Reg| {
+            *r != Reg::ZERO
+                && !s.best_instance.eq(r)
+                && !s.best_triangle.eq(r)
+                && !s.skip_instance.eq(r)
+                && !s.skip_triangle.eq(r)
+                && !s.q_o.contains(r)
+        };
         for r in p
             .into_iter()
             .chain(n)

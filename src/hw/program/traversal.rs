@@ -6,7 +6,11 @@
 //! the triangle tester (`hw::TriangleTester`), whose list unit drops the triangle the query
 //! starts on and those in the thread's triangle mailbox and queues the rest; the tester
 //! answers the unit with the closest hit, which ends the walk or pops its stack. A shadow
-//! query's walk (`q_any`) ends after the first leaf with a hit.
+//! query's walk (`KD_ANY_HIT` in its walk word) ends after the first leaf with a hit. A shadow
+//! ray has a trace routine of its own ([`Query::Any`]): its origin and direction are the
+//! shader's hit point and light vector in the query registers, its range and walk words
+//! registers of constants, its skip pair the hit the shader read there, so that the shader
+//! moves no register for it.
 //!
 //! The top-level tree of a scene with instances is walked by the traversal unit too
 //! (`kd.start` with `KD_TOP`), on the world ray that `tri.world` gave it (and instance entry)
@@ -25,12 +29,13 @@
 //! per top-level leaf 5 (the wait, the list's end, the end check, `kd.next` and the loop's
 //! jump) and no instruction per top-level inner node; per instance entered 6 (the list word,
 //! its address, the mailbox, `tri.enter`, the walk's wait, the loop) and 4 per instance the
-//! mailbox skips, with 2 more per walk of a shadow query (its answer); per trace 3 for the
-//! world ray, 2 for the top-level walk's start and 1 for the closest hit's t.
+//! mailbox skips, with 1 more per walk of a shadow query (its answer); per trace 3 for the
+//! world ray, 1 for the top-level walk's start and 1 for the closest hit's t (none for a
+//! shadow ray of one object, whose answer is the walk's hit flag).
 
 use super::asm::Asm;
 use super::asm::{Label, Reg, Val};
-use super::isa::{Op, TriFn, KD_TOP, KD_WALK_ENDED, MAILBOX_INSTANCES};
+use super::isa::{Op, TriFn, KD_ANY_HIT, KD_TOP, KD_WALK_ENDED, MAILBOX_INSTANCES};
 use super::Gen;
 use crate::layout::LISTS;
 
@@ -42,26 +47,72 @@ fn tester_ray(a: &Asm, o: [Reg; 3], d: [Reg; 3]) {
     a.tri_ray(TriFn::RayDyz, d[1], d[2]);
 }
 
+/// What a trace asks for: the closest hit of the query registers (primary and mirror rays),
+/// or any hit (a shadow ray: from the hit point in `q_o` along the light's vector in `q_d`,
+/// over `[t_min, one]`, both registers of constants).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Query {
+    Closest,
+    Any { t_min: Reg, one: Reg },
+}
+
 impl Gen<'_> {
-    /// The trace routine: closest hit (or any hit when `q_any` is set) of the query registers;
-    /// gives `hit`, `best_t`, `best_triangle` and (in a scene with a top level)
-    /// `best_instance`, and returns through `link` when `routine` (else it is in line).
-    pub(super) fn trace_routine(&self, routine: bool) {
+    /// The words `kd.start` (one object) and `tri.enter` (under a top level) walk an object
+    /// with, which the program keeps in registers from its start: the object's root (none
+    /// under a top level) and, with shadows, the same with [`KD_ANY_HIT`].
+    pub(super) fn walk_words(&self) -> Vec<u32> {
+        let root = match self.c.top_root {
+            Some(_) => 0,
+            None => self.c.object_root,
+        };
+        let mut words = vec![root];
+        if self.c.shadows {
+            words.push(root | KD_ANY_HIT);
+        }
+        words.retain(|&w| w != 0);
+        words
+    }
+
+    /// The walk word of [`Self::walk_words`] for `query`.
+    fn walk_word(&self, query: Query) -> Reg {
+        let root = match self.c.top_root {
+            Some(_) => 0,
+            None => self.c.object_root,
+        };
+        let any = if query == Query::Closest {
+            0
+        } else {
+            KD_ANY_HIT
+        };
+        match root | any {
+            0 => Reg::ZERO,
+            w => self
+                .asm
+                .kept_constant(w)
+                .expect("walk words are kept from the start"),
+        }
+    }
+
+    /// The trace: the closest hit of the query registers, or any hit (`query`); gives `hit`
+    /// (where the shader reads the flag) and `best_t`, and returns through `link` when
+    /// `routine` (else it is in line). The hit's instance and triangle stay in the tester.
+    pub(super) fn trace_routine(&self, routine: bool, query: Query) {
         let a = self.asm;
         let s = &self.s;
         a.section("trace");
         let done = a.label();
-        // A walk of the one object writes the hit flag; a top level may enter no instance.
-        if self.c.top_root.is_some() {
-            a.mov(s.hit, Val::K(0));
-        }
+        let (t_min, t_max) = match query {
+            Query::Closest => (s.q_t_min, s.q_t_max),
+            Query::Any { t_min, one } => (t_min, one),
+        };
         let world = (s.q_o, s.q_d);
-        a.tri_queue(TriFn::Init, s.q_t_min, s.q_t_max);
+        a.tri_queue(TriFn::Init, t_min, t_max);
         // The triangle a secondary ray starts on is never tested (primary rays skip none, so
         // a scene without secondary rays never names one).
         if self.secondary_rays() {
             a.tri_queue(TriFn::Skip, s.skip_instance, s.skip_triangle);
         }
+        let walk = self.walk_word(query);
         match self.c.top_root {
             Some(root) => {
                 // The world ray that the top-level walk and instance entry transform.
@@ -76,7 +127,11 @@ impl Gen<'_> {
                     a.tri_world(pair as u8, x, y);
                 }
                 a.mailbox_clear(MAILBOX_INSTANCES);
-                self.traverse(root, done);
+                self.traverse(root, t_max, walk, query, done);
+                a.bind(done);
+                a.section("trace");
+                // The instances' walks leave the closest hit in the tester.
+                a.tri_wait(s.best_t);
             }
             None => {
                 // Traced in line, the trace is the primary ray's, which ray generation has
@@ -84,106 +139,70 @@ impl Gen<'_> {
                 if routine {
                     tester_ray(a, world.0, world.1);
                 }
-                let from = self.walk_root(Val::K(self.c.object_root));
-                self.walk_object(from, s.q_t_max, done);
-                self.free_root(from);
-                a.section("intersect");
-                a.tri_wait(s.best_t);
+                a.section("traversal");
+                a.kd_start(walk, t_max);
+                self.walk_end(query, done);
+                // An any-hit query's answer is the walk's hit flag.
+                if query == Query::Closest {
+                    a.section("intersect");
+                    a.tri_wait(s.best_t);
+                }
+                a.bind(done);
             }
         }
-        a.bind(done);
-        a.section("trace");
-        if self.c.top_root.is_some() {
-            // The instances' walks leave the closest hit in the tester.
-            a.tri_wait(s.best_t);
-            a.tri_read(TriFn::Instance, s.best_instance);
-        }
-        a.tri_read(TriFn::Triangle, s.best_triangle);
         if routine {
+            a.section("trace");
             a.ret(s.link);
         }
     }
 
-    /// The word `kd.start` walks an object with: `root` (a node, or `KD_ENTERED`), and for a
-    /// shadow query (`q_any` is `KD_ANY_HIT` or 0) the flag that ends it at its first hit.
-    fn walk_root(&self, root: Val) -> Reg {
+    /// Sleeps until the thread's object walk ends and reads its hit flag (where the shader or
+    /// an any-hit query reads it); an any-hit query with a hit jumps to `answered`.
+    fn walk_end(&self, query: Query, answered: Label) {
         let a = self.asm;
         let s = &self.s;
-        match (root, self.c.shadows) {
-            (Val::K(0), false) => Reg::ZERO,
-            (Val::K(0), true) => s.q_any,
-            (Val::R(r), false) => r,
-            (root, true) => a.keep(a.op(Op::Or, s.q_any.into(), root)),
-            (k, false) => a.keep(k),
+        let any = query != Query::Closest;
+        a.kd_wait(if any || !self.hit_by_t() {
+            s.hit
+        } else {
+            Reg::ZERO
+        });
+        if any {
+            a.branch(Op::Beq, s.hit.into(), Val::K(0), true, answered);
         }
     }
 
-    /// An object's kd tree, walked by the traversal unit from `from` (see `walk_root`), which
-    /// hands each leaf's triangles to the triangle tester and goes on with its closest hit by
-    /// itself; the thread sleeps until the walk ends and reads the hit flag. An answered
-    /// any-hit query jumps to `answered`. `t_max` bounds the walk's segment.
-    fn walk_object(&self, from: Reg, t_max: Reg, answered: Label) {
+    /// The top-level tree from `root` up to `t_max`, walked front to back by the traversal
+    /// unit, which stops at each leaf for the thread to walk its instances with `walk` (see
+    /// `walk_word`); an answered any-hit query jumps to `answered` (and leaves the unit's
+    /// walk stopped at its leaf).
+    fn traverse(&self, root: u32, t_max: Reg, walk: Reg, query: Query, answered: Label) {
         let a = self.asm;
-        a.section("traversal");
-        a.kd_start(from, t_max);
-        self.walk_end(answered);
-    }
-
-    /// Sleeps until the thread's object walk ends and reads its hit flag; an answered any-hit
-    /// query jumps to `answered`.
-    fn walk_end(&self, answered: Label) {
-        let a = self.asm;
-        let s = &self.s;
-        a.kd_wait(if self.hit_by_t() { Reg::ZERO } else { s.hit });
-        if self.c.shadows {
-            // A shadow query is answered by any hit.
-            let closest = a.label();
-            a.branch(Op::Beq, s.hit.into(), Val::K(0), false, closest);
-            a.branch(Op::Beq, s.q_any.into(), Val::K(0), true, answered);
-            a.bind(closest);
-        }
-    }
-
-    /// Frees a register `walk_root` kept.
-    fn free_root(&self, from: Reg) {
-        if from != Reg::ZERO && from != self.s.q_any {
-            self.asm.free(from);
-        }
-    }
-
-    /// The top-level tree from `root`, walked front to back by the traversal unit, which
-    /// stops at each leaf for the thread to walk its instances; an answered any-hit query
-    /// jumps to `answered` (and leaves the unit's walk stopped at its leaf).
-    fn traverse(&self, root: u32, answered: Label) {
-        let a = self.asm;
-        let s = &self.s;
         a.section("traversal");
         let [list, end] = a.regs::<2>();
-        let top = a.keep(Val::K(root | KD_TOP));
-        a.kd_start(top, s.q_t_max);
-        a.free(top);
-        // Each instance's walk answers a shadow query with its first hit.
-        let walk = self.walk_root(Val::K(0));
+        let top = a
+            .kept_constant(root | KD_TOP)
+            .expect("kept at the program's start");
+        a.kd_start(top, t_max);
         let (leaf, finished) = (a.label(), a.label());
         a.bind(leaf);
         a.section("traversal");
         a.kd_wait(list);
         a.branch(Op::Beq, list.into(), Val::K(KD_WALK_ENDED), false, finished);
         a.kd_leaf(end);
-        self.instance_list(list, end, walk, answered);
+        self.instance_list(list, end, walk, query, answered);
         a.section("traversal");
         a.kd_next();
         a.jump(leaf);
         a.bind(finished);
         a.free(list);
         a.free(end);
-        self.free_root(walk);
     }
 
     /// The instances of a top-level leaf, `list..end` in bank 1 (`list` moves on to `end`;
     /// the traversal unit stops only at leaves with instances), each entered and walked with
-    /// `tri.enter` (`walk`: see `walk_root`).
-    fn instance_list(&self, list: Reg, end: Reg, walk: Reg, answered: Label) {
+    /// `tri.enter` (`walk`: see `walk_word`).
+    fn instance_list(&self, list: Reg, end: Reg, walk: Reg, query: Query, answered: Label) {
         let a = self.asm;
         a.section("instances");
         let (p, instance) = (list, a.reg());
@@ -198,7 +217,7 @@ impl Gen<'_> {
         // which then walks it; the thread sleeps until the walk ends.
         a.tri_enter(instance, walk);
         a.section("traversal");
-        self.walk_end(answered);
+        self.walk_end(query, answered);
         a.section("instances");
         a.bind(seen);
         a.branch(Op::Beq, p.into(), end.into(), true, next);

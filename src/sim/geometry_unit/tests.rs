@@ -846,6 +846,12 @@ impl<
         self.issued_thread.next = self.thread.val();
 
         self.rays.gen_take.next = self.take.val();
+        // No world normals in this bench: the direction store keeps the primary rays'.
+        self.rays.normal_write.next = false;
+        self.rays.normal_thread.next = 0.into();
+        for k in 0..3 {
+            self.rays.normal[k].next = 0.into();
+        }
         self.unit.in_valid.next = self.rays.gen_valid.val() & self.take.val();
         for k in 0..12 {
             self.unit.m[k].next = self.rays.gen_m[k].val();
@@ -1075,7 +1081,8 @@ const ENTRY_BANK_WORDS: usize = 16 * crate::layout::INSTANCE_WORDS;
 /// `engine::InstanceRays` with a TransformUnit on its client port (taking requests in the
 /// clocks `take` is high) and bank 4 as a ROM behind two registers (SRAM latency 2) on a bus
 /// that is free in the clocks `free` is high. World words (`world_*`) and entries
-/// (`enter_*`) come in on separate ports; the unit sees one at a time, as from the engine.
+/// (`enter_*`; a normal's when `normal` is high, with its z on `nz`) come in on separate
+/// ports; the unit sees one at a time, as from the engine.
 #[derive(LogicBlock)]
 struct InstanceRaysBench<
     const W: usize,
@@ -1096,9 +1103,12 @@ struct InstanceRaysBench<
     pub enter: Signal<In, Bit>,
     pub enter_thread: Signal<In, Bits<5>>,
     pub instance_id: Signal<In, Bits<24>>,
+    pub normal: Signal<In, Bit>,
+    pub nz: Signal<In, Bits<32>>,
     pub take: Signal<In, Bit>,
     pub free: Signal<In, Bit>,
     pub accepted: Signal<Out, Bit>,
+    pub normal_write: Signal<Out, Bit>,
     pub ray_write: Signal<Out, Bit>,
     pub ray_thread: Signal<Out, Bits<5>>,
     pub ray_o: [Signal<Out, Bits<W>>; 3],
@@ -1139,9 +1149,12 @@ impl<
             enter: Default::default(),
             enter_thread: Default::default(),
             instance_id: Default::default(),
+            normal: Default::default(),
+            nz: Default::default(),
             take: Default::default(),
             free: Default::default(),
             accepted: Default::default(),
+            normal_write: Default::default(),
             ray_write: Default::default(),
             ray_thread: Default::default(),
             ray_o: Default::default(),
@@ -1182,12 +1195,16 @@ impl<
         self.entries.world_write.next = self.world_write.val();
         self.entries.world_pair.next = self.world_pair.val();
         self.entries.word_a.next = self.word_a.val();
-        self.entries.word_b.next = self.word_b.val();
+        self.entries.word_b.next = self.nz.val();
+        if self.world_write.val() {
+            self.entries.word_b.next = self.word_b.val();
+        }
         self.entries.thread.next = self.enter_thread.val();
         if self.world_write.val() {
             self.entries.thread.next = self.world_thread.val();
         }
         self.entries.offer.next = self.enter.val() & (!self.world_write.val());
+        self.entries.offer_normal.next = self.normal.val();
         self.entries.instance_id.next = self.instance_id.val();
         self.accepted.next =
             self.enter.val() & (!self.world_write.val()) & (!self.entries.refused.val());
@@ -1210,16 +1227,19 @@ impl<
         }
         self.unit.point.next = self.entries.gen_point.val();
         self.unit.tag.next = bit_cast::<16, 5>(self.entries.gen_thread.val())
-            | (bit_cast::<16, 1>(self.entries.gen_direction.val().into()) << 5);
+            | (bit_cast::<16, 1>(self.entries.gen_direction.val().into()) << 5)
+            | (bit_cast::<16, 1>(self.entries.gen_normal.val().into()) << 6);
         self.entries.out_valid.next = self.unit.out_valid.val();
         self.entries.out_thread.next = self.unit.out_tag.val().get_bits::<5>(0);
         self.entries.out_direction.next = self.unit.out_tag.val().get_bit(5);
+        self.entries.out_normal.next = self.unit.out_tag.val().get_bit(6);
         for k in 0..3 {
             self.entries.out_v[k].next = self.unit.result[k].val();
             self.ray_o[k].next = self.entries.ray_o[k].val();
             self.ray_d[k].next = self.entries.ray_d[k].val();
         }
         self.ray_write.next = self.entries.ray_write.val();
+        self.normal_write.next = self.entries.normal_write.val();
         self.ray_thread.next = self.entries.ray_thread.val();
         self.done_mask.next = self.entries.done_mask.val();
         self.root_write.next = self.entries.root_write.val();
@@ -1231,10 +1251,13 @@ impl<
 /// InstanceRays' generated Verilog in `sim`, e7m16: every thread's world ray written (random
 /// words), then `entries` entries of threads 0..32 in turn into random instances of a bank
 /// of random words, offered again while refused, the unit taking requests and the bus free in
-/// random clocks. Asserts: each entry's ray is written whole for its thread, in entry order,
-/// as `units::transform` of the thread's world origin (a point) and direction (a vector) by
-/// the record's world-to-object words, with the thread's bit as wake-up, and its root (the
-/// record's root word's 26 bits) given for its thread; no read goes out on a busy bus.
+/// random clocks; four in ten are normals' (`tri.normal`, a random z). Asserts: each entry's
+/// ray is written whole for its thread, in entry order, as `units::transform` of the thread's
+/// world origin (a point) and direction (a vector) by the record's world-to-object words,
+/// with the thread's bit as wake-up, and its root (the record's root word's 26 bits) given
+/// for its thread; each normal is `units::transform3` of the record's normal matrix and the
+/// thread's world words 0, 1 and its z, in order, with the wake-up; no read goes out on a
+/// busy bus.
 fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
     use crate::emit::stream_bench::{InputStream, OutputSink, StreamBench};
     use crate::emit::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
@@ -1262,14 +1285,21 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
         .collect();
     writes.push((0, vec![0, 0, 0, 0, 0]));
     let records: Vec<usize> = (0..entries).map(|_| rng.gen_range(0..16)).collect();
+    // A normal's z, or none for an entry.
+    let normal_z: Vec<Option<u32>> = (0..entries)
+        .map(|_| rng.gen_bool(0.4).then(|| word(f, rng.gen_range(-1.0..1.0))))
+        .collect();
     let offers = records
         .iter()
+        .zip(&normal_z)
         .enumerate()
-        .map(|(i, &r)| {
+        .map(|(i, (&r, z))| {
             let gap = if i == 0 { 100 } else { rng.gen_range(0..4) };
-            (gap, vec![(i % 32) as u64, r as u64])
+            let (normal, z) = (u64::from(z.is_some()), u64::from(z.unwrap_or(0)));
+            (gap, vec![(i % 32) as u64, r as u64, normal, z])
         })
         .collect();
+    let entered = normal_z.iter().filter(|z| z.is_none()).count();
     let random_bits = |rng: &mut ChaCha8Rng, n: usize| -> Vec<(u32, Vec<u64>)> {
         let mut bits: Vec<(u32, Vec<u64>)> = (0..n)
             .map(|_| (0, vec![u64::from(rng.gen_bool(0.5))]))
@@ -1289,11 +1319,14 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
             ("enter", 1),
             ("enter_thread", 5),
             ("instance_id", 24),
+            ("normal", 1),
+            ("nz", 32),
             ("take", 1),
             ("free", 1),
         ],
         &[
             ("accepted", 1),
+            ("normal_write", 1),
             ("busy_read", 1),
             ("root_write", 1),
             ("root_thread", 5),
@@ -1326,7 +1359,11 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
             InputStream {
                 valid: Some("enter".into()),
                 ready: Some("accepted".into()),
-                ..stream("entries", &["enter_thread", "instance_id"], offers)
+                ..stream(
+                    "entries",
+                    &["enter_thread", "instance_id", "normal", "nz"],
+                    offers,
+                )
             },
             stream("takes", &["take"], takes),
             stream("frees", &["free"], frees),
@@ -1335,14 +1372,20 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
             OutputSink {
                 name: "rays".into(),
                 valid: "ray_write".into(),
-                fields: ray_fields,
-                expected: entries,
+                fields: ray_fields.clone(),
+                expected: entered,
             },
             OutputSink {
                 name: "roots".into(),
                 valid: "root_write".into(),
                 fields: vec!["root_thread".into(), "root".into()],
-                expected: entries,
+                expected: entered,
+            },
+            OutputSink {
+                name: "normals".into(),
+                valid: "normal_write".into(),
+                fields: ray_fields,
+                expected: entries - entered,
             },
             OutputSink {
                 name: "busy_reads".into(),
@@ -1359,20 +1402,53 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
         "{sim} instance entry, {entries} entries: compile {:.1} s, run {:.1} s",
         run.compile_seconds, run.run_seconds
     );
-    let (rays, roots, busy_reads) = (&run.sinks[0], &run.sinks[1], &run.sinks[2]);
+    let (rays, roots, normals, busy_reads) =
+        (&run.sinks[0], &run.sinks[1], &run.sinks[2], &run.sinks[3]);
     assert!(busy_reads.is_empty(), "{sim}: reads on a busy bus");
-    assert_eq!(rays.len(), entries, "{sim}: rays written");
-    let want_roots: Vec<Vec<u64>> = records
+    assert_eq!(rays.len(), entered, "{sim}: rays written");
+    // The entries (not normals): their index (the thread is `i % 32`) and record.
+    let enters: Vec<(usize, usize)> = records
         .iter()
+        .zip(&normal_z)
         .enumerate()
-        .map(|(i, &r)| {
+        .filter(|(_, (_, z))| z.is_none())
+        .map(|(i, (&r, _))| (i, r))
+        .collect();
+    let want_roots: Vec<Vec<u64>> = enters
+        .iter()
+        .map(|&(i, r)| {
             let root = bank[r * INSTANCE_WORDS + instance_word::ROOT] & ((1 << 26) - 1);
             vec![(i % 32) as u64, u64::from(root)]
         })
         .collect();
     assert_eq!(roots, &want_roots, "{sim}: roots given");
+    let want_normals: Vec<Vec<u64>> = records
+        .iter()
+        .zip(&normal_z)
+        .enumerate()
+        .filter_map(|(i, (&r, z))| {
+            let thread = i % 32;
+            let at = r * INSTANCE_WORDS + instance_word::NORMAL_MATRIX;
+            let m: &[u32; 9] = bank[at..at + 9].try_into().unwrap();
+            let n = units::transform3(f, m, [world[thread][0], world[thread][1], (*z)?]);
+            // The bench's ray ports: thread, o (not written for a normal), d, wake-up.
+            Some(
+                [thread as u64]
+                    .into_iter()
+                    .chain([0u64; 3])
+                    .chain(n.map(u64::from))
+                    .chain([1 << thread])
+                    .collect(),
+            )
+        })
+        .collect();
+    let got_normals: Vec<Vec<u64>> = normals
+        .iter()
+        .map(|v| [&v[..1], &[0, 0, 0][..], &v[4..]].concat())
+        .collect();
+    assert_eq!(got_normals, want_normals, "{sim}: world normals");
     let mut bad = 0;
-    for (i, (ray, &r)) in rays.iter().zip(&records).enumerate() {
+    for (ray, &(i, r)) in rays.iter().zip(&enters) {
         let thread = i % 32;
         let at = r * INSTANCE_WORDS + instance_word::WORLD_TO_OBJECT;
         let m: units::Mat34W = bank[at..at + 12].try_into().unwrap();
