@@ -31,6 +31,7 @@ module tb;
   wire [31:0] traversal_busy;
   wire [31:0] raygen_busy;
   wire [31:0] instance_busy;
+  wire [31:0] shading_busy;
   reg vga_clock = 1'b0;
   reg vga_reset = 1'b1;
   wire [23:0] vga_fb_addr;
@@ -55,7 +56,7 @@ module tb;
   reg [31:0] rd3 [0:1];
   integer k, n, f, fd;
   reg timeout = 1'b0;
-  dynrt_processor dut(.clock(clock), .start(start), .done(done), .cycles(cycles), .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank), .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write), .fb_addr(fb_addr), .fb_data(fb_data), .bank0_read(bank0_read), .bank0_addr(bank0_addr), .bank0_rdata(bank0_rdata), .bank2_read(bank2_read), .bank2_addr(bank2_addr), .bank2_rdata(bank2_rdata), .bank3_read(bank3_read), .bank3_addr(bank3_addr), .bank3_rdata(bank3_rdata), .transform_busy(transform_busy), .intersect_busy(intersect_busy), .traversal_busy(traversal_busy), .raygen_busy(raygen_busy), .instance_busy(instance_busy), .vga_clock(vga_clock), .vga_reset(vga_reset), .vga_fb_addr(vga_fb_addr), .vga_fb_data(vga_fb_data), .vga_hsync(vga_hsync), .vga_vsync(vga_vsync), .vga_rgb(vga_rgb), .vga_frame_start(vga_frame_start));
+  dynrt_processor dut(.clock(clock), .start(start), .done(done), .cycles(cycles), .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank), .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write), .fb_addr(fb_addr), .fb_data(fb_data), .bank0_read(bank0_read), .bank0_addr(bank0_addr), .bank0_rdata(bank0_rdata), .bank2_read(bank2_read), .bank2_addr(bank2_addr), .bank2_rdata(bank2_rdata), .bank3_read(bank3_read), .bank3_addr(bank3_addr), .bank3_rdata(bank3_rdata), .transform_busy(transform_busy), .intersect_busy(intersect_busy), .traversal_busy(traversal_busy), .raygen_busy(raygen_busy), .instance_busy(instance_busy), .shading_busy(shading_busy), .vga_clock(vga_clock), .vga_reset(vga_reset), .vga_fb_addr(vga_fb_addr), .vga_fb_data(vga_fb_data), .vga_hsync(vga_hsync), .vga_vsync(vga_vsync), .vga_rgb(vga_rgb), .vga_frame_start(vga_frame_start));
   always #5 clock = ~clock;
   // +heartbeat=N: a progress line every N clocks (frame, clocks, pixels written).
   initial if (!$value$plusargs("heartbeat=%d", heartbeat)) heartbeat = 0;
@@ -139,17 +140,18 @@ module tb;
     @(negedge clock) start = 1'b1;
     @(negedge clock) start = 1'b0;
     n = 0;
-    while (!done && n < 1663516) begin @(posedge clock); n = n + 1; end
+    while (!done && n < 1564508) begin @(posedge clock); n = n + 1; end
     if (!done) begin
-      $display("TIMEOUT: frame 0 not done after 1663516 clocks");
+      $display("TIMEOUT: frame 0 not done after 1564508 clocks");
       $fatal(1, "timeout");
     end
     fd = $fopen({out_dir, "/frame0.hex"}, "w");
     for (k = 0; k < 3072; k = k + 1) $fwrite(fd, "%06h\n", bank5[46 + k][23:0]);
     $fclose(fd);
     fd = $fopen({out_dir, "/frame0.stats"}, "w");
-    $fwrite(fd, "%0d %0d %0d %0d %0d %0d %0d\n", cycles, instructions, transform_busy,
-      intersect_busy, traversal_busy, raygen_busy, instance_busy);
+    $fwrite(fd, "%0d %0d %0d %0d %0d %0d %0d %0d\n", cycles, instructions,
+      transform_busy, intersect_busy, traversal_busy, raygen_busy, instance_busy,
+      shading_busy);
     $fclose(fd);
     $display("frame 0: %0d cycles, %0d instructions", cycles, instructions);
     if ($test$plusargs("vga")) begin
