@@ -99,7 +99,7 @@ fn good_with(extra: &str) -> String {
 fn corpus() -> Vec<Case> {
     let many_lights = format!(
         "{GOOD}{}",
-        "[[lights]]\nposition = [0.0, 1.9, 0.8]\n".repeat(120)
+        "[[lights]]\nposition = [0.0, 1.9, 0.8]\n".repeat(149)
     );
     let scaled = format!("{GOOD}[[instances]]\nobject = \"box\"\nscale = [1e39, 1e39, 1e39]\n");
     let far_camera = GOOD.replace("eye = [0.0, 1.0, 3.5]", "eye = [0.0, 1.0, 1e300]");
@@ -149,7 +149,7 @@ fn corpus() -> Vec<Case> {
             &[("s.toml", &many_lights)],
             "rtl $D/s.toml --out $D/r",
             USAGE,
-            &["ROM holds", "121 lights", "use at most"],
+            &["ROM holds", "150 lights", "use at most"],
         ),
         // Hangs and unbounded reads.
         case(
