@@ -24,7 +24,8 @@
 //!   thread.
 //! - I5 ([`OPERAND_STAGE`]): [`Execute`] computes the integer result and the addresses,
 //!   [`PrimaryRays`] hands out a pixel (and requests its primary ray), [`InstanceRays`] takes
-//!   an instance entry (`tri.enter`) or world ray words (`tri.world`), the mailbox registers
+//!   an instance entry (`tri.enter`), a normal (`tri.normal`) or world ray words
+//!   (`tri.world`), the mailbox registers
 //!   the entries it read (it compares at I6, hits and updates at I7), [`FpUnits`] take their
 //!   operands; this block drives the
 //!   memory and frame-buffer ports and offers `tri` and `kd` entries to the coprocessors (their
@@ -61,10 +62,12 @@
 //! read it; `kd.next` goes on). [`PrimaryRays`] sends each
 //! pixel's primary ray through the tester's TransformUnit, in the clocks the tests leave it
 //! free, and writes the ray into both coprocessors (a `pixel`, then a `tri.wait`);
-//! [`InstanceRays`] does the same for the world ray entering an instance (a `tri.enter`, then
-//! a `tri.wait`), after ray generation's requests, with the instance's matrix and object root
-//! read from bank 4 in the clocks the engine's and the list unit's reads leave the `mem_*`
-//! bus free (the root goes to the traversal unit).
+//! [`InstanceRays`] does the same for the world ray entering an instance (a `tri.enter`, whose
+//! ray write starts the traversal unit's walk of the object; then a `kd.wait`), after ray
+//! generation's requests, with the instance's matrix and object root read from bank 4 in the
+//! clocks the engine's and the list unit's reads leave the `mem_*` bus free (the root goes to
+//! the traversal unit), and for a hit's normal through the instance's normal matrix (a
+//! `tri.normal`, then a `tri.wait` and `tri.dir`).
 //!
 //! Memory: one read per clock on the `mem_*` port (banks 0, 1, 4, 5; the tester's list reads
 //! of bank 1 use it in the clocks the engine leaves free, instance entry's reads of bank 4 in
