@@ -16,7 +16,7 @@ use crate::hw::program::exec::{Machine, RunStats, Write};
 use crate::hw::program::isa::MAX_PROGRAM;
 use crate::hw::program::{build_program, Program, ProgramConfig};
 use crate::hw::traversal_unit::FETCH_CLOCKS_PER_NODE;
-use crate::hw::traversal_unit::{STACK_LEVELS, TOP_STACK_BASE, TOP_STACK_LEVELS};
+use crate::hw::traversal_unit::STACK_LEVELS;
 use crate::hw::triangle_tester::CLOCKS_PER_TEST;
 use crate::hw::vga::VgaMode;
 use crate::layout::{self, Layout, MemoryConfig, SceneTrees};
@@ -99,6 +99,7 @@ pub fn preflight(
         object_root: 0,
         materials: 0,
         frame_buffer: 0,
+        top_stack_base: crate::hw::traversal_unit::DEFAULT_TOP_STACK_BASE,
     };
     let length = |lights: u32| {
         build_program(&ProgramConfig {
@@ -684,29 +685,67 @@ fn describe(p: &Program, f: Format, w: &Write) -> String {
 }
 
 /// The traversal unit's stack holds every walk's pushes: an object walk's from entry 0, a
-/// top-level walk's from `TOP_STACK_BASE` (so that under a top level an object walk has the
-/// entries below it).
+/// top-level walk's from the processor's `top_stack_base`, the scene's deepest object tree
+/// (`ProgramConfig::top_stack_base`, the same in every frame: the object trees do not
+/// change), so the two trees' depths must fit the stack together.
 fn check_stack_depths(layouts: &[Layout]) -> Result<()> {
     let deepest = |depth: fn(&Layout) -> u32| layouts.iter().map(depth).max().unwrap_or(0);
     let (object, top) = (
         deepest(|l| l.info.object_depth),
         deepest(|l| l.info.top_depth),
     );
-    let (object_levels, what) = if layouts.iter().any(|l| l.info.top_root.is_some()) {
-        (TOP_STACK_BASE, "below the top-level walk's")
+    if layouts.iter().any(|l| l.info.top_root.is_some()) {
+        let base = layouts
+            .iter()
+            .map(|l| crate::hw::program::top_stack_base(&l.info))
+            .max()
+            .unwrap_or(1);
+        anyhow::ensure!(
+            object <= base && base as usize + top as usize <= STACK_LEVELS,
+            "the scene's deepest object kd tree has {object} levels and its top-level tree \
+             {top}: the traversal unit's stack holds {STACK_LEVELS} for both together: use \
+             fewer triangles per object or fewer instances"
+        );
     } else {
-        (STACK_LEVELS, "in all")
-    };
-    anyhow::ensure!(
-        object as usize <= object_levels,
-        "the scene's deepest object kd tree has {object} levels; the traversal unit's stack \
-         holds {object_levels} for an object walk ({what}): use fewer triangles per object or \
-         split the mesh into instances"
-    );
-    anyhow::ensure!(
-        top as usize <= TOP_STACK_LEVELS,
-        "the scene's top-level kd tree has {top} levels; the traversal unit's stack holds \
-         {TOP_STACK_LEVELS} for the top-level walk: use fewer instances"
-    );
+        anyhow::ensure!(
+            object as usize <= STACK_LEVELS,
+            "the scene's deepest object kd tree has {object} levels; the traversal unit's stack \
+             holds {STACK_LEVELS}: use fewer triangles per object or split the mesh into \
+             instances"
+        );
+    }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The paper's Quake3-p (17 objects under a top level) has an object tree 33 levels deep,
+    /// past the half of the stack a fixed split gave the object walks: the processor's split
+    /// follows the deepest object tree, so the scene is accepted, with the top-level walk's
+    /// stack starting at that depth; moving the object trees' depth past what the stack
+    /// leaves the top level is refused.
+    #[test]
+    fn the_stack_split_follows_the_deepest_object_tree() {
+        let f = Format::E7M16;
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper/quake3_p.toml");
+        let scene = Scene::load(&path).unwrap();
+        let trees = SceneTrees::build(&scene, f).unwrap();
+        let lay = layout::build(&scene, &trees, 0, &MemoryConfig::default()).unwrap();
+        assert!(lay.info.top_root.is_some());
+        assert!(
+            lay.info.object_depth > 32,
+            "depth {}",
+            lay.info.object_depth
+        );
+        check_stack_depths(std::slice::from_ref(&lay)).unwrap();
+        let config = ProgramConfig::from_layout(&lay);
+        assert_eq!(config.top_stack_base, lay.info.object_depth);
+        let mut deep = lay.clone();
+        deep.info.object_depth = (STACK_LEVELS as u32) - lay.info.top_depth + 1;
+        let err = check_stack_depths(&[deep]).unwrap_err().to_string();
+        assert!(err.contains("for both together"), "{err}");
+    }
 }

@@ -10,7 +10,8 @@
 //!
 //! The same pipeline walks a scene's top-level tree (`kd.start` with `KD_TOP`) on the thread's
 //! world ray (`world_write`, the engine's `tri.world`), with its stack at
-//! [`TOP_STACK_BASE`] and its leaf's segment kept apart from the object walks': at each leaf it
+//! the unit's `top_stack_base` (the scene's deepest object tree: the object walks under a top
+//! level have the entries below it) and its leaf's segment kept apart from the object walks': at each leaf it
 //! wakes the thread, which reads the leaf's list (`top_from`, `top_to`), walks the instances'
 //! objects (object walks of this unit), and goes on with `next` (`kd.next`: the closest hit
 //! so far, the thread's last answer, taken like the tester's answer for an object leaf); an
@@ -67,10 +68,11 @@ const CMP_DELAY: usize = COMPARE_LATENCY as usize;
 
 /// Entries of each thread's kd stack (the deepest object tree the unit walks).
 pub const STACK_LEVELS: usize = 64;
-/// Where a top-level walk's stack starts in the thread's stack: an object walk under a top
-/// level has the entries below it, the top-level walk the [`TOP_STACK_LEVELS`] above.
-pub const TOP_STACK_BASE: usize = 32;
-pub const TOP_STACK_LEVELS: usize = STACK_LEVELS - TOP_STACK_BASE;
+/// Where a top-level walk's stack starts in the thread's stack when the scene has no top
+/// level (the base is then never used) or in a test: an object walk under a top level has the
+/// entries below the base, the top-level walk those above. A scene's processor puts it at its
+/// deepest object tree ([`crate::hw::program::ProgramConfig::top_stack_base`]).
+pub const DEFAULT_TOP_STACK_BASE: u32 = 32;
 
 /// Clocks the fetch spends on one node, its two words (the unit's throughput bound).
 pub const FETCH_CLOCKS_PER_NODE: u32 = 2;
@@ -156,6 +158,8 @@ pub struct TraversalUnit<
     /// object walk, `top_from` is the hit flag of the walk's last answer.
     pub top_from: Signal<Out, Bits<32>>,
     pub top_to: Signal<Out, Bits<32>>,
+    /// The wake-up (`engine.done`, `engine.done_thread`) as a one-hot mask of the thread.
+    pub done_mask: Signal<Out, Bits<32>>,
 
     entry_fifo: SyncFifo<Entry, 5, 6>,
     /// `{thread[68:64], from[63:32], to[31:0]}`: a thread has at most one leaf out.
@@ -250,7 +254,7 @@ pub struct TraversalUnit<
     /// Depths after a pop, wrapped in 6 bits (the Verilog of an expression would widen it).
     f2_pop: Signal<Local, Bits<6>>,
     f5_pop: Signal<Local, Bits<6>>,
-    /// The empty stack's depth of the walk's level (0, or `TOP_STACK_BASE`).
+    /// The empty stack's depth of the walk's level (0, or the top-level walk's base).
     f5_base: Signal<Local, Bits<6>>,
     f5_root: Signal<Local, Bits<26>>,
     f1_leaf_address: Signal<Local, Bits<6>>,
@@ -294,9 +298,12 @@ pub struct TraversalUnit<
     entered_thread: DFF<Bits<5>>,
     /// The wake-up, a clock after the count of entries done is written (the engine's
     /// scheduler remembers a wake-up that comes before the waiter's write back): from A it
-    /// was a placed path of 8.9 ns routing into the scheduler (87.5 MHz).
+    /// was a placed path of 8.9 ns routing into the scheduler (87.5 MHz). The mask is
+    /// decoded before its register.
     done_r: DFF<Bit>,
     done_thread_r: DFF<Bits<5>>,
+    done_mask_r: DFF<Bits<32>>,
+    c_one: Constant<Bits<32>>,
     skip_thread: DFF<Bits<5>>,
 
     // Decision.
@@ -346,8 +353,11 @@ impl<
     > TraversalUnit<W, E, M, S, S1, X2, T, DL>
 {
     /// The unit for SRAM read latency `mem_latency` (1..=6).
-    pub fn new(mem_latency: u32) -> Self {
+    /// A top-level walk's stack starts at entry `top_stack_base` of the thread's
+    /// [`STACK_LEVELS`].
+    pub fn new(mem_latency: u32, top_stack_base: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
+        assert!((1..STACK_LEVELS as u32).contains(&top_stack_base));
         assert!(DL == div_latency(M as u32) as usize);
         let f = Format::new(E as u32, M as u32).expect("a supported format");
         Self {
@@ -379,6 +389,7 @@ impl<
             root: Default::default(),
             top_from: Default::default(),
             top_to: Default::default(),
+            done_mask: Default::default(),
             entry_fifo: Default::default(),
             leaf_fifo: Default::default(),
             any_hit: Default::default(),
@@ -493,6 +504,8 @@ impl<
             entered_thread: Default::default(),
             done_r: Default::default(),
             done_thread_r: Default::default(),
+            done_mask_r: Default::default(),
+            c_one: Constant::new(1u64.into()),
             sub: Default::default(),
             div: Default::default(),
             o_delay: Default::default(),
@@ -517,7 +530,7 @@ impl<
             c_zero: const_bits::<W>(u64::from(f.zero(false))),
             c_bank_nodes: Constant::new((1u64 << layout::NODES).into()),
             c_leaf_tag: Constant::new(u64::from(layout::LEAF_TAG).into()),
-            c_top_base: Constant::new((TOP_STACK_BASE as u64).into()),
+            c_top_base: Constant::new(u64::from(top_stack_base).into()),
             c_walk_ended: Constant::new(u64::from(KD_WALK_ENDED).into()),
             c_entered: Constant::new(u64::from(KD_ENTERED).into()),
         }
@@ -594,7 +607,8 @@ impl<
             entered_valid,
             entered_thread,
             done_r,
-            done_thread_r
+            done_thread_r,
+            done_mask_r
         );
         clock!(
             self,
@@ -857,7 +871,7 @@ impl<
         // f5: a start steps from the root (`a`) with [t_min, t_max = `b`]; a next ends the
         // walk when the hit lies in the leaf's segment, the walk answers any hit, the stack is
         // empty or the popped segment starts behind the hit, else steps from the popped entry.
-        // A top-level walk's stack starts at `TOP_STACK_BASE` (its `next` never comes after
+        // A top-level walk's stack starts at the base (its `next` never comes after
         // an answered any-hit query, so the thread's any-hit flag is that of no walk of its).
         self.f5_pop.next = self.f5_sp.q.val() - 1;
         self.f5_base.next = 0.into();
@@ -1047,6 +1061,11 @@ impl<
         self.done_thread_r.d.next = self.job.q.val().get_bits::<5>(96);
         self.engine.done.next = self.done_r.q.val();
         self.engine.done_thread.next = self.done_thread_r.q.val();
+        self.done_mask_r.d.next = 0.into();
+        if self.a_done.val() {
+            self.done_mask_r.d.next = self.c_one.val() << self.job.q.val().get_bits::<5>(96);
+        }
+        self.done_mask.next = self.done_mask_r.q.val();
         self.leaf_hi.write_enable.next = self.at_a.val() & self.a_leaf.val();
         self.leaf_sp.write_enable.next = self.at_a.val() & self.a_leaf.val();
 
@@ -1284,7 +1303,7 @@ mod tests {
         );
         assert!(want[7].len() == 8, "the any-hit walk ends at its first hit");
 
-        let mut u = Unit::new(mem_latency);
+        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE);
         u.connect_all();
         let cycle = |u: &mut Unit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
         for (th, (o, d)) in rays.iter().enumerate() {
@@ -1468,7 +1487,7 @@ mod tests {
         let fetch = |n: u32| Ok(lay.node(n));
         // An object walk up to `hi` whose every leaf is answered with `answer`.
         let object_walk = |root: u32, ray, hi: u32, answer: (u32, bool)| {
-            let levels = TOP_STACK_BASE;
+            let levels = DEFAULT_TOP_STACK_BASE as usize;
             let (mut walk, mut stop) = KdWalk::start(f, ray, root, (0, hi), levels, fetch).unwrap();
             let mut stops = vec![stop];
             while stop != KdStop::Finished {
@@ -1491,7 +1510,7 @@ mod tests {
         let mut empty_leaves = 0;
         let top_want: Vec<Vec<KdStop>> = (0..threads)
             .map(|th| {
-                let levels = TOP_STACK_LEVELS;
+                let levels = STACK_LEVELS - DEFAULT_TOP_STACK_BASE as usize;
                 let (mut walk, mut stop) =
                     KdWalk::start(f, worlds[th], top_root, (0, t_max), levels, fetch).unwrap();
                 let mut stops = vec![];
@@ -1536,7 +1555,7 @@ mod tests {
             "too few object leaves: {object_leaves}"
         );
 
-        let mut u = Unit::new(mem_latency);
+        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE);
         u.connect_all();
         let cycle = |u: &mut Unit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
         for th in 0..threads {

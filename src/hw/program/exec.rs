@@ -23,7 +23,7 @@ use super::isa::{
 use super::Program;
 use crate::fp::Format;
 use crate::hw::engine::CAMERA_WORDS;
-use crate::hw::traversal_unit::{STACK_LEVELS, TOP_STACK_BASE, TOP_STACK_LEVELS};
+use crate::hw::traversal_unit::STACK_LEVELS;
 use crate::layout::{
     instance_word, Layout, Node, INSTANCES, INSTANCE_WORDS, LISTS, NODES, NODE_WORDS, TRIANGLES_B,
     TRIANGLE_BANK_WORDS,
@@ -454,6 +454,8 @@ impl<'a> Machine<'a> {
                     self.kd_node(n)
                 };
                 let root = a & !(KD_ANY_HIT | KD_TOP | KD_ENTERED);
+                // The top-level walk's stack is above the object walks'.
+                let top_levels = STACK_LEVELS - self.program.config.top_stack_base as usize;
                 let world = (
                     t.world[..3].try_into().unwrap(),
                     t.world[3..].try_into().unwrap(),
@@ -465,7 +467,7 @@ impl<'a> Machine<'a> {
                         let answer = t.last_answer;
                         stop = t
                             .top_walk
-                            .next(f, world, answer, TOP_STACK_LEVELS, fetch)
+                            .next(f, world, answer, top_levels, fetch)
                             .map_err(fail)?;
                     }
                     match stop {
@@ -481,7 +483,7 @@ impl<'a> Machine<'a> {
                         t.last_answer = (b, false);
                         let segment = (t.tester.t_min, b);
                         let (walk, stop) =
-                            units::KdWalk::start(f, world, root, segment, TOP_STACK_LEVELS, fetch)
+                            units::KdWalk::start(f, world, root, segment, top_levels, fetch)
                                 .map_err(fail)?;
                         t.top_walk = walk;
                         top_stop(t, stop)?;
@@ -493,7 +495,7 @@ impl<'a> Machine<'a> {
                     KdFn::Next => {
                         let stop = t
                             .top_walk
-                            .next(f, world, t.last_answer, TOP_STACK_LEVELS, fetch)
+                            .next(f, world, t.last_answer, top_levels, fetch)
                             .map_err(fail)?;
                         top_stop(t, stop)?;
                     }
@@ -548,7 +550,7 @@ impl<'a> Machine<'a> {
             self.kd_node(n)
         };
         let levels = if self.program.config.top_root.is_some() {
-            TOP_STACK_BASE
+            self.program.config.top_stack_base as usize
         } else {
             STACK_LEVELS
         };

@@ -29,6 +29,7 @@ use asm::{Asm, Reg};
 use isa::{Instr, Unit};
 
 use crate::fp::Format;
+use crate::hw::traversal_unit::{DEFAULT_TOP_STACK_BASE, STACK_LEVELS};
 use crate::layout::Layout;
 
 /// What the generated processor is built for.
@@ -45,6 +46,20 @@ pub struct ProgramConfig {
     pub object_root: u32,
     pub materials: u32,
     pub frame_buffer: u32,
+    /// Where a top-level walk's stack starts in each thread's `STACK_LEVELS` entries of the
+    /// traversal unit: the scene's deepest object tree, whose walks under the top level have
+    /// the entries below it (without a top level it is never used).
+    pub top_stack_base: u32,
+}
+
+/// [`ProgramConfig::top_stack_base`] of a layout: its deepest object tree's depth, between 1
+/// and `STACK_LEVELS - 1` (the flow refuses a scene whose object and top-level trees do not
+/// fit the stack together).
+pub fn top_stack_base(info: &crate::layout::LayoutInfo) -> u32 {
+    match info.top_root {
+        Some(_) => info.object_depth.clamp(1, STACK_LEVELS as u32 - 1),
+        None => DEFAULT_TOP_STACK_BASE,
+    }
 }
 
 impl ProgramConfig {
@@ -63,6 +78,7 @@ impl ProgramConfig {
             object_root: 0,
             materials: 0,
             frame_buffer: 0,
+            top_stack_base: DEFAULT_TOP_STACK_BASE,
         }
     }
 
@@ -89,6 +105,7 @@ impl ProgramConfig {
             object_root: info.object_root,
             materials: info.materials,
             frame_buffer: info.frame_buffer,
+            top_stack_base: top_stack_base(info),
         }
     }
 }
