@@ -739,7 +739,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  scheduler__wb_wait_pending;
     reg  scheduler__tester_done;
     reg  [4:0] scheduler__tester_done_thread;
-    reg  [31:0] scheduler__walk_done_mask;
+    reg  scheduler__walk_done;
+    reg  [4:0] scheduler__walk_done_thread;
     reg  [31:0] scheduler__ray_done_mask;
     wire  scheduler__issue;
     wire  [4:0] scheduler__pick;
@@ -1130,7 +1131,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [25:0] traversal_unit__root;
     wire  [31:0] traversal_unit__top_from;
     wire  [31:0] traversal_unit__top_to;
-    wire  [31:0] traversal_unit__done_mask;
     reg  running__d;
     wire  running__q;
     reg  running__clock;
@@ -1253,7 +1253,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .wb_wait_pending(scheduler__wb_wait_pending),
         .tester_done(scheduler__tester_done),
         .tester_done_thread(scheduler__tester_done_thread),
-        .walk_done_mask(scheduler__walk_done_mask),
+        .walk_done(scheduler__walk_done),
+        .walk_done_thread(scheduler__walk_done_thread),
         .ray_done_mask(scheduler__ray_done_mask),
         .issue(scheduler__issue),
         .pick(scheduler__pick)
@@ -1676,8 +1677,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .root_thread(traversal_unit__root_thread),
         .root(traversal_unit__root),
         .top_from(traversal_unit__top_from),
-        .top_to(traversal_unit__top_to),
-        .done_mask(traversal_unit__done_mask)
+        .top_to(traversal_unit__top_to)
     );
     dynrt_processor__display__dark_d running(
         .d(running__d),
@@ -2278,7 +2278,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         scheduler__wb_wait_pending = write_back__wait_pending;
         scheduler__tester_done = tester__engine__done;
         scheduler__tester_done_thread = tester__engine__done_thread;
-        scheduler__walk_done_mask = traversal_unit__done_mask;
+        scheduler__walk_done = traversal_unit__engine__done;
+        scheduler__walk_done_thread = traversal_unit__engine__done_thread;
         scheduler__ray_done_mask = rays__done_mask | instances__done_mask;
         if (write_back__retired) begin
             instr_count__d = instr_count__q + 32'h1;
@@ -16466,7 +16467,7 @@ endmodule // dynrt_processor__engine__result_line__thread_line
 
 
 
-module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,wb_valid,wb_thread,wb_halt,wb_wait_pending,tester_done,tester_done_thread,walk_done_mask,ray_done_mask,issue,pick);
+module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,wb_valid,wb_thread,wb_halt,wb_wait_pending,tester_done,tester_done_thread,walk_done,walk_done_thread,ray_done_mask,issue,pick);
     
     // Module arguments
     input wire  clock;
@@ -16479,7 +16480,8 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     input wire  wb_wait_pending;
     input wire  tester_done;
     input wire  [4:0] tester_done_thread;
-    input wire  [31:0] walk_done_mask;
+    input wire  walk_done;
+    input wire  [4:0] walk_done_thread;
     input wire  [31:0] ray_done_mask;
     output reg  issue;
     output reg  [4:0] pick;
@@ -16531,6 +16533,7 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     reg  [31:0] issue_mask;
     reg  [31:0] wb_mask;
     reg  [31:0] tester_event;
+    reg  [31:0] walk_event;
     reg  [31:0] event_mask;
     reg  wb_sleep;
     reg  [31:0] wake_mask;
@@ -16632,7 +16635,11 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         if (tester_done) begin
             tester_event = c_one << tester_done_thread;
         end
-        event_mask = tester_event | walk_done_mask | ray_done_mask;
+        walk_event = 32'h0;
+        if (walk_done) begin
+            walk_event = c_one << walk_done_thread;
+        end
+        event_mask = tester_event | walk_event | ray_done_mask;
         wb_sleep = wb_valid & wb_wait_pending & (((woken__q | event_mask) & wb_mask) == 32'h0);
         wake_mask = 32'h0;
         sleep_mask = 32'h0;
@@ -27203,7 +27210,7 @@ endmodule // dynrt_processor__engine__tester__transform_unit__tag_delay
 
 
 
-module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,t_min_write,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2,nodes__read,nodes__addr,nodes__rdata,step_busy,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit,engine_next,world_write,world_pair,enter,entered,root_write,root_thread,root,top_from,top_to,done_mask);
+module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,t_min_write,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2,nodes__read,nodes__addr,nodes__rdata,step_busy,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit,engine_next,world_write,world_pair,enter,entered,root_write,root_thread,root,top_from,top_to);
     
     // Module arguments
     input wire  clock;
@@ -27252,10 +27259,8 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     input wire  [25:0] root;
     output reg  [31:0] top_from;
     output reg  [31:0] top_to;
-    output reg  [31:0] done_mask;
     
     // Constant declarations
-    localparam  c_one = 32'h1;
     localparam  c_ml_last = 4'h1;
     localparam  c_index__0 = 4'h0;
     localparam  c_index__1 = 4'h1;
@@ -27660,9 +27665,6 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  [4:0] done_thread_r__d;
     wire  [4:0] done_thread_r__q;
     reg  done_thread_r__clock;
-    reg  [31:0] done_mask_r__d;
-    wire  [31:0] done_mask_r__q;
-    reg  done_mask_r__clock;
     reg  [4:0] skip_thread__d;
     wire  [4:0] skip_thread__q;
     reg  skip_thread__clock;
@@ -28369,11 +28371,6 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(done_thread_r__q),
         .clock(done_thread_r__clock)
     );
-    dynrt_processor__engine__cycle_count done_mask_r(
-        .d(done_mask_r__d),
-        .q(done_mask_r__q),
-        .clock(done_mask_r__clock)
-    );
     dynrt_processor__engine__decode__t4 skip_thread(
         .d(skip_thread__d),
         .q(skip_thread__q),
@@ -28584,7 +28581,6 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         entered_thread__clock = clock;
         done_r__clock = clock;
         done_thread_r__clock = clock;
-        done_mask_r__clock = clock;
         f1_valid__d = f1_valid__q;
         f1_next__d = f1_next__q;
         f1_top__d = f1_top__q;
@@ -28640,7 +28636,6 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         entered_thread__d = entered_thread__q;
         done_r__d = done_r__q;
         done_thread_r__d = done_thread_r__q;
-        done_mask_r__d = done_mask_r__q;
         entry_fifo__clock = clock;
         leaf_fifo__clock = clock;
         in_flight__clock = clock;
@@ -29038,11 +29033,6 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         done_thread_r__d = job__q[(32'h60)+:(5)];
         engine__done = done_r__q;
         engine__done_thread = done_thread_r__q;
-        done_mask_r__d = 32'h0;
-        if (a_done) begin
-            done_mask_r__d = c_one << job__q[(32'h60)+:(5)];
-        end
-        done_mask = done_mask_r__q;
         leaf_hi__write_enable = at_a & a_leaf;
         leaf_sp__write_enable = at_a & a_leaf;
         step_busy = a_inner;
@@ -29694,8 +29684,6 @@ module dynrt_processor__engine__traversal_unit__control_delay_div(clock,data_in,
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__control_delay_div
-
-
 
 
 

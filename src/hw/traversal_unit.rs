@@ -158,8 +158,6 @@ pub struct TraversalUnit<
     /// object walk, `top_from` is the hit flag of the walk's last answer.
     pub top_from: Signal<Out, Bits<32>>,
     pub top_to: Signal<Out, Bits<32>>,
-    /// The wake-up (`engine.done`, `engine.done_thread`) as a one-hot mask of the thread.
-    pub done_mask: Signal<Out, Bits<32>>,
 
     entry_fifo: SyncFifo<Entry, 5, 6>,
     /// `{thread[68:64], from[63:32], to[31:0]}`: a thread has at most one leaf out.
@@ -298,12 +296,10 @@ pub struct TraversalUnit<
     entered_thread: DFF<Bits<5>>,
     /// The wake-up, a clock after the count of entries done is written (the engine's
     /// scheduler remembers a wake-up that comes before the waiter's write back): from A it
-    /// was a placed path of 8.9 ns routing into the scheduler (87.5 MHz). The mask is
-    /// decoded before its register.
+    /// was a placed path of 8.9 ns routing into the scheduler (87.5 MHz). (A one-hot mask
+    /// decoded before the register placed worse: 73.5 / 77.3 MHz, see the README.)
     done_r: DFF<Bit>,
     done_thread_r: DFF<Bits<5>>,
-    done_mask_r: DFF<Bits<32>>,
-    c_one: Constant<Bits<32>>,
     skip_thread: DFF<Bits<5>>,
 
     // Decision.
@@ -389,7 +385,6 @@ impl<
             root: Default::default(),
             top_from: Default::default(),
             top_to: Default::default(),
-            done_mask: Default::default(),
             entry_fifo: Default::default(),
             leaf_fifo: Default::default(),
             any_hit: Default::default(),
@@ -504,8 +499,6 @@ impl<
             entered_thread: Default::default(),
             done_r: Default::default(),
             done_thread_r: Default::default(),
-            done_mask_r: Default::default(),
-            c_one: Constant::new(1u64.into()),
             sub: Default::default(),
             div: Default::default(),
             o_delay: Default::default(),
@@ -607,8 +600,7 @@ impl<
             entered_valid,
             entered_thread,
             done_r,
-            done_thread_r,
-            done_mask_r
+            done_thread_r
         );
         clock!(
             self,
@@ -1061,11 +1053,6 @@ impl<
         self.done_thread_r.d.next = self.job.q.val().get_bits::<5>(96);
         self.engine.done.next = self.done_r.q.val();
         self.engine.done_thread.next = self.done_thread_r.q.val();
-        self.done_mask_r.d.next = 0.into();
-        if self.a_done.val() {
-            self.done_mask_r.d.next = self.c_one.val() << self.job.q.val().get_bits::<5>(96);
-        }
-        self.done_mask.next = self.done_mask_r.q.val();
         self.leaf_hi.write_enable.next = self.at_a.val() & self.a_leaf.val();
         self.leaf_sp.write_enable.next = self.at_a.val() & self.a_leaf.val();
 

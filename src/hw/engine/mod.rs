@@ -1003,7 +1003,8 @@ impl<
         self.scheduler.wb_wait_pending.next = self.write_back.wait_pending.val();
         self.scheduler.tester_done.next = self.tester.engine.done.val();
         self.scheduler.tester_done_thread.next = self.tester.engine.done_thread.val();
-        self.scheduler.walk_done_mask.next = self.traversal_unit.done_mask.val();
+        self.scheduler.walk_done.next = self.traversal_unit.engine.done.val();
+        self.scheduler.walk_done_thread.next = self.traversal_unit.engine.done_thread.val();
         self.scheduler.ray_done_mask.next =
             self.rays.done_mask.val() | self.instances.done_mask.val();
         // Instructions retired: every write back but a turn spent offering again to a full

@@ -4,8 +4,7 @@
 //! Contract: a thread is *ready* from the start of a frame and again at the write back of
 //! its instruction, unless that instruction was `halt` or a coprocessor wait (`tri.wait`,
 //! `kd.wait`) that is still pending. A pending waiter *sleeps* until its coprocessor reports
-//! a finish for it (`tester_done`, the traversal unit's `walk_done_mask`, or ray generation's
-//! `ray_done_mask`: a `tri.wait`
+//! a finish for it (`tester_done`, `walk_done`, or ray generation's `ray_done_mask`: a `tri.wait`
 //! also waits for the thread's primary ray); a finish between the waiter's issue and its
 //! write back is remembered (`woken`), so the waiter does not sleep through it. A long
 //! instruction (`fdiv`, `fsqrt`) at I3 reserves the clock its write back will take: the
@@ -51,9 +50,8 @@ pub struct Scheduler {
     /// The triangle tester and the traversal unit finished work for a thread.
     pub tester_done: Signal<In, Bit>,
     pub tester_done_thread: Signal<In, Bits<5>>,
-    /// The traversal unit's, as a registered one-hot mask (decoded from the thread number,
-    /// the wake-up was a placed path of 9.2 ns routing into `ready`: 85.9 MHz).
-    pub walk_done_mask: Signal<In, Bits<32>>,
+    pub walk_done: Signal<In, Bit>,
+    pub walk_done_thread: Signal<In, Bits<5>>,
     /// Ray generation wrote these threads' primary rays (a one-hot mask, registered: a
     /// `tri.wait` waits for the ray).
     pub ray_done_mask: Signal<In, Bits<32>>,
@@ -85,6 +83,7 @@ pub struct Scheduler {
     issue_mask: Signal<Local, Bits<32>>,
     wb_mask: Signal<Local, Bits<32>>,
     tester_event: Signal<Local, Bits<32>>,
+    walk_event: Signal<Local, Bits<32>>,
     event_mask: Signal<Local, Bits<32>>,
     wb_sleep: Signal<Local, Bit>,
     wake_mask: Signal<Local, Bits<32>>,
@@ -115,7 +114,8 @@ impl Scheduler {
             wb_wait_pending: Default::default(),
             tester_done: Default::default(),
             tester_done_thread: Default::default(),
-            walk_done_mask: Default::default(),
+            walk_done: Default::default(),
+            walk_done_thread: Default::default(),
             ray_done_mask: Default::default(),
             issue: Default::default(),
             pick: Default::default(),
@@ -135,6 +135,7 @@ impl Scheduler {
             issue_mask: Default::default(),
             wb_mask: Default::default(),
             tester_event: Default::default(),
+            walk_event: Default::default(),
             event_mask: Default::default(),
             wb_sleep: Default::default(),
             wake_mask: Default::default(),
@@ -198,8 +199,12 @@ impl Logic for Scheduler {
         if self.tester_done.val() {
             self.tester_event.next = self.c_one.val() << self.tester_done_thread.val();
         }
+        self.walk_event.next = 0.into();
+        if self.walk_done.val() {
+            self.walk_event.next = self.c_one.val() << self.walk_done_thread.val();
+        }
         self.event_mask.next =
-            self.tester_event.val() | self.walk_done_mask.val() | self.ray_done_mask.val();
+            self.tester_event.val() | self.walk_event.val() | self.ray_done_mask.val();
         self.wb_sleep.next = self.wb_valid.val()
             & self.wb_wait_pending.val()
             & (((self.woken.q.val() | self.event_mask.val()) & self.wb_mask.val()) == 0);
