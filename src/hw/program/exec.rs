@@ -404,14 +404,7 @@ impl<'a> Machine<'a> {
                     TriFn::Enter => {
                         // `hw::engine::InstanceRays`: origin, then direction, through the
                         // TransformUnit (its twin, `units::transform`), and the object root.
-                        let bank = &self.layout.banks[INSTANCES];
-                        let record = a as usize * INSTANCE_WORDS;
-                        let words = bank.get(record..record + INSTANCE_WORDS).ok_or_else(|| {
-                            fail(format!(
-                                "instance {a} beyond the instance bank's {} words",
-                                bank.len()
-                            ))
-                        })?;
+                        let words = self.instance_record(a).map_err(fail)?;
                         let at = instance_word::WORLD_TO_OBJECT;
                         let m: units::Mat34W = words[at..at + 12].try_into().unwrap();
                         let (o, d) = t.world.split_at(3);
@@ -428,17 +421,9 @@ impl<'a> Machine<'a> {
                     TriFn::Normal => {
                         // `hw::engine::InstanceRays`: the normal matrix through the
                         // TransformUnit (a vector), kept where `tri.dir` reads.
-                        let bank = &self.layout.banks[INSTANCES];
-                        let at = a as usize * INSTANCE_WORDS + instance_word::NORMAL_MATRIX;
-                        let m: &[u32; 9] = bank
-                            .get(at..at + 9)
-                            .and_then(|w| w.try_into().ok())
-                            .ok_or_else(|| {
-                                fail(format!(
-                                    "instance {a} beyond the instance bank's {} words",
-                                    bank.len()
-                                ))
-                            })?;
+                        let words = self.instance_record(a).map_err(fail)?;
+                        let at = instance_word::NORMAL_MATRIX;
+                        let m: &[u32; 9] = words[at..at + 9].try_into().unwrap();
                         t.primary_d = units::transform3(f, m, [t.world[0], t.world[1], b]);
                     }
                 }
@@ -529,6 +514,18 @@ impl<'a> Machine<'a> {
         stats.instructions += 1;
         t.pc = next;
         Ok(())
+    }
+
+    /// Instance `instance`'s record in bank 4, as instance entry reads it.
+    fn instance_record(&self, instance: u32) -> Result<&[u32], String> {
+        let bank = &self.layout.banks[INSTANCES];
+        let record = instance as usize * INSTANCE_WORDS;
+        bank.get(record..record + INSTANCE_WORDS).ok_or_else(|| {
+            format!(
+                "instance {instance} beyond the instance bank's {} words",
+                bank.len()
+            )
+        })
     }
 
     /// An object's whole walk by the traversal unit (`kd.start` of an object, or the walk of

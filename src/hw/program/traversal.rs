@@ -61,10 +61,7 @@ impl Gen<'_> {
     /// with, which the program keeps in registers from its start: the object's root (none
     /// under a top level) and, with shadows, the same with [`KD_ANY_HIT`].
     pub(super) fn walk_words(&self) -> Vec<u32> {
-        let root = match self.c.top_root {
-            Some(_) => 0,
-            None => self.c.object_root,
-        };
+        let root = self.walk_root();
         let mut words = vec![root];
         if self.c.shadows {
             words.push(root | KD_ANY_HIT);
@@ -73,12 +70,18 @@ impl Gen<'_> {
         words
     }
 
-    /// The walk word of [`Self::walk_words`] for `query`.
-    fn walk_word(&self, query: Query) -> Reg {
-        let root = match self.c.top_root {
+    /// The root an object walk names: the one object's, or none under a top level (the
+    /// entered object's, which the traversal unit keeps).
+    fn walk_root(&self) -> u32 {
+        match self.c.top_root {
             Some(_) => 0,
             None => self.c.object_root,
-        };
+        }
+    }
+
+    /// The walk word of [`Self::walk_words`] for `query`.
+    fn walk_word(&self, query: Query) -> Reg {
+        let root = self.walk_root();
         let any = if query == Query::Closest {
             0
         } else {
