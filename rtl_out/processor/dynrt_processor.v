@@ -3638,7 +3638,7 @@ module dynrt_processor__engine__fp_units(clock,a,b,sub,sum,product,quotient,root
         .data_in(div_delay__data_in),
         .data_out(div_delay__data_out)
     );
-    dynrt_processor__engine__fp_units__div_delay sqrt_delay(
+    dynrt_processor__engine__fp_units__sqrt_delay sqrt_delay(
         .clock(sqrt_delay__clock),
         .data_in(sqrt_delay__data_in),
         .data_out(sqrt_delay__data_out)
@@ -5883,7 +5883,13 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     localparam  c_hidden = 18'b10000000000000000;
     localparam  c_bias = 9'b111111;
     localparam  c_bias_less_one = 9'b111110;
-    localparam  c_one = 18'b1;
+    localparam  c_one = 24'h1;
+    localparam  c_two = 24'h2;
+    localparam  c_three = 24'h3;
+    localparam  c_extra = 8'h1;
+    localparam  c_extra_sig = 8'h2;
+    localparam  c_extra_mask = 24'h1;
+    localparam  c_rem_mask = 24'h3ffff;
     
     // Stub signals
     reg  [23:0] in_a__d;
@@ -5895,159 +5901,114 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  in_valid_r__d;
     wire  in_valid_r__q;
     reg  in_valid_r__clock;
-    reg  [17:0] rem__0__d;
-    wire  [17:0] rem__0__q;
+    reg  [23:0] rem__0__d;
+    wire  [23:0] rem__0__q;
     reg  rem__0__clock;
-    reg  [17:0] rem__1__d;
-    wire  [17:0] rem__1__q;
+    reg  [23:0] rem__1__d;
+    wire  [23:0] rem__1__q;
     reg  rem__1__clock;
-    reg  [17:0] rem__2__d;
-    wire  [17:0] rem__2__q;
+    reg  [23:0] rem__2__d;
+    wire  [23:0] rem__2__q;
     reg  rem__2__clock;
-    reg  [17:0] rem__3__d;
-    wire  [17:0] rem__3__q;
+    reg  [23:0] rem__3__d;
+    wire  [23:0] rem__3__q;
     reg  rem__3__clock;
-    reg  [17:0] rem__4__d;
-    wire  [17:0] rem__4__q;
+    reg  [23:0] rem__4__d;
+    wire  [23:0] rem__4__q;
     reg  rem__4__clock;
-    reg  [17:0] rem__5__d;
-    wire  [17:0] rem__5__q;
+    reg  [23:0] rem__5__d;
+    wire  [23:0] rem__5__q;
     reg  rem__5__clock;
-    reg  [17:0] rem__6__d;
-    wire  [17:0] rem__6__q;
+    reg  [23:0] rem__6__d;
+    wire  [23:0] rem__6__q;
     reg  rem__6__clock;
-    reg  [17:0] rem__7__d;
-    wire  [17:0] rem__7__q;
+    reg  [23:0] rem__7__d;
+    wire  [23:0] rem__7__q;
     reg  rem__7__clock;
-    reg  [17:0] rem__8__d;
-    wire  [17:0] rem__8__q;
+    reg  [23:0] rem__8__d;
+    wire  [23:0] rem__8__q;
     reg  rem__8__clock;
-    reg  [17:0] rem__9__d;
-    wire  [17:0] rem__9__q;
-    reg  rem__9__clock;
-    reg  [17:0] rem__10__d;
-    wire  [17:0] rem__10__q;
-    reg  rem__10__clock;
-    reg  [17:0] rem__11__d;
-    wire  [17:0] rem__11__q;
-    reg  rem__11__clock;
-    reg  [17:0] rem__12__d;
-    wire  [17:0] rem__12__q;
-    reg  rem__12__clock;
-    reg  [17:0] rem__13__d;
-    wire  [17:0] rem__13__q;
-    reg  rem__13__clock;
-    reg  [17:0] rem__14__d;
-    wire  [17:0] rem__14__q;
-    reg  rem__14__clock;
-    reg  [17:0] rem__15__d;
-    wire  [17:0] rem__15__q;
-    reg  rem__15__clock;
-    reg  [17:0] rem__16__d;
-    wire  [17:0] rem__16__q;
-    reg  rem__16__clock;
-    reg  [17:0] quo__0__d;
-    wire  [17:0] quo__0__q;
+    reg  [23:0] quo__0__d;
+    wire  [23:0] quo__0__q;
     reg  quo__0__clock;
-    reg  [17:0] quo__1__d;
-    wire  [17:0] quo__1__q;
+    reg  [23:0] quo__1__d;
+    wire  [23:0] quo__1__q;
     reg  quo__1__clock;
-    reg  [17:0] quo__2__d;
-    wire  [17:0] quo__2__q;
+    reg  [23:0] quo__2__d;
+    wire  [23:0] quo__2__q;
     reg  quo__2__clock;
-    reg  [17:0] quo__3__d;
-    wire  [17:0] quo__3__q;
+    reg  [23:0] quo__3__d;
+    wire  [23:0] quo__3__q;
     reg  quo__3__clock;
-    reg  [17:0] quo__4__d;
-    wire  [17:0] quo__4__q;
+    reg  [23:0] quo__4__d;
+    wire  [23:0] quo__4__q;
     reg  quo__4__clock;
-    reg  [17:0] quo__5__d;
-    wire  [17:0] quo__5__q;
+    reg  [23:0] quo__5__d;
+    wire  [23:0] quo__5__q;
     reg  quo__5__clock;
-    reg  [17:0] quo__6__d;
-    wire  [17:0] quo__6__q;
+    reg  [23:0] quo__6__d;
+    wire  [23:0] quo__6__q;
     reg  quo__6__clock;
-    reg  [17:0] quo__7__d;
-    wire  [17:0] quo__7__q;
+    reg  [23:0] quo__7__d;
+    wire  [23:0] quo__7__q;
     reg  quo__7__clock;
-    reg  [17:0] quo__8__d;
-    wire  [17:0] quo__8__q;
+    reg  [23:0] quo__8__d;
+    wire  [23:0] quo__8__q;
     reg  quo__8__clock;
-    reg  [17:0] quo__9__d;
-    wire  [17:0] quo__9__q;
-    reg  quo__9__clock;
-    reg  [17:0] quo__10__d;
-    wire  [17:0] quo__10__q;
-    reg  quo__10__clock;
-    reg  [17:0] quo__11__d;
-    wire  [17:0] quo__11__q;
-    reg  quo__11__clock;
-    reg  [17:0] quo__12__d;
-    wire  [17:0] quo__12__q;
-    reg  quo__12__clock;
-    reg  [17:0] quo__13__d;
-    wire  [17:0] quo__13__q;
-    reg  quo__13__clock;
-    reg  [17:0] quo__14__d;
-    wire  [17:0] quo__14__q;
-    reg  quo__14__clock;
-    reg  [17:0] quo__15__d;
-    wire  [17:0] quo__15__q;
-    reg  quo__15__clock;
-    reg  [17:0] quo__16__d;
-    wire  [17:0] quo__16__q;
-    reg  quo__16__clock;
-    reg  [17:0] divisor__0__d;
-    wire  [17:0] divisor__0__q;
+    reg  [23:0] divisor__0__d;
+    wire  [23:0] divisor__0__q;
     reg  divisor__0__clock;
-    reg  [17:0] divisor__1__d;
-    wire  [17:0] divisor__1__q;
+    reg  [23:0] divisor__1__d;
+    wire  [23:0] divisor__1__q;
     reg  divisor__1__clock;
-    reg  [17:0] divisor__2__d;
-    wire  [17:0] divisor__2__q;
+    reg  [23:0] divisor__2__d;
+    wire  [23:0] divisor__2__q;
     reg  divisor__2__clock;
-    reg  [17:0] divisor__3__d;
-    wire  [17:0] divisor__3__q;
+    reg  [23:0] divisor__3__d;
+    wire  [23:0] divisor__3__q;
     reg  divisor__3__clock;
-    reg  [17:0] divisor__4__d;
-    wire  [17:0] divisor__4__q;
+    reg  [23:0] divisor__4__d;
+    wire  [23:0] divisor__4__q;
     reg  divisor__4__clock;
-    reg  [17:0] divisor__5__d;
-    wire  [17:0] divisor__5__q;
+    reg  [23:0] divisor__5__d;
+    wire  [23:0] divisor__5__q;
     reg  divisor__5__clock;
-    reg  [17:0] divisor__6__d;
-    wire  [17:0] divisor__6__q;
+    reg  [23:0] divisor__6__d;
+    wire  [23:0] divisor__6__q;
     reg  divisor__6__clock;
-    reg  [17:0] divisor__7__d;
-    wire  [17:0] divisor__7__q;
+    reg  [23:0] divisor__7__d;
+    wire  [23:0] divisor__7__q;
     reg  divisor__7__clock;
-    reg  [17:0] divisor__8__d;
-    wire  [17:0] divisor__8__q;
+    reg  [23:0] divisor__8__d;
+    wire  [23:0] divisor__8__q;
     reg  divisor__8__clock;
-    reg  [17:0] divisor__9__d;
-    wire  [17:0] divisor__9__q;
-    reg  divisor__9__clock;
-    reg  [17:0] divisor__10__d;
-    wire  [17:0] divisor__10__q;
-    reg  divisor__10__clock;
-    reg  [17:0] divisor__11__d;
-    wire  [17:0] divisor__11__q;
-    reg  divisor__11__clock;
-    reg  [17:0] divisor__12__d;
-    wire  [17:0] divisor__12__q;
-    reg  divisor__12__clock;
-    reg  [17:0] divisor__13__d;
-    wire  [17:0] divisor__13__q;
-    reg  divisor__13__clock;
-    reg  [17:0] divisor__14__d;
-    wire  [17:0] divisor__14__q;
-    reg  divisor__14__clock;
-    reg  [17:0] divisor__15__d;
-    wire  [17:0] divisor__15__q;
-    reg  divisor__15__clock;
-    reg  [17:0] divisor__16__d;
-    wire  [17:0] divisor__16__q;
-    reg  divisor__16__clock;
+    reg  [23:0] divisor3__0__d;
+    wire  [23:0] divisor3__0__q;
+    reg  divisor3__0__clock;
+    reg  [23:0] divisor3__1__d;
+    wire  [23:0] divisor3__1__q;
+    reg  divisor3__1__clock;
+    reg  [23:0] divisor3__2__d;
+    wire  [23:0] divisor3__2__q;
+    reg  divisor3__2__clock;
+    reg  [23:0] divisor3__3__d;
+    wire  [23:0] divisor3__3__q;
+    reg  divisor3__3__clock;
+    reg  [23:0] divisor3__4__d;
+    wire  [23:0] divisor3__4__q;
+    reg  divisor3__4__clock;
+    reg  [23:0] divisor3__5__d;
+    wire  [23:0] divisor3__5__q;
+    reg  divisor3__5__clock;
+    reg  [23:0] divisor3__6__d;
+    wire  [23:0] divisor3__6__q;
+    reg  divisor3__6__clock;
+    reg  [23:0] divisor3__7__d;
+    wire  [23:0] divisor3__7__q;
+    reg  divisor3__7__clock;
+    reg  [23:0] divisor3__8__d;
+    wire  [23:0] divisor3__8__q;
+    reg  divisor3__8__clock;
     reg  [8:0] exp__0__d;
     wire  [8:0] exp__0__q;
     reg  exp__0__clock;
@@ -6075,30 +6036,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  [8:0] exp__8__d;
     wire  [8:0] exp__8__q;
     reg  exp__8__clock;
-    reg  [8:0] exp__9__d;
-    wire  [8:0] exp__9__q;
-    reg  exp__9__clock;
-    reg  [8:0] exp__10__d;
-    wire  [8:0] exp__10__q;
-    reg  exp__10__clock;
-    reg  [8:0] exp__11__d;
-    wire  [8:0] exp__11__q;
-    reg  exp__11__clock;
-    reg  [8:0] exp__12__d;
-    wire  [8:0] exp__12__q;
-    reg  exp__12__clock;
-    reg  [8:0] exp__13__d;
-    wire  [8:0] exp__13__q;
-    reg  exp__13__clock;
-    reg  [8:0] exp__14__d;
-    wire  [8:0] exp__14__q;
-    reg  exp__14__clock;
-    reg  [8:0] exp__15__d;
-    wire  [8:0] exp__15__q;
-    reg  exp__15__clock;
-    reg  [8:0] exp__16__d;
-    wire  [8:0] exp__16__q;
-    reg  exp__16__clock;
     reg  sign__0__d;
     wire  sign__0__q;
     reg  sign__0__clock;
@@ -6126,30 +6063,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  sign__8__d;
     wire  sign__8__q;
     reg  sign__8__clock;
-    reg  sign__9__d;
-    wire  sign__9__q;
-    reg  sign__9__clock;
-    reg  sign__10__d;
-    wire  sign__10__q;
-    reg  sign__10__clock;
-    reg  sign__11__d;
-    wire  sign__11__q;
-    reg  sign__11__clock;
-    reg  sign__12__d;
-    wire  sign__12__q;
-    reg  sign__12__clock;
-    reg  sign__13__d;
-    wire  sign__13__q;
-    reg  sign__13__clock;
-    reg  sign__14__d;
-    wire  sign__14__q;
-    reg  sign__14__clock;
-    reg  sign__15__d;
-    wire  sign__15__q;
-    reg  sign__15__clock;
-    reg  sign__16__d;
-    wire  sign__16__q;
-    reg  sign__16__clock;
     reg  nan__0__d;
     wire  nan__0__q;
     reg  nan__0__clock;
@@ -6177,30 +6090,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  nan__8__d;
     wire  nan__8__q;
     reg  nan__8__clock;
-    reg  nan__9__d;
-    wire  nan__9__q;
-    reg  nan__9__clock;
-    reg  nan__10__d;
-    wire  nan__10__q;
-    reg  nan__10__clock;
-    reg  nan__11__d;
-    wire  nan__11__q;
-    reg  nan__11__clock;
-    reg  nan__12__d;
-    wire  nan__12__q;
-    reg  nan__12__clock;
-    reg  nan__13__d;
-    wire  nan__13__q;
-    reg  nan__13__clock;
-    reg  nan__14__d;
-    wire  nan__14__q;
-    reg  nan__14__clock;
-    reg  nan__15__d;
-    wire  nan__15__q;
-    reg  nan__15__clock;
-    reg  nan__16__d;
-    wire  nan__16__q;
-    reg  nan__16__clock;
     reg  inf__0__d;
     wire  inf__0__q;
     reg  inf__0__clock;
@@ -6228,30 +6117,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  inf__8__d;
     wire  inf__8__q;
     reg  inf__8__clock;
-    reg  inf__9__d;
-    wire  inf__9__q;
-    reg  inf__9__clock;
-    reg  inf__10__d;
-    wire  inf__10__q;
-    reg  inf__10__clock;
-    reg  inf__11__d;
-    wire  inf__11__q;
-    reg  inf__11__clock;
-    reg  inf__12__d;
-    wire  inf__12__q;
-    reg  inf__12__clock;
-    reg  inf__13__d;
-    wire  inf__13__q;
-    reg  inf__13__clock;
-    reg  inf__14__d;
-    wire  inf__14__q;
-    reg  inf__14__clock;
-    reg  inf__15__d;
-    wire  inf__15__q;
-    reg  inf__15__clock;
-    reg  inf__16__d;
-    wire  inf__16__q;
-    reg  inf__16__clock;
     reg  zero__0__d;
     wire  zero__0__q;
     reg  zero__0__clock;
@@ -6279,30 +6144,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  zero__8__d;
     wire  zero__8__q;
     reg  zero__8__clock;
-    reg  zero__9__d;
-    wire  zero__9__q;
-    reg  zero__9__clock;
-    reg  zero__10__d;
-    wire  zero__10__q;
-    reg  zero__10__clock;
-    reg  zero__11__d;
-    wire  zero__11__q;
-    reg  zero__11__clock;
-    reg  zero__12__d;
-    wire  zero__12__q;
-    reg  zero__12__clock;
-    reg  zero__13__d;
-    wire  zero__13__q;
-    reg  zero__13__clock;
-    reg  zero__14__d;
-    wire  zero__14__q;
-    reg  zero__14__clock;
-    reg  zero__15__d;
-    wire  zero__15__q;
-    reg  zero__15__clock;
-    reg  zero__16__d;
-    wire  zero__16__q;
-    reg  zero__16__clock;
     reg  valid__0__d;
     wire  valid__0__q;
     reg  valid__0__clock;
@@ -6330,30 +6171,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  valid__8__d;
     wire  valid__8__q;
     reg  valid__8__clock;
-    reg  valid__9__d;
-    wire  valid__9__q;
-    reg  valid__9__clock;
-    reg  valid__10__d;
-    wire  valid__10__q;
-    reg  valid__10__clock;
-    reg  valid__11__d;
-    wire  valid__11__q;
-    reg  valid__11__clock;
-    reg  valid__12__d;
-    wire  valid__12__q;
-    reg  valid__12__clock;
-    reg  valid__13__d;
-    wire  valid__13__q;
-    reg  valid__13__clock;
-    reg  valid__14__d;
-    wire  valid__14__q;
-    reg  valid__14__clock;
-    reg  valid__15__d;
-    wire  valid__15__q;
-    reg  valid__15__clock;
-    reg  valid__16__d;
-    wire  valid__16__q;
-    reg  valid__16__clock;
     reg  last_sticky__d;
     wire  last_sticky__q;
     reg  last_sticky__clock;
@@ -6408,6 +6225,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     reg  a_below_b;
     reg  [17:0] rem_first;
     reg  [17:0] rem_first_doubled;
+    reg  [23:0] last_full;
+    reg  last_rest;
     reg  [16:0] sig;
     reg  round_up;
     
@@ -6427,260 +6246,185 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         .q(in_valid_r__q),
         .clock(in_valid_r__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__0(
+    dynrt_processor__display__rgb_q rem__0(
         .d(rem__0__d),
         .q(rem__0__q),
         .clock(rem__0__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__1(
+    dynrt_processor__display__rgb_q rem__1(
         .d(rem__1__d),
         .q(rem__1__q),
         .clock(rem__1__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__2(
+    dynrt_processor__display__rgb_q rem__2(
         .d(rem__2__d),
         .q(rem__2__q),
         .clock(rem__2__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__3(
+    dynrt_processor__display__rgb_q rem__3(
         .d(rem__3__d),
         .q(rem__3__q),
         .clock(rem__3__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__4(
+    dynrt_processor__display__rgb_q rem__4(
         .d(rem__4__d),
         .q(rem__4__q),
         .clock(rem__4__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__5(
+    dynrt_processor__display__rgb_q rem__5(
         .d(rem__5__d),
         .q(rem__5__q),
         .clock(rem__5__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__6(
+    dynrt_processor__display__rgb_q rem__6(
         .d(rem__6__d),
         .q(rem__6__q),
         .clock(rem__6__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__7(
+    dynrt_processor__display__rgb_q rem__7(
         .d(rem__7__d),
         .q(rem__7__q),
         .clock(rem__7__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__8(
+    dynrt_processor__display__rgb_q rem__8(
         .d(rem__8__d),
         .q(rem__8__q),
         .clock(rem__8__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__9(
-        .d(rem__9__d),
-        .q(rem__9__q),
-        .clock(rem__9__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__10(
-        .d(rem__10__d),
-        .q(rem__10__q),
-        .clock(rem__10__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__11(
-        .d(rem__11__d),
-        .q(rem__11__q),
-        .clock(rem__11__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__12(
-        .d(rem__12__d),
-        .q(rem__12__q),
-        .clock(rem__12__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__13(
-        .d(rem__13__d),
-        .q(rem__13__q),
-        .clock(rem__13__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__14(
-        .d(rem__14__d),
-        .q(rem__14__q),
-        .clock(rem__14__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__15(
-        .d(rem__15__d),
-        .q(rem__15__q),
-        .clock(rem__15__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig rem__16(
-        .d(rem__16__d),
-        .q(rem__16__q),
-        .clock(rem__16__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__0(
+    dynrt_processor__display__rgb_q quo__0(
         .d(quo__0__d),
         .q(quo__0__q),
         .clock(quo__0__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__1(
+    dynrt_processor__display__rgb_q quo__1(
         .d(quo__1__d),
         .q(quo__1__q),
         .clock(quo__1__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__2(
+    dynrt_processor__display__rgb_q quo__2(
         .d(quo__2__d),
         .q(quo__2__q),
         .clock(quo__2__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__3(
+    dynrt_processor__display__rgb_q quo__3(
         .d(quo__3__d),
         .q(quo__3__q),
         .clock(quo__3__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__4(
+    dynrt_processor__display__rgb_q quo__4(
         .d(quo__4__d),
         .q(quo__4__q),
         .clock(quo__4__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__5(
+    dynrt_processor__display__rgb_q quo__5(
         .d(quo__5__d),
         .q(quo__5__q),
         .clock(quo__5__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__6(
+    dynrt_processor__display__rgb_q quo__6(
         .d(quo__6__d),
         .q(quo__6__q),
         .clock(quo__6__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__7(
+    dynrt_processor__display__rgb_q quo__7(
         .d(quo__7__d),
         .q(quo__7__q),
         .clock(quo__7__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__8(
+    dynrt_processor__display__rgb_q quo__8(
         .d(quo__8__d),
         .q(quo__8__q),
         .clock(quo__8__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__9(
-        .d(quo__9__d),
-        .q(quo__9__q),
-        .clock(quo__9__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__10(
-        .d(quo__10__d),
-        .q(quo__10__q),
-        .clock(quo__10__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__11(
-        .d(quo__11__d),
-        .q(quo__11__q),
-        .clock(quo__11__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__12(
-        .d(quo__12__d),
-        .q(quo__12__q),
-        .clock(quo__12__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__13(
-        .d(quo__13__d),
-        .q(quo__13__q),
-        .clock(quo__13__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__14(
-        .d(quo__14__d),
-        .q(quo__14__q),
-        .clock(quo__14__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__15(
-        .d(quo__15__d),
-        .q(quo__15__q),
-        .clock(quo__15__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig quo__16(
-        .d(quo__16__d),
-        .q(quo__16__q),
-        .clock(quo__16__clock)
-    );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__0(
+    dynrt_processor__display__rgb_q divisor__0(
         .d(divisor__0__d),
         .q(divisor__0__q),
         .clock(divisor__0__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__1(
+    dynrt_processor__display__rgb_q divisor__1(
         .d(divisor__1__d),
         .q(divisor__1__q),
         .clock(divisor__1__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__2(
+    dynrt_processor__display__rgb_q divisor__2(
         .d(divisor__2__d),
         .q(divisor__2__q),
         .clock(divisor__2__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__3(
+    dynrt_processor__display__rgb_q divisor__3(
         .d(divisor__3__d),
         .q(divisor__3__q),
         .clock(divisor__3__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__4(
+    dynrt_processor__display__rgb_q divisor__4(
         .d(divisor__4__d),
         .q(divisor__4__q),
         .clock(divisor__4__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__5(
+    dynrt_processor__display__rgb_q divisor__5(
         .d(divisor__5__d),
         .q(divisor__5__q),
         .clock(divisor__5__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__6(
+    dynrt_processor__display__rgb_q divisor__6(
         .d(divisor__6__d),
         .q(divisor__6__q),
         .clock(divisor__6__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__7(
+    dynrt_processor__display__rgb_q divisor__7(
         .d(divisor__7__d),
         .q(divisor__7__q),
         .clock(divisor__7__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__8(
+    dynrt_processor__display__rgb_q divisor__8(
         .d(divisor__8__d),
         .q(divisor__8__q),
         .clock(divisor__8__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__9(
-        .d(divisor__9__d),
-        .q(divisor__9__q),
-        .clock(divisor__9__clock)
+    dynrt_processor__display__rgb_q divisor3__0(
+        .d(divisor3__0__d),
+        .q(divisor3__0__q),
+        .clock(divisor3__0__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__10(
-        .d(divisor__10__d),
-        .q(divisor__10__q),
-        .clock(divisor__10__clock)
+    dynrt_processor__display__rgb_q divisor3__1(
+        .d(divisor3__1__d),
+        .q(divisor3__1__q),
+        .clock(divisor3__1__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__11(
-        .d(divisor__11__d),
-        .q(divisor__11__q),
-        .clock(divisor__11__clock)
+    dynrt_processor__display__rgb_q divisor3__2(
+        .d(divisor3__2__d),
+        .q(divisor3__2__q),
+        .clock(divisor3__2__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__12(
-        .d(divisor__12__d),
-        .q(divisor__12__q),
-        .clock(divisor__12__clock)
+    dynrt_processor__display__rgb_q divisor3__3(
+        .d(divisor3__3__d),
+        .q(divisor3__3__q),
+        .clock(divisor3__3__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__13(
-        .d(divisor__13__d),
-        .q(divisor__13__q),
-        .clock(divisor__13__clock)
+    dynrt_processor__display__rgb_q divisor3__4(
+        .d(divisor3__4__d),
+        .q(divisor3__4__q),
+        .clock(divisor3__4__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__14(
-        .d(divisor__14__d),
-        .q(divisor__14__q),
-        .clock(divisor__14__clock)
+    dynrt_processor__display__rgb_q divisor3__5(
+        .d(divisor3__5__d),
+        .q(divisor3__5__q),
+        .clock(divisor3__5__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__15(
-        .d(divisor__15__d),
-        .q(divisor__15__q),
-        .clock(divisor__15__clock)
+    dynrt_processor__display__rgb_q divisor3__6(
+        .d(divisor3__6__d),
+        .q(divisor3__6__q),
+        .clock(divisor3__6__clock)
     );
-    dynrt_processor__engine__fp_units__add__rnd_sig divisor__16(
-        .d(divisor__16__d),
-        .q(divisor__16__q),
-        .clock(divisor__16__clock)
+    dynrt_processor__display__rgb_q divisor3__7(
+        .d(divisor3__7__d),
+        .q(divisor3__7__q),
+        .clock(divisor3__7__clock)
+    );
+    dynrt_processor__display__rgb_q divisor3__8(
+        .d(divisor3__8__d),
+        .q(divisor3__8__q),
+        .clock(divisor3__8__clock)
     );
     dynrt_processor__engine__fp_units__add__lz exp__0(
         .d(exp__0__d),
@@ -6727,46 +6471,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         .q(exp__8__q),
         .clock(exp__8__clock)
     );
-    dynrt_processor__engine__fp_units__add__lz exp__9(
-        .d(exp__9__d),
-        .q(exp__9__q),
-        .clock(exp__9__clock)
-    );
-    dynrt_processor__engine__fp_units__add__lz exp__10(
-        .d(exp__10__d),
-        .q(exp__10__q),
-        .clock(exp__10__clock)
-    );
-    dynrt_processor__engine__fp_units__add__lz exp__11(
-        .d(exp__11__d),
-        .q(exp__11__q),
-        .clock(exp__11__clock)
-    );
-    dynrt_processor__engine__fp_units__add__lz exp__12(
-        .d(exp__12__d),
-        .q(exp__12__q),
-        .clock(exp__12__clock)
-    );
-    dynrt_processor__engine__fp_units__add__lz exp__13(
-        .d(exp__13__d),
-        .q(exp__13__q),
-        .clock(exp__13__clock)
-    );
-    dynrt_processor__engine__fp_units__add__lz exp__14(
-        .d(exp__14__d),
-        .q(exp__14__q),
-        .clock(exp__14__clock)
-    );
-    dynrt_processor__engine__fp_units__add__lz exp__15(
-        .d(exp__15__d),
-        .q(exp__15__q),
-        .clock(exp__15__clock)
-    );
-    dynrt_processor__engine__fp_units__add__lz exp__16(
-        .d(exp__16__d),
-        .q(exp__16__q),
-        .clock(exp__16__clock)
-    );
     dynrt_processor__display__dark_d sign__0(
         .d(sign__0__d),
         .q(sign__0__q),
@@ -6811,46 +6515,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         .d(sign__8__d),
         .q(sign__8__q),
         .clock(sign__8__clock)
-    );
-    dynrt_processor__display__dark_d sign__9(
-        .d(sign__9__d),
-        .q(sign__9__q),
-        .clock(sign__9__clock)
-    );
-    dynrt_processor__display__dark_d sign__10(
-        .d(sign__10__d),
-        .q(sign__10__q),
-        .clock(sign__10__clock)
-    );
-    dynrt_processor__display__dark_d sign__11(
-        .d(sign__11__d),
-        .q(sign__11__q),
-        .clock(sign__11__clock)
-    );
-    dynrt_processor__display__dark_d sign__12(
-        .d(sign__12__d),
-        .q(sign__12__q),
-        .clock(sign__12__clock)
-    );
-    dynrt_processor__display__dark_d sign__13(
-        .d(sign__13__d),
-        .q(sign__13__q),
-        .clock(sign__13__clock)
-    );
-    dynrt_processor__display__dark_d sign__14(
-        .d(sign__14__d),
-        .q(sign__14__q),
-        .clock(sign__14__clock)
-    );
-    dynrt_processor__display__dark_d sign__15(
-        .d(sign__15__d),
-        .q(sign__15__q),
-        .clock(sign__15__clock)
-    );
-    dynrt_processor__display__dark_d sign__16(
-        .d(sign__16__d),
-        .q(sign__16__q),
-        .clock(sign__16__clock)
     );
     dynrt_processor__display__dark_d nan__0(
         .d(nan__0__d),
@@ -6897,46 +6561,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         .q(nan__8__q),
         .clock(nan__8__clock)
     );
-    dynrt_processor__display__dark_d nan__9(
-        .d(nan__9__d),
-        .q(nan__9__q),
-        .clock(nan__9__clock)
-    );
-    dynrt_processor__display__dark_d nan__10(
-        .d(nan__10__d),
-        .q(nan__10__q),
-        .clock(nan__10__clock)
-    );
-    dynrt_processor__display__dark_d nan__11(
-        .d(nan__11__d),
-        .q(nan__11__q),
-        .clock(nan__11__clock)
-    );
-    dynrt_processor__display__dark_d nan__12(
-        .d(nan__12__d),
-        .q(nan__12__q),
-        .clock(nan__12__clock)
-    );
-    dynrt_processor__display__dark_d nan__13(
-        .d(nan__13__d),
-        .q(nan__13__q),
-        .clock(nan__13__clock)
-    );
-    dynrt_processor__display__dark_d nan__14(
-        .d(nan__14__d),
-        .q(nan__14__q),
-        .clock(nan__14__clock)
-    );
-    dynrt_processor__display__dark_d nan__15(
-        .d(nan__15__d),
-        .q(nan__15__q),
-        .clock(nan__15__clock)
-    );
-    dynrt_processor__display__dark_d nan__16(
-        .d(nan__16__d),
-        .q(nan__16__q),
-        .clock(nan__16__clock)
-    );
     dynrt_processor__display__dark_d inf__0(
         .d(inf__0__d),
         .q(inf__0__q),
@@ -6981,46 +6605,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         .d(inf__8__d),
         .q(inf__8__q),
         .clock(inf__8__clock)
-    );
-    dynrt_processor__display__dark_d inf__9(
-        .d(inf__9__d),
-        .q(inf__9__q),
-        .clock(inf__9__clock)
-    );
-    dynrt_processor__display__dark_d inf__10(
-        .d(inf__10__d),
-        .q(inf__10__q),
-        .clock(inf__10__clock)
-    );
-    dynrt_processor__display__dark_d inf__11(
-        .d(inf__11__d),
-        .q(inf__11__q),
-        .clock(inf__11__clock)
-    );
-    dynrt_processor__display__dark_d inf__12(
-        .d(inf__12__d),
-        .q(inf__12__q),
-        .clock(inf__12__clock)
-    );
-    dynrt_processor__display__dark_d inf__13(
-        .d(inf__13__d),
-        .q(inf__13__q),
-        .clock(inf__13__clock)
-    );
-    dynrt_processor__display__dark_d inf__14(
-        .d(inf__14__d),
-        .q(inf__14__q),
-        .clock(inf__14__clock)
-    );
-    dynrt_processor__display__dark_d inf__15(
-        .d(inf__15__d),
-        .q(inf__15__q),
-        .clock(inf__15__clock)
-    );
-    dynrt_processor__display__dark_d inf__16(
-        .d(inf__16__d),
-        .q(inf__16__q),
-        .clock(inf__16__clock)
     );
     dynrt_processor__display__dark_d zero__0(
         .d(zero__0__d),
@@ -7067,46 +6651,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         .q(zero__8__q),
         .clock(zero__8__clock)
     );
-    dynrt_processor__display__dark_d zero__9(
-        .d(zero__9__d),
-        .q(zero__9__q),
-        .clock(zero__9__clock)
-    );
-    dynrt_processor__display__dark_d zero__10(
-        .d(zero__10__d),
-        .q(zero__10__q),
-        .clock(zero__10__clock)
-    );
-    dynrt_processor__display__dark_d zero__11(
-        .d(zero__11__d),
-        .q(zero__11__q),
-        .clock(zero__11__clock)
-    );
-    dynrt_processor__display__dark_d zero__12(
-        .d(zero__12__d),
-        .q(zero__12__q),
-        .clock(zero__12__clock)
-    );
-    dynrt_processor__display__dark_d zero__13(
-        .d(zero__13__d),
-        .q(zero__13__q),
-        .clock(zero__13__clock)
-    );
-    dynrt_processor__display__dark_d zero__14(
-        .d(zero__14__d),
-        .q(zero__14__q),
-        .clock(zero__14__clock)
-    );
-    dynrt_processor__display__dark_d zero__15(
-        .d(zero__15__d),
-        .q(zero__15__q),
-        .clock(zero__15__clock)
-    );
-    dynrt_processor__display__dark_d zero__16(
-        .d(zero__16__d),
-        .q(zero__16__q),
-        .clock(zero__16__clock)
-    );
     dynrt_processor__display__dark_d valid__0(
         .d(valid__0__d),
         .q(valid__0__q),
@@ -7151,46 +6695,6 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         .d(valid__8__d),
         .q(valid__8__q),
         .clock(valid__8__clock)
-    );
-    dynrt_processor__display__dark_d valid__9(
-        .d(valid__9__d),
-        .q(valid__9__q),
-        .clock(valid__9__clock)
-    );
-    dynrt_processor__display__dark_d valid__10(
-        .d(valid__10__d),
-        .q(valid__10__q),
-        .clock(valid__10__clock)
-    );
-    dynrt_processor__display__dark_d valid__11(
-        .d(valid__11__d),
-        .q(valid__11__q),
-        .clock(valid__11__clock)
-    );
-    dynrt_processor__display__dark_d valid__12(
-        .d(valid__12__d),
-        .q(valid__12__q),
-        .clock(valid__12__clock)
-    );
-    dynrt_processor__display__dark_d valid__13(
-        .d(valid__13__d),
-        .q(valid__13__q),
-        .clock(valid__13__clock)
-    );
-    dynrt_processor__display__dark_d valid__14(
-        .d(valid__14__d),
-        .q(valid__14__q),
-        .clock(valid__14__clock)
-    );
-    dynrt_processor__display__dark_d valid__15(
-        .d(valid__15__d),
-        .q(valid__15__q),
-        .clock(valid__15__clock)
-    );
-    dynrt_processor__display__dark_d valid__16(
-        .d(valid__16__d),
-        .q(valid__16__q),
-        .clock(valid__16__clock)
     );
     dynrt_processor__display__dark_d last_sticky(
         .d(last_sticky__d),
@@ -7281,6 +6785,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         rem__0__clock = clock;
         quo__0__clock = clock;
         divisor__0__clock = clock;
+        divisor3__0__clock = clock;
         exp__0__clock = clock;
         sign__0__clock = clock;
         nan__0__clock = clock;
@@ -7290,6 +6795,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         rem__1__clock = clock;
         quo__1__clock = clock;
         divisor__1__clock = clock;
+        divisor3__1__clock = clock;
         exp__1__clock = clock;
         sign__1__clock = clock;
         nan__1__clock = clock;
@@ -7299,6 +6805,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         rem__2__clock = clock;
         quo__2__clock = clock;
         divisor__2__clock = clock;
+        divisor3__2__clock = clock;
         exp__2__clock = clock;
         sign__2__clock = clock;
         nan__2__clock = clock;
@@ -7308,6 +6815,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         rem__3__clock = clock;
         quo__3__clock = clock;
         divisor__3__clock = clock;
+        divisor3__3__clock = clock;
         exp__3__clock = clock;
         sign__3__clock = clock;
         nan__3__clock = clock;
@@ -7317,6 +6825,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         rem__4__clock = clock;
         quo__4__clock = clock;
         divisor__4__clock = clock;
+        divisor3__4__clock = clock;
         exp__4__clock = clock;
         sign__4__clock = clock;
         nan__4__clock = clock;
@@ -7326,6 +6835,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         rem__5__clock = clock;
         quo__5__clock = clock;
         divisor__5__clock = clock;
+        divisor3__5__clock = clock;
         exp__5__clock = clock;
         sign__5__clock = clock;
         nan__5__clock = clock;
@@ -7335,6 +6845,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         rem__6__clock = clock;
         quo__6__clock = clock;
         divisor__6__clock = clock;
+        divisor3__6__clock = clock;
         exp__6__clock = clock;
         sign__6__clock = clock;
         nan__6__clock = clock;
@@ -7344,6 +6855,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         rem__7__clock = clock;
         quo__7__clock = clock;
         divisor__7__clock = clock;
+        divisor3__7__clock = clock;
         exp__7__clock = clock;
         sign__7__clock = clock;
         nan__7__clock = clock;
@@ -7353,84 +6865,13 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         rem__8__clock = clock;
         quo__8__clock = clock;
         divisor__8__clock = clock;
+        divisor3__8__clock = clock;
         exp__8__clock = clock;
         sign__8__clock = clock;
         nan__8__clock = clock;
         inf__8__clock = clock;
         zero__8__clock = clock;
         valid__8__clock = clock;
-        rem__9__clock = clock;
-        quo__9__clock = clock;
-        divisor__9__clock = clock;
-        exp__9__clock = clock;
-        sign__9__clock = clock;
-        nan__9__clock = clock;
-        inf__9__clock = clock;
-        zero__9__clock = clock;
-        valid__9__clock = clock;
-        rem__10__clock = clock;
-        quo__10__clock = clock;
-        divisor__10__clock = clock;
-        exp__10__clock = clock;
-        sign__10__clock = clock;
-        nan__10__clock = clock;
-        inf__10__clock = clock;
-        zero__10__clock = clock;
-        valid__10__clock = clock;
-        rem__11__clock = clock;
-        quo__11__clock = clock;
-        divisor__11__clock = clock;
-        exp__11__clock = clock;
-        sign__11__clock = clock;
-        nan__11__clock = clock;
-        inf__11__clock = clock;
-        zero__11__clock = clock;
-        valid__11__clock = clock;
-        rem__12__clock = clock;
-        quo__12__clock = clock;
-        divisor__12__clock = clock;
-        exp__12__clock = clock;
-        sign__12__clock = clock;
-        nan__12__clock = clock;
-        inf__12__clock = clock;
-        zero__12__clock = clock;
-        valid__12__clock = clock;
-        rem__13__clock = clock;
-        quo__13__clock = clock;
-        divisor__13__clock = clock;
-        exp__13__clock = clock;
-        sign__13__clock = clock;
-        nan__13__clock = clock;
-        inf__13__clock = clock;
-        zero__13__clock = clock;
-        valid__13__clock = clock;
-        rem__14__clock = clock;
-        quo__14__clock = clock;
-        divisor__14__clock = clock;
-        exp__14__clock = clock;
-        sign__14__clock = clock;
-        nan__14__clock = clock;
-        inf__14__clock = clock;
-        zero__14__clock = clock;
-        valid__14__clock = clock;
-        rem__15__clock = clock;
-        quo__15__clock = clock;
-        divisor__15__clock = clock;
-        exp__15__clock = clock;
-        sign__15__clock = clock;
-        nan__15__clock = clock;
-        inf__15__clock = clock;
-        zero__15__clock = clock;
-        valid__15__clock = clock;
-        rem__16__clock = clock;
-        quo__16__clock = clock;
-        divisor__16__clock = clock;
-        exp__16__clock = clock;
-        sign__16__clock = clock;
-        nan__16__clock = clock;
-        inf__16__clock = clock;
-        zero__16__clock = clock;
-        valid__16__clock = clock;
         in_a__d = a;
         in_b__d = b;
         in_valid_r__d = in_valid;
@@ -7447,12 +6888,13 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         a_below_b = sig_a < sig_b;
         rem_first = sig_a - sig_b;
         rem_first_doubled = (sig_a << 32'h1) - sig_b;
-        rem__0__d = rem_first << 32'h1;
+        rem__0__d = ((rem_first << 32'h1) & 24'hffffff);
         if (a_below_b) begin
-            rem__0__d = rem_first_doubled << 32'h1;
+            rem__0__d = ((rem_first_doubled << 32'h1) & 24'hffffff);
         end
         quo__0__d = c_one;
-        divisor__0__d = sig_b;
+        divisor__0__d = ((sig_b) & 24'hffffff);
+        divisor3__0__d = ((sig_b) & 24'hffffff) + (((sig_b) & 24'hffffff) << 32'h1);
         exp__0__d = (((exp_a) & 9'h1ff) - ((exp_b) & 9'h1ff)) + c_bias;
         if (a_below_b) begin
             exp__0__d = (((exp_a) & 9'h1ff) - ((exp_b) & 9'h1ff)) + c_bias_less_one;
@@ -7463,14 +6905,25 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         zero__0__d = zero_a | inf_b;
         valid__0__d = in_valid_r__q;
         if (rem__0__q >= divisor__0__q) begin
-            rem__1__d = (rem__0__q - divisor__0__q) << 32'h1;
-            quo__1__d = (quo__0__q << 32'h1) | c_one;
+            if ((rem__0__q << 32'h1) >= divisor3__0__q) begin
+                rem__1__d = (((rem__0__q << 32'h1) - divisor3__0__q) << 32'h1) & c_rem_mask;
+                quo__1__d = (quo__0__q << 32'h2) | c_three;
+            end
+            else begin
+                rem__1__d = ((rem__0__q - divisor__0__q) << 32'h2) & c_rem_mask;
+                quo__1__d = (quo__0__q << 32'h2) | c_two;
+            end
+        end
+        else if ((rem__0__q << 32'h1) >= divisor__0__q) begin
+            rem__1__d = (((rem__0__q << 32'h1) - divisor__0__q) << 32'h1) & c_rem_mask;
+            quo__1__d = (quo__0__q << 32'h2) | c_one;
         end
         else begin
-            rem__1__d = rem__0__q << 32'h1;
-            quo__1__d = quo__0__q << 32'h1;
+            rem__1__d = (rem__0__q << 32'h2) & c_rem_mask;
+            quo__1__d = quo__0__q << 32'h2;
         end
         divisor__1__d = divisor__0__q;
+        divisor3__1__d = divisor3__0__q;
         exp__1__d = exp__0__q;
         sign__1__d = sign__0__q;
         nan__1__d = nan__0__q;
@@ -7478,14 +6931,25 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         zero__1__d = zero__0__q;
         valid__1__d = valid__0__q;
         if (rem__1__q >= divisor__1__q) begin
-            rem__2__d = (rem__1__q - divisor__1__q) << 32'h1;
-            quo__2__d = (quo__1__q << 32'h1) | c_one;
+            if ((rem__1__q << 32'h1) >= divisor3__1__q) begin
+                rem__2__d = (((rem__1__q << 32'h1) - divisor3__1__q) << 32'h1) & c_rem_mask;
+                quo__2__d = (quo__1__q << 32'h2) | c_three;
+            end
+            else begin
+                rem__2__d = ((rem__1__q - divisor__1__q) << 32'h2) & c_rem_mask;
+                quo__2__d = (quo__1__q << 32'h2) | c_two;
+            end
+        end
+        else if ((rem__1__q << 32'h1) >= divisor__1__q) begin
+            rem__2__d = (((rem__1__q << 32'h1) - divisor__1__q) << 32'h1) & c_rem_mask;
+            quo__2__d = (quo__1__q << 32'h2) | c_one;
         end
         else begin
-            rem__2__d = rem__1__q << 32'h1;
-            quo__2__d = quo__1__q << 32'h1;
+            rem__2__d = (rem__1__q << 32'h2) & c_rem_mask;
+            quo__2__d = quo__1__q << 32'h2;
         end
         divisor__2__d = divisor__1__q;
+        divisor3__2__d = divisor3__1__q;
         exp__2__d = exp__1__q;
         sign__2__d = sign__1__q;
         nan__2__d = nan__1__q;
@@ -7493,14 +6957,25 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         zero__2__d = zero__1__q;
         valid__2__d = valid__1__q;
         if (rem__2__q >= divisor__2__q) begin
-            rem__3__d = (rem__2__q - divisor__2__q) << 32'h1;
-            quo__3__d = (quo__2__q << 32'h1) | c_one;
+            if ((rem__2__q << 32'h1) >= divisor3__2__q) begin
+                rem__3__d = (((rem__2__q << 32'h1) - divisor3__2__q) << 32'h1) & c_rem_mask;
+                quo__3__d = (quo__2__q << 32'h2) | c_three;
+            end
+            else begin
+                rem__3__d = ((rem__2__q - divisor__2__q) << 32'h2) & c_rem_mask;
+                quo__3__d = (quo__2__q << 32'h2) | c_two;
+            end
+        end
+        else if ((rem__2__q << 32'h1) >= divisor__2__q) begin
+            rem__3__d = (((rem__2__q << 32'h1) - divisor__2__q) << 32'h1) & c_rem_mask;
+            quo__3__d = (quo__2__q << 32'h2) | c_one;
         end
         else begin
-            rem__3__d = rem__2__q << 32'h1;
-            quo__3__d = quo__2__q << 32'h1;
+            rem__3__d = (rem__2__q << 32'h2) & c_rem_mask;
+            quo__3__d = quo__2__q << 32'h2;
         end
         divisor__3__d = divisor__2__q;
+        divisor3__3__d = divisor3__2__q;
         exp__3__d = exp__2__q;
         sign__3__d = sign__2__q;
         nan__3__d = nan__2__q;
@@ -7508,14 +6983,25 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         zero__3__d = zero__2__q;
         valid__3__d = valid__2__q;
         if (rem__3__q >= divisor__3__q) begin
-            rem__4__d = (rem__3__q - divisor__3__q) << 32'h1;
-            quo__4__d = (quo__3__q << 32'h1) | c_one;
+            if ((rem__3__q << 32'h1) >= divisor3__3__q) begin
+                rem__4__d = (((rem__3__q << 32'h1) - divisor3__3__q) << 32'h1) & c_rem_mask;
+                quo__4__d = (quo__3__q << 32'h2) | c_three;
+            end
+            else begin
+                rem__4__d = ((rem__3__q - divisor__3__q) << 32'h2) & c_rem_mask;
+                quo__4__d = (quo__3__q << 32'h2) | c_two;
+            end
+        end
+        else if ((rem__3__q << 32'h1) >= divisor__3__q) begin
+            rem__4__d = (((rem__3__q << 32'h1) - divisor__3__q) << 32'h1) & c_rem_mask;
+            quo__4__d = (quo__3__q << 32'h2) | c_one;
         end
         else begin
-            rem__4__d = rem__3__q << 32'h1;
-            quo__4__d = quo__3__q << 32'h1;
+            rem__4__d = (rem__3__q << 32'h2) & c_rem_mask;
+            quo__4__d = quo__3__q << 32'h2;
         end
         divisor__4__d = divisor__3__q;
+        divisor3__4__d = divisor3__3__q;
         exp__4__d = exp__3__q;
         sign__4__d = sign__3__q;
         nan__4__d = nan__3__q;
@@ -7523,14 +7009,25 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         zero__4__d = zero__3__q;
         valid__4__d = valid__3__q;
         if (rem__4__q >= divisor__4__q) begin
-            rem__5__d = (rem__4__q - divisor__4__q) << 32'h1;
-            quo__5__d = (quo__4__q << 32'h1) | c_one;
+            if ((rem__4__q << 32'h1) >= divisor3__4__q) begin
+                rem__5__d = (((rem__4__q << 32'h1) - divisor3__4__q) << 32'h1) & c_rem_mask;
+                quo__5__d = (quo__4__q << 32'h2) | c_three;
+            end
+            else begin
+                rem__5__d = ((rem__4__q - divisor__4__q) << 32'h2) & c_rem_mask;
+                quo__5__d = (quo__4__q << 32'h2) | c_two;
+            end
+        end
+        else if ((rem__4__q << 32'h1) >= divisor__4__q) begin
+            rem__5__d = (((rem__4__q << 32'h1) - divisor__4__q) << 32'h1) & c_rem_mask;
+            quo__5__d = (quo__4__q << 32'h2) | c_one;
         end
         else begin
-            rem__5__d = rem__4__q << 32'h1;
-            quo__5__d = quo__4__q << 32'h1;
+            rem__5__d = (rem__4__q << 32'h2) & c_rem_mask;
+            quo__5__d = quo__4__q << 32'h2;
         end
         divisor__5__d = divisor__4__q;
+        divisor3__5__d = divisor3__4__q;
         exp__5__d = exp__4__q;
         sign__5__d = sign__4__q;
         nan__5__d = nan__4__q;
@@ -7538,14 +7035,25 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         zero__5__d = zero__4__q;
         valid__5__d = valid__4__q;
         if (rem__5__q >= divisor__5__q) begin
-            rem__6__d = (rem__5__q - divisor__5__q) << 32'h1;
-            quo__6__d = (quo__5__q << 32'h1) | c_one;
+            if ((rem__5__q << 32'h1) >= divisor3__5__q) begin
+                rem__6__d = (((rem__5__q << 32'h1) - divisor3__5__q) << 32'h1) & c_rem_mask;
+                quo__6__d = (quo__5__q << 32'h2) | c_three;
+            end
+            else begin
+                rem__6__d = ((rem__5__q - divisor__5__q) << 32'h2) & c_rem_mask;
+                quo__6__d = (quo__5__q << 32'h2) | c_two;
+            end
+        end
+        else if ((rem__5__q << 32'h1) >= divisor__5__q) begin
+            rem__6__d = (((rem__5__q << 32'h1) - divisor__5__q) << 32'h1) & c_rem_mask;
+            quo__6__d = (quo__5__q << 32'h2) | c_one;
         end
         else begin
-            rem__6__d = rem__5__q << 32'h1;
-            quo__6__d = quo__5__q << 32'h1;
+            rem__6__d = (rem__5__q << 32'h2) & c_rem_mask;
+            quo__6__d = quo__5__q << 32'h2;
         end
         divisor__6__d = divisor__5__q;
+        divisor3__6__d = divisor3__5__q;
         exp__6__d = exp__5__q;
         sign__6__d = sign__5__q;
         nan__6__d = nan__5__q;
@@ -7553,14 +7061,25 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         zero__6__d = zero__5__q;
         valid__6__d = valid__5__q;
         if (rem__6__q >= divisor__6__q) begin
-            rem__7__d = (rem__6__q - divisor__6__q) << 32'h1;
-            quo__7__d = (quo__6__q << 32'h1) | c_one;
+            if ((rem__6__q << 32'h1) >= divisor3__6__q) begin
+                rem__7__d = (((rem__6__q << 32'h1) - divisor3__6__q) << 32'h1) & c_rem_mask;
+                quo__7__d = (quo__6__q << 32'h2) | c_three;
+            end
+            else begin
+                rem__7__d = ((rem__6__q - divisor__6__q) << 32'h2) & c_rem_mask;
+                quo__7__d = (quo__6__q << 32'h2) | c_two;
+            end
+        end
+        else if ((rem__6__q << 32'h1) >= divisor__6__q) begin
+            rem__7__d = (((rem__6__q << 32'h1) - divisor__6__q) << 32'h1) & c_rem_mask;
+            quo__7__d = (quo__6__q << 32'h2) | c_one;
         end
         else begin
-            rem__7__d = rem__6__q << 32'h1;
-            quo__7__d = quo__6__q << 32'h1;
+            rem__7__d = (rem__6__q << 32'h2) & c_rem_mask;
+            quo__7__d = quo__6__q << 32'h2;
         end
         divisor__7__d = divisor__6__q;
+        divisor3__7__d = divisor3__6__q;
         exp__7__d = exp__6__q;
         sign__7__d = sign__6__q;
         nan__7__d = nan__6__q;
@@ -7568,14 +7087,25 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         zero__7__d = zero__6__q;
         valid__7__d = valid__6__q;
         if (rem__7__q >= divisor__7__q) begin
-            rem__8__d = (rem__7__q - divisor__7__q) << 32'h1;
-            quo__8__d = (quo__7__q << 32'h1) | c_one;
+            if ((rem__7__q << 32'h1) >= divisor3__7__q) begin
+                rem__8__d = (((rem__7__q << 32'h1) - divisor3__7__q) << 32'h1) & c_rem_mask;
+                quo__8__d = (quo__7__q << 32'h2) | c_three;
+            end
+            else begin
+                rem__8__d = ((rem__7__q - divisor__7__q) << 32'h2) & c_rem_mask;
+                quo__8__d = (quo__7__q << 32'h2) | c_two;
+            end
+        end
+        else if ((rem__7__q << 32'h1) >= divisor__7__q) begin
+            rem__8__d = (((rem__7__q << 32'h1) - divisor__7__q) << 32'h1) & c_rem_mask;
+            quo__8__d = (quo__7__q << 32'h2) | c_one;
         end
         else begin
-            rem__8__d = rem__7__q << 32'h1;
-            quo__8__d = quo__7__q << 32'h1;
+            rem__8__d = (rem__7__q << 32'h2) & c_rem_mask;
+            quo__8__d = quo__7__q << 32'h2;
         end
         divisor__8__d = divisor__7__q;
+        divisor3__8__d = divisor3__7__q;
         exp__8__d = exp__7__q;
         sign__8__d = sign__7__q;
         nan__8__d = nan__7__q;
@@ -7583,140 +7113,32 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         zero__8__d = zero__7__q;
         valid__8__d = valid__7__q;
         if (rem__8__q >= divisor__8__q) begin
-            rem__9__d = (rem__8__q - divisor__8__q) << 32'h1;
-            quo__9__d = (quo__8__q << 32'h1) | c_one;
+            if ((rem__8__q << 32'h1) >= divisor3__8__q) begin
+                last_full = (quo__8__q << 32'h2) | c_three;
+                last_rest = (rem__8__q << 32'h1) != divisor3__8__q;
+            end
+            else begin
+                last_full = (quo__8__q << 32'h2) | c_two;
+                last_rest = rem__8__q != divisor__8__q;
+            end
+        end
+        else if ((rem__8__q << 32'h1) >= divisor__8__q) begin
+            last_full = (quo__8__q << 32'h2) | c_one;
+            last_rest = (rem__8__q << 32'h1) != divisor__8__q;
         end
         else begin
-            rem__9__d = rem__8__q << 32'h1;
-            quo__9__d = quo__8__q << 32'h1;
+            last_full = quo__8__q << 32'h2;
+            last_rest = |rem__8__q;
         end
-        divisor__9__d = divisor__8__q;
-        exp__9__d = exp__8__q;
-        sign__9__d = sign__8__q;
-        nan__9__d = nan__8__q;
-        inf__9__d = inf__8__q;
-        zero__9__d = zero__8__q;
-        valid__9__d = valid__8__q;
-        if (rem__9__q >= divisor__9__q) begin
-            rem__10__d = (rem__9__q - divisor__9__q) << 32'h1;
-            quo__10__d = (quo__9__q << 32'h1) | c_one;
-        end
-        else begin
-            rem__10__d = rem__9__q << 32'h1;
-            quo__10__d = quo__9__q << 32'h1;
-        end
-        divisor__10__d = divisor__9__q;
-        exp__10__d = exp__9__q;
-        sign__10__d = sign__9__q;
-        nan__10__d = nan__9__q;
-        inf__10__d = inf__9__q;
-        zero__10__d = zero__9__q;
-        valid__10__d = valid__9__q;
-        if (rem__10__q >= divisor__10__q) begin
-            rem__11__d = (rem__10__q - divisor__10__q) << 32'h1;
-            quo__11__d = (quo__10__q << 32'h1) | c_one;
-        end
-        else begin
-            rem__11__d = rem__10__q << 32'h1;
-            quo__11__d = quo__10__q << 32'h1;
-        end
-        divisor__11__d = divisor__10__q;
-        exp__11__d = exp__10__q;
-        sign__11__d = sign__10__q;
-        nan__11__d = nan__10__q;
-        inf__11__d = inf__10__q;
-        zero__11__d = zero__10__q;
-        valid__11__d = valid__10__q;
-        if (rem__11__q >= divisor__11__q) begin
-            rem__12__d = (rem__11__q - divisor__11__q) << 32'h1;
-            quo__12__d = (quo__11__q << 32'h1) | c_one;
-        end
-        else begin
-            rem__12__d = rem__11__q << 32'h1;
-            quo__12__d = quo__11__q << 32'h1;
-        end
-        divisor__12__d = divisor__11__q;
-        exp__12__d = exp__11__q;
-        sign__12__d = sign__11__q;
-        nan__12__d = nan__11__q;
-        inf__12__d = inf__11__q;
-        zero__12__d = zero__11__q;
-        valid__12__d = valid__11__q;
-        if (rem__12__q >= divisor__12__q) begin
-            rem__13__d = (rem__12__q - divisor__12__q) << 32'h1;
-            quo__13__d = (quo__12__q << 32'h1) | c_one;
-        end
-        else begin
-            rem__13__d = rem__12__q << 32'h1;
-            quo__13__d = quo__12__q << 32'h1;
-        end
-        divisor__13__d = divisor__12__q;
-        exp__13__d = exp__12__q;
-        sign__13__d = sign__12__q;
-        nan__13__d = nan__12__q;
-        inf__13__d = inf__12__q;
-        zero__13__d = zero__12__q;
-        valid__13__d = valid__12__q;
-        if (rem__13__q >= divisor__13__q) begin
-            rem__14__d = (rem__13__q - divisor__13__q) << 32'h1;
-            quo__14__d = (quo__13__q << 32'h1) | c_one;
-        end
-        else begin
-            rem__14__d = rem__13__q << 32'h1;
-            quo__14__d = quo__13__q << 32'h1;
-        end
-        divisor__14__d = divisor__13__q;
-        exp__14__d = exp__13__q;
-        sign__14__d = sign__13__q;
-        nan__14__d = nan__13__q;
-        inf__14__d = inf__13__q;
-        zero__14__d = zero__13__q;
-        valid__14__d = valid__13__q;
-        if (rem__14__q >= divisor__14__q) begin
-            rem__15__d = (rem__14__q - divisor__14__q) << 32'h1;
-            quo__15__d = (quo__14__q << 32'h1) | c_one;
-        end
-        else begin
-            rem__15__d = rem__14__q << 32'h1;
-            quo__15__d = quo__14__q << 32'h1;
-        end
-        divisor__15__d = divisor__14__q;
-        exp__15__d = exp__14__q;
-        sign__15__d = sign__14__q;
-        nan__15__d = nan__14__q;
-        inf__15__d = inf__14__q;
-        zero__15__d = zero__14__q;
-        valid__15__d = valid__14__q;
-        if (rem__15__q >= divisor__15__q) begin
-            rem__16__d = (rem__15__q - divisor__15__q) << 32'h1;
-            quo__16__d = (quo__15__q << 32'h1) | c_one;
-        end
-        else begin
-            rem__16__d = rem__15__q << 32'h1;
-            quo__16__d = quo__15__q << 32'h1;
-        end
-        divisor__16__d = divisor__15__q;
-        exp__16__d = exp__15__q;
-        sign__16__d = sign__15__q;
-        nan__16__d = nan__15__q;
-        inf__16__d = inf__15__q;
-        zero__16__d = zero__15__q;
-        valid__16__d = valid__15__q;
-        if (rem__16__q >= divisor__16__q) begin
-            last_sticky__d = rem__16__q != divisor__16__q;
-            last_quo__d = (quo__16__q << 32'h1) | c_one;
-        end
-        else begin
-            last_sticky__d = |rem__16__q;
-            last_quo__d = quo__16__q << 32'h1;
-        end
-        last_sig_ones__d = &quo__16__q[(32'h0)+:(17)];
-        last_exp__d = exp__16__q;
-        last_sign__d = sign__16__q;
-        last_nan__d = nan__16__q;
-        last_inf__d = inf__16__q;
-        last_zero__d = zero__16__q;
-        last_valid__d = valid__16__q;
+        last_exp__d = exp__8__q;
+        last_sign__d = sign__8__q;
+        last_nan__d = nan__8__q;
+        last_inf__d = inf__8__q;
+        last_zero__d = zero__8__q;
+        last_valid__d = valid__8__q;
+        last_quo__d = last_full[(c_extra)+:(18)];
+        last_sig_ones__d = &last_full[(c_extra_sig)+:(17)];
+        last_sticky__d = last_rest | |(last_full & c_extra_mask);
         sig = last_quo__q[(32'h1)+:(17)];
         round_up = last_quo__q[32'h0] & (last_sticky__q | sig[32'h0]);
         pack__clock = clock;
@@ -7960,132 +7382,6 @@ endmodule // dynrt_processor__engine__fp_units__div
 
 
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 module dynrt_processor__engine__fp_units__div_delay(clock,data_in,data_out);
     
     // Module arguments
@@ -8097,6 +7393,30 @@ module dynrt_processor__engine__fp_units__div_delay(clock,data_in,data_out);
     reg  [23:0] stage__0__d;
     wire  [23:0] stage__0__q;
     reg  stage__0__clock;
+    reg  [23:0] stage__1__d;
+    wire  [23:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [23:0] stage__2__d;
+    wire  [23:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [23:0] stage__3__d;
+    wire  [23:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [23:0] stage__4__d;
+    wire  [23:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [23:0] stage__5__d;
+    wire  [23:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [23:0] stage__6__d;
+    wire  [23:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [23:0] stage__7__d;
+    wire  [23:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [23:0] stage__8__d;
+    wire  [23:0] stage__8__q;
+    reg  stage__8__clock;
     
     // Sub module instances
     dynrt_processor__display__rgb_q stage__0(
@@ -8104,15 +7424,95 @@ module dynrt_processor__engine__fp_units__div_delay(clock,data_in,data_out);
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
+    dynrt_processor__display__rgb_q stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__display__rgb_q stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__display__rgb_q stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__display__rgb_q stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__display__rgb_q stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__display__rgb_q stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__display__rgb_q stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__display__rgb_q stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
     
     // Update code
     always @(*) begin
         stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
         stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
         data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
     end
     
 endmodule // dynrt_processor__engine__fp_units__div_delay
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -10739,6 +10139,33 @@ endmodule // dynrt_processor__engine__fp_units__sqrt__rnd_man
 
 
 
+module dynrt_processor__engine__fp_units__sqrt_delay(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [23:0] data_in;
+    output reg  [23:0] data_out;
+    
+    // Stub signals
+    reg  [23:0] stage__0__d;
+    wire  [23:0] stage__0__q;
+    reg  stage__0__clock;
+    
+    // Sub module instances
+    dynrt_processor__display__rgb_q stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__0__d = data_in;
+        data_out = stage__0__q;
+    end
+    
+endmodule // dynrt_processor__engine__fp_units__sqrt_delay
 
 
 
@@ -16493,6 +15920,18 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     localparam  c_reserve_bit = 32'h6;
     
     // Stub signals
+    reg  tester_done_r__d;
+    wire  tester_done_r__q;
+    reg  tester_done_r__clock;
+    reg  [4:0] tester_done_thread_r__d;
+    wire  [4:0] tester_done_thread_r__q;
+    reg  tester_done_thread_r__clock;
+    reg  walk_done_r__d;
+    wire  walk_done_r__q;
+    reg  walk_done_r__clock;
+    reg  [4:0] walk_done_thread_r__d;
+    wire  [4:0] walk_done_thread_r__q;
+    reg  walk_done_thread_r__clock;
     reg  [31:0] ready__d;
     wire  [31:0] ready__q;
     reg  ready__clock;
@@ -16540,6 +15979,26 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     reg  [31:0] sleep_mask;
     
     // Sub module instances
+    dynrt_processor__display__dark_d tester_done_r(
+        .d(tester_done_r__d),
+        .q(tester_done_r__q),
+        .clock(tester_done_r__clock)
+    );
+    dynrt_processor__engine__decode__t4 tester_done_thread_r(
+        .d(tester_done_thread_r__d),
+        .q(tester_done_thread_r__q),
+        .clock(tester_done_thread_r__clock)
+    );
+    dynrt_processor__display__dark_d walk_done_r(
+        .d(walk_done_r__d),
+        .q(walk_done_r__q),
+        .clock(walk_done_r__clock)
+    );
+    dynrt_processor__engine__decode__t4 walk_done_thread_r(
+        .d(walk_done_thread_r__d),
+        .q(walk_done_thread_r__q),
+        .clock(walk_done_thread_r__clock)
+    );
     dynrt_processor__engine__cycle_count ready(
         .d(ready__d),
         .q(ready__q),
@@ -16595,6 +16054,10 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     
     // Update code
     always @(*) begin
+        tester_done_r__clock = clock;
+        tester_done_thread_r__clock = clock;
+        walk_done_r__clock = clock;
+        walk_done_thread_r__clock = clock;
         ready__clock = clock;
         asleep__clock = clock;
         woken__clock = clock;
@@ -16604,6 +16067,10 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         pointer__clock = clock;
         below_pointer__clock = clock;
         reserved__clock = clock;
+        tester_done_r__d = tester_done_r__q;
+        tester_done_thread_r__d = tester_done_thread_r__q;
+        walk_done_r__d = walk_done_r__q;
+        walk_done_thread_r__d = walk_done_thread_r__q;
         ready__d = ready__q;
         asleep__d = asleep__q;
         woken__d = woken__q;
@@ -16631,13 +16098,17 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         pointer__d = pointer__q - 32'h1;
         below_pointer__d = ~(c_ones << (pointer__q - 32'h1));
         wb_mask = c_one << wb_thread;
+        tester_done_r__d = tester_done;
+        tester_done_thread_r__d = tester_done_thread;
+        walk_done_r__d = walk_done;
+        walk_done_thread_r__d = walk_done_thread;
         tester_event = 32'h0;
-        if (tester_done) begin
-            tester_event = c_one << tester_done_thread;
+        if (tester_done_r__q) begin
+            tester_event = c_one << tester_done_thread_r__q;
         end
         walk_event = 32'h0;
-        if (walk_done) begin
-            walk_event = c_one << walk_done_thread;
+        if (walk_done_r__q) begin
+            walk_event = c_one << walk_done_thread_r__q;
         end
         event_mask = tester_event | walk_event | ray_done_mask;
         wb_sleep = wb_valid & wb_wait_pending & (((woken__q | event_mask) & wb_mask) == 32'h0);
@@ -16659,6 +16130,8 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
             asleep__d = 32'h0;
             woken__d = 32'h0;
             reserved__d = 32'h0;
+            tester_done_r__d = 1'b0;
+            walk_done_r__d = 1'b0;
             picked__d = 1'b0;
         end
     end
@@ -16735,6 +16208,14 @@ module dynrt_processor__engine__scheduler__first_ready(preferred,others,found,on
     end
     
 endmodule // dynrt_processor__engine__scheduler__first_ready
+
+
+
+
+
+
+
+
 
 
 
@@ -17298,6 +16779,63 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [32:0] m3_best__d;
     wire  [32:0] m3_best__q;
     reg  m3_best__clock;
+    reg  gen_held__d;
+    wire  gen_held__q;
+    reg  gen_held__clock;
+    reg  [23:0] gen_hold_m__0__d;
+    wire  [23:0] gen_hold_m__0__q;
+    reg  gen_hold_m__0__clock;
+    reg  [23:0] gen_hold_m__1__d;
+    wire  [23:0] gen_hold_m__1__q;
+    reg  gen_hold_m__1__clock;
+    reg  [23:0] gen_hold_m__2__d;
+    wire  [23:0] gen_hold_m__2__q;
+    reg  gen_hold_m__2__clock;
+    reg  [23:0] gen_hold_m__3__d;
+    wire  [23:0] gen_hold_m__3__q;
+    reg  gen_hold_m__3__clock;
+    reg  [23:0] gen_hold_m__4__d;
+    wire  [23:0] gen_hold_m__4__q;
+    reg  gen_hold_m__4__clock;
+    reg  [23:0] gen_hold_m__5__d;
+    wire  [23:0] gen_hold_m__5__q;
+    reg  gen_hold_m__5__clock;
+    reg  [23:0] gen_hold_m__6__d;
+    wire  [23:0] gen_hold_m__6__q;
+    reg  gen_hold_m__6__clock;
+    reg  [23:0] gen_hold_m__7__d;
+    wire  [23:0] gen_hold_m__7__q;
+    reg  gen_hold_m__7__clock;
+    reg  [23:0] gen_hold_m__8__d;
+    wire  [23:0] gen_hold_m__8__q;
+    reg  gen_hold_m__8__clock;
+    reg  [23:0] gen_hold_m__9__d;
+    wire  [23:0] gen_hold_m__9__q;
+    reg  gen_hold_m__9__clock;
+    reg  [23:0] gen_hold_m__10__d;
+    wire  [23:0] gen_hold_m__10__q;
+    reg  gen_hold_m__10__clock;
+    reg  [23:0] gen_hold_m__11__d;
+    wire  [23:0] gen_hold_m__11__q;
+    reg  gen_hold_m__11__clock;
+    reg  [23:0] gen_hold_v__0__d;
+    wire  [23:0] gen_hold_v__0__q;
+    reg  gen_hold_v__0__clock;
+    reg  [23:0] gen_hold_v__1__d;
+    wire  [23:0] gen_hold_v__1__q;
+    reg  gen_hold_v__1__clock;
+    reg  [23:0] gen_hold_v__2__d;
+    wire  [23:0] gen_hold_v__2__q;
+    reg  gen_hold_v__2__clock;
+    reg  gen_hold_point__d;
+    wire  gen_hold_point__q;
+    reg  gen_hold_point__clock;
+    reg  [1:0] gen_hold_client__d;
+    wire  [1:0] gen_hold_client__q;
+    reg  gen_hold_client__clock;
+    reg  [4:0] gen_hold_thread__d;
+    wire  [4:0] gen_hold_thread__q;
+    reg  gen_hold_thread__clock;
     
     // Local signals
     reg  a_here__0;
@@ -17322,6 +16860,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  merge_write;
     reg  [15:0] launch_tag;
     reg  launching;
+    reg  gen_go;
     reg  gen_taken;
     
     // Sub module instances
@@ -17917,6 +17456,101 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m3_best__q),
         .clock(m3_best__clock)
     );
+    dynrt_processor__display__dark_d gen_held(
+        .d(gen_held__d),
+        .q(gen_held__q),
+        .clock(gen_held__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__0(
+        .d(gen_hold_m__0__d),
+        .q(gen_hold_m__0__q),
+        .clock(gen_hold_m__0__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__1(
+        .d(gen_hold_m__1__d),
+        .q(gen_hold_m__1__q),
+        .clock(gen_hold_m__1__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__2(
+        .d(gen_hold_m__2__d),
+        .q(gen_hold_m__2__q),
+        .clock(gen_hold_m__2__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__3(
+        .d(gen_hold_m__3__d),
+        .q(gen_hold_m__3__q),
+        .clock(gen_hold_m__3__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__4(
+        .d(gen_hold_m__4__d),
+        .q(gen_hold_m__4__q),
+        .clock(gen_hold_m__4__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__5(
+        .d(gen_hold_m__5__d),
+        .q(gen_hold_m__5__q),
+        .clock(gen_hold_m__5__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__6(
+        .d(gen_hold_m__6__d),
+        .q(gen_hold_m__6__q),
+        .clock(gen_hold_m__6__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__7(
+        .d(gen_hold_m__7__d),
+        .q(gen_hold_m__7__q),
+        .clock(gen_hold_m__7__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__8(
+        .d(gen_hold_m__8__d),
+        .q(gen_hold_m__8__q),
+        .clock(gen_hold_m__8__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__9(
+        .d(gen_hold_m__9__d),
+        .q(gen_hold_m__9__q),
+        .clock(gen_hold_m__9__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__10(
+        .d(gen_hold_m__10__d),
+        .q(gen_hold_m__10__q),
+        .clock(gen_hold_m__10__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__11(
+        .d(gen_hold_m__11__d),
+        .q(gen_hold_m__11__q),
+        .clock(gen_hold_m__11__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_v__0(
+        .d(gen_hold_v__0__d),
+        .q(gen_hold_v__0__q),
+        .clock(gen_hold_v__0__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_v__1(
+        .d(gen_hold_v__1__d),
+        .q(gen_hold_v__1__q),
+        .clock(gen_hold_v__1__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_v__2(
+        .d(gen_hold_v__2__d),
+        .q(gen_hold_v__2__q),
+        .clock(gen_hold_v__2__clock)
+    );
+    dynrt_processor__display__dark_d gen_hold_point(
+        .d(gen_hold_point__d),
+        .q(gen_hold_point__q),
+        .clock(gen_hold_point__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 gen_hold_client(
+        .d(gen_hold_client__d),
+        .q(gen_hold_client__q),
+        .clock(gen_hold_client__clock)
+    );
+    dynrt_processor__engine__decode__t4 gen_hold_thread(
+        .d(gen_hold_thread__d),
+        .q(gen_hold_thread__q),
+        .clock(gen_hold_thread__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -17950,6 +17584,10 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         m3_b__clock = clock;
         m3_done__clock = clock;
         m3_best__clock = clock;
+        gen_held__clock = clock;
+        gen_hold_point__clock = clock;
+        gen_hold_client__clock = clock;
+        gen_hold_thread__clock = clock;
         fetching__d = fetching__q;
         fb__d = fb__q;
         lb__d = lb__q;
@@ -17980,6 +17618,40 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         m3_b__d = m3_b__q;
         m3_done__d = m3_done__q;
         m3_best__d = m3_best__q;
+        gen_held__d = gen_held__q;
+        gen_hold_point__d = gen_hold_point__q;
+        gen_hold_client__d = gen_hold_client__q;
+        gen_hold_thread__d = gen_hold_thread__q;
+        gen_hold_m__0__clock = clock;
+        gen_hold_m__0__d = gen_hold_m__0__q;
+        gen_hold_m__1__clock = clock;
+        gen_hold_m__1__d = gen_hold_m__1__q;
+        gen_hold_m__2__clock = clock;
+        gen_hold_m__2__d = gen_hold_m__2__q;
+        gen_hold_m__3__clock = clock;
+        gen_hold_m__3__d = gen_hold_m__3__q;
+        gen_hold_m__4__clock = clock;
+        gen_hold_m__4__d = gen_hold_m__4__q;
+        gen_hold_m__5__clock = clock;
+        gen_hold_m__5__d = gen_hold_m__5__q;
+        gen_hold_m__6__clock = clock;
+        gen_hold_m__6__d = gen_hold_m__6__q;
+        gen_hold_m__7__clock = clock;
+        gen_hold_m__7__d = gen_hold_m__7__q;
+        gen_hold_m__8__clock = clock;
+        gen_hold_m__8__d = gen_hold_m__8__q;
+        gen_hold_m__9__clock = clock;
+        gen_hold_m__9__d = gen_hold_m__9__q;
+        gen_hold_m__10__clock = clock;
+        gen_hold_m__10__d = gen_hold_m__10__q;
+        gen_hold_m__11__clock = clock;
+        gen_hold_m__11__d = gen_hold_m__11__q;
+        gen_hold_v__0__clock = clock;
+        gen_hold_v__0__d = gen_hold_v__0__q;
+        gen_hold_v__1__clock = clock;
+        gen_hold_v__1__d = gen_hold_v__1__q;
+        gen_hold_v__2__clock = clock;
+        gen_hold_v__2__d = gen_hold_v__2__q;
         list_unit__clock = clock;
         ray__clock = clock;
         transform_unit__clock = clock;
@@ -18435,27 +18107,50 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             lphase__d = Launch__Wait;
         end
         launching = (lphase__q == Launch__Origin) | (lphase__q == Launch__Direction);
-        gen_taken = gen_valid & (~launching);
+        gen_go = gen_held__q & (~launching);
+        gen_taken = gen_valid & ((~gen_held__q) | gen_go);
         gen_take = gen_taken;
-        if (gen_taken) begin
+        if (gen_go) begin
+            gen_held__d = 1'b0;
             transform_unit__in_valid = 1'b1;
-            transform_unit__m__0 = gen_m__0;
-            transform_unit__m__1 = gen_m__1;
-            transform_unit__m__2 = gen_m__2;
-            transform_unit__m__3 = gen_m__3;
-            transform_unit__m__4 = gen_m__4;
-            transform_unit__m__5 = gen_m__5;
-            transform_unit__m__6 = gen_m__6;
-            transform_unit__m__7 = gen_m__7;
-            transform_unit__m__8 = gen_m__8;
-            transform_unit__m__9 = gen_m__9;
-            transform_unit__m__10 = gen_m__10;
-            transform_unit__m__11 = gen_m__11;
-            transform_unit__v__0 = gen_v__0;
-            transform_unit__v__1 = gen_v__1;
-            transform_unit__v__2 = gen_v__2;
-            transform_unit__point = gen_point;
-            transform_unit__tag = c_primary | (((gen_client) & 16'hffff) << 32'ha) | (((gen_thread) & 16'hffff) << 32'h5);
+            transform_unit__m__0 = gen_hold_m__0__q;
+            transform_unit__m__1 = gen_hold_m__1__q;
+            transform_unit__m__2 = gen_hold_m__2__q;
+            transform_unit__m__3 = gen_hold_m__3__q;
+            transform_unit__m__4 = gen_hold_m__4__q;
+            transform_unit__m__5 = gen_hold_m__5__q;
+            transform_unit__m__6 = gen_hold_m__6__q;
+            transform_unit__m__7 = gen_hold_m__7__q;
+            transform_unit__m__8 = gen_hold_m__8__q;
+            transform_unit__m__9 = gen_hold_m__9__q;
+            transform_unit__m__10 = gen_hold_m__10__q;
+            transform_unit__m__11 = gen_hold_m__11__q;
+            transform_unit__v__0 = gen_hold_v__0__q;
+            transform_unit__v__1 = gen_hold_v__1__q;
+            transform_unit__v__2 = gen_hold_v__2__q;
+            transform_unit__point = gen_hold_point__q;
+            transform_unit__tag = c_primary | (((gen_hold_client__q) & 16'hffff) << 32'ha) | (((gen_hold_thread__q) & 16'hffff) << 32'h5);
+        end
+        if (gen_taken) begin
+            gen_held__d = 1'b1;
+            gen_hold_m__0__d = gen_m__0;
+            gen_hold_m__1__d = gen_m__1;
+            gen_hold_m__2__d = gen_m__2;
+            gen_hold_m__3__d = gen_m__3;
+            gen_hold_m__4__d = gen_m__4;
+            gen_hold_m__5__d = gen_m__5;
+            gen_hold_m__6__d = gen_m__6;
+            gen_hold_m__7__d = gen_m__7;
+            gen_hold_m__8__d = gen_m__8;
+            gen_hold_m__9__d = gen_m__9;
+            gen_hold_m__10__d = gen_m__10;
+            gen_hold_m__11__d = gen_m__11;
+            gen_hold_v__0__d = gen_v__0;
+            gen_hold_v__1__d = gen_v__1;
+            gen_hold_v__2__d = gen_v__2;
+            gen_hold_point__d = gen_point;
+            gen_hold_client__d = gen_client;
+            gen_hold_thread__d = gen_thread;
         end
         gen_out_valid = transform_unit__out_valid & transform_unit__out_tag[32'he];
         gen_out_client = transform_unit__out_tag[(32'ha)+:(2)];
@@ -18741,6 +18436,44 @@ module dynrt_processor__engine__tester__flight_a(read_address,read_clock,read_da
     end
                 
 endmodule // dynrt_processor__engine__tester__flight_a
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -19993,132 +19726,6 @@ endmodule // dynrt_processor__engine__tester__intersect_unit
 
 
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 module dynrt_processor__engine__tester__intersect_unit__operand_delay__0(clock,data_in,data_out);
     
     // Module arguments
@@ -20166,30 +19773,6 @@ module dynrt_processor__engine__tester__intersect_unit__operand_delay__0(clock,d
     reg  [23:0] stage__12__d;
     wire  [23:0] stage__12__q;
     reg  stage__12__clock;
-    reg  [23:0] stage__13__d;
-    wire  [23:0] stage__13__q;
-    reg  stage__13__clock;
-    reg  [23:0] stage__14__d;
-    wire  [23:0] stage__14__q;
-    reg  stage__14__clock;
-    reg  [23:0] stage__15__d;
-    wire  [23:0] stage__15__q;
-    reg  stage__15__clock;
-    reg  [23:0] stage__16__d;
-    wire  [23:0] stage__16__q;
-    reg  stage__16__clock;
-    reg  [23:0] stage__17__d;
-    wire  [23:0] stage__17__q;
-    reg  stage__17__clock;
-    reg  [23:0] stage__18__d;
-    wire  [23:0] stage__18__q;
-    reg  stage__18__clock;
-    reg  [23:0] stage__19__d;
-    wire  [23:0] stage__19__q;
-    reg  stage__19__clock;
-    reg  [23:0] stage__20__d;
-    wire  [23:0] stage__20__q;
-    reg  stage__20__clock;
     
     // Sub module instances
     dynrt_processor__display__rgb_q stage__0(
@@ -20257,46 +19840,6 @@ module dynrt_processor__engine__tester__intersect_unit__operand_delay__0(clock,d
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor__display__rgb_q stage__13(
-        .d(stage__13__d),
-        .q(stage__13__q),
-        .clock(stage__13__clock)
-    );
-    dynrt_processor__display__rgb_q stage__14(
-        .d(stage__14__d),
-        .q(stage__14__q),
-        .clock(stage__14__clock)
-    );
-    dynrt_processor__display__rgb_q stage__15(
-        .d(stage__15__d),
-        .q(stage__15__q),
-        .clock(stage__15__clock)
-    );
-    dynrt_processor__display__rgb_q stage__16(
-        .d(stage__16__d),
-        .q(stage__16__q),
-        .clock(stage__16__clock)
-    );
-    dynrt_processor__display__rgb_q stage__17(
-        .d(stage__17__d),
-        .q(stage__17__q),
-        .clock(stage__17__clock)
-    );
-    dynrt_processor__display__rgb_q stage__18(
-        .d(stage__18__d),
-        .q(stage__18__q),
-        .clock(stage__18__clock)
-    );
-    dynrt_processor__display__rgb_q stage__19(
-        .d(stage__19__d),
-        .q(stage__19__q),
-        .clock(stage__19__clock)
-    );
-    dynrt_processor__display__rgb_q stage__20(
-        .d(stage__20__d),
-        .q(stage__20__q),
-        .clock(stage__20__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -20313,14 +19856,6 @@ module dynrt_processor__engine__tester__intersect_unit__operand_delay__0(clock,d
         stage__10__clock = clock;
         stage__11__clock = clock;
         stage__12__clock = clock;
-        stage__13__clock = clock;
-        stage__14__clock = clock;
-        stage__15__clock = clock;
-        stage__16__clock = clock;
-        stage__17__clock = clock;
-        stage__18__clock = clock;
-        stage__19__clock = clock;
-        stage__20__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -20334,14 +19869,6 @@ module dynrt_processor__engine__tester__intersect_unit__operand_delay__0(clock,d
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        stage__13__d = stage__12__q;
-        stage__14__d = stage__13__q;
-        stage__15__d = stage__14__q;
-        stage__16__d = stage__15__q;
-        stage__17__d = stage__16__q;
-        stage__18__d = stage__17__q;
-        stage__19__d = stage__18__q;
-        stage__20__d = stage__19__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -20355,113 +19882,9 @@ module dynrt_processor__engine__tester__intersect_unit__operand_delay__0(clock,d
         data_out = stage__10__q;
         data_out = stage__11__q;
         data_out = stage__12__q;
-        data_out = stage__13__q;
-        data_out = stage__14__q;
-        data_out = stage__15__q;
-        data_out = stage__16__q;
-        data_out = stage__17__q;
-        data_out = stage__18__q;
-        data_out = stage__19__q;
-        data_out = stage__20__q;
     end
     
 endmodule // dynrt_processor__engine__tester__intersect_unit__operand_delay__0
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 
 
 
@@ -21301,30 +20724,6 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_div(clock,data
     reg  [15:0] stage__12__d;
     wire  [15:0] stage__12__q;
     reg  stage__12__clock;
-    reg  [15:0] stage__13__d;
-    wire  [15:0] stage__13__q;
-    reg  stage__13__clock;
-    reg  [15:0] stage__14__d;
-    wire  [15:0] stage__14__q;
-    reg  stage__14__clock;
-    reg  [15:0] stage__15__d;
-    wire  [15:0] stage__15__q;
-    reg  stage__15__clock;
-    reg  [15:0] stage__16__d;
-    wire  [15:0] stage__16__q;
-    reg  stage__16__clock;
-    reg  [15:0] stage__17__d;
-    wire  [15:0] stage__17__q;
-    reg  stage__17__clock;
-    reg  [15:0] stage__18__d;
-    wire  [15:0] stage__18__q;
-    reg  stage__18__clock;
-    reg  [15:0] stage__19__d;
-    wire  [15:0] stage__19__q;
-    reg  stage__19__clock;
-    reg  [15:0] stage__20__d;
-    wire  [15:0] stage__20__q;
-    reg  stage__20__clock;
     
     // Sub module instances
     dynrt_processor__engine__fp_units__sqrt__rnd_man stage__0(
@@ -21392,46 +20791,6 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_div(clock,data
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__13(
-        .d(stage__13__d),
-        .q(stage__13__q),
-        .clock(stage__13__clock)
-    );
-    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__14(
-        .d(stage__14__d),
-        .q(stage__14__q),
-        .clock(stage__14__clock)
-    );
-    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__15(
-        .d(stage__15__d),
-        .q(stage__15__q),
-        .clock(stage__15__clock)
-    );
-    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__16(
-        .d(stage__16__d),
-        .q(stage__16__q),
-        .clock(stage__16__clock)
-    );
-    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__17(
-        .d(stage__17__d),
-        .q(stage__17__q),
-        .clock(stage__17__clock)
-    );
-    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__18(
-        .d(stage__18__d),
-        .q(stage__18__q),
-        .clock(stage__18__clock)
-    );
-    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__19(
-        .d(stage__19__d),
-        .q(stage__19__q),
-        .clock(stage__19__clock)
-    );
-    dynrt_processor__engine__fp_units__sqrt__rnd_man stage__20(
-        .d(stage__20__d),
-        .q(stage__20__q),
-        .clock(stage__20__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -21448,14 +20807,6 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_div(clock,data
         stage__10__clock = clock;
         stage__11__clock = clock;
         stage__12__clock = clock;
-        stage__13__clock = clock;
-        stage__14__clock = clock;
-        stage__15__clock = clock;
-        stage__16__clock = clock;
-        stage__17__clock = clock;
-        stage__18__clock = clock;
-        stage__19__clock = clock;
-        stage__20__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -21469,14 +20820,6 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_div(clock,data
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        stage__13__d = stage__12__q;
-        stage__14__d = stage__13__q;
-        stage__15__d = stage__14__q;
-        stage__16__d = stage__15__q;
-        stage__17__d = stage__16__q;
-        stage__18__d = stage__17__q;
-        stage__19__d = stage__18__q;
-        stage__20__d = stage__19__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -21490,33 +20833,9 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_div(clock,data
         data_out = stage__10__q;
         data_out = stage__11__q;
         data_out = stage__12__q;
-        data_out = stage__13__q;
-        data_out = stage__14__q;
-        data_out = stage__15__q;
-        data_out = stage__16__q;
-        data_out = stage__17__q;
-        data_out = stage__18__q;
-        data_out = stage__19__q;
-        data_out = stage__20__q;
     end
     
 endmodule // dynrt_processor__engine__tester__intersect_unit__tag_delay_div
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 
 
 
@@ -29484,30 +28803,6 @@ module dynrt_processor__engine__traversal_unit__control_delay_div(clock,data_in,
     reg  [38:0] stage__12__d;
     wire  [38:0] stage__12__q;
     reg  stage__12__clock;
-    reg  [38:0] stage__13__d;
-    wire  [38:0] stage__13__q;
-    reg  stage__13__clock;
-    reg  [38:0] stage__14__d;
-    wire  [38:0] stage__14__q;
-    reg  stage__14__clock;
-    reg  [38:0] stage__15__d;
-    wire  [38:0] stage__15__q;
-    reg  stage__15__clock;
-    reg  [38:0] stage__16__d;
-    wire  [38:0] stage__16__q;
-    reg  stage__16__clock;
-    reg  [38:0] stage__17__d;
-    wire  [38:0] stage__17__q;
-    reg  stage__17__clock;
-    reg  [38:0] stage__18__d;
-    wire  [38:0] stage__18__q;
-    reg  stage__18__clock;
-    reg  [38:0] stage__19__d;
-    wire  [38:0] stage__19__q;
-    reg  stage__19__clock;
-    reg  [38:0] stage__20__d;
-    wire  [38:0] stage__20__q;
-    reg  stage__20__clock;
     
     // Sub module instances
     dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__0(
@@ -29575,46 +28870,6 @@ module dynrt_processor__engine__traversal_unit__control_delay_div(clock,data_in,
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__13(
-        .d(stage__13__d),
-        .q(stage__13__q),
-        .clock(stage__13__clock)
-    );
-    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__14(
-        .d(stage__14__d),
-        .q(stage__14__q),
-        .clock(stage__14__clock)
-    );
-    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__15(
-        .d(stage__15__d),
-        .q(stage__15__q),
-        .clock(stage__15__clock)
-    );
-    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__16(
-        .d(stage__16__d),
-        .q(stage__16__q),
-        .clock(stage__16__clock)
-    );
-    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__17(
-        .d(stage__17__d),
-        .q(stage__17__q),
-        .clock(stage__17__clock)
-    );
-    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__18(
-        .d(stage__18__d),
-        .q(stage__18__q),
-        .clock(stage__18__clock)
-    );
-    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__19(
-        .d(stage__19__d),
-        .q(stage__19__q),
-        .clock(stage__19__clock)
-    );
-    dynrt_processor__engine__traversal_unit__control_delay__stage__0 stage__20(
-        .d(stage__20__d),
-        .q(stage__20__q),
-        .clock(stage__20__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -29631,14 +28886,6 @@ module dynrt_processor__engine__traversal_unit__control_delay_div(clock,data_in,
         stage__10__clock = clock;
         stage__11__clock = clock;
         stage__12__clock = clock;
-        stage__13__clock = clock;
-        stage__14__clock = clock;
-        stage__15__clock = clock;
-        stage__16__clock = clock;
-        stage__17__clock = clock;
-        stage__18__clock = clock;
-        stage__19__clock = clock;
-        stage__20__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -29652,14 +28899,6 @@ module dynrt_processor__engine__traversal_unit__control_delay_div(clock,data_in,
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        stage__13__d = stage__12__q;
-        stage__14__d = stage__13__q;
-        stage__15__d = stage__14__q;
-        stage__16__d = stage__15__q;
-        stage__17__d = stage__16__q;
-        stage__18__d = stage__17__q;
-        stage__19__d = stage__18__q;
-        stage__20__d = stage__19__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -29673,159 +28912,9 @@ module dynrt_processor__engine__traversal_unit__control_delay_div(clock,data_in,
         data_out = stage__10__q;
         data_out = stage__11__q;
         data_out = stage__12__q;
-        data_out = stage__13__q;
-        data_out = stage__14__q;
-        data_out = stage__15__q;
-        data_out = stage__16__q;
-        data_out = stage__17__q;
-        data_out = stage__18__q;
-        data_out = stage__19__q;
-        data_out = stage__20__q;
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__control_delay_div
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 
 
 
@@ -30929,86 +30018,6 @@ module dynrt_processor__engine__traversal_unit__leaf_sp(read_address,read_clock,
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__leaf_sp
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 
 
 

@@ -42,7 +42,7 @@ pub const PROCESSOR_TOP: &str = "dynrt_processor";
 
 /// Dispatches to `func::<W, E, M, S, S1, X2, T, P, DX, DL>(args)` for the engine: `DX =
 /// long_latency - ENGINE_LATENCY = M - 6` (the long line of `fdiv` and `fsqrt`) and `DL =
-/// div_latency = M + 5` (the IntersectUnit's divider).
+/// div_latency(M)` (the divider of the IntersectUnit and the traversal unit).
 #[macro_export]
 macro_rules! dispatch_engine_format {
     (@arms $fmt:expr, $func:ident, $args:tt ; $(($e:literal, $m:literal))*) => {{
@@ -56,7 +56,7 @@ macro_rules! dispatch_engine_format {
                         ($crate::hw::engine::long_latency($m)
                             - $crate::hw::engine::ENGINE_LATENCY) as usize
                     },
-                    { $m + 5 },
+                    { $crate::hw::fp::div::div_latency($m) as usize },
                 >$args),
             )*
             _ => Err($crate::hw::fp::UnsupportedFormat(format)),

@@ -23,11 +23,11 @@
 //! 11049 FFs, 8 MULT18X18 (two 24x24 products), depth 8. The margin's bounds cost 59 LUTs at
 //! e7m16 (55 at e8m23) and one LUT level at e7m16 over the exact test's 0 and 1, which the
 //! comparators simplify further. Most flip-flops are delay lines (O'x, O'y, D'x, D'y, t_min,
-//! t_max and the tag wait out the divider's `M + 5` clocks); yosys 0.23 does not map them to
+//! t_max and the tag wait out the divider's `div_latency` clocks); yosys 0.23 does not map them to
 //! SRL16s.
 //!
-//! Latency [`intersect_latency`] = div (`M + 5`) + mul (4) + add (8) + add (8) + compare (2):
-//! 43 clocks for e7m16, 50 for e8m23; one test per clock. `tag` travels with the data.
+//! Latency [`intersect_latency`] = div (`div_latency`) + mul (4) + add (8) + add (8) +
+//! compare (2): 35 clocks for e7m16, 38 for e8m23; one test per clock. `tag` travels with the data.
 //!
 //! Timeline (clock offsets from the input, with the operators' latencies `Lm`, `La`, `Lc`): t
 //! at `DL`; the two products at `DL + Lm`; u and v at `DL + Lm + La`; u + v at

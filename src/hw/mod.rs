@@ -34,7 +34,7 @@ pub mod triangle_tester;
 pub mod vga;
 
 pub use channel_byte::{ChannelByte, CHANNEL_BYTE_LATENCY};
-pub use delay::Delay;
+pub use delay::{Delay, DelayLine};
 pub use display::VgaDisplay;
 pub use intersect::{intersect_latency, IntersectUnit};
 pub use list_unit::ListUnit;

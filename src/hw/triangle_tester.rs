@@ -42,7 +42,7 @@
 //! bank in their clock; the fetch waits for it.
 //!
 //! Latency from launch to the merged hit: `TRANSFORM_LATENCY` (28) + 1 + `intersect_latency`
-//! (43 at e7m16) + 3. Up to [`FLIGHT_SLOTS`] entries are in flight in that time, each with its
+//! (35 at e7m16) + 3. Up to [`FLIGHT_SLOTS`] entries are in flight in that time, each with its
 //! own slot for the words the merge needs. Const parameters: the operators' `W, E, M, S, S1,
 //! X2, T, P` and `DL = div_latency(M)` (the IntersectUnit's).
 
@@ -139,10 +139,12 @@ pub struct TriangleTester<
     pub intersect_busy: Signal<Out, Bit>,
     /// The other clients' port on the TransformUnit (ray generation, instance entry): a
     /// request (`gen_valid`, the matrix `gen_m`, the point or vector `gen_v`, `gen_point`,
-    /// `gen_thread` and the `gen_client` bits the requester chooses) is taken (`gen_take`) in
-    /// a clock the launch leaves the unit free (the tests come first, so their latency stays
-    /// fixed); its result leaves [`TRANSFORM_LATENCY`] clocks later on `gen_out_*`, with the
-    /// request's client bits.
+    /// `gen_thread` and the `gen_client` bits the requester chooses) is taken (`gen_take`) into
+    /// a one-request hold when it is free or empties that clock, and goes from there into the
+    /// unit in a clock the launch leaves it free (the tests come first, so their latency stays
+    /// fixed); its result leaves [`TRANSFORM_LATENCY`] clocks after that, at least one more
+    /// after the take, on `gen_out_*`, with the request's client bits; requests stay in
+    /// order.
     pub gen_valid: Signal<In, Bit>,
     pub gen_m: [Signal<In, Bits<W>>; 12],
     pub gen_v: [Signal<In, Bits<W>>; 3],
@@ -250,6 +252,18 @@ pub struct TriangleTester<
     launch_tag: Signal<Local, Bits<16>>,
     /// The launch sends a test's origin or direction this clock; else ray generation may.
     launching: Signal<Local, Bit>,
+    /// The other clients' request, held a clock between their port and the TransformUnit:
+    /// from instance entry's state through both request selects into the unit's registers
+    /// was the processor's critical path (`instances.phase -> tester.transform_unit`, 10.2 ns
+    /// of routing: cornell, 84.2 MHz at stop 37). A request is taken into the hold when it is
+    /// empty or goes into the unit this clock (`gen_go`).
+    gen_held: DFF<Bit>,
+    gen_hold_m: [DFF<Bits<W>>; 12],
+    gen_hold_v: [DFF<Bits<W>>; 3],
+    gen_hold_point: DFF<Bit>,
+    gen_hold_client: DFF<Bits<2>>,
+    gen_hold_thread: DFF<Bits<5>>,
+    gen_go: Signal<Local, Bit>,
     gen_taken: Signal<Local, Bit>,
     /// Tag bit 14: a primary ray's direction (ray generation's request).
     c_primary: Constant<Bits<16>>,
@@ -338,6 +352,13 @@ impl<
             primary_o: Default::default(),
             primary_d: Default::default(),
             gen_taken: Default::default(),
+            gen_held: Default::default(),
+            gen_hold_m: Default::default(),
+            gen_hold_v: Default::default(),
+            gen_hold_point: Default::default(),
+            gen_hold_client: Default::default(),
+            gen_hold_thread: Default::default(),
+            gen_go: Default::default(),
             launching: Default::default(),
             c_primary: Constant::new((1u64 << 14).into()),
             list_unit: ListUnit::new(mem_latency),
@@ -449,11 +470,51 @@ impl<
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self, clock, fetching, fb, lb, lphase, a_issued, b_issued, seq, m1_valid, m1_hit,
-            m1_kind, m1_thread, m1_t, m2_valid, m2_hit, m2_kind, m2_thread, m2_t, m2_a, m2_b,
-            m2_done, m2_best, m3_valid, m3_hit, m3_kind, m3_thread, m3_t, m3_a, m3_b, m3_done,
-            m3_best
+            self,
+            clock,
+            fetching,
+            fb,
+            lb,
+            lphase,
+            a_issued,
+            b_issued,
+            seq,
+            m1_valid,
+            m1_hit,
+            m1_kind,
+            m1_thread,
+            m1_t,
+            m2_valid,
+            m2_hit,
+            m2_kind,
+            m2_thread,
+            m2_t,
+            m2_a,
+            m2_b,
+            m2_done,
+            m2_best,
+            m3_valid,
+            m3_hit,
+            m3_kind,
+            m3_thread,
+            m3_t,
+            m3_a,
+            m3_b,
+            m3_done,
+            m3_best,
+            gen_held,
+            gen_hold_point,
+            gen_hold_client,
+            gen_hold_thread
         );
+        for k in 0..12 {
+            self.gen_hold_m[k].clock.next = self.clock.val();
+            self.gen_hold_m[k].d.next = self.gen_hold_m[k].q.val();
+        }
+        for k in 0..3 {
+            self.gen_hold_v[k].clock.next = self.clock.val();
+            self.gen_hold_v[k].d.next = self.gen_hold_v[k].q.val();
+        }
         clock!(
             self,
             clock,
@@ -761,24 +822,38 @@ impl<
             self.lb.d.next = !self.lb.q.val();
             self.lphase.d.next = Launch::Wait;
         }
-        // The other clients' request takes the unit in a clock the launch leaves free; its
-        // tag is `{gen[14], client[11:10], thread[9:5]}`.
+        // The other clients' request goes from the hold into the unit in a clock the launch
+        // leaves free; its tag is `{gen[14], client[11:10], thread[9:5]}`.
         self.launching.next =
             (self.lphase.q.val() == Launch::Origin) | (self.lphase.q.val() == Launch::Direction);
-        self.gen_taken.next = self.gen_valid.val() & (!self.launching.val());
+        self.gen_go.next = self.gen_held.q.val() & (!self.launching.val());
+        self.gen_taken.next = self.gen_valid.val() & ((!self.gen_held.q.val()) | self.gen_go.val());
         self.gen_take.next = self.gen_taken.val();
-        if self.gen_taken.val() {
+        if self.gen_go.val() {
+            self.gen_held.d.next = false;
             self.transform_unit.in_valid.next = true;
             for k in 0..12 {
-                self.transform_unit.m[k].next = self.gen_m[k].val();
+                self.transform_unit.m[k].next = self.gen_hold_m[k].q.val();
             }
             for k in 0..3 {
-                self.transform_unit.v[k].next = self.gen_v[k].val();
+                self.transform_unit.v[k].next = self.gen_hold_v[k].q.val();
             }
-            self.transform_unit.point.next = self.gen_point.val();
+            self.transform_unit.point.next = self.gen_hold_point.q.val();
             self.transform_unit.tag.next = self.c_primary.val()
-                | (bit_cast::<16, 2>(self.gen_client.val()) << 10)
-                | (bit_cast::<16, 5>(self.gen_thread.val()) << 5);
+                | (bit_cast::<16, 2>(self.gen_hold_client.q.val()) << 10)
+                | (bit_cast::<16, 5>(self.gen_hold_thread.q.val()) << 5);
+        }
+        if self.gen_taken.val() {
+            self.gen_held.d.next = true;
+            for k in 0..12 {
+                self.gen_hold_m[k].d.next = self.gen_m[k].val();
+            }
+            for k in 0..3 {
+                self.gen_hold_v[k].d.next = self.gen_v[k].val();
+            }
+            self.gen_hold_point.d.next = self.gen_point.val();
+            self.gen_hold_client.d.next = self.gen_client.val();
+            self.gen_hold_thread.d.next = self.gen_thread.val();
         }
         self.gen_out_valid.next =
             self.transform_unit.out_valid.val() & self.transform_unit.out_tag.val().get_bit(14);

@@ -64,7 +64,7 @@ module tb;
         end else begin
             in_valid <= 1'b0;
         end
-        if (cycles > 1121) begin
+        if (cycles > 1113) begin
             $display("tb: timeout after %0d clocks", cycles);
             $finish;
         end

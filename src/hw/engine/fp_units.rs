@@ -22,6 +22,7 @@ use rust_hdl::prelude::*;
 use super::ENGINE_LATENCY;
 use crate::hw::fp::add_sub::ADD_SUB_LATENCY;
 use crate::hw::fp::compare::COMPARE_LATENCY;
+use crate::hw::fp::div::div_latency;
 use crate::hw::fp::mul::MUL_LATENCY;
 use crate::hw::fp::{FpAddSub, FpCompare, FpDiv, FpMul, FpSqrt};
 use crate::hw::ChannelByte;
@@ -32,7 +33,7 @@ const MUL_DELAY: usize = (ENGINE_LATENCY - MUL_LATENCY) as usize;
 /// The comparator's operands wait a clock in registers of their own (`cmp_a`, `cmp_b`).
 const CMP_DELAY: usize = (ENGINE_LATENCY - 1 - COMPARE_LATENCY) as usize;
 
-#[derive(LogicBlock, Default)]
+#[derive(LogicBlock)]
 pub struct FpUnits<
     const W: usize,
     const E: usize,
@@ -73,16 +74,63 @@ pub struct FpUnits<
     cmp_b: DFF<Bits<W>>,
     byte_unit: ChannelByte<W, E, M, S, S1, X2, T, P>,
     // Each delay brings its unit's result to the write back at `ENGINE_LATENCY` (12): 12 - 8
-    // for the adder, 12 - 4 for the multiplier, 12 - 1 - 2 for the comparator; the divider and
-    // square root (`M + 5`) write back one clock later, at `long_latency`. `ChannelByte` takes
+    // for the adder, 12 - 4 for the multiplier, 12 - 1 - 2 for the comparator; the square root
+    // (`M + 5`) writes back one clock later, at `long_latency`, the divider (`div_latency`)
+    // as many later as that takes. `ChannelByte` takes
     // the 12 clocks itself (`ENGINE_LATENCY` is its latency).
     add_delay: crate::hw::Delay<Bits<W>, ADD_DELAY>,
     mul_delay: crate::hw::Delay<Bits<W>, MUL_DELAY>,
-    div_delay: crate::hw::Delay<Bits<W>, 1>,
+    div_delay: crate::hw::DelayLine<Bits<W>>,
     sqrt_delay: crate::hw::Delay<Bits<W>, 1>,
     lt_delay: crate::hw::Delay<Bit, CMP_DELAY>,
     le_delay: crate::hw::Delay<Bit, CMP_DELAY>,
     eq_delay: crate::hw::Delay<Bit, CMP_DELAY>,
+}
+
+impl<
+        const W: usize,
+        const E: usize,
+        const M: usize,
+        const S: usize,
+        const S1: usize,
+        const X2: usize,
+        const T: usize,
+        const P: usize,
+    > Default for FpUnits<W, E, M, S, S1, X2, T, P>
+{
+    fn default() -> Self {
+        Self {
+            clock: Default::default(),
+            a: Default::default(),
+            b: Default::default(),
+            sub: Default::default(),
+            sum: Default::default(),
+            product: Default::default(),
+            quotient: Default::default(),
+            root: Default::default(),
+            lt: Default::default(),
+            le: Default::default(),
+            eq: Default::default(),
+            colour_byte: Default::default(),
+            add: Default::default(),
+            mul: Default::default(),
+            div: Default::default(),
+            sqrt: Default::default(),
+            cmp: Default::default(),
+            cmp_a: Default::default(),
+            cmp_b: Default::default(),
+            byte_unit: Default::default(),
+            add_delay: Default::default(),
+            mul_delay: Default::default(),
+            div_delay: crate::hw::DelayLine::new(
+                (super::long_latency(M as u32) - div_latency(M as u32)) as usize,
+            ),
+            sqrt_delay: Default::default(),
+            lt_delay: Default::default(),
+            le_delay: Default::default(),
+            eq_delay: Default::default(),
+        }
+    }
 }
 
 impl<

@@ -11,7 +11,7 @@
 //! root bit is always 1. `S + 1` root bits give the significand and the round bit; the final
 //! remainder being nonzero is the sticky bit, so the rounding is exact.
 //!
-//! Latency `M + 5` clocks, the same as [`super::FpDiv`] (e7m16: 21, e8m23: 28); throughput one
+//! Latency `M + 5` clocks (e7m16: 21, e8m23: 28); throughput one
 //! root per clock:
 //! 1. input registers;
 //! 2. unpack, special cases, exponent and the first root bit; registered;
@@ -37,8 +37,8 @@ use rust_hdl::prelude::*;
 
 use super::{bias, const_bits, const_index, inf_word, qnan_word};
 
-/// Latency of [`FpSqrt`] in clocks for a format with `man_bits` stored mantissa bits (equal to
-/// [`super::div::div_latency`]).
+/// Latency of [`FpSqrt`] in clocks for a format with `man_bits` stored mantissa bits (one
+/// root bit a stage: [`super::div::div_latency`] makes two quotient bits a stage).
 pub const fn sqrt_latency(man_bits: u32) -> u32 {
     man_bits + 5
 }
