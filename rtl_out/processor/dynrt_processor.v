@@ -681,6 +681,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam  op_fsub = 5'b10;
     localparam  op_fdiv = 5'b100;
     localparam  op_fsqrt = 5'b101;
+    localparam  op_byte = 5'b11110;
     localparam  op_ld = 5'b1101;
     localparam  op_st = 5'b1110;
     localparam  op_sts = 5'b10000;
@@ -1689,7 +1690,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(epoch__q),
         .clock(epoch__clock)
     );
-    dynrt_processor__engine__halted_count halted_count(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 halted_count(
         .d(halted_count__d),
         .q(halted_count__q),
         .clock(halted_count__clock)
@@ -1965,7 +1966,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         decode__ctl_i3 = fetch__ctl;
         decode__imm_i3 = fetch__imm;
         decode__aux_i3 = fetch__aux;
-        scheduler__long_at_i3 = fetch__valid & ((decode__op_i3 == op_fdiv) | (decode__op_i3 == op_fsqrt));
+        scheduler__long_at_i3 = fetch__valid & ((decode__op_i3 == op_fdiv) | (decode__op_i3 == op_fsqrt) | (decode__op_i3 == op_byte));
         mailboxes__read_thread = decode__thread_i4;
         mailboxes__read_which = decode__imm_i4[32'h0];
         tester__engine__query_thread = decode__thread_i4;
@@ -3553,6 +3554,9 @@ module dynrt_processor__engine__fp_units(clock,a,b,sub,sum,product,quotient,root
     reg  sqrt_delay__clock;
     reg  [23:0] sqrt_delay__data_in;
     wire  [23:0] sqrt_delay__data_out;
+    reg  byte_delay__clock;
+    reg  [7:0] byte_delay__data_in;
+    wire  [7:0] byte_delay__data_out;
     reg  lt_delay__clock;
     reg  lt_delay__data_in;
     wire  lt_delay__data_out;
@@ -3638,10 +3642,15 @@ module dynrt_processor__engine__fp_units(clock,a,b,sub,sum,product,quotient,root
         .data_in(div_delay__data_in),
         .data_out(div_delay__data_out)
     );
-    dynrt_processor__engine__fp_units__sqrt_delay sqrt_delay(
+    dynrt_processor__engine__fp_units__add_delay sqrt_delay(
         .clock(sqrt_delay__clock),
         .data_in(sqrt_delay__data_in),
         .data_out(sqrt_delay__data_out)
+    );
+    dynrt_processor__engine__fp_units__byte_delay byte_delay(
+        .clock(byte_delay__clock),
+        .data_in(byte_delay__data_in),
+        .data_out(byte_delay__data_out)
     );
     dynrt_processor__engine__fp_units__eq_delay lt_delay(
         .clock(lt_delay__clock),
@@ -3673,6 +3682,7 @@ module dynrt_processor__engine__fp_units(clock,a,b,sub,sum,product,quotient,root
         mul_delay__clock = clock;
         div_delay__clock = clock;
         sqrt_delay__clock = clock;
+        byte_delay__clock = clock;
         lt_delay__clock = clock;
         le_delay__clock = clock;
         eq_delay__clock = clock;
@@ -3709,7 +3719,8 @@ module dynrt_processor__engine__fp_units(clock,a,b,sub,sum,product,quotient,root
         lt = lt_delay__data_out;
         le = le_delay__data_out;
         eq = eq_delay__data_out;
-        colour_byte = byte_unit__result;
+        byte_delay__data_in = byte_unit__result;
+        colour_byte = byte_delay__data_out;
     end
     
 endmodule // dynrt_processor__engine__fp_units
@@ -4864,15 +4875,6 @@ module dynrt_processor__engine__fp_units__add_delay(clock,data_in,data_out);
     reg  [23:0] stage__0__d;
     wire  [23:0] stage__0__q;
     reg  stage__0__clock;
-    reg  [23:0] stage__1__d;
-    wire  [23:0] stage__1__q;
-    reg  stage__1__clock;
-    reg  [23:0] stage__2__d;
-    wire  [23:0] stage__2__q;
-    reg  stage__2__clock;
-    reg  [23:0] stage__3__d;
-    wire  [23:0] stage__3__q;
-    reg  stage__3__clock;
     
     // Sub module instances
     dynrt_processor__display__rgb_q stage__0(
@@ -4880,20 +4882,108 @@ module dynrt_processor__engine__fp_units__add_delay(clock,data_in,data_out);
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor__display__rgb_q stage__1(
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__0__d = data_in;
+        data_out = stage__0__q;
+    end
+    
+endmodule // dynrt_processor__engine__fp_units__add_delay
+
+
+
+
+module dynrt_processor__engine__fp_units__byte_delay(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [7:0] data_in;
+    output reg  [7:0] data_out;
+    
+    // Stub signals
+    reg  [7:0] stage__0__d;
+    wire  [7:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [7:0] stage__1__d;
+    wire  [7:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [7:0] stage__2__d;
+    wire  [7:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [7:0] stage__3__d;
+    wire  [7:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [7:0] stage__4__d;
+    wire  [7:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [7:0] stage__5__d;
+    wire  [7:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [7:0] stage__6__d;
+    wire  [7:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [7:0] stage__7__d;
+    wire  [7:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [7:0] stage__8__d;
+    wire  [7:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [7:0] stage__9__d;
+    wire  [7:0] stage__9__q;
+    reg  stage__9__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor__display__rgb_q stage__2(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor__display__rgb_q stage__3(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
     );
     
     // Update code
@@ -4902,17 +4992,64 @@ module dynrt_processor__engine__fp_units__add_delay(clock,data_in,data_out);
         stage__1__clock = clock;
         stage__2__clock = clock;
         stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
         stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
         data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
     end
     
-endmodule // dynrt_processor__engine__fp_units__add_delay
+endmodule // dynrt_processor__engine__fp_units__byte_delay
+
+
+module dynrt_processor__engine__fp_units__byte_delay__stage__0(d,q,clock);
+    
+    // Module arguments
+    input wire  [7:0] d;
+    output reg  [7:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 8'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__fp_units__byte_delay__stage__0
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -7543,15 +7680,6 @@ module dynrt_processor__engine__fp_units__eq_delay(clock,data_in,data_out);
     reg  stage__5__d;
     wire  stage__5__q;
     reg  stage__5__clock;
-    reg  stage__6__d;
-    wire  stage__6__q;
-    reg  stage__6__clock;
-    reg  stage__7__d;
-    wire  stage__7__q;
-    reg  stage__7__clock;
-    reg  stage__8__d;
-    wire  stage__8__q;
-    reg  stage__8__clock;
     
     // Sub module instances
     dynrt_processor__display__dark_d stage__0(
@@ -7584,21 +7712,6 @@ module dynrt_processor__engine__fp_units__eq_delay(clock,data_in,data_out);
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor__display__dark_d stage__6(
-        .d(stage__6__d),
-        .q(stage__6__q),
-        .clock(stage__6__clock)
-    );
-    dynrt_processor__display__dark_d stage__7(
-        .d(stage__7__d),
-        .q(stage__7__q),
-        .clock(stage__7__clock)
-    );
-    dynrt_processor__display__dark_d stage__8(
-        .d(stage__8__d),
-        .q(stage__8__q),
-        .clock(stage__8__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -7608,48 +7721,21 @@ module dynrt_processor__engine__fp_units__eq_delay(clock,data_in,data_out);
         stage__3__clock = clock;
         stage__4__clock = clock;
         stage__5__clock = clock;
-        stage__6__clock = clock;
-        stage__7__clock = clock;
-        stage__8__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
         stage__3__d = stage__2__q;
         stage__4__d = stage__3__q;
         stage__5__d = stage__4__q;
-        stage__6__d = stage__5__q;
-        stage__7__d = stage__6__q;
-        stage__8__d = stage__7__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
         data_out = stage__3__q;
         data_out = stage__4__q;
         data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
     end
     
 endmodule // dynrt_processor__engine__fp_units__eq_delay
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 
 
 
@@ -7759,15 +7845,6 @@ module dynrt_processor__engine__fp_units__mul_delay(clock,data_in,data_out);
     reg  [23:0] stage__4__d;
     wire  [23:0] stage__4__q;
     reg  stage__4__clock;
-    reg  [23:0] stage__5__d;
-    wire  [23:0] stage__5__q;
-    reg  stage__5__clock;
-    reg  [23:0] stage__6__d;
-    wire  [23:0] stage__6__q;
-    reg  stage__6__clock;
-    reg  [23:0] stage__7__d;
-    wire  [23:0] stage__7__q;
-    reg  stage__7__clock;
     
     // Sub module instances
     dynrt_processor__display__rgb_q stage__0(
@@ -7795,21 +7872,6 @@ module dynrt_processor__engine__fp_units__mul_delay(clock,data_in,data_out);
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor__display__rgb_q stage__5(
-        .d(stage__5__d),
-        .q(stage__5__q),
-        .clock(stage__5__clock)
-    );
-    dynrt_processor__display__rgb_q stage__6(
-        .d(stage__6__d),
-        .q(stage__6__q),
-        .clock(stage__6__clock)
-    );
-    dynrt_processor__display__rgb_q stage__7(
-        .d(stage__7__d),
-        .q(stage__7__q),
-        .clock(stage__7__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -7818,34 +7880,19 @@ module dynrt_processor__engine__fp_units__mul_delay(clock,data_in,data_out);
         stage__2__clock = clock;
         stage__3__clock = clock;
         stage__4__clock = clock;
-        stage__5__clock = clock;
-        stage__6__clock = clock;
-        stage__7__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
         stage__3__d = stage__2__q;
         stage__4__d = stage__3__q;
-        stage__5__d = stage__4__q;
-        stage__6__d = stage__5__q;
-        stage__7__d = stage__6__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
         data_out = stage__3__q;
         data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
     end
     
 endmodule // dynrt_processor__engine__fp_units__mul_delay
-
-
-
-
-
-
 
 
 
@@ -10139,54 +10186,10 @@ endmodule // dynrt_processor__engine__fp_units__sqrt__rnd_man
 
 
 
-module dynrt_processor__engine__fp_units__sqrt_delay(clock,data_in,data_out);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  [23:0] data_in;
-    output reg  [23:0] data_out;
-    
-    // Stub signals
-    reg  [23:0] stage__0__d;
-    wire  [23:0] stage__0__q;
-    reg  stage__0__clock;
-    
-    // Sub module instances
-    dynrt_processor__display__rgb_q stage__0(
-        .d(stage__0__d),
-        .q(stage__0__q),
-        .clock(stage__0__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        stage__0__clock = clock;
-        stage__0__d = data_in;
-        data_out = stage__0__q;
-    end
-    
-endmodule // dynrt_processor__engine__fp_units__sqrt_delay
 
 
 
 
-module dynrt_processor__engine__halted_count(d,q,clock);
-    
-    // Module arguments
-    input wire  [7:0] d;
-    output reg  [7:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 8'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor__engine__halted_count
 
 
 
@@ -10562,7 +10565,7 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         .q(arrived__q),
         .clock(arrived__clock)
     );
-    dynrt_processor__engine__halted_count flight(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 flight(
         .d(flight__d),
         .q(flight__q),
         .clock(flight__clock)
@@ -11370,7 +11373,7 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
         .q(entries_r__7__q),
         .clock(entries_r__7__clock)
     );
-    dynrt_processor__engine__halted_count meta_i6(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 meta_i6(
         .d(meta_i6__d),
         .q(meta_i6__q),
         .clock(meta_i6__clock)
@@ -11440,7 +11443,7 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
         .q(matches__7__q),
         .clock(matches__7__clock)
     );
-    dynrt_processor__engine__halted_count meta_r(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 meta_r(
         .d(meta_r__d),
         .q(meta_r__q),
         .clock(meta_r__clock)
@@ -13295,6 +13298,9 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
     reg  long_pc__clock;
     reg  [11:0] long_pc__data_in;
     wire  [11:0] long_pc__data_out;
+    reg  long_fast__clock;
+    reg  [31:0] long_fast__data_in;
+    wire  [31:0] long_fast__data_out;
     
     // Local signals
     reg  is_long;
@@ -13319,7 +13325,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .q(op_i6__q),
         .clock(op_i6__clock)
     );
-    dynrt_processor__engine__halted_count dst_i6(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 dst_i6(
         .d(dst_i6__d),
         .q(dst_i6__q),
         .clock(dst_i6__clock)
@@ -13559,7 +13565,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .data_in(fast_tail__data_in),
         .data_out(fast_tail__data_out)
     );
-    dynrt_processor__engine__result_line__cond_line long_valid(
+    dynrt_processor__engine__result_line__long_valid long_valid(
         .clock(long_valid__clock),
         .data_in(long_valid__data_in),
         .data_out(long_valid__data_out)
@@ -13574,7 +13580,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .data_in(long_thread__data_in),
         .data_out(long_thread__data_out)
     );
-    dynrt_processor__engine__result_line__cond_line long_write(
+    dynrt_processor__engine__result_line__long_valid long_write(
         .clock(long_write__clock),
         .data_in(long_write__data_in),
         .data_out(long_write__data_out)
@@ -13588,6 +13594,11 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .clock(long_pc__clock),
         .data_in(long_pc__data_in),
         .data_out(long_pc__data_out)
+    );
+    dynrt_processor__engine__result_line__long_fast long_fast(
+        .clock(long_fast__clock),
+        .data_in(long_fast__data_in),
+        .data_out(long_fast__data_out)
     );
     
     // Update code
@@ -13650,6 +13661,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         long_write__clock = clock;
         long_source__clock = clock;
         long_pc__clock = clock;
+        long_fast__clock = clock;
         fast_line__0__clock = clock;
         kind_line__0__clock = clock;
         fast_line__1__clock = clock;
@@ -13682,7 +13694,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         int_lt_i6__d = int_lt;
         pix_done_i6__d = pix_done;
         pix_busy_i6__d = pix_busy;
-        is_long = (op_i6__q == op_fdiv) | (op_i6__q == op_fsqrt);
+        is_long = (op_i6__q == op_fdiv) | (op_i6__q == op_fsqrt) | (op_i6__q == op_byte);
         is_mbx = op_i6__q == op_mbx;
         halts = op_i6__q == op_halt;
         repeats = ((op_i6__q == op_tri) & tri_busy_i6__q) | ((op_i6__q == op_kd) & kd_busy_i6__q) | ((op_i6__q == op_pixel) & pix_busy_i6__q);
@@ -13845,6 +13857,7 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         long_write__data_in = write_line__data_out;
         long_source__data_in = source_line__data_out;
         long_pc__data_in = pc_not_taken_line__data_out;
+        long_fast__data_in = fast_tail__data_out;
         if (long_valid__data_out) begin
             retiring__valid = 1'b1;
             retiring__dst = long_dst__data_out;
@@ -13878,6 +13891,9 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
             retiring__wait_pending = wait_pending_line__data_out;
         end
         retiring__fast = fast_tail__data_out;
+        if (long_valid__data_out) begin
+            retiring__fast = long_fast__data_out;
+        end
     end
     
 endmodule // dynrt_processor__engine__result_line
@@ -13914,15 +13930,6 @@ module dynrt_processor__engine__result_line__cond_line(clock,data_in,data_out);
     reg  stage__6__d;
     wire  stage__6__q;
     reg  stage__6__clock;
-    reg  stage__7__d;
-    wire  stage__7__q;
-    reg  stage__7__clock;
-    reg  stage__8__d;
-    wire  stage__8__q;
-    reg  stage__8__clock;
-    reg  stage__9__d;
-    wire  stage__9__q;
-    reg  stage__9__clock;
     
     // Sub module instances
     dynrt_processor__display__dark_d stage__0(
@@ -13960,21 +13967,6 @@ module dynrt_processor__engine__result_line__cond_line(clock,data_in,data_out);
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor__display__dark_d stage__7(
-        .d(stage__7__d),
-        .q(stage__7__q),
-        .clock(stage__7__clock)
-    );
-    dynrt_processor__display__dark_d stage__8(
-        .d(stage__8__d),
-        .q(stage__8__q),
-        .clock(stage__8__clock)
-    );
-    dynrt_processor__display__dark_d stage__9(
-        .d(stage__9__d),
-        .q(stage__9__q),
-        .clock(stage__9__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -13985,9 +13977,6 @@ module dynrt_processor__engine__result_line__cond_line(clock,data_in,data_out);
         stage__4__clock = clock;
         stage__5__clock = clock;
         stage__6__clock = clock;
-        stage__7__clock = clock;
-        stage__8__clock = clock;
-        stage__9__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -13995,9 +13984,6 @@ module dynrt_processor__engine__result_line__cond_line(clock,data_in,data_out);
         stage__4__d = stage__3__q;
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
-        stage__7__d = stage__6__q;
-        stage__8__d = stage__7__q;
-        stage__9__d = stage__8__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -14005,18 +13991,9 @@ module dynrt_processor__engine__result_line__cond_line(clock,data_in,data_out);
         data_out = stage__4__q;
         data_out = stage__5__q;
         data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__cond_line
-
-
-
-
-
-
 
 
 
@@ -14067,71 +14044,47 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
     reg  [7:0] stage__7__d;
     wire  [7:0] stage__7__q;
     reg  stage__7__clock;
-    reg  [7:0] stage__8__d;
-    wire  [7:0] stage__8__q;
-    reg  stage__8__clock;
-    reg  [7:0] stage__9__d;
-    wire  [7:0] stage__9__q;
-    reg  stage__9__clock;
-    reg  [7:0] stage__10__d;
-    wire  [7:0] stage__10__q;
-    reg  stage__10__clock;
     
     // Sub module instances
-    dynrt_processor__engine__halted_count stage__0(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor__engine__halted_count stage__1(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor__engine__halted_count stage__2(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor__engine__halted_count stage__3(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor__engine__halted_count stage__4(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor__engine__halted_count stage__5(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor__engine__halted_count stage__6(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor__engine__halted_count stage__7(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
-    );
-    dynrt_processor__engine__halted_count stage__8(
-        .d(stage__8__d),
-        .q(stage__8__q),
-        .clock(stage__8__clock)
-    );
-    dynrt_processor__engine__halted_count stage__9(
-        .d(stage__9__d),
-        .q(stage__9__q),
-        .clock(stage__9__clock)
-    );
-    dynrt_processor__engine__halted_count stage__10(
-        .d(stage__10__d),
-        .q(stage__10__q),
-        .clock(stage__10__clock)
     );
     
     // Update code
@@ -14144,9 +14097,6 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         stage__5__clock = clock;
         stage__6__clock = clock;
         stage__7__clock = clock;
-        stage__8__clock = clock;
-        stage__9__clock = clock;
-        stage__10__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -14155,9 +14105,6 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        stage__8__d = stage__7__q;
-        stage__9__d = stage__8__q;
-        stage__10__d = stage__9__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -14166,18 +14113,9 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         data_out = stage__5__q;
         data_out = stage__6__q;
         data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__dst_line
-
-
-
-
-
-
 
 
 
@@ -14223,15 +14161,6 @@ module dynrt_processor__engine__result_line__fast_tail(clock,data_in,data_out);
     reg  [31:0] stage__0__d;
     wire  [31:0] stage__0__q;
     reg  stage__0__clock;
-    reg  [31:0] stage__1__d;
-    wire  [31:0] stage__1__q;
-    reg  stage__1__clock;
-    reg  [31:0] stage__2__d;
-    wire  [31:0] stage__2__q;
-    reg  stage__2__clock;
-    reg  [31:0] stage__3__d;
-    wire  [31:0] stage__3__q;
-    reg  stage__3__clock;
     
     // Sub module instances
     dynrt_processor__engine__cycle_count stage__0(
@@ -14239,45 +14168,15 @@ module dynrt_processor__engine__result_line__fast_tail(clock,data_in,data_out);
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor__engine__cycle_count stage__1(
-        .d(stage__1__d),
-        .q(stage__1__q),
-        .clock(stage__1__clock)
-    );
-    dynrt_processor__engine__cycle_count stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
-    dynrt_processor__engine__cycle_count stage__3(
-        .d(stage__3__d),
-        .q(stage__3__q),
-        .clock(stage__3__clock)
-    );
     
     // Update code
     always @(*) begin
         stage__0__clock = clock;
-        stage__1__clock = clock;
-        stage__2__clock = clock;
-        stage__3__clock = clock;
         stage__0__d = data_in;
-        stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        stage__3__d = stage__2__q;
         data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__fast_tail
-
-
-
-
-
-
 
 
 
@@ -14314,15 +14213,6 @@ module dynrt_processor__engine__result_line__halt_line(clock,data_in,data_out);
     reg  stage__7__d;
     wire  stage__7__q;
     reg  stage__7__clock;
-    reg  stage__8__d;
-    wire  stage__8__q;
-    reg  stage__8__clock;
-    reg  stage__9__d;
-    wire  stage__9__q;
-    reg  stage__9__clock;
-    reg  stage__10__d;
-    wire  stage__10__q;
-    reg  stage__10__clock;
     
     // Sub module instances
     dynrt_processor__display__dark_d stage__0(
@@ -14365,21 +14255,6 @@ module dynrt_processor__engine__result_line__halt_line(clock,data_in,data_out);
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor__display__dark_d stage__8(
-        .d(stage__8__d),
-        .q(stage__8__q),
-        .clock(stage__8__clock)
-    );
-    dynrt_processor__display__dark_d stage__9(
-        .d(stage__9__d),
-        .q(stage__9__q),
-        .clock(stage__9__clock)
-    );
-    dynrt_processor__display__dark_d stage__10(
-        .d(stage__10__d),
-        .q(stage__10__q),
-        .clock(stage__10__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -14391,9 +14266,6 @@ module dynrt_processor__engine__result_line__halt_line(clock,data_in,data_out);
         stage__5__clock = clock;
         stage__6__clock = clock;
         stage__7__clock = clock;
-        stage__8__clock = clock;
-        stage__9__clock = clock;
-        stage__10__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -14402,9 +14274,6 @@ module dynrt_processor__engine__result_line__halt_line(clock,data_in,data_out);
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        stage__8__d = stage__7__q;
-        stage__9__d = stage__8__q;
-        stage__10__d = stage__9__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -14413,24 +14282,9 @@ module dynrt_processor__engine__result_line__halt_line(clock,data_in,data_out);
         data_out = stage__5__q;
         data_out = stage__6__q;
         data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__halt_line
-
-
-
-
-
-
-
-
-
-
-
-
 
 
 
@@ -14560,57 +14414,81 @@ module dynrt_processor__engine__result_line__long_dst(clock,data_in,data_out);
     reg  [7:0] stage__9__d;
     wire  [7:0] stage__9__q;
     reg  stage__9__clock;
+    reg  [7:0] stage__10__d;
+    wire  [7:0] stage__10__q;
+    reg  stage__10__clock;
+    reg  [7:0] stage__11__d;
+    wire  [7:0] stage__11__q;
+    reg  stage__11__clock;
+    reg  [7:0] stage__12__d;
+    wire  [7:0] stage__12__q;
+    reg  stage__12__clock;
     
     // Sub module instances
-    dynrt_processor__engine__halted_count stage__0(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor__engine__halted_count stage__1(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor__engine__halted_count stage__2(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor__engine__halted_count stage__3(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor__engine__halted_count stage__4(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor__engine__halted_count stage__5(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor__engine__halted_count stage__6(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor__engine__halted_count stage__7(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor__engine__halted_count stage__8(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor__engine__halted_count stage__9(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 stage__12(
+        .d(stage__12__d),
+        .q(stage__12__q),
+        .clock(stage__12__clock)
     );
     
     // Update code
@@ -14625,6 +14503,9 @@ module dynrt_processor__engine__result_line__long_dst(clock,data_in,data_out);
         stage__7__clock = clock;
         stage__8__clock = clock;
         stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__11__clock = clock;
+        stage__12__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -14635,6 +14516,9 @@ module dynrt_processor__engine__result_line__long_dst(clock,data_in,data_out);
         stage__7__d = stage__6__q;
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
+        stage__12__d = stage__11__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -14645,9 +14529,205 @@ module dynrt_processor__engine__result_line__long_dst(clock,data_in,data_out);
         data_out = stage__7__q;
         data_out = stage__8__q;
         data_out = stage__9__q;
+        data_out = stage__10__q;
+        data_out = stage__11__q;
+        data_out = stage__12__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__long_dst
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__result_line__long_fast(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] data_in;
+    output reg  [31:0] data_out;
+    
+    // Stub signals
+    reg  [31:0] stage__0__d;
+    wire  [31:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [31:0] stage__1__d;
+    wire  [31:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [31:0] stage__2__d;
+    wire  [31:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [31:0] stage__3__d;
+    wire  [31:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [31:0] stage__4__d;
+    wire  [31:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [31:0] stage__5__d;
+    wire  [31:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [31:0] stage__6__d;
+    wire  [31:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [31:0] stage__7__d;
+    wire  [31:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [31:0] stage__8__d;
+    wire  [31:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [31:0] stage__9__d;
+    wire  [31:0] stage__9__q;
+    reg  stage__9__clock;
+    reg  [31:0] stage__10__d;
+    wire  [31:0] stage__10__q;
+    reg  stage__10__clock;
+    reg  [31:0] stage__11__d;
+    wire  [31:0] stage__11__q;
+    reg  stage__11__clock;
+    reg  [31:0] stage__12__d;
+    wire  [31:0] stage__12__q;
+    reg  stage__12__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__cycle_count stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
+    dynrt_processor__engine__cycle_count stage__12(
+        .d(stage__12__d),
+        .q(stage__12__q),
+        .clock(stage__12__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__11__clock = clock;
+        stage__12__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
+        stage__12__d = stage__11__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+        data_out = stage__11__q;
+        data_out = stage__12__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__long_fast
+
+
+
+
+
+
 
 
 
@@ -14708,6 +14788,15 @@ module dynrt_processor__engine__result_line__long_pc(clock,data_in,data_out);
     reg  [11:0] stage__9__d;
     wire  [11:0] stage__9__q;
     reg  stage__9__clock;
+    reg  [11:0] stage__10__d;
+    wire  [11:0] stage__10__q;
+    reg  stage__10__clock;
+    reg  [11:0] stage__11__d;
+    wire  [11:0] stage__11__q;
+    reg  stage__11__clock;
+    reg  [11:0] stage__12__d;
+    wire  [11:0] stage__12__q;
+    reg  stage__12__clock;
     
     // Sub module instances
     dynrt_processor__display__timing__col stage__0(
@@ -14760,6 +14849,21 @@ module dynrt_processor__engine__result_line__long_pc(clock,data_in,data_out);
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
+    dynrt_processor__display__timing__col stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    dynrt_processor__display__timing__col stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
+    dynrt_processor__display__timing__col stage__12(
+        .d(stage__12__d),
+        .q(stage__12__q),
+        .clock(stage__12__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -14773,6 +14877,9 @@ module dynrt_processor__engine__result_line__long_pc(clock,data_in,data_out);
         stage__7__clock = clock;
         stage__8__clock = clock;
         stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__11__clock = clock;
+        stage__12__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -14783,6 +14890,9 @@ module dynrt_processor__engine__result_line__long_pc(clock,data_in,data_out);
         stage__7__d = stage__6__q;
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
+        stage__12__d = stage__11__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -14793,9 +14903,18 @@ module dynrt_processor__engine__result_line__long_pc(clock,data_in,data_out);
         data_out = stage__7__q;
         data_out = stage__8__q;
         data_out = stage__9__q;
+        data_out = stage__10__q;
+        data_out = stage__11__q;
+        data_out = stage__12__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__long_pc
+
+
+
+
+
+
 
 
 
@@ -14864,6 +14983,15 @@ module dynrt_processor__engine__result_line__long_source(clock,data_in,data_out)
     reg  [2:0] stage__9__d;
     wire  [2:0] stage__9__q;
     reg  stage__9__clock;
+    reg  [2:0] stage__10__d;
+    wire  [2:0] stage__10__q;
+    reg  stage__10__clock;
+    reg  [2:0] stage__11__d;
+    wire  [2:0] stage__11__q;
+    reg  stage__11__clock;
+    reg  [2:0] stage__12__d;
+    wire  [2:0] stage__12__q;
+    reg  stage__12__clock;
     
     // Sub module instances
     dynrt_processor__engine__result_line__long_source__stage__0 stage__0(
@@ -14916,6 +15044,21 @@ module dynrt_processor__engine__result_line__long_source(clock,data_in,data_out)
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
+    dynrt_processor__engine__result_line__long_source__stage__0 stage__12(
+        .d(stage__12__d),
+        .q(stage__12__q),
+        .clock(stage__12__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -14929,6 +15072,9 @@ module dynrt_processor__engine__result_line__long_source(clock,data_in,data_out)
         stage__7__clock = clock;
         stage__8__clock = clock;
         stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__11__clock = clock;
+        stage__12__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -14939,6 +15085,9 @@ module dynrt_processor__engine__result_line__long_source(clock,data_in,data_out)
         stage__7__d = stage__6__q;
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
+        stage__12__d = stage__11__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -14949,6 +15098,9 @@ module dynrt_processor__engine__result_line__long_source(clock,data_in,data_out)
         data_out = stage__7__q;
         data_out = stage__8__q;
         data_out = stage__9__q;
+        data_out = stage__10__q;
+        data_out = stage__11__q;
+        data_out = stage__12__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__long_source
@@ -14979,6 +15131,12 @@ module dynrt_processor__engine__result_line__long_source__stage__0(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__result_line__long_source__stage__0
+
+
+
+
+
+
 
 
 
@@ -15037,6 +15195,15 @@ module dynrt_processor__engine__result_line__long_thread(clock,data_in,data_out)
     reg  [4:0] stage__9__d;
     wire  [4:0] stage__9__q;
     reg  stage__9__clock;
+    reg  [4:0] stage__10__d;
+    wire  [4:0] stage__10__q;
+    reg  stage__10__clock;
+    reg  [4:0] stage__11__d;
+    wire  [4:0] stage__11__q;
+    reg  stage__11__clock;
+    reg  [4:0] stage__12__d;
+    wire  [4:0] stage__12__q;
+    reg  stage__12__clock;
     
     // Sub module instances
     dynrt_processor__engine__decode__t4 stage__0(
@@ -15089,6 +15256,21 @@ module dynrt_processor__engine__result_line__long_thread(clock,data_in,data_out)
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
+    dynrt_processor__engine__decode__t4 stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    dynrt_processor__engine__decode__t4 stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
+    dynrt_processor__engine__decode__t4 stage__12(
+        .d(stage__12__d),
+        .q(stage__12__q),
+        .clock(stage__12__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -15102,6 +15284,9 @@ module dynrt_processor__engine__result_line__long_thread(clock,data_in,data_out)
         stage__7__clock = clock;
         stage__8__clock = clock;
         stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__11__clock = clock;
+        stage__12__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -15112,6 +15297,9 @@ module dynrt_processor__engine__result_line__long_thread(clock,data_in,data_out)
         stage__7__d = stage__6__q;
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
+        stage__12__d = stage__11__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -15122,6 +15310,9 @@ module dynrt_processor__engine__result_line__long_thread(clock,data_in,data_out)
         data_out = stage__7__q;
         data_out = stage__8__q;
         data_out = stage__9__q;
+        data_out = stage__10__q;
+        data_out = stage__11__q;
+        data_out = stage__12__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__long_thread
@@ -15135,6 +15326,183 @@ endmodule // dynrt_processor__engine__result_line__long_thread
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__result_line__long_valid(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  data_in;
+    output reg  data_out;
+    
+    // Stub signals
+    reg  stage__0__d;
+    wire  stage__0__q;
+    reg  stage__0__clock;
+    reg  stage__1__d;
+    wire  stage__1__q;
+    reg  stage__1__clock;
+    reg  stage__2__d;
+    wire  stage__2__q;
+    reg  stage__2__clock;
+    reg  stage__3__d;
+    wire  stage__3__q;
+    reg  stage__3__clock;
+    reg  stage__4__d;
+    wire  stage__4__q;
+    reg  stage__4__clock;
+    reg  stage__5__d;
+    wire  stage__5__q;
+    reg  stage__5__clock;
+    reg  stage__6__d;
+    wire  stage__6__q;
+    reg  stage__6__clock;
+    reg  stage__7__d;
+    wire  stage__7__q;
+    reg  stage__7__clock;
+    reg  stage__8__d;
+    wire  stage__8__q;
+    reg  stage__8__clock;
+    reg  stage__9__d;
+    wire  stage__9__q;
+    reg  stage__9__clock;
+    reg  stage__10__d;
+    wire  stage__10__q;
+    reg  stage__10__clock;
+    reg  stage__11__d;
+    wire  stage__11__q;
+    reg  stage__11__clock;
+    reg  stage__12__d;
+    wire  stage__12__q;
+    reg  stage__12__clock;
+    
+    // Sub module instances
+    dynrt_processor__display__dark_d stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__display__dark_d stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__display__dark_d stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__display__dark_d stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__display__dark_d stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__display__dark_d stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__display__dark_d stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__display__dark_d stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__display__dark_d stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__display__dark_d stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__display__dark_d stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    dynrt_processor__display__dark_d stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
+    dynrt_processor__display__dark_d stage__12(
+        .d(stage__12__d),
+        .q(stage__12__q),
+        .clock(stage__12__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__11__clock = clock;
+        stage__12__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
+        stage__12__d = stage__11__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+        data_out = stage__11__q;
+        data_out = stage__12__q;
+    end
+    
+endmodule // dynrt_processor__engine__result_line__long_valid
 
 
 
@@ -15227,15 +15595,6 @@ module dynrt_processor__engine__result_line__pc_not_taken_line(clock,data_in,dat
     reg  [11:0] stage__7__d;
     wire  [11:0] stage__7__q;
     reg  stage__7__clock;
-    reg  [11:0] stage__8__d;
-    wire  [11:0] stage__8__q;
-    reg  stage__8__clock;
-    reg  [11:0] stage__9__d;
-    wire  [11:0] stage__9__q;
-    reg  stage__9__clock;
-    reg  [11:0] stage__10__d;
-    wire  [11:0] stage__10__q;
-    reg  stage__10__clock;
     
     // Sub module instances
     dynrt_processor__display__timing__col stage__0(
@@ -15278,21 +15637,6 @@ module dynrt_processor__engine__result_line__pc_not_taken_line(clock,data_in,dat
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor__display__timing__col stage__8(
-        .d(stage__8__d),
-        .q(stage__8__q),
-        .clock(stage__8__clock)
-    );
-    dynrt_processor__display__timing__col stage__9(
-        .d(stage__9__d),
-        .q(stage__9__q),
-        .clock(stage__9__clock)
-    );
-    dynrt_processor__display__timing__col stage__10(
-        .d(stage__10__d),
-        .q(stage__10__q),
-        .clock(stage__10__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -15304,9 +15648,6 @@ module dynrt_processor__engine__result_line__pc_not_taken_line(clock,data_in,dat
         stage__5__clock = clock;
         stage__6__clock = clock;
         stage__7__clock = clock;
-        stage__8__clock = clock;
-        stage__9__clock = clock;
-        stage__10__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -15315,9 +15656,6 @@ module dynrt_processor__engine__result_line__pc_not_taken_line(clock,data_in,dat
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        stage__8__d = stage__7__q;
-        stage__9__d = stage__8__q;
-        stage__10__d = stage__9__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -15326,48 +15664,9 @@ module dynrt_processor__engine__result_line__pc_not_taken_line(clock,data_in,dat
         data_out = stage__5__q;
         data_out = stage__6__q;
         data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__pc_not_taken_line
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 
 
 
@@ -15522,15 +15821,6 @@ module dynrt_processor__engine__result_line__source_line(clock,data_in,data_out)
     reg  [2:0] stage__7__d;
     wire  [2:0] stage__7__q;
     reg  stage__7__clock;
-    reg  [2:0] stage__8__d;
-    wire  [2:0] stage__8__q;
-    reg  stage__8__clock;
-    reg  [2:0] stage__9__d;
-    wire  [2:0] stage__9__q;
-    reg  stage__9__clock;
-    reg  [2:0] stage__10__d;
-    wire  [2:0] stage__10__q;
-    reg  stage__10__clock;
     
     // Sub module instances
     dynrt_processor__engine__result_line__long_source__stage__0 stage__0(
@@ -15573,21 +15863,6 @@ module dynrt_processor__engine__result_line__source_line(clock,data_in,data_out)
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor__engine__result_line__long_source__stage__0 stage__8(
-        .d(stage__8__d),
-        .q(stage__8__q),
-        .clock(stage__8__clock)
-    );
-    dynrt_processor__engine__result_line__long_source__stage__0 stage__9(
-        .d(stage__9__d),
-        .q(stage__9__q),
-        .clock(stage__9__clock)
-    );
-    dynrt_processor__engine__result_line__long_source__stage__0 stage__10(
-        .d(stage__10__d),
-        .q(stage__10__q),
-        .clock(stage__10__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -15599,9 +15874,6 @@ module dynrt_processor__engine__result_line__source_line(clock,data_in,data_out)
         stage__5__clock = clock;
         stage__6__clock = clock;
         stage__7__clock = clock;
-        stage__8__clock = clock;
-        stage__9__clock = clock;
-        stage__10__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -15610,9 +15882,6 @@ module dynrt_processor__engine__result_line__source_line(clock,data_in,data_out)
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        stage__8__d = stage__7__q;
-        stage__9__d = stage__8__q;
-        stage__10__d = stage__9__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -15621,18 +15890,9 @@ module dynrt_processor__engine__result_line__source_line(clock,data_in,data_out)
         data_out = stage__5__q;
         data_out = stage__6__q;
         data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__source_line
-
-
-
-
-
-
 
 
 
@@ -15687,15 +15947,6 @@ module dynrt_processor__engine__result_line__thread_line(clock,data_in,data_out)
     reg  [4:0] stage__7__d;
     wire  [4:0] stage__7__q;
     reg  stage__7__clock;
-    reg  [4:0] stage__8__d;
-    wire  [4:0] stage__8__q;
-    reg  stage__8__clock;
-    reg  [4:0] stage__9__d;
-    wire  [4:0] stage__9__q;
-    reg  stage__9__clock;
-    reg  [4:0] stage__10__d;
-    wire  [4:0] stage__10__q;
-    reg  stage__10__clock;
     
     // Sub module instances
     dynrt_processor__engine__decode__t4 stage__0(
@@ -15738,21 +15989,6 @@ module dynrt_processor__engine__result_line__thread_line(clock,data_in,data_out)
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor__engine__decode__t4 stage__8(
-        .d(stage__8__d),
-        .q(stage__8__q),
-        .clock(stage__8__clock)
-    );
-    dynrt_processor__engine__decode__t4 stage__9(
-        .d(stage__9__d),
-        .q(stage__9__q),
-        .clock(stage__9__clock)
-    );
-    dynrt_processor__engine__decode__t4 stage__10(
-        .d(stage__10__d),
-        .q(stage__10__q),
-        .clock(stage__10__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -15764,9 +16000,6 @@ module dynrt_processor__engine__result_line__thread_line(clock,data_in,data_out)
         stage__5__clock = clock;
         stage__6__clock = clock;
         stage__7__clock = clock;
-        stage__8__clock = clock;
-        stage__9__clock = clock;
-        stage__10__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
@@ -15775,9 +16008,6 @@ module dynrt_processor__engine__result_line__thread_line(clock,data_in,data_out)
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        stage__8__d = stage__7__q;
-        stage__9__d = stage__8__q;
-        stage__10__d = stage__9__q;
         data_out = stage__0__q;
         data_out = stage__1__q;
         data_out = stage__2__q;
@@ -15786,36 +16016,9 @@ module dynrt_processor__engine__result_line__thread_line(clock,data_in,data_out)
         data_out = stage__5__q;
         data_out = stage__6__q;
         data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
     end
     
 endmodule // dynrt_processor__engine__result_line__thread_line
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 
 
 
@@ -15917,7 +16120,7 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     localparam  c_thread_mask = 32'hffffffff;
     localparam  c_one = 32'h1;
     localparam  c_ones = 32'hffffffff;
-    localparam  c_reserve_bit = 32'h6;
+    localparam  c_reserve_bit = 32'h9;
     
     // Stub signals
     reg  tester_done_r__d;
@@ -16843,7 +17046,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  b_here__0;
     reg  b_here__1;
     reg  [31:0] fetch_a;
-    reg  fb_free;
+    reg  finishing;
+    reg  take_buf;
+    reg  take_free;
     reg  [1:0] l_kind;
     reg  [4:0] l_thread;
     reg  [31:0] l_a;
@@ -17401,7 +17606,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m2_b__q),
         .clock(m2_b__clock)
     );
-    dynrt_processor__engine__halted_count m2_done(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 m2_done(
         .d(m2_done__d),
         .q(m2_done__q),
         .clock(m2_done__clock)
@@ -17446,7 +17651,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m3_b__q),
         .clock(m3_b__clock)
     );
-    dynrt_processor__engine__halted_count m3_done(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 m3_done(
         .d(m3_done__d),
         .q(m3_done__q),
         .clock(m3_done__clock)
@@ -17842,26 +18047,29 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         b_line__4__d = b_line__3__q;
         a_line__5__d = a_line__4__q;
         b_line__5__d = b_line__4__q;
-        if (fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)))) begin
+        finishing = fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)));
+        if (finishing) begin
             fetching__d = 1'b0;
             fb__d = ~fb__q;
         end
-        fb_free = ~loaded__0__q;
-        if (fb__q) begin
-            fb_free = ~loaded__1__q;
+        take_buf = fb__q ^ finishing;
+        take_free = ~loaded__0__q;
+        if (take_buf) begin
+            take_free = ~loaded__1__q;
         end
-        if ((~fetching__q) & fb_free & list_unit__test_valid) begin
+        if (((~fetching__q) | finishing) & take_free & list_unit__test_valid) begin
             list_unit__test_take = 1'b1;
             a_issued__d = 32'h0;
             b_issued__d = 32'h0;
             fetching__d = 1'b1;
+            fb__d = take_buf;
             if (list_unit__test_entry[(32'h45)+:(2)] != c_test_triangle) begin
                 a_issued__d = 32'h6;
                 b_issued__d = 32'h6;
                 fetching__d = 1'b0;
-                fb__d = ~fb__q;
+                fb__d = ~take_buf;
             end
-            if (fb__q == c_buffer__0) begin
+            if (take_buf == c_buffer__0) begin
                 loaded__0__d = 1'b1;
                 cur_kind__0__d = list_unit__test_entry[(32'h45)+:(2)];
                 cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
@@ -17872,7 +18080,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
                     received__0__d = 32'hc;
                 end
             end
-            if (fb__q == c_buffer__1) begin
+            if (take_buf == c_buffer__1) begin
                 loaded__1__d = 1'b1;
                 cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
                 cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];
@@ -18772,12 +18980,12 @@ module dynrt_processor__engine__tester__intersect_unit(clock,in_valid,o__0,o__1,
         .data_in(operand_delay__5__data_in),
         .data_out(operand_delay__5__data_out)
     );
-    dynrt_processor__engine__fp_units__add_delay o_delay__0(
+    dynrt_processor__engine__tester__intersect_unit__o_delay__0 o_delay__0(
         .clock(o_delay__0__clock),
         .data_in(o_delay__0__data_in),
         .data_out(o_delay__0__data_out)
     );
-    dynrt_processor__engine__fp_units__add_delay o_delay__1(
+    dynrt_processor__engine__tester__intersect_unit__o_delay__0 o_delay__1(
         .clock(o_delay__1__clock),
         .data_in(o_delay__1__data_in),
         .data_out(o_delay__1__data_out)
@@ -18807,12 +19015,12 @@ module dynrt_processor__engine__tester__intersect_unit(clock,in_valid,o__0,o__1,
         .data_in(t_cmp_delay__1__data_in),
         .data_out(t_cmp_delay__1__data_out)
     );
-    dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0 uv_cmp_delay__0(
+    dynrt_processor__engine__result_line__halt_line uv_cmp_delay__0(
         .clock(uv_cmp_delay__0__clock),
         .data_in(uv_cmp_delay__0__data_in),
         .data_out(uv_cmp_delay__0__data_out)
     );
-    dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0 uv_cmp_delay__1(
+    dynrt_processor__engine__result_line__halt_line uv_cmp_delay__1(
         .clock(uv_cmp_delay__1__clock),
         .data_in(uv_cmp_delay__1__data_in),
         .data_out(uv_cmp_delay__1__data_out)
@@ -19706,6 +19914,66 @@ endmodule // dynrt_processor__engine__tester__intersect_unit
 
 
 
+module dynrt_processor__engine__tester__intersect_unit__o_delay__0(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [23:0] data_in;
+    output reg  [23:0] data_out;
+    
+    // Stub signals
+    reg  [23:0] stage__0__d;
+    wire  [23:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [23:0] stage__1__d;
+    wire  [23:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [23:0] stage__2__d;
+    wire  [23:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [23:0] stage__3__d;
+    wire  [23:0] stage__3__q;
+    reg  stage__3__clock;
+    
+    // Sub module instances
+    dynrt_processor__display__rgb_q stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__display__rgb_q stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__display__rgb_q stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__display__rgb_q stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+    end
+    
+endmodule // dynrt_processor__engine__tester__intersect_unit__o_delay__0
 
 
 
@@ -21168,110 +21436,6 @@ endmodule // dynrt_processor__engine__tester__intersect_unit__tag_delay_rest
 
 
 
-module dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0(clock,data_in,data_out);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  data_in;
-    output reg  data_out;
-    
-    // Stub signals
-    reg  stage__0__d;
-    wire  stage__0__q;
-    reg  stage__0__clock;
-    reg  stage__1__d;
-    wire  stage__1__q;
-    reg  stage__1__clock;
-    reg  stage__2__d;
-    wire  stage__2__q;
-    reg  stage__2__clock;
-    reg  stage__3__d;
-    wire  stage__3__q;
-    reg  stage__3__clock;
-    reg  stage__4__d;
-    wire  stage__4__q;
-    reg  stage__4__clock;
-    reg  stage__5__d;
-    wire  stage__5__q;
-    reg  stage__5__clock;
-    reg  stage__6__d;
-    wire  stage__6__q;
-    reg  stage__6__clock;
-    reg  stage__7__d;
-    wire  stage__7__q;
-    reg  stage__7__clock;
-    
-    // Sub module instances
-    dynrt_processor__display__dark_d stage__0(
-        .d(stage__0__d),
-        .q(stage__0__q),
-        .clock(stage__0__clock)
-    );
-    dynrt_processor__display__dark_d stage__1(
-        .d(stage__1__d),
-        .q(stage__1__q),
-        .clock(stage__1__clock)
-    );
-    dynrt_processor__display__dark_d stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
-    dynrt_processor__display__dark_d stage__3(
-        .d(stage__3__d),
-        .q(stage__3__q),
-        .clock(stage__3__clock)
-    );
-    dynrt_processor__display__dark_d stage__4(
-        .d(stage__4__d),
-        .q(stage__4__q),
-        .clock(stage__4__clock)
-    );
-    dynrt_processor__display__dark_d stage__5(
-        .d(stage__5__d),
-        .q(stage__5__q),
-        .clock(stage__5__clock)
-    );
-    dynrt_processor__display__dark_d stage__6(
-        .d(stage__6__d),
-        .q(stage__6__q),
-        .clock(stage__6__clock)
-    );
-    dynrt_processor__display__dark_d stage__7(
-        .d(stage__7__d),
-        .q(stage__7__q),
-        .clock(stage__7__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        stage__0__clock = clock;
-        stage__1__clock = clock;
-        stage__2__clock = clock;
-        stage__3__clock = clock;
-        stage__4__clock = clock;
-        stage__5__clock = clock;
-        stage__6__clock = clock;
-        stage__7__clock = clock;
-        stage__0__d = data_in;
-        stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        stage__3__d = stage__2__q;
-        stage__4__d = stage__3__q;
-        stage__5__d = stage__4__q;
-        stage__6__d = stage__5__q;
-        stage__7__d = stage__6__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-    end
-    
-endmodule // dynrt_processor__engine__tester__intersect_unit__uv_cmp_delay__0
 
 
 
@@ -23956,17 +24120,17 @@ module dynrt_processor__engine__tester__transform_unit(clock,in_valid,m__0,m__1,
         .out_valid(add__8__out_valid),
         .result(add__8__result)
     );
-    dynrt_processor__engine__fp_units__mul_delay p2_delay__0(
+    dynrt_processor__engine__tester__transform_unit__p2_delay__0 p2_delay__0(
         .clock(p2_delay__0__clock),
         .data_in(p2_delay__0__data_in),
         .data_out(p2_delay__0__data_out)
     );
-    dynrt_processor__engine__fp_units__mul_delay p2_delay__1(
+    dynrt_processor__engine__tester__transform_unit__p2_delay__0 p2_delay__1(
         .clock(p2_delay__1__clock),
         .data_in(p2_delay__1__data_in),
         .data_out(p2_delay__1__data_out)
     );
-    dynrt_processor__engine__fp_units__mul_delay p2_delay__2(
+    dynrt_processor__engine__tester__transform_unit__p2_delay__0 p2_delay__2(
         .clock(p2_delay__2__clock),
         .data_in(p2_delay__2__data_in),
         .data_out(p2_delay__2__data_out)
@@ -26039,6 +26203,110 @@ endmodule // dynrt_processor__engine__tester__transform_unit__offset_delay__0
 
 
 
+module dynrt_processor__engine__tester__transform_unit__p2_delay__0(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [23:0] data_in;
+    output reg  [23:0] data_out;
+    
+    // Stub signals
+    reg  [23:0] stage__0__d;
+    wire  [23:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [23:0] stage__1__d;
+    wire  [23:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [23:0] stage__2__d;
+    wire  [23:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [23:0] stage__3__d;
+    wire  [23:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [23:0] stage__4__d;
+    wire  [23:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [23:0] stage__5__d;
+    wire  [23:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [23:0] stage__6__d;
+    wire  [23:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [23:0] stage__7__d;
+    wire  [23:0] stage__7__q;
+    reg  stage__7__clock;
+    
+    // Sub module instances
+    dynrt_processor__display__rgb_q stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__display__rgb_q stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__display__rgb_q stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__display__rgb_q stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__display__rgb_q stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__display__rgb_q stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__display__rgb_q stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__display__rgb_q stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+    end
+    
+endmodule // dynrt_processor__engine__tester__transform_unit__p2_delay__0
 
 
 
@@ -27712,27 +27980,27 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .out_valid(div__out_valid),
         .result(div__result)
     );
-    dynrt_processor__engine__fp_units__mul_delay o_delay__0(
+    dynrt_processor__engine__tester__transform_unit__p2_delay__0 o_delay__0(
         .clock(o_delay__0__clock),
         .data_in(o_delay__0__data_in),
         .data_out(o_delay__0__data_out)
     );
-    dynrt_processor__engine__fp_units__mul_delay o_delay__1(
+    dynrt_processor__engine__tester__transform_unit__p2_delay__0 o_delay__1(
         .clock(o_delay__1__clock),
         .data_in(o_delay__1__data_in),
         .data_out(o_delay__1__data_out)
     );
-    dynrt_processor__engine__fp_units__mul_delay o_delay__2(
+    dynrt_processor__engine__tester__transform_unit__p2_delay__0 o_delay__2(
         .clock(o_delay__2__clock),
         .data_in(o_delay__2__data_in),
         .data_out(o_delay__2__data_out)
     );
-    dynrt_processor__engine__fp_units__mul_delay o_delay__3(
+    dynrt_processor__engine__tester__transform_unit__p2_delay__0 o_delay__3(
         .clock(o_delay__3__clock),
         .data_in(o_delay__3__data_in),
         .data_out(o_delay__3__data_out)
     );
-    dynrt_processor__engine__fp_units__mul_delay o_delay__4(
+    dynrt_processor__engine__tester__transform_unit__p2_delay__0 o_delay__4(
         .clock(o_delay__4__clock),
         .data_in(o_delay__4__data_in),
         .data_out(o_delay__4__data_out)
@@ -30647,7 +30915,7 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
         .q(thread_r__q),
         .clock(thread_r__clock)
     );
-    dynrt_processor__engine__halted_count dst_r(
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 dst_r(
         .d(dst_r__d),
         .q(dst_r__q),
         .clock(dst_r__clock)

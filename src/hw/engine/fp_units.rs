@@ -4,12 +4,13 @@
 //!
 //! Contract: operands `a`, `b` (and `sub` for `fsub`) given at I5 come out at the write back,
 //! [`super::ENGINE_LATENCY`] clocks later: `sum`, `product`, the compare flags `lt`, `le`,
-//! `eq`, `byte` (`ChannelByte`); `quotient` and `root` come
+//! `eq`; `quotient`, `root` and `colour_byte` (`ChannelByte`) come
 //! [`super::long_latency`]`(M)` clocks later, the clock the long line writes them back. Every
 //! unit takes an input every clock whether the instruction uses it or not; the write back
 //! picks the one its opcode names.
 //!
-//! Latency: `ENGINE_LATENCY` (12) clocks (`quotient`, `root`: `M + 6`). Throughput: one
+//! Latency: `ENGINE_LATENCY` (9) clocks (`quotient`, `root`, `colour_byte`: `M + 6`).
+//! Throughput: one
 //! operation per clock.
 //!
 //! Golden twin: each operator's own (`Format::add`, `sub`, `mul`, `div`, `sqrt`, `lt`, `le`,
@@ -25,7 +26,7 @@ use crate::hw::fp::compare::COMPARE_LATENCY;
 use crate::hw::fp::div::div_latency;
 use crate::hw::fp::mul::MUL_LATENCY;
 use crate::hw::fp::{FpAddSub, FpCompare, FpDiv, FpMul, FpSqrt};
-use crate::hw::ChannelByte;
+use crate::hw::{ChannelByte, CHANNEL_BYTE_LATENCY};
 
 /// Each delay brings its unit's result to the write back at `ENGINE_LATENCY`.
 const ADD_DELAY: usize = (ENGINE_LATENCY - ADD_SUB_LATENCY) as usize;
@@ -73,15 +74,15 @@ pub struct FpUnits<
     cmp_a: DFF<Bits<W>>,
     cmp_b: DFF<Bits<W>>,
     byte_unit: ChannelByte<W, E, M, S, S1, X2, T, P>,
-    // Each delay brings its unit's result to the write back at `ENGINE_LATENCY` (12): 12 - 8
-    // for the adder, 12 - 4 for the multiplier, 12 - 1 - 2 for the comparator; the square root
+    // Each delay brings its unit's result to the write back at `ENGINE_LATENCY` (9): 9 - 8
+    // for the adder, 9 - 4 for the multiplier, 9 - 1 - 2 for the comparator; the square root
     // (`M + 5`) writes back one clock later, at `long_latency`, the divider (`div_latency`)
-    // as many later as that takes. `ChannelByte` takes
-    // the 12 clocks itself (`ENGINE_LATENCY` is its latency).
+    // and `ChannelByte` (12) as many later as that takes.
     add_delay: crate::hw::Delay<Bits<W>, ADD_DELAY>,
     mul_delay: crate::hw::Delay<Bits<W>, MUL_DELAY>,
     div_delay: crate::hw::DelayLine<Bits<W>>,
     sqrt_delay: crate::hw::Delay<Bits<W>, 1>,
+    byte_delay: crate::hw::DelayLine<Bits<8>>,
     lt_delay: crate::hw::Delay<Bit, CMP_DELAY>,
     le_delay: crate::hw::Delay<Bit, CMP_DELAY>,
     eq_delay: crate::hw::Delay<Bit, CMP_DELAY>,
@@ -125,6 +126,9 @@ impl<
             div_delay: crate::hw::DelayLine::new(
                 (super::long_latency(M as u32) - div_latency(M as u32)) as usize,
             ),
+            byte_delay: crate::hw::DelayLine::new(
+                (super::long_latency(M as u32) - CHANNEL_BYTE_LATENCY) as usize,
+            ),
             sqrt_delay: Default::default(),
             lt_delay: Default::default(),
             le_delay: Default::default(),
@@ -148,7 +152,7 @@ impl<
     fn update(&mut self) {
         clock!(
             self, clock, add, mul, div, sqrt, cmp, cmp_a, cmp_b, byte_unit, add_delay, mul_delay,
-            div_delay, sqrt_delay, lt_delay, le_delay, eq_delay
+            div_delay, sqrt_delay, byte_delay, lt_delay, le_delay, eq_delay
         );
         self.add.a.next = self.a.val();
         self.add.b.next = self.b.val();
@@ -184,6 +188,7 @@ impl<
         self.lt.next = self.lt_delay.data_out.val();
         self.le.next = self.le_delay.data_out.val();
         self.eq.next = self.eq_delay.data_out.val();
-        self.colour_byte.next = self.byte_unit.result.val();
+        self.byte_delay.data_in.next = self.byte_unit.result.val();
+        self.colour_byte.next = self.byte_delay.data_out.val();
     }
 }

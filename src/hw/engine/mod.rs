@@ -2,14 +2,14 @@
 //! 32 ray threads, one instruction per clock, on pipelined floating-point units.
 //!
 //! A scheduler issues one ready thread per clock, round robin. An instruction writes back
-//! exactly [`ENGINE_LATENCY`] (12) clocks after its operands are read, `fdiv` and `fsqrt`
-//! [`long_latency`] (`M + 6`) clocks after, and a thread is ready again only at its write
+//! exactly [`ENGINE_LATENCY`] (9) clocks after its operands are read, `fdiv`, `fsqrt` and
+//! `byte` [`long_latency`] (`M + 6`) clocks after, and a thread is ready again only at its write
 //! back, so there is no hazard, stall or forwarding logic: memory and unit latency are hidden
 //! by the other threads (the paper's 32 threads). A long instruction reserves its write-back
 //! clock: the scheduler issues nothing in the one clock whose instruction would write back
-//! with it (one bubble per `fdiv` or `fsqrt`). A thread issues at most once per `period =
-//! OPERAND_STAGE + ENGINE_LATENCY + WAKE_UP` (20) clocks (`engine_period`). A thread whose coprocessor wait (`tri.wait`,
-//! `kd.wait`) is still pending sleeps: it is not ready until the coprocessor finishes work for
+//! with it (one bubble per `fdiv`, `fsqrt` or `byte`). A thread issues at most once per
+//! `period = OPERAND_STAGE + ENGINE_LATENCY + WAKE_UP` (17) clocks (`engine_period`). A thread
+//! whose coprocessor wait (`tri.wait`, `kd.wait`) is still pending sleeps: it is not ready until the coprocessor finishes work for
 //! it, so the clocks it waits go to the other threads (an offer to a full queue repeats at
 //! once).
 //!
@@ -33,7 +33,7 @@
 //!   a sleep for a wait).
 //! - I6..: the [`ResultLine`] decodes the opcode at I6; scratch data joins at I6, the mailbox
 //!   hit at I7, memory data at I6 + `mem_latency`.
-//! - I5 + 12 (`I5 + M + 6` for `fdiv`, `fsqrt`, which go on in the long line): the
+//! - I5 + 9 (`I5 + M + 6` for `fdiv`, `fsqrt`, `byte`, which go on in the long line): the
 //!   [`WriteBack`] chooses, and a clock later writes, the register and the next pc: `target`
 //!   when the condition differs from `invert` (a non-branching instruction's condition is
 //!   false, so its `invert` is a jump after it), else `pc + 1`; the condition comes from the
@@ -78,11 +78,12 @@
 
 use rust_hdl::prelude::*;
 
+use super::fp::add_sub::ADD_SUB_LATENCY;
 use super::list_unit;
 use super::ports::{BankedSramRead, FrameBufferWrite, SramRead, SHARED_BUS_BANKS};
 use super::program::isa::{KdFn, Op, TriFn, PC_BITS};
 use super::program::Program;
-use super::{TraversalUnit, TriangleTester, CHANNEL_BYTE_LATENCY};
+use super::{TraversalUnit, TriangleTester};
 use crate::layout;
 
 mod decode;
@@ -120,12 +121,16 @@ pub const MAX_MEM_LATENCY: u32 = 6;
 /// Scratch words per thread the engine provides.
 pub const SCRATCH_WORDS: u32 = 128;
 
-/// Clocks from operand read to write back of every instruction but `fdiv` and `fsqrt`: the
-/// longest of them is `byte` ([`CHANNEL_BYTE_LATENCY`]; `fadd` takes 8, loads at most 8).
-pub const ENGINE_LATENCY: u32 = CHANNEL_BYTE_LATENCY;
+/// Clocks from operand read to write back of every instruction but the long ones (`fdiv`,
+/// `fsqrt`, `byte`): the adder's 8 and a register (loads join by the eighth clock). `byte`
+/// ([`CHANNEL_BYTE_LATENCY`](crate::hw::CHANNEL_BYTE_LATENCY), 12) went into the long line at stop 38, which cut every other
+/// instruction's turn from 20 clocks to 17 at the cost of a reserved clock per `byte` (three
+/// per pixel).
+pub const ENGINE_LATENCY: u32 = ADD_SUB_LATENCY + 1;
 
-/// Clocks from operand read to write back of `fdiv` and `fsqrt` for mantissa width `m` (the
-/// square root's `m + 5`, plus one register; the faster divider's result waits for it).
+/// Clocks from operand read to write back of `fdiv`, `fsqrt` and `byte` for mantissa width
+/// `m` (the square root's `m + 5`, plus one register; the divider's and the colour unit's
+/// results wait for it).
 pub const fn long_latency(m: u32) -> u32 {
     m + 6
 }
@@ -330,6 +335,7 @@ pub struct ThreadEngine<
     op_fsub: Constant<Bits<5>>,
     op_fdiv: Constant<Bits<5>>,
     op_fsqrt: Constant<Bits<5>>,
+    op_byte: Constant<Bits<5>>,
     op_ld: Constant<Bits<5>>,
     op_st: Constant<Bits<5>>,
     op_sts: Constant<Bits<5>>,
@@ -485,6 +491,7 @@ impl<
             op_fsub: op_code(Op::FSub),
             op_fdiv: op_code(Op::FDiv),
             op_fsqrt: op_code(Op::FSqrt),
+            op_byte: op_code(Op::Byte),
             op_ld: op_code(Op::Ld),
             op_st: op_code(Op::St),
             op_sts: op_code(Op::Sts),
@@ -645,7 +652,8 @@ impl<
         self.decode.aux_i3.next = self.fetch.aux.val();
         self.scheduler.long_at_i3.next = self.fetch.valid.val()
             & ((self.decode.op_i3.val() == self.op_fdiv.val())
-                | (self.decode.op_i3.val() == self.op_fsqrt.val()));
+                | (self.decode.op_i3.val() == self.op_fsqrt.val())
+                | (self.decode.op_i3.val() == self.op_byte.val()));
 
         // I4: the per-thread state the units read one clock ahead of the operands.
         self.mailboxes.read_thread.next = self.decode.thread_i4.val();

@@ -2,9 +2,9 @@
 //! pcs, its conditions and its fast result, into which scratch and memory data join on the
 //! way. `fdiv` and `fsqrt` go on from there through a long line of `DX` more clocks.
 //!
-//! Contract: what enters at I5 leaves at the write back [`super::ENGINE_LATENCY`] (12) clocks
-//! later; a long instruction's control and pc leave `DX = long_latency - ENGINE_LATENCY`
-//! clocks later still (the scheduler reserved that clock, so no other instruction leaves with
+//! Contract: what enters at I5 leaves at the write back [`super::ENGINE_LATENCY`] (9) clocks
+//! later; a long instruction's (`fdiv`, `fsqrt`, `byte`) control, pc and fast result (`byte`'s
+//! `b << 8`) leave `DX = long_latency - ENGINE_LATENCY` clocks later still (the scheduler reserved that clock, so no other instruction leaves with
 //! it). The fast result of `lds` is replaced by the scratch word one clock after I5, that of
 //! `ld` by the word of its bank's port `mem_latency` clocks after the request (which leaves
 //! the engine one clock after I5).
@@ -20,7 +20,8 @@
 //! pending coprocessor instruction (the thread repeats it on its next turn), which does not
 //! retire. A long instruction never branches (both of its pcs are the same).
 //!
-//! Latency: 12 clocks (`fdiv`, `fsqrt`: `12 + DX`). Throughput: one instruction per clock.
+//! Latency: 9 clocks (`fdiv`, `fsqrt`, `byte`: `9 + DX`). Throughput: one instruction per
+//! clock.
 //!
 //! Golden twin: none (it computes nothing); the engine's twin `hw::program::exec` sees every
 //! result at once, and the frames' equality checks that the line keeps each result with its
@@ -37,7 +38,7 @@ use crate::hw::Delay;
 /// more follow.
 const FAST_STAGES: usize = 8;
 /// Registers of the fast line after the last join, up to the write back.
-const TAIL: usize = 4;
+const TAIL: usize = 1;
 /// Clocks from I5 to the write back.
 const LINE: usize = FAST_STAGES + TAIL;
 /// Clocks from I6 (the decode) and from I7 (the mailbox hit) to the write back.
@@ -132,13 +133,15 @@ pub struct ResultLine<const DX: usize> {
     fast_line: [DFF<Bits<32>>; FAST_STAGES],
     kind_line: [DFF<FastKind>; FAST_STAGES],
     fast_tail: Delay<Bits<32>, TAIL>,
-    /// The long line of `fdiv` and `fsqrt`.
+    /// The long line of `fdiv`, `fsqrt` and `byte`.
     long_valid: Delay<Bit, DX>,
     long_dst: Delay<Bits<REG_BITS>, DX>,
     long_thread: Delay<Bits<5>, DX>,
     long_write: Delay<Bit, DX>,
     long_source: Delay<ResultSource, DX>,
     long_pc: Delay<Bits<PC_BITS>, DX>,
+    /// `byte`'s fast result (`b << 8`), which the colour unit's byte joins at the write back.
+    long_fast: Delay<Bits<32>, DX>,
 
     c_mem_latency: Constant<Bits<8>>,
     c_index: [Constant<Bits<8>>; FAST_STAGES],
@@ -249,6 +252,7 @@ impl<const DX: usize> ResultLine<DX> {
             long_write: Default::default(),
             long_source: Default::default(),
             long_pc: Default::default(),
+            long_fast: Default::default(),
             c_mem_latency: Constant::new(u64::from(mem_latency).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
             op_fadd: op_code(Op::FAdd),
@@ -328,7 +332,8 @@ impl<const DX: usize> Logic for ResultLine<DX> {
             long_thread,
             long_write,
             long_source,
-            long_pc
+            long_pc,
+            long_fast
         );
         for k in 0..8 {
             self.fast_line[k].clock.next = self.clock.val();
@@ -354,7 +359,8 @@ impl<const DX: usize> Logic for ResultLine<DX> {
 
         // I6: decode.
         self.is_long.next = (self.op_i6.q.val() == self.op_fdiv.val())
-            | (self.op_i6.q.val() == self.op_fsqrt.val());
+            | (self.op_i6.q.val() == self.op_fsqrt.val())
+            | (self.op_i6.q.val() == self.op_byte.val());
         self.is_mbx.next = self.op_i6.q.val() == self.op_mbx.val();
         self.halts.next = self.op_i6.q.val() == self.op_halt.val();
         // A coprocessor refused the entry (queue full) or has not finished (a wait); ray
@@ -455,7 +461,7 @@ impl<const DX: usize> Logic for ResultLine<DX> {
         }
         self.fast_tail.data_in.next = self.fast_line[7].q.val();
 
-        // `fdiv` and `fsqrt` go on into the long line and leave from there.
+        // `fdiv`, `fsqrt` and `byte` go on into the long line and leave from there.
         self.long_valid.data_in.next =
             self.valid_line.data_out.val() & self.is_long_line.data_out.val();
         self.long_dst.data_in.next = self.dst_line.data_out.val();
@@ -463,6 +469,7 @@ impl<const DX: usize> Logic for ResultLine<DX> {
         self.long_write.data_in.next = self.write_line.data_out.val();
         self.long_source.data_in.next = self.source_line.data_out.val();
         self.long_pc.data_in.next = self.pc_not_taken_line.data_out.val();
+        self.long_fast.data_in.next = self.fast_tail.data_out.val();
         if self.long_valid.data_out.val() {
             self.retiring.valid.next = true;
             self.retiring.dst.next = self.long_dst.data_out.val();
@@ -498,5 +505,8 @@ impl<const DX: usize> Logic for ResultLine<DX> {
             self.retiring.wait_pending.next = self.wait_pending_line.data_out.val();
         }
         self.retiring.fast.next = self.fast_tail.data_out.val();
+        if self.long_valid.data_out.val() {
+            self.retiring.fast.next = self.long_fast.data_out.val();
+        }
     }
 }
