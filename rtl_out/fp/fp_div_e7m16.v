@@ -36,6 +36,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
     localparam  c_extra_sig = 8'h2;
     localparam  c_extra_mask = 24'h1;
     localparam  c_rem_mask = 24'h3ffff;
+    localparam  c_d3_mask = 24'h7ffff;
     
     // Stub signals
     reg  [23:0] in_a__d;
@@ -1040,7 +1041,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         end
         quo__0__d = c_one;
         divisor__0__d = ((sig_b) & 24'hffffff);
-        divisor3__0__d = ((sig_b) & 24'hffffff) + (((sig_b) & 24'hffffff) << 32'h1);
+        divisor3__0__d = (((sig_b) & 24'hffffff) + (((sig_b) & 24'hffffff) << 32'h1)) & c_d3_mask;
         exp__0__d = (((exp_a) & 9'h1ff) - ((exp_b) & 9'h1ff)) + c_bias;
         if (a_below_b) begin
             exp__0__d = (((exp_a) & 9'h1ff) - ((exp_b) & 9'h1ff)) + c_bias_less_one;
@@ -1050,8 +1051,8 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         inf__0__d = inf_a | zero_b;
         zero__0__d = zero_a | inf_b;
         valid__0__d = in_valid_r__q;
-        if (rem__0__q >= divisor__0__q) begin
-            if ((rem__0__q << 32'h1) >= divisor3__0__q) begin
+        if (~|((rem__0__q - divisor__0__q) >> c_sign_pos)) begin
+            if (~|(((rem__0__q << 32'h1) - divisor3__0__q) >> c_sign_pos)) begin
                 rem__1__d = (((rem__0__q << 32'h1) - divisor3__0__q) << 32'h1) & c_rem_mask;
                 quo__1__d = (quo__0__q << 32'h2) | c_three;
             end
@@ -1060,7 +1061,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
                 quo__1__d = (quo__0__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__0__q << 32'h1) >= divisor__0__q) begin
+        else if (~|(((rem__0__q << 32'h1) - divisor__0__q) >> c_sign_pos)) begin
             rem__1__d = (((rem__0__q << 32'h1) - divisor__0__q) << 32'h1) & c_rem_mask;
             quo__1__d = (quo__0__q << 32'h2) | c_one;
         end
@@ -1076,8 +1077,8 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         inf__1__d = inf__0__q;
         zero__1__d = zero__0__q;
         valid__1__d = valid__0__q;
-        if (rem__1__q >= divisor__1__q) begin
-            if ((rem__1__q << 32'h1) >= divisor3__1__q) begin
+        if (~|((rem__1__q - divisor__1__q) >> c_sign_pos)) begin
+            if (~|(((rem__1__q << 32'h1) - divisor3__1__q) >> c_sign_pos)) begin
                 rem__2__d = (((rem__1__q << 32'h1) - divisor3__1__q) << 32'h1) & c_rem_mask;
                 quo__2__d = (quo__1__q << 32'h2) | c_three;
             end
@@ -1086,7 +1087,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
                 quo__2__d = (quo__1__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__1__q << 32'h1) >= divisor__1__q) begin
+        else if (~|(((rem__1__q << 32'h1) - divisor__1__q) >> c_sign_pos)) begin
             rem__2__d = (((rem__1__q << 32'h1) - divisor__1__q) << 32'h1) & c_rem_mask;
             quo__2__d = (quo__1__q << 32'h2) | c_one;
         end
@@ -1102,8 +1103,8 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         inf__2__d = inf__1__q;
         zero__2__d = zero__1__q;
         valid__2__d = valid__1__q;
-        if (rem__2__q >= divisor__2__q) begin
-            if ((rem__2__q << 32'h1) >= divisor3__2__q) begin
+        if (~|((rem__2__q - divisor__2__q) >> c_sign_pos)) begin
+            if (~|(((rem__2__q << 32'h1) - divisor3__2__q) >> c_sign_pos)) begin
                 rem__3__d = (((rem__2__q << 32'h1) - divisor3__2__q) << 32'h1) & c_rem_mask;
                 quo__3__d = (quo__2__q << 32'h2) | c_three;
             end
@@ -1112,7 +1113,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
                 quo__3__d = (quo__2__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__2__q << 32'h1) >= divisor__2__q) begin
+        else if (~|(((rem__2__q << 32'h1) - divisor__2__q) >> c_sign_pos)) begin
             rem__3__d = (((rem__2__q << 32'h1) - divisor__2__q) << 32'h1) & c_rem_mask;
             quo__3__d = (quo__2__q << 32'h2) | c_one;
         end
@@ -1128,8 +1129,8 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         inf__3__d = inf__2__q;
         zero__3__d = zero__2__q;
         valid__3__d = valid__2__q;
-        if (rem__3__q >= divisor__3__q) begin
-            if ((rem__3__q << 32'h1) >= divisor3__3__q) begin
+        if (~|((rem__3__q - divisor__3__q) >> c_sign_pos)) begin
+            if (~|(((rem__3__q << 32'h1) - divisor3__3__q) >> c_sign_pos)) begin
                 rem__4__d = (((rem__3__q << 32'h1) - divisor3__3__q) << 32'h1) & c_rem_mask;
                 quo__4__d = (quo__3__q << 32'h2) | c_three;
             end
@@ -1138,7 +1139,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
                 quo__4__d = (quo__3__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__3__q << 32'h1) >= divisor__3__q) begin
+        else if (~|(((rem__3__q << 32'h1) - divisor__3__q) >> c_sign_pos)) begin
             rem__4__d = (((rem__3__q << 32'h1) - divisor__3__q) << 32'h1) & c_rem_mask;
             quo__4__d = (quo__3__q << 32'h2) | c_one;
         end
@@ -1154,8 +1155,8 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         inf__4__d = inf__3__q;
         zero__4__d = zero__3__q;
         valid__4__d = valid__3__q;
-        if (rem__4__q >= divisor__4__q) begin
-            if ((rem__4__q << 32'h1) >= divisor3__4__q) begin
+        if (~|((rem__4__q - divisor__4__q) >> c_sign_pos)) begin
+            if (~|(((rem__4__q << 32'h1) - divisor3__4__q) >> c_sign_pos)) begin
                 rem__5__d = (((rem__4__q << 32'h1) - divisor3__4__q) << 32'h1) & c_rem_mask;
                 quo__5__d = (quo__4__q << 32'h2) | c_three;
             end
@@ -1164,7 +1165,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
                 quo__5__d = (quo__4__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__4__q << 32'h1) >= divisor__4__q) begin
+        else if (~|(((rem__4__q << 32'h1) - divisor__4__q) >> c_sign_pos)) begin
             rem__5__d = (((rem__4__q << 32'h1) - divisor__4__q) << 32'h1) & c_rem_mask;
             quo__5__d = (quo__4__q << 32'h2) | c_one;
         end
@@ -1180,8 +1181,8 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         inf__5__d = inf__4__q;
         zero__5__d = zero__4__q;
         valid__5__d = valid__4__q;
-        if (rem__5__q >= divisor__5__q) begin
-            if ((rem__5__q << 32'h1) >= divisor3__5__q) begin
+        if (~|((rem__5__q - divisor__5__q) >> c_sign_pos)) begin
+            if (~|(((rem__5__q << 32'h1) - divisor3__5__q) >> c_sign_pos)) begin
                 rem__6__d = (((rem__5__q << 32'h1) - divisor3__5__q) << 32'h1) & c_rem_mask;
                 quo__6__d = (quo__5__q << 32'h2) | c_three;
             end
@@ -1190,7 +1191,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
                 quo__6__d = (quo__5__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__5__q << 32'h1) >= divisor__5__q) begin
+        else if (~|(((rem__5__q << 32'h1) - divisor__5__q) >> c_sign_pos)) begin
             rem__6__d = (((rem__5__q << 32'h1) - divisor__5__q) << 32'h1) & c_rem_mask;
             quo__6__d = (quo__5__q << 32'h2) | c_one;
         end
@@ -1206,8 +1207,8 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         inf__6__d = inf__5__q;
         zero__6__d = zero__5__q;
         valid__6__d = valid__5__q;
-        if (rem__6__q >= divisor__6__q) begin
-            if ((rem__6__q << 32'h1) >= divisor3__6__q) begin
+        if (~|((rem__6__q - divisor__6__q) >> c_sign_pos)) begin
+            if (~|(((rem__6__q << 32'h1) - divisor3__6__q) >> c_sign_pos)) begin
                 rem__7__d = (((rem__6__q << 32'h1) - divisor3__6__q) << 32'h1) & c_rem_mask;
                 quo__7__d = (quo__6__q << 32'h2) | c_three;
             end
@@ -1216,7 +1217,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
                 quo__7__d = (quo__6__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__6__q << 32'h1) >= divisor__6__q) begin
+        else if (~|(((rem__6__q << 32'h1) - divisor__6__q) >> c_sign_pos)) begin
             rem__7__d = (((rem__6__q << 32'h1) - divisor__6__q) << 32'h1) & c_rem_mask;
             quo__7__d = (quo__6__q << 32'h2) | c_one;
         end
@@ -1232,8 +1233,8 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         inf__7__d = inf__6__q;
         zero__7__d = zero__6__q;
         valid__7__d = valid__6__q;
-        if (rem__7__q >= divisor__7__q) begin
-            if ((rem__7__q << 32'h1) >= divisor3__7__q) begin
+        if (~|((rem__7__q - divisor__7__q) >> c_sign_pos)) begin
+            if (~|(((rem__7__q << 32'h1) - divisor3__7__q) >> c_sign_pos)) begin
                 rem__8__d = (((rem__7__q << 32'h1) - divisor3__7__q) << 32'h1) & c_rem_mask;
                 quo__8__d = (quo__7__q << 32'h2) | c_three;
             end
@@ -1242,7 +1243,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
                 quo__8__d = (quo__7__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__7__q << 32'h1) >= divisor__7__q) begin
+        else if (~|(((rem__7__q << 32'h1) - divisor__7__q) >> c_sign_pos)) begin
             rem__8__d = (((rem__7__q << 32'h1) - divisor__7__q) << 32'h1) & c_rem_mask;
             quo__8__d = (quo__7__q << 32'h2) | c_one;
         end
@@ -1258,8 +1259,8 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
         inf__8__d = inf__7__q;
         zero__8__d = zero__7__q;
         valid__8__d = valid__7__q;
-        if (rem__8__q >= divisor__8__q) begin
-            if ((rem__8__q << 32'h1) >= divisor3__8__q) begin
+        if (~|((rem__8__q - divisor__8__q) >> c_sign_pos)) begin
+            if (~|(((rem__8__q << 32'h1) - divisor3__8__q) >> c_sign_pos)) begin
                 last_full = (quo__8__q << 32'h2) | c_three;
                 last_rest = (rem__8__q << 32'h1) != divisor3__8__q;
             end
@@ -1268,7 +1269,7 @@ module fp_div_e7m16_core(clock,in_valid,a,b,out_valid,result);
                 last_rest = rem__8__q != divisor__8__q;
             end
         end
-        else if ((rem__8__q << 32'h1) >= divisor__8__q) begin
+        else if (~|(((rem__8__q << 32'h1) - divisor__8__q) >> c_sign_pos)) begin
             last_full = (quo__8__q << 32'h2) | c_one;
             last_rest = (rem__8__q << 32'h1) != divisor__8__q;
         end

@@ -6027,6 +6027,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
     localparam  c_extra_sig = 8'h2;
     localparam  c_extra_mask = 24'h1;
     localparam  c_rem_mask = 24'h3ffff;
+    localparam  c_d3_mask = 24'h7ffff;
     
     // Stub signals
     reg  [23:0] in_a__d;
@@ -7031,7 +7032,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         end
         quo__0__d = c_one;
         divisor__0__d = ((sig_b) & 24'hffffff);
-        divisor3__0__d = ((sig_b) & 24'hffffff) + (((sig_b) & 24'hffffff) << 32'h1);
+        divisor3__0__d = (((sig_b) & 24'hffffff) + (((sig_b) & 24'hffffff) << 32'h1)) & c_d3_mask;
         exp__0__d = (((exp_a) & 9'h1ff) - ((exp_b) & 9'h1ff)) + c_bias;
         if (a_below_b) begin
             exp__0__d = (((exp_a) & 9'h1ff) - ((exp_b) & 9'h1ff)) + c_bias_less_one;
@@ -7041,8 +7042,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         inf__0__d = inf_a | zero_b;
         zero__0__d = zero_a | inf_b;
         valid__0__d = in_valid_r__q;
-        if (rem__0__q >= divisor__0__q) begin
-            if ((rem__0__q << 32'h1) >= divisor3__0__q) begin
+        if (~|((rem__0__q - divisor__0__q) >> c_sign_pos)) begin
+            if (~|(((rem__0__q << 32'h1) - divisor3__0__q) >> c_sign_pos)) begin
                 rem__1__d = (((rem__0__q << 32'h1) - divisor3__0__q) << 32'h1) & c_rem_mask;
                 quo__1__d = (quo__0__q << 32'h2) | c_three;
             end
@@ -7051,7 +7052,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
                 quo__1__d = (quo__0__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__0__q << 32'h1) >= divisor__0__q) begin
+        else if (~|(((rem__0__q << 32'h1) - divisor__0__q) >> c_sign_pos)) begin
             rem__1__d = (((rem__0__q << 32'h1) - divisor__0__q) << 32'h1) & c_rem_mask;
             quo__1__d = (quo__0__q << 32'h2) | c_one;
         end
@@ -7067,8 +7068,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         inf__1__d = inf__0__q;
         zero__1__d = zero__0__q;
         valid__1__d = valid__0__q;
-        if (rem__1__q >= divisor__1__q) begin
-            if ((rem__1__q << 32'h1) >= divisor3__1__q) begin
+        if (~|((rem__1__q - divisor__1__q) >> c_sign_pos)) begin
+            if (~|(((rem__1__q << 32'h1) - divisor3__1__q) >> c_sign_pos)) begin
                 rem__2__d = (((rem__1__q << 32'h1) - divisor3__1__q) << 32'h1) & c_rem_mask;
                 quo__2__d = (quo__1__q << 32'h2) | c_three;
             end
@@ -7077,7 +7078,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
                 quo__2__d = (quo__1__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__1__q << 32'h1) >= divisor__1__q) begin
+        else if (~|(((rem__1__q << 32'h1) - divisor__1__q) >> c_sign_pos)) begin
             rem__2__d = (((rem__1__q << 32'h1) - divisor__1__q) << 32'h1) & c_rem_mask;
             quo__2__d = (quo__1__q << 32'h2) | c_one;
         end
@@ -7093,8 +7094,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         inf__2__d = inf__1__q;
         zero__2__d = zero__1__q;
         valid__2__d = valid__1__q;
-        if (rem__2__q >= divisor__2__q) begin
-            if ((rem__2__q << 32'h1) >= divisor3__2__q) begin
+        if (~|((rem__2__q - divisor__2__q) >> c_sign_pos)) begin
+            if (~|(((rem__2__q << 32'h1) - divisor3__2__q) >> c_sign_pos)) begin
                 rem__3__d = (((rem__2__q << 32'h1) - divisor3__2__q) << 32'h1) & c_rem_mask;
                 quo__3__d = (quo__2__q << 32'h2) | c_three;
             end
@@ -7103,7 +7104,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
                 quo__3__d = (quo__2__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__2__q << 32'h1) >= divisor__2__q) begin
+        else if (~|(((rem__2__q << 32'h1) - divisor__2__q) >> c_sign_pos)) begin
             rem__3__d = (((rem__2__q << 32'h1) - divisor__2__q) << 32'h1) & c_rem_mask;
             quo__3__d = (quo__2__q << 32'h2) | c_one;
         end
@@ -7119,8 +7120,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         inf__3__d = inf__2__q;
         zero__3__d = zero__2__q;
         valid__3__d = valid__2__q;
-        if (rem__3__q >= divisor__3__q) begin
-            if ((rem__3__q << 32'h1) >= divisor3__3__q) begin
+        if (~|((rem__3__q - divisor__3__q) >> c_sign_pos)) begin
+            if (~|(((rem__3__q << 32'h1) - divisor3__3__q) >> c_sign_pos)) begin
                 rem__4__d = (((rem__3__q << 32'h1) - divisor3__3__q) << 32'h1) & c_rem_mask;
                 quo__4__d = (quo__3__q << 32'h2) | c_three;
             end
@@ -7129,7 +7130,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
                 quo__4__d = (quo__3__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__3__q << 32'h1) >= divisor__3__q) begin
+        else if (~|(((rem__3__q << 32'h1) - divisor__3__q) >> c_sign_pos)) begin
             rem__4__d = (((rem__3__q << 32'h1) - divisor__3__q) << 32'h1) & c_rem_mask;
             quo__4__d = (quo__3__q << 32'h2) | c_one;
         end
@@ -7145,8 +7146,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         inf__4__d = inf__3__q;
         zero__4__d = zero__3__q;
         valid__4__d = valid__3__q;
-        if (rem__4__q >= divisor__4__q) begin
-            if ((rem__4__q << 32'h1) >= divisor3__4__q) begin
+        if (~|((rem__4__q - divisor__4__q) >> c_sign_pos)) begin
+            if (~|(((rem__4__q << 32'h1) - divisor3__4__q) >> c_sign_pos)) begin
                 rem__5__d = (((rem__4__q << 32'h1) - divisor3__4__q) << 32'h1) & c_rem_mask;
                 quo__5__d = (quo__4__q << 32'h2) | c_three;
             end
@@ -7155,7 +7156,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
                 quo__5__d = (quo__4__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__4__q << 32'h1) >= divisor__4__q) begin
+        else if (~|(((rem__4__q << 32'h1) - divisor__4__q) >> c_sign_pos)) begin
             rem__5__d = (((rem__4__q << 32'h1) - divisor__4__q) << 32'h1) & c_rem_mask;
             quo__5__d = (quo__4__q << 32'h2) | c_one;
         end
@@ -7171,8 +7172,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         inf__5__d = inf__4__q;
         zero__5__d = zero__4__q;
         valid__5__d = valid__4__q;
-        if (rem__5__q >= divisor__5__q) begin
-            if ((rem__5__q << 32'h1) >= divisor3__5__q) begin
+        if (~|((rem__5__q - divisor__5__q) >> c_sign_pos)) begin
+            if (~|(((rem__5__q << 32'h1) - divisor3__5__q) >> c_sign_pos)) begin
                 rem__6__d = (((rem__5__q << 32'h1) - divisor3__5__q) << 32'h1) & c_rem_mask;
                 quo__6__d = (quo__5__q << 32'h2) | c_three;
             end
@@ -7181,7 +7182,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
                 quo__6__d = (quo__5__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__5__q << 32'h1) >= divisor__5__q) begin
+        else if (~|(((rem__5__q << 32'h1) - divisor__5__q) >> c_sign_pos)) begin
             rem__6__d = (((rem__5__q << 32'h1) - divisor__5__q) << 32'h1) & c_rem_mask;
             quo__6__d = (quo__5__q << 32'h2) | c_one;
         end
@@ -7197,8 +7198,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         inf__6__d = inf__5__q;
         zero__6__d = zero__5__q;
         valid__6__d = valid__5__q;
-        if (rem__6__q >= divisor__6__q) begin
-            if ((rem__6__q << 32'h1) >= divisor3__6__q) begin
+        if (~|((rem__6__q - divisor__6__q) >> c_sign_pos)) begin
+            if (~|(((rem__6__q << 32'h1) - divisor3__6__q) >> c_sign_pos)) begin
                 rem__7__d = (((rem__6__q << 32'h1) - divisor3__6__q) << 32'h1) & c_rem_mask;
                 quo__7__d = (quo__6__q << 32'h2) | c_three;
             end
@@ -7207,7 +7208,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
                 quo__7__d = (quo__6__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__6__q << 32'h1) >= divisor__6__q) begin
+        else if (~|(((rem__6__q << 32'h1) - divisor__6__q) >> c_sign_pos)) begin
             rem__7__d = (((rem__6__q << 32'h1) - divisor__6__q) << 32'h1) & c_rem_mask;
             quo__7__d = (quo__6__q << 32'h2) | c_one;
         end
@@ -7223,8 +7224,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         inf__7__d = inf__6__q;
         zero__7__d = zero__6__q;
         valid__7__d = valid__6__q;
-        if (rem__7__q >= divisor__7__q) begin
-            if ((rem__7__q << 32'h1) >= divisor3__7__q) begin
+        if (~|((rem__7__q - divisor__7__q) >> c_sign_pos)) begin
+            if (~|(((rem__7__q << 32'h1) - divisor3__7__q) >> c_sign_pos)) begin
                 rem__8__d = (((rem__7__q << 32'h1) - divisor3__7__q) << 32'h1) & c_rem_mask;
                 quo__8__d = (quo__7__q << 32'h2) | c_three;
             end
@@ -7233,7 +7234,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
                 quo__8__d = (quo__7__q << 32'h2) | c_two;
             end
         end
-        else if ((rem__7__q << 32'h1) >= divisor__7__q) begin
+        else if (~|(((rem__7__q << 32'h1) - divisor__7__q) >> c_sign_pos)) begin
             rem__8__d = (((rem__7__q << 32'h1) - divisor__7__q) << 32'h1) & c_rem_mask;
             quo__8__d = (quo__7__q << 32'h2) | c_one;
         end
@@ -7249,8 +7250,8 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
         inf__8__d = inf__7__q;
         zero__8__d = zero__7__q;
         valid__8__d = valid__7__q;
-        if (rem__8__q >= divisor__8__q) begin
-            if ((rem__8__q << 32'h1) >= divisor3__8__q) begin
+        if (~|((rem__8__q - divisor__8__q) >> c_sign_pos)) begin
+            if (~|(((rem__8__q << 32'h1) - divisor3__8__q) >> c_sign_pos)) begin
                 last_full = (quo__8__q << 32'h2) | c_three;
                 last_rest = (rem__8__q << 32'h1) != divisor3__8__q;
             end
@@ -7259,7 +7260,7 @@ module dynrt_processor__engine__fp_units__div(clock,in_valid,a,b,out_valid,resul
                 last_rest = rem__8__q != divisor__8__q;
             end
         end
-        else if ((rem__8__q << 32'h1) >= divisor__8__q) begin
+        else if (~|(((rem__8__q << 32'h1) - divisor__8__q) >> c_sign_pos)) begin
             last_full = (quo__8__q << 32'h2) | c_one;
             last_rest = (rem__8__q << 32'h1) != divisor__8__q;
         end
@@ -17046,9 +17047,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  b_here__0;
     reg  b_here__1;
     reg  [31:0] fetch_a;
-    reg  finishing;
-    reg  take_buf;
-    reg  take_free;
+    reg  fb_free;
     reg  [1:0] l_kind;
     reg  [4:0] l_thread;
     reg  [31:0] l_a;
@@ -18047,29 +18046,26 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         b_line__4__d = b_line__3__q;
         a_line__5__d = a_line__4__q;
         b_line__5__d = b_line__4__q;
-        finishing = fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)));
-        if (finishing) begin
+        if (fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)))) begin
             fetching__d = 1'b0;
             fb__d = ~fb__q;
         end
-        take_buf = fb__q ^ finishing;
-        take_free = ~loaded__0__q;
-        if (take_buf) begin
-            take_free = ~loaded__1__q;
+        fb_free = ~loaded__0__q;
+        if (fb__q) begin
+            fb_free = ~loaded__1__q;
         end
-        if (((~fetching__q) | finishing) & take_free & list_unit__test_valid) begin
+        if ((~fetching__q) & fb_free & list_unit__test_valid) begin
             list_unit__test_take = 1'b1;
             a_issued__d = 32'h0;
             b_issued__d = 32'h0;
             fetching__d = 1'b1;
-            fb__d = take_buf;
             if (list_unit__test_entry[(32'h45)+:(2)] != c_test_triangle) begin
                 a_issued__d = 32'h6;
                 b_issued__d = 32'h6;
                 fetching__d = 1'b0;
-                fb__d = ~take_buf;
+                fb__d = ~fb__q;
             end
-            if (take_buf == c_buffer__0) begin
+            if (fb__q == c_buffer__0) begin
                 loaded__0__d = 1'b1;
                 cur_kind__0__d = list_unit__test_entry[(32'h45)+:(2)];
                 cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
@@ -18080,7 +18076,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
                     received__0__d = 32'hc;
                 end
             end
-            if (take_buf == c_buffer__1) begin
+            if (fb__q == c_buffer__1) begin
                 loaded__1__d = 1'b1;
                 cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
                 cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];

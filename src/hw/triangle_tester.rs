@@ -30,14 +30,13 @@
 //! (the first of equal ts stays), as in the golden model.
 //!
 //! Fetch and launch, two state machines around two entry buffers: the fetch takes an entry
-//! from the list unit's test queue into a free buffer and requests the triangle's 6 words of
-//! bank 2 and 6 of bank 3 (6 clocks when the engine leaves the banks alone; an init or a list
-//! end fetches nothing), taking the next entry into the other buffer in the clock of the last
-//! requests when that buffer is free (else in a later clock). The
+//! from the list unit's test queue into a free buffer (1 clock) and requests the triangle's 6
+//! words of bank 2 and 6 of bank 3 (6 clocks when the engine leaves the banks alone; an init
+//! or a list end fetches nothing), then goes on with the next entry in the other buffer. The
 //! launch waits for its buffer's words (the SRAM latency after their requests), launches the
 //! origin and then the direction into the TransformUnit (2 clocks), frees the buffer and
 //! waits a clock for the next entry's ray words. Throughput: one test per [`CLOCKS_PER_TEST`]
-//! (6) clocks, one init or list end per [`LAUNCH_SPACING`] (4); entries leave the launch at
+//! (7) clocks, one init or list end per [`LAUNCH_SPACING`] (4); entries leave the launch at
 //! least 4 clocks apart, which the hit merge needs (it reads, compares and writes a thread's
 //! best hit in 4 clocks). The engine's own loads of banks 2 and 3 (shading data) take the
 //! bank in their clock; the fetch waits for it.
@@ -84,10 +83,9 @@ pub fn flight_slots_suffice(fmt: Format) -> bool {
 }
 
 /// Clocks between two tests when the engine leaves banks 2 and 3 alone (the tester's
-/// throughput bound): the 6 words of each bank (the layout splits a triangle's transform 6 +
-/// 6 for this; 8 + 4 took 9 clocks); the next entry is taken in the clock of the last
-/// requests (a clock of its own made it 7 until stop 38).
-pub const CLOCKS_PER_TEST: u32 = 6;
+/// throughput bound): the take and the 6 words of each bank (the layout splits a triangle's
+/// transform 6 + 6 for this; 8 + 4 took 9 clocks).
+pub const CLOCKS_PER_TEST: u32 = 7;
 // `update` spells out its numbers (rust-hdl's Verilog cannot name Rust constants): a
 // triangle is 6 words of bank 2 (words 0-5 of its transform) and 6 of bank 3 (words 6-11,
 // `layout::TRANSFORM_BANK_WORDS`), buffer 1's words follow buffer 0's 12.
@@ -202,11 +200,7 @@ pub struct TriangleTester<
     seq: DFF<Bits<5>>,
     words: [DFF<Bits<W>>; 24],
     fetch_a: Signal<Local, Bits<32>>,
-    /// The fetch requests its buffer's last words this clock; the buffer the next take
-    /// fills (the other one then, so that the take costs no clock of its own); it is free.
-    finishing: Signal<Local, Bit>,
-    take_buf: Signal<Local, Bit>,
-    take_free: Signal<Local, Bit>,
+    fb_free: Signal<Local, Bit>,
     l_kind: Signal<Local, Bits<2>>,
     l_thread: Signal<Local, Bits<5>>,
     l_a: Signal<Local, Bits<32>>,
@@ -392,9 +386,7 @@ impl<
             a_here: Default::default(),
             b_here: Default::default(),
             fetch_a: Default::default(),
-            finishing: Default::default(),
-            take_buf: Default::default(),
-            take_free: Default::default(),
+            fb_free: Default::default(),
             l_kind: Default::default(),
             l_thread: Default::default(),
             l_a: Default::default(),
@@ -675,38 +667,32 @@ impl<
             self.a_line[k].d.next = self.a_line[k - 1].q.val();
             self.b_line[k].d.next = self.b_line[k - 1].q.val();
         }
-        // The fetch is done with the buffer once its last words are requested; in that clock
-        // it may take the next entry into the other buffer.
-        self.finishing.next = self.fetching.q.val()
+        // The fetch is done with the buffer once its last words are requested.
+        if self.fetching.q.val()
             & ((self.a_issued.q.val() == 6) | (self.a_take.val() & (self.a_issued.q.val() == 5)))
-            & ((self.b_issued.q.val() == 6) | (self.b_take.val() & (self.b_issued.q.val() == 5)));
-        if self.finishing.val() {
+            & ((self.b_issued.q.val() == 6) | (self.b_take.val() & (self.b_issued.q.val() == 5)))
+        {
             self.fetching.d.next = false;
             self.fb.d.next = !self.fb.q.val();
         }
-        self.take_buf.next = self.fb.q.val() ^ self.finishing.val();
-        self.take_free.next = !self.loaded[0].q.val();
-        if self.take_buf.val() {
-            self.take_free.next = !self.loaded[1].q.val();
+        self.fb_free.next = !self.loaded[0].q.val();
+        if self.fb.q.val() {
+            self.fb_free.next = !self.loaded[1].q.val();
         }
-        if ((!self.fetching.q.val()) | self.finishing.val())
-            & self.take_free.val()
-            & self.list_unit.test_valid.val()
-        {
+        if (!self.fetching.q.val()) & self.fb_free.val() & self.list_unit.test_valid.val() {
             self.list_unit.test_take.next = true;
             self.a_issued.d.next = 0.into();
             self.b_issued.d.next = 0.into();
             self.fetching.d.next = true;
-            self.fb.d.next = self.take_buf.val();
             if self.list_unit.test_entry.val().get_bits::<2>(69) != self.c_test_triangle.val() {
                 // An init or a list end fetches nothing.
                 self.a_issued.d.next = 6.into();
                 self.b_issued.d.next = 6.into();
                 self.fetching.d.next = false;
-                self.fb.d.next = !self.take_buf.val();
+                self.fb.d.next = !self.fb.q.val();
             }
             for k in 0..2 {
-                if self.take_buf.val() == self.c_buffer[k].val() {
+                if self.fb.q.val() == self.c_buffer[k].val() {
                     self.loaded[k].d.next = true;
                     self.cur_kind[k].d.next = self.list_unit.test_entry.val().get_bits::<2>(69);
                     self.cur_thread[k].d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
