@@ -3,6 +3,7 @@
 
 use dynrt::fp::Format;
 use dynrt::hw::program::exec::Machine;
+use dynrt::hw::program::isa::Unit;
 use dynrt::hw::program::{build_program, ProgramConfig};
 use dynrt::layout::{self, Layout, MemoryConfig, SceneTrees};
 use dynrt::model;
@@ -116,6 +117,16 @@ fn the_program_leaves_out_what_the_scene_does_not_need() {
     let q = build_program(&ProgramConfig::from_layout(&full));
     assert!(q.sections.contains(&"mirror"));
     assert!(q.code.len() > p.code.len());
+    // The engine is built without the units no instruction uses (`Program::units`): instance
+    // entry, the mailboxes and the scratch words only where the scene has instances and mirrors.
+    for u in [Unit::InstanceEntry, Unit::Mailbox, Unit::Scratch] {
+        assert!(!p.units().contains(&u) && q.units().contains(&u), "{u:?}");
+        let line = format!("{} unit (no instruction uses it)", u.name());
+        assert!(
+            p.left_out.contains(&line) && !q.left_out.contains(&line),
+            "{line}"
+        );
+    }
     println!(
         "cornell_noshadow: {} instructions, {} registers; mirror: {} instructions",
         p.code.len(),

@@ -332,6 +332,9 @@ pub struct TraversalUnit<
     c_bank_nodes: Constant<Bits<{ layout::BANKS }>>,
     c_leaf_tag: Constant<Bits<2>>,
     c_top_base: Constant<Bits<6>>,
+    /// The scene has a top level: without, no job is a top-level one, so the world ray's store
+    /// is never read and synthesis removes it.
+    c_top_level: Constant<Bit>,
     c_walk_ended: Constant<Bits<32>>,
     /// An entered object's start: `KD_ENTERED`.
     c_entered: Constant<Bits<32>>,
@@ -350,8 +353,8 @@ impl<
 {
     /// The unit for SRAM read latency `mem_latency` (1..=6).
     /// A top-level walk's stack starts at entry `top_stack_base` of the thread's
-    /// [`STACK_LEVELS`].
-    pub fn new(mem_latency: u32, top_stack_base: u32) -> Self {
+    /// [`STACK_LEVELS`]; `top_level` is false for a scene without a top level.
+    pub fn new(mem_latency: u32, top_stack_base: u32, top_level: bool) -> Self {
         assert!((1..=6).contains(&mem_latency));
         assert!((1..STACK_LEVELS as u32).contains(&top_stack_base));
         assert!(DL == div_latency(M as u32) as usize);
@@ -524,6 +527,7 @@ impl<
             c_bank_nodes: Constant::new((1u64 << layout::NODES).into()),
             c_leaf_tag: Constant::new(u64::from(layout::LEAF_TAG).into()),
             c_top_base: Constant::new(u64::from(top_stack_base).into()),
+            c_top_level: Constant::new(top_level),
             c_walk_ended: Constant::new(u64::from(KD_WALK_ENDED).into()),
             c_entered: Constant::new(u64::from(KD_ENTERED).into()),
         }
@@ -974,7 +978,7 @@ impl<
         self.a_leaf.next = self.job.q.val().get_bit(101)
             | (self.w0.q.val().get_bits::<2>(30) == self.c_leaf_tag.val());
         self.a_axis.next = self.w0.q.val().get_bits::<2>(30);
-        self.a_top.next = self.job.q.val().get_bit(102);
+        self.a_top.next = self.job.q.val().get_bit(102) & self.c_top_level.val();
         // The object walk's ray, or the top-level walk's world ray; its split axis.
         for k in 0..3 {
             self.a_ray_o[k].next = self.ray.o[k].val();
@@ -1290,7 +1294,7 @@ mod tests {
         );
         assert!(want[7].len() == 8, "the any-hit walk ends at its first hit");
 
-        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE);
+        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE, true);
         u.connect_all();
         let cycle = |u: &mut Unit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
         for (th, (o, d)) in rays.iter().enumerate() {
@@ -1542,7 +1546,7 @@ mod tests {
             "too few object leaves: {object_leaves}"
         );
 
-        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE);
+        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE, true);
         u.connect_all();
         let cycle = |u: &mut Unit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
         for th in 0..threads {

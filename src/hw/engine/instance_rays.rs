@@ -44,6 +44,11 @@
 //! `mem_latency` 2 and a free bus. Throughput: one entry per about `16 + mem_latency` clocks
 //! (the next entry's reads start while this one's requests are in the unit).
 //!
+//! Absent (`InstanceRays::new`'s `present` false, for a program with no `tri.world`,
+//! `tri.enter` or `tri.normal`): every output is held at 0, so nothing the unit holds is
+//! observable and synthesis removes it, and with it the engine's multiplexers in front of the
+//! TransformUnit and the ray stores.
+//!
 //! Golden twin: [`units::transform`](crate::units::transform) of the world origin (a point)
 //! and direction (a vector) by the record's `instance_word::WORLD_TO_OBJECT` words, and the
 //! record's `instance_word::ROOT`, as the engine's twin (`hw::program::exec`, `tri.enter`) and
@@ -174,11 +179,13 @@ pub struct InstanceRays<const W: usize> {
     /// The root's word after the matrix's first.
     c_root_offset: Constant<Bits<24>>,
     c_ml_last: Constant<Bits<3>>,
+    /// The program uses the unit (see the module doc's "Absent").
+    c_present: Constant<Bit>,
 }
 
 impl<const W: usize> InstanceRays<W> {
-    /// The unit for SRAM read latency `mem_latency` (1..=6).
-    pub fn new(mem_latency: u32) -> Self {
+    /// The unit for SRAM read latency `mem_latency` (1..=6), absent unless `present`.
+    pub fn new(mem_latency: u32, present: bool) -> Self {
         assert!((1..=6).contains(&mem_latency));
         Self {
             clock: Default::default(),
@@ -263,6 +270,7 @@ impl<const W: usize> InstanceRays<W> {
                 ((instance_word::ROOT - instance_word::WORLD_TO_OBJECT) as u64).into(),
             ),
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
+            c_present: Constant::new(present),
         }
     }
 }
@@ -476,6 +484,33 @@ impl<const W: usize> Logic for InstanceRays<W> {
             .get_bit(self.query_thread.val().index());
         self.pending.next = self.pending_r.q.val();
 
+        if !self.c_present.val() {
+            self.refused.next = false;
+            self.read.next = false;
+            self.addr.next = 0.into();
+            self.root_write.next = false;
+            self.root_thread.next = 0.into();
+            self.root.next = 0.into();
+            self.gen_valid.next = false;
+            self.gen_point.next = false;
+            self.gen_direction.next = false;
+            self.gen_normal.next = false;
+            self.gen_thread.next = 0.into();
+            for k in 0..12 {
+                self.gen_m[k].next = 0.into();
+            }
+            self.normal_write.next = false;
+            self.ray_write.next = false;
+            self.ray_thread.next = 0.into();
+            for k in 0..3 {
+                self.gen_v[k].next = 0.into();
+                self.ray_o[k].next = 0.into();
+                self.ray_d[k].next = 0.into();
+            }
+            self.done_mask.next = 0.into();
+            self.pending.next = false;
+        }
+
         if self.frame_start.val() {
             self.slot_valid.d.next = false;
             self.phase.d.next = EntryPhase::Idle;
@@ -493,6 +528,25 @@ mod tests {
     use crate::units;
     use rand::{Rng, SeedableRng};
     use std::collections::VecDeque;
+
+    /// An absent unit (a program with no instance entry) holds every output at 0 whatever its
+    /// inputs do, so Yosys (xc2v) keeps nothing of it: no LUT, flip-flop or RAM. A unit with
+    /// one output left live keeps the registers and RAMs behind it.
+    #[test]
+    fn an_absent_unit_synthesizes_to_nothing() {
+        let mut uut = InstanceRays::<24>::new(2, false);
+        uut.connect_all();
+        let dir = tempfile::tempdir().unwrap();
+        let src = dir.path().join("instance_rays.v");
+        std::fs::write(&src, generate_verilog(&uut)).unwrap();
+        let r = crate::synth::synth_xc2v(&[src], "top", dir.path()).unwrap();
+        assert_eq!(
+            (r.total_luts(), r.flip_flops, r.block_rams),
+            (0, 0, 0),
+            "{:?}",
+            r.all_cells
+        );
+    }
 
     /// InstanceRays in rust-hdl simulation, with threads writing world rays and entering
     /// instances at random, a bank 4 of random records behind a bus that is free in random
@@ -522,7 +576,7 @@ mod tests {
                 }
             })
             .collect();
-        let mut u = InstanceRays::<24>::new(mem_latency);
+        let mut u = InstanceRays::<24>::new(mem_latency, true);
         u.connect_all();
         let cycle =
             |u: &mut InstanceRays<24>| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });

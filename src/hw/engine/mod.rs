@@ -81,7 +81,7 @@ use rust_hdl::prelude::*;
 use super::fp::add_sub::ADD_SUB_LATENCY;
 use super::list_unit;
 use super::ports::{BankedSramRead, FrameBufferWrite, SramRead, SHARED_BUS_BANKS};
-use super::program::isa::{KdFn, Op, TriFn, PC_BITS};
+use super::program::isa::{KdFn, Op, TriFn, Unit, PC_BITS};
 use super::program::Program;
 use super::{TraversalUnit, TriangleTester};
 use crate::layout;
@@ -329,6 +329,11 @@ pub struct ThreadEngine<
     store_write: Signal<Local, Bit>,
 
     c_threads: Constant<Bits<8>>,
+    /// The program uses the mailboxes (`mbx`, `mbc`) and the scratch words (`lds`, `sts`):
+    /// without, their outputs are held at 0 and synthesis removes their RAMs and compares, as
+    /// it does an absent `InstanceRays`.
+    c_uses_mailboxes: Constant<Bit>,
+    c_uses_scratch: Constant<Bit>,
     // The glue's names, every one from its definition in `isa` (`Op`, `TriFn`, `KdFn`),
     // `layout` (banks) and `list_unit` (command kinds): the Verilog's localparams follow the
     // twin's numbering by construction.
@@ -403,6 +408,7 @@ impl<
             "the reservation would come too late"
         );
         let reserve_ahead = DX as u32 - (FETCH_LATENCY + 1);
+        let units = program.units();
         assert!(DL == super::fp::div::div_latency(M as u32) as usize);
         assert!((1..=MAX_THREADS as u32).contains(&threads));
         assert!((1..=MAX_MEM_LATENCY).contains(&mem_latency));
@@ -435,7 +441,7 @@ impl<
             decode: Decode::new(program.registers_used),
             mailboxes: Default::default(),
             rays: PrimaryRays::new(&program.config),
-            instances: InstanceRays::new(mem_latency),
+            instances: InstanceRays::new(mem_latency, units.contains(&Unit::InstanceEntry)),
             execute: Default::default(),
             fp_units: Default::default(),
             result_line: ResultLine::new(mem_latency),
@@ -443,7 +449,11 @@ impl<
             // Scratch words start undefined: the program writes every one before reading it.
             scratch: Default::default(),
             tester: TriangleTester::new(mem_latency),
-            traversal_unit: TraversalUnit::new(mem_latency, program.config.top_stack_base),
+            traversal_unit: TraversalUnit::new(
+                mem_latency,
+                program.config.top_stack_base,
+                program.config.top_root.is_some(),
+            ),
             running: Default::default(),
             epoch: Default::default(),
             halted_count: Default::default(),
@@ -488,6 +498,8 @@ impl<
             gen_instance: Default::default(),
             store_write: Default::default(),
             c_threads: Constant::new(u64::from(threads).into()),
+            c_uses_mailboxes: Constant::new(units.contains(&Unit::Mailbox)),
+            c_uses_scratch: Constant::new(units.contains(&Unit::Scratch)),
             op_fsub: op_code(Op::FSub),
             op_fdiv: op_code(Op::FDiv),
             op_fsqrt: op_code(Op::FSqrt),
@@ -974,12 +986,15 @@ impl<
         self.result_line.jr_target.next = self.decode.a.val().get_bits::<PC_BITS>(0);
         self.result_line.int_eq.next = self.execute.int_eq.val();
         self.result_line.int_lt.next = self.execute.int_lt.val();
-        self.result_line.mb_hit.next = self.mailboxes.hit.val();
+        self.result_line.mb_hit.next = self.mailboxes.hit.val() & self.c_uses_mailboxes.val();
         self.result_line.pix_done.next = self.rays.exhausted.val();
         self.result_line.pix_busy.next = self.rays.refused.val();
         self.result_line.fast.next = self.execute.fast.val();
         self.result_line.kind.next = self.execute.kind.val();
-        self.result_line.scratch_data.next = self.scratch.read_data.val();
+        self.result_line.scratch_data.next = 0.into();
+        if self.c_uses_scratch.val() {
+            self.result_line.scratch_data.next = self.scratch.read_data.val();
+        }
         self.result_line.mem_data.next = self.mem.rdata.val();
         self.result_line.nodes_data.next = self.bank0.rdata.val();
         self.result_line.a_data.next = self.bank2.rdata.val();

@@ -506,7 +506,7 @@ impl<'a> Machine<'a> {
                 }
             }
         }
-        *stats.per_unit.entry(i.op.unit()).or_default() += 1;
+        *stats.per_unit.entry(i.unit()).or_default() += 1;
         *stats
             .per_section
             .entry(self.program.sections[t.pc])

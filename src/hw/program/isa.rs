@@ -418,10 +418,12 @@ pub enum Unit {
     TriangleTester,
     TraversalUnit,
     ChannelByte,
+    /// `tri.world`, `tri.enter`, `tri.normal`: the engine's `InstanceRays`.
+    InstanceEntry,
 }
 
 impl Unit {
-    pub const ALL: [Unit; 13] = [
+    pub const ALL: [Unit; 14] = [
         Unit::FpAdd,
         Unit::FpMul,
         Unit::FpDiv,
@@ -435,6 +437,7 @@ impl Unit {
         Unit::TriangleTester,
         Unit::TraversalUnit,
         Unit::ChannelByte,
+        Unit::InstanceEntry,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -451,6 +454,7 @@ impl Unit {
             Unit::TriangleTester => "triangle tester",
             Unit::TraversalUnit => "traversal unit",
             Unit::ChannelByte => "channel byte",
+            Unit::InstanceEntry => "instance entry",
         }
     }
 }
@@ -491,6 +495,17 @@ impl Instr {
     /// non-branching instruction being false).
     pub fn jumps_after(&self) -> bool {
         self.invert && self.op.can_jump_after()
+    }
+
+    /// The unit that executes the instruction: its op's, but for the `tri` functions of
+    /// instance entry.
+    pub fn unit(&self) -> Unit {
+        let instance_entry = [TriFn::World, TriFn::Enter, TriFn::Normal].map(|f| f as u32);
+        if self.op == Op::Tri && instance_entry.contains(&self.imm) {
+            Unit::InstanceEntry
+        } else {
+            self.op.unit()
+        }
     }
 
     /// The ROM words (see the module doc for the fields).

@@ -150,7 +150,7 @@ pub struct Program {
 impl Program {
     /// The units some instruction uses; the engine is built with these only.
     pub fn units(&self) -> BTreeSet<Unit> {
-        self.code.iter().map(|i| i.op.unit()).collect()
+        self.code.iter().map(isa::Instr::unit).collect()
     }
     /// The instruction ROM: each instruction's words ([`isa::Instr::encode`]).
     pub fn rom(&self) -> Vec<[u32; isa::ROM_WORDS]> {

@@ -264,9 +264,11 @@ impl Gen<'_> {
         }
         a.bind(facing);
         a.end_temps();
-        let mat: [Val; 4] = a.load_n(FRAME, material.into(), 2, c.materials);
-        let kd = [mat[0], mat[1], mat[2]].map(|v| a.keep(v));
-        let mirror = a.keep(mat[3]);
+        let kd: [Val; 3] = a.load_n(FRAME, material.into(), 2, c.materials);
+        let kd = kd.map(|v| a.keep(v));
+        // The material's fourth word, its reflectivity, only where mirror rays are traced.
+        let mirror =
+            mirror_t_min.map(|_| a.keep(a.load(FRAME, material.into(), 2, c.materials + 3)));
         a.free(material);
         // The colour accumulates in `color`, where the pack and the mirror fold read it.
         a.assign3(color, units::ambient(a, kd.map(Val::R), ambient.into()));
@@ -338,6 +340,7 @@ impl Gen<'_> {
                 true,
                 local_done,
             );
+            let mirror = mirror.expect("loaded with mirror rays");
             a.branch(Op::BFlt, Val::K(0), mirror.into(), true, local_done);
             let entry = a.op(
                 Op::Shl,
@@ -372,7 +375,8 @@ impl Gen<'_> {
             .into_iter()
             .chain(n)
             .chain(kd)
-            .chain([mirror, hit_instance, hit_triangle])
+            .chain(mirror)
+            .chain([hit_instance, hit_triangle])
             .chain(if incoming == ray_d {
                 [Reg::ZERO; 3]
             } else {

@@ -1164,7 +1164,7 @@ impl<
             root_thread: Default::default(),
             root: Default::default(),
             busy_read: Default::default(),
-            entries: crate::hw::engine::InstanceRays::new(2),
+            entries: crate::hw::engine::InstanceRays::new(2, true),
             unit: Default::default(),
             bank: ROM::new(crate::hw::engine::word_map(
                 bank.iter().map(|&w| Bits::<32>::from(u64::from(w))),
