@@ -409,6 +409,9 @@ pub struct FrameReport {
     pub raygen_busy: u64,
     pub instance_busy: u64,
     pub shading_busy: u64,
+    /// Thread-clocks waiting for an issue slot and asleep in a coprocessor wait.
+    pub ready_thread_clocks: u64,
+    pub asleep_thread_clocks: u64,
     pub pixels: u64,
     pub mismatches: Vec<Mismatch>,
     pub differing_pixels: usize,
@@ -453,6 +456,15 @@ impl FrameReport {
             self.traversal_busy,
         ]
         .map(|n| n as f64 / c)
+    }
+    /// Shares of the frame's thread-clocks (`threads` x cycles): waiting for an issue slot,
+    /// asleep in a coprocessor wait, and the rest (an instruction in the engine's pipeline,
+    /// or halted at the frame's end).
+    pub fn thread_shares(&self, threads: u32) -> [f64; 3] {
+        let total = (u64::from(threads) * self.cycles).max(1) as f64;
+        let ready = self.ready_thread_clocks as f64 / total;
+        let asleep = self.asleep_thread_clocks as f64 / total;
+        [ready, asleep, 1.0 - ready - asleep]
     }
     /// Frames per second at 90 MHz for 512x384 at this scene's cycles per primary ray.
     pub fn fps_512x384(&self) -> f64 {
@@ -614,6 +626,8 @@ pub fn simulate_scene(
             raygen_busy: fr.raygen_busy,
             instance_busy: fr.instance_busy,
             shading_busy: fr.shading_busy,
+            ready_thread_clocks: fr.ready_thread_clocks,
+            asleep_thread_clocks: fr.asleep_thread_clocks,
             pixels: u64::from(w * h),
             differing_pixels: differing.len(),
             mismatches,

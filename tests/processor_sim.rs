@@ -49,6 +49,20 @@ fn check(name: &str, w: u32, h: u32, frames: Option<u32>, sim: Simulator, format
             sim.name(),
             f.mismatches
         );
+        // Thread-clocks: a thread is in the scheduler's ready mask in the clock it is picked,
+        // so every retired instruction counts at least one; every scene sleeps in walks; the
+        // two are disjoint states of at most `threads` threads a clock.
+        let threads = u64::from(ProcessorParams::default().threads);
+        assert!(
+            f.ready_thread_clocks >= f.instructions
+                && f.asleep_thread_clocks > 0
+                && f.ready_thread_clocks + f.asleep_thread_clocks <= threads * f.cycles,
+            "{name} frame {k}: {} ready and {} asleep thread-clocks, {} instructions, {} cycles",
+            f.ready_thread_clocks,
+            f.asleep_thread_clocks,
+            f.instructions,
+            f.cycles
+        );
         // The RTL issues exactly the instructions the engine's twin executes.
         if k == 0 {
             assert_eq!(

@@ -281,6 +281,7 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         "--board: dynrt sim writes no constraints; give the board to dynrt rtl"
     );
     let (scene, name, params) = setup(&a.rtl)?;
+    let threads = params.threads;
     let (mhz, clock_source) = fps_clock(&a)?;
     let trace = trace_window(&a)?;
     let out = OutputDir::create(&a.rtl.out, "--out")?;
@@ -359,6 +360,17 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
             100.0 * traversal
         ),
         format!("engine issue slots by routine: {}", shares.join(", ")),
+        {
+            let [ready, asleep, rest] = r.frames[0].thread_shares(threads);
+            format!(
+                "threads (frame 0): {:.0}% of the thread-clocks waiting for an issue slot, {:.0}% \
+                 asleep in a coprocessor wait, {:.0}% with an instruction in the pipeline (or \
+                 halted)",
+                100.0 * ready,
+                100.0 * asleep,
+                100.0 * rest
+            )
+        },
         format!(
             "simulated {:.0} cycles/s ({}, run {:.1} s)",
             r.simulated_cycles_per_second(),

@@ -20,7 +20,9 @@
 //! (only the words that changed), a start pulse, a wait for `done` or the cycle limit (then
 //! `TIMEOUT` and a non-zero exit), and the frame buffer written to `frame<k>.hex` (one
 //! `RRGGBB` word a line) with `cycles instructions transform_busy intersect_busy
-//! traversal_busy raygen_busy instance_busy shading_busy` in `frame<k>.stats`, in the current
+//! traversal_busy raygen_busy instance_busy shading_busy ready_clocks asleep_clocks` (the
+//! last two thread-clocks: the bits of the scheduler's `ready` and `asleep` masks added up
+//! every clock) in `frame<k>.stats`, in the current
 //! folder or
 //! `+out_dir=DIR`. Both files start with the [`GeneratedBy`] header.
 
@@ -304,6 +306,12 @@ const TESTBENCH_USES: [&str; 23] = [
 /// window; give it to a Verilator built with `--trace` or `--trace-fst`.
 pub const TRACE_DEFINE: &str = "DYNRT_TRACE";
 
+/// The scheduler's masks of the threads waiting for an issue slot and of those asleep in a
+/// coprocessor wait (`hw::engine::Scheduler`'s `ready` and `asleep`) as the testbench names
+/// them below `dut`: it adds up their bits every clock (thread-clocks, `frame<k>.stats`).
+const SCHEDULER_READY: &str = "engine.scheduler.ready__q";
+const SCHEDULER_ASLEEP: &str = "engine.scheduler.asleep__q";
+
 /// The testbench's waveform window. Icarus ends it with `$dumpoff`; Verilator 5.006 ignores
 /// `$dumpoff`, so the testbench closes the model's trace itself (`_traceDumpClose`, the call
 /// Verilator's own `$finish` makes), which exists only in a model built with tracing, hence
@@ -391,7 +399,8 @@ pub fn processor_testbench(
     }
     let _ = writeln!(
         v,
-        "  integer px;\n  string mem_dir, out_dir;\n  reg [63:0] clocks = 0, heartbeat = 0;\n  integer frame = 0, rays = 0;"
+        "  integer px;\n  string mem_dir, out_dir;\n  reg [63:0] clocks = 0, heartbeat = 0;\n  integer frame = 0, rays = 0;\n\
+         \x20 reg [63:0] ready_clocks = 0, asleep_clocks = 0;"
     );
     for (b, name) in BANK_NAMES.iter().enumerate() {
         let _ = writeln!(
@@ -415,6 +424,9 @@ pub fn processor_testbench(
          \x20 always @(posedge clock) begin\n\
          \x20   clocks <= clocks + 1;\n\
          \x20   if (fb_write) rays <= rays + 1;\n\
+         \x20   // Thread-clocks: threads waiting for an issue slot, threads asleep in a wait.\n\
+         \x20   ready_clocks <= ready_clocks + $countones(dut.{ready_mask});\n\
+         \x20   asleep_clocks <= asleep_clocks + $countones(dut.{asleep_mask});\n\
          \x20   if (heartbeat != 0 && clocks % heartbeat == 0 && clocks != 0)\n\
          \x20     $display(\"dynrt-heartbeat frame %0d: %0d cycles, %0d rays\", frame, cycles, rays);\n\
          \x20 end\n\
@@ -434,7 +446,9 @@ pub fn processor_testbench(
             .map(|p| format!(".{0}({0})", p.name))
             .collect::<Vec<_>>()
             .join(", "),
-        trace = TRACE_WINDOW.replace("{define}", TRACE_DEFINE)
+        trace = TRACE_WINDOW.replace("{define}", TRACE_DEFINE),
+        ready_mask = SCHEDULER_READY,
+        asleep_mask = SCHEDULER_ASLEEP,
     );
     for b in [1, 4, 5] {
         let _ = writeln!(
@@ -482,16 +496,16 @@ pub fn processor_testbench(
         }
         let _ = writeln!(
             v,
-            "    frame = {fr}; rays = 0;\n    @(negedge clock) start = 1'b1;\n    @(negedge clock) start = 1'b0;\n\
+            "    frame = {fr}; rays = 0; ready_clocks = 0; asleep_clocks = 0;\n    @(negedge clock) start = 1'b1;\n    @(negedge clock) start = 1'b0;\n\
              \x20   n = 0;\n    while (!done && n < {limit}) begin @(posedge clock); n = n + 1; end\n\
              \x20   if (!done) begin\n      $display(\"TIMEOUT: frame {fr} not done after {limit} clocks\");\n\
              \x20     $fatal(1, \"timeout\");\n    end\n\
              \x20   fd = $fopen({{out_dir, \"/frame{fr}.hex\"}}, \"w\");\n\
              \x20   for (k = 0; k < {px}; k = k + 1) $fwrite(fd, \"%06h\\n\", bank5[{fb} + k][23:0]);\n\
              \x20   $fclose(fd);\n    fd = $fopen({{out_dir, \"/frame{fr}.stats\"}}, \"w\");\n\
-             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d %0d\\n\", cycles, instructions,\n\
+             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\\n\", cycles, instructions,\n\
              \x20     transform_busy, intersect_busy, traversal_busy, raygen_busy, instance_busy,\n\
-             \x20     shading_busy);\n    $fclose(fd);\n\
+             \x20     shading_busy, ready_clocks, asleep_clocks);\n    $fclose(fd);\n\
              \x20   $display(\"frame {fr}: %0d cycles, %0d instructions\", cycles, instructions);",
             limit = frames.cycle_limit,
             px = frames.pixels,

@@ -37,6 +37,10 @@ pub struct SimFrame {
     pub raygen_busy: u64,
     pub instance_busy: u64,
     pub shading_busy: u64,
+    /// Thread-clocks waiting for an issue slot and asleep in a coprocessor wait: the bits of
+    /// the scheduler's `ready` and `asleep` masks, added up every clock of the frame.
+    pub ready_thread_clocks: u64,
+    pub asleep_thread_clocks: u64,
 }
 
 /// What a processor simulation produced.
@@ -301,10 +305,10 @@ pub fn simulate_processor(
             .split_whitespace()
             .filter_map(|w| w.parse().ok())
             .collect();
-        if nums.len() != 8 {
+        if nums.len() != 10 {
             bail!(
                 "{}: expected `cycles instructions transform_busy intersect_busy traversal_busy \
-                 raygen_busy instance_busy shading_busy`, \
+                 raygen_busy instance_busy shading_busy ready_clocks asleep_clocks`, \
                  got `{}`",
                 stats_path.display(),
                 stats.trim()
@@ -320,6 +324,8 @@ pub fn simulate_processor(
             raygen_busy: nums[5],
             instance_busy: nums[6],
             shading_busy: nums[7],
+            ready_thread_clocks: nums[8],
+            asleep_thread_clocks: nums[9],
         });
     }
     let vga = if capture_vga {

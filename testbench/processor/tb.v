@@ -44,6 +44,7 @@ module tb;
   string mem_dir, out_dir;
   reg [63:0] clocks = 0, heartbeat = 0;
   integer frame = 0, rays = 0;
+  reg [63:0] ready_clocks = 0, asleep_clocks = 0;
   reg [31:0] bank0 [0:117]; // nodes
   reg [31:0] bank1 [0:104]; // lists
   reg [31:0] bank2 [0:239]; // triangles_a
@@ -63,6 +64,9 @@ module tb;
   always @(posedge clock) begin
     clocks <= clocks + 1;
     if (fb_write) rays <= rays + 1;
+    // Thread-clocks: threads waiting for an issue slot, threads asleep in a wait.
+    ready_clocks <= ready_clocks + $countones(dut.engine.scheduler.ready__q);
+    asleep_clocks <= asleep_clocks + $countones(dut.engine.scheduler.asleep__q);
     if (heartbeat != 0 && clocks % heartbeat == 0 && clocks != 0)
       $display("dynrt-heartbeat frame %0d: %0d cycles, %0d rays", frame, cycles, rays);
   end
@@ -136,7 +140,7 @@ module tb;
     $readmemh({mem_dir, "/bank3_triangles_b.hex"}, bank3);
     $readmemh({mem_dir, "/bank4_instances.hex"}, bank4);
     $readmemh({mem_dir, "/bank5_frame.hex"}, bank5);
-    frame = 0; rays = 0;
+    frame = 0; rays = 0; ready_clocks = 0; asleep_clocks = 0;
     @(negedge clock) start = 1'b1;
     @(negedge clock) start = 1'b0;
     n = 0;
@@ -149,9 +153,9 @@ module tb;
     for (k = 0; k < 3072; k = k + 1) $fwrite(fd, "%06h\n", bank5[46 + k][23:0]);
     $fclose(fd);
     fd = $fopen({out_dir, "/frame0.stats"}, "w");
-    $fwrite(fd, "%0d %0d %0d %0d %0d %0d %0d %0d\n", cycles, instructions,
+    $fwrite(fd, "%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\n", cycles, instructions,
       transform_busy, intersect_busy, traversal_busy, raygen_busy, instance_busy,
-      shading_busy);
+      shading_busy, ready_clocks, asleep_clocks);
     $fclose(fd);
     $display("frame 0: %0d cycles, %0d instructions", cycles, instructions);
     if ($test$plusargs("vga")) begin
