@@ -10452,6 +10452,9 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     reg  taken;
     reg  [3:0] entry_words;
     reg  [23:0] normal_offset;
+    reg  [23:0] normal_row;
+    reg  [23:0] normal_column;
+    reg  [23:0] record;
     reg  reading;
     reg  arrives;
     reg  root_arrives;
@@ -10841,14 +10844,15 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
             slot_normal__d = offer_normal;
             slot_nz__d = word_b[(32'h0)+:(24)];
         end
+        record = (slot_instance__q << 32'h4) + (slot_instance__q << 32'h3);
         if ((phase__q == EntryPhase__Idle) & slot_valid__q) begin
             slot_valid__d = 1'b0;
             entry_thread__d = slot_thread__q;
             entry_normal__d = slot_normal__q;
             entry_nz__d = slot_nz__q;
-            entry_record__d = (slot_instance__q << 32'h4) + (slot_instance__q << 32'h3) + c_first_word;
+            entry_record__d = record + c_first_word;
             if (slot_normal__q) begin
-                entry_record__d = (slot_instance__q << 32'h4) + (slot_instance__q << 32'h3) + c_normal_first;
+                entry_record__d = record + c_normal_first;
             end
             issued__d = 32'h0;
             arrived__d = 32'h0;
@@ -10864,10 +10868,12 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         if (issued__q == c_last_word) begin
             addr = entry_record__q + c_root_offset;
         end
-        normal_offset = (((issued__q[(32'h2)+:(2)]) & 24'hffffff) << 32'h1) + ((issued__q[(32'h2)+:(2)]) & 24'hffffff) + ((issued__q[(32'h0)+:(2)]) & 24'hffffff);
+        normal_row = ((issued__q[(32'h2)+:(2)]) & 24'hffffff);
+        normal_column = ((issued__q[(32'h0)+:(2)]) & 24'hffffff);
         if (issued__q[(32'h0)+:(2)] == 32'h3) begin
-            normal_offset = (((issued__q[(32'h2)+:(2)]) & 24'hffffff) << 32'h1) + ((issued__q[(32'h2)+:(2)]) & 24'hffffff) + 32'h2;
+            normal_column = 32'h2;
         end
+        normal_offset = (normal_row << 32'h1) + normal_row + normal_column;
         if (entry_normal__q) begin
             addr = entry_record__q + normal_offset;
         end

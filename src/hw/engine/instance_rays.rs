@@ -147,6 +147,10 @@ pub struct InstanceRays<const W: usize> {
     /// A normal's word `issued`: row `issued / 4`, column `issued % 4` (the fourth, which a
     /// vector never reads, repeats the third).
     normal_offset: Signal<Local, Bits<24>>,
+    normal_row: Signal<Local, Bits<24>>,
+    normal_column: Signal<Local, Bits<24>>,
+    /// The slot's instance record's first word in bank 4.
+    record: Signal<Local, Bits<24>>,
     issued: DFF<Bits<4>>,
     arrived: DFF<Bits<4>>,
     flight: DFF<Bits<8>>,
@@ -241,6 +245,9 @@ impl<const W: usize> InstanceRays<W> {
             entry_nz: Default::default(),
             entry_words: Default::default(),
             normal_offset: Default::default(),
+            normal_row: Default::default(),
+            normal_column: Default::default(),
+            record: Default::default(),
             issued: Default::default(),
             arrived: Default::default(),
             flight: Default::default(),
@@ -340,19 +347,16 @@ impl<const W: usize> Logic for InstanceRays<W> {
             self.slot_normal.d.next = self.offer_normal.val();
             self.slot_nz.d.next = self.word_b.val().get_bits::<W>(0);
         }
+        // The slot's record: `INSTANCE_WORDS` = 24 = 16 + 8 words an instance.
+        self.record.next = (self.slot_instance.q.val() << 4) + (self.slot_instance.q.val() << 3);
         if (self.phase.q.val() == EntryPhase::Idle) & self.slot_valid.q.val() {
             self.slot_valid.d.next = false;
             self.entry_thread.d.next = self.slot_thread.q.val();
             self.entry_normal.d.next = self.slot_normal.q.val();
             self.entry_nz.d.next = self.slot_nz.q.val();
-            // `INSTANCE_WORDS` = 24 = 16 + 8.
-            self.entry_record.d.next = (self.slot_instance.q.val() << 4)
-                + (self.slot_instance.q.val() << 3)
-                + self.c_first_word.val();
+            self.entry_record.d.next = self.record.val() + self.c_first_word.val();
             if self.slot_normal.q.val() {
-                self.entry_record.d.next = (self.slot_instance.q.val() << 4)
-                    + (self.slot_instance.q.val() << 3)
-                    + self.c_normal_first.val();
+                self.entry_record.d.next = self.record.val() + self.c_normal_first.val();
             }
             self.issued.d.next = 0.into();
             self.arrived.d.next = 0.into();
@@ -372,15 +376,13 @@ impl<const W: usize> Logic for InstanceRays<W> {
         if self.issued.q.val() == self.c_last_word.val() {
             self.addr.next = self.entry_record.q.val() + self.c_root_offset.val();
         }
-        self.normal_offset.next = (bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(2)) << 1)
-            + bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(2))
-            + bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(0));
+        self.normal_row.next = bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(2));
+        self.normal_column.next = bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(0));
         if self.issued.q.val().get_bits::<2>(0) == 3 {
-            self.normal_offset.next = (bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(2))
-                << 1)
-                + bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(2))
-                + 2;
+            self.normal_column.next = 2.into();
         }
+        self.normal_offset.next =
+            (self.normal_row.val() << 1) + self.normal_row.val() + self.normal_column.val();
         if self.entry_normal.q.val() {
             self.addr.next = self.entry_record.q.val() + self.normal_offset.val();
         }
