@@ -10273,7 +10273,8 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     localparam  c_first_word = 24'h0;
     localparam  c_normal_first = 24'hc;
     localparam  c_normal_words = 4'hc;
-    localparam  c_root_offset = 24'h15;
+    localparam  c_root_step = 24'ha;
+    localparam  c_last_matrix_read = 4'hb;
     localparam  c_ml_last = 3'b1;
     localparam  c_present = 1'b0;
     
@@ -10348,9 +10349,9 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     reg  [4:0] entry_thread__d;
     wire  [4:0] entry_thread__q;
     reg  entry_thread__clock;
-    reg  [23:0] entry_record__d;
-    wire  [23:0] entry_record__q;
-    reg  entry_record__clock;
+    reg  [23:0] next_addr__d;
+    wire  [23:0] next_addr__q;
+    reg  next_addr__clock;
     reg  entry_normal__d;
     wire  entry_normal__q;
     reg  entry_normal__clock;
@@ -10451,9 +10452,7 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     // Local signals
     reg  taken;
     reg  [3:0] entry_words;
-    reg  [23:0] normal_offset;
-    reg  [23:0] normal_row;
-    reg  [23:0] normal_column;
+    reg  [23:0] addr_step;
     reg  [23:0] record;
     reg  reading;
     reg  arrives;
@@ -10551,10 +10550,10 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         .q(entry_thread__q),
         .clock(entry_thread__clock)
     );
-    dynrt_processor__display__rgb_q entry_record(
-        .d(entry_record__d),
-        .q(entry_record__q),
-        .clock(entry_record__clock)
+    dynrt_processor__display__rgb_q next_addr(
+        .d(next_addr__d),
+        .q(next_addr__q),
+        .clock(next_addr__clock)
     );
     dynrt_processor__display__dark_d entry_normal(
         .d(entry_normal__d),
@@ -10726,7 +10725,7 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         slot_nz__clock = clock;
         phase__clock = clock;
         entry_thread__clock = clock;
-        entry_record__clock = clock;
+        next_addr__clock = clock;
         entry_normal__clock = clock;
         entry_nz__clock = clock;
         issued__clock = clock;
@@ -10745,7 +10744,7 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         slot_nz__d = slot_nz__q;
         phase__d = phase__q;
         entry_thread__d = entry_thread__q;
-        entry_record__d = entry_record__q;
+        next_addr__d = next_addr__q;
         entry_normal__d = entry_normal__q;
         entry_nz__d = entry_nz__q;
         issued__d = issued__q;
@@ -10850,9 +10849,9 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
             entry_thread__d = slot_thread__q;
             entry_normal__d = slot_normal__q;
             entry_nz__d = slot_nz__q;
-            entry_record__d = record + c_first_word;
+            next_addr__d = record + c_first_word;
             if (slot_normal__q) begin
-                entry_record__d = record + c_normal_first;
+                next_addr__d = record + c_normal_first;
             end
             issued__d = 32'h0;
             arrived__d = 32'h0;
@@ -10864,21 +10863,20 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         end
         reading = (phase__q == EntryPhase__Fetch) & (issued__q != entry_words) & bus_free;
         read = reading;
-        addr = entry_record__q + ((issued__q) & 24'hffffff);
-        if (issued__q == c_last_word) begin
-            addr = entry_record__q + c_root_offset;
+        addr = next_addr__q;
+        addr_step = 32'h1;
+        if (issued__q == c_last_matrix_read) begin
+            addr_step = c_root_step;
         end
-        normal_row = ((issued__q[(32'h2)+:(2)]) & 24'hffffff);
-        normal_column = ((issued__q[(32'h0)+:(2)]) & 24'hffffff);
-        if (issued__q[(32'h0)+:(2)] == 32'h3) begin
-            normal_column = 32'h2;
-        end
-        normal_offset = (normal_row << 32'h1) + normal_row + normal_column;
         if (entry_normal__q) begin
-            addr = entry_record__q + normal_offset;
+            addr_step = 32'h1;
+            if (issued__q[(32'h0)+:(2)] == 32'h2) begin
+                addr_step = 32'h0;
+            end
         end
         if (reading) begin
             issued__d = issued__q + 32'h1;
+            next_addr__d = next_addr__q + addr_step;
         end
         flight__d = (flight__q << 32'h1) | ((reading) & 8'hff);
         arrives = flight__q[c_ml_last];

@@ -135,20 +135,20 @@ pub struct InstanceRays<const W: usize> {
     slot_normal: DFF<Bit>,
     slot_nz: DFF<Bits<W>>,
     taken: Signal<Local, Bit>,
-    /// The entry begun: its thread and matrix's address, the words read and arrived, and the
-    /// reads in flight (bit k: a read k + 1 clocks ago).
+    /// The entry begun: its thread, the address of its next read (a register, so that no
+    /// adder sits in front of the bus), the words read and arrived, and the reads in flight
+    /// (bit k: a read k + 1 clocks ago).
     phase: DFF<EntryPhase>,
     entry_thread: DFF<Bits<5>>,
-    entry_record: DFF<Bits<24>>,
+    next_addr: DFF<Bits<24>>,
     entry_normal: DFF<Bit>,
     entry_nz: DFF<Bits<W>>,
     /// Words the entry reads: 13, or a normal's 12.
     entry_words: Signal<Local, Bits<4>>,
-    /// A normal's word `issued`: row `issued / 4`, column `issued % 4` (the fourth, which a
-    /// vector never reads, repeats the third).
-    normal_offset: Signal<Local, Bits<24>>,
-    normal_row: Signal<Local, Bits<24>>,
-    normal_column: Signal<Local, Bits<24>>,
+    /// The step from this read's address to the next: 1, but from the matrix's last word to
+    /// the root, and 0 after a normal's third column (its fourth, which a vector never reads,
+    /// repeats the third: read `issued` is row `issued / 4`, column `min(issued % 4, 2)`).
+    addr_step: Signal<Local, Bits<24>>,
     /// The slot's instance record's first word in bank 4.
     record: Signal<Local, Bits<24>>,
     issued: DFF<Bits<4>>,
@@ -181,7 +181,8 @@ pub struct InstanceRays<const W: usize> {
     c_normal_first: Constant<Bits<24>>,
     c_normal_words: Constant<Bits<4>>,
     /// The root's word after the matrix's first.
-    c_root_offset: Constant<Bits<24>>,
+    c_root_step: Constant<Bits<24>>,
+    c_last_matrix_read: Constant<Bits<4>>,
     c_ml_last: Constant<Bits<3>>,
     /// The program uses the unit (see the module doc's "Absent").
     c_present: Constant<Bit>,
@@ -240,13 +241,11 @@ impl<const W: usize> InstanceRays<W> {
             taken: Default::default(),
             phase: Default::default(),
             entry_thread: Default::default(),
-            entry_record: Default::default(),
+            next_addr: Default::default(),
             entry_normal: Default::default(),
             entry_nz: Default::default(),
             entry_words: Default::default(),
-            normal_offset: Default::default(),
-            normal_row: Default::default(),
-            normal_column: Default::default(),
+            addr_step: Default::default(),
             record: Default::default(),
             issued: Default::default(),
             arrived: Default::default(),
@@ -273,8 +272,11 @@ impl<const W: usize> InstanceRays<W> {
             c_first_word: Constant::new((instance_word::WORLD_TO_OBJECT as u64).into()),
             c_normal_first: Constant::new((instance_word::NORMAL_MATRIX as u64).into()),
             c_normal_words: Constant::new(MATRIX_WORDS.into()),
-            c_root_offset: Constant::new(
-                ((instance_word::ROOT - instance_word::WORLD_TO_OBJECT) as u64).into(),
+            c_last_matrix_read: Constant::new((MATRIX_WORDS - 1).into()),
+            c_root_step: Constant::new(
+                ((instance_word::ROOT - instance_word::WORLD_TO_OBJECT) as u64
+                    - (MATRIX_WORDS - 1))
+                    .into(),
             ),
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
             c_present: Constant::new(present),
@@ -295,7 +297,7 @@ impl<const W: usize> Logic for InstanceRays<W> {
             slot_nz,
             phase,
             entry_thread,
-            entry_record,
+            next_addr,
             entry_normal,
             entry_nz,
             issued,
@@ -354,9 +356,9 @@ impl<const W: usize> Logic for InstanceRays<W> {
             self.entry_thread.d.next = self.slot_thread.q.val();
             self.entry_normal.d.next = self.slot_normal.q.val();
             self.entry_nz.d.next = self.slot_nz.q.val();
-            self.entry_record.d.next = self.record.val() + self.c_first_word.val();
+            self.next_addr.d.next = self.record.val() + self.c_first_word.val();
             if self.slot_normal.q.val() {
-                self.entry_record.d.next = self.record.val() + self.c_normal_first.val();
+                self.next_addr.d.next = self.record.val() + self.c_normal_first.val();
             }
             self.issued.d.next = 0.into();
             self.arrived.d.next = 0.into();
@@ -372,22 +374,20 @@ impl<const W: usize> Logic for InstanceRays<W> {
             & (self.issued.q.val() != self.entry_words.val())
             & self.bus_free.val();
         self.read.next = self.reading.val();
-        self.addr.next = self.entry_record.q.val() + bit_cast::<24, 4>(self.issued.q.val());
-        if self.issued.q.val() == self.c_last_word.val() {
-            self.addr.next = self.entry_record.q.val() + self.c_root_offset.val();
+        self.addr.next = self.next_addr.q.val();
+        self.addr_step.next = 1.into();
+        if self.issued.q.val() == self.c_last_matrix_read.val() {
+            self.addr_step.next = self.c_root_step.val();
         }
-        self.normal_row.next = bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(2));
-        self.normal_column.next = bit_cast::<24, 2>(self.issued.q.val().get_bits::<2>(0));
-        if self.issued.q.val().get_bits::<2>(0) == 3 {
-            self.normal_column.next = 2.into();
-        }
-        self.normal_offset.next =
-            (self.normal_row.val() << 1) + self.normal_row.val() + self.normal_column.val();
         if self.entry_normal.q.val() {
-            self.addr.next = self.entry_record.q.val() + self.normal_offset.val();
+            self.addr_step.next = 1.into();
+            if self.issued.q.val().get_bits::<2>(0) == 2 {
+                self.addr_step.next = 0.into();
+            }
         }
         if self.reading.val() {
             self.issued.d.next = self.issued.q.val() + 1;
+            self.next_addr.d.next = self.next_addr.q.val() + self.addr_step.val();
         }
         self.flight.d.next =
             (self.flight.q.val() << 1) | bit_cast::<8, 1>(self.reading.val().into());
