@@ -121,6 +121,116 @@ pub fn transform_row<A: Arith>(a: A, row: &[A::V], v: [A::V; 3], point: bool) ->
     }
 }
 
+/// One pass of the TransformUnit as its hardware computes it, `diagonal` included
+/// ([`hw::TransformUnit`](crate::hw::TransformUnit)'s input of that name): each row
+/// `((p0 + p1) + p2) + n` with `p_k = m[r][k] * v[k]`, except that in a diagonal pass the
+/// products off the diagonal are -0; a vector adds -0 in place of `n`. [`transform`] equals it
+/// without `diagonal` (the `+ (-0)` is an exact identity). Golden twin of the unit's passes
+/// for shading ([`hw::ShadeUnit`](crate::hw::ShadeUnit), src/hw/shade_unit.rs).
+pub fn transform_pass(f: Format, m: &Mat34W, v: Vec3W, point: bool, diagonal: bool) -> Vec3W {
+    let neg_zero = f.zero(true);
+    std::array::from_fn(|r| {
+        let p: [u32; 3] = std::array::from_fn(|k| {
+            if diagonal && r != k {
+                neg_zero
+            } else {
+                f.mul(m[r * 4 + k], v[k])
+            }
+        });
+        let s = f.add(f.add(p[0], p[1]), p[2]);
+        f.add(s, if point { m[r * 4 + 3] } else { neg_zero })
+    })
+}
+
+/// The 3x4 of a diagonal pass: `diag` on the diagonal, `offset` in the last column (zeros
+/// elsewhere: the pass never reads them).
+pub fn diagonal_matrix(diag: Vec3W, offset: Vec3W) -> Mat34W {
+    let mut m = [0; 12];
+    for r in 0..3 {
+        m[r * 4 + r] = diag[r];
+        m[r * 4 + 3] = offset[r];
+    }
+    m
+}
+
+/// A colour channel's frame-buffer bytes, `0x00RRGGBB`, as the engine's three `byte`
+/// instructions (or the ShadeUnit) pack them with [`channel_byte`].
+pub fn pack_channel_bytes(f: Format, c: Vec3W) -> u32 {
+    (channel_byte(f, c[0]) << 16) | (channel_byte(f, c[1]) << 8) | channel_byte(f, c[2])
+}
+
+/// A light of direct shading: its position and colour words.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LightWords {
+    pub position: Vec3W,
+    pub color: Vec3W,
+}
+
+/// The frame constants direct shading reads: ambient, background, the lights.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ShadingConstants {
+    pub ambient: u32,
+    pub background: Vec3W,
+    pub lights: Vec<LightWords>,
+}
+
+/// A hit as direct shading needs it: the ray, the hit's t, the triangle's stored unit normal
+/// and the material's diffuse colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SurfaceHit {
+    pub o: Vec3W,
+    pub d: Vec3W,
+    pub t: u32,
+    pub n: Vec3W,
+    pub kd: Vec3W,
+}
+
+/// Direct shading of a primary ray without shadows, mirrors or instances, pass for pass as
+/// the [`hw::ShadeUnit`](crate::hw::ShadeUnit) (src/hw/shade_unit.rs) computes it: the
+/// TransformUnit's passes ([`transform_pass`]) for the hit point `o + t d` (diagonal), `n . d`
+/// (a row), the ambient term `kd * ambient` (diagonal); per light `light - p` (diagonal, `-1`
+/// times `p` plus the light), `n . L` and `L . L` (two rows), then `sqrt` and `/` for the
+/// cosine, `kd * colour` and `acc + (kd colour) cos` (diagonal); the bytes packed. Equal bit
+/// for bit to the golden model's shading of the same hit (`model::golden`: [`ray_point`],
+/// [`facing_normal`], [`ambient`], [`lambert_cosine`], [`add_light`], [`pack_rgb`]; the test
+/// `shading_passes_equal_the_golden_shading`): `x + (-0) = x`, `-1 * x = -x` and the
+/// operators' commutativity make each pass the golden operation. `None`: a miss, the
+/// background.
+pub fn shade_direct(f: Format, k: &ShadingConstants, hit: Option<&SurfaceHit>) -> u32 {
+    let Some(h) = hit else {
+        return pack_channel_bytes(f, k.background);
+    };
+    let vector = |m: &Mat34W, v: Vec3W| transform_pass(f, m, v, false, false);
+    let diagonal = |diag: Vec3W, v: Vec3W, offset: Option<Vec3W>| {
+        let m = diagonal_matrix(diag, offset.unwrap_or([0; 3]));
+        transform_pass(f, &m, v, offset.is_some(), true)
+    };
+    let rows = |r0: Vec3W, r1: Vec3W, v: Vec3W| {
+        let m = [r0[0], r0[1], r0[2], 0, r1[0], r1[1], r1[2], 0, 0, 0, 0, 0];
+        vector(&m, v)
+    };
+    let p = diagonal(h.d, [h.t; 3], Some(h.o));
+    let along = rows(h.n, [0; 3], h.d)[0];
+    let n = if f.lt(0, along) {
+        h.n.map(|c| f.neg(c))
+    } else {
+        h.n
+    };
+    let mut acc = diagonal(h.kd, [k.ambient; 3], None);
+    let minus_one = f.from_int(-1);
+    for light in &k.lights {
+        let to_light = diagonal([minus_one; 3], p, Some(light.position));
+        let [n_dot_l, l_dot_l, _] = rows(n, to_light, to_light);
+        if !f.lt(0, n_dot_l) {
+            continue;
+        }
+        let cos = f.div(n_dot_l, f.sqrt(l_dot_l));
+        let tint = diagonal(h.kd, light.color, None);
+        acc = diagonal(tint, [cos; 3], Some(acc));
+    }
+    pack_channel_bytes(f, acc)
+}
+
 /// The normal transform is a 3x3 (the 3x4 layout without offsets), run as a vector transform.
 pub fn transform3<A: Arith>(a: A, m: &[A::V; 9], v: [A::V; 3]) -> [A::V; 3] {
     let row = |r: usize| {
@@ -529,6 +639,132 @@ mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+
+    // TransformUnit passes and direct shading.
+
+    /// A word for the pass tests: mostly values of magnitude 2^-6..2^6, else zeros of both
+    /// signs, infinities, NaN and uniform bit patterns (subnormals among them).
+    fn pass_word(f: Format, rng: &mut ChaCha8Rng) -> u32 {
+        match rng.gen_range(0..16) {
+            0 => f.zero(rng.gen_bool(0.5)),
+            1 => f.infinity(rng.gen_bool(0.5)),
+            2 => f.nan(),
+            3 => rng.gen::<u32>() & f.word_mask(),
+            _ => crate::hw::sim_harness::random_word(f, rng),
+        }
+    }
+
+    #[test]
+    fn a_pass_without_diagonal_is_the_transform() {
+        let seed = 71;
+        println!("seed {seed}");
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        for f in [Format::E7M16, Format::E8M23, Format::E5M10] {
+            for _ in 0..20_000 {
+                let m: Mat34W = std::array::from_fn(|_| pass_word(f, &mut rng));
+                let v: Vec3W = std::array::from_fn(|_| pass_word(f, &mut rng));
+                let point = rng.gen_bool(0.5);
+                assert_eq!(
+                    transform_pass(f, &m, v, point, false),
+                    transform(f, &m, v, point),
+                    "{f} {m:x?} {v:x?} {point}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_diagonal_pass_is_per_component() {
+        let seed = 72;
+        println!("seed {seed}");
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        for f in [Format::E7M16, Format::E8M23, Format::E5M10] {
+            for _ in 0..20_000 {
+                let mut w = || pass_word(f, &mut rng);
+                let (d, v, o) = ([w(), w(), w()], [w(), w(), w()], [w(), w(), w()]);
+                let m = diagonal_matrix(d, o);
+                let point = transform_pass(f, &m, v, true, true);
+                let vector = transform_pass(f, &m, v, false, true);
+                for r in 0..3 {
+                    assert_eq!(
+                        point[r],
+                        f.add(o[r], f.mul(v[r], d[r])),
+                        "{f} point row {r}"
+                    );
+                    assert_eq!(vector[r], f.mul(d[r], v[r]), "{f} vector row {r}");
+                }
+                // -1 times p plus the light is the light minus p.
+                let minus =
+                    transform_pass(f, &diagonal_matrix([f.from_int(-1); 3], o), v, true, true);
+                assert_eq!(minus, sub3(f, o, v), "{f}");
+            }
+        }
+    }
+
+    /// The golden model's direct shading of a hit (`model::golden`'s `shade` without shadows,
+    /// mirrors or instances), spelled with its own sequences.
+    fn golden_direct(f: Format, k: &ShadingConstants, hit: Option<&SurfaceHit>) -> u32 {
+        let Some(h) = hit else {
+            return pack_rgb(f, k.background);
+        };
+        let p = ray_point(f, h.o, h.d, h.t);
+        let n = facing_normal(f, h.n, h.d);
+        let mut acc = ambient(f, h.kd, k.ambient);
+        for light in &k.lights {
+            let to_light = sub3(f, light.position, p);
+            if let Some(cos) = lambert_cosine(f, n, to_light) {
+                acc = add_light(f, acc, h.kd, light.color, cos);
+            }
+        }
+        pack_rgb(f, acc)
+    }
+
+    #[test]
+    fn shading_passes_equal_the_golden_shading() {
+        let seed = 73;
+        println!("seed {seed}");
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        for f in [Format::E7M16, Format::E8M23, Format::E5M10] {
+            let mut lit = 0;
+            for case in 0..20_000 {
+                // Scene-like values most of the time (a unit normal, colours in [0, 1], a
+                // light above), any words in one case of four.
+                let wild = case % 4 == 0;
+                let mut w = |lo: f64, hi: f64| {
+                    if wild {
+                        pass_word(f, &mut rng)
+                    } else {
+                        f.from_f64(rng.gen_range(lo..hi))
+                    }
+                };
+                let n = [w(-1.0, 1.0), w(-1.0, 1.0), w(-1.0, 1.0)];
+                let hit = SurfaceHit {
+                    o: [w(-2.0, 2.0), w(-2.0, 2.0), w(-5.0, -3.0)],
+                    d: [w(-1.0, 1.0), w(-1.0, 1.0), w(0.5, 1.0)],
+                    t: w(0.0, 8.0),
+                    n,
+                    kd: [w(0.0, 1.0), w(0.0, 1.0), w(0.0, 1.0)],
+                };
+                let lights = (0..case % 4)
+                    .map(|_| LightWords {
+                        position: [w(-3.0, 3.0), w(2.0, 4.0), w(-3.0, 3.0)],
+                        color: [w(0.0, 1.0), w(0.0, 1.0), w(0.0, 1.0)],
+                    })
+                    .collect();
+                let k = ShadingConstants {
+                    ambient: w(0.0, 0.3),
+                    background: [w(0.0, 1.0), w(0.0, 1.0), w(0.0, 1.0)],
+                    lights,
+                };
+                let hit = (case % 7 != 0).then_some(&hit);
+                let got = shade_direct(f, &k, hit);
+                assert_eq!(got, golden_direct(f, &k, hit), "{f} case {case}");
+                lit += usize::from(got != pack_rgb(f, k.background) && hit.is_some());
+            }
+            // The comparison saw shaded surfaces, not only backgrounds and black.
+            assert!(lit > 5_000, "{f}: {lit}");
+        }
+    }
 
     // Channel bytes.
 

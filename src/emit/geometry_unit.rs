@@ -4,7 +4,7 @@
 //! [`geometry_unit_rtl`] produces one self-contained file: rust-hdl's flat output renamed to
 //! `<top>_core` (as for the fp operators, see `fp_unit`) and a top `<unit>_<format>` (e.g.
 //! `intersect_e7m16`) with one readable port per word:
-//! - `transform`: `in_valid, m_0..m_11` (row-major 3x4), `x, y, z, point, tag[15:0]` ->
+//! - `transform`: `in_valid, m_0..m_11` (row-major 3x4), `x, y, z, point, diagonal, tag[15:0]` ->
 //!   `out_valid, r_x, r_y, r_z, out_tag`;
 //! - `shared_transform`: per client `c` in 0..4: `c<c>_valid`, `c<c>_ready` (out),
 //!   `c<c>_m_0..11, c<c>_x, _y, _z, c<c>_point, c<c>_thread[7:0]` -> `out_valid,
@@ -157,6 +157,7 @@ fn top_ports(unit: GeometryUnit, w: u32) -> Vec<TopPort> {
                 p.push(input(*c, w, format!("v__{k}")));
             }
             p.push(input("point", 1, "point"));
+            p.push(input("diagonal", 1, "diagonal"));
             p.push(input("tag", tag, "tag"));
             p.push(output("out_valid", 1, "out_valid"));
             for (k, c) in XYZ.iter().enumerate() {

@@ -25,7 +25,7 @@ pub mod processor;
 pub mod ray_store;
 pub mod raygen;
 #[cfg(test)]
-mod sim_harness;
+pub(crate) mod sim_harness;
 pub mod sync_fifo;
 pub mod transform;
 pub mod transform_arbiter;

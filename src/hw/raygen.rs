@@ -348,6 +348,7 @@ impl<
             self.origin[k].next = self.eye[k].val();
         }
         self.unit.point.next = self.raygen.req_point.val();
+        self.unit.diagonal.next = false;
         self.unit.tag.next = bit_cast::<TAG_BITS, THREAD_BITS>(self.raygen.req_thread.val());
         self.out_valid.next = self.unit.out_valid.val();
         self.out_thread.next = self.unit.out_tag.val().get_bits::<THREAD_BITS>(0);

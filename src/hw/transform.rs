@@ -54,6 +54,11 @@ pub struct TransformUnit<
     pub v: [Signal<In, Bits<W>>; 3],
     /// 1: a point (add the offset column), 0: a vector.
     pub point: Signal<In, Bit>,
+    /// 1: the six products off the diagonal are -0 (each multiplier takes -0 times +0), so
+    /// row `r` is `m[r][r] * v[r]` (plus `n[r]` for a point) exactly: `x + (-0) = x` for
+    /// every word an operator produces. Shading's per-component passes (`o + t d`,
+    /// `light - p`, `kd * colour`, `acc + m cos`) go through the unit this way.
+    pub diagonal: Signal<In, Bit>,
     pub tag: Signal<In, Bits<TAG_BITS>>,
     pub out_valid: Signal<Out, Bit>,
     pub result: [Signal<Out, Bits<W>>; 3],
@@ -69,6 +74,7 @@ pub struct TransformUnit<
     tag_delay: Delay<Bits<TAG_BITS>, TOTAL_DELAY>,
     offset: [Signal<Local, Bits<W>>; 3],
     c_neg_zero: Constant<Bits<W>>,
+    c_zero: Constant<Bits<W>>,
 }
 
 impl<
@@ -91,6 +97,7 @@ impl<
             m: Default::default(),
             v: Default::default(),
             point: Default::default(),
+            diagonal: Default::default(),
             tag: Default::default(),
             out_valid: Default::default(),
             result: Default::default(),
@@ -102,6 +109,7 @@ impl<
             tag_delay: Default::default(),
             offset: Default::default(),
             c_neg_zero: const_bits::<W>(1 << (W - 1)),
+            c_zero: const_bits::<W>(0),
         }
     }
 }
@@ -157,6 +165,21 @@ impl<
             self.add[r * 3 + 2].b.next = self.offset_delay[r].data_out.val();
             self.result[r].next = self.add[r * 3 + 2].result.val();
         }
+        // The products off the diagonal (m[r][k], r != k: 1, 2, 3, 5, 6, 7) in a diagonal pass.
+        if self.diagonal.val() {
+            self.mul[1].a.next = self.c_neg_zero.val();
+            self.mul[1].b.next = self.c_zero.val();
+            self.mul[2].a.next = self.c_neg_zero.val();
+            self.mul[2].b.next = self.c_zero.val();
+            self.mul[3].a.next = self.c_neg_zero.val();
+            self.mul[3].b.next = self.c_zero.val();
+            self.mul[5].a.next = self.c_neg_zero.val();
+            self.mul[5].b.next = self.c_zero.val();
+            self.mul[6].a.next = self.c_neg_zero.val();
+            self.mul[6].b.next = self.c_zero.val();
+            self.mul[7].a.next = self.c_neg_zero.val();
+            self.mul[7].b.next = self.c_zero.val();
+        }
         self.tag_delay.data_in.next = self.tag.val();
         self.out_tag.next = self.tag_delay.data_out.val();
         self.out_valid.next = self.add[2].out_valid.val();
@@ -171,19 +194,21 @@ mod tests {
     use crate::units;
     use rand::{Rng, SeedableRng};
 
-    /// rust-hdl simulation: 300 random transforms (points and vectors) one per clock, each
-    /// result exactly TRANSFORM_LATENCY clocks after its request, equal to the model, tag kept.
+    /// rust-hdl simulation: 300 random transforms (points and vectors, full and diagonal
+    /// passes) one per clock, each result exactly TRANSFORM_LATENCY clocks after its request,
+    /// equal to the model, tag kept.
     #[test]
     fn rust_hdl_simulation_matches_model_e7m16() {
         let f = Format::E7M16;
         let seed = 11;
         println!("seed {seed}");
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let reqs: Vec<([u32; 12], [u32; 3], bool)> = (0..300)
+        let reqs: Vec<([u32; 12], [u32; 3], bool, bool)> = (0..300)
             .map(|_| {
                 (
                     std::array::from_fn(|_| random_word(f, &mut rng)),
                     std::array::from_fn(|_| random_word(f, &mut rng)),
+                    rng.gen_bool(0.5),
                     rng.gen_bool(0.5),
                 )
             })
@@ -195,7 +220,7 @@ mod tests {
         for cycle in 0..reqs.len() + lat + 2 {
             let req = reqs.get(cycle);
             u.in_valid.next = req.is_some();
-            if let Some((m, v, point)) = req {
+            if let Some((m, v, point, diagonal)) = req {
                 for k in 0..12 {
                     u.m[k].next = (m[k] as u64).into();
                 }
@@ -203,6 +228,7 @@ mod tests {
                     u.v[k].next = (v[k] as u64).into();
                 }
                 u.point.next = *point;
+                u.diagonal.next = *diagonal;
                 u.tag.next = ((cycle as u64 * 3) & 0xffff).into();
             }
             clock_cycle(&mut u, |u, c| u.clock.next = Clock { clk: c });
@@ -217,8 +243,22 @@ mod tests {
                 got.push((r, u.out_tag.val().to_u64()));
             }
         }
-        for (i, ((m, v, point), (r, tag))) in reqs.iter().zip(&got).enumerate() {
-            assert_eq!(*r, units::transform(f, m, *v, *point), "request {i}");
+        let diagonal_rows_differ = reqs
+            .iter()
+            .filter(|(m, v, point, diagonal)| {
+                *diagonal
+                    && units::transform(f, m, *v, *point)
+                        != units::transform_pass(f, m, *v, *point, true)
+            })
+            .count();
+        // The diagonal passes are not the full transform (a unit ignoring the input fails).
+        assert!(diagonal_rows_differ > 100, "{diagonal_rows_differ}");
+        for (i, ((m, v, point, diagonal), (r, tag))) in reqs.iter().zip(&got).enumerate() {
+            assert_eq!(
+                *r,
+                units::transform_pass(f, m, *v, *point, *diagonal),
+                "request {i}"
+            );
             assert_eq!(*tag, (i as u64 * 3) & 0xffff, "tag of request {i}");
         }
     }

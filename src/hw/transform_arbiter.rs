@@ -212,6 +212,7 @@ impl<
             self.unit.v[k].next = self.taken_v[k].q.val();
         }
         self.unit.point.next = self.taken_point.q.val();
+        self.unit.diagonal.next = false;
         self.unit.tag.next = self.taken_tag.q.val();
         self.unit.in_valid.next = self.taken_valid.q.val();
         if self.any_valid_before[4].val() {

@@ -149,6 +149,8 @@ pub struct TriangleTester<
     pub gen_m: [Signal<In, Bits<W>>; 12],
     pub gen_v: [Signal<In, Bits<W>>; 3],
     pub gen_point: Signal<In, Bit>,
+    /// The request is a diagonal pass (`TransformUnit::diagonal`).
+    pub gen_diagonal: Signal<In, Bit>,
     pub gen_client: Signal<In, Bits<2>>,
     pub gen_thread: Signal<In, Bits<5>>,
     pub gen_take: Signal<Out, Bit>,
@@ -261,6 +263,7 @@ pub struct TriangleTester<
     gen_hold_m: [DFF<Bits<W>>; 12],
     gen_hold_v: [DFF<Bits<W>>; 3],
     gen_hold_point: DFF<Bit>,
+    gen_hold_diagonal: DFF<Bit>,
     gen_hold_client: DFF<Bits<2>>,
     gen_hold_thread: DFF<Bits<5>>,
     gen_go: Signal<Local, Bit>,
@@ -340,6 +343,7 @@ impl<
             gen_m: Default::default(),
             gen_v: Default::default(),
             gen_point: Default::default(),
+            gen_diagonal: Default::default(),
             gen_client: Default::default(),
             gen_thread: Default::default(),
             gen_take: Default::default(),
@@ -356,6 +360,7 @@ impl<
             gen_hold_m: Default::default(),
             gen_hold_v: Default::default(),
             gen_hold_point: Default::default(),
+            gen_hold_diagonal: Default::default(),
             gen_hold_client: Default::default(),
             gen_hold_thread: Default::default(),
             gen_go: Default::default(),
@@ -504,6 +509,7 @@ impl<
             m3_best,
             gen_held,
             gen_hold_point,
+            gen_hold_diagonal,
             gen_hold_client,
             gen_hold_thread
         );
@@ -776,6 +782,7 @@ impl<
         self.ray.t_min_thread.next = self.l_thread.val();
         self.transform_unit.in_valid.next = false;
         self.transform_unit.point.next = true;
+        self.transform_unit.diagonal.next = false;
         for k in 0..3 {
             self.transform_unit.v[k].next = self.ray.o[k].val();
         }
@@ -839,6 +846,7 @@ impl<
                 self.transform_unit.v[k].next = self.gen_hold_v[k].q.val();
             }
             self.transform_unit.point.next = self.gen_hold_point.q.val();
+            self.transform_unit.diagonal.next = self.gen_hold_diagonal.q.val();
             self.transform_unit.tag.next = self.c_primary.val()
                 | (bit_cast::<16, 2>(self.gen_hold_client.q.val()) << 10)
                 | (bit_cast::<16, 5>(self.gen_hold_thread.q.val()) << 5);
@@ -852,6 +860,7 @@ impl<
                 self.gen_hold_v[k].d.next = self.gen_v[k].val();
             }
             self.gen_hold_point.d.next = self.gen_point.val();
+            self.gen_hold_diagonal.d.next = self.gen_diagonal.val();
             self.gen_hold_client.d.next = self.gen_client.val();
             self.gen_hold_thread.d.next = self.gen_thread.val();
         }

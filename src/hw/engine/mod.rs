@@ -848,6 +848,7 @@ impl<
         // written whole into both ray stores (the engine's ray words are refused in that
         // clock). The client bits say whose result it is (`GenClient`).
         self.tester.gen_valid.next = self.rays.gen_valid.val() | self.instances.gen_valid.val();
+        self.tester.gen_diagonal.next = false;
         if self.gen_instance.val() {
             for k in 0..12 {
                 self.tester.gen_m[k].next = self.instances.gen_m[k].val();

@@ -32,6 +32,8 @@ pub struct TransformRequest {
     pub m: [u32; 12],
     pub v: [u32; 3],
     pub point: bool,
+    /// A diagonal pass (`TransformUnit::diagonal`; the standalone unit only).
+    pub diagonal: bool,
     /// Travels with the request (the standalone unit's 16-bit tag; the shared unit's thread id,
     /// 8 bits).
     pub tag: u16,
@@ -109,13 +111,14 @@ pub fn run_transform(
     }
     let rtl = geometry_unit_rtl(GeometryUnit::Transform, fmt)?;
     let mut fields: Vec<String> = (0..12).map(|k| format!("m_{k}")).collect();
-    fields.extend(["x", "y", "z", "point", "tag"].map(String::from));
+    fields.extend(["x", "y", "z", "point", "diagonal", "tag"].map(String::from));
     let lines = requests
         .iter()
         .enumerate()
         .map(|(i, r)| {
             let mut v: Vec<u64> = r.m.iter().chain(&r.v).map(|&w| u64::from(w)).collect();
             v.push(u64::from(r.point));
+            v.push(u64::from(r.diagonal));
             v.push(u64::from(r.tag));
             (gaps.get(i).copied().unwrap_or(0), v)
         })

@@ -193,6 +193,7 @@ fn transform_random(f: Format, n: usize, seed: u64) -> Vec<TransformRequest> {
                 m,
                 v,
                 point: rng.gen_bool(0.5),
+                diagonal: rng.gen_ratio(1, 4),
                 tag: i as u16,
             }
         })
@@ -209,6 +210,7 @@ fn transform_hard(f: Format, seed: u64) -> Vec<TransformRequest> {
             m,
             v,
             point,
+            diagonal: false,
             tag: 0,
         })
     };
@@ -271,7 +273,7 @@ fn check_transform(f: Format, reqs: &[TransformRequest], got: &[TransformResult]
     assert_eq!(got.len(), reqs.len(), "{what}: result count");
     let mut bad = 0;
     for (i, (q, r)) in reqs.iter().zip(got).enumerate() {
-        let want = units::transform(f, &q.m, q.v, q.point);
+        let want = units::transform_pass(f, &q.m, q.v, q.point, q.diagonal);
         if r.r != want || r.tag != q.tag {
             if bad < 5 {
                 eprintln!(
@@ -340,7 +342,14 @@ fn transform_e8m23_verilator() {
 fn shared_case(f: Format, per_client: usize, seed: u64, sim: Simulator) {
     println!("shared transform {f}: seed {seed}");
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let reqs = transform_random(f, 4 * per_client, seed + 1);
+    // The shared unit's clients ask for full passes only.
+    let reqs: Vec<TransformRequest> = transform_random(f, 4 * per_client, seed + 1)
+        .into_iter()
+        .map(|r| TransformRequest {
+            diagonal: false,
+            ..r
+        })
+        .collect();
     let clients: [Vec<(u32, TransformRequest)>; 4] = std::array::from_fn(|c| {
         reqs[c * per_client..(c + 1) * per_client]
             .iter()
@@ -860,6 +869,7 @@ impl<
             self.unit.v[k].next = self.rays.gen_v[k].val();
         }
         self.unit.point.next = true;
+        self.unit.diagonal.next = false;
         self.unit.tag.next = bit_cast::<16, 5>(self.rays.gen_thread.val());
         self.rays.gen_out_valid.next = self.unit.out_valid.val();
         self.rays.gen_out_thread.next = self.unit.out_tag.val().get_bits::<5>(0);
@@ -1226,6 +1236,7 @@ impl<
             self.unit.v[k].next = self.entries.gen_v[k].val();
         }
         self.unit.point.next = self.entries.gen_point.val();
+        self.unit.diagonal.next = false;
         self.unit.tag.next = bit_cast::<16, 5>(self.entries.gen_thread.val())
             | (bit_cast::<16, 1>(self.entries.gen_direction.val().into()) << 5)
             | (bit_cast::<16, 1>(self.entries.gen_normal.val().into()) << 6);
