@@ -24,6 +24,7 @@ pub mod ports;
 pub mod processor;
 pub mod ray_store;
 pub mod raygen;
+pub mod shade_unit;
 #[cfg(test)]
 pub(crate) mod sim_harness;
 pub mod sync_fifo;
@@ -41,6 +42,7 @@ pub use list_unit::ListUnit;
 pub use lut_ram::LutRam;
 pub use no_collision_ram::NoCollisionRam;
 pub use raygen::{RayGen, RayGenUnit};
+pub use shade_unit::{ShadeConfig, ShadeUnit};
 pub use sync_fifo::SyncFifo;
 pub use transform::{TransformUnit, TRANSFORM_LATENCY};
 pub use transform_arbiter::{SharedTransformUnit, SHARED_TRANSFORM_LATENCY, TRANSFORM_CLIENTS};
