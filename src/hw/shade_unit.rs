@@ -20,7 +20,7 @@
 //!   loading); the thread's ray is copied then, so it may trace its next ray at once.
 //! - Memory: `tri_read` with `tri_addr` reads banks 2 and 3 at once (`tri_rdata_a`,
 //!   `tri_rdata_b`), `frame_read` with `frame_addr` bank 5; each read goes out in a clock
-//!   with its `*_grant` and its word arrives `mem_latency` clocks later.
+//!   with its `*_grant` and its word arrives `tri_latency` (`frame_latency`) clocks later.
 //! - TransformUnit (a client port like the tester's `gen_*`): a request (`gen_valid`, matrix
 //!   `gen_m`, `gen_v`, `gen_point`, `gen_diagonal`, `gen_slot`) is held until `gen_take`; its
 //!   result comes back on `res_*` with its slot, in request order.
@@ -56,7 +56,8 @@ use super::fp::{const_bits, FpDiv, FpSqrt};
 use super::{ChannelByte, Delay, DelayLine, LutRam, CHANNEL_BYTE_LATENCY};
 use crate::layout::{FrameMap, TRANSFORM_BANK_WORDS};
 
-/// Pixels the unit shades at once.
+/// Pixels the unit shades at once (`update` spells out `[8]`: rust-hdl's Verilog cannot name
+/// Rust constants in an index).
 pub const SHADE_SLOTS: usize = 8;
 /// Most lights the unit holds.
 pub const MAX_SHADE_LIGHTS: usize = 8;
@@ -168,7 +169,7 @@ pub struct ShadeUnit<
     d: [SlotRam<Bits<W>>; 3],
     t: SlotRam<Bits<W>>,
     addr: SlotRam<Bits<24>>,
-    tri: SlotRam<Bits<24>>,
+    triangle: SlotRam<Bits<24>>,
     n: [SlotRam<Bits<W>>; 3],
     material: SlotRam<Bits<24>>,
     kd: [SlotRam<Bits<W>>; 3],
@@ -284,8 +285,11 @@ pub struct ShadeUnit<
 /// The scene's side of a [`ShadeUnit`].
 #[derive(Clone, Copy, Debug)]
 pub struct ShadeConfig {
-    /// Clocks from a granted read to its word.
-    pub mem_latency: u32,
+    /// Clocks from a granted read of banks 2 and 3 to its words (the engine registers the
+    /// read: its memory latency plus one).
+    pub tri_latency: u32,
+    /// Clocks from a granted read of bank 5 to its word.
+    pub frame_latency: u32,
     /// The scene's lights (at most [`MAX_SHADE_LIGHTS`]).
     pub lights: u32,
     /// The frame word of material 0 (`ProgramConfig::materials`).
@@ -308,9 +312,11 @@ impl<
     pub fn new(config: ShadeConfig) -> Self {
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
         assert!(config.lights as usize <= MAX_SHADE_LIGHTS, "{config:?}");
-        assert!(config.mem_latency >= 1, "{config:?}");
+        assert!(
+            config.tri_latency >= 1 && config.frame_latency >= 1,
+            "{config:?}"
+        );
         let f = crate::fp::Format::new(E as u32, M as u32).expect("a supported format");
-        let mem = config.mem_latency as usize;
         let sqrt_clocks = sqrt_latency(M as u32) as usize;
         let cos_clocks = sqrt_clocks + div_latency(M as u32) as usize;
         let words = 4 + 6 * config.lights as u64;
@@ -363,7 +369,7 @@ impl<
             d: std::array::from_fn(|_| slot_ram()),
             t: slot_ram(),
             addr: slot_ram(),
-            tri: slot_ram(),
+            triangle: slot_ram(),
             n: std::array::from_fn(|_| slot_ram()),
             material: slot_ram(),
             kd: std::array::from_fn(|_| slot_ram()),
@@ -425,8 +431,8 @@ impl<
             byte_tag_in: Default::default(),
             rgb_next: Default::default(),
             any_busy: Default::default(),
-            tri_line: DelayLine::new(mem),
-            frame_line: DelayLine::new(mem),
+            tri_line: DelayLine::new(config.tri_latency as usize),
+            frame_line: DelayLine::new(config.frame_latency as usize),
             tri_tag: Default::default(),
             frame_tag: Default::default(),
             tri_arrived: Default::default(),
@@ -566,7 +572,7 @@ impl<
         }
         self.t.write_clock.next = self.clock.val();
         self.addr.write_clock.next = self.clock.val();
-        self.tri.write_clock.next = self.clock.val();
+        self.triangle.write_clock.next = self.clock.val();
         self.material.write_clock.next = self.clock.val();
         self.n_dot_l.write_clock.next = self.clock.val();
         self.l_dot_l.write_clock.next = self.clock.val();
@@ -574,7 +580,7 @@ impl<
         self.rgb.write_clock.next = self.clock.val();
         self.t.read_address.next = self.s1_slot.q.val();
         self.addr.read_address.next = self.s1_slot.q.val();
-        self.tri.read_address.next = self.s1_slot.q.val();
+        self.triangle.read_address.next = self.s1_slot.q.val();
         self.material.read_address.next = self.s1_slot.q.val();
         self.n_dot_l.read_address.next = self.s1_slot.q.val();
         self.l_dot_l.read_address.next = self.s1_slot.q.val();
@@ -608,7 +614,7 @@ impl<
             & (self.const_issued.q.val() != self.c_const_total.val())
             & self.frame_grant.val();
         self.tri_read.next = false;
-        self.tri_addr.next = (self.tri.read_data.val() << 3)
+        self.tri_addr.next = (self.triangle.read_data.val() << 3)
             + self.c_shading_word.val()
             + bit_cast::<24, 2>(self.s1_word.q.val());
         self.tri_tag.next = 0.into();
@@ -857,8 +863,8 @@ impl<
                 self.ready_slot.next = self.c_slot[s].val();
             }
         }
-        self.pick.next = self.any_ready_before[SHADE_SLOTS].val()
-            & ((!self.s1_valid.q.val()) | self.s1_done.val());
+        self.pick.next =
+            self.any_ready_before[8].val() & ((!self.s1_valid.q.val()) | self.s1_done.val());
         if (!self.s1_valid.q.val()) | self.s1_done.val() {
             self.s1_valid.d.next = self.pick.val();
             self.s1_slot.d.next = self.ready_slot.val();
@@ -876,7 +882,7 @@ impl<
                 self.free_slot.next = self.c_slot[s].val();
             }
         }
-        self.refused.next = self.loading.q.val() | (!self.any_free_before[SHADE_SLOTS].val());
+        self.refused.next = self.loading.q.val() | (!self.any_free_before[8].val());
         self.taken.next = self.offer.val() & (!self.refused.val());
         for k in 0..3 {
             self.o[k].write_address.next = self.free_slot.val();
@@ -892,9 +898,9 @@ impl<
         self.addr.write_address.next = self.free_slot.val();
         self.addr.write_enable.next = self.taken.val();
         self.addr.write_data.next = self.offer_addr.val();
-        self.tri.write_address.next = self.free_slot.val();
-        self.tri.write_enable.next = self.taken.val();
-        self.tri.write_data.next = self.offer_triangle.val();
+        self.triangle.write_address.next = self.free_slot.val();
+        self.triangle.write_enable.next = self.taken.val();
+        self.triangle.write_data.next = self.offer_triangle.val();
 
         // ---- Memory words arriving. ----
         self.tri_line.data_in.next = self.tri_tag.val();
@@ -1220,7 +1226,7 @@ mod tests {
     /// `units::shade_direct` of its hit (the golden model's shading).
     fn shade_pixels(lights: u32, seed: u64) {
         let f = Format::E7M16;
-        let mem_latency = 2;
+        let (tri_latency, frame_latency) = (3, 2);
         println!("seed {seed}, {lights} lights");
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let mut w = |rng: &mut ChaCha8Rng, lo: f64, hi: f64| f.from_f64(rng.gen_range(lo..hi));
@@ -1323,7 +1329,8 @@ mod tests {
             clock: Default::default(),
             tu_free: Default::default(),
             unit: Unit::new(ShadeConfig {
-                mem_latency,
+                tri_latency,
+                frame_latency,
                 lights,
                 materials: MATERIALS,
                 frame_buffer: FRAME_BUFFER,
@@ -1349,16 +1356,16 @@ mod tests {
             );
             let u = &mut b.unit;
             u.frame_start.next = cycles == 1;
-            // Words requested mem_latency clocks ago.
-            let word = |q: &VecDeque<Option<u32>>, bank: &[u32]| {
-                q.get(q.len().wrapping_sub(mem_latency as usize))
+            // Words requested the latency's clocks ago.
+            let word = |q: &VecDeque<Option<u32>>, latency: u32, bank: &[u32]| {
+                q.get(q.len().wrapping_sub(latency as usize))
                     .copied()
                     .flatten()
                     .map_or(0, |a| bank[a as usize])
             };
-            u.tri_rdata_a.next = (word(&tri_reads, &bank_a) as u64).into();
-            u.tri_rdata_b.next = (word(&tri_reads, &bank_b) as u64).into();
-            u.frame_rdata.next = (word(&frame_reads, &frame) as u64).into();
+            u.tri_rdata_a.next = (word(&tri_reads, tri_latency, &bank_a) as u64).into();
+            u.tri_rdata_b.next = (word(&tri_reads, tri_latency, &bank_b) as u64).into();
+            u.frame_rdata.next = (word(&frame_reads, frame_latency, &frame) as u64).into();
             u.tri_grant.next = rng.gen_ratio(3, 4);
             u.frame_grant.next = rng.gen_ratio(3, 4);
             u.fb_grant.next = rng.gen_ratio(3, 4);

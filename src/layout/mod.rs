@@ -275,6 +275,24 @@ impl Layout {
         let a = (self.info.materials + material * MATERIAL_WORDS as u32) as usize;
         (self.words::<3>(FRAME, a), self.banks[FRAME][a + 3])
     }
+    /// The frame constants of direct shading: ambient, background and the lights' words.
+    pub fn shading_constants(&self) -> crate::units::ShadingConstants {
+        let w = |k: usize| self.banks[FRAME][k];
+        let lights = (0..self.info.light_count as usize)
+            .map(|light| {
+                let at = FrameMap::LIGHTS + light * LIGHT_WORDS;
+                crate::units::LightWords {
+                    position: self.words::<3>(FRAME, at),
+                    color: self.words::<3>(FRAME, at + 3),
+                }
+            })
+            .collect();
+        crate::units::ShadingConstants {
+            ambient: w(FrameMap::AMBIENT),
+            background: self.words::<3>(FRAME, FrameMap::BACKGROUND),
+            lights,
+        }
+    }
     /// Words used per bank (frame buffer included).
     pub fn used_words(&self) -> Vec<usize> {
         self.banks.iter().map(Vec::len).collect()

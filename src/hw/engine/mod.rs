@@ -83,7 +83,8 @@ use super::list_unit;
 use super::ports::{BankedSramRead, FrameBufferWrite, SramRead, SHARED_BUS_BANKS};
 use super::program::isa::{KdFn, Op, TriFn, Unit, PC_BITS};
 use super::program::Program;
-use super::{TraversalUnit, TriangleTester};
+use super::shade_unit::ShadeConfig;
+use super::{ShadeUnit, TraversalUnit, TriangleTester};
 use crate::layout;
 
 mod decode;
@@ -263,6 +264,8 @@ pub struct ThreadEngine<
     mailboxes: MailboxUnit,
     rays: PrimaryRays<W, E, M>,
     instances: InstanceRays<W>,
+    /// Shading in hardware (`tri.shade`), present for a program that uses it.
+    shader: ShadeUnit<W, E, M, S, S1, X2, T, P>,
     execute: Execute<W>,
     fp_units: FpUnits<W, E, M, S, S1, X2, T, P>,
     result_line: ResultLine<DX>,
@@ -305,6 +308,16 @@ pub struct ThreadEngine<
     world_write: DFF<Bit>,
     enter_offer: DFF<Bit>,
     normal_offer: DFF<Bit>,
+    shade_offer: DFF<Bit>,
+    /// The address of banks 2 and 3 the tester's ports read for the engine: a load's, or the
+    /// ShadeUnit's in a clock the engine's loads leave them.
+    tri_load_addr_r: DFF<Bits<24>>,
+    engine_loads_triangles: Signal<Local, Bit>,
+    /// The ShadeUnit's request goes to the TransformUnit (after ray generation's and instance
+    /// entry's).
+    gen_shade: Signal<Local, Bit>,
+    /// The frame is in progress: threads run, or the ShadeUnit still has pixels.
+    in_frame: Signal<Local, Bit>,
     tri_enqueue: DFF<Bit>,
     tri_queues: DFF<Bit>,
     tri_kind: DFF<Bits<2>>,
@@ -334,6 +347,7 @@ pub struct ThreadEngine<
     /// it does an absent `InstanceRays`.
     c_uses_mailboxes: Constant<Bit>,
     c_uses_scratch: Constant<Bit>,
+    c_shading: Constant<Bit>,
     // The glue's names, every one from its definition in `isa` (`Op`, `TriFn`, `KdFn`),
     // `layout` (banks) and `list_unit` (command kinds): the Verilog's localparams follow the
     // twin's numbering by construction.
@@ -359,6 +373,7 @@ pub struct ThreadEngine<
     tri_world: Constant<Bits<32>>,
     tri_enter: Constant<Bits<32>>,
     tri_normal: Constant<Bits<32>>,
+    tri_shade: Constant<Bits<32>>,
     kd_start: Constant<Bits<32>>,
     kd_wait: Constant<Bits<32>>,
     kd_next: Constant<Bits<32>>,
@@ -368,6 +383,11 @@ pub struct ThreadEngine<
     cmd_skip: Constant<Bits<2>>,
     bank_lists: Constant<Bits<3>>,
     bank_instances: Constant<Bits<3>>,
+    bank_frame: Constant<Bits<3>>,
+    bank_triangles_a: Constant<Bits<3>>,
+    bank_triangles_b: Constant<Bits<3>>,
+    /// Banks 2 and 3 as `mem_load_r` bits.
+    triangle_banks: Constant<Bits<{ layout::BANKS }>>,
     client_primary: Constant<Bits<2>>,
     client_origin: Constant<Bits<2>>,
     client_normal: Constant<Bits<2>>,
@@ -442,6 +462,17 @@ impl<
             mailboxes: Default::default(),
             rays: PrimaryRays::new(&program.config),
             instances: InstanceRays::new(mem_latency, units.contains(&Unit::InstanceEntry)),
+            shader: ShadeUnit::new(ShadeConfig {
+                tri_latency: mem_latency + 1,
+                frame_latency: mem_latency,
+                lights: if units.contains(&Unit::Shading) {
+                    program.config.light_count
+                } else {
+                    0
+                },
+                materials: program.config.materials,
+                frame_buffer: program.config.frame_buffer,
+            }),
             execute: Default::default(),
             fp_units: Default::default(),
             result_line: ResultLine::new(mem_latency),
@@ -478,6 +509,11 @@ impl<
             world_write: Default::default(),
             enter_offer: Default::default(),
             normal_offer: Default::default(),
+            shade_offer: Default::default(),
+            tri_load_addr_r: Default::default(),
+            engine_loads_triangles: Default::default(),
+            gen_shade: Default::default(),
+            in_frame: Default::default(),
             tri_enqueue: Default::default(),
             tri_queues: Default::default(),
             tri_kind: Default::default(),
@@ -500,6 +536,7 @@ impl<
             c_threads: Constant::new(u64::from(threads).into()),
             c_uses_mailboxes: Constant::new(units.contains(&Unit::Mailbox)),
             c_uses_scratch: Constant::new(units.contains(&Unit::Scratch)),
+            c_shading: Constant::new(units.contains(&Unit::Shading)),
             op_fsub: op_code(Op::FSub),
             op_fdiv: op_code(Op::FDiv),
             op_fsqrt: op_code(Op::FSqrt),
@@ -521,6 +558,7 @@ impl<
             tri_world: tri_fn(TriFn::World),
             tri_enter: tri_fn(TriFn::Enter),
             tri_normal: tri_fn(TriFn::Normal),
+            tri_shade: tri_fn(TriFn::Shade),
             kd_start: kd_fn(KdFn::Start),
             kd_wait: kd_fn(KdFn::Wait),
             kd_next: kd_fn(KdFn::Next),
@@ -530,6 +568,12 @@ impl<
             cmd_skip: cmd(list_unit::CMD_SKIP),
             bank_lists: bank(layout::LISTS),
             bank_instances: bank(layout::INSTANCES),
+            bank_frame: bank(layout::FRAME),
+            bank_triangles_a: bank(layout::TRIANGLES_A),
+            bank_triangles_b: bank(layout::TRIANGLES_B),
+            triangle_banks: Constant::new(
+                ((1u64 << layout::TRIANGLES_A) | (1u64 << layout::TRIANGLES_B)).into(),
+            ),
             client_primary: Constant::new((GenClient::Primary as u64).into()),
             client_origin: Constant::new((GenClient::InstanceOrigin as u64).into()),
             client_normal: Constant::new((GenClient::InstanceNormal as u64).into()),
@@ -581,6 +625,8 @@ impl<
             world_write,
             enter_offer,
             normal_offer,
+            shade_offer,
+            tri_load_addr_r,
             tri_enqueue,
             tri_queues,
             tri_kind,
@@ -600,6 +646,7 @@ impl<
             mailboxes,
             rays,
             instances,
+            shader,
             fp_units,
             result_line,
             write_back,
@@ -617,8 +664,12 @@ impl<
 
         // Frame control and counters.
         self.frame_start.next = self.start.val() & (!self.running.q.val());
+        // The ShadeUnit writes its last pixels after the threads have halted (the last one
+        // a clock after it is idle, from the frame-buffer port's register).
+        self.in_frame.next = self.running.q.val()
+            | (self.c_shading.val() & ((!self.shader.idle.val()) | self.fb_write_r.q.val()));
         self.done.next =
-            (!self.running.q.val()) & (self.halted_count.q.val() == self.c_threads.val());
+            (!self.in_frame.val()) & (self.halted_count.q.val() == self.c_threads.val());
         self.cycles.next = self.cycle_count.q.val();
         self.instructions.next = self.instr_count.q.val();
         self.transform_busy.next = self.transform_count.q.val();
@@ -627,7 +678,7 @@ impl<
         self.raygen_busy.next = self.raygen_count.q.val();
         self.instance_busy.next = self.instance_count.q.val();
         self.shading_busy.next = self.shading_count.q.val();
-        if self.running.q.val() {
+        if self.in_frame.val() {
             self.cycle_count.d.next = self.cycle_count.q.val() + 1;
             if self.tester.transform_busy.val() {
                 self.transform_count.d.next = self.transform_count.q.val() + 1;
@@ -638,8 +689,11 @@ impl<
             if self.traversal_unit.step_busy.val() {
                 self.traversal_count.d.next = self.traversal_count.q.val() + 1;
             }
-            if self.tester.gen_take.val() & (!self.gen_instance.val()) {
+            if self.tester.gen_take.val() & (!self.gen_instance.val()) & (!self.gen_shade.val()) {
                 self.raygen_count.d.next = self.raygen_count.q.val() + 1;
+            }
+            if self.tester.gen_take.val() & self.gen_shade.val() {
+                self.shading_count.d.next = self.shading_count.q.val() + 1;
             }
             if self.tester.gen_take.val() & self.gen_instance.val() {
                 if self.instances.gen_normal.val() {
@@ -673,6 +727,7 @@ impl<
         self.tester.engine.query_thread.next = self.decode.thread_i4.val();
         self.traversal_unit.engine.query_thread.next = self.decode.thread_i4.val();
         self.instances.query_thread.next = self.decode.thread_i4.val();
+        self.shader.query_thread.next = self.decode.thread_i4.val();
 
         // I5.
         self.fp_units.a.next = self.decode.a.val().get_bits::<W>(0);
@@ -725,6 +780,13 @@ impl<
             | self.normal_offer.q.val();
         self.instances.offer_normal.next = self.normal_offer.q.val();
         self.instances.instance_id.next = self.decode.a.val().get_bits::<24>(0);
+        // `tri.shade`: the thread's query, as the tester answers it at I5, to the ShadeUnit.
+        self.shader.frame_start.next = self.frame_start.val() & self.c_shading.val();
+        self.shader.offer.next = self.shade_offer.q.val();
+        self.shader.offer_addr.next = self.decode.a.val().get_bits::<24>(0);
+        self.shader.offer_hit.next = self.tester.hit.val();
+        self.shader.offer_t.next = self.tester.best_t.val();
+        self.shader.offer_triangle.next = self.tester.best_triangle.val().get_bits::<24>(0);
 
         // Scratch memory.
         self.scratch.read_address.next = (bit_cast::<12, 5>(self.decode.thread.val()) << 7)
@@ -740,12 +802,34 @@ impl<
         if self.decode.valid.val() & (self.decode.op.val() == self.op_ld.val()) {
             self.mem_load_r.d.next = self.one_bank.val() << self.decode.bank.val();
         }
+        // The ShadeUnit reads banks 2 and 3 at once in a clock the engine's loads leave them,
+        // as a load of both (registered like the engine's: a clock more of latency).
+        self.engine_loads_triangles.next = self.decode.valid.val()
+            & (self.decode.op.val() == self.op_ld.val())
+            & ((self.decode.bank.val() == self.bank_triangles_a.val())
+                | (self.decode.bank.val() == self.bank_triangles_b.val()));
+        self.shader.tri_grant.next = self.c_shading.val() & (!self.engine_loads_triangles.val());
+        self.tri_load_addr_r.d.next = self.execute.mem_address.val().get_bits::<24>(0);
+        if self.shader.tri_read.val() & self.shader.tri_grant.val() {
+            self.mem_load_r.d.next = self.mem_load_r.d.val() | self.triangle_banks.val();
+            self.tri_load_addr_r.d.next = self.shader.tri_addr.val();
+        }
+        self.shader.tri_rdata_a.next = self.bank2.rdata.val();
+        self.shader.tri_rdata_b.next = self.bank3.rdata.val();
         self.mem_bank_r.d.next = self.decode.bank.val();
         self.mem_addr_r.d.next = self.execute.mem_address.val().get_bits::<24>(0);
         self.fb_write_r.d.next =
             self.decode.valid.val() & (self.decode.op.val() == self.op_st.val());
         self.fb_addr_r.d.next = self.execute.mem_address.val().get_bits::<24>(0);
         self.fb_data_r.d.next = self.decode.store.val();
+        // The ShadeUnit's pixels in the clocks the engine's stores leave the port.
+        self.shader.fb_grant.next = self.c_shading.val()
+            & (!(self.decode.valid.val() & (self.decode.op.val() == self.op_st.val())));
+        if self.shader.fb_write.val() & self.shader.fb_grant.val() {
+            self.fb_write_r.d.next = true;
+            self.fb_addr_r.d.next = self.shader.fb_addr.val();
+            self.fb_data_r.d.next = self.shader.fb_data.val();
+        }
         self.fb.write.next = self.fb_write_r.q.val();
         self.fb.addr.next = self.fb_addr_r.q.val();
         self.fb.data.next = self.fb_data_r.q.val();
@@ -754,21 +838,31 @@ impl<
         // instance entry's reads (bank 4) when neither does.
         self.instances.bus_free.next = ((self.mem_load_r.q.val() & self.shared_banks.val()) == 0)
             & (!self.tester.lists.read.val());
+        // The ShadeUnit's reads of bank 5 when all three leave the bus.
+        self.shader.frame_grant.next = self.c_shading.val()
+            & ((self.mem_load_r.q.val() & self.shared_banks.val()) == 0)
+            & (!self.tester.lists.read.val())
+            & (!self.instances.read.val());
         self.mem.read.next = ((self.mem_load_r.q.val() & self.shared_banks.val()) != 0)
             | self.tester.lists.read.val()
-            | self.instances.read.val();
+            | self.instances.read.val()
+            | (self.shader.frame_read.val() & self.shader.frame_grant.val());
         if self.tester.lists.read.val() {
             self.mem.bank.next = self.bank_lists.val();
             self.mem.addr.next = self.tester.lists.addr.val();
         } else if self.instances.read.val() {
             self.mem.bank.next = self.bank_instances.val();
             self.mem.addr.next = self.instances.addr.val();
+        } else if self.shader.frame_read.val() & self.shader.frame_grant.val() {
+            self.mem.bank.next = self.bank_frame.val();
+            self.mem.addr.next = self.shader.frame_addr.val();
         } else {
             self.mem.bank.next = self.mem_bank_r.q.val();
             self.mem.addr.next = self.mem_addr_r.q.val();
         }
         self.tester.lists.rdata.next = self.mem.rdata.val();
         self.instances.rdata.next = self.mem.rdata.val();
+        self.shader.frame_rdata.next = self.mem.rdata.val();
         SramRead::link(&mut self.bank0, &mut self.traversal_unit.nodes);
         SramRead::link(&mut self.bank2, &mut self.tester.a_words);
         SramRead::link(&mut self.bank3, &mut self.tester.b_words);
@@ -798,6 +892,10 @@ impl<
         self.normal_offer.d.next = self.decode.valid_i4.val()
             & self.tri_op.val()
             & (self.decode.imm_i4.val() == self.tri_normal.val());
+        self.shade_offer.d.next = self.decode.valid_i4.val()
+            & self.tri_op.val()
+            & (self.decode.imm_i4.val() == self.tri_shade.val())
+            & self.c_shading.val();
         self.t_min_write.d.next = self.decode.valid_i4.val()
             & self.tri_op.val()
             & (self.decode.imm_i4.val() == self.tri_init.val());
@@ -837,7 +935,7 @@ impl<
         self.traversal_unit.engine.ray_write.next =
             self.ray_write.q.val() & (!self.store_write.val());
         self.tester.engine.load_banks.next = self.mem_load_r.q.val();
-        self.tester.engine.load_addr.next = self.mem_addr_r.q.val();
+        self.tester.engine.load_addr.next = self.tri_load_addr_r.q.val();
         self.tester.engine.thread.next = self.decode.thread.val();
         self.tester.engine.word_a.next = self.decode.a.val();
         self.tester.engine.word_b.next = self.decode.b.val();
@@ -847,8 +945,13 @@ impl<
         // in the clocks the launch leaves free (ray generation's first), and their rays are
         // written whole into both ray stores (the engine's ray words are refused in that
         // clock). The client bits say whose result it is (`GenClient`).
-        self.tester.gen_valid.next = self.rays.gen_valid.val() | self.instances.gen_valid.val();
-        self.tester.gen_diagonal.next = false;
+        self.gen_shade.next = self.c_shading.val()
+            & self.shader.gen_valid.val()
+            & (!self.rays.gen_valid.val())
+            & (!self.instances.gen_valid.val());
+        self.tester.gen_valid.next =
+            self.rays.gen_valid.val() | self.instances.gen_valid.val() | self.gen_shade.val();
+        self.tester.gen_diagonal.next = self.gen_shade.val() & self.shader.gen_diagonal.val();
         if self.gen_instance.val() {
             for k in 0..12 {
                 self.tester.gen_m[k].next = self.instances.gen_m[k].val();
@@ -865,6 +968,18 @@ impl<
                 self.tester.gen_client.next = self.client_normal.val();
             }
             self.tester.gen_thread.next = self.instances.gen_thread.val();
+        } else if self.gen_shade.val() {
+            // The ShadeUnit's slot in the thread bits; its results share the normal's client
+            // bits (a program shades in the unit only without instances).
+            for k in 0..12 {
+                self.tester.gen_m[k].next = self.shader.gen_m[k].val();
+            }
+            for k in 0..3 {
+                self.tester.gen_v[k].next = self.shader.gen_v[k].val();
+            }
+            self.tester.gen_point.next = self.shader.gen_point.val();
+            self.tester.gen_client.next = self.client_normal.val();
+            self.tester.gen_thread.next = bit_cast::<5, 3>(self.shader.gen_slot.val());
         } else {
             for k in 0..12 {
                 self.tester.gen_m[k].next = self.rays.gen_m[k].val();
@@ -878,6 +993,14 @@ impl<
         }
         self.rays.gen_take.next = self.tester.gen_take.val();
         self.instances.gen_take.next = self.tester.gen_take.val() & self.gen_instance.val();
+        self.shader.gen_take.next = self.tester.gen_take.val() & self.gen_shade.val();
+        self.shader.res_valid.next = self.c_shading.val()
+            & self.tester.gen_out_valid.val()
+            & (self.tester.gen_out_client.val() == self.client_normal.val());
+        self.shader.res_slot.next = self.tester.gen_out_thread.val().get_bits::<3>(0);
+        for k in 0..3 {
+            self.shader.res_v[k].next = self.tester.gen_out_dir[k].val();
+        }
         self.rays.gen_out_valid.next = self.tester.gen_out_valid.val()
             & (self.tester.gen_out_client.val() == self.client_primary.val());
         self.rays.gen_out_thread.next = self.tester.gen_out_thread.val();
@@ -900,7 +1023,13 @@ impl<
         }
         self.tester.primary_write.next = self.store_write.val();
         self.traversal_unit.primary_write.next = self.store_write.val();
+        self.shader.ray_write.next = self.store_write.val();
         if self.instances.ray_write.val() {
+            self.shader.ray_thread.next = self.instances.ray_thread.val();
+            for k in 0..3 {
+                self.shader.ray_o[k].next = self.instances.ray_o[k].val();
+                self.shader.ray_d[k].next = self.instances.ray_d[k].val();
+            }
             self.tester.primary_thread.next = self.instances.ray_thread.val();
             self.traversal_unit.primary_thread.next = self.instances.ray_thread.val();
             for k in 0..3 {
@@ -912,6 +1041,11 @@ impl<
         } else {
             self.tester.primary_thread.next = self.rays.primary_thread.val();
             self.traversal_unit.primary_thread.next = self.rays.primary_thread.val();
+            self.shader.ray_thread.next = self.rays.primary_thread.val();
+            for k in 0..3 {
+                self.shader.ray_o[k].next = self.rays.primary_o[k].val();
+                self.shader.ray_d[k].next = self.rays.primary_d[k].val();
+            }
             for k in 0..3 {
                 self.tester.primary_o[k].next = self.rays.primary_o[k].val();
                 self.tester.primary_d[k].next = self.rays.primary_d[k].val();
@@ -938,6 +1072,9 @@ impl<
         }
         if self.normal_offer.q.val() {
             self.tri_busy.next = self.instances.refused.val();
+        }
+        if self.shade_offer.q.val() {
+            self.tri_busy.next = self.shader.refused.val();
         }
         if self.ray_write.q.val() & self.store_write.val() {
             self.tri_busy.next = true;

@@ -455,6 +455,14 @@ impl Asm {
         self.coprocessor(Op::Tri, TriFn::Normal as u32, Reg::ZERO, instance, z);
     }
 
+    /// Shades the thread's finished query into the frame buffer's word `address` (before the
+    /// frame buffer's base) in the ShadeUnit (`TriFn::Shade`; repeated while refused).
+    pub fn tri_shade(&self, address: Val) {
+        let mut i = self.operands(Op::Tri, address, Val::R(Reg::ZERO));
+        i.imm = TriFn::Shade as u32;
+        self.emit(i);
+    }
+
     /// Waits until the thread's queued entries are done; `dst` = the best t.
     pub fn tri_wait(&self, dst: Reg) {
         self.coprocessor(Op::Tri, TriFn::Wait as u32, dst, Reg::ZERO, Reg::ZERO);

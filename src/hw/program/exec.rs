@@ -167,6 +167,8 @@ pub struct Machine<'a> {
     /// What the engine runs: the program's ROM words, decoded.
     rom: Vec<Instr>,
     layout: &'a Layout,
+    /// The frame's ambient, background and lights (`tri.shade`).
+    shading: units::ShadingConstants,
     f: Format,
 }
 
@@ -181,6 +183,7 @@ impl<'a> Machine<'a> {
             program,
             rom,
             layout,
+            shading: layout.shading_constants(),
             f: program.config.format,
         }
     }
@@ -417,6 +420,26 @@ impl<'a> Machine<'a> {
                         (t.tester.object, t.tester.mailbox) = (a, Mailbox::default());
                         let walk = KD_ENTERED | (b & KD_ANY_HIT);
                         stats.kd_nodes += self.object_walk(t, walk, 0, stats).map_err(fail)?;
+                    }
+                    TriFn::Shade => {
+                        // `hw::ShadeUnit`: the thread's query shaded (its twin,
+                        // `units::shade_direct`) into the pixel's word, the frame buffer's
+                        // base added.
+                        let hit = tt.hit.then(|| {
+                            let (n, material) = self.layout.triangle_shading(tt.best_triangle);
+                            let (kd, _) = self.layout.material(material);
+                            units::SurfaceHit {
+                                o: tt.o,
+                                d: tt.d,
+                                t: tt.best_t,
+                                n,
+                                kd,
+                            }
+                        });
+                        let word = fb.get_mut(a as usize).ok_or_else(|| {
+                            fail(format!("shade of pixel word {a}, outside the frame buffer"))
+                        })?;
+                        *word = units::shade_direct(f, &self.shading, hit.as_ref());
                     }
                     TriFn::Normal => {
                         // `hw::engine::InstanceRays`: the normal matrix through the

@@ -221,10 +221,15 @@ pub enum TriFn {
     /// after a `wait` ([`units::transform3`](crate::units::transform3), not unit length).
     /// Repeats while refused.
     Normal,
+    /// Shade the thread's finished query into the frame buffer (`hw::ShadeUnit`): the pixel's
+    /// word `A` (before the frame buffer's base), the tester's closest hit (or its miss), the
+    /// thread's ray; the unit writes `units::shade_direct`'s pixel in its own time, so the
+    /// thread goes on at once. Repeats while refused (every slot busy).
+    Shade,
 }
 
 impl TriFn {
-    pub const ALL: [TriFn; 15] = [
+    pub const ALL: [TriFn; 16] = [
         TriFn::RayOxy,
         TriFn::RayOzDx,
         TriFn::RayDyz,
@@ -240,6 +245,7 @@ impl TriFn {
         TriFn::World,
         TriFn::Enter,
         TriFn::Normal,
+        TriFn::Shade,
     ];
     pub fn from_imm(imm: u32) -> Option<TriFn> {
         Self::ALL.get(imm as usize).copied()
@@ -261,6 +267,7 @@ impl TriFn {
             TriFn::World => "world",
             TriFn::Enter => "enter",
             TriFn::Normal => "normal",
+            TriFn::Shade => "shade",
         }
     }
     /// Whether the function puts an entry in the tester's queue.
@@ -420,10 +427,12 @@ pub enum Unit {
     ChannelByte,
     /// `tri.world`, `tri.enter`, `tri.normal`: the engine's `InstanceRays`.
     InstanceEntry,
+    /// `tri.shade`: the engine's `ShadeUnit`.
+    Shading,
 }
 
 impl Unit {
-    pub const ALL: [Unit; 14] = [
+    pub const ALL: [Unit; 15] = [
         Unit::FpAdd,
         Unit::FpMul,
         Unit::FpDiv,
@@ -438,6 +447,7 @@ impl Unit {
         Unit::TraversalUnit,
         Unit::ChannelByte,
         Unit::InstanceEntry,
+        Unit::Shading,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -455,6 +465,7 @@ impl Unit {
             Unit::TraversalUnit => "traversal unit",
             Unit::ChannelByte => "channel byte",
             Unit::InstanceEntry => "instance entry",
+            Unit::Shading => "shading",
         }
     }
 }
@@ -503,6 +514,8 @@ impl Instr {
         let instance_entry = [TriFn::World, TriFn::Enter, TriFn::Normal].map(|f| f as u32);
         if self.op == Op::Tri && instance_entry.contains(&self.imm) {
             Unit::InstanceEntry
+        } else if self.op == Op::Tri && self.imm == TriFn::Shade as u32 {
+            Unit::Shading
         } else {
             self.op.unit()
         }

@@ -298,6 +298,16 @@ impl Gen<'_> {
         self.c.shadows || self.c.reflection_depth > 0
     }
 
+    /// Whether the shading goes to the `hw::ShadeUnit` (`tri.shade`): primary rays alone, of
+    /// one untransformed object, with at most its [`MAX_SHADE_LIGHTS`] lights.
+    ///
+    /// [`MAX_SHADE_LIGHTS`]: crate::hw::shade_unit::MAX_SHADE_LIGHTS
+    pub fn shade_unit(&self) -> bool {
+        !self.secondary_rays()
+            && self.c.top_root.is_none()
+            && self.c.light_count as usize <= crate::hw::shade_unit::MAX_SHADE_LIGHTS
+    }
+
     /// Whether the shader tells a hit by `best_t < q_t_max` instead of the tester's hit flag
     /// (the same: a hit only ever lowers the best t from t_max): for the one primary trace of
     /// a scene of one object (which saves reading the flag), and under a top level (whose

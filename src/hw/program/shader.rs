@@ -48,6 +48,27 @@ pub(super) struct Constants {
 }
 
 impl Gen<'_> {
+    /// The pixel's frame-buffer word (before the frame buffer's base): `y * W + x` with shifts
+    /// and adds (W is a constant of the scene); the pixel word itself for a power-of-two W.
+    fn pixel_address(&self, pixel: Reg, x: Reg, y: Reg) -> Val {
+        let (a, c) = (self.asm, self.c);
+        if c.width.is_power_of_two() {
+            return Val::R(pixel);
+        }
+        let mut address = Val::R(x);
+        for bit in 0..32 {
+            if c.width >> bit & 1 == 1 {
+                let part = if bit == 0 {
+                    y.into()
+                } else {
+                    a.op(Op::Shl, y.into(), Val::K(bit))
+                };
+                address = a.op(Op::Add, address, part);
+            }
+        }
+        address
+    }
+
     pub(super) fn load_constants(&self) -> Constants {
         let a = self.asm;
         let c = self.c;
@@ -95,6 +116,17 @@ impl Gen<'_> {
         a.mov(s.q_t_max, Val::K(c.format.infinity(false)));
         if self.secondary_rays() && c.top_root.is_none() {
             a.mov(s.skip_instance, Val::K(0));
+        }
+        if self.shade_unit() {
+            // The ShadeUnit reads the frame's shading constants itself.
+            return Constants {
+                eye,
+                ambient: Reg::ZERO,
+                background: [Reg::ZERO; 3],
+                shadow_t_min: None,
+                mirror_t_min: None,
+                lights: None,
+            };
         }
         Constants {
             eye,
@@ -178,6 +210,21 @@ impl Gen<'_> {
         }
         if c.reflection_depth > 0 {
             a.mov(depth, Val::K(0));
+        }
+        if self.shade_unit() {
+            // The trace, then the ShadeUnit shades the pixel and writes it: the thread goes
+            // on with the next.
+            a.section("shader");
+            self.trace_routine(false, Query::Closest);
+            a.section("shader");
+            let address = self.pixel_address(pixel, x, y);
+            a.tri_shade(address);
+            a.end_temps();
+            a.jump(next_pixel);
+            a.bind(frame_done);
+            a.section("raygen");
+            a.halt();
+            return;
         }
 
         // Shade the ray (ray_o, ray_d, ray_t_min, skip) at mirror depth `depth`.
@@ -423,22 +470,7 @@ impl Gen<'_> {
             let high = if k == 0 { Val::K(0) } else { Val::R(rgb) };
             a.op_to(Op::Byte, rgb, color[k].into(), high);
         }
-        // y * W + x with shifts and adds (W is a constant of the scene); the pixel word itself
-        // for a power-of-two W.
-        let mut address = Val::R(x);
-        if c.width.is_power_of_two() {
-            address = Val::R(pixel);
-        }
-        for bit in 0..32 {
-            if !c.width.is_power_of_two() && c.width >> bit & 1 == 1 {
-                let part = if bit == 0 {
-                    y.into()
-                } else {
-                    a.op(Op::Shl, y.into(), Val::K(bit))
-                };
-                address = a.op(Op::Add, address, part);
-            }
-        }
+        let address = self.pixel_address(pixel, x, y);
         a.store_frame(address, 0, c.frame_buffer, rgb);
         a.end_temps();
         a.free(rgb);
