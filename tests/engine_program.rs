@@ -89,6 +89,21 @@ fn engine_order_frame_equals_per_pixel_runs_and_every_pixel_is_written() {
     assert!(frame.stats.rounds * 32 >= frame.stats.instructions);
 }
 
+/// Issue 18's programmable share: with the ShadeUnit, cornell_noshadow's threads issue at most
+/// 12 instructions per primary ray at the issue's 64x48 (the twin's count is the engine's,
+/// `processor_sim`; each thread's 29 instructions of frame set-up are in it), and its frame
+/// is the golden model's.
+#[test]
+fn cornell_noshadow_issues_at_most_12_instructions_per_primary_ray() {
+    let l = layout_of("cornell_noshadow.toml", 64, 48, Format::E7M16, 0);
+    let program = build_program(&ProgramConfig::from_layout(&l));
+    let frame = Machine::new(&program, &l).run_frame(32).unwrap();
+    assert_eq!(frame.pixels, model::render_golden(&l, false).rgb);
+    let per_ray = frame.stats.instructions as f64 / (64.0 * 48.0);
+    println!("cornell_noshadow: {per_ray:.2} instructions per primary ray");
+    assert!(per_ray <= 12.0, "{per_ray}");
+}
+
 #[test]
 fn animated_frames_match_the_golden_model() {
     let f = Format::E7M16;
@@ -117,6 +132,10 @@ fn the_program_leaves_out_what_the_scene_does_not_need() {
     let q = build_program(&ProgramConfig::from_layout(&full));
     assert!(q.sections.contains(&"mirror"));
     assert!(q.code.len() > p.code.len());
+    // The ShadeUnit shades the primary rays of a scene without secondary rays or instances.
+    assert!(p.units().contains(&Unit::Shading) && !q.units().contains(&Unit::Shading));
+    let line = format!("{} unit (no instruction uses it)", Unit::Shading.name());
+    assert!(!p.left_out.contains(&line) && q.left_out.contains(&line));
     // The engine is built without the units no instruction uses (`Program::units`): instance
     // entry, the mailboxes and the scratch words only where the scene has instances and mirrors.
     for u in [Unit::InstanceEntry, Unit::Mailbox, Unit::Scratch] {

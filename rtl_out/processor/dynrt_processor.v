@@ -7,6 +7,7 @@
 // Left out: scratch unit (no instruction uses it).
 // Left out: mailbox unit (no instruction uses it).
 // Left out: instance entry unit (no instruction uses it).
+// Left out: shading unit (no instruction uses it).
 // Display: 640x480 at 25.18 MHz pixel clock (vga_clock), frame buffer shown from word 46.
 
 /* verilator lint_off WIDTH */
@@ -681,6 +682,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam  c_threads = 8'h20;
     localparam  c_uses_mailboxes = 1'b0;
     localparam  c_uses_scratch = 1'b0;
+    localparam  c_shading = 1'b0;
     localparam  op_fsub = 5'b10;
     localparam  op_fdiv = 5'b100;
     localparam  op_fsqrt = 5'b101;
@@ -702,6 +704,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam  tri_world = 32'hc;
     localparam  tri_enter = 32'hd;
     localparam  tri_normal = 32'he;
+    localparam  tri_shade = 32'hf;
     localparam  kd_start = 32'h0;
     localparam  kd_wait = 32'h1;
     localparam  kd_next = 32'h2;
@@ -711,6 +714,10 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam  cmd_skip = 2'b11;
     localparam  bank_lists = 3'b1;
     localparam  bank_instances = 3'b100;
+    localparam  bank_frame = 3'b101;
+    localparam  bank_triangles_a = 3'b10;
+    localparam  bank_triangles_b = 3'b11;
+    localparam  triangle_banks = 6'b1100;
     localparam  client_primary = 2'b0;
     localparam  client_origin = 2'b1;
     localparam  client_normal = 2'b10;
@@ -719,6 +726,19 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam  shared_banks = 6'b110010;
     
     // Enums
+    localparam ShadeStep__Idle = 0;
+    localparam ShadeStep__TriLoad = 1;
+    localparam ShadeStep__Point = 2;
+    localparam ShadeStep__NormalDot = 3;
+    localparam ShadeStep__KdLoad = 4;
+    localparam ShadeStep__Ambient = 5;
+    localparam ShadeStep__ToLight = 6;
+    localparam ShadeStep__Dots = 7;
+    localparam ShadeStep__Cosine = 8;
+    localparam ShadeStep__Tint = 9;
+    localparam ShadeStep__Accumulate = 10;
+    localparam ShadeStep__Pack = 11;
+    localparam ShadeStep__Store = 12;
     localparam FastKind__Computed = 0;
     localparam FastKind__Scratch = 1;
     localparam FastKind__Memory = 2;
@@ -911,6 +931,62 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     wire  [31:0] instances__done_mask;
     reg  [4:0] instances__query_thread;
     wire  instances__pending;
+    reg  shader__clock;
+    reg  shader__frame_start;
+    reg  shader__ray_write;
+    reg  [4:0] shader__ray_thread;
+    reg  [23:0] shader__ray_o__0;
+    reg  [23:0] shader__ray_o__1;
+    reg  [23:0] shader__ray_o__2;
+    reg  [23:0] shader__ray_d__0;
+    reg  [23:0] shader__ray_d__1;
+    reg  [23:0] shader__ray_d__2;
+    reg  [4:0] shader__query_thread;
+    reg  shader__offer;
+    reg  [23:0] shader__offer_addr;
+    reg  shader__offer_hit;
+    reg  [23:0] shader__offer_t;
+    reg  [23:0] shader__offer_triangle;
+    wire  shader__refused;
+    wire  shader__tri_read;
+    wire  [23:0] shader__tri_addr;
+    reg  shader__tri_grant;
+    reg  [31:0] shader__tri_rdata_a;
+    reg  [31:0] shader__tri_rdata_b;
+    wire  shader__frame_read;
+    wire  [23:0] shader__frame_addr;
+    reg  shader__frame_grant;
+    reg  [31:0] shader__frame_rdata;
+    wire  shader__gen_valid;
+    wire  [23:0] shader__gen_m__0;
+    wire  [23:0] shader__gen_m__1;
+    wire  [23:0] shader__gen_m__2;
+    wire  [23:0] shader__gen_m__3;
+    wire  [23:0] shader__gen_m__4;
+    wire  [23:0] shader__gen_m__5;
+    wire  [23:0] shader__gen_m__6;
+    wire  [23:0] shader__gen_m__7;
+    wire  [23:0] shader__gen_m__8;
+    wire  [23:0] shader__gen_m__9;
+    wire  [23:0] shader__gen_m__10;
+    wire  [23:0] shader__gen_m__11;
+    wire  [23:0] shader__gen_v__0;
+    wire  [23:0] shader__gen_v__1;
+    wire  [23:0] shader__gen_v__2;
+    wire  shader__gen_point;
+    wire  shader__gen_diagonal;
+    wire  [2:0] shader__gen_slot;
+    reg  shader__gen_take;
+    reg  shader__res_valid;
+    reg  [2:0] shader__res_slot;
+    reg  [23:0] shader__res_v__0;
+    reg  [23:0] shader__res_v__1;
+    reg  [23:0] shader__res_v__2;
+    wire  shader__fb_write;
+    wire  [23:0] shader__fb_addr;
+    wire  [31:0] shader__fb_data;
+    reg  shader__fb_grant;
+    wire  shader__idle;
     reg  [4:0] execute__op;
     reg  [31:0] execute__a;
     reg  [31:0] execute__b;
@@ -1075,6 +1151,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [23:0] tester__gen_v__1;
     reg  [23:0] tester__gen_v__2;
     reg  tester__gen_point;
+    reg  tester__gen_diagonal;
     reg  [1:0] tester__gen_client;
     reg  [4:0] tester__gen_thread;
     wire  tester__gen_take;
@@ -1204,6 +1281,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  normal_offer__d;
     wire  normal_offer__q;
     reg  normal_offer__clock;
+    reg  shade_offer__d;
+    wire  shade_offer__q;
+    reg  shade_offer__clock;
+    reg  [23:0] tri_load_addr_r__d;
+    wire  [23:0] tri_load_addr_r__q;
+    reg  tri_load_addr_r__clock;
     reg  tri_enqueue__d;
     wire  tri_enqueue__q;
     reg  tri_enqueue__clock;
@@ -1234,6 +1317,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     
     // Local signals
     reg  frame_start;
+    reg  engine_loads_triangles;
+    reg  gen_shade;
+    reg  in_frame;
     reg  tri_op;
     reg  kd_op;
     reg  tri_wait_fn;
@@ -1436,6 +1522,64 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .query_thread(instances__query_thread),
         .pending(instances__pending)
     );
+    dynrt_processor__engine__shader shader(
+        .clock(shader__clock),
+        .frame_start(shader__frame_start),
+        .ray_write(shader__ray_write),
+        .ray_thread(shader__ray_thread),
+        .ray_o__0(shader__ray_o__0),
+        .ray_o__1(shader__ray_o__1),
+        .ray_o__2(shader__ray_o__2),
+        .ray_d__0(shader__ray_d__0),
+        .ray_d__1(shader__ray_d__1),
+        .ray_d__2(shader__ray_d__2),
+        .query_thread(shader__query_thread),
+        .offer(shader__offer),
+        .offer_addr(shader__offer_addr),
+        .offer_hit(shader__offer_hit),
+        .offer_t(shader__offer_t),
+        .offer_triangle(shader__offer_triangle),
+        .refused(shader__refused),
+        .tri_read(shader__tri_read),
+        .tri_addr(shader__tri_addr),
+        .tri_grant(shader__tri_grant),
+        .tri_rdata_a(shader__tri_rdata_a),
+        .tri_rdata_b(shader__tri_rdata_b),
+        .frame_read(shader__frame_read),
+        .frame_addr(shader__frame_addr),
+        .frame_grant(shader__frame_grant),
+        .frame_rdata(shader__frame_rdata),
+        .gen_valid(shader__gen_valid),
+        .gen_m__0(shader__gen_m__0),
+        .gen_m__1(shader__gen_m__1),
+        .gen_m__2(shader__gen_m__2),
+        .gen_m__3(shader__gen_m__3),
+        .gen_m__4(shader__gen_m__4),
+        .gen_m__5(shader__gen_m__5),
+        .gen_m__6(shader__gen_m__6),
+        .gen_m__7(shader__gen_m__7),
+        .gen_m__8(shader__gen_m__8),
+        .gen_m__9(shader__gen_m__9),
+        .gen_m__10(shader__gen_m__10),
+        .gen_m__11(shader__gen_m__11),
+        .gen_v__0(shader__gen_v__0),
+        .gen_v__1(shader__gen_v__1),
+        .gen_v__2(shader__gen_v__2),
+        .gen_point(shader__gen_point),
+        .gen_diagonal(shader__gen_diagonal),
+        .gen_slot(shader__gen_slot),
+        .gen_take(shader__gen_take),
+        .res_valid(shader__res_valid),
+        .res_slot(shader__res_slot),
+        .res_v__0(shader__res_v__0),
+        .res_v__1(shader__res_v__1),
+        .res_v__2(shader__res_v__2),
+        .fb_write(shader__fb_write),
+        .fb_addr(shader__fb_addr),
+        .fb_data(shader__fb_data),
+        .fb_grant(shader__fb_grant),
+        .idle(shader__idle)
+    );
     dynrt_processor__engine__execute execute(
         .op(execute__op),
         .a(execute__a),
@@ -1617,6 +1761,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .gen_v__1(tester__gen_v__1),
         .gen_v__2(tester__gen_v__2),
         .gen_point(tester__gen_point),
+        .gen_diagonal(tester__gen_diagonal),
         .gen_client(tester__gen_client),
         .gen_thread(tester__gen_thread),
         .gen_take(tester__gen_take),
@@ -1798,6 +1943,16 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(normal_offer__q),
         .clock(normal_offer__clock)
     );
+    dynrt_processor__display__dark_d shade_offer(
+        .d(shade_offer__d),
+        .q(shade_offer__q),
+        .clock(shade_offer__clock)
+    );
+    dynrt_processor__display__rgb_q tri_load_addr_r(
+        .d(tri_load_addr_r__d),
+        .q(tri_load_addr_r__q),
+        .clock(tri_load_addr_r__clock)
+    );
     dynrt_processor__display__dark_d tri_enqueue(
         .d(tri_enqueue__d),
         .q(tri_enqueue__q),
@@ -1869,6 +2024,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         world_write__clock = clock;
         enter_offer__clock = clock;
         normal_offer__clock = clock;
+        shade_offer__clock = clock;
+        tri_load_addr_r__clock = clock;
         tri_enqueue__clock = clock;
         tri_queues__clock = clock;
         tri_kind__clock = clock;
@@ -1901,6 +2058,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         world_write__d = world_write__q;
         enter_offer__d = enter_offer__q;
         normal_offer__d = normal_offer__q;
+        shade_offer__d = shade_offer__q;
+        tri_load_addr_r__d = tri_load_addr_r__q;
         tri_enqueue__d = tri_enqueue__q;
         tri_queues__d = tri_queues__q;
         tri_kind__d = tri_kind__q;
@@ -1916,6 +2075,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         mailboxes__clock = clock;
         rays__clock = clock;
         instances__clock = clock;
+        shader__clock = clock;
         fp_units__clock = clock;
         result_line__clock = clock;
         write_back__clock = clock;
@@ -1926,7 +2086,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         gen_instance = instances__gen_valid & (~rays__gen_valid);
         store_write = rays__primary_write | instances__ray_write;
         frame_start = start & (~running__q);
-        done = (~running__q) & (halted_count__q == c_threads);
+        in_frame = running__q | (c_shading & ((~shader__idle) | fb_write_r__q));
+        done = (~in_frame) & (halted_count__q == c_threads);
         cycles = cycle_count__q;
         instructions = instr_count__q;
         transform_busy = transform_count__q;
@@ -1935,7 +2096,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         raygen_busy = raygen_count__q;
         instance_busy = instance_count__q;
         shading_busy = shading_count__q;
-        if (running__q) begin
+        if (in_frame) begin
             cycle_count__d = cycle_count__q + 32'h1;
             if (tester__transform_busy) begin
                 transform_count__d = transform_count__q + 32'h1;
@@ -1946,8 +2107,11 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             if (traversal_unit__step_busy) begin
                 traversal_count__d = traversal_count__q + 32'h1;
             end
-            if (tester__gen_take & (~gen_instance)) begin
+            if (tester__gen_take & (~gen_instance) & (~gen_shade)) begin
                 raygen_count__d = raygen_count__q + 32'h1;
+            end
+            if (tester__gen_take & gen_shade) begin
+                shading_count__d = shading_count__q + 32'h1;
             end
             if (tester__gen_take & gen_instance) begin
                 if (instances__gen_normal) begin
@@ -1975,6 +2139,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tester__engine__query_thread = decode__thread_i4;
         traversal_unit__engine__query_thread = decode__thread_i4;
         instances__query_thread = decode__thread_i4;
+        shader__query_thread = decode__thread_i4;
         fp_units__a = decode__a[(32'h0)+:(24)];
         fp_units__b = decode__b[(32'h0)+:(24)];
         fp_units__sub = decode__op == op_fsub;
@@ -2017,6 +2182,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         instances__offer = (enter_offer__q & (~tester__engine__full)) | normal_offer__q;
         instances__offer_normal = normal_offer__q;
         instances__instance_id = decode__a[(32'h0)+:(24)];
+        shader__frame_start = frame_start & c_shading;
+        shader__offer = shade_offer__q;
+        shader__offer_addr = decode__a[(32'h0)+:(24)];
+        shader__offer_hit = tester__hit;
+        shader__offer_t = tester__best_t;
+        shader__offer_triangle = tester__best_triangle[(32'h0)+:(24)];
         scratch__read_address = (((decode__thread) & 12'hfff) << 32'h7) | ((execute__scratch_address[(32'h0)+:(7)]) & 12'hfff);
         scratch__write_address = (((decode__thread) & 12'hfff) << 32'h7) | ((execute__scratch_address[(32'h0)+:(7)]) & 12'hfff);
         scratch__write_data = decode__store;
@@ -2025,16 +2196,32 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         if (decode__valid & (decode__op == op_ld)) begin
             mem_load_r__d = one_bank << decode__bank;
         end
+        engine_loads_triangles = decode__valid & (decode__op == op_ld) & ((decode__bank == bank_triangles_a) | (decode__bank == bank_triangles_b));
+        shader__tri_grant = c_shading & (~engine_loads_triangles);
+        tri_load_addr_r__d = execute__mem_address[(32'h0)+:(24)];
+        if (shader__tri_read & shader__tri_grant) begin
+            mem_load_r__d = mem_load_r__d | triangle_banks;
+            tri_load_addr_r__d = shader__tri_addr;
+        end
+        shader__tri_rdata_a = bank2_rdata;
+        shader__tri_rdata_b = bank3_rdata;
         mem_bank_r__d = decode__bank;
         mem_addr_r__d = execute__mem_address[(32'h0)+:(24)];
         fb_write_r__d = decode__valid & (decode__op == op_st);
         fb_addr_r__d = execute__mem_address[(32'h0)+:(24)];
         fb_data_r__d = decode__store;
+        shader__fb_grant = c_shading & (~(decode__valid & (decode__op == op_st)));
+        if (shader__fb_write & shader__fb_grant) begin
+            fb_write_r__d = 1'b1;
+            fb_addr_r__d = shader__fb_addr;
+            fb_data_r__d = shader__fb_data;
+        end
         fb_write = fb_write_r__q;
         fb_addr = fb_addr_r__q;
         fb_data = fb_data_r__q;
         instances__bus_free = ((mem_load_r__q & shared_banks) == 32'h0) & (~tester__lists__read);
-        mem_read = ((mem_load_r__q & shared_banks) != 32'h0) | tester__lists__read | instances__read;
+        shader__frame_grant = c_shading & ((mem_load_r__q & shared_banks) == 32'h0) & (~tester__lists__read) & (~instances__read);
+        mem_read = ((mem_load_r__q & shared_banks) != 32'h0) | tester__lists__read | instances__read | (shader__frame_read & shader__frame_grant);
         if (tester__lists__read) begin
             mem_bank = bank_lists;
             mem_addr = tester__lists__addr;
@@ -2043,12 +2230,17 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             mem_bank = bank_instances;
             mem_addr = instances__addr;
         end
+        else if (shader__frame_read & shader__frame_grant) begin
+            mem_bank = bank_frame;
+            mem_addr = shader__frame_addr;
+        end
         else begin
             mem_bank = mem_bank_r__q;
             mem_addr = mem_addr_r__q;
         end
         tester__lists__rdata = mem_rdata;
         instances__rdata = mem_rdata;
+        shader__frame_rdata = mem_rdata;
         tri_op = decode__op_i4 == op_tri;
         kd_op = decode__op_i4 == op_kd;
         tri_wait_fn = decode__imm_i4 == tri_wait;
@@ -2059,6 +2251,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         world_write__d = decode__valid_i4 & tri_op & (decode__imm_i4 == tri_world);
         enter_offer__d = decode__valid_i4 & tri_op & (decode__imm_i4 == tri_enter);
         normal_offer__d = decode__valid_i4 & tri_op & (decode__imm_i4 == tri_normal);
+        shade_offer__d = decode__valid_i4 & tri_op & (decode__imm_i4 == tri_shade) & c_shading;
         t_min_write__d = decode__valid_i4 & tri_op & (decode__imm_i4 == tri_init);
         tri_queues__d = queued_fn;
         tri_enqueue__d = decode__valid_i4 & tri_op & queued_fn;
@@ -2087,13 +2280,15 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         traversal_unit__engine__ray_pair = decode__imm[(32'h0)+:(2)];
         traversal_unit__engine__ray_write = ray_write__q & (~store_write);
         tester__engine__load_banks = mem_load_r__q;
-        tester__engine__load_addr = mem_addr_r__q;
+        tester__engine__load_addr = tri_load_addr_r__q;
         tester__engine__thread = decode__thread;
         tester__engine__word_a = decode__a;
         tester__engine__word_b = decode__b;
         tester__engine__ray_pair = decode__imm[(32'h0)+:(2)];
         tester__engine__ray_write = ray_write__q & (~store_write);
-        tester__gen_valid = rays__gen_valid | instances__gen_valid;
+        gen_shade = c_shading & shader__gen_valid & (~rays__gen_valid) & (~instances__gen_valid);
+        tester__gen_valid = rays__gen_valid | instances__gen_valid | gen_shade;
+        tester__gen_diagonal = gen_shade & shader__gen_diagonal;
         if (gen_instance) begin
             tester__gen_m__0 = instances__gen_m__0;
             tester__gen_m__1 = instances__gen_m__1;
@@ -2120,6 +2315,26 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             end
             tester__gen_thread = instances__gen_thread;
         end
+        else if (gen_shade) begin
+            tester__gen_m__0 = shader__gen_m__0;
+            tester__gen_m__1 = shader__gen_m__1;
+            tester__gen_m__2 = shader__gen_m__2;
+            tester__gen_m__3 = shader__gen_m__3;
+            tester__gen_m__4 = shader__gen_m__4;
+            tester__gen_m__5 = shader__gen_m__5;
+            tester__gen_m__6 = shader__gen_m__6;
+            tester__gen_m__7 = shader__gen_m__7;
+            tester__gen_m__8 = shader__gen_m__8;
+            tester__gen_m__9 = shader__gen_m__9;
+            tester__gen_m__10 = shader__gen_m__10;
+            tester__gen_m__11 = shader__gen_m__11;
+            tester__gen_v__0 = shader__gen_v__0;
+            tester__gen_v__1 = shader__gen_v__1;
+            tester__gen_v__2 = shader__gen_v__2;
+            tester__gen_point = shader__gen_point;
+            tester__gen_client = client_normal;
+            tester__gen_thread = ((shader__gen_slot) & 5'h1f);
+        end
         else begin
             tester__gen_m__0 = rays__gen_m__0;
             tester__gen_m__1 = rays__gen_m__1;
@@ -2142,6 +2357,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         end
         rays__gen_take = tester__gen_take;
         instances__gen_take = tester__gen_take & gen_instance;
+        shader__gen_take = tester__gen_take & gen_shade;
+        shader__res_valid = c_shading & tester__gen_out_valid & (tester__gen_out_client == client_normal);
+        shader__res_slot = tester__gen_out_thread[(32'h0)+:(3)];
+        shader__res_v__0 = tester__gen_out_dir__0;
+        shader__res_v__1 = tester__gen_out_dir__1;
+        shader__res_v__2 = tester__gen_out_dir__2;
         rays__gen_out_valid = tester__gen_out_valid & (tester__gen_out_client == client_primary);
         rays__gen_out_thread = tester__gen_out_thread;
         instances__out_valid = tester__gen_out_valid & (tester__gen_out_client != client_primary);
@@ -2161,7 +2382,15 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         instances__out_v__2 = tester__gen_out_dir__2;
         tester__primary_write = store_write;
         traversal_unit__primary_write = store_write;
+        shader__ray_write = store_write;
         if (instances__ray_write) begin
+            shader__ray_thread = instances__ray_thread;
+            shader__ray_o__0 = instances__ray_o__0;
+            shader__ray_d__0 = instances__ray_d__0;
+            shader__ray_o__1 = instances__ray_o__1;
+            shader__ray_d__1 = instances__ray_d__1;
+            shader__ray_o__2 = instances__ray_o__2;
+            shader__ray_d__2 = instances__ray_d__2;
             tester__primary_thread = instances__ray_thread;
             traversal_unit__primary_thread = instances__ray_thread;
             tester__primary_o__0 = instances__ray_o__0;
@@ -2180,6 +2409,13 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         else begin
             tester__primary_thread = rays__primary_thread;
             traversal_unit__primary_thread = rays__primary_thread;
+            shader__ray_thread = rays__primary_thread;
+            shader__ray_o__0 = rays__primary_o__0;
+            shader__ray_d__0 = rays__primary_d__0;
+            shader__ray_o__1 = rays__primary_o__1;
+            shader__ray_d__1 = rays__primary_d__1;
+            shader__ray_o__2 = rays__primary_o__2;
+            shader__ray_d__2 = rays__primary_d__2;
             tester__primary_o__0 = rays__primary_o__0;
             tester__primary_d__0 = rays__primary_d__0;
             traversal_unit__primary_o__0 = rays__primary_o__0;
@@ -2207,6 +2443,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         end
         if (normal_offer__q) begin
             tri_busy = instances__refused;
+        end
+        if (shade_offer__q) begin
+            tri_busy = shader__refused;
         end
         if (ray_write__q & store_write) begin
             tri_busy = 1'b1;
@@ -16517,9 +16756,5146 @@ endmodule // dynrt_processor__engine__scratch
 
 
 
+module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ray_o__0,ray_o__1,ray_o__2,ray_d__0,ray_d__1,ray_d__2,query_thread,offer,offer_addr,offer_hit,offer_t,offer_triangle,refused,tri_read,tri_addr,tri_grant,tri_rdata_a,tri_rdata_b,frame_read,frame_addr,frame_grant,frame_rdata,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_diagonal,gen_slot,gen_take,res_valid,res_slot,res_v__0,res_v__1,res_v__2,fb_write,fb_addr,fb_data,fb_grant,idle);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  frame_start;
+    input wire  ray_write;
+    input wire  [4:0] ray_thread;
+    input wire  [23:0] ray_o__0;
+    input wire  [23:0] ray_o__1;
+    input wire  [23:0] ray_o__2;
+    input wire  [23:0] ray_d__0;
+    input wire  [23:0] ray_d__1;
+    input wire  [23:0] ray_d__2;
+    input wire  [4:0] query_thread;
+    input wire  offer;
+    input wire  [23:0] offer_addr;
+    input wire  offer_hit;
+    input wire  [23:0] offer_t;
+    input wire  [23:0] offer_triangle;
+    output reg  refused;
+    output reg  tri_read;
+    output reg  [23:0] tri_addr;
+    input wire  tri_grant;
+    input wire  [31:0] tri_rdata_a;
+    input wire  [31:0] tri_rdata_b;
+    output reg  frame_read;
+    output reg  [23:0] frame_addr;
+    input wire  frame_grant;
+    input wire  [31:0] frame_rdata;
+    output reg  gen_valid;
+    output reg  [23:0] gen_m__0;
+    output reg  [23:0] gen_m__1;
+    output reg  [23:0] gen_m__2;
+    output reg  [23:0] gen_m__3;
+    output reg  [23:0] gen_m__4;
+    output reg  [23:0] gen_m__5;
+    output reg  [23:0] gen_m__6;
+    output reg  [23:0] gen_m__7;
+    output reg  [23:0] gen_m__8;
+    output reg  [23:0] gen_m__9;
+    output reg  [23:0] gen_m__10;
+    output reg  [23:0] gen_m__11;
+    output reg  [23:0] gen_v__0;
+    output reg  [23:0] gen_v__1;
+    output reg  [23:0] gen_v__2;
+    output reg  gen_point;
+    output reg  gen_diagonal;
+    output reg  [2:0] gen_slot;
+    input wire  gen_take;
+    input wire  res_valid;
+    input wire  [2:0] res_slot;
+    input wire  [23:0] res_v__0;
+    input wire  [23:0] res_v__1;
+    input wire  [23:0] res_v__2;
+    output reg  fb_write;
+    output reg  [23:0] fb_addr;
+    output reg  [31:0] fb_data;
+    input wire  fb_grant;
+    output reg  idle;
+    
+    // Constant declarations
+    localparam  c_slot__0 = 3'b0;
+    localparam  c_slot__1 = 3'b1;
+    localparam  c_slot__2 = 3'b10;
+    localparam  c_slot__3 = 3'b11;
+    localparam  c_slot__4 = 3'b100;
+    localparam  c_slot__5 = 3'b101;
+    localparam  c_slot__6 = 3'b110;
+    localparam  c_slot__7 = 3'b111;
+    localparam  c_sign = 24'h800000;
+    localparam  c_exp_mask = 24'h7f0000;
+    localparam  c_man_mask = 24'hffff;
+    localparam  c_minus_one = 24'hbf0000;
+    localparam  c_zero = 24'h0;
+    localparam  c_shading_word = 24'h6;
+    localparam  c_materials = 24'h1e;
+    localparam  c_fb_base = 24'h2e;
+    localparam  c_const_addr = 24'hf;
+    localparam  c_lights_addr = 24'h18;
+    localparam  c_const_total = 6'b100;
+    localparam  c_last_light = 3'b0;
+    localparam  c_has_lights = 1'b0;
+    localparam  c_valid9 = 9'b1;
+    localparam  c_valid4 = 4'h1;
+    localparam  c_valid6 = 6'b1;
+    localparam  c_kind_tri = 2'b0;
+    localparam  c_kind_kd = 2'b1;
+    localparam  c_kind_light = 2'b10;
+    localparam  c_kind_const = 2'b11;
+    
+    // Enums
+    localparam ShadeStep__Idle = 0;
+    localparam ShadeStep__TriLoad = 1;
+    localparam ShadeStep__Point = 2;
+    localparam ShadeStep__NormalDot = 3;
+    localparam ShadeStep__KdLoad = 4;
+    localparam ShadeStep__Ambient = 5;
+    localparam ShadeStep__ToLight = 6;
+    localparam ShadeStep__Dots = 7;
+    localparam ShadeStep__Cosine = 8;
+    localparam ShadeStep__Tint = 9;
+    localparam ShadeStep__Accumulate = 10;
+    localparam ShadeStep__Pack = 11;
+    localparam ShadeStep__Store = 12;
+    
+    // Stub signals
+    reg  [4:0] rays__0__read_address;
+    reg  rays__0__read_clock;
+    wire  [23:0] rays__0__read_data;
+    reg  [4:0] rays__0__write_address;
+    reg  rays__0__write_clock;
+    reg  [23:0] rays__0__write_data;
+    reg  rays__0__write_enable;
+    reg  [4:0] rays__1__read_address;
+    reg  rays__1__read_clock;
+    wire  [23:0] rays__1__read_data;
+    reg  [4:0] rays__1__write_address;
+    reg  rays__1__write_clock;
+    reg  [23:0] rays__1__write_data;
+    reg  rays__1__write_enable;
+    reg  [4:0] rays__2__read_address;
+    reg  rays__2__read_clock;
+    wire  [23:0] rays__2__read_data;
+    reg  [4:0] rays__2__write_address;
+    reg  rays__2__write_clock;
+    reg  [23:0] rays__2__write_data;
+    reg  rays__2__write_enable;
+    reg  [4:0] rays__3__read_address;
+    reg  rays__3__read_clock;
+    wire  [23:0] rays__3__read_data;
+    reg  [4:0] rays__3__write_address;
+    reg  rays__3__write_clock;
+    reg  [23:0] rays__3__write_data;
+    reg  rays__3__write_enable;
+    reg  [4:0] rays__4__read_address;
+    reg  rays__4__read_clock;
+    wire  [23:0] rays__4__read_data;
+    reg  [4:0] rays__4__write_address;
+    reg  rays__4__write_clock;
+    reg  [23:0] rays__4__write_data;
+    reg  rays__4__write_enable;
+    reg  [4:0] rays__5__read_address;
+    reg  rays__5__read_clock;
+    wire  [23:0] rays__5__read_data;
+    reg  [4:0] rays__5__write_address;
+    reg  rays__5__write_clock;
+    reg  [23:0] rays__5__write_data;
+    reg  rays__5__write_enable;
+    reg  busy__0__d;
+    wire  busy__0__q;
+    reg  busy__0__clock;
+    reg  busy__1__d;
+    wire  busy__1__q;
+    reg  busy__1__clock;
+    reg  busy__2__d;
+    wire  busy__2__q;
+    reg  busy__2__clock;
+    reg  busy__3__d;
+    wire  busy__3__q;
+    reg  busy__3__clock;
+    reg  busy__4__d;
+    wire  busy__4__q;
+    reg  busy__4__clock;
+    reg  busy__5__d;
+    wire  busy__5__q;
+    reg  busy__5__clock;
+    reg  busy__6__d;
+    wire  busy__6__q;
+    reg  busy__6__clock;
+    reg  busy__7__d;
+    wire  busy__7__q;
+    reg  busy__7__clock;
+    reg  ready__0__d;
+    wire  ready__0__q;
+    reg  ready__0__clock;
+    reg  ready__1__d;
+    wire  ready__1__q;
+    reg  ready__1__clock;
+    reg  ready__2__d;
+    wire  ready__2__q;
+    reg  ready__2__clock;
+    reg  ready__3__d;
+    wire  ready__3__q;
+    reg  ready__3__clock;
+    reg  ready__4__d;
+    wire  ready__4__q;
+    reg  ready__4__clock;
+    reg  ready__5__d;
+    wire  ready__5__q;
+    reg  ready__5__clock;
+    reg  ready__6__d;
+    wire  ready__6__q;
+    reg  ready__6__clock;
+    reg  ready__7__d;
+    wire  ready__7__q;
+    reg  ready__7__clock;
+    reg  [3:0] step__0__d;
+    wire  [3:0] step__0__q;
+    reg  step__0__clock;
+    reg  [3:0] step__1__d;
+    wire  [3:0] step__1__q;
+    reg  step__1__clock;
+    reg  [3:0] step__2__d;
+    wire  [3:0] step__2__q;
+    reg  step__2__clock;
+    reg  [3:0] step__3__d;
+    wire  [3:0] step__3__q;
+    reg  step__3__clock;
+    reg  [3:0] step__4__d;
+    wire  [3:0] step__4__q;
+    reg  step__4__clock;
+    reg  [3:0] step__5__d;
+    wire  [3:0] step__5__q;
+    reg  step__5__clock;
+    reg  [3:0] step__6__d;
+    wire  [3:0] step__6__q;
+    reg  step__6__clock;
+    reg  [3:0] step__7__d;
+    wire  [3:0] step__7__q;
+    reg  step__7__clock;
+    reg  [2:0] light__0__d;
+    wire  [2:0] light__0__q;
+    reg  light__0__clock;
+    reg  [2:0] light__1__d;
+    wire  [2:0] light__1__q;
+    reg  light__1__clock;
+    reg  [2:0] light__2__d;
+    wire  [2:0] light__2__q;
+    reg  light__2__clock;
+    reg  [2:0] light__3__d;
+    wire  [2:0] light__3__q;
+    reg  light__3__clock;
+    reg  [2:0] light__4__d;
+    wire  [2:0] light__4__q;
+    reg  light__4__clock;
+    reg  [2:0] light__5__d;
+    wire  [2:0] light__5__q;
+    reg  light__5__clock;
+    reg  [2:0] light__6__d;
+    wire  [2:0] light__6__q;
+    reg  light__6__clock;
+    reg  [2:0] light__7__d;
+    wire  [2:0] light__7__q;
+    reg  light__7__clock;
+    reg  flip__0__d;
+    wire  flip__0__q;
+    reg  flip__0__clock;
+    reg  flip__1__d;
+    wire  flip__1__q;
+    reg  flip__1__clock;
+    reg  flip__2__d;
+    wire  flip__2__q;
+    reg  flip__2__clock;
+    reg  flip__3__d;
+    wire  flip__3__q;
+    reg  flip__3__clock;
+    reg  flip__4__d;
+    wire  flip__4__q;
+    reg  flip__4__clock;
+    reg  flip__5__d;
+    wire  flip__5__q;
+    reg  flip__5__clock;
+    reg  flip__6__d;
+    wire  flip__6__q;
+    reg  flip__6__clock;
+    reg  flip__7__d;
+    wire  flip__7__q;
+    reg  flip__7__clock;
+    reg  miss__0__d;
+    wire  miss__0__q;
+    reg  miss__0__clock;
+    reg  miss__1__d;
+    wire  miss__1__q;
+    reg  miss__1__clock;
+    reg  miss__2__d;
+    wire  miss__2__q;
+    reg  miss__2__clock;
+    reg  miss__3__d;
+    wire  miss__3__q;
+    reg  miss__3__clock;
+    reg  miss__4__d;
+    wire  miss__4__q;
+    reg  miss__4__clock;
+    reg  miss__5__d;
+    wire  miss__5__q;
+    reg  miss__5__clock;
+    reg  miss__6__d;
+    wire  miss__6__q;
+    reg  miss__6__clock;
+    reg  miss__7__d;
+    wire  miss__7__q;
+    reg  miss__7__clock;
+    reg  [2:0] o__0__read_address;
+    wire  [23:0] o__0__read_data;
+    reg  o__0__write_clock;
+    reg  [2:0] o__0__write_address;
+    reg  [23:0] o__0__write_data;
+    reg  o__0__write_enable;
+    reg  [2:0] o__1__read_address;
+    wire  [23:0] o__1__read_data;
+    reg  o__1__write_clock;
+    reg  [2:0] o__1__write_address;
+    reg  [23:0] o__1__write_data;
+    reg  o__1__write_enable;
+    reg  [2:0] o__2__read_address;
+    wire  [23:0] o__2__read_data;
+    reg  o__2__write_clock;
+    reg  [2:0] o__2__write_address;
+    reg  [23:0] o__2__write_data;
+    reg  o__2__write_enable;
+    reg  [2:0] d__0__read_address;
+    wire  [23:0] d__0__read_data;
+    reg  d__0__write_clock;
+    reg  [2:0] d__0__write_address;
+    reg  [23:0] d__0__write_data;
+    reg  d__0__write_enable;
+    reg  [2:0] d__1__read_address;
+    wire  [23:0] d__1__read_data;
+    reg  d__1__write_clock;
+    reg  [2:0] d__1__write_address;
+    reg  [23:0] d__1__write_data;
+    reg  d__1__write_enable;
+    reg  [2:0] d__2__read_address;
+    wire  [23:0] d__2__read_data;
+    reg  d__2__write_clock;
+    reg  [2:0] d__2__write_address;
+    reg  [23:0] d__2__write_data;
+    reg  d__2__write_enable;
+    reg  [2:0] t__read_address;
+    wire  [23:0] t__read_data;
+    reg  t__write_clock;
+    reg  [2:0] t__write_address;
+    reg  [23:0] t__write_data;
+    reg  t__write_enable;
+    reg  [2:0] addr__read_address;
+    wire  [23:0] addr__read_data;
+    reg  addr__write_clock;
+    reg  [2:0] addr__write_address;
+    reg  [23:0] addr__write_data;
+    reg  addr__write_enable;
+    reg  [2:0] triangle__read_address;
+    wire  [23:0] triangle__read_data;
+    reg  triangle__write_clock;
+    reg  [2:0] triangle__write_address;
+    reg  [23:0] triangle__write_data;
+    reg  triangle__write_enable;
+    reg  [2:0] n__0__read_address;
+    wire  [23:0] n__0__read_data;
+    reg  n__0__write_clock;
+    reg  [2:0] n__0__write_address;
+    reg  [23:0] n__0__write_data;
+    reg  n__0__write_enable;
+    reg  [2:0] n__1__read_address;
+    wire  [23:0] n__1__read_data;
+    reg  n__1__write_clock;
+    reg  [2:0] n__1__write_address;
+    reg  [23:0] n__1__write_data;
+    reg  n__1__write_enable;
+    reg  [2:0] n__2__read_address;
+    wire  [23:0] n__2__read_data;
+    reg  n__2__write_clock;
+    reg  [2:0] n__2__write_address;
+    reg  [23:0] n__2__write_data;
+    reg  n__2__write_enable;
+    reg  [2:0] material__read_address;
+    wire  [23:0] material__read_data;
+    reg  material__write_clock;
+    reg  [2:0] material__write_address;
+    reg  [23:0] material__write_data;
+    reg  material__write_enable;
+    reg  [2:0] kd__0__read_address;
+    wire  [23:0] kd__0__read_data;
+    reg  kd__0__write_clock;
+    reg  [2:0] kd__0__write_address;
+    reg  [23:0] kd__0__write_data;
+    reg  kd__0__write_enable;
+    reg  [2:0] kd__1__read_address;
+    wire  [23:0] kd__1__read_data;
+    reg  kd__1__write_clock;
+    reg  [2:0] kd__1__write_address;
+    reg  [23:0] kd__1__write_data;
+    reg  kd__1__write_enable;
+    reg  [2:0] kd__2__read_address;
+    wire  [23:0] kd__2__read_data;
+    reg  kd__2__write_clock;
+    reg  [2:0] kd__2__write_address;
+    reg  [23:0] kd__2__write_data;
+    reg  kd__2__write_enable;
+    reg  [2:0] p__0__read_address;
+    wire  [23:0] p__0__read_data;
+    reg  p__0__write_clock;
+    reg  [2:0] p__0__write_address;
+    reg  [23:0] p__0__write_data;
+    reg  p__0__write_enable;
+    reg  [2:0] p__1__read_address;
+    wire  [23:0] p__1__read_data;
+    reg  p__1__write_clock;
+    reg  [2:0] p__1__write_address;
+    reg  [23:0] p__1__write_data;
+    reg  p__1__write_enable;
+    reg  [2:0] p__2__read_address;
+    wire  [23:0] p__2__read_data;
+    reg  p__2__write_clock;
+    reg  [2:0] p__2__write_address;
+    reg  [23:0] p__2__write_data;
+    reg  p__2__write_enable;
+    reg  [2:0] acc__0__read_address;
+    wire  [23:0] acc__0__read_data;
+    reg  acc__0__write_clock;
+    reg  [2:0] acc__0__write_address;
+    reg  [23:0] acc__0__write_data;
+    reg  acc__0__write_enable;
+    reg  [2:0] acc__1__read_address;
+    wire  [23:0] acc__1__read_data;
+    reg  acc__1__write_clock;
+    reg  [2:0] acc__1__write_address;
+    reg  [23:0] acc__1__write_data;
+    reg  acc__1__write_enable;
+    reg  [2:0] acc__2__read_address;
+    wire  [23:0] acc__2__read_data;
+    reg  acc__2__write_clock;
+    reg  [2:0] acc__2__write_address;
+    reg  [23:0] acc__2__write_data;
+    reg  acc__2__write_enable;
+    reg  [2:0] to_light__0__read_address;
+    wire  [23:0] to_light__0__read_data;
+    reg  to_light__0__write_clock;
+    reg  [2:0] to_light__0__write_address;
+    reg  [23:0] to_light__0__write_data;
+    reg  to_light__0__write_enable;
+    reg  [2:0] to_light__1__read_address;
+    wire  [23:0] to_light__1__read_data;
+    reg  to_light__1__write_clock;
+    reg  [2:0] to_light__1__write_address;
+    reg  [23:0] to_light__1__write_data;
+    reg  to_light__1__write_enable;
+    reg  [2:0] to_light__2__read_address;
+    wire  [23:0] to_light__2__read_data;
+    reg  to_light__2__write_clock;
+    reg  [2:0] to_light__2__write_address;
+    reg  [23:0] to_light__2__write_data;
+    reg  to_light__2__write_enable;
+    reg  [2:0] n_dot_l__read_address;
+    wire  [23:0] n_dot_l__read_data;
+    reg  n_dot_l__write_clock;
+    reg  [2:0] n_dot_l__write_address;
+    reg  [23:0] n_dot_l__write_data;
+    reg  n_dot_l__write_enable;
+    reg  [2:0] l_dot_l__read_address;
+    wire  [23:0] l_dot_l__read_data;
+    reg  l_dot_l__write_clock;
+    reg  [2:0] l_dot_l__write_address;
+    reg  [23:0] l_dot_l__write_data;
+    reg  l_dot_l__write_enable;
+    reg  [2:0] tint__0__read_address;
+    wire  [23:0] tint__0__read_data;
+    reg  tint__0__write_clock;
+    reg  [2:0] tint__0__write_address;
+    reg  [23:0] tint__0__write_data;
+    reg  tint__0__write_enable;
+    reg  [2:0] tint__1__read_address;
+    wire  [23:0] tint__1__read_data;
+    reg  tint__1__write_clock;
+    reg  [2:0] tint__1__write_address;
+    reg  [23:0] tint__1__write_data;
+    reg  tint__1__write_enable;
+    reg  [2:0] tint__2__read_address;
+    wire  [23:0] tint__2__read_data;
+    reg  tint__2__write_clock;
+    reg  [2:0] tint__2__write_address;
+    reg  [23:0] tint__2__write_data;
+    reg  tint__2__write_enable;
+    reg  [2:0] cos__read_address;
+    wire  [23:0] cos__read_data;
+    reg  cos__write_clock;
+    reg  [2:0] cos__write_address;
+    reg  [23:0] cos__write_data;
+    reg  cos__write_enable;
+    reg  [2:0] rgb__read_address;
+    wire  [23:0] rgb__read_data;
+    reg  rgb__write_clock;
+    reg  [2:0] rgb__write_address;
+    reg  [23:0] rgb__write_data;
+    reg  rgb__write_enable;
+    reg  [23:0] ambient__d;
+    wire  [23:0] ambient__q;
+    reg  ambient__clock;
+    reg  [23:0] background__0__d;
+    wire  [23:0] background__0__q;
+    reg  background__0__clock;
+    reg  [23:0] background__1__d;
+    wire  [23:0] background__1__q;
+    reg  background__1__clock;
+    reg  [23:0] background__2__d;
+    wire  [23:0] background__2__q;
+    reg  background__2__clock;
+    reg  [2:0] light_position__0__read_address;
+    wire  [23:0] light_position__0__read_data;
+    reg  light_position__0__write_clock;
+    reg  [2:0] light_position__0__write_address;
+    reg  [23:0] light_position__0__write_data;
+    reg  light_position__0__write_enable;
+    reg  [2:0] light_position__1__read_address;
+    wire  [23:0] light_position__1__read_data;
+    reg  light_position__1__write_clock;
+    reg  [2:0] light_position__1__write_address;
+    reg  [23:0] light_position__1__write_data;
+    reg  light_position__1__write_enable;
+    reg  [2:0] light_position__2__read_address;
+    wire  [23:0] light_position__2__read_data;
+    reg  light_position__2__write_clock;
+    reg  [2:0] light_position__2__write_address;
+    reg  [23:0] light_position__2__write_data;
+    reg  light_position__2__write_enable;
+    reg  [2:0] light_color__0__read_address;
+    wire  [23:0] light_color__0__read_data;
+    reg  light_color__0__write_clock;
+    reg  [2:0] light_color__0__write_address;
+    reg  [23:0] light_color__0__write_data;
+    reg  light_color__0__write_enable;
+    reg  [2:0] light_color__1__read_address;
+    wire  [23:0] light_color__1__read_data;
+    reg  light_color__1__write_clock;
+    reg  [2:0] light_color__1__write_address;
+    reg  [23:0] light_color__1__write_data;
+    reg  light_color__1__write_enable;
+    reg  [2:0] light_color__2__read_address;
+    wire  [23:0] light_color__2__read_data;
+    reg  light_color__2__write_clock;
+    reg  [2:0] light_color__2__write_address;
+    reg  [23:0] light_color__2__write_data;
+    reg  light_color__2__write_enable;
+    reg  loading__d;
+    wire  loading__q;
+    reg  loading__clock;
+    reg  [5:0] const_issued__d;
+    wire  [5:0] const_issued__q;
+    reg  const_issued__clock;
+    reg  [5:0] const_arrived__d;
+    wire  [5:0] const_arrived__q;
+    reg  const_arrived__clock;
+    reg  [23:0] const_addr__d;
+    wire  [23:0] const_addr__q;
+    reg  const_addr__clock;
+    reg  const_lights__d;
+    wire  const_lights__q;
+    reg  const_lights__clock;
+    reg  [2:0] const_light__d;
+    wire  [2:0] const_light__q;
+    reg  const_light__clock;
+    reg  [2:0] const_word__d;
+    wire  [2:0] const_word__q;
+    reg  const_word__clock;
+    reg  s1_valid__d;
+    wire  s1_valid__q;
+    reg  s1_valid__clock;
+    reg  [2:0] s1_slot__d;
+    wire  [2:0] s1_slot__q;
+    reg  s1_slot__clock;
+    reg  [1:0] s1_word__d;
+    wire  [1:0] s1_word__q;
+    reg  s1_word__clock;
+    reg  [3:0] s1_step__d;
+    wire  [3:0] s1_step__q;
+    reg  s1_step__clock;
+    reg  [2:0] s1_light__d;
+    wire  [2:0] s1_light__q;
+    reg  s1_light__clock;
+    reg  s1_flip__d;
+    wire  s1_flip__q;
+    reg  s1_flip__clock;
+    reg  s1_miss__d;
+    wire  s1_miss__q;
+    reg  s1_miss__clock;
+    reg  gen_held__d;
+    wire  gen_held__q;
+    reg  gen_held__clock;
+    reg  [23:0] gen_hold_m__0__d;
+    wire  [23:0] gen_hold_m__0__q;
+    reg  gen_hold_m__0__clock;
+    reg  [23:0] gen_hold_m__1__d;
+    wire  [23:0] gen_hold_m__1__q;
+    reg  gen_hold_m__1__clock;
+    reg  [23:0] gen_hold_m__2__d;
+    wire  [23:0] gen_hold_m__2__q;
+    reg  gen_hold_m__2__clock;
+    reg  [23:0] gen_hold_m__3__d;
+    wire  [23:0] gen_hold_m__3__q;
+    reg  gen_hold_m__3__clock;
+    reg  [23:0] gen_hold_m__4__d;
+    wire  [23:0] gen_hold_m__4__q;
+    reg  gen_hold_m__4__clock;
+    reg  [23:0] gen_hold_m__5__d;
+    wire  [23:0] gen_hold_m__5__q;
+    reg  gen_hold_m__5__clock;
+    reg  [23:0] gen_hold_m__6__d;
+    wire  [23:0] gen_hold_m__6__q;
+    reg  gen_hold_m__6__clock;
+    reg  [23:0] gen_hold_m__7__d;
+    wire  [23:0] gen_hold_m__7__q;
+    reg  gen_hold_m__7__clock;
+    reg  [23:0] gen_hold_m__8__d;
+    wire  [23:0] gen_hold_m__8__q;
+    reg  gen_hold_m__8__clock;
+    reg  [23:0] gen_hold_m__9__d;
+    wire  [23:0] gen_hold_m__9__q;
+    reg  gen_hold_m__9__clock;
+    reg  [23:0] gen_hold_m__10__d;
+    wire  [23:0] gen_hold_m__10__q;
+    reg  gen_hold_m__10__clock;
+    reg  [23:0] gen_hold_m__11__d;
+    wire  [23:0] gen_hold_m__11__q;
+    reg  gen_hold_m__11__clock;
+    reg  [23:0] gen_hold_v__0__d;
+    wire  [23:0] gen_hold_v__0__q;
+    reg  gen_hold_v__0__clock;
+    reg  [23:0] gen_hold_v__1__d;
+    wire  [23:0] gen_hold_v__1__q;
+    reg  gen_hold_v__1__clock;
+    reg  [23:0] gen_hold_v__2__d;
+    wire  [23:0] gen_hold_v__2__q;
+    reg  gen_hold_v__2__clock;
+    reg  gen_hold_point__d;
+    wire  gen_hold_point__q;
+    reg  gen_hold_point__clock;
+    reg  gen_hold_diagonal__d;
+    wire  gen_hold_diagonal__q;
+    reg  gen_hold_diagonal__clock;
+    reg  [2:0] gen_hold_slot__d;
+    wire  [2:0] gen_hold_slot__q;
+    reg  gen_hold_slot__clock;
+    reg  tri_line__clock;
+    reg  [8:0] tri_line__data_in;
+    wire  [8:0] tri_line__data_out;
+    reg  frame_line__clock;
+    reg  [8:0] frame_line__data_in;
+    wire  [8:0] frame_line__data_out;
+    reg  sqrt__clock;
+    reg  sqrt__in_valid;
+    reg  [23:0] sqrt__a;
+    wire  sqrt__out_valid;
+    wire  [23:0] sqrt__result;
+    reg  div__clock;
+    reg  div__in_valid;
+    reg  [23:0] div__a;
+    reg  [23:0] div__b;
+    wire  div__out_valid;
+    wire  [23:0] div__result;
+    reg  cos_n_dot_l__clock;
+    reg  [23:0] cos_n_dot_l__data_in;
+    wire  [23:0] cos_n_dot_l__data_out;
+    reg  cos_slot__clock;
+    reg  [3:0] cos_slot__data_in;
+    wire  [3:0] cos_slot__data_out;
+    reg  byte_unit__clock;
+    reg  byte_unit__in_valid;
+    reg  [23:0] byte_unit__word;
+    wire  byte_unit__out_valid;
+    wire  [7:0] byte_unit__result;
+    reg  byte_tag__clock;
+    reg  [5:0] byte_tag__data_in;
+    wire  [5:0] byte_tag__data_out;
+    reg  [23:0] rgb_acc__d;
+    wire  [23:0] rgb_acc__q;
+    reg  rgb_acc__clock;
+    
+    // Local signals
+    reg  const_go;
+    reg  any_free_before__0;
+    reg  any_free_before__1;
+    reg  any_free_before__2;
+    reg  any_free_before__3;
+    reg  any_free_before__4;
+    reg  any_free_before__5;
+    reg  any_free_before__6;
+    reg  any_free_before__7;
+    reg  any_free_before__8;
+    reg  [2:0] free_slot;
+    reg  taken;
+    reg  [3:0] pick_step;
+    reg  [2:0] pick_light;
+    reg  pick_flip;
+    reg  pick_miss;
+    reg  s1_done;
+    reg  [23:0] facing__0;
+    reg  [23:0] facing__1;
+    reg  [23:0] facing__2;
+    reg  any_ready_before__0;
+    reg  any_ready_before__1;
+    reg  any_ready_before__2;
+    reg  any_ready_before__3;
+    reg  any_ready_before__4;
+    reg  any_ready_before__5;
+    reg  any_ready_before__6;
+    reg  any_ready_before__7;
+    reg  any_ready_before__8;
+    reg  [2:0] ready_slot;
+    reg  pick;
+    reg  gen_load;
+    reg  [23:0] req_m__0;
+    reg  [23:0] req_m__1;
+    reg  [23:0] req_m__2;
+    reg  [23:0] req_m__3;
+    reg  [23:0] req_m__4;
+    reg  [23:0] req_m__5;
+    reg  [23:0] req_m__6;
+    reg  [23:0] req_m__7;
+    reg  [23:0] req_m__8;
+    reg  [23:0] req_m__9;
+    reg  [23:0] req_m__10;
+    reg  [23:0] req_m__11;
+    reg  [23:0] req_v__0;
+    reg  [23:0] req_v__1;
+    reg  [23:0] req_v__2;
+    reg  req_point;
+    reg  req_diagonal;
+    reg  [3:0] res_step;
+    reg  [2:0] res_light;
+    reg  res_positive;
+    reg  tu_step;
+    reg  tri_word_0;
+    reg  tri_word_1;
+    reg  frame_valid;
+    reg  [1:0] frame_kind;
+    reg  [2:0] frame_word;
+    reg  [5:0] byte_tag_in;
+    reg  [23:0] rgb_next;
+    reg  any_busy;
+    reg  tri_read_l;
+    reg  frame_read_l;
+    reg  [23:0] frame_addr_l;
+    reg  fb_write_l;
+    reg  [8:0] tri_tag;
+    reg  [8:0] frame_tag;
+    reg  [8:0] tri_arrived;
+    reg  [8:0] frame_arrived;
+    
+    // Sub module instances
+    dynrt_processor__engine__instances__world__0 rays__0(
+        .read_address(rays__0__read_address),
+        .read_clock(rays__0__read_clock),
+        .read_data(rays__0__read_data),
+        .write_address(rays__0__write_address),
+        .write_clock(rays__0__write_clock),
+        .write_data(rays__0__write_data),
+        .write_enable(rays__0__write_enable)
+    );
+    dynrt_processor__engine__instances__world__0 rays__1(
+        .read_address(rays__1__read_address),
+        .read_clock(rays__1__read_clock),
+        .read_data(rays__1__read_data),
+        .write_address(rays__1__write_address),
+        .write_clock(rays__1__write_clock),
+        .write_data(rays__1__write_data),
+        .write_enable(rays__1__write_enable)
+    );
+    dynrt_processor__engine__instances__world__0 rays__2(
+        .read_address(rays__2__read_address),
+        .read_clock(rays__2__read_clock),
+        .read_data(rays__2__read_data),
+        .write_address(rays__2__write_address),
+        .write_clock(rays__2__write_clock),
+        .write_data(rays__2__write_data),
+        .write_enable(rays__2__write_enable)
+    );
+    dynrt_processor__engine__instances__world__0 rays__3(
+        .read_address(rays__3__read_address),
+        .read_clock(rays__3__read_clock),
+        .read_data(rays__3__read_data),
+        .write_address(rays__3__write_address),
+        .write_clock(rays__3__write_clock),
+        .write_data(rays__3__write_data),
+        .write_enable(rays__3__write_enable)
+    );
+    dynrt_processor__engine__instances__world__0 rays__4(
+        .read_address(rays__4__read_address),
+        .read_clock(rays__4__read_clock),
+        .read_data(rays__4__read_data),
+        .write_address(rays__4__write_address),
+        .write_clock(rays__4__write_clock),
+        .write_data(rays__4__write_data),
+        .write_enable(rays__4__write_enable)
+    );
+    dynrt_processor__engine__instances__world__0 rays__5(
+        .read_address(rays__5__read_address),
+        .read_clock(rays__5__read_clock),
+        .read_data(rays__5__read_data),
+        .write_address(rays__5__write_address),
+        .write_clock(rays__5__write_clock),
+        .write_data(rays__5__write_data),
+        .write_enable(rays__5__write_enable)
+    );
+    dynrt_processor__display__dark_d busy__0(
+        .d(busy__0__d),
+        .q(busy__0__q),
+        .clock(busy__0__clock)
+    );
+    dynrt_processor__display__dark_d busy__1(
+        .d(busy__1__d),
+        .q(busy__1__q),
+        .clock(busy__1__clock)
+    );
+    dynrt_processor__display__dark_d busy__2(
+        .d(busy__2__d),
+        .q(busy__2__q),
+        .clock(busy__2__clock)
+    );
+    dynrt_processor__display__dark_d busy__3(
+        .d(busy__3__d),
+        .q(busy__3__q),
+        .clock(busy__3__clock)
+    );
+    dynrt_processor__display__dark_d busy__4(
+        .d(busy__4__d),
+        .q(busy__4__q),
+        .clock(busy__4__clock)
+    );
+    dynrt_processor__display__dark_d busy__5(
+        .d(busy__5__d),
+        .q(busy__5__q),
+        .clock(busy__5__clock)
+    );
+    dynrt_processor__display__dark_d busy__6(
+        .d(busy__6__d),
+        .q(busy__6__q),
+        .clock(busy__6__clock)
+    );
+    dynrt_processor__display__dark_d busy__7(
+        .d(busy__7__d),
+        .q(busy__7__q),
+        .clock(busy__7__clock)
+    );
+    dynrt_processor__display__dark_d ready__0(
+        .d(ready__0__d),
+        .q(ready__0__q),
+        .clock(ready__0__clock)
+    );
+    dynrt_processor__display__dark_d ready__1(
+        .d(ready__1__d),
+        .q(ready__1__q),
+        .clock(ready__1__clock)
+    );
+    dynrt_processor__display__dark_d ready__2(
+        .d(ready__2__d),
+        .q(ready__2__q),
+        .clock(ready__2__clock)
+    );
+    dynrt_processor__display__dark_d ready__3(
+        .d(ready__3__d),
+        .q(ready__3__q),
+        .clock(ready__3__clock)
+    );
+    dynrt_processor__display__dark_d ready__4(
+        .d(ready__4__d),
+        .q(ready__4__q),
+        .clock(ready__4__clock)
+    );
+    dynrt_processor__display__dark_d ready__5(
+        .d(ready__5__d),
+        .q(ready__5__q),
+        .clock(ready__5__clock)
+    );
+    dynrt_processor__display__dark_d ready__6(
+        .d(ready__6__d),
+        .q(ready__6__q),
+        .clock(ready__6__clock)
+    );
+    dynrt_processor__display__dark_d ready__7(
+        .d(ready__7__d),
+        .q(ready__7__q),
+        .clock(ready__7__clock)
+    );
+    dynrt_processor__engine__shader__s1_step step__0(
+        .d(step__0__d),
+        .q(step__0__q),
+        .clock(step__0__clock)
+    );
+    dynrt_processor__engine__shader__s1_step step__1(
+        .d(step__1__d),
+        .q(step__1__q),
+        .clock(step__1__clock)
+    );
+    dynrt_processor__engine__shader__s1_step step__2(
+        .d(step__2__d),
+        .q(step__2__q),
+        .clock(step__2__clock)
+    );
+    dynrt_processor__engine__shader__s1_step step__3(
+        .d(step__3__d),
+        .q(step__3__q),
+        .clock(step__3__clock)
+    );
+    dynrt_processor__engine__shader__s1_step step__4(
+        .d(step__4__d),
+        .q(step__4__q),
+        .clock(step__4__clock)
+    );
+    dynrt_processor__engine__shader__s1_step step__5(
+        .d(step__5__d),
+        .q(step__5__q),
+        .clock(step__5__clock)
+    );
+    dynrt_processor__engine__shader__s1_step step__6(
+        .d(step__6__d),
+        .q(step__6__q),
+        .clock(step__6__clock)
+    );
+    dynrt_processor__engine__shader__s1_step step__7(
+        .d(step__7__d),
+        .q(step__7__q),
+        .clock(step__7__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__0(
+        .d(light__0__d),
+        .q(light__0__q),
+        .clock(light__0__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__1(
+        .d(light__1__d),
+        .q(light__1__q),
+        .clock(light__1__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__2(
+        .d(light__2__d),
+        .q(light__2__q),
+        .clock(light__2__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__3(
+        .d(light__3__d),
+        .q(light__3__q),
+        .clock(light__3__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__4(
+        .d(light__4__d),
+        .q(light__4__q),
+        .clock(light__4__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__5(
+        .d(light__5__d),
+        .q(light__5__q),
+        .clock(light__5__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__6(
+        .d(light__6__d),
+        .q(light__6__q),
+        .clock(light__6__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__7(
+        .d(light__7__d),
+        .q(light__7__q),
+        .clock(light__7__clock)
+    );
+    dynrt_processor__display__dark_d flip__0(
+        .d(flip__0__d),
+        .q(flip__0__q),
+        .clock(flip__0__clock)
+    );
+    dynrt_processor__display__dark_d flip__1(
+        .d(flip__1__d),
+        .q(flip__1__q),
+        .clock(flip__1__clock)
+    );
+    dynrt_processor__display__dark_d flip__2(
+        .d(flip__2__d),
+        .q(flip__2__q),
+        .clock(flip__2__clock)
+    );
+    dynrt_processor__display__dark_d flip__3(
+        .d(flip__3__d),
+        .q(flip__3__q),
+        .clock(flip__3__clock)
+    );
+    dynrt_processor__display__dark_d flip__4(
+        .d(flip__4__d),
+        .q(flip__4__q),
+        .clock(flip__4__clock)
+    );
+    dynrt_processor__display__dark_d flip__5(
+        .d(flip__5__d),
+        .q(flip__5__q),
+        .clock(flip__5__clock)
+    );
+    dynrt_processor__display__dark_d flip__6(
+        .d(flip__6__d),
+        .q(flip__6__q),
+        .clock(flip__6__clock)
+    );
+    dynrt_processor__display__dark_d flip__7(
+        .d(flip__7__d),
+        .q(flip__7__q),
+        .clock(flip__7__clock)
+    );
+    dynrt_processor__display__dark_d miss__0(
+        .d(miss__0__d),
+        .q(miss__0__q),
+        .clock(miss__0__clock)
+    );
+    dynrt_processor__display__dark_d miss__1(
+        .d(miss__1__d),
+        .q(miss__1__q),
+        .clock(miss__1__clock)
+    );
+    dynrt_processor__display__dark_d miss__2(
+        .d(miss__2__d),
+        .q(miss__2__q),
+        .clock(miss__2__clock)
+    );
+    dynrt_processor__display__dark_d miss__3(
+        .d(miss__3__d),
+        .q(miss__3__q),
+        .clock(miss__3__clock)
+    );
+    dynrt_processor__display__dark_d miss__4(
+        .d(miss__4__d),
+        .q(miss__4__q),
+        .clock(miss__4__clock)
+    );
+    dynrt_processor__display__dark_d miss__5(
+        .d(miss__5__d),
+        .q(miss__5__q),
+        .clock(miss__5__clock)
+    );
+    dynrt_processor__display__dark_d miss__6(
+        .d(miss__6__d),
+        .q(miss__6__q),
+        .clock(miss__6__clock)
+    );
+    dynrt_processor__display__dark_d miss__7(
+        .d(miss__7__d),
+        .q(miss__7__q),
+        .clock(miss__7__clock)
+    );
+    dynrt_processor__engine__shader__acc__0 o__0(
+        .read_address(o__0__read_address),
+        .read_data(o__0__read_data),
+        .write_clock(o__0__write_clock),
+        .write_address(o__0__write_address),
+        .write_data(o__0__write_data),
+        .write_enable(o__0__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 o__1(
+        .read_address(o__1__read_address),
+        .read_data(o__1__read_data),
+        .write_clock(o__1__write_clock),
+        .write_address(o__1__write_address),
+        .write_data(o__1__write_data),
+        .write_enable(o__1__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 o__2(
+        .read_address(o__2__read_address),
+        .read_data(o__2__read_data),
+        .write_clock(o__2__write_clock),
+        .write_address(o__2__write_address),
+        .write_data(o__2__write_data),
+        .write_enable(o__2__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 d__0(
+        .read_address(d__0__read_address),
+        .read_data(d__0__read_data),
+        .write_clock(d__0__write_clock),
+        .write_address(d__0__write_address),
+        .write_data(d__0__write_data),
+        .write_enable(d__0__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 d__1(
+        .read_address(d__1__read_address),
+        .read_data(d__1__read_data),
+        .write_clock(d__1__write_clock),
+        .write_address(d__1__write_address),
+        .write_data(d__1__write_data),
+        .write_enable(d__1__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 d__2(
+        .read_address(d__2__read_address),
+        .read_data(d__2__read_data),
+        .write_clock(d__2__write_clock),
+        .write_address(d__2__write_address),
+        .write_data(d__2__write_data),
+        .write_enable(d__2__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 t(
+        .read_address(t__read_address),
+        .read_data(t__read_data),
+        .write_clock(t__write_clock),
+        .write_address(t__write_address),
+        .write_data(t__write_data),
+        .write_enable(t__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 addr(
+        .read_address(addr__read_address),
+        .read_data(addr__read_data),
+        .write_clock(addr__write_clock),
+        .write_address(addr__write_address),
+        .write_data(addr__write_data),
+        .write_enable(addr__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 triangle(
+        .read_address(triangle__read_address),
+        .read_data(triangle__read_data),
+        .write_clock(triangle__write_clock),
+        .write_address(triangle__write_address),
+        .write_data(triangle__write_data),
+        .write_enable(triangle__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 n__0(
+        .read_address(n__0__read_address),
+        .read_data(n__0__read_data),
+        .write_clock(n__0__write_clock),
+        .write_address(n__0__write_address),
+        .write_data(n__0__write_data),
+        .write_enable(n__0__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 n__1(
+        .read_address(n__1__read_address),
+        .read_data(n__1__read_data),
+        .write_clock(n__1__write_clock),
+        .write_address(n__1__write_address),
+        .write_data(n__1__write_data),
+        .write_enable(n__1__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 n__2(
+        .read_address(n__2__read_address),
+        .read_data(n__2__read_data),
+        .write_clock(n__2__write_clock),
+        .write_address(n__2__write_address),
+        .write_data(n__2__write_data),
+        .write_enable(n__2__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 material(
+        .read_address(material__read_address),
+        .read_data(material__read_data),
+        .write_clock(material__write_clock),
+        .write_address(material__write_address),
+        .write_data(material__write_data),
+        .write_enable(material__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 kd__0(
+        .read_address(kd__0__read_address),
+        .read_data(kd__0__read_data),
+        .write_clock(kd__0__write_clock),
+        .write_address(kd__0__write_address),
+        .write_data(kd__0__write_data),
+        .write_enable(kd__0__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 kd__1(
+        .read_address(kd__1__read_address),
+        .read_data(kd__1__read_data),
+        .write_clock(kd__1__write_clock),
+        .write_address(kd__1__write_address),
+        .write_data(kd__1__write_data),
+        .write_enable(kd__1__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 kd__2(
+        .read_address(kd__2__read_address),
+        .read_data(kd__2__read_data),
+        .write_clock(kd__2__write_clock),
+        .write_address(kd__2__write_address),
+        .write_data(kd__2__write_data),
+        .write_enable(kd__2__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 p__0(
+        .read_address(p__0__read_address),
+        .read_data(p__0__read_data),
+        .write_clock(p__0__write_clock),
+        .write_address(p__0__write_address),
+        .write_data(p__0__write_data),
+        .write_enable(p__0__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 p__1(
+        .read_address(p__1__read_address),
+        .read_data(p__1__read_data),
+        .write_clock(p__1__write_clock),
+        .write_address(p__1__write_address),
+        .write_data(p__1__write_data),
+        .write_enable(p__1__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 p__2(
+        .read_address(p__2__read_address),
+        .read_data(p__2__read_data),
+        .write_clock(p__2__write_clock),
+        .write_address(p__2__write_address),
+        .write_data(p__2__write_data),
+        .write_enable(p__2__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 acc__0(
+        .read_address(acc__0__read_address),
+        .read_data(acc__0__read_data),
+        .write_clock(acc__0__write_clock),
+        .write_address(acc__0__write_address),
+        .write_data(acc__0__write_data),
+        .write_enable(acc__0__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 acc__1(
+        .read_address(acc__1__read_address),
+        .read_data(acc__1__read_data),
+        .write_clock(acc__1__write_clock),
+        .write_address(acc__1__write_address),
+        .write_data(acc__1__write_data),
+        .write_enable(acc__1__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 acc__2(
+        .read_address(acc__2__read_address),
+        .read_data(acc__2__read_data),
+        .write_clock(acc__2__write_clock),
+        .write_address(acc__2__write_address),
+        .write_data(acc__2__write_data),
+        .write_enable(acc__2__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 to_light__0(
+        .read_address(to_light__0__read_address),
+        .read_data(to_light__0__read_data),
+        .write_clock(to_light__0__write_clock),
+        .write_address(to_light__0__write_address),
+        .write_data(to_light__0__write_data),
+        .write_enable(to_light__0__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 to_light__1(
+        .read_address(to_light__1__read_address),
+        .read_data(to_light__1__read_data),
+        .write_clock(to_light__1__write_clock),
+        .write_address(to_light__1__write_address),
+        .write_data(to_light__1__write_data),
+        .write_enable(to_light__1__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 to_light__2(
+        .read_address(to_light__2__read_address),
+        .read_data(to_light__2__read_data),
+        .write_clock(to_light__2__write_clock),
+        .write_address(to_light__2__write_address),
+        .write_data(to_light__2__write_data),
+        .write_enable(to_light__2__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 n_dot_l(
+        .read_address(n_dot_l__read_address),
+        .read_data(n_dot_l__read_data),
+        .write_clock(n_dot_l__write_clock),
+        .write_address(n_dot_l__write_address),
+        .write_data(n_dot_l__write_data),
+        .write_enable(n_dot_l__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 l_dot_l(
+        .read_address(l_dot_l__read_address),
+        .read_data(l_dot_l__read_data),
+        .write_clock(l_dot_l__write_clock),
+        .write_address(l_dot_l__write_address),
+        .write_data(l_dot_l__write_data),
+        .write_enable(l_dot_l__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 tint__0(
+        .read_address(tint__0__read_address),
+        .read_data(tint__0__read_data),
+        .write_clock(tint__0__write_clock),
+        .write_address(tint__0__write_address),
+        .write_data(tint__0__write_data),
+        .write_enable(tint__0__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 tint__1(
+        .read_address(tint__1__read_address),
+        .read_data(tint__1__read_data),
+        .write_clock(tint__1__write_clock),
+        .write_address(tint__1__write_address),
+        .write_data(tint__1__write_data),
+        .write_enable(tint__1__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 tint__2(
+        .read_address(tint__2__read_address),
+        .read_data(tint__2__read_data),
+        .write_clock(tint__2__write_clock),
+        .write_address(tint__2__write_address),
+        .write_data(tint__2__write_data),
+        .write_enable(tint__2__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 cos(
+        .read_address(cos__read_address),
+        .read_data(cos__read_data),
+        .write_clock(cos__write_clock),
+        .write_address(cos__write_address),
+        .write_data(cos__write_data),
+        .write_enable(cos__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 rgb(
+        .read_address(rgb__read_address),
+        .read_data(rgb__read_data),
+        .write_clock(rgb__write_clock),
+        .write_address(rgb__write_address),
+        .write_data(rgb__write_data),
+        .write_enable(rgb__write_enable)
+    );
+    dynrt_processor__display__rgb_q ambient(
+        .d(ambient__d),
+        .q(ambient__q),
+        .clock(ambient__clock)
+    );
+    dynrt_processor__display__rgb_q background__0(
+        .d(background__0__d),
+        .q(background__0__q),
+        .clock(background__0__clock)
+    );
+    dynrt_processor__display__rgb_q background__1(
+        .d(background__1__d),
+        .q(background__1__q),
+        .clock(background__1__clock)
+    );
+    dynrt_processor__display__rgb_q background__2(
+        .d(background__2__d),
+        .q(background__2__q),
+        .clock(background__2__clock)
+    );
+    dynrt_processor__engine__shader__acc__0 light_position__0(
+        .read_address(light_position__0__read_address),
+        .read_data(light_position__0__read_data),
+        .write_clock(light_position__0__write_clock),
+        .write_address(light_position__0__write_address),
+        .write_data(light_position__0__write_data),
+        .write_enable(light_position__0__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 light_position__1(
+        .read_address(light_position__1__read_address),
+        .read_data(light_position__1__read_data),
+        .write_clock(light_position__1__write_clock),
+        .write_address(light_position__1__write_address),
+        .write_data(light_position__1__write_data),
+        .write_enable(light_position__1__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 light_position__2(
+        .read_address(light_position__2__read_address),
+        .read_data(light_position__2__read_data),
+        .write_clock(light_position__2__write_clock),
+        .write_address(light_position__2__write_address),
+        .write_data(light_position__2__write_data),
+        .write_enable(light_position__2__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 light_color__0(
+        .read_address(light_color__0__read_address),
+        .read_data(light_color__0__read_data),
+        .write_clock(light_color__0__write_clock),
+        .write_address(light_color__0__write_address),
+        .write_data(light_color__0__write_data),
+        .write_enable(light_color__0__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 light_color__1(
+        .read_address(light_color__1__read_address),
+        .read_data(light_color__1__read_data),
+        .write_clock(light_color__1__write_clock),
+        .write_address(light_color__1__write_address),
+        .write_data(light_color__1__write_data),
+        .write_enable(light_color__1__write_enable)
+    );
+    dynrt_processor__engine__shader__acc__0 light_color__2(
+        .read_address(light_color__2__read_address),
+        .read_data(light_color__2__read_data),
+        .write_clock(light_color__2__write_clock),
+        .write_address(light_color__2__write_address),
+        .write_data(light_color__2__write_data),
+        .write_enable(light_color__2__write_enable)
+    );
+    dynrt_processor__display__dark_d loading(
+        .d(loading__d),
+        .q(loading__q),
+        .clock(loading__clock)
+    );
+    dynrt_processor__engine__mem_load_r const_issued(
+        .d(const_issued__d),
+        .q(const_issued__q),
+        .clock(const_issued__clock)
+    );
+    dynrt_processor__engine__mem_load_r const_arrived(
+        .d(const_arrived__d),
+        .q(const_arrived__q),
+        .clock(const_arrived__clock)
+    );
+    dynrt_processor__display__rgb_q const_addr(
+        .d(const_addr__d),
+        .q(const_addr__q),
+        .clock(const_addr__clock)
+    );
+    dynrt_processor__display__dark_d const_lights(
+        .d(const_lights__d),
+        .q(const_lights__q),
+        .clock(const_lights__clock)
+    );
+    dynrt_processor__engine__mem_bank_r const_light(
+        .d(const_light__d),
+        .q(const_light__q),
+        .clock(const_light__clock)
+    );
+    dynrt_processor__engine__mem_bank_r const_word(
+        .d(const_word__d),
+        .q(const_word__q),
+        .clock(const_word__clock)
+    );
+    dynrt_processor__display__dark_d s1_valid(
+        .d(s1_valid__d),
+        .q(s1_valid__q),
+        .clock(s1_valid__clock)
+    );
+    dynrt_processor__engine__mem_bank_r s1_slot(
+        .d(s1_slot__d),
+        .q(s1_slot__q),
+        .clock(s1_slot__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 s1_word(
+        .d(s1_word__d),
+        .q(s1_word__q),
+        .clock(s1_word__clock)
+    );
+    dynrt_processor__engine__shader__s1_step s1_step(
+        .d(s1_step__d),
+        .q(s1_step__q),
+        .clock(s1_step__clock)
+    );
+    dynrt_processor__engine__mem_bank_r s1_light(
+        .d(s1_light__d),
+        .q(s1_light__q),
+        .clock(s1_light__clock)
+    );
+    dynrt_processor__display__dark_d s1_flip(
+        .d(s1_flip__d),
+        .q(s1_flip__q),
+        .clock(s1_flip__clock)
+    );
+    dynrt_processor__display__dark_d s1_miss(
+        .d(s1_miss__d),
+        .q(s1_miss__q),
+        .clock(s1_miss__clock)
+    );
+    dynrt_processor__display__dark_d gen_held(
+        .d(gen_held__d),
+        .q(gen_held__q),
+        .clock(gen_held__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__0(
+        .d(gen_hold_m__0__d),
+        .q(gen_hold_m__0__q),
+        .clock(gen_hold_m__0__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__1(
+        .d(gen_hold_m__1__d),
+        .q(gen_hold_m__1__q),
+        .clock(gen_hold_m__1__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__2(
+        .d(gen_hold_m__2__d),
+        .q(gen_hold_m__2__q),
+        .clock(gen_hold_m__2__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__3(
+        .d(gen_hold_m__3__d),
+        .q(gen_hold_m__3__q),
+        .clock(gen_hold_m__3__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__4(
+        .d(gen_hold_m__4__d),
+        .q(gen_hold_m__4__q),
+        .clock(gen_hold_m__4__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__5(
+        .d(gen_hold_m__5__d),
+        .q(gen_hold_m__5__q),
+        .clock(gen_hold_m__5__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__6(
+        .d(gen_hold_m__6__d),
+        .q(gen_hold_m__6__q),
+        .clock(gen_hold_m__6__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__7(
+        .d(gen_hold_m__7__d),
+        .q(gen_hold_m__7__q),
+        .clock(gen_hold_m__7__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__8(
+        .d(gen_hold_m__8__d),
+        .q(gen_hold_m__8__q),
+        .clock(gen_hold_m__8__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__9(
+        .d(gen_hold_m__9__d),
+        .q(gen_hold_m__9__q),
+        .clock(gen_hold_m__9__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__10(
+        .d(gen_hold_m__10__d),
+        .q(gen_hold_m__10__q),
+        .clock(gen_hold_m__10__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_m__11(
+        .d(gen_hold_m__11__d),
+        .q(gen_hold_m__11__q),
+        .clock(gen_hold_m__11__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_v__0(
+        .d(gen_hold_v__0__d),
+        .q(gen_hold_v__0__q),
+        .clock(gen_hold_v__0__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_v__1(
+        .d(gen_hold_v__1__d),
+        .q(gen_hold_v__1__q),
+        .clock(gen_hold_v__1__clock)
+    );
+    dynrt_processor__display__rgb_q gen_hold_v__2(
+        .d(gen_hold_v__2__d),
+        .q(gen_hold_v__2__q),
+        .clock(gen_hold_v__2__clock)
+    );
+    dynrt_processor__display__dark_d gen_hold_point(
+        .d(gen_hold_point__d),
+        .q(gen_hold_point__q),
+        .clock(gen_hold_point__clock)
+    );
+    dynrt_processor__display__dark_d gen_hold_diagonal(
+        .d(gen_hold_diagonal__d),
+        .q(gen_hold_diagonal__q),
+        .clock(gen_hold_diagonal__clock)
+    );
+    dynrt_processor__engine__mem_bank_r gen_hold_slot(
+        .d(gen_hold_slot__d),
+        .q(gen_hold_slot__q),
+        .clock(gen_hold_slot__clock)
+    );
+    dynrt_processor__engine__shader__tri_line tri_line(
+        .clock(tri_line__clock),
+        .data_in(tri_line__data_in),
+        .data_out(tri_line__data_out)
+    );
+    dynrt_processor__engine__shader__frame_line frame_line(
+        .clock(frame_line__clock),
+        .data_in(frame_line__data_in),
+        .data_out(frame_line__data_out)
+    );
+    dynrt_processor__engine__fp_units__sqrt sqrt(
+        .clock(sqrt__clock),
+        .in_valid(sqrt__in_valid),
+        .a(sqrt__a),
+        .out_valid(sqrt__out_valid),
+        .result(sqrt__result)
+    );
+    dynrt_processor__engine__fp_units__div div(
+        .clock(div__clock),
+        .in_valid(div__in_valid),
+        .a(div__a),
+        .b(div__b),
+        .out_valid(div__out_valid),
+        .result(div__result)
+    );
+    dynrt_processor__engine__shader__cos_n_dot_l cos_n_dot_l(
+        .clock(cos_n_dot_l__clock),
+        .data_in(cos_n_dot_l__data_in),
+        .data_out(cos_n_dot_l__data_out)
+    );
+    dynrt_processor__engine__shader__cos_slot cos_slot(
+        .clock(cos_slot__clock),
+        .data_in(cos_slot__data_in),
+        .data_out(cos_slot__data_out)
+    );
+    dynrt_processor__engine__fp_units__byte_unit byte_unit(
+        .clock(byte_unit__clock),
+        .in_valid(byte_unit__in_valid),
+        .word(byte_unit__word),
+        .out_valid(byte_unit__out_valid),
+        .result(byte_unit__result)
+    );
+    dynrt_processor__engine__shader__byte_tag byte_tag(
+        .clock(byte_tag__clock),
+        .data_in(byte_tag__data_in),
+        .data_out(byte_tag__data_out)
+    );
+    dynrt_processor__display__rgb_q rgb_acc(
+        .d(rgb_acc__d),
+        .q(rgb_acc__q),
+        .clock(rgb_acc__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        ambient__clock = clock;
+        loading__clock = clock;
+        const_issued__clock = clock;
+        const_arrived__clock = clock;
+        const_addr__clock = clock;
+        const_lights__clock = clock;
+        const_light__clock = clock;
+        const_word__clock = clock;
+        s1_valid__clock = clock;
+        s1_slot__clock = clock;
+        s1_word__clock = clock;
+        s1_step__clock = clock;
+        s1_light__clock = clock;
+        s1_flip__clock = clock;
+        s1_miss__clock = clock;
+        gen_held__clock = clock;
+        gen_hold_point__clock = clock;
+        gen_hold_diagonal__clock = clock;
+        gen_hold_slot__clock = clock;
+        rgb_acc__clock = clock;
+        ambient__d = ambient__q;
+        loading__d = loading__q;
+        const_issued__d = const_issued__q;
+        const_arrived__d = const_arrived__q;
+        const_addr__d = const_addr__q;
+        const_lights__d = const_lights__q;
+        const_light__d = const_light__q;
+        const_word__d = const_word__q;
+        s1_valid__d = s1_valid__q;
+        s1_slot__d = s1_slot__q;
+        s1_word__d = s1_word__q;
+        s1_step__d = s1_step__q;
+        s1_light__d = s1_light__q;
+        s1_flip__d = s1_flip__q;
+        s1_miss__d = s1_miss__q;
+        gen_held__d = gen_held__q;
+        gen_hold_point__d = gen_hold_point__q;
+        gen_hold_diagonal__d = gen_hold_diagonal__q;
+        gen_hold_slot__d = gen_hold_slot__q;
+        rgb_acc__d = rgb_acc__q;
+        busy__0__clock = clock;
+        busy__0__d = busy__0__q;
+        ready__0__clock = clock;
+        ready__0__d = ready__0__q;
+        step__0__clock = clock;
+        step__0__d = step__0__q;
+        light__0__clock = clock;
+        light__0__d = light__0__q;
+        flip__0__clock = clock;
+        flip__0__d = flip__0__q;
+        miss__0__clock = clock;
+        miss__0__d = miss__0__q;
+        busy__1__clock = clock;
+        busy__1__d = busy__1__q;
+        ready__1__clock = clock;
+        ready__1__d = ready__1__q;
+        step__1__clock = clock;
+        step__1__d = step__1__q;
+        light__1__clock = clock;
+        light__1__d = light__1__q;
+        flip__1__clock = clock;
+        flip__1__d = flip__1__q;
+        miss__1__clock = clock;
+        miss__1__d = miss__1__q;
+        busy__2__clock = clock;
+        busy__2__d = busy__2__q;
+        ready__2__clock = clock;
+        ready__2__d = ready__2__q;
+        step__2__clock = clock;
+        step__2__d = step__2__q;
+        light__2__clock = clock;
+        light__2__d = light__2__q;
+        flip__2__clock = clock;
+        flip__2__d = flip__2__q;
+        miss__2__clock = clock;
+        miss__2__d = miss__2__q;
+        busy__3__clock = clock;
+        busy__3__d = busy__3__q;
+        ready__3__clock = clock;
+        ready__3__d = ready__3__q;
+        step__3__clock = clock;
+        step__3__d = step__3__q;
+        light__3__clock = clock;
+        light__3__d = light__3__q;
+        flip__3__clock = clock;
+        flip__3__d = flip__3__q;
+        miss__3__clock = clock;
+        miss__3__d = miss__3__q;
+        busy__4__clock = clock;
+        busy__4__d = busy__4__q;
+        ready__4__clock = clock;
+        ready__4__d = ready__4__q;
+        step__4__clock = clock;
+        step__4__d = step__4__q;
+        light__4__clock = clock;
+        light__4__d = light__4__q;
+        flip__4__clock = clock;
+        flip__4__d = flip__4__q;
+        miss__4__clock = clock;
+        miss__4__d = miss__4__q;
+        busy__5__clock = clock;
+        busy__5__d = busy__5__q;
+        ready__5__clock = clock;
+        ready__5__d = ready__5__q;
+        step__5__clock = clock;
+        step__5__d = step__5__q;
+        light__5__clock = clock;
+        light__5__d = light__5__q;
+        flip__5__clock = clock;
+        flip__5__d = flip__5__q;
+        miss__5__clock = clock;
+        miss__5__d = miss__5__q;
+        busy__6__clock = clock;
+        busy__6__d = busy__6__q;
+        ready__6__clock = clock;
+        ready__6__d = ready__6__q;
+        step__6__clock = clock;
+        step__6__d = step__6__q;
+        light__6__clock = clock;
+        light__6__d = light__6__q;
+        flip__6__clock = clock;
+        flip__6__d = flip__6__q;
+        miss__6__clock = clock;
+        miss__6__d = miss__6__q;
+        busy__7__clock = clock;
+        busy__7__d = busy__7__q;
+        ready__7__clock = clock;
+        ready__7__d = ready__7__q;
+        step__7__clock = clock;
+        step__7__d = step__7__q;
+        light__7__clock = clock;
+        light__7__d = light__7__q;
+        flip__7__clock = clock;
+        flip__7__d = flip__7__q;
+        miss__7__clock = clock;
+        miss__7__d = miss__7__q;
+        background__0__clock = clock;
+        background__0__d = background__0__q;
+        gen_hold_v__0__clock = clock;
+        gen_hold_v__0__d = gen_hold_v__0__q;
+        background__1__clock = clock;
+        background__1__d = background__1__q;
+        gen_hold_v__1__clock = clock;
+        gen_hold_v__1__d = gen_hold_v__1__q;
+        background__2__clock = clock;
+        background__2__d = background__2__q;
+        gen_hold_v__2__clock = clock;
+        gen_hold_v__2__d = gen_hold_v__2__q;
+        gen_hold_m__0__clock = clock;
+        gen_hold_m__0__d = gen_hold_m__0__q;
+        gen_hold_m__1__clock = clock;
+        gen_hold_m__1__d = gen_hold_m__1__q;
+        gen_hold_m__2__clock = clock;
+        gen_hold_m__2__d = gen_hold_m__2__q;
+        gen_hold_m__3__clock = clock;
+        gen_hold_m__3__d = gen_hold_m__3__q;
+        gen_hold_m__4__clock = clock;
+        gen_hold_m__4__d = gen_hold_m__4__q;
+        gen_hold_m__5__clock = clock;
+        gen_hold_m__5__d = gen_hold_m__5__q;
+        gen_hold_m__6__clock = clock;
+        gen_hold_m__6__d = gen_hold_m__6__q;
+        gen_hold_m__7__clock = clock;
+        gen_hold_m__7__d = gen_hold_m__7__q;
+        gen_hold_m__8__clock = clock;
+        gen_hold_m__8__d = gen_hold_m__8__q;
+        gen_hold_m__9__clock = clock;
+        gen_hold_m__9__d = gen_hold_m__9__q;
+        gen_hold_m__10__clock = clock;
+        gen_hold_m__10__d = gen_hold_m__10__q;
+        gen_hold_m__11__clock = clock;
+        gen_hold_m__11__d = gen_hold_m__11__q;
+        rays__0__read_clock = clock;
+        rays__0__write_clock = clock;
+        rays__0__write_address = ray_thread;
+        rays__0__write_enable = ray_write;
+        rays__0__read_address = query_thread;
+        rays__1__read_clock = clock;
+        rays__1__write_clock = clock;
+        rays__1__write_address = ray_thread;
+        rays__1__write_enable = ray_write;
+        rays__1__read_address = query_thread;
+        rays__2__read_clock = clock;
+        rays__2__write_clock = clock;
+        rays__2__write_address = ray_thread;
+        rays__2__write_enable = ray_write;
+        rays__2__read_address = query_thread;
+        rays__3__read_clock = clock;
+        rays__3__write_clock = clock;
+        rays__3__write_address = ray_thread;
+        rays__3__write_enable = ray_write;
+        rays__3__read_address = query_thread;
+        rays__4__read_clock = clock;
+        rays__4__write_clock = clock;
+        rays__4__write_address = ray_thread;
+        rays__4__write_enable = ray_write;
+        rays__4__read_address = query_thread;
+        rays__5__read_clock = clock;
+        rays__5__write_clock = clock;
+        rays__5__write_address = ray_thread;
+        rays__5__write_enable = ray_write;
+        rays__5__read_address = query_thread;
+        rays__0__write_data = ray_o__0;
+        rays__3__write_data = ray_d__0;
+        rays__1__write_data = ray_o__1;
+        rays__4__write_data = ray_d__1;
+        rays__2__write_data = ray_o__2;
+        rays__5__write_data = ray_d__2;
+        tri_line__clock = clock;
+        frame_line__clock = clock;
+        sqrt__clock = clock;
+        div__clock = clock;
+        cos_n_dot_l__clock = clock;
+        cos_slot__clock = clock;
+        byte_unit__clock = clock;
+        byte_tag__clock = clock;
+        o__0__write_clock = clock;
+        d__0__write_clock = clock;
+        n__0__write_clock = clock;
+        kd__0__write_clock = clock;
+        p__0__write_clock = clock;
+        acc__0__write_clock = clock;
+        to_light__0__write_clock = clock;
+        tint__0__write_clock = clock;
+        light_position__0__write_clock = clock;
+        light_color__0__write_clock = clock;
+        o__0__read_address = s1_slot__q;
+        d__0__read_address = s1_slot__q;
+        n__0__read_address = s1_slot__q;
+        kd__0__read_address = s1_slot__q;
+        p__0__read_address = s1_slot__q;
+        acc__0__read_address = s1_slot__q;
+        to_light__0__read_address = s1_slot__q;
+        tint__0__read_address = s1_slot__q;
+        o__1__write_clock = clock;
+        d__1__write_clock = clock;
+        n__1__write_clock = clock;
+        kd__1__write_clock = clock;
+        p__1__write_clock = clock;
+        acc__1__write_clock = clock;
+        to_light__1__write_clock = clock;
+        tint__1__write_clock = clock;
+        light_position__1__write_clock = clock;
+        light_color__1__write_clock = clock;
+        o__1__read_address = s1_slot__q;
+        d__1__read_address = s1_slot__q;
+        n__1__read_address = s1_slot__q;
+        kd__1__read_address = s1_slot__q;
+        p__1__read_address = s1_slot__q;
+        acc__1__read_address = s1_slot__q;
+        to_light__1__read_address = s1_slot__q;
+        tint__1__read_address = s1_slot__q;
+        o__2__write_clock = clock;
+        d__2__write_clock = clock;
+        n__2__write_clock = clock;
+        kd__2__write_clock = clock;
+        p__2__write_clock = clock;
+        acc__2__write_clock = clock;
+        to_light__2__write_clock = clock;
+        tint__2__write_clock = clock;
+        light_position__2__write_clock = clock;
+        light_color__2__write_clock = clock;
+        o__2__read_address = s1_slot__q;
+        d__2__read_address = s1_slot__q;
+        n__2__read_address = s1_slot__q;
+        kd__2__read_address = s1_slot__q;
+        p__2__read_address = s1_slot__q;
+        acc__2__read_address = s1_slot__q;
+        to_light__2__read_address = s1_slot__q;
+        tint__2__read_address = s1_slot__q;
+        t__write_clock = clock;
+        addr__write_clock = clock;
+        triangle__write_clock = clock;
+        material__write_clock = clock;
+        n_dot_l__write_clock = clock;
+        l_dot_l__write_clock = clock;
+        cos__write_clock = clock;
+        rgb__write_clock = clock;
+        t__read_address = s1_slot__q;
+        addr__read_address = s1_slot__q;
+        triangle__read_address = s1_slot__q;
+        material__read_address = s1_slot__q;
+        n_dot_l__read_address = s1_slot__q;
+        l_dot_l__read_address = s1_slot__q;
+        cos__read_address = s1_slot__q;
+        rgb__read_address = s1_slot__q;
+        light_position__0__read_address = s1_light__q;
+        light_color__0__read_address = s1_light__q;
+        facing__0 = n__0__read_data;
+        if (s1_flip__q) begin
+            facing__0 = n__0__read_data ^ c_sign;
+        end
+        light_position__1__read_address = s1_light__q;
+        light_color__1__read_address = s1_light__q;
+        facing__1 = n__1__read_data;
+        if (s1_flip__q) begin
+            facing__1 = n__1__read_data ^ c_sign;
+        end
+        light_position__2__read_address = s1_light__q;
+        light_color__2__read_address = s1_light__q;
+        facing__2 = n__2__read_data;
+        if (s1_flip__q) begin
+            facing__2 = n__2__read_data ^ c_sign;
+        end
+        s1_done = 1'b0;
+        const_go = loading__q & (const_issued__q != c_const_total) & frame_grant;
+        tri_read_l = 1'b0;
+        tri_addr = (triangle__read_data << 32'h3) + c_shading_word + ((s1_word__q) & 24'hffffff);
+        tri_tag = 32'h0;
+        frame_read_l = loading__q & (const_issued__q != c_const_total);
+        frame_addr_l = const_addr__q;
+        frame_tag = 32'h0;
+        if (const_go) begin
+            frame_tag = (((const_word__q) & 9'h1ff) << 32'h6) | (((const_light__q) & 9'h1ff) << 32'h3) | c_valid9;
+            if (const_lights__q) begin
+                frame_tag = frame_tag | (((c_kind_light) & 9'h1ff) << 32'h1);
+            end
+            else begin
+                frame_tag = frame_tag | (((c_kind_const) & 9'h1ff) << 32'h1);
+            end
+            const_issued__d = const_issued__q + 32'h1;
+            const_addr__d = const_addr__q + 32'h1;
+            const_word__d = const_word__q + 32'h1;
+            if ((~const_lights__q) & (const_word__q == 32'h3)) begin
+                const_lights__d = 1'b1;
+                const_addr__d = c_lights_addr;
+                const_word__d = 32'h0;
+            end
+            if (const_lights__q & (const_word__q == 32'h5)) begin
+                const_light__d = const_light__q + 32'h1;
+                const_word__d = 32'h0;
+            end
+        end
+        sqrt__in_valid = 1'b0;
+        sqrt__a = l_dot_l__read_data;
+        cos_n_dot_l__data_in = n_dot_l__read_data;
+        cos_slot__data_in = ((s1_slot__q) & 4'hf) << 32'h1;
+        byte_unit__in_valid = 1'b0;
+        byte_unit__word = acc__0__read_data;
+        byte_tag_in = (((s1_word__q) & 6'h3f) << 32'h4) | (((s1_slot__q) & 6'h3f) << 32'h1);
+        fb_write_l = 1'b0;
+        fb_addr = addr__read_data + c_fb_base;
+        fb_data = ((rgb__read_data) & 32'hffffffff);
+        req_m__0 = c_zero;
+        req_m__1 = c_zero;
+        req_m__2 = c_zero;
+        req_m__3 = c_zero;
+        req_m__4 = c_zero;
+        req_m__5 = c_zero;
+        req_m__6 = c_zero;
+        req_m__7 = c_zero;
+        req_m__8 = c_zero;
+        req_m__9 = c_zero;
+        req_m__10 = c_zero;
+        req_m__11 = c_zero;
+        req_v__0 = c_zero;
+        req_v__1 = c_zero;
+        req_v__2 = c_zero;
+        req_point = 1'b0;
+        req_diagonal = 1'b0;
+        tu_step = (s1_step__q == ShadeStep__Point) | (s1_step__q == ShadeStep__NormalDot) | (s1_step__q == ShadeStep__Ambient) | (s1_step__q == ShadeStep__ToLight) | (s1_step__q == ShadeStep__Dots) | (s1_step__q == ShadeStep__Tint) | (s1_step__q == ShadeStep__Accumulate);
+        if (s1_step__q == ShadeStep__Point) begin
+            req_m__0 = d__0__read_data;
+            req_m__5 = d__1__read_data;
+            req_m__10 = d__2__read_data;
+            req_m__3 = o__0__read_data;
+            req_m__7 = o__1__read_data;
+            req_m__11 = o__2__read_data;
+            req_v__0 = t__read_data;
+            req_v__1 = t__read_data;
+            req_v__2 = t__read_data;
+            req_point = 1'b1;
+            req_diagonal = 1'b1;
+        end
+        if (s1_step__q == ShadeStep__NormalDot) begin
+            req_m__0 = n__0__read_data;
+            req_v__0 = d__0__read_data;
+            req_m__1 = n__1__read_data;
+            req_v__1 = d__1__read_data;
+            req_m__2 = n__2__read_data;
+            req_v__2 = d__2__read_data;
+        end
+        if (s1_step__q == ShadeStep__Ambient) begin
+            req_m__0 = kd__0__read_data;
+            req_m__5 = kd__1__read_data;
+            req_m__10 = kd__2__read_data;
+            req_v__0 = ambient__q;
+            req_v__1 = ambient__q;
+            req_v__2 = ambient__q;
+            req_diagonal = 1'b1;
+        end
+        if (s1_step__q == ShadeStep__ToLight) begin
+            req_m__0 = c_minus_one;
+            req_m__5 = c_minus_one;
+            req_m__10 = c_minus_one;
+            req_m__3 = light_position__0__read_data;
+            req_m__7 = light_position__1__read_data;
+            req_m__11 = light_position__2__read_data;
+            req_v__0 = p__0__read_data;
+            req_v__1 = p__1__read_data;
+            req_v__2 = p__2__read_data;
+            req_point = 1'b1;
+            req_diagonal = 1'b1;
+        end
+        if (s1_step__q == ShadeStep__Dots) begin
+            req_m__0 = facing__0;
+            req_m__4 = to_light__0__read_data;
+            req_v__0 = to_light__0__read_data;
+            req_m__1 = facing__1;
+            req_m__5 = to_light__1__read_data;
+            req_v__1 = to_light__1__read_data;
+            req_m__2 = facing__2;
+            req_m__6 = to_light__2__read_data;
+            req_v__2 = to_light__2__read_data;
+        end
+        if (s1_step__q == ShadeStep__Tint) begin
+            req_m__0 = kd__0__read_data;
+            req_m__5 = kd__1__read_data;
+            req_m__10 = kd__2__read_data;
+            req_v__0 = light_color__0__read_data;
+            req_v__1 = light_color__1__read_data;
+            req_v__2 = light_color__2__read_data;
+            req_diagonal = 1'b1;
+        end
+        if (s1_step__q == ShadeStep__Accumulate) begin
+            req_m__0 = tint__0__read_data;
+            req_m__5 = tint__1__read_data;
+            req_m__10 = tint__2__read_data;
+            req_m__3 = acc__0__read_data;
+            req_m__7 = acc__1__read_data;
+            req_m__11 = acc__2__read_data;
+            req_v__0 = cos__read_data;
+            req_v__1 = cos__read_data;
+            req_v__2 = cos__read_data;
+            req_point = 1'b1;
+            req_diagonal = 1'b1;
+        end
+        if (gen_take) begin
+            gen_held__d = 1'b0;
+        end
+        gen_load = s1_valid__q & tu_step & (~gen_held__q);
+        if (gen_load) begin
+            gen_held__d = 1'b1;
+            gen_hold_m__0__d = req_m__0;
+            gen_hold_m__1__d = req_m__1;
+            gen_hold_m__2__d = req_m__2;
+            gen_hold_m__3__d = req_m__3;
+            gen_hold_m__4__d = req_m__4;
+            gen_hold_m__5__d = req_m__5;
+            gen_hold_m__6__d = req_m__6;
+            gen_hold_m__7__d = req_m__7;
+            gen_hold_m__8__d = req_m__8;
+            gen_hold_m__9__d = req_m__9;
+            gen_hold_m__10__d = req_m__10;
+            gen_hold_m__11__d = req_m__11;
+            gen_hold_v__0__d = req_v__0;
+            gen_hold_v__1__d = req_v__1;
+            gen_hold_v__2__d = req_v__2;
+            gen_hold_point__d = req_point;
+            gen_hold_diagonal__d = req_diagonal;
+            gen_hold_slot__d = s1_slot__q;
+            s1_done = 1'b1;
+        end
+        gen_valid = gen_held__q;
+        gen_m__0 = gen_hold_m__0__q;
+        gen_m__1 = gen_hold_m__1__q;
+        gen_m__2 = gen_hold_m__2__q;
+        gen_m__3 = gen_hold_m__3__q;
+        gen_m__4 = gen_hold_m__4__q;
+        gen_m__5 = gen_hold_m__5__q;
+        gen_m__6 = gen_hold_m__6__q;
+        gen_m__7 = gen_hold_m__7__q;
+        gen_m__8 = gen_hold_m__8__q;
+        gen_m__9 = gen_hold_m__9__q;
+        gen_m__10 = gen_hold_m__10__q;
+        gen_m__11 = gen_hold_m__11__q;
+        gen_v__0 = gen_hold_v__0__q;
+        gen_v__1 = gen_hold_v__1__q;
+        gen_v__2 = gen_hold_v__2__q;
+        gen_point = gen_hold_point__q;
+        gen_diagonal = gen_hold_diagonal__q;
+        gen_slot = gen_hold_slot__q;
+        if (s1_valid__q) begin
+            if (s1_step__q == ShadeStep__TriLoad) begin
+                tri_read_l = 1'b1;
+                if (tri_grant) begin
+                    tri_tag = (((s1_word__q) & 9'h1ff) << 32'h6) | (((s1_slot__q) & 9'h1ff) << 32'h3) | (((c_kind_tri) & 9'h1ff) << 32'h1) | c_valid9;
+                    s1_word__d = s1_word__q + 32'h1;
+                    if (s1_word__q == 32'h1) begin
+                        s1_done = 1'b1;
+                    end
+                end
+            end
+            if ((s1_step__q == ShadeStep__KdLoad) & (~loading__q)) begin
+                frame_read_l = 1'b1;
+                frame_addr_l = (material__read_data << 32'h2) + c_materials + ((s1_word__q) & 24'hffffff);
+                if (frame_grant) begin
+                    frame_tag = (((s1_word__q) & 9'h1ff) << 32'h6) | (((s1_slot__q) & 9'h1ff) << 32'h3) | (((c_kind_kd) & 9'h1ff) << 32'h1) | c_valid9;
+                    s1_word__d = s1_word__q + 32'h1;
+                    if (s1_word__q == 32'h2) begin
+                        s1_done = 1'b1;
+                    end
+                end
+            end
+            if (s1_step__q == ShadeStep__Cosine) begin
+                sqrt__in_valid = 1'b1;
+                cos_slot__data_in = (((s1_slot__q) & 4'hf) << 32'h1) | c_valid4;
+                s1_done = 1'b1;
+            end
+            if (s1_step__q == ShadeStep__Pack) begin
+                byte_unit__in_valid = 1'b1;
+                byte_tag_in = byte_tag_in | c_valid6;
+                s1_word__d = s1_word__q + 32'h1;
+                if (s1_word__q == 32'h2) begin
+                    s1_done = 1'b1;
+                end
+            end
+            if (s1_step__q == ShadeStep__Store) begin
+                fb_write_l = 1'b1;
+                if (fb_grant) begin
+                    s1_done = 1'b1;
+                end
+            end
+        end
+        if (s1_word__q == 32'h1) begin
+            byte_unit__word = acc__1__read_data;
+        end
+        if (s1_word__q == 32'h2) begin
+            byte_unit__word = acc__2__read_data;
+        end
+        if (s1_miss__q) begin
+            byte_unit__word = background__0__q;
+            if (s1_word__q == 32'h1) begin
+                byte_unit__word = background__1__q;
+            end
+            if (s1_word__q == 32'h2) begin
+                byte_unit__word = background__2__q;
+            end
+        end
+        if (s1_done) begin
+            s1_word__d = 32'h0;
+        end
+        byte_tag__data_in = byte_tag_in;
+        tri_read = tri_read_l;
+        frame_read = frame_read_l;
+        frame_addr = frame_addr_l;
+        fb_write = fb_write_l;
+        any_ready_before__0 = 1'b0;
+        ready_slot = 32'h0;
+        any_ready_before__1 = any_ready_before__0 | (ready__0__q & busy__0__q);
+        any_ready_before__2 = any_ready_before__1 | (ready__1__q & busy__1__q);
+        any_ready_before__3 = any_ready_before__2 | (ready__2__q & busy__2__q);
+        any_ready_before__4 = any_ready_before__3 | (ready__3__q & busy__3__q);
+        any_ready_before__5 = any_ready_before__4 | (ready__4__q & busy__4__q);
+        any_ready_before__6 = any_ready_before__5 | (ready__5__q & busy__5__q);
+        any_ready_before__7 = any_ready_before__6 | (ready__6__q & busy__6__q);
+        any_ready_before__8 = any_ready_before__7 | (ready__7__q & busy__7__q);
+        if (ready__0__q & busy__0__q & (~any_ready_before__0)) begin
+            ready_slot = c_slot__0;
+        end
+        if (ready__1__q & busy__1__q & (~any_ready_before__1)) begin
+            ready_slot = c_slot__1;
+        end
+        if (ready__2__q & busy__2__q & (~any_ready_before__2)) begin
+            ready_slot = c_slot__2;
+        end
+        if (ready__3__q & busy__3__q & (~any_ready_before__3)) begin
+            ready_slot = c_slot__3;
+        end
+        if (ready__4__q & busy__4__q & (~any_ready_before__4)) begin
+            ready_slot = c_slot__4;
+        end
+        if (ready__5__q & busy__5__q & (~any_ready_before__5)) begin
+            ready_slot = c_slot__5;
+        end
+        if (ready__6__q & busy__6__q & (~any_ready_before__6)) begin
+            ready_slot = c_slot__6;
+        end
+        if (ready__7__q & busy__7__q & (~any_ready_before__7)) begin
+            ready_slot = c_slot__7;
+        end
+        pick = any_ready_before__8 & ((~s1_valid__q) | s1_done);
+        pick_step = ShadeStep__Idle;
+        pick_light = 32'h0;
+        pick_flip = 1'b0;
+        pick_miss = 1'b0;
+        if (ready_slot == c_slot__0) begin
+            pick_step = step__0__q;
+            pick_light = light__0__q;
+            pick_flip = flip__0__q;
+            pick_miss = miss__0__q;
+        end
+        if (ready_slot == c_slot__1) begin
+            pick_step = step__1__q;
+            pick_light = light__1__q;
+            pick_flip = flip__1__q;
+            pick_miss = miss__1__q;
+        end
+        if (ready_slot == c_slot__2) begin
+            pick_step = step__2__q;
+            pick_light = light__2__q;
+            pick_flip = flip__2__q;
+            pick_miss = miss__2__q;
+        end
+        if (ready_slot == c_slot__3) begin
+            pick_step = step__3__q;
+            pick_light = light__3__q;
+            pick_flip = flip__3__q;
+            pick_miss = miss__3__q;
+        end
+        if (ready_slot == c_slot__4) begin
+            pick_step = step__4__q;
+            pick_light = light__4__q;
+            pick_flip = flip__4__q;
+            pick_miss = miss__4__q;
+        end
+        if (ready_slot == c_slot__5) begin
+            pick_step = step__5__q;
+            pick_light = light__5__q;
+            pick_flip = flip__5__q;
+            pick_miss = miss__5__q;
+        end
+        if (ready_slot == c_slot__6) begin
+            pick_step = step__6__q;
+            pick_light = light__6__q;
+            pick_flip = flip__6__q;
+            pick_miss = miss__6__q;
+        end
+        if (ready_slot == c_slot__7) begin
+            pick_step = step__7__q;
+            pick_light = light__7__q;
+            pick_flip = flip__7__q;
+            pick_miss = miss__7__q;
+        end
+        if ((~s1_valid__q) | s1_done) begin
+            s1_valid__d = pick;
+            s1_slot__d = ready_slot;
+            s1_step__d = pick_step;
+            s1_light__d = pick_light;
+            s1_flip__d = pick_flip;
+            s1_miss__d = pick_miss;
+        end
+        any_free_before__0 = 1'b0;
+        free_slot = 32'h0;
+        any_free_before__1 = any_free_before__0 | (~busy__0__q);
+        any_free_before__2 = any_free_before__1 | (~busy__1__q);
+        any_free_before__3 = any_free_before__2 | (~busy__2__q);
+        any_free_before__4 = any_free_before__3 | (~busy__3__q);
+        any_free_before__5 = any_free_before__4 | (~busy__4__q);
+        any_free_before__6 = any_free_before__5 | (~busy__5__q);
+        any_free_before__7 = any_free_before__6 | (~busy__6__q);
+        any_free_before__8 = any_free_before__7 | (~busy__7__q);
+        if ((~busy__0__q) & (~any_free_before__0)) begin
+            free_slot = c_slot__0;
+        end
+        if ((~busy__1__q) & (~any_free_before__1)) begin
+            free_slot = c_slot__1;
+        end
+        if ((~busy__2__q) & (~any_free_before__2)) begin
+            free_slot = c_slot__2;
+        end
+        if ((~busy__3__q) & (~any_free_before__3)) begin
+            free_slot = c_slot__3;
+        end
+        if ((~busy__4__q) & (~any_free_before__4)) begin
+            free_slot = c_slot__4;
+        end
+        if ((~busy__5__q) & (~any_free_before__5)) begin
+            free_slot = c_slot__5;
+        end
+        if ((~busy__6__q) & (~any_free_before__6)) begin
+            free_slot = c_slot__6;
+        end
+        if ((~busy__7__q) & (~any_free_before__7)) begin
+            free_slot = c_slot__7;
+        end
+        refused = loading__q | (~any_free_before__8);
+        taken = offer & (~refused);
+        o__0__write_address = free_slot;
+        o__0__write_enable = taken;
+        o__0__write_data = rays__0__read_data;
+        d__0__write_address = free_slot;
+        d__0__write_enable = taken;
+        d__0__write_data = rays__3__read_data;
+        o__1__write_address = free_slot;
+        o__1__write_enable = taken;
+        o__1__write_data = rays__1__read_data;
+        d__1__write_address = free_slot;
+        d__1__write_enable = taken;
+        d__1__write_data = rays__4__read_data;
+        o__2__write_address = free_slot;
+        o__2__write_enable = taken;
+        o__2__write_data = rays__2__read_data;
+        d__2__write_address = free_slot;
+        d__2__write_enable = taken;
+        d__2__write_data = rays__5__read_data;
+        t__write_address = free_slot;
+        t__write_enable = taken;
+        t__write_data = offer_t;
+        addr__write_address = free_slot;
+        addr__write_enable = taken;
+        addr__write_data = offer_addr;
+        triangle__write_address = free_slot;
+        triangle__write_enable = taken;
+        triangle__write_data = offer_triangle;
+        tri_line__data_in = tri_tag;
+        frame_line__data_in = frame_tag;
+        tri_arrived = tri_line__data_out;
+        frame_arrived = frame_line__data_out;
+        n__0__write_address = tri_arrived[(32'h3)+:(3)];
+        n__1__write_address = tri_arrived[(32'h3)+:(3)];
+        n__2__write_address = tri_arrived[(32'h3)+:(3)];
+        n__0__write_data = tri_rdata_a[(32'h0)+:(24)];
+        n__1__write_data = tri_rdata_a[(32'h0)+:(24)];
+        n__2__write_data = tri_rdata_b[(32'h0)+:(24)];
+        material__write_address = tri_arrived[(32'h3)+:(3)];
+        material__write_data = tri_rdata_b[(32'h0)+:(24)];
+        tri_word_0 = tri_arrived[32'h0] & (~tri_arrived[32'h6]);
+        tri_word_1 = tri_arrived[32'h0] & tri_arrived[32'h6];
+        n__0__write_enable = tri_word_0;
+        n__2__write_enable = tri_word_0;
+        n__1__write_enable = tri_word_1;
+        material__write_enable = tri_word_1;
+        frame_valid = frame_arrived[32'h0];
+        frame_kind = frame_arrived[(32'h1)+:(2)];
+        frame_word = frame_arrived[(32'h6)+:(3)];
+        kd__0__write_address = frame_arrived[(32'h3)+:(3)];
+        kd__0__write_data = frame_rdata[(32'h0)+:(24)];
+        kd__0__write_enable = 1'b0;
+        light_position__0__write_address = frame_arrived[(32'h3)+:(3)];
+        light_position__0__write_data = frame_rdata[(32'h0)+:(24)];
+        light_position__0__write_enable = 1'b0;
+        light_color__0__write_address = frame_arrived[(32'h3)+:(3)];
+        light_color__0__write_data = frame_rdata[(32'h0)+:(24)];
+        light_color__0__write_enable = 1'b0;
+        kd__1__write_address = frame_arrived[(32'h3)+:(3)];
+        kd__1__write_data = frame_rdata[(32'h0)+:(24)];
+        kd__1__write_enable = 1'b0;
+        light_position__1__write_address = frame_arrived[(32'h3)+:(3)];
+        light_position__1__write_data = frame_rdata[(32'h0)+:(24)];
+        light_position__1__write_enable = 1'b0;
+        light_color__1__write_address = frame_arrived[(32'h3)+:(3)];
+        light_color__1__write_data = frame_rdata[(32'h0)+:(24)];
+        light_color__1__write_enable = 1'b0;
+        kd__2__write_address = frame_arrived[(32'h3)+:(3)];
+        kd__2__write_data = frame_rdata[(32'h0)+:(24)];
+        kd__2__write_enable = 1'b0;
+        light_position__2__write_address = frame_arrived[(32'h3)+:(3)];
+        light_position__2__write_data = frame_rdata[(32'h0)+:(24)];
+        light_position__2__write_enable = 1'b0;
+        light_color__2__write_address = frame_arrived[(32'h3)+:(3)];
+        light_color__2__write_data = frame_rdata[(32'h0)+:(24)];
+        light_color__2__write_enable = 1'b0;
+        if (frame_valid & (frame_kind == c_kind_kd)) begin
+            if (frame_word == 32'h0) begin
+                kd__0__write_enable = 1'b1;
+            end
+            if (frame_word == 32'h1) begin
+                kd__1__write_enable = 1'b1;
+            end
+            if (frame_word == 32'h2) begin
+                kd__2__write_enable = 1'b1;
+            end
+        end
+        if (frame_valid & (frame_kind == c_kind_light)) begin
+            if (frame_word == 32'h0) begin
+                light_position__0__write_enable = 1'b1;
+            end
+            if (frame_word == 32'h1) begin
+                light_position__1__write_enable = 1'b1;
+            end
+            if (frame_word == 32'h2) begin
+                light_position__2__write_enable = 1'b1;
+            end
+            if (frame_word == 32'h3) begin
+                light_color__0__write_enable = 1'b1;
+            end
+            if (frame_word == 32'h4) begin
+                light_color__1__write_enable = 1'b1;
+            end
+            if (frame_word == 32'h5) begin
+                light_color__2__write_enable = 1'b1;
+            end
+        end
+        if (frame_valid & (frame_kind == c_kind_const)) begin
+            if (frame_word == 32'h0) begin
+                ambient__d = frame_rdata[(32'h0)+:(24)];
+            end
+            if (frame_word == 32'h1) begin
+                background__0__d = frame_rdata[(32'h0)+:(24)];
+            end
+            if (frame_word == 32'h2) begin
+                background__1__d = frame_rdata[(32'h0)+:(24)];
+            end
+            if (frame_word == 32'h3) begin
+                background__2__d = frame_rdata[(32'h0)+:(24)];
+            end
+        end
+        if (frame_valid & ((frame_kind == c_kind_light) | (frame_kind == c_kind_const))) begin
+            const_arrived__d = const_arrived__q + 32'h1;
+            if (const_arrived__q + 32'h1 == c_const_total) begin
+                loading__d = 1'b0;
+            end
+        end
+        res_step = ShadeStep__Idle;
+        res_light = 32'h0;
+        if (res_slot == c_slot__0) begin
+            res_step = step__0__q;
+            res_light = light__0__q;
+        end
+        if (res_slot == c_slot__1) begin
+            res_step = step__1__q;
+            res_light = light__1__q;
+        end
+        if (res_slot == c_slot__2) begin
+            res_step = step__2__q;
+            res_light = light__2__q;
+        end
+        if (res_slot == c_slot__3) begin
+            res_step = step__3__q;
+            res_light = light__3__q;
+        end
+        if (res_slot == c_slot__4) begin
+            res_step = step__4__q;
+            res_light = light__4__q;
+        end
+        if (res_slot == c_slot__5) begin
+            res_step = step__5__q;
+            res_light = light__5__q;
+        end
+        if (res_slot == c_slot__6) begin
+            res_step = step__6__q;
+            res_light = light__6__q;
+        end
+        if (res_slot == c_slot__7) begin
+            res_step = step__7__q;
+            res_light = light__7__q;
+        end
+        res_positive = (~|(res_v__0 & c_sign)) & |(res_v__0 & c_exp_mask) & (~(((res_v__0 & c_exp_mask) == c_exp_mask) & |(res_v__0 & c_man_mask)));
+        p__0__write_address = res_slot;
+        p__0__write_data = res_v__0;
+        p__0__write_enable = res_valid & (res_step == ShadeStep__Point);
+        acc__0__write_address = res_slot;
+        acc__0__write_data = res_v__0;
+        acc__0__write_enable = res_valid & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
+        to_light__0__write_address = res_slot;
+        to_light__0__write_data = res_v__0;
+        to_light__0__write_enable = res_valid & (res_step == ShadeStep__ToLight);
+        tint__0__write_address = res_slot;
+        tint__0__write_data = res_v__0;
+        tint__0__write_enable = res_valid & (res_step == ShadeStep__Tint);
+        p__1__write_address = res_slot;
+        p__1__write_data = res_v__1;
+        p__1__write_enable = res_valid & (res_step == ShadeStep__Point);
+        acc__1__write_address = res_slot;
+        acc__1__write_data = res_v__1;
+        acc__1__write_enable = res_valid & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
+        to_light__1__write_address = res_slot;
+        to_light__1__write_data = res_v__1;
+        to_light__1__write_enable = res_valid & (res_step == ShadeStep__ToLight);
+        tint__1__write_address = res_slot;
+        tint__1__write_data = res_v__1;
+        tint__1__write_enable = res_valid & (res_step == ShadeStep__Tint);
+        p__2__write_address = res_slot;
+        p__2__write_data = res_v__2;
+        p__2__write_enable = res_valid & (res_step == ShadeStep__Point);
+        acc__2__write_address = res_slot;
+        acc__2__write_data = res_v__2;
+        acc__2__write_enable = res_valid & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
+        to_light__2__write_address = res_slot;
+        to_light__2__write_data = res_v__2;
+        to_light__2__write_enable = res_valid & (res_step == ShadeStep__ToLight);
+        tint__2__write_address = res_slot;
+        tint__2__write_data = res_v__2;
+        tint__2__write_enable = res_valid & (res_step == ShadeStep__Tint);
+        n_dot_l__write_address = res_slot;
+        n_dot_l__write_data = res_v__0;
+        n_dot_l__write_enable = res_valid & (res_step == ShadeStep__Dots);
+        l_dot_l__write_address = res_slot;
+        l_dot_l__write_data = res_v__1;
+        l_dot_l__write_enable = res_valid & (res_step == ShadeStep__Dots);
+        div__in_valid = sqrt__out_valid;
+        div__a = cos_n_dot_l__data_out;
+        div__b = sqrt__result;
+        cos__write_address = cos_slot__data_out[(32'h1)+:(3)];
+        cos__write_data = div__result;
+        cos__write_enable = cos_slot__data_out[32'h0];
+        rgb__write_address = byte_tag__data_out[(32'h1)+:(3)];
+        rgb_next = (rgb_acc__q << 32'h8) | ((byte_unit__result) & 24'hffffff);
+        rgb__write_data = rgb_next;
+        rgb__write_enable = 1'b0;
+        if (byte_tag__data_out[32'h0]) begin
+            rgb_acc__d = rgb_next;
+            if (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) begin
+                rgb__write_enable = 1'b1;
+            end
+        end
+        if (taken & (free_slot == c_slot__0)) begin
+            busy__0__d = 1'b1;
+            ready__0__d = 1'b1;
+            miss__0__d = ~offer_hit;
+            flip__0__d = 1'b0;
+            light__0__d = 32'h0;
+            step__0__d = ShadeStep__TriLoad;
+            if (~offer_hit) begin
+                step__0__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__0)) begin
+            ready__0__d = 1'b0;
+        end
+        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__0)) begin
+            busy__0__d = 1'b0;
+            step__0__d = ShadeStep__Idle;
+        end
+        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__0)) begin
+            ready__0__d = 1'b1;
+            step__0__d = ShadeStep__Point;
+        end
+        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__0)) begin
+            ready__0__d = 1'b1;
+            step__0__d = ShadeStep__Ambient;
+        end
+        if (res_valid & (res_slot == c_slot__0)) begin
+            ready__0__d = 1'b1;
+            if (res_step == ShadeStep__Point) begin
+                step__0__d = ShadeStep__NormalDot;
+            end
+            if (res_step == ShadeStep__NormalDot) begin
+                flip__0__d = res_positive;
+                step__0__d = ShadeStep__KdLoad;
+            end
+            if (res_step == ShadeStep__Ambient) begin
+                step__0__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__0__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step == ShadeStep__ToLight) begin
+                step__0__d = ShadeStep__Dots;
+            end
+            if (res_step == ShadeStep__Tint) begin
+                step__0__d = ShadeStep__Accumulate;
+            end
+            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+                step__0__d = ShadeStep__ToLight;
+                light__0__d = res_light + 32'h1;
+                if (res_light == c_last_light) begin
+                    step__0__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step == ShadeStep__Dots) & res_positive) begin
+                step__0__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__0)) begin
+            ready__0__d = 1'b1;
+            step__0__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__0)) begin
+            ready__0__d = 1'b1;
+            step__0__d = ShadeStep__Store;
+        end
+        if (taken & (free_slot == c_slot__1)) begin
+            busy__1__d = 1'b1;
+            ready__1__d = 1'b1;
+            miss__1__d = ~offer_hit;
+            flip__1__d = 1'b0;
+            light__1__d = 32'h0;
+            step__1__d = ShadeStep__TriLoad;
+            if (~offer_hit) begin
+                step__1__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__1)) begin
+            ready__1__d = 1'b0;
+        end
+        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__1)) begin
+            busy__1__d = 1'b0;
+            step__1__d = ShadeStep__Idle;
+        end
+        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__1)) begin
+            ready__1__d = 1'b1;
+            step__1__d = ShadeStep__Point;
+        end
+        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__1)) begin
+            ready__1__d = 1'b1;
+            step__1__d = ShadeStep__Ambient;
+        end
+        if (res_valid & (res_slot == c_slot__1)) begin
+            ready__1__d = 1'b1;
+            if (res_step == ShadeStep__Point) begin
+                step__1__d = ShadeStep__NormalDot;
+            end
+            if (res_step == ShadeStep__NormalDot) begin
+                flip__1__d = res_positive;
+                step__1__d = ShadeStep__KdLoad;
+            end
+            if (res_step == ShadeStep__Ambient) begin
+                step__1__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__1__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step == ShadeStep__ToLight) begin
+                step__1__d = ShadeStep__Dots;
+            end
+            if (res_step == ShadeStep__Tint) begin
+                step__1__d = ShadeStep__Accumulate;
+            end
+            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+                step__1__d = ShadeStep__ToLight;
+                light__1__d = res_light + 32'h1;
+                if (res_light == c_last_light) begin
+                    step__1__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step == ShadeStep__Dots) & res_positive) begin
+                step__1__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__1)) begin
+            ready__1__d = 1'b1;
+            step__1__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__1)) begin
+            ready__1__d = 1'b1;
+            step__1__d = ShadeStep__Store;
+        end
+        if (taken & (free_slot == c_slot__2)) begin
+            busy__2__d = 1'b1;
+            ready__2__d = 1'b1;
+            miss__2__d = ~offer_hit;
+            flip__2__d = 1'b0;
+            light__2__d = 32'h0;
+            step__2__d = ShadeStep__TriLoad;
+            if (~offer_hit) begin
+                step__2__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__2)) begin
+            ready__2__d = 1'b0;
+        end
+        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__2)) begin
+            busy__2__d = 1'b0;
+            step__2__d = ShadeStep__Idle;
+        end
+        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__2)) begin
+            ready__2__d = 1'b1;
+            step__2__d = ShadeStep__Point;
+        end
+        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__2)) begin
+            ready__2__d = 1'b1;
+            step__2__d = ShadeStep__Ambient;
+        end
+        if (res_valid & (res_slot == c_slot__2)) begin
+            ready__2__d = 1'b1;
+            if (res_step == ShadeStep__Point) begin
+                step__2__d = ShadeStep__NormalDot;
+            end
+            if (res_step == ShadeStep__NormalDot) begin
+                flip__2__d = res_positive;
+                step__2__d = ShadeStep__KdLoad;
+            end
+            if (res_step == ShadeStep__Ambient) begin
+                step__2__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__2__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step == ShadeStep__ToLight) begin
+                step__2__d = ShadeStep__Dots;
+            end
+            if (res_step == ShadeStep__Tint) begin
+                step__2__d = ShadeStep__Accumulate;
+            end
+            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+                step__2__d = ShadeStep__ToLight;
+                light__2__d = res_light + 32'h1;
+                if (res_light == c_last_light) begin
+                    step__2__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step == ShadeStep__Dots) & res_positive) begin
+                step__2__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__2)) begin
+            ready__2__d = 1'b1;
+            step__2__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__2)) begin
+            ready__2__d = 1'b1;
+            step__2__d = ShadeStep__Store;
+        end
+        if (taken & (free_slot == c_slot__3)) begin
+            busy__3__d = 1'b1;
+            ready__3__d = 1'b1;
+            miss__3__d = ~offer_hit;
+            flip__3__d = 1'b0;
+            light__3__d = 32'h0;
+            step__3__d = ShadeStep__TriLoad;
+            if (~offer_hit) begin
+                step__3__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__3)) begin
+            ready__3__d = 1'b0;
+        end
+        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__3)) begin
+            busy__3__d = 1'b0;
+            step__3__d = ShadeStep__Idle;
+        end
+        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__3)) begin
+            ready__3__d = 1'b1;
+            step__3__d = ShadeStep__Point;
+        end
+        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__3)) begin
+            ready__3__d = 1'b1;
+            step__3__d = ShadeStep__Ambient;
+        end
+        if (res_valid & (res_slot == c_slot__3)) begin
+            ready__3__d = 1'b1;
+            if (res_step == ShadeStep__Point) begin
+                step__3__d = ShadeStep__NormalDot;
+            end
+            if (res_step == ShadeStep__NormalDot) begin
+                flip__3__d = res_positive;
+                step__3__d = ShadeStep__KdLoad;
+            end
+            if (res_step == ShadeStep__Ambient) begin
+                step__3__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__3__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step == ShadeStep__ToLight) begin
+                step__3__d = ShadeStep__Dots;
+            end
+            if (res_step == ShadeStep__Tint) begin
+                step__3__d = ShadeStep__Accumulate;
+            end
+            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+                step__3__d = ShadeStep__ToLight;
+                light__3__d = res_light + 32'h1;
+                if (res_light == c_last_light) begin
+                    step__3__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step == ShadeStep__Dots) & res_positive) begin
+                step__3__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__3)) begin
+            ready__3__d = 1'b1;
+            step__3__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__3)) begin
+            ready__3__d = 1'b1;
+            step__3__d = ShadeStep__Store;
+        end
+        if (taken & (free_slot == c_slot__4)) begin
+            busy__4__d = 1'b1;
+            ready__4__d = 1'b1;
+            miss__4__d = ~offer_hit;
+            flip__4__d = 1'b0;
+            light__4__d = 32'h0;
+            step__4__d = ShadeStep__TriLoad;
+            if (~offer_hit) begin
+                step__4__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__4)) begin
+            ready__4__d = 1'b0;
+        end
+        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__4)) begin
+            busy__4__d = 1'b0;
+            step__4__d = ShadeStep__Idle;
+        end
+        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__4)) begin
+            ready__4__d = 1'b1;
+            step__4__d = ShadeStep__Point;
+        end
+        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__4)) begin
+            ready__4__d = 1'b1;
+            step__4__d = ShadeStep__Ambient;
+        end
+        if (res_valid & (res_slot == c_slot__4)) begin
+            ready__4__d = 1'b1;
+            if (res_step == ShadeStep__Point) begin
+                step__4__d = ShadeStep__NormalDot;
+            end
+            if (res_step == ShadeStep__NormalDot) begin
+                flip__4__d = res_positive;
+                step__4__d = ShadeStep__KdLoad;
+            end
+            if (res_step == ShadeStep__Ambient) begin
+                step__4__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__4__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step == ShadeStep__ToLight) begin
+                step__4__d = ShadeStep__Dots;
+            end
+            if (res_step == ShadeStep__Tint) begin
+                step__4__d = ShadeStep__Accumulate;
+            end
+            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+                step__4__d = ShadeStep__ToLight;
+                light__4__d = res_light + 32'h1;
+                if (res_light == c_last_light) begin
+                    step__4__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step == ShadeStep__Dots) & res_positive) begin
+                step__4__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__4)) begin
+            ready__4__d = 1'b1;
+            step__4__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__4)) begin
+            ready__4__d = 1'b1;
+            step__4__d = ShadeStep__Store;
+        end
+        if (taken & (free_slot == c_slot__5)) begin
+            busy__5__d = 1'b1;
+            ready__5__d = 1'b1;
+            miss__5__d = ~offer_hit;
+            flip__5__d = 1'b0;
+            light__5__d = 32'h0;
+            step__5__d = ShadeStep__TriLoad;
+            if (~offer_hit) begin
+                step__5__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__5)) begin
+            ready__5__d = 1'b0;
+        end
+        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__5)) begin
+            busy__5__d = 1'b0;
+            step__5__d = ShadeStep__Idle;
+        end
+        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__5)) begin
+            ready__5__d = 1'b1;
+            step__5__d = ShadeStep__Point;
+        end
+        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__5)) begin
+            ready__5__d = 1'b1;
+            step__5__d = ShadeStep__Ambient;
+        end
+        if (res_valid & (res_slot == c_slot__5)) begin
+            ready__5__d = 1'b1;
+            if (res_step == ShadeStep__Point) begin
+                step__5__d = ShadeStep__NormalDot;
+            end
+            if (res_step == ShadeStep__NormalDot) begin
+                flip__5__d = res_positive;
+                step__5__d = ShadeStep__KdLoad;
+            end
+            if (res_step == ShadeStep__Ambient) begin
+                step__5__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__5__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step == ShadeStep__ToLight) begin
+                step__5__d = ShadeStep__Dots;
+            end
+            if (res_step == ShadeStep__Tint) begin
+                step__5__d = ShadeStep__Accumulate;
+            end
+            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+                step__5__d = ShadeStep__ToLight;
+                light__5__d = res_light + 32'h1;
+                if (res_light == c_last_light) begin
+                    step__5__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step == ShadeStep__Dots) & res_positive) begin
+                step__5__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__5)) begin
+            ready__5__d = 1'b1;
+            step__5__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__5)) begin
+            ready__5__d = 1'b1;
+            step__5__d = ShadeStep__Store;
+        end
+        if (taken & (free_slot == c_slot__6)) begin
+            busy__6__d = 1'b1;
+            ready__6__d = 1'b1;
+            miss__6__d = ~offer_hit;
+            flip__6__d = 1'b0;
+            light__6__d = 32'h0;
+            step__6__d = ShadeStep__TriLoad;
+            if (~offer_hit) begin
+                step__6__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__6)) begin
+            ready__6__d = 1'b0;
+        end
+        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__6)) begin
+            busy__6__d = 1'b0;
+            step__6__d = ShadeStep__Idle;
+        end
+        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__6)) begin
+            ready__6__d = 1'b1;
+            step__6__d = ShadeStep__Point;
+        end
+        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__6)) begin
+            ready__6__d = 1'b1;
+            step__6__d = ShadeStep__Ambient;
+        end
+        if (res_valid & (res_slot == c_slot__6)) begin
+            ready__6__d = 1'b1;
+            if (res_step == ShadeStep__Point) begin
+                step__6__d = ShadeStep__NormalDot;
+            end
+            if (res_step == ShadeStep__NormalDot) begin
+                flip__6__d = res_positive;
+                step__6__d = ShadeStep__KdLoad;
+            end
+            if (res_step == ShadeStep__Ambient) begin
+                step__6__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__6__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step == ShadeStep__ToLight) begin
+                step__6__d = ShadeStep__Dots;
+            end
+            if (res_step == ShadeStep__Tint) begin
+                step__6__d = ShadeStep__Accumulate;
+            end
+            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+                step__6__d = ShadeStep__ToLight;
+                light__6__d = res_light + 32'h1;
+                if (res_light == c_last_light) begin
+                    step__6__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step == ShadeStep__Dots) & res_positive) begin
+                step__6__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__6)) begin
+            ready__6__d = 1'b1;
+            step__6__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__6)) begin
+            ready__6__d = 1'b1;
+            step__6__d = ShadeStep__Store;
+        end
+        if (taken & (free_slot == c_slot__7)) begin
+            busy__7__d = 1'b1;
+            ready__7__d = 1'b1;
+            miss__7__d = ~offer_hit;
+            flip__7__d = 1'b0;
+            light__7__d = 32'h0;
+            step__7__d = ShadeStep__TriLoad;
+            if (~offer_hit) begin
+                step__7__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__7)) begin
+            ready__7__d = 1'b0;
+        end
+        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__7)) begin
+            busy__7__d = 1'b0;
+            step__7__d = ShadeStep__Idle;
+        end
+        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__7)) begin
+            ready__7__d = 1'b1;
+            step__7__d = ShadeStep__Point;
+        end
+        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__7)) begin
+            ready__7__d = 1'b1;
+            step__7__d = ShadeStep__Ambient;
+        end
+        if (res_valid & (res_slot == c_slot__7)) begin
+            ready__7__d = 1'b1;
+            if (res_step == ShadeStep__Point) begin
+                step__7__d = ShadeStep__NormalDot;
+            end
+            if (res_step == ShadeStep__NormalDot) begin
+                flip__7__d = res_positive;
+                step__7__d = ShadeStep__KdLoad;
+            end
+            if (res_step == ShadeStep__Ambient) begin
+                step__7__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__7__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step == ShadeStep__ToLight) begin
+                step__7__d = ShadeStep__Dots;
+            end
+            if (res_step == ShadeStep__Tint) begin
+                step__7__d = ShadeStep__Accumulate;
+            end
+            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+                step__7__d = ShadeStep__ToLight;
+                light__7__d = res_light + 32'h1;
+                if (res_light == c_last_light) begin
+                    step__7__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step == ShadeStep__Dots) & res_positive) begin
+                step__7__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__7)) begin
+            ready__7__d = 1'b1;
+            step__7__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__7)) begin
+            ready__7__d = 1'b1;
+            step__7__d = ShadeStep__Store;
+        end
+        if (frame_start) begin
+            loading__d = 1'b1;
+            const_issued__d = 32'h0;
+            const_arrived__d = 32'h0;
+            const_addr__d = c_const_addr;
+            const_lights__d = 1'b0;
+            const_light__d = 32'h0;
+            const_word__d = 32'h0;
+        end
+        any_busy = 1'b0;
+        any_busy = any_busy | busy__0__q;
+        any_busy = any_busy | busy__1__q;
+        any_busy = any_busy | busy__2__q;
+        any_busy = any_busy | busy__3__q;
+        any_busy = any_busy | busy__4__q;
+        any_busy = any_busy | busy__5__q;
+        any_busy = any_busy | busy__6__q;
+        any_busy = any_busy | busy__7__q;
+        idle = (~loading__q) & (~any_busy);
+    end
+    
+endmodule // dynrt_processor__engine__shader
 
 
-module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,a_words__read,a_words__addr,a_words__rdata,b_words__read,b_words__addr,b_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_client,gen_thread,gen_take,gen_out_valid,gen_out_client,gen_out_thread,gen_out_dir__0,gen_out_dir__1,gen_out_dir__2,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2);
+module dynrt_processor__engine__shader__acc__0(read_address,read_data,write_clock,write_address,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [2:0] read_address;
+    output reg  [23:0] read_data;
+    input wire  write_clock;
+    input wire  [2:0] write_address;
+    input wire  [23:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[23:0] mem[7:0];
+    
+    initial begin
+       mem[0] = 24'h0;
+       mem[1] = 24'h0;
+       mem[2] = 24'h0;
+       mem[3] = 24'h0;
+       mem[4] = 24'h0;
+       mem[5] = 24'h0;
+       mem[6] = 24'h0;
+       mem[7] = 24'h0;
+    end
+    
+    always @(*) begin
+       read_data = mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+endmodule // dynrt_processor__engine__shader__acc__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__shader__byte_tag(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [5:0] data_in;
+    output reg  [5:0] data_out;
+    
+    // Stub signals
+    reg  [5:0] stage__0__d;
+    wire  [5:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [5:0] stage__1__d;
+    wire  [5:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [5:0] stage__2__d;
+    wire  [5:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [5:0] stage__3__d;
+    wire  [5:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [5:0] stage__4__d;
+    wire  [5:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [5:0] stage__5__d;
+    wire  [5:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [5:0] stage__6__d;
+    wire  [5:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [5:0] stage__7__d;
+    wire  [5:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [5:0] stage__8__d;
+    wire  [5:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [5:0] stage__9__d;
+    wire  [5:0] stage__9__q;
+    reg  stage__9__clock;
+    reg  [5:0] stage__10__d;
+    wire  [5:0] stage__10__q;
+    reg  stage__10__clock;
+    reg  [5:0] stage__11__d;
+    wire  [5:0] stage__11__q;
+    reg  stage__11__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__mem_load_r stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__mem_load_r stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__mem_load_r stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__engine__mem_load_r stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__engine__mem_load_r stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__engine__mem_load_r stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__engine__mem_load_r stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__engine__mem_load_r stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__engine__mem_load_r stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__engine__mem_load_r stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__engine__mem_load_r stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    dynrt_processor__engine__mem_load_r stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__11__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+        data_out = stage__11__q;
+    end
+    
+endmodule // dynrt_processor__engine__shader__byte_tag
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__shader__cos_n_dot_l(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [23:0] data_in;
+    output reg  [23:0] data_out;
+    
+    // Stub signals
+    reg  [23:0] stage__0__d;
+    wire  [23:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [23:0] stage__1__d;
+    wire  [23:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [23:0] stage__2__d;
+    wire  [23:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [23:0] stage__3__d;
+    wire  [23:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [23:0] stage__4__d;
+    wire  [23:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [23:0] stage__5__d;
+    wire  [23:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [23:0] stage__6__d;
+    wire  [23:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [23:0] stage__7__d;
+    wire  [23:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [23:0] stage__8__d;
+    wire  [23:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [23:0] stage__9__d;
+    wire  [23:0] stage__9__q;
+    reg  stage__9__clock;
+    reg  [23:0] stage__10__d;
+    wire  [23:0] stage__10__q;
+    reg  stage__10__clock;
+    reg  [23:0] stage__11__d;
+    wire  [23:0] stage__11__q;
+    reg  stage__11__clock;
+    reg  [23:0] stage__12__d;
+    wire  [23:0] stage__12__q;
+    reg  stage__12__clock;
+    reg  [23:0] stage__13__d;
+    wire  [23:0] stage__13__q;
+    reg  stage__13__clock;
+    reg  [23:0] stage__14__d;
+    wire  [23:0] stage__14__q;
+    reg  stage__14__clock;
+    reg  [23:0] stage__15__d;
+    wire  [23:0] stage__15__q;
+    reg  stage__15__clock;
+    reg  [23:0] stage__16__d;
+    wire  [23:0] stage__16__q;
+    reg  stage__16__clock;
+    reg  [23:0] stage__17__d;
+    wire  [23:0] stage__17__q;
+    reg  stage__17__clock;
+    reg  [23:0] stage__18__d;
+    wire  [23:0] stage__18__q;
+    reg  stage__18__clock;
+    reg  [23:0] stage__19__d;
+    wire  [23:0] stage__19__q;
+    reg  stage__19__clock;
+    reg  [23:0] stage__20__d;
+    wire  [23:0] stage__20__q;
+    reg  stage__20__clock;
+    
+    // Sub module instances
+    dynrt_processor__display__rgb_q stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__display__rgb_q stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__display__rgb_q stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__display__rgb_q stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__display__rgb_q stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__display__rgb_q stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__display__rgb_q stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__display__rgb_q stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__display__rgb_q stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__display__rgb_q stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__display__rgb_q stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    dynrt_processor__display__rgb_q stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
+    dynrt_processor__display__rgb_q stage__12(
+        .d(stage__12__d),
+        .q(stage__12__q),
+        .clock(stage__12__clock)
+    );
+    dynrt_processor__display__rgb_q stage__13(
+        .d(stage__13__d),
+        .q(stage__13__q),
+        .clock(stage__13__clock)
+    );
+    dynrt_processor__display__rgb_q stage__14(
+        .d(stage__14__d),
+        .q(stage__14__q),
+        .clock(stage__14__clock)
+    );
+    dynrt_processor__display__rgb_q stage__15(
+        .d(stage__15__d),
+        .q(stage__15__q),
+        .clock(stage__15__clock)
+    );
+    dynrt_processor__display__rgb_q stage__16(
+        .d(stage__16__d),
+        .q(stage__16__q),
+        .clock(stage__16__clock)
+    );
+    dynrt_processor__display__rgb_q stage__17(
+        .d(stage__17__d),
+        .q(stage__17__q),
+        .clock(stage__17__clock)
+    );
+    dynrt_processor__display__rgb_q stage__18(
+        .d(stage__18__d),
+        .q(stage__18__q),
+        .clock(stage__18__clock)
+    );
+    dynrt_processor__display__rgb_q stage__19(
+        .d(stage__19__d),
+        .q(stage__19__q),
+        .clock(stage__19__clock)
+    );
+    dynrt_processor__display__rgb_q stage__20(
+        .d(stage__20__d),
+        .q(stage__20__q),
+        .clock(stage__20__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__11__clock = clock;
+        stage__12__clock = clock;
+        stage__13__clock = clock;
+        stage__14__clock = clock;
+        stage__15__clock = clock;
+        stage__16__clock = clock;
+        stage__17__clock = clock;
+        stage__18__clock = clock;
+        stage__19__clock = clock;
+        stage__20__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
+        stage__12__d = stage__11__q;
+        stage__13__d = stage__12__q;
+        stage__14__d = stage__13__q;
+        stage__15__d = stage__14__q;
+        stage__16__d = stage__15__q;
+        stage__17__d = stage__16__q;
+        stage__18__d = stage__17__q;
+        stage__19__d = stage__18__q;
+        stage__20__d = stage__19__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+        data_out = stage__11__q;
+        data_out = stage__12__q;
+        data_out = stage__13__q;
+        data_out = stage__14__q;
+        data_out = stage__15__q;
+        data_out = stage__16__q;
+        data_out = stage__17__q;
+        data_out = stage__18__q;
+        data_out = stage__19__q;
+        data_out = stage__20__q;
+    end
+    
+endmodule // dynrt_processor__engine__shader__cos_n_dot_l
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__shader__cos_slot(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [3:0] data_in;
+    output reg  [3:0] data_out;
+    
+    // Stub signals
+    reg  [3:0] stage__0__d;
+    wire  [3:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [3:0] stage__1__d;
+    wire  [3:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [3:0] stage__2__d;
+    wire  [3:0] stage__2__q;
+    reg  stage__2__clock;
+    reg  [3:0] stage__3__d;
+    wire  [3:0] stage__3__q;
+    reg  stage__3__clock;
+    reg  [3:0] stage__4__d;
+    wire  [3:0] stage__4__q;
+    reg  stage__4__clock;
+    reg  [3:0] stage__5__d;
+    wire  [3:0] stage__5__q;
+    reg  stage__5__clock;
+    reg  [3:0] stage__6__d;
+    wire  [3:0] stage__6__q;
+    reg  stage__6__clock;
+    reg  [3:0] stage__7__d;
+    wire  [3:0] stage__7__q;
+    reg  stage__7__clock;
+    reg  [3:0] stage__8__d;
+    wire  [3:0] stage__8__q;
+    reg  stage__8__clock;
+    reg  [3:0] stage__9__d;
+    wire  [3:0] stage__9__q;
+    reg  stage__9__clock;
+    reg  [3:0] stage__10__d;
+    wire  [3:0] stage__10__q;
+    reg  stage__10__clock;
+    reg  [3:0] stage__11__d;
+    wire  [3:0] stage__11__q;
+    reg  stage__11__clock;
+    reg  [3:0] stage__12__d;
+    wire  [3:0] stage__12__q;
+    reg  stage__12__clock;
+    reg  [3:0] stage__13__d;
+    wire  [3:0] stage__13__q;
+    reg  stage__13__clock;
+    reg  [3:0] stage__14__d;
+    wire  [3:0] stage__14__q;
+    reg  stage__14__clock;
+    reg  [3:0] stage__15__d;
+    wire  [3:0] stage__15__q;
+    reg  stage__15__clock;
+    reg  [3:0] stage__16__d;
+    wire  [3:0] stage__16__q;
+    reg  stage__16__clock;
+    reg  [3:0] stage__17__d;
+    wire  [3:0] stage__17__q;
+    reg  stage__17__clock;
+    reg  [3:0] stage__18__d;
+    wire  [3:0] stage__18__q;
+    reg  stage__18__clock;
+    reg  [3:0] stage__19__d;
+    wire  [3:0] stage__19__q;
+    reg  stage__19__clock;
+    reg  [3:0] stage__20__d;
+    wire  [3:0] stage__20__q;
+    reg  stage__20__clock;
+    reg  [3:0] stage__21__d;
+    wire  [3:0] stage__21__q;
+    reg  stage__21__clock;
+    reg  [3:0] stage__22__d;
+    wire  [3:0] stage__22__q;
+    reg  stage__22__clock;
+    reg  [3:0] stage__23__d;
+    wire  [3:0] stage__23__q;
+    reg  stage__23__clock;
+    reg  [3:0] stage__24__d;
+    wire  [3:0] stage__24__q;
+    reg  stage__24__clock;
+    reg  [3:0] stage__25__d;
+    wire  [3:0] stage__25__q;
+    reg  stage__25__clock;
+    reg  [3:0] stage__26__d;
+    wire  [3:0] stage__26__q;
+    reg  stage__26__clock;
+    reg  [3:0] stage__27__d;
+    wire  [3:0] stage__27__q;
+    reg  stage__27__clock;
+    reg  [3:0] stage__28__d;
+    wire  [3:0] stage__28__q;
+    reg  stage__28__clock;
+    reg  [3:0] stage__29__d;
+    wire  [3:0] stage__29__q;
+    reg  stage__29__clock;
+    reg  [3:0] stage__30__d;
+    wire  [3:0] stage__30__q;
+    reg  stage__30__clock;
+    reg  [3:0] stage__31__d;
+    wire  [3:0] stage__31__q;
+    reg  stage__31__clock;
+    reg  [3:0] stage__32__d;
+    wire  [3:0] stage__32__q;
+    reg  stage__32__clock;
+    reg  [3:0] stage__33__d;
+    wire  [3:0] stage__33__q;
+    reg  stage__33__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__instances__arrived stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__3(
+        .d(stage__3__d),
+        .q(stage__3__q),
+        .clock(stage__3__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__4(
+        .d(stage__4__d),
+        .q(stage__4__q),
+        .clock(stage__4__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__5(
+        .d(stage__5__d),
+        .q(stage__5__q),
+        .clock(stage__5__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__6(
+        .d(stage__6__d),
+        .q(stage__6__q),
+        .clock(stage__6__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__7(
+        .d(stage__7__d),
+        .q(stage__7__q),
+        .clock(stage__7__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__8(
+        .d(stage__8__d),
+        .q(stage__8__q),
+        .clock(stage__8__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__9(
+        .d(stage__9__d),
+        .q(stage__9__q),
+        .clock(stage__9__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__10(
+        .d(stage__10__d),
+        .q(stage__10__q),
+        .clock(stage__10__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__11(
+        .d(stage__11__d),
+        .q(stage__11__q),
+        .clock(stage__11__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__12(
+        .d(stage__12__d),
+        .q(stage__12__q),
+        .clock(stage__12__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__13(
+        .d(stage__13__d),
+        .q(stage__13__q),
+        .clock(stage__13__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__14(
+        .d(stage__14__d),
+        .q(stage__14__q),
+        .clock(stage__14__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__15(
+        .d(stage__15__d),
+        .q(stage__15__q),
+        .clock(stage__15__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__16(
+        .d(stage__16__d),
+        .q(stage__16__q),
+        .clock(stage__16__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__17(
+        .d(stage__17__d),
+        .q(stage__17__q),
+        .clock(stage__17__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__18(
+        .d(stage__18__d),
+        .q(stage__18__q),
+        .clock(stage__18__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__19(
+        .d(stage__19__d),
+        .q(stage__19__q),
+        .clock(stage__19__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__20(
+        .d(stage__20__d),
+        .q(stage__20__q),
+        .clock(stage__20__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__21(
+        .d(stage__21__d),
+        .q(stage__21__q),
+        .clock(stage__21__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__22(
+        .d(stage__22__d),
+        .q(stage__22__q),
+        .clock(stage__22__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__23(
+        .d(stage__23__d),
+        .q(stage__23__q),
+        .clock(stage__23__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__24(
+        .d(stage__24__d),
+        .q(stage__24__q),
+        .clock(stage__24__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__25(
+        .d(stage__25__d),
+        .q(stage__25__q),
+        .clock(stage__25__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__26(
+        .d(stage__26__d),
+        .q(stage__26__q),
+        .clock(stage__26__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__27(
+        .d(stage__27__d),
+        .q(stage__27__q),
+        .clock(stage__27__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__28(
+        .d(stage__28__d),
+        .q(stage__28__q),
+        .clock(stage__28__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__29(
+        .d(stage__29__d),
+        .q(stage__29__q),
+        .clock(stage__29__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__30(
+        .d(stage__30__d),
+        .q(stage__30__q),
+        .clock(stage__30__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__31(
+        .d(stage__31__d),
+        .q(stage__31__q),
+        .clock(stage__31__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__32(
+        .d(stage__32__d),
+        .q(stage__32__q),
+        .clock(stage__32__clock)
+    );
+    dynrt_processor__engine__instances__arrived stage__33(
+        .d(stage__33__d),
+        .q(stage__33__q),
+        .clock(stage__33__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__3__clock = clock;
+        stage__4__clock = clock;
+        stage__5__clock = clock;
+        stage__6__clock = clock;
+        stage__7__clock = clock;
+        stage__8__clock = clock;
+        stage__9__clock = clock;
+        stage__10__clock = clock;
+        stage__11__clock = clock;
+        stage__12__clock = clock;
+        stage__13__clock = clock;
+        stage__14__clock = clock;
+        stage__15__clock = clock;
+        stage__16__clock = clock;
+        stage__17__clock = clock;
+        stage__18__clock = clock;
+        stage__19__clock = clock;
+        stage__20__clock = clock;
+        stage__21__clock = clock;
+        stage__22__clock = clock;
+        stage__23__clock = clock;
+        stage__24__clock = clock;
+        stage__25__clock = clock;
+        stage__26__clock = clock;
+        stage__27__clock = clock;
+        stage__28__clock = clock;
+        stage__29__clock = clock;
+        stage__30__clock = clock;
+        stage__31__clock = clock;
+        stage__32__clock = clock;
+        stage__33__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        stage__3__d = stage__2__q;
+        stage__4__d = stage__3__q;
+        stage__5__d = stage__4__q;
+        stage__6__d = stage__5__q;
+        stage__7__d = stage__6__q;
+        stage__8__d = stage__7__q;
+        stage__9__d = stage__8__q;
+        stage__10__d = stage__9__q;
+        stage__11__d = stage__10__q;
+        stage__12__d = stage__11__q;
+        stage__13__d = stage__12__q;
+        stage__14__d = stage__13__q;
+        stage__15__d = stage__14__q;
+        stage__16__d = stage__15__q;
+        stage__17__d = stage__16__q;
+        stage__18__d = stage__17__q;
+        stage__19__d = stage__18__q;
+        stage__20__d = stage__19__q;
+        stage__21__d = stage__20__q;
+        stage__22__d = stage__21__q;
+        stage__23__d = stage__22__q;
+        stage__24__d = stage__23__q;
+        stage__25__d = stage__24__q;
+        stage__26__d = stage__25__q;
+        stage__27__d = stage__26__q;
+        stage__28__d = stage__27__q;
+        stage__29__d = stage__28__q;
+        stage__30__d = stage__29__q;
+        stage__31__d = stage__30__q;
+        stage__32__d = stage__31__q;
+        stage__33__d = stage__32__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+        data_out = stage__3__q;
+        data_out = stage__4__q;
+        data_out = stage__5__q;
+        data_out = stage__6__q;
+        data_out = stage__7__q;
+        data_out = stage__8__q;
+        data_out = stage__9__q;
+        data_out = stage__10__q;
+        data_out = stage__11__q;
+        data_out = stage__12__q;
+        data_out = stage__13__q;
+        data_out = stage__14__q;
+        data_out = stage__15__q;
+        data_out = stage__16__q;
+        data_out = stage__17__q;
+        data_out = stage__18__q;
+        data_out = stage__19__q;
+        data_out = stage__20__q;
+        data_out = stage__21__q;
+        data_out = stage__22__q;
+        data_out = stage__23__q;
+        data_out = stage__24__q;
+        data_out = stage__25__q;
+        data_out = stage__26__q;
+        data_out = stage__27__q;
+        data_out = stage__28__q;
+        data_out = stage__29__q;
+        data_out = stage__30__q;
+        data_out = stage__31__q;
+        data_out = stage__32__q;
+        data_out = stage__33__q;
+    end
+    
+endmodule // dynrt_processor__engine__shader__cos_slot
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__shader__frame_line(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [8:0] data_in;
+    output reg  [8:0] data_out;
+    
+    // Stub signals
+    reg  [8:0] stage__0__d;
+    wire  [8:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [8:0] stage__1__d;
+    wire  [8:0] stage__1__q;
+    reg  stage__1__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__fp_units__add__lz stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__fp_units__add__lz stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+    end
+    
+endmodule // dynrt_processor__engine__shader__frame_line
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__shader__s1_step(d,q,clock);
+    
+    // Module arguments
+    input wire  [3:0] d;
+    output reg  [3:0] q;
+    input wire  clock;
+    
+    // Enums
+    localparam ShadeStep__Idle = 0;
+    localparam ShadeStep__TriLoad = 1;
+    localparam ShadeStep__Point = 2;
+    localparam ShadeStep__NormalDot = 3;
+    localparam ShadeStep__KdLoad = 4;
+    localparam ShadeStep__Ambient = 5;
+    localparam ShadeStep__ToLight = 6;
+    localparam ShadeStep__Dots = 7;
+    localparam ShadeStep__Cosine = 8;
+    localparam ShadeStep__Tint = 9;
+    localparam ShadeStep__Accumulate = 10;
+    localparam ShadeStep__Pack = 11;
+    localparam ShadeStep__Store = 12;
+    
+    // Update code (custom)
+    initial begin
+       q = 64'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__shader__s1_step
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__shader__tri_line(clock,data_in,data_out);
+    
+    // Module arguments
+    input wire  clock;
+    input wire  [8:0] data_in;
+    output reg  [8:0] data_out;
+    
+    // Stub signals
+    reg  [8:0] stage__0__d;
+    wire  [8:0] stage__0__q;
+    reg  stage__0__clock;
+    reg  [8:0] stage__1__d;
+    wire  [8:0] stage__1__q;
+    reg  stage__1__clock;
+    reg  [8:0] stage__2__d;
+    wire  [8:0] stage__2__q;
+    reg  stage__2__clock;
+    
+    // Sub module instances
+    dynrt_processor__engine__fp_units__add__lz stage__0(
+        .d(stage__0__d),
+        .q(stage__0__q),
+        .clock(stage__0__clock)
+    );
+    dynrt_processor__engine__fp_units__add__lz stage__1(
+        .d(stage__1__d),
+        .q(stage__1__q),
+        .clock(stage__1__clock)
+    );
+    dynrt_processor__engine__fp_units__add__lz stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
+    
+    // Update code
+    always @(*) begin
+        stage__0__clock = clock;
+        stage__1__clock = clock;
+        stage__2__clock = clock;
+        stage__0__d = data_in;
+        stage__1__d = stage__0__q;
+        stage__2__d = stage__1__q;
+        data_out = stage__0__q;
+        data_out = stage__1__q;
+        data_out = stage__2__q;
+    end
+    
+endmodule // dynrt_processor__engine__shader__tri_line
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,a_words__read,a_words__addr,a_words__rdata,b_words__read,b_words__addr,b_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_diagonal,gen_client,gen_thread,gen_take,gen_out_valid,gen_out_client,gen_out_thread,gen_out_dir__0,gen_out_dir__1,gen_out_dir__2,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2);
     
     // Module arguments
     input wire  clock;
@@ -16578,6 +21954,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     input wire  [23:0] gen_v__1;
     input wire  [23:0] gen_v__2;
     input wire  gen_point;
+    input wire  gen_diagonal;
     input wire  [1:0] gen_client;
     input wire  [4:0] gen_thread;
     output reg  gen_take;
@@ -16924,6 +22301,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [23:0] transform_unit__v__1;
     reg  [23:0] transform_unit__v__2;
     reg  transform_unit__point;
+    reg  transform_unit__diagonal;
     reg  [15:0] transform_unit__tag;
     wire  transform_unit__out_valid;
     wire  [23:0] transform_unit__result__0;
@@ -17084,6 +22462,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  gen_hold_point__d;
     wire  gen_hold_point__q;
     reg  gen_hold_point__clock;
+    reg  gen_hold_diagonal__d;
+    wire  gen_hold_diagonal__q;
+    reg  gen_hold_diagonal__clock;
     reg  [1:0] gen_hold_client__d;
     wire  [1:0] gen_hold_client__q;
     reg  gen_hold_client__clock;
@@ -17544,6 +22925,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .v__1(transform_unit__v__1),
         .v__2(transform_unit__v__2),
         .point(transform_unit__point),
+        .diagonal(transform_unit__diagonal),
         .tag(transform_unit__tag),
         .out_valid(transform_unit__out_valid),
         .result__0(transform_unit__result__0),
@@ -17795,6 +23177,11 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(gen_hold_point__q),
         .clock(gen_hold_point__clock)
     );
+    dynrt_processor__display__dark_d gen_hold_diagonal(
+        .d(gen_hold_diagonal__d),
+        .q(gen_hold_diagonal__q),
+        .clock(gen_hold_diagonal__clock)
+    );
     dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 gen_hold_client(
         .d(gen_hold_client__d),
         .q(gen_hold_client__q),
@@ -17840,6 +23227,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         m3_best__clock = clock;
         gen_held__clock = clock;
         gen_hold_point__clock = clock;
+        gen_hold_diagonal__clock = clock;
         gen_hold_client__clock = clock;
         gen_hold_thread__clock = clock;
         fetching__d = fetching__q;
@@ -17874,6 +23262,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         m3_best__d = m3_best__q;
         gen_held__d = gen_held__q;
         gen_hold_point__d = gen_hold_point__q;
+        gen_hold_diagonal__d = gen_hold_diagonal__q;
         gen_hold_client__d = gen_hold_client__q;
         gen_hold_thread__d = gen_hold_thread__q;
         gen_hold_m__0__clock = clock;
@@ -18316,6 +23705,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         ray__t_min_thread = l_thread;
         transform_unit__in_valid = 1'b0;
         transform_unit__point = 1'b1;
+        transform_unit__diagonal = 1'b0;
         transform_unit__v__0 = ray__o__0;
         transform_unit__v__1 = ray__o__1;
         transform_unit__v__2 = ray__o__2;
@@ -18383,6 +23773,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             transform_unit__v__1 = gen_hold_v__1__q;
             transform_unit__v__2 = gen_hold_v__2__q;
             transform_unit__point = gen_hold_point__q;
+            transform_unit__diagonal = gen_hold_diagonal__q;
             transform_unit__tag = c_primary | (((gen_hold_client__q) & 16'hffff) << 32'ha) | (((gen_hold_thread__q) & 16'hffff) << 32'h5);
         end
         if (gen_taken) begin
@@ -18403,6 +23794,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             gen_hold_v__1__d = gen_v__1;
             gen_hold_v__2__d = gen_v__2;
             gen_hold_point__d = gen_point;
+            gen_hold_diagonal__d = gen_diagonal;
             gen_hold_client__d = gen_client;
             gen_hold_thread__d = gen_thread;
         end
@@ -18690,6 +24082,8 @@ module dynrt_processor__engine__tester__flight_a(read_address,read_clock,read_da
     end
                 
 endmodule // dynrt_processor__engine__tester__flight_a
+
+
 
 
 
@@ -23836,7 +29230,7 @@ endmodule // dynrt_processor__engine__tester__ray
 
 
 
-module dynrt_processor__engine__tester__transform_unit(clock,in_valid,m__0,m__1,m__2,m__3,m__4,m__5,m__6,m__7,m__8,m__9,m__10,m__11,v__0,v__1,v__2,point,tag,out_valid,result__0,result__1,result__2,out_tag);
+module dynrt_processor__engine__tester__transform_unit(clock,in_valid,m__0,m__1,m__2,m__3,m__4,m__5,m__6,m__7,m__8,m__9,m__10,m__11,v__0,v__1,v__2,point,diagonal,tag,out_valid,result__0,result__1,result__2,out_tag);
     
     // Module arguments
     input wire  clock;
@@ -23857,6 +29251,7 @@ module dynrt_processor__engine__tester__transform_unit(clock,in_valid,m__0,m__1,
     input wire  [23:0] v__1;
     input wire  [23:0] v__2;
     input wire  point;
+    input wire  diagonal;
     input wire  [15:0] tag;
     output reg  out_valid;
     output reg  [23:0] result__0;
@@ -23866,6 +29261,7 @@ module dynrt_processor__engine__tester__transform_unit(clock,in_valid,m__0,m__1,
     
     // Constant declarations
     localparam  c_neg_zero = 24'h800000;
+    localparam  c_zero = 24'h0;
     
     // Stub signals
     reg  mul__0__clock;
@@ -24313,6 +29709,20 @@ module dynrt_processor__engine__tester__transform_unit(clock,in_valid,m__0,m__1,
         add__8__a = add__7__result;
         add__8__b = offset_delay__2__data_out;
         result__2 = add__8__result;
+        if (diagonal) begin
+            mul__1__a = c_neg_zero;
+            mul__1__b = c_zero;
+            mul__2__a = c_neg_zero;
+            mul__2__b = c_zero;
+            mul__3__a = c_neg_zero;
+            mul__3__b = c_zero;
+            mul__5__a = c_neg_zero;
+            mul__5__b = c_zero;
+            mul__6__a = c_neg_zero;
+            mul__6__b = c_zero;
+            mul__7__a = c_neg_zero;
+            mul__7__b = c_zero;
+        end
         tag_delay__data_in = tag;
         out_tag = tag_delay__data_out;
         out_valid = add__2__out_valid;
@@ -30697,6 +36107,8 @@ module dynrt_processor__engine__traversal_unit__stack_node(read_address,read_clo
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__stack_node
+
+
 
 
 

@@ -204,10 +204,16 @@ pub struct ShadeUnit<
     s1_slot: DFF<Bits<3>>,
     /// The word of a multi-clock operation (loads, bytes).
     s1_word: DFF<Bits<2>>,
-    s1_step: Signal<Local, ShadeStep>,
-    s1_light: Signal<Local, Bits<3>>,
-    s1_flip: Signal<Local, Bit>,
-    s1_miss: Signal<Local, Bit>,
+    /// The dispatched slot's step, light, flip and miss, registered as it is picked (a slot's
+    /// control changes only with its operation's result, so they hold while it is in S1).
+    s1_step: DFF<ShadeStep>,
+    s1_light: DFF<Bits<3>>,
+    s1_flip: DFF<Bit>,
+    s1_miss: DFF<Bit>,
+    pick_step: Signal<Local, ShadeStep>,
+    pick_light: Signal<Local, Bits<3>>,
+    pick_flip: Signal<Local, Bit>,
+    pick_miss: Signal<Local, Bit>,
     s1_done: Signal<Local, Bit>,
     /// The normal facing the ray (the stored one with its sign flipped by `flip`).
     facing: [Signal<Local, Bits<W>>; 3],
@@ -239,6 +245,10 @@ pub struct ShadeUnit<
     byte_tag_in: Signal<Local, Bits<6>>,
     rgb_next: Signal<Local, Bits<24>>,
     any_busy: Signal<Local, Bit>,
+    tri_read_l: Signal<Local, Bit>,
+    frame_read_l: Signal<Local, Bit>,
+    frame_addr_l: Signal<Local, Bits<24>>,
+    fb_write_l: Signal<Local, Bit>,
     /// Tags of memory words in flight: `{word[8:6], slot or light[5:3], kind[2:1], valid[0]}`.
     tri_line: DelayLine<Bits<9>>,
     frame_line: DelayLine<Bits<9>>,
@@ -403,6 +413,10 @@ impl<
             s1_light: Default::default(),
             s1_flip: Default::default(),
             s1_miss: Default::default(),
+            pick_step: Default::default(),
+            pick_light: Default::default(),
+            pick_flip: Default::default(),
+            pick_miss: Default::default(),
             s1_done: Default::default(),
             facing: Default::default(),
             any_ready_before: Default::default(),
@@ -431,6 +445,10 @@ impl<
             byte_tag_in: Default::default(),
             rgb_next: Default::default(),
             any_busy: Default::default(),
+            tri_read_l: Default::default(),
+            frame_read_l: Default::default(),
+            frame_addr_l: Default::default(),
+            fb_write_l: Default::default(),
             tri_line: DelayLine::new(config.tri_latency as usize),
             frame_line: DelayLine::new(config.frame_latency as usize),
             tri_tag: Default::default(),
@@ -496,6 +514,10 @@ impl<
             s1_valid,
             s1_slot,
             s1_word,
+            s1_step,
+            s1_light,
+            s1_flip,
+            s1_miss,
             gen_held,
             gen_hold_point,
             gen_hold_diagonal,
@@ -588,23 +610,11 @@ impl<
         self.rgb.read_address.next = self.s1_slot.q.val();
 
         // ---- The dispatched slot (S1): its step and operation. ----
-        self.s1_step.next = ShadeStep::Idle;
-        self.s1_light.next = 0.into();
-        self.s1_flip.next = false;
-        self.s1_miss.next = false;
-        for s in 0..SHADE_SLOTS {
-            if self.s1_slot.q.val() == self.c_slot[s].val() {
-                self.s1_step.next = self.step[s].q.val();
-                self.s1_light.next = self.light[s].q.val();
-                self.s1_flip.next = self.flip[s].q.val();
-                self.s1_miss.next = self.miss[s].q.val();
-            }
-        }
         for k in 0..3 {
-            self.light_position[k].read_address.next = self.s1_light.val();
-            self.light_color[k].read_address.next = self.s1_light.val();
+            self.light_position[k].read_address.next = self.s1_light.q.val();
+            self.light_color[k].read_address.next = self.s1_light.q.val();
             self.facing[k].next = self.n[k].read_data.val();
-            if self.s1_flip.val() {
+            if self.s1_flip.q.val() {
                 self.facing[k].next = self.n[k].read_data.val() ^ self.c_sign.val();
             }
         }
@@ -613,14 +623,14 @@ impl<
         self.const_go.next = self.loading.q.val()
             & (self.const_issued.q.val() != self.c_const_total.val())
             & self.frame_grant.val();
-        self.tri_read.next = false;
+        self.tri_read_l.next = false;
         self.tri_addr.next = (self.triangle.read_data.val() << 3)
             + self.c_shading_word.val()
             + bit_cast::<24, 2>(self.s1_word.q.val());
         self.tri_tag.next = 0.into();
-        self.frame_read.next =
+        self.frame_read_l.next =
             self.loading.q.val() & (self.const_issued.q.val() != self.c_const_total.val());
-        self.frame_addr.next = self.const_addr.q.val();
+        self.frame_addr_l.next = self.const_addr.q.val();
         self.frame_tag.next = 0.into();
         if self.const_go.val() {
             self.frame_tag.next = (bit_cast::<9, 3>(self.const_word.q.val()) << 6)
@@ -654,7 +664,7 @@ impl<
         self.byte_unit.word.next = self.acc[0].read_data.val();
         self.byte_tag_in.next = (bit_cast::<6, 2>(self.s1_word.q.val()) << 4)
             | (bit_cast::<6, 3>(self.s1_slot.q.val()) << 1);
-        self.fb_write.next = false;
+        self.fb_write_l.next = false;
         self.fb_addr.next = self.addr.read_data.val() + self.c_fb_base.val();
         self.fb_data.next = bit_cast::<32, 24>(self.rgb.read_data.val());
         // The TransformUnit's request of the step (zeros where the pass reads nothing).
@@ -666,14 +676,14 @@ impl<
         }
         self.req_point.next = false;
         self.req_diagonal.next = false;
-        self.tu_step.next = (self.s1_step.val() == ShadeStep::Point)
-            | (self.s1_step.val() == ShadeStep::NormalDot)
-            | (self.s1_step.val() == ShadeStep::Ambient)
-            | (self.s1_step.val() == ShadeStep::ToLight)
-            | (self.s1_step.val() == ShadeStep::Dots)
-            | (self.s1_step.val() == ShadeStep::Tint)
-            | (self.s1_step.val() == ShadeStep::Accumulate);
-        if self.s1_step.val() == ShadeStep::Point {
+        self.tu_step.next = (self.s1_step.q.val() == ShadeStep::Point)
+            | (self.s1_step.q.val() == ShadeStep::NormalDot)
+            | (self.s1_step.q.val() == ShadeStep::Ambient)
+            | (self.s1_step.q.val() == ShadeStep::ToLight)
+            | (self.s1_step.q.val() == ShadeStep::Dots)
+            | (self.s1_step.q.val() == ShadeStep::Tint)
+            | (self.s1_step.q.val() == ShadeStep::Accumulate);
+        if self.s1_step.q.val() == ShadeStep::Point {
             // o + t d: diag(d) times (t, t, t) plus o.
             self.req_m[0].next = self.d[0].read_data.val();
             self.req_m[5].next = self.d[1].read_data.val();
@@ -687,14 +697,14 @@ impl<
             self.req_point.next = true;
             self.req_diagonal.next = true;
         }
-        if self.s1_step.val() == ShadeStep::NormalDot {
+        if self.s1_step.q.val() == ShadeStep::NormalDot {
             // n . d: row 0 is the stored normal.
             for k in 0..3 {
                 self.req_m[k].next = self.n[k].read_data.val();
                 self.req_v[k].next = self.d[k].read_data.val();
             }
         }
-        if self.s1_step.val() == ShadeStep::Ambient {
+        if self.s1_step.q.val() == ShadeStep::Ambient {
             self.req_m[0].next = self.kd[0].read_data.val();
             self.req_m[5].next = self.kd[1].read_data.val();
             self.req_m[10].next = self.kd[2].read_data.val();
@@ -703,7 +713,7 @@ impl<
             }
             self.req_diagonal.next = true;
         }
-        if self.s1_step.val() == ShadeStep::ToLight {
+        if self.s1_step.q.val() == ShadeStep::ToLight {
             // light - p: diag(-1) times p plus the light.
             self.req_m[0].next = self.c_minus_one.val();
             self.req_m[5].next = self.c_minus_one.val();
@@ -717,7 +727,7 @@ impl<
             self.req_point.next = true;
             self.req_diagonal.next = true;
         }
-        if self.s1_step.val() == ShadeStep::Dots {
+        if self.s1_step.q.val() == ShadeStep::Dots {
             // Row 0 the facing normal, row 1 L, times L.
             for k in 0..3 {
                 self.req_m[k].next = self.facing[k].val();
@@ -725,7 +735,7 @@ impl<
                 self.req_v[k].next = self.to_light[k].read_data.val();
             }
         }
-        if self.s1_step.val() == ShadeStep::Tint {
+        if self.s1_step.q.val() == ShadeStep::Tint {
             self.req_m[0].next = self.kd[0].read_data.val();
             self.req_m[5].next = self.kd[1].read_data.val();
             self.req_m[10].next = self.kd[2].read_data.val();
@@ -734,7 +744,7 @@ impl<
             }
             self.req_diagonal.next = true;
         }
-        if self.s1_step.val() == ShadeStep::Accumulate {
+        if self.s1_step.q.val() == ShadeStep::Accumulate {
             // acc + tint cos: diag(tint) times (cos, cos, cos) plus acc.
             self.req_m[0].next = self.tint[0].read_data.val();
             self.req_m[5].next = self.tint[1].read_data.val();
@@ -748,13 +758,13 @@ impl<
             self.req_point.next = true;
             self.req_diagonal.next = true;
         }
-        // The held request leaves when taken; the dispatched one takes its place.
+        // The held request leaves when taken; the dispatched one waits for the next clock (not
+        // loaded in the clock of a take: the take comes from the tester's launch logic, and
+        // waiting for it here put the whole dispatch behind it, 65 MHz placed).
         if self.gen_take.val() {
             self.gen_held.d.next = false;
         }
-        self.gen_load.next = self.s1_valid.q.val()
-            & self.tu_step.val()
-            & ((!self.gen_held.q.val()) | self.gen_take.val());
+        self.gen_load.next = self.s1_valid.q.val() & self.tu_step.val() & (!self.gen_held.q.val());
         if self.gen_load.val() {
             self.gen_held.d.next = true;
             for k in 0..12 {
@@ -780,8 +790,8 @@ impl<
         self.gen_slot.next = self.gen_hold_slot.q.val();
         // The other operations go out from S1.
         if self.s1_valid.q.val() {
-            if self.s1_step.val() == ShadeStep::TriLoad {
-                self.tri_read.next = true;
+            if self.s1_step.q.val() == ShadeStep::TriLoad {
+                self.tri_read_l.next = true;
                 if self.tri_grant.val() {
                     self.tri_tag.next = (bit_cast::<9, 2>(self.s1_word.q.val()) << 6)
                         | (bit_cast::<9, 3>(self.s1_slot.q.val()) << 3)
@@ -793,9 +803,9 @@ impl<
                     }
                 }
             }
-            if (self.s1_step.val() == ShadeStep::KdLoad) & (!self.loading.q.val()) {
-                self.frame_read.next = true;
-                self.frame_addr.next = (self.material.read_data.val() << 2)
+            if (self.s1_step.q.val() == ShadeStep::KdLoad) & (!self.loading.q.val()) {
+                self.frame_read_l.next = true;
+                self.frame_addr_l.next = (self.material.read_data.val() << 2)
                     + self.c_materials.val()
                     + bit_cast::<24, 2>(self.s1_word.q.val());
                 if self.frame_grant.val() {
@@ -809,13 +819,13 @@ impl<
                     }
                 }
             }
-            if self.s1_step.val() == ShadeStep::Cosine {
+            if self.s1_step.q.val() == ShadeStep::Cosine {
                 self.sqrt.in_valid.next = true;
                 self.cos_slot.data_in.next =
                     (bit_cast::<4, 3>(self.s1_slot.q.val()) << 1) | self.c_valid4.val();
                 self.s1_done.next = true;
             }
-            if self.s1_step.val() == ShadeStep::Pack {
+            if self.s1_step.q.val() == ShadeStep::Pack {
                 self.byte_unit.in_valid.next = true;
                 self.byte_tag_in.next = self.byte_tag_in.val() | self.c_valid6.val();
                 self.s1_word.d.next = self.s1_word.q.val() + 1;
@@ -823,8 +833,8 @@ impl<
                     self.s1_done.next = true;
                 }
             }
-            if self.s1_step.val() == ShadeStep::Store {
-                self.fb_write.next = true;
+            if self.s1_step.q.val() == ShadeStep::Store {
+                self.fb_write_l.next = true;
                 if self.fb_grant.val() {
                     self.s1_done.next = true;
                 }
@@ -837,7 +847,7 @@ impl<
         if self.s1_word.q.val() == 2 {
             self.byte_unit.word.next = self.acc[2].read_data.val();
         }
-        if self.s1_miss.val() {
+        if self.s1_miss.q.val() {
             self.byte_unit.word.next = self.background[0].q.val();
             if self.s1_word.q.val() == 1 {
                 self.byte_unit.word.next = self.background[1].q.val();
@@ -850,6 +860,13 @@ impl<
             self.s1_word.d.next = 0.into();
         }
         self.byte_tag.data_in.next = self.byte_tag_in.val();
+        // Each output is written once, from its local: an output assigned a default and then
+        // overridden changes twice in one evaluation, and Icarus, waking the engine's block
+        // on each change, went round the two blocks without end.
+        self.tri_read.next = self.tri_read_l.val();
+        self.frame_read.next = self.frame_read_l.val();
+        self.frame_addr.next = self.frame_addr_l.val();
+        self.fb_write.next = self.fb_write_l.val();
 
         // ---- S0: the next slot when S1 is free next clock. ----
         self.any_ready_before[0].next = false;
@@ -865,9 +882,25 @@ impl<
         }
         self.pick.next =
             self.any_ready_before[8].val() & ((!self.s1_valid.q.val()) | self.s1_done.val());
+        self.pick_step.next = ShadeStep::Idle;
+        self.pick_light.next = 0.into();
+        self.pick_flip.next = false;
+        self.pick_miss.next = false;
+        for s in 0..SHADE_SLOTS {
+            if self.ready_slot.val() == self.c_slot[s].val() {
+                self.pick_step.next = self.step[s].q.val();
+                self.pick_light.next = self.light[s].q.val();
+                self.pick_flip.next = self.flip[s].q.val();
+                self.pick_miss.next = self.miss[s].q.val();
+            }
+        }
         if (!self.s1_valid.q.val()) | self.s1_done.val() {
             self.s1_valid.d.next = self.pick.val();
             self.s1_slot.d.next = self.ready_slot.val();
+            self.s1_step.d.next = self.pick_step.val();
+            self.s1_light.d.next = self.pick_light.val();
+            self.s1_flip.d.next = self.pick_flip.val();
+            self.s1_miss.d.next = self.pick_miss.val();
         }
 
         // ---- Offers take the first free slot. ----
@@ -1078,7 +1111,7 @@ impl<
             }
             // The store went out: the slot is free.
             if self.s1_done.val()
-                & (self.s1_step.val() == ShadeStep::Store)
+                & (self.s1_step.q.val() == ShadeStep::Store)
                 & (self.s1_slot.q.val() == self.c_slot[s].val())
             {
                 self.busy[s].d.next = false;
