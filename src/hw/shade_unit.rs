@@ -1262,7 +1262,7 @@ mod tests {
         let (tri_latency, frame_latency) = (3, 2);
         println!("seed {seed}, {lights} lights");
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let mut w = |rng: &mut ChaCha8Rng, lo: f64, hi: f64| f.from_f64(rng.gen_range(lo..hi));
+        let w = |rng: &mut ChaCha8Rng, lo: f64, hi: f64| f.from_f64(rng.gen_range(lo..hi));
         // Bank 5: constants, lights, materials.
         let mut frame = vec![0u32; 2048];
         let constants = ShadingConstants {
