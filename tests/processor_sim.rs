@@ -118,32 +118,8 @@ frames_equal_the_golden_model! {
     icarus_mirror: Icarus "mirror.toml" 2 x 2, frames None;
     icarus_tiny_animated: Icarus "tiny_animated.toml" 2 x 2, frames Some(2);
     icarus_terrain_small: Icarus "terrain_small.toml" 2 x 2, frames None;
-}
-
-/// Icarus does not simulate the ShadeUnit's design yet (it loops without advancing time):
-/// the run is refused with a clear error instead of hanging.
-#[test]
-fn icarus_refuses_the_shade_unit_clearly() {
-    let s = scene("cornell_noshadow.toml", 2, 2);
-    let dir = tempfile::tempdir().unwrap();
-    let e = flow::simulate_scene(
-        &s,
-        "cornell_noshadow",
-        Format::E7M16,
-        ProcessorParams::default(),
-        None,
-        Simulator::Icarus,
-        None,
-        dir.path(),
-        &GeneratedBy::library(),
-    )
-    .err()
-    .expect("refused");
-    let msg = format!("{e:#}");
-    assert!(
-        msg.contains("ShadeUnit") && msg.contains("--sim verilator"),
-        "{msg}"
-    );
+    // The ShadeUnit's design (cornell_noshadow shades there): its four pixels hit.
+    icarus_cornell_noshadow: Icarus "cornell_noshadow.toml" 2 x 2, frames None;
 }
 
 /// The ShadeUnit with three lights (one behind every wall it lights, some lit, some not) at

@@ -5253,15 +5253,6 @@ module dynrt_processor__engine__fp_units__byte_delay(clock,data_in,data_out);
         stage__7__d = stage__6__q;
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
         data_out = stage__9__q;
     end
     
@@ -5455,9 +5446,6 @@ module dynrt_processor__engine__fp_units__byte_unit__clamp_line(clock,data_in,da
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
         stage__3__d = stage__2__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
         data_out = stage__3__q;
     end
     
@@ -7868,14 +7856,6 @@ module dynrt_processor__engine__fp_units__div_delay(clock,data_in,data_out);
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
         stage__8__d = stage__7__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
         data_out = stage__8__q;
     end
     
@@ -7973,11 +7953,6 @@ module dynrt_processor__engine__fp_units__eq_delay(clock,data_in,data_out);
         stage__3__d = stage__2__q;
         stage__4__d = stage__3__q;
         stage__5__d = stage__4__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
         data_out = stage__5__q;
     end
     
@@ -8131,10 +8106,6 @@ module dynrt_processor__engine__fp_units__mul_delay(clock,data_in,data_out);
         stage__2__d = stage__1__q;
         stage__3__d = stage__2__q;
         stage__4__d = stage__3__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
         data_out = stage__4__q;
     end
     
@@ -14274,12 +14245,6 @@ module dynrt_processor__engine__result_line__cond_line(clock,data_in,data_out);
         stage__4__d = stage__3__q;
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
         data_out = stage__6__q;
     end
     
@@ -14395,13 +14360,6 @@ module dynrt_processor__engine__result_line__dst_line(clock,data_in,data_out);
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
         data_out = stage__7__q;
     end
     
@@ -14564,13 +14522,6 @@ module dynrt_processor__engine__result_line__halt_line(clock,data_in,data_out);
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
         data_out = stage__7__q;
     end
     
@@ -14809,18 +14760,6 @@ module dynrt_processor__engine__result_line__long_dst(clock,data_in,data_out);
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
         data_out = stage__12__q;
     end
     
@@ -14996,18 +14935,6 @@ module dynrt_processor__engine__result_line__long_fast(clock,data_in,data_out);
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
         data_out = stage__12__q;
     end
     
@@ -15183,18 +15110,6 @@ module dynrt_processor__engine__result_line__long_pc(clock,data_in,data_out);
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
         data_out = stage__12__q;
     end
     
@@ -15378,18 +15293,6 @@ module dynrt_processor__engine__result_line__long_source(clock,data_in,data_out)
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
         data_out = stage__12__q;
     end
     
@@ -15590,18 +15493,6 @@ module dynrt_processor__engine__result_line__long_thread(clock,data_in,data_out)
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
         data_out = stage__12__q;
     end
     
@@ -15777,18 +15668,6 @@ module dynrt_processor__engine__result_line__long_valid(clock,data_in,data_out);
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
         data_out = stage__12__q;
     end
     
@@ -15946,13 +15825,6 @@ module dynrt_processor__engine__result_line__pc_not_taken_line(clock,data_in,dat
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
         data_out = stage__7__q;
     end
     
@@ -16172,13 +16044,6 @@ module dynrt_processor__engine__result_line__source_line(clock,data_in,data_out)
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
         data_out = stage__7__q;
     end
     
@@ -16298,13 +16163,6 @@ module dynrt_processor__engine__result_line__thread_line(clock,data_in,data_out)
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
         data_out = stage__7__q;
     end
     
@@ -19980,17 +19838,6 @@ module dynrt_processor__engine__shader__byte_tag(clock,data_in,data_out);
         stage__9__d = stage__8__q;
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
         data_out = stage__11__q;
     end
     
@@ -20444,26 +20291,6 @@ module dynrt_processor__engine__shader__cos_n_dot_l(clock,data_in,data_out);
         stage__18__d = stage__17__q;
         stage__19__d = stage__18__q;
         stage__20__d = stage__19__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
-        data_out = stage__12__q;
-        data_out = stage__13__q;
-        data_out = stage__14__q;
-        data_out = stage__15__q;
-        data_out = stage__16__q;
-        data_out = stage__17__q;
-        data_out = stage__18__q;
-        data_out = stage__19__q;
         data_out = stage__20__q;
     end
     
@@ -20865,39 +20692,6 @@ module dynrt_processor__engine__shader__cos_slot(clock,data_in,data_out);
         stage__31__d = stage__30__q;
         stage__32__d = stage__31__q;
         stage__33__d = stage__32__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
-        data_out = stage__12__q;
-        data_out = stage__13__q;
-        data_out = stage__14__q;
-        data_out = stage__15__q;
-        data_out = stage__16__q;
-        data_out = stage__17__q;
-        data_out = stage__18__q;
-        data_out = stage__19__q;
-        data_out = stage__20__q;
-        data_out = stage__21__q;
-        data_out = stage__22__q;
-        data_out = stage__23__q;
-        data_out = stage__24__q;
-        data_out = stage__25__q;
-        data_out = stage__26__q;
-        data_out = stage__27__q;
-        data_out = stage__28__q;
-        data_out = stage__29__q;
-        data_out = stage__30__q;
-        data_out = stage__31__q;
-        data_out = stage__32__q;
         data_out = stage__33__q;
     end
     
@@ -21253,7 +21047,6 @@ module dynrt_processor__engine__shader__frame_line(clock,data_in,data_out);
         stage__1__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
-        data_out = stage__0__q;
         data_out = stage__1__q;
     end
     
@@ -21875,8 +21668,6 @@ module dynrt_processor__engine__shader__tri_line(clock,data_in,data_out);
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
         data_out = stage__2__q;
     end
     
@@ -25407,9 +25198,6 @@ module dynrt_processor__engine__tester__intersect_unit__o_delay__0(clock,data_in
         stage__1__d = stage__0__q;
         stage__2__d = stage__1__q;
         stage__3__d = stage__2__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
         data_out = stage__3__q;
     end
     
@@ -25577,18 +25365,6 @@ module dynrt_processor__engine__tester__intersect_unit__operand_delay__0(clock,d
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
         data_out = stage__12__q;
     end
     
@@ -25974,25 +25750,6 @@ module dynrt_processor__engine__tester__intersect_unit__t_cmp_delay__0(clock,dat
         stage__17__d = stage__16__q;
         stage__18__d = stage__17__q;
         stage__19__d = stage__18__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
-        data_out = stage__12__q;
-        data_out = stage__13__q;
-        data_out = stage__14__q;
-        data_out = stage__15__q;
-        data_out = stage__16__q;
-        data_out = stage__17__q;
-        data_out = stage__18__q;
         data_out = stage__19__q;
     end
     
@@ -26314,27 +26071,6 @@ module dynrt_processor__engine__tester__intersect_unit__t_delay(clock,data_in,da
         stage__19__d = stage__18__q;
         stage__20__d = stage__19__q;
         stage__21__d = stage__20__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
-        data_out = stage__12__q;
-        data_out = stage__13__q;
-        data_out = stage__14__q;
-        data_out = stage__15__q;
-        data_out = stage__16__q;
-        data_out = stage__17__q;
-        data_out = stage__18__q;
-        data_out = stage__19__q;
-        data_out = stage__20__q;
         data_out = stage__21__q;
     end
     
@@ -26528,18 +26264,6 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_div(clock,data
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
         data_out = stage__12__q;
     end
     
@@ -26805,27 +26529,6 @@ module dynrt_processor__engine__tester__intersect_unit__tag_delay_rest(clock,dat
         stage__19__d = stage__18__q;
         stage__20__d = stage__19__q;
         stage__21__d = stage__20__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
-        data_out = stage__12__q;
-        data_out = stage__13__q;
-        data_out = stage__14__q;
-        data_out = stage__15__q;
-        data_out = stage__16__q;
-        data_out = stage__17__q;
-        data_out = stage__18__q;
-        data_out = stage__19__q;
-        data_out = stage__20__q;
         data_out = stage__21__q;
     end
     
@@ -27025,15 +26728,6 @@ module dynrt_processor__engine__tester__intersect_unit__uv_delay__0(clock,data_i
         stage__7__d = stage__6__q;
         stage__8__d = stage__7__q;
         stage__9__d = stage__8__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
         data_out = stage__9__q;
     end
     
@@ -31510,25 +31204,6 @@ module dynrt_processor__engine__tester__transform_unit__offset_delay__0(clock,da
         stage__17__d = stage__16__q;
         stage__18__d = stage__17__q;
         stage__19__d = stage__18__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
-        data_out = stage__12__q;
-        data_out = stage__13__q;
-        data_out = stage__14__q;
-        data_out = stage__15__q;
-        data_out = stage__16__q;
-        data_out = stage__17__q;
-        data_out = stage__18__q;
         data_out = stage__19__q;
     end
     
@@ -31752,13 +31427,6 @@ module dynrt_processor__engine__tester__transform_unit__p2_delay__0(clock,data_i
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
         data_out = stage__7__q;
     end
     
@@ -32110,33 +31778,6 @@ module dynrt_processor__engine__tester__transform_unit__tag_delay(clock,data_in,
         stage__25__d = stage__24__q;
         stage__26__d = stage__25__q;
         stage__27__d = stage__26__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
-        data_out = stage__12__q;
-        data_out = stage__13__q;
-        data_out = stage__14__q;
-        data_out = stage__15__q;
-        data_out = stage__16__q;
-        data_out = stage__17__q;
-        data_out = stage__18__q;
-        data_out = stage__19__q;
-        data_out = stage__20__q;
-        data_out = stage__21__q;
-        data_out = stage__22__q;
-        data_out = stage__23__q;
-        data_out = stage__24__q;
-        data_out = stage__25__q;
-        data_out = stage__26__q;
         data_out = stage__27__q;
     end
     
@@ -34391,13 +34032,6 @@ module dynrt_processor__engine__traversal_unit__control_delay(clock,data_in,data
         stage__5__d = stage__4__q;
         stage__6__d = stage__5__q;
         stage__7__d = stage__6__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
         data_out = stage__7__q;
     end
     
@@ -34470,7 +34104,6 @@ module dynrt_processor__engine__traversal_unit__control_delay_cmp(clock,data_in,
         stage__1__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
-        data_out = stage__0__q;
         data_out = stage__1__q;
     end
     
@@ -34624,18 +34257,6 @@ module dynrt_processor__engine__traversal_unit__control_delay_div(clock,data_in,
         stage__10__d = stage__9__q;
         stage__11__d = stage__10__q;
         stage__12__d = stage__11__q;
-        data_out = stage__0__q;
-        data_out = stage__1__q;
-        data_out = stage__2__q;
-        data_out = stage__3__q;
-        data_out = stage__4__q;
-        data_out = stage__5__q;
-        data_out = stage__6__q;
-        data_out = stage__7__q;
-        data_out = stage__8__q;
-        data_out = stage__9__q;
-        data_out = stage__10__q;
-        data_out = stage__11__q;
         data_out = stage__12__q;
     end
     
@@ -35378,7 +34999,6 @@ module dynrt_processor__engine__traversal_unit__hi_delay(clock,data_in,data_out)
         stage__1__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
-        data_out = stage__0__q;
         data_out = stage__1__q;
     end
     

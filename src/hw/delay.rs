@@ -37,8 +37,12 @@ impl<D: Synth, const N: usize> Logic for Delay<D, N> {
         for i in 1..N {
             self.stage[i].d.next = self.stage[i - 1].q.val();
         }
-        // The last write wins: the last stage (rust-hdl's Verilog cannot index with `N - 1`).
-        for i in 0..N {
+        // A one-iteration loop: rust-hdl's Verilog cannot index with `N - 1`, but unrolls a
+        // loop's bounds. One assignment, not one per stage: in Icarus an output written several
+        // times in an evaluation changes several times and wakes its readers each time (a
+        // reader that drives `data_in` back through a default and an override then never
+        // settles).
+        for i in (N - 1)..N {
             self.data_out.next = self.stage[i].q.val();
         }
     }
@@ -78,8 +82,8 @@ impl<D: Synth> Logic for DelayLine<D> {
         for i in 1..self.stage.len() {
             self.stage[i].d.next = self.stage[i - 1].q.val();
         }
-        // The last write wins: the last stage.
-        for i in 0..self.stage.len() {
+        // The last stage, written once (see `Delay`).
+        for i in (self.stage.len() - 1)..self.stage.len() {
             self.data_out.next = self.stage[i].q.val();
         }
     }

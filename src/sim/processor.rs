@@ -216,18 +216,6 @@ pub fn simulate_processor(
     if let Some(t) = &trace {
         t.check()?;
     }
-    if matches!(sim, Simulator::Icarus)
-        && program
-            .units()
-            .contains(&crate::hw::program::isa::Unit::Shading)
-    {
-        anyhow::bail!(
-            "{scene_name}: this processor shades in its ShadeUnit (primary rays of one \
-             untransformed object, no shadows or mirrors), and Icarus Verilog does not simulate \
-             that design yet (it loops without advancing time, a known issue not yet found): \
-             simulate it with --sim verilator"
-        );
-    }
     let files = write_processor_files(
         program,
         layouts,
