@@ -313,6 +313,11 @@ pub struct ThreadEngine<
     /// ShadeUnit's in a clock the engine's loads leave them.
     tri_load_addr_r: DFF<Bits<24>>,
     engine_loads_triangles: Signal<Local, Bit>,
+    /// The ShadeUnit reads bank 5 in this clock (it has the shared bus after the engine).
+    shader_frame_read: Signal<Local, Bit>,
+    /// The engine's loads and the ShadeUnit's bank-5 read, one-hot by bank (the tester's
+    /// view: its list reads wait for either).
+    shared_bus_loads: Signal<Local, Bits<{ layout::BANKS }>>,
     /// The ShadeUnit's request goes to the TransformUnit (after ray generation's and instance
     /// entry's).
     gen_shade: Signal<Local, Bit>,
@@ -512,6 +517,8 @@ impl<
             shade_offer: Default::default(),
             tri_load_addr_r: Default::default(),
             engine_loads_triangles: Default::default(),
+            shader_frame_read: Default::default(),
+            shared_bus_loads: Default::default(),
             gen_shade: Default::default(),
             in_frame: Default::default(),
             tri_enqueue: Default::default(),
@@ -834,28 +841,36 @@ impl<
         self.fb.addr.next = self.fb_addr_r.q.val();
         self.fb.data.next = self.fb_data_r.q.val();
         // Bank 0 goes through the traversal unit's port, banks 2 and 3 through the triangle
-        // tester's; the tester's list reads (bank 1) use this bus when the engine does not,
-        // instance entry's reads (bank 4) when neither does.
+        // tester's; on this bus the engine's loads go first, then the ShadeUnit's reads of
+        // bank 5, the tester's list reads (bank 1), instance entry's reads (bank 4).
+        // The ShadeUnit's reads of bank 5 come after the engine's loads and before the list
+        // reads: its request comes from its registers, so its grant depends on registers alone
+        // (granted after the list unit's read, the grant ran from the list unit's state through
+        // the unit's dispatch: 71.4 MHz placed). The list unit sees such a read as a load.
+        self.shader.frame_grant.next =
+            self.c_shading.val() & ((self.mem_load_r.q.val() & self.shared_banks.val()) == 0);
+        self.shader_frame_read.next = self.shader.frame_read.val() & self.shader.frame_grant.val();
+        self.shared_bus_loads.next = self.mem_load_r.q.val();
+        if self.shader_frame_read.val() {
+            self.shared_bus_loads.next =
+                self.mem_load_r.q.val() | (self.one_bank.val() << self.bank_frame.val());
+        }
         self.instances.bus_free.next = ((self.mem_load_r.q.val() & self.shared_banks.val()) == 0)
-            & (!self.tester.lists.read.val());
-        // The ShadeUnit's reads of bank 5 when all three leave the bus.
-        self.shader.frame_grant.next = self.c_shading.val()
-            & ((self.mem_load_r.q.val() & self.shared_banks.val()) == 0)
             & (!self.tester.lists.read.val())
-            & (!self.instances.read.val());
+            & (!self.shader_frame_read.val());
         self.mem.read.next = ((self.mem_load_r.q.val() & self.shared_banks.val()) != 0)
             | self.tester.lists.read.val()
             | self.instances.read.val()
-            | (self.shader.frame_read.val() & self.shader.frame_grant.val());
-        if self.tester.lists.read.val() {
+            | self.shader_frame_read.val();
+        if self.shader_frame_read.val() {
+            self.mem.bank.next = self.bank_frame.val();
+            self.mem.addr.next = self.shader.frame_addr.val();
+        } else if self.tester.lists.read.val() {
             self.mem.bank.next = self.bank_lists.val();
             self.mem.addr.next = self.tester.lists.addr.val();
         } else if self.instances.read.val() {
             self.mem.bank.next = self.bank_instances.val();
             self.mem.addr.next = self.instances.addr.val();
-        } else if self.shader.frame_read.val() & self.shader.frame_grant.val() {
-            self.mem.bank.next = self.bank_frame.val();
-            self.mem.addr.next = self.shader.frame_addr.val();
         } else {
             self.mem.bank.next = self.mem_bank_r.q.val();
             self.mem.addr.next = self.mem_addr_r.q.val();
@@ -934,7 +949,7 @@ impl<
         self.traversal_unit.engine.ray_pair.next = self.decode.imm.val().get_bits::<2>(0);
         self.traversal_unit.engine.ray_write.next =
             self.ray_write.q.val() & (!self.store_write.val());
-        self.tester.engine.load_banks.next = self.mem_load_r.q.val();
+        self.tester.engine.load_banks.next = self.shared_bus_loads.val();
         self.tester.engine.load_addr.next = self.tri_load_addr_r.q.val();
         self.tester.engine.thread.next = self.decode.thread.val();
         self.tester.engine.word_a.next = self.decode.a.val();
