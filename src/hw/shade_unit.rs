@@ -23,7 +23,8 @@
 //!   with its `*_grant` and its word arrives `tri_latency` (`frame_latency`) clocks later.
 //! - TransformUnit (a client port like the tester's `gen_*`): a request (`gen_valid`, matrix
 //!   `gen_m`, `gen_v`, `gen_point`, `gen_diagonal`, `gen_slot`) is held until `gen_take`; its
-//!   result comes back on `res_*` with its slot, in request order.
+//!   result comes back on `res_*` with its slot, in request order, and is registered as it
+//!   arrives.
 //! - Frame buffer: `fb_write` with `fb_addr`, `fb_data` (`0x00RRGGBB`) goes out in a clock
 //!   with `fb_grant`.
 //! - `idle`: no pixel in the unit and no constant loading.
@@ -233,6 +234,11 @@ pub struct ShadeUnit<
     req_point: Signal<Local, Bit>,
     req_diagonal: Signal<Local, Bit>,
     // Results.
+    /// The TransformUnit's result, registered as it arrives: routed straight from the unit's
+    /// output into the slots' RAM writes it was the processor's critical path (56.0 MHz).
+    res_valid_r: DFF<Bit>,
+    res_slot_r: DFF<Bits<3>>,
+    res_v_r: [DFF<Bits<W>>; 3],
     res_step: Signal<Local, ShadeStep>,
     res_light: Signal<Local, Bits<3>>,
     res_positive: Signal<Local, Bit>,
@@ -433,6 +439,9 @@ impl<
             req_v: Default::default(),
             req_point: Default::default(),
             req_diagonal: Default::default(),
+            res_valid_r: Default::default(),
+            res_slot_r: Default::default(),
+            res_v_r: Default::default(),
             res_step: Default::default(),
             res_light: Default::default(),
             res_positive: Default::default(),
@@ -1029,46 +1038,54 @@ impl<
         }
 
         // ---- TransformUnit results, by the step of their slot. ----
+        self.res_valid_r.clock.next = self.clock.val();
+        self.res_valid_r.d.next = self.res_valid.val();
+        self.res_slot_r.clock.next = self.clock.val();
+        self.res_slot_r.d.next = self.res_slot.val();
+        for k in 0..3 {
+            self.res_v_r[k].clock.next = self.clock.val();
+            self.res_v_r[k].d.next = self.res_v[k].val();
+        }
         self.res_step.next = ShadeStep::Idle;
         self.res_light.next = 0.into();
         for s in 0..SHADE_SLOTS {
-            if self.res_slot.val() == self.c_slot[s].val() {
+            if self.res_slot_r.q.val() == self.c_slot[s].val() {
                 self.res_step.next = self.step[s].q.val();
                 self.res_light.next = self.light[s].q.val();
             }
         }
         // 0 < res_v[0]: positive, not zero (nor subnormal, read as zero), not NaN.
-        self.res_positive.next = (!(self.res_v[0].val() & self.c_sign.val()).any())
-            & (self.res_v[0].val() & self.c_exp_mask.val()).any()
-            & (!(((self.res_v[0].val() & self.c_exp_mask.val()) == self.c_exp_mask.val())
-                & (self.res_v[0].val() & self.c_man_mask.val()).any()));
+        self.res_positive.next = (!(self.res_v_r[0].q.val() & self.c_sign.val()).any())
+            & (self.res_v_r[0].q.val() & self.c_exp_mask.val()).any()
+            & (!(((self.res_v_r[0].q.val() & self.c_exp_mask.val()) == self.c_exp_mask.val())
+                & (self.res_v_r[0].q.val() & self.c_man_mask.val()).any()));
         for k in 0..3 {
-            self.p[k].write_address.next = self.res_slot.val();
-            self.p[k].write_data.next = self.res_v[k].val();
+            self.p[k].write_address.next = self.res_slot_r.q.val();
+            self.p[k].write_data.next = self.res_v_r[k].q.val();
             self.p[k].write_enable.next =
-                self.res_valid.val() & (self.res_step.val() == ShadeStep::Point);
-            self.acc[k].write_address.next = self.res_slot.val();
-            self.acc[k].write_data.next = self.res_v[k].val();
-            self.acc[k].write_enable.next = self.res_valid.val()
+                self.res_valid_r.q.val() & (self.res_step.val() == ShadeStep::Point);
+            self.acc[k].write_address.next = self.res_slot_r.q.val();
+            self.acc[k].write_data.next = self.res_v_r[k].q.val();
+            self.acc[k].write_enable.next = self.res_valid_r.q.val()
                 & ((self.res_step.val() == ShadeStep::Ambient)
                     | (self.res_step.val() == ShadeStep::Accumulate));
-            self.to_light[k].write_address.next = self.res_slot.val();
-            self.to_light[k].write_data.next = self.res_v[k].val();
+            self.to_light[k].write_address.next = self.res_slot_r.q.val();
+            self.to_light[k].write_data.next = self.res_v_r[k].q.val();
             self.to_light[k].write_enable.next =
-                self.res_valid.val() & (self.res_step.val() == ShadeStep::ToLight);
-            self.tint[k].write_address.next = self.res_slot.val();
-            self.tint[k].write_data.next = self.res_v[k].val();
+                self.res_valid_r.q.val() & (self.res_step.val() == ShadeStep::ToLight);
+            self.tint[k].write_address.next = self.res_slot_r.q.val();
+            self.tint[k].write_data.next = self.res_v_r[k].q.val();
             self.tint[k].write_enable.next =
-                self.res_valid.val() & (self.res_step.val() == ShadeStep::Tint);
+                self.res_valid_r.q.val() & (self.res_step.val() == ShadeStep::Tint);
         }
-        self.n_dot_l.write_address.next = self.res_slot.val();
-        self.n_dot_l.write_data.next = self.res_v[0].val();
+        self.n_dot_l.write_address.next = self.res_slot_r.q.val();
+        self.n_dot_l.write_data.next = self.res_v_r[0].q.val();
         self.n_dot_l.write_enable.next =
-            self.res_valid.val() & (self.res_step.val() == ShadeStep::Dots);
-        self.l_dot_l.write_address.next = self.res_slot.val();
-        self.l_dot_l.write_data.next = self.res_v[1].val();
+            self.res_valid_r.q.val() & (self.res_step.val() == ShadeStep::Dots);
+        self.l_dot_l.write_address.next = self.res_slot_r.q.val();
+        self.l_dot_l.write_data.next = self.res_v_r[1].q.val();
         self.l_dot_l.write_enable.next =
-            self.res_valid.val() & (self.res_step.val() == ShadeStep::Dots);
+            self.res_valid_r.q.val() & (self.res_step.val() == ShadeStep::Dots);
 
         // ---- The cosine: sqrt(L . L), then n . L over it. ----
         self.div.in_valid.next = self.sqrt.out_valid.val();
@@ -1134,7 +1151,7 @@ impl<
                 self.step[s].d.next = ShadeStep::Ambient;
             }
             // A TransformUnit result.
-            if self.res_valid.val() & (self.res_slot.val() == self.c_slot[s].val()) {
+            if self.res_valid_r.q.val() & (self.res_slot_r.q.val() == self.c_slot[s].val()) {
                 self.ready[s].d.next = true;
                 if self.res_step.val() == ShadeStep::Point {
                     self.step[s].d.next = ShadeStep::NormalDot;

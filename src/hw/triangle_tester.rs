@@ -29,14 +29,18 @@
 //! Entries are done in queue order, so a thread's closest hit is chosen in its list order
 //! (the first of equal ts stays), as in the golden model.
 //!
-//! Fetch and launch, two state machines around two entry buffers: the fetch takes an entry
-//! from the list unit's test queue into a free buffer (1 clock) and requests the triangle's 6
-//! words of bank 2 and 6 of bank 3 (6 clocks when the engine leaves the banks alone; an init
-//! or a list end fetches nothing), then goes on with the next entry in the other buffer. The
-//! launch waits for its buffer's words (the SRAM latency after their requests), launches the
-//! origin and then the direction into the TransformUnit (2 clocks), frees the buffer and
-//! waits a clock for the next entry's ray words. Throughput: one test per [`CLOCKS_PER_TEST`]
-//! (7) clocks, one init or list end per [`LAUNCH_SPACING`] (4); entries leave the launch at
+//! Fetch and launch, two state machines around [`TEST_BUFFERS`] (4) entry buffers in a ring:
+//! the fetch takes an entry from the list unit's test queue into a free buffer and requests
+//! the triangle's 6 words of bank 2 and 6 of bank 3 (6 clocks when the engine leaves the banks
+//! alone; an init or a list end fetches nothing), taking the next entry into the next buffer in
+//! the clock of its last requests. The launch waits for its buffer's words (the SRAM latency
+//! after their requests), launches the origin and then the direction into the TransformUnit
+//! (2 clocks), frees the buffer and waits a clock for the next entry's ray words. With two
+//! buffers and a clock of its own for each take, the entries that fetch nothing (a third of
+//! cornell_noshadow's) held the fetch up behind their 4 clocks of launch: 72.3 cycles per
+//! primary ray; four buffers, 63.3; and the take in the last request's clock, 56.6. Throughput:
+//! one test per [`CLOCKS_PER_TEST`] (6) clocks, one init or list end per [`LAUNCH_SPACING`]
+//! (4), the two overlapping as far as the buffers allow; entries leave the launch at
 //! least 4 clocks apart, which the hit merge needs (it reads, compares and writes a thread's
 //! best hit in 4 clocks). The engine's own loads of banks 2 and 3 (shading data) take the
 //! bank in their clock; the fetch waits for it.
@@ -54,7 +58,9 @@ use super::list_unit::{
 };
 use super::ports::{CoprocessorPort, SramRead};
 use super::ray_store::{zero_counters, RayStore};
-use super::{intersect_latency, IntersectUnit, ListUnit, TransformUnit, TRANSFORM_LATENCY};
+use super::{
+    intersect_latency, IntersectUnit, ListUnit, LutRam, TransformUnit, TRANSFORM_LATENCY,
+};
 use crate::fp::Format;
 use crate::layout;
 
@@ -83,12 +89,16 @@ pub fn flight_slots_suffice(fmt: Format) -> bool {
 }
 
 /// Clocks between two tests when the engine leaves banks 2 and 3 alone (the tester's
-/// throughput bound): the take and the 6 words of each bank (the layout splits a triangle's
-/// transform 6 + 6 for this; 8 + 4 took 9 clocks).
-pub const CLOCKS_PER_TEST: u32 = 7;
+/// throughput bound): the 6 words of each bank, the next take in the last one's clock (the
+/// layout splits a triangle's transform 6 + 6 for this; 8 + 4 took 9 clocks).
+pub const CLOCKS_PER_TEST: u32 = 6;
 // `update` spells out its numbers (rust-hdl's Verilog cannot name Rust constants): a
 // triangle is 6 words of bank 2 (words 0-5 of its transform) and 6 of bank 3 (words 6-11,
-// `layout::TRANSFORM_BANK_WORDS`), buffer 1's words follow buffer 0's 12.
+// `layout::TRANSFORM_BANK_WORDS`); word k of every buffer is in `words[k]`, addressed by
+// the buffer.
+
+/// Entry buffers between the fetch and the launch (a ring: `fb` and `lb` count modulo 4).
+pub const TEST_BUFFERS: usize = 4;
 
 #[derive(LogicBlock)]
 pub struct TriangleTester<
@@ -181,27 +191,34 @@ pub struct TriangleTester<
     flight_a: RAM<Bits<32>, 5>,
     flight_b: RAM<Bits<32>, 5>,
 
-    // Fetch and launch: two buffers of an entry and its triangle's 12 words; the fetch fills
-    // `fb` while the launch empties `lb`.
+    // Fetch and launch: [`TEST_BUFFERS`] buffers of an entry and its triangle's 12 words; the
+    // fetch fills `fb` while the launch empties `lb`.
     fetching: DFF<Bit>,
-    fb: DFF<Bit>,
-    lb: DFF<Bit>,
+    fb: DFF<Bits<2>>,
+    lb: DFF<Bits<2>>,
     lphase: DFF<Launch>,
-    loaded: [DFF<Bit>; 2],
+    loaded: [DFF<Bit>; TEST_BUFFERS],
     /// `list_unit::TEST_*`.
-    cur_kind: [DFF<Bits<2>>; 2],
-    cur_thread: [DFF<Bits<5>>; 2],
-    cur_a: [DFF<Bits<32>>; 2],
-    cur_b: [DFF<Bits<32>>; 2],
-    received: [DFF<Bits<4>>; 2],
+    cur_kind: [DFF<Bits<2>>; TEST_BUFFERS],
+    cur_thread: [DFF<Bits<5>>; TEST_BUFFERS],
+    cur_a: [DFF<Bits<32>>; TEST_BUFFERS],
+    cur_b: [DFF<Bits<32>>; TEST_BUFFERS],
+    received: [DFF<Bits<4>>; TEST_BUFFERS],
     /// A word of bank 2, of bank 3 arrives for each buffer this clock.
-    a_here: [Signal<Local, Bit>; 2],
-    b_here: [Signal<Local, Bit>; 2],
+    a_here: [Signal<Local, Bit>; TEST_BUFFERS],
+    b_here: [Signal<Local, Bit>; TEST_BUFFERS],
     a_issued: DFF<Bits<4>>,
     b_issued: DFF<Bits<4>>,
     seq: DFF<Bits<5>>,
-    words: [DFF<Bits<W>>; 24],
+    /// Word k of the triangle in each buffer (distributed RAM addressed by the buffer: the
+    /// launch reads its buffer's 12 words at once).
+    words: [LutRam<Bits<W>, 2>; 12],
     fetch_a: Signal<Local, Bits<32>>,
+    /// The fetch requests its buffer's last words this clock.
+    fetch_ends: Signal<Local, Bit>,
+    /// The buffer the fetch takes an entry into this clock (`fb`, or the next one as the
+    /// fetch ends).
+    next_fb: Signal<Local, Bits<2>>,
     fb_free: Signal<Local, Bit>,
     l_kind: Signal<Local, Bits<2>>,
     l_thread: Signal<Local, Bits<5>>,
@@ -210,11 +227,12 @@ pub struct TriangleTester<
     l_ready: Signal<Local, Bit>,
     a_take: Signal<Local, Bit>,
     b_take: Signal<Local, Bit>,
-    /// Requests in flight to the banks: `{valid, buffer, word index}` per clock of latency.
-    a_line: [DFF<Bits<5>>; 6],
-    b_line: [DFF<Bits<5>>; 6],
-    a_arrive: Signal<Local, Bits<5>>,
-    b_arrive: Signal<Local, Bits<5>>,
+    /// Requests in flight to the banks: `{valid[5], buffer[4:3], word index[2:0]}` per clock
+    /// of latency.
+    a_line: [DFF<Bits<6>>; 6],
+    b_line: [DFF<Bits<6>>; 6],
+    a_arrive: Signal<Local, Bits<6>>,
+    b_arrive: Signal<Local, Bits<6>>,
     transform_unit: TransformUnit<W, E, M, S, S1, X2, T, P>,
     o_hold: [DFF<Bits<W>>; 3],
     intersect_unit: IntersectUnit<W, E, M, S, S1, X2, T, P, DL>,
@@ -277,7 +295,7 @@ pub struct TriangleTester<
     c_d_pass: Constant<Bits<16>>,
     c_list_of_walk: Constant<Bits<32>>,
     /// Each buffer's number.
-    c_buffer: [Constant<Bit>; 2],
+    c_buffer: [Constant<Bits<2>>; TEST_BUFFERS],
     c_hit_flag: Constant<Bits<33>>,
     c_cmd_list: Constant<Bits<2>>,
     c_cmd_init: Constant<Bits<2>>,
@@ -391,6 +409,8 @@ impl<
             a_here: Default::default(),
             b_here: Default::default(),
             fetch_a: Default::default(),
+            fetch_ends: Default::default(),
+            next_fb: Default::default(),
             fb_free: Default::default(),
             l_kind: Default::default(),
             l_thread: Default::default(),
@@ -401,7 +421,7 @@ impl<
             b_issued: Default::default(),
             received: Default::default(),
             seq: Default::default(),
-            words: Default::default(),
+            words: std::array::from_fn(|_| LutRam::new(Default::default())),
             a_take: Default::default(),
             b_take: Default::default(),
             a_line: Default::default(),
@@ -446,7 +466,7 @@ impl<
             c_infinity: const_bits::<W>(u64::from(f.infinity(false))),
             c_d_pass: Constant::new((1u64 << 13).into()),
             c_list_of_walk: Constant::new(LIST_OF_WALK.into()),
-            c_buffer: [Constant::new(false), Constant::new(true)],
+            c_buffer: std::array::from_fn(|k| Constant::new((k as u64).into())),
             c_hit_flag: Constant::new((1u64 << 32).into()),
             c_cmd_list: Constant::new(CMD_LIST.into()),
             c_cmd_init: Constant::new(CMD_INIT.into()),
@@ -550,11 +570,12 @@ impl<
         self.flight_a.write_clock.next = self.clock.val();
         self.flight_b.read_clock.next = self.clock.val();
         self.flight_b.write_clock.next = self.clock.val();
-        for k in 0..24 {
-            self.words[k].clock.next = self.clock.val();
-            self.words[k].d.next = self.words[k].q.val();
+        for k in 0..12 {
+            self.words[k].write_clock.next = self.clock.val();
+            self.words[k].write_enable.next = false;
+            self.words[k].read_address.next = self.lb.q.val();
         }
-        for k in 0..2 {
+        for k in 0..4 {
             self.loaded[k].clock.next = self.clock.val();
             self.loaded[k].d.next = self.loaded[k].q.val();
             self.cur_kind[k].clock.next = self.clock.val();
@@ -649,8 +670,10 @@ impl<
         self.a_words.addr.next = self.engine.load_addr.val();
         self.b_words.addr.next = self.engine.load_addr.val();
         self.fetch_a.next = self.cur_a[0].q.val();
-        if self.fb.q.val() {
-            self.fetch_a.next = self.cur_a[1].q.val();
+        for k in 1..4 {
+            if self.fb.q.val() == self.c_buffer[k].val() {
+                self.fetch_a.next = self.cur_a[k].q.val();
+            }
         }
         if self.a_take.val() {
             self.a_words.addr.next = (self.fetch_a.val().get_bits::<24>(0) << 3)
@@ -663,29 +686,37 @@ impl<
             self.b_issued.d.next = self.b_issued.q.val() + 1;
         }
         // Requests in flight: `{valid, buffer, word index}`.
-        self.a_line[0].d.next = (bit_cast::<5, 1>(self.a_take.val().into()) << 4)
-            | (bit_cast::<5, 1>(self.fb.q.val().into()) << 3)
-            | bit_cast::<5, 3>(self.a_issued.q.val().get_bits::<3>(0));
-        self.b_line[0].d.next = (bit_cast::<5, 1>(self.b_take.val().into()) << 4)
-            | (bit_cast::<5, 1>(self.fb.q.val().into()) << 3)
-            | bit_cast::<5, 3>(self.b_issued.q.val().get_bits::<3>(0));
+        self.a_line[0].d.next = (bit_cast::<6, 1>(self.a_take.val().into()) << 5)
+            | (bit_cast::<6, 2>(self.fb.q.val()) << 3)
+            | bit_cast::<6, 3>(self.a_issued.q.val().get_bits::<3>(0));
+        self.b_line[0].d.next = (bit_cast::<6, 1>(self.b_take.val().into()) << 5)
+            | (bit_cast::<6, 2>(self.fb.q.val()) << 3)
+            | bit_cast::<6, 3>(self.b_issued.q.val().get_bits::<3>(0));
         for k in 1..6 {
             self.a_line[k].d.next = self.a_line[k - 1].q.val();
             self.b_line[k].d.next = self.b_line[k - 1].q.val();
         }
-        // The fetch is done with the buffer once its last words are requested.
-        if self.fetching.q.val()
+        // The fetch is done with the buffer once its last words are requested; the next
+        // entry is taken into the next buffer in that same clock (6 clocks per test, not 7).
+        self.fetch_ends.next = self.fetching.q.val()
             & ((self.a_issued.q.val() == 6) | (self.a_take.val() & (self.a_issued.q.val() == 5)))
-            & ((self.b_issued.q.val() == 6) | (self.b_take.val() & (self.b_issued.q.val() == 5)))
-        {
+            & ((self.b_issued.q.val() == 6) | (self.b_take.val() & (self.b_issued.q.val() == 5)));
+        self.next_fb.next = self.fb.q.val();
+        if self.fetch_ends.val() {
             self.fetching.d.next = false;
-            self.fb.d.next = !self.fb.q.val();
+            self.next_fb.next = self.fb.q.val() + 1;
+            self.fb.d.next = self.fb.q.val() + 1;
         }
         self.fb_free.next = !self.loaded[0].q.val();
-        if self.fb.q.val() {
-            self.fb_free.next = !self.loaded[1].q.val();
+        for k in 1..4 {
+            if self.next_fb.val() == self.c_buffer[k].val() {
+                self.fb_free.next = !self.loaded[k].q.val();
+            }
         }
-        if (!self.fetching.q.val()) & self.fb_free.val() & self.list_unit.test_valid.val() {
+        if ((!self.fetching.q.val()) | self.fetch_ends.val())
+            & self.fb_free.val()
+            & self.list_unit.test_valid.val()
+        {
             self.list_unit.test_take.next = true;
             self.a_issued.d.next = 0.into();
             self.b_issued.d.next = 0.into();
@@ -695,10 +726,10 @@ impl<
                 self.a_issued.d.next = 6.into();
                 self.b_issued.d.next = 6.into();
                 self.fetching.d.next = false;
-                self.fb.d.next = !self.fb.q.val();
+                self.fb.d.next = self.next_fb.val() + 1;
             }
-            for k in 0..2 {
-                if self.fb.q.val() == self.c_buffer[k].val() {
+            for k in 0..4 {
+                if self.next_fb.val() == self.c_buffer[k].val() {
                     self.loaded[k].d.next = true;
                     self.cur_kind[k].d.next = self.list_unit.test_entry.val().get_bits::<2>(69);
                     self.cur_thread[k].d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
@@ -723,32 +754,20 @@ impl<
             }
         }
         for k in 0..6 {
-            if self.a_arrive.val().get_bit(4)
-                & (bit_cast::<4, 3>(self.a_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
-            {
-                if self.a_arrive.val().get_bit(3) {
-                    self.words[12 + k].d.next = self.a_words.rdata.val().get_bits::<W>(0);
-                } else {
-                    self.words[k].d.next = self.a_words.rdata.val().get_bits::<W>(0);
-                }
-            }
+            self.words[k].write_address.next = self.a_arrive.val().get_bits::<2>(3);
+            self.words[k].write_data.next = self.a_words.rdata.val().get_bits::<W>(0);
+            self.words[k].write_enable.next = self.a_arrive.val().get_bit(5)
+                & (bit_cast::<4, 3>(self.a_arrive.val().get_bits::<3>(0)) == self.c_index[k].val());
+            self.words[6 + k].write_address.next = self.b_arrive.val().get_bits::<2>(3);
+            self.words[6 + k].write_data.next = self.b_words.rdata.val().get_bits::<W>(0);
+            self.words[6 + k].write_enable.next = self.b_arrive.val().get_bit(5)
+                & (bit_cast::<4, 3>(self.b_arrive.val().get_bits::<3>(0)) == self.c_index[k].val());
         }
-        for k in 0..6 {
-            if self.b_arrive.val().get_bit(4)
-                & (bit_cast::<4, 3>(self.b_arrive.val().get_bits::<3>(0)) == self.c_index[k].val())
-            {
-                if self.b_arrive.val().get_bit(3) {
-                    self.words[18 + k].d.next = self.b_words.rdata.val().get_bits::<W>(0);
-                } else {
-                    self.words[6 + k].d.next = self.b_words.rdata.val().get_bits::<W>(0);
-                }
-            }
-        }
-        for k in 0..2 {
-            self.a_here[k].next = self.a_arrive.val().get_bit(4)
-                & (self.a_arrive.val().get_bit(3) == self.c_buffer[k].val());
-            self.b_here[k].next = self.b_arrive.val().get_bit(4)
-                & (self.b_arrive.val().get_bit(3) == self.c_buffer[k].val());
+        for k in 0..4 {
+            self.a_here[k].next = self.a_arrive.val().get_bit(5)
+                & (self.a_arrive.val().get_bits::<2>(3) == self.c_buffer[k].val());
+            self.b_here[k].next = self.b_arrive.val().get_bit(5)
+                & (self.b_arrive.val().get_bits::<2>(3) == self.c_buffer[k].val());
             if self.a_here[k].val() | self.b_here[k].val() {
                 self.received[k].d.next = self.received[k].q.val() + 1;
             }
@@ -765,18 +784,17 @@ impl<
         self.l_a.next = self.cur_a[0].q.val();
         self.l_b.next = self.cur_b[0].q.val();
         self.l_ready.next = self.loaded[0].q.val() & (self.received[0].q.val() == 12);
-        for k in 0..12 {
-            self.transform_unit.m[k].next = self.words[k].q.val();
-        }
-        if self.lb.q.val() {
-            self.l_kind.next = self.cur_kind[1].q.val();
-            self.l_thread.next = self.cur_thread[1].q.val();
-            self.l_a.next = self.cur_a[1].q.val();
-            self.l_b.next = self.cur_b[1].q.val();
-            self.l_ready.next = self.loaded[1].q.val() & (self.received[1].q.val() == 12);
-            for k in 0..12 {
-                self.transform_unit.m[k].next = self.words[12 + k].q.val();
+        for k in 1..4 {
+            if self.lb.q.val() == self.c_buffer[k].val() {
+                self.l_kind.next = self.cur_kind[k].q.val();
+                self.l_thread.next = self.cur_thread[k].q.val();
+                self.l_a.next = self.cur_a[k].q.val();
+                self.l_b.next = self.cur_b[k].q.val();
+                self.l_ready.next = self.loaded[k].q.val() & (self.received[k].q.val() == 12);
             }
+        }
+        for k in 0..12 {
+            self.transform_unit.m[k].next = self.words[k].read_data.val();
         }
         self.ray.ray_thread.next = self.l_thread.val();
         self.ray.t_min_thread.next = self.l_thread.val();
@@ -821,12 +839,12 @@ impl<
             self.lphase.d.next = Launch::Free;
         }
         if self.lphase.q.val() == Launch::Free {
-            for k in 0..2 {
+            for k in 0..4 {
                 if self.lb.q.val() == self.c_buffer[k].val() {
                     self.loaded[k].d.next = false;
                 }
             }
-            self.lb.d.next = !self.lb.q.val();
+            self.lb.d.next = self.lb.q.val() + 1;
             self.lphase.d.next = Launch::Wait;
         }
         // The other clients' request goes from the hold into the unit in a clock the launch
