@@ -735,12 +735,6 @@ impl<
                     self.cur_thread[k].d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
                     self.cur_a[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(32);
                     self.cur_b[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(0);
-                    self.received[k].d.next = 0.into();
-                    if self.list_unit.test_entry.val().get_bits::<2>(69)
-                        != self.c_test_triangle.val()
-                    {
-                        self.received[k].d.next = 12.into();
-                    }
                 }
             }
         }
@@ -783,14 +777,21 @@ impl<
         self.l_thread.next = self.cur_thread[0].q.val();
         self.l_a.next = self.cur_a[0].q.val();
         self.l_b.next = self.cur_b[0].q.val();
-        self.l_ready.next = self.loaded[0].q.val() & (self.received[0].q.val() == 12);
+        // A buffer's word count is cleared as the launch frees it, not at the take: the
+        // take, in the clock of the fetch's last requests, was the critical path through the
+        // count (stops 33 and 38, `b_issued -> received`).
+        self.l_ready.next = self.loaded[0].q.val()
+            & ((self.cur_kind[0].q.val() != self.c_test_triangle.val())
+                | (self.received[0].q.val() == 12));
         for k in 1..4 {
             if self.lb.q.val() == self.c_buffer[k].val() {
                 self.l_kind.next = self.cur_kind[k].q.val();
                 self.l_thread.next = self.cur_thread[k].q.val();
                 self.l_a.next = self.cur_a[k].q.val();
                 self.l_b.next = self.cur_b[k].q.val();
-                self.l_ready.next = self.loaded[k].q.val() & (self.received[k].q.val() == 12);
+                self.l_ready.next = self.loaded[k].q.val()
+                    & ((self.cur_kind[k].q.val() != self.c_test_triangle.val())
+                        | (self.received[k].q.val() == 12));
             }
         }
         for k in 0..12 {
@@ -842,6 +843,7 @@ impl<
             for k in 0..4 {
                 if self.lb.q.val() == self.c_buffer[k].val() {
                     self.loaded[k].d.next = false;
+                    self.received[k].d.next = 0.into();
                 }
             }
             self.lb.d.next = self.lb.q.val() + 1;

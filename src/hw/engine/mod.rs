@@ -313,11 +313,6 @@ pub struct ThreadEngine<
     /// ShadeUnit's in a clock the engine's loads leave them.
     tri_load_addr_r: DFF<Bits<24>>,
     engine_loads_triangles: Signal<Local, Bit>,
-    /// The ShadeUnit reads bank 5 in this clock (it has the shared bus after the engine).
-    shader_frame_read: Signal<Local, Bit>,
-    /// The engine's loads and the ShadeUnit's bank-5 read, one-hot by bank (the tester's
-    /// view: its list reads wait for either).
-    shared_bus_loads: Signal<Local, Bits<{ layout::BANKS }>>,
     /// The ShadeUnit's request goes to the TransformUnit (after ray generation's and instance
     /// entry's).
     gen_shade: Signal<Local, Bit>,
@@ -393,6 +388,8 @@ pub struct ThreadEngine<
     bank_triangles_b: Constant<Bits<3>>,
     /// Banks 2 and 3 as `mem_load_r` bits.
     triangle_banks: Constant<Bits<{ layout::BANKS }>>,
+    /// Bank 5 as a `mem_load_r` bit.
+    frame_bank: Constant<Bits<{ layout::BANKS }>>,
     client_primary: Constant<Bits<2>>,
     client_origin: Constant<Bits<2>>,
     client_normal: Constant<Bits<2>>,
@@ -469,7 +466,7 @@ impl<
             instances: InstanceRays::new(mem_latency, units.contains(&Unit::InstanceEntry)),
             shader: ShadeUnit::new(ShadeConfig {
                 tri_latency: mem_latency + 1,
-                frame_latency: mem_latency,
+                frame_latency: mem_latency + 1,
                 lights: if units.contains(&Unit::Shading) {
                     program.config.light_count
                 } else {
@@ -517,8 +514,6 @@ impl<
             shade_offer: Default::default(),
             tri_load_addr_r: Default::default(),
             engine_loads_triangles: Default::default(),
-            shader_frame_read: Default::default(),
-            shared_bus_loads: Default::default(),
             gen_shade: Default::default(),
             in_frame: Default::default(),
             tri_enqueue: Default::default(),
@@ -581,6 +576,7 @@ impl<
             triangle_banks: Constant::new(
                 ((1u64 << layout::TRIANGLES_A) | (1u64 << layout::TRIANGLES_B)).into(),
             ),
+            frame_bank: Constant::new((1u64 << layout::FRAME).into()),
             client_primary: Constant::new((GenClient::Primary as u64).into()),
             client_origin: Constant::new((GenClient::InstanceOrigin as u64).into()),
             client_normal: Constant::new((GenClient::InstanceNormal as u64).into()),
@@ -825,6 +821,18 @@ impl<
         self.shader.tri_rdata_b.next = self.bank3.rdata.val();
         self.mem_bank_r.d.next = self.decode.bank.val();
         self.mem_addr_r.d.next = self.execute.mem_address.val().get_bits::<24>(0);
+        // Its reads of bank 5 likewise, in a clock without an engine load: a load on the
+        // shared bus a clock later, which the list unit and instance entry see as the
+        // engine's. (Granted on the bus's free clocks, the grant ran from the list unit's
+        // state into the unit's dispatch, 71.4 MHz placed; granted first, from the unit's
+        // dispatch into the list unit's room count, 65.2 MHz.)
+        self.shader.frame_grant.next = self.c_shading.val()
+            & (!(self.decode.valid.val() & (self.decode.op.val() == self.op_ld.val())));
+        if self.shader.frame_read.val() & self.shader.frame_grant.val() {
+            self.mem_load_r.d.next = self.mem_load_r.d.val() | self.frame_bank.val();
+            self.mem_bank_r.d.next = self.bank_frame.val();
+            self.mem_addr_r.d.next = self.shader.frame_addr.val();
+        }
         self.fb_write_r.d.next =
             self.decode.valid.val() & (self.decode.op.val() == self.op_st.val());
         self.fb_addr_r.d.next = self.execute.mem_address.val().get_bits::<24>(0);
@@ -841,31 +849,15 @@ impl<
         self.fb.addr.next = self.fb_addr_r.q.val();
         self.fb.data.next = self.fb_data_r.q.val();
         // Bank 0 goes through the traversal unit's port, banks 2 and 3 through the triangle
-        // tester's; on this bus the engine's loads go first, then the ShadeUnit's reads of
-        // bank 5, the tester's list reads (bank 1), instance entry's reads (bank 4).
-        // The ShadeUnit's reads of bank 5 come after the engine's loads and before the list
-        // reads: its request comes from its registers, so its grant depends on registers alone
-        // (granted after the list unit's read, the grant ran from the list unit's state through
-        // the unit's dispatch: 71.4 MHz placed). The list unit sees such a read as a load.
-        self.shader.frame_grant.next =
-            self.c_shading.val() & ((self.mem_load_r.q.val() & self.shared_banks.val()) == 0);
-        self.shader_frame_read.next = self.shader.frame_read.val() & self.shader.frame_grant.val();
-        self.shared_bus_loads.next = self.mem_load_r.q.val();
-        if self.shader_frame_read.val() {
-            self.shared_bus_loads.next =
-                self.mem_load_r.q.val() | (self.one_bank.val() << self.bank_frame.val());
-        }
+        // tester's; the tester's list reads (bank 1) use this bus when the engine's loads (and
+        // the ShadeUnit's reads of bank 5, made loads above) do not, instance entry's reads
+        // (bank 4) when neither does.
         self.instances.bus_free.next = ((self.mem_load_r.q.val() & self.shared_banks.val()) == 0)
-            & (!self.tester.lists.read.val())
-            & (!self.shader_frame_read.val());
+            & (!self.tester.lists.read.val());
         self.mem.read.next = ((self.mem_load_r.q.val() & self.shared_banks.val()) != 0)
             | self.tester.lists.read.val()
-            | self.instances.read.val()
-            | self.shader_frame_read.val();
-        if self.shader_frame_read.val() {
-            self.mem.bank.next = self.bank_frame.val();
-            self.mem.addr.next = self.shader.frame_addr.val();
-        } else if self.tester.lists.read.val() {
+            | self.instances.read.val();
+        if self.tester.lists.read.val() {
             self.mem.bank.next = self.bank_lists.val();
             self.mem.addr.next = self.tester.lists.addr.val();
         } else if self.instances.read.val() {
@@ -949,7 +941,7 @@ impl<
         self.traversal_unit.engine.ray_pair.next = self.decode.imm.val().get_bits::<2>(0);
         self.traversal_unit.engine.ray_write.next =
             self.ray_write.q.val() & (!self.store_write.val());
-        self.tester.engine.load_banks.next = self.shared_bus_loads.val();
+        self.tester.engine.load_banks.next = self.mem_load_r.q.val();
         self.tester.engine.load_addr.next = self.tri_load_addr_r.q.val();
         self.tester.engine.thread.next = self.decode.thread.val();
         self.tester.engine.word_a.next = self.decode.a.val();
