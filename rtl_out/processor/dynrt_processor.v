@@ -718,6 +718,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     localparam  bank_triangles_a = 3'b10;
     localparam  bank_triangles_b = 3'b11;
     localparam  triangle_banks = 6'b1100;
+    localparam  frame_bank = 6'b100000;
     localparam  client_primary = 2'b0;
     localparam  client_origin = 2'b1;
     localparam  client_normal = 2'b10;
@@ -2207,6 +2208,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         shader__tri_rdata_b = bank3_rdata;
         mem_bank_r__d = decode__bank;
         mem_addr_r__d = execute__mem_address[(32'h0)+:(24)];
+        shader__frame_grant = c_shading & (~(decode__valid & (decode__op == op_ld)));
+        if (shader__frame_read & shader__frame_grant) begin
+            mem_load_r__d = mem_load_r__d | frame_bank;
+            mem_bank_r__d = bank_frame;
+            mem_addr_r__d = shader__frame_addr;
+        end
         fb_write_r__d = decode__valid & (decode__op == op_st);
         fb_addr_r__d = execute__mem_address[(32'h0)+:(24)];
         fb_data_r__d = decode__store;
@@ -2220,8 +2227,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         fb_addr = fb_addr_r__q;
         fb_data = fb_data_r__q;
         instances__bus_free = ((mem_load_r__q & shared_banks) == 32'h0) & (~tester__lists__read);
-        shader__frame_grant = c_shading & ((mem_load_r__q & shared_banks) == 32'h0) & (~tester__lists__read) & (~instances__read);
-        mem_read = ((mem_load_r__q & shared_banks) != 32'h0) | tester__lists__read | instances__read | (shader__frame_read & shader__frame_grant);
+        mem_read = ((mem_load_r__q & shared_banks) != 32'h0) | tester__lists__read | instances__read;
         if (tester__lists__read) begin
             mem_bank = bank_lists;
             mem_addr = tester__lists__addr;
@@ -2229,10 +2235,6 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         else if (instances__read) begin
             mem_bank = bank_instances;
             mem_addr = instances__addr;
-        end
-        else if (shader__frame_read & shader__frame_grant) begin
-            mem_bank = bank_frame;
-            mem_addr = shader__frame_addr;
         end
         else begin
             mem_bank = mem_bank_r__q;
@@ -17245,6 +17247,21 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  [2:0] gen_hold_slot__d;
     wire  [2:0] gen_hold_slot__q;
     reg  gen_hold_slot__clock;
+    reg  res_valid_r__d;
+    wire  res_valid_r__q;
+    reg  res_valid_r__clock;
+    reg  [2:0] res_slot_r__d;
+    wire  [2:0] res_slot_r__q;
+    reg  res_slot_r__clock;
+    reg  [23:0] res_v_r__0__d;
+    wire  [23:0] res_v_r__0__q;
+    reg  res_v_r__0__clock;
+    reg  [23:0] res_v_r__1__d;
+    wire  [23:0] res_v_r__1__q;
+    reg  res_v_r__1__clock;
+    reg  [23:0] res_v_r__2__d;
+    wire  [23:0] res_v_r__2__q;
+    reg  res_v_r__2__clock;
     reg  tri_line__clock;
     reg  [8:0] tri_line__data_in;
     wire  [8:0] tri_line__data_out;
@@ -18135,7 +18152,32 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(gen_hold_slot__q),
         .clock(gen_hold_slot__clock)
     );
-    dynrt_processor__engine__shader__tri_line tri_line(
+    dynrt_processor__display__dark_d res_valid_r(
+        .d(res_valid_r__d),
+        .q(res_valid_r__q),
+        .clock(res_valid_r__clock)
+    );
+    dynrt_processor__engine__mem_bank_r res_slot_r(
+        .d(res_slot_r__d),
+        .q(res_slot_r__q),
+        .clock(res_slot_r__clock)
+    );
+    dynrt_processor__display__rgb_q res_v_r__0(
+        .d(res_v_r__0__d),
+        .q(res_v_r__0__q),
+        .clock(res_v_r__0__clock)
+    );
+    dynrt_processor__display__rgb_q res_v_r__1(
+        .d(res_v_r__1__d),
+        .q(res_v_r__1__q),
+        .clock(res_v_r__1__clock)
+    );
+    dynrt_processor__display__rgb_q res_v_r__2(
+        .d(res_v_r__2__d),
+        .q(res_v_r__2__q),
+        .clock(res_v_r__2__clock)
+    );
+    dynrt_processor__engine__shader__frame_line tri_line(
         .clock(tri_line__clock),
         .data_in(tri_line__data_in),
         .data_out(tri_line__data_out)
@@ -18994,83 +19036,93 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 loading__d = 1'b0;
             end
         end
+        res_valid_r__clock = clock;
+        res_valid_r__d = res_valid;
+        res_slot_r__clock = clock;
+        res_slot_r__d = res_slot;
+        res_v_r__0__clock = clock;
+        res_v_r__0__d = res_v__0;
+        res_v_r__1__clock = clock;
+        res_v_r__1__d = res_v__1;
+        res_v_r__2__clock = clock;
+        res_v_r__2__d = res_v__2;
         res_step = ShadeStep__Idle;
         res_light = 32'h0;
-        if (res_slot == c_slot__0) begin
+        if (res_slot_r__q == c_slot__0) begin
             res_step = step__0__q;
             res_light = light__0__q;
         end
-        if (res_slot == c_slot__1) begin
+        if (res_slot_r__q == c_slot__1) begin
             res_step = step__1__q;
             res_light = light__1__q;
         end
-        if (res_slot == c_slot__2) begin
+        if (res_slot_r__q == c_slot__2) begin
             res_step = step__2__q;
             res_light = light__2__q;
         end
-        if (res_slot == c_slot__3) begin
+        if (res_slot_r__q == c_slot__3) begin
             res_step = step__3__q;
             res_light = light__3__q;
         end
-        if (res_slot == c_slot__4) begin
+        if (res_slot_r__q == c_slot__4) begin
             res_step = step__4__q;
             res_light = light__4__q;
         end
-        if (res_slot == c_slot__5) begin
+        if (res_slot_r__q == c_slot__5) begin
             res_step = step__5__q;
             res_light = light__5__q;
         end
-        if (res_slot == c_slot__6) begin
+        if (res_slot_r__q == c_slot__6) begin
             res_step = step__6__q;
             res_light = light__6__q;
         end
-        if (res_slot == c_slot__7) begin
+        if (res_slot_r__q == c_slot__7) begin
             res_step = step__7__q;
             res_light = light__7__q;
         end
-        res_positive = (~|(res_v__0 & c_sign)) & |(res_v__0 & c_exp_mask) & (~(((res_v__0 & c_exp_mask) == c_exp_mask) & |(res_v__0 & c_man_mask)));
-        p__0__write_address = res_slot;
-        p__0__write_data = res_v__0;
-        p__0__write_enable = res_valid & (res_step == ShadeStep__Point);
-        acc__0__write_address = res_slot;
-        acc__0__write_data = res_v__0;
-        acc__0__write_enable = res_valid & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
-        to_light__0__write_address = res_slot;
-        to_light__0__write_data = res_v__0;
-        to_light__0__write_enable = res_valid & (res_step == ShadeStep__ToLight);
-        tint__0__write_address = res_slot;
-        tint__0__write_data = res_v__0;
-        tint__0__write_enable = res_valid & (res_step == ShadeStep__Tint);
-        p__1__write_address = res_slot;
-        p__1__write_data = res_v__1;
-        p__1__write_enable = res_valid & (res_step == ShadeStep__Point);
-        acc__1__write_address = res_slot;
-        acc__1__write_data = res_v__1;
-        acc__1__write_enable = res_valid & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
-        to_light__1__write_address = res_slot;
-        to_light__1__write_data = res_v__1;
-        to_light__1__write_enable = res_valid & (res_step == ShadeStep__ToLight);
-        tint__1__write_address = res_slot;
-        tint__1__write_data = res_v__1;
-        tint__1__write_enable = res_valid & (res_step == ShadeStep__Tint);
-        p__2__write_address = res_slot;
-        p__2__write_data = res_v__2;
-        p__2__write_enable = res_valid & (res_step == ShadeStep__Point);
-        acc__2__write_address = res_slot;
-        acc__2__write_data = res_v__2;
-        acc__2__write_enable = res_valid & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
-        to_light__2__write_address = res_slot;
-        to_light__2__write_data = res_v__2;
-        to_light__2__write_enable = res_valid & (res_step == ShadeStep__ToLight);
-        tint__2__write_address = res_slot;
-        tint__2__write_data = res_v__2;
-        tint__2__write_enable = res_valid & (res_step == ShadeStep__Tint);
-        n_dot_l__write_address = res_slot;
-        n_dot_l__write_data = res_v__0;
-        n_dot_l__write_enable = res_valid & (res_step == ShadeStep__Dots);
-        l_dot_l__write_address = res_slot;
-        l_dot_l__write_data = res_v__1;
-        l_dot_l__write_enable = res_valid & (res_step == ShadeStep__Dots);
+        res_positive = (~|(res_v_r__0__q & c_sign)) & |(res_v_r__0__q & c_exp_mask) & (~(((res_v_r__0__q & c_exp_mask) == c_exp_mask) & |(res_v_r__0__q & c_man_mask)));
+        p__0__write_address = res_slot_r__q;
+        p__0__write_data = res_v_r__0__q;
+        p__0__write_enable = res_valid_r__q & (res_step == ShadeStep__Point);
+        acc__0__write_address = res_slot_r__q;
+        acc__0__write_data = res_v_r__0__q;
+        acc__0__write_enable = res_valid_r__q & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
+        to_light__0__write_address = res_slot_r__q;
+        to_light__0__write_data = res_v_r__0__q;
+        to_light__0__write_enable = res_valid_r__q & (res_step == ShadeStep__ToLight);
+        tint__0__write_address = res_slot_r__q;
+        tint__0__write_data = res_v_r__0__q;
+        tint__0__write_enable = res_valid_r__q & (res_step == ShadeStep__Tint);
+        p__1__write_address = res_slot_r__q;
+        p__1__write_data = res_v_r__1__q;
+        p__1__write_enable = res_valid_r__q & (res_step == ShadeStep__Point);
+        acc__1__write_address = res_slot_r__q;
+        acc__1__write_data = res_v_r__1__q;
+        acc__1__write_enable = res_valid_r__q & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
+        to_light__1__write_address = res_slot_r__q;
+        to_light__1__write_data = res_v_r__1__q;
+        to_light__1__write_enable = res_valid_r__q & (res_step == ShadeStep__ToLight);
+        tint__1__write_address = res_slot_r__q;
+        tint__1__write_data = res_v_r__1__q;
+        tint__1__write_enable = res_valid_r__q & (res_step == ShadeStep__Tint);
+        p__2__write_address = res_slot_r__q;
+        p__2__write_data = res_v_r__2__q;
+        p__2__write_enable = res_valid_r__q & (res_step == ShadeStep__Point);
+        acc__2__write_address = res_slot_r__q;
+        acc__2__write_data = res_v_r__2__q;
+        acc__2__write_enable = res_valid_r__q & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
+        to_light__2__write_address = res_slot_r__q;
+        to_light__2__write_data = res_v_r__2__q;
+        to_light__2__write_enable = res_valid_r__q & (res_step == ShadeStep__ToLight);
+        tint__2__write_address = res_slot_r__q;
+        tint__2__write_data = res_v_r__2__q;
+        tint__2__write_enable = res_valid_r__q & (res_step == ShadeStep__Tint);
+        n_dot_l__write_address = res_slot_r__q;
+        n_dot_l__write_data = res_v_r__0__q;
+        n_dot_l__write_enable = res_valid_r__q & (res_step == ShadeStep__Dots);
+        l_dot_l__write_address = res_slot_r__q;
+        l_dot_l__write_data = res_v_r__1__q;
+        l_dot_l__write_enable = res_valid_r__q & (res_step == ShadeStep__Dots);
         div__in_valid = sqrt__out_valid;
         div__a = cos_n_dot_l__data_out;
         div__b = sqrt__result;
@@ -19113,7 +19165,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__0__d = 1'b1;
             step__0__d = ShadeStep__Ambient;
         end
-        if (res_valid & (res_slot == c_slot__0)) begin
+        if (res_valid_r__q & (res_slot_r__q == c_slot__0)) begin
             ready__0__d = 1'b1;
             if (res_step == ShadeStep__Point) begin
                 step__0__d = ShadeStep__NormalDot;
@@ -19179,7 +19231,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__1__d = 1'b1;
             step__1__d = ShadeStep__Ambient;
         end
-        if (res_valid & (res_slot == c_slot__1)) begin
+        if (res_valid_r__q & (res_slot_r__q == c_slot__1)) begin
             ready__1__d = 1'b1;
             if (res_step == ShadeStep__Point) begin
                 step__1__d = ShadeStep__NormalDot;
@@ -19245,7 +19297,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__2__d = 1'b1;
             step__2__d = ShadeStep__Ambient;
         end
-        if (res_valid & (res_slot == c_slot__2)) begin
+        if (res_valid_r__q & (res_slot_r__q == c_slot__2)) begin
             ready__2__d = 1'b1;
             if (res_step == ShadeStep__Point) begin
                 step__2__d = ShadeStep__NormalDot;
@@ -19311,7 +19363,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__3__d = 1'b1;
             step__3__d = ShadeStep__Ambient;
         end
-        if (res_valid & (res_slot == c_slot__3)) begin
+        if (res_valid_r__q & (res_slot_r__q == c_slot__3)) begin
             ready__3__d = 1'b1;
             if (res_step == ShadeStep__Point) begin
                 step__3__d = ShadeStep__NormalDot;
@@ -19377,7 +19429,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__4__d = 1'b1;
             step__4__d = ShadeStep__Ambient;
         end
-        if (res_valid & (res_slot == c_slot__4)) begin
+        if (res_valid_r__q & (res_slot_r__q == c_slot__4)) begin
             ready__4__d = 1'b1;
             if (res_step == ShadeStep__Point) begin
                 step__4__d = ShadeStep__NormalDot;
@@ -19443,7 +19495,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__5__d = 1'b1;
             step__5__d = ShadeStep__Ambient;
         end
-        if (res_valid & (res_slot == c_slot__5)) begin
+        if (res_valid_r__q & (res_slot_r__q == c_slot__5)) begin
             ready__5__d = 1'b1;
             if (res_step == ShadeStep__Point) begin
                 step__5__d = ShadeStep__NormalDot;
@@ -19509,7 +19561,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__6__d = 1'b1;
             step__6__d = ShadeStep__Ambient;
         end
-        if (res_valid & (res_slot == c_slot__6)) begin
+        if (res_valid_r__q & (res_slot_r__q == c_slot__6)) begin
             ready__6__d = 1'b1;
             if (res_step == ShadeStep__Point) begin
                 step__6__d = ShadeStep__NormalDot;
@@ -19575,7 +19627,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__7__d = 1'b1;
             step__7__d = ShadeStep__Ambient;
         end
-        if (res_valid & (res_slot == c_slot__7)) begin
+        if (res_valid_r__q & (res_slot_r__q == c_slot__7)) begin
             ready__7__d = 1'b1;
             if (res_step == ShadeStep__Point) begin
                 step__7__d = ShadeStep__NormalDot;
@@ -21028,6 +21080,9 @@ module dynrt_processor__engine__shader__frame_line(clock,data_in,data_out);
     reg  [8:0] stage__1__d;
     wire  [8:0] stage__1__q;
     reg  stage__1__clock;
+    reg  [8:0] stage__2__d;
+    wire  [8:0] stage__2__q;
+    reg  stage__2__clock;
     
     // Sub module instances
     dynrt_processor__engine__fp_units__add__lz stage__0(
@@ -21040,17 +21095,36 @@ module dynrt_processor__engine__shader__frame_line(clock,data_in,data_out);
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
+    dynrt_processor__engine__fp_units__add__lz stage__2(
+        .d(stage__2__d),
+        .q(stage__2__q),
+        .clock(stage__2__clock)
+    );
     
     // Update code
     always @(*) begin
         stage__0__clock = clock;
         stage__1__clock = clock;
+        stage__2__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
-        data_out = stage__1__q;
+        stage__2__d = stage__1__q;
+        data_out = stage__2__q;
     end
     
 endmodule // dynrt_processor__engine__shader__frame_line
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -21625,53 +21699,6 @@ endmodule // dynrt_processor__engine__shader__s1_step
 
 
 
-module dynrt_processor__engine__shader__tri_line(clock,data_in,data_out);
-    
-    // Module arguments
-    input wire  clock;
-    input wire  [8:0] data_in;
-    output reg  [8:0] data_out;
-    
-    // Stub signals
-    reg  [8:0] stage__0__d;
-    wire  [8:0] stage__0__q;
-    reg  stage__0__clock;
-    reg  [8:0] stage__1__d;
-    wire  [8:0] stage__1__q;
-    reg  stage__1__clock;
-    reg  [8:0] stage__2__d;
-    wire  [8:0] stage__2__q;
-    reg  stage__2__clock;
-    
-    // Sub module instances
-    dynrt_processor__engine__fp_units__add__lz stage__0(
-        .d(stage__0__d),
-        .q(stage__0__q),
-        .clock(stage__0__clock)
-    );
-    dynrt_processor__engine__fp_units__add__lz stage__1(
-        .d(stage__1__d),
-        .q(stage__1__q),
-        .clock(stage__1__clock)
-    );
-    dynrt_processor__engine__fp_units__add__lz stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
-    
-    // Update code
-    always @(*) begin
-        stage__0__clock = clock;
-        stage__1__clock = clock;
-        stage__2__clock = clock;
-        stage__0__d = data_in;
-        stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        data_out = stage__2__q;
-    end
-    
-endmodule // dynrt_processor__engine__shader__tri_line
 
 
 
@@ -21782,8 +21809,10 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     localparam  c_infinity = 24'h7f0000;
     localparam  c_d_pass = 16'h2000;
     localparam  c_list_of_walk = 32'h80000000;
-    localparam  c_buffer__0 = 1'b0;
-    localparam  c_buffer__1 = 1'b1;
+    localparam  c_buffer__0 = 2'b0;
+    localparam  c_buffer__1 = 2'b1;
+    localparam  c_buffer__2 = 2'b10;
+    localparam  c_buffer__3 = 2'b11;
     localparam  c_hit_flag = 33'h100000000;
     localparam  c_cmd_list = 2'b0;
     localparam  c_cmd_init = 2'b1;
@@ -21912,11 +21941,11 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  fetching__d;
     wire  fetching__q;
     reg  fetching__clock;
-    reg  fb__d;
-    wire  fb__q;
+    reg  [1:0] fb__d;
+    wire  [1:0] fb__q;
     reg  fb__clock;
-    reg  lb__d;
-    wire  lb__q;
+    reg  [1:0] lb__d;
+    wire  [1:0] lb__q;
     reg  lb__clock;
     reg  [1:0] lphase__d;
     wire  [1:0] lphase__q;
@@ -21927,36 +21956,72 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  loaded__1__d;
     wire  loaded__1__q;
     reg  loaded__1__clock;
+    reg  loaded__2__d;
+    wire  loaded__2__q;
+    reg  loaded__2__clock;
+    reg  loaded__3__d;
+    wire  loaded__3__q;
+    reg  loaded__3__clock;
     reg  [1:0] cur_kind__0__d;
     wire  [1:0] cur_kind__0__q;
     reg  cur_kind__0__clock;
     reg  [1:0] cur_kind__1__d;
     wire  [1:0] cur_kind__1__q;
     reg  cur_kind__1__clock;
+    reg  [1:0] cur_kind__2__d;
+    wire  [1:0] cur_kind__2__q;
+    reg  cur_kind__2__clock;
+    reg  [1:0] cur_kind__3__d;
+    wire  [1:0] cur_kind__3__q;
+    reg  cur_kind__3__clock;
     reg  [4:0] cur_thread__0__d;
     wire  [4:0] cur_thread__0__q;
     reg  cur_thread__0__clock;
     reg  [4:0] cur_thread__1__d;
     wire  [4:0] cur_thread__1__q;
     reg  cur_thread__1__clock;
+    reg  [4:0] cur_thread__2__d;
+    wire  [4:0] cur_thread__2__q;
+    reg  cur_thread__2__clock;
+    reg  [4:0] cur_thread__3__d;
+    wire  [4:0] cur_thread__3__q;
+    reg  cur_thread__3__clock;
     reg  [31:0] cur_a__0__d;
     wire  [31:0] cur_a__0__q;
     reg  cur_a__0__clock;
     reg  [31:0] cur_a__1__d;
     wire  [31:0] cur_a__1__q;
     reg  cur_a__1__clock;
+    reg  [31:0] cur_a__2__d;
+    wire  [31:0] cur_a__2__q;
+    reg  cur_a__2__clock;
+    reg  [31:0] cur_a__3__d;
+    wire  [31:0] cur_a__3__q;
+    reg  cur_a__3__clock;
     reg  [31:0] cur_b__0__d;
     wire  [31:0] cur_b__0__q;
     reg  cur_b__0__clock;
     reg  [31:0] cur_b__1__d;
     wire  [31:0] cur_b__1__q;
     reg  cur_b__1__clock;
+    reg  [31:0] cur_b__2__d;
+    wire  [31:0] cur_b__2__q;
+    reg  cur_b__2__clock;
+    reg  [31:0] cur_b__3__d;
+    wire  [31:0] cur_b__3__q;
+    reg  cur_b__3__clock;
     reg  [3:0] received__0__d;
     wire  [3:0] received__0__q;
     reg  received__0__clock;
     reg  [3:0] received__1__d;
     wire  [3:0] received__1__q;
     reg  received__1__clock;
+    reg  [3:0] received__2__d;
+    wire  [3:0] received__2__q;
+    reg  received__2__clock;
+    reg  [3:0] received__3__d;
+    wire  [3:0] received__3__q;
+    reg  received__3__clock;
     reg  [3:0] a_issued__d;
     wire  [3:0] a_issued__q;
     reg  a_issued__clock;
@@ -21966,113 +22031,113 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [4:0] seq__d;
     wire  [4:0] seq__q;
     reg  seq__clock;
-    reg  [23:0] words__0__d;
-    wire  [23:0] words__0__q;
-    reg  words__0__clock;
-    reg  [23:0] words__1__d;
-    wire  [23:0] words__1__q;
-    reg  words__1__clock;
-    reg  [23:0] words__2__d;
-    wire  [23:0] words__2__q;
-    reg  words__2__clock;
-    reg  [23:0] words__3__d;
-    wire  [23:0] words__3__q;
-    reg  words__3__clock;
-    reg  [23:0] words__4__d;
-    wire  [23:0] words__4__q;
-    reg  words__4__clock;
-    reg  [23:0] words__5__d;
-    wire  [23:0] words__5__q;
-    reg  words__5__clock;
-    reg  [23:0] words__6__d;
-    wire  [23:0] words__6__q;
-    reg  words__6__clock;
-    reg  [23:0] words__7__d;
-    wire  [23:0] words__7__q;
-    reg  words__7__clock;
-    reg  [23:0] words__8__d;
-    wire  [23:0] words__8__q;
-    reg  words__8__clock;
-    reg  [23:0] words__9__d;
-    wire  [23:0] words__9__q;
-    reg  words__9__clock;
-    reg  [23:0] words__10__d;
-    wire  [23:0] words__10__q;
-    reg  words__10__clock;
-    reg  [23:0] words__11__d;
-    wire  [23:0] words__11__q;
-    reg  words__11__clock;
-    reg  [23:0] words__12__d;
-    wire  [23:0] words__12__q;
-    reg  words__12__clock;
-    reg  [23:0] words__13__d;
-    wire  [23:0] words__13__q;
-    reg  words__13__clock;
-    reg  [23:0] words__14__d;
-    wire  [23:0] words__14__q;
-    reg  words__14__clock;
-    reg  [23:0] words__15__d;
-    wire  [23:0] words__15__q;
-    reg  words__15__clock;
-    reg  [23:0] words__16__d;
-    wire  [23:0] words__16__q;
-    reg  words__16__clock;
-    reg  [23:0] words__17__d;
-    wire  [23:0] words__17__q;
-    reg  words__17__clock;
-    reg  [23:0] words__18__d;
-    wire  [23:0] words__18__q;
-    reg  words__18__clock;
-    reg  [23:0] words__19__d;
-    wire  [23:0] words__19__q;
-    reg  words__19__clock;
-    reg  [23:0] words__20__d;
-    wire  [23:0] words__20__q;
-    reg  words__20__clock;
-    reg  [23:0] words__21__d;
-    wire  [23:0] words__21__q;
-    reg  words__21__clock;
-    reg  [23:0] words__22__d;
-    wire  [23:0] words__22__q;
-    reg  words__22__clock;
-    reg  [23:0] words__23__d;
-    wire  [23:0] words__23__q;
-    reg  words__23__clock;
-    reg  [4:0] a_line__0__d;
-    wire  [4:0] a_line__0__q;
+    reg  [1:0] words__0__read_address;
+    wire  [23:0] words__0__read_data;
+    reg  words__0__write_clock;
+    reg  [1:0] words__0__write_address;
+    reg  [23:0] words__0__write_data;
+    reg  words__0__write_enable;
+    reg  [1:0] words__1__read_address;
+    wire  [23:0] words__1__read_data;
+    reg  words__1__write_clock;
+    reg  [1:0] words__1__write_address;
+    reg  [23:0] words__1__write_data;
+    reg  words__1__write_enable;
+    reg  [1:0] words__2__read_address;
+    wire  [23:0] words__2__read_data;
+    reg  words__2__write_clock;
+    reg  [1:0] words__2__write_address;
+    reg  [23:0] words__2__write_data;
+    reg  words__2__write_enable;
+    reg  [1:0] words__3__read_address;
+    wire  [23:0] words__3__read_data;
+    reg  words__3__write_clock;
+    reg  [1:0] words__3__write_address;
+    reg  [23:0] words__3__write_data;
+    reg  words__3__write_enable;
+    reg  [1:0] words__4__read_address;
+    wire  [23:0] words__4__read_data;
+    reg  words__4__write_clock;
+    reg  [1:0] words__4__write_address;
+    reg  [23:0] words__4__write_data;
+    reg  words__4__write_enable;
+    reg  [1:0] words__5__read_address;
+    wire  [23:0] words__5__read_data;
+    reg  words__5__write_clock;
+    reg  [1:0] words__5__write_address;
+    reg  [23:0] words__5__write_data;
+    reg  words__5__write_enable;
+    reg  [1:0] words__6__read_address;
+    wire  [23:0] words__6__read_data;
+    reg  words__6__write_clock;
+    reg  [1:0] words__6__write_address;
+    reg  [23:0] words__6__write_data;
+    reg  words__6__write_enable;
+    reg  [1:0] words__7__read_address;
+    wire  [23:0] words__7__read_data;
+    reg  words__7__write_clock;
+    reg  [1:0] words__7__write_address;
+    reg  [23:0] words__7__write_data;
+    reg  words__7__write_enable;
+    reg  [1:0] words__8__read_address;
+    wire  [23:0] words__8__read_data;
+    reg  words__8__write_clock;
+    reg  [1:0] words__8__write_address;
+    reg  [23:0] words__8__write_data;
+    reg  words__8__write_enable;
+    reg  [1:0] words__9__read_address;
+    wire  [23:0] words__9__read_data;
+    reg  words__9__write_clock;
+    reg  [1:0] words__9__write_address;
+    reg  [23:0] words__9__write_data;
+    reg  words__9__write_enable;
+    reg  [1:0] words__10__read_address;
+    wire  [23:0] words__10__read_data;
+    reg  words__10__write_clock;
+    reg  [1:0] words__10__write_address;
+    reg  [23:0] words__10__write_data;
+    reg  words__10__write_enable;
+    reg  [1:0] words__11__read_address;
+    wire  [23:0] words__11__read_data;
+    reg  words__11__write_clock;
+    reg  [1:0] words__11__write_address;
+    reg  [23:0] words__11__write_data;
+    reg  words__11__write_enable;
+    reg  [5:0] a_line__0__d;
+    wire  [5:0] a_line__0__q;
     reg  a_line__0__clock;
-    reg  [4:0] a_line__1__d;
-    wire  [4:0] a_line__1__q;
+    reg  [5:0] a_line__1__d;
+    wire  [5:0] a_line__1__q;
     reg  a_line__1__clock;
-    reg  [4:0] a_line__2__d;
-    wire  [4:0] a_line__2__q;
+    reg  [5:0] a_line__2__d;
+    wire  [5:0] a_line__2__q;
     reg  a_line__2__clock;
-    reg  [4:0] a_line__3__d;
-    wire  [4:0] a_line__3__q;
+    reg  [5:0] a_line__3__d;
+    wire  [5:0] a_line__3__q;
     reg  a_line__3__clock;
-    reg  [4:0] a_line__4__d;
-    wire  [4:0] a_line__4__q;
+    reg  [5:0] a_line__4__d;
+    wire  [5:0] a_line__4__q;
     reg  a_line__4__clock;
-    reg  [4:0] a_line__5__d;
-    wire  [4:0] a_line__5__q;
+    reg  [5:0] a_line__5__d;
+    wire  [5:0] a_line__5__q;
     reg  a_line__5__clock;
-    reg  [4:0] b_line__0__d;
-    wire  [4:0] b_line__0__q;
+    reg  [5:0] b_line__0__d;
+    wire  [5:0] b_line__0__q;
     reg  b_line__0__clock;
-    reg  [4:0] b_line__1__d;
-    wire  [4:0] b_line__1__q;
+    reg  [5:0] b_line__1__d;
+    wire  [5:0] b_line__1__q;
     reg  b_line__1__clock;
-    reg  [4:0] b_line__2__d;
-    wire  [4:0] b_line__2__q;
+    reg  [5:0] b_line__2__d;
+    wire  [5:0] b_line__2__q;
     reg  b_line__2__clock;
-    reg  [4:0] b_line__3__d;
-    wire  [4:0] b_line__3__q;
+    reg  [5:0] b_line__3__d;
+    wire  [5:0] b_line__3__q;
     reg  b_line__3__clock;
-    reg  [4:0] b_line__4__d;
-    wire  [4:0] b_line__4__q;
+    reg  [5:0] b_line__4__d;
+    wire  [5:0] b_line__4__q;
     reg  b_line__4__clock;
-    reg  [4:0] b_line__5__d;
-    wire  [4:0] b_line__5__q;
+    reg  [5:0] b_line__5__d;
+    wire  [5:0] b_line__5__q;
     reg  b_line__5__clock;
     reg  transform_unit__clock;
     reg  transform_unit__in_valid;
@@ -22266,9 +22331,15 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     // Local signals
     reg  a_here__0;
     reg  a_here__1;
+    reg  a_here__2;
+    reg  a_here__3;
     reg  b_here__0;
     reg  b_here__1;
+    reg  b_here__2;
+    reg  b_here__3;
     reg  [31:0] fetch_a;
+    reg  fetch_ends;
+    reg  [1:0] next_fb;
     reg  fb_free;
     reg  [1:0] l_kind;
     reg  [4:0] l_thread;
@@ -22277,8 +22348,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  l_ready;
     reg  a_take;
     reg  b_take;
-    reg  [4:0] a_arrive;
-    reg  [4:0] b_arrive;
+    reg  [5:0] a_arrive;
+    reg  [5:0] b_arrive;
     reg  walk_take;
     reg  m3_counts;
     reg  merge_hit;
@@ -22427,12 +22498,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(fetching__q),
         .clock(fetching__clock)
     );
-    dynrt_processor__display__dark_d fb(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 fb(
         .d(fb__d),
         .q(fb__q),
         .clock(fb__clock)
     );
-    dynrt_processor__display__dark_d lb(
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 lb(
         .d(lb__d),
         .q(lb__q),
         .clock(lb__clock)
@@ -22452,6 +22523,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(loaded__1__q),
         .clock(loaded__1__clock)
     );
+    dynrt_processor__display__dark_d loaded__2(
+        .d(loaded__2__d),
+        .q(loaded__2__q),
+        .clock(loaded__2__clock)
+    );
+    dynrt_processor__display__dark_d loaded__3(
+        .d(loaded__3__d),
+        .q(loaded__3__q),
+        .clock(loaded__3__clock)
+    );
     dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 cur_kind__0(
         .d(cur_kind__0__d),
         .q(cur_kind__0__q),
@@ -22461,6 +22542,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .d(cur_kind__1__d),
         .q(cur_kind__1__q),
         .clock(cur_kind__1__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 cur_kind__2(
+        .d(cur_kind__2__d),
+        .q(cur_kind__2__q),
+        .clock(cur_kind__2__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 cur_kind__3(
+        .d(cur_kind__3__d),
+        .q(cur_kind__3__q),
+        .clock(cur_kind__3__clock)
     );
     dynrt_processor__engine__decode__t4 cur_thread__0(
         .d(cur_thread__0__d),
@@ -22472,6 +22563,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(cur_thread__1__q),
         .clock(cur_thread__1__clock)
     );
+    dynrt_processor__engine__decode__t4 cur_thread__2(
+        .d(cur_thread__2__d),
+        .q(cur_thread__2__q),
+        .clock(cur_thread__2__clock)
+    );
+    dynrt_processor__engine__decode__t4 cur_thread__3(
+        .d(cur_thread__3__d),
+        .q(cur_thread__3__q),
+        .clock(cur_thread__3__clock)
+    );
     dynrt_processor__engine__cycle_count cur_a__0(
         .d(cur_a__0__d),
         .q(cur_a__0__q),
@@ -22481,6 +22582,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .d(cur_a__1__d),
         .q(cur_a__1__q),
         .clock(cur_a__1__clock)
+    );
+    dynrt_processor__engine__cycle_count cur_a__2(
+        .d(cur_a__2__d),
+        .q(cur_a__2__q),
+        .clock(cur_a__2__clock)
+    );
+    dynrt_processor__engine__cycle_count cur_a__3(
+        .d(cur_a__3__d),
+        .q(cur_a__3__q),
+        .clock(cur_a__3__clock)
     );
     dynrt_processor__engine__cycle_count cur_b__0(
         .d(cur_b__0__d),
@@ -22492,6 +22603,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(cur_b__1__q),
         .clock(cur_b__1__clock)
     );
+    dynrt_processor__engine__cycle_count cur_b__2(
+        .d(cur_b__2__d),
+        .q(cur_b__2__q),
+        .clock(cur_b__2__clock)
+    );
+    dynrt_processor__engine__cycle_count cur_b__3(
+        .d(cur_b__3__d),
+        .q(cur_b__3__q),
+        .clock(cur_b__3__clock)
+    );
     dynrt_processor__engine__instances__arrived received__0(
         .d(received__0__d),
         .q(received__0__q),
@@ -22501,6 +22622,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .d(received__1__d),
         .q(received__1__q),
         .clock(received__1__clock)
+    );
+    dynrt_processor__engine__instances__arrived received__2(
+        .d(received__2__d),
+        .q(received__2__q),
+        .clock(received__2__clock)
+    );
+    dynrt_processor__engine__instances__arrived received__3(
+        .d(received__3__d),
+        .q(received__3__q),
+        .clock(received__3__clock)
     );
     dynrt_processor__engine__instances__arrived a_issued(
         .d(a_issued__d),
@@ -22517,182 +22648,158 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(seq__q),
         .clock(seq__clock)
     );
-    dynrt_processor__display__rgb_q words__0(
-        .d(words__0__d),
-        .q(words__0__q),
-        .clock(words__0__clock)
+    dynrt_processor__engine__tester__words__0 words__0(
+        .read_address(words__0__read_address),
+        .read_data(words__0__read_data),
+        .write_clock(words__0__write_clock),
+        .write_address(words__0__write_address),
+        .write_data(words__0__write_data),
+        .write_enable(words__0__write_enable)
     );
-    dynrt_processor__display__rgb_q words__1(
-        .d(words__1__d),
-        .q(words__1__q),
-        .clock(words__1__clock)
+    dynrt_processor__engine__tester__words__0 words__1(
+        .read_address(words__1__read_address),
+        .read_data(words__1__read_data),
+        .write_clock(words__1__write_clock),
+        .write_address(words__1__write_address),
+        .write_data(words__1__write_data),
+        .write_enable(words__1__write_enable)
     );
-    dynrt_processor__display__rgb_q words__2(
-        .d(words__2__d),
-        .q(words__2__q),
-        .clock(words__2__clock)
+    dynrt_processor__engine__tester__words__0 words__2(
+        .read_address(words__2__read_address),
+        .read_data(words__2__read_data),
+        .write_clock(words__2__write_clock),
+        .write_address(words__2__write_address),
+        .write_data(words__2__write_data),
+        .write_enable(words__2__write_enable)
     );
-    dynrt_processor__display__rgb_q words__3(
-        .d(words__3__d),
-        .q(words__3__q),
-        .clock(words__3__clock)
+    dynrt_processor__engine__tester__words__0 words__3(
+        .read_address(words__3__read_address),
+        .read_data(words__3__read_data),
+        .write_clock(words__3__write_clock),
+        .write_address(words__3__write_address),
+        .write_data(words__3__write_data),
+        .write_enable(words__3__write_enable)
     );
-    dynrt_processor__display__rgb_q words__4(
-        .d(words__4__d),
-        .q(words__4__q),
-        .clock(words__4__clock)
+    dynrt_processor__engine__tester__words__0 words__4(
+        .read_address(words__4__read_address),
+        .read_data(words__4__read_data),
+        .write_clock(words__4__write_clock),
+        .write_address(words__4__write_address),
+        .write_data(words__4__write_data),
+        .write_enable(words__4__write_enable)
     );
-    dynrt_processor__display__rgb_q words__5(
-        .d(words__5__d),
-        .q(words__5__q),
-        .clock(words__5__clock)
+    dynrt_processor__engine__tester__words__0 words__5(
+        .read_address(words__5__read_address),
+        .read_data(words__5__read_data),
+        .write_clock(words__5__write_clock),
+        .write_address(words__5__write_address),
+        .write_data(words__5__write_data),
+        .write_enable(words__5__write_enable)
     );
-    dynrt_processor__display__rgb_q words__6(
-        .d(words__6__d),
-        .q(words__6__q),
-        .clock(words__6__clock)
+    dynrt_processor__engine__tester__words__0 words__6(
+        .read_address(words__6__read_address),
+        .read_data(words__6__read_data),
+        .write_clock(words__6__write_clock),
+        .write_address(words__6__write_address),
+        .write_data(words__6__write_data),
+        .write_enable(words__6__write_enable)
     );
-    dynrt_processor__display__rgb_q words__7(
-        .d(words__7__d),
-        .q(words__7__q),
-        .clock(words__7__clock)
+    dynrt_processor__engine__tester__words__0 words__7(
+        .read_address(words__7__read_address),
+        .read_data(words__7__read_data),
+        .write_clock(words__7__write_clock),
+        .write_address(words__7__write_address),
+        .write_data(words__7__write_data),
+        .write_enable(words__7__write_enable)
     );
-    dynrt_processor__display__rgb_q words__8(
-        .d(words__8__d),
-        .q(words__8__q),
-        .clock(words__8__clock)
+    dynrt_processor__engine__tester__words__0 words__8(
+        .read_address(words__8__read_address),
+        .read_data(words__8__read_data),
+        .write_clock(words__8__write_clock),
+        .write_address(words__8__write_address),
+        .write_data(words__8__write_data),
+        .write_enable(words__8__write_enable)
     );
-    dynrt_processor__display__rgb_q words__9(
-        .d(words__9__d),
-        .q(words__9__q),
-        .clock(words__9__clock)
+    dynrt_processor__engine__tester__words__0 words__9(
+        .read_address(words__9__read_address),
+        .read_data(words__9__read_data),
+        .write_clock(words__9__write_clock),
+        .write_address(words__9__write_address),
+        .write_data(words__9__write_data),
+        .write_enable(words__9__write_enable)
     );
-    dynrt_processor__display__rgb_q words__10(
-        .d(words__10__d),
-        .q(words__10__q),
-        .clock(words__10__clock)
+    dynrt_processor__engine__tester__words__0 words__10(
+        .read_address(words__10__read_address),
+        .read_data(words__10__read_data),
+        .write_clock(words__10__write_clock),
+        .write_address(words__10__write_address),
+        .write_data(words__10__write_data),
+        .write_enable(words__10__write_enable)
     );
-    dynrt_processor__display__rgb_q words__11(
-        .d(words__11__d),
-        .q(words__11__q),
-        .clock(words__11__clock)
+    dynrt_processor__engine__tester__words__0 words__11(
+        .read_address(words__11__read_address),
+        .read_data(words__11__read_data),
+        .write_clock(words__11__write_clock),
+        .write_address(words__11__write_address),
+        .write_data(words__11__write_data),
+        .write_enable(words__11__write_enable)
     );
-    dynrt_processor__display__rgb_q words__12(
-        .d(words__12__d),
-        .q(words__12__q),
-        .clock(words__12__clock)
-    );
-    dynrt_processor__display__rgb_q words__13(
-        .d(words__13__d),
-        .q(words__13__q),
-        .clock(words__13__clock)
-    );
-    dynrt_processor__display__rgb_q words__14(
-        .d(words__14__d),
-        .q(words__14__q),
-        .clock(words__14__clock)
-    );
-    dynrt_processor__display__rgb_q words__15(
-        .d(words__15__d),
-        .q(words__15__q),
-        .clock(words__15__clock)
-    );
-    dynrt_processor__display__rgb_q words__16(
-        .d(words__16__d),
-        .q(words__16__q),
-        .clock(words__16__clock)
-    );
-    dynrt_processor__display__rgb_q words__17(
-        .d(words__17__d),
-        .q(words__17__q),
-        .clock(words__17__clock)
-    );
-    dynrt_processor__display__rgb_q words__18(
-        .d(words__18__d),
-        .q(words__18__q),
-        .clock(words__18__clock)
-    );
-    dynrt_processor__display__rgb_q words__19(
-        .d(words__19__d),
-        .q(words__19__q),
-        .clock(words__19__clock)
-    );
-    dynrt_processor__display__rgb_q words__20(
-        .d(words__20__d),
-        .q(words__20__q),
-        .clock(words__20__clock)
-    );
-    dynrt_processor__display__rgb_q words__21(
-        .d(words__21__d),
-        .q(words__21__q),
-        .clock(words__21__clock)
-    );
-    dynrt_processor__display__rgb_q words__22(
-        .d(words__22__d),
-        .q(words__22__q),
-        .clock(words__22__clock)
-    );
-    dynrt_processor__display__rgb_q words__23(
-        .d(words__23__d),
-        .q(words__23__q),
-        .clock(words__23__clock)
-    );
-    dynrt_processor__engine__decode__t4 a_line__0(
+    dynrt_processor__engine__mem_load_r a_line__0(
         .d(a_line__0__d),
         .q(a_line__0__q),
         .clock(a_line__0__clock)
     );
-    dynrt_processor__engine__decode__t4 a_line__1(
+    dynrt_processor__engine__mem_load_r a_line__1(
         .d(a_line__1__d),
         .q(a_line__1__q),
         .clock(a_line__1__clock)
     );
-    dynrt_processor__engine__decode__t4 a_line__2(
+    dynrt_processor__engine__mem_load_r a_line__2(
         .d(a_line__2__d),
         .q(a_line__2__q),
         .clock(a_line__2__clock)
     );
-    dynrt_processor__engine__decode__t4 a_line__3(
+    dynrt_processor__engine__mem_load_r a_line__3(
         .d(a_line__3__d),
         .q(a_line__3__q),
         .clock(a_line__3__clock)
     );
-    dynrt_processor__engine__decode__t4 a_line__4(
+    dynrt_processor__engine__mem_load_r a_line__4(
         .d(a_line__4__d),
         .q(a_line__4__q),
         .clock(a_line__4__clock)
     );
-    dynrt_processor__engine__decode__t4 a_line__5(
+    dynrt_processor__engine__mem_load_r a_line__5(
         .d(a_line__5__d),
         .q(a_line__5__q),
         .clock(a_line__5__clock)
     );
-    dynrt_processor__engine__decode__t4 b_line__0(
+    dynrt_processor__engine__mem_load_r b_line__0(
         .d(b_line__0__d),
         .q(b_line__0__q),
         .clock(b_line__0__clock)
     );
-    dynrt_processor__engine__decode__t4 b_line__1(
+    dynrt_processor__engine__mem_load_r b_line__1(
         .d(b_line__1__d),
         .q(b_line__1__q),
         .clock(b_line__1__clock)
     );
-    dynrt_processor__engine__decode__t4 b_line__2(
+    dynrt_processor__engine__mem_load_r b_line__2(
         .d(b_line__2__d),
         .q(b_line__2__q),
         .clock(b_line__2__clock)
     );
-    dynrt_processor__engine__decode__t4 b_line__3(
+    dynrt_processor__engine__mem_load_r b_line__3(
         .d(b_line__3__d),
         .q(b_line__3__q),
         .clock(b_line__3__clock)
     );
-    dynrt_processor__engine__decode__t4 b_line__4(
+    dynrt_processor__engine__mem_load_r b_line__4(
         .d(b_line__4__d),
         .q(b_line__4__q),
         .clock(b_line__4__clock)
     );
-    dynrt_processor__engine__decode__t4 b_line__5(
+    dynrt_processor__engine__mem_load_r b_line__5(
         .d(b_line__5__d),
         .q(b_line__5__q),
         .clock(b_line__5__clock)
@@ -23111,54 +23218,42 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         flight_a__write_clock = clock;
         flight_b__read_clock = clock;
         flight_b__write_clock = clock;
-        words__0__clock = clock;
-        words__0__d = words__0__q;
-        words__1__clock = clock;
-        words__1__d = words__1__q;
-        words__2__clock = clock;
-        words__2__d = words__2__q;
-        words__3__clock = clock;
-        words__3__d = words__3__q;
-        words__4__clock = clock;
-        words__4__d = words__4__q;
-        words__5__clock = clock;
-        words__5__d = words__5__q;
-        words__6__clock = clock;
-        words__6__d = words__6__q;
-        words__7__clock = clock;
-        words__7__d = words__7__q;
-        words__8__clock = clock;
-        words__8__d = words__8__q;
-        words__9__clock = clock;
-        words__9__d = words__9__q;
-        words__10__clock = clock;
-        words__10__d = words__10__q;
-        words__11__clock = clock;
-        words__11__d = words__11__q;
-        words__12__clock = clock;
-        words__12__d = words__12__q;
-        words__13__clock = clock;
-        words__13__d = words__13__q;
-        words__14__clock = clock;
-        words__14__d = words__14__q;
-        words__15__clock = clock;
-        words__15__d = words__15__q;
-        words__16__clock = clock;
-        words__16__d = words__16__q;
-        words__17__clock = clock;
-        words__17__d = words__17__q;
-        words__18__clock = clock;
-        words__18__d = words__18__q;
-        words__19__clock = clock;
-        words__19__d = words__19__q;
-        words__20__clock = clock;
-        words__20__d = words__20__q;
-        words__21__clock = clock;
-        words__21__d = words__21__q;
-        words__22__clock = clock;
-        words__22__d = words__22__q;
-        words__23__clock = clock;
-        words__23__d = words__23__q;
+        words__0__write_clock = clock;
+        words__0__write_enable = 1'b0;
+        words__0__read_address = lb__q;
+        words__1__write_clock = clock;
+        words__1__write_enable = 1'b0;
+        words__1__read_address = lb__q;
+        words__2__write_clock = clock;
+        words__2__write_enable = 1'b0;
+        words__2__read_address = lb__q;
+        words__3__write_clock = clock;
+        words__3__write_enable = 1'b0;
+        words__3__read_address = lb__q;
+        words__4__write_clock = clock;
+        words__4__write_enable = 1'b0;
+        words__4__read_address = lb__q;
+        words__5__write_clock = clock;
+        words__5__write_enable = 1'b0;
+        words__5__read_address = lb__q;
+        words__6__write_clock = clock;
+        words__6__write_enable = 1'b0;
+        words__6__read_address = lb__q;
+        words__7__write_clock = clock;
+        words__7__write_enable = 1'b0;
+        words__7__read_address = lb__q;
+        words__8__write_clock = clock;
+        words__8__write_enable = 1'b0;
+        words__8__read_address = lb__q;
+        words__9__write_clock = clock;
+        words__9__write_enable = 1'b0;
+        words__9__read_address = lb__q;
+        words__10__write_clock = clock;
+        words__10__write_enable = 1'b0;
+        words__10__read_address = lb__q;
+        words__11__write_clock = clock;
+        words__11__write_enable = 1'b0;
+        words__11__read_address = lb__q;
         loaded__0__clock = clock;
         loaded__0__d = loaded__0__q;
         cur_kind__0__clock = clock;
@@ -23183,6 +23278,30 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cur_b__1__d = cur_b__1__q;
         received__1__clock = clock;
         received__1__d = received__1__q;
+        loaded__2__clock = clock;
+        loaded__2__d = loaded__2__q;
+        cur_kind__2__clock = clock;
+        cur_kind__2__d = cur_kind__2__q;
+        cur_thread__2__clock = clock;
+        cur_thread__2__d = cur_thread__2__q;
+        cur_a__2__clock = clock;
+        cur_a__2__d = cur_a__2__q;
+        cur_b__2__clock = clock;
+        cur_b__2__d = cur_b__2__q;
+        received__2__clock = clock;
+        received__2__d = received__2__q;
+        loaded__3__clock = clock;
+        loaded__3__d = loaded__3__q;
+        cur_kind__3__clock = clock;
+        cur_kind__3__d = cur_kind__3__q;
+        cur_thread__3__clock = clock;
+        cur_thread__3__d = cur_thread__3__q;
+        cur_a__3__clock = clock;
+        cur_a__3__d = cur_a__3__q;
+        cur_b__3__clock = clock;
+        cur_b__3__d = cur_b__3__q;
+        received__3__clock = clock;
+        received__3__d = received__3__q;
         a_line__0__clock = clock;
         b_line__0__clock = clock;
         a_line__1__clock = clock;
@@ -23253,8 +23372,14 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         a_words__addr = engine__load_addr;
         b_words__addr = engine__load_addr;
         fetch_a = cur_a__0__q;
-        if (fb__q) begin
+        if (fb__q == c_buffer__1) begin
             fetch_a = cur_a__1__q;
+        end
+        if (fb__q == c_buffer__2) begin
+            fetch_a = cur_a__2__q;
+        end
+        if (fb__q == c_buffer__3) begin
+            fetch_a = cur_a__3__q;
         end
         if (a_take) begin
             a_words__addr = (fetch_a[(32'h0)+:(24)] << 32'h3) + ((a_issued__q) & 24'hffffff);
@@ -23264,8 +23389,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             b_words__addr = (fetch_a[(32'h0)+:(24)] << 32'h3) + ((b_issued__q) & 24'hffffff);
             b_issued__d = b_issued__q + 32'h1;
         end
-        a_line__0__d = (((a_take) & 5'h1f) << 32'h4) | (((fb__q) & 5'h1f) << 32'h3) | ((a_issued__q[(32'h0)+:(3)]) & 5'h1f);
-        b_line__0__d = (((b_take) & 5'h1f) << 32'h4) | (((fb__q) & 5'h1f) << 32'h3) | ((b_issued__q[(32'h0)+:(3)]) & 5'h1f);
+        a_line__0__d = (((a_take) & 6'h3f) << 32'h5) | (((fb__q) & 6'h3f) << 32'h3) | ((a_issued__q[(32'h0)+:(3)]) & 6'h3f);
+        b_line__0__d = (((b_take) & 6'h3f) << 32'h5) | (((fb__q) & 6'h3f) << 32'h3) | ((b_issued__q[(32'h0)+:(3)]) & 6'h3f);
         a_line__1__d = a_line__0__q;
         b_line__1__d = b_line__0__q;
         a_line__2__d = a_line__1__q;
@@ -23276,15 +23401,24 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         b_line__4__d = b_line__3__q;
         a_line__5__d = a_line__4__q;
         b_line__5__d = b_line__4__q;
-        if (fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)))) begin
+        fetch_ends = fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)));
+        next_fb = fb__q;
+        if (fetch_ends) begin
             fetching__d = 1'b0;
-            fb__d = ~fb__q;
+            next_fb = fb__q + 32'h1;
+            fb__d = fb__q + 32'h1;
         end
         fb_free = ~loaded__0__q;
-        if (fb__q) begin
+        if (next_fb == c_buffer__1) begin
             fb_free = ~loaded__1__q;
         end
-        if ((~fetching__q) & fb_free & list_unit__test_valid) begin
+        if (next_fb == c_buffer__2) begin
+            fb_free = ~loaded__2__q;
+        end
+        if (next_fb == c_buffer__3) begin
+            fb_free = ~loaded__3__q;
+        end
+        if (((~fetching__q) | fetch_ends) & fb_free & list_unit__test_valid) begin
             list_unit__test_take = 1'b1;
             a_issued__d = 32'h0;
             b_issued__d = 32'h0;
@@ -23293,29 +23427,35 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
                 a_issued__d = 32'h6;
                 b_issued__d = 32'h6;
                 fetching__d = 1'b0;
-                fb__d = ~fb__q;
+                fb__d = next_fb + 32'h1;
             end
-            if (fb__q == c_buffer__0) begin
+            if (next_fb == c_buffer__0) begin
                 loaded__0__d = 1'b1;
                 cur_kind__0__d = list_unit__test_entry[(32'h45)+:(2)];
                 cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
                 cur_a__0__d = list_unit__test_entry[(32'h20)+:(32)];
                 cur_b__0__d = list_unit__test_entry[(32'h0)+:(32)];
-                received__0__d = 32'h0;
-                if (list_unit__test_entry[(32'h45)+:(2)] != c_test_triangle) begin
-                    received__0__d = 32'hc;
-                end
             end
-            if (fb__q == c_buffer__1) begin
+            if (next_fb == c_buffer__1) begin
                 loaded__1__d = 1'b1;
                 cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
                 cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];
                 cur_a__1__d = list_unit__test_entry[(32'h20)+:(32)];
                 cur_b__1__d = list_unit__test_entry[(32'h0)+:(32)];
-                received__1__d = 32'h0;
-                if (list_unit__test_entry[(32'h45)+:(2)] != c_test_triangle) begin
-                    received__1__d = 32'hc;
-                end
+            end
+            if (next_fb == c_buffer__2) begin
+                loaded__2__d = 1'b1;
+                cur_kind__2__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__2__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__2__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__2__d = list_unit__test_entry[(32'h0)+:(32)];
+            end
+            if (next_fb == c_buffer__3) begin
+                loaded__3__d = 1'b1;
+                cur_kind__3__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__3__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__3__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__3__d = list_unit__test_entry[(32'h0)+:(32)];
             end
         end
         a_arrive = 32'h0;
@@ -23344,154 +23484,112 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             a_arrive = a_line__5__q;
             b_arrive = b_line__5__q;
         end
-        if (a_arrive[32'h4] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__0)) begin
-            if (a_arrive[32'h3]) begin
-                words__12__d = a_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__0__d = a_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        if (a_arrive[32'h4] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__1)) begin
-            if (a_arrive[32'h3]) begin
-                words__13__d = a_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__1__d = a_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        if (a_arrive[32'h4] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__2)) begin
-            if (a_arrive[32'h3]) begin
-                words__14__d = a_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__2__d = a_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        if (a_arrive[32'h4] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__3)) begin
-            if (a_arrive[32'h3]) begin
-                words__15__d = a_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__3__d = a_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        if (a_arrive[32'h4] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__4)) begin
-            if (a_arrive[32'h3]) begin
-                words__16__d = a_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__4__d = a_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        if (a_arrive[32'h4] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__5)) begin
-            if (a_arrive[32'h3]) begin
-                words__17__d = a_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__5__d = a_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        if (b_arrive[32'h4] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__0)) begin
-            if (b_arrive[32'h3]) begin
-                words__18__d = b_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__6__d = b_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        if (b_arrive[32'h4] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__1)) begin
-            if (b_arrive[32'h3]) begin
-                words__19__d = b_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__7__d = b_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        if (b_arrive[32'h4] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__2)) begin
-            if (b_arrive[32'h3]) begin
-                words__20__d = b_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__8__d = b_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        if (b_arrive[32'h4] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__3)) begin
-            if (b_arrive[32'h3]) begin
-                words__21__d = b_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__9__d = b_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        if (b_arrive[32'h4] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__4)) begin
-            if (b_arrive[32'h3]) begin
-                words__22__d = b_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__10__d = b_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        if (b_arrive[32'h4] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__5)) begin
-            if (b_arrive[32'h3]) begin
-                words__23__d = b_words__rdata[(32'h0)+:(24)];
-            end
-            else begin
-                words__11__d = b_words__rdata[(32'h0)+:(24)];
-            end
-        end
-        a_here__0 = a_arrive[32'h4] & (a_arrive[32'h3] == c_buffer__0);
-        b_here__0 = b_arrive[32'h4] & (b_arrive[32'h3] == c_buffer__0);
+        words__0__write_address = a_arrive[(32'h3)+:(2)];
+        words__0__write_data = a_words__rdata[(32'h0)+:(24)];
+        words__0__write_enable = a_arrive[32'h5] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__0);
+        words__6__write_address = b_arrive[(32'h3)+:(2)];
+        words__6__write_data = b_words__rdata[(32'h0)+:(24)];
+        words__6__write_enable = b_arrive[32'h5] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__0);
+        words__1__write_address = a_arrive[(32'h3)+:(2)];
+        words__1__write_data = a_words__rdata[(32'h0)+:(24)];
+        words__1__write_enable = a_arrive[32'h5] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__1);
+        words__7__write_address = b_arrive[(32'h3)+:(2)];
+        words__7__write_data = b_words__rdata[(32'h0)+:(24)];
+        words__7__write_enable = b_arrive[32'h5] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__1);
+        words__2__write_address = a_arrive[(32'h3)+:(2)];
+        words__2__write_data = a_words__rdata[(32'h0)+:(24)];
+        words__2__write_enable = a_arrive[32'h5] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__2);
+        words__8__write_address = b_arrive[(32'h3)+:(2)];
+        words__8__write_data = b_words__rdata[(32'h0)+:(24)];
+        words__8__write_enable = b_arrive[32'h5] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__2);
+        words__3__write_address = a_arrive[(32'h3)+:(2)];
+        words__3__write_data = a_words__rdata[(32'h0)+:(24)];
+        words__3__write_enable = a_arrive[32'h5] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__3);
+        words__9__write_address = b_arrive[(32'h3)+:(2)];
+        words__9__write_data = b_words__rdata[(32'h0)+:(24)];
+        words__9__write_enable = b_arrive[32'h5] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__3);
+        words__4__write_address = a_arrive[(32'h3)+:(2)];
+        words__4__write_data = a_words__rdata[(32'h0)+:(24)];
+        words__4__write_enable = a_arrive[32'h5] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__4);
+        words__10__write_address = b_arrive[(32'h3)+:(2)];
+        words__10__write_data = b_words__rdata[(32'h0)+:(24)];
+        words__10__write_enable = b_arrive[32'h5] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__4);
+        words__5__write_address = a_arrive[(32'h3)+:(2)];
+        words__5__write_data = a_words__rdata[(32'h0)+:(24)];
+        words__5__write_enable = a_arrive[32'h5] & (((a_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__5);
+        words__11__write_address = b_arrive[(32'h3)+:(2)];
+        words__11__write_data = b_words__rdata[(32'h0)+:(24)];
+        words__11__write_enable = b_arrive[32'h5] & (((b_arrive[(32'h0)+:(3)]) & 4'hf) == c_index__5);
+        a_here__0 = a_arrive[32'h5] & (a_arrive[(32'h3)+:(2)] == c_buffer__0);
+        b_here__0 = b_arrive[32'h5] & (b_arrive[(32'h3)+:(2)] == c_buffer__0);
         if (a_here__0 | b_here__0) begin
             received__0__d = received__0__q + 32'h1;
         end
         if (a_here__0 & b_here__0) begin
             received__0__d = received__0__q + 32'h2;
         end
-        a_here__1 = a_arrive[32'h4] & (a_arrive[32'h3] == c_buffer__1);
-        b_here__1 = b_arrive[32'h4] & (b_arrive[32'h3] == c_buffer__1);
+        a_here__1 = a_arrive[32'h5] & (a_arrive[(32'h3)+:(2)] == c_buffer__1);
+        b_here__1 = b_arrive[32'h5] & (b_arrive[(32'h3)+:(2)] == c_buffer__1);
         if (a_here__1 | b_here__1) begin
             received__1__d = received__1__q + 32'h1;
         end
         if (a_here__1 & b_here__1) begin
             received__1__d = received__1__q + 32'h2;
         end
+        a_here__2 = a_arrive[32'h5] & (a_arrive[(32'h3)+:(2)] == c_buffer__2);
+        b_here__2 = b_arrive[32'h5] & (b_arrive[(32'h3)+:(2)] == c_buffer__2);
+        if (a_here__2 | b_here__2) begin
+            received__2__d = received__2__q + 32'h1;
+        end
+        if (a_here__2 & b_here__2) begin
+            received__2__d = received__2__q + 32'h2;
+        end
+        a_here__3 = a_arrive[32'h5] & (a_arrive[(32'h3)+:(2)] == c_buffer__3);
+        b_here__3 = b_arrive[32'h5] & (b_arrive[(32'h3)+:(2)] == c_buffer__3);
+        if (a_here__3 | b_here__3) begin
+            received__3__d = received__3__q + 32'h1;
+        end
+        if (a_here__3 & b_here__3) begin
+            received__3__d = received__3__q + 32'h2;
+        end
         l_kind = cur_kind__0__q;
         l_thread = cur_thread__0__q;
         l_a = cur_a__0__q;
         l_b = cur_b__0__q;
-        l_ready = loaded__0__q & (received__0__q == 32'hc);
-        transform_unit__m__0 = words__0__q;
-        transform_unit__m__1 = words__1__q;
-        transform_unit__m__2 = words__2__q;
-        transform_unit__m__3 = words__3__q;
-        transform_unit__m__4 = words__4__q;
-        transform_unit__m__5 = words__5__q;
-        transform_unit__m__6 = words__6__q;
-        transform_unit__m__7 = words__7__q;
-        transform_unit__m__8 = words__8__q;
-        transform_unit__m__9 = words__9__q;
-        transform_unit__m__10 = words__10__q;
-        transform_unit__m__11 = words__11__q;
-        if (lb__q) begin
+        l_ready = loaded__0__q & ((cur_kind__0__q != c_test_triangle) | (received__0__q == 32'hc));
+        if (lb__q == c_buffer__1) begin
             l_kind = cur_kind__1__q;
             l_thread = cur_thread__1__q;
             l_a = cur_a__1__q;
             l_b = cur_b__1__q;
-            l_ready = loaded__1__q & (received__1__q == 32'hc);
-            transform_unit__m__0 = words__12__q;
-            transform_unit__m__1 = words__13__q;
-            transform_unit__m__2 = words__14__q;
-            transform_unit__m__3 = words__15__q;
-            transform_unit__m__4 = words__16__q;
-            transform_unit__m__5 = words__17__q;
-            transform_unit__m__6 = words__18__q;
-            transform_unit__m__7 = words__19__q;
-            transform_unit__m__8 = words__20__q;
-            transform_unit__m__9 = words__21__q;
-            transform_unit__m__10 = words__22__q;
-            transform_unit__m__11 = words__23__q;
+            l_ready = loaded__1__q & ((cur_kind__1__q != c_test_triangle) | (received__1__q == 32'hc));
         end
+        if (lb__q == c_buffer__2) begin
+            l_kind = cur_kind__2__q;
+            l_thread = cur_thread__2__q;
+            l_a = cur_a__2__q;
+            l_b = cur_b__2__q;
+            l_ready = loaded__2__q & ((cur_kind__2__q != c_test_triangle) | (received__2__q == 32'hc));
+        end
+        if (lb__q == c_buffer__3) begin
+            l_kind = cur_kind__3__q;
+            l_thread = cur_thread__3__q;
+            l_a = cur_a__3__q;
+            l_b = cur_b__3__q;
+            l_ready = loaded__3__q & ((cur_kind__3__q != c_test_triangle) | (received__3__q == 32'hc));
+        end
+        transform_unit__m__0 = words__0__read_data;
+        transform_unit__m__1 = words__1__read_data;
+        transform_unit__m__2 = words__2__read_data;
+        transform_unit__m__3 = words__3__read_data;
+        transform_unit__m__4 = words__4__read_data;
+        transform_unit__m__5 = words__5__read_data;
+        transform_unit__m__6 = words__6__read_data;
+        transform_unit__m__7 = words__7__read_data;
+        transform_unit__m__8 = words__8__read_data;
+        transform_unit__m__9 = words__9__read_data;
+        transform_unit__m__10 = words__10__read_data;
+        transform_unit__m__11 = words__11__read_data;
         ray__ray_thread = l_thread;
         ray__t_min_thread = l_thread;
         transform_unit__in_valid = 1'b0;
@@ -23534,11 +23632,21 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         if (lphase__q == Launch__Free) begin
             if (lb__q == c_buffer__0) begin
                 loaded__0__d = 1'b0;
+                received__0__d = 32'h0;
             end
             if (lb__q == c_buffer__1) begin
                 loaded__1__d = 1'b0;
+                received__1__d = 32'h0;
             end
-            lb__d = ~lb__q;
+            if (lb__q == c_buffer__2) begin
+                loaded__2__d = 1'b0;
+                received__2__d = 32'h0;
+            end
+            if (lb__q == c_buffer__3) begin
+                loaded__3__d = 1'b0;
+                received__3__d = 32'h0;
+            end
+            lb__d = lb__q + 32'h1;
             lphase__d = Launch__Wait;
         end
         launching = (lphase__q == Launch__Origin) | (lphase__q == Launch__Direction);
@@ -23741,6 +23849,22 @@ module dynrt_processor__engine__tester__best_e(read_address,read_clock,read_data
     end
                 
 endmodule // dynrt_processor__engine__tester__best_e
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -28572,6 +28696,10 @@ endmodule // dynrt_processor__engine__tester__list_unit__tests__ram
 
 
 
+
+
+
+
 module dynrt_processor__engine__tester__lphase(d,q,clock);
     
     // Module arguments
@@ -28902,6 +29030,10 @@ module dynrt_processor__engine__tester__ray(clock,thread,word_a,word_b,ray_write
     end
     
 endmodule // dynrt_processor__engine__tester__ray
+
+
+
+
 
 
 
@@ -31842,30 +31974,36 @@ endmodule // dynrt_processor__engine__tester__transform_unit__tag_delay
 
 
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
+module dynrt_processor__engine__tester__words__0(read_address,read_data,write_clock,write_address,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [1:0] read_address;
+    output reg  [23:0] read_data;
+    input wire  write_clock;
+    input wire  [1:0] write_address;
+    input wire  [23:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[23:0] mem[3:0];
+    
+    initial begin
+       mem[0] = 24'h0;
+       mem[1] = 24'h0;
+       mem[2] = 24'h0;
+       mem[3] = 24'h0;
+    end
+    
+    always @(*) begin
+       read_data = mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+endmodule // dynrt_processor__engine__tester__words__0
 
 
 

@@ -58,9 +58,7 @@ use super::list_unit::{
 };
 use super::ports::{CoprocessorPort, SramRead};
 use super::ray_store::{zero_counters, RayStore};
-use super::{
-    intersect_latency, IntersectUnit, ListUnit, LutRam, TransformUnit, TRANSFORM_LATENCY,
-};
+use super::{intersect_latency, IntersectUnit, ListUnit, LutRam, TransformUnit, TRANSFORM_LATENCY};
 use crate::fp::Format;
 use crate::layout;
 
