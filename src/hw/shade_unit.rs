@@ -870,8 +870,8 @@ impl<
         }
         self.byte_tag.data_in.next = self.byte_tag_in.val();
         // Each output is written once, from its local: an output assigned a default and then
-        // overridden changes twice in one evaluation, and Icarus, waking the engine's block
-        // on each change, went round the two blocks without end.
+        // overridden changes twice in one evaluation, and Icarus wakes the engine's block on
+        // each change (such double writes in `Delay` made Icarus loop; see delay.rs).
         self.tri_read.next = self.tri_read_l.val();
         self.frame_read.next = self.frame_read_l.val();
         self.frame_addr.next = self.frame_addr_l.val();
