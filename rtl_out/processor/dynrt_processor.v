@@ -17285,6 +17285,15 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  cos_slot__clock;
     reg  [3:0] cos_slot__data_in;
     wire  [3:0] cos_slot__data_out;
+    reg  byte_valid_r__d;
+    wire  byte_valid_r__q;
+    reg  byte_valid_r__clock;
+    reg  [23:0] byte_word_r__d;
+    wire  [23:0] byte_word_r__q;
+    reg  byte_word_r__clock;
+    reg  [5:0] byte_tag_r__d;
+    wire  [5:0] byte_tag_r__q;
+    reg  byte_tag_r__clock;
     reg  byte_unit__clock;
     reg  byte_unit__in_valid;
     reg  [23:0] byte_unit__word;
@@ -17357,6 +17366,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  [1:0] frame_kind;
     reg  [2:0] frame_word;
     reg  [5:0] byte_tag_in;
+    reg  byte_valid_l;
+    reg  [23:0] byte_word_l;
     reg  [23:0] rgb_next;
     reg  any_busy;
     reg  tri_read_l;
@@ -18212,6 +18223,21 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .data_in(cos_slot__data_in),
         .data_out(cos_slot__data_out)
     );
+    dynrt_processor__display__dark_d byte_valid_r(
+        .d(byte_valid_r__d),
+        .q(byte_valid_r__q),
+        .clock(byte_valid_r__clock)
+    );
+    dynrt_processor__display__rgb_q byte_word_r(
+        .d(byte_word_r__d),
+        .q(byte_word_r__q),
+        .clock(byte_word_r__clock)
+    );
+    dynrt_processor__engine__mem_load_r byte_tag_r(
+        .d(byte_tag_r__d),
+        .q(byte_tag_r__q),
+        .clock(byte_tag_r__clock)
+    );
     dynrt_processor__engine__fp_units__byte_unit byte_unit(
         .clock(byte_unit__clock),
         .in_valid(byte_unit__in_valid),
@@ -18446,6 +18472,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         div__clock = clock;
         cos_n_dot_l__clock = clock;
         cos_slot__clock = clock;
+        byte_valid_r__clock = clock;
+        byte_word_r__clock = clock;
+        byte_tag_r__clock = clock;
         byte_unit__clock = clock;
         byte_tag__clock = clock;
         o__0__write_clock = clock;
@@ -18569,8 +18598,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         sqrt__a = l_dot_l__read_data;
         cos_n_dot_l__data_in = n_dot_l__read_data;
         cos_slot__data_in = ((s1_slot__q) & 4'hf) << 32'h1;
-        byte_unit__in_valid = 1'b0;
-        byte_unit__word = acc__0__read_data;
+        byte_valid_l = 1'b0;
+        byte_word_l = acc__0__read_data;
         byte_tag_in = (((s1_word__q) & 6'h3f) << 32'h4) | (((s1_slot__q) & 6'h3f) << 32'h1);
         fb_write_l = 1'b0;
         fb_addr = addr__read_data + c_fb_base;
@@ -18742,7 +18771,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 s1_done = 1'b1;
             end
             if (s1_step__q == ShadeStep__Pack) begin
-                byte_unit__in_valid = 1'b1;
+                byte_valid_l = 1'b1;
                 byte_tag_in = byte_tag_in | c_valid6;
                 s1_word__d = s1_word__q + 32'h1;
                 if (s1_word__q == 32'h2) begin
@@ -18757,24 +18786,29 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             end
         end
         if (s1_word__q == 32'h1) begin
-            byte_unit__word = acc__1__read_data;
+            byte_word_l = acc__1__read_data;
         end
         if (s1_word__q == 32'h2) begin
-            byte_unit__word = acc__2__read_data;
+            byte_word_l = acc__2__read_data;
         end
         if (s1_miss__q) begin
-            byte_unit__word = background__0__q;
+            byte_word_l = background__0__q;
             if (s1_word__q == 32'h1) begin
-                byte_unit__word = background__1__q;
+                byte_word_l = background__1__q;
             end
             if (s1_word__q == 32'h2) begin
-                byte_unit__word = background__2__q;
+                byte_word_l = background__2__q;
             end
         end
         if (s1_done) begin
             s1_word__d = 32'h0;
         end
-        byte_tag__data_in = byte_tag_in;
+        byte_valid_r__d = byte_valid_l;
+        byte_word_r__d = byte_word_l;
+        byte_tag_r__d = byte_tag_in;
+        byte_unit__in_valid = byte_valid_r__q;
+        byte_unit__word = byte_word_r__q;
+        byte_tag__data_in = byte_tag_r__q;
         tri_read = tri_read_l;
         frame_read = frame_read_l;
         frame_addr = frame_addr_l;
@@ -19894,6 +19928,12 @@ module dynrt_processor__engine__shader__byte_tag(clock,data_in,data_out);
     end
     
 endmodule // dynrt_processor__engine__shader__byte_tag
+
+
+
+
+
+
 
 
 

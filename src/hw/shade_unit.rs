@@ -249,6 +249,8 @@ pub struct ShadeUnit<
     frame_kind: Signal<Local, Bits<2>>,
     frame_word: Signal<Local, Bits<3>>,
     byte_tag_in: Signal<Local, Bits<6>>,
+    byte_valid_l: Signal<Local, Bit>,
+    byte_word_l: Signal<Local, Bits<W>>,
     rgb_next: Signal<Local, Bits<24>>,
     any_busy: Signal<Local, Bit>,
     tri_read_l: Signal<Local, Bit>,
@@ -269,6 +271,11 @@ pub struct ShadeUnit<
     /// `{slot, valid}` of the cosine in flight.
     cos_slot: DelayLine<Bits<4>>,
     // The bytes.
+    /// The byte's input, registered: the slot RAM's read and the word's select take a clock
+    /// of their own, apart from the clamp (stop 41's critical path held all three).
+    byte_valid_r: DFF<Bit>,
+    byte_word_r: DFF<Bits<W>>,
+    byte_tag_r: DFF<Bits<6>>,
     byte_unit: ChannelByte<W, E, M, S, S1, X2, T, P>,
     /// `{word, slot, valid}` of the byte in flight.
     byte_tag: Delay<Bits<6>, { CHANNEL_BYTE_LATENCY as usize }>,
@@ -452,6 +459,8 @@ impl<
             frame_kind: Default::default(),
             frame_word: Default::default(),
             byte_tag_in: Default::default(),
+            byte_valid_l: Default::default(),
+            byte_word_l: Default::default(),
             rgb_next: Default::default(),
             any_busy: Default::default(),
             tri_read_l: Default::default(),
@@ -468,6 +477,9 @@ impl<
             div: Default::default(),
             cos_n_dot_l: DelayLine::new(sqrt_clocks),
             cos_slot: DelayLine::new(cos_clocks),
+            byte_valid_r: Default::default(),
+            byte_word_r: Default::default(),
+            byte_tag_r: Default::default(),
             byte_unit: Default::default(),
             byte_tag: Default::default(),
             rgb_acc: Default::default(),
@@ -577,6 +589,9 @@ impl<
             div,
             cos_n_dot_l,
             cos_slot,
+            byte_valid_r,
+            byte_word_r,
+            byte_tag_r,
             byte_unit,
             byte_tag
         );
@@ -669,8 +684,8 @@ impl<
         self.sqrt.a.next = self.l_dot_l.read_data.val();
         self.cos_n_dot_l.data_in.next = self.n_dot_l.read_data.val();
         self.cos_slot.data_in.next = bit_cast::<4, 3>(self.s1_slot.q.val()) << 1;
-        self.byte_unit.in_valid.next = false;
-        self.byte_unit.word.next = self.acc[0].read_data.val();
+        self.byte_valid_l.next = false;
+        self.byte_word_l.next = self.acc[0].read_data.val();
         self.byte_tag_in.next = (bit_cast::<6, 2>(self.s1_word.q.val()) << 4)
             | (bit_cast::<6, 3>(self.s1_slot.q.val()) << 1);
         self.fb_write_l.next = false;
@@ -835,7 +850,7 @@ impl<
                 self.s1_done.next = true;
             }
             if self.s1_step.q.val() == ShadeStep::Pack {
-                self.byte_unit.in_valid.next = true;
+                self.byte_valid_l.next = true;
                 self.byte_tag_in.next = self.byte_tag_in.val() | self.c_valid6.val();
                 self.s1_word.d.next = self.s1_word.q.val() + 1;
                 if self.s1_word.q.val() == 2 {
@@ -851,24 +866,29 @@ impl<
         }
         // The channel's word: the colour, or the background for a miss.
         if self.s1_word.q.val() == 1 {
-            self.byte_unit.word.next = self.acc[1].read_data.val();
+            self.byte_word_l.next = self.acc[1].read_data.val();
         }
         if self.s1_word.q.val() == 2 {
-            self.byte_unit.word.next = self.acc[2].read_data.val();
+            self.byte_word_l.next = self.acc[2].read_data.val();
         }
         if self.s1_miss.q.val() {
-            self.byte_unit.word.next = self.background[0].q.val();
+            self.byte_word_l.next = self.background[0].q.val();
             if self.s1_word.q.val() == 1 {
-                self.byte_unit.word.next = self.background[1].q.val();
+                self.byte_word_l.next = self.background[1].q.val();
             }
             if self.s1_word.q.val() == 2 {
-                self.byte_unit.word.next = self.background[2].q.val();
+                self.byte_word_l.next = self.background[2].q.val();
             }
         }
         if self.s1_done.val() {
             self.s1_word.d.next = 0.into();
         }
-        self.byte_tag.data_in.next = self.byte_tag_in.val();
+        self.byte_valid_r.d.next = self.byte_valid_l.val();
+        self.byte_word_r.d.next = self.byte_word_l.val();
+        self.byte_tag_r.d.next = self.byte_tag_in.val();
+        self.byte_unit.in_valid.next = self.byte_valid_r.q.val();
+        self.byte_unit.word.next = self.byte_word_r.q.val();
+        self.byte_tag.data_in.next = self.byte_tag_r.q.val();
         // Each output is written once, from its local: an output assigned a default and then
         // overridden changes twice in one evaluation, and Icarus wakes the engine's block on
         // each change (such double writes in `Delay` made Icarus loop; see delay.rs).
