@@ -1318,6 +1318,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     
     // Local signals
     reg  frame_start;
+    reg  engine_load;
     reg  engine_loads_triangles;
     reg  gen_shade;
     reg  in_frame;
@@ -2193,11 +2194,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         scratch__write_address = (((decode__thread) & 12'hfff) << 32'h7) | ((execute__scratch_address[(32'h0)+:(7)]) & 12'hfff);
         scratch__write_data = decode__store;
         scratch__write_enable = decode__valid & (decode__op == op_sts);
+        engine_load = decode__valid & (decode__op == op_ld);
         mem_load_r__d = 32'h0;
-        if (decode__valid & (decode__op == op_ld)) begin
+        if (engine_load) begin
             mem_load_r__d = one_bank << decode__bank;
         end
-        engine_loads_triangles = decode__valid & (decode__op == op_ld) & ((decode__bank == bank_triangles_a) | (decode__bank == bank_triangles_b));
+        engine_loads_triangles = engine_load & ((decode__bank == bank_triangles_a) | (decode__bank == bank_triangles_b));
         shader__tri_grant = c_shading & (~engine_loads_triangles);
         tri_load_addr_r__d = execute__mem_address[(32'h0)+:(24)];
         if (shader__tri_read & shader__tri_grant) begin
@@ -2208,7 +2210,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         shader__tri_rdata_b = bank3_rdata;
         mem_bank_r__d = decode__bank;
         mem_addr_r__d = execute__mem_address[(32'h0)+:(24)];
-        shader__frame_grant = c_shading & (~(decode__valid & (decode__op == op_ld)));
+        shader__frame_grant = c_shading & (~engine_load);
         if (shader__frame_read & shader__frame_grant) begin
             mem_load_r__d = mem_load_r__d | frame_bank;
             mem_bank_r__d = bank_frame;
@@ -22385,6 +22387,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [4:0] l_thread;
     reg  [31:0] l_a;
     reg  [31:0] l_b;
+    reg  l_loaded;
+    reg  [3:0] l_received;
     reg  l_ready;
     reg  a_take;
     reg  b_take;
@@ -23596,28 +23600,33 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         l_thread = cur_thread__0__q;
         l_a = cur_a__0__q;
         l_b = cur_b__0__q;
-        l_ready = loaded__0__q & ((cur_kind__0__q != c_test_triangle) | (received__0__q == 32'hc));
+        l_loaded = loaded__0__q;
+        l_received = received__0__q;
         if (lb__q == c_buffer__1) begin
             l_kind = cur_kind__1__q;
             l_thread = cur_thread__1__q;
             l_a = cur_a__1__q;
             l_b = cur_b__1__q;
-            l_ready = loaded__1__q & ((cur_kind__1__q != c_test_triangle) | (received__1__q == 32'hc));
+            l_loaded = loaded__1__q;
+            l_received = received__1__q;
         end
         if (lb__q == c_buffer__2) begin
             l_kind = cur_kind__2__q;
             l_thread = cur_thread__2__q;
             l_a = cur_a__2__q;
             l_b = cur_b__2__q;
-            l_ready = loaded__2__q & ((cur_kind__2__q != c_test_triangle) | (received__2__q == 32'hc));
+            l_loaded = loaded__2__q;
+            l_received = received__2__q;
         end
         if (lb__q == c_buffer__3) begin
             l_kind = cur_kind__3__q;
             l_thread = cur_thread__3__q;
             l_a = cur_a__3__q;
             l_b = cur_b__3__q;
-            l_ready = loaded__3__q & ((cur_kind__3__q != c_test_triangle) | (received__3__q == 32'hc));
+            l_loaded = loaded__3__q;
+            l_received = received__3__q;
         end
+        l_ready = l_loaded & ((l_kind != c_test_triangle) | (l_received == 32'hc));
         transform_unit__m__0 = words__0__read_data;
         transform_unit__m__1 = words__1__read_data;
         transform_unit__m__2 = words__2__read_data;

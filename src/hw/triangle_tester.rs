@@ -222,6 +222,8 @@ pub struct TriangleTester<
     l_thread: Signal<Local, Bits<5>>,
     l_a: Signal<Local, Bits<32>>,
     l_b: Signal<Local, Bits<32>>,
+    l_loaded: Signal<Local, Bit>,
+    l_received: Signal<Local, Bits<4>>,
     l_ready: Signal<Local, Bit>,
     a_take: Signal<Local, Bit>,
     b_take: Signal<Local, Bit>,
@@ -414,6 +416,8 @@ impl<
             l_thread: Default::default(),
             l_a: Default::default(),
             l_b: Default::default(),
+            l_loaded: Default::default(),
+            l_received: Default::default(),
             l_ready: Default::default(),
             a_issued: Default::default(),
             b_issued: Default::default(),
@@ -778,20 +782,20 @@ impl<
         // A buffer's word count is cleared as the launch frees it, not at the take: the
         // take, in the clock of the fetch's last requests, was the critical path through the
         // count (stops 33 and 38, `b_issued -> received`).
-        self.l_ready.next = self.loaded[0].q.val()
-            & ((self.cur_kind[0].q.val() != self.c_test_triangle.val())
-                | (self.received[0].q.val() == 12));
+        self.l_loaded.next = self.loaded[0].q.val();
+        self.l_received.next = self.received[0].q.val();
         for k in 1..4 {
             if self.lb.q.val() == self.c_buffer[k].val() {
                 self.l_kind.next = self.cur_kind[k].q.val();
                 self.l_thread.next = self.cur_thread[k].q.val();
                 self.l_a.next = self.cur_a[k].q.val();
                 self.l_b.next = self.cur_b[k].q.val();
-                self.l_ready.next = self.loaded[k].q.val()
-                    & ((self.cur_kind[k].q.val() != self.c_test_triangle.val())
-                        | (self.received[k].q.val() == 12));
+                self.l_loaded.next = self.loaded[k].q.val();
+                self.l_received.next = self.received[k].q.val();
             }
         }
+        self.l_ready.next = self.l_loaded.val()
+            & ((self.l_kind.val() != self.c_test_triangle.val()) | (self.l_received.val() == 12));
         for k in 0..12 {
             self.transform_unit.m[k].next = self.words[k].read_data.val();
         }

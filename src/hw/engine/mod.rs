@@ -312,6 +312,8 @@ pub struct ThreadEngine<
     /// The address of banks 2 and 3 the tester's ports read for the engine: a load's, or the
     /// ShadeUnit's in a clock the engine's loads leave them.
     tri_load_addr_r: DFF<Bits<24>>,
+    /// The engine's load in decode (one memory port for it, the ShadeUnit and the list unit).
+    engine_load: Signal<Local, Bit>,
     engine_loads_triangles: Signal<Local, Bit>,
     /// The ShadeUnit's request goes to the TransformUnit (after ray generation's and instance
     /// entry's).
@@ -513,6 +515,7 @@ impl<
             normal_offer: Default::default(),
             shade_offer: Default::default(),
             tri_load_addr_r: Default::default(),
+            engine_load: Default::default(),
             engine_loads_triangles: Default::default(),
             gen_shade: Default::default(),
             in_frame: Default::default(),
@@ -801,14 +804,15 @@ impl<
             self.decode.valid.val() & (self.decode.op.val() == self.op_sts.val());
 
         // Memory and frame-buffer ports (registered).
+        self.engine_load.next =
+            self.decode.valid.val() & (self.decode.op.val() == self.op_ld.val());
         self.mem_load_r.d.next = 0.into();
-        if self.decode.valid.val() & (self.decode.op.val() == self.op_ld.val()) {
+        if self.engine_load.val() {
             self.mem_load_r.d.next = self.one_bank.val() << self.decode.bank.val();
         }
         // The ShadeUnit reads banks 2 and 3 at once in a clock the engine's loads leave them,
         // as a load of both (registered like the engine's: a clock more of latency).
-        self.engine_loads_triangles.next = self.decode.valid.val()
-            & (self.decode.op.val() == self.op_ld.val())
+        self.engine_loads_triangles.next = self.engine_load.val()
             & ((self.decode.bank.val() == self.bank_triangles_a.val())
                 | (self.decode.bank.val() == self.bank_triangles_b.val()));
         self.shader.tri_grant.next = self.c_shading.val() & (!self.engine_loads_triangles.val());
@@ -826,8 +830,7 @@ impl<
         // engine's. (Granted on the bus's free clocks, the grant ran from the list unit's
         // state into the unit's dispatch, 71.4 MHz placed; granted first, from the unit's
         // dispatch into the list unit's room count, 65.2 MHz.)
-        self.shader.frame_grant.next = self.c_shading.val()
-            & (!(self.decode.valid.val() & (self.decode.op.val() == self.op_ld.val())));
+        self.shader.frame_grant.next = self.c_shading.val() & (!self.engine_load.val());
         if self.shader.frame_read.val() & self.shader.frame_grant.val() {
             self.mem_load_r.d.next = self.mem_load_r.d.val() | self.frame_bank.val();
             self.mem_bank_r.d.next = self.bank_frame.val();
