@@ -412,6 +412,8 @@ pub struct FrameReport {
     /// Thread-clocks waiting for an issue slot and asleep in a coprocessor wait.
     pub ready_thread_clocks: u64,
     pub asleep_thread_clocks: u64,
+    /// Words read from each bank (`layout::BANK_NAMES`).
+    pub bank_reads: [u64; 6],
     pub pixels: u64,
     pub mismatches: Vec<Mismatch>,
     pub differing_pixels: usize,
@@ -456,6 +458,12 @@ impl FrameReport {
             self.traversal_busy,
         ]
         .map(|n| n as f64 / c)
+    }
+    /// Bytes the frame moved over the memory ports per second at a clock of `hz`: every
+    /// bank's 32-bit reads and the frame buffer's writes (one a pixel).
+    pub fn memory_bytes_per_second_at(&self, hz: f64) -> f64 {
+        let words = self.bank_reads.iter().sum::<u64>() + self.pixels;
+        4.0 * words as f64 * self.fps_at(hz)
     }
     /// Shares of the frame's thread-clocks (`threads` x cycles): waiting for an issue slot,
     /// asleep in a coprocessor wait, and the rest (an instruction in the engine's pipeline,
@@ -628,6 +636,7 @@ pub fn simulate_scene(
             shading_busy: fr.shading_busy,
             ready_thread_clocks: fr.ready_thread_clocks,
             asleep_thread_clocks: fr.asleep_thread_clocks,
+            bank_reads: fr.bank_reads,
             pixels: u64::from(w * h),
             differing_pixels: differing.len(),
             mismatches,

@@ -66,6 +66,19 @@ fn check_scene(s: Scene, name: &str, frames: Option<u32>, sim: Simulator, format
             f.instructions,
             f.cycles
         );
+        // The testbench's memory counts its reads: every frame walks nodes and their lists,
+        // fetches triangles from both banks and loads the frame's constants; each bank's port
+        // gives at most a word a clock, and banks 1, 4 and 5 share one port.
+        let [nodes, lists, tri_a, tri_b, instances, frame] = f.bank_reads;
+        assert!(
+            [nodes, lists, tri_a, tri_b, frame].iter().all(|&r| r > 0)
+                && [nodes, tri_a, tri_b, lists + instances + frame]
+                    .iter()
+                    .all(|&r| r <= f.cycles),
+            "{name} frame {k}: bank reads {:?} in {} cycles",
+            f.bank_reads,
+            f.cycles
+        );
         // The RTL issues exactly the instructions the engine's twin executes.
         if k == 0 {
             assert_eq!(

@@ -359,6 +359,27 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
             100.0 * intersect,
             100.0 * traversal
         ),
+        {
+            let f = &r.frames[0];
+            let banks: Vec<String> = dynrt::layout::BANK_NAMES
+                .iter()
+                .zip(f.bank_reads)
+                .enumerate()
+                .map(|(b, (name, reads))| {
+                    format!(
+                        "{b} {name} {:.1} ({:.0}% of the clocks)",
+                        reads as f64 / f.pixels as f64,
+                        100.0 * reads as f64 / f.cycles.max(1) as f64
+                    )
+                })
+                .collect();
+            format!(
+                "memory (frame 0): words read per primary ray from bank {} (banks 1, 4 and 5 \
+                 share a port); {:.2} GB/s at {mhz:.1} MHz with the frame buffer's writes",
+                banks.join(", "),
+                f.memory_bytes_per_second_at(mhz * 1e6) / 1e9
+            )
+        },
         format!("engine issue slots by routine: {}", shares.join(", ")),
         {
             let [ready, asleep, rest] = r.frames[0].thread_shares(threads);

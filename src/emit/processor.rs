@@ -20,9 +20,10 @@
 //! (only the words that changed), a start pulse, a wait for `done` or the cycle limit (then
 //! `TIMEOUT` and a non-zero exit), and the frame buffer written to `frame<k>.hex` (one
 //! `RRGGBB` word a line) with `cycles instructions transform_busy intersect_busy
-//! traversal_busy raygen_busy instance_busy shading_busy ready_clocks asleep_clocks` (the
-//! last two thread-clocks: the bits of the scheduler's `ready` and `asleep` masks added up
-//! every clock) in `frame<k>.stats`, in the current
+//! traversal_busy raygen_busy instance_busy shading_busy ready_clocks asleep_clocks reads0 ..
+//! reads5` (`ready_clocks`, `asleep_clocks` are thread-clocks: the bits of the scheduler's
+//! `ready` and `asleep` masks added up every clock; `reads<b>` the words read from bank b) in
+//! `frame<k>.stats`, in the current
 //! folder or
 //! `+out_dir=DIR`. Both files start with the [`GeneratedBy`] header.
 
@@ -276,7 +277,7 @@ const TESTBENCH_DRIVES: [(&str, &str); 5] = [
 ];
 
 /// The ports the testbench's memory model and frame loop use by name.
-const TESTBENCH_USES: [&str; 23] = [
+const TESTBENCH_USES: [&str; 26] = [
     "done",
     "cycles",
     "instructions",
@@ -287,10 +288,13 @@ const TESTBENCH_USES: [&str; 23] = [
     "fb_write",
     "fb_addr",
     "fb_data",
+    "bank0_read",
     "bank0_addr",
     "bank0_rdata",
+    "bank2_read",
     "bank2_addr",
     "bank2_rdata",
+    "bank3_read",
     "bank3_addr",
     "bank3_rdata",
     "transform_busy",
@@ -400,7 +404,8 @@ pub fn processor_testbench(
     let _ = writeln!(
         v,
         "  integer px;\n  string mem_dir, out_dir;\n  reg [63:0] clocks = 0, heartbeat = 0;\n  integer frame = 0, rays = 0;\n\
-         \x20 reg [63:0] ready_clocks = 0, asleep_clocks = 0;"
+         \x20 reg [63:0] ready_clocks = 0, asleep_clocks = 0;\n\
+         \x20 reg [63:0] reads0 = 0, reads1 = 0, reads2 = 0, reads3 = 0, reads4 = 0, reads5 = 0;"
     );
     for (b, name) in BANK_NAMES.iter().enumerate() {
         let _ = writeln!(
@@ -427,6 +432,13 @@ pub fn processor_testbench(
          \x20   // Thread-clocks: threads waiting for an issue slot, threads asleep in a wait.\n\
          \x20   ready_clocks <= ready_clocks + $countones(dut.{ready_mask});\n\
          \x20   asleep_clocks <= asleep_clocks + $countones(dut.{asleep_mask});\n\
+         \x20   // Words read from each bank (banks 1, 4 and 5 share the `mem` port).\n\
+         \x20   if (bank0_read) reads0 <= reads0 + 1;\n\
+         \x20   if (bank2_read) reads2 <= reads2 + 1;\n\
+         \x20   if (bank3_read) reads3 <= reads3 + 1;\n\
+         \x20   if (mem_read && mem_bank == 3'd1) reads1 <= reads1 + 1;\n\
+         \x20   if (mem_read && mem_bank == 3'd4) reads4 <= reads4 + 1;\n\
+         \x20   if (mem_read && mem_bank == 3'd5) reads5 <= reads5 + 1;\n\
          \x20   if (heartbeat != 0 && clocks % heartbeat == 0 && clocks != 0)\n\
          \x20     $display(\"dynrt-heartbeat frame %0d: %0d cycles, %0d rays\", frame, cycles, rays);\n\
          \x20 end\n\
@@ -496,16 +508,18 @@ pub fn processor_testbench(
         }
         let _ = writeln!(
             v,
-            "    frame = {fr}; rays = 0; ready_clocks = 0; asleep_clocks = 0;\n    @(negedge clock) start = 1'b1;\n    @(negedge clock) start = 1'b0;\n\
+            "    frame = {fr}; rays = 0; ready_clocks = 0; asleep_clocks = 0;\n\
+             \x20   reads0 = 0; reads1 = 0; reads2 = 0; reads3 = 0; reads4 = 0; reads5 = 0;\n    @(negedge clock) start = 1'b1;\n    @(negedge clock) start = 1'b0;\n\
              \x20   n = 0;\n    while (!done && n < {limit}) begin @(posedge clock); n = n + 1; end\n\
              \x20   if (!done) begin\n      $display(\"TIMEOUT: frame {fr} not done after {limit} clocks\");\n\
              \x20     $fatal(1, \"timeout\");\n    end\n\
              \x20   fd = $fopen({{out_dir, \"/frame{fr}.hex\"}}, \"w\");\n\
              \x20   for (k = 0; k < {px}; k = k + 1) $fwrite(fd, \"%06h\\n\", bank5[{fb} + k][23:0]);\n\
              \x20   $fclose(fd);\n    fd = $fopen({{out_dir, \"/frame{fr}.stats\"}}, \"w\");\n\
-             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\\n\", cycles, instructions,\n\
-             \x20     transform_busy, intersect_busy, traversal_busy, raygen_busy, instance_busy,\n\
-             \x20     shading_busy, ready_clocks, asleep_clocks);\n    $fclose(fd);\n\
+             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\\n\",\n\
+             \x20     cycles, instructions, transform_busy, intersect_busy, traversal_busy, raygen_busy,\n\
+             \x20     instance_busy, shading_busy, ready_clocks, asleep_clocks,\n\
+             \x20     reads0, reads1, reads2, reads3, reads4, reads5);\n    $fclose(fd);\n\
              \x20   $display(\"frame {fr}: %0d cycles, %0d instructions\", cycles, instructions);",
             limit = frames.cycle_limit,
             px = frames.pixels,

@@ -41,6 +41,8 @@ pub struct SimFrame {
     /// the scheduler's `ready` and `asleep` masks, added up every clock of the frame.
     pub ready_thread_clocks: u64,
     pub asleep_thread_clocks: u64,
+    /// Words read from each bank (`layout::BANK_NAMES`), counted by the testbench's memory.
+    pub bank_reads: [u64; 6],
 }
 
 /// What a processor simulation produced.
@@ -305,10 +307,11 @@ pub fn simulate_processor(
             .split_whitespace()
             .filter_map(|w| w.parse().ok())
             .collect();
-        if nums.len() != 10 {
+        if nums.len() != 16 {
             bail!(
                 "{}: expected `cycles instructions transform_busy intersect_busy traversal_busy \
-                 raygen_busy instance_busy shading_busy ready_clocks asleep_clocks`, \
+                 raygen_busy instance_busy shading_busy ready_clocks asleep_clocks reads0 reads1 \
+                 reads2 reads3 reads4 reads5`, \
                  got `{}`",
                 stats_path.display(),
                 stats.trim()
@@ -326,6 +329,7 @@ pub fn simulate_processor(
             shading_busy: nums[7],
             ready_thread_clocks: nums[8],
             asleep_thread_clocks: nums[9],
+            bank_reads: std::array::from_fn(|b| nums[10 + b]),
         });
     }
     let vga = if capture_vga {

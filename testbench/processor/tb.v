@@ -45,6 +45,7 @@ module tb;
   reg [63:0] clocks = 0, heartbeat = 0;
   integer frame = 0, rays = 0;
   reg [63:0] ready_clocks = 0, asleep_clocks = 0;
+  reg [63:0] reads0 = 0, reads1 = 0, reads2 = 0, reads3 = 0, reads4 = 0, reads5 = 0;
   reg [31:0] bank0 [0:117]; // nodes
   reg [31:0] bank1 [0:104]; // lists
   reg [31:0] bank2 [0:239]; // triangles_a
@@ -67,6 +68,13 @@ module tb;
     // Thread-clocks: threads waiting for an issue slot, threads asleep in a wait.
     ready_clocks <= ready_clocks + $countones(dut.engine.scheduler.ready__q);
     asleep_clocks <= asleep_clocks + $countones(dut.engine.scheduler.asleep__q);
+    // Words read from each bank (banks 1, 4 and 5 share the `mem` port).
+    if (bank0_read) reads0 <= reads0 + 1;
+    if (bank2_read) reads2 <= reads2 + 1;
+    if (bank3_read) reads3 <= reads3 + 1;
+    if (mem_read && mem_bank == 3'd1) reads1 <= reads1 + 1;
+    if (mem_read && mem_bank == 3'd4) reads4 <= reads4 + 1;
+    if (mem_read && mem_bank == 3'd5) reads5 <= reads5 + 1;
     if (heartbeat != 0 && clocks % heartbeat == 0 && clocks != 0)
       $display("dynrt-heartbeat frame %0d: %0d cycles, %0d rays", frame, cycles, rays);
   end
@@ -141,6 +149,7 @@ module tb;
     $readmemh({mem_dir, "/bank4_instances.hex"}, bank4);
     $readmemh({mem_dir, "/bank5_frame.hex"}, bank5);
     frame = 0; rays = 0; ready_clocks = 0; asleep_clocks = 0;
+    reads0 = 0; reads1 = 0; reads2 = 0; reads3 = 0; reads4 = 0; reads5 = 0;
     @(negedge clock) start = 1'b1;
     @(negedge clock) start = 1'b0;
     n = 0;
@@ -153,9 +162,10 @@ module tb;
     for (k = 0; k < 3072; k = k + 1) $fwrite(fd, "%06h\n", bank5[46 + k][23:0]);
     $fclose(fd);
     fd = $fopen({out_dir, "/frame0.stats"}, "w");
-    $fwrite(fd, "%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\n", cycles, instructions,
-      transform_busy, intersect_busy, traversal_busy, raygen_busy, instance_busy,
-      shading_busy, ready_clocks, asleep_clocks);
+    $fwrite(fd, "%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\n",
+      cycles, instructions, transform_busy, intersect_busy, traversal_busy, raygen_busy,
+      instance_busy, shading_busy, ready_clocks, asleep_clocks,
+      reads0, reads1, reads2, reads3, reads4, reads5);
     $fclose(fd);
     $display("frame 0: %0d cycles, %0d instructions", cycles, instructions);
     if ($test$plusargs("vga")) begin
