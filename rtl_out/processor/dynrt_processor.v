@@ -17264,6 +17264,12 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  [23:0] res_v_r__2__d;
     wire  [23:0] res_v_r__2__q;
     reg  res_v_r__2__clock;
+    reg  [3:0] res_step_r__d;
+    wire  [3:0] res_step_r__q;
+    reg  res_step_r__clock;
+    reg  [2:0] res_light_r__d;
+    wire  [2:0] res_light_r__q;
+    reg  res_light_r__clock;
     reg  tri_line__clock;
     reg  [8:0] tri_line__data_in;
     wire  [8:0] tri_line__data_out;
@@ -17358,8 +17364,6 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  [23:0] req_v__2;
     reg  req_point;
     reg  req_diagonal;
-    reg  [3:0] res_step;
-    reg  [2:0] res_light;
     reg  res_positive;
     reg  tu_step;
     reg  tri_word_0;
@@ -17516,42 +17520,42 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(ready__7__q),
         .clock(ready__7__clock)
     );
-    dynrt_processor__engine__shader__s1_step step__0(
+    dynrt_processor__engine__shader__res_step_r step__0(
         .d(step__0__d),
         .q(step__0__q),
         .clock(step__0__clock)
     );
-    dynrt_processor__engine__shader__s1_step step__1(
+    dynrt_processor__engine__shader__res_step_r step__1(
         .d(step__1__d),
         .q(step__1__q),
         .clock(step__1__clock)
     );
-    dynrt_processor__engine__shader__s1_step step__2(
+    dynrt_processor__engine__shader__res_step_r step__2(
         .d(step__2__d),
         .q(step__2__q),
         .clock(step__2__clock)
     );
-    dynrt_processor__engine__shader__s1_step step__3(
+    dynrt_processor__engine__shader__res_step_r step__3(
         .d(step__3__d),
         .q(step__3__q),
         .clock(step__3__clock)
     );
-    dynrt_processor__engine__shader__s1_step step__4(
+    dynrt_processor__engine__shader__res_step_r step__4(
         .d(step__4__d),
         .q(step__4__q),
         .clock(step__4__clock)
     );
-    dynrt_processor__engine__shader__s1_step step__5(
+    dynrt_processor__engine__shader__res_step_r step__5(
         .d(step__5__d),
         .q(step__5__q),
         .clock(step__5__clock)
     );
-    dynrt_processor__engine__shader__s1_step step__6(
+    dynrt_processor__engine__shader__res_step_r step__6(
         .d(step__6__d),
         .q(step__6__q),
         .clock(step__6__clock)
     );
-    dynrt_processor__engine__shader__s1_step step__7(
+    dynrt_processor__engine__shader__res_step_r step__7(
         .d(step__7__d),
         .q(step__7__q),
         .clock(step__7__clock)
@@ -18050,7 +18054,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(s1_word__q),
         .clock(s1_word__clock)
     );
-    dynrt_processor__engine__shader__s1_step s1_step(
+    dynrt_processor__engine__shader__res_step_r s1_step(
         .d(s1_step__d),
         .q(s1_step__q),
         .clock(s1_step__clock)
@@ -18189,6 +18193,16 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .d(res_v_r__2__d),
         .q(res_v_r__2__q),
         .clock(res_v_r__2__clock)
+    );
+    dynrt_processor__engine__shader__res_step_r res_step_r(
+        .d(res_step_r__d),
+        .q(res_step_r__q),
+        .clock(res_step_r__clock)
+    );
+    dynrt_processor__engine__mem_bank_r res_light_r(
+        .d(res_light_r__d),
+        .q(res_light_r__q),
+        .clock(res_light_r__clock)
     );
     dynrt_processor__engine__shader__frame_line tri_line(
         .clock(tri_line__clock),
@@ -19082,83 +19096,85 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         res_v_r__1__d = res_v__1;
         res_v_r__2__clock = clock;
         res_v_r__2__d = res_v__2;
-        res_step = ShadeStep__Idle;
-        res_light = 32'h0;
-        if (res_slot_r__q == c_slot__0) begin
-            res_step = step__0__q;
-            res_light = light__0__q;
+        res_step_r__clock = clock;
+        res_light_r__clock = clock;
+        res_step_r__d = ShadeStep__Idle;
+        res_light_r__d = 32'h0;
+        if (res_slot == c_slot__0) begin
+            res_step_r__d = step__0__q;
+            res_light_r__d = light__0__q;
         end
-        if (res_slot_r__q == c_slot__1) begin
-            res_step = step__1__q;
-            res_light = light__1__q;
+        if (res_slot == c_slot__1) begin
+            res_step_r__d = step__1__q;
+            res_light_r__d = light__1__q;
         end
-        if (res_slot_r__q == c_slot__2) begin
-            res_step = step__2__q;
-            res_light = light__2__q;
+        if (res_slot == c_slot__2) begin
+            res_step_r__d = step__2__q;
+            res_light_r__d = light__2__q;
         end
-        if (res_slot_r__q == c_slot__3) begin
-            res_step = step__3__q;
-            res_light = light__3__q;
+        if (res_slot == c_slot__3) begin
+            res_step_r__d = step__3__q;
+            res_light_r__d = light__3__q;
         end
-        if (res_slot_r__q == c_slot__4) begin
-            res_step = step__4__q;
-            res_light = light__4__q;
+        if (res_slot == c_slot__4) begin
+            res_step_r__d = step__4__q;
+            res_light_r__d = light__4__q;
         end
-        if (res_slot_r__q == c_slot__5) begin
-            res_step = step__5__q;
-            res_light = light__5__q;
+        if (res_slot == c_slot__5) begin
+            res_step_r__d = step__5__q;
+            res_light_r__d = light__5__q;
         end
-        if (res_slot_r__q == c_slot__6) begin
-            res_step = step__6__q;
-            res_light = light__6__q;
+        if (res_slot == c_slot__6) begin
+            res_step_r__d = step__6__q;
+            res_light_r__d = light__6__q;
         end
-        if (res_slot_r__q == c_slot__7) begin
-            res_step = step__7__q;
-            res_light = light__7__q;
+        if (res_slot == c_slot__7) begin
+            res_step_r__d = step__7__q;
+            res_light_r__d = light__7__q;
         end
         res_positive = (~|(res_v_r__0__q & c_sign)) & |(res_v_r__0__q & c_exp_mask) & (~(((res_v_r__0__q & c_exp_mask) == c_exp_mask) & |(res_v_r__0__q & c_man_mask)));
         p__0__write_address = res_slot_r__q;
         p__0__write_data = res_v_r__0__q;
-        p__0__write_enable = res_valid_r__q & (res_step == ShadeStep__Point);
+        p__0__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__Point);
         acc__0__write_address = res_slot_r__q;
         acc__0__write_data = res_v_r__0__q;
-        acc__0__write_enable = res_valid_r__q & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
+        acc__0__write_enable = res_valid_r__q & ((res_step_r__q == ShadeStep__Ambient) | (res_step_r__q == ShadeStep__Accumulate));
         to_light__0__write_address = res_slot_r__q;
         to_light__0__write_data = res_v_r__0__q;
-        to_light__0__write_enable = res_valid_r__q & (res_step == ShadeStep__ToLight);
+        to_light__0__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__ToLight);
         tint__0__write_address = res_slot_r__q;
         tint__0__write_data = res_v_r__0__q;
-        tint__0__write_enable = res_valid_r__q & (res_step == ShadeStep__Tint);
+        tint__0__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__Tint);
         p__1__write_address = res_slot_r__q;
         p__1__write_data = res_v_r__1__q;
-        p__1__write_enable = res_valid_r__q & (res_step == ShadeStep__Point);
+        p__1__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__Point);
         acc__1__write_address = res_slot_r__q;
         acc__1__write_data = res_v_r__1__q;
-        acc__1__write_enable = res_valid_r__q & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
+        acc__1__write_enable = res_valid_r__q & ((res_step_r__q == ShadeStep__Ambient) | (res_step_r__q == ShadeStep__Accumulate));
         to_light__1__write_address = res_slot_r__q;
         to_light__1__write_data = res_v_r__1__q;
-        to_light__1__write_enable = res_valid_r__q & (res_step == ShadeStep__ToLight);
+        to_light__1__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__ToLight);
         tint__1__write_address = res_slot_r__q;
         tint__1__write_data = res_v_r__1__q;
-        tint__1__write_enable = res_valid_r__q & (res_step == ShadeStep__Tint);
+        tint__1__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__Tint);
         p__2__write_address = res_slot_r__q;
         p__2__write_data = res_v_r__2__q;
-        p__2__write_enable = res_valid_r__q & (res_step == ShadeStep__Point);
+        p__2__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__Point);
         acc__2__write_address = res_slot_r__q;
         acc__2__write_data = res_v_r__2__q;
-        acc__2__write_enable = res_valid_r__q & ((res_step == ShadeStep__Ambient) | (res_step == ShadeStep__Accumulate));
+        acc__2__write_enable = res_valid_r__q & ((res_step_r__q == ShadeStep__Ambient) | (res_step_r__q == ShadeStep__Accumulate));
         to_light__2__write_address = res_slot_r__q;
         to_light__2__write_data = res_v_r__2__q;
-        to_light__2__write_enable = res_valid_r__q & (res_step == ShadeStep__ToLight);
+        to_light__2__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__ToLight);
         tint__2__write_address = res_slot_r__q;
         tint__2__write_data = res_v_r__2__q;
-        tint__2__write_enable = res_valid_r__q & (res_step == ShadeStep__Tint);
+        tint__2__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__Tint);
         n_dot_l__write_address = res_slot_r__q;
         n_dot_l__write_data = res_v_r__0__q;
-        n_dot_l__write_enable = res_valid_r__q & (res_step == ShadeStep__Dots);
+        n_dot_l__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__Dots);
         l_dot_l__write_address = res_slot_r__q;
         l_dot_l__write_data = res_v_r__1__q;
-        l_dot_l__write_enable = res_valid_r__q & (res_step == ShadeStep__Dots);
+        l_dot_l__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__Dots);
         div__in_valid = sqrt__out_valid;
         div__a = cos_n_dot_l__data_out;
         div__b = sqrt__result;
@@ -19203,33 +19219,33 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         end
         if (res_valid_r__q & (res_slot_r__q == c_slot__0)) begin
             ready__0__d = 1'b1;
-            if (res_step == ShadeStep__Point) begin
+            if (res_step_r__q == ShadeStep__Point) begin
                 step__0__d = ShadeStep__NormalDot;
             end
-            if (res_step == ShadeStep__NormalDot) begin
+            if (res_step_r__q == ShadeStep__NormalDot) begin
                 flip__0__d = res_positive;
                 step__0__d = ShadeStep__KdLoad;
             end
-            if (res_step == ShadeStep__Ambient) begin
+            if (res_step_r__q == ShadeStep__Ambient) begin
                 step__0__d = ShadeStep__Pack;
                 if (c_has_lights) begin
                     step__0__d = ShadeStep__ToLight;
                 end
             end
-            if (res_step == ShadeStep__ToLight) begin
+            if (res_step_r__q == ShadeStep__ToLight) begin
                 step__0__d = ShadeStep__Dots;
             end
-            if (res_step == ShadeStep__Tint) begin
+            if (res_step_r__q == ShadeStep__Tint) begin
                 step__0__d = ShadeStep__Accumulate;
             end
-            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
                 step__0__d = ShadeStep__ToLight;
-                light__0__d = res_light + 32'h1;
-                if (res_light == c_last_light) begin
+                light__0__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
                     step__0__d = ShadeStep__Pack;
                 end
             end
-            if ((res_step == ShadeStep__Dots) & res_positive) begin
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
                 step__0__d = ShadeStep__Cosine;
             end
         end
@@ -19269,33 +19285,33 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         end
         if (res_valid_r__q & (res_slot_r__q == c_slot__1)) begin
             ready__1__d = 1'b1;
-            if (res_step == ShadeStep__Point) begin
+            if (res_step_r__q == ShadeStep__Point) begin
                 step__1__d = ShadeStep__NormalDot;
             end
-            if (res_step == ShadeStep__NormalDot) begin
+            if (res_step_r__q == ShadeStep__NormalDot) begin
                 flip__1__d = res_positive;
                 step__1__d = ShadeStep__KdLoad;
             end
-            if (res_step == ShadeStep__Ambient) begin
+            if (res_step_r__q == ShadeStep__Ambient) begin
                 step__1__d = ShadeStep__Pack;
                 if (c_has_lights) begin
                     step__1__d = ShadeStep__ToLight;
                 end
             end
-            if (res_step == ShadeStep__ToLight) begin
+            if (res_step_r__q == ShadeStep__ToLight) begin
                 step__1__d = ShadeStep__Dots;
             end
-            if (res_step == ShadeStep__Tint) begin
+            if (res_step_r__q == ShadeStep__Tint) begin
                 step__1__d = ShadeStep__Accumulate;
             end
-            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
                 step__1__d = ShadeStep__ToLight;
-                light__1__d = res_light + 32'h1;
-                if (res_light == c_last_light) begin
+                light__1__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
                     step__1__d = ShadeStep__Pack;
                 end
             end
-            if ((res_step == ShadeStep__Dots) & res_positive) begin
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
                 step__1__d = ShadeStep__Cosine;
             end
         end
@@ -19335,33 +19351,33 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         end
         if (res_valid_r__q & (res_slot_r__q == c_slot__2)) begin
             ready__2__d = 1'b1;
-            if (res_step == ShadeStep__Point) begin
+            if (res_step_r__q == ShadeStep__Point) begin
                 step__2__d = ShadeStep__NormalDot;
             end
-            if (res_step == ShadeStep__NormalDot) begin
+            if (res_step_r__q == ShadeStep__NormalDot) begin
                 flip__2__d = res_positive;
                 step__2__d = ShadeStep__KdLoad;
             end
-            if (res_step == ShadeStep__Ambient) begin
+            if (res_step_r__q == ShadeStep__Ambient) begin
                 step__2__d = ShadeStep__Pack;
                 if (c_has_lights) begin
                     step__2__d = ShadeStep__ToLight;
                 end
             end
-            if (res_step == ShadeStep__ToLight) begin
+            if (res_step_r__q == ShadeStep__ToLight) begin
                 step__2__d = ShadeStep__Dots;
             end
-            if (res_step == ShadeStep__Tint) begin
+            if (res_step_r__q == ShadeStep__Tint) begin
                 step__2__d = ShadeStep__Accumulate;
             end
-            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
                 step__2__d = ShadeStep__ToLight;
-                light__2__d = res_light + 32'h1;
-                if (res_light == c_last_light) begin
+                light__2__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
                     step__2__d = ShadeStep__Pack;
                 end
             end
-            if ((res_step == ShadeStep__Dots) & res_positive) begin
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
                 step__2__d = ShadeStep__Cosine;
             end
         end
@@ -19401,33 +19417,33 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         end
         if (res_valid_r__q & (res_slot_r__q == c_slot__3)) begin
             ready__3__d = 1'b1;
-            if (res_step == ShadeStep__Point) begin
+            if (res_step_r__q == ShadeStep__Point) begin
                 step__3__d = ShadeStep__NormalDot;
             end
-            if (res_step == ShadeStep__NormalDot) begin
+            if (res_step_r__q == ShadeStep__NormalDot) begin
                 flip__3__d = res_positive;
                 step__3__d = ShadeStep__KdLoad;
             end
-            if (res_step == ShadeStep__Ambient) begin
+            if (res_step_r__q == ShadeStep__Ambient) begin
                 step__3__d = ShadeStep__Pack;
                 if (c_has_lights) begin
                     step__3__d = ShadeStep__ToLight;
                 end
             end
-            if (res_step == ShadeStep__ToLight) begin
+            if (res_step_r__q == ShadeStep__ToLight) begin
                 step__3__d = ShadeStep__Dots;
             end
-            if (res_step == ShadeStep__Tint) begin
+            if (res_step_r__q == ShadeStep__Tint) begin
                 step__3__d = ShadeStep__Accumulate;
             end
-            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
                 step__3__d = ShadeStep__ToLight;
-                light__3__d = res_light + 32'h1;
-                if (res_light == c_last_light) begin
+                light__3__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
                     step__3__d = ShadeStep__Pack;
                 end
             end
-            if ((res_step == ShadeStep__Dots) & res_positive) begin
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
                 step__3__d = ShadeStep__Cosine;
             end
         end
@@ -19467,33 +19483,33 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         end
         if (res_valid_r__q & (res_slot_r__q == c_slot__4)) begin
             ready__4__d = 1'b1;
-            if (res_step == ShadeStep__Point) begin
+            if (res_step_r__q == ShadeStep__Point) begin
                 step__4__d = ShadeStep__NormalDot;
             end
-            if (res_step == ShadeStep__NormalDot) begin
+            if (res_step_r__q == ShadeStep__NormalDot) begin
                 flip__4__d = res_positive;
                 step__4__d = ShadeStep__KdLoad;
             end
-            if (res_step == ShadeStep__Ambient) begin
+            if (res_step_r__q == ShadeStep__Ambient) begin
                 step__4__d = ShadeStep__Pack;
                 if (c_has_lights) begin
                     step__4__d = ShadeStep__ToLight;
                 end
             end
-            if (res_step == ShadeStep__ToLight) begin
+            if (res_step_r__q == ShadeStep__ToLight) begin
                 step__4__d = ShadeStep__Dots;
             end
-            if (res_step == ShadeStep__Tint) begin
+            if (res_step_r__q == ShadeStep__Tint) begin
                 step__4__d = ShadeStep__Accumulate;
             end
-            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
                 step__4__d = ShadeStep__ToLight;
-                light__4__d = res_light + 32'h1;
-                if (res_light == c_last_light) begin
+                light__4__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
                     step__4__d = ShadeStep__Pack;
                 end
             end
-            if ((res_step == ShadeStep__Dots) & res_positive) begin
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
                 step__4__d = ShadeStep__Cosine;
             end
         end
@@ -19533,33 +19549,33 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         end
         if (res_valid_r__q & (res_slot_r__q == c_slot__5)) begin
             ready__5__d = 1'b1;
-            if (res_step == ShadeStep__Point) begin
+            if (res_step_r__q == ShadeStep__Point) begin
                 step__5__d = ShadeStep__NormalDot;
             end
-            if (res_step == ShadeStep__NormalDot) begin
+            if (res_step_r__q == ShadeStep__NormalDot) begin
                 flip__5__d = res_positive;
                 step__5__d = ShadeStep__KdLoad;
             end
-            if (res_step == ShadeStep__Ambient) begin
+            if (res_step_r__q == ShadeStep__Ambient) begin
                 step__5__d = ShadeStep__Pack;
                 if (c_has_lights) begin
                     step__5__d = ShadeStep__ToLight;
                 end
             end
-            if (res_step == ShadeStep__ToLight) begin
+            if (res_step_r__q == ShadeStep__ToLight) begin
                 step__5__d = ShadeStep__Dots;
             end
-            if (res_step == ShadeStep__Tint) begin
+            if (res_step_r__q == ShadeStep__Tint) begin
                 step__5__d = ShadeStep__Accumulate;
             end
-            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
                 step__5__d = ShadeStep__ToLight;
-                light__5__d = res_light + 32'h1;
-                if (res_light == c_last_light) begin
+                light__5__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
                     step__5__d = ShadeStep__Pack;
                 end
             end
-            if ((res_step == ShadeStep__Dots) & res_positive) begin
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
                 step__5__d = ShadeStep__Cosine;
             end
         end
@@ -19599,33 +19615,33 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         end
         if (res_valid_r__q & (res_slot_r__q == c_slot__6)) begin
             ready__6__d = 1'b1;
-            if (res_step == ShadeStep__Point) begin
+            if (res_step_r__q == ShadeStep__Point) begin
                 step__6__d = ShadeStep__NormalDot;
             end
-            if (res_step == ShadeStep__NormalDot) begin
+            if (res_step_r__q == ShadeStep__NormalDot) begin
                 flip__6__d = res_positive;
                 step__6__d = ShadeStep__KdLoad;
             end
-            if (res_step == ShadeStep__Ambient) begin
+            if (res_step_r__q == ShadeStep__Ambient) begin
                 step__6__d = ShadeStep__Pack;
                 if (c_has_lights) begin
                     step__6__d = ShadeStep__ToLight;
                 end
             end
-            if (res_step == ShadeStep__ToLight) begin
+            if (res_step_r__q == ShadeStep__ToLight) begin
                 step__6__d = ShadeStep__Dots;
             end
-            if (res_step == ShadeStep__Tint) begin
+            if (res_step_r__q == ShadeStep__Tint) begin
                 step__6__d = ShadeStep__Accumulate;
             end
-            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
                 step__6__d = ShadeStep__ToLight;
-                light__6__d = res_light + 32'h1;
-                if (res_light == c_last_light) begin
+                light__6__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
                     step__6__d = ShadeStep__Pack;
                 end
             end
-            if ((res_step == ShadeStep__Dots) & res_positive) begin
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
                 step__6__d = ShadeStep__Cosine;
             end
         end
@@ -19665,33 +19681,33 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         end
         if (res_valid_r__q & (res_slot_r__q == c_slot__7)) begin
             ready__7__d = 1'b1;
-            if (res_step == ShadeStep__Point) begin
+            if (res_step_r__q == ShadeStep__Point) begin
                 step__7__d = ShadeStep__NormalDot;
             end
-            if (res_step == ShadeStep__NormalDot) begin
+            if (res_step_r__q == ShadeStep__NormalDot) begin
                 flip__7__d = res_positive;
                 step__7__d = ShadeStep__KdLoad;
             end
-            if (res_step == ShadeStep__Ambient) begin
+            if (res_step_r__q == ShadeStep__Ambient) begin
                 step__7__d = ShadeStep__Pack;
                 if (c_has_lights) begin
                     step__7__d = ShadeStep__ToLight;
                 end
             end
-            if (res_step == ShadeStep__ToLight) begin
+            if (res_step_r__q == ShadeStep__ToLight) begin
                 step__7__d = ShadeStep__Dots;
             end
-            if (res_step == ShadeStep__Tint) begin
+            if (res_step_r__q == ShadeStep__Tint) begin
                 step__7__d = ShadeStep__Accumulate;
             end
-            if ((res_step == ShadeStep__Accumulate) | ((res_step == ShadeStep__Dots) & (~res_positive))) begin
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
                 step__7__d = ShadeStep__ToLight;
-                light__7__d = res_light + 32'h1;
-                if (res_light == c_last_light) begin
+                light__7__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
                     step__7__d = ShadeStep__Pack;
                 end
             end
-            if ((res_step == ShadeStep__Dots) & res_positive) begin
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
                 step__7__d = ShadeStep__Cosine;
             end
         end
@@ -21309,25 +21325,7 @@ endmodule // dynrt_processor__engine__shader__frame_line
 
 
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor__engine__shader__s1_step(d,q,clock);
+module dynrt_processor__engine__shader__res_step_r(d,q,clock);
     
     // Module arguments
     input wire  [3:0] d;
@@ -21358,7 +21356,29 @@ module dynrt_processor__engine__shader__s1_step(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor__engine__shader__s1_step
+endmodule // dynrt_processor__engine__shader__res_step_r
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 

@@ -239,8 +239,11 @@ pub struct ShadeUnit<
     res_valid_r: DFF<Bit>,
     res_slot_r: DFF<Bits<3>>,
     res_v_r: [DFF<Bits<W>>; 3],
-    res_step: Signal<Local, ShadeStep>,
-    res_light: Signal<Local, Bits<3>>,
+    /// The step and light of the result's slot, read as the result arrives and registered
+    /// with it (a slot waits for its one result, so they cannot change in between): the
+    /// slots' mux then the RAMs' write enables was stop 42's critical path in one clock.
+    res_step_r: DFF<ShadeStep>,
+    res_light_r: DFF<Bits<3>>,
     res_positive: Signal<Local, Bit>,
     tu_step: Signal<Local, Bit>,
     tri_word_0: Signal<Local, Bit>,
@@ -449,8 +452,8 @@ impl<
             res_valid_r: Default::default(),
             res_slot_r: Default::default(),
             res_v_r: Default::default(),
-            res_step: Default::default(),
-            res_light: Default::default(),
+            res_step_r: Default::default(),
+            res_light_r: Default::default(),
             res_positive: Default::default(),
             tu_step: Default::default(),
             tri_word_0: Default::default(),
@@ -1066,12 +1069,14 @@ impl<
             self.res_v_r[k].clock.next = self.clock.val();
             self.res_v_r[k].d.next = self.res_v[k].val();
         }
-        self.res_step.next = ShadeStep::Idle;
-        self.res_light.next = 0.into();
+        self.res_step_r.clock.next = self.clock.val();
+        self.res_light_r.clock.next = self.clock.val();
+        self.res_step_r.d.next = ShadeStep::Idle;
+        self.res_light_r.d.next = 0.into();
         for s in 0..SHADE_SLOTS {
-            if self.res_slot_r.q.val() == self.c_slot[s].val() {
-                self.res_step.next = self.step[s].q.val();
-                self.res_light.next = self.light[s].q.val();
+            if self.res_slot.val() == self.c_slot[s].val() {
+                self.res_step_r.d.next = self.step[s].q.val();
+                self.res_light_r.d.next = self.light[s].q.val();
             }
         }
         // 0 < res_v[0]: positive, not zero (nor subnormal, read as zero), not NaN.
@@ -1083,29 +1088,29 @@ impl<
             self.p[k].write_address.next = self.res_slot_r.q.val();
             self.p[k].write_data.next = self.res_v_r[k].q.val();
             self.p[k].write_enable.next =
-                self.res_valid_r.q.val() & (self.res_step.val() == ShadeStep::Point);
+                self.res_valid_r.q.val() & (self.res_step_r.q.val() == ShadeStep::Point);
             self.acc[k].write_address.next = self.res_slot_r.q.val();
             self.acc[k].write_data.next = self.res_v_r[k].q.val();
             self.acc[k].write_enable.next = self.res_valid_r.q.val()
-                & ((self.res_step.val() == ShadeStep::Ambient)
-                    | (self.res_step.val() == ShadeStep::Accumulate));
+                & ((self.res_step_r.q.val() == ShadeStep::Ambient)
+                    | (self.res_step_r.q.val() == ShadeStep::Accumulate));
             self.to_light[k].write_address.next = self.res_slot_r.q.val();
             self.to_light[k].write_data.next = self.res_v_r[k].q.val();
             self.to_light[k].write_enable.next =
-                self.res_valid_r.q.val() & (self.res_step.val() == ShadeStep::ToLight);
+                self.res_valid_r.q.val() & (self.res_step_r.q.val() == ShadeStep::ToLight);
             self.tint[k].write_address.next = self.res_slot_r.q.val();
             self.tint[k].write_data.next = self.res_v_r[k].q.val();
             self.tint[k].write_enable.next =
-                self.res_valid_r.q.val() & (self.res_step.val() == ShadeStep::Tint);
+                self.res_valid_r.q.val() & (self.res_step_r.q.val() == ShadeStep::Tint);
         }
         self.n_dot_l.write_address.next = self.res_slot_r.q.val();
         self.n_dot_l.write_data.next = self.res_v_r[0].q.val();
         self.n_dot_l.write_enable.next =
-            self.res_valid_r.q.val() & (self.res_step.val() == ShadeStep::Dots);
+            self.res_valid_r.q.val() & (self.res_step_r.q.val() == ShadeStep::Dots);
         self.l_dot_l.write_address.next = self.res_slot_r.q.val();
         self.l_dot_l.write_data.next = self.res_v_r[1].q.val();
         self.l_dot_l.write_enable.next =
-            self.res_valid_r.q.val() & (self.res_step.val() == ShadeStep::Dots);
+            self.res_valid_r.q.val() & (self.res_step_r.q.val() == ShadeStep::Dots);
 
         // ---- The cosine: sqrt(L . L), then n . L over it. ----
         self.div.in_valid.next = self.sqrt.out_valid.val();
@@ -1173,36 +1178,36 @@ impl<
             // A TransformUnit result.
             if self.res_valid_r.q.val() & (self.res_slot_r.q.val() == self.c_slot[s].val()) {
                 self.ready[s].d.next = true;
-                if self.res_step.val() == ShadeStep::Point {
+                if self.res_step_r.q.val() == ShadeStep::Point {
                     self.step[s].d.next = ShadeStep::NormalDot;
                 }
-                if self.res_step.val() == ShadeStep::NormalDot {
+                if self.res_step_r.q.val() == ShadeStep::NormalDot {
                     self.flip[s].d.next = self.res_positive.val();
                     self.step[s].d.next = ShadeStep::KdLoad;
                 }
-                if self.res_step.val() == ShadeStep::Ambient {
+                if self.res_step_r.q.val() == ShadeStep::Ambient {
                     self.step[s].d.next = ShadeStep::Pack;
                     if self.c_has_lights.val() {
                         self.step[s].d.next = ShadeStep::ToLight;
                     }
                 }
-                if self.res_step.val() == ShadeStep::ToLight {
+                if self.res_step_r.q.val() == ShadeStep::ToLight {
                     self.step[s].d.next = ShadeStep::Dots;
                 }
-                if self.res_step.val() == ShadeStep::Tint {
+                if self.res_step_r.q.val() == ShadeStep::Tint {
                     self.step[s].d.next = ShadeStep::Accumulate;
                 }
                 // The light is done (lit and added, or behind the surface): the next one.
-                if (self.res_step.val() == ShadeStep::Accumulate)
-                    | ((self.res_step.val() == ShadeStep::Dots) & (!self.res_positive.val()))
+                if (self.res_step_r.q.val() == ShadeStep::Accumulate)
+                    | ((self.res_step_r.q.val() == ShadeStep::Dots) & (!self.res_positive.val()))
                 {
                     self.step[s].d.next = ShadeStep::ToLight;
-                    self.light[s].d.next = self.res_light.val() + 1;
-                    if self.res_light.val() == self.c_last_light.val() {
+                    self.light[s].d.next = self.res_light_r.q.val() + 1;
+                    if self.res_light_r.q.val() == self.c_last_light.val() {
                         self.step[s].d.next = ShadeStep::Pack;
                     }
                 }
-                if (self.res_step.val() == ShadeStep::Dots) & self.res_positive.val() {
+                if (self.res_step_r.q.val() == ShadeStep::Dots) & self.res_positive.val() {
                     self.step[s].d.next = ShadeStep::Cosine;
                 }
             }
