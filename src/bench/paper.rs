@@ -56,12 +56,23 @@ pub struct SimFigures {
     pub width: u32,
     pub height: u32,
     pub cycles: u64,
+    /// 32-bit words the frame moved over the memory ports: every bank's reads and the frame
+    /// buffer's writes.
+    pub memory_words: u64,
     pub differing_pixels: usize,
 }
 
 impl SimFigures {
     pub fn cycles_per_pixel(&self) -> f64 {
         self.cycles as f64 / (u64::from(self.width) * u64::from(self.height)) as f64
+    }
+    pub fn memory_words_per_pixel(&self) -> f64 {
+        self.memory_words as f64 / (u64::from(self.width) * u64::from(self.height)) as f64
+    }
+    /// The memory bandwidth at a clock of `mhz`, in GB/s (the paper: about 2 without caches,
+    /// 1 with them, at 90 MHz).
+    pub fn memory_gb_per_s_at(&self, mhz: f64) -> f64 {
+        4.0 * self.memory_words as f64 / self.cycles.max(1) as f64 * mhz * 1e6 / 1e9
     }
     /// Frames per second at `mhz` of a 512x384 frame at this run's cycles per pixel.
     pub fn fps_at(&self, mhz: f64) -> f64 {
@@ -173,6 +184,7 @@ fn thousands(n: u64) -> String {
 /// The results as a table, fps at `clock_mhz` beside the paper's (one pipeline at 90 MHz).
 pub fn paper_table(results: &[PaperResult], clock_mhz: f64) -> Table {
     let fps_ours = format!("fps at {clock_mhz:.1} MHz (512x384)");
+    let bandwidth = format!("memory GB/s at {clock_mhz:.1} MHz");
     let mut t = Table::new(&[
         "scene",
         "paper triangles",
@@ -188,6 +200,8 @@ pub fn paper_table(results: &[PaperResult], clock_mhz: f64) -> Table {
         "simulated",
         "cycles/pixel",
         &fps_ours,
+        "memory words/pixel",
+        &bandwidth,
         "paper fps (90 MHz)",
         "paper / ours",
     ]);
@@ -202,7 +216,7 @@ pub fn paper_table(results: &[PaperResult], clock_mhz: f64) -> Table {
                 .collect();
             format!("no: {}", over.join(", "))
         };
-        let (simulated, cpp, fps, ratio) = match &r.sim {
+        let (simulated, cpp, fps, words, gbs, ratio) = match &r.sim {
             Sim::Ran(s) => {
                 let mut what = format!("{}x{}", s.width, s.height);
                 if (s.width, s.height) != (WIDTH, HEIGHT) {
@@ -219,10 +233,19 @@ pub fn paper_table(results: &[PaperResult], clock_mhz: f64) -> Table {
                     what,
                     format!("{:.1}", s.cycles_per_pixel()),
                     format!("{fps:.3}"),
+                    format!("{:.1}", s.memory_words_per_pixel()),
+                    format!("{:.3}", s.memory_gb_per_s_at(clock_mhz)),
                     format!("{:.0}", r.row.fps / fps),
                 )
             }
-            Sim::NotRun(why) => (format!("no: {why}"), "-".into(), "-".into(), "-".into()),
+            Sim::NotRun(why) => (
+                format!("no: {why}"),
+                "-".into(),
+                "-".into(),
+                "-".into(),
+                "-".into(),
+                "-".into(),
+            ),
         };
         t.push(vec![
             r.row.name.to_string(),
@@ -240,6 +263,8 @@ pub fn paper_table(results: &[PaperResult], clock_mhz: f64) -> Table {
             simulated,
             cpp,
             fps,
+            words,
+            gbs,
             format!("{:.1}", r.row.fps),
             ratio,
         ]);
@@ -288,7 +313,10 @@ pub fn paper_markdown(results: &[PaperResult], clock_mhz: f64, clock_source: &st
          that does not fit is rendered by the golden model from larger banks and not simulated. \
          Bytes per frame update: what the host writes to the banks between two frames of an \
          animated scene (the top-level tree's nodes and leaf lists, the instances' matrices), \
-         the largest over the animation, measured on its memory maps.\n\n\
+         the largest over the animation, measured on its memory maps. Memory words per pixel: \
+         the 32-bit words read from every bank (counted by the testbench's memory) and the frame \
+         buffer's writes; GB/s at the clock above (the paper needed about 2 GB/s at 90 MHz \
+         without caches, 1 with them).\n\n\
          {}\n\
          Bank sizes (MiB):\n\n{}\n{}",
         paper_table(results, clock_mhz).to_markdown(),
@@ -574,6 +602,7 @@ fn simulate(
         width: scene.camera.width,
         height: scene.camera.height,
         cycles: frame.cycles,
+        memory_words: frame.bank_reads.iter().sum::<u64>() + frame.pixels,
         differing_pixels: frame.differing_pixels,
     };
     say(
@@ -630,6 +659,8 @@ mod tests {
             width: 128,
             height: 96,
             cycles: 393_216,
+            // 20 words a pixel, 0.625 a clock: 0.225 GB/s at 90 MHz.
+            memory_words: 128 * 96 * 20,
             differing_pixels: 0,
         });
         let big = 9 << 20;
@@ -655,7 +686,7 @@ mod tests {
         assert_eq!(
             lines[1],
             "Scene6,806,820,806,1,1.77,yes,static,1.00,0.75,0.00,\
-             \"128x96 (same view, fps scaled to 512x384)\",32.0,14.305,60.8,4"
+             \"128x96 (same view, fps scaled to 512x384)\",32.0,14.305,20.0,0.225,60.8,4"
         );
         assert!(
             lines[2].starts_with(
@@ -665,7 +696,7 @@ mod tests {
             lines[2]
         );
         assert!(
-            lines[2].ends_with(",no: does not fit the banks,-,-,48.9,-"),
+            lines[2].ends_with(",no: does not fit the banks,-,-,-,-,48.9,-"),
             "{}",
             lines[2]
         );
@@ -694,6 +725,7 @@ mod tests {
                 width: 512,
                 height: 384,
                 cycles: 196_608 * 300,
+                memory_words: 196_608 * 40,
                 differing_pixels: 0,
             }),
         );
