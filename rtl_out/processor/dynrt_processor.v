@@ -17171,6 +17171,12 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  [2:0] const_word__d;
     wire  [2:0] const_word__q;
     reg  const_word__clock;
+    reg  [2:0] free_slot_r__d;
+    wire  [2:0] free_slot_r__q;
+    reg  free_slot_r__clock;
+    reg  has_free_r__d;
+    wire  has_free_r__q;
+    reg  has_free_r__clock;
     reg  s1_valid__d;
     wire  s1_valid__q;
     reg  s1_valid__clock;
@@ -17325,6 +17331,15 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  any_free_before__6;
     reg  any_free_before__7;
     reg  any_free_before__8;
+    reg  any_free_after_take__0;
+    reg  any_free_after_take__1;
+    reg  any_free_after_take__2;
+    reg  any_free_after_take__3;
+    reg  any_free_after_take__4;
+    reg  any_free_after_take__5;
+    reg  any_free_after_take__6;
+    reg  any_free_after_take__7;
+    reg  any_free_after_take__8;
     reg  [2:0] free_slot;
     reg  taken;
     reg  [3:0] pick_step;
@@ -18038,6 +18053,16 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .d(const_word__d),
         .q(const_word__q),
         .clock(const_word__clock)
+    );
+    dynrt_processor__engine__mem_bank_r free_slot_r(
+        .d(free_slot_r__d),
+        .q(free_slot_r__q),
+        .clock(free_slot_r__clock)
+    );
+    dynrt_processor__display__dark_d has_free_r(
+        .d(has_free_r__d),
+        .q(has_free_r__q),
+        .clock(has_free_r__clock)
     );
     dynrt_processor__display__dark_d s1_valid(
         .d(s1_valid__d),
@@ -18924,42 +18949,98 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             s1_flip__d = pick_flip;
             s1_miss__d = pick_miss;
         end
-        any_free_before__0 = 1'b0;
-        free_slot = 32'h0;
-        any_free_before__1 = any_free_before__0 | (~busy__0__q);
-        any_free_before__2 = any_free_before__1 | (~busy__1__q);
-        any_free_before__3 = any_free_before__2 | (~busy__2__q);
-        any_free_before__4 = any_free_before__3 | (~busy__3__q);
-        any_free_before__5 = any_free_before__4 | (~busy__4__q);
-        any_free_before__6 = any_free_before__5 | (~busy__5__q);
-        any_free_before__7 = any_free_before__6 | (~busy__6__q);
-        any_free_before__8 = any_free_before__7 | (~busy__7__q);
-        if ((~busy__0__q) & (~any_free_before__0)) begin
-            free_slot = c_slot__0;
-        end
-        if ((~busy__1__q) & (~any_free_before__1)) begin
-            free_slot = c_slot__1;
-        end
-        if ((~busy__2__q) & (~any_free_before__2)) begin
-            free_slot = c_slot__2;
-        end
-        if ((~busy__3__q) & (~any_free_before__3)) begin
-            free_slot = c_slot__3;
-        end
-        if ((~busy__4__q) & (~any_free_before__4)) begin
-            free_slot = c_slot__4;
-        end
-        if ((~busy__5__q) & (~any_free_before__5)) begin
-            free_slot = c_slot__5;
-        end
-        if ((~busy__6__q) & (~any_free_before__6)) begin
-            free_slot = c_slot__6;
-        end
-        if ((~busy__7__q) & (~any_free_before__7)) begin
-            free_slot = c_slot__7;
-        end
-        refused = loading__q | (~any_free_before__8);
+        free_slot = free_slot_r__q;
+        refused = loading__q | (~has_free_r__q);
         taken = offer & (~refused);
+        free_slot_r__clock = clock;
+        has_free_r__clock = clock;
+        any_free_before__0 = 1'b0;
+        any_free_after_take__0 = 1'b0;
+        any_free_before__1 = any_free_before__0 | (~busy__0__q);
+        any_free_after_take__1 = any_free_after_take__0 | ((~busy__0__q) & (free_slot_r__q != c_slot__0));
+        any_free_before__2 = any_free_before__1 | (~busy__1__q);
+        any_free_after_take__2 = any_free_after_take__1 | ((~busy__1__q) & (free_slot_r__q != c_slot__1));
+        any_free_before__3 = any_free_before__2 | (~busy__2__q);
+        any_free_after_take__3 = any_free_after_take__2 | ((~busy__2__q) & (free_slot_r__q != c_slot__2));
+        any_free_before__4 = any_free_before__3 | (~busy__3__q);
+        any_free_after_take__4 = any_free_after_take__3 | ((~busy__3__q) & (free_slot_r__q != c_slot__3));
+        any_free_before__5 = any_free_before__4 | (~busy__4__q);
+        any_free_after_take__5 = any_free_after_take__4 | ((~busy__4__q) & (free_slot_r__q != c_slot__4));
+        any_free_before__6 = any_free_before__5 | (~busy__5__q);
+        any_free_after_take__6 = any_free_after_take__5 | ((~busy__5__q) & (free_slot_r__q != c_slot__5));
+        any_free_before__7 = any_free_before__6 | (~busy__6__q);
+        any_free_after_take__7 = any_free_after_take__6 | ((~busy__6__q) & (free_slot_r__q != c_slot__6));
+        any_free_before__8 = any_free_before__7 | (~busy__7__q);
+        any_free_after_take__8 = any_free_after_take__7 | ((~busy__7__q) & (free_slot_r__q != c_slot__7));
+        free_slot_r__d = 32'h0;
+        has_free_r__d = any_free_before__8;
+        if (taken) begin
+            has_free_r__d = any_free_after_take__8;
+        end
+        if (taken) begin
+            if ((~busy__0__q) & (free_slot_r__q != c_slot__0) & (~any_free_after_take__0)) begin
+                free_slot_r__d = c_slot__0;
+            end
+        end
+        else if ((~busy__0__q) & (~any_free_before__0)) begin
+            free_slot_r__d = c_slot__0;
+        end
+        if (taken) begin
+            if ((~busy__1__q) & (free_slot_r__q != c_slot__1) & (~any_free_after_take__1)) begin
+                free_slot_r__d = c_slot__1;
+            end
+        end
+        else if ((~busy__1__q) & (~any_free_before__1)) begin
+            free_slot_r__d = c_slot__1;
+        end
+        if (taken) begin
+            if ((~busy__2__q) & (free_slot_r__q != c_slot__2) & (~any_free_after_take__2)) begin
+                free_slot_r__d = c_slot__2;
+            end
+        end
+        else if ((~busy__2__q) & (~any_free_before__2)) begin
+            free_slot_r__d = c_slot__2;
+        end
+        if (taken) begin
+            if ((~busy__3__q) & (free_slot_r__q != c_slot__3) & (~any_free_after_take__3)) begin
+                free_slot_r__d = c_slot__3;
+            end
+        end
+        else if ((~busy__3__q) & (~any_free_before__3)) begin
+            free_slot_r__d = c_slot__3;
+        end
+        if (taken) begin
+            if ((~busy__4__q) & (free_slot_r__q != c_slot__4) & (~any_free_after_take__4)) begin
+                free_slot_r__d = c_slot__4;
+            end
+        end
+        else if ((~busy__4__q) & (~any_free_before__4)) begin
+            free_slot_r__d = c_slot__4;
+        end
+        if (taken) begin
+            if ((~busy__5__q) & (free_slot_r__q != c_slot__5) & (~any_free_after_take__5)) begin
+                free_slot_r__d = c_slot__5;
+            end
+        end
+        else if ((~busy__5__q) & (~any_free_before__5)) begin
+            free_slot_r__d = c_slot__5;
+        end
+        if (taken) begin
+            if ((~busy__6__q) & (free_slot_r__q != c_slot__6) & (~any_free_after_take__6)) begin
+                free_slot_r__d = c_slot__6;
+            end
+        end
+        else if ((~busy__6__q) & (~any_free_before__6)) begin
+            free_slot_r__d = c_slot__6;
+        end
+        if (taken) begin
+            if ((~busy__7__q) & (free_slot_r__q != c_slot__7) & (~any_free_after_take__7)) begin
+                free_slot_r__d = c_slot__7;
+            end
+        end
+        else if ((~busy__7__q) & (~any_free_before__7)) begin
+            free_slot_r__d = c_slot__7;
+        end
         o__0__write_address = free_slot;
         o__0__write_enable = taken;
         o__0__write_data = rays__0__read_data;
@@ -21171,6 +21252,10 @@ module dynrt_processor__engine__shader__frame_line(clock,data_in,data_out);
     end
     
 endmodule // dynrt_processor__engine__shader__frame_line
+
+
+
+
 
 
 
