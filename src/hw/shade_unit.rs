@@ -16,8 +16,9 @@
 //!   whole-ray writes into the coprocessors' ray stores, snooped).
 //! - Offer (the engine's I5, `query_thread` at I4): `offer` for `query_thread` with
 //!   `offer_addr` (the pixel's frame-buffer word, before `fb_base`), `offer_hit`, `offer_t`,
-//!   `offer_triangle` is taken unless `refused` (all [`SHADE_SLOTS`] busy, or constants
-//!   loading); the thread's ray is copied then, so it may trace its next ray at once.
+//!   `offer_triangle` is taken unless `refused` (no slot of [`SHADE_SLOTS`] free as of the
+//!   clock before, or constants loading); the thread's ray is copied then, so it may trace
+//!   its next ray at once.
 //! - Memory: `tri_read` with `tri_addr` reads banks 2 and 3 at once (`tri_rdata_a`,
 //!   `tri_rdata_b`), `frame_read` with `frame_addr` bank 5; each read goes out in a clock
 //!   with its `*_grant` and its word arrives `tri_latency` (`frame_latency`) clocks later.
