@@ -459,11 +459,14 @@ impl FrameReport {
         ]
         .map(|n| n as f64 / c)
     }
-    /// Bytes the frame moved over the memory ports per second at a clock of `hz`: every
-    /// bank's 32-bit reads and the frame buffer's writes (one a pixel).
+    /// 32-bit words the frame moved over the memory ports: every bank's reads and the frame
+    /// buffer's writes (one a pixel).
+    pub fn memory_words(&self) -> u64 {
+        self.bank_reads.iter().sum::<u64>() + self.pixels
+    }
+    /// Bytes of [`Self::memory_words`] per second at a clock of `hz`.
     pub fn memory_bytes_per_second_at(&self, hz: f64) -> f64 {
-        let words = self.bank_reads.iter().sum::<u64>() + self.pixels;
-        4.0 * words as f64 * self.fps_at(hz)
+        4.0 * self.memory_words() as f64 * self.fps_at(hz)
     }
     /// Shares of the frame's thread-clocks (`threads` x cycles): waiting for an issue slot,
     /// asleep in a coprocessor wait, and the rest (an instruction in the engine's pipeline,

@@ -56,8 +56,7 @@ pub struct SimFigures {
     pub width: u32,
     pub height: u32,
     pub cycles: u64,
-    /// 32-bit words the frame moved over the memory ports: every bank's reads and the frame
-    /// buffer's writes.
+    /// The frame's `flow::FrameReport::memory_words`.
     pub memory_words: u64,
     pub differing_pixels: usize,
 }
@@ -602,7 +601,7 @@ fn simulate(
         width: scene.camera.width,
         height: scene.camera.height,
         cycles: frame.cycles,
-        memory_words: frame.bank_reads.iter().sum::<u64>() + frame.pixels,
+        memory_words: frame.memory_words(),
         differing_pixels: frame.differing_pixels,
     };
     say(
