@@ -17177,6 +17177,27 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  has_free_r__d;
     wire  has_free_r__q;
     reg  has_free_r__clock;
+    reg  s0_valid__d;
+    wire  s0_valid__q;
+    reg  s0_valid__clock;
+    reg  [2:0] s0_slot__d;
+    wire  [2:0] s0_slot__q;
+    reg  s0_slot__clock;
+    reg  [3:0] s0_step__d;
+    wire  [3:0] s0_step__q;
+    reg  s0_step__clock;
+    reg  [2:0] s0_light__d;
+    wire  [2:0] s0_light__q;
+    reg  s0_light__clock;
+    reg  s0_flip__d;
+    wire  s0_flip__q;
+    reg  s0_flip__clock;
+    reg  s0_miss__d;
+    wire  s0_miss__q;
+    reg  s0_miss__clock;
+    reg  s0_transform__d;
+    wire  s0_transform__q;
+    reg  s0_transform__clock;
     reg  s1_valid__d;
     wire  s1_valid__q;
     reg  s1_valid__clock;
@@ -17198,6 +17219,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  s1_miss__d;
     wire  s1_miss__q;
     reg  s1_miss__clock;
+    reg  s1_transform__d;
+    wire  s1_transform__q;
+    reg  s1_transform__clock;
     reg  gen_held__d;
     wire  gen_held__q;
     reg  gen_held__clock;
@@ -17340,8 +17364,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  any_free_after_take__6;
     reg  any_free_after_take__7;
     reg  any_free_after_take__8;
-    reg  [2:0] free_slot;
     reg  taken;
+    reg  s1_load;
     reg  [3:0] pick_step;
     reg  [2:0] pick_light;
     reg  pick_flip;
@@ -17380,7 +17404,6 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  req_point;
     reg  req_diagonal;
     reg  res_positive;
-    reg  tu_step;
     reg  tri_word_0;
     reg  tri_word_1;
     reg  frame_valid;
@@ -18064,6 +18087,41 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(has_free_r__q),
         .clock(has_free_r__clock)
     );
+    dynrt_processor__display__dark_d s0_valid(
+        .d(s0_valid__d),
+        .q(s0_valid__q),
+        .clock(s0_valid__clock)
+    );
+    dynrt_processor__engine__mem_bank_r s0_slot(
+        .d(s0_slot__d),
+        .q(s0_slot__q),
+        .clock(s0_slot__clock)
+    );
+    dynrt_processor__engine__shader__res_step_r s0_step(
+        .d(s0_step__d),
+        .q(s0_step__q),
+        .clock(s0_step__clock)
+    );
+    dynrt_processor__engine__mem_bank_r s0_light(
+        .d(s0_light__d),
+        .q(s0_light__q),
+        .clock(s0_light__clock)
+    );
+    dynrt_processor__display__dark_d s0_flip(
+        .d(s0_flip__d),
+        .q(s0_flip__q),
+        .clock(s0_flip__clock)
+    );
+    dynrt_processor__display__dark_d s0_miss(
+        .d(s0_miss__d),
+        .q(s0_miss__q),
+        .clock(s0_miss__clock)
+    );
+    dynrt_processor__display__dark_d s0_transform(
+        .d(s0_transform__d),
+        .q(s0_transform__q),
+        .clock(s0_transform__clock)
+    );
     dynrt_processor__display__dark_d s1_valid(
         .d(s1_valid__d),
         .q(s1_valid__q),
@@ -18098,6 +18156,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .d(s1_miss__d),
         .q(s1_miss__q),
         .clock(s1_miss__clock)
+    );
+    dynrt_processor__display__dark_d s1_transform(
+        .d(s1_transform__d),
+        .q(s1_transform__q),
+        .clock(s1_transform__clock)
     );
     dynrt_processor__display__dark_d gen_held(
         .d(gen_held__d),
@@ -18307,6 +18370,13 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         const_lights__clock = clock;
         const_light__clock = clock;
         const_word__clock = clock;
+        s0_valid__clock = clock;
+        s0_slot__clock = clock;
+        s0_step__clock = clock;
+        s0_light__clock = clock;
+        s0_flip__clock = clock;
+        s0_miss__clock = clock;
+        s0_transform__clock = clock;
         s1_valid__clock = clock;
         s1_slot__clock = clock;
         s1_word__clock = clock;
@@ -18314,6 +18384,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         s1_light__clock = clock;
         s1_flip__clock = clock;
         s1_miss__clock = clock;
+        s1_transform__clock = clock;
         gen_held__clock = clock;
         gen_hold_point__clock = clock;
         gen_hold_diagonal__clock = clock;
@@ -18327,6 +18398,13 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         const_lights__d = const_lights__q;
         const_light__d = const_light__q;
         const_word__d = const_word__q;
+        s0_valid__d = s0_valid__q;
+        s0_slot__d = s0_slot__q;
+        s0_step__d = s0_step__q;
+        s0_light__d = s0_light__q;
+        s0_flip__d = s0_flip__q;
+        s0_miss__d = s0_miss__q;
+        s0_transform__d = s0_transform__q;
         s1_valid__d = s1_valid__q;
         s1_slot__d = s1_slot__q;
         s1_word__d = s1_word__q;
@@ -18334,6 +18412,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         s1_light__d = s1_light__q;
         s1_flip__d = s1_flip__q;
         s1_miss__d = s1_miss__q;
+        s1_transform__d = s1_transform__q;
         gen_held__d = gen_held__q;
         gen_hold_point__d = gen_hold_point__q;
         gen_hold_diagonal__d = gen_hold_diagonal__q;
@@ -18662,7 +18741,6 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         req_v__2 = c_zero;
         req_point = 1'b0;
         req_diagonal = 1'b0;
-        tu_step = (s1_step__q == ShadeStep__Point) | (s1_step__q == ShadeStep__NormalDot) | (s1_step__q == ShadeStep__Ambient) | (s1_step__q == ShadeStep__ToLight) | (s1_step__q == ShadeStep__Dots) | (s1_step__q == ShadeStep__Tint) | (s1_step__q == ShadeStep__Accumulate);
         if (s1_step__q == ShadeStep__Point) begin
             req_m__0 = d__0__read_data;
             req_m__5 = d__1__read_data;
@@ -18742,7 +18820,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (gen_take) begin
             gen_held__d = 1'b0;
         end
-        gen_load = s1_valid__q & tu_step & (~gen_held__q);
+        gen_load = s1_valid__q & s1_transform__q & (~gen_held__q);
         if (gen_load) begin
             gen_held__d = 1'b1;
             gen_hold_m__0__d = req_m__0;
@@ -18888,7 +18966,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (ready__7__q & busy__7__q & (~any_ready_before__7)) begin
             ready_slot = c_slot__7;
         end
-        pick = any_ready_before__8 & ((~s1_valid__q) | s1_done);
+        pick = any_ready_before__8 & (~s0_valid__q);
         pick_step = ShadeStep__Idle;
         pick_light = 32'h0;
         pick_flip = 1'b0;
@@ -18941,15 +19019,28 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             pick_flip = flip__7__q;
             pick_miss = miss__7__q;
         end
-        if ((~s1_valid__q) | s1_done) begin
-            s1_valid__d = pick;
-            s1_slot__d = ready_slot;
-            s1_step__d = pick_step;
-            s1_light__d = pick_light;
-            s1_flip__d = pick_flip;
-            s1_miss__d = pick_miss;
+        if (pick) begin
+            s0_valid__d = 1'b1;
+            s0_slot__d = ready_slot;
+            s0_step__d = pick_step;
+            s0_light__d = pick_light;
+            s0_flip__d = pick_flip;
+            s0_miss__d = pick_miss;
+            s0_transform__d = (pick_step == ShadeStep__Point) | (pick_step == ShadeStep__NormalDot) | (pick_step == ShadeStep__Ambient) | (pick_step == ShadeStep__ToLight) | (pick_step == ShadeStep__Dots) | (pick_step == ShadeStep__Tint) | (pick_step == ShadeStep__Accumulate);
         end
-        free_slot = free_slot_r__q;
+        s1_load = (~s1_valid__q) | s1_done;
+        if (s1_load) begin
+            if (s0_valid__q) begin
+                s0_valid__d = 1'b0;
+            end
+            s1_valid__d = s0_valid__q;
+            s1_slot__d = s0_slot__q;
+            s1_step__d = s0_step__q;
+            s1_light__d = s0_light__q;
+            s1_flip__d = s0_flip__q;
+            s1_miss__d = s0_miss__q;
+            s1_transform__d = s0_transform__q;
+        end
         refused = loading__q | (~has_free_r__q);
         taken = offer & (~refused);
         free_slot_r__clock = clock;
@@ -19041,31 +19132,31 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         else if ((~busy__7__q) & (~any_free_before__7)) begin
             free_slot_r__d = c_slot__7;
         end
-        o__0__write_address = free_slot;
+        o__0__write_address = free_slot_r__q;
         o__0__write_enable = taken;
         o__0__write_data = rays__0__read_data;
-        d__0__write_address = free_slot;
+        d__0__write_address = free_slot_r__q;
         d__0__write_enable = taken;
         d__0__write_data = rays__3__read_data;
-        o__1__write_address = free_slot;
+        o__1__write_address = free_slot_r__q;
         o__1__write_enable = taken;
         o__1__write_data = rays__1__read_data;
-        d__1__write_address = free_slot;
+        d__1__write_address = free_slot_r__q;
         d__1__write_enable = taken;
         d__1__write_data = rays__4__read_data;
-        o__2__write_address = free_slot;
+        o__2__write_address = free_slot_r__q;
         o__2__write_enable = taken;
         o__2__write_data = rays__2__read_data;
-        d__2__write_address = free_slot;
+        d__2__write_address = free_slot_r__q;
         d__2__write_enable = taken;
         d__2__write_data = rays__5__read_data;
-        t__write_address = free_slot;
+        t__write_address = free_slot_r__q;
         t__write_enable = taken;
         t__write_data = offer_t;
-        addr__write_address = free_slot;
+        addr__write_address = free_slot_r__q;
         addr__write_enable = taken;
         addr__write_data = offer_addr;
-        triangle__write_address = free_slot;
+        triangle__write_address = free_slot_r__q;
         triangle__write_enable = taken;
         triangle__write_data = offer_triangle;
         tri_line__data_in = tri_tag;
@@ -19272,7 +19363,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 rgb__write_enable = 1'b1;
             end
         end
-        if (taken & (free_slot == c_slot__0)) begin
+        if (taken & (free_slot_r__q == c_slot__0)) begin
             busy__0__d = 1'b1;
             ready__0__d = 1'b1;
             miss__0__d = ~offer_hit;
@@ -19338,7 +19429,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__0__d = 1'b1;
             step__0__d = ShadeStep__Store;
         end
-        if (taken & (free_slot == c_slot__1)) begin
+        if (taken & (free_slot_r__q == c_slot__1)) begin
             busy__1__d = 1'b1;
             ready__1__d = 1'b1;
             miss__1__d = ~offer_hit;
@@ -19404,7 +19495,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__1__d = 1'b1;
             step__1__d = ShadeStep__Store;
         end
-        if (taken & (free_slot == c_slot__2)) begin
+        if (taken & (free_slot_r__q == c_slot__2)) begin
             busy__2__d = 1'b1;
             ready__2__d = 1'b1;
             miss__2__d = ~offer_hit;
@@ -19470,7 +19561,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__2__d = 1'b1;
             step__2__d = ShadeStep__Store;
         end
-        if (taken & (free_slot == c_slot__3)) begin
+        if (taken & (free_slot_r__q == c_slot__3)) begin
             busy__3__d = 1'b1;
             ready__3__d = 1'b1;
             miss__3__d = ~offer_hit;
@@ -19536,7 +19627,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__3__d = 1'b1;
             step__3__d = ShadeStep__Store;
         end
-        if (taken & (free_slot == c_slot__4)) begin
+        if (taken & (free_slot_r__q == c_slot__4)) begin
             busy__4__d = 1'b1;
             ready__4__d = 1'b1;
             miss__4__d = ~offer_hit;
@@ -19602,7 +19693,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__4__d = 1'b1;
             step__4__d = ShadeStep__Store;
         end
-        if (taken & (free_slot == c_slot__5)) begin
+        if (taken & (free_slot_r__q == c_slot__5)) begin
             busy__5__d = 1'b1;
             ready__5__d = 1'b1;
             miss__5__d = ~offer_hit;
@@ -19668,7 +19759,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__5__d = 1'b1;
             step__5__d = ShadeStep__Store;
         end
-        if (taken & (free_slot == c_slot__6)) begin
+        if (taken & (free_slot_r__q == c_slot__6)) begin
             busy__6__d = 1'b1;
             ready__6__d = 1'b1;
             miss__6__d = ~offer_hit;
@@ -19734,7 +19825,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__6__d = 1'b1;
             step__6__d = ShadeStep__Store;
         end
-        if (taken & (free_slot == c_slot__7)) begin
+        if (taken & (free_slot_r__q == c_slot__7)) begin
             busy__7__d = 1'b1;
             ready__7__d = 1'b1;
             miss__7__d = ~offer_hit;
@@ -21442,6 +21533,22 @@ module dynrt_processor__engine__shader__res_step_r(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__shader__res_step_r
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 

@@ -37,13 +37,14 @@
 //! and `L . L`, two rows; `kd * colour`, diagonal; `acc + tint * cos`, diagonal), the diffuse
 //! colour from bank 5, the cosine (a square root, then a division, in the unit's own
 //! pipelined operators) and the three channel bytes ([`ChannelByte`]). A slot is ready when
-//! its last operation's result is written; the dispatcher takes the first ready slot, reads
-//! its words (distributed RAM, read in the same clock) and issues the operation, so the slots'
-//! operations interleave in every unit. A light behind the surface (`!(0 < n . L)`) is
+//! its last operation's result is written; the dispatcher picks the first ready slot into S0
+//! (when S0 is empty), and S1 reads its words (distributed RAM, read in the same clock) and
+//! issues the operation, so the slots' operations interleave in every unit. A light behind the surface (`!(0 < n . L)`) is
 //! skipped; a miss is packed from the background.
 //!
 //! Latency: about 140 clocks plus 110 per light (lit), with the TransformUnit free.
-//! Throughput: one operation per clock from the dispatcher (about 14 a pixel with one light),
+//! Throughput: one operation every two clocks from the dispatcher (S0 refills the clock after
+//! S1 takes it; about 14 operations a pixel with one light),
 //! [`SHADE_SLOTS`] pixels in flight.
 //!
 //! Golden twin: [`units::shade_direct`](crate::units::shade_direct) (src/units.rs), pass for
@@ -208,19 +209,32 @@ pub struct ShadeUnit<
     /// slot's step (stop 42's critical path at 83.4 MHz).
     free_slot_r: DFF<Bits<3>>,
     has_free_r: DFF<Bit>,
-    free_slot: Signal<Local, Bits<3>>,
     taken: Signal<Local, Bit>,
-    // Dispatch: a slot chosen (S0) is read and issued (S1).
+    // Dispatch: a slot is picked into S0, then read and issued in S1. S0 is filled only when
+    // empty, so the pick (a priority chain over the slots) never waits for S1's operation to
+    // go out; with the pick waiting for `s1_done`, the grants, the pick and every slot's
+    // `ready` were one clock (stop 42's critical path, 68.8 MHz placed).
+    s0_valid: DFF<Bit>,
+    s0_slot: DFF<Bits<3>>,
+    s0_step: DFF<ShadeStep>,
+    s0_light: DFF<Bits<3>>,
+    s0_flip: DFF<Bit>,
+    s0_miss: DFF<Bit>,
+    /// The step is a TransformUnit pass, decoded at the pick.
+    s0_transform: DFF<Bit>,
     s1_valid: DFF<Bit>,
     s1_slot: DFF<Bits<3>>,
     /// The word of a multi-clock operation (loads, bytes).
     s1_word: DFF<Bits<2>>,
     /// The dispatched slot's step, light, flip and miss, registered as it is picked (a slot's
-    /// control changes only with its operation's result, so they hold while it is in S1).
+    /// control changes only with its operation's result, so they hold while it is in S0 and
+    /// S1).
     s1_step: DFF<ShadeStep>,
     s1_light: DFF<Bits<3>>,
     s1_flip: DFF<Bit>,
     s1_miss: DFF<Bit>,
+    s1_transform: DFF<Bit>,
+    s1_load: Signal<Local, Bit>,
     pick_step: Signal<Local, ShadeStep>,
     pick_light: Signal<Local, Bits<3>>,
     pick_flip: Signal<Local, Bit>,
@@ -255,7 +269,6 @@ pub struct ShadeUnit<
     res_step_r: DFF<ShadeStep>,
     res_light_r: DFF<Bits<3>>,
     res_positive: Signal<Local, Bit>,
-    tu_step: Signal<Local, Bit>,
     tri_word_0: Signal<Local, Bit>,
     tri_word_1: Signal<Local, Bit>,
     frame_valid: Signal<Local, Bit>,
@@ -433,8 +446,14 @@ impl<
             any_free_after_take: Default::default(),
             free_slot_r: Default::default(),
             has_free_r: Default::default(),
-            free_slot: Default::default(),
             taken: Default::default(),
+            s0_valid: Default::default(),
+            s0_slot: Default::default(),
+            s0_step: Default::default(),
+            s0_light: Default::default(),
+            s0_flip: Default::default(),
+            s0_miss: Default::default(),
+            s0_transform: Default::default(),
             s1_valid: Default::default(),
             s1_slot: Default::default(),
             s1_word: Default::default(),
@@ -442,6 +461,8 @@ impl<
             s1_light: Default::default(),
             s1_flip: Default::default(),
             s1_miss: Default::default(),
+            s1_transform: Default::default(),
+            s1_load: Default::default(),
             pick_step: Default::default(),
             pick_light: Default::default(),
             pick_flip: Default::default(),
@@ -468,7 +489,6 @@ impl<
             res_step_r: Default::default(),
             res_light_r: Default::default(),
             res_positive: Default::default(),
-            tu_step: Default::default(),
             tri_word_0: Default::default(),
             tri_word_1: Default::default(),
             frame_valid: Default::default(),
@@ -548,6 +568,13 @@ impl<
             const_lights,
             const_light,
             const_word,
+            s0_valid,
+            s0_slot,
+            s0_step,
+            s0_light,
+            s0_flip,
+            s0_miss,
+            s0_transform,
             s1_valid,
             s1_slot,
             s1_word,
@@ -555,6 +582,7 @@ impl<
             s1_light,
             s1_flip,
             s1_miss,
+            s1_transform,
             gen_held,
             gen_hold_point,
             gen_hold_diagonal,
@@ -716,13 +744,6 @@ impl<
         }
         self.req_point.next = false;
         self.req_diagonal.next = false;
-        self.tu_step.next = (self.s1_step.q.val() == ShadeStep::Point)
-            | (self.s1_step.q.val() == ShadeStep::NormalDot)
-            | (self.s1_step.q.val() == ShadeStep::Ambient)
-            | (self.s1_step.q.val() == ShadeStep::ToLight)
-            | (self.s1_step.q.val() == ShadeStep::Dots)
-            | (self.s1_step.q.val() == ShadeStep::Tint)
-            | (self.s1_step.q.val() == ShadeStep::Accumulate);
         if self.s1_step.q.val() == ShadeStep::Point {
             // o + t d: diag(d) times (t, t, t) plus o.
             self.req_m[0].next = self.d[0].read_data.val();
@@ -804,7 +825,8 @@ impl<
         if self.gen_take.val() {
             self.gen_held.d.next = false;
         }
-        self.gen_load.next = self.s1_valid.q.val() & self.tu_step.val() & (!self.gen_held.q.val());
+        self.gen_load.next =
+            self.s1_valid.q.val() & self.s1_transform.q.val() & (!self.gen_held.q.val());
         if self.gen_load.val() {
             self.gen_held.d.next = true;
             for k in 0..12 {
@@ -913,7 +935,7 @@ impl<
         self.frame_addr.next = self.frame_addr_l.val();
         self.fb_write.next = self.fb_write_l.val();
 
-        // ---- S0: the next slot when S1 is free next clock. ----
+        // ---- S0: the next slot, picked when S0 is empty. ----
         self.any_ready_before[0].next = false;
         self.ready_slot.next = 0.into();
         for s in 0..SHADE_SLOTS {
@@ -925,8 +947,7 @@ impl<
                 self.ready_slot.next = self.c_slot[s].val();
             }
         }
-        self.pick.next =
-            self.any_ready_before[8].val() & ((!self.s1_valid.q.val()) | self.s1_done.val());
+        self.pick.next = self.any_ready_before[8].val() & (!self.s0_valid.q.val());
         self.pick_step.next = ShadeStep::Idle;
         self.pick_light.next = 0.into();
         self.pick_flip.next = false;
@@ -939,17 +960,37 @@ impl<
                 self.pick_miss.next = self.miss[s].q.val();
             }
         }
-        if (!self.s1_valid.q.val()) | self.s1_done.val() {
-            self.s1_valid.d.next = self.pick.val();
-            self.s1_slot.d.next = self.ready_slot.val();
-            self.s1_step.d.next = self.pick_step.val();
-            self.s1_light.d.next = self.pick_light.val();
-            self.s1_flip.d.next = self.pick_flip.val();
-            self.s1_miss.d.next = self.pick_miss.val();
+        if self.pick.val() {
+            self.s0_valid.d.next = true;
+            self.s0_slot.d.next = self.ready_slot.val();
+            self.s0_step.d.next = self.pick_step.val();
+            self.s0_light.d.next = self.pick_light.val();
+            self.s0_flip.d.next = self.pick_flip.val();
+            self.s0_miss.d.next = self.pick_miss.val();
+            self.s0_transform.d.next = (self.pick_step.val() == ShadeStep::Point)
+                | (self.pick_step.val() == ShadeStep::NormalDot)
+                | (self.pick_step.val() == ShadeStep::Ambient)
+                | (self.pick_step.val() == ShadeStep::ToLight)
+                | (self.pick_step.val() == ShadeStep::Dots)
+                | (self.pick_step.val() == ShadeStep::Tint)
+                | (self.pick_step.val() == ShadeStep::Accumulate);
+        }
+        // S1 takes S0's slot when its own operation has gone out.
+        self.s1_load.next = (!self.s1_valid.q.val()) | self.s1_done.val();
+        if self.s1_load.val() {
+            if self.s0_valid.q.val() {
+                self.s0_valid.d.next = false;
+            }
+            self.s1_valid.d.next = self.s0_valid.q.val();
+            self.s1_slot.d.next = self.s0_slot.q.val();
+            self.s1_step.d.next = self.s0_step.q.val();
+            self.s1_light.d.next = self.s0_light.q.val();
+            self.s1_flip.d.next = self.s0_flip.q.val();
+            self.s1_miss.d.next = self.s0_miss.q.val();
+            self.s1_transform.d.next = self.s0_transform.q.val();
         }
 
         // ---- Offers take the first free slot. ----
-        self.free_slot.next = self.free_slot_r.q.val();
         self.refused.next = self.loading.q.val() | (!self.has_free_r.q.val());
         self.taken.next = self.offer.val() & (!self.refused.val());
         self.free_slot_r.clock.next = self.clock.val();
@@ -980,20 +1021,20 @@ impl<
             }
         }
         for k in 0..3 {
-            self.o[k].write_address.next = self.free_slot.val();
+            self.o[k].write_address.next = self.free_slot_r.q.val();
             self.o[k].write_enable.next = self.taken.val();
             self.o[k].write_data.next = self.rays[k].read_data.val();
-            self.d[k].write_address.next = self.free_slot.val();
+            self.d[k].write_address.next = self.free_slot_r.q.val();
             self.d[k].write_enable.next = self.taken.val();
             self.d[k].write_data.next = self.rays[3 + k].read_data.val();
         }
-        self.t.write_address.next = self.free_slot.val();
+        self.t.write_address.next = self.free_slot_r.q.val();
         self.t.write_enable.next = self.taken.val();
         self.t.write_data.next = self.offer_t.val();
-        self.addr.write_address.next = self.free_slot.val();
+        self.addr.write_address.next = self.free_slot_r.q.val();
         self.addr.write_enable.next = self.taken.val();
         self.addr.write_data.next = self.offer_addr.val();
-        self.triangle.write_address.next = self.free_slot.val();
+        self.triangle.write_address.next = self.free_slot_r.q.val();
         self.triangle.write_enable.next = self.taken.val();
         self.triangle.write_data.next = self.offer_triangle.val();
 
@@ -1166,7 +1207,7 @@ impl<
         // ---- Each slot's control. ----
         for s in 0..SHADE_SLOTS {
             // An offer.
-            if self.taken.val() & (self.free_slot.val() == self.c_slot[s].val()) {
+            if self.taken.val() & (self.free_slot_r.q.val() == self.c_slot[s].val()) {
                 self.busy[s].d.next = true;
                 self.ready[s].d.next = true;
                 self.miss[s].d.next = !self.offer_hit.val();
