@@ -22363,6 +22363,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [70:0] staged__d;
     wire  [70:0] staged__q;
     reg  staged__clock;
+    reg  spare_valid__d;
+    wire  spare_valid__q;
+    reg  spare_valid__clock;
+    reg  [70:0] spare__d;
+    wire  [70:0] spare__q;
+    reg  spare__clock;
     reg  [5:0] a_line__0__d;
     wire  [5:0] a_line__0__q;
     reg  a_line__0__clock;
@@ -23016,10 +23022,20 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(staged_valid__q),
         .clock(staged_valid__clock)
     );
-    dynrt_processor__engine__tester__staged staged(
+    dynrt_processor__engine__tester__spare staged(
         .d(staged__d),
         .q(staged__q),
         .clock(staged__clock)
+    );
+    dynrt_processor__display__dark_d spare_valid(
+        .d(spare_valid__d),
+        .q(spare_valid__q),
+        .clock(spare_valid__clock)
+    );
+    dynrt_processor__engine__tester__spare spare(
+        .d(spare__d),
+        .q(spare__q),
+        .clock(spare__clock)
     );
     dynrt_processor__engine__mem_load_r a_line__0(
         .d(a_line__0__d),
@@ -23373,6 +23389,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         fetching__clock = clock;
         staged_valid__clock = clock;
         staged__clock = clock;
+        spare_valid__clock = clock;
+        spare__clock = clock;
         fb__clock = clock;
         lb__clock = clock;
         lphase__clock = clock;
@@ -23410,6 +23428,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         fetching__d = fetching__q;
         staged_valid__d = staged_valid__q;
         staged__d = staged__q;
+        spare_valid__d = spare_valid__q;
+        spare__d = spare__q;
         fb__d = fb__q;
         lb__d = lb__q;
         lphase__d = lphase__q;
@@ -23645,12 +23665,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         issued__write_address = engine__thread;
         issued__write_data = issued__read_data + 32'h1;
         issued__write_enable = engine__enqueue & (~list_unit__full) & ((queue_kind == c_cmd_list) | (queue_kind == c_cmd_init));
-        stage = list_unit__test_valid & (~staged_valid__q);
+        stage = list_unit__test_valid & (~spare_valid__q);
         list_unit__test_take = stage;
-        if (stage) begin
-            staged_valid__d = 1'b1;
-            staged__d = list_unit__test_entry;
-        end
         a_take = fetching__q & (a_issued__q < 32'h6) & ((engine__load_banks & c_bank_a) == 32'h0);
         b_take = fetching__q & (b_issued__q < 32'h6) & ((engine__load_banks & c_bank_b) == 32'h0);
         a_words__read = a_take | ((engine__load_banks & c_bank_a) != 32'h0);
@@ -23727,7 +23743,28 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         end
         take_entry = ((~fetching__q) | fetch_ends) & fb_free & staged_valid__q;
         if (take_entry) begin
-            staged_valid__d = 1'b0;
+            if (spare_valid__q) begin
+                staged__d = spare__q;
+                spare_valid__d = 1'b0;
+            end
+            else if (stage) begin
+                staged__d = list_unit__test_entry;
+            end
+            else begin
+                staged_valid__d = 1'b0;
+            end
+        end
+        else if (stage) begin
+            if (staged_valid__q) begin
+                spare__d = list_unit__test_entry;
+                spare_valid__d = 1'b1;
+            end
+            else begin
+                staged__d = list_unit__test_entry;
+                staged_valid__d = 1'b1;
+            end
+        end
+        if (take_entry) begin
             a_issued__d = 32'h0;
             b_issued__d = 32'h0;
             fetching__d = 1'b1;
@@ -29369,7 +29406,7 @@ endmodule // dynrt_processor__engine__tester__ray
 
 
 
-module dynrt_processor__engine__tester__staged(d,q,clock);
+module dynrt_processor__engine__tester__spare(d,q,clock);
     
     // Module arguments
     input wire  [70:0] d;
@@ -29385,7 +29422,11 @@ module dynrt_processor__engine__tester__staged(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor__engine__tester__staged
+endmodule // dynrt_processor__engine__tester__spare
+
+
+
+
 
 
 
