@@ -22357,18 +22357,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [1:0] words__11__write_address;
     reg  [23:0] words__11__write_data;
     reg  words__11__write_enable;
-    reg  staged_valid__d;
-    wire  staged_valid__q;
-    reg  staged_valid__clock;
-    reg  [70:0] staged__d;
-    wire  [70:0] staged__q;
-    reg  staged__clock;
-    reg  spare_valid__d;
-    wire  spare_valid__q;
-    reg  spare_valid__clock;
-    reg  [70:0] spare__d;
-    wire  [70:0] spare__q;
-    reg  spare__clock;
     reg  [5:0] a_line__0__d;
     wire  [5:0] a_line__0__q;
     reg  a_line__0__clock;
@@ -22607,11 +22595,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  fetch_ends;
     reg  [1:0] next_fb;
     reg  fb_free;
-    reg  free_here;
-    reg  free_after;
-    reg  [1:0] fb_plus;
-    reg  stage;
-    reg  take_entry;
     reg  [1:0] l_kind;
     reg  [4:0] l_thread;
     reg  [31:0] l_a;
@@ -23017,26 +23000,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(words__11__write_data),
         .write_enable(words__11__write_enable)
     );
-    dynrt_processor__display__dark_d staged_valid(
-        .d(staged_valid__d),
-        .q(staged_valid__q),
-        .clock(staged_valid__clock)
-    );
-    dynrt_processor__engine__tester__spare staged(
-        .d(staged__d),
-        .q(staged__q),
-        .clock(staged__clock)
-    );
-    dynrt_processor__display__dark_d spare_valid(
-        .d(spare_valid__d),
-        .q(spare_valid__q),
-        .clock(spare_valid__clock)
-    );
-    dynrt_processor__engine__tester__spare spare(
-        .d(spare__d),
-        .q(spare__q),
-        .clock(spare__clock)
-    );
     dynrt_processor__engine__mem_load_r a_line__0(
         .d(a_line__0__d),
         .q(a_line__0__q),
@@ -23387,10 +23350,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     // Update code
     always @(*) begin
         fetching__clock = clock;
-        staged_valid__clock = clock;
-        staged__clock = clock;
-        spare_valid__clock = clock;
-        spare__clock = clock;
         fb__clock = clock;
         lb__clock = clock;
         lphase__clock = clock;
@@ -23426,10 +23385,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         gen_hold_client__clock = clock;
         gen_hold_thread__clock = clock;
         fetching__d = fetching__q;
-        staged_valid__d = staged_valid__q;
-        staged__d = staged__q;
-        spare_valid__d = spare_valid__q;
-        spare__d = spare__q;
         fb__d = fb__q;
         lb__d = lb__q;
         lphase__d = lphase__q;
@@ -23665,8 +23620,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         issued__write_address = engine__thread;
         issued__write_data = issued__read_data + 32'h1;
         issued__write_enable = engine__enqueue & (~list_unit__full) & ((queue_kind == c_cmd_list) | (queue_kind == c_cmd_init));
-        stage = list_unit__test_valid & (~spare_valid__q);
-        list_unit__test_take = stage;
+        list_unit__test_take = 1'b0;
         a_take = fetching__q & (a_issued__q < 32'h6) & ((engine__load_banks & c_bank_a) == 32'h0);
         b_take = fetching__q & (b_issued__q < 32'h6) & ((engine__load_banks & c_bank_b) == 32'h0);
         a_words__read = a_take | ((engine__load_banks & c_bank_a) != 32'h0);
@@ -23710,65 +23664,22 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             next_fb = fb__q + 32'h1;
             fb__d = fb__q + 32'h1;
         end
-        fb_plus = fb__q + 32'h1;
-        free_here = 1'b0;
-        free_after = 1'b0;
-        if (fb__q == c_buffer__0) begin
-            free_here = ~loaded__0__q;
+        fb_free = ~loaded__0__q;
+        if (next_fb == c_buffer__1) begin
+            fb_free = ~loaded__1__q;
         end
-        if (fb_plus == c_buffer__0) begin
-            free_after = ~loaded__0__q;
+        if (next_fb == c_buffer__2) begin
+            fb_free = ~loaded__2__q;
         end
-        if (fb__q == c_buffer__1) begin
-            free_here = ~loaded__1__q;
+        if (next_fb == c_buffer__3) begin
+            fb_free = ~loaded__3__q;
         end
-        if (fb_plus == c_buffer__1) begin
-            free_after = ~loaded__1__q;
-        end
-        if (fb__q == c_buffer__2) begin
-            free_here = ~loaded__2__q;
-        end
-        if (fb_plus == c_buffer__2) begin
-            free_after = ~loaded__2__q;
-        end
-        if (fb__q == c_buffer__3) begin
-            free_here = ~loaded__3__q;
-        end
-        if (fb_plus == c_buffer__3) begin
-            free_after = ~loaded__3__q;
-        end
-        fb_free = free_here;
-        if (fetch_ends) begin
-            fb_free = free_after;
-        end
-        take_entry = ((~fetching__q) | fetch_ends) & fb_free & staged_valid__q;
-        if (take_entry) begin
-            if (spare_valid__q) begin
-                staged__d = spare__q;
-                spare_valid__d = 1'b0;
-            end
-            else if (stage) begin
-                staged__d = list_unit__test_entry;
-            end
-            else begin
-                staged_valid__d = 1'b0;
-            end
-        end
-        else if (stage) begin
-            if (staged_valid__q) begin
-                spare__d = list_unit__test_entry;
-                spare_valid__d = 1'b1;
-            end
-            else begin
-                staged__d = list_unit__test_entry;
-                staged_valid__d = 1'b1;
-            end
-        end
-        if (take_entry) begin
+        if (((~fetching__q) | fetch_ends) & fb_free & list_unit__test_valid) begin
+            list_unit__test_take = 1'b1;
             a_issued__d = 32'h0;
             b_issued__d = 32'h0;
             fetching__d = 1'b1;
-            if (staged__q[(32'h45)+:(2)] != c_test_triangle) begin
+            if (list_unit__test_entry[(32'h45)+:(2)] != c_test_triangle) begin
                 a_issued__d = 32'h6;
                 b_issued__d = 32'h6;
                 fetching__d = 1'b0;
@@ -23776,31 +23687,31 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             end
             if (next_fb == c_buffer__0) begin
                 loaded__0__d = 1'b1;
-                cur_kind__0__d = staged__q[(32'h45)+:(2)];
-                cur_thread__0__d = staged__q[(32'h40)+:(5)];
-                cur_a__0__d = staged__q[(32'h20)+:(32)];
-                cur_b__0__d = staged__q[(32'h0)+:(32)];
+                cur_kind__0__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__0__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__0__d = list_unit__test_entry[(32'h0)+:(32)];
             end
             if (next_fb == c_buffer__1) begin
                 loaded__1__d = 1'b1;
-                cur_kind__1__d = staged__q[(32'h45)+:(2)];
-                cur_thread__1__d = staged__q[(32'h40)+:(5)];
-                cur_a__1__d = staged__q[(32'h20)+:(32)];
-                cur_b__1__d = staged__q[(32'h0)+:(32)];
+                cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__1__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__1__d = list_unit__test_entry[(32'h0)+:(32)];
             end
             if (next_fb == c_buffer__2) begin
                 loaded__2__d = 1'b1;
-                cur_kind__2__d = staged__q[(32'h45)+:(2)];
-                cur_thread__2__d = staged__q[(32'h40)+:(5)];
-                cur_a__2__d = staged__q[(32'h20)+:(32)];
-                cur_b__2__d = staged__q[(32'h0)+:(32)];
+                cur_kind__2__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__2__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__2__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__2__d = list_unit__test_entry[(32'h0)+:(32)];
             end
             if (next_fb == c_buffer__3) begin
                 loaded__3__d = 1'b1;
-                cur_kind__3__d = staged__q[(32'h45)+:(2)];
-                cur_thread__3__d = staged__q[(32'h40)+:(5)];
-                cur_a__3__d = staged__q[(32'h20)+:(32)];
-                cur_b__3__d = staged__q[(32'h0)+:(32)];
+                cur_kind__3__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__3__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__3__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__3__d = list_unit__test_entry[(32'h0)+:(32)];
             end
         end
         a_arrive = 32'h0;
@@ -29398,31 +29309,6 @@ endmodule // dynrt_processor__engine__tester__ray
 
 
 
-
-
-
-
-
-
-
-
-module dynrt_processor__engine__tester__spare(d,q,clock);
-    
-    // Module arguments
-    input wire  [70:0] d;
-    output reg  [70:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 71'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor__engine__tester__spare
 
 
 

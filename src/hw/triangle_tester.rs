@@ -30,8 +30,7 @@
 //! (the first of equal ts stays), as in the golden model.
 //!
 //! Fetch and launch, two state machines around [`TEST_BUFFERS`] (4) entry buffers in a ring:
-//! the fetch takes an entry from the list unit's test queue (two entries staged ahead in
-//! registers of their own) into a free buffer and requests
+//! the fetch takes an entry from the list unit's test queue into a free buffer and requests
 //! the triangle's 6 words of bank 2 and 6 of bank 3 (6 clocks when the engine leaves the banks
 //! alone; an init or a list end fetches nothing), taking the next entry into the next buffer in
 //! the clock of its last requests. The launch waits for its buffer's words (the SRAM latency
@@ -55,8 +54,7 @@ use rust_hdl::prelude::*;
 
 use super::fp::{const_bits, FpCompare};
 use super::list_unit::{
-    ListEntry, CMD_INIT, CMD_LIST, LIST_OF_WALK, TEST_INIT, TEST_LIST_END, TEST_TRIANGLE,
-    TEST_WALK_END,
+    CMD_INIT, CMD_LIST, LIST_OF_WALK, TEST_INIT, TEST_LIST_END, TEST_TRIANGLE, TEST_WALK_END,
 };
 use super::ports::{CoprocessorPort, SramRead};
 use super::ray_store::{zero_counters, RayStore};
@@ -220,23 +218,6 @@ pub struct TriangleTester<
     /// fetch ends).
     next_fb: Signal<Local, Bits<2>>,
     fb_free: Signal<Local, Bit>,
-    /// Whether buffer `fb`, buffer `fb + 1` is free (from registers only; the fetch's end
-    /// selects one).
-    free_here: Signal<Local, Bit>,
-    free_after: Signal<Local, Bit>,
-    fb_plus: Signal<Local, Bits<2>>,
-    /// The list unit's next two entries, staged (`staged` the older): popped while the
-    /// second stage is empty, so the pop (and the queue's RAM read behind it) never waits
-    /// for the take, which waits for the fetch's last grants (`a_issued ->
-    /// list_unit.test_entry` was the placed critical path with the ShadeUnit, 78.8 MHz: 8
-    /// levels, 10.3 ns of routing); two stages keep a take every clock (one stage, popped
-    /// only when empty, cost cornell_noshadow 1.8% of its cycles).
-    staged_valid: DFF<Bit>,
-    staged: DFF<ListEntry>,
-    spare_valid: DFF<Bit>,
-    spare: DFF<ListEntry>,
-    stage: Signal<Local, Bit>,
-    take_entry: Signal<Local, Bit>,
     l_kind: Signal<Local, Bits<2>>,
     l_thread: Signal<Local, Bits<5>>,
     l_a: Signal<Local, Bits<32>>,
@@ -431,15 +412,6 @@ impl<
             fetch_ends: Default::default(),
             next_fb: Default::default(),
             fb_free: Default::default(),
-            free_here: Default::default(),
-            free_after: Default::default(),
-            fb_plus: Default::default(),
-            staged_valid: Default::default(),
-            staged: Default::default(),
-            spare_valid: Default::default(),
-            spare: Default::default(),
-            stage: Default::default(),
-            take_entry: Default::default(),
             l_kind: Default::default(),
             l_thread: Default::default(),
             l_a: Default::default(),
@@ -528,10 +500,6 @@ impl<
             self,
             clock,
             fetching,
-            staged_valid,
-            staged,
-            spare_valid,
-            spare,
             fb,
             lb,
             lphase,
@@ -690,8 +658,7 @@ impl<
         // Fetch into buffer `fb`: take the list unit's next entry when the buffer is free,
         // then request its 6 + 6 words (the banks serve the engine first). An init or a list
         // end fetches nothing. The next entry's fetch goes on while this one is launched.
-        self.stage.next = self.list_unit.test_valid.val() & (!self.spare_valid.q.val());
-        self.list_unit.test_take.next = self.stage.val();
+        self.list_unit.test_take.next = false;
         self.a_take.next = self.fetching.q.val()
             & (self.a_issued.q.val() < 6)
             & ((self.engine.load_banks.val() & self.c_bank_a.val()) == 0);
@@ -742,48 +709,21 @@ impl<
             self.next_fb.next = self.fb.q.val() + 1;
             self.fb.d.next = self.fb.q.val() + 1;
         }
-        self.fb_plus.next = self.fb.q.val() + 1;
-        self.free_here.next = false;
-        self.free_after.next = false;
-        for k in 0..4 {
-            if self.fb.q.val() == self.c_buffer[k].val() {
-                self.free_here.next = !self.loaded[k].q.val();
-            }
-            if self.fb_plus.val() == self.c_buffer[k].val() {
-                self.free_after.next = !self.loaded[k].q.val();
+        self.fb_free.next = !self.loaded[0].q.val();
+        for k in 1..4 {
+            if self.next_fb.val() == self.c_buffer[k].val() {
+                self.fb_free.next = !self.loaded[k].q.val();
             }
         }
-        self.fb_free.next = self.free_here.val();
-        if self.fetch_ends.val() {
-            self.fb_free.next = self.free_after.val();
-        }
-        self.take_entry.next = ((!self.fetching.q.val()) | self.fetch_ends.val())
+        if ((!self.fetching.q.val()) | self.fetch_ends.val())
             & self.fb_free.val()
-            & self.staged_valid.q.val();
-        // The stages move up as an entry is taken; a popped entry goes to the first free one.
-        if self.take_entry.val() {
-            if self.spare_valid.q.val() {
-                self.staged.d.next = self.spare.q.val();
-                self.spare_valid.d.next = false;
-            } else if self.stage.val() {
-                self.staged.d.next = self.list_unit.test_entry.val();
-            } else {
-                self.staged_valid.d.next = false;
-            }
-        } else if self.stage.val() {
-            if self.staged_valid.q.val() {
-                self.spare.d.next = self.list_unit.test_entry.val();
-                self.spare_valid.d.next = true;
-            } else {
-                self.staged.d.next = self.list_unit.test_entry.val();
-                self.staged_valid.d.next = true;
-            }
-        }
-        if self.take_entry.val() {
+            & self.list_unit.test_valid.val()
+        {
+            self.list_unit.test_take.next = true;
             self.a_issued.d.next = 0.into();
             self.b_issued.d.next = 0.into();
             self.fetching.d.next = true;
-            if self.staged.q.val().get_bits::<2>(69) != self.c_test_triangle.val() {
+            if self.list_unit.test_entry.val().get_bits::<2>(69) != self.c_test_triangle.val() {
                 // An init or a list end fetches nothing.
                 self.a_issued.d.next = 6.into();
                 self.b_issued.d.next = 6.into();
@@ -793,10 +733,10 @@ impl<
             for k in 0..4 {
                 if self.next_fb.val() == self.c_buffer[k].val() {
                     self.loaded[k].d.next = true;
-                    self.cur_kind[k].d.next = self.staged.q.val().get_bits::<2>(69);
-                    self.cur_thread[k].d.next = self.staged.q.val().get_bits::<5>(64);
-                    self.cur_a[k].d.next = self.staged.q.val().get_bits::<32>(32);
-                    self.cur_b[k].d.next = self.staged.q.val().get_bits::<32>(0);
+                    self.cur_kind[k].d.next = self.list_unit.test_entry.val().get_bits::<2>(69);
+                    self.cur_thread[k].d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
+                    self.cur_a[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(32);
+                    self.cur_b[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(0);
                 }
             }
         }
