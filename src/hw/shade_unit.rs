@@ -39,8 +39,8 @@
 //! pipelined operators) and the three channel bytes ([`ChannelByte`]). A slot is ready when
 //! its last operation's result is written; the dispatcher picks the first ready slot into S0
 //! (when S0 is empty), and S1 reads its words (distributed RAM, read in the same clock) and
-//! issues the operation, so the slots' operations interleave in every unit. A light behind the surface (`!(0 < n . L)`) is
-//! skipped; a miss is packed from the background.
+//! issues the operation, so the slots' operations interleave in every unit. A light behind
+//! the surface (`!(0 < n . L)`) is skipped; a miss is packed from the background.
 //!
 //! Latency: about 140 clocks plus 110 per light (lit), with the TransformUnit free.
 //! Throughput: one operation every two clocks from the dispatcher (S0 refills the clock after
@@ -975,7 +975,8 @@ impl<
                 | (self.pick_step.val() == ShadeStep::Tint)
                 | (self.pick_step.val() == ShadeStep::Accumulate);
         }
-        // S1 takes S0's slot when its own operation has gone out.
+        // S1 takes S0's slot when its own operation has gone out (S0 is emptied only if full:
+        // an empty S0 may be filled by the pick in this clock).
         self.s1_load.next = (!self.s1_valid.q.val()) | self.s1_done.val();
         if self.s1_load.val() {
             if self.s0_valid.q.val() {
