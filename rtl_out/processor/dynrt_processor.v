@@ -22192,6 +22192,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  flight_b__write_clock;
     reg  [31:0] flight_b__write_data;
     reg  flight_b__write_enable;
+    reg  [1:0] tb__d;
+    wire  [1:0] tb__q;
+    reg  tb__clock;
     reg  fetching__d;
     wire  fetching__q;
     reg  fetching__clock;
@@ -22201,6 +22204,18 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [1:0] lb__d;
     wire  [1:0] lb__q;
     reg  lb__clock;
+    reg  unvisited__0__d;
+    wire  unvisited__0__q;
+    reg  unvisited__0__clock;
+    reg  unvisited__1__d;
+    wire  unvisited__1__q;
+    reg  unvisited__1__clock;
+    reg  unvisited__2__d;
+    wire  unvisited__2__q;
+    reg  unvisited__2__clock;
+    reg  unvisited__3__d;
+    wire  unvisited__3__q;
+    reg  unvisited__3__clock;
     reg  [1:0] lphase__d;
     wire  [1:0] lphase__q;
     reg  lphase__clock;
@@ -22593,8 +22608,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  b_here__3;
     reg  [31:0] fetch_a;
     reg  fetch_ends;
-    reg  [1:0] next_fb;
-    reg  fb_free;
+    reg  tb_free;
+    reg  take;
+    reg  take_triangle;
+    reg  fetch_moves;
+    reg  [1:0] fetch_next;
+    reg  next_triangle;
     reg  [1:0] l_kind;
     reg  [4:0] l_thread;
     reg  [31:0] l_a;
@@ -22749,6 +22768,11 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(flight_b__write_data),
         .write_enable(flight_b__write_enable)
     );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 tb(
+        .d(tb__d),
+        .q(tb__q),
+        .clock(tb__clock)
+    );
     dynrt_processor__display__dark_d fetching(
         .d(fetching__d),
         .q(fetching__q),
@@ -22763,6 +22787,26 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .d(lb__d),
         .q(lb__q),
         .clock(lb__clock)
+    );
+    dynrt_processor__display__dark_d unvisited__0(
+        .d(unvisited__0__d),
+        .q(unvisited__0__q),
+        .clock(unvisited__0__clock)
+    );
+    dynrt_processor__display__dark_d unvisited__1(
+        .d(unvisited__1__d),
+        .q(unvisited__1__q),
+        .clock(unvisited__1__clock)
+    );
+    dynrt_processor__display__dark_d unvisited__2(
+        .d(unvisited__2__d),
+        .q(unvisited__2__q),
+        .clock(unvisited__2__clock)
+    );
+    dynrt_processor__display__dark_d unvisited__3(
+        .d(unvisited__3__d),
+        .q(unvisited__3__q),
+        .clock(unvisited__3__clock)
     );
     dynrt_processor__engine__tester__lphase lphase(
         .d(lphase__d),
@@ -23349,6 +23393,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     
     // Update code
     always @(*) begin
+        tb__clock = clock;
         fetching__clock = clock;
         fb__clock = clock;
         lb__clock = clock;
@@ -23384,6 +23429,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         gen_hold_diagonal__clock = clock;
         gen_hold_client__clock = clock;
         gen_hold_thread__clock = clock;
+        tb__d = tb__q;
         fetching__d = fetching__q;
         fb__d = fb__q;
         lb__d = lb__q;
@@ -23512,6 +23558,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         words__11__read_address = lb__q;
         loaded__0__clock = clock;
         loaded__0__d = loaded__0__q;
+        unvisited__0__clock = clock;
+        unvisited__0__d = unvisited__0__q;
         cur_kind__0__clock = clock;
         cur_kind__0__d = cur_kind__0__q;
         cur_thread__0__clock = clock;
@@ -23524,6 +23572,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         received__0__d = received__0__q;
         loaded__1__clock = clock;
         loaded__1__d = loaded__1__q;
+        unvisited__1__clock = clock;
+        unvisited__1__d = unvisited__1__q;
         cur_kind__1__clock = clock;
         cur_kind__1__d = cur_kind__1__q;
         cur_thread__1__clock = clock;
@@ -23536,6 +23586,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         received__1__d = received__1__q;
         loaded__2__clock = clock;
         loaded__2__d = loaded__2__q;
+        unvisited__2__clock = clock;
+        unvisited__2__d = unvisited__2__q;
         cur_kind__2__clock = clock;
         cur_kind__2__d = cur_kind__2__q;
         cur_thread__2__clock = clock;
@@ -23548,6 +23600,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         received__2__d = received__2__q;
         loaded__3__clock = clock;
         loaded__3__d = loaded__3__q;
+        unvisited__3__clock = clock;
+        unvisited__3__d = unvisited__3__q;
         cur_kind__3__clock = clock;
         cur_kind__3__d = cur_kind__3__q;
         cur_thread__3__clock = clock;
@@ -23620,7 +23674,54 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         issued__write_address = engine__thread;
         issued__write_data = issued__read_data + 32'h1;
         issued__write_enable = engine__enqueue & (~list_unit__full) & ((queue_kind == c_cmd_list) | (queue_kind == c_cmd_init));
-        list_unit__test_take = 1'b0;
+        tb_free = ~loaded__0__q;
+        if (tb__q == c_buffer__1) begin
+            tb_free = ~loaded__1__q;
+        end
+        if (tb__q == c_buffer__2) begin
+            tb_free = ~loaded__2__q;
+        end
+        if (tb__q == c_buffer__3) begin
+            tb_free = ~loaded__3__q;
+        end
+        take = tb_free & list_unit__test_valid;
+        list_unit__test_take = take;
+        take_triangle = take & (list_unit__test_entry[(32'h45)+:(2)] == c_test_triangle);
+        if (take) begin
+            tb__d = tb__q + 32'h1;
+            if (tb__q == c_buffer__0) begin
+                loaded__0__d = 1'b1;
+                unvisited__0__d = 1'b1;
+                cur_kind__0__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__0__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__0__d = list_unit__test_entry[(32'h0)+:(32)];
+            end
+            if (tb__q == c_buffer__1) begin
+                loaded__1__d = 1'b1;
+                unvisited__1__d = 1'b1;
+                cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__1__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__1__d = list_unit__test_entry[(32'h0)+:(32)];
+            end
+            if (tb__q == c_buffer__2) begin
+                loaded__2__d = 1'b1;
+                unvisited__2__d = 1'b1;
+                cur_kind__2__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__2__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__2__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__2__d = list_unit__test_entry[(32'h0)+:(32)];
+            end
+            if (tb__q == c_buffer__3) begin
+                loaded__3__d = 1'b1;
+                unvisited__3__d = 1'b1;
+                cur_kind__3__d = list_unit__test_entry[(32'h45)+:(2)];
+                cur_thread__3__d = list_unit__test_entry[(32'h40)+:(5)];
+                cur_a__3__d = list_unit__test_entry[(32'h20)+:(32)];
+                cur_b__3__d = list_unit__test_entry[(32'h0)+:(32)];
+            end
+        end
         a_take = fetching__q & (a_issued__q < 32'h6) & ((engine__load_banks & c_bank_a) == 32'h0);
         b_take = fetching__q & (b_issued__q < 32'h6) & ((engine__load_banks & c_bank_b) == 32'h0);
         a_words__read = a_take | ((engine__load_banks & c_bank_a) != 32'h0);
@@ -23658,61 +23759,53 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         a_line__5__d = a_line__4__q;
         b_line__5__d = b_line__4__q;
         fetch_ends = fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)));
-        next_fb = fb__q;
-        if (fetch_ends) begin
-            fetching__d = 1'b0;
-            next_fb = fb__q + 32'h1;
+        fetch_moves = fetch_ends;
+        if ((fb__q == c_buffer__0) & (~fetching__q) & unvisited__0__q & (cur_kind__0__q != c_test_triangle)) begin
+            fetch_moves = 1'b1;
+        end
+        if ((fb__q == c_buffer__1) & (~fetching__q) & unvisited__1__q & (cur_kind__1__q != c_test_triangle)) begin
+            fetch_moves = 1'b1;
+        end
+        if ((fb__q == c_buffer__2) & (~fetching__q) & unvisited__2__q & (cur_kind__2__q != c_test_triangle)) begin
+            fetch_moves = 1'b1;
+        end
+        if ((fb__q == c_buffer__3) & (~fetching__q) & unvisited__3__q & (cur_kind__3__q != c_test_triangle)) begin
+            fetch_moves = 1'b1;
+        end
+        fetch_next = fb__q;
+        if (fetch_moves) begin
+            fetch_next = fb__q + 32'h1;
             fb__d = fb__q + 32'h1;
-        end
-        fb_free = ~loaded__0__q;
-        if (next_fb == c_buffer__1) begin
-            fb_free = ~loaded__1__q;
-        end
-        if (next_fb == c_buffer__2) begin
-            fb_free = ~loaded__2__q;
-        end
-        if (next_fb == c_buffer__3) begin
-            fb_free = ~loaded__3__q;
-        end
-        if (((~fetching__q) | fetch_ends) & fb_free & list_unit__test_valid) begin
-            list_unit__test_take = 1'b1;
             a_issued__d = 32'h0;
             b_issued__d = 32'h0;
-            fetching__d = 1'b1;
-            if (list_unit__test_entry[(32'h45)+:(2)] != c_test_triangle) begin
-                a_issued__d = 32'h6;
-                b_issued__d = 32'h6;
-                fetching__d = 1'b0;
-                fb__d = next_fb + 32'h1;
+            if (fb__q == c_buffer__0) begin
+                unvisited__0__d = 1'b0;
             end
-            if (next_fb == c_buffer__0) begin
-                loaded__0__d = 1'b1;
-                cur_kind__0__d = list_unit__test_entry[(32'h45)+:(2)];
-                cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
-                cur_a__0__d = list_unit__test_entry[(32'h20)+:(32)];
-                cur_b__0__d = list_unit__test_entry[(32'h0)+:(32)];
+            if (fb__q == c_buffer__1) begin
+                unvisited__1__d = 1'b0;
             end
-            if (next_fb == c_buffer__1) begin
-                loaded__1__d = 1'b1;
-                cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
-                cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];
-                cur_a__1__d = list_unit__test_entry[(32'h20)+:(32)];
-                cur_b__1__d = list_unit__test_entry[(32'h0)+:(32)];
+            if (fb__q == c_buffer__2) begin
+                unvisited__2__d = 1'b0;
             end
-            if (next_fb == c_buffer__2) begin
-                loaded__2__d = 1'b1;
-                cur_kind__2__d = list_unit__test_entry[(32'h45)+:(2)];
-                cur_thread__2__d = list_unit__test_entry[(32'h40)+:(5)];
-                cur_a__2__d = list_unit__test_entry[(32'h20)+:(32)];
-                cur_b__2__d = list_unit__test_entry[(32'h0)+:(32)];
+            if (fb__q == c_buffer__3) begin
+                unvisited__3__d = 1'b0;
             end
-            if (next_fb == c_buffer__3) begin
-                loaded__3__d = 1'b1;
-                cur_kind__3__d = list_unit__test_entry[(32'h45)+:(2)];
-                cur_thread__3__d = list_unit__test_entry[(32'h40)+:(5)];
-                cur_a__3__d = list_unit__test_entry[(32'h20)+:(32)];
-                cur_b__3__d = list_unit__test_entry[(32'h0)+:(32)];
-            end
+        end
+        next_triangle = take_triangle & (tb__q == fetch_next);
+        if ((fetch_next == c_buffer__0) & unvisited__0__q & (cur_kind__0__q == c_test_triangle)) begin
+            next_triangle = 1'b1;
+        end
+        if ((fetch_next == c_buffer__1) & unvisited__1__q & (cur_kind__1__q == c_test_triangle)) begin
+            next_triangle = 1'b1;
+        end
+        if ((fetch_next == c_buffer__2) & unvisited__2__q & (cur_kind__2__q == c_test_triangle)) begin
+            next_triangle = 1'b1;
+        end
+        if ((fetch_next == c_buffer__3) & unvisited__3__q & (cur_kind__3__q == c_test_triangle)) begin
+            next_triangle = 1'b1;
+        end
+        if ((~fetching__q) | fetch_ends) begin
+            fetching__d = next_triangle;
         end
         a_arrive = 32'h0;
         b_arrive = 32'h0;
@@ -29317,6 +29410,8 @@ endmodule // dynrt_processor__engine__tester__ray
 
 
 
+
+
 module dynrt_processor__engine__tester__transform_unit(clock,in_valid,m__0,m__1,m__2,m__3,m__4,m__5,m__6,m__7,m__8,m__9,m__10,m__11,v__0,v__1,v__2,point,diagonal,tag,out_valid,result__0,result__1,result__2,out_tag);
     
     // Module arguments
@@ -32175,6 +32270,14 @@ module dynrt_processor__engine__tester__transform_unit__tag_delay(clock,data_in,
     end
     
 endmodule // dynrt_processor__engine__tester__transform_unit__tag_delay
+
+
+
+
+
+
+
+
 
 
 

@@ -29,16 +29,18 @@
 //! Entries are done in queue order, so a thread's closest hit is chosen in its list order
 //! (the first of equal ts stays), as in the golden model.
 //!
-//! Fetch and launch, two state machines around [`TEST_BUFFERS`] (4) entry buffers in a ring:
-//! the fetch takes an entry from the list unit's test queue into a free buffer and requests
-//! the triangle's 6 words of bank 2 and 6 of bank 3 (6 clocks when the engine leaves the banks
-//! alone; an init or a list end fetches nothing), taking the next entry into the next buffer in
-//! the clock of its last requests. The launch waits for its buffer's words (the SRAM latency
-//! after their requests), launches the origin and then the direction into the TransformUnit
-//! (2 clocks), frees the buffer and waits a clock for the next entry's ray words. With two
-//! buffers and a clock of its own for each take, the entries that fetch nothing (a third of
-//! cornell_noshadow's) held the fetch up behind their 4 clocks of launch: 72.3 cycles per
-//! primary ray; four buffers, 63.3; and the take in the last request's clock, 56.6. Throughput:
+//! Take, fetch and launch, around [`TEST_BUFFERS`] (4) entry buffers in a ring: the take moves
+//! the list unit's next entry into the next buffer as soon as it is free; the fetch requests
+//! a buffer's triangle, 6 words of bank 2 and 6 of bank 3 (6 clocks when the engine leaves the
+//! banks alone), and goes on to the next buffer in the clock after its last requests (an init
+//! or a list end fetches nothing and is passed over in a clock). The launch waits for its
+//! buffer's words (the SRAM latency after their requests), launches the origin and then the
+//! direction into the TransformUnit (2 clocks), frees the buffer and waits a clock for the
+//! next entry's ray words. With two buffers and a clock of its own for each take, the entries
+//! that fetch nothing (a third of cornell_noshadow's) held the fetch up behind their 4 clocks
+//! of launch: 72.3 cycles per primary ray; four buffers, 63.3; and the next fetch from the
+//! clock after the last requests, 56.6. The take is apart from the fetch because in the clock
+//! of the last requests it hung on the bank grants (the critical path at stop 43). Throughput:
 //! one test per [`CLOCKS_PER_TEST`] (6) clocks, one init or list end per [`LAUNCH_SPACING`]
 //! (4), the two overlapping as far as the buffers allow; entries leave the launch at
 //! least 4 clocks apart, which the hit merge needs (it reads, compares and writes a thread's
@@ -87,15 +89,15 @@ pub fn flight_slots_suffice(fmt: Format) -> bool {
 }
 
 /// Clocks between two tests when the engine leaves banks 2 and 3 alone (the tester's
-/// throughput bound): the 6 words of each bank, the next take in the last one's clock (the
-/// layout splits a triangle's transform 6 + 6 for this; 8 + 4 took 9 clocks).
+/// throughput bound): the 6 words of each bank, the next triangle's from the clock after the
+/// last ones (the layout splits a triangle's transform 6 + 6 for this; 8 + 4 took 9 clocks).
 pub const CLOCKS_PER_TEST: u32 = 6;
 // `update` spells out its numbers (rust-hdl's Verilog cannot name Rust constants): a
 // triangle is 6 words of bank 2 (words 0-5 of its transform) and 6 of bank 3 (words 6-11,
 // `layout::TRANSFORM_BANK_WORDS`); word k of every buffer is in `words[k]`, addressed by
 // the buffer.
 
-/// Entry buffers between the fetch and the launch (a ring: `fb` and `lb` count modulo 4).
+/// Entry buffers between the take and the launch (a ring: `tb`, `fb` and `lb` count modulo 4).
 pub const TEST_BUFFERS: usize = 4;
 
 #[derive(LogicBlock)]
@@ -189,11 +191,17 @@ pub struct TriangleTester<
     flight_a: RAM<Bits<32>, 5>,
     flight_b: RAM<Bits<32>, 5>,
 
-    // Fetch and launch: [`TEST_BUFFERS`] buffers of an entry and its triangle's 12 words; the
-    // fetch fills `fb` while the launch empties `lb`.
+    // Take, fetch and launch: [`TEST_BUFFERS`] buffers of an entry and its triangle's 12
+    // words; the take fills `tb` with the list unit's next entry, the fetch requests the
+    // words of `fb`'s triangle, the launch empties `lb`.
+    tb: DFF<Bits<2>>,
+    /// Buffer `fb` holds a triangle whose words the fetch is requesting.
     fetching: DFF<Bit>,
     fb: DFF<Bits<2>>,
     lb: DFF<Bits<2>>,
+    /// Taken, and not yet left behind by the fetch (which requests a triangle's words and
+    /// passes over an entry that fetches nothing).
+    unvisited: [DFF<Bit>; TEST_BUFFERS],
     lphase: DFF<Launch>,
     loaded: [DFF<Bit>; TEST_BUFFERS],
     /// `list_unit::TEST_*`.
@@ -214,10 +222,17 @@ pub struct TriangleTester<
     fetch_a: Signal<Local, Bits<32>>,
     /// The fetch requests its buffer's last words this clock.
     fetch_ends: Signal<Local, Bit>,
-    /// The buffer the fetch takes an entry into this clock (`fb`, or the next one as the
-    /// fetch ends).
-    next_fb: Signal<Local, Bits<2>>,
-    fb_free: Signal<Local, Bit>,
+    /// Buffer `tb` is free, and the take fills it this clock.
+    tb_free: Signal<Local, Bit>,
+    take: Signal<Local, Bit>,
+    /// The entry taken is a triangle.
+    take_triangle: Signal<Local, Bit>,
+    /// The fetch leaves `fb` this clock: its last words requested, or an entry that fetches
+    /// nothing passed over.
+    fetch_moves: Signal<Local, Bit>,
+    /// The buffer the fetch is at next clock, and whether it holds a triangle to fetch.
+    fetch_next: Signal<Local, Bits<2>>,
+    next_triangle: Signal<Local, Bit>,
     l_kind: Signal<Local, Bits<2>>,
     l_thread: Signal<Local, Bits<5>>,
     l_a: Signal<Local, Bits<32>>,
@@ -397,9 +412,11 @@ impl<
             flight_t_min: Default::default(),
             flight_a: Default::default(),
             flight_b: Default::default(),
+            tb: Default::default(),
             fetching: Default::default(),
             fb: Default::default(),
             lb: Default::default(),
+            unvisited: Default::default(),
             lphase: Default::default(),
             loaded: Default::default(),
             cur_kind: Default::default(),
@@ -410,8 +427,12 @@ impl<
             b_here: Default::default(),
             fetch_a: Default::default(),
             fetch_ends: Default::default(),
-            next_fb: Default::default(),
-            fb_free: Default::default(),
+            tb_free: Default::default(),
+            take: Default::default(),
+            take_triangle: Default::default(),
+            fetch_moves: Default::default(),
+            fetch_next: Default::default(),
+            next_triangle: Default::default(),
             l_kind: Default::default(),
             l_thread: Default::default(),
             l_a: Default::default(),
@@ -499,6 +520,7 @@ impl<
         dff_setup!(
             self,
             clock,
+            tb,
             fetching,
             fb,
             lb,
@@ -580,6 +602,8 @@ impl<
         for k in 0..4 {
             self.loaded[k].clock.next = self.clock.val();
             self.loaded[k].d.next = self.loaded[k].q.val();
+            self.unvisited[k].clock.next = self.clock.val();
+            self.unvisited[k].d.next = self.unvisited[k].q.val();
             self.cur_kind[k].clock.next = self.clock.val();
             self.cur_kind[k].d.next = self.cur_kind[k].q.val();
             self.cur_thread[k].clock.next = self.clock.val();
@@ -655,10 +679,39 @@ impl<
             & ((self.queue_kind.val() == self.c_cmd_list.val())
                 | (self.queue_kind.val() == self.c_cmd_init.val()));
 
-        // Fetch into buffer `fb`: take the list unit's next entry when the buffer is free,
-        // then request its 6 + 6 words (the banks serve the engine first). An init or a list
-        // end fetches nothing. The next entry's fetch goes on while this one is launched.
-        self.list_unit.test_take.next = false;
+        // Take: the list unit's next entry into buffer `tb` whenever it is free, apart from the
+        // fetch. (Taken in the clock of the fetch's last requests, the take waited on the bank
+        // grants, and from them through the list unit's pop to its queue's read was the
+        // processor's critical path: cornell_noshadow, 78.8 MHz at stop 43.)
+        self.tb_free.next = !self.loaded[0].q.val();
+        for k in 1..4 {
+            if self.tb.q.val() == self.c_buffer[k].val() {
+                self.tb_free.next = !self.loaded[k].q.val();
+            }
+        }
+        self.take.next = self.tb_free.val() & self.list_unit.test_valid.val();
+        self.list_unit.test_take.next = self.take.val();
+        self.take_triangle.next = self.take.val()
+            & (self.list_unit.test_entry.val().get_bits::<2>(69) == self.c_test_triangle.val());
+        if self.take.val() {
+            self.tb.d.next = self.tb.q.val() + 1;
+            for k in 0..4 {
+                if self.tb.q.val() == self.c_buffer[k].val() {
+                    self.loaded[k].d.next = true;
+                    self.unvisited[k].d.next = true;
+                    self.cur_kind[k].d.next = self.list_unit.test_entry.val().get_bits::<2>(69);
+                    self.cur_thread[k].d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
+                    self.cur_a[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(32);
+                    self.cur_b[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(0);
+                }
+            }
+        }
+
+        // Fetch: request the 6 + 6 words of `fb`'s triangle (the banks serve the engine first),
+        // then go on to the next buffer; an init or a list end fetches nothing and is passed
+        // over in a clock. The fetch never falls behind the launch: a triangle launches once
+        // its words are in (so requested: the fetch has left it), and the launch frees an
+        // entry 3 clocks after it starts, the fetch passes over one in 1.
         self.a_take.next = self.fetching.q.val()
             & (self.a_issued.q.val() < 6)
             & ((self.engine.load_banks.val() & self.c_bank_a.val()) == 0);
@@ -698,47 +751,47 @@ impl<
             self.a_line[k].d.next = self.a_line[k - 1].q.val();
             self.b_line[k].d.next = self.b_line[k - 1].q.val();
         }
-        // The fetch is done with the buffer once its last words are requested; the next
-        // entry is taken into the next buffer in that same clock (6 clocks per test, not 7).
+        // The fetch is done with the buffer once its last words are requested, and requests
+        // the next buffer's words from the next clock (6 clocks per test, not 7).
         self.fetch_ends.next = self.fetching.q.val()
             & ((self.a_issued.q.val() == 6) | (self.a_take.val() & (self.a_issued.q.val() == 5)))
             & ((self.b_issued.q.val() == 6) | (self.b_take.val() & (self.b_issued.q.val() == 5)));
-        self.next_fb.next = self.fb.q.val();
-        if self.fetch_ends.val() {
-            self.fetching.d.next = false;
-            self.next_fb.next = self.fb.q.val() + 1;
-            self.fb.d.next = self.fb.q.val() + 1;
-        }
-        self.fb_free.next = !self.loaded[0].q.val();
-        for k in 1..4 {
-            if self.next_fb.val() == self.c_buffer[k].val() {
-                self.fb_free.next = !self.loaded[k].q.val();
+        self.fetch_moves.next = self.fetch_ends.val();
+        for k in 0..4 {
+            if (self.fb.q.val() == self.c_buffer[k].val())
+                & (!self.fetching.q.val())
+                & self.unvisited[k].q.val()
+                & (self.cur_kind[k].q.val() != self.c_test_triangle.val())
+            {
+                self.fetch_moves.next = true;
             }
         }
-        if ((!self.fetching.q.val()) | self.fetch_ends.val())
-            & self.fb_free.val()
-            & self.list_unit.test_valid.val()
-        {
-            self.list_unit.test_take.next = true;
+        self.fetch_next.next = self.fb.q.val();
+        if self.fetch_moves.val() {
+            self.fetch_next.next = self.fb.q.val() + 1;
+            self.fb.d.next = self.fb.q.val() + 1;
             self.a_issued.d.next = 0.into();
             self.b_issued.d.next = 0.into();
-            self.fetching.d.next = true;
-            if self.list_unit.test_entry.val().get_bits::<2>(69) != self.c_test_triangle.val() {
-                // An init or a list end fetches nothing.
-                self.a_issued.d.next = 6.into();
-                self.b_issued.d.next = 6.into();
-                self.fetching.d.next = false;
-                self.fb.d.next = self.next_fb.val() + 1;
-            }
             for k in 0..4 {
-                if self.next_fb.val() == self.c_buffer[k].val() {
-                    self.loaded[k].d.next = true;
-                    self.cur_kind[k].d.next = self.list_unit.test_entry.val().get_bits::<2>(69);
-                    self.cur_thread[k].d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
-                    self.cur_a[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(32);
-                    self.cur_b[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(0);
+                if self.fb.q.val() == self.c_buffer[k].val() {
+                    self.unvisited[k].d.next = false;
                 }
             }
+        }
+        // A triangle taken this clock into the buffer the fetch is at next is fetched from
+        // the next clock, as one taken before.
+        self.next_triangle.next =
+            self.take_triangle.val() & (self.tb.q.val() == self.fetch_next.val());
+        for k in 0..4 {
+            if (self.fetch_next.val() == self.c_buffer[k].val())
+                & self.unvisited[k].q.val()
+                & (self.cur_kind[k].q.val() == self.c_test_triangle.val())
+            {
+                self.next_triangle.next = true;
+            }
+        }
+        if (!self.fetching.q.val()) | self.fetch_ends.val() {
+            self.fetching.d.next = self.next_triangle.val();
         }
         // The word of the request `mem_latency` clocks ago.
         self.a_arrive.next = 0.into();
