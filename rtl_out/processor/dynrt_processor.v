@@ -17195,9 +17195,6 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  s0_miss__d;
     wire  s0_miss__q;
     reg  s0_miss__clock;
-    reg  s0_transform__d;
-    wire  s0_transform__q;
-    reg  s0_transform__clock;
     reg  s1_valid__d;
     wire  s1_valid__q;
     reg  s1_valid__clock;
@@ -18117,11 +18114,6 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(s0_miss__q),
         .clock(s0_miss__clock)
     );
-    dynrt_processor__display__dark_d s0_transform(
-        .d(s0_transform__d),
-        .q(s0_transform__q),
-        .clock(s0_transform__clock)
-    );
     dynrt_processor__display__dark_d s1_valid(
         .d(s1_valid__d),
         .q(s1_valid__q),
@@ -18376,7 +18368,6 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         s0_light__clock = clock;
         s0_flip__clock = clock;
         s0_miss__clock = clock;
-        s0_transform__clock = clock;
         s1_valid__clock = clock;
         s1_slot__clock = clock;
         s1_word__clock = clock;
@@ -18404,7 +18395,6 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         s0_light__d = s0_light__q;
         s0_flip__d = s0_flip__q;
         s0_miss__d = s0_miss__q;
-        s0_transform__d = s0_transform__q;
         s1_valid__d = s1_valid__q;
         s1_slot__d = s1_slot__q;
         s1_word__d = s1_word__q;
@@ -19026,7 +19016,6 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             s0_light__d = pick_light;
             s0_flip__d = pick_flip;
             s0_miss__d = pick_miss;
-            s0_transform__d = (pick_step == ShadeStep__Point) | (pick_step == ShadeStep__NormalDot) | (pick_step == ShadeStep__Ambient) | (pick_step == ShadeStep__ToLight) | (pick_step == ShadeStep__Dots) | (pick_step == ShadeStep__Tint) | (pick_step == ShadeStep__Accumulate);
         end
         s1_load = (~s1_valid__q) | s1_done;
         if (s1_load) begin
@@ -19039,7 +19028,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             s1_light__d = s0_light__q;
             s1_flip__d = s0_flip__q;
             s1_miss__d = s0_miss__q;
-            s1_transform__d = s0_transform__q;
+            s1_transform__d = (s0_step__q == ShadeStep__Point) | (s0_step__q == ShadeStep__NormalDot) | (s0_step__q == ShadeStep__Ambient) | (s0_step__q == ShadeStep__ToLight) | (s0_step__q == ShadeStep__Dots) | (s0_step__q == ShadeStep__Tint) | (s0_step__q == ShadeStep__Accumulate);
         end
         refused = loading__q | (~has_free_r__q);
         taken = offer & (~refused);
@@ -21533,8 +21522,6 @@ module dynrt_processor__engine__shader__res_step_r(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__shader__res_step_r
-
-
 
 
 
@@ -27572,6 +27559,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
     
     // Local signals
     reg  [23:0] cursor_next;
+    reg  [4:0] in_use;
     reg  take;
     reg  arrive;
     reg  seen;
@@ -28240,7 +28228,11 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
             phase__d = ListPhase__Walk;
         end
         take = (phase__q == ListPhase__Walk) & (~walked__q) & room__q & ((engine_banks & c_shared_banks) == 32'h0);
-        room__d = (((queued__q) & 5'h1f) + ((flight__q) & 5'h1f) + ((arrive_r__q) & 5'h1f) + ((take) & 5'h1f)) < 32'h7;
+        in_use = ((queued__q) & 5'h1f) + ((flight__q) & 5'h1f) + ((arrive_r__q) & 5'h1f);
+        room__d = in_use < 32'h7;
+        if (take) begin
+            room__d = in_use < 32'h6;
+        end
         list_read = take;
         list_addr = cursor__q;
         cursor_next = cursor__q + 32'h1;
