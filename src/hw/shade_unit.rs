@@ -220,8 +220,6 @@ pub struct ShadeUnit<
     s0_light: DFF<Bits<3>>,
     s0_flip: DFF<Bit>,
     s0_miss: DFF<Bit>,
-    /// The step is a TransformUnit pass, decoded at the pick.
-    s0_transform: DFF<Bit>,
     s1_valid: DFF<Bit>,
     s1_slot: DFF<Bits<3>>,
     /// The word of a multi-clock operation (loads, bytes).
@@ -233,6 +231,7 @@ pub struct ShadeUnit<
     s1_light: DFF<Bits<3>>,
     s1_flip: DFF<Bit>,
     s1_miss: DFF<Bit>,
+    /// The step is a TransformUnit pass.
     s1_transform: DFF<Bit>,
     s1_load: Signal<Local, Bit>,
     pick_step: Signal<Local, ShadeStep>,
@@ -453,7 +452,6 @@ impl<
             s0_light: Default::default(),
             s0_flip: Default::default(),
             s0_miss: Default::default(),
-            s0_transform: Default::default(),
             s1_valid: Default::default(),
             s1_slot: Default::default(),
             s1_word: Default::default(),
@@ -574,7 +572,6 @@ impl<
             s0_light,
             s0_flip,
             s0_miss,
-            s0_transform,
             s1_valid,
             s1_slot,
             s1_word,
@@ -967,13 +964,6 @@ impl<
             self.s0_light.d.next = self.pick_light.val();
             self.s0_flip.d.next = self.pick_flip.val();
             self.s0_miss.d.next = self.pick_miss.val();
-            self.s0_transform.d.next = (self.pick_step.val() == ShadeStep::Point)
-                | (self.pick_step.val() == ShadeStep::NormalDot)
-                | (self.pick_step.val() == ShadeStep::Ambient)
-                | (self.pick_step.val() == ShadeStep::ToLight)
-                | (self.pick_step.val() == ShadeStep::Dots)
-                | (self.pick_step.val() == ShadeStep::Tint)
-                | (self.pick_step.val() == ShadeStep::Accumulate);
         }
         // S1 takes S0's slot when its own operation has gone out (S0 is emptied only if full:
         // an empty S0 may be filled by the pick in this clock).
@@ -988,7 +978,14 @@ impl<
             self.s1_light.d.next = self.s0_light.q.val();
             self.s1_flip.d.next = self.s0_flip.q.val();
             self.s1_miss.d.next = self.s0_miss.q.val();
-            self.s1_transform.d.next = self.s0_transform.q.val();
+            // Decoded from S0's register, not after the pick's mux.
+            self.s1_transform.d.next = (self.s0_step.q.val() == ShadeStep::Point)
+                | (self.s0_step.q.val() == ShadeStep::NormalDot)
+                | (self.s0_step.q.val() == ShadeStep::Ambient)
+                | (self.s0_step.q.val() == ShadeStep::ToLight)
+                | (self.s0_step.q.val() == ShadeStep::Dots)
+                | (self.s0_step.q.val() == ShadeStep::Tint)
+                | (self.s0_step.q.val() == ShadeStep::Accumulate);
         }
 
         // ---- Offers take the first free slot. ----
@@ -996,6 +993,8 @@ impl<
         self.taken.next = self.offer.val() & (!self.refused.val());
         self.free_slot_r.clock.next = self.clock.val();
         self.has_free_r.clock.next = self.clock.val();
+        // Two priority chains, the free slots with and without the one an offer takes now, so
+        // that the offer (late: the engine's I5) only picks between their results.
         self.any_free_before[0].next = false;
         self.any_free_after_take[0].next = false;
         for s in 0..SHADE_SLOTS {
