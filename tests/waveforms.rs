@@ -150,15 +150,25 @@ fn traced_window(sim: &str, format: &str, start: u64, end: u64) {
     );
 }
 
+// One test per simulator and format: each builds a model of its own (a traced Verilator
+// build takes 30-60 s), and apart they share the test threads.
 #[test]
-fn icarus_traces_a_window_of_clocks_in_vcd_and_fst() {
+fn icarus_traces_a_window_of_clocks_in_vcd() {
     traced_window("iverilog", "vcd", 1000, 1100);
+}
+
+#[test]
+fn icarus_traces_a_window_of_clocks_in_fst() {
     traced_window("iverilog", "fst", 1000, 1100);
 }
 
 #[test]
-fn verilator_traces_a_window_of_clocks_in_vcd_and_fst() {
+fn verilator_traces_a_window_of_clocks_in_vcd() {
     traced_window("verilator", "vcd", 1000, 1100);
+}
+
+#[test]
+fn verilator_traces_a_window_of_clocks_in_fst() {
     traced_window("verilator", "fst", 1000, 1100);
 }
 
