@@ -23679,35 +23679,43 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             if (tb__q == c_buffer__0) begin
                 loaded__0__d = 1'b1;
                 unvisited__0__d = 1'b1;
-                cur_kind__0__d = list_unit__test_entry[(32'h45)+:(2)];
-                cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
-                cur_a__0__d = list_unit__test_entry[(32'h20)+:(32)];
-                cur_b__0__d = list_unit__test_entry[(32'h0)+:(32)];
             end
             if (tb__q == c_buffer__1) begin
                 loaded__1__d = 1'b1;
                 unvisited__1__d = 1'b1;
-                cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
-                cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];
-                cur_a__1__d = list_unit__test_entry[(32'h20)+:(32)];
-                cur_b__1__d = list_unit__test_entry[(32'h0)+:(32)];
             end
             if (tb__q == c_buffer__2) begin
                 loaded__2__d = 1'b1;
                 unvisited__2__d = 1'b1;
-                cur_kind__2__d = list_unit__test_entry[(32'h45)+:(2)];
-                cur_thread__2__d = list_unit__test_entry[(32'h40)+:(5)];
-                cur_a__2__d = list_unit__test_entry[(32'h20)+:(32)];
-                cur_b__2__d = list_unit__test_entry[(32'h0)+:(32)];
             end
             if (tb__q == c_buffer__3) begin
                 loaded__3__d = 1'b1;
                 unvisited__3__d = 1'b1;
-                cur_kind__3__d = list_unit__test_entry[(32'h45)+:(2)];
-                cur_thread__3__d = list_unit__test_entry[(32'h40)+:(5)];
-                cur_a__3__d = list_unit__test_entry[(32'h20)+:(32)];
-                cur_b__3__d = list_unit__test_entry[(32'h0)+:(32)];
             end
+        end
+        if ((tb__q == c_buffer__0) & (~loaded__0__q)) begin
+            cur_kind__0__d = list_unit__test_entry[(32'h45)+:(2)];
+            cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
+            cur_a__0__d = list_unit__test_entry[(32'h20)+:(32)];
+            cur_b__0__d = list_unit__test_entry[(32'h0)+:(32)];
+        end
+        if ((tb__q == c_buffer__1) & (~loaded__1__q)) begin
+            cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
+            cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];
+            cur_a__1__d = list_unit__test_entry[(32'h20)+:(32)];
+            cur_b__1__d = list_unit__test_entry[(32'h0)+:(32)];
+        end
+        if ((tb__q == c_buffer__2) & (~loaded__2__q)) begin
+            cur_kind__2__d = list_unit__test_entry[(32'h45)+:(2)];
+            cur_thread__2__d = list_unit__test_entry[(32'h40)+:(5)];
+            cur_a__2__d = list_unit__test_entry[(32'h20)+:(32)];
+            cur_b__2__d = list_unit__test_entry[(32'h0)+:(32)];
+        end
+        if ((tb__q == c_buffer__3) & (~loaded__3__q)) begin
+            cur_kind__3__d = list_unit__test_entry[(32'h45)+:(2)];
+            cur_thread__3__d = list_unit__test_entry[(32'h40)+:(5)];
+            cur_a__3__d = list_unit__test_entry[(32'h20)+:(32)];
+            cur_b__3__d = list_unit__test_entry[(32'h0)+:(32)];
         end
         a_take = fetching__q & (a_issued__q < 32'h6) & ((engine__load_banks & c_bank_a) == 32'h0);
         b_take = fetching__q & (b_issued__q < 32'h6) & ((engine__load_banks & c_bank_b) == 32'h0);
