@@ -222,7 +222,7 @@ pub struct TriangleTester<
     fetch_a: Signal<Local, Bits<32>>,
     /// The fetch requests its buffer's last words this clock.
     fetch_ends: Signal<Local, Bit>,
-    /// Buffer `tb` is free, and the take fills it this clock.
+    /// Buffer `tb` is free; `take`: it takes the queue's head this clock.
     tb_free: Signal<Local, Bit>,
     take: Signal<Local, Bit>,
     /// The entry taken is a triangle.
