@@ -195,7 +195,10 @@ pub struct TriangleTester<
     // words; the take fills `tb` with the list unit's next entry, the fetch requests the
     // words of `fb`'s triangle, the launch empties `lb`.
     tb: DFF<Bits<2>>,
-    /// Buffer `fb` holds a triangle whose words the fetch is requesting.
+    /// Buffer `fb` holds a triangle whose words the fetch is requesting. Always
+    /// `unvisited[fb]` and `cur_kind[fb] == TEST_TRIANGLE`, kept in a register of its own so
+    /// that the bank requests (`a_take`, `b_take`) start from a flip-flop, not from a mux on
+    /// `fb`.
     fetching: DFF<Bit>,
     fb: DFF<Bits<2>>,
     lb: DFF<Bits<2>>,
