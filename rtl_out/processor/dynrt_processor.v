@@ -17303,6 +17303,60 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  frame_line__clock;
     reg  [8:0] frame_line__data_in;
     wire  [8:0] frame_line__data_out;
+    reg  [8:0] tri_arrived_r__d;
+    wire  [8:0] tri_arrived_r__q;
+    reg  tri_arrived_r__clock;
+    reg  [8:0] frame_arrived_r__d;
+    wire  [8:0] frame_arrived_r__q;
+    reg  frame_arrived_r__clock;
+    reg  normal_in__0__d;
+    wire  normal_in__0__q;
+    reg  normal_in__0__clock;
+    reg  normal_in__1__d;
+    wire  normal_in__1__q;
+    reg  normal_in__1__clock;
+    reg  normal_in__2__d;
+    wire  normal_in__2__q;
+    reg  normal_in__2__clock;
+    reg  normal_in__3__d;
+    wire  normal_in__3__q;
+    reg  normal_in__3__clock;
+    reg  normal_in__4__d;
+    wire  normal_in__4__q;
+    reg  normal_in__4__clock;
+    reg  normal_in__5__d;
+    wire  normal_in__5__q;
+    reg  normal_in__5__clock;
+    reg  normal_in__6__d;
+    wire  normal_in__6__q;
+    reg  normal_in__6__clock;
+    reg  normal_in__7__d;
+    wire  normal_in__7__q;
+    reg  normal_in__7__clock;
+    reg  kd_in__0__d;
+    wire  kd_in__0__q;
+    reg  kd_in__0__clock;
+    reg  kd_in__1__d;
+    wire  kd_in__1__q;
+    reg  kd_in__1__clock;
+    reg  kd_in__2__d;
+    wire  kd_in__2__q;
+    reg  kd_in__2__clock;
+    reg  kd_in__3__d;
+    wire  kd_in__3__q;
+    reg  kd_in__3__clock;
+    reg  kd_in__4__d;
+    wire  kd_in__4__q;
+    reg  kd_in__4__clock;
+    reg  kd_in__5__d;
+    wire  kd_in__5__q;
+    reg  kd_in__5__clock;
+    reg  kd_in__6__d;
+    wire  kd_in__6__q;
+    reg  kd_in__6__clock;
+    reg  kd_in__7__d;
+    wire  kd_in__7__q;
+    reg  kd_in__7__clock;
     reg  sqrt__clock;
     reg  sqrt__in_valid;
     reg  [23:0] sqrt__a;
@@ -18294,6 +18348,96 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .data_in(frame_line__data_in),
         .data_out(frame_line__data_out)
     );
+    dynrt_processor__engine__fp_units__add__lz tri_arrived_r(
+        .d(tri_arrived_r__d),
+        .q(tri_arrived_r__q),
+        .clock(tri_arrived_r__clock)
+    );
+    dynrt_processor__engine__fp_units__add__lz frame_arrived_r(
+        .d(frame_arrived_r__d),
+        .q(frame_arrived_r__q),
+        .clock(frame_arrived_r__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__0(
+        .d(normal_in__0__d),
+        .q(normal_in__0__q),
+        .clock(normal_in__0__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__1(
+        .d(normal_in__1__d),
+        .q(normal_in__1__q),
+        .clock(normal_in__1__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__2(
+        .d(normal_in__2__d),
+        .q(normal_in__2__q),
+        .clock(normal_in__2__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__3(
+        .d(normal_in__3__d),
+        .q(normal_in__3__q),
+        .clock(normal_in__3__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__4(
+        .d(normal_in__4__d),
+        .q(normal_in__4__q),
+        .clock(normal_in__4__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__5(
+        .d(normal_in__5__d),
+        .q(normal_in__5__q),
+        .clock(normal_in__5__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__6(
+        .d(normal_in__6__d),
+        .q(normal_in__6__q),
+        .clock(normal_in__6__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__7(
+        .d(normal_in__7__d),
+        .q(normal_in__7__q),
+        .clock(normal_in__7__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__0(
+        .d(kd_in__0__d),
+        .q(kd_in__0__q),
+        .clock(kd_in__0__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__1(
+        .d(kd_in__1__d),
+        .q(kd_in__1__q),
+        .clock(kd_in__1__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__2(
+        .d(kd_in__2__d),
+        .q(kd_in__2__q),
+        .clock(kd_in__2__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__3(
+        .d(kd_in__3__d),
+        .q(kd_in__3__q),
+        .clock(kd_in__3__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__4(
+        .d(kd_in__4__d),
+        .q(kd_in__4__q),
+        .clock(kd_in__4__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__5(
+        .d(kd_in__5__d),
+        .q(kd_in__5__q),
+        .clock(kd_in__5__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__6(
+        .d(kd_in__6__d),
+        .q(kd_in__6__q),
+        .clock(kd_in__6__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__7(
+        .d(kd_in__7__d),
+        .q(kd_in__7__q),
+        .clock(kd_in__7__clock)
+    );
     dynrt_processor__engine__fp_units__sqrt sqrt(
         .clock(sqrt__clock),
         .in_valid(sqrt__in_valid),
@@ -18420,6 +18564,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         flip__0__d = flip__0__q;
         miss__0__clock = clock;
         miss__0__d = miss__0__q;
+        normal_in__0__clock = clock;
+        kd_in__0__clock = clock;
         busy__1__clock = clock;
         busy__1__d = busy__1__q;
         ready__1__clock = clock;
@@ -18432,6 +18578,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         flip__1__d = flip__1__q;
         miss__1__clock = clock;
         miss__1__d = miss__1__q;
+        normal_in__1__clock = clock;
+        kd_in__1__clock = clock;
         busy__2__clock = clock;
         busy__2__d = busy__2__q;
         ready__2__clock = clock;
@@ -18444,6 +18592,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         flip__2__d = flip__2__q;
         miss__2__clock = clock;
         miss__2__d = miss__2__q;
+        normal_in__2__clock = clock;
+        kd_in__2__clock = clock;
         busy__3__clock = clock;
         busy__3__d = busy__3__q;
         ready__3__clock = clock;
@@ -18456,6 +18606,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         flip__3__d = flip__3__q;
         miss__3__clock = clock;
         miss__3__d = miss__3__q;
+        normal_in__3__clock = clock;
+        kd_in__3__clock = clock;
         busy__4__clock = clock;
         busy__4__d = busy__4__q;
         ready__4__clock = clock;
@@ -18468,6 +18620,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         flip__4__d = flip__4__q;
         miss__4__clock = clock;
         miss__4__d = miss__4__q;
+        normal_in__4__clock = clock;
+        kd_in__4__clock = clock;
         busy__5__clock = clock;
         busy__5__d = busy__5__q;
         ready__5__clock = clock;
@@ -18480,6 +18634,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         flip__5__d = flip__5__q;
         miss__5__clock = clock;
         miss__5__d = miss__5__q;
+        normal_in__5__clock = clock;
+        kd_in__5__clock = clock;
         busy__6__clock = clock;
         busy__6__d = busy__6__q;
         ready__6__clock = clock;
@@ -18492,6 +18648,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         flip__6__d = flip__6__q;
         miss__6__clock = clock;
         miss__6__d = miss__6__q;
+        normal_in__6__clock = clock;
+        kd_in__6__clock = clock;
         busy__7__clock = clock;
         busy__7__d = busy__7__q;
         ready__7__clock = clock;
@@ -18504,6 +18662,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         flip__7__d = flip__7__q;
         miss__7__clock = clock;
         miss__7__d = miss__7__q;
+        normal_in__7__clock = clock;
+        kd_in__7__clock = clock;
         background__0__clock = clock;
         background__0__d = background__0__q;
         gen_hold_v__0__clock = clock;
@@ -18578,6 +18738,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         rays__5__write_data = ray_d__2;
         tri_line__clock = clock;
         frame_line__clock = clock;
+        tri_arrived_r__clock = clock;
+        frame_arrived_r__clock = clock;
         sqrt__clock = clock;
         div__clock = clock;
         cos_n_dot_l__clock = clock;
@@ -19150,8 +19312,26 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         triangle__write_data = offer_triangle;
         tri_line__data_in = tri_tag;
         frame_line__data_in = frame_tag;
-        tri_arrived = tri_line__data_out;
-        frame_arrived = frame_line__data_out;
+        tri_arrived_r__d = tri_line__data_out;
+        frame_arrived_r__d = frame_line__data_out;
+        tri_arrived = tri_arrived_r__q;
+        frame_arrived = frame_arrived_r__q;
+        normal_in__0__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__0);
+        kd_in__0__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__0);
+        normal_in__1__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__1);
+        kd_in__1__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__1);
+        normal_in__2__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__2);
+        kd_in__2__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__2);
+        normal_in__3__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__3);
+        kd_in__3__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__3);
+        normal_in__4__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__4);
+        kd_in__4__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__4);
+        normal_in__5__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__5);
+        kd_in__5__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__5);
+        normal_in__6__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__6);
+        kd_in__6__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__6);
+        normal_in__7__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__7);
+        kd_in__7__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__7);
         n__0__write_address = tri_arrived[(32'h3)+:(3)];
         n__1__write_address = tri_arrived[(32'h3)+:(3)];
         n__2__write_address = tri_arrived[(32'h3)+:(3)];
@@ -19370,11 +19550,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             busy__0__d = 1'b0;
             step__0__d = ShadeStep__Idle;
         end
-        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__0)) begin
+        if (normal_in__0__q) begin
             ready__0__d = 1'b1;
             step__0__d = ShadeStep__Point;
         end
-        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__0)) begin
+        if (kd_in__0__q) begin
             ready__0__d = 1'b1;
             step__0__d = ShadeStep__Ambient;
         end
@@ -19436,11 +19616,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             busy__1__d = 1'b0;
             step__1__d = ShadeStep__Idle;
         end
-        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__1)) begin
+        if (normal_in__1__q) begin
             ready__1__d = 1'b1;
             step__1__d = ShadeStep__Point;
         end
-        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__1)) begin
+        if (kd_in__1__q) begin
             ready__1__d = 1'b1;
             step__1__d = ShadeStep__Ambient;
         end
@@ -19502,11 +19682,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             busy__2__d = 1'b0;
             step__2__d = ShadeStep__Idle;
         end
-        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__2)) begin
+        if (normal_in__2__q) begin
             ready__2__d = 1'b1;
             step__2__d = ShadeStep__Point;
         end
-        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__2)) begin
+        if (kd_in__2__q) begin
             ready__2__d = 1'b1;
             step__2__d = ShadeStep__Ambient;
         end
@@ -19568,11 +19748,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             busy__3__d = 1'b0;
             step__3__d = ShadeStep__Idle;
         end
-        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__3)) begin
+        if (normal_in__3__q) begin
             ready__3__d = 1'b1;
             step__3__d = ShadeStep__Point;
         end
-        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__3)) begin
+        if (kd_in__3__q) begin
             ready__3__d = 1'b1;
             step__3__d = ShadeStep__Ambient;
         end
@@ -19634,11 +19814,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             busy__4__d = 1'b0;
             step__4__d = ShadeStep__Idle;
         end
-        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__4)) begin
+        if (normal_in__4__q) begin
             ready__4__d = 1'b1;
             step__4__d = ShadeStep__Point;
         end
-        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__4)) begin
+        if (kd_in__4__q) begin
             ready__4__d = 1'b1;
             step__4__d = ShadeStep__Ambient;
         end
@@ -19700,11 +19880,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             busy__5__d = 1'b0;
             step__5__d = ShadeStep__Idle;
         end
-        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__5)) begin
+        if (normal_in__5__q) begin
             ready__5__d = 1'b1;
             step__5__d = ShadeStep__Point;
         end
-        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__5)) begin
+        if (kd_in__5__q) begin
             ready__5__d = 1'b1;
             step__5__d = ShadeStep__Ambient;
         end
@@ -19766,11 +19946,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             busy__6__d = 1'b0;
             step__6__d = ShadeStep__Idle;
         end
-        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__6)) begin
+        if (normal_in__6__q) begin
             ready__6__d = 1'b1;
             step__6__d = ShadeStep__Point;
         end
-        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__6)) begin
+        if (kd_in__6__q) begin
             ready__6__d = 1'b1;
             step__6__d = ShadeStep__Ambient;
         end
@@ -19832,11 +20012,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             busy__7__d = 1'b0;
             step__7__d = ShadeStep__Idle;
         end
-        if (tri_word_1 & (tri_arrived[(32'h3)+:(3)] == c_slot__7)) begin
+        if (normal_in__7__q) begin
             ready__7__d = 1'b1;
             step__7__d = ShadeStep__Point;
         end
-        if (frame_valid & (frame_kind == c_kind_kd) & (frame_word == 32'h2) & (frame_arrived[(32'h3)+:(3)] == c_slot__7)) begin
+        if (kd_in__7__q) begin
             ready__7__d = 1'b1;
             step__7__d = ShadeStep__Ambient;
         end
@@ -21285,6 +21465,8 @@ endmodule // dynrt_processor__engine__shader__cos_slot
 
 
 
+
+
 module dynrt_processor__engine__shader__frame_line(clock,data_in,data_out);
     
     // Module arguments
@@ -21299,9 +21481,6 @@ module dynrt_processor__engine__shader__frame_line(clock,data_in,data_out);
     reg  [8:0] stage__1__d;
     wire  [8:0] stage__1__q;
     reg  stage__1__clock;
-    reg  [8:0] stage__2__d;
-    wire  [8:0] stage__2__q;
-    reg  stage__2__clock;
     
     // Sub module instances
     dynrt_processor__engine__fp_units__add__lz stage__0(
@@ -21314,24 +21493,47 @@ module dynrt_processor__engine__shader__frame_line(clock,data_in,data_out);
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor__engine__fp_units__add__lz stage__2(
-        .d(stage__2__d),
-        .q(stage__2__q),
-        .clock(stage__2__clock)
-    );
     
     // Update code
     always @(*) begin
         stage__0__clock = clock;
         stage__1__clock = clock;
-        stage__2__clock = clock;
         stage__0__d = data_in;
         stage__1__d = stage__0__q;
-        stage__2__d = stage__1__q;
-        data_out = stage__2__q;
+        data_out = stage__1__q;
     end
     
 endmodule // dynrt_processor__engine__shader__frame_line
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 

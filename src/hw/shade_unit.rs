@@ -287,8 +287,18 @@ pub struct ShadeUnit<
     frame_line: DelayLine<Bits<9>>,
     tri_tag: Signal<Local, Bits<9>>,
     frame_tag: Signal<Local, Bits<9>>,
+    /// The lines run a clock short of the words; their last tag is registered here, beside a
+    /// per-slot decode of it, so that a word's slot reaches that slot's step from a flip-flop
+    /// of its own. From the line's last stage straight into the eight slots' compares, one net
+    /// fanned out to every slot's step (stop 44's critical path, 71.9 MHz placed).
+    tri_arrived_r: DFF<Bits<9>>,
+    frame_arrived_r: DFF<Bits<9>>,
     tri_arrived: Signal<Local, Bits<9>>,
     frame_arrived: Signal<Local, Bits<9>>,
+    /// Slot s's normal is in (its second triangle word arrives now).
+    normal_in: [DFF<Bit>; SHADE_SLOTS],
+    /// Slot s's diffuse colour is in (its third word arrives now).
+    kd_in: [DFF<Bit>; SHADE_SLOTS],
     // The cosine: sqrt(L . L), then n . L over it.
     sqrt: FpSqrt<W, E, M, S, S1, T>,
     div: FpDiv<W, E, M, S, S1, X2>,
@@ -361,7 +371,7 @@ impl<
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
         assert!(config.lights as usize <= MAX_SHADE_LIGHTS, "{config:?}");
         assert!(
-            config.tri_latency >= 1 && config.frame_latency >= 1,
+            config.tri_latency >= 2 && config.frame_latency >= 2,
             "{config:?}"
         );
         let f = crate::fp::Format::new(E as u32, M as u32).expect("a supported format");
@@ -501,8 +511,12 @@ impl<
             frame_read_l: Default::default(),
             frame_addr_l: Default::default(),
             fb_write_l: Default::default(),
-            tri_line: DelayLine::new(config.tri_latency as usize),
-            frame_line: DelayLine::new(config.frame_latency as usize),
+            tri_line: DelayLine::new(config.tri_latency as usize - 1),
+            frame_line: DelayLine::new(config.frame_latency as usize - 1),
+            tri_arrived_r: Default::default(),
+            frame_arrived_r: Default::default(),
+            normal_in: Default::default(),
+            kd_in: Default::default(),
             tri_tag: Default::default(),
             frame_tag: Default::default(),
             tri_arrived: Default::default(),
@@ -599,6 +613,8 @@ impl<
             self.flip[s].d.next = self.flip[s].q.val();
             self.miss[s].clock.next = self.clock.val();
             self.miss[s].d.next = self.miss[s].q.val();
+            self.normal_in[s].clock.next = self.clock.val();
+            self.kd_in[s].clock.next = self.clock.val();
         }
         for k in 0..3 {
             self.background[k].clock.next = self.clock.val();
@@ -626,6 +642,8 @@ impl<
             clock,
             tri_line,
             frame_line,
+            tri_arrived_r,
+            frame_arrived_r,
             sqrt,
             div,
             cos_n_dot_l,
@@ -1041,8 +1059,19 @@ impl<
         // ---- Memory words arriving. ----
         self.tri_line.data_in.next = self.tri_tag.val();
         self.frame_line.data_in.next = self.frame_tag.val();
-        self.tri_arrived.next = self.tri_line.data_out.val();
-        self.frame_arrived.next = self.frame_line.data_out.val();
+        self.tri_arrived_r.d.next = self.tri_line.data_out.val();
+        self.frame_arrived_r.d.next = self.frame_line.data_out.val();
+        self.tri_arrived.next = self.tri_arrived_r.q.val();
+        self.frame_arrived.next = self.frame_arrived_r.q.val();
+        for s in 0..SHADE_SLOTS {
+            self.normal_in[s].d.next = self.tri_line.data_out.val().get_bit(0)
+                & self.tri_line.data_out.val().get_bit(6)
+                & (self.tri_line.data_out.val().get_bits::<3>(3) == self.c_slot[s].val());
+            self.kd_in[s].d.next = self.frame_line.data_out.val().get_bit(0)
+                & (self.frame_line.data_out.val().get_bits::<2>(1) == self.c_kind_kd.val())
+                & (self.frame_line.data_out.val().get_bits::<3>(6) == 2)
+                & (self.frame_line.data_out.val().get_bits::<3>(3) == self.c_slot[s].val());
+        }
         // Word 0 (the sixth of the triangle's record in each bank): normal x and z; word 1:
         // normal y and the material.
         for k in 0..3 {
@@ -1231,18 +1260,12 @@ impl<
                 self.step[s].d.next = ShadeStep::Idle;
             }
             // The normal's second word.
-            if self.tri_word_1.val()
-                & (self.tri_arrived.val().get_bits::<3>(3) == self.c_slot[s].val())
-            {
+            if self.normal_in[s].q.val() {
                 self.ready[s].d.next = true;
                 self.step[s].d.next = ShadeStep::Point;
             }
             // The diffuse colour's third word.
-            if self.frame_valid.val()
-                & (self.frame_kind.val() == self.c_kind_kd.val())
-                & (self.frame_word.val() == 2)
-                & (self.frame_arrived.val().get_bits::<3>(3) == self.c_slot[s].val())
-            {
+            if self.kd_in[s].q.val() {
                 self.ready[s].d.next = true;
                 self.step[s].d.next = ShadeStep::Ambient;
             }
