@@ -22270,7 +22270,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     localparam Launch__Wait = 0;
     localparam Launch__Origin = 1;
     localparam Launch__Direction = 2;
-    localparam Launch__Free = 3;
     
     // Stub signals
     reg  list_unit__clock;
@@ -22360,24 +22359,24 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  best_m__write_clock;
     reg  [32:0] best_m__write_data;
     reg  best_m__write_enable;
-    reg  [4:0] flight_t_min__read_address;
+    reg  [5:0] flight_t_min__read_address;
     reg  flight_t_min__read_clock;
     wire  [23:0] flight_t_min__read_data;
-    reg  [4:0] flight_t_min__write_address;
+    reg  [5:0] flight_t_min__write_address;
     reg  flight_t_min__write_clock;
     reg  [23:0] flight_t_min__write_data;
     reg  flight_t_min__write_enable;
-    reg  [4:0] flight_a__read_address;
+    reg  [5:0] flight_a__read_address;
     reg  flight_a__read_clock;
     wire  [31:0] flight_a__read_data;
-    reg  [4:0] flight_a__write_address;
+    reg  [5:0] flight_a__write_address;
     reg  flight_a__write_clock;
     reg  [31:0] flight_a__write_data;
     reg  flight_a__write_enable;
-    reg  [4:0] flight_b__read_address;
+    reg  [5:0] flight_b__read_address;
     reg  flight_b__read_clock;
     wire  [31:0] flight_b__read_data;
-    reg  [4:0] flight_b__write_address;
+    reg  [5:0] flight_b__write_address;
     reg  flight_b__write_clock;
     reg  [31:0] flight_b__write_data;
     reg  flight_b__write_enable;
@@ -22486,8 +22485,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [3:0] b_issued__d;
     wire  [3:0] b_issued__q;
     reg  b_issued__clock;
-    reg  [4:0] seq__d;
-    wire  [4:0] seq__q;
+    reg  [5:0] seq__d;
+    wire  [5:0] seq__q;
     reg  seq__clock;
     reg  [1:0] words__0__read_address;
     wire  [23:0] words__0__read_data;
@@ -22725,6 +22724,18 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [32:0] m3_best__d;
     wire  [32:0] m3_best__q;
     reg  m3_best__clock;
+    reg  lw_valid__d;
+    wire  lw_valid__q;
+    reg  lw_valid__clock;
+    reg  [4:0] lw_thread__d;
+    wire  [4:0] lw_thread__q;
+    reg  lw_thread__clock;
+    reg  [32:0] lw_best__d;
+    wire  [32:0] lw_best__q;
+    reg  lw_best__clock;
+    reg  [7:0] lw_done__d;
+    wire  [7:0] lw_done__q;
+    reg  lw_done__clock;
     reg  gen_held__d;
     wire  gen_held__q;
     reg  gen_held__clock;
@@ -22810,6 +22821,11 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  l_loaded;
     reg  [3:0] l_received;
     reg  l_ready;
+    reg  [4:0] n_thread;
+    reg  n_loaded;
+    reg  [1:0] n_kind;
+    reg  [3:0] n_received;
+    reg  n_ready;
     reg  a_take;
     reg  b_take;
     reg  [5:0] a_arrive;
@@ -22819,6 +22835,10 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  merge_hit;
     reg  [32:0] merge_best;
     reg  merge_write;
+    reg  [32:0] after_best;
+    reg  [7:0] after_done;
+    reg  [32:0] m1_best;
+    reg  [7:0] m1_done;
     reg  [15:0] launch_tag;
     reg  launching;
     reg  gen_go;
@@ -22894,7 +22914,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(best_e__write_data),
         .write_enable(best_e__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a instance_e(
+    dynrt_processor__engine__tester__instance_e instance_e(
         .read_address(instance_e__read_address),
         .read_clock(instance_e__read_clock),
         .read_data(instance_e__read_data),
@@ -22903,7 +22923,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(instance_e__write_data),
         .write_enable(instance_e__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a triangle_e(
+    dynrt_processor__engine__tester__instance_e triangle_e(
         .read_address(triangle_e__read_address),
         .read_clock(triangle_e__read_clock),
         .read_data(triangle_e__read_data),
@@ -22930,7 +22950,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(best_m__write_data),
         .write_enable(best_m__write_enable)
     );
-    dynrt_processor__engine__instances__world__0 flight_t_min(
+    dynrt_processor__engine__tester__flight_t_min flight_t_min(
         .read_address(flight_t_min__read_address),
         .read_clock(flight_t_min__read_clock),
         .read_data(flight_t_min__read_data),
@@ -22939,7 +22959,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(flight_t_min__write_data),
         .write_enable(flight_t_min__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a flight_a(
+    dynrt_processor__engine__mailboxes__entries__0 flight_a(
         .read_address(flight_a__read_address),
         .read_clock(flight_a__read_clock),
         .read_data(flight_a__read_data),
@@ -22948,7 +22968,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(flight_a__write_data),
         .write_enable(flight_a__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a flight_b(
+    dynrt_processor__engine__mailboxes__entries__0 flight_b(
         .read_address(flight_b__read_address),
         .read_clock(flight_b__read_clock),
         .read_data(flight_b__read_data),
@@ -23132,7 +23152,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(b_issued__q),
         .clock(b_issued__clock)
     );
-    dynrt_processor__engine__decode__t4 seq(
+    dynrt_processor__engine__mem_load_r seq(
         .d(seq__d),
         .q(seq__q),
         .clock(seq__clock)
@@ -23429,7 +23449,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m2_done__q),
         .clock(m2_done__clock)
     );
-    dynrt_processor__engine__tester__m2_best m2_best(
+    dynrt_processor__engine__tester__lw_best m2_best(
         .d(m2_best__d),
         .q(m2_best__q),
         .clock(m2_best__clock)
@@ -23474,10 +23494,30 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m3_done__q),
         .clock(m3_done__clock)
     );
-    dynrt_processor__engine__tester__m2_best m3_best(
+    dynrt_processor__engine__tester__lw_best m3_best(
         .d(m3_best__d),
         .q(m3_best__q),
         .clock(m3_best__clock)
+    );
+    dynrt_processor__display__dark_d lw_valid(
+        .d(lw_valid__d),
+        .q(lw_valid__q),
+        .clock(lw_valid__clock)
+    );
+    dynrt_processor__engine__decode__t4 lw_thread(
+        .d(lw_thread__d),
+        .q(lw_thread__q),
+        .clock(lw_thread__clock)
+    );
+    dynrt_processor__engine__tester__lw_best lw_best(
+        .d(lw_best__d),
+        .q(lw_best__q),
+        .clock(lw_best__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_delay__stage__0 lw_done(
+        .d(lw_done__d),
+        .q(lw_done__q),
+        .clock(lw_done__clock)
     );
     dynrt_processor__display__dark_d gen_held(
         .d(gen_held__d),
@@ -23613,6 +23653,10 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         m3_b__clock = clock;
         m3_done__clock = clock;
         m3_best__clock = clock;
+        lw_valid__clock = clock;
+        lw_thread__clock = clock;
+        lw_best__clock = clock;
+        lw_done__clock = clock;
         gen_held__clock = clock;
         gen_hold_point__clock = clock;
         gen_hold_diagonal__clock = clock;
@@ -23649,6 +23693,10 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         m3_b__d = m3_b__q;
         m3_done__d = m3_done__q;
         m3_best__d = m3_best__q;
+        lw_valid__d = lw_valid__q;
+        lw_thread__d = lw_thread__q;
+        lw_best__d = lw_best__q;
+        lw_done__d = lw_done__q;
         gen_held__d = gen_held__q;
         gen_hold_point__d = gen_hold_point__q;
         gen_hold_diagonal__d = gen_hold_diagonal__q;
@@ -24141,15 +24189,42 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         transform_unit__m__9 = words__9__read_data;
         transform_unit__m__10 = words__10__read_data;
         transform_unit__m__11 = words__11__read_data;
+        n_thread = cur_thread__0__q;
+        n_loaded = loaded__0__q;
+        n_kind = cur_kind__0__q;
+        n_received = received__0__q;
+        if (lb__q + 32'h1 == c_buffer__1) begin
+            n_thread = cur_thread__1__q;
+            n_loaded = loaded__1__q;
+            n_kind = cur_kind__1__q;
+            n_received = received__1__q;
+        end
+        if (lb__q + 32'h1 == c_buffer__2) begin
+            n_thread = cur_thread__2__q;
+            n_loaded = loaded__2__q;
+            n_kind = cur_kind__2__q;
+            n_received = received__2__q;
+        end
+        if (lb__q + 32'h1 == c_buffer__3) begin
+            n_thread = cur_thread__3__q;
+            n_loaded = loaded__3__q;
+            n_kind = cur_kind__3__q;
+            n_received = received__3__q;
+        end
+        n_ready = n_loaded & ((n_kind != c_test_triangle) | (n_received == 32'hc));
         ray__ray_thread = l_thread;
         ray__t_min_thread = l_thread;
+        if (lphase__q == Launch__Direction) begin
+            ray__ray_thread = n_thread;
+            ray__t_min_thread = n_thread;
+        end
         transform_unit__in_valid = 1'b0;
         transform_unit__point = 1'b1;
         transform_unit__diagonal = 1'b0;
         transform_unit__v__0 = ray__o__0;
         transform_unit__v__1 = ray__o__1;
         transform_unit__v__2 = ray__o__2;
-        launch_tag = (((l_kind) & 16'hffff) << 32'ha) | (((l_thread) & 16'hffff) << 32'h5) | ((seq__q) & 16'hffff);
+        launch_tag = (((l_kind) & 16'hffff) << 32'hb) | (((l_thread) & 16'hffff) << 32'h6) | ((seq__q) & 16'hffff);
         transform_unit__tag = launch_tag;
         flight_t_min__write_address = seq__q;
         flight_a__write_address = seq__q;
@@ -24178,9 +24253,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             transform_unit__v__2 = ray__d__2;
             transform_unit__tag = launch_tag | c_d_pass;
             seq__d = seq__q + 32'h1;
-            lphase__d = Launch__Free;
-        end
-        if (lphase__q == Launch__Free) begin
             if (lb__q == c_buffer__0) begin
                 loaded__0__d = 1'b0;
                 received__0__d = 32'h0;
@@ -24199,6 +24271,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             end
             lb__d = lb__q + 32'h1;
             lphase__d = Launch__Wait;
+            if (n_ready & (~gen_held__q)) begin
+                lphase__d = Launch__Origin;
+            end
         end
         launching = (lphase__q == Launch__Origin) | (lphase__q == Launch__Direction);
         gen_go = gen_held__q & (~launching);
@@ -24224,7 +24299,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             transform_unit__v__2 = gen_hold_v__2__q;
             transform_unit__point = gen_hold_point__q;
             transform_unit__diagonal = gen_hold_diagonal__q;
-            transform_unit__tag = c_primary | (((gen_hold_client__q) & 16'hffff) << 32'ha) | (((gen_hold_thread__q) & 16'hffff) << 32'h5);
+            transform_unit__tag = c_primary | (((gen_hold_client__q) & 16'hffff) << 32'hb) | (((gen_hold_thread__q) & 16'hffff) << 32'h6);
         end
         if (gen_taken) begin
             gen_held__d = 1'b1;
@@ -24249,8 +24324,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             gen_hold_thread__d = gen_thread;
         end
         gen_out_valid = transform_unit__out_valid & transform_unit__out_tag[32'he];
-        gen_out_client = transform_unit__out_tag[(32'ha)+:(2)];
-        gen_out_thread = transform_unit__out_tag[(32'h5)+:(5)];
+        gen_out_client = transform_unit__out_tag[(32'hb)+:(2)];
+        gen_out_thread = transform_unit__out_tag[(32'h6)+:(5)];
         gen_out_dir__0 = transform_unit__result__0;
         gen_out_dir__1 = transform_unit__result__1;
         gen_out_dir__2 = transform_unit__result__2;
@@ -24267,7 +24342,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         if (transform_unit__out_valid & (~transform_unit__out_tag[32'hd]) & (~transform_unit__out_tag[32'he])) begin
             o_hold__2__d = transform_unit__result__2;
         end
-        flight_t_min__read_address = transform_unit__out_tag[(32'h0)+:(5)];
+        flight_t_min__read_address = transform_unit__out_tag[(32'h0)+:(6)];
         intersect_unit__in_valid = transform_unit__out_valid & transform_unit__out_tag[32'hd];
         intersect_unit__o__0 = o_hold__0__q;
         intersect_unit__d__0 = transform_unit__result__0;
@@ -24278,19 +24353,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         intersect_unit__t_min = flight_t_min__read_data;
         intersect_unit__t_max = c_infinity;
         intersect_unit__tag = transform_unit__out_tag;
-        intersect_busy = intersect_unit__in_valid & (transform_unit__out_tag[(32'ha)+:(2)] == c_test_triangle);
-        done_m__read_address = intersect_unit__out_tag[(32'h5)+:(5)];
-        best_m__read_address = intersect_unit__out_tag[(32'h5)+:(5)];
-        flight_a__read_address = intersect_unit__out_tag[(32'h0)+:(5)];
-        flight_b__read_address = intersect_unit__out_tag[(32'h0)+:(5)];
+        intersect_busy = intersect_unit__in_valid & (transform_unit__out_tag[(32'hb)+:(2)] == c_test_triangle);
+        done_m__read_address = intersect_unit__out_tag[(32'h6)+:(5)];
+        best_m__read_address = intersect_unit__out_tag[(32'h6)+:(5)];
+        flight_a__read_address = intersect_unit__out_tag[(32'h0)+:(6)];
+        flight_b__read_address = intersect_unit__out_tag[(32'h0)+:(6)];
         m1_valid__d = intersect_unit__out_valid;
         m1_hit__d = intersect_unit__hit;
-        m1_kind__d = intersect_unit__out_tag[(32'ha)+:(2)];
-        m1_thread__d = intersect_unit__out_tag[(32'h5)+:(5)];
+        m1_kind__d = intersect_unit__out_tag[(32'hb)+:(2)];
+        m1_thread__d = intersect_unit__out_tag[(32'h6)+:(5)];
         m1_t__d = intersect_unit__t;
-        cmp__in_valid = 1'b1;
-        cmp__a = m1_t__q;
-        cmp__b = best_m__read_data[(32'h0)+:(24)];
         m2_valid__d = m1_valid__q;
         m2_hit__d = m1_hit__q;
         m2_kind__d = m1_kind__q;
@@ -24298,8 +24370,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         m2_t__d = m1_t__q;
         m2_a__d = flight_a__read_data;
         m2_b__d = flight_b__read_data;
-        m2_done__d = done_m__read_data;
-        m2_best__d = best_m__read_data;
         m3_valid__d = m2_valid__q;
         m3_hit__d = m2_hit__q;
         m3_kind__d = m2_kind__q;
@@ -24340,6 +24410,33 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         triangle_e__write_data = m3_a__q;
         instance_e__write_enable = m3_valid__q & merge_hit;
         triangle_e__write_enable = m3_valid__q & merge_hit;
+        after_best = m3_best__q;
+        if (merge_write) begin
+            after_best = merge_best;
+        end
+        after_done = m3_done__q;
+        if (m3_counts) begin
+            after_done = m3_done__q + 32'h1;
+        end
+        lw_valid__d = m3_valid__q;
+        lw_thread__d = m3_thread__q;
+        lw_best__d = after_best;
+        lw_done__d = after_done;
+        m1_best = best_m__read_data;
+        m1_done = done_m__read_data;
+        if (lw_valid__q & (lw_thread__q == m1_thread__q)) begin
+            m1_best = lw_best__q;
+            m1_done = lw_done__q;
+        end
+        if (m3_valid__q & (m3_thread__q == m1_thread__q)) begin
+            m1_best = after_best;
+            m1_done = after_done;
+        end
+        cmp__in_valid = 1'b1;
+        cmp__a = m1_t__q;
+        cmp__b = m1_best[(32'h0)+:(24)];
+        m2_done__d = m1_done;
+        m2_best__d = m1_best;
     end
     
 endmodule // dynrt_processor__engine__tester
@@ -24521,7 +24618,80 @@ endmodule // dynrt_processor__engine__tester__done_e
 
 
 
-module dynrt_processor__engine__tester__flight_a(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+
+
+
+
+module dynrt_processor__engine__tester__flight_t_min(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [5:0] read_address;
+    input wire  read_clock;
+    output reg  [23:0] read_data;
+    input wire  [5:0] write_address;
+    input wire  write_clock;
+    input wire  [23:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[23:0] mem[63:0];
+    
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__tester__flight_t_min
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__tester__instance_e(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [4:0] read_address;
@@ -24547,53 +24717,7 @@ module dynrt_processor__engine__tester__flight_a(read_address,read_clock,read_da
        end
     end
                 
-endmodule // dynrt_processor__engine__tester__flight_a
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
+endmodule // dynrt_processor__engine__tester__instance_e
 
 
 module dynrt_processor__engine__tester__intersect_unit(clock,in_valid,o__0,o__1,o__2,d__0,d__1,d__2,t_min,t_max,tag,out_valid,t,u,v,hit,out_tag);
@@ -27825,7 +27949,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .write_data(skip_triangle_ram__write_data),
         .write_enable(skip_triangle_ram__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a mailbox_ids__0(
+    dynrt_processor__engine__tester__instance_e mailbox_ids__0(
         .read_address(mailbox_ids__0__read_address),
         .read_clock(mailbox_ids__0__read_clock),
         .read_data(mailbox_ids__0__read_data),
@@ -27834,7 +27958,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .write_data(mailbox_ids__0__write_data),
         .write_enable(mailbox_ids__0__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a mailbox_ids__1(
+    dynrt_processor__engine__tester__instance_e mailbox_ids__1(
         .read_address(mailbox_ids__1__read_address),
         .read_clock(mailbox_ids__1__read_clock),
         .read_data(mailbox_ids__1__read_data),
@@ -27843,7 +27967,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .write_data(mailbox_ids__1__write_data),
         .write_enable(mailbox_ids__1__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a mailbox_ids__2(
+    dynrt_processor__engine__tester__instance_e mailbox_ids__2(
         .read_address(mailbox_ids__2__read_address),
         .read_clock(mailbox_ids__2__read_clock),
         .read_data(mailbox_ids__2__read_data),
@@ -27852,7 +27976,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .write_data(mailbox_ids__2__write_data),
         .write_enable(mailbox_ids__2__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a mailbox_ids__3(
+    dynrt_processor__engine__tester__instance_e mailbox_ids__3(
         .read_address(mailbox_ids__3__read_address),
         .read_clock(mailbox_ids__3__read_clock),
         .read_data(mailbox_ids__3__read_data),
@@ -27861,7 +27985,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .write_data(mailbox_ids__3__write_data),
         .write_enable(mailbox_ids__3__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a mailbox_ids__4(
+    dynrt_processor__engine__tester__instance_e mailbox_ids__4(
         .read_address(mailbox_ids__4__read_address),
         .read_clock(mailbox_ids__4__read_clock),
         .read_data(mailbox_ids__4__read_data),
@@ -27870,7 +27994,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .write_data(mailbox_ids__4__write_data),
         .write_enable(mailbox_ids__4__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a mailbox_ids__5(
+    dynrt_processor__engine__tester__instance_e mailbox_ids__5(
         .read_address(mailbox_ids__5__read_address),
         .read_clock(mailbox_ids__5__read_clock),
         .read_data(mailbox_ids__5__read_data),
@@ -27879,7 +28003,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .write_data(mailbox_ids__5__write_data),
         .write_enable(mailbox_ids__5__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a mailbox_ids__6(
+    dynrt_processor__engine__tester__instance_e mailbox_ids__6(
         .read_address(mailbox_ids__6__read_address),
         .read_clock(mailbox_ids__6__read_clock),
         .read_data(mailbox_ids__6__read_data),
@@ -27888,7 +28012,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .write_data(mailbox_ids__6__write_data),
         .write_enable(mailbox_ids__6__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a mailbox_ids__7(
+    dynrt_processor__engine__tester__instance_e mailbox_ids__7(
         .read_address(mailbox_ids__7__read_address),
         .read_clock(mailbox_ids__7__read_clock),
         .read_data(mailbox_ids__7__read_data),
@@ -29267,7 +29391,6 @@ module dynrt_processor__engine__tester__lphase(d,q,clock);
     localparam Launch__Wait = 0;
     localparam Launch__Origin = 1;
     localparam Launch__Direction = 2;
-    localparam Launch__Free = 3;
     
     // Update code (custom)
     initial begin
@@ -29281,21 +29404,7 @@ module dynrt_processor__engine__tester__lphase(d,q,clock);
 endmodule // dynrt_processor__engine__tester__lphase
 
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor__engine__tester__m2_best(d,q,clock);
+module dynrt_processor__engine__tester__lw_best(d,q,clock);
     
     // Module arguments
     input wire  [32:0] d;
@@ -29311,7 +29420,29 @@ module dynrt_processor__engine__tester__m2_best(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor__engine__tester__m2_best
+endmodule // dynrt_processor__engine__tester__lw_best
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -33332,7 +33463,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .write_data(done_u__write_data),
         .write_enable(done_u__write_enable)
     );
-    dynrt_processor__engine__traversal_unit__leaf_hi leaf_hi(
+    dynrt_processor__engine__tester__flight_t_min leaf_hi(
         .read_address(leaf_hi__read_address),
         .read_clock(leaf_hi__read_clock),
         .read_data(leaf_hi__read_data),
@@ -33350,7 +33481,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .write_data(leaf_sp__write_data),
         .write_enable(leaf_sp__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a top_from_ram(
+    dynrt_processor__engine__tester__instance_e top_from_ram(
         .read_address(top_from_ram__read_address),
         .read_clock(top_from_ram__read_clock),
         .read_data(top_from_ram__read_data),
@@ -33359,7 +33490,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .write_data(top_from_ram__write_data),
         .write_enable(top_from_ram__write_enable)
     );
-    dynrt_processor__engine__tester__flight_a top_to_ram(
+    dynrt_processor__engine__tester__instance_e top_to_ram(
         .read_address(top_to_ram__read_address),
         .read_clock(top_to_ram__read_clock),
         .read_data(top_to_ram__read_data),
@@ -36011,33 +36142,6 @@ endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo__ram
 
 
 
-module dynrt_processor__engine__traversal_unit__leaf_hi(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [5:0] read_address;
-    input wire  read_clock;
-    output reg  [23:0] read_data;
-    input wire  [5:0] write_address;
-    input wire  write_clock;
-    input wire  [23:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[23:0] mem[63:0];
-    
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor__engine__traversal_unit__leaf_hi
 
 
 module dynrt_processor__engine__traversal_unit__leaf_sp(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);

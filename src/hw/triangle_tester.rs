@@ -71,19 +71,19 @@ pub const TESTER_QUEUE: usize = 16;
 /// triangle, instance and t_min in its own slot until its merge reads them). Entries launch
 /// at least [`LAUNCH_SPACING`] clocks apart (an init or a list end, which fetch nothing), so
 /// the slots must outlast the launch-to-merge latency: see [`flight_slots_suffice`].
-pub const FLIGHT_SLOTS: u32 = 32;
+pub const FLIGHT_SLOTS: u32 = 64;
 
-/// The fewest clocks between two launches (take, fetch, origin, direction).
-pub const LAUNCH_SPACING: u32 = 4;
+/// The fewest clocks between two launches: the origin's pass and the direction's.
+pub const LAUNCH_SPACING: u32 = 2;
 
 /// Clocks from an entry's launch to its merge reading the entry's slot.
 pub fn launch_to_merge(fmt: Format) -> u32 {
     TRANSFORM_LATENCY + 1 + intersect_latency(fmt)
 }
 
-/// Whether a slot is still free when its sequence number comes round again: with 16 slots a
-/// burst of inits and list ends overwrote a hit's triangle before its merge (e7m16 needs 67
-/// clocks; 16 launches take 64).
+/// Whether a slot is still free when its sequence number comes round again: with 16 slots and
+/// launches 4 clocks apart a burst of inits and list ends overwrote a hit's triangle before
+/// its merge (e7m16 needs 67 clocks; 16 launches took 64).
 pub fn flight_slots_suffice(fmt: Format) -> bool {
     FLIGHT_SLOTS * LAUNCH_SPACING > launch_to_merge(fmt)
 }
@@ -187,9 +187,9 @@ pub struct TriangleTester<
     best_m: RAM<Bits<33>, 5>,
     /// Per launched entry (by sequence number, [`FLIGHT_SLOTS`] of them): t_min for the
     /// IntersectUnit; a and b for the merge.
-    flight_t_min: RAM<Bits<W>, 5>,
-    flight_a: RAM<Bits<32>, 5>,
-    flight_b: RAM<Bits<32>, 5>,
+    flight_t_min: RAM<Bits<W>, 6>,
+    flight_a: RAM<Bits<32>, 6>,
+    flight_b: RAM<Bits<32>, 6>,
 
     // Take, fetch and launch: [`TEST_BUFFERS`] buffers of an entry and its triangle's 12
     // words; the take fills `tb` with the list unit's next entry, the fetch requests the
@@ -218,7 +218,7 @@ pub struct TriangleTester<
     b_here: [Signal<Local, Bit>; TEST_BUFFERS],
     a_issued: DFF<Bits<4>>,
     b_issued: DFF<Bits<4>>,
-    seq: DFF<Bits<5>>,
+    seq: DFF<Bits<6>>,
     /// Word k of the triangle in each buffer (distributed RAM addressed by the buffer: the
     /// launch reads its buffer's 12 words at once).
     words: [LutRam<Bits<W>, 2>; 12],
@@ -243,6 +243,12 @@ pub struct TriangleTester<
     l_loaded: Signal<Local, Bit>,
     l_received: Signal<Local, Bits<4>>,
     l_ready: Signal<Local, Bit>,
+    /// The buffer after `lb`: its thread and whether it could launch (as `l_*`).
+    n_thread: Signal<Local, Bits<5>>,
+    n_loaded: Signal<Local, Bit>,
+    n_kind: Signal<Local, Bits<2>>,
+    n_received: Signal<Local, Bits<4>>,
+    n_ready: Signal<Local, Bit>,
     a_take: Signal<Local, Bit>,
     b_take: Signal<Local, Bit>,
     /// Requests in flight to the banks: `{valid[5], buffer[4:3], word index[2:0]}` per clock
@@ -287,6 +293,18 @@ pub struct TriangleTester<
     merge_hit: Signal<Local, Bit>,
     merge_best: Signal<Local, Bits<33>>,
     merge_write: Signal<Local, Bit>,
+    /// The state a thread's merge leaves (its best, its count of entries done), of the entry
+    /// in m3 now (`after_*`) and of the one in m3 a clock ago (`lw_*`, registered). Entries
+    /// merge 2 clocks apart, so an entry reading its thread's state in m1 may find the
+    /// writes of the two entries before it still to come: it takes theirs instead.
+    after_best: Signal<Local, Bits<33>>,
+    after_done: Signal<Local, Bits<8>>,
+    lw_valid: DFF<Bit>,
+    lw_thread: DFF<Bits<5>>,
+    lw_best: DFF<Bits<33>>,
+    lw_done: DFF<Bits<8>>,
+    m1_best: Signal<Local, Bits<33>>,
+    m1_done: Signal<Local, Bits<8>>,
     launch_tag: Signal<Local, Bits<16>>,
     /// The launch sends a test's origin or direction this clock; else ray generation may.
     launching: Signal<Local, Bit>,
@@ -327,13 +345,12 @@ pub struct TriangleTester<
 }
 
 /// The launch of a buffered entry: wait for a loaded buffer, launch the origin, then the
-/// direction, free the buffer.
+/// direction (and free the buffer).
 #[derive(Copy, Clone, Debug, PartialEq, LogicState)]
 pub enum Launch {
     Wait,
     Origin,
     Direction,
-    Free,
 }
 
 impl<
@@ -443,6 +460,11 @@ impl<
             l_loaded: Default::default(),
             l_received: Default::default(),
             l_ready: Default::default(),
+            n_thread: Default::default(),
+            n_loaded: Default::default(),
+            n_kind: Default::default(),
+            n_received: Default::default(),
+            n_ready: Default::default(),
             a_issued: Default::default(),
             b_issued: Default::default(),
             received: Default::default(),
@@ -486,6 +508,14 @@ impl<
             merge_hit: Default::default(),
             merge_best: Default::default(),
             merge_write: Default::default(),
+            after_best: Default::default(),
+            after_done: Default::default(),
+            lw_valid: Default::default(),
+            lw_thread: Default::default(),
+            lw_best: Default::default(),
+            lw_done: Default::default(),
+            m1_best: Default::default(),
+            m1_done: Default::default(),
             launch_tag: Default::default(),
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
             c_index: std::array::from_fn(|k| Constant::new((k as u64).into())),
@@ -554,6 +584,10 @@ impl<
             m3_b,
             m3_done,
             m3_best,
+            lw_valid,
+            lw_thread,
+            lw_best,
+            lw_done,
             gen_held,
             gen_hold_point,
             gen_hold_diagonal,
@@ -863,18 +897,40 @@ impl<
         for k in 0..12 {
             self.transform_unit.m[k].next = self.words[k].read_data.val();
         }
+        // The buffer after `lb`, which may launch right after `lb`'s direction.
+        self.n_thread.next = self.cur_thread[0].q.val();
+        self.n_loaded.next = self.loaded[0].q.val();
+        self.n_kind.next = self.cur_kind[0].q.val();
+        self.n_received.next = self.received[0].q.val();
+        for k in 1..4 {
+            if self.lb.q.val() + 1 == self.c_buffer[k].val() {
+                self.n_thread.next = self.cur_thread[k].q.val();
+                self.n_loaded.next = self.loaded[k].q.val();
+                self.n_kind.next = self.cur_kind[k].q.val();
+                self.n_received.next = self.received[k].q.val();
+            }
+        }
+        self.n_ready.next = self.n_loaded.val()
+            & ((self.n_kind.val() != self.c_test_triangle.val()) | (self.n_received.val() == 12));
+        // The ray store answers a clock after its address: the entry's thread while it waits
+        // and launches its origin, the next buffer's while it launches its direction (whose
+        // words were read in the origin's clock), so that the next origin may follow at once.
         self.ray.ray_thread.next = self.l_thread.val();
         self.ray.t_min_thread.next = self.l_thread.val();
+        if self.lphase.q.val() == Launch::Direction {
+            self.ray.ray_thread.next = self.n_thread.val();
+            self.ray.t_min_thread.next = self.n_thread.val();
+        }
         self.transform_unit.in_valid.next = false;
         self.transform_unit.point.next = true;
         self.transform_unit.diagonal.next = false;
         for k in 0..3 {
             self.transform_unit.v[k].next = self.ray.o[k].val();
         }
-        // Tag: `{d pass[13], kind[11:10], thread[9:5], seq[4:0]}`.
-        self.launch_tag.next = (bit_cast::<16, 2>(self.l_kind.val()) << 10)
-            | (bit_cast::<16, 5>(self.l_thread.val()) << 5)
-            | bit_cast::<16, 5>(self.seq.q.val());
+        // Tag: `{d pass[13], kind[12:11], thread[10:6], seq[5:0]}`.
+        self.launch_tag.next = (bit_cast::<16, 2>(self.l_kind.val()) << 11)
+            | (bit_cast::<16, 5>(self.l_thread.val()) << 6)
+            | bit_cast::<16, 6>(self.seq.q.val());
         self.transform_unit.tag.next = self.launch_tag.val();
         self.flight_t_min.write_address.next = self.seq.q.val();
         self.flight_a.write_address.next = self.seq.q.val();
@@ -903,9 +959,9 @@ impl<
             }
             self.transform_unit.tag.next = self.launch_tag.val() | self.c_d_pass.val();
             self.seq.d.next = self.seq.q.val() + 1;
-            self.lphase.d.next = Launch::Free;
-        }
-        if self.lphase.q.val() == Launch::Free {
+            // The buffer is free (its words were read in this clock and the last); the next
+            // one launches at once if it can and no other client's request waits (which goes
+            // in the clock between).
             for k in 0..4 {
                 if self.lb.q.val() == self.c_buffer[k].val() {
                     self.loaded[k].d.next = false;
@@ -914,9 +970,12 @@ impl<
             }
             self.lb.d.next = self.lb.q.val() + 1;
             self.lphase.d.next = Launch::Wait;
+            if self.n_ready.val() & (!self.gen_held.q.val()) {
+                self.lphase.d.next = Launch::Origin;
+            }
         }
         // The other clients' request goes from the hold into the unit in a clock the launch
-        // leaves free; its tag is `{gen[14], client[11:10], thread[9:5]}`.
+        // leaves free; its tag is `{gen[14], client[12:11], thread[10:6]}`.
         self.launching.next =
             (self.lphase.q.val() == Launch::Origin) | (self.lphase.q.val() == Launch::Direction);
         self.gen_go.next = self.gen_held.q.val() & (!self.launching.val());
@@ -934,8 +993,8 @@ impl<
             self.transform_unit.point.next = self.gen_hold_point.q.val();
             self.transform_unit.diagonal.next = self.gen_hold_diagonal.q.val();
             self.transform_unit.tag.next = self.c_primary.val()
-                | (bit_cast::<16, 2>(self.gen_hold_client.q.val()) << 10)
-                | (bit_cast::<16, 5>(self.gen_hold_thread.q.val()) << 5);
+                | (bit_cast::<16, 2>(self.gen_hold_client.q.val()) << 11)
+                | (bit_cast::<16, 5>(self.gen_hold_thread.q.val()) << 6);
         }
         if self.gen_taken.val() {
             self.gen_held.d.next = true;
@@ -952,8 +1011,8 @@ impl<
         }
         self.gen_out_valid.next =
             self.transform_unit.out_valid.val() & self.transform_unit.out_tag.val().get_bit(14);
-        self.gen_out_client.next = self.transform_unit.out_tag.val().get_bits::<2>(10);
-        self.gen_out_thread.next = self.transform_unit.out_tag.val().get_bits::<5>(5);
+        self.gen_out_client.next = self.transform_unit.out_tag.val().get_bits::<2>(11);
+        self.gen_out_thread.next = self.transform_unit.out_tag.val().get_bits::<5>(6);
         for k in 0..3 {
             self.gen_out_dir[k].next = self.transform_unit.result[k].val();
         }
@@ -971,7 +1030,7 @@ impl<
                 self.o_hold[k].d.next = self.transform_unit.result[k].val();
             }
         }
-        self.flight_t_min.read_address.next = self.transform_unit.out_tag.val().get_bits::<5>(0);
+        self.flight_t_min.read_address.next = self.transform_unit.out_tag.val().get_bits::<6>(0);
         self.intersect_unit.in_valid.next =
             self.transform_unit.out_valid.val() & self.transform_unit.out_tag.val().get_bit(13);
         for k in 0..3 {
@@ -982,21 +1041,18 @@ impl<
         self.intersect_unit.t_max.next = self.c_infinity.val();
         self.intersect_unit.tag.next = self.transform_unit.out_tag.val();
         self.intersect_busy.next = self.intersect_unit.in_valid.val()
-            & (self.transform_unit.out_tag.val().get_bits::<2>(10) == self.c_test_triangle.val());
+            & (self.transform_unit.out_tag.val().get_bits::<2>(11) == self.c_test_triangle.val());
 
         // Merge: read the thread's state, compare t with its best, write.
-        self.done_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(5);
-        self.best_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(5);
-        self.flight_a.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(0);
-        self.flight_b.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(0);
+        self.done_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(6);
+        self.best_m.read_address.next = self.intersect_unit.out_tag.val().get_bits::<5>(6);
+        self.flight_a.read_address.next = self.intersect_unit.out_tag.val().get_bits::<6>(0);
+        self.flight_b.read_address.next = self.intersect_unit.out_tag.val().get_bits::<6>(0);
         self.m1_valid.d.next = self.intersect_unit.out_valid.val();
         self.m1_hit.d.next = self.intersect_unit.hit.val();
-        self.m1_kind.d.next = self.intersect_unit.out_tag.val().get_bits::<2>(10);
-        self.m1_thread.d.next = self.intersect_unit.out_tag.val().get_bits::<5>(5);
+        self.m1_kind.d.next = self.intersect_unit.out_tag.val().get_bits::<2>(11);
+        self.m1_thread.d.next = self.intersect_unit.out_tag.val().get_bits::<5>(6);
         self.m1_t.d.next = self.intersect_unit.t.val();
-        self.cmp.in_valid.next = true;
-        self.cmp.a.next = self.m1_t.q.val();
-        self.cmp.b.next = self.best_m.read_data.val().get_bits::<W>(0);
         self.m2_valid.d.next = self.m1_valid.q.val();
         self.m2_hit.d.next = self.m1_hit.q.val();
         self.m2_kind.d.next = self.m1_kind.q.val();
@@ -1004,8 +1060,6 @@ impl<
         self.m2_t.d.next = self.m1_t.q.val();
         self.m2_a.d.next = self.flight_a.read_data.val();
         self.m2_b.d.next = self.flight_b.read_data.val();
-        self.m2_done.d.next = self.done_m.read_data.val();
-        self.m2_best.d.next = self.best_m.read_data.val();
         self.m3_valid.d.next = self.m2_valid.q.val();
         self.m3_hit.d.next = self.m2_hit.q.val();
         self.m3_kind.d.next = self.m2_kind.q.val();
@@ -1056,6 +1110,35 @@ impl<
         self.triangle_e.write_data.next = self.m3_a.q.val();
         self.instance_e.write_enable.next = self.m3_valid.q.val() & self.merge_hit.val();
         self.triangle_e.write_enable.next = self.m3_valid.q.val() & self.merge_hit.val();
+        self.after_best.next = self.m3_best.q.val();
+        if self.merge_write.val() {
+            self.after_best.next = self.merge_best.val();
+        }
+        self.after_done.next = self.m3_done.q.val();
+        if self.m3_counts.val() {
+            self.after_done.next = self.m3_done.q.val() + 1;
+        }
+        self.lw_valid.d.next = self.m3_valid.q.val();
+        self.lw_thread.d.next = self.m3_thread.q.val();
+        self.lw_best.d.next = self.after_best.val();
+        self.lw_done.d.next = self.after_done.val();
+        // m1: the thread's state as the two entries before this one leave it (see `after_best`),
+        // read after them (rust-hdl's Verilog needs a local written before it is read).
+        self.m1_best.next = self.best_m.read_data.val();
+        self.m1_done.next = self.done_m.read_data.val();
+        if self.lw_valid.q.val() & (self.lw_thread.q.val() == self.m1_thread.q.val()) {
+            self.m1_best.next = self.lw_best.q.val();
+            self.m1_done.next = self.lw_done.q.val();
+        }
+        if self.m3_valid.q.val() & (self.m3_thread.q.val() == self.m1_thread.q.val()) {
+            self.m1_best.next = self.after_best.val();
+            self.m1_done.next = self.after_done.val();
+        }
+        self.cmp.in_valid.next = true;
+        self.cmp.a.next = self.m1_t.q.val();
+        self.cmp.b.next = self.m1_best.val().get_bits::<W>(0);
+        self.m2_done.d.next = self.m1_done.val();
+        self.m2_best.d.next = self.m1_best.val();
     }
 }
 
@@ -1362,8 +1445,9 @@ mod tests {
                 assert!(flight_slots_suffice(f), "{f}: {}", launch_to_merge(f));
             }
         }
-        // 16 slots, the design before, do not suffice at the default format.
-        assert!(!(16 * LAUNCH_SPACING > launch_to_merge(Format::E7M16)));
+        // 32 slots (stop 44's, with launches 4 clocks apart) do not suffice at the default
+        // format now that entries launch 2 clocks apart.
+        assert!(!(32 * LAUNCH_SPACING > launch_to_merge(Format::E7M16)));
     }
 
     /// A burst of new queries launches right behind a thread's hit, one every 4 clocks (the
