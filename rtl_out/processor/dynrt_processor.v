@@ -1246,6 +1246,27 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [31:0] shading_count__d;
     wire  [31:0] shading_count__q;
     reg  shading_count__clock;
+    reg  count_in_frame__d;
+    wire  count_in_frame__q;
+    reg  count_in_frame__clock;
+    reg  tick_transform__d;
+    wire  tick_transform__q;
+    reg  tick_transform__clock;
+    reg  tick_intersect__d;
+    wire  tick_intersect__q;
+    reg  tick_intersect__clock;
+    reg  tick_traversal__d;
+    wire  tick_traversal__q;
+    reg  tick_traversal__clock;
+    reg  tick_raygen__d;
+    wire  tick_raygen__q;
+    reg  tick_raygen__clock;
+    reg  tick_instance__d;
+    wire  tick_instance__q;
+    reg  tick_instance__clock;
+    reg  tick_shading__d;
+    wire  tick_shading__q;
+    reg  tick_shading__clock;
     reg  [5:0] mem_load_r__d;
     wire  [5:0] mem_load_r__q;
     reg  mem_load_r__clock;
@@ -1885,6 +1906,41 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(shading_count__q),
         .clock(shading_count__clock)
     );
+    dynrt_processor__display__dark_d count_in_frame(
+        .d(count_in_frame__d),
+        .q(count_in_frame__q),
+        .clock(count_in_frame__clock)
+    );
+    dynrt_processor__display__dark_d tick_transform(
+        .d(tick_transform__d),
+        .q(tick_transform__q),
+        .clock(tick_transform__clock)
+    );
+    dynrt_processor__display__dark_d tick_intersect(
+        .d(tick_intersect__d),
+        .q(tick_intersect__q),
+        .clock(tick_intersect__clock)
+    );
+    dynrt_processor__display__dark_d tick_traversal(
+        .d(tick_traversal__d),
+        .q(tick_traversal__q),
+        .clock(tick_traversal__clock)
+    );
+    dynrt_processor__display__dark_d tick_raygen(
+        .d(tick_raygen__d),
+        .q(tick_raygen__q),
+        .clock(tick_raygen__clock)
+    );
+    dynrt_processor__display__dark_d tick_instance(
+        .d(tick_instance__d),
+        .q(tick_instance__q),
+        .clock(tick_instance__clock)
+    );
+    dynrt_processor__display__dark_d tick_shading(
+        .d(tick_shading__d),
+        .q(tick_shading__q),
+        .clock(tick_shading__clock)
+    );
     dynrt_processor__engine__mem_load_r mem_load_r(
         .d(mem_load_r__d),
         .q(mem_load_r__q),
@@ -2012,6 +2068,13 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         raygen_count__clock = clock;
         instance_count__clock = clock;
         shading_count__clock = clock;
+        count_in_frame__clock = clock;
+        tick_transform__clock = clock;
+        tick_intersect__clock = clock;
+        tick_traversal__clock = clock;
+        tick_raygen__clock = clock;
+        tick_instance__clock = clock;
+        tick_shading__clock = clock;
         intersect_count__clock = clock;
         traversal_count__clock = clock;
         mem_load_r__clock = clock;
@@ -2046,6 +2109,13 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         raygen_count__d = raygen_count__q;
         instance_count__d = instance_count__q;
         shading_count__d = shading_count__q;
+        count_in_frame__d = count_in_frame__q;
+        tick_transform__d = tick_transform__q;
+        tick_intersect__d = tick_intersect__q;
+        tick_traversal__d = tick_traversal__q;
+        tick_raygen__d = tick_raygen__q;
+        tick_instance__d = tick_instance__q;
+        tick_shading__d = tick_shading__q;
         intersect_count__d = intersect_count__q;
         traversal_count__d = traversal_count__q;
         mem_load_r__d = mem_load_r__q;
@@ -2100,28 +2170,29 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         shading_busy = shading_count__q;
         if (in_frame) begin
             cycle_count__d = cycle_count__q + 32'h1;
-            if (tester__transform_busy) begin
+        end
+        count_in_frame__d = in_frame;
+        tick_transform__d = tester__transform_busy;
+        tick_intersect__d = tester__intersect_busy;
+        tick_traversal__d = traversal_unit__step_busy;
+        if (count_in_frame__q) begin
+            if (tick_transform__q) begin
                 transform_count__d = transform_count__q + 32'h1;
             end
-            if (tester__intersect_busy) begin
+            if (tick_intersect__q) begin
                 intersect_count__d = intersect_count__q + 32'h1;
             end
-            if (traversal_unit__step_busy) begin
+            if (tick_traversal__q) begin
                 traversal_count__d = traversal_count__q + 32'h1;
             end
-            if (tester__gen_take & (~gen_instance) & (~gen_shade)) begin
+            if (tick_raygen__q) begin
                 raygen_count__d = raygen_count__q + 32'h1;
             end
-            if (tester__gen_take & gen_shade) begin
+            if (tick_shading__q) begin
                 shading_count__d = shading_count__q + 32'h1;
             end
-            if (tester__gen_take & gen_instance) begin
-                if (instances__gen_normal) begin
-                    shading_count__d = shading_count__q + 32'h1;
-                end
-                else begin
-                    instance_count__d = instance_count__q + 32'h1;
-                end
+            if (tick_instance__q) begin
+                instance_count__d = instance_count__q + 32'h1;
             end
         end
         scheduler__running = running__q;
@@ -2292,6 +2363,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tester__engine__ray_write = ray_write__q & (~store_write);
         gen_shade = c_shading & shader__gen_valid & (~rays__gen_valid) & (~instances__gen_valid);
         tester__gen_valid = rays__gen_valid | instances__gen_valid | gen_shade;
+        tick_raygen__d = tester__gen_take & (~gen_instance) & (~gen_shade);
+        tick_shading__d = tester__gen_take & (gen_shade | (gen_instance & instances__gen_normal));
+        tick_instance__d = tester__gen_take & gen_instance & (~instances__gen_normal);
         tester__gen_diagonal = gen_shade & shader__gen_diagonal;
         if (gen_instance) begin
             tester__gen_m__0 = instances__gen_m__0;
@@ -2571,6 +2645,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     always @(*) write_back__retiring__wait_pending = result_line__retiring__wait_pending;
     always @(*) write_back__retiring__fast = result_line__retiring__fast;
 endmodule // dynrt_processor__engine
+
+
 
 
 
@@ -32701,6 +32777,18 @@ module dynrt_processor__engine__tester__words__0(read_address,read_data,write_cl
        end
     end
 endmodule // dynrt_processor__engine__tester__words__0
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
