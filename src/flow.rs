@@ -71,6 +71,15 @@ pub fn preflight(
         "--mem-latency {}: the processor's SRAM read ports take a latency of 1..={MAX_MEM_LATENCY} clocks; use e.g. --mem-latency 2",
         params.mem_latency
     );
+    {
+        use crate::hw::triangle_tester::MAX_CACHE_SETS;
+        let sets = params.tri_cache_sets;
+        anyhow::ensure!(
+            sets == 0 || (sets.is_power_of_two() && sets <= MAX_CACHE_SETS),
+            "--tri-cache {sets}: the triangle cache has a power of two of sets up to \
+             {MAX_CACHE_SETS}, or 0 for none; use e.g. --tri-cache {MAX_CACHE_SETS}"
+        );
+    }
     if let Some(n) = frames {
         anyhow::ensure!(
             n >= 1 && n <= scene.frames,
@@ -414,6 +423,9 @@ pub struct FrameReport {
     pub asleep_thread_clocks: u64,
     /// Words read from each bank (`layout::BANK_NAMES`).
     pub bank_reads: [u64; 6],
+    /// Triangle tests whose words came from the triangle cache, and from banks 2 and 3.
+    pub tri_cache_hits: u64,
+    pub tri_cache_misses: u64,
     pub pixels: u64,
     pub mismatches: Vec<Mismatch>,
     pub differing_pixels: usize,
@@ -640,6 +652,8 @@ pub fn simulate_scene(
             ready_thread_clocks: fr.ready_thread_clocks,
             asleep_thread_clocks: fr.asleep_thread_clocks,
             bank_reads: fr.bank_reads,
+            tri_cache_hits: fr.tri_cache_hits,
+            tri_cache_misses: fr.tri_cache_misses,
             pixels: u64::from(w * h),
             differing_pixels: differing.len(),
             mismatches,

@@ -15,7 +15,7 @@
 /* verilator lint_off UNUSEDSIGNAL */
 
 
-module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy,vga_clock,vga_reset,vga_fb_addr,vga_fb_data,vga_hsync,vga_vsync,vga_rgb,vga_frame_start);
+module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy,tri_cache_hits,tri_cache_misses,vga_clock,vga_reset,vga_fb_addr,vga_fb_data,vga_hsync,vga_vsync,vga_rgb,vga_frame_start);
     
     // Module arguments
     input wire  clock;
@@ -45,6 +45,8 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
     output reg  [31:0] raygen_busy;
     output reg  [31:0] instance_busy;
     output reg  [31:0] shading_busy;
+    output reg  [31:0] tri_cache_hits;
+    output reg  [31:0] tri_cache_misses;
     input wire  vga_clock;
     input wire  vga_reset;
     output reg  [23:0] vga_fb_addr;
@@ -66,6 +68,8 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
     wire  [31:0] engine__raygen_busy;
     wire  [31:0] engine__instance_busy;
     wire  [31:0] engine__shading_busy;
+    wire  [31:0] engine__tri_cache_hits;
+    wire  [31:0] engine__tri_cache_misses;
     reg  display__clock;
     reg  display__reset;
     wire  [23:0] display__fb_addr;
@@ -103,7 +107,9 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
         .traversal_busy(engine__traversal_busy),
         .raygen_busy(engine__raygen_busy),
         .instance_busy(engine__instance_busy),
-        .shading_busy(engine__shading_busy)
+        .shading_busy(engine__shading_busy),
+        .tri_cache_hits(engine__tri_cache_hits),
+        .tri_cache_misses(engine__tri_cache_misses)
     );
     dynrt_processor__display display(
         .clock(display__clock),
@@ -129,6 +135,8 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
         raygen_busy = engine__raygen_busy;
         instance_busy = engine__instance_busy;
         shading_busy = engine__shading_busy;
+        tri_cache_hits = engine__tri_cache_hits;
+        tri_cache_misses = engine__tri_cache_misses;
         display__clock = vga_clock;
         display__reset = vga_reset;
         vga_fb_addr = ((display__fb_addr) & 24'hffffff);
@@ -647,7 +655,7 @@ endmodule // dynrt_processor__display__timing__col
 
 
 
-module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy);
+module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy,tri_cache_hits,tri_cache_misses);
     
     // Module arguments
     input wire  clock;
@@ -677,6 +685,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     output reg  [31:0] raygen_busy;
     output reg  [31:0] instance_busy;
     output reg  [31:0] shading_busy;
+    output reg  [31:0] tri_cache_hits;
+    output reg  [31:0] tri_cache_misses;
     
     // Constant declarations
     localparam  c_threads = 8'h20;
@@ -1135,6 +1145,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     wire  tester__walk_end_hit;
     wire  tester__transform_busy;
     wire  tester__intersect_busy;
+    wire  tester__cache_hit;
+    wire  tester__cache_miss;
     reg  tester__gen_valid;
     reg  [23:0] tester__gen_m__0;
     reg  [23:0] tester__gen_m__1;
@@ -1246,6 +1258,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [31:0] shading_count__d;
     wire  [31:0] shading_count__q;
     reg  shading_count__clock;
+    reg  [31:0] cache_hit_count__d;
+    wire  [31:0] cache_hit_count__q;
+    reg  cache_hit_count__clock;
+    reg  [31:0] cache_miss_count__d;
+    wire  [31:0] cache_miss_count__q;
+    reg  cache_miss_count__clock;
     reg  count_in_frame__d;
     wire  count_in_frame__q;
     reg  count_in_frame__clock;
@@ -1267,6 +1285,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  tick_shading__d;
     wire  tick_shading__q;
     reg  tick_shading__clock;
+    reg  tick_cache_hit__d;
+    wire  tick_cache_hit__q;
+    reg  tick_cache_hit__clock;
+    reg  tick_cache_miss__d;
+    wire  tick_cache_miss__q;
+    reg  tick_cache_miss__clock;
     reg  [5:0] mem_load_r__d;
     wire  [5:0] mem_load_r__q;
     reg  mem_load_r__clock;
@@ -1767,6 +1791,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .walk_end_hit(tester__walk_end_hit),
         .transform_busy(tester__transform_busy),
         .intersect_busy(tester__intersect_busy),
+        .cache_hit(tester__cache_hit),
+        .cache_miss(tester__cache_miss),
         .gen_valid(tester__gen_valid),
         .gen_m__0(tester__gen_m__0),
         .gen_m__1(tester__gen_m__1),
@@ -1866,45 +1892,55 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(halted_count__q),
         .clock(halted_count__clock)
     );
-    dynrt_processor__engine__cycle_count cycle_count(
+    dynrt_processor__engine__cache_hit_count cycle_count(
         .d(cycle_count__d),
         .q(cycle_count__q),
         .clock(cycle_count__clock)
     );
-    dynrt_processor__engine__cycle_count instr_count(
+    dynrt_processor__engine__cache_hit_count instr_count(
         .d(instr_count__d),
         .q(instr_count__q),
         .clock(instr_count__clock)
     );
-    dynrt_processor__engine__cycle_count transform_count(
+    dynrt_processor__engine__cache_hit_count transform_count(
         .d(transform_count__d),
         .q(transform_count__q),
         .clock(transform_count__clock)
     );
-    dynrt_processor__engine__cycle_count intersect_count(
+    dynrt_processor__engine__cache_hit_count intersect_count(
         .d(intersect_count__d),
         .q(intersect_count__q),
         .clock(intersect_count__clock)
     );
-    dynrt_processor__engine__cycle_count traversal_count(
+    dynrt_processor__engine__cache_hit_count traversal_count(
         .d(traversal_count__d),
         .q(traversal_count__q),
         .clock(traversal_count__clock)
     );
-    dynrt_processor__engine__cycle_count raygen_count(
+    dynrt_processor__engine__cache_hit_count raygen_count(
         .d(raygen_count__d),
         .q(raygen_count__q),
         .clock(raygen_count__clock)
     );
-    dynrt_processor__engine__cycle_count instance_count(
+    dynrt_processor__engine__cache_hit_count instance_count(
         .d(instance_count__d),
         .q(instance_count__q),
         .clock(instance_count__clock)
     );
-    dynrt_processor__engine__cycle_count shading_count(
+    dynrt_processor__engine__cache_hit_count shading_count(
         .d(shading_count__d),
         .q(shading_count__q),
         .clock(shading_count__clock)
+    );
+    dynrt_processor__engine__cache_hit_count cache_hit_count(
+        .d(cache_hit_count__d),
+        .q(cache_hit_count__q),
+        .clock(cache_hit_count__clock)
+    );
+    dynrt_processor__engine__cache_hit_count cache_miss_count(
+        .d(cache_miss_count__d),
+        .q(cache_miss_count__q),
+        .clock(cache_miss_count__clock)
     );
     dynrt_processor__display__dark_d count_in_frame(
         .d(count_in_frame__d),
@@ -1941,6 +1977,16 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(tick_shading__q),
         .clock(tick_shading__clock)
     );
+    dynrt_processor__display__dark_d tick_cache_hit(
+        .d(tick_cache_hit__d),
+        .q(tick_cache_hit__q),
+        .clock(tick_cache_hit__clock)
+    );
+    dynrt_processor__display__dark_d tick_cache_miss(
+        .d(tick_cache_miss__d),
+        .q(tick_cache_miss__q),
+        .clock(tick_cache_miss__clock)
+    );
     dynrt_processor__engine__mem_load_r mem_load_r(
         .d(mem_load_r__d),
         .q(mem_load_r__q),
@@ -1966,7 +2012,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(fb_addr_r__q),
         .clock(fb_addr_r__clock)
     );
-    dynrt_processor__engine__cycle_count fb_data_r(
+    dynrt_processor__engine__cache_hit_count fb_data_r(
         .d(fb_data_r__d),
         .q(fb_data_r__q),
         .clock(fb_data_r__clock)
@@ -2068,6 +2114,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         raygen_count__clock = clock;
         instance_count__clock = clock;
         shading_count__clock = clock;
+        cache_hit_count__clock = clock;
+        cache_miss_count__clock = clock;
         count_in_frame__clock = clock;
         tick_transform__clock = clock;
         tick_intersect__clock = clock;
@@ -2075,6 +2123,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tick_raygen__clock = clock;
         tick_instance__clock = clock;
         tick_shading__clock = clock;
+        tick_cache_hit__clock = clock;
+        tick_cache_miss__clock = clock;
         intersect_count__clock = clock;
         traversal_count__clock = clock;
         mem_load_r__clock = clock;
@@ -2109,6 +2159,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         raygen_count__d = raygen_count__q;
         instance_count__d = instance_count__q;
         shading_count__d = shading_count__q;
+        cache_hit_count__d = cache_hit_count__q;
+        cache_miss_count__d = cache_miss_count__q;
         count_in_frame__d = count_in_frame__q;
         tick_transform__d = tick_transform__q;
         tick_intersect__d = tick_intersect__q;
@@ -2116,6 +2168,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tick_raygen__d = tick_raygen__q;
         tick_instance__d = tick_instance__q;
         tick_shading__d = tick_shading__q;
+        tick_cache_hit__d = tick_cache_hit__q;
+        tick_cache_miss__d = tick_cache_miss__q;
         intersect_count__d = intersect_count__q;
         traversal_count__d = traversal_count__q;
         mem_load_r__d = mem_load_r__q;
@@ -2168,6 +2222,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         raygen_busy = raygen_count__q;
         instance_busy = instance_count__q;
         shading_busy = shading_count__q;
+        tri_cache_hits = cache_hit_count__q;
+        tri_cache_misses = cache_miss_count__q;
         if (in_frame) begin
             cycle_count__d = cycle_count__q + 32'h1;
         end
@@ -2175,6 +2231,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tick_transform__d = tester__transform_busy;
         tick_intersect__d = tester__intersect_busy;
         tick_traversal__d = traversal_unit__step_busy;
+        tick_cache_hit__d = tester__cache_hit;
+        tick_cache_miss__d = tester__cache_miss;
         if (count_in_frame__q) begin
             if (tick_transform__q) begin
                 transform_count__d = transform_count__q + 32'h1;
@@ -2193,6 +2251,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             end
             if (tick_instance__q) begin
                 instance_count__d = instance_count__q + 32'h1;
+            end
+            if (tick_cache_hit__q) begin
+                cache_hit_count__d = cache_hit_count__q + 32'h1;
+            end
+            if (tick_cache_miss__q) begin
+                cache_miss_count__d = cache_miss_count__q + 32'h1;
             end
         end
         scheduler__running = running__q;
@@ -2625,6 +2689,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             traversal_count__d = 32'h0;
             raygen_count__d = 32'h0;
             instance_count__d = 32'h0;
+            cache_hit_count__d = 32'h0;
+            cache_miss_count__d = 32'h0;
             shading_count__d = 32'h0;
         end
     end
@@ -2647,11 +2713,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
 endmodule // dynrt_processor__engine
 
 
-
-
-
-
-module dynrt_processor__engine__cycle_count(d,q,clock);
+module dynrt_processor__engine__cache_hit_count(d,q,clock);
     
     // Module arguments
     input wire  [31:0] d;
@@ -2667,7 +2729,15 @@ module dynrt_processor__engine__cycle_count(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor__engine__cycle_count
+endmodule // dynrt_processor__engine__cache_hit_count
+
+
+
+
+
+
+
+
 
 
 module dynrt_processor__engine__decode(clock,valid_i3,thread_i3,pc_i3,ctl_i3,imm_i3,aux_i3,op_i3,valid_i4,op_i4,thread_i4,imm_i4,valid,thread,pc,op,dst,invert,imm,shift,bank,target,a,b,store,wb_write,wb_thread,wb_dst,wb_data);
@@ -2816,17 +2886,17 @@ module dynrt_processor__engine__decode(clock,valid_i3,thread_i3,pc_i3,ctl_i3,imm
         .q(pc4__q),
         .clock(pc4__clock)
     );
-    dynrt_processor__engine__cycle_count ctl4(
+    dynrt_processor__engine__cache_hit_count ctl4(
         .d(ctl4__d),
         .q(ctl4__q),
         .clock(ctl4__clock)
     );
-    dynrt_processor__engine__cycle_count imm4(
+    dynrt_processor__engine__cache_hit_count imm4(
         .d(imm4__d),
         .q(imm4__q),
         .clock(imm4__clock)
     );
-    dynrt_processor__engine__cycle_count aux4(
+    dynrt_processor__engine__cache_hit_count aux4(
         .d(aux4__d),
         .q(aux4__q),
         .clock(aux4__clock)
@@ -2846,32 +2916,32 @@ module dynrt_processor__engine__decode(clock,valid_i3,thread_i3,pc_i3,ctl_i3,imm
         .q(pc5__q),
         .clock(pc5__clock)
     );
-    dynrt_processor__engine__cycle_count ctl5(
+    dynrt_processor__engine__cache_hit_count ctl5(
         .d(ctl5__d),
         .q(ctl5__q),
         .clock(ctl5__clock)
     );
-    dynrt_processor__engine__cycle_count imm5(
+    dynrt_processor__engine__cache_hit_count imm5(
         .d(imm5__d),
         .q(imm5__q),
         .clock(imm5__clock)
     );
-    dynrt_processor__engine__cycle_count aux5(
+    dynrt_processor__engine__cache_hit_count aux5(
         .d(aux5__d),
         .q(aux5__q),
         .clock(aux5__clock)
     );
-    dynrt_processor__engine__cycle_count a5(
+    dynrt_processor__engine__cache_hit_count a5(
         .d(a5__d),
         .q(a5__q),
         .clock(a5__clock)
     );
-    dynrt_processor__engine__cycle_count b5(
+    dynrt_processor__engine__cache_hit_count b5(
         .d(b5__d),
         .q(b5__q),
         .clock(b5__clock)
     );
-    dynrt_processor__engine__cycle_count store5(
+    dynrt_processor__engine__cache_hit_count store5(
         .d(store5__d),
         .q(store5__q),
         .clock(store5__clock)
@@ -3363,17 +3433,17 @@ module dynrt_processor__engine__fetch(clock,epoch,issue,pick,valid,thread,pc,ctl
         .q(pc3__q),
         .clock(pc3__clock)
     );
-    dynrt_processor__engine__cycle_count ctl3(
+    dynrt_processor__engine__cache_hit_count ctl3(
         .d(ctl3__d),
         .q(ctl3__q),
         .clock(ctl3__clock)
     );
-    dynrt_processor__engine__cycle_count imm3(
+    dynrt_processor__engine__cache_hit_count imm3(
         .d(imm3__d),
         .q(imm3__q),
         .clock(imm3__clock)
     );
-    dynrt_processor__engine__cycle_count aux3(
+    dynrt_processor__engine__cache_hit_count aux3(
         .d(aux3__d),
         .q(aux3__q),
         .clock(aux3__clock)
@@ -10985,7 +11055,7 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         .q(write_d__2__q),
         .clock(write_d__2__clock)
     );
-    dynrt_processor__engine__cycle_count write_mask(
+    dynrt_processor__engine__cache_hit_count write_mask(
         .d(write_mask__d),
         .q(write_mask__q),
         .clock(write_mask__clock)
@@ -10995,7 +11065,7 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         .q(normal_valid__q),
         .clock(normal_valid__clock)
     );
-    dynrt_processor__engine__cycle_count waiting(
+    dynrt_processor__engine__cache_hit_count waiting(
         .d(waiting__d),
         .q(waiting__q),
         .clock(waiting__clock)
@@ -11674,42 +11744,42 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
     reg  [5:0] write_address;
     
     // Sub module instances
-    dynrt_processor__engine__cycle_count entries_r__0(
+    dynrt_processor__engine__cache_hit_count entries_r__0(
         .d(entries_r__0__d),
         .q(entries_r__0__q),
         .clock(entries_r__0__clock)
     );
-    dynrt_processor__engine__cycle_count entries_r__1(
+    dynrt_processor__engine__cache_hit_count entries_r__1(
         .d(entries_r__1__d),
         .q(entries_r__1__q),
         .clock(entries_r__1__clock)
     );
-    dynrt_processor__engine__cycle_count entries_r__2(
+    dynrt_processor__engine__cache_hit_count entries_r__2(
         .d(entries_r__2__d),
         .q(entries_r__2__q),
         .clock(entries_r__2__clock)
     );
-    dynrt_processor__engine__cycle_count entries_r__3(
+    dynrt_processor__engine__cache_hit_count entries_r__3(
         .d(entries_r__3__d),
         .q(entries_r__3__q),
         .clock(entries_r__3__clock)
     );
-    dynrt_processor__engine__cycle_count entries_r__4(
+    dynrt_processor__engine__cache_hit_count entries_r__4(
         .d(entries_r__4__d),
         .q(entries_r__4__q),
         .clock(entries_r__4__clock)
     );
-    dynrt_processor__engine__cycle_count entries_r__5(
+    dynrt_processor__engine__cache_hit_count entries_r__5(
         .d(entries_r__5__d),
         .q(entries_r__5__q),
         .clock(entries_r__5__clock)
     );
-    dynrt_processor__engine__cycle_count entries_r__6(
+    dynrt_processor__engine__cache_hit_count entries_r__6(
         .d(entries_r__6__d),
         .q(entries_r__6__q),
         .clock(entries_r__6__clock)
     );
-    dynrt_processor__engine__cycle_count entries_r__7(
+    dynrt_processor__engine__cache_hit_count entries_r__7(
         .d(entries_r__7__d),
         .q(entries_r__7__q),
         .clock(entries_r__7__clock)
@@ -11729,7 +11799,7 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
         .q(which_i6__q),
         .clock(which_i6__clock)
     );
-    dynrt_processor__engine__cycle_count value_i6(
+    dynrt_processor__engine__cache_hit_count value_i6(
         .d(value_i6__d),
         .q(value_i6__q),
         .clock(value_i6__clock)
@@ -11799,7 +11869,7 @@ module dynrt_processor__engine__mailboxes(clock,read_thread,read_which,thread,wh
         .q(which_r__q),
         .clock(which_r__clock)
     );
-    dynrt_processor__engine__cycle_count value_r(
+    dynrt_processor__engine__cache_hit_count value_r(
         .d(value_r__d),
         .q(value_r__q),
         .clock(value_r__clock)
@@ -12743,12 +12813,12 @@ module dynrt_processor__engine__rays(clock,frame_start,camera_write,camera_pair,
         .q(result_dir__2__q),
         .clock(result_dir__2__clock)
     );
-    dynrt_processor__engine__cycle_count result_mask(
+    dynrt_processor__engine__cache_hit_count result_mask(
         .d(result_mask__d),
         .q(result_mask__q),
         .clock(result_mask__clock)
     );
-    dynrt_processor__engine__cycle_count waiting(
+    dynrt_processor__engine__cache_hit_count waiting(
         .d(waiting__d),
         .q(waiting__q),
         .clock(waiting__clock)
@@ -13821,42 +13891,42 @@ module dynrt_processor__engine__result_line(clock,valid,op,dst,thread,invert,pc,
         .data_in(wait_pending_line__data_in),
         .data_out(wait_pending_line__data_out)
     );
-    dynrt_processor__engine__cycle_count fast_line__0(
+    dynrt_processor__engine__cache_hit_count fast_line__0(
         .d(fast_line__0__d),
         .q(fast_line__0__q),
         .clock(fast_line__0__clock)
     );
-    dynrt_processor__engine__cycle_count fast_line__1(
+    dynrt_processor__engine__cache_hit_count fast_line__1(
         .d(fast_line__1__d),
         .q(fast_line__1__q),
         .clock(fast_line__1__clock)
     );
-    dynrt_processor__engine__cycle_count fast_line__2(
+    dynrt_processor__engine__cache_hit_count fast_line__2(
         .d(fast_line__2__d),
         .q(fast_line__2__q),
         .clock(fast_line__2__clock)
     );
-    dynrt_processor__engine__cycle_count fast_line__3(
+    dynrt_processor__engine__cache_hit_count fast_line__3(
         .d(fast_line__3__d),
         .q(fast_line__3__q),
         .clock(fast_line__3__clock)
     );
-    dynrt_processor__engine__cycle_count fast_line__4(
+    dynrt_processor__engine__cache_hit_count fast_line__4(
         .d(fast_line__4__d),
         .q(fast_line__4__q),
         .clock(fast_line__4__clock)
     );
-    dynrt_processor__engine__cycle_count fast_line__5(
+    dynrt_processor__engine__cache_hit_count fast_line__5(
         .d(fast_line__5__d),
         .q(fast_line__5__q),
         .clock(fast_line__5__clock)
     );
-    dynrt_processor__engine__cycle_count fast_line__6(
+    dynrt_processor__engine__cache_hit_count fast_line__6(
         .d(fast_line__6__d),
         .q(fast_line__6__q),
         .clock(fast_line__6__clock)
     );
-    dynrt_processor__engine__cycle_count fast_line__7(
+    dynrt_processor__engine__cache_hit_count fast_line__7(
         .d(fast_line__7__d),
         .q(fast_line__7__q),
         .clock(fast_line__7__clock)
@@ -14491,7 +14561,7 @@ module dynrt_processor__engine__result_line__fast_tail(clock,data_in,data_out);
     reg  stage__0__clock;
     
     // Sub module instances
-    dynrt_processor__engine__cycle_count stage__0(
+    dynrt_processor__engine__cache_hit_count stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
@@ -14921,67 +14991,67 @@ module dynrt_processor__engine__result_line__long_fast(clock,data_in,data_out);
     reg  stage__12__clock;
     
     // Sub module instances
-    dynrt_processor__engine__cycle_count stage__0(
+    dynrt_processor__engine__cache_hit_count stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor__engine__cycle_count stage__1(
+    dynrt_processor__engine__cache_hit_count stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor__engine__cycle_count stage__2(
+    dynrt_processor__engine__cache_hit_count stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor__engine__cycle_count stage__3(
+    dynrt_processor__engine__cache_hit_count stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor__engine__cycle_count stage__4(
+    dynrt_processor__engine__cache_hit_count stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor__engine__cycle_count stage__5(
+    dynrt_processor__engine__cache_hit_count stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor__engine__cycle_count stage__6(
+    dynrt_processor__engine__cache_hit_count stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor__engine__cycle_count stage__7(
+    dynrt_processor__engine__cache_hit_count stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor__engine__cycle_count stage__8(
+    dynrt_processor__engine__cache_hit_count stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor__engine__cycle_count stage__9(
+    dynrt_processor__engine__cache_hit_count stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor__engine__cycle_count stage__10(
+    dynrt_processor__engine__cache_hit_count stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor__engine__cycle_count stage__11(
+    dynrt_processor__engine__cache_hit_count stage__11(
         .d(stage__11__d),
         .q(stage__11__q),
         .clock(stage__11__clock)
     );
-    dynrt_processor__engine__cycle_count stage__12(
+    dynrt_processor__engine__cache_hit_count stage__12(
         .d(stage__12__d),
         .q(stage__12__q),
         .clock(stage__12__clock)
@@ -16430,17 +16500,17 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         .q(walk_done_thread_r__q),
         .clock(walk_done_thread_r__clock)
     );
-    dynrt_processor__engine__cycle_count ready(
+    dynrt_processor__engine__cache_hit_count ready(
         .d(ready__d),
         .q(ready__q),
         .clock(ready__clock)
     );
-    dynrt_processor__engine__cycle_count asleep(
+    dynrt_processor__engine__cache_hit_count asleep(
         .d(asleep__d),
         .q(asleep__q),
         .clock(asleep__clock)
     );
-    dynrt_processor__engine__cycle_count woken(
+    dynrt_processor__engine__cache_hit_count woken(
         .d(woken__d),
         .q(woken__q),
         .clock(woken__clock)
@@ -16450,7 +16520,7 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         .q(picked__q),
         .clock(picked__clock)
     );
-    dynrt_processor__engine__cycle_count pick_onehot(
+    dynrt_processor__engine__cache_hit_count pick_onehot(
         .d(pick_onehot__d),
         .q(pick_onehot__q),
         .clock(pick_onehot__clock)
@@ -16465,12 +16535,12 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         .q(pointer__q),
         .clock(pointer__clock)
     );
-    dynrt_processor__engine__cycle_count below_pointer(
+    dynrt_processor__engine__cache_hit_count below_pointer(
         .d(below_pointer__d),
         .q(below_pointer__q),
         .clock(below_pointer__clock)
     );
-    dynrt_processor__engine__cycle_count reserved(
+    dynrt_processor__engine__cache_hit_count reserved(
         .d(reserved__d),
         .q(reserved__q),
         .clock(reserved__clock)
@@ -22232,7 +22302,7 @@ endmodule // dynrt_processor__engine__shader__res_step_r
 
 
 
-module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,a_words__read,a_words__addr,a_words__rdata,b_words__read,b_words__addr,b_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_diagonal,gen_client,gen_thread,gen_take,gen_out_valid,gen_out_client,gen_out_thread,gen_out_dir__0,gen_out_dir__1,gen_out_dir__2,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2);
+module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,a_words__read,a_words__addr,a_words__rdata,b_words__read,b_words__addr,b_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy,cache_hit,cache_miss,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_diagonal,gen_client,gen_thread,gen_take,gen_out_valid,gen_out_client,gen_out_thread,gen_out_dir__0,gen_out_dir__1,gen_out_dir__2,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2);
     
     // Module arguments
     input wire  clock;
@@ -22274,6 +22344,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     output reg  walk_end_hit;
     output reg  transform_busy;
     output reg  intersect_busy;
+    output reg  cache_hit;
+    output reg  cache_miss;
     input wire  gen_valid;
     input wire  [23:0] gen_m__0;
     input wire  [23:0] gen_m__1;
@@ -22311,6 +22383,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     input wire  [23:0] primary_d__2;
     
     // Constant declarations
+    localparam  c_set_mask = 9'b111111111;
+    localparam  c_cache_on = 1'b1;
+    localparam  c_tag_valid = 25'h1000000;
     localparam  c_primary = 16'h4000;
     localparam  c_ml_last = 4'h1;
     localparam  c_index__0 = 4'h0;
@@ -22636,6 +22711,108 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [1:0] words__11__write_address;
     reg  [23:0] words__11__write_data;
     reg  words__11__write_enable;
+    reg  [8:0] cache_tag__read_address;
+    wire  [24:0] cache_tag__read_data;
+    reg  cache_tag__write_clock;
+    reg  [8:0] cache_tag__write_address;
+    reg  [24:0] cache_tag__write_data;
+    reg  cache_tag__write_enable;
+    reg  [8:0] cache_words__0__read_address;
+    reg  cache_words__0__read_clock;
+    wire  [23:0] cache_words__0__read_data;
+    reg  [8:0] cache_words__0__write_address;
+    reg  cache_words__0__write_clock;
+    reg  [23:0] cache_words__0__write_data;
+    reg  cache_words__0__write_enable;
+    reg  [8:0] cache_words__1__read_address;
+    reg  cache_words__1__read_clock;
+    wire  [23:0] cache_words__1__read_data;
+    reg  [8:0] cache_words__1__write_address;
+    reg  cache_words__1__write_clock;
+    reg  [23:0] cache_words__1__write_data;
+    reg  cache_words__1__write_enable;
+    reg  [8:0] cache_words__2__read_address;
+    reg  cache_words__2__read_clock;
+    wire  [23:0] cache_words__2__read_data;
+    reg  [8:0] cache_words__2__write_address;
+    reg  cache_words__2__write_clock;
+    reg  [23:0] cache_words__2__write_data;
+    reg  cache_words__2__write_enable;
+    reg  [8:0] cache_words__3__read_address;
+    reg  cache_words__3__read_clock;
+    wire  [23:0] cache_words__3__read_data;
+    reg  [8:0] cache_words__3__write_address;
+    reg  cache_words__3__write_clock;
+    reg  [23:0] cache_words__3__write_data;
+    reg  cache_words__3__write_enable;
+    reg  [8:0] cache_words__4__read_address;
+    reg  cache_words__4__read_clock;
+    wire  [23:0] cache_words__4__read_data;
+    reg  [8:0] cache_words__4__write_address;
+    reg  cache_words__4__write_clock;
+    reg  [23:0] cache_words__4__write_data;
+    reg  cache_words__4__write_enable;
+    reg  [8:0] cache_words__5__read_address;
+    reg  cache_words__5__read_clock;
+    wire  [23:0] cache_words__5__read_data;
+    reg  [8:0] cache_words__5__write_address;
+    reg  cache_words__5__write_clock;
+    reg  [23:0] cache_words__5__write_data;
+    reg  cache_words__5__write_enable;
+    reg  [8:0] cache_words__6__read_address;
+    reg  cache_words__6__read_clock;
+    wire  [23:0] cache_words__6__read_data;
+    reg  [8:0] cache_words__6__write_address;
+    reg  cache_words__6__write_clock;
+    reg  [23:0] cache_words__6__write_data;
+    reg  cache_words__6__write_enable;
+    reg  [8:0] cache_words__7__read_address;
+    reg  cache_words__7__read_clock;
+    wire  [23:0] cache_words__7__read_data;
+    reg  [8:0] cache_words__7__write_address;
+    reg  cache_words__7__write_clock;
+    reg  [23:0] cache_words__7__write_data;
+    reg  cache_words__7__write_enable;
+    reg  [8:0] cache_words__8__read_address;
+    reg  cache_words__8__read_clock;
+    wire  [23:0] cache_words__8__read_data;
+    reg  [8:0] cache_words__8__write_address;
+    reg  cache_words__8__write_clock;
+    reg  [23:0] cache_words__8__write_data;
+    reg  cache_words__8__write_enable;
+    reg  [8:0] cache_words__9__read_address;
+    reg  cache_words__9__read_clock;
+    wire  [23:0] cache_words__9__read_data;
+    reg  [8:0] cache_words__9__write_address;
+    reg  cache_words__9__write_clock;
+    reg  [23:0] cache_words__9__write_data;
+    reg  cache_words__9__write_enable;
+    reg  [8:0] cache_words__10__read_address;
+    reg  cache_words__10__read_clock;
+    wire  [23:0] cache_words__10__read_data;
+    reg  [8:0] cache_words__10__write_address;
+    reg  cache_words__10__write_clock;
+    reg  [23:0] cache_words__10__write_data;
+    reg  cache_words__10__write_enable;
+    reg  [8:0] cache_words__11__read_address;
+    reg  cache_words__11__read_clock;
+    wire  [23:0] cache_words__11__read_data;
+    reg  [8:0] cache_words__11__write_address;
+    reg  cache_words__11__write_clock;
+    reg  [23:0] cache_words__11__write_data;
+    reg  cache_words__11__write_enable;
+    reg  cached__0__d;
+    wire  cached__0__q;
+    reg  cached__0__clock;
+    reg  cached__1__d;
+    wire  cached__1__q;
+    reg  cached__1__clock;
+    reg  cached__2__d;
+    wire  cached__2__q;
+    reg  cached__2__clock;
+    reg  cached__3__d;
+    wire  cached__3__q;
+    reg  cached__3__clock;
     reg  [5:0] a_line__0__d;
     wire  [5:0] a_line__0__q;
     reg  a_line__0__clock;
@@ -22885,6 +23062,15 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [31:0] fetch_a;
     reg  fetch_ends;
     reg  tb_free;
+    reg  [23:0] head_triangle;
+    reg  [8:0] head_set;
+    reg  head_hit;
+    reg  l_cached;
+    reg  [8:0] l_set;
+    reg  n_cached;
+    reg  [8:0] n_set;
+    reg  cache_write;
+    reg  cache_block;
     reg  take;
     reg  take_triangle;
     reg  fetch_moves;
@@ -23158,42 +23344,42 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(cur_thread__3__q),
         .clock(cur_thread__3__clock)
     );
-    dynrt_processor__engine__cycle_count cur_a__0(
+    dynrt_processor__engine__cache_hit_count cur_a__0(
         .d(cur_a__0__d),
         .q(cur_a__0__q),
         .clock(cur_a__0__clock)
     );
-    dynrt_processor__engine__cycle_count cur_a__1(
+    dynrt_processor__engine__cache_hit_count cur_a__1(
         .d(cur_a__1__d),
         .q(cur_a__1__q),
         .clock(cur_a__1__clock)
     );
-    dynrt_processor__engine__cycle_count cur_a__2(
+    dynrt_processor__engine__cache_hit_count cur_a__2(
         .d(cur_a__2__d),
         .q(cur_a__2__q),
         .clock(cur_a__2__clock)
     );
-    dynrt_processor__engine__cycle_count cur_a__3(
+    dynrt_processor__engine__cache_hit_count cur_a__3(
         .d(cur_a__3__d),
         .q(cur_a__3__q),
         .clock(cur_a__3__clock)
     );
-    dynrt_processor__engine__cycle_count cur_b__0(
+    dynrt_processor__engine__cache_hit_count cur_b__0(
         .d(cur_b__0__d),
         .q(cur_b__0__q),
         .clock(cur_b__0__clock)
     );
-    dynrt_processor__engine__cycle_count cur_b__1(
+    dynrt_processor__engine__cache_hit_count cur_b__1(
         .d(cur_b__1__d),
         .q(cur_b__1__q),
         .clock(cur_b__1__clock)
     );
-    dynrt_processor__engine__cycle_count cur_b__2(
+    dynrt_processor__engine__cache_hit_count cur_b__2(
         .d(cur_b__2__d),
         .q(cur_b__2__q),
         .clock(cur_b__2__clock)
     );
-    dynrt_processor__engine__cycle_count cur_b__3(
+    dynrt_processor__engine__cache_hit_count cur_b__3(
         .d(cur_b__3__d),
         .q(cur_b__3__q),
         .clock(cur_b__3__clock)
@@ -23328,6 +23514,142 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_address(words__11__write_address),
         .write_data(words__11__write_data),
         .write_enable(words__11__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_tag cache_tag(
+        .read_address(cache_tag__read_address),
+        .read_data(cache_tag__read_data),
+        .write_clock(cache_tag__write_clock),
+        .write_address(cache_tag__write_address),
+        .write_data(cache_tag__write_data),
+        .write_enable(cache_tag__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__0(
+        .read_address(cache_words__0__read_address),
+        .read_clock(cache_words__0__read_clock),
+        .read_data(cache_words__0__read_data),
+        .write_address(cache_words__0__write_address),
+        .write_clock(cache_words__0__write_clock),
+        .write_data(cache_words__0__write_data),
+        .write_enable(cache_words__0__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__1(
+        .read_address(cache_words__1__read_address),
+        .read_clock(cache_words__1__read_clock),
+        .read_data(cache_words__1__read_data),
+        .write_address(cache_words__1__write_address),
+        .write_clock(cache_words__1__write_clock),
+        .write_data(cache_words__1__write_data),
+        .write_enable(cache_words__1__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__2(
+        .read_address(cache_words__2__read_address),
+        .read_clock(cache_words__2__read_clock),
+        .read_data(cache_words__2__read_data),
+        .write_address(cache_words__2__write_address),
+        .write_clock(cache_words__2__write_clock),
+        .write_data(cache_words__2__write_data),
+        .write_enable(cache_words__2__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__3(
+        .read_address(cache_words__3__read_address),
+        .read_clock(cache_words__3__read_clock),
+        .read_data(cache_words__3__read_data),
+        .write_address(cache_words__3__write_address),
+        .write_clock(cache_words__3__write_clock),
+        .write_data(cache_words__3__write_data),
+        .write_enable(cache_words__3__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__4(
+        .read_address(cache_words__4__read_address),
+        .read_clock(cache_words__4__read_clock),
+        .read_data(cache_words__4__read_data),
+        .write_address(cache_words__4__write_address),
+        .write_clock(cache_words__4__write_clock),
+        .write_data(cache_words__4__write_data),
+        .write_enable(cache_words__4__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__5(
+        .read_address(cache_words__5__read_address),
+        .read_clock(cache_words__5__read_clock),
+        .read_data(cache_words__5__read_data),
+        .write_address(cache_words__5__write_address),
+        .write_clock(cache_words__5__write_clock),
+        .write_data(cache_words__5__write_data),
+        .write_enable(cache_words__5__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__6(
+        .read_address(cache_words__6__read_address),
+        .read_clock(cache_words__6__read_clock),
+        .read_data(cache_words__6__read_data),
+        .write_address(cache_words__6__write_address),
+        .write_clock(cache_words__6__write_clock),
+        .write_data(cache_words__6__write_data),
+        .write_enable(cache_words__6__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__7(
+        .read_address(cache_words__7__read_address),
+        .read_clock(cache_words__7__read_clock),
+        .read_data(cache_words__7__read_data),
+        .write_address(cache_words__7__write_address),
+        .write_clock(cache_words__7__write_clock),
+        .write_data(cache_words__7__write_data),
+        .write_enable(cache_words__7__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__8(
+        .read_address(cache_words__8__read_address),
+        .read_clock(cache_words__8__read_clock),
+        .read_data(cache_words__8__read_data),
+        .write_address(cache_words__8__write_address),
+        .write_clock(cache_words__8__write_clock),
+        .write_data(cache_words__8__write_data),
+        .write_enable(cache_words__8__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__9(
+        .read_address(cache_words__9__read_address),
+        .read_clock(cache_words__9__read_clock),
+        .read_data(cache_words__9__read_data),
+        .write_address(cache_words__9__write_address),
+        .write_clock(cache_words__9__write_clock),
+        .write_data(cache_words__9__write_data),
+        .write_enable(cache_words__9__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__10(
+        .read_address(cache_words__10__read_address),
+        .read_clock(cache_words__10__read_clock),
+        .read_data(cache_words__10__read_data),
+        .write_address(cache_words__10__write_address),
+        .write_clock(cache_words__10__write_clock),
+        .write_data(cache_words__10__write_data),
+        .write_enable(cache_words__10__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_words__0 cache_words__11(
+        .read_address(cache_words__11__read_address),
+        .read_clock(cache_words__11__read_clock),
+        .read_data(cache_words__11__read_data),
+        .write_address(cache_words__11__write_address),
+        .write_clock(cache_words__11__write_clock),
+        .write_data(cache_words__11__write_data),
+        .write_enable(cache_words__11__write_enable)
+    );
+    dynrt_processor__display__dark_d cached__0(
+        .d(cached__0__d),
+        .q(cached__0__q),
+        .clock(cached__0__clock)
+    );
+    dynrt_processor__display__dark_d cached__1(
+        .d(cached__1__d),
+        .q(cached__1__q),
+        .clock(cached__1__clock)
+    );
+    dynrt_processor__display__dark_d cached__2(
+        .d(cached__2__d),
+        .q(cached__2__q),
+        .clock(cached__2__clock)
+    );
+    dynrt_processor__display__dark_d cached__3(
+        .d(cached__3__d),
+        .q(cached__3__q),
+        .clock(cached__3__clock)
     );
     dynrt_processor__engine__mem_load_r a_line__0(
         .d(a_line__0__d),
@@ -23510,12 +23832,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m2_t__q),
         .clock(m2_t__clock)
     );
-    dynrt_processor__engine__cycle_count m2_a(
+    dynrt_processor__engine__cache_hit_count m2_a(
         .d(m2_a__d),
         .q(m2_a__q),
         .clock(m2_a__clock)
     );
-    dynrt_processor__engine__cycle_count m2_b(
+    dynrt_processor__engine__cache_hit_count m2_b(
         .d(m2_b__d),
         .q(m2_b__q),
         .clock(m2_b__clock)
@@ -23555,12 +23877,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(m3_t__q),
         .clock(m3_t__clock)
     );
-    dynrt_processor__engine__cycle_count m3_a(
+    dynrt_processor__engine__cache_hit_count m3_a(
         .d(m3_a__d),
         .q(m3_a__q),
         .clock(m3_a__clock)
     );
-    dynrt_processor__engine__cycle_count m3_b(
+    dynrt_processor__engine__cache_hit_count m3_b(
         .d(m3_b__d),
         .q(m3_b__q),
         .clock(m3_b__clock)
@@ -23869,6 +24191,33 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         words__11__write_clock = clock;
         words__11__write_enable = 1'b0;
         words__11__read_address = lb__q;
+        cache_tag__write_clock = clock;
+        cache_words__0__read_clock = clock;
+        cache_words__0__write_clock = clock;
+        cache_words__1__read_clock = clock;
+        cache_words__1__write_clock = clock;
+        cache_words__2__read_clock = clock;
+        cache_words__2__write_clock = clock;
+        cache_words__3__read_clock = clock;
+        cache_words__3__write_clock = clock;
+        cache_words__4__read_clock = clock;
+        cache_words__4__write_clock = clock;
+        cache_words__5__read_clock = clock;
+        cache_words__5__write_clock = clock;
+        cache_words__6__read_clock = clock;
+        cache_words__6__write_clock = clock;
+        cache_words__7__read_clock = clock;
+        cache_words__7__write_clock = clock;
+        cache_words__8__read_clock = clock;
+        cache_words__8__write_clock = clock;
+        cache_words__9__read_clock = clock;
+        cache_words__9__write_clock = clock;
+        cache_words__10__read_clock = clock;
+        cache_words__10__write_clock = clock;
+        cache_words__11__read_clock = clock;
+        cache_words__11__write_clock = clock;
+        cached__0__clock = clock;
+        cached__0__d = cached__0__q;
         loaded__0__clock = clock;
         loaded__0__d = loaded__0__q;
         unvisited__0__clock = clock;
@@ -23883,6 +24232,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cur_b__0__d = cur_b__0__q;
         received__0__clock = clock;
         received__0__d = received__0__q;
+        cached__1__clock = clock;
+        cached__1__d = cached__1__q;
         loaded__1__clock = clock;
         loaded__1__d = loaded__1__q;
         unvisited__1__clock = clock;
@@ -23897,6 +24248,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cur_b__1__d = cur_b__1__q;
         received__1__clock = clock;
         received__1__d = received__1__q;
+        cached__2__clock = clock;
+        cached__2__d = cached__2__q;
         loaded__2__clock = clock;
         loaded__2__d = loaded__2__q;
         unvisited__2__clock = clock;
@@ -23911,6 +24264,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cur_b__2__d = cur_b__2__q;
         received__2__clock = clock;
         received__2__d = received__2__q;
+        cached__3__clock = clock;
+        cached__3__d = cached__3__q;
         loaded__3__clock = clock;
         loaded__3__d = loaded__3__q;
         unvisited__3__clock = clock;
@@ -23987,6 +24342,178 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         issued__write_address = engine__thread;
         issued__write_data = issued__read_data + 32'h1;
         issued__write_enable = engine__enqueue & (~list_unit__full) & ((queue_kind == c_cmd_list) | (queue_kind == c_cmd_init));
+        l_kind = cur_kind__0__q;
+        l_thread = cur_thread__0__q;
+        l_a = cur_a__0__q;
+        l_b = cur_b__0__q;
+        l_loaded = loaded__0__q;
+        l_received = received__0__q;
+        l_cached = cached__0__q;
+        if (lb__q == c_buffer__1) begin
+            l_kind = cur_kind__1__q;
+            l_thread = cur_thread__1__q;
+            l_a = cur_a__1__q;
+            l_b = cur_b__1__q;
+            l_loaded = loaded__1__q;
+            l_received = received__1__q;
+            l_cached = cached__1__q;
+        end
+        if (lb__q == c_buffer__2) begin
+            l_kind = cur_kind__2__q;
+            l_thread = cur_thread__2__q;
+            l_a = cur_a__2__q;
+            l_b = cur_b__2__q;
+            l_loaded = loaded__2__q;
+            l_received = received__2__q;
+            l_cached = cached__2__q;
+        end
+        if (lb__q == c_buffer__3) begin
+            l_kind = cur_kind__3__q;
+            l_thread = cur_thread__3__q;
+            l_a = cur_a__3__q;
+            l_b = cur_b__3__q;
+            l_loaded = loaded__3__q;
+            l_received = received__3__q;
+            l_cached = cached__3__q;
+        end
+        l_ready = l_loaded & ((l_kind != c_test_triangle) | (l_received == 32'hc) | l_cached);
+        n_thread = cur_thread__0__q;
+        n_loaded = loaded__0__q;
+        n_kind = cur_kind__0__q;
+        n_received = received__0__q;
+        n_cached = cached__0__q;
+        n_set = cur_a__0__q[(32'h0)+:(9)] & c_set_mask;
+        if (lb__q + 32'h1 == c_buffer__1) begin
+            n_thread = cur_thread__1__q;
+            n_loaded = loaded__1__q;
+            n_kind = cur_kind__1__q;
+            n_received = received__1__q;
+            n_cached = cached__1__q;
+            n_set = cur_a__1__q[(32'h0)+:(9)] & c_set_mask;
+        end
+        if (lb__q + 32'h1 == c_buffer__2) begin
+            n_thread = cur_thread__2__q;
+            n_loaded = loaded__2__q;
+            n_kind = cur_kind__2__q;
+            n_received = received__2__q;
+            n_cached = cached__2__q;
+            n_set = cur_a__2__q[(32'h0)+:(9)] & c_set_mask;
+        end
+        if (lb__q + 32'h1 == c_buffer__3) begin
+            n_thread = cur_thread__3__q;
+            n_loaded = loaded__3__q;
+            n_kind = cur_kind__3__q;
+            n_received = received__3__q;
+            n_cached = cached__3__q;
+            n_set = cur_a__3__q[(32'h0)+:(9)] & c_set_mask;
+        end
+        n_ready = n_loaded & ((n_kind != c_test_triangle) | (n_received == 32'hc) | n_cached);
+        l_set = l_a[(32'h0)+:(9)] & c_set_mask;
+        cache_block = 1'b0;
+        if (loaded__0__q & cached__0__q & ((cur_a__0__q[(32'h0)+:(9)] & c_set_mask) == l_set)) begin
+            cache_block = 1'b1;
+        end
+        if (loaded__1__q & cached__1__q & ((cur_a__1__q[(32'h0)+:(9)] & c_set_mask) == l_set)) begin
+            cache_block = 1'b1;
+        end
+        if (loaded__2__q & cached__2__q & ((cur_a__2__q[(32'h0)+:(9)] & c_set_mask) == l_set)) begin
+            cache_block = 1'b1;
+        end
+        if (loaded__3__q & cached__3__q & ((cur_a__3__q[(32'h0)+:(9)] & c_set_mask) == l_set)) begin
+            cache_block = 1'b1;
+        end
+        cache_write = c_cache_on & (lphase__q == Launch__Origin) & (l_kind == c_test_triangle) & (~l_cached) & (~cache_block);
+        cache_tag__write_address = l_set;
+        cache_tag__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
+        cache_tag__write_enable = cache_write;
+        cache_words__0__write_address = l_set;
+        cache_words__0__write_data = words__0__read_data;
+        cache_words__0__write_enable = cache_write;
+        cache_words__0__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__0__read_address = n_set;
+        end
+        cache_words__1__write_address = l_set;
+        cache_words__1__write_data = words__1__read_data;
+        cache_words__1__write_enable = cache_write;
+        cache_words__1__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__1__read_address = n_set;
+        end
+        cache_words__2__write_address = l_set;
+        cache_words__2__write_data = words__2__read_data;
+        cache_words__2__write_enable = cache_write;
+        cache_words__2__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__2__read_address = n_set;
+        end
+        cache_words__3__write_address = l_set;
+        cache_words__3__write_data = words__3__read_data;
+        cache_words__3__write_enable = cache_write;
+        cache_words__3__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__3__read_address = n_set;
+        end
+        cache_words__4__write_address = l_set;
+        cache_words__4__write_data = words__4__read_data;
+        cache_words__4__write_enable = cache_write;
+        cache_words__4__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__4__read_address = n_set;
+        end
+        cache_words__5__write_address = l_set;
+        cache_words__5__write_data = words__5__read_data;
+        cache_words__5__write_enable = cache_write;
+        cache_words__5__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__5__read_address = n_set;
+        end
+        cache_words__6__write_address = l_set;
+        cache_words__6__write_data = words__6__read_data;
+        cache_words__6__write_enable = cache_write;
+        cache_words__6__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__6__read_address = n_set;
+        end
+        cache_words__7__write_address = l_set;
+        cache_words__7__write_data = words__7__read_data;
+        cache_words__7__write_enable = cache_write;
+        cache_words__7__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__7__read_address = n_set;
+        end
+        cache_words__8__write_address = l_set;
+        cache_words__8__write_data = words__8__read_data;
+        cache_words__8__write_enable = cache_write;
+        cache_words__8__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__8__read_address = n_set;
+        end
+        cache_words__9__write_address = l_set;
+        cache_words__9__write_data = words__9__read_data;
+        cache_words__9__write_enable = cache_write;
+        cache_words__9__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__9__read_address = n_set;
+        end
+        cache_words__10__write_address = l_set;
+        cache_words__10__write_data = words__10__read_data;
+        cache_words__10__write_enable = cache_write;
+        cache_words__10__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__10__read_address = n_set;
+        end
+        cache_words__11__write_address = l_set;
+        cache_words__11__write_data = words__11__read_data;
+        cache_words__11__write_enable = cache_write;
+        cache_words__11__read_address = l_set;
+        if (lphase__q == Launch__Direction) begin
+            cache_words__11__read_address = n_set;
+        end
+        head_triangle = list_unit__test_entry[(32'h20)+:(24)];
+        head_set = head_triangle[(32'h0)+:(9)] & c_set_mask;
+        cache_tag__read_address = head_set;
+        head_hit = c_cache_on & (cache_tag__read_data == (c_tag_valid | ((head_triangle) & 25'h1ffffff))) & (~(cache_write & (l_set == head_set)));
         tb_free = ~loaded__0__q;
         if (tb__q == c_buffer__1) begin
             tb_free = ~loaded__1__q;
@@ -24024,24 +24551,28 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
             cur_a__0__d = list_unit__test_entry[(32'h20)+:(32)];
             cur_b__0__d = list_unit__test_entry[(32'h0)+:(32)];
+            cached__0__d = head_hit & (list_unit__test_entry[(32'h45)+:(2)] == c_test_triangle);
         end
         if ((tb__q == c_buffer__1) & (~loaded__1__q)) begin
             cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
             cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];
             cur_a__1__d = list_unit__test_entry[(32'h20)+:(32)];
             cur_b__1__d = list_unit__test_entry[(32'h0)+:(32)];
+            cached__1__d = head_hit & (list_unit__test_entry[(32'h45)+:(2)] == c_test_triangle);
         end
         if ((tb__q == c_buffer__2) & (~loaded__2__q)) begin
             cur_kind__2__d = list_unit__test_entry[(32'h45)+:(2)];
             cur_thread__2__d = list_unit__test_entry[(32'h40)+:(5)];
             cur_a__2__d = list_unit__test_entry[(32'h20)+:(32)];
             cur_b__2__d = list_unit__test_entry[(32'h0)+:(32)];
+            cached__2__d = head_hit & (list_unit__test_entry[(32'h45)+:(2)] == c_test_triangle);
         end
         if ((tb__q == c_buffer__3) & (~loaded__3__q)) begin
             cur_kind__3__d = list_unit__test_entry[(32'h45)+:(2)];
             cur_thread__3__d = list_unit__test_entry[(32'h40)+:(5)];
             cur_a__3__d = list_unit__test_entry[(32'h20)+:(32)];
             cur_b__3__d = list_unit__test_entry[(32'h0)+:(32)];
+            cached__3__d = head_hit & (list_unit__test_entry[(32'h45)+:(2)] == c_test_triangle);
         end
         a_take = fetching__q & (a_issued__q < 32'h6) & ((engine__load_banks & c_bank_a) == 32'h0);
         b_take = fetching__q & (b_issued__q < 32'h6) & ((engine__load_banks & c_bank_b) == 32'h0);
@@ -24081,16 +24612,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         b_line__5__d = b_line__4__q;
         fetch_ends = fetching__q & ((a_issued__q == 32'h6) | (a_take & (a_issued__q == 32'h5))) & ((b_issued__q == 32'h6) | (b_take & (b_issued__q == 32'h5)));
         fetch_moves = fetch_ends;
-        if ((fb__q == c_buffer__0) & (~fetching__q) & unvisited__0__q & (cur_kind__0__q != c_test_triangle)) begin
+        if ((fb__q == c_buffer__0) & (~fetching__q) & unvisited__0__q & ((cur_kind__0__q != c_test_triangle) | cached__0__q)) begin
             fetch_moves = 1'b1;
         end
-        if ((fb__q == c_buffer__1) & (~fetching__q) & unvisited__1__q & (cur_kind__1__q != c_test_triangle)) begin
+        if ((fb__q == c_buffer__1) & (~fetching__q) & unvisited__1__q & ((cur_kind__1__q != c_test_triangle) | cached__1__q)) begin
             fetch_moves = 1'b1;
         end
-        if ((fb__q == c_buffer__2) & (~fetching__q) & unvisited__2__q & (cur_kind__2__q != c_test_triangle)) begin
+        if ((fb__q == c_buffer__2) & (~fetching__q) & unvisited__2__q & ((cur_kind__2__q != c_test_triangle) | cached__2__q)) begin
             fetch_moves = 1'b1;
         end
-        if ((fb__q == c_buffer__3) & (~fetching__q) & unvisited__3__q & (cur_kind__3__q != c_test_triangle)) begin
+        if ((fb__q == c_buffer__3) & (~fetching__q) & unvisited__3__q & ((cur_kind__3__q != c_test_triangle) | cached__3__q)) begin
             fetch_moves = 1'b1;
         end
         fetch_next = fb__q;
@@ -24112,17 +24643,17 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
                 unvisited__3__d = 1'b0;
             end
         end
-        next_triangle = take_triangle & (tb__q == fetch_next);
-        if ((fetch_next == c_buffer__0) & unvisited__0__q & (cur_kind__0__q == c_test_triangle)) begin
+        next_triangle = take_triangle & (~head_hit) & (tb__q == fetch_next);
+        if ((fetch_next == c_buffer__0) & unvisited__0__q & (cur_kind__0__q == c_test_triangle) & (~cached__0__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__1) & unvisited__1__q & (cur_kind__1__q == c_test_triangle)) begin
+        if ((fetch_next == c_buffer__1) & unvisited__1__q & (cur_kind__1__q == c_test_triangle) & (~cached__1__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__2) & unvisited__2__q & (cur_kind__2__q == c_test_triangle)) begin
+        if ((fetch_next == c_buffer__2) & unvisited__2__q & (cur_kind__2__q == c_test_triangle) & (~cached__2__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__3) & unvisited__3__q & (cur_kind__3__q == c_test_triangle)) begin
+        if ((fetch_next == c_buffer__3) & unvisited__3__q & (cur_kind__3__q == c_test_triangle) & (~cached__3__q)) begin
             next_triangle = 1'b1;
         end
         if ((~fetching__q) | fetch_ends) begin
@@ -24222,72 +24753,54 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         if (a_here__3 & b_here__3) begin
             received__3__d = received__3__q + 32'h2;
         end
-        l_kind = cur_kind__0__q;
-        l_thread = cur_thread__0__q;
-        l_a = cur_a__0__q;
-        l_b = cur_b__0__q;
-        l_loaded = loaded__0__q;
-        l_received = received__0__q;
-        if (lb__q == c_buffer__1) begin
-            l_kind = cur_kind__1__q;
-            l_thread = cur_thread__1__q;
-            l_a = cur_a__1__q;
-            l_b = cur_b__1__q;
-            l_loaded = loaded__1__q;
-            l_received = received__1__q;
-        end
-        if (lb__q == c_buffer__2) begin
-            l_kind = cur_kind__2__q;
-            l_thread = cur_thread__2__q;
-            l_a = cur_a__2__q;
-            l_b = cur_b__2__q;
-            l_loaded = loaded__2__q;
-            l_received = received__2__q;
-        end
-        if (lb__q == c_buffer__3) begin
-            l_kind = cur_kind__3__q;
-            l_thread = cur_thread__3__q;
-            l_a = cur_a__3__q;
-            l_b = cur_b__3__q;
-            l_loaded = loaded__3__q;
-            l_received = received__3__q;
-        end
-        l_ready = l_loaded & ((l_kind != c_test_triangle) | (l_received == 32'hc));
         transform_unit__m__0 = words__0__read_data;
+        if (l_cached) begin
+            transform_unit__m__0 = cache_words__0__read_data;
+        end
         transform_unit__m__1 = words__1__read_data;
+        if (l_cached) begin
+            transform_unit__m__1 = cache_words__1__read_data;
+        end
         transform_unit__m__2 = words__2__read_data;
+        if (l_cached) begin
+            transform_unit__m__2 = cache_words__2__read_data;
+        end
         transform_unit__m__3 = words__3__read_data;
+        if (l_cached) begin
+            transform_unit__m__3 = cache_words__3__read_data;
+        end
         transform_unit__m__4 = words__4__read_data;
+        if (l_cached) begin
+            transform_unit__m__4 = cache_words__4__read_data;
+        end
         transform_unit__m__5 = words__5__read_data;
+        if (l_cached) begin
+            transform_unit__m__5 = cache_words__5__read_data;
+        end
         transform_unit__m__6 = words__6__read_data;
+        if (l_cached) begin
+            transform_unit__m__6 = cache_words__6__read_data;
+        end
         transform_unit__m__7 = words__7__read_data;
+        if (l_cached) begin
+            transform_unit__m__7 = cache_words__7__read_data;
+        end
         transform_unit__m__8 = words__8__read_data;
+        if (l_cached) begin
+            transform_unit__m__8 = cache_words__8__read_data;
+        end
         transform_unit__m__9 = words__9__read_data;
+        if (l_cached) begin
+            transform_unit__m__9 = cache_words__9__read_data;
+        end
         transform_unit__m__10 = words__10__read_data;
+        if (l_cached) begin
+            transform_unit__m__10 = cache_words__10__read_data;
+        end
         transform_unit__m__11 = words__11__read_data;
-        n_thread = cur_thread__0__q;
-        n_loaded = loaded__0__q;
-        n_kind = cur_kind__0__q;
-        n_received = received__0__q;
-        if (lb__q + 32'h1 == c_buffer__1) begin
-            n_thread = cur_thread__1__q;
-            n_loaded = loaded__1__q;
-            n_kind = cur_kind__1__q;
-            n_received = received__1__q;
+        if (l_cached) begin
+            transform_unit__m__11 = cache_words__11__read_data;
         end
-        if (lb__q + 32'h1 == c_buffer__2) begin
-            n_thread = cur_thread__2__q;
-            n_loaded = loaded__2__q;
-            n_kind = cur_kind__2__q;
-            n_received = received__2__q;
-        end
-        if (lb__q + 32'h1 == c_buffer__3) begin
-            n_thread = cur_thread__3__q;
-            n_loaded = loaded__3__q;
-            n_kind = cur_kind__3__q;
-            n_received = received__3__q;
-        end
-        n_ready = n_loaded & ((n_kind != c_test_triangle) | (n_received == 32'hc));
         ray__ray_thread = l_thread;
         ray__t_min_thread = l_thread;
         if (lphase__q == Launch__Direction) begin
@@ -24406,6 +24919,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         gen_out_dir__1 = transform_unit__result__1;
         gen_out_dir__2 = transform_unit__result__2;
         transform_busy = launching & (l_kind == c_test_triangle);
+        cache_hit = (lphase__q == Launch__Origin) & (l_kind == c_test_triangle) & l_cached;
+        cache_miss = (lphase__q == Launch__Origin) & (l_kind == c_test_triangle) & (~l_cached);
         o_hold__0__d = o_hold__0__q;
         if (transform_unit__out_valid & (~transform_unit__out_tag[32'hd]) & (~transform_unit__out_tag[32'he])) begin
             o_hold__0__d = transform_unit__result__0;
@@ -24573,6 +25088,605 @@ module dynrt_processor__engine__tester__best_e(read_address,read_clock,read_data
     end
                 
 endmodule // dynrt_processor__engine__tester__best_e
+
+
+
+
+module dynrt_processor__engine__tester__cache_tag(read_address,read_data,write_clock,write_address,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [8:0] read_address;
+    output reg  [24:0] read_data;
+    input wire  write_clock;
+    input wire  [8:0] write_address;
+    input wire  [24:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[24:0] mem[511:0];
+    
+    initial begin
+       mem[0] = 25'h0;
+       mem[1] = 25'h0;
+       mem[2] = 25'h0;
+       mem[3] = 25'h0;
+       mem[4] = 25'h0;
+       mem[5] = 25'h0;
+       mem[6] = 25'h0;
+       mem[7] = 25'h0;
+       mem[8] = 25'h0;
+       mem[9] = 25'h0;
+       mem[10] = 25'h0;
+       mem[11] = 25'h0;
+       mem[12] = 25'h0;
+       mem[13] = 25'h0;
+       mem[14] = 25'h0;
+       mem[15] = 25'h0;
+       mem[16] = 25'h0;
+       mem[17] = 25'h0;
+       mem[18] = 25'h0;
+       mem[19] = 25'h0;
+       mem[20] = 25'h0;
+       mem[21] = 25'h0;
+       mem[22] = 25'h0;
+       mem[23] = 25'h0;
+       mem[24] = 25'h0;
+       mem[25] = 25'h0;
+       mem[26] = 25'h0;
+       mem[27] = 25'h0;
+       mem[28] = 25'h0;
+       mem[29] = 25'h0;
+       mem[30] = 25'h0;
+       mem[31] = 25'h0;
+       mem[32] = 25'h0;
+       mem[33] = 25'h0;
+       mem[34] = 25'h0;
+       mem[35] = 25'h0;
+       mem[36] = 25'h0;
+       mem[37] = 25'h0;
+       mem[38] = 25'h0;
+       mem[39] = 25'h0;
+       mem[40] = 25'h0;
+       mem[41] = 25'h0;
+       mem[42] = 25'h0;
+       mem[43] = 25'h0;
+       mem[44] = 25'h0;
+       mem[45] = 25'h0;
+       mem[46] = 25'h0;
+       mem[47] = 25'h0;
+       mem[48] = 25'h0;
+       mem[49] = 25'h0;
+       mem[50] = 25'h0;
+       mem[51] = 25'h0;
+       mem[52] = 25'h0;
+       mem[53] = 25'h0;
+       mem[54] = 25'h0;
+       mem[55] = 25'h0;
+       mem[56] = 25'h0;
+       mem[57] = 25'h0;
+       mem[58] = 25'h0;
+       mem[59] = 25'h0;
+       mem[60] = 25'h0;
+       mem[61] = 25'h0;
+       mem[62] = 25'h0;
+       mem[63] = 25'h0;
+       mem[64] = 25'h0;
+       mem[65] = 25'h0;
+       mem[66] = 25'h0;
+       mem[67] = 25'h0;
+       mem[68] = 25'h0;
+       mem[69] = 25'h0;
+       mem[70] = 25'h0;
+       mem[71] = 25'h0;
+       mem[72] = 25'h0;
+       mem[73] = 25'h0;
+       mem[74] = 25'h0;
+       mem[75] = 25'h0;
+       mem[76] = 25'h0;
+       mem[77] = 25'h0;
+       mem[78] = 25'h0;
+       mem[79] = 25'h0;
+       mem[80] = 25'h0;
+       mem[81] = 25'h0;
+       mem[82] = 25'h0;
+       mem[83] = 25'h0;
+       mem[84] = 25'h0;
+       mem[85] = 25'h0;
+       mem[86] = 25'h0;
+       mem[87] = 25'h0;
+       mem[88] = 25'h0;
+       mem[89] = 25'h0;
+       mem[90] = 25'h0;
+       mem[91] = 25'h0;
+       mem[92] = 25'h0;
+       mem[93] = 25'h0;
+       mem[94] = 25'h0;
+       mem[95] = 25'h0;
+       mem[96] = 25'h0;
+       mem[97] = 25'h0;
+       mem[98] = 25'h0;
+       mem[99] = 25'h0;
+       mem[100] = 25'h0;
+       mem[101] = 25'h0;
+       mem[102] = 25'h0;
+       mem[103] = 25'h0;
+       mem[104] = 25'h0;
+       mem[105] = 25'h0;
+       mem[106] = 25'h0;
+       mem[107] = 25'h0;
+       mem[108] = 25'h0;
+       mem[109] = 25'h0;
+       mem[110] = 25'h0;
+       mem[111] = 25'h0;
+       mem[112] = 25'h0;
+       mem[113] = 25'h0;
+       mem[114] = 25'h0;
+       mem[115] = 25'h0;
+       mem[116] = 25'h0;
+       mem[117] = 25'h0;
+       mem[118] = 25'h0;
+       mem[119] = 25'h0;
+       mem[120] = 25'h0;
+       mem[121] = 25'h0;
+       mem[122] = 25'h0;
+       mem[123] = 25'h0;
+       mem[124] = 25'h0;
+       mem[125] = 25'h0;
+       mem[126] = 25'h0;
+       mem[127] = 25'h0;
+       mem[128] = 25'h0;
+       mem[129] = 25'h0;
+       mem[130] = 25'h0;
+       mem[131] = 25'h0;
+       mem[132] = 25'h0;
+       mem[133] = 25'h0;
+       mem[134] = 25'h0;
+       mem[135] = 25'h0;
+       mem[136] = 25'h0;
+       mem[137] = 25'h0;
+       mem[138] = 25'h0;
+       mem[139] = 25'h0;
+       mem[140] = 25'h0;
+       mem[141] = 25'h0;
+       mem[142] = 25'h0;
+       mem[143] = 25'h0;
+       mem[144] = 25'h0;
+       mem[145] = 25'h0;
+       mem[146] = 25'h0;
+       mem[147] = 25'h0;
+       mem[148] = 25'h0;
+       mem[149] = 25'h0;
+       mem[150] = 25'h0;
+       mem[151] = 25'h0;
+       mem[152] = 25'h0;
+       mem[153] = 25'h0;
+       mem[154] = 25'h0;
+       mem[155] = 25'h0;
+       mem[156] = 25'h0;
+       mem[157] = 25'h0;
+       mem[158] = 25'h0;
+       mem[159] = 25'h0;
+       mem[160] = 25'h0;
+       mem[161] = 25'h0;
+       mem[162] = 25'h0;
+       mem[163] = 25'h0;
+       mem[164] = 25'h0;
+       mem[165] = 25'h0;
+       mem[166] = 25'h0;
+       mem[167] = 25'h0;
+       mem[168] = 25'h0;
+       mem[169] = 25'h0;
+       mem[170] = 25'h0;
+       mem[171] = 25'h0;
+       mem[172] = 25'h0;
+       mem[173] = 25'h0;
+       mem[174] = 25'h0;
+       mem[175] = 25'h0;
+       mem[176] = 25'h0;
+       mem[177] = 25'h0;
+       mem[178] = 25'h0;
+       mem[179] = 25'h0;
+       mem[180] = 25'h0;
+       mem[181] = 25'h0;
+       mem[182] = 25'h0;
+       mem[183] = 25'h0;
+       mem[184] = 25'h0;
+       mem[185] = 25'h0;
+       mem[186] = 25'h0;
+       mem[187] = 25'h0;
+       mem[188] = 25'h0;
+       mem[189] = 25'h0;
+       mem[190] = 25'h0;
+       mem[191] = 25'h0;
+       mem[192] = 25'h0;
+       mem[193] = 25'h0;
+       mem[194] = 25'h0;
+       mem[195] = 25'h0;
+       mem[196] = 25'h0;
+       mem[197] = 25'h0;
+       mem[198] = 25'h0;
+       mem[199] = 25'h0;
+       mem[200] = 25'h0;
+       mem[201] = 25'h0;
+       mem[202] = 25'h0;
+       mem[203] = 25'h0;
+       mem[204] = 25'h0;
+       mem[205] = 25'h0;
+       mem[206] = 25'h0;
+       mem[207] = 25'h0;
+       mem[208] = 25'h0;
+       mem[209] = 25'h0;
+       mem[210] = 25'h0;
+       mem[211] = 25'h0;
+       mem[212] = 25'h0;
+       mem[213] = 25'h0;
+       mem[214] = 25'h0;
+       mem[215] = 25'h0;
+       mem[216] = 25'h0;
+       mem[217] = 25'h0;
+       mem[218] = 25'h0;
+       mem[219] = 25'h0;
+       mem[220] = 25'h0;
+       mem[221] = 25'h0;
+       mem[222] = 25'h0;
+       mem[223] = 25'h0;
+       mem[224] = 25'h0;
+       mem[225] = 25'h0;
+       mem[226] = 25'h0;
+       mem[227] = 25'h0;
+       mem[228] = 25'h0;
+       mem[229] = 25'h0;
+       mem[230] = 25'h0;
+       mem[231] = 25'h0;
+       mem[232] = 25'h0;
+       mem[233] = 25'h0;
+       mem[234] = 25'h0;
+       mem[235] = 25'h0;
+       mem[236] = 25'h0;
+       mem[237] = 25'h0;
+       mem[238] = 25'h0;
+       mem[239] = 25'h0;
+       mem[240] = 25'h0;
+       mem[241] = 25'h0;
+       mem[242] = 25'h0;
+       mem[243] = 25'h0;
+       mem[244] = 25'h0;
+       mem[245] = 25'h0;
+       mem[246] = 25'h0;
+       mem[247] = 25'h0;
+       mem[248] = 25'h0;
+       mem[249] = 25'h0;
+       mem[250] = 25'h0;
+       mem[251] = 25'h0;
+       mem[252] = 25'h0;
+       mem[253] = 25'h0;
+       mem[254] = 25'h0;
+       mem[255] = 25'h0;
+       mem[256] = 25'h0;
+       mem[257] = 25'h0;
+       mem[258] = 25'h0;
+       mem[259] = 25'h0;
+       mem[260] = 25'h0;
+       mem[261] = 25'h0;
+       mem[262] = 25'h0;
+       mem[263] = 25'h0;
+       mem[264] = 25'h0;
+       mem[265] = 25'h0;
+       mem[266] = 25'h0;
+       mem[267] = 25'h0;
+       mem[268] = 25'h0;
+       mem[269] = 25'h0;
+       mem[270] = 25'h0;
+       mem[271] = 25'h0;
+       mem[272] = 25'h0;
+       mem[273] = 25'h0;
+       mem[274] = 25'h0;
+       mem[275] = 25'h0;
+       mem[276] = 25'h0;
+       mem[277] = 25'h0;
+       mem[278] = 25'h0;
+       mem[279] = 25'h0;
+       mem[280] = 25'h0;
+       mem[281] = 25'h0;
+       mem[282] = 25'h0;
+       mem[283] = 25'h0;
+       mem[284] = 25'h0;
+       mem[285] = 25'h0;
+       mem[286] = 25'h0;
+       mem[287] = 25'h0;
+       mem[288] = 25'h0;
+       mem[289] = 25'h0;
+       mem[290] = 25'h0;
+       mem[291] = 25'h0;
+       mem[292] = 25'h0;
+       mem[293] = 25'h0;
+       mem[294] = 25'h0;
+       mem[295] = 25'h0;
+       mem[296] = 25'h0;
+       mem[297] = 25'h0;
+       mem[298] = 25'h0;
+       mem[299] = 25'h0;
+       mem[300] = 25'h0;
+       mem[301] = 25'h0;
+       mem[302] = 25'h0;
+       mem[303] = 25'h0;
+       mem[304] = 25'h0;
+       mem[305] = 25'h0;
+       mem[306] = 25'h0;
+       mem[307] = 25'h0;
+       mem[308] = 25'h0;
+       mem[309] = 25'h0;
+       mem[310] = 25'h0;
+       mem[311] = 25'h0;
+       mem[312] = 25'h0;
+       mem[313] = 25'h0;
+       mem[314] = 25'h0;
+       mem[315] = 25'h0;
+       mem[316] = 25'h0;
+       mem[317] = 25'h0;
+       mem[318] = 25'h0;
+       mem[319] = 25'h0;
+       mem[320] = 25'h0;
+       mem[321] = 25'h0;
+       mem[322] = 25'h0;
+       mem[323] = 25'h0;
+       mem[324] = 25'h0;
+       mem[325] = 25'h0;
+       mem[326] = 25'h0;
+       mem[327] = 25'h0;
+       mem[328] = 25'h0;
+       mem[329] = 25'h0;
+       mem[330] = 25'h0;
+       mem[331] = 25'h0;
+       mem[332] = 25'h0;
+       mem[333] = 25'h0;
+       mem[334] = 25'h0;
+       mem[335] = 25'h0;
+       mem[336] = 25'h0;
+       mem[337] = 25'h0;
+       mem[338] = 25'h0;
+       mem[339] = 25'h0;
+       mem[340] = 25'h0;
+       mem[341] = 25'h0;
+       mem[342] = 25'h0;
+       mem[343] = 25'h0;
+       mem[344] = 25'h0;
+       mem[345] = 25'h0;
+       mem[346] = 25'h0;
+       mem[347] = 25'h0;
+       mem[348] = 25'h0;
+       mem[349] = 25'h0;
+       mem[350] = 25'h0;
+       mem[351] = 25'h0;
+       mem[352] = 25'h0;
+       mem[353] = 25'h0;
+       mem[354] = 25'h0;
+       mem[355] = 25'h0;
+       mem[356] = 25'h0;
+       mem[357] = 25'h0;
+       mem[358] = 25'h0;
+       mem[359] = 25'h0;
+       mem[360] = 25'h0;
+       mem[361] = 25'h0;
+       mem[362] = 25'h0;
+       mem[363] = 25'h0;
+       mem[364] = 25'h0;
+       mem[365] = 25'h0;
+       mem[366] = 25'h0;
+       mem[367] = 25'h0;
+       mem[368] = 25'h0;
+       mem[369] = 25'h0;
+       mem[370] = 25'h0;
+       mem[371] = 25'h0;
+       mem[372] = 25'h0;
+       mem[373] = 25'h0;
+       mem[374] = 25'h0;
+       mem[375] = 25'h0;
+       mem[376] = 25'h0;
+       mem[377] = 25'h0;
+       mem[378] = 25'h0;
+       mem[379] = 25'h0;
+       mem[380] = 25'h0;
+       mem[381] = 25'h0;
+       mem[382] = 25'h0;
+       mem[383] = 25'h0;
+       mem[384] = 25'h0;
+       mem[385] = 25'h0;
+       mem[386] = 25'h0;
+       mem[387] = 25'h0;
+       mem[388] = 25'h0;
+       mem[389] = 25'h0;
+       mem[390] = 25'h0;
+       mem[391] = 25'h0;
+       mem[392] = 25'h0;
+       mem[393] = 25'h0;
+       mem[394] = 25'h0;
+       mem[395] = 25'h0;
+       mem[396] = 25'h0;
+       mem[397] = 25'h0;
+       mem[398] = 25'h0;
+       mem[399] = 25'h0;
+       mem[400] = 25'h0;
+       mem[401] = 25'h0;
+       mem[402] = 25'h0;
+       mem[403] = 25'h0;
+       mem[404] = 25'h0;
+       mem[405] = 25'h0;
+       mem[406] = 25'h0;
+       mem[407] = 25'h0;
+       mem[408] = 25'h0;
+       mem[409] = 25'h0;
+       mem[410] = 25'h0;
+       mem[411] = 25'h0;
+       mem[412] = 25'h0;
+       mem[413] = 25'h0;
+       mem[414] = 25'h0;
+       mem[415] = 25'h0;
+       mem[416] = 25'h0;
+       mem[417] = 25'h0;
+       mem[418] = 25'h0;
+       mem[419] = 25'h0;
+       mem[420] = 25'h0;
+       mem[421] = 25'h0;
+       mem[422] = 25'h0;
+       mem[423] = 25'h0;
+       mem[424] = 25'h0;
+       mem[425] = 25'h0;
+       mem[426] = 25'h0;
+       mem[427] = 25'h0;
+       mem[428] = 25'h0;
+       mem[429] = 25'h0;
+       mem[430] = 25'h0;
+       mem[431] = 25'h0;
+       mem[432] = 25'h0;
+       mem[433] = 25'h0;
+       mem[434] = 25'h0;
+       mem[435] = 25'h0;
+       mem[436] = 25'h0;
+       mem[437] = 25'h0;
+       mem[438] = 25'h0;
+       mem[439] = 25'h0;
+       mem[440] = 25'h0;
+       mem[441] = 25'h0;
+       mem[442] = 25'h0;
+       mem[443] = 25'h0;
+       mem[444] = 25'h0;
+       mem[445] = 25'h0;
+       mem[446] = 25'h0;
+       mem[447] = 25'h0;
+       mem[448] = 25'h0;
+       mem[449] = 25'h0;
+       mem[450] = 25'h0;
+       mem[451] = 25'h0;
+       mem[452] = 25'h0;
+       mem[453] = 25'h0;
+       mem[454] = 25'h0;
+       mem[455] = 25'h0;
+       mem[456] = 25'h0;
+       mem[457] = 25'h0;
+       mem[458] = 25'h0;
+       mem[459] = 25'h0;
+       mem[460] = 25'h0;
+       mem[461] = 25'h0;
+       mem[462] = 25'h0;
+       mem[463] = 25'h0;
+       mem[464] = 25'h0;
+       mem[465] = 25'h0;
+       mem[466] = 25'h0;
+       mem[467] = 25'h0;
+       mem[468] = 25'h0;
+       mem[469] = 25'h0;
+       mem[470] = 25'h0;
+       mem[471] = 25'h0;
+       mem[472] = 25'h0;
+       mem[473] = 25'h0;
+       mem[474] = 25'h0;
+       mem[475] = 25'h0;
+       mem[476] = 25'h0;
+       mem[477] = 25'h0;
+       mem[478] = 25'h0;
+       mem[479] = 25'h0;
+       mem[480] = 25'h0;
+       mem[481] = 25'h0;
+       mem[482] = 25'h0;
+       mem[483] = 25'h0;
+       mem[484] = 25'h0;
+       mem[485] = 25'h0;
+       mem[486] = 25'h0;
+       mem[487] = 25'h0;
+       mem[488] = 25'h0;
+       mem[489] = 25'h0;
+       mem[490] = 25'h0;
+       mem[491] = 25'h0;
+       mem[492] = 25'h0;
+       mem[493] = 25'h0;
+       mem[494] = 25'h0;
+       mem[495] = 25'h0;
+       mem[496] = 25'h0;
+       mem[497] = 25'h0;
+       mem[498] = 25'h0;
+       mem[499] = 25'h0;
+       mem[500] = 25'h0;
+       mem[501] = 25'h0;
+       mem[502] = 25'h0;
+       mem[503] = 25'h0;
+       mem[504] = 25'h0;
+       mem[505] = 25'h0;
+       mem[506] = 25'h0;
+       mem[507] = 25'h0;
+       mem[508] = 25'h0;
+       mem[509] = 25'h0;
+       mem[510] = 25'h0;
+       mem[511] = 25'h0;
+    end
+    
+    always @(*) begin
+       read_data = mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+endmodule // dynrt_processor__engine__tester__cache_tag
+
+
+module dynrt_processor__engine__tester__cache_words__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [8:0] read_address;
+    input wire  read_clock;
+    output reg  [23:0] read_data;
+    input wire  [8:0] write_address;
+    input wire  write_clock;
+    input wire  [23:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[23:0] mem[511:0];
+    
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__tester__cache_words__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -28136,57 +29250,57 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .q(of_walk__q),
         .clock(of_walk__clock)
     );
-    dynrt_processor__engine__cycle_count object_id(
+    dynrt_processor__engine__cache_hit_count object_id(
         .d(object_id__d),
         .q(object_id__q),
         .clock(object_id__clock)
     );
-    dynrt_processor__engine__cycle_count skip_object(
+    dynrt_processor__engine__cache_hit_count skip_object(
         .d(skip_object__d),
         .q(skip_object__q),
         .clock(skip_object__clock)
     );
-    dynrt_processor__engine__cycle_count skip_triangle(
+    dynrt_processor__engine__cache_hit_count skip_triangle(
         .d(skip_triangle__d),
         .q(skip_triangle__q),
         .clock(skip_triangle__clock)
     );
-    dynrt_processor__engine__cycle_count ids__0(
+    dynrt_processor__engine__cache_hit_count ids__0(
         .d(ids__0__d),
         .q(ids__0__q),
         .clock(ids__0__clock)
     );
-    dynrt_processor__engine__cycle_count ids__1(
+    dynrt_processor__engine__cache_hit_count ids__1(
         .d(ids__1__d),
         .q(ids__1__q),
         .clock(ids__1__clock)
     );
-    dynrt_processor__engine__cycle_count ids__2(
+    dynrt_processor__engine__cache_hit_count ids__2(
         .d(ids__2__d),
         .q(ids__2__q),
         .clock(ids__2__clock)
     );
-    dynrt_processor__engine__cycle_count ids__3(
+    dynrt_processor__engine__cache_hit_count ids__3(
         .d(ids__3__d),
         .q(ids__3__q),
         .clock(ids__3__clock)
     );
-    dynrt_processor__engine__cycle_count ids__4(
+    dynrt_processor__engine__cache_hit_count ids__4(
         .d(ids__4__d),
         .q(ids__4__q),
         .clock(ids__4__clock)
     );
-    dynrt_processor__engine__cycle_count ids__5(
+    dynrt_processor__engine__cache_hit_count ids__5(
         .d(ids__5__d),
         .q(ids__5__q),
         .clock(ids__5__clock)
     );
-    dynrt_processor__engine__cycle_count ids__6(
+    dynrt_processor__engine__cache_hit_count ids__6(
         .d(ids__6__d),
         .q(ids__6__q),
         .clock(ids__6__clock)
     );
-    dynrt_processor__engine__cycle_count ids__7(
+    dynrt_processor__engine__cache_hit_count ids__7(
         .d(ids__7__d),
         .q(ids__7__q),
         .clock(ids__7__clock)
@@ -28296,7 +29410,7 @@ module dynrt_processor__engine__tester__list_unit(clock,enqueue,kind,thread,word
         .q(arrive_r__q),
         .clock(arrive_r__clock)
     );
-    dynrt_processor__engine__cycle_count word_r(
+    dynrt_processor__engine__cache_hit_count word_r(
         .d(word_r__d),
         .q(word_r__q),
         .clock(word_r__clock)
@@ -32817,6 +33931,10 @@ endmodule // dynrt_processor__engine__tester__words__0
 
 
 
+
+
+
+
 module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,t_min_write,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2,nodes__read,nodes__addr,nodes__rdata,step_busy,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit,engine_next,world_write,world_pair,enter,entered,root_write,root_thread,root,top_from,top_to);
     
     // Module arguments
@@ -33670,12 +34788,12 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f1_thread__q),
         .clock(f1_thread__clock)
     );
-    dynrt_processor__engine__cycle_count f1_a(
+    dynrt_processor__engine__cache_hit_count f1_a(
         .d(f1_a__d),
         .q(f1_a__q),
         .clock(f1_a__clock)
     );
-    dynrt_processor__engine__cycle_count f1_b(
+    dynrt_processor__engine__cache_hit_count f1_b(
         .d(f1_b__d),
         .q(f1_b__q),
         .clock(f1_b__clock)
@@ -33700,12 +34818,12 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f2_thread__q),
         .clock(f2_thread__clock)
     );
-    dynrt_processor__engine__cycle_count f2_a(
+    dynrt_processor__engine__cache_hit_count f2_a(
         .d(f2_a__d),
         .q(f2_a__q),
         .clock(f2_a__clock)
     );
-    dynrt_processor__engine__cycle_count f2_b(
+    dynrt_processor__engine__cache_hit_count f2_b(
         .d(f2_b__d),
         .q(f2_b__q),
         .clock(f2_b__clock)
@@ -33730,12 +34848,12 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f3_thread__q),
         .clock(f3_thread__clock)
     );
-    dynrt_processor__engine__cycle_count f3_a(
+    dynrt_processor__engine__cache_hit_count f3_a(
         .d(f3_a__d),
         .q(f3_a__q),
         .clock(f3_a__clock)
     );
-    dynrt_processor__engine__cycle_count f3_b(
+    dynrt_processor__engine__cache_hit_count f3_b(
         .d(f3_b__d),
         .q(f3_b__q),
         .clock(f3_b__clock)
@@ -33770,12 +34888,12 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f4_thread__q),
         .clock(f4_thread__clock)
     );
-    dynrt_processor__engine__cycle_count f4_a(
+    dynrt_processor__engine__cache_hit_count f4_a(
         .d(f4_a__d),
         .q(f4_a__q),
         .clock(f4_a__clock)
     );
-    dynrt_processor__engine__cycle_count f4_b(
+    dynrt_processor__engine__cache_hit_count f4_b(
         .d(f4_b__d),
         .q(f4_b__q),
         .clock(f4_b__clock)
@@ -33825,12 +34943,12 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f5_thread__q),
         .clock(f5_thread__clock)
     );
-    dynrt_processor__engine__cycle_count f5_a(
+    dynrt_processor__engine__cache_hit_count f5_a(
         .d(f5_a__d),
         .q(f5_a__q),
         .clock(f5_a__clock)
     );
-    dynrt_processor__engine__cycle_count f5_b(
+    dynrt_processor__engine__cache_hit_count f5_b(
         .d(f5_b__d),
         .q(f5_b__q),
         .clock(f5_b__clock)
@@ -33914,12 +35032,12 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(words_in__q),
         .clock(words_in__clock)
     );
-    dynrt_processor__engine__cycle_count w0(
+    dynrt_processor__engine__cache_hit_count w0(
         .d(w0__d),
         .q(w0__q),
         .clock(w0__clock)
     );
-    dynrt_processor__engine__cycle_count w1(
+    dynrt_processor__engine__cache_hit_count w1(
         .d(w1__d),
         .q(w1__q),
         .clock(w1__clock)
@@ -36900,7 +38018,7 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
         .q(write_r__q),
         .clock(write_r__clock)
     );
-    dynrt_processor__engine__cycle_count data_r(
+    dynrt_processor__engine__cache_hit_count data_r(
         .d(data_r__d),
         .q(data_r__q),
         .clock(data_r__clock)

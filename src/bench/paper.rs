@@ -575,10 +575,7 @@ fn simulate(
     if let Some((w, h)) = resolution {
         scene.set_resolution(w, h)?;
     }
-    let params = ProcessorParams {
-        threads: 32,
-        mem_latency: 2,
-    };
+    let params = ProcessorParams::default();
     let f = crate::fp::Format::E7M16;
     if let Err(e) = crate::flow::preflight(&scene, f, params, Some(1)) {
         return Ok((Sim::NotRun(format!("{e:#}")), None));

@@ -27,6 +27,10 @@ pub struct RtlArgs {
     /// SRAM read latency in clocks (1..=6).
     #[arg(long, default_value_t = 2)]
     pub mem_latency: u32,
+    /// Sets of the triangle cache in front of banks 2 and 3 (a power of two up to 512, the
+    /// paper's 512 items; 0 for none).
+    #[arg(long, value_name = "SETS", default_value_t = 512)]
+    pub tri_cache: u32,
     /// Frames of an animated scene (default: all).
     #[arg(long)]
     pub frames: Option<u32>,
@@ -155,6 +159,7 @@ fn setup(a: &RtlArgs) -> anyhow::Result<(dynrt::scene::Scene, String, ProcessorP
     let params = ProcessorParams {
         threads: a.threads,
         mem_latency: a.mem_latency,
+        tri_cache_sets: a.tri_cache,
     };
     flow::preflight(&scene, a.format, params, a.frames)?;
     let name = a
@@ -172,6 +177,7 @@ fn summary(verb: &str, a: &RtlArgs, scene: &dynrt::scene::Scene, name: &str) -> 
     s.option("format", a.format.to_string())
         .option("threads", a.threads)
         .option("mem_latency", a.mem_latency)
+        .option("tri_cache", a.tri_cache)
         .option("frames", a.frames)
         .option("width", scene.camera.width)
         .option("height", scene.camera.height)
@@ -378,6 +384,19 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
                  share a port); {:.2} GB/s at {mhz:.1} MHz with the frame buffer's writes",
                 banks.join(", "),
                 f.memory_bytes_per_second_at(mhz * 1e6) / 1e9
+            )
+        },
+        {
+            let f = &r.frames[0];
+            let tests = f.tri_cache_hits + f.tri_cache_misses;
+            format!(
+                "triangle cache (frame 0): {} sets, {} of {} triangle tests hit ({:.1}%), {} \
+                 read banks 2 and 3",
+                a.rtl.tri_cache,
+                f.tri_cache_hits,
+                tests,
+                100.0 * f.tri_cache_hits as f64 / tests.max(1) as f64,
+                f.tri_cache_misses
             )
         },
         format!("engine issue slots by routine: {}", shares.join(", ")),

@@ -44,6 +44,10 @@ pub struct TimingArgs {
     /// SRAM read latency of the processor in clocks (1..=6).
     #[arg(long, default_value_t = 2)]
     pub mem_latency: u32,
+    /// Sets of the triangle cache in front of banks 2 and 3 (a power of two up to 512, the
+    /// paper's 512 items; 0 for none).
+    #[arg(long, value_name = "SETS", default_value_t = 512)]
+    pub tri_cache: u32,
     /// Report directory: timing.md, timing.csv and a folder per design.
     #[arg(long, default_value = "out/timing")]
     pub out: PathBuf,
@@ -151,6 +155,7 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
     let params = ProcessorParams {
         threads: a.threads,
         mem_latency: a.mem_latency,
+        tri_cache_sets: a.tri_cache,
     };
     let mut designs = Vec::new();
     for u in &a.unit {

@@ -8,8 +8,8 @@
 //! `bank0_read, bank0_addr[23:0], bank0_rdata[31:0]` (the kd nodes, read by the traversal
 //! unit) and the same for banks 2 and 3 (the triangles, which the triangle tester reads in
 //! parallel), `transform_busy[31:0], intersect_busy[31:0], traversal_busy[31:0],
-//! raygen_busy[31:0], instance_busy[31:0], shading_busy[31:0]` (activity counters of the
-//! frame), and the `vga_`
+//! raygen_busy[31:0], instance_busy[31:0], shading_busy[31:0], tri_cache_hits[31:0],
+//! tri_cache_misses[31:0]` (activity counters of the frame), and the `vga_`
 //! display ports.
 //!
 //! [`processor_testbench`] writes module `tb` for Icarus (`iverilog -g2012`) and Verilator 5
@@ -21,7 +21,7 @@
 //! `TIMEOUT` and a non-zero exit), and the frame buffer written to `frame<k>.hex` (one
 //! `RRGGBB` word a line) with `cycles instructions transform_busy intersect_busy
 //! traversal_busy raygen_busy instance_busy shading_busy ready_clocks asleep_clocks reads0 ..
-//! reads5` (`ready_clocks`, `asleep_clocks` are thread-clocks: the bits of the scheduler's
+//! reads5 tri_cache_hits tri_cache_misses` (`ready_clocks`, `asleep_clocks` are thread-clocks: the bits of the scheduler's
 //! `ready` and `asleep` masks added up every clock; `reads<b>` the words read from bank b) in
 //! `frame<k>.stats`, in the current
 //! folder or
@@ -92,6 +92,7 @@ fn processor_verilog<
         program,
         params.threads,
         params.mem_latency,
+        params.tri_cache_sets,
         mode,
     )?;
     uut.connect_all();
@@ -119,6 +120,9 @@ pub struct ProcessorParams {
     pub threads: u32,
     /// SRAM read latency in clocks (1..=6).
     pub mem_latency: u32,
+    /// Sets of the triangle cache (a power of two up to
+    /// [`MAX_CACHE_SETS`](crate::hw::triangle_tester::MAX_CACHE_SETS); 0: none).
+    pub tri_cache_sets: u32,
 }
 
 impl Default for ProcessorParams {
@@ -126,6 +130,7 @@ impl Default for ProcessorParams {
         ProcessorParams {
             threads: 32,
             mem_latency: 2,
+            tri_cache_sets: crate::hw::triangle_tester::MAX_CACHE_SETS,
         }
     }
 }
@@ -277,7 +282,7 @@ const TESTBENCH_DRIVES: [(&str, &str); 5] = [
 ];
 
 /// The ports the testbench's memory model and frame loop use by name.
-const TESTBENCH_USES: [&str; 26] = [
+const TESTBENCH_USES: [&str; 28] = [
     "done",
     "cycles",
     "instructions",
@@ -303,6 +308,8 @@ const TESTBENCH_USES: [&str; 26] = [
     "raygen_busy",
     "instance_busy",
     "shading_busy",
+    "tri_cache_hits",
+    "tri_cache_misses",
     "vga_fb_addr",
 ];
 
@@ -516,10 +523,10 @@ pub fn processor_testbench(
              \x20   fd = $fopen({{out_dir, \"/frame{fr}.hex\"}}, \"w\");\n\
              \x20   for (k = 0; k < {px}; k = k + 1) $fwrite(fd, \"%06h\\n\", bank5[{fb} + k][23:0]);\n\
              \x20   $fclose(fd);\n    fd = $fopen({{out_dir, \"/frame{fr}.stats\"}}, \"w\");\n\
-             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\\n\",\n\
+             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\\n\",\n\
              \x20     cycles, instructions, transform_busy, intersect_busy, traversal_busy, raygen_busy,\n\
              \x20     instance_busy, shading_busy, ready_clocks, asleep_clocks,\n\
-             \x20     reads0, reads1, reads2, reads3, reads4, reads5);\n    $fclose(fd);\n\
+             \x20     reads0, reads1, reads2, reads3, reads4, reads5, tri_cache_hits, tri_cache_misses);\n    $fclose(fd);\n\
              \x20   $display(\"frame {fr}: %0d cycles, %0d instructions\", cycles, instructions);",
             limit = frames.cycle_limit,
             px = frames.pixels,

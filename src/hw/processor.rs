@@ -9,7 +9,9 @@
 //! buffer (bank 5); `transform_busy`, `intersect_busy`, `traversal_busy` count the frame's
 //! clocks in which those units took work (the TransformUnit's triangle tests), `raygen_busy`,
 //! `instance_busy` and `shading_busy` the clocks in which ray generation's, instance entry's
-//! and shading's (world normals) requests took the TransformUnit. In the pixel clock (`vga.clock`): the display reads
+//! and shading's (world normals) requests took the TransformUnit; `tri_cache_hits` and
+//! `tri_cache_misses` the triangle tests whose words came from the triangle cache and from
+//! the banks. In the pixel clock (`vga.clock`): the display reads
 //! the frame buffer and drives the monitor. The Verilog names a bundle's port
 //! `<bundle>_<port>` (`mem_read`, `vga_hsync`): `Processor::ports` lists them, and the
 //! constraints and testbench are written from that list.
@@ -58,6 +60,8 @@ pub struct Processor<
     pub raygen_busy: Signal<Out, Bits<32>>,
     pub instance_busy: Signal<Out, Bits<32>>,
     pub shading_busy: Signal<Out, Bits<32>>,
+    pub tri_cache_hits: Signal<Out, Bits<32>>,
+    pub tri_cache_misses: Signal<Out, Bits<32>>,
     pub vga: VgaPort,
     engine: ThreadEngine<W, E, M, S, S1, X2, T, P, DX, DL>,
     display: VgaDisplay,
@@ -88,13 +92,14 @@ impl<
         const DL: usize,
     > Processor<W, E, M, S, S1, X2, T, P, DX, DL>
 {
-    /// The processor running `program` with `threads` threads and SRAM latency
-    /// `mem_latency`, showing a `width x height` frame from word `frame_buffer` of bank 5 in
+    /// The processor running `program` with `threads` threads, SRAM latency `mem_latency`
+    /// and a triangle cache of `tri_cache_sets` sets (0: none), showing a `width x height` frame from word `frame_buffer` of bank 5 in
     /// `mode`.
     pub fn new(
         program: &Program,
         threads: u32,
         mem_latency: u32,
+        tri_cache_sets: u32,
         mode: &VgaMode,
     ) -> Result<Self, VgaError> {
         let c = &program.config;
@@ -115,8 +120,10 @@ impl<
             raygen_busy: Default::default(),
             instance_busy: Default::default(),
             shading_busy: Default::default(),
+            tri_cache_hits: Default::default(),
+            tri_cache_misses: Default::default(),
             vga: Default::default(),
-            engine: ThreadEngine::new(program, threads, mem_latency),
+            engine: ThreadEngine::new(program, threads, mem_latency, tri_cache_sets),
             display: VgaDisplay::new(mode, c.width, c.height, c.frame_buffer)?,
         })
     }
@@ -204,6 +211,8 @@ impl<
         self.raygen_busy.next = self.engine.raygen_busy.val();
         self.instance_busy.next = self.engine.instance_busy.val();
         self.shading_busy.next = self.engine.shading_busy.val();
+        self.tri_cache_hits.next = self.engine.tri_cache_hits.val();
+        self.tri_cache_misses.next = self.engine.tri_cache_misses.val();
 
         self.display.clock.next = self.vga.clock.val();
         self.display.reset.next = self.vga.reset.val();

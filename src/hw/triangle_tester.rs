@@ -97,6 +97,10 @@ pub const CLOCKS_PER_TEST: u32 = 6;
 // `layout::TRANSFORM_BANK_WORDS`); word k of every buffer is in `words[k]`, addressed by
 // the buffer.
 
+/// Most sets of the triangle cache (the paper's 512 items): its RAMs are this deep, a
+/// smaller cache uses the first sets.
+pub const MAX_CACHE_SETS: u32 = 512;
+
 /// Entry buffers between the take and the launch (a ring: `tb`, `fb` and `lb` count modulo 4).
 pub const TEST_BUFFERS: usize = 4;
 
@@ -147,6 +151,10 @@ pub struct TriangleTester<
     /// input.
     pub transform_busy: Signal<Out, Bit>,
     pub intersect_busy: Signal<Out, Bit>,
+    /// A triangle test launches with its words from the triangle cache (`cache_hit`) or from
+    /// banks 2 and 3 (`cache_miss`) this clock.
+    pub cache_hit: Signal<Out, Bit>,
+    pub cache_miss: Signal<Out, Bit>,
     /// The other clients' port on the TransformUnit (ray generation, instance entry): a
     /// request (`gen_valid`, the matrix `gen_m`, the point or vector `gen_v`, `gen_point`,
     /// `gen_thread` and the `gen_client` bits the requester chooses) is taken (`gen_take`) into
@@ -227,6 +235,28 @@ pub struct TriangleTester<
     fetch_ends: Signal<Local, Bit>,
     /// Buffer `tb` is free; `take`: it takes the queue's head this clock.
     tb_free: Signal<Local, Bit>,
+    // The triangle cache (see "Triangle cache" above).
+    /// Per set: `{valid[24], triangle[23:0]}`.
+    cache_tag: LutRam<Bits<25>, 9>,
+    /// Word k of each set's triangle.
+    cache_words: [RAM<Bits<W>, 9>; 12],
+    /// The buffer's triangle is in the cache (decided at the take; its set is not written
+    /// until it launches).
+    cached: [DFF<Bit>; TEST_BUFFERS],
+    head_triangle: Signal<Local, Bits<24>>,
+    head_set: Signal<Local, Bits<9>>,
+    head_hit: Signal<Local, Bit>,
+    l_cached: Signal<Local, Bit>,
+    l_set: Signal<Local, Bits<9>>,
+    n_cached: Signal<Local, Bit>,
+    n_set: Signal<Local, Bits<9>>,
+    /// The launch writes its triangle's words into the cache this clock (`cache_block`: a
+    /// buffered triangle reads that set).
+    cache_write: Signal<Local, Bit>,
+    cache_block: Signal<Local, Bit>,
+    c_set_mask: Constant<Bits<9>>,
+    c_cache_on: Constant<Bit>,
+    c_tag_valid: Constant<Bits<25>>,
     take: Signal<Local, Bit>,
     /// The entry taken is a triangle.
     take_triangle: Signal<Local, Bit>,
@@ -366,8 +396,14 @@ impl<
     > TriangleTester<W, E, M, S, S1, X2, T, P, DL>
 {
     /// The tester for SRAM read latency `mem_latency` (1..=6).
-    pub fn new(mem_latency: u32) -> Self {
+    /// With a triangle cache of `cache_sets` sets (a power of two up to [`MAX_CACHE_SETS`],
+    /// 0 for none).
+    pub fn new(mem_latency: u32, cache_sets: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
+        assert!(
+            cache_sets == 0 || (cache_sets.is_power_of_two() && cache_sets <= MAX_CACHE_SETS),
+            "cache sets {cache_sets}"
+        );
         let f = Format::new(E as u32, M as u32).expect("a supported format");
         assert!(flight_slots_suffice(f), "{f}: too few in-flight slots");
         Self {
@@ -392,6 +428,8 @@ impl<
             walk_end_hit: Default::default(),
             transform_busy: Default::default(),
             intersect_busy: Default::default(),
+            cache_hit: Default::default(),
+            cache_miss: Default::default(),
             gen_valid: Default::default(),
             gen_m: Default::default(),
             gen_v: Default::default(),
@@ -448,6 +486,21 @@ impl<
             fetch_a: Default::default(),
             fetch_ends: Default::default(),
             tb_free: Default::default(),
+            cache_tag: LutRam::new(Default::default()),
+            cache_words: Default::default(),
+            cached: Default::default(),
+            head_triangle: Default::default(),
+            head_set: Default::default(),
+            head_hit: Default::default(),
+            l_cached: Default::default(),
+            l_set: Default::default(),
+            n_cached: Default::default(),
+            n_set: Default::default(),
+            cache_write: Default::default(),
+            cache_block: Default::default(),
+            c_set_mask: Constant::new(u64::from(cache_sets.max(1) - 1).into()),
+            c_cache_on: Constant::new(cache_sets > 0),
+            c_tag_valid: Constant::new((1u64 << 24).into()),
             take: Default::default(),
             take_triangle: Default::default(),
             fetch_moves: Default::default(),
@@ -636,7 +689,14 @@ impl<
             self.words[k].write_enable.next = false;
             self.words[k].read_address.next = self.lb.q.val();
         }
+        self.cache_tag.write_clock.next = self.clock.val();
+        for k in 0..12 {
+            self.cache_words[k].read_clock.next = self.clock.val();
+            self.cache_words[k].write_clock.next = self.clock.val();
+        }
         for k in 0..4 {
+            self.cached[k].clock.next = self.clock.val();
+            self.cached[k].d.next = self.cached[k].q.val();
             self.loaded[k].clock.next = self.clock.val();
             self.loaded[k].d.next = self.loaded[k].q.val();
             self.unvisited[k].clock.next = self.clock.val();
@@ -716,6 +776,99 @@ impl<
             & ((self.queue_kind.val() == self.c_cmd_list.val())
                 | (self.queue_kind.val() == self.c_cmd_init.val()));
 
+        // The launch's buffer `lb` and the one after it (read here: the cache's write, which
+        // the take must see, hangs on them).
+        self.l_kind.next = self.cur_kind[0].q.val();
+        self.l_thread.next = self.cur_thread[0].q.val();
+        self.l_a.next = self.cur_a[0].q.val();
+        self.l_b.next = self.cur_b[0].q.val();
+        // A buffer's word count is cleared as the launch frees it, not at the take: the
+        // take, in the clock of the fetch's last requests, was the critical path through the
+        // count (stops 33 and 38, `b_issued -> received`).
+        self.l_loaded.next = self.loaded[0].q.val();
+        self.l_received.next = self.received[0].q.val();
+        self.l_cached.next = self.cached[0].q.val();
+        for k in 1..4 {
+            if self.lb.q.val() == self.c_buffer[k].val() {
+                self.l_kind.next = self.cur_kind[k].q.val();
+                self.l_thread.next = self.cur_thread[k].q.val();
+                self.l_a.next = self.cur_a[k].q.val();
+                self.l_b.next = self.cur_b[k].q.val();
+                self.l_loaded.next = self.loaded[k].q.val();
+                self.l_received.next = self.received[k].q.val();
+                self.l_cached.next = self.cached[k].q.val();
+            }
+        }
+        self.l_ready.next = self.l_loaded.val()
+            & ((self.l_kind.val() != self.c_test_triangle.val())
+                | (self.l_received.val() == 12)
+                | self.l_cached.val());
+        // The buffer after `lb`, which may launch right after `lb`'s direction.
+        self.n_thread.next = self.cur_thread[0].q.val();
+        self.n_loaded.next = self.loaded[0].q.val();
+        self.n_kind.next = self.cur_kind[0].q.val();
+        self.n_received.next = self.received[0].q.val();
+        self.n_cached.next = self.cached[0].q.val();
+        self.n_set.next = self.cur_a[0].q.val().get_bits::<9>(0) & self.c_set_mask.val();
+        for k in 1..4 {
+            if self.lb.q.val() + 1 == self.c_buffer[k].val() {
+                self.n_thread.next = self.cur_thread[k].q.val();
+                self.n_loaded.next = self.loaded[k].q.val();
+                self.n_kind.next = self.cur_kind[k].q.val();
+                self.n_received.next = self.received[k].q.val();
+                self.n_cached.next = self.cached[k].q.val();
+                self.n_set.next = self.cur_a[k].q.val().get_bits::<9>(0) & self.c_set_mask.val();
+            }
+        }
+        self.n_ready.next = self.n_loaded.val()
+            & ((self.n_kind.val() != self.c_test_triangle.val())
+                | (self.n_received.val() == 12)
+                | self.n_cached.val());
+
+        // Triangle cache: a launched triangle that came from the banks is written into its
+        // set with its words (read from its buffer for the launch), unless a buffered
+        // triangle found in the cache reads that set (it keeps its words until it launches);
+        // the queue's head is looked up as the free buffer copies it, and a set written in
+        // that clock counts as a miss.
+        self.l_set.next = self.l_a.val().get_bits::<9>(0) & self.c_set_mask.val();
+        self.cache_block.next = false;
+        for k in 0..4 {
+            if self.loaded[k].q.val()
+                & self.cached[k].q.val()
+                & ((self.cur_a[k].q.val().get_bits::<9>(0) & self.c_set_mask.val())
+                    == self.l_set.val())
+            {
+                self.cache_block.next = true;
+            }
+        }
+        self.cache_write.next = self.c_cache_on.val()
+            & (self.lphase.q.val() == Launch::Origin)
+            & (self.l_kind.val() == self.c_test_triangle.val())
+            & (!self.l_cached.val())
+            & (!self.cache_block.val());
+        self.cache_tag.write_address.next = self.l_set.val();
+        self.cache_tag.write_data.next =
+            self.c_tag_valid.val() | bit_cast::<25, 24>(self.l_a.val().get_bits::<24>(0));
+        self.cache_tag.write_enable.next = self.cache_write.val();
+        // The words answer a clock after their set: the launch's while it waits and launches
+        // its origin, the next buffer's while it launches its direction (as the ray store).
+        for k in 0..12 {
+            self.cache_words[k].write_address.next = self.l_set.val();
+            self.cache_words[k].write_data.next = self.words[k].read_data.val();
+            self.cache_words[k].write_enable.next = self.cache_write.val();
+            self.cache_words[k].read_address.next = self.l_set.val();
+            if self.lphase.q.val() == Launch::Direction {
+                self.cache_words[k].read_address.next = self.n_set.val();
+            }
+        }
+        self.head_triangle.next = self.list_unit.test_entry.val().get_bits::<24>(32);
+        self.head_set.next = self.head_triangle.val().get_bits::<9>(0) & self.c_set_mask.val();
+        self.cache_tag.read_address.next = self.head_set.val();
+        self.head_hit.next = self.c_cache_on.val()
+            & (self.cache_tag.read_data.val()
+                == (self.c_tag_valid.val() | bit_cast::<25, 24>(self.head_triangle.val())))
+            & (!(self.cache_write.val() & (self.l_set.val() == self.head_set.val())));
+
         // Take: the list unit's next entry into buffer `tb` whenever it is free, apart from the
         // fetch. (Taken in the clock of the fetch's last requests, the take waited on the bank
         // grants, and from them through the list unit's pop to its queue's read was the
@@ -749,6 +902,9 @@ impl<
                 self.cur_thread[k].d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
                 self.cur_a[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(32);
                 self.cur_b[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(0);
+                self.cached[k].d.next = self.head_hit.val()
+                    & (self.list_unit.test_entry.val().get_bits::<2>(69)
+                        == self.c_test_triangle.val());
             }
         }
 
@@ -806,7 +962,8 @@ impl<
             if (self.fb.q.val() == self.c_buffer[k].val())
                 & (!self.fetching.q.val())
                 & self.unvisited[k].q.val()
-                & (self.cur_kind[k].q.val() != self.c_test_triangle.val())
+                & ((self.cur_kind[k].q.val() != self.c_test_triangle.val())
+                    | self.cached[k].q.val())
             {
                 self.fetch_moves.next = true;
             }
@@ -825,12 +982,14 @@ impl<
         }
         // A triangle taken this clock into the buffer the fetch is at next is fetched from
         // the next clock, as one taken before.
-        self.next_triangle.next =
-            self.take_triangle.val() & (self.tb.q.val() == self.fetch_next.val());
+        self.next_triangle.next = self.take_triangle.val()
+            & (!self.head_hit.val())
+            & (self.tb.q.val() == self.fetch_next.val());
         for k in 0..4 {
             if (self.fetch_next.val() == self.c_buffer[k].val())
                 & self.unvisited[k].q.val()
                 & (self.cur_kind[k].q.val() == self.c_test_triangle.val())
+                & (!self.cached[k].q.val())
             {
                 self.next_triangle.next = true;
             }
@@ -870,48 +1029,14 @@ impl<
             }
         }
 
-        // Launch from buffer `lb`: the origin, then the direction, of the entry's thread, then
-        // a clock to free the buffer and one for the next entry's ray words (entries launch
-        // `LAUNCH_SPACING` clocks apart at the fastest).
-        self.l_kind.next = self.cur_kind[0].q.val();
-        self.l_thread.next = self.cur_thread[0].q.val();
-        self.l_a.next = self.cur_a[0].q.val();
-        self.l_b.next = self.cur_b[0].q.val();
-        // A buffer's word count is cleared as the launch frees it, not at the take: the
-        // take, in the clock of the fetch's last requests, was the critical path through the
-        // count (stops 33 and 38, `b_issued -> received`).
-        self.l_loaded.next = self.loaded[0].q.val();
-        self.l_received.next = self.received[0].q.val();
-        for k in 1..4 {
-            if self.lb.q.val() == self.c_buffer[k].val() {
-                self.l_kind.next = self.cur_kind[k].q.val();
-                self.l_thread.next = self.cur_thread[k].q.val();
-                self.l_a.next = self.cur_a[k].q.val();
-                self.l_b.next = self.cur_b[k].q.val();
-                self.l_loaded.next = self.loaded[k].q.val();
-                self.l_received.next = self.received[k].q.val();
-            }
-        }
-        self.l_ready.next = self.l_loaded.val()
-            & ((self.l_kind.val() != self.c_test_triangle.val()) | (self.l_received.val() == 12));
+        // Launch from buffer `lb` (its words and the next buffer's: see above): the origin,
+        // then the direction, of the entry's thread.
         for k in 0..12 {
             self.transform_unit.m[k].next = self.words[k].read_data.val();
-        }
-        // The buffer after `lb`, which may launch right after `lb`'s direction.
-        self.n_thread.next = self.cur_thread[0].q.val();
-        self.n_loaded.next = self.loaded[0].q.val();
-        self.n_kind.next = self.cur_kind[0].q.val();
-        self.n_received.next = self.received[0].q.val();
-        for k in 1..4 {
-            if self.lb.q.val() + 1 == self.c_buffer[k].val() {
-                self.n_thread.next = self.cur_thread[k].q.val();
-                self.n_loaded.next = self.loaded[k].q.val();
-                self.n_kind.next = self.cur_kind[k].q.val();
-                self.n_received.next = self.received[k].q.val();
+            if self.l_cached.val() {
+                self.transform_unit.m[k].next = self.cache_words[k].read_data.val();
             }
         }
-        self.n_ready.next = self.n_loaded.val()
-            & ((self.n_kind.val() != self.c_test_triangle.val()) | (self.n_received.val() == 12));
         // The ray store answers a clock after its address: the entry's thread while it waits
         // and launches its origin, the next buffer's while it launches its direction (whose
         // words were read in the origin's clock), so that the next origin may follow at once.
@@ -1019,6 +1144,12 @@ impl<
         // Busy counts tests only (inits and list ends pass the units to keep their order).
         self.transform_busy.next =
             self.launching.val() & (self.l_kind.val() == self.c_test_triangle.val());
+        self.cache_hit.next = (self.lphase.q.val() == Launch::Origin)
+            & (self.l_kind.val() == self.c_test_triangle.val())
+            & self.l_cached.val();
+        self.cache_miss.next = (self.lphase.q.val() == Launch::Origin)
+            & (self.l_kind.val() == self.c_test_triangle.val())
+            & (!self.l_cached.val());
 
         // O' waits a clock for D'; then the unit-triangle test.
         for k in 0..3 {
@@ -1169,15 +1300,18 @@ mod tests {
     }
 
     /// Each thread's closest hit `(hit, t, instance, triangle)` from the model's sequential
-    /// `units::triangle_test` / `units::closer_hit` over its entries, after `units::Mailbox`.
+    /// `units::triangle_test` / `units::closer_hit` over its entries, after `units::Mailbox`,
+    /// and the number of triangle tests.
     fn model_hits(
         f: Format,
         triangles: &[units::Mat34W],
         bank1: &[u32],
         rays: &[([u32; 3], [u32; 3])],
         offers: &[VecDeque<Offer>],
-    ) -> Vec<(bool, u32, u32, u32)> {
-        rays.iter()
+    ) -> (Vec<(bool, u32, u32, u32)>, u64) {
+        let mut tests = 0;
+        let hits = rays
+            .iter()
             .zip(offers)
             .map(|(&(o, d), offers)| {
                 let (mut t_min, mut best) = (0, (false, 0, 0, 0));
@@ -1196,6 +1330,7 @@ mod tests {
                                     continue;
                                 }
                                 let m = triangles[triangle as usize];
+                                tests += 1;
                                 let r = units::triangle_test(f, &m, o, d, t_min);
                                 if units::closer_hit(f, &r, best.1) {
                                     best = (true, r.t, instance, triangle);
@@ -1206,13 +1341,17 @@ mod tests {
                 }
                 best
             })
-            .collect()
+            .collect();
+        (hits, tests)
     }
 
     /// What the driver saw: offers refused by a full queue, engine reads of banks 2 and 3.
     struct Drive {
         refused: usize,
         stolen: usize,
+        /// Triangle tests launched from the cache, from the banks.
+        cache_hits: u64,
+        cache_misses: u64,
     }
 
     /// Runs the tester in rust-hdl simulation with an SRAM model behind banks 1, 2 and 3 (the
@@ -1221,8 +1360,10 @@ mod tests {
     /// row, as in the engine), while the engine takes bank 1, 2 or 3 in one clock of
     /// `steal_one_in` (none when 0). Asserts the engine's reads get their banks and that every
     /// thread's closest hit equals `want` once the offers are drained.
+    #[allow(clippy::too_many_arguments)]
     fn drive_tester(
         mem_latency: u32,
+        cache_sets: u32,
         triangles: &[units::Mat34W],
         bank1: &[u32],
         rays: &[([u32; 3], [u32; 3])],
@@ -1243,7 +1384,7 @@ mod tests {
             }
         }
         let threads = rays.len();
-        let mut u = Tester::new(mem_latency);
+        let mut u = Tester::new(mem_latency, cache_sets);
         u.connect_all();
         let cycle = |u: &mut Tester| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
         // Ray words, one thread a clock.
@@ -1267,6 +1408,8 @@ mod tests {
         let mut drive = Drive {
             refused: 0,
             stolen: 0,
+            cache_hits: 0,
+            cache_misses: 0,
         };
         let mut drain = 0;
         // The thread whose counters were read last clock (the engine's I4): only it may offer.
@@ -1333,6 +1476,8 @@ mod tests {
                     offers[th].pop_front();
                 }
             }
+            drive.cache_hits += u64::from(u.cache_hit.val());
+            drive.cache_misses += u64::from(u.cache_miss.val());
             cycle(&mut u);
         }
         u.engine.enqueue.next = false;
@@ -1423,17 +1568,96 @@ mod tests {
                 q
             })
             .collect();
-        let want = model_hits(f, &triangles, &bank1, &rays, &offers);
+        let (want, tests) = model_hits(f, &triangles, &bank1, &rays, &offers);
         assert!(
             want.iter().filter(|b| b.0).count() >= 3,
             "too few hits: {want:?}"
         );
-        let drive = drive_tester(3, &triangles, &bank1, &rays, offers, 5, &mut rng, &want);
-        assert!(
-            drive.refused > 0,
-            "the queue never filled: back-pressure untested"
+        // No cache, two sets (24 triangles in them: evictions, and launches whose set a
+        // buffered hit holds) and the full cache.
+        for sets in [0, 2, MAX_CACHE_SETS] {
+            let mut rng = rng.clone();
+            let drive = drive_tester(
+                3,
+                sets,
+                &triangles,
+                &bank1,
+                &rays,
+                offers.clone(),
+                5,
+                &mut rng,
+                &want,
+            );
+            assert!(
+                drive.refused > 0,
+                "the queue never filled: back-pressure untested"
+            );
+            assert!(drive.stolen > 0);
+            assert_eq!(
+                drive.cache_hits + drive.cache_misses,
+                tests,
+                "{sets} sets: every test launches once"
+            );
+            match sets {
+                0 => assert_eq!(drive.cache_hits, 0),
+                2 => assert!(
+                    drive.cache_hits > 0 && drive.cache_misses > 24,
+                    "{sets} sets"
+                ),
+                // A triangle misses until its first test has launched (24 of them).
+                _ => assert!(
+                    (24..tests / 4).contains(&drive.cache_misses),
+                    "{sets} sets: {} misses of {tests}",
+                    drive.cache_misses
+                ),
+            }
+        }
+    }
+
+    /// Entries found in the cache launch 2 clocks apart, so an entry reads its thread's best
+    /// before the one in front of it has written it. One thread tests 8 triangles whose t
+    /// grows along the list, twice (a new query between: the second time every triangle is
+    /// in the cache): a merge reading a stale best would take a farther hit, and the closest
+    /// is the list's first.
+    #[test]
+    fn back_to_back_cached_tests_merge_in_list_order() {
+        let f = Format::E7M16;
+        let w = |x: f64| f.from_f64(x);
+        // The unit triangle moved away along z: t = 1 + k / 8 from z = 1 straight down.
+        let triangles: Vec<units::Mat34W> = (0..8)
+            .map(|k| {
+                let mut m = [0; 12];
+                for r in 0..3 {
+                    m[5 * r] = w(1.0);
+                }
+                m[11] = w(f64::from(k) / 8.0);
+                m
+            })
+            .collect();
+        let bank1: Vec<u32> = (0..8).collect();
+        let rays = vec![([w(0.25), w(0.25), w(1.0)], [0, 0, w(-1.0)])];
+        let init = Offer::Init {
+            t_min: 0,
+            t_max: f.infinity(false),
+        };
+        let list = Offer::List { from: 0, to: 8 };
+        let offers = vec![VecDeque::from([Offer::Object(5), init, list, init, list])];
+        let (want, tests) = model_hits(f, &triangles, &bank1, &rays, &offers);
+        assert_eq!(want[0], (true, w(1.0), 5, 0), "the model's hit");
+        assert_eq!(tests, 16);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
+        let drive = drive_tester(
+            2,
+            MAX_CACHE_SETS,
+            &triangles,
+            &bank1,
+            &rays,
+            offers,
+            0,
+            &mut rng,
+            &want,
         );
-        assert!(drive.stolen > 0);
+        assert_eq!((drive.cache_hits, drive.cache_misses), (8, 8));
     }
 
     /// Every format the generator accepts has enough in-flight slots (the `new` assertion).
@@ -1486,9 +1710,19 @@ mod tests {
                 q
             })
             .collect();
-        let want = model_hits(f, &triangles, &bank1, &rays, &offers);
+        let (want, _) = model_hits(f, &triangles, &bank1, &rays, &offers);
         assert_eq!(want[0], (true, w(1.0), 100, 7), "the model's hit");
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
-        drive_tester(1, &triangles, &bank1, &rays, offers, 0, &mut rng, &want);
+        drive_tester(
+            1,
+            MAX_CACHE_SETS,
+            &triangles,
+            &bank1,
+            &rays,
+            offers,
+            0,
+            &mut rng,
+            &want,
+        );
     }
 }

@@ -256,6 +256,9 @@ pub struct ThreadEngine<
     pub raygen_busy: Signal<Out, Bits<32>>,
     pub instance_busy: Signal<Out, Bits<32>>,
     pub shading_busy: Signal<Out, Bits<32>>,
+    /// Triangle tests launched with their words from the triangle cache, and from the banks.
+    pub tri_cache_hits: Signal<Out, Bits<32>>,
+    pub tri_cache_misses: Signal<Out, Bits<32>>,
 
     // The pipeline's stages.
     scheduler: Scheduler,
@@ -289,6 +292,8 @@ pub struct ThreadEngine<
     raygen_count: DFF<Bits<32>>,
     instance_count: DFF<Bits<32>>,
     shading_count: DFF<Bits<32>>,
+    cache_hit_count: DFF<Bits<32>>,
+    cache_miss_count: DFF<Bits<32>>,
     /// The busy counters' events, registered where they arise and counted a clock later: a
     /// unit's busy signal routed straight into a counter's 32 enables across the chip was
     /// the processor's critical path (stop 45: `tester.words.read_address ->
@@ -300,6 +305,8 @@ pub struct ThreadEngine<
     tick_raygen: DFF<Bit>,
     tick_instance: DFF<Bit>,
     tick_shading: DFF<Bit>,
+    tick_cache_hit: DFF<Bit>,
+    tick_cache_miss: DFF<Bit>,
     frame_start: Signal<Local, Bit>,
     // The memory and frame-buffer ports' request registers.
     /// The load's bank one-hot (`CoprocessorPort::load_banks`); `mem_bank_r` its number, for
@@ -426,9 +433,9 @@ impl<
         const DL: usize,
     > ThreadEngine<W, E, M, S, S1, X2, T, P, DX, DL>
 {
-    /// The engine running `program` with `threads` threads and memory read latency
-    /// `mem_latency`.
-    pub fn new(program: &Program, threads: u32, mem_latency: u32) -> Self {
+    /// The engine running `program` with `threads` threads, memory read latency
+    /// `mem_latency` and a triangle cache of `tri_cache_sets` sets (0: none).
+    pub fn new(program: &Program, threads: u32, mem_latency: u32, tri_cache_sets: u32) -> Self {
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
         assert!(P == 2 * S);
         // `FpUnits` pads the (faster) divider to the square root's latency.
@@ -469,6 +476,8 @@ impl<
             raygen_busy: Default::default(),
             instance_busy: Default::default(),
             shading_busy: Default::default(),
+            tri_cache_hits: Default::default(),
+            tri_cache_misses: Default::default(),
             intersect_busy: Default::default(),
             traversal_busy: Default::default(),
             scheduler: Scheduler::new(threads, reserve_ahead),
@@ -494,7 +503,7 @@ impl<
             write_back: Default::default(),
             // Scratch words start undefined: the program writes every one before reading it.
             scratch: Default::default(),
-            tester: TriangleTester::new(mem_latency),
+            tester: TriangleTester::new(mem_latency, tri_cache_sets),
             traversal_unit: TraversalUnit::new(
                 mem_latency,
                 program.config.top_stack_base,
@@ -509,6 +518,8 @@ impl<
             raygen_count: Default::default(),
             instance_count: Default::default(),
             shading_count: Default::default(),
+            cache_hit_count: Default::default(),
+            cache_miss_count: Default::default(),
             count_in_frame: Default::default(),
             tick_transform: Default::default(),
             tick_intersect: Default::default(),
@@ -516,6 +527,8 @@ impl<
             tick_raygen: Default::default(),
             tick_instance: Default::default(),
             tick_shading: Default::default(),
+            tick_cache_hit: Default::default(),
+            tick_cache_miss: Default::default(),
             intersect_count: Default::default(),
             traversal_count: Default::default(),
             frame_start: Default::default(),
@@ -635,6 +648,8 @@ impl<
             raygen_count,
             instance_count,
             shading_count,
+            cache_hit_count,
+            cache_miss_count,
             count_in_frame,
             tick_transform,
             tick_intersect,
@@ -642,6 +657,8 @@ impl<
             tick_raygen,
             tick_instance,
             tick_shading,
+            tick_cache_hit,
+            tick_cache_miss,
             intersect_count,
             traversal_count,
             mem_load_r,
@@ -709,6 +726,8 @@ impl<
         self.raygen_busy.next = self.raygen_count.q.val();
         self.instance_busy.next = self.instance_count.q.val();
         self.shading_busy.next = self.shading_count.q.val();
+        self.tri_cache_hits.next = self.cache_hit_count.q.val();
+        self.tri_cache_misses.next = self.cache_miss_count.q.val();
         if self.in_frame.val() {
             self.cycle_count.d.next = self.cycle_count.q.val() + 1;
         }
@@ -716,6 +735,8 @@ impl<
         self.tick_transform.d.next = self.tester.transform_busy.val();
         self.tick_intersect.d.next = self.tester.intersect_busy.val();
         self.tick_traversal.d.next = self.traversal_unit.step_busy.val();
+        self.tick_cache_hit.d.next = self.tester.cache_hit.val();
+        self.tick_cache_miss.d.next = self.tester.cache_miss.val();
         if self.count_in_frame.q.val() {
             if self.tick_transform.q.val() {
                 self.transform_count.d.next = self.transform_count.q.val() + 1;
@@ -734,6 +755,12 @@ impl<
             }
             if self.tick_instance.q.val() {
                 self.instance_count.d.next = self.instance_count.q.val() + 1;
+            }
+            if self.tick_cache_hit.q.val() {
+                self.cache_hit_count.d.next = self.cache_hit_count.q.val() + 1;
+            }
+            if self.tick_cache_miss.q.val() {
+                self.cache_miss_count.d.next = self.cache_miss_count.q.val() + 1;
             }
         }
 
@@ -1238,6 +1265,8 @@ impl<
             self.traversal_count.d.next = 0.into();
             self.raygen_count.d.next = 0.into();
             self.instance_count.d.next = 0.into();
+            self.cache_hit_count.d.next = 0.into();
+            self.cache_miss_count.d.next = 0.into();
             self.shading_count.d.next = 0.into();
         }
     }
