@@ -17323,6 +17323,15 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  has_free_r__d;
     wire  has_free_r__q;
     reg  has_free_r__clock;
+    reg  take_r__d;
+    wire  take_r__q;
+    reg  take_r__clock;
+    reg  [2:0] take_slot_r__d;
+    wire  [2:0] take_slot_r__q;
+    reg  take_slot_r__clock;
+    reg  take_hit_r__d;
+    wire  take_hit_r__q;
+    reg  take_hit_r__clock;
     reg  s0_valid__d;
     wire  s0_valid__q;
     reg  s0_valid__clock;
@@ -17562,6 +17571,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  any_free_after_take__7;
     reg  any_free_after_take__8;
     reg  taken;
+    reg  occupied__0;
+    reg  occupied__1;
+    reg  occupied__2;
+    reg  occupied__3;
+    reg  occupied__4;
+    reg  occupied__5;
+    reg  occupied__6;
+    reg  occupied__7;
     reg  s1_load;
     reg  [3:0] pick_step;
     reg  [2:0] pick_light;
@@ -18284,6 +18301,21 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(has_free_r__q),
         .clock(has_free_r__clock)
     );
+    dynrt_processor__display__dark_d take_r(
+        .d(take_r__d),
+        .q(take_r__q),
+        .clock(take_r__clock)
+    );
+    dynrt_processor__engine__mem_bank_r take_slot_r(
+        .d(take_slot_r__d),
+        .q(take_slot_r__q),
+        .clock(take_slot_r__clock)
+    );
+    dynrt_processor__display__dark_d take_hit_r(
+        .d(take_hit_r__d),
+        .q(take_hit_r__q),
+        .clock(take_hit_r__clock)
+    );
     dynrt_processor__display__dark_d s0_valid(
         .d(s0_valid__d),
         .q(s0_valid__q),
@@ -18666,6 +18698,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         s1_flip__clock = clock;
         s1_miss__clock = clock;
         s1_transform__clock = clock;
+        take_r__clock = clock;
+        take_slot_r__clock = clock;
+        take_hit_r__clock = clock;
         gen_held__clock = clock;
         gen_hold_point__clock = clock;
         gen_hold_diagonal__clock = clock;
@@ -18693,6 +18728,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         s1_flip__d = s1_flip__q;
         s1_miss__d = s1_miss__q;
         s1_transform__d = s1_transform__q;
+        take_r__d = take_r__q;
+        take_slot_r__d = take_slot_r__q;
+        take_hit_r__d = take_hit_r__q;
         gen_held__d = gen_held__q;
         gen_hold_point__d = gen_hold_point__q;
         gen_hold_diagonal__d = gen_hold_diagonal__q;
@@ -19342,91 +19380,102 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         taken = offer & (~refused);
         free_slot_r__clock = clock;
         has_free_r__clock = clock;
+        take_r__d = taken;
+        take_slot_r__d = free_slot_r__q;
+        take_hit_r__d = offer_hit;
+        occupied__0 = busy__0__q | (take_r__q & (take_slot_r__q == c_slot__0));
+        occupied__1 = busy__1__q | (take_r__q & (take_slot_r__q == c_slot__1));
+        occupied__2 = busy__2__q | (take_r__q & (take_slot_r__q == c_slot__2));
+        occupied__3 = busy__3__q | (take_r__q & (take_slot_r__q == c_slot__3));
+        occupied__4 = busy__4__q | (take_r__q & (take_slot_r__q == c_slot__4));
+        occupied__5 = busy__5__q | (take_r__q & (take_slot_r__q == c_slot__5));
+        occupied__6 = busy__6__q | (take_r__q & (take_slot_r__q == c_slot__6));
+        occupied__7 = busy__7__q | (take_r__q & (take_slot_r__q == c_slot__7));
         any_free_before__0 = 1'b0;
         any_free_after_take__0 = 1'b0;
-        any_free_before__1 = any_free_before__0 | (~busy__0__q);
-        any_free_after_take__1 = any_free_after_take__0 | ((~busy__0__q) & (free_slot_r__q != c_slot__0));
-        any_free_before__2 = any_free_before__1 | (~busy__1__q);
-        any_free_after_take__2 = any_free_after_take__1 | ((~busy__1__q) & (free_slot_r__q != c_slot__1));
-        any_free_before__3 = any_free_before__2 | (~busy__2__q);
-        any_free_after_take__3 = any_free_after_take__2 | ((~busy__2__q) & (free_slot_r__q != c_slot__2));
-        any_free_before__4 = any_free_before__3 | (~busy__3__q);
-        any_free_after_take__4 = any_free_after_take__3 | ((~busy__3__q) & (free_slot_r__q != c_slot__3));
-        any_free_before__5 = any_free_before__4 | (~busy__4__q);
-        any_free_after_take__5 = any_free_after_take__4 | ((~busy__4__q) & (free_slot_r__q != c_slot__4));
-        any_free_before__6 = any_free_before__5 | (~busy__5__q);
-        any_free_after_take__6 = any_free_after_take__5 | ((~busy__5__q) & (free_slot_r__q != c_slot__5));
-        any_free_before__7 = any_free_before__6 | (~busy__6__q);
-        any_free_after_take__7 = any_free_after_take__6 | ((~busy__6__q) & (free_slot_r__q != c_slot__6));
-        any_free_before__8 = any_free_before__7 | (~busy__7__q);
-        any_free_after_take__8 = any_free_after_take__7 | ((~busy__7__q) & (free_slot_r__q != c_slot__7));
+        any_free_before__1 = any_free_before__0 | (~occupied__0);
+        any_free_after_take__1 = any_free_after_take__0 | ((~occupied__0) & (free_slot_r__q != c_slot__0));
+        any_free_before__2 = any_free_before__1 | (~occupied__1);
+        any_free_after_take__2 = any_free_after_take__1 | ((~occupied__1) & (free_slot_r__q != c_slot__1));
+        any_free_before__3 = any_free_before__2 | (~occupied__2);
+        any_free_after_take__3 = any_free_after_take__2 | ((~occupied__2) & (free_slot_r__q != c_slot__2));
+        any_free_before__4 = any_free_before__3 | (~occupied__3);
+        any_free_after_take__4 = any_free_after_take__3 | ((~occupied__3) & (free_slot_r__q != c_slot__3));
+        any_free_before__5 = any_free_before__4 | (~occupied__4);
+        any_free_after_take__5 = any_free_after_take__4 | ((~occupied__4) & (free_slot_r__q != c_slot__4));
+        any_free_before__6 = any_free_before__5 | (~occupied__5);
+        any_free_after_take__6 = any_free_after_take__5 | ((~occupied__5) & (free_slot_r__q != c_slot__5));
+        any_free_before__7 = any_free_before__6 | (~occupied__6);
+        any_free_after_take__7 = any_free_after_take__6 | ((~occupied__6) & (free_slot_r__q != c_slot__6));
+        any_free_before__8 = any_free_before__7 | (~occupied__7);
+        any_free_after_take__8 = any_free_after_take__7 | ((~occupied__7) & (free_slot_r__q != c_slot__7));
         free_slot_r__d = 32'h0;
         has_free_r__d = any_free_before__8;
         if (taken) begin
             has_free_r__d = any_free_after_take__8;
         end
         if (taken) begin
-            if ((~busy__0__q) & (free_slot_r__q != c_slot__0) & (~any_free_after_take__0)) begin
+            if ((~occupied__0) & (free_slot_r__q != c_slot__0) & (~any_free_after_take__0)) begin
                 free_slot_r__d = c_slot__0;
             end
         end
-        else if ((~busy__0__q) & (~any_free_before__0)) begin
+        else if ((~occupied__0) & (~any_free_before__0)) begin
             free_slot_r__d = c_slot__0;
         end
         if (taken) begin
-            if ((~busy__1__q) & (free_slot_r__q != c_slot__1) & (~any_free_after_take__1)) begin
+            if ((~occupied__1) & (free_slot_r__q != c_slot__1) & (~any_free_after_take__1)) begin
                 free_slot_r__d = c_slot__1;
             end
         end
-        else if ((~busy__1__q) & (~any_free_before__1)) begin
+        else if ((~occupied__1) & (~any_free_before__1)) begin
             free_slot_r__d = c_slot__1;
         end
         if (taken) begin
-            if ((~busy__2__q) & (free_slot_r__q != c_slot__2) & (~any_free_after_take__2)) begin
+            if ((~occupied__2) & (free_slot_r__q != c_slot__2) & (~any_free_after_take__2)) begin
                 free_slot_r__d = c_slot__2;
             end
         end
-        else if ((~busy__2__q) & (~any_free_before__2)) begin
+        else if ((~occupied__2) & (~any_free_before__2)) begin
             free_slot_r__d = c_slot__2;
         end
         if (taken) begin
-            if ((~busy__3__q) & (free_slot_r__q != c_slot__3) & (~any_free_after_take__3)) begin
+            if ((~occupied__3) & (free_slot_r__q != c_slot__3) & (~any_free_after_take__3)) begin
                 free_slot_r__d = c_slot__3;
             end
         end
-        else if ((~busy__3__q) & (~any_free_before__3)) begin
+        else if ((~occupied__3) & (~any_free_before__3)) begin
             free_slot_r__d = c_slot__3;
         end
         if (taken) begin
-            if ((~busy__4__q) & (free_slot_r__q != c_slot__4) & (~any_free_after_take__4)) begin
+            if ((~occupied__4) & (free_slot_r__q != c_slot__4) & (~any_free_after_take__4)) begin
                 free_slot_r__d = c_slot__4;
             end
         end
-        else if ((~busy__4__q) & (~any_free_before__4)) begin
+        else if ((~occupied__4) & (~any_free_before__4)) begin
             free_slot_r__d = c_slot__4;
         end
         if (taken) begin
-            if ((~busy__5__q) & (free_slot_r__q != c_slot__5) & (~any_free_after_take__5)) begin
+            if ((~occupied__5) & (free_slot_r__q != c_slot__5) & (~any_free_after_take__5)) begin
                 free_slot_r__d = c_slot__5;
             end
         end
-        else if ((~busy__5__q) & (~any_free_before__5)) begin
+        else if ((~occupied__5) & (~any_free_before__5)) begin
             free_slot_r__d = c_slot__5;
         end
         if (taken) begin
-            if ((~busy__6__q) & (free_slot_r__q != c_slot__6) & (~any_free_after_take__6)) begin
+            if ((~occupied__6) & (free_slot_r__q != c_slot__6) & (~any_free_after_take__6)) begin
                 free_slot_r__d = c_slot__6;
             end
         end
-        else if ((~busy__6__q) & (~any_free_before__6)) begin
+        else if ((~occupied__6) & (~any_free_before__6)) begin
             free_slot_r__d = c_slot__6;
         end
         if (taken) begin
-            if ((~busy__7__q) & (free_slot_r__q != c_slot__7) & (~any_free_after_take__7)) begin
+            if ((~occupied__7) & (free_slot_r__q != c_slot__7) & (~any_free_after_take__7)) begin
                 free_slot_r__d = c_slot__7;
             end
         end
-        else if ((~busy__7__q) & (~any_free_before__7)) begin
+        else if ((~occupied__7) & (~any_free_before__7)) begin
             free_slot_r__d = c_slot__7;
         end
         o__0__write_address = free_slot_r__q;
@@ -19678,14 +19727,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 rgb__write_enable = 1'b1;
             end
         end
-        if (taken & (free_slot_r__q == c_slot__0)) begin
+        if (take_r__q & (take_slot_r__q == c_slot__0)) begin
             busy__0__d = 1'b1;
             ready__0__d = 1'b1;
-            miss__0__d = ~offer_hit;
+            miss__0__d = ~take_hit_r__q;
             flip__0__d = 1'b0;
             light__0__d = 32'h0;
             step__0__d = ShadeStep__TriLoad;
-            if (~offer_hit) begin
+            if (~take_hit_r__q) begin
                 step__0__d = ShadeStep__Pack;
             end
         end
@@ -19744,14 +19793,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__0__d = 1'b1;
             step__0__d = ShadeStep__Store;
         end
-        if (taken & (free_slot_r__q == c_slot__1)) begin
+        if (take_r__q & (take_slot_r__q == c_slot__1)) begin
             busy__1__d = 1'b1;
             ready__1__d = 1'b1;
-            miss__1__d = ~offer_hit;
+            miss__1__d = ~take_hit_r__q;
             flip__1__d = 1'b0;
             light__1__d = 32'h0;
             step__1__d = ShadeStep__TriLoad;
-            if (~offer_hit) begin
+            if (~take_hit_r__q) begin
                 step__1__d = ShadeStep__Pack;
             end
         end
@@ -19810,14 +19859,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__1__d = 1'b1;
             step__1__d = ShadeStep__Store;
         end
-        if (taken & (free_slot_r__q == c_slot__2)) begin
+        if (take_r__q & (take_slot_r__q == c_slot__2)) begin
             busy__2__d = 1'b1;
             ready__2__d = 1'b1;
-            miss__2__d = ~offer_hit;
+            miss__2__d = ~take_hit_r__q;
             flip__2__d = 1'b0;
             light__2__d = 32'h0;
             step__2__d = ShadeStep__TriLoad;
-            if (~offer_hit) begin
+            if (~take_hit_r__q) begin
                 step__2__d = ShadeStep__Pack;
             end
         end
@@ -19876,14 +19925,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__2__d = 1'b1;
             step__2__d = ShadeStep__Store;
         end
-        if (taken & (free_slot_r__q == c_slot__3)) begin
+        if (take_r__q & (take_slot_r__q == c_slot__3)) begin
             busy__3__d = 1'b1;
             ready__3__d = 1'b1;
-            miss__3__d = ~offer_hit;
+            miss__3__d = ~take_hit_r__q;
             flip__3__d = 1'b0;
             light__3__d = 32'h0;
             step__3__d = ShadeStep__TriLoad;
-            if (~offer_hit) begin
+            if (~take_hit_r__q) begin
                 step__3__d = ShadeStep__Pack;
             end
         end
@@ -19942,14 +19991,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__3__d = 1'b1;
             step__3__d = ShadeStep__Store;
         end
-        if (taken & (free_slot_r__q == c_slot__4)) begin
+        if (take_r__q & (take_slot_r__q == c_slot__4)) begin
             busy__4__d = 1'b1;
             ready__4__d = 1'b1;
-            miss__4__d = ~offer_hit;
+            miss__4__d = ~take_hit_r__q;
             flip__4__d = 1'b0;
             light__4__d = 32'h0;
             step__4__d = ShadeStep__TriLoad;
-            if (~offer_hit) begin
+            if (~take_hit_r__q) begin
                 step__4__d = ShadeStep__Pack;
             end
         end
@@ -20008,14 +20057,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__4__d = 1'b1;
             step__4__d = ShadeStep__Store;
         end
-        if (taken & (free_slot_r__q == c_slot__5)) begin
+        if (take_r__q & (take_slot_r__q == c_slot__5)) begin
             busy__5__d = 1'b1;
             ready__5__d = 1'b1;
-            miss__5__d = ~offer_hit;
+            miss__5__d = ~take_hit_r__q;
             flip__5__d = 1'b0;
             light__5__d = 32'h0;
             step__5__d = ShadeStep__TriLoad;
-            if (~offer_hit) begin
+            if (~take_hit_r__q) begin
                 step__5__d = ShadeStep__Pack;
             end
         end
@@ -20074,14 +20123,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__5__d = 1'b1;
             step__5__d = ShadeStep__Store;
         end
-        if (taken & (free_slot_r__q == c_slot__6)) begin
+        if (take_r__q & (take_slot_r__q == c_slot__6)) begin
             busy__6__d = 1'b1;
             ready__6__d = 1'b1;
-            miss__6__d = ~offer_hit;
+            miss__6__d = ~take_hit_r__q;
             flip__6__d = 1'b0;
             light__6__d = 32'h0;
             step__6__d = ShadeStep__TriLoad;
-            if (~offer_hit) begin
+            if (~take_hit_r__q) begin
                 step__6__d = ShadeStep__Pack;
             end
         end
@@ -20140,14 +20189,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__6__d = 1'b1;
             step__6__d = ShadeStep__Store;
         end
-        if (taken & (free_slot_r__q == c_slot__7)) begin
+        if (take_r__q & (take_slot_r__q == c_slot__7)) begin
             busy__7__d = 1'b1;
             ready__7__d = 1'b1;
-            miss__7__d = ~offer_hit;
+            miss__7__d = ~take_hit_r__q;
             flip__7__d = 1'b0;
             light__7__d = 32'h0;
             step__7__d = ShadeStep__TriLoad;
-            if (~offer_hit) begin
+            if (~take_hit_r__q) begin
                 step__7__d = ShadeStep__Pack;
             end
         end
@@ -20224,7 +20273,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         any_busy = any_busy | busy__5__q;
         any_busy = any_busy | busy__6__q;
         any_busy = any_busy | busy__7__q;
-        idle = (~loading__q) & (~any_busy);
+        idle = (~loading__q) & (~any_busy) & (~take_r__q);
     end
     
 endmodule // dynrt_processor__engine__shader
@@ -21870,6 +21919,12 @@ module dynrt_processor__engine__shader__res_step_r(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__shader__res_step_r
+
+
+
+
+
+
 
 
 
