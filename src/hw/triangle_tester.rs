@@ -32,20 +32,38 @@
 //! Take, fetch and launch, around [`TEST_BUFFERS`] (4) entry buffers in a ring: the take moves
 //! the list unit's next entry into the next buffer as soon as it is free; the fetch requests
 //! a buffer's triangle, 6 words of bank 2 and 6 of bank 3 (6 clocks when the engine leaves the
-//! banks alone), and goes on to the next buffer in the clock after its last requests (an init
-//! or a list end fetches nothing and is passed over in a clock). The launch waits for its
-//! buffer's words (the SRAM latency after their requests), launches the origin and then the
-//! direction into the TransformUnit (2 clocks), frees the buffer and waits a clock for the
-//! next entry's ray words. With two buffers and a clock of its own for each take, the entries
-//! that fetch nothing (a third of cornell_noshadow's) held the fetch up behind their 4 clocks
-//! of launch: 72.3 cycles per primary ray; four buffers, 63.3; and the next fetch from the
-//! clock after the last requests, 56.6. The take is apart from the fetch because in the clock
-//! of the last requests it hung on the bank grants (the critical path at stop 43). Throughput:
-//! one test per [`CLOCKS_PER_TEST`] (6) clocks, one init or list end per [`LAUNCH_SPACING`]
-//! (4), the two overlapping as far as the buffers allow; entries leave the launch at
-//! least 4 clocks apart, which the hit merge needs (it reads, compares and writes a thread's
-//! best hit in 4 clocks). The engine's own loads of banks 2 and 3 (shading data) take the
+//! banks alone), and goes on to the next buffer in the clock after its last requests (an
+//! entry that fetches nothing, an init, a list end or a triangle in the cache, is passed over
+//! in a clock). The launch waits for its buffer's words (the SRAM latency after their
+//! requests), then launches the origin and the direction into the TransformUnit (2 clocks),
+//! freeing the buffer with the direction; the next buffer's origin follows at once if its
+//! words are in and no other client's request waits for the unit (which then goes in the
+//! clock between). With two buffers and a clock of its own for each take, the entries that
+//! fetch nothing (a third of cornell_noshadow's) held the fetch up behind their launch:
+//! 72.3 cycles per primary ray; four buffers, 63.3; the next fetch from the clock after the
+//! last requests, 56.6; launches 2 clocks apart (were 4), 55.5; the triangle cache, 38.4. The
+//! take is apart from the fetch because in the clock of the last requests it hung on the
+//! bank grants (the critical path at stop 43). Throughput: one test from the banks per
+//! [`CLOCKS_PER_TEST`] (6) clocks, one entry (a test from the cache, an init, a list end) per
+//! [`LAUNCH_SPACING`] (2). The engine's own loads of banks 2 and 3 (shading data) take the
 //! bank in their clock; the fetch waits for it.
+//!
+//! Hit merge: an entry reads its thread's best hit and count of entries done as it leaves the
+//! IntersectUnit, compares its t with the best in the [`FpCompare`] (2 clocks) and writes both
+//! back 3 clocks after the read. Entries 2 or 3 clocks apart would read a state still to be
+//! written, so the merge takes it from the entry ahead instead (`after_*`, `lw_*`).
+//!
+//! Triangle cache: [`MAX_CACHE_SETS`] (the paper's 512 items) sets of a triangle's 12 words,
+//! direct mapped by the triangle's low bits, in block RAM, with a tag (triangle and valid bit)
+//! in distributed RAM; `new`'s `cache_sets` uses the first sets only (0: no cache). The
+//! queue's head is looked up as the free buffer copies it; a triangle found there is not
+//! fetched, and the launch reads its words from the cache (addressed a clock ahead, as the ray
+//! store). A triangle fetched from the banks is written into its set as it launches, from
+//! the words it launches with, unless a buffered triangle found in the cache holds that set
+//! (it must find its words there until it launches); a head looked up in the clock of a
+//! write to its set counts as a miss. The frames of an animated scene leave banks 2 and 3
+//! as they are (only instances and the top level move; `emit::memory_images`' tests hold
+//! it), so the cache lives across frames.
 //!
 //! Latency from launch to the merged hit: `TRANSFORM_LATENCY` (28) + 1 + `intersect_latency`
 //! (35 at e7m16) + 3. Up to [`FLIGHT_SLOTS`] entries are in flight in that time, each with its
@@ -235,7 +253,7 @@ pub struct TriangleTester<
     fetch_ends: Signal<Local, Bit>,
     /// Buffer `tb` is free; `take`: it takes the queue's head this clock.
     tb_free: Signal<Local, Bit>,
-    // The triangle cache (see "Triangle cache" above).
+    // The triangle cache (see "Triangle cache" in the module's doc).
     /// Per set: `{valid[24], triangle[23:0]}`.
     cache_tag: LutRam<Bits<25>, 9>,
     /// Word k of each set's triangle.

@@ -14,7 +14,7 @@
 //! them and only steer their results (clearing a zero operand before comparing put the zero
 //! test in front of the carry chain: `in_b.q -> out_lt.q` at 128 MHz on the ECP5, issue 16).
 //! The latency stays 2 because the triangle tester's hit merge reads, compares and writes a
-//! thread's best hit in 4 clocks.
+//! thread's best hit in 4 clocks (entries closer together take the state from the one ahead).
 //!
 //! Const parameters: `W = 1 + E + M` (word width), `E` exponent bits, `M` stored mantissa bits.
 
