@@ -22868,6 +22868,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  cached__3__d;
     wire  cached__3__q;
     reg  cached__3__clock;
+    reg  cache_write_r__d;
+    wire  cache_write_r__q;
+    reg  cache_write_r__clock;
     reg  [5:0] a_line__0__d;
     wire  [5:0] a_line__0__q;
     reg  a_line__0__clock;
@@ -23126,6 +23129,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [8:0] n_set;
     reg  cache_write;
     reg  cache_block;
+    reg  head_clash;
     reg  take;
     reg  take_triangle;
     reg  fetch_moves;
@@ -23706,6 +23710,11 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(cached__3__q),
         .clock(cached__3__clock)
     );
+    dynrt_processor__display__dark_d cache_write_r(
+        .d(cache_write_r__d),
+        .q(cache_write_r__q),
+        .clock(cache_write_r__clock)
+    );
     dynrt_processor__engine__mem_load_r a_line__0(
         .d(a_line__0__d),
         .q(a_line__0__q),
@@ -24107,6 +24116,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         m3_done__clock = clock;
         m3_best__clock = clock;
         lw_valid__clock = clock;
+        cache_write_r__clock = clock;
         lw_thread__clock = clock;
         lw_best__clock = clock;
         lw_done__clock = clock;
@@ -24147,6 +24157,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         m3_done__d = m3_done__q;
         m3_best__d = m3_best__q;
         lw_valid__d = lw_valid__q;
+        cache_write_r__d = cache_write_r__q;
         lw_thread__d = lw_thread__q;
         lw_best__d = lw_best__q;
         lw_done__d = lw_done__q;
@@ -24478,89 +24489,90 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             cache_block = 1'b1;
         end
         cache_write = c_cache_on & (lphase__q == Launch__Origin) & (l_kind == c_test_triangle) & (~l_cached) & (~cache_block);
+        cache_write_r__d = cache_write;
         cache_tag__write_address = l_set;
         cache_tag__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
-        cache_tag__write_enable = cache_write;
+        cache_tag__write_enable = cache_write_r__q;
         cache_words__0__write_address = l_set;
         cache_words__0__write_data = words__0__read_data;
-        cache_words__0__write_enable = cache_write;
+        cache_words__0__write_enable = cache_write_r__q;
         cache_words__0__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__0__read_address = n_set;
         end
         cache_words__1__write_address = l_set;
         cache_words__1__write_data = words__1__read_data;
-        cache_words__1__write_enable = cache_write;
+        cache_words__1__write_enable = cache_write_r__q;
         cache_words__1__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__1__read_address = n_set;
         end
         cache_words__2__write_address = l_set;
         cache_words__2__write_data = words__2__read_data;
-        cache_words__2__write_enable = cache_write;
+        cache_words__2__write_enable = cache_write_r__q;
         cache_words__2__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__2__read_address = n_set;
         end
         cache_words__3__write_address = l_set;
         cache_words__3__write_data = words__3__read_data;
-        cache_words__3__write_enable = cache_write;
+        cache_words__3__write_enable = cache_write_r__q;
         cache_words__3__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__3__read_address = n_set;
         end
         cache_words__4__write_address = l_set;
         cache_words__4__write_data = words__4__read_data;
-        cache_words__4__write_enable = cache_write;
+        cache_words__4__write_enable = cache_write_r__q;
         cache_words__4__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__4__read_address = n_set;
         end
         cache_words__5__write_address = l_set;
         cache_words__5__write_data = words__5__read_data;
-        cache_words__5__write_enable = cache_write;
+        cache_words__5__write_enable = cache_write_r__q;
         cache_words__5__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__5__read_address = n_set;
         end
         cache_words__6__write_address = l_set;
         cache_words__6__write_data = words__6__read_data;
-        cache_words__6__write_enable = cache_write;
+        cache_words__6__write_enable = cache_write_r__q;
         cache_words__6__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__6__read_address = n_set;
         end
         cache_words__7__write_address = l_set;
         cache_words__7__write_data = words__7__read_data;
-        cache_words__7__write_enable = cache_write;
+        cache_words__7__write_enable = cache_write_r__q;
         cache_words__7__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__7__read_address = n_set;
         end
         cache_words__8__write_address = l_set;
         cache_words__8__write_data = words__8__read_data;
-        cache_words__8__write_enable = cache_write;
+        cache_words__8__write_enable = cache_write_r__q;
         cache_words__8__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__8__read_address = n_set;
         end
         cache_words__9__write_address = l_set;
         cache_words__9__write_data = words__9__read_data;
-        cache_words__9__write_enable = cache_write;
+        cache_words__9__write_enable = cache_write_r__q;
         cache_words__9__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__9__read_address = n_set;
         end
         cache_words__10__write_address = l_set;
         cache_words__10__write_data = words__10__read_data;
-        cache_words__10__write_enable = cache_write;
+        cache_words__10__write_enable = cache_write_r__q;
         cache_words__10__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__10__read_address = n_set;
         end
         cache_words__11__write_address = l_set;
         cache_words__11__write_data = words__11__read_data;
-        cache_words__11__write_enable = cache_write;
+        cache_words__11__write_enable = cache_write_r__q;
         cache_words__11__read_address = l_set;
         if (lphase__q == Launch__Direction) begin
             cache_words__11__read_address = n_set;
@@ -24568,7 +24580,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_triangle = list_unit__test_entry[(32'h20)+:(24)];
         head_set = head_triangle[(32'h0)+:(9)] & c_set_mask;
         cache_tag__read_address = head_set;
-        head_hit = c_cache_on & (cache_tag__read_data == (c_tag_valid | ((head_triangle) & 25'h1ffffff))) & (~(cache_write & (l_set == head_set)));
+        head_clash = ((lphase__q == Launch__Origin) | cache_write_r__q) & (l_set == head_set);
+        head_hit = c_cache_on & (cache_tag__read_data == (c_tag_valid | ((head_triangle) & 25'h1ffffff))) & (~head_clash);
         tb_free = ~loaded__0__q;
         if (tb__q == c_buffer__1) begin
             tb_free = ~loaded__1__q;
@@ -25714,6 +25727,8 @@ module dynrt_processor__engine__tester__cache_words__0(read_address,read_clock,r
     end
                 
 endmodule // dynrt_processor__engine__tester__cache_words__0
+
+
 
 
 
