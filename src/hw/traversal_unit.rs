@@ -291,7 +291,8 @@ pub struct TraversalUnit<
     /// An empty top-level leaf's thread, whose walk goes on in the front's next clock.
     skip_valid: DFF<Bit>,
     /// An entered object's walk to start: it takes the entry queue in a clock without a
-    /// tester's answer (those come at least 4 clocks apart, entries 16), ahead of the engine.
+    /// tester's answer (those come at least `LAUNCH_SPACING` = 2 clocks apart, so it waits at
+    /// most a clock; entries 16), ahead of the engine.
     entered_valid: DFF<Bit>,
     entered_thread: DFF<Bits<5>>,
     /// The wake-up, a clock after the count of entries done is written (the engine's

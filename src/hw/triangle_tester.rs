@@ -943,10 +943,10 @@ impl<
         }
 
         // Fetch: request the 6 + 6 words of `fb`'s triangle (the banks serve the engine first),
-        // then go on to the next buffer; an init or a list end fetches nothing and is passed
-        // over in a clock. The fetch never falls behind the launch: a triangle launches once
+        // then go on to the next buffer; an init, a list end or a triangle in the cache
+        // fetches nothing and is passed over in a clock. The fetch never falls behind the launch: a triangle launches once
         // its words are in (so requested: the fetch has left it), and the launch frees an
-        // entry 3 clocks after it starts, the fetch passes over one in 1.
+        // entry in the second clock of its launch, the fetch passes over one in 1.
         self.a_take.next = self.fetching.q.val()
             & (self.a_issued.q.val() < 6)
             & ((self.engine.load_banks.val() & self.c_bank_a.val()) == 0);
@@ -1708,8 +1708,8 @@ mod tests {
         assert!(!(32 * LAUNCH_SPACING > launch_to_merge(Format::E7M16)));
     }
 
-    /// A burst of new queries launches right behind a thread's hit, one every 4 clocks (the
-    /// fastest launches): more entries launch within the hit's latency than 16. The hit keeps
+    /// A burst of new queries launches right behind a thread's hit, one every 2 clocks (the
+    /// fastest launches): more entries launch within the hit's latency than 32. The hit keeps
     /// its triangle and instance (each in-flight entry keeps its own slot until it merges),
     /// and the bursting threads end with no hit.
     #[test]
