@@ -72,10 +72,10 @@ pub fn preflight(
         params.mem_latency
     );
     {
-        use crate::hw::triangle_tester::MAX_CACHE_SETS;
+        use crate::hw::triangle_tester::{cache_sets_supported, MAX_CACHE_SETS};
         let sets = params.tri_cache_sets;
         anyhow::ensure!(
-            sets == 0 || (sets.is_power_of_two() && sets <= MAX_CACHE_SETS),
+            cache_sets_supported(sets),
             "--tri-cache {sets}: the triangle cache has a power of two of sets up to \
              {MAX_CACHE_SETS}, or 0 for none; use e.g. --tri-cache {MAX_CACHE_SETS}"
         );

@@ -61,9 +61,9 @@
 //! store). A triangle fetched from the banks is written into its set as it launches (in its
 //! direction's clock, decided in its origin's), from the words it launches with, unless a
 //! buffered triangle found in the cache holds that set (it must find its words there until
-//! it launches); a head looked up in either clock misses if its set is the launch's. The frames of an animated scene leave banks 2 and 3
-//! as they are (only instances and the top level move; `emit::memory_images`' tests hold
-//! it), so the cache lives across frames.
+//! it launches); a head looked up in either clock misses if its set is the launch's. The
+//! frames of an animated scene leave banks 2 and 3 as they are (only instances and the top
+//! level move; `emit::memory_images`' tests hold it), so the cache lives across frames.
 //!
 //! Latency from launch to the merged hit: `TRANSFORM_LATENCY` (28) + 1 + `intersect_latency`
 //! (35 at e7m16) + 3. Up to [`FLIGHT_SLOTS`] entries are in flight in that time, each with its
@@ -118,6 +118,12 @@ pub const CLOCKS_PER_TEST: u32 = 6;
 /// Most sets of the triangle cache (the paper's 512 items): its RAMs are this deep, a
 /// smaller cache uses the first sets.
 pub const MAX_CACHE_SETS: u32 = 512;
+
+/// Whether the triangle cache can have `sets` sets: a power of two up to [`MAX_CACHE_SETS`],
+/// or 0 for none.
+pub fn cache_sets_supported(sets: u32) -> bool {
+    sets == 0 || (sets.is_power_of_two() && sets <= MAX_CACHE_SETS)
+}
 
 /// Entry buffers between the take and the launch (a ring: `tb`, `fb` and `lb` count modulo 4).
 pub const TEST_BUFFERS: usize = 4;
@@ -424,10 +430,7 @@ impl<
     /// 0 for none).
     pub fn new(mem_latency: u32, cache_sets: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
-        assert!(
-            cache_sets == 0 || (cache_sets.is_power_of_two() && cache_sets <= MAX_CACHE_SETS),
-            "cache sets {cache_sets}"
-        );
+        assert!(cache_sets_supported(cache_sets), "cache sets {cache_sets}");
         let f = Format::new(E as u32, M as u32).expect("a supported format");
         assert!(flight_slots_suffice(f), "{f}: too few in-flight slots");
         Self {
