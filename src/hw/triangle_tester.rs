@@ -55,15 +55,16 @@
 //!
 //! Triangle cache: [`MAX_CACHE_SETS`] (the paper's 512 items) sets of a triangle's 12 words,
 //! direct mapped by the triangle's low bits, in block RAM, with a tag (triangle and valid bit)
-//! in distributed RAM; `new`'s `cache_sets` uses the first sets only (0: no cache). The
-//! queue's head is looked up as the free buffer copies it; a triangle found there is not
-//! fetched, and the launch reads its words from the cache (addressed a clock ahead, as the ray
-//! store). A triangle fetched from the banks is written into its set as it launches (in its
-//! direction's clock, decided in its origin's), from the words it launches with, unless a
-//! buffered triangle found in the cache holds that set (it must find its words there until
-//! it launches); a head looked up in either clock misses if its set is the launch's. The
-//! frames of an animated scene leave banks 2 and 3 as they are (only instances and the top
-//! level move; `emit::memory_images`' tests hold it), so the cache lives across frames.
+//! in distributed RAM; `new`'s `cache_sets` uses the first sets only (0: no cache). The queue's
+//! head is looked up as the free buffer copies it; a triangle found there is not fetched, and
+//! the launch takes its words from the cache (addressed two clocks ahead: the launch's words,
+//! from the buffer or the cache, wait in a register, `matrix`). A triangle fetched from the
+//! banks is written into its set as it launches (in its direction's clock, decided in its
+//! origin's), from the words it launches with, unless a buffered triangle found in the cache
+//! holds that set (it must find its words there until it launches); a head looked up in either
+//! clock misses if its set is the launch's. The frames of an animated scene leave banks 2 and 3
+//! as they are (only instances and the top level move; `emit::memory_images`' tests hold it),
+//! so the cache lives across frames.
 //!
 //! Latency from launch to the merged hit: `TRANSFORM_LATENCY` (28) + 1 + `intersect_latency`
 //! (35 at e7m16) + 3. Up to [`FLIGHT_SLOTS`] entries are in flight in that time, each with its
@@ -254,6 +255,18 @@ pub struct TriangleTester<
     /// Word k of the triangle in each buffer (distributed RAM addressed by the buffer: the
     /// launch reads its buffer's 12 words at once).
     words: [LutRam<Bits<W>, 2>; 12],
+    /// The buffer whose words are read: `lb`, or the next one in the direction's clock.
+    words_buffer: Signal<Local, Bits<2>>,
+    /// The 12 words the launch takes into the TransformUnit, selected from the buffer or the
+    /// cache a clock ahead: in each clock of waiting (`lb`'s) and in the direction's (the next
+    /// buffer's, for an origin that follows at once). Selected in the launch's clock, the
+    /// path from the buffer's address through its RAM and the cache-or-buffer select into
+    /// the TransformUnit's multipliers was cornell's critical path (70.4 MHz placed, stop 45).
+    matrix: [DFF<Bits<W>>; 12],
+    /// The cache answers next clock with the set of the buffer that clock's launch step reads
+    /// (`lb`'s while waiting, the next buffer's in the direction's clock): a buffer loaded a
+    /// clock ago had its set addressed before its entry was there.
+    cache_ready: DFF<Bit>,
     fetch_a: Signal<Local, Bits<32>>,
     /// The fetch requests its buffer's last words this clock.
     fetch_ends: Signal<Local, Bit>,
@@ -520,6 +533,9 @@ impl<
             head_set: Default::default(),
             head_hit: Default::default(),
             l_cached: Default::default(),
+            words_buffer: Default::default(),
+            matrix: Default::default(),
+            cache_ready: Default::default(),
             l_set: Default::default(),
             n_cached: Default::default(),
             n_set: Default::default(),
@@ -640,6 +656,7 @@ impl<
             fb,
             lb,
             lphase,
+            cache_ready,
             a_issued,
             b_issued,
             seq,
@@ -714,10 +731,16 @@ impl<
         self.flight_a.write_clock.next = self.clock.val();
         self.flight_b.read_clock.next = self.clock.val();
         self.flight_b.write_clock.next = self.clock.val();
+        self.words_buffer.next = self.lb.q.val();
+        if self.lphase.q.val() == Launch::Direction {
+            self.words_buffer.next = self.lb.q.val() + 1;
+        }
         for k in 0..12 {
             self.words[k].write_clock.next = self.clock.val();
             self.words[k].write_enable.next = false;
-            self.words[k].read_address.next = self.lb.q.val();
+            self.words[k].read_address.next = self.words_buffer.val();
+            self.matrix[k].clock.next = self.clock.val();
+            self.matrix[k].d.next = self.matrix[k].q.val();
         }
         self.cache_tag.write_clock.next = self.clock.val();
         for k in 0..12 {
@@ -832,7 +855,7 @@ impl<
         self.l_ready.next = self.l_loaded.val()
             & ((self.l_kind.val() != self.c_test_triangle.val())
                 | (self.l_received.val() == 12)
-                | self.l_cached.val());
+                | (self.l_cached.val() & self.cache_ready.q.val()));
         // The buffer after `lb`, which may launch right after `lb`'s direction.
         self.n_thread.next = self.cur_thread[0].q.val();
         self.n_loaded.next = self.loaded[0].q.val();
@@ -853,7 +876,7 @@ impl<
         self.n_ready.next = self.n_loaded.val()
             & ((self.n_kind.val() != self.c_test_triangle.val())
                 | (self.n_received.val() == 12)
-                | self.n_cached.val());
+                | (self.n_cached.val() & self.cache_ready.q.val()));
 
         // Triangle cache: a launched triangle that came from the banks is written into its
         // set with its words (read from its buffer for the launch) in its direction's clock,
@@ -877,19 +900,23 @@ impl<
             & (!self.l_cached.val())
             & (!self.cache_block.val());
         self.cache_write_r.d.next = self.cache_write.val();
-        // In the direction's clock `lb` and its words are still the launch's.
+        // In the direction's clock `lb` and its words (in `matrix`) are still the launch's.
         self.cache_tag.write_address.next = self.l_set.val();
         self.cache_tag.write_data.next =
             self.c_tag_valid.val() | bit_cast::<25, 24>(self.l_a.val().get_bits::<24>(0));
         self.cache_tag.write_enable.next = self.cache_write_r.q.val();
-        // The words answer a clock after their set: the launch's while it waits and launches
-        // its origin, the next buffer's while it launches its direction (as the ray store).
+        // The words answer a clock after their set: the launch's while it waits, the next
+        // buffer's from the origin's clock on (`matrix` takes them in the direction's).
+        self.cache_ready.d.next = self.l_loaded.val();
+        if self.lphase.q.val() != Launch::Wait {
+            self.cache_ready.d.next = self.n_loaded.val();
+        }
         for k in 0..12 {
             self.cache_words[k].write_address.next = self.l_set.val();
-            self.cache_words[k].write_data.next = self.words[k].read_data.val();
+            self.cache_words[k].write_data.next = self.matrix[k].q.val();
             self.cache_words[k].write_enable.next = self.cache_write_r.q.val();
             self.cache_words[k].read_address.next = self.l_set.val();
-            if self.lphase.q.val() == Launch::Direction {
+            if self.lphase.q.val() != Launch::Wait {
                 self.cache_words[k].read_address.next = self.n_set.val();
             }
         }
@@ -1069,9 +1096,18 @@ impl<
         // Launch from buffer `lb` (its words and the next buffer's: see above): the origin,
         // then the direction, of the entry's thread.
         for k in 0..12 {
-            self.transform_unit.m[k].next = self.words[k].read_data.val();
-            if self.l_cached.val() {
-                self.transform_unit.m[k].next = self.cache_words[k].read_data.val();
+            self.transform_unit.m[k].next = self.matrix[k].q.val();
+            if self.lphase.q.val() == Launch::Wait {
+                self.matrix[k].d.next = self.words[k].read_data.val();
+                if self.l_cached.val() {
+                    self.matrix[k].d.next = self.cache_words[k].read_data.val();
+                }
+            }
+            if self.lphase.q.val() == Launch::Direction {
+                self.matrix[k].d.next = self.words[k].read_data.val();
+                if self.n_cached.val() {
+                    self.matrix[k].d.next = self.cache_words[k].read_data.val();
+                }
             }
         }
         // The ray store answers a clock after its address: the entry's thread while it waits
