@@ -17332,6 +17332,12 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  take_hit_r__d;
     wire  take_hit_r__q;
     reg  take_hit_r__clock;
+    reg  stored_r__d;
+    wire  stored_r__q;
+    reg  stored_r__clock;
+    reg  [2:0] stored_slot_r__d;
+    wire  [2:0] stored_slot_r__q;
+    reg  stored_slot_r__clock;
     reg  s0_valid__d;
     wire  s0_valid__q;
     reg  s0_valid__clock;
@@ -18316,6 +18322,16 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(take_hit_r__q),
         .clock(take_hit_r__clock)
     );
+    dynrt_processor__display__dark_d stored_r(
+        .d(stored_r__d),
+        .q(stored_r__q),
+        .clock(stored_r__clock)
+    );
+    dynrt_processor__engine__mem_bank_r stored_slot_r(
+        .d(stored_slot_r__d),
+        .q(stored_slot_r__q),
+        .clock(stored_slot_r__clock)
+    );
     dynrt_processor__display__dark_d s0_valid(
         .d(s0_valid__d),
         .q(s0_valid__q),
@@ -18701,6 +18717,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         take_r__clock = clock;
         take_slot_r__clock = clock;
         take_hit_r__clock = clock;
+        stored_r__clock = clock;
+        stored_slot_r__clock = clock;
         gen_held__clock = clock;
         gen_hold_point__clock = clock;
         gen_hold_diagonal__clock = clock;
@@ -18731,6 +18749,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         take_r__d = take_r__q;
         take_slot_r__d = take_slot_r__q;
         take_hit_r__d = take_hit_r__q;
+        stored_r__d = stored_r__q;
+        stored_slot_r__d = stored_slot_r__q;
         gen_held__d = gen_held__q;
         gen_hold_point__d = gen_hold_point__q;
         gen_hold_diagonal__d = gen_hold_diagonal__q;
@@ -19727,6 +19747,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 rgb__write_enable = 1'b1;
             end
         end
+        stored_r__d = s1_done & (s1_step__q == ShadeStep__Store);
+        stored_slot_r__d = s1_slot__q;
         if (take_r__q & (take_slot_r__q == c_slot__0)) begin
             busy__0__d = 1'b1;
             ready__0__d = 1'b1;
@@ -19741,7 +19763,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (pick & (ready_slot == c_slot__0)) begin
             ready__0__d = 1'b0;
         end
-        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__0)) begin
+        if (stored_r__q & (stored_slot_r__q == c_slot__0)) begin
             busy__0__d = 1'b0;
             step__0__d = ShadeStep__Idle;
         end
@@ -19807,7 +19829,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (pick & (ready_slot == c_slot__1)) begin
             ready__1__d = 1'b0;
         end
-        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__1)) begin
+        if (stored_r__q & (stored_slot_r__q == c_slot__1)) begin
             busy__1__d = 1'b0;
             step__1__d = ShadeStep__Idle;
         end
@@ -19873,7 +19895,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (pick & (ready_slot == c_slot__2)) begin
             ready__2__d = 1'b0;
         end
-        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__2)) begin
+        if (stored_r__q & (stored_slot_r__q == c_slot__2)) begin
             busy__2__d = 1'b0;
             step__2__d = ShadeStep__Idle;
         end
@@ -19939,7 +19961,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (pick & (ready_slot == c_slot__3)) begin
             ready__3__d = 1'b0;
         end
-        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__3)) begin
+        if (stored_r__q & (stored_slot_r__q == c_slot__3)) begin
             busy__3__d = 1'b0;
             step__3__d = ShadeStep__Idle;
         end
@@ -20005,7 +20027,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (pick & (ready_slot == c_slot__4)) begin
             ready__4__d = 1'b0;
         end
-        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__4)) begin
+        if (stored_r__q & (stored_slot_r__q == c_slot__4)) begin
             busy__4__d = 1'b0;
             step__4__d = ShadeStep__Idle;
         end
@@ -20071,7 +20093,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (pick & (ready_slot == c_slot__5)) begin
             ready__5__d = 1'b0;
         end
-        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__5)) begin
+        if (stored_r__q & (stored_slot_r__q == c_slot__5)) begin
             busy__5__d = 1'b0;
             step__5__d = ShadeStep__Idle;
         end
@@ -20137,7 +20159,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (pick & (ready_slot == c_slot__6)) begin
             ready__6__d = 1'b0;
         end
-        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__6)) begin
+        if (stored_r__q & (stored_slot_r__q == c_slot__6)) begin
             busy__6__d = 1'b0;
             step__6__d = ShadeStep__Idle;
         end
@@ -20203,7 +20225,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (pick & (ready_slot == c_slot__7)) begin
             ready__7__d = 1'b0;
         end
-        if (s1_done & (s1_step__q == ShadeStep__Store) & (s1_slot__q == c_slot__7)) begin
+        if (stored_r__q & (stored_slot_r__q == c_slot__7)) begin
             busy__7__d = 1'b0;
             step__7__d = ShadeStep__Idle;
         end
@@ -22357,6 +22379,10 @@ endmodule // dynrt_processor__engine__shader__res_step_r
 
 
 
+
+
+
+
 module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,a_words__read,a_words__addr,a_words__rdata,b_words__read,b_words__addr,b_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy,cache_hit,cache_miss,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_diagonal,gen_client,gen_thread,gen_take,gen_out_valid,gen_out_client,gen_out_thread,gen_out_dir__0,gen_out_dir__1,gen_out_dir__2,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2);
     
     // Module arguments
@@ -22766,6 +22792,45 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [1:0] words__11__write_address;
     reg  [23:0] words__11__write_data;
     reg  words__11__write_enable;
+    reg  [23:0] matrix__0__d;
+    wire  [23:0] matrix__0__q;
+    reg  matrix__0__clock;
+    reg  [23:0] matrix__1__d;
+    wire  [23:0] matrix__1__q;
+    reg  matrix__1__clock;
+    reg  [23:0] matrix__2__d;
+    wire  [23:0] matrix__2__q;
+    reg  matrix__2__clock;
+    reg  [23:0] matrix__3__d;
+    wire  [23:0] matrix__3__q;
+    reg  matrix__3__clock;
+    reg  [23:0] matrix__4__d;
+    wire  [23:0] matrix__4__q;
+    reg  matrix__4__clock;
+    reg  [23:0] matrix__5__d;
+    wire  [23:0] matrix__5__q;
+    reg  matrix__5__clock;
+    reg  [23:0] matrix__6__d;
+    wire  [23:0] matrix__6__q;
+    reg  matrix__6__clock;
+    reg  [23:0] matrix__7__d;
+    wire  [23:0] matrix__7__q;
+    reg  matrix__7__clock;
+    reg  [23:0] matrix__8__d;
+    wire  [23:0] matrix__8__q;
+    reg  matrix__8__clock;
+    reg  [23:0] matrix__9__d;
+    wire  [23:0] matrix__9__q;
+    reg  matrix__9__clock;
+    reg  [23:0] matrix__10__d;
+    wire  [23:0] matrix__10__q;
+    reg  matrix__10__clock;
+    reg  [23:0] matrix__11__d;
+    wire  [23:0] matrix__11__q;
+    reg  matrix__11__clock;
+    reg  cache_ready__d;
+    wire  cache_ready__q;
+    reg  cache_ready__clock;
     reg  [8:0] cache_tag__read_address;
     wire  [24:0] cache_tag__read_data;
     reg  cache_tag__write_clock;
@@ -23117,6 +23182,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  b_here__1;
     reg  b_here__2;
     reg  b_here__3;
+    reg  [1:0] words_buffer;
     reg  [31:0] fetch_a;
     reg  fetch_ends;
     reg  tb_free;
@@ -23573,6 +23639,71 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_address(words__11__write_address),
         .write_data(words__11__write_data),
         .write_enable(words__11__write_enable)
+    );
+    dynrt_processor__display__rgb_q matrix__0(
+        .d(matrix__0__d),
+        .q(matrix__0__q),
+        .clock(matrix__0__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__1(
+        .d(matrix__1__d),
+        .q(matrix__1__q),
+        .clock(matrix__1__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__2(
+        .d(matrix__2__d),
+        .q(matrix__2__q),
+        .clock(matrix__2__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__3(
+        .d(matrix__3__d),
+        .q(matrix__3__q),
+        .clock(matrix__3__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__4(
+        .d(matrix__4__d),
+        .q(matrix__4__q),
+        .clock(matrix__4__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__5(
+        .d(matrix__5__d),
+        .q(matrix__5__q),
+        .clock(matrix__5__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__6(
+        .d(matrix__6__d),
+        .q(matrix__6__q),
+        .clock(matrix__6__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__7(
+        .d(matrix__7__d),
+        .q(matrix__7__q),
+        .clock(matrix__7__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__8(
+        .d(matrix__8__d),
+        .q(matrix__8__q),
+        .clock(matrix__8__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__9(
+        .d(matrix__9__d),
+        .q(matrix__9__q),
+        .clock(matrix__9__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__10(
+        .d(matrix__10__d),
+        .q(matrix__10__q),
+        .clock(matrix__10__clock)
+    );
+    dynrt_processor__display__rgb_q matrix__11(
+        .d(matrix__11__d),
+        .q(matrix__11__q),
+        .clock(matrix__11__clock)
+    );
+    dynrt_processor__display__dark_d cache_ready(
+        .d(cache_ready__d),
+        .q(cache_ready__q),
+        .clock(cache_ready__clock)
     );
     dynrt_processor__engine__tester__cache_tag cache_tag(
         .read_address(cache_tag__read_address),
@@ -24089,6 +24220,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         fb__clock = clock;
         lb__clock = clock;
         lphase__clock = clock;
+        cache_ready__clock = clock;
         a_issued__clock = clock;
         b_issued__clock = clock;
         seq__clock = clock;
@@ -24130,6 +24262,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         fb__d = fb__q;
         lb__d = lb__q;
         lphase__d = lphase__q;
+        cache_ready__d = cache_ready__q;
         a_issued__d = a_issued__q;
         b_issued__d = b_issued__q;
         seq__d = seq__q;
@@ -24221,42 +24354,70 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         flight_a__write_clock = clock;
         flight_b__read_clock = clock;
         flight_b__write_clock = clock;
+        words_buffer = lb__q;
+        if (lphase__q == Launch__Direction) begin
+            words_buffer = lb__q + 32'h1;
+        end
         words__0__write_clock = clock;
         words__0__write_enable = 1'b0;
-        words__0__read_address = lb__q;
+        words__0__read_address = words_buffer;
+        matrix__0__clock = clock;
+        matrix__0__d = matrix__0__q;
         words__1__write_clock = clock;
         words__1__write_enable = 1'b0;
-        words__1__read_address = lb__q;
+        words__1__read_address = words_buffer;
+        matrix__1__clock = clock;
+        matrix__1__d = matrix__1__q;
         words__2__write_clock = clock;
         words__2__write_enable = 1'b0;
-        words__2__read_address = lb__q;
+        words__2__read_address = words_buffer;
+        matrix__2__clock = clock;
+        matrix__2__d = matrix__2__q;
         words__3__write_clock = clock;
         words__3__write_enable = 1'b0;
-        words__3__read_address = lb__q;
+        words__3__read_address = words_buffer;
+        matrix__3__clock = clock;
+        matrix__3__d = matrix__3__q;
         words__4__write_clock = clock;
         words__4__write_enable = 1'b0;
-        words__4__read_address = lb__q;
+        words__4__read_address = words_buffer;
+        matrix__4__clock = clock;
+        matrix__4__d = matrix__4__q;
         words__5__write_clock = clock;
         words__5__write_enable = 1'b0;
-        words__5__read_address = lb__q;
+        words__5__read_address = words_buffer;
+        matrix__5__clock = clock;
+        matrix__5__d = matrix__5__q;
         words__6__write_clock = clock;
         words__6__write_enable = 1'b0;
-        words__6__read_address = lb__q;
+        words__6__read_address = words_buffer;
+        matrix__6__clock = clock;
+        matrix__6__d = matrix__6__q;
         words__7__write_clock = clock;
         words__7__write_enable = 1'b0;
-        words__7__read_address = lb__q;
+        words__7__read_address = words_buffer;
+        matrix__7__clock = clock;
+        matrix__7__d = matrix__7__q;
         words__8__write_clock = clock;
         words__8__write_enable = 1'b0;
-        words__8__read_address = lb__q;
+        words__8__read_address = words_buffer;
+        matrix__8__clock = clock;
+        matrix__8__d = matrix__8__q;
         words__9__write_clock = clock;
         words__9__write_enable = 1'b0;
-        words__9__read_address = lb__q;
+        words__9__read_address = words_buffer;
+        matrix__9__clock = clock;
+        matrix__9__d = matrix__9__q;
         words__10__write_clock = clock;
         words__10__write_enable = 1'b0;
-        words__10__read_address = lb__q;
+        words__10__read_address = words_buffer;
+        matrix__10__clock = clock;
+        matrix__10__d = matrix__10__q;
         words__11__write_clock = clock;
         words__11__write_enable = 1'b0;
-        words__11__read_address = lb__q;
+        words__11__read_address = words_buffer;
+        matrix__11__clock = clock;
+        matrix__11__d = matrix__11__q;
         cache_tag__write_clock = clock;
         cache_words__0__read_clock = clock;
         cache_words__0__write_clock = clock;
@@ -24442,7 +24603,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_received = received__3__q;
             l_cached = cached__3__q;
         end
-        l_ready = l_loaded & ((l_kind != c_test_triangle) | (l_received == 32'hc) | l_cached);
+        l_ready = l_loaded & ((l_kind != c_test_triangle) | (l_received == 32'hc) | (l_cached & cache_ready__q));
         n_thread = cur_thread__0__q;
         n_loaded = loaded__0__q;
         n_kind = cur_kind__0__q;
@@ -24473,7 +24634,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_cached = cached__3__q;
             n_set = cur_a__3__q[(32'h0)+:(9)] & c_set_mask;
         end
-        n_ready = n_loaded & ((n_kind != c_test_triangle) | (n_received == 32'hc) | n_cached);
+        n_ready = n_loaded & ((n_kind != c_test_triangle) | (n_received == 32'hc) | (n_cached & cache_ready__q));
         l_set = l_a[(32'h0)+:(9)] & c_set_mask;
         cache_block = 1'b0;
         if (loaded__0__q & cached__0__q & ((cur_a__0__q[(32'h0)+:(9)] & c_set_mask) == l_set)) begin
@@ -24493,88 +24654,92 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cache_tag__write_address = l_set;
         cache_tag__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
         cache_tag__write_enable = cache_write_r__q;
+        cache_ready__d = l_loaded;
+        if (lphase__q != Launch__Wait) begin
+            cache_ready__d = n_loaded;
+        end
         cache_words__0__write_address = l_set;
-        cache_words__0__write_data = words__0__read_data;
+        cache_words__0__write_data = matrix__0__q;
         cache_words__0__write_enable = cache_write_r__q;
         cache_words__0__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__0__read_address = n_set;
         end
         cache_words__1__write_address = l_set;
-        cache_words__1__write_data = words__1__read_data;
+        cache_words__1__write_data = matrix__1__q;
         cache_words__1__write_enable = cache_write_r__q;
         cache_words__1__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__1__read_address = n_set;
         end
         cache_words__2__write_address = l_set;
-        cache_words__2__write_data = words__2__read_data;
+        cache_words__2__write_data = matrix__2__q;
         cache_words__2__write_enable = cache_write_r__q;
         cache_words__2__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__2__read_address = n_set;
         end
         cache_words__3__write_address = l_set;
-        cache_words__3__write_data = words__3__read_data;
+        cache_words__3__write_data = matrix__3__q;
         cache_words__3__write_enable = cache_write_r__q;
         cache_words__3__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__3__read_address = n_set;
         end
         cache_words__4__write_address = l_set;
-        cache_words__4__write_data = words__4__read_data;
+        cache_words__4__write_data = matrix__4__q;
         cache_words__4__write_enable = cache_write_r__q;
         cache_words__4__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__4__read_address = n_set;
         end
         cache_words__5__write_address = l_set;
-        cache_words__5__write_data = words__5__read_data;
+        cache_words__5__write_data = matrix__5__q;
         cache_words__5__write_enable = cache_write_r__q;
         cache_words__5__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__5__read_address = n_set;
         end
         cache_words__6__write_address = l_set;
-        cache_words__6__write_data = words__6__read_data;
+        cache_words__6__write_data = matrix__6__q;
         cache_words__6__write_enable = cache_write_r__q;
         cache_words__6__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__6__read_address = n_set;
         end
         cache_words__7__write_address = l_set;
-        cache_words__7__write_data = words__7__read_data;
+        cache_words__7__write_data = matrix__7__q;
         cache_words__7__write_enable = cache_write_r__q;
         cache_words__7__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__7__read_address = n_set;
         end
         cache_words__8__write_address = l_set;
-        cache_words__8__write_data = words__8__read_data;
+        cache_words__8__write_data = matrix__8__q;
         cache_words__8__write_enable = cache_write_r__q;
         cache_words__8__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__8__read_address = n_set;
         end
         cache_words__9__write_address = l_set;
-        cache_words__9__write_data = words__9__read_data;
+        cache_words__9__write_data = matrix__9__q;
         cache_words__9__write_enable = cache_write_r__q;
         cache_words__9__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__9__read_address = n_set;
         end
         cache_words__10__write_address = l_set;
-        cache_words__10__write_data = words__10__read_data;
+        cache_words__10__write_data = matrix__10__q;
         cache_words__10__write_enable = cache_write_r__q;
         cache_words__10__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__10__read_address = n_set;
         end
         cache_words__11__write_address = l_set;
-        cache_words__11__write_data = words__11__read_data;
+        cache_words__11__write_data = matrix__11__q;
         cache_words__11__write_enable = cache_write_r__q;
         cache_words__11__read_address = l_set;
-        if (lphase__q == Launch__Direction) begin
+        if (lphase__q != Launch__Wait) begin
             cache_words__11__read_address = n_set;
         end
         head_triangle = list_unit__test_entry[(32'h20)+:(24)];
@@ -24821,53 +24986,161 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         if (a_here__3 & b_here__3) begin
             received__3__d = received__3__q + 32'h2;
         end
-        transform_unit__m__0 = words__0__read_data;
-        if (l_cached) begin
-            transform_unit__m__0 = cache_words__0__read_data;
+        transform_unit__m__0 = matrix__0__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__0__d = words__0__read_data;
+            if (l_cached) begin
+                matrix__0__d = cache_words__0__read_data;
+            end
         end
-        transform_unit__m__1 = words__1__read_data;
-        if (l_cached) begin
-            transform_unit__m__1 = cache_words__1__read_data;
+        if (lphase__q == Launch__Direction) begin
+            matrix__0__d = words__0__read_data;
+            if (n_cached) begin
+                matrix__0__d = cache_words__0__read_data;
+            end
         end
-        transform_unit__m__2 = words__2__read_data;
-        if (l_cached) begin
-            transform_unit__m__2 = cache_words__2__read_data;
+        transform_unit__m__1 = matrix__1__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__1__d = words__1__read_data;
+            if (l_cached) begin
+                matrix__1__d = cache_words__1__read_data;
+            end
         end
-        transform_unit__m__3 = words__3__read_data;
-        if (l_cached) begin
-            transform_unit__m__3 = cache_words__3__read_data;
+        if (lphase__q == Launch__Direction) begin
+            matrix__1__d = words__1__read_data;
+            if (n_cached) begin
+                matrix__1__d = cache_words__1__read_data;
+            end
         end
-        transform_unit__m__4 = words__4__read_data;
-        if (l_cached) begin
-            transform_unit__m__4 = cache_words__4__read_data;
+        transform_unit__m__2 = matrix__2__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__2__d = words__2__read_data;
+            if (l_cached) begin
+                matrix__2__d = cache_words__2__read_data;
+            end
         end
-        transform_unit__m__5 = words__5__read_data;
-        if (l_cached) begin
-            transform_unit__m__5 = cache_words__5__read_data;
+        if (lphase__q == Launch__Direction) begin
+            matrix__2__d = words__2__read_data;
+            if (n_cached) begin
+                matrix__2__d = cache_words__2__read_data;
+            end
         end
-        transform_unit__m__6 = words__6__read_data;
-        if (l_cached) begin
-            transform_unit__m__6 = cache_words__6__read_data;
+        transform_unit__m__3 = matrix__3__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__3__d = words__3__read_data;
+            if (l_cached) begin
+                matrix__3__d = cache_words__3__read_data;
+            end
         end
-        transform_unit__m__7 = words__7__read_data;
-        if (l_cached) begin
-            transform_unit__m__7 = cache_words__7__read_data;
+        if (lphase__q == Launch__Direction) begin
+            matrix__3__d = words__3__read_data;
+            if (n_cached) begin
+                matrix__3__d = cache_words__3__read_data;
+            end
         end
-        transform_unit__m__8 = words__8__read_data;
-        if (l_cached) begin
-            transform_unit__m__8 = cache_words__8__read_data;
+        transform_unit__m__4 = matrix__4__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__4__d = words__4__read_data;
+            if (l_cached) begin
+                matrix__4__d = cache_words__4__read_data;
+            end
         end
-        transform_unit__m__9 = words__9__read_data;
-        if (l_cached) begin
-            transform_unit__m__9 = cache_words__9__read_data;
+        if (lphase__q == Launch__Direction) begin
+            matrix__4__d = words__4__read_data;
+            if (n_cached) begin
+                matrix__4__d = cache_words__4__read_data;
+            end
         end
-        transform_unit__m__10 = words__10__read_data;
-        if (l_cached) begin
-            transform_unit__m__10 = cache_words__10__read_data;
+        transform_unit__m__5 = matrix__5__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__5__d = words__5__read_data;
+            if (l_cached) begin
+                matrix__5__d = cache_words__5__read_data;
+            end
         end
-        transform_unit__m__11 = words__11__read_data;
-        if (l_cached) begin
-            transform_unit__m__11 = cache_words__11__read_data;
+        if (lphase__q == Launch__Direction) begin
+            matrix__5__d = words__5__read_data;
+            if (n_cached) begin
+                matrix__5__d = cache_words__5__read_data;
+            end
+        end
+        transform_unit__m__6 = matrix__6__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__6__d = words__6__read_data;
+            if (l_cached) begin
+                matrix__6__d = cache_words__6__read_data;
+            end
+        end
+        if (lphase__q == Launch__Direction) begin
+            matrix__6__d = words__6__read_data;
+            if (n_cached) begin
+                matrix__6__d = cache_words__6__read_data;
+            end
+        end
+        transform_unit__m__7 = matrix__7__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__7__d = words__7__read_data;
+            if (l_cached) begin
+                matrix__7__d = cache_words__7__read_data;
+            end
+        end
+        if (lphase__q == Launch__Direction) begin
+            matrix__7__d = words__7__read_data;
+            if (n_cached) begin
+                matrix__7__d = cache_words__7__read_data;
+            end
+        end
+        transform_unit__m__8 = matrix__8__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__8__d = words__8__read_data;
+            if (l_cached) begin
+                matrix__8__d = cache_words__8__read_data;
+            end
+        end
+        if (lphase__q == Launch__Direction) begin
+            matrix__8__d = words__8__read_data;
+            if (n_cached) begin
+                matrix__8__d = cache_words__8__read_data;
+            end
+        end
+        transform_unit__m__9 = matrix__9__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__9__d = words__9__read_data;
+            if (l_cached) begin
+                matrix__9__d = cache_words__9__read_data;
+            end
+        end
+        if (lphase__q == Launch__Direction) begin
+            matrix__9__d = words__9__read_data;
+            if (n_cached) begin
+                matrix__9__d = cache_words__9__read_data;
+            end
+        end
+        transform_unit__m__10 = matrix__10__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__10__d = words__10__read_data;
+            if (l_cached) begin
+                matrix__10__d = cache_words__10__read_data;
+            end
+        end
+        if (lphase__q == Launch__Direction) begin
+            matrix__10__d = words__10__read_data;
+            if (n_cached) begin
+                matrix__10__d = cache_words__10__read_data;
+            end
+        end
+        transform_unit__m__11 = matrix__11__q;
+        if (lphase__q == Launch__Wait) begin
+            matrix__11__d = words__11__read_data;
+            if (l_cached) begin
+                matrix__11__d = cache_words__11__read_data;
+            end
+        end
+        if (lphase__q == Launch__Direction) begin
+            matrix__11__d = words__11__read_data;
+            if (n_cached) begin
+                matrix__11__d = cache_words__11__read_data;
+            end
         end
         ray__ray_thread = l_thread;
         ray__t_min_thread = l_thread;
@@ -25156,6 +25429,8 @@ module dynrt_processor__engine__tester__best_e(read_address,read_clock,read_data
     end
                 
 endmodule // dynrt_processor__engine__tester__best_e
+
+
 
 
 
@@ -30681,6 +30956,30 @@ module dynrt_processor__engine__tester__lw_best(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__tester__lw_best
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
