@@ -73,12 +73,16 @@ pub fn preflight(
     );
     {
         use crate::hw::triangle_tester::{cache_sets_supported, MAX_CACHE_SETS};
-        let sets = params.tri_cache_sets;
-        anyhow::ensure!(
-            cache_sets_supported(sets),
-            "--tri-cache {sets}: the triangle cache has a power of two of sets up to \
-             {MAX_CACHE_SETS}, or 0 for none; use e.g. --tri-cache {MAX_CACHE_SETS}"
-        );
+        for (flag, cache, sets) in [
+            ("--tri-cache", "triangle", params.tri_cache_sets),
+            ("--node-cache", "node", params.node_cache_sets),
+        ] {
+            anyhow::ensure!(
+                cache_sets_supported(sets),
+                "{flag} {sets}: the {cache} cache has a power of two of sets up to \
+                 {MAX_CACHE_SETS}, or 0 for none; use e.g. {flag} {MAX_CACHE_SETS}"
+            );
+        }
     }
     if let Some(n) = frames {
         anyhow::ensure!(
@@ -426,6 +430,8 @@ pub struct FrameReport {
     /// Triangle tests whose words came from the triangle cache, and from banks 2 and 3.
     pub tri_cache_hits: u64,
     pub tri_cache_misses: u64,
+    pub node_cache_hits: u64,
+    pub node_cache_misses: u64,
     pub pixels: u64,
     pub mismatches: Vec<Mismatch>,
     pub differing_pixels: usize,
@@ -654,6 +660,8 @@ pub fn simulate_scene(
             bank_reads: fr.bank_reads,
             tri_cache_hits: fr.tri_cache_hits,
             tri_cache_misses: fr.tri_cache_misses,
+            node_cache_hits: fr.node_cache_hits,
+            node_cache_misses: fr.node_cache_misses,
             pixels: u64::from(w * h),
             differing_pixels: differing.len(),
             mismatches,

@@ -15,7 +15,7 @@
 /* verilator lint_off UNUSEDSIGNAL */
 
 
-module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy,tri_cache_hits,tri_cache_misses,vga_clock,vga_reset,vga_fb_addr,vga_fb_data,vga_hsync,vga_vsync,vga_rgb,vga_frame_start);
+module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy,tri_cache_hits,tri_cache_misses,node_cache_hits,node_cache_misses,vga_clock,vga_reset,vga_fb_addr,vga_fb_data,vga_hsync,vga_vsync,vga_rgb,vga_frame_start);
     
     // Module arguments
     input wire  clock;
@@ -47,6 +47,8 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
     output reg  [31:0] shading_busy;
     output reg  [31:0] tri_cache_hits;
     output reg  [31:0] tri_cache_misses;
+    output reg  [31:0] node_cache_hits;
+    output reg  [31:0] node_cache_misses;
     input wire  vga_clock;
     input wire  vga_reset;
     output reg  [23:0] vga_fb_addr;
@@ -70,6 +72,8 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
     wire  [31:0] engine__shading_busy;
     wire  [31:0] engine__tri_cache_hits;
     wire  [31:0] engine__tri_cache_misses;
+    wire  [31:0] engine__node_cache_hits;
+    wire  [31:0] engine__node_cache_misses;
     reg  display__clock;
     reg  display__reset;
     wire  [23:0] display__fb_addr;
@@ -109,7 +113,9 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
         .instance_busy(engine__instance_busy),
         .shading_busy(engine__shading_busy),
         .tri_cache_hits(engine__tri_cache_hits),
-        .tri_cache_misses(engine__tri_cache_misses)
+        .tri_cache_misses(engine__tri_cache_misses),
+        .node_cache_hits(engine__node_cache_hits),
+        .node_cache_misses(engine__node_cache_misses)
     );
     dynrt_processor__display display(
         .clock(display__clock),
@@ -137,6 +143,8 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
         shading_busy = engine__shading_busy;
         tri_cache_hits = engine__tri_cache_hits;
         tri_cache_misses = engine__tri_cache_misses;
+        node_cache_hits = engine__node_cache_hits;
+        node_cache_misses = engine__node_cache_misses;
         display__clock = vga_clock;
         display__reset = vga_reset;
         vga_fb_addr = ((display__fb_addr) & 24'hffffff);
@@ -655,7 +663,7 @@ endmodule // dynrt_processor__display__timing__col
 
 
 
-module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy,tri_cache_hits,tri_cache_misses);
+module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy,tri_cache_hits,tri_cache_misses,node_cache_hits,node_cache_misses);
     
     // Module arguments
     input wire  clock;
@@ -687,6 +695,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     output reg  [31:0] shading_busy;
     output reg  [31:0] tri_cache_hits;
     output reg  [31:0] tri_cache_misses;
+    output reg  [31:0] node_cache_hits;
+    output reg  [31:0] node_cache_misses;
     
     // Constant declarations
     localparam  c_threads = 8'h20;
@@ -1225,6 +1235,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [25:0] traversal_unit__root;
     wire  [31:0] traversal_unit__top_from;
     wire  [31:0] traversal_unit__top_to;
+    wire  traversal_unit__cache_hit;
+    wire  traversal_unit__cache_miss;
     reg  running__d;
     wire  running__q;
     reg  running__clock;
@@ -1264,6 +1276,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [31:0] cache_miss_count__d;
     wire  [31:0] cache_miss_count__q;
     reg  cache_miss_count__clock;
+    reg  [31:0] node_hit_count__d;
+    wire  [31:0] node_hit_count__q;
+    reg  node_hit_count__clock;
+    reg  [31:0] node_miss_count__d;
+    wire  [31:0] node_miss_count__q;
+    reg  node_miss_count__clock;
     reg  count_in_frame__d;
     wire  count_in_frame__q;
     reg  count_in_frame__clock;
@@ -1291,6 +1309,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  tick_cache_miss__d;
     wire  tick_cache_miss__q;
     reg  tick_cache_miss__clock;
+    reg  tick_node_hit__d;
+    wire  tick_node_hit__q;
+    reg  tick_node_hit__clock;
+    reg  tick_node_miss__d;
+    wire  tick_node_miss__q;
+    reg  tick_node_miss__clock;
     reg  [5:0] mem_load_r__d;
     wire  [5:0] mem_load_r__q;
     reg  mem_load_r__clock;
@@ -1875,7 +1899,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .root_thread(traversal_unit__root_thread),
         .root(traversal_unit__root),
         .top_from(traversal_unit__top_from),
-        .top_to(traversal_unit__top_to)
+        .top_to(traversal_unit__top_to),
+        .cache_hit(traversal_unit__cache_hit),
+        .cache_miss(traversal_unit__cache_miss)
     );
     dynrt_processor__display__dark_d running(
         .d(running__d),
@@ -1942,6 +1968,16 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(cache_miss_count__q),
         .clock(cache_miss_count__clock)
     );
+    dynrt_processor__engine__cache_hit_count node_hit_count(
+        .d(node_hit_count__d),
+        .q(node_hit_count__q),
+        .clock(node_hit_count__clock)
+    );
+    dynrt_processor__engine__cache_hit_count node_miss_count(
+        .d(node_miss_count__d),
+        .q(node_miss_count__q),
+        .clock(node_miss_count__clock)
+    );
     dynrt_processor__display__dark_d count_in_frame(
         .d(count_in_frame__d),
         .q(count_in_frame__q),
@@ -1986,6 +2022,16 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .d(tick_cache_miss__d),
         .q(tick_cache_miss__q),
         .clock(tick_cache_miss__clock)
+    );
+    dynrt_processor__display__dark_d tick_node_hit(
+        .d(tick_node_hit__d),
+        .q(tick_node_hit__q),
+        .clock(tick_node_hit__clock)
+    );
+    dynrt_processor__display__dark_d tick_node_miss(
+        .d(tick_node_miss__d),
+        .q(tick_node_miss__q),
+        .clock(tick_node_miss__clock)
     );
     dynrt_processor__engine__mem_load_r mem_load_r(
         .d(mem_load_r__d),
@@ -2116,6 +2162,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         shading_count__clock = clock;
         cache_hit_count__clock = clock;
         cache_miss_count__clock = clock;
+        node_hit_count__clock = clock;
+        node_miss_count__clock = clock;
         count_in_frame__clock = clock;
         tick_transform__clock = clock;
         tick_intersect__clock = clock;
@@ -2125,6 +2173,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tick_shading__clock = clock;
         tick_cache_hit__clock = clock;
         tick_cache_miss__clock = clock;
+        tick_node_hit__clock = clock;
+        tick_node_miss__clock = clock;
         intersect_count__clock = clock;
         traversal_count__clock = clock;
         mem_load_r__clock = clock;
@@ -2161,6 +2211,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         shading_count__d = shading_count__q;
         cache_hit_count__d = cache_hit_count__q;
         cache_miss_count__d = cache_miss_count__q;
+        node_hit_count__d = node_hit_count__q;
+        node_miss_count__d = node_miss_count__q;
         count_in_frame__d = count_in_frame__q;
         tick_transform__d = tick_transform__q;
         tick_intersect__d = tick_intersect__q;
@@ -2170,6 +2222,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tick_shading__d = tick_shading__q;
         tick_cache_hit__d = tick_cache_hit__q;
         tick_cache_miss__d = tick_cache_miss__q;
+        tick_node_hit__d = tick_node_hit__q;
+        tick_node_miss__d = tick_node_miss__q;
         intersect_count__d = intersect_count__q;
         traversal_count__d = traversal_count__q;
         mem_load_r__d = mem_load_r__q;
@@ -2224,6 +2278,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         shading_busy = shading_count__q;
         tri_cache_hits = cache_hit_count__q;
         tri_cache_misses = cache_miss_count__q;
+        node_cache_hits = node_hit_count__q;
+        node_cache_misses = node_miss_count__q;
         if (in_frame) begin
             cycle_count__d = cycle_count__q + 32'h1;
         end
@@ -2233,6 +2289,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tick_traversal__d = traversal_unit__step_busy;
         tick_cache_hit__d = tester__cache_hit;
         tick_cache_miss__d = tester__cache_miss;
+        tick_node_hit__d = traversal_unit__cache_hit;
+        tick_node_miss__d = traversal_unit__cache_miss;
         if (count_in_frame__q) begin
             if (tick_transform__q) begin
                 transform_count__d = transform_count__q + 32'h1;
@@ -2257,6 +2315,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             end
             if (tick_cache_miss__q) begin
                 cache_miss_count__d = cache_miss_count__q + 32'h1;
+            end
+            if (tick_node_hit__q) begin
+                node_hit_count__d = node_hit_count__q + 32'h1;
+            end
+            if (tick_node_miss__q) begin
+                node_miss_count__d = node_miss_count__q + 32'h1;
             end
         end
         scheduler__running = running__q;
@@ -2691,6 +2755,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             instance_count__d = 32'h0;
             cache_hit_count__d = 32'h0;
             cache_miss_count__d = 32'h0;
+            node_hit_count__d = 32'h0;
+            node_miss_count__d = 32'h0;
             shading_count__d = 32'h0;
         end
     end
@@ -12393,6 +12459,10 @@ module dynrt_processor__engine__mem_load_r(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__mem_load_r
+
+
+
+
 
 
 
@@ -22792,6 +22862,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [1:0] words__11__write_address;
     reg  [23:0] words__11__write_data;
     reg  words__11__write_enable;
+    reg  [1:0] words_buffer__d;
+    wire  [1:0] words_buffer__q;
+    reg  words_buffer__clock;
+    reg  matrix_cached__d;
+    wire  matrix_cached__q;
+    reg  matrix_cached__clock;
     reg  [23:0] matrix__0__d;
     wire  [23:0] matrix__0__q;
     reg  matrix__0__clock;
@@ -22832,9 +22908,10 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     wire  cache_ready__q;
     reg  cache_ready__clock;
     reg  [8:0] cache_tag__read_address;
+    reg  cache_tag__read_clock;
     wire  [24:0] cache_tag__read_data;
-    reg  cache_tag__write_clock;
     reg  [8:0] cache_tag__write_address;
+    reg  cache_tag__write_clock;
     reg  [24:0] cache_tag__write_data;
     reg  cache_tag__write_enable;
     reg  [8:0] cache_words__0__read_address;
@@ -22933,6 +23010,27 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  cached__3__d;
     wire  cached__3__q;
     reg  cached__3__clock;
+    reg  fresh__0__d;
+    wire  fresh__0__q;
+    reg  fresh__0__clock;
+    reg  fresh__1__d;
+    wire  fresh__1__q;
+    reg  fresh__1__clock;
+    reg  fresh__2__d;
+    wire  fresh__2__q;
+    reg  fresh__2__clock;
+    reg  fresh__3__d;
+    wire  fresh__3__q;
+    reg  fresh__3__clock;
+    reg  [23:0] head_triangle_r__d;
+    wire  [23:0] head_triangle_r__q;
+    reg  head_triangle_r__clock;
+    reg  [8:0] head_set_r__d;
+    wire  [8:0] head_set_r__q;
+    reg  head_set_r__clock;
+    reg  head_clash_r__d;
+    wire  head_clash_r__q;
+    reg  head_clash_r__clock;
     reg  cache_write_r__d;
     wire  cache_write_r__q;
     reg  cache_write_r__clock;
@@ -23182,13 +23280,14 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  b_here__1;
     reg  b_here__2;
     reg  b_here__3;
-    reg  [1:0] words_buffer;
     reg  [31:0] fetch_a;
     reg  fetch_ends;
     reg  tb_free;
     reg  [23:0] head_triangle;
     reg  [8:0] head_set;
     reg  head_hit;
+    reg  l_fresh;
+    reg  n_fresh;
     reg  l_cached;
     reg  [8:0] l_set;
     reg  n_cached;
@@ -23197,7 +23296,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  cache_block;
     reg  head_clash;
     reg  take;
-    reg  take_triangle;
     reg  fetch_moves;
     reg  [1:0] fetch_next;
     reg  next_triangle;
@@ -23640,6 +23738,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(words__11__write_data),
         .write_enable(words__11__write_enable)
     );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 words_buffer(
+        .d(words_buffer__d),
+        .q(words_buffer__q),
+        .clock(words_buffer__clock)
+    );
+    dynrt_processor__display__dark_d matrix_cached(
+        .d(matrix_cached__d),
+        .q(matrix_cached__q),
+        .clock(matrix_cached__clock)
+    );
     dynrt_processor__display__rgb_q matrix__0(
         .d(matrix__0__d),
         .q(matrix__0__q),
@@ -23707,9 +23815,10 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     );
     dynrt_processor__engine__tester__cache_tag cache_tag(
         .read_address(cache_tag__read_address),
+        .read_clock(cache_tag__read_clock),
         .read_data(cache_tag__read_data),
-        .write_clock(cache_tag__write_clock),
         .write_address(cache_tag__write_address),
+        .write_clock(cache_tag__write_clock),
         .write_data(cache_tag__write_data),
         .write_enable(cache_tag__write_enable)
     );
@@ -23840,6 +23949,41 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .d(cached__3__d),
         .q(cached__3__q),
         .clock(cached__3__clock)
+    );
+    dynrt_processor__display__dark_d fresh__0(
+        .d(fresh__0__d),
+        .q(fresh__0__q),
+        .clock(fresh__0__clock)
+    );
+    dynrt_processor__display__dark_d fresh__1(
+        .d(fresh__1__d),
+        .q(fresh__1__q),
+        .clock(fresh__1__clock)
+    );
+    dynrt_processor__display__dark_d fresh__2(
+        .d(fresh__2__d),
+        .q(fresh__2__q),
+        .clock(fresh__2__clock)
+    );
+    dynrt_processor__display__dark_d fresh__3(
+        .d(fresh__3__d),
+        .q(fresh__3__q),
+        .clock(fresh__3__clock)
+    );
+    dynrt_processor__display__rgb_q head_triangle_r(
+        .d(head_triangle_r__d),
+        .q(head_triangle_r__q),
+        .clock(head_triangle_r__clock)
+    );
+    dynrt_processor__engine__fp_units__add__lz head_set_r(
+        .d(head_set_r__d),
+        .q(head_set_r__q),
+        .clock(head_set_r__clock)
+    );
+    dynrt_processor__display__dark_d head_clash_r(
+        .d(head_clash_r__d),
+        .q(head_clash_r__q),
+        .clock(head_clash_r__clock)
     );
     dynrt_processor__display__dark_d cache_write_r(
         .d(cache_write_r__d),
@@ -24220,7 +24364,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         fb__clock = clock;
         lb__clock = clock;
         lphase__clock = clock;
+        words_buffer__clock = clock;
+        matrix_cached__clock = clock;
         cache_ready__clock = clock;
+        head_triangle_r__clock = clock;
+        head_set_r__clock = clock;
+        head_clash_r__clock = clock;
         a_issued__clock = clock;
         b_issued__clock = clock;
         seq__clock = clock;
@@ -24262,7 +24411,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         fb__d = fb__q;
         lb__d = lb__q;
         lphase__d = lphase__q;
+        words_buffer__d = words_buffer__q;
+        matrix_cached__d = matrix_cached__q;
         cache_ready__d = cache_ready__q;
+        head_triangle_r__d = head_triangle_r__q;
+        head_set_r__d = head_set_r__q;
+        head_clash_r__d = head_clash_r__q;
         a_issued__d = a_issued__q;
         b_issued__d = b_issued__q;
         seq__d = seq__q;
@@ -24354,71 +24508,68 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         flight_a__write_clock = clock;
         flight_b__read_clock = clock;
         flight_b__write_clock = clock;
-        words_buffer = lb__q;
-        if (lphase__q == Launch__Direction) begin
-            words_buffer = lb__q + 32'h1;
-        end
         words__0__write_clock = clock;
         words__0__write_enable = 1'b0;
-        words__0__read_address = words_buffer;
+        words__0__read_address = words_buffer__q;
         matrix__0__clock = clock;
         matrix__0__d = matrix__0__q;
         words__1__write_clock = clock;
         words__1__write_enable = 1'b0;
-        words__1__read_address = words_buffer;
+        words__1__read_address = words_buffer__q;
         matrix__1__clock = clock;
         matrix__1__d = matrix__1__q;
         words__2__write_clock = clock;
         words__2__write_enable = 1'b0;
-        words__2__read_address = words_buffer;
+        words__2__read_address = words_buffer__q;
         matrix__2__clock = clock;
         matrix__2__d = matrix__2__q;
         words__3__write_clock = clock;
         words__3__write_enable = 1'b0;
-        words__3__read_address = words_buffer;
+        words__3__read_address = words_buffer__q;
         matrix__3__clock = clock;
         matrix__3__d = matrix__3__q;
         words__4__write_clock = clock;
         words__4__write_enable = 1'b0;
-        words__4__read_address = words_buffer;
+        words__4__read_address = words_buffer__q;
         matrix__4__clock = clock;
         matrix__4__d = matrix__4__q;
         words__5__write_clock = clock;
         words__5__write_enable = 1'b0;
-        words__5__read_address = words_buffer;
+        words__5__read_address = words_buffer__q;
         matrix__5__clock = clock;
         matrix__5__d = matrix__5__q;
         words__6__write_clock = clock;
         words__6__write_enable = 1'b0;
-        words__6__read_address = words_buffer;
+        words__6__read_address = words_buffer__q;
         matrix__6__clock = clock;
         matrix__6__d = matrix__6__q;
         words__7__write_clock = clock;
         words__7__write_enable = 1'b0;
-        words__7__read_address = words_buffer;
+        words__7__read_address = words_buffer__q;
         matrix__7__clock = clock;
         matrix__7__d = matrix__7__q;
         words__8__write_clock = clock;
         words__8__write_enable = 1'b0;
-        words__8__read_address = words_buffer;
+        words__8__read_address = words_buffer__q;
         matrix__8__clock = clock;
         matrix__8__d = matrix__8__q;
         words__9__write_clock = clock;
         words__9__write_enable = 1'b0;
-        words__9__read_address = words_buffer;
+        words__9__read_address = words_buffer__q;
         matrix__9__clock = clock;
         matrix__9__d = matrix__9__q;
         words__10__write_clock = clock;
         words__10__write_enable = 1'b0;
-        words__10__read_address = words_buffer;
+        words__10__read_address = words_buffer__q;
         matrix__10__clock = clock;
         matrix__10__d = matrix__10__q;
         words__11__write_clock = clock;
         words__11__write_enable = 1'b0;
-        words__11__read_address = words_buffer;
+        words__11__read_address = words_buffer__q;
         matrix__11__clock = clock;
         matrix__11__d = matrix__11__q;
         cache_tag__write_clock = clock;
+        cache_tag__read_clock = clock;
         cache_words__0__read_clock = clock;
         cache_words__0__write_clock = clock;
         cache_words__1__read_clock = clock;
@@ -24445,6 +24596,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cache_words__11__write_clock = clock;
         cached__0__clock = clock;
         cached__0__d = cached__0__q;
+        fresh__0__clock = clock;
         loaded__0__clock = clock;
         loaded__0__d = loaded__0__q;
         unvisited__0__clock = clock;
@@ -24461,6 +24613,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         received__0__d = received__0__q;
         cached__1__clock = clock;
         cached__1__d = cached__1__q;
+        fresh__1__clock = clock;
         loaded__1__clock = clock;
         loaded__1__d = loaded__1__q;
         unvisited__1__clock = clock;
@@ -24477,6 +24630,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         received__1__d = received__1__q;
         cached__2__clock = clock;
         cached__2__d = cached__2__q;
+        fresh__2__clock = clock;
         loaded__2__clock = clock;
         loaded__2__d = loaded__2__q;
         unvisited__2__clock = clock;
@@ -24493,6 +24647,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         received__2__d = received__2__q;
         cached__3__clock = clock;
         cached__3__d = cached__3__q;
+        fresh__3__clock = clock;
         loaded__3__clock = clock;
         loaded__3__d = loaded__3__q;
         unvisited__3__clock = clock;
@@ -24576,6 +24731,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         l_loaded = loaded__0__q;
         l_received = received__0__q;
         l_cached = cached__0__q;
+        l_fresh = fresh__0__q;
         if (lb__q == c_buffer__1) begin
             l_kind = cur_kind__1__q;
             l_thread = cur_thread__1__q;
@@ -24584,6 +24740,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__1__q;
             l_received = received__1__q;
             l_cached = cached__1__q;
+            l_fresh = fresh__1__q;
         end
         if (lb__q == c_buffer__2) begin
             l_kind = cur_kind__2__q;
@@ -24593,6 +24750,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__2__q;
             l_received = received__2__q;
             l_cached = cached__2__q;
+            l_fresh = fresh__2__q;
         end
         if (lb__q == c_buffer__3) begin
             l_kind = cur_kind__3__q;
@@ -24602,6 +24760,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__3__q;
             l_received = received__3__q;
             l_cached = cached__3__q;
+            l_fresh = fresh__3__q;
         end
         l_ready = l_loaded & ((l_kind != c_test_triangle) | (l_received == 32'hc) | (l_cached & cache_ready__q));
         n_thread = cur_thread__0__q;
@@ -24609,6 +24768,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         n_kind = cur_kind__0__q;
         n_received = received__0__q;
         n_cached = cached__0__q;
+        n_fresh = fresh__0__q;
         n_set = cur_a__0__q[(32'h0)+:(9)] & c_set_mask;
         if (lb__q + 32'h1 == c_buffer__1) begin
             n_thread = cur_thread__1__q;
@@ -24616,6 +24776,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__1__q;
             n_received = received__1__q;
             n_cached = cached__1__q;
+            n_fresh = fresh__1__q;
             n_set = cur_a__1__q[(32'h0)+:(9)] & c_set_mask;
         end
         if (lb__q + 32'h1 == c_buffer__2) begin
@@ -24624,6 +24785,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__2__q;
             n_received = received__2__q;
             n_cached = cached__2__q;
+            n_fresh = fresh__2__q;
             n_set = cur_a__2__q[(32'h0)+:(9)] & c_set_mask;
         end
         if (lb__q + 32'h1 == c_buffer__3) begin
@@ -24632,6 +24794,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__3__q;
             n_received = received__3__q;
             n_cached = cached__3__q;
+            n_fresh = fresh__3__q;
             n_set = cur_a__3__q[(32'h0)+:(9)] & c_set_mask;
         end
         n_ready = n_loaded & ((n_kind != c_test_triangle) | (n_received == 32'hc) | (n_cached & cache_ready__q));
@@ -24654,9 +24817,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cache_tag__write_address = l_set;
         cache_tag__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
         cache_tag__write_enable = cache_write_r__q;
-        cache_ready__d = l_loaded;
+        cache_ready__d = l_loaded & (~l_fresh);
         if (lphase__q != Launch__Wait) begin
-            cache_ready__d = n_loaded;
+            cache_ready__d = n_loaded & (~n_fresh);
         end
         cache_words__0__write_address = l_set;
         cache_words__0__write_data = matrix__0__q;
@@ -24746,7 +24909,10 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_set = head_triangle[(32'h0)+:(9)] & c_set_mask;
         cache_tag__read_address = head_set;
         head_clash = ((lphase__q == Launch__Origin) | cache_write_r__q) & (l_set == head_set);
-        head_hit = c_cache_on & (cache_tag__read_data == (c_tag_valid | ((head_triangle) & 25'h1ffffff))) & (~head_clash);
+        head_triangle_r__d = head_triangle;
+        head_set_r__d = head_set;
+        head_clash_r__d = head_clash;
+        head_hit = c_cache_on & (cache_tag__read_data == (c_tag_valid | ((head_triangle_r__q) & 25'h1ffffff))) & (~head_clash_r__q) & (~((lphase__q == Launch__Origin) & (l_set == head_set_r__q)));
         tb_free = ~loaded__0__q;
         if (tb__q == c_buffer__1) begin
             tb_free = ~loaded__1__q;
@@ -24759,7 +24925,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         end
         take = tb_free & list_unit__test_valid;
         list_unit__test_take = take;
-        take_triangle = take & (list_unit__test_entry[(32'h45)+:(2)] == c_test_triangle);
         if (take) begin
             tb__d = tb__q + 32'h1;
             if (tb__q == c_buffer__0) begin
@@ -24784,28 +24949,44 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             cur_thread__0__d = list_unit__test_entry[(32'h40)+:(5)];
             cur_a__0__d = list_unit__test_entry[(32'h20)+:(32)];
             cur_b__0__d = list_unit__test_entry[(32'h0)+:(32)];
-            cached__0__d = head_hit & (list_unit__test_entry[(32'h45)+:(2)] == c_test_triangle);
+            cached__0__d = 1'b0;
         end
         if ((tb__q == c_buffer__1) & (~loaded__1__q)) begin
             cur_kind__1__d = list_unit__test_entry[(32'h45)+:(2)];
             cur_thread__1__d = list_unit__test_entry[(32'h40)+:(5)];
             cur_a__1__d = list_unit__test_entry[(32'h20)+:(32)];
             cur_b__1__d = list_unit__test_entry[(32'h0)+:(32)];
-            cached__1__d = head_hit & (list_unit__test_entry[(32'h45)+:(2)] == c_test_triangle);
+            cached__1__d = 1'b0;
         end
         if ((tb__q == c_buffer__2) & (~loaded__2__q)) begin
             cur_kind__2__d = list_unit__test_entry[(32'h45)+:(2)];
             cur_thread__2__d = list_unit__test_entry[(32'h40)+:(5)];
             cur_a__2__d = list_unit__test_entry[(32'h20)+:(32)];
             cur_b__2__d = list_unit__test_entry[(32'h0)+:(32)];
-            cached__2__d = head_hit & (list_unit__test_entry[(32'h45)+:(2)] == c_test_triangle);
+            cached__2__d = 1'b0;
         end
         if ((tb__q == c_buffer__3) & (~loaded__3__q)) begin
             cur_kind__3__d = list_unit__test_entry[(32'h45)+:(2)];
             cur_thread__3__d = list_unit__test_entry[(32'h40)+:(5)];
             cur_a__3__d = list_unit__test_entry[(32'h20)+:(32)];
             cur_b__3__d = list_unit__test_entry[(32'h0)+:(32)];
-            cached__3__d = head_hit & (list_unit__test_entry[(32'h45)+:(2)] == c_test_triangle);
+            cached__3__d = 1'b0;
+        end
+        fresh__0__d = take & (tb__q == c_buffer__0);
+        if (fresh__0__q) begin
+            cached__0__d = head_hit & (cur_kind__0__q == c_test_triangle);
+        end
+        fresh__1__d = take & (tb__q == c_buffer__1);
+        if (fresh__1__q) begin
+            cached__1__d = head_hit & (cur_kind__1__q == c_test_triangle);
+        end
+        fresh__2__d = take & (tb__q == c_buffer__2);
+        if (fresh__2__q) begin
+            cached__2__d = head_hit & (cur_kind__2__q == c_test_triangle);
+        end
+        fresh__3__d = take & (tb__q == c_buffer__3);
+        if (fresh__3__q) begin
+            cached__3__d = head_hit & (cur_kind__3__q == c_test_triangle);
         end
         a_take = fetching__q & (a_issued__q < 32'h6) & ((engine__load_banks & c_bank_a) == 32'h0);
         b_take = fetching__q & (b_issued__q < 32'h6) & ((engine__load_banks & c_bank_b) == 32'h0);
@@ -24876,17 +25057,17 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
                 unvisited__3__d = 1'b0;
             end
         end
-        next_triangle = take_triangle & (~head_hit) & (tb__q == fetch_next);
-        if ((fetch_next == c_buffer__0) & unvisited__0__q & (cur_kind__0__q == c_test_triangle) & (~cached__0__q)) begin
+        next_triangle = 1'b0;
+        if ((fetch_next == c_buffer__0) & unvisited__0__q & (~fresh__0__q) & (cur_kind__0__q == c_test_triangle) & (~cached__0__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__1) & unvisited__1__q & (cur_kind__1__q == c_test_triangle) & (~cached__1__q)) begin
+        if ((fetch_next == c_buffer__1) & unvisited__1__q & (~fresh__1__q) & (cur_kind__1__q == c_test_triangle) & (~cached__1__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__2) & unvisited__2__q & (cur_kind__2__q == c_test_triangle) & (~cached__2__q)) begin
+        if ((fetch_next == c_buffer__2) & unvisited__2__q & (~fresh__2__q) & (cur_kind__2__q == c_test_triangle) & (~cached__2__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__3) & unvisited__3__q & (cur_kind__3__q == c_test_triangle) & (~cached__3__q)) begin
+        if ((fetch_next == c_buffer__3) & unvisited__3__q & (~fresh__3__q) & (cur_kind__3__q == c_test_triangle) & (~cached__3__q)) begin
             next_triangle = 1'b1;
         end
         if ((~fetching__q) | fetch_ends) begin
@@ -24986,159 +25167,93 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         if (a_here__3 & b_here__3) begin
             received__3__d = received__3__q + 32'h2;
         end
-        transform_unit__m__0 = matrix__0__q;
+        words_buffer__d = lb__q + 32'h1;
+        matrix_cached__d = n_cached;
         if (lphase__q == Launch__Wait) begin
-            matrix__0__d = words__0__read_data;
-            if (l_cached) begin
-                matrix__0__d = cache_words__0__read_data;
-            end
+            words_buffer__d = lb__q;
+            matrix_cached__d = l_cached;
         end
-        if (lphase__q == Launch__Direction) begin
+        transform_unit__m__0 = matrix__0__q;
+        if (lphase__q != Launch__Origin) begin
             matrix__0__d = words__0__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__0__d = cache_words__0__read_data;
             end
         end
         transform_unit__m__1 = matrix__1__q;
-        if (lphase__q == Launch__Wait) begin
+        if (lphase__q != Launch__Origin) begin
             matrix__1__d = words__1__read_data;
-            if (l_cached) begin
-                matrix__1__d = cache_words__1__read_data;
-            end
-        end
-        if (lphase__q == Launch__Direction) begin
-            matrix__1__d = words__1__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__1__d = cache_words__1__read_data;
             end
         end
         transform_unit__m__2 = matrix__2__q;
-        if (lphase__q == Launch__Wait) begin
+        if (lphase__q != Launch__Origin) begin
             matrix__2__d = words__2__read_data;
-            if (l_cached) begin
-                matrix__2__d = cache_words__2__read_data;
-            end
-        end
-        if (lphase__q == Launch__Direction) begin
-            matrix__2__d = words__2__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__2__d = cache_words__2__read_data;
             end
         end
         transform_unit__m__3 = matrix__3__q;
-        if (lphase__q == Launch__Wait) begin
+        if (lphase__q != Launch__Origin) begin
             matrix__3__d = words__3__read_data;
-            if (l_cached) begin
-                matrix__3__d = cache_words__3__read_data;
-            end
-        end
-        if (lphase__q == Launch__Direction) begin
-            matrix__3__d = words__3__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__3__d = cache_words__3__read_data;
             end
         end
         transform_unit__m__4 = matrix__4__q;
-        if (lphase__q == Launch__Wait) begin
+        if (lphase__q != Launch__Origin) begin
             matrix__4__d = words__4__read_data;
-            if (l_cached) begin
-                matrix__4__d = cache_words__4__read_data;
-            end
-        end
-        if (lphase__q == Launch__Direction) begin
-            matrix__4__d = words__4__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__4__d = cache_words__4__read_data;
             end
         end
         transform_unit__m__5 = matrix__5__q;
-        if (lphase__q == Launch__Wait) begin
+        if (lphase__q != Launch__Origin) begin
             matrix__5__d = words__5__read_data;
-            if (l_cached) begin
-                matrix__5__d = cache_words__5__read_data;
-            end
-        end
-        if (lphase__q == Launch__Direction) begin
-            matrix__5__d = words__5__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__5__d = cache_words__5__read_data;
             end
         end
         transform_unit__m__6 = matrix__6__q;
-        if (lphase__q == Launch__Wait) begin
+        if (lphase__q != Launch__Origin) begin
             matrix__6__d = words__6__read_data;
-            if (l_cached) begin
-                matrix__6__d = cache_words__6__read_data;
-            end
-        end
-        if (lphase__q == Launch__Direction) begin
-            matrix__6__d = words__6__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__6__d = cache_words__6__read_data;
             end
         end
         transform_unit__m__7 = matrix__7__q;
-        if (lphase__q == Launch__Wait) begin
+        if (lphase__q != Launch__Origin) begin
             matrix__7__d = words__7__read_data;
-            if (l_cached) begin
-                matrix__7__d = cache_words__7__read_data;
-            end
-        end
-        if (lphase__q == Launch__Direction) begin
-            matrix__7__d = words__7__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__7__d = cache_words__7__read_data;
             end
         end
         transform_unit__m__8 = matrix__8__q;
-        if (lphase__q == Launch__Wait) begin
+        if (lphase__q != Launch__Origin) begin
             matrix__8__d = words__8__read_data;
-            if (l_cached) begin
-                matrix__8__d = cache_words__8__read_data;
-            end
-        end
-        if (lphase__q == Launch__Direction) begin
-            matrix__8__d = words__8__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__8__d = cache_words__8__read_data;
             end
         end
         transform_unit__m__9 = matrix__9__q;
-        if (lphase__q == Launch__Wait) begin
+        if (lphase__q != Launch__Origin) begin
             matrix__9__d = words__9__read_data;
-            if (l_cached) begin
-                matrix__9__d = cache_words__9__read_data;
-            end
-        end
-        if (lphase__q == Launch__Direction) begin
-            matrix__9__d = words__9__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__9__d = cache_words__9__read_data;
             end
         end
         transform_unit__m__10 = matrix__10__q;
-        if (lphase__q == Launch__Wait) begin
+        if (lphase__q != Launch__Origin) begin
             matrix__10__d = words__10__read_data;
-            if (l_cached) begin
-                matrix__10__d = cache_words__10__read_data;
-            end
-        end
-        if (lphase__q == Launch__Direction) begin
-            matrix__10__d = words__10__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__10__d = cache_words__10__read_data;
             end
         end
         transform_unit__m__11 = matrix__11__q;
-        if (lphase__q == Launch__Wait) begin
+        if (lphase__q != Launch__Origin) begin
             matrix__11__d = words__11__read_data;
-            if (l_cached) begin
-                matrix__11__d = cache_words__11__read_data;
-            end
-        end
-        if (lphase__q == Launch__Direction) begin
-            matrix__11__d = words__11__read_data;
-            if (n_cached) begin
+            if (matrix_cached__q) begin
                 matrix__11__d = cache_words__11__read_data;
             end
         end
@@ -25435,13 +25550,14 @@ endmodule // dynrt_processor__engine__tester__best_e
 
 
 
-module dynrt_processor__engine__tester__cache_tag(read_address,read_data,write_clock,write_address,write_data,write_enable);
+module dynrt_processor__engine__tester__cache_tag(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [8:0] read_address;
+    input wire  read_clock;
     output reg  [24:0] read_data;
-    input wire  write_clock;
     input wire  [8:0] write_address;
+    input wire  write_clock;
     input wire  [24:0] write_data;
     input wire  write_enable;
     
@@ -25449,522 +25565,523 @@ module dynrt_processor__engine__tester__cache_tag(read_address,read_data,write_c
     reg[24:0] mem[511:0];
     
     initial begin
-       mem[0] = 25'h0;
-       mem[1] = 25'h0;
-       mem[2] = 25'h0;
-       mem[3] = 25'h0;
-       mem[4] = 25'h0;
-       mem[5] = 25'h0;
-       mem[6] = 25'h0;
-       mem[7] = 25'h0;
-       mem[8] = 25'h0;
-       mem[9] = 25'h0;
-       mem[10] = 25'h0;
-       mem[11] = 25'h0;
-       mem[12] = 25'h0;
-       mem[13] = 25'h0;
-       mem[14] = 25'h0;
-       mem[15] = 25'h0;
-       mem[16] = 25'h0;
-       mem[17] = 25'h0;
-       mem[18] = 25'h0;
-       mem[19] = 25'h0;
-       mem[20] = 25'h0;
-       mem[21] = 25'h0;
-       mem[22] = 25'h0;
-       mem[23] = 25'h0;
-       mem[24] = 25'h0;
-       mem[25] = 25'h0;
-       mem[26] = 25'h0;
-       mem[27] = 25'h0;
-       mem[28] = 25'h0;
-       mem[29] = 25'h0;
-       mem[30] = 25'h0;
-       mem[31] = 25'h0;
-       mem[32] = 25'h0;
-       mem[33] = 25'h0;
-       mem[34] = 25'h0;
-       mem[35] = 25'h0;
-       mem[36] = 25'h0;
-       mem[37] = 25'h0;
-       mem[38] = 25'h0;
-       mem[39] = 25'h0;
-       mem[40] = 25'h0;
-       mem[41] = 25'h0;
-       mem[42] = 25'h0;
-       mem[43] = 25'h0;
-       mem[44] = 25'h0;
-       mem[45] = 25'h0;
-       mem[46] = 25'h0;
-       mem[47] = 25'h0;
-       mem[48] = 25'h0;
-       mem[49] = 25'h0;
-       mem[50] = 25'h0;
-       mem[51] = 25'h0;
-       mem[52] = 25'h0;
-       mem[53] = 25'h0;
-       mem[54] = 25'h0;
-       mem[55] = 25'h0;
-       mem[56] = 25'h0;
-       mem[57] = 25'h0;
-       mem[58] = 25'h0;
-       mem[59] = 25'h0;
-       mem[60] = 25'h0;
-       mem[61] = 25'h0;
-       mem[62] = 25'h0;
-       mem[63] = 25'h0;
-       mem[64] = 25'h0;
-       mem[65] = 25'h0;
-       mem[66] = 25'h0;
-       mem[67] = 25'h0;
-       mem[68] = 25'h0;
-       mem[69] = 25'h0;
-       mem[70] = 25'h0;
-       mem[71] = 25'h0;
-       mem[72] = 25'h0;
-       mem[73] = 25'h0;
-       mem[74] = 25'h0;
-       mem[75] = 25'h0;
-       mem[76] = 25'h0;
-       mem[77] = 25'h0;
-       mem[78] = 25'h0;
-       mem[79] = 25'h0;
-       mem[80] = 25'h0;
-       mem[81] = 25'h0;
-       mem[82] = 25'h0;
-       mem[83] = 25'h0;
-       mem[84] = 25'h0;
-       mem[85] = 25'h0;
-       mem[86] = 25'h0;
-       mem[87] = 25'h0;
-       mem[88] = 25'h0;
-       mem[89] = 25'h0;
-       mem[90] = 25'h0;
-       mem[91] = 25'h0;
-       mem[92] = 25'h0;
-       mem[93] = 25'h0;
-       mem[94] = 25'h0;
-       mem[95] = 25'h0;
-       mem[96] = 25'h0;
-       mem[97] = 25'h0;
-       mem[98] = 25'h0;
-       mem[99] = 25'h0;
-       mem[100] = 25'h0;
-       mem[101] = 25'h0;
-       mem[102] = 25'h0;
-       mem[103] = 25'h0;
-       mem[104] = 25'h0;
-       mem[105] = 25'h0;
-       mem[106] = 25'h0;
-       mem[107] = 25'h0;
-       mem[108] = 25'h0;
-       mem[109] = 25'h0;
-       mem[110] = 25'h0;
-       mem[111] = 25'h0;
-       mem[112] = 25'h0;
-       mem[113] = 25'h0;
-       mem[114] = 25'h0;
-       mem[115] = 25'h0;
-       mem[116] = 25'h0;
-       mem[117] = 25'h0;
-       mem[118] = 25'h0;
-       mem[119] = 25'h0;
-       mem[120] = 25'h0;
-       mem[121] = 25'h0;
-       mem[122] = 25'h0;
-       mem[123] = 25'h0;
-       mem[124] = 25'h0;
-       mem[125] = 25'h0;
-       mem[126] = 25'h0;
-       mem[127] = 25'h0;
-       mem[128] = 25'h0;
-       mem[129] = 25'h0;
-       mem[130] = 25'h0;
-       mem[131] = 25'h0;
-       mem[132] = 25'h0;
-       mem[133] = 25'h0;
-       mem[134] = 25'h0;
-       mem[135] = 25'h0;
-       mem[136] = 25'h0;
-       mem[137] = 25'h0;
-       mem[138] = 25'h0;
-       mem[139] = 25'h0;
-       mem[140] = 25'h0;
-       mem[141] = 25'h0;
-       mem[142] = 25'h0;
-       mem[143] = 25'h0;
-       mem[144] = 25'h0;
-       mem[145] = 25'h0;
-       mem[146] = 25'h0;
-       mem[147] = 25'h0;
-       mem[148] = 25'h0;
-       mem[149] = 25'h0;
-       mem[150] = 25'h0;
-       mem[151] = 25'h0;
-       mem[152] = 25'h0;
-       mem[153] = 25'h0;
-       mem[154] = 25'h0;
-       mem[155] = 25'h0;
-       mem[156] = 25'h0;
-       mem[157] = 25'h0;
-       mem[158] = 25'h0;
-       mem[159] = 25'h0;
-       mem[160] = 25'h0;
-       mem[161] = 25'h0;
-       mem[162] = 25'h0;
-       mem[163] = 25'h0;
-       mem[164] = 25'h0;
-       mem[165] = 25'h0;
-       mem[166] = 25'h0;
-       mem[167] = 25'h0;
-       mem[168] = 25'h0;
-       mem[169] = 25'h0;
-       mem[170] = 25'h0;
-       mem[171] = 25'h0;
-       mem[172] = 25'h0;
-       mem[173] = 25'h0;
-       mem[174] = 25'h0;
-       mem[175] = 25'h0;
-       mem[176] = 25'h0;
-       mem[177] = 25'h0;
-       mem[178] = 25'h0;
-       mem[179] = 25'h0;
-       mem[180] = 25'h0;
-       mem[181] = 25'h0;
-       mem[182] = 25'h0;
-       mem[183] = 25'h0;
-       mem[184] = 25'h0;
-       mem[185] = 25'h0;
-       mem[186] = 25'h0;
-       mem[187] = 25'h0;
-       mem[188] = 25'h0;
-       mem[189] = 25'h0;
-       mem[190] = 25'h0;
-       mem[191] = 25'h0;
-       mem[192] = 25'h0;
-       mem[193] = 25'h0;
-       mem[194] = 25'h0;
-       mem[195] = 25'h0;
-       mem[196] = 25'h0;
-       mem[197] = 25'h0;
-       mem[198] = 25'h0;
-       mem[199] = 25'h0;
-       mem[200] = 25'h0;
-       mem[201] = 25'h0;
-       mem[202] = 25'h0;
-       mem[203] = 25'h0;
-       mem[204] = 25'h0;
-       mem[205] = 25'h0;
-       mem[206] = 25'h0;
-       mem[207] = 25'h0;
-       mem[208] = 25'h0;
-       mem[209] = 25'h0;
-       mem[210] = 25'h0;
-       mem[211] = 25'h0;
-       mem[212] = 25'h0;
-       mem[213] = 25'h0;
-       mem[214] = 25'h0;
-       mem[215] = 25'h0;
-       mem[216] = 25'h0;
-       mem[217] = 25'h0;
-       mem[218] = 25'h0;
-       mem[219] = 25'h0;
-       mem[220] = 25'h0;
-       mem[221] = 25'h0;
-       mem[222] = 25'h0;
-       mem[223] = 25'h0;
-       mem[224] = 25'h0;
-       mem[225] = 25'h0;
-       mem[226] = 25'h0;
-       mem[227] = 25'h0;
-       mem[228] = 25'h0;
-       mem[229] = 25'h0;
-       mem[230] = 25'h0;
-       mem[231] = 25'h0;
-       mem[232] = 25'h0;
-       mem[233] = 25'h0;
-       mem[234] = 25'h0;
-       mem[235] = 25'h0;
-       mem[236] = 25'h0;
-       mem[237] = 25'h0;
-       mem[238] = 25'h0;
-       mem[239] = 25'h0;
-       mem[240] = 25'h0;
-       mem[241] = 25'h0;
-       mem[242] = 25'h0;
-       mem[243] = 25'h0;
-       mem[244] = 25'h0;
-       mem[245] = 25'h0;
-       mem[246] = 25'h0;
-       mem[247] = 25'h0;
-       mem[248] = 25'h0;
-       mem[249] = 25'h0;
-       mem[250] = 25'h0;
-       mem[251] = 25'h0;
-       mem[252] = 25'h0;
-       mem[253] = 25'h0;
-       mem[254] = 25'h0;
-       mem[255] = 25'h0;
-       mem[256] = 25'h0;
-       mem[257] = 25'h0;
-       mem[258] = 25'h0;
-       mem[259] = 25'h0;
-       mem[260] = 25'h0;
-       mem[261] = 25'h0;
-       mem[262] = 25'h0;
-       mem[263] = 25'h0;
-       mem[264] = 25'h0;
-       mem[265] = 25'h0;
-       mem[266] = 25'h0;
-       mem[267] = 25'h0;
-       mem[268] = 25'h0;
-       mem[269] = 25'h0;
-       mem[270] = 25'h0;
-       mem[271] = 25'h0;
-       mem[272] = 25'h0;
-       mem[273] = 25'h0;
-       mem[274] = 25'h0;
-       mem[275] = 25'h0;
-       mem[276] = 25'h0;
-       mem[277] = 25'h0;
-       mem[278] = 25'h0;
-       mem[279] = 25'h0;
-       mem[280] = 25'h0;
-       mem[281] = 25'h0;
-       mem[282] = 25'h0;
-       mem[283] = 25'h0;
-       mem[284] = 25'h0;
-       mem[285] = 25'h0;
-       mem[286] = 25'h0;
-       mem[287] = 25'h0;
-       mem[288] = 25'h0;
-       mem[289] = 25'h0;
-       mem[290] = 25'h0;
-       mem[291] = 25'h0;
-       mem[292] = 25'h0;
-       mem[293] = 25'h0;
-       mem[294] = 25'h0;
-       mem[295] = 25'h0;
-       mem[296] = 25'h0;
-       mem[297] = 25'h0;
-       mem[298] = 25'h0;
-       mem[299] = 25'h0;
-       mem[300] = 25'h0;
-       mem[301] = 25'h0;
-       mem[302] = 25'h0;
-       mem[303] = 25'h0;
-       mem[304] = 25'h0;
-       mem[305] = 25'h0;
-       mem[306] = 25'h0;
-       mem[307] = 25'h0;
-       mem[308] = 25'h0;
-       mem[309] = 25'h0;
-       mem[310] = 25'h0;
-       mem[311] = 25'h0;
-       mem[312] = 25'h0;
-       mem[313] = 25'h0;
-       mem[314] = 25'h0;
-       mem[315] = 25'h0;
-       mem[316] = 25'h0;
-       mem[317] = 25'h0;
-       mem[318] = 25'h0;
-       mem[319] = 25'h0;
-       mem[320] = 25'h0;
-       mem[321] = 25'h0;
-       mem[322] = 25'h0;
-       mem[323] = 25'h0;
-       mem[324] = 25'h0;
-       mem[325] = 25'h0;
-       mem[326] = 25'h0;
-       mem[327] = 25'h0;
-       mem[328] = 25'h0;
-       mem[329] = 25'h0;
-       mem[330] = 25'h0;
-       mem[331] = 25'h0;
-       mem[332] = 25'h0;
-       mem[333] = 25'h0;
-       mem[334] = 25'h0;
-       mem[335] = 25'h0;
-       mem[336] = 25'h0;
-       mem[337] = 25'h0;
-       mem[338] = 25'h0;
-       mem[339] = 25'h0;
-       mem[340] = 25'h0;
-       mem[341] = 25'h0;
-       mem[342] = 25'h0;
-       mem[343] = 25'h0;
-       mem[344] = 25'h0;
-       mem[345] = 25'h0;
-       mem[346] = 25'h0;
-       mem[347] = 25'h0;
-       mem[348] = 25'h0;
-       mem[349] = 25'h0;
-       mem[350] = 25'h0;
-       mem[351] = 25'h0;
-       mem[352] = 25'h0;
-       mem[353] = 25'h0;
-       mem[354] = 25'h0;
-       mem[355] = 25'h0;
-       mem[356] = 25'h0;
-       mem[357] = 25'h0;
-       mem[358] = 25'h0;
-       mem[359] = 25'h0;
-       mem[360] = 25'h0;
-       mem[361] = 25'h0;
-       mem[362] = 25'h0;
-       mem[363] = 25'h0;
-       mem[364] = 25'h0;
-       mem[365] = 25'h0;
-       mem[366] = 25'h0;
-       mem[367] = 25'h0;
-       mem[368] = 25'h0;
-       mem[369] = 25'h0;
-       mem[370] = 25'h0;
-       mem[371] = 25'h0;
-       mem[372] = 25'h0;
-       mem[373] = 25'h0;
-       mem[374] = 25'h0;
-       mem[375] = 25'h0;
-       mem[376] = 25'h0;
-       mem[377] = 25'h0;
-       mem[378] = 25'h0;
-       mem[379] = 25'h0;
-       mem[380] = 25'h0;
-       mem[381] = 25'h0;
-       mem[382] = 25'h0;
-       mem[383] = 25'h0;
-       mem[384] = 25'h0;
-       mem[385] = 25'h0;
-       mem[386] = 25'h0;
-       mem[387] = 25'h0;
-       mem[388] = 25'h0;
-       mem[389] = 25'h0;
-       mem[390] = 25'h0;
-       mem[391] = 25'h0;
-       mem[392] = 25'h0;
-       mem[393] = 25'h0;
-       mem[394] = 25'h0;
-       mem[395] = 25'h0;
-       mem[396] = 25'h0;
-       mem[397] = 25'h0;
-       mem[398] = 25'h0;
-       mem[399] = 25'h0;
-       mem[400] = 25'h0;
-       mem[401] = 25'h0;
-       mem[402] = 25'h0;
-       mem[403] = 25'h0;
-       mem[404] = 25'h0;
-       mem[405] = 25'h0;
-       mem[406] = 25'h0;
-       mem[407] = 25'h0;
-       mem[408] = 25'h0;
-       mem[409] = 25'h0;
-       mem[410] = 25'h0;
-       mem[411] = 25'h0;
-       mem[412] = 25'h0;
-       mem[413] = 25'h0;
-       mem[414] = 25'h0;
-       mem[415] = 25'h0;
-       mem[416] = 25'h0;
-       mem[417] = 25'h0;
-       mem[418] = 25'h0;
-       mem[419] = 25'h0;
-       mem[420] = 25'h0;
-       mem[421] = 25'h0;
-       mem[422] = 25'h0;
-       mem[423] = 25'h0;
-       mem[424] = 25'h0;
-       mem[425] = 25'h0;
-       mem[426] = 25'h0;
-       mem[427] = 25'h0;
-       mem[428] = 25'h0;
-       mem[429] = 25'h0;
-       mem[430] = 25'h0;
-       mem[431] = 25'h0;
-       mem[432] = 25'h0;
-       mem[433] = 25'h0;
-       mem[434] = 25'h0;
-       mem[435] = 25'h0;
-       mem[436] = 25'h0;
-       mem[437] = 25'h0;
-       mem[438] = 25'h0;
-       mem[439] = 25'h0;
-       mem[440] = 25'h0;
-       mem[441] = 25'h0;
-       mem[442] = 25'h0;
-       mem[443] = 25'h0;
-       mem[444] = 25'h0;
-       mem[445] = 25'h0;
-       mem[446] = 25'h0;
-       mem[447] = 25'h0;
-       mem[448] = 25'h0;
-       mem[449] = 25'h0;
-       mem[450] = 25'h0;
-       mem[451] = 25'h0;
-       mem[452] = 25'h0;
-       mem[453] = 25'h0;
-       mem[454] = 25'h0;
-       mem[455] = 25'h0;
-       mem[456] = 25'h0;
-       mem[457] = 25'h0;
-       mem[458] = 25'h0;
-       mem[459] = 25'h0;
-       mem[460] = 25'h0;
-       mem[461] = 25'h0;
-       mem[462] = 25'h0;
-       mem[463] = 25'h0;
-       mem[464] = 25'h0;
-       mem[465] = 25'h0;
-       mem[466] = 25'h0;
-       mem[467] = 25'h0;
-       mem[468] = 25'h0;
-       mem[469] = 25'h0;
-       mem[470] = 25'h0;
-       mem[471] = 25'h0;
-       mem[472] = 25'h0;
-       mem[473] = 25'h0;
-       mem[474] = 25'h0;
-       mem[475] = 25'h0;
-       mem[476] = 25'h0;
-       mem[477] = 25'h0;
-       mem[478] = 25'h0;
-       mem[479] = 25'h0;
-       mem[480] = 25'h0;
-       mem[481] = 25'h0;
-       mem[482] = 25'h0;
-       mem[483] = 25'h0;
-       mem[484] = 25'h0;
-       mem[485] = 25'h0;
-       mem[486] = 25'h0;
-       mem[487] = 25'h0;
-       mem[488] = 25'h0;
-       mem[489] = 25'h0;
-       mem[490] = 25'h0;
-       mem[491] = 25'h0;
-       mem[492] = 25'h0;
-       mem[493] = 25'h0;
-       mem[494] = 25'h0;
-       mem[495] = 25'h0;
-       mem[496] = 25'h0;
-       mem[497] = 25'h0;
-       mem[498] = 25'h0;
-       mem[499] = 25'h0;
-       mem[500] = 25'h0;
-       mem[501] = 25'h0;
-       mem[502] = 25'h0;
-       mem[503] = 25'h0;
-       mem[504] = 25'h0;
-       mem[505] = 25'h0;
-       mem[506] = 25'h0;
-       mem[507] = 25'h0;
-       mem[508] = 25'h0;
-       mem[509] = 25'h0;
-       mem[510] = 25'h0;
-       mem[511] = 25'h0;
+    mem[9'b0] = 25'h0;
+    mem[9'b1] = 25'h0;
+    mem[9'b10] = 25'h0;
+    mem[9'b11] = 25'h0;
+    mem[9'b100] = 25'h0;
+    mem[9'b101] = 25'h0;
+    mem[9'b110] = 25'h0;
+    mem[9'b111] = 25'h0;
+    mem[9'b1000] = 25'h0;
+    mem[9'b1001] = 25'h0;
+    mem[9'b1010] = 25'h0;
+    mem[9'b1011] = 25'h0;
+    mem[9'b1100] = 25'h0;
+    mem[9'b1101] = 25'h0;
+    mem[9'b1110] = 25'h0;
+    mem[9'b1111] = 25'h0;
+    mem[9'b10000] = 25'h0;
+    mem[9'b10001] = 25'h0;
+    mem[9'b10010] = 25'h0;
+    mem[9'b10011] = 25'h0;
+    mem[9'b10100] = 25'h0;
+    mem[9'b10101] = 25'h0;
+    mem[9'b10110] = 25'h0;
+    mem[9'b10111] = 25'h0;
+    mem[9'b11000] = 25'h0;
+    mem[9'b11001] = 25'h0;
+    mem[9'b11010] = 25'h0;
+    mem[9'b11011] = 25'h0;
+    mem[9'b11100] = 25'h0;
+    mem[9'b11101] = 25'h0;
+    mem[9'b11110] = 25'h0;
+    mem[9'b11111] = 25'h0;
+    mem[9'b100000] = 25'h0;
+    mem[9'b100001] = 25'h0;
+    mem[9'b100010] = 25'h0;
+    mem[9'b100011] = 25'h0;
+    mem[9'b100100] = 25'h0;
+    mem[9'b100101] = 25'h0;
+    mem[9'b100110] = 25'h0;
+    mem[9'b100111] = 25'h0;
+    mem[9'b101000] = 25'h0;
+    mem[9'b101001] = 25'h0;
+    mem[9'b101010] = 25'h0;
+    mem[9'b101011] = 25'h0;
+    mem[9'b101100] = 25'h0;
+    mem[9'b101101] = 25'h0;
+    mem[9'b101110] = 25'h0;
+    mem[9'b101111] = 25'h0;
+    mem[9'b110000] = 25'h0;
+    mem[9'b110001] = 25'h0;
+    mem[9'b110010] = 25'h0;
+    mem[9'b110011] = 25'h0;
+    mem[9'b110100] = 25'h0;
+    mem[9'b110101] = 25'h0;
+    mem[9'b110110] = 25'h0;
+    mem[9'b110111] = 25'h0;
+    mem[9'b111000] = 25'h0;
+    mem[9'b111001] = 25'h0;
+    mem[9'b111010] = 25'h0;
+    mem[9'b111011] = 25'h0;
+    mem[9'b111100] = 25'h0;
+    mem[9'b111101] = 25'h0;
+    mem[9'b111110] = 25'h0;
+    mem[9'b111111] = 25'h0;
+    mem[9'b1000000] = 25'h0;
+    mem[9'b1000001] = 25'h0;
+    mem[9'b1000010] = 25'h0;
+    mem[9'b1000011] = 25'h0;
+    mem[9'b1000100] = 25'h0;
+    mem[9'b1000101] = 25'h0;
+    mem[9'b1000110] = 25'h0;
+    mem[9'b1000111] = 25'h0;
+    mem[9'b1001000] = 25'h0;
+    mem[9'b1001001] = 25'h0;
+    mem[9'b1001010] = 25'h0;
+    mem[9'b1001011] = 25'h0;
+    mem[9'b1001100] = 25'h0;
+    mem[9'b1001101] = 25'h0;
+    mem[9'b1001110] = 25'h0;
+    mem[9'b1001111] = 25'h0;
+    mem[9'b1010000] = 25'h0;
+    mem[9'b1010001] = 25'h0;
+    mem[9'b1010010] = 25'h0;
+    mem[9'b1010011] = 25'h0;
+    mem[9'b1010100] = 25'h0;
+    mem[9'b1010101] = 25'h0;
+    mem[9'b1010110] = 25'h0;
+    mem[9'b1010111] = 25'h0;
+    mem[9'b1011000] = 25'h0;
+    mem[9'b1011001] = 25'h0;
+    mem[9'b1011010] = 25'h0;
+    mem[9'b1011011] = 25'h0;
+    mem[9'b1011100] = 25'h0;
+    mem[9'b1011101] = 25'h0;
+    mem[9'b1011110] = 25'h0;
+    mem[9'b1011111] = 25'h0;
+    mem[9'b1100000] = 25'h0;
+    mem[9'b1100001] = 25'h0;
+    mem[9'b1100010] = 25'h0;
+    mem[9'b1100011] = 25'h0;
+    mem[9'b1100100] = 25'h0;
+    mem[9'b1100101] = 25'h0;
+    mem[9'b1100110] = 25'h0;
+    mem[9'b1100111] = 25'h0;
+    mem[9'b1101000] = 25'h0;
+    mem[9'b1101001] = 25'h0;
+    mem[9'b1101010] = 25'h0;
+    mem[9'b1101011] = 25'h0;
+    mem[9'b1101100] = 25'h0;
+    mem[9'b1101101] = 25'h0;
+    mem[9'b1101110] = 25'h0;
+    mem[9'b1101111] = 25'h0;
+    mem[9'b1110000] = 25'h0;
+    mem[9'b1110001] = 25'h0;
+    mem[9'b1110010] = 25'h0;
+    mem[9'b1110011] = 25'h0;
+    mem[9'b1110100] = 25'h0;
+    mem[9'b1110101] = 25'h0;
+    mem[9'b1110110] = 25'h0;
+    mem[9'b1110111] = 25'h0;
+    mem[9'b1111000] = 25'h0;
+    mem[9'b1111001] = 25'h0;
+    mem[9'b1111010] = 25'h0;
+    mem[9'b1111011] = 25'h0;
+    mem[9'b1111100] = 25'h0;
+    mem[9'b1111101] = 25'h0;
+    mem[9'b1111110] = 25'h0;
+    mem[9'b1111111] = 25'h0;
+    mem[9'b10000000] = 25'h0;
+    mem[9'b10000001] = 25'h0;
+    mem[9'b10000010] = 25'h0;
+    mem[9'b10000011] = 25'h0;
+    mem[9'b10000100] = 25'h0;
+    mem[9'b10000101] = 25'h0;
+    mem[9'b10000110] = 25'h0;
+    mem[9'b10000111] = 25'h0;
+    mem[9'b10001000] = 25'h0;
+    mem[9'b10001001] = 25'h0;
+    mem[9'b10001010] = 25'h0;
+    mem[9'b10001011] = 25'h0;
+    mem[9'b10001100] = 25'h0;
+    mem[9'b10001101] = 25'h0;
+    mem[9'b10001110] = 25'h0;
+    mem[9'b10001111] = 25'h0;
+    mem[9'b10010000] = 25'h0;
+    mem[9'b10010001] = 25'h0;
+    mem[9'b10010010] = 25'h0;
+    mem[9'b10010011] = 25'h0;
+    mem[9'b10010100] = 25'h0;
+    mem[9'b10010101] = 25'h0;
+    mem[9'b10010110] = 25'h0;
+    mem[9'b10010111] = 25'h0;
+    mem[9'b10011000] = 25'h0;
+    mem[9'b10011001] = 25'h0;
+    mem[9'b10011010] = 25'h0;
+    mem[9'b10011011] = 25'h0;
+    mem[9'b10011100] = 25'h0;
+    mem[9'b10011101] = 25'h0;
+    mem[9'b10011110] = 25'h0;
+    mem[9'b10011111] = 25'h0;
+    mem[9'b10100000] = 25'h0;
+    mem[9'b10100001] = 25'h0;
+    mem[9'b10100010] = 25'h0;
+    mem[9'b10100011] = 25'h0;
+    mem[9'b10100100] = 25'h0;
+    mem[9'b10100101] = 25'h0;
+    mem[9'b10100110] = 25'h0;
+    mem[9'b10100111] = 25'h0;
+    mem[9'b10101000] = 25'h0;
+    mem[9'b10101001] = 25'h0;
+    mem[9'b10101010] = 25'h0;
+    mem[9'b10101011] = 25'h0;
+    mem[9'b10101100] = 25'h0;
+    mem[9'b10101101] = 25'h0;
+    mem[9'b10101110] = 25'h0;
+    mem[9'b10101111] = 25'h0;
+    mem[9'b10110000] = 25'h0;
+    mem[9'b10110001] = 25'h0;
+    mem[9'b10110010] = 25'h0;
+    mem[9'b10110011] = 25'h0;
+    mem[9'b10110100] = 25'h0;
+    mem[9'b10110101] = 25'h0;
+    mem[9'b10110110] = 25'h0;
+    mem[9'b10110111] = 25'h0;
+    mem[9'b10111000] = 25'h0;
+    mem[9'b10111001] = 25'h0;
+    mem[9'b10111010] = 25'h0;
+    mem[9'b10111011] = 25'h0;
+    mem[9'b10111100] = 25'h0;
+    mem[9'b10111101] = 25'h0;
+    mem[9'b10111110] = 25'h0;
+    mem[9'b10111111] = 25'h0;
+    mem[9'b11000000] = 25'h0;
+    mem[9'b11000001] = 25'h0;
+    mem[9'b11000010] = 25'h0;
+    mem[9'b11000011] = 25'h0;
+    mem[9'b11000100] = 25'h0;
+    mem[9'b11000101] = 25'h0;
+    mem[9'b11000110] = 25'h0;
+    mem[9'b11000111] = 25'h0;
+    mem[9'b11001000] = 25'h0;
+    mem[9'b11001001] = 25'h0;
+    mem[9'b11001010] = 25'h0;
+    mem[9'b11001011] = 25'h0;
+    mem[9'b11001100] = 25'h0;
+    mem[9'b11001101] = 25'h0;
+    mem[9'b11001110] = 25'h0;
+    mem[9'b11001111] = 25'h0;
+    mem[9'b11010000] = 25'h0;
+    mem[9'b11010001] = 25'h0;
+    mem[9'b11010010] = 25'h0;
+    mem[9'b11010011] = 25'h0;
+    mem[9'b11010100] = 25'h0;
+    mem[9'b11010101] = 25'h0;
+    mem[9'b11010110] = 25'h0;
+    mem[9'b11010111] = 25'h0;
+    mem[9'b11011000] = 25'h0;
+    mem[9'b11011001] = 25'h0;
+    mem[9'b11011010] = 25'h0;
+    mem[9'b11011011] = 25'h0;
+    mem[9'b11011100] = 25'h0;
+    mem[9'b11011101] = 25'h0;
+    mem[9'b11011110] = 25'h0;
+    mem[9'b11011111] = 25'h0;
+    mem[9'b11100000] = 25'h0;
+    mem[9'b11100001] = 25'h0;
+    mem[9'b11100010] = 25'h0;
+    mem[9'b11100011] = 25'h0;
+    mem[9'b11100100] = 25'h0;
+    mem[9'b11100101] = 25'h0;
+    mem[9'b11100110] = 25'h0;
+    mem[9'b11100111] = 25'h0;
+    mem[9'b11101000] = 25'h0;
+    mem[9'b11101001] = 25'h0;
+    mem[9'b11101010] = 25'h0;
+    mem[9'b11101011] = 25'h0;
+    mem[9'b11101100] = 25'h0;
+    mem[9'b11101101] = 25'h0;
+    mem[9'b11101110] = 25'h0;
+    mem[9'b11101111] = 25'h0;
+    mem[9'b11110000] = 25'h0;
+    mem[9'b11110001] = 25'h0;
+    mem[9'b11110010] = 25'h0;
+    mem[9'b11110011] = 25'h0;
+    mem[9'b11110100] = 25'h0;
+    mem[9'b11110101] = 25'h0;
+    mem[9'b11110110] = 25'h0;
+    mem[9'b11110111] = 25'h0;
+    mem[9'b11111000] = 25'h0;
+    mem[9'b11111001] = 25'h0;
+    mem[9'b11111010] = 25'h0;
+    mem[9'b11111011] = 25'h0;
+    mem[9'b11111100] = 25'h0;
+    mem[9'b11111101] = 25'h0;
+    mem[9'b11111110] = 25'h0;
+    mem[9'b11111111] = 25'h0;
+    mem[9'b100000000] = 25'h0;
+    mem[9'b100000001] = 25'h0;
+    mem[9'b100000010] = 25'h0;
+    mem[9'b100000011] = 25'h0;
+    mem[9'b100000100] = 25'h0;
+    mem[9'b100000101] = 25'h0;
+    mem[9'b100000110] = 25'h0;
+    mem[9'b100000111] = 25'h0;
+    mem[9'b100001000] = 25'h0;
+    mem[9'b100001001] = 25'h0;
+    mem[9'b100001010] = 25'h0;
+    mem[9'b100001011] = 25'h0;
+    mem[9'b100001100] = 25'h0;
+    mem[9'b100001101] = 25'h0;
+    mem[9'b100001110] = 25'h0;
+    mem[9'b100001111] = 25'h0;
+    mem[9'b100010000] = 25'h0;
+    mem[9'b100010001] = 25'h0;
+    mem[9'b100010010] = 25'h0;
+    mem[9'b100010011] = 25'h0;
+    mem[9'b100010100] = 25'h0;
+    mem[9'b100010101] = 25'h0;
+    mem[9'b100010110] = 25'h0;
+    mem[9'b100010111] = 25'h0;
+    mem[9'b100011000] = 25'h0;
+    mem[9'b100011001] = 25'h0;
+    mem[9'b100011010] = 25'h0;
+    mem[9'b100011011] = 25'h0;
+    mem[9'b100011100] = 25'h0;
+    mem[9'b100011101] = 25'h0;
+    mem[9'b100011110] = 25'h0;
+    mem[9'b100011111] = 25'h0;
+    mem[9'b100100000] = 25'h0;
+    mem[9'b100100001] = 25'h0;
+    mem[9'b100100010] = 25'h0;
+    mem[9'b100100011] = 25'h0;
+    mem[9'b100100100] = 25'h0;
+    mem[9'b100100101] = 25'h0;
+    mem[9'b100100110] = 25'h0;
+    mem[9'b100100111] = 25'h0;
+    mem[9'b100101000] = 25'h0;
+    mem[9'b100101001] = 25'h0;
+    mem[9'b100101010] = 25'h0;
+    mem[9'b100101011] = 25'h0;
+    mem[9'b100101100] = 25'h0;
+    mem[9'b100101101] = 25'h0;
+    mem[9'b100101110] = 25'h0;
+    mem[9'b100101111] = 25'h0;
+    mem[9'b100110000] = 25'h0;
+    mem[9'b100110001] = 25'h0;
+    mem[9'b100110010] = 25'h0;
+    mem[9'b100110011] = 25'h0;
+    mem[9'b100110100] = 25'h0;
+    mem[9'b100110101] = 25'h0;
+    mem[9'b100110110] = 25'h0;
+    mem[9'b100110111] = 25'h0;
+    mem[9'b100111000] = 25'h0;
+    mem[9'b100111001] = 25'h0;
+    mem[9'b100111010] = 25'h0;
+    mem[9'b100111011] = 25'h0;
+    mem[9'b100111100] = 25'h0;
+    mem[9'b100111101] = 25'h0;
+    mem[9'b100111110] = 25'h0;
+    mem[9'b100111111] = 25'h0;
+    mem[9'b101000000] = 25'h0;
+    mem[9'b101000001] = 25'h0;
+    mem[9'b101000010] = 25'h0;
+    mem[9'b101000011] = 25'h0;
+    mem[9'b101000100] = 25'h0;
+    mem[9'b101000101] = 25'h0;
+    mem[9'b101000110] = 25'h0;
+    mem[9'b101000111] = 25'h0;
+    mem[9'b101001000] = 25'h0;
+    mem[9'b101001001] = 25'h0;
+    mem[9'b101001010] = 25'h0;
+    mem[9'b101001011] = 25'h0;
+    mem[9'b101001100] = 25'h0;
+    mem[9'b101001101] = 25'h0;
+    mem[9'b101001110] = 25'h0;
+    mem[9'b101001111] = 25'h0;
+    mem[9'b101010000] = 25'h0;
+    mem[9'b101010001] = 25'h0;
+    mem[9'b101010010] = 25'h0;
+    mem[9'b101010011] = 25'h0;
+    mem[9'b101010100] = 25'h0;
+    mem[9'b101010101] = 25'h0;
+    mem[9'b101010110] = 25'h0;
+    mem[9'b101010111] = 25'h0;
+    mem[9'b101011000] = 25'h0;
+    mem[9'b101011001] = 25'h0;
+    mem[9'b101011010] = 25'h0;
+    mem[9'b101011011] = 25'h0;
+    mem[9'b101011100] = 25'h0;
+    mem[9'b101011101] = 25'h0;
+    mem[9'b101011110] = 25'h0;
+    mem[9'b101011111] = 25'h0;
+    mem[9'b101100000] = 25'h0;
+    mem[9'b101100001] = 25'h0;
+    mem[9'b101100010] = 25'h0;
+    mem[9'b101100011] = 25'h0;
+    mem[9'b101100100] = 25'h0;
+    mem[9'b101100101] = 25'h0;
+    mem[9'b101100110] = 25'h0;
+    mem[9'b101100111] = 25'h0;
+    mem[9'b101101000] = 25'h0;
+    mem[9'b101101001] = 25'h0;
+    mem[9'b101101010] = 25'h0;
+    mem[9'b101101011] = 25'h0;
+    mem[9'b101101100] = 25'h0;
+    mem[9'b101101101] = 25'h0;
+    mem[9'b101101110] = 25'h0;
+    mem[9'b101101111] = 25'h0;
+    mem[9'b101110000] = 25'h0;
+    mem[9'b101110001] = 25'h0;
+    mem[9'b101110010] = 25'h0;
+    mem[9'b101110011] = 25'h0;
+    mem[9'b101110100] = 25'h0;
+    mem[9'b101110101] = 25'h0;
+    mem[9'b101110110] = 25'h0;
+    mem[9'b101110111] = 25'h0;
+    mem[9'b101111000] = 25'h0;
+    mem[9'b101111001] = 25'h0;
+    mem[9'b101111010] = 25'h0;
+    mem[9'b101111011] = 25'h0;
+    mem[9'b101111100] = 25'h0;
+    mem[9'b101111101] = 25'h0;
+    mem[9'b101111110] = 25'h0;
+    mem[9'b101111111] = 25'h0;
+    mem[9'b110000000] = 25'h0;
+    mem[9'b110000001] = 25'h0;
+    mem[9'b110000010] = 25'h0;
+    mem[9'b110000011] = 25'h0;
+    mem[9'b110000100] = 25'h0;
+    mem[9'b110000101] = 25'h0;
+    mem[9'b110000110] = 25'h0;
+    mem[9'b110000111] = 25'h0;
+    mem[9'b110001000] = 25'h0;
+    mem[9'b110001001] = 25'h0;
+    mem[9'b110001010] = 25'h0;
+    mem[9'b110001011] = 25'h0;
+    mem[9'b110001100] = 25'h0;
+    mem[9'b110001101] = 25'h0;
+    mem[9'b110001110] = 25'h0;
+    mem[9'b110001111] = 25'h0;
+    mem[9'b110010000] = 25'h0;
+    mem[9'b110010001] = 25'h0;
+    mem[9'b110010010] = 25'h0;
+    mem[9'b110010011] = 25'h0;
+    mem[9'b110010100] = 25'h0;
+    mem[9'b110010101] = 25'h0;
+    mem[9'b110010110] = 25'h0;
+    mem[9'b110010111] = 25'h0;
+    mem[9'b110011000] = 25'h0;
+    mem[9'b110011001] = 25'h0;
+    mem[9'b110011010] = 25'h0;
+    mem[9'b110011011] = 25'h0;
+    mem[9'b110011100] = 25'h0;
+    mem[9'b110011101] = 25'h0;
+    mem[9'b110011110] = 25'h0;
+    mem[9'b110011111] = 25'h0;
+    mem[9'b110100000] = 25'h0;
+    mem[9'b110100001] = 25'h0;
+    mem[9'b110100010] = 25'h0;
+    mem[9'b110100011] = 25'h0;
+    mem[9'b110100100] = 25'h0;
+    mem[9'b110100101] = 25'h0;
+    mem[9'b110100110] = 25'h0;
+    mem[9'b110100111] = 25'h0;
+    mem[9'b110101000] = 25'h0;
+    mem[9'b110101001] = 25'h0;
+    mem[9'b110101010] = 25'h0;
+    mem[9'b110101011] = 25'h0;
+    mem[9'b110101100] = 25'h0;
+    mem[9'b110101101] = 25'h0;
+    mem[9'b110101110] = 25'h0;
+    mem[9'b110101111] = 25'h0;
+    mem[9'b110110000] = 25'h0;
+    mem[9'b110110001] = 25'h0;
+    mem[9'b110110010] = 25'h0;
+    mem[9'b110110011] = 25'h0;
+    mem[9'b110110100] = 25'h0;
+    mem[9'b110110101] = 25'h0;
+    mem[9'b110110110] = 25'h0;
+    mem[9'b110110111] = 25'h0;
+    mem[9'b110111000] = 25'h0;
+    mem[9'b110111001] = 25'h0;
+    mem[9'b110111010] = 25'h0;
+    mem[9'b110111011] = 25'h0;
+    mem[9'b110111100] = 25'h0;
+    mem[9'b110111101] = 25'h0;
+    mem[9'b110111110] = 25'h0;
+    mem[9'b110111111] = 25'h0;
+    mem[9'b111000000] = 25'h0;
+    mem[9'b111000001] = 25'h0;
+    mem[9'b111000010] = 25'h0;
+    mem[9'b111000011] = 25'h0;
+    mem[9'b111000100] = 25'h0;
+    mem[9'b111000101] = 25'h0;
+    mem[9'b111000110] = 25'h0;
+    mem[9'b111000111] = 25'h0;
+    mem[9'b111001000] = 25'h0;
+    mem[9'b111001001] = 25'h0;
+    mem[9'b111001010] = 25'h0;
+    mem[9'b111001011] = 25'h0;
+    mem[9'b111001100] = 25'h0;
+    mem[9'b111001101] = 25'h0;
+    mem[9'b111001110] = 25'h0;
+    mem[9'b111001111] = 25'h0;
+    mem[9'b111010000] = 25'h0;
+    mem[9'b111010001] = 25'h0;
+    mem[9'b111010010] = 25'h0;
+    mem[9'b111010011] = 25'h0;
+    mem[9'b111010100] = 25'h0;
+    mem[9'b111010101] = 25'h0;
+    mem[9'b111010110] = 25'h0;
+    mem[9'b111010111] = 25'h0;
+    mem[9'b111011000] = 25'h0;
+    mem[9'b111011001] = 25'h0;
+    mem[9'b111011010] = 25'h0;
+    mem[9'b111011011] = 25'h0;
+    mem[9'b111011100] = 25'h0;
+    mem[9'b111011101] = 25'h0;
+    mem[9'b111011110] = 25'h0;
+    mem[9'b111011111] = 25'h0;
+    mem[9'b111100000] = 25'h0;
+    mem[9'b111100001] = 25'h0;
+    mem[9'b111100010] = 25'h0;
+    mem[9'b111100011] = 25'h0;
+    mem[9'b111100100] = 25'h0;
+    mem[9'b111100101] = 25'h0;
+    mem[9'b111100110] = 25'h0;
+    mem[9'b111100111] = 25'h0;
+    mem[9'b111101000] = 25'h0;
+    mem[9'b111101001] = 25'h0;
+    mem[9'b111101010] = 25'h0;
+    mem[9'b111101011] = 25'h0;
+    mem[9'b111101100] = 25'h0;
+    mem[9'b111101101] = 25'h0;
+    mem[9'b111101110] = 25'h0;
+    mem[9'b111101111] = 25'h0;
+    mem[9'b111110000] = 25'h0;
+    mem[9'b111110001] = 25'h0;
+    mem[9'b111110010] = 25'h0;
+    mem[9'b111110011] = 25'h0;
+    mem[9'b111110100] = 25'h0;
+    mem[9'b111110101] = 25'h0;
+    mem[9'b111110110] = 25'h0;
+    mem[9'b111110111] = 25'h0;
+    mem[9'b111111000] = 25'h0;
+    mem[9'b111111001] = 25'h0;
+    mem[9'b111111010] = 25'h0;
+    mem[9'b111111011] = 25'h0;
+    mem[9'b111111100] = 25'h0;
+    mem[9'b111111101] = 25'h0;
+    mem[9'b111111110] = 25'h0;
+    mem[9'b111111111] = 25'h0;
     end
     
-    always @(*) begin
-       read_data = mem[read_address];
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
     end
     
     always @(posedge write_clock) begin
@@ -25972,6 +26089,7 @@ module dynrt_processor__engine__tester__cache_tag(read_address,read_data,write_c
           mem[write_address] <= write_data;
        end
     end
+                
 endmodule // dynrt_processor__engine__tester__cache_tag
 
 
@@ -26184,6 +26302,20 @@ module dynrt_processor__engine__tester__flight_t_min(read_address,read_clock,rea
     end
                 
 endmodule // dynrt_processor__engine__tester__flight_t_min
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -31040,6 +31172,8 @@ endmodule // dynrt_processor__engine__tester__lw_best
 
 
 
+
+
 module dynrt_processor__engine__tester__ray(clock,thread,word_a,word_b,ray_write,ray_pair,t_min_write,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2,ray_thread,o__0,o__1,o__2,d__0,d__1,d__2,t_min_thread,t_min);
     
     // Module arguments
@@ -34304,7 +34438,13 @@ endmodule // dynrt_processor__engine__tester__words__0
 
 
 
-module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,t_min_write,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2,nodes__read,nodes__addr,nodes__rdata,step_busy,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit,engine_next,world_write,world_pair,enter,entered,root_write,root_thread,root,top_from,top_to);
+
+
+
+
+
+
+module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,t_min_write,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2,nodes__read,nodes__addr,nodes__rdata,step_busy,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit,engine_next,world_write,world_pair,enter,entered,root_write,root_thread,root,top_from,top_to,cache_hit,cache_miss);
     
     // Module arguments
     input wire  clock;
@@ -34353,8 +34493,13 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     input wire  [25:0] root;
     output reg  [31:0] top_from;
     output reg  [31:0] top_to;
+    output reg  cache_hit;
+    output reg  cache_miss;
     
     // Constant declarations
+    localparam  c_set_mask = 9'b111111111;
+    localparam  c_cache_on = 1'b1;
+    localparam  c_tag_valid = 27'h4000000;
     localparam  c_ml_last = 4'h1;
     localparam  c_index__0 = 4'h0;
     localparam  c_index__1 = 4'h1;
@@ -34727,24 +34872,74 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  [31:0] w1__d;
     wire  [31:0] w1__q;
     reg  w1__clock;
-    reg  [1:0] node_line__0__d;
-    wire  [1:0] node_line__0__q;
+    reg  [2:0] node_line__0__d;
+    wire  [2:0] node_line__0__q;
     reg  node_line__0__clock;
-    reg  [1:0] node_line__1__d;
-    wire  [1:0] node_line__1__q;
+    reg  [2:0] node_line__1__d;
+    wire  [2:0] node_line__1__q;
     reg  node_line__1__clock;
-    reg  [1:0] node_line__2__d;
-    wire  [1:0] node_line__2__q;
+    reg  [2:0] node_line__2__d;
+    wire  [2:0] node_line__2__q;
     reg  node_line__2__clock;
-    reg  [1:0] node_line__3__d;
-    wire  [1:0] node_line__3__q;
+    reg  [2:0] node_line__3__d;
+    wire  [2:0] node_line__3__q;
     reg  node_line__3__clock;
-    reg  [1:0] node_line__4__d;
-    wire  [1:0] node_line__4__q;
+    reg  [2:0] node_line__4__d;
+    wire  [2:0] node_line__4__q;
     reg  node_line__4__clock;
-    reg  [1:0] node_line__5__d;
-    wire  [1:0] node_line__5__q;
+    reg  [2:0] node_line__5__d;
+    wire  [2:0] node_line__5__q;
     reg  node_line__5__clock;
+    reg  [63:0] data_line__0__d;
+    wire  [63:0] data_line__0__q;
+    reg  data_line__0__clock;
+    reg  [63:0] data_line__1__d;
+    wire  [63:0] data_line__1__q;
+    reg  data_line__1__clock;
+    reg  [63:0] data_line__2__d;
+    wire  [63:0] data_line__2__q;
+    reg  data_line__2__clock;
+    reg  [63:0] data_line__3__d;
+    wire  [63:0] data_line__3__q;
+    reg  data_line__3__clock;
+    reg  [63:0] data_line__4__d;
+    wire  [63:0] data_line__4__q;
+    reg  data_line__4__clock;
+    reg  [63:0] data_line__5__d;
+    wire  [63:0] data_line__5__q;
+    reg  data_line__5__clock;
+    reg  look_valid__d;
+    wire  look_valid__q;
+    reg  look_valid__clock;
+    reg  [102:0] look_job__d;
+    wire  [102:0] look_job__q;
+    reg  look_job__clock;
+    reg  look_stale__d;
+    wire  look_stale__q;
+    reg  look_stale__clock;
+    reg  [8:0] cache_tag__read_address;
+    reg  cache_tag__read_clock;
+    wire  [26:0] cache_tag__read_data;
+    reg  [8:0] cache_tag__write_address;
+    reg  cache_tag__write_clock;
+    reg  [26:0] cache_tag__write_data;
+    reg  cache_tag__write_enable;
+    reg  [8:0] cache_words__read_address;
+    reg  cache_words__read_clock;
+    wire  [63:0] cache_words__read_data;
+    reg  [8:0] cache_words__write_address;
+    reg  cache_words__write_clock;
+    reg  [63:0] cache_words__write_data;
+    reg  cache_words__write_enable;
+    reg  fetch_hit__d;
+    wire  fetch_hit__q;
+    reg  fetch_hit__clock;
+    reg  [63:0] fetch_words__d;
+    wire  [63:0] fetch_words__q;
+    reg  fetch_words__clock;
+    reg  a_fetched__d;
+    wire  a_fetched__q;
+    reg  a_fetched__clock;
     reg  skip_valid__d;
     wire  skip_valid__q;
     reg  skip_valid__clock;
@@ -34886,7 +35081,15 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  fetch_free;
     reg  [4:0] next_a_thread;
     reg  take;
-    reg  [1:0] arrive;
+    reg  [2:0] arrive;
+    reg  [63:0] arrive_data;
+    reg  look_move;
+    reg  look_load;
+    reg  look_hit;
+    reg  [8:0] read_set;
+    reg  hit_now;
+    reg  fill;
+    reg  [8:0] fill_set;
     reg  at_a;
     reg  a_leaf;
     reg  [1:0] a_axis;
@@ -35411,35 +35614,113 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(w1__q),
         .clock(w1__clock)
     );
-    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__0(
+    dynrt_processor__engine__mem_bank_r node_line__0(
         .d(node_line__0__d),
         .q(node_line__0__q),
         .clock(node_line__0__clock)
     );
-    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__1(
+    dynrt_processor__engine__mem_bank_r node_line__1(
         .d(node_line__1__d),
         .q(node_line__1__q),
         .clock(node_line__1__clock)
     );
-    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__2(
+    dynrt_processor__engine__mem_bank_r node_line__2(
         .d(node_line__2__d),
         .q(node_line__2__q),
         .clock(node_line__2__clock)
     );
-    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__3(
+    dynrt_processor__engine__mem_bank_r node_line__3(
         .d(node_line__3__d),
         .q(node_line__3__q),
         .clock(node_line__3__clock)
     );
-    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__4(
+    dynrt_processor__engine__mem_bank_r node_line__4(
         .d(node_line__4__d),
         .q(node_line__4__q),
         .clock(node_line__4__clock)
     );
-    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 node_line__5(
+    dynrt_processor__engine__mem_bank_r node_line__5(
         .d(node_line__5__d),
         .q(node_line__5__q),
         .clock(node_line__5__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 data_line__0(
+        .d(data_line__0__d),
+        .q(data_line__0__q),
+        .clock(data_line__0__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 data_line__1(
+        .d(data_line__1__d),
+        .q(data_line__1__q),
+        .clock(data_line__1__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 data_line__2(
+        .d(data_line__2__d),
+        .q(data_line__2__q),
+        .clock(data_line__2__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 data_line__3(
+        .d(data_line__3__d),
+        .q(data_line__3__q),
+        .clock(data_line__3__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 data_line__4(
+        .d(data_line__4__d),
+        .q(data_line__4__q),
+        .clock(data_line__4__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 data_line__5(
+        .d(data_line__5__d),
+        .q(data_line__5__q),
+        .clock(data_line__5__clock)
+    );
+    dynrt_processor__display__dark_d look_valid(
+        .d(look_valid__d),
+        .q(look_valid__q),
+        .clock(look_valid__clock)
+    );
+    dynrt_processor__engine__traversal_unit__fetch_job look_job(
+        .d(look_job__d),
+        .q(look_job__q),
+        .clock(look_job__clock)
+    );
+    dynrt_processor__display__dark_d look_stale(
+        .d(look_stale__d),
+        .q(look_stale__q),
+        .clock(look_stale__clock)
+    );
+    dynrt_processor__engine__traversal_unit__cache_tag cache_tag(
+        .read_address(cache_tag__read_address),
+        .read_clock(cache_tag__read_clock),
+        .read_data(cache_tag__read_data),
+        .write_address(cache_tag__write_address),
+        .write_clock(cache_tag__write_clock),
+        .write_data(cache_tag__write_data),
+        .write_enable(cache_tag__write_enable)
+    );
+    dynrt_processor__engine__traversal_unit__cache_words cache_words(
+        .read_address(cache_words__read_address),
+        .read_clock(cache_words__read_clock),
+        .read_data(cache_words__read_data),
+        .write_address(cache_words__write_address),
+        .write_clock(cache_words__write_clock),
+        .write_data(cache_words__write_data),
+        .write_enable(cache_words__write_enable)
+    );
+    dynrt_processor__display__dark_d fetch_hit(
+        .d(fetch_hit__d),
+        .q(fetch_hit__q),
+        .clock(fetch_hit__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 fetch_words(
+        .d(fetch_words__d),
+        .q(fetch_words__q),
+        .clock(fetch_words__clock)
+    );
+    dynrt_processor__display__dark_d a_fetched(
+        .d(a_fetched__d),
+        .q(a_fetched__q),
+        .clock(a_fetched__clock)
     );
     dynrt_processor__display__dark_d skip_valid(
         .d(skip_valid__d),
@@ -35670,6 +35951,12 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         words_in__clock = clock;
         w0__clock = clock;
         w1__clock = clock;
+        look_valid__clock = clock;
+        look_job__clock = clock;
+        look_stale__clock = clock;
+        fetch_hit__clock = clock;
+        fetch_words__clock = clock;
+        a_fetched__clock = clock;
         skip_valid__clock = clock;
         skip_thread__clock = clock;
         entered_valid__clock = clock;
@@ -35725,6 +36012,12 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         words_in__d = words_in__q;
         w0__d = w0__q;
         w1__d = w1__q;
+        look_valid__d = look_valid__q;
+        look_job__d = look_job__q;
+        look_stale__d = look_stale__q;
+        fetch_hit__d = fetch_hit__q;
+        fetch_words__d = fetch_words__q;
+        a_fetched__d = a_fetched__q;
         skip_valid__d = skip_valid__q;
         skip_thread__d = skip_thread__q;
         entered_valid__d = entered_valid__q;
@@ -35778,12 +36071,22 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         stack_lo__write_clock = clock;
         stack_hi__read_clock = clock;
         stack_hi__write_clock = clock;
+        cache_tag__read_clock = clock;
+        cache_tag__write_clock = clock;
+        cache_words__read_clock = clock;
+        cache_words__write_clock = clock;
         node_line__0__clock = clock;
+        data_line__0__clock = clock;
         node_line__1__clock = clock;
+        data_line__1__clock = clock;
         node_line__2__clock = clock;
+        data_line__2__clock = clock;
         node_line__3__clock = clock;
+        data_line__3__clock = clock;
         node_line__4__clock = clock;
+        data_line__4__clock = clock;
         node_line__5__clock = clock;
+        data_line__5__clock = clock;
         o_delay__0__clock = clock;
         o_delay_div__0__clock = clock;
         o_delay__1__clock = clock;
@@ -35980,7 +36283,9 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         loop_fifo__read = 1'b0;
         front_fifo__read = 1'b0;
         in_flight__read = 1'b0;
-        take = (phase__q != Fetch__Idle) & ((engine__load_banks & c_bank_nodes) == 32'h0);
+        look_hit = c_cache_on & (~look_job__q[32'h66]) & (~look_stale__q) & (cache_tag__read_data == (c_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
+        hit_now = (phase__q == Fetch__Word0) & fetch_hit__q;
+        take = (phase__q != Fetch__Idle) & (~hit_now) & ((engine__load_banks & c_bank_nodes) == 32'h0);
         nodes__read = take | ((engine__load_banks & c_bank_nodes) != 32'h0);
         nodes__addr = engine__load_addr;
         if (take) begin
@@ -35990,33 +36295,51 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
                 phase__d = Fetch__Idle;
             end
         end
-        in_flight__write = take & (phase__q == Fetch__Word0);
+        if (hit_now) begin
+            phase__d = Fetch__Idle;
+        end
+        cache_hit = hit_now;
+        cache_miss = take & (phase__q == Fetch__Word0) & (~fetch_job__q[32'h66]);
+        in_flight__write = (take & (phase__q == Fetch__Word0)) | hit_now;
         in_flight__data_in = fetch_job__q;
         words_in__d = 32'h0;
-        node_line__0__d = (((take) & 2'h3) << 32'h1) | (((phase__q == Fetch__Word1)) & 2'h3);
+        node_line__0__d = (((hit_now) & 3'h7) << 32'h2) | (((take) & 3'h7) << 32'h1) | (((phase__q == Fetch__Word1)) & 3'h7);
+        data_line__0__d = fetch_words__q;
         node_line__1__d = node_line__0__q;
+        data_line__1__d = data_line__0__q;
         node_line__2__d = node_line__1__q;
+        data_line__2__d = data_line__1__q;
         node_line__3__d = node_line__2__q;
+        data_line__3__d = data_line__2__q;
         node_line__4__d = node_line__3__q;
+        data_line__4__d = data_line__3__q;
         node_line__5__d = node_line__4__q;
+        data_line__5__d = data_line__4__q;
         arrive = 32'h0;
+        arrive_data = 32'h0;
         if (c_ml_last == c_index__0) begin
             arrive = node_line__0__q;
+            arrive_data = data_line__0__q;
         end
         if (c_ml_last == c_index__1) begin
             arrive = node_line__1__q;
+            arrive_data = data_line__1__q;
         end
         if (c_ml_last == c_index__2) begin
             arrive = node_line__2__q;
+            arrive_data = data_line__2__q;
         end
         if (c_ml_last == c_index__3) begin
             arrive = node_line__3__q;
+            arrive_data = data_line__3__q;
         end
         if (c_ml_last == c_index__4) begin
             arrive = node_line__4__q;
+            arrive_data = data_line__4__q;
         end
         if (c_ml_last == c_index__5) begin
             arrive = node_line__5__q;
+            arrive_data = data_line__5__q;
         end
         if (arrive == 32'h2) begin
             w0__d = nodes__rdata;
@@ -36024,32 +36347,58 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         next_a_thread = job__q[(32'h60)+:(5)];
         if (arrive == 32'h3) begin
             w1__d = nodes__rdata;
+            a_fetched__d = 1'b1;
+        end
+        if (arrive == 32'h4) begin
+            w0__d = arrive_data[(32'h0)+:(32)];
+            w1__d = arrive_data[(32'h20)+:(32)];
+            a_fetched__d = 1'b0;
+        end
+        if ((arrive == 32'h3) | (arrive == 32'h4)) begin
             job__d = in_flight__data_out;
             next_a_thread = in_flight__data_out[(32'h60)+:(5)];
             in_flight__read = 1'b1;
             words_in__d = 32'h1;
         end
-        fetch_free = (phase__q == Fetch__Idle) | ((phase__q == Fetch__Word1) & take);
-        if (fetch_free) begin
-            if (~loop_fifo__empty) begin
-                loop_fifo__read = 1'b1;
-                fetch_job__d = loop_fifo__data_out;
+        fetch_free = (phase__q == Fetch__Idle) | ((phase__q == Fetch__Word1) & take) | hit_now;
+        look_move = 1'b0;
+        if (fetch_free & look_valid__q) begin
+            if (~look_job__q[32'h65]) begin
+                look_move = 1'b1;
+                fetch_job__d = look_job__q;
+                fetch_hit__d = look_hit;
+                fetch_words__d = cache_words__read_data;
                 phase__d = Fetch__Word0;
             end
-            else if (~front_fifo__empty) begin
-                if (~front_fifo__data_out[32'h65]) begin
-                    front_fifo__read = 1'b1;
-                    fetch_job__d = front_fifo__data_out;
-                    phase__d = Fetch__Word0;
-                end
-                else if ((phase__q == Fetch__Idle) & in_flight__empty) begin
-                    front_fifo__read = 1'b1;
-                    job__d = front_fifo__data_out;
-                    next_a_thread = front_fifo__data_out[(32'h60)+:(5)];
-                    words_in__d = 32'h1;
-                end
+            else if ((phase__q == Fetch__Idle) & in_flight__empty) begin
+                look_move = 1'b1;
+                job__d = look_job__q;
+                next_a_thread = look_job__q[(32'h60)+:(5)];
+                words_in__d = 32'h1;
+                a_fetched__d = 1'b0;
             end
         end
+        look_load = (~look_valid__q) | look_move;
+        if (look_move) begin
+            look_valid__d = 1'b0;
+        end
+        read_set = look_job__q[(32'h40)+:(9)] & c_set_mask;
+        if (look_load) begin
+            if (~loop_fifo__empty) begin
+                loop_fifo__read = 1'b1;
+                look_valid__d = 1'b1;
+                look_job__d = loop_fifo__data_out;
+                read_set = loop_fifo__data_out[(32'h40)+:(9)] & c_set_mask;
+            end
+            else if (~front_fifo__empty) begin
+                front_fifo__read = 1'b1;
+                look_valid__d = 1'b1;
+                look_job__d = front_fifo__data_out;
+                read_set = front_fifo__data_out[(32'h40)+:(9)] & c_set_mask;
+            end
+        end
+        cache_tag__read_address = read_set;
+        cache_words__read_address = read_set;
         ray__ray_thread = in_flight__data_out[(32'h60)+:(5)];
         world__ray_thread = in_flight__data_out[(32'h60)+:(5)];
         at_a = words_in__q == 32'h1;
@@ -36126,6 +36475,15 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         done_e__write_enable = a_done;
         done_r__d = a_done;
         done_thread_r__d = job__q[(32'h60)+:(5)];
+        fill = c_cache_on & at_a & a_fetched__q & (~job__q[32'h66]);
+        fill_set = job__q[(32'h40)+:(9)] & c_set_mask;
+        cache_tag__write_address = fill_set;
+        cache_tag__write_data = c_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
+        cache_tag__write_enable = fill;
+        cache_words__write_address = fill_set;
+        cache_words__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
+        cache_words__write_enable = fill;
+        look_stale__d = fill & (fill_set == read_set);
         engine__done = done_r__q;
         engine__done_thread = done_thread_r__q;
         leaf_hi__write_enable = at_a & a_leaf;
@@ -36208,6 +36566,8 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
 endmodule // dynrt_processor__engine__traversal_unit
 
 
+
+
 module dynrt_processor__engine__traversal_unit__any_hit(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -36235,6 +36595,578 @@ module dynrt_processor__engine__traversal_unit__any_hit(read_address,read_clock,
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__any_hit
+
+
+module dynrt_processor__engine__traversal_unit__cache_tag(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [8:0] read_address;
+    input wire  read_clock;
+    output reg  [26:0] read_data;
+    input wire  [8:0] write_address;
+    input wire  write_clock;
+    input wire  [26:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[26:0] mem[511:0];
+    
+    initial begin
+    mem[9'b0] = 27'h0;
+    mem[9'b1] = 27'h0;
+    mem[9'b10] = 27'h0;
+    mem[9'b11] = 27'h0;
+    mem[9'b100] = 27'h0;
+    mem[9'b101] = 27'h0;
+    mem[9'b110] = 27'h0;
+    mem[9'b111] = 27'h0;
+    mem[9'b1000] = 27'h0;
+    mem[9'b1001] = 27'h0;
+    mem[9'b1010] = 27'h0;
+    mem[9'b1011] = 27'h0;
+    mem[9'b1100] = 27'h0;
+    mem[9'b1101] = 27'h0;
+    mem[9'b1110] = 27'h0;
+    mem[9'b1111] = 27'h0;
+    mem[9'b10000] = 27'h0;
+    mem[9'b10001] = 27'h0;
+    mem[9'b10010] = 27'h0;
+    mem[9'b10011] = 27'h0;
+    mem[9'b10100] = 27'h0;
+    mem[9'b10101] = 27'h0;
+    mem[9'b10110] = 27'h0;
+    mem[9'b10111] = 27'h0;
+    mem[9'b11000] = 27'h0;
+    mem[9'b11001] = 27'h0;
+    mem[9'b11010] = 27'h0;
+    mem[9'b11011] = 27'h0;
+    mem[9'b11100] = 27'h0;
+    mem[9'b11101] = 27'h0;
+    mem[9'b11110] = 27'h0;
+    mem[9'b11111] = 27'h0;
+    mem[9'b100000] = 27'h0;
+    mem[9'b100001] = 27'h0;
+    mem[9'b100010] = 27'h0;
+    mem[9'b100011] = 27'h0;
+    mem[9'b100100] = 27'h0;
+    mem[9'b100101] = 27'h0;
+    mem[9'b100110] = 27'h0;
+    mem[9'b100111] = 27'h0;
+    mem[9'b101000] = 27'h0;
+    mem[9'b101001] = 27'h0;
+    mem[9'b101010] = 27'h0;
+    mem[9'b101011] = 27'h0;
+    mem[9'b101100] = 27'h0;
+    mem[9'b101101] = 27'h0;
+    mem[9'b101110] = 27'h0;
+    mem[9'b101111] = 27'h0;
+    mem[9'b110000] = 27'h0;
+    mem[9'b110001] = 27'h0;
+    mem[9'b110010] = 27'h0;
+    mem[9'b110011] = 27'h0;
+    mem[9'b110100] = 27'h0;
+    mem[9'b110101] = 27'h0;
+    mem[9'b110110] = 27'h0;
+    mem[9'b110111] = 27'h0;
+    mem[9'b111000] = 27'h0;
+    mem[9'b111001] = 27'h0;
+    mem[9'b111010] = 27'h0;
+    mem[9'b111011] = 27'h0;
+    mem[9'b111100] = 27'h0;
+    mem[9'b111101] = 27'h0;
+    mem[9'b111110] = 27'h0;
+    mem[9'b111111] = 27'h0;
+    mem[9'b1000000] = 27'h0;
+    mem[9'b1000001] = 27'h0;
+    mem[9'b1000010] = 27'h0;
+    mem[9'b1000011] = 27'h0;
+    mem[9'b1000100] = 27'h0;
+    mem[9'b1000101] = 27'h0;
+    mem[9'b1000110] = 27'h0;
+    mem[9'b1000111] = 27'h0;
+    mem[9'b1001000] = 27'h0;
+    mem[9'b1001001] = 27'h0;
+    mem[9'b1001010] = 27'h0;
+    mem[9'b1001011] = 27'h0;
+    mem[9'b1001100] = 27'h0;
+    mem[9'b1001101] = 27'h0;
+    mem[9'b1001110] = 27'h0;
+    mem[9'b1001111] = 27'h0;
+    mem[9'b1010000] = 27'h0;
+    mem[9'b1010001] = 27'h0;
+    mem[9'b1010010] = 27'h0;
+    mem[9'b1010011] = 27'h0;
+    mem[9'b1010100] = 27'h0;
+    mem[9'b1010101] = 27'h0;
+    mem[9'b1010110] = 27'h0;
+    mem[9'b1010111] = 27'h0;
+    mem[9'b1011000] = 27'h0;
+    mem[9'b1011001] = 27'h0;
+    mem[9'b1011010] = 27'h0;
+    mem[9'b1011011] = 27'h0;
+    mem[9'b1011100] = 27'h0;
+    mem[9'b1011101] = 27'h0;
+    mem[9'b1011110] = 27'h0;
+    mem[9'b1011111] = 27'h0;
+    mem[9'b1100000] = 27'h0;
+    mem[9'b1100001] = 27'h0;
+    mem[9'b1100010] = 27'h0;
+    mem[9'b1100011] = 27'h0;
+    mem[9'b1100100] = 27'h0;
+    mem[9'b1100101] = 27'h0;
+    mem[9'b1100110] = 27'h0;
+    mem[9'b1100111] = 27'h0;
+    mem[9'b1101000] = 27'h0;
+    mem[9'b1101001] = 27'h0;
+    mem[9'b1101010] = 27'h0;
+    mem[9'b1101011] = 27'h0;
+    mem[9'b1101100] = 27'h0;
+    mem[9'b1101101] = 27'h0;
+    mem[9'b1101110] = 27'h0;
+    mem[9'b1101111] = 27'h0;
+    mem[9'b1110000] = 27'h0;
+    mem[9'b1110001] = 27'h0;
+    mem[9'b1110010] = 27'h0;
+    mem[9'b1110011] = 27'h0;
+    mem[9'b1110100] = 27'h0;
+    mem[9'b1110101] = 27'h0;
+    mem[9'b1110110] = 27'h0;
+    mem[9'b1110111] = 27'h0;
+    mem[9'b1111000] = 27'h0;
+    mem[9'b1111001] = 27'h0;
+    mem[9'b1111010] = 27'h0;
+    mem[9'b1111011] = 27'h0;
+    mem[9'b1111100] = 27'h0;
+    mem[9'b1111101] = 27'h0;
+    mem[9'b1111110] = 27'h0;
+    mem[9'b1111111] = 27'h0;
+    mem[9'b10000000] = 27'h0;
+    mem[9'b10000001] = 27'h0;
+    mem[9'b10000010] = 27'h0;
+    mem[9'b10000011] = 27'h0;
+    mem[9'b10000100] = 27'h0;
+    mem[9'b10000101] = 27'h0;
+    mem[9'b10000110] = 27'h0;
+    mem[9'b10000111] = 27'h0;
+    mem[9'b10001000] = 27'h0;
+    mem[9'b10001001] = 27'h0;
+    mem[9'b10001010] = 27'h0;
+    mem[9'b10001011] = 27'h0;
+    mem[9'b10001100] = 27'h0;
+    mem[9'b10001101] = 27'h0;
+    mem[9'b10001110] = 27'h0;
+    mem[9'b10001111] = 27'h0;
+    mem[9'b10010000] = 27'h0;
+    mem[9'b10010001] = 27'h0;
+    mem[9'b10010010] = 27'h0;
+    mem[9'b10010011] = 27'h0;
+    mem[9'b10010100] = 27'h0;
+    mem[9'b10010101] = 27'h0;
+    mem[9'b10010110] = 27'h0;
+    mem[9'b10010111] = 27'h0;
+    mem[9'b10011000] = 27'h0;
+    mem[9'b10011001] = 27'h0;
+    mem[9'b10011010] = 27'h0;
+    mem[9'b10011011] = 27'h0;
+    mem[9'b10011100] = 27'h0;
+    mem[9'b10011101] = 27'h0;
+    mem[9'b10011110] = 27'h0;
+    mem[9'b10011111] = 27'h0;
+    mem[9'b10100000] = 27'h0;
+    mem[9'b10100001] = 27'h0;
+    mem[9'b10100010] = 27'h0;
+    mem[9'b10100011] = 27'h0;
+    mem[9'b10100100] = 27'h0;
+    mem[9'b10100101] = 27'h0;
+    mem[9'b10100110] = 27'h0;
+    mem[9'b10100111] = 27'h0;
+    mem[9'b10101000] = 27'h0;
+    mem[9'b10101001] = 27'h0;
+    mem[9'b10101010] = 27'h0;
+    mem[9'b10101011] = 27'h0;
+    mem[9'b10101100] = 27'h0;
+    mem[9'b10101101] = 27'h0;
+    mem[9'b10101110] = 27'h0;
+    mem[9'b10101111] = 27'h0;
+    mem[9'b10110000] = 27'h0;
+    mem[9'b10110001] = 27'h0;
+    mem[9'b10110010] = 27'h0;
+    mem[9'b10110011] = 27'h0;
+    mem[9'b10110100] = 27'h0;
+    mem[9'b10110101] = 27'h0;
+    mem[9'b10110110] = 27'h0;
+    mem[9'b10110111] = 27'h0;
+    mem[9'b10111000] = 27'h0;
+    mem[9'b10111001] = 27'h0;
+    mem[9'b10111010] = 27'h0;
+    mem[9'b10111011] = 27'h0;
+    mem[9'b10111100] = 27'h0;
+    mem[9'b10111101] = 27'h0;
+    mem[9'b10111110] = 27'h0;
+    mem[9'b10111111] = 27'h0;
+    mem[9'b11000000] = 27'h0;
+    mem[9'b11000001] = 27'h0;
+    mem[9'b11000010] = 27'h0;
+    mem[9'b11000011] = 27'h0;
+    mem[9'b11000100] = 27'h0;
+    mem[9'b11000101] = 27'h0;
+    mem[9'b11000110] = 27'h0;
+    mem[9'b11000111] = 27'h0;
+    mem[9'b11001000] = 27'h0;
+    mem[9'b11001001] = 27'h0;
+    mem[9'b11001010] = 27'h0;
+    mem[9'b11001011] = 27'h0;
+    mem[9'b11001100] = 27'h0;
+    mem[9'b11001101] = 27'h0;
+    mem[9'b11001110] = 27'h0;
+    mem[9'b11001111] = 27'h0;
+    mem[9'b11010000] = 27'h0;
+    mem[9'b11010001] = 27'h0;
+    mem[9'b11010010] = 27'h0;
+    mem[9'b11010011] = 27'h0;
+    mem[9'b11010100] = 27'h0;
+    mem[9'b11010101] = 27'h0;
+    mem[9'b11010110] = 27'h0;
+    mem[9'b11010111] = 27'h0;
+    mem[9'b11011000] = 27'h0;
+    mem[9'b11011001] = 27'h0;
+    mem[9'b11011010] = 27'h0;
+    mem[9'b11011011] = 27'h0;
+    mem[9'b11011100] = 27'h0;
+    mem[9'b11011101] = 27'h0;
+    mem[9'b11011110] = 27'h0;
+    mem[9'b11011111] = 27'h0;
+    mem[9'b11100000] = 27'h0;
+    mem[9'b11100001] = 27'h0;
+    mem[9'b11100010] = 27'h0;
+    mem[9'b11100011] = 27'h0;
+    mem[9'b11100100] = 27'h0;
+    mem[9'b11100101] = 27'h0;
+    mem[9'b11100110] = 27'h0;
+    mem[9'b11100111] = 27'h0;
+    mem[9'b11101000] = 27'h0;
+    mem[9'b11101001] = 27'h0;
+    mem[9'b11101010] = 27'h0;
+    mem[9'b11101011] = 27'h0;
+    mem[9'b11101100] = 27'h0;
+    mem[9'b11101101] = 27'h0;
+    mem[9'b11101110] = 27'h0;
+    mem[9'b11101111] = 27'h0;
+    mem[9'b11110000] = 27'h0;
+    mem[9'b11110001] = 27'h0;
+    mem[9'b11110010] = 27'h0;
+    mem[9'b11110011] = 27'h0;
+    mem[9'b11110100] = 27'h0;
+    mem[9'b11110101] = 27'h0;
+    mem[9'b11110110] = 27'h0;
+    mem[9'b11110111] = 27'h0;
+    mem[9'b11111000] = 27'h0;
+    mem[9'b11111001] = 27'h0;
+    mem[9'b11111010] = 27'h0;
+    mem[9'b11111011] = 27'h0;
+    mem[9'b11111100] = 27'h0;
+    mem[9'b11111101] = 27'h0;
+    mem[9'b11111110] = 27'h0;
+    mem[9'b11111111] = 27'h0;
+    mem[9'b100000000] = 27'h0;
+    mem[9'b100000001] = 27'h0;
+    mem[9'b100000010] = 27'h0;
+    mem[9'b100000011] = 27'h0;
+    mem[9'b100000100] = 27'h0;
+    mem[9'b100000101] = 27'h0;
+    mem[9'b100000110] = 27'h0;
+    mem[9'b100000111] = 27'h0;
+    mem[9'b100001000] = 27'h0;
+    mem[9'b100001001] = 27'h0;
+    mem[9'b100001010] = 27'h0;
+    mem[9'b100001011] = 27'h0;
+    mem[9'b100001100] = 27'h0;
+    mem[9'b100001101] = 27'h0;
+    mem[9'b100001110] = 27'h0;
+    mem[9'b100001111] = 27'h0;
+    mem[9'b100010000] = 27'h0;
+    mem[9'b100010001] = 27'h0;
+    mem[9'b100010010] = 27'h0;
+    mem[9'b100010011] = 27'h0;
+    mem[9'b100010100] = 27'h0;
+    mem[9'b100010101] = 27'h0;
+    mem[9'b100010110] = 27'h0;
+    mem[9'b100010111] = 27'h0;
+    mem[9'b100011000] = 27'h0;
+    mem[9'b100011001] = 27'h0;
+    mem[9'b100011010] = 27'h0;
+    mem[9'b100011011] = 27'h0;
+    mem[9'b100011100] = 27'h0;
+    mem[9'b100011101] = 27'h0;
+    mem[9'b100011110] = 27'h0;
+    mem[9'b100011111] = 27'h0;
+    mem[9'b100100000] = 27'h0;
+    mem[9'b100100001] = 27'h0;
+    mem[9'b100100010] = 27'h0;
+    mem[9'b100100011] = 27'h0;
+    mem[9'b100100100] = 27'h0;
+    mem[9'b100100101] = 27'h0;
+    mem[9'b100100110] = 27'h0;
+    mem[9'b100100111] = 27'h0;
+    mem[9'b100101000] = 27'h0;
+    mem[9'b100101001] = 27'h0;
+    mem[9'b100101010] = 27'h0;
+    mem[9'b100101011] = 27'h0;
+    mem[9'b100101100] = 27'h0;
+    mem[9'b100101101] = 27'h0;
+    mem[9'b100101110] = 27'h0;
+    mem[9'b100101111] = 27'h0;
+    mem[9'b100110000] = 27'h0;
+    mem[9'b100110001] = 27'h0;
+    mem[9'b100110010] = 27'h0;
+    mem[9'b100110011] = 27'h0;
+    mem[9'b100110100] = 27'h0;
+    mem[9'b100110101] = 27'h0;
+    mem[9'b100110110] = 27'h0;
+    mem[9'b100110111] = 27'h0;
+    mem[9'b100111000] = 27'h0;
+    mem[9'b100111001] = 27'h0;
+    mem[9'b100111010] = 27'h0;
+    mem[9'b100111011] = 27'h0;
+    mem[9'b100111100] = 27'h0;
+    mem[9'b100111101] = 27'h0;
+    mem[9'b100111110] = 27'h0;
+    mem[9'b100111111] = 27'h0;
+    mem[9'b101000000] = 27'h0;
+    mem[9'b101000001] = 27'h0;
+    mem[9'b101000010] = 27'h0;
+    mem[9'b101000011] = 27'h0;
+    mem[9'b101000100] = 27'h0;
+    mem[9'b101000101] = 27'h0;
+    mem[9'b101000110] = 27'h0;
+    mem[9'b101000111] = 27'h0;
+    mem[9'b101001000] = 27'h0;
+    mem[9'b101001001] = 27'h0;
+    mem[9'b101001010] = 27'h0;
+    mem[9'b101001011] = 27'h0;
+    mem[9'b101001100] = 27'h0;
+    mem[9'b101001101] = 27'h0;
+    mem[9'b101001110] = 27'h0;
+    mem[9'b101001111] = 27'h0;
+    mem[9'b101010000] = 27'h0;
+    mem[9'b101010001] = 27'h0;
+    mem[9'b101010010] = 27'h0;
+    mem[9'b101010011] = 27'h0;
+    mem[9'b101010100] = 27'h0;
+    mem[9'b101010101] = 27'h0;
+    mem[9'b101010110] = 27'h0;
+    mem[9'b101010111] = 27'h0;
+    mem[9'b101011000] = 27'h0;
+    mem[9'b101011001] = 27'h0;
+    mem[9'b101011010] = 27'h0;
+    mem[9'b101011011] = 27'h0;
+    mem[9'b101011100] = 27'h0;
+    mem[9'b101011101] = 27'h0;
+    mem[9'b101011110] = 27'h0;
+    mem[9'b101011111] = 27'h0;
+    mem[9'b101100000] = 27'h0;
+    mem[9'b101100001] = 27'h0;
+    mem[9'b101100010] = 27'h0;
+    mem[9'b101100011] = 27'h0;
+    mem[9'b101100100] = 27'h0;
+    mem[9'b101100101] = 27'h0;
+    mem[9'b101100110] = 27'h0;
+    mem[9'b101100111] = 27'h0;
+    mem[9'b101101000] = 27'h0;
+    mem[9'b101101001] = 27'h0;
+    mem[9'b101101010] = 27'h0;
+    mem[9'b101101011] = 27'h0;
+    mem[9'b101101100] = 27'h0;
+    mem[9'b101101101] = 27'h0;
+    mem[9'b101101110] = 27'h0;
+    mem[9'b101101111] = 27'h0;
+    mem[9'b101110000] = 27'h0;
+    mem[9'b101110001] = 27'h0;
+    mem[9'b101110010] = 27'h0;
+    mem[9'b101110011] = 27'h0;
+    mem[9'b101110100] = 27'h0;
+    mem[9'b101110101] = 27'h0;
+    mem[9'b101110110] = 27'h0;
+    mem[9'b101110111] = 27'h0;
+    mem[9'b101111000] = 27'h0;
+    mem[9'b101111001] = 27'h0;
+    mem[9'b101111010] = 27'h0;
+    mem[9'b101111011] = 27'h0;
+    mem[9'b101111100] = 27'h0;
+    mem[9'b101111101] = 27'h0;
+    mem[9'b101111110] = 27'h0;
+    mem[9'b101111111] = 27'h0;
+    mem[9'b110000000] = 27'h0;
+    mem[9'b110000001] = 27'h0;
+    mem[9'b110000010] = 27'h0;
+    mem[9'b110000011] = 27'h0;
+    mem[9'b110000100] = 27'h0;
+    mem[9'b110000101] = 27'h0;
+    mem[9'b110000110] = 27'h0;
+    mem[9'b110000111] = 27'h0;
+    mem[9'b110001000] = 27'h0;
+    mem[9'b110001001] = 27'h0;
+    mem[9'b110001010] = 27'h0;
+    mem[9'b110001011] = 27'h0;
+    mem[9'b110001100] = 27'h0;
+    mem[9'b110001101] = 27'h0;
+    mem[9'b110001110] = 27'h0;
+    mem[9'b110001111] = 27'h0;
+    mem[9'b110010000] = 27'h0;
+    mem[9'b110010001] = 27'h0;
+    mem[9'b110010010] = 27'h0;
+    mem[9'b110010011] = 27'h0;
+    mem[9'b110010100] = 27'h0;
+    mem[9'b110010101] = 27'h0;
+    mem[9'b110010110] = 27'h0;
+    mem[9'b110010111] = 27'h0;
+    mem[9'b110011000] = 27'h0;
+    mem[9'b110011001] = 27'h0;
+    mem[9'b110011010] = 27'h0;
+    mem[9'b110011011] = 27'h0;
+    mem[9'b110011100] = 27'h0;
+    mem[9'b110011101] = 27'h0;
+    mem[9'b110011110] = 27'h0;
+    mem[9'b110011111] = 27'h0;
+    mem[9'b110100000] = 27'h0;
+    mem[9'b110100001] = 27'h0;
+    mem[9'b110100010] = 27'h0;
+    mem[9'b110100011] = 27'h0;
+    mem[9'b110100100] = 27'h0;
+    mem[9'b110100101] = 27'h0;
+    mem[9'b110100110] = 27'h0;
+    mem[9'b110100111] = 27'h0;
+    mem[9'b110101000] = 27'h0;
+    mem[9'b110101001] = 27'h0;
+    mem[9'b110101010] = 27'h0;
+    mem[9'b110101011] = 27'h0;
+    mem[9'b110101100] = 27'h0;
+    mem[9'b110101101] = 27'h0;
+    mem[9'b110101110] = 27'h0;
+    mem[9'b110101111] = 27'h0;
+    mem[9'b110110000] = 27'h0;
+    mem[9'b110110001] = 27'h0;
+    mem[9'b110110010] = 27'h0;
+    mem[9'b110110011] = 27'h0;
+    mem[9'b110110100] = 27'h0;
+    mem[9'b110110101] = 27'h0;
+    mem[9'b110110110] = 27'h0;
+    mem[9'b110110111] = 27'h0;
+    mem[9'b110111000] = 27'h0;
+    mem[9'b110111001] = 27'h0;
+    mem[9'b110111010] = 27'h0;
+    mem[9'b110111011] = 27'h0;
+    mem[9'b110111100] = 27'h0;
+    mem[9'b110111101] = 27'h0;
+    mem[9'b110111110] = 27'h0;
+    mem[9'b110111111] = 27'h0;
+    mem[9'b111000000] = 27'h0;
+    mem[9'b111000001] = 27'h0;
+    mem[9'b111000010] = 27'h0;
+    mem[9'b111000011] = 27'h0;
+    mem[9'b111000100] = 27'h0;
+    mem[9'b111000101] = 27'h0;
+    mem[9'b111000110] = 27'h0;
+    mem[9'b111000111] = 27'h0;
+    mem[9'b111001000] = 27'h0;
+    mem[9'b111001001] = 27'h0;
+    mem[9'b111001010] = 27'h0;
+    mem[9'b111001011] = 27'h0;
+    mem[9'b111001100] = 27'h0;
+    mem[9'b111001101] = 27'h0;
+    mem[9'b111001110] = 27'h0;
+    mem[9'b111001111] = 27'h0;
+    mem[9'b111010000] = 27'h0;
+    mem[9'b111010001] = 27'h0;
+    mem[9'b111010010] = 27'h0;
+    mem[9'b111010011] = 27'h0;
+    mem[9'b111010100] = 27'h0;
+    mem[9'b111010101] = 27'h0;
+    mem[9'b111010110] = 27'h0;
+    mem[9'b111010111] = 27'h0;
+    mem[9'b111011000] = 27'h0;
+    mem[9'b111011001] = 27'h0;
+    mem[9'b111011010] = 27'h0;
+    mem[9'b111011011] = 27'h0;
+    mem[9'b111011100] = 27'h0;
+    mem[9'b111011101] = 27'h0;
+    mem[9'b111011110] = 27'h0;
+    mem[9'b111011111] = 27'h0;
+    mem[9'b111100000] = 27'h0;
+    mem[9'b111100001] = 27'h0;
+    mem[9'b111100010] = 27'h0;
+    mem[9'b111100011] = 27'h0;
+    mem[9'b111100100] = 27'h0;
+    mem[9'b111100101] = 27'h0;
+    mem[9'b111100110] = 27'h0;
+    mem[9'b111100111] = 27'h0;
+    mem[9'b111101000] = 27'h0;
+    mem[9'b111101001] = 27'h0;
+    mem[9'b111101010] = 27'h0;
+    mem[9'b111101011] = 27'h0;
+    mem[9'b111101100] = 27'h0;
+    mem[9'b111101101] = 27'h0;
+    mem[9'b111101110] = 27'h0;
+    mem[9'b111101111] = 27'h0;
+    mem[9'b111110000] = 27'h0;
+    mem[9'b111110001] = 27'h0;
+    mem[9'b111110010] = 27'h0;
+    mem[9'b111110011] = 27'h0;
+    mem[9'b111110100] = 27'h0;
+    mem[9'b111110101] = 27'h0;
+    mem[9'b111110110] = 27'h0;
+    mem[9'b111110111] = 27'h0;
+    mem[9'b111111000] = 27'h0;
+    mem[9'b111111001] = 27'h0;
+    mem[9'b111111010] = 27'h0;
+    mem[9'b111111011] = 27'h0;
+    mem[9'b111111100] = 27'h0;
+    mem[9'b111111101] = 27'h0;
+    mem[9'b111111110] = 27'h0;
+    mem[9'b111111111] = 27'h0;
+    end
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__traversal_unit__cache_tag
+
+
+module dynrt_processor__engine__traversal_unit__cache_words(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [8:0] read_address;
+    input wire  read_clock;
+    output reg  [63:0] read_data;
+    input wire  [8:0] write_address;
+    input wire  write_clock;
+    input wire  [63:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[63:0] mem[511:0];
+    
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__traversal_unit__cache_words
 
 
 
@@ -36687,6 +37619,35 @@ endmodule // dynrt_processor__engine__traversal_unit__control_delay_div
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__traversal_unit__data_line__0(d,q,clock);
+    
+    // Module arguments
+    input wire  [63:0] d;
+    output reg  [63:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 64'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__traversal_unit__data_line__0
 
 
 
@@ -37213,6 +38174,8 @@ endmodule // dynrt_processor__engine__traversal_unit__f4_node
 
 
 
+
+
 module dynrt_processor__engine__traversal_unit__fetch_job(d,q,clock);
     
     // Module arguments
@@ -37230,6 +38193,8 @@ module dynrt_processor__engine__traversal_unit__fetch_job(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__traversal_unit__fetch_job
+
+
 
 
 module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,empty,write,data_in,full);
@@ -37746,6 +38711,12 @@ module dynrt_processor__engine__traversal_unit__leaf_sp(read_address,read_clock,
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__leaf_sp
+
+
+
+
+
+
 
 
 

@@ -31,6 +31,11 @@ pub struct RtlArgs {
     /// paper's 512 items; 0 for none).
     #[arg(long, value_name = "SETS", default_value_t = 512)]
     pub tri_cache: u32,
+    /// Sets of the node cache in front of bank 0 (a power of two up to 512, the paper's 512
+    /// items; 0 for none). It keeps the object trees' nodes (the top level's are rewritten
+    /// between frames) and is off at --mem-latency 1.
+    #[arg(long, value_name = "SETS", default_value_t = 512)]
+    pub node_cache: u32,
     /// Frames of an animated scene (default: all).
     #[arg(long)]
     pub frames: Option<u32>,
@@ -160,6 +165,7 @@ fn setup(a: &RtlArgs) -> anyhow::Result<(dynrt::scene::Scene, String, ProcessorP
         threads: a.threads,
         mem_latency: a.mem_latency,
         tri_cache_sets: a.tri_cache,
+        node_cache_sets: a.node_cache,
     };
     flow::preflight(&scene, a.format, params, a.frames)?;
     let name = a
@@ -178,6 +184,7 @@ fn summary(verb: &str, a: &RtlArgs, scene: &dynrt::scene::Scene, name: &str) -> 
         .option("threads", a.threads)
         .option("mem_latency", a.mem_latency)
         .option("tri_cache", a.tri_cache)
+        .option("node_cache", a.node_cache)
         .option("frames", a.frames)
         .option("width", scene.camera.width)
         .option("height", scene.camera.height)
@@ -397,6 +404,19 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
                 tests,
                 100.0 * f.tri_cache_hits as f64 / tests.max(1) as f64,
                 f.tri_cache_misses
+            )
+        },
+        {
+            let f = &r.frames[0];
+            let nodes = f.node_cache_hits + f.node_cache_misses;
+            format!(
+                "node cache (frame 0): {} sets, {} of {} object-tree nodes hit ({:.1}%), {} \
+                 read bank 0",
+                a.rtl.node_cache,
+                f.node_cache_hits,
+                nodes,
+                100.0 * f.node_cache_hits as f64 / nodes.max(1) as f64,
+                f.node_cache_misses
             )
         },
         format!("engine issue slots by routine: {}", shares.join(", ")),

@@ -48,6 +48,11 @@ pub struct TimingArgs {
     /// paper's 512 items; 0 for none).
     #[arg(long, value_name = "SETS", default_value_t = 512)]
     pub tri_cache: u32,
+    /// Sets of the node cache in front of bank 0 (a power of two up to 512, the paper's 512
+    /// items; 0 for none). It keeps the object trees' nodes (the top level's are rewritten
+    /// between frames) and is off at --mem-latency 1.
+    #[arg(long, value_name = "SETS", default_value_t = 512)]
+    pub node_cache: u32,
     /// Report directory: timing.md, timing.csv and a folder per design.
     #[arg(long, default_value = "out/timing")]
     pub out: PathBuf,
@@ -156,6 +161,7 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
         threads: a.threads,
         mem_latency: a.mem_latency,
         tri_cache_sets: a.tri_cache,
+        node_cache_sets: a.node_cache,
     };
     let mut designs = Vec::new();
     for u in &a.unit {

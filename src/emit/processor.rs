@@ -9,7 +9,8 @@
 //! unit) and the same for banks 2 and 3 (the triangles, which the triangle tester reads in
 //! parallel), `transform_busy[31:0], intersect_busy[31:0], traversal_busy[31:0],
 //! raygen_busy[31:0], instance_busy[31:0], shading_busy[31:0], tri_cache_hits[31:0],
-//! tri_cache_misses[31:0]` (activity counters of the frame), and the `vga_`
+//! tri_cache_misses[31:0], node_cache_hits[31:0], node_cache_misses[31:0]` (activity counters
+//! of the frame), and the `vga_`
 //! display ports.
 //!
 //! [`processor_testbench`] writes module `tb` for Icarus (`iverilog -g2012`) and Verilator 5
@@ -21,7 +22,7 @@
 //! `TIMEOUT` and a non-zero exit), and the frame buffer written to `frame<k>.hex` (one
 //! `RRGGBB` word a line) with `cycles instructions transform_busy intersect_busy
 //! traversal_busy raygen_busy instance_busy shading_busy ready_clocks asleep_clocks reads0 ..
-//! reads5 tri_cache_hits tri_cache_misses` (`ready_clocks`, `asleep_clocks` are thread-clocks: the bits of the scheduler's
+//! reads5 tri_cache_hits tri_cache_misses node_cache_hits node_cache_misses` (`ready_clocks`, `asleep_clocks` are thread-clocks: the bits of the scheduler's
 //! `ready` and `asleep` masks added up every clock; `reads<b>` the words read from bank b) in
 //! `frame<k>.stats`, in the current
 //! folder or
@@ -93,6 +94,7 @@ fn processor_verilog<
         params.threads,
         params.mem_latency,
         params.tri_cache_sets,
+        params.node_cache_sets,
         mode,
     )?;
     uut.connect_all();
@@ -123,6 +125,8 @@ pub struct ProcessorParams {
     /// Sets of the triangle cache (a power of two up to
     /// [`MAX_CACHE_SETS`](crate::hw::triangle_tester::MAX_CACHE_SETS); 0: none).
     pub tri_cache_sets: u32,
+    /// Sets of the traversal unit's node cache (the same rule; 0: none).
+    pub node_cache_sets: u32,
 }
 
 impl Default for ProcessorParams {
@@ -131,6 +135,7 @@ impl Default for ProcessorParams {
             threads: 32,
             mem_latency: 2,
             tri_cache_sets: crate::hw::triangle_tester::MAX_CACHE_SETS,
+            node_cache_sets: crate::hw::triangle_tester::MAX_CACHE_SETS,
         }
     }
 }
@@ -282,7 +287,7 @@ const TESTBENCH_DRIVES: [(&str, &str); 5] = [
 ];
 
 /// The ports the testbench's memory model and frame loop use by name.
-const TESTBENCH_USES: [&str; 28] = [
+const TESTBENCH_USES: [&str; 30] = [
     "done",
     "cycles",
     "instructions",
@@ -310,6 +315,8 @@ const TESTBENCH_USES: [&str; 28] = [
     "shading_busy",
     "tri_cache_hits",
     "tri_cache_misses",
+    "node_cache_hits",
+    "node_cache_misses",
     "vga_fb_addr",
 ];
 
@@ -523,10 +530,11 @@ pub fn processor_testbench(
              \x20   fd = $fopen({{out_dir, \"/frame{fr}.hex\"}}, \"w\");\n\
              \x20   for (k = 0; k < {px}; k = k + 1) $fwrite(fd, \"%06h\\n\", bank5[{fb} + k][23:0]);\n\
              \x20   $fclose(fd);\n    fd = $fopen({{out_dir, \"/frame{fr}.stats\"}}, \"w\");\n\
-             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\\n\",\n\
+             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\\n\",\n\
              \x20     cycles, instructions, transform_busy, intersect_busy, traversal_busy, raygen_busy,\n\
              \x20     instance_busy, shading_busy, ready_clocks, asleep_clocks,\n\
-             \x20     reads0, reads1, reads2, reads3, reads4, reads5, tri_cache_hits, tri_cache_misses);\n    $fclose(fd);\n\
+             \x20     reads0, reads1, reads2, reads3, reads4, reads5, tri_cache_hits, tri_cache_misses,\n\
+             \x20     node_cache_hits, node_cache_misses);\n    $fclose(fd);\n\
              \x20   $display(\"frame {fr}: %0d cycles, %0d instructions\", cycles, instructions);",
             limit = frames.cycle_limit,
             px = frames.pixels,

@@ -11,7 +11,8 @@
 //! `instance_busy` and `shading_busy` the clocks in which ray generation's, instance entry's
 //! and shading's (world normals) requests took the TransformUnit; `tri_cache_hits` and
 //! `tri_cache_misses` the triangle tests whose words came from the triangle cache and from
-//! the banks. In the pixel clock (`vga.clock`): the display reads
+//! the banks, `node_cache_hits` and `node_cache_misses` the object-tree nodes the traversal
+//! unit took from its node cache and from bank 0. In the pixel clock (`vga.clock`): the display reads
 //! the frame buffer and drives the monitor. The Verilog names a bundle's port
 //! `<bundle>_<port>` (`mem_read`, `vga_hsync`): `Processor::ports` lists them, and the
 //! constraints and testbench are written from that list.
@@ -62,6 +63,8 @@ pub struct Processor<
     pub shading_busy: Signal<Out, Bits<32>>,
     pub tri_cache_hits: Signal<Out, Bits<32>>,
     pub tri_cache_misses: Signal<Out, Bits<32>>,
+    pub node_cache_hits: Signal<Out, Bits<32>>,
+    pub node_cache_misses: Signal<Out, Bits<32>>,
     pub vga: VgaPort,
     engine: ThreadEngine<W, E, M, S, S1, X2, T, P, DX, DL>,
     display: VgaDisplay,
@@ -93,13 +96,14 @@ impl<
     > Processor<W, E, M, S, S1, X2, T, P, DX, DL>
 {
     /// The processor running `program` with `threads` threads, SRAM latency `mem_latency`
-    /// and a triangle cache of `tri_cache_sets` sets (0: none), showing a `width x height` frame from word `frame_buffer` of bank 5 in
-    /// `mode`.
+    /// and triangle and node caches of `tri_cache_sets` and `node_cache_sets` sets (0: none),
+    /// showing a `width x height` frame from word `frame_buffer` of bank 5 in `mode`.
     pub fn new(
         program: &Program,
         threads: u32,
         mem_latency: u32,
         tri_cache_sets: u32,
+        node_cache_sets: u32,
         mode: &VgaMode,
     ) -> Result<Self, VgaError> {
         let c = &program.config;
@@ -122,8 +126,16 @@ impl<
             shading_busy: Default::default(),
             tri_cache_hits: Default::default(),
             tri_cache_misses: Default::default(),
+            node_cache_hits: Default::default(),
+            node_cache_misses: Default::default(),
             vga: Default::default(),
-            engine: ThreadEngine::new(program, threads, mem_latency, tri_cache_sets),
+            engine: ThreadEngine::new(
+                program,
+                threads,
+                mem_latency,
+                tri_cache_sets,
+                node_cache_sets,
+            ),
             display: VgaDisplay::new(mode, c.width, c.height, c.frame_buffer)?,
         })
     }
@@ -213,6 +225,8 @@ impl<
         self.shading_busy.next = self.engine.shading_busy.val();
         self.tri_cache_hits.next = self.engine.tri_cache_hits.val();
         self.tri_cache_misses.next = self.engine.tri_cache_misses.val();
+        self.node_cache_hits.next = self.engine.node_cache_hits.val();
+        self.node_cache_misses.next = self.engine.node_cache_misses.val();
 
         self.display.clock.next = self.vga.clock.val();
         self.display.reset.next = self.vga.reset.val();

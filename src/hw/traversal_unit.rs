@@ -33,16 +33,27 @@
 //! in two clocks in a row (the engine's scheduler guarantees both).
 //!
 //! Structure: entries go through the front (an engine's start becomes a step job; a tester's
-//! answer reads the thread's leaf segment and stack and compares the hit with both in 5
-//! clocks, its own pipeline, one entry a clock) into the front queue; steps that continue go into the loop queue, which the fetch serves first. Fetch:
-//! two words of bank 0 a job, the next job's requests right behind (the engine's own loads of
-//! bank 0 go first; the words come back in order), then the decision pipeline: `split - o`
-//! (FpAddSub), `/ d` (FpDiv), then five FpCompares; at its end a push and the next step.
-//! Latency per inner node: `mem_latency + 3` clocks of fetch plus `8 + DL + 2` of decision
-//! (`ADD_SUB_LATENCY + DL + COMPARE_LATENCY`);
-//! throughput one node per [`FETCH_CLOCKS_PER_NODE`] (2) clocks, while other threads' jobs
-//! fill the decision pipeline. Each thread has at most one job in
-//! the unit, so the 32-entry queues never overflow.
+//! answer reads the thread's leaf segment and stack and compares the hit with both in 5 clocks,
+//! its own pipeline, one entry a clock) into the front queue; steps that continue go into the
+//! loop queue, which the fetch serves first. Fetch: two words of bank 0 a job, the next job's
+//! requests right behind (the engine's own loads of bank 0 go first; the words come back in
+//! order), then the decision pipeline: `split - o` (FpAddSub), `/ d` (FpDiv), then five
+//! FpCompares; at its end a push and the next step. Latency per inner node: `mem_latency + 4`
+//! clocks of fetch (with `look`) plus `8 + DL + 2` of decision (`ADD_SUB_LATENCY + DL +
+//! COMPARE_LATENCY`); throughput one node per [`FETCH_CLOCKS_PER_NODE`] (2) clocks from the
+//! bank, one a clock from the node cache, while other threads' jobs fill the decision pipeline.
+//! Each thread has at most one job in the unit, so the 32-entry queues never overflow.
+//!
+//! Node cache: [`MAX_CACHE_SETS`] (the paper's 512 items) sets of a node's two words, direct
+//! mapped by the node's low bits, tag (node and valid bit) and words in block RAM; `new`'s
+//! `cache_sets` uses the first sets only (0: none; off at SRAM latency 1, where a cached node's
+//! words would come back before the FIFO behind them can pop). A job waits for the fetch in
+//! `look`, whose cache set is read as it comes in; from the cache the fetch takes a node in a
+//! clock with no request, and its words travel the latency line beside the bank's (in order,
+//! at the bank's latency). A node from the bank is written into its set at A. Only the object
+//! trees' nodes are kept: the top level's part of bank 0 is rewritten between an animated
+//! scene's frames (the object trees are not), so the cache lives across frames. A set written
+//! in the clock it is read for `look` misses (its words may be the old ones).
 //!
 //! Per thread: a stack of [`STACK_LEVELS`] entries `(node, lo, hi)`, the leaf's segment end
 //! and stack depth. Const parameters: the operators' `W, E, M, S, S1, X2, T` and
@@ -57,6 +68,7 @@ use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
 use super::ports::{CoprocessorPort, SramRead};
 use super::program::isa::{KD_ENTERED, KD_WALK_ENDED};
 use super::ray_store::{zero_counters, RayStore};
+use super::triangle_tester::{cache_sets_supported, MAX_CACHE_SETS};
 use super::{Delay, SyncFifo};
 use crate::fp::Format;
 use crate::layout;
@@ -74,7 +86,8 @@ pub const STACK_LEVELS: usize = 64;
 /// deepest object tree ([`crate::hw::program::ProgramConfig::top_stack_base`]).
 pub const DEFAULT_TOP_STACK_BASE: u32 = 32;
 
-/// Clocks the fetch spends on one node, its two words (the unit's throughput bound).
+/// Clocks the fetch spends on one node from bank 0, its two words (the unit's throughput
+/// bound without the node cache, which gives a node in one).
 pub const FETCH_CLOCKS_PER_NODE: u32 = 2;
 
 /// Engine queue entry: `{top[70], next[69], thread[68:64], a[63:32], b[31:0]}`.
@@ -147,7 +160,9 @@ pub struct TraversalUnit<
     /// when `word_b` has `KD_ANY_HIT`.
     pub enter: Signal<In, Bit>,
     /// The entered ray is written (with `primary_write`, of `primary_thread`): the unit
-    /// starts the thread's walk of the entered object, as a start with `KD_ENTERED`.
+    /// starts the thread's walk of the entered object, as a start with `KD_ENTERED`. At most
+    /// every other clock (instance entry's origin and direction results come between two
+    /// writes), as the tester's answers: the start waits a clock behind an answer, at most.
     pub entered: Signal<In, Bit>,
     /// The object root of `root_thread`'s last instance entry (`KD_ENTERED` walks it).
     pub root_write: Signal<In, Bit>,
@@ -264,16 +279,52 @@ pub struct TraversalUnit<
     fetch_job: DFF<Job>,
     fetch_free: Signal<Local, Bit>,
     next_a_thread: Signal<Local, Bits<5>>,
-    /// Jobs whose words are requested, oldest first (at most `mem_latency / 2 + 2`).
+    /// Jobs whose words are requested, oldest first (at most `mem_latency + 1`: one a clock from
+    /// the cache).
     in_flight: SyncFifo<Job, 3, 4>,
     job: DFF<Job>,
     words_in: DFF<Bits<2>>,
     w0: DFF<Bits<32>>,
     w1: DFF<Bits<32>>,
     take: Signal<Local, Bit>,
-    /// Requests in flight: `{valid, word}` per clock of latency.
-    node_line: [DFF<Bits<2>>; 6],
-    arrive: Signal<Local, Bits<2>>,
+    /// Requests in flight: `{cached[2], valid[1], word[0]}` per clock of latency (`cached`:
+    /// a node from the cache, both its words in `data_line`, at the bank's latency so that
+    /// the words come back in order).
+    node_line: [DFF<Bits<3>>; 6],
+    arrive: Signal<Local, Bits<3>>,
+    /// The words of the node from the cache beside `node_line[k]`: `{w1, w0}`.
+    data_line: [DFF<Bits<64>>; 6],
+    arrive_data: Signal<Local, Bits<64>>,
+    // The node cache (see "Node cache" in the module's doc).
+    /// `look_job` waits for the fetch (the cache was read for it in the clock it came in).
+    look_valid: DFF<Bit>,
+    look_job: DFF<Job>,
+    /// The cache's set written in the clock it was read for `look_job` (its words may be the
+    /// old ones: a miss).
+    look_stale: DFF<Bit>,
+    look_move: Signal<Local, Bit>,
+    look_load: Signal<Local, Bit>,
+    look_hit: Signal<Local, Bit>,
+    /// The set read this clock (`look_job`'s next clock).
+    read_set: Signal<Local, Bits<9>>,
+    /// Per set: `{valid[26], node[25:0]}`, and the node's words `{w1, w0}`.
+    cache_tag: RAM<Bits<27>, 9>,
+    cache_words: RAM<Bits<64>, 9>,
+    /// `fetch_job`'s node is in the cache, with its words: the fetch takes it in a clock.
+    fetch_hit: DFF<Bit>,
+    fetch_words: DFF<Bits<64>>,
+    hit_now: Signal<Local, Bit>,
+    /// The words of the node at A came from bank 0: written into the cache.
+    a_fetched: DFF<Bit>,
+    fill: Signal<Local, Bit>,
+    fill_set: Signal<Local, Bits<9>>,
+    /// High in the clock a node's fetch takes it from the cache, or requests its first word
+    /// from bank 0 (an object tree's node: the top level's nodes are not cached).
+    pub cache_hit: Signal<Out, Bit>,
+    pub cache_miss: Signal<Out, Bit>,
+    c_set_mask: Constant<Bits<9>>,
+    c_cache_on: Constant<Bit>,
+    c_tag_valid: Constant<Bits<27>>,
     // A: the node's words are here.
     at_a: Signal<Local, Bit>,
     a_leaf: Signal<Local, Bit>,
@@ -352,11 +403,16 @@ impl<
         const DL: usize,
     > TraversalUnit<W, E, M, S, S1, X2, T, DL>
 {
-    /// The unit for SRAM read latency `mem_latency` (1..=6).
+    /// The unit for SRAM read latency `mem_latency` (1..=6) and a node cache of `cache_sets`
+    /// sets (0: none; see [`cache_sets_supported`]).
     /// A top-level walk's stack starts at entry `top_stack_base` of the thread's
     /// [`STACK_LEVELS`]; `top_level` is false for a scene without a top level.
-    pub fn new(mem_latency: u32, top_stack_base: u32, top_level: bool) -> Self {
+    pub fn new(mem_latency: u32, top_stack_base: u32, top_level: bool, cache_sets: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
+        assert!(
+            cache_sets_supported(cache_sets),
+            "node cache sets: {cache_sets}"
+        );
         assert!((1..STACK_LEVELS as u32).contains(&top_stack_base));
         assert!(DL == div_latency(M as u32) as usize);
         let f = Format::new(E as u32, M as u32).expect("a supported format");
@@ -484,6 +540,32 @@ impl<
             take: Default::default(),
             node_line: Default::default(),
             arrive: Default::default(),
+            data_line: Default::default(),
+            arrive_data: Default::default(),
+            look_valid: Default::default(),
+            look_job: Default::default(),
+            look_stale: Default::default(),
+            look_move: Default::default(),
+            look_load: Default::default(),
+            look_hit: Default::default(),
+            read_set: Default::default(),
+            cache_tag: RAM::new(
+                (0..MAX_CACHE_SETS as u64)
+                    .map(|k| (Bits::<9>::from(k), Bits::<27>::from(0u64)))
+                    .collect(),
+            ),
+            cache_words: Default::default(),
+            fetch_hit: Default::default(),
+            fetch_words: Default::default(),
+            hit_now: Default::default(),
+            a_fetched: Default::default(),
+            fill: Default::default(),
+            fill_set: Default::default(),
+            cache_hit: Default::default(),
+            cache_miss: Default::default(),
+            c_set_mask: Constant::new(u64::from(cache_sets.max(1) - 1).into()),
+            c_cache_on: Constant::new(cache_sets > 0 && mem_latency >= 2),
+            c_tag_valid: Constant::new((1u64 << 26).into()),
             at_a: Default::default(),
             a_leaf: Default::default(),
             a_axis: Default::default(),
@@ -600,6 +682,12 @@ impl<
             words_in,
             w0,
             w1,
+            look_valid,
+            look_job,
+            look_stale,
+            fetch_hit,
+            fetch_words,
+            a_fetched,
             skip_valid,
             skip_thread,
             entered_valid,
@@ -658,8 +746,13 @@ impl<
         self.stack_lo.write_clock.next = self.clock.val();
         self.stack_hi.read_clock.next = self.clock.val();
         self.stack_hi.write_clock.next = self.clock.val();
+        self.cache_tag.read_clock.next = self.clock.val();
+        self.cache_tag.write_clock.next = self.clock.val();
+        self.cache_words.read_clock.next = self.clock.val();
+        self.cache_words.write_clock.next = self.clock.val();
         for k in 0..6 {
             self.node_line[k].clock.next = self.clock.val();
+            self.data_line[k].clock.next = self.clock.val();
         }
         for k in 0..5 {
             self.o_delay[k].clock.next = self.clock.val();
@@ -902,13 +995,22 @@ impl<
         self.front_fifo.write.next = self.f5_valid.q.val();
         self.front_fifo.data_in.next = self.front_job.val();
 
-        // Fetch: loop jobs first; two words of bank 0 a job (the engine's loads first), the
-        // next job's right behind. The words arrive in order: a job waits in `in_flight` from
-        // its first request to its second word.
+        // Fetch: two words of bank 0 a job (the engine's loads first), the next job's right
+        // behind; a job whose node `look` found in the cache takes a clock and no request.
+        // The words arrive in order: a job waits in `in_flight` from its first request (or its
+        // clock from the cache) to its second word.
         self.loop_fifo.read.next = false;
         self.front_fifo.read.next = false;
         self.in_flight.read.next = false;
+        self.look_hit.next = self.c_cache_on.val()
+            & (!self.look_job.q.val().get_bit(102))
+            & (!self.look_stale.q.val())
+            & (self.cache_tag.read_data.val()
+                == (self.c_tag_valid.val()
+                    | bit_cast::<27, 26>(self.look_job.q.val().get_bits::<26>(64))));
+        self.hit_now.next = (self.phase.q.val() == Fetch::Word0) & self.fetch_hit.q.val();
         self.take.next = (self.phase.q.val() != Fetch::Idle)
+            & (!self.hit_now.val())
             & ((self.engine.load_banks.val() & self.c_bank_nodes.val()) == 0);
         self.nodes.read.next =
             self.take.val() | ((self.engine.load_banks.val() & self.c_bank_nodes.val()) != 0);
@@ -922,18 +1024,31 @@ impl<
                 self.phase.d.next = Fetch::Idle;
             }
         }
-        self.in_flight.write.next = self.take.val() & (self.phase.q.val() == Fetch::Word0);
+        if self.hit_now.val() {
+            self.phase.d.next = Fetch::Idle;
+        }
+        self.cache_hit.next = self.hit_now.val();
+        self.cache_miss.next = self.take.val()
+            & (self.phase.q.val() == Fetch::Word0)
+            & (!self.fetch_job.q.val().get_bit(102));
+        self.in_flight.write.next =
+            (self.take.val() & (self.phase.q.val() == Fetch::Word0)) | self.hit_now.val();
         self.in_flight.data_in.next = self.fetch_job.q.val();
         self.words_in.d.next = 0.into();
-        self.node_line[0].d.next = (bit_cast::<2, 1>(self.take.val().into()) << 1)
-            | bit_cast::<2, 1>((self.phase.q.val() == Fetch::Word1).into());
+        self.node_line[0].d.next = (bit_cast::<3, 1>(self.hit_now.val().into()) << 2)
+            | (bit_cast::<3, 1>(self.take.val().into()) << 1)
+            | bit_cast::<3, 1>((self.phase.q.val() == Fetch::Word1).into());
+        self.data_line[0].d.next = self.fetch_words.q.val();
         for k in 1..6 {
             self.node_line[k].d.next = self.node_line[k - 1].q.val();
+            self.data_line[k].d.next = self.data_line[k - 1].q.val();
         }
         self.arrive.next = 0.into();
+        self.arrive_data.next = 0.into();
         for k in 0..6 {
             if self.c_ml_last.val() == self.c_index[k].val() {
                 self.arrive.next = self.node_line[k].q.val();
+                self.arrive_data.next = self.data_line[k].q.val();
             }
         }
         if self.arrive.val() == 2 {
@@ -943,32 +1058,63 @@ impl<
         self.next_a_thread.next = self.job.q.val().get_bits::<5>(96);
         if self.arrive.val() == 3 {
             self.w1.d.next = self.nodes.rdata.val();
+            self.a_fetched.d.next = true;
+        }
+        if self.arrive.val() == 4 {
+            self.w0.d.next = self.arrive_data.val().get_bits::<32>(0);
+            self.w1.d.next = self.arrive_data.val().get_bits::<32>(32);
+            self.a_fetched.d.next = false;
+        }
+        if (self.arrive.val() == 3) | (self.arrive.val() == 4) {
             self.job.d.next = self.in_flight.data_out.val();
             self.next_a_thread.next = self.in_flight.data_out.val().get_bits::<5>(96);
             self.in_flight.read.next = true;
             self.words_in.d.next = 1.into();
         }
-        // The next job: a fetch, or a finishing job straight to A when nothing is in flight.
+        // `look_job` moves on when the fetch is free: into the fetch, or a finishing job
+        // straight to A when nothing is in flight.
         self.fetch_free.next = (self.phase.q.val() == Fetch::Idle)
-            | ((self.phase.q.val() == Fetch::Word1) & self.take.val());
-        if self.fetch_free.val() {
-            if !self.loop_fifo.empty.val() {
-                self.loop_fifo.read.next = true;
-                self.fetch_job.d.next = self.loop_fifo.data_out.val();
+            | ((self.phase.q.val() == Fetch::Word1) & self.take.val())
+            | self.hit_now.val();
+        self.look_move.next = false;
+        if self.fetch_free.val() & self.look_valid.q.val() {
+            if !self.look_job.q.val().get_bit(101) {
+                self.look_move.next = true;
+                self.fetch_job.d.next = self.look_job.q.val();
+                self.fetch_hit.d.next = self.look_hit.val();
+                self.fetch_words.d.next = self.cache_words.read_data.val();
                 self.phase.d.next = Fetch::Word0;
-            } else if !self.front_fifo.empty.val() {
-                if !self.front_fifo.data_out.val().get_bit(101) {
-                    self.front_fifo.read.next = true;
-                    self.fetch_job.d.next = self.front_fifo.data_out.val();
-                    self.phase.d.next = Fetch::Word0;
-                } else if (self.phase.q.val() == Fetch::Idle) & self.in_flight.empty.val() {
-                    self.front_fifo.read.next = true;
-                    self.job.d.next = self.front_fifo.data_out.val();
-                    self.next_a_thread.next = self.front_fifo.data_out.val().get_bits::<5>(96);
-                    self.words_in.d.next = 1.into();
-                }
+            } else if (self.phase.q.val() == Fetch::Idle) & self.in_flight.empty.val() {
+                self.look_move.next = true;
+                self.job.d.next = self.look_job.q.val();
+                self.next_a_thread.next = self.look_job.q.val().get_bits::<5>(96);
+                self.words_in.d.next = 1.into();
+                self.a_fetched.d.next = false;
             }
         }
+        // The next job for `look` (loop jobs first), its set read from the cache as it comes.
+        self.look_load.next = (!self.look_valid.q.val()) | self.look_move.val();
+        if self.look_move.val() {
+            self.look_valid.d.next = false;
+        }
+        self.read_set.next = self.look_job.q.val().get_bits::<9>(64) & self.c_set_mask.val();
+        if self.look_load.val() {
+            if !self.loop_fifo.empty.val() {
+                self.loop_fifo.read.next = true;
+                self.look_valid.d.next = true;
+                self.look_job.d.next = self.loop_fifo.data_out.val();
+                self.read_set.next =
+                    self.loop_fifo.data_out.val().get_bits::<9>(64) & self.c_set_mask.val();
+            } else if !self.front_fifo.empty.val() {
+                self.front_fifo.read.next = true;
+                self.look_valid.d.next = true;
+                self.look_job.d.next = self.front_fifo.data_out.val();
+                self.read_set.next =
+                    self.front_fifo.data_out.val().get_bits::<9>(64) & self.c_set_mask.val();
+            }
+        }
+        self.cache_tag.read_address.next = self.read_set.val();
+        self.cache_words.read_address.next = self.read_set.val();
         // The ray's words for A: read for the oldest job in flight, a clock before it gets
         // there.
         self.ray.ray_thread.next = self.in_flight.data_out.val().get_bits::<5>(96);
@@ -1056,6 +1202,22 @@ impl<
         self.done_e.write_enable.next = self.a_done.val();
         self.done_r.d.next = self.a_done.val();
         self.done_thread_r.d.next = self.job.q.val().get_bits::<5>(96);
+        // The node cache keeps the object trees' nodes that came from bank 0 (the top level's
+        // part of the bank is rewritten between an animated scene's frames), written from A.
+        self.fill.next = self.c_cache_on.val()
+            & self.at_a.val()
+            & self.a_fetched.q.val()
+            & (!self.job.q.val().get_bit(102));
+        self.fill_set.next = self.job.q.val().get_bits::<9>(64) & self.c_set_mask.val();
+        self.cache_tag.write_address.next = self.fill_set.val();
+        self.cache_tag.write_data.next =
+            self.c_tag_valid.val() | bit_cast::<27, 26>(self.job.q.val().get_bits::<26>(64));
+        self.cache_tag.write_enable.next = self.fill.val();
+        self.cache_words.write_address.next = self.fill_set.val();
+        self.cache_words.write_data.next =
+            (bit_cast::<64, 32>(self.w1.q.val()) << 32) | bit_cast::<64, 32>(self.w0.q.val());
+        self.cache_words.write_enable.next = self.fill.val();
+        self.look_stale.d.next = self.fill.val() & (self.fill_set.val() == self.read_set.val());
         self.engine.done.next = self.done_r.q.val();
         self.engine.done_thread.next = self.done_thread_r.q.val();
         self.leaf_hi.write_enable.next = self.at_a.val() & self.a_leaf.val();
@@ -1224,8 +1386,10 @@ mod tests {
     /// on, one thread in two) a hit at a random distance; each thread walks twice. Every thread's sequence of leaves
     /// and its end equal `units::KdWalk`'s (an any-hit walk ends at its first hit); the engine
     /// takes bank 0 in random clocks, and its starts are refused while an answer goes in.
-    #[test]
-    fn rust_hdl_simulation_walks_like_the_model() {
+    /// Run with a node cache of `cache_sets` sets: every node the model reads is a hit or a
+    /// miss of the unit's cache (none a hit without a cache); returns the hits and the
+    /// unit's reads of bank 0.
+    fn walk_like_the_model(cache_sets: u32) -> (usize, usize) {
         let f = Format::E7M16;
         let seed = 41;
         println!("seed {seed}");
@@ -1267,7 +1431,11 @@ mod tests {
                     .collect()
             })
             .collect();
-        let fetch = |n: u32| Ok(lay.node(n));
+        let model_fetches = std::cell::Cell::new(0usize);
+        let fetch = |n: u32| {
+            model_fetches.set(model_fetches.get() + 1);
+            Ok(lay.node(n))
+        };
         let t_max = f.infinity(false);
         let want: Vec<Vec<KdStop>> = (0..threads)
             .map(|th| {
@@ -1294,8 +1462,10 @@ mod tests {
             "too few leaves"
         );
         assert!(want[7].len() == 8, "the any-hit walk ends at its first hit");
+        // Each thread walks twice.
+        let model_fetches = 2 * model_fetches.get();
 
-        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE, true);
+        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE, true, cache_sets);
         u.connect_all();
         let cycle = |u: &mut Unit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
         for (th, (o, d)) in rays.iter().enumerate() {
@@ -1321,6 +1491,9 @@ mod tests {
             requests: VecDeque<Option<u32>>,
             stolen: usize,
             refused: usize,
+            hits: usize,
+            misses: usize,
+            reads: usize,
             /// Answers due: (clock, thread, best t, hit).
             due: Vec<(u64, usize, u32, bool)>,
             clock: u64,
@@ -1332,6 +1505,9 @@ mod tests {
             requests: std::iter::repeat(None).take(mem_latency as usize).collect(),
             stolen: 0,
             refused: 0,
+            hits: 0,
+            misses: 0,
+            reads: 0,
             due: Vec::new(),
             clock: 0,
             got: vec![Vec::new(); threads],
@@ -1362,7 +1538,11 @@ mod tests {
                 b.stolen += 1;
                 let request = b.requests.back().unwrap();
                 assert_eq!(*request, Some(a as u32), "the engine's read");
+            } else if b.requests.back().unwrap().is_some() {
+                b.reads += 1;
             }
+            b.hits += usize::from(u.cache_hit.val());
+            b.misses += usize::from(u.cache_miss.val());
             let full = u.engine.full.val();
             if full && u.engine.enqueue.val() {
                 b.refused += 1;
@@ -1407,6 +1587,25 @@ mod tests {
         assert!(b.stolen > 0);
         assert!(b.refused > 0, "no start was refused for an answer");
         assert_eq!(b.got, want, "leaves per thread");
+        assert_eq!(b.hits + b.misses, model_fetches, "nodes fetched");
+        assert_eq!(b.reads, 2 * b.misses, "bank 0 reads: two words per miss");
+        (b.hits, b.reads)
+    }
+
+    #[test]
+    fn rust_hdl_simulation_walks_like_the_model() {
+        let (hits, reads) = walk_like_the_model(0);
+        assert_eq!(hits, 0, "no cache, no hit");
+        // A cache of the paper's 512 sets holds the whole Cornell tree: each node is read from
+        // the bank once; two sets evict (fewer hits, more reads).
+        let (hits_512, reads_512) = walk_like_the_model(MAX_CACHE_SETS);
+        let (hits_2, reads_2) = walk_like_the_model(2);
+        println!("hits / reads: none 0 / {reads}, 2 sets {hits_2} / {reads_2}, 512 {hits_512} / {reads_512}");
+        assert!(hits_512 > hits_2 && hits_2 > 0, "{hits_512} {hits_2}");
+        assert!(
+            reads_512 < reads_2 && reads_2 < reads,
+            "{reads_512} {reads_2} {reads}"
+        );
     }
 
     /// rust-hdl simulation of top-level walks on the dynamic scene's trees (1,202 instances):
@@ -1416,8 +1615,11 @@ mod tests {
     /// thread an entered root (`root_write`, as instance entry does) and has the unit walk
     /// that object: every other walk starts with `kd.start KD_ENTERED`, the others as
     /// `tri.enter` starts them (`enter`, and some clocks later `entered` with the ray, as
-    /// instance entry writes it, half of them in the clock of a tester's answer). The test
-    /// plays the tester, answering each object leaf in random clocks with the thread's
+    /// instance entry writes it, half of them in the clock of a tester's answer; entered rays
+    /// and answers each at most every other clock, the unit's contract: with both in
+    /// consecutive clocks a pending entered walk was overwritten, which the node cache's
+    /// timing showed). The test plays the tester, answering each object leaf in random
+    /// clocks with the thread's
     /// closest hit so far (none, or from its second top-level leaf on, one thread in two, a
     /// hit at a random distance), checks `kd.wait`'s hit flag after each object walk, then
     /// sends `next`. Every top-level walk stops at `units::KdWalk`'s leaves on the world ray,
@@ -1547,7 +1749,7 @@ mod tests {
             "too few object leaves: {object_leaves}"
         );
 
-        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE, true);
+        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE, true, MAX_CACHE_SETS);
         u.connect_all();
         let cycle = |u: &mut Unit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
         for th in 0..threads {
@@ -1596,6 +1798,10 @@ mod tests {
             /// Entered rays to write (clock, thread); how many in the clock of an answer.
             entering: Vec<(u64, usize)>,
             entered_with_answer: usize,
+            /// The last clocks of an answer and of an entered ray: each comes at most every
+            /// other clock (`LAUNCH_SPACING`; instance entry's origin and direction passes).
+            last_answer: u64,
+            last_entered: u64,
         }
         let mut b = Bench {
             requests: std::iter::repeat(None).take(mem_latency as usize).collect(),
@@ -1605,16 +1811,30 @@ mod tests {
             answer: vec![(t_max, false); threads],
             entering: Vec::new(),
             entered_with_answer: 0,
+            last_answer: 0,
+            last_entered: 0,
         };
         let mut th = 0;
         let tick = |u: &mut Unit, b: &mut Bench, rng: &mut rand_chacha::ChaCha8Rng, offer: bool| {
             b.clock += 1;
-            let answer = b.due.iter().position(|d| d.0 <= b.clock || offer);
+            let answer = b
+                .due
+                .iter()
+                .position(|d| d.0 <= b.clock || offer)
+                .filter(|_| b.clock > b.last_answer + 1);
             let answer = answer.map(|k| {
+                b.last_answer = b.clock;
                 let (_, th) = b.due.remove(k);
                 (th, b.answer[th].0, b.answer[th].1)
             });
-            let entered = b.entering.iter().position(|e| e.0 <= b.clock);
+            let entered = b
+                .entering
+                .iter()
+                .position(|e| e.0 <= b.clock)
+                .filter(|_| b.clock > b.last_entered + 1);
+            if entered.is_some() {
+                b.last_entered = b.clock;
+            }
             u.entered.next = entered.is_some();
             u.primary_write.next = entered.is_some();
             if let Some(k) = entered {

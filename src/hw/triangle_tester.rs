@@ -54,17 +54,18 @@
 //! written, so the merge takes it from the entry ahead instead (`after_*`, `lw_*`).
 //!
 //! Triangle cache: [`MAX_CACHE_SETS`] (the paper's 512 items) sets of a triangle's 12 words,
-//! direct mapped by the triangle's low bits, in block RAM, with a tag (triangle and valid bit)
-//! in distributed RAM; `new`'s `cache_sets` uses the first sets only (0: no cache). The queue's
-//! head is looked up as the free buffer copies it; a triangle found there is not fetched, and
-//! the launch takes its words from the cache (addressed two clocks ahead: the launch's words,
-//! from the buffer or the cache, wait in a register, `matrix`). A triangle fetched from the
-//! banks is written into its set as it launches (in its direction's clock, decided in its
-//! origin's), from the words it launches with, unless a buffered triangle found in the cache
-//! holds that set (it must find its words there until it launches); a head looked up in either
-//! clock misses if its set is the launch's. The frames of an animated scene leave banks 2 and 3
-//! as they are (only instances and the top level move; `emit::memory_images`' tests hold it),
-//! so the cache lives across frames.
+//! direct mapped by the triangle's low bits, with a tag (triangle and valid bit), all in block
+//! RAM; `new`'s `cache_sets` uses the first sets only (0: no cache). The queue's head's tag is
+//! read as the free buffer copies it and compared in the next clock, which decides the buffer's
+//! `cached` (the fetch leaves the buffer alone until then); a triangle found there is not
+//! fetched, and the launch takes its words from the cache (addressed two clocks ahead: the
+//! launch's words, from the buffer or the cache, wait in a register, `matrix`). A triangle
+//! fetched from the banks is written into its set as it launches (in its direction's clock,
+//! decided in its origin's), from the words it launches with, unless a buffered triangle found
+//! in the cache holds that set (it must find its words there until it launches); a head looked
+//! up in either clock, or decided in an origin's clock, misses if its set is the launch's. The
+//! frames of an animated scene leave banks 2 and 3 as they are (only instances and the top
+//! level move; `emit::memory_images`' tests hold it), so the cache lives across frames.
 //!
 //! Latency from launch to the merged hit: `TRANSFORM_LATENCY` (28) + 1 + `intersect_latency`
 //! (35 at e7m16) + 3. Up to [`FLIGHT_SLOTS`] entries are in flight in that time, each with its
@@ -120,8 +121,8 @@ pub const CLOCKS_PER_TEST: u32 = 6;
 /// smaller cache uses the first sets.
 pub const MAX_CACHE_SETS: u32 = 512;
 
-/// Whether the triangle cache can have `sets` sets: a power of two up to [`MAX_CACHE_SETS`],
-/// or 0 for none.
+/// Whether a cache (this unit's triangle cache, the traversal unit's node cache) can have
+/// `sets` sets: a power of two up to [`MAX_CACHE_SETS`], or 0 for none.
 pub fn cache_sets_supported(sets: u32) -> bool {
     sets == 0 || (sets.is_power_of_two() && sets <= MAX_CACHE_SETS)
 }
@@ -255,8 +256,13 @@ pub struct TriangleTester<
     /// Word k of the triangle in each buffer (distributed RAM addressed by the buffer: the
     /// launch reads its buffer's 12 words at once).
     words: [LutRam<Bits<W>, 2>; 12],
-    /// The buffer whose words are read: `lb`, or the next one in the direction's clock.
-    words_buffer: Signal<Local, Bits<2>>,
+    /// The buffer whose words are read, and whether `matrix` takes the cache's words instead:
+    /// `lb`'s while waiting, the next buffer's in the direction's clock (the origin's reads
+    /// are not taken). Registered the clock before, from `lphase` (an origin follows a wait
+    /// or a direction, a direction an origin): from `lb` through the buffer's read and the
+    /// buffers' cache flags into `matrix` was cornell's critical path (68.3 MHz placed).
+    words_buffer: DFF<Bits<2>>,
+    matrix_cached: DFF<Bit>,
     /// The 12 words the launch takes into the TransformUnit, selected from the buffer or the
     /// cache a clock ahead: in each clock of waiting (`lb`'s) and in the direction's (the next
     /// buffer's, for an origin that follows at once). Selected in the launch's clock, the
@@ -273,16 +279,27 @@ pub struct TriangleTester<
     /// Buffer `tb` is free; `take`: it takes the queue's head this clock.
     tb_free: Signal<Local, Bit>,
     // The triangle cache (see "Triangle cache" in the module's doc).
-    /// Per set: `{valid[24], triangle[23:0]}`.
-    cache_tag: LutRam<Bits<25>, 9>,
+    /// Per set: `{valid[24], triangle[23:0]}`, in block RAM: read at the head's set in every
+    /// clock, compared in the next. (In distributed RAM read and compared in the take's
+    /// clock, its 512-deep read ran through the compare into the fetch's start: stop 46's
+    /// critical path, `cache_tag.read_address -> fetching`, 67.3 MHz placed.)
+    cache_tag: RAM<Bits<25>, 9>,
     /// Word k of each set's triangle.
     cache_words: [RAM<Bits<W>, 9>; 12],
-    /// The buffer's triangle is in the cache (decided at the take; its set is not written
-    /// until it launches).
+    /// The buffer's triangle is in the cache (decided in the clock after the take, when
+    /// `fresh`; its set is not written until it launches).
     cached: [DFF<Bit>; TEST_BUFFERS],
+    /// The buffer was taken last clock: its `cached` is decided now.
+    fresh: [DFF<Bit>; TEST_BUFFERS],
     head_triangle: Signal<Local, Bits<24>>,
     head_set: Signal<Local, Bits<9>>,
+    /// The head of last clock (the tag's read is for its set) and whether its set clashed.
+    head_triangle_r: DFF<Bits<24>>,
+    head_set_r: DFF<Bits<9>>,
+    head_clash_r: DFF<Bit>,
     head_hit: Signal<Local, Bit>,
+    l_fresh: Signal<Local, Bit>,
+    n_fresh: Signal<Local, Bit>,
     l_cached: Signal<Local, Bit>,
     l_set: Signal<Local, Bits<9>>,
     n_cached: Signal<Local, Bit>,
@@ -301,8 +318,6 @@ pub struct TriangleTester<
     c_cache_on: Constant<Bit>,
     c_tag_valid: Constant<Bits<25>>,
     take: Signal<Local, Bit>,
-    /// The entry taken is a triangle.
-    take_triangle: Signal<Local, Bit>,
     /// The fetch leaves `fb` this clock: its last words requested, or an entry that fetches
     /// nothing passed over.
     fetch_moves: Signal<Local, Bit>,
@@ -526,14 +541,25 @@ impl<
             fetch_a: Default::default(),
             fetch_ends: Default::default(),
             tb_free: Default::default(),
-            cache_tag: LutRam::new(Default::default()),
+            cache_tag: RAM::new(
+                (0..MAX_CACHE_SETS as u64)
+                    .map(|k| (Bits::<9>::from(k), Bits::<25>::from(0u64)))
+                    .collect(),
+            ),
             cache_words: Default::default(),
             cached: Default::default(),
+            fresh: Default::default(),
             head_triangle: Default::default(),
             head_set: Default::default(),
+            head_triangle_r: Default::default(),
+            head_set_r: Default::default(),
+            head_clash_r: Default::default(),
             head_hit: Default::default(),
+            l_fresh: Default::default(),
+            n_fresh: Default::default(),
             l_cached: Default::default(),
             words_buffer: Default::default(),
+            matrix_cached: Default::default(),
             matrix: Default::default(),
             cache_ready: Default::default(),
             l_set: Default::default(),
@@ -547,7 +573,6 @@ impl<
             c_cache_on: Constant::new(cache_sets > 0),
             c_tag_valid: Constant::new((1u64 << 24).into()),
             take: Default::default(),
-            take_triangle: Default::default(),
             fetch_moves: Default::default(),
             fetch_next: Default::default(),
             next_triangle: Default::default(),
@@ -656,7 +681,12 @@ impl<
             fb,
             lb,
             lphase,
+            words_buffer,
+            matrix_cached,
             cache_ready,
+            head_triangle_r,
+            head_set_r,
+            head_clash_r,
             a_issued,
             b_issued,
             seq,
@@ -731,18 +761,15 @@ impl<
         self.flight_a.write_clock.next = self.clock.val();
         self.flight_b.read_clock.next = self.clock.val();
         self.flight_b.write_clock.next = self.clock.val();
-        self.words_buffer.next = self.lb.q.val();
-        if self.lphase.q.val() == Launch::Direction {
-            self.words_buffer.next = self.lb.q.val() + 1;
-        }
         for k in 0..12 {
             self.words[k].write_clock.next = self.clock.val();
             self.words[k].write_enable.next = false;
-            self.words[k].read_address.next = self.words_buffer.val();
+            self.words[k].read_address.next = self.words_buffer.q.val();
             self.matrix[k].clock.next = self.clock.val();
             self.matrix[k].d.next = self.matrix[k].q.val();
         }
         self.cache_tag.write_clock.next = self.clock.val();
+        self.cache_tag.read_clock.next = self.clock.val();
         for k in 0..12 {
             self.cache_words[k].read_clock.next = self.clock.val();
             self.cache_words[k].write_clock.next = self.clock.val();
@@ -750,6 +777,7 @@ impl<
         for k in 0..4 {
             self.cached[k].clock.next = self.clock.val();
             self.cached[k].d.next = self.cached[k].q.val();
+            self.fresh[k].clock.next = self.clock.val();
             self.loaded[k].clock.next = self.clock.val();
             self.loaded[k].d.next = self.loaded[k].q.val();
             self.unvisited[k].clock.next = self.clock.val();
@@ -841,6 +869,7 @@ impl<
         self.l_loaded.next = self.loaded[0].q.val();
         self.l_received.next = self.received[0].q.val();
         self.l_cached.next = self.cached[0].q.val();
+        self.l_fresh.next = self.fresh[0].q.val();
         for k in 1..4 {
             if self.lb.q.val() == self.c_buffer[k].val() {
                 self.l_kind.next = self.cur_kind[k].q.val();
@@ -850,6 +879,7 @@ impl<
                 self.l_loaded.next = self.loaded[k].q.val();
                 self.l_received.next = self.received[k].q.val();
                 self.l_cached.next = self.cached[k].q.val();
+                self.l_fresh.next = self.fresh[k].q.val();
             }
         }
         self.l_ready.next = self.l_loaded.val()
@@ -862,6 +892,7 @@ impl<
         self.n_kind.next = self.cur_kind[0].q.val();
         self.n_received.next = self.received[0].q.val();
         self.n_cached.next = self.cached[0].q.val();
+        self.n_fresh.next = self.fresh[0].q.val();
         self.n_set.next = self.cur_a[0].q.val().get_bits::<9>(0) & self.c_set_mask.val();
         for k in 1..4 {
             if self.lb.q.val() + 1 == self.c_buffer[k].val() {
@@ -870,6 +901,7 @@ impl<
                 self.n_kind.next = self.cur_kind[k].q.val();
                 self.n_received.next = self.received[k].q.val();
                 self.n_cached.next = self.cached[k].q.val();
+                self.n_fresh.next = self.fresh[k].q.val();
                 self.n_set.next = self.cur_a[k].q.val().get_bits::<9>(0) & self.c_set_mask.val();
             }
         }
@@ -907,9 +939,9 @@ impl<
         self.cache_tag.write_enable.next = self.cache_write_r.q.val();
         // The words answer a clock after their set: the launch's while it waits, the next
         // buffer's from the origin's clock on (`matrix` takes them in the direction's).
-        self.cache_ready.d.next = self.l_loaded.val();
+        self.cache_ready.d.next = self.l_loaded.val() & (!self.l_fresh.val());
         if self.lphase.q.val() != Launch::Wait {
-            self.cache_ready.d.next = self.n_loaded.val();
+            self.cache_ready.d.next = self.n_loaded.val() & (!self.n_fresh.val());
         }
         for k in 0..12 {
             self.cache_words[k].write_address.next = self.l_set.val();
@@ -924,14 +956,21 @@ impl<
         self.head_set.next = self.head_triangle.val().get_bits::<9>(0) & self.c_set_mask.val();
         self.cache_tag.read_address.next = self.head_set.val();
         // A head taken in an origin's clock (whose write is decided then) or in a write's
-        // clock (the tag read shows the set before the write) misses if the set is the same.
+        // clock (the tag read shows the set before the write) misses if the set is the same,
+        // as one whose set an origin decides to write in the next clock, while its `cached`
+        // is decided (the origin's `cache_block` sees it from the clock after).
         self.head_clash.next = ((self.lphase.q.val() == Launch::Origin)
             | self.cache_write_r.q.val())
             & (self.l_set.val() == self.head_set.val());
+        self.head_triangle_r.d.next = self.head_triangle.val();
+        self.head_set_r.d.next = self.head_set.val();
+        self.head_clash_r.d.next = self.head_clash.val();
         self.head_hit.next = self.c_cache_on.val()
             & (self.cache_tag.read_data.val()
-                == (self.c_tag_valid.val() | bit_cast::<25, 24>(self.head_triangle.val())))
-            & (!self.head_clash.val());
+                == (self.c_tag_valid.val() | bit_cast::<25, 24>(self.head_triangle_r.q.val())))
+            & (!self.head_clash_r.q.val())
+            & (!((self.lphase.q.val() == Launch::Origin)
+                & (self.l_set.val() == self.head_set_r.q.val())));
 
         // Take: the list unit's next entry into buffer `tb` whenever it is free, apart from the
         // fetch. (Taken in the clock of the fetch's last requests, the take waited on the bank
@@ -945,8 +984,6 @@ impl<
         }
         self.take.next = self.tb_free.val() & self.list_unit.test_valid.val();
         self.list_unit.test_take.next = self.take.val();
-        self.take_triangle.next = self.take.val()
-            & (self.list_unit.test_entry.val().get_bits::<2>(69) == self.c_test_triangle.val());
         if self.take.val() {
             self.tb.d.next = self.tb.q.val() + 1;
             for k in 0..4 {
@@ -966,9 +1003,15 @@ impl<
                 self.cur_thread[k].d.next = self.list_unit.test_entry.val().get_bits::<5>(64);
                 self.cur_a[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(32);
                 self.cur_b[k].d.next = self.list_unit.test_entry.val().get_bits::<32>(0);
-                self.cached[k].d.next = self.head_hit.val()
-                    & (self.list_unit.test_entry.val().get_bits::<2>(69)
-                        == self.c_test_triangle.val());
+                self.cached[k].d.next = false;
+            }
+        }
+        // The buffer taken last clock: in the cache if its triangle's tag matched.
+        for k in 0..4 {
+            self.fresh[k].d.next = self.take.val() & (self.tb.q.val() == self.c_buffer[k].val());
+            if self.fresh[k].q.val() {
+                self.cached[k].d.next =
+                    self.head_hit.val() & (self.cur_kind[k].q.val() == self.c_test_triangle.val());
             }
         }
 
@@ -1046,12 +1089,11 @@ impl<
         }
         // A triangle taken this clock into the buffer the fetch is at next is fetched from
         // the next clock, as one taken before.
-        self.next_triangle.next = self.take_triangle.val()
-            & (!self.head_hit.val())
-            & (self.tb.q.val() == self.fetch_next.val());
+        self.next_triangle.next = false;
         for k in 0..4 {
             if (self.fetch_next.val() == self.c_buffer[k].val())
                 & self.unvisited[k].q.val()
+                & (!self.fresh[k].q.val())
                 & (self.cur_kind[k].q.val() == self.c_test_triangle.val())
                 & (!self.cached[k].q.val())
             {
@@ -1095,17 +1137,17 @@ impl<
 
         // Launch from buffer `lb` (its words and the next buffer's: see above): the origin,
         // then the direction, of the entry's thread.
+        self.words_buffer.d.next = self.lb.q.val() + 1;
+        self.matrix_cached.d.next = self.n_cached.val();
+        if self.lphase.q.val() == Launch::Wait {
+            self.words_buffer.d.next = self.lb.q.val();
+            self.matrix_cached.d.next = self.l_cached.val();
+        }
         for k in 0..12 {
             self.transform_unit.m[k].next = self.matrix[k].q.val();
-            if self.lphase.q.val() == Launch::Wait {
+            if self.lphase.q.val() != Launch::Origin {
                 self.matrix[k].d.next = self.words[k].read_data.val();
-                if self.l_cached.val() {
-                    self.matrix[k].d.next = self.cache_words[k].read_data.val();
-                }
-            }
-            if self.lphase.q.val() == Launch::Direction {
-                self.matrix[k].d.next = self.words[k].read_data.val();
-                if self.n_cached.val() {
+                if self.matrix_cached.q.val() {
                     self.matrix[k].d.next = self.cache_words[k].read_data.val();
                 }
             }

@@ -259,6 +259,9 @@ pub struct ThreadEngine<
     /// Triangle tests launched with their words from the triangle cache, and from the banks.
     pub tri_cache_hits: Signal<Out, Bits<32>>,
     pub tri_cache_misses: Signal<Out, Bits<32>>,
+    /// Object-tree nodes the traversal unit took from its node cache, and from bank 0.
+    pub node_cache_hits: Signal<Out, Bits<32>>,
+    pub node_cache_misses: Signal<Out, Bits<32>>,
 
     // The pipeline's stages.
     scheduler: Scheduler,
@@ -294,6 +297,8 @@ pub struct ThreadEngine<
     shading_count: DFF<Bits<32>>,
     cache_hit_count: DFF<Bits<32>>,
     cache_miss_count: DFF<Bits<32>>,
+    node_hit_count: DFF<Bits<32>>,
+    node_miss_count: DFF<Bits<32>>,
     /// The busy counters' events, registered where they arise and counted a clock later: a
     /// unit's busy signal routed straight into a counter's 32 enables across the chip was
     /// the processor's critical path (stop 45: `tester.words.read_address ->
@@ -307,6 +312,8 @@ pub struct ThreadEngine<
     tick_shading: DFF<Bit>,
     tick_cache_hit: DFF<Bit>,
     tick_cache_miss: DFF<Bit>,
+    tick_node_hit: DFF<Bit>,
+    tick_node_miss: DFF<Bit>,
     frame_start: Signal<Local, Bit>,
     // The memory and frame-buffer ports' request registers.
     /// The load's bank one-hot (`CoprocessorPort::load_banks`); `mem_bank_r` its number, for
@@ -434,8 +441,15 @@ impl<
     > ThreadEngine<W, E, M, S, S1, X2, T, P, DX, DL>
 {
     /// The engine running `program` with `threads` threads, memory read latency
-    /// `mem_latency` and a triangle cache of `tri_cache_sets` sets (0: none).
-    pub fn new(program: &Program, threads: u32, mem_latency: u32, tri_cache_sets: u32) -> Self {
+    /// `mem_latency`, a triangle cache of `tri_cache_sets` sets and a node cache of
+    /// `node_cache_sets` (0: none).
+    pub fn new(
+        program: &Program,
+        threads: u32,
+        mem_latency: u32,
+        tri_cache_sets: u32,
+        node_cache_sets: u32,
+    ) -> Self {
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
         assert!(P == 2 * S);
         // `FpUnits` pads the (faster) divider to the square root's latency.
@@ -478,6 +492,8 @@ impl<
             shading_busy: Default::default(),
             tri_cache_hits: Default::default(),
             tri_cache_misses: Default::default(),
+            node_cache_hits: Default::default(),
+            node_cache_misses: Default::default(),
             intersect_busy: Default::default(),
             traversal_busy: Default::default(),
             scheduler: Scheduler::new(threads, reserve_ahead),
@@ -508,6 +524,7 @@ impl<
                 mem_latency,
                 program.config.top_stack_base,
                 program.config.top_root.is_some(),
+                node_cache_sets,
             ),
             running: Default::default(),
             epoch: Default::default(),
@@ -520,6 +537,8 @@ impl<
             shading_count: Default::default(),
             cache_hit_count: Default::default(),
             cache_miss_count: Default::default(),
+            node_hit_count: Default::default(),
+            node_miss_count: Default::default(),
             count_in_frame: Default::default(),
             tick_transform: Default::default(),
             tick_intersect: Default::default(),
@@ -529,6 +548,8 @@ impl<
             tick_shading: Default::default(),
             tick_cache_hit: Default::default(),
             tick_cache_miss: Default::default(),
+            tick_node_hit: Default::default(),
+            tick_node_miss: Default::default(),
             intersect_count: Default::default(),
             traversal_count: Default::default(),
             frame_start: Default::default(),
@@ -650,6 +671,8 @@ impl<
             shading_count,
             cache_hit_count,
             cache_miss_count,
+            node_hit_count,
+            node_miss_count,
             count_in_frame,
             tick_transform,
             tick_intersect,
@@ -659,6 +682,8 @@ impl<
             tick_shading,
             tick_cache_hit,
             tick_cache_miss,
+            tick_node_hit,
+            tick_node_miss,
             intersect_count,
             traversal_count,
             mem_load_r,
@@ -728,6 +753,8 @@ impl<
         self.shading_busy.next = self.shading_count.q.val();
         self.tri_cache_hits.next = self.cache_hit_count.q.val();
         self.tri_cache_misses.next = self.cache_miss_count.q.val();
+        self.node_cache_hits.next = self.node_hit_count.q.val();
+        self.node_cache_misses.next = self.node_miss_count.q.val();
         if self.in_frame.val() {
             self.cycle_count.d.next = self.cycle_count.q.val() + 1;
         }
@@ -737,6 +764,8 @@ impl<
         self.tick_traversal.d.next = self.traversal_unit.step_busy.val();
         self.tick_cache_hit.d.next = self.tester.cache_hit.val();
         self.tick_cache_miss.d.next = self.tester.cache_miss.val();
+        self.tick_node_hit.d.next = self.traversal_unit.cache_hit.val();
+        self.tick_node_miss.d.next = self.traversal_unit.cache_miss.val();
         if self.count_in_frame.q.val() {
             if self.tick_transform.q.val() {
                 self.transform_count.d.next = self.transform_count.q.val() + 1;
@@ -761,6 +790,12 @@ impl<
             }
             if self.tick_cache_miss.q.val() {
                 self.cache_miss_count.d.next = self.cache_miss_count.q.val() + 1;
+            }
+            if self.tick_node_hit.q.val() {
+                self.node_hit_count.d.next = self.node_hit_count.q.val() + 1;
+            }
+            if self.tick_node_miss.q.val() {
+                self.node_miss_count.d.next = self.node_miss_count.q.val() + 1;
             }
         }
 
@@ -1267,6 +1302,8 @@ impl<
             self.instance_count.d.next = 0.into();
             self.cache_hit_count.d.next = 0.into();
             self.cache_miss_count.d.next = 0.into();
+            self.node_hit_count.d.next = 0.into();
+            self.node_miss_count.d.next = 0.into();
             self.shading_count.d.next = 0.into();
         }
     }
