@@ -34497,9 +34497,9 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     output reg  cache_miss;
     
     // Constant declarations
-    localparam  c_set_mask = 9'b111111111;
-    localparam  c_cache_on = 1'b1;
-    localparam  c_tag_valid = 27'h4000000;
+    localparam  c_node_set_mask = 9'b111111111;
+    localparam  c_node_cache_on = 1'b1;
+    localparam  c_node_tag_valid = 27'h4000000;
     localparam  c_ml_last = 4'h1;
     localparam  c_index__0 = 4'h0;
     localparam  c_index__1 = 4'h1;
@@ -36283,7 +36283,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         loop_fifo__read = 1'b0;
         front_fifo__read = 1'b0;
         in_flight__read = 1'b0;
-        look_hit = c_cache_on & (~look_job__q[32'h66]) & (~look_stale__q) & (cache_tag__read_data == (c_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
+        look_hit = c_node_cache_on & (~look_job__q[32'h66]) & (~look_stale__q) & (cache_tag__read_data == (c_node_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
         hit_now = (phase__q == Fetch__Word0) & fetch_hit__q;
         take = (phase__q != Fetch__Idle) & (~hit_now) & ((engine__load_banks & c_bank_nodes) == 32'h0);
         nodes__read = take | ((engine__load_banks & c_bank_nodes) != 32'h0);
@@ -36382,19 +36382,19 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         if (look_move) begin
             look_valid__d = 1'b0;
         end
-        read_set = look_job__q[(32'h40)+:(9)] & c_set_mask;
+        read_set = look_job__q[(32'h40)+:(9)] & c_node_set_mask;
         if (look_load) begin
             if (~loop_fifo__empty) begin
                 loop_fifo__read = 1'b1;
                 look_valid__d = 1'b1;
                 look_job__d = loop_fifo__data_out;
-                read_set = loop_fifo__data_out[(32'h40)+:(9)] & c_set_mask;
+                read_set = loop_fifo__data_out[(32'h40)+:(9)] & c_node_set_mask;
             end
             else if (~front_fifo__empty) begin
                 front_fifo__read = 1'b1;
                 look_valid__d = 1'b1;
                 look_job__d = front_fifo__data_out;
-                read_set = front_fifo__data_out[(32'h40)+:(9)] & c_set_mask;
+                read_set = front_fifo__data_out[(32'h40)+:(9)] & c_node_set_mask;
             end
         end
         cache_tag__read_address = read_set;
@@ -36475,10 +36475,10 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         done_e__write_enable = a_done;
         done_r__d = a_done;
         done_thread_r__d = job__q[(32'h60)+:(5)];
-        fill = c_cache_on & at_a & a_fetched__q & (~job__q[32'h66]);
-        fill_set = job__q[(32'h40)+:(9)] & c_set_mask;
+        fill = c_node_cache_on & at_a & a_fetched__q & (~job__q[32'h66]);
+        fill_set = job__q[(32'h40)+:(9)] & c_node_set_mask;
         cache_tag__write_address = fill_set;
-        cache_tag__write_data = c_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
+        cache_tag__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
         cache_tag__write_enable = fill;
         cache_words__write_address = fill_set;
         cache_words__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);

@@ -322,9 +322,11 @@ pub struct TraversalUnit<
     /// from bank 0 (an object tree's node: the top level's nodes are not cached).
     pub cache_hit: Signal<Out, Bit>,
     pub cache_miss: Signal<Out, Bit>,
-    c_set_mask: Constant<Bits<9>>,
-    c_cache_on: Constant<Bit>,
-    c_tag_valid: Constant<Bits<27>>,
+    /// Named apart from the triangle tester's cache constants: the engine's stages share one
+    /// namespace of constants (`tests/generated_files.rs` holds each name to one value).
+    c_node_set_mask: Constant<Bits<9>>,
+    c_node_cache_on: Constant<Bit>,
+    c_node_tag_valid: Constant<Bits<27>>,
     // A: the node's words are here.
     at_a: Signal<Local, Bit>,
     a_leaf: Signal<Local, Bit>,
@@ -563,9 +565,9 @@ impl<
             fill_set: Default::default(),
             cache_hit: Default::default(),
             cache_miss: Default::default(),
-            c_set_mask: Constant::new(u64::from(cache_sets.max(1) - 1).into()),
-            c_cache_on: Constant::new(cache_sets > 0 && mem_latency >= 2),
-            c_tag_valid: Constant::new((1u64 << 26).into()),
+            c_node_set_mask: Constant::new(u64::from(cache_sets.max(1) - 1).into()),
+            c_node_cache_on: Constant::new(cache_sets > 0 && mem_latency >= 2),
+            c_node_tag_valid: Constant::new((1u64 << 26).into()),
             at_a: Default::default(),
             a_leaf: Default::default(),
             a_axis: Default::default(),
@@ -1002,11 +1004,11 @@ impl<
         self.loop_fifo.read.next = false;
         self.front_fifo.read.next = false;
         self.in_flight.read.next = false;
-        self.look_hit.next = self.c_cache_on.val()
+        self.look_hit.next = self.c_node_cache_on.val()
             & (!self.look_job.q.val().get_bit(102))
             & (!self.look_stale.q.val())
             & (self.cache_tag.read_data.val()
-                == (self.c_tag_valid.val()
+                == (self.c_node_tag_valid.val()
                     | bit_cast::<27, 26>(self.look_job.q.val().get_bits::<26>(64))));
         self.hit_now.next = (self.phase.q.val() == Fetch::Word0) & self.fetch_hit.q.val();
         self.take.next = (self.phase.q.val() != Fetch::Idle)
@@ -1097,20 +1099,20 @@ impl<
         if self.look_move.val() {
             self.look_valid.d.next = false;
         }
-        self.read_set.next = self.look_job.q.val().get_bits::<9>(64) & self.c_set_mask.val();
+        self.read_set.next = self.look_job.q.val().get_bits::<9>(64) & self.c_node_set_mask.val();
         if self.look_load.val() {
             if !self.loop_fifo.empty.val() {
                 self.loop_fifo.read.next = true;
                 self.look_valid.d.next = true;
                 self.look_job.d.next = self.loop_fifo.data_out.val();
                 self.read_set.next =
-                    self.loop_fifo.data_out.val().get_bits::<9>(64) & self.c_set_mask.val();
+                    self.loop_fifo.data_out.val().get_bits::<9>(64) & self.c_node_set_mask.val();
             } else if !self.front_fifo.empty.val() {
                 self.front_fifo.read.next = true;
                 self.look_valid.d.next = true;
                 self.look_job.d.next = self.front_fifo.data_out.val();
                 self.read_set.next =
-                    self.front_fifo.data_out.val().get_bits::<9>(64) & self.c_set_mask.val();
+                    self.front_fifo.data_out.val().get_bits::<9>(64) & self.c_node_set_mask.val();
             }
         }
         self.cache_tag.read_address.next = self.read_set.val();
@@ -1204,14 +1206,14 @@ impl<
         self.done_thread_r.d.next = self.job.q.val().get_bits::<5>(96);
         // The node cache keeps the object trees' nodes that came from bank 0 (the top level's
         // part of the bank is rewritten between an animated scene's frames), written from A.
-        self.fill.next = self.c_cache_on.val()
+        self.fill.next = self.c_node_cache_on.val()
             & self.at_a.val()
             & self.a_fetched.q.val()
             & (!self.job.q.val().get_bit(102));
-        self.fill_set.next = self.job.q.val().get_bits::<9>(64) & self.c_set_mask.val();
+        self.fill_set.next = self.job.q.val().get_bits::<9>(64) & self.c_node_set_mask.val();
         self.cache_tag.write_address.next = self.fill_set.val();
         self.cache_tag.write_data.next =
-            self.c_tag_valid.val() | bit_cast::<27, 26>(self.job.q.val().get_bits::<26>(64));
+            self.c_node_tag_valid.val() | bit_cast::<27, 26>(self.job.q.val().get_bits::<26>(64));
         self.cache_tag.write_enable.next = self.fill.val();
         self.cache_words.write_address.next = self.fill_set.val();
         self.cache_words.write_data.next =
