@@ -68,7 +68,7 @@ use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
 use super::ports::{CoprocessorPort, SramRead};
 use super::program::isa::{KD_ENTERED, KD_WALK_ENDED};
 use super::ray_store::{zero_counters, RayStore};
-use super::triangle_tester::{cache_sets_supported, MAX_CACHE_SETS};
+use super::triangle_tester::{cache_sets_supported, empty_cache_tags, MAX_CACHE_SETS};
 use super::{Delay, SyncFifo};
 use crate::fp::Format;
 use crate::layout;
@@ -551,11 +551,7 @@ impl<
             look_load: Default::default(),
             look_hit: Default::default(),
             read_set: Default::default(),
-            cache_tag: RAM::new(
-                (0..MAX_CACHE_SETS as u64)
-                    .map(|k| (Bits::<9>::from(k), Bits::<27>::from(0u64)))
-                    .collect(),
-            ),
+            cache_tag: empty_cache_tags(),
             cache_words: Default::default(),
             fetch_hit: Default::default(),
             fetch_words: Default::default(),

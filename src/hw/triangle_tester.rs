@@ -127,6 +127,16 @@ pub fn cache_sets_supported(sets: u32) -> bool {
     sets == 0 || (sets.is_power_of_two() && sets <= MAX_CACHE_SETS)
 }
 
+/// A cache's tag RAM, every set's word zero (its valid bit clear): a block RAM read before it
+/// is written must not give Icarus an undefined tag.
+pub fn empty_cache_tags<const B: usize>() -> RAM<Bits<B>, 9> {
+    RAM::new(
+        (0..u64::from(MAX_CACHE_SETS))
+            .map(|k| (Bits::<9>::from(k), Bits::<B>::from(0u64)))
+            .collect(),
+    )
+}
+
 /// Entry buffers between the take and the launch (a ring: `tb`, `fb` and `lb` count modulo 4).
 pub const TEST_BUFFERS: usize = 4;
 
@@ -541,11 +551,7 @@ impl<
             fetch_a: Default::default(),
             fetch_ends: Default::default(),
             tb_free: Default::default(),
-            cache_tag: RAM::new(
-                (0..MAX_CACHE_SETS as u64)
-                    .map(|k| (Bits::<9>::from(k), Bits::<25>::from(0u64)))
-                    .collect(),
-            ),
+            cache_tag: empty_cache_tags(),
             cache_words: Default::default(),
             cached: Default::default(),
             fresh: Default::default(),
@@ -1016,10 +1022,10 @@ impl<
         }
 
         // Fetch: request the 6 + 6 words of `fb`'s triangle (the banks serve the engine first),
-        // then go on to the next buffer; an init, a list end or a triangle in the cache
-        // fetches nothing and is passed over in a clock. The fetch never falls behind the launch: a triangle launches once
-        // its words are in (so requested: the fetch has left it), and the launch frees an
-        // entry in the second clock of its launch, the fetch passes over one in 1.
+        // then go on to the next buffer; an init, a list end or a triangle in the cache fetches
+        // nothing and is passed over in a clock. The fetch never falls behind the launch: a
+        // triangle launches once its words are in (so requested: the fetch has left it), and the
+        // launch frees an entry in the second clock of its launch, the fetch passes over one in 1.
         self.a_take.next = self.fetching.q.val()
             & (self.a_issued.q.val() < 6)
             & ((self.engine.load_banks.val() & self.c_bank_a.val()) == 0);
