@@ -17450,6 +17450,24 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  s1_transform__d;
     wire  s1_transform__q;
     reg  s1_transform__clock;
+    reg  s1_tri_load__d;
+    wire  s1_tri_load__q;
+    reg  s1_tri_load__clock;
+    reg  s1_kd_load__d;
+    wire  s1_kd_load__q;
+    reg  s1_kd_load__clock;
+    reg  s1_cosine__d;
+    wire  s1_cosine__q;
+    reg  s1_cosine__clock;
+    reg  s1_pack__d;
+    wire  s1_pack__q;
+    reg  s1_pack__clock;
+    reg  s1_store__d;
+    wire  s1_store__q;
+    reg  s1_store__clock;
+    reg  s1_granted__d;
+    wire  s1_granted__q;
+    reg  s1_granted__clock;
     reg  gen_held__d;
     wire  gen_held__q;
     reg  gen_held__clock;
@@ -18472,6 +18490,36 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(s1_transform__q),
         .clock(s1_transform__clock)
     );
+    dynrt_processor__display__dark_d s1_tri_load(
+        .d(s1_tri_load__d),
+        .q(s1_tri_load__q),
+        .clock(s1_tri_load__clock)
+    );
+    dynrt_processor__display__dark_d s1_kd_load(
+        .d(s1_kd_load__d),
+        .q(s1_kd_load__q),
+        .clock(s1_kd_load__clock)
+    );
+    dynrt_processor__display__dark_d s1_cosine(
+        .d(s1_cosine__d),
+        .q(s1_cosine__q),
+        .clock(s1_cosine__clock)
+    );
+    dynrt_processor__display__dark_d s1_pack(
+        .d(s1_pack__d),
+        .q(s1_pack__q),
+        .clock(s1_pack__clock)
+    );
+    dynrt_processor__display__dark_d s1_store(
+        .d(s1_store__d),
+        .q(s1_store__q),
+        .clock(s1_store__clock)
+    );
+    dynrt_processor__display__dark_d s1_granted(
+        .d(s1_granted__d),
+        .q(s1_granted__q),
+        .clock(s1_granted__clock)
+    );
     dynrt_processor__display__dark_d gen_held(
         .d(gen_held__d),
         .q(gen_held__q),
@@ -18784,6 +18832,12 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         s1_flip__clock = clock;
         s1_miss__clock = clock;
         s1_transform__clock = clock;
+        s1_tri_load__clock = clock;
+        s1_kd_load__clock = clock;
+        s1_cosine__clock = clock;
+        s1_pack__clock = clock;
+        s1_store__clock = clock;
+        s1_granted__clock = clock;
         take_r__clock = clock;
         take_slot_r__clock = clock;
         take_hit_r__clock = clock;
@@ -18816,6 +18870,12 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         s1_flip__d = s1_flip__q;
         s1_miss__d = s1_miss__q;
         s1_transform__d = s1_transform__q;
+        s1_tri_load__d = s1_tri_load__q;
+        s1_kd_load__d = s1_kd_load__q;
+        s1_cosine__d = s1_cosine__q;
+        s1_pack__d = s1_pack__q;
+        s1_store__d = s1_store__q;
+        s1_granted__d = s1_granted__q;
         take_r__d = take_r__q;
         take_slot_r__d = take_slot_r__q;
         take_hit_r__d = take_hit_r__q;
@@ -19288,34 +19348,41 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         gen_point = gen_hold_point__q;
         gen_diagonal = gen_hold_diagonal__q;
         gen_slot = gen_hold_slot__q;
-        if (s1_valid__q) begin
-            if (s1_step__q == ShadeStep__TriLoad) begin
+        s1_granted__d = 1'b0;
+        stored_r__d = 1'b0;
+        if (s1_granted__q) begin
+            s1_done = 1'b1;
+        end
+        if (s1_valid__q & (~s1_granted__q)) begin
+            if (s1_tri_load__q) begin
                 tri_read_l = 1'b1;
                 if (tri_grant) begin
                     tri_tag = (((s1_word__q) & 9'h1ff) << 32'h6) | (((s1_slot__q) & 9'h1ff) << 32'h3) | (((c_kind_tri) & 9'h1ff) << 32'h1) | c_valid9;
                     s1_word__d = s1_word__q + 32'h1;
                     if (s1_word__q == 32'h1) begin
-                        s1_done = 1'b1;
+                        s1_granted__d = 1'b1;
                     end
                 end
             end
-            if ((s1_step__q == ShadeStep__KdLoad) & (~loading__q)) begin
+            if (s1_kd_load__q & (~loading__q)) begin
                 frame_read_l = 1'b1;
                 frame_addr_l = (material__read_data << 32'h2) + c_materials + ((s1_word__q) & 24'hffffff);
                 if (frame_grant) begin
                     frame_tag = (((s1_word__q) & 9'h1ff) << 32'h6) | (((s1_slot__q) & 9'h1ff) << 32'h3) | (((c_kind_kd) & 9'h1ff) << 32'h1) | c_valid9;
                     s1_word__d = s1_word__q + 32'h1;
                     if (s1_word__q == 32'h2) begin
-                        s1_done = 1'b1;
+                        s1_granted__d = 1'b1;
                     end
                 end
             end
-            if (s1_step__q == ShadeStep__Cosine) begin
+        end
+        if (s1_valid__q) begin
+            if (s1_cosine__q) begin
                 sqrt__in_valid = 1'b1;
                 cos_slot__data_in = (((s1_slot__q) & 4'hf) << 32'h1) | c_valid4;
                 s1_done = 1'b1;
             end
-            if (s1_step__q == ShadeStep__Pack) begin
+            if (s1_pack__q) begin
                 byte_valid_l = 1'b1;
                 byte_tag_in = byte_tag_in | c_valid6;
                 s1_word__d = s1_word__q + 32'h1;
@@ -19323,10 +19390,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                     s1_done = 1'b1;
                 end
             end
-            if (s1_step__q == ShadeStep__Store) begin
+            if (s1_store__q & (~s1_granted__q)) begin
                 fb_write_l = 1'b1;
                 if (fb_grant) begin
-                    s1_done = 1'b1;
+                    s1_granted__d = 1'b1;
+                    stored_r__d = 1'b1;
                 end
             end
         end
@@ -19465,6 +19533,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             s1_flip__d = s0_flip__q;
             s1_miss__d = s0_miss__q;
             s1_transform__d = (s0_step__q == ShadeStep__Point) | (s0_step__q == ShadeStep__NormalDot) | (s0_step__q == ShadeStep__Ambient) | (s0_step__q == ShadeStep__ToLight) | (s0_step__q == ShadeStep__Dots) | (s0_step__q == ShadeStep__Tint) | (s0_step__q == ShadeStep__Accumulate);
+            s1_tri_load__d = s0_step__q == ShadeStep__TriLoad;
+            s1_kd_load__d = s0_step__q == ShadeStep__KdLoad;
+            s1_cosine__d = s0_step__q == ShadeStep__Cosine;
+            s1_pack__d = s0_step__q == ShadeStep__Pack;
+            s1_store__d = s0_step__q == ShadeStep__Store;
         end
         refused = loading__q | (~has_free_r__q);
         taken = offer & (~refused);
@@ -19817,7 +19890,6 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 rgb__write_enable = 1'b1;
             end
         end
-        stored_r__d = s1_done & (s1_step__q == ShadeStep__Store);
         stored_slot_r__d = s1_slot__q;
         if (take_r__q & (take_slot_r__q == c_slot__0)) begin
             busy__0__d = 1'b1;
@@ -22453,6 +22525,18 @@ endmodule // dynrt_processor__engine__shader__res_step_r
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,a_words__read,a_words__addr,a_words__rdata,b_words__read,b_words__addr,b_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy,cache_hit,cache_miss,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_diagonal,gen_client,gen_thread,gen_take,gen_out_valid,gen_out_client,gen_out_thread,gen_out_dir__0,gen_out_dir__1,gen_out_dir__2,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2);
     
     // Module arguments
@@ -23022,6 +23106,18 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  fresh__3__d;
     wire  fresh__3__q;
     reg  fresh__3__clock;
+    reg  deciding__0__d;
+    wire  deciding__0__q;
+    reg  deciding__0__clock;
+    reg  deciding__1__d;
+    wire  deciding__1__q;
+    reg  deciding__1__clock;
+    reg  deciding__2__d;
+    wire  deciding__2__q;
+    reg  deciding__2__clock;
+    reg  deciding__3__d;
+    wire  deciding__3__q;
+    reg  deciding__3__clock;
     reg  [23:0] head_triangle_r__d;
     wire  [23:0] head_triangle_r__q;
     reg  head_triangle_r__clock;
@@ -23031,6 +23127,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  head_clash_r__d;
     wire  head_clash_r__q;
     reg  head_clash_r__clock;
+    reg  head_hit_r__d;
+    wire  head_hit_r__q;
+    reg  head_hit_r__clock;
+    reg  [8:0] head_set_rr__d;
+    wire  [8:0] head_set_rr__q;
+    reg  head_set_rr__clock;
     reg  cache_write_r__d;
     wire  cache_write_r__q;
     reg  cache_write_r__clock;
@@ -23970,6 +24072,26 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(fresh__3__q),
         .clock(fresh__3__clock)
     );
+    dynrt_processor__display__dark_d deciding__0(
+        .d(deciding__0__d),
+        .q(deciding__0__q),
+        .clock(deciding__0__clock)
+    );
+    dynrt_processor__display__dark_d deciding__1(
+        .d(deciding__1__d),
+        .q(deciding__1__q),
+        .clock(deciding__1__clock)
+    );
+    dynrt_processor__display__dark_d deciding__2(
+        .d(deciding__2__d),
+        .q(deciding__2__q),
+        .clock(deciding__2__clock)
+    );
+    dynrt_processor__display__dark_d deciding__3(
+        .d(deciding__3__d),
+        .q(deciding__3__q),
+        .clock(deciding__3__clock)
+    );
     dynrt_processor__display__rgb_q head_triangle_r(
         .d(head_triangle_r__d),
         .q(head_triangle_r__q),
@@ -23984,6 +24106,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .d(head_clash_r__d),
         .q(head_clash_r__q),
         .clock(head_clash_r__clock)
+    );
+    dynrt_processor__display__dark_d head_hit_r(
+        .d(head_hit_r__d),
+        .q(head_hit_r__q),
+        .clock(head_hit_r__clock)
+    );
+    dynrt_processor__engine__fp_units__add__lz head_set_rr(
+        .d(head_set_rr__d),
+        .q(head_set_rr__q),
+        .clock(head_set_rr__clock)
     );
     dynrt_processor__display__dark_d cache_write_r(
         .d(cache_write_r__d),
@@ -24370,6 +24502,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_triangle_r__clock = clock;
         head_set_r__clock = clock;
         head_clash_r__clock = clock;
+        head_hit_r__clock = clock;
+        head_set_rr__clock = clock;
         a_issued__clock = clock;
         b_issued__clock = clock;
         seq__clock = clock;
@@ -24417,6 +24551,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_triangle_r__d = head_triangle_r__q;
         head_set_r__d = head_set_r__q;
         head_clash_r__d = head_clash_r__q;
+        head_hit_r__d = head_hit_r__q;
+        head_set_rr__d = head_set_rr__q;
         a_issued__d = a_issued__q;
         b_issued__d = b_issued__q;
         seq__d = seq__q;
@@ -24597,6 +24733,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cached__0__clock = clock;
         cached__0__d = cached__0__q;
         fresh__0__clock = clock;
+        deciding__0__clock = clock;
         loaded__0__clock = clock;
         loaded__0__d = loaded__0__q;
         unvisited__0__clock = clock;
@@ -24614,6 +24751,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cached__1__clock = clock;
         cached__1__d = cached__1__q;
         fresh__1__clock = clock;
+        deciding__1__clock = clock;
         loaded__1__clock = clock;
         loaded__1__d = loaded__1__q;
         unvisited__1__clock = clock;
@@ -24631,6 +24769,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cached__2__clock = clock;
         cached__2__d = cached__2__q;
         fresh__2__clock = clock;
+        deciding__2__clock = clock;
         loaded__2__clock = clock;
         loaded__2__d = loaded__2__q;
         unvisited__2__clock = clock;
@@ -24648,6 +24787,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cached__3__clock = clock;
         cached__3__d = cached__3__q;
         fresh__3__clock = clock;
+        deciding__3__clock = clock;
         loaded__3__clock = clock;
         loaded__3__d = loaded__3__q;
         unvisited__3__clock = clock;
@@ -24731,7 +24871,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         l_loaded = loaded__0__q;
         l_received = received__0__q;
         l_cached = cached__0__q;
-        l_fresh = fresh__0__q;
+        l_fresh = fresh__0__q | deciding__0__q;
         if (lb__q == c_buffer__1) begin
             l_kind = cur_kind__1__q;
             l_thread = cur_thread__1__q;
@@ -24740,7 +24880,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__1__q;
             l_received = received__1__q;
             l_cached = cached__1__q;
-            l_fresh = fresh__1__q;
+            l_fresh = fresh__1__q | deciding__1__q;
         end
         if (lb__q == c_buffer__2) begin
             l_kind = cur_kind__2__q;
@@ -24750,7 +24890,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__2__q;
             l_received = received__2__q;
             l_cached = cached__2__q;
-            l_fresh = fresh__2__q;
+            l_fresh = fresh__2__q | deciding__2__q;
         end
         if (lb__q == c_buffer__3) begin
             l_kind = cur_kind__3__q;
@@ -24760,7 +24900,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__3__q;
             l_received = received__3__q;
             l_cached = cached__3__q;
-            l_fresh = fresh__3__q;
+            l_fresh = fresh__3__q | deciding__3__q;
         end
         l_ready = l_loaded & ((l_kind != c_test_triangle) | (l_received == 32'hc) | (l_cached & cache_ready__q));
         n_thread = cur_thread__0__q;
@@ -24768,7 +24908,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         n_kind = cur_kind__0__q;
         n_received = received__0__q;
         n_cached = cached__0__q;
-        n_fresh = fresh__0__q;
+        n_fresh = fresh__0__q | deciding__0__q;
         n_set = cur_a__0__q[(32'h0)+:(9)] & c_set_mask;
         if (lb__q + 32'h1 == c_buffer__1) begin
             n_thread = cur_thread__1__q;
@@ -24776,7 +24916,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__1__q;
             n_received = received__1__q;
             n_cached = cached__1__q;
-            n_fresh = fresh__1__q;
+            n_fresh = fresh__1__q | deciding__1__q;
             n_set = cur_a__1__q[(32'h0)+:(9)] & c_set_mask;
         end
         if (lb__q + 32'h1 == c_buffer__2) begin
@@ -24785,7 +24925,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__2__q;
             n_received = received__2__q;
             n_cached = cached__2__q;
-            n_fresh = fresh__2__q;
+            n_fresh = fresh__2__q | deciding__2__q;
             n_set = cur_a__2__q[(32'h0)+:(9)] & c_set_mask;
         end
         if (lb__q + 32'h1 == c_buffer__3) begin
@@ -24794,7 +24934,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__3__q;
             n_received = received__3__q;
             n_cached = cached__3__q;
-            n_fresh = fresh__3__q;
+            n_fresh = fresh__3__q | deciding__3__q;
             n_set = cur_a__3__q[(32'h0)+:(9)] & c_set_mask;
         end
         n_ready = n_loaded & ((n_kind != c_test_triangle) | (n_received == 32'hc) | (n_cached & cache_ready__q));
@@ -24913,6 +25053,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_set_r__d = head_set;
         head_clash_r__d = head_clash;
         head_hit = c_cache_on & (cache_tag__read_data == (c_tag_valid | ((head_triangle_r__q) & 25'h1ffffff))) & (~head_clash_r__q) & (~((lphase__q == Launch__Origin) & (l_set == head_set_r__q)));
+        head_hit_r__d = head_hit;
+        head_set_rr__d = head_set_r__q;
         tb_free = ~loaded__0__q;
         if (tb__q == c_buffer__1) begin
             tb_free = ~loaded__1__q;
@@ -24973,20 +25115,24 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             cached__3__d = 1'b0;
         end
         fresh__0__d = take & (tb__q == c_buffer__0);
-        if (fresh__0__q) begin
-            cached__0__d = head_hit & (cur_kind__0__q == c_test_triangle);
+        deciding__0__d = fresh__0__q;
+        if (deciding__0__q) begin
+            cached__0__d = head_hit_r__q & (~((lphase__q == Launch__Origin) & (l_set == head_set_rr__q))) & (cur_kind__0__q == c_test_triangle);
         end
         fresh__1__d = take & (tb__q == c_buffer__1);
-        if (fresh__1__q) begin
-            cached__1__d = head_hit & (cur_kind__1__q == c_test_triangle);
+        deciding__1__d = fresh__1__q;
+        if (deciding__1__q) begin
+            cached__1__d = head_hit_r__q & (~((lphase__q == Launch__Origin) & (l_set == head_set_rr__q))) & (cur_kind__1__q == c_test_triangle);
         end
         fresh__2__d = take & (tb__q == c_buffer__2);
-        if (fresh__2__q) begin
-            cached__2__d = head_hit & (cur_kind__2__q == c_test_triangle);
+        deciding__2__d = fresh__2__q;
+        if (deciding__2__q) begin
+            cached__2__d = head_hit_r__q & (~((lphase__q == Launch__Origin) & (l_set == head_set_rr__q))) & (cur_kind__2__q == c_test_triangle);
         end
         fresh__3__d = take & (tb__q == c_buffer__3);
-        if (fresh__3__q) begin
-            cached__3__d = head_hit & (cur_kind__3__q == c_test_triangle);
+        deciding__3__d = fresh__3__q;
+        if (deciding__3__q) begin
+            cached__3__d = head_hit_r__q & (~((lphase__q == Launch__Origin) & (l_set == head_set_rr__q))) & (cur_kind__3__q == c_test_triangle);
         end
         a_take = fetching__q & (a_issued__q < 32'h6) & ((engine__load_banks & c_bank_a) == 32'h0);
         b_take = fetching__q & (b_issued__q < 32'h6) & ((engine__load_banks & c_bank_b) == 32'h0);
@@ -25058,16 +25204,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             end
         end
         next_triangle = 1'b0;
-        if ((fetch_next == c_buffer__0) & unvisited__0__q & (~fresh__0__q) & (cur_kind__0__q == c_test_triangle) & (~cached__0__q)) begin
+        if ((fetch_next == c_buffer__0) & unvisited__0__q & (~fresh__0__q) & (~deciding__0__q) & (cur_kind__0__q == c_test_triangle) & (~cached__0__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__1) & unvisited__1__q & (~fresh__1__q) & (cur_kind__1__q == c_test_triangle) & (~cached__1__q)) begin
+        if ((fetch_next == c_buffer__1) & unvisited__1__q & (~fresh__1__q) & (~deciding__1__q) & (cur_kind__1__q == c_test_triangle) & (~cached__1__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__2) & unvisited__2__q & (~fresh__2__q) & (cur_kind__2__q == c_test_triangle) & (~cached__2__q)) begin
+        if ((fetch_next == c_buffer__2) & unvisited__2__q & (~fresh__2__q) & (~deciding__2__q) & (cur_kind__2__q == c_test_triangle) & (~cached__2__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__3) & unvisited__3__q & (~fresh__3__q) & (cur_kind__3__q == c_test_triangle) & (~cached__3__q)) begin
+        if ((fetch_next == c_buffer__3) & unvisited__3__q & (~fresh__3__q) & (~deciding__3__q) & (cur_kind__3__q == c_test_triangle) & (~cached__3__q)) begin
             next_triangle = 1'b1;
         end
         if ((~fetching__q) | fetch_ends) begin
@@ -26202,6 +26348,14 @@ endmodule // dynrt_processor__engine__tester__cache_words__0
 
 
 
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__tester__done_e(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -26302,6 +26456,10 @@ module dynrt_processor__engine__tester__flight_t_min(read_address,read_clock,rea
     end
                 
 endmodule // dynrt_processor__engine__tester__flight_t_min
+
+
+
+
 
 
 

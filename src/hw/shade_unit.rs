@@ -248,6 +248,18 @@ pub struct ShadeUnit<
     s1_miss: DFF<Bit>,
     /// The step is a TransformUnit pass.
     s1_transform: DFF<Bit>,
+    /// The step, one flag per operation that goes out from S1 itself, decoded from S0's
+    /// register as the slot moves in (S1's `done` then needs no decode of `s1_step`).
+    s1_tri_load: DFF<Bit>,
+    s1_kd_load: DFF<Bit>,
+    s1_cosine: DFF<Bit>,
+    s1_pack: DFF<Bit>,
+    s1_store: DFF<Bit>,
+    /// The memory step's last request was granted last clock: S1 is done now. (Done in the
+    /// grant's clock, the bank and frame-buffer grants ran through S1's reload into the slot
+    /// RAMs' read address: stop 46's critical path on cornell_noshadow, `shader.s1_step ->
+    /// shader.o.0.read_address`, 72.8 MHz placed.)
+    s1_granted: DFF<Bit>,
     s1_load: Signal<Local, Bit>,
     pick_step: Signal<Local, ShadeStep>,
     pick_light: Signal<Local, Bits<3>>,
@@ -491,6 +503,12 @@ impl<
             s1_flip: Default::default(),
             s1_miss: Default::default(),
             s1_transform: Default::default(),
+            s1_tri_load: Default::default(),
+            s1_kd_load: Default::default(),
+            s1_cosine: Default::default(),
+            s1_pack: Default::default(),
+            s1_store: Default::default(),
+            s1_granted: Default::default(),
             s1_load: Default::default(),
             pick_step: Default::default(),
             pick_light: Default::default(),
@@ -615,6 +633,12 @@ impl<
             s1_flip,
             s1_miss,
             s1_transform,
+            s1_tri_load,
+            s1_kd_load,
+            s1_cosine,
+            s1_pack,
+            s1_store,
+            s1_granted,
             take_r,
             take_slot_r,
             take_hit_r,
@@ -891,9 +915,15 @@ impl<
         self.gen_point.next = self.gen_hold_point.q.val();
         self.gen_diagonal.next = self.gen_hold_diagonal.q.val();
         self.gen_slot.next = self.gen_hold_slot.q.val();
-        // The other operations go out from S1.
-        if self.s1_valid.q.val() {
-            if self.s1_step.q.val() == ShadeStep::TriLoad {
+        // The other operations go out from S1; a memory step is done in the clock after its
+        // last grant, and requests nothing in it.
+        self.s1_granted.d.next = false;
+        self.stored_r.d.next = false;
+        if self.s1_granted.q.val() {
+            self.s1_done.next = true;
+        }
+        if self.s1_valid.q.val() & (!self.s1_granted.q.val()) {
+            if self.s1_tri_load.q.val() {
                 self.tri_read_l.next = true;
                 if self.tri_grant.val() {
                     self.tri_tag.next = (bit_cast::<9, 2>(self.s1_word.q.val()) << 6)
@@ -902,11 +932,11 @@ impl<
                         | self.c_valid9.val();
                     self.s1_word.d.next = self.s1_word.q.val() + 1;
                     if self.s1_word.q.val() == 1 {
-                        self.s1_done.next = true;
+                        self.s1_granted.d.next = true;
                     }
                 }
             }
-            if (self.s1_step.q.val() == ShadeStep::KdLoad) & (!self.loading.q.val()) {
+            if self.s1_kd_load.q.val() & (!self.loading.q.val()) {
                 self.frame_read_l.next = true;
                 self.frame_addr_l.next = (self.material.read_data.val() << 2)
                     + self.c_materials.val()
@@ -918,17 +948,19 @@ impl<
                         | self.c_valid9.val();
                     self.s1_word.d.next = self.s1_word.q.val() + 1;
                     if self.s1_word.q.val() == 2 {
-                        self.s1_done.next = true;
+                        self.s1_granted.d.next = true;
                     }
                 }
             }
-            if self.s1_step.q.val() == ShadeStep::Cosine {
+        }
+        if self.s1_valid.q.val() {
+            if self.s1_cosine.q.val() {
                 self.sqrt.in_valid.next = true;
                 self.cos_slot.data_in.next =
                     (bit_cast::<4, 3>(self.s1_slot.q.val()) << 1) | self.c_valid4.val();
                 self.s1_done.next = true;
             }
-            if self.s1_step.q.val() == ShadeStep::Pack {
+            if self.s1_pack.q.val() {
                 self.byte_valid_l.next = true;
                 self.byte_tag_in.next = self.byte_tag_in.val() | self.c_valid6.val();
                 self.s1_word.d.next = self.s1_word.q.val() + 1;
@@ -936,10 +968,11 @@ impl<
                     self.s1_done.next = true;
                 }
             }
-            if self.s1_step.q.val() == ShadeStep::Store {
+            if self.s1_store.q.val() & (!self.s1_granted.q.val()) {
                 self.fb_write_l.next = true;
                 if self.fb_grant.val() {
-                    self.s1_done.next = true;
+                    self.s1_granted.d.next = true;
+                    self.stored_r.d.next = true;
                 }
             }
         }
@@ -1030,6 +1063,11 @@ impl<
                 | (self.s0_step.q.val() == ShadeStep::Dots)
                 | (self.s0_step.q.val() == ShadeStep::Tint)
                 | (self.s0_step.q.val() == ShadeStep::Accumulate);
+            self.s1_tri_load.d.next = self.s0_step.q.val() == ShadeStep::TriLoad;
+            self.s1_kd_load.d.next = self.s0_step.q.val() == ShadeStep::KdLoad;
+            self.s1_cosine.d.next = self.s0_step.q.val() == ShadeStep::Cosine;
+            self.s1_pack.d.next = self.s0_step.q.val() == ShadeStep::Pack;
+            self.s1_store.d.next = self.s0_step.q.val() == ShadeStep::Store;
         }
 
         // ---- Offers take the first free slot. ----
@@ -1267,7 +1305,6 @@ impl<
         }
 
         // ---- Each slot's control. ----
-        self.stored_r.d.next = self.s1_done.val() & (self.s1_step.q.val() == ShadeStep::Store);
         self.stored_slot_r.d.next = self.s1_slot.q.val();
         for s in 0..SHADE_SLOTS {
             // An offer, taken last clock.

@@ -44,13 +44,13 @@
 //! bank, one a clock from the node cache, while other threads' jobs fill the decision pipeline.
 //! Each thread has at most one job in the unit, so the 32-entry queues never overflow.
 //!
-//! Node cache: [`MAX_CACHE_SETS`] (the paper's 512 items) sets of a node's two words, direct
-//! mapped by the node's low bits, tag (node and valid bit) and words in block RAM; `new`'s
-//! `cache_sets` uses the first sets only (0: none; off at SRAM latency 1, where a cached node's
-//! words would come back before the FIFO behind them can pop). A job waits for the fetch in
-//! `look`, whose cache set is read as it comes in; from the cache the fetch takes a node in a
-//! clock with no request, and its words travel the latency line beside the bank's (in order,
-//! at the bank's latency). A node from the bank is written into its set at A. Only the object
+//! Node cache: [`MAX_CACHE_SETS`](super::triangle_tester::MAX_CACHE_SETS) (the paper's 512
+//! items) sets of a node's two words, direct mapped by the node's low bits, tag (node and
+//! valid bit) and words in block RAM; `new`'s `cache_sets` uses the first sets only (0: none;
+//! off at SRAM latency 1, where a cached node's words would come back before the FIFO behind
+//! them can pop). A job waits for the fetch in `look`, whose cache set is read as it comes
+//! in; from the cache the fetch takes a node in a clock with no request, and its words travel
+//! the latency line beside the bank's (in order, at the bank's latency). A node from the bank is written into its set at A. Only the object
 //! trees' nodes are kept: the top level's part of bank 0 is rewritten between an animated
 //! scene's frames (the object trees are not), so the cache lives across frames. A set written
 //! in the clock it is read for `look` misses (its words may be the old ones).
@@ -68,7 +68,7 @@ use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
 use super::ports::{CoprocessorPort, SramRead};
 use super::program::isa::{KD_ENTERED, KD_WALK_ENDED};
 use super::ray_store::{zero_counters, RayStore};
-use super::triangle_tester::{cache_sets_supported, empty_cache_tags, MAX_CACHE_SETS};
+use super::triangle_tester::{cache_sets_supported, empty_cache_tags};
 use super::{Delay, SyncFifo};
 use crate::fp::Format;
 use crate::layout;
@@ -1326,6 +1326,7 @@ mod tests {
     use super::*;
     use crate::fp::Format;
     use crate::hw::sim_harness::{clock_cycle, settle};
+    use crate::hw::triangle_tester::MAX_CACHE_SETS;
     use crate::layout::{self, FrameMap, MemoryConfig, SceneTrees, FRAME, NODES};
     use crate::scene::Scene;
     use crate::units::{KdStop, KdWalk};
