@@ -9,28 +9,28 @@
 //! `model::golden`'s `traverse`.
 //!
 //! The same pipeline walks a scene's top-level tree (`kd.start` with `KD_TOP`) on the thread's
-//! world ray (`world_write`, the engine's `tri.world`), with its stack at
-//! the unit's `top_stack_base` (the scene's deepest object tree: the object walks under a top
-//! level have the entries below it) and its leaf's segment kept apart from the object walks': at each leaf it
+//! world ray (`world_write`, the engine's `tri.world`), with its stack at the unit's
+//! `top_stack_base` (the scene's deepest object tree: the object walks under a top level have the
+//! entries below it) and its leaf's segment kept apart from the object walks': at each leaf it
 //! wakes the thread, which reads the leaf's list (`top_from`, `top_to`), walks the instances'
-//! objects (object walks of this unit), and goes on with `next` (`kd.next`: the closest hit
-//! so far, the thread's last answer, taken like the tester's answer for an object leaf); an
-//! empty leaf (two in three on the dynamic scene) it passes by itself, with that answer. At
-//! the walk's end `top_from` is `KD_WALK_ENDED`.
+//! objects (object walks of this unit), and goes on with `next` (`kd.next`: the closest hit so far,
+//! the thread's last answer, taken like the tester's answer for an object leaf); an empty leaf (two
+//! in three on the dynamic scene) it passes by itself, with that answer. At the walk's end
+//! `top_from` is `KD_WALK_ENDED`.
 //!
 //! Golden twin: [`units::KdWalk`](crate::units::KdWalk) (src/units.rs), one walk resumable at
 //! each leaf, with [`units::traversal_step`](crate::units::traversal_step) and
 //! [`units::split_distance`](crate::units::split_distance) for each inner node; they name this
 //! unit back. Latency and throughput: see "Structure" below.
 //!
-//! Engine side (I4/I5, like the triangle tester): `enqueue` offers the start of a walk of
-//! `thread` (root `word_a`, t_max `word_b`, t_min the thread's `t_min` written with the
-//! tester's init), taken when `full` is low. `query_thread` at I4; at I5 `pending` (the
-//! thread's walk has not ended); `done` with `done_thread` wakes a waiting thread, a clock
-//! after its walk ends or stops at a top-level leaf. `enter` counts the walk of a `tri.enter`,
-//! which the unit starts when instance entry writes the ray (`entered`). The entry offered at I5 must be of the thread presented at
-//! I4 the clock before (its count of entries taken is read there), and a thread never offers
-//! in two clocks in a row (the engine's scheduler guarantees both).
+//! Engine side (I4/I5, like the triangle tester): `enqueue` offers the start of a walk of `thread`
+//! (root `word_a`, t_max `word_b`, t_min the thread's `t_min` written with the tester's init),
+//! taken when `full` is low. `query_thread` at I4; at I5 `pending` (the thread's walk has not
+//! ended); `done` with `done_thread` wakes a waiting thread, a clock after its walk ends or stops
+//! at a top-level leaf. `enter` counts the walk of a `tri.enter`, which the unit starts when
+//! instance entry writes the ray (`entered`). The entry offered at I5 must be of the thread
+//! presented at I4 the clock before (its count of entries taken is read there), and a thread never
+//! offers in two clocks in a row (the engine's scheduler guarantees both).
 //!
 //! Structure: entries go through the front (an engine's start becomes a step job; a tester's
 //! answer reads the thread's leaf segment and stack and compares the hit with both in 5 clocks,
@@ -44,16 +44,16 @@
 //! bank, one a clock from the node cache, while other threads' jobs fill the decision pipeline.
 //! Each thread has at most one job in the unit, so the 32-entry queues never overflow.
 //!
-//! Node cache: [`MAX_CACHE_SETS`](super::triangle_tester::MAX_CACHE_SETS) (the paper's 512
-//! items) sets of a node's two words, direct mapped by the node's low bits, tag (node and
-//! valid bit) and words in block RAM; `new`'s `cache_sets` uses the first sets only (0: none;
-//! off at SRAM latency 1, where a cached node's words would come back before the FIFO behind
-//! them can pop). A job waits for the fetch in `look`, whose cache set is read as it comes
-//! in; from the cache the fetch takes a node in a clock with no request, and its words travel
-//! the latency line beside the bank's (in order, at the bank's latency). A node from the bank is written into its set at A. Only the object
-//! trees' nodes are kept: the top level's part of bank 0 is rewritten between an animated
-//! scene's frames (the object trees are not), so the cache lives across frames. A set written
-//! in the clock it is read for `look` misses (its words may be the old ones).
+//! Node cache: [`MAX_CACHE_SETS`](super::triangle_tester::MAX_CACHE_SETS) (the paper's 512 items)
+//! sets of a node's two words, direct mapped by the node's low bits, tag (node and valid bit) and
+//! words in block RAM; `new`'s `cache_sets` uses the first sets only (0: none; off at SRAM latency
+//! 1, where a cached node's words would come back before the FIFO behind them can pop). A job waits
+//! for the fetch in `look`, whose cache set is read as it comes in; from the cache the fetch takes
+//! a node in a clock with no request, and its words travel the latency line beside the bank's (in
+//! order, at the bank's latency). A node from the bank is written into its set at A. Only the
+//! object trees' nodes are kept: the top level's part of bank 0 is rewritten between an animated
+//! scene's frames (the object trees are not), so the cache lives across frames. A set written in
+//! the clock it is read for `look` misses (its words may be the old ones).
 //!
 //! Per thread: a stack of [`STACK_LEVELS`] entries `(node, lo, hi)`, the leaf's segment end
 //! and stack depth. Const parameters: the operators' `W, E, M, S, S1, X2, T` and
@@ -1382,9 +1382,10 @@ mod tests {
     /// eight threads start walks from the root with rays from around the eye (two of them
     /// any-hit walks); the test plays the triangle tester: it takes each leaf in random
     /// clocks and answers it some clocks later with no hit, or (from a thread's third leaf
-    /// on, one thread in two) a hit at a random distance; each thread walks twice. Every thread's sequence of leaves
-    /// and its end equal `units::KdWalk`'s (an any-hit walk ends at its first hit); the engine
-    /// takes bank 0 in random clocks, and its starts are refused while an answer goes in.
+    /// on, one thread in two) a hit at a random distance; each thread walks twice. Every
+    /// thread's sequence of leaves and its end equal `units::KdWalk`'s (an any-hit walk ends
+    /// at its first hit); the engine takes bank 0 in random clocks, and its starts are
+    /// refused while an answer goes in.
     /// Run with a node cache of `cache_sets` sets: every node the model reads is a hit or a
     /// miss of the unit's cache (none a hit without a cache); returns the hits and the
     /// unit's reads of bank 0.
