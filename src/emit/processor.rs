@@ -35,6 +35,7 @@ use rust_hdl::prelude::*;
 
 use super::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
 use crate::fp::Format;
+pub use crate::hw::processor::ProcessorParams;
 use crate::hw::processor::{Processor, TopPort};
 use crate::hw::program::Program;
 use crate::hw::vga::VgaMode;
@@ -89,14 +90,7 @@ fn processor_verilog<
     params: ProcessorParams,
     mode: &VgaMode,
 ) -> Result<(String, Vec<TopPort>)> {
-    let mut uut = Processor::<W, E, M, S, S1, X2, T, P, DX, DL>::new(
-        program,
-        params.threads,
-        params.mem_latency,
-        params.tri_cache_sets,
-        params.node_cache_sets,
-        mode,
-    )?;
+    let mut uut = Processor::<W, E, M, S, S1, X2, T, P, DX, DL>::new(program, &params, mode)?;
     uut.connect_all();
     Ok((generate_verilog(&uut), uut.ports()))
 }
@@ -113,31 +107,6 @@ fn on_large_stack<T: Send>(f: impl FnOnce() -> T + Send) -> T {
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
     })
-}
-
-/// How the processor is built.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ProcessorParams {
-    /// Ray threads (1..=32).
-    pub threads: u32,
-    /// SRAM read latency in clocks (1..=6).
-    pub mem_latency: u32,
-    /// Sets of the triangle cache (a power of two up to
-    /// [`MAX_CACHE_SETS`](crate::hw::triangle_tester::MAX_CACHE_SETS); 0: none).
-    pub tri_cache_sets: u32,
-    /// Sets of the traversal unit's node cache (the same rule; 0: none).
-    pub node_cache_sets: u32,
-}
-
-impl Default for ProcessorParams {
-    fn default() -> Self {
-        ProcessorParams {
-            threads: 32,
-            mem_latency: 2,
-            tri_cache_sets: crate::hw::triangle_tester::MAX_CACHE_SETS,
-            node_cache_sets: crate::hw::triangle_tester::MAX_CACHE_SETS,
-        }
-    }
 }
 
 /// The video mode the processor's display uses for a `width x height` frame: 640x480 at 60 Hz

@@ -31,6 +31,31 @@ use super::program::Program;
 use super::vga::{VgaError, VgaMode, VGA_ADDR_BITS};
 use super::VgaDisplay;
 
+/// How the processor is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ProcessorParams {
+    /// Ray threads (1..=32).
+    pub threads: u32,
+    /// SRAM read latency in clocks (1..=6).
+    pub mem_latency: u32,
+    /// Sets of the triangle cache (a power of two up to
+    /// [`MAX_CACHE_SETS`](crate::hw::triangle_tester::MAX_CACHE_SETS); 0: none).
+    pub tri_cache_sets: u32,
+    /// Sets of the traversal unit's node cache (the same rule; 0: none).
+    pub node_cache_sets: u32,
+}
+
+impl Default for ProcessorParams {
+    fn default() -> Self {
+        ProcessorParams {
+            threads: 32,
+            mem_latency: 2,
+            tri_cache_sets: crate::hw::triangle_tester::MAX_CACHE_SETS,
+            node_cache_sets: crate::hw::triangle_tester::MAX_CACHE_SETS,
+        }
+    }
+}
+
 #[derive(LogicBlock)]
 pub struct Processor<
     const W: usize,
@@ -95,15 +120,11 @@ impl<
         const DL: usize,
     > Processor<W, E, M, S, S1, X2, T, P, DX, DL>
 {
-    /// The processor running `program` with `threads` threads, SRAM latency `mem_latency`
-    /// and triangle and node caches of `tri_cache_sets` and `node_cache_sets` sets (0: none),
+    /// The processor running `program` as `params` say (threads, SRAM latency, caches),
     /// showing a `width x height` frame from word `frame_buffer` of bank 5 in `mode`.
     pub fn new(
         program: &Program,
-        threads: u32,
-        mem_latency: u32,
-        tri_cache_sets: u32,
-        node_cache_sets: u32,
+        params: &ProcessorParams,
         mode: &VgaMode,
     ) -> Result<Self, VgaError> {
         let c = &program.config;
@@ -129,13 +150,7 @@ impl<
             node_cache_hits: Default::default(),
             node_cache_misses: Default::default(),
             vga: Default::default(),
-            engine: ThreadEngine::new(
-                program,
-                threads,
-                mem_latency,
-                tri_cache_sets,
-                node_cache_sets,
-            ),
+            engine: ThreadEngine::new(program, params),
             display: VgaDisplay::new(mode, c.width, c.height, c.frame_buffer)?,
         })
     }

@@ -81,6 +81,7 @@ use rust_hdl::prelude::*;
 use super::fp::add_sub::ADD_SUB_LATENCY;
 use super::list_unit;
 use super::ports::{BankedSramRead, FrameBufferWrite, SramRead, SHARED_BUS_BANKS};
+use super::processor::ProcessorParams;
 use super::program::isa::{KdFn, Op, TriFn, Unit, PC_BITS};
 use super::program::Program;
 use super::shade_unit::ShadeConfig;
@@ -440,16 +441,15 @@ impl<
         const DL: usize,
     > ThreadEngine<W, E, M, S, S1, X2, T, P, DX, DL>
 {
-    /// The engine running `program` with `threads` threads, memory read latency
-    /// `mem_latency`, a triangle cache of `tri_cache_sets` sets and a node cache of
-    /// `node_cache_sets` (0: none).
-    pub fn new(
-        program: &Program,
-        threads: u32,
-        mem_latency: u32,
-        tri_cache_sets: u32,
-        node_cache_sets: u32,
-    ) -> Self {
+    /// The engine running `program` with the threads, memory read latency and triangle and
+    /// node caches `params` give.
+    pub fn new(program: &Program, params: &ProcessorParams) -> Self {
+        let ProcessorParams {
+            threads,
+            mem_latency,
+            tri_cache_sets,
+            node_cache_sets,
+        } = *params;
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
         assert!(P == 2 * S);
         // `FpUnits` pads the (faster) divider to the square root's latency.
