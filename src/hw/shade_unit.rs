@@ -59,9 +59,12 @@ use super::fp::{const_bits, FpDiv, FpSqrt};
 use super::{ChannelByte, Delay, DelayLine, LutRam, CHANNEL_BYTE_LATENCY};
 use crate::layout::{FrameMap, TRANSFORM_BANK_WORDS};
 
-/// Pixels the unit shades at once (`update` spells out `[8]`: rust-hdl's Verilog cannot name
-/// Rust constants in an index).
-pub const SHADE_SLOTS: usize = 8;
+/// Pixels the unit shades at once (`update` spells out `[16]` and the slot's 4 bits:
+/// rust-hdl's Verilog cannot name Rust constants in an index). A pixel takes its slot for
+/// about 250 clocks (one light), so 8 slots let one pixel in per 31 clocks, cornell_noshadow's
+/// bound at 38.3 cycles per primary ray (stop 46); 16 slots fit the same distributed RAMs
+/// (ECP5's are 16 words deep).
+pub const SHADE_SLOTS: usize = 16;
 /// Most lights the unit holds.
 pub const MAX_SHADE_LIGHTS: usize = 8;
 
@@ -103,7 +106,7 @@ const KIND_LIGHT: u64 = 2;
 const KIND_CONST: u64 = 3;
 
 /// Words of a slot's state, each a distributed RAM of [`SHADE_SLOTS`] words.
-type SlotRam<D> = LutRam<D, 3>;
+type SlotRam<D> = LutRam<D, 4>;
 
 fn slot_ram<D: Synth>() -> SlotRam<D> {
     LutRam::new(Default::default())
@@ -147,10 +150,10 @@ pub struct ShadeUnit<
     pub gen_v: [Signal<Out, Bits<W>>; 3],
     pub gen_point: Signal<Out, Bit>,
     pub gen_diagonal: Signal<Out, Bit>,
-    pub gen_slot: Signal<Out, Bits<3>>,
+    pub gen_slot: Signal<Out, Bits<4>>,
     pub gen_take: Signal<In, Bit>,
     pub res_valid: Signal<In, Bit>,
-    pub res_slot: Signal<In, Bits<3>>,
+    pub res_slot: Signal<In, Bits<4>>,
     pub res_v: [Signal<In, Bits<W>>; 3],
     pub fb_write: Signal<Out, Bit>,
     pub fb_addr: Signal<Out, Bits<24>>,
@@ -201,13 +204,13 @@ pub struct ShadeUnit<
     // Offers.
     /// Slots free before slot s (`[s]`), of the busy ones (`any_free_before`) and of the busy
     /// ones and the slot the offer takes (`any_free_after_take`).
-    any_free_before: [Signal<Local, Bit>; 9],
-    any_free_after_take: [Signal<Local, Bit>; 9],
+    any_free_before: [Signal<Local, Bit>; 17],
+    any_free_after_take: [Signal<Local, Bit>; 17],
     /// The slot the next offer takes, and whether there is one, registered: the first free
     /// slot of this clock's busy slots and taken one (a slot freed in this clock is offered a
     /// clock later). Taken straight from the busy slots, the priority chain ran into every
     /// slot's step (stop 42's critical path at 83.4 MHz).
-    free_slot_r: DFF<Bits<3>>,
+    free_slot_r: DFF<Bits<4>>,
     has_free_r: DFF<Bit>,
     taken: Signal<Local, Bit>,
     /// An offer taken last clock, its slot and whether it hit: the slot's control is set a
@@ -215,14 +218,14 @@ pub struct ShadeUnit<
     /// take's clock, the engine's offer ran through the take into every slot's step (stop 45's
     /// critical path, `execute.op -> shader.step`, 69.6 MHz placed, 11 levels).
     take_r: DFF<Bit>,
-    take_slot_r: DFF<Bits<3>>,
+    take_slot_r: DFF<Bits<4>>,
     take_hit_r: DFF<Bit>,
     /// A store went out last clock, and its slot: the slot is freed a clock after the store's
     /// grant. Freed in the grant's clock, the frame buffer's grant ran through S1's step
     /// decode into every slot's step (stop 45's critical path, `s1_step -> step.4`, 71.2 MHz
     /// placed, 9 levels).
     stored_r: DFF<Bit>,
-    stored_slot_r: DFF<Bits<3>>,
+    stored_slot_r: DFF<Bits<4>>,
     /// Slot s is busy or taken last clock.
     occupied: [Signal<Local, Bit>; SHADE_SLOTS],
     // Dispatch: a slot is picked into S0, then read and issued in S1. S0 is filled only when
@@ -230,13 +233,13 @@ pub struct ShadeUnit<
     // go out; with the pick waiting for `s1_done`, the grants, the pick and every slot's
     // `ready` were one clock (stop 42's critical path, 68.8 MHz placed).
     s0_valid: DFF<Bit>,
-    s0_slot: DFF<Bits<3>>,
+    s0_slot: DFF<Bits<4>>,
     s0_step: DFF<ShadeStep>,
     s0_light: DFF<Bits<3>>,
     s0_flip: DFF<Bit>,
     s0_miss: DFF<Bit>,
     s1_valid: DFF<Bit>,
-    s1_slot: DFF<Bits<3>>,
+    s1_slot: DFF<Bits<4>>,
     /// The word of a multi-clock operation (loads, bytes).
     s1_word: DFF<Bits<2>>,
     /// The dispatched slot's step, light, flip and miss, registered as it is picked (a slot's
@@ -268,8 +271,8 @@ pub struct ShadeUnit<
     s1_done: Signal<Local, Bit>,
     /// The normal facing the ray (the stored one with its sign flipped by `flip`).
     facing: [Signal<Local, Bits<W>>; 3],
-    any_ready_before: [Signal<Local, Bit>; 9],
-    ready_slot: Signal<Local, Bits<3>>,
+    any_ready_before: [Signal<Local, Bit>; 17],
+    ready_slot: Signal<Local, Bits<4>>,
     pick: Signal<Local, Bit>,
     // TransformUnit request held until taken.
     gen_held: DFF<Bit>,
@@ -277,7 +280,7 @@ pub struct ShadeUnit<
     gen_hold_v: [DFF<Bits<W>>; 3],
     gen_hold_point: DFF<Bit>,
     gen_hold_diagonal: DFF<Bit>,
-    gen_hold_slot: DFF<Bits<3>>,
+    gen_hold_slot: DFF<Bits<4>>,
     gen_load: Signal<Local, Bit>,
     req_m: [Signal<Local, Bits<W>>; 12],
     req_v: [Signal<Local, Bits<W>>; 3],
@@ -287,7 +290,7 @@ pub struct ShadeUnit<
     /// The TransformUnit's result, registered as it arrives: routed straight from the unit's
     /// output into the slots' RAM writes it was the processor's critical path (56.0 MHz).
     res_valid_r: DFF<Bit>,
-    res_slot_r: DFF<Bits<3>>,
+    res_slot_r: DFF<Bits<4>>,
     res_v_r: [DFF<Bits<W>>; 3],
     /// The step and light of the result's slot, read as the result arrives and registered
     /// with it (a slot waits for its one result, so they cannot change in between): the
@@ -300,7 +303,7 @@ pub struct ShadeUnit<
     frame_valid: Signal<Local, Bit>,
     frame_kind: Signal<Local, Bits<2>>,
     frame_word: Signal<Local, Bits<3>>,
-    byte_tag_in: Signal<Local, Bits<6>>,
+    byte_tag_in: Signal<Local, Bits<7>>,
     byte_valid_l: Signal<Local, Bit>,
     byte_word_l: Signal<Local, Bits<W>>,
     rgb_next: Signal<Local, Bits<24>>,
@@ -310,18 +313,18 @@ pub struct ShadeUnit<
     frame_addr_l: Signal<Local, Bits<24>>,
     fb_write_l: Signal<Local, Bit>,
     /// Tags of memory words in flight: `{word[8:6], slot or light[5:3], kind[2:1], valid[0]}`.
-    tri_line: DelayLine<Bits<9>>,
-    frame_line: DelayLine<Bits<9>>,
-    tri_tag: Signal<Local, Bits<9>>,
-    frame_tag: Signal<Local, Bits<9>>,
+    tri_line: DelayLine<Bits<10>>,
+    frame_line: DelayLine<Bits<10>>,
+    tri_tag: Signal<Local, Bits<10>>,
+    frame_tag: Signal<Local, Bits<10>>,
     /// The lines run a clock short of the words; their last tag is registered here, beside a
     /// per-slot decode of it, so that a word's slot reaches that slot's step from a flip-flop
     /// of its own. From the line's last stage straight into the eight slots' compares, one net
     /// fanned out to every slot's step (stop 44's critical path, 71.9 MHz placed).
-    tri_arrived_r: DFF<Bits<9>>,
-    frame_arrived_r: DFF<Bits<9>>,
-    tri_arrived: Signal<Local, Bits<9>>,
-    frame_arrived: Signal<Local, Bits<9>>,
+    tri_arrived_r: DFF<Bits<10>>,
+    frame_arrived_r: DFF<Bits<10>>,
+    tri_arrived: Signal<Local, Bits<10>>,
+    frame_arrived: Signal<Local, Bits<10>>,
     /// Slot s's normal is in (its second triangle word arrives now).
     normal_in: [DFF<Bit>; SHADE_SLOTS],
     /// Slot s's diffuse colour is in (its third word arrives now).
@@ -331,19 +334,19 @@ pub struct ShadeUnit<
     div: FpDiv<W, E, M, S, S1, X2>,
     cos_n_dot_l: DelayLine<Bits<W>>,
     /// `{slot, valid}` of the cosine in flight.
-    cos_slot: DelayLine<Bits<4>>,
+    cos_slot: DelayLine<Bits<5>>,
     // The bytes.
     /// The byte's input, registered: the slot RAM's read and the word's select take a clock
     /// of their own, apart from the clamp (stop 41's critical path held all three).
     byte_valid_r: DFF<Bit>,
     byte_word_r: DFF<Bits<W>>,
-    byte_tag_r: DFF<Bits<6>>,
+    byte_tag_r: DFF<Bits<7>>,
     byte_unit: ChannelByte<W, E, M, S, S1, X2, T, P>,
     /// `{word, slot, valid}` of the byte in flight.
-    byte_tag: Delay<Bits<6>, { CHANNEL_BYTE_LATENCY as usize }>,
+    byte_tag: Delay<Bits<7>, { CHANNEL_BYTE_LATENCY as usize }>,
     rgb_acc: DFF<Bits<24>>,
     // Constants.
-    c_slot: [Constant<Bits<3>>; SHADE_SLOTS],
+    c_slot: [Constant<Bits<4>>; SHADE_SLOTS],
     c_sign: Constant<Bits<W>>,
     c_exp_mask: Constant<Bits<W>>,
     c_man_mask: Constant<Bits<W>>,
@@ -358,9 +361,9 @@ pub struct ShadeUnit<
     c_last_light: Constant<Bits<3>>,
     c_has_lights: Constant<Bit>,
     /// Bit 0 (a tag's valid bit) of each tag's width.
-    c_valid9: Constant<Bits<9>>,
-    c_valid4: Constant<Bits<4>>,
-    c_valid6: Constant<Bits<6>>,
+    c_valid10: Constant<Bits<10>>,
+    c_valid5: Constant<Bits<5>>,
+    c_valid7: Constant<Bits<7>>,
     c_kind_tri: Constant<Bits<2>>,
     c_kind_kd: Constant<Bits<2>>,
     c_kind_light: Constant<Bits<2>>,
@@ -468,8 +471,8 @@ impl<
             rgb: slot_ram(),
             ambient: Default::default(),
             background: Default::default(),
-            light_position: std::array::from_fn(|_| slot_ram()),
-            light_color: std::array::from_fn(|_| slot_ram()),
+            light_position: std::array::from_fn(|_| LutRam::new(Default::default())),
+            light_color: std::array::from_fn(|_| LutRam::new(Default::default())),
             loading: Default::default(),
             const_issued: Default::default(),
             const_arrived: Default::default(),
@@ -584,9 +587,9 @@ impl<
             c_const_total: const_bits::<6>(words),
             c_last_light: const_bits::<3>(config.lights.saturating_sub(1) as u64),
             c_has_lights: Constant::new(config.lights > 0),
-            c_valid9: const_bits::<9>(1),
-            c_valid4: const_bits::<4>(1),
-            c_valid6: const_bits::<6>(1),
+            c_valid10: const_bits::<10>(1),
+            c_valid5: const_bits::<5>(1),
+            c_valid7: const_bits::<7>(1),
             c_kind_tri: const_bits::<2>(KIND_TRI),
             c_kind_kd: const_bits::<2>(KIND_KD),
             c_kind_light: const_bits::<2>(KIND_LIGHT),
@@ -766,15 +769,15 @@ impl<
         self.frame_addr_l.next = self.const_addr.q.val();
         self.frame_tag.next = 0.into();
         if self.const_go.val() {
-            self.frame_tag.next = (bit_cast::<9, 3>(self.const_word.q.val()) << 6)
-                | (bit_cast::<9, 3>(self.const_light.q.val()) << 3)
-                | self.c_valid9.val();
+            self.frame_tag.next = (bit_cast::<10, 3>(self.const_word.q.val()) << 7)
+                | (bit_cast::<10, 3>(self.const_light.q.val()) << 3)
+                | self.c_valid10.val();
             if self.const_lights.q.val() {
                 self.frame_tag.next =
-                    self.frame_tag.val() | (bit_cast::<9, 2>(self.c_kind_light.val()) << 1);
+                    self.frame_tag.val() | (bit_cast::<10, 2>(self.c_kind_light.val()) << 1);
             } else {
                 self.frame_tag.next =
-                    self.frame_tag.val() | (bit_cast::<9, 2>(self.c_kind_const.val()) << 1);
+                    self.frame_tag.val() | (bit_cast::<10, 2>(self.c_kind_const.val()) << 1);
             }
             self.const_issued.d.next = self.const_issued.q.val() + 1;
             self.const_addr.d.next = self.const_addr.q.val() + 1;
@@ -792,11 +795,11 @@ impl<
         self.sqrt.in_valid.next = false;
         self.sqrt.a.next = self.l_dot_l.read_data.val();
         self.cos_n_dot_l.data_in.next = self.n_dot_l.read_data.val();
-        self.cos_slot.data_in.next = bit_cast::<4, 3>(self.s1_slot.q.val()) << 1;
+        self.cos_slot.data_in.next = bit_cast::<5, 4>(self.s1_slot.q.val()) << 1;
         self.byte_valid_l.next = false;
         self.byte_word_l.next = self.acc[0].read_data.val();
-        self.byte_tag_in.next = (bit_cast::<6, 2>(self.s1_word.q.val()) << 4)
-            | (bit_cast::<6, 3>(self.s1_slot.q.val()) << 1);
+        self.byte_tag_in.next = (bit_cast::<7, 2>(self.s1_word.q.val()) << 5)
+            | (bit_cast::<7, 4>(self.s1_slot.q.val()) << 1);
         self.fb_write_l.next = false;
         self.fb_addr.next = self.addr.read_data.val() + self.c_fb_base.val();
         self.fb_data.next = bit_cast::<32, 24>(self.rgb.read_data.val());
@@ -926,10 +929,10 @@ impl<
             if self.s1_tri_load.q.val() {
                 self.tri_read_l.next = true;
                 if self.tri_grant.val() {
-                    self.tri_tag.next = (bit_cast::<9, 2>(self.s1_word.q.val()) << 6)
-                        | (bit_cast::<9, 3>(self.s1_slot.q.val()) << 3)
-                        | (bit_cast::<9, 2>(self.c_kind_tri.val()) << 1)
-                        | self.c_valid9.val();
+                    self.tri_tag.next = (bit_cast::<10, 2>(self.s1_word.q.val()) << 7)
+                        | (bit_cast::<10, 4>(self.s1_slot.q.val()) << 3)
+                        | (bit_cast::<10, 2>(self.c_kind_tri.val()) << 1)
+                        | self.c_valid10.val();
                     self.s1_word.d.next = self.s1_word.q.val() + 1;
                     if self.s1_word.q.val() == 1 {
                         self.s1_granted.d.next = true;
@@ -942,10 +945,10 @@ impl<
                     + self.c_materials.val()
                     + bit_cast::<24, 2>(self.s1_word.q.val());
                 if self.frame_grant.val() {
-                    self.frame_tag.next = (bit_cast::<9, 2>(self.s1_word.q.val()) << 6)
-                        | (bit_cast::<9, 3>(self.s1_slot.q.val()) << 3)
-                        | (bit_cast::<9, 2>(self.c_kind_kd.val()) << 1)
-                        | self.c_valid9.val();
+                    self.frame_tag.next = (bit_cast::<10, 2>(self.s1_word.q.val()) << 7)
+                        | (bit_cast::<10, 4>(self.s1_slot.q.val()) << 3)
+                        | (bit_cast::<10, 2>(self.c_kind_kd.val()) << 1)
+                        | self.c_valid10.val();
                     self.s1_word.d.next = self.s1_word.q.val() + 1;
                     if self.s1_word.q.val() == 2 {
                         self.s1_granted.d.next = true;
@@ -957,12 +960,12 @@ impl<
             if self.s1_cosine.q.val() {
                 self.sqrt.in_valid.next = true;
                 self.cos_slot.data_in.next =
-                    (bit_cast::<4, 3>(self.s1_slot.q.val()) << 1) | self.c_valid4.val();
+                    (bit_cast::<5, 4>(self.s1_slot.q.val()) << 1) | self.c_valid5.val();
                 self.s1_done.next = true;
             }
             if self.s1_pack.q.val() {
                 self.byte_valid_l.next = true;
-                self.byte_tag_in.next = self.byte_tag_in.val() | self.c_valid6.val();
+                self.byte_tag_in.next = self.byte_tag_in.val() | self.c_valid7.val();
                 self.s1_word.d.next = self.s1_word.q.val() + 1;
                 if self.s1_word.q.val() == 2 {
                     self.s1_done.next = true;
@@ -1021,7 +1024,7 @@ impl<
                 self.ready_slot.next = self.c_slot[s].val();
             }
         }
-        self.pick.next = self.any_ready_before[8].val() & (!self.s0_valid.q.val());
+        self.pick.next = self.any_ready_before[16].val() & (!self.s0_valid.q.val());
         self.pick_step.next = ShadeStep::Idle;
         self.pick_light.next = 0.into();
         self.pick_flip.next = false;
@@ -1093,9 +1096,9 @@ impl<
                 | ((!self.occupied[s].val()) & (self.free_slot_r.q.val() != self.c_slot[s].val()));
         }
         self.free_slot_r.d.next = 0.into();
-        self.has_free_r.d.next = self.any_free_before[8].val();
+        self.has_free_r.d.next = self.any_free_before[16].val();
         if self.taken.val() {
-            self.has_free_r.d.next = self.any_free_after_take[8].val();
+            self.has_free_r.d.next = self.any_free_after_take[16].val();
         }
         for s in 0..SHADE_SLOTS {
             if self.taken.val() {
@@ -1136,27 +1139,27 @@ impl<
         self.frame_arrived.next = self.frame_arrived_r.q.val();
         for s in 0..SHADE_SLOTS {
             self.normal_in[s].d.next = self.tri_line.data_out.val().get_bit(0)
-                & self.tri_line.data_out.val().get_bit(6)
-                & (self.tri_line.data_out.val().get_bits::<3>(3) == self.c_slot[s].val());
+                & self.tri_line.data_out.val().get_bit(7)
+                & (self.tri_line.data_out.val().get_bits::<4>(3) == self.c_slot[s].val());
             self.kd_in[s].d.next = self.frame_line.data_out.val().get_bit(0)
                 & (self.frame_line.data_out.val().get_bits::<2>(1) == self.c_kind_kd.val())
-                & (self.frame_line.data_out.val().get_bits::<3>(6) == 2)
-                & (self.frame_line.data_out.val().get_bits::<3>(3) == self.c_slot[s].val());
+                & (self.frame_line.data_out.val().get_bits::<3>(7) == 2)
+                & (self.frame_line.data_out.val().get_bits::<4>(3) == self.c_slot[s].val());
         }
         // Word 0 (the sixth of the triangle's record in each bank): normal x and z; word 1:
         // normal y and the material.
         for k in 0..3 {
-            self.n[k].write_address.next = self.tri_arrived.val().get_bits::<3>(3);
+            self.n[k].write_address.next = self.tri_arrived.val().get_bits::<4>(3);
         }
         self.n[0].write_data.next = self.tri_rdata_a.val().get_bits::<W>(0);
         self.n[1].write_data.next = self.tri_rdata_a.val().get_bits::<W>(0);
         self.n[2].write_data.next = self.tri_rdata_b.val().get_bits::<W>(0);
-        self.material.write_address.next = self.tri_arrived.val().get_bits::<3>(3);
+        self.material.write_address.next = self.tri_arrived.val().get_bits::<4>(3);
         self.material.write_data.next = self.tri_rdata_b.val().get_bits::<24>(0);
         self.tri_word_0.next =
-            self.tri_arrived.val().get_bit(0) & (!self.tri_arrived.val().get_bit(6));
+            self.tri_arrived.val().get_bit(0) & (!self.tri_arrived.val().get_bit(7));
         self.tri_word_1.next =
-            self.tri_arrived.val().get_bit(0) & self.tri_arrived.val().get_bit(6);
+            self.tri_arrived.val().get_bit(0) & self.tri_arrived.val().get_bit(7);
         self.n[0].write_enable.next = self.tri_word_0.val();
         self.n[2].write_enable.next = self.tri_word_0.val();
         self.n[1].write_enable.next = self.tri_word_1.val();
@@ -1164,9 +1167,9 @@ impl<
         // Frame words: the diffuse colour, a light's word, the ambient or a background word.
         self.frame_valid.next = self.frame_arrived.val().get_bit(0);
         self.frame_kind.next = self.frame_arrived.val().get_bits::<2>(1);
-        self.frame_word.next = self.frame_arrived.val().get_bits::<3>(6);
+        self.frame_word.next = self.frame_arrived.val().get_bits::<3>(7);
         for k in 0..3 {
-            self.kd[k].write_address.next = self.frame_arrived.val().get_bits::<3>(3);
+            self.kd[k].write_address.next = self.frame_arrived.val().get_bits::<4>(3);
             self.kd[k].write_data.next = self.frame_rdata.val().get_bits::<W>(0);
             self.kd[k].write_enable.next = false;
             self.light_position[k].write_address.next = self.frame_arrived.val().get_bits::<3>(3);
@@ -1287,19 +1290,19 @@ impl<
         self.div.in_valid.next = self.sqrt.out_valid.val();
         self.div.a.next = self.cos_n_dot_l.data_out.val();
         self.div.b.next = self.sqrt.result.val();
-        self.cos.write_address.next = self.cos_slot.data_out.val().get_bits::<3>(1);
+        self.cos.write_address.next = self.cos_slot.data_out.val().get_bits::<4>(1);
         self.cos.write_data.next = self.div.result.val();
         self.cos.write_enable.next = self.cos_slot.data_out.val().get_bit(0);
 
         // ---- The bytes: shifted in, the third writes the pixel's word. ----
-        self.rgb.write_address.next = self.byte_tag.data_out.val().get_bits::<3>(1);
+        self.rgb.write_address.next = self.byte_tag.data_out.val().get_bits::<4>(1);
         self.rgb_next.next =
             (self.rgb_acc.q.val() << 8) | bit_cast::<24, 8>(self.byte_unit.result.val());
         self.rgb.write_data.next = self.rgb_next.val();
         self.rgb.write_enable.next = false;
         if self.byte_tag.data_out.val().get_bit(0) {
             self.rgb_acc.d.next = self.rgb_next.val();
-            if self.byte_tag.data_out.val().get_bits::<2>(4) == 2 {
+            if self.byte_tag.data_out.val().get_bits::<2>(5) == 2 {
                 self.rgb.write_enable.next = true;
             }
         }
@@ -1376,15 +1379,15 @@ impl<
             }
             // The cosine.
             if self.cos_slot.data_out.val().get_bit(0)
-                & (self.cos_slot.data_out.val().get_bits::<3>(1) == self.c_slot[s].val())
+                & (self.cos_slot.data_out.val().get_bits::<4>(1) == self.c_slot[s].val())
             {
                 self.ready[s].d.next = true;
                 self.step[s].d.next = ShadeStep::Tint;
             }
             // The third byte.
             if self.byte_tag.data_out.val().get_bit(0)
-                & (self.byte_tag.data_out.val().get_bits::<2>(4) == 2)
-                & (self.byte_tag.data_out.val().get_bits::<3>(1) == self.c_slot[s].val())
+                & (self.byte_tag.data_out.val().get_bits::<2>(5) == 2)
+                & (self.byte_tag.data_out.val().get_bits::<4>(1) == self.c_slot[s].val())
             {
                 self.ready[s].d.next = true;
                 self.step[s].d.next = ShadeStep::Store;
@@ -1448,9 +1451,9 @@ mod tests {
             }
             self.tu.point.next = self.unit.gen_point.val();
             self.tu.diagonal.next = self.unit.gen_diagonal.val();
-            self.tu.tag.next = bit_cast::<TAG_BITS, 3>(self.unit.gen_slot.val());
+            self.tu.tag.next = bit_cast::<TAG_BITS, 4>(self.unit.gen_slot.val());
             self.unit.res_valid.next = self.tu.out_valid.val();
-            self.unit.res_slot.next = self.tu.out_tag.val().get_bits::<3>(0);
+            self.unit.res_slot.next = self.tu.out_tag.val().get_bits::<4>(0);
         }
     }
 
@@ -1460,8 +1463,8 @@ mod tests {
 
     /// rust-hdl simulation: a frame's constants, then 120 pixels (hits and misses) offered by
     /// 32 threads as fast as the unit takes them, its memory and frame-buffer ports and the
-    /// TransformUnit granted at random; every pixel is written once, equal to
-    /// `units::shade_direct` of its hit (the golden model's shading).
+    /// TransformUnit granted at random, so that all [`SHADE_SLOTS`] slots fill; every pixel is
+    /// written once, equal to `units::shade_direct` of its hit (the golden model's shading).
     fn shade_pixels(lights: u32, seed: u64) {
         let f = Format::E7M16;
         let (tri_latency, frame_latency) = (3, 2);
@@ -1584,6 +1587,7 @@ mod tests {
         let (mut next_job, mut phase) = (0usize, 0);
         let mut cycles = 0;
         let mut refused_while_loading = 0;
+        let mut refused_full = 0;
         loop {
             cycles += 1;
             assert!(
@@ -1653,6 +1657,7 @@ mod tests {
             if u.offer.val() {
                 if u.refused.val() {
                     refused_while_loading += usize::from(cycles < 60);
+                    refused_full += usize::from(cycles >= 60);
                 } else {
                     next_job += 1;
                     phase = 0;
@@ -1665,6 +1670,8 @@ mod tests {
         }
         println!("{} pixels in {cycles} clocks", jobs.len());
         assert!(refused_while_loading > 0, "offers wait for the constants");
+        // Offers were refused with the constants in: every one of the slots was taken.
+        assert!(refused_full > 0, "the slots never filled");
         assert_eq!(written.len(), jobs.len());
         for (i, want) in expect.iter().enumerate() {
             let addr = FRAME_BUFFER + i as u32;

@@ -1086,7 +1086,7 @@ impl<
             }
             self.tester.gen_point.next = self.shader.gen_point.val();
             self.tester.gen_client.next = self.client_normal.val();
-            self.tester.gen_thread.next = bit_cast::<5, 3>(self.shader.gen_slot.val());
+            self.tester.gen_thread.next = bit_cast::<5, 4>(self.shader.gen_slot.val());
         } else {
             for k in 0..12 {
                 self.tester.gen_m[k].next = self.rays.gen_m[k].val();
@@ -1104,7 +1104,7 @@ impl<
         self.shader.res_valid.next = self.c_shading.val()
             & self.tester.gen_out_valid.val()
             & (self.tester.gen_out_client.val() == self.client_normal.val());
-        self.shader.res_slot.next = self.tester.gen_out_thread.val().get_bits::<3>(0);
+        self.shader.res_slot.next = self.tester.gen_out_thread.val().get_bits::<4>(0);
         for k in 0..3 {
             self.shader.res_v[k].next = self.tester.gen_out_dir[k].val();
         }
