@@ -996,10 +996,10 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     wire  [23:0] shader__gen_v__2;
     wire  shader__gen_point;
     wire  shader__gen_diagonal;
-    wire  [2:0] shader__gen_slot;
+    wire  [3:0] shader__gen_slot;
     reg  shader__gen_take;
     reg  shader__res_valid;
-    reg  [2:0] shader__res_slot;
+    reg  [3:0] shader__res_slot;
     reg  [23:0] shader__res_v__0;
     reg  [23:0] shader__res_v__1;
     reg  [23:0] shader__res_v__2;
@@ -2565,7 +2565,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         instances__gen_take = tester__gen_take & gen_instance;
         shader__gen_take = tester__gen_take & gen_shade;
         shader__res_valid = c_shading & tester__gen_out_valid & (tester__gen_out_client == client_normal);
-        shader__res_slot = tester__gen_out_thread[(32'h0)+:(3)];
+        shader__res_slot = tester__gen_out_thread[(32'h0)+:(4)];
         shader__res_v__0 = tester__gen_out_dir__0;
         shader__res_v__1 = tester__gen_out_dir__1;
         shader__res_v__2 = tester__gen_out_dir__2;
@@ -16881,10 +16881,10 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     output reg  [23:0] gen_v__2;
     output reg  gen_point;
     output reg  gen_diagonal;
-    output reg  [2:0] gen_slot;
+    output reg  [3:0] gen_slot;
     input wire  gen_take;
     input wire  res_valid;
-    input wire  [2:0] res_slot;
+    input wire  [3:0] res_slot;
     input wire  [23:0] res_v__0;
     input wire  [23:0] res_v__1;
     input wire  [23:0] res_v__2;
@@ -16895,14 +16895,22 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     output reg  idle;
     
     // Constant declarations
-    localparam  c_slot__0 = 3'b0;
-    localparam  c_slot__1 = 3'b1;
-    localparam  c_slot__2 = 3'b10;
-    localparam  c_slot__3 = 3'b11;
-    localparam  c_slot__4 = 3'b100;
-    localparam  c_slot__5 = 3'b101;
-    localparam  c_slot__6 = 3'b110;
-    localparam  c_slot__7 = 3'b111;
+    localparam  c_slot__0 = 4'h0;
+    localparam  c_slot__1 = 4'h1;
+    localparam  c_slot__2 = 4'h2;
+    localparam  c_slot__3 = 4'h3;
+    localparam  c_slot__4 = 4'h4;
+    localparam  c_slot__5 = 4'h5;
+    localparam  c_slot__6 = 4'h6;
+    localparam  c_slot__7 = 4'h7;
+    localparam  c_slot__8 = 4'h8;
+    localparam  c_slot__9 = 4'h9;
+    localparam  c_slot__10 = 4'ha;
+    localparam  c_slot__11 = 4'hb;
+    localparam  c_slot__12 = 4'hc;
+    localparam  c_slot__13 = 4'hd;
+    localparam  c_slot__14 = 4'he;
+    localparam  c_slot__15 = 4'hf;
     localparam  c_sign = 24'h800000;
     localparam  c_exp_mask = 24'h7f0000;
     localparam  c_man_mask = 24'hffff;
@@ -16916,9 +16924,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     localparam  c_const_total = 6'b100;
     localparam  c_last_light = 3'b0;
     localparam  c_has_lights = 1'b0;
-    localparam  c_valid9 = 9'b1;
-    localparam  c_valid4 = 4'h1;
-    localparam  c_valid6 = 6'b1;
+    localparam  c_valid10 = 10'b1;
+    localparam  c_valid5 = 5'b1;
+    localparam  c_valid7 = 7'b1;
     localparam  c_kind_tri = 2'b0;
     localparam  c_kind_kd = 2'b1;
     localparam  c_kind_light = 2'b10;
@@ -17006,6 +17014,30 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  busy__7__d;
     wire  busy__7__q;
     reg  busy__7__clock;
+    reg  busy__8__d;
+    wire  busy__8__q;
+    reg  busy__8__clock;
+    reg  busy__9__d;
+    wire  busy__9__q;
+    reg  busy__9__clock;
+    reg  busy__10__d;
+    wire  busy__10__q;
+    reg  busy__10__clock;
+    reg  busy__11__d;
+    wire  busy__11__q;
+    reg  busy__11__clock;
+    reg  busy__12__d;
+    wire  busy__12__q;
+    reg  busy__12__clock;
+    reg  busy__13__d;
+    wire  busy__13__q;
+    reg  busy__13__clock;
+    reg  busy__14__d;
+    wire  busy__14__q;
+    reg  busy__14__clock;
+    reg  busy__15__d;
+    wire  busy__15__q;
+    reg  busy__15__clock;
     reg  ready__0__d;
     wire  ready__0__q;
     reg  ready__0__clock;
@@ -17030,6 +17062,30 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  ready__7__d;
     wire  ready__7__q;
     reg  ready__7__clock;
+    reg  ready__8__d;
+    wire  ready__8__q;
+    reg  ready__8__clock;
+    reg  ready__9__d;
+    wire  ready__9__q;
+    reg  ready__9__clock;
+    reg  ready__10__d;
+    wire  ready__10__q;
+    reg  ready__10__clock;
+    reg  ready__11__d;
+    wire  ready__11__q;
+    reg  ready__11__clock;
+    reg  ready__12__d;
+    wire  ready__12__q;
+    reg  ready__12__clock;
+    reg  ready__13__d;
+    wire  ready__13__q;
+    reg  ready__13__clock;
+    reg  ready__14__d;
+    wire  ready__14__q;
+    reg  ready__14__clock;
+    reg  ready__15__d;
+    wire  ready__15__q;
+    reg  ready__15__clock;
     reg  [3:0] step__0__d;
     wire  [3:0] step__0__q;
     reg  step__0__clock;
@@ -17054,6 +17110,30 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  [3:0] step__7__d;
     wire  [3:0] step__7__q;
     reg  step__7__clock;
+    reg  [3:0] step__8__d;
+    wire  [3:0] step__8__q;
+    reg  step__8__clock;
+    reg  [3:0] step__9__d;
+    wire  [3:0] step__9__q;
+    reg  step__9__clock;
+    reg  [3:0] step__10__d;
+    wire  [3:0] step__10__q;
+    reg  step__10__clock;
+    reg  [3:0] step__11__d;
+    wire  [3:0] step__11__q;
+    reg  step__11__clock;
+    reg  [3:0] step__12__d;
+    wire  [3:0] step__12__q;
+    reg  step__12__clock;
+    reg  [3:0] step__13__d;
+    wire  [3:0] step__13__q;
+    reg  step__13__clock;
+    reg  [3:0] step__14__d;
+    wire  [3:0] step__14__q;
+    reg  step__14__clock;
+    reg  [3:0] step__15__d;
+    wire  [3:0] step__15__q;
+    reg  step__15__clock;
     reg  [2:0] light__0__d;
     wire  [2:0] light__0__q;
     reg  light__0__clock;
@@ -17078,6 +17158,30 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  [2:0] light__7__d;
     wire  [2:0] light__7__q;
     reg  light__7__clock;
+    reg  [2:0] light__8__d;
+    wire  [2:0] light__8__q;
+    reg  light__8__clock;
+    reg  [2:0] light__9__d;
+    wire  [2:0] light__9__q;
+    reg  light__9__clock;
+    reg  [2:0] light__10__d;
+    wire  [2:0] light__10__q;
+    reg  light__10__clock;
+    reg  [2:0] light__11__d;
+    wire  [2:0] light__11__q;
+    reg  light__11__clock;
+    reg  [2:0] light__12__d;
+    wire  [2:0] light__12__q;
+    reg  light__12__clock;
+    reg  [2:0] light__13__d;
+    wire  [2:0] light__13__q;
+    reg  light__13__clock;
+    reg  [2:0] light__14__d;
+    wire  [2:0] light__14__q;
+    reg  light__14__clock;
+    reg  [2:0] light__15__d;
+    wire  [2:0] light__15__q;
+    reg  light__15__clock;
     reg  flip__0__d;
     wire  flip__0__q;
     reg  flip__0__clock;
@@ -17102,6 +17206,30 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  flip__7__d;
     wire  flip__7__q;
     reg  flip__7__clock;
+    reg  flip__8__d;
+    wire  flip__8__q;
+    reg  flip__8__clock;
+    reg  flip__9__d;
+    wire  flip__9__q;
+    reg  flip__9__clock;
+    reg  flip__10__d;
+    wire  flip__10__q;
+    reg  flip__10__clock;
+    reg  flip__11__d;
+    wire  flip__11__q;
+    reg  flip__11__clock;
+    reg  flip__12__d;
+    wire  flip__12__q;
+    reg  flip__12__clock;
+    reg  flip__13__d;
+    wire  flip__13__q;
+    reg  flip__13__clock;
+    reg  flip__14__d;
+    wire  flip__14__q;
+    reg  flip__14__clock;
+    reg  flip__15__d;
+    wire  flip__15__q;
+    reg  flip__15__clock;
     reg  miss__0__d;
     wire  miss__0__q;
     reg  miss__0__clock;
@@ -17126,196 +17254,220 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  miss__7__d;
     wire  miss__7__q;
     reg  miss__7__clock;
-    reg  [2:0] o__0__read_address;
+    reg  miss__8__d;
+    wire  miss__8__q;
+    reg  miss__8__clock;
+    reg  miss__9__d;
+    wire  miss__9__q;
+    reg  miss__9__clock;
+    reg  miss__10__d;
+    wire  miss__10__q;
+    reg  miss__10__clock;
+    reg  miss__11__d;
+    wire  miss__11__q;
+    reg  miss__11__clock;
+    reg  miss__12__d;
+    wire  miss__12__q;
+    reg  miss__12__clock;
+    reg  miss__13__d;
+    wire  miss__13__q;
+    reg  miss__13__clock;
+    reg  miss__14__d;
+    wire  miss__14__q;
+    reg  miss__14__clock;
+    reg  miss__15__d;
+    wire  miss__15__q;
+    reg  miss__15__clock;
+    reg  [3:0] o__0__read_address;
     wire  [23:0] o__0__read_data;
     reg  o__0__write_clock;
-    reg  [2:0] o__0__write_address;
+    reg  [3:0] o__0__write_address;
     reg  [23:0] o__0__write_data;
     reg  o__0__write_enable;
-    reg  [2:0] o__1__read_address;
+    reg  [3:0] o__1__read_address;
     wire  [23:0] o__1__read_data;
     reg  o__1__write_clock;
-    reg  [2:0] o__1__write_address;
+    reg  [3:0] o__1__write_address;
     reg  [23:0] o__1__write_data;
     reg  o__1__write_enable;
-    reg  [2:0] o__2__read_address;
+    reg  [3:0] o__2__read_address;
     wire  [23:0] o__2__read_data;
     reg  o__2__write_clock;
-    reg  [2:0] o__2__write_address;
+    reg  [3:0] o__2__write_address;
     reg  [23:0] o__2__write_data;
     reg  o__2__write_enable;
-    reg  [2:0] d__0__read_address;
+    reg  [3:0] d__0__read_address;
     wire  [23:0] d__0__read_data;
     reg  d__0__write_clock;
-    reg  [2:0] d__0__write_address;
+    reg  [3:0] d__0__write_address;
     reg  [23:0] d__0__write_data;
     reg  d__0__write_enable;
-    reg  [2:0] d__1__read_address;
+    reg  [3:0] d__1__read_address;
     wire  [23:0] d__1__read_data;
     reg  d__1__write_clock;
-    reg  [2:0] d__1__write_address;
+    reg  [3:0] d__1__write_address;
     reg  [23:0] d__1__write_data;
     reg  d__1__write_enable;
-    reg  [2:0] d__2__read_address;
+    reg  [3:0] d__2__read_address;
     wire  [23:0] d__2__read_data;
     reg  d__2__write_clock;
-    reg  [2:0] d__2__write_address;
+    reg  [3:0] d__2__write_address;
     reg  [23:0] d__2__write_data;
     reg  d__2__write_enable;
-    reg  [2:0] t__read_address;
+    reg  [3:0] t__read_address;
     wire  [23:0] t__read_data;
     reg  t__write_clock;
-    reg  [2:0] t__write_address;
+    reg  [3:0] t__write_address;
     reg  [23:0] t__write_data;
     reg  t__write_enable;
-    reg  [2:0] addr__read_address;
+    reg  [3:0] addr__read_address;
     wire  [23:0] addr__read_data;
     reg  addr__write_clock;
-    reg  [2:0] addr__write_address;
+    reg  [3:0] addr__write_address;
     reg  [23:0] addr__write_data;
     reg  addr__write_enable;
-    reg  [2:0] triangle__read_address;
+    reg  [3:0] triangle__read_address;
     wire  [23:0] triangle__read_data;
     reg  triangle__write_clock;
-    reg  [2:0] triangle__write_address;
+    reg  [3:0] triangle__write_address;
     reg  [23:0] triangle__write_data;
     reg  triangle__write_enable;
-    reg  [2:0] n__0__read_address;
+    reg  [3:0] n__0__read_address;
     wire  [23:0] n__0__read_data;
     reg  n__0__write_clock;
-    reg  [2:0] n__0__write_address;
+    reg  [3:0] n__0__write_address;
     reg  [23:0] n__0__write_data;
     reg  n__0__write_enable;
-    reg  [2:0] n__1__read_address;
+    reg  [3:0] n__1__read_address;
     wire  [23:0] n__1__read_data;
     reg  n__1__write_clock;
-    reg  [2:0] n__1__write_address;
+    reg  [3:0] n__1__write_address;
     reg  [23:0] n__1__write_data;
     reg  n__1__write_enable;
-    reg  [2:0] n__2__read_address;
+    reg  [3:0] n__2__read_address;
     wire  [23:0] n__2__read_data;
     reg  n__2__write_clock;
-    reg  [2:0] n__2__write_address;
+    reg  [3:0] n__2__write_address;
     reg  [23:0] n__2__write_data;
     reg  n__2__write_enable;
-    reg  [2:0] material__read_address;
+    reg  [3:0] material__read_address;
     wire  [23:0] material__read_data;
     reg  material__write_clock;
-    reg  [2:0] material__write_address;
+    reg  [3:0] material__write_address;
     reg  [23:0] material__write_data;
     reg  material__write_enable;
-    reg  [2:0] kd__0__read_address;
+    reg  [3:0] kd__0__read_address;
     wire  [23:0] kd__0__read_data;
     reg  kd__0__write_clock;
-    reg  [2:0] kd__0__write_address;
+    reg  [3:0] kd__0__write_address;
     reg  [23:0] kd__0__write_data;
     reg  kd__0__write_enable;
-    reg  [2:0] kd__1__read_address;
+    reg  [3:0] kd__1__read_address;
     wire  [23:0] kd__1__read_data;
     reg  kd__1__write_clock;
-    reg  [2:0] kd__1__write_address;
+    reg  [3:0] kd__1__write_address;
     reg  [23:0] kd__1__write_data;
     reg  kd__1__write_enable;
-    reg  [2:0] kd__2__read_address;
+    reg  [3:0] kd__2__read_address;
     wire  [23:0] kd__2__read_data;
     reg  kd__2__write_clock;
-    reg  [2:0] kd__2__write_address;
+    reg  [3:0] kd__2__write_address;
     reg  [23:0] kd__2__write_data;
     reg  kd__2__write_enable;
-    reg  [2:0] p__0__read_address;
+    reg  [3:0] p__0__read_address;
     wire  [23:0] p__0__read_data;
     reg  p__0__write_clock;
-    reg  [2:0] p__0__write_address;
+    reg  [3:0] p__0__write_address;
     reg  [23:0] p__0__write_data;
     reg  p__0__write_enable;
-    reg  [2:0] p__1__read_address;
+    reg  [3:0] p__1__read_address;
     wire  [23:0] p__1__read_data;
     reg  p__1__write_clock;
-    reg  [2:0] p__1__write_address;
+    reg  [3:0] p__1__write_address;
     reg  [23:0] p__1__write_data;
     reg  p__1__write_enable;
-    reg  [2:0] p__2__read_address;
+    reg  [3:0] p__2__read_address;
     wire  [23:0] p__2__read_data;
     reg  p__2__write_clock;
-    reg  [2:0] p__2__write_address;
+    reg  [3:0] p__2__write_address;
     reg  [23:0] p__2__write_data;
     reg  p__2__write_enable;
-    reg  [2:0] acc__0__read_address;
+    reg  [3:0] acc__0__read_address;
     wire  [23:0] acc__0__read_data;
     reg  acc__0__write_clock;
-    reg  [2:0] acc__0__write_address;
+    reg  [3:0] acc__0__write_address;
     reg  [23:0] acc__0__write_data;
     reg  acc__0__write_enable;
-    reg  [2:0] acc__1__read_address;
+    reg  [3:0] acc__1__read_address;
     wire  [23:0] acc__1__read_data;
     reg  acc__1__write_clock;
-    reg  [2:0] acc__1__write_address;
+    reg  [3:0] acc__1__write_address;
     reg  [23:0] acc__1__write_data;
     reg  acc__1__write_enable;
-    reg  [2:0] acc__2__read_address;
+    reg  [3:0] acc__2__read_address;
     wire  [23:0] acc__2__read_data;
     reg  acc__2__write_clock;
-    reg  [2:0] acc__2__write_address;
+    reg  [3:0] acc__2__write_address;
     reg  [23:0] acc__2__write_data;
     reg  acc__2__write_enable;
-    reg  [2:0] to_light__0__read_address;
+    reg  [3:0] to_light__0__read_address;
     wire  [23:0] to_light__0__read_data;
     reg  to_light__0__write_clock;
-    reg  [2:0] to_light__0__write_address;
+    reg  [3:0] to_light__0__write_address;
     reg  [23:0] to_light__0__write_data;
     reg  to_light__0__write_enable;
-    reg  [2:0] to_light__1__read_address;
+    reg  [3:0] to_light__1__read_address;
     wire  [23:0] to_light__1__read_data;
     reg  to_light__1__write_clock;
-    reg  [2:0] to_light__1__write_address;
+    reg  [3:0] to_light__1__write_address;
     reg  [23:0] to_light__1__write_data;
     reg  to_light__1__write_enable;
-    reg  [2:0] to_light__2__read_address;
+    reg  [3:0] to_light__2__read_address;
     wire  [23:0] to_light__2__read_data;
     reg  to_light__2__write_clock;
-    reg  [2:0] to_light__2__write_address;
+    reg  [3:0] to_light__2__write_address;
     reg  [23:0] to_light__2__write_data;
     reg  to_light__2__write_enable;
-    reg  [2:0] n_dot_l__read_address;
+    reg  [3:0] n_dot_l__read_address;
     wire  [23:0] n_dot_l__read_data;
     reg  n_dot_l__write_clock;
-    reg  [2:0] n_dot_l__write_address;
+    reg  [3:0] n_dot_l__write_address;
     reg  [23:0] n_dot_l__write_data;
     reg  n_dot_l__write_enable;
-    reg  [2:0] l_dot_l__read_address;
+    reg  [3:0] l_dot_l__read_address;
     wire  [23:0] l_dot_l__read_data;
     reg  l_dot_l__write_clock;
-    reg  [2:0] l_dot_l__write_address;
+    reg  [3:0] l_dot_l__write_address;
     reg  [23:0] l_dot_l__write_data;
     reg  l_dot_l__write_enable;
-    reg  [2:0] tint__0__read_address;
+    reg  [3:0] tint__0__read_address;
     wire  [23:0] tint__0__read_data;
     reg  tint__0__write_clock;
-    reg  [2:0] tint__0__write_address;
+    reg  [3:0] tint__0__write_address;
     reg  [23:0] tint__0__write_data;
     reg  tint__0__write_enable;
-    reg  [2:0] tint__1__read_address;
+    reg  [3:0] tint__1__read_address;
     wire  [23:0] tint__1__read_data;
     reg  tint__1__write_clock;
-    reg  [2:0] tint__1__write_address;
+    reg  [3:0] tint__1__write_address;
     reg  [23:0] tint__1__write_data;
     reg  tint__1__write_enable;
-    reg  [2:0] tint__2__read_address;
+    reg  [3:0] tint__2__read_address;
     wire  [23:0] tint__2__read_data;
     reg  tint__2__write_clock;
-    reg  [2:0] tint__2__write_address;
+    reg  [3:0] tint__2__write_address;
     reg  [23:0] tint__2__write_data;
     reg  tint__2__write_enable;
-    reg  [2:0] cos__read_address;
+    reg  [3:0] cos__read_address;
     wire  [23:0] cos__read_data;
     reg  cos__write_clock;
-    reg  [2:0] cos__write_address;
+    reg  [3:0] cos__write_address;
     reg  [23:0] cos__write_data;
     reg  cos__write_enable;
-    reg  [2:0] rgb__read_address;
+    reg  [3:0] rgb__read_address;
     wire  [23:0] rgb__read_data;
     reg  rgb__write_clock;
-    reg  [2:0] rgb__write_address;
+    reg  [3:0] rgb__write_address;
     reg  [23:0] rgb__write_data;
     reg  rgb__write_enable;
     reg  [23:0] ambient__d;
@@ -17387,8 +17539,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  [2:0] const_word__d;
     wire  [2:0] const_word__q;
     reg  const_word__clock;
-    reg  [2:0] free_slot_r__d;
-    wire  [2:0] free_slot_r__q;
+    reg  [3:0] free_slot_r__d;
+    wire  [3:0] free_slot_r__q;
     reg  free_slot_r__clock;
     reg  has_free_r__d;
     wire  has_free_r__q;
@@ -17396,8 +17548,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  take_r__d;
     wire  take_r__q;
     reg  take_r__clock;
-    reg  [2:0] take_slot_r__d;
-    wire  [2:0] take_slot_r__q;
+    reg  [3:0] take_slot_r__d;
+    wire  [3:0] take_slot_r__q;
     reg  take_slot_r__clock;
     reg  take_hit_r__d;
     wire  take_hit_r__q;
@@ -17405,14 +17557,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  stored_r__d;
     wire  stored_r__q;
     reg  stored_r__clock;
-    reg  [2:0] stored_slot_r__d;
-    wire  [2:0] stored_slot_r__q;
+    reg  [3:0] stored_slot_r__d;
+    wire  [3:0] stored_slot_r__q;
     reg  stored_slot_r__clock;
     reg  s0_valid__d;
     wire  s0_valid__q;
     reg  s0_valid__clock;
-    reg  [2:0] s0_slot__d;
-    wire  [2:0] s0_slot__q;
+    reg  [3:0] s0_slot__d;
+    wire  [3:0] s0_slot__q;
     reg  s0_slot__clock;
     reg  [3:0] s0_step__d;
     wire  [3:0] s0_step__q;
@@ -17429,8 +17581,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  s1_valid__d;
     wire  s1_valid__q;
     reg  s1_valid__clock;
-    reg  [2:0] s1_slot__d;
-    wire  [2:0] s1_slot__q;
+    reg  [3:0] s1_slot__d;
+    wire  [3:0] s1_slot__q;
     reg  s1_slot__clock;
     reg  [1:0] s1_word__d;
     wire  [1:0] s1_word__q;
@@ -17522,14 +17674,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  gen_hold_diagonal__d;
     wire  gen_hold_diagonal__q;
     reg  gen_hold_diagonal__clock;
-    reg  [2:0] gen_hold_slot__d;
-    wire  [2:0] gen_hold_slot__q;
+    reg  [3:0] gen_hold_slot__d;
+    wire  [3:0] gen_hold_slot__q;
     reg  gen_hold_slot__clock;
     reg  res_valid_r__d;
     wire  res_valid_r__q;
     reg  res_valid_r__clock;
-    reg  [2:0] res_slot_r__d;
-    wire  [2:0] res_slot_r__q;
+    reg  [3:0] res_slot_r__d;
+    wire  [3:0] res_slot_r__q;
     reg  res_slot_r__clock;
     reg  [23:0] res_v_r__0__d;
     wire  [23:0] res_v_r__0__q;
@@ -17547,16 +17699,16 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     wire  [2:0] res_light_r__q;
     reg  res_light_r__clock;
     reg  tri_line__clock;
-    reg  [8:0] tri_line__data_in;
-    wire  [8:0] tri_line__data_out;
+    reg  [9:0] tri_line__data_in;
+    wire  [9:0] tri_line__data_out;
     reg  frame_line__clock;
-    reg  [8:0] frame_line__data_in;
-    wire  [8:0] frame_line__data_out;
-    reg  [8:0] tri_arrived_r__d;
-    wire  [8:0] tri_arrived_r__q;
+    reg  [9:0] frame_line__data_in;
+    wire  [9:0] frame_line__data_out;
+    reg  [9:0] tri_arrived_r__d;
+    wire  [9:0] tri_arrived_r__q;
     reg  tri_arrived_r__clock;
-    reg  [8:0] frame_arrived_r__d;
-    wire  [8:0] frame_arrived_r__q;
+    reg  [9:0] frame_arrived_r__d;
+    wire  [9:0] frame_arrived_r__q;
     reg  frame_arrived_r__clock;
     reg  normal_in__0__d;
     wire  normal_in__0__q;
@@ -17582,6 +17734,30 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  normal_in__7__d;
     wire  normal_in__7__q;
     reg  normal_in__7__clock;
+    reg  normal_in__8__d;
+    wire  normal_in__8__q;
+    reg  normal_in__8__clock;
+    reg  normal_in__9__d;
+    wire  normal_in__9__q;
+    reg  normal_in__9__clock;
+    reg  normal_in__10__d;
+    wire  normal_in__10__q;
+    reg  normal_in__10__clock;
+    reg  normal_in__11__d;
+    wire  normal_in__11__q;
+    reg  normal_in__11__clock;
+    reg  normal_in__12__d;
+    wire  normal_in__12__q;
+    reg  normal_in__12__clock;
+    reg  normal_in__13__d;
+    wire  normal_in__13__q;
+    reg  normal_in__13__clock;
+    reg  normal_in__14__d;
+    wire  normal_in__14__q;
+    reg  normal_in__14__clock;
+    reg  normal_in__15__d;
+    wire  normal_in__15__q;
+    reg  normal_in__15__clock;
     reg  kd_in__0__d;
     wire  kd_in__0__q;
     reg  kd_in__0__clock;
@@ -17606,6 +17782,30 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  kd_in__7__d;
     wire  kd_in__7__q;
     reg  kd_in__7__clock;
+    reg  kd_in__8__d;
+    wire  kd_in__8__q;
+    reg  kd_in__8__clock;
+    reg  kd_in__9__d;
+    wire  kd_in__9__q;
+    reg  kd_in__9__clock;
+    reg  kd_in__10__d;
+    wire  kd_in__10__q;
+    reg  kd_in__10__clock;
+    reg  kd_in__11__d;
+    wire  kd_in__11__q;
+    reg  kd_in__11__clock;
+    reg  kd_in__12__d;
+    wire  kd_in__12__q;
+    reg  kd_in__12__clock;
+    reg  kd_in__13__d;
+    wire  kd_in__13__q;
+    reg  kd_in__13__clock;
+    reg  kd_in__14__d;
+    wire  kd_in__14__q;
+    reg  kd_in__14__clock;
+    reg  kd_in__15__d;
+    wire  kd_in__15__q;
+    reg  kd_in__15__clock;
     reg  sqrt__clock;
     reg  sqrt__in_valid;
     reg  [23:0] sqrt__a;
@@ -17621,16 +17821,16 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  [23:0] cos_n_dot_l__data_in;
     wire  [23:0] cos_n_dot_l__data_out;
     reg  cos_slot__clock;
-    reg  [3:0] cos_slot__data_in;
-    wire  [3:0] cos_slot__data_out;
+    reg  [4:0] cos_slot__data_in;
+    wire  [4:0] cos_slot__data_out;
     reg  byte_valid_r__d;
     wire  byte_valid_r__q;
     reg  byte_valid_r__clock;
     reg  [23:0] byte_word_r__d;
     wire  [23:0] byte_word_r__q;
     reg  byte_word_r__clock;
-    reg  [5:0] byte_tag_r__d;
-    wire  [5:0] byte_tag_r__q;
+    reg  [6:0] byte_tag_r__d;
+    wire  [6:0] byte_tag_r__q;
     reg  byte_tag_r__clock;
     reg  byte_unit__clock;
     reg  byte_unit__in_valid;
@@ -17638,8 +17838,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     wire  byte_unit__out_valid;
     wire  [7:0] byte_unit__result;
     reg  byte_tag__clock;
-    reg  [5:0] byte_tag__data_in;
-    wire  [5:0] byte_tag__data_out;
+    reg  [6:0] byte_tag__data_in;
+    wire  [6:0] byte_tag__data_out;
     reg  [23:0] rgb_acc__d;
     wire  [23:0] rgb_acc__q;
     reg  rgb_acc__clock;
@@ -17655,6 +17855,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  any_free_before__6;
     reg  any_free_before__7;
     reg  any_free_before__8;
+    reg  any_free_before__9;
+    reg  any_free_before__10;
+    reg  any_free_before__11;
+    reg  any_free_before__12;
+    reg  any_free_before__13;
+    reg  any_free_before__14;
+    reg  any_free_before__15;
+    reg  any_free_before__16;
     reg  any_free_after_take__0;
     reg  any_free_after_take__1;
     reg  any_free_after_take__2;
@@ -17664,6 +17872,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  any_free_after_take__6;
     reg  any_free_after_take__7;
     reg  any_free_after_take__8;
+    reg  any_free_after_take__9;
+    reg  any_free_after_take__10;
+    reg  any_free_after_take__11;
+    reg  any_free_after_take__12;
+    reg  any_free_after_take__13;
+    reg  any_free_after_take__14;
+    reg  any_free_after_take__15;
+    reg  any_free_after_take__16;
     reg  taken;
     reg  occupied__0;
     reg  occupied__1;
@@ -17673,6 +17889,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  occupied__5;
     reg  occupied__6;
     reg  occupied__7;
+    reg  occupied__8;
+    reg  occupied__9;
+    reg  occupied__10;
+    reg  occupied__11;
+    reg  occupied__12;
+    reg  occupied__13;
+    reg  occupied__14;
+    reg  occupied__15;
     reg  s1_load;
     reg  [3:0] pick_step;
     reg  [2:0] pick_light;
@@ -17691,7 +17915,15 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  any_ready_before__6;
     reg  any_ready_before__7;
     reg  any_ready_before__8;
-    reg  [2:0] ready_slot;
+    reg  any_ready_before__9;
+    reg  any_ready_before__10;
+    reg  any_ready_before__11;
+    reg  any_ready_before__12;
+    reg  any_ready_before__13;
+    reg  any_ready_before__14;
+    reg  any_ready_before__15;
+    reg  any_ready_before__16;
+    reg  [3:0] ready_slot;
     reg  pick;
     reg  gen_load;
     reg  [23:0] req_m__0;
@@ -17717,7 +17949,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  frame_valid;
     reg  [1:0] frame_kind;
     reg  [2:0] frame_word;
-    reg  [5:0] byte_tag_in;
+    reg  [6:0] byte_tag_in;
     reg  byte_valid_l;
     reg  [23:0] byte_word_l;
     reg  [23:0] rgb_next;
@@ -17726,10 +17958,10 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  frame_read_l;
     reg  [23:0] frame_addr_l;
     reg  fb_write_l;
-    reg  [8:0] tri_tag;
-    reg  [8:0] frame_tag;
-    reg  [8:0] tri_arrived;
-    reg  [8:0] frame_arrived;
+    reg  [9:0] tri_tag;
+    reg  [9:0] frame_tag;
+    reg  [9:0] tri_arrived;
+    reg  [9:0] frame_arrived;
     
     // Sub module instances
     dynrt_processor__engine__instances__world__0 rays__0(
@@ -17826,6 +18058,46 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(busy__7__q),
         .clock(busy__7__clock)
     );
+    dynrt_processor__display__dark_d busy__8(
+        .d(busy__8__d),
+        .q(busy__8__q),
+        .clock(busy__8__clock)
+    );
+    dynrt_processor__display__dark_d busy__9(
+        .d(busy__9__d),
+        .q(busy__9__q),
+        .clock(busy__9__clock)
+    );
+    dynrt_processor__display__dark_d busy__10(
+        .d(busy__10__d),
+        .q(busy__10__q),
+        .clock(busy__10__clock)
+    );
+    dynrt_processor__display__dark_d busy__11(
+        .d(busy__11__d),
+        .q(busy__11__q),
+        .clock(busy__11__clock)
+    );
+    dynrt_processor__display__dark_d busy__12(
+        .d(busy__12__d),
+        .q(busy__12__q),
+        .clock(busy__12__clock)
+    );
+    dynrt_processor__display__dark_d busy__13(
+        .d(busy__13__d),
+        .q(busy__13__q),
+        .clock(busy__13__clock)
+    );
+    dynrt_processor__display__dark_d busy__14(
+        .d(busy__14__d),
+        .q(busy__14__q),
+        .clock(busy__14__clock)
+    );
+    dynrt_processor__display__dark_d busy__15(
+        .d(busy__15__d),
+        .q(busy__15__q),
+        .clock(busy__15__clock)
+    );
     dynrt_processor__display__dark_d ready__0(
         .d(ready__0__d),
         .q(ready__0__q),
@@ -17865,6 +18137,46 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .d(ready__7__d),
         .q(ready__7__q),
         .clock(ready__7__clock)
+    );
+    dynrt_processor__display__dark_d ready__8(
+        .d(ready__8__d),
+        .q(ready__8__q),
+        .clock(ready__8__clock)
+    );
+    dynrt_processor__display__dark_d ready__9(
+        .d(ready__9__d),
+        .q(ready__9__q),
+        .clock(ready__9__clock)
+    );
+    dynrt_processor__display__dark_d ready__10(
+        .d(ready__10__d),
+        .q(ready__10__q),
+        .clock(ready__10__clock)
+    );
+    dynrt_processor__display__dark_d ready__11(
+        .d(ready__11__d),
+        .q(ready__11__q),
+        .clock(ready__11__clock)
+    );
+    dynrt_processor__display__dark_d ready__12(
+        .d(ready__12__d),
+        .q(ready__12__q),
+        .clock(ready__12__clock)
+    );
+    dynrt_processor__display__dark_d ready__13(
+        .d(ready__13__d),
+        .q(ready__13__q),
+        .clock(ready__13__clock)
+    );
+    dynrt_processor__display__dark_d ready__14(
+        .d(ready__14__d),
+        .q(ready__14__q),
+        .clock(ready__14__clock)
+    );
+    dynrt_processor__display__dark_d ready__15(
+        .d(ready__15__d),
+        .q(ready__15__q),
+        .clock(ready__15__clock)
     );
     dynrt_processor__engine__shader__res_step_r step__0(
         .d(step__0__d),
@@ -17906,6 +18218,46 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(step__7__q),
         .clock(step__7__clock)
     );
+    dynrt_processor__engine__shader__res_step_r step__8(
+        .d(step__8__d),
+        .q(step__8__q),
+        .clock(step__8__clock)
+    );
+    dynrt_processor__engine__shader__res_step_r step__9(
+        .d(step__9__d),
+        .q(step__9__q),
+        .clock(step__9__clock)
+    );
+    dynrt_processor__engine__shader__res_step_r step__10(
+        .d(step__10__d),
+        .q(step__10__q),
+        .clock(step__10__clock)
+    );
+    dynrt_processor__engine__shader__res_step_r step__11(
+        .d(step__11__d),
+        .q(step__11__q),
+        .clock(step__11__clock)
+    );
+    dynrt_processor__engine__shader__res_step_r step__12(
+        .d(step__12__d),
+        .q(step__12__q),
+        .clock(step__12__clock)
+    );
+    dynrt_processor__engine__shader__res_step_r step__13(
+        .d(step__13__d),
+        .q(step__13__q),
+        .clock(step__13__clock)
+    );
+    dynrt_processor__engine__shader__res_step_r step__14(
+        .d(step__14__d),
+        .q(step__14__q),
+        .clock(step__14__clock)
+    );
+    dynrt_processor__engine__shader__res_step_r step__15(
+        .d(step__15__d),
+        .q(step__15__q),
+        .clock(step__15__clock)
+    );
     dynrt_processor__engine__mem_bank_r light__0(
         .d(light__0__d),
         .q(light__0__q),
@@ -17945,6 +18297,46 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .d(light__7__d),
         .q(light__7__q),
         .clock(light__7__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__8(
+        .d(light__8__d),
+        .q(light__8__q),
+        .clock(light__8__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__9(
+        .d(light__9__d),
+        .q(light__9__q),
+        .clock(light__9__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__10(
+        .d(light__10__d),
+        .q(light__10__q),
+        .clock(light__10__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__11(
+        .d(light__11__d),
+        .q(light__11__q),
+        .clock(light__11__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__12(
+        .d(light__12__d),
+        .q(light__12__q),
+        .clock(light__12__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__13(
+        .d(light__13__d),
+        .q(light__13__q),
+        .clock(light__13__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__14(
+        .d(light__14__d),
+        .q(light__14__q),
+        .clock(light__14__clock)
+    );
+    dynrt_processor__engine__mem_bank_r light__15(
+        .d(light__15__d),
+        .q(light__15__q),
+        .clock(light__15__clock)
     );
     dynrt_processor__display__dark_d flip__0(
         .d(flip__0__d),
@@ -17986,6 +18378,46 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(flip__7__q),
         .clock(flip__7__clock)
     );
+    dynrt_processor__display__dark_d flip__8(
+        .d(flip__8__d),
+        .q(flip__8__q),
+        .clock(flip__8__clock)
+    );
+    dynrt_processor__display__dark_d flip__9(
+        .d(flip__9__d),
+        .q(flip__9__q),
+        .clock(flip__9__clock)
+    );
+    dynrt_processor__display__dark_d flip__10(
+        .d(flip__10__d),
+        .q(flip__10__q),
+        .clock(flip__10__clock)
+    );
+    dynrt_processor__display__dark_d flip__11(
+        .d(flip__11__d),
+        .q(flip__11__q),
+        .clock(flip__11__clock)
+    );
+    dynrt_processor__display__dark_d flip__12(
+        .d(flip__12__d),
+        .q(flip__12__q),
+        .clock(flip__12__clock)
+    );
+    dynrt_processor__display__dark_d flip__13(
+        .d(flip__13__d),
+        .q(flip__13__q),
+        .clock(flip__13__clock)
+    );
+    dynrt_processor__display__dark_d flip__14(
+        .d(flip__14__d),
+        .q(flip__14__q),
+        .clock(flip__14__clock)
+    );
+    dynrt_processor__display__dark_d flip__15(
+        .d(flip__15__d),
+        .q(flip__15__q),
+        .clock(flip__15__clock)
+    );
     dynrt_processor__display__dark_d miss__0(
         .d(miss__0__d),
         .q(miss__0__q),
@@ -18025,6 +18457,46 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .d(miss__7__d),
         .q(miss__7__q),
         .clock(miss__7__clock)
+    );
+    dynrt_processor__display__dark_d miss__8(
+        .d(miss__8__d),
+        .q(miss__8__q),
+        .clock(miss__8__clock)
+    );
+    dynrt_processor__display__dark_d miss__9(
+        .d(miss__9__d),
+        .q(miss__9__q),
+        .clock(miss__9__clock)
+    );
+    dynrt_processor__display__dark_d miss__10(
+        .d(miss__10__d),
+        .q(miss__10__q),
+        .clock(miss__10__clock)
+    );
+    dynrt_processor__display__dark_d miss__11(
+        .d(miss__11__d),
+        .q(miss__11__q),
+        .clock(miss__11__clock)
+    );
+    dynrt_processor__display__dark_d miss__12(
+        .d(miss__12__d),
+        .q(miss__12__q),
+        .clock(miss__12__clock)
+    );
+    dynrt_processor__display__dark_d miss__13(
+        .d(miss__13__d),
+        .q(miss__13__q),
+        .clock(miss__13__clock)
+    );
+    dynrt_processor__display__dark_d miss__14(
+        .d(miss__14__d),
+        .q(miss__14__q),
+        .clock(miss__14__clock)
+    );
+    dynrt_processor__display__dark_d miss__15(
+        .d(miss__15__d),
+        .q(miss__15__q),
+        .clock(miss__15__clock)
     );
     dynrt_processor__engine__shader__acc__0 o__0(
         .read_address(o__0__read_address),
@@ -18302,7 +18774,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(background__2__q),
         .clock(background__2__clock)
     );
-    dynrt_processor__engine__shader__acc__0 light_position__0(
+    dynrt_processor__engine__shader__light_color__0 light_position__0(
         .read_address(light_position__0__read_address),
         .read_data(light_position__0__read_data),
         .write_clock(light_position__0__write_clock),
@@ -18310,7 +18782,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .write_data(light_position__0__write_data),
         .write_enable(light_position__0__write_enable)
     );
-    dynrt_processor__engine__shader__acc__0 light_position__1(
+    dynrt_processor__engine__shader__light_color__0 light_position__1(
         .read_address(light_position__1__read_address),
         .read_data(light_position__1__read_data),
         .write_clock(light_position__1__write_clock),
@@ -18318,7 +18790,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .write_data(light_position__1__write_data),
         .write_enable(light_position__1__write_enable)
     );
-    dynrt_processor__engine__shader__acc__0 light_position__2(
+    dynrt_processor__engine__shader__light_color__0 light_position__2(
         .read_address(light_position__2__read_address),
         .read_data(light_position__2__read_data),
         .write_clock(light_position__2__write_clock),
@@ -18326,7 +18798,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .write_data(light_position__2__write_data),
         .write_enable(light_position__2__write_enable)
     );
-    dynrt_processor__engine__shader__acc__0 light_color__0(
+    dynrt_processor__engine__shader__light_color__0 light_color__0(
         .read_address(light_color__0__read_address),
         .read_data(light_color__0__read_data),
         .write_clock(light_color__0__write_clock),
@@ -18334,7 +18806,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .write_data(light_color__0__write_data),
         .write_enable(light_color__0__write_enable)
     );
-    dynrt_processor__engine__shader__acc__0 light_color__1(
+    dynrt_processor__engine__shader__light_color__0 light_color__1(
         .read_address(light_color__1__read_address),
         .read_data(light_color__1__read_data),
         .write_clock(light_color__1__write_clock),
@@ -18342,7 +18814,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .write_data(light_color__1__write_data),
         .write_enable(light_color__1__write_enable)
     );
-    dynrt_processor__engine__shader__acc__0 light_color__2(
+    dynrt_processor__engine__shader__light_color__0 light_color__2(
         .read_address(light_color__2__read_address),
         .read_data(light_color__2__read_data),
         .write_clock(light_color__2__write_clock),
@@ -18385,7 +18857,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(const_word__q),
         .clock(const_word__clock)
     );
-    dynrt_processor__engine__mem_bank_r free_slot_r(
+    dynrt_processor__engine__instances__arrived free_slot_r(
         .d(free_slot_r__d),
         .q(free_slot_r__q),
         .clock(free_slot_r__clock)
@@ -18400,7 +18872,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(take_r__q),
         .clock(take_r__clock)
     );
-    dynrt_processor__engine__mem_bank_r take_slot_r(
+    dynrt_processor__engine__instances__arrived take_slot_r(
         .d(take_slot_r__d),
         .q(take_slot_r__q),
         .clock(take_slot_r__clock)
@@ -18415,7 +18887,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(stored_r__q),
         .clock(stored_r__clock)
     );
-    dynrt_processor__engine__mem_bank_r stored_slot_r(
+    dynrt_processor__engine__instances__arrived stored_slot_r(
         .d(stored_slot_r__d),
         .q(stored_slot_r__q),
         .clock(stored_slot_r__clock)
@@ -18425,7 +18897,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(s0_valid__q),
         .clock(s0_valid__clock)
     );
-    dynrt_processor__engine__mem_bank_r s0_slot(
+    dynrt_processor__engine__instances__arrived s0_slot(
         .d(s0_slot__d),
         .q(s0_slot__q),
         .clock(s0_slot__clock)
@@ -18455,7 +18927,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(s1_valid__q),
         .clock(s1_valid__clock)
     );
-    dynrt_processor__engine__mem_bank_r s1_slot(
+    dynrt_processor__engine__instances__arrived s1_slot(
         .d(s1_slot__d),
         .q(s1_slot__q),
         .clock(s1_slot__clock)
@@ -18610,7 +19082,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(gen_hold_diagonal__q),
         .clock(gen_hold_diagonal__clock)
     );
-    dynrt_processor__engine__mem_bank_r gen_hold_slot(
+    dynrt_processor__engine__instances__arrived gen_hold_slot(
         .d(gen_hold_slot__d),
         .q(gen_hold_slot__q),
         .clock(gen_hold_slot__clock)
@@ -18620,7 +19092,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(res_valid_r__q),
         .clock(res_valid_r__clock)
     );
-    dynrt_processor__engine__mem_bank_r res_slot_r(
+    dynrt_processor__engine__instances__arrived res_slot_r(
         .d(res_slot_r__d),
         .q(res_slot_r__q),
         .clock(res_slot_r__clock)
@@ -18660,12 +19132,12 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .data_in(frame_line__data_in),
         .data_out(frame_line__data_out)
     );
-    dynrt_processor__engine__fp_units__add__lz tri_arrived_r(
+    dynrt_processor__engine__shader__frame_arrived_r tri_arrived_r(
         .d(tri_arrived_r__d),
         .q(tri_arrived_r__q),
         .clock(tri_arrived_r__clock)
     );
-    dynrt_processor__engine__fp_units__add__lz frame_arrived_r(
+    dynrt_processor__engine__shader__frame_arrived_r frame_arrived_r(
         .d(frame_arrived_r__d),
         .q(frame_arrived_r__q),
         .clock(frame_arrived_r__clock)
@@ -18710,6 +19182,46 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(normal_in__7__q),
         .clock(normal_in__7__clock)
     );
+    dynrt_processor__display__dark_d normal_in__8(
+        .d(normal_in__8__d),
+        .q(normal_in__8__q),
+        .clock(normal_in__8__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__9(
+        .d(normal_in__9__d),
+        .q(normal_in__9__q),
+        .clock(normal_in__9__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__10(
+        .d(normal_in__10__d),
+        .q(normal_in__10__q),
+        .clock(normal_in__10__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__11(
+        .d(normal_in__11__d),
+        .q(normal_in__11__q),
+        .clock(normal_in__11__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__12(
+        .d(normal_in__12__d),
+        .q(normal_in__12__q),
+        .clock(normal_in__12__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__13(
+        .d(normal_in__13__d),
+        .q(normal_in__13__q),
+        .clock(normal_in__13__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__14(
+        .d(normal_in__14__d),
+        .q(normal_in__14__q),
+        .clock(normal_in__14__clock)
+    );
+    dynrt_processor__display__dark_d normal_in__15(
+        .d(normal_in__15__d),
+        .q(normal_in__15__q),
+        .clock(normal_in__15__clock)
+    );
     dynrt_processor__display__dark_d kd_in__0(
         .d(kd_in__0__d),
         .q(kd_in__0__q),
@@ -18750,6 +19262,46 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(kd_in__7__q),
         .clock(kd_in__7__clock)
     );
+    dynrt_processor__display__dark_d kd_in__8(
+        .d(kd_in__8__d),
+        .q(kd_in__8__q),
+        .clock(kd_in__8__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__9(
+        .d(kd_in__9__d),
+        .q(kd_in__9__q),
+        .clock(kd_in__9__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__10(
+        .d(kd_in__10__d),
+        .q(kd_in__10__q),
+        .clock(kd_in__10__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__11(
+        .d(kd_in__11__d),
+        .q(kd_in__11__q),
+        .clock(kd_in__11__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__12(
+        .d(kd_in__12__d),
+        .q(kd_in__12__q),
+        .clock(kd_in__12__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__13(
+        .d(kd_in__13__d),
+        .q(kd_in__13__q),
+        .clock(kd_in__13__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__14(
+        .d(kd_in__14__d),
+        .q(kd_in__14__q),
+        .clock(kd_in__14__clock)
+    );
+    dynrt_processor__display__dark_d kd_in__15(
+        .d(kd_in__15__d),
+        .q(kd_in__15__q),
+        .clock(kd_in__15__clock)
+    );
     dynrt_processor__engine__fp_units__sqrt sqrt(
         .clock(sqrt__clock),
         .in_valid(sqrt__in_valid),
@@ -18785,7 +19337,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(byte_word_r__q),
         .clock(byte_word_r__clock)
     );
-    dynrt_processor__engine__mem_load_r byte_tag_r(
+    dynrt_processor__engine__fp_units__add__al_exp byte_tag_r(
         .d(byte_tag_r__d),
         .q(byte_tag_r__q),
         .clock(byte_tag_r__clock)
@@ -18998,6 +19550,118 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__7__d = miss__7__q;
         normal_in__7__clock = clock;
         kd_in__7__clock = clock;
+        busy__8__clock = clock;
+        busy__8__d = busy__8__q;
+        ready__8__clock = clock;
+        ready__8__d = ready__8__q;
+        step__8__clock = clock;
+        step__8__d = step__8__q;
+        light__8__clock = clock;
+        light__8__d = light__8__q;
+        flip__8__clock = clock;
+        flip__8__d = flip__8__q;
+        miss__8__clock = clock;
+        miss__8__d = miss__8__q;
+        normal_in__8__clock = clock;
+        kd_in__8__clock = clock;
+        busy__9__clock = clock;
+        busy__9__d = busy__9__q;
+        ready__9__clock = clock;
+        ready__9__d = ready__9__q;
+        step__9__clock = clock;
+        step__9__d = step__9__q;
+        light__9__clock = clock;
+        light__9__d = light__9__q;
+        flip__9__clock = clock;
+        flip__9__d = flip__9__q;
+        miss__9__clock = clock;
+        miss__9__d = miss__9__q;
+        normal_in__9__clock = clock;
+        kd_in__9__clock = clock;
+        busy__10__clock = clock;
+        busy__10__d = busy__10__q;
+        ready__10__clock = clock;
+        ready__10__d = ready__10__q;
+        step__10__clock = clock;
+        step__10__d = step__10__q;
+        light__10__clock = clock;
+        light__10__d = light__10__q;
+        flip__10__clock = clock;
+        flip__10__d = flip__10__q;
+        miss__10__clock = clock;
+        miss__10__d = miss__10__q;
+        normal_in__10__clock = clock;
+        kd_in__10__clock = clock;
+        busy__11__clock = clock;
+        busy__11__d = busy__11__q;
+        ready__11__clock = clock;
+        ready__11__d = ready__11__q;
+        step__11__clock = clock;
+        step__11__d = step__11__q;
+        light__11__clock = clock;
+        light__11__d = light__11__q;
+        flip__11__clock = clock;
+        flip__11__d = flip__11__q;
+        miss__11__clock = clock;
+        miss__11__d = miss__11__q;
+        normal_in__11__clock = clock;
+        kd_in__11__clock = clock;
+        busy__12__clock = clock;
+        busy__12__d = busy__12__q;
+        ready__12__clock = clock;
+        ready__12__d = ready__12__q;
+        step__12__clock = clock;
+        step__12__d = step__12__q;
+        light__12__clock = clock;
+        light__12__d = light__12__q;
+        flip__12__clock = clock;
+        flip__12__d = flip__12__q;
+        miss__12__clock = clock;
+        miss__12__d = miss__12__q;
+        normal_in__12__clock = clock;
+        kd_in__12__clock = clock;
+        busy__13__clock = clock;
+        busy__13__d = busy__13__q;
+        ready__13__clock = clock;
+        ready__13__d = ready__13__q;
+        step__13__clock = clock;
+        step__13__d = step__13__q;
+        light__13__clock = clock;
+        light__13__d = light__13__q;
+        flip__13__clock = clock;
+        flip__13__d = flip__13__q;
+        miss__13__clock = clock;
+        miss__13__d = miss__13__q;
+        normal_in__13__clock = clock;
+        kd_in__13__clock = clock;
+        busy__14__clock = clock;
+        busy__14__d = busy__14__q;
+        ready__14__clock = clock;
+        ready__14__d = ready__14__q;
+        step__14__clock = clock;
+        step__14__d = step__14__q;
+        light__14__clock = clock;
+        light__14__d = light__14__q;
+        flip__14__clock = clock;
+        flip__14__d = flip__14__q;
+        miss__14__clock = clock;
+        miss__14__d = miss__14__q;
+        normal_in__14__clock = clock;
+        kd_in__14__clock = clock;
+        busy__15__clock = clock;
+        busy__15__d = busy__15__q;
+        ready__15__clock = clock;
+        ready__15__d = ready__15__q;
+        step__15__clock = clock;
+        step__15__d = step__15__q;
+        light__15__clock = clock;
+        light__15__d = light__15__q;
+        flip__15__clock = clock;
+        flip__15__d = flip__15__q;
+        miss__15__clock = clock;
+        miss__15__d = miss__15__q;
+        normal_in__15__clock = clock;
+        kd_in__15__clock = clock;
         background__0__clock = clock;
         background__0__d = background__0__q;
         gen_hold_v__0__clock = clock;
@@ -19180,12 +19844,12 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         frame_addr_l = const_addr__q;
         frame_tag = 32'h0;
         if (const_go) begin
-            frame_tag = (((const_word__q) & 9'h1ff) << 32'h6) | (((const_light__q) & 9'h1ff) << 32'h3) | c_valid9;
+            frame_tag = (((const_word__q) & 10'h3ff) << 32'h7) | (((const_light__q) & 10'h3ff) << 32'h3) | c_valid10;
             if (const_lights__q) begin
-                frame_tag = frame_tag | (((c_kind_light) & 9'h1ff) << 32'h1);
+                frame_tag = frame_tag | (((c_kind_light) & 10'h3ff) << 32'h1);
             end
             else begin
-                frame_tag = frame_tag | (((c_kind_const) & 9'h1ff) << 32'h1);
+                frame_tag = frame_tag | (((c_kind_const) & 10'h3ff) << 32'h1);
             end
             const_issued__d = const_issued__q + 32'h1;
             const_addr__d = const_addr__q + 32'h1;
@@ -19203,10 +19867,10 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         sqrt__in_valid = 1'b0;
         sqrt__a = l_dot_l__read_data;
         cos_n_dot_l__data_in = n_dot_l__read_data;
-        cos_slot__data_in = ((s1_slot__q) & 4'hf) << 32'h1;
+        cos_slot__data_in = ((s1_slot__q) & 5'h1f) << 32'h1;
         byte_valid_l = 1'b0;
         byte_word_l = acc__0__read_data;
-        byte_tag_in = (((s1_word__q) & 6'h3f) << 32'h4) | (((s1_slot__q) & 6'h3f) << 32'h1);
+        byte_tag_in = (((s1_word__q) & 7'h7f) << 32'h5) | (((s1_slot__q) & 7'h7f) << 32'h1);
         fb_write_l = 1'b0;
         fb_addr = addr__read_data + c_fb_base;
         fb_data = ((rgb__read_data) & 32'hffffffff);
@@ -19357,7 +20021,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             if (s1_tri_load__q) begin
                 tri_read_l = 1'b1;
                 if (tri_grant) begin
-                    tri_tag = (((s1_word__q) & 9'h1ff) << 32'h6) | (((s1_slot__q) & 9'h1ff) << 32'h3) | (((c_kind_tri) & 9'h1ff) << 32'h1) | c_valid9;
+                    tri_tag = (((s1_word__q) & 10'h3ff) << 32'h7) | (((s1_slot__q) & 10'h3ff) << 32'h3) | (((c_kind_tri) & 10'h3ff) << 32'h1) | c_valid10;
                     s1_word__d = s1_word__q + 32'h1;
                     if (s1_word__q == 32'h1) begin
                         s1_granted__d = 1'b1;
@@ -19368,7 +20032,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 frame_read_l = 1'b1;
                 frame_addr_l = (material__read_data << 32'h2) + c_materials + ((s1_word__q) & 24'hffffff);
                 if (frame_grant) begin
-                    frame_tag = (((s1_word__q) & 9'h1ff) << 32'h6) | (((s1_slot__q) & 9'h1ff) << 32'h3) | (((c_kind_kd) & 9'h1ff) << 32'h1) | c_valid9;
+                    frame_tag = (((s1_word__q) & 10'h3ff) << 32'h7) | (((s1_slot__q) & 10'h3ff) << 32'h3) | (((c_kind_kd) & 10'h3ff) << 32'h1) | c_valid10;
                     s1_word__d = s1_word__q + 32'h1;
                     if (s1_word__q == 32'h2) begin
                         s1_granted__d = 1'b1;
@@ -19379,12 +20043,12 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (s1_valid__q) begin
             if (s1_cosine__q) begin
                 sqrt__in_valid = 1'b1;
-                cos_slot__data_in = (((s1_slot__q) & 4'hf) << 32'h1) | c_valid4;
+                cos_slot__data_in = (((s1_slot__q) & 5'h1f) << 32'h1) | c_valid5;
                 s1_done = 1'b1;
             end
             if (s1_pack__q) begin
                 byte_valid_l = 1'b1;
-                byte_tag_in = byte_tag_in | c_valid6;
+                byte_tag_in = byte_tag_in | c_valid7;
                 s1_word__d = s1_word__q + 32'h1;
                 if (s1_word__q == 32'h2) begin
                     s1_done = 1'b1;
@@ -19436,6 +20100,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         any_ready_before__6 = any_ready_before__5 | (ready__5__q & busy__5__q);
         any_ready_before__7 = any_ready_before__6 | (ready__6__q & busy__6__q);
         any_ready_before__8 = any_ready_before__7 | (ready__7__q & busy__7__q);
+        any_ready_before__9 = any_ready_before__8 | (ready__8__q & busy__8__q);
+        any_ready_before__10 = any_ready_before__9 | (ready__9__q & busy__9__q);
+        any_ready_before__11 = any_ready_before__10 | (ready__10__q & busy__10__q);
+        any_ready_before__12 = any_ready_before__11 | (ready__11__q & busy__11__q);
+        any_ready_before__13 = any_ready_before__12 | (ready__12__q & busy__12__q);
+        any_ready_before__14 = any_ready_before__13 | (ready__13__q & busy__13__q);
+        any_ready_before__15 = any_ready_before__14 | (ready__14__q & busy__14__q);
+        any_ready_before__16 = any_ready_before__15 | (ready__15__q & busy__15__q);
         if (ready__0__q & busy__0__q & (~any_ready_before__0)) begin
             ready_slot = c_slot__0;
         end
@@ -19460,7 +20132,31 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         if (ready__7__q & busy__7__q & (~any_ready_before__7)) begin
             ready_slot = c_slot__7;
         end
-        pick = any_ready_before__8 & (~s0_valid__q);
+        if (ready__8__q & busy__8__q & (~any_ready_before__8)) begin
+            ready_slot = c_slot__8;
+        end
+        if (ready__9__q & busy__9__q & (~any_ready_before__9)) begin
+            ready_slot = c_slot__9;
+        end
+        if (ready__10__q & busy__10__q & (~any_ready_before__10)) begin
+            ready_slot = c_slot__10;
+        end
+        if (ready__11__q & busy__11__q & (~any_ready_before__11)) begin
+            ready_slot = c_slot__11;
+        end
+        if (ready__12__q & busy__12__q & (~any_ready_before__12)) begin
+            ready_slot = c_slot__12;
+        end
+        if (ready__13__q & busy__13__q & (~any_ready_before__13)) begin
+            ready_slot = c_slot__13;
+        end
+        if (ready__14__q & busy__14__q & (~any_ready_before__14)) begin
+            ready_slot = c_slot__14;
+        end
+        if (ready__15__q & busy__15__q & (~any_ready_before__15)) begin
+            ready_slot = c_slot__15;
+        end
+        pick = any_ready_before__16 & (~s0_valid__q);
         pick_step = ShadeStep__Idle;
         pick_light = 32'h0;
         pick_flip = 1'b0;
@@ -19513,6 +20209,54 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             pick_flip = flip__7__q;
             pick_miss = miss__7__q;
         end
+        if (ready_slot == c_slot__8) begin
+            pick_step = step__8__q;
+            pick_light = light__8__q;
+            pick_flip = flip__8__q;
+            pick_miss = miss__8__q;
+        end
+        if (ready_slot == c_slot__9) begin
+            pick_step = step__9__q;
+            pick_light = light__9__q;
+            pick_flip = flip__9__q;
+            pick_miss = miss__9__q;
+        end
+        if (ready_slot == c_slot__10) begin
+            pick_step = step__10__q;
+            pick_light = light__10__q;
+            pick_flip = flip__10__q;
+            pick_miss = miss__10__q;
+        end
+        if (ready_slot == c_slot__11) begin
+            pick_step = step__11__q;
+            pick_light = light__11__q;
+            pick_flip = flip__11__q;
+            pick_miss = miss__11__q;
+        end
+        if (ready_slot == c_slot__12) begin
+            pick_step = step__12__q;
+            pick_light = light__12__q;
+            pick_flip = flip__12__q;
+            pick_miss = miss__12__q;
+        end
+        if (ready_slot == c_slot__13) begin
+            pick_step = step__13__q;
+            pick_light = light__13__q;
+            pick_flip = flip__13__q;
+            pick_miss = miss__13__q;
+        end
+        if (ready_slot == c_slot__14) begin
+            pick_step = step__14__q;
+            pick_light = light__14__q;
+            pick_flip = flip__14__q;
+            pick_miss = miss__14__q;
+        end
+        if (ready_slot == c_slot__15) begin
+            pick_step = step__15__q;
+            pick_light = light__15__q;
+            pick_flip = flip__15__q;
+            pick_miss = miss__15__q;
+        end
         if (pick) begin
             s0_valid__d = 1'b1;
             s0_slot__d = ready_slot;
@@ -19554,6 +20298,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         occupied__5 = busy__5__q | (take_r__q & (take_slot_r__q == c_slot__5));
         occupied__6 = busy__6__q | (take_r__q & (take_slot_r__q == c_slot__6));
         occupied__7 = busy__7__q | (take_r__q & (take_slot_r__q == c_slot__7));
+        occupied__8 = busy__8__q | (take_r__q & (take_slot_r__q == c_slot__8));
+        occupied__9 = busy__9__q | (take_r__q & (take_slot_r__q == c_slot__9));
+        occupied__10 = busy__10__q | (take_r__q & (take_slot_r__q == c_slot__10));
+        occupied__11 = busy__11__q | (take_r__q & (take_slot_r__q == c_slot__11));
+        occupied__12 = busy__12__q | (take_r__q & (take_slot_r__q == c_slot__12));
+        occupied__13 = busy__13__q | (take_r__q & (take_slot_r__q == c_slot__13));
+        occupied__14 = busy__14__q | (take_r__q & (take_slot_r__q == c_slot__14));
+        occupied__15 = busy__15__q | (take_r__q & (take_slot_r__q == c_slot__15));
         any_free_before__0 = 1'b0;
         any_free_after_take__0 = 1'b0;
         any_free_before__1 = any_free_before__0 | (~occupied__0);
@@ -19572,10 +20324,26 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         any_free_after_take__7 = any_free_after_take__6 | ((~occupied__6) & (free_slot_r__q != c_slot__6));
         any_free_before__8 = any_free_before__7 | (~occupied__7);
         any_free_after_take__8 = any_free_after_take__7 | ((~occupied__7) & (free_slot_r__q != c_slot__7));
+        any_free_before__9 = any_free_before__8 | (~occupied__8);
+        any_free_after_take__9 = any_free_after_take__8 | ((~occupied__8) & (free_slot_r__q != c_slot__8));
+        any_free_before__10 = any_free_before__9 | (~occupied__9);
+        any_free_after_take__10 = any_free_after_take__9 | ((~occupied__9) & (free_slot_r__q != c_slot__9));
+        any_free_before__11 = any_free_before__10 | (~occupied__10);
+        any_free_after_take__11 = any_free_after_take__10 | ((~occupied__10) & (free_slot_r__q != c_slot__10));
+        any_free_before__12 = any_free_before__11 | (~occupied__11);
+        any_free_after_take__12 = any_free_after_take__11 | ((~occupied__11) & (free_slot_r__q != c_slot__11));
+        any_free_before__13 = any_free_before__12 | (~occupied__12);
+        any_free_after_take__13 = any_free_after_take__12 | ((~occupied__12) & (free_slot_r__q != c_slot__12));
+        any_free_before__14 = any_free_before__13 | (~occupied__13);
+        any_free_after_take__14 = any_free_after_take__13 | ((~occupied__13) & (free_slot_r__q != c_slot__13));
+        any_free_before__15 = any_free_before__14 | (~occupied__14);
+        any_free_after_take__15 = any_free_after_take__14 | ((~occupied__14) & (free_slot_r__q != c_slot__14));
+        any_free_before__16 = any_free_before__15 | (~occupied__15);
+        any_free_after_take__16 = any_free_after_take__15 | ((~occupied__15) & (free_slot_r__q != c_slot__15));
         free_slot_r__d = 32'h0;
-        has_free_r__d = any_free_before__8;
+        has_free_r__d = any_free_before__16;
         if (taken) begin
-            has_free_r__d = any_free_after_take__8;
+            has_free_r__d = any_free_after_take__16;
         end
         if (taken) begin
             if ((~occupied__0) & (free_slot_r__q != c_slot__0) & (~any_free_after_take__0)) begin
@@ -19641,6 +20409,70 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         else if ((~occupied__7) & (~any_free_before__7)) begin
             free_slot_r__d = c_slot__7;
         end
+        if (taken) begin
+            if ((~occupied__8) & (free_slot_r__q != c_slot__8) & (~any_free_after_take__8)) begin
+                free_slot_r__d = c_slot__8;
+            end
+        end
+        else if ((~occupied__8) & (~any_free_before__8)) begin
+            free_slot_r__d = c_slot__8;
+        end
+        if (taken) begin
+            if ((~occupied__9) & (free_slot_r__q != c_slot__9) & (~any_free_after_take__9)) begin
+                free_slot_r__d = c_slot__9;
+            end
+        end
+        else if ((~occupied__9) & (~any_free_before__9)) begin
+            free_slot_r__d = c_slot__9;
+        end
+        if (taken) begin
+            if ((~occupied__10) & (free_slot_r__q != c_slot__10) & (~any_free_after_take__10)) begin
+                free_slot_r__d = c_slot__10;
+            end
+        end
+        else if ((~occupied__10) & (~any_free_before__10)) begin
+            free_slot_r__d = c_slot__10;
+        end
+        if (taken) begin
+            if ((~occupied__11) & (free_slot_r__q != c_slot__11) & (~any_free_after_take__11)) begin
+                free_slot_r__d = c_slot__11;
+            end
+        end
+        else if ((~occupied__11) & (~any_free_before__11)) begin
+            free_slot_r__d = c_slot__11;
+        end
+        if (taken) begin
+            if ((~occupied__12) & (free_slot_r__q != c_slot__12) & (~any_free_after_take__12)) begin
+                free_slot_r__d = c_slot__12;
+            end
+        end
+        else if ((~occupied__12) & (~any_free_before__12)) begin
+            free_slot_r__d = c_slot__12;
+        end
+        if (taken) begin
+            if ((~occupied__13) & (free_slot_r__q != c_slot__13) & (~any_free_after_take__13)) begin
+                free_slot_r__d = c_slot__13;
+            end
+        end
+        else if ((~occupied__13) & (~any_free_before__13)) begin
+            free_slot_r__d = c_slot__13;
+        end
+        if (taken) begin
+            if ((~occupied__14) & (free_slot_r__q != c_slot__14) & (~any_free_after_take__14)) begin
+                free_slot_r__d = c_slot__14;
+            end
+        end
+        else if ((~occupied__14) & (~any_free_before__14)) begin
+            free_slot_r__d = c_slot__14;
+        end
+        if (taken) begin
+            if ((~occupied__15) & (free_slot_r__q != c_slot__15) & (~any_free_after_take__15)) begin
+                free_slot_r__d = c_slot__15;
+            end
+        end
+        else if ((~occupied__15) & (~any_free_before__15)) begin
+            free_slot_r__d = c_slot__15;
+        end
         o__0__write_address = free_slot_r__q;
         o__0__write_enable = taken;
         o__0__write_data = rays__0__read_data;
@@ -19674,40 +20506,56 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         frame_arrived_r__d = frame_line__data_out;
         tri_arrived = tri_arrived_r__q;
         frame_arrived = frame_arrived_r__q;
-        normal_in__0__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__0);
-        kd_in__0__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__0);
-        normal_in__1__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__1);
-        kd_in__1__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__1);
-        normal_in__2__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__2);
-        kd_in__2__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__2);
-        normal_in__3__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__3);
-        kd_in__3__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__3);
-        normal_in__4__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__4);
-        kd_in__4__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__4);
-        normal_in__5__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__5);
-        kd_in__5__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__5);
-        normal_in__6__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__6);
-        kd_in__6__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__6);
-        normal_in__7__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h6] & (tri_line__data_out[(32'h3)+:(3)] == c_slot__7);
-        kd_in__7__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h6)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(3)] == c_slot__7);
-        n__0__write_address = tri_arrived[(32'h3)+:(3)];
-        n__1__write_address = tri_arrived[(32'h3)+:(3)];
-        n__2__write_address = tri_arrived[(32'h3)+:(3)];
+        normal_in__0__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__0);
+        kd_in__0__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__0);
+        normal_in__1__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__1);
+        kd_in__1__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__1);
+        normal_in__2__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__2);
+        kd_in__2__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__2);
+        normal_in__3__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__3);
+        kd_in__3__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__3);
+        normal_in__4__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__4);
+        kd_in__4__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__4);
+        normal_in__5__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__5);
+        kd_in__5__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__5);
+        normal_in__6__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__6);
+        kd_in__6__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__6);
+        normal_in__7__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__7);
+        kd_in__7__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__7);
+        normal_in__8__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__8);
+        kd_in__8__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__8);
+        normal_in__9__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__9);
+        kd_in__9__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__9);
+        normal_in__10__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__10);
+        kd_in__10__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__10);
+        normal_in__11__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__11);
+        kd_in__11__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__11);
+        normal_in__12__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__12);
+        kd_in__12__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__12);
+        normal_in__13__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__13);
+        kd_in__13__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__13);
+        normal_in__14__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__14);
+        kd_in__14__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__14);
+        normal_in__15__d = tri_line__data_out[32'h0] & tri_line__data_out[32'h7] & (tri_line__data_out[(32'h3)+:(4)] == c_slot__15);
+        kd_in__15__d = frame_line__data_out[32'h0] & (frame_line__data_out[(32'h1)+:(2)] == c_kind_kd) & (frame_line__data_out[(32'h7)+:(3)] == 32'h2) & (frame_line__data_out[(32'h3)+:(4)] == c_slot__15);
+        n__0__write_address = tri_arrived[(32'h3)+:(4)];
+        n__1__write_address = tri_arrived[(32'h3)+:(4)];
+        n__2__write_address = tri_arrived[(32'h3)+:(4)];
         n__0__write_data = tri_rdata_a[(32'h0)+:(24)];
         n__1__write_data = tri_rdata_a[(32'h0)+:(24)];
         n__2__write_data = tri_rdata_b[(32'h0)+:(24)];
-        material__write_address = tri_arrived[(32'h3)+:(3)];
+        material__write_address = tri_arrived[(32'h3)+:(4)];
         material__write_data = tri_rdata_b[(32'h0)+:(24)];
-        tri_word_0 = tri_arrived[32'h0] & (~tri_arrived[32'h6]);
-        tri_word_1 = tri_arrived[32'h0] & tri_arrived[32'h6];
+        tri_word_0 = tri_arrived[32'h0] & (~tri_arrived[32'h7]);
+        tri_word_1 = tri_arrived[32'h0] & tri_arrived[32'h7];
         n__0__write_enable = tri_word_0;
         n__2__write_enable = tri_word_0;
         n__1__write_enable = tri_word_1;
         material__write_enable = tri_word_1;
         frame_valid = frame_arrived[32'h0];
         frame_kind = frame_arrived[(32'h1)+:(2)];
-        frame_word = frame_arrived[(32'h6)+:(3)];
-        kd__0__write_address = frame_arrived[(32'h3)+:(3)];
+        frame_word = frame_arrived[(32'h7)+:(3)];
+        kd__0__write_address = frame_arrived[(32'h3)+:(4)];
         kd__0__write_data = frame_rdata[(32'h0)+:(24)];
         kd__0__write_enable = 1'b0;
         light_position__0__write_address = frame_arrived[(32'h3)+:(3)];
@@ -19716,7 +20564,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         light_color__0__write_address = frame_arrived[(32'h3)+:(3)];
         light_color__0__write_data = frame_rdata[(32'h0)+:(24)];
         light_color__0__write_enable = 1'b0;
-        kd__1__write_address = frame_arrived[(32'h3)+:(3)];
+        kd__1__write_address = frame_arrived[(32'h3)+:(4)];
         kd__1__write_data = frame_rdata[(32'h0)+:(24)];
         kd__1__write_enable = 1'b0;
         light_position__1__write_address = frame_arrived[(32'h3)+:(3)];
@@ -19725,7 +20573,7 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         light_color__1__write_address = frame_arrived[(32'h3)+:(3)];
         light_color__1__write_data = frame_rdata[(32'h0)+:(24)];
         light_color__1__write_enable = 1'b0;
-        kd__2__write_address = frame_arrived[(32'h3)+:(3)];
+        kd__2__write_address = frame_arrived[(32'h3)+:(4)];
         kd__2__write_data = frame_rdata[(32'h0)+:(24)];
         kd__2__write_enable = 1'b0;
         light_position__2__write_address = frame_arrived[(32'h3)+:(3)];
@@ -19831,6 +20679,38 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             res_step_r__d = step__7__q;
             res_light_r__d = light__7__q;
         end
+        if (res_slot == c_slot__8) begin
+            res_step_r__d = step__8__q;
+            res_light_r__d = light__8__q;
+        end
+        if (res_slot == c_slot__9) begin
+            res_step_r__d = step__9__q;
+            res_light_r__d = light__9__q;
+        end
+        if (res_slot == c_slot__10) begin
+            res_step_r__d = step__10__q;
+            res_light_r__d = light__10__q;
+        end
+        if (res_slot == c_slot__11) begin
+            res_step_r__d = step__11__q;
+            res_light_r__d = light__11__q;
+        end
+        if (res_slot == c_slot__12) begin
+            res_step_r__d = step__12__q;
+            res_light_r__d = light__12__q;
+        end
+        if (res_slot == c_slot__13) begin
+            res_step_r__d = step__13__q;
+            res_light_r__d = light__13__q;
+        end
+        if (res_slot == c_slot__14) begin
+            res_step_r__d = step__14__q;
+            res_light_r__d = light__14__q;
+        end
+        if (res_slot == c_slot__15) begin
+            res_step_r__d = step__15__q;
+            res_light_r__d = light__15__q;
+        end
         res_positive = (~|(res_v_r__0__q & c_sign)) & |(res_v_r__0__q & c_exp_mask) & (~(((res_v_r__0__q & c_exp_mask) == c_exp_mask) & |(res_v_r__0__q & c_man_mask)));
         p__0__write_address = res_slot_r__q;
         p__0__write_data = res_v_r__0__q;
@@ -19877,16 +20757,16 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         div__in_valid = sqrt__out_valid;
         div__a = cos_n_dot_l__data_out;
         div__b = sqrt__result;
-        cos__write_address = cos_slot__data_out[(32'h1)+:(3)];
+        cos__write_address = cos_slot__data_out[(32'h1)+:(4)];
         cos__write_data = div__result;
         cos__write_enable = cos_slot__data_out[32'h0];
-        rgb__write_address = byte_tag__data_out[(32'h1)+:(3)];
+        rgb__write_address = byte_tag__data_out[(32'h1)+:(4)];
         rgb_next = (rgb_acc__q << 32'h8) | ((byte_unit__result) & 24'hffffff);
         rgb__write_data = rgb_next;
         rgb__write_enable = 1'b0;
         if (byte_tag__data_out[32'h0]) begin
             rgb_acc__d = rgb_next;
-            if (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) begin
+            if (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) begin
                 rgb__write_enable = 1'b1;
             end
         end
@@ -19949,11 +20829,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 step__0__d = ShadeStep__Cosine;
             end
         end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__0)) begin
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__0)) begin
             ready__0__d = 1'b1;
             step__0__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__0)) begin
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__0)) begin
             ready__0__d = 1'b1;
             step__0__d = ShadeStep__Store;
         end
@@ -20015,11 +20895,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 step__1__d = ShadeStep__Cosine;
             end
         end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__1)) begin
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__1)) begin
             ready__1__d = 1'b1;
             step__1__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__1)) begin
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__1)) begin
             ready__1__d = 1'b1;
             step__1__d = ShadeStep__Store;
         end
@@ -20081,11 +20961,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 step__2__d = ShadeStep__Cosine;
             end
         end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__2)) begin
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__2)) begin
             ready__2__d = 1'b1;
             step__2__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__2)) begin
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__2)) begin
             ready__2__d = 1'b1;
             step__2__d = ShadeStep__Store;
         end
@@ -20147,11 +21027,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 step__3__d = ShadeStep__Cosine;
             end
         end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__3)) begin
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__3)) begin
             ready__3__d = 1'b1;
             step__3__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__3)) begin
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__3)) begin
             ready__3__d = 1'b1;
             step__3__d = ShadeStep__Store;
         end
@@ -20213,11 +21093,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 step__4__d = ShadeStep__Cosine;
             end
         end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__4)) begin
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__4)) begin
             ready__4__d = 1'b1;
             step__4__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__4)) begin
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__4)) begin
             ready__4__d = 1'b1;
             step__4__d = ShadeStep__Store;
         end
@@ -20279,11 +21159,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 step__5__d = ShadeStep__Cosine;
             end
         end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__5)) begin
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__5)) begin
             ready__5__d = 1'b1;
             step__5__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__5)) begin
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__5)) begin
             ready__5__d = 1'b1;
             step__5__d = ShadeStep__Store;
         end
@@ -20345,11 +21225,11 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 step__6__d = ShadeStep__Cosine;
             end
         end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__6)) begin
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__6)) begin
             ready__6__d = 1'b1;
             step__6__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__6)) begin
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__6)) begin
             ready__6__d = 1'b1;
             step__6__d = ShadeStep__Store;
         end
@@ -20411,13 +21291,541 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
                 step__7__d = ShadeStep__Cosine;
             end
         end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(3)] == c_slot__7)) begin
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__7)) begin
             ready__7__d = 1'b1;
             step__7__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h4)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(3)] == c_slot__7)) begin
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__7)) begin
             ready__7__d = 1'b1;
             step__7__d = ShadeStep__Store;
+        end
+        if (take_r__q & (take_slot_r__q == c_slot__8)) begin
+            busy__8__d = 1'b1;
+            ready__8__d = 1'b1;
+            miss__8__d = ~take_hit_r__q;
+            flip__8__d = 1'b0;
+            light__8__d = 32'h0;
+            step__8__d = ShadeStep__TriLoad;
+            if (~take_hit_r__q) begin
+                step__8__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__8)) begin
+            ready__8__d = 1'b0;
+        end
+        if (stored_r__q & (stored_slot_r__q == c_slot__8)) begin
+            busy__8__d = 1'b0;
+            step__8__d = ShadeStep__Idle;
+        end
+        if (normal_in__8__q) begin
+            ready__8__d = 1'b1;
+            step__8__d = ShadeStep__Point;
+        end
+        if (kd_in__8__q) begin
+            ready__8__d = 1'b1;
+            step__8__d = ShadeStep__Ambient;
+        end
+        if (res_valid_r__q & (res_slot_r__q == c_slot__8)) begin
+            ready__8__d = 1'b1;
+            if (res_step_r__q == ShadeStep__Point) begin
+                step__8__d = ShadeStep__NormalDot;
+            end
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__8__d = res_positive;
+                step__8__d = ShadeStep__KdLoad;
+            end
+            if (res_step_r__q == ShadeStep__Ambient) begin
+                step__8__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__8__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step_r__q == ShadeStep__ToLight) begin
+                step__8__d = ShadeStep__Dots;
+            end
+            if (res_step_r__q == ShadeStep__Tint) begin
+                step__8__d = ShadeStep__Accumulate;
+            end
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
+                step__8__d = ShadeStep__ToLight;
+                light__8__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
+                    step__8__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
+                step__8__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__8)) begin
+            ready__8__d = 1'b1;
+            step__8__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__8)) begin
+            ready__8__d = 1'b1;
+            step__8__d = ShadeStep__Store;
+        end
+        if (take_r__q & (take_slot_r__q == c_slot__9)) begin
+            busy__9__d = 1'b1;
+            ready__9__d = 1'b1;
+            miss__9__d = ~take_hit_r__q;
+            flip__9__d = 1'b0;
+            light__9__d = 32'h0;
+            step__9__d = ShadeStep__TriLoad;
+            if (~take_hit_r__q) begin
+                step__9__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__9)) begin
+            ready__9__d = 1'b0;
+        end
+        if (stored_r__q & (stored_slot_r__q == c_slot__9)) begin
+            busy__9__d = 1'b0;
+            step__9__d = ShadeStep__Idle;
+        end
+        if (normal_in__9__q) begin
+            ready__9__d = 1'b1;
+            step__9__d = ShadeStep__Point;
+        end
+        if (kd_in__9__q) begin
+            ready__9__d = 1'b1;
+            step__9__d = ShadeStep__Ambient;
+        end
+        if (res_valid_r__q & (res_slot_r__q == c_slot__9)) begin
+            ready__9__d = 1'b1;
+            if (res_step_r__q == ShadeStep__Point) begin
+                step__9__d = ShadeStep__NormalDot;
+            end
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__9__d = res_positive;
+                step__9__d = ShadeStep__KdLoad;
+            end
+            if (res_step_r__q == ShadeStep__Ambient) begin
+                step__9__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__9__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step_r__q == ShadeStep__ToLight) begin
+                step__9__d = ShadeStep__Dots;
+            end
+            if (res_step_r__q == ShadeStep__Tint) begin
+                step__9__d = ShadeStep__Accumulate;
+            end
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
+                step__9__d = ShadeStep__ToLight;
+                light__9__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
+                    step__9__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
+                step__9__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__9)) begin
+            ready__9__d = 1'b1;
+            step__9__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__9)) begin
+            ready__9__d = 1'b1;
+            step__9__d = ShadeStep__Store;
+        end
+        if (take_r__q & (take_slot_r__q == c_slot__10)) begin
+            busy__10__d = 1'b1;
+            ready__10__d = 1'b1;
+            miss__10__d = ~take_hit_r__q;
+            flip__10__d = 1'b0;
+            light__10__d = 32'h0;
+            step__10__d = ShadeStep__TriLoad;
+            if (~take_hit_r__q) begin
+                step__10__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__10)) begin
+            ready__10__d = 1'b0;
+        end
+        if (stored_r__q & (stored_slot_r__q == c_slot__10)) begin
+            busy__10__d = 1'b0;
+            step__10__d = ShadeStep__Idle;
+        end
+        if (normal_in__10__q) begin
+            ready__10__d = 1'b1;
+            step__10__d = ShadeStep__Point;
+        end
+        if (kd_in__10__q) begin
+            ready__10__d = 1'b1;
+            step__10__d = ShadeStep__Ambient;
+        end
+        if (res_valid_r__q & (res_slot_r__q == c_slot__10)) begin
+            ready__10__d = 1'b1;
+            if (res_step_r__q == ShadeStep__Point) begin
+                step__10__d = ShadeStep__NormalDot;
+            end
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__10__d = res_positive;
+                step__10__d = ShadeStep__KdLoad;
+            end
+            if (res_step_r__q == ShadeStep__Ambient) begin
+                step__10__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__10__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step_r__q == ShadeStep__ToLight) begin
+                step__10__d = ShadeStep__Dots;
+            end
+            if (res_step_r__q == ShadeStep__Tint) begin
+                step__10__d = ShadeStep__Accumulate;
+            end
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
+                step__10__d = ShadeStep__ToLight;
+                light__10__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
+                    step__10__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
+                step__10__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__10)) begin
+            ready__10__d = 1'b1;
+            step__10__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__10)) begin
+            ready__10__d = 1'b1;
+            step__10__d = ShadeStep__Store;
+        end
+        if (take_r__q & (take_slot_r__q == c_slot__11)) begin
+            busy__11__d = 1'b1;
+            ready__11__d = 1'b1;
+            miss__11__d = ~take_hit_r__q;
+            flip__11__d = 1'b0;
+            light__11__d = 32'h0;
+            step__11__d = ShadeStep__TriLoad;
+            if (~take_hit_r__q) begin
+                step__11__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__11)) begin
+            ready__11__d = 1'b0;
+        end
+        if (stored_r__q & (stored_slot_r__q == c_slot__11)) begin
+            busy__11__d = 1'b0;
+            step__11__d = ShadeStep__Idle;
+        end
+        if (normal_in__11__q) begin
+            ready__11__d = 1'b1;
+            step__11__d = ShadeStep__Point;
+        end
+        if (kd_in__11__q) begin
+            ready__11__d = 1'b1;
+            step__11__d = ShadeStep__Ambient;
+        end
+        if (res_valid_r__q & (res_slot_r__q == c_slot__11)) begin
+            ready__11__d = 1'b1;
+            if (res_step_r__q == ShadeStep__Point) begin
+                step__11__d = ShadeStep__NormalDot;
+            end
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__11__d = res_positive;
+                step__11__d = ShadeStep__KdLoad;
+            end
+            if (res_step_r__q == ShadeStep__Ambient) begin
+                step__11__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__11__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step_r__q == ShadeStep__ToLight) begin
+                step__11__d = ShadeStep__Dots;
+            end
+            if (res_step_r__q == ShadeStep__Tint) begin
+                step__11__d = ShadeStep__Accumulate;
+            end
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
+                step__11__d = ShadeStep__ToLight;
+                light__11__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
+                    step__11__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
+                step__11__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__11)) begin
+            ready__11__d = 1'b1;
+            step__11__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__11)) begin
+            ready__11__d = 1'b1;
+            step__11__d = ShadeStep__Store;
+        end
+        if (take_r__q & (take_slot_r__q == c_slot__12)) begin
+            busy__12__d = 1'b1;
+            ready__12__d = 1'b1;
+            miss__12__d = ~take_hit_r__q;
+            flip__12__d = 1'b0;
+            light__12__d = 32'h0;
+            step__12__d = ShadeStep__TriLoad;
+            if (~take_hit_r__q) begin
+                step__12__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__12)) begin
+            ready__12__d = 1'b0;
+        end
+        if (stored_r__q & (stored_slot_r__q == c_slot__12)) begin
+            busy__12__d = 1'b0;
+            step__12__d = ShadeStep__Idle;
+        end
+        if (normal_in__12__q) begin
+            ready__12__d = 1'b1;
+            step__12__d = ShadeStep__Point;
+        end
+        if (kd_in__12__q) begin
+            ready__12__d = 1'b1;
+            step__12__d = ShadeStep__Ambient;
+        end
+        if (res_valid_r__q & (res_slot_r__q == c_slot__12)) begin
+            ready__12__d = 1'b1;
+            if (res_step_r__q == ShadeStep__Point) begin
+                step__12__d = ShadeStep__NormalDot;
+            end
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__12__d = res_positive;
+                step__12__d = ShadeStep__KdLoad;
+            end
+            if (res_step_r__q == ShadeStep__Ambient) begin
+                step__12__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__12__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step_r__q == ShadeStep__ToLight) begin
+                step__12__d = ShadeStep__Dots;
+            end
+            if (res_step_r__q == ShadeStep__Tint) begin
+                step__12__d = ShadeStep__Accumulate;
+            end
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
+                step__12__d = ShadeStep__ToLight;
+                light__12__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
+                    step__12__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
+                step__12__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__12)) begin
+            ready__12__d = 1'b1;
+            step__12__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__12)) begin
+            ready__12__d = 1'b1;
+            step__12__d = ShadeStep__Store;
+        end
+        if (take_r__q & (take_slot_r__q == c_slot__13)) begin
+            busy__13__d = 1'b1;
+            ready__13__d = 1'b1;
+            miss__13__d = ~take_hit_r__q;
+            flip__13__d = 1'b0;
+            light__13__d = 32'h0;
+            step__13__d = ShadeStep__TriLoad;
+            if (~take_hit_r__q) begin
+                step__13__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__13)) begin
+            ready__13__d = 1'b0;
+        end
+        if (stored_r__q & (stored_slot_r__q == c_slot__13)) begin
+            busy__13__d = 1'b0;
+            step__13__d = ShadeStep__Idle;
+        end
+        if (normal_in__13__q) begin
+            ready__13__d = 1'b1;
+            step__13__d = ShadeStep__Point;
+        end
+        if (kd_in__13__q) begin
+            ready__13__d = 1'b1;
+            step__13__d = ShadeStep__Ambient;
+        end
+        if (res_valid_r__q & (res_slot_r__q == c_slot__13)) begin
+            ready__13__d = 1'b1;
+            if (res_step_r__q == ShadeStep__Point) begin
+                step__13__d = ShadeStep__NormalDot;
+            end
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__13__d = res_positive;
+                step__13__d = ShadeStep__KdLoad;
+            end
+            if (res_step_r__q == ShadeStep__Ambient) begin
+                step__13__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__13__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step_r__q == ShadeStep__ToLight) begin
+                step__13__d = ShadeStep__Dots;
+            end
+            if (res_step_r__q == ShadeStep__Tint) begin
+                step__13__d = ShadeStep__Accumulate;
+            end
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
+                step__13__d = ShadeStep__ToLight;
+                light__13__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
+                    step__13__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
+                step__13__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__13)) begin
+            ready__13__d = 1'b1;
+            step__13__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__13)) begin
+            ready__13__d = 1'b1;
+            step__13__d = ShadeStep__Store;
+        end
+        if (take_r__q & (take_slot_r__q == c_slot__14)) begin
+            busy__14__d = 1'b1;
+            ready__14__d = 1'b1;
+            miss__14__d = ~take_hit_r__q;
+            flip__14__d = 1'b0;
+            light__14__d = 32'h0;
+            step__14__d = ShadeStep__TriLoad;
+            if (~take_hit_r__q) begin
+                step__14__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__14)) begin
+            ready__14__d = 1'b0;
+        end
+        if (stored_r__q & (stored_slot_r__q == c_slot__14)) begin
+            busy__14__d = 1'b0;
+            step__14__d = ShadeStep__Idle;
+        end
+        if (normal_in__14__q) begin
+            ready__14__d = 1'b1;
+            step__14__d = ShadeStep__Point;
+        end
+        if (kd_in__14__q) begin
+            ready__14__d = 1'b1;
+            step__14__d = ShadeStep__Ambient;
+        end
+        if (res_valid_r__q & (res_slot_r__q == c_slot__14)) begin
+            ready__14__d = 1'b1;
+            if (res_step_r__q == ShadeStep__Point) begin
+                step__14__d = ShadeStep__NormalDot;
+            end
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__14__d = res_positive;
+                step__14__d = ShadeStep__KdLoad;
+            end
+            if (res_step_r__q == ShadeStep__Ambient) begin
+                step__14__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__14__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step_r__q == ShadeStep__ToLight) begin
+                step__14__d = ShadeStep__Dots;
+            end
+            if (res_step_r__q == ShadeStep__Tint) begin
+                step__14__d = ShadeStep__Accumulate;
+            end
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
+                step__14__d = ShadeStep__ToLight;
+                light__14__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
+                    step__14__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
+                step__14__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__14)) begin
+            ready__14__d = 1'b1;
+            step__14__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__14)) begin
+            ready__14__d = 1'b1;
+            step__14__d = ShadeStep__Store;
+        end
+        if (take_r__q & (take_slot_r__q == c_slot__15)) begin
+            busy__15__d = 1'b1;
+            ready__15__d = 1'b1;
+            miss__15__d = ~take_hit_r__q;
+            flip__15__d = 1'b0;
+            light__15__d = 32'h0;
+            step__15__d = ShadeStep__TriLoad;
+            if (~take_hit_r__q) begin
+                step__15__d = ShadeStep__Pack;
+            end
+        end
+        if (pick & (ready_slot == c_slot__15)) begin
+            ready__15__d = 1'b0;
+        end
+        if (stored_r__q & (stored_slot_r__q == c_slot__15)) begin
+            busy__15__d = 1'b0;
+            step__15__d = ShadeStep__Idle;
+        end
+        if (normal_in__15__q) begin
+            ready__15__d = 1'b1;
+            step__15__d = ShadeStep__Point;
+        end
+        if (kd_in__15__q) begin
+            ready__15__d = 1'b1;
+            step__15__d = ShadeStep__Ambient;
+        end
+        if (res_valid_r__q & (res_slot_r__q == c_slot__15)) begin
+            ready__15__d = 1'b1;
+            if (res_step_r__q == ShadeStep__Point) begin
+                step__15__d = ShadeStep__NormalDot;
+            end
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__15__d = res_positive;
+                step__15__d = ShadeStep__KdLoad;
+            end
+            if (res_step_r__q == ShadeStep__Ambient) begin
+                step__15__d = ShadeStep__Pack;
+                if (c_has_lights) begin
+                    step__15__d = ShadeStep__ToLight;
+                end
+            end
+            if (res_step_r__q == ShadeStep__ToLight) begin
+                step__15__d = ShadeStep__Dots;
+            end
+            if (res_step_r__q == ShadeStep__Tint) begin
+                step__15__d = ShadeStep__Accumulate;
+            end
+            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
+                step__15__d = ShadeStep__ToLight;
+                light__15__d = res_light_r__q + 32'h1;
+                if (res_light_r__q == c_last_light) begin
+                    step__15__d = ShadeStep__Pack;
+                end
+            end
+            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
+                step__15__d = ShadeStep__Cosine;
+            end
+        end
+        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__15)) begin
+            ready__15__d = 1'b1;
+            step__15__d = ShadeStep__Tint;
+        end
+        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__15)) begin
+            ready__15__d = 1'b1;
+            step__15__d = ShadeStep__Store;
         end
         if (frame_start) begin
             loading__d = 1'b1;
@@ -20437,6 +21845,14 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         any_busy = any_busy | busy__5__q;
         any_busy = any_busy | busy__6__q;
         any_busy = any_busy | busy__7__q;
+        any_busy = any_busy | busy__8__q;
+        any_busy = any_busy | busy__9__q;
+        any_busy = any_busy | busy__10__q;
+        any_busy = any_busy | busy__11__q;
+        any_busy = any_busy | busy__12__q;
+        any_busy = any_busy | busy__13__q;
+        any_busy = any_busy | busy__14__q;
+        any_busy = any_busy | busy__15__q;
         idle = (~loading__q) & (~any_busy) & (~take_r__q);
     end
     
@@ -20446,15 +21862,15 @@ endmodule // dynrt_processor__engine__shader
 module dynrt_processor__engine__shader__acc__0(read_address,read_data,write_clock,write_address,write_data,write_enable);
     
     // Module arguments
-    input wire  [2:0] read_address;
+    input wire  [3:0] read_address;
     output reg  [23:0] read_data;
     input wire  write_clock;
-    input wire  [2:0] write_address;
+    input wire  [3:0] write_address;
     input wire  [23:0] write_data;
     input wire  write_enable;
     
     // Update code (custom)
-    reg[23:0] mem[7:0];
+    reg[23:0] mem[15:0];
     
     initial begin
        mem[0] = 24'h0;
@@ -20465,6 +21881,14 @@ module dynrt_processor__engine__shader__acc__0(read_address,read_data,write_cloc
        mem[5] = 24'h0;
        mem[6] = 24'h0;
        mem[7] = 24'h0;
+       mem[8] = 24'h0;
+       mem[9] = 24'h0;
+       mem[10] = 24'h0;
+       mem[11] = 24'h0;
+       mem[12] = 24'h0;
+       mem[13] = 24'h0;
+       mem[14] = 24'h0;
+       mem[15] = 24'h0;
     end
     
     always @(*) begin
@@ -20509,108 +21933,124 @@ endmodule // dynrt_processor__engine__shader__acc__0
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__shader__byte_tag(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
-    input wire  [5:0] data_in;
-    output reg  [5:0] data_out;
+    input wire  [6:0] data_in;
+    output reg  [6:0] data_out;
     
     // Stub signals
-    reg  [5:0] stage__0__d;
-    wire  [5:0] stage__0__q;
+    reg  [6:0] stage__0__d;
+    wire  [6:0] stage__0__q;
     reg  stage__0__clock;
-    reg  [5:0] stage__1__d;
-    wire  [5:0] stage__1__q;
+    reg  [6:0] stage__1__d;
+    wire  [6:0] stage__1__q;
     reg  stage__1__clock;
-    reg  [5:0] stage__2__d;
-    wire  [5:0] stage__2__q;
+    reg  [6:0] stage__2__d;
+    wire  [6:0] stage__2__q;
     reg  stage__2__clock;
-    reg  [5:0] stage__3__d;
-    wire  [5:0] stage__3__q;
+    reg  [6:0] stage__3__d;
+    wire  [6:0] stage__3__q;
     reg  stage__3__clock;
-    reg  [5:0] stage__4__d;
-    wire  [5:0] stage__4__q;
+    reg  [6:0] stage__4__d;
+    wire  [6:0] stage__4__q;
     reg  stage__4__clock;
-    reg  [5:0] stage__5__d;
-    wire  [5:0] stage__5__q;
+    reg  [6:0] stage__5__d;
+    wire  [6:0] stage__5__q;
     reg  stage__5__clock;
-    reg  [5:0] stage__6__d;
-    wire  [5:0] stage__6__q;
+    reg  [6:0] stage__6__d;
+    wire  [6:0] stage__6__q;
     reg  stage__6__clock;
-    reg  [5:0] stage__7__d;
-    wire  [5:0] stage__7__q;
+    reg  [6:0] stage__7__d;
+    wire  [6:0] stage__7__q;
     reg  stage__7__clock;
-    reg  [5:0] stage__8__d;
-    wire  [5:0] stage__8__q;
+    reg  [6:0] stage__8__d;
+    wire  [6:0] stage__8__q;
     reg  stage__8__clock;
-    reg  [5:0] stage__9__d;
-    wire  [5:0] stage__9__q;
+    reg  [6:0] stage__9__d;
+    wire  [6:0] stage__9__q;
     reg  stage__9__clock;
-    reg  [5:0] stage__10__d;
-    wire  [5:0] stage__10__q;
+    reg  [6:0] stage__10__d;
+    wire  [6:0] stage__10__q;
     reg  stage__10__clock;
-    reg  [5:0] stage__11__d;
-    wire  [5:0] stage__11__q;
+    reg  [6:0] stage__11__d;
+    wire  [6:0] stage__11__q;
     reg  stage__11__clock;
     
     // Sub module instances
-    dynrt_processor__engine__mem_load_r stage__0(
+    dynrt_processor__engine__fp_units__add__al_exp stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor__engine__mem_load_r stage__1(
+    dynrt_processor__engine__fp_units__add__al_exp stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor__engine__mem_load_r stage__2(
+    dynrt_processor__engine__fp_units__add__al_exp stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor__engine__mem_load_r stage__3(
+    dynrt_processor__engine__fp_units__add__al_exp stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor__engine__mem_load_r stage__4(
+    dynrt_processor__engine__fp_units__add__al_exp stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor__engine__mem_load_r stage__5(
+    dynrt_processor__engine__fp_units__add__al_exp stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor__engine__mem_load_r stage__6(
+    dynrt_processor__engine__fp_units__add__al_exp stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor__engine__mem_load_r stage__7(
+    dynrt_processor__engine__fp_units__add__al_exp stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor__engine__mem_load_r stage__8(
+    dynrt_processor__engine__fp_units__add__al_exp stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor__engine__mem_load_r stage__9(
+    dynrt_processor__engine__fp_units__add__al_exp stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor__engine__mem_load_r stage__10(
+    dynrt_processor__engine__fp_units__add__al_exp stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor__engine__mem_load_r stage__11(
+    dynrt_processor__engine__fp_units__add__al_exp stage__11(
         .d(stage__11__d),
         .q(stage__11__q),
         .clock(stage__11__clock)
@@ -21153,280 +22593,280 @@ module dynrt_processor__engine__shader__cos_slot(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
-    input wire  [3:0] data_in;
-    output reg  [3:0] data_out;
+    input wire  [4:0] data_in;
+    output reg  [4:0] data_out;
     
     // Stub signals
-    reg  [3:0] stage__0__d;
-    wire  [3:0] stage__0__q;
+    reg  [4:0] stage__0__d;
+    wire  [4:0] stage__0__q;
     reg  stage__0__clock;
-    reg  [3:0] stage__1__d;
-    wire  [3:0] stage__1__q;
+    reg  [4:0] stage__1__d;
+    wire  [4:0] stage__1__q;
     reg  stage__1__clock;
-    reg  [3:0] stage__2__d;
-    wire  [3:0] stage__2__q;
+    reg  [4:0] stage__2__d;
+    wire  [4:0] stage__2__q;
     reg  stage__2__clock;
-    reg  [3:0] stage__3__d;
-    wire  [3:0] stage__3__q;
+    reg  [4:0] stage__3__d;
+    wire  [4:0] stage__3__q;
     reg  stage__3__clock;
-    reg  [3:0] stage__4__d;
-    wire  [3:0] stage__4__q;
+    reg  [4:0] stage__4__d;
+    wire  [4:0] stage__4__q;
     reg  stage__4__clock;
-    reg  [3:0] stage__5__d;
-    wire  [3:0] stage__5__q;
+    reg  [4:0] stage__5__d;
+    wire  [4:0] stage__5__q;
     reg  stage__5__clock;
-    reg  [3:0] stage__6__d;
-    wire  [3:0] stage__6__q;
+    reg  [4:0] stage__6__d;
+    wire  [4:0] stage__6__q;
     reg  stage__6__clock;
-    reg  [3:0] stage__7__d;
-    wire  [3:0] stage__7__q;
+    reg  [4:0] stage__7__d;
+    wire  [4:0] stage__7__q;
     reg  stage__7__clock;
-    reg  [3:0] stage__8__d;
-    wire  [3:0] stage__8__q;
+    reg  [4:0] stage__8__d;
+    wire  [4:0] stage__8__q;
     reg  stage__8__clock;
-    reg  [3:0] stage__9__d;
-    wire  [3:0] stage__9__q;
+    reg  [4:0] stage__9__d;
+    wire  [4:0] stage__9__q;
     reg  stage__9__clock;
-    reg  [3:0] stage__10__d;
-    wire  [3:0] stage__10__q;
+    reg  [4:0] stage__10__d;
+    wire  [4:0] stage__10__q;
     reg  stage__10__clock;
-    reg  [3:0] stage__11__d;
-    wire  [3:0] stage__11__q;
+    reg  [4:0] stage__11__d;
+    wire  [4:0] stage__11__q;
     reg  stage__11__clock;
-    reg  [3:0] stage__12__d;
-    wire  [3:0] stage__12__q;
+    reg  [4:0] stage__12__d;
+    wire  [4:0] stage__12__q;
     reg  stage__12__clock;
-    reg  [3:0] stage__13__d;
-    wire  [3:0] stage__13__q;
+    reg  [4:0] stage__13__d;
+    wire  [4:0] stage__13__q;
     reg  stage__13__clock;
-    reg  [3:0] stage__14__d;
-    wire  [3:0] stage__14__q;
+    reg  [4:0] stage__14__d;
+    wire  [4:0] stage__14__q;
     reg  stage__14__clock;
-    reg  [3:0] stage__15__d;
-    wire  [3:0] stage__15__q;
+    reg  [4:0] stage__15__d;
+    wire  [4:0] stage__15__q;
     reg  stage__15__clock;
-    reg  [3:0] stage__16__d;
-    wire  [3:0] stage__16__q;
+    reg  [4:0] stage__16__d;
+    wire  [4:0] stage__16__q;
     reg  stage__16__clock;
-    reg  [3:0] stage__17__d;
-    wire  [3:0] stage__17__q;
+    reg  [4:0] stage__17__d;
+    wire  [4:0] stage__17__q;
     reg  stage__17__clock;
-    reg  [3:0] stage__18__d;
-    wire  [3:0] stage__18__q;
+    reg  [4:0] stage__18__d;
+    wire  [4:0] stage__18__q;
     reg  stage__18__clock;
-    reg  [3:0] stage__19__d;
-    wire  [3:0] stage__19__q;
+    reg  [4:0] stage__19__d;
+    wire  [4:0] stage__19__q;
     reg  stage__19__clock;
-    reg  [3:0] stage__20__d;
-    wire  [3:0] stage__20__q;
+    reg  [4:0] stage__20__d;
+    wire  [4:0] stage__20__q;
     reg  stage__20__clock;
-    reg  [3:0] stage__21__d;
-    wire  [3:0] stage__21__q;
+    reg  [4:0] stage__21__d;
+    wire  [4:0] stage__21__q;
     reg  stage__21__clock;
-    reg  [3:0] stage__22__d;
-    wire  [3:0] stage__22__q;
+    reg  [4:0] stage__22__d;
+    wire  [4:0] stage__22__q;
     reg  stage__22__clock;
-    reg  [3:0] stage__23__d;
-    wire  [3:0] stage__23__q;
+    reg  [4:0] stage__23__d;
+    wire  [4:0] stage__23__q;
     reg  stage__23__clock;
-    reg  [3:0] stage__24__d;
-    wire  [3:0] stage__24__q;
+    reg  [4:0] stage__24__d;
+    wire  [4:0] stage__24__q;
     reg  stage__24__clock;
-    reg  [3:0] stage__25__d;
-    wire  [3:0] stage__25__q;
+    reg  [4:0] stage__25__d;
+    wire  [4:0] stage__25__q;
     reg  stage__25__clock;
-    reg  [3:0] stage__26__d;
-    wire  [3:0] stage__26__q;
+    reg  [4:0] stage__26__d;
+    wire  [4:0] stage__26__q;
     reg  stage__26__clock;
-    reg  [3:0] stage__27__d;
-    wire  [3:0] stage__27__q;
+    reg  [4:0] stage__27__d;
+    wire  [4:0] stage__27__q;
     reg  stage__27__clock;
-    reg  [3:0] stage__28__d;
-    wire  [3:0] stage__28__q;
+    reg  [4:0] stage__28__d;
+    wire  [4:0] stage__28__q;
     reg  stage__28__clock;
-    reg  [3:0] stage__29__d;
-    wire  [3:0] stage__29__q;
+    reg  [4:0] stage__29__d;
+    wire  [4:0] stage__29__q;
     reg  stage__29__clock;
-    reg  [3:0] stage__30__d;
-    wire  [3:0] stage__30__q;
+    reg  [4:0] stage__30__d;
+    wire  [4:0] stage__30__q;
     reg  stage__30__clock;
-    reg  [3:0] stage__31__d;
-    wire  [3:0] stage__31__q;
+    reg  [4:0] stage__31__d;
+    wire  [4:0] stage__31__q;
     reg  stage__31__clock;
-    reg  [3:0] stage__32__d;
-    wire  [3:0] stage__32__q;
+    reg  [4:0] stage__32__d;
+    wire  [4:0] stage__32__q;
     reg  stage__32__clock;
-    reg  [3:0] stage__33__d;
-    wire  [3:0] stage__33__q;
+    reg  [4:0] stage__33__d;
+    wire  [4:0] stage__33__q;
     reg  stage__33__clock;
     
     // Sub module instances
-    dynrt_processor__engine__instances__arrived stage__0(
+    dynrt_processor__engine__decode__t4 stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__1(
+    dynrt_processor__engine__decode__t4 stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__2(
+    dynrt_processor__engine__decode__t4 stage__2(
         .d(stage__2__d),
         .q(stage__2__q),
         .clock(stage__2__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__3(
+    dynrt_processor__engine__decode__t4 stage__3(
         .d(stage__3__d),
         .q(stage__3__q),
         .clock(stage__3__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__4(
+    dynrt_processor__engine__decode__t4 stage__4(
         .d(stage__4__d),
         .q(stage__4__q),
         .clock(stage__4__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__5(
+    dynrt_processor__engine__decode__t4 stage__5(
         .d(stage__5__d),
         .q(stage__5__q),
         .clock(stage__5__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__6(
+    dynrt_processor__engine__decode__t4 stage__6(
         .d(stage__6__d),
         .q(stage__6__q),
         .clock(stage__6__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__7(
+    dynrt_processor__engine__decode__t4 stage__7(
         .d(stage__7__d),
         .q(stage__7__q),
         .clock(stage__7__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__8(
+    dynrt_processor__engine__decode__t4 stage__8(
         .d(stage__8__d),
         .q(stage__8__q),
         .clock(stage__8__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__9(
+    dynrt_processor__engine__decode__t4 stage__9(
         .d(stage__9__d),
         .q(stage__9__q),
         .clock(stage__9__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__10(
+    dynrt_processor__engine__decode__t4 stage__10(
         .d(stage__10__d),
         .q(stage__10__q),
         .clock(stage__10__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__11(
+    dynrt_processor__engine__decode__t4 stage__11(
         .d(stage__11__d),
         .q(stage__11__q),
         .clock(stage__11__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__12(
+    dynrt_processor__engine__decode__t4 stage__12(
         .d(stage__12__d),
         .q(stage__12__q),
         .clock(stage__12__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__13(
+    dynrt_processor__engine__decode__t4 stage__13(
         .d(stage__13__d),
         .q(stage__13__q),
         .clock(stage__13__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__14(
+    dynrt_processor__engine__decode__t4 stage__14(
         .d(stage__14__d),
         .q(stage__14__q),
         .clock(stage__14__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__15(
+    dynrt_processor__engine__decode__t4 stage__15(
         .d(stage__15__d),
         .q(stage__15__q),
         .clock(stage__15__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__16(
+    dynrt_processor__engine__decode__t4 stage__16(
         .d(stage__16__d),
         .q(stage__16__q),
         .clock(stage__16__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__17(
+    dynrt_processor__engine__decode__t4 stage__17(
         .d(stage__17__d),
         .q(stage__17__q),
         .clock(stage__17__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__18(
+    dynrt_processor__engine__decode__t4 stage__18(
         .d(stage__18__d),
         .q(stage__18__q),
         .clock(stage__18__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__19(
+    dynrt_processor__engine__decode__t4 stage__19(
         .d(stage__19__d),
         .q(stage__19__q),
         .clock(stage__19__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__20(
+    dynrt_processor__engine__decode__t4 stage__20(
         .d(stage__20__d),
         .q(stage__20__q),
         .clock(stage__20__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__21(
+    dynrt_processor__engine__decode__t4 stage__21(
         .d(stage__21__d),
         .q(stage__21__q),
         .clock(stage__21__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__22(
+    dynrt_processor__engine__decode__t4 stage__22(
         .d(stage__22__d),
         .q(stage__22__q),
         .clock(stage__22__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__23(
+    dynrt_processor__engine__decode__t4 stage__23(
         .d(stage__23__d),
         .q(stage__23__q),
         .clock(stage__23__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__24(
+    dynrt_processor__engine__decode__t4 stage__24(
         .d(stage__24__d),
         .q(stage__24__q),
         .clock(stage__24__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__25(
+    dynrt_processor__engine__decode__t4 stage__25(
         .d(stage__25__d),
         .q(stage__25__q),
         .clock(stage__25__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__26(
+    dynrt_processor__engine__decode__t4 stage__26(
         .d(stage__26__d),
         .q(stage__26__q),
         .clock(stage__26__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__27(
+    dynrt_processor__engine__decode__t4 stage__27(
         .d(stage__27__d),
         .q(stage__27__q),
         .clock(stage__27__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__28(
+    dynrt_processor__engine__decode__t4 stage__28(
         .d(stage__28__d),
         .q(stage__28__q),
         .clock(stage__28__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__29(
+    dynrt_processor__engine__decode__t4 stage__29(
         .d(stage__29__d),
         .q(stage__29__q),
         .clock(stage__29__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__30(
+    dynrt_processor__engine__decode__t4 stage__30(
         .d(stage__30__d),
         .q(stage__30__q),
         .clock(stage__30__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__31(
+    dynrt_processor__engine__decode__t4 stage__31(
         .d(stage__31__d),
         .q(stage__31__q),
         .clock(stage__31__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__32(
+    dynrt_processor__engine__decode__t4 stage__32(
         .d(stage__32__d),
         .q(stage__32__q),
         .clock(stage__32__clock)
     );
-    dynrt_processor__engine__instances__arrived stage__33(
+    dynrt_processor__engine__decode__t4 stage__33(
         .d(stage__33__d),
         .q(stage__33__q),
         .clock(stage__33__clock)
@@ -21826,28 +23266,61 @@ endmodule // dynrt_processor__engine__shader__cos_slot
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__shader__frame_arrived_r(d,q,clock);
+    
+    // Module arguments
+    input wire  [9:0] d;
+    output reg  [9:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 10'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__shader__frame_arrived_r
+
+
 module dynrt_processor__engine__shader__frame_line(clock,data_in,data_out);
     
     // Module arguments
     input wire  clock;
-    input wire  [8:0] data_in;
-    output reg  [8:0] data_out;
+    input wire  [9:0] data_in;
+    output reg  [9:0] data_out;
     
     // Stub signals
-    reg  [8:0] stage__0__d;
-    wire  [8:0] stage__0__q;
+    reg  [9:0] stage__0__d;
+    wire  [9:0] stage__0__q;
     reg  stage__0__clock;
-    reg  [8:0] stage__1__d;
-    wire  [8:0] stage__1__q;
+    reg  [9:0] stage__1__d;
+    wire  [9:0] stage__1__q;
     reg  stage__1__clock;
     
     // Sub module instances
-    dynrt_processor__engine__fp_units__add__lz stage__0(
+    dynrt_processor__engine__shader__frame_arrived_r stage__0(
         .d(stage__0__d),
         .q(stage__0__q),
         .clock(stage__0__clock)
     );
-    dynrt_processor__engine__fp_units__add__lz stage__1(
+    dynrt_processor__engine__shader__frame_arrived_r stage__1(
         .d(stage__1__d),
         .q(stage__1__q),
         .clock(stage__1__clock)
@@ -21903,6 +23376,120 @@ endmodule // dynrt_processor__engine__shader__frame_line
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__shader__light_color__0(read_address,read_data,write_clock,write_address,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [2:0] read_address;
+    output reg  [23:0] read_data;
+    input wire  write_clock;
+    input wire  [2:0] write_address;
+    input wire  [23:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[23:0] mem[7:0];
+    
+    initial begin
+       mem[0] = 24'h0;
+       mem[1] = 24'h0;
+       mem[2] = 24'h0;
+       mem[3] = 24'h0;
+       mem[4] = 24'h0;
+       mem[5] = 24'h0;
+       mem[6] = 24'h0;
+       mem[7] = 24'h0;
+    end
+    
+    always @(*) begin
+       read_data = mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+endmodule // dynrt_processor__engine__shader__light_color__0
 
 
 
@@ -22083,6 +23670,22 @@ module dynrt_processor__engine__shader__res_step_r(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__shader__res_step_r
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -23106,6 +24709,18 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  fresh__3__d;
     wire  fresh__3__q;
     reg  fresh__3__clock;
+    reg  comparing__0__d;
+    wire  comparing__0__q;
+    reg  comparing__0__clock;
+    reg  comparing__1__d;
+    wire  comparing__1__q;
+    reg  comparing__1__clock;
+    reg  comparing__2__d;
+    wire  comparing__2__q;
+    reg  comparing__2__clock;
+    reg  comparing__3__d;
+    wire  comparing__3__q;
+    reg  comparing__3__clock;
     reg  deciding__0__d;
     wire  deciding__0__q;
     reg  deciding__0__clock;
@@ -23121,18 +24736,33 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [23:0] head_triangle_r__d;
     wire  [23:0] head_triangle_r__q;
     reg  head_triangle_r__clock;
+    reg  [23:0] head_triangle_rr__d;
+    wire  [23:0] head_triangle_rr__q;
+    reg  head_triangle_rr__clock;
     reg  [8:0] head_set_r__d;
     wire  [8:0] head_set_r__q;
     reg  head_set_r__clock;
-    reg  head_clash_r__d;
-    wire  head_clash_r__q;
-    reg  head_clash_r__clock;
-    reg  head_hit_r__d;
-    wire  head_hit_r__q;
-    reg  head_hit_r__clock;
     reg  [8:0] head_set_rr__d;
     wire  [8:0] head_set_rr__q;
     reg  head_set_rr__clock;
+    reg  [8:0] head_set_rrr__d;
+    wire  [8:0] head_set_rrr__q;
+    reg  head_set_rrr__clock;
+    reg  head_clash_r__d;
+    wire  head_clash_r__q;
+    reg  head_clash_r__clock;
+    reg  head_clash_rr__d;
+    wire  head_clash_rr__q;
+    reg  head_clash_rr__clock;
+    reg  head_clash_rrr__d;
+    wire  head_clash_rrr__q;
+    reg  head_clash_rrr__clock;
+    reg  [24:0] tag_word_r__d;
+    wire  [24:0] tag_word_r__q;
+    reg  tag_word_r__clock;
+    reg  head_hit_r__d;
+    wire  head_hit_r__q;
+    reg  head_hit_r__clock;
     reg  cache_write_r__d;
     wire  cache_write_r__q;
     reg  cache_write_r__clock;
@@ -24072,6 +25702,26 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(fresh__3__q),
         .clock(fresh__3__clock)
     );
+    dynrt_processor__display__dark_d comparing__0(
+        .d(comparing__0__d),
+        .q(comparing__0__q),
+        .clock(comparing__0__clock)
+    );
+    dynrt_processor__display__dark_d comparing__1(
+        .d(comparing__1__d),
+        .q(comparing__1__q),
+        .clock(comparing__1__clock)
+    );
+    dynrt_processor__display__dark_d comparing__2(
+        .d(comparing__2__d),
+        .q(comparing__2__q),
+        .clock(comparing__2__clock)
+    );
+    dynrt_processor__display__dark_d comparing__3(
+        .d(comparing__3__d),
+        .q(comparing__3__q),
+        .clock(comparing__3__clock)
+    );
     dynrt_processor__display__dark_d deciding__0(
         .d(deciding__0__d),
         .q(deciding__0__q),
@@ -24097,25 +25747,50 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(head_triangle_r__q),
         .clock(head_triangle_r__clock)
     );
+    dynrt_processor__display__rgb_q head_triangle_rr(
+        .d(head_triangle_rr__d),
+        .q(head_triangle_rr__q),
+        .clock(head_triangle_rr__clock)
+    );
     dynrt_processor__engine__fp_units__add__lz head_set_r(
         .d(head_set_r__d),
         .q(head_set_r__q),
         .clock(head_set_r__clock)
+    );
+    dynrt_processor__engine__fp_units__add__lz head_set_rr(
+        .d(head_set_rr__d),
+        .q(head_set_rr__q),
+        .clock(head_set_rr__clock)
+    );
+    dynrt_processor__engine__fp_units__add__lz head_set_rrr(
+        .d(head_set_rrr__d),
+        .q(head_set_rrr__q),
+        .clock(head_set_rrr__clock)
     );
     dynrt_processor__display__dark_d head_clash_r(
         .d(head_clash_r__d),
         .q(head_clash_r__q),
         .clock(head_clash_r__clock)
     );
+    dynrt_processor__display__dark_d head_clash_rr(
+        .d(head_clash_rr__d),
+        .q(head_clash_rr__q),
+        .clock(head_clash_rr__clock)
+    );
+    dynrt_processor__display__dark_d head_clash_rrr(
+        .d(head_clash_rrr__d),
+        .q(head_clash_rrr__q),
+        .clock(head_clash_rrr__clock)
+    );
+    dynrt_processor__engine__tester__tag_word_r tag_word_r(
+        .d(tag_word_r__d),
+        .q(tag_word_r__q),
+        .clock(tag_word_r__clock)
+    );
     dynrt_processor__display__dark_d head_hit_r(
         .d(head_hit_r__d),
         .q(head_hit_r__q),
         .clock(head_hit_r__clock)
-    );
-    dynrt_processor__engine__fp_units__add__lz head_set_rr(
-        .d(head_set_rr__d),
-        .q(head_set_rr__q),
-        .clock(head_set_rr__clock)
     );
     dynrt_processor__display__dark_d cache_write_r(
         .d(cache_write_r__d),
@@ -24502,8 +26177,13 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_triangle_r__clock = clock;
         head_set_r__clock = clock;
         head_clash_r__clock = clock;
-        head_hit_r__clock = clock;
+        head_triangle_rr__clock = clock;
         head_set_rr__clock = clock;
+        head_set_rrr__clock = clock;
+        head_clash_rr__clock = clock;
+        head_clash_rrr__clock = clock;
+        tag_word_r__clock = clock;
+        head_hit_r__clock = clock;
         a_issued__clock = clock;
         b_issued__clock = clock;
         seq__clock = clock;
@@ -24551,8 +26231,13 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_triangle_r__d = head_triangle_r__q;
         head_set_r__d = head_set_r__q;
         head_clash_r__d = head_clash_r__q;
-        head_hit_r__d = head_hit_r__q;
+        head_triangle_rr__d = head_triangle_rr__q;
         head_set_rr__d = head_set_rr__q;
+        head_set_rrr__d = head_set_rrr__q;
+        head_clash_rr__d = head_clash_rr__q;
+        head_clash_rrr__d = head_clash_rrr__q;
+        tag_word_r__d = tag_word_r__q;
+        head_hit_r__d = head_hit_r__q;
         a_issued__d = a_issued__q;
         b_issued__d = b_issued__q;
         seq__d = seq__q;
@@ -24733,6 +26418,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cached__0__clock = clock;
         cached__0__d = cached__0__q;
         fresh__0__clock = clock;
+        comparing__0__clock = clock;
         deciding__0__clock = clock;
         loaded__0__clock = clock;
         loaded__0__d = loaded__0__q;
@@ -24751,6 +26437,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cached__1__clock = clock;
         cached__1__d = cached__1__q;
         fresh__1__clock = clock;
+        comparing__1__clock = clock;
         deciding__1__clock = clock;
         loaded__1__clock = clock;
         loaded__1__d = loaded__1__q;
@@ -24769,6 +26456,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cached__2__clock = clock;
         cached__2__d = cached__2__q;
         fresh__2__clock = clock;
+        comparing__2__clock = clock;
         deciding__2__clock = clock;
         loaded__2__clock = clock;
         loaded__2__d = loaded__2__q;
@@ -24787,6 +26475,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cached__3__clock = clock;
         cached__3__d = cached__3__q;
         fresh__3__clock = clock;
+        comparing__3__clock = clock;
         deciding__3__clock = clock;
         loaded__3__clock = clock;
         loaded__3__d = loaded__3__q;
@@ -24871,7 +26560,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         l_loaded = loaded__0__q;
         l_received = received__0__q;
         l_cached = cached__0__q;
-        l_fresh = fresh__0__q | deciding__0__q;
+        l_fresh = fresh__0__q | comparing__0__q | deciding__0__q;
         if (lb__q == c_buffer__1) begin
             l_kind = cur_kind__1__q;
             l_thread = cur_thread__1__q;
@@ -24880,7 +26569,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__1__q;
             l_received = received__1__q;
             l_cached = cached__1__q;
-            l_fresh = fresh__1__q | deciding__1__q;
+            l_fresh = fresh__1__q | comparing__1__q | deciding__1__q;
         end
         if (lb__q == c_buffer__2) begin
             l_kind = cur_kind__2__q;
@@ -24890,7 +26579,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__2__q;
             l_received = received__2__q;
             l_cached = cached__2__q;
-            l_fresh = fresh__2__q | deciding__2__q;
+            l_fresh = fresh__2__q | comparing__2__q | deciding__2__q;
         end
         if (lb__q == c_buffer__3) begin
             l_kind = cur_kind__3__q;
@@ -24900,7 +26589,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__3__q;
             l_received = received__3__q;
             l_cached = cached__3__q;
-            l_fresh = fresh__3__q | deciding__3__q;
+            l_fresh = fresh__3__q | comparing__3__q | deciding__3__q;
         end
         l_ready = l_loaded & ((l_kind != c_test_triangle) | (l_received == 32'hc) | (l_cached & cache_ready__q));
         n_thread = cur_thread__0__q;
@@ -24908,7 +26597,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         n_kind = cur_kind__0__q;
         n_received = received__0__q;
         n_cached = cached__0__q;
-        n_fresh = fresh__0__q | deciding__0__q;
+        n_fresh = fresh__0__q | comparing__0__q | deciding__0__q;
         n_set = cur_a__0__q[(32'h0)+:(9)] & c_set_mask;
         if (lb__q + 32'h1 == c_buffer__1) begin
             n_thread = cur_thread__1__q;
@@ -24916,7 +26605,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__1__q;
             n_received = received__1__q;
             n_cached = cached__1__q;
-            n_fresh = fresh__1__q | deciding__1__q;
+            n_fresh = fresh__1__q | comparing__1__q | deciding__1__q;
             n_set = cur_a__1__q[(32'h0)+:(9)] & c_set_mask;
         end
         if (lb__q + 32'h1 == c_buffer__2) begin
@@ -24925,7 +26614,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__2__q;
             n_received = received__2__q;
             n_cached = cached__2__q;
-            n_fresh = fresh__2__q | deciding__2__q;
+            n_fresh = fresh__2__q | comparing__2__q | deciding__2__q;
             n_set = cur_a__2__q[(32'h0)+:(9)] & c_set_mask;
         end
         if (lb__q + 32'h1 == c_buffer__3) begin
@@ -24934,7 +26623,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__3__q;
             n_received = received__3__q;
             n_cached = cached__3__q;
-            n_fresh = fresh__3__q | deciding__3__q;
+            n_fresh = fresh__3__q | comparing__3__q | deciding__3__q;
             n_set = cur_a__3__q[(32'h0)+:(9)] & c_set_mask;
         end
         n_ready = n_loaded & ((n_kind != c_test_triangle) | (n_received == 32'hc) | (n_cached & cache_ready__q));
@@ -25050,11 +26739,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cache_tag__read_address = head_set;
         head_clash = ((lphase__q == Launch__Origin) | cache_write_r__q) & (l_set == head_set);
         head_triangle_r__d = head_triangle;
+        head_triangle_rr__d = head_triangle_r__q;
         head_set_r__d = head_set;
-        head_clash_r__d = head_clash;
-        head_hit = c_cache_on & (cache_tag__read_data == (c_tag_valid | ((head_triangle_r__q) & 25'h1ffffff))) & (~head_clash_r__q) & (~((lphase__q == Launch__Origin) & (l_set == head_set_r__q)));
-        head_hit_r__d = head_hit;
         head_set_rr__d = head_set_r__q;
+        head_set_rrr__d = head_set_rr__q;
+        head_clash_r__d = head_clash;
+        head_clash_rr__d = head_clash_r__q | ((lphase__q == Launch__Origin) & (l_set == head_set_r__q));
+        head_clash_rrr__d = head_clash_rr__q | ((lphase__q == Launch__Origin) & (l_set == head_set_rr__q));
+        tag_word_r__d = cache_tag__read_data;
+        head_hit = c_cache_on & (tag_word_r__q == (c_tag_valid | ((head_triangle_rr__q) & 25'h1ffffff)));
+        head_hit_r__d = head_hit;
         tb_free = ~loaded__0__q;
         if (tb__q == c_buffer__1) begin
             tb_free = ~loaded__1__q;
@@ -25115,24 +26809,28 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             cached__3__d = 1'b0;
         end
         fresh__0__d = take & (tb__q == c_buffer__0);
-        deciding__0__d = fresh__0__q;
+        comparing__0__d = fresh__0__q;
+        deciding__0__d = comparing__0__q;
         if (deciding__0__q) begin
-            cached__0__d = head_hit_r__q & (~((lphase__q == Launch__Origin) & (l_set == head_set_rr__q))) & (cur_kind__0__q == c_test_triangle);
+            cached__0__d = head_hit_r__q & (~head_clash_rrr__q) & (~((lphase__q == Launch__Origin) & (l_set == head_set_rrr__q))) & (cur_kind__0__q == c_test_triangle);
         end
         fresh__1__d = take & (tb__q == c_buffer__1);
-        deciding__1__d = fresh__1__q;
+        comparing__1__d = fresh__1__q;
+        deciding__1__d = comparing__1__q;
         if (deciding__1__q) begin
-            cached__1__d = head_hit_r__q & (~((lphase__q == Launch__Origin) & (l_set == head_set_rr__q))) & (cur_kind__1__q == c_test_triangle);
+            cached__1__d = head_hit_r__q & (~head_clash_rrr__q) & (~((lphase__q == Launch__Origin) & (l_set == head_set_rrr__q))) & (cur_kind__1__q == c_test_triangle);
         end
         fresh__2__d = take & (tb__q == c_buffer__2);
-        deciding__2__d = fresh__2__q;
+        comparing__2__d = fresh__2__q;
+        deciding__2__d = comparing__2__q;
         if (deciding__2__q) begin
-            cached__2__d = head_hit_r__q & (~((lphase__q == Launch__Origin) & (l_set == head_set_rr__q))) & (cur_kind__2__q == c_test_triangle);
+            cached__2__d = head_hit_r__q & (~head_clash_rrr__q) & (~((lphase__q == Launch__Origin) & (l_set == head_set_rrr__q))) & (cur_kind__2__q == c_test_triangle);
         end
         fresh__3__d = take & (tb__q == c_buffer__3);
-        deciding__3__d = fresh__3__q;
+        comparing__3__d = fresh__3__q;
+        deciding__3__d = comparing__3__q;
         if (deciding__3__q) begin
-            cached__3__d = head_hit_r__q & (~((lphase__q == Launch__Origin) & (l_set == head_set_rr__q))) & (cur_kind__3__q == c_test_triangle);
+            cached__3__d = head_hit_r__q & (~head_clash_rrr__q) & (~((lphase__q == Launch__Origin) & (l_set == head_set_rrr__q))) & (cur_kind__3__q == c_test_triangle);
         end
         a_take = fetching__q & (a_issued__q < 32'h6) & ((engine__load_banks & c_bank_a) == 32'h0);
         b_take = fetching__q & (b_issued__q < 32'h6) & ((engine__load_banks & c_bank_b) == 32'h0);
@@ -25204,16 +26902,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             end
         end
         next_triangle = 1'b0;
-        if ((fetch_next == c_buffer__0) & unvisited__0__q & (~fresh__0__q) & (~deciding__0__q) & (cur_kind__0__q == c_test_triangle) & (~cached__0__q)) begin
+        if ((fetch_next == c_buffer__0) & unvisited__0__q & (~fresh__0__q) & (~comparing__0__q) & (~deciding__0__q) & (cur_kind__0__q == c_test_triangle) & (~cached__0__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__1) & unvisited__1__q & (~fresh__1__q) & (~deciding__1__q) & (cur_kind__1__q == c_test_triangle) & (~cached__1__q)) begin
+        if ((fetch_next == c_buffer__1) & unvisited__1__q & (~fresh__1__q) & (~comparing__1__q) & (~deciding__1__q) & (cur_kind__1__q == c_test_triangle) & (~cached__1__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__2) & unvisited__2__q & (~fresh__2__q) & (~deciding__2__q) & (cur_kind__2__q == c_test_triangle) & (~cached__2__q)) begin
+        if ((fetch_next == c_buffer__2) & unvisited__2__q & (~fresh__2__q) & (~comparing__2__q) & (~deciding__2__q) & (cur_kind__2__q == c_test_triangle) & (~cached__2__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__3) & unvisited__3__q & (~fresh__3__q) & (~deciding__3__q) & (cur_kind__3__q == c_test_triangle) & (~cached__3__q)) begin
+        if ((fetch_next == c_buffer__3) & unvisited__3__q & (~fresh__3__q) & (~comparing__3__q) & (~deciding__3__q) & (cur_kind__3__q == c_test_triangle) & (~cached__3__q)) begin
             next_triangle = 1'b1;
         end
         if ((~fetching__q) | fetch_ends) begin
@@ -26356,6 +28054,14 @@ endmodule // dynrt_processor__engine__tester__cache_words__0
 
 
 
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__tester__done_e(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -26456,6 +28162,14 @@ module dynrt_processor__engine__tester__flight_t_min(read_address,read_clock,rea
     end
                 
 endmodule // dynrt_processor__engine__tester__flight_t_min
+
+
+
+
+
+
+
+
 
 
 
@@ -31594,6 +33308,25 @@ endmodule // dynrt_processor__engine__tester__ray
 
 
 
+module dynrt_processor__engine__tester__tag_word_r(d,q,clock);
+    
+    // Module arguments
+    input wire  [24:0] d;
+    output reg  [24:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 25'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__tester__tag_word_r
+
+
 
 
 module dynrt_processor__engine__tester__transform_unit(clock,in_valid,m__0,m__1,m__2,m__3,m__4,m__5,m__6,m__7,m__8,m__9,m__10,m__11,v__0,v__1,v__2,point,diagonal,tag,out_valid,result__0,result__1,result__2,out_tag);
@@ -35075,6 +36808,18 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  look_stale__d;
     wire  look_stale__q;
     reg  look_stale__clock;
+    reg  [26:0] tag_word_r__d;
+    wire  [26:0] tag_word_r__q;
+    reg  tag_word_r__clock;
+    reg  [63:0] words_r__d;
+    wire  [63:0] words_r__q;
+    reg  words_r__clock;
+    reg  stale_r__d;
+    wire  stale_r__q;
+    reg  stale_r__clock;
+    reg  look_ready__d;
+    wire  look_ready__q;
+    reg  look_ready__clock;
     reg  [8:0] cache_tag__read_address;
     reg  cache_tag__read_clock;
     wire  [26:0] cache_tag__read_data;
@@ -35847,6 +37592,26 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(look_stale__q),
         .clock(look_stale__clock)
     );
+    dynrt_processor__engine__traversal_unit__tag_word_r tag_word_r(
+        .d(tag_word_r__d),
+        .q(tag_word_r__q),
+        .clock(tag_word_r__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 words_r(
+        .d(words_r__d),
+        .q(words_r__q),
+        .clock(words_r__clock)
+    );
+    dynrt_processor__display__dark_d stale_r(
+        .d(stale_r__d),
+        .q(stale_r__q),
+        .clock(stale_r__clock)
+    );
+    dynrt_processor__display__dark_d look_ready(
+        .d(look_ready__d),
+        .q(look_ready__q),
+        .clock(look_ready__clock)
+    );
     dynrt_processor__engine__traversal_unit__cache_tag cache_tag(
         .read_address(cache_tag__read_address),
         .read_clock(cache_tag__read_clock),
@@ -36112,6 +37877,10 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         look_valid__clock = clock;
         look_job__clock = clock;
         look_stale__clock = clock;
+        tag_word_r__clock = clock;
+        words_r__clock = clock;
+        stale_r__clock = clock;
+        look_ready__clock = clock;
         fetch_hit__clock = clock;
         fetch_words__clock = clock;
         a_fetched__clock = clock;
@@ -36173,6 +37942,10 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         look_valid__d = look_valid__q;
         look_job__d = look_job__q;
         look_stale__d = look_stale__q;
+        tag_word_r__d = tag_word_r__q;
+        words_r__d = words_r__q;
+        stale_r__d = stale_r__q;
+        look_ready__d = look_ready__q;
         fetch_hit__d = fetch_hit__q;
         fetch_words__d = fetch_words__q;
         a_fetched__d = a_fetched__q;
@@ -36441,7 +38214,10 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         loop_fifo__read = 1'b0;
         front_fifo__read = 1'b0;
         in_flight__read = 1'b0;
-        look_hit = c_node_cache_on & (~look_job__q[32'h66]) & (~look_stale__q) & (cache_tag__read_data == (c_node_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
+        tag_word_r__d = cache_tag__read_data;
+        words_r__d = cache_words__read_data;
+        stale_r__d = look_stale__q;
+        look_hit = c_node_cache_on & (~look_job__q[32'h66]) & (~stale_r__q) & (tag_word_r__q == (c_node_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
         hit_now = (phase__q == Fetch__Word0) & fetch_hit__q;
         take = (phase__q != Fetch__Idle) & (~hit_now) & ((engine__load_banks & c_bank_nodes) == 32'h0);
         nodes__read = take | ((engine__load_banks & c_bank_nodes) != 32'h0);
@@ -36522,11 +38298,13 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         look_move = 1'b0;
         if (fetch_free & look_valid__q) begin
             if (~look_job__q[32'h65]) begin
-                look_move = 1'b1;
-                fetch_job__d = look_job__q;
-                fetch_hit__d = look_hit;
-                fetch_words__d = cache_words__read_data;
-                phase__d = Fetch__Word0;
+                if (look_ready__q) begin
+                    look_move = 1'b1;
+                    fetch_job__d = look_job__q;
+                    fetch_hit__d = look_hit;
+                    fetch_words__d = words_r__q;
+                    phase__d = Fetch__Word0;
+                end
             end
             else if ((phase__q == Fetch__Idle) & in_flight__empty) begin
                 look_move = 1'b1;
@@ -36537,6 +38315,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
             end
         end
         look_load = (~look_valid__q) | look_move;
+        look_ready__d = look_valid__q & (~look_move);
         if (look_move) begin
             look_valid__d = 1'b0;
         end
@@ -39137,6 +40916,8 @@ endmodule // dynrt_processor__engine__traversal_unit__leaf_sp
 
 
 
+
+
 module dynrt_processor__engine__traversal_unit__phase(d,q,clock);
     
     // Module arguments
@@ -39367,6 +41148,29 @@ endmodule // dynrt_processor__engine__traversal_unit__stack_node
 
 
 
+
+
+
+
+
+
+module dynrt_processor__engine__traversal_unit__tag_word_r(d,q,clock);
+    
+    // Module arguments
+    input wire  [26:0] d;
+    output reg  [26:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 27'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__traversal_unit__tag_word_r
 
 
 

@@ -56,9 +56,9 @@
 //! Triangle cache: [`MAX_CACHE_SETS`] (the paper's 512 items) sets of a triangle's 12 words,
 //! direct mapped by the triangle's low bits, with a tag (triangle and valid bit), all in block
 //! RAM; `new`'s `cache_sets` uses the first sets only (0: no cache). The queue's head's tag is
-//! read as the free buffer copies it and compared in the next clock, whose result decides the
-//! buffer's `cached` in the clock after (the fetch leaves the buffer alone until then); a
-//! triangle found there is not
+//! read as the free buffer copies it, registered in the next clock, compared in the one after,
+//! and the compare decides the buffer's `cached` in the fourth (the fetch leaves the buffer
+//! alone until then); a triangle found there is not
 //! fetched, and the launch takes its words from the cache (addressed two clocks ahead: the
 //! launch's words, from the buffer or the cache, wait in a register, `matrix`). A triangle
 //! fetched from the banks is written into its set as it launches (in its direction's clock,
@@ -298,27 +298,35 @@ pub struct TriangleTester<
     cache_tag: RAM<Bits<25>, 9>,
     /// Word k of each set's triangle.
     cache_words: [RAM<Bits<W>, 9>; 12],
-    /// The buffer's triangle is in the cache (decided two clocks after the take, when
+    /// The buffer's triangle is in the cache (decided three clocks after the take, when
     /// `deciding`; its set is not written until it launches).
     cached: [DFF<Bit>; TEST_BUFFERS],
-    /// The buffer was taken last clock: its head's tag is compared now.
+    /// The buffer was taken one, two or three clocks ago: its head's tag word is registered
+    /// (`tag_word_r`), compared (`head_hit_r`), and its `cached` decided. (The block RAM's
+    /// 5.6-5.8 ns clock to out ran through the 25-bit compare into the next register when
+    /// compared in the clock after the read: the placed critical path of cornell at stop 46,
+    /// `tester.cache_tag -> tester.cached.1`, 70.2 MHz, and of cornell_noshadow at stop 47,
+    /// `-> tester.head_hit_r`, 71.4 MHz.)
     fresh: [DFF<Bit>; TEST_BUFFERS],
-    /// The buffer was taken two clocks ago: its `cached` is decided now, from the compare
-    /// registered in `head_hit_r`. (Compared and decided in one clock, the tag's block RAM
-    /// (5.6 ns clock to out) ran through the 25-bit compare into `cached`: stop 46's
-    /// critical path on cornell, `tester.cache_tag -> tester.cached.1`, 70.2 MHz placed.)
+    comparing: [DFF<Bit>; TEST_BUFFERS],
     deciding: [DFF<Bit>; TEST_BUFFERS],
     head_triangle: Signal<Local, Bits<24>>,
     head_set: Signal<Local, Bits<9>>,
-    /// The head of last clock (the tag's read is for its set) and whether its set clashed.
+    /// The head as it goes down the three clocks of its lookup: its triangle and set, and
+    /// whether a launch wrote or chose to write its set since it was read (`head_clash`, a
+    /// clock at a time).
     head_triangle_r: DFF<Bits<24>>,
+    head_triangle_rr: DFF<Bits<24>>,
     head_set_r: DFF<Bits<9>>,
-    head_clash_r: DFF<Bit>,
-    head_hit: Signal<Local, Bit>,
-    /// The compare of the head of two clocks ago, and its set (a launch's origin in the
-    /// deciding clock may still choose to write that set).
-    head_hit_r: DFF<Bit>,
     head_set_rr: DFF<Bits<9>>,
+    head_set_rrr: DFF<Bits<9>>,
+    head_clash_r: DFF<Bit>,
+    head_clash_rr: DFF<Bit>,
+    head_clash_rrr: DFF<Bit>,
+    /// The tag word read for the head of last clock.
+    tag_word_r: DFF<Bits<25>>,
+    head_hit: Signal<Local, Bit>,
+    head_hit_r: DFF<Bit>,
     /// The launch's buffer (`l_`) or the next one (`n_`) is fresh or deciding: its `cached`
     /// may change in the next clock, so `matrix_cached`, registered from it, is not yet its.
     l_fresh: Signal<Local, Bit>,
@@ -568,9 +576,15 @@ impl<
             cache_words: Default::default(),
             cached: Default::default(),
             fresh: Default::default(),
+            comparing: Default::default(),
             deciding: Default::default(),
-            head_hit_r: Default::default(),
+            head_triangle_rr: Default::default(),
             head_set_rr: Default::default(),
+            head_set_rrr: Default::default(),
+            head_clash_rr: Default::default(),
+            head_clash_rrr: Default::default(),
+            tag_word_r: Default::default(),
+            head_hit_r: Default::default(),
             head_triangle: Default::default(),
             head_set: Default::default(),
             head_triangle_r: Default::default(),
@@ -709,8 +723,13 @@ impl<
             head_triangle_r,
             head_set_r,
             head_clash_r,
-            head_hit_r,
+            head_triangle_rr,
             head_set_rr,
+            head_set_rrr,
+            head_clash_rr,
+            head_clash_rrr,
+            tag_word_r,
+            head_hit_r,
             a_issued,
             b_issued,
             seq,
@@ -802,6 +821,7 @@ impl<
             self.cached[k].clock.next = self.clock.val();
             self.cached[k].d.next = self.cached[k].q.val();
             self.fresh[k].clock.next = self.clock.val();
+            self.comparing[k].clock.next = self.clock.val();
             self.deciding[k].clock.next = self.clock.val();
             self.loaded[k].clock.next = self.clock.val();
             self.loaded[k].d.next = self.loaded[k].q.val();
@@ -894,7 +914,8 @@ impl<
         self.l_loaded.next = self.loaded[0].q.val();
         self.l_received.next = self.received[0].q.val();
         self.l_cached.next = self.cached[0].q.val();
-        self.l_fresh.next = self.fresh[0].q.val() | self.deciding[0].q.val();
+        self.l_fresh.next =
+            self.fresh[0].q.val() | self.comparing[0].q.val() | self.deciding[0].q.val();
         for k in 1..4 {
             if self.lb.q.val() == self.c_buffer[k].val() {
                 self.l_kind.next = self.cur_kind[k].q.val();
@@ -904,7 +925,8 @@ impl<
                 self.l_loaded.next = self.loaded[k].q.val();
                 self.l_received.next = self.received[k].q.val();
                 self.l_cached.next = self.cached[k].q.val();
-                self.l_fresh.next = self.fresh[k].q.val() | self.deciding[k].q.val();
+                self.l_fresh.next =
+                    self.fresh[k].q.val() | self.comparing[k].q.val() | self.deciding[k].q.val();
             }
         }
         self.l_ready.next = self.l_loaded.val()
@@ -917,7 +939,8 @@ impl<
         self.n_kind.next = self.cur_kind[0].q.val();
         self.n_received.next = self.received[0].q.val();
         self.n_cached.next = self.cached[0].q.val();
-        self.n_fresh.next = self.fresh[0].q.val() | self.deciding[0].q.val();
+        self.n_fresh.next =
+            self.fresh[0].q.val() | self.comparing[0].q.val() | self.deciding[0].q.val();
         self.n_set.next = self.cur_a[0].q.val().get_bits::<9>(0) & self.c_set_mask.val();
         for k in 1..4 {
             if self.lb.q.val() + 1 == self.c_buffer[k].val() {
@@ -926,7 +949,8 @@ impl<
                 self.n_kind.next = self.cur_kind[k].q.val();
                 self.n_received.next = self.received[k].q.val();
                 self.n_cached.next = self.cached[k].q.val();
-                self.n_fresh.next = self.fresh[k].q.val() | self.deciding[k].q.val();
+                self.n_fresh.next =
+                    self.fresh[k].q.val() | self.comparing[k].q.val() | self.deciding[k].q.val();
                 self.n_set.next = self.cur_a[k].q.val().get_bits::<9>(0) & self.c_set_mask.val();
             }
         }
@@ -982,23 +1006,29 @@ impl<
         self.cache_tag.read_address.next = self.head_set.val();
         // A head taken in an origin's clock (whose write is decided then) or in a write's
         // clock (the tag read shows the set before the write) misses if the set is the same,
-        // as one whose set an origin decides to write in either of the next two clocks, while
-        // its tag is compared and its `cached` decided (the origin's `cache_block` sees it
-        // from the clock after).
+        // as one whose set an origin decides to write in any of the next three clocks, while
+        // its tag is registered and compared and its `cached` decided (the origin's
+        // `cache_block` sees it from the clock after).
         self.head_clash.next = ((self.lphase.q.val() == Launch::Origin)
             | self.cache_write_r.q.val())
             & (self.l_set.val() == self.head_set.val());
         self.head_triangle_r.d.next = self.head_triangle.val();
+        self.head_triangle_rr.d.next = self.head_triangle_r.q.val();
         self.head_set_r.d.next = self.head_set.val();
-        self.head_clash_r.d.next = self.head_clash.val();
-        self.head_hit.next = self.c_cache_on.val()
-            & (self.cache_tag.read_data.val()
-                == (self.c_tag_valid.val() | bit_cast::<25, 24>(self.head_triangle_r.q.val())))
-            & (!self.head_clash_r.q.val())
-            & (!((self.lphase.q.val() == Launch::Origin)
-                & (self.l_set.val() == self.head_set_r.q.val())));
-        self.head_hit_r.d.next = self.head_hit.val();
         self.head_set_rr.d.next = self.head_set_r.q.val();
+        self.head_set_rrr.d.next = self.head_set_rr.q.val();
+        self.head_clash_r.d.next = self.head_clash.val();
+        self.head_clash_rr.d.next = self.head_clash_r.q.val()
+            | ((self.lphase.q.val() == Launch::Origin)
+                & (self.l_set.val() == self.head_set_r.q.val()));
+        self.head_clash_rrr.d.next = self.head_clash_rr.q.val()
+            | ((self.lphase.q.val() == Launch::Origin)
+                & (self.l_set.val() == self.head_set_rr.q.val()));
+        self.tag_word_r.d.next = self.cache_tag.read_data.val();
+        self.head_hit.next = self.c_cache_on.val()
+            & (self.tag_word_r.q.val()
+                == (self.c_tag_valid.val() | bit_cast::<25, 24>(self.head_triangle_rr.q.val())));
+        self.head_hit_r.d.next = self.head_hit.val();
 
         // Take: the list unit's next entry into buffer `tb` whenever it is free, apart from the
         // fetch. (Taken in the clock of the fetch's last requests, the take waited on the bank
@@ -1034,15 +1064,18 @@ impl<
                 self.cached[k].d.next = false;
             }
         }
-        // The buffer taken two clocks ago: in the cache if its triangle's tag matched and no
-        // origin has chosen its set since (one in this clock sees `cached` from the next).
+        // The buffer taken three clocks ago: in the cache if its triangle's tag matched and
+        // no launch has written or chosen its set since (an origin in this clock sees `cached`
+        // from the next).
         for k in 0..4 {
             self.fresh[k].d.next = self.take.val() & (self.tb.q.val() == self.c_buffer[k].val());
-            self.deciding[k].d.next = self.fresh[k].q.val();
+            self.comparing[k].d.next = self.fresh[k].q.val();
+            self.deciding[k].d.next = self.comparing[k].q.val();
             if self.deciding[k].q.val() {
                 self.cached[k].d.next = self.head_hit_r.q.val()
+                    & (!self.head_clash_rrr.q.val())
                     & (!((self.lphase.q.val() == Launch::Origin)
-                        & (self.l_set.val() == self.head_set_rr.q.val())))
+                        & (self.l_set.val() == self.head_set_rrr.q.val())))
                     & (self.cur_kind[k].q.val() == self.c_test_triangle.val());
             }
         }
@@ -1126,6 +1159,7 @@ impl<
             if (self.fetch_next.val() == self.c_buffer[k].val())
                 & self.unvisited[k].q.val()
                 & (!self.fresh[k].q.val())
+                & (!self.comparing[k].q.val())
                 & (!self.deciding[k].q.val())
                 & (self.cur_kind[k].q.val() == self.c_test_triangle.val())
                 & (!self.cached[k].q.val())
