@@ -38217,7 +38217,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         tag_word_r__d = cache_tag__read_data;
         words_r__d = cache_words__read_data;
         stale_r__d = look_stale__q;
-        look_hit = c_node_cache_on & (~look_job__q[32'h66]) & (~stale_r__q) & (tag_word_r__q == (c_node_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
+        look_hit = c_node_cache_on & look_ready__q & (~look_job__q[32'h66]) & (~stale_r__q) & (tag_word_r__q == (c_node_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
         hit_now = (phase__q == Fetch__Word0) & fetch_hit__q;
         take = (phase__q != Fetch__Idle) & (~hit_now) & ((engine__load_banks & c_bank_nodes) == 32'h0);
         nodes__read = take | ((engine__load_banks & c_bank_nodes) != 32'h0);
@@ -38298,13 +38298,11 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         look_move = 1'b0;
         if (fetch_free & look_valid__q) begin
             if (~look_job__q[32'h65]) begin
-                if (look_ready__q) begin
-                    look_move = 1'b1;
-                    fetch_job__d = look_job__q;
-                    fetch_hit__d = look_hit;
-                    fetch_words__d = words_r__q;
-                    phase__d = Fetch__Word0;
-                end
+                look_move = 1'b1;
+                fetch_job__d = look_job__q;
+                fetch_hit__d = look_hit;
+                fetch_words__d = words_r__q;
+                phase__d = Fetch__Word0;
             end
             else if ((phase__q == Fetch__Idle) & in_flight__empty) begin
                 look_move = 1'b1;

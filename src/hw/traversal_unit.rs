@@ -38,8 +38,8 @@
 //! loop queue, which the fetch serves first. Fetch: two words of bank 0 a job, the next job's
 //! requests right behind (the engine's own loads of bank 0 go first; the words come back in
 //! order), then the decision pipeline: `split - o` (FpAddSub), `/ d` (FpDiv), then five
-//! FpCompares; at its end a push and the next step. Latency per inner node: `mem_latency + 5`
-//! clocks of fetch (with `look`'s two) plus `8 + DL + 2` of decision (`ADD_SUB_LATENCY + DL +
+//! FpCompares; at its end a push and the next step. Latency per inner node: `mem_latency + 4`
+//! clocks of fetch (with `look`) plus `8 + DL + 2` of decision (`ADD_SUB_LATENCY + DL +
 //! COMPARE_LATENCY`); throughput one node per [`FETCH_CLOCKS_PER_NODE`] (2) clocks from the
 //! bank, one a clock from the node cache, while other threads' jobs fill the decision pipeline.
 //! Each thread has at most one job in the unit, so the 32-entry queues never overflow.
@@ -49,13 +49,14 @@
 //! words in block RAM; `new`'s `cache_sets` uses the first sets only (0: none; off at SRAM latency
 //! 1, where a cached node's words would come back before the FIFO behind them can pop). A job waits
 //! for the fetch in `look`, whose cache set is read as it comes in; the set's tag and words read
-//! are registered, and the job's tag is compared with them from its second clock in `look`
-//! (the block RAM's output is not compared in the clock it comes out); from the cache the fetch
-//! takes a node in a clock with no request, and its words travel the latency line beside the bank's (in
-//! order, at the bank's latency). A node from the bank is written into its set at A. Only the
-//! object trees' nodes are kept: the top level's part of bank 0 is rewritten between an animated
-//! scene's frames (the object trees are not), so the cache lives across frames. A set written in
-//! the clock it is read for `look` misses (its words may be the old ones).
+//! are registered, and the job's tag is compared with them from its second clock in `look` (the
+//! block RAM's output is not compared in the clock it comes out; a job the fetch takes in its first
+//! clock goes to the bank); from the cache the fetch takes a node in a clock with no request, and
+//! its words travel the latency line beside the bank's (in order, at the bank's latency). A node
+//! from the bank is written into its set at A. Only the object trees' nodes are kept: the top
+//! level's part of bank 0 is rewritten between an animated scene's frames (the object trees are
+//! not), so the cache lives across frames. A set written in the clock it is read for `look` misses
+//! (its words may be the old ones).
 //!
 //! Per thread: a stack of [`STACK_LEVELS`] entries `(node, lo, hi)`, the leaf's segment end
 //! and stack depth. Const parameters: the operators' `W, E, M, S, S1, X2, T` and
@@ -305,10 +306,12 @@ pub struct TraversalUnit<
     /// old ones: a miss).
     look_stale: DFF<Bit>,
     /// The set's tag and words as read last clock, and whether they were stale: a job in
-    /// `look` compares its tag with them from its second clock there (`look_ready`). (The
-    /// block RAM's 5.6 ns clock to out ran through the compare into `fetch_hit` when the
-    /// read word was compared as it came out: cornell's placed critical path at stop 47,
-    /// `traversal_unit.cache_tag -> fetch_hit`, 75.9 MHz.)
+    /// `look` compares its tag with them from its second clock there (`look_ready`); one
+    /// that the fetch takes in its first clock goes to the bank (the fetch was idle, so the
+    /// bank's two clocks cost nothing, and the latency is the same). (The block RAM's 5.6 ns
+    /// clock to out ran through the compare into `fetch_hit` when the read word was compared
+    /// as it came out: cornell's placed critical path at stop 47, `traversal_unit.cache_tag
+    /// -> fetch_hit`, 75.9 MHz.)
     tag_word_r: DFF<Bits<27>>,
     words_r: DFF<Bits<64>>,
     stale_r: DFF<Bit>,
@@ -1023,6 +1026,7 @@ impl<
         self.words_r.d.next = self.cache_words.read_data.val();
         self.stale_r.d.next = self.look_stale.q.val();
         self.look_hit.next = self.c_node_cache_on.val()
+            & self.look_ready.q.val()
             & (!self.look_job.q.val().get_bit(102))
             & (!self.stale_r.q.val())
             & (self.tag_word_r.q.val()
@@ -1099,13 +1103,11 @@ impl<
         self.look_move.next = false;
         if self.fetch_free.val() & self.look_valid.q.val() {
             if !self.look_job.q.val().get_bit(101) {
-                if self.look_ready.q.val() {
-                    self.look_move.next = true;
-                    self.fetch_job.d.next = self.look_job.q.val();
-                    self.fetch_hit.d.next = self.look_hit.val();
-                    self.fetch_words.d.next = self.words_r.q.val();
-                    self.phase.d.next = Fetch::Word0;
-                }
+                self.look_move.next = true;
+                self.fetch_job.d.next = self.look_job.q.val();
+                self.fetch_hit.d.next = self.look_hit.val();
+                self.fetch_words.d.next = self.words_r.q.val();
+                self.phase.d.next = Fetch::Word0;
             } else if (self.phase.q.val() == Fetch::Idle) & self.in_flight.empty.val() {
                 self.look_move.next = true;
                 self.job.d.next = self.look_job.q.val();
