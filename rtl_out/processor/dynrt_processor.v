@@ -17698,6 +17698,57 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  [2:0] res_light_r__d;
     wire  [2:0] res_light_r__q;
     reg  res_light_r__clock;
+    reg  res_positive__d;
+    wire  res_positive__q;
+    reg  res_positive__clock;
+    reg  res_for__0__d;
+    wire  res_for__0__q;
+    reg  res_for__0__clock;
+    reg  res_for__1__d;
+    wire  res_for__1__q;
+    reg  res_for__1__clock;
+    reg  res_for__2__d;
+    wire  res_for__2__q;
+    reg  res_for__2__clock;
+    reg  res_for__3__d;
+    wire  res_for__3__q;
+    reg  res_for__3__clock;
+    reg  res_for__4__d;
+    wire  res_for__4__q;
+    reg  res_for__4__clock;
+    reg  res_for__5__d;
+    wire  res_for__5__q;
+    reg  res_for__5__clock;
+    reg  res_for__6__d;
+    wire  res_for__6__q;
+    reg  res_for__6__clock;
+    reg  res_for__7__d;
+    wire  res_for__7__q;
+    reg  res_for__7__clock;
+    reg  res_for__8__d;
+    wire  res_for__8__q;
+    reg  res_for__8__clock;
+    reg  res_for__9__d;
+    wire  res_for__9__q;
+    reg  res_for__9__clock;
+    reg  res_for__10__d;
+    wire  res_for__10__q;
+    reg  res_for__10__clock;
+    reg  res_for__11__d;
+    wire  res_for__11__q;
+    reg  res_for__11__clock;
+    reg  res_for__12__d;
+    wire  res_for__12__q;
+    reg  res_for__12__clock;
+    reg  res_for__13__d;
+    wire  res_for__13__q;
+    reg  res_for__13__clock;
+    reg  res_for__14__d;
+    wire  res_for__14__q;
+    reg  res_for__14__clock;
+    reg  res_for__15__d;
+    wire  res_for__15__q;
+    reg  res_for__15__clock;
     reg  tri_line__clock;
     reg  [9:0] tri_line__data_in;
     wire  [9:0] tri_line__data_out;
@@ -17823,6 +17874,54 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  cos_slot__clock;
     reg  [4:0] cos_slot__data_in;
     wire  [4:0] cos_slot__data_out;
+    reg  cos_for__0__d;
+    wire  cos_for__0__q;
+    reg  cos_for__0__clock;
+    reg  cos_for__1__d;
+    wire  cos_for__1__q;
+    reg  cos_for__1__clock;
+    reg  cos_for__2__d;
+    wire  cos_for__2__q;
+    reg  cos_for__2__clock;
+    reg  cos_for__3__d;
+    wire  cos_for__3__q;
+    reg  cos_for__3__clock;
+    reg  cos_for__4__d;
+    wire  cos_for__4__q;
+    reg  cos_for__4__clock;
+    reg  cos_for__5__d;
+    wire  cos_for__5__q;
+    reg  cos_for__5__clock;
+    reg  cos_for__6__d;
+    wire  cos_for__6__q;
+    reg  cos_for__6__clock;
+    reg  cos_for__7__d;
+    wire  cos_for__7__q;
+    reg  cos_for__7__clock;
+    reg  cos_for__8__d;
+    wire  cos_for__8__q;
+    reg  cos_for__8__clock;
+    reg  cos_for__9__d;
+    wire  cos_for__9__q;
+    reg  cos_for__9__clock;
+    reg  cos_for__10__d;
+    wire  cos_for__10__q;
+    reg  cos_for__10__clock;
+    reg  cos_for__11__d;
+    wire  cos_for__11__q;
+    reg  cos_for__11__clock;
+    reg  cos_for__12__d;
+    wire  cos_for__12__q;
+    reg  cos_for__12__clock;
+    reg  cos_for__13__d;
+    wire  cos_for__13__q;
+    reg  cos_for__13__clock;
+    reg  cos_for__14__d;
+    wire  cos_for__14__q;
+    reg  cos_for__14__clock;
+    reg  cos_for__15__d;
+    wire  cos_for__15__q;
+    reg  cos_for__15__clock;
     reg  byte_valid_r__d;
     wire  byte_valid_r__q;
     reg  byte_valid_r__clock;
@@ -17840,6 +17939,54 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  byte_tag__clock;
     reg  [6:0] byte_tag__data_in;
     wire  [6:0] byte_tag__data_out;
+    reg  byte_for__0__d;
+    wire  byte_for__0__q;
+    reg  byte_for__0__clock;
+    reg  byte_for__1__d;
+    wire  byte_for__1__q;
+    reg  byte_for__1__clock;
+    reg  byte_for__2__d;
+    wire  byte_for__2__q;
+    reg  byte_for__2__clock;
+    reg  byte_for__3__d;
+    wire  byte_for__3__q;
+    reg  byte_for__3__clock;
+    reg  byte_for__4__d;
+    wire  byte_for__4__q;
+    reg  byte_for__4__clock;
+    reg  byte_for__5__d;
+    wire  byte_for__5__q;
+    reg  byte_for__5__clock;
+    reg  byte_for__6__d;
+    wire  byte_for__6__q;
+    reg  byte_for__6__clock;
+    reg  byte_for__7__d;
+    wire  byte_for__7__q;
+    reg  byte_for__7__clock;
+    reg  byte_for__8__d;
+    wire  byte_for__8__q;
+    reg  byte_for__8__clock;
+    reg  byte_for__9__d;
+    wire  byte_for__9__q;
+    reg  byte_for__9__clock;
+    reg  byte_for__10__d;
+    wire  byte_for__10__q;
+    reg  byte_for__10__clock;
+    reg  byte_for__11__d;
+    wire  byte_for__11__q;
+    reg  byte_for__11__clock;
+    reg  byte_for__12__d;
+    wire  byte_for__12__q;
+    reg  byte_for__12__clock;
+    reg  byte_for__13__d;
+    wire  byte_for__13__q;
+    reg  byte_for__13__clock;
+    reg  byte_for__14__d;
+    wire  byte_for__14__q;
+    reg  byte_for__14__clock;
+    reg  byte_for__15__d;
+    wire  byte_for__15__q;
+    reg  byte_for__15__clock;
     reg  [23:0] rgb_acc__d;
     wire  [23:0] rgb_acc__q;
     reg  rgb_acc__clock;
@@ -17943,7 +18090,8 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
     reg  [23:0] req_v__2;
     reg  req_point;
     reg  req_diagonal;
-    reg  res_positive;
+    reg  [3:0] res_next_step;
+    reg  [2:0] res_next_light;
     reg  tri_word_0;
     reg  tri_word_1;
     reg  frame_valid;
@@ -19122,6 +19270,91 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .q(res_light_r__q),
         .clock(res_light_r__clock)
     );
+    dynrt_processor__display__dark_d res_positive(
+        .d(res_positive__d),
+        .q(res_positive__q),
+        .clock(res_positive__clock)
+    );
+    dynrt_processor__display__dark_d res_for__0(
+        .d(res_for__0__d),
+        .q(res_for__0__q),
+        .clock(res_for__0__clock)
+    );
+    dynrt_processor__display__dark_d res_for__1(
+        .d(res_for__1__d),
+        .q(res_for__1__q),
+        .clock(res_for__1__clock)
+    );
+    dynrt_processor__display__dark_d res_for__2(
+        .d(res_for__2__d),
+        .q(res_for__2__q),
+        .clock(res_for__2__clock)
+    );
+    dynrt_processor__display__dark_d res_for__3(
+        .d(res_for__3__d),
+        .q(res_for__3__q),
+        .clock(res_for__3__clock)
+    );
+    dynrt_processor__display__dark_d res_for__4(
+        .d(res_for__4__d),
+        .q(res_for__4__q),
+        .clock(res_for__4__clock)
+    );
+    dynrt_processor__display__dark_d res_for__5(
+        .d(res_for__5__d),
+        .q(res_for__5__q),
+        .clock(res_for__5__clock)
+    );
+    dynrt_processor__display__dark_d res_for__6(
+        .d(res_for__6__d),
+        .q(res_for__6__q),
+        .clock(res_for__6__clock)
+    );
+    dynrt_processor__display__dark_d res_for__7(
+        .d(res_for__7__d),
+        .q(res_for__7__q),
+        .clock(res_for__7__clock)
+    );
+    dynrt_processor__display__dark_d res_for__8(
+        .d(res_for__8__d),
+        .q(res_for__8__q),
+        .clock(res_for__8__clock)
+    );
+    dynrt_processor__display__dark_d res_for__9(
+        .d(res_for__9__d),
+        .q(res_for__9__q),
+        .clock(res_for__9__clock)
+    );
+    dynrt_processor__display__dark_d res_for__10(
+        .d(res_for__10__d),
+        .q(res_for__10__q),
+        .clock(res_for__10__clock)
+    );
+    dynrt_processor__display__dark_d res_for__11(
+        .d(res_for__11__d),
+        .q(res_for__11__q),
+        .clock(res_for__11__clock)
+    );
+    dynrt_processor__display__dark_d res_for__12(
+        .d(res_for__12__d),
+        .q(res_for__12__q),
+        .clock(res_for__12__clock)
+    );
+    dynrt_processor__display__dark_d res_for__13(
+        .d(res_for__13__d),
+        .q(res_for__13__q),
+        .clock(res_for__13__clock)
+    );
+    dynrt_processor__display__dark_d res_for__14(
+        .d(res_for__14__d),
+        .q(res_for__14__q),
+        .clock(res_for__14__clock)
+    );
+    dynrt_processor__display__dark_d res_for__15(
+        .d(res_for__15__d),
+        .q(res_for__15__q),
+        .clock(res_for__15__clock)
+    );
     dynrt_processor__engine__shader__frame_line tri_line(
         .clock(tri_line__clock),
         .data_in(tri_line__data_in),
@@ -19327,6 +19560,86 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .data_in(cos_slot__data_in),
         .data_out(cos_slot__data_out)
     );
+    dynrt_processor__display__dark_d cos_for__0(
+        .d(cos_for__0__d),
+        .q(cos_for__0__q),
+        .clock(cos_for__0__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__1(
+        .d(cos_for__1__d),
+        .q(cos_for__1__q),
+        .clock(cos_for__1__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__2(
+        .d(cos_for__2__d),
+        .q(cos_for__2__q),
+        .clock(cos_for__2__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__3(
+        .d(cos_for__3__d),
+        .q(cos_for__3__q),
+        .clock(cos_for__3__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__4(
+        .d(cos_for__4__d),
+        .q(cos_for__4__q),
+        .clock(cos_for__4__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__5(
+        .d(cos_for__5__d),
+        .q(cos_for__5__q),
+        .clock(cos_for__5__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__6(
+        .d(cos_for__6__d),
+        .q(cos_for__6__q),
+        .clock(cos_for__6__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__7(
+        .d(cos_for__7__d),
+        .q(cos_for__7__q),
+        .clock(cos_for__7__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__8(
+        .d(cos_for__8__d),
+        .q(cos_for__8__q),
+        .clock(cos_for__8__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__9(
+        .d(cos_for__9__d),
+        .q(cos_for__9__q),
+        .clock(cos_for__9__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__10(
+        .d(cos_for__10__d),
+        .q(cos_for__10__q),
+        .clock(cos_for__10__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__11(
+        .d(cos_for__11__d),
+        .q(cos_for__11__q),
+        .clock(cos_for__11__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__12(
+        .d(cos_for__12__d),
+        .q(cos_for__12__q),
+        .clock(cos_for__12__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__13(
+        .d(cos_for__13__d),
+        .q(cos_for__13__q),
+        .clock(cos_for__13__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__14(
+        .d(cos_for__14__d),
+        .q(cos_for__14__q),
+        .clock(cos_for__14__clock)
+    );
+    dynrt_processor__display__dark_d cos_for__15(
+        .d(cos_for__15__d),
+        .q(cos_for__15__q),
+        .clock(cos_for__15__clock)
+    );
     dynrt_processor__display__dark_d byte_valid_r(
         .d(byte_valid_r__d),
         .q(byte_valid_r__q),
@@ -19353,6 +19666,86 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         .clock(byte_tag__clock),
         .data_in(byte_tag__data_in),
         .data_out(byte_tag__data_out)
+    );
+    dynrt_processor__display__dark_d byte_for__0(
+        .d(byte_for__0__d),
+        .q(byte_for__0__q),
+        .clock(byte_for__0__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__1(
+        .d(byte_for__1__d),
+        .q(byte_for__1__q),
+        .clock(byte_for__1__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__2(
+        .d(byte_for__2__d),
+        .q(byte_for__2__q),
+        .clock(byte_for__2__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__3(
+        .d(byte_for__3__d),
+        .q(byte_for__3__q),
+        .clock(byte_for__3__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__4(
+        .d(byte_for__4__d),
+        .q(byte_for__4__q),
+        .clock(byte_for__4__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__5(
+        .d(byte_for__5__d),
+        .q(byte_for__5__q),
+        .clock(byte_for__5__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__6(
+        .d(byte_for__6__d),
+        .q(byte_for__6__q),
+        .clock(byte_for__6__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__7(
+        .d(byte_for__7__d),
+        .q(byte_for__7__q),
+        .clock(byte_for__7__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__8(
+        .d(byte_for__8__d),
+        .q(byte_for__8__q),
+        .clock(byte_for__8__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__9(
+        .d(byte_for__9__d),
+        .q(byte_for__9__q),
+        .clock(byte_for__9__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__10(
+        .d(byte_for__10__d),
+        .q(byte_for__10__q),
+        .clock(byte_for__10__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__11(
+        .d(byte_for__11__d),
+        .q(byte_for__11__q),
+        .clock(byte_for__11__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__12(
+        .d(byte_for__12__d),
+        .q(byte_for__12__q),
+        .clock(byte_for__12__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__13(
+        .d(byte_for__13__d),
+        .q(byte_for__13__q),
+        .clock(byte_for__13__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__14(
+        .d(byte_for__14__d),
+        .q(byte_for__14__q),
+        .clock(byte_for__14__clock)
+    );
+    dynrt_processor__display__dark_d byte_for__15(
+        .d(byte_for__15__d),
+        .q(byte_for__15__q),
+        .clock(byte_for__15__clock)
     );
     dynrt_processor__display__rgb_q rgb_acc(
         .d(rgb_acc__d),
@@ -19452,6 +19845,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__0__d = miss__0__q;
         normal_in__0__clock = clock;
         kd_in__0__clock = clock;
+        res_for__0__clock = clock;
+        cos_for__0__clock = clock;
+        byte_for__0__clock = clock;
         busy__1__clock = clock;
         busy__1__d = busy__1__q;
         ready__1__clock = clock;
@@ -19466,6 +19862,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__1__d = miss__1__q;
         normal_in__1__clock = clock;
         kd_in__1__clock = clock;
+        res_for__1__clock = clock;
+        cos_for__1__clock = clock;
+        byte_for__1__clock = clock;
         busy__2__clock = clock;
         busy__2__d = busy__2__q;
         ready__2__clock = clock;
@@ -19480,6 +19879,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__2__d = miss__2__q;
         normal_in__2__clock = clock;
         kd_in__2__clock = clock;
+        res_for__2__clock = clock;
+        cos_for__2__clock = clock;
+        byte_for__2__clock = clock;
         busy__3__clock = clock;
         busy__3__d = busy__3__q;
         ready__3__clock = clock;
@@ -19494,6 +19896,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__3__d = miss__3__q;
         normal_in__3__clock = clock;
         kd_in__3__clock = clock;
+        res_for__3__clock = clock;
+        cos_for__3__clock = clock;
+        byte_for__3__clock = clock;
         busy__4__clock = clock;
         busy__4__d = busy__4__q;
         ready__4__clock = clock;
@@ -19508,6 +19913,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__4__d = miss__4__q;
         normal_in__4__clock = clock;
         kd_in__4__clock = clock;
+        res_for__4__clock = clock;
+        cos_for__4__clock = clock;
+        byte_for__4__clock = clock;
         busy__5__clock = clock;
         busy__5__d = busy__5__q;
         ready__5__clock = clock;
@@ -19522,6 +19930,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__5__d = miss__5__q;
         normal_in__5__clock = clock;
         kd_in__5__clock = clock;
+        res_for__5__clock = clock;
+        cos_for__5__clock = clock;
+        byte_for__5__clock = clock;
         busy__6__clock = clock;
         busy__6__d = busy__6__q;
         ready__6__clock = clock;
@@ -19536,6 +19947,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__6__d = miss__6__q;
         normal_in__6__clock = clock;
         kd_in__6__clock = clock;
+        res_for__6__clock = clock;
+        cos_for__6__clock = clock;
+        byte_for__6__clock = clock;
         busy__7__clock = clock;
         busy__7__d = busy__7__q;
         ready__7__clock = clock;
@@ -19550,6 +19964,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__7__d = miss__7__q;
         normal_in__7__clock = clock;
         kd_in__7__clock = clock;
+        res_for__7__clock = clock;
+        cos_for__7__clock = clock;
+        byte_for__7__clock = clock;
         busy__8__clock = clock;
         busy__8__d = busy__8__q;
         ready__8__clock = clock;
@@ -19564,6 +19981,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__8__d = miss__8__q;
         normal_in__8__clock = clock;
         kd_in__8__clock = clock;
+        res_for__8__clock = clock;
+        cos_for__8__clock = clock;
+        byte_for__8__clock = clock;
         busy__9__clock = clock;
         busy__9__d = busy__9__q;
         ready__9__clock = clock;
@@ -19578,6 +19998,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__9__d = miss__9__q;
         normal_in__9__clock = clock;
         kd_in__9__clock = clock;
+        res_for__9__clock = clock;
+        cos_for__9__clock = clock;
+        byte_for__9__clock = clock;
         busy__10__clock = clock;
         busy__10__d = busy__10__q;
         ready__10__clock = clock;
@@ -19592,6 +20015,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__10__d = miss__10__q;
         normal_in__10__clock = clock;
         kd_in__10__clock = clock;
+        res_for__10__clock = clock;
+        cos_for__10__clock = clock;
+        byte_for__10__clock = clock;
         busy__11__clock = clock;
         busy__11__d = busy__11__q;
         ready__11__clock = clock;
@@ -19606,6 +20032,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__11__d = miss__11__q;
         normal_in__11__clock = clock;
         kd_in__11__clock = clock;
+        res_for__11__clock = clock;
+        cos_for__11__clock = clock;
+        byte_for__11__clock = clock;
         busy__12__clock = clock;
         busy__12__d = busy__12__q;
         ready__12__clock = clock;
@@ -19620,6 +20049,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__12__d = miss__12__q;
         normal_in__12__clock = clock;
         kd_in__12__clock = clock;
+        res_for__12__clock = clock;
+        cos_for__12__clock = clock;
+        byte_for__12__clock = clock;
         busy__13__clock = clock;
         busy__13__d = busy__13__q;
         ready__13__clock = clock;
@@ -19634,6 +20066,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__13__d = miss__13__q;
         normal_in__13__clock = clock;
         kd_in__13__clock = clock;
+        res_for__13__clock = clock;
+        cos_for__13__clock = clock;
+        byte_for__13__clock = clock;
         busy__14__clock = clock;
         busy__14__d = busy__14__q;
         ready__14__clock = clock;
@@ -19648,6 +20083,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__14__d = miss__14__q;
         normal_in__14__clock = clock;
         kd_in__14__clock = clock;
+        res_for__14__clock = clock;
+        cos_for__14__clock = clock;
+        byte_for__14__clock = clock;
         busy__15__clock = clock;
         busy__15__d = busy__15__q;
         ready__15__clock = clock;
@@ -19662,6 +20100,9 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
         miss__15__d = miss__15__q;
         normal_in__15__clock = clock;
         kd_in__15__clock = clock;
+        res_for__15__clock = clock;
+        cos_for__15__clock = clock;
+        byte_for__15__clock = clock;
         background__0__clock = clock;
         background__0__d = background__0__q;
         gen_hold_v__0__clock = clock;
@@ -20711,7 +21152,54 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             res_step_r__d = step__15__q;
             res_light_r__d = light__15__q;
         end
-        res_positive = (~|(res_v_r__0__q & c_sign)) & |(res_v_r__0__q & c_exp_mask) & (~(((res_v_r__0__q & c_exp_mask) == c_exp_mask) & |(res_v_r__0__q & c_man_mask)));
+        res_positive__clock = clock;
+        res_positive__d = (~|(res_v__0 & c_sign)) & |(res_v__0 & c_exp_mask) & (~(((res_v__0 & c_exp_mask) == c_exp_mask) & |(res_v__0 & c_man_mask)));
+        res_for__0__d = res_valid & (res_slot == c_slot__0);
+        res_for__1__d = res_valid & (res_slot == c_slot__1);
+        res_for__2__d = res_valid & (res_slot == c_slot__2);
+        res_for__3__d = res_valid & (res_slot == c_slot__3);
+        res_for__4__d = res_valid & (res_slot == c_slot__4);
+        res_for__5__d = res_valid & (res_slot == c_slot__5);
+        res_for__6__d = res_valid & (res_slot == c_slot__6);
+        res_for__7__d = res_valid & (res_slot == c_slot__7);
+        res_for__8__d = res_valid & (res_slot == c_slot__8);
+        res_for__9__d = res_valid & (res_slot == c_slot__9);
+        res_for__10__d = res_valid & (res_slot == c_slot__10);
+        res_for__11__d = res_valid & (res_slot == c_slot__11);
+        res_for__12__d = res_valid & (res_slot == c_slot__12);
+        res_for__13__d = res_valid & (res_slot == c_slot__13);
+        res_for__14__d = res_valid & (res_slot == c_slot__14);
+        res_for__15__d = res_valid & (res_slot == c_slot__15);
+        res_next_step = res_step_r__q;
+        res_next_light = res_light_r__q;
+        if (res_step_r__q == ShadeStep__Point) begin
+            res_next_step = ShadeStep__NormalDot;
+        end
+        if (res_step_r__q == ShadeStep__NormalDot) begin
+            res_next_step = ShadeStep__KdLoad;
+        end
+        if (res_step_r__q == ShadeStep__Ambient) begin
+            res_next_step = ShadeStep__Pack;
+            if (c_has_lights) begin
+                res_next_step = ShadeStep__ToLight;
+            end
+        end
+        if (res_step_r__q == ShadeStep__ToLight) begin
+            res_next_step = ShadeStep__Dots;
+        end
+        if (res_step_r__q == ShadeStep__Tint) begin
+            res_next_step = ShadeStep__Accumulate;
+        end
+        if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive__q))) begin
+            res_next_step = ShadeStep__ToLight;
+            res_next_light = res_light_r__q + 32'h1;
+            if (res_light_r__q == c_last_light) begin
+                res_next_step = ShadeStep__Pack;
+            end
+        end
+        if ((res_step_r__q == ShadeStep__Dots) & res_positive__q) begin
+            res_next_step = ShadeStep__Cosine;
+        end
         p__0__write_address = res_slot_r__q;
         p__0__write_data = res_v_r__0__q;
         p__0__write_enable = res_valid_r__q & (res_step_r__q == ShadeStep__Point);
@@ -20797,45 +21285,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__0__d = 1'b1;
             step__0__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__0)) begin
-            ready__0__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__0__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__0__d = res_positive;
-                step__0__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__0__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__0__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__0__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__0__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__0__d = ShadeStep__ToLight;
-                light__0__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__0__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__0__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__0)) begin
+        cos_for__0__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__0);
+        byte_for__0__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__0);
+        if (cos_for__0__q) begin
             ready__0__d = 1'b1;
             step__0__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__0)) begin
+        if (byte_for__0__q) begin
             ready__0__d = 1'b1;
             step__0__d = ShadeStep__Store;
+        end
+        if (res_for__0__q) begin
+            ready__0__d = 1'b1;
+            step__0__d = res_next_step;
+            light__0__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__0__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__1)) begin
             busy__1__d = 1'b1;
@@ -20863,45 +21329,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__1__d = 1'b1;
             step__1__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__1)) begin
-            ready__1__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__1__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__1__d = res_positive;
-                step__1__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__1__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__1__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__1__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__1__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__1__d = ShadeStep__ToLight;
-                light__1__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__1__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__1__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__1)) begin
+        cos_for__1__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__1);
+        byte_for__1__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__1);
+        if (cos_for__1__q) begin
             ready__1__d = 1'b1;
             step__1__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__1)) begin
+        if (byte_for__1__q) begin
             ready__1__d = 1'b1;
             step__1__d = ShadeStep__Store;
+        end
+        if (res_for__1__q) begin
+            ready__1__d = 1'b1;
+            step__1__d = res_next_step;
+            light__1__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__1__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__2)) begin
             busy__2__d = 1'b1;
@@ -20929,45 +21373,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__2__d = 1'b1;
             step__2__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__2)) begin
-            ready__2__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__2__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__2__d = res_positive;
-                step__2__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__2__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__2__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__2__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__2__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__2__d = ShadeStep__ToLight;
-                light__2__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__2__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__2__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__2)) begin
+        cos_for__2__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__2);
+        byte_for__2__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__2);
+        if (cos_for__2__q) begin
             ready__2__d = 1'b1;
             step__2__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__2)) begin
+        if (byte_for__2__q) begin
             ready__2__d = 1'b1;
             step__2__d = ShadeStep__Store;
+        end
+        if (res_for__2__q) begin
+            ready__2__d = 1'b1;
+            step__2__d = res_next_step;
+            light__2__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__2__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__3)) begin
             busy__3__d = 1'b1;
@@ -20995,45 +21417,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__3__d = 1'b1;
             step__3__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__3)) begin
-            ready__3__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__3__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__3__d = res_positive;
-                step__3__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__3__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__3__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__3__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__3__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__3__d = ShadeStep__ToLight;
-                light__3__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__3__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__3__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__3)) begin
+        cos_for__3__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__3);
+        byte_for__3__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__3);
+        if (cos_for__3__q) begin
             ready__3__d = 1'b1;
             step__3__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__3)) begin
+        if (byte_for__3__q) begin
             ready__3__d = 1'b1;
             step__3__d = ShadeStep__Store;
+        end
+        if (res_for__3__q) begin
+            ready__3__d = 1'b1;
+            step__3__d = res_next_step;
+            light__3__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__3__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__4)) begin
             busy__4__d = 1'b1;
@@ -21061,45 +21461,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__4__d = 1'b1;
             step__4__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__4)) begin
-            ready__4__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__4__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__4__d = res_positive;
-                step__4__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__4__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__4__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__4__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__4__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__4__d = ShadeStep__ToLight;
-                light__4__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__4__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__4__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__4)) begin
+        cos_for__4__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__4);
+        byte_for__4__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__4);
+        if (cos_for__4__q) begin
             ready__4__d = 1'b1;
             step__4__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__4)) begin
+        if (byte_for__4__q) begin
             ready__4__d = 1'b1;
             step__4__d = ShadeStep__Store;
+        end
+        if (res_for__4__q) begin
+            ready__4__d = 1'b1;
+            step__4__d = res_next_step;
+            light__4__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__4__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__5)) begin
             busy__5__d = 1'b1;
@@ -21127,45 +21505,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__5__d = 1'b1;
             step__5__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__5)) begin
-            ready__5__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__5__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__5__d = res_positive;
-                step__5__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__5__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__5__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__5__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__5__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__5__d = ShadeStep__ToLight;
-                light__5__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__5__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__5__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__5)) begin
+        cos_for__5__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__5);
+        byte_for__5__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__5);
+        if (cos_for__5__q) begin
             ready__5__d = 1'b1;
             step__5__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__5)) begin
+        if (byte_for__5__q) begin
             ready__5__d = 1'b1;
             step__5__d = ShadeStep__Store;
+        end
+        if (res_for__5__q) begin
+            ready__5__d = 1'b1;
+            step__5__d = res_next_step;
+            light__5__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__5__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__6)) begin
             busy__6__d = 1'b1;
@@ -21193,45 +21549,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__6__d = 1'b1;
             step__6__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__6)) begin
-            ready__6__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__6__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__6__d = res_positive;
-                step__6__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__6__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__6__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__6__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__6__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__6__d = ShadeStep__ToLight;
-                light__6__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__6__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__6__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__6)) begin
+        cos_for__6__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__6);
+        byte_for__6__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__6);
+        if (cos_for__6__q) begin
             ready__6__d = 1'b1;
             step__6__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__6)) begin
+        if (byte_for__6__q) begin
             ready__6__d = 1'b1;
             step__6__d = ShadeStep__Store;
+        end
+        if (res_for__6__q) begin
+            ready__6__d = 1'b1;
+            step__6__d = res_next_step;
+            light__6__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__6__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__7)) begin
             busy__7__d = 1'b1;
@@ -21259,45 +21593,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__7__d = 1'b1;
             step__7__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__7)) begin
-            ready__7__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__7__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__7__d = res_positive;
-                step__7__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__7__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__7__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__7__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__7__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__7__d = ShadeStep__ToLight;
-                light__7__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__7__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__7__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__7)) begin
+        cos_for__7__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__7);
+        byte_for__7__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__7);
+        if (cos_for__7__q) begin
             ready__7__d = 1'b1;
             step__7__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__7)) begin
+        if (byte_for__7__q) begin
             ready__7__d = 1'b1;
             step__7__d = ShadeStep__Store;
+        end
+        if (res_for__7__q) begin
+            ready__7__d = 1'b1;
+            step__7__d = res_next_step;
+            light__7__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__7__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__8)) begin
             busy__8__d = 1'b1;
@@ -21325,45 +21637,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__8__d = 1'b1;
             step__8__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__8)) begin
-            ready__8__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__8__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__8__d = res_positive;
-                step__8__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__8__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__8__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__8__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__8__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__8__d = ShadeStep__ToLight;
-                light__8__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__8__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__8__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__8)) begin
+        cos_for__8__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__8);
+        byte_for__8__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__8);
+        if (cos_for__8__q) begin
             ready__8__d = 1'b1;
             step__8__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__8)) begin
+        if (byte_for__8__q) begin
             ready__8__d = 1'b1;
             step__8__d = ShadeStep__Store;
+        end
+        if (res_for__8__q) begin
+            ready__8__d = 1'b1;
+            step__8__d = res_next_step;
+            light__8__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__8__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__9)) begin
             busy__9__d = 1'b1;
@@ -21391,45 +21681,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__9__d = 1'b1;
             step__9__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__9)) begin
-            ready__9__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__9__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__9__d = res_positive;
-                step__9__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__9__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__9__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__9__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__9__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__9__d = ShadeStep__ToLight;
-                light__9__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__9__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__9__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__9)) begin
+        cos_for__9__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__9);
+        byte_for__9__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__9);
+        if (cos_for__9__q) begin
             ready__9__d = 1'b1;
             step__9__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__9)) begin
+        if (byte_for__9__q) begin
             ready__9__d = 1'b1;
             step__9__d = ShadeStep__Store;
+        end
+        if (res_for__9__q) begin
+            ready__9__d = 1'b1;
+            step__9__d = res_next_step;
+            light__9__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__9__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__10)) begin
             busy__10__d = 1'b1;
@@ -21457,45 +21725,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__10__d = 1'b1;
             step__10__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__10)) begin
-            ready__10__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__10__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__10__d = res_positive;
-                step__10__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__10__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__10__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__10__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__10__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__10__d = ShadeStep__ToLight;
-                light__10__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__10__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__10__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__10)) begin
+        cos_for__10__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__10);
+        byte_for__10__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__10);
+        if (cos_for__10__q) begin
             ready__10__d = 1'b1;
             step__10__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__10)) begin
+        if (byte_for__10__q) begin
             ready__10__d = 1'b1;
             step__10__d = ShadeStep__Store;
+        end
+        if (res_for__10__q) begin
+            ready__10__d = 1'b1;
+            step__10__d = res_next_step;
+            light__10__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__10__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__11)) begin
             busy__11__d = 1'b1;
@@ -21523,45 +21769,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__11__d = 1'b1;
             step__11__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__11)) begin
-            ready__11__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__11__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__11__d = res_positive;
-                step__11__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__11__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__11__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__11__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__11__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__11__d = ShadeStep__ToLight;
-                light__11__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__11__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__11__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__11)) begin
+        cos_for__11__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__11);
+        byte_for__11__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__11);
+        if (cos_for__11__q) begin
             ready__11__d = 1'b1;
             step__11__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__11)) begin
+        if (byte_for__11__q) begin
             ready__11__d = 1'b1;
             step__11__d = ShadeStep__Store;
+        end
+        if (res_for__11__q) begin
+            ready__11__d = 1'b1;
+            step__11__d = res_next_step;
+            light__11__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__11__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__12)) begin
             busy__12__d = 1'b1;
@@ -21589,45 +21813,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__12__d = 1'b1;
             step__12__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__12)) begin
-            ready__12__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__12__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__12__d = res_positive;
-                step__12__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__12__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__12__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__12__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__12__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__12__d = ShadeStep__ToLight;
-                light__12__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__12__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__12__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__12)) begin
+        cos_for__12__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__12);
+        byte_for__12__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__12);
+        if (cos_for__12__q) begin
             ready__12__d = 1'b1;
             step__12__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__12)) begin
+        if (byte_for__12__q) begin
             ready__12__d = 1'b1;
             step__12__d = ShadeStep__Store;
+        end
+        if (res_for__12__q) begin
+            ready__12__d = 1'b1;
+            step__12__d = res_next_step;
+            light__12__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__12__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__13)) begin
             busy__13__d = 1'b1;
@@ -21655,45 +21857,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__13__d = 1'b1;
             step__13__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__13)) begin
-            ready__13__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__13__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__13__d = res_positive;
-                step__13__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__13__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__13__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__13__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__13__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__13__d = ShadeStep__ToLight;
-                light__13__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__13__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__13__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__13)) begin
+        cos_for__13__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__13);
+        byte_for__13__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__13);
+        if (cos_for__13__q) begin
             ready__13__d = 1'b1;
             step__13__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__13)) begin
+        if (byte_for__13__q) begin
             ready__13__d = 1'b1;
             step__13__d = ShadeStep__Store;
+        end
+        if (res_for__13__q) begin
+            ready__13__d = 1'b1;
+            step__13__d = res_next_step;
+            light__13__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__13__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__14)) begin
             busy__14__d = 1'b1;
@@ -21721,45 +21901,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__14__d = 1'b1;
             step__14__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__14)) begin
-            ready__14__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__14__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__14__d = res_positive;
-                step__14__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__14__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__14__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__14__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__14__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__14__d = ShadeStep__ToLight;
-                light__14__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__14__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__14__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__14)) begin
+        cos_for__14__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__14);
+        byte_for__14__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__14);
+        if (cos_for__14__q) begin
             ready__14__d = 1'b1;
             step__14__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__14)) begin
+        if (byte_for__14__q) begin
             ready__14__d = 1'b1;
             step__14__d = ShadeStep__Store;
+        end
+        if (res_for__14__q) begin
+            ready__14__d = 1'b1;
+            step__14__d = res_next_step;
+            light__14__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__14__d = res_positive__q;
+            end
         end
         if (take_r__q & (take_slot_r__q == c_slot__15)) begin
             busy__15__d = 1'b1;
@@ -21787,45 +21945,23 @@ module dynrt_processor__engine__shader(clock,frame_start,ray_write,ray_thread,ra
             ready__15__d = 1'b1;
             step__15__d = ShadeStep__Ambient;
         end
-        if (res_valid_r__q & (res_slot_r__q == c_slot__15)) begin
-            ready__15__d = 1'b1;
-            if (res_step_r__q == ShadeStep__Point) begin
-                step__15__d = ShadeStep__NormalDot;
-            end
-            if (res_step_r__q == ShadeStep__NormalDot) begin
-                flip__15__d = res_positive;
-                step__15__d = ShadeStep__KdLoad;
-            end
-            if (res_step_r__q == ShadeStep__Ambient) begin
-                step__15__d = ShadeStep__Pack;
-                if (c_has_lights) begin
-                    step__15__d = ShadeStep__ToLight;
-                end
-            end
-            if (res_step_r__q == ShadeStep__ToLight) begin
-                step__15__d = ShadeStep__Dots;
-            end
-            if (res_step_r__q == ShadeStep__Tint) begin
-                step__15__d = ShadeStep__Accumulate;
-            end
-            if ((res_step_r__q == ShadeStep__Accumulate) | ((res_step_r__q == ShadeStep__Dots) & (~res_positive))) begin
-                step__15__d = ShadeStep__ToLight;
-                light__15__d = res_light_r__q + 32'h1;
-                if (res_light_r__q == c_last_light) begin
-                    step__15__d = ShadeStep__Pack;
-                end
-            end
-            if ((res_step_r__q == ShadeStep__Dots) & res_positive) begin
-                step__15__d = ShadeStep__Cosine;
-            end
-        end
-        if (cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__15)) begin
+        cos_for__15__d = cos_slot__data_out[32'h0] & (cos_slot__data_out[(32'h1)+:(4)] == c_slot__15);
+        byte_for__15__d = byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__15);
+        if (cos_for__15__q) begin
             ready__15__d = 1'b1;
             step__15__d = ShadeStep__Tint;
         end
-        if (byte_tag__data_out[32'h0] & (byte_tag__data_out[(32'h5)+:(2)] == 32'h2) & (byte_tag__data_out[(32'h1)+:(4)] == c_slot__15)) begin
+        if (byte_for__15__q) begin
             ready__15__d = 1'b1;
             step__15__d = ShadeStep__Store;
+        end
+        if (res_for__15__q) begin
+            ready__15__d = 1'b1;
+            step__15__d = res_next_step;
+            light__15__d = res_next_light;
+            if (res_step_r__q == ShadeStep__NormalDot) begin
+                flip__15__d = res_positive__q;
+            end
         end
         if (frame_start) begin
             loading__d = 1'b1;
@@ -21901,6 +22037,38 @@ module dynrt_processor__engine__shader__acc__0(read_address,read_data,write_cloc
        end
     end
 endmodule // dynrt_processor__engine__shader__acc__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -22086,6 +22254,38 @@ module dynrt_processor__engine__shader__byte_tag(clock,data_in,data_out);
     end
     
 endmodule // dynrt_processor__engine__shader__byte_tag
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -23638,6 +23838,40 @@ endmodule // dynrt_processor__engine__shader__light_color__0
 
 
 
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 module dynrt_processor__engine__shader__res_step_r(d,q,clock);
     
     // Module arguments
@@ -25015,11 +25249,15 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [31:0] fetch_a;
     reg  fetch_ends;
     reg  tb_free;
+    reg  lookup_pending__0;
+    reg  lookup_pending__1;
+    reg  lookup_pending__2;
+    reg  lookup_pending__3;
     reg  [23:0] head_triangle;
     reg  [8:0] head_set;
     reg  head_hit;
-    reg  l_fresh;
-    reg  n_fresh;
+    reg  l_pending;
+    reg  n_pending;
     reg  l_cached;
     reg  [8:0] l_set;
     reg  n_cached;
@@ -26420,6 +26658,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         fresh__0__clock = clock;
         comparing__0__clock = clock;
         deciding__0__clock = clock;
+        lookup_pending__0 = fresh__0__q | comparing__0__q | deciding__0__q;
         loaded__0__clock = clock;
         loaded__0__d = loaded__0__q;
         unvisited__0__clock = clock;
@@ -26439,6 +26678,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         fresh__1__clock = clock;
         comparing__1__clock = clock;
         deciding__1__clock = clock;
+        lookup_pending__1 = fresh__1__q | comparing__1__q | deciding__1__q;
         loaded__1__clock = clock;
         loaded__1__d = loaded__1__q;
         unvisited__1__clock = clock;
@@ -26458,6 +26698,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         fresh__2__clock = clock;
         comparing__2__clock = clock;
         deciding__2__clock = clock;
+        lookup_pending__2 = fresh__2__q | comparing__2__q | deciding__2__q;
         loaded__2__clock = clock;
         loaded__2__d = loaded__2__q;
         unvisited__2__clock = clock;
@@ -26477,6 +26718,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         fresh__3__clock = clock;
         comparing__3__clock = clock;
         deciding__3__clock = clock;
+        lookup_pending__3 = fresh__3__q | comparing__3__q | deciding__3__q;
         loaded__3__clock = clock;
         loaded__3__d = loaded__3__q;
         unvisited__3__clock = clock;
@@ -26560,7 +26802,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         l_loaded = loaded__0__q;
         l_received = received__0__q;
         l_cached = cached__0__q;
-        l_fresh = fresh__0__q | comparing__0__q | deciding__0__q;
+        l_pending = lookup_pending__0;
         if (lb__q == c_buffer__1) begin
             l_kind = cur_kind__1__q;
             l_thread = cur_thread__1__q;
@@ -26569,7 +26811,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__1__q;
             l_received = received__1__q;
             l_cached = cached__1__q;
-            l_fresh = fresh__1__q | comparing__1__q | deciding__1__q;
+            l_pending = lookup_pending__1;
         end
         if (lb__q == c_buffer__2) begin
             l_kind = cur_kind__2__q;
@@ -26579,7 +26821,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__2__q;
             l_received = received__2__q;
             l_cached = cached__2__q;
-            l_fresh = fresh__2__q | comparing__2__q | deciding__2__q;
+            l_pending = lookup_pending__2;
         end
         if (lb__q == c_buffer__3) begin
             l_kind = cur_kind__3__q;
@@ -26589,7 +26831,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__3__q;
             l_received = received__3__q;
             l_cached = cached__3__q;
-            l_fresh = fresh__3__q | comparing__3__q | deciding__3__q;
+            l_pending = lookup_pending__3;
         end
         l_ready = l_loaded & ((l_kind != c_test_triangle) | (l_received == 32'hc) | (l_cached & cache_ready__q));
         n_thread = cur_thread__0__q;
@@ -26597,7 +26839,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         n_kind = cur_kind__0__q;
         n_received = received__0__q;
         n_cached = cached__0__q;
-        n_fresh = fresh__0__q | comparing__0__q | deciding__0__q;
+        n_pending = lookup_pending__0;
         n_set = cur_a__0__q[(32'h0)+:(9)] & c_set_mask;
         if (lb__q + 32'h1 == c_buffer__1) begin
             n_thread = cur_thread__1__q;
@@ -26605,7 +26847,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__1__q;
             n_received = received__1__q;
             n_cached = cached__1__q;
-            n_fresh = fresh__1__q | comparing__1__q | deciding__1__q;
+            n_pending = lookup_pending__1;
             n_set = cur_a__1__q[(32'h0)+:(9)] & c_set_mask;
         end
         if (lb__q + 32'h1 == c_buffer__2) begin
@@ -26614,7 +26856,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__2__q;
             n_received = received__2__q;
             n_cached = cached__2__q;
-            n_fresh = fresh__2__q | comparing__2__q | deciding__2__q;
+            n_pending = lookup_pending__2;
             n_set = cur_a__2__q[(32'h0)+:(9)] & c_set_mask;
         end
         if (lb__q + 32'h1 == c_buffer__3) begin
@@ -26623,7 +26865,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__3__q;
             n_received = received__3__q;
             n_cached = cached__3__q;
-            n_fresh = fresh__3__q | comparing__3__q | deciding__3__q;
+            n_pending = lookup_pending__3;
             n_set = cur_a__3__q[(32'h0)+:(9)] & c_set_mask;
         end
         n_ready = n_loaded & ((n_kind != c_test_triangle) | (n_received == 32'hc) | (n_cached & cache_ready__q));
@@ -26646,9 +26888,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cache_tag__write_address = l_set;
         cache_tag__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
         cache_tag__write_enable = cache_write_r__q;
-        cache_ready__d = l_loaded & (~l_fresh);
+        cache_ready__d = l_loaded & (~l_pending);
         if (lphase__q != Launch__Wait) begin
-            cache_ready__d = n_loaded & (~n_fresh);
+            cache_ready__d = n_loaded & (~n_pending);
         end
         cache_words__0__write_address = l_set;
         cache_words__0__write_data = matrix__0__q;
@@ -26902,16 +27144,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             end
         end
         next_triangle = 1'b0;
-        if ((fetch_next == c_buffer__0) & unvisited__0__q & (~fresh__0__q) & (~comparing__0__q) & (~deciding__0__q) & (cur_kind__0__q == c_test_triangle) & (~cached__0__q)) begin
+        if ((fetch_next == c_buffer__0) & unvisited__0__q & (~lookup_pending__0) & (cur_kind__0__q == c_test_triangle) & (~cached__0__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__1) & unvisited__1__q & (~fresh__1__q) & (~comparing__1__q) & (~deciding__1__q) & (cur_kind__1__q == c_test_triangle) & (~cached__1__q)) begin
+        if ((fetch_next == c_buffer__1) & unvisited__1__q & (~lookup_pending__1) & (cur_kind__1__q == c_test_triangle) & (~cached__1__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__2) & unvisited__2__q & (~fresh__2__q) & (~comparing__2__q) & (~deciding__2__q) & (cur_kind__2__q == c_test_triangle) & (~cached__2__q)) begin
+        if ((fetch_next == c_buffer__2) & unvisited__2__q & (~lookup_pending__2) & (cur_kind__2__q == c_test_triangle) & (~cached__2__q)) begin
             next_triangle = 1'b1;
         end
-        if ((fetch_next == c_buffer__3) & unvisited__3__q & (~fresh__3__q) & (~comparing__3__q) & (~deciding__3__q) & (cur_kind__3__q == c_test_triangle) & (~cached__3__q)) begin
+        if ((fetch_next == c_buffer__3) & unvisited__3__q & (~lookup_pending__3) & (cur_kind__3__q == c_test_triangle) & (~cached__3__q)) begin
             next_triangle = 1'b1;
         end
         if ((~fetching__q) | fetch_ends) begin

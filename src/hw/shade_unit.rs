@@ -297,7 +297,15 @@ pub struct ShadeUnit<
     /// slots' mux then the RAMs' write enables was stop 42's critical path in one clock.
     res_step_r: DFF<ShadeStep>,
     res_light_r: DFF<Bits<3>>,
-    res_positive: Signal<Local, Bit>,
+    /// `0 < result x`, registered from the unit's result beside `res_v_r`: decoded from
+    /// `res_v_r` it was the head of stop 47's placed path on cornell_noshadow (the sign, the
+    /// exponent's and mantissa's ORs, then every slot's step: 72.9 MHz).
+    res_positive: DFF<Bit>,
+    /// The result is slot s's, a per-slot decode registered beside `res_slot_r`.
+    res_for: [DFF<Bit>; SHADE_SLOTS],
+    /// The step and light a result moves its slot to, decided once for all slots.
+    res_next_step: Signal<Local, ShadeStep>,
+    res_next_light: Signal<Local, Bits<3>>,
     tri_word_0: Signal<Local, Bit>,
     tri_word_1: Signal<Local, Bit>,
     frame_valid: Signal<Local, Bit>,
@@ -335,6 +343,9 @@ pub struct ShadeUnit<
     cos_n_dot_l: DelayLine<Bits<W>>,
     /// `{slot, valid}` of the cosine in flight.
     cos_slot: DelayLine<Bits<5>>,
+    /// Slot s's cosine was written last clock (decoded from `cos_slot` and registered, so
+    /// that each slot's step reads a flip-flop of its own).
+    cos_for: [DFF<Bit>; SHADE_SLOTS],
     // The bytes.
     /// The byte's input, registered: the slot RAM's read and the word's select take a clock
     /// of their own, apart from the clamp (stop 41's critical path held all three).
@@ -344,6 +355,8 @@ pub struct ShadeUnit<
     byte_unit: ChannelByte<W, E, M, S, S1, X2, T, P>,
     /// `{word, slot, valid}` of the byte in flight.
     byte_tag: Delay<Bits<7>, { CHANNEL_BYTE_LATENCY as usize }>,
+    /// Slot s's third byte was written last clock (as `cos_for`).
+    byte_for: [DFF<Bit>; SHADE_SLOTS],
     rgb_acc: DFF<Bits<24>>,
     // Constants.
     c_slot: [Constant<Bits<4>>; SHADE_SLOTS],
@@ -539,6 +552,9 @@ impl<
             res_step_r: Default::default(),
             res_light_r: Default::default(),
             res_positive: Default::default(),
+            res_for: Default::default(),
+            res_next_step: Default::default(),
+            res_next_light: Default::default(),
             tri_word_0: Default::default(),
             tri_word_1: Default::default(),
             frame_valid: Default::default(),
@@ -567,11 +583,13 @@ impl<
             div: Default::default(),
             cos_n_dot_l: DelayLine::new(sqrt_clocks),
             cos_slot: DelayLine::new(cos_clocks),
+            cos_for: Default::default(),
             byte_valid_r: Default::default(),
             byte_word_r: Default::default(),
             byte_tag_r: Default::default(),
             byte_unit: Default::default(),
             byte_tag: Default::default(),
+            byte_for: Default::default(),
             rgb_acc: Default::default(),
             c_slot: std::array::from_fn(|s| Constant::new((s as u64).into())),
             c_sign: const_bits::<W>(f.sign_mask() as u64),
@@ -668,6 +686,9 @@ impl<
             self.miss[s].d.next = self.miss[s].q.val();
             self.normal_in[s].clock.next = self.clock.val();
             self.kd_in[s].clock.next = self.clock.val();
+            self.res_for[s].clock.next = self.clock.val();
+            self.cos_for[s].clock.next = self.clock.val();
+            self.byte_for[s].clock.next = self.clock.val();
         }
         for k in 0..3 {
             self.background[k].clock.next = self.clock.val();
@@ -1254,10 +1275,50 @@ impl<
             }
         }
         // 0 < res_v[0]: positive, not zero (nor subnormal, read as zero), not NaN.
-        self.res_positive.next = (!(self.res_v_r[0].q.val() & self.c_sign.val()).any())
-            & (self.res_v_r[0].q.val() & self.c_exp_mask.val()).any()
-            & (!(((self.res_v_r[0].q.val() & self.c_exp_mask.val()) == self.c_exp_mask.val())
-                & (self.res_v_r[0].q.val() & self.c_man_mask.val()).any()));
+        self.res_positive.clock.next = self.clock.val();
+        self.res_positive.d.next = (!(self.res_v[0].val() & self.c_sign.val()).any())
+            & (self.res_v[0].val() & self.c_exp_mask.val()).any()
+            & (!(((self.res_v[0].val() & self.c_exp_mask.val()) == self.c_exp_mask.val())
+                & (self.res_v[0].val() & self.c_man_mask.val()).any()));
+        for s in 0..SHADE_SLOTS {
+            self.res_for[s].d.next =
+                self.res_valid.val() & (self.res_slot.val() == self.c_slot[s].val());
+        }
+        // Where a result moves its slot: a slot waits for one result at a time, so this is
+        // decided once, from the registered step, light and sign.
+        self.res_next_step.next = self.res_step_r.q.val();
+        self.res_next_light.next = self.res_light_r.q.val();
+        if self.res_step_r.q.val() == ShadeStep::Point {
+            self.res_next_step.next = ShadeStep::NormalDot;
+        }
+        if self.res_step_r.q.val() == ShadeStep::NormalDot {
+            self.res_next_step.next = ShadeStep::KdLoad;
+        }
+        if self.res_step_r.q.val() == ShadeStep::Ambient {
+            self.res_next_step.next = ShadeStep::Pack;
+            if self.c_has_lights.val() {
+                self.res_next_step.next = ShadeStep::ToLight;
+            }
+        }
+        if self.res_step_r.q.val() == ShadeStep::ToLight {
+            self.res_next_step.next = ShadeStep::Dots;
+        }
+        if self.res_step_r.q.val() == ShadeStep::Tint {
+            self.res_next_step.next = ShadeStep::Accumulate;
+        }
+        // The light is done (lit and added, or behind the surface): the next one.
+        if (self.res_step_r.q.val() == ShadeStep::Accumulate)
+            | ((self.res_step_r.q.val() == ShadeStep::Dots) & (!self.res_positive.q.val()))
+        {
+            self.res_next_step.next = ShadeStep::ToLight;
+            self.res_next_light.next = self.res_light_r.q.val() + 1;
+            if self.res_light_r.q.val() == self.c_last_light.val() {
+                self.res_next_step.next = ShadeStep::Pack;
+            }
+        }
+        if (self.res_step_r.q.val() == ShadeStep::Dots) & self.res_positive.q.val() {
+            self.res_next_step.next = ShadeStep::Cosine;
+        }
         for k in 0..3 {
             self.p[k].write_address.next = self.res_slot_r.q.val();
             self.p[k].write_data.next = self.res_v_r[k].q.val();
@@ -1341,56 +1402,30 @@ impl<
                 self.ready[s].d.next = true;
                 self.step[s].d.next = ShadeStep::Ambient;
             }
-            // A TransformUnit result.
-            if self.res_valid_r.q.val() & (self.res_slot_r.q.val() == self.c_slot[s].val()) {
-                self.ready[s].d.next = true;
-                if self.res_step_r.q.val() == ShadeStep::Point {
-                    self.step[s].d.next = ShadeStep::NormalDot;
-                }
-                if self.res_step_r.q.val() == ShadeStep::NormalDot {
-                    self.flip[s].d.next = self.res_positive.val();
-                    self.step[s].d.next = ShadeStep::KdLoad;
-                }
-                if self.res_step_r.q.val() == ShadeStep::Ambient {
-                    self.step[s].d.next = ShadeStep::Pack;
-                    if self.c_has_lights.val() {
-                        self.step[s].d.next = ShadeStep::ToLight;
-                    }
-                }
-                if self.res_step_r.q.val() == ShadeStep::ToLight {
-                    self.step[s].d.next = ShadeStep::Dots;
-                }
-                if self.res_step_r.q.val() == ShadeStep::Tint {
-                    self.step[s].d.next = ShadeStep::Accumulate;
-                }
-                // The light is done (lit and added, or behind the surface): the next one.
-                if (self.res_step_r.q.val() == ShadeStep::Accumulate)
-                    | ((self.res_step_r.q.val() == ShadeStep::Dots) & (!self.res_positive.val()))
-                {
-                    self.step[s].d.next = ShadeStep::ToLight;
-                    self.light[s].d.next = self.res_light_r.q.val() + 1;
-                    if self.res_light_r.q.val() == self.c_last_light.val() {
-                        self.step[s].d.next = ShadeStep::Pack;
-                    }
-                }
-                if (self.res_step_r.q.val() == ShadeStep::Dots) & self.res_positive.val() {
-                    self.step[s].d.next = ShadeStep::Cosine;
-                }
-            }
+            self.cos_for[s].d.next = self.cos_slot.data_out.val().get_bit(0)
+                & (self.cos_slot.data_out.val().get_bits::<4>(1) == self.c_slot[s].val());
+            self.byte_for[s].d.next = self.byte_tag.data_out.val().get_bit(0)
+                & (self.byte_tag.data_out.val().get_bits::<2>(5) == 2)
+                & (self.byte_tag.data_out.val().get_bits::<4>(1) == self.c_slot[s].val());
             // The cosine.
-            if self.cos_slot.data_out.val().get_bit(0)
-                & (self.cos_slot.data_out.val().get_bits::<4>(1) == self.c_slot[s].val())
-            {
+            if self.cos_for[s].q.val() {
                 self.ready[s].d.next = true;
                 self.step[s].d.next = ShadeStep::Tint;
             }
             // The third byte.
-            if self.byte_tag.data_out.val().get_bit(0)
-                & (self.byte_tag.data_out.val().get_bits::<2>(5) == 2)
-                & (self.byte_tag.data_out.val().get_bits::<4>(1) == self.c_slot[s].val())
-            {
+            if self.byte_for[s].q.val() {
                 self.ready[s].d.next = true;
                 self.step[s].d.next = ShadeStep::Store;
+            }
+            // A TransformUnit result (last: its step is the latest to settle, and a slot
+            // has one event at a time, so the order of these is free).
+            if self.res_for[s].q.val() {
+                self.ready[s].d.next = true;
+                self.step[s].d.next = self.res_next_step.val();
+                self.light[s].d.next = self.res_next_light.val();
+                if self.res_step_r.q.val() == ShadeStep::NormalDot {
+                    self.flip[s].d.next = self.res_positive.q.val();
+                }
             }
         }
 

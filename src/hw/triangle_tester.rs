@@ -310,6 +310,9 @@ pub struct TriangleTester<
     fresh: [DFF<Bit>; TEST_BUFFERS],
     comparing: [DFF<Bit>; TEST_BUFFERS],
     deciding: [DFF<Bit>; TEST_BUFFERS],
+    /// The buffer's lookup is under way (`fresh`, `comparing` or `deciding`): its `cached`
+    /// is not yet known.
+    lookup_pending: [Signal<Local, Bit>; TEST_BUFFERS],
     head_triangle: Signal<Local, Bits<24>>,
     head_set: Signal<Local, Bits<9>>,
     /// The head as it goes down the three clocks of its lookup: its triangle and set, and
@@ -327,10 +330,10 @@ pub struct TriangleTester<
     tag_word_r: DFF<Bits<25>>,
     head_hit: Signal<Local, Bit>,
     head_hit_r: DFF<Bit>,
-    /// The launch's buffer (`l_`) or the next one (`n_`) is fresh or deciding: its `cached`
+    /// The lookup of the launch's buffer (`l_`) or the next one's (`n_`) is pending: its `cached`
     /// may change in the next clock, so `matrix_cached`, registered from it, is not yet its.
-    l_fresh: Signal<Local, Bit>,
-    n_fresh: Signal<Local, Bit>,
+    l_pending: Signal<Local, Bit>,
+    n_pending: Signal<Local, Bit>,
     l_cached: Signal<Local, Bit>,
     l_set: Signal<Local, Bits<9>>,
     n_cached: Signal<Local, Bit>,
@@ -578,6 +581,7 @@ impl<
             fresh: Default::default(),
             comparing: Default::default(),
             deciding: Default::default(),
+            lookup_pending: Default::default(),
             head_triangle_rr: Default::default(),
             head_set_rr: Default::default(),
             head_set_rrr: Default::default(),
@@ -591,8 +595,8 @@ impl<
             head_set_r: Default::default(),
             head_clash_r: Default::default(),
             head_hit: Default::default(),
-            l_fresh: Default::default(),
-            n_fresh: Default::default(),
+            l_pending: Default::default(),
+            n_pending: Default::default(),
             l_cached: Default::default(),
             words_buffer: Default::default(),
             matrix_cached: Default::default(),
@@ -823,6 +827,8 @@ impl<
             self.fresh[k].clock.next = self.clock.val();
             self.comparing[k].clock.next = self.clock.val();
             self.deciding[k].clock.next = self.clock.val();
+            self.lookup_pending[k].next =
+                self.fresh[k].q.val() | self.comparing[k].q.val() | self.deciding[k].q.val();
             self.loaded[k].clock.next = self.clock.val();
             self.loaded[k].d.next = self.loaded[k].q.val();
             self.unvisited[k].clock.next = self.clock.val();
@@ -914,8 +920,7 @@ impl<
         self.l_loaded.next = self.loaded[0].q.val();
         self.l_received.next = self.received[0].q.val();
         self.l_cached.next = self.cached[0].q.val();
-        self.l_fresh.next =
-            self.fresh[0].q.val() | self.comparing[0].q.val() | self.deciding[0].q.val();
+        self.l_pending.next = self.lookup_pending[0].val();
         for k in 1..4 {
             if self.lb.q.val() == self.c_buffer[k].val() {
                 self.l_kind.next = self.cur_kind[k].q.val();
@@ -925,8 +930,7 @@ impl<
                 self.l_loaded.next = self.loaded[k].q.val();
                 self.l_received.next = self.received[k].q.val();
                 self.l_cached.next = self.cached[k].q.val();
-                self.l_fresh.next =
-                    self.fresh[k].q.val() | self.comparing[k].q.val() | self.deciding[k].q.val();
+                self.l_pending.next = self.lookup_pending[k].val();
             }
         }
         self.l_ready.next = self.l_loaded.val()
@@ -939,8 +943,7 @@ impl<
         self.n_kind.next = self.cur_kind[0].q.val();
         self.n_received.next = self.received[0].q.val();
         self.n_cached.next = self.cached[0].q.val();
-        self.n_fresh.next =
-            self.fresh[0].q.val() | self.comparing[0].q.val() | self.deciding[0].q.val();
+        self.n_pending.next = self.lookup_pending[0].val();
         self.n_set.next = self.cur_a[0].q.val().get_bits::<9>(0) & self.c_set_mask.val();
         for k in 1..4 {
             if self.lb.q.val() + 1 == self.c_buffer[k].val() {
@@ -949,8 +952,7 @@ impl<
                 self.n_kind.next = self.cur_kind[k].q.val();
                 self.n_received.next = self.received[k].q.val();
                 self.n_cached.next = self.cached[k].q.val();
-                self.n_fresh.next =
-                    self.fresh[k].q.val() | self.comparing[k].q.val() | self.deciding[k].q.val();
+                self.n_pending.next = self.lookup_pending[k].val();
                 self.n_set.next = self.cur_a[k].q.val().get_bits::<9>(0) & self.c_set_mask.val();
             }
         }
@@ -988,9 +990,9 @@ impl<
         self.cache_tag.write_enable.next = self.cache_write_r.q.val();
         // The words answer a clock after their set: the launch's while it waits, the next
         // buffer's from the origin's clock on (`matrix` takes them in the direction's).
-        self.cache_ready.d.next = self.l_loaded.val() & (!self.l_fresh.val());
+        self.cache_ready.d.next = self.l_loaded.val() & (!self.l_pending.val());
         if self.lphase.q.val() != Launch::Wait {
-            self.cache_ready.d.next = self.n_loaded.val() & (!self.n_fresh.val());
+            self.cache_ready.d.next = self.n_loaded.val() & (!self.n_pending.val());
         }
         for k in 0..12 {
             self.cache_words[k].write_address.next = self.l_set.val();
@@ -1158,9 +1160,7 @@ impl<
         for k in 0..4 {
             if (self.fetch_next.val() == self.c_buffer[k].val())
                 & self.unvisited[k].q.val()
-                & (!self.fresh[k].q.val())
-                & (!self.comparing[k].q.val())
-                & (!self.deciding[k].q.val())
+                & (!self.lookup_pending[k].val())
                 & (self.cur_kind[k].q.val() == self.c_test_triangle.val())
                 & (!self.cached[k].q.val())
             {
