@@ -76,6 +76,7 @@ pub fn preflight(
         for (flag, cache, sets) in [
             ("--tri-cache", "triangle", params.tri_cache_sets),
             ("--node-cache", "node", params.node_cache_sets),
+            ("--instance-cache", "instance", params.instance_cache_sets),
         ] {
             anyhow::ensure!(
                 cache_sets_supported(sets),
@@ -432,6 +433,10 @@ pub struct FrameReport {
     pub tri_cache_misses: u64,
     pub node_cache_hits: u64,
     pub node_cache_misses: u64,
+    /// Instance entries (and world normals) whose record came from the instance cache, and
+    /// from bank 4.
+    pub instance_cache_hits: u64,
+    pub instance_cache_misses: u64,
     pub pixels: u64,
     pub mismatches: Vec<Mismatch>,
     pub differing_pixels: usize,
@@ -662,6 +667,8 @@ pub fn simulate_scene(
             tri_cache_misses: fr.tri_cache_misses,
             node_cache_hits: fr.node_cache_hits,
             node_cache_misses: fr.node_cache_misses,
+            instance_cache_hits: fr.instance_cache_hits,
+            instance_cache_misses: fr.instance_cache_misses,
             pixels: u64::from(w * h),
             differing_pixels: differing.len(),
             mismatches,

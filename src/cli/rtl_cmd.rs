@@ -36,6 +36,11 @@ pub struct RtlArgs {
     /// between frames) and is off at --mem-latency 1.
     #[arg(long, value_name = "SETS", default_value_t = 512)]
     pub node_cache: u32,
+    /// Sets of the instance cache in front of bank 4 (a power of two up to 512, the paper's
+    /// 512 items; 0 for none). It is flushed as each frame starts (the host rewrites the
+    /// instances' records between frames).
+    #[arg(long, value_name = "SETS", default_value_t = 512)]
+    pub instance_cache: u32,
     /// Frames of an animated scene (default: all).
     #[arg(long)]
     pub frames: Option<u32>,
@@ -166,6 +171,7 @@ fn setup(a: &RtlArgs) -> anyhow::Result<(dynrt::scene::Scene, String, ProcessorP
         mem_latency: a.mem_latency,
         tri_cache_sets: a.tri_cache,
         node_cache_sets: a.node_cache,
+        instance_cache_sets: a.instance_cache,
     };
     flow::preflight(&scene, a.format, params, a.frames)?;
     let name = a
@@ -185,6 +191,7 @@ fn summary(verb: &str, a: &RtlArgs, scene: &dynrt::scene::Scene, name: &str) -> 
         .option("mem_latency", a.mem_latency)
         .option("tri_cache", a.tri_cache)
         .option("node_cache", a.node_cache)
+        .option("instance_cache", a.instance_cache)
         .option("frames", a.frames)
         .option("width", scene.camera.width)
         .option("height", scene.camera.height)
@@ -417,6 +424,19 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
                 nodes,
                 100.0 * f.node_cache_hits as f64 / nodes.max(1) as f64,
                 f.node_cache_misses
+            )
+        },
+        {
+            let f = &r.frames[0];
+            let lookups = f.instance_cache_hits + f.instance_cache_misses;
+            format!(
+                "instance cache (frame 0): {} sets, {} of {} instance records hit ({:.1}%), {} \
+                 read bank 4",
+                a.rtl.instance_cache,
+                f.instance_cache_hits,
+                lookups,
+                100.0 * f.instance_cache_hits as f64 / lookups.max(1) as f64,
+                f.instance_cache_misses
             )
         },
         format!("engine issue slots by routine: {}", shares.join(", ")),

@@ -53,6 +53,11 @@ pub struct TimingArgs {
     /// between frames) and is off at --mem-latency 1.
     #[arg(long, value_name = "SETS", default_value_t = 512)]
     pub node_cache: u32,
+    /// Sets of the instance cache in front of bank 4 (a power of two up to 512, the paper's
+    /// 512 items; 0 for none). It is flushed as each frame starts (the host rewrites the
+    /// instances' records between frames).
+    #[arg(long, value_name = "SETS", default_value_t = 512)]
+    pub instance_cache: u32,
     /// Report directory: timing.md, timing.csv and a folder per design.
     #[arg(long, default_value = "out/timing")]
     pub out: PathBuf,
@@ -162,6 +167,7 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
         mem_latency: a.mem_latency,
         tri_cache_sets: a.tri_cache,
         node_cache_sets: a.node_cache,
+        instance_cache_sets: a.instance_cache,
     };
     let mut designs = Vec::new();
     for u in &a.unit {

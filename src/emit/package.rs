@@ -213,6 +213,8 @@ pub fn port_meaning(name: &str) -> Option<&'static str> {
         "tri_cache_misses" => "triangle tests whose words came from banks 2 and 3",
         "node_cache_hits" => "object-tree nodes the traversal unit took from the node cache",
         "node_cache_misses" => "object-tree nodes the traversal unit read from bank 0",
+        "instance_cache_hits" => "instance records instance entry took from the instance cache",
+        "instance_cache_misses" => "instance records instance entry read from bank 4",
         "traversal_busy" => "clocks in which the traversal unit started a node decision",
         "mem_read" => "read request on the shared port (banks 1, 4, 5)",
         "mem_bank" => "bank of the shared port's request (1 lists, 4 instances, 5 frame)",

@@ -9,7 +9,8 @@
 //! unit) and the same for banks 2 and 3 (the triangles, which the triangle tester reads in
 //! parallel), `transform_busy[31:0], intersect_busy[31:0], traversal_busy[31:0],
 //! raygen_busy[31:0], instance_busy[31:0], shading_busy[31:0], tri_cache_hits[31:0],
-//! tri_cache_misses[31:0], node_cache_hits[31:0], node_cache_misses[31:0]` (activity counters
+//! tri_cache_misses[31:0], node_cache_hits[31:0], node_cache_misses[31:0],
+//! instance_cache_hits[31:0], instance_cache_misses[31:0]` (activity counters
 //! of the frame), and the `vga_`
 //! display ports.
 //!
@@ -22,7 +23,8 @@
 //! `TIMEOUT` and a non-zero exit), and the frame buffer written to `frame<k>.hex` (one
 //! `RRGGBB` word a line) with `cycles instructions transform_busy intersect_busy
 //! traversal_busy raygen_busy instance_busy shading_busy ready_clocks asleep_clocks reads0 ..
-//! reads5 tri_cache_hits tri_cache_misses node_cache_hits node_cache_misses` (`ready_clocks`, `asleep_clocks` are thread-clocks: the bits of the scheduler's
+//! reads5 tri_cache_hits tri_cache_misses node_cache_hits node_cache_misses
+//! instance_cache_hits instance_cache_misses` (`ready_clocks`, `asleep_clocks` are thread-clocks: the bits of the scheduler's
 //! `ready` and `asleep` masks added up every clock; `reads<b>` the words read from bank b) in
 //! `frame<k>.stats`, in the current
 //! folder or
@@ -256,7 +258,7 @@ const TESTBENCH_DRIVES: [(&str, &str); 5] = [
 ];
 
 /// The ports the testbench's memory model and frame loop use by name.
-const TESTBENCH_USES: [&str; 30] = [
+const TESTBENCH_USES: [&str; 32] = [
     "done",
     "cycles",
     "instructions",
@@ -286,6 +288,8 @@ const TESTBENCH_USES: [&str; 30] = [
     "tri_cache_misses",
     "node_cache_hits",
     "node_cache_misses",
+    "instance_cache_hits",
+    "instance_cache_misses",
     "vga_fb_addr",
 ];
 
@@ -499,11 +503,11 @@ pub fn processor_testbench(
              \x20   fd = $fopen({{out_dir, \"/frame{fr}.hex\"}}, \"w\");\n\
              \x20   for (k = 0; k < {px}; k = k + 1) $fwrite(fd, \"%06h\\n\", bank5[{fb} + k][23:0]);\n\
              \x20   $fclose(fd);\n    fd = $fopen({{out_dir, \"/frame{fr}.stats\"}}, \"w\");\n\
-             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\\n\",\n\
+             \x20   $fwrite(fd, \"%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\\n\",\n\
              \x20     cycles, instructions, transform_busy, intersect_busy, traversal_busy, raygen_busy,\n\
              \x20     instance_busy, shading_busy, ready_clocks, asleep_clocks,\n\
              \x20     reads0, reads1, reads2, reads3, reads4, reads5, tri_cache_hits, tri_cache_misses,\n\
-             \x20     node_cache_hits, node_cache_misses);\n    $fclose(fd);\n\
+             \x20     node_cache_hits, node_cache_misses, instance_cache_hits, instance_cache_misses);\n    $fclose(fd);\n\
              \x20   $display(\"frame {fr}: %0d cycles, %0d instructions\", cycles, instructions);",
             limit = frames.cycle_limit,
             px = frames.pixels,

@@ -12,7 +12,9 @@
 //! and shading's (world normals) requests took the TransformUnit; `tri_cache_hits` and
 //! `tri_cache_misses` the triangle tests whose words came from the triangle cache and from
 //! the banks, `node_cache_hits` and `node_cache_misses` the object-tree nodes the traversal
-//! unit took from its node cache and from bank 0. In the pixel clock (`vga.clock`): the display reads
+//! unit took from its node cache and from bank 0, `instance_cache_hits` and
+//! `instance_cache_misses` the instance entries (and world normals) whose record came from
+//! the instance cache and from bank 4. In the pixel clock (`vga.clock`): the display reads
 //! the frame buffer and drives the monitor. The Verilog names a bundle's port
 //! `<bundle>_<port>` (`mem_read`, `vga_hsync`): `Processor::ports` lists them, and the
 //! constraints and testbench are written from that list.
@@ -43,6 +45,8 @@ pub struct ProcessorParams {
     pub tri_cache_sets: u32,
     /// Sets of the traversal unit's node cache (the same rule; 0: none).
     pub node_cache_sets: u32,
+    /// Sets of instance entry's instance cache (the same rule; 0: none).
+    pub instance_cache_sets: u32,
 }
 
 impl Default for ProcessorParams {
@@ -52,6 +56,7 @@ impl Default for ProcessorParams {
             mem_latency: 2,
             tri_cache_sets: crate::hw::triangle_tester::MAX_CACHE_SETS,
             node_cache_sets: crate::hw::triangle_tester::MAX_CACHE_SETS,
+            instance_cache_sets: crate::hw::triangle_tester::MAX_CACHE_SETS,
         }
     }
 }
@@ -90,6 +95,8 @@ pub struct Processor<
     pub tri_cache_misses: Signal<Out, Bits<32>>,
     pub node_cache_hits: Signal<Out, Bits<32>>,
     pub node_cache_misses: Signal<Out, Bits<32>>,
+    pub instance_cache_hits: Signal<Out, Bits<32>>,
+    pub instance_cache_misses: Signal<Out, Bits<32>>,
     pub vga: VgaPort,
     engine: ThreadEngine<W, E, M, S, S1, X2, T, P, DX, DL>,
     display: VgaDisplay,
@@ -149,6 +156,8 @@ impl<
             tri_cache_misses: Default::default(),
             node_cache_hits: Default::default(),
             node_cache_misses: Default::default(),
+            instance_cache_hits: Default::default(),
+            instance_cache_misses: Default::default(),
             vga: Default::default(),
             engine: ThreadEngine::new(program, params),
             display: VgaDisplay::new(mode, c.width, c.height, c.frame_buffer)?,
@@ -242,6 +251,8 @@ impl<
         self.tri_cache_misses.next = self.engine.tri_cache_misses.val();
         self.node_cache_hits.next = self.engine.node_cache_hits.val();
         self.node_cache_misses.next = self.engine.node_cache_misses.val();
+        self.instance_cache_hits.next = self.engine.instance_cache_hits.val();
+        self.instance_cache_misses.next = self.engine.instance_cache_misses.val();
 
         self.display.clock.next = self.vga.clock.val();
         self.display.reset.next = self.vga.reset.val();

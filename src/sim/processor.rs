@@ -42,6 +42,8 @@ pub struct SimFrame {
     pub tri_cache_misses: u64,
     pub node_cache_hits: u64,
     pub node_cache_misses: u64,
+    pub instance_cache_hits: u64,
+    pub instance_cache_misses: u64,
     /// Thread-clocks waiting for an issue slot and asleep in a coprocessor wait: the bits of
     /// the scheduler's `ready` and `asleep` masks, added up every clock of the frame.
     pub ready_thread_clocks: u64,
@@ -312,12 +314,12 @@ pub fn simulate_processor(
             .split_whitespace()
             .filter_map(|w| w.parse().ok())
             .collect();
-        if nums.len() != 20 {
+        if nums.len() != 22 {
             bail!(
                 "{}: expected `cycles instructions transform_busy intersect_busy traversal_busy \
                  raygen_busy instance_busy shading_busy ready_clocks asleep_clocks reads0 reads1 \
                  reads2 reads3 reads4 reads5 tri_cache_hits tri_cache_misses node_cache_hits \
-                 node_cache_misses`, \
+                 node_cache_misses instance_cache_hits instance_cache_misses`, \
                  got `{}`",
                 stats_path.display(),
                 stats.trim()
@@ -340,6 +342,8 @@ pub fn simulate_processor(
             tri_cache_misses: nums[17],
             node_cache_hits: nums[18],
             node_cache_misses: nums[19],
+            instance_cache_hits: nums[20],
+            instance_cache_misses: nums[21],
         });
     }
     let vga = if capture_vga {

@@ -37,12 +37,20 @@
 //!   own, and the unit gives one result per clock. A normal: `normal_write` with
 //!   `ray_thread` and the normal on `ray_d`, and the same wake-up.
 //! - Answers: `query_thread` at I4; at I5 `pending` (the entered ray is not written yet).
+//! - Instance cache (`cache_sets` sets, the paper's 512 items by default; 0 for none): each
+//!   entry, and each normal, looks up its record's words in a direct-mapped cache, set
+//!   `{instance[7:0], normal}` of the sets, tag `{instance, normal, valid}`; a hit reads
+//!   nothing from bank 4, a miss reads the record and fills the set. `cache_hit` or
+//!   `cache_miss` pulses once per lookup. `frame_start` clears every set's tag, one a clock
+//!   (the host rewrites the records between frames); a lookup read during the sweep misses.
 //!
-//! Latency: from the `tri.enter` at I5, 1 clock to start the entry, 13 reads (one per free
+//! Latency: from the `tri.enter` at I5, 1 clock to start the entry, 3 for the cache's lookup
+//! (the set's words, the tag compare, the decision), then on a miss 13 reads (one per free
 //! bus clock) and `mem_latency` for the last word, then the two requests and
-//! [`TRANSFORM_LATENCY`] (28) in the unit, and 1 to the write: about 46 clocks with
-//! `mem_latency` 2 and a free bus. Throughput: one entry per about `16 + mem_latency` clocks
-//! (the next entry's reads start while this one's requests are in the unit).
+//! [`TRANSFORM_LATENCY`] (28) in the unit, and 1 to the write: about 33 clocks on a hit, 49
+//! on a miss with `mem_latency` 2 and a free bus. Throughput: one entry per about 6 clocks
+//! on hits, `19 + mem_latency` on misses (the next entry's lookup starts while this one's
+//! requests are in the unit).
 //!
 //! Absent (`InstanceRays::new`'s `present` false, for a program with no `tri.world`,
 //! `tri.enter` or `tri.normal`): every output is held at 0, so nothing the unit holds is
@@ -61,6 +69,7 @@
 
 use rust_hdl::prelude::*;
 
+use crate::hw::triangle_tester::{cache_sets_supported, empty_cache_tags};
 use crate::layout::instance_word;
 
 /// Words of a world-to-object matrix (3x4), read per entry, then the root's.
@@ -69,8 +78,15 @@ const MATRIX_WORDS: u64 = 12;
 /// What the unit is doing with the entry it has begun.
 #[derive(Copy, Clone, Debug, PartialEq, LogicState)]
 pub enum EntryPhase {
-    /// No entry begun: the slot's entry, if any, begins.
+    /// No entry begun: the slot's entry, if any, begins (and its set of the cache is read).
     Idle,
+    /// The cache's words for the entry's set arrive and are registered (the tag into
+    /// `tag_r`, the matrix into `matrix`, the root into `root_r`).
+    Look,
+    /// The registered tag is compared with the entry's.
+    Compare,
+    /// A hit goes to the requests (with the root's write), a miss to the fetch.
+    Decide,
     /// Reading the matrix's twelve words and the root (a normal's: its nine words as twelve).
     Fetch,
     /// The origin's request waits for the unit; then the direction's.
@@ -125,6 +141,10 @@ pub struct InstanceRays<const W: usize> {
     pub done_mask: Signal<Out, Bits<32>>,
     pub query_thread: Signal<In, Bits<5>>,
     pub pending: Signal<Out, Bit>,
+    /// An entry's (or normal's) record came from the instance cache (a pulse per lookup).
+    pub cache_hit: Signal<Out, Bit>,
+    /// An entry's (or normal's) record is read from bank 4 (a pulse per lookup).
+    pub cache_miss: Signal<Out, Bit>,
 
     /// Per thread, each word of its world ray.
     world: [RAM<Bits<W>, 5>; 6],
@@ -184,14 +204,46 @@ pub struct InstanceRays<const W: usize> {
     c_root_step: Constant<Bits<24>>,
     c_last_matrix_read: Constant<Bits<4>>,
     c_ml_last: Constant<Bits<3>>,
+    /// The instance cache: per set, a tag `{instance, normal, valid}`, the twelve words of
+    /// a record's world-to-object matrix (or its normal matrix as read, twelve words), and
+    /// the root.
+    cache_tag: RAM<Bits<26>, 9>,
+    cache_words: [RAM<Bits<W>, 9>; 12],
+    cache_root: RAM<Bits<26>, 9>,
+    /// The slot's set, read as its entry begins; the entry's set and tag, for the compare
+    /// and the fill.
+    slot_set: Signal<Local, Bits<9>>,
+    entry_instance: DFF<Bits<24>>,
+    entry_set: Signal<Local, Bits<9>>,
+    entry_tag: Signal<Local, Bits<26>>,
+    tag_r: DFF<Bits<26>>,
+    root_r: DFF<Bits<26>>,
+    hit_r: DFF<Bit>,
+    /// No sweep wrote the cache as the entry's set was read: its words are of this frame.
+    look_clean: DFF<Bit>,
+    /// A normal's twelfth word arrived last clock: its matrix is whole, to be written.
+    fill_normal: DFF<Bit>,
+    fill: Signal<Local, Bit>,
+    /// The frame's records may differ from the last frame's: each set's tag is cleared, one a
+    /// clock, from the frame's start.
+    sweeping: DFF<Bit>,
+    sweep_set: DFF<Bits<9>>,
+    c_cached: Constant<Bit>,
+    c_set_mask: Constant<Bits<9>>,
     /// The program uses the unit (see the module doc's "Absent").
     c_present: Constant<Bit>,
 }
 
 impl<const W: usize> InstanceRays<W> {
-    /// The unit for SRAM read latency `mem_latency` (1..=6), absent unless `present`.
-    pub fn new(mem_latency: u32, present: bool) -> Self {
+    /// The unit for SRAM read latency `mem_latency` (1..=6), absent unless `present`, with an
+    /// instance cache of `cache_sets` sets (a power of two up to `MAX_CACHE_SETS`, 0 for
+    /// none).
+    pub fn new(mem_latency: u32, present: bool, cache_sets: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
+        assert!(
+            cache_sets_supported(cache_sets),
+            "{cache_sets} instance cache sets"
+        );
         Self {
             clock: Default::default(),
             frame_start: Default::default(),
@@ -232,6 +284,8 @@ impl<const W: usize> InstanceRays<W> {
             done_mask: Default::default(),
             query_thread: Default::default(),
             pending: Default::default(),
+            cache_hit: Default::default(),
+            cache_miss: Default::default(),
             world: Default::default(),
             slot_valid: Default::default(),
             slot_thread: Default::default(),
@@ -279,6 +333,23 @@ impl<const W: usize> InstanceRays<W> {
                     .into(),
             ),
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
+            cache_tag: empty_cache_tags(),
+            cache_words: Default::default(),
+            cache_root: Default::default(),
+            slot_set: Default::default(),
+            entry_instance: Default::default(),
+            entry_set: Default::default(),
+            entry_tag: Default::default(),
+            tag_r: Default::default(),
+            root_r: Default::default(),
+            hit_r: Default::default(),
+            look_clean: Default::default(),
+            fill_normal: Default::default(),
+            fill: Default::default(),
+            sweeping: Default::default(),
+            sweep_set: Default::default(),
+            c_cached: Constant::new(cache_sets > 0),
+            c_set_mask: Constant::new(u64::from(cache_sets.max(1) - 1).into()),
             c_present: Constant::new(present),
         }
     }
@@ -308,7 +379,15 @@ impl<const W: usize> Logic for InstanceRays<W> {
             write_mask,
             normal_valid,
             waiting,
-            pending_r
+            pending_r,
+            entry_instance,
+            tag_r,
+            root_r,
+            hit_r,
+            look_clean,
+            fill_normal,
+            sweeping,
+            sweep_set
         );
         for k in 0..12 {
             self.matrix[k].clock.next = self.clock.val();
@@ -351,8 +430,13 @@ impl<const W: usize> Logic for InstanceRays<W> {
         }
         // The slot's record: `INSTANCE_WORDS` = 24 = 16 + 8 words an instance.
         self.record.next = (self.slot_instance.q.val() << 4) + (self.slot_instance.q.val() << 3);
+        self.slot_set.next = ((bit_cast::<9, 8>(self.slot_instance.q.val().get_bits::<8>(0)) << 1)
+            | bit_cast::<9, 1>(self.slot_normal.q.val().into()))
+            & self.c_set_mask.val();
         if (self.phase.q.val() == EntryPhase::Idle) & self.slot_valid.q.val() {
             self.slot_valid.d.next = false;
+            self.entry_instance.d.next = self.slot_instance.q.val();
+            self.look_clean.d.next = !self.sweeping.q.val();
             self.entry_thread.d.next = self.slot_thread.q.val();
             self.entry_normal.d.next = self.slot_normal.q.val();
             self.entry_nz.d.next = self.slot_nz.q.val();
@@ -363,6 +447,59 @@ impl<const W: usize> Logic for InstanceRays<W> {
             self.issued.d.next = 0.into();
             self.arrived.d.next = 0.into();
             self.phase.d.next = EntryPhase::Fetch;
+            if self.c_cached.val() {
+                self.phase.d.next = EntryPhase::Look;
+            }
+        }
+
+        // The instance cache: the slot's set is read in every clock, so that an entry
+        // beginning has its words in `Look`; the tag compare has a clock of its own after the
+        // block RAM's (the tester's triangle cache found the read and the compare too long for
+        // one clock).
+        self.entry_set.next = ((bit_cast::<9, 8>(self.entry_instance.q.val().get_bits::<8>(0))
+            << 1)
+            | bit_cast::<9, 1>(self.entry_normal.q.val().into()))
+            & self.c_set_mask.val();
+        self.entry_tag.next = (bit_cast::<26, 24>(self.entry_instance.q.val()) << 2)
+            | (bit_cast::<26, 1>(self.entry_normal.q.val().into()) << 1)
+            | 1;
+        self.cache_tag.read_clock.next = self.clock.val();
+        self.cache_tag.write_clock.next = self.clock.val();
+        self.cache_tag.read_address.next = self.slot_set.val();
+        self.cache_root.read_clock.next = self.clock.val();
+        self.cache_root.write_clock.next = self.clock.val();
+        self.cache_root.read_address.next = self.slot_set.val();
+        for k in 0..12 {
+            self.cache_words[k].read_clock.next = self.clock.val();
+            self.cache_words[k].write_clock.next = self.clock.val();
+            self.cache_words[k].read_address.next = self.slot_set.val();
+        }
+        if self.c_cached.val() & (self.phase.q.val() == EntryPhase::Look) {
+            self.tag_r.d.next = self.cache_tag.read_data.val();
+            self.root_r.d.next = self.cache_root.read_data.val();
+            for k in 0..12 {
+                self.matrix[k].d.next = self.cache_words[k].read_data.val();
+            }
+            self.phase.d.next = EntryPhase::Compare;
+        }
+        if self.phase.q.val() == EntryPhase::Compare {
+            self.hit_r.d.next =
+                (self.tag_r.q.val() == self.entry_tag.val()) & self.look_clean.q.val();
+            self.phase.d.next = EntryPhase::Decide;
+        }
+        self.cache_hit.next = false;
+        self.cache_miss.next = false;
+        if self.phase.q.val() == EntryPhase::Decide {
+            if self.hit_r.q.val() {
+                self.cache_hit.next = true;
+                self.phase.d.next = EntryPhase::Origin;
+                if self.entry_normal.q.val() {
+                    self.phase.d.next = EntryPhase::Normal;
+                }
+            } else {
+                self.cache_miss.next = true;
+                self.phase.d.next = EntryPhase::Fetch;
+            }
         }
 
         // Fetch: a read in each clock the bus is free; each word shifts in as it arrives.
@@ -415,6 +552,41 @@ impl<const W: usize> Logic for InstanceRays<W> {
         self.root_write.next = self.root_arrives.val();
         self.root_thread.next = self.entry_thread.q.val();
         self.root.next = self.rdata.val().get_bits::<26>(0);
+        if (self.phase.q.val() == EntryPhase::Decide)
+            & self.hit_r.q.val()
+            & (!self.entry_normal.q.val())
+        {
+            self.root_write.next = true;
+            self.root.next = self.root_r.q.val();
+        }
+
+        // A miss's record fills its set once whole: an entry's as its root arrives (the
+        // matrix's twelve words are in), a normal's the clock after its twelfth word. The
+        // sweep has the write port while it runs; a record it keeps out is read again.
+        self.fill_normal.d.next = self.last_normal_word.val();
+        self.fill.next = self.c_cached.val()
+            & (self.root_arrives.val() | self.fill_normal.q.val())
+            & (!self.sweeping.q.val());
+        self.cache_tag.write_address.next = self.entry_set.val();
+        self.cache_tag.write_data.next = self.entry_tag.val();
+        self.cache_tag.write_enable.next = self.fill.val();
+        self.cache_root.write_address.next = self.entry_set.val();
+        self.cache_root.write_data.next = self.rdata.val().get_bits::<26>(0);
+        self.cache_root.write_enable.next = self.fill.val();
+        for k in 0..12 {
+            self.cache_words[k].write_address.next = self.entry_set.val();
+            self.cache_words[k].write_data.next = self.matrix[k].q.val();
+            self.cache_words[k].write_enable.next = self.fill.val();
+        }
+        if self.sweeping.q.val() {
+            self.cache_tag.write_address.next = self.sweep_set.q.val();
+            self.cache_tag.write_data.next = 0.into();
+            self.cache_tag.write_enable.next = true;
+            self.sweep_set.d.next = self.sweep_set.q.val() + 1;
+            if self.sweep_set.q.val() == self.c_set_mask.val() {
+                self.sweeping.d.next = false;
+            }
+        }
 
         // The requests: the origin as a point, then the direction as a vector; or the normal
         // as a vector.
@@ -511,12 +683,16 @@ impl<const W: usize> Logic for InstanceRays<W> {
             }
             self.done_mask.next = 0.into();
             self.pending.next = false;
+            self.cache_hit.next = false;
+            self.cache_miss.next = false;
         }
 
         if self.frame_start.val() {
             self.slot_valid.d.next = false;
             self.phase.d.next = EntryPhase::Idle;
             self.waiting.d.next = 0.into();
+            self.sweeping.d.next = self.c_cached.val();
+            self.sweep_set.d.next = 0.into();
         }
     }
 }
@@ -536,7 +712,7 @@ mod tests {
     /// one output left live keeps the registers and RAMs behind it.
     #[test]
     fn an_absent_unit_synthesizes_to_nothing() {
-        let mut uut = InstanceRays::<24>::new(2, false);
+        let mut uut = InstanceRays::<24>::new(2, false, 512);
         uut.connect_all();
         let dir = tempfile::tempdir().unwrap();
         let src = dir.path().join("instance_rays.v");
@@ -562,23 +738,46 @@ mod tests {
     /// Four offers in ten are normals' (`tri.normal`): each gives `units::transform3` of the
     /// record's normal matrix and the thread's world words 0, 1 and the offer's z, once, on
     /// `normal_write`, with no root and no ray, in twelve reads.
+    ///
+    /// Four frames, the bank's records rewritten between them (a frame's start after the
+    /// unit drained, as the processor's): with an instance cache, a record read in an earlier
+    /// frame would give a wrong ray. Every entry is a hit or a miss, a miss reads its twelve
+    /// or thirteen words and a hit none; with a set for each record and kind (32 sets) each
+    /// misses at most once a frame, with 4 sets they evict each other.
     #[test]
     fn every_entry_gets_its_object_ray_through_the_shared_unit() {
+        entries_case(0, 35);
+    }
+
+    #[test]
+    fn the_instance_cache_keeps_each_record_for_its_frame() {
+        entries_case(32, 36);
+    }
+
+    #[test]
+    fn instance_cache_sets_evict_each_other() {
+        entries_case(4, 37);
+    }
+
+    fn entries_case(cache_sets: u32, seed: u64) {
         let f = Format::E7M16;
         let mem_latency = 3;
         let records = 16;
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(35);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         // Random floats, and random roots in each record's root word.
-        let bank: Vec<u32> = (0..records * INSTANCE_WORDS)
-            .map(|k| {
-                if k % INSTANCE_WORDS == instance_word::ROOT {
-                    rng.gen_range(0..1 << 26)
-                } else {
-                    f.from_f64(rng.gen_range(-2.0..2.0))
-                }
-            })
-            .collect();
-        let mut u = InstanceRays::<24>::new(mem_latency, true);
+        let new_bank = |rng: &mut rand_chacha::ChaCha8Rng| -> Vec<u32> {
+            (0..records * INSTANCE_WORDS)
+                .map(|k| {
+                    if k % INSTANCE_WORDS == instance_word::ROOT {
+                        rng.gen_range(0..1 << 26)
+                    } else {
+                        f.from_f64(rng.gen_range(-2.0..2.0))
+                    }
+                })
+                .collect()
+        };
+        let mut bank = new_bank(&mut rng);
+        let mut u = InstanceRays::<24>::new(mem_latency, true, cache_sets);
         u.connect_all();
         let cycle =
             |u: &mut InstanceRays<24>| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
@@ -596,13 +795,20 @@ mod tests {
         let mut memory: VecDeque<Option<u32>> = vec![None; mem_latency as usize].into();
         let mut in_unit: VecDeque<Option<(u32, bool, bool, [u32; 3])>> = vec![None; 28].into();
         let (mut offers, mut refused, mut written, mut reads) = (0, 0, 0, 0);
-        for clock in 0..6000 {
+        let (mut hits, mut misses) = (0, 0);
+        const FRAME_CLOCKS: usize = 2000;
+        let frames = 4;
+        for clock in 0..frames * FRAME_CLOCKS {
             let thread = rng.gen_range(0..32u32);
             let t = thread as usize;
             // The first 96 clocks write every thread's world ray; then world words and entries
-            // at random, never for a thread whose entry is pending.
+            // at random, never for a thread whose entry is pending; none in a frame's last 150
+            // clocks (the unit drains) and first 40 (the cache's sweep of 32 sets).
+            let quiet = clock % FRAME_CLOCKS >= FRAME_CLOCKS - 150 || clock % FRAME_CLOCKS < 40;
             let (write, offer) = if clock < 96 {
                 (true, false)
+            } else if quiet {
+                (false, false)
             } else if entered[t].is_none() && normals[t].is_none() {
                 let r = rng.gen_range(0..10);
                 (r == 0, r >= 7)
@@ -715,8 +921,29 @@ mod tests {
             } else {
                 assert_eq!(u.done_mask.val().to_u64(), 0, "a wake-up without a ray");
             }
+            hits += usize::from(u.cache_hit.val());
+            misses += usize::from(u.cache_miss.val());
             cycle(&mut u);
             assert_eq!(u.pending.val(), want_pending, "thread {asked} pending");
+            if clock % FRAME_CLOCKS == FRAME_CLOCKS - 1 {
+                // The frame is over: the host rewrites the records, the next frame starts.
+                assert!(
+                    entered.iter().all(|e| e.is_none()),
+                    "an entry left at the frame's end"
+                );
+                assert!(
+                    normals.iter().all(|n| n.is_none()),
+                    "a normal left at the frame's end"
+                );
+                assert!(
+                    memory.iter().all(|m| m.is_none()),
+                    "a read left at the frame's end"
+                );
+                bank = new_bank(&mut rng);
+                u.frame_start.next = true;
+                cycle(&mut u);
+                u.frame_start.next = false;
+            }
         }
         let left = entered.iter().filter(|e| e.is_some()).count();
         let normals_left = normals.iter().filter(|e| e.is_some()).count();
@@ -724,12 +951,38 @@ mod tests {
         assert!(written > 80, "entries written: {written}");
         assert!(normals_written > 60, "normals written: {normals_written}");
         assert!((written..=written + left).contains(&roots_written));
-        let done_reads = 13 * written + 12 * normals_written;
-        assert!(
-            (done_reads..=done_reads + 13 * (left + normals_left)).contains(&reads),
-            "{reads} reads for {written} entries and {normals_written} normals written and \
-             {left} + {normals_left} begun"
-        );
+        if cache_sets == 0 {
+            let done_reads = 13 * written + 12 * normals_written;
+            assert!(
+                (done_reads..=done_reads + 13 * (left + normals_left)).contains(&reads),
+                "{reads} reads for {written} entries and {normals_written} normals written and \
+                 {left} + {normals_left} begun"
+            );
+            assert_eq!((hits, misses), (0, 0), "no cache, no lookups");
+        } else {
+            let done = written + normals_written;
+            assert!(
+                (done..=done + left + normals_left).contains(&(hits + misses)),
+                "{hits} hits and {misses} misses for {done} entries and normals written"
+            );
+            assert!(
+                (12 * misses..=13 * misses).contains(&reads),
+                "{reads} reads for {misses} misses"
+            );
+            if cache_sets == 32 {
+                assert!(
+                    misses <= 2 * records * frames,
+                    "{misses} misses: a record and kind missed twice in a frame"
+                );
+                assert!(hits > misses, "{hits} hits, {misses} misses");
+            } else {
+                // Random records and kinds in 4 sets: about one lookup in eight hits.
+                assert!(
+                    misses > 2 * records * frames && hits > 10,
+                    "{hits} hits and {misses} misses in 4 sets for 32 records and kinds"
+                );
+            }
+        }
         assert!(
             refused > 10,
             "the slot refused entries ({refused} of {offers})"

@@ -263,6 +263,8 @@ pub struct ThreadEngine<
     /// Object-tree nodes the traversal unit took from its node cache, and from bank 0.
     pub node_cache_hits: Signal<Out, Bits<32>>,
     pub node_cache_misses: Signal<Out, Bits<32>>,
+    pub instance_cache_hits: Signal<Out, Bits<32>>,
+    pub instance_cache_misses: Signal<Out, Bits<32>>,
 
     // The pipeline's stages.
     scheduler: Scheduler,
@@ -300,6 +302,8 @@ pub struct ThreadEngine<
     cache_miss_count: DFF<Bits<32>>,
     node_hit_count: DFF<Bits<32>>,
     node_miss_count: DFF<Bits<32>>,
+    instance_hit_count: DFF<Bits<32>>,
+    instance_miss_count: DFF<Bits<32>>,
     /// The busy counters' events, registered where they arise and counted a clock later: a
     /// unit's busy signal routed straight into a counter's 32 enables across the chip was
     /// the processor's critical path (stop 45: `tester.words.read_address ->
@@ -314,6 +318,8 @@ pub struct ThreadEngine<
     tick_cache_hit: DFF<Bit>,
     tick_cache_miss: DFF<Bit>,
     tick_node_hit: DFF<Bit>,
+    tick_instance_hit: DFF<Bit>,
+    tick_instance_miss: DFF<Bit>,
     tick_node_miss: DFF<Bit>,
     frame_start: Signal<Local, Bit>,
     // The memory and frame-buffer ports' request registers.
@@ -449,6 +455,7 @@ impl<
             mem_latency,
             tri_cache_sets,
             node_cache_sets,
+            instance_cache_sets,
         } = *params;
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
         assert!(P == 2 * S);
@@ -494,6 +501,8 @@ impl<
             tri_cache_misses: Default::default(),
             node_cache_hits: Default::default(),
             node_cache_misses: Default::default(),
+            instance_cache_hits: Default::default(),
+            instance_cache_misses: Default::default(),
             intersect_busy: Default::default(),
             traversal_busy: Default::default(),
             scheduler: Scheduler::new(threads, reserve_ahead),
@@ -501,7 +510,11 @@ impl<
             decode: Decode::new(program.registers_used),
             mailboxes: Default::default(),
             rays: PrimaryRays::new(&program.config),
-            instances: InstanceRays::new(mem_latency, units.contains(&Unit::InstanceEntry)),
+            instances: InstanceRays::new(
+                mem_latency,
+                units.contains(&Unit::InstanceEntry),
+                instance_cache_sets,
+            ),
             shader: ShadeUnit::new(ShadeConfig {
                 tri_latency: mem_latency + 1,
                 frame_latency: mem_latency + 1,
@@ -539,6 +552,8 @@ impl<
             cache_miss_count: Default::default(),
             node_hit_count: Default::default(),
             node_miss_count: Default::default(),
+            instance_hit_count: Default::default(),
+            instance_miss_count: Default::default(),
             count_in_frame: Default::default(),
             tick_transform: Default::default(),
             tick_intersect: Default::default(),
@@ -549,6 +564,8 @@ impl<
             tick_cache_hit: Default::default(),
             tick_cache_miss: Default::default(),
             tick_node_hit: Default::default(),
+            tick_instance_hit: Default::default(),
+            tick_instance_miss: Default::default(),
             tick_node_miss: Default::default(),
             intersect_count: Default::default(),
             traversal_count: Default::default(),
@@ -673,6 +690,8 @@ impl<
             cache_miss_count,
             node_hit_count,
             node_miss_count,
+            instance_hit_count,
+            instance_miss_count,
             count_in_frame,
             tick_transform,
             tick_intersect,
@@ -683,6 +702,8 @@ impl<
             tick_cache_hit,
             tick_cache_miss,
             tick_node_hit,
+            tick_instance_hit,
+            tick_instance_miss,
             tick_node_miss,
             intersect_count,
             traversal_count,
@@ -755,6 +776,8 @@ impl<
         self.tri_cache_misses.next = self.cache_miss_count.q.val();
         self.node_cache_hits.next = self.node_hit_count.q.val();
         self.node_cache_misses.next = self.node_miss_count.q.val();
+        self.instance_cache_hits.next = self.instance_hit_count.q.val();
+        self.instance_cache_misses.next = self.instance_miss_count.q.val();
         if self.in_frame.val() {
             self.cycle_count.d.next = self.cycle_count.q.val() + 1;
         }
@@ -765,6 +788,8 @@ impl<
         self.tick_cache_hit.d.next = self.tester.cache_hit.val();
         self.tick_cache_miss.d.next = self.tester.cache_miss.val();
         self.tick_node_hit.d.next = self.traversal_unit.cache_hit.val();
+        self.tick_instance_hit.d.next = self.instances.cache_hit.val();
+        self.tick_instance_miss.d.next = self.instances.cache_miss.val();
         self.tick_node_miss.d.next = self.traversal_unit.cache_miss.val();
         if self.count_in_frame.q.val() {
             if self.tick_transform.q.val() {
@@ -796,6 +821,12 @@ impl<
             }
             if self.tick_node_miss.q.val() {
                 self.node_miss_count.d.next = self.node_miss_count.q.val() + 1;
+            }
+            if self.tick_instance_hit.q.val() {
+                self.instance_hit_count.d.next = self.instance_hit_count.q.val() + 1;
+            }
+            if self.tick_instance_miss.q.val() {
+                self.instance_miss_count.d.next = self.instance_miss_count.q.val() + 1;
             }
         }
 
@@ -1304,6 +1335,8 @@ impl<
             self.cache_miss_count.d.next = 0.into();
             self.node_hit_count.d.next = 0.into();
             self.node_miss_count.d.next = 0.into();
+            self.instance_hit_count.d.next = 0.into();
+            self.instance_miss_count.d.next = 0.into();
             self.shading_count.d.next = 0.into();
         }
     }

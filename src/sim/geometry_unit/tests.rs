@@ -1129,6 +1129,9 @@ struct InstanceRaysBench<
     pub root: Signal<Out, Bits<26>>,
     /// A read in a clock the bus was not free (never).
     pub busy_read: Signal<Out, Bit>,
+    /// The instance cache's lookups.
+    pub cache_hit: Signal<Out, Bit>,
+    pub cache_miss: Signal<Out, Bit>,
     entries: crate::hw::engine::InstanceRays<W>,
     unit: crate::hw::TransformUnit<W, E, M, S, S1, X2, T, P>,
     bank: ROM<Bits<32>, 9>,
@@ -1174,7 +1177,9 @@ impl<
             root_thread: Default::default(),
             root: Default::default(),
             busy_read: Default::default(),
-            entries: crate::hw::engine::InstanceRays::new(2, true),
+            cache_hit: Default::default(),
+            cache_miss: Default::default(),
+            entries: crate::hw::engine::InstanceRays::new(2, true, 512),
             unit: Default::default(),
             bank: ROM::new(crate::hw::engine::word_map(
                 bank.iter().map(|&w| Bits::<32>::from(u64::from(w))),
@@ -1256,6 +1261,8 @@ impl<
         self.root_write.next = self.entries.root_write.val();
         self.root_thread.next = self.entries.root_thread.val();
         self.root.next = self.entries.root.val();
+        self.cache_hit.next = self.entries.cache_hit.val();
+        self.cache_miss.next = self.entries.cache_miss.val();
     }
 }
 
@@ -1268,7 +1275,8 @@ impl<
 /// with the thread's bit as wake-up, and its root (the record's root word's 26 bits) given
 /// for its thread; each normal is `units::transform3` of the record's normal matrix and the
 /// thread's world words 0, 1 and its z, in order, with the wake-up; no read goes out on a
-/// busy bus.
+/// busy bus; the instance cache (512 sets, one frame) misses once for each record and kind
+/// entered and hits for every other entry.
 fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
     use crate::emit::stream_bench::{InputStream, OutputSink, StreamBench};
     use crate::emit::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
@@ -1311,6 +1319,11 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
         })
         .collect();
     let entered = normal_z.iter().filter(|z| z.is_none()).count();
+    let kinds: std::collections::BTreeSet<(usize, bool)> = records
+        .iter()
+        .zip(&normal_z)
+        .map(|(&r, z)| (r, z.is_some()))
+        .collect();
     let random_bits = |rng: &mut ChaCha8Rng, n: usize| -> Vec<(u32, Vec<u64>)> {
         let mut bits: Vec<(u32, Vec<u64>)> = (0..n)
             .map(|_| (0, vec![u64::from(rng.gen_bool(0.5))]))
@@ -1342,6 +1355,8 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
             ("root_write", 1),
             ("root_thread", 5),
             ("root", 26),
+            ("cache_hit", 1),
+            ("cache_miss", 1),
         ],
         "ray",
     );
@@ -1404,6 +1419,18 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
                 fields: vec!["busy_read".into()],
                 expected: 0,
             },
+            OutputSink {
+                name: "hits".into(),
+                valid: "cache_hit".into(),
+                fields: vec!["cache_hit".into()],
+                expected: entries - kinds.len(),
+            },
+            OutputSink {
+                name: "misses".into(),
+                valid: "cache_miss".into(),
+                fields: vec!["cache_miss".into()],
+                expected: kinds.len(),
+            },
         ],
         max_cycles: 40 * entries as u64 + 1000,
     };
@@ -1416,6 +1443,11 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
     let (rays, roots, normals, busy_reads) =
         (&run.sinks[0], &run.sinks[1], &run.sinks[2], &run.sinks[3]);
     assert!(busy_reads.is_empty(), "{sim}: reads on a busy bus");
+    assert_eq!(
+        (run.sinks[4].len(), run.sinks[5].len()),
+        (entries - kinds.len(), kinds.len()),
+        "{sim}: instance cache hits and misses"
+    );
     assert_eq!(rays.len(), entered, "{sim}: rays written");
     // The entries (not normals): their index (the thread is `i % 32`) and record.
     let enters: Vec<(usize, usize)> = records
