@@ -15,7 +15,7 @@
 /* verilator lint_off UNUSEDSIGNAL */
 
 
-module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy,tri_cache_hits,tri_cache_misses,node_cache_hits,node_cache_misses,vga_clock,vga_reset,vga_fb_addr,vga_fb_data,vga_hsync,vga_vsync,vga_rgb,vga_frame_start);
+module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy,tri_cache_hits,tri_cache_misses,node_cache_hits,node_cache_misses,instance_cache_hits,instance_cache_misses,vga_clock,vga_reset,vga_fb_addr,vga_fb_data,vga_hsync,vga_vsync,vga_rgb,vga_frame_start);
     
     // Module arguments
     input wire  clock;
@@ -49,6 +49,8 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
     output reg  [31:0] tri_cache_misses;
     output reg  [31:0] node_cache_hits;
     output reg  [31:0] node_cache_misses;
+    output reg  [31:0] instance_cache_hits;
+    output reg  [31:0] instance_cache_misses;
     input wire  vga_clock;
     input wire  vga_reset;
     output reg  [23:0] vga_fb_addr;
@@ -74,6 +76,8 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
     wire  [31:0] engine__tri_cache_misses;
     wire  [31:0] engine__node_cache_hits;
     wire  [31:0] engine__node_cache_misses;
+    wire  [31:0] engine__instance_cache_hits;
+    wire  [31:0] engine__instance_cache_misses;
     reg  display__clock;
     reg  display__reset;
     wire  [23:0] display__fb_addr;
@@ -115,7 +119,9 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
         .tri_cache_hits(engine__tri_cache_hits),
         .tri_cache_misses(engine__tri_cache_misses),
         .node_cache_hits(engine__node_cache_hits),
-        .node_cache_misses(engine__node_cache_misses)
+        .node_cache_misses(engine__node_cache_misses),
+        .instance_cache_hits(engine__instance_cache_hits),
+        .instance_cache_misses(engine__instance_cache_misses)
     );
     dynrt_processor__display display(
         .clock(display__clock),
@@ -145,6 +151,8 @@ module dynrt_processor(clock,start,done,cycles,instructions,mem_read,mem_bank,me
         tri_cache_misses = engine__tri_cache_misses;
         node_cache_hits = engine__node_cache_hits;
         node_cache_misses = engine__node_cache_misses;
+        instance_cache_hits = engine__instance_cache_hits;
+        instance_cache_misses = engine__instance_cache_misses;
         display__clock = vga_clock;
         display__reset = vga_reset;
         vga_fb_addr = ((display__fb_addr) & 24'hffffff);
@@ -663,7 +671,7 @@ endmodule // dynrt_processor__display__timing__col
 
 
 
-module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy,tri_cache_hits,tri_cache_misses,node_cache_hits,node_cache_misses);
+module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem_bank,mem_addr,mem_rdata,fb_write,fb_addr,fb_data,bank0_read,bank0_addr,bank0_rdata,bank2_read,bank2_addr,bank2_rdata,bank3_read,bank3_addr,bank3_rdata,transform_busy,intersect_busy,traversal_busy,raygen_busy,instance_busy,shading_busy,tri_cache_hits,tri_cache_misses,node_cache_hits,node_cache_misses,instance_cache_hits,instance_cache_misses);
     
     // Module arguments
     input wire  clock;
@@ -697,6 +705,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     output reg  [31:0] tri_cache_misses;
     output reg  [31:0] node_cache_hits;
     output reg  [31:0] node_cache_misses;
+    output reg  [31:0] instance_cache_hits;
+    output reg  [31:0] instance_cache_misses;
     
     // Constant declarations
     localparam  c_threads = 8'h20;
@@ -779,7 +789,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  scheduler__frame_start;
     reg  scheduler__long_at_i3;
     reg  scheduler__wb_valid;
-    reg  [4:0] scheduler__wb_thread;
+    reg  [31:0] scheduler__wb_thread_mask;
     reg  scheduler__wb_halt;
     reg  scheduler__wb_wait_pending;
     reg  scheduler__tester_done;
@@ -952,6 +962,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     wire  [31:0] instances__done_mask;
     reg  [4:0] instances__query_thread;
     wire  instances__pending;
+    wire  instances__cache_hit;
+    wire  instances__cache_miss;
     reg  shader__clock;
     reg  shader__frame_start;
     reg  shader__ray_write;
@@ -1108,6 +1120,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [7:0] write_back__colour_byte;
     wire  write_back__valid;
     wire  [4:0] write_back__thread;
+    wire  [31:0] write_back__thread_mask;
     wire  [7:0] write_back__dst;
     wire  write_back__write;
     wire  [31:0] write_back__data;
@@ -1282,6 +1295,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [31:0] node_miss_count__d;
     wire  [31:0] node_miss_count__q;
     reg  node_miss_count__clock;
+    reg  [31:0] instance_hit_count__d;
+    wire  [31:0] instance_hit_count__q;
+    reg  instance_hit_count__clock;
+    reg  [31:0] instance_miss_count__d;
+    wire  [31:0] instance_miss_count__q;
+    reg  instance_miss_count__clock;
     reg  count_in_frame__d;
     wire  count_in_frame__q;
     reg  count_in_frame__clock;
@@ -1312,6 +1331,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  tick_node_hit__d;
     wire  tick_node_hit__q;
     reg  tick_node_hit__clock;
+    reg  tick_instance_hit__d;
+    wire  tick_instance_hit__q;
+    reg  tick_instance_hit__clock;
+    reg  tick_instance_miss__d;
+    wire  tick_instance_miss__q;
+    reg  tick_instance_miss__clock;
     reg  tick_node_miss__d;
     wire  tick_node_miss__q;
     reg  tick_node_miss__clock;
@@ -1409,7 +1434,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .frame_start(scheduler__frame_start),
         .long_at_i3(scheduler__long_at_i3),
         .wb_valid(scheduler__wb_valid),
-        .wb_thread(scheduler__wb_thread),
+        .wb_thread_mask(scheduler__wb_thread_mask),
         .wb_halt(scheduler__wb_halt),
         .wb_wait_pending(scheduler__wb_wait_pending),
         .tester_done(scheduler__tester_done),
@@ -1591,7 +1616,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .normal_write(instances__normal_write),
         .done_mask(instances__done_mask),
         .query_thread(instances__query_thread),
-        .pending(instances__pending)
+        .pending(instances__pending),
+        .cache_hit(instances__cache_hit),
+        .cache_miss(instances__cache_miss)
     );
     dynrt_processor__engine__shader shader(
         .clock(shader__clock),
@@ -1758,6 +1785,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .colour_byte(write_back__colour_byte),
         .valid(write_back__valid),
         .thread(write_back__thread),
+        .thread_mask(write_back__thread_mask),
         .dst(write_back__dst),
         .write(write_back__write),
         .data(write_back__data),
@@ -1978,6 +2006,16 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(node_miss_count__q),
         .clock(node_miss_count__clock)
     );
+    dynrt_processor__engine__cache_hit_count instance_hit_count(
+        .d(instance_hit_count__d),
+        .q(instance_hit_count__q),
+        .clock(instance_hit_count__clock)
+    );
+    dynrt_processor__engine__cache_hit_count instance_miss_count(
+        .d(instance_miss_count__d),
+        .q(instance_miss_count__q),
+        .clock(instance_miss_count__clock)
+    );
     dynrt_processor__display__dark_d count_in_frame(
         .d(count_in_frame__d),
         .q(count_in_frame__q),
@@ -2027,6 +2065,16 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .d(tick_node_hit__d),
         .q(tick_node_hit__q),
         .clock(tick_node_hit__clock)
+    );
+    dynrt_processor__display__dark_d tick_instance_hit(
+        .d(tick_instance_hit__d),
+        .q(tick_instance_hit__q),
+        .clock(tick_instance_hit__clock)
+    );
+    dynrt_processor__display__dark_d tick_instance_miss(
+        .d(tick_instance_miss__d),
+        .q(tick_instance_miss__q),
+        .clock(tick_instance_miss__clock)
     );
     dynrt_processor__display__dark_d tick_node_miss(
         .d(tick_node_miss__d),
@@ -2164,6 +2212,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         cache_miss_count__clock = clock;
         node_hit_count__clock = clock;
         node_miss_count__clock = clock;
+        instance_hit_count__clock = clock;
+        instance_miss_count__clock = clock;
         count_in_frame__clock = clock;
         tick_transform__clock = clock;
         tick_intersect__clock = clock;
@@ -2174,6 +2224,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tick_cache_hit__clock = clock;
         tick_cache_miss__clock = clock;
         tick_node_hit__clock = clock;
+        tick_instance_hit__clock = clock;
+        tick_instance_miss__clock = clock;
         tick_node_miss__clock = clock;
         intersect_count__clock = clock;
         traversal_count__clock = clock;
@@ -2213,6 +2265,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         cache_miss_count__d = cache_miss_count__q;
         node_hit_count__d = node_hit_count__q;
         node_miss_count__d = node_miss_count__q;
+        instance_hit_count__d = instance_hit_count__q;
+        instance_miss_count__d = instance_miss_count__q;
         count_in_frame__d = count_in_frame__q;
         tick_transform__d = tick_transform__q;
         tick_intersect__d = tick_intersect__q;
@@ -2223,6 +2277,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tick_cache_hit__d = tick_cache_hit__q;
         tick_cache_miss__d = tick_cache_miss__q;
         tick_node_hit__d = tick_node_hit__q;
+        tick_instance_hit__d = tick_instance_hit__q;
+        tick_instance_miss__d = tick_instance_miss__q;
         tick_node_miss__d = tick_node_miss__q;
         intersect_count__d = intersect_count__q;
         traversal_count__d = traversal_count__q;
@@ -2280,6 +2336,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tri_cache_misses = cache_miss_count__q;
         node_cache_hits = node_hit_count__q;
         node_cache_misses = node_miss_count__q;
+        instance_cache_hits = instance_hit_count__q;
+        instance_cache_misses = instance_miss_count__q;
         if (in_frame) begin
             cycle_count__d = cycle_count__q + 32'h1;
         end
@@ -2290,6 +2348,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         tick_cache_hit__d = tester__cache_hit;
         tick_cache_miss__d = tester__cache_miss;
         tick_node_hit__d = traversal_unit__cache_hit;
+        tick_instance_hit__d = instances__cache_hit;
+        tick_instance_miss__d = instances__cache_miss;
         tick_node_miss__d = traversal_unit__cache_miss;
         if (count_in_frame__q) begin
             if (tick_transform__q) begin
@@ -2321,6 +2381,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             end
             if (tick_node_miss__q) begin
                 node_miss_count__d = node_miss_count__q + 32'h1;
+            end
+            if (tick_instance_hit__q) begin
+                instance_hit_count__d = instance_hit_count__q + 32'h1;
+            end
+            if (tick_instance_miss__q) begin
+                instance_miss_count__d = instance_miss_count__q + 32'h1;
             end
         end
         scheduler__running = running__q;
@@ -2725,7 +2791,7 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         fetch__wb_halt = write_back__halt;
         fetch__wb_next_pc = write_back__next_pc;
         scheduler__wb_valid = write_back__valid;
-        scheduler__wb_thread = write_back__thread;
+        scheduler__wb_thread_mask = write_back__thread_mask;
         scheduler__wb_halt = write_back__halt;
         scheduler__wb_wait_pending = write_back__wait_pending;
         scheduler__tester_done = tester__engine__done;
@@ -2757,6 +2823,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             cache_miss_count__d = 32'h0;
             node_hit_count__d = 32'h0;
             node_miss_count__d = 32'h0;
+            instance_hit_count__d = 32'h0;
+            instance_miss_count__d = 32'h0;
             shading_count__d = 32'h0;
         end
     end
@@ -10627,7 +10695,11 @@ endmodule // dynrt_processor__engine__fp_units__sqrt__rnd_man
 
 
 
-module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pair,word_a,word_b,thread,offer,offer_normal,instance_id,refused,bus_free,read,addr,rdata,root_write,root_thread,root,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_direction,gen_normal,gen_thread,gen_take,out_valid,out_direction,out_normal,out_thread,out_v__0,out_v__1,out_v__2,ray_write,ray_thread,ray_o__0,ray_o__1,ray_o__2,ray_d__0,ray_d__1,ray_d__2,normal_write,done_mask,query_thread,pending);
+
+
+
+
+module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pair,word_a,word_b,thread,offer,offer_normal,instance_id,refused,bus_free,read,addr,rdata,root_write,root_thread,root,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_direction,gen_normal,gen_thread,gen_take,out_valid,out_direction,out_normal,out_thread,out_v__0,out_v__1,out_v__2,ray_write,ray_thread,ray_o__0,ray_o__1,ray_o__2,ray_d__0,ray_d__1,ray_d__2,normal_write,done_mask,query_thread,pending,cache_hit,cache_miss);
     
     // Module arguments
     input wire  clock;
@@ -10688,6 +10760,8 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     output reg  [31:0] done_mask;
     input wire  [4:0] query_thread;
     output reg  pending;
+    output reg  cache_hit;
+    output reg  cache_miss;
     
     // Constant declarations
     localparam  c_one = 32'h1;
@@ -10702,14 +10776,19 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     localparam  c_root_step = 24'ha;
     localparam  c_last_matrix_read = 4'hb;
     localparam  c_ml_last = 3'b1;
+    localparam  c_cached = 1'b1;
+    localparam  c_set_mask = 9'b111111111;
     localparam  c_present = 1'b0;
     
     // Enums
     localparam EntryPhase__Idle = 0;
-    localparam EntryPhase__Fetch = 1;
-    localparam EntryPhase__Origin = 2;
-    localparam EntryPhase__Direction = 3;
-    localparam EntryPhase__Normal = 4;
+    localparam EntryPhase__Look = 1;
+    localparam EntryPhase__Compare = 2;
+    localparam EntryPhase__Decide = 3;
+    localparam EntryPhase__Fetch = 4;
+    localparam EntryPhase__Origin = 5;
+    localparam EntryPhase__Direction = 6;
+    localparam EntryPhase__Normal = 7;
     
     // Stub signals
     reg  [4:0] world__0__read_address;
@@ -10874,6 +10953,128 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     reg  pending_r__d;
     wire  pending_r__q;
     reg  pending_r__clock;
+    reg  [8:0] cache_tag__read_address;
+    reg  cache_tag__read_clock;
+    wire  [25:0] cache_tag__read_data;
+    reg  [8:0] cache_tag__write_address;
+    reg  cache_tag__write_clock;
+    reg  [25:0] cache_tag__write_data;
+    reg  cache_tag__write_enable;
+    reg  [8:0] cache_words__0__read_address;
+    reg  cache_words__0__read_clock;
+    wire  [23:0] cache_words__0__read_data;
+    reg  [8:0] cache_words__0__write_address;
+    reg  cache_words__0__write_clock;
+    reg  [23:0] cache_words__0__write_data;
+    reg  cache_words__0__write_enable;
+    reg  [8:0] cache_words__1__read_address;
+    reg  cache_words__1__read_clock;
+    wire  [23:0] cache_words__1__read_data;
+    reg  [8:0] cache_words__1__write_address;
+    reg  cache_words__1__write_clock;
+    reg  [23:0] cache_words__1__write_data;
+    reg  cache_words__1__write_enable;
+    reg  [8:0] cache_words__2__read_address;
+    reg  cache_words__2__read_clock;
+    wire  [23:0] cache_words__2__read_data;
+    reg  [8:0] cache_words__2__write_address;
+    reg  cache_words__2__write_clock;
+    reg  [23:0] cache_words__2__write_data;
+    reg  cache_words__2__write_enable;
+    reg  [8:0] cache_words__3__read_address;
+    reg  cache_words__3__read_clock;
+    wire  [23:0] cache_words__3__read_data;
+    reg  [8:0] cache_words__3__write_address;
+    reg  cache_words__3__write_clock;
+    reg  [23:0] cache_words__3__write_data;
+    reg  cache_words__3__write_enable;
+    reg  [8:0] cache_words__4__read_address;
+    reg  cache_words__4__read_clock;
+    wire  [23:0] cache_words__4__read_data;
+    reg  [8:0] cache_words__4__write_address;
+    reg  cache_words__4__write_clock;
+    reg  [23:0] cache_words__4__write_data;
+    reg  cache_words__4__write_enable;
+    reg  [8:0] cache_words__5__read_address;
+    reg  cache_words__5__read_clock;
+    wire  [23:0] cache_words__5__read_data;
+    reg  [8:0] cache_words__5__write_address;
+    reg  cache_words__5__write_clock;
+    reg  [23:0] cache_words__5__write_data;
+    reg  cache_words__5__write_enable;
+    reg  [8:0] cache_words__6__read_address;
+    reg  cache_words__6__read_clock;
+    wire  [23:0] cache_words__6__read_data;
+    reg  [8:0] cache_words__6__write_address;
+    reg  cache_words__6__write_clock;
+    reg  [23:0] cache_words__6__write_data;
+    reg  cache_words__6__write_enable;
+    reg  [8:0] cache_words__7__read_address;
+    reg  cache_words__7__read_clock;
+    wire  [23:0] cache_words__7__read_data;
+    reg  [8:0] cache_words__7__write_address;
+    reg  cache_words__7__write_clock;
+    reg  [23:0] cache_words__7__write_data;
+    reg  cache_words__7__write_enable;
+    reg  [8:0] cache_words__8__read_address;
+    reg  cache_words__8__read_clock;
+    wire  [23:0] cache_words__8__read_data;
+    reg  [8:0] cache_words__8__write_address;
+    reg  cache_words__8__write_clock;
+    reg  [23:0] cache_words__8__write_data;
+    reg  cache_words__8__write_enable;
+    reg  [8:0] cache_words__9__read_address;
+    reg  cache_words__9__read_clock;
+    wire  [23:0] cache_words__9__read_data;
+    reg  [8:0] cache_words__9__write_address;
+    reg  cache_words__9__write_clock;
+    reg  [23:0] cache_words__9__write_data;
+    reg  cache_words__9__write_enable;
+    reg  [8:0] cache_words__10__read_address;
+    reg  cache_words__10__read_clock;
+    wire  [23:0] cache_words__10__read_data;
+    reg  [8:0] cache_words__10__write_address;
+    reg  cache_words__10__write_clock;
+    reg  [23:0] cache_words__10__write_data;
+    reg  cache_words__10__write_enable;
+    reg  [8:0] cache_words__11__read_address;
+    reg  cache_words__11__read_clock;
+    wire  [23:0] cache_words__11__read_data;
+    reg  [8:0] cache_words__11__write_address;
+    reg  cache_words__11__write_clock;
+    reg  [23:0] cache_words__11__write_data;
+    reg  cache_words__11__write_enable;
+    reg  [8:0] cache_root__read_address;
+    reg  cache_root__read_clock;
+    wire  [25:0] cache_root__read_data;
+    reg  [8:0] cache_root__write_address;
+    reg  cache_root__write_clock;
+    reg  [25:0] cache_root__write_data;
+    reg  cache_root__write_enable;
+    reg  [23:0] entry_instance__d;
+    wire  [23:0] entry_instance__q;
+    reg  entry_instance__clock;
+    reg  [25:0] tag_r__d;
+    wire  [25:0] tag_r__q;
+    reg  tag_r__clock;
+    reg  [25:0] root_r__d;
+    wire  [25:0] root_r__q;
+    reg  root_r__clock;
+    reg  hit_r__d;
+    wire  hit_r__q;
+    reg  hit_r__clock;
+    reg  look_clean__d;
+    wire  look_clean__q;
+    reg  look_clean__clock;
+    reg  fill_normal__d;
+    wire  fill_normal__q;
+    reg  fill_normal__clock;
+    reg  sweeping__d;
+    wire  sweeping__q;
+    reg  sweeping__clock;
+    reg  [8:0] sweep_set__d;
+    wire  [8:0] sweep_set__q;
+    reg  sweep_set__clock;
     
     // Local signals
     reg  taken;
@@ -10885,6 +11086,10 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     reg  root_arrives;
     reg  last_normal_word;
     reg  [31:0] taken_mask;
+    reg  [8:0] slot_set;
+    reg  [8:0] entry_set;
+    reg  [25:0] entry_tag;
+    reg  fill;
     
     // Sub module instances
     dynrt_processor__engine__instances__world__0 world__0(
@@ -11141,6 +11346,172 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         .q(pending_r__q),
         .clock(pending_r__clock)
     );
+    dynrt_processor__engine__instances__cache_tag cache_tag(
+        .read_address(cache_tag__read_address),
+        .read_clock(cache_tag__read_clock),
+        .read_data(cache_tag__read_data),
+        .write_address(cache_tag__write_address),
+        .write_clock(cache_tag__write_clock),
+        .write_data(cache_tag__write_data),
+        .write_enable(cache_tag__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__0(
+        .read_address(cache_words__0__read_address),
+        .read_clock(cache_words__0__read_clock),
+        .read_data(cache_words__0__read_data),
+        .write_address(cache_words__0__write_address),
+        .write_clock(cache_words__0__write_clock),
+        .write_data(cache_words__0__write_data),
+        .write_enable(cache_words__0__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__1(
+        .read_address(cache_words__1__read_address),
+        .read_clock(cache_words__1__read_clock),
+        .read_data(cache_words__1__read_data),
+        .write_address(cache_words__1__write_address),
+        .write_clock(cache_words__1__write_clock),
+        .write_data(cache_words__1__write_data),
+        .write_enable(cache_words__1__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__2(
+        .read_address(cache_words__2__read_address),
+        .read_clock(cache_words__2__read_clock),
+        .read_data(cache_words__2__read_data),
+        .write_address(cache_words__2__write_address),
+        .write_clock(cache_words__2__write_clock),
+        .write_data(cache_words__2__write_data),
+        .write_enable(cache_words__2__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__3(
+        .read_address(cache_words__3__read_address),
+        .read_clock(cache_words__3__read_clock),
+        .read_data(cache_words__3__read_data),
+        .write_address(cache_words__3__write_address),
+        .write_clock(cache_words__3__write_clock),
+        .write_data(cache_words__3__write_data),
+        .write_enable(cache_words__3__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__4(
+        .read_address(cache_words__4__read_address),
+        .read_clock(cache_words__4__read_clock),
+        .read_data(cache_words__4__read_data),
+        .write_address(cache_words__4__write_address),
+        .write_clock(cache_words__4__write_clock),
+        .write_data(cache_words__4__write_data),
+        .write_enable(cache_words__4__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__5(
+        .read_address(cache_words__5__read_address),
+        .read_clock(cache_words__5__read_clock),
+        .read_data(cache_words__5__read_data),
+        .write_address(cache_words__5__write_address),
+        .write_clock(cache_words__5__write_clock),
+        .write_data(cache_words__5__write_data),
+        .write_enable(cache_words__5__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__6(
+        .read_address(cache_words__6__read_address),
+        .read_clock(cache_words__6__read_clock),
+        .read_data(cache_words__6__read_data),
+        .write_address(cache_words__6__write_address),
+        .write_clock(cache_words__6__write_clock),
+        .write_data(cache_words__6__write_data),
+        .write_enable(cache_words__6__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__7(
+        .read_address(cache_words__7__read_address),
+        .read_clock(cache_words__7__read_clock),
+        .read_data(cache_words__7__read_data),
+        .write_address(cache_words__7__write_address),
+        .write_clock(cache_words__7__write_clock),
+        .write_data(cache_words__7__write_data),
+        .write_enable(cache_words__7__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__8(
+        .read_address(cache_words__8__read_address),
+        .read_clock(cache_words__8__read_clock),
+        .read_data(cache_words__8__read_data),
+        .write_address(cache_words__8__write_address),
+        .write_clock(cache_words__8__write_clock),
+        .write_data(cache_words__8__write_data),
+        .write_enable(cache_words__8__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__9(
+        .read_address(cache_words__9__read_address),
+        .read_clock(cache_words__9__read_clock),
+        .read_data(cache_words__9__read_data),
+        .write_address(cache_words__9__write_address),
+        .write_clock(cache_words__9__write_clock),
+        .write_data(cache_words__9__write_data),
+        .write_enable(cache_words__9__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__10(
+        .read_address(cache_words__10__read_address),
+        .read_clock(cache_words__10__read_clock),
+        .read_data(cache_words__10__read_data),
+        .write_address(cache_words__10__write_address),
+        .write_clock(cache_words__10__write_clock),
+        .write_data(cache_words__10__write_data),
+        .write_enable(cache_words__10__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_words__0 cache_words__11(
+        .read_address(cache_words__11__read_address),
+        .read_clock(cache_words__11__read_clock),
+        .read_data(cache_words__11__read_data),
+        .write_address(cache_words__11__write_address),
+        .write_clock(cache_words__11__write_clock),
+        .write_data(cache_words__11__write_data),
+        .write_enable(cache_words__11__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_root cache_root(
+        .read_address(cache_root__read_address),
+        .read_clock(cache_root__read_clock),
+        .read_data(cache_root__read_data),
+        .write_address(cache_root__write_address),
+        .write_clock(cache_root__write_clock),
+        .write_data(cache_root__write_data),
+        .write_enable(cache_root__write_enable)
+    );
+    dynrt_processor__display__rgb_q entry_instance(
+        .d(entry_instance__d),
+        .q(entry_instance__q),
+        .clock(entry_instance__clock)
+    );
+    dynrt_processor__engine__instances__root_r tag_r(
+        .d(tag_r__d),
+        .q(tag_r__q),
+        .clock(tag_r__clock)
+    );
+    dynrt_processor__engine__instances__root_r root_r(
+        .d(root_r__d),
+        .q(root_r__q),
+        .clock(root_r__clock)
+    );
+    dynrt_processor__display__dark_d hit_r(
+        .d(hit_r__d),
+        .q(hit_r__q),
+        .clock(hit_r__clock)
+    );
+    dynrt_processor__display__dark_d look_clean(
+        .d(look_clean__d),
+        .q(look_clean__q),
+        .clock(look_clean__clock)
+    );
+    dynrt_processor__display__dark_d fill_normal(
+        .d(fill_normal__d),
+        .q(fill_normal__q),
+        .clock(fill_normal__clock)
+    );
+    dynrt_processor__display__dark_d sweeping(
+        .d(sweeping__d),
+        .q(sweeping__q),
+        .clock(sweeping__clock)
+    );
+    dynrt_processor__engine__fp_units__add__lz sweep_set(
+        .d(sweep_set__d),
+        .q(sweep_set__q),
+        .clock(sweep_set__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -11163,6 +11534,14 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         normal_valid__clock = clock;
         waiting__clock = clock;
         pending_r__clock = clock;
+        entry_instance__clock = clock;
+        tag_r__clock = clock;
+        root_r__clock = clock;
+        hit_r__clock = clock;
+        look_clean__clock = clock;
+        fill_normal__clock = clock;
+        sweeping__clock = clock;
+        sweep_set__clock = clock;
         slot_valid__d = slot_valid__q;
         slot_thread__d = slot_thread__q;
         slot_instance__d = slot_instance__q;
@@ -11182,6 +11561,14 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         normal_valid__d = normal_valid__q;
         waiting__d = waiting__q;
         pending_r__d = pending_r__q;
+        entry_instance__d = entry_instance__q;
+        tag_r__d = tag_r__q;
+        root_r__d = root_r__q;
+        hit_r__d = hit_r__q;
+        look_clean__d = look_clean__q;
+        fill_normal__d = fill_normal__q;
+        sweeping__d = sweeping__q;
+        sweep_set__d = sweep_set__q;
         matrix__0__clock = clock;
         matrix__0__d = matrix__0__q;
         matrix__1__clock = clock;
@@ -11270,8 +11657,11 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
             slot_nz__d = word_b[(32'h0)+:(24)];
         end
         record = (slot_instance__q << 32'h4) + (slot_instance__q << 32'h3);
+        slot_set = ((((slot_instance__q[(32'h0)+:(8)]) & 9'h1ff) << 32'h1) | ((slot_normal__q) & 9'h1ff)) & c_set_mask;
         if ((phase__q == EntryPhase__Idle) & slot_valid__q) begin
             slot_valid__d = 1'b0;
+            entry_instance__d = slot_instance__q;
+            look_clean__d = ~sweeping__q;
             entry_thread__d = slot_thread__q;
             entry_normal__d = slot_normal__q;
             entry_nz__d = slot_nz__q;
@@ -11282,6 +11672,89 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
             issued__d = 32'h0;
             arrived__d = 32'h0;
             phase__d = EntryPhase__Fetch;
+            if (c_cached) begin
+                phase__d = EntryPhase__Look;
+            end
+        end
+        entry_set = ((((entry_instance__q[(32'h0)+:(8)]) & 9'h1ff) << 32'h1) | ((entry_normal__q) & 9'h1ff)) & c_set_mask;
+        entry_tag = (((entry_instance__q) & 26'h3ffffff) << 32'h2) | (((entry_normal__q) & 26'h3ffffff) << 32'h1) | 32'h1;
+        cache_tag__read_clock = clock;
+        cache_tag__write_clock = clock;
+        cache_tag__read_address = slot_set;
+        cache_root__read_clock = clock;
+        cache_root__write_clock = clock;
+        cache_root__read_address = slot_set;
+        cache_words__0__read_clock = clock;
+        cache_words__0__write_clock = clock;
+        cache_words__0__read_address = slot_set;
+        cache_words__1__read_clock = clock;
+        cache_words__1__write_clock = clock;
+        cache_words__1__read_address = slot_set;
+        cache_words__2__read_clock = clock;
+        cache_words__2__write_clock = clock;
+        cache_words__2__read_address = slot_set;
+        cache_words__3__read_clock = clock;
+        cache_words__3__write_clock = clock;
+        cache_words__3__read_address = slot_set;
+        cache_words__4__read_clock = clock;
+        cache_words__4__write_clock = clock;
+        cache_words__4__read_address = slot_set;
+        cache_words__5__read_clock = clock;
+        cache_words__5__write_clock = clock;
+        cache_words__5__read_address = slot_set;
+        cache_words__6__read_clock = clock;
+        cache_words__6__write_clock = clock;
+        cache_words__6__read_address = slot_set;
+        cache_words__7__read_clock = clock;
+        cache_words__7__write_clock = clock;
+        cache_words__7__read_address = slot_set;
+        cache_words__8__read_clock = clock;
+        cache_words__8__write_clock = clock;
+        cache_words__8__read_address = slot_set;
+        cache_words__9__read_clock = clock;
+        cache_words__9__write_clock = clock;
+        cache_words__9__read_address = slot_set;
+        cache_words__10__read_clock = clock;
+        cache_words__10__write_clock = clock;
+        cache_words__10__read_address = slot_set;
+        cache_words__11__read_clock = clock;
+        cache_words__11__write_clock = clock;
+        cache_words__11__read_address = slot_set;
+        if (c_cached & (phase__q == EntryPhase__Look)) begin
+            tag_r__d = cache_tag__read_data;
+            root_r__d = cache_root__read_data;
+            matrix__0__d = cache_words__0__read_data;
+            matrix__1__d = cache_words__1__read_data;
+            matrix__2__d = cache_words__2__read_data;
+            matrix__3__d = cache_words__3__read_data;
+            matrix__4__d = cache_words__4__read_data;
+            matrix__5__d = cache_words__5__read_data;
+            matrix__6__d = cache_words__6__read_data;
+            matrix__7__d = cache_words__7__read_data;
+            matrix__8__d = cache_words__8__read_data;
+            matrix__9__d = cache_words__9__read_data;
+            matrix__10__d = cache_words__10__read_data;
+            matrix__11__d = cache_words__11__read_data;
+            phase__d = EntryPhase__Compare;
+        end
+        if (phase__q == EntryPhase__Compare) begin
+            hit_r__d = (tag_r__q == entry_tag) & look_clean__q;
+            phase__d = EntryPhase__Decide;
+        end
+        cache_hit = 1'b0;
+        cache_miss = 1'b0;
+        if (phase__q == EntryPhase__Decide) begin
+            if (hit_r__q) begin
+                cache_hit = 1'b1;
+                phase__d = EntryPhase__Origin;
+                if (entry_normal__q) begin
+                    phase__d = EntryPhase__Normal;
+                end
+            end
+            else begin
+                cache_miss = 1'b1;
+                phase__d = EntryPhase__Fetch;
+            end
         end
         entry_words = c_words;
         if (entry_normal__q) begin
@@ -11334,6 +11807,63 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         root_write = root_arrives;
         root_thread = entry_thread__q;
         root = rdata[(32'h0)+:(26)];
+        if ((phase__q == EntryPhase__Decide) & hit_r__q & (~entry_normal__q)) begin
+            root_write = 1'b1;
+            root = root_r__q;
+        end
+        fill_normal__d = last_normal_word;
+        fill = c_cached & (root_arrives | fill_normal__q) & (~sweeping__q);
+        cache_tag__write_address = entry_set;
+        cache_tag__write_data = entry_tag;
+        cache_tag__write_enable = fill;
+        cache_root__write_address = entry_set;
+        cache_root__write_data = rdata[(32'h0)+:(26)];
+        cache_root__write_enable = fill;
+        cache_words__0__write_address = entry_set;
+        cache_words__0__write_data = matrix__0__q;
+        cache_words__0__write_enable = fill;
+        cache_words__1__write_address = entry_set;
+        cache_words__1__write_data = matrix__1__q;
+        cache_words__1__write_enable = fill;
+        cache_words__2__write_address = entry_set;
+        cache_words__2__write_data = matrix__2__q;
+        cache_words__2__write_enable = fill;
+        cache_words__3__write_address = entry_set;
+        cache_words__3__write_data = matrix__3__q;
+        cache_words__3__write_enable = fill;
+        cache_words__4__write_address = entry_set;
+        cache_words__4__write_data = matrix__4__q;
+        cache_words__4__write_enable = fill;
+        cache_words__5__write_address = entry_set;
+        cache_words__5__write_data = matrix__5__q;
+        cache_words__5__write_enable = fill;
+        cache_words__6__write_address = entry_set;
+        cache_words__6__write_data = matrix__6__q;
+        cache_words__6__write_enable = fill;
+        cache_words__7__write_address = entry_set;
+        cache_words__7__write_data = matrix__7__q;
+        cache_words__7__write_enable = fill;
+        cache_words__8__write_address = entry_set;
+        cache_words__8__write_data = matrix__8__q;
+        cache_words__8__write_enable = fill;
+        cache_words__9__write_address = entry_set;
+        cache_words__9__write_data = matrix__9__q;
+        cache_words__9__write_enable = fill;
+        cache_words__10__write_address = entry_set;
+        cache_words__10__write_data = matrix__10__q;
+        cache_words__10__write_enable = fill;
+        cache_words__11__write_address = entry_set;
+        cache_words__11__write_data = matrix__11__q;
+        cache_words__11__write_enable = fill;
+        if (sweeping__q) begin
+            cache_tag__write_address = sweep_set__q;
+            cache_tag__write_data = 32'h0;
+            cache_tag__write_enable = 1'b1;
+            sweep_set__d = sweep_set__q + 32'h1;
+            if (sweep_set__q == c_set_mask) begin
+                sweeping__d = 1'b0;
+            end
+        end
         gen_valid = (phase__q == EntryPhase__Origin) | (phase__q == EntryPhase__Direction) | (phase__q == EntryPhase__Normal);
         gen_point = phase__q == EntryPhase__Origin;
         gen_direction = phase__q == EntryPhase__Direction;
@@ -11447,11 +11977,15 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
             ray_d__2 = 32'h0;
             done_mask = 32'h0;
             pending = 1'b0;
+            cache_hit = 1'b0;
+            cache_miss = 1'b0;
         end
         if (frame_start) begin
             slot_valid__d = 1'b0;
             phase__d = EntryPhase__Idle;
             waiting__d = 32'h0;
+            sweeping__d = c_cached;
+            sweep_set__d = 32'h0;
         end
     end
     
@@ -11475,6 +12009,637 @@ module dynrt_processor__engine__instances__arrived(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__instances__arrived
+
+
+module dynrt_processor__engine__instances__cache_root(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [8:0] read_address;
+    input wire  read_clock;
+    output reg  [25:0] read_data;
+    input wire  [8:0] write_address;
+    input wire  write_clock;
+    input wire  [25:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[25:0] mem[511:0];
+    
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__instances__cache_root
+
+
+module dynrt_processor__engine__instances__cache_tag(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [8:0] read_address;
+    input wire  read_clock;
+    output reg  [25:0] read_data;
+    input wire  [8:0] write_address;
+    input wire  write_clock;
+    input wire  [25:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[25:0] mem[511:0];
+    
+    initial begin
+    mem[9'b0] = 26'h0;
+    mem[9'b1] = 26'h0;
+    mem[9'b10] = 26'h0;
+    mem[9'b11] = 26'h0;
+    mem[9'b100] = 26'h0;
+    mem[9'b101] = 26'h0;
+    mem[9'b110] = 26'h0;
+    mem[9'b111] = 26'h0;
+    mem[9'b1000] = 26'h0;
+    mem[9'b1001] = 26'h0;
+    mem[9'b1010] = 26'h0;
+    mem[9'b1011] = 26'h0;
+    mem[9'b1100] = 26'h0;
+    mem[9'b1101] = 26'h0;
+    mem[9'b1110] = 26'h0;
+    mem[9'b1111] = 26'h0;
+    mem[9'b10000] = 26'h0;
+    mem[9'b10001] = 26'h0;
+    mem[9'b10010] = 26'h0;
+    mem[9'b10011] = 26'h0;
+    mem[9'b10100] = 26'h0;
+    mem[9'b10101] = 26'h0;
+    mem[9'b10110] = 26'h0;
+    mem[9'b10111] = 26'h0;
+    mem[9'b11000] = 26'h0;
+    mem[9'b11001] = 26'h0;
+    mem[9'b11010] = 26'h0;
+    mem[9'b11011] = 26'h0;
+    mem[9'b11100] = 26'h0;
+    mem[9'b11101] = 26'h0;
+    mem[9'b11110] = 26'h0;
+    mem[9'b11111] = 26'h0;
+    mem[9'b100000] = 26'h0;
+    mem[9'b100001] = 26'h0;
+    mem[9'b100010] = 26'h0;
+    mem[9'b100011] = 26'h0;
+    mem[9'b100100] = 26'h0;
+    mem[9'b100101] = 26'h0;
+    mem[9'b100110] = 26'h0;
+    mem[9'b100111] = 26'h0;
+    mem[9'b101000] = 26'h0;
+    mem[9'b101001] = 26'h0;
+    mem[9'b101010] = 26'h0;
+    mem[9'b101011] = 26'h0;
+    mem[9'b101100] = 26'h0;
+    mem[9'b101101] = 26'h0;
+    mem[9'b101110] = 26'h0;
+    mem[9'b101111] = 26'h0;
+    mem[9'b110000] = 26'h0;
+    mem[9'b110001] = 26'h0;
+    mem[9'b110010] = 26'h0;
+    mem[9'b110011] = 26'h0;
+    mem[9'b110100] = 26'h0;
+    mem[9'b110101] = 26'h0;
+    mem[9'b110110] = 26'h0;
+    mem[9'b110111] = 26'h0;
+    mem[9'b111000] = 26'h0;
+    mem[9'b111001] = 26'h0;
+    mem[9'b111010] = 26'h0;
+    mem[9'b111011] = 26'h0;
+    mem[9'b111100] = 26'h0;
+    mem[9'b111101] = 26'h0;
+    mem[9'b111110] = 26'h0;
+    mem[9'b111111] = 26'h0;
+    mem[9'b1000000] = 26'h0;
+    mem[9'b1000001] = 26'h0;
+    mem[9'b1000010] = 26'h0;
+    mem[9'b1000011] = 26'h0;
+    mem[9'b1000100] = 26'h0;
+    mem[9'b1000101] = 26'h0;
+    mem[9'b1000110] = 26'h0;
+    mem[9'b1000111] = 26'h0;
+    mem[9'b1001000] = 26'h0;
+    mem[9'b1001001] = 26'h0;
+    mem[9'b1001010] = 26'h0;
+    mem[9'b1001011] = 26'h0;
+    mem[9'b1001100] = 26'h0;
+    mem[9'b1001101] = 26'h0;
+    mem[9'b1001110] = 26'h0;
+    mem[9'b1001111] = 26'h0;
+    mem[9'b1010000] = 26'h0;
+    mem[9'b1010001] = 26'h0;
+    mem[9'b1010010] = 26'h0;
+    mem[9'b1010011] = 26'h0;
+    mem[9'b1010100] = 26'h0;
+    mem[9'b1010101] = 26'h0;
+    mem[9'b1010110] = 26'h0;
+    mem[9'b1010111] = 26'h0;
+    mem[9'b1011000] = 26'h0;
+    mem[9'b1011001] = 26'h0;
+    mem[9'b1011010] = 26'h0;
+    mem[9'b1011011] = 26'h0;
+    mem[9'b1011100] = 26'h0;
+    mem[9'b1011101] = 26'h0;
+    mem[9'b1011110] = 26'h0;
+    mem[9'b1011111] = 26'h0;
+    mem[9'b1100000] = 26'h0;
+    mem[9'b1100001] = 26'h0;
+    mem[9'b1100010] = 26'h0;
+    mem[9'b1100011] = 26'h0;
+    mem[9'b1100100] = 26'h0;
+    mem[9'b1100101] = 26'h0;
+    mem[9'b1100110] = 26'h0;
+    mem[9'b1100111] = 26'h0;
+    mem[9'b1101000] = 26'h0;
+    mem[9'b1101001] = 26'h0;
+    mem[9'b1101010] = 26'h0;
+    mem[9'b1101011] = 26'h0;
+    mem[9'b1101100] = 26'h0;
+    mem[9'b1101101] = 26'h0;
+    mem[9'b1101110] = 26'h0;
+    mem[9'b1101111] = 26'h0;
+    mem[9'b1110000] = 26'h0;
+    mem[9'b1110001] = 26'h0;
+    mem[9'b1110010] = 26'h0;
+    mem[9'b1110011] = 26'h0;
+    mem[9'b1110100] = 26'h0;
+    mem[9'b1110101] = 26'h0;
+    mem[9'b1110110] = 26'h0;
+    mem[9'b1110111] = 26'h0;
+    mem[9'b1111000] = 26'h0;
+    mem[9'b1111001] = 26'h0;
+    mem[9'b1111010] = 26'h0;
+    mem[9'b1111011] = 26'h0;
+    mem[9'b1111100] = 26'h0;
+    mem[9'b1111101] = 26'h0;
+    mem[9'b1111110] = 26'h0;
+    mem[9'b1111111] = 26'h0;
+    mem[9'b10000000] = 26'h0;
+    mem[9'b10000001] = 26'h0;
+    mem[9'b10000010] = 26'h0;
+    mem[9'b10000011] = 26'h0;
+    mem[9'b10000100] = 26'h0;
+    mem[9'b10000101] = 26'h0;
+    mem[9'b10000110] = 26'h0;
+    mem[9'b10000111] = 26'h0;
+    mem[9'b10001000] = 26'h0;
+    mem[9'b10001001] = 26'h0;
+    mem[9'b10001010] = 26'h0;
+    mem[9'b10001011] = 26'h0;
+    mem[9'b10001100] = 26'h0;
+    mem[9'b10001101] = 26'h0;
+    mem[9'b10001110] = 26'h0;
+    mem[9'b10001111] = 26'h0;
+    mem[9'b10010000] = 26'h0;
+    mem[9'b10010001] = 26'h0;
+    mem[9'b10010010] = 26'h0;
+    mem[9'b10010011] = 26'h0;
+    mem[9'b10010100] = 26'h0;
+    mem[9'b10010101] = 26'h0;
+    mem[9'b10010110] = 26'h0;
+    mem[9'b10010111] = 26'h0;
+    mem[9'b10011000] = 26'h0;
+    mem[9'b10011001] = 26'h0;
+    mem[9'b10011010] = 26'h0;
+    mem[9'b10011011] = 26'h0;
+    mem[9'b10011100] = 26'h0;
+    mem[9'b10011101] = 26'h0;
+    mem[9'b10011110] = 26'h0;
+    mem[9'b10011111] = 26'h0;
+    mem[9'b10100000] = 26'h0;
+    mem[9'b10100001] = 26'h0;
+    mem[9'b10100010] = 26'h0;
+    mem[9'b10100011] = 26'h0;
+    mem[9'b10100100] = 26'h0;
+    mem[9'b10100101] = 26'h0;
+    mem[9'b10100110] = 26'h0;
+    mem[9'b10100111] = 26'h0;
+    mem[9'b10101000] = 26'h0;
+    mem[9'b10101001] = 26'h0;
+    mem[9'b10101010] = 26'h0;
+    mem[9'b10101011] = 26'h0;
+    mem[9'b10101100] = 26'h0;
+    mem[9'b10101101] = 26'h0;
+    mem[9'b10101110] = 26'h0;
+    mem[9'b10101111] = 26'h0;
+    mem[9'b10110000] = 26'h0;
+    mem[9'b10110001] = 26'h0;
+    mem[9'b10110010] = 26'h0;
+    mem[9'b10110011] = 26'h0;
+    mem[9'b10110100] = 26'h0;
+    mem[9'b10110101] = 26'h0;
+    mem[9'b10110110] = 26'h0;
+    mem[9'b10110111] = 26'h0;
+    mem[9'b10111000] = 26'h0;
+    mem[9'b10111001] = 26'h0;
+    mem[9'b10111010] = 26'h0;
+    mem[9'b10111011] = 26'h0;
+    mem[9'b10111100] = 26'h0;
+    mem[9'b10111101] = 26'h0;
+    mem[9'b10111110] = 26'h0;
+    mem[9'b10111111] = 26'h0;
+    mem[9'b11000000] = 26'h0;
+    mem[9'b11000001] = 26'h0;
+    mem[9'b11000010] = 26'h0;
+    mem[9'b11000011] = 26'h0;
+    mem[9'b11000100] = 26'h0;
+    mem[9'b11000101] = 26'h0;
+    mem[9'b11000110] = 26'h0;
+    mem[9'b11000111] = 26'h0;
+    mem[9'b11001000] = 26'h0;
+    mem[9'b11001001] = 26'h0;
+    mem[9'b11001010] = 26'h0;
+    mem[9'b11001011] = 26'h0;
+    mem[9'b11001100] = 26'h0;
+    mem[9'b11001101] = 26'h0;
+    mem[9'b11001110] = 26'h0;
+    mem[9'b11001111] = 26'h0;
+    mem[9'b11010000] = 26'h0;
+    mem[9'b11010001] = 26'h0;
+    mem[9'b11010010] = 26'h0;
+    mem[9'b11010011] = 26'h0;
+    mem[9'b11010100] = 26'h0;
+    mem[9'b11010101] = 26'h0;
+    mem[9'b11010110] = 26'h0;
+    mem[9'b11010111] = 26'h0;
+    mem[9'b11011000] = 26'h0;
+    mem[9'b11011001] = 26'h0;
+    mem[9'b11011010] = 26'h0;
+    mem[9'b11011011] = 26'h0;
+    mem[9'b11011100] = 26'h0;
+    mem[9'b11011101] = 26'h0;
+    mem[9'b11011110] = 26'h0;
+    mem[9'b11011111] = 26'h0;
+    mem[9'b11100000] = 26'h0;
+    mem[9'b11100001] = 26'h0;
+    mem[9'b11100010] = 26'h0;
+    mem[9'b11100011] = 26'h0;
+    mem[9'b11100100] = 26'h0;
+    mem[9'b11100101] = 26'h0;
+    mem[9'b11100110] = 26'h0;
+    mem[9'b11100111] = 26'h0;
+    mem[9'b11101000] = 26'h0;
+    mem[9'b11101001] = 26'h0;
+    mem[9'b11101010] = 26'h0;
+    mem[9'b11101011] = 26'h0;
+    mem[9'b11101100] = 26'h0;
+    mem[9'b11101101] = 26'h0;
+    mem[9'b11101110] = 26'h0;
+    mem[9'b11101111] = 26'h0;
+    mem[9'b11110000] = 26'h0;
+    mem[9'b11110001] = 26'h0;
+    mem[9'b11110010] = 26'h0;
+    mem[9'b11110011] = 26'h0;
+    mem[9'b11110100] = 26'h0;
+    mem[9'b11110101] = 26'h0;
+    mem[9'b11110110] = 26'h0;
+    mem[9'b11110111] = 26'h0;
+    mem[9'b11111000] = 26'h0;
+    mem[9'b11111001] = 26'h0;
+    mem[9'b11111010] = 26'h0;
+    mem[9'b11111011] = 26'h0;
+    mem[9'b11111100] = 26'h0;
+    mem[9'b11111101] = 26'h0;
+    mem[9'b11111110] = 26'h0;
+    mem[9'b11111111] = 26'h0;
+    mem[9'b100000000] = 26'h0;
+    mem[9'b100000001] = 26'h0;
+    mem[9'b100000010] = 26'h0;
+    mem[9'b100000011] = 26'h0;
+    mem[9'b100000100] = 26'h0;
+    mem[9'b100000101] = 26'h0;
+    mem[9'b100000110] = 26'h0;
+    mem[9'b100000111] = 26'h0;
+    mem[9'b100001000] = 26'h0;
+    mem[9'b100001001] = 26'h0;
+    mem[9'b100001010] = 26'h0;
+    mem[9'b100001011] = 26'h0;
+    mem[9'b100001100] = 26'h0;
+    mem[9'b100001101] = 26'h0;
+    mem[9'b100001110] = 26'h0;
+    mem[9'b100001111] = 26'h0;
+    mem[9'b100010000] = 26'h0;
+    mem[9'b100010001] = 26'h0;
+    mem[9'b100010010] = 26'h0;
+    mem[9'b100010011] = 26'h0;
+    mem[9'b100010100] = 26'h0;
+    mem[9'b100010101] = 26'h0;
+    mem[9'b100010110] = 26'h0;
+    mem[9'b100010111] = 26'h0;
+    mem[9'b100011000] = 26'h0;
+    mem[9'b100011001] = 26'h0;
+    mem[9'b100011010] = 26'h0;
+    mem[9'b100011011] = 26'h0;
+    mem[9'b100011100] = 26'h0;
+    mem[9'b100011101] = 26'h0;
+    mem[9'b100011110] = 26'h0;
+    mem[9'b100011111] = 26'h0;
+    mem[9'b100100000] = 26'h0;
+    mem[9'b100100001] = 26'h0;
+    mem[9'b100100010] = 26'h0;
+    mem[9'b100100011] = 26'h0;
+    mem[9'b100100100] = 26'h0;
+    mem[9'b100100101] = 26'h0;
+    mem[9'b100100110] = 26'h0;
+    mem[9'b100100111] = 26'h0;
+    mem[9'b100101000] = 26'h0;
+    mem[9'b100101001] = 26'h0;
+    mem[9'b100101010] = 26'h0;
+    mem[9'b100101011] = 26'h0;
+    mem[9'b100101100] = 26'h0;
+    mem[9'b100101101] = 26'h0;
+    mem[9'b100101110] = 26'h0;
+    mem[9'b100101111] = 26'h0;
+    mem[9'b100110000] = 26'h0;
+    mem[9'b100110001] = 26'h0;
+    mem[9'b100110010] = 26'h0;
+    mem[9'b100110011] = 26'h0;
+    mem[9'b100110100] = 26'h0;
+    mem[9'b100110101] = 26'h0;
+    mem[9'b100110110] = 26'h0;
+    mem[9'b100110111] = 26'h0;
+    mem[9'b100111000] = 26'h0;
+    mem[9'b100111001] = 26'h0;
+    mem[9'b100111010] = 26'h0;
+    mem[9'b100111011] = 26'h0;
+    mem[9'b100111100] = 26'h0;
+    mem[9'b100111101] = 26'h0;
+    mem[9'b100111110] = 26'h0;
+    mem[9'b100111111] = 26'h0;
+    mem[9'b101000000] = 26'h0;
+    mem[9'b101000001] = 26'h0;
+    mem[9'b101000010] = 26'h0;
+    mem[9'b101000011] = 26'h0;
+    mem[9'b101000100] = 26'h0;
+    mem[9'b101000101] = 26'h0;
+    mem[9'b101000110] = 26'h0;
+    mem[9'b101000111] = 26'h0;
+    mem[9'b101001000] = 26'h0;
+    mem[9'b101001001] = 26'h0;
+    mem[9'b101001010] = 26'h0;
+    mem[9'b101001011] = 26'h0;
+    mem[9'b101001100] = 26'h0;
+    mem[9'b101001101] = 26'h0;
+    mem[9'b101001110] = 26'h0;
+    mem[9'b101001111] = 26'h0;
+    mem[9'b101010000] = 26'h0;
+    mem[9'b101010001] = 26'h0;
+    mem[9'b101010010] = 26'h0;
+    mem[9'b101010011] = 26'h0;
+    mem[9'b101010100] = 26'h0;
+    mem[9'b101010101] = 26'h0;
+    mem[9'b101010110] = 26'h0;
+    mem[9'b101010111] = 26'h0;
+    mem[9'b101011000] = 26'h0;
+    mem[9'b101011001] = 26'h0;
+    mem[9'b101011010] = 26'h0;
+    mem[9'b101011011] = 26'h0;
+    mem[9'b101011100] = 26'h0;
+    mem[9'b101011101] = 26'h0;
+    mem[9'b101011110] = 26'h0;
+    mem[9'b101011111] = 26'h0;
+    mem[9'b101100000] = 26'h0;
+    mem[9'b101100001] = 26'h0;
+    mem[9'b101100010] = 26'h0;
+    mem[9'b101100011] = 26'h0;
+    mem[9'b101100100] = 26'h0;
+    mem[9'b101100101] = 26'h0;
+    mem[9'b101100110] = 26'h0;
+    mem[9'b101100111] = 26'h0;
+    mem[9'b101101000] = 26'h0;
+    mem[9'b101101001] = 26'h0;
+    mem[9'b101101010] = 26'h0;
+    mem[9'b101101011] = 26'h0;
+    mem[9'b101101100] = 26'h0;
+    mem[9'b101101101] = 26'h0;
+    mem[9'b101101110] = 26'h0;
+    mem[9'b101101111] = 26'h0;
+    mem[9'b101110000] = 26'h0;
+    mem[9'b101110001] = 26'h0;
+    mem[9'b101110010] = 26'h0;
+    mem[9'b101110011] = 26'h0;
+    mem[9'b101110100] = 26'h0;
+    mem[9'b101110101] = 26'h0;
+    mem[9'b101110110] = 26'h0;
+    mem[9'b101110111] = 26'h0;
+    mem[9'b101111000] = 26'h0;
+    mem[9'b101111001] = 26'h0;
+    mem[9'b101111010] = 26'h0;
+    mem[9'b101111011] = 26'h0;
+    mem[9'b101111100] = 26'h0;
+    mem[9'b101111101] = 26'h0;
+    mem[9'b101111110] = 26'h0;
+    mem[9'b101111111] = 26'h0;
+    mem[9'b110000000] = 26'h0;
+    mem[9'b110000001] = 26'h0;
+    mem[9'b110000010] = 26'h0;
+    mem[9'b110000011] = 26'h0;
+    mem[9'b110000100] = 26'h0;
+    mem[9'b110000101] = 26'h0;
+    mem[9'b110000110] = 26'h0;
+    mem[9'b110000111] = 26'h0;
+    mem[9'b110001000] = 26'h0;
+    mem[9'b110001001] = 26'h0;
+    mem[9'b110001010] = 26'h0;
+    mem[9'b110001011] = 26'h0;
+    mem[9'b110001100] = 26'h0;
+    mem[9'b110001101] = 26'h0;
+    mem[9'b110001110] = 26'h0;
+    mem[9'b110001111] = 26'h0;
+    mem[9'b110010000] = 26'h0;
+    mem[9'b110010001] = 26'h0;
+    mem[9'b110010010] = 26'h0;
+    mem[9'b110010011] = 26'h0;
+    mem[9'b110010100] = 26'h0;
+    mem[9'b110010101] = 26'h0;
+    mem[9'b110010110] = 26'h0;
+    mem[9'b110010111] = 26'h0;
+    mem[9'b110011000] = 26'h0;
+    mem[9'b110011001] = 26'h0;
+    mem[9'b110011010] = 26'h0;
+    mem[9'b110011011] = 26'h0;
+    mem[9'b110011100] = 26'h0;
+    mem[9'b110011101] = 26'h0;
+    mem[9'b110011110] = 26'h0;
+    mem[9'b110011111] = 26'h0;
+    mem[9'b110100000] = 26'h0;
+    mem[9'b110100001] = 26'h0;
+    mem[9'b110100010] = 26'h0;
+    mem[9'b110100011] = 26'h0;
+    mem[9'b110100100] = 26'h0;
+    mem[9'b110100101] = 26'h0;
+    mem[9'b110100110] = 26'h0;
+    mem[9'b110100111] = 26'h0;
+    mem[9'b110101000] = 26'h0;
+    mem[9'b110101001] = 26'h0;
+    mem[9'b110101010] = 26'h0;
+    mem[9'b110101011] = 26'h0;
+    mem[9'b110101100] = 26'h0;
+    mem[9'b110101101] = 26'h0;
+    mem[9'b110101110] = 26'h0;
+    mem[9'b110101111] = 26'h0;
+    mem[9'b110110000] = 26'h0;
+    mem[9'b110110001] = 26'h0;
+    mem[9'b110110010] = 26'h0;
+    mem[9'b110110011] = 26'h0;
+    mem[9'b110110100] = 26'h0;
+    mem[9'b110110101] = 26'h0;
+    mem[9'b110110110] = 26'h0;
+    mem[9'b110110111] = 26'h0;
+    mem[9'b110111000] = 26'h0;
+    mem[9'b110111001] = 26'h0;
+    mem[9'b110111010] = 26'h0;
+    mem[9'b110111011] = 26'h0;
+    mem[9'b110111100] = 26'h0;
+    mem[9'b110111101] = 26'h0;
+    mem[9'b110111110] = 26'h0;
+    mem[9'b110111111] = 26'h0;
+    mem[9'b111000000] = 26'h0;
+    mem[9'b111000001] = 26'h0;
+    mem[9'b111000010] = 26'h0;
+    mem[9'b111000011] = 26'h0;
+    mem[9'b111000100] = 26'h0;
+    mem[9'b111000101] = 26'h0;
+    mem[9'b111000110] = 26'h0;
+    mem[9'b111000111] = 26'h0;
+    mem[9'b111001000] = 26'h0;
+    mem[9'b111001001] = 26'h0;
+    mem[9'b111001010] = 26'h0;
+    mem[9'b111001011] = 26'h0;
+    mem[9'b111001100] = 26'h0;
+    mem[9'b111001101] = 26'h0;
+    mem[9'b111001110] = 26'h0;
+    mem[9'b111001111] = 26'h0;
+    mem[9'b111010000] = 26'h0;
+    mem[9'b111010001] = 26'h0;
+    mem[9'b111010010] = 26'h0;
+    mem[9'b111010011] = 26'h0;
+    mem[9'b111010100] = 26'h0;
+    mem[9'b111010101] = 26'h0;
+    mem[9'b111010110] = 26'h0;
+    mem[9'b111010111] = 26'h0;
+    mem[9'b111011000] = 26'h0;
+    mem[9'b111011001] = 26'h0;
+    mem[9'b111011010] = 26'h0;
+    mem[9'b111011011] = 26'h0;
+    mem[9'b111011100] = 26'h0;
+    mem[9'b111011101] = 26'h0;
+    mem[9'b111011110] = 26'h0;
+    mem[9'b111011111] = 26'h0;
+    mem[9'b111100000] = 26'h0;
+    mem[9'b111100001] = 26'h0;
+    mem[9'b111100010] = 26'h0;
+    mem[9'b111100011] = 26'h0;
+    mem[9'b111100100] = 26'h0;
+    mem[9'b111100101] = 26'h0;
+    mem[9'b111100110] = 26'h0;
+    mem[9'b111100111] = 26'h0;
+    mem[9'b111101000] = 26'h0;
+    mem[9'b111101001] = 26'h0;
+    mem[9'b111101010] = 26'h0;
+    mem[9'b111101011] = 26'h0;
+    mem[9'b111101100] = 26'h0;
+    mem[9'b111101101] = 26'h0;
+    mem[9'b111101110] = 26'h0;
+    mem[9'b111101111] = 26'h0;
+    mem[9'b111110000] = 26'h0;
+    mem[9'b111110001] = 26'h0;
+    mem[9'b111110010] = 26'h0;
+    mem[9'b111110011] = 26'h0;
+    mem[9'b111110100] = 26'h0;
+    mem[9'b111110101] = 26'h0;
+    mem[9'b111110110] = 26'h0;
+    mem[9'b111110111] = 26'h0;
+    mem[9'b111111000] = 26'h0;
+    mem[9'b111111001] = 26'h0;
+    mem[9'b111111010] = 26'h0;
+    mem[9'b111111011] = 26'h0;
+    mem[9'b111111100] = 26'h0;
+    mem[9'b111111101] = 26'h0;
+    mem[9'b111111110] = 26'h0;
+    mem[9'b111111111] = 26'h0;
+    end
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__instances__cache_tag
+
+
+module dynrt_processor__engine__instances__cache_words__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [8:0] read_address;
+    input wire  read_clock;
+    output reg  [23:0] read_data;
+    input wire  [8:0] write_address;
+    input wire  write_clock;
+    input wire  [23:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[23:0] mem[511:0];
+    
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__instances__cache_words__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -11532,10 +12697,13 @@ module dynrt_processor__engine__instances__phase(d,q,clock);
     
     // Enums
     localparam EntryPhase__Idle = 0;
-    localparam EntryPhase__Fetch = 1;
-    localparam EntryPhase__Origin = 2;
-    localparam EntryPhase__Direction = 3;
-    localparam EntryPhase__Normal = 4;
+    localparam EntryPhase__Look = 1;
+    localparam EntryPhase__Compare = 2;
+    localparam EntryPhase__Decide = 3;
+    localparam EntryPhase__Fetch = 4;
+    localparam EntryPhase__Origin = 5;
+    localparam EntryPhase__Direction = 6;
+    localparam EntryPhase__Normal = 7;
     
     // Update code (custom)
     initial begin
@@ -11547,6 +12715,31 @@ module dynrt_processor__engine__instances__phase(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__instances__phase
+
+
+module dynrt_processor__engine__instances__root_r(d,q,clock);
+    
+    // Module arguments
+    input wire  [25:0] d;
+    output reg  [25:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 26'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__instances__root_r
+
+
+
+
+
+
 
 
 
@@ -16465,7 +17658,7 @@ endmodule // dynrt_processor__engine__result_line__thread_line
 
 
 
-module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,wb_valid,wb_thread,wb_halt,wb_wait_pending,tester_done,tester_done_thread,walk_done,walk_done_thread,ray_done_mask,issue,pick);
+module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,wb_valid,wb_thread_mask,wb_halt,wb_wait_pending,tester_done,tester_done_thread,walk_done,walk_done_thread,ray_done_mask,issue,pick);
     
     // Module arguments
     input wire  clock;
@@ -16473,7 +17666,7 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     input wire  frame_start;
     input wire  long_at_i3;
     input wire  wb_valid;
-    input wire  [4:0] wb_thread;
+    input wire  [31:0] wb_thread_mask;
     input wire  wb_halt;
     input wire  wb_wait_pending;
     input wire  tester_done;
@@ -16491,18 +17684,12 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     localparam  c_reserve_bit = 32'h9;
     
     // Stub signals
-    reg  tester_done_r__d;
-    wire  tester_done_r__q;
-    reg  tester_done_r__clock;
-    reg  [4:0] tester_done_thread_r__d;
-    wire  [4:0] tester_done_thread_r__q;
-    reg  tester_done_thread_r__clock;
-    reg  walk_done_r__d;
-    wire  walk_done_r__q;
-    reg  walk_done_r__clock;
-    reg  [4:0] walk_done_thread_r__d;
-    wire  [4:0] walk_done_thread_r__q;
-    reg  walk_done_thread_r__clock;
+    reg  [31:0] tester_event__d;
+    wire  [31:0] tester_event__q;
+    reg  tester_event__clock;
+    reg  [31:0] walk_event__d;
+    wire  [31:0] walk_event__q;
+    reg  walk_event__clock;
     reg  [31:0] ready__d;
     wire  [31:0] ready__q;
     reg  ready__clock;
@@ -16542,33 +17729,21 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     reg  issues;
     reg  [31:0] issue_mask;
     reg  [31:0] wb_mask;
-    reg  [31:0] tester_event;
-    reg  [31:0] walk_event;
     reg  [31:0] event_mask;
     reg  wb_sleep;
     reg  [31:0] wake_mask;
     reg  [31:0] sleep_mask;
     
     // Sub module instances
-    dynrt_processor__display__dark_d tester_done_r(
-        .d(tester_done_r__d),
-        .q(tester_done_r__q),
-        .clock(tester_done_r__clock)
+    dynrt_processor__engine__cache_hit_count tester_event(
+        .d(tester_event__d),
+        .q(tester_event__q),
+        .clock(tester_event__clock)
     );
-    dynrt_processor__engine__decode__t4 tester_done_thread_r(
-        .d(tester_done_thread_r__d),
-        .q(tester_done_thread_r__q),
-        .clock(tester_done_thread_r__clock)
-    );
-    dynrt_processor__display__dark_d walk_done_r(
-        .d(walk_done_r__d),
-        .q(walk_done_r__q),
-        .clock(walk_done_r__clock)
-    );
-    dynrt_processor__engine__decode__t4 walk_done_thread_r(
-        .d(walk_done_thread_r__d),
-        .q(walk_done_thread_r__q),
-        .clock(walk_done_thread_r__clock)
+    dynrt_processor__engine__cache_hit_count walk_event(
+        .d(walk_event__d),
+        .q(walk_event__q),
+        .clock(walk_event__clock)
     );
     dynrt_processor__engine__cache_hit_count ready(
         .d(ready__d),
@@ -16625,10 +17800,8 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
     
     // Update code
     always @(*) begin
-        tester_done_r__clock = clock;
-        tester_done_thread_r__clock = clock;
-        walk_done_r__clock = clock;
-        walk_done_thread_r__clock = clock;
+        tester_event__clock = clock;
+        walk_event__clock = clock;
         ready__clock = clock;
         asleep__clock = clock;
         woken__clock = clock;
@@ -16638,10 +17811,8 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         pointer__clock = clock;
         below_pointer__clock = clock;
         reserved__clock = clock;
-        tester_done_r__d = tester_done_r__q;
-        tester_done_thread_r__d = tester_done_thread_r__q;
-        walk_done_r__d = walk_done_r__q;
-        walk_done_thread_r__d = walk_done_thread_r__q;
+        tester_event__d = tester_event__q;
+        walk_event__d = walk_event__q;
         ready__d = ready__q;
         asleep__d = asleep__q;
         woken__d = woken__q;
@@ -16668,20 +17839,16 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
         pick_number__d = first_ready__number;
         pointer__d = pointer__q - 32'h1;
         below_pointer__d = ~(c_ones << (pointer__q - 32'h1));
-        wb_mask = c_one << wb_thread;
-        tester_done_r__d = tester_done;
-        tester_done_thread_r__d = tester_done_thread;
-        walk_done_r__d = walk_done;
-        walk_done_thread_r__d = walk_done_thread;
-        tester_event = 32'h0;
-        if (tester_done_r__q) begin
-            tester_event = c_one << tester_done_thread_r__q;
+        wb_mask = wb_thread_mask;
+        tester_event__d = 32'h0;
+        if (tester_done) begin
+            tester_event__d = c_one << tester_done_thread;
         end
-        walk_event = 32'h0;
-        if (walk_done_r__q) begin
-            walk_event = c_one << walk_done_thread_r__q;
+        walk_event__d = 32'h0;
+        if (walk_done) begin
+            walk_event__d = c_one << walk_done_thread;
         end
-        event_mask = tester_event | walk_event | ray_done_mask;
+        event_mask = tester_event__q | walk_event__q | ray_done_mask;
         wb_sleep = wb_valid & wb_wait_pending & (((woken__q | event_mask) & wb_mask) == 32'h0);
         wake_mask = 32'h0;
         sleep_mask = 32'h0;
@@ -16701,8 +17868,8 @@ module dynrt_processor__engine__scheduler(clock,running,frame_start,long_at_i3,w
             asleep__d = 32'h0;
             woken__d = 32'h0;
             reserved__d = 32'h0;
-            tester_done_r__d = 1'b0;
-            walk_done_r__d = 1'b0;
+            tester_event__d = 32'h0;
+            walk_event__d = 32'h0;
             picked__d = 1'b0;
         end
     end
@@ -16779,10 +17946,6 @@ module dynrt_processor__engine__scheduler__first_ready(preferred,others,found,on
     end
     
 endmodule // dynrt_processor__engine__scheduler__first_ready
-
-
-
-
 
 
 
@@ -25792,7 +26955,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_tag__write_data),
         .write_enable(cache_tag__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__0(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__0(
         .read_address(cache_words__0__read_address),
         .read_clock(cache_words__0__read_clock),
         .read_data(cache_words__0__read_data),
@@ -25801,7 +26964,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_words__0__write_data),
         .write_enable(cache_words__0__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__1(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__1(
         .read_address(cache_words__1__read_address),
         .read_clock(cache_words__1__read_clock),
         .read_data(cache_words__1__read_data),
@@ -25810,7 +26973,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_words__1__write_data),
         .write_enable(cache_words__1__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__2(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__2(
         .read_address(cache_words__2__read_address),
         .read_clock(cache_words__2__read_clock),
         .read_data(cache_words__2__read_data),
@@ -25819,7 +26982,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_words__2__write_data),
         .write_enable(cache_words__2__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__3(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__3(
         .read_address(cache_words__3__read_address),
         .read_clock(cache_words__3__read_clock),
         .read_data(cache_words__3__read_data),
@@ -25828,7 +26991,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_words__3__write_data),
         .write_enable(cache_words__3__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__4(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__4(
         .read_address(cache_words__4__read_address),
         .read_clock(cache_words__4__read_clock),
         .read_data(cache_words__4__read_data),
@@ -25837,7 +27000,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_words__4__write_data),
         .write_enable(cache_words__4__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__5(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__5(
         .read_address(cache_words__5__read_address),
         .read_clock(cache_words__5__read_clock),
         .read_data(cache_words__5__read_data),
@@ -25846,7 +27009,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_words__5__write_data),
         .write_enable(cache_words__5__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__6(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__6(
         .read_address(cache_words__6__read_address),
         .read_clock(cache_words__6__read_clock),
         .read_data(cache_words__6__read_data),
@@ -25855,7 +27018,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_words__6__write_data),
         .write_enable(cache_words__6__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__7(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__7(
         .read_address(cache_words__7__read_address),
         .read_clock(cache_words__7__read_clock),
         .read_data(cache_words__7__read_data),
@@ -25864,7 +27027,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_words__7__write_data),
         .write_enable(cache_words__7__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__8(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__8(
         .read_address(cache_words__8__read_address),
         .read_clock(cache_words__8__read_clock),
         .read_data(cache_words__8__read_data),
@@ -25873,7 +27036,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_words__8__write_data),
         .write_enable(cache_words__8__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__9(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__9(
         .read_address(cache_words__9__read_address),
         .read_clock(cache_words__9__read_clock),
         .read_data(cache_words__9__read_data),
@@ -25882,7 +27045,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_words__9__write_data),
         .write_enable(cache_words__9__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__10(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__10(
         .read_address(cache_words__10__read_address),
         .read_clock(cache_words__10__read_clock),
         .read_data(cache_words__10__read_data),
@@ -25891,7 +27054,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_data(cache_words__10__write_data),
         .write_enable(cache_words__10__write_enable)
     );
-    dynrt_processor__engine__tester__cache_words__0 cache_words__11(
+    dynrt_processor__engine__instances__cache_words__0 cache_words__11(
         .read_address(cache_words__11__read_address),
         .read_clock(cache_words__11__read_clock),
         .read_data(cache_words__11__read_data),
@@ -28179,33 +29342,6 @@ module dynrt_processor__engine__tester__cache_tag(read_address,read_clock,read_d
 endmodule // dynrt_processor__engine__tester__cache_tag
 
 
-module dynrt_processor__engine__tester__cache_words__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
-    
-    // Module arguments
-    input wire  [8:0] read_address;
-    input wire  read_clock;
-    output reg  [23:0] read_data;
-    input wire  [8:0] write_address;
-    input wire  write_clock;
-    input wire  [23:0] write_data;
-    input wire  write_enable;
-    
-    // Update code (custom)
-    reg[23:0] mem[511:0];
-    
-    
-    
-    always @(posedge read_clock) begin
-       read_data <= mem[read_address];
-    end
-    
-    always @(posedge write_clock) begin
-       if (write_enable) begin
-          mem[write_address] <= write_data;
-       end
-    end
-                
-endmodule // dynrt_processor__engine__tester__cache_words__0
 
 
 
@@ -36577,6 +37713,10 @@ endmodule // dynrt_processor__engine__tester__words__0
 
 
 
+
+
+
+
 module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,t_min_write,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2,nodes__read,nodes__addr,nodes__rdata,step_busy,leaf_valid,leaf_thread,leaf_from,leaf_to,leaf_take,answer_valid,answer_thread,answer_t,answer_hit,engine_next,world_write,world_pair,enter,entered,root_write,root_thread,root,top_from,top_to,cache_hit,cache_miss);
     
     // Module arguments
@@ -37625,7 +38765,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f4_t_min__q),
         .clock(f4_t_min__clock)
     );
-    dynrt_processor__engine__traversal_unit__f4_node f4_node(
+    dynrt_processor__engine__instances__root_r f4_node(
         .d(f4_node__d),
         .q(f4_node__q),
         .clock(f4_node__clock)
@@ -37680,7 +38820,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(f5_t_min__q),
         .clock(f5_t_min__clock)
     );
-    dynrt_processor__engine__traversal_unit__f4_node f5_node(
+    dynrt_processor__engine__instances__root_r f5_node(
         .d(f5_node__d),
         .q(f5_node__q),
         .clock(f5_node__clock)
@@ -40298,23 +41438,6 @@ endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__ram
 
 
 
-module dynrt_processor__engine__traversal_unit__f4_node(d,q,clock);
-    
-    // Module arguments
-    input wire  [25:0] d;
-    output reg  [25:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 26'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor__engine__traversal_unit__f4_node
 
 
 
@@ -41461,7 +42584,7 @@ endmodule // dynrt_processor__engine__traversal_unit__tag_word_r
 
 
 
-module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,retiring__thread,retiring__write,retiring__source,retiring__cond,retiring__sel_lt,retiring__sel_le,retiring__sel_eq,retiring__pc_taken,retiring__pc_not_taken,retiring__halt,retiring__retired,retiring__wait_pending,retiring__fast,sum,product,quotient,root,lt,le,eq,colour_byte,valid,thread,dst,write,data,next_pc,halt,retired,wait_pending);
+module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,retiring__thread,retiring__write,retiring__source,retiring__cond,retiring__sel_lt,retiring__sel_le,retiring__sel_eq,retiring__pc_taken,retiring__pc_not_taken,retiring__halt,retiring__retired,retiring__wait_pending,retiring__fast,sum,product,quotient,root,lt,le,eq,colour_byte,valid,thread,thread_mask,dst,write,data,next_pc,halt,retired,wait_pending);
     
     // Module arguments
     input wire  clock;
@@ -41490,6 +42613,7 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
     input wire  [7:0] colour_byte;
     output reg  valid;
     output reg  [4:0] thread;
+    output reg  [31:0] thread_mask;
     output reg  [7:0] dst;
     output reg  write;
     output reg  [31:0] data;
@@ -41497,6 +42621,9 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
     output reg  halt;
     output reg  retired;
     output reg  wait_pending;
+    
+    // Constant declarations
+    localparam  c_one = 32'h1;
     
     // Enums
     localparam ResultSource__Fast = 0;
@@ -41513,6 +42640,9 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
     reg  [4:0] thread_r__d;
     wire  [4:0] thread_r__q;
     reg  thread_r__clock;
+    reg  [31:0] thread_mask_r__d;
+    wire  [31:0] thread_mask_r__q;
+    reg  thread_mask_r__clock;
     reg  [7:0] dst_r__d;
     wire  [7:0] dst_r__q;
     reg  dst_r__clock;
@@ -41549,6 +42679,11 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
         .d(thread_r__d),
         .q(thread_r__q),
         .clock(thread_r__clock)
+    );
+    dynrt_processor__engine__cache_hit_count thread_mask_r(
+        .d(thread_mask_r__d),
+        .q(thread_mask_r__q),
+        .clock(thread_mask_r__clock)
     );
     dynrt_processor__engine__fp_units__byte_delay__stage__0 dst_r(
         .d(dst_r__d),
@@ -41590,6 +42725,7 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
     always @(*) begin
         valid_r__clock = clock;
         thread_r__clock = clock;
+        thread_mask_r__clock = clock;
         dst_r__clock = clock;
         write_r__clock = clock;
         data_r__clock = clock;
@@ -41599,6 +42735,7 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
         wait_pending_r__clock = clock;
         valid_r__d = valid_r__q;
         thread_r__d = thread_r__q;
+        thread_mask_r__d = thread_mask_r__q;
         dst_r__d = dst_r__q;
         write_r__d = write_r__q;
         data_r__d = data_r__q;
@@ -41639,6 +42776,7 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
         endcase
         valid_r__d = retiring__valid;
         thread_r__d = retiring__thread;
+        thread_mask_r__d = c_one << retiring__thread;
         dst_r__d = retiring__dst;
         data_r__d = result;
         write_r__d = retiring__write;
@@ -41647,6 +42785,7 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
         wait_pending_r__d = retiring__wait_pending;
         valid = valid_r__q;
         thread = thread_r__q;
+        thread_mask = thread_mask_r__q;
         dst = dst_r__q;
         write = write_r__q;
         data = data_r__q;
@@ -41657,6 +42796,8 @@ module dynrt_processor__engine__write_back(clock,retiring__valid,retiring__dst,r
     end
     
 endmodule // dynrt_processor__engine__write_back
+
+
 
 
 

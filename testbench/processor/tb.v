@@ -36,6 +36,8 @@ module tb;
   wire [31:0] tri_cache_misses;
   wire [31:0] node_cache_hits;
   wire [31:0] node_cache_misses;
+  wire [31:0] instance_cache_hits;
+  wire [31:0] instance_cache_misses;
   reg vga_clock = 1'b0;
   reg vga_reset = 1'b1;
   wire [23:0] vga_fb_addr;
@@ -62,7 +64,7 @@ module tb;
   reg [31:0] rd3 [0:1];
   integer k, n, f, fd;
   reg timeout = 1'b0;
-  dynrt_processor dut(.clock(clock), .start(start), .done(done), .cycles(cycles), .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank), .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write), .fb_addr(fb_addr), .fb_data(fb_data), .bank0_read(bank0_read), .bank0_addr(bank0_addr), .bank0_rdata(bank0_rdata), .bank2_read(bank2_read), .bank2_addr(bank2_addr), .bank2_rdata(bank2_rdata), .bank3_read(bank3_read), .bank3_addr(bank3_addr), .bank3_rdata(bank3_rdata), .transform_busy(transform_busy), .intersect_busy(intersect_busy), .traversal_busy(traversal_busy), .raygen_busy(raygen_busy), .instance_busy(instance_busy), .shading_busy(shading_busy), .tri_cache_hits(tri_cache_hits), .tri_cache_misses(tri_cache_misses), .node_cache_hits(node_cache_hits), .node_cache_misses(node_cache_misses), .vga_clock(vga_clock), .vga_reset(vga_reset), .vga_fb_addr(vga_fb_addr), .vga_fb_data(vga_fb_data), .vga_hsync(vga_hsync), .vga_vsync(vga_vsync), .vga_rgb(vga_rgb), .vga_frame_start(vga_frame_start));
+  dynrt_processor dut(.clock(clock), .start(start), .done(done), .cycles(cycles), .instructions(instructions), .mem_read(mem_read), .mem_bank(mem_bank), .mem_addr(mem_addr), .mem_rdata(mem_rdata), .fb_write(fb_write), .fb_addr(fb_addr), .fb_data(fb_data), .bank0_read(bank0_read), .bank0_addr(bank0_addr), .bank0_rdata(bank0_rdata), .bank2_read(bank2_read), .bank2_addr(bank2_addr), .bank2_rdata(bank2_rdata), .bank3_read(bank3_read), .bank3_addr(bank3_addr), .bank3_rdata(bank3_rdata), .transform_busy(transform_busy), .intersect_busy(intersect_busy), .traversal_busy(traversal_busy), .raygen_busy(raygen_busy), .instance_busy(instance_busy), .shading_busy(shading_busy), .tri_cache_hits(tri_cache_hits), .tri_cache_misses(tri_cache_misses), .node_cache_hits(node_cache_hits), .node_cache_misses(node_cache_misses), .instance_cache_hits(instance_cache_hits), .instance_cache_misses(instance_cache_misses), .vga_clock(vga_clock), .vga_reset(vga_reset), .vga_fb_addr(vga_fb_addr), .vga_fb_data(vga_fb_data), .vga_hsync(vga_hsync), .vga_vsync(vga_vsync), .vga_rgb(vga_rgb), .vga_frame_start(vga_frame_start));
   always #5 clock = ~clock;
   // +heartbeat=N: a progress line every N clocks (frame, clocks, pixels written).
   initial if (!$value$plusargs("heartbeat=%d", heartbeat)) heartbeat = 0;
@@ -166,11 +168,11 @@ module tb;
     for (k = 0; k < 3072; k = k + 1) $fwrite(fd, "%06h\n", bank5[46 + k][23:0]);
     $fclose(fd);
     fd = $fopen({out_dir, "/frame0.stats"}, "w");
-    $fwrite(fd, "%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\n",
+    $fwrite(fd, "%0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d\n",
       cycles, instructions, transform_busy, intersect_busy, traversal_busy, raygen_busy,
       instance_busy, shading_busy, ready_clocks, asleep_clocks,
       reads0, reads1, reads2, reads3, reads4, reads5, tri_cache_hits, tri_cache_misses,
-      node_cache_hits, node_cache_misses);
+      node_cache_hits, node_cache_misses, instance_cache_hits, instance_cache_misses);
     $fclose(fd);
     $display("frame 0: %0d cycles, %0d instructions", cycles, instructions);
     if ($test$plusargs("vga")) begin

@@ -1298,7 +1298,7 @@ impl<
         self.fetch.wb_halt.next = self.write_back.halt.val();
         self.fetch.wb_next_pc.next = self.write_back.next_pc.val();
         self.scheduler.wb_valid.next = self.write_back.valid.val();
-        self.scheduler.wb_thread.next = self.write_back.thread.val();
+        self.scheduler.wb_thread_mask.next = self.write_back.thread_mask.val();
         self.scheduler.wb_halt.next = self.write_back.halt.val();
         self.scheduler.wb_wait_pending.next = self.write_back.wait_pending.val();
         self.scheduler.tester_done.next = self.tester.engine.done.val();

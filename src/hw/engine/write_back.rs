@@ -43,6 +43,7 @@ pub struct WriteBack<const W: usize> {
     /// The clock after the instruction left the line: it, its thread and destination.
     pub valid: Signal<Out, Bit>,
     pub thread: Signal<Out, Bits<5>>,
+    pub thread_mask: Signal<Out, Bits<32>>,
     pub dst: Signal<Out, Bits<REG_BITS>>,
     pub write: Signal<Out, Bit>,
     pub data: Signal<Out, Bits<32>>,
@@ -55,6 +56,8 @@ pub struct WriteBack<const W: usize> {
     result: Signal<Local, Bits<32>>,
     valid_r: DFF<Bit>,
     thread_r: DFF<Bits<5>>,
+    /// The thread, one-hot, for the scheduler (see `Scheduler::wb_thread_mask`).
+    thread_mask_r: DFF<Bits<32>>,
     dst_r: DFF<Bits<REG_BITS>>,
     write_r: DFF<Bit>,
     data_r: DFF<Bits<32>>,
@@ -62,6 +65,7 @@ pub struct WriteBack<const W: usize> {
     halt_r: DFF<Bit>,
     retired_r: DFF<Bit>,
     wait_pending_r: DFF<Bit>,
+    c_one: Constant<Bits<32>>,
 }
 
 impl<const W: usize> Default for WriteBack<W> {
@@ -79,6 +83,7 @@ impl<const W: usize> Default for WriteBack<W> {
             colour_byte: Default::default(),
             valid: Default::default(),
             thread: Default::default(),
+            thread_mask: Default::default(),
             dst: Default::default(),
             write: Default::default(),
             data: Default::default(),
@@ -90,6 +95,7 @@ impl<const W: usize> Default for WriteBack<W> {
             result: Default::default(),
             valid_r: Default::default(),
             thread_r: Default::default(),
+            thread_mask_r: Default::default(),
             dst_r: Default::default(),
             write_r: Default::default(),
             data_r: Default::default(),
@@ -97,6 +103,7 @@ impl<const W: usize> Default for WriteBack<W> {
             halt_r: Default::default(),
             retired_r: Default::default(),
             wait_pending_r: Default::default(),
+            c_one: Constant::new(1u64.into()),
         }
     }
 }
@@ -109,6 +116,7 @@ impl<const W: usize> Logic for WriteBack<W> {
             clock,
             valid_r,
             thread_r,
+            thread_mask_r,
             dst_r,
             write_r,
             data_r,
@@ -149,6 +157,7 @@ impl<const W: usize> Logic for WriteBack<W> {
 
         self.valid_r.d.next = self.retiring.valid.val();
         self.thread_r.d.next = self.retiring.thread.val();
+        self.thread_mask_r.d.next = self.c_one.val() << self.retiring.thread.val();
         self.dst_r.d.next = self.retiring.dst.val();
         self.data_r.d.next = self.result.val();
         self.write_r.d.next = self.retiring.write.val();
@@ -158,6 +167,7 @@ impl<const W: usize> Logic for WriteBack<W> {
 
         self.valid.next = self.valid_r.q.val();
         self.thread.next = self.thread_r.q.val();
+        self.thread_mask.next = self.thread_mask_r.q.val();
         self.dst.next = self.dst_r.q.val();
         self.write.next = self.write_r.q.val();
         self.data.next = self.data_r.q.val();
