@@ -79,6 +79,15 @@ fn check_scene(s: Scene, name: &str, frames: Option<u32>, sim: Simulator, format
             f.bank_reads,
             f.cycles
         );
+        // Instance entry reads a record's 12 or 13 words from bank 4 on a miss of the
+        // instance cache and none on a hit; each frame starts with the cache flushed (the
+        // host rewrote the records), so a frame that enters instances misses at least once.
+        let (hits, misses) = (f.instance_cache_hits, f.instance_cache_misses);
+        assert!(
+            (12 * misses..=13 * misses).contains(&instances) && (hits == 0 || misses > 0),
+            "{name} frame {k}: {instances} bank-4 words for {hits} instance cache hits and \
+             {misses} misses"
+        );
         // The RTL issues exactly the instructions the engine's twin executes.
         if k == 0 {
             assert_eq!(

@@ -429,15 +429,22 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         {
             let f = &r.frames[0];
             let lookups = f.instance_cache_hits + f.instance_cache_misses;
-            format!(
+            if lookups == 0 {
+                format!(
+                    "instance cache (frame 0): {} sets, no instance entered",
+                    a.rtl.instance_cache
+                )
+            } else {
+                format!(
                 "instance cache (frame 0): {} sets, {} of {} instance records hit ({:.1}%), {} \
                  read bank 4",
                 a.rtl.instance_cache,
                 f.instance_cache_hits,
                 lookups,
-                100.0 * f.instance_cache_hits as f64 / lookups.max(1) as f64,
+                100.0 * f.instance_cache_hits as f64 / lookups as f64,
                 f.instance_cache_misses
             )
+            }
         },
         format!("engine issue slots by routine: {}", shares.join(", ")),
         {
