@@ -11054,6 +11054,9 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     reg  [23:0] entry_instance__d;
     wire  [23:0] entry_instance__q;
     reg  entry_instance__clock;
+    reg  [8:0] entry_set__d;
+    wire  [8:0] entry_set__q;
+    reg  entry_set__clock;
     reg  [25:0] tag_r__d;
     wire  [25:0] tag_r__q;
     reg  tag_r__clock;
@@ -11087,7 +11090,6 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     reg  last_normal_word;
     reg  [31:0] taken_mask;
     reg  [8:0] slot_set;
-    reg  [8:0] entry_set;
     reg  [25:0] entry_tag;
     reg  fill;
     
@@ -11477,6 +11479,11 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         .q(entry_instance__q),
         .clock(entry_instance__clock)
     );
+    dynrt_processor__engine__fp_units__add__lz entry_set(
+        .d(entry_set__d),
+        .q(entry_set__q),
+        .clock(entry_set__clock)
+    );
     dynrt_processor__engine__instances__root_r tag_r(
         .d(tag_r__d),
         .q(tag_r__q),
@@ -11535,6 +11542,7 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         waiting__clock = clock;
         pending_r__clock = clock;
         entry_instance__clock = clock;
+        entry_set__clock = clock;
         tag_r__clock = clock;
         root_r__clock = clock;
         hit_r__clock = clock;
@@ -11562,6 +11570,7 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         waiting__d = waiting__q;
         pending_r__d = pending_r__q;
         entry_instance__d = entry_instance__q;
+        entry_set__d = entry_set__q;
         tag_r__d = tag_r__q;
         root_r__d = root_r__q;
         hit_r__d = hit_r__q;
@@ -11661,6 +11670,7 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         if ((phase__q == EntryPhase__Idle) & slot_valid__q) begin
             slot_valid__d = 1'b0;
             entry_instance__d = slot_instance__q;
+            entry_set__d = slot_set;
             look_clean__d = ~sweeping__q;
             entry_thread__d = slot_thread__q;
             entry_normal__d = slot_normal__q;
@@ -11676,7 +11686,6 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
                 phase__d = EntryPhase__Look;
             end
         end
-        entry_set = ((((entry_instance__q[(32'h0)+:(8)]) & 9'h1ff) << 32'h1) | ((entry_normal__q) & 9'h1ff)) & c_set_mask;
         entry_tag = (((entry_instance__q) & 26'h3ffffff) << 32'h2) | (((entry_normal__q) & 26'h3ffffff) << 32'h1) | 32'h1;
         cache_tag__read_clock = clock;
         cache_tag__write_clock = clock;
@@ -11813,46 +11822,46 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         end
         fill_normal__d = last_normal_word;
         fill = c_cached & (root_arrives | fill_normal__q) & (~sweeping__q);
-        cache_tag__write_address = entry_set;
+        cache_tag__write_address = entry_set__q;
         cache_tag__write_data = entry_tag;
         cache_tag__write_enable = fill;
-        cache_root__write_address = entry_set;
+        cache_root__write_address = entry_set__q;
         cache_root__write_data = rdata[(32'h0)+:(26)];
         cache_root__write_enable = fill;
-        cache_words__0__write_address = entry_set;
+        cache_words__0__write_address = entry_set__q;
         cache_words__0__write_data = matrix__0__q;
         cache_words__0__write_enable = fill;
-        cache_words__1__write_address = entry_set;
+        cache_words__1__write_address = entry_set__q;
         cache_words__1__write_data = matrix__1__q;
         cache_words__1__write_enable = fill;
-        cache_words__2__write_address = entry_set;
+        cache_words__2__write_address = entry_set__q;
         cache_words__2__write_data = matrix__2__q;
         cache_words__2__write_enable = fill;
-        cache_words__3__write_address = entry_set;
+        cache_words__3__write_address = entry_set__q;
         cache_words__3__write_data = matrix__3__q;
         cache_words__3__write_enable = fill;
-        cache_words__4__write_address = entry_set;
+        cache_words__4__write_address = entry_set__q;
         cache_words__4__write_data = matrix__4__q;
         cache_words__4__write_enable = fill;
-        cache_words__5__write_address = entry_set;
+        cache_words__5__write_address = entry_set__q;
         cache_words__5__write_data = matrix__5__q;
         cache_words__5__write_enable = fill;
-        cache_words__6__write_address = entry_set;
+        cache_words__6__write_address = entry_set__q;
         cache_words__6__write_data = matrix__6__q;
         cache_words__6__write_enable = fill;
-        cache_words__7__write_address = entry_set;
+        cache_words__7__write_address = entry_set__q;
         cache_words__7__write_data = matrix__7__q;
         cache_words__7__write_enable = fill;
-        cache_words__8__write_address = entry_set;
+        cache_words__8__write_address = entry_set__q;
         cache_words__8__write_data = matrix__8__q;
         cache_words__8__write_enable = fill;
-        cache_words__9__write_address = entry_set;
+        cache_words__9__write_address = entry_set__q;
         cache_words__9__write_data = matrix__9__q;
         cache_words__9__write_enable = fill;
-        cache_words__10__write_address = entry_set;
+        cache_words__10__write_address = entry_set__q;
         cache_words__10__write_data = matrix__10__q;
         cache_words__10__write_enable = fill;
-        cache_words__11__write_address = entry_set;
+        cache_words__11__write_address = entry_set__q;
         cache_words__11__write_data = matrix__11__q;
         cache_words__11__write_enable = fill;
         if (sweeping__q) begin
@@ -12610,6 +12619,8 @@ module dynrt_processor__engine__instances__cache_words__0(read_address,read_cloc
     end
                 
 endmodule // dynrt_processor__engine__instances__cache_words__0
+
+
 
 
 

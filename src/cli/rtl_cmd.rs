@@ -400,52 +400,30 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
                 f.memory_bytes_per_second_at(mhz * 1e6) / 1e9
             )
         },
-        {
-            let f = &r.frames[0];
-            let tests = f.tri_cache_hits + f.tri_cache_misses;
-            format!(
-                "triangle cache (frame 0): {} sets, {} of {} triangle tests hit ({:.1}%), {} \
-                 read banks 2 and 3",
-                a.rtl.tri_cache,
-                f.tri_cache_hits,
-                tests,
-                100.0 * f.tri_cache_hits as f64 / tests.max(1) as f64,
-                f.tri_cache_misses
-            )
-        },
-        {
-            let f = &r.frames[0];
-            let nodes = f.node_cache_hits + f.node_cache_misses;
-            format!(
-                "node cache (frame 0): {} sets, {} of {} object-tree nodes hit ({:.1}%), {} \
-                 read bank 0",
-                a.rtl.node_cache,
-                f.node_cache_hits,
-                nodes,
-                100.0 * f.node_cache_hits as f64 / nodes.max(1) as f64,
-                f.node_cache_misses
-            )
-        },
-        {
-            let f = &r.frames[0];
-            let lookups = f.instance_cache_hits + f.instance_cache_misses;
-            if lookups == 0 {
-                format!(
-                    "instance cache (frame 0): {} sets, no instance entered",
-                    a.rtl.instance_cache
-                )
-            } else {
-                format!(
-                "instance cache (frame 0): {} sets, {} of {} instance records hit ({:.1}%), {} \
-                 read bank 4",
-                a.rtl.instance_cache,
-                f.instance_cache_hits,
-                lookups,
-                100.0 * f.instance_cache_hits as f64 / lookups as f64,
-                f.instance_cache_misses
-            )
-            }
-        },
+        cache_line(
+            "triangle",
+            a.rtl.tri_cache,
+            (r.frames[0].tri_cache_hits, r.frames[0].tri_cache_misses),
+            "triangle tests",
+            "banks 2 and 3",
+        ),
+        cache_line(
+            "node",
+            a.rtl.node_cache,
+            (r.frames[0].node_cache_hits, r.frames[0].node_cache_misses),
+            "object-tree nodes",
+            "bank 0",
+        ),
+        cache_line(
+            "instance",
+            a.rtl.instance_cache,
+            (
+                r.frames[0].instance_cache_hits,
+                r.frames[0].instance_cache_misses,
+            ),
+            "instance records",
+            "bank 4",
+        ),
         format!("engine issue slots by routine: {}", shares.join(", ")),
         {
             let [ready, asleep, rest] = r.frames[0].thread_shares(threads);
@@ -503,4 +481,24 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
     } else {
         super::EXIT_DIFFERS
     })
+}
+
+/// `dynrt sim`'s line for one cache in frame 0: its sets, the lookups that hit and those that
+/// read `bank`.
+fn cache_line(
+    cache: &str,
+    sets: u32,
+    (hits, misses): (u64, u64),
+    items: &str,
+    bank: &str,
+) -> String {
+    let lookups = hits + misses;
+    if lookups == 0 {
+        return format!("{cache} cache (frame 0): {sets} sets, no {items} looked up");
+    }
+    format!(
+        "{cache} cache (frame 0): {sets} sets, {hits} of {lookups} {items} hit ({:.1}%), {misses} \
+         read {bank}",
+        100.0 * hits as f64 / lookups as f64
+    )
 }

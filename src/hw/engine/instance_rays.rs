@@ -210,11 +210,11 @@ pub struct InstanceRays<const W: usize> {
     cache_tag: RAM<Bits<26>, 9>,
     cache_words: [RAM<Bits<W>, 9>; 12],
     cache_root: RAM<Bits<26>, 9>,
-    /// The slot's set, read as its entry begins; the entry's set and tag, for the compare
-    /// and the fill.
+    /// The slot's set, read as its entry begins; the entry's set (the slot's, kept) and tag,
+    /// for the compare and the fill.
     slot_set: Signal<Local, Bits<9>>,
     entry_instance: DFF<Bits<24>>,
-    entry_set: Signal<Local, Bits<9>>,
+    entry_set: DFF<Bits<9>>,
     entry_tag: Signal<Local, Bits<26>>,
     tag_r: DFF<Bits<26>>,
     root_r: DFF<Bits<26>>,
@@ -381,6 +381,7 @@ impl<const W: usize> Logic for InstanceRays<W> {
             waiting,
             pending_r,
             entry_instance,
+            entry_set,
             tag_r,
             root_r,
             hit_r,
@@ -436,6 +437,7 @@ impl<const W: usize> Logic for InstanceRays<W> {
         if (self.phase.q.val() == EntryPhase::Idle) & self.slot_valid.q.val() {
             self.slot_valid.d.next = false;
             self.entry_instance.d.next = self.slot_instance.q.val();
+            self.entry_set.d.next = self.slot_set.val();
             self.look_clean.d.next = !self.sweeping.q.val();
             self.entry_thread.d.next = self.slot_thread.q.val();
             self.entry_normal.d.next = self.slot_normal.q.val();
@@ -456,10 +458,6 @@ impl<const W: usize> Logic for InstanceRays<W> {
         // beginning has its words in `Look`; the tag compare has a clock of its own after the
         // block RAM's (the tester's triangle cache found the read and the compare too long for
         // one clock).
-        self.entry_set.next = ((bit_cast::<9, 8>(self.entry_instance.q.val().get_bits::<8>(0))
-            << 1)
-            | bit_cast::<9, 1>(self.entry_normal.q.val().into()))
-            & self.c_set_mask.val();
         self.entry_tag.next = (bit_cast::<26, 24>(self.entry_instance.q.val()) << 2)
             | (bit_cast::<26, 1>(self.entry_normal.q.val().into()) << 1)
             | 1;
@@ -567,14 +565,14 @@ impl<const W: usize> Logic for InstanceRays<W> {
         self.fill.next = self.c_cached.val()
             & (self.root_arrives.val() | self.fill_normal.q.val())
             & (!self.sweeping.q.val());
-        self.cache_tag.write_address.next = self.entry_set.val();
+        self.cache_tag.write_address.next = self.entry_set.q.val();
         self.cache_tag.write_data.next = self.entry_tag.val();
         self.cache_tag.write_enable.next = self.fill.val();
-        self.cache_root.write_address.next = self.entry_set.val();
+        self.cache_root.write_address.next = self.entry_set.q.val();
         self.cache_root.write_data.next = self.rdata.val().get_bits::<26>(0);
         self.cache_root.write_enable.next = self.fill.val();
         for k in 0..12 {
-            self.cache_words[k].write_address.next = self.entry_set.val();
+            self.cache_words[k].write_address.next = self.entry_set.q.val();
             self.cache_words[k].write_data.next = self.matrix[k].q.val();
             self.cache_words[k].write_enable.next = self.fill.val();
         }
