@@ -72,7 +72,9 @@ pub fn preflight(
         params.mem_latency
     );
     {
-        use crate::hw::triangle_tester::{cache_sets_supported, MAX_CACHE_SETS};
+        use crate::hw::cache::{
+            cache_sets_supported, cache_shape_supported, MAX_CACHE_SETS, MAX_CACHE_WAYS,
+        };
         for (flag, cache, sets) in [
             ("--tri-cache", "triangle", params.tri_cache_sets),
             ("--node-cache", "node", params.node_cache_sets),
@@ -84,6 +86,18 @@ pub fn preflight(
                  {MAX_CACHE_SETS}, or 0 for none; use e.g. {flag} {MAX_CACHE_SETS}"
             );
         }
+        let (sets, ways) = (params.instance_cache_sets, params.instance_cache_ways);
+        anyhow::ensure!(
+            cache_shape_supported(sets, ways),
+            "--instance-cache {sets} --instance-ways {ways}: the instance cache has 1, 2 or \
+             {MAX_CACHE_WAYS} ways and at most {MAX_CACHE_SETS} items (sets times ways); use \
+             e.g. --instance-cache {} --instance-ways {ways}",
+            if ways.is_power_of_two() && ways <= MAX_CACHE_WAYS {
+                MAX_CACHE_SETS / ways
+            } else {
+                MAX_CACHE_SETS
+            }
+        );
     }
     if let Some(n) = frames {
         anyhow::ensure!(

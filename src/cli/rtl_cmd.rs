@@ -41,6 +41,11 @@ pub struct RtlArgs {
     /// instances' records between frames).
     #[arg(long, value_name = "SETS", default_value_t = 512)]
     pub instance_cache: u32,
+    /// Ways of the instance cache (1, 2 or 4; --instance-cache sets of this many ways, at
+    /// most 512 items in all, e.g. --instance-cache 256 --instance-ways 2). A miss fills its
+    /// set's ways in turn.
+    #[arg(long, value_name = "WAYS", default_value_t = 1)]
+    pub instance_ways: u32,
     /// Frames of an animated scene (default: all).
     #[arg(long)]
     pub frames: Option<u32>,
@@ -172,6 +177,7 @@ fn setup(a: &RtlArgs) -> anyhow::Result<(dynrt::scene::Scene, String, ProcessorP
         tri_cache_sets: a.tri_cache,
         node_cache_sets: a.node_cache,
         instance_cache_sets: a.instance_cache,
+        instance_cache_ways: a.instance_ways,
     };
     flow::preflight(&scene, a.format, params, a.frames)?;
     let name = a
@@ -192,6 +198,7 @@ fn summary(verb: &str, a: &RtlArgs, scene: &dynrt::scene::Scene, name: &str) -> 
         .option("tri_cache", a.tri_cache)
         .option("node_cache", a.node_cache)
         .option("instance_cache", a.instance_cache)
+        .option("instance_ways", a.instance_ways)
         .option("frames", a.frames)
         .option("width", scene.camera.width)
         .option("height", scene.camera.height)
@@ -402,21 +409,28 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         },
         cache_line(
             "triangle",
-            a.rtl.tri_cache,
+            format!("{} sets", a.rtl.tri_cache),
             (r.frames[0].tri_cache_hits, r.frames[0].tri_cache_misses),
             "triangle tests",
             "banks 2 and 3",
         ),
         cache_line(
             "node",
-            a.rtl.node_cache,
+            format!("{} sets", a.rtl.node_cache),
             (r.frames[0].node_cache_hits, r.frames[0].node_cache_misses),
             "object-tree nodes",
             "bank 0",
         ),
         cache_line(
             "instance",
-            a.rtl.instance_cache,
+            if a.rtl.instance_ways == 1 {
+                format!("{} sets", a.rtl.instance_cache)
+            } else {
+                format!(
+                    "{} sets of {} ways",
+                    a.rtl.instance_cache, a.rtl.instance_ways
+                )
+            },
             (
                 r.frames[0].instance_cache_hits,
                 r.frames[0].instance_cache_misses,
@@ -487,17 +501,17 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
 /// read `bank`.
 fn cache_line(
     cache: &str,
-    sets: u32,
+    shape: String,
     (hits, misses): (u64, u64),
     items: &str,
     bank: &str,
 ) -> String {
     let lookups = hits + misses;
     if lookups == 0 {
-        return format!("{cache} cache (frame 0): {sets} sets, no {items} looked up");
+        return format!("{cache} cache (frame 0): {shape}, no {items} looked up");
     }
     format!(
-        "{cache} cache (frame 0): {sets} sets, {hits} of {lookups} {items} hit ({:.1}%), {misses} \
+        "{cache} cache (frame 0): {shape}, {hits} of {lookups} {items} hit ({:.1}%), {misses} \
          read {bank}",
         100.0 * hits as f64 / lookups as f64
     )

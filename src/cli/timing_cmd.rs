@@ -58,6 +58,11 @@ pub struct TimingArgs {
     /// instances' records between frames).
     #[arg(long, value_name = "SETS", default_value_t = 512)]
     pub instance_cache: u32,
+    /// Ways of the instance cache (1, 2 or 4; --instance-cache sets of this many ways, at
+    /// most 512 items in all, e.g. --instance-cache 256 --instance-ways 2). A miss fills its
+    /// set's ways in turn.
+    #[arg(long, value_name = "WAYS", default_value_t = 1)]
+    pub instance_ways: u32,
     /// Report directory: timing.md, timing.csv and a folder per design.
     #[arg(long, default_value = "out/timing")]
     pub out: PathBuf,
@@ -168,6 +173,7 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
         tri_cache_sets: a.tri_cache,
         node_cache_sets: a.node_cache,
         instance_cache_sets: a.instance_cache,
+        instance_cache_ways: a.instance_ways,
     };
     let mut designs = Vec::new();
     for u in &a.unit {

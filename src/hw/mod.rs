@@ -10,6 +10,7 @@
 //! domain (modes [`VgaMode::VGA_640X480_60`], [`VgaMode::XGA_1024X768_60`]), and
 //! [`VgaDisplay`], which reads the frame buffer with it and drives the monitor.
 
+pub mod cache;
 pub mod channel_byte;
 pub mod delay;
 pub mod display;

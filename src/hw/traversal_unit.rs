@@ -44,7 +44,7 @@
 //! bank, one a clock from the node cache, while other threads' jobs fill the decision pipeline.
 //! Each thread has at most one job in the unit, so the 32-entry queues never overflow.
 //!
-//! Node cache: [`MAX_CACHE_SETS`](super::triangle_tester::MAX_CACHE_SETS) (the paper's 512 items)
+//! Node cache: [`MAX_CACHE_SETS`](super::cache::MAX_CACHE_SETS) (the paper's 512 items)
 //! sets of a node's two words, direct mapped by the node's low bits, tag (node and valid bit) and
 //! words in block RAM; `new`'s `cache_sets` uses the first sets only (0: none; off at SRAM latency
 //! 1, where a cached node's words would come back before the FIFO behind them can pop). A job waits
@@ -64,6 +64,7 @@
 
 use rust_hdl::prelude::*;
 
+use super::cache::{cache_sets_supported, empty_cache_tags};
 use super::fp::add_sub::ADD_SUB_LATENCY;
 use super::fp::compare::COMPARE_LATENCY;
 use super::fp::div::div_latency;
@@ -71,7 +72,6 @@ use super::fp::{const_bits, FpAddSub, FpCompare, FpDiv};
 use super::ports::{CoprocessorPort, SramRead};
 use super::program::isa::{KD_ENTERED, KD_WALK_ENDED};
 use super::ray_store::{zero_counters, RayStore};
-use super::triangle_tester::{cache_sets_supported, empty_cache_tags};
 use super::{Delay, SyncFifo};
 use crate::fp::Format;
 use crate::layout;
@@ -1352,8 +1352,8 @@ impl<
 mod tests {
     use super::*;
     use crate::fp::Format;
+    use crate::hw::cache::MAX_CACHE_SETS;
     use crate::hw::sim_harness::{clock_cycle, settle};
-    use crate::hw::triangle_tester::MAX_CACHE_SETS;
     use crate::layout::{self, FrameMap, MemoryConfig, SceneTrees, FRAME, NODES};
     use crate::scene::Scene;
     use crate::units::{KdStop, KdWalk};

@@ -53,7 +53,7 @@
 //! back 3 clocks after the read. Entries 2 or 3 clocks apart would read a state still to be
 //! written, so the merge takes it from the entry ahead instead (`after_*`, `lw_*`).
 //!
-//! Triangle cache: [`MAX_CACHE_SETS`] (the paper's 512 items) sets of a triangle's 12 words,
+//! Triangle cache: [`MAX_CACHE_SETS`](super::cache::MAX_CACHE_SETS) (the paper's 512 items) sets of a triangle's 12 words,
 //! direct mapped by the triangle's low bits, with a tag (triangle and valid bit), all in block
 //! RAM; `new`'s `cache_sets` uses the first sets only (0: no cache). The queue's head's tag is
 //! read as the free buffer copies it, registered in the next clock, compared in the one after,
@@ -75,6 +75,7 @@
 
 use rust_hdl::prelude::*;
 
+use super::cache::{cache_sets_supported, empty_cache_tags};
 use super::fp::{const_bits, FpCompare};
 use super::list_unit::{
     CMD_INIT, CMD_LIST, LIST_OF_WALK, TEST_INIT, TEST_LIST_END, TEST_TRIANGLE, TEST_WALK_END,
@@ -117,26 +118,6 @@ pub const CLOCKS_PER_TEST: u32 = 6;
 // triangle is 6 words of bank 2 (words 0-5 of its transform) and 6 of bank 3 (words 6-11,
 // `layout::TRANSFORM_BANK_WORDS`); word k of every buffer is in `words[k]`, addressed by
 // the buffer.
-
-/// Most sets of the triangle cache (the paper's 512 items): its RAMs are this deep, a
-/// smaller cache uses the first sets.
-pub const MAX_CACHE_SETS: u32 = 512;
-
-/// Whether a cache (this unit's triangle cache, the traversal unit's node cache) can have
-/// `sets` sets: a power of two up to [`MAX_CACHE_SETS`], or 0 for none.
-pub fn cache_sets_supported(sets: u32) -> bool {
-    sets == 0 || (sets.is_power_of_two() && sets <= MAX_CACHE_SETS)
-}
-
-/// A cache's tag RAM, every set's word zero (its valid bit clear): a block RAM read before it
-/// is written must not give Icarus an undefined tag.
-pub fn empty_cache_tags<const B: usize>() -> RAM<Bits<B>, 9> {
-    RAM::new(
-        (0..u64::from(MAX_CACHE_SETS))
-            .map(|k| (Bits::<9>::from(k), Bits::<B>::from(0u64)))
-            .collect(),
-    )
-}
 
 /// Entry buffers between the take and the launch (a ring: `tb`, `fb` and `lb` count modulo 4).
 pub const TEST_BUFFERS: usize = 4;
@@ -488,7 +469,7 @@ impl<
     > TriangleTester<W, E, M, S, S1, X2, T, P, DL>
 {
     /// The tester for SRAM read latency `mem_latency` (1..=6).
-    /// With a triangle cache of `cache_sets` sets (a power of two up to [`MAX_CACHE_SETS`],
+    /// With a triangle cache of `cache_sets` sets (a power of two up to [`MAX_CACHE_SETS`](super::cache::MAX_CACHE_SETS),
     /// 0 for none).
     pub fn new(mem_latency: u32, cache_sets: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
@@ -1458,6 +1439,7 @@ impl<
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::hw::cache::MAX_CACHE_SETS;
     use crate::hw::fp::div::div_latency;
     use crate::hw::sim_harness::{clock_cycle, settle};
     use crate::units;

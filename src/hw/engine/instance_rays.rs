@@ -37,20 +37,22 @@
 //!   own, and the unit gives one result per clock. A normal: `normal_write` with
 //!   `ray_thread` and the normal on `ray_d`, and the same wake-up.
 //! - Answers: `query_thread` at I4; at I5 `pending` (the entered ray is not written yet).
-//! - Instance cache (`cache_sets` sets, the paper's 512 items by default; 0 for none): each
-//!   entry, and each normal, looks up its record's words in a direct-mapped cache, set
-//!   `{instance[7:0], normal}` of the sets, tag `{instance, normal, valid}`; a hit reads
-//!   nothing from bank 4, a miss reads the record and fills the set. `cache_hit` or
-//!   `cache_miss` pulses once per lookup. `frame_start` clears every set's tag, one a clock
-//!   (the host rewrites the records between frames); a lookup read during the sweep misses.
+//! - Instance cache (`cache_sets` sets of `cache_ways` ways, 1, 2 or 4; the paper's 512
+//!   items by default, 512 sets of one way; 0 sets for none): each entry, and each normal,
+//!   looks up its record's words in set `{instance[7:0], normal}` of the sets, tag
+//!   `{instance, normal, valid}` in each way; a hit reads nothing from bank 4, a miss reads
+//!   the record and fills the set's next way (round robin per set: [`crate::hw::cache`]).
+//!   `cache_hit` or `cache_miss` pulses once per lookup. `frame_start` clears every set's
+//!   tags, one set a clock (the host rewrites the records between frames); a lookup read
+//!   during the sweep misses.
 //!
 //! Latency: from the `tri.enter` at I5, 1 clock to start the entry, 3 for the cache's lookup
-//! (the set's words, the tag compare, the decision), then on a miss 13 reads (one per free
-//! bus clock) and `mem_latency` for the last word, then the two requests and
-//! [`TRANSFORM_LATENCY`] (28) in the unit, and 1 to the write: about 33 clocks on a hit, 49
-//! on a miss with `mem_latency` 2 and a free bus. Throughput: one entry per about 6 clocks
-//! on hits, `19 + mem_latency` on misses (the next entry's lookup starts while this one's
-//! requests are in the unit).
+//! (the set's tags, their compare, the decision), then on a hit 1 to read the way's words,
+//! on a miss 13 reads (one per free bus clock) and `mem_latency` for the last word, then the
+//! two requests and [`TRANSFORM_LATENCY`] (28) in the unit, and 1 to the write: about 34
+//! clocks on a hit, 49 on a miss with `mem_latency` 2 and a free bus. Throughput: one entry
+//! per about 7 clocks on hits, `19 + mem_latency` on misses (the next entry's lookup starts
+//! while this one's requests are in the unit).
 //!
 //! Absent (`InstanceRays::new`'s `present` false, for a program with no `tri.world`,
 //! `tri.enter` or `tri.normal`): every output is held at 0, so nothing the unit holds is
@@ -69,7 +71,7 @@
 
 use rust_hdl::prelude::*;
 
-use crate::hw::triangle_tester::{cache_sets_supported, empty_cache_tags};
+use crate::hw::cache::{cache_shape_supported, empty_cache_tags, way_shift};
 use crate::layout::instance_word;
 
 /// Words of a world-to-object matrix (3x4), read per entry, then the root's.
@@ -80,13 +82,16 @@ const MATRIX_WORDS: u64 = 12;
 pub enum EntryPhase {
     /// No entry begun: the slot's entry, if any, begins (and its set of the cache is read).
     Idle,
-    /// The cache's words for the entry's set arrive and are registered (the tag into
-    /// `tag_r`, the matrix into `matrix`, the root into `root_r`).
+    /// The tags of the entry's set arrive and are registered (`tag_r`, one per way, and the
+    /// way a miss fills, `victim_r`).
     Look,
-    /// The registered tag is compared with the entry's.
+    /// The registered tags are compared with the entry's.
     Compare,
-    /// A hit goes to the requests (with the root's write), a miss to the fetch.
+    /// A hit reads its way's words, a miss goes to the fetch.
     Decide,
+    /// A hit's words arrive and are registered (the matrix into `matrix`, the root into
+    /// `root_r`, written the next clock); then the requests.
+    Words,
     /// Reading the matrix's twelve words and the root (a normal's: its nine words as twelve).
     Fetch,
     /// The origin's request waits for the unit; then the direction's.
@@ -204,21 +209,30 @@ pub struct InstanceRays<const W: usize> {
     c_root_step: Constant<Bits<24>>,
     c_last_matrix_read: Constant<Bits<4>>,
     c_ml_last: Constant<Bits<3>>,
-    /// The instance cache: per set, a tag `{instance, normal, valid}`, the twelve words of
-    /// a record's world-to-object matrix (or its normal matrix as read, twelve words), and
-    /// the root.
-    cache_tag: RAM<Bits<26>, 9>,
+    /// The instance cache: per way a RAM of the sets' tags `{instance, normal, valid}`; per
+    /// line (`set << way_shift | way`) the twelve words of a record's world-to-object matrix
+    /// (or its normal matrix as read, twelve words) and the root; per set the way its next
+    /// miss fills.
+    cache_tag: [RAM<Bits<26>, 9>; 4],
     cache_words: [RAM<Bits<W>, 9>; 12],
     cache_root: RAM<Bits<26>, 9>,
+    victim: RAM<Bits<2>, 9>,
+    /// The line a hit reads (the entry's set, the way that hit) and the line a miss fills.
+    hit_line: Signal<Local, Bits<9>>,
+    fill_line: Signal<Local, Bits<9>>,
     /// The slot's set, read as its entry begins; the entry's set (the slot's, kept) and tag,
     /// for the compare and the fill.
     slot_set: Signal<Local, Bits<9>>,
     entry_instance: DFF<Bits<24>>,
     entry_set: DFF<Bits<9>>,
     entry_tag: Signal<Local, Bits<26>>,
-    tag_r: DFF<Bits<26>>,
+    tag_r: [DFF<Bits<26>>; 4],
+    victim_r: DFF<Bits<2>>,
     root_r: DFF<Bits<26>>,
     hit_r: DFF<Bit>,
+    hit_way_r: DFF<Bits<2>>,
+    /// A hit's root, registered in `Words`, is written to the traversal unit.
+    hit_root: DFF<Bit>,
     /// No sweep wrote the cache as the entry's set was read: its words are of this frame.
     look_clean: DFF<Bit>,
     /// A normal's twelfth word arrived last clock: its matrix is whole, to be written.
@@ -230,19 +244,24 @@ pub struct InstanceRays<const W: usize> {
     sweep_set: DFF<Bits<9>>,
     c_cached: Constant<Bit>,
     c_set_mask: Constant<Bits<9>>,
+    /// `ways - 1`, `log2(ways)`, each way's number, and whether the cache has that way.
+    c_way_mask: Constant<Bits<2>>,
+    c_way_shift: Constant<Bits<2>>,
+    c_way: [Constant<Bits<2>>; 4],
+    c_way_used: [Constant<Bit>; 4],
     /// The program uses the unit (see the module doc's "Absent").
     c_present: Constant<Bit>,
 }
 
 impl<const W: usize> InstanceRays<W> {
     /// The unit for SRAM read latency `mem_latency` (1..=6), absent unless `present`, with an
-    /// instance cache of `cache_sets` sets (a power of two up to `MAX_CACHE_SETS`, 0 for
-    /// none).
-    pub fn new(mem_latency: u32, present: bool, cache_sets: u32) -> Self {
+    /// instance cache of `cache_sets` sets of `cache_ways` ways (see
+    /// [`cache_shape_supported`]; 0 sets for none).
+    pub fn new(mem_latency: u32, present: bool, cache_sets: u32, cache_ways: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
         assert!(
-            cache_sets_supported(cache_sets),
-            "{cache_sets} instance cache sets"
+            cache_shape_supported(cache_sets, cache_ways),
+            "{cache_sets} instance cache sets of {cache_ways} ways"
         );
         Self {
             clock: Default::default(),
@@ -333,16 +352,22 @@ impl<const W: usize> InstanceRays<W> {
                     .into(),
             ),
             c_ml_last: Constant::new(u64::from(mem_latency - 1).into()),
-            cache_tag: empty_cache_tags(),
+            cache_tag: std::array::from_fn(|_| empty_cache_tags()),
             cache_words: Default::default(),
             cache_root: Default::default(),
+            victim: empty_cache_tags(),
+            hit_line: Default::default(),
+            fill_line: Default::default(),
             slot_set: Default::default(),
             entry_instance: Default::default(),
             entry_set: Default::default(),
             entry_tag: Default::default(),
             tag_r: Default::default(),
+            victim_r: Default::default(),
             root_r: Default::default(),
             hit_r: Default::default(),
+            hit_way_r: Default::default(),
+            hit_root: Default::default(),
             look_clean: Default::default(),
             fill_normal: Default::default(),
             fill: Default::default(),
@@ -350,6 +375,12 @@ impl<const W: usize> InstanceRays<W> {
             sweep_set: Default::default(),
             c_cached: Constant::new(cache_sets > 0),
             c_set_mask: Constant::new(u64::from(cache_sets.max(1) - 1).into()),
+            c_way_mask: Constant::new(u64::from(cache_ways - 1).into()),
+            c_way_shift: Constant::new(u64::from(way_shift(cache_ways)).into()),
+            c_way: std::array::from_fn(|w| Constant::new((w as u64).into())),
+            c_way_used: std::array::from_fn(|w| {
+                Constant::new(cache_sets > 0 && (w as u32) < cache_ways)
+            }),
             c_present: Constant::new(present),
         }
     }
@@ -382,9 +413,11 @@ impl<const W: usize> Logic for InstanceRays<W> {
             pending_r,
             entry_instance,
             entry_set,
-            tag_r,
+            victim_r,
             root_r,
             hit_r,
+            hit_way_r,
+            hit_root,
             look_clean,
             fill_normal,
             sweeping,
@@ -393,6 +426,10 @@ impl<const W: usize> Logic for InstanceRays<W> {
         for k in 0..12 {
             self.matrix[k].clock.next = self.clock.val();
             self.matrix[k].d.next = self.matrix[k].q.val();
+        }
+        for w in 0..4 {
+            self.tag_r[w].clock.next = self.clock.val();
+            self.tag_r[w].d.next = self.tag_r[w].q.val();
         }
         for k in 0..3 {
             self.origin[k].clock.next = self.clock.val();
@@ -454,35 +491,50 @@ impl<const W: usize> Logic for InstanceRays<W> {
             }
         }
 
-        // The instance cache: the slot's set is read in every clock, so that an entry
-        // beginning has its words in `Look`; the tag compare has a clock of its own after the
+        // The instance cache: the slot's set of tags is read in every clock, so that an entry
+        // beginning has them in `Look`; the tag compare has a clock of its own after the
         // block RAM's (the tester's triangle cache found the read and the compare too long for
-        // one clock).
+        // one clock). A hit's way is known in `Decide`, which reads its line's words.
         self.entry_tag.next = (bit_cast::<26, 24>(self.entry_instance.q.val()) << 2)
             | (bit_cast::<26, 1>(self.entry_normal.q.val().into()) << 1)
             | 1;
-        self.cache_tag.read_clock.next = self.clock.val();
-        self.cache_tag.write_clock.next = self.clock.val();
-        self.cache_tag.read_address.next = self.slot_set.val();
+        for w in 0..4 {
+            self.cache_tag[w].read_clock.next = self.clock.val();
+            self.cache_tag[w].write_clock.next = self.clock.val();
+            self.cache_tag[w].read_address.next = self.slot_set.val();
+        }
+        self.victim.read_clock.next = self.clock.val();
+        self.victim.write_clock.next = self.clock.val();
+        self.victim.read_address.next = self.slot_set.val();
+        self.hit_line.next = (self.entry_set.q.val() << self.c_way_shift.val())
+            | bit_cast::<9, 2>(self.hit_way_r.q.val());
+        self.fill_line.next = (self.entry_set.q.val() << self.c_way_shift.val())
+            | bit_cast::<9, 2>(self.victim_r.q.val());
         self.cache_root.read_clock.next = self.clock.val();
         self.cache_root.write_clock.next = self.clock.val();
-        self.cache_root.read_address.next = self.slot_set.val();
+        self.cache_root.read_address.next = self.hit_line.val();
         for k in 0..12 {
             self.cache_words[k].read_clock.next = self.clock.val();
             self.cache_words[k].write_clock.next = self.clock.val();
-            self.cache_words[k].read_address.next = self.slot_set.val();
+            self.cache_words[k].read_address.next = self.hit_line.val();
         }
         if self.c_cached.val() & (self.phase.q.val() == EntryPhase::Look) {
-            self.tag_r.d.next = self.cache_tag.read_data.val();
-            self.root_r.d.next = self.cache_root.read_data.val();
-            for k in 0..12 {
-                self.matrix[k].d.next = self.cache_words[k].read_data.val();
+            for w in 0..4 {
+                self.tag_r[w].d.next = self.cache_tag[w].read_data.val();
             }
+            self.victim_r.d.next = self.victim.read_data.val() & self.c_way_mask.val();
             self.phase.d.next = EntryPhase::Compare;
         }
         if self.phase.q.val() == EntryPhase::Compare {
-            self.hit_r.d.next =
-                (self.tag_r.q.val() == self.entry_tag.val()) & self.look_clean.q.val();
+            // A way the cache does not have keeps its tags zero (never written): no match.
+            self.hit_r.d.next = false;
+            self.hit_way_r.d.next = 0.into();
+            for w in 0..4 {
+                if self.tag_r[w].q.val() == self.entry_tag.val() {
+                    self.hit_r.d.next = self.look_clean.q.val();
+                    self.hit_way_r.d.next = self.c_way[w].val();
+                }
+            }
             self.phase.d.next = EntryPhase::Decide;
         }
         self.cache_hit.next = false;
@@ -490,13 +542,22 @@ impl<const W: usize> Logic for InstanceRays<W> {
         if self.phase.q.val() == EntryPhase::Decide {
             if self.hit_r.q.val() {
                 self.cache_hit.next = true;
-                self.phase.d.next = EntryPhase::Origin;
-                if self.entry_normal.q.val() {
-                    self.phase.d.next = EntryPhase::Normal;
-                }
+                self.phase.d.next = EntryPhase::Words;
             } else {
                 self.cache_miss.next = true;
                 self.phase.d.next = EntryPhase::Fetch;
+            }
+        }
+        self.hit_root.d.next = false;
+        if self.phase.q.val() == EntryPhase::Words {
+            self.root_r.d.next = self.cache_root.read_data.val();
+            for k in 0..12 {
+                self.matrix[k].d.next = self.cache_words[k].read_data.val();
+            }
+            self.hit_root.d.next = !self.entry_normal.q.val();
+            self.phase.d.next = EntryPhase::Origin;
+            if self.entry_normal.q.val() {
+                self.phase.d.next = EntryPhase::Normal;
             }
         }
 
@@ -550,10 +611,7 @@ impl<const W: usize> Logic for InstanceRays<W> {
         self.root_write.next = self.root_arrives.val();
         self.root_thread.next = self.entry_thread.q.val();
         self.root.next = self.rdata.val().get_bits::<26>(0);
-        if (self.phase.q.val() == EntryPhase::Decide)
-            & self.hit_r.q.val()
-            & (!self.entry_normal.q.val())
-        {
+        if self.hit_root.q.val() {
             self.root_write.next = true;
             self.root.next = self.root_r.q.val();
         }
@@ -565,21 +623,30 @@ impl<const W: usize> Logic for InstanceRays<W> {
         self.fill.next = self.c_cached.val()
             & (self.root_arrives.val() | self.fill_normal.q.val())
             & (!self.sweeping.q.val());
-        self.cache_tag.write_address.next = self.entry_set.q.val();
-        self.cache_tag.write_data.next = self.entry_tag.val();
-        self.cache_tag.write_enable.next = self.fill.val();
-        self.cache_root.write_address.next = self.entry_set.q.val();
+        for w in 0..4 {
+            self.cache_tag[w].write_address.next = self.entry_set.q.val();
+            self.cache_tag[w].write_data.next = self.entry_tag.val();
+            self.cache_tag[w].write_enable.next = self.c_way_used[w].val()
+                & self.fill.val()
+                & (self.victim_r.q.val() == self.c_way[w].val());
+        }
+        self.victim.write_address.next = self.entry_set.q.val();
+        self.victim.write_data.next = (self.victim_r.q.val() + 1) & self.c_way_mask.val();
+        self.victim.write_enable.next = self.fill.val();
+        self.cache_root.write_address.next = self.fill_line.val();
         self.cache_root.write_data.next = self.rdata.val().get_bits::<26>(0);
         self.cache_root.write_enable.next = self.fill.val();
         for k in 0..12 {
-            self.cache_words[k].write_address.next = self.entry_set.q.val();
+            self.cache_words[k].write_address.next = self.fill_line.val();
             self.cache_words[k].write_data.next = self.matrix[k].q.val();
             self.cache_words[k].write_enable.next = self.fill.val();
         }
         if self.sweeping.q.val() {
-            self.cache_tag.write_address.next = self.sweep_set.q.val();
-            self.cache_tag.write_data.next = 0.into();
-            self.cache_tag.write_enable.next = true;
+            for w in 0..4 {
+                self.cache_tag[w].write_address.next = self.sweep_set.q.val();
+                self.cache_tag[w].write_data.next = 0.into();
+                self.cache_tag[w].write_enable.next = self.c_way_used[w].val();
+            }
             self.sweep_set.d.next = self.sweep_set.q.val() + 1;
             if self.sweep_set.q.val() == self.c_set_mask.val() {
                 self.sweeping.d.next = false;
@@ -710,7 +777,7 @@ mod tests {
     /// one output left live keeps the registers and RAMs behind it.
     #[test]
     fn an_absent_unit_synthesizes_to_nothing() {
-        let mut uut = InstanceRays::<24>::new(2, false, 512);
+        let mut uut = InstanceRays::<24>::new(2, false, 512, 1);
         uut.connect_all();
         let dir = tempfile::tempdir().unwrap();
         let src = dir.path().join("instance_rays.v");
@@ -740,24 +807,50 @@ mod tests {
     /// Four frames, the bank's records rewritten between them (a frame's start after the
     /// unit drained, as the processor's): with an instance cache, a record read in an earlier
     /// frame would give a wrong ray. Every entry is a hit or a miss, a miss reads its twelve
-    /// or thirteen words and a hit none; with a set for each record and kind (32 sets) each
-    /// misses at most once a frame, with 4 sets they evict each other.
+    /// or thirteen words and a hit none; where the cache holds every record and kind (32
+    /// sets of one way, 16 of two, 8 of four) each misses at most once a frame, with 4 sets
+    /// of one way they evict each other.
     #[test]
     fn every_entry_gets_its_object_ray_through_the_shared_unit() {
-        entries_case(0, 35);
+        entries_case(0, 1, &ALL, Expect::NoCache, 35);
     }
 
     #[test]
     fn the_instance_cache_keeps_each_record_for_its_frame() {
-        entries_case(32, 36);
+        entries_case(32, 1, &ALL, Expect::Fits, 36);
+        entries_case(16, 2, &ALL, Expect::Fits, 38);
+        entries_case(8, 4, &ALL, Expect::Fits, 39);
     }
 
     #[test]
     fn instance_cache_sets_evict_each_other() {
-        entries_case(4, 37);
+        entries_case(4, 1, &ALL, Expect::Evicts, 37);
     }
 
-    fn entries_case(cache_sets: u32, seed: u64) {
+    /// Instances 0 and 2 share every set of a direct-mapped cache of four items (set
+    /// `{instance[7:0], normal} & 3`: the normal bit alone), so their entries evict each other;
+    /// two ways of two sets hold both, and each record and kind misses once a frame. A cache
+    /// that filled or looked up one way only would miss as the direct-mapped one does.
+    #[test]
+    fn two_ways_keep_what_one_way_evicts() {
+        entries_case(4, 1, &[0, 2], Expect::Evicts, 40);
+        entries_case(2, 2, &[0, 2], Expect::Fits, 41);
+    }
+
+    const ALL: [usize; 16] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15];
+
+    #[derive(PartialEq)]
+    enum Expect {
+        NoCache,
+        /// Every record and kind in the pool misses at most once a frame.
+        Fits,
+        /// They miss more often than that (and some hit).
+        Evicts,
+    }
+
+    /// Entries of random threads into instances drawn from `pool` (of 16 records), through
+    /// an instance cache of `cache_sets` sets of `ways` ways.
+    fn entries_case(cache_sets: u32, ways: u32, pool: &[usize], expect: Expect, seed: u64) {
         let f = Format::E7M16;
         let mem_latency = 3;
         let records = 16;
@@ -775,7 +868,7 @@ mod tests {
                 .collect()
         };
         let mut bank = new_bank(&mut rng);
-        let mut u = InstanceRays::<24>::new(mem_latency, true, cache_sets);
+        let mut u = InstanceRays::<24>::new(mem_latency, true, cache_sets, ways);
         u.connect_all();
         let cycle =
             |u: &mut InstanceRays<24>| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
@@ -820,7 +913,7 @@ mod tests {
             };
             let words = [0, 1].map(|_| f.from_f64(rng.gen_range(-3.0..3.0)));
             let thread = if clock < 96 { clock as u32 / 3 } else { thread };
-            let instance = rng.gen_range(0..records);
+            let instance = pool[rng.gen_range(0..pool.len())];
             let record = instance * INSTANCE_WORDS;
             u.thread.next = u64::from(thread).into();
             u.world_write.next = write;
@@ -949,7 +1042,7 @@ mod tests {
         assert!(written > 80, "entries written: {written}");
         assert!(normals_written > 60, "normals written: {normals_written}");
         assert!((written..=written + left).contains(&roots_written));
-        if cache_sets == 0 {
+        if expect == Expect::NoCache {
             let done_reads = 13 * written + 12 * normals_written;
             assert!(
                 (done_reads..=done_reads + 13 * (left + normals_left)).contains(&reads),
@@ -967,17 +1060,20 @@ mod tests {
                 (12 * misses..=13 * misses).contains(&reads),
                 "{reads} reads for {misses} misses"
             );
-            if cache_sets == 32 {
+            let keys = 2 * pool.len() * frames;
+            if expect == Expect::Fits {
                 assert!(
-                    misses <= 2 * records * frames,
-                    "{misses} misses: a record and kind missed twice in a frame"
+                    misses <= keys,
+                    "{misses} misses: a record and kind missed twice in a frame \
+                     ({cache_sets} sets of {ways} ways)"
                 );
                 assert!(hits > misses, "{hits} hits, {misses} misses");
             } else {
-                // Random records and kinds in 4 sets: about one lookup in eight hits.
                 assert!(
-                    misses > 2 * records * frames && hits > 10,
-                    "{hits} hits and {misses} misses in 4 sets for 32 records and kinds"
+                    misses > keys && hits > 10,
+                    "{hits} hits and {misses} misses in {cache_sets} sets of {ways} ways \
+                     for {} records and kinds",
+                    2 * pool.len()
                 );
             }
         }

@@ -346,6 +346,12 @@ pub struct ThreadEngine<
     tri_load_addr_r: DFF<Bits<24>>,
     /// The engine's load in decode (one memory port for it, the ShadeUnit and the list unit).
     engine_load: Signal<Local, Bit>,
+    /// I5: the instruction is a valid `ld` / `st`, decoded at I4 and registered: the ports'
+    /// grants to the ShadeUnit read them, and the opcode's compare ran in front of the
+    /// memory port's address mux (placed critical path at stop 48, `result_line.op_i6 ->
+    /// mem_addr_r`, 79.9 MHz).
+    load_i5: DFF<Bit>,
+    store_i5: DFF<Bit>,
     engine_loads_triangles: Signal<Local, Bit>,
     /// The ShadeUnit's request goes to the TransformUnit (after ray generation's and instance
     /// entry's).
@@ -456,6 +462,7 @@ impl<
             tri_cache_sets,
             node_cache_sets,
             instance_cache_sets,
+            instance_cache_ways,
         } = *params;
         assert!(W == 1 + E + M && S == M + 1 && S1 == S + 1 && X2 == E + 2 && T == S + 4);
         assert!(P == 2 * S);
@@ -514,6 +521,7 @@ impl<
                 mem_latency,
                 units.contains(&Unit::InstanceEntry),
                 instance_cache_sets,
+                instance_cache_ways,
             ),
             shader: ShadeUnit::new(ShadeConfig {
                 tri_latency: mem_latency + 1,
@@ -583,6 +591,8 @@ impl<
             enter_offer: Default::default(),
             normal_offer: Default::default(),
             shade_offer: Default::default(),
+            load_i5: Default::default(),
+            store_i5: Default::default(),
             tri_load_addr_r: Default::default(),
             engine_load: Default::default(),
             engine_loads_triangles: Default::default(),
@@ -720,6 +730,8 @@ impl<
             enter_offer,
             normal_offer,
             shade_offer,
+            load_i5,
+            store_i5,
             tri_load_addr_r,
             tri_enqueue,
             tri_queues,
@@ -924,8 +936,11 @@ impl<
             self.decode.valid.val() & (self.decode.op.val() == self.op_sts.val());
 
         // Memory and frame-buffer ports (registered).
-        self.engine_load.next =
-            self.decode.valid.val() & (self.decode.op.val() == self.op_ld.val());
+        self.load_i5.d.next =
+            self.decode.valid_i4.val() & (self.decode.op_i4.val() == self.op_ld.val());
+        self.store_i5.d.next =
+            self.decode.valid_i4.val() & (self.decode.op_i4.val() == self.op_st.val());
+        self.engine_load.next = self.load_i5.q.val();
         self.mem_load_r.d.next = 0.into();
         if self.engine_load.val() {
             self.mem_load_r.d.next = self.one_bank.val() << self.decode.bank.val();
@@ -956,13 +971,11 @@ impl<
             self.mem_bank_r.d.next = self.bank_frame.val();
             self.mem_addr_r.d.next = self.shader.frame_addr.val();
         }
-        self.fb_write_r.d.next =
-            self.decode.valid.val() & (self.decode.op.val() == self.op_st.val());
+        self.fb_write_r.d.next = self.store_i5.q.val();
         self.fb_addr_r.d.next = self.execute.mem_address.val().get_bits::<24>(0);
         self.fb_data_r.d.next = self.decode.store.val();
         // The ShadeUnit's pixels in the clocks the engine's stores leave the port.
-        self.shader.fb_grant.next = self.c_shading.val()
-            & (!(self.decode.valid.val() & (self.decode.op.val() == self.op_st.val())));
+        self.shader.fb_grant.next = self.c_shading.val() & (!self.store_i5.q.val());
         if self.shader.fb_write.val() & self.shader.fb_grant.val() {
             self.fb_write_r.d.next = true;
             self.fb_addr_r.d.next = self.shader.fb_addr.val();

@@ -1150,7 +1150,7 @@ impl<
         const P: usize,
     > InstanceRaysBench<W, E, M, S, S1, X2, T, P>
 {
-    fn new(bank: &[u32]) -> Self {
+    fn new(bank: &[u32], cache_sets: u32, cache_ways: u32) -> Self {
         assert!(bank.len() <= 512);
         Self {
             clock: Default::default(),
@@ -1179,7 +1179,7 @@ impl<
             busy_read: Default::default(),
             cache_hit: Default::default(),
             cache_miss: Default::default(),
-            entries: crate::hw::engine::InstanceRays::new(2, true, 512),
+            entries: crate::hw::engine::InstanceRays::new(2, true, cache_sets, cache_ways),
             unit: Default::default(),
             bank: ROM::new(crate::hw::engine::word_map(
                 bank.iter().map(|&w| Bits::<32>::from(u64::from(w))),
@@ -1275,9 +1275,10 @@ impl<
 /// with the thread's bit as wake-up, and its root (the record's root word's 26 bits) given
 /// for its thread; each normal is `units::transform3` of the record's normal matrix and the
 /// thread's world words 0, 1 and its z, in order, with the wake-up; no read goes out on a
-/// busy bus; the instance cache (512 sets, one frame) misses once for each record and kind
-/// entered and hits for every other entry.
-fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
+/// busy bus; the instance cache (`cache_sets` sets of `cache_ways` ways, one frame, room for
+/// every record and kind) misses once for each record and kind entered and hits for every
+/// other entry.
+fn instance_rays_case(entries: usize, seed: u64, sim: Simulator, cache_sets: u32, cache_ways: u32) {
     use crate::emit::stream_bench::{InputStream, OutputSink, StreamBench};
     use crate::emit::verilog_tidy::{merge_identical_modules, rename_rust_hdl_names};
     use crate::layout::{instance_word, INSTANCE_WORDS};
@@ -1290,7 +1291,8 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
     let world: Vec<[u32; 6]> = (0..32)
         .map(|_| std::array::from_fn(|_| word(f, rng.gen_range(-4.0..4.0))))
         .collect();
-    let mut uut = InstanceRaysBench::<24, 7, 16, 17, 18, 9, 21, 34>::new(&bank);
+    let mut uut =
+        InstanceRaysBench::<24, 7, 16, 17, 18, 9, 21, 34>::new(&bank, cache_sets, cache_ways);
     uut.connect_all();
     let top = "instance_rays_bench";
     let verilog = merge_identical_modules(&rename_rust_hdl_names(&generate_verilog(&uut), top));
@@ -1513,14 +1515,17 @@ fn instance_rays_case(entries: usize, seed: u64, sim: Simulator) {
     assert_eq!(bad, 0, "{sim}: {bad} of {entries} entered rays differ");
 }
 
+/// Icarus with the default cache (512 sets of one way); Verilator with 8 sets of 4 ways, where
+/// the 32 records and kinds (16 records, an entry's and a normal's) fill every way of every
+/// set (set `{instance[7:0], normal} & 7`: four a set).
 #[test]
 fn instance_rays_e7m16_icarus() {
-    instance_rays_case(120, 3501, Simulator::Icarus);
+    instance_rays_case(120, 3501, Simulator::Icarus, 512, 1);
 }
 
 #[test]
 fn instance_rays_e7m16_verilator() {
-    instance_rays_case(400, 3502, Simulator::Verilator);
+    instance_rays_case(400, 3502, Simulator::Verilator, 8, 4);
 }
 
 // ---------------------------------------------------------------------------------------
