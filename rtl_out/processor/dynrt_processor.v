@@ -1382,6 +1382,12 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
     reg  [23:0] tri_load_addr_r__d;
     wire  [23:0] tri_load_addr_r__q;
     reg  tri_load_addr_r__clock;
+    reg  load_i5__d;
+    wire  load_i5__q;
+    reg  load_i5__clock;
+    reg  store_i5__d;
+    wire  store_i5__q;
+    reg  store_i5__clock;
     reg  tri_enqueue__d;
     wire  tri_enqueue__q;
     reg  tri_enqueue__clock;
@@ -2151,6 +2157,16 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         .q(tri_load_addr_r__q),
         .clock(tri_load_addr_r__clock)
     );
+    dynrt_processor__display__dark_d load_i5(
+        .d(load_i5__d),
+        .q(load_i5__q),
+        .clock(load_i5__clock)
+    );
+    dynrt_processor__display__dark_d store_i5(
+        .d(store_i5__d),
+        .q(store_i5__q),
+        .clock(store_i5__clock)
+    );
     dynrt_processor__display__dark_d tri_enqueue(
         .d(tri_enqueue__d),
         .q(tri_enqueue__q),
@@ -2242,6 +2258,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         enter_offer__clock = clock;
         normal_offer__clock = clock;
         shade_offer__clock = clock;
+        load_i5__clock = clock;
+        store_i5__clock = clock;
         tri_load_addr_r__clock = clock;
         tri_enqueue__clock = clock;
         tri_queues__clock = clock;
@@ -2295,6 +2313,8 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         enter_offer__d = enter_offer__q;
         normal_offer__d = normal_offer__q;
         shade_offer__d = shade_offer__q;
+        load_i5__d = load_i5__q;
+        store_i5__d = store_i5__q;
         tri_load_addr_r__d = tri_load_addr_r__q;
         tri_enqueue__d = tri_enqueue__q;
         tri_queues__d = tri_queues__q;
@@ -2459,7 +2479,9 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
         scratch__write_address = (((decode__thread) & 12'hfff) << 32'h7) | ((execute__scratch_address[(32'h0)+:(7)]) & 12'hfff);
         scratch__write_data = decode__store;
         scratch__write_enable = decode__valid & (decode__op == op_sts);
-        engine_load = decode__valid & (decode__op == op_ld);
+        load_i5__d = decode__valid_i4 & (decode__op_i4 == op_ld);
+        store_i5__d = decode__valid_i4 & (decode__op_i4 == op_st);
+        engine_load = load_i5__q;
         mem_load_r__d = 32'h0;
         if (engine_load) begin
             mem_load_r__d = one_bank << decode__bank;
@@ -2481,10 +2503,10 @@ module dynrt_processor__engine(clock,start,done,cycles,instructions,mem_read,mem
             mem_bank_r__d = bank_frame;
             mem_addr_r__d = shader__frame_addr;
         end
-        fb_write_r__d = decode__valid & (decode__op == op_st);
+        fb_write_r__d = store_i5__q;
         fb_addr_r__d = execute__mem_address[(32'h0)+:(24)];
         fb_data_r__d = decode__store;
-        shader__fb_grant = c_shading & (~(decode__valid & (decode__op == op_st)));
+        shader__fb_grant = c_shading & (~store_i5__q);
         if (shader__fb_write & shader__fb_grant) begin
             fb_write_r__d = 1'b1;
             fb_addr_r__d = shader__fb_addr;
@@ -10778,6 +10800,16 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     localparam  c_ml_last = 3'b1;
     localparam  c_cached = 1'b1;
     localparam  c_set_mask = 9'b111111111;
+    localparam  c_way_mask = 2'b0;
+    localparam  c_way_shift = 2'b0;
+    localparam  c_way__0 = 2'b0;
+    localparam  c_way__1 = 2'b1;
+    localparam  c_way__2 = 2'b10;
+    localparam  c_way__3 = 2'b11;
+    localparam  c_way_used__0 = 1'b1;
+    localparam  c_way_used__1 = 1'b0;
+    localparam  c_way_used__2 = 1'b0;
+    localparam  c_way_used__3 = 1'b0;
     localparam  c_present = 1'b0;
     
     // Enums
@@ -10785,10 +10817,11 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     localparam EntryPhase__Look = 1;
     localparam EntryPhase__Compare = 2;
     localparam EntryPhase__Decide = 3;
-    localparam EntryPhase__Fetch = 4;
-    localparam EntryPhase__Origin = 5;
-    localparam EntryPhase__Direction = 6;
-    localparam EntryPhase__Normal = 7;
+    localparam EntryPhase__Words = 4;
+    localparam EntryPhase__Fetch = 5;
+    localparam EntryPhase__Origin = 6;
+    localparam EntryPhase__Direction = 7;
+    localparam EntryPhase__Normal = 8;
     
     // Stub signals
     reg  [4:0] world__0__read_address;
@@ -10848,8 +10881,8 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     reg  [23:0] slot_nz__d;
     wire  [23:0] slot_nz__q;
     reg  slot_nz__clock;
-    reg  [2:0] phase__d;
-    wire  [2:0] phase__q;
+    reg  [3:0] phase__d;
+    wire  [3:0] phase__q;
     reg  phase__clock;
     reg  [4:0] entry_thread__d;
     wire  [4:0] entry_thread__q;
@@ -10953,13 +10986,34 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     reg  pending_r__d;
     wire  pending_r__q;
     reg  pending_r__clock;
-    reg  [8:0] cache_tag__read_address;
-    reg  cache_tag__read_clock;
-    wire  [25:0] cache_tag__read_data;
-    reg  [8:0] cache_tag__write_address;
-    reg  cache_tag__write_clock;
-    reg  [25:0] cache_tag__write_data;
-    reg  cache_tag__write_enable;
+    reg  [8:0] cache_tag__0__read_address;
+    reg  cache_tag__0__read_clock;
+    wire  [25:0] cache_tag__0__read_data;
+    reg  [8:0] cache_tag__0__write_address;
+    reg  cache_tag__0__write_clock;
+    reg  [25:0] cache_tag__0__write_data;
+    reg  cache_tag__0__write_enable;
+    reg  [8:0] cache_tag__1__read_address;
+    reg  cache_tag__1__read_clock;
+    wire  [25:0] cache_tag__1__read_data;
+    reg  [8:0] cache_tag__1__write_address;
+    reg  cache_tag__1__write_clock;
+    reg  [25:0] cache_tag__1__write_data;
+    reg  cache_tag__1__write_enable;
+    reg  [8:0] cache_tag__2__read_address;
+    reg  cache_tag__2__read_clock;
+    wire  [25:0] cache_tag__2__read_data;
+    reg  [8:0] cache_tag__2__write_address;
+    reg  cache_tag__2__write_clock;
+    reg  [25:0] cache_tag__2__write_data;
+    reg  cache_tag__2__write_enable;
+    reg  [8:0] cache_tag__3__read_address;
+    reg  cache_tag__3__read_clock;
+    wire  [25:0] cache_tag__3__read_data;
+    reg  [8:0] cache_tag__3__write_address;
+    reg  cache_tag__3__write_clock;
+    reg  [25:0] cache_tag__3__write_data;
+    reg  cache_tag__3__write_enable;
     reg  [8:0] cache_words__0__read_address;
     reg  cache_words__0__read_clock;
     wire  [23:0] cache_words__0__read_data;
@@ -11051,21 +11105,46 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     reg  cache_root__write_clock;
     reg  [25:0] cache_root__write_data;
     reg  cache_root__write_enable;
+    reg  [8:0] victim__read_address;
+    reg  victim__read_clock;
+    wire  [1:0] victim__read_data;
+    reg  [8:0] victim__write_address;
+    reg  victim__write_clock;
+    reg  [1:0] victim__write_data;
+    reg  victim__write_enable;
     reg  [23:0] entry_instance__d;
     wire  [23:0] entry_instance__q;
     reg  entry_instance__clock;
     reg  [8:0] entry_set__d;
     wire  [8:0] entry_set__q;
     reg  entry_set__clock;
-    reg  [25:0] tag_r__d;
-    wire  [25:0] tag_r__q;
-    reg  tag_r__clock;
+    reg  [25:0] tag_r__0__d;
+    wire  [25:0] tag_r__0__q;
+    reg  tag_r__0__clock;
+    reg  [25:0] tag_r__1__d;
+    wire  [25:0] tag_r__1__q;
+    reg  tag_r__1__clock;
+    reg  [25:0] tag_r__2__d;
+    wire  [25:0] tag_r__2__q;
+    reg  tag_r__2__clock;
+    reg  [25:0] tag_r__3__d;
+    wire  [25:0] tag_r__3__q;
+    reg  tag_r__3__clock;
+    reg  [1:0] victim_r__d;
+    wire  [1:0] victim_r__q;
+    reg  victim_r__clock;
     reg  [25:0] root_r__d;
     wire  [25:0] root_r__q;
     reg  root_r__clock;
     reg  hit_r__d;
     wire  hit_r__q;
     reg  hit_r__clock;
+    reg  [1:0] hit_way_r__d;
+    wire  [1:0] hit_way_r__q;
+    reg  hit_way_r__clock;
+    reg  hit_root__d;
+    wire  hit_root__q;
+    reg  hit_root__clock;
     reg  look_clean__d;
     wire  look_clean__q;
     reg  look_clean__clock;
@@ -11089,6 +11168,8 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     reg  root_arrives;
     reg  last_normal_word;
     reg  [31:0] taken_mask;
+    reg  [8:0] hit_line;
+    reg  [8:0] fill_line;
     reg  [8:0] slot_set;
     reg  [25:0] entry_tag;
     reg  fill;
@@ -11348,14 +11429,41 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         .q(pending_r__q),
         .clock(pending_r__clock)
     );
-    dynrt_processor__engine__instances__cache_tag cache_tag(
-        .read_address(cache_tag__read_address),
-        .read_clock(cache_tag__read_clock),
-        .read_data(cache_tag__read_data),
-        .write_address(cache_tag__write_address),
-        .write_clock(cache_tag__write_clock),
-        .write_data(cache_tag__write_data),
-        .write_enable(cache_tag__write_enable)
+    dynrt_processor__engine__instances__cache_tag__0 cache_tag__0(
+        .read_address(cache_tag__0__read_address),
+        .read_clock(cache_tag__0__read_clock),
+        .read_data(cache_tag__0__read_data),
+        .write_address(cache_tag__0__write_address),
+        .write_clock(cache_tag__0__write_clock),
+        .write_data(cache_tag__0__write_data),
+        .write_enable(cache_tag__0__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_tag__0 cache_tag__1(
+        .read_address(cache_tag__1__read_address),
+        .read_clock(cache_tag__1__read_clock),
+        .read_data(cache_tag__1__read_data),
+        .write_address(cache_tag__1__write_address),
+        .write_clock(cache_tag__1__write_clock),
+        .write_data(cache_tag__1__write_data),
+        .write_enable(cache_tag__1__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_tag__0 cache_tag__2(
+        .read_address(cache_tag__2__read_address),
+        .read_clock(cache_tag__2__read_clock),
+        .read_data(cache_tag__2__read_data),
+        .write_address(cache_tag__2__write_address),
+        .write_clock(cache_tag__2__write_clock),
+        .write_data(cache_tag__2__write_data),
+        .write_enable(cache_tag__2__write_enable)
+    );
+    dynrt_processor__engine__instances__cache_tag__0 cache_tag__3(
+        .read_address(cache_tag__3__read_address),
+        .read_clock(cache_tag__3__read_clock),
+        .read_data(cache_tag__3__read_data),
+        .write_address(cache_tag__3__write_address),
+        .write_clock(cache_tag__3__write_clock),
+        .write_data(cache_tag__3__write_data),
+        .write_enable(cache_tag__3__write_enable)
     );
     dynrt_processor__engine__instances__cache_words__0 cache_words__0(
         .read_address(cache_words__0__read_address),
@@ -11474,6 +11582,15 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         .write_data(cache_root__write_data),
         .write_enable(cache_root__write_enable)
     );
+    dynrt_processor__engine__instances__victim victim(
+        .read_address(victim__read_address),
+        .read_clock(victim__read_clock),
+        .read_data(victim__read_data),
+        .write_address(victim__write_address),
+        .write_clock(victim__write_clock),
+        .write_data(victim__write_data),
+        .write_enable(victim__write_enable)
+    );
     dynrt_processor__display__rgb_q entry_instance(
         .d(entry_instance__d),
         .q(entry_instance__q),
@@ -11484,10 +11601,30 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         .q(entry_set__q),
         .clock(entry_set__clock)
     );
-    dynrt_processor__engine__instances__root_r tag_r(
-        .d(tag_r__d),
-        .q(tag_r__q),
-        .clock(tag_r__clock)
+    dynrt_processor__engine__instances__root_r tag_r__0(
+        .d(tag_r__0__d),
+        .q(tag_r__0__q),
+        .clock(tag_r__0__clock)
+    );
+    dynrt_processor__engine__instances__root_r tag_r__1(
+        .d(tag_r__1__d),
+        .q(tag_r__1__q),
+        .clock(tag_r__1__clock)
+    );
+    dynrt_processor__engine__instances__root_r tag_r__2(
+        .d(tag_r__2__d),
+        .q(tag_r__2__q),
+        .clock(tag_r__2__clock)
+    );
+    dynrt_processor__engine__instances__root_r tag_r__3(
+        .d(tag_r__3__d),
+        .q(tag_r__3__q),
+        .clock(tag_r__3__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 victim_r(
+        .d(victim_r__d),
+        .q(victim_r__q),
+        .clock(victim_r__clock)
     );
     dynrt_processor__engine__instances__root_r root_r(
         .d(root_r__d),
@@ -11498,6 +11635,16 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         .d(hit_r__d),
         .q(hit_r__q),
         .clock(hit_r__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 hit_way_r(
+        .d(hit_way_r__d),
+        .q(hit_way_r__q),
+        .clock(hit_way_r__clock)
+    );
+    dynrt_processor__display__dark_d hit_root(
+        .d(hit_root__d),
+        .q(hit_root__q),
+        .clock(hit_root__clock)
     );
     dynrt_processor__display__dark_d look_clean(
         .d(look_clean__d),
@@ -11543,9 +11690,11 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         pending_r__clock = clock;
         entry_instance__clock = clock;
         entry_set__clock = clock;
-        tag_r__clock = clock;
+        victim_r__clock = clock;
         root_r__clock = clock;
         hit_r__clock = clock;
+        hit_way_r__clock = clock;
+        hit_root__clock = clock;
         look_clean__clock = clock;
         fill_normal__clock = clock;
         sweeping__clock = clock;
@@ -11571,9 +11720,11 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         pending_r__d = pending_r__q;
         entry_instance__d = entry_instance__q;
         entry_set__d = entry_set__q;
-        tag_r__d = tag_r__q;
+        victim_r__d = victim_r__q;
         root_r__d = root_r__q;
         hit_r__d = hit_r__q;
+        hit_way_r__d = hit_way_r__q;
+        hit_root__d = hit_root__q;
         look_clean__d = look_clean__q;
         fill_normal__d = fill_normal__q;
         sweeping__d = sweeping__q;
@@ -11602,6 +11753,14 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         matrix__10__d = matrix__10__q;
         matrix__11__clock = clock;
         matrix__11__d = matrix__11__q;
+        tag_r__0__clock = clock;
+        tag_r__0__d = tag_r__0__q;
+        tag_r__1__clock = clock;
+        tag_r__1__d = tag_r__1__q;
+        tag_r__2__clock = clock;
+        tag_r__2__d = tag_r__2__q;
+        tag_r__3__clock = clock;
+        tag_r__3__d = tag_r__3__q;
         origin__0__clock = clock;
         origin__0__d = origin__0__q;
         write_o__0__clock = clock;
@@ -11687,50 +11846,105 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
             end
         end
         entry_tag = (((entry_instance__q) & 26'h3ffffff) << 32'h2) | (((entry_normal__q) & 26'h3ffffff) << 32'h1) | 32'h1;
-        cache_tag__read_clock = clock;
-        cache_tag__write_clock = clock;
-        cache_tag__read_address = slot_set;
+        cache_tag__0__read_clock = clock;
+        cache_tag__0__write_clock = clock;
+        cache_tag__0__read_address = slot_set;
+        cache_tag__1__read_clock = clock;
+        cache_tag__1__write_clock = clock;
+        cache_tag__1__read_address = slot_set;
+        cache_tag__2__read_clock = clock;
+        cache_tag__2__write_clock = clock;
+        cache_tag__2__read_address = slot_set;
+        cache_tag__3__read_clock = clock;
+        cache_tag__3__write_clock = clock;
+        cache_tag__3__read_address = slot_set;
+        victim__read_clock = clock;
+        victim__write_clock = clock;
+        victim__read_address = slot_set;
+        hit_line = (entry_set__q << c_way_shift) | ((hit_way_r__q) & 9'h1ff);
+        fill_line = (entry_set__q << c_way_shift) | ((victim_r__q) & 9'h1ff);
         cache_root__read_clock = clock;
         cache_root__write_clock = clock;
-        cache_root__read_address = slot_set;
+        cache_root__read_address = hit_line;
         cache_words__0__read_clock = clock;
         cache_words__0__write_clock = clock;
-        cache_words__0__read_address = slot_set;
+        cache_words__0__read_address = hit_line;
         cache_words__1__read_clock = clock;
         cache_words__1__write_clock = clock;
-        cache_words__1__read_address = slot_set;
+        cache_words__1__read_address = hit_line;
         cache_words__2__read_clock = clock;
         cache_words__2__write_clock = clock;
-        cache_words__2__read_address = slot_set;
+        cache_words__2__read_address = hit_line;
         cache_words__3__read_clock = clock;
         cache_words__3__write_clock = clock;
-        cache_words__3__read_address = slot_set;
+        cache_words__3__read_address = hit_line;
         cache_words__4__read_clock = clock;
         cache_words__4__write_clock = clock;
-        cache_words__4__read_address = slot_set;
+        cache_words__4__read_address = hit_line;
         cache_words__5__read_clock = clock;
         cache_words__5__write_clock = clock;
-        cache_words__5__read_address = slot_set;
+        cache_words__5__read_address = hit_line;
         cache_words__6__read_clock = clock;
         cache_words__6__write_clock = clock;
-        cache_words__6__read_address = slot_set;
+        cache_words__6__read_address = hit_line;
         cache_words__7__read_clock = clock;
         cache_words__7__write_clock = clock;
-        cache_words__7__read_address = slot_set;
+        cache_words__7__read_address = hit_line;
         cache_words__8__read_clock = clock;
         cache_words__8__write_clock = clock;
-        cache_words__8__read_address = slot_set;
+        cache_words__8__read_address = hit_line;
         cache_words__9__read_clock = clock;
         cache_words__9__write_clock = clock;
-        cache_words__9__read_address = slot_set;
+        cache_words__9__read_address = hit_line;
         cache_words__10__read_clock = clock;
         cache_words__10__write_clock = clock;
-        cache_words__10__read_address = slot_set;
+        cache_words__10__read_address = hit_line;
         cache_words__11__read_clock = clock;
         cache_words__11__write_clock = clock;
-        cache_words__11__read_address = slot_set;
+        cache_words__11__read_address = hit_line;
         if (c_cached & (phase__q == EntryPhase__Look)) begin
-            tag_r__d = cache_tag__read_data;
+            tag_r__0__d = cache_tag__0__read_data;
+            tag_r__1__d = cache_tag__1__read_data;
+            tag_r__2__d = cache_tag__2__read_data;
+            tag_r__3__d = cache_tag__3__read_data;
+            victim_r__d = victim__read_data & c_way_mask;
+            phase__d = EntryPhase__Compare;
+        end
+        if (phase__q == EntryPhase__Compare) begin
+            hit_r__d = 1'b0;
+            hit_way_r__d = 32'h0;
+            if (tag_r__0__q == entry_tag) begin
+                hit_r__d = look_clean__q;
+                hit_way_r__d = c_way__0;
+            end
+            if (tag_r__1__q == entry_tag) begin
+                hit_r__d = look_clean__q;
+                hit_way_r__d = c_way__1;
+            end
+            if (tag_r__2__q == entry_tag) begin
+                hit_r__d = look_clean__q;
+                hit_way_r__d = c_way__2;
+            end
+            if (tag_r__3__q == entry_tag) begin
+                hit_r__d = look_clean__q;
+                hit_way_r__d = c_way__3;
+            end
+            phase__d = EntryPhase__Decide;
+        end
+        cache_hit = 1'b0;
+        cache_miss = 1'b0;
+        if (phase__q == EntryPhase__Decide) begin
+            if (hit_r__q) begin
+                cache_hit = 1'b1;
+                phase__d = EntryPhase__Words;
+            end
+            else begin
+                cache_miss = 1'b1;
+                phase__d = EntryPhase__Fetch;
+            end
+        end
+        hit_root__d = 1'b0;
+        if (phase__q == EntryPhase__Words) begin
             root_r__d = cache_root__read_data;
             matrix__0__d = cache_words__0__read_data;
             matrix__1__d = cache_words__1__read_data;
@@ -11744,25 +11958,10 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
             matrix__9__d = cache_words__9__read_data;
             matrix__10__d = cache_words__10__read_data;
             matrix__11__d = cache_words__11__read_data;
-            phase__d = EntryPhase__Compare;
-        end
-        if (phase__q == EntryPhase__Compare) begin
-            hit_r__d = (tag_r__q == entry_tag) & look_clean__q;
-            phase__d = EntryPhase__Decide;
-        end
-        cache_hit = 1'b0;
-        cache_miss = 1'b0;
-        if (phase__q == EntryPhase__Decide) begin
-            if (hit_r__q) begin
-                cache_hit = 1'b1;
-                phase__d = EntryPhase__Origin;
-                if (entry_normal__q) begin
-                    phase__d = EntryPhase__Normal;
-                end
-            end
-            else begin
-                cache_miss = 1'b1;
-                phase__d = EntryPhase__Fetch;
+            hit_root__d = ~entry_normal__q;
+            phase__d = EntryPhase__Origin;
+            if (entry_normal__q) begin
+                phase__d = EntryPhase__Normal;
             end
         end
         entry_words = c_words;
@@ -11816,58 +12015,79 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         root_write = root_arrives;
         root_thread = entry_thread__q;
         root = rdata[(32'h0)+:(26)];
-        if ((phase__q == EntryPhase__Decide) & hit_r__q & (~entry_normal__q)) begin
+        if (hit_root__q) begin
             root_write = 1'b1;
             root = root_r__q;
         end
         fill_normal__d = last_normal_word;
         fill = c_cached & (root_arrives | fill_normal__q) & (~sweeping__q);
-        cache_tag__write_address = entry_set__q;
-        cache_tag__write_data = entry_tag;
-        cache_tag__write_enable = fill;
-        cache_root__write_address = entry_set__q;
+        cache_tag__0__write_address = entry_set__q;
+        cache_tag__0__write_data = entry_tag;
+        cache_tag__0__write_enable = c_way_used__0 & fill & (victim_r__q == c_way__0);
+        cache_tag__1__write_address = entry_set__q;
+        cache_tag__1__write_data = entry_tag;
+        cache_tag__1__write_enable = c_way_used__1 & fill & (victim_r__q == c_way__1);
+        cache_tag__2__write_address = entry_set__q;
+        cache_tag__2__write_data = entry_tag;
+        cache_tag__2__write_enable = c_way_used__2 & fill & (victim_r__q == c_way__2);
+        cache_tag__3__write_address = entry_set__q;
+        cache_tag__3__write_data = entry_tag;
+        cache_tag__3__write_enable = c_way_used__3 & fill & (victim_r__q == c_way__3);
+        victim__write_address = entry_set__q;
+        victim__write_data = (victim_r__q + 32'h1) & c_way_mask;
+        victim__write_enable = fill;
+        cache_root__write_address = fill_line;
         cache_root__write_data = rdata[(32'h0)+:(26)];
         cache_root__write_enable = fill;
-        cache_words__0__write_address = entry_set__q;
+        cache_words__0__write_address = fill_line;
         cache_words__0__write_data = matrix__0__q;
         cache_words__0__write_enable = fill;
-        cache_words__1__write_address = entry_set__q;
+        cache_words__1__write_address = fill_line;
         cache_words__1__write_data = matrix__1__q;
         cache_words__1__write_enable = fill;
-        cache_words__2__write_address = entry_set__q;
+        cache_words__2__write_address = fill_line;
         cache_words__2__write_data = matrix__2__q;
         cache_words__2__write_enable = fill;
-        cache_words__3__write_address = entry_set__q;
+        cache_words__3__write_address = fill_line;
         cache_words__3__write_data = matrix__3__q;
         cache_words__3__write_enable = fill;
-        cache_words__4__write_address = entry_set__q;
+        cache_words__4__write_address = fill_line;
         cache_words__4__write_data = matrix__4__q;
         cache_words__4__write_enable = fill;
-        cache_words__5__write_address = entry_set__q;
+        cache_words__5__write_address = fill_line;
         cache_words__5__write_data = matrix__5__q;
         cache_words__5__write_enable = fill;
-        cache_words__6__write_address = entry_set__q;
+        cache_words__6__write_address = fill_line;
         cache_words__6__write_data = matrix__6__q;
         cache_words__6__write_enable = fill;
-        cache_words__7__write_address = entry_set__q;
+        cache_words__7__write_address = fill_line;
         cache_words__7__write_data = matrix__7__q;
         cache_words__7__write_enable = fill;
-        cache_words__8__write_address = entry_set__q;
+        cache_words__8__write_address = fill_line;
         cache_words__8__write_data = matrix__8__q;
         cache_words__8__write_enable = fill;
-        cache_words__9__write_address = entry_set__q;
+        cache_words__9__write_address = fill_line;
         cache_words__9__write_data = matrix__9__q;
         cache_words__9__write_enable = fill;
-        cache_words__10__write_address = entry_set__q;
+        cache_words__10__write_address = fill_line;
         cache_words__10__write_data = matrix__10__q;
         cache_words__10__write_enable = fill;
-        cache_words__11__write_address = entry_set__q;
+        cache_words__11__write_address = fill_line;
         cache_words__11__write_data = matrix__11__q;
         cache_words__11__write_enable = fill;
         if (sweeping__q) begin
-            cache_tag__write_address = sweep_set__q;
-            cache_tag__write_data = 32'h0;
-            cache_tag__write_enable = 1'b1;
+            cache_tag__0__write_address = sweep_set__q;
+            cache_tag__0__write_data = 32'h0;
+            cache_tag__0__write_enable = c_way_used__0;
+            cache_tag__1__write_address = sweep_set__q;
+            cache_tag__1__write_data = 32'h0;
+            cache_tag__1__write_enable = c_way_used__1;
+            cache_tag__2__write_address = sweep_set__q;
+            cache_tag__2__write_data = 32'h0;
+            cache_tag__2__write_enable = c_way_used__2;
+            cache_tag__3__write_address = sweep_set__q;
+            cache_tag__3__write_data = 32'h0;
+            cache_tag__3__write_enable = c_way_used__3;
             sweep_set__d = sweep_set__q + 32'h1;
             if (sweep_set__q == c_set_mask) begin
                 sweeping__d = 1'b0;
@@ -12049,7 +12269,7 @@ module dynrt_processor__engine__instances__cache_root(read_address,read_clock,re
 endmodule // dynrt_processor__engine__instances__cache_root
 
 
-module dynrt_processor__engine__instances__cache_tag(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__instances__cache_tag__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [8:0] read_address;
@@ -12589,7 +12809,13 @@ module dynrt_processor__engine__instances__cache_tag(read_address,read_clock,rea
        end
     end
                 
-endmodule // dynrt_processor__engine__instances__cache_tag
+endmodule // dynrt_processor__engine__instances__cache_tag__0
+
+
+
+
+
+
 
 
 module dynrt_processor__engine__instances__cache_words__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
@@ -12699,11 +12925,15 @@ endmodule // dynrt_processor__engine__instances__cache_words__0
 
 
 
+
+
+
+
 module dynrt_processor__engine__instances__phase(d,q,clock);
     
     // Module arguments
-    input wire  [2:0] d;
-    output reg  [2:0] q;
+    input wire  [3:0] d;
+    output reg  [3:0] q;
     input wire  clock;
     
     // Enums
@@ -12711,10 +12941,11 @@ module dynrt_processor__engine__instances__phase(d,q,clock);
     localparam EntryPhase__Look = 1;
     localparam EntryPhase__Compare = 2;
     localparam EntryPhase__Decide = 3;
-    localparam EntryPhase__Fetch = 4;
-    localparam EntryPhase__Origin = 5;
-    localparam EntryPhase__Direction = 6;
-    localparam EntryPhase__Normal = 7;
+    localparam EntryPhase__Words = 4;
+    localparam EntryPhase__Fetch = 5;
+    localparam EntryPhase__Origin = 6;
+    localparam EntryPhase__Direction = 7;
+    localparam EntryPhase__Normal = 8;
     
     // Update code (custom)
     initial begin
@@ -12765,6 +12996,557 @@ endmodule // dynrt_processor__engine__instances__root_r
 
 
 
+
+
+
+
+module dynrt_processor__engine__instances__victim(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+    
+    // Module arguments
+    input wire  [8:0] read_address;
+    input wire  read_clock;
+    output reg  [1:0] read_data;
+    input wire  [8:0] write_address;
+    input wire  write_clock;
+    input wire  [1:0] write_data;
+    input wire  write_enable;
+    
+    // Update code (custom)
+    reg[1:0] mem[511:0];
+    
+    initial begin
+    mem[9'b0] = 2'b0;
+    mem[9'b1] = 2'b0;
+    mem[9'b10] = 2'b0;
+    mem[9'b11] = 2'b0;
+    mem[9'b100] = 2'b0;
+    mem[9'b101] = 2'b0;
+    mem[9'b110] = 2'b0;
+    mem[9'b111] = 2'b0;
+    mem[9'b1000] = 2'b0;
+    mem[9'b1001] = 2'b0;
+    mem[9'b1010] = 2'b0;
+    mem[9'b1011] = 2'b0;
+    mem[9'b1100] = 2'b0;
+    mem[9'b1101] = 2'b0;
+    mem[9'b1110] = 2'b0;
+    mem[9'b1111] = 2'b0;
+    mem[9'b10000] = 2'b0;
+    mem[9'b10001] = 2'b0;
+    mem[9'b10010] = 2'b0;
+    mem[9'b10011] = 2'b0;
+    mem[9'b10100] = 2'b0;
+    mem[9'b10101] = 2'b0;
+    mem[9'b10110] = 2'b0;
+    mem[9'b10111] = 2'b0;
+    mem[9'b11000] = 2'b0;
+    mem[9'b11001] = 2'b0;
+    mem[9'b11010] = 2'b0;
+    mem[9'b11011] = 2'b0;
+    mem[9'b11100] = 2'b0;
+    mem[9'b11101] = 2'b0;
+    mem[9'b11110] = 2'b0;
+    mem[9'b11111] = 2'b0;
+    mem[9'b100000] = 2'b0;
+    mem[9'b100001] = 2'b0;
+    mem[9'b100010] = 2'b0;
+    mem[9'b100011] = 2'b0;
+    mem[9'b100100] = 2'b0;
+    mem[9'b100101] = 2'b0;
+    mem[9'b100110] = 2'b0;
+    mem[9'b100111] = 2'b0;
+    mem[9'b101000] = 2'b0;
+    mem[9'b101001] = 2'b0;
+    mem[9'b101010] = 2'b0;
+    mem[9'b101011] = 2'b0;
+    mem[9'b101100] = 2'b0;
+    mem[9'b101101] = 2'b0;
+    mem[9'b101110] = 2'b0;
+    mem[9'b101111] = 2'b0;
+    mem[9'b110000] = 2'b0;
+    mem[9'b110001] = 2'b0;
+    mem[9'b110010] = 2'b0;
+    mem[9'b110011] = 2'b0;
+    mem[9'b110100] = 2'b0;
+    mem[9'b110101] = 2'b0;
+    mem[9'b110110] = 2'b0;
+    mem[9'b110111] = 2'b0;
+    mem[9'b111000] = 2'b0;
+    mem[9'b111001] = 2'b0;
+    mem[9'b111010] = 2'b0;
+    mem[9'b111011] = 2'b0;
+    mem[9'b111100] = 2'b0;
+    mem[9'b111101] = 2'b0;
+    mem[9'b111110] = 2'b0;
+    mem[9'b111111] = 2'b0;
+    mem[9'b1000000] = 2'b0;
+    mem[9'b1000001] = 2'b0;
+    mem[9'b1000010] = 2'b0;
+    mem[9'b1000011] = 2'b0;
+    mem[9'b1000100] = 2'b0;
+    mem[9'b1000101] = 2'b0;
+    mem[9'b1000110] = 2'b0;
+    mem[9'b1000111] = 2'b0;
+    mem[9'b1001000] = 2'b0;
+    mem[9'b1001001] = 2'b0;
+    mem[9'b1001010] = 2'b0;
+    mem[9'b1001011] = 2'b0;
+    mem[9'b1001100] = 2'b0;
+    mem[9'b1001101] = 2'b0;
+    mem[9'b1001110] = 2'b0;
+    mem[9'b1001111] = 2'b0;
+    mem[9'b1010000] = 2'b0;
+    mem[9'b1010001] = 2'b0;
+    mem[9'b1010010] = 2'b0;
+    mem[9'b1010011] = 2'b0;
+    mem[9'b1010100] = 2'b0;
+    mem[9'b1010101] = 2'b0;
+    mem[9'b1010110] = 2'b0;
+    mem[9'b1010111] = 2'b0;
+    mem[9'b1011000] = 2'b0;
+    mem[9'b1011001] = 2'b0;
+    mem[9'b1011010] = 2'b0;
+    mem[9'b1011011] = 2'b0;
+    mem[9'b1011100] = 2'b0;
+    mem[9'b1011101] = 2'b0;
+    mem[9'b1011110] = 2'b0;
+    mem[9'b1011111] = 2'b0;
+    mem[9'b1100000] = 2'b0;
+    mem[9'b1100001] = 2'b0;
+    mem[9'b1100010] = 2'b0;
+    mem[9'b1100011] = 2'b0;
+    mem[9'b1100100] = 2'b0;
+    mem[9'b1100101] = 2'b0;
+    mem[9'b1100110] = 2'b0;
+    mem[9'b1100111] = 2'b0;
+    mem[9'b1101000] = 2'b0;
+    mem[9'b1101001] = 2'b0;
+    mem[9'b1101010] = 2'b0;
+    mem[9'b1101011] = 2'b0;
+    mem[9'b1101100] = 2'b0;
+    mem[9'b1101101] = 2'b0;
+    mem[9'b1101110] = 2'b0;
+    mem[9'b1101111] = 2'b0;
+    mem[9'b1110000] = 2'b0;
+    mem[9'b1110001] = 2'b0;
+    mem[9'b1110010] = 2'b0;
+    mem[9'b1110011] = 2'b0;
+    mem[9'b1110100] = 2'b0;
+    mem[9'b1110101] = 2'b0;
+    mem[9'b1110110] = 2'b0;
+    mem[9'b1110111] = 2'b0;
+    mem[9'b1111000] = 2'b0;
+    mem[9'b1111001] = 2'b0;
+    mem[9'b1111010] = 2'b0;
+    mem[9'b1111011] = 2'b0;
+    mem[9'b1111100] = 2'b0;
+    mem[9'b1111101] = 2'b0;
+    mem[9'b1111110] = 2'b0;
+    mem[9'b1111111] = 2'b0;
+    mem[9'b10000000] = 2'b0;
+    mem[9'b10000001] = 2'b0;
+    mem[9'b10000010] = 2'b0;
+    mem[9'b10000011] = 2'b0;
+    mem[9'b10000100] = 2'b0;
+    mem[9'b10000101] = 2'b0;
+    mem[9'b10000110] = 2'b0;
+    mem[9'b10000111] = 2'b0;
+    mem[9'b10001000] = 2'b0;
+    mem[9'b10001001] = 2'b0;
+    mem[9'b10001010] = 2'b0;
+    mem[9'b10001011] = 2'b0;
+    mem[9'b10001100] = 2'b0;
+    mem[9'b10001101] = 2'b0;
+    mem[9'b10001110] = 2'b0;
+    mem[9'b10001111] = 2'b0;
+    mem[9'b10010000] = 2'b0;
+    mem[9'b10010001] = 2'b0;
+    mem[9'b10010010] = 2'b0;
+    mem[9'b10010011] = 2'b0;
+    mem[9'b10010100] = 2'b0;
+    mem[9'b10010101] = 2'b0;
+    mem[9'b10010110] = 2'b0;
+    mem[9'b10010111] = 2'b0;
+    mem[9'b10011000] = 2'b0;
+    mem[9'b10011001] = 2'b0;
+    mem[9'b10011010] = 2'b0;
+    mem[9'b10011011] = 2'b0;
+    mem[9'b10011100] = 2'b0;
+    mem[9'b10011101] = 2'b0;
+    mem[9'b10011110] = 2'b0;
+    mem[9'b10011111] = 2'b0;
+    mem[9'b10100000] = 2'b0;
+    mem[9'b10100001] = 2'b0;
+    mem[9'b10100010] = 2'b0;
+    mem[9'b10100011] = 2'b0;
+    mem[9'b10100100] = 2'b0;
+    mem[9'b10100101] = 2'b0;
+    mem[9'b10100110] = 2'b0;
+    mem[9'b10100111] = 2'b0;
+    mem[9'b10101000] = 2'b0;
+    mem[9'b10101001] = 2'b0;
+    mem[9'b10101010] = 2'b0;
+    mem[9'b10101011] = 2'b0;
+    mem[9'b10101100] = 2'b0;
+    mem[9'b10101101] = 2'b0;
+    mem[9'b10101110] = 2'b0;
+    mem[9'b10101111] = 2'b0;
+    mem[9'b10110000] = 2'b0;
+    mem[9'b10110001] = 2'b0;
+    mem[9'b10110010] = 2'b0;
+    mem[9'b10110011] = 2'b0;
+    mem[9'b10110100] = 2'b0;
+    mem[9'b10110101] = 2'b0;
+    mem[9'b10110110] = 2'b0;
+    mem[9'b10110111] = 2'b0;
+    mem[9'b10111000] = 2'b0;
+    mem[9'b10111001] = 2'b0;
+    mem[9'b10111010] = 2'b0;
+    mem[9'b10111011] = 2'b0;
+    mem[9'b10111100] = 2'b0;
+    mem[9'b10111101] = 2'b0;
+    mem[9'b10111110] = 2'b0;
+    mem[9'b10111111] = 2'b0;
+    mem[9'b11000000] = 2'b0;
+    mem[9'b11000001] = 2'b0;
+    mem[9'b11000010] = 2'b0;
+    mem[9'b11000011] = 2'b0;
+    mem[9'b11000100] = 2'b0;
+    mem[9'b11000101] = 2'b0;
+    mem[9'b11000110] = 2'b0;
+    mem[9'b11000111] = 2'b0;
+    mem[9'b11001000] = 2'b0;
+    mem[9'b11001001] = 2'b0;
+    mem[9'b11001010] = 2'b0;
+    mem[9'b11001011] = 2'b0;
+    mem[9'b11001100] = 2'b0;
+    mem[9'b11001101] = 2'b0;
+    mem[9'b11001110] = 2'b0;
+    mem[9'b11001111] = 2'b0;
+    mem[9'b11010000] = 2'b0;
+    mem[9'b11010001] = 2'b0;
+    mem[9'b11010010] = 2'b0;
+    mem[9'b11010011] = 2'b0;
+    mem[9'b11010100] = 2'b0;
+    mem[9'b11010101] = 2'b0;
+    mem[9'b11010110] = 2'b0;
+    mem[9'b11010111] = 2'b0;
+    mem[9'b11011000] = 2'b0;
+    mem[9'b11011001] = 2'b0;
+    mem[9'b11011010] = 2'b0;
+    mem[9'b11011011] = 2'b0;
+    mem[9'b11011100] = 2'b0;
+    mem[9'b11011101] = 2'b0;
+    mem[9'b11011110] = 2'b0;
+    mem[9'b11011111] = 2'b0;
+    mem[9'b11100000] = 2'b0;
+    mem[9'b11100001] = 2'b0;
+    mem[9'b11100010] = 2'b0;
+    mem[9'b11100011] = 2'b0;
+    mem[9'b11100100] = 2'b0;
+    mem[9'b11100101] = 2'b0;
+    mem[9'b11100110] = 2'b0;
+    mem[9'b11100111] = 2'b0;
+    mem[9'b11101000] = 2'b0;
+    mem[9'b11101001] = 2'b0;
+    mem[9'b11101010] = 2'b0;
+    mem[9'b11101011] = 2'b0;
+    mem[9'b11101100] = 2'b0;
+    mem[9'b11101101] = 2'b0;
+    mem[9'b11101110] = 2'b0;
+    mem[9'b11101111] = 2'b0;
+    mem[9'b11110000] = 2'b0;
+    mem[9'b11110001] = 2'b0;
+    mem[9'b11110010] = 2'b0;
+    mem[9'b11110011] = 2'b0;
+    mem[9'b11110100] = 2'b0;
+    mem[9'b11110101] = 2'b0;
+    mem[9'b11110110] = 2'b0;
+    mem[9'b11110111] = 2'b0;
+    mem[9'b11111000] = 2'b0;
+    mem[9'b11111001] = 2'b0;
+    mem[9'b11111010] = 2'b0;
+    mem[9'b11111011] = 2'b0;
+    mem[9'b11111100] = 2'b0;
+    mem[9'b11111101] = 2'b0;
+    mem[9'b11111110] = 2'b0;
+    mem[9'b11111111] = 2'b0;
+    mem[9'b100000000] = 2'b0;
+    mem[9'b100000001] = 2'b0;
+    mem[9'b100000010] = 2'b0;
+    mem[9'b100000011] = 2'b0;
+    mem[9'b100000100] = 2'b0;
+    mem[9'b100000101] = 2'b0;
+    mem[9'b100000110] = 2'b0;
+    mem[9'b100000111] = 2'b0;
+    mem[9'b100001000] = 2'b0;
+    mem[9'b100001001] = 2'b0;
+    mem[9'b100001010] = 2'b0;
+    mem[9'b100001011] = 2'b0;
+    mem[9'b100001100] = 2'b0;
+    mem[9'b100001101] = 2'b0;
+    mem[9'b100001110] = 2'b0;
+    mem[9'b100001111] = 2'b0;
+    mem[9'b100010000] = 2'b0;
+    mem[9'b100010001] = 2'b0;
+    mem[9'b100010010] = 2'b0;
+    mem[9'b100010011] = 2'b0;
+    mem[9'b100010100] = 2'b0;
+    mem[9'b100010101] = 2'b0;
+    mem[9'b100010110] = 2'b0;
+    mem[9'b100010111] = 2'b0;
+    mem[9'b100011000] = 2'b0;
+    mem[9'b100011001] = 2'b0;
+    mem[9'b100011010] = 2'b0;
+    mem[9'b100011011] = 2'b0;
+    mem[9'b100011100] = 2'b0;
+    mem[9'b100011101] = 2'b0;
+    mem[9'b100011110] = 2'b0;
+    mem[9'b100011111] = 2'b0;
+    mem[9'b100100000] = 2'b0;
+    mem[9'b100100001] = 2'b0;
+    mem[9'b100100010] = 2'b0;
+    mem[9'b100100011] = 2'b0;
+    mem[9'b100100100] = 2'b0;
+    mem[9'b100100101] = 2'b0;
+    mem[9'b100100110] = 2'b0;
+    mem[9'b100100111] = 2'b0;
+    mem[9'b100101000] = 2'b0;
+    mem[9'b100101001] = 2'b0;
+    mem[9'b100101010] = 2'b0;
+    mem[9'b100101011] = 2'b0;
+    mem[9'b100101100] = 2'b0;
+    mem[9'b100101101] = 2'b0;
+    mem[9'b100101110] = 2'b0;
+    mem[9'b100101111] = 2'b0;
+    mem[9'b100110000] = 2'b0;
+    mem[9'b100110001] = 2'b0;
+    mem[9'b100110010] = 2'b0;
+    mem[9'b100110011] = 2'b0;
+    mem[9'b100110100] = 2'b0;
+    mem[9'b100110101] = 2'b0;
+    mem[9'b100110110] = 2'b0;
+    mem[9'b100110111] = 2'b0;
+    mem[9'b100111000] = 2'b0;
+    mem[9'b100111001] = 2'b0;
+    mem[9'b100111010] = 2'b0;
+    mem[9'b100111011] = 2'b0;
+    mem[9'b100111100] = 2'b0;
+    mem[9'b100111101] = 2'b0;
+    mem[9'b100111110] = 2'b0;
+    mem[9'b100111111] = 2'b0;
+    mem[9'b101000000] = 2'b0;
+    mem[9'b101000001] = 2'b0;
+    mem[9'b101000010] = 2'b0;
+    mem[9'b101000011] = 2'b0;
+    mem[9'b101000100] = 2'b0;
+    mem[9'b101000101] = 2'b0;
+    mem[9'b101000110] = 2'b0;
+    mem[9'b101000111] = 2'b0;
+    mem[9'b101001000] = 2'b0;
+    mem[9'b101001001] = 2'b0;
+    mem[9'b101001010] = 2'b0;
+    mem[9'b101001011] = 2'b0;
+    mem[9'b101001100] = 2'b0;
+    mem[9'b101001101] = 2'b0;
+    mem[9'b101001110] = 2'b0;
+    mem[9'b101001111] = 2'b0;
+    mem[9'b101010000] = 2'b0;
+    mem[9'b101010001] = 2'b0;
+    mem[9'b101010010] = 2'b0;
+    mem[9'b101010011] = 2'b0;
+    mem[9'b101010100] = 2'b0;
+    mem[9'b101010101] = 2'b0;
+    mem[9'b101010110] = 2'b0;
+    mem[9'b101010111] = 2'b0;
+    mem[9'b101011000] = 2'b0;
+    mem[9'b101011001] = 2'b0;
+    mem[9'b101011010] = 2'b0;
+    mem[9'b101011011] = 2'b0;
+    mem[9'b101011100] = 2'b0;
+    mem[9'b101011101] = 2'b0;
+    mem[9'b101011110] = 2'b0;
+    mem[9'b101011111] = 2'b0;
+    mem[9'b101100000] = 2'b0;
+    mem[9'b101100001] = 2'b0;
+    mem[9'b101100010] = 2'b0;
+    mem[9'b101100011] = 2'b0;
+    mem[9'b101100100] = 2'b0;
+    mem[9'b101100101] = 2'b0;
+    mem[9'b101100110] = 2'b0;
+    mem[9'b101100111] = 2'b0;
+    mem[9'b101101000] = 2'b0;
+    mem[9'b101101001] = 2'b0;
+    mem[9'b101101010] = 2'b0;
+    mem[9'b101101011] = 2'b0;
+    mem[9'b101101100] = 2'b0;
+    mem[9'b101101101] = 2'b0;
+    mem[9'b101101110] = 2'b0;
+    mem[9'b101101111] = 2'b0;
+    mem[9'b101110000] = 2'b0;
+    mem[9'b101110001] = 2'b0;
+    mem[9'b101110010] = 2'b0;
+    mem[9'b101110011] = 2'b0;
+    mem[9'b101110100] = 2'b0;
+    mem[9'b101110101] = 2'b0;
+    mem[9'b101110110] = 2'b0;
+    mem[9'b101110111] = 2'b0;
+    mem[9'b101111000] = 2'b0;
+    mem[9'b101111001] = 2'b0;
+    mem[9'b101111010] = 2'b0;
+    mem[9'b101111011] = 2'b0;
+    mem[9'b101111100] = 2'b0;
+    mem[9'b101111101] = 2'b0;
+    mem[9'b101111110] = 2'b0;
+    mem[9'b101111111] = 2'b0;
+    mem[9'b110000000] = 2'b0;
+    mem[9'b110000001] = 2'b0;
+    mem[9'b110000010] = 2'b0;
+    mem[9'b110000011] = 2'b0;
+    mem[9'b110000100] = 2'b0;
+    mem[9'b110000101] = 2'b0;
+    mem[9'b110000110] = 2'b0;
+    mem[9'b110000111] = 2'b0;
+    mem[9'b110001000] = 2'b0;
+    mem[9'b110001001] = 2'b0;
+    mem[9'b110001010] = 2'b0;
+    mem[9'b110001011] = 2'b0;
+    mem[9'b110001100] = 2'b0;
+    mem[9'b110001101] = 2'b0;
+    mem[9'b110001110] = 2'b0;
+    mem[9'b110001111] = 2'b0;
+    mem[9'b110010000] = 2'b0;
+    mem[9'b110010001] = 2'b0;
+    mem[9'b110010010] = 2'b0;
+    mem[9'b110010011] = 2'b0;
+    mem[9'b110010100] = 2'b0;
+    mem[9'b110010101] = 2'b0;
+    mem[9'b110010110] = 2'b0;
+    mem[9'b110010111] = 2'b0;
+    mem[9'b110011000] = 2'b0;
+    mem[9'b110011001] = 2'b0;
+    mem[9'b110011010] = 2'b0;
+    mem[9'b110011011] = 2'b0;
+    mem[9'b110011100] = 2'b0;
+    mem[9'b110011101] = 2'b0;
+    mem[9'b110011110] = 2'b0;
+    mem[9'b110011111] = 2'b0;
+    mem[9'b110100000] = 2'b0;
+    mem[9'b110100001] = 2'b0;
+    mem[9'b110100010] = 2'b0;
+    mem[9'b110100011] = 2'b0;
+    mem[9'b110100100] = 2'b0;
+    mem[9'b110100101] = 2'b0;
+    mem[9'b110100110] = 2'b0;
+    mem[9'b110100111] = 2'b0;
+    mem[9'b110101000] = 2'b0;
+    mem[9'b110101001] = 2'b0;
+    mem[9'b110101010] = 2'b0;
+    mem[9'b110101011] = 2'b0;
+    mem[9'b110101100] = 2'b0;
+    mem[9'b110101101] = 2'b0;
+    mem[9'b110101110] = 2'b0;
+    mem[9'b110101111] = 2'b0;
+    mem[9'b110110000] = 2'b0;
+    mem[9'b110110001] = 2'b0;
+    mem[9'b110110010] = 2'b0;
+    mem[9'b110110011] = 2'b0;
+    mem[9'b110110100] = 2'b0;
+    mem[9'b110110101] = 2'b0;
+    mem[9'b110110110] = 2'b0;
+    mem[9'b110110111] = 2'b0;
+    mem[9'b110111000] = 2'b0;
+    mem[9'b110111001] = 2'b0;
+    mem[9'b110111010] = 2'b0;
+    mem[9'b110111011] = 2'b0;
+    mem[9'b110111100] = 2'b0;
+    mem[9'b110111101] = 2'b0;
+    mem[9'b110111110] = 2'b0;
+    mem[9'b110111111] = 2'b0;
+    mem[9'b111000000] = 2'b0;
+    mem[9'b111000001] = 2'b0;
+    mem[9'b111000010] = 2'b0;
+    mem[9'b111000011] = 2'b0;
+    mem[9'b111000100] = 2'b0;
+    mem[9'b111000101] = 2'b0;
+    mem[9'b111000110] = 2'b0;
+    mem[9'b111000111] = 2'b0;
+    mem[9'b111001000] = 2'b0;
+    mem[9'b111001001] = 2'b0;
+    mem[9'b111001010] = 2'b0;
+    mem[9'b111001011] = 2'b0;
+    mem[9'b111001100] = 2'b0;
+    mem[9'b111001101] = 2'b0;
+    mem[9'b111001110] = 2'b0;
+    mem[9'b111001111] = 2'b0;
+    mem[9'b111010000] = 2'b0;
+    mem[9'b111010001] = 2'b0;
+    mem[9'b111010010] = 2'b0;
+    mem[9'b111010011] = 2'b0;
+    mem[9'b111010100] = 2'b0;
+    mem[9'b111010101] = 2'b0;
+    mem[9'b111010110] = 2'b0;
+    mem[9'b111010111] = 2'b0;
+    mem[9'b111011000] = 2'b0;
+    mem[9'b111011001] = 2'b0;
+    mem[9'b111011010] = 2'b0;
+    mem[9'b111011011] = 2'b0;
+    mem[9'b111011100] = 2'b0;
+    mem[9'b111011101] = 2'b0;
+    mem[9'b111011110] = 2'b0;
+    mem[9'b111011111] = 2'b0;
+    mem[9'b111100000] = 2'b0;
+    mem[9'b111100001] = 2'b0;
+    mem[9'b111100010] = 2'b0;
+    mem[9'b111100011] = 2'b0;
+    mem[9'b111100100] = 2'b0;
+    mem[9'b111100101] = 2'b0;
+    mem[9'b111100110] = 2'b0;
+    mem[9'b111100111] = 2'b0;
+    mem[9'b111101000] = 2'b0;
+    mem[9'b111101001] = 2'b0;
+    mem[9'b111101010] = 2'b0;
+    mem[9'b111101011] = 2'b0;
+    mem[9'b111101100] = 2'b0;
+    mem[9'b111101101] = 2'b0;
+    mem[9'b111101110] = 2'b0;
+    mem[9'b111101111] = 2'b0;
+    mem[9'b111110000] = 2'b0;
+    mem[9'b111110001] = 2'b0;
+    mem[9'b111110010] = 2'b0;
+    mem[9'b111110011] = 2'b0;
+    mem[9'b111110100] = 2'b0;
+    mem[9'b111110101] = 2'b0;
+    mem[9'b111110110] = 2'b0;
+    mem[9'b111110111] = 2'b0;
+    mem[9'b111111000] = 2'b0;
+    mem[9'b111111001] = 2'b0;
+    mem[9'b111111010] = 2'b0;
+    mem[9'b111111011] = 2'b0;
+    mem[9'b111111100] = 2'b0;
+    mem[9'b111111101] = 2'b0;
+    mem[9'b111111110] = 2'b0;
+    mem[9'b111111111] = 2'b0;
+    end
+    
+    
+    always @(posedge read_clock) begin
+       read_data <= mem[read_address];
+    end
+    
+    always @(posedge write_clock) begin
+       if (write_enable) begin
+          mem[write_address] <= write_data;
+       end
+    end
+                
+endmodule // dynrt_processor__engine__instances__victim
+
+
+
+
+
+
 module dynrt_processor__engine__instances__world__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -12792,6 +13574,8 @@ module dynrt_processor__engine__instances__world__0(read_address,read_clock,read
     end
                 
 endmodule // dynrt_processor__engine__instances__world__0
+
+
 
 
 
@@ -25548,6 +26332,8 @@ endmodule // dynrt_processor__engine__shader__res_step_r
 
 
 
+
+
 module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engine__word_b,engine__ray_write,engine__ray_pair,engine__enqueue,engine__full,engine__query_thread,engine__pending,engine__done,engine__done_thread,engine__load_banks,engine__load_addr,queue_kind,hit,best_t,best_instance,best_triangle,a_words__read,a_words__addr,a_words__rdata,b_words__read,b_words__addr,b_words__rdata,lists__read,lists__addr,lists__rdata,walk_list_valid,walk_list_thread,walk_list_from,walk_list_to,walk_list_take,walk_end_event,walk_end_thread,walk_end_t,walk_end_hit,transform_busy,intersect_busy,cache_hit,cache_miss,gen_valid,gen_m__0,gen_m__1,gen_m__2,gen_m__3,gen_m__4,gen_m__5,gen_m__6,gen_m__7,gen_m__8,gen_m__9,gen_m__10,gen_m__11,gen_v__0,gen_v__1,gen_v__2,gen_point,gen_diagonal,gen_client,gen_thread,gen_take,gen_out_valid,gen_out_client,gen_out_thread,gen_out_dir__0,gen_out_dir__1,gen_out_dir__2,primary_write,primary_thread,primary_o__0,primary_o__1,primary_o__2,primary_d__0,primary_d__1,primary_d__2);
     
     // Module arguments
@@ -33723,6 +34509,13 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
     reg  ram__write_clock;
     reg  [70:0] ram__write_data;
     reg  ram__write_enable;
+    reg  [3:0] ram_next__read_address;
+    reg  ram_next__read_clock;
+    wire  [70:0] ram_next__read_data;
+    reg  [3:0] ram_next__write_address;
+    reg  ram_next__write_clock;
+    reg  [70:0] ram_next__write_data;
+    reg  ram_next__write_enable;
     reg  [4:0] read_address__d;
     wire  [4:0] read_address__q;
     reg  read_address__clock;
@@ -33735,6 +34528,9 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
+    reg  popped__d;
+    wire  popped__q;
+    reg  popped__clock;
     
     // Local signals
     reg  [4:0] read_next;
@@ -33750,6 +34546,15 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
+    );
+    dynrt_processor__engine__tester__list_unit__commands__ram ram_next(
+        .read_address(ram_next__read_address),
+        .read_clock(ram_next__read_clock),
+        .read_data(ram_next__read_data),
+        .write_address(ram_next__write_address),
+        .write_clock(ram_next__write_clock),
+        .write_data(ram_next__write_data),
+        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__decode__t4 read_address(
         .d(read_address__d),
@@ -33771,6 +34576,11 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
         .q(filled__q),
         .clock(filled__clock)
     );
+    dynrt_processor__display__dark_d popped(
+        .d(popped__d),
+        .q(popped__q),
+        .clock(popped__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -33778,12 +34588,16 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
+        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
+        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
+        ram_next__read_clock = clock;
+        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 4'hf) == ((write_address__q) & 4'hf));
         pop = read & filled__q;
@@ -33791,24 +34605,33 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 4'hf);
         ram__write_data = data_in;
+        ram_next__write_enable = push;
+        ram_next__write_address = ((write_address__q) & 4'hf);
+        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        read_next = read_address__q + 32'h1;
         ram__read_address = ((read_address__q) & 4'hf);
+        read_next = read_address__q + 32'h1;
+        ram_next__read_address = ((read_next) & 4'hf);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
+        popped__d = pop;
         if (pop) begin
-            ram__read_address = ((read_next) & 4'hf);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
+        if (popped__q) begin
+            data_out = ram_next__read_data;
+        end
     end
     
 endmodule // dynrt_processor__engine__tester__list_unit__commands
+
+
 
 
 
@@ -33840,6 +34663,8 @@ module dynrt_processor__engine__tester__list_unit__commands__ram(read_address,re
     end
                 
 endmodule // dynrt_processor__engine__tester__list_unit__commands__ram
+
+
 
 
 
@@ -34153,6 +34978,13 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
     reg  ram__write_clock;
     reg  [70:0] ram__write_data;
     reg  ram__write_enable;
+    reg  [2:0] ram_next__read_address;
+    reg  ram_next__read_clock;
+    wire  [70:0] ram_next__read_data;
+    reg  [2:0] ram_next__write_address;
+    reg  ram_next__write_clock;
+    reg  [70:0] ram_next__write_data;
+    reg  ram_next__write_enable;
     reg  [3:0] read_address__d;
     wire  [3:0] read_address__q;
     reg  read_address__clock;
@@ -34165,6 +34997,9 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
+    reg  popped__d;
+    wire  popped__q;
+    reg  popped__clock;
     
     // Local signals
     reg  [3:0] read_next;
@@ -34180,6 +35015,15 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
+    );
+    dynrt_processor__engine__tester__list_unit__tests__ram ram_next(
+        .read_address(ram_next__read_address),
+        .read_clock(ram_next__read_clock),
+        .read_data(ram_next__read_data),
+        .write_address(ram_next__write_address),
+        .write_clock(ram_next__write_clock),
+        .write_data(ram_next__write_data),
+        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__instances__arrived read_address(
         .d(read_address__d),
@@ -34201,6 +35045,11 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
         .q(filled__q),
         .clock(filled__clock)
     );
+    dynrt_processor__display__dark_d popped(
+        .d(popped__d),
+        .q(popped__q),
+        .clock(popped__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -34208,12 +35057,16 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
+        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
+        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
+        ram_next__read_clock = clock;
+        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 3'h7) == ((write_address__q) & 3'h7));
         pop = read & filled__q;
@@ -34221,24 +35074,33 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 3'h7);
         ram__write_data = data_in;
+        ram_next__write_enable = push;
+        ram_next__write_address = ((write_address__q) & 3'h7);
+        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        read_next = read_address__q + 32'h1;
         ram__read_address = ((read_address__q) & 3'h7);
+        read_next = read_address__q + 32'h1;
+        ram_next__read_address = ((read_next) & 3'h7);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
+        popped__d = pop;
         if (pop) begin
-            ram__read_address = ((read_next) & 3'h7);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
+        if (popped__q) begin
+            data_out = ram_next__read_data;
+        end
     end
     
 endmodule // dynrt_processor__engine__tester__list_unit__tests
+
+
 
 
 
@@ -34270,6 +35132,8 @@ module dynrt_processor__engine__tester__list_unit__tests__ram(read_address,read_
     end
                 
 endmodule // dynrt_processor__engine__tester__list_unit__tests__ram
+
+
 
 
 
@@ -41274,6 +42138,13 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
     reg  ram__write_clock;
     reg  [70:0] ram__write_data;
     reg  ram__write_enable;
+    reg  [4:0] ram_next__read_address;
+    reg  ram_next__read_clock;
+    wire  [70:0] ram_next__read_data;
+    reg  [4:0] ram_next__write_address;
+    reg  ram_next__write_clock;
+    reg  [70:0] ram_next__write_data;
+    reg  ram_next__write_enable;
     reg  [5:0] read_address__d;
     wire  [5:0] read_address__q;
     reg  read_address__clock;
@@ -41286,6 +42157,9 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
+    reg  popped__d;
+    wire  popped__q;
+    reg  popped__clock;
     
     // Local signals
     reg  [5:0] read_next;
@@ -41301,6 +42175,15 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
+    );
+    dynrt_processor__engine__traversal_unit__entry_fifo__ram ram_next(
+        .read_address(ram_next__read_address),
+        .read_clock(ram_next__read_clock),
+        .read_data(ram_next__read_data),
+        .write_address(ram_next__write_address),
+        .write_clock(ram_next__write_clock),
+        .write_data(ram_next__write_data),
+        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__mem_load_r read_address(
         .d(read_address__d),
@@ -41322,6 +42205,11 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
         .q(filled__q),
         .clock(filled__clock)
     );
+    dynrt_processor__display__dark_d popped(
+        .d(popped__d),
+        .q(popped__q),
+        .clock(popped__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -41329,12 +42217,16 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
+        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
+        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
+        ram_next__read_clock = clock;
+        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 5'h1f) == ((write_address__q) & 5'h1f));
         pop = read & filled__q;
@@ -41342,24 +42234,33 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 5'h1f);
         ram__write_data = data_in;
+        ram_next__write_enable = push;
+        ram_next__write_address = ((write_address__q) & 5'h1f);
+        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        read_next = read_address__q + 32'h1;
         ram__read_address = ((read_address__q) & 5'h1f);
+        read_next = read_address__q + 32'h1;
+        ram_next__read_address = ((read_next) & 5'h1f);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
+        popped__d = pop;
         if (pop) begin
-            ram__read_address = ((read_next) & 5'h1f);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
+        if (popped__q) begin
+            data_out = ram_next__read_data;
+        end
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__entry_fifo
+
+
 
 
 
@@ -41391,6 +42292,8 @@ module dynrt_processor__engine__traversal_unit__entry_fifo__ram(read_address,rea
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__ram
+
+
 
 
 
@@ -41527,6 +42430,13 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
     reg  ram__write_clock;
     reg  [102:0] ram__write_data;
     reg  ram__write_enable;
+    reg  [4:0] ram_next__read_address;
+    reg  ram_next__read_clock;
+    wire  [102:0] ram_next__read_data;
+    reg  [4:0] ram_next__write_address;
+    reg  ram_next__write_clock;
+    reg  [102:0] ram_next__write_data;
+    reg  ram_next__write_enable;
     reg  [5:0] read_address__d;
     wire  [5:0] read_address__q;
     reg  read_address__clock;
@@ -41539,6 +42449,9 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
+    reg  popped__d;
+    wire  popped__q;
+    reg  popped__clock;
     
     // Local signals
     reg  [5:0] read_next;
@@ -41554,6 +42467,15 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
+    );
+    dynrt_processor__engine__traversal_unit__front_fifo__ram ram_next(
+        .read_address(ram_next__read_address),
+        .read_clock(ram_next__read_clock),
+        .read_data(ram_next__read_data),
+        .write_address(ram_next__write_address),
+        .write_clock(ram_next__write_clock),
+        .write_data(ram_next__write_data),
+        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__mem_load_r read_address(
         .d(read_address__d),
@@ -41575,6 +42497,11 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
         .q(filled__q),
         .clock(filled__clock)
     );
+    dynrt_processor__display__dark_d popped(
+        .d(popped__d),
+        .q(popped__q),
+        .clock(popped__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -41582,12 +42509,16 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
+        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
+        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
+        ram_next__read_clock = clock;
+        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 5'h1f) == ((write_address__q) & 5'h1f));
         pop = read & filled__q;
@@ -41595,24 +42526,33 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 5'h1f);
         ram__write_data = data_in;
+        ram_next__write_enable = push;
+        ram_next__write_address = ((write_address__q) & 5'h1f);
+        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        read_next = read_address__q + 32'h1;
         ram__read_address = ((read_address__q) & 5'h1f);
+        read_next = read_address__q + 32'h1;
+        ram_next__read_address = ((read_next) & 5'h1f);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
+        popped__d = pop;
         if (pop) begin
-            ram__read_address = ((read_next) & 5'h1f);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
+        if (popped__q) begin
+            data_out = ram_next__read_data;
+        end
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__front_fifo
+
+
 
 
 
@@ -41644,6 +42584,8 @@ module dynrt_processor__engine__traversal_unit__front_fifo__ram(read_address,rea
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__front_fifo__ram
+
+
 
 
 
@@ -41714,6 +42656,13 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
     reg  ram__write_clock;
     reg  [102:0] ram__write_data;
     reg  ram__write_enable;
+    reg  [2:0] ram_next__read_address;
+    reg  ram_next__read_clock;
+    wire  [102:0] ram_next__read_data;
+    reg  [2:0] ram_next__write_address;
+    reg  ram_next__write_clock;
+    reg  [102:0] ram_next__write_data;
+    reg  ram_next__write_enable;
     reg  [3:0] read_address__d;
     wire  [3:0] read_address__q;
     reg  read_address__clock;
@@ -41726,6 +42675,9 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
+    reg  popped__d;
+    wire  popped__q;
+    reg  popped__clock;
     
     // Local signals
     reg  [3:0] read_next;
@@ -41741,6 +42693,15 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
+    );
+    dynrt_processor__engine__traversal_unit__in_flight__ram ram_next(
+        .read_address(ram_next__read_address),
+        .read_clock(ram_next__read_clock),
+        .read_data(ram_next__read_data),
+        .write_address(ram_next__write_address),
+        .write_clock(ram_next__write_clock),
+        .write_data(ram_next__write_data),
+        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__instances__arrived read_address(
         .d(read_address__d),
@@ -41762,6 +42723,11 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
         .q(filled__q),
         .clock(filled__clock)
     );
+    dynrt_processor__display__dark_d popped(
+        .d(popped__d),
+        .q(popped__q),
+        .clock(popped__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -41769,12 +42735,16 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
+        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
+        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
+        ram_next__read_clock = clock;
+        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 3'h7) == ((write_address__q) & 3'h7));
         pop = read & filled__q;
@@ -41782,24 +42752,33 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 3'h7);
         ram__write_data = data_in;
+        ram_next__write_enable = push;
+        ram_next__write_address = ((write_address__q) & 3'h7);
+        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        read_next = read_address__q + 32'h1;
         ram__read_address = ((read_address__q) & 3'h7);
+        read_next = read_address__q + 32'h1;
+        ram_next__read_address = ((read_next) & 3'h7);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
+        popped__d = pop;
         if (pop) begin
-            ram__read_address = ((read_next) & 3'h7);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
+        if (popped__q) begin
+            data_out = ram_next__read_data;
+        end
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__in_flight
+
+
 
 
 
@@ -41849,6 +42828,8 @@ endmodule // dynrt_processor__engine__traversal_unit__in_flight__ram
 
 
 
+
+
 module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,empty,write,data_in,full);
     
     // Module arguments
@@ -41868,6 +42849,13 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
     reg  ram__write_clock;
     reg  [68:0] ram__write_data;
     reg  ram__write_enable;
+    reg  [4:0] ram_next__read_address;
+    reg  ram_next__read_clock;
+    wire  [68:0] ram_next__read_data;
+    reg  [4:0] ram_next__write_address;
+    reg  ram_next__write_clock;
+    reg  [68:0] ram_next__write_data;
+    reg  ram_next__write_enable;
     reg  [5:0] read_address__d;
     wire  [5:0] read_address__q;
     reg  read_address__clock;
@@ -41880,6 +42868,9 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
+    reg  popped__d;
+    wire  popped__q;
+    reg  popped__clock;
     
     // Local signals
     reg  [5:0] read_next;
@@ -41895,6 +42886,15 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
+    );
+    dynrt_processor__engine__traversal_unit__leaf_fifo__ram ram_next(
+        .read_address(ram_next__read_address),
+        .read_clock(ram_next__read_clock),
+        .read_data(ram_next__read_data),
+        .write_address(ram_next__write_address),
+        .write_clock(ram_next__write_clock),
+        .write_data(ram_next__write_data),
+        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__mem_load_r read_address(
         .d(read_address__d),
@@ -41916,6 +42916,11 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
         .q(filled__q),
         .clock(filled__clock)
     );
+    dynrt_processor__display__dark_d popped(
+        .d(popped__d),
+        .q(popped__q),
+        .clock(popped__clock)
+    );
     
     // Update code
     always @(*) begin
@@ -41923,12 +42928,16 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
+        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
+        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
+        ram_next__read_clock = clock;
+        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 5'h1f) == ((write_address__q) & 5'h1f));
         pop = read & filled__q;
@@ -41936,24 +42945,33 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 5'h1f);
         ram__write_data = data_in;
+        ram_next__write_enable = push;
+        ram_next__write_address = ((write_address__q) & 5'h1f);
+        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        read_next = read_address__q + 32'h1;
         ram__read_address = ((read_address__q) & 5'h1f);
+        read_next = read_address__q + 32'h1;
+        ram_next__read_address = ((read_next) & 5'h1f);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
+        popped__d = pop;
         if (pop) begin
-            ram__read_address = ((read_next) & 5'h1f);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
+        if (popped__q) begin
+            data_out = ram_next__read_data;
+        end
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo
+
+
 
 
 
@@ -41995,6 +43013,8 @@ endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo__ram
 
 
 
+
+
 module dynrt_processor__engine__traversal_unit__leaf_sp(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -42022,6 +43042,10 @@ module dynrt_processor__engine__traversal_unit__leaf_sp(read_address,read_clock,
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__leaf_sp
+
+
+
+
 
 
 
