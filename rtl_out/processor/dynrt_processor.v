@@ -34509,13 +34509,6 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
     reg  ram__write_clock;
     reg  [70:0] ram__write_data;
     reg  ram__write_enable;
-    reg  [3:0] ram_next__read_address;
-    reg  ram_next__read_clock;
-    wire  [70:0] ram_next__read_data;
-    reg  [3:0] ram_next__write_address;
-    reg  ram_next__write_clock;
-    reg  [70:0] ram_next__write_data;
-    reg  ram_next__write_enable;
     reg  [4:0] read_address__d;
     wire  [4:0] read_address__q;
     reg  read_address__clock;
@@ -34528,9 +34521,6 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
-    reg  popped__d;
-    wire  popped__q;
-    reg  popped__clock;
     
     // Local signals
     reg  [4:0] read_next;
@@ -34546,15 +34536,6 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
-    );
-    dynrt_processor__engine__tester__list_unit__commands__ram ram_next(
-        .read_address(ram_next__read_address),
-        .read_clock(ram_next__read_clock),
-        .read_data(ram_next__read_data),
-        .write_address(ram_next__write_address),
-        .write_clock(ram_next__write_clock),
-        .write_data(ram_next__write_data),
-        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__decode__t4 read_address(
         .d(read_address__d),
@@ -34576,11 +34557,6 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
         .q(filled__q),
         .clock(filled__clock)
     );
-    dynrt_processor__display__dark_d popped(
-        .d(popped__d),
-        .q(popped__q),
-        .clock(popped__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -34588,16 +34564,12 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
-        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
-        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
-        ram_next__read_clock = clock;
-        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 4'hf) == ((write_address__q) & 4'hf));
         pop = read & filled__q;
@@ -34605,33 +34577,24 @@ module dynrt_processor__engine__tester__list_unit__commands(clock,read,data_out,
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 4'hf);
         ram__write_data = data_in;
-        ram_next__write_enable = push;
-        ram_next__write_address = ((write_address__q) & 4'hf);
-        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        ram__read_address = ((read_address__q) & 4'hf);
         read_next = read_address__q + 32'h1;
-        ram_next__read_address = ((read_next) & 4'hf);
+        ram__read_address = ((read_address__q) & 4'hf);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
-        popped__d = pop;
         if (pop) begin
+            ram__read_address = ((read_next) & 4'hf);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
-        if (popped__q) begin
-            data_out = ram_next__read_data;
-        end
     end
     
 endmodule // dynrt_processor__engine__tester__list_unit__commands
-
-
 
 
 
@@ -34663,8 +34626,6 @@ module dynrt_processor__engine__tester__list_unit__commands__ram(read_address,re
     end
                 
 endmodule // dynrt_processor__engine__tester__list_unit__commands__ram
-
-
 
 
 
@@ -34978,13 +34939,6 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
     reg  ram__write_clock;
     reg  [70:0] ram__write_data;
     reg  ram__write_enable;
-    reg  [2:0] ram_next__read_address;
-    reg  ram_next__read_clock;
-    wire  [70:0] ram_next__read_data;
-    reg  [2:0] ram_next__write_address;
-    reg  ram_next__write_clock;
-    reg  [70:0] ram_next__write_data;
-    reg  ram_next__write_enable;
     reg  [3:0] read_address__d;
     wire  [3:0] read_address__q;
     reg  read_address__clock;
@@ -34997,9 +34951,6 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
-    reg  popped__d;
-    wire  popped__q;
-    reg  popped__clock;
     
     // Local signals
     reg  [3:0] read_next;
@@ -35015,15 +34966,6 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
-    );
-    dynrt_processor__engine__tester__list_unit__tests__ram ram_next(
-        .read_address(ram_next__read_address),
-        .read_clock(ram_next__read_clock),
-        .read_data(ram_next__read_data),
-        .write_address(ram_next__write_address),
-        .write_clock(ram_next__write_clock),
-        .write_data(ram_next__write_data),
-        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__instances__arrived read_address(
         .d(read_address__d),
@@ -35045,11 +34987,6 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
         .q(filled__q),
         .clock(filled__clock)
     );
-    dynrt_processor__display__dark_d popped(
-        .d(popped__d),
-        .q(popped__q),
-        .clock(popped__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -35057,16 +34994,12 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
-        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
-        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
-        ram_next__read_clock = clock;
-        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 3'h7) == ((write_address__q) & 3'h7));
         pop = read & filled__q;
@@ -35074,33 +35007,24 @@ module dynrt_processor__engine__tester__list_unit__tests(clock,read,data_out,emp
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 3'h7);
         ram__write_data = data_in;
-        ram_next__write_enable = push;
-        ram_next__write_address = ((write_address__q) & 3'h7);
-        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        ram__read_address = ((read_address__q) & 3'h7);
         read_next = read_address__q + 32'h1;
-        ram_next__read_address = ((read_next) & 3'h7);
+        ram__read_address = ((read_address__q) & 3'h7);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
-        popped__d = pop;
         if (pop) begin
+            ram__read_address = ((read_next) & 3'h7);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
-        if (popped__q) begin
-            data_out = ram_next__read_data;
-        end
     end
     
 endmodule // dynrt_processor__engine__tester__list_unit__tests
-
-
 
 
 
@@ -35132,8 +35056,6 @@ module dynrt_processor__engine__tester__list_unit__tests__ram(read_address,read_
     end
                 
 endmodule // dynrt_processor__engine__tester__list_unit__tests__ram
-
-
 
 
 
@@ -42138,13 +42060,6 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
     reg  ram__write_clock;
     reg  [70:0] ram__write_data;
     reg  ram__write_enable;
-    reg  [4:0] ram_next__read_address;
-    reg  ram_next__read_clock;
-    wire  [70:0] ram_next__read_data;
-    reg  [4:0] ram_next__write_address;
-    reg  ram_next__write_clock;
-    reg  [70:0] ram_next__write_data;
-    reg  ram_next__write_enable;
     reg  [5:0] read_address__d;
     wire  [5:0] read_address__q;
     reg  read_address__clock;
@@ -42157,9 +42072,6 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
-    reg  popped__d;
-    wire  popped__q;
-    reg  popped__clock;
     
     // Local signals
     reg  [5:0] read_next;
@@ -42175,15 +42087,6 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
-    );
-    dynrt_processor__engine__traversal_unit__entry_fifo__ram ram_next(
-        .read_address(ram_next__read_address),
-        .read_clock(ram_next__read_clock),
-        .read_data(ram_next__read_data),
-        .write_address(ram_next__write_address),
-        .write_clock(ram_next__write_clock),
-        .write_data(ram_next__write_data),
-        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__mem_load_r read_address(
         .d(read_address__d),
@@ -42205,11 +42108,6 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
         .q(filled__q),
         .clock(filled__clock)
     );
-    dynrt_processor__display__dark_d popped(
-        .d(popped__d),
-        .q(popped__q),
-        .clock(popped__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -42217,16 +42115,12 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
-        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
-        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
-        ram_next__read_clock = clock;
-        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 5'h1f) == ((write_address__q) & 5'h1f));
         pop = read & filled__q;
@@ -42234,33 +42128,24 @@ module dynrt_processor__engine__traversal_unit__entry_fifo(clock,read,data_out,e
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 5'h1f);
         ram__write_data = data_in;
-        ram_next__write_enable = push;
-        ram_next__write_address = ((write_address__q) & 5'h1f);
-        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        ram__read_address = ((read_address__q) & 5'h1f);
         read_next = read_address__q + 32'h1;
-        ram_next__read_address = ((read_next) & 5'h1f);
+        ram__read_address = ((read_address__q) & 5'h1f);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
-        popped__d = pop;
         if (pop) begin
+            ram__read_address = ((read_next) & 5'h1f);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
-        if (popped__q) begin
-            data_out = ram_next__read_data;
-        end
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__entry_fifo
-
-
 
 
 
@@ -42292,8 +42177,6 @@ module dynrt_processor__engine__traversal_unit__entry_fifo__ram(read_address,rea
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__entry_fifo__ram
-
-
 
 
 
@@ -42430,13 +42313,6 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
     reg  ram__write_clock;
     reg  [102:0] ram__write_data;
     reg  ram__write_enable;
-    reg  [4:0] ram_next__read_address;
-    reg  ram_next__read_clock;
-    wire  [102:0] ram_next__read_data;
-    reg  [4:0] ram_next__write_address;
-    reg  ram_next__write_clock;
-    reg  [102:0] ram_next__write_data;
-    reg  ram_next__write_enable;
     reg  [5:0] read_address__d;
     wire  [5:0] read_address__q;
     reg  read_address__clock;
@@ -42449,9 +42325,6 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
-    reg  popped__d;
-    wire  popped__q;
-    reg  popped__clock;
     
     // Local signals
     reg  [5:0] read_next;
@@ -42467,15 +42340,6 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
-    );
-    dynrt_processor__engine__traversal_unit__front_fifo__ram ram_next(
-        .read_address(ram_next__read_address),
-        .read_clock(ram_next__read_clock),
-        .read_data(ram_next__read_data),
-        .write_address(ram_next__write_address),
-        .write_clock(ram_next__write_clock),
-        .write_data(ram_next__write_data),
-        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__mem_load_r read_address(
         .d(read_address__d),
@@ -42497,11 +42361,6 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
         .q(filled__q),
         .clock(filled__clock)
     );
-    dynrt_processor__display__dark_d popped(
-        .d(popped__d),
-        .q(popped__q),
-        .clock(popped__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -42509,16 +42368,12 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
-        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
-        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
-        ram_next__read_clock = clock;
-        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 5'h1f) == ((write_address__q) & 5'h1f));
         pop = read & filled__q;
@@ -42526,33 +42381,24 @@ module dynrt_processor__engine__traversal_unit__front_fifo(clock,read,data_out,e
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 5'h1f);
         ram__write_data = data_in;
-        ram_next__write_enable = push;
-        ram_next__write_address = ((write_address__q) & 5'h1f);
-        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        ram__read_address = ((read_address__q) & 5'h1f);
         read_next = read_address__q + 32'h1;
-        ram_next__read_address = ((read_next) & 5'h1f);
+        ram__read_address = ((read_address__q) & 5'h1f);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
-        popped__d = pop;
         if (pop) begin
+            ram__read_address = ((read_next) & 5'h1f);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
-        if (popped__q) begin
-            data_out = ram_next__read_data;
-        end
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__front_fifo
-
-
 
 
 
@@ -42584,8 +42430,6 @@ module dynrt_processor__engine__traversal_unit__front_fifo__ram(read_address,rea
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__front_fifo__ram
-
-
 
 
 
@@ -42656,13 +42500,6 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
     reg  ram__write_clock;
     reg  [102:0] ram__write_data;
     reg  ram__write_enable;
-    reg  [2:0] ram_next__read_address;
-    reg  ram_next__read_clock;
-    wire  [102:0] ram_next__read_data;
-    reg  [2:0] ram_next__write_address;
-    reg  ram_next__write_clock;
-    reg  [102:0] ram_next__write_data;
-    reg  ram_next__write_enable;
     reg  [3:0] read_address__d;
     wire  [3:0] read_address__q;
     reg  read_address__clock;
@@ -42675,9 +42512,6 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
-    reg  popped__d;
-    wire  popped__q;
-    reg  popped__clock;
     
     // Local signals
     reg  [3:0] read_next;
@@ -42693,15 +42527,6 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
-    );
-    dynrt_processor__engine__traversal_unit__in_flight__ram ram_next(
-        .read_address(ram_next__read_address),
-        .read_clock(ram_next__read_clock),
-        .read_data(ram_next__read_data),
-        .write_address(ram_next__write_address),
-        .write_clock(ram_next__write_clock),
-        .write_data(ram_next__write_data),
-        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__instances__arrived read_address(
         .d(read_address__d),
@@ -42723,11 +42548,6 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
         .q(filled__q),
         .clock(filled__clock)
     );
-    dynrt_processor__display__dark_d popped(
-        .d(popped__d),
-        .q(popped__q),
-        .clock(popped__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -42735,16 +42555,12 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
-        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
-        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
-        ram_next__read_clock = clock;
-        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 3'h7) == ((write_address__q) & 3'h7));
         pop = read & filled__q;
@@ -42752,33 +42568,24 @@ module dynrt_processor__engine__traversal_unit__in_flight(clock,read,data_out,em
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 3'h7);
         ram__write_data = data_in;
-        ram_next__write_enable = push;
-        ram_next__write_address = ((write_address__q) & 3'h7);
-        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        ram__read_address = ((read_address__q) & 3'h7);
         read_next = read_address__q + 32'h1;
-        ram_next__read_address = ((read_next) & 3'h7);
+        ram__read_address = ((read_address__q) & 3'h7);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
-        popped__d = pop;
         if (pop) begin
+            ram__read_address = ((read_next) & 3'h7);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
-        if (popped__q) begin
-            data_out = ram_next__read_data;
-        end
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__in_flight
-
-
 
 
 
@@ -42828,8 +42635,6 @@ endmodule // dynrt_processor__engine__traversal_unit__in_flight__ram
 
 
 
-
-
 module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,empty,write,data_in,full);
     
     // Module arguments
@@ -42849,13 +42654,6 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
     reg  ram__write_clock;
     reg  [68:0] ram__write_data;
     reg  ram__write_enable;
-    reg  [4:0] ram_next__read_address;
-    reg  ram_next__read_clock;
-    wire  [68:0] ram_next__read_data;
-    reg  [4:0] ram_next__write_address;
-    reg  ram_next__write_clock;
-    reg  [68:0] ram_next__write_data;
-    reg  ram_next__write_enable;
     reg  [5:0] read_address__d;
     wire  [5:0] read_address__q;
     reg  read_address__clock;
@@ -42868,9 +42666,6 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
     reg  filled__d;
     wire  filled__q;
     reg  filled__clock;
-    reg  popped__d;
-    wire  popped__q;
-    reg  popped__clock;
     
     // Local signals
     reg  [5:0] read_next;
@@ -42886,15 +42681,6 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
         .write_clock(ram__write_clock),
         .write_data(ram__write_data),
         .write_enable(ram__write_enable)
-    );
-    dynrt_processor__engine__traversal_unit__leaf_fifo__ram ram_next(
-        .read_address(ram_next__read_address),
-        .read_clock(ram_next__read_clock),
-        .read_data(ram_next__read_data),
-        .write_address(ram_next__write_address),
-        .write_clock(ram_next__write_clock),
-        .write_data(ram_next__write_data),
-        .write_enable(ram_next__write_enable)
     );
     dynrt_processor__engine__mem_load_r read_address(
         .d(read_address__d),
@@ -42916,11 +42702,6 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
         .q(filled__q),
         .clock(filled__clock)
     );
-    dynrt_processor__display__dark_d popped(
-        .d(popped__d),
-        .q(popped__q),
-        .clock(popped__clock)
-    );
     
     // Update code
     always @(*) begin
@@ -42928,16 +42709,12 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
         write_address__clock = clock;
         write_address_delayed__clock = clock;
         filled__clock = clock;
-        popped__clock = clock;
         read_address__d = read_address__q;
         write_address__d = write_address__q;
         write_address_delayed__d = write_address_delayed__q;
         filled__d = filled__q;
-        popped__d = popped__q;
         ram__read_clock = clock;
         ram__write_clock = clock;
-        ram_next__read_clock = clock;
-        ram_next__write_clock = clock;
         empty = ~filled__q;
         full = filled__q & (((read_address__q) & 5'h1f) == ((write_address__q) & 5'h1f));
         pop = read & filled__q;
@@ -42945,33 +42722,24 @@ module dynrt_processor__engine__traversal_unit__leaf_fifo(clock,read,data_out,em
         ram__write_enable = push;
         ram__write_address = ((write_address__q) & 5'h1f);
         ram__write_data = data_in;
-        ram_next__write_enable = push;
-        ram_next__write_address = ((write_address__q) & 5'h1f);
-        ram_next__write_data = data_in;
         write_address__d = write_address__q;
         if (push) begin
             write_address__d = write_address__q + 32'h1;
         end
         write_address_delayed__d = write_address__q;
-        ram__read_address = ((read_address__q) & 5'h1f);
         read_next = read_address__q + 32'h1;
-        ram_next__read_address = ((read_next) & 5'h1f);
+        ram__read_address = ((read_address__q) & 5'h1f);
         read_address__d = read_address__q;
         filled__d = read_address__q != write_address__q;
-        popped__d = pop;
         if (pop) begin
+            ram__read_address = ((read_next) & 5'h1f);
             read_address__d = read_next;
             filled__d = read_next != write_address__q;
         end
         data_out = ram__read_data;
-        if (popped__q) begin
-            data_out = ram_next__read_data;
-        end
     end
     
 endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo
-
-
 
 
 
@@ -43013,8 +42781,6 @@ endmodule // dynrt_processor__engine__traversal_unit__leaf_fifo__ram
 
 
 
-
-
 module dynrt_processor__engine__traversal_unit__leaf_sp(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -43042,10 +42808,6 @@ module dynrt_processor__engine__traversal_unit__leaf_sp(read_address,read_clock,
     end
                 
 endmodule // dynrt_processor__engine__traversal_unit__leaf_sp
-
-
-
-
 
 
 

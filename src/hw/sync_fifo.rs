@@ -1,21 +1,13 @@
 //! `SyncFifo`: a first-in first-out queue of `2^N` words in one clock domain, clock for clock
-//! the queue of rust-hdl's `SynchronousFIFO` (the same pointers and flag timing), with its
-//! `empty` flag held in a flip-flop instead of compared from the pointers in every clock, and
-//! its RAM read at addresses that a pop does not decide.
+//! the queue of rust-hdl's `SynchronousFIFO` (the same RAM, pointers and flag timing), with its
+//! `empty` flag held in a flip-flop instead of compared from the pointers in every clock.
 //!
-//! Why: a pop decided from `empty` ran on through the next read address into the RAM and its
-//! output register. With `empty` compared from the pointers (two LUT levels on the ECP5)
+//! Why: a pop decided from `empty` runs on through the next read address into the RAM and
+//! its output register. With `empty` compared from the pointers (two LUT levels on the ECP5)
 //! ahead of that decision, the traversal unit's fetch queues were the processor's critical
 //! path at 87.3 MHz (`loop_fifo.read_address -> loop_fifo.data_out`, 11.45 ns of which
 //! 9.3 ns routing; issue 16). The flag's next value is selected from two compares of
-//! registers, so nothing before the pop decision is compared. With the flag registered the
-//! pop's own decision still ran through the read address into the RAM (stop 48's placed
-//! paths: `list_unit.engine_banks -> traversal_unit.loop_fifo.data_out` 84.6 MHz,
-//! `traversal_unit.fetch_hit -> front_fifo.data_out` 85.3 MHz): so two copies of the RAM
-//! are read in every clock, one at the read pointer and one at the word after it (the
-//! pointer register and its increment), and `data_out` takes the second copy's word in the
-//! clock after a pop, the first's otherwise. A pop now decides only registers; the cost is
-//! the second copy (distributed RAM, as the first).
+//! registers, so nothing before the pop decision is compared.
 //!
 //! Contract (rust-hdl's): `data_out` is the oldest word while `empty` is low; `read` pops it
 //! (ignored when empty) and the next word shows in the next clock. `write` pushes `data_in`
@@ -37,10 +29,7 @@ pub struct SyncFifo<D: Synth, const N: usize, const NP1: usize> {
     pub write: Signal<In, Bit>,
     pub data_in: Signal<In, D>,
     pub full: Signal<Out, Bit>,
-    /// Two copies of the queue's words, written alike: `ram` read at the read pointer,
-    /// `ram_next` at the word after it.
     ram: RAM<D, N>,
-    ram_next: RAM<D, N>,
     /// Pointers with a wrap bit (`NP1 = N + 1`); the write pointer also a clock late, since a
     /// word is popped no earlier than a clock after the RAM stored it.
     read_address: DFF<Bits<NP1>>,
@@ -48,10 +37,7 @@ pub struct SyncFifo<D: Synth, const N: usize, const NP1: usize> {
     write_address_delayed: DFF<Bits<NP1>>,
     /// `read_address != write_address_delayed`, registered (zero at power-up: empty).
     filled: DFF<Bit>,
-    /// The read pointer plus one.
     read_next: Signal<Local, Bits<NP1>>,
-    /// A word was popped last clock: `data_out` is `ram_next`'s.
-    popped: DFF<Bit>,
     pop: Signal<Local, Bit>,
     push: Signal<Local, Bit>,
 }
@@ -65,13 +51,10 @@ impl<D: Synth, const N: usize, const NP1: usize> Logic for SyncFifo<D, N, NP1> {
             read_address,
             write_address,
             write_address_delayed,
-            filled,
-            popped
+            filled
         );
         self.ram.read_clock.next = self.clock.val();
         self.ram.write_clock.next = self.clock.val();
-        self.ram_next.read_clock.next = self.clock.val();
-        self.ram_next.write_clock.next = self.clock.val();
 
         self.empty.next = !self.filled.q.val();
         self.full.next = self.filled.q.val()
@@ -83,31 +66,24 @@ impl<D: Synth, const N: usize, const NP1: usize> Logic for SyncFifo<D, N, NP1> {
         self.ram.write_enable.next = self.push.val();
         self.ram.write_address.next = bit_cast::<N, NP1>(self.write_address.q.val());
         self.ram.write_data.next = self.data_in.val();
-        self.ram_next.write_enable.next = self.push.val();
-        self.ram_next.write_address.next = bit_cast::<N, NP1>(self.write_address.q.val());
-        self.ram_next.write_data.next = self.data_in.val();
         self.write_address.d.next = self.write_address.q.val();
         if self.push.val() {
             self.write_address.d.next = self.write_address.q.val() + 1;
         }
         self.write_address_delayed.d.next = self.write_address.q.val();
 
-        // The RAMs register their reads: in the clock after a pop the head is the word after
-        // the popped one, which `ram_next` read at the old pointer plus one.
-        self.ram.read_address.next = bit_cast::<N, NP1>(self.read_address.q.val());
+        // The RAM registers its read: address the word after the popped one in the clock of
+        // the pop, so that it shows in the next clock.
         self.read_next.next = self.read_address.q.val() + 1;
-        self.ram_next.read_address.next = bit_cast::<N, NP1>(self.read_next.val());
+        self.ram.read_address.next = bit_cast::<N, NP1>(self.read_address.q.val());
         self.read_address.d.next = self.read_address.q.val();
         self.filled.d.next = self.read_address.q.val() != self.write_address.q.val();
-        self.popped.d.next = self.pop.val();
         if self.pop.val() {
+            self.ram.read_address.next = bit_cast::<N, NP1>(self.read_next.val());
             self.read_address.d.next = self.read_next.val();
             self.filled.d.next = self.read_next.val() != self.write_address.q.val();
         }
         self.data_out.next = self.ram.read_data.val();
-        if self.popped.q.val() {
-            self.data_out.next = self.ram_next.read_data.val();
-        }
     }
 }
 
