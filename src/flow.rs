@@ -78,7 +78,6 @@ pub fn preflight(
         for (flag, cache, sets) in [
             ("--tri-cache", "triangle", params.tri_cache_sets),
             ("--node-cache", "node", params.node_cache_sets),
-            ("--instance-cache", "instance", params.instance_cache_sets),
         ] {
             anyhow::ensure!(
                 cache_sets_supported(sets),
@@ -89,14 +88,10 @@ pub fn preflight(
         let (sets, ways) = (params.instance_cache_sets, params.instance_cache_ways);
         anyhow::ensure!(
             cache_shape_supported(sets, ways),
-            "--instance-cache {sets} --instance-ways {ways}: the instance cache has 1, 2 or \
-             {MAX_CACHE_WAYS} ways and at most {MAX_CACHE_SETS} items (sets times ways); use \
-             e.g. --instance-cache {} --instance-ways {ways}",
-            if ways.is_power_of_two() && ways <= MAX_CACHE_WAYS {
-                MAX_CACHE_SETS / ways
-            } else {
-                MAX_CACHE_SETS
-            }
+            "--instance-cache {sets} --instance-ways {ways}: the instance cache has a power of \
+             two of sets (or 0 for none) of 1, 2 or {MAX_CACHE_WAYS} ways, at most \
+             {MAX_CACHE_SETS} items (sets times ways); use e.g. --instance-cache 128 \
+             --instance-ways 4"
         );
     }
     if let Some(n) = frames {

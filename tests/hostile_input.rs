@@ -341,6 +341,23 @@ fn corpus() -> Vec<Case> {
             &["--mem-latency 0"],
         ),
         case(
+            "a triangle cache of 96 sets",
+            &[("s.toml", &good)],
+            "sim $D/s.toml --out $D/r --tri-cache 96",
+            USAGE,
+            &["--tri-cache 96", "power of two", "--tri-cache 512"],
+        ),
+        case(
+            "an instance cache of 256 sets of 4 ways",
+            &[("s.toml", &good)],
+            "rtl $D/s.toml --out $D/r --instance-cache 256 --instance-ways 4",
+            USAGE,
+            &[
+                "--instance-cache 256 --instance-ways 4",
+                "at most 512 items",
+            ],
+        ),
+        case(
             "too large for the display",
             &[("s.toml", &good)],
             "rtl $D/s.toml --out $D/r --width 2000 --height 1000",

@@ -409,28 +409,24 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         },
         cache_line(
             "triangle",
-            format!("{} sets", a.rtl.tri_cache),
+            a.rtl.tri_cache,
+            1,
             (r.frames[0].tri_cache_hits, r.frames[0].tri_cache_misses),
             "triangle tests",
             "banks 2 and 3",
         ),
         cache_line(
             "node",
-            format!("{} sets", a.rtl.node_cache),
+            a.rtl.node_cache,
+            1,
             (r.frames[0].node_cache_hits, r.frames[0].node_cache_misses),
             "object-tree nodes",
             "bank 0",
         ),
         cache_line(
             "instance",
-            if a.rtl.instance_ways == 1 {
-                format!("{} sets", a.rtl.instance_cache)
-            } else {
-                format!(
-                    "{} sets of {} ways",
-                    a.rtl.instance_cache, a.rtl.instance_ways
-                )
-            },
+            a.rtl.instance_cache,
+            a.rtl.instance_ways,
             (
                 r.frames[0].instance_cache_hits,
                 r.frames[0].instance_cache_misses,
@@ -497,15 +493,20 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
     })
 }
 
-/// `dynrt sim`'s line for one cache in frame 0: its sets, the lookups that hit and those that
-/// read `bank`.
+/// `dynrt sim`'s line for one cache in frame 0: its sets (and ways if more than one), the
+/// lookups that hit and those that read `bank`.
 fn cache_line(
     cache: &str,
-    shape: String,
+    sets: u32,
+    ways: u32,
     (hits, misses): (u64, u64),
     items: &str,
     bank: &str,
 ) -> String {
+    let shape = match ways {
+        1 => format!("{sets} sets"),
+        _ => format!("{sets} sets of {ways} ways"),
+    };
     let lookups = hits + misses;
     if lookups == 0 {
         return format!("{cache} cache (frame 0): {shape}, no {items} looked up");

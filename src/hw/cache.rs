@@ -22,7 +22,7 @@ pub const MAX_CACHE_WAYS: u32 = 4;
 /// Whether a direct-mapped cache can have `sets` sets: a power of two up to
 /// [`MAX_CACHE_SETS`], or 0 for none.
 pub fn cache_sets_supported(sets: u32) -> bool {
-    sets == 0 || (sets.is_power_of_two() && sets <= MAX_CACHE_SETS)
+    cache_shape_supported(sets, 1)
 }
 
 /// Whether a cache can have `sets` sets of `ways` ways: 1, 2 or 4 ways, and sets a power of
