@@ -26951,6 +26951,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  head_clash_rrr__d;
     wire  head_clash_rrr__q;
     reg  head_clash_rrr__clock;
+    reg  origin_clash__d;
+    wire  origin_clash__q;
+    reg  origin_clash__clock;
     reg  [24:0] tag_word_r__d;
     wire  [24:0] tag_word_r__q;
     reg  tag_word_r__clock;
@@ -27215,6 +27218,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  lookup_pending__3;
     reg  [23:0] head_triangle;
     reg  [8:0] head_set;
+    reg  next_origin;
+    reg  [8:0] next_set;
     reg  head_hit;
     reg  l_pending;
     reg  n_pending;
@@ -27980,6 +27985,11 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(head_clash_rrr__q),
         .clock(head_clash_rrr__clock)
     );
+    dynrt_processor__display__dark_d origin_clash(
+        .d(origin_clash__d),
+        .q(origin_clash__q),
+        .clock(origin_clash__clock)
+    );
     dynrt_processor__engine__tester__tag_word_r tag_word_r(
         .d(tag_word_r__d),
         .q(tag_word_r__q),
@@ -28378,6 +28388,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_triangle_rr__clock = clock;
         head_set_rr__clock = clock;
         head_set_rrr__clock = clock;
+        origin_clash__clock = clock;
         head_clash_rr__clock = clock;
         head_clash_rrr__clock = clock;
         tag_word_r__clock = clock;
@@ -28432,6 +28443,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_triangle_rr__d = head_triangle_rr__q;
         head_set_rr__d = head_set_rr__q;
         head_set_rrr__d = head_set_rrr__q;
+        origin_clash__d = origin_clash__q;
         head_clash_rr__d = head_clash_rr__q;
         head_clash_rrr__d = head_clash_rrr__q;
         tag_word_r__d = tag_word_r__q;
@@ -28945,6 +28957,12 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_set_r__d = head_set;
         head_set_rr__d = head_set_r__q;
         head_set_rrr__d = head_set_rr__q;
+        next_origin = ((lphase__q == Launch__Wait) & l_ready) | ((lphase__q == Launch__Direction) & n_ready & (~gen_held__q));
+        next_set = l_set;
+        if (lphase__q == Launch__Direction) begin
+            next_set = n_set;
+        end
+        origin_clash__d = next_origin & (next_set == head_set_rr__q);
         head_clash_r__d = head_clash;
         head_clash_rr__d = head_clash_r__q | ((lphase__q == Launch__Origin) & (l_set == head_set_r__q));
         head_clash_rrr__d = head_clash_rr__q | ((lphase__q == Launch__Origin) & (l_set == head_set_rr__q));
@@ -29014,25 +29032,25 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         comparing__0__d = fresh__0__q;
         deciding__0__d = comparing__0__q;
         if (deciding__0__q) begin
-            cached__0__d = head_hit_r__q & (~head_clash_rrr__q) & (~((lphase__q == Launch__Origin) & (l_set == head_set_rrr__q))) & (cur_kind__0__q == c_test_triangle);
+            cached__0__d = head_hit_r__q & (~head_clash_rrr__q) & (~origin_clash__q) & (cur_kind__0__q == c_test_triangle);
         end
         fresh__1__d = take & (tb__q == c_buffer__1);
         comparing__1__d = fresh__1__q;
         deciding__1__d = comparing__1__q;
         if (deciding__1__q) begin
-            cached__1__d = head_hit_r__q & (~head_clash_rrr__q) & (~((lphase__q == Launch__Origin) & (l_set == head_set_rrr__q))) & (cur_kind__1__q == c_test_triangle);
+            cached__1__d = head_hit_r__q & (~head_clash_rrr__q) & (~origin_clash__q) & (cur_kind__1__q == c_test_triangle);
         end
         fresh__2__d = take & (tb__q == c_buffer__2);
         comparing__2__d = fresh__2__q;
         deciding__2__d = comparing__2__q;
         if (deciding__2__q) begin
-            cached__2__d = head_hit_r__q & (~head_clash_rrr__q) & (~((lphase__q == Launch__Origin) & (l_set == head_set_rrr__q))) & (cur_kind__2__q == c_test_triangle);
+            cached__2__d = head_hit_r__q & (~head_clash_rrr__q) & (~origin_clash__q) & (cur_kind__2__q == c_test_triangle);
         end
         fresh__3__d = take & (tb__q == c_buffer__3);
         comparing__3__d = fresh__3__q;
         deciding__3__d = comparing__3__q;
         if (deciding__3__q) begin
-            cached__3__d = head_hit_r__q & (~head_clash_rrr__q) & (~((lphase__q == Launch__Origin) & (l_set == head_set_rrr__q))) & (cur_kind__3__q == c_test_triangle);
+            cached__3__d = head_hit_r__q & (~head_clash_rrr__q) & (~origin_clash__q) & (cur_kind__3__q == c_test_triangle);
         end
         a_take = fetching__q & (a_issued__q < 32'h6) & ((engine__load_banks & c_bank_a) == 32'h0);
         b_take = fetching__q & (b_issued__q < 32'h6) & ((engine__load_banks & c_bank_b) == 32'h0);
@@ -35135,6 +35153,8 @@ module dynrt_processor__engine__tester__lw_best(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__tester__lw_best
+
+
 
 
 
