@@ -72,27 +72,38 @@ pub fn preflight(
         params.mem_latency
     );
     {
-        use crate::hw::cache::{
-            cache_sets_supported, cache_shape_supported, MAX_CACHE_SETS, MAX_CACHE_WAYS,
-        };
-        for (flag, cache, sets) in [
-            ("--tri-cache", "triangle", params.tri_cache_sets),
-            ("--node-cache", "node", params.node_cache_sets),
+        use crate::hw::cache::{cache_shape_supported, MAX_CACHE_SETS, MAX_CACHE_WAYS};
+        for (cache, flags, sets, ways, example) in [
+            (
+                "triangle",
+                ["--tri-cache", "--tri-ways"],
+                params.tri_cache_sets,
+                params.tri_cache_ways,
+                "--tri-cache 128 --tri-ways 4",
+            ),
+            (
+                "node",
+                ["--node-cache", "--node-ways"],
+                params.node_cache_sets,
+                params.node_cache_ways,
+                "--node-cache 256 --node-ways 2",
+            ),
+            (
+                "instance",
+                ["--instance-cache", "--instance-ways"],
+                params.instance_cache_sets,
+                params.instance_cache_ways,
+                "--instance-cache 128 --instance-ways 4",
+            ),
         ] {
+            let [sets_flag, ways_flag] = flags;
             anyhow::ensure!(
-                cache_sets_supported(sets),
-                "{flag} {sets}: the {cache} cache has a power of two of sets up to \
-                 {MAX_CACHE_SETS}, or 0 for none; use e.g. {flag} {MAX_CACHE_SETS}"
+                cache_shape_supported(sets, ways),
+                "{sets_flag} {sets} {ways_flag} {ways}: the {cache} cache has a power of two of \
+                 sets (or 0 for none) of 1, 2 or {MAX_CACHE_WAYS} ways, at most {MAX_CACHE_SETS} \
+                 items (sets times ways); use e.g. {example}"
             );
         }
-        let (sets, ways) = (params.instance_cache_sets, params.instance_cache_ways);
-        anyhow::ensure!(
-            cache_shape_supported(sets, ways),
-            "--instance-cache {sets} --instance-ways {ways}: the instance cache has a power of \
-             two of sets (or 0 for none) of 1, 2 or {MAX_CACHE_WAYS} ways, at most \
-             {MAX_CACHE_SETS} items (sets times ways); use e.g. --instance-cache 128 \
-             --instance-ways 4"
-        );
     }
     if let Some(n) = frames {
         anyhow::ensure!(

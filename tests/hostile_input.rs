@@ -345,7 +345,22 @@ fn corpus() -> Vec<Case> {
             &[("s.toml", &good)],
             "sim $D/s.toml --out $D/r --tri-cache 96",
             USAGE,
-            &["--tri-cache 96", "power of two", "--tri-cache 512"],
+            &[
+                "--tri-cache 96",
+                "power of two",
+                "--tri-cache 128 --tri-ways 4",
+            ],
+        ),
+        case(
+            "a node cache of 512 sets of 2 ways",
+            &[("s.toml", &good)],
+            "timing $D/s.toml --out $D/r --node-cache 512 --node-ways 2",
+            USAGE,
+            &[
+                "--node-cache 512 --node-ways 2",
+                "at most 512 items",
+                "--node-cache 256 --node-ways 2",
+            ],
         ),
         case(
             "an instance cache of 256 sets of 4 ways",

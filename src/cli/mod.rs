@@ -165,6 +165,53 @@ impl SizeArgs {
     }
 }
 
+/// The shapes of the processor's three read-only caches (`rtl`, `sim` and `timing`): sets and
+/// ways of each, the paper's 512 items direct mapped by default.
+#[derive(Args, Clone, Copy, Debug)]
+pub struct CacheArgs {
+    /// Sets of the triangle cache in front of banks 2 and 3 (a power of two, sets times
+    /// --tri-ways at most 512, the paper's 512 items; 0 for none).
+    #[arg(long, value_name = "SETS", default_value_t = 512)]
+    pub tri_cache: u32,
+    /// Ways of the triangle cache (1, 2 or 4, e.g. --tri-cache 128 --tri-ways 4). A write
+    /// fills the ways in turn.
+    #[arg(long, value_name = "WAYS", default_value_t = 1)]
+    pub tri_ways: u32,
+    /// Sets of the node cache in front of bank 0 (the same rule with --node-ways; 0 for
+    /// none). It keeps the object trees' nodes (the top level's are rewritten between
+    /// frames) and is off at --mem-latency 1.
+    #[arg(long, value_name = "SETS", default_value_t = 512)]
+    pub node_cache: u32,
+    /// Ways of the node cache (1, 2 or 4). A fill takes the ways in turn.
+    #[arg(long, value_name = "WAYS", default_value_t = 1)]
+    pub node_ways: u32,
+    /// Sets of the instance cache in front of bank 4 (the same rule with --instance-ways; 0
+    /// for none). It is flushed as each frame starts (the host rewrites the instances'
+    /// records between frames).
+    #[arg(long, value_name = "SETS", default_value_t = 512)]
+    pub instance_cache: u32,
+    /// Ways of the instance cache (1, 2 or 4, e.g. --instance-cache 256 --instance-ways 2).
+    /// A miss fills its set's ways in turn.
+    #[arg(long, value_name = "WAYS", default_value_t = 1)]
+    pub instance_ways: u32,
+}
+
+impl CacheArgs {
+    /// The processor with `threads` ray threads, SRAM latency `mem_latency` and these caches.
+    pub fn params(&self, threads: u32, mem_latency: u32) -> dynrt::hw::processor::ProcessorParams {
+        dynrt::hw::processor::ProcessorParams {
+            threads,
+            mem_latency,
+            tri_cache_sets: self.tri_cache,
+            tri_cache_ways: self.tri_ways,
+            node_cache_sets: self.node_cache,
+            node_cache_ways: self.node_ways,
+            instance_cache_sets: self.instance_cache,
+            instance_cache_ways: self.instance_ways,
+        }
+    }
+}
+
 /// Runs the command line and returns the process exit status.
 pub fn run() -> i32 {
     let cli = Cli::parse();

@@ -27,25 +27,8 @@ pub struct RtlArgs {
     /// SRAM read latency in clocks (1..=6).
     #[arg(long, default_value_t = 2)]
     pub mem_latency: u32,
-    /// Sets of the triangle cache in front of banks 2 and 3 (a power of two up to 512, the
-    /// paper's 512 items; 0 for none).
-    #[arg(long, value_name = "SETS", default_value_t = 512)]
-    pub tri_cache: u32,
-    /// Sets of the node cache in front of bank 0 (a power of two up to 512, the paper's 512
-    /// items; 0 for none). It keeps the object trees' nodes (the top level's are rewritten
-    /// between frames) and is off at --mem-latency 1.
-    #[arg(long, value_name = "SETS", default_value_t = 512)]
-    pub node_cache: u32,
-    /// Sets of the instance cache in front of bank 4 (a power of two up to 512, the paper's
-    /// 512 items; 0 for none). It is flushed as each frame starts (the host rewrites the
-    /// instances' records between frames).
-    #[arg(long, value_name = "SETS", default_value_t = 512)]
-    pub instance_cache: u32,
-    /// Ways of the instance cache (1, 2 or 4; --instance-cache sets of this many ways, at
-    /// most 512 items in all, e.g. --instance-cache 256 --instance-ways 2). A miss fills its
-    /// set's ways in turn.
-    #[arg(long, value_name = "WAYS", default_value_t = 1)]
-    pub instance_ways: u32,
+    #[command(flatten)]
+    pub cache: super::CacheArgs,
     /// Frames of an animated scene (default: all).
     #[arg(long)]
     pub frames: Option<u32>,
@@ -171,14 +154,7 @@ fn setup(a: &RtlArgs) -> anyhow::Result<(dynrt::scene::Scene, String, ProcessorP
     dynrt::output::check_output_dir(&a.out, "--out")?;
     let (width, height) = a.size.width_height();
     let scene = super::render_cmd::load_scene(&a.scene, width, height)?;
-    let params = ProcessorParams {
-        threads: a.threads,
-        mem_latency: a.mem_latency,
-        tri_cache_sets: a.tri_cache,
-        node_cache_sets: a.node_cache,
-        instance_cache_sets: a.instance_cache,
-        instance_cache_ways: a.instance_ways,
-    };
+    let params = a.cache.params(a.threads, a.mem_latency);
     flow::preflight(&scene, a.format, params, a.frames)?;
     let name = a
         .scene
@@ -195,10 +171,12 @@ fn summary(verb: &str, a: &RtlArgs, scene: &dynrt::scene::Scene, name: &str) -> 
     s.option("format", a.format.to_string())
         .option("threads", a.threads)
         .option("mem_latency", a.mem_latency)
-        .option("tri_cache", a.tri_cache)
-        .option("node_cache", a.node_cache)
-        .option("instance_cache", a.instance_cache)
-        .option("instance_ways", a.instance_ways)
+        .option("tri_cache", a.cache.tri_cache)
+        .option("tri_ways", a.cache.tri_ways)
+        .option("node_cache", a.cache.node_cache)
+        .option("node_ways", a.cache.node_ways)
+        .option("instance_cache", a.cache.instance_cache)
+        .option("instance_ways", a.cache.instance_ways)
         .option("frames", a.frames)
         .option("width", scene.camera.width)
         .option("height", scene.camera.height)
@@ -409,24 +387,24 @@ pub fn run_sim(a: SimArgs) -> anyhow::Result<i32> {
         },
         cache_line(
             "triangle",
-            a.rtl.tri_cache,
-            1,
+            a.rtl.cache.tri_cache,
+            a.rtl.cache.tri_ways,
             (r.frames[0].tri_cache_hits, r.frames[0].tri_cache_misses),
             "triangle tests",
             "banks 2 and 3",
         ),
         cache_line(
             "node",
-            a.rtl.node_cache,
-            1,
+            a.rtl.cache.node_cache,
+            a.rtl.cache.node_ways,
             (r.frames[0].node_cache_hits, r.frames[0].node_cache_misses),
             "object-tree nodes",
             "bank 0",
         ),
         cache_line(
             "instance",
-            a.rtl.instance_cache,
-            a.rtl.instance_ways,
+            a.rtl.cache.instance_cache,
+            a.rtl.cache.instance_ways,
             (
                 r.frames[0].instance_cache_hits,
                 r.frames[0].instance_cache_misses,

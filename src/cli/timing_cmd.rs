@@ -44,25 +44,8 @@ pub struct TimingArgs {
     /// SRAM read latency of the processor in clocks (1..=6).
     #[arg(long, default_value_t = 2)]
     pub mem_latency: u32,
-    /// Sets of the triangle cache in front of banks 2 and 3 (a power of two up to 512, the
-    /// paper's 512 items; 0 for none).
-    #[arg(long, value_name = "SETS", default_value_t = 512)]
-    pub tri_cache: u32,
-    /// Sets of the node cache in front of bank 0 (a power of two up to 512, the paper's 512
-    /// items; 0 for none). It keeps the object trees' nodes (the top level's are rewritten
-    /// between frames) and is off at --mem-latency 1.
-    #[arg(long, value_name = "SETS", default_value_t = 512)]
-    pub node_cache: u32,
-    /// Sets of the instance cache in front of bank 4 (a power of two up to 512, the paper's
-    /// 512 items; 0 for none). It is flushed as each frame starts (the host rewrites the
-    /// instances' records between frames).
-    #[arg(long, value_name = "SETS", default_value_t = 512)]
-    pub instance_cache: u32,
-    /// Ways of the instance cache (1, 2 or 4; --instance-cache sets of this many ways, at
-    /// most 512 items in all, e.g. --instance-cache 256 --instance-ways 2). A miss fills its
-    /// set's ways in turn.
-    #[arg(long, value_name = "WAYS", default_value_t = 1)]
-    pub instance_ways: u32,
+    #[command(flatten)]
+    pub cache: super::CacheArgs,
     /// Report directory: timing.md, timing.csv and a folder per design.
     #[arg(long, default_value = "out/timing")]
     pub out: PathBuf,
@@ -167,14 +150,7 @@ pub fn run(a: TimingArgs) -> anyhow::Result<i32> {
         ..Ecp5Options::default()
     };
     ecp5::check_options(&options)?;
-    let params = ProcessorParams {
-        threads: a.threads,
-        mem_latency: a.mem_latency,
-        tri_cache_sets: a.tri_cache,
-        node_cache_sets: a.node_cache,
-        instance_cache_sets: a.instance_cache,
-        instance_cache_ways: a.instance_ways,
-    };
+    let params = a.cache.params(a.threads, a.mem_latency);
     let mut designs = Vec::new();
     for u in &a.unit {
         designs.push(parse_unit(u)?);

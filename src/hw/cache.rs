@@ -1,11 +1,15 @@
 //! What the processor's three read-only caches share: their shape (sets and ways, the
 //! paper's 512 items at most), the check of a shape, and an empty tag RAM.
 //!
-//! The node cache ([`super::TraversalUnit`]) and the triangle cache ([`super::TriangleTester`])
-//! are direct mapped. The instance cache ([`super::engine::InstanceRays`]) has 1, 2 or 4 ways:
-//! a tag RAM per way read at once, the words of every way in one RAM deep enough for all of
-//! them (line `set << way_shift | way`, so its block RAMs are those of the direct-mapped cache of
-//! as many items), and per set the way a miss fills next (round robin).
+//! Each has 1, 2 or 4 ways, a tag RAM per way read at once (a way the cache does not have is
+//! never written, and synthesis removes it). Where the words are read after the tag compare
+//! (the instance cache, [`super::engine::InstanceRays`], and the triangle cache,
+//! [`super::TriangleTester`], whose buffers keep the way they hit in) the words of every way
+//! are in one RAM deep enough for all of them (line `set << way_shift | way`, so its block
+//! RAMs are those of the direct-mapped cache of as many items); the node cache
+//! ([`super::TraversalUnit`]) reads a set's words with its tags, so each way's words have a
+//! RAM of their own. The instance cache fills a set's ways in turn (a way number per set); the
+//! others take the ways in turn over the whole cache (no RAM read before a write).
 //!
 //! Golden twin: none; a cache changes when a word arrives, never which word.
 
@@ -18,12 +22,6 @@ pub const MAX_CACHE_SETS: u32 = 512;
 /// Most ways of a set-associative cache (the instance cache has this many tag RAMs; a
 /// smaller cache leaves the others unwritten, and synthesis removes them).
 pub const MAX_CACHE_WAYS: u32 = 4;
-
-/// Whether a direct-mapped cache can have `sets` sets: a power of two up to
-/// [`MAX_CACHE_SETS`], or 0 for none.
-pub fn cache_sets_supported(sets: u32) -> bool {
-    cache_shape_supported(sets, 1)
-}
 
 /// Whether a cache can have `sets` sets of `ways` ways: 1, 2 or 4 ways, and sets a power of
 /// two with `sets * ways` at most [`MAX_CACHE_SETS`], or 0 sets for none.

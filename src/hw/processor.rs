@@ -40,13 +40,15 @@ pub struct ProcessorParams {
     pub threads: u32,
     /// SRAM read latency in clocks (1..=6).
     pub mem_latency: u32,
-    /// Sets of the triangle cache (a power of two up to
-    /// [`MAX_CACHE_SETS`](crate::hw::cache::MAX_CACHE_SETS); 0: none).
+    /// Sets of the triangle cache (0: none) and its ways (1, 2 or 4; sets a power of two,
+    /// sets times ways at most [`MAX_CACHE_SETS`](crate::hw::cache::MAX_CACHE_SETS):
+    /// [`crate::hw::cache::cache_shape_supported`]).
     pub tri_cache_sets: u32,
-    /// Sets of the traversal unit's node cache (the same rule; 0: none).
+    pub tri_cache_ways: u32,
+    /// Sets and ways of the traversal unit's node cache (the same rule).
     pub node_cache_sets: u32,
-    /// Sets of instance entry's instance cache (0: none), and its ways (1, 2 or 4; sets
-    /// times ways at most `MAX_CACHE_SETS`: [`crate::hw::cache::cache_shape_supported`]).
+    pub node_cache_ways: u32,
+    /// Sets and ways of instance entry's instance cache (the same rule).
     pub instance_cache_sets: u32,
     pub instance_cache_ways: u32,
 }
@@ -57,7 +59,9 @@ impl Default for ProcessorParams {
             threads: 32,
             mem_latency: 2,
             tri_cache_sets: crate::hw::cache::MAX_CACHE_SETS,
+            tri_cache_ways: 1,
             node_cache_sets: crate::hw::cache::MAX_CACHE_SETS,
+            node_cache_ways: 1,
             instance_cache_sets: crate::hw::cache::MAX_CACHE_SETS,
             instance_cache_ways: 1,
         }

@@ -44,11 +44,14 @@
 //! bank, one a clock from the node cache, while other threads' jobs fill the decision pipeline.
 //! Each thread has at most one job in the unit, so the 32-entry queues never overflow.
 //!
-//! Node cache: [`MAX_CACHE_SETS`](super::cache::MAX_CACHE_SETS) (the paper's 512 items)
-//! sets of a node's two words, direct mapped by the node's low bits, tag (node and valid bit) and
-//! words in block RAM; `new`'s `cache_sets` uses the first sets only (0: none; off at SRAM latency
-//! 1, where a cached node's words would come back before the FIFO behind them can pop). A job waits
-//! for the fetch in `look`, whose cache set is read as it comes in; the set's tag and words read
+//! Node cache: up to [`MAX_CACHE_SETS`](super::cache::MAX_CACHE_SETS) (the paper's 512) items
+//! of a node's two words, `cache_sets` sets (by the node's low bits) of `cache_ways` ways (1, 2
+//! or 4), each way's tags (node and valid bit) and words in block RAMs of their own, so that a
+//! set's ways are read at once (a way the cache does not have is never written, and synthesis
+//! removes it: 2 ways take twice the words' block RAM of 1, 4 ways four times); a fill takes
+//! the ways in turn (one count for the whole cache). 0 sets: none; off at SRAM latency
+//! 1, where a cached node's words would come back before the FIFO behind them can pop. A job waits
+//! for the fetch in `look`, whose cache set is read as it comes in; the set's tags and words read
 //! are registered, and the job's tag is compared with them from its second clock in `look` (the
 //! block RAM's output is not compared in the clock it comes out; a job the fetch takes in its first
 //! clock goes to the bank); from the cache the fetch takes a node in a clock with no request, and
@@ -64,7 +67,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::cache::{cache_sets_supported, empty_cache_tags};
+use super::cache::{cache_shape_supported, empty_cache_tags};
 use super::fp::add_sub::ADD_SUB_LATENCY;
 use super::fp::compare::COMPARE_LATENCY;
 use super::fp::div::div_latency;
@@ -312,8 +315,8 @@ pub struct TraversalUnit<
     /// clock to out ran through the compare into `fetch_hit` when the read word was compared
     /// as it came out: cornell's placed critical path at stop 47, `traversal_unit.cache_tag
     /// -> fetch_hit`, 75.9 MHz.)
-    tag_word_r: DFF<Bits<27>>,
-    words_r: DFF<Bits<64>>,
+    tag_word_r: [DFF<Bits<27>>; 4],
+    words_r: [DFF<Bits<64>>; 4],
     stale_r: DFF<Bit>,
     look_ready: DFF<Bit>,
     look_move: Signal<Local, Bit>,
@@ -322,8 +325,13 @@ pub struct TraversalUnit<
     /// The set read this clock (`look_job`'s next clock).
     read_set: Signal<Local, Bits<9>>,
     /// Per set: `{valid[26], node[25:0]}`, and the node's words `{w1, w0}`.
-    cache_tag: RAM<Bits<27>, 9>,
-    cache_words: RAM<Bits<64>, 9>,
+    cache_tag: [RAM<Bits<27>, 9>; 4],
+    cache_words: [RAM<Bits<64>, 9>; 4],
+    /// The way `look_job`'s node is in (when `look_hit`).
+    look_way_hit: [Signal<Local, Bit>; 4],
+    /// The way the next fill writes: a count of fills (round robin over the whole cache,
+    /// not per set, so that no RAM is read before a fill).
+    fill_way: DFF<Bits<2>>,
     /// `fetch_job`'s node is in the cache, with its words: the fetch takes it in a clock.
     fetch_hit: DFF<Bit>,
     fetch_words: DFF<Bits<64>>,
@@ -341,6 +349,10 @@ pub struct TraversalUnit<
     c_node_set_mask: Constant<Bits<9>>,
     c_node_cache_on: Constant<Bit>,
     c_node_tag_valid: Constant<Bits<27>>,
+    /// `ways - 1`, each way's number, and whether the cache has that way.
+    c_node_way_mask: Constant<Bits<2>>,
+    c_node_way: [Constant<Bits<2>>; 4],
+    c_node_way_used: [Constant<Bit>; 4],
     // A: the node's words are here.
     at_a: Signal<Local, Bit>,
     a_leaf: Signal<Local, Bit>,
@@ -420,14 +432,20 @@ impl<
     > TraversalUnit<W, E, M, S, S1, X2, T, DL>
 {
     /// The unit for SRAM read latency `mem_latency` (1..=6) and a node cache of `cache_sets`
-    /// sets (0: none; see [`cache_sets_supported`]).
+    /// sets of `cache_ways` ways (0 sets: none; see [`cache_shape_supported`]).
     /// A top-level walk's stack starts at entry `top_stack_base` of the thread's
     /// [`STACK_LEVELS`]; `top_level` is false for a scene without a top level.
-    pub fn new(mem_latency: u32, top_stack_base: u32, top_level: bool, cache_sets: u32) -> Self {
+    pub fn new(
+        mem_latency: u32,
+        top_stack_base: u32,
+        top_level: bool,
+        cache_sets: u32,
+        cache_ways: u32,
+    ) -> Self {
         assert!((1..=6).contains(&mem_latency));
         assert!(
-            cache_sets_supported(cache_sets),
-            "node cache sets: {cache_sets}"
+            cache_shape_supported(cache_sets, cache_ways),
+            "node cache: {cache_sets} sets of {cache_ways} ways"
         );
         assert!((1..STACK_LEVELS as u32).contains(&top_stack_base));
         assert!(DL == div_latency(M as u32) as usize);
@@ -569,8 +587,10 @@ impl<
             look_load: Default::default(),
             look_hit: Default::default(),
             read_set: Default::default(),
-            cache_tag: empty_cache_tags(),
+            cache_tag: std::array::from_fn(|_| empty_cache_tags()),
             cache_words: Default::default(),
+            look_way_hit: Default::default(),
+            fill_way: Default::default(),
             fetch_hit: Default::default(),
             fetch_words: Default::default(),
             hit_now: Default::default(),
@@ -582,6 +602,11 @@ impl<
             c_node_set_mask: Constant::new(u64::from(cache_sets.max(1) - 1).into()),
             c_node_cache_on: Constant::new(cache_sets > 0 && mem_latency >= 2),
             c_node_tag_valid: Constant::new((1u64 << 26).into()),
+            c_node_way_mask: Constant::new(u64::from(cache_ways - 1).into()),
+            c_node_way: std::array::from_fn(|w| Constant::new((w as u64).into())),
+            c_node_way_used: std::array::from_fn(|w| {
+                Constant::new(cache_sets > 0 && (w as u32) < cache_ways)
+            }),
             at_a: Default::default(),
             a_leaf: Default::default(),
             a_axis: Default::default(),
@@ -701,8 +726,7 @@ impl<
             look_valid,
             look_job,
             look_stale,
-            tag_word_r,
-            words_r,
+            fill_way,
             stale_r,
             look_ready,
             fetch_hit,
@@ -766,10 +790,16 @@ impl<
         self.stack_lo.write_clock.next = self.clock.val();
         self.stack_hi.read_clock.next = self.clock.val();
         self.stack_hi.write_clock.next = self.clock.val();
-        self.cache_tag.read_clock.next = self.clock.val();
-        self.cache_tag.write_clock.next = self.clock.val();
-        self.cache_words.read_clock.next = self.clock.val();
-        self.cache_words.write_clock.next = self.clock.val();
+        for w in 0..4 {
+            self.cache_tag[w].read_clock.next = self.clock.val();
+            self.cache_tag[w].write_clock.next = self.clock.val();
+            self.cache_words[w].read_clock.next = self.clock.val();
+            self.cache_words[w].write_clock.next = self.clock.val();
+            self.tag_word_r[w].clock.next = self.clock.val();
+            self.words_r[w].clock.next = self.clock.val();
+            self.tag_word_r[w].d.next = self.tag_word_r[w].q.val();
+            self.words_r[w].d.next = self.words_r[w].q.val();
+        }
         for k in 0..6 {
             self.node_line[k].clock.next = self.clock.val();
             self.data_line[k].clock.next = self.clock.val();
@@ -1022,16 +1052,23 @@ impl<
         self.loop_fifo.read.next = false;
         self.front_fifo.read.next = false;
         self.in_flight.read.next = false;
-        self.tag_word_r.d.next = self.cache_tag.read_data.val();
-        self.words_r.d.next = self.cache_words.read_data.val();
         self.stale_r.d.next = self.look_stale.q.val();
-        self.look_hit.next = self.c_node_cache_on.val()
-            & self.look_ready.q.val()
-            & (!self.look_job.q.val().get_bit(102))
-            & (!self.stale_r.q.val())
-            & (self.tag_word_r.q.val()
-                == (self.c_node_tag_valid.val()
-                    | bit_cast::<27, 26>(self.look_job.q.val().get_bits::<26>(64))));
+        // A way the cache does not have keeps its tags zero (never written): no match.
+        self.look_hit.next = false;
+        for w in 0..4 {
+            self.tag_word_r[w].d.next = self.cache_tag[w].read_data.val();
+            self.words_r[w].d.next = self.cache_words[w].read_data.val();
+            self.look_way_hit[w].next = self.c_node_way_used[w].val()
+                & (self.tag_word_r[w].q.val()
+                    == (self.c_node_tag_valid.val()
+                        | bit_cast::<27, 26>(self.look_job.q.val().get_bits::<26>(64))));
+            if self.look_way_hit[w].val() {
+                self.look_hit.next = self.c_node_cache_on.val()
+                    & self.look_ready.q.val()
+                    & (!self.look_job.q.val().get_bit(102))
+                    & (!self.stale_r.q.val());
+            }
+        }
         self.hit_now.next = (self.phase.q.val() == Fetch::Word0) & self.fetch_hit.q.val();
         self.take.next = (self.phase.q.val() != Fetch::Idle)
             & (!self.hit_now.val())
@@ -1106,7 +1143,12 @@ impl<
                 self.look_move.next = true;
                 self.fetch_job.d.next = self.look_job.q.val();
                 self.fetch_hit.d.next = self.look_hit.val();
-                self.fetch_words.d.next = self.words_r.q.val();
+                self.fetch_words.d.next = self.words_r[0].q.val();
+                for w in 1..4 {
+                    if self.look_way_hit[w].val() {
+                        self.fetch_words.d.next = self.words_r[w].q.val();
+                    }
+                }
                 self.phase.d.next = Fetch::Word0;
             } else if (self.phase.q.val() == Fetch::Idle) & self.in_flight.empty.val() {
                 self.look_move.next = true;
@@ -1138,8 +1180,10 @@ impl<
                     self.front_fifo.data_out.val().get_bits::<9>(64) & self.c_node_set_mask.val();
             }
         }
-        self.cache_tag.read_address.next = self.read_set.val();
-        self.cache_words.read_address.next = self.read_set.val();
+        for w in 0..4 {
+            self.cache_tag[w].read_address.next = self.read_set.val();
+            self.cache_words[w].read_address.next = self.read_set.val();
+        }
         // The ray's words for A: read for the oldest job in flight, a clock before it gets
         // there.
         self.ray.ray_thread.next = self.in_flight.data_out.val().get_bits::<5>(96);
@@ -1234,14 +1278,21 @@ impl<
             & self.a_fetched.q.val()
             & (!self.job.q.val().get_bit(102));
         self.fill_set.next = self.job.q.val().get_bits::<9>(64) & self.c_node_set_mask.val();
-        self.cache_tag.write_address.next = self.fill_set.val();
-        self.cache_tag.write_data.next =
-            self.c_node_tag_valid.val() | bit_cast::<27, 26>(self.job.q.val().get_bits::<26>(64));
-        self.cache_tag.write_enable.next = self.fill.val();
-        self.cache_words.write_address.next = self.fill_set.val();
-        self.cache_words.write_data.next =
-            (bit_cast::<64, 32>(self.w1.q.val()) << 32) | bit_cast::<64, 32>(self.w0.q.val());
-        self.cache_words.write_enable.next = self.fill.val();
+        for w in 0..4 {
+            self.cache_tag[w].write_address.next = self.fill_set.val();
+            self.cache_tag[w].write_data.next = self.c_node_tag_valid.val()
+                | bit_cast::<27, 26>(self.job.q.val().get_bits::<26>(64));
+            self.cache_tag[w].write_enable.next = self.c_node_way_used[w].val()
+                & self.fill.val()
+                & (self.fill_way.q.val() == self.c_node_way[w].val());
+            self.cache_words[w].write_address.next = self.fill_set.val();
+            self.cache_words[w].write_data.next =
+                (bit_cast::<64, 32>(self.w1.q.val()) << 32) | bit_cast::<64, 32>(self.w0.q.val());
+            self.cache_words[w].write_enable.next = self.cache_tag[w].write_enable.val();
+        }
+        if self.fill.val() {
+            self.fill_way.d.next = (self.fill_way.q.val() + 1) & self.c_node_way_mask.val();
+        }
         self.look_stale.d.next = self.fill.val() & (self.fill_set.val() == self.read_set.val());
         self.engine.done.next = self.done_r.q.val();
         self.engine.done_thread.next = self.done_thread_r.q.val();
@@ -1416,7 +1467,7 @@ mod tests {
     /// Run with a node cache of `cache_sets` sets: every node the model reads is a hit or a
     /// miss of the unit's cache (none a hit without a cache); returns the hits and the
     /// unit's reads of bank 0.
-    fn walk_like_the_model(cache_sets: u32) -> (usize, usize) {
+    fn walk_like_the_model((cache_sets, cache_ways): (u32, u32)) -> (usize, usize) {
         let f = Format::E7M16;
         let seed = 41;
         println!("seed {seed}");
@@ -1492,7 +1543,13 @@ mod tests {
         // Each thread walks twice.
         let model_fetches = 2 * model_fetches.get();
 
-        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE, true, cache_sets);
+        let mut u = Unit::new(
+            mem_latency,
+            DEFAULT_TOP_STACK_BASE,
+            true,
+            cache_sets,
+            cache_ways,
+        );
         u.connect_all();
         let cycle = |u: &mut Unit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
         for (th, (o, d)) in rays.iter().enumerate() {
@@ -1621,18 +1678,32 @@ mod tests {
 
     #[test]
     fn rust_hdl_simulation_walks_like_the_model() {
-        let (hits, reads) = walk_like_the_model(0);
+        let (hits, reads) = walk_like_the_model((0, 1));
         assert_eq!(hits, 0, "no cache, no hit");
         // A cache of the paper's 512 sets holds the whole Cornell tree: each node is read from
-        // the bank once; two sets evict (fewer hits, more reads).
-        let (hits_512, reads_512) = walk_like_the_model(MAX_CACHE_SETS);
-        let (hits_2, reads_2) = walk_like_the_model(2);
-        println!("hits / reads: none 0 / {reads}, 2 sets {hits_2} / {reads_2}, 512 {hits_512} / {reads_512}");
+        // the bank once; two sets evict (fewer hits, more reads), and two sets of four ways
+        // hold four times the nodes of two sets of one (a cache that looked up or filled one
+        // way only would hit as the direct-mapped one does).
+        let (hits_512, reads_512) = walk_like_the_model((MAX_CACHE_SETS, 1));
+        let (hits_2, reads_2) = walk_like_the_model((2, 1));
+        let (hits_2x4, reads_2x4) = walk_like_the_model((2, 4));
+        let (hits_256x2, reads_256x2) = walk_like_the_model((256, 2));
+        println!(
+            "hits / reads: none 0 / {reads}, 2 sets {hits_2} / {reads_2}, 2 sets of 4 ways \
+             {hits_2x4} / {reads_2x4}, 256 of 2 {hits_256x2} / {reads_256x2}, 512 {hits_512} / \
+             {reads_512}"
+        );
         assert!(hits_512 > hits_2 && hits_2 > 0, "{hits_512} {hits_2}");
         assert!(
             reads_512 < reads_2 && reads_2 < reads,
             "{reads_512} {reads_2} {reads}"
         );
+        assert!(
+            hits_2x4 > hits_2 && reads_2x4 < reads_2,
+            "{hits_2x4} {hits_2}"
+        );
+        // 512 items either way hold the whole tree.
+        assert_eq!((hits_256x2, reads_256x2), (hits_512, reads_512));
     }
 
     /// rust-hdl simulation of top-level walks on the dynamic scene's trees (1,202 instances):
@@ -1776,7 +1847,7 @@ mod tests {
             "too few object leaves: {object_leaves}"
         );
 
-        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE, true, MAX_CACHE_SETS);
+        let mut u = Unit::new(mem_latency, DEFAULT_TOP_STACK_BASE, true, MAX_CACHE_SETS, 1);
         u.connect_all();
         let cycle = |u: &mut Unit| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
         for th in 0..threads {

@@ -53,16 +53,19 @@
 //! back 3 clocks after the read. Entries 2 or 3 clocks apart would read a state still to be
 //! written, so the merge takes it from the entry ahead instead (`after_*`, `lw_*`).
 //!
-//! Triangle cache: [`MAX_CACHE_SETS`](super::cache::MAX_CACHE_SETS) (the paper's 512 items) sets of a triangle's 12 words,
-//! direct mapped by the triangle's low bits, with a tag (triangle and valid bit), all in block
-//! RAM; `new`'s `cache_sets` uses the first sets only (0: no cache). The queue's head's tag is
+//! Triangle cache: up to [`MAX_CACHE_SETS`](super::cache::MAX_CACHE_SETS) (the paper's 512)
+//! items of a triangle's 12 words, `cache_sets` sets (by the triangle's low bits) of
+//! `cache_ways` ways (1, 2 or 4), a tag RAM (triangle and valid bit) per way and the words of
+//! every way in one RAM per word (line `set << way_shift | way`), all in block RAM (0 sets: no
+//! cache). The queue's head's tags are
 //! read as the free buffer copies it, registered in the next clock, compared in the one after,
-//! and the compare decides the buffer's `cached` in the fourth (the fetch leaves the buffer
-//! alone until then); a triangle found there is not
+//! and the compare decides the buffer's `cached` and the way it hit in the fourth (the fetch
+//! leaves the buffer alone until then); a triangle found there is not
 //! fetched, and the launch takes its words from the cache (addressed two clocks ahead: the
 //! launch's words, from the buffer or the cache, wait in a register, `matrix`). A triangle
 //! fetched from the banks is written into its set as it launches (in its direction's clock,
-//! decided in its origin's), from the words it launches with, unless a buffered triangle found
+//! decided in its origin's; the ways in turn, one count for the whole cache), from the words
+//! it launches with, unless a buffered triangle found
 //! in the cache holds that set (it must find its words there until it launches); a head looked
 //! up in either clock, or decided in an origin's clock, misses if its set is the launch's. The
 //! frames of an animated scene leave banks 2 and 3 as they are (only instances and the top
@@ -75,7 +78,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::cache::{cache_sets_supported, empty_cache_tags};
+use super::cache::{cache_shape_supported, empty_cache_tags, way_shift};
 use super::fp::{const_bits, FpCompare};
 use super::list_unit::{
     CMD_INIT, CMD_LIST, LIST_OF_WALK, TEST_INIT, TEST_LIST_END, TEST_TRIANGLE, TEST_WALK_END,
@@ -276,9 +279,14 @@ pub struct TriangleTester<
     /// clock, compared in the next. (In distributed RAM read and compared in the take's
     /// clock, its 512-deep read ran through the compare into the fetch's start: stop 46's
     /// critical path, `cache_tag.read_address -> fetching`, 67.3 MHz placed.)
-    cache_tag: RAM<Bits<25>, 9>,
-    /// Word k of each set's triangle.
+    cache_tag: [RAM<Bits<25>, 9>; 4],
+    /// Word k of each line's triangle (line `set << way_shift | way`).
     cache_words: [RAM<Bits<W>, 9>; 12],
+    /// The way the buffer's triangle is in (when `cached`).
+    cached_way: [DFF<Bits<2>>; TEST_BUFFERS],
+    /// The way the next write fills: a count of writes (round robin over the whole cache, not
+    /// per set, so that no RAM is read before a write).
+    fill_way: DFF<Bits<2>>,
     /// The buffer's triangle is in the cache (decided three clocks after the take, when
     /// `deciding`; its set is not written until it launches).
     cached: [DFF<Bit>; TEST_BUFFERS],
@@ -318,9 +326,12 @@ pub struct TriangleTester<
     next_origin: Signal<Local, Bit>,
     next_set: Signal<Local, Bits<9>>,
     /// The tag word read for the head of last clock.
-    tag_word_r: DFF<Bits<25>>,
+    tag_word_r: [DFF<Bits<25>>; 4],
     head_hit: Signal<Local, Bit>,
     head_hit_r: DFF<Bit>,
+    /// The way the head's tag matched in.
+    head_way: Signal<Local, Bits<2>>,
+    head_way_r: DFF<Bits<2>>,
     /// The lookup of the launch's buffer (`l_`) or the next one's (`n_`) is pending: its `cached`
     /// may change in the next clock, so `matrix_cached`, registered from it, is not yet its.
     l_pending: Signal<Local, Bit>,
@@ -329,6 +340,13 @@ pub struct TriangleTester<
     l_set: Signal<Local, Bits<9>>,
     n_cached: Signal<Local, Bit>,
     n_set: Signal<Local, Bits<9>>,
+    /// The cache lines the launch's buffer and the next one's words are read from (their set
+    /// and the way they were found in), and the line a write fills.
+    l_way: Signal<Local, Bits<2>>,
+    n_way: Signal<Local, Bits<2>>,
+    l_line: Signal<Local, Bits<9>>,
+    n_line: Signal<Local, Bits<9>>,
+    fill_line: Signal<Local, Bits<9>>,
     /// The launch's origin decides to write its triangle into the cache (`cache_block`: a
     /// buffered triangle reads that set); the write goes out in the direction's clock, from
     /// this register (from the buffers' flags straight into the tag RAM's 512 write enables
@@ -342,6 +360,11 @@ pub struct TriangleTester<
     c_set_mask: Constant<Bits<9>>,
     c_cache_on: Constant<Bit>,
     c_tag_valid: Constant<Bits<25>>,
+    /// `ways - 1`, `log2(ways)`, each way's number, and whether the cache has that way.
+    c_tri_way_mask: Constant<Bits<2>>,
+    c_tri_way_shift: Constant<Bits<2>>,
+    c_tri_way: [Constant<Bits<2>>; 4],
+    c_tri_way_used: [Constant<Bit>; 4],
     take: Signal<Local, Bit>,
     /// The fetch leaves `fb` this clock: its last words requested, or an entry that fetches
     /// nothing passed over.
@@ -478,12 +501,14 @@ impl<
         const DL: usize,
     > TriangleTester<W, E, M, S, S1, X2, T, P, DL>
 {
-    /// The tester for SRAM read latency `mem_latency` (1..=6).
-    /// With a triangle cache of `cache_sets` sets (a power of two up to [`MAX_CACHE_SETS`](super::cache::MAX_CACHE_SETS),
-    /// 0 for none).
-    pub fn new(mem_latency: u32, cache_sets: u32) -> Self {
+    /// The tester for SRAM read latency `mem_latency` (1..=6), with a triangle cache of
+    /// `cache_sets` sets of `cache_ways` ways (0 sets: none; see [`cache_shape_supported`]).
+    pub fn new(mem_latency: u32, cache_sets: u32, cache_ways: u32) -> Self {
         assert!((1..=6).contains(&mem_latency));
-        assert!(cache_sets_supported(cache_sets), "cache sets {cache_sets}");
+        assert!(
+            cache_shape_supported(cache_sets, cache_ways),
+            "triangle cache: {cache_sets} sets of {cache_ways} ways"
+        );
         let f = Format::new(E as u32, M as u32).expect("a supported format");
         assert!(flight_slots_suffice(f), "{f}: too few in-flight slots");
         Self {
@@ -566,8 +591,17 @@ impl<
             fetch_a: Default::default(),
             fetch_ends: Default::default(),
             tb_free: Default::default(),
-            cache_tag: empty_cache_tags(),
+            cache_tag: std::array::from_fn(|_| empty_cache_tags()),
             cache_words: Default::default(),
+            cached_way: Default::default(),
+            fill_way: Default::default(),
+            head_way: Default::default(),
+            head_way_r: Default::default(),
+            l_way: Default::default(),
+            n_way: Default::default(),
+            l_line: Default::default(),
+            n_line: Default::default(),
+            fill_line: Default::default(),
             cached: Default::default(),
             fresh: Default::default(),
             comparing: Default::default(),
@@ -606,6 +640,12 @@ impl<
             c_set_mask: Constant::new(u64::from(cache_sets.max(1) - 1).into()),
             c_cache_on: Constant::new(cache_sets > 0),
             c_tag_valid: Constant::new((1u64 << 24).into()),
+            c_tri_way_mask: Constant::new(u64::from(cache_ways - 1).into()),
+            c_tri_way_shift: Constant::new(u64::from(way_shift(cache_ways)).into()),
+            c_tri_way: std::array::from_fn(|w| Constant::new((w as u64).into())),
+            c_tri_way_used: std::array::from_fn(|w| {
+                Constant::new(cache_sets > 0 && (w as u32) < cache_ways)
+            }),
             take: Default::default(),
             fetch_moves: Default::default(),
             fetch_next: Default::default(),
@@ -727,8 +767,9 @@ impl<
             origin_clash,
             head_clash_rr,
             head_clash_rrr,
-            tag_word_r,
             head_hit_r,
+            head_way_r,
+            fill_way,
             a_issued,
             b_issued,
             seq,
@@ -810,8 +851,12 @@ impl<
             self.matrix[k].clock.next = self.clock.val();
             self.matrix[k].d.next = self.matrix[k].q.val();
         }
-        self.cache_tag.write_clock.next = self.clock.val();
-        self.cache_tag.read_clock.next = self.clock.val();
+        for w in 0..4 {
+            self.cache_tag[w].write_clock.next = self.clock.val();
+            self.cache_tag[w].read_clock.next = self.clock.val();
+            self.tag_word_r[w].clock.next = self.clock.val();
+            self.tag_word_r[w].d.next = self.tag_word_r[w].q.val();
+        }
         for k in 0..12 {
             self.cache_words[k].read_clock.next = self.clock.val();
             self.cache_words[k].write_clock.next = self.clock.val();
@@ -819,6 +864,8 @@ impl<
         for k in 0..4 {
             self.cached[k].clock.next = self.clock.val();
             self.cached[k].d.next = self.cached[k].q.val();
+            self.cached_way[k].clock.next = self.clock.val();
+            self.cached_way[k].d.next = self.cached_way[k].q.val();
             self.fresh[k].clock.next = self.clock.val();
             self.comparing[k].clock.next = self.clock.val();
             self.deciding[k].clock.next = self.clock.val();
@@ -915,6 +962,7 @@ impl<
         self.l_loaded.next = self.loaded[0].q.val();
         self.l_received.next = self.received[0].q.val();
         self.l_cached.next = self.cached[0].q.val();
+        self.l_way.next = self.cached_way[0].q.val();
         self.l_pending.next = self.lookup_pending[0].val();
         for k in 1..4 {
             if self.lb.q.val() == self.c_buffer[k].val() {
@@ -925,6 +973,7 @@ impl<
                 self.l_loaded.next = self.loaded[k].q.val();
                 self.l_received.next = self.received[k].q.val();
                 self.l_cached.next = self.cached[k].q.val();
+                self.l_way.next = self.cached_way[k].q.val();
                 self.l_pending.next = self.lookup_pending[k].val();
             }
         }
@@ -938,6 +987,7 @@ impl<
         self.n_kind.next = self.cur_kind[0].q.val();
         self.n_received.next = self.received[0].q.val();
         self.n_cached.next = self.cached[0].q.val();
+        self.n_way.next = self.cached_way[0].q.val();
         self.n_pending.next = self.lookup_pending[0].val();
         self.n_set.next = self.cur_a[0].q.val().get_bits::<9>(0) & self.c_set_mask.val();
         for k in 1..4 {
@@ -947,6 +997,7 @@ impl<
                 self.n_kind.next = self.cur_kind[k].q.val();
                 self.n_received.next = self.received[k].q.val();
                 self.n_cached.next = self.cached[k].q.val();
+                self.n_way.next = self.cached_way[k].q.val();
                 self.n_pending.next = self.lookup_pending[k].val();
                 self.n_set.next = self.cur_a[k].q.val().get_bits::<9>(0) & self.c_set_mask.val();
             }
@@ -979,10 +1030,23 @@ impl<
             & (!self.cache_block.val());
         self.cache_write_r.d.next = self.cache_write.val();
         // In the direction's clock `lb` and its words (in `matrix`) are still the launch's.
-        self.cache_tag.write_address.next = self.l_set.val();
-        self.cache_tag.write_data.next =
-            self.c_tag_valid.val() | bit_cast::<25, 24>(self.l_a.val().get_bits::<24>(0));
-        self.cache_tag.write_enable.next = self.cache_write_r.q.val();
+        for w in 0..4 {
+            self.cache_tag[w].write_address.next = self.l_set.val();
+            self.cache_tag[w].write_data.next =
+                self.c_tag_valid.val() | bit_cast::<25, 24>(self.l_a.val().get_bits::<24>(0));
+            self.cache_tag[w].write_enable.next = self.c_tri_way_used[w].val()
+                & self.cache_write_r.q.val()
+                & (self.fill_way.q.val() == self.c_tri_way[w].val());
+        }
+        if self.cache_write_r.q.val() {
+            self.fill_way.d.next = (self.fill_way.q.val() + 1) & self.c_tri_way_mask.val();
+        }
+        self.l_line.next =
+            (self.l_set.val() << self.c_tri_way_shift.val()) | bit_cast::<9, 2>(self.l_way.val());
+        self.n_line.next =
+            (self.n_set.val() << self.c_tri_way_shift.val()) | bit_cast::<9, 2>(self.n_way.val());
+        self.fill_line.next = (self.l_set.val() << self.c_tri_way_shift.val())
+            | bit_cast::<9, 2>(self.fill_way.q.val());
         // The words answer a clock after their set: the launch's while it waits, the next
         // buffer's from the origin's clock on (`matrix` takes them in the direction's).
         self.cache_ready.d.next = self.l_loaded.val() & (!self.l_pending.val());
@@ -990,17 +1054,19 @@ impl<
             self.cache_ready.d.next = self.n_loaded.val() & (!self.n_pending.val());
         }
         for k in 0..12 {
-            self.cache_words[k].write_address.next = self.l_set.val();
+            self.cache_words[k].write_address.next = self.fill_line.val();
             self.cache_words[k].write_data.next = self.matrix[k].q.val();
             self.cache_words[k].write_enable.next = self.cache_write_r.q.val();
-            self.cache_words[k].read_address.next = self.l_set.val();
+            self.cache_words[k].read_address.next = self.l_line.val();
             if self.lphase.q.val() != Launch::Wait {
-                self.cache_words[k].read_address.next = self.n_set.val();
+                self.cache_words[k].read_address.next = self.n_line.val();
             }
         }
         self.head_triangle.next = self.list_unit.test_entry.val().get_bits::<24>(32);
         self.head_set.next = self.head_triangle.val().get_bits::<9>(0) & self.c_set_mask.val();
-        self.cache_tag.read_address.next = self.head_set.val();
+        for w in 0..4 {
+            self.cache_tag[w].read_address.next = self.head_set.val();
+        }
         // A head taken in an origin's clock (whose write is decided then) or in a write's
         // clock (the tag read shows the set before the write) misses if the set is the same,
         // as one whose set an origin decides to write in any of the next three clocks, while
@@ -1031,11 +1097,21 @@ impl<
         self.head_clash_rrr.d.next = self.head_clash_rr.q.val()
             | ((self.lphase.q.val() == Launch::Origin)
                 & (self.l_set.val() == self.head_set_rr.q.val()));
-        self.tag_word_r.d.next = self.cache_tag.read_data.val();
-        self.head_hit.next = self.c_cache_on.val()
-            & (self.tag_word_r.q.val()
-                == (self.c_tag_valid.val() | bit_cast::<25, 24>(self.head_triangle_rr.q.val())));
+        // A way the cache does not have keeps its tags zero (never written): no match.
+        self.head_hit.next = false;
+        self.head_way.next = 0.into();
+        for w in 0..4 {
+            self.tag_word_r[w].d.next = self.cache_tag[w].read_data.val();
+            if self.c_tri_way_used[w].val()
+                & (self.tag_word_r[w].q.val()
+                    == (self.c_tag_valid.val() | bit_cast::<25, 24>(self.head_triangle_rr.q.val())))
+            {
+                self.head_hit.next = self.c_cache_on.val();
+                self.head_way.next = self.c_tri_way[w].val();
+            }
+        }
         self.head_hit_r.d.next = self.head_hit.val();
+        self.head_way_r.d.next = self.head_way.val();
 
         // Take: the list unit's next entry into buffer `tb` whenever it is free, apart from the
         // fetch. (Taken in the clock of the fetch's last requests, the take waited on the bank
@@ -1079,6 +1155,7 @@ impl<
             self.comparing[k].d.next = self.fresh[k].q.val();
             self.deciding[k].d.next = self.comparing[k].q.val();
             if self.deciding[k].q.val() {
+                self.cached_way[k].d.next = self.head_way_r.q.val();
                 self.cached[k].d.next = self.head_hit_r.q.val()
                     & (!self.head_clash_rrr.q.val())
                     & (!self.origin_clash.q.val())
@@ -1552,7 +1629,7 @@ mod tests {
     #[allow(clippy::too_many_arguments)]
     fn drive_tester(
         mem_latency: u32,
-        cache_sets: u32,
+        (cache_sets, cache_ways): (u32, u32),
         triangles: &[units::Mat34W],
         bank1: &[u32],
         rays: &[([u32; 3], [u32; 3])],
@@ -1573,7 +1650,7 @@ mod tests {
             }
         }
         let threads = rays.len();
-        let mut u = Tester::new(mem_latency, cache_sets);
+        let mut u = Tester::new(mem_latency, cache_sets, cache_ways);
         u.connect_all();
         let cycle = |u: &mut Tester| clock_cycle(u, |u, c| u.clock.next = Clock { clk: c });
         // Ray words, one thread a clock.
@@ -1771,12 +1848,14 @@ mod tests {
             "too few hits: {want:?}"
         );
         // No cache, two sets (24 triangles in them: evictions, and launches whose set a
-        // buffered hit holds) and the full cache.
-        for sets in [0, 2, MAX_CACHE_SETS] {
+        // buffered hit holds), two sets of four ways (8 items), and the paper's 512 items
+        // direct mapped and in two ways.
+        let mut hits_of = std::collections::HashMap::new();
+        for (sets, ways) in [(0, 1), (2, 1), (2, 4), (MAX_CACHE_SETS, 1), (256, 2)] {
             let mut rng = rng.clone();
             let drive = drive_tester(
                 3,
-                sets,
+                (sets, ways),
                 &triangles,
                 &bank1,
                 &rays,
@@ -1793,11 +1872,21 @@ mod tests {
             assert_eq!(
                 drive.cache_hits + drive.cache_misses,
                 tests,
-                "{sets} sets: every test launches once"
+                "{sets} sets of {ways} ways: every test launches once"
             );
-            match sets {
-                0 => assert_eq!(drive.cache_hits, 0),
-                2 => assert!(
+            hits_of.insert((sets, ways), drive.cache_hits);
+            match (sets, ways) {
+                (0, _) => assert_eq!(drive.cache_hits, 0),
+                // Four ways hold four times the triangles of one: a cache that looked up or
+                // filled one way only would hit as the direct-mapped one does.
+                (2, 4) => assert!(
+                    drive.cache_hits > hits_of[&(2, 1)] && drive.cache_misses > 24,
+                    "2 sets of 4 ways: {} hits (of one way: {}), {} misses",
+                    drive.cache_hits,
+                    hits_of[&(2, 1)],
+                    drive.cache_misses
+                ),
+                (2, 1) => assert!(
                     drive.cache_hits > 0 && drive.cache_misses > 24 && drive.origin_clashes > 0,
                     "{sets} sets: {} hits, {} misses, {} origins into a deciding set",
                     drive.cache_hits,
@@ -1807,7 +1896,7 @@ mod tests {
                 // A triangle misses until its first test has launched (24 of them).
                 _ => assert!(
                     (24..tests / 4).contains(&drive.cache_misses),
-                    "{sets} sets: {} misses of {tests}",
+                    "{sets} sets of {ways} ways: {} misses of {tests}",
                     drive.cache_misses
                 ),
             }
@@ -1848,7 +1937,7 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
         let drive = drive_tester(
             2,
-            MAX_CACHE_SETS,
+            (MAX_CACHE_SETS, 1),
             &triangles,
             &bank1,
             &rays,
@@ -1915,7 +2004,7 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
         drive_tester(
             1,
-            MAX_CACHE_SETS,
+            (MAX_CACHE_SETS, 1),
             &triangles,
             &bank1,
             &rays,

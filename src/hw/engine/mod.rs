@@ -460,7 +460,9 @@ impl<
             threads,
             mem_latency,
             tri_cache_sets,
+            tri_cache_ways,
             node_cache_sets,
+            node_cache_ways,
             instance_cache_sets,
             instance_cache_ways,
         } = *params;
@@ -540,12 +542,13 @@ impl<
             write_back: Default::default(),
             // Scratch words start undefined: the program writes every one before reading it.
             scratch: Default::default(),
-            tester: TriangleTester::new(mem_latency, tri_cache_sets),
+            tester: TriangleTester::new(mem_latency, tri_cache_sets, tri_cache_ways),
             traversal_unit: TraversalUnit::new(
                 mem_latency,
                 program.config.top_stack_base,
                 program.config.top_root.is_some(),
                 node_cache_sets,
+                node_cache_ways,
             ),
             running: Default::default(),
             epoch: Default::default(),
