@@ -26418,6 +26418,16 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     localparam  c_set_mask = 9'b111111111;
     localparam  c_cache_on = 1'b1;
     localparam  c_tag_valid = 25'h1000000;
+    localparam  c_tri_way_mask = 2'b0;
+    localparam  c_tri_way_shift = 2'b0;
+    localparam  c_tri_way__0 = 2'b0;
+    localparam  c_tri_way__1 = 2'b1;
+    localparam  c_tri_way__2 = 2'b10;
+    localparam  c_tri_way__3 = 2'b11;
+    localparam  c_tri_way_used__0 = 1'b1;
+    localparam  c_tri_way_used__1 = 1'b0;
+    localparam  c_tri_way_used__2 = 1'b0;
+    localparam  c_tri_way_used__3 = 1'b0;
     localparam  c_primary = 16'h4000;
     localparam  c_ml_last = 4'h1;
     localparam  c_index__0 = 4'h0;
@@ -26788,13 +26798,34 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  cache_ready__d;
     wire  cache_ready__q;
     reg  cache_ready__clock;
-    reg  [8:0] cache_tag__read_address;
-    reg  cache_tag__read_clock;
-    wire  [24:0] cache_tag__read_data;
-    reg  [8:0] cache_tag__write_address;
-    reg  cache_tag__write_clock;
-    reg  [24:0] cache_tag__write_data;
-    reg  cache_tag__write_enable;
+    reg  [8:0] cache_tag__0__read_address;
+    reg  cache_tag__0__read_clock;
+    wire  [24:0] cache_tag__0__read_data;
+    reg  [8:0] cache_tag__0__write_address;
+    reg  cache_tag__0__write_clock;
+    reg  [24:0] cache_tag__0__write_data;
+    reg  cache_tag__0__write_enable;
+    reg  [8:0] cache_tag__1__read_address;
+    reg  cache_tag__1__read_clock;
+    wire  [24:0] cache_tag__1__read_data;
+    reg  [8:0] cache_tag__1__write_address;
+    reg  cache_tag__1__write_clock;
+    reg  [24:0] cache_tag__1__write_data;
+    reg  cache_tag__1__write_enable;
+    reg  [8:0] cache_tag__2__read_address;
+    reg  cache_tag__2__read_clock;
+    wire  [24:0] cache_tag__2__read_data;
+    reg  [8:0] cache_tag__2__write_address;
+    reg  cache_tag__2__write_clock;
+    reg  [24:0] cache_tag__2__write_data;
+    reg  cache_tag__2__write_enable;
+    reg  [8:0] cache_tag__3__read_address;
+    reg  cache_tag__3__read_clock;
+    wire  [24:0] cache_tag__3__read_data;
+    reg  [8:0] cache_tag__3__write_address;
+    reg  cache_tag__3__write_clock;
+    reg  [24:0] cache_tag__3__write_data;
+    reg  cache_tag__3__write_enable;
     reg  [8:0] cache_words__0__read_address;
     reg  cache_words__0__read_clock;
     wire  [23:0] cache_words__0__read_data;
@@ -26879,6 +26910,21 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  cache_words__11__write_clock;
     reg  [23:0] cache_words__11__write_data;
     reg  cache_words__11__write_enable;
+    reg  [1:0] cached_way__0__d;
+    wire  [1:0] cached_way__0__q;
+    reg  cached_way__0__clock;
+    reg  [1:0] cached_way__1__d;
+    wire  [1:0] cached_way__1__q;
+    reg  cached_way__1__clock;
+    reg  [1:0] cached_way__2__d;
+    wire  [1:0] cached_way__2__q;
+    reg  cached_way__2__clock;
+    reg  [1:0] cached_way__3__d;
+    wire  [1:0] cached_way__3__q;
+    reg  cached_way__3__clock;
+    reg  [1:0] fill_way__d;
+    wire  [1:0] fill_way__q;
+    reg  fill_way__clock;
     reg  cached__0__d;
     wire  cached__0__q;
     reg  cached__0__clock;
@@ -26954,12 +27000,24 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  origin_clash__d;
     wire  origin_clash__q;
     reg  origin_clash__clock;
-    reg  [24:0] tag_word_r__d;
-    wire  [24:0] tag_word_r__q;
-    reg  tag_word_r__clock;
+    reg  [24:0] tag_word_r__0__d;
+    wire  [24:0] tag_word_r__0__q;
+    reg  tag_word_r__0__clock;
+    reg  [24:0] tag_word_r__1__d;
+    wire  [24:0] tag_word_r__1__q;
+    reg  tag_word_r__1__clock;
+    reg  [24:0] tag_word_r__2__d;
+    wire  [24:0] tag_word_r__2__q;
+    reg  tag_word_r__2__clock;
+    reg  [24:0] tag_word_r__3__d;
+    wire  [24:0] tag_word_r__3__q;
+    reg  tag_word_r__3__clock;
     reg  head_hit_r__d;
     wire  head_hit_r__q;
     reg  head_hit_r__clock;
+    reg  [1:0] head_way_r__d;
+    wire  [1:0] head_way_r__q;
+    reg  head_way_r__clock;
     reg  cache_write_r__d;
     wire  cache_write_r__q;
     reg  cache_write_r__clock;
@@ -27221,12 +27279,18 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  next_origin;
     reg  [8:0] next_set;
     reg  head_hit;
+    reg  [1:0] head_way;
     reg  l_pending;
     reg  n_pending;
     reg  l_cached;
     reg  [8:0] l_set;
     reg  n_cached;
     reg  [8:0] n_set;
+    reg  [1:0] l_way;
+    reg  [1:0] n_way;
+    reg  [8:0] l_line;
+    reg  [8:0] n_line;
+    reg  [8:0] fill_line;
     reg  cache_write;
     reg  cache_block;
     reg  head_clash;
@@ -27748,14 +27812,41 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(cache_ready__q),
         .clock(cache_ready__clock)
     );
-    dynrt_processor__engine__tester__cache_tag cache_tag(
-        .read_address(cache_tag__read_address),
-        .read_clock(cache_tag__read_clock),
-        .read_data(cache_tag__read_data),
-        .write_address(cache_tag__write_address),
-        .write_clock(cache_tag__write_clock),
-        .write_data(cache_tag__write_data),
-        .write_enable(cache_tag__write_enable)
+    dynrt_processor__engine__tester__cache_tag__0 cache_tag__0(
+        .read_address(cache_tag__0__read_address),
+        .read_clock(cache_tag__0__read_clock),
+        .read_data(cache_tag__0__read_data),
+        .write_address(cache_tag__0__write_address),
+        .write_clock(cache_tag__0__write_clock),
+        .write_data(cache_tag__0__write_data),
+        .write_enable(cache_tag__0__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_tag__0 cache_tag__1(
+        .read_address(cache_tag__1__read_address),
+        .read_clock(cache_tag__1__read_clock),
+        .read_data(cache_tag__1__read_data),
+        .write_address(cache_tag__1__write_address),
+        .write_clock(cache_tag__1__write_clock),
+        .write_data(cache_tag__1__write_data),
+        .write_enable(cache_tag__1__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_tag__0 cache_tag__2(
+        .read_address(cache_tag__2__read_address),
+        .read_clock(cache_tag__2__read_clock),
+        .read_data(cache_tag__2__read_data),
+        .write_address(cache_tag__2__write_address),
+        .write_clock(cache_tag__2__write_clock),
+        .write_data(cache_tag__2__write_data),
+        .write_enable(cache_tag__2__write_enable)
+    );
+    dynrt_processor__engine__tester__cache_tag__0 cache_tag__3(
+        .read_address(cache_tag__3__read_address),
+        .read_clock(cache_tag__3__read_clock),
+        .read_data(cache_tag__3__read_data),
+        .write_address(cache_tag__3__write_address),
+        .write_clock(cache_tag__3__write_clock),
+        .write_data(cache_tag__3__write_data),
+        .write_enable(cache_tag__3__write_enable)
     );
     dynrt_processor__engine__instances__cache_words__0 cache_words__0(
         .read_address(cache_words__0__read_address),
@@ -27864,6 +27955,31 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .write_clock(cache_words__11__write_clock),
         .write_data(cache_words__11__write_data),
         .write_enable(cache_words__11__write_enable)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 cached_way__0(
+        .d(cached_way__0__d),
+        .q(cached_way__0__q),
+        .clock(cached_way__0__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 cached_way__1(
+        .d(cached_way__1__d),
+        .q(cached_way__1__q),
+        .clock(cached_way__1__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 cached_way__2(
+        .d(cached_way__2__d),
+        .q(cached_way__2__q),
+        .clock(cached_way__2__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 cached_way__3(
+        .d(cached_way__3__d),
+        .q(cached_way__3__q),
+        .clock(cached_way__3__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 fill_way(
+        .d(fill_way__d),
+        .q(fill_way__q),
+        .clock(fill_way__clock)
     );
     dynrt_processor__display__dark_d cached__0(
         .d(cached__0__d),
@@ -27990,15 +28106,35 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(origin_clash__q),
         .clock(origin_clash__clock)
     );
-    dynrt_processor__engine__tester__tag_word_r tag_word_r(
-        .d(tag_word_r__d),
-        .q(tag_word_r__q),
-        .clock(tag_word_r__clock)
+    dynrt_processor__engine__tester__tag_word_r__0 tag_word_r__0(
+        .d(tag_word_r__0__d),
+        .q(tag_word_r__0__q),
+        .clock(tag_word_r__0__clock)
+    );
+    dynrt_processor__engine__tester__tag_word_r__0 tag_word_r__1(
+        .d(tag_word_r__1__d),
+        .q(tag_word_r__1__q),
+        .clock(tag_word_r__1__clock)
+    );
+    dynrt_processor__engine__tester__tag_word_r__0 tag_word_r__2(
+        .d(tag_word_r__2__d),
+        .q(tag_word_r__2__q),
+        .clock(tag_word_r__2__clock)
+    );
+    dynrt_processor__engine__tester__tag_word_r__0 tag_word_r__3(
+        .d(tag_word_r__3__d),
+        .q(tag_word_r__3__q),
+        .clock(tag_word_r__3__clock)
     );
     dynrt_processor__display__dark_d head_hit_r(
         .d(head_hit_r__d),
         .q(head_hit_r__q),
         .clock(head_hit_r__clock)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 head_way_r(
+        .d(head_way_r__d),
+        .q(head_way_r__q),
+        .clock(head_way_r__clock)
     );
     dynrt_processor__display__dark_d cache_write_r(
         .d(cache_write_r__d),
@@ -28391,8 +28527,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         origin_clash__clock = clock;
         head_clash_rr__clock = clock;
         head_clash_rrr__clock = clock;
-        tag_word_r__clock = clock;
         head_hit_r__clock = clock;
+        head_way_r__clock = clock;
+        fill_way__clock = clock;
         a_issued__clock = clock;
         b_issued__clock = clock;
         seq__clock = clock;
@@ -28446,8 +28583,9 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         origin_clash__d = origin_clash__q;
         head_clash_rr__d = head_clash_rr__q;
         head_clash_rrr__d = head_clash_rrr__q;
-        tag_word_r__d = tag_word_r__q;
         head_hit_r__d = head_hit_r__q;
+        head_way_r__d = head_way_r__q;
+        fill_way__d = fill_way__q;
         a_issued__d = a_issued__q;
         b_issued__d = b_issued__q;
         seq__d = seq__q;
@@ -28599,8 +28737,22 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         words__11__read_address = words_buffer__q;
         matrix__11__clock = clock;
         matrix__11__d = matrix__11__q;
-        cache_tag__write_clock = clock;
-        cache_tag__read_clock = clock;
+        cache_tag__0__write_clock = clock;
+        cache_tag__0__read_clock = clock;
+        tag_word_r__0__clock = clock;
+        tag_word_r__0__d = tag_word_r__0__q;
+        cache_tag__1__write_clock = clock;
+        cache_tag__1__read_clock = clock;
+        tag_word_r__1__clock = clock;
+        tag_word_r__1__d = tag_word_r__1__q;
+        cache_tag__2__write_clock = clock;
+        cache_tag__2__read_clock = clock;
+        tag_word_r__2__clock = clock;
+        tag_word_r__2__d = tag_word_r__2__q;
+        cache_tag__3__write_clock = clock;
+        cache_tag__3__read_clock = clock;
+        tag_word_r__3__clock = clock;
+        tag_word_r__3__d = tag_word_r__3__q;
         cache_words__0__read_clock = clock;
         cache_words__0__write_clock = clock;
         cache_words__1__read_clock = clock;
@@ -28627,6 +28779,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cache_words__11__write_clock = clock;
         cached__0__clock = clock;
         cached__0__d = cached__0__q;
+        cached_way__0__clock = clock;
+        cached_way__0__d = cached_way__0__q;
         fresh__0__clock = clock;
         comparing__0__clock = clock;
         deciding__0__clock = clock;
@@ -28647,6 +28801,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         received__0__d = received__0__q;
         cached__1__clock = clock;
         cached__1__d = cached__1__q;
+        cached_way__1__clock = clock;
+        cached_way__1__d = cached_way__1__q;
         fresh__1__clock = clock;
         comparing__1__clock = clock;
         deciding__1__clock = clock;
@@ -28667,6 +28823,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         received__1__d = received__1__q;
         cached__2__clock = clock;
         cached__2__d = cached__2__q;
+        cached_way__2__clock = clock;
+        cached_way__2__d = cached_way__2__q;
         fresh__2__clock = clock;
         comparing__2__clock = clock;
         deciding__2__clock = clock;
@@ -28687,6 +28845,8 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         received__2__d = received__2__q;
         cached__3__clock = clock;
         cached__3__d = cached__3__q;
+        cached_way__3__clock = clock;
+        cached_way__3__d = cached_way__3__q;
         fresh__3__clock = clock;
         comparing__3__clock = clock;
         deciding__3__clock = clock;
@@ -28774,6 +28934,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         l_loaded = loaded__0__q;
         l_received = received__0__q;
         l_cached = cached__0__q;
+        l_way = cached_way__0__q;
         l_pending = lookup_pending__0;
         if (lb__q == c_buffer__1) begin
             l_kind = cur_kind__1__q;
@@ -28783,6 +28944,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__1__q;
             l_received = received__1__q;
             l_cached = cached__1__q;
+            l_way = cached_way__1__q;
             l_pending = lookup_pending__1;
         end
         if (lb__q == c_buffer__2) begin
@@ -28793,6 +28955,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__2__q;
             l_received = received__2__q;
             l_cached = cached__2__q;
+            l_way = cached_way__2__q;
             l_pending = lookup_pending__2;
         end
         if (lb__q == c_buffer__3) begin
@@ -28803,6 +28966,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             l_loaded = loaded__3__q;
             l_received = received__3__q;
             l_cached = cached__3__q;
+            l_way = cached_way__3__q;
             l_pending = lookup_pending__3;
         end
         l_ready = l_loaded & ((l_kind != c_test_triangle) | (l_received == 32'hc) | (l_cached & cache_ready__q));
@@ -28811,6 +28975,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         n_kind = cur_kind__0__q;
         n_received = received__0__q;
         n_cached = cached__0__q;
+        n_way = cached_way__0__q;
         n_pending = lookup_pending__0;
         n_set = cur_a__0__q[(32'h0)+:(9)] & c_set_mask;
         if (lb__q + 32'h1 == c_buffer__1) begin
@@ -28819,6 +28984,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__1__q;
             n_received = received__1__q;
             n_cached = cached__1__q;
+            n_way = cached_way__1__q;
             n_pending = lookup_pending__1;
             n_set = cur_a__1__q[(32'h0)+:(9)] & c_set_mask;
         end
@@ -28828,6 +28994,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__2__q;
             n_received = received__2__q;
             n_cached = cached__2__q;
+            n_way = cached_way__2__q;
             n_pending = lookup_pending__2;
             n_set = cur_a__2__q[(32'h0)+:(9)] & c_set_mask;
         end
@@ -28837,6 +29004,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
             n_kind = cur_kind__3__q;
             n_received = received__3__q;
             n_cached = cached__3__q;
+            n_way = cached_way__3__q;
             n_pending = lookup_pending__3;
             n_set = cur_a__3__q[(32'h0)+:(9)] & c_set_mask;
         end
@@ -28857,100 +29025,118 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         end
         cache_write = c_cache_on & (lphase__q == Launch__Origin) & (l_kind == c_test_triangle) & (~l_cached) & (~cache_block);
         cache_write_r__d = cache_write;
-        cache_tag__write_address = l_set;
-        cache_tag__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
-        cache_tag__write_enable = cache_write_r__q;
+        cache_tag__0__write_address = l_set;
+        cache_tag__0__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
+        cache_tag__0__write_enable = c_tri_way_used__0 & cache_write_r__q & (fill_way__q == c_tri_way__0);
+        cache_tag__1__write_address = l_set;
+        cache_tag__1__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
+        cache_tag__1__write_enable = c_tri_way_used__1 & cache_write_r__q & (fill_way__q == c_tri_way__1);
+        cache_tag__2__write_address = l_set;
+        cache_tag__2__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
+        cache_tag__2__write_enable = c_tri_way_used__2 & cache_write_r__q & (fill_way__q == c_tri_way__2);
+        cache_tag__3__write_address = l_set;
+        cache_tag__3__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
+        cache_tag__3__write_enable = c_tri_way_used__3 & cache_write_r__q & (fill_way__q == c_tri_way__3);
+        if (cache_write_r__q) begin
+            fill_way__d = (fill_way__q + 32'h1) & c_tri_way_mask;
+        end
+        l_line = (l_set << c_tri_way_shift) | ((l_way) & 9'h1ff);
+        n_line = (n_set << c_tri_way_shift) | ((n_way) & 9'h1ff);
+        fill_line = (l_set << c_tri_way_shift) | ((fill_way__q) & 9'h1ff);
         cache_ready__d = l_loaded & (~l_pending);
         if (lphase__q != Launch__Wait) begin
             cache_ready__d = n_loaded & (~n_pending);
         end
-        cache_words__0__write_address = l_set;
+        cache_words__0__write_address = fill_line;
         cache_words__0__write_data = matrix__0__q;
         cache_words__0__write_enable = cache_write_r__q;
-        cache_words__0__read_address = l_set;
+        cache_words__0__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__0__read_address = n_set;
+            cache_words__0__read_address = n_line;
         end
-        cache_words__1__write_address = l_set;
+        cache_words__1__write_address = fill_line;
         cache_words__1__write_data = matrix__1__q;
         cache_words__1__write_enable = cache_write_r__q;
-        cache_words__1__read_address = l_set;
+        cache_words__1__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__1__read_address = n_set;
+            cache_words__1__read_address = n_line;
         end
-        cache_words__2__write_address = l_set;
+        cache_words__2__write_address = fill_line;
         cache_words__2__write_data = matrix__2__q;
         cache_words__2__write_enable = cache_write_r__q;
-        cache_words__2__read_address = l_set;
+        cache_words__2__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__2__read_address = n_set;
+            cache_words__2__read_address = n_line;
         end
-        cache_words__3__write_address = l_set;
+        cache_words__3__write_address = fill_line;
         cache_words__3__write_data = matrix__3__q;
         cache_words__3__write_enable = cache_write_r__q;
-        cache_words__3__read_address = l_set;
+        cache_words__3__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__3__read_address = n_set;
+            cache_words__3__read_address = n_line;
         end
-        cache_words__4__write_address = l_set;
+        cache_words__4__write_address = fill_line;
         cache_words__4__write_data = matrix__4__q;
         cache_words__4__write_enable = cache_write_r__q;
-        cache_words__4__read_address = l_set;
+        cache_words__4__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__4__read_address = n_set;
+            cache_words__4__read_address = n_line;
         end
-        cache_words__5__write_address = l_set;
+        cache_words__5__write_address = fill_line;
         cache_words__5__write_data = matrix__5__q;
         cache_words__5__write_enable = cache_write_r__q;
-        cache_words__5__read_address = l_set;
+        cache_words__5__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__5__read_address = n_set;
+            cache_words__5__read_address = n_line;
         end
-        cache_words__6__write_address = l_set;
+        cache_words__6__write_address = fill_line;
         cache_words__6__write_data = matrix__6__q;
         cache_words__6__write_enable = cache_write_r__q;
-        cache_words__6__read_address = l_set;
+        cache_words__6__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__6__read_address = n_set;
+            cache_words__6__read_address = n_line;
         end
-        cache_words__7__write_address = l_set;
+        cache_words__7__write_address = fill_line;
         cache_words__7__write_data = matrix__7__q;
         cache_words__7__write_enable = cache_write_r__q;
-        cache_words__7__read_address = l_set;
+        cache_words__7__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__7__read_address = n_set;
+            cache_words__7__read_address = n_line;
         end
-        cache_words__8__write_address = l_set;
+        cache_words__8__write_address = fill_line;
         cache_words__8__write_data = matrix__8__q;
         cache_words__8__write_enable = cache_write_r__q;
-        cache_words__8__read_address = l_set;
+        cache_words__8__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__8__read_address = n_set;
+            cache_words__8__read_address = n_line;
         end
-        cache_words__9__write_address = l_set;
+        cache_words__9__write_address = fill_line;
         cache_words__9__write_data = matrix__9__q;
         cache_words__9__write_enable = cache_write_r__q;
-        cache_words__9__read_address = l_set;
+        cache_words__9__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__9__read_address = n_set;
+            cache_words__9__read_address = n_line;
         end
-        cache_words__10__write_address = l_set;
+        cache_words__10__write_address = fill_line;
         cache_words__10__write_data = matrix__10__q;
         cache_words__10__write_enable = cache_write_r__q;
-        cache_words__10__read_address = l_set;
+        cache_words__10__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__10__read_address = n_set;
+            cache_words__10__read_address = n_line;
         end
-        cache_words__11__write_address = l_set;
+        cache_words__11__write_address = fill_line;
         cache_words__11__write_data = matrix__11__q;
         cache_words__11__write_enable = cache_write_r__q;
-        cache_words__11__read_address = l_set;
+        cache_words__11__read_address = l_line;
         if (lphase__q != Launch__Wait) begin
-            cache_words__11__read_address = n_set;
+            cache_words__11__read_address = n_line;
         end
         head_triangle = list_unit__test_entry[(32'h20)+:(24)];
         head_set = head_triangle[(32'h0)+:(9)] & c_set_mask;
-        cache_tag__read_address = head_set;
+        cache_tag__0__read_address = head_set;
+        cache_tag__1__read_address = head_set;
+        cache_tag__2__read_address = head_set;
+        cache_tag__3__read_address = head_set;
         head_clash = ((lphase__q == Launch__Origin) | cache_write_r__q) & (l_set == head_set);
         head_triangle_r__d = head_triangle;
         head_triangle_rr__d = head_triangle_r__q;
@@ -28966,9 +29152,30 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_clash_r__d = head_clash;
         head_clash_rr__d = head_clash_r__q | ((lphase__q == Launch__Origin) & (l_set == head_set_r__q));
         head_clash_rrr__d = head_clash_rr__q | ((lphase__q == Launch__Origin) & (l_set == head_set_rr__q));
-        tag_word_r__d = cache_tag__read_data;
-        head_hit = c_cache_on & (tag_word_r__q == (c_tag_valid | ((head_triangle_rr__q) & 25'h1ffffff)));
+        head_hit = 1'b0;
+        head_way = 32'h0;
+        tag_word_r__0__d = cache_tag__0__read_data;
+        if (c_tri_way_used__0 & (tag_word_r__0__q == (c_tag_valid | ((head_triangle_rr__q) & 25'h1ffffff)))) begin
+            head_hit = c_cache_on;
+            head_way = c_tri_way__0;
+        end
+        tag_word_r__1__d = cache_tag__1__read_data;
+        if (c_tri_way_used__1 & (tag_word_r__1__q == (c_tag_valid | ((head_triangle_rr__q) & 25'h1ffffff)))) begin
+            head_hit = c_cache_on;
+            head_way = c_tri_way__1;
+        end
+        tag_word_r__2__d = cache_tag__2__read_data;
+        if (c_tri_way_used__2 & (tag_word_r__2__q == (c_tag_valid | ((head_triangle_rr__q) & 25'h1ffffff)))) begin
+            head_hit = c_cache_on;
+            head_way = c_tri_way__2;
+        end
+        tag_word_r__3__d = cache_tag__3__read_data;
+        if (c_tri_way_used__3 & (tag_word_r__3__q == (c_tag_valid | ((head_triangle_rr__q) & 25'h1ffffff)))) begin
+            head_hit = c_cache_on;
+            head_way = c_tri_way__3;
+        end
         head_hit_r__d = head_hit;
+        head_way_r__d = head_way;
         tb_free = ~loaded__0__q;
         if (tb__q == c_buffer__1) begin
             tb_free = ~loaded__1__q;
@@ -29032,24 +29239,28 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         comparing__0__d = fresh__0__q;
         deciding__0__d = comparing__0__q;
         if (deciding__0__q) begin
+            cached_way__0__d = head_way_r__q;
             cached__0__d = head_hit_r__q & (~head_clash_rrr__q) & (~origin_clash__q) & (cur_kind__0__q == c_test_triangle);
         end
         fresh__1__d = take & (tb__q == c_buffer__1);
         comparing__1__d = fresh__1__q;
         deciding__1__d = comparing__1__q;
         if (deciding__1__q) begin
+            cached_way__1__d = head_way_r__q;
             cached__1__d = head_hit_r__q & (~head_clash_rrr__q) & (~origin_clash__q) & (cur_kind__1__q == c_test_triangle);
         end
         fresh__2__d = take & (tb__q == c_buffer__2);
         comparing__2__d = fresh__2__q;
         deciding__2__d = comparing__2__q;
         if (deciding__2__q) begin
+            cached_way__2__d = head_way_r__q;
             cached__2__d = head_hit_r__q & (~head_clash_rrr__q) & (~origin_clash__q) & (cur_kind__2__q == c_test_triangle);
         end
         fresh__3__d = take & (tb__q == c_buffer__3);
         comparing__3__d = fresh__3__q;
         deciding__3__d = comparing__3__q;
         if (deciding__3__q) begin
+            cached_way__3__d = head_way_r__q;
             cached__3__d = head_hit_r__q & (~head_clash_rrr__q) & (~origin_clash__q) & (cur_kind__3__q == c_test_triangle);
         end
         a_take = fetching__q & (a_issued__q < 32'h6) & ((engine__load_banks & c_bank_a) == 32'h0);
@@ -29614,7 +29825,7 @@ endmodule // dynrt_processor__engine__tester__best_e
 
 
 
-module dynrt_processor__engine__tester__cache_tag(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__tester__cache_tag__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [8:0] read_address;
@@ -30154,7 +30365,21 @@ module dynrt_processor__engine__tester__cache_tag(read_address,read_clock,read_d
        end
     end
                 
-endmodule // dynrt_processor__engine__tester__cache_tag
+endmodule // dynrt_processor__engine__tester__cache_tag__0
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -30328,6 +30553,8 @@ endmodule // dynrt_processor__engine__tester__done_e
 
 
 
+
+
 module dynrt_processor__engine__tester__flight_t_min(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
@@ -30355,6 +30582,8 @@ module dynrt_processor__engine__tester__flight_t_min(read_address,read_clock,rea
     end
                 
 endmodule // dynrt_processor__engine__tester__flight_t_min
+
+
 
 
 
@@ -35503,7 +35732,7 @@ endmodule // dynrt_processor__engine__tester__ray
 
 
 
-module dynrt_processor__engine__tester__tag_word_r(d,q,clock);
+module dynrt_processor__engine__tester__tag_word_r__0(d,q,clock);
     
     // Module arguments
     input wire  [24:0] d;
@@ -35519,7 +35748,13 @@ module dynrt_processor__engine__tester__tag_word_r(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor__engine__tester__tag_word_r
+endmodule // dynrt_processor__engine__tester__tag_word_r__0
+
+
+
+
+
+
 
 
 
@@ -38590,6 +38825,15 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     localparam  c_node_set_mask = 9'b111111111;
     localparam  c_node_cache_on = 1'b1;
     localparam  c_node_tag_valid = 27'h4000000;
+    localparam  c_node_way_mask = 2'b0;
+    localparam  c_node_way__0 = 2'b0;
+    localparam  c_node_way__1 = 2'b1;
+    localparam  c_node_way__2 = 2'b10;
+    localparam  c_node_way__3 = 2'b11;
+    localparam  c_node_way_used__0 = 1'b1;
+    localparam  c_node_way_used__1 = 1'b0;
+    localparam  c_node_way_used__2 = 1'b0;
+    localparam  c_node_way_used__3 = 1'b0;
     localparam  c_ml_last = 4'h1;
     localparam  c_index__0 = 4'h0;
     localparam  c_index__1 = 4'h1;
@@ -39007,32 +39251,95 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  look_stale__d;
     wire  look_stale__q;
     reg  look_stale__clock;
-    reg  [26:0] tag_word_r__d;
-    wire  [26:0] tag_word_r__q;
-    reg  tag_word_r__clock;
-    reg  [63:0] words_r__d;
-    wire  [63:0] words_r__q;
-    reg  words_r__clock;
+    reg  [26:0] tag_word_r__0__d;
+    wire  [26:0] tag_word_r__0__q;
+    reg  tag_word_r__0__clock;
+    reg  [26:0] tag_word_r__1__d;
+    wire  [26:0] tag_word_r__1__q;
+    reg  tag_word_r__1__clock;
+    reg  [26:0] tag_word_r__2__d;
+    wire  [26:0] tag_word_r__2__q;
+    reg  tag_word_r__2__clock;
+    reg  [26:0] tag_word_r__3__d;
+    wire  [26:0] tag_word_r__3__q;
+    reg  tag_word_r__3__clock;
+    reg  [63:0] words_r__0__d;
+    wire  [63:0] words_r__0__q;
+    reg  words_r__0__clock;
+    reg  [63:0] words_r__1__d;
+    wire  [63:0] words_r__1__q;
+    reg  words_r__1__clock;
+    reg  [63:0] words_r__2__d;
+    wire  [63:0] words_r__2__q;
+    reg  words_r__2__clock;
+    reg  [63:0] words_r__3__d;
+    wire  [63:0] words_r__3__q;
+    reg  words_r__3__clock;
     reg  stale_r__d;
     wire  stale_r__q;
     reg  stale_r__clock;
     reg  look_ready__d;
     wire  look_ready__q;
     reg  look_ready__clock;
-    reg  [8:0] cache_tag__read_address;
-    reg  cache_tag__read_clock;
-    wire  [26:0] cache_tag__read_data;
-    reg  [8:0] cache_tag__write_address;
-    reg  cache_tag__write_clock;
-    reg  [26:0] cache_tag__write_data;
-    reg  cache_tag__write_enable;
-    reg  [8:0] cache_words__read_address;
-    reg  cache_words__read_clock;
-    wire  [63:0] cache_words__read_data;
-    reg  [8:0] cache_words__write_address;
-    reg  cache_words__write_clock;
-    reg  [63:0] cache_words__write_data;
-    reg  cache_words__write_enable;
+    reg  [8:0] cache_tag__0__read_address;
+    reg  cache_tag__0__read_clock;
+    wire  [26:0] cache_tag__0__read_data;
+    reg  [8:0] cache_tag__0__write_address;
+    reg  cache_tag__0__write_clock;
+    reg  [26:0] cache_tag__0__write_data;
+    reg  cache_tag__0__write_enable;
+    reg  [8:0] cache_tag__1__read_address;
+    reg  cache_tag__1__read_clock;
+    wire  [26:0] cache_tag__1__read_data;
+    reg  [8:0] cache_tag__1__write_address;
+    reg  cache_tag__1__write_clock;
+    reg  [26:0] cache_tag__1__write_data;
+    reg  cache_tag__1__write_enable;
+    reg  [8:0] cache_tag__2__read_address;
+    reg  cache_tag__2__read_clock;
+    wire  [26:0] cache_tag__2__read_data;
+    reg  [8:0] cache_tag__2__write_address;
+    reg  cache_tag__2__write_clock;
+    reg  [26:0] cache_tag__2__write_data;
+    reg  cache_tag__2__write_enable;
+    reg  [8:0] cache_tag__3__read_address;
+    reg  cache_tag__3__read_clock;
+    wire  [26:0] cache_tag__3__read_data;
+    reg  [8:0] cache_tag__3__write_address;
+    reg  cache_tag__3__write_clock;
+    reg  [26:0] cache_tag__3__write_data;
+    reg  cache_tag__3__write_enable;
+    reg  [8:0] cache_words__0__read_address;
+    reg  cache_words__0__read_clock;
+    wire  [63:0] cache_words__0__read_data;
+    reg  [8:0] cache_words__0__write_address;
+    reg  cache_words__0__write_clock;
+    reg  [63:0] cache_words__0__write_data;
+    reg  cache_words__0__write_enable;
+    reg  [8:0] cache_words__1__read_address;
+    reg  cache_words__1__read_clock;
+    wire  [63:0] cache_words__1__read_data;
+    reg  [8:0] cache_words__1__write_address;
+    reg  cache_words__1__write_clock;
+    reg  [63:0] cache_words__1__write_data;
+    reg  cache_words__1__write_enable;
+    reg  [8:0] cache_words__2__read_address;
+    reg  cache_words__2__read_clock;
+    wire  [63:0] cache_words__2__read_data;
+    reg  [8:0] cache_words__2__write_address;
+    reg  cache_words__2__write_clock;
+    reg  [63:0] cache_words__2__write_data;
+    reg  cache_words__2__write_enable;
+    reg  [8:0] cache_words__3__read_address;
+    reg  cache_words__3__read_clock;
+    wire  [63:0] cache_words__3__read_data;
+    reg  [8:0] cache_words__3__write_address;
+    reg  cache_words__3__write_clock;
+    reg  [63:0] cache_words__3__write_data;
+    reg  cache_words__3__write_enable;
+    reg  [1:0] fill_way__d;
+    wire  [1:0] fill_way__q;
+    reg  fill_way__clock;
     reg  fetch_hit__d;
     wire  fetch_hit__q;
     reg  fetch_hit__clock;
@@ -39189,6 +39496,10 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  look_load;
     reg  look_hit;
     reg  [8:0] read_set;
+    reg  look_way_hit__0;
+    reg  look_way_hit__1;
+    reg  look_way_hit__2;
+    reg  look_way_hit__3;
     reg  hit_now;
     reg  fill;
     reg  [8:0] fill_set;
@@ -39791,15 +40102,45 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(look_stale__q),
         .clock(look_stale__clock)
     );
-    dynrt_processor__engine__traversal_unit__tag_word_r tag_word_r(
-        .d(tag_word_r__d),
-        .q(tag_word_r__q),
-        .clock(tag_word_r__clock)
+    dynrt_processor__engine__traversal_unit__tag_word_r__0 tag_word_r__0(
+        .d(tag_word_r__0__d),
+        .q(tag_word_r__0__q),
+        .clock(tag_word_r__0__clock)
     );
-    dynrt_processor__engine__traversal_unit__data_line__0 words_r(
-        .d(words_r__d),
-        .q(words_r__q),
-        .clock(words_r__clock)
+    dynrt_processor__engine__traversal_unit__tag_word_r__0 tag_word_r__1(
+        .d(tag_word_r__1__d),
+        .q(tag_word_r__1__q),
+        .clock(tag_word_r__1__clock)
+    );
+    dynrt_processor__engine__traversal_unit__tag_word_r__0 tag_word_r__2(
+        .d(tag_word_r__2__d),
+        .q(tag_word_r__2__q),
+        .clock(tag_word_r__2__clock)
+    );
+    dynrt_processor__engine__traversal_unit__tag_word_r__0 tag_word_r__3(
+        .d(tag_word_r__3__d),
+        .q(tag_word_r__3__q),
+        .clock(tag_word_r__3__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 words_r__0(
+        .d(words_r__0__d),
+        .q(words_r__0__q),
+        .clock(words_r__0__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 words_r__1(
+        .d(words_r__1__d),
+        .q(words_r__1__q),
+        .clock(words_r__1__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 words_r__2(
+        .d(words_r__2__d),
+        .q(words_r__2__q),
+        .clock(words_r__2__clock)
+    );
+    dynrt_processor__engine__traversal_unit__data_line__0 words_r__3(
+        .d(words_r__3__d),
+        .q(words_r__3__q),
+        .clock(words_r__3__clock)
     );
     dynrt_processor__display__dark_d stale_r(
         .d(stale_r__d),
@@ -39811,23 +40152,82 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .q(look_ready__q),
         .clock(look_ready__clock)
     );
-    dynrt_processor__engine__traversal_unit__cache_tag cache_tag(
-        .read_address(cache_tag__read_address),
-        .read_clock(cache_tag__read_clock),
-        .read_data(cache_tag__read_data),
-        .write_address(cache_tag__write_address),
-        .write_clock(cache_tag__write_clock),
-        .write_data(cache_tag__write_data),
-        .write_enable(cache_tag__write_enable)
+    dynrt_processor__engine__traversal_unit__cache_tag__0 cache_tag__0(
+        .read_address(cache_tag__0__read_address),
+        .read_clock(cache_tag__0__read_clock),
+        .read_data(cache_tag__0__read_data),
+        .write_address(cache_tag__0__write_address),
+        .write_clock(cache_tag__0__write_clock),
+        .write_data(cache_tag__0__write_data),
+        .write_enable(cache_tag__0__write_enable)
     );
-    dynrt_processor__engine__traversal_unit__cache_words cache_words(
-        .read_address(cache_words__read_address),
-        .read_clock(cache_words__read_clock),
-        .read_data(cache_words__read_data),
-        .write_address(cache_words__write_address),
-        .write_clock(cache_words__write_clock),
-        .write_data(cache_words__write_data),
-        .write_enable(cache_words__write_enable)
+    dynrt_processor__engine__traversal_unit__cache_tag__0 cache_tag__1(
+        .read_address(cache_tag__1__read_address),
+        .read_clock(cache_tag__1__read_clock),
+        .read_data(cache_tag__1__read_data),
+        .write_address(cache_tag__1__write_address),
+        .write_clock(cache_tag__1__write_clock),
+        .write_data(cache_tag__1__write_data),
+        .write_enable(cache_tag__1__write_enable)
+    );
+    dynrt_processor__engine__traversal_unit__cache_tag__0 cache_tag__2(
+        .read_address(cache_tag__2__read_address),
+        .read_clock(cache_tag__2__read_clock),
+        .read_data(cache_tag__2__read_data),
+        .write_address(cache_tag__2__write_address),
+        .write_clock(cache_tag__2__write_clock),
+        .write_data(cache_tag__2__write_data),
+        .write_enable(cache_tag__2__write_enable)
+    );
+    dynrt_processor__engine__traversal_unit__cache_tag__0 cache_tag__3(
+        .read_address(cache_tag__3__read_address),
+        .read_clock(cache_tag__3__read_clock),
+        .read_data(cache_tag__3__read_data),
+        .write_address(cache_tag__3__write_address),
+        .write_clock(cache_tag__3__write_clock),
+        .write_data(cache_tag__3__write_data),
+        .write_enable(cache_tag__3__write_enable)
+    );
+    dynrt_processor__engine__traversal_unit__cache_words__0 cache_words__0(
+        .read_address(cache_words__0__read_address),
+        .read_clock(cache_words__0__read_clock),
+        .read_data(cache_words__0__read_data),
+        .write_address(cache_words__0__write_address),
+        .write_clock(cache_words__0__write_clock),
+        .write_data(cache_words__0__write_data),
+        .write_enable(cache_words__0__write_enable)
+    );
+    dynrt_processor__engine__traversal_unit__cache_words__0 cache_words__1(
+        .read_address(cache_words__1__read_address),
+        .read_clock(cache_words__1__read_clock),
+        .read_data(cache_words__1__read_data),
+        .write_address(cache_words__1__write_address),
+        .write_clock(cache_words__1__write_clock),
+        .write_data(cache_words__1__write_data),
+        .write_enable(cache_words__1__write_enable)
+    );
+    dynrt_processor__engine__traversal_unit__cache_words__0 cache_words__2(
+        .read_address(cache_words__2__read_address),
+        .read_clock(cache_words__2__read_clock),
+        .read_data(cache_words__2__read_data),
+        .write_address(cache_words__2__write_address),
+        .write_clock(cache_words__2__write_clock),
+        .write_data(cache_words__2__write_data),
+        .write_enable(cache_words__2__write_enable)
+    );
+    dynrt_processor__engine__traversal_unit__cache_words__0 cache_words__3(
+        .read_address(cache_words__3__read_address),
+        .read_clock(cache_words__3__read_clock),
+        .read_data(cache_words__3__read_data),
+        .write_address(cache_words__3__write_address),
+        .write_clock(cache_words__3__write_clock),
+        .write_data(cache_words__3__write_data),
+        .write_enable(cache_words__3__write_enable)
+    );
+    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 fill_way(
+        .d(fill_way__d),
+        .q(fill_way__q),
+        .clock(fill_way__clock)
     );
     dynrt_processor__display__dark_d fetch_hit(
         .d(fetch_hit__d),
@@ -40076,8 +40476,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         look_valid__clock = clock;
         look_job__clock = clock;
         look_stale__clock = clock;
-        tag_word_r__clock = clock;
-        words_r__clock = clock;
+        fill_way__clock = clock;
         stale_r__clock = clock;
         look_ready__clock = clock;
         fetch_hit__clock = clock;
@@ -40141,8 +40540,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         look_valid__d = look_valid__q;
         look_job__d = look_job__q;
         look_stale__d = look_stale__q;
-        tag_word_r__d = tag_word_r__q;
-        words_r__d = words_r__q;
+        fill_way__d = fill_way__q;
         stale_r__d = stale_r__q;
         look_ready__d = look_ready__q;
         fetch_hit__d = fetch_hit__q;
@@ -40201,10 +40599,38 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         stack_lo__write_clock = clock;
         stack_hi__read_clock = clock;
         stack_hi__write_clock = clock;
-        cache_tag__read_clock = clock;
-        cache_tag__write_clock = clock;
-        cache_words__read_clock = clock;
-        cache_words__write_clock = clock;
+        cache_tag__0__read_clock = clock;
+        cache_tag__0__write_clock = clock;
+        cache_words__0__read_clock = clock;
+        cache_words__0__write_clock = clock;
+        tag_word_r__0__clock = clock;
+        words_r__0__clock = clock;
+        tag_word_r__0__d = tag_word_r__0__q;
+        words_r__0__d = words_r__0__q;
+        cache_tag__1__read_clock = clock;
+        cache_tag__1__write_clock = clock;
+        cache_words__1__read_clock = clock;
+        cache_words__1__write_clock = clock;
+        tag_word_r__1__clock = clock;
+        words_r__1__clock = clock;
+        tag_word_r__1__d = tag_word_r__1__q;
+        words_r__1__d = words_r__1__q;
+        cache_tag__2__read_clock = clock;
+        cache_tag__2__write_clock = clock;
+        cache_words__2__read_clock = clock;
+        cache_words__2__write_clock = clock;
+        tag_word_r__2__clock = clock;
+        words_r__2__clock = clock;
+        tag_word_r__2__d = tag_word_r__2__q;
+        words_r__2__d = words_r__2__q;
+        cache_tag__3__read_clock = clock;
+        cache_tag__3__write_clock = clock;
+        cache_words__3__read_clock = clock;
+        cache_words__3__write_clock = clock;
+        tag_word_r__3__clock = clock;
+        words_r__3__clock = clock;
+        tag_word_r__3__d = tag_word_r__3__q;
+        words_r__3__d = words_r__3__q;
         node_line__0__clock = clock;
         data_line__0__clock = clock;
         node_line__1__clock = clock;
@@ -40413,10 +40839,32 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         loop_fifo__read = 1'b0;
         front_fifo__read = 1'b0;
         in_flight__read = 1'b0;
-        tag_word_r__d = cache_tag__read_data;
-        words_r__d = cache_words__read_data;
         stale_r__d = look_stale__q;
-        look_hit = c_node_cache_on & look_ready__q & (~look_job__q[32'h66]) & (~stale_r__q) & (tag_word_r__q == (c_node_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
+        look_hit = 1'b0;
+        tag_word_r__0__d = cache_tag__0__read_data;
+        words_r__0__d = cache_words__0__read_data;
+        look_way_hit__0 = c_node_way_used__0 & (tag_word_r__0__q == (c_node_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
+        if (look_way_hit__0) begin
+            look_hit = c_node_cache_on & look_ready__q & (~look_job__q[32'h66]) & (~stale_r__q);
+        end
+        tag_word_r__1__d = cache_tag__1__read_data;
+        words_r__1__d = cache_words__1__read_data;
+        look_way_hit__1 = c_node_way_used__1 & (tag_word_r__1__q == (c_node_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
+        if (look_way_hit__1) begin
+            look_hit = c_node_cache_on & look_ready__q & (~look_job__q[32'h66]) & (~stale_r__q);
+        end
+        tag_word_r__2__d = cache_tag__2__read_data;
+        words_r__2__d = cache_words__2__read_data;
+        look_way_hit__2 = c_node_way_used__2 & (tag_word_r__2__q == (c_node_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
+        if (look_way_hit__2) begin
+            look_hit = c_node_cache_on & look_ready__q & (~look_job__q[32'h66]) & (~stale_r__q);
+        end
+        tag_word_r__3__d = cache_tag__3__read_data;
+        words_r__3__d = cache_words__3__read_data;
+        look_way_hit__3 = c_node_way_used__3 & (tag_word_r__3__q == (c_node_tag_valid | ((look_job__q[(32'h40)+:(26)]) & 27'h7ffffff)));
+        if (look_way_hit__3) begin
+            look_hit = c_node_cache_on & look_ready__q & (~look_job__q[32'h66]) & (~stale_r__q);
+        end
         hit_now = (phase__q == Fetch__Word0) & fetch_hit__q;
         take = (phase__q != Fetch__Idle) & (~hit_now) & ((engine__load_banks & c_bank_nodes) == 32'h0);
         nodes__read = take | ((engine__load_banks & c_bank_nodes) != 32'h0);
@@ -40500,7 +40948,16 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
                 look_move = 1'b1;
                 fetch_job__d = look_job__q;
                 fetch_hit__d = look_hit;
-                fetch_words__d = words_r__q;
+                fetch_words__d = words_r__0__q;
+                if (look_way_hit__1) begin
+                    fetch_words__d = words_r__1__q;
+                end
+                if (look_way_hit__2) begin
+                    fetch_words__d = words_r__2__q;
+                end
+                if (look_way_hit__3) begin
+                    fetch_words__d = words_r__3__q;
+                end
                 phase__d = Fetch__Word0;
             end
             else if ((phase__q == Fetch__Idle) & in_flight__empty) begin
@@ -40531,8 +40988,14 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
                 read_set = front_fifo__data_out[(32'h40)+:(9)] & c_node_set_mask;
             end
         end
-        cache_tag__read_address = read_set;
-        cache_words__read_address = read_set;
+        cache_tag__0__read_address = read_set;
+        cache_words__0__read_address = read_set;
+        cache_tag__1__read_address = read_set;
+        cache_words__1__read_address = read_set;
+        cache_tag__2__read_address = read_set;
+        cache_words__2__read_address = read_set;
+        cache_tag__3__read_address = read_set;
+        cache_words__3__read_address = read_set;
         ray__ray_thread = in_flight__data_out[(32'h60)+:(5)];
         world__ray_thread = in_flight__data_out[(32'h60)+:(5)];
         at_a = words_in__q == 32'h1;
@@ -40611,12 +41074,33 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         done_thread_r__d = job__q[(32'h60)+:(5)];
         fill = c_node_cache_on & at_a & a_fetched__q & (~job__q[32'h66]);
         fill_set = job__q[(32'h40)+:(9)] & c_node_set_mask;
-        cache_tag__write_address = fill_set;
-        cache_tag__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
-        cache_tag__write_enable = fill;
-        cache_words__write_address = fill_set;
-        cache_words__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
-        cache_words__write_enable = fill;
+        cache_tag__0__write_address = fill_set;
+        cache_tag__0__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
+        cache_tag__0__write_enable = c_node_way_used__0 & fill & (fill_way__q == c_node_way__0);
+        cache_words__0__write_address = fill_set;
+        cache_words__0__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
+        cache_words__0__write_enable = cache_tag__0__write_enable;
+        cache_tag__1__write_address = fill_set;
+        cache_tag__1__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
+        cache_tag__1__write_enable = c_node_way_used__1 & fill & (fill_way__q == c_node_way__1);
+        cache_words__1__write_address = fill_set;
+        cache_words__1__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
+        cache_words__1__write_enable = cache_tag__1__write_enable;
+        cache_tag__2__write_address = fill_set;
+        cache_tag__2__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
+        cache_tag__2__write_enable = c_node_way_used__2 & fill & (fill_way__q == c_node_way__2);
+        cache_words__2__write_address = fill_set;
+        cache_words__2__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
+        cache_words__2__write_enable = cache_tag__2__write_enable;
+        cache_tag__3__write_address = fill_set;
+        cache_tag__3__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
+        cache_tag__3__write_enable = c_node_way_used__3 & fill & (fill_way__q == c_node_way__3);
+        cache_words__3__write_address = fill_set;
+        cache_words__3__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
+        cache_words__3__write_enable = cache_tag__3__write_enable;
+        if (fill) begin
+            fill_way__d = (fill_way__q + 32'h1) & c_node_way_mask;
+        end
         look_stale__d = fill & (fill_set == read_set);
         engine__done = done_r__q;
         engine__done_thread = done_thread_r__q;
@@ -40731,7 +41215,7 @@ module dynrt_processor__engine__traversal_unit__any_hit(read_address,read_clock,
 endmodule // dynrt_processor__engine__traversal_unit__any_hit
 
 
-module dynrt_processor__engine__traversal_unit__cache_tag(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__traversal_unit__cache_tag__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [8:0] read_address;
@@ -41271,10 +41755,16 @@ module dynrt_processor__engine__traversal_unit__cache_tag(read_address,read_cloc
        end
     end
                 
-endmodule // dynrt_processor__engine__traversal_unit__cache_tag
+endmodule // dynrt_processor__engine__traversal_unit__cache_tag__0
 
 
-module dynrt_processor__engine__traversal_unit__cache_words(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+
+
+
+
+
+
+module dynrt_processor__engine__traversal_unit__cache_words__0(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [8:0] read_address;
@@ -41300,7 +41790,13 @@ module dynrt_processor__engine__traversal_unit__cache_words(read_address,read_cl
        end
     end
                 
-endmodule // dynrt_processor__engine__traversal_unit__cache_words
+endmodule // dynrt_processor__engine__traversal_unit__cache_words__0
+
+
+
+
+
+
 
 
 
@@ -42310,6 +42806,8 @@ module dynrt_processor__engine__traversal_unit__fetch_job(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__traversal_unit__fetch_job
+
+
 
 
 
@@ -43334,7 +43832,7 @@ endmodule // dynrt_processor__engine__traversal_unit__stack_node
 
 
 
-module dynrt_processor__engine__traversal_unit__tag_word_r(d,q,clock);
+module dynrt_processor__engine__traversal_unit__tag_word_r__0(d,q,clock);
     
     // Module arguments
     input wire  [26:0] d;
@@ -43350,7 +43848,19 @@ module dynrt_processor__engine__traversal_unit__tag_word_r(d,q,clock);
        q <= d;
     end
           
-endmodule // dynrt_processor__engine__traversal_unit__tag_word_r
+endmodule // dynrt_processor__engine__traversal_unit__tag_word_r__0
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
