@@ -153,3 +153,43 @@ fn the_program_leaves_out_what_the_scene_does_not_need() {
         q.code.len()
     );
 }
+
+/// A primary ray's trace takes its query from constants and its ray from ray generation: the
+/// pixel loop's head moves no register and writes no ray words, and only mirror rays (and,
+/// under a top level, shadow rays) trace through a routine; the frames are the golden model's
+/// (`microprogram_renders_the_golden_frame_on_every_bundled_scene`).
+#[test]
+fn a_primary_trace_moves_no_register_and_only_mirror_and_top_level_shadow_rays_call_a_routine() {
+    use dynrt::hw::program::isa::{Op, TriFn};
+    for (name, routines) in [
+        ("cornell.toml", 0),
+        ("terrain.toml", 0),
+        ("dynamic.toml", 1),
+        ("mirror.toml", 2),
+    ] {
+        let l = layout_of(name, 16, 12, Format::E7M16, 0);
+        let p = build_program(&ProgramConfig::from_layout(&l));
+        let sections = || p.code.iter().zip(&p.sections);
+        let returns = p.code.iter().filter(|i| i.op == Op::Jr).count();
+        assert_eq!(returns, routines, "{name}: routines");
+        let mirrors = l.info.reflection_depth > 0;
+        // With mirrors the eye goes to the query's origin (where shading finds every depth's
+        // ray) and the depth to 0; without, nothing.
+        let moves = sections()
+            .filter(|(i, s)| **s == "raygen" && i.op == Op::Or)
+            .count();
+        assert_eq!(moves, if mirrors { 4 } else { 0 }, "{name}: moves");
+        // Ray words (3) are written for the secondary rays of one object only: each light's
+        // shadow ray in line and the mirror routine's ray.
+        let ray_words = p
+            .code
+            .iter()
+            .filter(|i| i.op == Op::Tri && i.imm <= TriFn::RayDyz as u32)
+            .count() as u32;
+        let want = match l.info.top_root {
+            None => 3 * (l.info.shadows as u32 * l.info.light_count + mirrors as u32),
+            Some(_) => 0,
+        };
+        assert_eq!(ray_words, want, "{name}: ray words");
+    }
+}

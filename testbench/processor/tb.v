@@ -159,9 +159,9 @@ module tb;
     @(negedge clock) start = 1'b1;
     @(negedge clock) start = 1'b0;
     n = 0;
-    while (!done && n < 1457004) begin @(posedge clock); n = n + 1; end
+    while (!done && n < 1380780) begin @(posedge clock); n = n + 1; end
     if (!done) begin
-      $display("TIMEOUT: frame 0 not done after 1457004 clocks");
+      $display("TIMEOUT: frame 0 not done after 1380780 clocks");
       $fatal(1, "timeout");
     end
     fd = $fopen({out_dir, "/frame0.hex"}, "w");

@@ -44,6 +44,8 @@ struct State {
     section: &'static str,
     labels: Vec<Option<u16>>,
     fixups: Vec<(usize, Label)>,
+    /// Instructions whose immediate is a label's address ([`Asm::mov_label`]).
+    address_fixups: Vec<(usize, Label)>,
     free: Vec<Reg>,
     temps: Vec<Reg>,
     /// Registers that hold a constant for the whole program ([`Asm::keep_constant`]).
@@ -73,6 +75,7 @@ impl Asm {
                 section: "init",
                 labels: Vec::new(),
                 fixups: Vec::new(),
+                address_fixups: Vec::new(),
                 // Lowest numbers first.
                 free: (1..REGISTERS).rev().map(|r| Reg(r as u8)).collect(),
                 temps: Vec::new(),
@@ -396,6 +399,15 @@ impl Asm {
         );
     }
 
+    /// `dst = ` the address of `target`: a return address for a routine entered by a jump,
+    /// when the call cannot sit just before where it returns to.
+    pub fn mov_label(&self, dst: Reg, target: Label) {
+        let at = self.len();
+        self.mov(dst, Val::K(0));
+        debug_assert_eq!(self.len(), at + 1);
+        self.state.borrow_mut().address_fixups.push((at, target));
+    }
+
     pub fn ret(&self, link: Reg) {
         self.emit(Instr {
             a: link.0,
@@ -557,8 +569,12 @@ impl Asm {
         // A program longer than the ROM is returned whole: `flow::preflight` refuses its scene
         // with the reason, and the engine refuses to build it.
         let mut code = s.code;
-        for (at, l) in s.fixups {
-            code[at].target = s.labels[l.0].expect("label never bound");
+        let address = |l: Label| s.labels[l.0].expect("label never bound");
+        for &(at, l) in &s.fixups {
+            code[at].target = address(l);
+        }
+        for &(at, l) in &s.address_fixups {
+            code[at].imm = address(l) as u32;
         }
         fold_jumps(&mut code);
         Assembled {
@@ -648,6 +664,25 @@ mod tests {
         assert_eq!((code[1].op, code[1].target), (Op::Jal, 0));
         assert!(!code[2].jumps_after() && !code[2].invert && code[2].target == 4);
         assert!(!code[4].jumps_after());
+    }
+
+    #[test]
+    fn a_label_address_is_the_bound_instruction_and_a_jump_after_it_folds() {
+        let a = Asm::new(Format::E7M16);
+        let (routine, back) = (a.label(), a.label());
+        let link = a.reg();
+        a.halt(); // 0
+        a.mov_label(link, back); // 1: link = 4, then jump @5
+        a.jump(routine); // 2
+        a.halt(); // 3
+        a.bind(back);
+        a.halt(); // 4
+        a.bind(routine);
+        a.ret(link); // 5
+        let code = a.finish().code;
+        assert_eq!((code[1].op, code[1].dst, code[1].imm), (Op::Or, link.0, 4));
+        assert!(code[1].b_imm && code[1].a == 0);
+        assert!(code[1].jumps_after() && code[1].target == 5, "{}", code[1]);
     }
 
     #[test]

@@ -224,30 +224,33 @@ pub fn build_program(config: &ProgramConfig) -> Program {
         s,
     };
     let constants = gen.load_constants();
-    // With secondary rays the trace is a routine, whose registers are its own (the shader's
-    // values live across its calls), and a shadow ray's another; else the one primary trace
-    // is written in line.
+    // A mirror ray's trace is a routine, whose registers are its own (the shader's values
+    // live across its calls), which the primary ray enters after its query; a shadow ray's
+    // under a top level is another (its instance loop is long). Other traces are written in
+    // line: the primary ray's without mirrors, and each light's shadow ray in one object.
     let routine = |query| {
         let (trace, after) = (a.label(), a.label());
         a.jump(after);
         a.bind(trace);
         let start = a.len();
-        gen.trace_routine(true, query);
+        let primary_entry = gen.trace_routine(true, query, traversal::Ray::Query);
         a.reserve_registers_of(start);
         a.bind(after);
-        trace
+        (trace, primary_entry)
     };
-    let trace = gen
-        .secondary_rays()
-        .then(|| routine(traversal::Query::Closest));
-    let shadow = constants.shadow_t_min.map(|t_min| {
-        routine(traversal::Query::Any {
-            t_min,
-            one: a
-                .kept_constant(config.format.one())
-                .expect("kept at the program's start"),
-        })
-    });
+    let trace = (config.reflection_depth > 0).then(|| routine(traversal::Query::Closest));
+    let shadow = match (constants.shadow_t_min, config.top_root) {
+        (Some(t_min), Some(_)) => Some(
+            routine(traversal::Query::Any {
+                t_min,
+                one: a
+                    .kept_constant(config.format.one())
+                    .expect("kept at the program's start"),
+            })
+            .0,
+        ),
+        _ => None,
+    };
     gen.pixel_loop(&constants, trace, shadow);
     let scratch = gen.scratch;
     let mut left_out = Vec::new();

@@ -18,9 +18,9 @@
 //! Cost: about 35 instructions per pixel plus 40 per hit, 20 per light and the traces
 //! (`cornell_noshadow`: 118 per primary ray, the walk included).
 
-use super::asm::{Reg, Val};
+use super::asm::{Label, Reg, Val};
 use super::isa::{Op, TriFn, KD_TOP};
-use super::traversal::Query;
+use super::traversal::{Query, Ray, NO_HIT};
 use super::{Gen, CHAIN_ENTRY_WORDS};
 use crate::layout::{FrameMap, FRAME, TRANSFORM_BANK_WORDS, TRIANGLES_A, TRIANGLES_B};
 use crate::units;
@@ -99,16 +99,17 @@ impl Gen<'_> {
         for w in self.walk_words() {
             a.keep_constant(w);
         }
-        // Without secondary rays every query starts at the eye with t_min 0 and t_max
-        // infinity: the query registers hold them for the whole frame.
+        // Without secondary rays every query starts at the eye: the query's origin registers
+        // hold it for the whole frame. With them, a primary ray's query skips the pair no hit
+        // has.
         let eye = if self.secondary_rays() {
+            a.keep_constant(NO_HIT);
             eye_words
         } else {
             a.mov3(s.q_o, eye_words.map(Val::R));
             for r in eye_words {
                 a.free(r);
             }
-            a.mov(s.q_t_min, Val::K(0));
             s.q_o
         };
         // A closest hit's t_max (a shadow ray's is 1), and the skip pair's instance in a scene
@@ -142,13 +143,15 @@ impl Gen<'_> {
         }
     }
 
-    /// One pixel after another until the frame is done; `trace` is the trace routine (none:
-    /// the trace is written in line, for a scene without secondary rays).
+    /// One pixel after another until the frame is done. `trace`: the closest-hit trace
+    /// routine of a scene with mirror rays and its primary rays' entry (none: the primary
+    /// trace is written in line); `shadow`: the shadow rays' routine under a top level (none:
+    /// each light's shadow trace is written in line).
     pub(super) fn pixel_loop(
         &self,
         k: &Constants,
-        trace: Option<super::asm::Label>,
-        shadow: Option<super::asm::Label>,
+        trace: Option<(Label, Label)>,
+        shadow: Option<Label>,
     ) {
         let a = self.asm;
         let s = &self.s;
@@ -158,7 +161,7 @@ impl Gen<'_> {
             eye,
             ambient,
             background,
-            shadow_t_min: _,
+            shadow_t_min,
             mirror_t_min,
             ref lights,
         } = *k;
@@ -175,7 +178,7 @@ impl Gen<'_> {
         let secondary = self.secondary_rays();
         let color: [Reg; 3] = a.regs();
 
-        let (next_pixel, frame_done, shade, fold, pack) =
+        let (next_pixel, frame_done, traced, fold, pack) =
             (a.label(), a.label(), a.label(), a.label(), a.label());
         a.bind(next_pixel);
         a.section("raygen");
@@ -197,25 +200,23 @@ impl Gen<'_> {
                 a.tri_dir(k as u8, ray_d[k]);
             }
         }
-        // A primary ray skips no triangle: under a top level no instance has the number
-        // u32::MAX, in one object no triangle.
-        if secondary {
+        // The primary ray's query comes from constants (`Ray::Primary`). With mirrors the
+        // shading of every depth finds its ray's origin in the query registers, where a mirror
+        // ray's trace reads it; without, the hit point is `eye + t d`.
+        let mirrors = c.reflection_depth > 0;
+        let origin = if mirrors {
             a.mov3(ray_o, eye.map(Val::R));
-            a.mov(ray_t_min, Val::K(0));
-            if c.top_root.is_some() {
-                a.mov(s.skip_instance, Val::K(u32::MAX));
-            } else {
-                a.mov(s.skip_triangle, Val::K(u32::MAX));
-            }
-        }
-        if c.reflection_depth > 0 {
             a.mov(depth, Val::K(0));
-        }
+            ray_o
+        } else {
+            eye
+        };
+        let primary = Ray::Primary { eye };
         if self.shade_unit() {
             // The trace, then the ShadeUnit shades the pixel and writes it: the thread goes
             // on with the next.
             a.section("shader");
-            self.trace_routine(false, Query::Closest);
+            self.trace_routine(false, Query::Closest, primary);
             a.section("shader");
             let address = self.pixel_address(pixel, x, y);
             a.tri_shade(address);
@@ -227,13 +228,21 @@ impl Gen<'_> {
             return;
         }
 
-        // Shade the ray (ray_o, ray_d, ray_t_min, skip) at mirror depth `depth`.
-        a.bind(shade);
+        // Trace the primary ray, in line or through the mirror rays' routine, and shade the
+        // hit; a mirror ray's trace returns to `traced` too, with the ray (ray_o, ray_d,
+        // ray_t_min, skip) at mirror depth `depth`.
         a.section("shader");
         match trace {
-            Some(trace) => a.call(s.link, trace),
-            None => self.trace_routine(false, Query::Closest),
+            Some((_, primary_entry)) => {
+                self.trace_query(Query::Closest, primary);
+                a.section("shader");
+                a.call(s.link, primary_entry);
+            }
+            None => {
+                self.trace_routine(false, Query::Closest, primary);
+            }
         }
+        a.bind(traced);
         a.section("shader");
         let miss = a.label();
         if self.hit_by_t() {
@@ -269,11 +278,11 @@ impl Gen<'_> {
         let p = if c.shadows {
             for k in 0..3 {
                 let along = a.op(Op::FMul, s.best_t.into(), ray_d[k].into());
-                a.op_to(Op::FAdd, ray_o[k], ray_o[k].into(), along);
+                a.op_to(Op::FAdd, ray_o[k], origin[k].into(), along);
             }
             ray_o
         } else {
-            units::ray_point(a, ray_o.map(Val::R), ray_d.map(Val::R), s.best_t.into())
+            units::ray_point(a, origin.map(Val::R), ray_d.map(Val::R), s.best_t.into())
                 .map(|v| a.keep(v))
         };
         a.end_temps();
@@ -344,12 +353,18 @@ impl Gen<'_> {
             a.branch(Op::BFlt, Val::K(0), n_dot_l, true, skip_light);
             let cos = a.keep(units::lambert_from_dot(a, n_dot_l, to_light.map(Val::R)));
             a.end_temps();
-            if let Some(shadow) = shadow {
+            if let Some(t_min) = shadow_t_min {
                 // The shadow ray's query is in place: the hit point, the light's vector and
                 // the hit as the pair to skip.
                 a.section("shadow");
                 debug_assert!(p == s.q_o && to_light == s.q_d);
-                a.call(s.link, shadow);
+                match shadow {
+                    Some(shadow) => a.call(s.link, shadow),
+                    None => {
+                        let one = a.kept_constant(f.one()).expect("kept at the start");
+                        self.trace_routine(false, Query::Any { t_min, one }, Ray::Query);
+                    }
+                }
                 a.section("light");
                 if self.hit_by_t() {
                     let one = a.kept_constant(f.one()).expect("kept at the start");
@@ -407,7 +422,9 @@ impl Gen<'_> {
             a.mov(ray_t_min, mirror_t_min.into());
             // The hit is the skip pair already (see `hit_instance`).
             a.end_temps();
-            a.jump(shade);
+            let (trace, _) = trace.expect("a routine with mirror rays");
+            a.mov_label(s.link, traced);
+            a.jump(trace);
         }
         a.bind(local_done);
         let owned = |r: &Reg| {

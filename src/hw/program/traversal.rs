@@ -56,6 +56,20 @@ pub(super) enum Query {
     Any { t_min: Reg, one: Reg },
 }
 
+/// Where a trace's ray is.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Ray {
+    /// A primary ray: ray generation wrote it into both coprocessors and its direction into
+    /// the query's direction registers; it starts at the eye (`eye`) at t 0 and skips nothing,
+    /// so the trace sets its query from constants and moves no register.
+    Primary { eye: [Reg; 3] },
+    /// The query registers: origin, direction, t range and skip pair.
+    Query,
+}
+
+/// The skip pair's word no instance and no triangle has.
+pub(super) const NO_HIT: u32 = u32::MAX;
+
 impl Gen<'_> {
     /// The words `kd.start` (one object) and `tri.enter` (under a top level) walk an object
     /// with, which the program keeps in registers from its start: the object's root (none
@@ -96,36 +110,33 @@ impl Gen<'_> {
         }
     }
 
-    /// The trace: the closest hit of the query registers, or any hit (`query`); gives `hit`
-    /// (where the shader reads the flag) and `best_t`, and returns through `link` when
-    /// `routine` (else it is in line). The hit's instance and triangle stay in the tester.
-    pub(super) fn trace_routine(&self, routine: bool, query: Query) {
+    /// The trace of `ray`: its closest hit, or any hit (`query`); gives `hit` (where the
+    /// shader reads the flag) and `best_t`, and returns through `link` when `routine` (else it
+    /// is in line). The hit's instance and triangle stay in the tester. Returns where a primary
+    /// ray enters the routine, after the words it brings itself: its query (from
+    /// [`Self::trace_query`]) and, for one object, its ray (ray generation's).
+    pub(super) fn trace_routine(&self, routine: bool, query: Query, ray: Ray) -> Label {
         let a = self.asm;
         let s = &self.s;
-        a.section("trace");
         let done = a.label();
-        let (t_min, t_max) = match query {
-            Query::Closest => (s.q_t_min, s.q_t_max),
-            Query::Any { t_min, one } => (t_min, one),
-        };
-        let world = (s.q_o, s.q_d);
-        a.tri_queue(TriFn::Init, t_min, t_max);
-        // The triangle a secondary ray starts on is never tested (primary rays skip none, so
-        // a scene without secondary rays never names one).
-        if self.secondary_rays() {
-            a.tri_queue(TriFn::Skip, s.skip_instance, s.skip_triangle);
-        }
+        let primary_entry = a.label();
+        self.trace_query(query, ray);
         let walk = self.walk_word(query);
+        let t_max = match query {
+            Query::Closest => s.q_t_max,
+            Query::Any { one, .. } => one,
+        };
         match self.c.top_root {
             Some(root) => {
+                a.bind(primary_entry);
                 // The world ray that the top-level walk and instance entry transform.
-                for (pair, [x, y]) in [
-                    [world.0[0], world.0[1]],
-                    [world.0[2], world.1[0]],
-                    [world.1[1], world.1[2]],
-                ]
-                .into_iter()
-                .enumerate()
+                let o = match ray {
+                    Ray::Primary { eye } => eye,
+                    Ray::Query => s.q_o,
+                };
+                for (pair, [x, y]) in [[o[0], o[1]], [o[2], s.q_d[0]], [s.q_d[1], s.q_d[2]]]
+                    .into_iter()
+                    .enumerate()
                 {
                     a.tri_world(pair as u8, x, y);
                 }
@@ -137,15 +148,15 @@ impl Gen<'_> {
                 a.tri_wait(s.best_t);
             }
             None => {
-                // Traced in line, the trace is the primary ray's, which ray generation has
-                // written into both coprocessors already.
-                if routine {
-                    tester_ray(a, world.0, world.1);
+                // A primary ray is in both coprocessors already (ray generation wrote it).
+                if ray == Ray::Query {
+                    tester_ray(a, s.q_o, s.q_d);
                 }
+                a.bind(primary_entry);
                 a.section("traversal");
                 a.kd_start(walk, t_max);
-                self.walk_end(query, done);
-                // An any-hit query's answer is the walk's hit flag.
+                // One object's any-hit walk ends at its first hit by itself.
+                self.walk_end(query, None);
                 if query == Query::Closest {
                     a.section("intersect");
                     a.tri_wait(s.best_t);
@@ -157,11 +168,44 @@ impl Gen<'_> {
             a.section("trace");
             a.ret(s.link);
         }
+        primary_entry
+    }
+
+    /// A trace's query in the tester: its t range and (with secondary rays) the hit it starts
+    /// on, which it skips (a primary ray: from 0, skipping the pair no hit has).
+    pub(super) fn trace_query(&self, query: Query, ray: Ray) {
+        let a = self.asm;
+        let s = &self.s;
+        a.section("trace");
+        let (t_min, t_max) = match (query, ray) {
+            (Query::Closest, Ray::Query) => (s.q_t_min, s.q_t_max),
+            (Query::Closest, Ray::Primary { .. }) => (Reg::ZERO, s.q_t_max),
+            (Query::Any { t_min, one }, _) => (t_min, one),
+        };
+        a.tri_queue(TriFn::Init, t_min, t_max);
+        // The triangle a secondary ray starts on is never tested (primary rays skip none, so
+        // a scene without secondary rays never names one).
+        if self.secondary_rays() {
+            let (instance, triangle) = match ray {
+                Ray::Primary { .. } => (self.no_hit(), self.no_hit()),
+                Ray::Query => (s.skip_instance, s.skip_triangle),
+            };
+            a.tri_queue(TriFn::Skip, instance, triangle);
+        }
+    }
+
+    /// The register holding [`NO_HIT`], kept from the program's start in a scene with
+    /// secondary rays.
+    pub(super) fn no_hit(&self) -> Reg {
+        self.asm
+            .kept_constant(NO_HIT)
+            .expect("kept at the program's start")
     }
 
     /// Sleeps until the thread's object walk ends and reads its hit flag (where the shader or
-    /// an any-hit query reads it); an any-hit query with a hit jumps to `answered`.
-    fn walk_end(&self, query: Query, answered: Label) {
+    /// an any-hit query reads it); an any-hit query with a hit jumps to `answered` (a walk
+    /// under a top level, whose instance loop that ends).
+    fn walk_end(&self, query: Query, answered: Option<Label>) {
         let a = self.asm;
         let s = &self.s;
         let any = query != Query::Closest;
@@ -170,7 +214,7 @@ impl Gen<'_> {
         } else {
             Reg::ZERO
         });
-        if any {
+        if let (true, Some(answered)) = (any, answered) {
             a.branch(Op::Beq, s.hit.into(), Val::K(0), true, answered);
         }
     }
@@ -220,7 +264,7 @@ impl Gen<'_> {
         // which then walks it; the thread sleeps until the walk ends.
         a.tri_enter(instance, walk);
         a.section("traversal");
-        self.walk_end(query, answered);
+        self.walk_end(query, Some(answered));
         a.section("instances");
         a.bind(seen);
         a.branch(Op::Beq, p.into(), end.into(), true, next);
