@@ -26794,9 +26794,13 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [1:0] cached_way__3__d;
     wire  [1:0] cached_way__3__q;
     reg  cached_way__3__clock;
-    reg  [1:0] fill_way__d;
-    wire  [1:0] fill_way__q;
-    reg  fill_way__clock;
+    reg  [8:0] fill_way__read_address;
+    reg  fill_way__read_clock;
+    wire  [1:0] fill_way__read_data;
+    reg  [8:0] fill_way__write_address;
+    reg  fill_way__write_clock;
+    reg  [1:0] fill_way__write_data;
+    reg  fill_way__write_enable;
     reg  cached__0__d;
     wire  cached__0__q;
     reg  cached__0__clock;
@@ -27848,10 +27852,14 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(cached_way__3__q),
         .clock(cached_way__3__clock)
     );
-    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 fill_way(
-        .d(fill_way__d),
-        .q(fill_way__q),
-        .clock(fill_way__clock)
+    dynrt_processor__engine__instances__victim fill_way(
+        .read_address(fill_way__read_address),
+        .read_clock(fill_way__read_clock),
+        .read_data(fill_way__read_data),
+        .write_address(fill_way__write_address),
+        .write_clock(fill_way__write_clock),
+        .write_data(fill_way__write_data),
+        .write_enable(fill_way__write_enable)
     );
     dynrt_processor__display__dark_d cached__0(
         .d(cached__0__d),
@@ -28401,7 +28409,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_clash_rrr__clock = clock;
         head_hit_r__clock = clock;
         head_way_r__clock = clock;
-        fill_way__clock = clock;
         a_issued__clock = clock;
         b_issued__clock = clock;
         seq__clock = clock;
@@ -28457,7 +28464,6 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         head_clash_rrr__d = head_clash_rrr__q;
         head_hit_r__d = head_hit_r__q;
         head_way_r__d = head_way_r__q;
-        fill_way__d = fill_way__q;
         a_issued__d = a_issued__q;
         b_issued__d = b_issued__q;
         seq__d = seq__q;
@@ -28612,19 +28618,17 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cache_tag__0__write_clock = clock;
         cache_tag__0__read_clock = clock;
         tag_word_r__0__clock = clock;
-        tag_word_r__0__d = tag_word_r__0__q;
         cache_tag__1__write_clock = clock;
         cache_tag__1__read_clock = clock;
         tag_word_r__1__clock = clock;
-        tag_word_r__1__d = tag_word_r__1__q;
         cache_tag__2__write_clock = clock;
         cache_tag__2__read_clock = clock;
         tag_word_r__2__clock = clock;
-        tag_word_r__2__d = tag_word_r__2__q;
         cache_tag__3__write_clock = clock;
         cache_tag__3__read_clock = clock;
         tag_word_r__3__clock = clock;
-        tag_word_r__3__d = tag_word_r__3__q;
+        fill_way__read_clock = clock;
+        fill_way__write_clock = clock;
         cache_words__0__read_clock = clock;
         cache_words__0__write_clock = clock;
         cache_words__1__read_clock = clock;
@@ -28899,22 +28903,23 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cache_write_r__d = cache_write;
         cache_tag__0__write_address = l_set;
         cache_tag__0__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
-        cache_tag__0__write_enable = c_tri_way_used__0 & cache_write_r__q & (fill_way__q == c_tri_way__0);
+        cache_tag__0__write_enable = c_tri_way_used__0 & cache_write_r__q & (fill_way__read_data == c_tri_way__0);
         cache_tag__1__write_address = l_set;
         cache_tag__1__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
-        cache_tag__1__write_enable = c_tri_way_used__1 & cache_write_r__q & (fill_way__q == c_tri_way__1);
+        cache_tag__1__write_enable = c_tri_way_used__1 & cache_write_r__q & (fill_way__read_data == c_tri_way__1);
         cache_tag__2__write_address = l_set;
         cache_tag__2__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
-        cache_tag__2__write_enable = c_tri_way_used__2 & cache_write_r__q & (fill_way__q == c_tri_way__2);
+        cache_tag__2__write_enable = c_tri_way_used__2 & cache_write_r__q & (fill_way__read_data == c_tri_way__2);
         cache_tag__3__write_address = l_set;
         cache_tag__3__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
-        cache_tag__3__write_enable = c_tri_way_used__3 & cache_write_r__q & (fill_way__q == c_tri_way__3);
-        if (cache_write_r__q) begin
-            fill_way__d = (fill_way__q + 32'h1) & c_tri_way_mask;
-        end
+        cache_tag__3__write_enable = c_tri_way_used__3 & cache_write_r__q & (fill_way__read_data == c_tri_way__3);
+        fill_way__read_address = l_set;
+        fill_way__write_address = l_set;
+        fill_way__write_data = (fill_way__read_data + 32'h1) & c_tri_way_mask;
+        fill_way__write_enable = cache_write_r__q;
         l_line = (l_set << c_tri_way_shift) | ((l_way) & 9'h1ff);
         n_line = (n_set << c_tri_way_shift) | ((n_way) & 9'h1ff);
-        fill_line = (l_set << c_tri_way_shift) | ((fill_way__q) & 9'h1ff);
+        fill_line = (l_set << c_tri_way_shift) | ((fill_way__read_data) & 9'h1ff);
         cache_ready__d = l_loaded & (~l_pending);
         if (lphase__q != Launch__Wait) begin
             cache_ready__d = n_loaded & (~n_pending);
@@ -39209,9 +39214,13 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  cache_words__3__write_clock;
     reg  [63:0] cache_words__3__write_data;
     reg  cache_words__3__write_enable;
-    reg  [1:0] fill_way__d;
-    wire  [1:0] fill_way__q;
-    reg  fill_way__clock;
+    reg  [8:0] fill_way__read_address;
+    reg  fill_way__read_clock;
+    wire  [1:0] fill_way__read_data;
+    reg  [8:0] fill_way__write_address;
+    reg  fill_way__write_clock;
+    reg  [1:0] fill_way__write_data;
+    reg  fill_way__write_enable;
     reg  fetch_hit__d;
     wire  fetch_hit__q;
     reg  fetch_hit__clock;
@@ -39360,7 +39369,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  front_end;
     reg  [102:0] front_job;
     reg  fetch_free;
-    reg  [4:0] next_a_thread;
+    reg  [102:0] next_a_job;
     reg  take;
     reg  [2:0] arrive;
     reg  [63:0] arrive_data;
@@ -40096,10 +40105,14 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .write_data(cache_words__3__write_data),
         .write_enable(cache_words__3__write_enable)
     );
-    dynrt_processor__engine__fp_units__byte_unit__clamp_line__stage__0 fill_way(
-        .d(fill_way__d),
-        .q(fill_way__q),
-        .clock(fill_way__clock)
+    dynrt_processor__engine__instances__victim fill_way(
+        .read_address(fill_way__read_address),
+        .read_clock(fill_way__read_clock),
+        .read_data(fill_way__read_data),
+        .write_address(fill_way__write_address),
+        .write_clock(fill_way__write_clock),
+        .write_data(fill_way__write_data),
+        .write_enable(fill_way__write_enable)
     );
     dynrt_processor__display__dark_d fetch_hit(
         .d(fetch_hit__d),
@@ -40348,7 +40361,6 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         look_valid__clock = clock;
         look_job__clock = clock;
         look_stale__clock = clock;
-        fill_way__clock = clock;
         stale_r__clock = clock;
         look_ready__clock = clock;
         fetch_hit__clock = clock;
@@ -40412,7 +40424,6 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         look_valid__d = look_valid__q;
         look_job__d = look_job__q;
         look_stale__d = look_stale__q;
-        fill_way__d = fill_way__q;
         stale_r__d = stale_r__q;
         look_ready__d = look_ready__q;
         fetch_hit__d = fetch_hit__q;
@@ -40477,32 +40488,26 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         cache_words__0__write_clock = clock;
         tag_word_r__0__clock = clock;
         words_r__0__clock = clock;
-        tag_word_r__0__d = tag_word_r__0__q;
-        words_r__0__d = words_r__0__q;
         cache_tag__1__read_clock = clock;
         cache_tag__1__write_clock = clock;
         cache_words__1__read_clock = clock;
         cache_words__1__write_clock = clock;
         tag_word_r__1__clock = clock;
         words_r__1__clock = clock;
-        tag_word_r__1__d = tag_word_r__1__q;
-        words_r__1__d = words_r__1__q;
         cache_tag__2__read_clock = clock;
         cache_tag__2__write_clock = clock;
         cache_words__2__read_clock = clock;
         cache_words__2__write_clock = clock;
         tag_word_r__2__clock = clock;
         words_r__2__clock = clock;
-        tag_word_r__2__d = tag_word_r__2__q;
-        words_r__2__d = words_r__2__q;
         cache_tag__3__read_clock = clock;
         cache_tag__3__write_clock = clock;
         cache_words__3__read_clock = clock;
         cache_words__3__write_clock = clock;
         tag_word_r__3__clock = clock;
         words_r__3__clock = clock;
-        tag_word_r__3__d = tag_word_r__3__q;
-        words_r__3__d = words_r__3__q;
+        fill_way__read_clock = clock;
+        fill_way__write_clock = clock;
         node_line__0__clock = clock;
         data_line__0__clock = clock;
         node_line__1__clock = clock;
@@ -40797,7 +40802,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         if (arrive == 32'h2) begin
             w0__d = nodes__rdata;
         end
-        next_a_thread = job__q[(32'h60)+:(5)];
+        next_a_job = job__q;
         if (arrive == 32'h3) begin
             w1__d = nodes__rdata;
             a_fetched__d = 1'b1;
@@ -40809,7 +40814,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         end
         if ((arrive == 32'h3) | (arrive == 32'h4)) begin
             job__d = in_flight__data_out;
-            next_a_thread = in_flight__data_out[(32'h60)+:(5)];
+            next_a_job = in_flight__data_out;
             in_flight__read = 1'b1;
             words_in__d = 32'h1;
         end
@@ -40835,7 +40840,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
             else if ((phase__q == Fetch__Idle) & in_flight__empty) begin
                 look_move = 1'b1;
                 job__d = look_job__q;
-                next_a_thread = look_job__q[(32'h60)+:(5)];
+                next_a_job = look_job__q;
                 words_in__d = 32'h1;
                 a_fetched__d = 1'b0;
             end
@@ -40934,8 +40939,8 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         leaf_sp__write_address = a_leaf_address;
         leaf_hi__write_data = job__q[(32'h0)+:(24)];
         leaf_sp__write_data = job__q[(32'h5a)+:(6)];
-        done_u__read_address = next_a_thread;
-        last_hit_a__read_address = next_a_thread;
+        done_u__read_address = next_a_job[(32'h60)+:(5)];
+        last_hit_a__read_address = next_a_job[(32'h60)+:(5)];
         done_u__write_address = job__q[(32'h60)+:(5)];
         done_e__write_data = done_u__read_data + 32'h1;
         done_u__write_data = done_u__read_data + 32'h1;
@@ -40946,33 +40951,34 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         done_thread_r__d = job__q[(32'h60)+:(5)];
         fill = c_node_cache_on & at_a & a_fetched__q & (~job__q[32'h66]);
         fill_set = job__q[(32'h40)+:(9)] & c_node_set_mask;
+        fill_way__read_address = next_a_job[(32'h40)+:(9)] & c_node_set_mask;
         cache_tag__0__write_address = fill_set;
         cache_tag__0__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
-        cache_tag__0__write_enable = c_node_way_used__0 & fill & (fill_way__q == c_node_way__0);
+        cache_tag__0__write_enable = c_node_way_used__0 & fill & (fill_way__read_data == c_node_way__0);
         cache_words__0__write_address = fill_set;
         cache_words__0__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
         cache_words__0__write_enable = cache_tag__0__write_enable;
         cache_tag__1__write_address = fill_set;
         cache_tag__1__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
-        cache_tag__1__write_enable = c_node_way_used__1 & fill & (fill_way__q == c_node_way__1);
+        cache_tag__1__write_enable = c_node_way_used__1 & fill & (fill_way__read_data == c_node_way__1);
         cache_words__1__write_address = fill_set;
         cache_words__1__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
         cache_words__1__write_enable = cache_tag__1__write_enable;
         cache_tag__2__write_address = fill_set;
         cache_tag__2__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
-        cache_tag__2__write_enable = c_node_way_used__2 & fill & (fill_way__q == c_node_way__2);
+        cache_tag__2__write_enable = c_node_way_used__2 & fill & (fill_way__read_data == c_node_way__2);
         cache_words__2__write_address = fill_set;
         cache_words__2__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
         cache_words__2__write_enable = cache_tag__2__write_enable;
         cache_tag__3__write_address = fill_set;
         cache_tag__3__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
-        cache_tag__3__write_enable = c_node_way_used__3 & fill & (fill_way__q == c_node_way__3);
+        cache_tag__3__write_enable = c_node_way_used__3 & fill & (fill_way__read_data == c_node_way__3);
         cache_words__3__write_address = fill_set;
         cache_words__3__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
         cache_words__3__write_enable = cache_tag__3__write_enable;
-        if (fill) begin
-            fill_way__d = (fill_way__q + 32'h1) & c_node_way_mask;
-        end
+        fill_way__write_address = fill_set;
+        fill_way__write_data = (fill_way__read_data + 32'h1) & c_node_way_mask;
+        fill_way__write_enable = fill;
         look_stale__d = fill & (fill_set == read_set);
         engine__done = done_r__q;
         engine__done_thread = done_thread_r__q;

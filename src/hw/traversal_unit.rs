@@ -49,7 +49,9 @@
 //! or 4), each way's tags (node and valid bit) and words in block RAMs of their own, so that a
 //! set's ways are read at once (a way the cache does not have is never written, and synthesis
 //! removes it: 2 ways take twice the words' block RAM of 1, 4 ways four times); a fill takes
-//! the ways in turn (one count for the whole cache). 0 sets: none; off at SRAM latency
+//! its set's ways in turn (a count per set, read a clock before the fill with the set of the
+//! job coming to A: fills are at least two clocks apart, one per node from the bank, so the
+//! count read always has the last fill's write). 0 sets: none; off at SRAM latency
 //! 1, where a cached node's words would come back before the FIFO behind them can pop. A job waits
 //! for the fetch in `look`, whose cache set is read as it comes in; the set's tags and words read
 //! are registered, and the job's tag is compared with them from its second clock in `look` (the
@@ -284,7 +286,9 @@ pub struct TraversalUnit<
     phase: DFF<Fetch>,
     fetch_job: DFF<Job>,
     fetch_free: Signal<Local, Bit>,
-    next_a_thread: Signal<Local, Bits<5>>,
+    /// The job at A next clock: its thread's count of entries done and its node's set's next
+    /// way to fill are read now.
+    next_a_job: Signal<Local, Job>,
     /// Jobs whose words are requested, oldest first (at most `mem_latency + 1`: one a clock from
     /// the cache).
     in_flight: SyncFifo<Job, 3, 4>,
@@ -329,9 +333,8 @@ pub struct TraversalUnit<
     cache_words: [RAM<Bits<64>, 9>; 4],
     /// The way `look_job`'s node is in (when `look_hit`).
     look_way_hit: [Signal<Local, Bit>; 4],
-    /// The way the next fill writes: a count of fills (round robin over the whole cache,
-    /// not per set, so that no RAM is read before a fill).
-    fill_way: DFF<Bits<2>>,
+    /// Per set, the way its next fill writes (round robin).
+    fill_way: RAM<Bits<2>, 9>,
     /// `fetch_job`'s node is in the cache, with its words: the fetch takes it in a clock.
     fetch_hit: DFF<Bit>,
     fetch_words: DFF<Bits<64>>,
@@ -565,7 +568,7 @@ impl<
             phase: Default::default(),
             fetch_job: Default::default(),
             fetch_free: Default::default(),
-            next_a_thread: Default::default(),
+            next_a_job: Default::default(),
             in_flight: Default::default(),
             job: Default::default(),
             words_in: Default::default(),
@@ -590,7 +593,7 @@ impl<
             cache_tag: std::array::from_fn(|_| empty_cache_tags()),
             cache_words: Default::default(),
             look_way_hit: Default::default(),
-            fill_way: Default::default(),
+            fill_way: empty_cache_tags(),
             fetch_hit: Default::default(),
             fetch_words: Default::default(),
             hit_now: Default::default(),
@@ -726,7 +729,6 @@ impl<
             look_valid,
             look_job,
             look_stale,
-            fill_way,
             stale_r,
             look_ready,
             fetch_hit,
@@ -797,9 +799,9 @@ impl<
             self.cache_words[w].write_clock.next = self.clock.val();
             self.tag_word_r[w].clock.next = self.clock.val();
             self.words_r[w].clock.next = self.clock.val();
-            self.tag_word_r[w].d.next = self.tag_word_r[w].q.val();
-            self.words_r[w].d.next = self.words_r[w].q.val();
         }
+        self.fill_way.read_clock.next = self.clock.val();
+        self.fill_way.write_clock.next = self.clock.val();
         for k in 0..6 {
             self.node_line[k].clock.next = self.clock.val();
             self.data_line[k].clock.next = self.clock.val();
@@ -1115,8 +1117,7 @@ impl<
         if self.arrive.val() == 2 {
             self.w0.d.next = self.nodes.rdata.val();
         }
-        // The thread of the job at A next clock, whose count of entries done is read now.
-        self.next_a_thread.next = self.job.q.val().get_bits::<5>(96);
+        self.next_a_job.next = self.job.q.val();
         if self.arrive.val() == 3 {
             self.w1.d.next = self.nodes.rdata.val();
             self.a_fetched.d.next = true;
@@ -1128,7 +1129,7 @@ impl<
         }
         if (self.arrive.val() == 3) | (self.arrive.val() == 4) {
             self.job.d.next = self.in_flight.data_out.val();
-            self.next_a_thread.next = self.in_flight.data_out.val().get_bits::<5>(96);
+            self.next_a_job.next = self.in_flight.data_out.val();
             self.in_flight.read.next = true;
             self.words_in.d.next = 1.into();
         }
@@ -1153,7 +1154,7 @@ impl<
             } else if (self.phase.q.val() == Fetch::Idle) & self.in_flight.empty.val() {
                 self.look_move.next = true;
                 self.job.d.next = self.look_job.q.val();
-                self.next_a_thread.next = self.look_job.q.val().get_bits::<5>(96);
+                self.next_a_job.next = self.look_job.q.val();
                 self.words_in.d.next = 1.into();
                 self.a_fetched.d.next = false;
             }
@@ -1260,8 +1261,8 @@ impl<
         self.leaf_sp.write_data.next = self.job.q.val().get_bits::<6>(90);
         // Entries done: the unit's copy is read a clock ahead at the thread of the job coming
         // to A, the engine's at its own.
-        self.done_u.read_address.next = self.next_a_thread.val();
-        self.last_hit_a.read_address.next = self.next_a_thread.val();
+        self.done_u.read_address.next = self.next_a_job.val().get_bits::<5>(96);
+        self.last_hit_a.read_address.next = self.next_a_job.val().get_bits::<5>(96);
         self.done_u.write_address.next = self.job.q.val().get_bits::<5>(96);
         self.done_e.write_data.next = self.done_u.read_data.val() + 1;
         self.done_u.write_data.next = self.done_u.read_data.val() + 1;
@@ -1278,21 +1279,24 @@ impl<
             & self.a_fetched.q.val()
             & (!self.job.q.val().get_bit(102));
         self.fill_set.next = self.job.q.val().get_bits::<9>(64) & self.c_node_set_mask.val();
+        self.fill_way.read_address.next =
+            self.next_a_job.val().get_bits::<9>(64) & self.c_node_set_mask.val();
         for w in 0..4 {
             self.cache_tag[w].write_address.next = self.fill_set.val();
             self.cache_tag[w].write_data.next = self.c_node_tag_valid.val()
                 | bit_cast::<27, 26>(self.job.q.val().get_bits::<26>(64));
             self.cache_tag[w].write_enable.next = self.c_node_way_used[w].val()
                 & self.fill.val()
-                & (self.fill_way.q.val() == self.c_node_way[w].val());
+                & (self.fill_way.read_data.val() == self.c_node_way[w].val());
             self.cache_words[w].write_address.next = self.fill_set.val();
             self.cache_words[w].write_data.next =
                 (bit_cast::<64, 32>(self.w1.q.val()) << 32) | bit_cast::<64, 32>(self.w0.q.val());
             self.cache_words[w].write_enable.next = self.cache_tag[w].write_enable.val();
         }
-        if self.fill.val() {
-            self.fill_way.d.next = (self.fill_way.q.val() + 1) & self.c_node_way_mask.val();
-        }
+        self.fill_way.write_address.next = self.fill_set.val();
+        self.fill_way.write_data.next =
+            (self.fill_way.read_data.val() + 1) & self.c_node_way_mask.val();
+        self.fill_way.write_enable.next = self.fill.val();
         self.look_stale.d.next = self.fill.val() & (self.fill_set.val() == self.read_set.val());
         self.engine.done.next = self.done_r.q.val();
         self.engine.done_thread.next = self.done_thread_r.q.val();
@@ -1465,9 +1469,11 @@ mod tests {
     /// at its first hit); the engine takes bank 0 in random clocks, and its starts are
     /// refused while an answer goes in.
     /// Run with a node cache of `cache_sets` sets: every node the model reads is a hit or a
-    /// miss of the unit's cache (none a hit without a cache); returns the hits and the
-    /// unit's reads of bank 0.
-    fn walk_like_the_model((cache_sets, cache_ways): (u32, u32)) -> (usize, usize) {
+    /// miss of the unit's cache (none a hit without a cache); returns the hits, the
+    /// unit's reads of bank 0 and the cache's fills in order, (set, way).
+    fn walk_like_the_model(
+        (cache_sets, cache_ways): (u32, u32),
+    ) -> (usize, usize, Vec<(u32, u32)>) {
         let f = Format::E7M16;
         let seed = 41;
         println!("seed {seed}");
@@ -1578,6 +1584,7 @@ mod tests {
             hits: usize,
             misses: usize,
             reads: usize,
+            fills: Vec<(u32, u32)>,
             /// Answers due: (clock, thread, best t, hit).
             due: Vec<(u64, usize, u32, bool)>,
             clock: u64,
@@ -1592,6 +1599,7 @@ mod tests {
             hits: 0,
             misses: 0,
             reads: 0,
+            fills: Vec::new(),
             due: Vec::new(),
             clock: 0,
             got: vec![Vec::new(); threads],
@@ -1627,6 +1635,11 @@ mod tests {
             }
             b.hits += usize::from(u.cache_hit.val());
             b.misses += usize::from(u.cache_miss.val());
+            if u.fill.val() {
+                let set = u.fill_set.val().to_u64() as u32;
+                b.fills
+                    .push((set, u.fill_way.read_data.val().to_u64() as u32));
+            }
             let full = u.engine.full.val();
             if full && u.engine.enqueue.val() {
                 b.refused += 1;
@@ -1673,21 +1686,21 @@ mod tests {
         assert_eq!(b.got, want, "leaves per thread");
         assert_eq!(b.hits + b.misses, model_fetches, "nodes fetched");
         assert_eq!(b.reads, 2 * b.misses, "bank 0 reads: two words per miss");
-        (b.hits, b.reads)
+        (b.hits, b.reads, b.fills)
     }
 
     #[test]
     fn rust_hdl_simulation_walks_like_the_model() {
-        let (hits, reads) = walk_like_the_model((0, 1));
+        let (hits, reads, _) = walk_like_the_model((0, 1));
         assert_eq!(hits, 0, "no cache, no hit");
         // A cache of the paper's 512 sets holds the whole Cornell tree: each node is read from
         // the bank once; two sets evict (fewer hits, more reads), and two sets of four ways
         // hold four times the nodes of two sets of one (a cache that looked up or filled one
         // way only would hit as the direct-mapped one does).
-        let (hits_512, reads_512) = walk_like_the_model((MAX_CACHE_SETS, 1));
-        let (hits_2, reads_2) = walk_like_the_model((2, 1));
-        let (hits_2x4, reads_2x4) = walk_like_the_model((2, 4));
-        let (hits_256x2, reads_256x2) = walk_like_the_model((256, 2));
+        let (hits_512, reads_512, _) = walk_like_the_model((MAX_CACHE_SETS, 1));
+        let (hits_2, reads_2, _) = walk_like_the_model((2, 1));
+        let (hits_2x4, reads_2x4, fills_2x4) = walk_like_the_model((2, 4));
+        let (hits_256x2, reads_256x2, _) = walk_like_the_model((256, 2));
         println!(
             "hits / reads: none 0 / {reads}, 2 sets {hits_2} / {reads_2}, 2 sets of 4 ways \
              {hits_2x4} / {reads_2x4}, 256 of 2 {hits_256x2} / {reads_256x2}, 512 {hits_512} / \
@@ -1704,6 +1717,24 @@ mod tests {
         );
         // 512 items either way hold the whole tree.
         assert_eq!((hits_256x2, reads_256x2), (hits_512, reads_512));
+        // Each set's fills take its ways in turn, from way 0 (one count of fills for the whole
+        // cache gave a set's first fill whatever way the other set's fills had left).
+        let (_, _, fills_2x2) = walk_like_the_model((2, 2));
+        for (ways, fills) in [(2, fills_2x2), (4, fills_2x4)] {
+            for set in 0..2 {
+                let taken: Vec<u32> = fills
+                    .iter()
+                    .filter(|fill| fill.0 == set)
+                    .map(|fill| fill.1)
+                    .collect();
+                let in_turn: Vec<u32> = (0..taken.len() as u32).map(|k| k % ways).collect();
+                assert!(
+                    taken.len() > ways as usize,
+                    "{ways} ways, set {set}: {taken:?}"
+                );
+                assert_eq!(taken, in_turn, "{ways} ways, set {set}");
+            }
+        }
     }
 
     /// rust-hdl simulation of top-level walks on the dynamic scene's trees (1,202 instances):

@@ -64,7 +64,8 @@
 //! fetched, and the launch takes its words from the cache (addressed two clocks ahead: the
 //! launch's words, from the buffer or the cache, wait in a register, `matrix`). A triangle
 //! fetched from the banks is written into its set as it launches (in its direction's clock,
-//! decided in its origin's; the ways in turn, one count for the whole cache), from the words
+//! decided in its origin's; its set's ways in turn, a count per set read in the origin's clock),
+//! from the words
 //! it launches with, unless a buffered triangle found
 //! in the cache holds that set (it must find its words there until it launches); a head looked
 //! up in either clock, or decided in an origin's clock, misses if its set is the launch's. The
@@ -284,9 +285,10 @@ pub struct TriangleTester<
     cache_words: [RAM<Bits<W>, 9>; 12],
     /// The way the buffer's triangle is in (when `cached`).
     cached_way: [DFF<Bits<2>>; TEST_BUFFERS],
-    /// The way the next write fills: a count of writes (round robin over the whole cache, not
-    /// per set, so that no RAM is read before a write).
-    fill_way: DFF<Bits<2>>,
+    /// Per set, the way its next write fills (round robin), read at the launch's set in every
+    /// clock: in the direction's clock, which writes, it has the origin's set, the launch's
+    /// (launches are two clocks apart, so it has the last write's count).
+    fill_way: RAM<Bits<2>, 9>,
     /// The buffer's triangle is in the cache (decided three clocks after the take, when
     /// `deciding`; its set is not written until it launches).
     cached: [DFF<Bit>; TEST_BUFFERS],
@@ -594,7 +596,7 @@ impl<
             cache_tag: std::array::from_fn(|_| empty_cache_tags()),
             cache_words: Default::default(),
             cached_way: Default::default(),
-            fill_way: Default::default(),
+            fill_way: empty_cache_tags(),
             head_way: Default::default(),
             head_way_r: Default::default(),
             l_way: Default::default(),
@@ -769,7 +771,6 @@ impl<
             head_clash_rrr,
             head_hit_r,
             head_way_r,
-            fill_way,
             a_issued,
             b_issued,
             seq,
@@ -855,8 +856,9 @@ impl<
             self.cache_tag[w].write_clock.next = self.clock.val();
             self.cache_tag[w].read_clock.next = self.clock.val();
             self.tag_word_r[w].clock.next = self.clock.val();
-            self.tag_word_r[w].d.next = self.tag_word_r[w].q.val();
         }
+        self.fill_way.read_clock.next = self.clock.val();
+        self.fill_way.write_clock.next = self.clock.val();
         for k in 0..12 {
             self.cache_words[k].read_clock.next = self.clock.val();
             self.cache_words[k].write_clock.next = self.clock.val();
@@ -1036,17 +1038,19 @@ impl<
                 self.c_tag_valid.val() | bit_cast::<25, 24>(self.l_a.val().get_bits::<24>(0));
             self.cache_tag[w].write_enable.next = self.c_tri_way_used[w].val()
                 & self.cache_write_r.q.val()
-                & (self.fill_way.q.val() == self.c_tri_way[w].val());
+                & (self.fill_way.read_data.val() == self.c_tri_way[w].val());
         }
-        if self.cache_write_r.q.val() {
-            self.fill_way.d.next = (self.fill_way.q.val() + 1) & self.c_tri_way_mask.val();
-        }
+        self.fill_way.read_address.next = self.l_set.val();
+        self.fill_way.write_address.next = self.l_set.val();
+        self.fill_way.write_data.next =
+            (self.fill_way.read_data.val() + 1) & self.c_tri_way_mask.val();
+        self.fill_way.write_enable.next = self.cache_write_r.q.val();
         self.l_line.next =
             (self.l_set.val() << self.c_tri_way_shift.val()) | bit_cast::<9, 2>(self.l_way.val());
         self.n_line.next =
             (self.n_set.val() << self.c_tri_way_shift.val()) | bit_cast::<9, 2>(self.n_way.val());
         self.fill_line.next = (self.l_set.val() << self.c_tri_way_shift.val())
-            | bit_cast::<9, 2>(self.fill_way.q.val());
+            | bit_cast::<9, 2>(self.fill_way.read_data.val());
         // The words answer a clock after their set: the launch's while it waits, the next
         // buffer's from the origin's clock on (`matrix` takes them in the direction's).
         self.cache_ready.d.next = self.l_loaded.val() & (!self.l_pending.val());
@@ -1618,6 +1622,8 @@ mod tests {
         cache_misses: u64,
         /// Clocks in which a buffer decided its `cached` while an origin launched into its set.
         origin_clashes: u64,
+        /// The cache's fills in order: (set, way).
+        fills: Vec<(u32, u32)>,
     }
 
     /// Runs the tester in rust-hdl simulation with an SRAM model behind banks 1, 2 and 3 (the
@@ -1677,6 +1683,7 @@ mod tests {
             cache_hits: 0,
             cache_misses: 0,
             origin_clashes: 0,
+            fills: Vec::new(),
         };
         let mut drain = 0;
         // The thread whose counters were read last clock (the engine's I4): only it may offer.
@@ -1749,6 +1756,12 @@ mod tests {
                 } else {
                     offers[th].pop_front();
                 }
+            }
+            if u.cache_write_r.q.val() {
+                drive.fills.push((
+                    u.l_set.val().to_u64() as u32,
+                    u.fill_way.read_data.val().to_u64() as u32,
+                ));
             }
             drive.cache_hits += u64::from(u.cache_hit.val());
             drive.cache_misses += u64::from(u.cache_miss.val());
@@ -1947,6 +1960,65 @@ mod tests {
             &want,
         );
         assert_eq!((drive.cache_hits, drive.cache_misses), (8, 8));
+    }
+
+    /// A fill takes its own set's ways in turn. Two sets (a set by the triangle's low bit):
+    /// triangles 0, 1, 2 and six more of set 1 fill set 0 twice and set 1 seven times; each
+    /// set's fills take ways 0, 1, ... in turn from 0. (One count of fills for the whole cache
+    /// gave set 1's first fill way 1.)
+    #[test]
+    fn a_fill_takes_its_own_sets_ways_in_turn() {
+        let f = Format::E7M16;
+        let w = |x: f64| f.from_f64(x);
+        let triangles: Vec<units::Mat34W> = (0..16)
+            .map(|k| {
+                let mut m = [0; 12];
+                for r in 0..3 {
+                    m[5 * r] = w(1.0);
+                }
+                m[11] = w(f64::from(k) / 16.0);
+                m
+            })
+            .collect();
+        let bank1: Vec<u32> = vec![0, 1, 2, 3, 5, 7, 9, 11, 13];
+        let rays = vec![([w(0.25), w(0.25), w(1.0)], [0, 0, w(-1.0)])];
+        let init = Offer::Init {
+            t_min: 0,
+            t_max: f.infinity(false),
+        };
+        let offers = vec![VecDeque::from([
+            Offer::Object(5),
+            init,
+            Offer::List { from: 0, to: 9 },
+        ])];
+        let (want, tests) = model_hits(f, &triangles, &bank1, &rays, &offers);
+        assert_eq!(tests, 9);
+        for ways in [2, 4] {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
+            let drive = drive_tester(
+                2,
+                (2, ways),
+                &triangles,
+                &bank1,
+                &rays,
+                offers.clone(),
+                0,
+                &mut rng,
+                &want,
+            );
+            assert_eq!(drive.cache_misses, 9, "every triangle is new");
+            for set in 0..2 {
+                let taken: Vec<u32> = drive
+                    .fills
+                    .iter()
+                    .filter(|fill| fill.0 == set)
+                    .map(|fill| fill.1)
+                    .collect();
+                let in_turn: Vec<u32> = (0..taken.len() as u32).map(|k| k % ways).collect();
+                assert_eq!(taken, in_turn, "{ways} ways, set {set}");
+                assert_eq!(taken.len(), [2, 7][set as usize], "{ways} ways, set {set}");
+            }
+        }
     }
 
     /// Every format the generator accepts has enough in-flight slots (the `new` assertion).
