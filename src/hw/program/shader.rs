@@ -15,8 +15,11 @@
 //! byte (the `byte` instruction: `units::channel_byte`) is shifted into the word written to
 //! the frame buffer at `y * W + x`. Lights' words stay in registers (up to [`KEPT_LIGHTS`]).
 //!
-//! Cost: about 35 instructions per pixel plus 40 per hit, 20 per light and the traces
-//! (`cornell_noshadow`: 118 per primary ray, the walk included).
+//! Cost (instructions = engine turns): per pixel 5 for the pixel and its ray (`pixel`, the
+//! wait, three `tri.dir`), 5 for its trace in one object (query, skip, walk, two waits), and
+//! 4 for the pack and store; per hit about 25 (the point, the normal and its flip, the
+//! material, ambient); per lit light about 22, plus 7 for its shadow ray in one object
+//! (cornell at 64x48: 60.7 per primary ray; with the ShadeUnit, cornell_noshadow: 7.3).
 
 use super::asm::{Label, Reg, Val};
 use super::isa::{Op, TriFn, KD_TOP};
