@@ -1916,6 +1916,30 @@ mod tests {
         }
     }
 
+    /// `n` unit triangles moved away along z (`t = 1 + k / n` from z = 1 straight down), and
+    /// the one ray that hits them all.
+    #[allow(clippy::type_complexity)]
+    fn stacked_unit_triangles(
+        f: Format,
+        n: u32,
+    ) -> (Vec<units::Mat34W>, Vec<([u32; 3], [u32; 3])>) {
+        let w = |x: f64| f.from_f64(x);
+        let triangles = (0..n)
+            .map(|k| {
+                let mut m = [0; 12];
+                for r in 0..3 {
+                    m[5 * r] = w(1.0);
+                }
+                m[11] = w(f64::from(k) / f64::from(n));
+                m
+            })
+            .collect();
+        (
+            triangles,
+            vec![([w(0.25), w(0.25), w(1.0)], [0, 0, w(-1.0)])],
+        )
+    }
+
     /// Entries found in the cache launch 2 clocks apart, so an entry reads its thread's best
     /// before the one in front of it has written it. One thread tests 8 triangles whose t
     /// grows along the list, twice (a new query between: the second time every triangle is
@@ -1925,19 +1949,8 @@ mod tests {
     fn back_to_back_cached_tests_merge_in_list_order() {
         let f = Format::E7M16;
         let w = |x: f64| f.from_f64(x);
-        // The unit triangle moved away along z: t = 1 + k / 8 from z = 1 straight down.
-        let triangles: Vec<units::Mat34W> = (0..8)
-            .map(|k| {
-                let mut m = [0; 12];
-                for r in 0..3 {
-                    m[5 * r] = w(1.0);
-                }
-                m[11] = w(f64::from(k) / 8.0);
-                m
-            })
-            .collect();
+        let (triangles, rays) = stacked_unit_triangles(f, 8);
         let bank1: Vec<u32> = (0..8).collect();
-        let rays = vec![([w(0.25), w(0.25), w(1.0)], [0, 0, w(-1.0)])];
         let init = Offer::Init {
             t_min: 0,
             t_max: f.infinity(false),
@@ -1969,19 +1982,8 @@ mod tests {
     #[test]
     fn a_fill_takes_its_own_sets_ways_in_turn() {
         let f = Format::E7M16;
-        let w = |x: f64| f.from_f64(x);
-        let triangles: Vec<units::Mat34W> = (0..16)
-            .map(|k| {
-                let mut m = [0; 12];
-                for r in 0..3 {
-                    m[5 * r] = w(1.0);
-                }
-                m[11] = w(f64::from(k) / 16.0);
-                m
-            })
-            .collect();
+        let (triangles, rays) = stacked_unit_triangles(f, 16);
         let bank1: Vec<u32> = vec![0, 1, 2, 3, 5, 7, 9, 11, 13];
-        let rays = vec![([w(0.25), w(0.25), w(1.0)], [0, 0, w(-1.0)])];
         let init = Offer::Init {
             t_min: 0,
             t_max: f.infinity(false),
