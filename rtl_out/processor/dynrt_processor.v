@@ -10977,13 +10977,13 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
     reg  cache_root__write_clock;
     reg  [25:0] cache_root__write_data;
     reg  cache_root__write_enable;
-    reg  [8:0] victim__read_address;
-    reg  victim__read_clock;
-    wire  [1:0] victim__read_data;
-    reg  [8:0] victim__write_address;
-    reg  victim__write_clock;
-    reg  [1:0] victim__write_data;
-    reg  victim__write_enable;
+    reg  fill_counts__clock;
+    reg  [8:0] fill_counts__read_set;
+    reg  [1:0] fill_counts__way_mask;
+    wire  [1:0] fill_counts__way;
+    reg  fill_counts__fill;
+    reg  [8:0] fill_counts__fill_set;
+    reg  [1:0] fill_counts__fill_way;
     reg  [23:0] entry_instance__d;
     wire  [23:0] entry_instance__q;
     reg  entry_instance__clock;
@@ -11454,14 +11454,14 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         .write_data(cache_root__write_data),
         .write_enable(cache_root__write_enable)
     );
-    dynrt_processor__engine__instances__victim victim(
-        .read_address(victim__read_address),
-        .read_clock(victim__read_clock),
-        .read_data(victim__read_data),
-        .write_address(victim__write_address),
-        .write_clock(victim__write_clock),
-        .write_data(victim__write_data),
-        .write_enable(victim__write_enable)
+    dynrt_processor__engine__instances__fill_counts fill_counts(
+        .clock(fill_counts__clock),
+        .read_set(fill_counts__read_set),
+        .way_mask(fill_counts__way_mask),
+        .way(fill_counts__way),
+        .fill(fill_counts__fill),
+        .fill_set(fill_counts__fill_set),
+        .fill_way(fill_counts__fill_way)
     );
     dynrt_processor__display__rgb_q entry_instance(
         .d(entry_instance__d),
@@ -11730,9 +11730,9 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         cache_tag__3__read_clock = clock;
         cache_tag__3__write_clock = clock;
         cache_tag__3__read_address = slot_set;
-        victim__read_clock = clock;
-        victim__write_clock = clock;
-        victim__read_address = slot_set;
+        fill_counts__clock = clock;
+        fill_counts__read_set = slot_set;
+        fill_counts__way_mask = c_way_mask;
         hit_line = (entry_set__q << c_way_shift) | ((hit_way_r__q) & 9'h1ff);
         fill_line = (entry_set__q << c_way_shift) | ((victim_r__q) & 9'h1ff);
         cache_root__read_clock = clock;
@@ -11779,7 +11779,7 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
             tag_r__1__d = cache_tag__1__read_data;
             tag_r__2__d = cache_tag__2__read_data;
             tag_r__3__d = cache_tag__3__read_data;
-            victim_r__d = victim__read_data & c_way_mask;
+            victim_r__d = fill_counts__way;
             phase__d = EntryPhase__Compare;
         end
         if (phase__q == EntryPhase__Compare) begin
@@ -11905,9 +11905,9 @@ module dynrt_processor__engine__instances(clock,frame_start,world_write,world_pa
         cache_tag__3__write_address = entry_set__q;
         cache_tag__3__write_data = entry_tag;
         cache_tag__3__write_enable = c_way_used__3 & fill & (victim_r__q == c_way__3);
-        victim__write_address = entry_set__q;
-        victim__write_data = (victim_r__q + 32'h1) & c_way_mask;
-        victim__write_enable = fill;
+        fill_counts__fill_set = entry_set__q;
+        fill_counts__fill_way = victim_r__q;
+        fill_counts__fill = fill;
         cache_root__write_address = fill_line;
         cache_root__write_data = rdata[(32'h0)+:(26)];
         cache_root__write_enable = fill;
@@ -12751,128 +12751,52 @@ endmodule // dynrt_processor__engine__instances__cache_words__0
 
 
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor__engine__instances__phase(d,q,clock);
+module dynrt_processor__engine__instances__fill_counts(clock,read_set,way_mask,way,fill,fill_set,fill_way);
     
     // Module arguments
-    input wire  [3:0] d;
-    output reg  [3:0] q;
     input wire  clock;
+    input wire  [8:0] read_set;
+    input wire  [1:0] way_mask;
+    output reg  [1:0] way;
+    input wire  fill;
+    input wire  [8:0] fill_set;
+    input wire  [1:0] fill_way;
     
-    // Enums
-    localparam EntryPhase__Idle = 0;
-    localparam EntryPhase__Look = 1;
-    localparam EntryPhase__Compare = 2;
-    localparam EntryPhase__Decide = 3;
-    localparam EntryPhase__Words = 4;
-    localparam EntryPhase__Fetch = 5;
-    localparam EntryPhase__Origin = 6;
-    localparam EntryPhase__Direction = 7;
-    localparam EntryPhase__Normal = 8;
+    // Stub signals
+    reg  [8:0] counts__read_address;
+    reg  counts__read_clock;
+    wire  [1:0] counts__read_data;
+    reg  [8:0] counts__write_address;
+    reg  counts__write_clock;
+    reg  [1:0] counts__write_data;
+    reg  counts__write_enable;
     
-    // Update code (custom)
-    initial begin
-       q = 64'h0;
+    // Sub module instances
+    dynrt_processor__engine__instances__fill_counts__counts counts(
+        .read_address(counts__read_address),
+        .read_clock(counts__read_clock),
+        .read_data(counts__read_data),
+        .write_address(counts__write_address),
+        .write_clock(counts__write_clock),
+        .write_data(counts__write_data),
+        .write_enable(counts__write_enable)
+    );
+    
+    // Update code
+    always @(*) begin
+        counts__read_clock = clock;
+        counts__write_clock = clock;
+        counts__read_address = read_set;
+        way = counts__read_data & way_mask;
+        counts__write_address = fill_set;
+        counts__write_data = (fill_way + 32'h1) & way_mask;
+        counts__write_enable = fill;
     end
     
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor__engine__instances__phase
+endmodule // dynrt_processor__engine__instances__fill_counts
 
 
-module dynrt_processor__engine__instances__root_r(d,q,clock);
-    
-    // Module arguments
-    input wire  [25:0] d;
-    output reg  [25:0] q;
-    input wire  clock;
-    
-    // Update code (custom)
-    initial begin
-       q = 26'h0;
-    end
-    
-    always @(posedge clock) begin
-       q <= d;
-    end
-          
-endmodule // dynrt_processor__engine__instances__root_r
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-module dynrt_processor__engine__instances__victim(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
+module dynrt_processor__engine__instances__fill_counts__counts(read_address,read_clock,read_data,write_address,write_clock,write_data,write_enable);
     
     // Module arguments
     input wire  [8:0] read_address;
@@ -13412,7 +13336,128 @@ module dynrt_processor__engine__instances__victim(read_address,read_clock,read_d
        end
     end
                 
-endmodule // dynrt_processor__engine__instances__victim
+endmodule // dynrt_processor__engine__instances__fill_counts__counts
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+module dynrt_processor__engine__instances__phase(d,q,clock);
+    
+    // Module arguments
+    input wire  [3:0] d;
+    output reg  [3:0] q;
+    input wire  clock;
+    
+    // Enums
+    localparam EntryPhase__Idle = 0;
+    localparam EntryPhase__Look = 1;
+    localparam EntryPhase__Compare = 2;
+    localparam EntryPhase__Decide = 3;
+    localparam EntryPhase__Words = 4;
+    localparam EntryPhase__Fetch = 5;
+    localparam EntryPhase__Origin = 6;
+    localparam EntryPhase__Direction = 7;
+    localparam EntryPhase__Normal = 8;
+    
+    // Update code (custom)
+    initial begin
+       q = 64'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__instances__phase
+
+
+module dynrt_processor__engine__instances__root_r(d,q,clock);
+    
+    // Module arguments
+    input wire  [25:0] d;
+    output reg  [25:0] q;
+    input wire  clock;
+    
+    // Update code (custom)
+    initial begin
+       q = 26'h0;
+    end
+    
+    always @(posedge clock) begin
+       q <= d;
+    end
+          
+endmodule // dynrt_processor__engine__instances__root_r
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 
@@ -26794,13 +26839,13 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
     reg  [1:0] cached_way__3__d;
     wire  [1:0] cached_way__3__q;
     reg  cached_way__3__clock;
-    reg  [8:0] fill_way__read_address;
-    reg  fill_way__read_clock;
-    wire  [1:0] fill_way__read_data;
-    reg  [8:0] fill_way__write_address;
-    reg  fill_way__write_clock;
-    reg  [1:0] fill_way__write_data;
-    reg  fill_way__write_enable;
+    reg  fill_counts__clock;
+    reg  [8:0] fill_counts__read_set;
+    reg  [1:0] fill_counts__way_mask;
+    wire  [1:0] fill_counts__way;
+    reg  fill_counts__fill;
+    reg  [8:0] fill_counts__fill_set;
+    reg  [1:0] fill_counts__fill_way;
     reg  cached__0__d;
     wire  cached__0__q;
     reg  cached__0__clock;
@@ -27852,14 +27897,14 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         .q(cached_way__3__q),
         .clock(cached_way__3__clock)
     );
-    dynrt_processor__engine__instances__victim fill_way(
-        .read_address(fill_way__read_address),
-        .read_clock(fill_way__read_clock),
-        .read_data(fill_way__read_data),
-        .write_address(fill_way__write_address),
-        .write_clock(fill_way__write_clock),
-        .write_data(fill_way__write_data),
-        .write_enable(fill_way__write_enable)
+    dynrt_processor__engine__instances__fill_counts fill_counts(
+        .clock(fill_counts__clock),
+        .read_set(fill_counts__read_set),
+        .way_mask(fill_counts__way_mask),
+        .way(fill_counts__way),
+        .fill(fill_counts__fill),
+        .fill_set(fill_counts__fill_set),
+        .fill_way(fill_counts__fill_way)
     );
     dynrt_processor__display__dark_d cached__0(
         .d(cached__0__d),
@@ -28627,8 +28672,7 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cache_tag__3__write_clock = clock;
         cache_tag__3__read_clock = clock;
         tag_word_r__3__clock = clock;
-        fill_way__read_clock = clock;
-        fill_way__write_clock = clock;
+        fill_counts__clock = clock;
         cache_words__0__read_clock = clock;
         cache_words__0__write_clock = clock;
         cache_words__1__read_clock = clock;
@@ -28903,23 +28947,24 @@ module dynrt_processor__engine__tester(clock,engine__thread,engine__word_a,engin
         cache_write_r__d = cache_write;
         cache_tag__0__write_address = l_set;
         cache_tag__0__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
-        cache_tag__0__write_enable = c_tri_way_used__0 & cache_write_r__q & (fill_way__read_data == c_tri_way__0);
+        cache_tag__0__write_enable = c_tri_way_used__0 & cache_write_r__q & (fill_counts__way == c_tri_way__0);
         cache_tag__1__write_address = l_set;
         cache_tag__1__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
-        cache_tag__1__write_enable = c_tri_way_used__1 & cache_write_r__q & (fill_way__read_data == c_tri_way__1);
+        cache_tag__1__write_enable = c_tri_way_used__1 & cache_write_r__q & (fill_counts__way == c_tri_way__1);
         cache_tag__2__write_address = l_set;
         cache_tag__2__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
-        cache_tag__2__write_enable = c_tri_way_used__2 & cache_write_r__q & (fill_way__read_data == c_tri_way__2);
+        cache_tag__2__write_enable = c_tri_way_used__2 & cache_write_r__q & (fill_counts__way == c_tri_way__2);
         cache_tag__3__write_address = l_set;
         cache_tag__3__write_data = c_tag_valid | ((l_a[(32'h0)+:(24)]) & 25'h1ffffff);
-        cache_tag__3__write_enable = c_tri_way_used__3 & cache_write_r__q & (fill_way__read_data == c_tri_way__3);
-        fill_way__read_address = l_set;
-        fill_way__write_address = l_set;
-        fill_way__write_data = (fill_way__read_data + 32'h1) & c_tri_way_mask;
-        fill_way__write_enable = cache_write_r__q;
+        cache_tag__3__write_enable = c_tri_way_used__3 & cache_write_r__q & (fill_counts__way == c_tri_way__3);
+        fill_counts__read_set = l_set;
+        fill_counts__way_mask = c_tri_way_mask;
+        fill_counts__fill_set = l_set;
+        fill_counts__fill_way = fill_counts__way;
+        fill_counts__fill = cache_write_r__q;
         l_line = (l_set << c_tri_way_shift) | ((l_way) & 9'h1ff);
         n_line = (n_set << c_tri_way_shift) | ((n_way) & 9'h1ff);
-        fill_line = (l_set << c_tri_way_shift) | ((fill_way__read_data) & 9'h1ff);
+        fill_line = (l_set << c_tri_way_shift) | ((fill_counts__way) & 9'h1ff);
         cache_ready__d = l_loaded & (~l_pending);
         if (lphase__q != Launch__Wait) begin
             cache_ready__d = n_loaded & (~n_pending);
@@ -30418,6 +30463,8 @@ module dynrt_processor__engine__tester__done_e(read_address,read_clock,read_data
     end
                 
 endmodule // dynrt_processor__engine__tester__done_e
+
+
 
 
 
@@ -39214,13 +39261,13 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
     reg  cache_words__3__write_clock;
     reg  [63:0] cache_words__3__write_data;
     reg  cache_words__3__write_enable;
-    reg  [8:0] fill_way__read_address;
-    reg  fill_way__read_clock;
-    wire  [1:0] fill_way__read_data;
-    reg  [8:0] fill_way__write_address;
-    reg  fill_way__write_clock;
-    reg  [1:0] fill_way__write_data;
-    reg  fill_way__write_enable;
+    reg  fill_counts__clock;
+    reg  [8:0] fill_counts__read_set;
+    reg  [1:0] fill_counts__way_mask;
+    wire  [1:0] fill_counts__way;
+    reg  fill_counts__fill;
+    reg  [8:0] fill_counts__fill_set;
+    reg  [1:0] fill_counts__fill_way;
     reg  fetch_hit__d;
     wire  fetch_hit__q;
     reg  fetch_hit__clock;
@@ -40105,14 +40152,14 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         .write_data(cache_words__3__write_data),
         .write_enable(cache_words__3__write_enable)
     );
-    dynrt_processor__engine__instances__victim fill_way(
-        .read_address(fill_way__read_address),
-        .read_clock(fill_way__read_clock),
-        .read_data(fill_way__read_data),
-        .write_address(fill_way__write_address),
-        .write_clock(fill_way__write_clock),
-        .write_data(fill_way__write_data),
-        .write_enable(fill_way__write_enable)
+    dynrt_processor__engine__instances__fill_counts fill_counts(
+        .clock(fill_counts__clock),
+        .read_set(fill_counts__read_set),
+        .way_mask(fill_counts__way_mask),
+        .way(fill_counts__way),
+        .fill(fill_counts__fill),
+        .fill_set(fill_counts__fill_set),
+        .fill_way(fill_counts__fill_way)
     );
     dynrt_processor__display__dark_d fetch_hit(
         .d(fetch_hit__d),
@@ -40506,8 +40553,7 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         cache_words__3__write_clock = clock;
         tag_word_r__3__clock = clock;
         words_r__3__clock = clock;
-        fill_way__read_clock = clock;
-        fill_way__write_clock = clock;
+        fill_counts__clock = clock;
         node_line__0__clock = clock;
         data_line__0__clock = clock;
         node_line__1__clock = clock;
@@ -40951,34 +40997,35 @@ module dynrt_processor__engine__traversal_unit(clock,engine__thread,engine__word
         done_thread_r__d = job__q[(32'h60)+:(5)];
         fill = c_node_cache_on & at_a & a_fetched__q & (~job__q[32'h66]);
         fill_set = job__q[(32'h40)+:(9)] & c_node_set_mask;
-        fill_way__read_address = next_a_job[(32'h40)+:(9)] & c_node_set_mask;
+        fill_counts__read_set = next_a_job[(32'h40)+:(9)] & c_node_set_mask;
+        fill_counts__way_mask = c_node_way_mask;
         cache_tag__0__write_address = fill_set;
         cache_tag__0__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
-        cache_tag__0__write_enable = c_node_way_used__0 & fill & (fill_way__read_data == c_node_way__0);
+        cache_tag__0__write_enable = c_node_way_used__0 & fill & (fill_counts__way == c_node_way__0);
         cache_words__0__write_address = fill_set;
         cache_words__0__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
         cache_words__0__write_enable = cache_tag__0__write_enable;
         cache_tag__1__write_address = fill_set;
         cache_tag__1__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
-        cache_tag__1__write_enable = c_node_way_used__1 & fill & (fill_way__read_data == c_node_way__1);
+        cache_tag__1__write_enable = c_node_way_used__1 & fill & (fill_counts__way == c_node_way__1);
         cache_words__1__write_address = fill_set;
         cache_words__1__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
         cache_words__1__write_enable = cache_tag__1__write_enable;
         cache_tag__2__write_address = fill_set;
         cache_tag__2__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
-        cache_tag__2__write_enable = c_node_way_used__2 & fill & (fill_way__read_data == c_node_way__2);
+        cache_tag__2__write_enable = c_node_way_used__2 & fill & (fill_counts__way == c_node_way__2);
         cache_words__2__write_address = fill_set;
         cache_words__2__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
         cache_words__2__write_enable = cache_tag__2__write_enable;
         cache_tag__3__write_address = fill_set;
         cache_tag__3__write_data = c_node_tag_valid | ((job__q[(32'h40)+:(26)]) & 27'h7ffffff);
-        cache_tag__3__write_enable = c_node_way_used__3 & fill & (fill_way__read_data == c_node_way__3);
+        cache_tag__3__write_enable = c_node_way_used__3 & fill & (fill_counts__way == c_node_way__3);
         cache_words__3__write_address = fill_set;
         cache_words__3__write_data = (((w1__q) & 64'hffffffffffffffff) << 32'h20) | ((w0__q) & 64'hffffffffffffffff);
         cache_words__3__write_enable = cache_tag__3__write_enable;
-        fill_way__write_address = fill_set;
-        fill_way__write_data = (fill_way__read_data + 32'h1) & c_node_way_mask;
-        fill_way__write_enable = fill;
+        fill_counts__fill_set = fill_set;
+        fill_counts__fill_way = fill_counts__way;
+        fill_counts__fill = fill;
         look_stale__d = fill & (fill_set == read_set);
         engine__done = done_r__q;
         engine__done_thread = done_thread_r__q;
@@ -42684,6 +42731,8 @@ module dynrt_processor__engine__traversal_unit__fetch_job(d,q,clock);
     end
           
 endmodule // dynrt_processor__engine__traversal_unit__fetch_job
+
+
 
 
 

@@ -8,8 +8,7 @@
 //! are in one RAM deep enough for all of them (line `set << way_shift | way`, so its block
 //! RAMs are those of the direct-mapped cache of as many items); the node cache
 //! ([`super::TraversalUnit`]) reads a set's words with its tags, so each way's words have a
-//! RAM of their own. The instance cache fills a set's ways in turn (a way number per set); the
-//! others take the ways in turn over the whole cache (no RAM read before a write).
+//! RAM of their own. Each cache fills a set's ways in turn, counted by a [`FillCounts`].
 //!
 //! Golden twin: none; a cache changes when a word arrives, never which word.
 
@@ -46,9 +45,80 @@ pub fn empty_cache_tags<const B: usize>() -> RAM<Bits<B>, 9> {
     )
 }
 
+/// Per set, the way its next fill writes: round robin over the set's ways.
+///
+/// Contract: `way` is the count of the set `read_set` named a clock before, masked to the
+/// ways there are (`way_mask`, ways - 1), so with one way it is the constant 0 and synthesis
+/// removes the counts' block RAM (read unmasked, it was kept: stop 52's placement). A clock
+/// with `fill` high steps `fill_set`'s count past `fill_way`, the way that fill wrote (the
+/// cache's own copy of `way`, read a clock or more before). Latency one clock, a fill every
+/// clock.
+///
+/// Golden twin: none (which way a line takes changes a hit, never a word); the caches' tests
+/// check the turns with [`tests::assert_fills_in_turn`].
+#[derive(LogicBlock)]
+pub struct FillCounts {
+    pub clock: Signal<In, Clock>,
+    pub read_set: Signal<In, Bits<9>>,
+    pub way_mask: Signal<In, Bits<2>>,
+    pub way: Signal<Out, Bits<2>>,
+    pub fill: Signal<In, Bit>,
+    pub fill_set: Signal<In, Bits<9>>,
+    pub fill_way: Signal<In, Bits<2>>,
+    counts: RAM<Bits<2>, 9>,
+}
+
+impl Default for FillCounts {
+    fn default() -> Self {
+        Self {
+            clock: Default::default(),
+            read_set: Default::default(),
+            way_mask: Default::default(),
+            way: Default::default(),
+            fill: Default::default(),
+            fill_set: Default::default(),
+            fill_way: Default::default(),
+            counts: empty_cache_tags(),
+        }
+    }
+}
+
+impl Logic for FillCounts {
+    #[hdl_gen]
+    fn update(&mut self) {
+        self.counts.read_clock.next = self.clock.val();
+        self.counts.write_clock.next = self.clock.val();
+        self.counts.read_address.next = self.read_set.val();
+        self.way.next = self.counts.read_data.val() & self.way_mask.val();
+        self.counts.write_address.next = self.fill_set.val();
+        self.counts.write_data.next = (self.fill_way.val() + 1) & self.way_mask.val();
+        self.counts.write_enable.next = self.fill.val();
+    }
+}
+
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// Asserts that each set's fills, `(set, way)` in the order they happened, took the
+    /// set's ways in turn from way 0, and that each set listed in `sets` filled more lines
+    /// than it has ways (so that the turn wrapped). One count for the whole cache fails this
+    /// as soon as two sets fill.
+    pub(crate) fn assert_fills_in_turn(fills: &[(u32, u32)], sets: &[u32], ways: u32) {
+        for &set in sets {
+            let taken: Vec<u32> = fills
+                .iter()
+                .filter(|fill| fill.0 == set)
+                .map(|fill| fill.1)
+                .collect();
+            let in_turn: Vec<u32> = (0..taken.len() as u32).map(|k| k % ways).collect();
+            assert!(
+                taken.len() > ways as usize,
+                "{ways} ways, set {set}: {taken:?}"
+            );
+            assert_eq!(taken, in_turn, "{ways} ways, set {set}");
+        }
+    }
 
     /// The shapes the CLI accepts: every power-of-two set count with 1, 2 or 4 ways up to 512
     /// items, and none of 3 ways, 1,024 items, or a set count that is not a power of two.

@@ -69,7 +69,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::cache::{cache_shape_supported, empty_cache_tags};
+use super::cache::{cache_shape_supported, empty_cache_tags, FillCounts};
 use super::fp::add_sub::ADD_SUB_LATENCY;
 use super::fp::compare::COMPARE_LATENCY;
 use super::fp::div::div_latency;
@@ -334,7 +334,7 @@ pub struct TraversalUnit<
     /// The way `look_job`'s node is in (when `look_hit`).
     look_way_hit: [Signal<Local, Bit>; 4],
     /// Per set, the way its next fill writes (round robin).
-    fill_way: RAM<Bits<2>, 9>,
+    fill_counts: FillCounts,
     /// `fetch_job`'s node is in the cache, with its words: the fetch takes it in a clock.
     fetch_hit: DFF<Bit>,
     fetch_words: DFF<Bits<64>>,
@@ -593,7 +593,7 @@ impl<
             cache_tag: std::array::from_fn(|_| empty_cache_tags()),
             cache_words: Default::default(),
             look_way_hit: Default::default(),
-            fill_way: empty_cache_tags(),
+            fill_counts: Default::default(),
             fetch_hit: Default::default(),
             fetch_words: Default::default(),
             hit_now: Default::default(),
@@ -800,8 +800,7 @@ impl<
             self.tag_word_r[w].clock.next = self.clock.val();
             self.words_r[w].clock.next = self.clock.val();
         }
-        self.fill_way.read_clock.next = self.clock.val();
-        self.fill_way.write_clock.next = self.clock.val();
+        self.fill_counts.clock.next = self.clock.val();
         for k in 0..6 {
             self.node_line[k].clock.next = self.clock.val();
             self.data_line[k].clock.next = self.clock.val();
@@ -1279,24 +1278,24 @@ impl<
             & self.a_fetched.q.val()
             & (!self.job.q.val().get_bit(102));
         self.fill_set.next = self.job.q.val().get_bits::<9>(64) & self.c_node_set_mask.val();
-        self.fill_way.read_address.next =
+        self.fill_counts.read_set.next =
             self.next_a_job.val().get_bits::<9>(64) & self.c_node_set_mask.val();
+        self.fill_counts.way_mask.next = self.c_node_way_mask.val();
         for w in 0..4 {
             self.cache_tag[w].write_address.next = self.fill_set.val();
             self.cache_tag[w].write_data.next = self.c_node_tag_valid.val()
                 | bit_cast::<27, 26>(self.job.q.val().get_bits::<26>(64));
             self.cache_tag[w].write_enable.next = self.c_node_way_used[w].val()
                 & self.fill.val()
-                & (self.fill_way.read_data.val() == self.c_node_way[w].val());
+                & (self.fill_counts.way.val() == self.c_node_way[w].val());
             self.cache_words[w].write_address.next = self.fill_set.val();
             self.cache_words[w].write_data.next =
                 (bit_cast::<64, 32>(self.w1.q.val()) << 32) | bit_cast::<64, 32>(self.w0.q.val());
             self.cache_words[w].write_enable.next = self.cache_tag[w].write_enable.val();
         }
-        self.fill_way.write_address.next = self.fill_set.val();
-        self.fill_way.write_data.next =
-            (self.fill_way.read_data.val() + 1) & self.c_node_way_mask.val();
-        self.fill_way.write_enable.next = self.fill.val();
+        self.fill_counts.fill_set.next = self.fill_set.val();
+        self.fill_counts.fill_way.next = self.fill_counts.way.val();
+        self.fill_counts.fill.next = self.fill.val();
         self.look_stale.d.next = self.fill.val() & (self.fill_set.val() == self.read_set.val());
         self.engine.done.next = self.done_r.q.val();
         self.engine.done_thread.next = self.done_thread_r.q.val();
@@ -1407,7 +1406,7 @@ impl<
 mod tests {
     use super::*;
     use crate::fp::Format;
-    use crate::hw::cache::MAX_CACHE_SETS;
+    use crate::hw::cache::{tests::assert_fills_in_turn, MAX_CACHE_SETS};
     use crate::hw::sim_harness::{clock_cycle, settle};
     use crate::layout::{self, FrameMap, MemoryConfig, SceneTrees, FRAME, NODES};
     use crate::scene::Scene;
@@ -1637,8 +1636,7 @@ mod tests {
             b.misses += usize::from(u.cache_miss.val());
             if u.fill.val() {
                 let set = u.fill_set.val().to_u64() as u32;
-                b.fills
-                    .push((set, u.fill_way.read_data.val().to_u64() as u32));
+                b.fills.push((set, u.fill_counts.way.val().to_u64() as u32));
             }
             let full = u.engine.full.val();
             if full && u.engine.enqueue.val() {
@@ -1721,19 +1719,7 @@ mod tests {
         // cache gave a set's first fill whatever way the other set's fills had left).
         let (_, _, fills_2x2) = walk_like_the_model((2, 2));
         for (ways, fills) in [(2, fills_2x2), (4, fills_2x4)] {
-            for set in 0..2 {
-                let taken: Vec<u32> = fills
-                    .iter()
-                    .filter(|fill| fill.0 == set)
-                    .map(|fill| fill.1)
-                    .collect();
-                let in_turn: Vec<u32> = (0..taken.len() as u32).map(|k| k % ways).collect();
-                assert!(
-                    taken.len() > ways as usize,
-                    "{ways} ways, set {set}: {taken:?}"
-                );
-                assert_eq!(taken, in_turn, "{ways} ways, set {set}");
-            }
+            assert_fills_in_turn(&fills, &[0, 1], ways);
         }
     }
 

@@ -79,7 +79,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::cache::{cache_shape_supported, empty_cache_tags, way_shift};
+use super::cache::{cache_shape_supported, empty_cache_tags, way_shift, FillCounts};
 use super::fp::{const_bits, FpCompare};
 use super::list_unit::{
     CMD_INIT, CMD_LIST, LIST_OF_WALK, TEST_INIT, TEST_LIST_END, TEST_TRIANGLE, TEST_WALK_END,
@@ -288,7 +288,7 @@ pub struct TriangleTester<
     /// Per set, the way its next write fills (round robin), read at the launch's set in every
     /// clock: in the direction's clock, which writes, it has the origin's set, the launch's
     /// (launches are two clocks apart, so it has the last write's count).
-    fill_way: RAM<Bits<2>, 9>,
+    fill_counts: FillCounts,
     /// The buffer's triangle is in the cache (decided three clocks after the take, when
     /// `deciding`; its set is not written until it launches).
     cached: [DFF<Bit>; TEST_BUFFERS],
@@ -596,7 +596,7 @@ impl<
             cache_tag: std::array::from_fn(|_| empty_cache_tags()),
             cache_words: Default::default(),
             cached_way: Default::default(),
-            fill_way: empty_cache_tags(),
+            fill_counts: Default::default(),
             head_way: Default::default(),
             head_way_r: Default::default(),
             l_way: Default::default(),
@@ -857,8 +857,7 @@ impl<
             self.cache_tag[w].read_clock.next = self.clock.val();
             self.tag_word_r[w].clock.next = self.clock.val();
         }
-        self.fill_way.read_clock.next = self.clock.val();
-        self.fill_way.write_clock.next = self.clock.val();
+        self.fill_counts.clock.next = self.clock.val();
         for k in 0..12 {
             self.cache_words[k].read_clock.next = self.clock.val();
             self.cache_words[k].write_clock.next = self.clock.val();
@@ -1038,19 +1037,19 @@ impl<
                 self.c_tag_valid.val() | bit_cast::<25, 24>(self.l_a.val().get_bits::<24>(0));
             self.cache_tag[w].write_enable.next = self.c_tri_way_used[w].val()
                 & self.cache_write_r.q.val()
-                & (self.fill_way.read_data.val() == self.c_tri_way[w].val());
+                & (self.fill_counts.way.val() == self.c_tri_way[w].val());
         }
-        self.fill_way.read_address.next = self.l_set.val();
-        self.fill_way.write_address.next = self.l_set.val();
-        self.fill_way.write_data.next =
-            (self.fill_way.read_data.val() + 1) & self.c_tri_way_mask.val();
-        self.fill_way.write_enable.next = self.cache_write_r.q.val();
+        self.fill_counts.read_set.next = self.l_set.val();
+        self.fill_counts.way_mask.next = self.c_tri_way_mask.val();
+        self.fill_counts.fill_set.next = self.l_set.val();
+        self.fill_counts.fill_way.next = self.fill_counts.way.val();
+        self.fill_counts.fill.next = self.cache_write_r.q.val();
         self.l_line.next =
             (self.l_set.val() << self.c_tri_way_shift.val()) | bit_cast::<9, 2>(self.l_way.val());
         self.n_line.next =
             (self.n_set.val() << self.c_tri_way_shift.val()) | bit_cast::<9, 2>(self.n_way.val());
         self.fill_line.next = (self.l_set.val() << self.c_tri_way_shift.val())
-            | bit_cast::<9, 2>(self.fill_way.read_data.val());
+            | bit_cast::<9, 2>(self.fill_counts.way.val());
         // The words answer a clock after their set: the launch's while it waits, the next
         // buffer's from the origin's clock on (`matrix` takes them in the direction's).
         self.cache_ready.d.next = self.l_loaded.val() & (!self.l_pending.val());
@@ -1543,7 +1542,7 @@ impl<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hw::cache::MAX_CACHE_SETS;
+    use crate::hw::cache::{tests::assert_fills_in_turn, MAX_CACHE_SETS};
     use crate::hw::fp::div::div_latency;
     use crate::hw::sim_harness::{clock_cycle, settle};
     use crate::units;
@@ -1760,7 +1759,7 @@ mod tests {
             if u.cache_write_r.q.val() {
                 drive.fills.push((
                     u.l_set.val().to_u64() as u32,
-                    u.fill_way.read_data.val().to_u64() as u32,
+                    u.fill_counts.way.val().to_u64() as u32,
                 ));
             }
             drive.cache_hits += u64::from(u.cache_hit.val());
@@ -2009,17 +2008,9 @@ mod tests {
                 &want,
             );
             assert_eq!(drive.cache_misses, 9, "every triangle is new");
-            for set in 0..2 {
-                let taken: Vec<u32> = drive
-                    .fills
-                    .iter()
-                    .filter(|fill| fill.0 == set)
-                    .map(|fill| fill.1)
-                    .collect();
-                let in_turn: Vec<u32> = (0..taken.len() as u32).map(|k| k % ways).collect();
-                assert_eq!(taken, in_turn, "{ways} ways, set {set}");
-                assert_eq!(taken.len(), [2, 7][set as usize], "{ways} ways, set {set}");
-            }
+            let per_set = |set| drive.fills.iter().filter(|fill| fill.0 == set).count();
+            assert_eq!((per_set(0), per_set(1)), (2, 7), "{ways} ways");
+            assert_fills_in_turn(&drive.fills, &[1], ways);
         }
     }
 

@@ -71,7 +71,7 @@
 
 use rust_hdl::prelude::*;
 
-use crate::hw::cache::{cache_shape_supported, empty_cache_tags, way_shift};
+use crate::hw::cache::{cache_shape_supported, empty_cache_tags, way_shift, FillCounts};
 use crate::layout::instance_word;
 
 /// Words of a world-to-object matrix (3x4), read per entry, then the root's.
@@ -216,7 +216,7 @@ pub struct InstanceRays<const W: usize> {
     cache_tag: [RAM<Bits<26>, 9>; 4],
     cache_words: [RAM<Bits<W>, 9>; 12],
     cache_root: RAM<Bits<26>, 9>,
-    victim: RAM<Bits<2>, 9>,
+    fill_counts: FillCounts,
     /// The line a hit reads (the entry's set, the way that hit) and the line a miss fills.
     hit_line: Signal<Local, Bits<9>>,
     fill_line: Signal<Local, Bits<9>>,
@@ -355,7 +355,7 @@ impl<const W: usize> InstanceRays<W> {
             cache_tag: std::array::from_fn(|_| empty_cache_tags()),
             cache_words: Default::default(),
             cache_root: Default::default(),
-            victim: empty_cache_tags(),
+            fill_counts: Default::default(),
             hit_line: Default::default(),
             fill_line: Default::default(),
             slot_set: Default::default(),
@@ -503,9 +503,9 @@ impl<const W: usize> Logic for InstanceRays<W> {
             self.cache_tag[w].write_clock.next = self.clock.val();
             self.cache_tag[w].read_address.next = self.slot_set.val();
         }
-        self.victim.read_clock.next = self.clock.val();
-        self.victim.write_clock.next = self.clock.val();
-        self.victim.read_address.next = self.slot_set.val();
+        self.fill_counts.clock.next = self.clock.val();
+        self.fill_counts.read_set.next = self.slot_set.val();
+        self.fill_counts.way_mask.next = self.c_way_mask.val();
         self.hit_line.next = (self.entry_set.q.val() << self.c_way_shift.val())
             | bit_cast::<9, 2>(self.hit_way_r.q.val());
         self.fill_line.next = (self.entry_set.q.val() << self.c_way_shift.val())
@@ -522,7 +522,7 @@ impl<const W: usize> Logic for InstanceRays<W> {
             for w in 0..4 {
                 self.tag_r[w].d.next = self.cache_tag[w].read_data.val();
             }
-            self.victim_r.d.next = self.victim.read_data.val() & self.c_way_mask.val();
+            self.victim_r.d.next = self.fill_counts.way.val();
             self.phase.d.next = EntryPhase::Compare;
         }
         if self.phase.q.val() == EntryPhase::Compare {
@@ -630,9 +630,9 @@ impl<const W: usize> Logic for InstanceRays<W> {
                 & self.fill.val()
                 & (self.victim_r.q.val() == self.c_way[w].val());
         }
-        self.victim.write_address.next = self.entry_set.q.val();
-        self.victim.write_data.next = (self.victim_r.q.val() + 1) & self.c_way_mask.val();
-        self.victim.write_enable.next = self.fill.val();
+        self.fill_counts.fill_set.next = self.entry_set.q.val();
+        self.fill_counts.fill_way.next = self.victim_r.q.val();
+        self.fill_counts.fill.next = self.fill.val();
         self.cache_root.write_address.next = self.fill_line.val();
         self.cache_root.write_data.next = self.rdata.val().get_bits::<26>(0);
         self.cache_root.write_enable.next = self.fill.val();
