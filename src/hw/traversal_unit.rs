@@ -1718,9 +1718,8 @@ mod tests {
         // Each set's fills take its ways in turn, from way 0 (one count of fills for the whole
         // cache gave a set's first fill whatever way the other set's fills had left).
         let (_, _, fills_2x2) = walk_like_the_model((2, 2));
-        for (ways, fills) in [(2, fills_2x2), (4, fills_2x4)] {
-            assert_fills_in_turn(&fills, &[0, 1], ways);
-        }
+        assert_fills_in_turn(&fills_2x2, 2, &[0, 1]);
+        assert_fills_in_turn(&fills_2x4, 4, &[0, 1]);
     }
 
     /// rust-hdl simulation of top-level walks on the dynamic scene's trees (1,202 instances):

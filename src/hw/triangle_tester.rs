@@ -2010,7 +2010,7 @@ mod tests {
             assert_eq!(drive.cache_misses, 9, "every triangle is new");
             let per_set = |set| drive.fills.iter().filter(|fill| fill.0 == set).count();
             assert_eq!((per_set(0), per_set(1)), (2, 7), "{ways} ways");
-            assert_fills_in_turn(&drive.fills, &[1], ways);
+            assert_fills_in_turn(&drive.fills, ways, &[1]);
         }
     }
 

@@ -361,16 +361,15 @@ impl Gen<'_> {
                 // the hit as the pair to skip.
                 a.section("shadow");
                 debug_assert!(p == s.q_o && to_light == s.q_d);
+                let one = a.kept_constant(f.one()).expect("kept at the start");
                 match shadow {
                     Some(shadow) => a.call(s.link, shadow),
                     None => {
-                        let one = a.kept_constant(f.one()).expect("kept at the start");
                         self.trace_routine(false, Query::Any { t_min, one }, Ray::Query);
                     }
                 }
                 a.section("light");
                 if self.hit_by_t() {
-                    let one = a.kept_constant(f.one()).expect("kept at the start");
                     a.branch(Op::BFlt, s.best_t.into(), one.into(), false, skip_light);
                 } else {
                     a.branch(Op::Beq, s.hit.into(), Val::K(0), true, skip_light);

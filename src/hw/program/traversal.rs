@@ -120,12 +120,8 @@ impl Gen<'_> {
         let s = &self.s;
         let done = a.label();
         let primary_entry = a.label();
-        self.trace_query(query, ray);
+        let t_max = self.trace_query(query, ray);
         let walk = self.walk_word(query);
-        let t_max = match query {
-            Query::Closest => s.q_t_max,
-            Query::Any { one, .. } => one,
-        };
         match self.c.top_root {
             Some(root) => {
                 a.bind(primary_entry);
@@ -172,8 +168,9 @@ impl Gen<'_> {
     }
 
     /// A trace's query in the tester: its t range and (with secondary rays) the hit it starts
-    /// on, which it skips (a primary ray: from 0, skipping the pair no hit has).
-    pub(super) fn trace_query(&self, query: Query, ray: Ray) {
+    /// on, which it skips (a primary ray: from 0, skipping the pair no hit has). Returns the
+    /// register holding the range's end, where the walk stops too.
+    pub(super) fn trace_query(&self, query: Query, ray: Ray) -> Reg {
         let a = self.asm;
         let s = &self.s;
         a.section("trace");
@@ -192,6 +189,7 @@ impl Gen<'_> {
             };
             a.tri_queue(TriFn::Skip, instance, triangle);
         }
+        t_max
     }
 
     /// The register holding [`NO_HIT`], kept from the program's start in a scene with
